@@ -1,0 +1,56 @@
+"""Payload dataclasses shared by the client, the worker and the GUI."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from app.protocol.datetime_regs import ControllerClock
+from app.protocol.enums import (
+    Alarm,
+    CommandKind,
+    CommandStatus,
+    ControllerMode,
+    ProgramState,
+    RunCommand,
+)
+
+
+@dataclass(frozen=True)
+class Pose:
+    """Live position: XYZABC in the base frame (mm, degrees), external axes, joints."""
+
+    x: float
+    y: float
+    z: float
+    a: float
+    b: float
+    c: float
+    ext: tuple[float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0)
+    joints: tuple[float, ...] | None = None  # J1..J6 (project extension GV250..255)
+
+    @property
+    def xyzabc(self) -> tuple[float, float, float, float, float, float]:
+        return (self.x, self.y, self.z, self.a, self.b, self.c)
+
+
+@dataclass(frozen=True)
+class ControllerStatus:
+    """Table 2 decoded. ``mode``/``program_state`` keep raw ints when the value is unknown."""
+
+    mode: ControllerMode | int
+    program_state: ProgramState | int
+    alarms: Alarm
+    command_status_code: int  # GV291 as decoded from either encoding
+    clock: ControllerClock | None = None
+
+
+@dataclass(frozen=True)
+class CommandResult:
+    """How a command sent by the host ended."""
+
+    command: RunCommand | None
+    kind: CommandKind | None
+    status: CommandStatus | None
+    ok: bool
+    message: str = ""
+    details: dict[str, float] = field(default_factory=dict)

@@ -1,0 +1,1 @@
+"""The Bochuang controller's Modbus contract as code (see shared/PROTOCOL.md)."""

@@ -1,0 +1,24 @@
+"""Named timing constants, in one place. Tests and settings may override them."""
+
+from __future__ import annotations
+
+# Modbus request timeout (s) and retries of the pymodbus client.
+REQUEST_TIMEOUT = 1.0
+REQUEST_RETRIES = 0
+
+# Waiting for a command's GV291 result.
+STATUS_POLL_INTERVAL = 0.002  # s between status reads while waiting for a short command
+MOVE_POLL_INTERVAL = 0.01  # s between status reads while waiting for a motion
+ACK_TIMEOUT = 2.0  # s for the controller to show it has taken a command (leave the stale code)
+CREATE_POINT_TIMEOUT = 3.0  # s for create-point / teach enable to finish
+MOVE_TIMEOUT_MIN = 10.0  # s; a move's timeout is max(this, 3 x its estimated duration)
+
+# Worker (GUI side).
+POLL_HZ_DEFAULT = 50
+CLOCK_POLL_PERIOD = 1.0  # s between date/time reads
+RECONNECT_BACKOFF = (0.2, 0.5, 1.0, 2.0, 5.0)  # s, last one repeats
+LINK_LOSS_POLLS = 3  # consecutive failed polls before the link is declared down
+
+# Simulator.
+SIM_TICK_HZ = 100
+SIM_COMMAND_LATENCY = 0.001  # s from a create/teach command to its final GV291
