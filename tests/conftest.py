@@ -1,0 +1,104 @@
+"""Shared fixtures: the simulator on a free loopback port, and a strict Qt leak check."""
+
+from __future__ import annotations
+
+import os
+import weakref
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+
+@pytest.fixture
+def sim() -> Iterator[Any]:
+    """A running simulated controller on 127.0.0.1:<free port>, stopped after the test."""
+    from app.sim import SimConfig, SimController
+
+    controller = SimController(SimConfig(host="127.0.0.1", port=0))
+    controller.start()
+    try:
+        yield controller
+    finally:
+        controller.stop()
+
+
+@pytest.fixture
+def sim_factory() -> Iterator[Any]:
+    """Build simulators with custom settings; all are stopped after the test."""
+    from app.sim import SimConfig, SimController
+
+    made: list[Any] = []
+
+    def make(**kwargs: Any) -> Any:
+        kwargs.setdefault("host", "127.0.0.1")
+        kwargs.setdefault("port", 0)
+        controller = SimController(SimConfig(**kwargs))
+        controller.start()
+        made.append(controller)
+        return controller
+
+    try:
+        yield make
+    finally:
+        for controller in made:
+            controller.stop()
+
+
+# --- Qt leak check (napari-style): a test must not leave a QThread running or a QTimer active.
+_threads: weakref.WeakSet[Any] = weakref.WeakSet()
+_timers: weakref.WeakSet[Any] = weakref.WeakSet()
+_patched = False
+
+
+def _patch_qt() -> None:
+    global _patched
+    if _patched:
+        return
+    from PySide6.QtCore import QThread, QTimer
+
+    thread_start = QThread.start
+    timer_start = QTimer.start
+
+    def tracked_thread_start(self: Any, *args: Any) -> None:
+        _threads.add(self)
+        thread_start(self, *args)
+
+    def tracked_timer_start(self: Any, *args: Any) -> None:
+        _timers.add(self)
+        timer_start(self, *args)
+
+    QThread.start = tracked_thread_start  # type: ignore[method-assign]
+    QTimer.start = tracked_timer_start  # type: ignore[method-assign]
+    _patched = True
+
+
+@pytest.fixture(autouse=True)
+def _qt_leak_check(request: pytest.FixtureRequest) -> Iterator[None]:
+    if "qtbot" not in request.fixturenames and "qapp" not in request.fixturenames:
+        yield
+        return
+    _patch_qt()
+    import shiboken6
+
+    before_threads = set(map(id, _threads))
+    before_timers = set(map(id, _timers))
+    yield
+    leaked_threads = [
+        t for t in list(_threads)
+        if id(t) not in before_threads and shiboken6.isValid(t) and t.isRunning()
+    ]
+    leaked_timers = [
+        t for t in list(_timers)
+        if id(t) not in before_timers and shiboken6.isValid(t) and t.isActive()
+    ]
+    _threads.clear()
+    _timers.clear()
+    if leaked_threads or leaked_timers:
+        pytest.fail(
+            f"test leaked {len(leaked_threads)} running QThread(s) and "
+            f"{len(leaked_timers)} active QTimer(s)",
+            pytrace=False,
+        )
