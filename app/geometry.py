@@ -86,4 +86,5 @@ def slerp_matrix(r1: Matrix, r2: Matrix, s: float) -> Matrix:
     th = angle * s
     k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
     step = np.eye(3) + math.sin(th) * k + (1.0 - math.cos(th)) * (k @ k)
-    return r1 @ step
+    result: Matrix = r1 @ step
+    return result

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import enum
 import math
+import numbers
 import struct
 from collections.abc import Iterable, Sequence
 
@@ -65,15 +66,22 @@ def decode_floats(regs: Sequence[int], order: WordOrder = WordOrder.LOW_FIRST) -
     return [registers_to_float(regs[i : i + 2], order) for i in range(0, len(regs), 2)]
 
 
+FLOAT32_MAX: float = struct.unpack(">f", b"\x7f\x7f\xff\xff")[0]
+
+
 def check_float32(value: float, name: str = "value") -> float:
-    """Refuse NaN, infinities and values a float32 cannot hold."""
-    if not isinstance(value, (int, float)) or isinstance(value, bool):
+    """Refuse NaN, infinities and values a float32 cannot hold (numpy scalars are fine)."""
+    if not isinstance(value, numbers.Real) or isinstance(value, bool):
         raise ValueError(f"{name} must be a number, got {value!r}")
-    if not math.isfinite(value):
-        raise ValueError(f"{name} must be finite, got {value}")
-    if abs(value) > 3.4028234e38:
-        raise ValueError(f"{name} {value} does not fit a float32")
-    return float(value)
+    try:
+        number = float(value)
+    except OverflowError:
+        raise ValueError(f"{name} {value} does not fit a float32") from None
+    if not math.isfinite(number):
+        raise ValueError(f"{name} must be finite, got {number}")
+    if abs(number) > FLOAT32_MAX:
+        raise ValueError(f"{name} {number} does not fit a float32")
+    return number
 
 
 def as_uint16(value: int) -> int:

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from app.protocol.codec import WordOrder, registers_to_float
 
 
-def QT_TRANSLATE_NOOP(context: str, text: str) -> str:  # noqa: N802 - lupdate keyword
+def QT_TRANSLATE_NOOP(context: str, text: str) -> str:
     """Mark ``text`` for translation in ``context``; returns it unchanged."""
     return text
 
@@ -297,7 +297,9 @@ class CommandStatus:
 
     @property
     def is_error(self) -> bool:
-        """A code that ends the command unsuccessfully."""
+        """A code that ends the command unsuccessfully (never true when the kind is unknown)."""
+        if self.kind is None:
+            return False
         return not (self.is_done or self.is_initial or self.is_moving)
 
 

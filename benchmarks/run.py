@@ -1,0 +1,59 @@
+"""`make bench`: run every benchmark and print one JSON object.
+
+Usage: python -m benchmarks.run [--quick] [--only core,gui,points]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+import time
+from typing import Any
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--quick", action="store_true", help="small N and short windows")
+    parser.add_argument("--only", default="core,gui,points", help="comma-separated suites")
+    args = parser.parse_args(argv)
+    suites = {s.strip() for s in args.only.split(",") if s.strip()}
+    os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+    out: dict[str, Any] = {
+        "machine": {
+            "python": platform.python_version(),
+            "cpus": os.cpu_count(),
+            "platform": platform.platform(),
+        },
+        "quick": args.quick,
+    }
+    t0 = time.perf_counter()
+    if "core" in suites:
+        from benchmarks import core
+
+        out["core"] = core.run(args.quick)
+    if "gui" in suites:
+        try:
+            from benchmarks import gui
+        except ImportError as exc:  # suite not written yet
+            out["gui"] = {"skipped": str(exc)}
+        else:
+            out["gui"] = gui.run(args.quick)
+    if "points" in suites:
+        try:
+            from benchmarks import points
+        except ImportError as exc:
+            out["points"] = {"skipped": str(exc)}
+        else:
+            out["points"] = points.run(args.quick)
+    out["total_s"] = time.perf_counter() - t0
+    json.dump(out, sys.stdout, indent=2, sort_keys=True)
+    sys.stdout.write("\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
