@@ -42,6 +42,7 @@ from app.geometry import abc_to_matrix, matrix_to_abc
 Vector = NDArray[np.float64]
 Matrix = NDArray[np.float64]
 Pose6 = tuple[float, float, float, float, float, float]
+JointsLike = Sequence[float] | NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -96,7 +97,7 @@ def _dh_matrix(theta: float, row: DHRow) -> Matrix:
     )
 
 
-def _frames(q_deg: Sequence[float]) -> list[Matrix]:
+def _frames(q_deg: JointsLike) -> list[Matrix]:
     """Base-to-frame transforms T0..T6 (T0 is identity)."""
     frames = [np.eye(4)]
     t = np.eye(4)
@@ -106,12 +107,12 @@ def _frames(q_deg: Sequence[float]) -> list[Matrix]:
     return frames
 
 
-def forward(q_deg: Sequence[float]) -> Matrix:
+def forward(q_deg: JointsLike) -> Matrix:
     """4x4 flange transform of joints J1..J6 (degrees)."""
     return _frames(q_deg)[-1]
 
 
-def forward_pose(q_deg: Sequence[float]) -> Pose6:
+def forward_pose(q_deg: JointsLike) -> Pose6:
     """X Y Z A B C of joints J1..J6."""
     return transform_to_pose6(forward(q_deg))
 
@@ -128,7 +129,7 @@ def pose6_to_transform(pose: Sequence[float]) -> Matrix:
     return t
 
 
-def jacobian(q_deg: Sequence[float]) -> Matrix:
+def jacobian(q_deg: JointsLike) -> Matrix:
     """Geometric Jacobian (6x6): rows vx vy vz (mm/rad) wx wy wz (rad/rad)."""
     frames = _frames(q_deg)
     pe = frames[-1][:3, 3]
@@ -156,11 +157,11 @@ def rotation_error(r_current: Matrix, r_target: Matrix) -> Vector:
     return np.asarray(vee * (angle / (2.0 * math.sin(angle))), dtype=np.float64)
 
 
-def within_limits(q_deg: Sequence[float], margin: float = 1e-6) -> bool:
+def within_limits(q_deg: JointsLike, margin: float = 1e-6) -> bool:
     return all(lo - margin <= qi <= hi + margin for qi, (lo, hi) in zip(q_deg[:6], JOINT_LIMITS, strict=True))
 
 
-def inverse(target: Matrix, seed_deg: Sequence[float], *, max_iter: int = IK_MAX_ITER) -> Vector | None:
+def inverse(target: Matrix, seed_deg: JointsLike, *, max_iter: int = IK_MAX_ITER) -> Vector | None:
     """Joints J1..J6 (degrees) reaching ``target`` (4x4), starting from ``seed_deg``.
 
     Damped least squares; returns None when it does not converge within the tolerances or the
@@ -171,7 +172,7 @@ def inverse(target: Matrix, seed_deg: Sequence[float], *, max_iter: int = IK_MAX
     r_target = target[:3, :3]
     lam = 0.5
     for _ in range(max_iter + 1):
-        q_deg = np.degrees(q)
+        q_deg: Vector = np.asarray(np.degrees(q), dtype=np.float64)
         t = forward(q_deg)
         dp = p_target - t[:3, 3]
         dw = rotation_error(t[:3, :3], r_target)
@@ -191,5 +192,5 @@ def inverse(target: Matrix, seed_deg: Sequence[float], *, max_iter: int = IK_MAX
     return None
 
 
-def inverse_pose(pose: Sequence[float], seed_deg: Sequence[float]) -> Vector | None:
+def inverse_pose(pose: Sequence[float], seed_deg: JointsLike) -> Vector | None:
     return inverse(pose6_to_transform(pose), seed_deg)

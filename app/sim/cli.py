@@ -1,0 +1,158 @@
+"""``teachpad-sim``: run the simulated controller in the foreground."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import signal
+import sys
+import threading
+from collections.abc import Sequence
+from typing import TextIO
+
+from pymodbus.constants import ExcCodes
+
+from app.protocol.codec import WordOrder
+from app.protocol.enums import Alarm
+from app.sim.server import SimConfig, SimController
+
+log = logging.getLogger(__name__)
+
+ALARM_NAMES: dict[str, Alarm] = {
+    "estop": Alarm.ESTOP, "servo": Alarm.SERVO, "brake": Alarm.BRAKE,
+    "algorithm": Alarm.ALGORITHM, "encoder": Alarm.ENCODER,
+}
+
+COMMANDS_HELP = """\
+commands typed on stdin while running (one per line):
+  alarm NAME on|off   raise / clear an alarm; NAME: estop servo brake algorithm encoder
+  delay SECONDS       delay every answer (0 = off)
+  status-delay SECONDS  GV291 keeps its old value this long after a command
+  drop                close the connections of the connected clients
+  exception CODE      answer every request with Modbus exception CODE (1-11)
+  exception off       answer normally again
+  silent on|off       receive requests but never answer
+  restart             the controller logs in again: temp points wiped, motion stopped
+  status              print the state (pose, joints, mode, alarms, GV291, points)
+  help                this list
+  quit                stop the simulator
+"""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="teachpad-sim",
+        description="Simulated Bochuang robot controller (Modbus TCP slave) for TeachPad.",
+        epilog=COMMANDS_HELP,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
+    parser.add_argument("--port", type=int, default=5020, help="TCP port (default 5020, 0 = any free port)")
+    parser.add_argument("--unit", type=int, default=1, help="Modbus unit id (default 1)")
+    parser.add_argument("--word-order", choices=[w.value for w in WordOrder],
+                        default=WordOrder.LOW_FIRST.value,
+                        help="word order of float32 values (default low-first)")
+    parser.add_argument("--status-encoding", choices=["float", "int"], default="float",
+                        help="GV291 as float32 (default) or integer in register 582")
+    parser.add_argument("--status-delay", type=float, default=0.0, metavar="S",
+                        help="GV291 keeps its old value S seconds after a command")
+    parser.add_argument("--rtu-framing", action="store_true", help="RTU framing over TCP instead of MBAP")
+    parser.add_argument("--tick-hz", type=float, default=100.0, help="simulation rate (default 100)")
+    parser.add_argument("--no-stdin", action="store_true", help="do not read commands from stdin")
+    parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
+    return parser
+
+
+def execute(sim: SimController, line: str, out: TextIO) -> bool:
+    """Run one stdin command. Returns False when the simulator should quit."""
+    words = line.split()
+    if not words:
+        return True
+    cmd, args = words[0].lower(), [w.lower() for w in words[1:]]
+    try:
+        if cmd == "alarm" and len(args) == 2 and args[0] in ALARM_NAMES and args[1] in ("on", "off"):
+            sim.set_alarm(ALARM_NAMES[args[0]], args[1] == "on")
+        elif cmd == "delay" and len(args) == 1:
+            sim.set_response_delay(float(args[0]))
+        elif cmd == "status-delay" and len(args) == 1:
+            sim.set_status_delay(float(args[0]))
+        elif cmd == "drop" and not args:
+            sim.drop_connections()
+        elif cmd == "exception" and len(args) == 1:
+            sim.set_exception(None if args[0] == "off" else ExcCodes(int(args[0], 0)))
+        elif cmd == "silent" and len(args) == 1 and args[0] in ("on", "off"):
+            sim.set_silent(args[0] == "on")
+        elif cmd == "restart" and not args:
+            sim.restart_controller()
+        elif cmd == "status" and not args:
+            s = sim.state()
+            print(f"pose {' '.join(f'{v:.3f}' for v in s.pose)}", file=out)
+            print(f"joints {' '.join(f'{v:.3f}' for v in s.joints)}", file=out)
+            print(f"mode {s.mode.name} program {s.program_state.name} alarms {int(s.alarms)} "
+                  f"teach {'on' if s.teach_enabled else 'off'} ratio {s.teach_ratio:g} "
+                  f"GV291 {s.command_status} points {len(s.points)}", file=out)
+        elif cmd == "help":
+            print(COMMANDS_HELP, file=out)
+        elif cmd in ("quit", "exit"):
+            return False
+        else:
+            print(f"unknown command: {line.strip()!r} (type help)", file=out)
+    except ValueError as exc:
+        print(f"bad command {line.strip()!r}: {exc}", file=out)
+    out.flush()
+    return True
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
+                        format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    if not args.verbose:
+        logging.getLogger("pymodbus").setLevel(logging.WARNING)
+    config = SimConfig(host=args.host, port=args.port, unit=args.unit,
+                       word_order=WordOrder.parse(args.word_order),
+                       status_encoding=args.status_encoding, status_delay=args.status_delay,
+                       framer="rtu" if args.rtu_framing else "socket", tick_hz=args.tick_hz)
+    sim = SimController(config)
+    try:
+        sim.start()
+    except OSError as exc:
+        print(f"teachpad-sim: {exc}", file=sys.stderr)
+        return 1
+    done = threading.Event()
+    print(f"teachpad-sim listening on {config.host}:{sim.port} (unit {config.unit}); Ctrl-C to stop",
+          flush=True)
+
+    previous: dict[signal.Signals, object] = {}
+    if threading.current_thread() is threading.main_thread():
+        def on_signal(signum: int, _frame: object) -> None:
+            log.info("signal %d: stopping", signum)
+            done.set()
+
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            previous[sig] = signal.signal(sig, on_signal)
+
+    if not args.no_stdin:
+        def read_stdin() -> None:
+            for line in sys.stdin:
+                if not execute(sim, line, sys.stdout):
+                    done.set()
+                    return
+
+        threading.Thread(target=read_stdin, name="sim-stdin", daemon=True).start()
+
+    try:
+        while not done.wait(0.2):
+            pass
+    except KeyboardInterrupt:
+        pass
+    finally:
+        sim.stop()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)  # type: ignore[arg-type]
+    print("teachpad-sim stopped", flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
