@@ -9,7 +9,11 @@ current state.
 
 GV291 publication: on a 440 command with a status (0x40/0x41/0x42/0xE0/0x80/0x81) the old
 value stays for ``status_delay`` seconds, then 0 (INITIAL) shows for ``command_latency``
-seconds, then the robot's value (6 while moving, 0xFF done, or the error). A stop (441) keeps
+seconds — and, for the instant commands (create point, teach enable/disable), until a host has
+read GV291 at least once (at most ``ZERO_HOLD_MAX`` seconds) —
+then the robot's value (6 while moving, 0xFF done, or the error). The read rule emulates a
+controller whose cycle is slower than the host's poll, and makes the fresh-versus-stale
+question deterministic in tests: a host that polls always sees the 0 between two 0xFF. A stop (441) keeps
 the old value for ``status_delay`` and then shows 0. Float32 by default, or the integer in
 register 582 (583 = 0) with ``status_encoding="int"``.
 
@@ -72,6 +76,9 @@ from app.protocol.registers import (
 from app.sim.robot import Pose6, SimRobot, StoredPoint, TraceSample
 
 log = logging.getLogger(__name__)
+
+# Longest time the 0 ("received") phase of GV291 waits for a host to read it.
+ZERO_HOLD_MAX = 0.25
 
 _FC_WRITE_SINGLE = 6
 _STATUS_COMMANDS = frozenset({RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT,
@@ -176,6 +183,7 @@ class SimController:
         self._hold_old_until = 0.0
         self._hold_old_value = 0
         self._hold_zero_until = 0.0
+        self._zero_unread = False  # the 0 phase has not been seen by a host read yet
 
     # --- lifecycle ------------------------------------------------------------------------
     @property
@@ -349,6 +357,10 @@ class SimController:
                     registers[offset : offset + len(values)] = before
                     return result
             self._refresh(registers, start_address)
+            status_reg = gv_reg(GV_COMMAND_STATUS)
+            if (set_values is None and self._zero_unread and address <= status_reg < address + count
+                    and time.monotonic() >= self._hold_old_until):
+                self._zero_unread = False  # a host has now seen the 0
         return None
 
     # --- registers ------------------------------------------------------------------------
@@ -383,6 +395,8 @@ class SimController:
                 return self._hold_old_value
             if now < self._hold_zero_until:
                 return 0
+            if self._zero_unread and now < self._hold_old_until + ZERO_HOLD_MAX:
+                return 0
             return self.robot.command_status
 
     def _hold_status(self, latency: bool) -> None:
@@ -391,6 +405,7 @@ class SimController:
         self._hold_old_value = old
         self._hold_old_until = now + self._status_delay
         self._hold_zero_until = self._hold_old_until + (self.config.command_latency if latency else 0.0)
+        self._zero_unread = latency
 
     def _refresh(self, regs: list[int], start: int) -> None:
         robot = self.robot
@@ -453,6 +468,10 @@ class SimController:
         robot = self.robot
         if command in _STATUS_COMMANDS:
             self._hold_status(latency=True)
+            # moves show 6 (moving) as their own evidence; only the instant commands wait
+            # for a host to have seen the 0
+            self._zero_unread = command in (RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE,
+                                            RunCommand.TEACH_DISABLE)
         p = self._gvs(regs, start, GV_PARAM0, 6)
         speed = self._gv(regs, start, GV_EXPECTED_SPEED)
         ext = self._gvs(regs, start, GV_EXT_OFFSET0, NUM_EXTERNAL_AXES)
@@ -542,6 +561,7 @@ class SimController:
         with self.lock:
             self.robot.restart()
             self._hold_old_until = self._hold_zero_until = 0.0
+            self._zero_unread = False
         log.info("controller restarted: temp points wiped")
 
     def add_point(self, point_id: int, pose: Pose6, tool: int = 200) -> None:

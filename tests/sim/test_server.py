@@ -414,6 +414,19 @@ def test_command_latency_shows_initial(sim_factory: Callable[..., SimController]
     assert poll(bus.status, lambda s: s != 0, 2.0) == 0xFF
 
 
+def test_instant_command_shows_initial_until_a_host_reads_it(sim: SimController, bus: Bus) -> None:
+    """A slow host still sees the 0 between the old and the new 0xFF of a create point."""
+    assert create_point(bus, 1) == 0xFF
+    bus.set_gv(GV_PARAM0, [2.0, 0.0, 0.0])
+    bus.write(RUN, 0xE0)
+    t0 = sim.state().t
+    # let the simulator run well past its command latency before the host looks
+    assert sim.wait_for(lambda s: s.t > t0 + 0.05, 2)
+    assert 2 in sim.state().points  # the point exists already ...
+    assert bus.status() == 0  # ... but the host's first look still shows "received"
+    assert bus.status() == 0xFF
+
+
 # --- fault injection ----------------------------------------------------------------------
 def test_response_delay(sim: SimController, bus: Bus) -> None:
     sim.set_response_delay(0.3)

@@ -1,0 +1,484 @@
+"""``teachpad-cli`` commands for temp points and plans: ``points ...`` and ``run``.
+
+Plugging in: ``app/cli.py`` imports this module (it is in its ``PLUGIN_MODULES``) and calls
+``register(subparsers)``, which adds ``points`` (list / upload / export / import) and ``run``
+and sets ``handler`` on each with ``set_defaults``. A handler can be called two ways:
+
+* ``args.handler(ctx)`` with ``app.cli.CliContext`` (what ``app/cli.py`` does): uses
+  ``ctx.args``, the lazily connected ``ctx.client``, ``ctx.out`` / ``ctx.err``; the context
+  closes the client.
+* ``args.handler(args, make_client)``: ``make_client()`` returns a connected ``RobotClient``
+  built from the global options (``--host --port --unit`` ...); the handler closes it.
+
+Either way the client is asked for only by commands that talk to the controller
+(``points upload``, ``run`` without ``--check``), at most once. Of ``RobotClient`` they use
+``read_pose``, ``create_point``, ``move_to_point``, ``stop`` (duck-typed). The ``cmd_*``
+functions take ``(args, make_client, *, out=None, err=None, close_client=True)``.
+
+Exit codes, as ``app/cli.py``: 0 ok; 1 failed (controller refused, run failed or stopped,
+points not on the controller without ``--upload``); 2 usage (bad arguments, a malformed
+file, a plan with errors; nothing sent); 3 link (cannot connect, no answer); 130 interrupted
+(Ctrl-C; a motion under way is stopped first). Global options read when the main parser
+defines them: ``point_id_min``, ``point_id_max`` (accepted temp point ids, default 0..10000).
+
+Commands::
+
+    points list   PROJECT
+    points upload PROJECT [--ids 1,2,5-9 | --needed]
+    points export PROJECT --csv OUT [--no-bom]
+    points import PROJECT --csv IN [--merge]        # creates PROJECT if it does not exist
+    run PROJECT [--plan NAME] [--loops N] [--from K] [--from-loop I] [--single]
+                [--upload] [--check] [--max-speed MM_S]
+
+Segment numbers on the command line and in messages count from 1. ``run`` checks the plan
+first (the GUI's checks): errors refuse to run; points that are not on the controller are
+uploaded with ``--upload``, otherwise the command says which ones to upload. A failed or
+interrupted run prints the ``--from`` / ``--from-loop`` that resumes it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, TextIO
+
+from app.errors import InvalidInput, LinkError, ResponseTimeout, TeachPadError
+from app.models import Pose
+from app.plan import (
+    IssueKind,
+    Plan,
+    PlanLimits,
+    check_plan,
+    estimate_plan,
+    ids_needing_upload,
+    segment_timeouts,
+)
+from app.points import (
+    DEFAULT_LIMITS,
+    FileFormatError,
+    ImportMode,
+    PointLedger,
+    PointLimits,
+    TempPoint,
+    UploadReport,
+    apply_upload,
+    parse_id_list,
+    tool_text,
+    upload_points,
+)
+from app.project import Project, load_project, read_points_csv, save_project, write_points_csv
+from app.runner import PlanRunner, RunEvent, RunProgress, RunState
+
+PROG = "teachpad-cli"
+
+EXIT_OK = 0
+EXIT_FAILED = 1
+EXIT_USAGE = 2
+EXIT_LINK = 3
+EXIT_INTERRUPTED = 130
+EXIT_NEEDS_UPLOAD = EXIT_FAILED
+
+MakeClient = Callable[[], Any]
+Command = Callable[..., int]
+
+
+class _Io:
+    def __init__(self, out: TextIO | None, err: TextIO | None) -> None:
+        self.out = out or sys.stdout
+        self.err = err or sys.stderr
+
+    def print(self, text: str) -> None:
+        print(text, file=self.out, flush=True)
+
+    def error(self, text: str) -> None:
+        print(f"{PROG}: error: {text}", file=self.err, flush=True)
+
+    def warn(self, text: str) -> None:
+        print(f"{PROG}: warning: {text}", file=self.err, flush=True)
+
+
+def _handler(command: Command) -> Callable[..., int]:
+    """``handler(ctx)`` or ``handler(args, make_client)`` around a ``cmd_*`` function."""
+
+    def handler(*call: Any) -> int:
+        if len(call) == 2:
+            args, make_client = call
+            return command(args, make_client)
+        (ctx,) = call
+        return command(ctx.args, lambda: ctx.client, out=getattr(ctx, "out", None),
+                       err=getattr(ctx, "err", None), close_client=False)
+
+    handler.__name__ = command.__name__
+    handler.__doc__ = command.__doc__
+    return handler
+
+
+def register(subparsers: Any) -> None:
+    """Add ``points`` and ``run`` to the main parser's subparsers."""
+    points = subparsers.add_parser("points", help="temp points of a project: list, upload, export, import")
+    psub = points.add_subparsers(dest="points_command", metavar="ACTION", required=True)
+
+    p = psub.add_parser("list", help="print the points and plans of a project")
+    p.add_argument("project", type=Path)
+    p.set_defaults(handler=_handler(cmd_points_list))
+
+    p = psub.add_parser("upload", help="create the project's points on the controller (function 2)")
+    p.add_argument("project", type=Path)
+    group = p.add_mutually_exclusive_group()
+    group.add_argument("--ids", help="ids to upload, e.g. 1,2,5-9 (default: all)")
+    group.add_argument("--needed", action="store_true", help="only points not known to be on the controller")
+    p.set_defaults(handler=_handler(cmd_points_upload))
+
+    p = psub.add_parser("export", help="write the project's points to a CSV file")
+    p.add_argument("project", type=Path)
+    p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="OUT")
+    p.add_argument("--no-bom", action="store_true", help="write UTF-8 without a byte order mark")
+    p.set_defaults(handler=_handler(cmd_points_export))
+
+    p = psub.add_parser("import", help="read points from a CSV file into the project")
+    p.add_argument("project", type=Path)
+    p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="IN")
+    p.add_argument("--merge", action="store_true",
+                   help="update and add points, keep the others (default: replace all points)")
+    p.set_defaults(handler=_handler(cmd_points_import))
+
+    r = subparsers.add_parser("run", help="run a plan of a project on the controller (function 3)")
+    r.add_argument("project", type=Path)
+    r.add_argument("--plan", help="plan name (needed when the project has several)")
+    r.add_argument("--loops", type=int, help="loop count (default: the plan's; 0 = until stopped)")
+    r.add_argument("--from", type=int, default=1, dest="from_segment", metavar="K",
+                   help="start at segment K (counting from 1)")
+    r.add_argument("--from-loop", type=int, default=1, metavar="I", help="start in loop I (to resume)")
+    r.add_argument("--single", action="store_true", help="run segment K only")
+    r.add_argument("--upload", action="store_true", help="upload points the controller does not have")
+    r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
+    r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
+                   help="highest speed a segment may have (default %(default)g mm/s)")
+    r.set_defaults(handler=_handler(cmd_run))
+
+
+# --- helpers ------------------------------------------------------------------------------------
+
+
+def _limits(args: argparse.Namespace) -> PointLimits:
+    lo = getattr(args, "point_id_min", None)
+    hi = getattr(args, "point_id_max", None)
+    if lo is None and hi is None:
+        return DEFAULT_LIMITS
+    return PointLimits(
+        DEFAULT_LIMITS.id_min if lo is None else lo, DEFAULT_LIMITS.id_max if hi is None else hi
+    )
+
+
+def _load(io: _Io, path: Path, limits: PointLimits) -> Project | None:
+    try:
+        return load_project(path, limits)
+    except FileFormatError as exc:
+        io.error(str(exc))
+        return None
+
+
+def _save(io: _Io, project: Project, path: Path) -> bool:
+    try:
+        save_project(project, path)
+    except OSError as exc:
+        io.error(f"{path}: could not save: {exc}")
+        return False
+    return True
+
+
+def _link_code(io: _Io, exc: TeachPadError, what: str) -> int:
+    io.error(f"{what}: {exc}")
+    return EXIT_LINK if isinstance(exc, LinkError | ResponseTimeout) else EXIT_FAILED
+
+
+def _fmt_time(seconds: float) -> str:
+    if math.isinf(seconds):
+        return "until stopped"
+    if math.isnan(seconds):
+        return "unknown"
+    minutes, sec = divmod(round(seconds), 60)
+    return f"{minutes} min {sec:02d} s" if minutes else f"{seconds:.1f} s"
+
+
+class _ProgressLine:
+    """One self-overwriting line on a terminal, one line per report otherwise."""
+
+    def __init__(self, stream: TextIO) -> None:
+        self.stream = stream
+        self.tty = bool(getattr(stream, "isatty", lambda: False)())
+        self.width = 0
+
+    def show(self, text: str) -> None:
+        if self.tty:
+            self.stream.write("\r" + text + " " * max(0, self.width - len(text)))
+            self.width = len(text)
+        else:
+            self.stream.write(text + "\n")
+        self.stream.flush()
+
+    def done(self) -> None:
+        if self.tty and self.width:
+            self.stream.write("\n")
+            self.stream.flush()
+        self.width = 0
+
+
+def _upload(io: _Io, project: Project, points: Sequence[TempPoint], client: Any) -> UploadReport:
+    line = _ProgressLine(io.out)
+
+    def progress(done: int, total: int) -> None:
+        if done < total:
+            line.show(f"uploading {done + 1}/{total}: {points[done].label}")
+
+    try:
+        report = upload_points(client, points, progress=progress)
+    finally:
+        line.done()
+    apply_upload(project.ledger, report)
+    io.print(f"uploaded {report.ok_count} point(s)")
+    for outcome in report.failed:
+        io.error(f"P{outcome.point_id}: {outcome.reason}")
+    if report.aborted:
+        left = ",".join(str(i) for i in report.not_attempted)
+        io.error(f"upload stopped ({report.aborted}); not attempted: {left}")
+    return report
+
+
+def _upload_code(report: UploadReport) -> int:
+    if report.interrupted:
+        return EXIT_INTERRUPTED
+    if report.aborted:
+        return EXIT_LINK
+    return EXIT_OK if report.all_ok else EXIT_FAILED
+
+
+# --- points ------------------------------------------------------------------------------------
+
+
+def cmd_points_list(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
+                    err: TextIO | None = None, close_client: bool = True) -> int:
+    """``points list PROJECT``."""
+    io = _Io(out, err)
+    project = _load(io, args.project, _limits(args))
+    if project is None:
+        return EXIT_USAGE
+    io.print(f"{project.name}: {len(project.ledger)} point(s), {len(project.plans)} plan(s)")
+    for p in project.ledger:
+        pose = " ".join(f"{v:9.3f}" for v in p.xyzabc)
+        state = p.sync.text + (f" ({p.sync_error})" if p.sync_error else "")
+        io.print(f"{p.id:6d}  {p.name[:20]:20s} {pose}  {tool_text(p.tool):14s} {state}")
+    for plan in project.plans:
+        io.print(f"plan {plan.name!r}: {len(plan)} segment(s), loops {plan.loops or 'until stopped'}")
+    return EXIT_OK
+
+
+def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
+                      err: TextIO | None = None, close_client: bool = True) -> int:
+    """``points upload PROJECT [--ids ... | --needed]``; saves the sync states."""
+    io = _Io(out, err)
+    project = _load(io, args.project, _limits(args))
+    if project is None:
+        return EXIT_USAGE
+    ledger = project.ledger
+    if args.ids:
+        try:
+            ids = parse_id_list(args.ids)
+        except InvalidInput as exc:
+            io.error(str(exc))
+            return EXIT_USAGE
+        missing = [i for i in ids if i not in ledger]
+        if missing:
+            io.error(f"no point with id {', '.join(map(str, missing))} in {args.project}")
+            return EXIT_USAGE
+        points = [ledger.point(i) for i in ids]
+    elif args.needed:
+        points = ledger.needing_upload()
+    else:
+        points = list(ledger)
+    if not points:
+        io.print("nothing to upload")
+        return EXIT_OK
+    client: Any = None
+    try:
+        client = make_client()
+        report = _upload(io, project, points, client)
+    except TeachPadError as exc:
+        return _link_code(io, exc, "cannot upload")
+    finally:
+        if close_client and client is not None:
+            client.close()
+    if not _save(io, project, args.project):
+        return EXIT_FAILED
+    return _upload_code(report)
+
+
+def cmd_points_export(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
+                      err: TextIO | None = None, close_client: bool = True) -> int:
+    """``points export PROJECT --csv OUT``."""
+    io = _Io(out, err)
+    project = _load(io, args.project, _limits(args))
+    if project is None:
+        return EXIT_USAGE
+    try:
+        write_points_csv(args.csv_path, project.ledger, bom=not args.no_bom)
+    except OSError as exc:
+        io.error(f"{args.csv_path}: could not write: {exc}")
+        return EXIT_FAILED
+    io.print(f"wrote {len(project.ledger)} point(s) to {args.csv_path}")
+    return EXIT_OK
+
+
+def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
+                      err: TextIO | None = None, close_client: bool = True) -> int:
+    """``points import PROJECT --csv IN [--merge]``; the project is saved only if all rows are good."""
+    io = _Io(out, err)
+    limits = _limits(args)
+    if args.project.exists():
+        project = _load(io, args.project, limits)
+        if project is None:
+            return EXIT_USAGE
+    else:
+        name = args.project.name.removesuffix(".json").removesuffix(".teachpad")
+        project = Project(name=name, ledger=PointLedger((), limits))
+    try:
+        points = read_points_csv(args.csv_path, limits)
+        report = project.ledger.import_points(points, ImportMode.MERGE if args.merge else ImportMode.REPLACE)
+    except InvalidInput as exc:
+        io.error(str(exc))
+        return EXIT_USAGE
+    if not _save(io, project, args.project):
+        return EXIT_FAILED
+    io.print(f"imported {len(points)} point(s) into {args.project}: {report.text}")
+    for plan in project.plans:
+        missing = sorted(i for i in plan.point_ids() if i not in project.ledger)
+        if missing:
+            io.warn(f"plan {plan.name!r} uses points that are gone: {', '.join(map(str, missing))}")
+    return EXIT_OK
+
+
+# --- run ---------------------------------------------------------------------------------------
+
+
+def _pick_plan(io: _Io, project: Project, name: str | None) -> Plan | None:
+    if name is not None:
+        try:
+            return project.plan(name)
+        except InvalidInput as exc:
+            io.error(str(exc))
+            return None
+    if len(project.plans) == 1:
+        return project.plans[0]
+    if not project.plans:
+        io.error("the project has no plans")
+    else:
+        io.error(f"the project has {len(project.plans)} plans ({', '.join(project.plan_names())}): "
+                 "choose one with --plan")
+    return None
+
+
+def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
+            err: TextIO | None = None, close_client: bool = True) -> int:
+    """``run PROJECT [--plan NAME] ...``: check, upload if asked, run with a progress line."""
+    io = _Io(out, err)
+    project = _load(io, args.project, _limits(args))
+    if project is None:
+        return EXIT_USAGE
+    plan = _pick_plan(io, project, args.plan)
+    if plan is None:
+        return EXIT_USAGE
+    loops = plan.loops if args.loops is None else args.loops
+    start = args.from_segment - 1
+    try:
+        limits = PlanLimits(max_speed=args.max_speed)
+        if loops < 0:
+            raise InvalidInput("--loops must be >= 0 (0 = until stopped)")
+        if not 0 <= start < len(plan):
+            raise InvalidInput(f"--from {args.from_segment}: the plan has segments 1..{len(plan)}")
+        if args.from_loop < 1 or (loops and args.from_loop > loops):
+            raise InvalidInput(f"--from-loop {args.from_loop}: the run has loops 1..{loops}")
+    except InvalidInput as exc:
+        io.error(str(exc))
+        return EXIT_USAGE
+
+    client: Any = None
+    try:
+        pose: Pose | None = None
+        if not args.check:
+            try:
+                client = make_client()
+                pose = client.read_pose()
+            except TeachPadError as exc:
+                return _link_code(io, exc, "cannot read the robot's pose")
+        return _run(io, args, project, plan, client, pose, limits, loops, start)
+    finally:
+        if close_client and client is not None:
+            client.close()
+
+
+def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client: Any, pose: Pose | None,
+         limits: PlanLimits, loops: int, start: int) -> int:
+    ledger = project.ledger
+    issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops)
+    for issue in issues:
+        if issue.kind is IssueKind.WARNING:
+            io.warn(issue.message)
+    errors = [i for i in issues if i.kind is IssueKind.ERROR]
+    if errors:
+        for issue in errors:
+            io.error(issue.message)
+        io.error(f"plan {plan.name!r} has {len(errors)} error(s): not running it")
+        return EXIT_USAGE
+    est = estimate_plan(plan, ledger, pose, loops=loops)
+    io.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
+             f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}")
+    needed = ids_needing_upload(issues)
+    if args.check:
+        if needed:
+            io.print(f"needs upload: {', '.join(map(str, needed))}")
+        io.print("check only: not running")
+        return EXIT_OK
+    if needed:
+        if not args.upload:
+            for issue in issues:
+                if issue.kind is IssueKind.NEEDS_UPLOAD:
+                    io.error(issue.message)
+            io.error(f"upload them first ({PROG} points upload {args.project} --ids "
+                     f"{','.join(map(str, needed))}) or pass --upload")
+            return EXIT_NEEDS_UPLOAD
+        report = _upload(io, project, [ledger.point(i) for i in needed], client)
+        saved = _save(io, project, args.project)
+        if _upload_code(report) != EXIT_OK or not saved:
+            return _upload_code(report) or EXIT_FAILED
+
+    line = _ProgressLine(io.out)
+
+    def progress(p: RunProgress) -> None:
+        if p.event is RunEvent.SEGMENT_STARTED:
+            line.show(f"{p.text}: {p.message}")
+
+    runner = PlanRunner(plan, loops=loops, start=start, start_loop=args.from_loop, single=args.single,
+                        timeouts=segment_timeouts(plan, ledger, pose), progress=progress)
+    try:
+        outcome = runner.run(client)
+    finally:
+        line.done()
+    if outcome.state is RunState.FINISHED:
+        io.print(f"done: {outcome.segments_done} segment(s)")
+        return EXIT_OK
+    io.error(f"{outcome.state.value}: {outcome.message}")
+    if outcome.resume_from is not None:
+        resume = f"--from {outcome.resume_from + 1}"
+        if outcome.resume_loop and outcome.resume_loop > 1:
+            resume += f" --from-loop {outcome.resume_loop}"
+        plan_arg = f" --plan {plan.name!r}" if len(project.plans) > 1 else ""
+        loops_arg = f" --loops {loops}" if args.loops is not None else ""
+        io.print(f"to resume: {PROG} run {args.project}{plan_arg} {resume}{loops_arg}")
+    if outcome.interrupted:
+        return EXIT_INTERRUPTED
+    if isinstance(outcome.error, LinkError | ResponseTimeout):
+        return EXIT_LINK
+    return EXIT_FAILED

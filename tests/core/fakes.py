@@ -1,0 +1,74 @@
+"""A scripted stand-in for RobotClient: records calls, fails where told. No I/O, no sleeps."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+from app.models import CommandResult, Pose
+from app.protocol.enums import CommandKind, CommandStatus, RunCommand
+
+DONE = CommandResult(RunCommand.MOVE_TO_POINT, CommandKind.MOVE, CommandStatus(CommandKind.MOVE, 0xFF), True)
+
+
+def failed(code: int, message: str = "") -> CommandResult:
+    status = CommandStatus(CommandKind.MOVE, code)
+    return CommandResult(RunCommand.MOVE_TO_POINT, CommandKind.MOVE, status, False, message)
+
+
+@dataclass
+class FakeClient:
+    """``moves``/``creates`` record the calls. ``move_script[i]`` (i = 0-based call number) is
+    a CommandResult to return, an exception to raise, or a callable run before answering."""
+
+    pose: Pose = field(default_factory=lambda: Pose(400.0, 0.0, 450.0, 180.0, 0.0, 0.0))
+    move_script: dict[int, Any] = field(default_factory=dict)
+    create_script: dict[int, Any] = field(default_factory=dict)
+    moves: list[dict[str, Any]] = field(default_factory=list)
+    creates: list[dict[str, Any]] = field(default_factory=list)
+    stops: int = 0
+    closed: bool = False
+
+    def read_pose(self) -> Pose:
+        return self.pose
+
+    def create_point(self, point_id: int, *, pose: Sequence[float] | None = None, gv_start: int = 0,
+                     tool: int = 200, wait: bool = True, timeout: float | None = None) -> CommandResult:
+        n = len(self.creates)
+        self.creates.append({"id": point_id, "pose": tuple(pose) if pose else None, "tool": tool})
+        return self._answer(self.create_script.get(n), CommandResult(
+            RunCommand.CREATE_POINT, CommandKind.CREATE_POINT,
+            CommandStatus(CommandKind.CREATE_POINT, 0xFF), True))
+
+    def move_to_point(self, end_id: int, *, via_id: int | None = None, orientation_changes: bool = True,
+                      ignore_middle: bool = False, speed: float = 50.0, tool: int = 200, wait: bool = True,
+                      timeout: float | None = None) -> CommandResult:
+        n = len(self.moves)
+        self.moves.append({"end": end_id, "via": via_id, "orientation_changes": orientation_changes,
+                           "ignore_middle": ignore_middle, "speed": speed, "tool": tool, "wait": wait,
+                           "timeout": timeout})
+        return self._answer(self.move_script.get(n), DONE)
+
+    def stop(self) -> None:
+        self.stops += 1
+
+    def pause(self) -> None:
+        pass
+
+    def resume(self) -> None:
+        pass
+
+    def close(self) -> None:
+        self.closed = True
+
+    @staticmethod
+    def _answer(script: Any, default: CommandResult) -> CommandResult:
+        if isinstance(script, BaseException):
+            raise script
+        if isinstance(script, CommandResult):
+            return script
+        if callable(script):
+            out = script()
+            return out if isinstance(out, CommandResult) else default
+        return default

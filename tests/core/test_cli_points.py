@@ -1,0 +1,247 @@
+"""``points`` and ``run`` commands, with the main parser simulated and a fake client."""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from app import cli_points
+from app.errors import CommandRefused, LinkError
+from app.points import SyncState
+from app.project import load_project
+from app.protocol.enums import CommandKind, CommandStatus
+from tests.core.fakes import FakeClient
+
+SAMPLES = Path(__file__).resolve().parents[2] / "resources" / "samples"
+
+
+class Cli:
+    """Runs a command like app/cli.py will: parse, then ``args.handler(args, make_client)``."""
+
+    def __init__(self, client: Any = None) -> None:
+        self.client = client or FakeClient()
+        self.clients_made = 0
+
+    def make_client(self) -> Any:
+        self.clients_made += 1
+        return self.client
+
+    def __call__(self, *argv: str) -> int:
+        parser = argparse.ArgumentParser(prog="teachpad-cli")
+        parser.add_argument("--host", default="127.0.0.1")  # a global option of the main parser
+        sub = parser.add_subparsers(dest="command", required=True)
+        cli_points.register(sub)
+        args = parser.parse_args(list(argv))
+        code: int = args.handler(args, self.make_client)
+        return code
+
+
+@pytest.fixture
+def demo(tmp_path: Path) -> Path:
+    path = tmp_path / "demo.teachpad.json"
+    shutil.copy(SAMPLES / "demo.teachpad.json", path)
+    return path
+
+
+def test_list(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cli = Cli()
+    assert cli("points", "list", str(demo)) == 0
+    out = capsys.readouterr().out
+    assert "8 point(s), 2 plan(s)" in out and "取料点" in out and "plan 'circle'" in out
+    assert cli.clients_made == 0
+
+
+def test_export_import_round_trip(demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cli = Cli()
+    out_csv = tmp_path / "out.csv"
+    assert cli("points", "export", str(demo), "--csv", str(out_csv)) == 0
+    assert out_csv.read_bytes().startswith(b"\xef\xbb\xbfid,name,")
+    text = out_csv.read_text(encoding="utf-8-sig").replace("450.0,-150.0,250.0", "455.0,-150.0,250.0")
+    out_csv.write_text(text + "20,新点,300,0,300,180,0,0,0,0,0,0,0,200,\n", encoding="utf-8")
+    assert cli("points", "import", str(demo), "--csv", str(out_csv)) == 0
+    assert "1 added, 1 updated, 7 unchanged, 0 removed" in capsys.readouterr().out
+    project = load_project(demo)
+    assert len(project.ledger) == 9 and project.ledger.point(20).name == "新点"
+    assert project.ledger.point(2).x == 455 and project.ledger.point(2).sync is SyncState.CHANGED
+    assert project.ledger.point(1).sync is SyncState.UNKNOWN
+    assert cli.clients_made == 0
+
+
+def test_import_into_a_new_project(tmp_path: Path) -> None:
+    target = tmp_path / "fresh.teachpad.json"
+    assert Cli()("points", "import", str(target), "--csv", str(SAMPLES / "demo_points.csv")) == 0
+    project = load_project(target)
+    assert project.name == "fresh" and len(project.ledger) == 8 and project.plans == []
+
+
+def test_import_of_a_bad_csv_leaves_the_project_as_it_was(demo: Path, tmp_path: Path,
+                                                          capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.csv"
+    bad.write_text("id,name,x,y,z,a,b,c\n1,a,0,0,0,0,0,0\n2,b,0,abc,0,0,0,0\n", encoding="utf-8")
+    before = demo.read_bytes()
+    assert Cli()("points", "import", str(demo), "--csv", str(bad), "--merge") == cli_points.EXIT_USAGE
+    assert "row 3, column 'y': 'abc' is not a number" in capsys.readouterr().err
+    assert demo.read_bytes() == before
+
+
+def test_import_warns_about_plans_losing_points(demo: Path, tmp_path: Path,
+                                                     capsys: pytest.CaptureFixture[str]) -> None:
+    small = tmp_path / "small.csv"
+    small.write_text("id,x,y,z,a,b,c\n1,400,0,450,180,0,0\n", encoding="utf-8")
+    assert Cli()("points", "import", str(demo), "--csv", str(small)) == 0
+    assert "warning: plan 'circle' uses points that are gone: 5, 6, 7, 8" in capsys.readouterr().err
+
+
+def test_bad_project_file(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    bad = tmp_path / "bad.teachpad.json"
+    bad.write_text('{"format": "teachpad-project", "version": 9}', encoding="utf-8")
+    assert Cli()("run", str(bad), "--check") == cli_points.EXIT_USAGE
+    assert "version 9 is not supported" in capsys.readouterr().err
+
+
+def test_upload_selected_ids(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cli = Cli()
+    assert cli("points", "upload", str(demo), "--ids", "1,2,5-6") == 0
+    assert [c["id"] for c in cli.client.creates] == [1, 2, 5, 6]
+    assert cli.client.creates[1]["pose"] == (450.0, -150.0, 250.0, 180.0, 0.0, 0.0)
+    assert cli.client.closed
+    ledger = load_project(demo).ledger
+    assert [p.id for p in ledger if p.sync is SyncState.ON_CONTROLLER] == [1, 2, 5, 6]
+    assert "uploaded 4 point(s)" in capsys.readouterr().out
+    cli2 = Cli()
+    assert cli2("points", "upload", str(demo), "--needed") == 0
+    assert [c["id"] for c in cli2.client.creates] == [3, 4, 7, 8]
+    assert Cli()("points", "upload", str(demo), "--ids", "1,99") == cli_points.EXIT_USAGE
+    assert Cli()("points", "upload", str(demo), "--ids", "x") == cli_points.EXIT_USAGE
+
+
+def test_upload_with_lost_link_saves_what_was_done(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cli = Cli(FakeClient(create_script={2: LinkError("connection lost")}))
+    assert cli("points", "upload", str(demo)) == cli_points.EXIT_LINK
+    assert "not attempted: 3,4,5,6,7,8" in capsys.readouterr().err
+    ledger = load_project(demo).ledger
+    assert [p.id for p in ledger if p.sync is SyncState.ON_CONTROLLER] == [1, 2]
+
+
+def test_run_needs_a_plan_name_when_there_are_several(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert Cli()("run", str(demo)) == cli_points.EXIT_USAGE
+    assert "choose one with --plan" in capsys.readouterr().err
+    assert Cli()("run", str(demo), "--plan", "nope") == cli_points.EXIT_USAGE
+
+
+def test_run_refuses_when_points_are_not_on_the_controller(demo: Path,
+                                                           capsys: pytest.CaptureFixture[str]) -> None:
+    cli = Cli()
+    assert cli("run", str(demo), "--plan", "circle") == cli_points.EXIT_NEEDS_UPLOAD
+    err = capsys.readouterr().err
+    assert "--ids 1,5,6,7,8" in err and "or pass --upload" in err
+    assert cli.client.moves == [] and cli.client.closed
+
+
+def test_run_with_upload(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cli = Cli()
+    assert cli("run", str(demo), "--plan", "circle", "--upload") == 0
+    assert sorted(c["id"] for c in cli.client.creates) == [1, 5, 6, 7, 8]
+    assert [(m["via"], m["end"]) for m in cli.client.moves] == [(None, 5), (6, 7), (8, 5), (None, 1)]
+    assert all(m["timeout"] and m["timeout"] >= 10.0 for m in cli.client.moves)
+    out = capsys.readouterr().out
+    assert "plan 'circle': 4 segment(s)" in out and "loop 1/1, segment 2/4: arc via P6 to P7" in out
+    assert "done: 4 segment(s)" in out
+    assert load_project(demo).ledger.point(5).sync is SyncState.ON_CONTROLLER
+
+
+def test_run_failure_prints_how_to_resume(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    Cli()("points", "upload", str(demo))
+    cli = Cli(FakeClient(move_script={4: LinkError("connection lost")}))
+    assert cli("run", str(demo), "--plan", "pick and place") == cli_points.EXIT_LINK
+    captured = capsys.readouterr()
+    assert "failed: segment 2/3 (loop 2/2): connection lost" in captured.err
+    assert "--plan 'pick and place' --from 2 --from-loop 2" in captured.out
+    cli = Cli()
+    assert cli("run", str(demo), "--plan", "pick and place", "--from", "2", "--from-loop", "2") == 0
+    assert [m["end"] for m in cli.client.moves] == [3, 1]
+
+
+def test_run_single_segment_and_loops(demo: Path) -> None:
+    Cli()("points", "upload", str(demo))
+    cli = Cli()
+    assert cli("run", str(demo), "--plan", "circle", "--from", "2", "--single") == 0
+    assert [m["end"] for m in cli.client.moves] == [7]
+    cli = Cli()
+    assert cli("run", str(demo), "--plan", "circle", "--loops", "2") == 0
+    assert len(cli.client.moves) == 8
+
+
+def test_run_refuses_a_plan_with_errors(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    Cli()("points", "upload", str(demo))
+    cli = Cli()
+    assert cli("run", str(demo), "--plan", "circle", "--max-speed", "60") == cli_points.EXIT_USAGE
+    err = capsys.readouterr().err
+    assert "segment 1: speed 100 mm/s is not in (0, 60] mm/s" in err and "not running it" in err
+    assert cli.client.moves == []
+
+
+def test_run_check_only_does_not_connect(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cli = Cli()
+    assert cli("run", str(demo), "--plan", "pick and place", "--check") == 0
+    out = capsys.readouterr().out
+    assert "needs upload: 1, 2, 3, 4" in out and "check only" in out
+    assert cli.clients_made == 0
+
+
+def test_run_bad_arguments(demo: Path) -> None:
+    assert Cli()("run", str(demo), "--plan", "circle", "--from", "9") == cli_points.EXIT_USAGE
+    assert Cli()("run", str(demo), "--plan", "circle", "--from-loop", "2") == cli_points.EXIT_USAGE
+    assert Cli()("run", str(demo), "--plan", "circle", "--loops", "-1") == cli_points.EXIT_USAGE
+
+
+def test_run_when_the_controller_is_unreachable(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    class Unreachable(Cli):
+        def make_client(self) -> Any:
+            raise LinkError("connection refused")
+
+    assert Unreachable()("run", str(demo), "--plan", "circle") == cli_points.EXIT_LINK
+    assert "connection refused" in capsys.readouterr().err
+    assert Unreachable()("points", "upload", str(demo)) == cli_points.EXIT_LINK
+
+
+def test_ctrl_c_during_a_run_stops_the_robot(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    Cli()("points", "upload", str(demo))
+    cli = Cli(FakeClient(move_script={1: KeyboardInterrupt()}))
+    assert cli("run", str(demo), "--plan", "circle") == cli_points.EXIT_INTERRUPTED
+    assert cli.client.stops == 1
+    assert "--plan 'circle' --from 2" in capsys.readouterr().out
+
+
+def test_ctrl_c_during_upload_keeps_what_was_done(demo: Path) -> None:
+    cli = Cli(FakeClient(create_script={3: KeyboardInterrupt()}))
+    assert cli("points", "upload", str(demo)) == cli_points.EXIT_INTERRUPTED
+    ledger = load_project(demo).ledger
+    assert [p.id for p in ledger if p.sync is SyncState.ON_CONTROLLER] == [1, 2, 3]
+
+
+def test_failed_segment_exit_code(demo: Path) -> None:
+    Cli()("points", "upload", str(demo))
+    refused = CommandRefused(CommandStatus(CommandKind.MOVE, 13))
+    assert Cli(FakeClient(move_script={0: refused}))("run", str(demo), "--plan", "circle") == 1
+
+
+def test_through_the_main_cli(demo: Path, capsys: pytest.CaptureFixture[str],
+                              monkeypatch: pytest.MonkeyPatch) -> None:
+    """app/cli.py finds this module as a plugin and calls handler(ctx)."""
+    from app import cli as main_cli
+
+    assert main_cli.main(["points", "list", str(demo)]) == 0
+    assert "8 point(s), 2 plan(s)" in capsys.readouterr().out
+    assert main_cli.main(["run", str(demo), "--plan", "circle", "--check"]) == 0
+    assert "check only" in capsys.readouterr().out
+
+    fake = FakeClient()
+    monkeypatch.setattr(main_cli.CliContext, "client", property(lambda self: fake))
+    assert main_cli.main(["run", str(demo), "--plan", "circle", "--upload"]) == 0
+    assert len(fake.moves) == 4 and len(fake.creates) == 5
+    assert not fake.closed  # the context owns the client (it closes its own, real one)
