@@ -1,0 +1,377 @@
+"""Event log: timestamped info / warning / error rows from the link, the alarms and the commands.
+
+``add_event`` is the general entry; ``on_alarms``, ``on_command_result`` and ``on_connection``
+turn the worker's payloads into events (alarm bits are logged on their transitions only).
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import os
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+from PySide6.QtCore import (
+    QAbstractTableModel,
+    QCoreApplication,
+    QEvent,
+    QModelIndex,
+    QPersistentModelIndex,
+    QSortFilterProxyModel,
+    Qt,
+    Signal,
+    Slot,
+)
+from PySide6.QtGui import QBrush, QColor
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QComboBox,
+    QFileDialog,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QMessageBox,
+    QPushButton,
+    QTableView,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.models import CommandResult
+from app.protocol.enums import ALARM_BITS, ALARM_TEXT, TR_CONTEXT
+from ui.widgets_common import (
+    COLOR_ERROR,
+    COLOR_ERROR_BG,
+    COLOR_WARN_BG,
+    LEVEL_ERROR,
+    LEVEL_WARN,
+    atomic_write_text,
+    command_result_text,
+    connection_display,
+    monospace_font,
+    state_name,
+)
+
+LEVELS: tuple[str, ...] = ("info", "warning", "error")
+MAX_EVENTS_DEFAULT = 5000
+COL_TIME, COL_LEVEL, COL_SOURCE, COL_MESSAGE = range(4)
+_COLUMN_COUNT = 4
+
+
+@dataclass(frozen=True, slots=True)
+class LogEvent:
+    when: dt.datetime
+    level: str  # one of LEVELS
+    source: str
+    text: str
+
+    @property
+    def severity(self) -> int:
+        return LEVELS.index(self.level)
+
+
+class EventLogModel(QAbstractTableModel):
+    """Bounded list of events, oldest dropped first. Columns: time, level, source, message."""
+
+    def __init__(self, parent: Any = None, *, max_events: int = MAX_EVENTS_DEFAULT) -> None:
+        super().__init__(parent)
+        if max_events < 1:
+            raise ValueError("max_events must be >= 1")
+        self._events: list[LogEvent] = []
+        self._max = max_events
+        self._mono = monospace_font(9.5)
+        self._fg = {"warning": QBrush(QColor("#8a5300")), "error": QBrush(QColor(COLOR_ERROR))}
+        self._bg = {"warning": QBrush(QColor(COLOR_WARN_BG)), "error": QBrush(QColor(COLOR_ERROR_BG))}
+        self._headers: tuple[str, ...] = ()
+        self._level_text: dict[str, str] = {}
+        self._set_texts()
+
+    def _set_texts(self) -> None:
+        self._headers = (
+            QCoreApplication.translate("EventLogModel", "Time"),
+            QCoreApplication.translate("EventLogModel", "Level"),
+            QCoreApplication.translate("EventLogModel", "Source"),
+            QCoreApplication.translate("EventLogModel", "Message"),
+        )
+        self._level_text = {
+            "info": QCoreApplication.translate("EventLogModel", "Info"),
+            "warning": QCoreApplication.translate("EventLogModel", "Warning"),
+            "error": QCoreApplication.translate("EventLogModel", "Error"),
+        }
+
+    def retranslate(self) -> None:
+        """Headers and level names in the current language (logged messages stay as written)."""
+        self._set_texts()
+        self.headerDataChanged.emit(Qt.Orientation.Horizontal, 0, _COLUMN_COUNT - 1)
+        if self._events:
+            last = len(self._events) - 1
+            self.dataChanged.emit(
+                self.index(0, COL_LEVEL), self.index(last, COL_LEVEL), [Qt.ItemDataRole.DisplayRole]
+            )
+
+    @property
+    def max_events(self) -> int:
+        return self._max
+
+    def add(self, event: LogEvent) -> None:
+        if len(self._events) >= self._max:
+            drop = min(len(self._events), max(1, self._max // 20))
+            self.beginRemoveRows(QModelIndex(), 0, drop - 1)
+            del self._events[:drop]
+            self.endRemoveRows()
+        row = len(self._events)
+        self.beginInsertRows(QModelIndex(), row, row)
+        self._events.append(event)
+        self.endInsertRows()
+
+    def clear(self) -> None:
+        self.beginResetModel()
+        self._events.clear()
+        self.endResetModel()
+
+    def event_at(self, row: int) -> LogEvent:
+        return self._events[row]
+
+    def events(self) -> Iterable[LogEvent]:
+        return iter(self._events)
+
+    def level_text(self, level: str) -> str:
+        return self._level_text.get(level, level)
+
+    def rowCount(self, parent: QModelIndex | QPersistentModelIndex = QModelIndex()) -> int:  # noqa: B008
+        return 0 if parent.isValid() else len(self._events)
+
+    def columnCount(self, parent: QModelIndex | QPersistentModelIndex = QModelIndex()) -> int:  # noqa: B008
+        return 0 if parent.isValid() else _COLUMN_COUNT
+
+    def data(
+        self, index: QModelIndex | QPersistentModelIndex, role: int = Qt.ItemDataRole.DisplayRole
+    ) -> Any:
+        if not index.isValid():
+            return None
+        r, column = index.row(), index.column()
+        if not (0 <= r < len(self._events) and 0 <= column < _COLUMN_COUNT):
+            return None
+        event = self._events[r]
+        if role == Qt.ItemDataRole.DisplayRole:
+            if column == COL_TIME:
+                return event.when.strftime("%H:%M:%S.") + f"{event.when.microsecond // 1000:03d}"
+            if column == COL_LEVEL:
+                return self.level_text(event.level)
+            if column == COL_SOURCE:
+                return event.source
+            return event.text
+        if role == Qt.ItemDataRole.ForegroundRole:
+            return self._fg.get(event.level)
+        if role == Qt.ItemDataRole.BackgroundRole:
+            return self._bg.get(event.level)
+        if role == Qt.ItemDataRole.FontRole and column == COL_TIME:
+            return self._mono
+        if role == Qt.ItemDataRole.ToolTipRole:
+            if column == COL_TIME:
+                return event.when.isoformat(sep=" ", timespec="milliseconds")
+            if column == COL_MESSAGE:
+                return event.text
+        return None
+
+    def headerData(
+        self, section: int, orientation: Qt.Orientation, role: int = Qt.ItemDataRole.DisplayRole
+    ) -> Any:
+        horizontal = orientation == Qt.Orientation.Horizontal
+        if horizontal and role == Qt.ItemDataRole.DisplayRole and 0 <= section < _COLUMN_COUNT:
+            return self._headers[section]
+        return None
+
+
+class _LevelFilter(QSortFilterProxyModel):
+    def __init__(self, parent: Any = None) -> None:
+        super().__init__(parent)
+        self._min = 0
+
+    def set_min_severity(self, severity: int) -> None:
+        if severity != self._min:
+            self.beginFilterChange()
+            self._min = severity
+            self.endFilterChange(QSortFilterProxyModel.Direction.Rows)
+
+    def filterAcceptsRow(self, source_row: int, source_parent: QModelIndex | QPersistentModelIndex) -> bool:
+        model = self.sourceModel()
+        assert isinstance(model, EventLogModel)
+        return self._min == 0 or model.event_at(source_row).severity >= self._min
+
+
+class EventLogPanel(QWidget):
+    """Timestamped, colour-coded event list with a level filter, clear and export."""
+
+    eventAdded = Signal(object)  # noqa: N815 - LogEvent, e.g. for a status-bar flash on errors
+
+    def __init__(self, parent: QWidget | None = None, *, max_events: int = MAX_EVENTS_DEFAULT) -> None:
+        super().__init__(parent)
+        self.setObjectName("EventLogPanel")
+        self._alarms: int | None = None
+        self._last_connection: tuple[str, str] | None = None
+        self.model = EventLogModel(self, max_events=max_events)
+        self.proxy = _LevelFilter(self)
+        self.proxy.setSourceModel(self.model)
+
+        self.level_combo = QComboBox(self)
+        for severity in range(len(LEVELS)):
+            self.level_combo.addItem("", severity)
+        self.level_combo.currentIndexChanged.connect(
+            lambda i: self.proxy.set_min_severity(int(self.level_combo.itemData(i)))
+        )
+        self.clear_button = QPushButton(self)
+        self.clear_button.clicked.connect(self.clear)
+        self.export_button = QPushButton(self)
+        self.export_button.clicked.connect(self._export_dialog)
+
+        self.view = QTableView(self)
+        self.view.setModel(self.proxy)
+        self.view.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
+        self.view.setWordWrap(False)
+        self.view.setTextElideMode(Qt.TextElideMode.ElideRight)
+        vheader = self.view.verticalHeader()
+        vheader.setVisible(False)
+        vheader.setSectionResizeMode(QHeaderView.ResizeMode.Fixed)
+        vheader.setDefaultSectionSize(self.fontMetrics().height() + 6)
+        header = self.view.horizontalHeader()
+        header.setStretchLastSection(True)
+        header.setSectionResizeMode(QHeaderView.ResizeMode.Interactive)
+        digit = self.view.fontMetrics().horizontalAdvance("0")
+        self.view.setColumnWidth(COL_TIME, digit * 15)
+        self.view.setColumnWidth(COL_LEVEL, digit * 10)
+        self.view.setColumnWidth(COL_SOURCE, digit * 12)
+
+        bar = QHBoxLayout()
+        bar.setContentsMargins(0, 0, 0, 0)
+        self._show_label = QLabel(self)
+        self._show_label.setBuddy(self.level_combo)
+        bar.addWidget(self._show_label)
+        bar.addWidget(self.level_combo)
+        bar.addStretch(1)
+        bar.addWidget(self.clear_button)
+        bar.addWidget(self.export_button)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(6, 6, 6, 6)
+        layout.addLayout(bar)
+        layout.addWidget(self.view, 1)
+        self.retranslate()
+
+    def retranslate(self) -> None:
+        """(Re)set every user-visible text: at construction and on a language change."""
+        self._show_label.setText(self.tr("Show:"))
+        self.level_combo.setItemText(0, self.tr("All events"))
+        self.level_combo.setItemText(1, self.tr("Warnings and errors"))
+        self.level_combo.setItemText(2, self.tr("Errors only"))
+        self.clear_button.setText(self.tr("Clear"))
+        self.export_button.setText(self.tr("Export…"))
+        self.model.retranslate()
+
+    def changeEvent(self, event: QEvent) -> None:
+        if event.type() == QEvent.Type.LanguageChange:
+            self.retranslate()
+        super().changeEvent(event)
+
+    # --- entries ----------------------------------------------------------------------
+    def add_event(self, level: str, source: str, text: str, when: dt.datetime | None = None) -> LogEvent:
+        """Log one event; ``level`` is "info", "warning" or "error"; ``when`` defaults to now."""
+        if level not in LEVELS:
+            raise ValueError(f"level must be one of {LEVELS}, got {level!r}")
+        event = LogEvent(when or dt.datetime.now(), level, source, text)
+        bar = self.view.verticalScrollBar()
+        follow = bar.value() >= bar.maximum() - 2
+        self.model.add(event)
+        if follow:
+            self.view.scrollToBottom()
+        self.eventAdded.emit(event)
+        return event
+
+    @Slot(int)
+    def on_alarms(self, alarms: int) -> None:
+        """Log each alarm bit that was raised or cleared since the last call."""
+        alarms = int(alarms) & 0xFFFF
+        previous = self._alarms or 0
+        self._alarms = alarms
+        changed = alarms ^ previous
+        if not changed:
+            return
+        source = self.tr("alarm")
+        for bit in range(16):
+            mask = 1 << bit
+            if not changed & mask:
+                continue
+            name = self._alarm_name(mask)
+            if alarms & mask:
+                self.add_event("error", source, self.tr("Alarm raised: {name}").format(name=name))
+            else:
+                self.add_event("info", source, self.tr("Alarm cleared: {name}").format(name=name))
+
+    def _alarm_name(self, mask: int) -> str:
+        for bit in ALARM_BITS:
+            if int(bit) == mask:
+                return QCoreApplication.translate(TR_CONTEXT, ALARM_TEXT[bit])
+        return self.tr("bit {n}").format(n=mask.bit_length() - 1)
+
+    @Slot(object)
+    def on_command_result(self, result: CommandResult) -> None:
+        self.add_event("info" if result.ok else "error", self.tr("command"), command_result_text(result))
+
+    @Slot(object)
+    def on_connection(self, state_obj: Any) -> None:
+        """Log link state changes (a repeat of the same state and message is not logged)."""
+        name = state_name(state_obj)
+        message = str(getattr(state_obj, "message", "") or "")
+        if (name, message) == self._last_connection:
+            return
+        self._last_connection = (name, message)
+        text, lamp = connection_display(state_obj)
+        endpoint = str(getattr(state_obj, "endpoint", "") or "")
+        parts = [text, *(p for p in (endpoint, message) if p)]
+        if lamp == LEVEL_ERROR:
+            level = "error"
+        elif lamp == LEVEL_WARN and name != "CONNECTING":  # connecting is routine, reconnecting is not
+            level = "warning"
+        else:
+            level = "info"
+        self.add_event(level, self.tr("link"), " — ".join(parts))
+
+    @Slot()
+    def clear(self) -> None:
+        self.model.clear()
+
+    # --- export -----------------------------------------------------------------------
+    def export_to(self, path: str | os.PathLike[str]) -> int:
+        """Write every event as tab-separated text, atomically; returns the number of events."""
+        lines = [
+            "\t".join(
+                (
+                    e.when.isoformat(sep=" ", timespec="milliseconds"),
+                    e.level.upper(),
+                    e.source,
+                    " ".join(e.text.split()),
+                )
+            )  # one line per event
+            for e in self.model.events()
+        ]
+        atomic_write_text(path, "".join(line + "\n" for line in lines))
+        return len(lines)
+
+    @Slot()
+    def _export_dialog(self) -> None:
+        path, _ = QFileDialog.getSaveFileName(
+            self,
+            self.tr("Export event log"),
+            "events.txt",
+            self.tr("Text files (*.txt *.log);;All files (*)"),
+        )
+        if not path:
+            return
+        try:
+            self.export_to(path)
+        except OSError as exc:
+            QMessageBox.warning(
+                self,
+                self.tr("Export event log"),
+                self.tr("Could not write {path}: {error}").format(path=path, error=exc),
+            )

@@ -1,0 +1,435 @@
+"""Live position monitor: big XYZABC / external-axis / joint readouts, rolling plots, X–Y trace.
+
+Poll rate and paint rate are separate clocks: ``on_pose`` (called at the poll rate, 50–200 Hz)
+only stores the sample in preallocated ring buffers; a QTimer at ≤ 30 Hz, running only while the
+panel is visible, updates the readouts and hands contiguous buffer views to the curves, and does
+nothing when no sample arrived since the last paint.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6.QtCore import QEvent, QSignalBlocker, Qt, QTimer, Slot
+from PySide6.QtGui import QCloseEvent, QHideEvent, QResizeEvent, QShowEvent
+from PySide6.QtWidgets import (
+    QComboBox,
+    QGridLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QSizePolicy,
+    QSplitter,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.models import Pose
+from ui.ring_buffer import RingBuffer
+from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
+
+PAINT_HZ = 30
+PAINT_INTERVAL_MS = math.ceil(1000 / PAINT_HZ)  # 34 ms: never faster than PAINT_HZ
+WINDOW_CHOICES_S: tuple[int, ...] = (10, 30, 60)
+DEFAULT_WINDOW_S = 30
+HISTORY_CAPACITY = 16384  # samples: the longest window at up to ~270 Hz
+TRACE_CAPACITY = 20000  # X–Y path points
+TRACE_MIN_STEP_MM = 0.05  # a standing robot does not fill the trace with one point
+MAX_PLOT_POINTS = 2500  # per curve; longer windows are drawn with a stride (still a view)
+# Curves keep a view of the ring buffer until the scene repaints; never hand them the whole
+# buffer, so samples arriving before that repaint cannot overwrite what they show.
+PAINT_MARGIN = 512
+
+# History channels.
+_T, _X, _Y, _Z, _A, _B, _C = range(7)
+_CARTESIAN = ("X", "Y", "Z", "A", "B", "C")
+_PLOT_COLORS = {
+    "X": "#d62728",
+    "Y": "#2ca02c",
+    "Z": "#1f77b4",
+    "A": "#d62728",
+    "B": "#2ca02c",
+    "C": "#1f77b4",
+}
+_TRACE_COLOR = "#6a1b9a"
+_BIG_POINTS = 22.0  # readout sizes at ~1280 px width; they grow with the panel (see resizeEvent)
+_SMALL_POINTS = 13.0
+_BIG_POINTS_MAX = 34.0
+_SMALL_POINTS_MAX = 18.0
+
+
+def _style_plot(plot: pg.PlotWidget) -> None:
+    plot.setBackground("w")
+    item = plot.getPlotItem()
+    item.showGrid(x=True, y=True, alpha=0.25)
+    for name in ("left", "bottom"):
+        axis = item.getAxis(name)
+        axis.enableAutoSIPrefix(False)  # "1500 mm", never "1.5 kmm"
+        axis.setPen(pg.mkPen("#455a64"))
+        axis.setTextPen(pg.mkPen("#263238"))
+    plot.setMenuEnabled(False)
+    plot.setMinimumHeight(90)
+
+
+class MonitorPanel(QWidget):
+    """Big live readouts and plots of the robot position. Feed it with ``on_pose``."""
+
+    def __init__(
+        self,
+        parent: QWidget | None = None,
+        *,
+        history_capacity: int = HISTORY_CAPACITY,
+        trace_capacity: int = TRACE_CAPACITY,
+    ) -> None:
+        super().__init__(parent)
+        self.setObjectName("MonitorPanel")
+        # Samples: time + XYZABC; the X–Y trace has its own (longer, decimated) buffer.
+        self._history = RingBuffer(history_capacity, 7)
+        self._trace = RingBuffer(trace_capacity, 2)
+        self._t0: float | None = None
+        self._latest: Pose | None = None
+        self._readouts_dirty = False
+        self._painted_history = -1  # RingBuffer.total at the last paint (-1: force)
+        self._painted_trace = -1
+        self._window_s = float(DEFAULT_WINDOW_S)
+        self._paused = False
+
+        self._timer = QTimer(self)
+        self._timer.setInterval(PAINT_INTERVAL_MS)
+        self._timer.timeout.connect(self.refresh)
+
+        self._build_ui()
+
+    # --- UI ---------------------------------------------------------------------------
+    def _build_ui(self) -> None:
+        self.readouts: dict[str, NumericReadout] = {}
+
+        cart = QGroupBox(self)
+        self._cart_box = cart
+        grid = QGridLayout(cart)
+        grid.setContentsMargins(6, 6, 6, 6)
+        grid.setHorizontalSpacing(8)
+        grid.setVerticalSpacing(6)
+        for i, name in enumerate(_CARTESIAN):
+            readout = NumericReadout(name, "", point_size=_BIG_POINTS, parent=cart)
+            self.readouts[name] = readout
+            grid.addWidget(readout, i // 3, i % 3)
+
+        # Joints (when published) above the external axes, six columns, one box.
+        axes = QGroupBox(self)
+        axes_grid = QGridLayout(axes)
+        axes_grid.setContentsMargins(6, 4, 6, 4)
+        axes_grid.setHorizontalSpacing(6)
+        axes_grid.setVerticalSpacing(4)
+        self._joint_readouts: list[NumericReadout] = []
+        for i in range(1, 7):
+            readout = NumericReadout(
+                f"J{i}", "", point_size=_SMALL_POINTS, width_chars=8, unit_room="°", parent=axes
+            )
+            readout.setVisible(False)  # shown once a pose carries joint angles
+            self.readouts[f"J{i}"] = readout
+            self._joint_readouts.append(readout)
+            axes_grid.addWidget(readout, 0, i - 1)
+        for i in range(1, 6):
+            readout = NumericReadout(
+                f"EJ{i}", "", point_size=_SMALL_POINTS, width_chars=8, unit_room="°", parent=axes
+            )
+            self.readouts[f"EJ{i}"] = readout
+            axes_grid.addWidget(readout, 1, i - 1)
+        for column in range(6):
+            axes_grid.setColumnStretch(column, 1)
+        self._axes_box = axes
+
+        # Plot controls.
+        self.window_combo = QComboBox(self)
+        for seconds in WINDOW_CHOICES_S:
+            self.window_combo.addItem("", seconds)
+        self.window_combo.setCurrentIndex(WINDOW_CHOICES_S.index(DEFAULT_WINDOW_S))
+        self.window_combo.currentIndexChanged.connect(self._on_window_index)
+        self.pause_button = QPushButton(self)
+        self.pause_button.setCheckable(True)
+        self.pause_button.toggled.connect(self.set_paused)
+        self.clear_trace_button = QPushButton(self)
+        self.clear_trace_button.clicked.connect(self.clear_trace)
+
+        controls = QHBoxLayout()
+        controls.setContentsMargins(0, 0, 0, 0)
+        self._window_label = QLabel(self)
+        self._window_label.setBuddy(self.window_combo)
+        controls.addWidget(self._window_label)
+        controls.addWidget(self.window_combo)
+        controls.addWidget(self.pause_button)
+        controls.addStretch(1)
+        controls.addWidget(self.clear_trace_button)
+
+        # Plots.
+        self.xyz_plot = pg.PlotWidget(self)
+        self.abc_plot = pg.PlotWidget(self)
+        self.trace_plot = pg.PlotWidget(self)
+        for plot in (self.xyz_plot, self.abc_plot, self.trace_plot):
+            _style_plot(plot)
+        self.abc_plot.setXLink(self.xyz_plot)
+        self.xyz_plot.getPlotItem().hideAxis("bottom")
+        self.curves: dict[str, pg.PlotCurveItem] = {}
+        for name in _CARTESIAN:
+            plot = self.xyz_plot if name in "XYZ" else self.abc_plot
+            if name in ("X", "A"):
+                plot.addLegend(
+                    offset=(6, 6),
+                    colCount=3,
+                    labelTextColor="#263238",
+                    brush=pg.mkBrush(255, 255, 255, 210),
+                    pen=pg.mkPen("#b0bec5"),
+                )
+            curve = pg.PlotCurveItem(pen=pg.mkPen(_PLOT_COLORS[name], width=2), name=name)
+            plot.addItem(curve)
+            self.curves[name] = curve
+
+        self.trace_plot.setAspectLocked(True)
+        self.trace_curve = pg.PlotCurveItem(pen=pg.mkPen(_TRACE_COLOR, width=2))
+        self.trace_plot.addItem(self.trace_curve)
+        self.trace_marker = pg.ScatterPlotItem(size=11, brush=pg.mkBrush("#ff6f00"), pen=pg.mkPen("#263238"))
+        self.trace_plot.addItem(self.trace_marker)
+
+        time_plots = QSplitter(Qt.Orientation.Vertical, self)
+        time_plots.addWidget(self.xyz_plot)
+        time_plots.addWidget(self.abc_plot)
+        time_plots.setChildrenCollapsible(False)
+        plots = QSplitter(Qt.Orientation.Horizontal, self)
+        plots.addWidget(time_plots)
+        plots.addWidget(self.trace_plot)
+        plots.setStretchFactor(0, 2)
+        plots.setStretchFactor(1, 1)
+        plots.setChildrenCollapsible(False)
+        plots.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+
+        self._status = QLabel(self)
+        self._status.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(6, 6, 6, 6)
+        layout.setSpacing(6)
+        layout.addWidget(cart)
+        layout.addWidget(axes)
+        layout.addLayout(controls)
+        layout.addWidget(plots, 1)
+        layout.addWidget(self._status)
+        self.retranslate()
+
+    def retranslate(self) -> None:
+        """(Re)set every user-visible text: at construction and on a language change."""
+        mm, deg = self.tr("mm"), self.tr("°")
+        self._cart_box.setTitle(self.tr("TCP position (base frame)"))
+        self._axes_box.setTitle(self.tr("Joints and external axes"))
+        for i, name in enumerate(_CARTESIAN):
+            self.readouts[name].set_unit(mm if i < 3 else deg)
+        for name, readout in self.readouts.items():
+            if name.startswith(("J", "EJ")):
+                readout.set_unit(deg)
+        for index, seconds in enumerate(WINDOW_CHOICES_S):
+            self.window_combo.setItemText(index, self.tr("{n} s").format(n=seconds))
+        self.window_combo.setToolTip(self.tr("Time span of the position plots"))
+        self._window_label.setText(self.tr("Window:"))
+        self.pause_button.setText(self.tr("Pause plots"))
+        self.pause_button.setToolTip(self.tr("Freeze the plots; samples keep being recorded"))
+        self.clear_trace_button.setText(self.tr("Clear trace"))
+        self.clear_trace_button.setToolTip(self.tr("Erase the X–Y path trace"))
+        self.xyz_plot.setLabel("left", self.tr("position"), units=mm)
+        self.abc_plot.setLabel("left", self.tr("orientation"), units=deg)
+        self.abc_plot.setLabel("bottom", self.tr("time"), units=self.tr("s"))
+        self.trace_plot.setTitle(self.tr("TCP path, top view (X–Y)"), color="#263238", size="10pt")
+        self.trace_plot.setLabel("bottom", "X", units=mm)
+        self.trace_plot.setLabel("left", "Y", units=mm)
+        self._update_status_text()
+
+    def changeEvent(self, event: QEvent) -> None:
+        if event.type() == QEvent.Type.LanguageChange:
+            self.retranslate()
+        super().changeEvent(event)
+
+    # --- slots ------------------------------------------------------------------------
+    @Slot(object)
+    def on_pose(self, pose: Pose, t: float | None = None) -> None:
+        """Record one sample (``t``: monotonic seconds, default now). Cheap: no painting here."""
+        self._latest = pose
+        self._readouts_dirty = True
+        if not all(map(math.isfinite, pose.xyzabc)):
+            return  # shown as "—"; kept out of the plots (skipFiniteCheck trusts the data)
+        if t is None:
+            t = time.monotonic()
+        if self._t0 is None:
+            self._t0 = t
+        rel = t - self._t0
+        self._history.append((rel, pose.x, pose.y, pose.z, pose.a, pose.b, pose.c))
+        trace = self._trace
+        if (
+            not len(trace)
+            or math.hypot(pose.x - trace.latest(0), pose.y - trace.latest(1)) >= TRACE_MIN_STEP_MM
+        ):
+            trace.append((pose.x, pose.y))
+
+    @Slot()
+    def clear_trace(self) -> None:
+        self._trace.clear()
+        self._painted_trace = -1
+
+    @Slot()
+    def clear(self) -> None:
+        """Forget every sample (e.g. after connecting to another controller)."""
+        self._history.clear()
+        self._trace.clear()
+        self._t0 = None
+        self._latest = None
+        self._readouts_dirty = True
+        self._painted_history = -1
+        self._painted_trace = -1
+
+    @Slot(bool)
+    def set_paused(self, paused: bool) -> None:
+        """Freeze the plots (readouts and recording go on)."""
+        paused = bool(paused)
+        if paused == self._paused:
+            return
+        self._paused = paused
+        with QSignalBlocker(self.pause_button):
+            self.pause_button.setChecked(paused)
+        if not paused:
+            self._painted_history = self._painted_trace = -1
+        self._update_status_text()
+
+    def is_paused(self) -> bool:
+        return self._paused
+
+    def set_window(self, seconds: float) -> None:
+        """Time span of the rolling plots; a value from ``WINDOW_CHOICES_S`` selects its entry."""
+        if seconds <= 0:
+            raise ValueError("the plot window must be positive")
+        self._window_s = float(seconds)
+        index = self.window_combo.findData(int(seconds)) if float(seconds).is_integer() else -1
+        if index >= 0:
+            with QSignalBlocker(self.window_combo):
+                self.window_combo.setCurrentIndex(index)
+        self._painted_history = -1
+        self._update_status_text()
+
+    def window_seconds(self) -> float:
+        return self._window_s
+
+    @property
+    def paint_timer_active(self) -> bool:
+        return self._timer.isActive()
+
+    @property
+    def sample_count(self) -> int:
+        return len(self._history)
+
+    @property
+    def trace_count(self) -> int:
+        return len(self._trace)
+
+    # --- painting ---------------------------------------------------------------------
+    @Slot()
+    def refresh(self) -> None:
+        """One paint tick: readouts, then plots if new samples arrived (called by the timer)."""
+        if self._readouts_dirty:
+            self._readouts_dirty = False
+            self._paint_readouts()
+        if self._paused:
+            return
+        if self._history.total != self._painted_history:
+            self._painted_history = self._history.total
+            self._paint_history()
+        if self._trace.total != self._painted_trace:
+            self._painted_trace = self._trace.total
+            self._paint_trace()
+
+    def _paint_readouts(self) -> None:
+        pose = self._latest
+        readouts = self.readouts
+        if pose is None:
+            for readout in readouts.values():
+                readout.set_value(None)
+            return
+        for name, value in zip(_CARTESIAN, pose.xyzabc, strict=True):
+            readouts[name].set_value(value)
+        for i, value in enumerate(pose.ext[:5], start=1):
+            readouts[f"EJ{i}"].set_value(value)
+        joints = pose.joints
+        if joints and not self.joints_shown:
+            for readout in self._joint_readouts:
+                readout.setVisible(True)
+        for i, readout in enumerate(self._joint_readouts):
+            readout.set_value(joints[i] if joints and i < len(joints) else None)
+
+    @property
+    def joints_shown(self) -> bool:
+        """Whether the joint readouts are shown (after the first pose with joint angles)."""
+        return self._joint_readouts[0].isVisibleTo(self)
+
+    def _paint_history(self) -> None:
+        history = self._history
+        n = min(len(history), history.capacity - PAINT_MARGIN)
+        if n <= 0:
+            for curve in self.curves.values():
+                curve.setData([], [])
+            return
+        t = history.view(_T, n)
+        t_end = float(t[-1])
+        start = int(np.searchsorted(t, t_end - self._window_s, side="left"))
+        count = n - start
+        step = max(1, -(-count // MAX_PLOT_POINTS))
+        first = start + (count - 1) % step  # keep the newest sample on the stride
+        t_view = t[first::step]
+        for channel, name in enumerate(_CARTESIAN, start=_X):
+            self.curves[name].setData(t_view, history.view(channel, n)[first::step], skipFiniteCheck=True)
+        self.xyz_plot.setXRange(max(0.0, t_end - self._window_s), max(t_end, self._window_s), padding=0)
+
+    def _paint_trace(self) -> None:
+        trace = self._trace
+        n = min(len(trace), trace.capacity - PAINT_MARGIN)
+        if n <= 0:
+            self.trace_curve.setData([], [])
+            self.trace_marker.setData([], [])
+            return
+        xs, ys = trace.view(0, n), trace.view(1, n)
+        self.trace_curve.setData(xs, ys, skipFiniteCheck=True)
+        self.trace_marker.setData([float(xs[-1])], [float(ys[-1])])
+
+    def _update_status_text(self) -> None:
+        text = self.tr("Plots: last {n} s").format(n=f"{self._window_s:g}")
+        if self._paused:
+            text += " — " + self.tr("paused")
+        self._status.setText(text)
+
+    @Slot(int)
+    def _on_window_index(self, index: int) -> None:
+        seconds = self.window_combo.itemData(index)
+        if seconds:
+            self.set_window(float(seconds))
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        # Bigger numbers on bigger screens: readable from a distance at 1920 px as at 1280 px.
+        scale = min(max(event.size().width() / 1280.0, 1.0), _BIG_POINTS_MAX / _BIG_POINTS)
+        big, small = round(_BIG_POINTS * scale), round(min(_SMALL_POINTS * scale, _SMALL_POINTS_MAX))
+        for name, readout in self.readouts.items():
+            readout.set_point_size(big if name in _CARTESIAN else small)
+        super().resizeEvent(event)
+
+    # --- timer follows visibility -------------------------------------------------------
+    def showEvent(self, event: QShowEvent) -> None:
+        super().showEvent(event)
+        self._readouts_dirty = True
+        self.refresh()
+        self._timer.start()
+
+    def hideEvent(self, event: QHideEvent) -> None:
+        self._timer.stop()
+        super().hideEvent(event)
+
+    def closeEvent(self, event: QCloseEvent) -> None:
+        self._timer.stop()
+        super().closeEvent(event)

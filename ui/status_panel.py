@@ -1,0 +1,342 @@
+"""Controller status at a glance: link and RTT, mode, program state, alarm lamps, last command
+result and the controller clock with its drift from the PC clock.
+
+The panel only displays what its slots receive; it keeps no controller state of its own beyond
+what is needed to draw it.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+from typing import Any
+
+from PySide6.QtCore import QCoreApplication, QEvent, Qt, Slot
+from PySide6.QtWidgets import (
+    QFormLayout,
+    QGridLayout,
+    QGroupBox,
+    QLabel,
+    QSizePolicy,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.models import CommandResult, ControllerStatus
+from app.protocol.datetime_regs import ControllerClock
+from app.protocol.enums import (
+    ALARM_BITS,
+    ALARM_MASK,
+    ALARM_TEXT,
+    CONTROLLER_MODE_TEXT,
+    PROGRAM_STATE_TEXT,
+    TR_CONTEXT,
+    UNKNOWN_STATUS_TEXT,
+    ControllerMode,
+    ProgramState,
+)
+from app.protocol.registers import GV_DATE
+from ui.widgets_common import (
+    COLOR_ERROR,
+    COLOR_NEUTRAL,
+    COLOR_OK,
+    COLOR_WARN,
+    LEVEL_ERROR,
+    LEVEL_INFO,
+    LEVEL_OFF,
+    LEVEL_OK,
+    LEVEL_WARN,
+    AlarmLamp,
+    Lamp,
+    command_result_text,
+    connection_display,
+    monospace_font,
+)
+
+CLOCK_DRIFT_WARN_S = 5.0  # |controller - PC| above this is shown in amber
+CLOCK_DRIFT_ERROR_S = 300.0  # ... and above this in red
+_CLOCK_FIRST_REGISTER = 2 * GV_DATE  # 576
+
+_MODE_LEVEL = {
+    ControllerMode.MANUAL: LEVEL_OFF,
+    ControllerMode.AUTO: LEVEL_INFO,
+    ControllerMode.MODBUS_TEACH: LEVEL_WARN,
+}
+_PROGRAM_LEVEL = {
+    ProgramState.STOPPED: LEVEL_OFF,
+    ProgramState.RUNNING: LEVEL_OK,
+    ProgramState.PAUSED: LEVEL_WARN,
+}
+_LAMP_POINTS = 11.0
+
+
+def _protocol_tr(text: str) -> str:
+    return QCoreApplication.translate(TR_CONTEXT, text)
+
+
+def _enum_text(enum_type: Any, texts: dict[Any, str], value: int) -> tuple[Any, str]:
+    """(member or None, translated text) of a table-2 value; unknown values say their code."""
+    try:
+        member = enum_type(value)
+    except ValueError:
+        return None, _protocol_tr(UNKNOWN_STATUS_TEXT).format(code=value)
+    return member, _protocol_tr(texts[member])
+
+
+class StatusPanel(QWidget):
+    """Shows ControllerStatus, link state, RTT, the last CommandResult and the controller clock.
+
+    The last payload of each slot is kept only to redraw it after a language change.
+    """
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("StatusPanel")
+        self._alarms: int | None = None
+        self._status: ControllerStatus | None = None
+        self._connection: Any = None
+        self._rtt: float | None = None
+        self._result: CommandResult | None = None
+        self._clock: ControllerClock | None = None
+        self._drift: float | None = None
+        self._build_ui()
+        self.retranslate()
+
+    def _build_ui(self) -> None:
+        # Link.
+        self._link_box = QGroupBox(self)
+        link_form = QFormLayout(self._link_box)
+        link_form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+        self.link_lamp = Lamp("", self._link_box, point_size=_LAMP_POINTS)
+        self.link_message = QLabel("", self._link_box)
+        self.link_message.setWordWrap(True)
+        self.link_message.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+        self.link_message.setVisible(False)
+        self.rtt_label = QLabel("—", self._link_box)
+        self.rtt_label.setFont(monospace_font(12))
+        self._row_labels: dict[str, QLabel] = {}
+        link_form.addRow(self._row_label("state"), self.link_lamp)
+        link_form.addRow("", self.link_message)
+        link_form.addRow(self._row_label("rtt"), self.rtt_label)
+
+        # Controller.
+        self._ctrl_box = QGroupBox(self)
+        ctrl_form = QFormLayout(self._ctrl_box)
+        ctrl_form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
+        self.mode_label = Lamp("—", self._ctrl_box, point_size=_LAMP_POINTS + 1)
+        self.program_label = Lamp("—", self._ctrl_box, point_size=_LAMP_POINTS + 1)
+        self.clock_label = QLabel("—", self._ctrl_box)
+        self.clock_label.setFont(monospace_font(12))
+        self.drift_label = QLabel("", self._ctrl_box)
+        self.drift_label.setFont(monospace_font(11))
+        self.command_label = QLabel("", self._ctrl_box)
+        self.command_label.setWordWrap(True)
+        self.command_label.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Preferred)
+        self.command_label.setProperty("ok", None)
+        self.command_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+        ctrl_form.addRow(self._row_label("mode"), self.mode_label)
+        ctrl_form.addRow(self._row_label("program"), self.program_label)
+        ctrl_form.addRow(self._row_label("command"), self.command_label)
+        ctrl_form.addRow(self._row_label("clock"), self.clock_label)
+        ctrl_form.addRow(self._row_label("drift"), self.drift_label)
+
+        # Alarms: one lamp per documented bit, plus one for undocumented bits.
+        self._alarm_box = QGroupBox(self)
+        alarm_grid = QGridLayout(self._alarm_box)
+        alarm_grid.setSpacing(6)
+        self.alarm_lamps: dict[int, AlarmLamp] = {}
+        for i, bit in enumerate(ALARM_BITS):
+            lamp = AlarmLamp("", self._alarm_box, point_size=_LAMP_POINTS)
+            self.alarm_lamps[int(bit)] = lamp
+            alarm_grid.addWidget(lamp, i // 2, i % 2)
+        self.other_alarm_lamp = AlarmLamp("", self._alarm_box, point_size=_LAMP_POINTS)
+        alarm_grid.addWidget(self.other_alarm_lamp, len(ALARM_BITS) // 2, len(ALARM_BITS) % 2)
+        alarm_grid.setColumnStretch(0, 1)
+        alarm_grid.setColumnStretch(1, 1)
+
+        for label in (self.rtt_label, self.clock_label, self.drift_label, self.command_label):
+            label.setMinimumHeight(28)
+            label.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
+
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(6, 6, 6, 6)
+        layout.addWidget(self._link_box)
+        layout.addWidget(self._ctrl_box)
+        layout.addWidget(self._alarm_box)
+        layout.addStretch(1)
+        self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Preferred)
+
+    def _row_label(self, key: str) -> QLabel:
+        # As tall as a lamp and centred, so the caption lines up with the lamp's text.
+        label = QLabel(self)
+        label.setMinimumHeight(28)
+        label.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
+        self._row_labels[key] = label
+        return label
+
+    def retranslate(self) -> None:
+        """(Re)set every user-visible text: at construction and on a language change."""
+        self._link_box.setTitle(self.tr("Link"))
+        self._ctrl_box.setTitle(self.tr("Controller"))
+        self._alarm_box.setTitle(self.tr("Alarms"))
+        rows = self._row_labels
+        rows["state"].setText(self.tr("State:"))
+        rows["rtt"].setText(self.tr("RTT:"))
+        rows["mode"].setText(self.tr("Mode:"))
+        rows["program"].setText(self.tr("Program:"))
+        rows["command"].setText(self.tr("Last command:"))
+        rows["clock"].setText(self.tr("Clock:"))
+        rows["drift"].setText(self.tr("Drift:"))
+        self.rtt_label.setToolTip(self.tr("Round-trip time of the last poll"))
+        for bit in ALARM_BITS:
+            lamp = self.alarm_lamps[int(bit)]
+            lamp.setText(_protocol_tr(ALARM_TEXT[bit]))
+            lamp.setToolTip(self.tr("Register 562 bit {bit}").format(bit=int(bit).bit_length() - 1))
+        self.other_alarm_lamp.setToolTip(self.tr("Register 562 bits with no documented meaning"))
+        # Redraw what the slots showed, in the new language.
+        if self._connection is None:
+            self.link_lamp.setText(self.tr("disconnected"))
+        else:
+            self._render_connection()
+        self._render_rtt()
+        if self._status is not None:
+            self._render_status()
+        self._render_alarms()
+        if self._result is None:
+            self.command_label.setText(self.tr("none yet"))
+        else:
+            self._render_result()
+        if self._clock is not None:
+            self._render_clock()
+
+    def changeEvent(self, event: QEvent) -> None:
+        if event.type() == QEvent.Type.LanguageChange:
+            self.retranslate()
+        super().changeEvent(event)
+
+    # --- slots ------------------------------------------------------------------------
+    @Slot(object)
+    def on_status(self, status: ControllerStatus) -> None:
+        """Mode, program state, alarm bits and (when read along) the clock."""
+        self._status = status
+        self._render_status()
+        self.on_alarms(int(status.alarms))
+        if status.clock is not None:
+            self.on_clock(status.clock)
+
+    @Slot(int)
+    def on_alarms(self, alarms: int) -> None:
+        alarms = int(alarms) & 0xFFFF
+        if alarms != self._alarms:
+            self._alarms = alarms
+            self._render_alarms()
+
+    @Slot(object)
+    def on_connection(self, state_obj: Any) -> None:
+        """Anything with ``.state.name`` and ``.message`` (optionally ``.endpoint``, ``.monitor_only``)."""
+        self._connection = state_obj
+        self._render_connection()
+
+    @Slot(float)
+    def on_rtt(self, ms: float) -> None:
+        self._rtt = ms
+        self._render_rtt()
+
+    @Slot(object)
+    def on_command_result(self, result: CommandResult) -> None:
+        self._result = result
+        self._render_result()
+
+    @Slot(object)
+    def on_clock(self, clock: ControllerClock, now: dt.datetime | None = None) -> None:
+        """Controller date/time, its drift from the PC clock (``now``, default: local now)."""
+        self._clock = clock
+        if clock.value is None:
+            self._drift = None
+        else:
+            self._drift = (clock.value - (now or dt.datetime.now())).total_seconds()
+        self._render_clock()
+
+    def alarm_lamp_for(self, bit: int) -> AlarmLamp:
+        return self.alarm_lamps[int(bit)]
+
+    # --- drawing ----------------------------------------------------------------------
+    def _render_status(self) -> None:
+        status = self._status
+        assert status is not None
+        mode, text = _enum_text(ControllerMode, CONTROLLER_MODE_TEXT, int(status.mode))
+        self.mode_label.setText(text)
+        self.mode_label.set_level(_MODE_LEVEL.get(mode, LEVEL_ERROR))
+        state, text = _enum_text(ProgramState, PROGRAM_STATE_TEXT, int(status.program_state))
+        self.program_label.setText(text)
+        self.program_label.set_level(_PROGRAM_LEVEL.get(state, LEVEL_ERROR))
+
+    def _render_alarms(self) -> None:
+        alarms = self._alarms or 0
+        for bit, lamp in self.alarm_lamps.items():
+            lamp.set_active(bool(alarms & bit))
+        unknown = alarms & ~ALARM_MASK
+        self.other_alarm_lamp.set_active(bool(unknown))
+        if unknown:
+            bits = ", ".join(str(b) for b in range(16) if unknown & (1 << b))
+            self.other_alarm_lamp.setText(self.tr("other bits: {bits}").format(bits=bits))
+        else:
+            self.other_alarm_lamp.setText(self.tr("other bits"))
+
+    def _render_connection(self) -> None:
+        state_obj = self._connection
+        text, level = connection_display(state_obj)
+        self.link_lamp.setText(text)
+        self.link_lamp.set_level(level)
+        parts = [str(p) for p in (getattr(state_obj, "endpoint", ""), getattr(state_obj, "message", "")) if p]
+        if getattr(state_obj, "monitor_only", False):
+            parts.append(self.tr("monitor only: writes blocked"))
+        self.link_message.setText(" — ".join(parts))
+        self.link_message.setVisible(bool(parts))
+
+    def _render_rtt(self) -> None:
+        ms = self._rtt
+        text = "—" if ms is None or not math.isfinite(ms) else self.tr("{ms} ms").format(ms=f"{ms:.1f}")
+        if text != self.rtt_label.text():
+            self.rtt_label.setText(text)
+
+    def _render_result(self) -> None:
+        result = self._result
+        assert result is not None
+        self.command_label.setText(command_result_text(result))
+        self.command_label.setProperty("ok", bool(result.ok))
+        color = COLOR_OK if result.ok else COLOR_ERROR
+        self.command_label.setStyleSheet(f"color: {color}; font-weight: bold;")
+        tip = []
+        if result.status is not None:
+            tip.append(self.tr("GV291 code: {code}").format(code=result.status.code))
+        tip.extend(f"{key} = {value:g}" for key, value in result.details.items())
+        self.command_label.setToolTip("\n".join(tip))
+
+    def _render_clock(self) -> None:
+        clock = self._clock
+        assert clock is not None
+        last = _CLOCK_FIRST_REGISTER + len(clock.raw) - 1
+        tip = self.tr("Raw words {first}..{last}: {words}").format(
+            first=_CLOCK_FIRST_REGISTER, last=last, words=clock.raw_hex
+        )
+        self.clock_label.setToolTip(tip)
+        self.drift_label.setToolTip(self.tr("Controller clock minus PC clock") + "\n" + tip)
+        drift = self._drift
+        self.drift_label.setProperty("drift", drift)
+        if clock.value is None or drift is None:
+            self.clock_label.setText(self.tr("invalid date/time"))
+            self.clock_label.setStyleSheet(f"color: {COLOR_ERROR};")
+            self.drift_label.setText("—")
+            self.drift_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+            return
+        self.clock_label.setText(clock.value.strftime("%Y-%m-%d %H:%M:%S"))
+        self.clock_label.setStyleSheet("")
+        self.drift_label.setText(self.tr("{drift} s").format(drift=f"{drift:+.0f}"))
+        if abs(drift) > CLOCK_DRIFT_ERROR_S:
+            color = COLOR_ERROR
+        elif abs(drift) > CLOCK_DRIFT_WARN_S:
+            color = COLOR_WARN
+        else:
+            color = COLOR_OK
+        self.drift_label.setStyleSheet(f"color: {color};")

@@ -1,0 +1,286 @@
+"""Small widgets and helpers shared by the panels: numeric readout, lamps, atomic file writes,
+and the display text of connection states and command results.
+
+Translatable strings here use the context ``Panels``; protocol texts keep theirs (``Protocol``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QCoreApplication, Qt
+from PySide6.QtGui import QFont, QFontDatabase
+from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QSizePolicy, QWidget
+
+from app.models import CommandResult
+from app.protocol.enums import (
+    QT_TRANSLATE_NOOP,
+    RUN_COMMAND_TEXT,
+    TR_CONTEXT,
+    UNKNOWN_STATUS_TEXT,
+)
+
+TR = "Panels"
+
+# --- colours (one place; the lamps and the tables use the same ones) --------------------
+COLOR_ERROR = "#c62828"
+COLOR_ERROR_BG = "#fde0e0"
+COLOR_WARN = "#ef8f00"
+COLOR_WARN_BG = "#fff1d6"
+COLOR_OK = "#2e7d32"
+COLOR_OK_BG = "#e3f4e4"
+COLOR_INFO = "#1565c0"
+COLOR_NEUTRAL = "#5f6368"
+COLOR_NEUTRAL_BG = "#eceff1"
+
+# Lamp levels: the ``level`` dynamic property holds one of these.
+LEVEL_OFF = "off"
+LEVEL_OK = "ok"
+LEVEL_WARN = "warn"
+LEVEL_ERROR = "error"
+LEVEL_INFO = "info"
+
+_LAMP_STYLE: dict[str, tuple[str, str, str]] = {  # level -> (background, text, border)
+    LEVEL_OFF: (COLOR_NEUTRAL_BG, COLOR_NEUTRAL, "#cfd8dc"),
+    LEVEL_OK: (COLOR_OK, "#ffffff", COLOR_OK),
+    LEVEL_WARN: (COLOR_WARN, "#ffffff", COLOR_WARN),
+    LEVEL_ERROR: (COLOR_ERROR, "#ffffff", COLOR_ERROR),
+    LEVEL_INFO: (COLOR_INFO, "#ffffff", COLOR_INFO),
+}
+
+
+def monospace_font(point_size: float, *, bold: bool = False) -> QFont:
+    """The system fixed-pitch font (equal-width digits) at ``point_size``."""
+    font = QFontDatabase.systemFont(QFontDatabase.SystemFont.FixedFont)
+    font.setStyleHint(QFont.StyleHint.TypeWriter)
+    font.setFixedPitch(True)
+    font.setPointSizeF(point_size)
+    font.setBold(bold)
+    return font
+
+
+class Lamp(QLabel):
+    """A coloured indicator with a caption. ``level()`` is also the ``level`` dynamic property."""
+
+    def __init__(self, text: str = "", parent: QWidget | None = None, *, point_size: float = 0.0) -> None:
+        super().__init__(text, parent)
+        self.setAlignment(Qt.AlignmentFlag.AlignCenter)
+        self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Fixed)
+        self.setMinimumHeight(28)
+        if point_size:
+            font = self.font()
+            font.setPointSizeF(point_size)
+            self.setFont(font)
+        self._level = ""
+        self.set_level(LEVEL_OFF)
+
+    def level(self) -> str:
+        return self._level
+
+    def set_level(self, level: str) -> None:
+        if level not in _LAMP_STYLE:
+            raise ValueError(f"unknown lamp level {level!r}")
+        if level == self._level:
+            return
+        self._level = level
+        self.setProperty("level", level)
+        background, text, border = _LAMP_STYLE[level]
+        weight = "normal" if level == LEVEL_OFF else "bold"
+        self.setStyleSheet(
+            f"QLabel {{ background-color: {background}; color: {text}; border: 1px solid {border};"
+            f" border-radius: 5px; padding: 3px 10px; font-weight: {weight}; }}"
+        )
+
+
+class AlarmLamp(Lamp):
+    """One alarm bit: red while set, neutral otherwise (``active`` dynamic property too)."""
+
+    def __init__(self, text: str = "", parent: QWidget | None = None, *, point_size: float = 0.0) -> None:
+        super().__init__(text, parent, point_size=point_size)
+        self.setProperty("active", False)
+
+    def is_active(self) -> bool:
+        return self.level() == LEVEL_ERROR
+
+    def set_active(self, active: bool) -> None:
+        self.setProperty("active", bool(active))
+        self.set_level(LEVEL_ERROR if active else LEVEL_OFF)
+
+
+class NumericReadout(QFrame):
+    """A large fixed-decimal number with its caption and unit, e.g. ``X  -123.456 mm``.
+
+    ``set_value`` only touches the label when the shown text changes, so calling it at the
+    paint rate with an unchanged value costs nothing.
+    """
+
+    PLACEHOLDER = "—"
+
+    def __init__(
+        self,
+        caption: str,
+        unit: str,
+        *,
+        decimals: int = 3,
+        point_size: float = 22.0,
+        width_chars: int = 9,
+        unit_room: str = "mm ",
+        parent: QWidget | None = None,
+    ) -> None:
+        super().__init__(parent)
+        self.setFrameShape(QFrame.Shape.StyledPanel)
+        self.setObjectName("NumericReadout")
+        self._decimals = decimals
+        self._value: float | None = None
+
+        self._width_chars = width_chars
+        self._unit_room = unit_room  # the unit column is this wide, so numbers line up
+        self._point_size = 0.0
+
+        self._caption = QLabel(caption, self)
+        self._caption.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+        self._number = QLabel(self.PLACEHOLDER, self)
+        self._number.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+        self._number.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Preferred)
+        self._number.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self._unit = QLabel(unit, self)
+        self._unit.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+        self.set_point_size(point_size)
+
+        layout = QHBoxLayout(self)
+        layout.setContentsMargins(6, 2, 6, 2)
+        layout.setSpacing(6)
+        layout.addWidget(self._caption)
+        layout.addWidget(self._number, 1)
+        layout.addWidget(self._unit)
+        self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
+
+    def point_size(self) -> float:
+        return self._point_size
+
+    def set_point_size(self, point_size: float) -> None:
+        """Size of the number; caption and unit follow. Keeps room for ``width_chars`` digits."""
+        if point_size == self._point_size:
+            return
+        self._point_size = point_size
+        caption_font = self.font()
+        caption_font.setPointSizeF(max(9.0, point_size * 0.6))
+        caption_font.setBold(True)
+        self._caption.setFont(caption_font)
+        self._number.setFont(monospace_font(point_size, bold=True))
+        # Room for the widest expected value so the layout does not jump while the robot moves.
+        self._number.setMinimumWidth(self._number.fontMetrics().horizontalAdvance("8" * self._width_chars))
+        unit_font = self.font()
+        unit_font.setPointSizeF(max(9.0, point_size * 0.55))
+        self._unit.setFont(unit_font)
+        self._unit.setMinimumWidth(self._unit.fontMetrics().horizontalAdvance(self._unit_room))
+
+    @property
+    def value(self) -> float | None:
+        return self._value
+
+    def text(self) -> str:
+        """The number as shown (without caption and unit)."""
+        return self._number.text()
+
+    def caption(self) -> str:
+        return self._caption.text()
+
+    def unit(self) -> str:
+        return self._unit.text()
+
+    def set_unit(self, unit: str) -> None:
+        self._unit.setText(unit)
+
+    def set_value(self, value: float | None) -> None:
+        self._value = value
+        if value is None or value != value:  # None or NaN
+            text = self.PLACEHOLDER
+        else:
+            text = f"{value:.{self._decimals}f}"
+            if text.startswith("-") and float(text) == 0.0:
+                text = text[1:]  # no "-0.000" flicker around zero
+        if text != self._number.text():
+            self._number.setText(text)
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str, *, encoding: str = "utf-8") -> None:
+    """Write ``text`` to ``path`` atomically: a temp file in the same folder, then ``os.replace``.
+
+    Readers see the old file or the complete new one, never a partial one; the temp file is
+    removed if anything fails.
+    """
+    target = Path(path)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent or ".")
+    try:
+        with os.fdopen(fd, "w", encoding=encoding, newline="") as handle:
+            handle.write(text)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.replace(tmp_name, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp_name)
+        raise
+
+
+# --- connection state -------------------------------------------------------------------
+_STATE_TEXT: dict[str, tuple[str, str]] = {  # state name -> (text, lamp level)
+    "CONNECTED": (QT_TRANSLATE_NOOP("Panels", "connected"), LEVEL_OK),
+    "CONNECTING": (QT_TRANSLATE_NOOP("Panels", "connecting"), LEVEL_WARN),
+    "RECONNECTING": (QT_TRANSLATE_NOOP("Panels", "reconnecting"), LEVEL_WARN),
+    "DISCONNECTED": (QT_TRANSLATE_NOOP("Panels", "disconnected"), LEVEL_OFF),
+    "STOPPED": (QT_TRANSLATE_NOOP("Panels", "stopped"), LEVEL_OFF),
+    "DOWN": (QT_TRANSLATE_NOOP("Panels", "link down"), LEVEL_ERROR),
+    "LOST": (QT_TRANSLATE_NOOP("Panels", "link lost"), LEVEL_ERROR),
+    "LINK_LOST": (QT_TRANSLATE_NOOP("Panels", "link lost"), LEVEL_ERROR),
+    "ERROR": (QT_TRANSLATE_NOOP("Panels", "error"), LEVEL_ERROR),
+    "FAILED": (QT_TRANSLATE_NOOP("Panels", "failed"), LEVEL_ERROR),
+}
+
+
+def state_name(state_obj: Any) -> str:
+    """``state_obj.state.name`` (any enum-like), or ``str(state)`` for plain values."""
+    state = getattr(state_obj, "state", state_obj)
+    return str(getattr(state, "name", state)).upper()
+
+
+def connection_display(state_obj: Any) -> tuple[str, str]:
+    """(translated text, lamp level) for an object with ``.state.name`` and ``.message``."""
+    name = state_name(state_obj)
+    text, level = _STATE_TEXT.get(name, (name.lower().replace("_", " "), LEVEL_WARN))
+    return QCoreApplication.translate(TR, text), level
+
+
+# --- command results --------------------------------------------------------------------
+def command_name(result: CommandResult) -> str:
+    """Translated name of the command a result belongs to."""
+    if result.command is not None and result.command in RUN_COMMAND_TEXT:
+        return QCoreApplication.translate(TR_CONTEXT, RUN_COMMAND_TEXT[result.command])
+    return QCoreApplication.translate("Panels", "command")
+
+
+def command_status_text(result: CommandResult) -> str:
+    """Translated GV291 meaning, decoded with the table of the result's command kind."""
+    status = result.status
+    if status is None:
+        if result.ok:
+            return QCoreApplication.translate("Panels", "done")
+        return QCoreApplication.translate("Panels", "failed")
+    if status.text == UNKNOWN_STATUS_TEXT.format(code=status.code):
+        return QCoreApplication.translate(TR_CONTEXT, UNKNOWN_STATUS_TEXT).format(code=status.code)
+    return QCoreApplication.translate(TR_CONTEXT, status.text)
+
+
+def command_result_text(result: CommandResult) -> str:
+    """``"<command>: <status>"`` plus the result's message when it has one."""
+    text = QCoreApplication.translate("Panels", "{command}: {status}").format(
+        command=command_name(result), status=command_status_text(result)
+    )
+    if result.message:
+        text = f"{text} — {result.message}"
+    return text
