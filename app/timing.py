@@ -9,9 +9,11 @@ REQUEST_RETRIES = 0
 # Waiting for a command's GV291 result.
 STATUS_POLL_INTERVAL = 0.002  # s between status reads while waiting for a short command
 MOVE_POLL_INTERVAL = 0.01  # s between status reads while waiting for a motion
+ACK_POLL_INTERVAL = 0.0005  # s between status reads until GV291 leaves the pre-command code
 ACK_TIMEOUT = 2.0  # s for the controller to show it has taken a command (leave the stale code)
 CREATE_POINT_TIMEOUT = 3.0  # s for create-point / teach enable to finish
 MOVE_TIMEOUT_MIN = 10.0  # s; a move's timeout is max(this, 3 x its estimated duration)
+STOP_SETTLE = 0.3  # s a moved command must read 'stopped' with GV291 = 0 before it counts as stopped
 
 # Worker (GUI side).
 POLL_HZ_DEFAULT = 50

@@ -204,7 +204,7 @@ class _LevelFilter(QSortFilterProxyModel):
 class EventLogPanel(QWidget):
     """Timestamped, colour-coded event list with a level filter, clear and export."""
 
-    eventAdded = Signal(object)  # noqa: N815 - LogEvent, e.g. for a status-bar flash on errors
+    eventAdded = Signal(object)
 
     def __init__(self, parent: QWidget | None = None, *, max_events: int = MAX_EVENTS_DEFAULT) -> None:
         super().__init__(parent)

@@ -456,7 +456,7 @@ class TrafficFilter(QSortFilterProxyModel):
 class TrafficPanel(QWidget):
     """Table of Modbus frames with filter, hide-polls, pause capture, clear and export."""
 
-    captureEnabledChanged = Signal(bool)  # noqa: N815 - Qt signal naming
+    captureEnabledChanged = Signal(bool)
 
     def __init__(self, parent: QWidget | None = None, *, max_rows: int = MAX_ROWS_DEFAULT) -> None:
         super().__init__(parent)

@@ -1,0 +1,1032 @@
+"""RobotClient: one method per controller operation, typed results, typed errors.
+
+The client owns one synchronous pymodbus client (TCP, RTU over serial, or RTU framing over
+TCP for tests) and is not thread-safe: one thread owns it (the GUI worker, or the CLI).
+
+Decisions on the open questions of PROTOCOL.md section 7 that live here:
+
+* **Completion detection** (the stale-0xFF problem) is :class:`CommandTracker`. A command is
+  *acknowledged* once GV291 has shown a value different from the code it held before the
+  command was sent, or — for moves — once the motion is visibly under way (program state
+  running/paused, status "moving", or the pose left its starting value). A terminal code
+  (0xFF or an error) ends the command only if GV291 has left the pre-command code at some
+  point since the command was sent; a code equal to the stale one never ends it. So an old
+  0xFF is never taken for the new command's, at the price that a controller which goes
+  0xFF -> 0 -> 0xFF faster than the host can read looks unacknowledged
+  (-> :class:`CommandTimeout` after ``timing.ACK_TIMEOUT``). To keep that window small the
+  first status read follows the command at once and, until GV291 has changed, reads follow
+  every ``timing.ACK_POLL_INTERVAL`` (for at most ``ACK_TIMEOUT``). A move that was seen
+  moving and has stopped while GV291 never left the stale code ends, after ``ACK_TIMEOUT``,
+  as a :class:`CommandTimeout` saying the result is unknown (never as success).
+* **After a stop** the wait ends when the host sent the stop itself, or when a move that was
+  seen under way shows program state *stopped* with GV291 at 0 (initial) for
+  ``timing.STOP_SETTLE`` (a transient 0 just before 0xFF is not a stop).
+* **Work mode**: before a motion/create/teach command the client reads the status (it needs
+  it as the tracker's "before" anyway) and writes 444 <- auto only when the mode reads manual
+  (or an unknown value); Modbus-teach (2) counts as auto.
+* **Cached parameters**: GV245 (tool), GV241 (user frame) and the external-axis offsets
+  GV236-240 are written only when they differ from what this client last wrote; the cache is
+  dropped whenever the connection is (re)made or fails, and by :meth:`invalidate_cache`.
+* Control registers 440-445 are written with 0x06 only; raw multi-register writes that touch
+  them are refused (:class:`InvalidInput`).
+* A request that timed out closes the link (the next request reconnects), so a late answer
+  is never read as the next request's.
+* Traffic observers are called synchronously in the client's thread, inside the request:
+  keep them short (the GUI should only queue the record).
+"""
+
+from __future__ import annotations
+
+import enum
+import logging
+import math
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from pymodbus.client import ModbusSerialClient, ModbusTcpClient
+from pymodbus.exceptions import ConnectionException, ModbusException, ModbusIOException
+from pymodbus.framer import FramerType
+
+from app import timing
+from app.errors import (
+    AlarmRaised,
+    CommandRefused,
+    CommandStopped,
+    CommandTimeout,
+    InvalidInput,
+    LinkError,
+    ModbusExceptionError,
+    ResponseTimeout,
+    TeachPadError,
+    WriteBlocked,
+)
+from app.models import CommandResult, ControllerStatus, Pose
+from app.protocol import registers
+from app.protocol.codec import WordOrder, check_float32, decode_floats, encode_floats
+from app.protocol.datetime_regs import ControllerClock, DateTimeLayout, decode_clock
+from app.protocol.enums import (
+    RUN_COMMAND_TEXT,
+    Alarm,
+    CommandKind,
+    CommandStatus,
+    ControllerMode,
+    ProgramMotionMode,
+    ProgramState,
+    RunCommand,
+    TeachFrame,
+    WorkMode,
+    alarm_names,
+    decode_command_status,
+    decode_status_registers,
+)
+
+__all__ = [
+    "POSE_EPSILON",
+    "CommandTracker",
+    "ConnectionSettings",
+    "RobotClient",
+    "StepFrame",
+    "TrafficRecord",
+]
+
+_log = logging.getLogger(__name__)
+
+# A pose component that changed by more than this (mm or degrees) counts as motion.
+POSE_EPSILON = 1e-3
+
+_CONTROL_REGISTERS = range(registers.REG_RUN_COMMAND, registers.REG_GO_ZERO + 1)  # 440..445: 0x06 only
+_MAX_REGISTER = 0xFFFF
+_GENERAL_POSE_LAST_START = registers.GV_GENERAL_LAST - 5  # six GVs must fit in GV0..GV99
+
+_MODBUS_EXCEPTION_TEXT: dict[int, str] = {
+    0x01: "illegal function",
+    0x02: "illegal data address",
+    0x03: "illegal data value",
+    0x04: "server device failure",
+    0x05: "acknowledge",
+    0x06: "server device busy",
+    0x07: "negative acknowledge",
+    0x08: "memory parity error",
+    0x0A: "gateway path unavailable",
+    0x0B: "gateway target device failed to respond",
+}
+
+
+class StepFrame(enum.Enum):
+    """Frame of an incremental move (function 1)."""
+
+    JOINT = "joint"
+    BASE = "base"
+
+    @property
+    def command(self) -> RunCommand:
+        return RunCommand.STEP_JOINT if self is StepFrame.JOINT else RunCommand.STEP_BASE
+
+
+@dataclass
+class ConnectionSettings:
+    """How to reach the controller, and the host-side limits."""
+
+    host: str = "127.0.0.1"
+    port: int = 502
+    unit: int = 1
+    serial_port: str | None = None  # RTU over a serial line when set
+    baudrate: int = 115200
+    parity: str = "N"
+    stopbits: int = 1
+    bytesize: int = 8
+    framer: Literal["socket", "rtu"] = "socket"  # "rtu" over TCP is for tests
+    word_order: WordOrder = WordOrder.LOW_FIRST
+    timeout: float = timing.REQUEST_TIMEOUT
+    retries: int = timing.REQUEST_RETRIES
+    monitor_only: bool = False
+    datetime_layout: DateTimeLayout = DateTimeLayout.SPLIT_WORDS
+    point_id_min: int = registers.TEMP_POINT_ID_MIN
+    point_id_max: int = registers.TEMP_POINT_ID_MAX
+
+    @property
+    def transport(self) -> Literal["tcp", "rtu"]:
+        """What the frames look like on the wire."""
+        return "rtu" if self.serial_port is not None or self.framer == "rtu" else "tcp"
+
+    @property
+    def endpoint(self) -> str:
+        """``host:port`` or the serial device, for messages."""
+        return self.serial_port if self.serial_port is not None else f"{self.host}:{self.port}"
+
+
+@dataclass(frozen=True, slots=True)
+class TrafficRecord:
+    """One frame as on the wire (MBAP included for TCP, CRC included for RTU)."""
+
+    t: float  # time.time() when the frame was sent / decoded
+    direction: Literal["tx", "rx"]
+    frame: bytes
+    transport: Literal["tcp", "rtu"]
+
+
+# --------------------------------------------------------------------------------------------
+# Completion detection
+# --------------------------------------------------------------------------------------------
+
+
+def _command_text(command: RunCommand) -> str:
+    return RUN_COMMAND_TEXT.get(command, f"command 0x{int(command):02X}")
+
+
+def _pose_values(pose: Pose) -> tuple[float, ...]:
+    return pose.xyzabc + tuple(pose.ext) + tuple(pose.joints or ())
+
+
+def _pose_moved(a: Pose, b: Pose) -> bool:
+    va, vb = _pose_values(a), _pose_values(b)
+    return len(va) != len(vb) or any(abs(x - y) > POSE_EPSILON for x, y in zip(va, vb, strict=True))
+
+
+def _seconds(value: float) -> str:
+    return str(round(value, 3))
+
+
+class CommandTracker:
+    """Decides how a command ended from successive status reads (see the module docstring).
+
+    Feed it every status read (and, for moves, the pose) with :meth:`update`; it returns
+    ``None`` while the command is under way and a :class:`CommandResult` when it ended. A
+    result with ``ok=False`` has the matching typed error in :attr:`error` (CommandRefused,
+    AlarmRaised, CommandTimeout, CommandStopped). Timing constants are read when the tracker
+    is created, so tests can shrink them.
+    """
+
+    def __init__(
+        self,
+        command: RunCommand,
+        before: ControllerStatus,
+        before_pose: Pose | None,
+        now: float,
+        *,
+        timeout: float | None = None,
+    ) -> None:
+        self.command = command
+        self.kind = CommandKind.of(command)
+        self.before = before
+        self.before_pose = before_pose
+        self.pre_code = before.command_status_code
+        self.started = now
+        self.is_move = self.kind is CommandKind.MOVE
+        self.ack_timeout = timing.ACK_TIMEOUT
+        self.stop_settle = timing.STOP_SETTLE
+        self.hard_timeout = timeout
+        # Without an explicit timeout a move may run as long as it makes progress.
+        if timeout is not None:
+            self._budget = timeout
+        elif self.is_move:
+            self._budget = timing.MOVE_TIMEOUT_MIN
+        else:
+            self._budget = timing.CREATE_POINT_TIMEOUT
+        self._deadline = now + self._budget
+        self.acknowledged = False
+        self.ack_time: float | None = None
+        self.code_left_pre = False
+        self.motion_seen = False
+        self.ack_poll_interval = timing.ACK_POLL_INTERVAL
+        self.poll_interval_after_ack = (timing.MOVE_POLL_INTERVAL if self.is_move
+                                        else timing.STATUS_POLL_INTERVAL)
+        self._stopped_since: float | None = None
+        self._idle_since: float | None = None
+        self._last_pose = before_pose
+        self.last_status: ControllerStatus | None = None
+        self.result: CommandResult | None = None
+        self.error: TeachPadError | None = None
+
+    # -- public --------------------------------------------------------------------------
+    @property
+    def finished(self) -> bool:
+        return self.result is not None
+
+    @property
+    def text(self) -> str:
+        return _command_text(self.command)
+
+    def decode(self, code: int) -> CommandStatus:
+        return decode_command_status(self.kind, code)
+
+    def poll_interval(self, now: float) -> float:
+        """How long to wait before the next status read.
+
+        Fast until GV291 has left the pre-command code (the controller may show 0, "received",
+        only briefly before the new final code), for at most the acknowledgement timeout.
+        """
+        if not self.code_left_pre and now - self.started < self.ack_timeout:
+            return self.ack_poll_interval
+        return self.poll_interval_after_ack
+
+    def update(self, status: ControllerStatus, pose: Pose | None, now: float) -> CommandResult | None:
+        """Take one status read; return the result once the command has ended."""
+        if self.result is not None:
+            return self.result
+        self.last_status = status
+        code = status.command_status_code
+        if status.alarms:
+            names = ", ".join(alarm_names(int(status.alarms))) or str(int(status.alarms))
+            return self._fail(
+                AlarmRaised(int(status.alarms), f"{self.text}: alarm while waiting: {names}"),
+                code, now,
+            )
+        if code != self.pre_code:
+            self.code_left_pre = True
+        progressed = self._note_motion(status, pose)
+        if not self.acknowledged and (self.code_left_pre or self.motion_seen):
+            self.acknowledged = True
+            self.ack_time = now
+        if self.acknowledged:
+            decoded = self.decode(code)
+            # A terminal code counts only once GV291 has left the stale pre-command value.
+            if self.code_left_pre and decoded.is_done:
+                return self._finish(True, decoded, f"{self.text}: {decoded.text}", now)
+            if self.code_left_pre and decoded.is_error:
+                err = CommandRefused(decoded, f"{self.text} refused: {decoded.text} (status {code})")
+                return self._fail(err, code, now)
+            stopped = self._check_stopped(status, code, now)
+            if stopped is not None:
+                return stopped
+            if self._moved_without_status(status, progressed, now):
+                text = self.decode(self.pre_code).text
+                return self._fail(
+                    CommandTimeout(
+                        f"{self.text}: the arm moved and stopped, but the command status stayed "
+                        f"{self.pre_code} '{text}' from before the command; the result is unknown"
+                    ),
+                    code, now,
+                )
+        elif now - self.started >= self.ack_timeout:
+            text = self.decode(self.pre_code).text
+            return self._fail(
+                CommandTimeout(
+                    f"controller did not acknowledge {self.text} within {_seconds(self.ack_timeout)} s "
+                    f"(command status stayed {self.pre_code} '{text}' from before the command)"
+                ),
+                code, now,
+            )
+        if progressed and self.hard_timeout is None:
+            self._deadline = now + self._budget
+        if now >= self._deadline:
+            decoded = self.decode(code)
+            return self._fail(
+                CommandTimeout(
+                    f"{self.text} did not complete within {_seconds(self._budget)} s "
+                    f"(last command status {code} '{decoded.text}')"
+                ),
+                code, now,
+            )
+        return None
+
+    def stopped(self, now: float) -> CommandResult:
+        """The host sent stop itself: the command ends as stopped (unless it already ended)."""
+        if self.result is not None:
+            return self.result
+        code = self.last_status.command_status_code if self.last_status else self.pre_code
+        return self._fail(CommandStopped(f"{self.text} stopped by the host"), code, now)
+
+    # -- internals -----------------------------------------------------------------------
+    def _note_motion(self, status: ControllerStatus, pose: Pose | None) -> bool:
+        """Update ``motion_seen``; True when this read shows progress (for the stall timer)."""
+        if not self.is_move:
+            return False
+        progressed = False
+        state = status.program_state
+        if state in (ProgramState.RUNNING, ProgramState.PAUSED):
+            self.motion_seen = True
+            progressed = state == ProgramState.PAUSED  # a paused move is alive, not stalled
+        code = status.command_status_code
+        if self.decode(code).is_moving and (self.code_left_pre or self.pre_code != code):
+            self.motion_seen = True
+        if pose is not None:
+            if self.before_pose is not None and _pose_moved(pose, self.before_pose):
+                self.motion_seen = True
+            if self._last_pose is not None and _pose_moved(pose, self._last_pose):
+                progressed = True
+            self._last_pose = pose
+        return progressed
+
+    def _check_stopped(self, status: ControllerStatus, code: int, now: float) -> CommandResult | None:
+        if not (self.is_move and self.motion_seen and status.program_state == ProgramState.STOPPED
+                and self.code_left_pre and self.decode(code).is_initial):
+            self._stopped_since = None
+            return None
+        if self._stopped_since is None:
+            self._stopped_since = now
+        if now - self._stopped_since < self.stop_settle:
+            return None
+        return self._fail(
+            CommandStopped(f"{self.text} stopped: program state returned to stopped without 'done'"),
+            code, now,
+        )
+
+    def _moved_without_status(self, status: ControllerStatus, progressed: bool, now: float) -> bool:
+        """A move seen under way has been still for a while and GV291 never left the stale code."""
+        if not self.is_move or self.code_left_pre or not self.motion_seen:
+            return False
+        if status.program_state != ProgramState.STOPPED or progressed:
+            self._idle_since = None
+            return False
+        if self._idle_since is None:
+            self._idle_since = now
+        return now - self._idle_since >= self.stop_settle and now - self.started >= self.ack_timeout
+
+    def _details(self, now: float) -> dict[str, float]:
+        details = {"elapsed": now - self.started}
+        if self.ack_time is not None:
+            details["ack_after"] = self.ack_time - self.started
+        return details
+
+    def _finish(self, ok: bool, status: CommandStatus, message: str, now: float) -> CommandResult:
+        self.result = CommandResult(self.command, self.kind, status, ok, message, self._details(now))
+        return self.result
+
+    def _fail(self, error: TeachPadError, code: int, now: float) -> CommandResult:
+        self.error = error
+        return self._finish(False, self.decode(code), str(error), now)
+
+
+# --------------------------------------------------------------------------------------------
+# Input validation (before the wire)
+# --------------------------------------------------------------------------------------------
+
+
+def _check_int(value: object, lo: int, hi: int, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        if isinstance(value, float) and value.is_integer():
+            value = int(value)
+        else:
+            raise InvalidInput(f"{name} must be an integer, got {value!r}")
+    if not lo <= value <= hi:
+        raise InvalidInput(f"{name} must be in {lo}..{hi}, got {value}")
+    return value
+
+
+def _check_float(value: object, name: str, lo: float | None = None, hi: float | None = None,
+                 *, lo_open: bool = False) -> float:
+    try:
+        number = check_float32(value, name)  # type: ignore[arg-type]
+    except ValueError as exc:
+        raise InvalidInput(str(exc)) from None
+    if lo is not None and (number < lo or (lo_open and number == lo)):
+        bound = f"> {lo:g}" if lo_open else f">= {lo:g}"
+        raise InvalidInput(f"{name} must be {bound}, got {number:g}")
+    if hi is not None and number > hi:
+        raise InvalidInput(f"{name} must be <= {hi:g}, got {number:g}")
+    return number
+
+
+def _check_floats(values: Sequence[float], count: int, name: str) -> list[float]:
+    if isinstance(values, (str, bytes)):
+        raise InvalidInput(f"{name} must be {count} numbers")
+    items = list(values)
+    if len(items) != count:
+        raise InvalidInput(f"{name} needs {count} values, got {len(items)}")
+    return [_check_float(v, f"{name}[{i}]") for i, v in enumerate(items)]
+
+
+def _check_enum(value: Any, enum_type: type[enum.IntEnum], name: str) -> Any:
+    try:
+        return enum_type(value)
+    except (ValueError, TypeError):
+        allowed = ", ".join(f"{m.name.lower()} ({m.value})" for m in enum_type)
+        raise InvalidInput(f"{name} must be one of {allowed}, got {value!r}") from None
+
+
+def _check_tool(tool: int) -> int:
+    # GV245: 200 = no tool frame, N = tool N+1.
+    return _check_int(tool, 0, registers.TOOL_NONE, "tool frame")
+
+
+def _gv_name(register: int) -> str:
+    n, half = registers.reg_to_gv(register)
+    return f"GV{n}_{half}"
+
+
+def _range_name(address: int, count: int) -> str:
+    last = address + count - 1
+    if count == 1:
+        return f"register {address} ({_gv_name(address)})"
+    if address % 2 == 0 and last % 2 == 1:
+        first_gv, last_gv = address // 2, last // 2
+        gvs = f"GV{first_gv}" if first_gv == last_gv else f"GV{first_gv}..GV{last_gv}"
+    else:
+        gvs = f"{_gv_name(address)}..{_gv_name(last)}"
+    return f"registers {address}..{last} ({gvs})"
+
+
+def _check_settings(s: ConnectionSettings) -> None:
+    _check_int(s.port, 1, 0xFFFF, "port")
+    _check_int(s.unit, 0, 247, "unit id")
+    _check_float(s.timeout, "timeout", 0.0, lo_open=True)
+    _check_int(s.retries, 0, 100, "retries")
+    if not isinstance(s.word_order, WordOrder):
+        raise InvalidInput(f"word order must be a WordOrder, got {s.word_order!r}")
+    if s.framer not in ("socket", "rtu"):
+        raise InvalidInput(f"framer must be socket or rtu, got {s.framer!r}")
+    if s.parity not in ("N", "E", "O"):
+        raise InvalidInput(f"parity must be N, E or O, got {s.parity!r}")
+    if not s.point_id_min <= s.point_id_max:
+        raise InvalidInput("point_id_min must not exceed point_id_max")
+
+
+# --------------------------------------------------------------------------------------------
+# The client
+# --------------------------------------------------------------------------------------------
+
+TrafficObserver = Callable[[TrafficRecord], None]
+ProgressCallback = Callable[[int, int], bool]
+
+
+class RobotClient:
+    """One method per controller operation. Blocking; owned by one thread."""
+
+    def __init__(self, settings: ConnectionSettings) -> None:
+        _check_settings(settings)
+        self.settings = settings
+        self._observers: list[TrafficObserver] = []
+        self._observing = False  # checked first on the hot path
+        self._rx_buffer = b""
+        self._mb: Any = self._make_modbus_client()
+        self._tool_cache: int | None = None
+        self._user_frame_cache: int | None = None
+        self._ext_cache: tuple[float, ...] | None = None
+        self._last_kind: CommandKind | None = None
+        self._teach_frame: TeachFrame | None = None
+        self.last_status: ControllerStatus | None = None
+        self.last_tracker: CommandTracker | None = None
+        self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
+
+    # -- connection ----------------------------------------------------------------------
+    def _make_modbus_client(self) -> Any:
+        s = self.settings
+        common: dict[str, Any] = {
+            "timeout": s.timeout,
+            "retries": s.retries,
+            "trace_packet": self._trace_packet,
+            "trace_pdu": self._trace_pdu,
+        }
+        if s.serial_port is not None:
+            return ModbusSerialClient(
+                s.serial_port, framer=FramerType.RTU, baudrate=s.baudrate, parity=s.parity,
+                stopbits=s.stopbits, bytesize=s.bytesize, **common,
+            )
+        framer = FramerType.RTU if s.framer == "rtu" else FramerType.SOCKET
+        return ModbusTcpClient(s.host, port=s.port, framer=framer, **common)
+
+    def connect(self) -> None:
+        """Open the link; raises :class:`LinkError` when the controller cannot be reached."""
+        self.invalidate_cache()
+        if not self._mb.connect():
+            raise LinkError(f"cannot connect to the controller at {self.settings.endpoint}")
+
+    def close(self) -> None:
+        self._mb.close()
+        self.invalidate_cache()
+
+    @property
+    def connected(self) -> bool:
+        return bool(self._mb.connected)
+
+    def __enter__(self) -> RobotClient:
+        self.connect()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def invalidate_cache(self) -> None:
+        """Forget which tool / user frame / external offsets were written last."""
+        self._tool_cache = None
+        self._user_frame_cache = None
+        self._ext_cache = None
+
+    # -- observers -----------------------------------------------------------------------
+    def add_observer(self, cb: TrafficObserver) -> None:
+        self._observers.append(cb)
+        self._observing = True
+
+    def remove_observer(self, cb: TrafficObserver) -> None:
+        if cb in self._observers:
+            self._observers.remove(cb)
+        self._observing = bool(self._observers)
+
+    def _emit(self, direction: Literal["tx", "rx"], frame: bytes) -> None:
+        record = TrafficRecord(time.time(), direction, bytes(frame), self.settings.transport)
+        for cb in list(self._observers):
+            try:
+                cb(record)
+            except Exception:  # an observer must not break the link
+                _log.exception("traffic observer %r failed", cb)
+
+    def _trace_packet(self, sending: bool, data: bytes) -> bytes:
+        if not self._observing:
+            return data
+        if sending:
+            self._emit("tx", data)
+        else:
+            self._rx_buffer = data  # may be partial; emitted once a PDU is decoded from it
+        return data
+
+    def _trace_pdu(self, sending: bool, pdu: Any) -> Any:
+        if not self._observing or sending:
+            return pdu
+        buffer, self._rx_buffer = self._rx_buffer, b""
+        if buffer:
+            # The buffer may start with a late frame of an earlier request: keep the tail that
+            # is this PDU's frame (MBAP 7 + fc + data for TCP; unit + fc + data + CRC for RTU).
+            body = 1 + len(pdu.encode())
+            size = body + (7 if self.settings.transport == "tcp" else 3)
+            self._emit("rx", buffer[-size:] if len(buffer) > size else buffer)
+        return pdu
+
+    # -- the one place that talks to pymodbus --------------------------------------------
+    def _call(self, what: str, method: Callable[..., Any], *args: Any, **kwargs: Any) -> Any:
+        was_connected = bool(self._mb.connected)
+        if not was_connected:
+            self.invalidate_cache()  # a new connection may mean a restarted controller
+        try:
+            response = method(*args, device_id=self.settings.unit, **kwargs)
+        except ConnectionException as exc:
+            self.invalidate_cache()
+            self._mb.close()
+            verb = "lost the connection to" if was_connected else "cannot connect to"
+            raise LinkError(f"{verb} the controller at {self.settings.endpoint}") from exc
+        except ModbusIOException as exc:
+            # A late answer would be read as the next request's: start again on a fresh link.
+            self.invalidate_cache()
+            self._mb.close()
+            total = self.settings.timeout * (self.settings.retries + 1)
+            raise ResponseTimeout(
+                f"controller did not answer within {_seconds(total)} s ({self.settings.endpoint})"
+            ) from exc
+        except ModbusException as exc:
+            self.invalidate_cache()
+            raise LinkError(f"Modbus link error with {self.settings.endpoint}: {exc}") from exc
+        except OSError as exc:
+            self.invalidate_cache()
+            self._mb.close()
+            raise LinkError(f"link error with {self.settings.endpoint}: {exc}") from exc
+        if response is None:
+            raise ResponseTimeout(f"controller did not answer ({self.settings.endpoint})")
+        if response.isError():
+            code = int(getattr(response, "exception_code", 0))
+            text = _MODBUS_EXCEPTION_TEXT.get(code, f"exception code {code}")
+            raise ModbusExceptionError(
+                int(response.function_code) & 0x7F, code, f"controller refused {what}: {text}"
+            )
+        return response
+
+    def _read(self, address: int, count: int) -> list[int]:
+        response = self._call(
+            f"read of {_range_name(address, count)}", self._mb.read_holding_registers,
+            address, count=count,
+        )
+        regs = [int(r) & 0xFFFF for r in response.registers]
+        if len(regs) < count:
+            raise ResponseTimeout(
+                f"controller answered {len(regs)} of {count} registers from {address} "
+                f"({self.settings.endpoint})"
+            )
+        return regs[:count]
+
+    def _require_writable(self, what: str) -> None:
+        if self.settings.monitor_only:
+            raise WriteBlocked(f"monitor-only mode: {what} was not sent")
+
+    def _write(self, address: int, values: Sequence[int], *, single: bool = False) -> None:
+        """The write guard: every write to the controller passes here."""
+        name = _range_name(address, len(values))
+        self._require_writable(f"write to {name}")
+        if not values:
+            raise InvalidInput("nothing to write")
+        if single:
+            if len(values) != 1:
+                raise InvalidInput("a single-register write takes one value")
+            _log.debug("write 0x06 %s <- %d", name, values[0])
+            self.write_count += 1
+            self._call(f"write to {name}", self._mb.write_register, address, int(values[0]))
+        else:
+            _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
+            self.write_count += 1
+            self._call(f"write to {name}", self._mb.write_registers, address, [int(v) for v in values])
+
+    def _write_floats(self, gv: int, values: Sequence[float]) -> None:
+        self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order))
+
+    def _write_control(self, register: int, value: int) -> None:
+        self._write(register, [value], single=True)
+
+    # -- raw access ----------------------------------------------------------------------
+    def read_registers(self, addr: int, count: int) -> list[int]:
+        addr = _check_int(addr, 0, _MAX_REGISTER, "register address")
+        count = _check_int(count, 1, _MAX_REGISTER + 1 - addr, "register count")
+        out: list[int] = []
+        while count > 0:
+            n = min(count, registers.MAX_READ_REGISTERS)
+            out.extend(self._read(addr, n))
+            addr += n
+            count -= n
+        return out
+
+    def write_register(self, addr: int, value: int) -> None:
+        """0x06 write of one register (the way 440..445 must be written)."""
+        addr = _check_int(addr, 0, _MAX_REGISTER, "register address")
+        value = _check_int(value, 0, 0xFFFF, "register value")
+        self._write(addr, [value], single=True)
+
+    def write_registers(self, addr: int, values: Sequence[int]) -> None:
+        """0x10 write (split every 123 registers); refuses the control registers 440..445."""
+        addr = _check_int(addr, 0, _MAX_REGISTER, "register address")
+        regs = [_check_int(v, 0, 0xFFFF, "register value") for v in values]
+        if not regs:
+            raise InvalidInput("nothing to write")
+        if addr + len(regs) - 1 > _MAX_REGISTER:
+            raise InvalidInput("write goes past register 65535")
+        end = addr + len(regs)
+        if addr < _CONTROL_REGISTERS.stop and end > _CONTROL_REGISTERS.start:
+            raise InvalidInput(
+                "registers 440..445 (GV220..GV222) are control registers written one at a time "
+                "with 0x06; use write_register or the command methods"
+            )
+        for i in range(0, len(regs), registers.MAX_WRITE_REGISTERS):
+            self._write(addr + i, regs[i : i + registers.MAX_WRITE_REGISTERS])
+
+    def read_gv(self, n: int, count: int = 1) -> list[float]:
+        n = _check_int(n, 0, _MAX_REGISTER // 2, "GV index")
+        count = _check_int(count, 1, (_MAX_REGISTER + 1) // 2 - n, "GV count")
+        return decode_floats(self.read_registers(registers.gv_reg(n), 2 * count), self.settings.word_order)
+
+    def write_gv(self, n: int, values: Sequence[float]) -> None:
+        n = _check_int(n, 0, _MAX_REGISTER // 2, "GV index")
+        floats = [_check_float(v, f"GV{n + i}") for i, v in enumerate(values)]
+        self.write_registers(registers.gv_reg(n), encode_floats(floats, self.settings.word_order))
+
+    # -- reads ---------------------------------------------------------------------------
+    def read_pose(self) -> Pose:
+        """Pose, external axes and joints (GV206..GV255) in one FC03 of 100 registers."""
+        regs = self._read(registers.POSE_BLOCK_START, registers.POSE_BLOCK_COUNT)
+        order = self.settings.word_order
+
+        def gvs(gv: int, count: int) -> list[float]:
+            start = registers.gv_reg(gv) - registers.POSE_BLOCK_START
+            return decode_floats(regs[start : start + 2 * count], order)
+
+        x, y, z, a, b, c = gvs(registers.GV_POSE, 6)
+        e = gvs(registers.GV_EXT_AXES, registers.NUM_EXTERNAL_AXES)
+        joints = tuple(gvs(registers.GV_JOINTS, registers.NUM_ROBOT_AXES))
+        return Pose(x, y, z, a, b, c, ext=(e[0], e[1], e[2], e[3], e[4]), joints=joints)
+
+    def read_status(self, with_clock: bool = False) -> ControllerStatus:
+        """Table 2 (560..583) in one FC03; the clock (576..579) comes from the same block."""
+        regs = self._read(registers.STATUS_BLOCK_START, registers.STATUS_BLOCK_COUNT)
+        status = self._decode_status(regs, with_clock)
+        self.last_status = status
+        return status
+
+    def _decode_status(self, regs: Sequence[int], with_clock: bool) -> ControllerStatus:
+        base = registers.STATUS_BLOCK_START
+        mode_raw = regs[registers.REG_CONTROLLER_MODE - base]
+        state_raw = regs[registers.REG_PROGRAM_STATE - base]
+        mode: ControllerMode | int
+        state: ProgramState | int
+        try:
+            mode = ControllerMode(mode_raw)
+        except ValueError:
+            mode = mode_raw
+        try:
+            state = ProgramState(state_raw)
+        except ValueError:
+            state = state_raw
+        st = registers.gv_reg(registers.GV_COMMAND_STATUS) - base
+        code = decode_status_registers(regs[st : st + 2], self.settings.word_order)
+        clock = None
+        if with_clock:
+            cs = registers.gv_reg(registers.GV_DATE) - base
+            clock = decode_clock(regs[cs : cs + 4], self.settings.datetime_layout)
+        return ControllerStatus(mode, state, Alarm(regs[registers.REG_ALARMS - base]), code, clock)
+
+    def read_clock(self) -> ControllerClock:
+        return decode_clock(self._read(registers.gv_reg(registers.GV_DATE), 4), self.settings.datetime_layout)
+
+    def command_status(self) -> CommandStatus:
+        """GV291 decoded with the table of the last command this client sent."""
+        regs = self._read(registers.gv_reg(registers.GV_COMMAND_STATUS), 2)
+        return decode_command_status(self._last_kind, decode_status_registers(regs, self.settings.word_order))
+
+    # -- plain commands (no GV291) -------------------------------------------------------
+    def set_work_mode(self, mode: WorkMode) -> None:
+        mode = _check_enum(mode, WorkMode, "work mode")
+        self._write_control(registers.REG_WORK_MODE, int(mode))
+
+    def stop(self) -> None:
+        self._write_control(registers.REG_STOP, 1)
+        tracker = self.last_tracker
+        if tracker is not None and not tracker.finished:
+            tracker.stopped(time.monotonic())
+
+    def pause(self) -> None:
+        self._write_control(registers.REG_PAUSE, 1)
+
+    def resume(self) -> None:
+        self._write_control(registers.REG_RESUME, 1)
+
+    def go_zero(self, axis: int | None) -> None:
+        """Send one axis (0..10 = J1..J11) or all axes (None) to zero."""
+        last_axis = registers.NUM_AXES_TOTAL - 1
+        value = registers.GO_ZERO_ALL if axis is None else _check_int(axis, 0, last_axis, "axis")
+        self._require_writable("go to zero")
+        self._ensure_auto(self.read_status())
+        self._write_control(registers.REG_GO_ZERO, value)
+
+    def run_program(self, program_id: int, mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
+                    cycles: int = 1, speed_ratio: int = 100) -> None:
+        """446..449 in one 0x10, then 440 <- 0x01."""
+        program_id = _check_int(program_id, 0, 0xFFFF, "program id")
+        motion = _check_enum(mode, ProgramMotionMode, "program motion mode")
+        cycles = _check_int(cycles, 0, 0xFFFF, "cycle count")
+        speed_ratio = _check_int(speed_ratio, 1, 100, "program speed ratio")
+        self._require_writable("run program")
+        self._ensure_auto(self.read_status())
+        self._write(registers.REG_PROGRAM_ID, [program_id, int(motion), cycles, speed_ratio])
+        self._write_control(registers.REG_RUN_COMMAND, int(RunCommand.RUN_PROGRAM))
+
+    # -- helpers of the four functions ---------------------------------------------------
+    def _ensure_auto(self, status: ControllerStatus) -> None:
+        """444 <- auto unless the (fresh) status already says auto or Modbus teach."""
+        if status.mode not in (ControllerMode.AUTO, ControllerMode.MODBUS_TEACH):
+            self.set_work_mode(WorkMode.AUTO)
+
+    def ensure_auto(self) -> None:
+        self._require_writable("set work mode")
+        self._ensure_auto(self.read_status())
+
+    def _prepare(self, command: RunCommand, *, auto: bool = True) -> tuple[ControllerStatus, Pose | None]:
+        self._require_writable(_command_text(command))
+        before = self.read_status()
+        before_pose = self.read_pose() if CommandKind.of(command) is CommandKind.MOVE else None
+        if auto:
+            self._ensure_auto(before)
+        return before, before_pose
+
+    def _write_tool(self, tool: int) -> None:
+        if self._tool_cache != tool:
+            self._write_floats(registers.GV_TOOL_FRAME, [float(tool)])
+            self._tool_cache = tool
+
+    def _write_user_frame(self, user: int) -> None:
+        if self._user_frame_cache != user:
+            self._write_floats(registers.GV_USER_FRAME, [float(user)])
+            self._user_frame_cache = user
+
+    def begin_command(self, command: RunCommand, before: ControllerStatus, before_pose: Pose | None,
+                      *, timeout: float | None = None) -> CommandTracker:
+        """Write 440 <- ``command`` (parameters already written) and return its tracker."""
+        tracker = CommandTracker(command, before, before_pose, time.monotonic(), timeout=timeout)
+        self._last_kind = tracker.kind
+        self.last_tracker = tracker
+        self._write_control(registers.REG_RUN_COMMAND, int(command))
+        return tracker
+
+    def poll(self, tracker: CommandTracker) -> CommandResult | None:
+        """One status read (plus the pose for moves) fed to ``tracker``."""
+        status = self.read_status()
+        pose = self.read_pose() if tracker.is_move else None
+        return tracker.update(status, pose, time.monotonic())
+
+    def wait(self, tracker: CommandTracker, *, raise_errors: bool = True) -> CommandResult:
+        """Poll until ``tracker`` ends; raise its typed error when it failed (by default)."""
+        while True:
+            result = self.poll(tracker)  # the first poll is immediate: keep the ack window small
+            if result is not None:
+                if raise_errors and tracker.error is not None:
+                    raise tracker.error
+                return result
+            time.sleep(tracker.poll_interval(time.monotonic()))
+
+    def _finish(self, tracker: CommandTracker, wait: bool) -> CommandResult:
+        if wait:
+            return self.wait(tracker)
+        return CommandResult(tracker.command, tracker.kind, None, True, f"{tracker.text}: sent")
+
+    def _check_point_id(self, point_id: int, name: str = "point id") -> int:
+        return _check_int(point_id, self.settings.point_id_min, self.settings.point_id_max, name)
+
+    # -- function 1: incremental move ----------------------------------------------------
+    def step(self, frame: StepFrame, offsets: Sequence[float],
+             ext_offsets: Sequence[float] = (0.0,) * registers.NUM_EXTERNAL_AXES, speed: float = 10.0,
+             *, wait: bool = True, timeout: float | None = None) -> CommandResult:
+        """Incremental move: GV200-205 (one 0x10), GV236-240 when needed, GV225, 440 <- 0x40/0x41.
+
+        ``offsets`` are J1..J6 (degrees, joint frame) or X Y Z A B C (mm, degrees, base
+        frame); ``ext_offsets`` are J7..J11. ``speed`` is rpm (joint) or mm/s (base).
+        """
+        if not isinstance(frame, StepFrame):
+            raise InvalidInput(f"step frame must be joint or base, got {frame!r}")
+        offs = _check_floats(offsets, registers.NUM_ROBOT_AXES, "offsets")
+        ext = tuple(_check_floats(ext_offsets, registers.NUM_EXTERNAL_AXES, "external offsets"))
+        speed = _check_float(speed, "speed", 0.0, lo_open=True)
+        if timeout is not None:
+            timeout = _check_float(timeout, "timeout", 0.0, lo_open=True)
+        if not any(offs) and not any(ext):
+            raise InvalidInput("step: every offset is zero, nothing to move")
+        if timeout is None:
+            timeout = self._step_timeout(frame, offs, ext, speed)
+        command = frame.command
+        before, before_pose = self._prepare(command)
+        self._write_floats(registers.GV_PARAM0, offs)
+        if self._ext_cache != ext:
+            self._write_floats(registers.GV_EXT_OFFSET0, ext)
+            self._ext_cache = ext
+        self._write_floats(registers.GV_EXPECTED_SPEED, [speed])
+        tracker = self.begin_command(command, before, before_pose, timeout=timeout)
+        return self._finish(tracker, wait)
+
+    @staticmethod
+    def _step_timeout(frame: StepFrame, offs: Sequence[float], ext: Sequence[float],
+                      speed: float) -> float | None:
+        """max(MOVE_TIMEOUT_MIN, 3 x the estimated duration) when that exceeds the minimum."""
+        if frame is StepFrame.JOINT:
+            duration = max(abs(v) for v in (*offs, *ext)) / (speed * 6.0)  # rpm -> deg/s
+        else:
+            duration = math.dist((0.0, 0.0, 0.0), offs[:3]) / speed
+        estimate = 3.0 * duration
+        return estimate if estimate > timing.MOVE_TIMEOUT_MIN else None
+
+    # -- function 2: create temp point ---------------------------------------------------
+    def create_point(self, point_id: int, *, pose: Sequence[float] | None = None, gv_start: int = 0,
+                     tool: int = registers.TOOL_NONE, wait: bool = True,
+                     timeout: float | None = None) -> CommandResult:
+        """Create (or overwrite) a temp point from the current pose, or from ``pose`` via GVs."""
+        point_id = self._check_point_id(point_id)
+        tool = _check_tool(tool)
+        values = None if pose is None else _check_floats(pose, 6, "pose")
+        gv_start = _check_int(gv_start, registers.GV_GENERAL_FIRST, _GENERAL_POSE_LAST_START, "first pose GV")
+        if timeout is not None:
+            timeout = _check_float(timeout, "timeout", 0.0, lo_open=True)
+        before, _ = self._prepare(RunCommand.CREATE_POINT)
+        if values is None:
+            self._write_floats(registers.GV_PARAM0, [float(point_id), 0.0])
+        else:
+            self._write_floats(gv_start, values)
+            self._write_floats(registers.GV_PARAM0, [float(point_id), 1.0, float(gv_start)])
+        self._write_tool(tool)
+        tracker = self.begin_command(RunCommand.CREATE_POINT, before, None, timeout=timeout)
+        return self._finish(tracker, wait)
+
+    def upload_points(self, points: Iterable[tuple[int, Sequence[float]]], tool: int = registers.TOOL_NONE,
+                      progress: ProgressCallback | None = None, *,
+                      gv_start: int = 0) -> list[CommandResult]:
+        """Batched case 2.2: per point GV0-5 (one 0x10), GV200-202 (one 0x10), 440 <- 0xE0, polls.
+
+        Every point is validated before the first write. Returns one result per point tried,
+        in order (``details["point_id"]``); a refused point does not stop the others. A link
+        error or timeout ends the batch after a failed result for that point; ``progress``
+        (done, total) returning False cancels after the current point.
+        """
+        items = [(self._check_point_id(pid), _check_floats(pose, 6, f"pose of point {pid}"))
+                 for pid, pose in points]
+        tool = _check_tool(tool)
+        gv_start = _check_int(gv_start, registers.GV_GENERAL_FIRST, _GENERAL_POSE_LAST_START, "first pose GV")
+        results: list[CommandResult] = []
+        if not items:
+            return results
+        status, _ = self._prepare(RunCommand.CREATE_POINT)
+        self._write_tool(tool)
+        kind = CommandKind.CREATE_POINT
+        total = len(items)
+        for index, (point_id, values) in enumerate(items, start=1):
+            try:
+                self._write_floats(gv_start, values)
+                self._write_floats(registers.GV_PARAM0, [float(point_id), 1.0, float(gv_start)])
+                tracker = self.begin_command(RunCommand.CREATE_POINT, status, None)
+                result = self.wait(tracker, raise_errors=False)
+                status = tracker.last_status or status
+            except (LinkError, ResponseTimeout, ModbusExceptionError) as exc:
+                results.append(CommandResult(RunCommand.CREATE_POINT, kind, None, False, str(exc),
+                                             {"point_id": float(point_id)}))
+                break
+            details = dict(result.details, point_id=float(point_id))
+            message = f"point {point_id}: {result.message}"
+            results.append(CommandResult(result.command, result.kind, result.status, result.ok,
+                                         message, details))
+            if progress is not None and progress(index, total) is False:
+                break
+        return results
+
+    # -- function 3: move to temp point --------------------------------------------------
+    def move_to_point(self, end_id: int, *, via_id: int | None = None, orientation_changes: bool = True,
+                      ignore_middle: bool = False, speed: float = 50.0, tool: int = registers.TOOL_NONE,
+                      wait: bool = True, timeout: float | None = None) -> CommandResult:
+        """Line (``via_id`` None) or arc through ``via_id``: GV200-203 one 0x10, GV225, GV245, 0x42."""
+        end_id = self._check_point_id(end_id, "end point id")
+        motion = -1.0
+        if via_id is not None:
+            via_id = self._check_point_id(via_id, "middle point id")
+            if via_id == end_id:
+                raise InvalidInput("the arc's middle point must differ from its end point")
+            motion = float(via_id)
+        speed = _check_float(speed, "speed", 0.0, lo_open=True)
+        tool = _check_tool(tool)
+        if timeout is not None:
+            timeout = _check_float(timeout, "timeout", 0.0, lo_open=True)
+        before, before_pose = self._prepare(RunCommand.MOVE_TO_POINT)
+        self._write_floats(registers.GV_PARAM0, [motion, float(end_id), 1.0 if orientation_changes else 0.0,
+                                         1.0 if ignore_middle else 0.0])
+        self._write_floats(registers.GV_EXPECTED_SPEED, [speed])
+        self._write_tool(tool)
+        tracker = self.begin_command(RunCommand.MOVE_TO_POINT, before, before_pose, timeout=timeout)
+        return self._finish(tracker, wait)
+
+    # -- function 4: teach (jog) ---------------------------------------------------------
+    def _check_axis(self, frame: TeachFrame | None, axis: int) -> int:
+        joint = frame in (TeachFrame.JOINT, None)
+        top = (registers.NUM_AXES_TOTAL if joint else registers.NUM_ROBOT_AXES) - 1
+        return _check_int(axis, 0, top, "axis")
+
+    @staticmethod
+    def _check_direction(direction: int) -> int:
+        return _check_int(direction, 0, 1, "direction (0 negative, 1 positive)")
+
+    def teach_enable(self, frame: TeachFrame, axis: int, direction: int, *, user_frame: int = 0,
+                     tool_frame: int = 0, wait: bool = True,
+                     timeout: float | None = None) -> CommandResult:
+        """GV200-203 = (frame, axis, direction, 0) in one 0x10, GV241/GV245 if needed, 440 <- 0x80."""
+        frame = _check_enum(frame, TeachFrame, "teach frame")
+        axis = self._check_axis(frame, axis)
+        direction = self._check_direction(direction)
+        user_frame = _check_int(user_frame, 0, 0xFFFF, "user frame")
+        tool_frame = _check_tool(tool_frame)
+        before, _ = self._prepare(RunCommand.TEACH_ENABLE)
+        self._write_floats(registers.GV_PARAM0, [float(frame), float(axis), float(direction), 0.0])
+        if frame is TeachFrame.USER:
+            self._write_user_frame(user_frame)
+        elif frame is TeachFrame.TOOL:
+            self._write_tool(tool_frame)
+        tracker = self.begin_command(RunCommand.TEACH_ENABLE, before, None, timeout=timeout)
+        self._teach_frame = frame
+        return self._finish(tracker, wait)
+
+    def teach_set_ratio(self, ratio: float) -> None:
+        """GV203 <- ratio: > 0 moves, 0 stops the jog (teach stays enabled)."""
+        ratio = _check_float(ratio, "speed ratio", 0.0, 100.0)
+        self._write_floats(registers.GV_PARAM3, [ratio])
+
+    def teach_set_axis(self, axis: int, direction: int) -> None:
+        """Ratio 0 first, then GV201-202 (same frame); start again with :meth:`teach_set_ratio`."""
+        axis = self._check_axis(self._teach_frame, axis)
+        direction = self._check_direction(direction)
+        self._write_floats(registers.GV_PARAM3, [0.0])
+        self._write_floats(registers.GV_PARAM1, [float(axis), float(direction)])
+
+    def teach_disable(self, *, wait: bool = True, timeout: float | None = None) -> CommandResult:
+        """GV203 <- 0 (the controller refuses to disable while the ratio is not 0), 440 <- 0x81."""
+        before, _ = self._prepare(RunCommand.TEACH_DISABLE, auto=False)
+        self._write_floats(registers.GV_PARAM3, [0.0])
+        tracker = self.begin_command(RunCommand.TEACH_DISABLE, before, None, timeout=timeout)
+        self._teach_frame = None
+        return self._finish(tracker, wait)

@@ -1,0 +1,216 @@
+"""CommandTracker fed with synthetic status sequences (no wire)."""
+
+from __future__ import annotations
+
+import pytest
+
+from app import timing
+from app.client import CommandTracker
+from app.errors import AlarmRaised, CommandRefused, CommandStopped, CommandTimeout
+from app.models import ControllerStatus, Pose
+from app.protocol.enums import (
+    Alarm,
+    CommandKind,
+    ControllerMode,
+    CreatePointStatus,
+    MoveStatus,
+    ProgramState,
+    RunCommand,
+    TeachStatus,
+)
+
+DONE = 0xFF
+STOPPED, RUNNING, PAUSED = ProgramState.STOPPED, ProgramState.RUNNING, ProgramState.PAUSED
+HOME = Pose(100.0, 0.0, 500.0, 180.0, 0.0, 0.0)
+
+
+def st(code: int, state: ProgramState = STOPPED, alarms: Alarm = Alarm.NONE) -> ControllerStatus:
+    return ControllerStatus(ControllerMode.AUTO, state, alarms, code)
+
+
+def moved(dx: float) -> Pose:
+    return Pose(100.0 + dx, 0.0, 500.0, 180.0, 0.0, 0.0)
+
+
+def feed(tracker: CommandTracker, steps: list[tuple[float, ControllerStatus, Pose | None]]):
+    """Feed (t, status, pose) samples; return (index, result) of the first result, or (None, None)."""
+    for i, (t, status, pose) in enumerate(steps):
+        result = tracker.update(status, pose, t)
+        if result is not None:
+            return i, result
+    return None, None
+
+
+def test_stale_done_is_not_taken_for_the_new_create_point() -> None:
+    tr = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0)
+    # The old 0xFF lingers (status delay), then 0 (received), then the new 0xFF.
+    i, result = feed(tr, [(0.01, st(DONE), None), (0.1, st(DONE), None), (0.2, st(0), None),
+                          (0.3, st(DONE), None)])
+    assert i == 3
+    assert result.ok and result.kind is CommandKind.CREATE_POINT
+    assert result.status.member is CreatePointStatus.DONE
+    assert result.details["ack_after"] == pytest.approx(0.2)
+    assert tr.error is None
+
+
+def test_unacknowledged_command_times_out_with_a_clear_message(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
+    tr = CommandTracker(RunCommand.TEACH_ENABLE, st(DONE), None, 0.0)
+    assert tr.update(st(DONE), None, 0.4) is None
+    result = tr.update(st(DONE), None, 0.5)
+    assert result is not None and not result.ok
+    assert isinstance(tr.error, CommandTimeout)
+    assert "did not acknowledge teach enable" in str(tr.error)
+    assert "255" in str(tr.error)
+
+
+def test_error_code_after_ack_is_a_refusal_with_the_decoded_status() -> None:
+    tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
+    i, result = feed(tr, [(0.01, st(DONE), HOME), (0.02, st(0), HOME), (0.03, st(13), HOME)])
+    assert i == 2 and not result.ok
+    assert isinstance(tr.error, CommandRefused)
+    assert tr.error.status.member is MoveStatus.BAD_END_POINT
+    assert "bad end point id" in result.message
+
+
+def test_stale_error_code_is_ignored_until_the_code_changes() -> None:
+    # The previous command failed with 13; the new one is a fine move.
+    tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(13), HOME, 0.0)
+    i, result = feed(tr, [(0.01, st(13, RUNNING), moved(1)), (0.02, st(13, RUNNING), moved(2)),
+                          (0.03, st(6, RUNNING), moved(3)), (0.04, st(DONE), moved(4))])
+    assert i == 3 and result.ok
+
+
+def test_first_error_when_pre_code_was_initial() -> None:
+    tr = CommandTracker(RunCommand.TEACH_ENABLE, st(0), None, 0.0)
+    _, result = feed(tr, [(0.01, st(0), None), (0.02, st(TeachStatus.RATIO_NOT_ZERO), None)])
+    assert not result.ok and isinstance(tr.error, CommandRefused)
+    assert tr.error.status.member is TeachStatus.RATIO_NOT_ZERO
+
+
+def test_move_acknowledged_by_motion_still_waits_for_a_fresh_done() -> None:
+    """Program state running and pose moving ack the move, but the stale 0xFF is not 'done'."""
+    tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
+    steps = [(0.01, st(DONE, RUNNING), moved(1)), (0.05, st(DONE, RUNNING), moved(5)),
+             (0.10, st(DONE, STOPPED), moved(10)), (0.2, st(DONE, STOPPED), moved(10))]
+    i, result = feed(tr, steps)
+    assert i is None and tr.acknowledged and tr.motion_seen
+    i, result = feed(tr, [(0.25, st(0), moved(10)), (0.26, st(DONE), moved(10))])
+    assert i == 1 and result.ok
+
+
+def test_pose_change_alone_acknowledges_a_fast_move() -> None:
+    # A move so short the host saw neither 0, 6 nor RUNNING; then the new 0xFF from pre-code 0.
+    tr = CommandTracker(RunCommand.STEP_JOINT, st(0), HOME, 0.0)
+    assert tr.update(st(0), moved(0.5), 0.01) is None
+    assert tr.acknowledged
+    result = tr.update(st(DONE), moved(1), 0.02)
+    assert result is not None and result.ok
+
+
+def test_alarm_while_waiting_raises_alarm() -> None:
+    tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
+    i, result = feed(tr, [(0.01, st(6, RUNNING), moved(1)),
+                          (0.02, st(0, STOPPED, Alarm.ESTOP | Alarm.SERVO), moved(1))])
+    assert i == 1 and not result.ok
+    assert isinstance(tr.error, AlarmRaised)
+    assert tr.error.alarms == int(Alarm.ESTOP | Alarm.SERVO)
+    assert "emergency stop" in str(tr.error) and "servo alarm" in str(tr.error)
+
+
+def test_program_state_back_to_stopped_with_initial_code_is_a_stop(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "STOP_SETTLE", 0.1)
+    tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
+    steps = [(0.01, st(0, RUNNING), moved(1)), (0.02, st(6, RUNNING), moved(2)),
+             (0.03, st(0, STOPPED), moved(3)), (0.08, st(0, STOPPED), moved(3)),
+             (0.14, st(0, STOPPED), moved(3))]
+    i, result = feed(tr, steps)
+    assert i == 4 and not result.ok
+    assert isinstance(tr.error, CommandStopped)
+
+
+def test_transient_initial_before_done_is_not_a_stop(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "STOP_SETTLE", 0.1)
+    tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
+    steps = [(0.01, st(DONE, RUNNING), moved(1)), (0.05, st(DONE, STOPPED), moved(2)),
+             (0.06, st(0, STOPPED), moved(2)), (0.08, st(DONE, STOPPED), moved(2))]
+    i, result = feed(tr, steps)
+    assert i == 3 and result.ok
+
+
+def test_host_sent_stop_ends_the_wait() -> None:
+    tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
+    assert tr.update(st(6, RUNNING), moved(1), 0.01) is None
+    result = tr.stopped(0.02)
+    assert not result.ok and isinstance(tr.error, CommandStopped)
+    assert "stopped by the host" in result.message
+    # Later reads do not change the outcome.
+    assert tr.update(st(DONE), moved(1), 0.03) is result
+
+
+def test_paused_move_keeps_waiting_and_resumes() -> None:
+    tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
+    steps = [(0.01, st(6, RUNNING), moved(1)), (0.02, st(6, PAUSED), moved(1)),
+             (5.0, st(6, PAUSED), moved(1)), (9.0, st(6, PAUSED), moved(1)),
+             (15.0, st(6, RUNNING), moved(2)), (15.1, st(DONE), moved(3))]
+    i, result = feed(tr, steps)
+    assert i == 5 and result.ok
+
+
+def test_move_without_progress_times_out(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "MOVE_TIMEOUT_MIN", 1.0)
+    tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
+    assert tr.update(st(6, RUNNING), moved(1), 0.5) is None
+    assert tr.update(st(6, RUNNING), moved(2), 1.2) is None  # progress extends the deadline
+    assert tr.update(st(6, RUNNING), moved(2), 2.1) is None
+    result = tr.update(st(6, RUNNING), moved(2), 2.3)
+    assert result is not None and isinstance(tr.error, CommandTimeout)
+    assert "did not complete within 1.0 s" in result.message
+    assert "moving" in result.message
+
+
+def test_explicit_timeout_is_a_hard_deadline() -> None:
+    tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0, timeout=0.5)
+    assert tr.update(st(6, RUNNING), moved(1), 0.3) is None
+    result = tr.update(st(6, RUNNING), moved(2), 0.6)
+    assert result is not None and isinstance(tr.error, CommandTimeout)
+
+
+def test_create_point_overall_timeout(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "CREATE_POINT_TIMEOUT", 0.5)
+    tr = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0)
+    assert tr.update(st(0), None, 0.1) is None
+    result = tr.update(st(0), None, 0.6)
+    assert result is not None and isinstance(tr.error, CommandTimeout)
+    assert "create temp point did not complete" in result.message
+
+
+def test_teach_code_6_is_an_alarm_not_moving() -> None:
+    tr = CommandTracker(RunCommand.TEACH_ENABLE, st(DONE), None, 0.0)
+    _, result = feed(tr, [(0.01, st(TeachStatus.ALGORITHM_ALARM), None)])
+    assert not result.ok and isinstance(tr.error, CommandRefused)
+    assert "algorithm alarm" in result.message
+
+
+def test_move_that_ends_without_a_status_update_is_unknown(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 1.0)
+    monkeypatch.setattr(timing, "STOP_SETTLE", 0.1)
+    tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
+    steps = [(0.01, st(DONE, RUNNING), moved(1)), (0.05, st(DONE, STOPPED), moved(2)),
+             (0.5, st(DONE, STOPPED), moved(2)), (0.99, st(DONE, STOPPED), moved(2))]
+    assert feed(tr, steps) == (None, None)
+    result = tr.update(st(DONE, STOPPED), moved(2), 1.0)
+    assert result is not None and isinstance(tr.error, CommandTimeout)
+    assert "the arm moved and stopped" in result.message and "result is unknown" in result.message
+
+
+def test_poll_interval_is_fast_until_the_code_changes(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "ACK_POLL_INTERVAL", 0.001)
+    monkeypatch.setattr(timing, "MOVE_POLL_INTERVAL", 0.02)
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 1.0)
+    tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
+    tr.update(st(DONE, RUNNING), moved(1), 0.01)
+    assert tr.poll_interval(0.01) == 0.001  # acknowledged by motion, GV291 still stale
+    assert tr.poll_interval(1.5) == 0.02  # not forever
+    tr.update(st(6, RUNNING), moved(2), 0.02)
+    assert tr.poll_interval(0.02) == 0.02

@@ -1,0 +1,118 @@
+"""Fixtures and helpers shared by the pendant's GUI/worker tests (imported explicitly)."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pytest
+
+from app import timing
+from app.client import ConnectionSettings
+from app.protocol.codec import WordOrder, registers_to_float
+from app.worker import ConnectionState, LinkState, RobotLink
+
+SIGNAL_TIMEOUT_MS = 5000
+# The offscreen platform warns when a top-level window gets size constraints; not our concern.
+QT_LOG_IGNORE = ("This plugin does not support propagateSizeHints",)
+REQUEST_TIMEOUT = 0.25  # s: a silent simulator is noticed quickly
+
+
+@pytest.fixture(name="fast_reconnect")
+def fast_reconnect_fixture(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "RECONNECT_BACKOFF", (0.05, 0.1, 0.2))
+
+
+@pytest.fixture(name="link")
+def link_fixture(qtbot: Any, fast_reconnect: None) -> Iterator[RobotLink]:
+    """A RobotLink (worker thread running), shut down after the test."""
+    robot_link = RobotLink(poll_hz=timing.POLL_HZ_DEFAULT)
+    try:
+        yield robot_link
+    finally:
+        robot_link.shutdown()
+        assert not robot_link.is_running
+
+
+def is_state(state: LinkState) -> Callable[[ConnectionState], bool]:
+    return lambda s: s.state is state
+
+
+def connection_settings(sim: Any, **overrides: Any) -> ConnectionSettings:
+    values: dict[str, Any] = {"host": "127.0.0.1", "port": sim.port, "timeout": REQUEST_TIMEOUT}
+    values.update(overrides)
+    return ConnectionSettings(**values)
+
+
+def connect(qtbot: Any, robot_link: RobotLink, sim: Any, **overrides: Any) -> ConnectionSettings:
+    """Connect ``robot_link`` to ``sim`` and wait until the link is up."""
+    settings = connection_settings(sim, **overrides)
+    with qtbot.waitSignal(robot_link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED),
+                          timeout=SIGNAL_TIMEOUT_MS):
+        robot_link.connect_to(settings)
+    return settings
+
+
+def gv_writes(sim: Any, gv: int) -> list[tuple[int, float]]:
+    """(index in ``sim.writes``, value) of every write that covered both registers of GVn."""
+    low = 2 * gv
+    out: list[tuple[int, float]] = []
+    for index, write in enumerate(list(sim.writes)):
+        start = low - write.address
+        if start >= 0 and start + 2 <= len(write.values):
+            regs = write.values[start:start + 2]
+            out.append((index, registers_to_float(regs, WordOrder.LOW_FIRST)))
+    return out
+
+
+def ratio_writes(sim: Any) -> list[float]:
+    """Every value written to GV203 (the teach speed ratio), in order."""
+    return [value for _, value in gv_writes(sim, 203)]
+
+
+def register_writes(sim: Any, address: int) -> list[tuple[int, int]]:
+    """(index in ``sim.writes``, value) of the writes to one control register (440..445)."""
+    out: list[tuple[int, int]] = []
+    for index, write in enumerate(list(sim.writes)):
+        if write.address <= address < write.address + len(write.values):
+            out.append((index, write.values[address - write.address]))
+    return out
+
+
+def jogging(sim: Any) -> bool:
+    state = sim.state()
+    return bool(state.teach_enabled and state.jogging and state.teach_ratio > 0)
+
+
+@pytest.fixture(name="app_settings")
+def app_settings_fixture(tmp_path: Any) -> Any:
+    """Settings in a temporary INI file: tests never touch the user's settings."""
+    from ui.settings import AppSettings
+
+    return AppSettings.from_file(tmp_path / "teachpad.ini")
+
+
+@pytest.fixture(name="translator")
+def translator_fixture(qapp: Any) -> Iterator[Any]:
+    from ui.i18n import Translator
+
+    translator = Translator()
+    try:
+        yield translator
+    finally:
+        translator.uninstall()  # the next test starts in English
+
+
+@pytest.fixture(name="window")
+def window_fixture(qtbot: Any, link: RobotLink, app_settings: Any, translator: Any) -> Any:
+    """The main window on ``link``, shown and active; confirmations answer yes."""
+    from ui.main_window import MainWindow
+
+    main_window = MainWindow(link, app_settings, translator)
+    main_window.confirm = lambda _title, _text: True
+    qtbot.addWidget(main_window)
+    main_window.show()
+    qtbot.waitExposed(main_window)
+    main_window.activateWindow()
+    qtbot.waitActive(main_window)
+    return main_window

@@ -1,0 +1,182 @@
+"""Connect…: Modbus TCP or RTU (serial), unit id, word order, timeout, monitor-only."""
+
+from __future__ import annotations
+
+import dataclasses
+
+from PySide6.QtCore import QEvent, Slot
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QDialog,
+    QDialogButtonBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QLabel,
+    QLineEdit,
+    QSpinBox,
+    QStackedWidget,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.client import ConnectionSettings
+from app.protocol.codec import WordOrder
+
+_BAUDRATES = (9600, 19200, 38400, 57600, 115200, 230400)
+_PARITIES = ("N", "E", "O")
+
+
+class ConnectionDialog(QDialog):
+    """Edits a :class:`ConnectionSettings`; ``settings()`` returns the result."""
+
+    def __init__(self, settings: ConnectionSettings | None = None, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("ConnectionDialog")
+        self._base = settings or ConnectionSettings()
+
+        self.transport_combo = QComboBox(self)
+        self.transport_combo.addItem("", "tcp")
+        self.transport_combo.addItem("", "rtu")
+
+        self.tcp_page = QWidget(self)
+        tcp_form = QFormLayout(self.tcp_page)
+        tcp_form.setContentsMargins(0, 0, 0, 0)
+        self.host_edit = QLineEdit(self.tcp_page)
+        self.port_spin = QSpinBox(self.tcp_page)
+        self.port_spin.setRange(1, 65535)
+        self.host_caption = QLabel(self.tcp_page)
+        self.port_caption = QLabel(self.tcp_page)
+        tcp_form.addRow(self.host_caption, self.host_edit)
+        tcp_form.addRow(self.port_caption, self.port_spin)
+
+        self.rtu_page = QWidget(self)
+        rtu_form = QFormLayout(self.rtu_page)
+        rtu_form.setContentsMargins(0, 0, 0, 0)
+        self.serial_edit = QLineEdit(self.rtu_page)
+        self.serial_edit.setPlaceholderText("/dev/ttyUSB0, COM3")
+        self.baud_combo = QComboBox(self.rtu_page)
+        for baud in _BAUDRATES:
+            self.baud_combo.addItem(str(baud), baud)
+        self.parity_combo = QComboBox(self.rtu_page)
+        for parity in _PARITIES:
+            self.parity_combo.addItem("", parity)
+        self.stopbits_spin = QSpinBox(self.rtu_page)
+        self.stopbits_spin.setRange(1, 2)
+        self.serial_caption = QLabel(self.rtu_page)
+        self.baud_caption = QLabel(self.rtu_page)
+        self.parity_caption = QLabel(self.rtu_page)
+        self.stopbits_caption = QLabel(self.rtu_page)
+        rtu_form.addRow(self.serial_caption, self.serial_edit)
+        rtu_form.addRow(self.baud_caption, self.baud_combo)
+        rtu_form.addRow(self.parity_caption, self.parity_combo)
+        rtu_form.addRow(self.stopbits_caption, self.stopbits_spin)
+
+        self.pages = QStackedWidget(self)
+        self.pages.addWidget(self.tcp_page)
+        self.pages.addWidget(self.rtu_page)
+        self.transport_combo.currentIndexChanged.connect(self.pages.setCurrentIndex)
+
+        self.unit_spin = QSpinBox(self)
+        self.unit_spin.setRange(0, 247)
+        self.order_combo = QComboBox(self)
+        self.order_combo.addItem("", WordOrder.LOW_FIRST.value)
+        self.order_combo.addItem("", WordOrder.HIGH_FIRST.value)
+        self.timeout_spin = QDoubleSpinBox(self)
+        self.timeout_spin.setRange(0.05, 30.0)
+        self.timeout_spin.setDecimals(2)
+        self.timeout_spin.setSingleStep(0.1)
+        self.timeout_spin.setSuffix(" s")
+        self.monitor_check = QCheckBox(self)
+
+        self.transport_caption = QLabel(self)
+        self.unit_caption = QLabel(self)
+        self.order_caption = QLabel(self)
+        self.timeout_caption = QLabel(self)
+        form = QFormLayout()
+        form.addRow(self.transport_caption, self.transport_combo)
+        form.addRow(self.pages)
+        form.addRow(self.unit_caption, self.unit_spin)
+        form.addRow(self.order_caption, self.order_combo)
+        form.addRow(self.timeout_caption, self.timeout_spin)
+        form.addRow(self.monitor_check)
+
+        self.buttons = QDialogButtonBox(
+            QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel, self)
+        self.buttons.accepted.connect(self.accept)
+        self.buttons.rejected.connect(self.reject)
+        layout = QVBoxLayout(self)
+        layout.addLayout(form)
+        layout.addWidget(self.buttons)
+        self.set_settings(self._base)
+        self.retranslate()
+
+    def retranslate(self) -> None:
+        self.setWindowTitle(self.tr("Connect to controller"))
+        self.transport_caption.setText(self.tr("Transport:"))
+        self.transport_combo.setItemText(0, self.tr("Modbus TCP"))
+        self.transport_combo.setItemText(1, self.tr("Modbus RTU (serial)"))
+        self.host_caption.setText(self.tr("Host:"))
+        self.port_caption.setText(self.tr("Port:"))
+        self.serial_caption.setText(self.tr("Serial port:"))
+        self.baud_caption.setText(self.tr("Baud rate:"))
+        self.parity_caption.setText(self.tr("Parity:"))
+        for i, text in enumerate((self.tr("none"), self.tr("even"), self.tr("odd"))):
+            self.parity_combo.setItemText(i, text)
+        self.stopbits_caption.setText(self.tr("Stop bits:"))
+        self.unit_caption.setText(self.tr("Unit id:"))
+        self.order_caption.setText(self.tr("Float word order:"))
+        self.order_combo.setItemText(0, self.tr("Low word first (CDAB, default)"))
+        self.order_combo.setItemText(1, self.tr("High word first (ABCD)"))
+        self.timeout_caption.setText(self.tr("Timeout:"))
+        self.monitor_check.setText(self.tr("Monitor only (never write to the controller)"))
+
+    def changeEvent(self, event: QEvent) -> None:
+        if event.type() == QEvent.Type.LanguageChange:
+            self.retranslate()
+        super().changeEvent(event)
+
+    def set_settings(self, settings: ConnectionSettings) -> None:
+        rtu = settings.serial_port is not None
+        self.transport_combo.setCurrentIndex(1 if rtu else 0)
+        self.pages.setCurrentIndex(1 if rtu else 0)
+        self.host_edit.setText(settings.host)
+        self.port_spin.setValue(settings.port)
+        self.serial_edit.setText(settings.serial_port or "")
+        index = self.baud_combo.findData(settings.baudrate)
+        if index < 0:
+            self.baud_combo.addItem(str(settings.baudrate), settings.baudrate)
+            index = self.baud_combo.count() - 1
+        self.baud_combo.setCurrentIndex(index)
+        self.parity_combo.setCurrentIndex(max(0, self.parity_combo.findData(settings.parity)))
+        self.stopbits_spin.setValue(settings.stopbits)
+        self.unit_spin.setValue(settings.unit)
+        self.order_combo.setCurrentIndex(max(0, self.order_combo.findData(settings.word_order.value)))
+        self.timeout_spin.setValue(settings.timeout)
+        self.monitor_check.setChecked(settings.monitor_only)
+
+    def settings(self) -> ConnectionSettings:
+        rtu = self.transport_combo.currentData() == "rtu"
+        serial = self.serial_edit.text().strip() if rtu else ""
+        return dataclasses.replace(
+            self._base,
+            host=self.host_edit.text().strip() or "127.0.0.1",
+            port=self.port_spin.value(),
+            serial_port=serial or None,
+            framer="socket" if not rtu else self._base.framer,
+            baudrate=int(self.baud_combo.currentData()),
+            parity=str(self.parity_combo.currentData()),
+            stopbits=self.stopbits_spin.value(),
+            unit=self.unit_spin.value(),
+            word_order=WordOrder(self.order_combo.currentData()),
+            timeout=self.timeout_spin.value(),
+            monitor_only=self.monitor_check.isChecked(),
+        )
+
+    @Slot()
+    def accept(self) -> None:
+        if self.transport_combo.currentData() == "rtu" and not self.serial_edit.text().strip():
+            self.serial_edit.setFocus()
+            self.serial_edit.setPlaceholderText(self.tr("a serial port is needed for RTU"))
+            return
+        super().accept()

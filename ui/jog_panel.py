@@ -1,0 +1,385 @@
+"""Jog (teach, function 4): hold a ± button or a key to move, let go to stop.
+
+Dead-man everywhere: a jog lasts exactly as long as the button or key is held. It also ends
+when the panel loses the keyboard focus, when the window is deactivated or closed, and when
+the link goes down (the main window calls :meth:`JogPanel.release_all`). A button that was
+cancelled that way needs a fresh press: dragging back onto it does not restart the motion.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from PySide6.QtCore import QEvent, QObject, Qt, Signal, Slot
+from PySide6.QtGui import QKeyEvent, QMouseEvent
+from PySide6.QtWidgets import (
+    QApplication,
+    QComboBox,
+    QGridLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QSizePolicy,
+    QSlider,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.protocol.enums import CARTESIAN_AXIS_NAMES, JOINT_AXIS_NAMES, TeachFrame
+from app.protocol.registers import NUM_AXES_TOTAL, NUM_ROBOT_AXES, TOOL_NONE
+from app.worker import JogRequest
+
+DEFAULT_RATIO = 20
+# Keyboard jog: axis n (1..6) plus / minus. Letters on two rows of a QWERTY keyboard.
+PLUS_KEYS: tuple[Qt.Key, ...] = (Qt.Key.Key_Q, Qt.Key.Key_W, Qt.Key.Key_E, Qt.Key.Key_R, Qt.Key.Key_T,
+                                 Qt.Key.Key_Y)
+MINUS_KEYS: tuple[Qt.Key, ...] = (Qt.Key.Key_A, Qt.Key.Key_S, Qt.Key.Key_D, Qt.Key.Key_F, Qt.Key.Key_G,
+                                  Qt.Key.Key_H)
+_FRAMES: tuple[TeachFrame, ...] = (TeachFrame.BASE, TeachFrame.USER, TeachFrame.TOOL, TeachFrame.JOINT)
+BUTTON_SIZE = 52
+
+
+@dataclass(frozen=True)
+class _Held:
+    source: str  # "mouse" or "key:<code>"
+    axis: int
+    direction: int
+
+
+class JogButton(QPushButton):
+    """A hold-to-move button: ``held`` on press, ``letGo`` on release or when the pointer leaves."""
+
+    held = Signal()
+    letGo = Signal()
+
+    def __init__(self, text: str, parent: QWidget | None = None) -> None:
+        super().__init__(text, parent)
+        self._held = False
+        self.setAutoRepeat(False)
+        self.setFocusPolicy(Qt.FocusPolicy.NoFocus)  # keep the keyboard focus on the panel
+        self.setMinimumSize(BUTTON_SIZE, BUTTON_SIZE - 12)
+        self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
+        font = self.font()
+        font.setPointSizeF(font.pointSizeF() * 1.3)
+        font.setBold(True)
+        self.setFont(font)
+
+    @property
+    def is_held(self) -> bool:
+        return self._held
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        if event.button() != Qt.MouseButton.LeftButton or not self.isEnabled():
+            event.ignore()
+            return
+        event.accept()
+        self._held = True
+        self.setDown(True)
+        self.held.emit()
+
+    def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        event.accept()
+        if event.button() == Qt.MouseButton.LeftButton:
+            self._let_go()
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        event.accept()
+        if self._held and not self.rect().contains(event.position().toPoint()):
+            self._let_go()  # sliding off the button is letting go
+
+    def cancel(self) -> None:
+        """Drop the hold without a signal (the panel already released the jog)."""
+        self._held = False
+        self.setDown(False)
+
+    def _let_go(self) -> None:
+        if self._held:
+            self._held = False
+            self.setDown(False)
+            self.letGo.emit()
+
+    def changeEvent(self, event: QEvent) -> None:
+        if event.type() == QEvent.Type.EnabledChange and not self.isEnabled():
+            self._let_go()
+        super().changeEvent(event)
+
+
+class JogPanel(QWidget):
+    """Frame, ± buttons per axis, speed slider, keyboard jogging; emits press / release."""
+
+    jogPressed = Signal(JogRequest)
+    jogReleased = Signal()
+    ratioChanged = Signal(float)
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("JogPanel")
+        self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+        self._held: _Held | None = None
+        self._motion_enabled = False
+
+        self.frame_box = QGroupBox(self)
+        self.frame_combo = QComboBox(self.frame_box)
+        for frame in _FRAMES:
+            self.frame_combo.addItem("", int(frame))
+        self.frame_combo.currentIndexChanged.connect(self._on_frame_changed)
+        self.frame_combo.installEventFilter(self)
+        self.user_label = QLabel(self.frame_box)
+        self.user_spin = QSpinBox(self.frame_box)
+        self.user_spin.setRange(0, 0xFFFF)
+        self.tool_label = QLabel(self.frame_box)
+        self.tool_spin = QSpinBox(self.frame_box)
+        self.tool_spin.setRange(0, TOOL_NONE - 1)
+        frame_row = QHBoxLayout(self.frame_box)
+        frame_row.addWidget(self.frame_combo, 1)
+        frame_row.addWidget(self.user_label)
+        frame_row.addWidget(self.user_spin)
+        frame_row.addWidget(self.tool_label)
+        frame_row.addWidget(self.tool_spin)
+
+        self.axes_box = QGroupBox(self)
+        grid = QGridLayout(self.axes_box)
+        grid.setHorizontalSpacing(8)
+        grid.setVerticalSpacing(4)
+        self.axis_labels: list[QLabel] = []
+        self.minus_buttons: list[JogButton] = []
+        self.plus_buttons: list[JogButton] = []
+        for axis in range(NUM_AXES_TOTAL):
+            label = QLabel(self.axes_box)
+            label.setAlignment(Qt.AlignmentFlag.AlignCenter)
+            label.setMinimumWidth(48)
+            font = label.font()
+            font.setBold(True)
+            font.setPointSizeF(font.pointSizeF() * 1.2)
+            label.setFont(font)
+            minus = JogButton("−", self.axes_box)
+            plus = JogButton("+", self.axes_box)
+            minus.setObjectName(f"jog_minus_{axis}")
+            plus.setObjectName(f"jog_plus_{axis}")
+            minus.held.connect(lambda a=axis: self._press("mouse", a, 0))
+            plus.held.connect(lambda a=axis: self._press("mouse", a, 1))
+            minus.letGo.connect(lambda: self._release("mouse"))
+            plus.letGo.connect(lambda: self._release("mouse"))
+            row = axis if axis < NUM_ROBOT_AXES else axis + 1  # a gap before the external axes
+            grid.addWidget(minus, row, 0)
+            grid.addWidget(label, row, 1)
+            grid.addWidget(plus, row, 2)
+            self.axis_labels.append(label)
+            self.minus_buttons.append(minus)
+            self.plus_buttons.append(plus)
+        self.external_caption = QLabel(self.axes_box)
+        self.external_caption.setStyleSheet("color: #5f6368;")
+        grid.addWidget(self.external_caption, NUM_ROBOT_AXES, 0, 1, 3)
+
+        self.hold_label = QLabel(self)
+        self.hold_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
+        self.hold_label.setStyleSheet("QLabel { color: #ef8f00; font-weight: bold; font-size: 15px; }")
+
+        self.speed_caption = QLabel(self)
+        self.speed_slider = QSlider(Qt.Orientation.Horizontal, self)
+        self.speed_slider.setRange(1, 100)
+        self.speed_slider.setValue(DEFAULT_RATIO)
+        self.speed_slider.setPageStep(10)
+        self.speed_slider.installEventFilter(self)
+        self.speed_value = QLabel(self)
+        self.speed_value.setMinimumWidth(self.speed_value.fontMetrics().horizontalAdvance("100 %") + 8)
+        self.speed_slider.valueChanged.connect(self._on_speed_changed)
+        speed_row = QHBoxLayout()
+        speed_row.addWidget(self.speed_caption)
+        speed_row.addWidget(self.speed_slider, 1)
+        speed_row.addWidget(self.speed_value)
+
+        self.keys_label = QLabel(self)
+        self.keys_label.setWordWrap(True)
+        self.keys_label.setStyleSheet("color: #5f6368;")
+
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(6, 6, 6, 6)
+        layout.addWidget(self.frame_box)
+        layout.addLayout(speed_row)
+        layout.addWidget(self.hold_label)
+        layout.addWidget(self.axes_box, 1)
+        layout.addWidget(self.keys_label)
+
+        app = QApplication.instance()
+        if isinstance(app, QApplication):
+            app.focusChanged.connect(self._on_focus_changed)
+        self.set_motion_enabled(False)
+        self.retranslate()
+
+    # --- texts ------------------------------------------------------------------------
+    def retranslate(self) -> None:
+        self.frame_box.setTitle(self.tr("Frame"))
+        names = {
+            TeachFrame.BASE: self.tr("Base frame"),
+            TeachFrame.USER: self.tr("User frame"),
+            TeachFrame.TOOL: self.tr("Tool frame"),
+            TeachFrame.JOINT: self.tr("Joint frame"),
+        }
+        for i, frame in enumerate(_FRAMES):
+            self.frame_combo.setItemText(i, names[frame])
+        self.user_label.setText(self.tr("User no.:"))
+        self.tool_label.setText(self.tr("Tool no.:"))
+        self.axes_box.setTitle(self.tr("Jog"))
+        self.external_caption.setText(self.tr("External axes"))
+        self.hold_label.setText(self.tr("HOLD TO MOVE — release to stop"))
+        self.speed_caption.setText(self.tr("Speed:"))
+        self._show_speed()
+        plus = " ".join(k.name[-1] for k in PLUS_KEYS)
+        minus = " ".join(k.name[-1] for k in MINUS_KEYS)
+        keys = self.tr(
+            "Keyboard: click this panel, then hold {plus} (+) or {minus} (−) for axes 1–6; "
+            "releasing the key stops."
+        ).format(plus=plus, minus=minus)
+        self.keys_label.setText(keys)
+        self.setToolTip(keys)
+        self._update_axes()
+
+    def changeEvent(self, event: QEvent) -> None:
+        if event.type() == QEvent.Type.LanguageChange:
+            self.retranslate()
+        super().changeEvent(event)
+
+    # --- public -----------------------------------------------------------------------
+    @property
+    def frame(self) -> TeachFrame:
+        return TeachFrame(int(self.frame_combo.currentData()))
+
+    def set_frame(self, frame: TeachFrame) -> None:
+        self.frame_combo.setCurrentIndex(_FRAMES.index(TeachFrame(frame)))
+
+    @property
+    def ratio(self) -> int:
+        return int(self.speed_slider.value())
+
+    def set_ratio(self, ratio: int) -> None:
+        self.speed_slider.setValue(int(ratio))
+
+    @property
+    def is_jogging(self) -> bool:
+        return self._held is not None
+
+    def axis_count(self) -> int:
+        return NUM_AXES_TOTAL if self.frame is TeachFrame.JOINT else NUM_ROBOT_AXES
+
+    def button(self, axis: int, direction: int) -> JogButton:
+        return (self.plus_buttons if direction else self.minus_buttons)[axis]
+
+    def set_motion_enabled(self, enabled: bool) -> None:
+        """Off while the link is down or monitor-only: any jog is released at once."""
+        self._motion_enabled = bool(enabled)
+        if not enabled:
+            self.release_all()
+        self.axes_box.setEnabled(self._motion_enabled)
+        self.hold_label.setEnabled(self._motion_enabled)
+
+    @Slot()
+    def release_all(self) -> None:
+        """End any jog (focus loss, deactivation, close, link loss). Buttons need a new press."""
+        for button in (*self.minus_buttons, *self.plus_buttons):
+            button.cancel()
+        if self._held is not None:
+            self._held = None
+            self.jogReleased.emit()
+
+    # --- keyboard ---------------------------------------------------------------------
+    def _key_axis(self, key: int) -> tuple[int, int] | None:
+        for axis, (plus, minus) in enumerate(zip(PLUS_KEYS, MINUS_KEYS, strict=True)):
+            if key == plus:
+                return axis, 1
+            if key == minus:
+                return axis, 0
+        return None
+
+    def _handle_key(self, event: QKeyEvent) -> bool:
+        mapping = self._key_axis(event.key())
+        if mapping is None or event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier:
+            return False
+        if event.isAutoRepeat():
+            return True  # a held key repeats: the jog is already running
+        axis, direction = mapping
+        source = f"key:{event.key()}"
+        if event.type() == QEvent.Type.KeyPress:
+            self._press(source, axis, direction)
+        else:
+            self._release(source)
+        return True
+
+    def keyPressEvent(self, event: QKeyEvent) -> None:
+        if not self._handle_key(event):
+            super().keyPressEvent(event)
+
+    def keyReleaseEvent(self, event: QKeyEvent) -> None:
+        if not self._handle_key(event):
+            super().keyReleaseEvent(event)
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        # The frame combo and the slider would eat letters (keyboard search): jog keys win.
+        if event.type() in (QEvent.Type.KeyPress, QEvent.Type.KeyRelease) and isinstance(event, QKeyEvent):
+            return self._handle_key(event)
+        return super().eventFilter(watched, event)
+
+    # --- internals --------------------------------------------------------------------
+    def _press(self, source: str, axis: int, direction: int) -> None:
+        if not self._motion_enabled or axis >= self.axis_count():
+            if source == "mouse":
+                self.button(axis, direction).cancel()
+            return
+        held = _Held(source, axis, direction)
+        if self._held == held:
+            return
+        self._held = held
+        frame = self.frame
+        self.jogPressed.emit(JogRequest(frame, axis, direction, float(self.ratio),
+                                        user=self.user_spin.value(), tool=self.tool_spin.value()))
+
+    def _release(self, source: str) -> None:
+        held = self._held
+        if held is None or held.source != source:
+            return  # an older key let go while a newer one is held: the newer one goes on
+        self._held = None
+        self.jogReleased.emit()
+
+    @Slot(int)
+    def _on_frame_changed(self, _index: int) -> None:
+        self.release_all()
+        self._update_axes()
+
+    def _update_axes(self) -> None:
+        frame = self.frame
+        joint = frame is TeachFrame.JOINT
+        names = JOINT_AXIS_NAMES if joint else CARTESIAN_AXIS_NAMES
+        for axis, label in enumerate(self.axis_labels):
+            visible = axis < (NUM_AXES_TOTAL if joint else NUM_ROBOT_AXES)
+            if visible:
+                label.setText(names[axis])
+                unit = self.tr("°") if joint or axis >= 3 else self.tr("mm")
+                self.minus_buttons[axis].setToolTip(self.tr("Hold: {axis} − ({unit})").format(
+                    axis=names[axis], unit=unit))
+                self.plus_buttons[axis].setToolTip(self.tr("Hold: {axis} + ({unit})").format(
+                    axis=names[axis], unit=unit))
+            for widget in (label, self.minus_buttons[axis], self.plus_buttons[axis]):
+                widget.setVisible(visible)
+        self.external_caption.setVisible(joint)
+        self.user_label.setVisible(frame is TeachFrame.USER)
+        self.user_spin.setVisible(frame is TeachFrame.USER)
+        self.tool_label.setVisible(frame is TeachFrame.TOOL)
+        self.tool_spin.setVisible(frame is TeachFrame.TOOL)
+
+    def _show_speed(self) -> None:
+        self.speed_value.setText(self.tr("{ratio} %").format(ratio=self.ratio))
+
+    @Slot(int)
+    def _on_speed_changed(self, value: int) -> None:
+        self._show_speed()
+        if self._held is not None:
+            self.ratioChanged.emit(float(value))
+
+    @Slot(object, object)
+    def _on_focus_changed(self, _old: QWidget | None, new: QWidget | None) -> None:
+        if self._held is None:
+            return
+        if new is None or (new is not self and not self.isAncestorOf(new)):
+            self.release_all()

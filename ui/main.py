@@ -1,0 +1,162 @@
+"""``teachpad``: the desktop teach pendant.
+
+    teachpad --sim                      built-in simulator on a free loopback port
+    teachpad --host H --port P [--unit U]   a real controller (Modbus TCP)
+    teachpad --lang zh_CN               language for this run (the menu remembers a choice)
+    teachpad --sim --screenshot out.png --size 1400x900   render once connected, save, exit
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import sys
+from collections.abc import Sequence
+
+from PySide6.QtCore import QTimer
+from PySide6.QtWidgets import QApplication
+
+from app.client import ConnectionSettings
+from app.models import Pose
+from app.protocol.enums import ProgramMotionMode
+from app.worker import ConnectionState, RobotLink
+from ui.i18n import LANGUAGE_NAMES, Translator
+from ui.main_window import MainWindow
+from ui.settings import APPLICATION, ORGANIZATION, AppSettings
+
+SCREENSHOT_SETTLE_MS = 1500  # after the first pose: let the plots fill and the panels paint
+SCREENSHOT_TIMEOUT_MS = 20_000  # give up when no pose arrives
+DEMO_PROGRAM = 1  # the simulator's "square 100 mm in XY"
+
+
+def _size(text: str) -> tuple[int, int]:
+    try:
+        width, height = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"size must look like 1400x900, got {text!r}") from None
+    if width < 200 or height < 200:
+        raise argparse.ArgumentTypeError("size must be at least 200x200")
+    return width, height
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="teachpad",
+                                     description="Teach pendant for Bochuang robot controllers")
+    target = parser.add_mutually_exclusive_group()
+    target.add_argument("--sim", action="store_true", help="start the built-in simulator and connect to it")
+    target.add_argument("--host", help="controller address (Modbus TCP)")
+    parser.add_argument("--port", type=int, default=502, help="Modbus TCP port (default 502)")
+    parser.add_argument("--unit", type=int, default=1, help="Modbus unit id (default 1)")
+    parser.add_argument("--monitor-only", action="store_true", help="never write to the controller")
+    parser.add_argument("--lang", choices=sorted(LANGUAGE_NAMES), help="user interface language")
+    parser.add_argument("--poll-hz", type=float, help="pose/status poll rate (default 50)")
+    parser.add_argument("--settings", metavar="FILE", help="keep settings in this INI file")
+    parser.add_argument("--size", type=_size, metavar="WxH", help="window size, e.g. 1400x900")
+    parser.add_argument("--screenshot", metavar="PNG",
+                        help="save the window once connected with a pose, then exit")
+    parser.add_argument("--demo", action="store_true",
+                        help=f"with --sim: run the simulator's program {DEMO_PROGRAM} in a loop")
+    return parser
+
+
+class _Screenshot:
+    """Saves the window once the link is up and a pose arrived, then quits the application."""
+
+    def __init__(self, window: MainWindow, link: RobotLink, path: str, app: QApplication) -> None:
+        self.window, self.link, self.path, self.app = window, link, path, app
+        self.connected = False
+        self.scheduled = False
+        self.ok = False
+        link.connectionChanged.connect(self._on_connection)
+        link.poseChanged.connect(self._on_pose)
+        self.timeout = QTimer(window)
+        self.timeout.setSingleShot(True)
+        self.timeout.timeout.connect(self._give_up)
+        self.timeout.start(SCREENSHOT_TIMEOUT_MS)
+        self.settle = QTimer(window)
+        self.settle.setSingleShot(True)
+        self.settle.timeout.connect(self._save)
+
+    def _on_connection(self, state: ConnectionState) -> None:
+        self.connected = state.connected
+
+    def _on_pose(self, _pose: Pose) -> None:
+        if self.connected and not self.scheduled:
+            self.scheduled = True
+            self.settle.start(SCREENSHOT_SETTLE_MS)
+
+    def _save(self) -> None:
+        self.timeout.stop()
+        self.ok = self.window.grab().save(self.path, "PNG")
+        if not self.ok:
+            print(f"teachpad: could not write {self.path}", file=sys.stderr)
+        self.app.exit(0 if self.ok else 1)
+
+    def _give_up(self) -> None:
+        self.settle.stop()
+        print("teachpad: no pose from the controller, no screenshot taken", file=sys.stderr)
+        self.app.exit(1)
+
+    def cancel(self) -> None:
+        self.timeout.stop()
+        self.settle.stop()
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args_in = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser()
+    args, qt_args = parser.parse_known_args(args_in)
+    if args.demo and not args.sim:
+        parser.error("--demo needs --sim")
+
+    existing = QApplication.instance()
+    app = existing if isinstance(existing, QApplication) else QApplication([sys.argv[0], *qt_args])
+    app.setOrganizationName(ORGANIZATION)
+    app.setApplicationName(APPLICATION)
+    settings = AppSettings.from_file(args.settings) if args.settings else AppSettings()
+    translator = Translator()
+    language = args.lang or settings.language
+    if not translator.set_language(language):
+        print(f"teachpad: no translation for {language}, using English", file=sys.stderr)
+
+    sim = None
+    connection: ConnectionSettings | None = None
+    if args.sim:
+        from app.sim import SimConfig, SimController
+
+        sim = SimController(SimConfig(host="127.0.0.1", port=0))
+        sim.start()
+        connection = ConnectionSettings(host="127.0.0.1", port=sim.port, unit=1,
+                                        monitor_only=args.monitor_only)
+    elif args.host:
+        connection = dataclasses.replace(settings.connection(), host=args.host, port=args.port,
+                                         unit=args.unit, serial_port=None, framer="socket",
+                                         monitor_only=args.monitor_only)
+        settings.save_connection(connection)
+
+    link = RobotLink(poll_hz=args.poll_hz or settings.poll_hz)
+    window = MainWindow(link, settings, translator)
+    if args.size:
+        window.resize(*args.size)
+    shot = _Screenshot(window, link, args.screenshot, app) if args.screenshot else None
+    window.show()
+    if connection is not None:
+        link.connect_to(connection)
+        if args.demo:
+            link.run_program(DEMO_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
+    try:
+        code = app.exec()
+    finally:
+        if shot is not None:
+            shot.cancel()
+        window.close()  # saves the window state and shuts the link down (stops any jog)
+        link.shutdown()
+        if sim is not None:
+            sim.stop()
+        translator.uninstall()
+        window.deleteLater()
+    return int(code)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,465 @@
+"""The pendant's main window: control bar, jog / step / program tabs, docked display panels.
+
+The window holds no robot state: it forwards the panels' requests to the :class:`RobotLink`
+and the link's signals to the panels. Motion controls are enabled only while the link is up
+and writable (not monitor-only). Any jog ends when the window loses the focus, is hidden or
+closed, and when the link goes down.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from PySide6.QtCore import QCoreApplication, QEvent, Qt, Slot
+from PySide6.QtGui import QAction, QActionGroup, QCloseEvent, QHideEvent, QKeySequence
+from PySide6.QtWidgets import (
+    QApplication,
+    QDockWidget,
+    QLabel,
+    QMainWindow,
+    QMessageBox,
+    QTabWidget,
+    QToolBar,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app import __version__
+from app.client import ConnectionSettings
+from app.models import CommandResult, ControllerStatus
+from app.protocol.enums import ProgramMotionMode, WorkMode
+from app.worker import ConnectionState, JogRequest, LinkState, RobotLink, WorkerError
+from ui.connection_dialog import ConnectionDialog
+from ui.control_bar import ControlBar
+from ui.event_log import EventLogPanel
+from ui.i18n import LANGUAGE_NAMES, Translator
+from ui.jog_panel import JogPanel
+from ui.monitor_panel import MonitorPanel
+from ui.program_panel import ProgramPanel, ProgramRequest
+from ui.settings import AppSettings
+from ui.status_panel import StatusPanel
+from ui.step_panel import ConfirmFn, StepPanel, StepRequest
+from ui.traffic_panel import TrafficPanel
+from ui.widgets_common import connection_display
+
+DEFAULT_SIZE = (1680, 1000)
+
+
+class MainWindow(QMainWindow):
+    """See the module docstring. ``confirm`` (settable) is used by every panel that asks."""
+
+    def __init__(self, link: RobotLink, settings: AppSettings, translator: Translator | None = None,
+                 parent: QWidget | None = None, *, shutdown_link_on_close: bool = True) -> None:
+        super().__init__(parent)
+        self.setObjectName("MainWindow")
+        self.link = link
+        self.settings = settings
+        self.translator = translator
+        self.shutdown_link_on_close = shutdown_link_on_close
+        self._connection = link.state
+        self._traffic_capture = False
+        self._operation_names: dict[str, str] = {}
+
+        # --- central: control bar + motion tabs ---------------------------------------
+        self.control_bar = ControlBar(self)
+        self.jog_panel = JogPanel(self)
+        self.step_panel = StepPanel(self)
+        self.program_panel = ProgramPanel(self)
+        self.tabs = QTabWidget(self)
+        self.tabs.addTab(self.jog_panel, "")
+        self.tabs.addTab(self.step_panel, "")
+        self.tabs.addTab(self.program_panel, "")
+        self.tabs.currentChanged.connect(lambda _i: self.jog_panel.release_all())
+        self.motion_banner = QLabel(self)
+        self.motion_banner.setAlignment(Qt.AlignmentFlag.AlignCenter)
+        self.motion_banner.setStyleSheet(
+            "QLabel { background: #fff1d6; color: #7a4a00; border: 1px solid #ef8f00;"
+            " border-radius: 4px; padding: 4px; font-weight: bold; }")
+        central = QWidget(self)
+        column = QVBoxLayout(central)
+        column.setContentsMargins(4, 4, 4, 4)
+        column.addWidget(self.control_bar)
+        column.addWidget(self.motion_banner)
+        column.addWidget(self.tabs, 1)
+        self.setCentralWidget(central)
+
+        # --- docks: the display panels --------------------------------------------------
+        self.monitor_panel = MonitorPanel(self)
+        self.status_panel = StatusPanel(self)
+        self.traffic_panel = TrafficPanel(self)
+        self.event_log = EventLogPanel(self)
+        area = Qt.DockWidgetArea
+        self.monitor_dock = self._dock("MonitorDock", self.monitor_panel, area.RightDockWidgetArea)
+        self.status_dock = self._dock("StatusDock", self.status_panel, area.LeftDockWidgetArea)
+        self.event_dock = self._dock("EventLogDock", self.event_log, area.BottomDockWidgetArea)
+        self.traffic_dock = self._dock("TrafficDock", self.traffic_panel, area.BottomDockWidgetArea)
+        self.tabifyDockWidget(self.event_dock, self.traffic_dock)
+        self.event_dock.raise_()
+        self.traffic_dock.visibilityChanged.connect(self._update_traffic_capture)
+        self.traffic_panel.captureEnabledChanged.connect(self._update_traffic_capture)
+
+        # --- actions, menus, toolbar, status bar ---------------------------------------
+        self._make_actions()
+        self._make_menus()
+        self.status_link = QLabel(self)
+        self.status_rtt = QLabel(self)
+        self.status_monitor_only = QLabel(self)
+        self.status_monitor_only.setStyleSheet("color: #c62828; font-weight: bold;")
+        self.statusBar().addPermanentWidget(self.status_monitor_only)
+        self.statusBar().addPermanentWidget(self.status_rtt)
+        self.statusBar().addPermanentWidget(self.status_link)
+
+        self._wire()
+        self.resize(*DEFAULT_SIZE)
+        self._restore_window()
+        app = QApplication.instance()
+        self._app_state_connected = isinstance(app, QApplication)
+        if isinstance(app, QApplication):
+            app.applicationStateChanged.connect(self._on_application_state)
+        self.retranslate()
+        self._on_connection(link.state, log=False)
+
+    # --- construction -----------------------------------------------------------------
+    def _dock(self, name: str, widget: QWidget, area: Qt.DockWidgetArea) -> QDockWidget:
+        dock = QDockWidget(self)
+        dock.setObjectName(name)
+        dock.setWidget(widget)
+        self.addDockWidget(area, dock)
+        return dock
+
+    def _action(self, slot: Callable[[], object],
+                shortcut: QKeySequence | QKeySequence.StandardKey | Qt.Key | str | None = None, *,
+                context: Qt.ShortcutContext = Qt.ShortcutContext.WindowShortcut) -> QAction:
+        action = QAction(self)
+        if shortcut is not None:
+            action.setShortcut(QKeySequence(shortcut))
+        action.setShortcutContext(context)
+        action.triggered.connect(slot)
+        self.addAction(action)
+        return action
+
+    def _make_actions(self) -> None:
+        app_wide = Qt.ShortcutContext.ApplicationShortcut  # also from floating docks
+        self.connect_action = self._action(self.open_connection_dialog, "Ctrl+K")
+        self.disconnect_action = self._action(self.link.disconnect, "Ctrl+Shift+K")
+        self.quit_action = self._action(self.close, QKeySequence.StandardKey.Quit)
+        self.stop_action = self._action(self.link.stop, Qt.Key.Key_Escape, context=app_wide)
+        self.stop_action.setObjectName("StopAction")
+        self.pause_action = self._action(self.link.pause, Qt.Key.Key_F6, context=app_wide)
+        self.resume_action = self._action(self.link.resume, Qt.Key.Key_F7, context=app_wide)
+        self.about_action = self._action(self.show_about)
+        self.language_group = QActionGroup(self)
+        self.language_group.setExclusive(True)
+        self.language_actions: dict[str, QAction] = {}
+        for code, name in LANGUAGE_NAMES.items():
+            action = QAction(name, self)  # each language in its own script, never translated
+            action.setCheckable(True)
+            action.setData(code)
+            action.triggered.connect(lambda _checked=False, c=code: self.set_language(c))
+            self.language_group.addAction(action)
+            self.language_actions[code] = action
+        current = self.translator.language if self.translator else "en"
+        self.language_actions.get(current, self.language_actions["en"]).setChecked(True)
+
+    def _make_menus(self) -> None:
+        bar = self.menuBar()
+        self.file_menu = bar.addMenu("")
+        self.file_menu.addAction(self.connect_action)
+        self.file_menu.addAction(self.disconnect_action)
+        self.file_menu.addSeparator()
+        self.file_menu.addAction(self.quit_action)
+        self.motion_menu = bar.addMenu("")
+        self.motion_menu.addAction(self.stop_action)
+        self.motion_menu.addAction(self.pause_action)
+        self.motion_menu.addAction(self.resume_action)
+        self.view_menu = bar.addMenu("")
+        for dock in (self.monitor_dock, self.status_dock, self.event_dock, self.traffic_dock):
+            self.view_menu.addAction(dock.toggleViewAction())
+        self.language_menu = bar.addMenu("")
+        for action in self.language_actions.values():
+            self.language_menu.addAction(action)
+        self.help_menu = bar.addMenu("")
+        self.help_menu.addAction(self.about_action)
+
+        self.toolbar = QToolBar(self)
+        self.toolbar.setObjectName("MainToolBar")
+        self.toolbar.setMovable(False)
+        for action in (self.connect_action, self.disconnect_action):
+            self.toolbar.addAction(action)
+        self.toolbar.addSeparator()
+        for action in (self.stop_action, self.pause_action, self.resume_action):
+            self.toolbar.addAction(action)
+        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.toolbar)
+        self.view_menu.addSeparator()
+        self.view_menu.addAction(self.toolbar.toggleViewAction())
+
+    def _wire(self) -> None:
+        link = self.link
+        link.poseChanged.connect(self.monitor_panel.on_pose)
+        link.statusChanged.connect(self._on_status)
+        link.alarmsChanged.connect(self.status_panel.on_alarms)
+        link.alarmsChanged.connect(self.event_log.on_alarms)
+        link.connectionChanged.connect(self._on_connection)
+        link.rttChanged.connect(self.status_panel.on_rtt)
+        link.rttChanged.connect(self._on_rtt)
+        link.commandFinished.connect(self._on_command_result)
+        link.errorOccurred.connect(self._on_error)
+        link.trafficObserved.connect(self.traffic_panel.on_traffic)
+        link.controllerReconnected.connect(self._on_reconnected)
+
+        bar = self.control_bar
+        bar.stopRequested.connect(link.stop)
+        bar.pauseRequested.connect(link.pause)
+        bar.resumeRequested.connect(link.resume)
+        bar.modeRequested.connect(self._on_mode_requested)
+        self.jog_panel.jogPressed.connect(self._on_jog_pressed)
+        self.jog_panel.jogReleased.connect(link.jog_release)
+        self.jog_panel.ratioChanged.connect(link.set_jog_ratio)
+        self.step_panel.stepRequested.connect(self._on_step_requested)
+        self.program_panel.programRequested.connect(self._on_program_requested)
+        self.program_panel.goZeroRequested.connect(self._on_go_zero_requested)
+
+    # --- texts ------------------------------------------------------------------------
+    def retranslate(self) -> None:
+        self._update_title()
+        self.tabs.setTabText(0, self.tr("Jog"))
+        self.tabs.setTabText(1, self.tr("Step"))
+        self.tabs.setTabText(2, self.tr("Program"))
+        self.monitor_dock.setWindowTitle(self.tr("Position"))
+        self.status_dock.setWindowTitle(self.tr("Status"))
+        self.event_dock.setWindowTitle(self.tr("Event log"))
+        self.traffic_dock.setWindowTitle(self.tr("Modbus traffic"))
+        self.file_menu.setTitle(self.tr("&File"))
+        self.motion_menu.setTitle(self.tr("&Motion"))
+        self.view_menu.setTitle(self.tr("&View"))
+        self.language_menu.setTitle(self.tr("&Language"))
+        self.help_menu.setTitle(self.tr("&Help"))
+        self.toolbar.setWindowTitle(self.tr("Toolbar"))
+        self.toolbar.toggleViewAction().setText(self.tr("Toolbar"))
+        self.connect_action.setText(self.tr("&Connect…"))
+        self.connect_action.setToolTip(self.tr("Connect to a controller (Ctrl+K)"))
+        self.disconnect_action.setText(self.tr("&Disconnect"))
+        self.quit_action.setText(self.tr("&Quit"))
+        self.stop_action.setText(self.tr("&Stop"))
+        self.stop_action.setToolTip(self.tr("Stop all motion (Esc)"))
+        self.pause_action.setText(self.tr("&Pause"))
+        self.pause_action.setToolTip(self.tr("Pause the current move or program (F6)"))
+        self.resume_action.setText(self.tr("&Resume"))
+        self.resume_action.setToolTip(self.tr("Resume the paused move or program (F7)"))
+        self.about_action.setText(self.tr("&About TeachPad"))
+        self.status_monitor_only.setText(self.tr("MONITOR ONLY") if self.link.monitor_only else "")
+        self._operation_names = {
+            "stop": self.tr("stop"),
+            "pause": self.tr("pause"),
+            "resume": self.tr("resume"),
+            "jog": self.tr("jog"),
+            "jog release": self.tr("jog release"),
+            "jog speed": self.tr("jog speed"),
+            "step": self.tr("incremental move"),
+            "set mode": self.tr("work mode"),
+            "go to zero": self.tr("go to zero"),
+            "run program": self.tr("run program"),
+            "create point": self.tr("create temp point"),
+            "move to point": self.tr("move to temp point"),
+            "upload points": self.tr("upload temp points"),
+            "teach disable": self.tr("teach disable"),
+            "poll": self.tr("monitor"),
+            "connect": self.tr("connect"),
+            "disconnect": self.tr("disconnect"),
+            "shutdown": self.tr("shutdown"),
+        }
+        self._show_connection()
+        self._update_motion_enabled()
+
+    def changeEvent(self, event: QEvent) -> None:
+        kind = event.type()
+        if kind == QEvent.Type.LanguageChange:
+            self.retranslate()
+        elif kind == QEvent.Type.ActivationChange and not self.isActiveWindow():
+            self.jog_panel.release_all()  # dead-man: focus went to another window
+        super().changeEvent(event)
+
+    def event(self, event: QEvent) -> bool:
+        if event.type() == QEvent.Type.WindowDeactivate:
+            self.jog_panel.release_all()
+        return super().event(event)
+
+    def _update_title(self) -> None:
+        endpoint = self._connection.endpoint
+        title = self.tr("TeachPad")
+        self.setWindowTitle(f"{title} — {endpoint}" if endpoint else title)
+
+    def operation_text(self, operation: str) -> str:
+        return self._operation_names.get(operation, operation)
+
+    # --- link -> panels ---------------------------------------------------------------
+    @Slot(object)
+    def _on_connection(self, state: ConnectionState, log: bool = True) -> None:
+        self._connection = state
+        if not state.connected:
+            self.jog_panel.release_all()  # link lost: the worker makes it safe on return
+            self.control_bar.clear_status()
+        self.status_panel.on_connection(state)
+        if log:
+            self.event_log.on_connection(state)
+        self._show_connection()
+        self._update_title()
+        self._update_motion_enabled()
+
+    def _show_connection(self) -> None:
+        text, _level = connection_display(self._connection)
+        if self._connection.state is LinkState.DOWN:
+            text = self.tr("link down")
+        self.status_link.setText(text)
+        self.status_link.setToolTip(self._connection.message)
+        self.status_monitor_only.setText(self.tr("MONITOR ONLY") if self._connection.monitor_only else "")
+        self.disconnect_action.setEnabled(self._connection.state is not LinkState.DISCONNECTED)
+
+    @property
+    def motion_enabled(self) -> bool:
+        return self._connection.connected and not self._connection.monitor_only
+
+    def _update_motion_enabled(self) -> None:
+        enabled = self.motion_enabled
+        self.jog_panel.set_motion_enabled(enabled)
+        self.step_panel.set_motion_enabled(enabled)
+        self.program_panel.set_motion_enabled(enabled)
+        self.control_bar.set_motion_enabled(enabled)
+        self.pause_action.setEnabled(enabled)
+        self.resume_action.setEnabled(enabled)
+        if self._connection.connected and self._connection.monitor_only:
+            self.motion_banner.setText(self.tr("Monitor only: motion controls are disabled"))
+        elif not self._connection.connected:
+            self.motion_banner.setText(self.tr("Not connected: motion controls are disabled"))
+        self.motion_banner.setVisible(not enabled)
+
+    @Slot(object)
+    def _on_status(self, status: ControllerStatus) -> None:
+        self.status_panel.on_status(status)
+        self.control_bar.on_status(status)
+
+    @Slot(float)
+    def _on_rtt(self, ms: float) -> None:
+        self.status_rtt.setText(self.tr("RTT {ms} ms").format(ms=f"{ms:.1f}"))
+
+    @Slot(object)
+    def _on_command_result(self, result: CommandResult) -> None:
+        self.status_panel.on_command_result(result)
+        self.event_log.on_command_result(result)
+
+    @Slot(object)
+    def _on_error(self, error: WorkerError) -> None:
+        self.event_log.add_event("error", self.operation_text(error.operation), error.message)
+        self.statusBar().showMessage(f"{self.operation_text(error.operation)}: {error.message}", 8000)
+
+    @Slot()
+    def _on_reconnected(self) -> None:
+        text = self.tr("Reconnected to the controller: jog stopped and teach mode switched off")
+        self.event_log.add_event("warning", self.tr("link"), text)
+
+    @Slot()
+    def _update_traffic_capture(self) -> None:
+        want = self.traffic_dock.isVisible() and self.traffic_panel.capture_enabled()
+        if want != self._traffic_capture:
+            self._traffic_capture = want
+            self.link.set_traffic_capture(want)
+
+    # --- panels -> link ---------------------------------------------------------------
+    @Slot(object)
+    def _on_jog_pressed(self, request: JogRequest) -> None:
+        self.link.jog_press(request.frame, request.axis, request.direction, request.ratio,
+                            request.user, request.tool)
+
+    @Slot(object)
+    def _on_step_requested(self, request: StepRequest) -> None:
+        self.link.step(request.frame, request.offsets, request.ext_offsets, request.speed)
+
+    @Slot(object)
+    def _on_program_requested(self, request: ProgramRequest) -> None:
+        self.link.run_program(request.program_id, ProgramMotionMode(request.mode), request.cycles,
+                              request.speed_ratio)
+
+    @Slot(object)
+    def _on_go_zero_requested(self, axis: int | None) -> None:
+        self.link.go_zero(axis)
+
+    @Slot(object)
+    def _on_mode_requested(self, mode: WorkMode) -> None:
+        self.jog_panel.release_all()
+        self.link.set_mode(mode)
+
+    # --- confirmation (one setter for every panel that asks) --------------------------
+    @property
+    def confirm(self) -> ConfirmFn:
+        return self.program_panel.confirm
+
+    @confirm.setter
+    def confirm(self, fn: ConfirmFn) -> None:
+        self.program_panel.confirm = fn
+        self.step_panel.confirm = fn
+
+    # --- actions ----------------------------------------------------------------------
+    @Slot()
+    def open_connection_dialog(self) -> None:
+        self.jog_panel.release_all()
+        dialog = ConnectionDialog(self.settings.connection(), self)
+        if dialog.exec() == ConnectionDialog.DialogCode.Accepted:
+            self.connect_with(dialog.settings())
+
+    def connect_with(self, settings: ConnectionSettings) -> None:
+        """Remember ``settings`` and connect (the link retries by itself until it succeeds)."""
+        self.settings.save_connection(settings)
+        self.link.connect_to(settings)
+
+    @Slot()
+    def show_about(self) -> None:
+        QMessageBox.about(self, self.tr("About TeachPad"), self.tr(
+            "<b>TeachPad {version}</b><br>Desktop teach pendant for Bochuang robot controllers "
+            "(Modbus TCP / RTU).<br><br>Esc stops all motion. Jog buttons and keys move only while held."
+        ).format(version=__version__))
+
+    def set_language(self, code: str) -> None:
+        """Switch the UI language at runtime and remember it."""
+        self.jog_panel.release_all()
+        if self.translator is not None and not self.translator.set_language(code):
+            self.event_log.add_event("warning", self.tr("language"),
+                                     self.tr("No translation file for {code}").format(code=code))
+            code = self.translator.language
+        self.settings.language = code
+        # Qt posts LanguageChange to the windows: deliver it now so the switch is immediate.
+        QCoreApplication.sendPostedEvents(None, QEvent.Type.LanguageChange)
+        action = self.language_actions.get(code)
+        if action is not None:
+            action.setChecked(True)
+
+    # --- focus, visibility, close ------------------------------------------------------
+    @Slot(Qt.ApplicationState)
+    def _on_application_state(self, state: Qt.ApplicationState) -> None:
+        if state != Qt.ApplicationState.ApplicationActive:
+            self.jog_panel.release_all()
+
+    def hideEvent(self, event: QHideEvent) -> None:
+        self.jog_panel.release_all()
+        super().hideEvent(event)
+
+    def closeEvent(self, event: QCloseEvent) -> None:
+        self.jog_panel.release_all()
+        self.settings.save_window(self.saveGeometry(), self.saveState())
+        self.settings.sync()
+        if self._app_state_connected:
+            self._app_state_connected = False
+            app = QApplication.instance()
+            if isinstance(app, QApplication):
+                app.applicationStateChanged.disconnect(self._on_application_state)
+        if self.shutdown_link_on_close:
+            self.link.shutdown()
+        super().closeEvent(event)
+
+    def _restore_window(self) -> None:
+        geometry = self.settings.window_geometry()
+        if geometry is not None:
+            self.restoreGeometry(geometry)
+        state = self.settings.window_state()
+        if state is not None:
+            self.restoreState(state)
+

@@ -1,0 +1,127 @@
+"""Remembered settings: language, connection, poll rate, window geometry (a QSettings wrapper).
+
+``AppSettings()`` uses the user's settings store (organisation ``Bochuang``, application
+``TeachPad``); tests and portable installs pass an explicit INI file
+(``AppSettings.from_file(path)``) so they never touch the user's.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+from typing import Any
+
+from PySide6.QtCore import QByteArray, QSettings
+
+from app import timing
+from app.client import ConnectionSettings
+from app.protocol.codec import WordOrder
+
+ORGANIZATION = "Bochuang"
+APPLICATION = "TeachPad"
+LANGUAGES = ("en", "zh_CN")
+DEFAULT_LANGUAGE = "en"
+
+_CONNECTION_KEYS: dict[str, type] = {
+    "host": str,
+    "port": int,
+    "unit": int,
+    "serial_port": str,
+    "baudrate": int,
+    "parity": str,
+    "stopbits": int,
+    "bytesize": int,
+    "framer": str,
+    "timeout": float,
+    "retries": int,
+    "monitor_only": bool,
+}
+
+
+def _to_bool(value: Any) -> bool:
+    if isinstance(value, str):  # INI files store booleans as "true"/"false"
+        return value.strip().lower() in ("1", "true", "yes", "on")
+    return bool(value)
+
+
+class AppSettings:
+    """Typed access to the few values TeachPad remembers between runs."""
+
+    def __init__(self, store: QSettings | None = None) -> None:
+        self._store = store if store is not None else QSettings(ORGANIZATION, APPLICATION)
+
+    @classmethod
+    def from_file(cls, path: str | os.PathLike[str]) -> AppSettings:
+        return cls(QSettings(os.fspath(path), QSettings.Format.IniFormat))
+
+    @property
+    def store(self) -> QSettings:
+        return self._store
+
+    def sync(self) -> None:
+        self._store.sync()
+
+    # --- language ---------------------------------------------------------------------
+    @property
+    def language(self) -> str:
+        value = str(self._store.value("ui/language", DEFAULT_LANGUAGE))
+        return value if value in LANGUAGES else DEFAULT_LANGUAGE
+
+    @language.setter
+    def language(self, code: str) -> None:
+        self._store.setValue("ui/language", code if code in LANGUAGES else DEFAULT_LANGUAGE)
+
+    # --- poll rate --------------------------------------------------------------------
+    @property
+    def poll_hz(self) -> float:
+        try:
+            value = float(self._store.value("link/poll_hz", timing.POLL_HZ_DEFAULT))  # type: ignore[arg-type]
+        except (TypeError, ValueError):
+            return float(timing.POLL_HZ_DEFAULT)
+        return value if 1.0 <= value <= 500.0 else float(timing.POLL_HZ_DEFAULT)
+
+    @poll_hz.setter
+    def poll_hz(self, hz: float) -> None:
+        self._store.setValue("link/poll_hz", float(hz))
+
+    # --- connection -------------------------------------------------------------------
+    def connection(self) -> ConnectionSettings:
+        """The last connection settings (defaults for what was never saved)."""
+        defaults = ConnectionSettings()
+        values: dict[str, Any] = {}
+        for key, kind in _CONNECTION_KEYS.items():
+            raw = self._store.value(f"connection/{key}")
+            if raw is None or raw == "":
+                continue
+            try:
+                values[key] = _to_bool(raw) if kind is bool else kind(raw)
+            except (TypeError, ValueError):
+                continue
+        if "serial_port" in values and not values["serial_port"]:
+            values["serial_port"] = None
+        order = self._store.value("connection/word_order")
+        if order is not None:
+            try:
+                values["word_order"] = WordOrder[str(order)]
+            except KeyError:
+                pass
+        return dataclasses.replace(defaults, **values)
+
+    def save_connection(self, settings: ConnectionSettings) -> None:
+        for key in _CONNECTION_KEYS:
+            value = getattr(settings, key)
+            self._store.setValue(f"connection/{key}", "" if value is None else value)
+        self._store.setValue("connection/word_order", settings.word_order.name)
+
+    # --- window -----------------------------------------------------------------------
+    def window_geometry(self) -> QByteArray | None:
+        value = self._store.value("window/geometry")
+        return value if isinstance(value, QByteArray) and not value.isEmpty() else None
+
+    def window_state(self) -> QByteArray | None:
+        value = self._store.value("window/state")
+        return value if isinstance(value, QByteArray) and not value.isEmpty() else None
+
+    def save_window(self, geometry: QByteArray, state: QByteArray) -> None:
+        self._store.setValue("window/geometry", geometry)
+        self._store.setValue("window/state", state)

@@ -1,0 +1,288 @@
+"""Incremental move (function 1): joint or base frame, preset or exact offsets, speed GV225.
+
+A ± button moves one axis by the selected preset (0.1 / 1 / 10 mm or °). "Move by values"
+sends every exact value at once; a move longer than :data:`CONFIRM_ABOVE` asks first (the
+``confirm`` attribute, replaceable in tests). Speed is rpm in the joint frame and mm/s in the
+base frame (the controller's unit for GV225 depends on the frame).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from PySide6.QtCore import QEvent, Signal, Slot
+from PySide6.QtWidgets import (
+    QButtonGroup,
+    QCheckBox,
+    QComboBox,
+    QDoubleSpinBox,
+    QGridLayout,
+    QGroupBox,
+    QHBoxLayout,
+    QLabel,
+    QMessageBox,
+    QPushButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.client import StepFrame
+from app.protocol.enums import CARTESIAN_AXIS_NAMES, JOINT_AXIS_NAMES
+from app.protocol.registers import NUM_AXES_TOTAL, NUM_EXTERNAL_AXES, NUM_ROBOT_AXES
+
+PRESETS: tuple[float, ...] = (0.1, 1.0, 10.0)
+DEFAULT_PRESET = 1.0
+OFFSET_LIMIT = 10_000.0  # mm or degrees, per axis and move
+CONFIRM_ABOVE = 10.0  # an exact-values move with any |offset| above this asks first
+SPEED_DEFAULT = {StepFrame.JOINT: 5.0, StepFrame.BASE: 50.0}  # rpm, mm/s
+SPEED_MAX = {StepFrame.JOINT: 100.0, StepFrame.BASE: 2000.0}
+
+ConfirmFn = Callable[[str, str], bool]
+
+
+@dataclass(frozen=True)
+class StepRequest:
+    frame: StepFrame
+    offsets: tuple[float, float, float, float, float, float]
+    ext_offsets: tuple[float, float, float, float, float]
+    speed: float
+
+
+def ask_confirmation(parent: QWidget) -> ConfirmFn:
+    """The default confirmation: a Yes/No question box, No being the default."""
+
+    def confirm(title: str, text: str) -> bool:
+        answer = QMessageBox.question(parent, title, text,
+                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
+                                      QMessageBox.StandardButton.No)
+        return answer == QMessageBox.StandardButton.Yes
+
+    return confirm
+
+
+class StepPanel(QWidget):
+    """Emits ``stepRequested(StepRequest)``."""
+
+    stepRequested = Signal(StepRequest)
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("StepPanel")
+        self.confirm: ConfirmFn = ask_confirmation(self)
+        self._speeds = dict(SPEED_DEFAULT)
+        self._frame = StepFrame.JOINT
+
+        self.frame_caption = QLabel(self)
+        self.frame_combo = QComboBox(self)
+        self.frame_combo.addItem("", StepFrame.JOINT.value)
+        self.frame_combo.addItem("", StepFrame.BASE.value)
+        self.frame_combo.currentIndexChanged.connect(self._on_frame_changed)
+        self.speed_caption = QLabel(self)
+        self.speed_spin = QDoubleSpinBox(self)
+        self.speed_spin.setDecimals(1)
+        self.speed_spin.setMinimum(0.1)
+        self.speed_spin.valueChanged.connect(self._on_speed_changed)
+        top = QHBoxLayout()
+        top.addWidget(self.frame_caption)
+        top.addWidget(self.frame_combo, 1)
+        top.addSpacing(12)
+        top.addWidget(self.speed_caption)
+        top.addWidget(self.speed_spin)
+
+        self.preset_box = QGroupBox(self)
+        preset_row = QHBoxLayout(self.preset_box)
+        self.preset_group = QButtonGroup(self)
+        self.preset_buttons: list[QPushButton] = []
+        for i, value in enumerate(PRESETS):
+            button = QPushButton(f"{value:g}", self.preset_box)
+            button.setCheckable(True)
+            button.setChecked(value == DEFAULT_PRESET)
+            self.preset_group.addButton(button, i)
+            preset_row.addWidget(button)
+            self.preset_buttons.append(button)
+
+        self.axes_box = QGroupBox(self)
+        grid = QGridLayout(self.axes_box)
+        self.axis_labels: list[QLabel] = []
+        self.minus_buttons: list[QPushButton] = []
+        self.plus_buttons: list[QPushButton] = []
+        self.value_spins: list[QDoubleSpinBox] = []
+        self.value_caption = QLabel(self.axes_box)
+        grid.addWidget(self.value_caption, 0, 3)
+        for axis in range(NUM_AXES_TOTAL):
+            label = QLabel(self.axes_box)
+            minus = QPushButton("−", self.axes_box)
+            plus = QPushButton("+", self.axes_box)
+            minus.setObjectName(f"step_minus_{axis}")
+            plus.setObjectName(f"step_plus_{axis}")
+            minus.clicked.connect(lambda _=False, a=axis: self._step_one(a, -1.0))
+            plus.clicked.connect(lambda _=False, a=axis: self._step_one(a, 1.0))
+            spin = QDoubleSpinBox(self.axes_box)
+            spin.setRange(-OFFSET_LIMIT, OFFSET_LIMIT)
+            spin.setDecimals(3)
+            spin.setSingleStep(DEFAULT_PRESET)
+            row = axis + 1 if axis < NUM_ROBOT_AXES else axis + 2  # external axes below their switch
+            grid.addWidget(label, row, 0)
+            grid.addWidget(minus, row, 1)
+            grid.addWidget(plus, row, 2)
+            grid.addWidget(spin, row, 3)
+            self.axis_labels.append(label)
+            self.minus_buttons.append(minus)
+            self.plus_buttons.append(plus)
+            self.value_spins.append(spin)
+        self.external_check = QCheckBox(self.axes_box)
+        self.external_check.toggled.connect(self._show_external)
+        grid.addWidget(self.external_check, NUM_AXES_TOTAL + 1, 0, 1, 4)
+        self.move_button = QPushButton(self)
+        self.move_button.clicked.connect(self._move_by_values)
+        self.clear_button = QPushButton(self)
+        self.clear_button.clicked.connect(self.clear_values)
+        actions = QHBoxLayout()
+        actions.addStretch(1)
+        actions.addWidget(self.clear_button)
+        actions.addWidget(self.move_button)
+
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(6, 6, 6, 6)
+        layout.addLayout(top)
+        layout.addWidget(self.preset_box)
+        layout.addWidget(self.axes_box, 1)
+        layout.addLayout(actions)
+        self.preset_group.idClicked.connect(self._on_preset)
+        self._show_external(False)
+        self._apply_frame()
+        self.retranslate()
+
+    # --- texts ------------------------------------------------------------------------
+    def retranslate(self) -> None:
+        self.frame_caption.setText(self.tr("Frame:"))
+        self.frame_combo.setItemText(0, self.tr("Joint frame"))
+        self.frame_combo.setItemText(1, self.tr("Base frame"))
+        self.speed_caption.setText(self.tr("Speed:"))
+        self.speed_spin.setToolTip(self.tr("Expected speed of the incremental move (GV225)"))
+        self.preset_box.setTitle(self.tr("Increment per click (mm or °)"))
+        self.axes_box.setTitle(self.tr("Incremental move"))
+        self.value_caption.setText(self.tr("Exact offset"))
+        self.move_button.setText(self.tr("Move by values"))
+        self.move_button.setToolTip(self.tr("Move every axis by its exact offset in one incremental move"))
+        self.clear_button.setText(self.tr("Clear values"))
+        self.external_check.setText(self.tr("External axes J7–J11"))
+        self.external_check.setToolTip(self.tr("Show the external axes; while hidden their offsets are 0"))
+        self._apply_units()
+
+    def changeEvent(self, event: QEvent) -> None:
+        if event.type() == QEvent.Type.LanguageChange:
+            self.retranslate()
+        super().changeEvent(event)
+
+    # --- public -----------------------------------------------------------------------
+    @property
+    def frame(self) -> StepFrame:
+        return self._frame
+
+    def set_frame(self, frame: StepFrame) -> None:
+        self.frame_combo.setCurrentIndex(0 if frame is StepFrame.JOINT else 1)
+
+    @property
+    def preset(self) -> float:
+        return PRESETS[max(0, self.preset_group.checkedId())]
+
+    def set_preset(self, value: float) -> None:
+        self.preset_buttons[PRESETS.index(value)].setChecked(True)
+        self._on_preset(PRESETS.index(value))
+
+    @property
+    def speed(self) -> float:
+        return float(self.speed_spin.value())
+
+    def speed_unit(self) -> str:
+        return self.tr("rpm") if self._frame is StepFrame.JOINT else self.tr("mm/s")
+
+    def set_values(self, values: list[float]) -> None:
+        for spin, value in zip(self.value_spins, values, strict=False):
+            spin.setValue(value)
+
+    @Slot()
+    def clear_values(self) -> None:
+        for spin in self.value_spins:
+            spin.setValue(0.0)
+
+    def set_motion_enabled(self, enabled: bool) -> None:
+        self.axes_box.setEnabled(enabled)
+        self.move_button.setEnabled(enabled)
+
+    # --- internals --------------------------------------------------------------------
+    def _request(self, offsets: list[float]) -> None:
+        robot = offsets[:NUM_ROBOT_AXES]
+        ext = offsets[NUM_ROBOT_AXES:NUM_AXES_TOTAL] if self.external_check.isChecked() else [0.0] * 5
+        self.stepRequested.emit(StepRequest(
+            self._frame,
+            (robot[0], robot[1], robot[2], robot[3], robot[4], robot[5]),
+            (ext[0], ext[1], ext[2], ext[3], ext[4]),
+            self.speed,
+        ))
+
+    def _step_one(self, axis: int, sign: float) -> None:
+        offsets = [0.0] * NUM_AXES_TOTAL
+        offsets[axis] = sign * self.preset
+        self._request(offsets)
+
+    @Slot(bool)
+    def _show_external(self, shown: bool) -> None:
+        for axis in range(NUM_ROBOT_AXES, NUM_AXES_TOTAL):
+            for widget in (self.axis_labels[axis], self.minus_buttons[axis], self.plus_buttons[axis],
+                           self.value_spins[axis]):
+                widget.setVisible(shown)
+
+    @Slot()
+    def _move_by_values(self) -> None:
+        offsets = [spin.value() for spin in self.value_spins]
+        if not self.external_check.isChecked():
+            offsets[NUM_ROBOT_AXES:] = [0.0] * NUM_EXTERNAL_AXES
+        if not any(offsets):
+            return
+        if max(abs(v) for v in offsets) > CONFIRM_ABOVE:
+            names = self._axis_names()
+            moves = ", ".join(f"{names[i]} {v:+g}" for i, v in enumerate(offsets) if v)
+            text = self.tr("Move by {moves} at {speed} {unit}?").format(
+                moves=moves, speed=f"{self.speed:g}", unit=self.speed_unit())
+            if not self.confirm(self.tr("Confirm incremental move"), text):
+                return
+        self._request(offsets)
+
+    def _axis_names(self) -> tuple[str, ...]:
+        robot = JOINT_AXIS_NAMES[:NUM_ROBOT_AXES] if self._frame is StepFrame.JOINT else CARTESIAN_AXIS_NAMES
+        return (*robot, *JOINT_AXIS_NAMES[NUM_ROBOT_AXES:NUM_ROBOT_AXES + NUM_EXTERNAL_AXES])
+
+    @Slot(int)
+    def _on_frame_changed(self, index: int) -> None:
+        self._frame = StepFrame.JOINT if index == 0 else StepFrame.BASE
+        self._apply_frame()
+
+    def _apply_frame(self) -> None:
+        frame = self._frame
+        self.speed_spin.blockSignals(True)
+        self.speed_spin.setMaximum(SPEED_MAX[frame])
+        self.speed_spin.setValue(self._speeds[frame])
+        self.speed_spin.blockSignals(False)
+        self._apply_units()
+
+    def _apply_units(self) -> None:
+        self.speed_spin.setSuffix(" " + self.speed_unit())
+        names = self._axis_names()
+        deg, mm = self.tr("°"), self.tr("mm")
+        for axis, label in enumerate(self.axis_labels):
+            linear = self._frame is StepFrame.BASE and axis < 3
+            unit = mm if linear else deg
+            label.setText(f"{names[axis]} ({unit})")
+            self.value_spins[axis].setSuffix(f" {unit}")
+
+    @Slot(float)
+    def _on_speed_changed(self, value: float) -> None:
+        self._speeds[self._frame] = float(value)
+
+    @Slot(int)
+    def _on_preset(self, index: int) -> None:
+        for spin in self.value_spins:
+            spin.setSingleStep(PRESETS[index])
