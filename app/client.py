@@ -256,9 +256,16 @@ class CommandTracker:
         """How long to wait before the next status read.
 
         Fast until GV291 has left the pre-command code (the controller may show 0, "received",
-        only briefly before the new final code), for at most the acknowledgement timeout.
+        only briefly before the new final code), and for short commands until they end, for at
+        most the acknowledgement timeout.
         """
-        if not self.code_left_pre and now - self.started < self.ack_timeout:
+        # short commands (create point, teach) finish within a controller cycle or two once
+        # taken: keep reading fast after the acknowledgement too
+        short = self.kind is not CommandKind.MOVE
+        if short and now - self.started < timing.SHORT_COMMAND_SPIN:
+            return 0.0  # back to back: the round trip itself paces the reads
+        fast = not self.code_left_pre or short
+        if fast and now - self.started < self.ack_timeout:
             return self.ack_poll_interval
         return self.poll_interval_after_ack
 
@@ -846,7 +853,9 @@ class RobotClient:
                 if raise_errors and tracker.error is not None:
                     raise tracker.error
                 return result
-            time.sleep(tracker.poll_interval(time.monotonic()))
+            interval = tracker.poll_interval(time.monotonic())
+            if interval > 0:
+                time.sleep(interval)
 
     def _finish(self, tracker: CommandTracker, wait: bool) -> CommandResult:
         if wait:

@@ -160,6 +160,7 @@ def _seed_upload(bare: ModbusTcpClient, points: list[tuple[int, list[float]]]) -
 def bench_upload(sim: SimController, n: int) -> dict[str, Any]:
     host, port = "127.0.0.1", sim.port
     points = _poses(n)
+    sim.restart_controller()
 
     client = RobotClient(ConnectionSettings(host=host, port=port))
     client.connect()
@@ -178,16 +179,19 @@ def bench_upload(sim: SimController, n: int) -> dict[str, Any]:
         t0 = time.perf_counter()
         _seed_upload(bare, points)
         seed_s = time.perf_counter() - t0
-        # round trip of one write and one read on the same link, for the bound
+        # round trip of one small request on the same link, for the bound
         rtt = _rate(lambda: bare.read_holding_registers(R.gv_reg(291), count=2, device_id=1), 1.0)
     finally:
         bare.close()
-    # Minimal transactions per point with the GV route: pose write, id/source/index write,
-    # the 0xE0 command, one status read that sees the result.
+    latency = sim.config.command_latency
+    # Minimal transactions per point with the GV route: pose write, id/source/index write, the
+    # 0xE0 command, one status read that sees the result (a host that also proves the result
+    # is fresh reads twice: the 0, then 0xFF). The controller's own latency adds to each point.
     min_tx_per_point = 4
-    bound_s = n * min_tx_per_point * rtt["p50_ms"] / 1000.0
+    bound_s = n * (min_tx_per_point * rtt["p50_ms"] / 1000.0 + latency)
     return {
         "points": n,
+        "controller_latency_ms": 1000 * latency,
         "failed": failed,
         "batched_s": batched_s,
         "seed_sequence_s": seed_s,
@@ -208,4 +212,15 @@ def run(quick: bool) -> dict[str, Any]:
         upload = bench_upload(sim, n=500 if quick else 10000)
     finally:
         sim.stop()
-    return {"monitor_cycle": monitor, "upload_points": upload}
+    # the same upload against a controller that answers instantly: transactions dominate
+    instant = SimController(SimConfig(host="127.0.0.1", port=0, command_latency=0.0))
+    instant.start()
+    try:
+        upload_instant = bench_upload(instant, n=500 if quick else 10000)
+    finally:
+        instant.stop()
+    return {
+        "monitor_cycle": monitor,
+        "upload_points": upload,
+        "upload_points_instant_controller": upload_instant,
+    }
