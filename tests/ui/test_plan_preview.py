@@ -1,0 +1,129 @@
+"""PlanPreview: the three projections, arcs through their middle point, selection, live TCP,
+and a 1,000-segment plan drawn with one curve item per projection."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pyqtgraph as pg
+import pytest
+
+from app.models import Pose
+from app.plan import Plan, Segment, plan_path
+from app.points import PointLedger, make_point
+from ui.plan_preview import PROJECTIONS, PlanPreview
+
+
+@pytest.fixture
+def ledger() -> PointLedger:
+    return PointLedger([
+        make_point(1, "home", (400, 0, 450, 180, 0, 0)),
+        make_point(5, "W", (300, 0, 300, 180, 0, 0)),
+        make_point(6, "N", (400, 100, 320, 180, 0, 0)),
+        make_point(7, "E", (500, 0, 300, 180, 0, 0)),
+    ])
+
+
+@pytest.fixture
+def preview(qtbot: Any) -> PlanPreview:
+    widget = PlanPreview()
+    qtbot.addWidget(widget)
+    widget.resize(1000, 320)
+    return widget
+
+
+def curve_xy(item: pg.PlotCurveItem) -> tuple[np.ndarray, np.ndarray]:
+    x, y = item.getData()
+    return np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+
+
+def test_projections_and_items(preview: PlanPreview, ledger: PointLedger) -> None:
+    plan = Plan("p", [Segment.line(5), Segment.arc(6, 7), Segment.line(1)])
+    path = plan_path(plan, ledger, (400, 0, 450))
+    preview.set_path(path)
+    preview.set_points([(p.x, p.y, p.z) for p in ledger], [f"P{p.id}" for p in ledger])
+    preview.set_start((400, 0, 450))
+    assert list(preview.projections) == [key for key, _, _ in PROJECTIONS] == ["top", "front", "side"]
+    for proj in preview.projections.values():
+        x, y = curve_xy(proj.path)
+        assert x.shape == (path.xyz.shape[0],)
+        np.testing.assert_allclose(x, path.xyz[:, proj.h])
+        np.testing.assert_allclose(y, path.xyz[:, proj.v])
+        assert len(proj.labels) == 4
+        assert proj.points.data.shape[0] == 4 and proj.start.data.shape[0] == 1
+        items = proj.plot.getPlotItem().items
+        assert proj.path in items and proj.selected in items and proj.tcp in items
+
+
+def test_arc_passes_through_its_middle_point(preview: PlanPreview, ledger: PointLedger) -> None:
+    plan = Plan("p", [Segment.line(5), Segment.arc(6, 7)])
+    preview.set_path(plan_path(plan, ledger, (400, 0, 450)))
+    middle = (400.0, 100.0, 320.0)
+    for proj in preview.projections.values():
+        x, y = curve_xy(proj.path)
+        distance = np.hypot(x - middle[proj.h], y - middle[proj.v])
+        assert np.nanmin(distance) < 1e-9
+    # and it is a circle: every sample of the arc is at the same distance from its centre
+    path = preview.path
+    assert path is not None
+    arc = path.xyz[path.segment == 1]
+    s, m, e = arc[0], np.array(middle), arc[-1]
+    from app.plan import arc_geometry
+
+    geo = arc_geometry(s[None, :], m[None, :], e[None, :])
+    radii = np.linalg.norm(arc - geo.centre[0], axis=1)
+    np.testing.assert_allclose(radii, geo.radius[0], rtol=1e-9)
+
+
+def test_selected_segment_is_highlighted(preview: PlanPreview, ledger: PointLedger) -> None:
+    plan = Plan("p", [Segment.line(5), Segment.arc(6, 7), Segment.line(1)])
+    path = plan_path(plan, ledger, (400, 0, 450))
+    preview.set_path(path)
+    preview.set_selected(1)
+    x, _ = curve_xy(preview.projections["top"].selected)
+    np.testing.assert_allclose(x, path.xyz[path.segment == 1][:, 0])
+    preview.set_selected(None)
+    assert curve_xy(preview.projections["top"].selected)[0].size == 0
+
+
+def test_unknown_segments_leave_a_gap(preview: PlanPreview, ledger: PointLedger) -> None:
+    plan = Plan("p", [Segment.line(99), Segment.line(5), Segment.line(7)])
+    preview.set_path(plan_path(plan, ledger, (400, 0, 450)))
+    x, _ = curve_xy(preview.projections["top"].path)
+    assert np.isnan(x).any() and np.isfinite(x).any()
+
+
+def test_thousand_segments_one_item_per_projection(preview: PlanPreview, ledger: PointLedger) -> None:
+    segments = [Segment.arc(6, 7) if k % 3 == 1 else Segment.line((5, 1, 7)[k % 3]) for k in range(1000)]
+    plan = Plan("big", segments)
+    path = plan_path(plan, ledger, (400, 0, 450))
+    for _ in range(2):  # redraw
+        preview.set_path(path)
+        preview.set_selected(500)
+    for proj in preview.projections.values():
+        curves = [item for item in proj.plot.getPlotItem().items if isinstance(item, pg.PlotCurveItem)]
+        assert len(curves) == 3  # path, selection, live trail
+        assert curve_xy(proj.path)[0].shape == (path.xyz.shape[0],)
+    preview.grab()  # paints without error
+
+
+def test_live_tcp(qtbot: Any, preview: PlanPreview) -> None:
+    top = preview.projections["top"]
+    preview.show()
+    preview.on_pose(Pose(1.0, 2.0, 3.0, 0.0, 0.0, 0.0))  # not live: only remembered
+    assert top.tcp.data.shape[0] == 0
+    preview.start_live()  # draws the latest pose at once
+    assert preview.live
+    assert list(top.tcp.data["x"]) == [1.0] and list(top.tcp.data["y"]) == [2.0]
+    for k in range(5):
+        preview.on_pose(Pose(10.0 + k, 20.0, 30.0, 0.0, 0.0, 0.0))
+    qtbot.waitUntil(lambda: list(top.tcp.data["x"]) == [14.0])
+    preview.stop_live()
+    assert not preview.live
+    x, _ = curve_xy(top.trail)
+    assert x.size >= 1 and x[-1] == 14.0
+    side = preview.projections["side"]
+    assert list(side.tcp.data["x"]) == [20.0] and list(side.tcp.data["y"]) == [30.0]
+    preview.clear()
+    assert top.tcp.data.shape[0] == 0

@@ -1,0 +1,389 @@
+"""PointsPanel and PointSyncController with a fake link: teach, upload / cancel / restore,
+move to point (confirmation injected), validation messages, filter, undo of teach."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pytest
+from PySide6.QtCore import QObject, Signal
+from PySide6.QtGui import QUndoStack
+
+from app.models import CommandResult, Pose
+from app.points import SyncState, make_point
+from app.project import load_project
+from app.protocol.enums import CommandKind, CommandStatus, RunCommand
+from ui.points_model import COL_E1, COL_TOOL, COL_X, PointsModel
+from ui.points_panel import PointsPanel, PointSyncController
+
+SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
+
+
+# --- the fake link (also used by test_planner.py) ------------------------------------------
+
+
+@dataclass(frozen=True)
+class FakeState:
+    connected: bool = True
+    message: str = ""
+
+
+@dataclass(frozen=True)
+class FakeError:
+    operation: str
+    message: str
+
+
+@dataclass
+class Call:
+    name: str
+    args: tuple[Any, ...]
+    kwargs: dict[str, Any] = field(default_factory=dict)
+
+
+class FakeLink(QObject):
+    """The signals and methods of ``RobotLink`` the panels use; records the calls."""
+
+    poseChanged = Signal(object)  # noqa: N815
+    commandFinished = Signal(object)  # noqa: N815
+    errorOccurred = Signal(object)  # noqa: N815
+    connectionChanged = Signal(object)  # noqa: N815
+    controllerReconnected = Signal()  # noqa: N815
+    uploadProgress = Signal(int, int)  # noqa: N815
+    called = Signal(str)
+
+    def __init__(self, connected: bool = True) -> None:
+        super().__init__()
+        self.state = FakeState(connected)
+        self.calls: list[Call] = []
+
+    def _record(self, name: str, *args: Any, **kwargs: Any) -> None:
+        self.calls.append(Call(name, args, kwargs))
+        self.called.emit(name)
+
+    def named(self, name: str) -> list[Call]:
+        return [c for c in self.calls if c.name == name]
+
+    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = 200) -> None:
+        self._record("create_point", point_id, pose, tool)
+
+    def upload_points(self, points: Any, tool: int = 200) -> None:
+        self._record("upload_points", [(pid, tuple(pose)) for pid, pose in points], tool)
+
+    def move_to_point(self, end_id: int, via_id: int | None = None, **kwargs: Any) -> None:
+        self._record("move_to_point", end_id, via_id, **kwargs)
+
+    def stop(self) -> None:
+        self._record("stop")
+
+    def pause(self) -> None:
+        self._record("pause")
+
+    def resume(self) -> None:
+        self._record("resume")
+
+    # what the worker would emit
+    def set_connected(self, connected: bool, message: str = "") -> None:
+        self.state = FakeState(connected, message)
+        self.connectionChanged.emit(self.state)
+
+    def finish_create(self, ok: bool = True, pose: Sequence[float] | None = None, message: str = "") -> None:
+        details = dict(zip("xyzabc", pose, strict=True)) if pose is not None else {}
+        status = CommandStatus(CommandKind.CREATE_POINT, 0xFF if ok else 1)
+        self.commandFinished.emit(CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, status, ok,
+                                                message, {k: float(v) for k, v in details.items()}))
+
+    def finish_move(self, ok: bool = True, code: int = 0xFF, message: str = "") -> None:
+        status = CommandStatus(CommandKind.MOVE, code)
+        result = CommandResult(RunCommand.MOVE_TO_POINT, CommandKind.MOVE, status, ok, message)
+        self.commandFinished.emit(result)
+
+    def point_failed(self, point_id: int, message: str) -> None:
+        status = CommandStatus(CommandKind.CREATE_POINT, 1)
+        result = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, status, False, message,
+                               {"point_id": float(point_id)})
+        self.commandFinished.emit(result)
+
+    def upload_summary(self, uploaded: int, total: int, stopped: bool = False) -> None:
+        text = f"uploaded {uploaded} of {total} points" + (" (stopped)" if stopped else "")
+        self.commandFinished.emit(CommandResult(RunCommand.CREATE_POINT, None, None, uploaded == total, text,
+                                                {"uploaded": float(uploaded)}))
+
+
+# --- fixtures -------------------------------------------------------------------------------
+
+
+@pytest.fixture
+def link() -> FakeLink:
+    return FakeLink()
+
+
+@pytest.fixture
+def model() -> PointsModel:
+    return PointsModel(load_project(SAMPLE), QUndoStack())
+
+
+@pytest.fixture
+def answers() -> list[bool]:
+    return []
+
+
+@pytest.fixture
+def panel(qtbot: Any, model: PointsModel, link: FakeLink, answers: list[bool]) -> Iterator[PointsPanel]:
+    questions: list[str] = []
+
+    def confirm(title: str, text: str) -> bool:
+        questions.append(text)
+        return answers.pop(0) if answers else False
+
+    widget = PointsPanel(model, PointSyncController(model, link), confirm=confirm)
+    widget.questions = questions  # type: ignore[attr-defined]
+    qtbot.addWidget(widget)
+    widget.resize(1000, 500)
+    yield widget
+
+
+# --- teach ----------------------------------------------------------------------------------
+
+
+def test_teach_creates_next_point_from_the_current_pose(qtbot: Any, panel: PointsPanel,
+                                                        link: FakeLink) -> None:
+    assert panel.action_teach.isEnabled()
+    assert panel.action_teach.shortcut().toString() == "Ctrl+T"
+    panel.action_teach.trigger()
+    assert [(c.args) for c in link.named("create_point")] == [(9, None, 200)]
+    assert not panel.action_teach.isEnabled()  # one operation at a time
+    assert 9 not in panel.model.ledger  # nothing until the controller confirms
+    link.poseChanged.emit(Pose(0, 0, 0, 0, 0, 0, ext=(1, 2, 3, 4, 5)))
+    with qtbot.waitSignal(panel.controller.pointTaught) as taught:
+        link.finish_create(True, pose=(410.5, -20.0, 300.25, 180.0, 0.0, 45.0))
+    assert taught.args == [9]
+    point = panel.model.ledger.point(9)
+    assert point.xyzabc == (410.5, -20.0, 300.25, 180.0, 0.0, 45.0)  # from the result's details
+    assert point.ext == (1, 2, 3, 4, 5) and point.sync is SyncState.ON_CONTROLLER
+    assert panel.selected_rows() == [panel.model.row_of(9)]
+    assert "Taught P9" in panel.status.text()
+    # undo / redo of teach
+    panel.model.undo_stack.undo()
+    assert 9 not in panel.model.ledger
+    panel.model.undo_stack.redo()
+    assert panel.model.ledger.point(9).sync is SyncState.ON_CONTROLLER
+
+
+def test_teach_without_pose_details_uses_the_latest_pose(qtbot: Any, panel: PointsPanel,
+                                                         link: FakeLink) -> None:
+    panel.teach()
+    link.poseChanged.emit(Pose(1.0, 2.0, 3.0, 4.0, 5.0, 6.0))
+    with qtbot.waitSignal(panel.controller.pointTaught):
+        link.finish_create(True)
+    assert panel.model.ledger.point(9).xyzabc == (1.0, 2.0, 3.0, 4.0, 5.0, 6.0)
+
+
+def test_teach_refused_by_the_controller(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
+    panel.teach()
+    with qtbot.assertNotEmitted(panel.controller.pointTaught):
+        link.finish_create(False, message="bad point id")
+    assert 9 not in panel.model.ledger
+    assert "bad point id" in panel.status.text()
+    assert panel.action_teach.isEnabled()
+
+
+def test_teach_ignores_unrelated_results_and_ends_on_link_loss(qtbot: Any, panel: PointsPanel,
+                                                                link: FakeLink) -> None:
+    panel.teach()
+    link.commandFinished.emit(CommandResult(None, None, None, True, "pause: sent"))
+    link.finish_move(True)
+    assert panel.controller.busy
+    link.set_connected(False, "connection refused")
+    assert not panel.controller.busy
+    assert "connection refused" in panel.status.text()
+    assert not panel.action_teach.isEnabled()
+
+
+def test_teach_needs_a_connection(panel: PointsPanel, link: FakeLink) -> None:
+    link.set_connected(False)
+    assert not panel.action_teach.isEnabled()
+    panel.controller.teach()
+    assert link.calls == []
+    assert "not connected" in panel.status.text()
+
+
+# --- upload ----------------------------------------------------------------------------------
+
+
+def test_upload_selected_with_progress_and_a_refused_point(qtbot: Any, panel: PointsPanel,
+                                                           link: FakeLink) -> None:
+    panel.select_rows([0, 2, 4])
+    panel.action_upload_selected.trigger()
+    (call,) = link.named("upload_points")
+    assert [pid for pid, _ in call.args[0]] == [1, 3, 5] and call.args[1] == 200
+    assert call.args[0][0][1] == (400.0, 0.0, 450.0, 180.0, 0.0, 0.0)
+    assert panel.progress_row.isVisibleTo(panel)
+    link.uploadProgress.emit(1, 3)
+    assert panel.progress.value() == 1
+    link.uploadProgress.emit(2, 3)
+    link.point_failed(3, "point 3: bad point id")
+    link.uploadProgress.emit(3, 3)
+    with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
+        link.upload_summary(2, 3)
+    report = finished.args[0]
+    assert report.ok_count == 2 and [o.point_id for o in report.failed] == [3]
+    ledger = panel.model.ledger
+    assert ledger.point(1).sync is SyncState.ON_CONTROLLER
+    assert ledger.point(5).sync is SyncState.ON_CONTROLLER
+    assert ledger.point(3).sync is SyncState.FAILED and "bad point id" in ledger.point(3).sync_error
+    assert ledger.point(2).sync is SyncState.UNKNOWN  # not part of it
+    assert not panel.progress_row.isVisibleTo(panel)
+
+
+def test_cancel_half_way_keeps_what_was_uploaded(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
+    ledger = panel.model.ledger
+    panel.model.setData(panel.model.index(5, COL_X), "401")  # P6 changed on host
+    panel.upload_all()
+    link.uploadProgress.emit(1, 8)
+    link.uploadProgress.emit(2, 8)
+    panel.action_cancel_upload.trigger()
+    assert link.named("stop")  # the worker's stop ends a running upload
+    with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
+        link.upload_summary(2, 8, stopped=True)
+    report = finished.args[0]
+    assert report.aborted and report.not_attempted == [3, 4, 5, 6, 7, 8]
+    assert [p.sync for p in ledger][:2] == [SyncState.ON_CONTROLLER] * 2
+    assert ledger.point(6).sync is SyncState.CHANGED  # kept its state
+    assert ledger.point(7).sync is SyncState.UNKNOWN
+    assert "stopped after 2 of 8" in panel.status.text()
+
+
+def test_upload_is_batched_by_tool_frame(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
+    panel.model.setData(panel.model.index(1, COL_TOOL), "4")  # P2 tool 4
+    panel.controller.upload([1, 2, 3])
+    first = link.named("upload_points")
+    assert [([pid for pid, _ in c.args[0]], c.args[1]) for c in first] == [([1, 3], 200)]
+    link.uploadProgress.emit(2, 2)
+    link.upload_summary(2, 2)
+    second = link.named("upload_points")[1]
+    assert [pid for pid, _ in second.args[0]] == [2] and second.args[1] == 4
+    with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
+        link.uploadProgress.emit(1, 1)
+        assert panel.progress.value() == 3
+        link.upload_summary(1, 1)
+    assert finished.args[0].all_ok
+
+
+def test_upload_refused_by_the_worker(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
+    panel.controller.upload([1])
+    with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
+        link.errorOccurred.emit(FakeError("upload points", "move to point is still under way"))
+    assert finished.args[0].aborted == "move to point is still under way"
+    assert panel.model.ledger.point(1).sync is SyncState.UNKNOWN
+
+
+def test_reconnect_marks_unknown_and_offers_restore(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
+    model = panel.model
+    model.apply_upload(_report_ok(model, [1, 2]))
+    assert not panel.banner.isVisibleTo(panel)
+    link.controllerReconnected.emit()
+    assert [p.sync for p in model.ledger][:2] == [SyncState.UNKNOWN] * 2
+    assert panel.banner.isVisibleTo(panel) and panel.restore_button.isEnabled()
+    panel.restore_button.click()
+    (call,) = link.named("upload_points")
+    assert [pid for pid, _ in call.args[0]] == model.ledger.ids()
+    with qtbot.waitSignal(panel.controller.uploadFinished):
+        link.upload_summary(8, 8)
+    assert all(p.sync is SyncState.ON_CONTROLLER for p in model.ledger)
+    assert not panel.banner.isVisibleTo(panel)
+
+
+def _report_ok(model: PointsModel, ids: list[int]) -> Any:
+    from app.points import UploadOutcome, UploadReport
+
+    return UploadReport([UploadOutcome(pid, True, sent=model.ledger.point(pid)) for pid in ids])
+
+
+# --- move to point ---------------------------------------------------------------------------
+
+
+def test_move_to_point_asks_first(qtbot: Any, panel: PointsPanel, link: FakeLink,
+                                  answers: list[bool]) -> None:
+    model = panel.model
+    model.apply_upload(_report_ok(model, [2]))
+    panel.select_rows([1])
+    panel.speed.setValue(120.0)
+    answers.append(False)
+    panel.action_move_to.trigger()
+    assert "P2" in panel.questions[-1] and "120" in panel.questions[-1]  # type: ignore[attr-defined]
+    assert link.named("move_to_point") == []
+    answers.append(True)
+    panel.move_to_selected()
+    (call,) = link.named("move_to_point")
+    assert call.args == (2, None) and call.kwargs["speed"] == 120.0 and call.kwargs["tool"] == 200
+    with qtbot.waitSignal(panel.controller.moveFinished) as done:
+        link.finish_move(False, code=13, message="bad end-point id")
+    assert done.args[0] is False and "bad end-point id" in done.args[1]
+
+
+def test_move_to_a_point_not_on_the_controller_is_refused(panel: PointsPanel, link: FakeLink,
+                                                          answers: list[bool]) -> None:
+    panel.select_rows([0])
+    answers.append(True)
+    panel.move_to_selected()
+    assert link.named("move_to_point") == []
+    assert "upload it first" in panel.status.text()
+
+
+def test_run_active_disables_motion(panel: PointsPanel) -> None:
+    panel.select_rows([0])
+    assert panel.action_move_to.isEnabled()
+    panel.set_run_active(True)
+    assert not panel.action_move_to.isEnabled() and not panel.action_teach.isEnabled()
+    assert panel.action_delete.isEnabled()
+
+
+# --- editing from the panel ---------------------------------------------------------------------
+
+
+def test_rejected_edit_shows_the_reason(panel: PointsPanel) -> None:
+    panel.model.setData(panel.model.index(0, COL_X), "abc")
+    assert "'abc' is not a number" in panel.status.text()
+
+
+def test_add_delete_move_from_the_panel(panel: PointsPanel) -> None:
+    model = panel.model
+    panel.select_rows([1])
+    panel.action_add.trigger()
+    assert model.ledger.ids()[2] == 9 and panel.selected_rows() == [2]
+    panel.select_rows([0, 1])
+    panel.action_move_down.trigger()
+    assert model.ledger.ids()[:3] == [9, 1, 2] and panel.selected_rows() == [1, 2]
+    panel.action_delete.trigger()
+    assert model.ledger.ids()[:2] == [9, 3]
+    assert "used by plan" in panel.status.text()
+    model.undo_stack.undo()
+    assert model.ledger.ids()[:3] == [9, 1, 2]
+
+
+def test_find_filters_and_selection_maps_to_the_model(panel: PointsPanel) -> None:
+    panel.find_edit.setText("circle")
+    assert panel.proxy.rowCount() == 4
+    panel.table.selectRow(1)
+    assert panel.selected_rows() == [5]
+    panel.action_duplicate.trigger()
+    assert panel.model.ledger.ids()[6] == 9
+
+
+def test_external_axes_columns_hideable(panel: PointsPanel) -> None:
+    assert panel.table.isColumnHidden(COL_E1)
+    panel.action_show_ext.setChecked(True)
+    assert not panel.table.isColumnHidden(COL_E1)
+
+
+def test_points_with_other_ids_work(qtbot: Any) -> None:
+    from app.project import Project
+
+    project = Project()
+    project.ledger.replace_all([make_point(10000, "last")])
+    model = PointsModel(project, QUndoStack())
+    assert model.next_id() == 0  # the highest id is at the limit: smallest free one

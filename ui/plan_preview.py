@@ -1,0 +1,291 @@
+"""Plan preview: the path in three projections — top (XY), front (XZ), side (YZ).
+
+Each projection draws the whole plan with **one** ``PlotCurveItem`` whose data is the sampled
+path of :func:`app.plan.plan_path` (NaN rows separate unknown segments; ``connect="finite"``),
+so a plan of 1,000 segments is three ``setData`` calls, not 3,000 items. Arcs are the true
+circles through start, middle and end (the core samples them with the middle point among the
+samples). On top: the selected segment (thick), the referenced points (one scatter item,
+labels for the first :data:`MAX_LABELS`), where the plan starts, and while a plan runs the
+live TCP (position and a short trail), repainted at most :data:`LIVE_FPS` times a second from
+the latest pose (poses arrive at the poll rate). Outside a run, poses are only remembered.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pyqtgraph as pg
+from numpy.typing import NDArray
+from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
+
+from app.models import Pose
+from app.plan import PlanPath
+
+MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
+LIVE_FPS = 30
+TRAIL_LENGTH = 600  # live TCP positions kept for the trail
+INFO_WIDTH = 210  # px, the lengths / times column
+PATH_COLOUR = "#1565c0"
+SELECTED_COLOUR = "#ff6f00"
+POINT_COLOUR = "#455a64"
+START_COLOUR = "#2e7d32"
+TCP_COLOUR = "#c62828"
+TRAIL_COLOUR = "#ef9a9a"
+
+#: (key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.
+PROJECTIONS: tuple[tuple[str, int, int], ...] = (("top", 0, 1), ("front", 0, 2), ("side", 1, 2))
+AXIS_NAMES = ("X", "Y", "Z")
+
+FloatArray = NDArray[np.float64]
+
+
+def _style_plot(plot: pg.PlotWidget) -> None:
+    plot.setBackground("w")
+    item = plot.getPlotItem()
+    item.showGrid(x=True, y=True, alpha=0.25)
+    for name in ("left", "bottom"):
+        axis = item.getAxis(name)
+        axis.enableAutoSIPrefix(False)
+        axis.setPen(pg.mkPen("#455a64"))
+        axis.setTextPen(pg.mkPen("#263238"))
+    plot.setMenuEnabled(False)
+    plot.setAspectLocked(True)
+    plot.getViewBox().setDefaultPadding(0.12)  # room for the point labels at the edges
+    plot.setMinimumSize(150, 150)
+
+
+class _Projection:
+    """The items of one projection."""
+
+    def __init__(self, plot: pg.PlotWidget, h: int, v: int) -> None:
+        self.plot = plot
+        self.h = h
+        self.v = v
+        self.path = pg.PlotCurveItem(pen=pg.mkPen(PATH_COLOUR, width=2), connect="finite", antialias=True)
+        self.selected = pg.PlotCurveItem(pen=pg.mkPen(SELECTED_COLOUR, width=5), connect="finite",
+                                         antialias=True)
+        self.points = pg.ScatterPlotItem(size=7, brush=pg.mkBrush(POINT_COLOUR), pen=pg.mkPen("w"))
+        self.start = pg.ScatterPlotItem(size=11, symbol="t1", brush=pg.mkBrush(START_COLOUR),
+                                        pen=pg.mkPen("w"))
+        self.trail = pg.PlotCurveItem(pen=pg.mkPen(TRAIL_COLOUR, width=2))
+        self.tcp = pg.ScatterPlotItem(size=13, symbol="o", brush=pg.mkBrush(TCP_COLOUR),
+                                      pen=pg.mkPen("#263238"))
+        self.labels: list[pg.TextItem] = []
+        for z, item in enumerate((self.path, self.selected, self.points, self.start, self.trail, self.tcp)):
+            item.setZValue(z)
+            plot.addItem(item)
+
+    def set_labels(self, xyz: FloatArray, texts: Sequence[str]) -> None:
+        for label in self.labels:
+            self.plot.removeItem(label)
+        self.labels = []
+        for row, text in zip(xyz[:MAX_LABELS], texts[:MAX_LABELS], strict=False):
+            label = pg.TextItem(text, color="#37474f", anchor=(0.0, 1.0))
+            label.setPos(float(row[self.h]), float(row[self.v]))
+            label.setZValue(10)
+            self.plot.addItem(label)
+            self.labels.append(label)
+
+
+class PlanPreview(QWidget):
+    """Top / front / side projections of a plan (see the module docstring).
+
+    Public: :meth:`set_path`, :meth:`set_points`, :meth:`set_start`, :meth:`set_selected`,
+    :meth:`start_live` / :meth:`stop_live` / :meth:`on_pose` (live TCP), :meth:`clear`;
+    ``projections`` (key -> items) for tests.
+    """
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("PlanPreview")
+        self._path: PlanPath | None = None
+        self._selected: int | None = None
+        self._pending: Pose | None = None
+        self._live_wanted = False
+        self._trail = np.full((2 * TRAIL_LENGTH, 3), np.nan)
+        self._trail_count = 0
+        self._live_timer = QTimer(self)
+        self._live_timer.setInterval(int(1000 / LIVE_FPS))
+        self._live_timer.timeout.connect(self._paint_live)
+
+        row = QHBoxLayout()
+        row.setContentsMargins(0, 0, 0, 0)
+        row.setSpacing(6)
+        self.projections: dict[str, _Projection] = {}
+        self._titles: dict[str, QLabel] = {}
+        for key, h, v in PROJECTIONS:
+            plot = pg.PlotWidget(self)
+            _style_plot(plot)
+            plot.setLabel("bottom", f"{AXIS_NAMES[h]} (mm)")
+            plot.setLabel("left", f"{AXIS_NAMES[v]} (mm)")
+            self.projections[key] = _Projection(plot, h, v)
+            title = QLabel(self)
+            title.setStyleSheet("font-weight: bold; color: #37474f;")
+            self._titles[key] = title
+            cell = QVBoxLayout()
+            cell.setSpacing(0)
+            cell.addWidget(title)
+            cell.addWidget(plot, 1)
+            row.addLayout(cell, 1)
+        self.info = QLabel(self)
+        self.info.setWordWrap(True)
+        self.info.setStyleSheet("color: #37474f;")
+        self.info.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
+        self.info.setFixedWidth(INFO_WIDTH)
+        self.info.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        row.addWidget(self.info)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addLayout(row)
+        self.retranslate()
+
+    def retranslate(self) -> None:
+        names = {
+            "top": QCoreApplication.translate("PlanPreview", "Top (XY)"),
+            "front": QCoreApplication.translate("PlanPreview", "Front (XZ)"),
+            "side": QCoreApplication.translate("PlanPreview", "Side (YZ)"),
+        }
+        for key, title in self._titles.items():
+            title.setText(names[key])
+
+    def changeEvent(self, event: QEvent) -> None:
+        if event.type() == QEvent.Type.LanguageChange:
+            self.retranslate()
+        super().changeEvent(event)
+
+    # --- the plan
+    @property
+    def path(self) -> PlanPath | None:
+        return self._path
+
+    def set_path(self, path: PlanPath | None, *, keep_view: bool = False) -> None:
+        """The plan's sampled path (None: nothing to draw). ``keep_view``: the same plan was
+        edited, leave the operator's zoom alone (autorange otherwise)."""
+        self._path = path
+        for proj in self.projections.values():
+            if path is None or path.xyz.shape[0] == 0:
+                proj.path.setData([], [])
+            else:
+                proj.path.setData(path.xyz[:, proj.h], path.xyz[:, proj.v], connect="finite")
+        self._draw_selected()
+        if not keep_view:
+            self._auto_range()
+
+    def set_points(self, xyz: FloatArray | Sequence[Sequence[float]], labels: Sequence[str] = ()) -> None:
+        """Points to mark (the plan's points), with labels (the first :data:`MAX_LABELS`)."""
+        arr = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+        for proj in self.projections.values():
+            proj.points.setData(arr[:, proj.h], arr[:, proj.v])
+            proj.set_labels(arr, list(labels))
+
+    def set_start(self, xyz: Sequence[float] | FloatArray | None) -> None:
+        """Where the plan starts (the robot's pose, or an assumed start)."""
+        for proj in self.projections.values():
+            if xyz is None:
+                proj.start.setData([], [])
+            else:
+                proj.start.setData([float(xyz[proj.h])], [float(xyz[proj.v])])
+
+    def set_selected(self, index: int | None) -> None:
+        self._selected = index
+        self._draw_selected()
+
+    @property
+    def selected(self) -> int | None:
+        return self._selected
+
+    def set_info(self, text: str) -> None:
+        self.info.setText(text)
+
+    def clear(self) -> None:
+        self.set_path(None)
+        self.set_points(np.empty((0, 3)))
+        self.set_start(None)
+        self.clear_live()
+
+    def _draw_selected(self) -> None:
+        path, index = self._path, self._selected
+        rows: FloatArray | None = None
+        if path is not None and index is not None:
+            hit = np.flatnonzero(path.segment == index)
+            if hit.size:
+                rows = path.xyz[hit[0]:hit[-1] + 1]
+        for proj in self.projections.values():
+            if rows is None:
+                proj.selected.setData([], [])
+            else:
+                proj.selected.setData(rows[:, proj.h], rows[:, proj.v], connect="finite")
+
+    def _auto_range(self) -> None:
+        for proj in self.projections.values():
+            proj.plot.getPlotItem().enableAutoRange()
+            proj.plot.getPlotItem().autoRange()
+
+    # --- live TCP
+    @property
+    def live(self) -> bool:
+        return self._live_wanted
+
+    def start_live(self) -> None:
+        """Draw the TCP from :meth:`on_pose` (throttled) until :meth:`stop_live`."""
+        self._trail[:] = np.nan
+        self._trail_count = 0
+        self._live_wanted = True
+        self._paint_live()
+        if self.isVisible() and not self._live_timer.isActive():
+            self._live_timer.start()
+
+    def stop_live(self) -> None:
+        """Stop repainting; the last TCP position and trail stay visible."""
+        self._live_wanted = False
+        self._live_timer.stop()
+        self._paint_live()
+
+    def clear_live(self) -> None:
+        self._live_wanted = False
+        self._live_timer.stop()
+        self._pending = None
+        self._trail[:] = np.nan
+        self._trail_count = 0
+        for proj in self.projections.values():
+            proj.tcp.setData([], [])
+            proj.trail.setData([], [])
+
+    @Slot(object)
+    def on_pose(self, pose: Pose) -> None:
+        """Latest TCP pose: drawn on the next live frame (kept for later when not live)."""
+        self._pending = pose
+
+    def _paint_live(self) -> None:
+        pose, self._pending = self._pending, None
+        if pose is None:
+            return
+        # ring buffer written twice so that the last TRAIL_LENGTH rows are one contiguous view
+        k = self._trail_count % TRAIL_LENGTH
+        xyz = (pose.x, pose.y, pose.z)
+        self._trail[k] = xyz
+        self._trail[k + TRAIL_LENGTH] = xyz
+        self._trail_count += 1
+        n = min(self._trail_count, TRAIL_LENGTH)
+        end = k + 1 + TRAIL_LENGTH if self._trail_count > TRAIL_LENGTH else k + 1
+        view = self._trail[end - n:end]
+        for proj in self.projections.values():
+            proj.trail.setData(view[:, proj.h], view[:, proj.v])
+        self._paint_tcp(pose)
+
+    def _paint_tcp(self, pose: Pose) -> None:
+        xyz = (pose.x, pose.y, pose.z)
+        for proj in self.projections.values():
+            proj.tcp.setData([xyz[proj.h]], [xyz[proj.v]])
+
+    def hideEvent(self, event: Any) -> None:
+        self._live_timer.stop()  # nothing to paint while hidden; showEvent resumes
+        super().hideEvent(event)
+
+    def showEvent(self, event: Any) -> None:
+        super().showEvent(event)
+        if self._live_wanted and not self._live_timer.isActive():
+            self._live_timer.start()

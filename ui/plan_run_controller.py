@@ -1,0 +1,321 @@
+"""Runs a plan on the controller from the GUI thread, one segment at a time, via the link.
+
+:class:`PlanRunController` wraps :class:`app.runner.PlanRunner` (the sequencing, resume
+points and messages live there) around the non-blocking robot link: it sends segment k with
+``link.move_to_point(...)`` and sends segment k+1 only after the link's ``commandFinished``
+for segment k. Pause / resume / stop are forwarded to the link. A failed segment, a refused
+command or a lost link ends the run in ``FAILED`` at that segment; :meth:`resume_run`
+continues from it ("Resume from k").
+
+Which ``commandFinished`` belongs to the running segment: results of command
+``MOVE_TO_POINT``, and failures the link reports without a command but with the move's kind
+or the "move to point" operation name (a Modbus exception, a refusal, "cancelled by Stop").
+Plain acknowledgements ("pause: sent") and other commands' results are ignored. The link runs
+one motion at a time, so this is unambiguous as long as nothing else moves the robot during a
+run (the panels disable their motion buttons while :attr:`running`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any, Protocol
+
+from PySide6.QtCore import QObject, Signal, SignalInstance, Slot
+
+from app.errors import LinkError, TeachPadError
+from app.models import CommandResult, Pose
+from app.plan import Plan, Segment
+from app.protocol.enums import CommandKind, MoveStatus, RunCommand
+from app.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState
+
+MOVE_OPERATION = "move to point"  # the link's name of the move job (WorkerError.operation)
+STOP_OPERATION = "stop"
+
+
+class MotionLink(Protocol):
+    """What a run needs from the robot link (``app.worker.RobotLink`` fits)."""
+
+    poseChanged: SignalInstance
+    commandFinished: SignalInstance
+    errorOccurred: SignalInstance
+    connectionChanged: SignalInstance
+
+    @property
+    def state(self) -> Any: ...  # ConnectionState (.connected)
+
+    def move_to_point(self, end_id: int, via_id: int | None = None, *, orientation_changes: bool = ...,
+                      ignore_middle: bool = ..., speed: float = ..., tool: int = ...) -> None: ...
+
+    def stop(self) -> None: ...
+
+    def pause(self) -> None: ...
+
+    def resume(self) -> None: ...
+
+
+def is_move_result(result: CommandResult) -> bool:
+    """Whether ``result`` ends a move-to-point command (see the module docstring)."""
+    if result.command is RunCommand.MOVE_TO_POINT:
+        return True
+    if result.command is None and not result.ok:
+        return result.kind is CommandKind.MOVE or result.message.startswith(MOVE_OPERATION)
+    return False
+
+
+class PlanRunController(QObject):
+    """GUI-thread driver of a plan run (see the module docstring).
+
+    Signals: ``runningChanged(bool)``, ``pausedChanged(bool)``, ``progressChanged(object)``
+    (:class:`RunProgress`, every segment start / end), ``segmentStarted(int, int)`` (0-based
+    index, 1-based loop), ``runFinished(object)`` (:class:`RunOutcome`), ``connectedChanged(bool)``,
+    ``poseChanged(object)`` (the link's pose, forwarded for the preview), ``pointsMissing(object)``
+    (list of point ids: the controller answered "bad end point id", so it does not hold the
+    segment's points — e.g. it restarted without the link noticing).
+    """
+
+    runningChanged = Signal(bool)
+    pausedChanged = Signal(bool)
+    progressChanged = Signal(object)
+    segmentStarted = Signal(int, int)
+    runFinished = Signal(object)
+    connectedChanged = Signal(bool)
+    poseChanged = Signal(object)
+    pointsMissing = Signal(object)
+
+    def __init__(self, link: MotionLink | None = None, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self._link: MotionLink | None = None
+        self._runner: PlanRunner | None = None
+        self._plan: Plan | None = None
+        self._paused = False
+        self._connected = False
+        self._last_pose: Pose | None = None
+        self._outcome: RunOutcome | None = None
+        self._progress: RunProgress | None = None
+        self._sent: list[int] = []  # segment indices sent, in order (for tests and the log)
+        if link is not None:
+            self.set_link(link)
+
+    def set_link(self, link: MotionLink) -> None:
+        if self._link is not None:
+            raise RuntimeError("the link is already set")
+        self._link = link
+        link.commandFinished.connect(self._on_result)
+        link.errorOccurred.connect(self._on_error)
+        link.connectionChanged.connect(self._on_connection)
+        link.poseChanged.connect(self._on_pose)
+        self._set_connected(bool(getattr(getattr(link, "state", None), "connected", False)))
+
+    # --- state
+    @property
+    def link(self) -> MotionLink | None:
+        return self._link
+
+    @property
+    def connected(self) -> bool:
+        return self._connected
+
+    @property
+    def running(self) -> bool:
+        runner = self._runner
+        return runner is not None and not runner.state.is_over
+
+    @property
+    def paused(self) -> bool:
+        return self._paused
+
+    @property
+    def plan(self) -> Plan | None:
+        return self._plan
+
+    @property
+    def runner(self) -> PlanRunner | None:
+        return self._runner
+
+    @property
+    def outcome(self) -> RunOutcome | None:
+        """How the last run ended (None while running or before the first run)."""
+        return self._outcome
+
+    @property
+    def progress(self) -> RunProgress | None:
+        return self._progress
+
+    @property
+    def last_pose(self) -> Pose | None:
+        return self._last_pose
+
+    @property
+    def can_resume(self) -> bool:
+        """A stopped or failed run can continue from :attr:`resume_from`."""
+        runner = self._runner
+        return (runner is not None and runner.state in (RunState.STOPPED, RunState.FAILED)
+                and runner.resume_from is not None)
+
+    @property
+    def resume_from(self) -> int | None:
+        return self._runner.resume_from if self._runner is not None else None
+
+    @property
+    def resume_loop(self) -> int | None:
+        return self._runner.resume_loop if self._runner is not None else None
+
+    @property
+    def sent_segments(self) -> list[int]:
+        return list(self._sent)
+
+    # --- commands
+    def start(self, plan: Plan | Sequence[Segment], *, start: int = 0, start_loop: int = 1,
+              single: bool = False, loops: int | None = None) -> None:
+        """Run ``plan`` from segment ``start`` (``single``: that segment only). Raises
+        :class:`~app.errors.InvalidInput` for a bad start and :class:`LinkError` without a link."""
+        if self.running:
+            raise RuntimeError("a run is already under way")
+        link = self._require_link()
+        self._runner = PlanRunner(plan, loops=loops, start=start, start_loop=start_loop, single=single,
+                                  progress=self._on_progress)
+        self._plan = plan if isinstance(plan, Plan) else None
+        self._outcome = None
+        self._sent = []
+        self._set_paused(False)
+        self.runningChanged.emit(True)
+        self._send_next(link)
+
+    def run(self, plan: Plan) -> None:
+        self.start(plan)
+
+    def run_from(self, plan: Plan, index: int, loop: int = 1) -> None:
+        self.start(plan, start=index, start_loop=loop)
+
+    def step(self, plan: Plan, index: int, loop: int = 1) -> None:
+        self.start(plan, start=index, start_loop=loop, single=True)
+
+    def resume_run(self) -> None:
+        """Continue a stopped or failed run from the segment it ended at."""
+        runner = self._runner
+        if runner is None or not self.can_resume:
+            raise RuntimeError("there is no stopped or failed run to resume")
+        link = self._require_link()
+        runner.resume()
+        self._outcome = None
+        self._set_paused(False)
+        self.runningChanged.emit(True)
+        self._send_next(link)
+
+    def pause(self) -> None:
+        if self.running and not self._paused and self._link is not None:
+            self._link.pause()
+            self._set_paused(True)
+
+    def resume(self) -> None:
+        """Resume a paused move (not to be confused with :meth:`resume_run`)."""
+        if self.running and self._paused and self._link is not None:
+            self._link.resume()
+            self._set_paused(False)
+
+    def stop(self) -> None:
+        """Stop the robot and the run. The run ends when the link reports the stopped move
+        (at once when no move is out, or when the link is down)."""
+        runner = self._runner
+        link = self._link
+        if link is not None:
+            link.stop()
+        if runner is None or runner.state.is_over:
+            return
+        runner.request_stop()
+        self._set_paused(False)
+        if runner.state is not RunState.RUNNING or not self._connected:
+            runner.on_stopped()
+            self._finish()
+
+    # --- internals
+    def _require_link(self) -> MotionLink:
+        if self._link is None or not self._connected:
+            raise LinkError("not connected to a controller")
+        return self._link
+
+    def _set_paused(self, paused: bool) -> None:
+        if paused != self._paused:
+            self._paused = paused
+            self.pausedChanged.emit(paused)
+
+    def _set_connected(self, connected: bool) -> None:
+        if connected != self._connected:
+            self._connected = connected
+            self.connectedChanged.emit(connected)
+
+    def _on_progress(self, progress: RunProgress) -> None:
+        self._progress = progress
+        if progress.event is RunEvent.SEGMENT_STARTED:
+            self.segmentStarted.emit(progress.index, progress.loop)
+        self.progressChanged.emit(progress)
+
+    def _send_next(self, link: MotionLink) -> None:
+        runner = self._runner
+        assert runner is not None
+        command = runner.next_command()
+        if command is None:
+            self._finish()
+            return
+        seg = command.segment
+        self._sent.append(command.index)
+        link.move_to_point(seg.end_id, seg.via_id, orientation_changes=seg.orientation_changes,
+                           ignore_middle=seg.ignore_middle, speed=seg.speed, tool=seg.tool)
+
+    def _finish(self) -> None:
+        runner = self._runner
+        assert runner is not None
+        self._set_paused(False)
+        self._outcome = runner.outcome()
+        self.runningChanged.emit(False)
+        self.runFinished.emit(self._outcome)
+
+    def _after_report(self) -> None:
+        runner = self._runner
+        assert runner is not None
+        if runner.state.is_over:
+            self._finish()
+        elif self._link is not None:
+            self._send_next(self._link)
+
+    @Slot(object)
+    def _on_result(self, result: CommandResult) -> None:
+        runner = self._runner
+        if runner is None or runner.state is not RunState.RUNNING or not is_move_result(result):
+            return
+        current = runner.current
+        missing = (not result.ok and result.status is not None
+                   and result.status.code == MoveStatus.BAD_END_POINT and current is not None)
+        runner.on_result(result)
+        if missing and current is not None:
+            self.pointsMissing.emit(list(current.segment.point_ids))
+        self._after_report()
+
+    @Slot(object)
+    def _on_error(self, error: Any) -> None:
+        runner = self._runner
+        if runner is None or runner.state is not RunState.RUNNING:
+            return
+        operation = str(getattr(error, "operation", ""))
+        message = str(getattr(error, "message", error))
+        if operation == MOVE_OPERATION:
+            runner.on_error(TeachPadError(message))
+            self._after_report()
+        elif operation == STOP_OPERATION and runner.stop_requested:
+            runner.on_stopped(message)
+            self._finish()
+
+    @Slot(object)
+    def _on_connection(self, state: Any) -> None:
+        connected = bool(getattr(state, "connected", False))
+        self._set_connected(connected)
+        runner = self._runner
+        if not connected and runner is not None and runner.state is RunState.RUNNING:
+            reason = str(getattr(state, "message", "")) or "link lost"
+            runner.on_error(LinkError(f"link lost: {reason}"))
+            self._finish()
+
+    @Slot(object)
+    def _on_pose(self, pose: Pose) -> None:
+        self._last_pose = pose
+        self.poseChanged.emit(pose)

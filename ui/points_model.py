@@ -1,0 +1,704 @@
+"""The point ledger as a Qt table model; every edit is a ``QUndoCommand``.
+
+:class:`PointsModel` shows the :class:`~app.points.PointLedger` of a
+:class:`~app.project.Project` (one row per temp point) and changes it only through commands
+pushed on a ``QUndoStack``: cell edits, add, duplicate, delete, reorder, teach and CSV import
+are all undoable. Editing a point's id follows the id in every plan of the project (undo puts
+the plans back too). Refused input raises :class:`~app.errors.InvalidInput` from the
+``edit_*`` methods; ``setData`` turns it into :attr:`PointsModel.editRejected` and leaves the
+model unchanged.
+
+Sync states are not undoable: they describe the controller, not the operator's edits. The
+model keeps what it knows each id holds on the controller (``_on_controller``: set by uploads
+and teach, cleared by a reconnect) and derives the sync state of every point an undo or redo
+puts back from it, so undoing an edit after an upload never claims a point is on the
+controller when it is not.
+
+The generic commands (:class:`InsertRowsCommand`, :class:`RemoveRowsCommand`,
+:class:`MoveRowsCommand`, :class:`ReplaceRowCommand`) work on any list model deriving from
+:class:`UndoableListModel`; ``ui/plan_model.py`` uses them for segments.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import replace
+from typing import Any, Protocol, TypeVar
+
+from PySide6.QtCore import (
+    QAbstractTableModel,
+    QCoreApplication,
+    QModelIndex,
+    QPersistentModelIndex,
+    QSortFilterProxyModel,
+    Qt,
+    Signal,
+)
+from PySide6.QtGui import QBrush, QColor, QUndoCommand, QUndoStack
+
+from app.errors import InvalidInput
+from app.plan import Plan, Segment
+from app.points import (
+    EXT_FIELDS,
+    POSE_FIELDS,
+    FieldError,
+    ImportMode,
+    ImportReport,
+    PointLedger,
+    SyncState,
+    TempPoint,
+    UploadReport,
+    apply_upload,
+    make_point,
+    point_from_pose,
+    with_field,
+)
+from app.points import TR_CONTEXT as POINTS_CORE_CONTEXT
+from app.project import Project
+from app.protocol.registers import TOOL_NONE
+from ui.widgets_common import (
+    COLOR_ERROR,
+    COLOR_ERROR_BG,
+    COLOR_NEUTRAL,
+    COLOR_NEUTRAL_BG,
+    COLOR_OK,
+    COLOR_OK_BG,
+    COLOR_WARN_BG,
+)
+
+ModelIndex = QModelIndex | QPersistentModelIndex
+
+#: Columns of the table: the point's fields in CSV order, with the sync state before the note.
+COLUMNS: tuple[str, ...] = ("id", "name", *POSE_FIELDS, *EXT_FIELDS, "tool", "sync", "note")
+COL_ID = COLUMNS.index("id")
+COL_NAME = COLUMNS.index("name")
+COL_X = COLUMNS.index("x")
+COL_C = COLUMNS.index("c")
+COL_E1 = COLUMNS.index("e1")
+COL_E5 = COLUMNS.index("e5")
+COL_TOOL = COLUMNS.index("tool")
+COL_SYNC = COLUMNS.index("sync")
+COL_NOTE = COLUMNS.index("note")
+EXT_COLUMNS: tuple[int, ...] = tuple(range(COL_E1, COL_E5 + 1))
+NUMBER_COLUMNS: frozenset[int] = frozenset((COL_ID, *range(COL_X, COL_E5 + 1)))
+
+#: Custom roles.
+POINT_ID_ROLE = Qt.ItemDataRole.UserRole + 1  # int, any column
+SYNC_ROLE = Qt.ItemDataRole.UserRole + 2  # SyncState, any column
+
+#: Text the tool cell accepts for "no tool frame" besides 200.
+TOOL_NONE_WORDS: frozenset[str] = frozenset(("", "none", "-", "无"))
+
+SYNC_COLOURS: dict[SyncState, tuple[str, str]] = {  # state -> (text, background)
+    SyncState.UNKNOWN: (COLOR_NEUTRAL, COLOR_NEUTRAL_BG),
+    SyncState.ON_CONTROLLER: (COLOR_OK, COLOR_OK_BG),
+    SyncState.CHANGED: ("#8a5300", COLOR_WARN_BG),
+    SyncState.FAILED: (COLOR_ERROR, COLOR_ERROR_BG),
+}
+
+
+def sync_text(state: SyncState) -> str:
+    """The sync state in the current language (the core marks the English in context Points)."""
+    return QCoreApplication.translate(POINTS_CORE_CONTEXT, state.text)
+
+
+def tool_display(tool: int) -> str:
+    if tool == TOOL_NONE:
+        return QCoreApplication.translate("PointsModel", "none")
+    return QCoreApplication.translate("PointsModel", "tool {n}").format(n=tool + 1)
+
+
+def format_number(value: float) -> str:
+    return f"{value:.3f}"
+
+
+def edit_text(value: float) -> str:
+    """Editor text of a float that round-trips exactly (``400.0``, ``0.1``)."""
+    return repr(float(value))
+
+
+# --------------------------------------------------------------------------------------------
+# Generic undoable list model and its commands
+# --------------------------------------------------------------------------------------------
+
+T = TypeVar("T")
+
+
+class RowList(Protocol[T]):
+    """What a command needs of the list it changes (``PointLedger`` and ``Plan`` both fit)."""
+
+    def __len__(self) -> int: ...
+    def __getitem__(self, row: int) -> T: ...
+    def insert(self, row: int, item: T) -> int: ...
+    def remove(self, row: int) -> T: ...
+    def move(self, src: int, dst: int) -> None: ...
+    def replace(self, row: int, item: T) -> T: ...
+
+
+class UndoableListModel(QAbstractTableModel):
+    """A table model whose rows are the items of a :class:`RowList`.
+
+    Subclasses implement :meth:`_show` (make ``target`` the list on display, e.g. another
+    plan) and may override :meth:`_prepare` (adjust an item before it goes back in).
+    The ``_apply_*`` methods are called by the commands only.
+    """
+
+    #: An edit refused (bad value, duplicate id ...): the message for the status line.
+    editRejected = Signal(str)
+    #: A command changed ``target``'s list (after the change).
+    listEdited = Signal(object)
+
+    def __init__(self, undo_stack: QUndoStack, parent: Any = None) -> None:
+        super().__init__(parent)
+        self._stack = undo_stack
+
+    @property
+    def undo_stack(self) -> QUndoStack:
+        return self._stack
+
+    def _show(self, target: Any) -> None:
+        raise NotImplementedError
+
+    def _prepare(self, target: Any, item: Any) -> Any:
+        return item
+
+    def _after_change(self, target: Any) -> None:
+        self.listEdited.emit(target)
+
+    # --- called by the commands
+    def _apply_insert(self, target: RowList[Any], items: Sequence[tuple[int, Any]]) -> None:
+        """Insert ``(row, item)`` pairs in ascending row order (rows are final positions)."""
+        self._show(target)
+        for row, item in items:
+            prepared = self._prepare(target, item)
+            self.beginInsertRows(QModelIndex(), row, row)
+            target.insert(row, prepared)
+            self.endInsertRows()
+        self._after_change(target)
+
+    def _apply_remove(self, target: RowList[Any], rows: Sequence[int]) -> list[tuple[int, Any]]:
+        self._show(target)
+        removed: list[tuple[int, Any]] = []
+        for row in sorted(rows, reverse=True):
+            self.beginRemoveRows(QModelIndex(), row, row)
+            removed.append((row, target.remove(row)))
+            self.endRemoveRows()
+        self._after_change(target)
+        removed.reverse()
+        return removed
+
+    def _apply_move(self, target: RowList[Any], rows: Sequence[int], delta: int) -> list[int]:
+        """Move each of ``rows`` by ``delta`` (+1 / -1); returns the new rows (ascending)."""
+        self._show(target)
+        order = sorted(rows, reverse=delta > 0)
+        for row in order:
+            dst = row + delta
+            # beginMoveRows wants the destination *before* the move (one past for downward moves)
+            self.beginMoveRows(QModelIndex(), row, row, QModelIndex(), dst + 1 if delta > 0 else dst)
+            target.move(row, dst)
+            self.endMoveRows()
+        self._after_change(target)
+        return sorted(r + delta for r in rows)
+
+    def _apply_replace(self, target: RowList[Any], row: int, item: Any) -> Any:
+        self._show(target)
+        old = target.replace(row, self._prepare(target, item))
+        self.dataChanged.emit(self.index(row, 0), self.index(row, self.columnCount() - 1))
+        self._after_change(target)
+        return old
+
+
+class InsertRowsCommand(QUndoCommand):
+    """Insert items at rows (rows are where they end up, ascending)."""
+
+    def __init__(self, model: UndoableListModel, target: RowList[Any], items: Sequence[tuple[int, Any]],
+                 text: str) -> None:
+        super().__init__(text)
+        self._model = model
+        self._target = target
+        self._items = sorted(items, key=lambda pair: pair[0])
+
+    def redo(self) -> None:
+        self._model._apply_insert(self._target, self._items)
+
+    def undo(self) -> None:
+        self._model._apply_remove(self._target, [row for row, _ in self._items])
+
+
+class RemoveRowsCommand(QUndoCommand):
+    def __init__(self, model: UndoableListModel, target: RowList[Any], rows: Iterable[int],
+                 text: str) -> None:
+        super().__init__(text)
+        self._model = model
+        self._target = target
+        self._rows = sorted(set(rows))
+        self._removed: list[tuple[int, Any]] = []
+
+    def redo(self) -> None:
+        self._removed = self._model._apply_remove(self._target, self._rows)
+
+    def undo(self) -> None:
+        self._model._apply_insert(self._target, self._removed)
+
+
+class MoveRowsCommand(QUndoCommand):
+    """Move a set of rows one place up (-1) or down (+1)."""
+
+    def __init__(self, model: UndoableListModel, target: RowList[Any], rows: Iterable[int], delta: int,
+                 text: str) -> None:
+        super().__init__(text)
+        if delta not in (-1, 1):
+            raise ValueError("delta must be -1 or +1")
+        self._model = model
+        self._target = target
+        self._rows = sorted(set(rows))
+        self._delta = delta
+        self.new_rows: list[int] = [r + delta for r in self._rows]
+
+    def redo(self) -> None:
+        self.new_rows = self._model._apply_move(self._target, self._rows, self._delta)
+
+    def undo(self) -> None:
+        self._model._apply_move(self._target, self.new_rows, -self._delta)
+
+
+class ReplaceRowCommand(QUndoCommand):
+    """One row replaced (a cell edit); ``extra`` commands run after it (redo) / before (undo)."""
+
+    def __init__(self, model: UndoableListModel, target: RowList[Any], row: int, old: Any, new: Any,
+                 text: str, *, after: Callable[[bool], None] | None = None) -> None:
+        super().__init__(text)
+        self._model = model
+        self._target = target
+        self._row = row
+        self._old = old
+        self._new = new
+        self._after = after
+
+    def redo(self) -> None:
+        self._model._apply_replace(self._target, self._row, self._new)
+        if self._after is not None:
+            self._after(True)
+
+    def undo(self) -> None:
+        if self._after is not None:
+            self._after(False)
+        self._model._apply_replace(self._target, self._row, self._old)
+
+
+# --------------------------------------------------------------------------------------------
+# The points model
+# --------------------------------------------------------------------------------------------
+
+
+class _ReplaceAllCommand(QUndoCommand):
+    """The whole list swapped (CSV import)."""
+
+    def __init__(self, model: PointsModel, before: Sequence[TempPoint], after: Sequence[TempPoint],
+                 text: str) -> None:
+        super().__init__(text)
+        self._model = model
+        self._before = tuple(before)
+        self._after = tuple(after)
+
+    def redo(self) -> None:
+        self._model._apply_replace_all(self._after)
+
+    def undo(self) -> None:
+        self._model._apply_replace_all(self._before)
+
+
+class PointsModel(UndoableListModel):
+    """Table model over ``project.ledger``; see the module docstring.
+
+    Signals: ``editRejected(str)``, ``listEdited(object)`` (inherited), ``planReferencesChanged()``
+    (an id edit, or its undo, changed segments of plans), ``syncChanged()`` (sync states changed
+    without an edit: upload, teach, reconnect).
+    """
+
+    planReferencesChanged = Signal()
+    syncChanged = Signal()
+
+    def __init__(self, project: Project, undo_stack: QUndoStack, parent: Any = None) -> None:
+        super().__init__(undo_stack, parent)
+        self._project = project
+        self._on_controller: dict[int, TempPoint] = {}
+        self._headers: tuple[str, ...] = ()
+        self._header_tips: dict[int, str] = {}
+        self._brushes = {
+            state: (QBrush(QColor(fg)), QBrush(QColor(bg))) for state, (fg, bg) in SYNC_COLOURS.items()
+        }
+        self._seed_controller_copy()
+        self.retranslate()
+
+    # --- project
+    @property
+    def project(self) -> Project:
+        return self._project
+
+    @property
+    def ledger(self) -> PointLedger:
+        return self._project.ledger
+
+    def set_project(self, project: Project) -> None:
+        """Show another project (open, new, recover). The caller clears the undo stack."""
+        self.beginResetModel()
+        self._project = project
+        self._seed_controller_copy()
+        self.endResetModel()
+
+    def _seed_controller_copy(self) -> None:
+        self._on_controller = {p.id: p for p in self.ledger if p.sync is SyncState.ON_CONTROLLER}
+
+    def retranslate(self) -> None:
+        names = {"id": self.tr("ID"), "name": self.tr("Name"), "tool": self.tr("Tool"),
+                 "sync": self.tr("Sync"), "note": self.tr("Note")}
+        self._headers = tuple(names.get(c, c.upper()) for c in COLUMNS)
+        self._header_tips = {
+            COL_ID: self.tr("Temp point id on the controller"),
+            COL_TOOL: self.tr("Tool frame (200 = none)"),
+            COL_SYNC: self.tr("Whether the controller holds this point"),
+            **{c: self.tr("mm, base frame") for c in range(COL_X, COL_X + 3)},
+            **{c: self.tr("degrees") for c in range(COL_X + 3, COL_C + 1)},
+            **dict.fromkeys(EXT_COLUMNS,
+                            self.tr("External axis (recorded only: the controller does not store it)")),
+        }
+        self.headerDataChanged.emit(Qt.Orientation.Horizontal, 0, len(COLUMNS) - 1)
+
+    # --- reading
+    def rowCount(self, parent: ModelIndex = QModelIndex()) -> int:  # noqa: B008
+        return 0 if parent.isValid() else len(self.ledger)
+
+    def columnCount(self, parent: ModelIndex = QModelIndex()) -> int:  # noqa: B008
+        return 0 if parent.isValid() else len(COLUMNS)
+
+    def point_at(self, row: int) -> TempPoint:
+        return self.ledger[row]
+
+    def row_of(self, point_id: int) -> int | None:
+        return self.ledger.row_of(point_id)
+
+    def headerData(self, section: int, orientation: Qt.Orientation,
+                   role: int = Qt.ItemDataRole.DisplayRole) -> Any:
+        if orientation == Qt.Orientation.Horizontal and 0 <= section < len(COLUMNS):
+            if role == Qt.ItemDataRole.DisplayRole:
+                return self._headers[section]
+            if role == Qt.ItemDataRole.ToolTipRole:
+                return self._header_tips.get(section)
+        elif orientation == Qt.Orientation.Vertical and role == Qt.ItemDataRole.DisplayRole:
+            return section + 1
+        return None
+
+    def data(self, index: ModelIndex, role: int = Qt.ItemDataRole.DisplayRole) -> Any:
+        if not index.isValid() or not 0 <= index.row() < len(self.ledger):
+            return None
+        point = self.ledger[index.row()]
+        column = index.column()
+        if not 0 <= column < len(COLUMNS):
+            return None
+        name = COLUMNS[column]
+        if role == Qt.ItemDataRole.DisplayRole:
+            return self._display(point, name)
+        if role == Qt.ItemDataRole.EditRole:
+            return self._edit_value(point, name)
+        if role == Qt.ItemDataRole.ToolTipRole:
+            return self._tooltip(point, name)
+        if role == Qt.ItemDataRole.TextAlignmentRole:
+            if column in NUMBER_COLUMNS:
+                return int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+            return int(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
+        if role == Qt.ItemDataRole.ForegroundRole and column == COL_SYNC:
+            return self._brushes[point.sync][0]
+        if role == Qt.ItemDataRole.BackgroundRole and column == COL_SYNC:
+            return self._brushes[point.sync][1]
+        if role == POINT_ID_ROLE:
+            return point.id
+        if role == SYNC_ROLE:
+            return point.sync
+        return None
+
+    def _display(self, point: TempPoint, name: str) -> str:
+        if name in ("id",):
+            return str(point.id)
+        if name in ("name", "note"):
+            return str(point.get(name)).replace("\n", " ⏎ ") if name == "note" else point.name
+        if name == "tool":
+            return tool_display(point.tool)
+        if name == "sync":
+            return sync_text(point.sync)
+        value = point.get(name)
+        return format_number(float(value)) if isinstance(value, float | int) else str(value)
+
+    def _edit_value(self, point: TempPoint, name: str) -> str:
+        if name == "sync":
+            return point.sync.value
+        value = point.get(name)
+        if isinstance(value, float):
+            return edit_text(value)
+        return str(value)
+
+    def _tooltip(self, point: TempPoint, name: str) -> str | None:
+        if name == "sync":
+            if point.sync is SyncState.FAILED:
+                reason = point.sync_error or self.tr("no reason given")
+                return self.tr("Upload failed: {reason}").format(reason=reason)
+            return {
+                SyncState.UNKNOWN: self.tr("Not known whether the controller holds this point (it "
+                                           "restarted or the link was lost): upload it before moving to it"),
+                SyncState.ON_CONTROLLER: self.tr("The controller holds this point with these values"),
+                SyncState.CHANGED: self.tr("Changed on the host (or new) since the last upload"),
+            }[point.sync]
+        if name == "note" and point.note:
+            return point.note
+        if name == "tool":
+            return self.tr("Tool frame {value}").format(value=point.tool)
+        return None
+
+    def flags(self, index: ModelIndex) -> Qt.ItemFlag:
+        if not index.isValid():
+            return Qt.ItemFlag.NoItemFlags
+        base = Qt.ItemFlag.ItemIsSelectable | Qt.ItemFlag.ItemIsEnabled
+        if index.column() != COL_SYNC:
+            base |= Qt.ItemFlag.ItemIsEditable
+        return base
+
+    # --- editing through the view
+    def setData(self, index: ModelIndex, value: Any, role: int = Qt.ItemDataRole.EditRole) -> bool:
+        if role != Qt.ItemDataRole.EditRole or not index.isValid() or value is None:
+            return False
+        if not 0 <= index.row() < len(self.ledger) or not 0 <= index.column() < len(COLUMNS):
+            return False
+        name = COLUMNS[index.column()]
+        if name == "sync":
+            return False
+        try:
+            self.edit_field(index.row(), name, value)
+        except InvalidInput as exc:
+            self.editRejected.emit(self.refusal_text(self.ledger[index.row()], name, exc))
+            return False
+        return True
+
+    def refusal_text(self, point: TempPoint, name: str, exc: InvalidInput) -> str:
+        reason = exc.reason if isinstance(exc, FieldError) else str(exc)
+        column = self._headers[COLUMNS.index(name)] if name in COLUMNS else name
+        return self.tr("{point}, {column}: refused, {reason}").format(point=point.label, column=column,
+                                                                  reason=reason)
+
+    # --- edits (each pushes one undo command; raise InvalidInput when refused)
+    def edit_field(self, row: int, name: str, value: object) -> bool:
+        """Set one field of the point at ``row``; False when nothing changed."""
+        old = self.ledger[row]
+        if name == "tool" and isinstance(value, str) and value.strip().lower() in TOOL_NONE_WORDS:
+            value = TOOL_NONE
+        new = with_field(old, name, value, self.ledger.limits)
+        if new == old:
+            return False
+        if name == "id":
+            other = self.ledger.row_of(new.id)
+            if other is not None and other != row:
+                raise FieldError("id", f"id {new.id} is already used by {self.ledger[other].label}")
+        after = self._follow_id(old.id, new.id) if old.id != new.id else None
+        column = self._headers[COLUMNS.index(name)] if name in COLUMNS else name
+        text = self.tr("Edit {point} {column}").format(point=old.label, column=column)
+        self._stack.push(ReplaceRowCommand(self, self.ledger, row, old, new, text, after=after))
+        return True
+
+    def _follow_id(self, old_id: int, new_id: int) -> Callable[[bool], None]:
+        """Renumber references in the plans (redo) and put them back exactly (undo)."""
+        saved: list[tuple[Plan, list[tuple[int, Segment]]]] = []
+
+        def apply(forward: bool) -> None:
+            if forward:
+                saved.clear()
+                for plan in self._project.plans:
+                    before = list(plan.segments)
+                    changed = plan.replace_point_id(old_id, new_id)
+                    if changed:
+                        saved.append((plan, [(r, before[r]) for r in changed]))
+            else:
+                for plan, originals in saved:
+                    for r, seg in originals:
+                        plan.replace(r, seg)
+            if saved:
+                self.planReferencesChanged.emit()
+
+        return apply
+
+    def add_point(self, row: int | None = None, *, name: str = "", pose: Sequence[float] | None = None,
+                  tool: int = TOOL_NONE) -> int:
+        """A new point (next free id) at ``row`` (default: the end); returns its row."""
+        point = make_point(self.next_id(), name, pose or (0.0,) * 6, tool=tool, limits=self.ledger.limits)
+        row = len(self.ledger) if row is None else max(0, min(row, len(self.ledger)))
+        self._stack.push(InsertRowsCommand(self, self.ledger, [(row, point)],
+                                           self.tr("Add {point}").format(point=point.label)))
+        return row
+
+    def next_id(self) -> int:
+        """The id for a new point: one more than the highest (1 for an empty list), or the
+        smallest free id when the highest is at the limit."""
+        limits = self.ledger.limits
+        ids = self.ledger.ids()
+        candidate = max(ids) + 1 if ids else max(1, limits.id_min)
+        if limits.id_min <= candidate <= limits.id_max:
+            return candidate
+        return self.ledger.next_free_id()
+
+    def duplicate_rows(self, rows: Iterable[int]) -> list[int]:
+        """Copy each row right after the block it belongs to, under new ids; returns new rows."""
+        chosen = sorted(set(rows))
+        if not chosen:
+            return []
+        used = set(self.ledger.ids())
+        copies: list[tuple[int, TempPoint]] = []
+        for offset, row in enumerate(chosen):
+            source = self.ledger[row]
+            new_id = self._free_id_after(source.id, used)
+            used.add(new_id)
+            copy = replace(source, id=new_id, sync=SyncState.CHANGED, sync_error="")
+            copies.append((row + 1 + offset, copy))
+        text = (self.tr("Duplicate {point}").format(point=self.ledger[chosen[0]].label) if len(chosen) == 1
+                else self.tr("Duplicate {n} points").format(n=len(chosen)))
+        self._stack.push(InsertRowsCommand(self, self.ledger, copies, text))
+        return [row for row, _ in copies]
+
+    def _free_id_after(self, after: int, used: set[int]) -> int:
+        limits = self.ledger.limits
+        for start in (after + 1, limits.id_min):
+            for candidate in range(max(start, limits.id_min), limits.id_max + 1):
+                if candidate not in used:
+                    return candidate
+        raise InvalidInput(f"no free point id left in {limits.id_min}..{limits.id_max}")
+
+    def remove_rows(self, rows: Iterable[int]) -> int:
+        """Delete rows (one undo step); returns how many."""
+        chosen = sorted({r for r in rows if 0 <= r < len(self.ledger)})
+        if not chosen:
+            return 0
+        text = (self.tr("Delete {point}").format(point=self.ledger[chosen[0]].label) if len(chosen) == 1
+                else self.tr("Delete {n} points").format(n=len(chosen)))
+        self._stack.push(RemoveRowsCommand(self, self.ledger, chosen, text))
+        return len(chosen)
+
+    def can_move(self, rows: Iterable[int], delta: int) -> bool:
+        chosen = sorted(set(rows))
+        if not chosen:
+            return False
+        return chosen[0] + delta >= 0 if delta < 0 else chosen[-1] + delta < len(self.ledger)
+
+    def move_rows(self, rows: Iterable[int], delta: int) -> list[int]:
+        """Move rows one place up (-1) or down (+1); returns their new rows (unchanged if at an end)."""
+        chosen = sorted(set(rows))
+        if not self.can_move(chosen, delta):
+            return chosen
+        text = self.tr("Move up") if delta < 0 else self.tr("Move down")
+        command = MoveRowsCommand(self, self.ledger, chosen, delta, text)
+        self._stack.push(command)
+        return list(command.new_rows)
+
+    def add_taught_point(self, point_id: int, pose: Any, *, name: str = "", tool: int = TOOL_NONE) -> int:
+        """A point the controller just created from its current pose (``pose``: a ``Pose``).
+
+        It is on the controller by construction. Returns its row."""
+        point = point_from_pose(point_id, pose, name, tool=tool, limits=self.ledger.limits)
+        point = replace(point, sync=SyncState.ON_CONTROLLER)
+        if self.ledger.row_of(point_id) is not None:
+            raise FieldError("id", f"id {point_id} is already used by {self.ledger.point(point_id).label}")
+        self._on_controller[point_id] = point
+        row = len(self.ledger)
+        self._stack.push(InsertRowsCommand(self, self.ledger, [(row, point)],
+                                           self.tr("Teach {point}").format(point=point.label)))
+        return row
+
+    def import_points(self, points: Sequence[TempPoint],
+                      mode: ImportMode = ImportMode.REPLACE) -> ImportReport:
+        """Import parsed points (one undo step); the ledger is untouched when refused."""
+        scratch = PointLedger(self.ledger.snapshot(), self.ledger.limits)
+        report = scratch.import_points(points, mode)
+        text = self.tr("Import {n} points").format(n=len(points))
+        self._stack.push(_ReplaceAllCommand(self, self.ledger.snapshot(), scratch.snapshot(), text))
+        return report
+
+    # --- sync state (not undoable)
+    def mark_all_unknown(self) -> int:
+        """The controller restarted or reconnected: nothing is known to be on it any more."""
+        self._on_controller.clear()
+        rows = self.ledger.mark_all_unknown()
+        self._sync_rows_changed(rows)
+        return len(rows)
+
+    def apply_upload(self, report: UploadReport) -> list[int]:
+        """Record an upload (see :func:`app.points.apply_upload`); returns the rows changed."""
+        for outcome in report.outcomes:
+            if outcome.ok and outcome.sent is not None:
+                self._on_controller[outcome.point_id] = outcome.sent
+            elif not outcome.ok:
+                self._on_controller.pop(outcome.point_id, None)
+        rows = apply_upload(self.ledger, report)
+        self._sync_rows_changed(rows)
+        return rows
+
+    def set_sync(self, point_id: int, state: SyncState, reason: str = "") -> None:
+        """Record the controller's side of one point (e.g. a teach that overwrote it)."""
+        if state is not SyncState.ON_CONTROLLER:
+            self._on_controller.pop(point_id, None)
+        else:
+            self._on_controller[point_id] = self.ledger.point(point_id)
+        self._sync_rows_changed([self.ledger.set_sync(point_id, state, reason)])
+
+    def _sync_rows_changed(self, rows: Sequence[int]) -> None:
+        if rows:
+            self.dataChanged.emit(self.index(min(rows), 0), self.index(max(rows), len(COLUMNS) - 1))
+            self.syncChanged.emit()
+
+    # --- command hooks
+    def _show(self, target: Any) -> None:
+        if target is not self.ledger:
+            raise RuntimeError("undo command for a ledger that is no longer shown")
+
+    def _prepare(self, target: Any, item: Any) -> Any:
+        return self.settle(item)
+
+    def settle(self, point: TempPoint) -> TempPoint:
+        """``point`` with the sync state that what the controller is known to hold implies."""
+        known = self._on_controller.get(point.id)
+        if known is not None:
+            if known.same_on_controller(point):
+                return replace(point, sync=SyncState.ON_CONTROLLER, sync_error="")
+            return replace(point, sync=SyncState.CHANGED, sync_error="")
+        if point.sync is SyncState.ON_CONTROLLER:
+            return replace(point, sync=SyncState.UNKNOWN, sync_error="")
+        return point
+
+    def _apply_replace_all(self, points: Sequence[TempPoint]) -> None:
+        self.beginResetModel()
+        self.ledger.replace_all([self.settle(p) for p in points])
+        self.endResetModel()
+        self._after_change(self.ledger)
+
+
+class PointFilterProxy(QSortFilterProxyModel):
+    """Rows whose id equals the filter text or whose name contains it (case-insensitive)."""
+
+    def __init__(self, parent: Any = None) -> None:
+        super().__init__(parent)
+        self._needle = ""
+
+    @property
+    def filter_text(self) -> str:
+        return self._needle
+
+    def set_filter_text(self, text: str) -> None:
+        needle = text.strip().casefold()
+        if needle != self._needle:
+            self.beginFilterChange()
+            self._needle = needle
+            self.endFilterChange(QSortFilterProxyModel.Direction.Rows)
+
+    def filterAcceptsRow(self, source_row: int, source_parent: ModelIndex) -> bool:
+        if not self._needle:
+            return True
+        model = self.sourceModel()
+        if not isinstance(model, PointsModel) or source_row >= model.rowCount():
+            return True
+        point = model.point_at(source_row)
+        return self._needle == str(point.id) or self._needle in point.name.casefold()

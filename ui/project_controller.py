@@ -1,0 +1,423 @@
+"""The open project on the Qt side: file actions, undo stack, dirty state, autosave, recovery.
+
+:class:`ProjectController` owns the :class:`~app.project.Project`, the ``QUndoStack`` shared by
+every edit, and the table models built on them (:class:`~ui.points_model.PointsModel`,
+:class:`~ui.plan_model.PlanListModel`). Opening, recovering or starting a new project swaps the
+project inside the same models (``modelReset``) and clears the undo stack, so the panels keep
+their models for the life of the window.
+
+Files: open / save / save as (atomic, by the core), import / export CSV. A malformed file is
+refused with the core's message, which names the row (or item) and the field, and nothing
+changes. All questions and file choosers go through a :class:`ProjectDialogs` object, replaced
+by a fake in tests.
+
+Autosave: every :data:`AUTOSAVE_INTERVAL_S` seconds while the project has unsaved changes, to
+``<name>.autosave.json`` next to the project (or the per-user directory for an untitled
+project). A save removes it. At startup :meth:`ProjectController.check_recovery` returns an
+autosave newer than its project (a crash left it); :meth:`ProjectController.offer_recovery`
+asks and loads it. :meth:`ProjectController.close` stops the timer.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QObject, QTimer, Signal, Slot
+from PySide6.QtGui import QAction, QKeySequence, QUndoStack
+from PySide6.QtWidgets import QFileDialog, QInputDialog, QMessageBox, QWidget
+
+from app.errors import InvalidInput
+from app.points import FileFormatError, ImportMode
+from app.project import (
+    PROJECT_SUFFIX,
+    Project,
+    autosave_path,
+    discard_autosave,
+    find_autosave,
+    load_project,
+    read_points_csv,
+    save_autosave,
+    save_project,
+    write_points_csv,
+)
+from ui.plan_model import PlanListModel
+from ui.points_model import PointsModel
+
+AUTOSAVE_INTERVAL_S = 60.0  # seconds between autosaves while there are unsaved changes
+SAVE_CHOICES = ("save", "discard", "cancel")
+
+
+class ProjectDialogs:
+    """Questions and file choosers of :class:`ProjectController` (Qt dialogs).
+
+    Tests pass an object with the same methods that answers without showing anything."""
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        self.parent = parent
+
+    def tr(self, text: str) -> str:
+        from PySide6.QtCore import QCoreApplication
+
+        return QCoreApplication.translate("ProjectDialogs", text)
+
+    def open_path(self, title: str, filters: str) -> str | None:
+        path, _ = QFileDialog.getOpenFileName(self.parent, title, "", filters)
+        return path or None
+
+    def save_path(self, title: str, filters: str, suggested: str) -> str | None:
+        path, _ = QFileDialog.getSaveFileName(self.parent, title, suggested, filters)
+        return path or None
+
+    def error(self, title: str, text: str) -> None:
+        QMessageBox.critical(self.parent, title, text)
+
+    def ask_save_changes(self, name: str) -> str:
+        """"save", "discard" or "cancel"."""
+        box = QMessageBox(QMessageBox.Icon.Question, self.tr("Unsaved changes"),
+                          self.tr("Save the changes to {name}?").format(name=name),
+                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
+                          | QMessageBox.StandardButton.Cancel, self.parent)
+        answer = box.exec()
+        if answer == QMessageBox.StandardButton.Save:
+            return "save"
+        if answer == QMessageBox.StandardButton.Discard:
+            return "discard"
+        return "cancel"
+
+    def ask_recover(self, autosave: Path, project_path: Path | None) -> bool:
+        what = str(project_path) if project_path else self.tr("an unsaved project")
+        text = self.tr("TeachPad was not closed properly. An autosave of {what} is newer than the saved "
+                       "file:\n{autosave}\n\nRecover it?").format(what=what, autosave=autosave)
+        answer = QMessageBox.question(self.parent, self.tr("Recover autosave"), text,
+                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
+                                      QMessageBox.StandardButton.Yes)
+        return answer == QMessageBox.StandardButton.Yes
+
+    def ask_import_mode(self) -> ImportMode | None:
+        replace_text = self.tr("Replace all points")
+        merge_text = self.tr("Merge (update the same ids, append new ones)")
+        choice, ok = QInputDialog.getItem(self.parent, self.tr("Import points"), self.tr("Import mode:"),
+                                          [replace_text, merge_text], 0, False)
+        if not ok:
+            return None
+        return ImportMode.MERGE if choice == merge_text else ImportMode.REPLACE
+
+
+class ProjectController(QObject):
+    """See the module docstring.
+
+    Signals: ``projectReplaced(object)`` (the new :class:`Project`), ``dirtyChanged(bool)``,
+    ``pathChanged(str)`` ("" when untitled), ``titleChanged(str)`` (name plus "*" when dirty),
+    ``autosaved(str)`` (path), ``statusMessage(str)``.
+
+    QActions: ``action_new``, ``action_open``, ``action_save``, ``action_save_as``,
+    ``action_import_csv``, ``action_export_csv``, ``action_undo``, ``action_redo``;
+    :meth:`file_actions` lists the File menu (None = separator).
+    """
+
+    projectReplaced = Signal(object)
+    dirtyChanged = Signal(bool)
+    pathChanged = Signal(str)
+    titleChanged = Signal(str)
+    autosaved = Signal(str)
+    statusMessage = Signal(str)
+
+    def __init__(self, project: Project | None = None, path: str | os.PathLike[str] | None = None, *,
+                 dialogs: Any = None, autosave_interval: float = AUTOSAVE_INTERVAL_S,
+                 autosave_dir: str | os.PathLike[str] | None = None, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self._project = project or Project()
+        self._path: Path | None = Path(path) if path is not None else None
+        self.dialogs = dialogs or ProjectDialogs()
+        self._autosave_dir = Path(autosave_dir) if autosave_dir is not None else None
+        self._saved_revision = self._project.revision
+        self._autosaved_revision = self._project.revision
+        self._dirty = False
+
+        self.undo_stack = QUndoStack(self)
+        self.points_model = PointsModel(self._project, self.undo_stack, self)
+        self.plans_model = PlanListModel(self._project, self.undo_stack, self)
+        self.undo_stack.indexChanged.connect(self._check_dirty)
+        self.points_model.syncChanged.connect(self._check_dirty)
+
+        self._timer = QTimer(self)
+        self._timer.timeout.connect(self.autosave_now)
+        self.set_autosave_interval(autosave_interval)
+
+        self._make_actions()
+        self.retranslate()
+
+    # --- actions
+    def _make_actions(self) -> None:
+        def act(slot: Any, shortcut: QKeySequence.StandardKey | None = None) -> QAction:
+            action = QAction(self)
+            if shortcut is not None:
+                action.setShortcut(QKeySequence(shortcut))
+            action.triggered.connect(lambda _checked=False: slot())
+            return action
+
+        self.action_new = act(self.new_project, QKeySequence.StandardKey.New)
+        self.action_open = act(self.open_file, QKeySequence.StandardKey.Open)
+        self.action_save = act(self.save, QKeySequence.StandardKey.Save)
+        self.action_save_as = act(self.save_as, QKeySequence.StandardKey.SaveAs)
+        self.action_import_csv = act(self.import_csv)
+        self.action_export_csv = act(self.export_csv)
+        # the stack keeps their text up to date: "Undo Edit P5 X"
+        self.action_undo = self.undo_stack.createUndoAction(self, self.tr("Undo"))
+        self.action_undo.setShortcut(QKeySequence(QKeySequence.StandardKey.Undo))
+        self.action_redo = self.undo_stack.createRedoAction(self, self.tr("Redo"))
+        self.action_redo.setShortcut(QKeySequence(QKeySequence.StandardKey.Redo))
+
+    def retranslate(self) -> None:
+        self.action_new.setText(self.tr("&New project"))
+        self.action_open.setText(self.tr("&Open project…"))
+        self.action_save.setText(self.tr("&Save project"))
+        self.action_save_as.setText(self.tr("Save project &as…"))
+        self.action_import_csv.setText(self.tr("&Import points (CSV)…"))
+        self.action_export_csv.setText(self.tr("&Export points (CSV)…"))
+        self.points_model.retranslate()
+        self.plans_model.retranslate()
+
+    def file_actions(self) -> list[QAction | None]:
+        return [self.action_new, self.action_open, self.action_save, self.action_save_as, None,
+                self.action_import_csv, self.action_export_csv]
+
+    # --- state
+    @property
+    def project(self) -> Project:
+        return self._project
+
+    @property
+    def path(self) -> Path | None:
+        return self._path
+
+    @property
+    def is_dirty(self) -> bool:
+        return self._project.revision != self._saved_revision
+
+    @property
+    def display_name(self) -> str:
+        return self._path.name if self._path is not None else self.tr("untitled")
+
+    @property
+    def title(self) -> str:
+        return self.display_name + ("*" if self.is_dirty else "")
+
+    @property
+    def autosave_timer(self) -> QTimer:
+        return self._timer
+
+    @property
+    def autosave_file(self) -> Path:
+        return autosave_path(self._path, user_dir=self._autosave_dir)
+
+    def set_autosave_interval(self, seconds: float) -> None:
+        """0 turns autosave off."""
+        self._timer.stop()
+        if seconds > 0:
+            self._timer.setInterval(int(seconds * 1000))
+            self._timer.start()
+
+    # --- file operations
+    @Slot()
+    def new_project(self) -> bool:
+        if not self.maybe_save():
+            return False
+        self._replace(Project(), None)
+        return True
+
+    def open_file(self, path: str | os.PathLike[str] | None = None) -> bool:
+        """Open a project (asks for the file when ``path`` is None). A bad file is refused
+        with the core's message and the open project stays as it was."""
+        if path is None:
+            chosen = self.dialogs.open_path(self.tr("Open project"), self._project_filter())
+            if not chosen:
+                return False
+            path = chosen
+        if not self.maybe_save():
+            return False
+        try:
+            project = load_project(path, self._project.ledger.limits)
+        except (FileFormatError, InvalidInput) as exc:
+            self.dialogs.error(self.tr("Cannot open project"), str(exc))
+            return False
+        except OSError as exc:
+            self.dialogs.error(self.tr("Cannot open project"), f"{path}: {exc.strerror or exc}")
+            return False
+        self._replace(project, Path(path))
+        self.statusMessage.emit(self.tr("Opened {path}").format(path=path))
+        return True
+
+    @Slot()
+    def save(self) -> bool:
+        if self._path is None:
+            return self.save_as()
+        return self._save_to(self._path)
+
+    def save_as(self, path: str | os.PathLike[str] | None = None) -> bool:
+        if path is None:
+            suggested = str(self._path) if self._path else self._project.name + PROJECT_SUFFIX
+            chosen = self.dialogs.save_path(self.tr("Save project"), self._project_filter(), suggested)
+            if not chosen:
+                return False
+            path = chosen
+        target = Path(path)
+        if not target.name.endswith(".json"):
+            target = target.with_name(target.name + PROJECT_SUFFIX)
+        return self._save_to(target)
+
+    def _save_to(self, target: Path) -> bool:
+        old_autosave = self.autosave_file
+        try:
+            save_project(self._project, target)
+        except OSError as exc:
+            self.dialogs.error(self.tr("Cannot save project"), f"{target}: {exc.strerror or exc}")
+            return False
+        old_path, self._path = self._path, target
+        self._saved_revision = self._autosaved_revision = self._project.revision
+        self.undo_stack.setClean()
+        for stale in {old_autosave, self.autosave_file}:
+            stale.unlink(missing_ok=True)
+        if old_path != target:
+            self.pathChanged.emit(str(target))
+        self._check_dirty(force=True)
+        self.statusMessage.emit(self.tr("Saved {path}").format(path=target))
+        return True
+
+    def import_csv(self, path: str | os.PathLike[str] | None = None, mode: ImportMode | None = None) -> bool:
+        """Import points from CSV (one undo step). A bad file leaves the table as it was."""
+        if path is None:
+            chosen = self.dialogs.open_path(self.tr("Import points"), self._csv_filter())
+            if not chosen:
+                return False
+            path = chosen
+        try:
+            points = read_points_csv(path, self._project.ledger.limits)
+        except (FileFormatError, InvalidInput) as exc:
+            self.dialogs.error(self.tr("Cannot import points"), str(exc))
+            return False
+        except OSError as exc:
+            self.dialogs.error(self.tr("Cannot import points"), f"{path}: {exc.strerror or exc}")
+            return False
+        if mode is None:
+            mode = self.dialogs.ask_import_mode()
+            if mode is None:
+                return False
+        try:
+            report = self.points_model.import_points(points, mode)
+        except InvalidInput as exc:
+            self.dialogs.error(self.tr("Cannot import points"), str(exc))
+            return False
+        self.statusMessage.emit(self.tr("Imported {path}: {report}").format(path=path, report=report.text))
+        return True
+
+    def export_csv(self, path: str | os.PathLike[str] | None = None) -> bool:
+        if path is None:
+            suggested = (self._path.name.removesuffix(PROJECT_SUFFIX) if self._path else "points") + ".csv"
+            chosen = self.dialogs.save_path(self.tr("Export points"), self._csv_filter(), suggested)
+            if not chosen:
+                return False
+            path = chosen
+        try:
+            write_points_csv(path, self._project.ledger)
+        except OSError as exc:
+            self.dialogs.error(self.tr("Cannot export points"), f"{path}: {exc.strerror or exc}")
+            return False
+        self.statusMessage.emit(self.tr("Exported {n} points to {path}").format(
+            n=len(self._project.ledger), path=path))
+        return True
+
+    def maybe_save(self) -> bool:
+        """Ask to save unsaved changes; False when the operator cancels."""
+        if not self.is_dirty:
+            return True
+        choice = self.dialogs.ask_save_changes(self.display_name)
+        if choice == "save":
+            return self.save()
+        if choice == "discard":
+            discard_autosave(self._path, user_dir=self._autosave_dir)
+            return True
+        return False
+
+    # --- autosave and recovery
+    @Slot()
+    def autosave_now(self) -> Path | None:
+        """Write the autosave if there are changes since the last save / autosave."""
+        revision = self._project.revision
+        if not self.is_dirty or revision == self._autosaved_revision:
+            return None
+        try:
+            written = save_autosave(self._project, self._path, user_dir=self._autosave_dir)
+        except OSError as exc:
+            self.statusMessage.emit(self.tr("Autosave failed: {reason}").format(reason=exc.strerror or exc))
+            return None
+        self._autosaved_revision = revision
+        self.autosaved.emit(str(written))
+        return written
+
+    def check_recovery(self) -> Path | None:
+        """The autosave to offer at startup (newer than the project, or of an untitled one)."""
+        return find_autosave(self._path, user_dir=self._autosave_dir)
+
+    def offer_recovery(self) -> bool:
+        """Ask whether to recover :meth:`check_recovery`'s file; True when recovered.
+        Declining removes the autosave."""
+        found = self.check_recovery()
+        if found is None:
+            return False
+        if not self.dialogs.ask_recover(found, self._path):
+            found.unlink(missing_ok=True)
+            return False
+        return self.recover(found)
+
+    def recover(self, autosave: str | os.PathLike[str]) -> bool:
+        """Load an autosave in place of the project; it stays unsaved (the autosave is kept
+        until the next save)."""
+        try:
+            project = load_project(autosave, self._project.ledger.limits)
+        except (FileFormatError, InvalidInput) as exc:
+            self.dialogs.error(self.tr("Cannot recover autosave"), str(exc))
+            return False
+        except OSError as exc:
+            self.dialogs.error(self.tr("Cannot recover autosave"), f"{autosave}: {exc.strerror or exc}")
+            return False
+        self._replace(project, self._path, dirty=True)
+        self.statusMessage.emit(self.tr("Recovered the autosave {path}").format(path=autosave))
+        return True
+
+    @Slot()
+    def close(self) -> None:
+        """Stop autosaving (the window is closing; call :meth:`maybe_save` first)."""
+        self._timer.stop()
+
+    # --- internals
+    def _replace(self, project: Project, path: Path | None, *, dirty: bool = False) -> None:
+        old_path = self._path
+        self.undo_stack.clear()
+        self._project = project
+        self._path = path
+        self._saved_revision = project.revision - (1 if dirty else 0)
+        self._autosaved_revision = project.revision
+        self.points_model.set_project(project)
+        self.plans_model.set_project(project)
+        self.projectReplaced.emit(project)
+        if old_path != path:
+            self.pathChanged.emit(str(path) if path else "")
+        self._check_dirty(force=True)
+
+    def _check_dirty(self, *_args: Any, force: bool = False) -> None:
+        dirty = self.is_dirty
+        if dirty != self._dirty or force:
+            changed = dirty != self._dirty
+            self._dirty = dirty
+            if changed:
+                self.dirtyChanged.emit(dirty)
+            self.titleChanged.emit(self.title)
+
+    def _project_filter(self) -> str:
+        return self.tr("TeachPad projects (*.teachpad.json *.json);;All files (*)")
+
+    def _csv_filter(self) -> str:
+        return self.tr("CSV files (*.csv);;All files (*)")
