@@ -35,8 +35,10 @@ bench: $(STAMP)
 bench-quick: $(STAMP)
 	$(BIN)/python -m benchmarks.run --quick
 
+# Collect every tr() string, fill Chinese from resources/translations/*_zh_CN.txt, compile the .qm.
 translations: $(STAMP)
-	$(BIN)/pyside6-lupdate $$(find app ui -name '*.py') -ts resources/translations/teachpad_zh_CN.ts
+	$(BIN)/pyside6-lupdate -no-obsolete $$(find app ui -name '*.py' | sort) -ts resources/translations/teachpad_zh_CN.ts
+	$(BIN)/python resources/translations/merge.py resources/translations/teachpad_zh_CN.ts resources/translations/*_zh_CN.txt
 	$(BIN)/pyside6-lrelease resources/translations/teachpad_zh_CN.ts -qm ui/i18n/teachpad_zh_CN.qm
 
 clean:
