@@ -80,6 +80,7 @@ __all__ = [
     "ConnectionState",
     "JogRequest",
     "LinkState",
+    "Operation",
     "RobotLink",
     "RobotWorker",
     "WorkerError",
@@ -92,6 +93,31 @@ RTT_REPORT_PERIOD = 0.5  # s between rttChanged emissions (mean of the period's 
 TEACH_IDLE_DISABLE = 30.0  # s after the last jog release before teach mode is disabled
 TEACH_MODE_GRACE = 0.3  # s after teach enable during which a status without mode 2 is not "teach lost"
 SHUTDOWN_TIMEOUT_MS = 10_000  # ms to wait for the worker thread to end
+
+
+class Operation:
+    """The operation names in ``WorkerError.operation`` and ``CommandResult.operation``."""
+
+    STOP = "stop"
+    PAUSE = "pause"
+    RESUME = "resume"
+    JOG = "jog"
+    JOG_RELEASE = "jog release"
+    JOG_SPEED = "jog speed"
+    STEP = "step"
+    SET_MODE = "set mode"
+    GO_ZERO = "go to zero"
+    RUN_PROGRAM = "run program"
+    CREATE_POINT = "create point"
+    MOVE_TO_POINT = "move to point"
+    UPLOAD_POINTS = "upload points"
+    CANCEL_UPLOAD = "cancel upload"
+    TEACH_DISABLE = "teach disable"
+    POLL = "poll"
+    CONNECT = "connect"
+    DISCONNECT = "disconnect"
+    SHUTDOWN = "shutdown"
+    CANARY = "restart check"
 
 
 class LinkState(enum.Enum):

@@ -15,7 +15,7 @@ from ui.i18n import protocol_text
 
 STOP_STYLE = (
     "QPushButton { background-color: #c62828; color: white; font-weight: bold; font-size: 20px;"
-    " border: 2px solid #8e0000; border-radius: 8px; padding: 6px 18px; }"
+    " border: 2px solid #8e0000; border-radius: 8px; padding: 6px 10px; }"
     "QPushButton:hover { background-color: #d32f2f; }"
     "QPushButton:pressed { background-color: #8e0000; }"
 )

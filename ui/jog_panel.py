@@ -59,7 +59,7 @@ class JogButton(QPushButton):
         self._held = False
         self.setAutoRepeat(False)
         self.setFocusPolicy(Qt.FocusPolicy.NoFocus)  # keep the keyboard focus on the panel
-        self.setMinimumSize(BUTTON_SIZE, BUTTON_SIZE - 12)
+        self.setMinimumSize(BUTTON_SIZE, BUTTON_SIZE - 18)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         font = self.font()
         font.setPointSizeF(font.pointSizeF() * 1.3)

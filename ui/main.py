@@ -3,7 +3,8 @@
     teachpad --sim                      built-in simulator on a free loopback port
     teachpad --host H --port P [--unit U]   a real controller (Modbus TCP)
     teachpad --lang zh_CN               language for this run (the menu remembers a choice)
-    teachpad --sim --screenshot out.png --size 1400x900   render once connected, save, exit
+    teachpad --project FILE             open this project (default: the last one)
+    teachpad --sim --screenshot out.png --size 1400x900 [--tab planner]   render once connected, save, exit
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from app.models import Pose
 from app.protocol.enums import ProgramMotionMode
 from app.worker import ConnectionState, RobotLink
 from ui.i18n import LANGUAGE_NAMES, Translator
-from ui.main_window import MainWindow
+from ui.main_window import TAB_NAMES, MainWindow
 from ui.settings import APPLICATION, ORGANIZATION, AppSettings
 
 SCREENSHOT_SETTLE_MS = 1500  # after the first pose: let the plots fill and the panels paint
@@ -54,6 +55,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--size", type=_size, metavar="WxH", help="window size, e.g. 1400x900")
     parser.add_argument("--screenshot", metavar="PNG",
                         help="save the window once connected with a pose, then exit")
+    parser.add_argument("--project", metavar="FILE", help="open this project (.teachpad.json) at start")
+    parser.add_argument("--tab", choices=TAB_NAMES, help="work tab to show first")
     parser.add_argument("--demo", action="store_true",
                         help=f"with --sim: run the simulator's program {DEMO_PROGRAM} in a loop")
     return parser
@@ -138,8 +141,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     window = MainWindow(link, settings, translator)
     if args.size:
         window.resize(*args.size)
+    if args.tab:
+        window.show_tab(args.tab)
     shot = _Screenshot(window, link, args.screenshot, app) if args.screenshot else None
     window.show()
+    # A screenshot run never stops on a question: it opens only what it was given.
+    window.start_project(args.project, reopen_last=not args.screenshot, offer_recovery=not args.screenshot)
     if connection is not None:
         link.connect_to(connection)
         if args.demo:

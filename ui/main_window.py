@@ -1,23 +1,47 @@
-"""The pendant's main window: control bar, jog / step / program tabs, docked display panels.
+"""The pendant's main window: control column, work tabs, docked status / log panels.
+
+Layout (fits 1280×800 and grows to 1920×1080): on the left the control column (control bar
+with the big STOP, then the Jog / Step / Program tabs); on the right the work tabs
+Monitor | Points | Planner; docks: Status (left, narrow), Event log and Modbus traffic (bottom,
+tabified). STOP stays visible whatever tab is shown.
 
 The window holds no robot state: it forwards the panels' requests to the :class:`RobotLink`
-and the link's signals to the panels. Motion controls are enabled only while the link is up
-and writable (not monitor-only). Any jog ends when the window loses the focus, is hidden or
-closed, and when the link goes down.
+and the link's signals to the panels. One :class:`ProjectController` owns the open project
+(File and Edit menus); the points panel and the planner share its models, a
+:class:`PointSyncController` and a :class:`PlanRunController`. Motion controls are enabled only
+while the link is up and writable (not monitor-only). Any jog ends when the window loses the
+focus, is hidden or closed, and when the link goes down.
+
+Close order: jog release first (before any question), then "save changes?" (Cancel keeps the
+window and the link), then the window state is saved and the link shut down.
 """
 
 from __future__ import annotations
 
+import functools
+import os
 from collections.abc import Callable
+from pathlib import Path
+from typing import Any
 
-from PySide6.QtCore import QCoreApplication, QEvent, Qt, Slot
-from PySide6.QtGui import QAction, QActionGroup, QCloseEvent, QHideEvent, QKeySequence
+from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
+from PySide6.QtGui import (
+    QAction,
+    QActionGroup,
+    QCloseEvent,
+    QGuiApplication,
+    QHideEvent,
+    QKeySequence,
+    QShowEvent,
+)
 from PySide6.QtWidgets import (
     QApplication,
     QDockWidget,
     QLabel,
     QMainWindow,
     QMessageBox,
+    QSizePolicy,
+    QSplitter,
     QTabWidget,
     QToolBar,
     QVBoxLayout,
@@ -28,28 +52,38 @@ from app import __version__
 from app.client import ConnectionSettings
 from app.models import CommandResult, ControllerStatus
 from app.protocol.enums import ProgramMotionMode, WorkMode
-from app.worker import ConnectionState, JogRequest, LinkState, RobotLink, WorkerError
+from app.worker import ConnectionState, JogRequest, LinkState, Operation, RobotLink, WorkerError
 from ui.connection_dialog import ConnectionDialog
 from ui.control_bar import ControlBar
 from ui.event_log import EventLogPanel
 from ui.i18n import LANGUAGE_NAMES, Translator
 from ui.jog_panel import JogPanel
 from ui.monitor_panel import MonitorPanel
+from ui.plan_run_controller import PlanRunController
+from ui.planner_panel import PlannerPanel
+from ui.points_panel import PointsPanel, PointSyncController
 from ui.program_panel import ProgramPanel, ProgramRequest
+from ui.project_controller import ProjectController, ProjectDialogs
 from ui.settings import AppSettings
 from ui.status_panel import StatusPanel
 from ui.step_panel import ConfirmFn, StepPanel, StepRequest
 from ui.traffic_panel import TrafficPanel
 from ui.widgets_common import connection_display
 
-DEFAULT_SIZE = (1680, 1000)
+DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size
+MIN_SIZE = (1024, 700)  # the layout stays usable down to this
+STATUS_DOCK_WIDTH = 250  # px at first start (the operator's layout is remembered)
+DOCK_MIN_HEIGHT = 72  # px, the bottom docks (event log, traffic) at their smallest
+TAB_MONITOR, TAB_POINTS, TAB_PLANNER = range(3)
+TAB_NAMES = ("monitor", "points", "planner")
 
 
 class MainWindow(QMainWindow):
     """See the module docstring. ``confirm`` (settable) is used by every panel that asks."""
 
     def __init__(self, link: RobotLink, settings: AppSettings, translator: Translator | None = None,
-                 parent: QWidget | None = None, *, shutdown_link_on_close: bool = True) -> None:
+                 parent: QWidget | None = None, *, shutdown_link_on_close: bool = True,
+                 project_dialogs: Any = None, autosave_dir: str | os.PathLike[str] | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("MainWindow")
         self.link = link
@@ -59,65 +93,114 @@ class MainWindow(QMainWindow):
         self._connection = link.state
         self._traffic_capture = False
         self._operation_names: dict[str, str] = {}
+        self._run_active = False
+        self._close_accepted = False
 
-        # --- central: control bar + motion tabs ---------------------------------------
+        # --- the project and its controllers (no widgets) ---------------------------------
+        self.project = ProjectController(dialogs=project_dialogs or ProjectDialogs(self),
+                                         autosave_dir=autosave_dir, parent=self)
+        self.point_sync = PointSyncController(self.project.points_model, link, self)
+        self.run_controller = PlanRunController(link, self)
+
+        # --- left: control bar + motion tabs ----------------------------------------------
         self.control_bar = ControlBar(self)
         self.jog_panel = JogPanel(self)
         self.step_panel = StepPanel(self)
         self.program_panel = ProgramPanel(self)
         self.tabs = QTabWidget(self)
+        self.tabs.setObjectName("MotionTabs")
         self.tabs.addTab(self.jog_panel, "")
         self.tabs.addTab(self.step_panel, "")
         self.tabs.addTab(self.program_panel, "")
         self.tabs.currentChanged.connect(lambda _i: self.jog_panel.release_all())
         self.motion_banner = QLabel(self)
         self.motion_banner.setAlignment(Qt.AlignmentFlag.AlignCenter)
+        self.motion_banner.setWordWrap(True)
         self.motion_banner.setStyleSheet(
             "QLabel { background: #fff1d6; color: #7a4a00; border: 1px solid #ef8f00;"
             " border-radius: 4px; padding: 4px; font-weight: bold; }")
-        central = QWidget(self)
-        column = QVBoxLayout(central)
-        column.setContentsMargins(4, 4, 4, 4)
+        self.control_column = QWidget(self)
+        self.control_column.setObjectName("ControlColumn")
+        column = QVBoxLayout(self.control_column)
+        column.setContentsMargins(0, 0, 0, 0)
         column.addWidget(self.control_bar)
         column.addWidget(self.motion_banner)
         column.addWidget(self.tabs, 1)
+        self.control_column.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Expanding)
+
+        # --- right: the work tabs ---------------------------------------------------------
+        self.monitor_panel = MonitorPanel(self)
+        self.points_panel = PointsPanel(self.project.points_model, self.point_sync, self)
+        self.planner_panel = PlannerPanel(self.project.plans_model, self.project.points_model,
+                                          self.run_controller, self.point_sync, self)
+        self.work_tabs = QTabWidget(self)
+        self.work_tabs.setObjectName("WorkTabs")
+        self.work_tabs.addTab(self.monitor_panel, "")
+        self.work_tabs.addTab(self.points_panel, "")
+        self.work_tabs.addTab(self.planner_panel, "")
+
+        self.splitter = QSplitter(Qt.Orientation.Horizontal, self)
+        self.splitter.setObjectName("MainSplitter")
+        self.splitter.addWidget(self.control_column)
+        self.splitter.addWidget(self.work_tabs)
+        self.splitter.setStretchFactor(0, 0)
+        self.splitter.setStretchFactor(1, 1)
+        self.splitter.setChildrenCollapsible(False)
+        central = QWidget(self)
+        outer = QVBoxLayout(central)
+        outer.setContentsMargins(4, 4, 4, 0)
+        outer.addWidget(self.splitter)
         self.setCentralWidget(central)
 
         # --- docks: the display panels --------------------------------------------------
-        self.monitor_panel = MonitorPanel(self)
         self.status_panel = StatusPanel(self)
         self.traffic_panel = TrafficPanel(self)
         self.event_log = EventLogPanel(self)
         area = Qt.DockWidgetArea
-        self.monitor_dock = self._dock("MonitorDock", self.monitor_panel, area.RightDockWidgetArea)
         self.status_dock = self._dock("StatusDock", self.status_panel, area.LeftDockWidgetArea)
         self.event_dock = self._dock("EventLogDock", self.event_log, area.BottomDockWidgetArea)
         self.traffic_dock = self._dock("TrafficDock", self.traffic_panel, area.BottomDockWidgetArea)
         self.tabifyDockWidget(self.event_dock, self.traffic_dock)
         self.event_dock.raise_()
+        self.setCorner(Qt.Corner.BottomLeftCorner, area.LeftDockWidgetArea)  # status runs full height
+        for panel in (self.event_log, self.traffic_panel):
+            panel.setMinimumHeight(DOCK_MIN_HEIGHT)  # a short log scrolls; the window fits 800 px
         self.traffic_dock.visibilityChanged.connect(self._update_traffic_capture)
         self.traffic_panel.captureEnabledChanged.connect(self._update_traffic_capture)
 
         # --- actions, menus, toolbar, status bar ---------------------------------------
         self._make_actions()
         self._make_menus()
+        self.status_project = QLabel(self)
         self.status_link = QLabel(self)
         self.status_rtt = QLabel(self)
         self.status_monitor_only = QLabel(self)
         self.status_monitor_only.setStyleSheet("color: #c62828; font-weight: bold;")
         self.statusBar().addPermanentWidget(self.status_monitor_only)
+        self.statusBar().addPermanentWidget(self.status_project)
         self.statusBar().addPermanentWidget(self.status_rtt)
         self.statusBar().addPermanentWidget(self.status_link)
 
         self._wire()
-        self.resize(*DEFAULT_SIZE)
-        self._restore_window()
+        self.setMinimumSize(*MIN_SIZE)
+        self.resize(*self._default_size())
+        self.splitter.setSizes([360, max(600, self.width() - 360)])
+        self._docks_sized = self._restore_window()  # else sized at the first show
         app = QApplication.instance()
         self._app_state_connected = isinstance(app, QApplication)
         if isinstance(app, QApplication):
             app.applicationStateChanged.connect(self._on_application_state)
         self.retranslate()
         self._on_connection(link.state, log=False)
+
+    @staticmethod
+    def _default_size() -> tuple[int, int]:
+        width, height = DEFAULT_SIZE
+        screen = QGuiApplication.primaryScreen()
+        if screen is not None:
+            available = screen.availableGeometry()
+            width, height = min(width, available.width()), min(height, available.height())
+        return max(width, MIN_SIZE[0]), max(height, MIN_SIZE[1])
 
     # --- construction -----------------------------------------------------------------
     def _dock(self, name: str, widget: QWidget, area: Qt.DockWidgetArea) -> QDockWidget:
@@ -148,6 +231,8 @@ class MainWindow(QMainWindow):
         self.pause_action = self._action(self.link.pause, Qt.Key.Key_F6, context=app_wide)
         self.resume_action = self._action(self.link.resume, Qt.Key.Key_F7, context=app_wide)
         self.about_action = self._action(self.show_about)
+        self.tab_actions = [self._action(functools.partial(self.show_tab, i), f"Ctrl+{i + 1}")
+                            for i in range(len(TAB_NAMES))]
         self.language_group = QActionGroup(self)
         self.language_group.setExclusive(True)
         self.language_actions: dict[str, QAction] = {}
@@ -164,16 +249,31 @@ class MainWindow(QMainWindow):
     def _make_menus(self) -> None:
         bar = self.menuBar()
         self.file_menu = bar.addMenu("")
+        for file_action in self.project.file_actions():
+            if file_action is None:
+                self.file_menu.addSeparator()
+            else:
+                self.file_menu.addAction(file_action)
+                self.addAction(file_action)  # shortcuts work from every panel
+        self.file_menu.addSeparator()
         self.file_menu.addAction(self.connect_action)
         self.file_menu.addAction(self.disconnect_action)
         self.file_menu.addSeparator()
         self.file_menu.addAction(self.quit_action)
+        self.edit_menu = bar.addMenu("")
+        self.edit_menu.addAction(self.project.action_undo)
+        self.edit_menu.addAction(self.project.action_redo)
+        self.addAction(self.project.action_undo)
+        self.addAction(self.project.action_redo)
         self.motion_menu = bar.addMenu("")
         self.motion_menu.addAction(self.stop_action)
         self.motion_menu.addAction(self.pause_action)
         self.motion_menu.addAction(self.resume_action)
         self.view_menu = bar.addMenu("")
-        for dock in (self.monitor_dock, self.status_dock, self.event_dock, self.traffic_dock):
+        for action in self.tab_actions:
+            self.view_menu.addAction(action)
+        self.view_menu.addSeparator()
+        for dock in (self.status_dock, self.event_dock, self.traffic_dock):
             self.view_menu.addAction(dock.toggleViewAction())
         self.language_menu = bar.addMenu("")
         for action in self.language_actions.values():
@@ -219,17 +319,35 @@ class MainWindow(QMainWindow):
         self.program_panel.programRequested.connect(self._on_program_requested)
         self.program_panel.goZeroRequested.connect(self._on_go_zero_requested)
 
+        project = self.project
+        project.titleChanged.connect(self._on_project_title)
+        project.pathChanged.connect(self._on_project_path)
+        project.statusMessage.connect(self._show_message)
+        self.points_panel.statusMessage.connect(self._show_message)
+        self.planner_panel.statusMessage.connect(self._show_message)
+        self.run_controller.runningChanged.connect(self.points_panel.set_run_active)
+        self.run_controller.runningChanged.connect(self._on_run_active)
+        restarted = getattr(link, "controllerRestarted", None)
+        if restarted is not None:
+            restarted.connect(self._on_restarted)
+
     # --- texts ------------------------------------------------------------------------
     def retranslate(self) -> None:
         self._update_title()
         self.tabs.setTabText(0, self.tr("Jog"))
         self.tabs.setTabText(1, self.tr("Step"))
         self.tabs.setTabText(2, self.tr("Program"))
-        self.monitor_dock.setWindowTitle(self.tr("Position"))
+        self.work_tabs.setTabText(TAB_MONITOR, self.tr("Monitor"))
+        self.work_tabs.setTabText(TAB_POINTS, self.tr("Points"))
+        self.work_tabs.setTabText(TAB_PLANNER, self.tr("Planner"))
+        for action, text in zip(self.tab_actions, (self.tr("Show &monitor"), self.tr("Show &points"),
+                                                   self.tr("Show p&lanner")), strict=True):
+            action.setText(text)
         self.status_dock.setWindowTitle(self.tr("Status"))
         self.event_dock.setWindowTitle(self.tr("Event log"))
         self.traffic_dock.setWindowTitle(self.tr("Modbus traffic"))
         self.file_menu.setTitle(self.tr("&File"))
+        self.edit_menu.setTitle(self.tr("&Edit"))
         self.motion_menu.setTitle(self.tr("&Motion"))
         self.view_menu.setTitle(self.tr("&View"))
         self.language_menu.setTitle(self.tr("&Language"))
@@ -249,25 +367,28 @@ class MainWindow(QMainWindow):
         self.about_action.setText(self.tr("&About TeachPad"))
         self.status_monitor_only.setText(self.tr("MONITOR ONLY") if self.link.monitor_only else "")
         self._operation_names = {
-            "stop": self.tr("stop"),
-            "pause": self.tr("pause"),
-            "resume": self.tr("resume"),
-            "jog": self.tr("jog"),
-            "jog release": self.tr("jog release"),
-            "jog speed": self.tr("jog speed"),
-            "step": self.tr("incremental move"),
-            "set mode": self.tr("work mode"),
-            "go to zero": self.tr("go to zero"),
-            "run program": self.tr("run program"),
-            "create point": self.tr("create temp point"),
-            "move to point": self.tr("move to temp point"),
-            "upload points": self.tr("upload temp points"),
-            "teach disable": self.tr("teach disable"),
-            "poll": self.tr("monitor"),
-            "connect": self.tr("connect"),
-            "disconnect": self.tr("disconnect"),
-            "shutdown": self.tr("shutdown"),
+            Operation.STOP: self.tr("stop"),
+            Operation.PAUSE: self.tr("pause"),
+            Operation.RESUME: self.tr("resume"),
+            Operation.JOG: self.tr("jog"),
+            Operation.JOG_RELEASE: self.tr("jog release"),
+            Operation.JOG_SPEED: self.tr("jog speed"),
+            Operation.STEP: self.tr("incremental move"),
+            Operation.SET_MODE: self.tr("work mode"),
+            Operation.GO_ZERO: self.tr("go to zero"),
+            Operation.RUN_PROGRAM: self.tr("run program"),
+            Operation.CREATE_POINT: self.tr("create temp point"),
+            Operation.MOVE_TO_POINT: self.tr("move to temp point"),
+            Operation.UPLOAD_POINTS: self.tr("upload temp points"),
+            Operation.TEACH_DISABLE: self.tr("teach disable"),
+            Operation.POLL: self.tr("monitor"),
+            Operation.CONNECT: self.tr("connect"),
+            Operation.DISCONNECT: self.tr("disconnect"),
+            Operation.SHUTDOWN: self.tr("shutdown"),
+            Operation.CANARY: self.tr("restart check"),
         }
+        self.project.retranslate()
+        self._on_project_title(self.project.title)
         self._show_connection()
         self._update_motion_enabled()
 
@@ -286,8 +407,10 @@ class MainWindow(QMainWindow):
 
     def _update_title(self) -> None:
         endpoint = self._connection.endpoint
-        title = self.tr("TeachPad")
-        self.setWindowTitle(f"{title} — {endpoint}" if endpoint else title)
+        parts = [self.tr("TeachPad"), self.project.title]
+        if endpoint:
+            parts.append(endpoint)
+        self.setWindowTitle(" — ".join(parts))
 
     def operation_text(self, operation: str) -> str:
         return self._operation_names.get(operation, operation)
@@ -321,9 +444,10 @@ class MainWindow(QMainWindow):
 
     def _update_motion_enabled(self) -> None:
         enabled = self.motion_enabled
-        self.jog_panel.set_motion_enabled(enabled)
-        self.step_panel.set_motion_enabled(enabled)
-        self.program_panel.set_motion_enabled(enabled)
+        # While a plan runs the jog / step / program controls wait; Stop, Pause, Resume stay.
+        self.jog_panel.set_motion_enabled(enabled and not self._run_active)
+        self.step_panel.set_motion_enabled(enabled and not self._run_active)
+        self.program_panel.set_motion_enabled(enabled and not self._run_active)
         self.control_bar.set_motion_enabled(enabled)
         self.pause_action.setEnabled(enabled)
         self.resume_action.setEnabled(enabled)
@@ -351,6 +475,34 @@ class MainWindow(QMainWindow):
     def _on_error(self, error: WorkerError) -> None:
         self.event_log.add_event("error", self.operation_text(error.operation), error.message)
         self.statusBar().showMessage(f"{self.operation_text(error.operation)}: {error.message}", 8000)
+
+    @Slot(str)
+    def _show_message(self, text: str) -> None:
+        self.statusBar().showMessage(text, 8000)
+
+    @Slot(str)
+    def _on_project_title(self, title: str) -> None:
+        self.status_project.setText(self.tr("Project: {name}").format(name=title))
+        self.status_project.setToolTip(str(self.project.path or ""))
+        self._update_title()
+
+    @Slot(str)
+    def _on_project_path(self, path: str) -> None:
+        if path:
+            self.settings.last_project = path
+
+    @Slot(bool)
+    def _on_run_active(self, active: bool) -> None:
+        self._run_active = active
+        if active:
+            self.jog_panel.release_all()
+        self._update_motion_enabled()
+
+    @Slot()
+    def _on_restarted(self) -> None:
+        text = self.tr("The controller restarted (its temp points are gone): "
+                       "restore them from the Points tab")
+        self.event_log.add_event("warning", self.tr("link"), text)
 
     @Slot()
     def _on_reconnected(self) -> None:
@@ -397,6 +549,29 @@ class MainWindow(QMainWindow):
     def confirm(self, fn: ConfirmFn) -> None:
         self.program_panel.confirm = fn
         self.step_panel.confirm = fn
+        self.points_panel.set_confirm(fn)
+        self.planner_panel.set_confirm(fn)
+
+    # --- project -----------------------------------------------------------------------
+    def show_tab(self, index: int | str) -> None:
+        """Bring a work tab to the front: 0..2 or "monitor" / "points" / "planner"."""
+        if isinstance(index, str):
+            index = TAB_NAMES.index(index)
+        self.work_tabs.setCurrentIndex(index)
+
+    def start_project(self, path: str | os.PathLike[str] | None = None, *, reopen_last: bool = True,
+                      offer_recovery: bool = True) -> bool:
+        """At startup: open ``path`` (else the last project, if it still exists), then offer to
+        recover an autosave a crash left behind. True when a project was opened or recovered."""
+        opened = False
+        if path is None and reopen_last:
+            last = self.settings.last_project
+            if last and Path(last).is_file():
+                path = last
+        if path is not None:
+            opened = self.project.open_file(path)
+        recovered = offer_recovery and self.project.offer_recovery()
+        return opened or recovered
 
     # --- actions ----------------------------------------------------------------------
     @Slot()
@@ -438,12 +613,29 @@ class MainWindow(QMainWindow):
         if state != Qt.ApplicationState.ApplicationActive:
             self.jog_panel.release_all()
 
+    def showEvent(self, event: QShowEvent) -> None:
+        super().showEvent(event)
+        if not self._docks_sized:  # first start: a narrow status dock, a short log
+            self._docks_sized = True
+            QTimer.singleShot(0, self, self._size_docks)  # once the layout has its real size
+
+    @Slot()
+    def _size_docks(self) -> None:
+        self.resizeDocks([self.status_dock], [STATUS_DOCK_WIDTH], Qt.Orientation.Horizontal)
+        self.resizeDocks([self.event_dock], [150], Qt.Orientation.Vertical)
+
     def hideEvent(self, event: QHideEvent) -> None:
         self.jog_panel.release_all()
         super().hideEvent(event)
 
     def closeEvent(self, event: QCloseEvent) -> None:
-        self.jog_panel.release_all()
+        self.jog_panel.release_all()  # first, before any question
+        if not self._close_accepted:
+            if not self.project.maybe_save():
+                event.ignore()  # the operator cancelled: the window and the link stay
+                return
+            self._close_accepted = True
+        self.project.close()
         self.settings.save_window(self.saveGeometry(), self.saveState())
         self.settings.sync()
         if self._app_state_connected:
@@ -455,11 +647,11 @@ class MainWindow(QMainWindow):
             self.link.shutdown()
         super().closeEvent(event)
 
-    def _restore_window(self) -> None:
+    def _restore_window(self) -> bool:
+        """The remembered geometry and dock layout; False when there was none."""
         geometry = self.settings.window_geometry()
         if geometry is not None:
             self.restoreGeometry(geometry)
         state = self.settings.window_state()
-        if state is not None:
-            self.restoreState(state)
+        return state is not None and self.restoreState(state)
 

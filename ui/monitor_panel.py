@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 import pyqtgraph as pg
-from PySide6.QtCore import QEvent, QSignalBlocker, Qt, QTimer, Slot
+from PySide6.QtCore import QEvent, QSignalBlocker, QSize, Qt, QTimer, Slot
 from PySide6.QtGui import QCloseEvent, QHideEvent, QResizeEvent, QShowEvent
 from PySide6.QtWidgets import (
     QComboBox,
@@ -56,10 +56,33 @@ _PLOT_COLORS = {
     "C": "#1f77b4",
 }
 _TRACE_COLOR = "#6a1b9a"
-_BIG_POINTS = 22.0  # readout sizes at ~1280 px width; they grow with the panel (see resizeEvent)
+_BIG_POINTS = 22.0  # readout sizes at REFERENCE_WIDTH; they follow the panel's width (see resizeEvent)
 _SMALL_POINTS = 13.0
 _BIG_POINTS_MAX = 34.0
 _SMALL_POINTS_MAX = 18.0
+REFERENCE_WIDTH = 760  # px of panel width at which the readouts use _BIG_POINTS / _SMALL_POINTS
+MIN_SCALE = 0.55  # readouts shrink down to this on a narrow panel (then the panel's minimum width)
+MIN_WIDTH = 420  # px: the panel's minimum width (the readouts' fonts shrink to fit)
+
+
+def unwrap_degrees(previous_raw: float, previous_unwrapped: float, raw: float) -> float:
+    """Continue an unwrapped angle: the step from ``previous_raw`` to ``raw`` taken the short way
+    round (so -179 -> +179 is a 2 degree step, not 358), added to ``previous_unwrapped``."""
+    step = (raw - previous_raw + 180.0) % 360.0 - 180.0
+    return previous_unwrapped + step
+
+
+def _add_legend(plot: pg.PlotWidget) -> None:
+    """A compact one-row legend in the top-right corner, translucent so the curves show through."""
+    plot.addLegend(
+        offset=(-4, 2),  # negative x: anchored to the right edge
+        colCount=3,
+        labelTextColor="#263238",
+        brush=pg.mkBrush(255, 255, 255, 150),
+        pen=pg.mkPen(176, 190, 197, 160),
+        verSpacing=-6,
+        horSpacing=8,
+    )
 
 
 def _style_plot(plot: pg.PlotWidget) -> None:
@@ -73,6 +96,7 @@ def _style_plot(plot: pg.PlotWidget) -> None:
         axis.setTextPen(pg.mkPen("#263238"))
     plot.setMenuEnabled(False)
     plot.setMinimumHeight(90)
+    plot.setMinimumWidth(120)
 
 
 class MonitorPanel(QWidget):
@@ -97,6 +121,10 @@ class MonitorPanel(QWidget):
         self._painted_trace = -1
         self._window_s = float(DEFAULT_WINDOW_S)
         self._paused = False
+        # A B C are plotted unwrapped (a turn through +-180 draws on continuously); the readouts
+        # show the controller's values. Last raw value and its unwrapped counterpart per angle.
+        self._angle_raw: list[float] | None = None
+        self._angle_unwrapped = [0.0, 0.0, 0.0]
 
         self._timer = QTimer(self)
         self._timer.setInterval(PAINT_INTERVAL_MS)
@@ -178,13 +206,7 @@ class MonitorPanel(QWidget):
         for name in _CARTESIAN:
             plot = self.xyz_plot if name in "XYZ" else self.abc_plot
             if name in ("X", "A"):
-                plot.addLegend(
-                    offset=(6, 6),
-                    colCount=3,
-                    labelTextColor="#263238",
-                    brush=pg.mkBrush(255, 255, 255, 210),
-                    pen=pg.mkPen("#b0bec5"),
-                )
+                _add_legend(plot)
             curve = pg.PlotCurveItem(pen=pg.mkPen(_PLOT_COLORS[name], width=2), name=name)
             plot.addItem(curve)
             self.curves[name] = curve
@@ -264,7 +286,14 @@ class MonitorPanel(QWidget):
         if self._t0 is None:
             self._t0 = t
         rel = t - self._t0
-        self._history.append((rel, pose.x, pose.y, pose.z, pose.a, pose.b, pose.c))
+        raw = [pose.a, pose.b, pose.c]
+        if self._angle_raw is None:
+            unwrapped = list(raw)
+        else:
+            unwrapped = [unwrap_degrees(p, u, r)
+                         for p, u, r in zip(self._angle_raw, self._angle_unwrapped, raw, strict=True)]
+        self._angle_raw, self._angle_unwrapped = raw, unwrapped
+        self._history.append((rel, pose.x, pose.y, pose.z, *unwrapped))
         trace = self._trace
         if (
             not len(trace)
@@ -282,6 +311,7 @@ class MonitorPanel(QWidget):
         """Forget every sample (e.g. after connecting to another controller)."""
         self._history.clear()
         self._trace.clear()
+        self._angle_raw = None
         self._t0 = None
         self._latest = None
         self._readouts_dirty = True
@@ -411,12 +441,25 @@ class MonitorPanel(QWidget):
         if seconds:
             self.set_window(float(seconds))
 
+    def minimumSizeHint(self) -> QSize:
+        # The readouts' fonts follow the width (resizeEvent), so the fonts in use now do not
+        # set the minimum: a narrow window gets smaller numbers, never a clipped panel.
+        hint = super().minimumSizeHint()
+        return QSize(min(hint.width(), MIN_WIDTH), hint.height())
+
+    def readout_scale(self, width: int) -> float:
+        """Readout size factor for a panel ``width`` px wide (1.0 at REFERENCE_WIDTH)."""
+        return min(max((width - 40) / (REFERENCE_WIDTH - 40), MIN_SCALE), _BIG_POINTS_MAX / _BIG_POINTS)
+
     def resizeEvent(self, event: QResizeEvent) -> None:
-        # Bigger numbers on bigger screens: readable from a distance at 1920 px as at 1280 px.
-        scale = min(max(event.size().width() / 1280.0, 1.0), _BIG_POINTS_MAX / _BIG_POINTS)
-        big, small = round(_BIG_POINTS * scale), round(min(_SMALL_POINTS * scale, _SMALL_POINTS_MAX))
+        # Numbers as big as the panel allows: readable from a distance at 1920 px, still whole at 1280 px.
+        scale = self.readout_scale(event.size().width())
+        big = round(_BIG_POINTS * scale, 1)
+        # six small readouts share a row: about 13 character cells each at ~0.85 pt per px
+        fit = (event.size().width() - 60) / 6 / (13 * 0.85)
+        small = round(min(_SMALL_POINTS * scale, _SMALL_POINTS_MAX, fit), 1)
         for name, readout in self.readouts.items():
-            readout.set_point_size(big if name in _CARTESIAN else small)
+            readout.set_point_size(big if name in _CARTESIAN else max(small, 8.0))
         super().resizeEvent(event)
 
     # --- timer follows visibility -------------------------------------------------------

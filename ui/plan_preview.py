@@ -19,7 +19,8 @@ import numpy as np
 import pyqtgraph as pg
 from numpy.typing import NDArray
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
-from PySide6.QtWidgets import QHBoxLayout, QLabel, QVBoxLayout, QWidget
+from PySide6.QtGui import QResizeEvent
+from PySide6.QtWidgets import QBoxLayout, QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from app.models import Pose
 from app.plan import PlanPath
@@ -27,7 +28,9 @@ from app.plan import PlanPath
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
 LIVE_FPS = 30
 TRAIL_LENGTH = 600  # live TCP positions kept for the trail
-INFO_WIDTH = 210  # px, the lengths / times column
+INFO_WIDTH = 210  # px, the lengths / times column (at most)
+INFO_MIN_WIDTH = 140  # px, on a narrow window
+INFO_BELOW_WIDTH = 620  # px: a narrower preview shows the lengths / times below the plots
 PATH_COLOUR = "#1565c0"
 SELECTED_COLOUR = "#ff6f00"
 POINT_COLOUR = "#455a64"
@@ -54,7 +57,7 @@ def _style_plot(plot: pg.PlotWidget) -> None:
     plot.setMenuEnabled(False)
     plot.setAspectLocked(True)
     plot.getViewBox().setDefaultPadding(0.12)  # room for the point labels at the edges
-    plot.setMinimumSize(150, 150)
+    plot.setMinimumSize(90, 110)
 
 
 class _Projection:
@@ -134,13 +137,24 @@ class PlanPreview(QWidget):
         self.info.setWordWrap(True)
         self.info.setStyleSheet("color: #37474f;")
         self.info.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
-        self.info.setFixedWidth(INFO_WIDTH)
+        self.info.setMinimumWidth(INFO_MIN_WIDTH)
+        self.info.setMaximumWidth(INFO_WIDTH)
         self.info.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
-        row.addWidget(self.info)
-        layout = QVBoxLayout(self)
+        # The lengths / times sit right of the plots, or below them on a narrow panel.
+        layout = QBoxLayout(QBoxLayout.Direction.LeftToRight, self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.addLayout(row)
+        layout.addLayout(row, 1)
+        layout.addWidget(self.info)
+        self._layout = layout
         self.retranslate()
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        below = event.size().width() < INFO_BELOW_WIDTH
+        direction = QBoxLayout.Direction.TopToBottom if below else QBoxLayout.Direction.LeftToRight
+        if self._layout.direction() != direction:
+            self._layout.setDirection(direction)
+            self.info.setMaximumWidth(16777215 if below else INFO_WIDTH)
+        super().resizeEvent(event)
 
     def retranslate(self) -> None:
         names = {

@@ -479,6 +479,10 @@ class PlannerPanel(QWidget):
             selection.setCurrentIndex(self.segments.index(rows[0], 0), selection.SelectionFlag.NoUpdate)
             self.segment_view.scrollTo(self.segments.index(rows[0], 0))
 
+    def set_confirm(self, confirm: ConfirmCallable) -> None:
+        """Replace the operator's yes/no question (tests answer without a dialog)."""
+        self._confirm = confirm
+
     @Slot(str, str)
     def show_message(self, text: str, level: str = "info") -> None:
         colour = {"error": COLOR_ERROR, "warn": "#8a5300", "info": COLOR_OK}.get(level, "")

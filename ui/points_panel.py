@@ -781,6 +781,10 @@ class PointsPanel(QWidget):
             selection.setCurrentIndex(first, selection.SelectionFlag.NoUpdate)
             self.table.scrollTo(first)
 
+    def set_confirm(self, confirm: ConfirmCallable) -> None:
+        """Replace the operator's yes/no question (tests answer without a dialog)."""
+        self._confirm = confirm
+
     @Slot(bool)
     def set_run_active(self, active: bool) -> None:
         """A plan is running: no teach / upload / move from here."""

@@ -1,4 +1,4 @@
-"""Remembered settings: language, connection, poll rate, window geometry (a QSettings wrapper).
+"""Remembered settings: language, connection, poll rate, last project, window geometry (a QSettings wrapper).
 
 ``AppSettings()`` uses the user's settings store (organisation ``Bochuang``, application
 ``TeachPad``); tests and portable installs pass an explicit INI file
@@ -112,6 +112,16 @@ class AppSettings:
             value = getattr(settings, key)
             self._store.setValue(f"connection/{key}", "" if value is None else value)
         self._store.setValue("connection/word_order", settings.word_order.name)
+
+    # --- project ----------------------------------------------------------------------
+    @property
+    def last_project(self) -> str:
+        """The project file opened or saved last ("" when none)."""
+        return str(self._store.value("project/last", "") or "")
+
+    @last_project.setter
+    def last_project(self, path: str) -> None:
+        self._store.setValue("project/last", str(path))
 
     # --- window -----------------------------------------------------------------------
     def window_geometry(self) -> QByteArray | None:

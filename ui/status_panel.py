@@ -11,7 +11,8 @@ import datetime as dt
 import math
 from typing import Any
 
-from PySide6.QtCore import QCoreApplication, QEvent, Qt, Slot
+from PySide6.QtCore import QCoreApplication, QEvent, QSize, Qt, Slot
+from PySide6.QtGui import QResizeEvent
 from PySide6.QtWidgets import (
     QFormLayout,
     QGridLayout,
@@ -83,6 +84,9 @@ def _enum_text(enum_type: Any, texts: dict[Any, str], value: int) -> tuple[Any, 
     return member, _protocol_tr(texts[member])
 
 
+PREFERRED_WIDTH = 240  # px
+
+
 class StatusPanel(QWidget):
     """Shows ControllerStatus, link state, RTT, the last CommandResult and the controller clock.
 
@@ -144,15 +148,17 @@ class StatusPanel(QWidget):
         self._alarm_box = QGroupBox(self)
         alarm_grid = QGridLayout(self._alarm_box)
         alarm_grid.setSpacing(6)
+        self._alarm_grid = alarm_grid
+        self._alarm_columns = 0
         self.alarm_lamps: dict[int, AlarmLamp] = {}
-        for i, bit in enumerate(ALARM_BITS):
+        for bit in ALARM_BITS:
             lamp = AlarmLamp("", self._alarm_box, point_size=_LAMP_POINTS)
             self.alarm_lamps[int(bit)] = lamp
-            alarm_grid.addWidget(lamp, i // 2, i % 2)
         self.other_alarm_lamp = AlarmLamp("", self._alarm_box, point_size=_LAMP_POINTS)
-        alarm_grid.addWidget(self.other_alarm_lamp, len(ALARM_BITS) // 2, len(ALARM_BITS) % 2)
-        alarm_grid.setColumnStretch(0, 1)
-        alarm_grid.setColumnStretch(1, 1)
+        for lamp in self._all_alarm_lamps():
+            # The grid reflows (two columns, or one on a narrow dock): the lamps set no minimum width.
+            lamp.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
+        self._layout_alarms(2)
 
         for label in (self.rtt_label, self.clock_label, self.drift_label, self.command_label):
             label.setMinimumHeight(28)
@@ -165,6 +171,37 @@ class StatusPanel(QWidget):
         layout.addWidget(self._alarm_box)
         layout.addStretch(1)
         self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Preferred)
+
+    def sizeHint(self) -> QSize:
+        # Narrow by default: the work tabs need the room; the dock can be widened by hand.
+        hint = super().sizeHint()
+        return QSize(min(hint.width(), PREFERRED_WIDTH), hint.height())
+
+    def _all_alarm_lamps(self) -> list[AlarmLamp]:
+        return [*self.alarm_lamps.values(), self.other_alarm_lamp]
+
+    def _layout_alarms(self, columns: int) -> None:
+        if columns == self._alarm_columns:
+            return
+        self._alarm_columns = columns
+        grid = self._alarm_grid
+        lamps = self._all_alarm_lamps()
+        for lamp in lamps:
+            grid.removeWidget(lamp)
+        for i, lamp in enumerate(lamps):
+            grid.addWidget(lamp, i // columns, i % columns)
+        for column in range(2):
+            grid.setColumnStretch(column, 1 if column < columns else 0)
+
+    @property
+    def alarm_columns(self) -> int:
+        return self._alarm_columns
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        widest = max(lamp.sizeHint().width() for lamp in self._all_alarm_lamps())
+        margins = self._alarm_box.contentsMargins().left() + self._alarm_box.contentsMargins().right() + 24
+        self._layout_alarms(2 if event.size().width() >= 2 * widest + margins else 1)
+        super().resizeEvent(event)
 
     def _row_label(self, key: str) -> QLabel:
         # As tall as a lamp and centred, so the caption lines up with the lamp's text.

@@ -84,6 +84,7 @@ _FC_WRITE_SINGLE = 6
 _STATUS_COMMANDS = frozenset({RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT,
                               RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE})
 _START_TIMEOUT = 5.0
+_GENERAL_REGISTERS = 200  # GV0..GV99 (registers 0..199): cleared by a controller restart
 _STOP_TIMEOUT = 2.0
 
 
@@ -184,6 +185,7 @@ class SimController:
         self._hold_old_value = 0
         self._hold_zero_until = 0.0
         self._zero_unread = False  # the 0 phase has not been seen by a host read yet
+        self._wipe_general = False  # set by restart_controller(): clear GV0..GV99 on the next request
 
     # --- lifecycle ------------------------------------------------------------------------
     @property
@@ -345,6 +347,10 @@ class SimController:
             return exc
         offset = address - start_address
         with self.lock:
+            if self._wipe_general:  # a restarted controller starts with cleared general-purpose GVs
+                self._wipe_general = False
+                first, last = max(0, -start_address), max(0, _GENERAL_REGISTERS - start_address)
+                registers[first:last] = [0] * (last - first)
             if set_values is not None:
                 values = [int(v) & 0xFFFF for v in set_values]
                 self.writes.append(WriteRecord(time.monotonic(), function_code, address, tuple(values)))
@@ -562,7 +568,8 @@ class SimController:
             self.robot.restart()
             self._hold_old_until = self._hold_zero_until = 0.0
             self._zero_unread = False
-        log.info("controller restarted: temp points wiped")
+            self._wipe_general = True  # GV0..GV99 read 0 from the next request on
+        log.info("controller restarted: temp points and GV0-GV99 wiped")
 
     def add_point(self, point_id: int, pose: Pose6, tool: int = 200) -> None:
         """Store a temp point directly (test setup)."""

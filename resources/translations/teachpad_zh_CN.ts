@@ -2,14 +2,6 @@
 <!DOCTYPE TS>
 <TS version="2.1" language="zh_CN">
     <context>
-        <name />
-        <message>
-            <source>none</source>
-            <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
-            <translation type="obsolete">无</translation>
-        </message>
-    </context>
-    <context>
         <name>ConnectionDialog</name>
         <message>
             <location filename="../../ui/connection_dialog.py" line="115" />
@@ -385,274 +377,320 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="225" />
+            <location filename="../../ui/main_window.py" line="337" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="226" />
+            <location filename="../../ui/main_window.py" line="338" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="227" />
+            <location filename="../../ui/main_window.py" line="339" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="228" />
-            <source>Position</source>
-            <translation>位置</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="229" />
+            <location filename="../../ui/main_window.py" line="346" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="230" />
+            <location filename="../../ui/main_window.py" line="347" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="231" />
+            <location filename="../../ui/main_window.py" line="348" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="232" />
+            <location filename="../../ui/main_window.py" line="349" />
             <source>&amp;File</source>
             <translation>文件(&amp;F)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="233" />
+            <location filename="../../ui/main_window.py" line="350" />
+            <source>&amp;Edit</source>
+            <translation>编辑(&amp;E)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="351" />
             <source>&amp;Motion</source>
             <translation>运动(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="234" />
+            <location filename="../../ui/main_window.py" line="352" />
             <source>&amp;View</source>
             <translation>视图(&amp;V)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="235" />
+            <location filename="../../ui/main_window.py" line="353" />
             <source>&amp;Language</source>
             <translation>语言(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="236" />
+            <location filename="../../ui/main_window.py" line="354" />
             <source>&amp;Help</source>
             <translation>帮助(&amp;H)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="237" />
-            <location filename="../../ui/main_window.py" line="238" />
+            <location filename="../../ui/main_window.py" line="355" />
+            <location filename="../../ui/main_window.py" line="356" />
             <source>Toolbar</source>
             <translation>工具栏</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="239" />
+            <location filename="../../ui/main_window.py" line="357" />
             <source>&amp;Connect…</source>
             <translation>连接(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="240" />
+            <location filename="../../ui/main_window.py" line="358" />
             <source>Connect to a controller (Ctrl+K)</source>
             <translation>连接控制器（Ctrl+K）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="241" />
+            <location filename="../../ui/main_window.py" line="359" />
             <source>&amp;Disconnect</source>
             <translation>断开(&amp;D)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="242" />
+            <location filename="../../ui/main_window.py" line="360" />
             <source>&amp;Quit</source>
             <translation>退出(&amp;Q)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="243" />
+            <location filename="../../ui/main_window.py" line="361" />
             <source>&amp;Stop</source>
             <translation>停止(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="244" />
+            <location filename="../../ui/main_window.py" line="362" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="245" />
+            <location filename="../../ui/main_window.py" line="363" />
             <source>&amp;Pause</source>
             <translation>暂停(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="246" />
+            <location filename="../../ui/main_window.py" line="364" />
             <source>Pause the current move or program (F6)</source>
             <translation>暂停当前运动或程序（F6）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="247" />
+            <location filename="../../ui/main_window.py" line="365" />
             <source>&amp;Resume</source>
             <translation>继续(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="248" />
+            <location filename="../../ui/main_window.py" line="366" />
             <source>Resume the paused move or program (F7)</source>
             <translation>继续已暂停的运动或程序（F7）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="249" />
+            <location filename="../../ui/main_window.py" line="367" />
             <source>&amp;About TeachPad</source>
             <translation>关于 TeachPad(&amp;A)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="250" />
-            <location filename="../../ui/main_window.py" line="315" />
+            <location filename="../../ui/main_window.py" line="368" />
+            <location filename="../../ui/main_window.py" line="438" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="252" />
+            <location filename="../../ui/main_window.py" line="370" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="253" />
+            <location filename="../../ui/main_window.py" line="371" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="254" />
+            <location filename="../../ui/main_window.py" line="372" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="255" />
+            <location filename="../../ui/main_window.py" line="373" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="256" />
+            <location filename="../../ui/main_window.py" line="374" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="257" />
+            <location filename="../../ui/main_window.py" line="375" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="258" />
+            <location filename="../../ui/main_window.py" line="376" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="259" />
+            <location filename="../../ui/main_window.py" line="377" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="260" />
+            <location filename="../../ui/main_window.py" line="378" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="261" />
+            <location filename="../../ui/main_window.py" line="379" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="262" />
+            <location filename="../../ui/main_window.py" line="380" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="263" />
+            <location filename="../../ui/main_window.py" line="381" />
             <source>move to temp point</source>
             <translation>运动到临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="264" />
+            <location filename="../../ui/main_window.py" line="382" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="265" />
+            <location filename="../../ui/main_window.py" line="383" />
             <source>teach disable</source>
             <translation>关闭示教</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="266" />
+            <location filename="../../ui/main_window.py" line="384" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="267" />
+            <location filename="../../ui/main_window.py" line="385" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="268" />
+            <location filename="../../ui/main_window.py" line="386" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="269" />
+            <location filename="../../ui/main_window.py" line="387" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="289" />
+            <location filename="../../ui/main_window.py" line="388" />
+            <source>restart check</source>
+            <translation>重启检测</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="410" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="312" />
+            <location filename="../../ui/main_window.py" line="435" />
             <source>link down</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="331" />
+            <location filename="../../ui/main_window.py" line="455" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="333" />
+            <location filename="../../ui/main_window.py" line="457" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="343" />
+            <location filename="../../ui/main_window.py" line="467" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="357" />
+            <location filename="../../ui/main_window.py" line="485" />
+            <source>Project: {name}</source>
+            <translation>工程：{name}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="503" />
+            <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
+            <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="509" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="358" />
+            <location filename="../../ui/main_window.py" line="505" />
+            <location filename="../../ui/main_window.py" line="510" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="416" />
+            <location filename="../../ui/main_window.py" line="340" />
+            <source>Monitor</source>
+            <translation>监视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="341" />
+            <source>Points</source>
+            <translation>点位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="342" />
+            <source>Planner</source>
+            <translation>轨迹规划</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="343" />
+            <source>Show &amp;monitor</source>
+            <translation>显示监视(&amp;M)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="343" />
+            <source>Show &amp;points</source>
+            <translation>显示点位(&amp;P)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="344" />
+            <source>Show p&amp;lanner</source>
+            <translation>显示轨迹规划(&amp;L)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="591" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="417" />
+            <location filename="../../ui/main_window.py" line="592" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="425" />
+            <location filename="../../ui/main_window.py" line="600" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="426" />
+            <location filename="../../ui/main_window.py" line="601" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -660,92 +698,92 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="225" />
+            <location filename="../../ui/monitor_panel.py" line="247" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="225" />
+            <location filename="../../ui/monitor_panel.py" line="247" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="226" />
+            <location filename="../../ui/monitor_panel.py" line="248" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="227" />
+            <location filename="../../ui/monitor_panel.py" line="249" />
             <source>Joints and external axes</source>
             <translation>关节与附加轴</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="234" />
+            <location filename="../../ui/monitor_panel.py" line="256" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="235" />
+            <location filename="../../ui/monitor_panel.py" line="257" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="236" />
+            <location filename="../../ui/monitor_panel.py" line="258" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="237" />
+            <location filename="../../ui/monitor_panel.py" line="259" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="238" />
+            <location filename="../../ui/monitor_panel.py" line="260" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="239" />
+            <location filename="../../ui/monitor_panel.py" line="261" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="240" />
+            <location filename="../../ui/monitor_panel.py" line="262" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="241" />
+            <location filename="../../ui/monitor_panel.py" line="263" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="242" />
+            <location filename="../../ui/monitor_panel.py" line="264" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="243" />
+            <location filename="../../ui/monitor_panel.py" line="265" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="243" />
+            <location filename="../../ui/monitor_panel.py" line="265" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="244" />
+            <location filename="../../ui/monitor_panel.py" line="266" />
             <source>TCP path, top view (X–Y)</source>
             <translation>TCP 轨迹俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="403" />
+            <location filename="../../ui/monitor_panel.py" line="433" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="405" />
+            <location filename="../../ui/monitor_panel.py" line="435" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -895,18 +933,18 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/plan_preview.py" line="147" />
+            <location filename="../../ui/plan_preview.py" line="161" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_preview.py" line="148" />
+            <location filename="../../ui/plan_preview.py" line="162" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_preview.py" line="149" />
+            <location filename="../../ui/plan_preview.py" line="163" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
@@ -1074,7 +1112,7 @@
         </message>
         <message>
             <location filename="../../ui/planner_panel.py" line="422" />
-            <location filename="../../ui/planner_panel.py" line="858" />
+            <location filename="../../ui/planner_panel.py" line="862" />
             <source>Resume from segment</source>
             <translation>从该段继续</translation>
         </message>
@@ -1099,193 +1137,193 @@
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="518" />
+            <location filename="../../ui/planner_panel.py" line="522" />
             <source>Deleted plan {name} (Ctrl+Z to undo)</source>
             <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="605" />
+            <location filename="../../ui/planner_panel.py" line="609" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="607" />
+            <location filename="../../ui/planner_panel.py" line="611" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="609" />
+            <location filename="../../ui/planner_panel.py" line="613" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="613" />
+            <location filename="../../ui/planner_panel.py" line="617" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="618" />
+            <location filename="../../ui/planner_panel.py" line="622" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="642" />
-            <location filename="../../ui/planner_panel.py" line="819" />
+            <location filename="../../ui/planner_panel.py" line="646" />
+            <location filename="../../ui/planner_panel.py" line="823" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="644" />
+            <location filename="../../ui/planner_panel.py" line="648" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="646" />
+            <location filename="../../ui/planner_panel.py" line="650" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="648" />
+            <location filename="../../ui/planner_panel.py" line="652" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="652" />
+            <location filename="../../ui/planner_panel.py" line="656" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="658" />
+            <location filename="../../ui/planner_panel.py" line="662" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="660" />
+            <location filename="../../ui/planner_panel.py" line="664" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="661" />
+            <location filename="../../ui/planner_panel.py" line="665" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="668" />
+            <location filename="../../ui/planner_panel.py" line="672" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="671" />
+            <location filename="../../ui/planner_panel.py" line="675" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="682" />
+            <location filename="../../ui/planner_panel.py" line="686" />
             <source>Not connected to a controller</source>
             <translation>未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="695" />
+            <location filename="../../ui/planner_panel.py" line="699" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="701" />
+            <location filename="../../ui/planner_panel.py" line="705" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="703" />
+            <location filename="../../ui/planner_panel.py" line="707" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="704" />
+            <location filename="../../ui/planner_panel.py" line="708" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="705" />
+            <location filename="../../ui/planner_panel.py" line="709" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="717" />
+            <location filename="../../ui/planner_panel.py" line="721" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="719" />
+            <location filename="../../ui/planner_panel.py" line="723" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="721" />
+            <location filename="../../ui/planner_panel.py" line="725" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="723" />
+            <location filename="../../ui/planner_panel.py" line="727" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="724" />
+            <location filename="../../ui/planner_panel.py" line="728" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="726" />
+            <location filename="../../ui/planner_panel.py" line="730" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="727" />
+            <location filename="../../ui/planner_panel.py" line="731" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="796" />
+            <location filename="../../ui/planner_panel.py" line="800" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="820" />
+            <location filename="../../ui/planner_panel.py" line="824" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="838" />
+            <location filename="../../ui/planner_panel.py" line="842" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="839" />
+            <location filename="../../ui/planner_panel.py" line="843" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="849" />
+            <location filename="../../ui/planner_panel.py" line="853" />
             <source>Failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="849" />
+            <location filename="../../ui/planner_panel.py" line="853" />
             <source>Stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="857" />
+            <location filename="../../ui/planner_panel.py" line="861" />
             <source>Resume from segment {k}</source>
             <translation>从第 {k} 段继续</translation>
         </message>
@@ -1723,7 +1761,7 @@
         </message>
         <message>
             <location filename="../../ui/points_panel.py" line="733" />
-            <location filename="../../ui/points_panel.py" line="869" />
+            <location filename="../../ui/points_panel.py" line="873" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
@@ -1778,22 +1816,22 @@
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="832" />
+            <location filename="../../ui/points_panel.py" line="836" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="835" />
+            <location filename="../../ui/points_panel.py" line="839" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="858" />
+            <location filename="../../ui/points_panel.py" line="862" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="862" />
+            <location filename="../../ui/points_panel.py" line="866" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -1806,7 +1844,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="905" />
+            <location filename="../../ui/points_panel.py" line="909" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -2505,122 +2543,122 @@ Recover it?</source>
     <context>
         <name>StatusPanel</name>
         <message>
-            <location filename="../../ui/status_panel.py" line="179" />
+            <location filename="../../ui/status_panel.py" line="216" />
             <source>Link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="180" />
+            <location filename="../../ui/status_panel.py" line="217" />
             <source>Controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="181" />
+            <location filename="../../ui/status_panel.py" line="218" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="183" />
+            <location filename="../../ui/status_panel.py" line="220" />
             <source>State:</source>
             <translation>状态：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="184" />
+            <location filename="../../ui/status_panel.py" line="221" />
             <source>RTT:</source>
             <translation>往返时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="185" />
+            <location filename="../../ui/status_panel.py" line="222" />
             <source>Mode:</source>
             <translation>模式：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="186" />
+            <location filename="../../ui/status_panel.py" line="223" />
             <source>Program:</source>
             <translation>程序：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="187" />
+            <location filename="../../ui/status_panel.py" line="224" />
             <source>Last command:</source>
             <translation>上一条命令：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="188" />
+            <location filename="../../ui/status_panel.py" line="225" />
             <source>Clock:</source>
             <translation>系统时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="189" />
+            <location filename="../../ui/status_panel.py" line="226" />
             <source>Drift:</source>
             <translation>时差：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="190" />
+            <location filename="../../ui/status_panel.py" line="227" />
             <source>Round-trip time of the last poll</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="194" />
+            <location filename="../../ui/status_panel.py" line="231" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="195" />
+            <location filename="../../ui/status_panel.py" line="232" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="198" />
+            <location filename="../../ui/status_panel.py" line="235" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="206" />
+            <location filename="../../ui/status_panel.py" line="243" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="282" />
+            <location filename="../../ui/status_panel.py" line="319" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="284" />
+            <location filename="../../ui/status_panel.py" line="321" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="293" />
+            <location filename="../../ui/status_panel.py" line="330" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="299" />
+            <location filename="../../ui/status_panel.py" line="336" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="312" />
+            <location filename="../../ui/status_panel.py" line="349" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="320" />
+            <location filename="../../ui/status_panel.py" line="357" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="324" />
+            <location filename="../../ui/status_panel.py" line="361" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="328" />
+            <location filename="../../ui/status_panel.py" line="365" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="335" />
+            <location filename="../../ui/status_panel.py" line="372" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>

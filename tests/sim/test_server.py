@@ -162,6 +162,19 @@ def test_create_points_overwrite_and_restart(sim: SimController, bus: Bus) -> No
     assert wait_move_result(bus) == 13
 
 
+def test_restart_clears_the_general_purpose_gvs(sim: SimController, bus: Bus) -> None:
+    bus.set_gv(0, [1.5, 2.5])
+    bus.set_gv(99, [12345.0])
+    bus.set_gv(100, [7.0])  # outside GV0..GV99: kept
+    assert bus.gv(99) == [12345.0]
+    sim.restart_controller()
+    assert bus.gv(0, 2) == [0.0, 0.0]
+    assert bus.gv(99) == [0.0]
+    assert bus.gv(100) == [7.0]
+    bus.set_gv(99, [3.0])  # written after the restart: stays
+    assert bus.gv(99) == [3.0]
+
+
 def test_point_id_range_is_configurable(sim_factory: Callable[..., SimController],
                                         make_bus: Callable[..., Bus]) -> None:
     sim = sim_factory(point_id_min=1, point_id_max=5)

@@ -103,12 +103,54 @@ def translator_fixture(qapp: Any) -> Iterator[Any]:
         translator.uninstall()  # the next test starts in English
 
 
+class FakeProjectDialogs:
+    """Answers the project's questions without showing anything; records what was asked."""
+
+    def __init__(self) -> None:
+        self.save_choice = "discard"  # "save" | "discard" | "cancel"
+        self.recover = False
+        self.open_answer: str | None = None
+        self.save_answer: str | None = None
+        self.asked: list[str] = []
+        self.errors: list[tuple[str, str]] = []
+
+    def open_path(self, title: str, filters: str) -> str | None:
+        self.asked.append("open")
+        return self.open_answer
+
+    def save_path(self, title: str, filters: str, suggested: str) -> str | None:
+        self.asked.append("save path")
+        return self.save_answer
+
+    def error(self, title: str, text: str) -> None:
+        self.errors.append((title, text))
+
+    def ask_save_changes(self, name: str) -> str:
+        self.asked.append("save changes")
+        return self.save_choice
+
+    def ask_recover(self, autosave: Any, project_path: Any) -> bool:
+        self.asked.append("recover")
+        return self.recover
+
+    def ask_import_mode(self) -> Any:
+        return None
+
+
+@pytest.fixture(name="project_dialogs")
+def project_dialogs_fixture() -> FakeProjectDialogs:
+    return FakeProjectDialogs()
+
+
 @pytest.fixture(name="window")
-def window_fixture(qtbot: Any, link: RobotLink, app_settings: Any, translator: Any) -> Any:
-    """The main window on ``link``, shown and active; confirmations answer yes."""
+def window_fixture(qtbot: Any, link: RobotLink, app_settings: Any, translator: Any,
+                   project_dialogs: FakeProjectDialogs, tmp_path: Any) -> Any:
+    """The main window on ``link``, shown and active; confirmations answer yes, project
+    questions go to ``project_dialogs``, autosaves to ``tmp_path``."""
     from ui.main_window import MainWindow
 
-    main_window = MainWindow(link, app_settings, translator)
+    main_window = MainWindow(link, app_settings, translator, project_dialogs=project_dialogs,
+                             autosave_dir=tmp_path / "autosave")
     main_window.confirm = lambda _title, _text: True
     qtbot.addWidget(main_window)
     main_window.show()

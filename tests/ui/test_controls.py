@@ -18,6 +18,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     connect,
     fast_reconnect_fixture,
     link_fixture,
+    project_dialogs_fixture,
     register_writes,
     translator_fixture,
     window_fixture,

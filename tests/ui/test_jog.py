@@ -21,6 +21,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     is_state,
     jogging,
     link_fixture,
+    project_dialogs_fixture,
     ratio_writes,
     translator_fixture,
     window_fixture,

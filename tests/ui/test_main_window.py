@@ -21,6 +21,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     fast_reconnect_fixture,
     is_state,
     link_fixture,
+    project_dialogs_fixture,
     translator_fixture,
     window_fixture,
 )

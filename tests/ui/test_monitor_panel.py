@@ -228,11 +228,11 @@ def test_hidden_panel_does_not_paint(qtbot: Any, panel: MonitorPanel) -> None:
 
 
 def test_readouts_grow_on_wide_screens(qtbot: Any, panel: MonitorPanel) -> None:
-    panel.resize(1280, 700)
+    panel.resize(640, 700)  # the monitor tab of a 1280 px window
     panel.show()
     qtbot.waitExposed(panel)
     small = panel.readouts["X"].point_size()
-    panel.resize(1920, 1000)
+    panel.resize(1300, 1000)  # ... of a 1920 px window
     qtbot.waitUntil(lambda: panel.readouts["X"].point_size() > small, timeout=2000)
     assert panel.readouts["X"].point_size() <= monitor_panel._BIG_POINTS_MAX
 
