@@ -72,7 +72,8 @@ from ui.widgets_common import connection_display
 
 DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size
 MIN_SIZE = (1024, 700)  # the layout stays usable down to this
-STATUS_DOCK_WIDTH = 250  # px at first start (the operator's layout is remembered)
+QWIDGETSIZE_MAX = (1 << 24) - 1  # Qt's "no maximum"
+STATUS_DOCK_WIDTH = 265  # px at first start (the operator's layout is remembered)
 DOCK_MIN_HEIGHT = 72  # px, the bottom docks (event log, traffic) at their smallest
 TAB_MONITOR, TAB_POINTS, TAB_PLANNER = range(3)
 TAB_NAMES = ("monitor", "points", "planner")
@@ -621,8 +622,16 @@ class MainWindow(QMainWindow):
 
     @Slot()
     def _size_docks(self) -> None:
+        # resizeDocks alone loses against the layout's share-out of spare width: cap the
+        # status dock for one layout pass, then let the operator widen it again.
+        self.status_dock.setMaximumWidth(STATUS_DOCK_WIDTH)
         self.resizeDocks([self.status_dock], [STATUS_DOCK_WIDTH], Qt.Orientation.Horizontal)
         self.resizeDocks([self.event_dock], [150], Qt.Orientation.Vertical)
+        QTimer.singleShot(0, self, self._release_dock_width)
+
+    @Slot()
+    def _release_dock_width(self) -> None:
+        self.status_dock.setMaximumWidth(QWIDGETSIZE_MAX)
 
     def hideEvent(self, event: QHideEvent) -> None:
         self.jog_panel.release_all()
