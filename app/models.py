@@ -54,3 +54,4 @@ class CommandResult:
     ok: bool
     message: str = ""
     details: dict[str, float] = field(default_factory=dict)
+    request_id: int | None = None  # the id RobotLink returned for the request (None: not from one)

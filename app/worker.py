@@ -9,8 +9,8 @@ thread-safe queue: the GUI thread never waits for the network.
   between any two transactions (between the pose and the status read of a poll, between the
   steps of a jog sequence, while a short teach command completes, between uploaded points),
   and the GUI wakes the worker with a queued call, so a stop goes out right after the
-  transaction in flight. A stop also cancels the motion jobs queued before it, and a jog
-  release drops a jog press that has not started yet.
+  transaction in flight. A stop also cancels the motion jobs queued before it (and ends a
+  running upload), and a jog release drops a jog press that has not started yet.
 * **Long commands** (step, move to point, go to zero, run program, create point) are started
   without waiting; the regular polls feed their :class:`CommandTracker` (or, for the two
   commands without GV291, a watch on program state and pose) until a
@@ -24,6 +24,18 @@ thread-safe queue: the GUI thread never waits for the network.
 * **Link loss**: :data:`app.timing.LINK_LOSS_POLLS` failed transactions in a row declare the
   link down (``connectionChanged(DOWN)`` at once); reconnection follows
   :data:`app.timing.RECONNECT_BACKOFF` by itself and ends with ``controllerReconnected``.
+
+* **Request ids**: every :class:`RobotLink` command returns an ``int`` id; each
+  :class:`CommandResult` / :class:`WorkerError` that request causes carries it (``request_id``).
+* **Uploads** (``upload_points`` of ``(id, pose6, tool)`` items) are grouped by tool frame and run
+  in chunks (:data:`UPLOAD_CHUNK_POINTS` points or :data:`UPLOAD_CHUNK_SECONDS` per event-loop
+  turn), so polls and queued calls keep flowing; ``pointUploaded`` per point, ``uploadProgress``
+  at most every :data:`UPLOAD_PROGRESS_PERIOD`, one final ``commandFinished``. ``cancel_upload``
+  ends it between points without a controller stop; a stop ends it too.
+* **Restart canary**: a random token in a spare GV (:data:`DEFAULT_CANARY_GV`), read back on the
+  clock poll; a change means the controller restarted under a live link: ``controllerRestarted``.
+
+See docs/DESIGN.md, "Worker / RobotLink", for the whole contract.
 
 Errors: every failure becomes a signal, never an exception in the GUI thread.
 ``commandFinished`` carries the outcome of every command that reached the controller (success,
@@ -40,6 +52,8 @@ import dataclasses
 import enum
 import itertools
 import logging
+import math
+import random
 import threading
 import time
 from collections import deque
@@ -74,9 +88,13 @@ from app.protocol.enums import (
 )
 
 __all__ = [
+    "DEFAULT_CANARY_GV",
     "RTT_REPORT_PERIOD",
     "SHUTDOWN_TIMEOUT_MS",
     "TEACH_IDLE_DISABLE",
+    "UPLOAD_CHUNK_POINTS",
+    "UPLOAD_CHUNK_SECONDS",
+    "UPLOAD_PROGRESS_PERIOD",
     "ConnectionState",
     "JogRequest",
     "LinkState",
@@ -87,12 +105,20 @@ __all__ = [
 ]
 
 _log = logging.getLogger(__name__)
+_FLOAT32_MAX = 3.4028234663852886e38
 
 # Timing of the worker (module constants so tests can shrink them; read at use time).
 RTT_REPORT_PERIOD = 0.5  # s between rttChanged emissions (mean of the period's transactions)
 TEACH_IDLE_DISABLE = 30.0  # s after the last jog release before teach mode is disabled
 TEACH_MODE_GRACE = 0.3  # s after teach enable during which a status without mode 2 is not "teach lost"
 SHUTDOWN_TIMEOUT_MS = 10_000  # ms to wait for the worker thread to end
+UPLOAD_CHUNK_POINTS = 20  # points per event-loop turn of an upload, at most ...
+UPLOAD_CHUNK_SECONDS = 0.03  # ... or this long (s), whichever comes first
+UPLOAD_PROGRESS_PERIOD = 0.05  # s between uploadProgress emissions (the last one always goes out)
+
+#: The spare general-purpose GV holding the restart canary (registers 198-199); None disables it.
+DEFAULT_CANARY_GV: int | None = 99
+UPLOAD_POSE_GV = 0  # an upload passes each pose in GV0..GV5 (case 2.2)
 
 
 class Operation:
@@ -147,6 +173,7 @@ class WorkerError:
 
     operation: str
     message: str
+    request_id: int | None = None  # the request it belongs to (None: polls, the link itself)
 
 
 @dataclass(frozen=True)
@@ -183,6 +210,7 @@ class _Job:
     run: Callable[[], None]
     kind: _JobKind
     seq: int = 0
+    request_id: int = 0
     coalesce: str | None = None  # a newer job with the same key replaces a queued one
     needs_link: bool = True
     cancels: tuple[str, ...] = ()  # an urgent job drops the queued jobs with these coalesce keys
@@ -200,22 +228,27 @@ class _JobQueue:
         self._urgent: deque[_Job] = deque()
         self._normal: deque[_Job] = deque()
         self._seq = itertools.count(1)
+        self._ids = itertools.count(1)
 
-    def put(self, job: _Job) -> None:
+    def put(self, job: _Job) -> int:
+        """Queue ``job``; returns its request id (unique, increasing, never 0). A coalesced job
+        takes the place of the queued one it replaces, which then never runs (and has no result)."""
         with self._lock:
             job.seq = next(self._seq)
+            job.request_id = next(self._ids)
             if job.kind is _JobKind.URGENT:
                 if job.cancels:  # e.g. a release drops a press still waiting: it must never start
                     self._normal = deque(q for q in self._normal if q.coalesce not in job.cancels)
                 self._urgent.append(job)
-                return
+                return job.request_id
             if job.coalesce is not None:
                 for i, queued in enumerate(self._normal):
                     if queued.coalesce == job.coalesce:
                         job.seq = queued.seq  # keep its place in the queue
                         self._normal[i] = job
-                        return
+                        return job.request_id
             self._normal.append(job)
+            return job.request_id
 
     def pop_urgent(self) -> _Job | None:
         with self._lock:
@@ -311,6 +344,31 @@ class _Active:
     operation: str
     completion: _Completion
     motion: bool  # a motion (blocks other motions) rather than a short command
+    request_id: int | None = None
+
+
+UploadItem = tuple[int, tuple[float, ...], int]  # (point id, pose X Y Z A B C, tool frame)
+
+
+@dataclass
+class _UploadRun:
+    """An upload under way: processed a chunk per event-loop turn (see ``RobotWorker._upload_step``)."""
+
+    request_id: int | None
+    items: list[UploadItem]  # grouped by tool frame: GV245 is written once per group
+    index: int = 0  # items attempted so far
+    good: int = 0
+    end: str | None = None  # why it ends early ("cancelled", "stopped", "link lost: ..."), once set
+    progress_at: float = 0.0  # when uploadProgress was last emitted
+    progress_done: int = -1  # the ``done`` it carried
+
+
+def group_by_tool(items: Iterable[UploadItem]) -> list[UploadItem]:
+    """Stable grouping: the tools in order of first appearance, each tool's points in input order."""
+    groups: dict[int, list[UploadItem]] = {}
+    for item in items:
+        groups.setdefault(item[2], []).append(item)
+    return [item for group in groups.values() for item in group]
 
 
 @dataclass
@@ -343,16 +401,27 @@ class RobotWorker(QObject):
     errorOccurred = Signal(WorkerError)  # noqa: N815
     trafficObserved = Signal(list)  # noqa: N815 - list[TrafficRecord], one batch per poll, only while capturing
     controllerReconnected = Signal()  # noqa: N815
+    controllerRestarted = Signal()  # noqa: N815 - the canary GV changed while the link stayed up
     uploadProgress = Signal(int, int)  # noqa: N815 - points done, total
+    pointUploaded = Signal(int, bool, str)  # noqa: N815 - point id, ok, reason ("" when ok)
 
     # Wakes the worker from any thread (a queued call, since the worker lives in its thread).
     _wake = Signal()
+    # The next chunk of an upload, one event-loop turn later (polls and queued calls in between).
+    _uploadStep = Signal()  # noqa: N815
 
-    def __init__(self, poll_hz: float = timing.POLL_HZ_DEFAULT) -> None:
+    def __init__(self, poll_hz: float = timing.POLL_HZ_DEFAULT, *,
+                 canary_gv: int | None = DEFAULT_CANARY_GV) -> None:
         super().__init__()
+        if canary_gv is not None and not (UPLOAD_POSE_GV + 6 <= canary_gv <= registers.GV_GENERAL_LAST):
+            raise ValueError(f"the restart canary must be a spare general-purpose GV in "
+                             f"GV{UPLOAD_POSE_GV + 6}..GV{registers.GV_GENERAL_LAST} (uploads use "
+                             f"GV{UPLOAD_POSE_GV}..GV{UPLOAD_POSE_GV + 5}), got GV{canary_gv}")
         self._poll_hz = float(poll_hz)
+        self._canary_gv = canary_gv
         self._jobs = _JobQueue()
         self._wake.connect(self._on_wake, Qt.ConnectionType.QueuedConnection)
+        self._uploadStep.connect(self._upload_step, Qt.ConnectionType.QueuedConnection)
         # Everything below is touched only in the worker thread.
         self._client: RobotClient | None = None
         self._settings: ConnectionSettings | None = None
@@ -384,7 +453,11 @@ class RobotWorker(QObject):
         self._last_rtt: float | None = None
         self._last_poll = 0.0
         self._current_seq = 0  # sequence number of the job being executed
-        self._stop_seen = False
+        self._request_id: int | None = None  # request id of the job being executed
+        self._upload: _UploadRun | None = None
+        self._upload_busy = False  # inside a chunk (client.upload_points is running)
+        self._canary_token: float | None = None  # what we wrote to the canary GV (None: not checking)
+        self._random = random.Random()
 
     # --- lifecycle (worker thread) ------------------------------------------------------
     @Slot()
@@ -404,7 +477,7 @@ class RobotWorker(QObject):
         if self._closed:
             return
         # Jobs queued since the GUI asked for this connection run once it is up.
-        self._close_link("connect", LinkState.DISCONNECTED, "", emit=False, fail_queued=False)
+        self._close_link(Operation.CONNECT, LinkState.DISCONNECTED, "", emit=False, fail_queued=False)
         self._settings = settings
         self._client = RobotClient(settings)
         if self._capture:
@@ -421,14 +494,14 @@ class RobotWorker(QObject):
         """Stop jogging, switch teach off, close the link, stop retrying."""
         if self._closed:
             return
-        self._close_link("disconnect", LinkState.DISCONNECTED, "")
+        self._close_link(Operation.DISCONNECT, LinkState.DISCONNECTED, "")
 
     @Slot()
     def shutdown(self) -> None:
         """Called with a blocking queued connection: stop motion, close, hand the object back."""
         if self._closed:
             return
-        self._close_link("shutdown", LinkState.DISCONNECTED, "")
+        self._close_link(Operation.SHUTDOWN, LinkState.DISCONNECTED, "")
         self._closed = True
         for timer in (self._poll_timer, self._reconnect_timer):
             if timer is not None:
@@ -463,59 +536,70 @@ class RobotWorker(QObject):
 
     # --- requests (any thread) ----------------------------------------------------------
     def post(self, operation: str, run: Callable[[], None], kind: _JobKind = _JobKind.PLAIN,
-             *, coalesce: str | None = None, needs_link: bool = True, cancels: tuple[str, ...] = ()) -> None:
-        self._jobs.put(_Job(operation, run, kind, coalesce=coalesce, needs_link=needs_link, cancels=cancels))
+             *, coalesce: str | None = None, needs_link: bool = True, cancels: tuple[str, ...] = ()) -> int:
+        """Queue a job and wake the worker; returns the request id its results will carry."""
+        request_id = self._jobs.put(_Job(operation, run, kind, coalesce=coalesce, needs_link=needs_link,
+                                         cancels=cancels))
         self._wake.emit()
+        return request_id
 
-    def request_stop(self) -> None:
-        self.post("stop", self._do_stop, _JobKind.URGENT)
+    def request_stop(self) -> int:
+        return self.post(Operation.STOP, self._do_stop, _JobKind.URGENT)
 
-    def request_pause(self) -> None:
-        self.post("pause", self._do_pause, _JobKind.URGENT)
+    def request_pause(self) -> int:
+        return self.post(Operation.PAUSE, self._do_pause, _JobKind.URGENT)
 
-    def request_resume(self) -> None:
-        self.post("resume", self._do_resume, _JobKind.URGENT)
+    def request_resume(self) -> int:
+        return self.post(Operation.RESUME, self._do_resume, _JobKind.URGENT)
 
-    def request_jog_press(self, request: JogRequest) -> None:
-        self.post("jog", lambda: self._do_jog_press(request), _JobKind.MOTION, coalesce=_JOG_PRESS)
+    def request_jog_press(self, request: JogRequest) -> int:
+        return self.post(Operation.JOG, lambda: self._do_jog_press(request), _JobKind.MOTION,
+                         coalesce=_JOG_PRESS)
 
-    def request_jog_release(self) -> None:
-        self.post("jog release", self._do_jog_release, _JobKind.URGENT, needs_link=False,
-                  cancels=(_JOG_PRESS, _JOG_RATIO))
+    def request_jog_release(self) -> int:
+        return self.post(Operation.JOG_RELEASE, self._do_jog_release, _JobKind.URGENT, needs_link=False,
+                         cancels=(_JOG_PRESS, _JOG_RATIO))
 
-    def request_jog_ratio(self, ratio: float) -> None:
-        self.post("jog speed", lambda: self._do_jog_ratio(ratio), _JobKind.MOTION, coalesce=_JOG_RATIO)
+    def request_jog_ratio(self, ratio: float) -> int:
+        return self.post(Operation.JOG_SPEED, lambda: self._do_jog_ratio(ratio), _JobKind.MOTION,
+                         coalesce=_JOG_RATIO)
 
     def request_step(self, frame: StepFrame, offsets: Sequence[float], ext_offsets: Sequence[float],
-                     speed: float) -> None:
+                     speed: float) -> int:
         offs, ext = tuple(offsets), tuple(ext_offsets)
-        self.post("step", lambda: self._do_step(frame, offs, ext, speed), _JobKind.MOTION)
+        return self.post(Operation.STEP, lambda: self._do_step(frame, offs, ext, speed), _JobKind.MOTION)
 
-    def request_set_mode(self, mode: WorkMode) -> None:
-        self.post("set mode", lambda: self._do_set_mode(mode))
+    def request_set_mode(self, mode: WorkMode) -> int:
+        return self.post(Operation.SET_MODE, lambda: self._do_set_mode(mode))
 
-    def request_go_zero(self, axis: int | None) -> None:
-        self.post("go to zero", lambda: self._do_go_zero(axis), _JobKind.MOTION)
+    def request_go_zero(self, axis: int | None) -> int:
+        return self.post(Operation.GO_ZERO, lambda: self._do_go_zero(axis), _JobKind.MOTION)
 
     def request_run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int,
-                            speed_ratio: int) -> None:
-        self.post("run program", lambda: self._do_run_program(program_id, mode, cycles, speed_ratio),
-                  _JobKind.MOTION)
+                            speed_ratio: int) -> int:
+        return self.post(Operation.RUN_PROGRAM,
+                         lambda: self._do_run_program(program_id, mode, cycles, speed_ratio), _JobKind.MOTION)
 
-    def request_create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> None:
+    def request_create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> int:
         values = None if pose is None else tuple(pose)
-        self.post("create point", lambda: self._do_create_point(point_id, values, tool))
+        return self.post(Operation.CREATE_POINT, lambda: self._do_create_point(point_id, values, tool))
 
     def request_move_to_point(self, end_id: int, via_id: int | None, orientation_changes: bool,
-                              ignore_middle: bool, speed: float, tool: int) -> None:
-        self.post("move to point",
-                  lambda: self._do_move_to_point(end_id, via_id, orientation_changes, ignore_middle, speed,
-                                                 tool),
-                  _JobKind.MOTION)
+                              ignore_middle: bool, speed: float, tool: int) -> int:
+        return self.post(Operation.MOVE_TO_POINT,
+                         lambda: self._do_move_to_point(end_id, via_id, orientation_changes, ignore_middle,
+                                                        speed, tool),
+                         _JobKind.MOTION)
 
-    def request_upload_points(self, points: Iterable[tuple[int, Sequence[float]]], tool: int) -> None:
-        items = [(int(pid), tuple(pose)) for pid, pose in points]
-        self.post("upload points", lambda: self._do_upload_points(items, tool), _JobKind.MOTION)
+    def request_upload_points(self, points: Iterable[tuple[int, Sequence[float], int]]) -> int:
+        """Items (id, pose6, tool); copied here, checked in the worker before the first write."""
+        items: list[tuple[object, tuple[object, ...], object]] = [
+            (pid, tuple(pose), tool) for pid, pose, tool in points]
+        return self.post(Operation.UPLOAD_POINTS, lambda: self._do_upload_points(items), _JobKind.MOTION)
+
+    def request_cancel_upload(self) -> int:
+        """End the running upload after the point in progress, without a controller stop."""
+        return self.post(Operation.CANCEL_UPLOAD, self._do_cancel_upload, _JobKind.URGENT, needs_link=False)
 
     # --- connection (worker thread) -----------------------------------------------------
     def _set_state(self, state: LinkState, message: str) -> None:
@@ -551,6 +635,7 @@ class RobotWorker(QObject):
         self._rtt_since = now
         reconnected = self._ever_connected
         self._ever_connected = True
+        self._arm_canary()  # before the GUI hears of the link: a restart from now on is noticed
         self._set_state(LinkState.CONNECTED, "")
         self._publish(pose, status)
         if reconnected:
@@ -558,6 +643,32 @@ class RobotWorker(QObject):
         if self._poll_timer is not None:
             self._poll_timer.start(self._poll_interval_ms())
         self._run_jobs()
+
+    def _arm_canary(self) -> None:
+        """Write a fresh random token to the canary GV (not in monitor-only mode, not when disabled)."""
+        self._canary_token = None
+        client = self._client
+        gv = self._canary_gv
+        if gv is None or client is None or client.settings.monitor_only:
+            return
+        token = float(self._random.randint(1, 1 << 23))  # nonzero, exact in float32
+        try:
+            client.write_gv(gv, [token])
+        except TeachPadError as exc:
+            self._emit_error(Operation.CANARY, f"could not write the restart canary GV{gv}: {exc}", None)
+            if isinstance(exc, (LinkError, ResponseTimeout)):
+                self._transport_failed(str(exc))
+            return
+        self._canary_token = token
+
+    def _canary_changed(self, value: float) -> None:
+        """The canary GV no longer holds our token: the controller restarted under a live link."""
+        _log.warning("restart canary GV%s reads %g instead of %g: the controller restarted",
+                     self._canary_gv, value, self._canary_token)
+        if self._client is not None:
+            self._client.invalidate_cache()  # GV245 and friends may have been reset too
+        self.controllerRestarted.emit()
+        self._arm_canary()
 
     def _make_teach_safe(self, status: ControllerStatus) -> None:
         """On (re)connection: a jog left running by a lost link is stopped before anything else."""
@@ -590,6 +701,8 @@ class RobotWorker(QObject):
             self._teach_dirty = True  # a real controller keeps jogging: switch it off on return
         self._end_jog()
         self._teach = _TeachState()
+        self._canary_token = None
+        self._end_upload(f"link lost: {message}")
         self._fail_active("link lost while the command was under way; its outcome is unknown")
         self._fail_queued("the link to the controller is down")
         if self._client is not None:
@@ -608,7 +721,9 @@ class RobotWorker(QObject):
             try:
                 self._stop_jog_and_teach()
             except TeachPadError as exc:
-                self.errorOccurred.emit(WorkerError(operation, f"could not stop teach mode: {exc}"))
+                self._emit_error(operation, f"could not stop teach mode: {exc}", None)
+        self._canary_token = None
+        self._end_upload(f"{operation}: the link was closed")
         self._fail_active(f"{operation}: the link was closed while the command was under way")
         if fail_queued:
             self._fail_queued(f"{operation}: the link was closed")
@@ -648,7 +763,7 @@ class RobotWorker(QObject):
         assert tracker is not None
         result = self._await_short(tracker, urgent=False)
         if not result.ok:
-            self.commandFinished.emit(result)
+            self._emit_result(result)
 
     # --- job execution (worker thread) --------------------------------------------------
     @Slot()
@@ -679,30 +794,44 @@ class RobotWorker(QObject):
 
     def _execute(self, job: _Job) -> None:
         if job.needs_link and not self._link_up:
-            self.errorOccurred.emit(WorkerError(job.operation, "not connected to a controller"))
+            self._emit_error(job.operation, "not connected to a controller", job.request_id)
             return
         outer_seq, self._current_seq = self._current_seq, job.seq
+        outer_id, self._request_id = self._request_id, job.request_id
         try:
             job.run()
         except _PreemptedError:
             pass
         except WriteBlocked as exc:
-            self.errorOccurred.emit(WorkerError(job.operation, str(exc)))
+            self._emit_error(job.operation, str(exc))
         except (LinkError, ResponseTimeout) as exc:
-            self.errorOccurred.emit(WorkerError(job.operation, str(exc)))
+            self._emit_error(job.operation, str(exc))
             self._transport_failed(str(exc))
         except ModbusExceptionError as exc:
-            self.commandFinished.emit(CommandResult(None, None, None, False, f"{job.operation}: {exc}"))
+            self._emit_result(CommandResult(None, None, None, False, f"{job.operation}: {exc}"))
         except CommandRefused as exc:
-            self.commandFinished.emit(CommandResult(None, exc.status.kind, exc.status, False, str(exc)))
+            self._emit_result(CommandResult(None, exc.status.kind, exc.status, False, str(exc)))
         except TeachPadError as exc:  # InvalidInput and the rest
-            self.errorOccurred.emit(WorkerError(job.operation, str(exc)))
+            self._emit_error(job.operation, str(exc))
         except Exception as exc:  # a bug: report it plainly, keep the worker alive
             _log.exception("%s failed", job.operation)
             message = f"internal error: {type(exc).__name__}: {exc}"
-            self.errorOccurred.emit(WorkerError(job.operation, message))
+            self._emit_error(job.operation, message)
         finally:
             self._current_seq = outer_seq
+            self._request_id = outer_id
+
+    def _emit_result(self, result: CommandResult, request_id: int | None = -1) -> None:
+        """``commandFinished`` with the request id (default: the job being executed)."""
+        rid = self._request_id if request_id == -1 else request_id
+        if result.request_id is None and rid is not None:
+            result = dataclasses.replace(result, request_id=rid)
+        self.commandFinished.emit(result)
+
+    def _emit_error(self, operation: str, message: str, request_id: int | None = -1) -> None:
+        """``errorOccurred`` with the request id (default: the job being executed)."""
+        rid = self._request_id if request_id == -1 else request_id
+        self.errorOccurred.emit(WorkerError(operation, message, rid))
 
     def _transport_failed(self, message: str) -> None:
         self._failures += 1
@@ -712,12 +841,12 @@ class RobotWorker(QObject):
     def _fail_queued(self, message: str) -> None:
         for job in self._jobs.clear():
             if job.needs_link:
-                self.errorOccurred.emit(WorkerError(job.operation, message))
+                self._emit_error(job.operation, message, job.request_id)
 
     def _fail_active(self, message: str) -> None:
         active, self._active = self._active, None
         if active is not None:
-            self._failed(f"{active.operation}: {message}")
+            self._failed(f"{active.operation}: {message}", active.request_id)
 
     def _client_or_raise(self) -> RobotClient:
         if self._client is None or not self._link_up:
@@ -728,22 +857,25 @@ class RobotWorker(QObject):
         active = self._active
         if active is not None and active.motion:
             raise InvalidInput(f"{active.operation} is still under way: wait for it or press Stop")
+        if self._upload is not None:
+            raise InvalidInput(f"{Operation.UPLOAD_POINTS} is still under way: wait for it, cancel it "
+                               "or press Stop")
 
     def _track(self, operation: str, completion: _Completion, *, motion: bool) -> None:
-        self._active = _Active(operation, completion, motion)
+        self._active = _Active(operation, completion, motion, self._request_id)
 
     # --- plain and urgent commands ------------------------------------------------------
     def _done(self, text: str) -> None:
-        self.commandFinished.emit(CommandResult(None, None, None, True, text))
+        self._emit_result(CommandResult(None, None, None, True, text))
 
-    def _failed(self, text: str) -> None:
-        self.commandFinished.emit(CommandResult(None, None, None, False, text))
+    def _failed(self, text: str, request_id: int | None = -1) -> None:
+        self._emit_result(CommandResult(None, None, None, False, text), request_id)
 
     def _do_stop(self) -> None:
         client = self._client_or_raise()
         client.stop()  # first: nothing else goes out before the stop
         now = time.monotonic()
-        self._stop_seen = True
+        self._end_upload("stopped")
         self._end_jog()
         if self._teach.enabled and self._teach.ratio != 0.0:
             client.teach_set_ratio(0.0)
@@ -751,10 +883,20 @@ class RobotWorker(QObject):
         active, self._active = self._active, None
         stop_seq = self._current_seq
         for job in self._jobs.cancel(lambda j: j.kind is _JobKind.MOTION and j.seq < stop_seq):
-            self._failed(f"{job.operation}: cancelled by Stop")
+            self._failed(f"{job.operation}: cancelled by Stop", job.request_id)
         if active is not None:
-            self.commandFinished.emit(active.completion.stopped(now))
+            self._emit_result(active.completion.stopped(now), active.request_id)
         self._done("stop: sent")
+
+    def _do_cancel_upload(self) -> None:
+        """No controller stop: the upload ends after the point in progress; queued uploads are dropped."""
+        for job in self._jobs.cancel(lambda j: j.operation == Operation.UPLOAD_POINTS):
+            self._failed(f"{job.operation}: cancelled", job.request_id)
+        if self._upload is None:
+            self._done(f"{Operation.CANCEL_UPLOAD}: no upload under way")
+            return
+        self._end_upload("cancelled")
+        self._done(f"{Operation.CANCEL_UPLOAD}: the upload ends after the current point")
 
     def _do_pause(self) -> None:
         self._client_or_raise().pause()
@@ -789,7 +931,7 @@ class RobotWorker(QObject):
           GV291 while servicing urgent jobs, then the ratio.
         A release or stop arriving in between ends the sequence before the ratio is written.
         """
-        self._require_no_motion("jog")
+        self._require_no_motion(Operation.JOG)
         client = self._client_or_raise()
         if not 0.0 < request.ratio <= 100.0:
             raise InvalidInput(f"jog speed must be 1..100 %, got {request.ratio:g}")
@@ -825,7 +967,7 @@ class RobotWorker(QObject):
             # Refused: teach is off for sure. Stopped / timed out: it may be on, switch it off later.
             self._teach_dirty = not isinstance(tracker.error, CommandRefused)
             self._end_jog()
-            self.commandFinished.emit(result)
+            self._emit_result(result)
             return
         self._check_jog(serial)
         client.teach_set_ratio(request.ratio)
@@ -864,7 +1006,7 @@ class RobotWorker(QObject):
         result = self._await_short(tracker, urgent=True)
         if not result.ok:
             self._teach_dirty = True
-            self.commandFinished.emit(result)
+            self._emit_result(result)
             raise _PreemptedError
 
     def _leave_teach(self) -> None:
@@ -897,80 +1039,188 @@ class RobotWorker(QObject):
     # --- long commands ------------------------------------------------------------------
     def _do_step(self, frame: StepFrame, offsets: Sequence[float], ext: Sequence[float],
                  speed: float) -> None:
-        self._require_no_motion("step")
+        self._require_no_motion(Operation.STEP)
         client = self._client_or_raise()
         self._leave_teach()
         client.step(frame, offsets, ext, speed, wait=False)
         tracker = client.last_tracker
         assert tracker is not None
-        self._track("step", tracker, motion=True)
+        self._track(Operation.STEP, tracker, motion=True)
 
     def _do_move_to_point(self, end_id: int, via_id: int | None, orientation_changes: bool,
                           ignore_middle: bool, speed: float, tool: int) -> None:
-        self._require_no_motion("move to point")
+        self._require_no_motion(Operation.MOVE_TO_POINT)
         client = self._client_or_raise()
         self._leave_teach()
         client.move_to_point(end_id, via_id=via_id, orientation_changes=orientation_changes,
                              ignore_middle=ignore_middle, speed=speed, tool=tool, wait=False)
         tracker = client.last_tracker
         assert tracker is not None
-        self._track("move to point", tracker, motion=True)
+        self._track(Operation.MOVE_TO_POINT, tracker, motion=True)
 
     def _do_go_zero(self, axis: int | None) -> None:
-        self._require_no_motion("go to zero")
+        self._require_no_motion(Operation.GO_ZERO)
         client = self._client_or_raise()
         self._leave_teach()
         before = self._last_pose
         client.go_zero(axis)
         which = "all axes" if axis is None else f"J{axis + 1}"
-        self._track("go to zero", _MotionWatch(None, f"go to zero ({which})", before, time.monotonic()),
+        self._track(Operation.GO_ZERO, _MotionWatch(None, f"go to zero ({which})", before, time.monotonic()),
                     motion=True)
 
     def _do_run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int,
                         speed_ratio: int) -> None:
-        self._require_no_motion("run program")
+        self._require_no_motion(Operation.RUN_PROGRAM)
         client = self._client_or_raise()
         self._leave_teach()
         before = self._last_pose
         client.run_program(program_id, mode, cycles, speed_ratio)
         watch = _MotionWatch(RunCommand.RUN_PROGRAM, f"run program {program_id}", before, time.monotonic())
-        self._track("run program", watch, motion=True)
+        self._track(Operation.RUN_PROGRAM, watch, motion=True)
 
     def _do_create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> None:
-        self._require_no_motion("create point")
+        self._require_no_motion(Operation.CREATE_POINT)
         client = self._client_or_raise()
         client.create_point(point_id, pose=pose, tool=tool, wait=False)
         tracker = client.last_tracker
         assert tracker is not None
-        self._track("create point", tracker, motion=False)
+        self._track(Operation.CREATE_POINT, tracker, motion=False)
 
-    def _do_upload_points(self, items: list[tuple[int, tuple[float, ...]]], tool: int) -> None:
-        """Case 2.2 in one batch; urgent jobs and the monitor polls run between points."""
-        self._require_no_motion("upload points")
+    def _do_upload_points(self, raw: list[tuple[object, tuple[object, ...], object]]) -> None:
+        """Case 2.2 for many points, tool by tool; runs in chunks, see :meth:`_upload_step`."""
+        self._require_no_motion(Operation.UPLOAD_POINTS)
         client = self._client_or_raise()
+        if client.settings.monitor_only:
+            raise WriteBlocked(f"monitor-only mode: {Operation.UPLOAD_POINTS} was not sent")
+        items = group_by_tool(self._check_upload_items(client, raw))  # all checked before any write
+        total = len(items)
+        if not total:
+            self._emit_result(CommandResult(RunCommand.CREATE_POINT, None, None, True,
+                                            "uploaded 0 of 0 points", {"uploaded": 0.0, "total": 0.0}))
+            return
         self._leave_teach()
-        stopped = False
+        self._upload = _UploadRun(self._request_id, items)
+        self._note_upload_progress(self._upload, force=True)
+        self._uploadStep.emit()
+
+    @staticmethod
+    def _check_upload_items(client: RobotClient, raw: Sequence[tuple[object, tuple[object, ...], object]],
+                            ) -> list[UploadItem]:
+        lo, hi = client.settings.point_id_min, client.settings.point_id_max
+        items: list[UploadItem] = []
+        for pid, pose, tool in raw:
+            if isinstance(pid, bool) or not isinstance(pid, int) or not lo <= pid <= hi:
+                raise InvalidInput(f"point id must be an integer in {lo}..{hi}, got {pid!r}")
+            if isinstance(tool, bool) or not isinstance(tool, int) or not 0 <= tool <= registers.TOOL_NONE:
+                raise InvalidInput(f"tool frame of point {pid} must be 0..{registers.TOOL_NONE}, "
+                                   f"got {tool!r}")
+            if len(pose) != 6:
+                raise InvalidInput(f"pose of point {pid} needs 6 values, got {len(pose)}")
+            values: list[float] = []
+            for v in pose:
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
+                        or abs(v) > _FLOAT32_MAX:
+                    raise InvalidInput(f"pose of point {pid}: {v!r} is not a finite float32")
+                values.append(float(v))
+            items.append((pid, tuple(values), tool))
+        return items
+
+    @Slot()
+    def _upload_step(self) -> None:
+        """One chunk of the running upload (at most UPLOAD_CHUNK_POINTS points of one tool frame, or
+        UPLOAD_CHUNK_SECONDS), then the next chunk is queued behind whatever arrived meanwhile."""
+        upload = self._upload
+        if upload is None or self._closed:
+            return
+        if upload.end is None and upload.index < len(upload.items) and self._link_up:
+            if time.monotonic() - self._last_poll >= 1.0 / self._poll_hz:
+                self._poll()  # keep the monitor live even if the event loop favours queued calls
+            self._run_urgent()
+            if upload.end is None and self._link_up and self._upload is upload:
+                self._upload_chunk(upload)
+        if self._upload is not upload:
+            return  # ended meanwhile (link lost, closed)
+        if upload.end is not None or upload.index >= len(upload.items) or not self._link_up:
+            self._finish_upload()
+        else:
+            self._uploadStep.emit()
+
+    def _upload_chunk(self, upload: _UploadRun) -> None:
+        client = self._client
+        assert client is not None
+        start = time.monotonic()
+        items = upload.items
+        first = upload.index
+        tool = items[first][2]
+        last = first
+        while last < len(items) and last - first < UPLOAD_CHUNK_POINTS and items[last][2] == tool:
+            last += 1
 
         def progress(done: int, total: int) -> bool:
-            nonlocal stopped
-            self.uploadProgress.emit(done, total)
-            self._run_urgent()
-            if self._stop_seen:
-                stopped = True
+            self._run_urgent()  # stop / pause / cancel / jog release between two points
+            if upload.end is not None or not self._link_up or self._closed:
                 return False
             if time.monotonic() - self._last_poll >= 1.0 / self._poll_hz:
                 self._poll()
-            return self._link_up
+            return self._link_up and time.monotonic() - start < UPLOAD_CHUNK_SECONDS
 
-        self._stop_seen = False
-        results = client.upload_points(items, tool, progress)
-        for result in results:
-            if not result.ok:
-                self.commandFinished.emit(result)
-        good = sum(1 for r in results if r.ok)
-        text = f"uploaded {good} of {len(items)} points" + (" (stopped)" if stopped else "")
-        self.commandFinished.emit(CommandResult(RunCommand.CREATE_POINT, None, None,
-                                                good == len(items), text, {"uploaded": float(good)}))
+        transport_error: str | None = None
+        self._upload_busy = True
+        outer_id, self._request_id = self._request_id, upload.request_id
+        try:
+            chunk = [(pid, pose) for pid, pose, _ in items[first:last]]
+            results = client.upload_points(chunk, tool, progress, gv_start=UPLOAD_POSE_GV)
+        except (LinkError, ResponseTimeout) as exc:  # before the first point (status read, mode)
+            results, transport_error = [], str(exc)
+        except TeachPadError as exc:
+            results = []
+            upload.end = upload.end or str(exc)
+        finally:
+            self._upload_busy = False
+            self._request_id = outer_id
+        for (point_id, _, _), result in zip(items[first:], results, strict=False):
+            upload.index += 1
+            if result.ok:
+                upload.good += 1
+                self.pointUploaded.emit(point_id, True, "")
+            else:
+                self.pointUploaded.emit(point_id, False, result.message or "failed")
+                if result.status is None:  # the link failed during this point: its outcome is unknown
+                    transport_error = result.message
+        if transport_error is not None:
+            upload.end = upload.end or transport_error
+            self._transport_failed(transport_error)
+        self._note_upload_progress(upload)
+
+    def _note_upload_progress(self, upload: _UploadRun, *, force: bool = False) -> None:
+        now = time.monotonic()
+        due = force or now - upload.progress_at >= UPLOAD_PROGRESS_PERIOD
+        if upload.index != upload.progress_done and due:
+            upload.progress_at = now
+            upload.progress_done = upload.index
+            self.uploadProgress.emit(upload.index, len(upload.items))
+
+    def _end_upload(self, reason: str) -> None:
+        """Ask the running upload to end before its next point (at once when between chunks)."""
+        upload = self._upload
+        if upload is None:
+            return
+        if upload.end is None:
+            upload.end = reason
+        if not self._upload_busy:
+            self._finish_upload()
+
+    def _finish_upload(self) -> None:
+        """The batch's final commandFinished (after every pointUploaded), with the upload's request id."""
+        upload, self._upload = self._upload, None
+        if upload is None:
+            return
+        total = len(upload.items)
+        self._note_upload_progress(upload, force=True)
+        text = f"uploaded {upload.good} of {total} points" + (f" ({upload.end})" if upload.end else "")
+        details = {"uploaded": float(upload.good), "attempted": float(upload.index), "total": float(total)}
+        result = CommandResult(RunCommand.CREATE_POINT, None, None, upload.good == total, text, details)
+        self._emit_result(result, upload.request_id)
 
     # --- polling ------------------------------------------------------------------------
     @Slot()
@@ -982,12 +1232,21 @@ class RobotWorker(QObject):
             self._poll()
 
     def _poll(self) -> None:
+        """One poll; results emitted from here belong to no request (even inside a job)."""
+        outer_id, self._request_id = self._request_id, None
+        try:
+            self._poll_once()
+        finally:
+            self._request_id = outer_id
+
+    def _poll_once(self) -> None:
         client = self._client
         if client is None:
             return
         now = time.monotonic()
         self._last_poll = now
         with_clock = now >= self._next_clock
+        canary: float | None = None
         try:
             t0 = time.perf_counter()
             pose = client.read_pose()
@@ -998,6 +1257,8 @@ class RobotWorker(QObject):
             t2 = time.perf_counter()
             status = client.read_status(with_clock=with_clock)
             t3 = time.perf_counter()
+            if with_clock and self._canary_token is not None and self._canary_gv is not None:
+                canary = client.read_gv(self._canary_gv)[0]  # the restart canary, on the slow clock
         except (LinkError, ResponseTimeout) as exc:
             self._report_poll_error(str(exc))
             self._transport_failed(str(exc))
@@ -1013,13 +1274,15 @@ class RobotWorker(QObject):
             status = dataclasses.replace(status, clock=self._last_status.clock)
         self._note_rtt((t1 - t0) + (t3 - t2), 2, now)
         self._publish(pose, status)
+        if canary is not None and canary != self._canary_token:
+            self._canary_changed(canary)
         self._after_status(status, pose, now)
         self._flush_traffic()
 
     def _report_poll_error(self, message: str) -> None:
         if message != self._poll_error:  # once per distinct error, not 50 times a second
             self._poll_error = message
-            self.errorOccurred.emit(WorkerError("poll", message))
+            self._emit_error(Operation.POLL, message)
 
     def _publish(self, pose: Pose, status: ControllerStatus) -> None:
         if pose != self._last_pose:
@@ -1039,11 +1302,11 @@ class RobotWorker(QObject):
             result = active.completion.update(status, pose, now)
             if result is not None:
                 self._active = None
-                if active.operation == "create point" and result.ok:
+                if active.operation == Operation.CREATE_POINT and result.ok:
                     details = dict(result.details)
                     details.update(zip(("x", "y", "z", "a", "b", "c"), pose.xyzabc, strict=True))
                     result = dataclasses.replace(result, details=details)
-                self.commandFinished.emit(result)
+                self._emit_result(result, active.request_id)
         teach = self._teach
         if teach.enabled and status.mode != ControllerMode.MODBUS_TEACH \
                 and now - teach.enabled_at > TEACH_MODE_GRACE:
@@ -1052,13 +1315,13 @@ class RobotWorker(QObject):
                 self._end_jog()
                 mode = controller_mode_text(int(status.mode))
                 message = f"the controller left teach mode (mode now: {mode})"
-                self.errorOccurred.emit(WorkerError("jog", message))
+                self._emit_error(Operation.JOG, message)
         elif (teach.enabled or self._teach_dirty) and self._jog is None and self._active is None \
                 and now - self._released_at >= TEACH_IDLE_DISABLE:
             try:
                 self._stop_jog_and_teach()
             except TeachPadError as exc:
-                self.errorOccurred.emit(WorkerError("teach disable", str(exc)))
+                self._emit_error(Operation.TEACH_DISABLE, str(exc))
 
     def _note_rtt(self, seconds: float, transactions: int, now: float) -> None:
         self._rtt_sum += seconds
@@ -1098,7 +1361,9 @@ class RobotLink(QObject):
     errorOccurred = Signal(WorkerError)  # noqa: N815
     trafficObserved = Signal(list)  # noqa: N815
     controllerReconnected = Signal()  # noqa: N815
+    controllerRestarted = Signal()  # noqa: N815
     uploadProgress = Signal(int, int)  # noqa: N815
+    pointUploaded = Signal(int, bool, str)  # noqa: N815
 
     _connectRequested = Signal(object)  # noqa: N815
     _disconnectRequested = Signal()  # noqa: N815
@@ -1106,7 +1371,8 @@ class RobotLink(QObject):
     _pollRateRequested = Signal(float)  # noqa: N815
     _captureRequested = Signal(bool)  # noqa: N815
 
-    def __init__(self, parent: QObject | None = None, *, poll_hz: float = timing.POLL_HZ_DEFAULT) -> None:
+    def __init__(self, parent: QObject | None = None, *, poll_hz: float = timing.POLL_HZ_DEFAULT,
+                 canary_gv: int | None = DEFAULT_CANARY_GV) -> None:
         super().__init__(parent)
         self._settings: ConnectionSettings | None = None
         self._state = ConnectionState(LinkState.DISCONNECTED)
@@ -1114,12 +1380,13 @@ class RobotLink(QObject):
         self._capture_users = 0
         self._thread = QThread()
         self._thread.setObjectName("RobotWorker")
-        self._worker = RobotWorker(poll_hz)
+        self._worker = RobotWorker(poll_hz, canary_gv=canary_gv)
         self._worker.moveToThread(self._thread)
         self._thread.started.connect(self._worker.start)
         w = self._worker
         for name in ("poseChanged", "statusChanged", "alarmsChanged", "rttChanged", "commandFinished",
-                     "errorOccurred", "trafficObserved", "controllerReconnected", "uploadProgress"):
+                     "errorOccurred", "trafficObserved", "controllerReconnected", "controllerRestarted",
+                     "uploadProgress", "pointUploaded"):
             getattr(w, name).connect(getattr(self, name))
         w.connectionChanged.connect(self._on_connection)
         self._connectRequested.connect(w.connect_to)
@@ -1177,66 +1444,73 @@ class RobotLink(QObject):
         self._captureRequested.emit(self._capture_users > 0)
 
     # --- commands (queued; results come back as signals) -------------------------------
-    def stop(self) -> None:
-        if not self._shut:
-            self._worker.request_stop()
+    # Each returns the request id that its CommandResult / WorkerError will carry (0 after shutdown:
+    # nothing was queued).
+    def stop(self) -> int:
+        return 0 if self._shut else self._worker.request_stop()
 
-    def pause(self) -> None:
-        if not self._shut:
-            self._worker.request_pause()
+    def pause(self) -> int:
+        return 0 if self._shut else self._worker.request_pause()
 
-    def resume(self) -> None:
-        if not self._shut:
-            self._worker.request_resume()
+    def resume(self) -> int:
+        return 0 if self._shut else self._worker.request_resume()
 
     def jog_press(self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0,
-                  tool: int = 0) -> None:
-        if not self._shut:
-            self._worker.request_jog_press(JogRequest(TeachFrame(frame), axis, direction, ratio, user, tool))
+                  tool: int = 0) -> int:
+        if self._shut:
+            return 0
+        request = JogRequest(TeachFrame(frame), axis, direction, ratio, user, tool)
+        return self._worker.request_jog_press(request)
 
-    def jog_release(self) -> None:
-        if not self._shut:
-            self._worker.request_jog_release()
+    def jog_release(self) -> int:
+        return 0 if self._shut else self._worker.request_jog_release()
 
-    def set_jog_ratio(self, ratio: float) -> None:
-        if not self._shut:
-            self._worker.request_jog_ratio(ratio)
+    def set_jog_ratio(self, ratio: float) -> int:
+        return 0 if self._shut else self._worker.request_jog_ratio(ratio)
 
     def step(self, frame: StepFrame, offsets: Sequence[float],
              ext_offsets: Sequence[float] = (0.0,) * registers.NUM_EXTERNAL_AXES,
-             speed: float = 10.0) -> None:
-        if not self._shut:
-            self._worker.request_step(frame, offsets, ext_offsets, speed)
+             speed: float = 10.0) -> int:
+        return 0 if self._shut else self._worker.request_step(frame, offsets, ext_offsets, speed)
 
-    def set_mode(self, mode: WorkMode) -> None:
-        if not self._shut:
-            self._worker.request_set_mode(mode)
+    def set_mode(self, mode: WorkMode) -> int:
+        return 0 if self._shut else self._worker.request_set_mode(mode)
 
-    def go_zero(self, axis: int | None) -> None:
-        if not self._shut:
-            self._worker.request_go_zero(axis)
+    def go_zero(self, axis: int | None) -> int:
+        return 0 if self._shut else self._worker.request_go_zero(axis)
 
     def run_program(self, program_id: int, mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
-                    cycles: int = 1, speed_ratio: int = 100) -> None:
-        if not self._shut:
-            self._worker.request_run_program(program_id, mode, cycles, speed_ratio)
+                    cycles: int = 1, speed_ratio: int = 100) -> int:
+        return 0 if self._shut else self._worker.request_run_program(program_id, mode, cycles, speed_ratio)
 
     def create_point(self, point_id: int, pose: Sequence[float] | None = None,
-                     tool: int = registers.TOOL_NONE) -> None:
-        if not self._shut:
-            self._worker.request_create_point(point_id, pose, tool)
+                     tool: int = registers.TOOL_NONE) -> int:
+        return 0 if self._shut else self._worker.request_create_point(point_id, pose, tool)
 
     def move_to_point(self, end_id: int, via_id: int | None = None, *, orientation_changes: bool = True,
                       ignore_middle: bool = False, speed: float = 50.0,
-                      tool: int = registers.TOOL_NONE) -> None:
-        if not self._shut:
-            self._worker.request_move_to_point(end_id, via_id, orientation_changes, ignore_middle, speed,
-                                               tool)
+                      tool: int = registers.TOOL_NONE) -> int:
+        if self._shut:
+            return 0
+        return self._worker.request_move_to_point(end_id, via_id, orientation_changes, ignore_middle, speed,
+                                                  tool)
 
-    def upload_points(self, points: Iterable[tuple[int, Sequence[float]]],
-                      tool: int = registers.TOOL_NONE) -> None:
-        if not self._shut:
-            self._worker.request_upload_points(points, tool)
+    def upload_points(self, points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
+                      tool: int = registers.TOOL_NONE) -> int:
+        """Create temp points from (id, pose6, tool) items ((id, pose6) items take ``tool``).
+
+        The worker groups them by tool frame (GV245 written once per group) and reports each
+        point with ``pointUploaded``, progress with ``uploadProgress`` and the batch with one
+        ``commandFinished`` carrying the returned id. Stop or :meth:`cancel_upload` end it
+        between two points."""
+        if self._shut:
+            return 0
+        items = [(item[0], item[1], item[2] if len(item) > 2 else tool) for item in points]
+        return self._worker.request_upload_points(items)
+
+    def cancel_upload(self) -> int:
+        """End the running upload after the current point; sends no stop to the controller."""
+        return 0 if self._shut else self._worker.request_cancel_upload()
 
     # --- shutdown -----------------------------------------------------------------------
     @Slot()

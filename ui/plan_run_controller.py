@@ -7,12 +7,11 @@ for segment k. Pause / resume / stop are forwarded to the link. A failed segment
 command or a lost link ends the run in ``FAILED`` at that segment; :meth:`resume_run`
 continues from it ("Resume from k").
 
-Which ``commandFinished`` belongs to the running segment: results of command
-``MOVE_TO_POINT``, and failures the link reports without a command but with the move's kind
-or the "move to point" operation name (a Modbus exception, a refusal, "cancelled by Stop").
-Plain acknowledgements ("pause: sent") and other commands' results are ignored. The link runs
-one motion at a time, so this is unambiguous as long as nothing else moves the robot during a
-run (the panels disable their motion buttons while :attr:`running`).
+Which ``commandFinished`` / ``errorOccurred`` belongs to the running segment: the one carrying
+the request id that ``link.move_to_point`` returned for it (the link gives every request an id
+and every outcome, including "cancelled by Stop" and refusals, carries it). Everything else
+(acknowledgements, other panels' commands) is ignored. A failed stop request of ours, matched by
+its id, ends a run that is stopping.
 """
 
 from __future__ import annotations
@@ -25,11 +24,8 @@ from PySide6.QtCore import QObject, Signal, SignalInstance, Slot
 from app.errors import LinkError, TeachPadError
 from app.models import CommandResult, Pose
 from app.plan import Plan, Segment
-from app.protocol.enums import CommandKind, MoveStatus, RunCommand
+from app.protocol.enums import MoveStatus
 from app.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState
-
-MOVE_OPERATION = "move to point"  # the link's name of the move job (WorkerError.operation)
-STOP_OPERATION = "stop"
 
 
 class MotionLink(Protocol):
@@ -44,22 +40,13 @@ class MotionLink(Protocol):
     def state(self) -> Any: ...  # ConnectionState (.connected)
 
     def move_to_point(self, end_id: int, via_id: int | None = None, *, orientation_changes: bool = ...,
-                      ignore_middle: bool = ..., speed: float = ..., tool: int = ...) -> None: ...
+                      ignore_middle: bool = ..., speed: float = ..., tool: int = ...) -> int: ...
 
-    def stop(self) -> None: ...
+    def stop(self) -> int: ...
 
-    def pause(self) -> None: ...
+    def pause(self) -> int: ...
 
-    def resume(self) -> None: ...
-
-
-def is_move_result(result: CommandResult) -> bool:
-    """Whether ``result`` ends a move-to-point command (see the module docstring)."""
-    if result.command is RunCommand.MOVE_TO_POINT:
-        return True
-    if result.command is None and not result.ok:
-        return result.kind is CommandKind.MOVE or result.message.startswith(MOVE_OPERATION)
-    return False
+    def resume(self) -> int: ...
 
 
 class PlanRunController(QObject):
@@ -93,6 +80,8 @@ class PlanRunController(QObject):
         self._outcome: RunOutcome | None = None
         self._progress: RunProgress | None = None
         self._sent: list[int] = []  # segment indices sent, in order (for tests and the log)
+        self._move_request: int | None = None  # request id of the segment under way
+        self._stop_request: int | None = None  # request id of our last stop
         if link is not None:
             self.set_link(link)
 
@@ -219,7 +208,7 @@ class PlanRunController(QObject):
         runner = self._runner
         link = self._link
         if link is not None:
-            link.stop()
+            self._stop_request = link.stop()
         if runner is None or runner.state.is_over:
             return
         runner.request_stop()
@@ -259,8 +248,9 @@ class PlanRunController(QObject):
             return
         seg = command.segment
         self._sent.append(command.index)
-        link.move_to_point(seg.end_id, seg.via_id, orientation_changes=seg.orientation_changes,
-                           ignore_middle=seg.ignore_middle, speed=seg.speed, tool=seg.tool)
+        self._move_request = link.move_to_point(
+            seg.end_id, seg.via_id, orientation_changes=seg.orientation_changes,
+            ignore_middle=seg.ignore_middle, speed=seg.speed, tool=seg.tool)
 
     def _finish(self) -> None:
         runner = self._runner
@@ -281,8 +271,10 @@ class PlanRunController(QObject):
     @Slot(object)
     def _on_result(self, result: CommandResult) -> None:
         runner = self._runner
-        if runner is None or runner.state is not RunState.RUNNING or not is_move_result(result):
+        if runner is None or runner.state is not RunState.RUNNING or result.request_id is None \
+                or result.request_id != self._move_request:
             return
+        self._move_request = None
         current = runner.current
         missing = (not result.ok and result.status is not None
                    and result.status.code == MoveStatus.BAD_END_POINT and current is not None)
@@ -296,12 +288,15 @@ class PlanRunController(QObject):
         runner = self._runner
         if runner is None or runner.state is not RunState.RUNNING:
             return
-        operation = str(getattr(error, "operation", ""))
+        request_id = getattr(error, "request_id", None)
         message = str(getattr(error, "message", error))
-        if operation == MOVE_OPERATION:
+        if request_id is None:
+            return
+        if request_id == self._move_request:
+            self._move_request = None
             runner.on_error(TeachPadError(message))
             self._after_report()
-        elif operation == STOP_OPERATION and runner.stop_requested:
+        elif request_id == self._stop_request and runner.stop_requested:
             runner.on_stopped(message)
             self._finish()
 

@@ -13,10 +13,12 @@ Two classes:
 The link is anything that fits :class:`PointLink` (``app.worker.RobotLink`` does); the tests
 use a small fake.
 
-Completion of the link's commands is matched by kind: only one point operation runs at a
-time, and ``commandFinished`` results are taken for it when their command (or, for failures
-reported without one, their kind or operation name) matches. Teach reads the pose back from
-the ``x``..``c`` details that ``RobotLink`` adds to a successful create-point result (the
+Completion of the link's commands is matched by request id: every link command returns one
+and the ``commandFinished`` / ``errorOccurred`` that ends it carries it. An upload is one
+request: ``pointUploaded`` marks each point on the controller / failed as it goes (applied to
+the ledger at each ``uploadProgress`` and at the end, so a cancel or a lost link half way
+leaves exact states), and the batch's ``commandFinished`` ends it. Teach reads the pose back
+from the ``x``..``c`` details that ``RobotLink`` adds to a successful create-point result (the
 pose polled together with the completion); without them it uses the latest ``poseChanged``.
 """
 
@@ -51,7 +53,6 @@ from PySide6.QtWidgets import (
 from app.errors import InvalidInput
 from app.models import CommandResult, Pose
 from app.points import SyncState, TempPoint, UploadOutcome, UploadReport
-from app.protocol.enums import CommandKind, RunCommand
 from app.protocol.registers import TOOL_NONE
 from ui.points_model import (
     COL_ID,
@@ -78,23 +79,27 @@ class PointLink(Protocol):
     """What the point panel needs from the robot link (``app.worker.RobotLink`` fits)."""
 
     poseChanged: SignalInstance  # (Pose)
-    commandFinished: SignalInstance  # (CommandResult)
-    errorOccurred: SignalInstance  # (WorkerError: .operation, .message)
+    commandFinished: SignalInstance  # (CommandResult, .request_id)
+    errorOccurred: SignalInstance  # (WorkerError: .operation, .message, .request_id)
     connectionChanged: SignalInstance  # (ConnectionState: .connected, .message)
     controllerReconnected: SignalInstance  # ()
-    uploadProgress: SignalInstance  # (done, total) of the running batch
+    uploadProgress: SignalInstance  # (done, total) of the running upload
+    pointUploaded: SignalInstance  # (point id, ok, reason)
+    # optional: controllerRestarted (), the restart canary; handled like controllerReconnected
 
     @property
     def state(self) -> Any: ...  # ConnectionState
 
-    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = ...) -> None: ...
+    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = ...) -> int: ...
 
-    def upload_points(self, points: Iterable[tuple[int, Sequence[float]]], tool: int = ...) -> None: ...
+    def upload_points(self, points: Iterable[tuple[int, Sequence[float], int]]) -> int: ...
+
+    def cancel_upload(self) -> int: ...
 
     def move_to_point(self, end_id: int, via_id: int | None = None, *, orientation_changes: bool = ...,
-                      ignore_middle: bool = ..., speed: float = ..., tool: int = ...) -> None: ...
+                      ignore_middle: bool = ..., speed: float = ..., tool: int = ...) -> int: ...
 
-    def stop(self) -> None: ...
+    def stop(self) -> int: ...
 
 
 def result_reason(result: CommandResult) -> str:
@@ -114,13 +119,17 @@ def _pose_from_details(details: dict[str, float], fallback: Pose | None) -> Pose
 
 @dataclass
 class _Upload:
-    batches: list[list[TempPoint]]
-    total: int
+    points: dict[int, TempPoint]  # id -> the point as sent (ledger order)
     restore: bool
-    done_before: int = 0  # points in the finished batches
-    failures: dict[int, str] = field(default_factory=dict)  # of the running batch
+    request_id: int = 0
     report: UploadReport = field(default_factory=UploadReport)
+    pending: list[UploadOutcome] = field(default_factory=list)  # reported, not yet in the ledger
     cancelled: bool = False
+    link_lost: str | None = None  # the link went down: waiting for the worker's final result
+
+    @property
+    def total(self) -> int:
+        return len(self.points)
 
 
 class PointSyncController(QObject):
@@ -151,6 +160,7 @@ class PointSyncController(QObject):
         self._teach_id: int | None = None
         self._teach_name = ""
         self._move_id: int | None = None
+        self._request = 0  # request id of the running teach / move
         self._upload: _Upload | None = None
         self._last_pose: Pose | None = None
         self._restore_offered = False
@@ -196,7 +206,11 @@ class PointSyncController(QObject):
         link.errorOccurred.connect(self._on_error)
         link.connectionChanged.connect(self._on_connection)
         link.controllerReconnected.connect(self._on_reconnected)
+        restarted = getattr(link, "controllerRestarted", None)  # the restart canary (RobotLink)
+        if restarted is not None:
+            restarted.connect(self._on_reconnected)  # the same path: the points may be gone
         link.uploadProgress.connect(self._on_upload_progress)
+        link.pointUploaded.connect(self._on_point_uploaded)
         state = getattr(link, "state", None)
         self._set_connected(bool(getattr(state, "connected", False)))
 
@@ -216,11 +230,12 @@ class PointSyncController(QObject):
         self._teach_name = name
         self._set_operation("teach")
         self._say(self.tr("Teaching P{id} at the current pose…").format(id=point_id), LEVEL_INFO)
-        link.create_point(point_id, None, self.teach_tool)
+        self._request = link.create_point(point_id, None, self.teach_tool)
         return point_id
 
     def upload(self, point_ids: Iterable[int], *, restore: bool = False) -> bool:
-        """Create these points on the controller (ledger order kept within each tool frame)."""
+        """Create these points on the controller (one request; the link groups them by tool frame,
+        keeping the ledger order within each)."""
         wanted = set(point_ids)
         points = [p for p in self._model.ledger if p.id in wanted]
         if not points:
@@ -229,14 +244,12 @@ class PointSyncController(QObject):
         link = self._ready(self.tr("Upload"))
         if link is None:
             return False
-        by_tool: dict[int, list[TempPoint]] = {}
-        for point in points:
-            by_tool.setdefault(point.tool, []).append(point)
-        self._upload = _Upload(list(by_tool.values()), len(points), restore)
+        upload = _Upload({p.id: p for p in points}, restore)
+        self._upload = upload
         self._set_operation("upload")
         self.uploadProgress.emit(0, len(points))
         self._say(self.tr("Uploading {n} points…").format(n=len(points)), LEVEL_INFO)
-        self._send_batch()
+        upload.request_id = link.upload_points([(p.id, p.xyzabc, p.tool) for p in points])
         return True
 
     def upload_needed(self) -> bool:
@@ -248,14 +261,19 @@ class PointSyncController(QObject):
         return self.upload(self._model.ledger.ids(), restore=True)
 
     def cancel_upload(self) -> None:
-        """Stop after the point being created; the points done so far are recorded."""
+        """End the upload after the point being created (no controller stop); the points done
+        so far are recorded."""
         upload = self._upload
-        if upload is None or upload.cancelled:
+        if upload is None:
+            return
+        if upload.link_lost is not None:  # nothing more will come from the worker for it
+            self._finish_upload(aborted=upload.link_lost)
+            return
+        if upload.cancelled:
             return
         upload.cancelled = True
-        del upload.batches[1:]
         if self._link is not None:
-            self._link.stop()
+            self._link.cancel_upload()
         self._say(self.tr("Cancelling the upload…"), LEVEL_WARN)
 
     def move_to(self, point_id: int, speed: float = DEFAULT_MOVE_SPEED) -> bool:
@@ -278,8 +296,8 @@ class PointSyncController(QObject):
         self._set_operation("move")
         self._say(self.tr("Moving to {point} at {v} mm/s…").format(point=point.label, v=f"{speed:g}"),
                   LEVEL_INFO)
-        link.move_to_point(point_id, None, orientation_changes=True, ignore_middle=False, speed=float(speed),
-                           tool=point.tool)
+        self._request = link.move_to_point(point_id, None, orientation_changes=True, ignore_middle=False,
+                                           speed=float(speed), tool=point.tool)
         return True
 
     def points_missing(self, point_ids: Iterable[int]) -> None:
@@ -341,35 +359,43 @@ class PointSyncController(QObject):
         self._set_connected(connected)
         if not connected and self._operation:
             reason = getattr(state, "message", "") or self.tr("link lost")
-            self._abort(reason)
+            if self._upload is not None:
+                # The worker still reports the points it finished, then ends the batch: wait for it.
+                self._upload.link_lost = reason
+            else:
+                self._abort(reason)
 
     @Slot()
     def _on_reconnected(self) -> None:
-        changed = self._model.mark_all_unknown()
+        """The controller restarted (canary) or the link came back: its points may be gone."""
+        self._flush_upload()
+        self._model.mark_all_unknown()
         if len(self._model.ledger):
             self._offer_restore(True)
             self._say(self.tr("The controller restarted or reconnected: {n} points may be gone from it. "
                               "Restore all to re-create them.").format(n=len(self._model.ledger)), LEVEL_WARN)
-        del changed
+
+    def _current_request(self) -> int | None:
+        if self._upload is not None:
+            return self._upload.request_id
+        return self._request if self._operation in ("teach", "move") else None
 
     @Slot(object)
     def _on_error(self, error: Any) -> None:
-        operation = str(getattr(error, "operation", ""))
-        message = str(getattr(error, "message", error))
-        expected = {"teach": "create point", "upload": "upload points", "move": "move to point"}
-        if self._operation and operation == expected.get(self._operation):
-            self._abort(message)
+        request_id = getattr(error, "request_id", None)
+        if request_id is not None and request_id == self._current_request():
+            self._abort(str(getattr(error, "message", error)))
 
     @Slot(object)
     def _on_result(self, result: CommandResult) -> None:
+        if result.request_id is None or result.request_id != self._current_request():
+            return
         if self._operation == "teach":
-            if _is_result_of(result, RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, "create point"):
-                self._finish_teach(result)
+            self._finish_teach(result)
         elif self._operation == "move":
-            if _is_result_of(result, RunCommand.MOVE_TO_POINT, CommandKind.MOVE, "move to point"):
-                self._finish_move(result)
+            self._finish_move(result)
         elif self._operation == "upload":
-            self._upload_result(result)
+            self._upload_done(result)
 
     def _abort(self, reason: str) -> None:
         operation = self._operation
@@ -429,54 +455,46 @@ class PointSyncController(QObject):
             self.moveFinished.emit(False, reason)
 
     # upload
-    def _send_batch(self) -> None:
+    @Slot(int, bool, str)
+    def _on_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None:
         upload = self._upload
-        assert upload is not None and self._link is not None
-        batch = upload.batches[0]
-        upload.failures = {}
-        self._link.upload_points([(p.id, p.xyzabc) for p in batch], batch[0].tool)
+        if upload is None or point_id not in upload.points:
+            return
+        sent = upload.points[point_id]
+        outcome = UploadOutcome(point_id, True, sent=sent) if ok else UploadOutcome(point_id, False, reason)
+        upload.report.outcomes.append(outcome)
+        upload.pending.append(outcome)
+
+    def _flush_upload(self) -> None:
+        """Apply the outcomes reported since the last flush to the ledger (one model update)."""
+        upload = self._upload
+        if upload is not None and upload.pending:
+            batch, upload.pending = upload.pending, []
+            self._model.apply_upload(UploadReport(outcomes=batch))
 
     @Slot(int, int)
     def _on_upload_progress(self, done: int, total: int) -> None:
         upload = self._upload
         if upload is not None and self._operation == "upload":
-            self.uploadProgress.emit(upload.done_before + min(done, total), upload.total)
+            self._flush_upload()
+            self.uploadProgress.emit(min(done, upload.total), upload.total)
 
-    def _upload_result(self, result: CommandResult) -> None:
+    def _upload_done(self, result: CommandResult) -> None:
         upload = self._upload
         assert upload is not None
-        details = result.details
-        if "point_id" in details and not result.ok:
-            upload.failures[int(details["point_id"])] = result.message or result_reason(result)
-            return
-        if result.command is RunCommand.CREATE_POINT and "uploaded" in details:
-            self._batch_done(result)
-        elif result.command is None and not result.ok and result.message.startswith("upload points"):
-            self._finish_upload(aborted=result.message)
-
-    def _batch_done(self, result: CommandResult) -> None:
-        upload = self._upload
-        assert upload is not None
-        batch = upload.batches.pop(0)
-        uploaded = int(result.details.get("uploaded", 0))
-        good = [p for p in batch if p.id not in upload.failures][:uploaded]
-        outcomes = [UploadOutcome(p.id, True, sent=p) for p in good]
-        outcomes += [UploadOutcome(pid, False, reason) for pid, reason in upload.failures.items()]
-        batch_report = UploadReport(outcomes=outcomes)
-        attempted = len(good) + len(upload.failures)
-        upload.report.outcomes.extend(outcomes)
-        self._model.apply_upload(batch_report)
-        upload.done_before += len(batch)
-        self.uploadProgress.emit(upload.done_before, upload.total)
-        if attempted < len(batch):
-            reason = self.tr("cancelled") if upload.cancelled else (result.message or self.tr("stopped"))
-            self._finish_upload(aborted=reason, rest=batch[attempted:])
-        elif upload.batches and not upload.cancelled:
-            self._send_batch()
+        self._flush_upload()
+        attempted = len(upload.report.outcomes)
+        self.uploadProgress.emit(attempted, upload.total)
+        if attempted >= upload.total:
+            self._finish_upload(aborted=None)
+        elif upload.cancelled:
+            self._finish_upload(aborted=self.tr("cancelled"))
         else:
-            self._finish_upload(aborted=self.tr("cancelled") if upload.cancelled and upload.batches else None)
+            reason = upload.link_lost or _batch_reason(result.message) or self.tr("stopped")
+            self._finish_upload(aborted=reason)
 
-    def _finish_upload(self, aborted: str | None, rest: Sequence[TempPoint] = ()) -> None:
+    def _finish_upload(self, aborted: str | None) -> None:
+        self._flush_upload()
         upload, self._upload = self._upload, None
         self._set_operation("")
         if upload is None:
@@ -485,8 +503,7 @@ class PointSyncController(QObject):
         done_ids = {o.point_id for o in report.outcomes}
         if aborted is not None:
             report.aborted = aborted
-            pending = [p.id for p in rest] + [p.id for b in upload.batches for p in b]
-            report.not_attempted = [pid for pid in pending if pid not in done_ids]
+            report.not_attempted = [pid for pid in upload.points if pid not in done_ids]
         ok, failed = report.ok_count, len(report.failed)
         if report.all_ok:
             self._say(self.tr("Uploaded {n} points").format(n=ok), LEVEL_INFO)
@@ -503,13 +520,10 @@ class PointSyncController(QObject):
         self.uploadFinished.emit(report)
 
 
-def _is_result_of(result: CommandResult, command: RunCommand, kind: CommandKind, operation: str) -> bool:
-    """Whether ``result`` ends the command we wait for (failures may come without a command)."""
-    if result.command is command:
-        return True
-    if result.command is None and not result.ok:
-        return result.kind is kind or result.message.startswith(operation)
-    return False
+def _batch_reason(message: str) -> str:
+    """Why an upload ended early, from the link's "uploaded N of M points (reason)"."""
+    _head, sep, tail = message.partition(" (")
+    return tail[:-1] if sep and tail.endswith(")") else message
 
 
 # --------------------------------------------------------------------------------------------

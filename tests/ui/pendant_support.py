@@ -25,7 +25,21 @@ def fast_reconnect_fixture(monkeypatch: pytest.MonkeyPatch) -> None:
 
 @pytest.fixture(name="link")
 def link_fixture(qtbot: Any, fast_reconnect: None) -> Iterator[RobotLink]:
-    """A RobotLink (worker thread running), shut down after the test."""
+    """A RobotLink (worker thread running), shut down after the test. The restart canary is off
+    here, so tests can say "nothing was written"; ``canary_link`` has it on (GV99, the default)."""
+    robot_link = RobotLink(poll_hz=timing.POLL_HZ_DEFAULT, canary_gv=None)
+    try:
+        yield robot_link
+    finally:
+        robot_link.shutdown()
+        assert not robot_link.is_running
+
+
+@pytest.fixture(name="canary_link")
+def canary_link_fixture(qtbot: Any, fast_reconnect: None,
+                        monkeypatch: pytest.MonkeyPatch) -> Iterator[RobotLink]:
+    """A RobotLink with the restart canary on its default GV, checked every 0.1 s."""
+    monkeypatch.setattr(timing, "CLOCK_POLL_PERIOD", 0.1)
     robot_link = RobotLink(poll_hz=timing.POLL_HZ_DEFAULT)
     try:
         yield robot_link

@@ -270,8 +270,12 @@ def test_lost_link_and_refusal_end_the_run(qtbot: Any, runner: PlanRunController
     assert finished.args[0].state is RunState.FAILED and "connection reset" in finished.args[0].message
     link.set_connected(True)
     runner.resume_run()
+    link.errorOccurred.emit(FakeError("move to point", "another request's error",
+                                      link.last_id("move_to_point") - 1))
+    assert runner.running  # not ours
     with qtbot.waitSignal(runner.runFinished) as finished:
-        link.errorOccurred.emit(FakeError("move to point", "jog is still under way"))
+        link.errorOccurred.emit(FakeError("move to point", "jog is still under way",
+                                          link.last_id("move_to_point")))
     assert finished.args[0].resume_from == 0 and "jog is still under way" in finished.args[0].message
 
 
@@ -329,8 +333,9 @@ def test_panel_summary_and_upload_now_then_run(qtbot: Any, planner: PlannerPanel
     assert planner.run(0)
     assert "not on the controller" in planner.questions[0]  # type: ignore[attr-defined]
     (upload,) = link.named("upload_points")
-    assert sorted(pid for pid, _ in upload.args[0]) == [1, 5, 6, 7, 8]
+    assert sorted(pid for pid, _, _ in upload.args[0]) == [1, 5, 6, 7, 8]
     assert moves(link) == []
+    link.point_ok(1, 5, 6, 7, 8)
     with qtbot.waitSignal(planner.run_controller.runningChanged):
         link.upload_summary(5, 5)
     assert moves(link) == [(5, None)]

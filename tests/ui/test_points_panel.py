@@ -35,6 +35,7 @@ class FakeState:
 class FakeError:
     operation: str
     message: str
+    request_id: int | None = None
 
 
 @dataclass
@@ -42,48 +43,63 @@ class Call:
     name: str
     args: tuple[Any, ...]
     kwargs: dict[str, Any] = field(default_factory=dict)
+    request_id: int = 0
 
 
 class FakeLink(QObject):
-    """The signals and methods of ``RobotLink`` the panels use; records the calls."""
+    """The signals and methods of ``RobotLink`` the panels use; records the calls. Every command
+    returns a request id; the ``finish_*`` helpers answer the latest request of their kind."""
 
     poseChanged = Signal(object)  # noqa: N815
     commandFinished = Signal(object)  # noqa: N815
     errorOccurred = Signal(object)  # noqa: N815
     connectionChanged = Signal(object)  # noqa: N815
     controllerReconnected = Signal()  # noqa: N815
+    controllerRestarted = Signal()  # noqa: N815
     uploadProgress = Signal(int, int)  # noqa: N815
+    pointUploaded = Signal(int, bool, str)  # noqa: N815
     called = Signal(str)
 
     def __init__(self, connected: bool = True) -> None:
         super().__init__()
         self.state = FakeState(connected)
         self.calls: list[Call] = []
+        self._next_id = 100
 
-    def _record(self, name: str, *args: Any, **kwargs: Any) -> None:
-        self.calls.append(Call(name, args, kwargs))
+    def _record(self, name: str, *args: Any, **kwargs: Any) -> int:
+        self._next_id += 1
+        self.calls.append(Call(name, args, kwargs, self._next_id))
         self.called.emit(name)
+        return self._next_id
 
     def named(self, name: str) -> list[Call]:
         return [c for c in self.calls if c.name == name]
 
-    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = 200) -> None:
-        self._record("create_point", point_id, pose, tool)
+    def last_id(self, name: str) -> int:
+        """The id of the latest ``name`` call (0, an id never given out, if there was none)."""
+        calls = self.named(name)
+        return calls[-1].request_id if calls else 0
 
-    def upload_points(self, points: Any, tool: int = 200) -> None:
-        self._record("upload_points", [(pid, tuple(pose)) for pid, pose in points], tool)
+    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = 200) -> int:
+        return self._record("create_point", point_id, pose, tool)
 
-    def move_to_point(self, end_id: int, via_id: int | None = None, **kwargs: Any) -> None:
-        self._record("move_to_point", end_id, via_id, **kwargs)
+    def upload_points(self, points: Any) -> int:
+        return self._record("upload_points", [(pid, tuple(pose), tool) for pid, pose, tool in points])
 
-    def stop(self) -> None:
-        self._record("stop")
+    def cancel_upload(self) -> int:
+        return self._record("cancel_upload")
 
-    def pause(self) -> None:
-        self._record("pause")
+    def move_to_point(self, end_id: int, via_id: int | None = None, **kwargs: Any) -> int:
+        return self._record("move_to_point", end_id, via_id, **kwargs)
 
-    def resume(self) -> None:
-        self._record("resume")
+    def stop(self) -> int:
+        return self._record("stop")
+
+    def pause(self) -> int:
+        return self._record("pause")
+
+    def resume(self) -> int:
+        return self._record("resume")
 
     # what the worker would emit
     def set_connected(self, connected: bool, message: str = "") -> None:
@@ -94,23 +110,27 @@ class FakeLink(QObject):
         details = dict(zip("xyzabc", pose, strict=True)) if pose is not None else {}
         status = CommandStatus(CommandKind.CREATE_POINT, 0xFF if ok else 1)
         self.commandFinished.emit(CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, status, ok,
-                                                message, {k: float(v) for k, v in details.items()}))
+                                                message, {k: float(v) for k, v in details.items()},
+                                                request_id=self.last_id("create_point")))
 
     def finish_move(self, ok: bool = True, code: int = 0xFF, message: str = "") -> None:
         status = CommandStatus(CommandKind.MOVE, code)
-        result = CommandResult(RunCommand.MOVE_TO_POINT, CommandKind.MOVE, status, ok, message)
+        result = CommandResult(RunCommand.MOVE_TO_POINT, CommandKind.MOVE, status, ok, message,
+                               request_id=self.last_id("move_to_point"))
         self.commandFinished.emit(result)
+
+    def point_ok(self, *point_ids: int) -> None:
+        for point_id in point_ids:
+            self.pointUploaded.emit(point_id, True, "")
 
     def point_failed(self, point_id: int, message: str) -> None:
-        status = CommandStatus(CommandKind.CREATE_POINT, 1)
-        result = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, status, False, message,
-                               {"point_id": float(point_id)})
-        self.commandFinished.emit(result)
+        self.pointUploaded.emit(point_id, False, message)
 
-    def upload_summary(self, uploaded: int, total: int, stopped: bool = False) -> None:
-        text = f"uploaded {uploaded} of {total} points" + (" (stopped)" if stopped else "")
+    def upload_summary(self, uploaded: int, total: int, reason: str = "") -> None:
+        text = f"uploaded {uploaded} of {total} points" + (f" ({reason})" if reason else "")
         self.commandFinished.emit(CommandResult(RunCommand.CREATE_POINT, None, None, uploaded == total, text,
-                                                {"uploaded": float(uploaded)}))
+                                                {"uploaded": float(uploaded)},
+                                                request_id=self.last_id("upload_points")))
 
 
 # --- fixtures -------------------------------------------------------------------------------
@@ -196,6 +216,9 @@ def test_teach_ignores_unrelated_results_and_ends_on_link_loss(qtbot: Any, panel
     panel.teach()
     link.commandFinished.emit(CommandResult(None, None, None, True, "pause: sent"))
     link.finish_move(True)
+    stale = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, None, True, "",
+                          request_id=link.last_id("create_point") - 1)  # an older create's result
+    link.commandFinished.emit(stale)
     assert panel.controller.busy
     link.set_connected(False, "connection refused")
     assert not panel.controller.busy
@@ -219,22 +242,24 @@ def test_upload_selected_with_progress_and_a_refused_point(qtbot: Any, panel: Po
     panel.select_rows([0, 2, 4])
     panel.action_upload_selected.trigger()
     (call,) = link.named("upload_points")
-    assert [pid for pid, _ in call.args[0]] == [1, 3, 5] and call.args[1] == 200
+    assert [(pid, tool) for pid, _, tool in call.args[0]] == [(1, 200), (3, 200), (5, 200)]
     assert call.args[0][0][1] == (400.0, 0.0, 450.0, 180.0, 0.0, 0.0)
     assert panel.progress_row.isVisibleTo(panel)
+    ledger = panel.model.ledger
+    link.point_ok(1)
     link.uploadProgress.emit(1, 3)
     assert panel.progress.value() == 1
-    link.uploadProgress.emit(2, 3)
+    assert ledger.point(1).sync is SyncState.ON_CONTROLLER  # marked as it goes
     link.point_failed(3, "point 3: bad point id")
+    link.point_ok(5)
     link.uploadProgress.emit(3, 3)
+    assert ledger.point(3).sync is SyncState.FAILED and "bad point id" in ledger.point(3).sync_error
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
         link.upload_summary(2, 3)
     report = finished.args[0]
     assert report.ok_count == 2 and [o.point_id for o in report.failed] == [3]
-    ledger = panel.model.ledger
     assert ledger.point(1).sync is SyncState.ON_CONTROLLER
     assert ledger.point(5).sync is SyncState.ON_CONTROLLER
-    assert ledger.point(3).sync is SyncState.FAILED and "bad point id" in ledger.point(3).sync_error
     assert ledger.point(2).sync is SyncState.UNKNOWN  # not part of it
     assert not panel.progress_row.isVisibleTo(panel)
 
@@ -243,54 +268,89 @@ def test_cancel_half_way_keeps_what_was_uploaded(qtbot: Any, panel: PointsPanel,
     ledger = panel.model.ledger
     panel.model.setData(panel.model.index(5, COL_X), "401")  # P6 changed on host
     panel.upload_all()
-    link.uploadProgress.emit(1, 8)
+    link.point_ok(1, 2)
     link.uploadProgress.emit(2, 8)
     panel.action_cancel_upload.trigger()
-    assert link.named("stop")  # the worker's stop ends a running upload
+    assert link.named("cancel_upload") and not link.named("stop")  # no controller stop
+    assert panel.controller.busy  # until the link says the batch ended
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
-        link.upload_summary(2, 8, stopped=True)
+        link.upload_summary(2, 8, "cancelled")
     report = finished.args[0]
-    assert report.aborted and report.not_attempted == [3, 4, 5, 6, 7, 8]
+    assert report.aborted == "cancelled" and report.not_attempted == [3, 4, 5, 6, 7, 8]
     assert [p.sync for p in ledger][:2] == [SyncState.ON_CONTROLLER] * 2
     assert ledger.point(6).sync is SyncState.CHANGED  # kept its state
     assert ledger.point(7).sync is SyncState.UNKNOWN
     assert "stopped after 2 of 8" in panel.status.text()
 
 
-def test_upload_is_batched_by_tool_frame(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
+def test_a_stopped_upload_says_why(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
+    panel.controller.upload([1, 2, 3])
+    link.point_ok(1)
+    with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
+        link.upload_summary(1, 3, "stopped")
+    assert finished.args[0].aborted == "stopped" and finished.args[0].not_attempted == [2, 3]
+    assert panel.model.ledger.point(1).sync is SyncState.ON_CONTROLLER  # applied at the end too
+
+
+def test_upload_sends_each_points_tool_in_one_request(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
     panel.model.setData(panel.model.index(1, COL_TOOL), "4")  # P2 tool 4
     panel.controller.upload([1, 2, 3])
-    first = link.named("upload_points")
-    assert [([pid for pid, _ in c.args[0]], c.args[1]) for c in first] == [([1, 3], 200)]
-    link.uploadProgress.emit(2, 2)
-    link.upload_summary(2, 2)
-    second = link.named("upload_points")[1]
-    assert [pid for pid, _ in second.args[0]] == [2] and second.args[1] == 4
+    (call,) = link.named("upload_points")
+    assert [(pid, tool) for pid, _, tool in call.args[0]] == [(1, 200), (2, 4), (3, 200)]
+    link.point_ok(1, 3, 2)
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
-        link.uploadProgress.emit(1, 1)
+        link.uploadProgress.emit(3, 3)
         assert panel.progress.value() == 3
-        link.upload_summary(1, 1)
+        link.upload_summary(3, 3)
     assert finished.args[0].all_ok
+
+
+def test_results_of_other_requests_are_ignored(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
+    panel.controller.upload([1])
+    other = CommandResult(RunCommand.CREATE_POINT, None, None, True, "uploaded 1 of 1 points",
+                          {"uploaded": 1.0}, request_id=link.last_id("upload_points") - 1)
+    link.commandFinished.emit(other)
+    link.errorOccurred.emit(FakeError("upload points", "someone else's", request_id=None))
+    assert panel.controller.busy
 
 
 def test_upload_refused_by_the_worker(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
     panel.controller.upload([1])
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
-        link.errorOccurred.emit(FakeError("upload points", "move to point is still under way"))
+        link.errorOccurred.emit(FakeError("upload points", "move to point is still under way",
+                                          link.last_id("upload_points")))
     assert finished.args[0].aborted == "move to point is still under way"
     assert panel.model.ledger.point(1).sync is SyncState.UNKNOWN
 
 
-def test_reconnect_marks_unknown_and_offers_restore(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
+def test_link_loss_during_an_upload_keeps_the_late_reports(qtbot: Any, panel: PointsPanel,
+                                                          link: FakeLink) -> None:
+    panel.controller.upload([1, 2, 3])
+    link.point_ok(1)
+    link.set_connected(False, "link lost: timeout")
+    assert panel.controller.busy
+    link.point_ok(2)  # finished before the worker noticed
+    with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
+        link.upload_summary(2, 3, "link lost: timeout")
+    assert finished.args[0].not_attempted == [3] and "link lost" in (finished.args[0].aborted or "")
+    ledger = panel.model.ledger
+    assert [ledger.point(i).sync for i in (1, 2, 3)] == [SyncState.ON_CONTROLLER, SyncState.ON_CONTROLLER,
+                                                         SyncState.UNKNOWN]
+
+
+@pytest.mark.parametrize("signal", ["controllerReconnected", "controllerRestarted"])
+def test_reconnect_marks_unknown_and_offers_restore(qtbot: Any, panel: PointsPanel, link: FakeLink,
+                                                    signal: str) -> None:
     model = panel.model
     model.apply_upload(_report_ok(model, [1, 2]))
     assert not panel.banner.isVisibleTo(panel)
-    link.controllerReconnected.emit()
+    getattr(link, signal).emit()
     assert [p.sync for p in model.ledger][:2] == [SyncState.UNKNOWN] * 2
     assert panel.banner.isVisibleTo(panel) and panel.restore_button.isEnabled()
     panel.restore_button.click()
     (call,) = link.named("upload_points")
-    assert [pid for pid, _ in call.args[0]] == model.ledger.ids()
+    assert [pid for pid, _, _ in call.args[0]] == model.ledger.ids()
+    link.point_ok(*model.ledger.ids())
     with qtbot.waitSignal(panel.controller.uploadFinished):
         link.upload_summary(8, 8)
     assert all(p.sync is SyncState.ON_CONTROLLER for p in model.ledger)

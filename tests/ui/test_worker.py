@@ -3,18 +3,21 @@
 from __future__ import annotations
 
 import sys
+import time
 from typing import Any
 
 import pytest
 from pymodbus.constants import ExcCodes
 
+from app import timing
 from app import worker as worker_module
 from app.client import StepFrame
 from app.models import CommandResult, Pose
 from app.protocol.enums import Alarm, ControllerMode, ProgramState, TeachFrame, WorkMode
-from app.worker import LinkState, RobotLink, WorkerError
+from app.worker import LinkState, RobotLink, RobotWorker, WorkerError
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
+    canary_link_fixture,
     connect,
     connection_settings,
     fast_reconnect_fixture,
@@ -257,8 +260,8 @@ def test_refusals_and_exceptions_are_results(qtbot: Any, sim: Any, link: RobotLi
 
 def test_commands_while_disconnected_are_errors(qtbot: Any, link: RobotLink) -> None:
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as blocker:
-        link.stop()
-    assert blocker.args[0] == WorkerError("stop", "not connected to a controller")
+        request_id = link.stop()
+    assert blocker.args[0] == WorkerError("stop", "not connected to a controller", request_id)
 
 
 def test_unreachable_controller_goes_down_and_shuts_down_cleanly(qtbot: Any, sim_factory: Any,
@@ -289,8 +292,200 @@ def test_points_create_upload_and_move(qtbot: Any, sim: Any, link: RobotLink) ->
                           timeout=SIGNAL_TIMEOUT_MS) as blocker:
         link.upload_points([(8, target), (9, pose)])
     assert blocker.args[0].ok and blocker.args[0].message == "uploaded 2 of 2 points"
-    assert progress == [(1, 2), (2, 2)] and sim.state().points[8] == pytest.approx(target)
+    assert progress[0] == (0, 2) and progress[-1] == (2, 2)
+    assert sim.state().points[8] == pytest.approx(target)
     with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: r.ok),
                           timeout=SIGNAL_TIMEOUT_MS):
         link.move_to_point(8, speed=400.0)
     assert sim.state().pose[1] == pytest.approx(target[1], abs=1e-3)
+
+
+# --- request ids ------------------------------------------------------------------------------
+
+
+def test_request_ids_round_trip(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    connect(qtbot, link, sim)
+    results: list[CommandResult] = []
+    errors: list[WorkerError] = []
+    link.commandFinished.connect(results.append)
+    link.errorOccurred.connect(errors.append)
+    step_id = link.step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], speed=10.0)
+    refused_id = link.go_zero(0)  # a motion is under way: refused by the worker
+    qtbot.waitUntil(lambda: any(r.request_id == step_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
+    bad_id = link.step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0])  # invalid input
+    create_id = link.create_point(11)
+    qtbot.waitUntil(lambda: any(r.request_id == create_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
+    stop_id = link.stop()
+    qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
+    ids = [step_id, refused_id, bad_id, create_id, stop_id]
+    assert ids == sorted(ids) and len(set(ids)) == 5 and min(ids) > 0
+    by_id = {r.request_id: r for r in results}
+    assert by_id[step_id].ok and "done" in by_id[step_id].message
+    assert by_id[create_id].ok and 11 in sim.state().points
+    assert by_id[stop_id].message == "stop: sent"
+    errors_by_id = {e.request_id: e for e in errors}
+    assert "still under way" in errors_by_id[refused_id].message
+    assert errors_by_id[bad_id].operation == "step" and "zero" in errors_by_id[bad_id].message
+    assert all(r.request_id is not None for r in results)
+
+
+def test_a_stop_cancels_queued_motions_with_their_ids(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    connect(qtbot, link, sim)
+    sim.set_response_delay(0.1)
+    seen = sim.requests_count
+    qtbot.waitUntil(lambda: sim.requests_count > seen, timeout=SIGNAL_TIMEOUT_MS)
+    results: list[CommandResult] = []
+    link.commandFinished.connect(results.append)
+    queued = [link.go_zero(0), link.run_program(1)]
+    stop_id = link.stop()
+    qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
+    sim.set_response_delay(0.0)
+    cancelled = {r.request_id for r in results if "cancelled by Stop" in r.message}
+    assert cancelled == set(queued)
+
+
+# --- uploads ------------------------------------------------------------------------------------
+
+
+def _poses(sim: Any, ids: range) -> list[tuple[int, tuple[float, ...], int]]:
+    x, y, z, a, b, c = sim.state().pose
+    return [(pid, (x + pid * 0.01, y, z, a, b, c), 200) for pid in ids]
+
+
+def _batch_result(request_id: int) -> Any:
+    return _result(lambda r: r.request_id == request_id)
+
+
+def test_upload_reports_each_point_and_cancel_sends_no_stop(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    connect(qtbot, link, sim)
+    points: list[tuple[int, bool, str]] = []
+    progress: list[tuple[int, int]] = []
+    link.uploadProgress.connect(lambda done, total: progress.append((done, total)))
+    cancel_ids: list[int] = []
+
+    def on_point(point_id: int, ok: bool, reason: str) -> None:
+        points.append((point_id, ok, reason))
+        if len(points) == 150:
+            cancel_ids.append(link.cancel_upload())
+
+    link.pointUploaded.connect(on_point)
+    items = _poses(sim, range(1, 301))
+    upload_id = link.upload_points(items)
+    with qtbot.waitSignal(link.commandFinished, check_params_cb=_batch_result(upload_id),
+                          timeout=30_000) as done:
+        pass
+    batch = done.args[0]
+    assert "cancelled" in batch.message and not batch.ok
+    uploaded = [pid for pid, ok, _ in points if ok]
+    assert 150 <= len(uploaded) < 300 and len(points) == len(uploaded)  # no point failed
+    assert uploaded == list(range(1, len(uploaded) + 1))  # in order, each once
+    assert batch.details["uploaded"] == len(uploaded)
+    assert sorted(sim.state().points) == uploaded  # exactly those, nothing half-made
+    assert register_writes(sim, 441) == []  # cancel is not a controller stop
+    assert progress[0] == (0, 300) and progress[-1] == (len(uploaded), 300)
+    assert len(progress) <= 2 + 20 * 30  # rate-limited (<= ~20/s; generous bound for a slow machine)
+    assert cancel_ids and cancel_ids[0] > upload_id
+
+
+def test_stop_during_a_large_upload_is_serviced_promptly(qtbot: Any, sim: Any, link: RobotLink,
+                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "CLOCK_POLL_PERIOD", 0.05)
+    connect(qtbot, link, sim)
+    link.set_traffic_capture(True)  # one trafficObserved batch per poll: proof that polls go on
+    polls: list[int] = []
+    statuses: list[Any] = []
+    link.trafficObserved.connect(lambda batch: polls.append(len(batch)))
+    link.statusChanged.connect(statuses.append)
+    total = 3000
+    upload_id = link.upload_points(_poses(sim, range(1, total + 1)))
+    qtbot.waitUntil(lambda: len(sim.state().points) >= 100, timeout=30_000)
+    polls.clear()
+    statuses.clear()
+    # while the upload goes on: polls, and the status (the clock at least) keeps coming
+    qtbot.waitUntil(lambda: len(polls) >= 10 and bool(statuses), timeout=SIGNAL_TIMEOUT_MS)
+    assert len(sim.state().points) < total
+    writes_before = len(sim.writes)
+    with qtbot.waitSignal(link.commandFinished, check_params_cb=_batch_result(upload_id),
+                          timeout=SIGNAL_TIMEOUT_MS) as done:
+        t0 = time.monotonic()
+        link.stop()
+        assert sim.wait_for(lambda _s: any(w.address == 441 for w in sim.writes[writes_before:]), 1.0)
+        latency = time.monotonic() - t0
+        created_at_stop = len(sim.state().points)
+    assert latency < 0.5
+    assert created_at_stop < total  # the stop went out while the upload was still going
+    assert "stopped" in done.args[0].message
+    after = sim.writes[writes_before:]
+    stop_index = next(i for i, w in enumerate(after) if w.address == 441)
+    assert stop_index <= 4  # at most the point in progress finished before the stop (3 writes)
+    assert not any(w.address == 440 for w in after[stop_index:])  # no point started after it
+    assert len(sim.state().points) == done.args[0].details["uploaded"]
+
+
+def test_upload_tool_per_point_writes_gv245_once_per_tool(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    connect(qtbot, link, sim)
+    x, y, z, a, b, c = sim.state().pose
+    tools = {1: 200, 2: 3, 3: 200, 4: 3, 5: 5, 6: 200}
+    items = [(pid, (x, y + pid, z, a, b, c), tool) for pid, tool in tools.items()]
+    order: list[int] = []
+    link.pointUploaded.connect(lambda pid, ok, _reason: order.append(pid) if ok else None)
+    with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: "uploaded" in r.message),
+                          timeout=SIGNAL_TIMEOUT_MS) as done:
+        link.upload_points(items)
+    assert done.args[0].ok
+    assert order == [1, 3, 6, 2, 4, 5]  # grouped by tool, first appearance first
+    with sim.lock:
+        stored = {pid: point.tool for pid, point in sim.robot.points.items()}
+    assert stored == tools
+    assert [value for _, value in gv_writes(sim, 245)] == [200.0, 3.0, 5.0]
+
+
+def test_upload_checks_every_point_before_writing(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    connect(qtbot, link, sim)
+    with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as blocker:
+        upload_id = link.upload_points([(1, (0.0,) * 6, 200), (2, (0.0, float("nan"), 0, 0, 0, 0), 200)])
+    assert blocker.args[0].request_id == upload_id and "point 2" in blocker.args[0].message
+    with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as blocker:
+        link.upload_points([(1, (0.0,) * 6, 201)])
+    assert "tool frame" in blocker.args[0].message
+    assert sim.writes == []
+
+
+# --- the restart canary -------------------------------------------------------------------------
+
+
+def test_restart_canary_detects_a_restart_under_a_live_link(qtbot: Any, sim: Any,
+                                                            canary_link: RobotLink) -> None:
+    link = canary_link
+    reconnected: list[bool] = []
+    link.controllerReconnected.connect(lambda: reconnected.append(True))
+    connect(qtbot, link, sim)
+    assert worker_module.DEFAULT_CANARY_GV == 99
+    assert len(gv_writes(sim, 99)) == 1
+    token = gv_writes(sim, 99)[0][1]
+    assert token != 0.0 and [w.address for w in sim.writes] == [198]
+    with qtbot.assertNotEmitted(link.controllerRestarted, wait=400):  # several checks, all fine
+        pass
+    with qtbot.waitSignal(link.controllerRestarted, timeout=SIGNAL_TIMEOUT_MS):
+        sim.restart_controller()
+    qtbot.waitUntil(lambda: len(gv_writes(sim, 99)) == 2, timeout=SIGNAL_TIMEOUT_MS)  # a new token
+    assert gv_writes(sim, 99)[1][1] != 0.0
+    with qtbot.assertNotEmitted(link.controllerRestarted, wait=400):  # armed again, quiet
+        pass
+    assert reconnected == [] and link.state.state is LinkState.CONNECTED
+
+
+def test_restart_canary_is_never_written_in_monitor_only(qtbot: Any, sim: Any,
+                                                         canary_link: RobotLink) -> None:
+    connect(qtbot, canary_link, sim, monitor_only=True)
+    with qtbot.assertNotEmitted(canary_link.controllerRestarted, wait=400):
+        sim.restart_controller()
+    assert sim.writes == []
+
+
+def test_restart_canary_must_not_collide_with_the_upload_gvs(qapp: Any) -> None:
+    with pytest.raises(ValueError, match=r"GV6\.\.GV99"):
+        RobotWorker(canary_gv=5)
+    with pytest.raises(ValueError):
+        RobotWorker(canary_gv=100)
+    RobotWorker(canary_gv=6).deleteLater()
