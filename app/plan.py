@@ -354,6 +354,11 @@ class IssueKind(enum.Enum):
     WARNING = "warning"  # it can run, but look
 
 
+# An arc resumed from a pose this far from its planned start is checked for a detour.
+ARC_RESUME_TOLERANCE_MM = 1.0
+ARC_RESUME_TOLERANCE_DEG = 2.0
+
+
 class IssueCode(enum.Enum):
     EMPTY_PLAN = "empty-plan"
     MISSING_POINT = "missing-point"
@@ -366,6 +371,7 @@ class IssueCode(enum.Enum):
     ZERO_LENGTH = "zero-length"
     TOOL_MISMATCH = "tool-mismatch"
     BAD_START = "bad-start"
+    ARC_RESUME_PAST_MIDDLE = "arc-resume-past-middle"
 
 
 @dataclass(frozen=True)
@@ -519,6 +525,11 @@ def check_plan(
                 if problem is not None:
                     issues.append(PlanIssue(i, IssueKind.ERROR, problem[0],
                                             f"{_seg_name(i)}: {problem[1]}{suffix}"))
+                elif i == start_index and i > 0 and (planned_start := ends[i - 1]) is not None:
+                    detour = _arc_detour(start, planned_start, xyz_of(via_pt), end_xyz)
+                    if detour is not None:
+                        issues.append(PlanIssue(i, detour[0], IssueCode.ARC_RESUME_PAST_MIDDLE,
+                                                f"{_seg_name(i)}: {detour[1]}"))
             elif start is not None and end_xyz is not None:
                 length = float(np.linalg.norm(end_xyz - start))
                 if length < limits.zero_length:
@@ -528,6 +539,40 @@ def check_plan(
     order = {IssueKind.ERROR: 0, IssueKind.NEEDS_UPLOAD: 1, IssueKind.WARNING: 2}
     issues.sort(key=lambda it: (-1 if it.segment is None else it.segment, order[it.kind]))
     return issues
+
+
+def _arc_detour(start: FloatArray, planned_start: FloatArray, via: FloatArray,
+                end: FloatArray) -> tuple[IssueKind, str] | None:
+    """Why an arc sent from ``start`` would not follow the planned arc, or None.
+
+    An arc interrupted past its middle point and sent again from where the arm stopped goes
+    through the middle point again: the circle through (here, M, E) runs almost all the way
+    round. That is an error when the arm stands on the planned arc past M; from elsewhere a
+    sweep clearly larger than planned is a warning.
+    """
+    if float(np.linalg.norm(start - planned_start)) < ARC_RESUME_TOLERANCE_MM:
+        return None
+    planned = arc_geometry(planned_start, via, end)
+    now = arc_geometry(start, via, end)
+    sweep_now, sweep_planned = float(now.sweep[0]), float(planned.sweep[0])
+    if not (math.isfinite(sweep_now) and math.isfinite(sweep_planned)):
+        return None
+    rel = start - planned.centre[0]
+    off_plane = abs(float(np.dot(rel, planned.normal[0])))
+    in_plane = rel - np.dot(rel, planned.normal[0]) * planned.normal[0]
+    off_circle = abs(float(np.linalg.norm(in_plane)) - float(planned.radius[0]))
+    at = math.atan2(float(np.dot(rel, planned.v[0])), float(np.dot(rel, planned.u[0]))) % (2.0 * math.pi)
+    on_arc = max(off_plane, off_circle) < ARC_RESUME_TOLERANCE_MM
+    past_middle = on_arc and float(planned.via_angle[0]) < at < sweep_planned
+    larger = sweep_now > sweep_planned + math.radians(ARC_RESUME_TOLERANCE_DEG)
+    if not (past_middle or larger):
+        return None
+    swing = (f"sent from here the arc would swing {math.degrees(sweep_now):.0f}° round through the "
+             f"middle point (planned {math.degrees(sweep_planned):.0f}°)")
+    if past_middle:
+        return IssueKind.ERROR, (f"the arm stopped past the arc's middle point: {swing}; move to the "
+                                 "end point with a line, or run from the segment before")
+    return IssueKind.WARNING, f"{swing}; check the preview before running from here"
 
 
 # --- geometry ------------------------------------------------------------------------------

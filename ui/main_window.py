@@ -72,8 +72,8 @@ from ui.widgets_common import connection_display
 
 DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size
 MIN_SIZE = (1024, 700)  # the layout stays usable down to this
-QWIDGETSIZE_MAX = (1 << 24) - 1  # Qt's "no maximum"
-STATUS_DOCK_WIDTH = 265  # px at first start (the operator's layout is remembered)
+STATUS_DOCK_WIDTH = 265
+STATUS_DOCK_MAX_WIDTH = 320  # the status column never needs more; the work tabs get the rest
 DOCK_MIN_HEIGHT = 72  # px, the bottom docks (event log, traffic) at their smallest
 TAB_MONITOR, TAB_POINTS, TAB_PLANNER = range(3)
 TAB_NAMES = ("monitor", "points", "planner")
@@ -151,6 +151,8 @@ class MainWindow(QMainWindow):
         outer = QVBoxLayout(central)
         outer.setContentsMargins(4, 4, 4, 0)
         outer.addWidget(self.splitter)
+        # the work area, not the docks, takes the spare width of a resized window
+        central.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
         self.setCentralWidget(central)
 
         # --- docks: the display panels --------------------------------------------------
@@ -159,6 +161,9 @@ class MainWindow(QMainWindow):
         self.event_log = EventLogPanel(self)
         area = Qt.DockWidgetArea
         self.status_dock = self._dock("StatusDock", self.status_panel, area.LeftDockWidgetArea)
+        # QMainWindow hands a narrow window's spare width to the docks as well: a status
+        # column wider than this only steals room from the work tabs
+        self.status_dock.setMaximumWidth(STATUS_DOCK_MAX_WIDTH)
         self.event_dock = self._dock("EventLogDock", self.event_log, area.BottomDockWidgetArea)
         self.traffic_dock = self._dock("TrafficDock", self.traffic_panel, area.BottomDockWidgetArea)
         self.tabifyDockWidget(self.event_dock, self.traffic_dock)
@@ -622,16 +627,8 @@ class MainWindow(QMainWindow):
 
     @Slot()
     def _size_docks(self) -> None:
-        # resizeDocks alone loses against the layout's share-out of spare width: cap the
-        # status dock for one layout pass, then let the operator widen it again.
-        self.status_dock.setMaximumWidth(STATUS_DOCK_WIDTH)
         self.resizeDocks([self.status_dock], [STATUS_DOCK_WIDTH], Qt.Orientation.Horizontal)
         self.resizeDocks([self.event_dock], [150], Qt.Orientation.Vertical)
-        QTimer.singleShot(0, self, self._release_dock_width)
-
-    @Slot()
-    def _release_dock_width(self) -> None:
-        self.status_dock.setMaximumWidth(QWIDGETSIZE_MAX)
 
     def hideEvent(self, event: QHideEvent) -> None:
         self.jog_panel.release_all()

@@ -374,27 +374,30 @@ class PlannerPanel(QWidget):
         preview_layout = QVBoxLayout(self.preview_box)
         preview_layout.addWidget(self.preview)
 
-        right = QSplitter(Qt.Orientation.Vertical, self)
-        right.addWidget(self.segments_box)
-        right.addWidget(self.preview_box)
-        right.setStretchFactor(0, 1)
-        right.setStretchFactor(1, 1)
-        right.setSizes([380, 360])
-        right.setChildrenCollapsible(False)
-        splitter = QSplitter(Qt.Orientation.Horizontal, self)
-        splitter.addWidget(left)
-        splitter.addWidget(right)
-        splitter.setStretchFactor(0, 0)
-        splitter.setStretchFactor(1, 1)
-        splitter.setSizes([240, 1040])
-        splitter.setChildrenCollapsible(False)
-        self.splitter = splitter
+        # plans and segments side by side on top, the preview across the full width below:
+        # the three projections stay readable on a 1280 px screen
+        top = QSplitter(Qt.Orientation.Horizontal, self)
+        top.addWidget(left)
+        top.addWidget(self.segments_box)
+        top.setStretchFactor(0, 0)
+        top.setStretchFactor(1, 1)
+        top.setSizes([230, 1050])
+        top.setChildrenCollapsible(False)
+        self.splitter = top
+        outer = QSplitter(Qt.Orientation.Vertical, self)
+        outer.addWidget(top)
+        outer.addWidget(self.preview_box)
+        outer.setStretchFactor(0, 1)
+        outer.setStretchFactor(1, 1)
+        outer.setSizes([340, 400])
+        outer.setChildrenCollapsible(False)
+        self.outer_splitter = outer
 
         self.status = QLabel(self)
         self.status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
-        layout.addWidget(splitter, 1)
+        layout.addWidget(outer, 1)
         layout.addWidget(self.status)
 
     def retranslate(self) -> None:

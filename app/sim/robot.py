@@ -177,6 +177,10 @@ class _Arc(_Geometry):
         angle = math.atan2(float(np.dot(rel, self.v)), float(np.dot(rel, self.u)))
         self.angle = angle if angle > 0 else angle + 2.0 * math.pi
         self.length = self.radius * self.angle
+        rel_mid = p2 - centre
+        mid = math.atan2(float(np.dot(rel_mid, self.v)), float(np.dot(rel_mid, self.u)))
+        mid = mid if mid > 0 else mid + 2.0 * math.pi
+        self.middle_fraction = mid / self.angle  # where along the path the middle point lies
 
     def point(self, s: float) -> Vector:
         th = s * self.angle
@@ -185,13 +189,21 @@ class _Arc(_Geometry):
 
 
 class _CartesianMotion(_Motion):
-    """Linear or circular TCP path at constant speed, orientation slerped, IK every tick."""
+    """Linear or circular TCP path at constant speed, orientation slerped, IK every tick.
+
+    With ``via`` = (middle rotation, path fraction at the middle point) the orientation goes
+    r0 -> middle -> r1, reaching the middle point's orientation at the middle point.
+    """
 
     def __init__(self, geometry: _Geometry, r0: Matrix, r1: Matrix, speed: float,
-                 ext0: Vector, ext1: Vector) -> None:
+                 ext0: Vector, ext1: Vector, via: tuple[Matrix, float] | None = None) -> None:
         self.geometry = geometry
         self.r0, self.r1 = r0, r1
-        angle = rotation_angle_deg(r0, r1)
+        self.via = via if via is not None and 0.0 < via[1] < 1.0 else None
+        if self.via is not None:
+            angle = rotation_angle_deg(r0, self.via[0]) + rotation_angle_deg(self.via[0], r1)
+        else:
+            angle = rotation_angle_deg(r0, r1)
         ang_speed = min(speed, MAX_ANGULAR_SPEED)
         self.duration = max(geometry.length / speed, angle / ang_speed)
         wanted = max(2, math.ceil(geometry.length / CHECK_STEP_MM), math.ceil(angle / CHECK_STEP_DEG))
@@ -199,9 +211,17 @@ class _CartesianMotion(_Motion):
         self.ext0, self.ext1 = ext0, ext1
         self.elapsed = 0.0
 
+    def rotation(self, s: float) -> Matrix:
+        if self.via is None:
+            return slerp_matrix(self.r0, self.r1, s)
+        r_mid, s_mid = self.via
+        if s <= s_mid:
+            return slerp_matrix(self.r0, r_mid, s / s_mid)
+        return slerp_matrix(r_mid, self.r1, (s - s_mid) / (1.0 - s_mid))
+
     def target(self, s: float) -> Matrix:
         t = np.eye(4)
-        t[:3, :3] = slerp_matrix(self.r0, self.r1, s)
+        t[:3, :3] = self.rotation(s)
         t[:3, 3] = self.geometry.point(s)
         return t
 
@@ -454,7 +474,13 @@ class SimRobot:
     # --- function 3: move to temp point ---------------------------------------------------
     def move_to_point(self, via: float, end: float, orientation_changes: float, ignore_middle: float,
                       speed: float, tool: float = 200.0) -> int:
-        """0x42: line (via = -1 or ignore_middle) or arc through point ``via`` to point ``end``."""
+        """0x42: line (via = -1) or arc through point ``via`` to point ``end``.
+
+        GV203 "ignore the middle point" (project decision, PROTOCOL.md leaves it open): the arc
+        still passes through the middle point's position, but its orientation is ignored — the
+        tool turns straight from the start to the end orientation. Without the flag (and with
+        orientation changing) the tool reaches the middle point's orientation at the middle.
+        """
         self.last_kind = CommandKind.MOVE
         if (refusal := self._move_refusal()) is not None:
             return self._finish(refusal)
@@ -462,7 +488,7 @@ class SimRobot:
         if end_id is None or end_id not in self.points:
             log.info("move to point refused: no end point %s", end)
             return self._finish(MoveStatus.BAD_END_POINT)
-        line = bool(ignore_middle) or via == -1
+        line = via == -1
         mid_id = _as_int(via)
         if not line and (mid_id is None or mid_id not in self.points):
             log.info("move to point refused: no middle point %s", via)
@@ -475,17 +501,22 @@ class SimRobot:
         r0 = self._flange[:3, :3].copy()
         r1 = abc_to_matrix(*end_pose[3:]) if orientation_changes else r0
         geometry: _Geometry
+        via_rotation: tuple[Matrix, float] | None = None
         if line:
             geometry = _Line(p0, p_end)
         else:
             assert mid_id is not None
+            mid_pose = self.points[mid_id].pose
             try:
-                geometry = _Arc(p0, np.array(self.points[mid_id].pose[:3]), p_end)
+                arc = _Arc(p0, np.array(mid_pose[:3]), p_end)
             except ValueError as exc:
                 log.info("move to point refused: %s", exc)
                 return self._finish(MoveStatus.CALCULATION_ERROR)
+            geometry = arc
+            if orientation_changes and not ignore_middle:
+                via_rotation = (abc_to_matrix(*mid_pose[3:]), arc.middle_fraction)
         ext = self.joints[NUM_ROBOT_AXES:].copy()
-        motion = _CartesianMotion(geometry, r0, r1, min(speed, MAX_LINEAR_SPEED), ext, ext)
+        motion = _CartesianMotion(geometry, r0, r1, min(speed, MAX_LINEAR_SPEED), ext, ext, via_rotation)
         if not motion.check(self.joints):
             log.info("move to point refused: path unreachable")
             return self._finish(MoveStatus.CALCULATION_ERROR)

@@ -328,3 +328,30 @@ def test_thousand_segments_are_fast() -> None:
     assert path.xyz.shape == (32000, 3) and np.isfinite(path.xyz).all()
     assert est.unknown == () and not has_errors(issues)
     assert elapsed < 2.0  # typically ~0.05 s; generous for slow CI
+
+
+# --- resuming an arc part-way ----------------------------------------------------------------
+def _resume_issues(x: float, y: float, z: float = 300.0) -> list[tuple[IssueKind, IssueCode]]:
+    issues = check_plan(circle_plan(), ledger(), current_pose=(x, y, z, 180, 0, 0), start_index=1)
+    return [(it.kind, it.code) for it in issues if it.segment == 1]
+
+
+def test_resuming_an_arc_from_its_planned_start_is_fine() -> None:
+    assert _resume_issues(300.0, 0.0) == []
+
+
+def test_resuming_an_arc_before_its_middle_point_is_fine() -> None:
+    # on the circle W -> N -> E, a quarter of the way to N
+    a = math.radians(135.0)
+    assert _resume_issues(400 + 100 * math.cos(a), 100 * math.sin(a)) == []
+
+
+def test_resuming_an_arc_past_its_middle_point_is_an_error() -> None:
+    a = math.radians(45.0)  # between N (90 deg) and E (0 deg): past the middle point
+    assert _resume_issues(400 + 100 * math.cos(a), 100 * math.sin(a)) == [
+        (IssueKind.ERROR, IssueCode.ARC_RESUME_PAST_MIDDLE)]
+
+
+def test_an_arc_from_elsewhere_with_a_larger_sweep_is_a_warning() -> None:
+    # off the circle, beyond E: the circle through here, N and E sweeps the long way round
+    assert _resume_issues(520.0, -40.0) == [(IssueKind.WARNING, IssueCode.ARC_RESUME_PAST_MIDDLE)]

@@ -104,7 +104,8 @@ def test_collinear_arc_and_missing_points() -> None:
     assert robot.move_to_point(1, 2, 0, 0, 100.0) == MoveStatus.CALCULATION_ERROR
     assert robot.move_to_point(-1, 99, 0, 0, 100.0) == MoveStatus.BAD_END_POINT
     assert robot.move_to_point(98, 2, 0, 0, 100.0) == MoveStatus.BAD_END_POINT
-    assert robot.move_to_point(98, 2, 0, 1, 100.0) == MoveStatus.MOVING  # middle ignored: a line
+    # "ignore the middle point" still needs the point: only its orientation is ignored
+    assert robot.move_to_point(98, 2, 0, 1, 100.0) == MoveStatus.BAD_END_POINT
 
 
 def test_unreachable_point_is_refused_at_the_start() -> None:

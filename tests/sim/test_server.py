@@ -217,13 +217,26 @@ def test_arc_passes_near_the_middle_point(sim: SimController, bus: Bus) -> None:
         assert math.dist(p[:2], (x + 80.0, y)) == pytest.approx(80.0, abs=0.1)
 
 
-def test_ignore_middle_moves_in_a_line(sim: SimController, bus: Bus) -> None:
+def test_ignore_middle_keeps_the_arc_but_not_the_middle_orientation(sim: SimController, bus: Bus) -> None:
+    """Project decision on GV203: the path still goes through M; only M's orientation is ignored."""
     x, y, z, a, b, c = bus.pose()
-    assert create_point(bus, 1, [x + 80.0, y + 80.0, z, a, b, c]) == 0xFF
+    assert create_point(bus, 1, [x + 80.0, y + 80.0, z, a, b, c + 40.0]) == 0xFF  # M turned 40 deg
     assert create_point(bus, 2, [x + 160.0, y, z, a, b, c]) == 0xFF
-    move_to_point(bus, 2, via=1, ignore=1, speed=800.0)
+
+    def run(ignore: int) -> list[tuple[float, ...]]:
+        move_to_point(bus, 2, via=1, ignore=ignore, speed=600.0)
+        assert wait_move_result(bus) == 0xFF
+        return [tuple(s.pose) for s in sim.trajectory()]
+
+    def yaw_near_middle(samples: list[tuple[float, ...]]) -> float:
+        nearest = min(samples, key=lambda p: math.dist(p[:3], (x + 80.0, y + 80.0, z)))
+        assert math.dist(nearest[:3], (x + 80.0, y + 80.0, z)) < 8.0  # through M both times
+        return (nearest[5] - c + 180.0) % 360.0 - 180.0
+
+    assert yaw_near_middle(run(ignore=0)) == pytest.approx(40.0, abs=3.0)  # M's orientation reached
+    step_base(bus, [-160.0, 0, 0, 0, 0, 0], 600.0)  # back to the start
     assert wait_move_result(bus) == 0xFF
-    assert max(abs(s.pose[1] - y) for s in sim.trajectory()) < 0.05
+    assert abs(yaw_near_middle(run(ignore=1))) < 1.0  # start and end share C: no turn at all
 
 
 def test_bad_points_and_collinear_arc(sim: SimController, bus: Bus) -> None:

@@ -1,0 +1,369 @@
+"""Temp points and plans at scale: project files, the point table, restore-all, plan preview.
+
+Each figure is measured in the same run as a baseline:
+* loading a 10,000-point project (``app.project.load_project``, which parses and validates
+  everything) vs ``json.load`` of the same file;
+* showing it: ``ui.points_model.PointsModel`` (behind the panel's ``PointFilterProxy``) in a
+  ``QTableView`` set up like the points panel's, from construction to the first paint, vs a
+  minimal table model of the same shape in the same view (offscreen Qt; null with a reason
+  when the UI module is missing);
+* restoring all points to the simulator with ``RobotClient.upload_points`` — the product's
+  "restore all" path (the GUI worker calls it) — vs the minimal-transactions bound
+  (4 transactions x measured round trip + the simulator's command latency, per point); the
+  CLI's path (``app.points.upload_points``: one ``create_point`` per point) on a sample;
+* plan geometry for 1,000 segments (``plan_path``, ``plan_geometry``, ``check_plan``,
+  ``estimate_plan``) vs sampling the same segments one by one with ``segment_path``; and the
+  preview widget's (``ui.plan_preview.PlanPreview``) redraw of the 1,000 segments, vs the
+  same widget redrawing a 10-segment plan.
+
+Quick mode restores 500 points instead of 10,000 and repeats less.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import statistics
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pymodbus.client import ModbusTcpClient
+
+from app.client import ConnectionSettings, RobotClient
+from app.plan import Plan, Segment, check_plan, estimate_plan, plan_geometry, plan_path, segment_path
+from app.points import PointLedger, SyncState, TempPoint, make_point, upload_points
+from app.project import Project, load_project, save_project
+from app.protocol import registers as R  # noqa: N812
+from app.sim import SimConfig, SimController
+
+PROJECT_POINTS = 10_000
+PLAN_SEGMENTS = 1_000
+PAINT_TIMEOUT = 10.0  # s to wait for a widget's first paint
+HOME = (525.0, 0.0, 504.4)
+
+
+def _ms(seconds: float) -> float:
+    return round(1000.0 * seconds, 3)
+
+
+def _median_ms(fn: Callable[[], object], repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t0)
+    return _ms(statistics.median(times))
+
+
+def _points(n: int) -> list[TempPoint]:
+    """``n`` points in front of the arm, tool down; ids 1..n."""
+    return [
+        make_point(i, f"p{i}", (300.0 + i % 100, -100.0 + i % 50, 300.0 + i % 20, 180.0, 0.0, float(i % 90)),
+                   note="bench" if i % 10 == 0 else "", sync=SyncState.UNKNOWN)
+        for i in range(1, n + 1)
+    ]
+
+
+# --- project file: load and show ---------------------------------------------------------------
+
+
+def bench_load(path: Path, repeats: int) -> dict[str, Any]:
+    def product() -> object:
+        return load_project(path)
+
+    def baseline() -> object:
+        with path.open(encoding="utf-8") as f:
+            return json.load(f)
+
+    product()  # warm the file cache and imports
+    load_ms = [_median_ms(product, 1) for _ in range(repeats)]
+    json_ms = [_median_ms(baseline, 1) for _ in range(repeats)]
+    load, base = statistics.median(load_ms), statistics.median(json_ms)
+    return {"points": PROJECT_POINTS, "file_bytes": path.stat().st_size, "load_project_ms": load,
+            "json_load_ms": base, "ratio_load_vs_json": round(load / base, 2)}
+
+
+def _qt_app() -> Any:
+    from PySide6.QtWidgets import QApplication
+
+    return QApplication.instance() or QApplication([])
+
+
+class _PaintProbe:
+    """Counts paint events of one widget (an event filter; painting is done once
+    ``processEvents`` returns)."""
+
+    def __init__(self, widget: Any) -> None:
+        from PySide6.QtCore import QEvent, QObject
+
+        paint = QEvent.Type.Paint
+        probe = self
+
+        class Filter(QObject):
+            def eventFilter(self, obj: Any, event: Any) -> bool:
+                if event.type() == paint:
+                    probe.count += 1
+                return False
+
+        self.count = 0
+        self._filter = Filter()
+        widget.installEventFilter(self._filter)
+
+
+def _wait_painted(app: Any, probes: list[_PaintProbe], since: list[int]) -> None:
+    deadline = time.perf_counter() + PAINT_TIMEOUT
+    while any(p.count <= s for p, s in zip(probes, since, strict=True)):
+        app.processEvents()
+        if time.perf_counter() > deadline:
+            raise RuntimeError("the widget was not painted within the timeout")
+
+
+def bench_show(project: Project, repeats: int) -> dict[str, Any]:
+    try:
+        from PySide6.QtCore import QAbstractTableModel, QModelIndex, Qt
+        from PySide6.QtGui import QUndoStack
+        from PySide6.QtWidgets import QHeaderView, QTableView
+
+        from ui.points_model import COLUMNS, PointFilterProxy, PointsModel
+    except ImportError as exc:
+        return {"show_ms": None, "reason": f"ui/points_model.py is not usable: {exc}"}
+    app = _qt_app()
+    rows, cols = len(project.ledger), len(COLUMNS)
+
+    class MinimalModel(QAbstractTableModel):
+        def rowCount(self, parent: Any = QModelIndex()) -> int:  # noqa: B008
+            return 0 if parent.isValid() else rows
+
+        def columnCount(self, parent: Any = QModelIndex()) -> int:  # noqa: B008
+            return 0 if parent.isValid() else cols
+
+        def data(self, index: Any, role: int = Qt.ItemDataRole.DisplayRole) -> Any:
+            return str(index.row()) if role == Qt.ItemDataRole.DisplayRole else None
+
+    def show(make_model: Callable[[], Any]) -> float:
+        t0 = time.perf_counter()
+        model = make_model()
+        proxy = PointFilterProxy()
+        proxy.setSourceModel(model)
+        view = QTableView()  # set up like ui/points_panel.py's table
+        view.setModel(proxy)
+        view.setAlternatingRowColors(True)
+        view.setWordWrap(False)
+        view.verticalHeader().setVisible(False)
+        view.verticalHeader().setDefaultSectionSize(24)
+        view.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Interactive)
+        view.horizontalHeader().setStretchLastSection(True)
+        view.resize(1280, 700)
+        probe = _PaintProbe(view.viewport())
+        view.show()
+        _wait_painted(app, [probe], [0])
+        elapsed = time.perf_counter() - t0
+        view.close()
+        view.deleteLater()
+        proxy.deleteLater()
+        app.processEvents()
+        return elapsed
+
+    stacks: list[Any] = []
+
+    def product() -> Any:
+        stack = QUndoStack()
+        stacks.append(stack)
+        return PointsModel(project, stack)
+
+    show(product)  # warm up fonts, styles, the platform plugin
+    product_ms = [_ms(show(product)) for _ in range(repeats)]
+    baseline_ms = [_ms(show(MinimalModel)) for _ in range(repeats)]
+    shown, base = statistics.median(product_ms), statistics.median(baseline_ms)
+    return {"points": rows, "show_ms": shown, "minimal_model_show_ms": base,
+            "ratio_vs_minimal_model": round(shown / base, 2),
+            "what": "PointsModel + PointFilterProxy + QTableView, construction to first paint (offscreen)"}
+
+
+# --- restore all -----------------------------------------------------------------------------------
+
+
+def _rtt_samples(port: int, seconds: float) -> list[float]:
+    """Round trips (s) of one small read (GV291) with a bare pymodbus client."""
+    bare = ModbusTcpClient("127.0.0.1", port=port, timeout=1.0)
+    bare.connect()
+    try:
+        for _ in range(50):
+            bare.read_holding_registers(R.gv_reg(R.GV_COMMAND_STATUS), count=2, device_id=1)
+        lat: list[float] = []
+        end = time.perf_counter() + seconds
+        while time.perf_counter() < end:
+            t0 = time.perf_counter()
+            bare.read_holding_registers(R.gv_reg(R.GV_COMMAND_STATUS), count=2, device_id=1)
+            lat.append(time.perf_counter() - t0)
+    finally:
+        bare.close()
+    return lat
+
+
+def bench_restore(n: int, cli_n: int) -> dict[str, Any]:
+    sim = SimController(SimConfig(host="127.0.0.1", port=0))
+    sim.start()
+    try:
+        points = _points(n)
+        # the round trip, measured before and after the uploads (machine noise hits both alike)
+        rtt_s = _rtt_samples(sim.port, 0.3)
+        client = RobotClient(ConnectionSettings(host="127.0.0.1", port=sim.port))
+        client.connect()
+        try:
+            t0 = time.perf_counter()
+            results = client.upload_points([(p.id, p.xyzabc) for p in points])
+            restore_s = time.perf_counter() - t0
+            failed = sum(1 for r in results if not r.ok)
+            held = len(sim.state().points)
+            sim.restart_controller()
+            sample = points[:cli_n]
+            t0 = time.perf_counter()
+            report = upload_points(client, sample)
+            cli_s = time.perf_counter() - t0
+        finally:
+            client.close()
+        rtt_s += _rtt_samples(sim.port, 0.3)
+        rtt = 1000.0 * statistics.median(rtt_s)
+        latency = sim.config.command_latency
+    finally:
+        sim.stop()
+    per_point_tx = 4  # pose GVs, id/source/index GVs, 440 <- 0xE0, one status read
+    bound_s = n * (per_point_tx * rtt / 1000.0 + latency)
+    return {
+        "points": n,
+        "path": "RobotClient.upload_points (the GUI's restore-all, via the worker)",
+        "restore_s": round(restore_s, 3),
+        "failed": failed,
+        "held_by_controller": held,
+        "points_per_s": round(n / restore_s, 1),
+        "min_transactions_bound_s": round(bound_s, 3),
+        "ratio_vs_bound": round(restore_s / bound_s, 2),
+        "rtt_ms": round(rtt, 4),
+        "controller_latency_ms": 1000.0 * latency,
+        "cli_path": {
+            "path": "app.points.upload_points (teachpad-cli points upload: create_point per point)",
+            "points": cli_n,
+            "failed": len(report.failed) + len(report.not_attempted),
+            "ms_per_point": round(1000.0 * cli_s / cli_n, 3),
+            "restore_ms_per_point": round(1000.0 * restore_s / n, 3),
+            "ratio_cli_vs_restore": round((cli_s / cli_n) / (restore_s / n), 2),
+        },
+    }
+
+
+# --- plan geometry and preview -------------------------------------------------------------------
+
+
+def _plan(segments: int) -> tuple[Plan, PointLedger]:
+    """Points on a slowly rising helix; lines and arcs alternate (an arc uses two points)."""
+    count = segments + segments // 2 + 1
+    pts = []
+    for i in range(1, count + 1):
+        t = 0.35 * i
+        pts.append(make_point(i, "", (450.0 + 80.0 * math.cos(t), 80.0 * math.sin(t), 300.0 + 0.05 * i,
+                                      180.0, 0.0, 0.0)))
+    ledger = PointLedger(pts)
+    segs: list[Segment] = []
+    pid = 1
+    for k in range(segments):
+        if k % 2 == 0:
+            segs.append(Segment.line(pid, speed=200.0))
+            pid += 1
+        else:
+            segs.append(Segment.arc(pid, pid + 1, speed=100.0))
+            pid += 2
+    return Plan("bench", segs), ledger
+
+
+def bench_plan(repeats: int) -> dict[str, Any]:
+    plan, ledger = _plan(PLAN_SEGMENTS)
+
+    def one_by_one() -> np.ndarray[Any, Any]:
+        start: Any = HOME
+        out = []
+        for seg in plan.segments:
+            xyz = segment_path(start, seg, ledger)
+            out.append(xyz)
+            start = xyz[-1]
+        return np.concatenate(out)
+
+    path = plan_path(plan, ledger, HOME)
+    assert np.allclose(path.xyz, one_by_one(), atol=1e-6), "plan_path and segment_path disagree"
+    vectorised = _median_ms(lambda: plan_path(plan, ledger, HOME), repeats)
+    baseline = _median_ms(one_by_one, repeats)
+    return {
+        "segments": PLAN_SEGMENTS,
+        "samples": int(path.xyz.shape[0]),
+        "plan_path_ms": vectorised,
+        "segment_by_segment_ms": baseline,
+        "ratio_plan_path_vs_one_by_one": round(vectorised / baseline, 3),
+        "plan_geometry_ms": _median_ms(lambda: plan_geometry(plan, ledger, HOME), repeats),
+        "check_plan_ms": _median_ms(lambda: check_plan(plan, ledger, current_pose=HOME), repeats),
+        "estimate_plan_ms": _median_ms(lambda: estimate_plan(plan, ledger, HOME), repeats),
+    }
+
+
+def bench_preview(repeats: int) -> dict[str, Any]:
+    try:
+        from ui.plan_preview import PlanPreview
+    except ImportError as exc:
+        return {"redraw_ms": None, "reason": f"ui/plan_preview.py is not usable: {exc}"}
+    app = _qt_app()
+    big_plan, big_ledger = _plan(PLAN_SEGMENTS)
+    small_plan, small_ledger = _plan(10)
+    # two versions of each path so that every redraw has new data to draw
+    other_start = (500.0, 50.0, 450.0)
+    big = [plan_path(big_plan, big_ledger, HOME), plan_path(big_plan, big_ledger, other_start)]
+    small = [plan_path(small_plan, small_ledger, HOME), plan_path(small_plan, small_ledger, other_start)]
+    preview = PlanPreview()
+    preview.resize(1280, 360)
+    try:
+        viewports = [proj.plot.viewport() for proj in preview.projections.values()]
+    except AttributeError as exc:
+        return {"redraw_ms": None, "reason": f"PlanPreview has no plot viewports to watch: {exc}"}
+    probes = [_PaintProbe(v) for v in viewports]
+    preview.show()
+    _wait_painted(app, probes, [0] * len(probes))
+
+    def redraw(path: Any) -> float:
+        since = [p.count for p in probes]
+        t0 = time.perf_counter()
+        preview.set_path(path)
+        _wait_painted(app, probes, since)
+        return time.perf_counter() - t0
+
+    try:
+        redraw(big[1])  # warm up
+        big_ms = [_ms(redraw(big[i % 2])) for i in range(repeats)]
+        small_ms = [_ms(redraw(small[i % 2])) for i in range(repeats)]
+    finally:
+        preview.close()
+        preview.deleteLater()
+        app.processEvents()
+    redraw_big, redraw_small = statistics.median(big_ms), statistics.median(small_ms)
+    return {"segments": PLAN_SEGMENTS, "redraw_ms": redraw_big, "redraw_10_segments_ms": redraw_small,
+            "ratio_vs_10_segments": round(redraw_big / redraw_small, 2),
+            "what": "PlanPreview.set_path (3 projections) until all three plots painted (offscreen)"}
+
+
+def run(quick: bool) -> dict[str, Any]:
+    repeats = 3 if quick else 5
+    out: dict[str, Any] = {}
+    with tempfile.TemporaryDirectory(prefix="teachpad-bench-") as tmp:
+        path = Path(tmp) / "bench.teachpad.json"
+        project = Project("bench", PointLedger(_points(PROJECT_POINTS)))
+        t0 = time.perf_counter()
+        save_project(project, path)
+        save_s = time.perf_counter() - t0
+        out["project_load"] = bench_load(path, repeats)
+        out["project_load"]["save_project_ms"] = _ms(save_s)
+        out["points_table_show"] = bench_show(load_project(path), repeats)
+    out["restore_all"] = bench_restore(500 if quick else PROJECT_POINTS, 200 if quick else 1000)
+    out["plan_geometry"] = bench_plan(repeats)
+    out["plan_preview"] = bench_preview(repeats)
+    return out
