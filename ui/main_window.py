@@ -171,7 +171,10 @@ class MainWindow(QMainWindow):
         self.setCorner(Qt.Corner.BottomLeftCorner, area.LeftDockWidgetArea)  # status runs full height
         for panel in (self.event_log, self.traffic_panel):
             panel.setMinimumHeight(DOCK_MIN_HEIGHT)  # a short log scrolls; the window fits 800 px
-        self.traffic_dock.visibilityChanged.connect(self._update_traffic_capture)
+        # visibilityChanged(bool) says whether the dock can be seen: False while it is tabbed
+        # behind the event log, when isVisible() still says True
+        self._traffic_dock_shown = False
+        self.traffic_dock.visibilityChanged.connect(self._on_traffic_dock_visibility)
         self.traffic_panel.captureEnabledChanged.connect(self._update_traffic_capture)
 
         # --- actions, menus, toolbar, status bar ---------------------------------------
@@ -515,9 +518,15 @@ class MainWindow(QMainWindow):
         text = self.tr("Reconnected to the controller: jog stopped and teach mode switched off")
         self.event_log.add_event("warning", self.tr("link"), text)
 
+    @Slot(bool)
+    def _on_traffic_dock_visibility(self, shown: bool) -> None:
+        self._traffic_dock_shown = shown
+        self._update_traffic_capture()
+
     @Slot()
     def _update_traffic_capture(self) -> None:
-        want = self.traffic_dock.isVisible() and self.traffic_panel.capture_enabled()
+        # the worker builds traffic records only while someone can read them
+        want = self._traffic_dock_shown and self.traffic_panel.capture_enabled()
         if want != self._traffic_capture:
             self._traffic_capture = want
             self.link.set_traffic_capture(want)

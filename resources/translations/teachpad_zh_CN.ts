@@ -377,320 +377,320 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="337" />
+            <location filename="../../ui/main_window.py" line="346" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="338" />
+            <location filename="../../ui/main_window.py" line="347" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="339" />
+            <location filename="../../ui/main_window.py" line="348" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="346" />
+            <location filename="../../ui/main_window.py" line="355" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="347" />
+            <location filename="../../ui/main_window.py" line="356" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="348" />
+            <location filename="../../ui/main_window.py" line="357" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="349" />
+            <location filename="../../ui/main_window.py" line="358" />
             <source>&amp;File</source>
             <translation>文件(&amp;F)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="350" />
+            <location filename="../../ui/main_window.py" line="359" />
             <source>&amp;Edit</source>
             <translation>编辑(&amp;E)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="351" />
+            <location filename="../../ui/main_window.py" line="360" />
             <source>&amp;Motion</source>
             <translation>运动(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="352" />
+            <location filename="../../ui/main_window.py" line="361" />
             <source>&amp;View</source>
             <translation>视图(&amp;V)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="353" />
+            <location filename="../../ui/main_window.py" line="362" />
             <source>&amp;Language</source>
             <translation>语言(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="354" />
+            <location filename="../../ui/main_window.py" line="363" />
             <source>&amp;Help</source>
             <translation>帮助(&amp;H)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="355" />
-            <location filename="../../ui/main_window.py" line="356" />
+            <location filename="../../ui/main_window.py" line="364" />
+            <location filename="../../ui/main_window.py" line="365" />
             <source>Toolbar</source>
             <translation>工具栏</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="357" />
+            <location filename="../../ui/main_window.py" line="366" />
             <source>&amp;Connect…</source>
             <translation>连接(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="358" />
+            <location filename="../../ui/main_window.py" line="367" />
             <source>Connect to a controller (Ctrl+K)</source>
             <translation>连接控制器（Ctrl+K）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="359" />
+            <location filename="../../ui/main_window.py" line="368" />
             <source>&amp;Disconnect</source>
             <translation>断开(&amp;D)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="360" />
+            <location filename="../../ui/main_window.py" line="369" />
             <source>&amp;Quit</source>
             <translation>退出(&amp;Q)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="361" />
+            <location filename="../../ui/main_window.py" line="370" />
             <source>&amp;Stop</source>
             <translation>停止(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="362" />
+            <location filename="../../ui/main_window.py" line="371" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="363" />
+            <location filename="../../ui/main_window.py" line="372" />
             <source>&amp;Pause</source>
             <translation>暂停(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="364" />
+            <location filename="../../ui/main_window.py" line="373" />
             <source>Pause the current move or program (F6)</source>
             <translation>暂停当前运动或程序（F6）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="365" />
+            <location filename="../../ui/main_window.py" line="374" />
             <source>&amp;Resume</source>
             <translation>继续(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="366" />
+            <location filename="../../ui/main_window.py" line="375" />
             <source>Resume the paused move or program (F7)</source>
             <translation>继续已暂停的运动或程序（F7）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="367" />
+            <location filename="../../ui/main_window.py" line="376" />
             <source>&amp;About TeachPad</source>
             <translation>关于 TeachPad(&amp;A)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="368" />
-            <location filename="../../ui/main_window.py" line="438" />
+            <location filename="../../ui/main_window.py" line="377" />
+            <location filename="../../ui/main_window.py" line="447" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="370" />
+            <location filename="../../ui/main_window.py" line="379" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="371" />
+            <location filename="../../ui/main_window.py" line="380" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="372" />
+            <location filename="../../ui/main_window.py" line="381" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="373" />
+            <location filename="../../ui/main_window.py" line="382" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="374" />
+            <location filename="../../ui/main_window.py" line="383" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="375" />
+            <location filename="../../ui/main_window.py" line="384" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="376" />
+            <location filename="../../ui/main_window.py" line="385" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="377" />
+            <location filename="../../ui/main_window.py" line="386" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="378" />
+            <location filename="../../ui/main_window.py" line="387" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="379" />
+            <location filename="../../ui/main_window.py" line="388" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="380" />
+            <location filename="../../ui/main_window.py" line="389" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="381" />
+            <location filename="../../ui/main_window.py" line="390" />
             <source>move to temp point</source>
             <translation>运动到临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="382" />
+            <location filename="../../ui/main_window.py" line="391" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="383" />
+            <location filename="../../ui/main_window.py" line="392" />
             <source>teach disable</source>
             <translation>关闭示教</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="384" />
+            <location filename="../../ui/main_window.py" line="393" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="385" />
+            <location filename="../../ui/main_window.py" line="394" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="386" />
+            <location filename="../../ui/main_window.py" line="395" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="387" />
+            <location filename="../../ui/main_window.py" line="396" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="388" />
+            <location filename="../../ui/main_window.py" line="397" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="410" />
+            <location filename="../../ui/main_window.py" line="419" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="435" />
+            <location filename="../../ui/main_window.py" line="444" />
             <source>link down</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="455" />
+            <location filename="../../ui/main_window.py" line="464" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="457" />
+            <location filename="../../ui/main_window.py" line="466" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="467" />
+            <location filename="../../ui/main_window.py" line="476" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="485" />
+            <location filename="../../ui/main_window.py" line="494" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="503" />
+            <location filename="../../ui/main_window.py" line="512" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="509" />
+            <location filename="../../ui/main_window.py" line="518" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="505" />
-            <location filename="../../ui/main_window.py" line="510" />
+            <location filename="../../ui/main_window.py" line="514" />
+            <location filename="../../ui/main_window.py" line="519" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="340" />
+            <location filename="../../ui/main_window.py" line="349" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="341" />
+            <location filename="../../ui/main_window.py" line="350" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="342" />
+            <location filename="../../ui/main_window.py" line="351" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="343" />
+            <location filename="../../ui/main_window.py" line="352" />
             <source>Show &amp;monitor</source>
             <translation>显示监视(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="343" />
+            <location filename="../../ui/main_window.py" line="352" />
             <source>Show &amp;points</source>
             <translation>显示点位(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="344" />
+            <location filename="../../ui/main_window.py" line="353" />
             <source>Show p&amp;lanner</source>
             <translation>显示轨迹规划(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="591" />
+            <location filename="../../ui/main_window.py" line="606" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="592" />
+            <location filename="../../ui/main_window.py" line="607" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="600" />
+            <location filename="../../ui/main_window.py" line="615" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="601" />
+            <location filename="../../ui/main_window.py" line="616" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -698,92 +698,92 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="247" />
+            <location filename="../../ui/monitor_panel.py" line="255" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="247" />
+            <location filename="../../ui/monitor_panel.py" line="255" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="248" />
+            <location filename="../../ui/monitor_panel.py" line="256" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="249" />
-            <source>Joints and external axes</source>
-            <translation>关节与附加轴</translation>
+            <location filename="../../ui/monitor_panel.py" line="258" />
+            <source>Joints and external axes (°)</source>
+            <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="256" />
+            <location filename="../../ui/monitor_panel.py" line="262" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="257" />
+            <location filename="../../ui/monitor_panel.py" line="263" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="258" />
+            <location filename="../../ui/monitor_panel.py" line="264" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="259" />
+            <location filename="../../ui/monitor_panel.py" line="265" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="260" />
+            <location filename="../../ui/monitor_panel.py" line="266" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="261" />
+            <location filename="../../ui/monitor_panel.py" line="267" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="262" />
+            <location filename="../../ui/monitor_panel.py" line="268" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="263" />
+            <location filename="../../ui/monitor_panel.py" line="269" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="264" />
+            <location filename="../../ui/monitor_panel.py" line="270" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="265" />
+            <location filename="../../ui/monitor_panel.py" line="271" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="265" />
+            <location filename="../../ui/monitor_panel.py" line="271" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="266" />
+            <location filename="../../ui/monitor_panel.py" line="272" />
             <source>TCP path, top view (X–Y)</source>
             <translation>TCP 轨迹俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="433" />
+            <location filename="../../ui/monitor_panel.py" line="439" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="435" />
+            <location filename="../../ui/monitor_panel.py" line="441" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -952,378 +952,378 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/planner_panel.py" line="402" />
+            <location filename="../../ui/planner_panel.py" line="405" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="402" />
+            <location filename="../../ui/planner_panel.py" line="405" />
             <source>Add an empty plan</source>
             <translation>添加空轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="403" />
+            <location filename="../../ui/planner_panel.py" line="406" />
             <source>Rename</source>
             <translation>重命名</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="403" />
+            <location filename="../../ui/planner_panel.py" line="406" />
             <source>Rename the selected plan (F2)</source>
             <translation>重命名所选轨迹（F2）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="404" />
+            <location filename="../../ui/planner_panel.py" line="407" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="404" />
+            <location filename="../../ui/planner_panel.py" line="407" />
             <source>Copy the selected plan</source>
             <translation>复制所选轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="405" />
-            <location filename="../../ui/planner_panel.py" line="410" />
+            <location filename="../../ui/planner_panel.py" line="408" />
+            <location filename="../../ui/planner_panel.py" line="413" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="406" />
+            <location filename="../../ui/planner_panel.py" line="409" />
             <source>Delete the selected plan (Ctrl+Z to undo)</source>
             <translation>删除所选轨迹（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="407" />
+            <location filename="../../ui/planner_panel.py" line="410" />
             <source>+ Line</source>
             <translation>+ 直线</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="408" />
+            <location filename="../../ui/planner_panel.py" line="411" />
             <source>Add a line segment after the selection (Ctrl+L)</source>
             <translation>在所选段之后添加直线段（Ctrl+L）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="409" />
+            <location filename="../../ui/planner_panel.py" line="412" />
             <source>+ Arc</source>
             <translation>+ 圆弧</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="409" />
+            <location filename="../../ui/planner_panel.py" line="412" />
             <source>Add an arc segment after the selection</source>
             <translation>在所选段之后添加圆弧段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="410" />
+            <location filename="../../ui/planner_panel.py" line="413" />
             <source>Delete the selected segments</source>
             <translation>删除所选段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="411" />
+            <location filename="../../ui/planner_panel.py" line="414" />
             <source>Move the selected segments up (Alt+Up)</source>
             <translation>上移所选段（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="412" />
+            <location filename="../../ui/planner_panel.py" line="415" />
             <source>Move the selected segments down (Alt+Down)</source>
             <translation>下移所选段（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="413" />
-            <location filename="../../ui/planner_panel.py" line="432" />
+            <location filename="../../ui/planner_panel.py" line="416" />
+            <location filename="../../ui/planner_panel.py" line="435" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="413" />
+            <location filename="../../ui/planner_panel.py" line="416" />
             <source>Check the plan from the robot's current pose</source>
             <translation>以机器人当前位姿检查轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="414" />
-            <location filename="../../ui/planner_panel.py" line="431" />
+            <location filename="../../ui/planner_panel.py" line="417" />
+            <location filename="../../ui/planner_panel.py" line="434" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="414" />
+            <location filename="../../ui/planner_panel.py" line="417" />
             <source>Upload the points the plan needs</source>
             <translation>上传轨迹所需的点</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="415" />
-            <location filename="../../ui/planner_panel.py" line="428" />
+            <location filename="../../ui/planner_panel.py" line="418" />
+            <location filename="../../ui/planner_panel.py" line="431" />
             <source>Run</source>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="415" />
+            <location filename="../../ui/planner_panel.py" line="418" />
             <source>Run the plan from the first segment (F5)</source>
             <translation>从第一段开始运行轨迹（F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="416" />
+            <location filename="../../ui/planner_panel.py" line="419" />
             <source>Run from here</source>
             <translation>从此处运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="417" />
+            <location filename="../../ui/planner_panel.py" line="420" />
             <source>Run from the selected segment (Shift+F5)</source>
             <translation>从所选段开始运行（Shift+F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="418" />
+            <location filename="../../ui/planner_panel.py" line="421" />
             <source>Step</source>
             <translation>单步</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="418" />
+            <location filename="../../ui/planner_panel.py" line="421" />
             <source>Run one segment, then stop (F10)</source>
             <translation>运行一段后停止（F10）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="419" />
+            <location filename="../../ui/planner_panel.py" line="422" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="419" />
+            <location filename="../../ui/planner_panel.py" line="422" />
             <source>Pause the motion</source>
             <translation>暂停运动</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="420" />
+            <location filename="../../ui/planner_panel.py" line="423" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="420" />
+            <location filename="../../ui/planner_panel.py" line="423" />
             <source>Resume the paused motion</source>
             <translation>继续已暂停的运动</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="421" />
+            <location filename="../../ui/planner_panel.py" line="424" />
             <source>Stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="421" />
+            <location filename="../../ui/planner_panel.py" line="424" />
             <source>Stop the robot and the run</source>
             <translation>停止机器人和轨迹运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="422" />
-            <location filename="../../ui/planner_panel.py" line="862" />
+            <location filename="../../ui/planner_panel.py" line="425" />
+            <location filename="../../ui/planner_panel.py" line="865" />
             <source>Resume from segment</source>
             <translation>从该段继续</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="422" />
+            <location filename="../../ui/planner_panel.py" line="425" />
             <source>Continue the stopped run</source>
             <translation>继续已停止的运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="427" />
+            <location filename="../../ui/planner_panel.py" line="430" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="429" />
+            <location filename="../../ui/planner_panel.py" line="432" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="430" />
+            <location filename="../../ui/planner_panel.py" line="433" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="522" />
+            <location filename="../../ui/planner_panel.py" line="525" />
             <source>Deleted plan {name} (Ctrl+Z to undo)</source>
             <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="609" />
+            <location filename="../../ui/planner_panel.py" line="612" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="611" />
+            <location filename="../../ui/planner_panel.py" line="614" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="613" />
+            <location filename="../../ui/planner_panel.py" line="616" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="617" />
+            <location filename="../../ui/planner_panel.py" line="620" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="622" />
+            <location filename="../../ui/planner_panel.py" line="625" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="646" />
-            <location filename="../../ui/planner_panel.py" line="823" />
+            <location filename="../../ui/planner_panel.py" line="649" />
+            <location filename="../../ui/planner_panel.py" line="826" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="648" />
+            <location filename="../../ui/planner_panel.py" line="651" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="650" />
+            <location filename="../../ui/planner_panel.py" line="653" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="652" />
+            <location filename="../../ui/planner_panel.py" line="655" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="656" />
+            <location filename="../../ui/planner_panel.py" line="659" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="662" />
+            <location filename="../../ui/planner_panel.py" line="665" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="664" />
+            <location filename="../../ui/planner_panel.py" line="667" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="665" />
+            <location filename="../../ui/planner_panel.py" line="668" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="672" />
+            <location filename="../../ui/planner_panel.py" line="675" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="675" />
+            <location filename="../../ui/planner_panel.py" line="678" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="686" />
+            <location filename="../../ui/planner_panel.py" line="689" />
             <source>Not connected to a controller</source>
             <translation>未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="699" />
+            <location filename="../../ui/planner_panel.py" line="702" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="705" />
+            <location filename="../../ui/planner_panel.py" line="708" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="707" />
+            <location filename="../../ui/planner_panel.py" line="710" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="708" />
+            <location filename="../../ui/planner_panel.py" line="711" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="709" />
+            <location filename="../../ui/planner_panel.py" line="712" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="721" />
+            <location filename="../../ui/planner_panel.py" line="724" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="723" />
+            <location filename="../../ui/planner_panel.py" line="726" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="725" />
+            <location filename="../../ui/planner_panel.py" line="728" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="727" />
+            <location filename="../../ui/planner_panel.py" line="730" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="728" />
+            <location filename="../../ui/planner_panel.py" line="731" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="730" />
+            <location filename="../../ui/planner_panel.py" line="733" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="731" />
+            <location filename="../../ui/planner_panel.py" line="734" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="800" />
+            <location filename="../../ui/planner_panel.py" line="803" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="824" />
+            <location filename="../../ui/planner_panel.py" line="827" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="842" />
+            <location filename="../../ui/planner_panel.py" line="845" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="843" />
+            <location filename="../../ui/planner_panel.py" line="846" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="853" />
+            <location filename="../../ui/planner_panel.py" line="856" />
             <source>Failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="853" />
+            <location filename="../../ui/planner_panel.py" line="856" />
             <source>Stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="861" />
+            <location filename="../../ui/planner_panel.py" line="864" />
             <source>Resume from segment {k}</source>
             <translation>从第 {k} 段继续</translation>
         </message>
@@ -1331,153 +1331,152 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/points_panel.py" line="207" />
+            <location filename="../../ui/points_panel.py" line="221" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="218" />
+            <location filename="../../ui/points_panel.py" line="232" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="227" />
+            <location filename="../../ui/points_panel.py" line="242" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="229" />
+            <location filename="../../ui/points_panel.py" line="244" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="238" />
+            <location filename="../../ui/points_panel.py" line="251" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="259" />
+            <location filename="../../ui/points_panel.py" line="277" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="265" />
+            <location filename="../../ui/points_panel.py" line="283" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="268" />
+            <location filename="../../ui/points_panel.py" line="286" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="272" />
+            <location filename="../../ui/points_panel.py" line="290" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="274" />
+            <location filename="../../ui/points_panel.py" line="292" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="279" />
+            <location filename="../../ui/points_panel.py" line="297" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="295" />
+            <location filename="../../ui/points_panel.py" line="313" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="308" />
+            <location filename="../../ui/points_panel.py" line="326" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="311" />
+            <location filename="../../ui/points_panel.py" line="329" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="343" />
+            <location filename="../../ui/points_panel.py" line="361" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="351" />
+            <location filename="../../ui/points_panel.py" line="375" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="379" />
+            <location filename="../../ui/points_panel.py" line="405" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="384" />
+            <location filename="../../ui/points_panel.py" line="410" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="395" />
+            <location filename="../../ui/points_panel.py" line="421" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="399" />
+            <location filename="../../ui/points_panel.py" line="425" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="405" />
+            <location filename="../../ui/points_panel.py" line="431" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="412" />
+            <location filename="../../ui/points_panel.py" line="438" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="414" />
+            <location filename="../../ui/points_panel.py" line="440" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="423" />
+            <location filename="../../ui/points_panel.py" line="449" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="427" />
+            <location filename="../../ui/points_panel.py" line="453" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="472" />
-            <location filename="../../ui/points_panel.py" line="477" />
+            <location filename="../../ui/points_panel.py" line="491" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="472" />
+            <location filename="../../ui/points_panel.py" line="493" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="492" />
+            <location filename="../../ui/points_panel.py" line="509" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="496" />
+            <location filename="../../ui/points_panel.py" line="513" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="500" />
+            <location filename="../../ui/points_panel.py" line="517" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -1664,174 +1663,174 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/points_panel.py" line="717" />
+            <location filename="../../ui/points_panel.py" line="731" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="717" />
+            <location filename="../../ui/points_panel.py" line="731" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="719" />
+            <location filename="../../ui/points_panel.py" line="733" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="719" />
+            <location filename="../../ui/points_panel.py" line="733" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="720" />
+            <location filename="../../ui/points_panel.py" line="734" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="720" />
+            <location filename="../../ui/points_panel.py" line="734" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="721" />
+            <location filename="../../ui/points_panel.py" line="735" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="722" />
+            <location filename="../../ui/points_panel.py" line="736" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="723" />
+            <location filename="../../ui/points_panel.py" line="737" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="724" />
+            <location filename="../../ui/points_panel.py" line="738" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="725" />
+            <location filename="../../ui/points_panel.py" line="739" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="726" />
+            <location filename="../../ui/points_panel.py" line="740" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="727" />
+            <location filename="../../ui/points_panel.py" line="741" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="728" />
+            <location filename="../../ui/points_panel.py" line="742" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="729" />
+            <location filename="../../ui/points_panel.py" line="743" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="729" />
+            <location filename="../../ui/points_panel.py" line="743" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="730" />
-            <location filename="../../ui/points_panel.py" line="746" />
+            <location filename="../../ui/points_panel.py" line="744" />
+            <location filename="../../ui/points_panel.py" line="760" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="731" />
+            <location filename="../../ui/points_panel.py" line="745" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="732" />
+            <location filename="../../ui/points_panel.py" line="746" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="733" />
-            <location filename="../../ui/points_panel.py" line="873" />
+            <location filename="../../ui/points_panel.py" line="747" />
+            <location filename="../../ui/points_panel.py" line="887" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="734" />
+            <location filename="../../ui/points_panel.py" line="748" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="735" />
+            <location filename="../../ui/points_panel.py" line="749" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="735" />
+            <location filename="../../ui/points_panel.py" line="749" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="736" />
+            <location filename="../../ui/points_panel.py" line="750" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="741" />
+            <location filename="../../ui/points_panel.py" line="755" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="742" />
+            <location filename="../../ui/points_panel.py" line="756" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="743" />
+            <location filename="../../ui/points_panel.py" line="757" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="744" />
+            <location filename="../../ui/points_panel.py" line="758" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="747" />
+            <location filename="../../ui/points_panel.py" line="761" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="748" />
+            <location filename="../../ui/points_panel.py" line="762" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="836" />
+            <location filename="../../ui/points_panel.py" line="850" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="839" />
+            <location filename="../../ui/points_panel.py" line="853" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="862" />
+            <location filename="../../ui/points_panel.py" line="876" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="866" />
+            <location filename="../../ui/points_panel.py" line="880" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -1844,7 +1843,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="909" />
+            <location filename="../../ui/points_panel.py" line="923" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>

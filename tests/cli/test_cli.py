@@ -144,9 +144,15 @@ def test_motion_commands(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     code, out, err = run(csim, capsys, "move", "5", "--speed", "400")
     assert code == EXIT_OK, err
     assert csim.state().pose[1] == pytest.approx(y0 + 30, abs=0.05)
-    code, out, err = run(csim, capsys, "move", "6", "--via", "5", "--ignore-middle", "--keep-orientation",
+    # the arm stands on point 5: the arc needs a middle point of its own
+    code, out, _ = run(csim, capsys, "point", "create", "7", "--xyzabc", str(x0 + 25), str(y0 + 20), str(z0),
+                       "180", "0", "0")
+    assert code == EXIT_OK
+    code, out, err = run(csim, capsys, "move", "6", "--via", "7", "--ignore-middle", "--keep-orientation",
                          "--speed", "400")
     assert code == EXIT_OK, err
+    code, out, err = run(csim, capsys, "move", "6", "--via", "6", "--speed", "400")
+    assert code == EXIT_USAGE and "middle point must differ" in one_line_error(err)
     code, _, err = run(csim, capsys, "move", "99")
     assert code == EXIT_FAILED
     assert one_line_error(err) == ("teachpad-cli: error: move to temp point refused: bad end point id "
