@@ -45,7 +45,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from app.errors import InvalidInput, LinkError, ResponseTimeout, TeachPadError
+from app.errors import CommandRefused, InvalidInput, LinkError, ResponseTimeout, TeachPadError
 from app.models import Pose
 from app.plan import (
     IssueKind,
@@ -70,6 +70,7 @@ from app.points import (
     upload_points,
 )
 from app.project import Project, load_project, read_points_csv, save_project, write_points_csv
+from app.protocol.enums import MoveStatus
 from app.runner import PlanRunner, RunEvent, RunProgress, RunState
 
 PROG = "teachpad-cli"
@@ -380,6 +381,10 @@ def _pick_plan(io: _Io, project: Project, name: str | None) -> Plan | None:
     return None
 
 
+def _points_lost(error: BaseException | None) -> bool:
+    return isinstance(error, CommandRefused) and error.status.code == MoveStatus.BAD_END_POINT
+
+
 def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
             err: TextIO | None = None, close_client: bool = True) -> int:
     """``run PROJECT [--plan NAME] ...``: check, upload if asked, run with a progress line."""
@@ -470,6 +475,13 @@ def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client
         io.print(f"done: {outcome.segments_done} segment(s)")
         return EXIT_OK
     io.error(f"{outcome.state.value}: {outcome.message}")
+    if _points_lost(outcome.error):
+        # "bad end point id": the controller no longer holds the ledger's points (it has most
+        # likely restarted): record that, so `run --upload` restores them before resuming
+        ledger.mark_all_unknown()
+        if _save(io, project, args.project):
+            io.error("the controller does not hold the points any more (restarted?): all points "
+                     "are marked unknown; resume with --upload to restore them first")
     if outcome.resume_from is not None:
         resume = f"--from {outcome.resume_from + 1}"
         if outcome.resume_loop and outcome.resume_loop > 1:

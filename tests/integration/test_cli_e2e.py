@@ -106,11 +106,13 @@ def test_run_fails_at_the_segment_whose_point_the_controller_lost(
     assert "failed: segment 1/4 (loop 1/1): " in captured.err
     assert "bad end point id" in captured.err
     assert f"to resume: teachpad-cli run {demo} --plan 'circle' --from 1" in captured.out
+    assert "all points are marked unknown" in captured.err
     assert not sim.state().moving
+    assert {p.sync for p in load_project(demo).ledger} == {SyncState.UNKNOWN}  # saved
 
-    # restore, then resume exactly as the message says
-    assert teachpad_cli(sim.port, "points", "upload", str(demo)) == cli.EXIT_OK
-    assert teachpad_cli(sim.port, "run", str(demo), "--plan", "circle", "--from", "1") == cli.EXIT_OK
+    # resume with --upload: the lost points are restored first, then the plan runs
+    assert teachpad_cli(sim.port, "run", str(demo), "--plan", "circle", "--from", "1",
+                        "--upload") == cli.EXIT_OK
     assert_pose_at(sim.state().pose, sample_poses(demo)[1], "the final pose")
 
 
