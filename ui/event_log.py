@@ -27,11 +27,9 @@ from PySide6.QtGui import QBrush, QColor
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QComboBox,
-    QFileDialog,
     QHBoxLayout,
     QHeaderView,
     QLabel,
-    QMessageBox,
     QPushButton,
     QTableView,
     QVBoxLayout,
@@ -49,6 +47,7 @@ from ui.widgets_common import (
     atomic_write_text,
     command_result_text,
     connection_display,
+    export_with_dialog,
     monospace_font,
     state_name,
 )
@@ -359,19 +358,5 @@ class EventLogPanel(QWidget):
 
     @Slot()
     def _export_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(
-            self,
-            self.tr("Export event log"),
-            "events.txt",
-            self.tr("Text files (*.txt *.log);;All files (*)"),
-        )
-        if not path:
-            return
-        try:
-            self.export_to(path)
-        except OSError as exc:
-            QMessageBox.warning(
-                self,
-                self.tr("Export event log"),
-                self.tr("Could not write {path}: {error}").format(path=path, error=exc),
-            )
+        export_with_dialog(self, self.tr("Export event log"), "events.txt",
+                           self.tr("Text files (*.txt *.log);;All files (*)"), self.export_to)

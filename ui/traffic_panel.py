@@ -34,12 +34,10 @@ from PySide6.QtGui import QBrush, QColor, QFontMetrics, QGuiApplication, QHideEv
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
-    QFileDialog,
     QHBoxLayout,
     QHeaderView,
     QLabel,
     QLineEdit,
-    QMessageBox,
     QPushButton,
     QTableView,
     QVBoxLayout,
@@ -51,7 +49,14 @@ from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 from app.protocol.enums import CommandKind, RunCommand
 from app.protocol.frames import DecodedFrame, decode_frame
-from ui.widgets_common import COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, atomic_write_text, monospace_font
+from ui.widgets_common import (
+    COLOR_ERROR,
+    COLOR_INFO,
+    COLOR_NEUTRAL,
+    atomic_write_text,
+    export_with_dialog,
+    monospace_font,
+)
 
 MAX_ROWS_DEFAULT = 20_000
 HEX_DISPLAY_BYTES = 40  # bytes shown in the table cell; a 412.. read answer has 209
@@ -654,22 +659,8 @@ class TrafficPanel(QWidget):
 
     @Slot()
     def _export_dialog(self) -> None:
-        path, _ = QFileDialog.getSaveFileName(
-            self,
-            self.tr("Export traffic"),
-            "traffic.csv",
-            self.tr("CSV files (*.csv);;Text files (*.txt);;All files (*)"),
-        )
-        if not path:
-            return
-        try:
-            self.export_to(path)
-        except OSError as exc:
-            QMessageBox.warning(
-                self,
-                self.tr("Export traffic"),
-                self.tr("Could not write {path}: {error}").format(path=path, error=exc),
-            )
+        export_with_dialog(self, self.tr("Export traffic"), "traffic.csv",
+                           self.tr("CSV files (*.csv);;Text files (*.txt);;All files (*)"), self.export_to)
 
     # --- internals --------------------------------------------------------------------
     @Slot(str)

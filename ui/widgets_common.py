@@ -9,12 +9,13 @@ from __future__ import annotations
 import contextlib
 import os
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QCoreApplication, Qt
 from PySide6.QtGui import QFont, QFontDatabase
-from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QSizePolicy, QWidget
+from PySide6.QtWidgets import QFileDialog, QFrame, QHBoxLayout, QLabel, QMessageBox, QSizePolicy, QWidget
 
 from app.models import CommandResult
 from app.protocol.enums import (
@@ -284,3 +285,16 @@ def command_result_text(result: CommandResult) -> str:
     if result.message:
         text = f"{text} — {result.message}"
     return text
+
+
+def export_with_dialog(parent: QWidget, title: str, default_name: str, filters: str,
+                       export: Callable[[str], object]) -> None:
+    """Ask for a file name, run ``export(path)``; a failed write is shown, never raised."""
+    path, _ = QFileDialog.getSaveFileName(parent, title, default_name, filters)
+    if not path:
+        return
+    try:
+        export(path)
+    except OSError as exc:
+        QMessageBox.warning(parent, title, QCoreApplication.translate(
+            "Export", "Could not write {path}: {error}").format(path=path, error=exc))

@@ -172,37 +172,37 @@
     <context>
         <name>EventLogModel</name>
         <message>
-            <location filename="../../ui/event_log.py" line="92" />
+            <location filename="../../ui/event_log.py" line="91" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="93" />
+            <location filename="../../ui/event_log.py" line="92" />
             <source>Level</source>
             <translation>级别</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="94" />
+            <location filename="../../ui/event_log.py" line="93" />
             <source>Source</source>
             <translation>来源</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="95" />
+            <location filename="../../ui/event_log.py" line="94" />
             <source>Message</source>
             <translation>消息</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="98" />
+            <location filename="../../ui/event_log.py" line="97" />
             <source>Info</source>
             <translation>信息</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="99" />
+            <location filename="../../ui/event_log.py" line="98" />
             <source>Warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="100" />
+            <location filename="../../ui/event_log.py" line="99" />
             <source>Error</source>
             <translation>错误</translation>
         </message>
@@ -210,78 +210,80 @@
     <context>
         <name>EventLogPanel</name>
         <message>
-            <location filename="../../ui/event_log.py" line="263" />
+            <location filename="../../ui/event_log.py" line="262" />
             <source>Show:</source>
             <translation>显示：</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="264" />
+            <location filename="../../ui/event_log.py" line="263" />
             <source>All events</source>
             <translation>全部事件</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="265" />
+            <location filename="../../ui/event_log.py" line="264" />
             <source>Warnings and errors</source>
             <translation>警告和错误</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="266" />
+            <location filename="../../ui/event_log.py" line="265" />
             <source>Errors only</source>
             <translation>仅错误</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="267" />
+            <location filename="../../ui/event_log.py" line="266" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="268" />
+            <location filename="../../ui/event_log.py" line="267" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="299" />
+            <location filename="../../ui/event_log.py" line="298" />
             <source>alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="306" />
+            <location filename="../../ui/event_log.py" line="305" />
             <source>Alarm raised: {name}</source>
             <translation>报警触发：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="308" />
+            <location filename="../../ui/event_log.py" line="307" />
             <source>Alarm cleared: {name}</source>
             <translation>报警解除：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="314" />
+            <location filename="../../ui/event_log.py" line="313" />
             <source>bit {n}</source>
             <translation>第 {n} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="318" />
+            <location filename="../../ui/event_log.py" line="317" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="337" />
+            <location filename="../../ui/event_log.py" line="336" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="364" />
-            <location filename="../../ui/event_log.py" line="375" />
+            <location filename="../../ui/event_log.py" line="361" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="366" />
+            <location filename="../../ui/event_log.py" line="362" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
+    </context>
+    <context>
+        <name>Export</name>
         <message>
-            <location filename="../../ui/event_log.py" line="376" />
+            <location filename="../../ui/widgets_common.py" line="299" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -791,64 +793,64 @@
     <context>
         <name>Panels</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="233" />
+            <location filename="../../ui/widgets_common.py" line="234" />
             <source>connected</source>
             <translation>已连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="234" />
+            <location filename="../../ui/widgets_common.py" line="235" />
             <source>connecting</source>
             <translation>正在连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="235" />
+            <location filename="../../ui/widgets_common.py" line="236" />
             <source>reconnecting</source>
             <translation>正在重连</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="236" />
+            <location filename="../../ui/widgets_common.py" line="237" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="237" />
+            <location filename="../../ui/widgets_common.py" line="238" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="238" />
+            <location filename="../../ui/widgets_common.py" line="239" />
             <source>link down</source>
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="239" />
             <location filename="../../ui/widgets_common.py" line="240" />
+            <location filename="../../ui/widgets_common.py" line="241" />
             <source>link lost</source>
             <translation>链路丢失</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="241" />
+            <location filename="../../ui/widgets_common.py" line="242" />
             <source>error</source>
             <translation>错误</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="242" />
-            <location filename="../../ui/widgets_common.py" line="273" />
+            <location filename="../../ui/widgets_common.py" line="243" />
+            <location filename="../../ui/widgets_common.py" line="274" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="264" />
+            <location filename="../../ui/widgets_common.py" line="265" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="272" />
+            <location filename="../../ui/widgets_common.py" line="273" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="281" />
+            <location filename="../../ui/widgets_common.py" line="282" />
             <source>{command}: {status}</source>
             <translation>{command}：{status}</translation>
         </message>
@@ -2763,37 +2765,37 @@ Recover it?</source>
     <context>
         <name>TrafficModel</name>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="216" />
+            <location filename="../../ui/traffic_panel.py" line="221" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="217" />
+            <location filename="../../ui/traffic_panel.py" line="222" />
             <source>Dir</source>
             <translation>方向</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="218" />
+            <location filename="../../ui/traffic_panel.py" line="223" />
             <source>Bytes</source>
             <translation>字节</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="219" />
+            <location filename="../../ui/traffic_panel.py" line="224" />
             <source>Meaning</source>
             <translation>含义</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="221" />
+            <location filename="../../ui/traffic_panel.py" line="226" />
             <source>→ Tx</source>
             <translation>→ 发送</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="222" />
+            <location filename="../../ui/traffic_panel.py" line="227" />
             <source>← Rx</source>
             <translation>← 接收</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="386" />
+            <location filename="../../ui/traffic_panel.py" line="391" />
             <source>{n} bytes</source>
             <translation>{n} 字节</translation>
         </message>
@@ -2801,68 +2803,62 @@ Recover it?</source>
     <context>
         <name>TrafficPanel</name>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="531" />
+            <location filename="../../ui/traffic_panel.py" line="536" />
             <source>Filter: bytes or meaning</source>
             <translation>过滤：字节或含义</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="532" />
+            <location filename="../../ui/traffic_panel.py" line="537" />
             <source>Hide polls</source>
             <translation>隐藏轮询</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="534" />
+            <location filename="../../ui/traffic_panel.py" line="539" />
             <source>Hide the periodic reads of 412.. (pose) and 560.. (status)</source>
             <translation>隐藏对 412..（位姿）和 560..（状态）的周期读取</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="536" />
+            <location filename="../../ui/traffic_panel.py" line="541" />
             <source>Pause capture</source>
             <translation>暂停抓包</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="537" />
+            <location filename="../../ui/traffic_panel.py" line="542" />
             <source>Stop recording frames (the worker stops building them)</source>
             <translation>停止记录报文（后台不再生成报文记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="538" />
+            <location filename="../../ui/traffic_panel.py" line="543" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="539" />
+            <location filename="../../ui/traffic_panel.py" line="544" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="659" />
-            <location filename="../../ui/traffic_panel.py" line="670" />
+            <location filename="../../ui/traffic_panel.py" line="662" />
             <source>Export traffic</source>
             <translation>导出通信报文</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="661" />
+            <location filename="../../ui/traffic_panel.py" line="663" />
             <source>CSV files (*.csv);;Text files (*.txt);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;文本文件 (*.txt);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="671" />
-            <source>Could not write {path}: {error}</source>
-            <translation>无法写入 {path}：{error}</translation>
-        </message>
-        <message>
-            <location filename="../../ui/traffic_panel.py" line="699" />
+            <location filename="../../ui/traffic_panel.py" line="690" />
             <source>{n} frames</source>
             <translation>{n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="701" />
+            <location filename="../../ui/traffic_panel.py" line="692" />
             <source>{shown} of {n} frames shown</source>
             <translation>显示 {shown} / {n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="703" />
+            <location filename="../../ui/traffic_panel.py" line="694" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
         </message>
