@@ -10,7 +10,7 @@ from PySide6.QtGui import QImage
 
 from app.client import ConnectionSettings
 from app.protocol.codec import WordOrder
-from app.protocol.enums import Alarm
+from app.protocol.enums import Alarm, WorkMode
 from app.worker import LinkState
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
@@ -164,3 +164,31 @@ def test_teachpad_sim_screenshot(qtbot: Any, tmp_path: Any) -> None:
     assert code == 0
     image = QImage(str(png))
     assert not image.isNull() and image.width() >= 1600
+
+
+def test_traffic_inspector_shows_decoded_frames_from_the_simulator(
+    qtbot: Any, sim: Any, window: MainWindow
+) -> None:
+    """Raise the inspector, connect, send a command: its frames arrive decoded, as in the seed."""
+    from ui.traffic_panel import COL_BYTES, COL_MEANING
+
+    window.show()
+    window.traffic_dock.show()
+    window.traffic_dock.raise_()
+    connect(qtbot, window.link, sim)
+    panel = window.traffic_panel
+    model = panel.model
+
+    def texts(column: int) -> list[str]:
+        panel.flush()
+        return [str(model.data(model.index(r, column))) for r in range(model.rowCount())]
+
+    qtbot.waitUntil(lambda: any("read pose" in t for t in texts(COL_MEANING)), timeout=SIGNAL_TIMEOUT_MS)
+    window.link.set_mode(WorkMode.MANUAL)  # 444 <- 0, a 0x06 write
+    qtbot.waitUntil(lambda: any("work mode manual (444 ← 0)" in t for t in texts(COL_MEANING)),
+                    timeout=SIGNAL_TIMEOUT_MS)
+    # the hex column shows the bytes as the seed prints them: MBAP, then 01 06 01 BC 00 00
+    assert any(t.endswith("01 06 01 BC 00 00") for t in texts(COL_BYTES))
+    # hidden behind the event log, nothing is captured any more
+    window.event_dock.raise_()
+    qtbot.waitUntil(lambda: not window._traffic_capture, timeout=SIGNAL_TIMEOUT_MS)
