@@ -47,6 +47,33 @@ def sim_factory() -> Iterator[Any]:
             controller.stop()
 
 
+@pytest.fixture
+def make_client() -> Iterator[Any]:
+    """RobotClients for a simulator (its port, framer and word order) or any ``port=``;
+    connected unless ``connect=False``; every one is closed after the test."""
+    from app.client import ConnectionSettings, RobotClient
+
+    made: list[Any] = []
+
+    def make(sim: Any = None, *, connect: bool = True, **kwargs: Any) -> Any:
+        kwargs.setdefault("host", "127.0.0.1")
+        if sim is not None:
+            kwargs.setdefault("port", sim.port)
+            kwargs.setdefault("framer", sim.config.framer)
+            kwargs.setdefault("word_order", sim.config.word_order)
+        client = RobotClient(ConnectionSettings(**kwargs))
+        made.append(client)
+        if connect:
+            client.connect()
+        return client
+
+    try:
+        yield make
+    finally:
+        for client in made:
+            client.close()
+
+
 # --- Qt leak check (napari-style): a test must not leave a QThread running or a QTimer active.
 _threads: weakref.WeakSet[Any] = weakref.WeakSet()
 _timers: weakref.WeakSet[Any] = weakref.WeakSet()

@@ -9,6 +9,7 @@ import socket
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -90,21 +91,27 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
     assert not state.teach_enabled and state.teach_ratio == 0 and not state.jogging
 
 
-def test_jog_interrupted_still_stops_and_disables(csim: Any) -> None:
+def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) -> tuple[int, str]:
+    """Run teachpad-cli in a subprocess, press Ctrl-C once ``started(state)``; (exit code, stderr)."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli", "--port", str(csim.port), "jog", "--frame", "joint",
-         "--axis", "J1", "--dir", "-", "--ratio", "20", "--for", "60"],
+        [sys.executable, "-m", "app.cli", "--port", str(csim.port), *args],
         cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     try:
-        assert csim.wait_for(lambda s: s.jogging, 10.0)
+        assert csim.wait_for(started, 10.0)
         proc.send_signal(signal.SIGINT)
         _, err = proc.communicate(timeout=10)
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.communicate()
-    assert proc.returncode == EXIT_INTERRUPTED
+    return proc.returncode, err
+
+
+def test_jog_interrupted_still_stops_and_disables(csim: Any) -> None:
+    code, err = interrupt_cli(csim, ["jog", "--frame", "joint", "--axis", "J1", "--dir", "-", "--ratio", "20",
+                                     "--for", "60"], lambda s: s.jogging)
+    assert code == EXIT_INTERRUPTED
     assert one_line_error(err) == "teachpad-cli: error: interrupted"
     state = csim.state()
     assert not state.teach_enabled and not state.jogging and state.teach_ratio == 0
@@ -250,20 +257,8 @@ def test_entry_point_module_runs() -> None:
 
 
 def test_interrupted_move_is_stopped(csim: Any) -> None:
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli", "--port", str(csim.port), "step", "--frame", "base", "Y=100",
-         "--speed", "20"],
-        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-    )
-    try:
-        assert csim.wait_for(lambda s: s.moving, 10.0)
-        proc.send_signal(signal.SIGINT)
-        _, err = proc.communicate(timeout=10)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate()
-    assert proc.returncode == EXIT_INTERRUPTED
+    code, err = interrupt_cli(csim, ["step", "--frame", "base", "Y=100", "--speed", "20"], lambda s: s.moving)
+    assert code == EXIT_INTERRUPTED
     assert err.splitlines() == ["teachpad-cli: warning: interrupted: stop sent",
                                 "teachpad-cli: error: interrupted"]
     assert csim.wait_for(lambda s: not s.moving, 2.0)

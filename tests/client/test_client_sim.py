@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import struct
 import threading
+from collections.abc import Callable
 from typing import Any
 
 import pytest
@@ -35,13 +36,14 @@ from app.protocol.enums import (
     TeachFrame,
     WorkMode,
 )
-from tests.client.conftest import MakeClient
 
 FC06, FC10 = 0x06, 0x10
 # Create/teach commands publish 0 (received) for command_latency before the final code. The
 # default 1 ms window is shorter than one scheduling hiccup on a loaded 2-core machine, so the
 # tests that chain many create/teach commands give the simulated controller a 20 ms scan.
 SCAN = 0.02
+
+MakeClient = Callable[..., RobotClient]  # the make_client fixture (tests/conftest.py)
 
 
 def wire(sim: Any, since: int = 0) -> list[tuple[int, int, int]]:
