@@ -5,6 +5,10 @@ from __future__ import annotations
 # Modbus request timeout (s) and retries of the pymodbus client.
 REQUEST_TIMEOUT = 1.0
 REQUEST_RETRIES = 0
+# Monitoring reads have their own, short timeout so a silent controller is seen at once
+# (polling at >= 20 Hz: next poll within 50 ms + this = "not answering" within 250 ms).
+POLL_TIMEOUT_TCP = 0.15
+POLL_TIMEOUT_RTU_MARGIN = 0.1  # s added to twice the largest answer's time on the wire
 
 # Waiting for a command's GV291 result.
 STATUS_POLL_INTERVAL = 0.002  # s between status reads while waiting for a short command

@@ -19,7 +19,7 @@ from typing import Any
 
 from pymodbus.client import ModbusTcpClient
 
-from app.client import ConnectionSettings, RobotClient
+from app.link.client import ConnectionSettings, RobotClient
 from app.protocol import registers as R  # noqa: N812
 from app.protocol.codec import encode_floats
 from app.protocol.enums import RunCommand, decode_status_registers

@@ -54,12 +54,13 @@ from PySide6.QtCore import QCoreApplication, QEvent, QEventLoop, QObject, QPoint
 from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import QApplication
 
-from app.client import ConnectionSettings
+from app.link.client import ConnectionSettings
+from app.link.robot_link import RobotLink
+from app.link.types import ConnectionState, LinkState
 from app.models import CommandResult, Pose
 from app.protocol import registers as R  # noqa: N812
 from app.protocol.enums import ProgramMotionMode, RunCommand
 from app.sim import SimConfig, SimController, WriteRecord
-from app.worker import ConnectionState, LinkState, RobotLink
 from ui.main_window import DEFAULT_SIZE, MainWindow
 from ui.settings import AppSettings
 

@@ -1,19 +1,19 @@
 """Temp points and plans at scale: project files, the point table, restore-all, plan preview.
 
 Each figure is measured in the same run as a baseline:
-* loading a 10,000-point project (``app.project.load_project``, which parses and validates
+* loading a 10,000-point project (``app.points.project.load_project``, which parses and validates
   everything) vs ``json.load`` of the same file;
-* showing it: ``ui.points_model.PointsModel`` (behind the panel's ``PointFilterProxy``) in a
+* showing it: ``ui.models.points_model.PointsModel`` (behind the panel's ``PointFilterProxy``) in a
   ``QTableView`` set up like the points panel's, from construction to the first paint, vs a
   minimal table model of the same shape in the same view (offscreen Qt; null with a reason
   when the UI module is missing);
 * restoring all points to the simulator with ``RobotClient.upload_points`` — the product's
   "restore all" path (the GUI worker calls it) — vs the minimal-transactions bound
   (4 transactions x measured round trip + the simulator's command latency, per point); the
-  CLI's path (``app.points.upload_points``: one ``create_point`` per point) on a sample;
+  CLI's path (``app.points.ledger.upload_points``: one ``create_point`` per point) on a sample;
 * plan geometry for 1,000 segments (``plan_path``, ``plan_geometry``, ``check_plan``,
   ``estimate_plan``) vs sampling the same segments one by one with ``segment_path``; and the
-  preview widget's (``ui.plan_preview.PlanPreview``) redraw of the 1,000 segments, vs the
+  preview widget's (``ui.panels.plan_preview.PlanPreview``) redraw of the 1,000 segments, vs the
   same widget redrawing a 10-segment plan.
 
 Quick mode restores 500 points instead of 10,000 and repeats less.
@@ -33,10 +33,10 @@ from typing import Any
 import numpy as np
 from pymodbus.client import ModbusTcpClient
 
-from app.client import ConnectionSettings, RobotClient
-from app.plan import Plan, Segment, check_plan, estimate_plan, plan_geometry, plan_path, segment_path
-from app.points import PointLedger, SyncState, TempPoint, make_point, upload_points
-from app.project import Project, load_project, save_project
+from app.link.client import ConnectionSettings, RobotClient
+from app.plan.segments import Plan, Segment, check_plan, estimate_plan, plan_geometry, plan_path, segment_path
+from app.points.ledger import PointLedger, SyncState, TempPoint, make_point, upload_points
+from app.points.project import Project, load_project, save_project
 from app.protocol import registers as R  # noqa: N812
 from app.sim import SimConfig, SimController
 
@@ -128,7 +128,7 @@ def bench_show(project: Project, repeats: int) -> dict[str, Any]:
         from PySide6.QtGui import QUndoStack
         from PySide6.QtWidgets import QHeaderView, QTableView
 
-        from ui.points_model import COLUMNS, PointFilterProxy, PointsModel
+        from ui.models.points_model import COLUMNS, PointFilterProxy, PointsModel
     except ImportError as exc:
         return {"show_ms": None, "reason": f"ui/points_model.py is not usable: {exc}"}
     app = _qt_app()
@@ -246,7 +246,7 @@ def bench_restore(n: int, cli_n: int) -> dict[str, Any]:
         "rtt_ms": round(rtt, 4),
         "controller_latency_ms": 1000.0 * latency,
         "cli_path": {
-            "path": "app.points.upload_points (teachpad-cli points upload: create_point per point)",
+            "path": "app.points.ledger.upload_points (teachpad-cli points upload: create_point per point)",
             "points": cli_n,
             "failed": len(report.failed) + len(report.not_attempted),
             "ms_per_point": round(1000.0 * cli_s / cli_n, 3),
@@ -310,7 +310,7 @@ def bench_plan(repeats: int) -> dict[str, Any]:
 
 def bench_preview(repeats: int) -> dict[str, Any]:
     try:
-        from ui.plan_preview import PlanPreview
+        from ui.panels.plan_preview import PlanPreview
     except ImportError as exc:
         return {"redraw_ms": None, "reason": f"ui/plan_preview.py is not usable: {exc}"}
     app = _qt_app()

@@ -51,7 +51,7 @@ def sim_factory() -> Iterator[Any]:
 def make_client() -> Iterator[Any]:
     """RobotClients for a simulator (its port, framer and word order) or any ``port=``;
     connected unless ``connect=False``; every one is closed after the test."""
-    from app.client import ConnectionSettings, RobotClient
+    from app.link.client import ConnectionSettings, RobotClient
 
     made: list[Any] = []
 

@@ -17,10 +17,11 @@ from collections.abc import Sequence
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication
 
-from app.client import ConnectionSettings
+from app.link.client import ConnectionSettings
+from app.link.robot_link import RobotLink
+from app.link.types import ConnectionState
 from app.models import Pose
 from app.protocol.enums import ProgramMotionMode
-from app.worker import ConnectionState, RobotLink
 from ui.i18n import LANGUAGE_NAMES, Translator
 from ui.main_window import TAB_NAMES, MainWindow
 from ui.settings import APPLICATION, ORGANIZATION, AppSettings

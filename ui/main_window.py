@@ -49,25 +49,26 @@ from PySide6.QtWidgets import (
 )
 
 from app import __version__
-from app.client import ConnectionSettings
+from app.link.client import ConnectionSettings
+from app.link.robot_link import RobotLink
+from app.link.types import ConnectionState, JogRequest, LinkState, Operation, WorkerError
 from app.models import CommandResult, ControllerStatus
 from app.protocol.enums import ProgramMotionMode, WorkMode
-from app.worker import ConnectionState, JogRequest, LinkState, Operation, RobotLink, WorkerError
-from ui.connection_dialog import ConnectionDialog
-from ui.control_bar import ControlBar
-from ui.event_log import EventLogPanel
+from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.project_controller import ProjectController, ProjectDialogs
+from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import LANGUAGE_NAMES, Translator
-from ui.jog_panel import JogPanel
-from ui.monitor_panel import MonitorPanel
-from ui.plan_run_controller import PlanRunController
-from ui.planner_panel import PlannerPanel
-from ui.points_panel import PointsPanel, PointSyncController
-from ui.program_panel import ProgramPanel, ProgramRequest
-from ui.project_controller import ProjectController, ProjectDialogs
+from ui.panels.control_bar import ControlBar
+from ui.panels.event_log import EventLogPanel
+from ui.panels.jog_panel import JogPanel
+from ui.panels.monitor_panel import MonitorPanel
+from ui.panels.planner_panel import PlannerPanel
+from ui.panels.points_panel import PointsPanel, PointSyncController
+from ui.panels.program_panel import ProgramPanel, ProgramRequest
+from ui.panels.status_panel import StatusPanel
+from ui.panels.step_panel import ConfirmFn, StepPanel, StepRequest
+from ui.panels.traffic_panel import TrafficPanel
 from ui.settings import AppSettings
-from ui.status_panel import StatusPanel
-from ui.step_panel import ConfirmFn, StepPanel, StepRequest
-from ui.traffic_panel import TrafficPanel
 from ui.widgets_common import connection_display
 
 DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size

@@ -14,7 +14,7 @@ from typing import Any
 from PySide6.QtCore import QByteArray, QSettings
 
 from app import timing
-from app.client import ConnectionSettings
+from app.link.client import ConnectionSettings
 from app.protocol.codec import WordOrder
 
 ORGANIZATION = "Bochuang"

@@ -4,102 +4,102 @@
     <context>
         <name>ConnectionDialog</name>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="115" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="115" />
             <source>Connect to controller</source>
             <translation>连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="116" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="116" />
             <source>Transport:</source>
             <translation>通信方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="117" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="117" />
             <source>Modbus TCP</source>
             <translation>Modbus TCP</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="118" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="118" />
             <source>Modbus RTU (serial)</source>
             <translation>Modbus RTU（串口）</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="119" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="119" />
             <source>Host:</source>
             <translation>主机：</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="120" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="120" />
             <source>Port:</source>
             <translation>端口：</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="121" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="121" />
             <source>Serial port:</source>
             <translation>串口：</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="122" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="122" />
             <source>Baud rate:</source>
             <translation>波特率：</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="123" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="123" />
             <source>Parity:</source>
             <translation>校验位：</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="124" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="124" />
             <source>none</source>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="124" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="124" />
             <source>even</source>
             <translation>偶校验</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="124" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="124" />
             <source>odd</source>
             <translation>奇校验</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="126" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="126" />
             <source>Stop bits:</source>
             <translation>停止位：</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="127" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="127" />
             <source>Unit id:</source>
             <translation>从站地址：</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="128" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="128" />
             <source>Float word order:</source>
             <translation>浮点数字序：</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="129" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="129" />
             <source>Low word first (CDAB, default)</source>
             <translation>低字在前（CDAB，默认）</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="130" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="130" />
             <source>High word first (ABCD)</source>
             <translation>高字在前（ABCD）</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="131" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="131" />
             <source>Timeout:</source>
             <translation>超时：</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="132" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="132" />
             <source>Monitor only (never write to the controller)</source>
             <translation>仅监视（从不写入控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/connection_dialog.py" line="180" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="180" />
             <source>a serial port is needed for RTU</source>
             <translation>RTU 方式需要指定串口</translation>
         </message>
@@ -107,62 +107,62 @@
     <context>
         <name>ControlBar</name>
         <message>
-            <location filename="../../ui/control_bar.py" line="95" />
+            <location filename="../../ui/panels/control_bar.py" line="95" />
             <source>STOP</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="96" />
+            <location filename="../../ui/panels/control_bar.py" line="96" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="97" />
+            <location filename="../../ui/panels/control_bar.py" line="97" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="98" />
+            <location filename="../../ui/panels/control_bar.py" line="98" />
             <source>Pause the current move or program</source>
             <translation>暂停当前运动或程序</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="99" />
+            <location filename="../../ui/panels/control_bar.py" line="99" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="100" />
+            <location filename="../../ui/panels/control_bar.py" line="100" />
             <source>Resume the paused move or program</source>
             <translation>继续已暂停的运动或程序</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="101" />
+            <location filename="../../ui/panels/control_bar.py" line="101" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="102" />
+            <location filename="../../ui/panels/control_bar.py" line="102" />
             <source>Manual</source>
             <translation>手动</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="103" />
+            <location filename="../../ui/panels/control_bar.py" line="103" />
             <source>Switch the controller to manual mode</source>
             <translation>将控制器切换到手动模式</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="104" />
+            <location filename="../../ui/panels/control_bar.py" line="104" />
             <source>Auto</source>
             <translation>自动</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="105" />
+            <location filename="../../ui/panels/control_bar.py" line="105" />
             <source>Switch the controller to auto mode (needed for Modbus motion)</source>
             <translation>将控制器切换到自动模式（Modbus 运动需要自动模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/control_bar.py" line="138" />
+            <location filename="../../ui/panels/control_bar.py" line="138" />
             <source>Mode:
 {mode}</source>
             <translation>模式：
@@ -172,37 +172,37 @@
     <context>
         <name>EventLogModel</name>
         <message>
-            <location filename="../../ui/event_log.py" line="91" />
+            <location filename="../../ui/panels/event_log.py" line="91" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="92" />
+            <location filename="../../ui/panels/event_log.py" line="92" />
             <source>Level</source>
             <translation>级别</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="93" />
+            <location filename="../../ui/panels/event_log.py" line="93" />
             <source>Source</source>
             <translation>来源</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="94" />
+            <location filename="../../ui/panels/event_log.py" line="94" />
             <source>Message</source>
             <translation>消息</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="97" />
+            <location filename="../../ui/panels/event_log.py" line="97" />
             <source>Info</source>
             <translation>信息</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="98" />
+            <location filename="../../ui/panels/event_log.py" line="98" />
             <source>Warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="99" />
+            <location filename="../../ui/panels/event_log.py" line="99" />
             <source>Error</source>
             <translation>错误</translation>
         </message>
@@ -210,72 +210,72 @@
     <context>
         <name>EventLogPanel</name>
         <message>
-            <location filename="../../ui/event_log.py" line="262" />
+            <location filename="../../ui/panels/event_log.py" line="262" />
             <source>Show:</source>
             <translation>显示：</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="263" />
+            <location filename="../../ui/panels/event_log.py" line="263" />
             <source>All events</source>
             <translation>全部事件</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="264" />
+            <location filename="../../ui/panels/event_log.py" line="264" />
             <source>Warnings and errors</source>
             <translation>警告和错误</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="265" />
+            <location filename="../../ui/panels/event_log.py" line="265" />
             <source>Errors only</source>
             <translation>仅错误</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="266" />
+            <location filename="../../ui/panels/event_log.py" line="266" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="267" />
+            <location filename="../../ui/panels/event_log.py" line="267" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="298" />
+            <location filename="../../ui/panels/event_log.py" line="298" />
             <source>alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="305" />
+            <location filename="../../ui/panels/event_log.py" line="305" />
             <source>Alarm raised: {name}</source>
             <translation>报警触发：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="307" />
+            <location filename="../../ui/panels/event_log.py" line="307" />
             <source>Alarm cleared: {name}</source>
             <translation>报警解除：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="313" />
+            <location filename="../../ui/panels/event_log.py" line="313" />
             <source>bit {n}</source>
             <translation>第 {n} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="317" />
+            <location filename="../../ui/panels/event_log.py" line="317" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="336" />
+            <location filename="../../ui/panels/event_log.py" line="336" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="361" />
+            <location filename="../../ui/panels/event_log.py" line="361" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/event_log.py" line="362" />
+            <location filename="../../ui/panels/event_log.py" line="362" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -291,87 +291,87 @@
     <context>
         <name>JogPanel</name>
         <message>
-            <location filename="../../ui/jog_panel.py" line="214" />
+            <location filename="../../ui/panels/jog_panel.py" line="214" />
             <source>Frame</source>
             <translation>坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="216" />
+            <location filename="../../ui/panels/jog_panel.py" line="216" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="217" />
+            <location filename="../../ui/panels/jog_panel.py" line="217" />
             <source>User frame</source>
             <translation>用户坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="218" />
+            <location filename="../../ui/panels/jog_panel.py" line="218" />
             <source>Tool frame</source>
             <translation>工具坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="219" />
+            <location filename="../../ui/panels/jog_panel.py" line="219" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="223" />
+            <location filename="../../ui/panels/jog_panel.py" line="223" />
             <source>User no.:</source>
             <translation>用户坐标号：</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="224" />
+            <location filename="../../ui/panels/jog_panel.py" line="224" />
             <source>Tool no.:</source>
             <translation>工具号：</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="225" />
+            <location filename="../../ui/panels/jog_panel.py" line="225" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="226" />
+            <location filename="../../ui/panels/jog_panel.py" line="226" />
             <source>External axes</source>
             <translation>外部轴</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="227" />
+            <location filename="../../ui/panels/jog_panel.py" line="227" />
             <source>HOLD TO MOVE — release to stop</source>
             <translation>按住运动 — 松开即停</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="228" />
+            <location filename="../../ui/panels/jog_panel.py" line="228" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="233" />
+            <location filename="../../ui/panels/jog_panel.py" line="233" />
             <source>Keyboard: click this panel, then hold {plus} (+) or {minus} (−) for axes 1–6; releasing the key stops.</source>
             <translation>键盘：先单击本面板，再按住 {plus}（+）或 {minus}（−）点动第 1–6 轴；松开按键即停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="358" />
+            <location filename="../../ui/panels/jog_panel.py" line="358" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="358" />
+            <location filename="../../ui/panels/jog_panel.py" line="358" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="359" />
+            <location filename="../../ui/panels/jog_panel.py" line="359" />
             <source>Hold: {axis} − ({unit})</source>
             <translation>按住：{axis} −（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="361" />
+            <location filename="../../ui/panels/jog_panel.py" line="361" />
             <source>Hold: {axis} + ({unit})</source>
             <translation>按住：{axis} +（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/jog_panel.py" line="372" />
+            <location filename="../../ui/panels/jog_panel.py" line="372" />
             <source>{ratio} %</source>
             <translation>{ratio} %</translation>
         </message>
@@ -379,320 +379,320 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="346" />
+            <location filename="../../ui/main_window.py" line="347" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="347" />
+            <location filename="../../ui/main_window.py" line="348" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="348" />
+            <location filename="../../ui/main_window.py" line="349" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="355" />
+            <location filename="../../ui/main_window.py" line="356" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="356" />
+            <location filename="../../ui/main_window.py" line="357" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="357" />
+            <location filename="../../ui/main_window.py" line="358" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="358" />
+            <location filename="../../ui/main_window.py" line="359" />
             <source>&amp;File</source>
             <translation>文件(&amp;F)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="359" />
+            <location filename="../../ui/main_window.py" line="360" />
             <source>&amp;Edit</source>
             <translation>编辑(&amp;E)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="360" />
+            <location filename="../../ui/main_window.py" line="361" />
             <source>&amp;Motion</source>
             <translation>运动(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="361" />
+            <location filename="../../ui/main_window.py" line="362" />
             <source>&amp;View</source>
             <translation>视图(&amp;V)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="362" />
+            <location filename="../../ui/main_window.py" line="363" />
             <source>&amp;Language</source>
             <translation>语言(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="363" />
+            <location filename="../../ui/main_window.py" line="364" />
             <source>&amp;Help</source>
             <translation>帮助(&amp;H)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="364" />
             <location filename="../../ui/main_window.py" line="365" />
+            <location filename="../../ui/main_window.py" line="366" />
             <source>Toolbar</source>
             <translation>工具栏</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="366" />
+            <location filename="../../ui/main_window.py" line="367" />
             <source>&amp;Connect…</source>
             <translation>连接(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="367" />
+            <location filename="../../ui/main_window.py" line="368" />
             <source>Connect to a controller (Ctrl+K)</source>
             <translation>连接控制器（Ctrl+K）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="368" />
+            <location filename="../../ui/main_window.py" line="369" />
             <source>&amp;Disconnect</source>
             <translation>断开(&amp;D)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="369" />
+            <location filename="../../ui/main_window.py" line="370" />
             <source>&amp;Quit</source>
             <translation>退出(&amp;Q)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="370" />
+            <location filename="../../ui/main_window.py" line="371" />
             <source>&amp;Stop</source>
             <translation>停止(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="371" />
+            <location filename="../../ui/main_window.py" line="372" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="372" />
+            <location filename="../../ui/main_window.py" line="373" />
             <source>&amp;Pause</source>
             <translation>暂停(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="373" />
+            <location filename="../../ui/main_window.py" line="374" />
             <source>Pause the current move or program (F6)</source>
             <translation>暂停当前运动或程序（F6）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="374" />
+            <location filename="../../ui/main_window.py" line="375" />
             <source>&amp;Resume</source>
             <translation>继续(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="375" />
+            <location filename="../../ui/main_window.py" line="376" />
             <source>Resume the paused move or program (F7)</source>
             <translation>继续已暂停的运动或程序（F7）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="376" />
+            <location filename="../../ui/main_window.py" line="377" />
             <source>&amp;About TeachPad</source>
             <translation>关于 TeachPad(&amp;A)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="377" />
-            <location filename="../../ui/main_window.py" line="447" />
+            <location filename="../../ui/main_window.py" line="378" />
+            <location filename="../../ui/main_window.py" line="448" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="379" />
+            <location filename="../../ui/main_window.py" line="380" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="380" />
+            <location filename="../../ui/main_window.py" line="381" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="381" />
+            <location filename="../../ui/main_window.py" line="382" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="382" />
+            <location filename="../../ui/main_window.py" line="383" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="383" />
+            <location filename="../../ui/main_window.py" line="384" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="384" />
+            <location filename="../../ui/main_window.py" line="385" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="385" />
+            <location filename="../../ui/main_window.py" line="386" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="386" />
+            <location filename="../../ui/main_window.py" line="387" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="387" />
+            <location filename="../../ui/main_window.py" line="388" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="388" />
+            <location filename="../../ui/main_window.py" line="389" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="389" />
+            <location filename="../../ui/main_window.py" line="390" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="390" />
+            <location filename="../../ui/main_window.py" line="391" />
             <source>move to temp point</source>
             <translation>运动到临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="391" />
+            <location filename="../../ui/main_window.py" line="392" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="392" />
+            <location filename="../../ui/main_window.py" line="393" />
             <source>teach disable</source>
             <translation>关闭示教</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="393" />
+            <location filename="../../ui/main_window.py" line="394" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="394" />
+            <location filename="../../ui/main_window.py" line="395" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="395" />
+            <location filename="../../ui/main_window.py" line="396" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="396" />
+            <location filename="../../ui/main_window.py" line="397" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="397" />
+            <location filename="../../ui/main_window.py" line="398" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="419" />
+            <location filename="../../ui/main_window.py" line="420" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="444" />
+            <location filename="../../ui/main_window.py" line="445" />
             <source>link down</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="464" />
+            <location filename="../../ui/main_window.py" line="465" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="466" />
+            <location filename="../../ui/main_window.py" line="467" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="476" />
+            <location filename="../../ui/main_window.py" line="477" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="494" />
+            <location filename="../../ui/main_window.py" line="495" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="512" />
+            <location filename="../../ui/main_window.py" line="513" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="518" />
+            <location filename="../../ui/main_window.py" line="519" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="514" />
-            <location filename="../../ui/main_window.py" line="519" />
+            <location filename="../../ui/main_window.py" line="515" />
+            <location filename="../../ui/main_window.py" line="520" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="349" />
+            <location filename="../../ui/main_window.py" line="350" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="350" />
+            <location filename="../../ui/main_window.py" line="351" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="351" />
+            <location filename="../../ui/main_window.py" line="352" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="352" />
+            <location filename="../../ui/main_window.py" line="353" />
             <source>Show &amp;monitor</source>
             <translation>显示监视(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="352" />
+            <location filename="../../ui/main_window.py" line="353" />
             <source>Show &amp;points</source>
             <translation>显示点位(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="353" />
+            <location filename="../../ui/main_window.py" line="354" />
             <source>Show p&amp;lanner</source>
             <translation>显示轨迹规划(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="606" />
+            <location filename="../../ui/main_window.py" line="607" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="607" />
+            <location filename="../../ui/main_window.py" line="608" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="615" />
+            <location filename="../../ui/main_window.py" line="616" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="616" />
+            <location filename="../../ui/main_window.py" line="617" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -700,92 +700,92 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="255" />
+            <location filename="../../ui/panels/monitor_panel.py" line="255" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="255" />
+            <location filename="../../ui/panels/monitor_panel.py" line="255" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="256" />
+            <location filename="../../ui/panels/monitor_panel.py" line="256" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="258" />
+            <location filename="../../ui/panels/monitor_panel.py" line="258" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="262" />
+            <location filename="../../ui/panels/monitor_panel.py" line="262" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="263" />
+            <location filename="../../ui/panels/monitor_panel.py" line="263" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="264" />
+            <location filename="../../ui/panels/monitor_panel.py" line="264" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="265" />
+            <location filename="../../ui/panels/monitor_panel.py" line="265" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="266" />
+            <location filename="../../ui/panels/monitor_panel.py" line="266" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="267" />
+            <location filename="../../ui/panels/monitor_panel.py" line="267" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="268" />
+            <location filename="../../ui/panels/monitor_panel.py" line="268" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="269" />
+            <location filename="../../ui/panels/monitor_panel.py" line="269" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="270" />
+            <location filename="../../ui/panels/monitor_panel.py" line="270" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="271" />
+            <location filename="../../ui/panels/monitor_panel.py" line="271" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="271" />
+            <location filename="../../ui/panels/monitor_panel.py" line="271" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="272" />
+            <location filename="../../ui/panels/monitor_panel.py" line="272" />
             <source>TCP path, top view (X–Y)</source>
             <translation>TCP 轨迹俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="439" />
+            <location filename="../../ui/panels/monitor_panel.py" line="439" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/monitor_panel.py" line="441" />
+            <location filename="../../ui/panels/monitor_panel.py" line="441" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -858,13 +858,13 @@
     <context>
         <name>Plan</name>
         <message>
-            <location filename="../../app/plan.py" line="74" />
+            <location filename="../../app/plan/segments.py" line="74" />
             <source>line</source>
             <extracomment>Time added per segment to length / speed: command round trip, acceleration, settling (s). Editable fields of a segment, in table column order.</extracomment>
             <translation>直线</translation>
         </message>
         <message>
-            <location filename="../../app/plan.py" line="75" />
+            <location filename="../../app/plan/segments.py" line="75" />
             <source>arc</source>
             <translation>圆弧</translation>
         </message>
@@ -872,62 +872,62 @@
     <context>
         <name>PlanListModel</name>
         <message>
-            <location filename="../../ui/plan_model.py" line="196" />
+            <location filename="../../ui/models/plan_model.py" line="196" />
             <source>Plan</source>
             <translation>轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="196" />
+            <location filename="../../ui/models/plan_model.py" line="196" />
             <source>Loops</source>
             <translation>循环次数</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="196" />
+            <location filename="../../ui/models/plan_model.py" line="196" />
             <source>Segments</source>
             <translation>段数</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="248" />
+            <location filename="../../ui/models/plan_model.py" line="248" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="252" />
+            <location filename="../../ui/models/plan_model.py" line="252" />
             <source>How many times the plan runs (0 = until stopped)</source>
             <translation>轨迹运行次数（0 = 直到停止）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="277" />
+            <location filename="../../ui/models/plan_model.py" line="277" />
             <source>Plan: refused, {reason}</source>
             <translation>轨迹：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="283" />
+            <location filename="../../ui/models/plan_model.py" line="283" />
             <source>plan</source>
             <translation>轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="287" />
+            <location filename="../../ui/models/plan_model.py" line="287" />
             <source>Add plan {name}</source>
             <translation>添加轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="295" />
+            <location filename="../../ui/models/plan_model.py" line="295" />
             <source>Duplicate plan {name}</source>
             <translation>复制轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="300" />
+            <location filename="../../ui/models/plan_model.py" line="300" />
             <source>Delete plan {name}</source>
             <translation>删除轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="310" />
+            <location filename="../../ui/models/plan_model.py" line="310" />
             <source>Rename plan {old} to {new}</source>
             <translation>将轨迹 {old} 重命名为 {new}</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="319" />
+            <location filename="../../ui/models/plan_model.py" line="319" />
             <source>Set loops of {name} to {n}</source>
             <translation>将轨迹 {name} 的循环次数设为 {n}</translation>
         </message>
@@ -935,18 +935,18 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/plan_preview.py" line="161" />
+            <location filename="../../ui/panels/plan_preview.py" line="161" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_preview.py" line="162" />
+            <location filename="../../ui/panels/plan_preview.py" line="162" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_preview.py" line="163" />
+            <location filename="../../ui/panels/plan_preview.py" line="163" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
@@ -954,378 +954,378 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/planner_panel.py" line="405" />
+            <location filename="../../ui/panels/planner_panel.py" line="405" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="405" />
+            <location filename="../../ui/panels/planner_panel.py" line="405" />
             <source>Add an empty plan</source>
             <translation>添加空轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="406" />
+            <location filename="../../ui/panels/planner_panel.py" line="406" />
             <source>Rename</source>
             <translation>重命名</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="406" />
+            <location filename="../../ui/panels/planner_panel.py" line="406" />
             <source>Rename the selected plan (F2)</source>
             <translation>重命名所选轨迹（F2）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="407" />
+            <location filename="../../ui/panels/planner_panel.py" line="407" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="407" />
+            <location filename="../../ui/panels/planner_panel.py" line="407" />
             <source>Copy the selected plan</source>
             <translation>复制所选轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="408" />
-            <location filename="../../ui/planner_panel.py" line="413" />
+            <location filename="../../ui/panels/planner_panel.py" line="408" />
+            <location filename="../../ui/panels/planner_panel.py" line="413" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="409" />
+            <location filename="../../ui/panels/planner_panel.py" line="409" />
             <source>Delete the selected plan (Ctrl+Z to undo)</source>
             <translation>删除所选轨迹（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="410" />
+            <location filename="../../ui/panels/planner_panel.py" line="410" />
             <source>+ Line</source>
             <translation>+ 直线</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="411" />
+            <location filename="../../ui/panels/planner_panel.py" line="411" />
             <source>Add a line segment after the selection (Ctrl+L)</source>
             <translation>在所选段之后添加直线段（Ctrl+L）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="412" />
+            <location filename="../../ui/panels/planner_panel.py" line="412" />
             <source>+ Arc</source>
             <translation>+ 圆弧</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="412" />
+            <location filename="../../ui/panels/planner_panel.py" line="412" />
             <source>Add an arc segment after the selection</source>
             <translation>在所选段之后添加圆弧段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="413" />
+            <location filename="../../ui/panels/planner_panel.py" line="413" />
             <source>Delete the selected segments</source>
             <translation>删除所选段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="414" />
+            <location filename="../../ui/panels/planner_panel.py" line="414" />
             <source>Move the selected segments up (Alt+Up)</source>
             <translation>上移所选段（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="415" />
+            <location filename="../../ui/panels/planner_panel.py" line="415" />
             <source>Move the selected segments down (Alt+Down)</source>
             <translation>下移所选段（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="416" />
-            <location filename="../../ui/planner_panel.py" line="435" />
+            <location filename="../../ui/panels/planner_panel.py" line="416" />
+            <location filename="../../ui/panels/planner_panel.py" line="435" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="416" />
+            <location filename="../../ui/panels/planner_panel.py" line="416" />
             <source>Check the plan from the robot's current pose</source>
             <translation>以机器人当前位姿检查轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="417" />
-            <location filename="../../ui/planner_panel.py" line="434" />
+            <location filename="../../ui/panels/planner_panel.py" line="417" />
+            <location filename="../../ui/panels/planner_panel.py" line="434" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="417" />
+            <location filename="../../ui/panels/planner_panel.py" line="417" />
             <source>Upload the points the plan needs</source>
             <translation>上传轨迹所需的点</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="418" />
-            <location filename="../../ui/planner_panel.py" line="431" />
+            <location filename="../../ui/panels/planner_panel.py" line="418" />
+            <location filename="../../ui/panels/planner_panel.py" line="431" />
             <source>Run</source>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="418" />
+            <location filename="../../ui/panels/planner_panel.py" line="418" />
             <source>Run the plan from the first segment (F5)</source>
             <translation>从第一段开始运行轨迹（F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="419" />
+            <location filename="../../ui/panels/planner_panel.py" line="419" />
             <source>Run from here</source>
             <translation>从此处运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="420" />
+            <location filename="../../ui/panels/planner_panel.py" line="420" />
             <source>Run from the selected segment (Shift+F5)</source>
             <translation>从所选段开始运行（Shift+F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="421" />
+            <location filename="../../ui/panels/planner_panel.py" line="421" />
             <source>Step</source>
             <translation>单步</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="421" />
+            <location filename="../../ui/panels/planner_panel.py" line="421" />
             <source>Run one segment, then stop (F10)</source>
             <translation>运行一段后停止（F10）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="422" />
+            <location filename="../../ui/panels/planner_panel.py" line="422" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="422" />
+            <location filename="../../ui/panels/planner_panel.py" line="422" />
             <source>Pause the motion</source>
             <translation>暂停运动</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="423" />
+            <location filename="../../ui/panels/planner_panel.py" line="423" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="423" />
+            <location filename="../../ui/panels/planner_panel.py" line="423" />
             <source>Resume the paused motion</source>
             <translation>继续已暂停的运动</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="424" />
+            <location filename="../../ui/panels/planner_panel.py" line="424" />
             <source>Stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="424" />
+            <location filename="../../ui/panels/planner_panel.py" line="424" />
             <source>Stop the robot and the run</source>
             <translation>停止机器人和轨迹运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="425" />
-            <location filename="../../ui/planner_panel.py" line="865" />
+            <location filename="../../ui/panels/planner_panel.py" line="425" />
+            <location filename="../../ui/panels/planner_panel.py" line="865" />
             <source>Resume from segment</source>
             <translation>从该段继续</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="425" />
+            <location filename="../../ui/panels/planner_panel.py" line="425" />
             <source>Continue the stopped run</source>
             <translation>继续已停止的运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="430" />
+            <location filename="../../ui/panels/planner_panel.py" line="430" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="432" />
+            <location filename="../../ui/panels/planner_panel.py" line="432" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="433" />
+            <location filename="../../ui/panels/planner_panel.py" line="433" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="525" />
+            <location filename="../../ui/panels/planner_panel.py" line="525" />
             <source>Deleted plan {name} (Ctrl+Z to undo)</source>
             <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="612" />
+            <location filename="../../ui/panels/planner_panel.py" line="612" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="614" />
+            <location filename="../../ui/panels/planner_panel.py" line="614" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="616" />
+            <location filename="../../ui/panels/planner_panel.py" line="616" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="620" />
+            <location filename="../../ui/panels/planner_panel.py" line="620" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="625" />
+            <location filename="../../ui/panels/planner_panel.py" line="625" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="649" />
-            <location filename="../../ui/planner_panel.py" line="826" />
+            <location filename="../../ui/panels/planner_panel.py" line="649" />
+            <location filename="../../ui/panels/planner_panel.py" line="826" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="651" />
+            <location filename="../../ui/panels/planner_panel.py" line="651" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="653" />
+            <location filename="../../ui/panels/planner_panel.py" line="653" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="655" />
+            <location filename="../../ui/panels/planner_panel.py" line="655" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="659" />
+            <location filename="../../ui/panels/planner_panel.py" line="659" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="665" />
+            <location filename="../../ui/panels/planner_panel.py" line="665" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="667" />
+            <location filename="../../ui/panels/planner_panel.py" line="667" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="668" />
+            <location filename="../../ui/panels/planner_panel.py" line="668" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="675" />
+            <location filename="../../ui/panels/planner_panel.py" line="675" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="678" />
+            <location filename="../../ui/panels/planner_panel.py" line="678" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="689" />
+            <location filename="../../ui/panels/planner_panel.py" line="689" />
             <source>Not connected to a controller</source>
             <translation>未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="702" />
+            <location filename="../../ui/panels/planner_panel.py" line="702" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="708" />
+            <location filename="../../ui/panels/planner_panel.py" line="708" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/planner_panel.py" line="710" />
+            <location filename="../../ui/panels/planner_panel.py" line="710" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="711" />
+            <location filename="../../ui/panels/planner_panel.py" line="711" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="712" />
+            <location filename="../../ui/panels/planner_panel.py" line="712" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="724" />
+            <location filename="../../ui/panels/planner_panel.py" line="724" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="726" />
+            <location filename="../../ui/panels/planner_panel.py" line="726" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="728" />
+            <location filename="../../ui/panels/planner_panel.py" line="728" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="730" />
+            <location filename="../../ui/panels/planner_panel.py" line="730" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="731" />
+            <location filename="../../ui/panels/planner_panel.py" line="731" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="733" />
+            <location filename="../../ui/panels/planner_panel.py" line="733" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="734" />
+            <location filename="../../ui/panels/planner_panel.py" line="734" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="803" />
+            <location filename="../../ui/panels/planner_panel.py" line="803" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="827" />
+            <location filename="../../ui/panels/planner_panel.py" line="827" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="845" />
+            <location filename="../../ui/panels/planner_panel.py" line="845" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="846" />
+            <location filename="../../ui/panels/planner_panel.py" line="846" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="856" />
+            <location filename="../../ui/panels/planner_panel.py" line="856" />
             <source>Failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="856" />
+            <location filename="../../ui/panels/planner_panel.py" line="856" />
             <source>Stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/planner_panel.py" line="864" />
+            <location filename="../../ui/panels/planner_panel.py" line="864" />
             <source>Resume from segment {k}</source>
             <translation>从第 {k} 段继续</translation>
         </message>
@@ -1333,152 +1333,152 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/points_panel.py" line="221" />
+            <location filename="../../ui/panels/points_panel.py" line="221" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="232" />
+            <location filename="../../ui/panels/points_panel.py" line="232" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="242" />
+            <location filename="../../ui/panels/points_panel.py" line="242" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="244" />
+            <location filename="../../ui/panels/points_panel.py" line="244" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="251" />
+            <location filename="../../ui/panels/points_panel.py" line="251" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="277" />
+            <location filename="../../ui/panels/points_panel.py" line="277" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="283" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="286" />
+            <location filename="../../ui/panels/points_panel.py" line="286" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="290" />
+            <location filename="../../ui/panels/points_panel.py" line="290" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="292" />
+            <location filename="../../ui/panels/points_panel.py" line="292" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="297" />
+            <location filename="../../ui/panels/points_panel.py" line="297" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="313" />
+            <location filename="../../ui/panels/points_panel.py" line="313" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="326" />
+            <location filename="../../ui/panels/points_panel.py" line="326" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="329" />
+            <location filename="../../ui/panels/points_panel.py" line="329" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="361" />
+            <location filename="../../ui/panels/points_panel.py" line="361" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="375" />
+            <location filename="../../ui/panels/points_panel.py" line="375" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="405" />
+            <location filename="../../ui/panels/points_panel.py" line="405" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="410" />
+            <location filename="../../ui/panels/points_panel.py" line="410" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="421" />
+            <location filename="../../ui/panels/points_panel.py" line="421" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="425" />
+            <location filename="../../ui/panels/points_panel.py" line="425" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="431" />
+            <location filename="../../ui/panels/points_panel.py" line="431" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="438" />
+            <location filename="../../ui/panels/points_panel.py" line="438" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="440" />
+            <location filename="../../ui/panels/points_panel.py" line="440" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="449" />
+            <location filename="../../ui/panels/points_panel.py" line="449" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="453" />
+            <location filename="../../ui/panels/points_panel.py" line="453" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="491" />
+            <location filename="../../ui/panels/points_panel.py" line="491" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="493" />
+            <location filename="../../ui/panels/points_panel.py" line="493" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="509" />
+            <location filename="../../ui/panels/points_panel.py" line="509" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="513" />
+            <location filename="../../ui/panels/points_panel.py" line="513" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="517" />
+            <location filename="../../ui/panels/points_panel.py" line="517" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -1486,23 +1486,23 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points.py" line="131" />
+            <location filename="../../app/points/ledger.py" line="131" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host".</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points.py" line="132" />
+            <location filename="../../app/points/ledger.py" line="132" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points.py" line="133" />
+            <location filename="../../app/points/ledger.py" line="133" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points.py" line="134" />
+            <location filename="../../app/points/ledger.py" line="134" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
@@ -1510,154 +1510,154 @@
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/points_model.py" line="107" />
+            <location filename="../../ui/models/points_model.py" line="107" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="108" />
+            <location filename="../../ui/models/points_model.py" line="108" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="354" />
+            <location filename="../../ui/models/points_model.py" line="354" />
             <source>ID</source>
             <extracomment>An edit refused (bad value, duplicate id ...): the message for the status line. A command changed ``target``'s list (after the change).</extracomment>
             <translation>编号</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="354" />
+            <location filename="../../ui/models/points_model.py" line="354" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="354" />
+            <location filename="../../ui/models/points_model.py" line="354" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="355" />
+            <location filename="../../ui/models/points_model.py" line="355" />
             <source>Sync</source>
             <translation>同步状态</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="355" />
+            <location filename="../../ui/models/points_model.py" line="355" />
             <source>Note</source>
             <translation>备注</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="358" />
+            <location filename="../../ui/models/points_model.py" line="358" />
             <source>Temp point id on the controller</source>
             <translation>控制器上的临时点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="359" />
+            <location filename="../../ui/models/points_model.py" line="359" />
             <source>Tool frame (200 = none)</source>
             <translation>工具坐标系（200 = 无）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="360" />
+            <location filename="../../ui/models/points_model.py" line="360" />
             <source>Whether the controller holds this point</source>
             <translation>控制器上是否有此点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="361" />
+            <location filename="../../ui/models/points_model.py" line="361" />
             <source>mm, base frame</source>
             <translation>毫米，基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="362" />
+            <location filename="../../ui/models/points_model.py" line="362" />
             <source>degrees</source>
             <translation>度</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="364" />
+            <location filename="../../ui/models/points_model.py" line="364" />
             <source>External axis (recorded only: the controller does not store it)</source>
             <translation>外部轴（仅记录：控制器不保存）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="443" />
+            <location filename="../../ui/models/points_model.py" line="443" />
             <source>no reason given</source>
             <translation>未给出原因</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="444" />
+            <location filename="../../ui/models/points_model.py" line="444" />
             <source>Upload failed: {reason}</source>
             <translation>上传失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="446" />
+            <location filename="../../ui/models/points_model.py" line="446" />
             <source>Not known whether the controller holds this point (it restarted or the link was lost): upload it before moving to it</source>
             <translation>不确定控制器上是否有此点（控制器已重启或通信曾中断）：运动到该点前请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="448" />
+            <location filename="../../ui/models/points_model.py" line="448" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="449" />
+            <location filename="../../ui/models/points_model.py" line="449" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="454" />
+            <location filename="../../ui/models/points_model.py" line="454" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="484" />
+            <location filename="../../ui/models/points_model.py" line="484" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="502" />
+            <location filename="../../ui/models/points_model.py" line="502" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="533" />
+            <location filename="../../ui/models/points_model.py" line="533" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="559" />
+            <location filename="../../ui/models/points_model.py" line="559" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="560" />
+            <location filename="../../ui/models/points_model.py" line="560" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="577" />
+            <location filename="../../ui/models/points_model.py" line="577" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="578" />
+            <location filename="../../ui/models/points_model.py" line="578" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="593" />
+            <location filename="../../ui/models/points_model.py" line="593" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="593" />
+            <location filename="../../ui/models/points_model.py" line="593" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="609" />
+            <location filename="../../ui/models/points_model.py" line="609" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/points_model.py" line="617" />
+            <location filename="../../ui/models/points_model.py" line="617" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -1665,174 +1665,174 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/points_panel.py" line="731" />
+            <location filename="../../ui/panels/points_panel.py" line="731" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="731" />
+            <location filename="../../ui/panels/points_panel.py" line="731" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="733" />
+            <location filename="../../ui/panels/points_panel.py" line="733" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="733" />
+            <location filename="../../ui/panels/points_panel.py" line="733" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="734" />
+            <location filename="../../ui/panels/points_panel.py" line="734" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="734" />
+            <location filename="../../ui/panels/points_panel.py" line="734" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="735" />
+            <location filename="../../ui/panels/points_panel.py" line="735" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="736" />
+            <location filename="../../ui/panels/points_panel.py" line="736" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="737" />
+            <location filename="../../ui/panels/points_panel.py" line="737" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="738" />
+            <location filename="../../ui/panels/points_panel.py" line="738" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="739" />
+            <location filename="../../ui/panels/points_panel.py" line="739" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="740" />
+            <location filename="../../ui/panels/points_panel.py" line="740" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="741" />
+            <location filename="../../ui/panels/points_panel.py" line="741" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="742" />
+            <location filename="../../ui/panels/points_panel.py" line="742" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="743" />
+            <location filename="../../ui/panels/points_panel.py" line="743" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="743" />
+            <location filename="../../ui/panels/points_panel.py" line="743" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="744" />
-            <location filename="../../ui/points_panel.py" line="760" />
+            <location filename="../../ui/panels/points_panel.py" line="744" />
+            <location filename="../../ui/panels/points_panel.py" line="760" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="745" />
+            <location filename="../../ui/panels/points_panel.py" line="745" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="746" />
+            <location filename="../../ui/panels/points_panel.py" line="746" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="747" />
-            <location filename="../../ui/points_panel.py" line="887" />
+            <location filename="../../ui/panels/points_panel.py" line="747" />
+            <location filename="../../ui/panels/points_panel.py" line="887" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="748" />
+            <location filename="../../ui/panels/points_panel.py" line="748" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="749" />
+            <location filename="../../ui/panels/points_panel.py" line="749" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="749" />
+            <location filename="../../ui/panels/points_panel.py" line="749" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="750" />
+            <location filename="../../ui/panels/points_panel.py" line="750" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="755" />
+            <location filename="../../ui/panels/points_panel.py" line="755" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="756" />
+            <location filename="../../ui/panels/points_panel.py" line="756" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="757" />
+            <location filename="../../ui/panels/points_panel.py" line="757" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="758" />
+            <location filename="../../ui/panels/points_panel.py" line="758" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="761" />
+            <location filename="../../ui/panels/points_panel.py" line="761" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="762" />
+            <location filename="../../ui/panels/points_panel.py" line="762" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="850" />
+            <location filename="../../ui/panels/points_panel.py" line="850" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="853" />
+            <location filename="../../ui/panels/points_panel.py" line="853" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="876" />
+            <location filename="../../ui/panels/points_panel.py" line="876" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="880" />
+            <location filename="../../ui/panels/points_panel.py" line="880" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -1845,7 +1845,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/points_panel.py" line="923" />
+            <location filename="../../ui/panels/points_panel.py" line="923" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -1853,78 +1853,78 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProgramPanel</name>
         <message>
-            <location filename="../../ui/program_panel.py" line="102" />
+            <location filename="../../ui/panels/program_panel.py" line="102" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="103" />
+            <location filename="../../ui/panels/program_panel.py" line="103" />
             <source>Program no.:</source>
             <translation>程序号：</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="103" />
+            <location filename="../../ui/panels/program_panel.py" line="103" />
             <source>Run mode:</source>
             <translation>运行方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="103" />
+            <location filename="../../ui/panels/program_panel.py" line="103" />
             <source>Cycles:</source>
             <translation>循环次数：</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="103" />
+            <location filename="../../ui/panels/program_panel.py" line="103" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="108" />
+            <location filename="../../ui/panels/program_panel.py" line="108" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="109" />
+            <location filename="../../ui/panels/program_panel.py" line="109" />
             <source>Number of cycles in cycle mode; 0 runs until stopped</source>
             <translation>循环模式下的循环次数；0 表示一直运行直到停止</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="110" />
+            <location filename="../../ui/panels/program_panel.py" line="110" />
             <source>Run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="111" />
-            <location filename="../../ui/program_panel.py" line="113" />
+            <location filename="../../ui/panels/program_panel.py" line="111" />
+            <location filename="../../ui/panels/program_panel.py" line="113" />
             <source>Go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="112" />
+            <location filename="../../ui/panels/program_panel.py" line="112" />
             <source>All axes</source>
             <translation>所有轴</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="146" />
+            <location filename="../../ui/panels/program_panel.py" line="146" />
             <source>Run program {id} ({mode}) at {speed} %? The arm will move.</source>
             <translation>以 {speed} % 速度运行程序 {id}（{mode}）？机械臂将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="148" />
+            <location filename="../../ui/panels/program_panel.py" line="148" />
             <source>Confirm program run</source>
             <translation>确认运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="154" />
+            <location filename="../../ui/panels/program_panel.py" line="154" />
             <source>all axes</source>
             <translation>所有轴</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="155" />
+            <location filename="../../ui/panels/program_panel.py" line="155" />
             <source>Move {which} to zero? The arm will move.</source>
             <translation>将 {which} 回零？机械臂将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/program_panel.py" line="156" />
+            <location filename="../../ui/panels/program_panel.py" line="156" />
             <source>Confirm go to zero</source>
             <translation>确认回零</translation>
         </message>
@@ -1932,136 +1932,136 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/project_controller.py" line="168" />
+            <location filename="../../ui/controllers/project_controller.py" line="168" />
             <source>Undo</source>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="170" />
+            <location filename="../../ui/controllers/project_controller.py" line="170" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="174" />
+            <location filename="../../ui/controllers/project_controller.py" line="174" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="175" />
+            <location filename="../../ui/controllers/project_controller.py" line="175" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="176" />
+            <location filename="../../ui/controllers/project_controller.py" line="176" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="177" />
+            <location filename="../../ui/controllers/project_controller.py" line="177" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="178" />
+            <location filename="../../ui/controllers/project_controller.py" line="178" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="179" />
+            <location filename="../../ui/controllers/project_controller.py" line="179" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="202" />
+            <location filename="../../ui/controllers/project_controller.py" line="202" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="235" />
+            <location filename="../../ui/controllers/project_controller.py" line="235" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="244" />
-            <location filename="../../ui/project_controller.py" line="247" />
+            <location filename="../../ui/controllers/project_controller.py" line="244" />
+            <location filename="../../ui/controllers/project_controller.py" line="247" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="250" />
+            <location filename="../../ui/controllers/project_controller.py" line="250" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="262" />
+            <location filename="../../ui/controllers/project_controller.py" line="262" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="276" />
+            <location filename="../../ui/controllers/project_controller.py" line="276" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="286" />
+            <location filename="../../ui/controllers/project_controller.py" line="286" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="292" />
+            <location filename="../../ui/controllers/project_controller.py" line="292" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="299" />
-            <location filename="../../ui/project_controller.py" line="302" />
-            <location filename="../../ui/project_controller.py" line="311" />
+            <location filename="../../ui/controllers/project_controller.py" line="299" />
+            <location filename="../../ui/controllers/project_controller.py" line="302" />
+            <location filename="../../ui/controllers/project_controller.py" line="311" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="313" />
+            <location filename="../../ui/controllers/project_controller.py" line="313" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="319" />
+            <location filename="../../ui/controllers/project_controller.py" line="319" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="326" />
+            <location filename="../../ui/controllers/project_controller.py" line="326" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="328" />
+            <location filename="../../ui/controllers/project_controller.py" line="328" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="354" />
+            <location filename="../../ui/controllers/project_controller.py" line="354" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="381" />
-            <location filename="../../ui/project_controller.py" line="384" />
+            <location filename="../../ui/controllers/project_controller.py" line="381" />
+            <location filename="../../ui/controllers/project_controller.py" line="384" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="387" />
+            <location filename="../../ui/controllers/project_controller.py" line="387" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="420" />
+            <location filename="../../ui/controllers/project_controller.py" line="420" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="423" />
+            <location filename="../../ui/controllers/project_controller.py" line="423" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>
@@ -2069,22 +2069,22 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectDialogs</name>
         <message>
-            <location filename="../../ui/project_controller.py" line="78" />
+            <location filename="../../ui/controllers/project_controller.py" line="78" />
             <source>Unsaved changes</source>
             <translation>未保存的更改</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="79" />
+            <location filename="../../ui/controllers/project_controller.py" line="79" />
             <source>Save the changes to {name}?</source>
             <translation>保存对 {name} 的更改？</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="90" />
+            <location filename="../../ui/controllers/project_controller.py" line="90" />
             <source>an unsaved project</source>
             <translation>未保存的工程</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="91" />
+            <location filename="../../ui/controllers/project_controller.py" line="91" />
             <source>TeachPad was not closed properly. An autosave of {what} is newer than the saved file:
 {autosave}
 
@@ -2095,27 +2095,27 @@ Recover it?</source>
 是否恢复？</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="93" />
+            <location filename="../../ui/controllers/project_controller.py" line="93" />
             <source>Recover autosave</source>
             <translation>恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="99" />
+            <location filename="../../ui/controllers/project_controller.py" line="99" />
             <source>Replace all points</source>
             <translation>替换全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="100" />
+            <location filename="../../ui/controllers/project_controller.py" line="100" />
             <source>Merge (update the same ids, append new ones)</source>
             <translation>合并（更新相同编号，追加新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="101" />
+            <location filename="../../ui/controllers/project_controller.py" line="101" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/project_controller.py" line="101" />
+            <location filename="../../ui/controllers/project_controller.py" line="101" />
             <source>Import mode:</source>
             <translation>导入方式：</translation>
         </message>
@@ -2343,27 +2343,27 @@ Recover it?</source>
     <context>
         <name>Runner</name>
         <message>
-            <location filename="../../app/runner.py" line="80" />
+            <location filename="../../app/plan/runner.py" line="80" />
             <source>ready</source>
             <translation>就绪</translation>
         </message>
         <message>
-            <location filename="../../app/runner.py" line="81" />
+            <location filename="../../app/plan/runner.py" line="81" />
             <source>running</source>
             <translation>运行中</translation>
         </message>
         <message>
-            <location filename="../../app/runner.py" line="82" />
+            <location filename="../../app/plan/runner.py" line="82" />
             <source>finished</source>
             <translation>已完成</translation>
         </message>
         <message>
-            <location filename="../../app/runner.py" line="83" />
+            <location filename="../../app/plan/runner.py" line="83" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../app/runner.py" line="84" />
+            <location filename="../../app/plan/runner.py" line="84" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
@@ -2371,172 +2371,172 @@ Recover it?</source>
     <context>
         <name>SegmentTableModel</name>
         <message>
-            <location filename="../../ui/plan_model.py" line="389" />
+            <location filename="../../ui/models/plan_model.py" line="389" />
             <source>Type</source>
             <translation>类型</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="389" />
+            <location filename="../../ui/models/plan_model.py" line="389" />
             <source>Middle point</source>
             <translation>中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="389" />
+            <location filename="../../ui/models/plan_model.py" line="389" />
             <source>End point</source>
             <translation>终点</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="390" />
+            <location filename="../../ui/models/plan_model.py" line="390" />
             <source>Orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="390" />
+            <location filename="../../ui/models/plan_model.py" line="390" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="97" />
+            <location filename="../../ui/models/plan_model.py" line="97" />
             <source>changes</source>
             <translation>姿态变化</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="98" />
+            <location filename="../../ui/models/plan_model.py" line="98" />
             <source>kept</source>
             <translation>姿态保持</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="122" />
+            <location filename="../../ui/models/plan_model.py" line="122" />
             <source>error</source>
             <translation>错误</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="123" />
+            <location filename="../../ui/models/plan_model.py" line="123" />
             <source>needs upload</source>
             <translation>需要上传</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="124" />
+            <location filename="../../ui/models/plan_model.py" line="124" />
             <source>warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="389" />
+            <location filename="../../ui/models/plan_model.py" line="389" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="390" />
+            <location filename="../../ui/models/plan_model.py" line="390" />
             <source>Speed</source>
             <translation>速度</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="390" />
+            <location filename="../../ui/models/plan_model.py" line="390" />
             <source>Ignore mid.</source>
             <translation>忽略中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="391" />
+            <location filename="../../ui/models/plan_model.py" line="391" />
             <source>Length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="391" />
+            <location filename="../../ui/models/plan_model.py" line="391" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="480" />
+            <location filename="../../ui/models/plan_model.py" line="480" />
             <source>Checks before running: hover the icon for details</source>
             <translation>运行前检查：鼠标悬停在图标上查看详情</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="481" />
+            <location filename="../../ui/models/plan_model.py" line="481" />
             <source>Speed in mm/s (GV225)</source>
             <translation>速度，单位 mm/s（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="482" />
+            <location filename="../../ui/models/plan_model.py" line="482" />
             <source>Middle point of an arc (GV200)</source>
             <translation>圆弧的中间点（GV200）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="483" />
+            <location filename="../../ui/models/plan_model.py" line="483" />
             <source>End point (GV201)</source>
             <translation>终点（GV201）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="484" />
+            <location filename="../../ui/models/plan_model.py" line="484" />
             <source>Orientation kept constant or changing along the move (GV202)</source>
             <translation>运动中姿态保持不变或变化（GV202）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="485" />
+            <location filename="../../ui/models/plan_model.py" line="485" />
             <source>Ignore the arc's middle point orientation (GV203)</source>
             <translation>忽略圆弧中间点的姿态（GV203）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="486" />
+            <location filename="../../ui/models/plan_model.py" line="486" />
             <source>Tool frame of the move (GV245)</source>
             <translation>运动使用的工具坐标系（GV245）</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="487" />
+            <location filename="../../ui/models/plan_model.py" line="487" />
             <source>Estimated path length</source>
             <translation>估计路径长度</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="488" />
+            <location filename="../../ui/models/plan_model.py" line="488" />
             <source>Estimated time: length / speed plus a fixed overhead per segment</source>
             <translation>估计时间：长度 / 速度，加上每段固定开销</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="588" />
+            <location filename="../../ui/models/plan_model.py" line="588" />
             <source>Segment {n}: no problems found</source>
             <translation>第 {n} 段：未发现问题</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="593" />
+            <location filename="../../ui/models/plan_model.py" line="593" />
             <source>Point P{id} does not exist</source>
             <translation>点 P{id} 不存在</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="627" />
+            <location filename="../../ui/models/plan_model.py" line="627" />
             <source>Segment {n}, {column}: refused, {reason}</source>
             <translation>第 {n} 段，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="649" />
+            <location filename="../../ui/models/plan_model.py" line="649" />
             <source>Edit segment {n} {column}</source>
             <translation>编辑第 {n} 段 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="660" />
+            <location filename="../../ui/models/plan_model.py" line="660" />
             <source>Add {kind} segment</source>
             <translation>添加{kind}段</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="692" />
+            <location filename="../../ui/models/plan_model.py" line="692" />
             <source>Add {n} segments</source>
             <translation>添加 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="699" />
+            <location filename="../../ui/models/plan_model.py" line="699" />
             <source>Delete segment {n}</source>
             <translation>删除第 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="700" />
+            <location filename="../../ui/models/plan_model.py" line="700" />
             <source>Delete {n} segments</source>
             <translation>删除 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="716" />
+            <location filename="../../ui/models/plan_model.py" line="716" />
             <source>Move segment up</source>
             <translation>上移段</translation>
         </message>
         <message>
-            <location filename="../../ui/plan_model.py" line="716" />
+            <location filename="../../ui/models/plan_model.py" line="716" />
             <source>Move segment down</source>
             <translation>下移段</translation>
         </message>
@@ -2544,122 +2544,122 @@ Recover it?</source>
     <context>
         <name>StatusPanel</name>
         <message>
-            <location filename="../../ui/status_panel.py" line="216" />
+            <location filename="../../ui/panels/status_panel.py" line="216" />
             <source>Link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="217" />
+            <location filename="../../ui/panels/status_panel.py" line="217" />
             <source>Controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="218" />
+            <location filename="../../ui/panels/status_panel.py" line="218" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="220" />
+            <location filename="../../ui/panels/status_panel.py" line="220" />
             <source>State:</source>
             <translation>状态：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="221" />
+            <location filename="../../ui/panels/status_panel.py" line="221" />
             <source>RTT:</source>
             <translation>往返时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="222" />
+            <location filename="../../ui/panels/status_panel.py" line="222" />
             <source>Mode:</source>
             <translation>模式：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="223" />
+            <location filename="../../ui/panels/status_panel.py" line="223" />
             <source>Program:</source>
             <translation>程序：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="224" />
+            <location filename="../../ui/panels/status_panel.py" line="224" />
             <source>Last command:</source>
             <translation>上一条命令：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="225" />
+            <location filename="../../ui/panels/status_panel.py" line="225" />
             <source>Clock:</source>
             <translation>系统时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="226" />
+            <location filename="../../ui/panels/status_panel.py" line="226" />
             <source>Drift:</source>
             <translation>时差：</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="227" />
+            <location filename="../../ui/panels/status_panel.py" line="227" />
             <source>Round-trip time of the last poll</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="231" />
+            <location filename="../../ui/panels/status_panel.py" line="231" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="232" />
+            <location filename="../../ui/panels/status_panel.py" line="232" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="235" />
+            <location filename="../../ui/panels/status_panel.py" line="235" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="243" />
+            <location filename="../../ui/panels/status_panel.py" line="243" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="319" />
+            <location filename="../../ui/panels/status_panel.py" line="319" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="321" />
+            <location filename="../../ui/panels/status_panel.py" line="321" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="330" />
+            <location filename="../../ui/panels/status_panel.py" line="330" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="336" />
+            <location filename="../../ui/panels/status_panel.py" line="336" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="349" />
+            <location filename="../../ui/panels/status_panel.py" line="349" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="357" />
+            <location filename="../../ui/panels/status_panel.py" line="357" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="361" />
+            <location filename="../../ui/panels/status_panel.py" line="361" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="365" />
+            <location filename="../../ui/panels/status_panel.py" line="365" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/status_panel.py" line="372" />
+            <location filename="../../ui/panels/status_panel.py" line="372" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>
@@ -2667,97 +2667,97 @@ Recover it?</source>
     <context>
         <name>StepPanel</name>
         <message>
-            <location filename="../../ui/step_panel.py" line="159" />
+            <location filename="../../ui/panels/step_panel.py" line="159" />
             <source>Frame:</source>
             <translation>坐标系：</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="160" />
+            <location filename="../../ui/panels/step_panel.py" line="160" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="161" />
+            <location filename="../../ui/panels/step_panel.py" line="161" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="162" />
+            <location filename="../../ui/panels/step_panel.py" line="162" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="163" />
+            <location filename="../../ui/panels/step_panel.py" line="163" />
             <source>Expected speed of the incremental move (GV225)</source>
             <translation>增量运动的期望速度（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="164" />
+            <location filename="../../ui/panels/step_panel.py" line="164" />
             <source>Increment per click (mm or °)</source>
             <translation>每次点击的增量（mm 或 °）</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="165" />
+            <location filename="../../ui/panels/step_panel.py" line="165" />
             <source>Incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="166" />
+            <location filename="../../ui/panels/step_panel.py" line="166" />
             <source>Exact offset</source>
             <translation>精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="167" />
+            <location filename="../../ui/panels/step_panel.py" line="167" />
             <source>Move by values</source>
             <translation>按数值运动</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="168" />
+            <location filename="../../ui/panels/step_panel.py" line="168" />
             <source>Move every axis by its exact offset in one incremental move</source>
             <translation>以一次增量运动使各轴移动其精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="169" />
+            <location filename="../../ui/panels/step_panel.py" line="169" />
             <source>Clear values</source>
             <translation>清除数值</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="170" />
+            <location filename="../../ui/panels/step_panel.py" line="170" />
             <source>External axes J7–J11</source>
             <translation>外部轴 J7–J11</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="171" />
+            <location filename="../../ui/panels/step_panel.py" line="171" />
             <source>Show the external axes; while hidden their offsets are 0</source>
             <translation>显示外部轴；隐藏时其偏移量为 0</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="200" />
+            <location filename="../../ui/panels/step_panel.py" line="200" />
             <source>rpm</source>
             <translation>转/分</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="200" />
+            <location filename="../../ui/panels/step_panel.py" line="200" />
             <source>mm/s</source>
             <translation>mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="248" />
+            <location filename="../../ui/panels/step_panel.py" line="248" />
             <source>Move by {moves} at {speed} {unit}?</source>
             <translation>以 {speed} {unit} 运动 {moves}？</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="250" />
+            <location filename="../../ui/panels/step_panel.py" line="250" />
             <source>Confirm incremental move</source>
             <translation>确认增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="274" />
+            <location filename="../../ui/panels/step_panel.py" line="274" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/step_panel.py" line="274" />
+            <location filename="../../ui/panels/step_panel.py" line="274" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
@@ -2765,37 +2765,37 @@ Recover it?</source>
     <context>
         <name>TrafficModel</name>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="221" />
+            <location filename="../../ui/panels/traffic_panel.py" line="221" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="222" />
+            <location filename="../../ui/panels/traffic_panel.py" line="222" />
             <source>Dir</source>
             <translation>方向</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="223" />
+            <location filename="../../ui/panels/traffic_panel.py" line="223" />
             <source>Bytes</source>
             <translation>字节</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="224" />
+            <location filename="../../ui/panels/traffic_panel.py" line="224" />
             <source>Meaning</source>
             <translation>含义</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="226" />
+            <location filename="../../ui/panels/traffic_panel.py" line="226" />
             <source>→ Tx</source>
             <translation>→ 发送</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="227" />
+            <location filename="../../ui/panels/traffic_panel.py" line="227" />
             <source>← Rx</source>
             <translation>← 接收</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="391" />
+            <location filename="../../ui/panels/traffic_panel.py" line="391" />
             <source>{n} bytes</source>
             <translation>{n} 字节</translation>
         </message>
@@ -2803,62 +2803,62 @@ Recover it?</source>
     <context>
         <name>TrafficPanel</name>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="536" />
+            <location filename="../../ui/panels/traffic_panel.py" line="536" />
             <source>Filter: bytes or meaning</source>
             <translation>过滤：字节或含义</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="537" />
+            <location filename="../../ui/panels/traffic_panel.py" line="537" />
             <source>Hide polls</source>
             <translation>隐藏轮询</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="539" />
+            <location filename="../../ui/panels/traffic_panel.py" line="539" />
             <source>Hide the periodic reads of 412.. (pose) and 560.. (status)</source>
             <translation>隐藏对 412..（位姿）和 560..（状态）的周期读取</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="541" />
+            <location filename="../../ui/panels/traffic_panel.py" line="541" />
             <source>Pause capture</source>
             <translation>暂停抓包</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="542" />
+            <location filename="../../ui/panels/traffic_panel.py" line="542" />
             <source>Stop recording frames (the worker stops building them)</source>
             <translation>停止记录报文（后台不再生成报文记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="543" />
+            <location filename="../../ui/panels/traffic_panel.py" line="543" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="544" />
+            <location filename="../../ui/panels/traffic_panel.py" line="544" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="662" />
+            <location filename="../../ui/panels/traffic_panel.py" line="662" />
             <source>Export traffic</source>
             <translation>导出通信报文</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="663" />
+            <location filename="../../ui/panels/traffic_panel.py" line="663" />
             <source>CSV files (*.csv);;Text files (*.txt);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;文本文件 (*.txt);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="690" />
+            <location filename="../../ui/panels/traffic_panel.py" line="690" />
             <source>{n} frames</source>
             <translation>{n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="692" />
+            <location filename="../../ui/panels/traffic_panel.py" line="692" />
             <source>{shown} of {n} frames shown</source>
             <translation>显示 {shown} / {n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_panel.py" line="694" />
+            <location filename="../../ui/panels/traffic_panel.py" line="694" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
         </message>

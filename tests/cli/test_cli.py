@@ -16,7 +16,7 @@ from typing import Any
 import pytest
 from pymodbus.constants import ExcCodes
 
-from app.cli import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_LINK, EXIT_OK, EXIT_USAGE, main
+from app.cli.main import EXIT_FAILED, EXIT_INTERRUPTED, EXIT_LINK, EXIT_OK, EXIT_USAGE, main
 from app.protocol.enums import Alarm, WorkMode
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -65,7 +65,7 @@ def test_status_json_and_text(csim: Any, capsys: pytest.CaptureFixture[str]) -> 
 def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     """`jog` runs in another process; `status --json` here sees the pose change meanwhile."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli", "--port", str(csim.port), "jog", "--frame", "base",
+        [sys.executable, "-m", "app.cli.main", "--port", str(csim.port), "jog", "--frame", "base",
          "--axis", "Y", "--dir", "+", "--ratio", "40", "--for", "0.8"],
         cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
@@ -94,7 +94,7 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
 def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) -> tuple[int, str]:
     """Run teachpad-cli in a subprocess, press Ctrl-C once ``started(state)``; (exit code, stderr)."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli", "--port", str(csim.port), *args],
+        [sys.executable, "-m", "app.cli.main", "--port", str(csim.port), *args],
         cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     try:
@@ -251,7 +251,7 @@ def test_rtu_framing_option(sim_factory: Any, capsys: pytest.CaptureFixture[str]
 
 def test_entry_point_module_runs() -> None:
     env = dict(os.environ)
-    proc = subprocess.run([sys.executable, "-m", "app.cli", "--help"], cwd=ROOT, capture_output=True,
+    proc = subprocess.run([sys.executable, "-m", "app.cli.main", "--help"], cwd=ROOT, capture_output=True,
                           text=True, env=env, timeout=30, check=False)
     assert proc.returncode == 0 and "teachpad-cli" in proc.stdout
 

@@ -12,7 +12,6 @@ import pytest
 from pymodbus.constants import ExcCodes
 
 from app import timing
-from app.client import RobotClient, StepFrame, TrafficRecord
 from app.errors import (
     AlarmRaised,
     CommandRefused,
@@ -24,6 +23,7 @@ from app.errors import (
     ResponseTimeout,
     WriteBlocked,
 )
+from app.link.client import RobotClient, StepFrame, TrafficRecord
 from app.protocol.codec import WordOrder
 from app.protocol.enums import (
     Alarm,
@@ -633,7 +633,7 @@ def test_client_in_a_thread_while_another_reads(scan_sim: Any, make_client: Make
 
 
 def test_clients_are_context_managers(sim: Any) -> None:
-    from app.client import ConnectionSettings
+    from app.link.client import ConnectionSettings
 
     with RobotClient(ConnectionSettings(port=sim.port)) as c:
         assert c.connected
@@ -652,7 +652,7 @@ def test_late_answer_is_not_taken_for_the_next_request(sim: Any, make_client: Ma
 
 
 def test_settings_are_checked() -> None:
-    from app.client import ConnectionSettings
+    from app.link.client import ConnectionSettings
 
     for bad in ({"port": 0}, {"unit": 300}, {"timeout": 0}, {"framer": "ascii"}, {"parity": "X"},
                 {"point_id_min": 5, "point_id_max": 1}, {"word_order": "low-first"}):

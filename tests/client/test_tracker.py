@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from app import timing
-from app.client import CommandTracker
 from app.errors import AlarmRaised, CommandRefused, CommandStopped, CommandTimeout
+from app.link.tracker import CommandTracker
 from app.models import ControllerStatus, Pose
 from app.protocol.enums import (
     Alarm,

@@ -9,10 +9,10 @@ from typing import Any
 
 import pytest
 
-from app import cli_points
+from app.cli import points as cli_points
 from app.errors import CommandRefused, LinkError
-from app.points import SyncState
-from app.project import load_project
+from app.points.ledger import SyncState
+from app.points.project import load_project
 from app.protocol.enums import CommandKind, CommandStatus
 from tests.core.fakes import FakeClient
 
@@ -233,7 +233,7 @@ def test_failed_segment_exit_code(demo: Path) -> None:
 def test_through_the_main_cli(demo: Path, capsys: pytest.CaptureFixture[str],
                               monkeypatch: pytest.MonkeyPatch) -> None:
     """app/cli.py finds this module as a plugin and calls handler(ctx)."""
-    from app import cli as main_cli
+    from app.cli import main as main_cli
 
     assert main_cli.main(["points", "list", str(demo)]) == 0
     assert "8 point(s), 2 plan(s)" in capsys.readouterr().out

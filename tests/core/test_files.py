@@ -10,8 +10,8 @@ from pathlib import Path
 import pytest
 
 from app.errors import InvalidInput
-from app.plan import Plan, Segment, check_plan, has_errors
-from app.points import (
+from app.plan.segments import Plan, Segment, check_plan, has_errors
+from app.points.ledger import (
     FileFormatError,
     ImportMode,
     PointLedger,
@@ -21,7 +21,7 @@ from app.points import (
     parse_points_csv,
     points_to_csv,
 )
-from app.project import (
+from app.points.project import (
     Project,
     atomic_write_bytes,
     autosave_path,

@@ -10,7 +10,7 @@ import pytest
 
 from app.errors import InvalidInput
 from app.models import Pose
-from app.plan import (
+from app.plan.segments import (
     SEGMENT_OVERHEAD_S,
     IssueCode,
     IssueKind,
@@ -30,7 +30,7 @@ from app.plan import (
     segment_path,
     segment_timeouts,
 )
-from app.points import FieldError, PointLedger, SyncState, make_point
+from app.points.ledger import FieldError, PointLedger, SyncState, make_point
 
 ON = SyncState.ON_CONTROLLER
 HOME = (400.0, 0.0, 450.0)

@@ -8,7 +8,7 @@ import pytest
 
 from app.errors import CommandRefused, InvalidInput, LinkError
 from app.models import Pose
-from app.points import (
+from app.points.ledger import (
     FieldError,
     ImportMode,
     PointLedger,

@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 
 from app.errors import AlarmRaised, CommandRefused, CommandStopped, CommandTimeout, InvalidInput, LinkError
-from app.plan import Plan, Segment
+from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
+from app.plan.segments import Plan, Segment
 from app.protocol.enums import CommandKind, CommandStatus
-from app.runner import PlanRunner, RunEvent, RunProgress, RunState
 from tests.core.fakes import DONE, FakeClient, failed
 
 

@@ -14,8 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from app.client import RobotClient
-from app.points import PointLedger, apply_upload, make_point, upload_points
+from app.link.client import RobotClient
+from app.points.ledger import PointLedger, apply_upload, make_point, upload_points
 from app.protocol import registers
 from app.protocol.enums import RunCommand
 

@@ -1,4 +1,4 @@
-"""``teachpad-cli`` end to end: ``app.cli.main(argv)`` against the real simulator over TCP.
+"""``teachpad-cli`` end to end: ``app.cli.main.main(argv)`` against the real simulator over TCP.
 
 The project is a copy of ``resources/samples/demo.teachpad.json`` with its speeds raised (the
 sample's 50..100 mm/s would make the file slow); points and plans are the sample's own.
@@ -13,9 +13,9 @@ from typing import Any
 
 import pytest
 
-from app import cli
-from app.points import SyncState
-from app.project import load_project
+from app.cli import main as cli
+from app.points.ledger import SyncState
+from app.points.project import load_project
 from tests.integration.support import assert_pose_at, move_commands
 
 SAMPLES = Path(__file__).resolve().parents[2] / "resources" / "samples"

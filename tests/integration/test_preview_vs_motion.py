@@ -1,6 +1,6 @@
 """What the host predicts (plan preview, checks) against what the controller then does.
 
-The planner's preview (``app.plan.plan_path``) and checks (``check_plan``) are what an operator
+The planner's preview (``app.plan.segments.plan_path``) and checks (``check_plan``) are what an operator
 sees before pressing run; the simulator is the stand-in for the controller. For every kind of
 segment the arm must move along the path the preview drew, and a resume that would move the
 arm somewhere the operator did not plan must be flagged before it is sent.
@@ -14,8 +14,8 @@ from typing import Any
 import numpy as np
 import pytest
 
-from app.plan import Plan, Segment, check_plan, plan_geometry, plan_path
-from app.runner import PlanRunner, RunState
+from app.plan.runner import PlanRunner, RunState
+from app.plan.segments import Plan, Segment, check_plan, plan_geometry, plan_path
 from tests.integration.support import (
     ARC_CENTRE,
     ARC_U,

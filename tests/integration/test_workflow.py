@@ -13,13 +13,21 @@ from typing import Any
 
 import numpy as np
 
-from app.client import RobotClient, StepFrame
 from app.errors import CommandRefused, CommandStopped, LinkError
-from app.plan import Plan, Segment, arc_geometry, check_plan, has_errors, ids_needing_upload, plan_path
-from app.points import PointLedger, SyncState, point_from_pose
+from app.link.client import RobotClient, StepFrame
+from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
+from app.plan.segments import (
+    Plan,
+    Segment,
+    arc_geometry,
+    check_plan,
+    has_errors,
+    ids_needing_upload,
+    plan_path,
+)
+from app.points.ledger import PointLedger, SyncState, point_from_pose
 from app.protocol import registers
 from app.protocol.enums import ProgramState
-from app.runner import PlanRunner, RunEvent, RunProgress, RunState
 from tests.integration.support import (
     ARC_CENTRE,
     ARC_END_DEG,

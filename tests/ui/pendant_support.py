@@ -8,9 +8,10 @@ from typing import Any
 import pytest
 
 from app import timing
-from app.client import ConnectionSettings
+from app.link.client import ConnectionSettings
+from app.link.robot_link import RobotLink
+from app.link.types import ConnectionState, LinkState
 from app.protocol.codec import WordOrder, registers_to_float
-from app.worker import ConnectionState, LinkState, RobotLink
 
 SIGNAL_TIMEOUT_MS = 5000
 # The offscreen platform warns when a top-level window gets size constraints; not our concern.

@@ -7,10 +7,10 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
-from app.client import StepFrame
+from app.link.client import StepFrame
+from app.link.types import WorkerError
 from app.models import CommandResult
 from app.protocol.enums import ControllerMode, ProgramMotionMode, ProgramState, WorkMode
-from app.worker import WorkerError
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,

@@ -14,7 +14,15 @@ from PySide6.QtCore import QCoreApplication, Qt, QTranslator
 
 from app.models import CommandResult
 from app.protocol.enums import Alarm, CommandKind, CommandStatus, RunCommand
-from ui.event_log import COL_LEVEL, COL_MESSAGE, COL_SOURCE, COL_TIME, EventLogModel, EventLogPanel, LogEvent
+from ui.panels.event_log import (
+    COL_LEVEL,
+    COL_MESSAGE,
+    COL_SOURCE,
+    COL_TIME,
+    EventLogModel,
+    EventLogPanel,
+    LogEvent,
+)
 from ui.widgets_common import COLOR_ERROR_BG, COLOR_WARN_BG
 
 

@@ -8,10 +8,10 @@ import pytest
 from PySide6.QtCore import QSettings
 from PySide6.QtGui import QImage
 
-from app.client import ConnectionSettings
+from app.link.client import ConnectionSettings
+from app.link.types import LinkState
 from app.protocol.codec import WordOrder
 from app.protocol.enums import Alarm, WorkMode
-from app.worker import LinkState
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,
@@ -25,7 +25,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     translator_fixture,
     window_fixture,
 )
-from ui.connection_dialog import ConnectionDialog
+from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import qm_path
 from ui.main import main
 from ui.main_window import MainWindow
@@ -170,7 +170,7 @@ def test_traffic_inspector_shows_decoded_frames_from_the_simulator(
     qtbot: Any, sim: Any, window: MainWindow
 ) -> None:
     """Raise the inspector, connect, send a command: its frames arrive decoded, as in the seed."""
-    from ui.traffic_panel import COL_BYTES, COL_MEANING
+    from ui.panels.traffic_panel import COL_BYTES, COL_MEANING
 
     window.show()
     window.traffic_dock.show()

@@ -11,12 +11,13 @@ import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 
-from app.plan import IssueKind, Segment, SegmentKind
-from app.points import SyncState, UploadOutcome, UploadReport
-from app.project import Project, load_project
-from app.runner import RunState
+from app.plan.runner import RunState
+from app.plan.segments import IssueKind, Segment, SegmentKind
+from app.points.ledger import SyncState, UploadOutcome, UploadReport
+from app.points.project import Project, load_project
 from tests.ui.test_points_panel import FakeError, FakeLink
-from ui.plan_model import (
+from ui.controllers.plan_run_controller import PlanRunController
+from ui.models.plan_model import (
     COL_END,
     COL_IGNORE,
     COL_INDEX,
@@ -29,10 +30,9 @@ from ui.plan_model import (
     PlanListModel,
     SegmentTableModel,
 )
-from ui.plan_run_controller import PlanRunController
-from ui.planner_panel import PlannerPanel
-from ui.points_model import PointsModel
-from ui.points_panel import PointSyncController
+from ui.models.points_model import PointsModel
+from ui.panels.planner_panel import PlannerPanel
+from ui.panels.points_panel import PointSyncController
 
 SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
 
@@ -169,7 +169,7 @@ def test_plan_list_edits(qtbot: Any, project: Project, stack: QUndoStack) -> Non
 
 
 def test_issues_shown_on_their_rows(segments: SegmentTableModel, project: Project) -> None:
-    from app.plan import check_plan
+    from app.plan.segments import check_plan
 
     plan = segments.plan
     assert plan is not None

@@ -10,10 +10,10 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 
 from app.models import Pose
-from app.plan import Plan, Segment
-from app.points import SyncState, TempPoint, UploadOutcome, UploadReport, make_point
-from app.project import Project, load_project
-from ui.points_model import (
+from app.plan.segments import Plan, Segment
+from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport, make_point
+from app.points.project import Project, load_project
+from ui.models.points_model import (
     COL_ID,
     COL_NAME,
     COL_SYNC,

@@ -13,11 +13,11 @@ from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoStack
 
 from app.models import CommandResult, Pose
-from app.points import SyncState, make_point
-from app.project import load_project
+from app.points.ledger import SyncState, make_point
+from app.points.project import load_project
 from app.protocol.enums import CommandKind, CommandStatus, RunCommand
-from ui.points_model import COL_E1, COL_TOOL, COL_X, PointsModel
-from ui.points_panel import PointsPanel, PointSyncController
+from ui.models.points_model import COL_E1, COL_TOOL, COL_X, PointsModel
+from ui.panels.points_panel import PointsPanel, PointSyncController
 
 SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
 
@@ -358,7 +358,7 @@ def test_reconnect_marks_unknown_and_offers_restore(qtbot: Any, panel: PointsPan
 
 
 def _report_ok(model: PointsModel, ids: list[int]) -> Any:
-    from app.points import UploadOutcome, UploadReport
+    from app.points.ledger import UploadOutcome, UploadReport
 
     return UploadReport([UploadOutcome(pid, True, sent=model.ledger.point(pid)) for pid in ids])
 
@@ -441,7 +441,7 @@ def test_external_axes_columns_hideable(panel: PointsPanel) -> None:
 
 
 def test_points_with_other_ids_work(qtbot: Any) -> None:
-    from app.project import Project
+    from app.points.project import Project
 
     project = Project()
     project.ledger.replace_all([make_point(10000, "last")])

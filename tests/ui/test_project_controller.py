@@ -11,10 +11,10 @@ from typing import Any
 
 import pytest
 
-from app.points import ImportMode
-from app.project import load_project
-from ui.points_model import COL_X
-from ui.project_controller import ProjectController
+from app.points.ledger import ImportMode
+from app.points.project import load_project
+from ui.controllers.project_controller import ProjectController
+from ui.models.points_model import COL_X
 
 SAMPLES = Path(__file__).resolve().parents[2] / "resources" / "samples"
 

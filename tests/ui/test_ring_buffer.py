@@ -7,7 +7,7 @@ import tracemalloc
 import numpy as np
 import pytest
 
-from ui.ring_buffer import RingBuffer
+from ui.models.ring_buffer import RingBuffer
 
 
 def _fill(rb: RingBuffer, start: int, stop: int) -> None:

@@ -21,7 +21,7 @@ from app.protocol.enums import (
     ProgramState,
     RunCommand,
 )
-from ui.status_panel import StatusPanel
+from ui.panels.status_panel import StatusPanel
 from ui.widgets_common import COLOR_ERROR, COLOR_OK, COLOR_WARN, LEVEL_ERROR, LEVEL_OFF, LEVEL_OK, LEVEL_WARN
 
 

@@ -15,7 +15,7 @@ from PySide6.QtCore import QCoreApplication, QModelIndex, Qt, QTranslator
 from app.protocol.codec import WordOrder, encode_floats
 from app.protocol.frames import encode_request, encode_response, encode_write_gv
 from app.protocol.registers import POSE_BLOCK_COUNT, POSE_BLOCK_START, STATUS_BLOCK_COUNT, STATUS_BLOCK_START
-from ui.traffic_panel import (
+from ui.panels.traffic_panel import (
     COL_BYTES,
     COL_DIRECTION,
     COL_MEANING,
@@ -34,7 +34,7 @@ T0 = 1_750_000_000.0
 
 @dataclass(frozen=True)
 class Rec:
-    """Shaped like app.client.TrafficRecord."""
+    """Shaped like app.link.client.TrafficRecord."""
 
     t: float
     direction: str
@@ -139,7 +139,7 @@ def test_rows_show_time_direction_seed_hex_and_meaning(panel: TrafficPanel) -> N
 
 
 def test_decoding_is_lazy_and_cached(panel: TrafficPanel, monkeypatch: pytest.MonkeyPatch) -> None:
-    import ui.traffic_panel as traffic
+    import ui.panels.traffic_panel as traffic
 
     calls: list[bytes] = []
     real = traffic.decode_frame

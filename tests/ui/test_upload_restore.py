@@ -9,9 +9,9 @@ from typing import Any
 import pytest
 from PySide6.QtGui import QUndoStack
 
-from app.points import SyncState, make_point
-from app.project import Project
-from app.worker import RobotLink
+from app.link.robot_link import RobotLink
+from app.points.ledger import SyncState, make_point
+from app.points.project import Project
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     canary_link_fixture,
@@ -20,8 +20,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     link_fixture,
     register_writes,
 )
-from ui.points_model import PointsModel
-from ui.points_panel import PointsPanel, PointSyncController
+from ui.models.points_model import PointsModel
+from ui.panels.points_panel import PointsPanel, PointSyncController
 
 pytestmark = pytest.mark.timeout(120)
 

@@ -9,8 +9,8 @@ from typing import Any
 
 import pytest
 
-from app.points import SyncState
-from app.runner import RunState
+from app.plan.runner import RunState
+from app.points.ledger import SyncState
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,
@@ -24,7 +24,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     window_fixture,
 )
 from ui.main_window import TAB_PLANNER, TAB_POINTS, MainWindow
-from ui.monitor_panel import MonitorPanel, unwrap_degrees
+from ui.panels.monitor_panel import MonitorPanel, unwrap_degrees
 from ui.settings import AppSettings
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]

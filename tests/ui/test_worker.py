@@ -10,11 +10,13 @@ import pytest
 from pymodbus.constants import ExcCodes
 
 from app import timing
-from app import worker as worker_module
-from app.client import StepFrame
+from app.link import worker as worker_module
+from app.link.client import StepFrame
+from app.link.robot_link import RobotLink
+from app.link.types import LinkState, WorkerError
+from app.link.worker import RobotWorker
 from app.models import CommandResult, Pose
 from app.protocol.enums import Alarm, ControllerMode, ProgramState, TeachFrame, WorkMode
-from app.worker import LinkState, RobotLink, RobotWorker, WorkerError
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     canary_link_fixture,

@@ -6,11 +6,11 @@ Two classes:
   ledger: teach a point from the current pose (function 2, "from the current pose"), upload
   points (function 2 from GVs, batched by tool frame), restore them all after a controller
   restart, move to a point (function 3, line). It records the outcome in the
-  :class:`~ui.points_model.PointsModel` and says what happened through signals.
+  :class:`~ui.models.points_model.PointsModel` and says what happened through signals.
 * :class:`PointsPanel` (the widget): toolbar, reconnect banner, upload progress, the table
   (filter by id / name, E1..E5 hideable) and a status line.
 
-The link is anything that fits :class:`PointLink` (``app.worker.RobotLink`` does); the tests
+The link is anything that fits :class:`PointLink` (``app.link.worker.RobotLink`` does); the tests
 use a small fake.
 
 Completion of the link's commands is matched by request id: every link command returns one
@@ -52,9 +52,9 @@ from PySide6.QtWidgets import (
 
 from app.errors import InvalidInput
 from app.models import CommandResult, Pose
-from app.points import SyncState, TempPoint, UploadOutcome, UploadReport
+from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport
 from app.protocol.registers import TOOL_NONE
-from ui.points_model import (
+from ui.models.points_model import (
     COL_ID,
     COL_NAME,
     COL_SYNC,
@@ -76,7 +76,7 @@ LEVEL_ERROR = "error"
 
 
 class PointLink(Protocol):
-    """What the point panel needs from the robot link (``app.worker.RobotLink`` fits)."""
+    """What the point panel needs from the robot link (``app.link.worker.RobotLink`` fits)."""
 
     poseChanged: SignalInstance  # (Pose)
     commandFinished: SignalInstance  # (CommandResult, .request_id)

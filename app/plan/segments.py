@@ -2,7 +2,7 @@
 
 A :class:`Plan` is an ordered list of :class:`Segment` run one after the other with function 3
 (move to temp point). A segment names its end point (and, for an arc, its middle point) by id
-in a :class:`~app.points.PointLedger`; it starts wherever the previous one ended. The first
+in a :class:`~app.points.ledger.PointLedger`; it starts wherever the previous one ended. The first
 segment starts at the robot's pose when the run begins, and on every loop after the first at
 the end of the last segment.
 
@@ -17,7 +17,7 @@ Indices are 0-based in the API (``PlanIssue.segment``, ``PlanRunner`` positions)
 for people count segments from 1.
 
 Mutation methods of :class:`Plan` return what they changed so a Qt model and an undo stack
-can wrap them (same conventions as :class:`~app.points.PointLedger`).
+can wrap them (same conventions as :class:`~app.points.ledger.PointLedger`).
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from app import timing
 from app.errors import InvalidInput
 from app.models import Pose
-from app.points import (
+from app.points.ledger import (
     FieldError,
     PointLedger,
     SyncState,

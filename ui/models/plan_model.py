@@ -5,8 +5,8 @@ The segment model shows one plan at a time. An undo or redo of a command that be
 another plan first switches the model to that plan and emits ``planShown`` so that the panel
 selects it in the list: the operator always sees what an undo changed.
 
-The results of the checks (:func:`app.plan.check_plan`) and the estimates
-(:func:`app.plan.estimate_plan`) are given to the segment model by the panel
+The results of the checks (:func:`app.plan.segments.check_plan`) and the estimates
+(:func:`app.plan.segments.estimate_plan`) are given to the segment model by the panel
 (:meth:`SegmentTableModel.set_issues`, :meth:`SegmentTableModel.set_estimate`); each row shows
 its issues as an icon and a tooltip in the ``#`` column.
 """
@@ -29,7 +29,7 @@ from PySide6.QtCore import (
 from PySide6.QtGui import QBrush, QColor, QFont, QIcon, QPainter, QPixmap, QUndoCommand, QUndoStack
 
 from app.errors import InvalidInput
-from app.plan import (
+from app.plan.segments import (
     DEFAULT_SPEED,
     IssueKind,
     Plan,
@@ -39,11 +39,11 @@ from app.plan import (
     validate_loops,
     validate_plan_name,
 )
-from app.plan import TR_CONTEXT as PLAN_CORE_CONTEXT
-from app.points import FieldError, PointLedger, parse_point_id
-from app.project import Project
+from app.plan.segments import TR_CONTEXT as PLAN_CORE_CONTEXT
+from app.points.ledger import FieldError, PointLedger, parse_point_id
+from app.points.project import Project
 from app.protocol.registers import TOOL_NONE
-from ui.points_model import (
+from ui.models.points_model import (
     TOOL_NONE_WORDS,
     InsertRowsCommand,
     MoveRowsCommand,

@@ -29,7 +29,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.models import Pose
-from ui.ring_buffer import RingBuffer
+from ui.models.ring_buffer import RingBuffer
 from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
 
 PAINT_HZ = 30

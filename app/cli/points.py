@@ -4,7 +4,7 @@ Plugging in: ``app/cli.py`` imports this module (it is in its ``PLUGIN_MODULES``
 ``register(subparsers)``, which adds ``points`` (list / upload / export / import) and ``run``
 and sets ``handler`` on each with ``set_defaults``. A handler can be called two ways:
 
-* ``args.handler(ctx)`` with ``app.cli.CliContext`` (what ``app/cli.py`` does): uses
+* ``args.handler(ctx)`` with ``app.cli.main.CliContext`` (what ``app/cli.py`` does): uses
   ``ctx.args``, the lazily connected ``ctx.client``, ``ctx.out`` / ``ctx.err``; the context
   closes the client.
 * ``args.handler(args, make_client)``: ``make_client()`` returns a connected ``RobotClient``
@@ -47,7 +47,8 @@ from typing import Any, TextIO
 
 from app.errors import CommandRefused, InvalidInput, LinkError, ResponseTimeout, TeachPadError
 from app.models import Pose
-from app.plan import (
+from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
+from app.plan.segments import (
     IssueKind,
     Plan,
     PlanLimits,
@@ -56,7 +57,7 @@ from app.plan import (
     ids_needing_upload,
     segment_timeouts,
 )
-from app.points import (
+from app.points.ledger import (
     DEFAULT_LIMITS,
     FileFormatError,
     ImportMode,
@@ -69,9 +70,8 @@ from app.points import (
     tool_text,
     upload_points,
 )
-from app.project import Project, load_project, read_points_csv, save_project, write_points_csv
+from app.points.project import Project, load_project, read_points_csv, save_project, write_points_csv
 from app.protocol.enums import MoveStatus
-from app.runner import PlanRunner, RunEvent, RunProgress, RunState
 
 PROG = "teachpad-cli"
 

@@ -24,7 +24,7 @@ itself on Ctrl-C, on a command timeout and on an unexpected exception. Pause and
 move are plain controller commands too; the runner needs no notice (the move just lasts
 longer).
 
-The client is duck-typed (:class:`MoveClient`): ``app.client.RobotClient`` fits.
+The client is duck-typed (:class:`MoveClient`): ``app.link.client.RobotClient`` fits.
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ from typing import Protocol
 
 from app.errors import CommandStopped, CommandTimeout, InvalidInput, TeachPadError
 from app.models import CommandResult
-from app.plan import Plan, Segment
+from app.plan.segments import Plan, Segment
 from app.protocol.enums import QT_TRANSLATE_NOOP
 
 

@@ -20,7 +20,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.client import ConnectionSettings
+from app.link.client import ConnectionSettings
 from app.protocol.codec import WordOrder
 
 _BAUDRATES = (9600, 19200, 38400, 57600, 115200, 230400)

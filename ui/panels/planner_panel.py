@@ -6,13 +6,13 @@ Stop, Resume from k; progress "segment k of n, loop i of m"); in the middle the 
 (editable, undoable) with the checks on their rows and a summary line; on the right the
 preview (top / front / side) with lengths and times.
 
-Checks (:func:`app.plan.check_plan`), estimates and the preview are recomputed whenever the
+Checks (:func:`app.plan.segments.check_plan`), estimates and the preview are recomputed whenever the
 plan, the points or the selection change. Before a run the checks are made again from the
 robot's current pose: errors refuse the run, points that need an upload are offered for upload
 ("1 point needs upload — Upload now?") and the run starts when the upload succeeded.
 
-The robot is driven by a :class:`~ui.plan_run_controller.PlanRunController`; uploads go through
-a :class:`~ui.points_panel.PointSyncController`. Questions to the operator go through the
+The robot is driven by a :class:`~ui.controllers.plan_run_controller.PlanRunController`; uploads go through
+a :class:`~ui.panels.points_panel.PointSyncController`. Questions to the operator go through the
 injectable ``confirm(title, text) -> bool`` callable.
 """
 
@@ -47,7 +47,8 @@ from PySide6.QtWidgets import (
 
 from app.errors import InvalidInput, TeachPadError
 from app.models import Pose
-from app.plan import (
+from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
+from app.plan.segments import (
     IssueKind,
     Plan,
     PlanIssue,
@@ -58,9 +59,9 @@ from app.plan import (
     ids_needing_upload,
     plan_path,
 )
-from app.points import UploadReport
-from app.runner import RunEvent, RunOutcome, RunProgress, RunState
-from ui.plan_model import (
+from app.points.ledger import UploadReport
+from ui.controllers.plan_run_controller import PlanRunController
+from ui.models.plan_model import (
     COL_END,
     COL_IGNORE,
     COL_INDEX,
@@ -76,10 +77,9 @@ from ui.plan_model import (
     kind_text,
     orientation_text,
 )
-from ui.plan_preview import PlanPreview
-from ui.plan_run_controller import PlanRunController
-from ui.points_model import PointsModel
-from ui.points_panel import PointSyncController
+from ui.models.points_model import PointsModel
+from ui.panels.plan_preview import PlanPreview
+from ui.panels.points_panel import PointSyncController
 from ui.widgets_common import COLOR_ERROR, COLOR_INFO, COLOR_OK, COLOR_WARN
 
 ModelIndex = QModelIndex | QPersistentModelIndex

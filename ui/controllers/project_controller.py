@@ -1,8 +1,8 @@
 """The open project on the Qt side: file actions, undo stack, dirty state, autosave, recovery.
 
-:class:`ProjectController` owns the :class:`~app.project.Project`, the ``QUndoStack`` shared by
-every edit, and the table models built on them (:class:`~ui.points_model.PointsModel`,
-:class:`~ui.plan_model.PlanListModel`). Opening, recovering or starting a new project swaps the
+:class:`ProjectController` owns the :class:`~app.points.project.Project`, the ``QUndoStack`` shared by
+every edit, and the table models built on them (:class:`~ui.models.points_model.PointsModel`,
+:class:`~ui.models.plan_model.PlanListModel`). Opening, recovering or starting a new project swaps the
 project inside the same models (``modelReset``) and clears the undo stack, so the panels keep
 their models for the life of the window.
 
@@ -29,8 +29,8 @@ from PySide6.QtGui import QAction, QKeySequence, QUndoStack
 from PySide6.QtWidgets import QFileDialog, QInputDialog, QMessageBox, QWidget
 
 from app.errors import InvalidInput
-from app.points import FileFormatError, ImportMode
-from app.project import (
+from app.points.ledger import FileFormatError, ImportMode
+from app.points.project import (
     PROJECT_SUFFIX,
     Project,
     autosave_path,
@@ -42,8 +42,8 @@ from app.project import (
     save_project,
     write_points_csv,
 )
-from ui.plan_model import PlanListModel
-from ui.points_model import PointsModel
+from ui.models.plan_model import PlanListModel
+from ui.models.points_model import PointsModel
 
 AUTOSAVE_INTERVAL_S = 60.0  # seconds between autosaves while there are unsaved changes
 SAVE_CHOICES = ("save", "discard", "cancel")

@@ -61,10 +61,9 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
-from PySide6.QtCore import QCoreApplication, QObject, Qt, QThread, QTimer, Signal, Slot
+from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot
 
 from app import timing
-from app.client import POSE_EPSILON, CommandTracker, ConnectionSettings, RobotClient, StepFrame, TrafficRecord
 from app.errors import (
     CommandRefused,
     InvalidInput,
@@ -74,6 +73,9 @@ from app.errors import (
     TeachPadError,
     WriteBlocked,
 )
+from app.link.client import ConnectionSettings, RobotClient, StepFrame, TrafficRecord
+from app.link.tracker import CommandTracker, pose_moved
+from app.link.types import ConnectionState, JogRequest, LinkState, Operation, WorkerError
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import (
@@ -95,13 +97,7 @@ __all__ = [
     "UPLOAD_CHUNK_POINTS",
     "UPLOAD_CHUNK_SECONDS",
     "UPLOAD_PROGRESS_PERIOD",
-    "ConnectionState",
-    "JogRequest",
-    "LinkState",
-    "Operation",
-    "RobotLink",
     "RobotWorker",
-    "WorkerError",
 ]
 
 _log = logging.getLogger(__name__)
@@ -119,78 +115,6 @@ UPLOAD_PROGRESS_PERIOD = 0.05  # s between uploadProgress emissions (the last on
 #: The spare general-purpose GV holding the restart canary (registers 198-199); None disables it.
 DEFAULT_CANARY_GV: int | None = 99
 UPLOAD_POSE_GV = 0  # an upload passes each pose in GV0..GV5 (case 2.2)
-
-
-class Operation:
-    """The operation names in ``WorkerError.operation`` and ``CommandResult.operation``."""
-
-    STOP = "stop"
-    PAUSE = "pause"
-    RESUME = "resume"
-    JOG = "jog"
-    JOG_RELEASE = "jog release"
-    JOG_SPEED = "jog speed"
-    STEP = "step"
-    SET_MODE = "set mode"
-    GO_ZERO = "go to zero"
-    RUN_PROGRAM = "run program"
-    CREATE_POINT = "create point"
-    MOVE_TO_POINT = "move to point"
-    UPLOAD_POINTS = "upload points"
-    CANCEL_UPLOAD = "cancel upload"
-    TEACH_DISABLE = "teach disable"
-    POLL = "poll"
-    CONNECT = "connect"
-    DISCONNECT = "disconnect"
-    SHUTDOWN = "shutdown"
-    CANARY = "restart check"
-
-
-class LinkState(enum.Enum):
-    CONNECTING = "connecting"
-    CONNECTED = "connected"
-    DOWN = "down"  # lost or unreachable; the worker is retrying by itself
-    DISCONNECTED = "disconnected"  # by request (or never connected)
-
-
-@dataclass(frozen=True)
-class ConnectionState:
-    """Link state for the GUI; ``message`` says why in plain English."""
-
-    state: LinkState
-    message: str = ""
-    endpoint: str = ""
-    monitor_only: bool = False
-
-    @property
-    def connected(self) -> bool:
-        return self.state is LinkState.CONNECTED
-
-
-@dataclass(frozen=True)
-class WorkerError:
-    """Something that went wrong, for the operator: which operation and why."""
-
-    operation: str
-    message: str
-    request_id: int | None = None  # the request it belongs to (None: polls, the link itself)
-
-
-@dataclass(frozen=True)
-class JogRequest:
-    """A held jog button: frame, axis (0-5 X..C, joint frame 0-10 J1..J11), direction, ratio %."""
-
-    frame: TeachFrame
-    axis: int
-    direction: int  # 0 negative, 1 positive
-    ratio: float  # 0 < ratio <= 100
-    user: int = 0  # user frame id (frame USER)
-    tool: int = 0  # tool frame id (frame TOOL)
-
-    @property
-    def frame_key(self) -> tuple[TeachFrame, int, int]:
-        return (self.frame, self.user if self.frame is TeachFrame.USER else 0,
-                self.tool if self.frame is TeachFrame.TOOL else 0)
 
 
 # --------------------------------------------------------------------------------------------
@@ -287,14 +211,6 @@ class _Completion(Protocol):
     def stopped(self, now: float) -> CommandResult: ...
 
 
-def _pose_values(pose: Pose) -> tuple[float, ...]:
-    return (*pose.xyzabc, *pose.ext, *(pose.joints or ()))
-
-
-def _pose_moved(a: Pose, b: Pose) -> bool:
-    return any(abs(x - y) > POSE_EPSILON for x, y in zip(_pose_values(a), _pose_values(b), strict=False))
-
-
 class _MotionWatch:
     """Program state and pose decide how a program run / go to zero ended (GV291 is not used).
 
@@ -320,7 +236,7 @@ class _MotionWatch:
             names = ", ".join(alarm_names(int(status.alarms)))
             return self._result(False, f"{self.text}: alarm: {names}", now)
         running = status.program_state in (ProgramState.RUNNING, ProgramState.PAUSED)
-        moved = pose is not None and self._last_pose is not None and _pose_moved(pose, self._last_pose)
+        moved = pose is not None and self._last_pose is not None and pose_moved(pose, self._last_pose)
         if pose is not None:
             self._last_pose = pose
         if not self._seen:
@@ -1347,180 +1263,3 @@ class RobotWorker(QObject):
 # --------------------------------------------------------------------------------------------
 # The GUI-thread facade
 # --------------------------------------------------------------------------------------------
-
-
-class RobotLink(QObject):
-    """Owns the worker thread; plain methods that never block on the network (except shutdown)."""
-
-    poseChanged = Signal(Pose)  # noqa: N815
-    statusChanged = Signal(ControllerStatus)  # noqa: N815
-    alarmsChanged = Signal(int)  # noqa: N815
-    connectionChanged = Signal(ConnectionState)  # noqa: N815
-    rttChanged = Signal(float)  # noqa: N815
-    commandFinished = Signal(CommandResult)  # noqa: N815
-    errorOccurred = Signal(WorkerError)  # noqa: N815
-    trafficObserved = Signal(list)  # noqa: N815
-    controllerReconnected = Signal()  # noqa: N815
-    controllerRestarted = Signal()  # noqa: N815
-    uploadProgress = Signal(int, int)  # noqa: N815
-    pointUploaded = Signal(int, bool, str)  # noqa: N815
-
-    _connectRequested = Signal(object)  # noqa: N815
-    _disconnectRequested = Signal()  # noqa: N815
-    _shutdownRequested = Signal()  # noqa: N815
-    _pollRateRequested = Signal(float)  # noqa: N815
-    _captureRequested = Signal(bool)  # noqa: N815
-
-    def __init__(self, parent: QObject | None = None, *, poll_hz: float = timing.POLL_HZ_DEFAULT,
-                 canary_gv: int | None = DEFAULT_CANARY_GV) -> None:
-        super().__init__(parent)
-        self._settings: ConnectionSettings | None = None
-        self._state = ConnectionState(LinkState.DISCONNECTED)
-        self._shut = False
-        self._capture_users = 0
-        self._thread = QThread()
-        self._thread.setObjectName("RobotWorker")
-        self._worker = RobotWorker(poll_hz, canary_gv=canary_gv)
-        self._worker.moveToThread(self._thread)
-        self._thread.started.connect(self._worker.start)
-        w = self._worker
-        for name in ("poseChanged", "statusChanged", "alarmsChanged", "rttChanged", "commandFinished",
-                     "errorOccurred", "trafficObserved", "controllerReconnected", "controllerRestarted",
-                     "uploadProgress", "pointUploaded"):
-            getattr(w, name).connect(getattr(self, name))
-        w.connectionChanged.connect(self._on_connection)
-        self._connectRequested.connect(w.connect_to)
-        self._disconnectRequested.connect(w.disconnect_link)
-        self._pollRateRequested.connect(w.set_poll_rate)
-        self._captureRequested.connect(w.set_traffic_capture)
-        self._shutdownRequested.connect(w.shutdown, Qt.ConnectionType.BlockingQueuedConnection)
-        app = QCoreApplication.instance()
-        if app is not None:
-            app.aboutToQuit.connect(self.shutdown)
-        self._thread.start()
-
-    # --- state --------------------------------------------------------------------------
-    @property
-    def state(self) -> ConnectionState:
-        return self._state
-
-    @property
-    def settings(self) -> ConnectionSettings | None:
-        return self._settings
-
-    @property
-    def monitor_only(self) -> bool:
-        return bool(self._settings and self._settings.monitor_only)
-
-    @property
-    def is_running(self) -> bool:
-        return self._thread.isRunning()
-
-    @Slot(object)
-    def _on_connection(self, state: ConnectionState) -> None:
-        self._state = state
-        self.connectionChanged.emit(state)
-
-    # --- connection ---------------------------------------------------------------------
-    def connect_to(self, settings: ConnectionSettings) -> None:
-        if self._shut:
-            return
-        self._settings = settings
-        self._connectRequested.emit(settings)
-
-    def disconnect(self) -> None:  # type: ignore[override]  # QObject.disconnect is not used on links
-        if not self._shut:
-            self._disconnectRequested.emit()
-
-    def set_poll_rate(self, hz: float) -> None:
-        if not self._shut:
-            self._pollRateRequested.emit(float(hz))
-
-    def set_traffic_capture(self, on: bool) -> None:
-        """Reference-counted: capture runs while at least one user asked for it."""
-        if self._shut:
-            return
-        self._capture_users = max(0, self._capture_users + (1 if on else -1))
-        self._captureRequested.emit(self._capture_users > 0)
-
-    # --- commands (queued; results come back as signals) -------------------------------
-    # Each returns the request id that its CommandResult / WorkerError will carry (0 after shutdown:
-    # nothing was queued).
-    def stop(self) -> int:
-        return 0 if self._shut else self._worker.request_stop()
-
-    def pause(self) -> int:
-        return 0 if self._shut else self._worker.request_pause()
-
-    def resume(self) -> int:
-        return 0 if self._shut else self._worker.request_resume()
-
-    def jog_press(self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0,
-                  tool: int = 0) -> int:
-        if self._shut:
-            return 0
-        request = JogRequest(TeachFrame(frame), axis, direction, ratio, user, tool)
-        return self._worker.request_jog_press(request)
-
-    def jog_release(self) -> int:
-        return 0 if self._shut else self._worker.request_jog_release()
-
-    def set_jog_ratio(self, ratio: float) -> int:
-        return 0 if self._shut else self._worker.request_jog_ratio(ratio)
-
-    def step(self, frame: StepFrame, offsets: Sequence[float],
-             ext_offsets: Sequence[float] = (0.0,) * registers.NUM_EXTERNAL_AXES,
-             speed: float = 10.0) -> int:
-        return 0 if self._shut else self._worker.request_step(frame, offsets, ext_offsets, speed)
-
-    def set_mode(self, mode: WorkMode) -> int:
-        return 0 if self._shut else self._worker.request_set_mode(mode)
-
-    def go_zero(self, axis: int | None) -> int:
-        return 0 if self._shut else self._worker.request_go_zero(axis)
-
-    def run_program(self, program_id: int, mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
-                    cycles: int = 1, speed_ratio: int = 100) -> int:
-        return 0 if self._shut else self._worker.request_run_program(program_id, mode, cycles, speed_ratio)
-
-    def create_point(self, point_id: int, pose: Sequence[float] | None = None,
-                     tool: int = registers.TOOL_NONE) -> int:
-        return 0 if self._shut else self._worker.request_create_point(point_id, pose, tool)
-
-    def move_to_point(self, end_id: int, via_id: int | None = None, *, orientation_changes: bool = True,
-                      ignore_middle: bool = False, speed: float = 50.0,
-                      tool: int = registers.TOOL_NONE) -> int:
-        if self._shut:
-            return 0
-        return self._worker.request_move_to_point(end_id, via_id, orientation_changes, ignore_middle, speed,
-                                                  tool)
-
-    def upload_points(self, points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
-                      tool: int = registers.TOOL_NONE) -> int:
-        """Create temp points from (id, pose6, tool) items ((id, pose6) items take ``tool``).
-
-        The worker groups them by tool frame (GV245 written once per group) and reports each
-        point with ``pointUploaded``, progress with ``uploadProgress`` and the batch with one
-        ``commandFinished`` carrying the returned id. Stop or :meth:`cancel_upload` end it
-        between two points."""
-        if self._shut:
-            return 0
-        items = [(item[0], item[1], item[2] if len(item) > 2 else tool) for item in points]
-        return self._worker.request_upload_points(items)
-
-    def cancel_upload(self) -> int:
-        """End the running upload after the current point; sends no stop to the controller."""
-        return 0 if self._shut else self._worker.request_cancel_upload()
-
-    # --- shutdown -----------------------------------------------------------------------
-    @Slot()
-    def shutdown(self) -> None:
-        """Stop jogging, close the client (blocking queued call), then end the thread. Idempotent."""
-        if self._shut:
-            return
-        self._shut = True
-        if self._thread.isRunning():
-            self._shutdownRequested.emit()  # blocks until the worker has stopped motion and closed
-            self._thread.quit()
-            if not self._thread.wait(SHUTDOWN_TIMEOUT_MS):
-                _log.error("the robot worker thread did not end within %d ms", SHUTDOWN_TIMEOUT_MS)

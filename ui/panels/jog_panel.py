@@ -27,9 +27,9 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.link.types import JogRequest
 from app.protocol.enums import CARTESIAN_AXIS_NAMES, JOINT_AXIS_NAMES, TeachFrame
 from app.protocol.registers import NUM_AXES_TOTAL, NUM_ROBOT_AXES, TOOL_NONE
-from app.worker import JogRequest
 
 DEFAULT_RATIO = 20
 # Keyboard jog: axis n (1..6) plus / minus. Letters on two rows of a QWERTY keyboard.

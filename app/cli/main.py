@@ -11,9 +11,9 @@ values, nothing sent); 3 link problem (cannot connect, no answer in time); 130 i
 Adding subcommands: a *registrar* is a callable ``register(subparsers)`` that adds parsers to
 the ``argparse`` sub-parser action and sets ``handler=fn`` on each with ``set_defaults``;
 ``fn(ctx: CliContext) -> int`` gets the parsed arguments as ``ctx.args`` and a connected
-:class:`~app.client.RobotClient` from ``ctx.client`` (connected on first use, so commands that
+:class:`~app.link.client.RobotClient` from ``ctx.client`` (connected on first use, so commands that
 work offline never touch the link). Put a registrar in :data:`REGISTRARS`, or ship a module
-named in :data:`PLUGIN_MODULES` (``app.cli_points``, ``app.cli_run``) with a ``register``
+named in :data:`PLUGIN_MODULES` (``app.cli.points``, ``app.cli_run``) with a ``register``
 function: it is picked up when it exists.
 """
 
@@ -32,7 +32,6 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TextIO
 
-from app.client import ConnectionSettings, RobotClient, StepFrame
 from app.errors import (
     AlarmRaised,
     InvalidInput,
@@ -40,6 +39,7 @@ from app.errors import (
     ResponseTimeout,
     TeachPadError,
 )
+from app.link.client import ConnectionSettings, RobotClient, StepFrame
 from app.models import ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.codec import WordOrder, decode_floats, encode_floats
@@ -554,7 +554,7 @@ def register_core(sub: Any) -> None:
 # Registrars run in order; other modules may append theirs.
 REGISTRARS: list[Registrar] = [register_core]
 # Optional modules with a ``register(subparsers)`` function, used when they exist.
-PLUGIN_MODULES: tuple[str, ...] = ("app.cli_points", "app.cli_run")
+PLUGIN_MODULES: tuple[str, ...] = ("app.cli.points", "app.cli_run")
 
 
 def _plugin_registrars() -> Iterator[Registrar]:

@@ -1,7 +1,7 @@
 """The point ledger as a Qt table model; every edit is a ``QUndoCommand``.
 
-:class:`PointsModel` shows the :class:`~app.points.PointLedger` of a
-:class:`~app.project.Project` (one row per temp point) and changes it only through commands
+:class:`PointsModel` shows the :class:`~app.points.ledger.PointLedger` of a
+:class:`~app.points.project.Project` (one row per temp point) and changes it only through commands
 pushed on a ``QUndoStack``: cell edits, add, duplicate, delete, reorder, teach and CSV import
 are all undoable. Editing a point's id follows the id in every plan of the project (undo puts
 the plans back too). Refused input raises :class:`~app.errors.InvalidInput` from the
@@ -37,8 +37,8 @@ from PySide6.QtCore import (
 from PySide6.QtGui import QBrush, QColor, QUndoCommand, QUndoStack
 
 from app.errors import InvalidInput
-from app.plan import Plan, Segment
-from app.points import (
+from app.plan.segments import Plan, Segment
+from app.points.ledger import (
     EXT_FIELDS,
     POSE_FIELDS,
     FieldError,
@@ -53,8 +53,8 @@ from app.points import (
     point_from_pose,
     with_field,
 )
-from app.points import TR_CONTEXT as POINTS_CORE_CONTEXT
-from app.project import Project
+from app.points.ledger import TR_CONTEXT as POINTS_CORE_CONTEXT
+from app.points.project import Project
 from app.protocol.registers import TOOL_NONE
 from ui.widgets_common import (
     COLOR_ERROR,
@@ -627,7 +627,7 @@ class PointsModel(UndoableListModel):
         return len(rows)
 
     def apply_upload(self, report: UploadReport) -> list[int]:
-        """Record an upload (see :func:`app.points.apply_upload`); returns the rows changed."""
+        """Record an upload (see :func:`app.points.ledger.apply_upload`); returns the rows changed."""
         for outcome in report.outcomes:
             if outcome.ok and outcome.sent is not None:
                 self._on_controller[outcome.point_id] = outcome.sent

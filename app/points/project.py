@@ -28,7 +28,7 @@ A point's keys are the CSV columns plus ``sync`` (``unknown`` / ``on-controller`
 ``changed`` / ``failed``) and ``sync_error``. Unknown keys are ignored; a different
 ``format`` or ``version`` is refused. Loading parses and validates everything before it
 returns, so a bad file never half-replaces what the caller holds; errors are
-:class:`~app.points.FileFormatError` naming the item and field
+:class:`~app.points.ledger.FileFormatError` naming the item and field
 (``points[6] (id 12), field 'x': 'abc' is not a number``).
 
 Saving writes a temp file in the same directory, fsyncs it and ``os.replace``-s it over the
@@ -52,7 +52,7 @@ from pathlib import Path
 from typing import Any
 
 from app.errors import InvalidInput
-from app.plan import (
+from app.plan.segments import (
     Plan,
     Segment,
     SegmentKind,
@@ -61,7 +61,7 @@ from app.plan import (
     validate_loops,
     validate_plan_name,
 )
-from app.points import (
+from app.points.ledger import (
     DEFAULT_LIMITS,
     EXT_FIELDS,
     POSE_FIELDS,

@@ -1,6 +1,6 @@
 """Runs a plan on the controller from the GUI thread, one segment at a time, via the link.
 
-:class:`PlanRunController` wraps :class:`app.runner.PlanRunner` (the sequencing, resume
+:class:`PlanRunController` wraps :class:`app.plan.runner.PlanRunner` (the sequencing, resume
 points and messages live there) around the non-blocking robot link: it sends segment k with
 ``link.move_to_point(...)`` and sends segment k+1 only after the link's ``commandFinished``
 for segment k. Pause / resume / stop are forwarded to the link. A failed segment, a refused
@@ -23,13 +23,13 @@ from PySide6.QtCore import QObject, Signal, SignalInstance, Slot
 
 from app.errors import LinkError, TeachPadError
 from app.models import CommandResult, Pose
-from app.plan import Plan, Segment
+from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState
+from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
-from app.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState
 
 
 class MotionLink(Protocol):
-    """What a run needs from the robot link (``app.worker.RobotLink`` fits)."""
+    """What a run needs from the robot link (``app.link.worker.RobotLink`` fits)."""
 
     poseChanged: SignalInstance
     commandFinished: SignalInstance

@@ -1,0 +1,83 @@
+"""The link's public data types: what the GUI and the worker say to each other."""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass
+
+from app.protocol.enums import TeachFrame
+
+__all__ = ["ConnectionState", "JogRequest", "LinkState", "Operation", "WorkerError"]
+
+
+class Operation:
+    """The operation names in ``WorkerError.operation`` and ``CommandResult.operation``."""
+
+    STOP = "stop"
+    PAUSE = "pause"
+    RESUME = "resume"
+    JOG = "jog"
+    JOG_RELEASE = "jog release"
+    JOG_SPEED = "jog speed"
+    STEP = "step"
+    SET_MODE = "set mode"
+    GO_ZERO = "go to zero"
+    RUN_PROGRAM = "run program"
+    CREATE_POINT = "create point"
+    MOVE_TO_POINT = "move to point"
+    UPLOAD_POINTS = "upload points"
+    CANCEL_UPLOAD = "cancel upload"
+    TEACH_DISABLE = "teach disable"
+    POLL = "poll"
+    CONNECT = "connect"
+    DISCONNECT = "disconnect"
+    SHUTDOWN = "shutdown"
+    CANARY = "restart check"
+
+
+class LinkState(enum.Enum):
+    CONNECTING = "connecting"
+    CONNECTED = "connected"
+    NOT_ANSWERING = "not answering"  # the link is up but the controller is silent (poll timed out)
+    DOWN = "down"  # lost or unreachable; the worker is retrying by itself
+    DISCONNECTED = "disconnected"  # by request (or never connected)
+
+
+@dataclass(frozen=True)
+class ConnectionState:
+    """Link state for the GUI; ``message`` says why in plain English."""
+
+    state: LinkState
+    message: str = ""
+    endpoint: str = ""
+    monitor_only: bool = False
+
+    @property
+    def connected(self) -> bool:
+        return self.state is LinkState.CONNECTED
+
+
+@dataclass(frozen=True)
+class WorkerError:
+    """Something that went wrong, for the operator: which operation and why."""
+
+    operation: str
+    message: str
+    request_id: int | None = None  # the request it belongs to (None: polls, the link itself)
+
+
+@dataclass(frozen=True)
+class JogRequest:
+    """A held jog button: frame, axis (0-5 X..C, joint frame 0-10 J1..J11), direction, ratio %."""
+
+    frame: TeachFrame
+    axis: int
+    direction: int  # 0 negative, 1 positive
+    ratio: float  # 0 < ratio <= 100
+    user: int = 0  # user frame id (frame USER)
+    tool: int = 0  # tool frame id (frame TOOL)
+
+    @property
+    def frame_key(self) -> tuple[TeachFrame, int, int]:
+        return (self.frame, self.user if self.frame is TeachFrame.USER else 0,
+                self.tool if self.frame is TeachFrame.TOOL else 0)
