@@ -21,6 +21,7 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import logging
 import math
@@ -41,6 +42,7 @@ from app.errors import (
     ResponseTimeout,
     WriteBlocked,
 )
+from app.link.stats import LinkStats
 from app.link.tracker import CommandTracker, command_text
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
@@ -271,6 +273,7 @@ class RobotClient:
         self.last_status: ControllerStatus | None = None
         self.last_tracker: CommandTracker | None = None
         self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
+        self._stats = LinkStats()
 
     # -- connection ----------------------------------------------------------------------
     def _make_modbus_client(self) -> Any:
@@ -315,6 +318,17 @@ class RobotClient:
         self._tool_cache = None
         self._user_frame_cache = None
         self._ext_cache = None
+
+    @property
+    def stats(self) -> LinkStats:
+        """The link's counters so far (a snapshot)."""
+        return self._stats
+
+    def _count(self, field: str, error: str | None = None) -> None:
+        changes: dict[str, int | str] = {field: getattr(self._stats, field) + 1}
+        if error is not None:
+            changes["last_error"] = error
+        self._stats = dataclasses.replace(self._stats, **changes)  # type: ignore[arg-type]
 
     # -- observers -----------------------------------------------------------------------
     def add_observer(self, cb: TrafficObserver) -> None:
@@ -365,21 +379,25 @@ class RobotClient:
         saved_timeout = params.timeout_connect
         if timeout is not None:
             params.timeout_connect = timeout  # pymodbus reads it per receive
+        self._count("requests")
         try:
             response = method(*args, device_id=self.settings.unit, **kwargs)
         except ConnectionException as exc:
             self.invalidate_cache()
             self._mb.close()
             verb = "lost the connection to" if was_connected else "cannot connect to"
-            raise LinkError(f"{verb} the controller at {self.settings.endpoint}") from exc
+            message = f"{verb} the controller at {self.settings.endpoint}"
+            self._count("link_errors", message)
+            raise LinkError(message) from exc
         except ModbusIOException as exc:
             # A late answer would be read as the next request's: start again on a fresh link.
             self.invalidate_cache()
             self._mb.close()
             total = (timeout or self.settings.timeout) * (self.settings.retries + 1)
-            raise ResponseTimeout(
-                f"controller did not answer within {_seconds(total)} s ({self.settings.endpoint})"
-            ) from exc
+            message = f"controller did not answer within {_seconds(total)} s ({self.settings.endpoint})"
+            self._count("timeouts", message)
+            self._count("resyncs")
+            raise ResponseTimeout(message) from exc
         except ModbusException as exc:
             self.invalidate_cache()
             raise LinkError(f"Modbus link error with {self.settings.endpoint}: {exc}") from exc
@@ -394,9 +412,10 @@ class RobotClient:
         if response.isError():
             code = int(getattr(response, "exception_code", 0))
             text = _MODBUS_EXCEPTION_TEXT.get(code, f"exception code {code}")
-            raise ModbusExceptionError(
-                int(response.function_code) & 0x7F, code, f"controller refused {what}: {text}"
-            )
+            message = f"controller refused {what}: {text}"
+            self._count("exceptions", message)
+            raise ModbusExceptionError(int(response.function_code) & 0x7F, code, message)
+        self._count("answers")
         return response
 
     def _read(self, address: int, count: int, timeout: float | None = None) -> list[int]:
