@@ -11,8 +11,9 @@ import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 
+from app.plan.checks import IssueKind
 from app.plan.runner import RunState
-from app.plan.segments import IssueKind, Segment, SegmentKind
+from app.plan.segments import Segment, SegmentKind
 from app.points.ledger import SyncState, UploadOutcome, UploadReport
 from app.points.project import Project, load_project
 from tests.ui.test_points_panel import FakeError, FakeLink
@@ -169,7 +170,7 @@ def test_plan_list_edits(qtbot: Any, project: Project, stack: QUndoStack) -> Non
 
 
 def test_issues_shown_on_their_rows(segments: SegmentTableModel, project: Project) -> None:
-    from app.plan.segments import check_plan
+    from app.plan.checks import check_plan
 
     plan = segments.plan
     assert plan is not None

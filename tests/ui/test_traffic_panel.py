@@ -13,7 +13,7 @@ import pytest
 from PySide6.QtCore import QCoreApplication, QModelIndex, Qt, QTranslator
 
 from app.protocol.codec import WordOrder, encode_floats
-from app.protocol.frames import encode_request, encode_response, encode_write_gv
+from app.protocol.framing import encode_request, encode_response, encode_write_gv
 from app.protocol.registers import POSE_BLOCK_COUNT, POSE_BLOCK_START, STATUS_BLOCK_COUNT, STATUS_BLOCK_START
 from ui.panels.traffic_panel import (
     COL_BYTES,

@@ -5,8 +5,8 @@ The segment model shows one plan at a time. An undo or redo of a command that be
 another plan first switches the model to that plan and emits ``planShown`` so that the panel
 selects it in the list: the operator always sees what an undo changed.
 
-The results of the checks (:func:`app.plan.segments.check_plan`) and the estimates
-(:func:`app.plan.segments.estimate_plan`) are given to the segment model by the panel
+The results of the checks (:func:`app.plan.checks.check_plan`) and the estimates
+(:func:`app.plan.estimates.estimate_plan`) are given to the segment model by the panel
 (:meth:`SegmentTableModel.set_issues`, :meth:`SegmentTableModel.set_estimate`); each row shows
 its issues as an icon and a tooltip in the ``#`` column.
 """
@@ -29,11 +29,10 @@ from PySide6.QtCore import (
 from PySide6.QtGui import QBrush, QColor, QFont, QIcon, QPainter, QPixmap, QUndoCommand, QUndoStack
 
 from app.errors import InvalidInput
+from app.plan.checks import IssueKind, PlanIssue
 from app.plan.segments import (
     DEFAULT_SPEED,
-    IssueKind,
     Plan,
-    PlanIssue,
     Segment,
     SegmentKind,
     validate_loops,

@@ -1,7 +1,7 @@
 """Plan preview: the path in three projections — top (XY), front (XZ), side (YZ).
 
 Each projection draws the whole plan with **one** ``PlotCurveItem`` whose data is the sampled
-path of :func:`app.plan.segments.plan_path` (NaN rows separate unknown segments; ``connect="finite"``),
+path of :func:`app.plan.geometry.plan_path` (NaN rows separate unknown segments; ``connect="finite"``),
 so a plan of 1,000 segments is three ``setData`` calls, not 3,000 items. Arcs are the true
 circles through start, middle and end (the core samples them with the middle point among the
 samples). On top: the selected segment (thick), the referenced points (one scatter item,
@@ -23,7 +23,7 @@ from PySide6.QtGui import QResizeEvent
 from PySide6.QtWidgets import QBoxLayout, QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from app.models import Pose
-from app.plan.segments import PlanPath
+from app.plan.geometry import PlanPath
 
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
 LIVE_FPS = 30

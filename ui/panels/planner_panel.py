@@ -6,7 +6,7 @@ Stop, Resume from k; progress "segment k of n, loop i of m"); in the middle the 
 (editable, undoable) with the checks on their rows and a summary line; on the right the
 preview (top / front / side) with lengths and times.
 
-Checks (:func:`app.plan.segments.check_plan`), estimates and the preview are recomputed whenever the
+Checks (:func:`app.plan.checks.check_plan`), estimates and the preview are recomputed whenever the
 plan, the points or the selection change. Before a run the checks are made again from the
 robot's current pose: errors refuse the run, points that need an upload are offered for upload
 ("1 point needs upload — Upload now?") and the run starts when the upload succeeded.
@@ -47,18 +47,11 @@ from PySide6.QtWidgets import (
 
 from app.errors import InvalidInput, TeachPadError
 from app.models import Pose
+from app.plan.checks import IssueKind, PlanIssue, PlanLimits, check_plan, ids_needing_upload
+from app.plan.estimates import estimate_plan
+from app.plan.geometry import plan_path
 from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
-from app.plan.segments import (
-    IssueKind,
-    Plan,
-    PlanIssue,
-    PlanLimits,
-    SegmentKind,
-    check_plan,
-    estimate_plan,
-    ids_needing_upload,
-    plan_path,
-)
+from app.plan.segments import Plan, SegmentKind
 from app.points.ledger import UploadReport
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.models.plan_model import (
