@@ -33,21 +33,17 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.errors import InvalidInput, TeachPadError
+from app.errors import InvalidInput
 from app.models import Pose
-from app.plan.checks import PlanIssue, PlanLimits, check_plan, ids_needing_upload
+from app.plan.checks import PlanIssue, PlanLimits, check_plan
 from app.plan.estimates import PlanEstimate, estimate_plan
 from app.plan.geometry import plan_path
 from app.plan.presenter import (
     Level,
     PanelState,
-    RunBlock,
-    RunKind,
     action_states,
     plan_info,
     plan_start,
-    run_gate,
-    run_kind,
     summarize_checks,
 )
 from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
@@ -62,6 +58,7 @@ from ui.models.plan_model import (
 from ui.models.points_model import PointsModel
 from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_actions import PlannerActions
+from ui.panels.planner_run import PlanRunFlow
 from ui.panels.planner_widgets import (
     STATUS_COLOURS,
     PlanChecksBar,
@@ -100,15 +97,12 @@ class PlannerPanel(QWidget):
         self._confirm = confirm or self._ask
         self.limits = limits or PlanLimits()
         self._issues: list[PlanIssue] = []
-        self._pending_run: tuple[int, bool, bool] | None = None  # (start, single, resume) after an upload
-        self._next_step: tuple[int, int] | None = None
-        self._run_plan: Plan | None = None
-        self._run_revision = -1  # the run plan's revision when the run started
         self._summary_text = ""
         self._previewed: Plan | None = None  # the plan the preview's view range was fitted to
         self._pose_known = False
 
         self.segments = SegmentTableModel(plans.undo_stack, points.ledger, self)
+        self.run_flow = PlanRunFlow(self, self._runner, point_sync, points, self)
         self._make_actions()
         self._build()
         self.retranslate()
@@ -405,109 +399,23 @@ class PlannerPanel(QWidget):
         self._update_actions()
 
     def _set_info(self, plan: Plan, estimate: PlanEstimate, assumed: bool) -> None:
-        info = plan_info(plan, estimate, self._selected_index(), assumed)
-        loops = self.tr("endless") if info.loops == 0 else str(info.loops)
-        lines = [
-            self.tr("<b>{name}</b>: {n} segments, loops: {loops}").format(name=info.name, n=info.segments,
-                                                                         loops=loops),
-            self.tr("One loop: {length}, {time}").format(length=info.loop_length, time=info.loop_time),
-            self.tr("Total: {length}, {time}").format(length=info.total_length, time=info.total_time),
-        ]
-        if info.unknown:
-            lines.append(self.tr("Not counted (unknown length): segments {list}").format(
-                list=", ".join(str(k) for k in info.unknown)))
-        if info.selected is not None:
-            k = info.selected
-            lines.append(self.tr("Segment {k}: {length}, {time}").format(k=k.number, length=k.length,
-                                                                        time=k.time))
-        lines.append(self.tr("Start: end of the last segment (robot pose unknown)") if info.assumed_start
-                     else self.tr("Start: the robot's current pose"))
-        self.preview.set_info("<br>".join(lines))
+        self.preview.show_info(plan_info(plan, estimate, self._selected_index(), assumed))
 
-    # --- running
-    def _plan_for_run(self) -> Plan | None:
-        plan = self.current_plan()
-        if plan is None or not len(plan):
-            self.show_message(self.tr("The plan has no segments"), "error")
-            return None
-        if self._sync is not None and self._sync.busy:
-            self.show_message(self.tr("Wait until the point upload or move ends"), "warn")
-            return None
-        return plan
+    # --- running (the flow: planner_run.py)
+    def confirm(self, title: str, text: str) -> bool:
+        return self._confirm(title, text)
+
+    def show_issues(self, issues: list[PlanIssue], plan: Plan) -> str:
+        """Show checks made for a run on the rows and the summary; returns the summary."""
+        self._issues = issues
+        self.segments.set_issues(issues)
+        self._set_summary(issues, plan)
+        return self._summary_text
 
     def run(self, start: int = 0, single: bool = False, *, resume: bool = False) -> bool:
         """Check, offer an upload, confirm, then run from ``start`` (``single``: one segment).
         Returns True when the run (or the upload before it) started."""
-        plan = self._plan_for_run()
-        if plan is None:
-            return False
-        if not self._runner.connected:
-            self.show_message(self.tr("Not connected to a controller"), "error")
-            return False
-        pose = self._pose()
-        issues = check_plan(plan, self._points.ledger, self.limits, pose, start_index=start,
-                            loops=1 if single else plan.loops)
-        self._issues = issues
-        self.segments.set_issues(issues)
-        self._set_summary(issues, plan)
-        gate = run_gate(issues)
-        if gate.block is RunBlock.ERRORS and (first := gate.first_error) is not None:
-            if first.segment is not None:
-                self.select_segments([first.segment])
-            self.show_message(self.tr("Cannot run: {summary}. First: {message}").format(
-                summary=self._summary_text.split("\n")[0], message=first.message), "error")
-            return False
-        needs = list(gate.uploads)
-        if gate.block is RunBlock.UPLOAD:
-            if self._sync is None:
-                self.show_message(self.tr("Cannot run: %n point(s) need upload", "", len(needs)), "error")
-                return False
-            question = self.tr("%n point(s) of the plan are not on the controller: ", "", len(needs))
-            question += ", ".join(f"P{pid}" for pid in needs[:20]) + "\n\n" + self.tr("Upload now, then run?")
-            if not self._confirm(self.tr("Upload points"), question):
-                return False
-            if self._sync.upload(needs):
-                self._pending_run = (start, single, resume)
-                return True
-            return False
-        return self._confirm_and_start(plan, start, single, resume)
-
-    def _confirm_and_start(self, plan: Plan, start: int, single: bool, resume: bool) -> bool:
-        warnings = run_gate(self._issues).warnings
-        kind = run_kind(start, single, resume)
-        if kind is RunKind.RESUME:
-            k = (self._runner.resume_from or 0) + 1
-            what = self.tr("Resume plan '{name}' from segment {k}?").format(name=plan.name, k=k)
-        elif kind is RunKind.STEP:
-            what = self.tr("Run segment {k} of plan '{name}' (one step)?").format(k=start + 1, name=plan.name)
-        elif kind is RunKind.FROM:
-            what = self.tr("Run plan '{name}' from segment {k}?").format(name=plan.name, k=start + 1)
-        else:
-            what = self.tr("Run plan '{name}'?").format(name=plan.name)
-        text = what + "\n\n" + self.tr("The robot will move.")
-        if warnings:
-            text += "\n\n" + self.tr("Warnings:") + "\n" + "\n".join(f"• {w}" for w in warnings)
-        if not self._confirm(self.tr("Run plan"), text):
-            return False
-        try:
-            if resume and plan is self._run_plan and plan.revision == self._run_revision:
-                self._runner.resume_run()
-            elif resume:
-                # the plan was edited since: a new run of the current segments from the same place
-                loop = self._runner.resume_loop or 1
-                self._run_revision = plan.revision
-                self._runner.start(plan, start=start, start_loop=loop)
-            else:
-                loop = 1
-                if single and self._next_step is not None and self._next_step[0] == start:
-                    loop = self._next_step[1]
-                self._run_plan = plan
-                self._run_revision = plan.revision
-                self._runner.start(plan, start=start, start_loop=loop, single=single)
-        except (TeachPadError, RuntimeError) as exc:
-            self.show_message(str(exc), "error")
-            return False
-        return True
+        return self.run_flow.run(start, single, resume=resume)
 
     @Slot()
     def run_from_selected(self) -> None:
@@ -516,16 +424,11 @@ class PlannerPanel(QWidget):
 
     @Slot()
     def step(self) -> None:
-        rows = self.selected_segments()
-        start = rows[0] if rows else (self._next_step[0] if self._next_step else 0)
-        self.run(start, single=True)
+        self.run(self.run_flow.step_start(self.selected_segments()), single=True)
 
     @Slot()
     def stop(self) -> None:
-        self._pending_run = None
-        self._runner.stop()
-        if self._sync is not None and self._sync.operation == "upload":
-            self._sync.cancel_upload()
+        self.run_flow.stop()
 
     @Slot()
     def resume_from(self) -> None:
@@ -533,35 +436,22 @@ class PlannerPanel(QWidget):
         k = self._runner.resume_from
         if k is None:
             return
-        if self._run_plan is not None and self._run_plan is not self.current_plan():
-            row = self._plans.row_of(self._run_plan)
+        run_plan = self.run_flow.run_plan
+        if run_plan is not None and run_plan is not self.current_plan():
+            row = self._plans.row_of(run_plan)
             if row is not None:
                 self.select_plan(row)
         self.run(k, resume=True)
 
     @Slot()
     def upload_needed(self) -> None:
-        plan = self.current_plan()
-        if plan is None or self._sync is None:
-            return
-        ids = ids_needing_upload(self._issues)
-        if ids:
-            self._sync.upload(ids)
+        self.run_flow.upload_needed()
 
     # --- reactions
     @Slot(object)
     def _on_upload_finished(self, report: UploadReport) -> None:
-        pending, self._pending_run = self._pending_run, None
         self.recheck()
-        if pending is None:
-            return
-        if not report.all_ok:
-            self.show_message(self.tr("The upload did not complete: the plan was not started"), "error")
-            return
-        plan = self.current_plan()
-        if plan is not None:
-            start, single, resume = pending
-            self._confirm_and_start(plan, start, single, resume)
+        self.run_flow.upload_finished(report)
 
     @Slot(bool)
     def _on_running(self, running: bool) -> None:
@@ -583,17 +473,18 @@ class PlannerPanel(QWidget):
 
     @Slot(object)
     def _on_run_finished(self, outcome: RunOutcome) -> None:
+        self.run_flow.run_finished(outcome)
+        run_plan = self.run_flow.run_plan
         if outcome.state is RunState.FINISHED:
             self.segments.set_run_marker(None, None)
             self.run_box.show_finished(outcome.segments_done)
             self.show_message(self.tr("Plan finished"), "info")
-            self._next_step = outcome.next_position
-            if outcome.next_position is not None and self.current_plan() is self._run_plan:
+            if outcome.next_position is not None and self.current_plan() is run_plan:
                 self.select_segments([outcome.next_position[0]])
         else:
             k = outcome.resume_from
             self.segments.set_run_marker(None, k if outcome.state is RunState.FAILED else None)
-            if k is not None and self.current_plan() is self._run_plan:
+            if k is not None and self.current_plan() is run_plan:
                 self.select_segments([k])
             level = "error" if outcome.state is RunState.FAILED else "warn"
             label = self.tr("Failed") if outcome.state is RunState.FAILED else self.tr("Stopped")
@@ -652,7 +543,7 @@ class PlannerPanel(QWidget):
         r = self._runner
         if not r.running:
             self.preview.clear_live()  # the last run's TCP trail belongs to its plan
-            if plan is not None and plan is self._run_plan and r.can_resume and r.outcome is not None:
+            if plan is not None and plan is self.run_flow.run_plan and r.can_resume and r.outcome is not None:
                 failed = r.resume_from if r.outcome.state is RunState.FAILED else None
                 self.segments.set_run_marker(None, failed)
         self._update_actions()
