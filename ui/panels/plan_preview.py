@@ -23,8 +23,10 @@ from PySide6.QtGui import QResizeEvent
 from PySide6.QtWidgets import QBoxLayout, QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from app.models import Pose
-from app.plan.geometry import PlanPath
+from app.plan.geometry import PlanPath, plan_path
 from app.plan.presenter import PlanInfo
+from app.plan.segments import Plan
+from app.points.ledger import PointLedger
 from ui.palette import (
     COLOR_AXIS,
     COLOR_HIGHLIGHT,
@@ -111,6 +113,7 @@ class PlanPreview(QWidget):
         self.setObjectName("PlanPreview")
         self._path: PlanPath | None = None
         self._selected: int | None = None
+        self._previewed: Plan | None = None  # the plan the view range was fitted to
         self._pending: Pose | None = None
         self._live_wanted = False
         self._trail = np.full((2 * TRAIL_LENGTH, 3), np.nan)
@@ -218,6 +221,19 @@ class PlanPreview(QWidget):
 
     def set_info(self, text: str) -> None:
         self.info.setText(text)
+
+    def show_plan(self, plan: Plan, ledger: PointLedger, start: Sequence[float] | None,
+                  selected: int | None) -> None:
+        """Draw ``plan`` from ``start`` with the points it uses; the view range is fitted when
+        another plan is shown, kept while the same plan is redrawn."""
+        self.set_path(plan_path(plan, ledger, start), keep_view=plan is self._previewed)
+        self._previewed = plan
+        used = [ledger.get(pid) for pid in sorted(plan.point_ids())]
+        present = [p for p in used if p is not None]
+        self.set_points(np.array([p.xyz for p in present], dtype=np.float64).reshape(-1, 3),
+                        [f"P{p.id}" for p in present])
+        self.set_start(start)
+        self.set_selected(selected)
 
     def show_info(self, info: PlanInfo) -> None:
         """The plan's lengths and times (worked out by :func:`app.plan.presenter.plan_info`)."""

@@ -21,14 +21,12 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-import numpy as np
-from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, Qt, Signal, Slot
+from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, Signal, Slot
 from PySide6.QtWidgets import (
     QGroupBox,
     QLabel,
     QMessageBox,
     QSizePolicy,
-    QSplitter,
     QVBoxLayout,
     QWidget,
 )
@@ -37,7 +35,6 @@ from app.errors import InvalidInput
 from app.models import Pose
 from app.plan.checks import PlanIssue, PlanLimits, check_plan
 from app.plan.estimates import PlanEstimate, estimate_plan
-from app.plan.geometry import plan_path
 from app.plan.presenter import (
     Level,
     PanelState,
@@ -65,6 +62,7 @@ from ui.panels.planner_widgets import (
     PlanListBox,
     PlanRunBox,
     SegmentEditorBox,
+    planner_splitters,
 )
 from ui.panels.points_panel import PointSyncController
 
@@ -98,7 +96,6 @@ class PlannerPanel(QWidget):
         self.limits = limits or PlanLimits()
         self._issues: list[PlanIssue] = []
         self._summary_text = ""
-        self._previewed: Plan | None = None  # the plan the preview's view range was fitted to
         self._pose_known = False
 
         self.segments = SegmentTableModel(plans.undo_stack, points.ledger, self)
@@ -176,12 +173,6 @@ class PlannerPanel(QWidget):
         self.run_label = self.run_box.run_label
         self.run_progress = self.run_box.run_progress
 
-        left = QWidget(self)
-        left_layout = QVBoxLayout(left)
-        left_layout.setContentsMargins(0, 0, 0, 0)
-        left_layout.addWidget(self.plans_box, 1)
-        left_layout.addWidget(self.run_box)
-
         # middle: segments
         self.checks_bar = PlanChecksBar(self.upload_needed, self.recheck, self)
         self.summary = self.checks_bar.summary
@@ -199,30 +190,13 @@ class PlannerPanel(QWidget):
         preview_layout = QVBoxLayout(self.preview_box)
         preview_layout.addWidget(self.preview)
 
-        # plans and segments side by side on top, the preview across the full width below:
-        # the three projections stay readable on a 1280 px screen
-        top = QSplitter(Qt.Orientation.Horizontal, self)
-        top.addWidget(left)
-        top.addWidget(self.segments_box)
-        top.setStretchFactor(0, 0)
-        top.setStretchFactor(1, 1)
-        top.setSizes([230, 1050])
-        top.setChildrenCollapsible(False)
-        self.splitter = top
-        outer = QSplitter(Qt.Orientation.Vertical, self)
-        outer.addWidget(top)
-        outer.addWidget(self.preview_box)
-        outer.setStretchFactor(0, 1)
-        outer.setStretchFactor(1, 1)
-        outer.setSizes([340, 400])
-        outer.setChildrenCollapsible(False)
-        self.outer_splitter = outer
-
+        self.splitter, self.outer_splitter = planner_splitters(self, self.plans_box, self.run_box,
+                                                               self.segments_box, self.preview_box)
         self.status = QLabel(self)
         self.status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
-        layout.addWidget(outer, 1)
+        layout.addWidget(self.outer_splitter, 1)
         layout.addWidget(self.status)
 
     def retranslate(self) -> None:
@@ -377,15 +351,7 @@ class PlannerPanel(QWidget):
         self.segments.set_issues(self._issues)
         estimate = estimate_plan(plan, ledger, start)
         self.segments.set_estimate(estimate.lengths, estimate.times)
-        self.preview.set_path(plan_path(plan, ledger, start), keep_view=plan is self._previewed)
-        self._previewed = plan
-        ids = sorted(plan.point_ids())
-        used = [ledger.get(pid) for pid in ids]
-        present = [p for p in used if p is not None]
-        self.preview.set_points(np.array([p.xyz for p in present], dtype=np.float64).reshape(-1, 3),
-                                [f"P{p.id}" for p in present])
-        self.preview.set_start(start)
-        self.preview.set_selected(self._selected_index())
+        self.preview.show_plan(plan, ledger, start, self._selected_index())
         self._set_summary(self._issues, plan)
         self._set_info(plan, estimate, assumed)
 

@@ -18,6 +18,7 @@ from PySide6.QtWidgets import (
     QProgressBar,
     QPushButton,
     QSizePolicy,
+    QSplitter,
     QStyledItemDelegate,
     QStyleOptionViewItem,
     QTableView,
@@ -312,3 +313,29 @@ class SegmentEditorBox(QGroupBox):
 
     def retranslate(self) -> None:
         self.setTitle(self.tr("Segments"))
+
+
+def planner_splitters(parent: QWidget, plans_box: QWidget, run_box: QWidget, segments_box: QWidget,
+                      preview_box: QWidget) -> tuple[QSplitter, QSplitter]:
+    """Plans (over the run box) and segments side by side on top, the preview across the full
+    width below: the three projections stay readable on a 1280 px screen. Returns (top, outer)."""
+    left = QWidget(parent)
+    left_layout = QVBoxLayout(left)
+    left_layout.setContentsMargins(0, 0, 0, 0)
+    left_layout.addWidget(plans_box, 1)
+    left_layout.addWidget(run_box)
+    top = QSplitter(Qt.Orientation.Horizontal, parent)
+    top.addWidget(left)
+    top.addWidget(segments_box)
+    top.setStretchFactor(0, 0)
+    top.setStretchFactor(1, 1)
+    top.setSizes([230, 1050])
+    top.setChildrenCollapsible(False)
+    outer = QSplitter(Qt.Orientation.Vertical, parent)
+    outer.addWidget(top)
+    outer.addWidget(preview_box)
+    outer.setStretchFactor(0, 1)
+    outer.setStretchFactor(1, 1)
+    outer.setSizes([340, 400])
+    outer.setChildrenCollapsible(False)
+    return top, outer
