@@ -18,7 +18,7 @@ from app.points.ledger import SyncState, UploadOutcome, UploadReport
 from app.points.project import Project, load_project
 from tests.ui.test_points_panel import FakeError, FakeLink
 from ui.controllers.plan_run_controller import PlanRunController
-from ui.models.plan_model import (
+from ui.models.plan_columns import (
     COL_END,
     COL_IGNORE,
     COL_INDEX,
@@ -28,10 +28,10 @@ from ui.models.plan_model import (
     ISSUE_LEVEL_ROLE,
     PLAN_COL_LOOPS,
     PLAN_COL_NAME,
-    PlanListModel,
-    SegmentTableModel,
 )
+from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
+from ui.models.segment_model import SegmentTableModel
 from ui.panels.planner_panel import PlannerPanel
 from ui.panels.points_panel import PointSyncController
 

@@ -47,12 +47,10 @@ from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, SegmentKind
 from app.points.ledger import UploadReport
 from ui.controllers.plan_run_controller import PlanRunController
-from ui.models.plan_model import (
-    PLAN_COL_NAME,
-    PlanListModel,
-    SegmentTableModel,
-)
+from ui.models.plan_columns import PLAN_COL_NAME
+from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
+from ui.models.segment_model import SegmentTableModel
 from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_actions import PlannerActions
 from ui.panels.planner_run import PlanRunFlow

@@ -30,7 +30,7 @@ from PySide6.QtWidgets import (
 from app.plan.presenter import CheckSummary, Level, progress_bar
 from app.plan.runner import RunEvent, RunProgress
 from app.plan.segments import SegmentKind
-from ui.models.plan_model import (
+from ui.models.plan_columns import (
     COL_END,
     COL_IGNORE,
     COL_INDEX,
@@ -41,12 +41,12 @@ from ui.models.plan_model import (
     COL_TOOL,
     COL_VIA,
     PLAN_COL_NAME,
-    PlanListModel,
-    SegmentTableModel,
     kind_text,
     orientation_text,
 )
+from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
+from ui.models.segment_model import SegmentTableModel
 from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_OK, COLOR_WARN, COLOR_WARN_TEXT
 
 ModelIndex = QModelIndex | QPersistentModelIndex
