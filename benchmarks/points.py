@@ -131,7 +131,8 @@ def bench_show(project: Project, repeats: int) -> dict[str, Any]:
         from PySide6.QtGui import QUndoStack
         from PySide6.QtWidgets import QHeaderView, QTableView
 
-        from ui.models.points_model import COLUMNS, PointFilterProxy, PointsModel
+        from ui.models.point_columns import COLUMNS
+        from ui.models.points_model import PointFilterProxy, PointsModel
     except ImportError as exc:
         return {"show_ms": None, "reason": f"ui/points_model.py is not usable: {exc}"}
     app = _qt_app()

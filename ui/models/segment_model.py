@@ -60,14 +60,13 @@ from ui.models.plan_columns import (
     kind_text,
     orientation_text,
 )
-from ui.models.points_model import (
-    TOOL_NONE_WORDS,
+from ui.models.point_columns import TOOL_NONE_WORDS, tool_display
+from ui.models.undo_list import (
     InsertRowsCommand,
     MoveRowsCommand,
     RemoveRowsCommand,
     ReplaceRowCommand,
     UndoableListModel,
-    tool_display,
 )
 from ui.widgets_common import COLOR_ERROR, COLOR_ERROR_BG
 
