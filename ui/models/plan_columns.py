@@ -16,7 +16,7 @@ from app.plan.segments import TR_CONTEXT as PLAN_CORE_CONTEXT
 from app.plan.segments import (
     SegmentKind,
 )
-from ui.widgets_common import COLOR_ERROR, COLOR_INFO, COLOR_WARN
+from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_WARN, COLOR_WHITE
 
 ModelIndex = QModelIndex | QPersistentModelIndex
 
@@ -48,7 +48,6 @@ ISSUE_COLOURS: dict[IssueKind, str] = {
 }
 ISSUE_ORDER = {IssueKind.ERROR: 0, IssueKind.NEEDS_UPLOAD: 1, IssueKind.WARNING: 2}
 ISSUE_GLYPH = {IssueKind.ERROR: "✕", IssueKind.NEEDS_UPLOAD: "↑", IssueKind.WARNING: "!"}
-ACTIVE_BG = "#d6e6fb"
 RIGHT_ALIGNED = frozenset((COL_SPEED, COL_LENGTH, COL_TIME))
 
 
@@ -71,7 +70,7 @@ def issue_icon(kind: IssueKind, size: int = 16) -> QIcon:
     painter.setPen(Qt.PenStyle.NoPen)
     painter.setBrush(QColor(ISSUE_COLOURS[kind]))
     painter.drawEllipse(1, 1, size - 2, size - 2)
-    painter.setPen(QColor("#ffffff"))
+    painter.setPen(QColor(COLOR_WHITE))
     font = QFont()
     font.setBold(True)
     font.setPixelSize(int(size * 0.7))

@@ -37,7 +37,6 @@ from app.plan.segments import (
 from app.points.ledger import FieldError, PointLedger, parse_point_id
 from app.protocol.registers import TOOL_NONE
 from ui.models.plan_columns import (
-    ACTIVE_BG,
     COL_END,
     COL_IGNORE,
     COL_INDEX,
@@ -68,7 +67,7 @@ from ui.models.undo_list import (
     ReplaceRowCommand,
     UndoableListModel,
 )
-from ui.widgets_common import COLOR_ERROR, COLOR_ERROR_BG
+from ui.palette import COLOR_ACTIVE_BG, COLOR_ERROR, COLOR_ERROR_BG
 
 
 class SegmentTableModel(UndoableListModel):
@@ -94,7 +93,7 @@ class SegmentTableModel(UndoableListModel):
         self._headers: tuple[str, ...] = ()
         self._icons: dict[IssueKind, QIcon] = {}  # made on first use (pixmaps need a GUI application)
         self._missing = QBrush(QColor(COLOR_ERROR))
-        self._active_bg = QBrush(QColor(ACTIVE_BG))
+        self._active_bg = QBrush(QColor(COLOR_ACTIVE_BG))
         self._failed_bg = QBrush(QColor(COLOR_ERROR_BG))
         self.retranslate()
 
