@@ -914,6 +914,14 @@
         </message>
     </context>
     <context>
+        <name>PlanEdits</name>
+        <message>
+            <location filename="../../ui/panels/planner_edit.py" line="73" />
+            <source>Deleted plan {name} (Ctrl+Z to undo)</source>
+            <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
+        </message>
+    </context>
+    <context>
         <name>PlanListBox</name>
         <message>
             <location filename="../../ui/panels/planner_widgets.py" line="266" />
@@ -1332,27 +1340,22 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="205" />
+            <location filename="../../ui/panels/planner_panel.py" line="210" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="297" />
-            <source>Deleted plan {name} (Ctrl+Z to undo)</source>
-            <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="445" />
+            <location filename="../../ui/panels/planner_panel.py" line="388" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="454" />
+            <location filename="../../ui/panels/planner_panel.py" line="397" />
             <source>Failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="454" />
+            <location filename="../../ui/panels/planner_panel.py" line="397" />
             <source>Stopped</source>
             <translation>已停止</translation>
         </message>

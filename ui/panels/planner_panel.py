@@ -31,7 +31,6 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.errors import InvalidInput
 from app.models import Pose
 from app.plan.checks import PlanIssue, PlanLimits, check_plan
 from app.plan.estimates import PlanEstimate, estimate_plan
@@ -53,6 +52,7 @@ from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
 from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_actions import PlannerActions
+from ui.panels.planner_edit import PlanEdits
 from ui.panels.planner_run import PlanRunFlow
 from ui.panels.planner_widgets import (
     STATUS_COLOURS,
@@ -98,6 +98,11 @@ class PlannerPanel(QWidget):
 
         self.segments = SegmentTableModel(plans.undo_stack, points.ledger, self)
         self.run_flow = PlanRunFlow(self, self._runner, point_sync, points, self)
+        self.edits = PlanEdits(self, plans, self.segments, self)
+        e = self.edits
+        self.add_plan, self.rename_plan, self.duplicate_plan = e.add_plan, e.rename_plan, e.duplicate_plan
+        self.delete_plan, self.add_segment = e.delete_plan, e.add_segment
+        self.delete_segments, self.move_segments = e.delete_segments, e.move_segments
         self._make_actions()
         self._build()
         self.retranslate()
@@ -265,68 +270,6 @@ class PlannerPanel(QWidget):
         self.status.setText(text)
         self.status.setToolTip(text)
         self.statusMessage.emit(text)
-
-    # --- plans and segments
-    @Slot()
-    def add_plan(self) -> None:
-        row = self._plans.add_plan()
-        self.select_plan(row)
-
-    @Slot()
-    def rename_plan(self) -> None:
-        """Edit the selected plan's name in place (undoable like every edit)."""
-        row = self.plan_view.currentIndex().row()
-        if row >= 0:
-            self.plan_view.setFocus()
-            self.plan_view.edit(self._plans.index(row, PLAN_COL_NAME))
-
-    @Slot()
-    def duplicate_plan(self) -> None:
-        row = self.plan_view.currentIndex().row()
-        if row >= 0:
-            self.select_plan(self._plans.duplicate_plan(row))
-
-    @Slot()
-    def delete_plan(self) -> None:
-        row = self.plan_view.currentIndex().row()
-        if row < 0:
-            return
-        name = self._plans.plan_at(row).name
-        self._plans.remove_plan(row)
-        self.select_plan(min(row, self._plans.rowCount() - 1))
-        self.show_message(self.tr("Deleted plan {name} (Ctrl+Z to undo)").format(name=name))
-
-    def add_segment(self, kind: SegmentKind) -> None:
-        if self.current_plan() is None:
-            self.add_plan()
-        rows = self.selected_segments()
-        at = rows[-1] + 1 if rows else None
-        try:
-            row = self.segments.insert_segment(at, kind)
-        except InvalidInput as exc:
-            self.show_message(str(exc), "error")
-            return
-        self.select_segments([row])
-
-    @Slot()
-    def delete_segments(self) -> None:
-        rows = self.selected_segments()
-        try:
-            n = self.segments.remove_rows(rows)
-        except InvalidInput as exc:
-            self.show_message(str(exc), "error")
-            return
-        if n:
-            left = min(rows[0], self.segments.rowCount() - 1)
-            self.select_segments([left] if left >= 0 else [])
-
-    def move_segments(self, delta: int) -> None:
-        try:
-            rows = self.segments.move_rows(self.selected_segments(), delta)
-        except InvalidInput as exc:
-            self.show_message(str(exc), "error")
-            return
-        self.select_segments(rows)
 
     # --- checks, estimates, preview
     def _pose(self) -> Pose | None:
