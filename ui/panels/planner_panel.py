@@ -14,6 +14,10 @@ robot's current pose: errors refuse the run, points that need an upload are offe
 The robot is driven by a :class:`~ui.controllers.plan_run_controller.PlanRunController`; uploads go through
 a :class:`~ui.panels.points_panel.PointSyncController`. Questions to the operator go through the
 injectable ``confirm(title, text) -> bool`` callable.
+
+What is shown is worked out without Qt by :mod:`app.plan.presenter`. The panel composes its
+parts: ``planner_actions`` (the QActions), ``planner_widgets`` (plan list, segment editor, run
+box, checks bar), ``planner_edit`` (plan and segment edits), ``planner_run`` (the run flow).
 """
 
 from __future__ import annotations
