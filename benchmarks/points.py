@@ -34,7 +34,10 @@ import numpy as np
 from pymodbus.client import ModbusTcpClient
 
 from app.link.client import ConnectionSettings, RobotClient
-from app.plan.segments import Plan, Segment, check_plan, estimate_plan, plan_geometry, plan_path, segment_path
+from app.plan.checks import check_plan
+from app.plan.estimates import estimate_plan
+from app.plan.geometry import plan_geometry, plan_path, segment_path
+from app.plan.segments import Plan, Segment
 from app.points.ledger import PointLedger, SyncState, TempPoint, make_point, upload_points
 from app.points.project import Project, load_project, save_project
 from app.protocol import registers as R  # noqa: N812
@@ -128,7 +131,8 @@ def bench_show(project: Project, repeats: int) -> dict[str, Any]:
         from PySide6.QtGui import QUndoStack
         from PySide6.QtWidgets import QHeaderView, QTableView
 
-        from ui.models.points_model import COLUMNS, PointFilterProxy, PointsModel
+        from ui.models.point_columns import COLUMNS
+        from ui.models.points_model import PointFilterProxy, PointsModel
     except ImportError as exc:
         return {"show_ms": None, "reason": f"ui/points_model.py is not usable: {exc}"}
     app = _qt_app()

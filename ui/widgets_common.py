@@ -24,19 +24,21 @@ from app.protocol.enums import (
     TR_CONTEXT,
     UNKNOWN_STATUS_TEXT,
 )
+from ui.palette import (  # re-exported: panels import the state colours from here
+    COLOR_BORDER,
+    COLOR_ERROR,
+    COLOR_ERROR_BG,  # noqa: F401
+    COLOR_INFO,
+    COLOR_NEUTRAL,
+    COLOR_NEUTRAL_BG,
+    COLOR_OK,
+    COLOR_OK_BG,  # noqa: F401
+    COLOR_WARN,
+    COLOR_WARN_BG,  # noqa: F401
+    COLOR_WHITE,
+)
 
 TR = "Panels"
-
-# --- colours (one place; the lamps and the tables use the same ones) --------------------
-COLOR_ERROR = "#c62828"
-COLOR_ERROR_BG = "#fde0e0"
-COLOR_WARN = "#ef8f00"
-COLOR_WARN_BG = "#fff1d6"
-COLOR_OK = "#2e7d32"
-COLOR_OK_BG = "#e3f4e4"
-COLOR_INFO = "#1565c0"
-COLOR_NEUTRAL = "#5f6368"
-COLOR_NEUTRAL_BG = "#eceff1"
 
 # Lamp levels: the ``level`` dynamic property holds one of these.
 LEVEL_OFF = "off"
@@ -46,11 +48,11 @@ LEVEL_ERROR = "error"
 LEVEL_INFO = "info"
 
 _LAMP_STYLE: dict[str, tuple[str, str, str]] = {  # level -> (background, text, border)
-    LEVEL_OFF: (COLOR_NEUTRAL_BG, COLOR_NEUTRAL, "#cfd8dc"),
-    LEVEL_OK: (COLOR_OK, "#ffffff", COLOR_OK),
-    LEVEL_WARN: (COLOR_WARN, "#ffffff", COLOR_WARN),
-    LEVEL_ERROR: (COLOR_ERROR, "#ffffff", COLOR_ERROR),
-    LEVEL_INFO: (COLOR_INFO, "#ffffff", COLOR_INFO),
+    LEVEL_OFF: (COLOR_NEUTRAL_BG, COLOR_NEUTRAL, COLOR_BORDER),
+    LEVEL_OK: (COLOR_OK, COLOR_WHITE, COLOR_OK),
+    LEVEL_WARN: (COLOR_WARN, COLOR_WHITE, COLOR_WARN),
+    LEVEL_ERROR: (COLOR_ERROR, COLOR_WHITE, COLOR_ERROR),
+    LEVEL_INFO: (COLOR_INFO, COLOR_WHITE, COLOR_INFO),
 }
 
 

@@ -47,16 +47,10 @@ from typing import Any, TextIO
 
 from app.errors import CommandRefused, InvalidInput, LinkError, ResponseTimeout, TeachPadError
 from app.models import Pose
+from app.plan.checks import IssueKind, PlanLimits, check_plan, ids_needing_upload
+from app.plan.estimates import estimate_plan, segment_timeouts
 from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
-from app.plan.segments import (
-    IssueKind,
-    Plan,
-    PlanLimits,
-    check_plan,
-    estimate_plan,
-    ids_needing_upload,
-    segment_timeouts,
-)
+from app.plan.segments import Plan
 from app.points.ledger import (
     DEFAULT_LIMITS,
     FileFormatError,

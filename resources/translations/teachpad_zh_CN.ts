@@ -283,7 +283,7 @@
     <context>
         <name>Export</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="299" />
+            <location filename="../../ui/widgets_common.py" line="301" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -793,64 +793,64 @@
     <context>
         <name>Panels</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="234" />
+            <location filename="../../ui/widgets_common.py" line="236" />
             <source>connected</source>
             <translation>已连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="235" />
+            <location filename="../../ui/widgets_common.py" line="237" />
             <source>connecting</source>
             <translation>正在连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="236" />
+            <location filename="../../ui/widgets_common.py" line="238" />
             <source>reconnecting</source>
             <translation>正在重连</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="237" />
+            <location filename="../../ui/widgets_common.py" line="239" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="238" />
+            <location filename="../../ui/widgets_common.py" line="240" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="239" />
+            <location filename="../../ui/widgets_common.py" line="241" />
             <source>link down</source>
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="240" />
-            <location filename="../../ui/widgets_common.py" line="241" />
+            <location filename="../../ui/widgets_common.py" line="242" />
+            <location filename="../../ui/widgets_common.py" line="243" />
             <source>link lost</source>
             <translation>链路丢失</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="242" />
+            <location filename="../../ui/widgets_common.py" line="244" />
             <source>error</source>
             <translation>错误</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="243" />
-            <location filename="../../ui/widgets_common.py" line="274" />
+            <location filename="../../ui/widgets_common.py" line="245" />
+            <location filename="../../ui/widgets_common.py" line="276" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="265" />
+            <location filename="../../ui/widgets_common.py" line="267" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="273" />
+            <location filename="../../ui/widgets_common.py" line="275" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="282" />
+            <location filename="../../ui/widgets_common.py" line="284" />
             <source>{command}: {status}</source>
             <translation>{command}：{status}</translation>
         </message>
@@ -858,76 +858,136 @@
     <context>
         <name>Plan</name>
         <message>
-            <location filename="../../app/plan/segments.py" line="74" />
+            <location filename="../../app/plan/segments.py" line="66" />
             <source>line</source>
-            <extracomment>Time added per segment to length / speed: command round trip, acceleration, settling (s). Editable fields of a segment, in table column order.</extracomment>
+            <extracomment>Editable fields of a segment, in table column order.</extracomment>
             <translation>直线</translation>
         </message>
         <message>
-            <location filename="../../app/plan/segments.py" line="75" />
+            <location filename="../../app/plan/segments.py" line="67" />
             <source>arc</source>
             <translation>圆弧</translation>
         </message>
     </context>
     <context>
+        <name>PlanChecksBar</name>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="204" />
+            <source>Upload now</source>
+            <translation>立即上传</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="205" />
+            <source>Check</source>
+            <translation>检查</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="224" />
+            <source>Checks passed: ready to run</source>
+            <translation>检查通过：可以运行</translation>
+        </message>
+        <message numerus="yes">
+            <location filename="../../ui/panels/planner_widgets.py" line="227" />
+            <source>%n error(s)</source>
+            <translation>
+                <numerusform>%n 个错误</numerusform>
+            </translation>
+        </message>
+        <message numerus="yes">
+            <location filename="../../ui/panels/planner_widgets.py" line="229" />
+            <source>%n point(s) need upload</source>
+            <translation>
+                <numerusform>%n 个点需要上传</numerusform>
+            </translation>
+        </message>
+        <message numerus="yes">
+            <location filename="../../ui/panels/planner_widgets.py" line="231" />
+            <source>%n warning(s)</source>
+            <translation>
+                <numerusform>%n 个警告</numerusform>
+            </translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="234" />
+            <source>Upload now?</source>
+            <translation>立即上传？</translation>
+        </message>
+    </context>
+    <context>
+        <name>PlanEdits</name>
+        <message>
+            <location filename="../../ui/panels/planner_edit.py" line="73" />
+            <source>Deleted plan {name} (Ctrl+Z to undo)</source>
+            <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
+        </message>
+    </context>
+    <context>
+        <name>PlanListBox</name>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="266" />
+            <source>Plans</source>
+            <translation>轨迹规划</translation>
+        </message>
+    </context>
+    <context>
         <name>PlanListModel</name>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="196" />
+            <location filename="../../ui/models/plan_model.py" line="101" />
             <source>Plan</source>
             <translation>轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="196" />
+            <location filename="../../ui/models/plan_model.py" line="101" />
             <source>Loops</source>
             <translation>循环次数</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="196" />
+            <location filename="../../ui/models/plan_model.py" line="101" />
             <source>Segments</source>
             <translation>段数</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="248" />
+            <location filename="../../ui/models/plan_model.py" line="153" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="252" />
+            <location filename="../../ui/models/plan_model.py" line="157" />
             <source>How many times the plan runs (0 = until stopped)</source>
             <translation>轨迹运行次数（0 = 直到停止）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="277" />
+            <location filename="../../ui/models/plan_model.py" line="182" />
             <source>Plan: refused, {reason}</source>
             <translation>轨迹：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="283" />
+            <location filename="../../ui/models/plan_model.py" line="188" />
             <source>plan</source>
             <translation>轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="287" />
+            <location filename="../../ui/models/plan_model.py" line="192" />
             <source>Add plan {name}</source>
             <translation>添加轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="295" />
+            <location filename="../../ui/models/plan_model.py" line="200" />
             <source>Duplicate plan {name}</source>
             <translation>复制轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="300" />
+            <location filename="../../ui/models/plan_model.py" line="205" />
             <source>Delete plan {name}</source>
             <translation>删除轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="310" />
+            <location filename="../../ui/models/plan_model.py" line="215" />
             <source>Rename plan {old} to {new}</source>
             <translation>将轨迹 {old} 重命名为 {new}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="319" />
+            <location filename="../../ui/models/plan_model.py" line="224" />
             <source>Set loops of {name} to {n}</source>
             <translation>将轨迹 {name} 的循环次数设为 {n}</translation>
         </message>
@@ -935,550 +995,520 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="161" />
+            <location filename="../../ui/panels/plan_preview.py" line="169" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="162" />
+            <location filename="../../ui/panels/plan_preview.py" line="170" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="163" />
+            <location filename="../../ui/panels/plan_preview.py" line="171" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
-    </context>
-    <context>
-        <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="405" />
-            <source>Add</source>
-            <translation>添加</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="405" />
-            <source>Add an empty plan</source>
-            <translation>添加空轨迹</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="406" />
-            <source>Rename</source>
-            <translation>重命名</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="406" />
-            <source>Rename the selected plan (F2)</source>
-            <translation>重命名所选轨迹（F2）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="407" />
-            <source>Duplicate</source>
-            <translation>复制</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="407" />
-            <source>Copy the selected plan</source>
-            <translation>复制所选轨迹</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="408" />
-            <location filename="../../ui/panels/planner_panel.py" line="413" />
-            <source>Delete</source>
-            <translation>删除</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="409" />
-            <source>Delete the selected plan (Ctrl+Z to undo)</source>
-            <translation>删除所选轨迹（Ctrl+Z 撤销）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="410" />
-            <source>+ Line</source>
-            <translation>+ 直线</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="411" />
-            <source>Add a line segment after the selection (Ctrl+L)</source>
-            <translation>在所选段之后添加直线段（Ctrl+L）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="412" />
-            <source>+ Arc</source>
-            <translation>+ 圆弧</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="412" />
-            <source>Add an arc segment after the selection</source>
-            <translation>在所选段之后添加圆弧段</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="413" />
-            <source>Delete the selected segments</source>
-            <translation>删除所选段</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="414" />
-            <source>Move the selected segments up (Alt+Up)</source>
-            <translation>上移所选段（Alt+↑）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="415" />
-            <source>Move the selected segments down (Alt+Down)</source>
-            <translation>下移所选段（Alt+↓）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="416" />
-            <location filename="../../ui/panels/planner_panel.py" line="435" />
-            <source>Check</source>
-            <translation>检查</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="416" />
-            <source>Check the plan from the robot's current pose</source>
-            <translation>以机器人当前位姿检查轨迹</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="417" />
-            <location filename="../../ui/panels/planner_panel.py" line="434" />
-            <source>Upload now</source>
-            <translation>立即上传</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="417" />
-            <source>Upload the points the plan needs</source>
-            <translation>上传轨迹所需的点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="418" />
-            <location filename="../../ui/panels/planner_panel.py" line="431" />
-            <source>Run</source>
-            <translation>运行</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="418" />
-            <source>Run the plan from the first segment (F5)</source>
-            <translation>从第一段开始运行轨迹（F5）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="419" />
-            <source>Run from here</source>
-            <translation>从此处运行</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="420" />
-            <source>Run from the selected segment (Shift+F5)</source>
-            <translation>从所选段开始运行（Shift+F5）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="421" />
-            <source>Step</source>
-            <translation>单步</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="421" />
-            <source>Run one segment, then stop (F10)</source>
-            <translation>运行一段后停止（F10）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="422" />
-            <source>Pause</source>
-            <translation>暂停</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="422" />
-            <source>Pause the motion</source>
-            <translation>暂停运动</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="423" />
-            <source>Resume</source>
-            <translation>继续</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="423" />
-            <source>Resume the paused motion</source>
-            <translation>继续已暂停的运动</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="424" />
-            <source>Stop</source>
-            <translation>停止</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="424" />
-            <source>Stop the robot and the run</source>
-            <translation>停止机器人和轨迹运行</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="425" />
-            <location filename="../../ui/panels/planner_panel.py" line="865" />
-            <source>Resume from segment</source>
-            <translation>从该段继续</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="425" />
-            <source>Continue the stopped run</source>
-            <translation>继续已停止的运行</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="430" />
-            <source>Plans</source>
-            <translation>轨迹规划</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="432" />
-            <source>Segments</source>
-            <translation>轨迹段</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="433" />
-            <source>Preview</source>
-            <translation>预览</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="525" />
-            <source>Deleted plan {name} (Ctrl+Z to undo)</source>
-            <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
-        </message>
-        <message numerus="yes">
-            <location filename="../../ui/panels/planner_panel.py" line="612" />
-            <source>%n error(s)</source>
-            <translation>
-                <numerusform>%n 个错误</numerusform>
-            </translation>
-        </message>
-        <message numerus="yes">
-            <location filename="../../ui/panels/planner_panel.py" line="614" />
-            <source>%n point(s) need upload</source>
-            <translation>
-                <numerusform>%n 个点需要上传</numerusform>
-            </translation>
-        </message>
-        <message numerus="yes">
-            <location filename="../../ui/panels/planner_panel.py" line="616" />
-            <source>%n warning(s)</source>
-            <translation>
-                <numerusform>%n 个警告</numerusform>
-            </translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="620" />
-            <source>Checks passed: ready to run</source>
-            <translation>检查通过：可以运行</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="625" />
-            <source>Upload now?</source>
-            <translation>立即上传？</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="649" />
-            <location filename="../../ui/panels/planner_panel.py" line="826" />
+            <location filename="../../ui/panels/plan_preview.py" line="240" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="651" />
+            <location filename="../../ui/panels/plan_preview.py" line="242" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="653" />
+            <location filename="../../ui/panels/plan_preview.py" line="244" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="655" />
+            <location filename="../../ui/panels/plan_preview.py" line="245" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="659" />
+            <location filename="../../ui/panels/plan_preview.py" line="248" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="665" />
+            <location filename="../../ui/panels/plan_preview.py" line="252" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="667" />
+            <location filename="../../ui/panels/plan_preview.py" line="254" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="668" />
+            <location filename="../../ui/panels/plan_preview.py" line="255" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
+    </context>
+    <context>
+        <name>PlanRunBox</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="675" />
+            <location filename="../../ui/panels/planner_widgets.py" line="160" />
+            <source>Run</source>
+            <extracomment>Colour of a summary line by level (the status line uses the darker warning text).</extracomment>
+            <translation>运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="163" />
+            <source>endless</source>
+            <translation>无限循环</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="164" />
+            <source>Segment {k} of {n}, loop {i} of {m}</source>
+            <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="178" />
+            <source>Finished: {n} segments run</source>
+            <translation>已完成：运行了 {n} 段</translation>
+        </message>
+    </context>
+    <context>
+        <name>PlanRunFlow</name>
+        <message>
+            <location filename="../../ui/panels/planner_run.py" line="68" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="678" />
+            <location filename="../../ui/panels/planner_run.py" line="71" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="689" />
+            <location filename="../../ui/panels/planner_run.py" line="83" />
             <source>Not connected to a controller</source>
             <translation>未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="702" />
+            <location filename="../../ui/panels/planner_run.py" line="92" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_panel.py" line="708" />
+            <location filename="../../ui/panels/planner_run.py" line="98" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_panel.py" line="710" />
+            <location filename="../../ui/panels/planner_run.py" line="100" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="711" />
+            <location filename="../../ui/panels/planner_run.py" line="102" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="712" />
+            <location filename="../../ui/panels/planner_run.py" line="103" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="724" />
+            <location filename="../../ui/panels/planner_run.py" line="115" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="726" />
+            <location filename="../../ui/panels/planner_run.py" line="117" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="728" />
+            <location filename="../../ui/panels/planner_run.py" line="119" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="730" />
+            <location filename="../../ui/panels/planner_run.py" line="121" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="731" />
+            <location filename="../../ui/panels/planner_run.py" line="122" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="733" />
+            <location filename="../../ui/panels/planner_run.py" line="125" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="734" />
+            <location filename="../../ui/panels/planner_run.py" line="129" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="803" />
+            <location filename="../../ui/panels/planner_run.py" line="178" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
+    </context>
+    <context>
+        <name>PlannerActions</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="827" />
-            <source>Segment {k} of {n}, loop {i} of {m}</source>
-            <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
+            <location filename="../../ui/panels/planner_actions.py" line="58" />
+            <source>Add</source>
+            <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="845" />
-            <source>Finished: {n} segments run</source>
-            <translation>已完成：运行了 {n} 段</translation>
+            <location filename="../../ui/panels/planner_actions.py" line="58" />
+            <source>Add an empty plan</source>
+            <translation>添加空轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="846" />
-            <source>Plan finished</source>
-            <translation>轨迹运行完成</translation>
+            <location filename="../../ui/panels/planner_actions.py" line="59" />
+            <source>Rename</source>
+            <translation>重命名</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="856" />
-            <source>Failed</source>
-            <translation>失败</translation>
+            <location filename="../../ui/panels/planner_actions.py" line="59" />
+            <source>Rename the selected plan (F2)</source>
+            <translation>重命名所选轨迹（F2）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="856" />
-            <source>Stopped</source>
-            <translation>已停止</translation>
+            <location filename="../../ui/panels/planner_actions.py" line="60" />
+            <source>Duplicate</source>
+            <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="864" />
+            <location filename="../../ui/panels/planner_actions.py" line="60" />
+            <source>Copy the selected plan</source>
+            <translation>复制所选轨迹</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="61" />
+            <location filename="../../ui/panels/planner_actions.py" line="64" />
+            <source>Delete</source>
+            <translation>删除</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="61" />
+            <source>Delete the selected plan (Ctrl+Z to undo)</source>
+            <translation>删除所选轨迹（Ctrl+Z 撤销）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="62" />
+            <source>+ Line</source>
+            <translation>+ 直线</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="62" />
+            <source>Add a line segment after the selection (Ctrl+L)</source>
+            <translation>在所选段之后添加直线段（Ctrl+L）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="63" />
+            <source>+ Arc</source>
+            <translation>+ 圆弧</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="63" />
+            <source>Add an arc segment after the selection</source>
+            <translation>在所选段之后添加圆弧段</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="64" />
+            <source>Delete the selected segments</source>
+            <translation>删除所选段</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="65" />
+            <source>Move the selected segments up (Alt+Up)</source>
+            <translation>上移所选段（Alt+↑）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="66" />
+            <source>Move the selected segments down (Alt+Down)</source>
+            <translation>下移所选段（Alt+↓）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="67" />
+            <source>Check</source>
+            <translation>检查</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="67" />
+            <source>Check the plan from the robot's current pose</source>
+            <translation>以机器人当前位姿检查轨迹</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="68" />
+            <source>Upload now</source>
+            <translation>立即上传</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="68" />
+            <source>Upload the points the plan needs</source>
+            <translation>上传轨迹所需的点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="69" />
+            <source>Run</source>
+            <translation>运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="69" />
+            <source>Run the plan from the first segment (F5)</source>
+            <translation>从第一段开始运行轨迹（F5）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="70" />
+            <source>Run from here</source>
+            <translation>从此处运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="70" />
+            <source>Run from the selected segment (Shift+F5)</source>
+            <translation>从所选段开始运行（Shift+F5）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="71" />
+            <source>Step</source>
+            <translation>单步</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="71" />
+            <source>Run one segment, then stop (F10)</source>
+            <translation>运行一段后停止（F10）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="72" />
+            <source>Pause</source>
+            <translation>暂停</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="72" />
+            <source>Pause the motion</source>
+            <translation>暂停运动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="73" />
+            <source>Resume</source>
+            <translation>继续</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="73" />
+            <source>Resume the paused motion</source>
+            <translation>继续已暂停的运动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="74" />
+            <source>Stop</source>
+            <translation>停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="74" />
+            <source>Stop the robot and the run</source>
+            <translation>停止机器人和轨迹运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="75" />
+            <location filename="../../ui/panels/planner_actions.py" line="84" />
+            <source>Resume from segment</source>
+            <translation>从该段继续</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="75" />
+            <source>Continue the stopped run</source>
+            <translation>继续已停止的运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="83" />
             <source>Resume from segment {k}</source>
             <translation>从第 {k} 段继续</translation>
         </message>
     </context>
     <context>
+        <name>PlannerPanel</name>
+        <message>
+            <location filename="../../ui/panels/planner_panel.py" line="210" />
+            <source>Preview</source>
+            <translation>预览</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_panel.py" line="388" />
+            <source>Plan finished</source>
+            <translation>轨迹运行完成</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_panel.py" line="397" />
+            <source>Failed</source>
+            <translation>失败</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_panel.py" line="397" />
+            <source>Stopped</source>
+            <translation>已停止</translation>
+        </message>
+    </context>
+    <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="221" />
+            <location filename="../../ui/panels/points_panel.py" line="213" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="232" />
+            <location filename="../../ui/panels/points_panel.py" line="224" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="242" />
+            <location filename="../../ui/panels/points_panel.py" line="234" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="244" />
+            <location filename="../../ui/panels/points_panel.py" line="236" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="251" />
+            <location filename="../../ui/panels/points_panel.py" line="243" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="277" />
+            <location filename="../../ui/panels/points_panel.py" line="269" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="275" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="286" />
+            <location filename="../../ui/panels/points_panel.py" line="278" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="290" />
+            <location filename="../../ui/panels/points_panel.py" line="282" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="292" />
+            <location filename="../../ui/panels/points_panel.py" line="284" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="297" />
+            <location filename="../../ui/panels/points_panel.py" line="289" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="313" />
+            <location filename="../../ui/panels/points_panel.py" line="305" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="326" />
+            <location filename="../../ui/panels/points_panel.py" line="318" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="329" />
+            <location filename="../../ui/panels/points_panel.py" line="321" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="361" />
+            <location filename="../../ui/panels/points_panel.py" line="353" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="375" />
+            <location filename="../../ui/panels/points_panel.py" line="367" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="405" />
+            <location filename="../../ui/panels/points_panel.py" line="397" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="410" />
+            <location filename="../../ui/panels/points_panel.py" line="402" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="421" />
+            <location filename="../../ui/panels/points_panel.py" line="413" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="425" />
+            <location filename="../../ui/panels/points_panel.py" line="417" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="431" />
+            <location filename="../../ui/panels/points_panel.py" line="423" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="438" />
+            <location filename="../../ui/panels/points_panel.py" line="430" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="440" />
+            <location filename="../../ui/panels/points_panel.py" line="432" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="449" />
+            <location filename="../../ui/panels/points_panel.py" line="441" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="453" />
+            <location filename="../../ui/panels/points_panel.py" line="445" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="491" />
+            <location filename="../../ui/panels/points_panel.py" line="483" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="493" />
+            <location filename="../../ui/panels/points_panel.py" line="485" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="509" />
+            <location filename="../../ui/panels/points_panel.py" line="501" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="513" />
+            <location filename="../../ui/panels/points_panel.py" line="505" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="517" />
+            <location filename="../../ui/panels/points_panel.py" line="509" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -1510,154 +1540,153 @@
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/models/points_model.py" line="107" />
+            <location filename="../../ui/models/point_columns.py" line="64" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="108" />
+            <location filename="../../ui/models/point_columns.py" line="65" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="354" />
+            <location filename="../../ui/models/points_model.py" line="140" />
             <source>ID</source>
-            <extracomment>An edit refused (bad value, duplicate id ...): the message for the status line. A command changed ``target``'s list (after the change).</extracomment>
             <translation>编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="354" />
+            <location filename="../../ui/models/points_model.py" line="140" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="354" />
+            <location filename="../../ui/models/points_model.py" line="140" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="355" />
+            <location filename="../../ui/models/points_model.py" line="141" />
             <source>Sync</source>
             <translation>同步状态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="355" />
+            <location filename="../../ui/models/points_model.py" line="141" />
             <source>Note</source>
             <translation>备注</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="358" />
+            <location filename="../../ui/models/points_model.py" line="144" />
             <source>Temp point id on the controller</source>
             <translation>控制器上的临时点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="359" />
+            <location filename="../../ui/models/points_model.py" line="145" />
             <source>Tool frame (200 = none)</source>
             <translation>工具坐标系（200 = 无）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="360" />
+            <location filename="../../ui/models/points_model.py" line="146" />
             <source>Whether the controller holds this point</source>
             <translation>控制器上是否有此点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="361" />
+            <location filename="../../ui/models/points_model.py" line="147" />
             <source>mm, base frame</source>
             <translation>毫米，基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="362" />
+            <location filename="../../ui/models/points_model.py" line="148" />
             <source>degrees</source>
             <translation>度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="364" />
+            <location filename="../../ui/models/points_model.py" line="150" />
             <source>External axis (recorded only: the controller does not store it)</source>
             <translation>外部轴（仅记录：控制器不保存）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="443" />
+            <location filename="../../ui/models/points_model.py" line="229" />
             <source>no reason given</source>
             <translation>未给出原因</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="444" />
+            <location filename="../../ui/models/points_model.py" line="230" />
             <source>Upload failed: {reason}</source>
             <translation>上传失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="446" />
+            <location filename="../../ui/models/points_model.py" line="232" />
             <source>Not known whether the controller holds this point (it restarted or the link was lost): upload it before moving to it</source>
             <translation>不确定控制器上是否有此点（控制器已重启或通信曾中断）：运动到该点前请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="448" />
+            <location filename="../../ui/models/points_model.py" line="234" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="449" />
+            <location filename="../../ui/models/points_model.py" line="235" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="454" />
+            <location filename="../../ui/models/points_model.py" line="240" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="484" />
+            <location filename="../../ui/models/points_model.py" line="270" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="502" />
+            <location filename="../../ui/models/points_model.py" line="288" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="533" />
+            <location filename="../../ui/models/points_model.py" line="319" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="559" />
+            <location filename="../../ui/models/points_model.py" line="345" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="560" />
+            <location filename="../../ui/models/points_model.py" line="346" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="577" />
+            <location filename="../../ui/models/points_model.py" line="363" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="578" />
+            <location filename="../../ui/models/points_model.py" line="364" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="593" />
+            <location filename="../../ui/models/points_model.py" line="379" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="593" />
+            <location filename="../../ui/models/points_model.py" line="379" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="609" />
+            <location filename="../../ui/models/points_model.py" line="395" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="617" />
+            <location filename="../../ui/models/points_model.py" line="403" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -1665,174 +1694,174 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="731" />
+            <location filename="../../ui/panels/points_panel.py" line="723" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="731" />
+            <location filename="../../ui/panels/points_panel.py" line="723" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="733" />
+            <location filename="../../ui/panels/points_panel.py" line="725" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="733" />
+            <location filename="../../ui/panels/points_panel.py" line="725" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="734" />
+            <location filename="../../ui/panels/points_panel.py" line="726" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="734" />
+            <location filename="../../ui/panels/points_panel.py" line="726" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="735" />
+            <location filename="../../ui/panels/points_panel.py" line="727" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="736" />
+            <location filename="../../ui/panels/points_panel.py" line="728" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="737" />
+            <location filename="../../ui/panels/points_panel.py" line="729" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="738" />
+            <location filename="../../ui/panels/points_panel.py" line="730" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="739" />
+            <location filename="../../ui/panels/points_panel.py" line="731" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="740" />
+            <location filename="../../ui/panels/points_panel.py" line="732" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="741" />
+            <location filename="../../ui/panels/points_panel.py" line="733" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="742" />
+            <location filename="../../ui/panels/points_panel.py" line="734" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="743" />
+            <location filename="../../ui/panels/points_panel.py" line="735" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="743" />
+            <location filename="../../ui/panels/points_panel.py" line="735" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="744" />
-            <location filename="../../ui/panels/points_panel.py" line="760" />
+            <location filename="../../ui/panels/points_panel.py" line="736" />
+            <location filename="../../ui/panels/points_panel.py" line="752" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="745" />
+            <location filename="../../ui/panels/points_panel.py" line="737" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="746" />
+            <location filename="../../ui/panels/points_panel.py" line="738" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="747" />
-            <location filename="../../ui/panels/points_panel.py" line="887" />
+            <location filename="../../ui/panels/points_panel.py" line="739" />
+            <location filename="../../ui/panels/points_panel.py" line="879" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="748" />
+            <location filename="../../ui/panels/points_panel.py" line="740" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="749" />
+            <location filename="../../ui/panels/points_panel.py" line="741" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="749" />
+            <location filename="../../ui/panels/points_panel.py" line="741" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="750" />
+            <location filename="../../ui/panels/points_panel.py" line="742" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="755" />
+            <location filename="../../ui/panels/points_panel.py" line="747" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="756" />
+            <location filename="../../ui/panels/points_panel.py" line="748" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="757" />
+            <location filename="../../ui/panels/points_panel.py" line="749" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="758" />
+            <location filename="../../ui/panels/points_panel.py" line="750" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="761" />
+            <location filename="../../ui/panels/points_panel.py" line="753" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="762" />
+            <location filename="../../ui/panels/points_panel.py" line="754" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="850" />
+            <location filename="../../ui/panels/points_panel.py" line="842" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="853" />
+            <location filename="../../ui/panels/points_panel.py" line="845" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="876" />
+            <location filename="../../ui/panels/points_panel.py" line="868" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="880" />
+            <location filename="../../ui/panels/points_panel.py" line="872" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -1845,7 +1874,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="923" />
+            <location filename="../../ui/panels/points_panel.py" line="915" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -2369,174 +2398,182 @@ Recover it?</source>
         </message>
     </context>
     <context>
+        <name>SegmentEditorBox</name>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="315" />
+            <source>Segments</source>
+            <translation>轨迹段</translation>
+        </message>
+    </context>
+    <context>
         <name>SegmentTableModel</name>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="389" />
+            <location filename="../../ui/models/segment_model.py" line="105" />
             <source>Type</source>
             <translation>类型</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="389" />
+            <location filename="../../ui/models/segment_model.py" line="105" />
             <source>Middle point</source>
             <translation>中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="389" />
+            <location filename="../../ui/models/segment_model.py" line="105" />
             <source>End point</source>
             <translation>终点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="390" />
+            <location filename="../../ui/models/segment_model.py" line="106" />
             <source>Orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="390" />
+            <location filename="../../ui/models/segment_model.py" line="106" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="97" />
+            <location filename="../../ui/models/plan_columns.py" line="60" />
             <source>changes</source>
             <translation>姿态变化</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="98" />
+            <location filename="../../ui/models/plan_columns.py" line="61" />
             <source>kept</source>
             <translation>姿态保持</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="122" />
+            <location filename="../../ui/models/plan_columns.py" line="85" />
             <source>error</source>
             <translation>错误</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="123" />
+            <location filename="../../ui/models/plan_columns.py" line="86" />
             <source>needs upload</source>
             <translation>需要上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="124" />
+            <location filename="../../ui/models/plan_columns.py" line="87" />
             <source>warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="389" />
+            <location filename="../../ui/models/segment_model.py" line="105" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="390" />
+            <location filename="../../ui/models/segment_model.py" line="106" />
             <source>Speed</source>
             <translation>速度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="390" />
+            <location filename="../../ui/models/segment_model.py" line="106" />
             <source>Ignore mid.</source>
             <translation>忽略中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="391" />
+            <location filename="../../ui/models/segment_model.py" line="107" />
             <source>Length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="391" />
+            <location filename="../../ui/models/segment_model.py" line="107" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="480" />
+            <location filename="../../ui/models/segment_model.py" line="196" />
             <source>Checks before running: hover the icon for details</source>
             <translation>运行前检查：鼠标悬停在图标上查看详情</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="481" />
+            <location filename="../../ui/models/segment_model.py" line="197" />
             <source>Speed in mm/s (GV225)</source>
             <translation>速度，单位 mm/s（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="482" />
+            <location filename="../../ui/models/segment_model.py" line="198" />
             <source>Middle point of an arc (GV200)</source>
             <translation>圆弧的中间点（GV200）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="483" />
+            <location filename="../../ui/models/segment_model.py" line="199" />
             <source>End point (GV201)</source>
             <translation>终点（GV201）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="484" />
+            <location filename="../../ui/models/segment_model.py" line="200" />
             <source>Orientation kept constant or changing along the move (GV202)</source>
             <translation>运动中姿态保持不变或变化（GV202）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="485" />
+            <location filename="../../ui/models/segment_model.py" line="201" />
             <source>Ignore the arc's middle point orientation (GV203)</source>
             <translation>忽略圆弧中间点的姿态（GV203）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="486" />
+            <location filename="../../ui/models/segment_model.py" line="202" />
             <source>Tool frame of the move (GV245)</source>
             <translation>运动使用的工具坐标系（GV245）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="487" />
+            <location filename="../../ui/models/segment_model.py" line="203" />
             <source>Estimated path length</source>
             <translation>估计路径长度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="488" />
+            <location filename="../../ui/models/segment_model.py" line="204" />
             <source>Estimated time: length / speed plus a fixed overhead per segment</source>
             <translation>估计时间：长度 / 速度，加上每段固定开销</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="588" />
+            <location filename="../../ui/models/segment_model.py" line="304" />
             <source>Segment {n}: no problems found</source>
             <translation>第 {n} 段：未发现问题</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="593" />
+            <location filename="../../ui/models/segment_model.py" line="309" />
             <source>Point P{id} does not exist</source>
             <translation>点 P{id} 不存在</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="627" />
+            <location filename="../../ui/models/segment_model.py" line="343" />
             <source>Segment {n}, {column}: refused, {reason}</source>
             <translation>第 {n} 段，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="649" />
+            <location filename="../../ui/models/segment_model.py" line="365" />
             <source>Edit segment {n} {column}</source>
             <translation>编辑第 {n} 段 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="660" />
+            <location filename="../../ui/models/segment_model.py" line="376" />
             <source>Add {kind} segment</source>
             <translation>添加{kind}段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="692" />
+            <location filename="../../ui/models/segment_model.py" line="408" />
             <source>Add {n} segments</source>
             <translation>添加 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="699" />
+            <location filename="../../ui/models/segment_model.py" line="415" />
             <source>Delete segment {n}</source>
             <translation>删除第 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="700" />
+            <location filename="../../ui/models/segment_model.py" line="416" />
             <source>Delete {n} segments</source>
             <translation>删除 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="716" />
+            <location filename="../../ui/models/segment_model.py" line="432" />
             <source>Move segment up</source>
             <translation>上移段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="716" />
+            <location filename="../../ui/models/segment_model.py" line="432" />
             <source>Move segment down</source>
             <translation>下移段</translation>
         </message>
@@ -2765,37 +2802,37 @@ Recover it?</source>
     <context>
         <name>TrafficModel</name>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="221" />
+            <location filename="../../ui/models/traffic_model.py" line="189" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="222" />
+            <location filename="../../ui/models/traffic_model.py" line="190" />
             <source>Dir</source>
             <translation>方向</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="223" />
+            <location filename="../../ui/models/traffic_model.py" line="191" />
             <source>Bytes</source>
             <translation>字节</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="224" />
+            <location filename="../../ui/models/traffic_model.py" line="192" />
             <source>Meaning</source>
             <translation>含义</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="226" />
+            <location filename="../../ui/models/traffic_model.py" line="194" />
             <source>→ Tx</source>
             <translation>→ 发送</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="227" />
+            <location filename="../../ui/models/traffic_model.py" line="195" />
             <source>← Rx</source>
             <translation>← 接收</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="391" />
+            <location filename="../../ui/models/traffic_model.py" line="359" />
             <source>{n} bytes</source>
             <translation>{n} 字节</translation>
         </message>
@@ -2803,62 +2840,62 @@ Recover it?</source>
     <context>
         <name>TrafficPanel</name>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="536" />
+            <location filename="../../ui/panels/traffic_panel.py" line="135" />
             <source>Filter: bytes or meaning</source>
             <translation>过滤：字节或含义</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="537" />
+            <location filename="../../ui/panels/traffic_panel.py" line="136" />
             <source>Hide polls</source>
             <translation>隐藏轮询</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="539" />
+            <location filename="../../ui/panels/traffic_panel.py" line="138" />
             <source>Hide the periodic reads of 412.. (pose) and 560.. (status)</source>
             <translation>隐藏对 412..（位姿）和 560..（状态）的周期读取</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="541" />
+            <location filename="../../ui/panels/traffic_panel.py" line="140" />
             <source>Pause capture</source>
             <translation>暂停抓包</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="542" />
+            <location filename="../../ui/panels/traffic_panel.py" line="141" />
             <source>Stop recording frames (the worker stops building them)</source>
             <translation>停止记录报文（后台不再生成报文记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="543" />
+            <location filename="../../ui/panels/traffic_panel.py" line="142" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="544" />
+            <location filename="../../ui/panels/traffic_panel.py" line="143" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="662" />
+            <location filename="../../ui/panels/traffic_panel.py" line="261" />
             <source>Export traffic</source>
             <translation>导出通信报文</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="663" />
+            <location filename="../../ui/panels/traffic_panel.py" line="262" />
             <source>CSV files (*.csv);;Text files (*.txt);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;文本文件 (*.txt);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="690" />
+            <location filename="../../ui/panels/traffic_panel.py" line="289" />
             <source>{n} frames</source>
             <translation>{n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="692" />
+            <location filename="../../ui/panels/traffic_panel.py" line="291" />
             <source>{shown} of {n} frames shown</source>
             <translation>显示 {shown} / {n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="694" />
+            <location filename="../../ui/panels/traffic_panel.py" line="293" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
         </message>

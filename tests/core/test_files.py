@@ -10,7 +10,8 @@ from pathlib import Path
 import pytest
 
 from app.errors import InvalidInput
-from app.plan.segments import Plan, Segment, check_plan, has_errors
+from app.plan.checks import check_plan, has_errors
+from app.plan.segments import Plan, Segment
 from app.points.ledger import (
     FileFormatError,
     ImportMode,

@@ -10,26 +10,23 @@ import pytest
 
 from app.errors import InvalidInput
 from app.models import Pose
-from app.plan.segments import (
-    SEGMENT_OVERHEAD_S,
+from app.plan.checks import (
     IssueCode,
     IssueKind,
-    Plan,
     PlanLimits,
-    Segment,
-    SegmentKind,
-    arc_geometry,
     check_plan,
-    estimate_plan,
-    estimate_time,
     has_errors,
     ids_needing_upload,
+)
+from app.plan.estimates import (
+    SEGMENT_OVERHEAD_S,
+    estimate_plan,
+    estimate_time,
     move_timeout,
-    plan_path,
-    segment_length,
-    segment_path,
     segment_timeouts,
 )
+from app.plan.geometry import arc_geometry, plan_path, segment_length, segment_path
+from app.plan.segments import Plan, Segment, SegmentKind
 from app.points.ledger import FieldError, PointLedger, SyncState, make_point
 
 ON = SyncState.ON_CONTROLLER

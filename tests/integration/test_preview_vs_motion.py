@@ -14,8 +14,10 @@ from typing import Any
 import numpy as np
 import pytest
 
+from app.plan.checks import check_plan
+from app.plan.geometry import plan_geometry, plan_path
 from app.plan.runner import PlanRunner, RunState
-from app.plan.segments import Plan, Segment, check_plan, plan_geometry, plan_path
+from app.plan.segments import Plan, Segment
 from tests.integration.support import (
     ARC_CENTRE,
     ARC_U,

@@ -15,16 +15,10 @@ import numpy as np
 
 from app.errors import CommandRefused, CommandStopped, LinkError
 from app.link.client import RobotClient, StepFrame
+from app.plan.checks import check_plan, has_errors, ids_needing_upload
+from app.plan.geometry import arc_geometry, plan_path
 from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
-from app.plan.segments import (
-    Plan,
-    Segment,
-    arc_geometry,
-    check_plan,
-    has_errors,
-    ids_needing_upload,
-    plan_path,
-)
+from app.plan.segments import Plan, Segment
 from app.points.ledger import PointLedger, SyncState, point_from_pose
 from app.protocol import registers
 from app.protocol.enums import ProgramState

@@ -11,17 +11,18 @@ from pymodbus.framer import FramerRTU
 from app.protocol.codec import WordOrder, encode_floats, float_to_registers
 from app.protocol.datetime_regs import DateTimeLayout, encode_clock
 from app.protocol.enums import Alarm, RunCommand
-from app.protocol.frames import (
-    EXCEPTION_TEXT,
-    FrameDecoder,
+from app.protocol.exceptions import MODBUS_EXCEPTION_TEXT, exception_text
+from app.protocol.frames import FrameDecoder, decode_frame
+from app.protocol.framing import (
     FunctionCode,
-    ItemKind,
     crc16,
-    decode_frame,
-    describe_registers,
     encode_request,
     encode_response,
     encode_write_gv,
+)
+from app.protocol.naming import (
+    ItemKind,
+    describe_registers,
     format_float32,
     range_label,
     single_write_text,
@@ -185,11 +186,19 @@ def test_unknown_function() -> None:
 # --- Exceptions -----------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize(("code", "text"), sorted(EXCEPTION_TEXT.items()))
+@pytest.mark.parametrize(("code", "text"), sorted(MODBUS_EXCEPTION_TEXT.items()))
 def test_exception_texts(code: int, text: str) -> None:
     frame = decode_frame(encode_response(FC06, exception=code), transport="tcp")
     assert frame.summary == f"exception {code:02X} {text}"
     assert frame.exception_code == code and frame.is_exception and not frame.ok
+
+
+def test_one_exception_table_covers_every_standard_code() -> None:
+    # 0x01-0x0B of the Modbus standard; 0x09 is not assigned.
+    assert sorted(MODBUS_EXCEPTION_TEXT) == [c for c in range(0x01, 0x0C) if c != 0x09]
+    assert exception_text(0x07) == "negative acknowledge"
+    assert exception_text(0x77) == "unknown exception"
+    assert exception_text(0x77, "exception code 119") == "exception code 119"
 
 
 def test_exception_unknown_code_and_missing_code() -> None:

@@ -15,16 +15,9 @@ import pytest
 
 from app.protocol.codec import WordOrder, float_to_registers
 from app.protocol.enums import RunCommand, WorkMode
-from app.protocol.frames import (
-    DecodedFrame,
-    FrameDecoder,
-    FunctionCode,
-    decode_frame,
-    describe_registers,
-    encode_request,
-    encode_response,
-    encode_write_gv,
-)
+from app.protocol.frames import DecodedFrame, FrameDecoder, decode_frame
+from app.protocol.framing import FunctionCode, encode_request, encode_response, encode_write_gv
+from app.protocol.naming import describe_registers
 from app.protocol.registers import (
     GV_EXPECTED_SPEED,
     GV_PARAM0,

@@ -170,7 +170,7 @@ def test_traffic_inspector_shows_decoded_frames_from_the_simulator(
     qtbot: Any, sim: Any, window: MainWindow
 ) -> None:
     """Raise the inspector, connect, send a command: its frames arrive decoded, as in the seed."""
-    from ui.panels.traffic_panel import COL_BYTES, COL_MEANING
+    from ui.models.traffic_model import COL_BYTES, COL_MEANING
 
     window.show()
     window.traffic_dock.show()

@@ -10,7 +10,8 @@ import pyqtgraph as pg
 import pytest
 
 from app.models import Pose
-from app.plan.segments import Plan, Segment, plan_path
+from app.plan.geometry import plan_path
+from app.plan.segments import Plan, Segment
 from app.points.ledger import PointLedger, make_point
 from ui.panels.plan_preview import PROJECTIONS, PlanPreview
 
@@ -69,7 +70,7 @@ def test_arc_passes_through_its_middle_point(preview: PlanPreview, ledger: Point
     assert path is not None
     arc = path.xyz[path.segment == 1]
     s, m, e = arc[0], np.array(middle), arc[-1]
-    from app.plan.segments import arc_geometry
+    from app.plan.geometry import arc_geometry
 
     geo = arc_geometry(s[None, :], m[None, :], e[None, :])
     radii = np.linalg.norm(arc - geo.centre[0], axis=1)

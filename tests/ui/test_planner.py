@@ -11,13 +11,14 @@ import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 
+from app.plan.checks import IssueKind
 from app.plan.runner import RunState
-from app.plan.segments import IssueKind, Segment, SegmentKind
+from app.plan.segments import Segment, SegmentKind
 from app.points.ledger import SyncState, UploadOutcome, UploadReport
 from app.points.project import Project, load_project
 from tests.ui.test_points_panel import FakeError, FakeLink
 from ui.controllers.plan_run_controller import PlanRunController
-from ui.models.plan_model import (
+from ui.models.plan_columns import (
     COL_END,
     COL_IGNORE,
     COL_INDEX,
@@ -27,10 +28,11 @@ from ui.models.plan_model import (
     ISSUE_LEVEL_ROLE,
     PLAN_COL_LOOPS,
     PLAN_COL_NAME,
-    PlanListModel,
-    SegmentTableModel,
 )
+from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
+from ui.models.segment_model import SegmentTableModel
+from ui.palette import COLOR_ERROR, COLOR_WARN_TEXT
 from ui.panels.planner_panel import PlannerPanel
 from ui.panels.points_panel import PointSyncController
 
@@ -169,7 +171,7 @@ def test_plan_list_edits(qtbot: Any, project: Project, stack: QUndoStack) -> Non
 
 
 def test_issues_shown_on_their_rows(segments: SegmentTableModel, project: Project) -> None:
-    from app.plan.segments import check_plan
+    from app.plan.checks import check_plan
 
     plan = segments.plan
     assert plan is not None
@@ -400,6 +402,36 @@ def test_panel_undo_of_other_plan_switches_to_it(planner: PlannerPanel) -> None:
     assert planner.current_plan() is planner.segments.plan
     assert planner.current_plan() is not None and planner.current_plan().name == "pick and place"
     assert planner.plan_view.currentIndex().row() == 0
+
+
+def test_panel_plan_and_segment_edits_through_the_actions(planner: PlannerPanel, project: Project) -> None:
+    count = len(project.plans)
+    planner.select_plan(1)
+    planner.action_duplicate_plan.trigger()
+    assert len(project.plans) == count + 1 and planner.plan_view.currentIndex().row() == 2
+    copy = planner.current_plan()
+    assert copy is not None and copy is project.plans[2] and len(copy) == len(project.plans[1])
+    planner.select_segments([0])
+    planner.action_add_arc.trigger()  # after the selection, and selected
+    assert copy[1].is_arc and planner.selected_segments() == [1]
+    planner.action_segment_up.trigger()
+    assert copy[0].is_arc and planner.selected_segments() == [0]
+    planner.action_delete_segment.trigger()
+    assert len(copy) == len(project.plans[1])
+    planner.action_delete_plan.trigger()
+    assert len(project.plans) == count and copy not in project.plans
+    assert planner.status.text() == f"Deleted plan {copy.name} (Ctrl+Z to undo)"
+    planner.segments.undo_stack.undo()
+    assert project.plans[2] is copy
+
+
+def test_panel_status_levels_use_the_palette(planner: PlannerPanel) -> None:
+    planner.show_message("refused", "error")
+    assert COLOR_ERROR in planner.status.styleSheet()
+    planner.show_message("careful", "warn")
+    assert COLOR_WARN_TEXT in planner.status.styleSheet()
+    planner.show_message("plain", "other")
+    assert planner.status.styleSheet() == ""
 
 
 def test_points_upload_updates_the_checks(planner: PlannerPanel, project: Project) -> None:

@@ -13,16 +13,8 @@ from app.models import Pose
 from app.plan.segments import Plan, Segment
 from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport, make_point
 from app.points.project import Project, load_project
-from ui.models.points_model import (
-    COL_ID,
-    COL_NAME,
-    COL_SYNC,
-    COL_TOOL,
-    COL_X,
-    COLUMNS,
-    PointFilterProxy,
-    PointsModel,
-)
+from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COL_TOOL, COL_X, COLUMNS
+from ui.models.points_model import PointFilterProxy, PointsModel
 
 SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
 COL_Y = COLUMNS.index("y")

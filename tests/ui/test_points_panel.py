@@ -16,7 +16,8 @@ from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, make_point
 from app.points.project import load_project
 from app.protocol.enums import CommandKind, CommandStatus, RunCommand
-from ui.models.points_model import COL_E1, COL_TOOL, COL_X, PointsModel
+from ui.models.point_columns import COL_E1, COL_TOOL, COL_X
+from ui.models.points_model import PointsModel
 from ui.panels.points_panel import PointsPanel, PointSyncController
 
 SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"

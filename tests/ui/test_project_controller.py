@@ -14,7 +14,7 @@ import pytest
 from app.points.ledger import ImportMode
 from app.points.project import load_project
 from ui.controllers.project_controller import ProjectController
-from ui.models.points_model import COL_X
+from ui.models.point_columns import COL_X
 
 SAMPLES = Path(__file__).resolve().parents[2] / "resources" / "samples"
 

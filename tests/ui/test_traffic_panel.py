@@ -13,17 +13,17 @@ import pytest
 from PySide6.QtCore import QCoreApplication, QModelIndex, Qt, QTranslator
 
 from app.protocol.codec import WordOrder, encode_floats
-from app.protocol.frames import encode_request, encode_response, encode_write_gv
+from app.protocol.framing import encode_request, encode_response, encode_write_gv
 from app.protocol.registers import POSE_BLOCK_COUNT, POSE_BLOCK_START, STATUS_BLOCK_COUNT, STATUS_BLOCK_START
-from ui.panels.traffic_panel import (
+from ui.models.traffic_model import (
     COL_BYTES,
     COL_DIRECTION,
     COL_MEANING,
     COL_TIME,
     TrafficModel,
-    TrafficPanel,
     is_poll_read,
 )
+from ui.panels.traffic_panel import TrafficPanel
 
 pytestmark = pytest.mark.qt_log_ignore("This plugin does not support propagateSizeHints")
 
@@ -139,7 +139,7 @@ def test_rows_show_time_direction_seed_hex_and_meaning(panel: TrafficPanel) -> N
 
 
 def test_decoding_is_lazy_and_cached(panel: TrafficPanel, monkeypatch: pytest.MonkeyPatch) -> None:
-    import ui.panels.traffic_panel as traffic
+    import ui.models.traffic_model as traffic
 
     calls: list[bytes] = []
     real = traffic.decode_frame

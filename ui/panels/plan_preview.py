@@ -1,7 +1,7 @@
 """Plan preview: the path in three projections — top (XY), front (XZ), side (YZ).
 
 Each projection draws the whole plan with **one** ``PlotCurveItem`` whose data is the sampled
-path of :func:`app.plan.segments.plan_path` (NaN rows separate unknown segments; ``connect="finite"``),
+path of :func:`app.plan.geometry.plan_path` (NaN rows separate unknown segments; ``connect="finite"``),
 so a plan of 1,000 segments is three ``setData`` calls, not 3,000 items. Arcs are the true
 circles through start, middle and end (the core samples them with the middle point among the
 samples). On top: the selected segment (thick), the referenced points (one scatter item,
@@ -23,7 +23,20 @@ from PySide6.QtGui import QResizeEvent
 from PySide6.QtWidgets import QBoxLayout, QHBoxLayout, QLabel, QVBoxLayout, QWidget
 
 from app.models import Pose
-from app.plan.segments import PlanPath
+from app.plan.geometry import PlanPath, plan_path
+from app.plan.presenter import PlanInfo
+from app.plan.segments import Plan
+from app.points.ledger import PointLedger
+from ui.palette import (
+    COLOR_AXIS,
+    COLOR_HIGHLIGHT,
+    COLOR_INK,
+    COLOR_INK_SOFT,
+    COLOR_PATH,
+    COLOR_START,
+    COLOR_TCP,
+    COLOR_TRAIL,
+)
 
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
 LIVE_FPS = 30
@@ -31,12 +44,6 @@ TRAIL_LENGTH = 600  # live TCP positions kept for the trail
 INFO_WIDTH = 210  # px, the lengths / times column (at most)
 INFO_MIN_WIDTH = 140  # px, on a narrow window
 INFO_BELOW_WIDTH = 620  # px: a narrower preview shows the lengths / times below the plots
-PATH_COLOUR = "#1565c0"
-SELECTED_COLOUR = "#ff6f00"
-POINT_COLOUR = "#455a64"
-START_COLOUR = "#2e7d32"
-TCP_COLOUR = "#c62828"
-TRAIL_COLOUR = "#ef9a9a"
 
 #: (key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.
 PROJECTIONS: tuple[tuple[str, int, int], ...] = (("top", 0, 1), ("front", 0, 2), ("side", 1, 2))
@@ -52,8 +59,8 @@ def _style_plot(plot: pg.PlotWidget) -> None:
     for name in ("left", "bottom"):
         axis = item.getAxis(name)
         axis.enableAutoSIPrefix(False)
-        axis.setPen(pg.mkPen("#455a64"))
-        axis.setTextPen(pg.mkPen("#263238"))
+        axis.setPen(pg.mkPen(COLOR_AXIS))
+        axis.setTextPen(pg.mkPen(COLOR_INK))
     plot.setMenuEnabled(False)
     plot.setAspectLocked(True)
     plot.getViewBox().setDefaultPadding(0.12)  # room for the point labels at the edges
@@ -67,15 +74,15 @@ class _Projection:
         self.plot = plot
         self.h = h
         self.v = v
-        self.path = pg.PlotCurveItem(pen=pg.mkPen(PATH_COLOUR, width=2), connect="finite", antialias=True)
-        self.selected = pg.PlotCurveItem(pen=pg.mkPen(SELECTED_COLOUR, width=5), connect="finite",
+        self.path = pg.PlotCurveItem(pen=pg.mkPen(COLOR_PATH, width=2), connect="finite", antialias=True)
+        self.selected = pg.PlotCurveItem(pen=pg.mkPen(COLOR_HIGHLIGHT, width=5), connect="finite",
                                          antialias=True)
-        self.points = pg.ScatterPlotItem(size=7, brush=pg.mkBrush(POINT_COLOUR), pen=pg.mkPen("w"))
-        self.start = pg.ScatterPlotItem(size=11, symbol="t1", brush=pg.mkBrush(START_COLOUR),
+        self.points = pg.ScatterPlotItem(size=7, brush=pg.mkBrush(COLOR_AXIS), pen=pg.mkPen("w"))
+        self.start = pg.ScatterPlotItem(size=11, symbol="t1", brush=pg.mkBrush(COLOR_START),
                                         pen=pg.mkPen("w"))
-        self.trail = pg.PlotCurveItem(pen=pg.mkPen(TRAIL_COLOUR, width=2))
-        self.tcp = pg.ScatterPlotItem(size=13, symbol="o", brush=pg.mkBrush(TCP_COLOUR),
-                                      pen=pg.mkPen("#263238"))
+        self.trail = pg.PlotCurveItem(pen=pg.mkPen(COLOR_TRAIL, width=2))
+        self.tcp = pg.ScatterPlotItem(size=13, symbol="o", brush=pg.mkBrush(COLOR_TCP),
+                                      pen=pg.mkPen(COLOR_INK))
         self.labels: list[pg.TextItem] = []
         for z, item in enumerate((self.path, self.selected, self.points, self.start, self.trail, self.tcp)):
             item.setZValue(z)
@@ -86,7 +93,7 @@ class _Projection:
             self.plot.removeItem(label)
         self.labels = []
         for row, text in zip(xyz[:MAX_LABELS], texts[:MAX_LABELS], strict=False):
-            label = pg.TextItem(text, color="#37474f", anchor=(0.0, 1.0))
+            label = pg.TextItem(text, color=COLOR_INK_SOFT, anchor=(0.0, 1.0))
             label.setPos(float(row[self.h]), float(row[self.v]))
             label.setZValue(10)
             self.plot.addItem(label)
@@ -106,6 +113,7 @@ class PlanPreview(QWidget):
         self.setObjectName("PlanPreview")
         self._path: PlanPath | None = None
         self._selected: int | None = None
+        self._previewed: Plan | None = None  # the plan the view range was fitted to
         self._pending: Pose | None = None
         self._live_wanted = False
         self._trail = np.full((2 * TRAIL_LENGTH, 3), np.nan)
@@ -126,7 +134,7 @@ class PlanPreview(QWidget):
             plot.setLabel("left", f"{AXIS_NAMES[v]} (mm)")
             self.projections[key] = _Projection(plot, h, v)
             title = QLabel(self)
-            title.setStyleSheet("font-weight: bold; color: #37474f;")
+            title.setStyleSheet(f"font-weight: bold; color: {COLOR_INK_SOFT};")
             self._titles[key] = title
             cell = QVBoxLayout()
             cell.setSpacing(0)
@@ -135,7 +143,7 @@ class PlanPreview(QWidget):
             row.addLayout(cell, 1)
         self.info = QLabel(self)
         self.info.setWordWrap(True)
-        self.info.setStyleSheet("color: #37474f;")
+        self.info.setStyleSheet(f"color: {COLOR_INK_SOFT};")
         self.info.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
         self.info.setMinimumWidth(INFO_MIN_WIDTH)
         self.info.setMaximumWidth(INFO_WIDTH)
@@ -213,6 +221,39 @@ class PlanPreview(QWidget):
 
     def set_info(self, text: str) -> None:
         self.info.setText(text)
+
+    def show_plan(self, plan: Plan, ledger: PointLedger, start: Sequence[float] | None,
+                  selected: int | None) -> None:
+        """Draw ``plan`` from ``start`` with the points it uses; the view range is fitted when
+        another plan is shown, kept while the same plan is redrawn."""
+        self.set_path(plan_path(plan, ledger, start), keep_view=plan is self._previewed)
+        self._previewed = plan
+        used = [ledger.get(pid) for pid in sorted(plan.point_ids())]
+        present = [p for p in used if p is not None]
+        self.set_points(np.array([p.xyz for p in present], dtype=np.float64).reshape(-1, 3),
+                        [f"P{p.id}" for p in present])
+        self.set_start(start)
+        self.set_selected(selected)
+
+    def show_info(self, info: PlanInfo) -> None:
+        """The plan's lengths and times (worked out by :func:`app.plan.presenter.plan_info`)."""
+        loops = self.tr("endless") if info.loops == 0 else str(info.loops)
+        lines = [
+            self.tr("<b>{name}</b>: {n} segments, loops: {loops}").format(name=info.name, n=info.segments,
+                                                                         loops=loops),
+            self.tr("One loop: {length}, {time}").format(length=info.loop_length, time=info.loop_time),
+            self.tr("Total: {length}, {time}").format(length=info.total_length, time=info.total_time),
+        ]
+        if info.unknown:
+            lines.append(self.tr("Not counted (unknown length): segments {list}").format(
+                list=", ".join(str(k) for k in info.unknown)))
+        if info.selected is not None:
+            k = info.selected
+            lines.append(self.tr("Segment {k}: {length}, {time}").format(k=k.number, length=k.length,
+                                                                        time=k.time))
+        lines.append(self.tr("Start: end of the last segment (robot pose unknown)") if info.assumed_start
+                     else self.tr("Start: the robot's current pose"))
+        self.set_info("<br>".join(lines))
 
     def clear(self) -> None:
         self.set_path(None)

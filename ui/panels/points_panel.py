@@ -54,16 +54,8 @@ from app.errors import InvalidInput
 from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport
 from app.protocol.registers import TOOL_NONE
-from ui.models.points_model import (
-    COL_ID,
-    COL_NAME,
-    COL_SYNC,
-    COLUMNS,
-    EXT_COLUMNS,
-    PointFilterProxy,
-    PointsModel,
-    sync_text,
-)
+from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COLUMNS, EXT_COLUMNS, sync_text
+from ui.models.points_model import PointFilterProxy, PointsModel
 from ui.widgets_common import COLOR_ERROR, COLOR_OK, COLOR_WARN, COLOR_WARN_BG, command_status_text
 
 DEFAULT_MOVE_SPEED = 50.0  # mm/s for "move to point"

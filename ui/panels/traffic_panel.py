@@ -1,10 +1,9 @@
 """Modbus traffic inspector: every frame on the wire, decoded on demand.
 
 ``on_traffic(records)`` takes a batch of ``TrafficRecord``-like objects (``t``, ``direction``,
-``frame``, ``transport``) and inserts it with one ``beginInsertRows``. At insertion only a few
-bytes are peeked at (pairing a response with its request, spotting polls and run commands);
-the full decoding (``app.protocol.frames.decode_frame``) runs the first time a row's meaning
-is shown, filtered on or exported, and is cached, so 100 Hz traffic does not stall the GUI.
+``frame``, ``transport``) and inserts it with one ``beginInsertRows``. The table and its filter
+are :mod:`ui.models.traffic_model`: frames are decoded only when a row's meaning is shown,
+filtered on or exported, so 100 Hz traffic does not stall the GUI.
 """
 
 from __future__ import annotations
@@ -12,25 +11,17 @@ from __future__ import annotations
 import csv
 import io
 import os
-import time
-from collections import OrderedDict
-from collections.abc import Iterable, Sequence
 from typing import Any
 
 from PySide6.QtCore import (
-    QAbstractTableModel,
-    QCoreApplication,
     QEvent,
-    QModelIndex,
-    QPersistentModelIndex,
     QSignalBlocker,
-    QSortFilterProxyModel,
     Qt,
     QTimer,
     Signal,
     Slot,
 )
-from PySide6.QtGui import QBrush, QColor, QFontMetrics, QGuiApplication, QHideEvent
+from PySide6.QtGui import QFontMetrics, QGuiApplication, QHideEvent
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
@@ -44,418 +35,26 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.protocol import registers as regs
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
-from app.protocol.enums import CommandKind, RunCommand
-from app.protocol.frames import DecodedFrame, decode_frame
+from ui.models.traffic_model import (
+    COL_BYTES,
+    COL_DIRECTION,
+    COL_TIME,
+    MAX_ROWS_DEFAULT,
+    TrafficFilter,
+    TrafficModel,
+)
+from ui.palette import COLOR_NEUTRAL
 from ui.widgets_common import (
-    COLOR_ERROR,
-    COLOR_INFO,
-    COLOR_NEUTRAL,
     atomic_write_text,
     export_with_dialog,
     monospace_font,
 )
 
-MAX_ROWS_DEFAULT = 20_000
-HEX_DISPLAY_BYTES = 40  # bytes shown in the table cell; a 412.. read answer has 209
 FILTER_DEBOUNCE_MS = 200  # typing in the filter box re-filters once the user pauses
 FLUSH_INTERVAL_MS = 50  # at most 20 table updates a second while the panel is visible
-_MAX_PENDING = 256  # unanswered TCP requests remembered for pairing
-_SUMMARY_CACHE_SIZE = 4096  # distinct response contents remembered
 _BUSY_CURSOR_ROWS = 2000
-
-COL_TIME, COL_DIRECTION, COL_BYTES, COL_MEANING = range(4)
-_COLUMN_COUNT = 4
-_DISPLAY = Qt.ItemDataRole.DisplayRole.value
-_FOREGROUND = Qt.ItemDataRole.ForegroundRole.value
-_FONT = Qt.ItemDataRole.FontRole.value
-_TOOLTIP = Qt.ItemDataRole.ToolTipRole.value
-_USED_ROLES = frozenset({_DISPLAY, _FOREGROUND, _FONT, _TOOLTIP})
-
-_FC_READ = 0x03
-_FC_WRITE_SINGLE = 0x06
-_EXCEPTION_FLAG = 0x80
-_MBAP_SIZE = 7
-# Reads inside these register blocks are the monitor's polls ("hide polls").
-_POLL_BLOCKS: tuple[range, ...] = (
-    range(regs.POSE_BLOCK_START, regs.POSE_BLOCK_START + regs.POSE_BLOCK_COUNT),
-    range(regs.STATUS_BLOCK_START, regs.STATUS_BLOCK_START + regs.STATUS_BLOCK_COUNT),
-)
-
-
-def is_poll_read(address: int, count: int) -> bool:
-    """An FC03 read that lies wholly in the pose block (412..) or the status block (560..)."""
-    last = address + count - 1
-    return count > 0 and any(address in block and last in block for block in _POLL_BLOCKS)
-
-
-class TrafficRow:
-    """One captured frame plus what was learnt cheaply at insertion; decoding is cached."""
-
-    __slots__ = (
-        "_decoded",
-        "_hex",
-        "_summary",
-        "_time",
-        "bad",
-        "direction",
-        "frame",
-        "last_command",
-        "poll",
-        "request",
-        "t",
-        "transport",
-    )
-
-    def __init__(self, t: float, direction: str, frame: bytes, transport: str) -> None:
-        self.t = t
-        self.direction = direction
-        self.frame = frame
-        self.transport = transport
-        self.poll = False  # a read of the pose/status block, or its answer
-        self.bad = False  # exception response (or, once decoded, malformed)
-        self.request: TrafficRow | None = None  # for a response: the request it answers
-        self.last_command: RunCommand | None = None  # decides the GV291 table
-        self._hex: str | None = None
-        self._summary: str | None = None
-        self._time: str | None = None
-        self._decoded: DecodedFrame | None = None  # kept for requests only (they are small)
-
-    @property
-    def hex(self) -> str:
-        """All bytes, spaced uppercase hex as in the seed (not cached: cheap, and long)."""
-        return self.frame.hex(" ").upper()
-
-    @property
-    def hex_display(self) -> str:
-        """The hex cut after ``HEX_DISPLAY_BYTES`` (cached): eliding a 600-character string on
-        every repaint made the table slow. The tooltip and exports carry all bytes."""
-        if self._hex is None:
-            if len(self.frame) <= HEX_DISPLAY_BYTES:
-                self._hex = self.hex
-            else:
-                self._hex = self.frame[:HEX_DISPLAY_BYTES].hex(" ").upper() + " …"
-        return self._hex
-
-    def decode(self, word_order: WordOrder, clock_layout: DateTimeLayout) -> DecodedFrame:
-        """Full decoding (not cached for responses: use ``summary`` for the cached text)."""
-        if self._decoded is not None:
-            return self._decoded
-        request = self.request.decode(word_order, clock_layout) if self.request is not None else None
-        decoded = decode_frame(
-            self.frame,
-            transport="rtu" if self.transport == "rtu" else "tcp",
-            direction="rx" if self.direction == "rx" else "tx",
-            word_order=word_order,
-            last_command=self.last_command,
-            clock_layout=clock_layout,
-            request=request,
-        )
-        if self.direction == "tx":
-            self._decoded = decoded
-        return decoded
-
-    def summary(self, word_order: WordOrder, clock_layout: DateTimeLayout) -> str:
-        if self._summary is None:
-            decoded = self.decode(word_order, clock_layout)
-            text = decoded.summary
-            if decoded.errors:
-                text = f"{text} [{'; '.join(decoded.errors)}]"
-                self.bad = True
-            self._summary = text
-        return self._summary
-
-    @property
-    def time_display(self) -> str:
-        if self._time is None:
-            self._time = self.time_text()
-        return self._time
-
-    def time_text(self, with_date: bool = False) -> str:
-        stamp = time.localtime(self.t)
-        ms = int(self.t * 1000) % 1000
-        return time.strftime("%Y-%m-%d %H:%M:%S" if with_date else "%H:%M:%S", stamp) + f".{ms:03d}"
-
-
-def _wrap_hex(text: str, per_line: int = 16) -> str:
-    step = 3 * per_line
-    return "\n".join(text[i : i + step].rstrip() for i in range(0, len(text), step))
-
-
-class TrafficModel(QAbstractTableModel):
-    """Bounded table of frames, oldest dropped first. Columns: time, direction, bytes, meaning."""
-
-    def __init__(
-        self,
-        parent: Any = None,
-        *,
-        max_rows: int = MAX_ROWS_DEFAULT,
-        word_order: WordOrder = WordOrder.LOW_FIRST,
-        clock_layout: DateTimeLayout = DateTimeLayout.SPLIT_WORDS,
-    ) -> None:
-        super().__init__(parent)
-        if max_rows < 1:
-            raise ValueError("max_rows must be >= 1")
-        self._rows: list[TrafficRow] = []
-        self._max_rows = max_rows
-        # Dropping a chunk at a time keeps removals (and the proxy's remapping) rare.
-        self._drop_chunk = max(1, max_rows // 20)
-        self.word_order = word_order
-        self.clock_layout = clock_layout
-        self._summary_cache: dict[tuple[Any, ...], tuple[str, bool]] = {}
-        self._pending: OrderedDict[int, TrafficRow] = OrderedDict()  # TCP: transaction id -> request
-        self._last_request: TrafficRow | None = None  # RTU: half duplex, answers follow requests
-        self._last_command: RunCommand | None = None
-        self._mono = monospace_font(9.5)
-        self._tx_brush = QBrush(QColor(COLOR_INFO))
-        self._rx_brush = QBrush(QColor("#37474f"))
-        self._bad_brush = QBrush(QColor(COLOR_ERROR))
-        self._headers: tuple[str, ...] = ()
-        self._tx_text = self._rx_text = ""
-        self._set_texts()
-
-    def _set_texts(self) -> None:
-        self._headers = (
-            QCoreApplication.translate("TrafficModel", "Time"),
-            QCoreApplication.translate("TrafficModel", "Dir"),
-            QCoreApplication.translate("TrafficModel", "Bytes"),
-            QCoreApplication.translate("TrafficModel", "Meaning"),
-        )
-        self._tx_text = QCoreApplication.translate("TrafficModel", "→ Tx")
-        self._rx_text = QCoreApplication.translate("TrafficModel", "← Rx")
-
-    def retranslate(self) -> None:
-        """Headers and direction texts in the current language (the decoded meaning stays English)."""
-        self._set_texts()
-        self.headerDataChanged.emit(Qt.Orientation.Horizontal, 0, _COLUMN_COUNT - 1)
-        if self._rows:
-            self.dataChanged.emit(
-                self.index(0, COL_DIRECTION),
-                self.index(len(self._rows) - 1, COL_DIRECTION),
-                [Qt.ItemDataRole.DisplayRole],
-            )
-
-    # --- data in ----------------------------------------------------------------------
-    @property
-    def max_rows(self) -> int:
-        return self._max_rows
-
-    def append_records(self, records: Sequence[Any]) -> int:
-        """Add a batch (one insert notification); returns how many rows were added."""
-        if not records:
-            return 0
-        if len(records) > self._max_rows:
-            records = records[len(records) - self._max_rows :]
-        new_rows = [self._make_row(r) for r in records]
-        overflow = len(self._rows) + len(new_rows) - self._max_rows
-        if overflow > 0:
-            drop = min(len(self._rows), max(overflow, self._drop_chunk))
-            self.beginRemoveRows(QModelIndex(), 0, drop - 1)
-            del self._rows[:drop]
-            self.endRemoveRows()
-        first = len(self._rows)
-        self.beginInsertRows(QModelIndex(), first, first + len(new_rows) - 1)
-        self._rows.extend(new_rows)
-        self.endInsertRows()
-        return len(new_rows)
-
-    def _make_row(self, record: Any) -> TrafficRow:
-        frame = bytes(record.frame)
-        transport = "rtu" if record.transport == "rtu" else "tcp"
-        row = TrafficRow(float(record.t), "rx" if record.direction == "rx" else "tx", frame, transport)
-        offset = _MBAP_SIZE if transport == "tcp" else 1  # where the PDU starts
-        fc = frame[offset] if len(frame) > offset else None
-        if row.direction == "tx":
-            if fc == _FC_READ and len(frame) >= offset + 5:
-                address = int.from_bytes(frame[offset + 1 : offset + 3], "big")
-                count = int.from_bytes(frame[offset + 3 : offset + 5], "big")
-                row.poll = is_poll_read(address, count)
-            elif fc == _FC_WRITE_SINGLE and len(frame) >= offset + 5:
-                address = int.from_bytes(frame[offset + 1 : offset + 3], "big")
-                if address == regs.REG_RUN_COMMAND:
-                    self._note_command(int.from_bytes(frame[offset + 3 : offset + 5], "big"))
-            row.last_command = self._last_command
-            if transport == "tcp" and len(frame) >= 2:
-                tid = int.from_bytes(frame[:2], "big")
-                self._pending.pop(tid, None)
-                self._pending[tid] = row
-                while len(self._pending) > _MAX_PENDING:
-                    self._pending.popitem(last=False)
-            else:
-                self._last_request = row
-            return row
-        # A response.
-        row.last_command = self._last_command
-        row.bad = fc is None or bool(fc & _EXCEPTION_FLAG)
-        request: TrafficRow | None = None
-        if transport == "tcp":
-            if len(frame) >= 2:
-                request = self._pending.pop(int.from_bytes(frame[:2], "big"), None)
-        else:
-            request, self._last_request = self._last_request, None
-        if request is not None and len(request.frame) > offset:
-            req_fc = request.frame[offset]
-            if fc is not None and (fc & ~_EXCEPTION_FLAG) == req_fc:
-                row.request = request
-                row.poll = request.poll and not row.bad
-        return row
-
-    def _note_command(self, value: int) -> None:
-        try:
-            command = RunCommand(value)
-        except ValueError:
-            return
-        if CommandKind.of(command) is not None:
-            self._last_command = command
-
-    def clear(self) -> None:
-        self.beginResetModel()
-        self._rows.clear()
-        self._pending.clear()
-        self._last_request = None
-        self.endResetModel()
-
-    def row_at(self, row: int) -> TrafficRow:
-        return self._rows[row]
-
-    def rows(self) -> Iterable[TrafficRow]:
-        return iter(self._rows)
-
-    def summary(self, row: TrafficRow) -> str:
-        """The decoded meaning (cached in the row). Identical answers (a robot standing still
-        answers every poll with the same bytes) are decoded once, via a content-keyed cache."""
-        if row._summary is not None:
-            return row._summary
-        request = row.request
-        if row.direction != "rx" or request is None:
-            return row.summary(self.word_order, self.clock_layout)
-        skip = 2 if row.transport == "tcp" else 0  # the transaction id does not change the meaning
-        key = (row.transport, row.frame[skip:], request.frame[skip:], row.last_command)
-        cached = self._summary_cache.get(key)
-        if cached is None:
-            cached = (row.summary(self.word_order, self.clock_layout), row.bad)
-            if len(self._summary_cache) >= _SUMMARY_CACHE_SIZE:
-                self._summary_cache.clear()
-            self._summary_cache[key] = cached
-        row._summary, row.bad = cached[0], row.bad or cached[1]
-        return row._summary
-
-    def set_word_order(self, order: WordOrder) -> None:
-        """Word order of float32 values (applies to rows decoded from now on)."""
-        self.word_order = order
-        self._summary_cache.clear()
-
-    def set_clock_layout(self, layout: DateTimeLayout) -> None:
-        """Layout of the clock registers (applies to rows decoded from now on)."""
-        self.clock_layout = layout
-        self._summary_cache.clear()
-
-    def direction_text(self, row: TrafficRow) -> str:
-        return self._tx_text if row.direction == "tx" else self._rx_text
-
-    # --- QAbstractTableModel ----------------------------------------------------------
-    def rowCount(self, parent: QModelIndex | QPersistentModelIndex = QModelIndex()) -> int:  # noqa: B008
-        return 0 if parent.isValid() else len(self._rows)
-
-    def columnCount(self, parent: QModelIndex | QPersistentModelIndex = QModelIndex()) -> int:  # noqa: B008
-        return 0 if parent.isValid() else _COLUMN_COUNT
-
-    def data(self, index: QModelIndex | QPersistentModelIndex, role: int = _DISPLAY) -> Any:
-        # Called ~500 times per repaint: cheap role test first, plain int compares, cached texts.
-        if role not in _USED_ROLES or not index.isValid():
-            return None
-        r, column = index.row(), index.column()
-        if not (0 <= r < len(self._rows) and 0 <= column < _COLUMN_COUNT):
-            return None
-        row = self._rows[r]
-        if role == _DISPLAY:
-            if column == COL_MEANING:
-                return row._summary if row._summary is not None else self.summary(row)
-            if column == COL_BYTES:
-                return row.hex_display
-            if column == COL_TIME:
-                return row.time_display
-            return self._tx_text if row.direction == "tx" else self._rx_text
-        if role == _FOREGROUND:
-            if row.bad:  # exception response, or found malformed when decoded
-                return self._bad_brush
-            if column == COL_DIRECTION:
-                return self._tx_brush if row.direction == "tx" else self._rx_brush
-            return None
-        if role == _FONT:
-            return self._mono if column in (COL_TIME, COL_BYTES) else None
-        # Tooltip: rare, may decode again.
-        if column == COL_BYTES:
-            size = QCoreApplication.translate("TrafficModel", "{n} bytes").format(n=len(row.frame))
-            return f"{size}\n{_wrap_hex(row.hex)}"
-        if column == COL_MEANING:
-            decoded = row.decode(self.word_order, self.clock_layout)
-            lines = [item.label for item in decoded.items[:40]]
-            if len(decoded.items) > 40:
-                lines.append("…")
-            lines.extend(decoded.errors)
-            return "\n".join(lines) or None
-        return None
-
-    def headerData(
-        self, section: int, orientation: Qt.Orientation, role: int = Qt.ItemDataRole.DisplayRole
-    ) -> Any:
-        horizontal = orientation == Qt.Orientation.Horizontal
-        if horizontal and role == Qt.ItemDataRole.DisplayRole and 0 <= section < _COLUMN_COUNT:
-            return self._headers[section]
-        return None
-
-
-class TrafficFilter(QSortFilterProxyModel):
-    """Text filter (bytes or meaning, case-insensitive) and "hide polls"."""
-
-    def __init__(self, parent: Any = None) -> None:
-        super().__init__(parent)
-        self._text = ""
-        self._hide_polls = False
-
-    def traffic_model(self) -> TrafficModel:
-        model = self.sourceModel()
-        assert isinstance(model, TrafficModel)
-        return model
-
-    def text(self) -> str:
-        return self._text
-
-    def hide_polls(self) -> bool:
-        return self._hide_polls
-
-    def set_text(self, text: str) -> None:
-        text = text.strip().lower()
-        if text != self._text:
-            self.beginFilterChange()
-            self._text = text
-            self.endFilterChange(QSortFilterProxyModel.Direction.Rows)
-
-    def set_hide_polls(self, hide: bool) -> None:
-        hide = bool(hide)
-        if hide != self._hide_polls:
-            self.beginFilterChange()
-            self._hide_polls = hide
-            self.endFilterChange(QSortFilterProxyModel.Direction.Rows)
-
-    def accepts(self, model: TrafficModel, row: TrafficRow) -> bool:
-        if self._hide_polls and row.poll:
-            return False
-        if not self._text:
-            return True
-        text = self._text
-        return (
-            text in row.hex.lower()
-            or text in model.summary(row).lower()
-            or text in model.direction_text(row).lower()
-        )
-
-    def filterAcceptsRow(self, source_row: int, source_parent: QModelIndex | QPersistentModelIndex) -> bool:
-        model = self.traffic_model()
-        return self.accepts(model, model.row_at(source_row))
 
 
 class TrafficPanel(QWidget):

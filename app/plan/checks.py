@@ -1,0 +1,256 @@
+"""Checks of a plan before it runs: missing or unsent points, arcs that define no circle,
+speeds, tools, and an arc resumed past its middle point.
+
+Messages are plain English and already name the segment (counted from 1).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from app.errors import InvalidInput
+from app.plan.geometry import PointLike, arc_geometry, xyz_of
+from app.plan.segments import FloatArray, Plan
+from app.points.ledger import (
+    PointLedger,
+    SyncState,
+    tool_text,
+)
+
+
+@dataclass(frozen=True)
+class PlanLimits:
+    """Settings the checks use."""
+
+    max_speed: float = 1000.0  # mm/s
+    collinear_tolerance: float = 0.1  # mm: an arc's middle point must be this far off the chord line
+    min_point_distance: float = 0.1  # mm: an arc's three points must be this far apart
+    zero_length: float = 0.01  # mm: a shorter line is reported (warning)
+
+    def __post_init__(self) -> None:
+        for name in ("max_speed", "collinear_tolerance", "min_point_distance", "zero_length"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise InvalidInput(f"{name} must be a finite number >= 0")
+        if self.max_speed <= 0:
+            raise InvalidInput("max_speed must be > 0")
+
+
+class IssueKind(enum.Enum):
+    ERROR = "error"  # the plan cannot run as it is
+    NEEDS_UPLOAD = "needs-upload"  # a point must be (re)created on the controller first
+    WARNING = "warning"  # it can run, but look
+
+
+# An arc resumed from a pose this far from its planned start is checked for a detour.
+ARC_RESUME_TOLERANCE_MM = 1.0
+ARC_RESUME_TOLERANCE_DEG = 2.0
+
+
+class IssueCode(enum.Enum):
+    EMPTY_PLAN = "empty-plan"
+    MISSING_POINT = "missing-point"
+    NEEDS_UPLOAD = "needs-upload"
+    ARC_NO_MIDDLE = "arc-no-middle"
+    ARC_POINTS_COINCIDE = "arc-points-coincide"
+    ARC_COLLINEAR = "arc-collinear"
+    ARC_START_UNKNOWN = "arc-start-unknown"
+    BAD_SPEED = "bad-speed"
+    ZERO_LENGTH = "zero-length"
+    TOOL_MISMATCH = "tool-mismatch"
+    BAD_START = "bad-start"
+    ARC_RESUME_PAST_MIDDLE = "arc-resume-past-middle"
+
+
+@dataclass(frozen=True)
+class PlanIssue:
+    """One problem of a plan. ``segment`` is the 0-based index (None: the whole plan)."""
+
+    segment: int | None
+    kind: IssueKind
+    code: IssueCode
+    message: str  # plain English, already says which segment
+    point_id: int | None = None
+
+    @property
+    def is_error(self) -> bool:
+        return self.kind is IssueKind.ERROR
+
+    def __str__(self) -> str:
+        return f"{self.kind.value}: {self.message}"
+
+
+def has_errors(issues: Sequence[PlanIssue]) -> bool:
+    return any(i.kind is IssueKind.ERROR for i in issues)
+
+
+def ids_needing_upload(issues: Sequence[PlanIssue]) -> list[int]:
+    return sorted({i.point_id for i in issues if i.kind is IssueKind.NEEDS_UPLOAD and i.point_id is not None})
+
+
+
+def _seg_name(index: int) -> str:
+    return f"segment {index + 1}"
+
+
+def _arc_issue(
+    s: FloatArray, m: FloatArray, e: FloatArray, limits: PlanLimits
+) -> tuple[IssueCode, str] | None:
+    """Why S, M, E define no usable circle, or None."""
+    d_sm, d_me, d_se = (float(np.linalg.norm(p - q)) for p, q in ((m, s), (e, m), (e, s)))
+    tol = limits.min_point_distance
+    if min(d_sm, d_me, d_se) < tol:
+        which = "start and middle" if d_sm < tol else ("middle and end" if d_me < tol else "start and end")
+        return IssueCode.ARC_POINTS_COINCIDE, (
+            f"the arc's {which} points coincide (closer than {tol:g} mm): three distinct points are needed"
+        )
+    # distance of M from the line S-E
+    off = float(np.linalg.norm(np.cross(m - s, e - s))) / d_se
+    if off < limits.collinear_tolerance:
+        return IssueCode.ARC_COLLINEAR, (
+            f"the arc's three points are (nearly) on one line: the middle point is {off:.3g} mm off the "
+            f"start-end line (at least {limits.collinear_tolerance:g} mm needed); use a line instead"
+        )
+    return None
+
+
+def check_plan(
+    plan: Plan,
+    ledger: PointLedger,
+    limits: PlanLimits | None = None,
+    current_pose: PointLike | None = None,
+    *,
+    start_index: int = 0,
+    loops: int | None = None,
+) -> list[PlanIssue]:
+    """Everything to fix (or know) before running ``plan`` from segment ``start_index``.
+
+    ``current_pose`` is where the robot is now: the start of segment ``start_index``.
+    Without it, an arc starting there is reported as unchecked (warning). With ``loops``
+    other than 1, the first segment is also checked from the end of the last one.
+    Issues come sorted by segment; "needs upload" is reported once per point.
+    """
+    limits = limits or PlanLimits()
+    loops = plan.loops if loops is None else loops
+    issues: list[PlanIssue] = []
+    n = len(plan.segments)
+    if n == 0:
+        return [PlanIssue(None, IssueKind.ERROR, IssueCode.EMPTY_PLAN, f"plan '{plan.name}' has no segments")]
+    if not 0 <= start_index < n:
+        return [PlanIssue(None, IssueKind.ERROR, IssueCode.BAD_START,
+                          f"cannot start at segment {start_index + 1}: the plan has {n} segments")]
+    ends: list[FloatArray | None] = []
+    upload_reported: set[int] = set()
+    for i, seg in enumerate(plan.segments):
+        name = _seg_name(i)
+        end = ledger.get(seg.end_id)
+        via = ledger.get(seg.via_id) if seg.via_id is not None else None
+        ends.append(None if end is None else xyz_of(end))
+        if not 0 < seg.speed <= limits.max_speed:
+            issues.append(PlanIssue(i, IssueKind.ERROR, IssueCode.BAD_SPEED,
+                                    f"{name}: speed {seg.speed:g} mm/s is not in "
+                                    f"(0, {limits.max_speed:g}] mm/s"))
+        if seg.is_arc and seg.via_id is None:
+            issues.append(PlanIssue(i, IssueKind.ERROR, IssueCode.ARC_NO_MIDDLE,
+                                    f"{name}: the arc has no middle point"))
+        for role, pid, point in (("middle", seg.via_id, via), ("end", seg.end_id, end)):
+            if pid is None:
+                continue
+            if point is None:
+                issues.append(PlanIssue(i, IssueKind.ERROR, IssueCode.MISSING_POINT,
+                                        f"{name}: {role} point P{pid} does not exist", pid))
+                continue
+            if point.needs_upload and pid not in upload_reported:
+                upload_reported.add(pid)
+                why = point.sync.text + (f": {point.sync_error}" if point.sync is SyncState.FAILED else "")
+                issues.append(PlanIssue(i, IssueKind.NEEDS_UPLOAD, IssueCode.NEEDS_UPLOAD,
+                                        f"{name}: {point.label} is not on the controller ({why}); upload it",
+                                        pid))
+            if point.tool != seg.tool:
+                issues.append(PlanIssue(i, IssueKind.WARNING, IssueCode.TOOL_MISMATCH,
+                                        f"{name}: {point.label} was taught with {tool_text(point.tool)}, "
+                                        f"the segment moves with {tool_text(seg.tool)}", pid))
+    # Geometry, from where each segment starts when it runs: segment start_index from the
+    # current pose, the others from the previous end; with more loops, segment 0 also from
+    # the last end, and the segments before start_index run on later loops.
+    start_pose = None if current_pose is None else xyz_of(current_pose)
+    more_loops = loops != 1
+    for i, seg in enumerate(plan.segments):
+        starts: list[tuple[FloatArray | None, str]] = []
+        if i == start_index:
+            starts.append((start_pose, "from the current pose"))
+        if i > 0 and (i > start_index or more_loops):
+            later = "" if i > start_index else f"on loops after the first, starting at the end of segment {i}"
+            starts.append((ends[i - 1], later))
+        if i == 0 and more_loops:
+            starts.append((ends[n - 1], f"on loops after the first, starting at the end of segment {n}"))
+        end_xyz = ends[i]
+        via_pt = ledger.get(seg.via_id) if seg.via_id is not None else None
+        for start, context in starts:
+            suffix = f" ({context})" if context else ""
+            if seg.is_arc:
+                if via_pt is None or end_xyz is None:
+                    continue
+                if start is None:
+                    if i == start_index and current_pose is None:
+                        issues.append(PlanIssue(i, IssueKind.WARNING, IssueCode.ARC_START_UNKNOWN,
+                                                f"{_seg_name(i)}: the arc starts at the robot's current "
+                                                "pose, which is not known: its shape is not checked"))
+                    continue
+                problem = _arc_issue(start, xyz_of(via_pt), end_xyz, limits)
+                if problem is not None:
+                    issues.append(PlanIssue(i, IssueKind.ERROR, problem[0],
+                                            f"{_seg_name(i)}: {problem[1]}{suffix}"))
+                elif i == start_index and i > 0 and (planned_start := ends[i - 1]) is not None:
+                    detour = _arc_detour(start, planned_start, xyz_of(via_pt), end_xyz)
+                    if detour is not None:
+                        issues.append(PlanIssue(i, detour[0], IssueCode.ARC_RESUME_PAST_MIDDLE,
+                                                f"{_seg_name(i)}: {detour[1]}"))
+            elif start is not None and end_xyz is not None:
+                length = float(np.linalg.norm(end_xyz - start))
+                if length < limits.zero_length:
+                    issues.append(PlanIssue(i, IssueKind.WARNING, IssueCode.ZERO_LENGTH,
+                                            f"{_seg_name(i)}: the line goes nowhere "
+                                            f"(start and end {length:.3g} mm apart){suffix}"))
+    order = {IssueKind.ERROR: 0, IssueKind.NEEDS_UPLOAD: 1, IssueKind.WARNING: 2}
+    issues.sort(key=lambda it: (-1 if it.segment is None else it.segment, order[it.kind]))
+    return issues
+
+
+def _arc_detour(start: FloatArray, planned_start: FloatArray, via: FloatArray,
+                end: FloatArray) -> tuple[IssueKind, str] | None:
+    """Why an arc sent from ``start`` would not follow the planned arc, or None.
+
+    An arc interrupted past its middle point and sent again from where the arm stopped goes
+    through the middle point again: the circle through (here, M, E) runs almost all the way
+    round. That is an error when the arm stands on the planned arc past M; from elsewhere a
+    sweep clearly larger than planned is a warning.
+    """
+    if float(np.linalg.norm(start - planned_start)) < ARC_RESUME_TOLERANCE_MM:
+        return None
+    planned = arc_geometry(planned_start, via, end)
+    now = arc_geometry(start, via, end)
+    sweep_now, sweep_planned = float(now.sweep[0]), float(planned.sweep[0])
+    if not (math.isfinite(sweep_now) and math.isfinite(sweep_planned)):
+        return None
+    rel = start - planned.centre[0]
+    off_plane = abs(float(np.dot(rel, planned.normal[0])))
+    in_plane = rel - np.dot(rel, planned.normal[0]) * planned.normal[0]
+    off_circle = abs(float(np.linalg.norm(in_plane)) - float(planned.radius[0]))
+    at = math.atan2(float(np.dot(rel, planned.v[0])), float(np.dot(rel, planned.u[0]))) % (2.0 * math.pi)
+    on_arc = max(off_plane, off_circle) < ARC_RESUME_TOLERANCE_MM
+    past_middle = on_arc and float(planned.via_angle[0]) < at < sweep_planned
+    larger = sweep_now > sweep_planned + math.radians(ARC_RESUME_TOLERANCE_DEG)
+    if not (past_middle or larger):
+        return None
+    swing = (f"sent from here the arc would swing {math.degrees(sweep_now):.0f}° round through the "
+             f"middle point (planned {math.degrees(sweep_planned):.0f}°)")
+    if past_middle:
+        return IssueKind.ERROR, (f"the arm stopped past the arc's middle point: {swing}; move to the "
+                                 "end point with a line, or run from the segment before")
+    return IssueKind.WARNING, f"{swing}; check the preview before running from here"

@@ -1,0 +1,31 @@
+"""The Modbus exception codes in words: one table for the frame decoder and the client.
+
+The codes are the standard's (Modbus Application Protocol v1.1b3, section 7); the controller
+answers 0x02 / 0x03 / 0x04 / 0x06 in practice (PROTOCOL.md), the rest are here so that a
+gateway or another device on the line is named too.
+"""
+
+from __future__ import annotations
+
+from typing import Final
+
+MODBUS_EXCEPTION_TEXT: Final[dict[int, str]] = {
+    0x01: "illegal function",
+    0x02: "illegal data address",
+    0x03: "illegal data value",
+    0x04: "server device failure",
+    0x05: "acknowledge",
+    0x06: "server device busy",
+    0x07: "negative acknowledge",
+    0x08: "memory parity error",
+    0x0A: "gateway path unavailable",
+    0x0B: "gateway target device failed to respond",
+}
+
+
+def exception_text(code: int, unknown: str = "unknown exception") -> str:
+    """The standard's name of exception ``code``; ``unknown`` for a code it does not define."""
+    return MODBUS_EXCEPTION_TEXT.get(code, unknown)
+
+
+__all__ = ["MODBUS_EXCEPTION_TEXT", "exception_text"]

@@ -1,0 +1,341 @@
+"""The planner's parts that only draw: the plan list, the segment table with its editors,
+the run box (buttons, progress) and the checks bar (summary, Upload now, Check). What they
+show is worked out by :mod:`app.plan.presenter`; the panel (``planner_panel.py``) wires them."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+from PySide6.QtCore import QAbstractItemModel, QModelIndex, QPersistentModelIndex, Qt
+from PySide6.QtGui import QAction
+from PySide6.QtWidgets import (
+    QAbstractItemView,
+    QComboBox,
+    QGroupBox,
+    QHBoxLayout,
+    QHeaderView,
+    QLabel,
+    QProgressBar,
+    QPushButton,
+    QSizePolicy,
+    QSplitter,
+    QStyledItemDelegate,
+    QStyleOptionViewItem,
+    QTableView,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.plan.presenter import CheckSummary, Level, progress_bar
+from app.plan.runner import RunEvent, RunProgress
+from app.plan.segments import SegmentKind
+from ui.models.plan_columns import (
+    COL_END,
+    COL_IGNORE,
+    COL_INDEX,
+    COL_KIND,
+    COL_LENGTH,
+    COL_ORIENTATION,
+    COL_SPEED,
+    COL_TOOL,
+    COL_VIA,
+    PLAN_COL_NAME,
+    kind_text,
+    orientation_text,
+)
+from ui.models.plan_model import PlanListModel
+from ui.models.points_model import PointsModel
+from ui.models.segment_model import SegmentTableModel
+from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_OK, COLOR_WARN, COLOR_WARN_TEXT
+
+ModelIndex = QModelIndex | QPersistentModelIndex
+
+#: Colour of a summary line by level (the status line uses the darker warning text).
+SUMMARY_COLOURS: dict[Level, str] = {
+    Level.OK: COLOR_OK, Level.INFO: COLOR_INFO, Level.WARN: COLOR_WARN, Level.ERROR: COLOR_ERROR,
+}
+STATUS_COLOURS: dict[Level, str] = {**SUMMARY_COLOURS, Level.WARN: COLOR_WARN_TEXT, Level.INFO: COLOR_OK}
+
+
+def action_button(action: QAction, *, bold: bool = False) -> QToolButton:
+    """A text button for ``action`` that takes the row's width."""
+    button = QToolButton()
+    button.setDefaultAction(action)
+    button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
+    button.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
+    button.setMinimumHeight(28)
+    if bold:
+        font = button.font()
+        font.setBold(True)
+        button.setFont(font)
+    return button
+
+
+class ChoiceDelegate(QStyledItemDelegate):
+    """A combo box of fixed choices: ``choices()`` gives ``(value, text)`` pairs."""
+
+    def __init__(self, choices: Callable[[], Sequence[tuple[str, str]]],
+                 parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self._choices = choices
+
+    def createEditor(self, parent: QWidget, option: QStyleOptionViewItem, index: ModelIndex) -> QWidget:
+        combo = QComboBox(parent)
+        for value, text in self._choices():
+            combo.addItem(text, value)
+        return combo
+
+    def setEditorData(self, editor: QWidget, index: ModelIndex) -> None:
+        assert isinstance(editor, QComboBox)
+        found = editor.findData(index.data(Qt.ItemDataRole.EditRole))
+        editor.setCurrentIndex(max(found, 0))
+
+    def setModelData(self, editor: QWidget, model: QAbstractItemModel, index: ModelIndex) -> None:
+        assert isinstance(editor, QComboBox)
+        model.setData(index, editor.currentData(), Qt.ItemDataRole.EditRole)
+
+
+class PointRefDelegate(QStyledItemDelegate):
+    """An editable combo box of the ledger's points (``P5  name``); typing an id works too."""
+
+    def __init__(self, points: PointsModel, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self._points = points
+
+    def createEditor(self, parent: QWidget, option: QStyleOptionViewItem, index: ModelIndex) -> QWidget:
+        combo = QComboBox(parent)
+        combo.setEditable(True)
+        combo.setInsertPolicy(QComboBox.InsertPolicy.NoInsert)
+        for point in self._points.ledger:
+            combo.addItem(f"P{point.id}  {point.name}".rstrip(), str(point.id))
+        return combo
+
+    def setEditorData(self, editor: QWidget, index: ModelIndex) -> None:
+        assert isinstance(editor, QComboBox)
+        value = str(index.data(Qt.ItemDataRole.EditRole) or "")
+        found = editor.findData(value)
+        if found >= 0:
+            editor.setCurrentIndex(found)
+        else:
+            editor.setEditText(value)
+
+    def setModelData(self, editor: QWidget, model: QAbstractItemModel, index: ModelIndex) -> None:
+        assert isinstance(editor, QComboBox)
+        text = editor.currentText()
+        found = editor.findText(text)
+        model.setData(index, editor.itemData(found) if found >= 0 else text, Qt.ItemDataRole.EditRole)
+
+
+class PlanRunBox(QGroupBox):
+    """Run, Run from here, Step / Pause, Resume, Stop / Resume from k, and the run's progress."""
+
+    def __init__(self, run: QAction, run_from: QAction, step: QAction, pause: QAction, resume: QAction,
+                 stop: QAction, resume_from: QAction, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        row1 = QHBoxLayout()
+        row1.addWidget(action_button(run, bold=True))
+        row1.addWidget(action_button(run_from))
+        row1.addWidget(action_button(step))
+        row2 = QHBoxLayout()
+        row2.addWidget(action_button(pause))
+        row2.addWidget(action_button(resume))
+        stop_button = action_button(stop, bold=True)
+        stop_button.setStyleSheet(f"QToolButton:enabled {{ color: {COLOR_ERROR}; }}")
+        row2.addWidget(stop_button)
+        self.resume_from_button = action_button(resume_from)
+        self.run_label = QLabel(self)
+        self.run_label.setWordWrap(True)
+        self.run_progress = QProgressBar(self)
+        self.run_progress.setTextVisible(False)
+        self.run_progress.setMaximumHeight(10)
+        layout = QVBoxLayout(self)
+        layout.addLayout(row1)
+        layout.addLayout(row2)
+        layout.addWidget(self.resume_from_button)
+        layout.addWidget(self.run_progress)
+        layout.addWidget(self.run_label)
+
+    def retranslate(self) -> None:
+        self.setTitle(self.tr("Run"))
+
+    def show_progress(self, progress: RunProgress) -> None:
+        loops = self.tr("endless") if progress.loops == 0 else str(progress.loops)
+        self.run_label.setText(self.tr("Segment {k} of {n}, loop {i} of {m}").format(
+            k=progress.index + 1, n=progress.count, i=progress.loop, m=loops))
+        bar = progress_bar(progress.index, progress.count, progress.loop, progress.loops,
+                           progress.event is RunEvent.SEGMENT_DONE)
+        if bar is None:
+            self.run_progress.setRange(0, 0)  # endless: a busy bar
+        else:
+            done, total = bar
+            self.run_progress.setRange(0, total)
+            self.run_progress.setValue(done)
+
+    def show_finished(self, segments_done: int) -> None:
+        self.run_progress.setRange(0, 1)
+        self.run_progress.setValue(1)
+        self.run_label.setText(self.tr("Finished: {n} segments run").format(n=segments_done))
+
+    def show_ended(self, text: str) -> None:
+        self.run_label.setText(text)
+
+
+class PlanChecksBar(QWidget):
+    """The checks in one line under the segment table, with Upload now and Check."""
+
+    def __init__(self, upload: Callable[[], None], check: Callable[[], None],
+                 parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.summary = QLabel(self)
+        self.summary.setWordWrap(True)
+        self.summary.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self.upload_button = QPushButton(self)
+        self.upload_button.clicked.connect(upload)
+        self.check_button = QPushButton(self)
+        self.check_button.clicked.connect(check)
+        layout = QHBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self.summary, 1)
+        layout.addWidget(self.upload_button)
+        layout.addWidget(self.check_button)
+
+    def retranslate(self) -> None:
+        self.upload_button.setText(self.tr("Upload now"))
+        self.check_button.setText(self.tr("Check"))
+
+    def show_checks(self, checks: CheckSummary | None, can_upload: bool) -> str:
+        """Show the summary (None: no plan); returns the text shown."""
+        if checks is None:
+            text, colour = "", ""
+        else:
+            text = self._words(checks, can_upload)
+            colour = SUMMARY_COLOURS[checks.level]
+            if checks.whole_plan:
+                text += "\n" + "\n".join(checks.whole_plan)
+        self.summary.setText(text)
+        self.summary.setStyleSheet(f"color: {colour};" if colour else "")
+        self.summary.setToolTip(checks.details if checks is not None else "")
+        self.upload_button.setVisible(bool(checks and checks.uploads) and can_upload)
+        return text
+
+    def _words(self, checks: CheckSummary, can_upload: bool) -> str:
+        if checks.passed:
+            return self.tr("Checks passed: ready to run")
+        parts: list[str] = []
+        if checks.errors:
+            parts.append(self.tr("%n error(s)", "", checks.errors))
+        if checks.uploads:
+            parts.append(self.tr("%n point(s) need upload", "", len(checks.uploads)))
+        if checks.warnings:
+            parts.append(self.tr("%n warning(s)", "", checks.warnings))
+        text = ", ".join(parts)
+        if checks.uploads and can_upload:
+            text += " — " + self.tr("Upload now?")
+        if checks.first_row_error:
+            text += "\n" + checks.first_row_error
+        return text
+
+
+class PlanListBox(QGroupBox):
+    """The project's plans (name, loops, segments) and the plan buttons below them."""
+
+    def __init__(self, plans: PlanListModel, actions: Sequence[QAction],
+                 parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.plan_view = QTableView(self)
+        view = self.plan_view
+        view.setModel(plans)
+        view.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
+        view.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
+        view.verticalHeader().setVisible(False)
+        view.verticalHeader().setDefaultSectionSize(24)
+        header = view.horizontalHeader()
+        header.setSectionResizeMode(PLAN_COL_NAME, QHeaderView.ResizeMode.Stretch)
+        header.setSectionResizeMode(1, QHeaderView.ResizeMode.ResizeToContents)
+        header.setSectionResizeMode(2, QHeaderView.ResizeMode.ResizeToContents)
+        buttons = QHBoxLayout()
+        for action in actions:
+            buttons.addWidget(action_button(action))
+        buttons.setSpacing(3)
+        layout = QVBoxLayout(self)
+        layout.addWidget(view, 1)
+        layout.addLayout(buttons)
+
+    def retranslate(self) -> None:
+        self.setTitle(self.tr("Plans"))
+
+
+SEGMENT_COLUMN_WIDTHS: dict[int, int] = {
+    COL_INDEX: 50, COL_KIND: 50, COL_VIA: 104, COL_END: 104, COL_SPEED: 78, COL_ORIENTATION: 78,
+    COL_IGNORE: 84, COL_TOOL: 60, COL_LENGTH: 76,
+}
+
+
+class SegmentEditorBox(QGroupBox):
+    """The segment table (combo-box editors for kind, orientation and points), its buttons
+    above and the checks bar below."""
+
+    def __init__(self, segments: SegmentTableModel, points: PointsModel, actions: Sequence[QAction],
+                 checks_bar: PlanChecksBar, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.segment_view = QTableView(self)
+        view = self.segment_view
+        view.setModel(segments)
+        view.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
+        view.setSelectionMode(QAbstractItemView.SelectionMode.ExtendedSelection)
+        view.setEditTriggers(QAbstractItemView.EditTrigger.DoubleClicked
+                             | QAbstractItemView.EditTrigger.EditKeyPressed
+                             | QAbstractItemView.EditTrigger.SelectedClicked)
+        view.verticalHeader().setDefaultSectionSize(24)
+        view.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Fixed)
+        view.setWordWrap(False)
+        view.setAlternatingRowColors(True)
+        self._kind_delegate = ChoiceDelegate(lambda: [(k.value, kind_text(k)) for k in SegmentKind], view)
+        self._orientation_delegate = ChoiceDelegate(
+            lambda: [("changes", orientation_text(True)), ("kept", orientation_text(False))], view)
+        self._point_delegate = PointRefDelegate(points, view)
+        view.setItemDelegateForColumn(COL_KIND, self._kind_delegate)
+        view.setItemDelegateForColumn(COL_ORIENTATION, self._orientation_delegate)
+        view.setItemDelegateForColumn(COL_VIA, self._point_delegate)
+        view.setItemDelegateForColumn(COL_END, self._point_delegate)
+        view.horizontalHeader().setStretchLastSection(True)
+        for column in range(segments.columnCount()):
+            view.setColumnWidth(column, SEGMENT_COLUMN_WIDTHS.get(column, 60))
+        buttons = QHBoxLayout()
+        for action in actions:
+            buttons.addWidget(action_button(action))
+        buttons.addStretch(1)
+        layout = QVBoxLayout(self)
+        layout.addLayout(buttons)
+        layout.addWidget(view, 1)
+        layout.addWidget(checks_bar)
+
+    def retranslate(self) -> None:
+        self.setTitle(self.tr("Segments"))
+
+
+def planner_splitters(parent: QWidget, plans_box: QWidget, run_box: QWidget, segments_box: QWidget,
+                      preview_box: QWidget) -> tuple[QSplitter, QSplitter]:
+    """Plans (over the run box) and segments side by side on top, the preview across the full
+    width below: the three projections stay readable on a 1280 px screen. Returns (top, outer)."""
+    left = QWidget(parent)
+    left_layout = QVBoxLayout(left)
+    left_layout.setContentsMargins(0, 0, 0, 0)
+    left_layout.addWidget(plans_box, 1)
+    left_layout.addWidget(run_box)
+    top = QSplitter(Qt.Orientation.Horizontal, parent)
+    top.addWidget(left)
+    top.addWidget(segments_box)
+    top.setStretchFactor(0, 0)
+    top.setStretchFactor(1, 1)
+    top.setSizes([230, 1050])
+    top.setChildrenCollapsible(False)
+    outer = QSplitter(Qt.Orientation.Vertical, parent)
+    outer.addWidget(top)
+    outer.addWidget(preview_box)
+    outer.setStretchFactor(0, 1)
+    outer.setStretchFactor(1, 1)
+    outer.setSizes([340, 400])
+    outer.setChildrenCollapsible(False)
+    return top, outer
