@@ -32,7 +32,6 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QHeaderView,
     QLabel,
-    QMessageBox,
     QProgressBar,
     QPushButton,
     QSizePolicy,
@@ -61,6 +60,8 @@ from app.plan.segments import (
 )
 from app.points.ledger import UploadReport
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.point_sync import PointSyncController
+from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.models.plan_model import (
     COL_END,
     COL_IGNORE,
@@ -79,11 +80,9 @@ from ui.models.plan_model import (
 )
 from ui.models.points_model import PointsModel
 from ui.panels.plan_preview import PlanPreview
-from ui.panels.points_panel import PointSyncController
 from ui.widgets_common import COLOR_ERROR, COLOR_INFO, COLOR_OK, COLOR_WARN
 
 ModelIndex = QModelIndex | QPersistentModelIndex
-ConfirmCallable = Callable[[str, str], bool]
 
 
 # --------------------------------------------------------------------------------------------
@@ -166,14 +165,14 @@ class PlannerPanel(QWidget):
     def __init__(self, plans: PlanListModel, points: PointsModel,
                  run_controller: PlanRunController | None = None,
                  point_sync: PointSyncController | None = None, parent: QWidget | None = None, *,
-                 confirm: ConfirmCallable | None = None, limits: PlanLimits | None = None) -> None:
+                 confirm: ConfirmFn | None = None, limits: PlanLimits | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("PlannerPanel")
         self._plans = plans
         self._points = points
         self._runner = run_controller or PlanRunController(parent=self)
         self._sync = point_sync
-        self._confirm = confirm or self._ask
+        self._confirm = confirm or ask_confirmation(self)
         self.limits = limits or PlanLimits()
         self._issues: list[PlanIssue] = []
         self._pending_run: tuple[int, bool, bool] | None = None  # (start, single, resume) after an upload
@@ -482,7 +481,7 @@ class PlannerPanel(QWidget):
             selection.setCurrentIndex(self.segments.index(rows[0], 0), selection.SelectionFlag.NoUpdate)
             self.segment_view.scrollTo(self.segments.index(rows[0], 0))
 
-    def set_confirm(self, confirm: ConfirmCallable) -> None:
+    def set_confirm(self, confirm: ConfirmFn) -> None:
         """Replace the operator's yes/no question (tests answer without a dialog)."""
         self._confirm = confirm
 
@@ -932,12 +931,6 @@ class PlannerPanel(QWidget):
             start, assumed = self._start_of(plan)
             self._set_info(plan, estimate_plan(plan, self._points.ledger, start), assumed)
         self._update_actions()
-
-    def _ask(self, title: str, question: str) -> bool:
-        answer = QMessageBox.question(self, title, question,
-                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.Cancel,
-                                      QMessageBox.StandardButton.Cancel)
-        return answer == QMessageBox.StandardButton.Yes
 
     @Slot()
     def _update_actions(self, *_args: Any) -> None:
