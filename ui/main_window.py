@@ -20,20 +20,15 @@ window and the link), then the window state is saved and the link shut down.
 
 from __future__ import annotations
 
-import functools
 import os
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
 from PySide6.QtGui import (
-    QAction,
-    QActionGroup,
     QCloseEvent,
     QGuiApplication,
     QHideEvent,
-    QKeySequence,
     QShowEvent,
 )
 from PySide6.QtWidgets import (
@@ -45,7 +40,6 @@ from PySide6.QtWidgets import (
     QSizePolicy,
     QSplitter,
     QTabWidget,
-    QToolBar,
     QVBoxLayout,
     QWidget,
 )
@@ -60,7 +54,7 @@ from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController, ProjectDialogs
 from ui.dialogs.confirm import ConfirmFn
 from ui.dialogs.connection_dialog import ConnectionDialog
-from ui.i18n import LANGUAGE_NAMES, Translator
+from ui.i18n import Translator
 from ui.panels.control_bar import ControlBar
 from ui.panels.event_log import EventLogPanel
 from ui.panels.jog_panel import JogPanel
@@ -73,6 +67,7 @@ from ui.panels.step_panel import StepPanel
 from ui.panels.traffic_panel import TrafficPanel
 from ui.settings import AppSettings
 from ui.widgets_common import connection_display
+from ui.window_actions import WindowActions
 
 DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size
 MIN_SIZE = (1024, 700)  # the layout stays usable down to this
@@ -179,8 +174,13 @@ class MainWindow(QMainWindow):
         self.traffic_panel.captureEnabledChanged.connect(self._update_traffic_capture)
 
         # --- actions, menus, toolbar, status bar ---------------------------------------
-        self._make_actions()
-        self._make_menus()
+        self.menus = WindowActions(
+            self, connect=self.open_connection_dialog, disconnect=link.disconnect, stop=link.stop,
+            pause=link.pause, resume=link.resume, about=self.show_about, show_tab=self.show_tab,
+            tab_count=len(TAB_NAMES), set_language=self.set_language,
+            language=translator.language if translator else "en", file_actions=self.project.file_actions(),
+            edit_actions=[self.project.action_undo, self.project.action_redo],
+            docks=[self.status_dock, self.event_dock, self.traffic_dock])
         self.status_project = QLabel(self)
         self.status_link = QLabel(self)
         self.status_rtt = QLabel(self)
@@ -219,89 +219,6 @@ class MainWindow(QMainWindow):
         self.addDockWidget(area, dock)
         return dock
 
-    def _action(self, slot: Callable[[], object],
-                shortcut: QKeySequence | QKeySequence.StandardKey | Qt.Key | str | None = None, *,
-                context: Qt.ShortcutContext = Qt.ShortcutContext.WindowShortcut) -> QAction:
-        action = QAction(self)
-        if shortcut is not None:
-            action.setShortcut(QKeySequence(shortcut))
-        action.setShortcutContext(context)
-        action.triggered.connect(slot)
-        self.addAction(action)
-        return action
-
-    def _make_actions(self) -> None:
-        app_wide = Qt.ShortcutContext.ApplicationShortcut  # also from floating docks
-        self.connect_action = self._action(self.open_connection_dialog, "Ctrl+K")
-        self.disconnect_action = self._action(self.link.disconnect, "Ctrl+Shift+K")
-        self.quit_action = self._action(self.close, QKeySequence.StandardKey.Quit)
-        self.stop_action = self._action(self.link.stop, Qt.Key.Key_Escape, context=app_wide)
-        self.stop_action.setObjectName("StopAction")
-        self.pause_action = self._action(self.link.pause, Qt.Key.Key_F6, context=app_wide)
-        self.resume_action = self._action(self.link.resume, Qt.Key.Key_F7, context=app_wide)
-        self.about_action = self._action(self.show_about)
-        self.tab_actions = [self._action(functools.partial(self.show_tab, i), f"Ctrl+{i + 1}")
-                            for i in range(len(TAB_NAMES))]
-        self.language_group = QActionGroup(self)
-        self.language_group.setExclusive(True)
-        self.language_actions: dict[str, QAction] = {}
-        for code, name in LANGUAGE_NAMES.items():
-            action = QAction(name, self)  # each language in its own script, never translated
-            action.setCheckable(True)
-            action.setData(code)
-            action.triggered.connect(lambda _checked=False, c=code: self.set_language(c))
-            self.language_group.addAction(action)
-            self.language_actions[code] = action
-        current = self.translator.language if self.translator else "en"
-        self.language_actions.get(current, self.language_actions["en"]).setChecked(True)
-
-    def _make_menus(self) -> None:
-        bar = self.menuBar()
-        self.file_menu = bar.addMenu("")
-        for file_action in self.project.file_actions():
-            if file_action is None:
-                self.file_menu.addSeparator()
-            else:
-                self.file_menu.addAction(file_action)
-                self.addAction(file_action)  # shortcuts work from every panel
-        self.file_menu.addSeparator()
-        self.file_menu.addAction(self.connect_action)
-        self.file_menu.addAction(self.disconnect_action)
-        self.file_menu.addSeparator()
-        self.file_menu.addAction(self.quit_action)
-        self.edit_menu = bar.addMenu("")
-        self.edit_menu.addAction(self.project.action_undo)
-        self.edit_menu.addAction(self.project.action_redo)
-        self.addAction(self.project.action_undo)
-        self.addAction(self.project.action_redo)
-        self.motion_menu = bar.addMenu("")
-        self.motion_menu.addAction(self.stop_action)
-        self.motion_menu.addAction(self.pause_action)
-        self.motion_menu.addAction(self.resume_action)
-        self.view_menu = bar.addMenu("")
-        for action in self.tab_actions:
-            self.view_menu.addAction(action)
-        self.view_menu.addSeparator()
-        for dock in (self.status_dock, self.event_dock, self.traffic_dock):
-            self.view_menu.addAction(dock.toggleViewAction())
-        self.language_menu = bar.addMenu("")
-        for action in self.language_actions.values():
-            self.language_menu.addAction(action)
-        self.help_menu = bar.addMenu("")
-        self.help_menu.addAction(self.about_action)
-
-        self.toolbar = QToolBar(self)
-        self.toolbar.setObjectName("MainToolBar")
-        self.toolbar.setMovable(False)
-        for action in (self.connect_action, self.disconnect_action):
-            self.toolbar.addAction(action)
-        self.toolbar.addSeparator()
-        for action in (self.stop_action, self.pause_action, self.resume_action):
-            self.toolbar.addAction(action)
-        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.toolbar)
-        self.view_menu.addSeparator()
-        self.view_menu.addAction(self.toolbar.toggleViewAction())
-
     def _wire(self) -> None:
         link, state = self.link, self.link.state
         for panel in (self.monitor_panel, self.status_panel, self.event_log, self.control_bar):
@@ -331,31 +248,10 @@ class MainWindow(QMainWindow):
         self.work_tabs.setTabText(TAB_MONITOR, self.tr("Monitor"))
         self.work_tabs.setTabText(TAB_POINTS, self.tr("Points"))
         self.work_tabs.setTabText(TAB_PLANNER, self.tr("Planner"))
-        for action, text in zip(self.tab_actions, (self.tr("Show &monitor"), self.tr("Show &points"),
-                                                   self.tr("Show p&lanner")), strict=True):
-            action.setText(text)
         self.status_dock.setWindowTitle(self.tr("Status"))
         self.event_dock.setWindowTitle(self.tr("Event log"))
         self.traffic_dock.setWindowTitle(self.tr("Modbus traffic"))
-        self.file_menu.setTitle(self.tr("&File"))
-        self.edit_menu.setTitle(self.tr("&Edit"))
-        self.motion_menu.setTitle(self.tr("&Motion"))
-        self.view_menu.setTitle(self.tr("&View"))
-        self.language_menu.setTitle(self.tr("&Language"))
-        self.help_menu.setTitle(self.tr("&Help"))
-        self.toolbar.setWindowTitle(self.tr("Toolbar"))
-        self.toolbar.toggleViewAction().setText(self.tr("Toolbar"))
-        self.connect_action.setText(self.tr("&Connect…"))
-        self.connect_action.setToolTip(self.tr("Connect to a controller (Ctrl+K)"))
-        self.disconnect_action.setText(self.tr("&Disconnect"))
-        self.quit_action.setText(self.tr("&Quit"))
-        self.stop_action.setText(self.tr("&Stop"))
-        self.stop_action.setToolTip(self.tr("Stop all motion (Esc)"))
-        self.pause_action.setText(self.tr("&Pause"))
-        self.pause_action.setToolTip(self.tr("Pause the current move or program (F6)"))
-        self.resume_action.setText(self.tr("&Resume"))
-        self.resume_action.setToolTip(self.tr("Resume the paused move or program (F7)"))
-        self.about_action.setText(self.tr("&About TeachPad"))
+        self.menus.retranslate()
         self.project.retranslate()
         self._on_project_title(self.project.title)
         self._show_connection()
@@ -388,7 +284,7 @@ class MainWindow(QMainWindow):
         self.status_link.setText(text)
         self.status_link.setToolTip(connection.message)
         self.status_monitor_only.setText(self.tr("MONITOR ONLY") if connection.monitor_only else "")
-        self.disconnect_action.setEnabled(connection.state is not LinkState.DISCONNECTED)
+        self.menus.disconnect_action.setEnabled(connection.state is not LinkState.DISCONNECTED)
         self._update_title()
         self._update_motion_enabled()
 
@@ -400,8 +296,8 @@ class MainWindow(QMainWindow):
     def _update_motion_enabled(self) -> None:
         connection = self.link.state.connection
         enabled = self.link.state.writable
-        self.pause_action.setEnabled(enabled)
-        self.resume_action.setEnabled(enabled)
+        self.menus.pause_action.setEnabled(enabled)
+        self.menus.resume_action.setEnabled(enabled)
         if connection.connected and connection.monitor_only:
             self.motion_banner.setText(self.tr("Monitor only: motion controls are disabled"))
         elif not connection.connected:
@@ -519,7 +415,7 @@ class MainWindow(QMainWindow):
         self.settings.language = code
         # Qt posts LanguageChange to the windows: deliver it now so the switch is immediate.
         QCoreApplication.sendPostedEvents(None, QEvent.Type.LanguageChange)
-        action = self.language_actions.get(code)
+        action = self.menus.language_actions.get(code)
         if action is not None:
             action.setChecked(True)
 

@@ -95,10 +95,10 @@ class RequestRouter:
 class LinkPort(Protocol):
     """What panels and controllers use of the link, with the real types (RobotLink fits)."""
 
-    controllerReconnected: SignalInstance  # () the link came back: the worker made it safe
-    controllerRestarted: SignalInstance  # () the restart canary changed: temp points are gone
-    uploadProgress: SignalInstance  # (int, int) points done, total of the running upload
-    pointUploaded: SignalInstance  # (int, bool, str) point id, ok, reason
+    controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
+    controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
+    uploadProgress: SignalInstance  # noqa: N815 - (int, int) points done, total of the running upload
+    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str) point id, ok, reason
 
     @property
     def state(self) -> RobotState: ...
