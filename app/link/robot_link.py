@@ -20,7 +20,7 @@ from app import timing
 from app.link.client import ConnectionSettings, StepFrame
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, RobotState
 from app.link.stats import LinkStats
-from app.link.types import ConnectionState, JogRequest, WorkerError
+from app.link.types import ConnectionState, JogRequest, LinkState, WorkerError
 from app.link.worker import DEFAULT_CANARY_GV, SHUTDOWN_TIMEOUT_MS, RobotWorker
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
@@ -195,6 +195,7 @@ class RobotLink(QObject):
         self._pollRateRequested.connect(w.set_poll_rate)
         self._captureRequested.connect(w.set_traffic_capture)
         self._shutdownRequested.connect(w.shutdown, Qt.ConnectionType.BlockingQueuedConnection)
+        self._shutdownRequested.connect(self._on_shut_down)  # after the worker's blocking stop
         app = QCoreApplication.instance()
         if app is not None:
             app.aboutToQuit.connect(self.shutdown)
@@ -231,6 +232,12 @@ class RobotLink(QObject):
     def _on_connection(self, state: ConnectionState) -> None:
         self._state.set_connection(state)
         self.connectionChanged.emit(state)
+
+    @Slot()
+    def _on_shut_down(self) -> None:
+        """Nothing is live after a shutdown: the state says so (and its freshness timer stops)."""
+        endpoint = self._state.connection.endpoint
+        self._state.set_connection(ConnectionState(LinkState.DISCONNECTED, "the link was shut down", endpoint))
 
     @Slot(CommandResult)
     def _on_result(self, result: CommandResult) -> None:
