@@ -176,9 +176,6 @@ class RobotLink(QObject):
         self._worker.moveToThread(self._thread)
         self._thread.started.connect(self._worker.start)
         w = self._worker
-        for name in ("poseChanged", "statusChanged", "alarmsChanged", "rttChanged", "trafficObserved",
-                     "controllerReconnected", "controllerRestarted", "uploadProgress", "pointUploaded"):
-            getattr(w, name).connect(getattr(self, name))
         # the model first, so a view that reacts to the re-emitted signal reads the new value
         state = self._state
         w.poseChanged.connect(state.set_pose)
@@ -190,6 +187,14 @@ class RobotLink(QObject):
         w.commandFinished.connect(self._on_result)
         w.errorOccurred.connect(self._on_error)
         w.connectionChanged.connect(self._on_connection)
+        for source, target in ((w.poseChanged, self.poseChanged), (w.statusChanged, self.statusChanged),
+                               (w.alarmsChanged, self.alarmsChanged), (w.rttChanged, self.rttChanged),
+                               (w.trafficObserved, self.trafficObserved),
+                               (w.controllerReconnected, self.controllerReconnected),
+                               (w.controllerRestarted, self.controllerRestarted),
+                               (w.uploadProgress, self.uploadProgress),
+                               (w.pointUploaded, self.pointUploaded)):
+            source.connect(target)
         self._connectRequested.connect(w.connect_to)
         self._disconnectRequested.connect(w.disconnect_link)
         self._pollRateRequested.connect(w.set_poll_rate)
@@ -237,7 +242,8 @@ class RobotLink(QObject):
     def _on_shut_down(self) -> None:
         """Nothing is live after a shutdown: the state says so (and its freshness timer stops)."""
         endpoint = self._state.connection.endpoint
-        self._state.set_connection(ConnectionState(LinkState.DISCONNECTED, "the link was shut down", endpoint))
+        shut = ConnectionState(LinkState.DISCONNECTED, "the link was shut down", endpoint)
+        self._state.set_connection(shut)
 
     @Slot(CommandResult)
     def _on_result(self, result: CommandResult) -> None:
