@@ -197,12 +197,12 @@ def test_the_fake_link_routes_like_the_link(qapp: Any) -> None:
 # --- on the real link ----------------------------------------------------------------------
 
 
-def _outcomes(qtbot: Any, *pendings: Pending) -> dict[int, list[object]]:
+def _outcomes(qtbot: Any, *pendings: Pending, timeout: int = SIGNAL_TIMEOUT_MS) -> dict[int, list[object]]:
     outcomes: dict[int, list[object]] = {p.request_id: [] for p in pendings}
     for pending in pendings:
         pending.finished.connect(outcomes[pending.request_id].append)
         pending.failed.connect(outcomes[pending.request_id].append)
-    qtbot.waitUntil(lambda: all(outcomes.values()), timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(lambda: all(outcomes.values()), timeout=timeout)
     return outcomes
 
 
@@ -228,7 +228,7 @@ def test_two_creates_in_a_row_each_get_their_own_result(qtbot: Any, sim: Any, li
     connect(qtbot, link, sim)
     first = link.track(link.create_point(21))
     second = link.track(link.create_point(22, (400.0, 10.0, 300.0, 180.0, 0.0, 0.0)))
-    _outcomes(qtbot, first, second)
+    _outcomes(qtbot, first, second, timeout=2000)  # each takes ~25 ms on the simulator
 
 
 def test_the_state_follows_the_link(qtbot: Any, sim: Any, qapp: Any, fast_reconnect: None) -> None:
