@@ -291,7 +291,7 @@ class _Counters(QObject):
         self.poses = 0
         self.traffic_frames = 0
         self.results: list[CommandResult] = []
-        self.state = link.state
+        self.state = link.connection
         link.poseChanged.connect(self._on_pose)
         link.trafficObserved.connect(self._on_traffic)
         link.commandFinished.connect(self._on_result)

@@ -5,12 +5,14 @@ with the big STOP, then the Jog / Step / Program tabs); on the right the work ta
 Monitor | Points | Planner; docks: Status (left, narrow), Event log and Modbus traffic (bottom,
 tabified). STOP stays visible whatever tab is shown.
 
-The window holds no robot state: it forwards the panels' requests to the :class:`RobotLink`
-and the link's signals to the panels. One :class:`ProjectController` owns the open project
-(File and Edit menus); the points panel and the planner share its models, a
-:class:`PointSyncController` and a :class:`PlanRunController`. Motion controls are enabled only
-while the link is up and writable (not monitor-only). Any jog ends when the window loses the
-focus, is hidden or closed, and when the link goes down.
+The window only composes: the robot's state lives in one :class:`~app.link.state.RobotState`
+(``link.state``) and every panel subscribes to the fields it shows (``panel.bind(state)``);
+controllers turn the panels' intents into link requests. One :class:`ProjectController` owns
+the open project (File and Edit menus); the points panel and the planner share its models, a
+:class:`PointSyncController` and a :class:`PlanRunController`; a :class:`MotionController`
+drives the motion panels and enables them only while the link is up and writable (not
+monitor-only). Any jog ends when the window loses the focus, is hidden or closed, and when the
+link goes down.
 
 Close order: jog release first (before any question), then "save changes?" (Cancel keeps the
 window and the link), then the window state is saved and the link shut down.
@@ -18,20 +20,15 @@ window and the link), then the window state is saved and the link shut down.
 
 from __future__ import annotations
 
-import functools
 import os
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
 from PySide6.QtGui import (
-    QAction,
-    QActionGroup,
     QCloseEvent,
     QGuiApplication,
     QHideEvent,
-    QKeySequence,
     QShowEvent,
 )
 from PySide6.QtWidgets import (
@@ -43,7 +40,6 @@ from PySide6.QtWidgets import (
     QSizePolicy,
     QSplitter,
     QTabWidget,
-    QToolBar,
     QVBoxLayout,
     QWidget,
 )
@@ -51,25 +47,27 @@ from PySide6.QtWidgets import (
 from app import __version__
 from app.link.client import ConnectionSettings
 from app.link.robot_link import RobotLink
-from app.link.types import ConnectionState, JogRequest, LinkState, Operation, WorkerError
-from app.models import CommandResult, ControllerStatus
-from app.protocol.enums import ProgramMotionMode, WorkMode
+from app.link.types import ConnectionState, LinkState, WorkerError
+from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController, ProjectDialogs
+from ui.dialogs.confirm import ConfirmFn
 from ui.dialogs.connection_dialog import ConnectionDialog
-from ui.i18n import LANGUAGE_NAMES, Translator
+from ui.i18n import Translator
 from ui.panels.control_bar import ControlBar
 from ui.panels.event_log import EventLogPanel
 from ui.panels.jog_panel import JogPanel
 from ui.panels.monitor_panel import MonitorPanel
 from ui.panels.planner_panel import PlannerPanel
-from ui.panels.points_panel import PointsPanel, PointSyncController
-from ui.panels.program_panel import ProgramPanel, ProgramRequest
+from ui.panels.points_panel import PointsPanel
+from ui.panels.program_panel import ProgramPanel
 from ui.panels.status_panel import StatusPanel
-from ui.panels.step_panel import ConfirmFn, StepPanel, StepRequest
+from ui.panels.step_panel import StepPanel
 from ui.panels.traffic_panel import TrafficPanel
 from ui.settings import AppSettings
 from ui.widgets_common import connection_display
+from ui.window_actions import WindowActions
 
 DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size
 MIN_SIZE = (1024, 700)  # the layout stays usable down to this
@@ -92,10 +90,7 @@ class MainWindow(QMainWindow):
         self.settings = settings
         self.translator = translator
         self.shutdown_link_on_close = shutdown_link_on_close
-        self._connection = link.state
         self._traffic_capture = False
-        self._operation_names: dict[str, str] = {}
-        self._run_active = False
         self._close_accepted = False
 
         # --- the project and its controllers (no widgets) ---------------------------------
@@ -179,8 +174,13 @@ class MainWindow(QMainWindow):
         self.traffic_panel.captureEnabledChanged.connect(self._update_traffic_capture)
 
         # --- actions, menus, toolbar, status bar ---------------------------------------
-        self._make_actions()
-        self._make_menus()
+        self.menus = WindowActions(
+            self, connect=self.open_connection_dialog, disconnect=link.disconnect, stop=link.stop,
+            pause=link.pause, resume=link.resume, about=self.show_about, show_tab=self.show_tab,
+            tab_count=len(TAB_NAMES), set_language=self.set_language,
+            language=translator.language if translator else "en", file_actions=self.project.file_actions(),
+            edit_actions=[self.project.action_undo, self.project.action_redo],
+            docks=[self.status_dock, self.event_dock, self.traffic_dock])
         self.status_project = QLabel(self)
         self.status_link = QLabel(self)
         self.status_rtt = QLabel(self)
@@ -201,7 +201,6 @@ class MainWindow(QMainWindow):
         if isinstance(app, QApplication):
             app.applicationStateChanged.connect(self._on_application_state)
         self.retranslate()
-        self._on_connection(link.state, log=False)
 
     @staticmethod
     def _default_size() -> tuple[int, int]:
@@ -220,126 +219,25 @@ class MainWindow(QMainWindow):
         self.addDockWidget(area, dock)
         return dock
 
-    def _action(self, slot: Callable[[], object],
-                shortcut: QKeySequence | QKeySequence.StandardKey | Qt.Key | str | None = None, *,
-                context: Qt.ShortcutContext = Qt.ShortcutContext.WindowShortcut) -> QAction:
-        action = QAction(self)
-        if shortcut is not None:
-            action.setShortcut(QKeySequence(shortcut))
-        action.setShortcutContext(context)
-        action.triggered.connect(slot)
-        self.addAction(action)
-        return action
-
-    def _make_actions(self) -> None:
-        app_wide = Qt.ShortcutContext.ApplicationShortcut  # also from floating docks
-        self.connect_action = self._action(self.open_connection_dialog, "Ctrl+K")
-        self.disconnect_action = self._action(self.link.disconnect, "Ctrl+Shift+K")
-        self.quit_action = self._action(self.close, QKeySequence.StandardKey.Quit)
-        self.stop_action = self._action(self.link.stop, Qt.Key.Key_Escape, context=app_wide)
-        self.stop_action.setObjectName("StopAction")
-        self.pause_action = self._action(self.link.pause, Qt.Key.Key_F6, context=app_wide)
-        self.resume_action = self._action(self.link.resume, Qt.Key.Key_F7, context=app_wide)
-        self.about_action = self._action(self.show_about)
-        self.tab_actions = [self._action(functools.partial(self.show_tab, i), f"Ctrl+{i + 1}")
-                            for i in range(len(TAB_NAMES))]
-        self.language_group = QActionGroup(self)
-        self.language_group.setExclusive(True)
-        self.language_actions: dict[str, QAction] = {}
-        for code, name in LANGUAGE_NAMES.items():
-            action = QAction(name, self)  # each language in its own script, never translated
-            action.setCheckable(True)
-            action.setData(code)
-            action.triggered.connect(lambda _checked=False, c=code: self.set_language(c))
-            self.language_group.addAction(action)
-            self.language_actions[code] = action
-        current = self.translator.language if self.translator else "en"
-        self.language_actions.get(current, self.language_actions["en"]).setChecked(True)
-
-    def _make_menus(self) -> None:
-        bar = self.menuBar()
-        self.file_menu = bar.addMenu("")
-        for file_action in self.project.file_actions():
-            if file_action is None:
-                self.file_menu.addSeparator()
-            else:
-                self.file_menu.addAction(file_action)
-                self.addAction(file_action)  # shortcuts work from every panel
-        self.file_menu.addSeparator()
-        self.file_menu.addAction(self.connect_action)
-        self.file_menu.addAction(self.disconnect_action)
-        self.file_menu.addSeparator()
-        self.file_menu.addAction(self.quit_action)
-        self.edit_menu = bar.addMenu("")
-        self.edit_menu.addAction(self.project.action_undo)
-        self.edit_menu.addAction(self.project.action_redo)
-        self.addAction(self.project.action_undo)
-        self.addAction(self.project.action_redo)
-        self.motion_menu = bar.addMenu("")
-        self.motion_menu.addAction(self.stop_action)
-        self.motion_menu.addAction(self.pause_action)
-        self.motion_menu.addAction(self.resume_action)
-        self.view_menu = bar.addMenu("")
-        for action in self.tab_actions:
-            self.view_menu.addAction(action)
-        self.view_menu.addSeparator()
-        for dock in (self.status_dock, self.event_dock, self.traffic_dock):
-            self.view_menu.addAction(dock.toggleViewAction())
-        self.language_menu = bar.addMenu("")
-        for action in self.language_actions.values():
-            self.language_menu.addAction(action)
-        self.help_menu = bar.addMenu("")
-        self.help_menu.addAction(self.about_action)
-
-        self.toolbar = QToolBar(self)
-        self.toolbar.setObjectName("MainToolBar")
-        self.toolbar.setMovable(False)
-        for action in (self.connect_action, self.disconnect_action):
-            self.toolbar.addAction(action)
-        self.toolbar.addSeparator()
-        for action in (self.stop_action, self.pause_action, self.resume_action):
-            self.toolbar.addAction(action)
-        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.toolbar)
-        self.view_menu.addSeparator()
-        self.view_menu.addAction(self.toolbar.toggleViewAction())
-
     def _wire(self) -> None:
-        link = self.link
-        link.poseChanged.connect(self.monitor_panel.on_pose)
-        link.statusChanged.connect(self._on_status)
-        link.alarmsChanged.connect(self.status_panel.on_alarms)
-        link.alarmsChanged.connect(self.event_log.on_alarms)
-        link.connectionChanged.connect(self._on_connection)
-        link.rttChanged.connect(self.status_panel.on_rtt)
-        link.rttChanged.connect(self._on_rtt)
-        link.commandFinished.connect(self._on_command_result)
+        link, state = self.link, self.link.state
+        for panel in (self.monitor_panel, self.status_panel, self.event_log, self.control_bar):
+            panel.bind(state)
+        state.connectionChanged.connect(self._show_connection)
+        state.rttChanged.connect(self._show_rtt)
+        link.errorOccurred.connect(self.event_log.on_error)
         link.errorOccurred.connect(self._on_error)
         link.trafficObserved.connect(self.traffic_panel.on_traffic)
         link.controllerReconnected.connect(self._on_reconnected)
-
-        bar = self.control_bar
-        bar.stopRequested.connect(link.stop)
-        bar.pauseRequested.connect(link.pause)
-        bar.resumeRequested.connect(link.resume)
-        bar.modeRequested.connect(self._on_mode_requested)
-        self.jog_panel.jogPressed.connect(self._on_jog_pressed)
-        self.jog_panel.jogReleased.connect(link.jog_release)
-        self.jog_panel.ratioChanged.connect(link.set_jog_ratio)
-        self.step_panel.stepRequested.connect(self._on_step_requested)
-        self.program_panel.programRequested.connect(self._on_program_requested)
-        self.program_panel.goZeroRequested.connect(self._on_go_zero_requested)
-
+        link.controllerRestarted.connect(self._on_restarted)
+        self.motion = MotionController(link, self.control_bar, self.jog_panel, self.step_panel,
+                                       self.program_panel, self.run_controller, self)
+        self.run_controller.runningChanged.connect(self.points_panel.set_run_active)
         project = self.project
         project.titleChanged.connect(self._on_project_title)
         project.pathChanged.connect(self._on_project_path)
-        project.statusMessage.connect(self._show_message)
-        self.points_panel.statusMessage.connect(self._show_message)
-        self.planner_panel.statusMessage.connect(self._show_message)
-        self.run_controller.runningChanged.connect(self.points_panel.set_run_active)
-        self.run_controller.runningChanged.connect(self._on_run_active)
-        restarted = getattr(link, "controllerRestarted", None)
-        if restarted is not None:
-            restarted.connect(self._on_restarted)
+        for source in (project, self.points_panel, self.planner_panel):
+            source.statusMessage.connect(self._show_message)
 
     # --- texts ------------------------------------------------------------------------
     def retranslate(self) -> None:
@@ -350,57 +248,13 @@ class MainWindow(QMainWindow):
         self.work_tabs.setTabText(TAB_MONITOR, self.tr("Monitor"))
         self.work_tabs.setTabText(TAB_POINTS, self.tr("Points"))
         self.work_tabs.setTabText(TAB_PLANNER, self.tr("Planner"))
-        for action, text in zip(self.tab_actions, (self.tr("Show &monitor"), self.tr("Show &points"),
-                                                   self.tr("Show p&lanner")), strict=True):
-            action.setText(text)
         self.status_dock.setWindowTitle(self.tr("Status"))
         self.event_dock.setWindowTitle(self.tr("Event log"))
         self.traffic_dock.setWindowTitle(self.tr("Modbus traffic"))
-        self.file_menu.setTitle(self.tr("&File"))
-        self.edit_menu.setTitle(self.tr("&Edit"))
-        self.motion_menu.setTitle(self.tr("&Motion"))
-        self.view_menu.setTitle(self.tr("&View"))
-        self.language_menu.setTitle(self.tr("&Language"))
-        self.help_menu.setTitle(self.tr("&Help"))
-        self.toolbar.setWindowTitle(self.tr("Toolbar"))
-        self.toolbar.toggleViewAction().setText(self.tr("Toolbar"))
-        self.connect_action.setText(self.tr("&Connect…"))
-        self.connect_action.setToolTip(self.tr("Connect to a controller (Ctrl+K)"))
-        self.disconnect_action.setText(self.tr("&Disconnect"))
-        self.quit_action.setText(self.tr("&Quit"))
-        self.stop_action.setText(self.tr("&Stop"))
-        self.stop_action.setToolTip(self.tr("Stop all motion (Esc)"))
-        self.pause_action.setText(self.tr("&Pause"))
-        self.pause_action.setToolTip(self.tr("Pause the current move or program (F6)"))
-        self.resume_action.setText(self.tr("&Resume"))
-        self.resume_action.setToolTip(self.tr("Resume the paused move or program (F7)"))
-        self.about_action.setText(self.tr("&About TeachPad"))
-        self.status_monitor_only.setText(self.tr("MONITOR ONLY") if self.link.monitor_only else "")
-        self._operation_names = {
-            Operation.STOP: self.tr("stop"),
-            Operation.PAUSE: self.tr("pause"),
-            Operation.RESUME: self.tr("resume"),
-            Operation.JOG: self.tr("jog"),
-            Operation.JOG_RELEASE: self.tr("jog release"),
-            Operation.JOG_SPEED: self.tr("jog speed"),
-            Operation.STEP: self.tr("incremental move"),
-            Operation.SET_MODE: self.tr("work mode"),
-            Operation.GO_ZERO: self.tr("go to zero"),
-            Operation.RUN_PROGRAM: self.tr("run program"),
-            Operation.CREATE_POINT: self.tr("create temp point"),
-            Operation.MOVE_TO_POINT: self.tr("move to temp point"),
-            Operation.UPLOAD_POINTS: self.tr("upload temp points"),
-            Operation.TEACH_DISABLE: self.tr("teach disable"),
-            Operation.POLL: self.tr("monitor"),
-            Operation.CONNECT: self.tr("connect"),
-            Operation.DISCONNECT: self.tr("disconnect"),
-            Operation.SHUTDOWN: self.tr("shutdown"),
-            Operation.CANARY: self.tr("restart check"),
-        }
+        self.menus.retranslate()
         self.project.retranslate()
         self._on_project_title(self.project.title)
         self._show_connection()
-        self._update_motion_enabled()
 
     def changeEvent(self, event: QEvent) -> None:
         kind = event.type()
@@ -416,75 +270,48 @@ class MainWindow(QMainWindow):
         return super().event(event)
 
     def _update_title(self) -> None:
-        endpoint = self._connection.endpoint
+        endpoint = self.link.state.connection.endpoint
         parts = [self.tr("TeachPad"), self.project.title]
         if endpoint:
             parts.append(endpoint)
         self.setWindowTitle(" — ".join(parts))
 
-    def operation_text(self, operation: str) -> str:
-        return self._operation_names.get(operation, operation)
-
-    # --- link -> panels ---------------------------------------------------------------
-    @Slot(object)
-    def _on_connection(self, state: ConnectionState, log: bool = True) -> None:
-        self._connection = state
-        if not state.connected:
-            self.jog_panel.release_all()  # link lost: the worker makes it safe on return
-            self.control_bar.clear_status()
-        self.status_panel.on_connection(state)
-        if log:
-            self.event_log.on_connection(state)
-        self._show_connection()
+    # --- link -> the window's own labels ----------------------------------------------------
+    @Slot()
+    def _show_connection(self) -> None:
+        connection: ConnectionState = self.link.state.connection
+        text, _level = connection_display(connection)
+        self.status_link.setText(text)
+        self.status_link.setToolTip(connection.message)
+        self.status_monitor_only.setText(self.tr("MONITOR ONLY") if connection.monitor_only else "")
+        self.menus.disconnect_action.setEnabled(connection.state is not LinkState.DISCONNECTED)
         self._update_title()
         self._update_motion_enabled()
 
-    def _show_connection(self) -> None:
-        text, _level = connection_display(self._connection)
-        if self._connection.state is LinkState.DOWN:
-            text = self.tr("link down")
-        self.status_link.setText(text)
-        self.status_link.setToolTip(self._connection.message)
-        self.status_monitor_only.setText(self.tr("MONITOR ONLY") if self._connection.monitor_only else "")
-        self.disconnect_action.setEnabled(self._connection.state is not LinkState.DISCONNECTED)
-
     @property
     def motion_enabled(self) -> bool:
-        return self._connection.connected and not self._connection.monitor_only
+        return self.motion.motion_enabled
 
+    @Slot()
     def _update_motion_enabled(self) -> None:
-        enabled = self.motion_enabled
-        # While a plan runs the jog / step / program controls wait; Stop, Pause, Resume stay.
-        self.jog_panel.set_motion_enabled(enabled and not self._run_active)
-        self.step_panel.set_motion_enabled(enabled and not self._run_active)
-        self.program_panel.set_motion_enabled(enabled and not self._run_active)
-        self.control_bar.set_motion_enabled(enabled)
-        self.pause_action.setEnabled(enabled)
-        self.resume_action.setEnabled(enabled)
-        if self._connection.connected and self._connection.monitor_only:
+        connection = self.link.state.connection
+        enabled = self.link.state.writable
+        self.menus.pause_action.setEnabled(enabled)
+        self.menus.resume_action.setEnabled(enabled)
+        if connection.connected and connection.monitor_only:
             self.motion_banner.setText(self.tr("Monitor only: motion controls are disabled"))
-        elif not self._connection.connected:
+        elif not connection.connected:
             self.motion_banner.setText(self.tr("Not connected: motion controls are disabled"))
         self.motion_banner.setVisible(not enabled)
 
-    @Slot(object)
-    def _on_status(self, status: ControllerStatus) -> None:
-        self.status_panel.on_status(status)
-        self.control_bar.on_status(status)
-
     @Slot(float)
-    def _on_rtt(self, ms: float) -> None:
+    def _show_rtt(self, ms: float) -> None:
         self.status_rtt.setText(self.tr("RTT {ms} ms").format(ms=f"{ms:.1f}"))
 
-    @Slot(object)
-    def _on_command_result(self, result: CommandResult) -> None:
-        self.status_panel.on_command_result(result)
-        self.event_log.on_command_result(result)
-
-    @Slot(object)
+    @Slot(WorkerError)
     def _on_error(self, error: WorkerError) -> None:
-        self.event_log.add_event("error", self.operation_text(error.operation), error.message)
-        self.statusBar().showMessage(f"{self.operation_text(error.operation)}: {error.message}", 8000)
+        operation = self.event_log.operation_text(error.operation)
+        self.statusBar().showMessage(f"{operation}: {error.message}", 8000)
 
     @Slot(str)
     def _show_message(self, text: str) -> None:
@@ -500,13 +327,6 @@ class MainWindow(QMainWindow):
     def _on_project_path(self, path: str) -> None:
         if path:
             self.settings.last_project = path
-
-    @Slot(bool)
-    def _on_run_active(self, active: bool) -> None:
-        self._run_active = active
-        if active:
-            self.jog_panel.release_all()
-        self._update_motion_enabled()
 
     @Slot()
     def _on_restarted(self) -> None:
@@ -531,30 +351,6 @@ class MainWindow(QMainWindow):
         if want != self._traffic_capture:
             self._traffic_capture = want
             self.link.set_traffic_capture(want)
-
-    # --- panels -> link ---------------------------------------------------------------
-    @Slot(object)
-    def _on_jog_pressed(self, request: JogRequest) -> None:
-        self.link.jog_press(request.frame, request.axis, request.direction, request.ratio,
-                            request.user, request.tool)
-
-    @Slot(object)
-    def _on_step_requested(self, request: StepRequest) -> None:
-        self.link.step(request.frame, request.offsets, request.ext_offsets, request.speed)
-
-    @Slot(object)
-    def _on_program_requested(self, request: ProgramRequest) -> None:
-        self.link.run_program(request.program_id, ProgramMotionMode(request.mode), request.cycles,
-                              request.speed_ratio)
-
-    @Slot(object)
-    def _on_go_zero_requested(self, axis: int | None) -> None:
-        self.link.go_zero(axis)
-
-    @Slot(object)
-    def _on_mode_requested(self, mode: WorkMode) -> None:
-        self.jog_panel.release_all()
-        self.link.set_mode(mode)
 
     # --- confirmation (one setter for every panel that asks) --------------------------
     @property
@@ -619,7 +415,7 @@ class MainWindow(QMainWindow):
         self.settings.language = code
         # Qt posts LanguageChange to the windows: deliver it now so the switch is immediate.
         QCoreApplication.sendPostedEvents(None, QEvent.Type.LanguageChange)
-        action = self.language_actions.get(code)
+        action = self.menus.language_actions.get(code)
         if action is not None:
             action.setChecked(True)
 

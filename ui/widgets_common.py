@@ -11,12 +11,12 @@ import os
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 from PySide6.QtCore import QCoreApplication, Qt
 from PySide6.QtGui import QFont, QFontDatabase
 from PySide6.QtWidgets import QFileDialog, QFrame, QHBoxLayout, QLabel, QMessageBox, QSizePolicy, QWidget
 
+from app.link.types import ConnectionState, LinkState
 from app.models import CommandResult
 from app.protocol.enums import (
     QT_TRANSLATE_NOOP,
@@ -232,30 +232,18 @@ def atomic_write_text(path: str | os.PathLike[str], text: str, *, encoding: str 
 
 
 # --- connection state -------------------------------------------------------------------
-_STATE_TEXT: dict[str, tuple[str, str]] = {  # state name -> (text, lamp level)
-    "CONNECTED": (QT_TRANSLATE_NOOP("Panels", "connected"), LEVEL_OK),
-    "CONNECTING": (QT_TRANSLATE_NOOP("Panels", "connecting"), LEVEL_WARN),
-    "RECONNECTING": (QT_TRANSLATE_NOOP("Panels", "reconnecting"), LEVEL_WARN),
-    "DISCONNECTED": (QT_TRANSLATE_NOOP("Panels", "disconnected"), LEVEL_OFF),
-    "STOPPED": (QT_TRANSLATE_NOOP("Panels", "stopped"), LEVEL_OFF),
-    "DOWN": (QT_TRANSLATE_NOOP("Panels", "link down"), LEVEL_ERROR),
-    "LOST": (QT_TRANSLATE_NOOP("Panels", "link lost"), LEVEL_ERROR),
-    "LINK_LOST": (QT_TRANSLATE_NOOP("Panels", "link lost"), LEVEL_ERROR),
-    "ERROR": (QT_TRANSLATE_NOOP("Panels", "error"), LEVEL_ERROR),
-    "FAILED": (QT_TRANSLATE_NOOP("Panels", "failed"), LEVEL_ERROR),
+_STATE_TEXT: dict[LinkState, tuple[str, str]] = {  # link state -> (text, lamp level)
+    LinkState.CONNECTED: (QT_TRANSLATE_NOOP("Panels", "connected"), LEVEL_OK),
+    LinkState.CONNECTING: (QT_TRANSLATE_NOOP("Panels", "connecting"), LEVEL_WARN),
+    LinkState.NOT_ANSWERING: (QT_TRANSLATE_NOOP("Panels", "not answering"), LEVEL_WARN),
+    LinkState.DOWN: (QT_TRANSLATE_NOOP("Panels", "link down"), LEVEL_ERROR),
+    LinkState.DISCONNECTED: (QT_TRANSLATE_NOOP("Panels", "disconnected"), LEVEL_OFF),
 }
 
 
-def state_name(state_obj: Any) -> str:
-    """``state_obj.state.name`` (any enum-like), or ``str(state)`` for plain values."""
-    state = getattr(state_obj, "state", state_obj)
-    return str(getattr(state, "name", state)).upper()
-
-
-def connection_display(state_obj: Any) -> tuple[str, str]:
-    """(translated text, lamp level) for an object with ``.state.name`` and ``.message``."""
-    name = state_name(state_obj)
-    text, level = _STATE_TEXT.get(name, (name.lower().replace("_", " "), LEVEL_WARN))
+def connection_display(connection: ConnectionState) -> tuple[str, str]:
+    """(translated text, lamp level) of a link state."""
+    text, level = _STATE_TEXT[connection.state]
     return QCoreApplication.translate(TR, text), level
 
 

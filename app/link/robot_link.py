@@ -1,23 +1,142 @@
-"""RobotLink: the GUI-thread facade of the worker (owns the thread, plain methods, shutdown)."""
+"""RobotLink: the GUI-thread facade of the worker (owns the thread, plain methods, shutdown).
+
+Besides the worker's signals (re-exposed for logs, benchmarks and tests) the link holds the
+GUI side's one picture of the robot, :class:`~app.link.state.RobotState` (``link.state``), and
+matches request ids in one place: ``link.track(link.move_to_point(...))`` gives a
+:class:`Pending` whose ``finished(CommandResult)`` / ``failed(WorkerError)`` fire only for that
+request. :class:`LinkPort` is the typed port that panels and controllers use (RobotLink fits;
+tests use a small fake that fits too).
+"""
 
 from __future__ import annotations
 
 import logging
 from collections.abc import Iterable, Sequence
+from typing import Protocol
 
-from PySide6.QtCore import QCoreApplication, QObject, Qt, QThread, Signal, Slot
+from PySide6.QtCore import QCoreApplication, QObject, Qt, QThread, QTimer, Signal, SignalInstance, Slot
 
 from app import timing
 from app.link.client import ConnectionSettings, StepFrame
+from app.link.state import DEFAULT_FRESHNESS_LIMIT, RobotState
+from app.link.stats import LinkStats
 from app.link.types import ConnectionState, JogRequest, LinkState, WorkerError
 from app.link.worker import DEFAULT_CANARY_GV, SHUTDOWN_TIMEOUT_MS, RobotWorker
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
 
-__all__ = ["RobotLink"]
+__all__ = ["LinkPort", "Pending", "RequestRouter", "RobotLink"]
 
 _log = logging.getLogger(__name__)
+
+
+class Pending(QObject):
+    """One request's outcome: exactly one of ``finished`` / ``failed`` fires, once."""
+
+    finished = Signal(CommandResult)
+    failed = Signal(WorkerError)
+
+    def __init__(self, request_id: int, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self._request_id = request_id
+        self.result: CommandResult | None = None
+        self.error: WorkerError | None = None
+
+    @property
+    def request_id(self) -> int:
+        return self._request_id
+
+    @property
+    def done(self) -> bool:
+        return self.result is not None or self.error is not None
+
+    def _finish(self, result: CommandResult) -> None:
+        if not self.done:
+            self.result = result
+            self.finished.emit(result)
+
+    def _fail(self, error: WorkerError) -> None:
+        if not self.done:
+            self.error = error
+            self.failed.emit(error)
+
+
+class RequestRouter:
+    """Request id -> :class:`Pending`; the outcomes of untracked requests are ignored here."""
+
+    def __init__(self) -> None:
+        self._pending: dict[int, Pending] = {}
+
+    def track(self, request_id: int) -> Pending:
+        pending = self._pending.get(request_id)
+        if pending is not None:
+            return pending
+        pending = Pending(request_id)
+        if request_id <= 0:  # nothing was queued (the link is shut down): fail once connected to
+            error = WorkerError("request", "the link is shut down: nothing was sent", None)
+            QTimer.singleShot(0, pending, lambda: pending._fail(error))
+        else:
+            self._pending[request_id] = pending
+        return pending
+
+    def on_result(self, result: CommandResult) -> None:
+        if result.request_id is not None and (pending := self._pending.pop(result.request_id, None)):
+            pending._finish(result)
+
+    def on_error(self, error: WorkerError) -> None:
+        if error.request_id is not None and (pending := self._pending.pop(error.request_id, None)):
+            pending._fail(error)
+
+    def __len__(self) -> int:
+        return len(self._pending)
+
+
+class LinkPort(Protocol):
+    """What panels and controllers use of the link, with the real types (RobotLink fits)."""
+
+    controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
+    controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
+    uploadProgress: SignalInstance  # noqa: N815 - (int, int) points done, total of the running upload
+    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str) point id, ok, reason
+
+    @property
+    def state(self) -> RobotState: ...
+
+    def track(self, request_id: int) -> Pending: ...
+
+    def stop(self) -> int: ...
+
+    def pause(self) -> int: ...
+
+    def resume(self) -> int: ...
+
+    def jog_press(self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0,
+                  tool: int = 0) -> int: ...
+
+    def jog_release(self) -> int: ...
+
+    def set_jog_ratio(self, ratio: float) -> int: ...
+
+    def step(self, frame: StepFrame, offsets: Sequence[float], ext_offsets: Sequence[float] = ...,
+             speed: float = ...) -> int: ...
+
+    def set_mode(self, mode: WorkMode) -> int: ...
+
+    def go_zero(self, axis: int | None) -> int: ...
+
+    def run_program(self, program_id: int, mode: ProgramMotionMode = ..., cycles: int = ...,
+                    speed_ratio: int = ...) -> int: ...
+
+    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = ...) -> int: ...
+
+    def move_to_point(self, end_id: int, via_id: int | None = None, *, orientation_changes: bool = ...,
+                      ignore_middle: bool = ..., speed: float = ..., tool: int = ...) -> int: ...
+
+    def upload_points(self, points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
+                      tool: int = ...) -> int: ...
+
+    def cancel_upload(self) -> int: ...
 
 
 class RobotLink(QObject):
@@ -43,10 +162,12 @@ class RobotLink(QObject):
     _captureRequested = Signal(bool)  # noqa: N815
 
     def __init__(self, parent: QObject | None = None, *, poll_hz: float = timing.POLL_HZ_DEFAULT,
-                 canary_gv: int | None = DEFAULT_CANARY_GV) -> None:
+                 canary_gv: int | None = DEFAULT_CANARY_GV,
+                 freshness_limit: float = DEFAULT_FRESHNESS_LIMIT) -> None:
         super().__init__(parent)
         self._settings: ConnectionSettings | None = None
-        self._state = ConnectionState(LinkState.DISCONNECTED)
+        self._state = RobotState(self, freshness_limit=freshness_limit)
+        self._router = RequestRouter()
         self._shut = False
         self._capture_users = 0
         self._thread = QThread()
@@ -55,16 +176,31 @@ class RobotLink(QObject):
         self._worker.moveToThread(self._thread)
         self._thread.started.connect(self._worker.start)
         w = self._worker
-        for name in ("poseChanged", "statusChanged", "alarmsChanged", "rttChanged", "commandFinished",
-                     "errorOccurred", "trafficObserved", "controllerReconnected", "controllerRestarted",
-                     "uploadProgress", "pointUploaded"):
-            getattr(w, name).connect(getattr(self, name))
+        # the model first, so a view that reacts to the re-emitted signal reads the new value
+        state = self._state
+        w.poseChanged.connect(state.set_pose)
+        w.statusChanged.connect(state.set_status)
+        w.alarmsChanged.connect(state.set_alarms)
+        w.rttChanged.connect(state.set_rtt)
+        w.pollSucceeded.connect(state.note_good_poll)
+        w.linkStatsChanged.connect(self._on_stats)
+        w.commandFinished.connect(self._on_result)
+        w.errorOccurred.connect(self._on_error)
         w.connectionChanged.connect(self._on_connection)
+        for source, target in ((w.poseChanged, self.poseChanged), (w.statusChanged, self.statusChanged),
+                               (w.alarmsChanged, self.alarmsChanged), (w.rttChanged, self.rttChanged),
+                               (w.trafficObserved, self.trafficObserved),
+                               (w.controllerReconnected, self.controllerReconnected),
+                               (w.controllerRestarted, self.controllerRestarted),
+                               (w.uploadProgress, self.uploadProgress),
+                               (w.pointUploaded, self.pointUploaded)):
+            source.connect(target)
         self._connectRequested.connect(w.connect_to)
         self._disconnectRequested.connect(w.disconnect_link)
         self._pollRateRequested.connect(w.set_poll_rate)
         self._captureRequested.connect(w.set_traffic_capture)
         self._shutdownRequested.connect(w.shutdown, Qt.ConnectionType.BlockingQueuedConnection)
+        self._shutdownRequested.connect(self._on_shut_down)  # after the worker's blocking stop
         app = QCoreApplication.instance()
         if app is not None:
             app.aboutToQuit.connect(self.shutdown)
@@ -72,8 +208,13 @@ class RobotLink(QObject):
 
     # --- state --------------------------------------------------------------------------
     @property
-    def state(self) -> ConnectionState:
+    def state(self) -> RobotState:
+        """The observable robot state (connection, freshness, pose, status, ...)."""
         return self._state
+
+    @property
+    def connection(self) -> ConnectionState:
+        return self._state.connection
 
     @property
     def settings(self) -> ConnectionSettings | None:
@@ -87,10 +228,37 @@ class RobotLink(QObject):
     def is_running(self) -> bool:
         return self._thread.isRunning()
 
-    @Slot(object)
+    def track(self, request_id: int) -> Pending:
+        """The :class:`Pending` of a request id this link returned (call it right away, in the
+        GUI thread: outcomes arrive through queued signals, so none can be missed)."""
+        return self._router.track(request_id)
+
+    @Slot(ConnectionState)
     def _on_connection(self, state: ConnectionState) -> None:
-        self._state = state
+        self._state.set_connection(state)
         self.connectionChanged.emit(state)
+
+    @Slot()
+    def _on_shut_down(self) -> None:
+        """Nothing is live after a shutdown: the state says so (and its freshness timer stops)."""
+        endpoint = self._state.connection.endpoint
+        shut = ConnectionState(LinkState.DISCONNECTED, "the link was shut down", endpoint)
+        self._state.set_connection(shut)
+
+    @Slot(CommandResult)
+    def _on_result(self, result: CommandResult) -> None:
+        self._state.set_last_result(result)
+        self._router.on_result(result)
+        self.commandFinished.emit(result)
+
+    @Slot(WorkerError)
+    def _on_error(self, error: WorkerError) -> None:
+        self._router.on_error(error)
+        self.errorOccurred.emit(error)
+
+    @Slot(object)
+    def _on_stats(self, stats: LinkStats) -> None:
+        self._state.set_stats(stats)
 
     # --- connection ---------------------------------------------------------------------
     def connect_to(self, settings: ConnectionSettings) -> None:

@@ -320,6 +320,9 @@ class RobotWorker(QObject):
     controllerRestarted = Signal()  # noqa: N815 - the canary GV changed while the link stayed up
     uploadProgress = Signal(int, int)  # noqa: N815 - points done, total
     pointUploaded = Signal(int, bool, str)  # noqa: N815 - point id, ok, reason ("" when ok)
+    # provided by the worker split (declared here so robot-state can consume them before the merge)
+    pollSucceeded = Signal(float)  # noqa: N815 - time.monotonic() of a good poll, after its pose/status
+    linkStatsChanged = Signal(object)  # noqa: N815 - LinkStats snapshot, at most 2 Hz
 
     # Wakes the worker from any thread (a queued call, since the worker lives in its thread).
     _wake = Signal()
@@ -367,6 +370,7 @@ class RobotWorker(QObject):
         self._rtt_count = 0
         self._rtt_since = 0.0
         self._last_rtt: float | None = None
+        self._stats_sent = 0.0  # provided by the worker split: monotonic time of the last linkStatsChanged
         self._last_poll = 0.0
         self._current_seq = 0  # sequence number of the job being executed
         self._request_id: int | None = None  # request id of the job being executed
@@ -1190,6 +1194,10 @@ class RobotWorker(QObject):
             status = dataclasses.replace(status, clock=self._last_status.clock)
         self._note_rtt((t1 - t0) + (t3 - t2), 2, now)
         self._publish(pose, status)
+        self.pollSucceeded.emit(now)  # provided by the worker split
+        if now - self._stats_sent >= 0.5:  # provided by the worker split
+            self._stats_sent = now
+            self.linkStatsChanged.emit(client.stats)
         if canary is not None and canary != self._canary_token:
             self._canary_changed(canary)
         self._after_status(status, pose, now)

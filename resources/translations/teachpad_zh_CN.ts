@@ -107,62 +107,62 @@
     <context>
         <name>ControlBar</name>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="95" />
+            <location filename="../../ui/panels/control_bar.py" line="97" />
             <source>STOP</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="96" />
+            <location filename="../../ui/panels/control_bar.py" line="98" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="97" />
+            <location filename="../../ui/panels/control_bar.py" line="99" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="98" />
+            <location filename="../../ui/panels/control_bar.py" line="100" />
             <source>Pause the current move or program</source>
             <translation>暂停当前运动或程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="99" />
+            <location filename="../../ui/panels/control_bar.py" line="101" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="100" />
+            <location filename="../../ui/panels/control_bar.py" line="102" />
             <source>Resume the paused move or program</source>
             <translation>继续已暂停的运动或程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="101" />
+            <location filename="../../ui/panels/control_bar.py" line="103" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="102" />
+            <location filename="../../ui/panels/control_bar.py" line="104" />
             <source>Manual</source>
             <translation>手动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="103" />
+            <location filename="../../ui/panels/control_bar.py" line="105" />
             <source>Switch the controller to manual mode</source>
             <translation>将控制器切换到手动模式</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="104" />
+            <location filename="../../ui/panels/control_bar.py" line="106" />
             <source>Auto</source>
             <translation>自动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="105" />
+            <location filename="../../ui/panels/control_bar.py" line="107" />
             <source>Switch the controller to auto mode (needed for Modbus motion)</source>
             <translation>将控制器切换到自动模式（Modbus 运动需要自动模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="138" />
+            <location filename="../../ui/panels/control_bar.py" line="152" />
             <source>Mode:
 {mode}</source>
             <translation>模式：
@@ -172,37 +172,37 @@
     <context>
         <name>EventLogModel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="91" />
+            <location filename="../../ui/panels/event_log.py" line="92" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="92" />
+            <location filename="../../ui/panels/event_log.py" line="93" />
             <source>Level</source>
             <translation>级别</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="93" />
+            <location filename="../../ui/panels/event_log.py" line="94" />
             <source>Source</source>
             <translation>来源</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="94" />
+            <location filename="../../ui/panels/event_log.py" line="95" />
             <source>Message</source>
             <translation>消息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="97" />
+            <location filename="../../ui/panels/event_log.py" line="98" />
             <source>Info</source>
             <translation>信息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="98" />
+            <location filename="../../ui/panels/event_log.py" line="99" />
             <source>Warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="99" />
+            <location filename="../../ui/panels/event_log.py" line="100" />
             <source>Error</source>
             <translation>错误</translation>
         </message>
@@ -210,72 +210,172 @@
     <context>
         <name>EventLogPanel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="262" />
+            <location filename="../../ui/panels/event_log.py" line="263" />
             <source>Show:</source>
             <translation>显示：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="263" />
+            <location filename="../../ui/panels/event_log.py" line="264" />
             <source>All events</source>
             <translation>全部事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="264" />
+            <location filename="../../ui/panels/event_log.py" line="265" />
             <source>Warnings and errors</source>
             <translation>警告和错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="265" />
+            <location filename="../../ui/panels/event_log.py" line="266" />
             <source>Errors only</source>
             <translation>仅错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="266" />
+            <location filename="../../ui/panels/event_log.py" line="267" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="267" />
+            <location filename="../../ui/panels/event_log.py" line="268" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="298" />
+            <location filename="../../ui/panels/event_log.py" line="308" />
             <source>alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="305" />
+            <location filename="../../ui/panels/event_log.py" line="315" />
             <source>Alarm raised: {name}</source>
             <translation>报警触发：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="307" />
+            <location filename="../../ui/panels/event_log.py" line="317" />
             <source>Alarm cleared: {name}</source>
             <translation>报警解除：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="313" />
+            <location filename="../../ui/panels/event_log.py" line="323" />
             <source>bit {n}</source>
             <translation>第 {n} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="317" />
+            <location filename="../../ui/panels/event_log.py" line="327" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
             <location filename="../../ui/panels/event_log.py" line="336" />
+            <source>stop</source>
+            <translation>停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="337" />
+            <source>pause</source>
+            <translation>暂停</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="338" />
+            <source>resume</source>
+            <translation>继续</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="339" />
+            <source>jog</source>
+            <translation>点动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="340" />
+            <source>jog release</source>
+            <translation>点动松开</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="341" />
+            <source>jog speed</source>
+            <translation>点动速度</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="342" />
+            <source>incremental move</source>
+            <translation>增量运动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="343" />
+            <source>work mode</source>
+            <translation>工作模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="344" />
+            <source>go to zero</source>
+            <translation>回零</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="345" />
+            <source>run program</source>
+            <translation>运行程序</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="346" />
+            <source>create temp point</source>
+            <translation>创建临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="347" />
+            <source>move to temp point</source>
+            <translation>运动至临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="348" />
+            <source>upload temp points</source>
+            <translation>上传临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="349" />
+            <source>cancel upload</source>
+            <translation>取消上传</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="350" />
+            <source>teach disable</source>
+            <translation>示教禁止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="351" />
+            <source>monitor</source>
+            <translation>监视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="352" />
+            <source>connect</source>
+            <translation>连接</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="353" />
+            <source>disconnect</source>
+            <translation>断开</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="354" />
+            <source>shutdown</source>
+            <translation>关闭</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="355" />
+            <source>restart check</source>
+            <translation>重启检测</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="374" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="361" />
+            <location filename="../../ui/panels/event_log.py" line="399" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="362" />
+            <location filename="../../ui/panels/event_log.py" line="400" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -283,7 +383,7 @@
     <context>
         <name>Export</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="301" />
+            <location filename="../../ui/widgets_common.py" line="289" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -379,320 +479,113 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="347" />
+            <location filename="../../ui/main_window.py" line="245" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="348" />
+            <location filename="../../ui/main_window.py" line="246" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="349" />
+            <location filename="../../ui/main_window.py" line="247" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="356" />
+            <location filename="../../ui/main_window.py" line="251" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="357" />
+            <location filename="../../ui/main_window.py" line="252" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="358" />
+            <location filename="../../ui/main_window.py" line="253" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="359" />
-            <source>&amp;File</source>
-            <translation>文件(&amp;F)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="360" />
-            <source>&amp;Edit</source>
-            <translation>编辑(&amp;E)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="361" />
-            <source>&amp;Motion</source>
-            <translation>运动(&amp;M)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="362" />
-            <source>&amp;View</source>
-            <translation>视图(&amp;V)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="363" />
-            <source>&amp;Language</source>
-            <translation>语言(&amp;L)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="364" />
-            <source>&amp;Help</source>
-            <translation>帮助(&amp;H)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="365" />
-            <location filename="../../ui/main_window.py" line="366" />
-            <source>Toolbar</source>
-            <translation>工具栏</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="367" />
-            <source>&amp;Connect…</source>
-            <translation>连接(&amp;C)…</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="368" />
-            <source>Connect to a controller (Ctrl+K)</source>
-            <translation>连接控制器（Ctrl+K）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="369" />
-            <source>&amp;Disconnect</source>
-            <translation>断开(&amp;D)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="370" />
-            <source>&amp;Quit</source>
-            <translation>退出(&amp;Q)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="371" />
-            <source>&amp;Stop</source>
-            <translation>停止(&amp;S)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="372" />
-            <source>Stop all motion (Esc)</source>
-            <translation>停止所有运动（Esc）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="373" />
-            <source>&amp;Pause</source>
-            <translation>暂停(&amp;P)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="374" />
-            <source>Pause the current move or program (F6)</source>
-            <translation>暂停当前运动或程序（F6）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="375" />
-            <source>&amp;Resume</source>
-            <translation>继续(&amp;R)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="376" />
-            <source>Resume the paused move or program (F7)</source>
-            <translation>继续已暂停的运动或程序（F7）</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="377" />
-            <source>&amp;About TeachPad</source>
-            <translation>关于 TeachPad(&amp;A)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="378" />
-            <location filename="../../ui/main_window.py" line="448" />
+            <location filename="../../ui/main_window.py" line="286" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="380" />
-            <source>stop</source>
-            <translation>停止</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="381" />
-            <source>pause</source>
-            <translation>暂停</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="382" />
-            <source>resume</source>
-            <translation>继续</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="383" />
-            <source>jog</source>
-            <translation>点动</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="384" />
-            <source>jog release</source>
-            <translation>点动松开</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="385" />
-            <source>jog speed</source>
-            <translation>点动速度</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="386" />
-            <source>incremental move</source>
-            <translation>增量运动</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="387" />
-            <source>work mode</source>
-            <translation>工作模式</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="388" />
-            <source>go to zero</source>
-            <translation>回零</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="389" />
-            <source>run program</source>
-            <translation>运行程序</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="390" />
-            <source>create temp point</source>
-            <translation>创建临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="391" />
-            <source>move to temp point</source>
-            <translation>运动到临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="392" />
-            <source>upload temp points</source>
-            <translation>上传临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="393" />
-            <source>teach disable</source>
-            <translation>关闭示教</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="394" />
-            <source>monitor</source>
-            <translation>监视</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="395" />
-            <source>connect</source>
-            <translation>连接</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="396" />
-            <source>disconnect</source>
-            <translation>断开</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="397" />
-            <source>shutdown</source>
-            <translation>关闭</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="398" />
-            <source>restart check</source>
-            <translation>重启检测</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="420" />
+            <location filename="../../ui/main_window.py" line="274" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="445" />
-            <source>link down</source>
-            <translation>通信中断</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="465" />
+            <location filename="../../ui/main_window.py" line="302" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="467" />
+            <location filename="../../ui/main_window.py" line="304" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="477" />
+            <location filename="../../ui/main_window.py" line="309" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="495" />
+            <location filename="../../ui/main_window.py" line="322" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="513" />
+            <location filename="../../ui/main_window.py" line="333" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="519" />
+            <location filename="../../ui/main_window.py" line="339" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="515" />
-            <location filename="../../ui/main_window.py" line="520" />
+            <location filename="../../ui/main_window.py" line="335" />
+            <location filename="../../ui/main_window.py" line="340" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="350" />
+            <location filename="../../ui/main_window.py" line="248" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="351" />
+            <location filename="../../ui/main_window.py" line="249" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="352" />
+            <location filename="../../ui/main_window.py" line="250" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="353" />
-            <source>Show &amp;monitor</source>
-            <translation>显示监视(&amp;M)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="353" />
-            <source>Show &amp;points</source>
-            <translation>显示点位(&amp;P)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="354" />
-            <source>Show p&amp;lanner</source>
-            <translation>显示轨迹规划(&amp;L)</translation>
-        </message>
-        <message>
-            <location filename="../../ui/main_window.py" line="607" />
+            <location filename="../../ui/main_window.py" line="403" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="608" />
+            <location filename="../../ui/main_window.py" line="404" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="616" />
+            <location filename="../../ui/main_window.py" line="412" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="617" />
+            <location filename="../../ui/main_window.py" line="413" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -700,92 +593,92 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="255" />
+            <location filename="../../ui/panels/monitor_panel.py" line="256" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="255" />
+            <location filename="../../ui/panels/monitor_panel.py" line="256" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="256" />
+            <location filename="../../ui/panels/monitor_panel.py" line="257" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="258" />
+            <location filename="../../ui/panels/monitor_panel.py" line="259" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="262" />
+            <location filename="../../ui/panels/monitor_panel.py" line="263" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="263" />
+            <location filename="../../ui/panels/monitor_panel.py" line="264" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="264" />
+            <location filename="../../ui/panels/monitor_panel.py" line="265" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="265" />
+            <location filename="../../ui/panels/monitor_panel.py" line="266" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="266" />
+            <location filename="../../ui/panels/monitor_panel.py" line="267" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="267" />
+            <location filename="../../ui/panels/monitor_panel.py" line="268" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="268" />
+            <location filename="../../ui/panels/monitor_panel.py" line="269" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="269" />
+            <location filename="../../ui/panels/monitor_panel.py" line="270" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="270" />
+            <location filename="../../ui/panels/monitor_panel.py" line="271" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="271" />
+            <location filename="../../ui/panels/monitor_panel.py" line="272" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="271" />
+            <location filename="../../ui/panels/monitor_panel.py" line="272" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="272" />
+            <location filename="../../ui/panels/monitor_panel.py" line="273" />
             <source>TCP path, top view (X–Y)</source>
             <translation>TCP 轨迹俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="439" />
+            <location filename="../../ui/panels/monitor_panel.py" line="444" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="441" />
+            <location filename="../../ui/panels/monitor_panel.py" line="446" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -803,54 +696,37 @@
             <translation>正在连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="238" />
-            <source>reconnecting</source>
-            <translation>正在重连</translation>
-        </message>
-        <message>
-            <location filename="../../ui/widgets_common.py" line="239" />
+            <location filename="../../ui/widgets_common.py" line="240" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="240" />
-            <source>stopped</source>
-            <translation>已停止</translation>
-        </message>
-        <message>
-            <location filename="../../ui/widgets_common.py" line="241" />
+            <location filename="../../ui/widgets_common.py" line="239" />
             <source>link down</source>
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="242" />
-            <location filename="../../ui/widgets_common.py" line="243" />
-            <source>link lost</source>
-            <translation>链路丢失</translation>
-        </message>
-        <message>
-            <location filename="../../ui/widgets_common.py" line="244" />
-            <source>error</source>
-            <translation>错误</translation>
-        </message>
-        <message>
-            <location filename="../../ui/widgets_common.py" line="245" />
-            <location filename="../../ui/widgets_common.py" line="276" />
+            <location filename="../../ui/widgets_common.py" line="264" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="267" />
+            <location filename="../../ui/widgets_common.py" line="255" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="275" />
+            <location filename="../../ui/widgets_common.py" line="238" />
+            <source>not answering</source>
+            <translation>无应答</translation>
+        </message>
+        <message>
+            <location filename="../../ui/widgets_common.py" line="263" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="284" />
+            <location filename="../../ui/widgets_common.py" line="272" />
             <source>{command}: {status}</source>
             <translation>{command}：{status}</translation>
         </message>
@@ -1340,22 +1216,22 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="210" />
+            <location filename="../../ui/panels/planner_panel.py" line="213" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="388" />
+            <location filename="../../ui/panels/planner_panel.py" line="391" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="397" />
+            <location filename="../../ui/panels/planner_panel.py" line="400" />
             <source>Failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="397" />
+            <location filename="../../ui/panels/planner_panel.py" line="400" />
             <source>Stopped</source>
             <translation>已停止</translation>
         </message>
@@ -1363,152 +1239,152 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="213" />
+            <location filename="../../ui/controllers/point_sync.py" line="153" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="224" />
+            <location filename="../../ui/controllers/point_sync.py" line="164" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="234" />
+            <location filename="../../ui/controllers/point_sync.py" line="174" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="236" />
+            <location filename="../../ui/controllers/point_sync.py" line="176" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="243" />
+            <location filename="../../ui/controllers/point_sync.py" line="183" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="269" />
+            <location filename="../../ui/controllers/point_sync.py" line="209" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="275" />
+            <location filename="../../ui/controllers/point_sync.py" line="215" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="278" />
+            <location filename="../../ui/controllers/point_sync.py" line="218" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="282" />
+            <location filename="../../ui/controllers/point_sync.py" line="222" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="284" />
+            <location filename="../../ui/controllers/point_sync.py" line="224" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="289" />
+            <location filename="../../ui/controllers/point_sync.py" line="229" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="305" />
+            <location filename="../../ui/controllers/point_sync.py" line="245" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="318" />
+            <location filename="../../ui/controllers/point_sync.py" line="265" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="321" />
+            <location filename="../../ui/controllers/point_sync.py" line="268" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="353" />
+            <location filename="../../ui/controllers/point_sync.py" line="298" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="367" />
+            <location filename="../../ui/controllers/point_sync.py" line="312" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="397" />
+            <location filename="../../ui/controllers/point_sync.py" line="336" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="402" />
+            <location filename="../../ui/controllers/point_sync.py" line="341" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="413" />
+            <location filename="../../ui/controllers/point_sync.py" line="352" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="417" />
+            <location filename="../../ui/controllers/point_sync.py" line="356" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="423" />
+            <location filename="../../ui/controllers/point_sync.py" line="362" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="430" />
+            <location filename="../../ui/controllers/point_sync.py" line="369" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="432" />
+            <location filename="../../ui/controllers/point_sync.py" line="371" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="441" />
+            <location filename="../../ui/controllers/point_sync.py" line="380" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="445" />
+            <location filename="../../ui/controllers/point_sync.py" line="384" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="483" />
+            <location filename="../../ui/controllers/point_sync.py" line="422" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="485" />
+            <location filename="../../ui/controllers/point_sync.py" line="424" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="501" />
+            <location filename="../../ui/controllers/point_sync.py" line="440" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="505" />
+            <location filename="../../ui/controllers/point_sync.py" line="444" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="509" />
+            <location filename="../../ui/controllers/point_sync.py" line="448" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -1694,174 +1570,174 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="723" />
+            <location filename="../../ui/panels/points_panel.py" line="245" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="723" />
+            <location filename="../../ui/panels/points_panel.py" line="245" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="725" />
+            <location filename="../../ui/panels/points_panel.py" line="247" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="725" />
+            <location filename="../../ui/panels/points_panel.py" line="247" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="726" />
+            <location filename="../../ui/panels/points_panel.py" line="248" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="726" />
+            <location filename="../../ui/panels/points_panel.py" line="248" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="727" />
+            <location filename="../../ui/panels/points_panel.py" line="249" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="728" />
+            <location filename="../../ui/panels/points_panel.py" line="250" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="729" />
+            <location filename="../../ui/panels/points_panel.py" line="251" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="730" />
+            <location filename="../../ui/panels/points_panel.py" line="252" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="731" />
+            <location filename="../../ui/panels/points_panel.py" line="253" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="732" />
+            <location filename="../../ui/panels/points_panel.py" line="254" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="733" />
+            <location filename="../../ui/panels/points_panel.py" line="255" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="734" />
+            <location filename="../../ui/panels/points_panel.py" line="256" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="735" />
+            <location filename="../../ui/panels/points_panel.py" line="257" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="735" />
+            <location filename="../../ui/panels/points_panel.py" line="257" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="736" />
-            <location filename="../../ui/panels/points_panel.py" line="752" />
+            <location filename="../../ui/panels/points_panel.py" line="258" />
+            <location filename="../../ui/panels/points_panel.py" line="274" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="737" />
+            <location filename="../../ui/panels/points_panel.py" line="259" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="738" />
+            <location filename="../../ui/panels/points_panel.py" line="260" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="739" />
-            <location filename="../../ui/panels/points_panel.py" line="879" />
+            <location filename="../../ui/panels/points_panel.py" line="261" />
+            <location filename="../../ui/panels/points_panel.py" line="401" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="740" />
+            <location filename="../../ui/panels/points_panel.py" line="262" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="741" />
+            <location filename="../../ui/panels/points_panel.py" line="263" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="741" />
+            <location filename="../../ui/panels/points_panel.py" line="263" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="742" />
+            <location filename="../../ui/panels/points_panel.py" line="264" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="747" />
+            <location filename="../../ui/panels/points_panel.py" line="269" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="748" />
+            <location filename="../../ui/panels/points_panel.py" line="270" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="749" />
+            <location filename="../../ui/panels/points_panel.py" line="271" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="750" />
+            <location filename="../../ui/panels/points_panel.py" line="272" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="753" />
+            <location filename="../../ui/panels/points_panel.py" line="275" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="754" />
+            <location filename="../../ui/panels/points_panel.py" line="276" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="842" />
+            <location filename="../../ui/panels/points_panel.py" line="364" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="845" />
+            <location filename="../../ui/panels/points_panel.py" line="367" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="868" />
+            <location filename="../../ui/panels/points_panel.py" line="390" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="872" />
+            <location filename="../../ui/panels/points_panel.py" line="394" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -1874,7 +1750,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="915" />
+            <location filename="../../ui/panels/points_panel.py" line="431" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -2581,122 +2457,122 @@ Recover it?</source>
     <context>
         <name>StatusPanel</name>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="216" />
+            <location filename="../../ui/panels/status_panel.py" line="219" />
             <source>Link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="217" />
+            <location filename="../../ui/panels/status_panel.py" line="220" />
             <source>Controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="218" />
+            <location filename="../../ui/panels/status_panel.py" line="221" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="220" />
+            <location filename="../../ui/panels/status_panel.py" line="223" />
             <source>State:</source>
             <translation>状态：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="221" />
+            <location filename="../../ui/panels/status_panel.py" line="224" />
             <source>RTT:</source>
             <translation>往返时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="222" />
+            <location filename="../../ui/panels/status_panel.py" line="225" />
             <source>Mode:</source>
             <translation>模式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="223" />
+            <location filename="../../ui/panels/status_panel.py" line="226" />
             <source>Program:</source>
             <translation>程序：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="224" />
+            <location filename="../../ui/panels/status_panel.py" line="227" />
             <source>Last command:</source>
             <translation>上一条命令：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="225" />
+            <location filename="../../ui/panels/status_panel.py" line="228" />
             <source>Clock:</source>
             <translation>系统时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="226" />
+            <location filename="../../ui/panels/status_panel.py" line="229" />
             <source>Drift:</source>
             <translation>时差：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="227" />
+            <location filename="../../ui/panels/status_panel.py" line="230" />
             <source>Round-trip time of the last poll</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="231" />
+            <location filename="../../ui/panels/status_panel.py" line="234" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="232" />
+            <location filename="../../ui/panels/status_panel.py" line="235" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="235" />
+            <location filename="../../ui/panels/status_panel.py" line="238" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="243" />
+            <location filename="../../ui/panels/status_panel.py" line="246" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="319" />
+            <location filename="../../ui/panels/status_panel.py" line="336" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="321" />
+            <location filename="../../ui/panels/status_panel.py" line="338" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="330" />
+            <location filename="../../ui/panels/status_panel.py" line="348" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="336" />
+            <location filename="../../ui/panels/status_panel.py" line="354" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="349" />
+            <location filename="../../ui/panels/status_panel.py" line="367" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="357" />
+            <location filename="../../ui/panels/status_panel.py" line="375" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="361" />
+            <location filename="../../ui/panels/status_panel.py" line="379" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="365" />
+            <location filename="../../ui/panels/status_panel.py" line="383" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="372" />
+            <location filename="../../ui/panels/status_panel.py" line="390" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>
@@ -2704,97 +2580,97 @@ Recover it?</source>
     <context>
         <name>StepPanel</name>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="159" />
+            <location filename="../../ui/panels/step_panel.py" line="143" />
             <source>Frame:</source>
             <translation>坐标系：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="160" />
+            <location filename="../../ui/panels/step_panel.py" line="144" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="161" />
+            <location filename="../../ui/panels/step_panel.py" line="145" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="162" />
+            <location filename="../../ui/panels/step_panel.py" line="146" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="163" />
+            <location filename="../../ui/panels/step_panel.py" line="147" />
             <source>Expected speed of the incremental move (GV225)</source>
             <translation>增量运动的期望速度（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="164" />
+            <location filename="../../ui/panels/step_panel.py" line="148" />
             <source>Increment per click (mm or °)</source>
             <translation>每次点击的增量（mm 或 °）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="165" />
+            <location filename="../../ui/panels/step_panel.py" line="149" />
             <source>Incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="166" />
+            <location filename="../../ui/panels/step_panel.py" line="150" />
             <source>Exact offset</source>
             <translation>精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="167" />
+            <location filename="../../ui/panels/step_panel.py" line="151" />
             <source>Move by values</source>
             <translation>按数值运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="168" />
+            <location filename="../../ui/panels/step_panel.py" line="152" />
             <source>Move every axis by its exact offset in one incremental move</source>
             <translation>以一次增量运动使各轴移动其精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="169" />
+            <location filename="../../ui/panels/step_panel.py" line="153" />
             <source>Clear values</source>
             <translation>清除数值</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="170" />
+            <location filename="../../ui/panels/step_panel.py" line="154" />
             <source>External axes J7–J11</source>
             <translation>外部轴 J7–J11</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="171" />
+            <location filename="../../ui/panels/step_panel.py" line="155" />
             <source>Show the external axes; while hidden their offsets are 0</source>
             <translation>显示外部轴；隐藏时其偏移量为 0</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="200" />
+            <location filename="../../ui/panels/step_panel.py" line="184" />
             <source>rpm</source>
             <translation>转/分</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="200" />
+            <location filename="../../ui/panels/step_panel.py" line="184" />
             <source>mm/s</source>
             <translation>mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="248" />
+            <location filename="../../ui/panels/step_panel.py" line="232" />
             <source>Move by {moves} at {speed} {unit}?</source>
             <translation>以 {speed} {unit} 运动 {moves}？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="250" />
+            <location filename="../../ui/panels/step_panel.py" line="234" />
             <source>Confirm incremental move</source>
             <translation>确认增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="274" />
+            <location filename="../../ui/panels/step_panel.py" line="258" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="274" />
+            <location filename="../../ui/panels/step_panel.py" line="258" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
@@ -2898,6 +2774,115 @@ Recover it?</source>
             <location filename="../../ui/panels/traffic_panel.py" line="293" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
+        </message>
+    </context>
+    <context>
+        <name>WindowActions</name>
+        <message>
+            <location filename="../../ui/window_actions.py" line="118" />
+            <source>Show &amp;monitor</source>
+            <translation>显示监视(&amp;M)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="118" />
+            <source>Show &amp;points</source>
+            <translation>显示点位(&amp;P)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="119" />
+            <source>Show p&amp;lanner</source>
+            <translation>显示轨迹规划(&amp;L)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="121" />
+            <source>&amp;File</source>
+            <translation>文件(&amp;F)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="122" />
+            <source>&amp;Edit</source>
+            <translation>编辑(&amp;E)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="123" />
+            <source>&amp;Motion</source>
+            <translation>运动(&amp;M)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="124" />
+            <source>&amp;View</source>
+            <translation>视图(&amp;V)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="125" />
+            <source>&amp;Language</source>
+            <translation>语言(&amp;L)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="126" />
+            <source>&amp;Help</source>
+            <translation>帮助(&amp;H)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="127" />
+            <location filename="../../ui/window_actions.py" line="128" />
+            <source>Toolbar</source>
+            <translation>工具栏</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="129" />
+            <source>&amp;Connect…</source>
+            <translation>连接(&amp;C)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="130" />
+            <source>Connect to a controller (Ctrl+K)</source>
+            <translation>连接控制器（Ctrl+K）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="131" />
+            <source>&amp;Disconnect</source>
+            <translation>断开(&amp;D)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="132" />
+            <source>&amp;Quit</source>
+            <translation>退出(&amp;Q)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="133" />
+            <source>&amp;Stop</source>
+            <translation>停止(&amp;S)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="134" />
+            <source>Stop all motion (Esc)</source>
+            <translation>停止所有运动（Esc）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="135" />
+            <source>&amp;Pause</source>
+            <translation>暂停(&amp;P)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="136" />
+            <source>Pause the current move or program (F6)</source>
+            <translation>暂停当前运动或程序（F6）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="137" />
+            <source>&amp;Resume</source>
+            <translation>继续(&amp;R)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="138" />
+            <source>Resume the paused move or program (F7)</source>
+            <translation>继续已暂停的运动或程序（F7）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="139" />
+            <source>&amp;About TeachPad</source>
+            <translation>关于 TeachPad(&amp;A)</translation>
         </message>
     </context>
 </TS>

@@ -38,7 +38,7 @@ def _connected(qtbot: Any, window: Any, sim: Any, **overrides: Any) -> None:
 
 def test_escape_and_stop_button_stop_a_running_program(qtbot: Any, sim: Any, window: Any) -> None:
     _connected(qtbot, window, sim)
-    assert window.stop_action.shortcut().toString() == "Esc"
+    assert window.menus.stop_action.shortcut().toString() == "Esc"
     assert window.control_bar.stop_button.isVisible() and window.control_bar.stop_button.isEnabled()
     window.program_panel.id_spin.setValue(2)
     qtbot.mouseClick(window.program_panel.run_button, Qt.MouseButton.LeftButton)

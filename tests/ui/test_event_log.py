@@ -3,15 +3,14 @@
 from __future__ import annotations
 
 import datetime as dt
-import enum
 from collections.abc import Iterator
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import pytest
 from PySide6.QtCore import QCoreApplication, Qt, QTranslator
 
+from app.link.types import ConnectionState, LinkState
 from app.models import CommandResult
 from app.protocol.enums import Alarm, CommandKind, CommandStatus, RunCommand
 from ui.panels.event_log import (
@@ -24,21 +23,6 @@ from ui.panels.event_log import (
     LogEvent,
 )
 from ui.widgets_common import COLOR_ERROR_BG, COLOR_WARN_BG
-
-
-class LinkState(enum.Enum):
-    CONNECTING = 1
-    CONNECTED = 2
-    RECONNECTING = 3
-    LINK_LOST = 4
-
-
-@dataclass(frozen=True)
-class FakeConnection:
-    state: LinkState
-    message: str = ""
-    endpoint: str = ""
-
 
 WHEN = dt.datetime(2025, 6, 1, 8, 30, 15, 250_000)
 
@@ -125,16 +109,18 @@ def test_command_results(panel: EventLogPanel) -> None:
 
 
 def test_connection_changes_are_logged_once(panel: EventLogPanel) -> None:
-    panel.on_connection(FakeConnection(LinkState.CONNECTING, "", "127.0.0.1:502"))
-    panel.on_connection(FakeConnection(LinkState.CONNECTED, "", "127.0.0.1:502"))
-    panel.on_connection(FakeConnection(LinkState.CONNECTED, "", "127.0.0.1:502"))
-    panel.on_connection(FakeConnection(LinkState.LINK_LOST, "no answer", "127.0.0.1:502"))
-    panel.on_connection(FakeConnection(LinkState.RECONNECTING, "retry in 0.5 s"))
+    panel.on_connection(ConnectionState(LinkState.CONNECTING, "", "127.0.0.1:502"))
+    panel.on_connection(ConnectionState(LinkState.CONNECTED, "", "127.0.0.1:502"))
+    panel.on_connection(ConnectionState(LinkState.CONNECTED, "", "127.0.0.1:502"))
+    panel.on_connection(ConnectionState(LinkState.NOT_ANSWERING, "no answer", "127.0.0.1:502"))
+    panel.on_connection(ConnectionState(LinkState.DOWN, "retry in 0.5 s"))
+    panel.on_connection(ConnectionState(LinkState.DISCONNECTED))
     assert messages(panel) == [
         ("info", "connecting — 127.0.0.1:502"),
         ("info", "connected — 127.0.0.1:502"),
-        ("error", "link lost — 127.0.0.1:502 — no answer"),
-        ("warning", "reconnecting — retry in 0.5 s"),
+        ("warning", "not answering — 127.0.0.1:502 — no answer"),
+        ("error", "link down — retry in 0.5 s"),
+        ("info", "disconnected"),
     ]
 
 

@@ -38,7 +38,7 @@ def _english(window: MainWindow) -> dict[str, str]:
     return {
         "tab": window.tabs.tabText(0),
         "stop": window.control_bar.stop_button.text(),
-        "menu": window.motion_menu.title(),
+        "menu": window.menus.motion_menu.title(),
         "frame": window.jog_panel.frame_combo.itemText(0),
         "step": window.step_panel.axes_box.title(),
         "program": window.program_panel.run_button.text(),
@@ -52,7 +52,7 @@ def test_builds_and_switches_language_at_runtime(qtbot: Any, sim: Any, window: M
                                 "step": "Incremental move", "program": "Run program"}
     connect(qtbot, window.link, sim)
     qtbot.waitUntil(lambda: window.control_bar.mode_text() == "auto", timeout=SIGNAL_TIMEOUT_MS)
-    window.language_actions["zh_CN"].trigger()
+    window.menus.language_actions["zh_CN"].trigger()
     assert _english(window) == {"tab": "点动", "stop": "停止", "menu": "运动(&M)", "frame": "基坐标系",
                                 "step": "增量运动", "program": "运行程序"}
     assert window.control_bar.mode_text() == "自动"  # protocol texts too
@@ -70,7 +70,7 @@ def test_builds_in_chinese_from_the_start(qtbot: Any, link: Any, app_settings: A
     qtbot.addWidget(window)
     assert window.tabs.tabText(1) == "增量运动"
     assert window.step_panel.speed_unit() == "转/分"
-    assert window.language_actions["zh_CN"].isChecked()
+    assert window.menus.language_actions["zh_CN"].isChecked()
     assert "未连接" in window.motion_banner.text()
 
 
@@ -110,13 +110,13 @@ def test_connect_disconnect_from_the_window(qtbot: Any, sim: Any, window: MainWi
     assert app_settings.connection() == settings  # remembered
     with qtbot.waitSignal(window.link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED),
                           timeout=SIGNAL_TIMEOUT_MS):
-        window.disconnect_action.trigger()
+        window.menus.disconnect_action.trigger()
     assert not window.motion_enabled
 
 
 def test_errors_reach_the_event_log(qtbot: Any, window: MainWindow) -> None:
     with qtbot.waitSignal(window.link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS):
-        window.stop_action.trigger()  # not connected
+        window.menus.stop_action.trigger()  # not connected
     last = list(window.event_log.model.events())[-1]
     assert (last.level, last.source, last.text) == ("error", "stop", "not connected to a controller")
 

@@ -11,13 +11,15 @@ import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 
+from app.link.types import WorkerError
 from app.plan.checks import IssueKind
 from app.plan.runner import RunState
 from app.plan.segments import Segment, SegmentKind
 from app.points.ledger import SyncState, UploadOutcome, UploadReport
 from app.points.project import Project, load_project
-from tests.ui.test_points_panel import FakeError, FakeLink
+from tests.ui.fake_link import FakeLink
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.point_sync import PointSyncController
 from ui.models.plan_columns import (
     COL_END,
     COL_IGNORE,
@@ -34,7 +36,6 @@ from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
 from ui.palette import COLOR_ERROR, COLOR_WARN_TEXT
 from ui.panels.planner_panel import PlannerPanel
-from ui.panels.points_panel import PointSyncController
 
 SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
 
@@ -272,11 +273,11 @@ def test_lost_link_and_refusal_end_the_run(qtbot: Any, runner: PlanRunController
     assert finished.args[0].state is RunState.FAILED and "connection reset" in finished.args[0].message
     link.set_connected(True)
     runner.resume_run()
-    link.errorOccurred.emit(FakeError("move to point", "another request's error",
+    link.errorOccurred.emit(WorkerError("move to point", "another request's error",
                                       link.last_id("move_to_point") - 1))
     assert runner.running  # not ours
     with qtbot.waitSignal(runner.runFinished) as finished:
-        link.errorOccurred.emit(FakeError("move to point", "jog is still under way",
+        link.errorOccurred.emit(WorkerError("move to point", "jog is still under way",
                                           link.last_id("move_to_point")))
     assert finished.args[0].resume_from == 0 and "jog is still under way" in finished.args[0].message
 

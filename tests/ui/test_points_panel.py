@@ -1,137 +1,27 @@
-"""PointsPanel and PointSyncController with a fake link: teach, upload / cancel / restore,
+"""PointsPanel and PointSyncController with the typed fake link: teach, upload / cancel / restore,
 move to point (confirmation injected), validation messages, filter, undo of teach."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QObject, Signal
 from PySide6.QtGui import QUndoStack
 
+from app.link.types import WorkerError
 from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, make_point
 from app.points.project import load_project
-from app.protocol.enums import CommandKind, CommandStatus, RunCommand
+from app.protocol.enums import CommandKind, RunCommand
+from tests.ui.fake_link import FakeLink
+from ui.controllers.point_sync import PointSyncController
 from ui.models.point_columns import COL_E1, COL_TOOL, COL_X
 from ui.models.points_model import PointsModel
-from ui.panels.points_panel import PointsPanel, PointSyncController
+from ui.panels.points_panel import PointsPanel
 
 SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
-
-
-# --- the fake link (also used by test_planner.py) ------------------------------------------
-
-
-@dataclass(frozen=True)
-class FakeState:
-    connected: bool = True
-    message: str = ""
-
-
-@dataclass(frozen=True)
-class FakeError:
-    operation: str
-    message: str
-    request_id: int | None = None
-
-
-@dataclass
-class Call:
-    name: str
-    args: tuple[Any, ...]
-    kwargs: dict[str, Any] = field(default_factory=dict)
-    request_id: int = 0
-
-
-class FakeLink(QObject):
-    """The signals and methods of ``RobotLink`` the panels use; records the calls. Every command
-    returns a request id; the ``finish_*`` helpers answer the latest request of their kind."""
-
-    poseChanged = Signal(object)  # noqa: N815
-    commandFinished = Signal(object)  # noqa: N815
-    errorOccurred = Signal(object)  # noqa: N815
-    connectionChanged = Signal(object)  # noqa: N815
-    controllerReconnected = Signal()  # noqa: N815
-    controllerRestarted = Signal()  # noqa: N815
-    uploadProgress = Signal(int, int)  # noqa: N815
-    pointUploaded = Signal(int, bool, str)  # noqa: N815
-    called = Signal(str)
-
-    def __init__(self, connected: bool = True) -> None:
-        super().__init__()
-        self.state = FakeState(connected)
-        self.calls: list[Call] = []
-        self._next_id = 100
-
-    def _record(self, name: str, *args: Any, **kwargs: Any) -> int:
-        self._next_id += 1
-        self.calls.append(Call(name, args, kwargs, self._next_id))
-        self.called.emit(name)
-        return self._next_id
-
-    def named(self, name: str) -> list[Call]:
-        return [c for c in self.calls if c.name == name]
-
-    def last_id(self, name: str) -> int:
-        """The id of the latest ``name`` call (0, an id never given out, if there was none)."""
-        calls = self.named(name)
-        return calls[-1].request_id if calls else 0
-
-    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = 200) -> int:
-        return self._record("create_point", point_id, pose, tool)
-
-    def upload_points(self, points: Any) -> int:
-        return self._record("upload_points", [(pid, tuple(pose), tool) for pid, pose, tool in points])
-
-    def cancel_upload(self) -> int:
-        return self._record("cancel_upload")
-
-    def move_to_point(self, end_id: int, via_id: int | None = None, **kwargs: Any) -> int:
-        return self._record("move_to_point", end_id, via_id, **kwargs)
-
-    def stop(self) -> int:
-        return self._record("stop")
-
-    def pause(self) -> int:
-        return self._record("pause")
-
-    def resume(self) -> int:
-        return self._record("resume")
-
-    # what the worker would emit
-    def set_connected(self, connected: bool, message: str = "") -> None:
-        self.state = FakeState(connected, message)
-        self.connectionChanged.emit(self.state)
-
-    def finish_create(self, ok: bool = True, pose: Sequence[float] | None = None, message: str = "") -> None:
-        details = dict(zip("xyzabc", pose, strict=True)) if pose is not None else {}
-        status = CommandStatus(CommandKind.CREATE_POINT, 0xFF if ok else 1)
-        self.commandFinished.emit(CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, status, ok,
-                                                message, {k: float(v) for k, v in details.items()},
-                                                request_id=self.last_id("create_point")))
-
-    def finish_move(self, ok: bool = True, code: int = 0xFF, message: str = "") -> None:
-        status = CommandStatus(CommandKind.MOVE, code)
-        result = CommandResult(RunCommand.MOVE_TO_POINT, CommandKind.MOVE, status, ok, message,
-                               request_id=self.last_id("move_to_point"))
-        self.commandFinished.emit(result)
-
-    def point_ok(self, *point_ids: int) -> None:
-        for point_id in point_ids:
-            self.pointUploaded.emit(point_id, True, "")
-
-    def point_failed(self, point_id: int, message: str) -> None:
-        self.pointUploaded.emit(point_id, False, message)
-
-    def upload_summary(self, uploaded: int, total: int, reason: str = "") -> None:
-        text = f"uploaded {uploaded} of {total} points" + (f" ({reason})" if reason else "")
-        self.commandFinished.emit(CommandResult(RunCommand.CREATE_POINT, None, None, uploaded == total, text,
-                                                {"uploaded": float(uploaded)},
-                                                request_id=self.last_id("upload_points")))
 
 
 # --- fixtures -------------------------------------------------------------------------------
@@ -178,7 +68,7 @@ def test_teach_creates_next_point_from_the_current_pose(qtbot: Any, panel: Point
     assert [(c.args) for c in link.named("create_point")] == [(9, None, 200)]
     assert not panel.action_teach.isEnabled()  # one operation at a time
     assert 9 not in panel.model.ledger  # nothing until the controller confirms
-    link.poseChanged.emit(Pose(0, 0, 0, 0, 0, 0, ext=(1, 2, 3, 4, 5)))
+    link.state.set_pose(Pose(0, 0, 0, 0, 0, 0, ext=(1, 2, 3, 4, 5)))
     with qtbot.waitSignal(panel.controller.pointTaught) as taught:
         link.finish_create(True, pose=(410.5, -20.0, 300.25, 180.0, 0.0, 45.0))
     assert taught.args == [9]
@@ -197,7 +87,7 @@ def test_teach_creates_next_point_from_the_current_pose(qtbot: Any, panel: Point
 def test_teach_without_pose_details_uses_the_latest_pose(qtbot: Any, panel: PointsPanel,
                                                          link: FakeLink) -> None:
     panel.teach()
-    link.poseChanged.emit(Pose(1.0, 2.0, 3.0, 4.0, 5.0, 6.0))
+    link.state.set_pose(Pose(1.0, 2.0, 3.0, 4.0, 5.0, 6.0))
     with qtbot.waitSignal(panel.controller.pointTaught):
         link.finish_create(True)
     assert panel.model.ledger.point(9).xyzabc == (1.0, 2.0, 3.0, 4.0, 5.0, 6.0)
@@ -311,14 +201,14 @@ def test_results_of_other_requests_are_ignored(qtbot: Any, panel: PointsPanel, l
     other = CommandResult(RunCommand.CREATE_POINT, None, None, True, "uploaded 1 of 1 points",
                           {"uploaded": 1.0}, request_id=link.last_id("upload_points") - 1)
     link.commandFinished.emit(other)
-    link.errorOccurred.emit(FakeError("upload points", "someone else's", request_id=None))
+    link.errorOccurred.emit(WorkerError("upload points", "someone else's", request_id=None))
     assert panel.controller.busy
 
 
 def test_upload_refused_by_the_worker(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
     panel.controller.upload([1])
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
-        link.errorOccurred.emit(FakeError("upload points", "move to point is still under way",
+        link.errorOccurred.emit(WorkerError("upload points", "move to point is still under way",
                                           link.last_id("upload_points")))
     assert finished.args[0].aborted == "move to point is still under way"
     assert panel.model.ledger.point(1).sync is SyncState.UNKNOWN

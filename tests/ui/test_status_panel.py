@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import datetime as dt
-import enum
 from collections.abc import Iterator
-from dataclasses import dataclass
 from typing import Any
 
 import pytest
 from PySide6.QtCore import QCoreApplication, QTranslator
 
+from app.link.types import ConnectionState, LinkState
 from app.models import CommandResult, ControllerStatus
 from app.protocol.datetime_regs import ControllerClock, decode_clock, encode_clock
 from app.protocol.enums import (
@@ -23,22 +22,6 @@ from app.protocol.enums import (
 )
 from ui.panels.status_panel import StatusPanel
 from ui.widgets_common import COLOR_ERROR, COLOR_OK, COLOR_WARN, LEVEL_ERROR, LEVEL_OFF, LEVEL_OK, LEVEL_WARN
-
-
-class LinkState(enum.Enum):
-    CONNECTED = "connected"
-    CONNECTING = "connecting"
-    LINK_LOST = "link lost"
-    DOWN = "down"
-    WEIRD_STATE = "?"
-
-
-@dataclass(frozen=True)
-class FakeConnection:
-    state: LinkState
-    message: str = ""
-    endpoint: str = ""
-    monitor_only: bool = False
 
 
 def status(
@@ -198,20 +181,20 @@ def test_invalid_clock_shows_raw_words(panel: StatusPanel) -> None:
     [
         (LinkState.CONNECTED, "connected", LEVEL_OK),
         (LinkState.CONNECTING, "connecting", LEVEL_WARN),
-        (LinkState.LINK_LOST, "link lost", LEVEL_ERROR),
+        (LinkState.NOT_ANSWERING, "not answering", LEVEL_WARN),
         (LinkState.DOWN, "link down", LEVEL_ERROR),
-        (LinkState.WEIRD_STATE, "weird state", LEVEL_WARN),
+        (LinkState.DISCONNECTED, "disconnected", LEVEL_OFF),
     ],
 )
 def test_link_state(panel: StatusPanel, state: LinkState, text: str, level: str) -> None:
-    panel.on_connection(FakeConnection(state, "no answer", "10.0.0.5:502"))
+    panel.on_connection(ConnectionState(state, "no answer", "10.0.0.5:502"))
     assert panel.link_lamp.text() == text
     assert panel.link_lamp.level() == level
     assert panel.link_message.text() == "10.0.0.5:502 — no answer"
 
 
 def test_monitor_only_is_shown(panel: StatusPanel) -> None:
-    panel.on_connection(FakeConnection(LinkState.CONNECTED, "", "127.0.0.1:502", monitor_only=True))
+    panel.on_connection(ConnectionState(LinkState.CONNECTED, "", "127.0.0.1:502", monitor_only=True))
     assert panel.link_message.text() == "127.0.0.1:502 — monitor only: writes blocked"
 
 

@@ -20,8 +20,9 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     link_fixture,
     register_writes,
 )
+from ui.controllers.point_sync import PointSyncController
 from ui.models.points_model import PointsModel
-from ui.panels.points_panel import PointsPanel, PointSyncController
+from ui.panels.points_panel import PointsPanel
 
 pytestmark = pytest.mark.timeout(120)
 

@@ -70,8 +70,8 @@ def test_tabs_and_menus_in_both_languages(qtbot: Any, link: Any, app_settings: A
         assert window.work_tabs.widget(TAB_POINTS) is window.points_panel
         assert window.work_tabs.widget(TAB_PLANNER) is window.planner_panel
         assert all(window.work_tabs.tabText(i) for i in range(3))
-        assert window.project.action_undo in window.edit_menu.actions()
-        assert window.project.action_open in window.file_menu.actions()
+        assert window.project.action_undo in window.menus.edit_menu.actions()
+        assert window.project.action_open in window.menus.file_menu.actions()
         if language == "zh_CN":
             assert window.tabs.tabText(0) == "点动"
         window.close()

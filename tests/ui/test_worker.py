@@ -44,7 +44,7 @@ def test_connect_poll_disconnect(qtbot: Any, sim: Any, link: RobotLink) -> None:
     with qtbot.waitSignals([link.poseChanged, link.statusChanged], timeout=SIGNAL_TIMEOUT_MS):
         connect(qtbot, link, sim)
     assert states[:2] == [LinkState.CONNECTING, LinkState.CONNECTED]
-    assert link.state.endpoint == f"127.0.0.1:{sim.port}"
+    assert link.connection.endpoint == f"127.0.0.1:{sim.port}"
     with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED),
                           timeout=SIGNAL_TIMEOUT_MS):
         link.disconnect()
@@ -191,7 +191,7 @@ def test_monitor_only_never_writes(qtbot: Any, sim: Any, link: RobotLink) -> Non
     errors: list[WorkerError] = []
     link.errorOccurred.connect(errors.append)
     connect(qtbot, link, sim, monitor_only=True)
-    assert link.state.monitor_only
+    assert link.connection.monitor_only
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS):
         link.jog_press(TeachFrame.BASE, 0, 1, 50.0)
     link.jog_release()  # (a release right after a press would drop the press unsent)
@@ -222,7 +222,7 @@ def test_link_loss_then_reconnect_stops_the_jog_first(qtbot: Any, sim: Any, link
     assert after[disable].values == (0x81,)  # teach disable ...
     assert disable >= 1  # ... after ratio 0, and nothing else before
     assert all(w.address == 406 and w.values == (0, 0) for w in after[:disable])
-    assert link.state.state is LinkState.CONNECTED
+    assert link.connection.state is LinkState.CONNECTED
 
 
 def test_dropped_connections_recover(qtbot: Any, sim: Any, link: RobotLink) -> None:
@@ -474,7 +474,7 @@ def test_restart_canary_detects_a_restart_under_a_live_link(qtbot: Any, sim: Any
     assert gv_writes(sim, 99)[1][1] != 0.0
     with qtbot.assertNotEmitted(link.controllerRestarted, wait=400):  # armed again, quiet
         pass
-    assert reconnected == [] and link.state.state is LinkState.CONNECTED
+    assert reconnected == [] and link.connection.state is LinkState.CONNECTED
 
 
 def test_restart_canary_is_never_written_in_monitor_only(qtbot: Any, sim: Any,

@@ -7,46 +7,26 @@ for segment k. Pause / resume / stop are forwarded to the link. A failed segment
 command or a lost link ends the run in ``FAILED`` at that segment; :meth:`resume_run`
 continues from it ("Resume from k").
 
-Which ``commandFinished`` / ``errorOccurred`` belongs to the running segment: the one carrying
-the request id that ``link.move_to_point`` returned for it (the link gives every request an id
-and every outcome, including "cancelled by Stop" and refusals, carries it). Everything else
-(acknowledgements, other panels' commands) is ignored. A failed stop request of ours, matched by
-its id, ends a run that is stopping.
+Each segment's outcome comes back on its own :class:`~app.link.robot_link.Pending`
+(``link.track(link.move_to_point(...))``: the link matches request ids, including "cancelled by
+Stop" and refusals); everything else (acknowledgements, other panels' commands) never reaches
+the run. A failed stop request of ours ends a run that is stopping. Connection and pose come
+from ``link.state`` (:class:`~app.link.state.RobotState`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any, Protocol
 
-from PySide6.QtCore import QObject, Signal, SignalInstance, Slot
+from PySide6.QtCore import QObject, Signal, Slot
 
 from app.errors import LinkError, TeachPadError
+from app.link.robot_link import LinkPort, Pending
+from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult, Pose
 from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
-
-
-class MotionLink(Protocol):
-    """What a run needs from the robot link (``app.link.worker.RobotLink`` fits)."""
-
-    poseChanged: SignalInstance
-    commandFinished: SignalInstance
-    errorOccurred: SignalInstance
-    connectionChanged: SignalInstance
-
-    @property
-    def state(self) -> Any: ...  # ConnectionState (.connected)
-
-    def move_to_point(self, end_id: int, via_id: int | None = None, *, orientation_changes: bool = ...,
-                      ignore_middle: bool = ..., speed: float = ..., tool: int = ...) -> int: ...
-
-    def stop(self) -> int: ...
-
-    def pause(self) -> int: ...
-
-    def resume(self) -> int: ...
 
 
 class PlanRunController(QObject):
@@ -69,35 +49,32 @@ class PlanRunController(QObject):
     poseChanged = Signal(object)
     pointsMissing = Signal(object)
 
-    def __init__(self, link: MotionLink | None = None, parent: QObject | None = None) -> None:
+    def __init__(self, link: LinkPort | None = None, parent: QObject | None = None) -> None:
         super().__init__(parent)
-        self._link: MotionLink | None = None
+        self._link: LinkPort | None = None
         self._runner: PlanRunner | None = None
         self._plan: Plan | None = None
         self._paused = False
         self._connected = False
-        self._last_pose: Pose | None = None
         self._outcome: RunOutcome | None = None
         self._progress: RunProgress | None = None
         self._sent: list[int] = []  # segment indices sent, in order (for tests and the log)
-        self._move_request: int | None = None  # request id of the segment under way
-        self._stop_request: int | None = None  # request id of our last stop
+        self._move: Pending | None = None  # the outcome of the segment under way
+        self._stop: Pending | None = None  # the outcome of our last stop
         if link is not None:
             self.set_link(link)
 
-    def set_link(self, link: MotionLink) -> None:
+    def set_link(self, link: LinkPort) -> None:
         if self._link is not None:
             raise RuntimeError("the link is already set")
         self._link = link
-        link.commandFinished.connect(self._on_result)
-        link.errorOccurred.connect(self._on_error)
-        link.connectionChanged.connect(self._on_connection)
-        link.poseChanged.connect(self._on_pose)
-        self._set_connected(bool(getattr(getattr(link, "state", None), "connected", False)))
+        link.state.connectionChanged.connect(self._on_connection)
+        link.state.poseChanged.connect(self.poseChanged)
+        self._set_connected(link.state.connected)
 
     # --- state
     @property
-    def link(self) -> MotionLink | None:
+    def link(self) -> LinkPort | None:
         return self._link
 
     @property
@@ -132,7 +109,7 @@ class PlanRunController(QObject):
 
     @property
     def last_pose(self) -> Pose | None:
-        return self._last_pose
+        return self._link.state.pose if self._link is not None else None
 
     @property
     def can_resume(self) -> bool:
@@ -208,7 +185,9 @@ class PlanRunController(QObject):
         runner = self._runner
         link = self._link
         if link is not None:
-            self._stop_request = link.stop()
+            stop = link.track(link.stop())
+            self._stop = stop
+            stop.failed.connect(lambda error: self._on_stop_failed(stop, error))
         if runner is None or runner.state.is_over:
             return
         runner.request_stop()
@@ -218,7 +197,7 @@ class PlanRunController(QObject):
             self._finish()
 
     # --- internals
-    def _require_link(self) -> MotionLink:
+    def _require_link(self) -> LinkPort:
         if self._link is None or not self._connected:
             raise LinkError("not connected to a controller")
         return self._link
@@ -239,7 +218,7 @@ class PlanRunController(QObject):
             self.segmentStarted.emit(progress.index, progress.loop)
         self.progressChanged.emit(progress)
 
-    def _send_next(self, link: MotionLink) -> None:
+    def _send_next(self, link: LinkPort) -> None:
         runner = self._runner
         assert runner is not None
         command = runner.next_command()
@@ -248,9 +227,12 @@ class PlanRunController(QObject):
             return
         seg = command.segment
         self._sent.append(command.index)
-        self._move_request = link.move_to_point(
+        move = link.track(link.move_to_point(
             seg.end_id, seg.via_id, orientation_changes=seg.orientation_changes,
-            ignore_middle=seg.ignore_middle, speed=seg.speed, tool=seg.tool)
+            ignore_middle=seg.ignore_middle, speed=seg.speed, tool=seg.tool))
+        self._move = move
+        move.finished.connect(lambda result: self._on_result(move, result))
+        move.failed.connect(lambda error: self._on_error(move, error))
 
     def _finish(self) -> None:
         runner = self._runner
@@ -268,13 +250,11 @@ class PlanRunController(QObject):
         elif self._link is not None:
             self._send_next(self._link)
 
-    @Slot(object)
-    def _on_result(self, result: CommandResult) -> None:
+    def _on_result(self, move: Pending, result: CommandResult) -> None:
         runner = self._runner
-        if runner is None or runner.state is not RunState.RUNNING or result.request_id is None \
-                or result.request_id != self._move_request:
+        if move is not self._move or runner is None or runner.state is not RunState.RUNNING:
             return
-        self._move_request = None
+        self._move = None
         current = runner.current
         missing = (not result.ok and result.status is not None
                    and result.status.code == MoveStatus.BAD_END_POINT and current is not None)
@@ -283,34 +263,26 @@ class PlanRunController(QObject):
             self.pointsMissing.emit(list(current.segment.point_ids))
         self._after_report()
 
-    @Slot(object)
-    def _on_error(self, error: Any) -> None:
+    def _on_error(self, move: Pending, error: WorkerError) -> None:
         runner = self._runner
-        if runner is None or runner.state is not RunState.RUNNING:
+        if move is not self._move or runner is None or runner.state is not RunState.RUNNING:
             return
-        request_id = getattr(error, "request_id", None)
-        message = str(getattr(error, "message", error))
-        if request_id is None:
-            return
-        if request_id == self._move_request:
-            self._move_request = None
-            runner.on_error(TeachPadError(message))
-            self._after_report()
-        elif request_id == self._stop_request and runner.stop_requested:
-            runner.on_stopped(message)
+        self._move = None
+        runner.on_error(TeachPadError(error.message))
+        self._after_report()
+
+    def _on_stop_failed(self, stop: Pending, error: WorkerError) -> None:
+        runner = self._runner
+        if stop is self._stop and runner is not None and runner.state is RunState.RUNNING \
+                and runner.stop_requested:
+            runner.on_stopped(error.message)
             self._finish()
 
-    @Slot(object)
-    def _on_connection(self, state: Any) -> None:
-        connected = bool(getattr(state, "connected", False))
-        self._set_connected(connected)
+    @Slot(ConnectionState)
+    def _on_connection(self, state: ConnectionState) -> None:
+        self._set_connected(state.connected)
         runner = self._runner
-        if not connected and runner is not None and runner.state is RunState.RUNNING:
-            reason = str(getattr(state, "message", "")) or "link lost"
-            runner.on_error(LinkError(f"link lost: {reason}"))
+        if not state.connected and runner is not None and runner.state is RunState.RUNNING:
+            self._move = None
+            runner.on_error(LinkError(f"link lost: {state.message or 'link lost'}"))
             self._finish()
-
-    @Slot(object)
-    def _on_pose(self, pose: Pose) -> None:
-        self._last_pose = pose
-        self.poseChanged.emit(pose)

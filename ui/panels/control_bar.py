@@ -9,6 +9,8 @@ from __future__ import annotations
 from PySide6.QtCore import QEvent, Qt, Signal, Slot
 from PySide6.QtWidgets import QButtonGroup, QGridLayout, QLabel, QPushButton, QSizePolicy, QWidget
 
+from app.link.state import RobotState
+from app.link.types import ConnectionState
 from app.models import ControllerStatus
 from app.protocol.enums import ControllerMode, WorkMode, controller_mode_text
 from ui.i18n import protocol_text
@@ -111,7 +113,19 @@ class ControlBar(QWidget):
         super().changeEvent(event)
 
     # --- slots ------------------------------------------------------------------------
-    @Slot(object)
+    def bind(self, state: RobotState) -> None:
+        """Show the mode of ``state``'s status; no mode while the link is not connected."""
+        state.statusChanged.connect(self.on_status)
+        state.connectionChanged.connect(self._on_connection)
+        if state.status is not None and state.connected:
+            self.on_status(state.status)
+
+    @Slot(ConnectionState)
+    def _on_connection(self, connection: ConnectionState) -> None:
+        if not connection.connected:
+            self.clear_status()
+
+    @Slot(ControllerStatus)
     def on_status(self, status: ControllerStatus) -> None:
         if status.mode != self._mode:
             self._mode = status.mode

@@ -36,6 +36,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.link.state import RobotState
+from app.link.types import ConnectionState, LinkState, Operation, WorkerError
 from app.models import CommandResult
 from app.protocol.enums import ALARM_BITS, ALARM_TEXT, TR_CONTEXT
 from ui.widgets_common import (
@@ -49,7 +51,6 @@ from ui.widgets_common import (
     connection_display,
     export_with_dialog,
     monospace_font,
-    state_name,
 )
 
 LEVELS: tuple[str, ...] = ("info", "warning", "error")
@@ -209,7 +210,7 @@ class EventLogPanel(QWidget):
         super().__init__(parent)
         self.setObjectName("EventLogPanel")
         self._alarms: int | None = None
-        self._last_connection: tuple[str, str] | None = None
+        self._last_connection: tuple[LinkState, str] | None = None
         self.model = EventLogModel(self, max_events=max_events)
         self.proxy = _LevelFilter(self)
         self.proxy.setSourceModel(self.model)
@@ -286,6 +287,15 @@ class EventLogPanel(QWidget):
         self.eventAdded.emit(event)
         return event
 
+    def bind(self, state: RobotState) -> None:
+        """Log ``state``'s link changes, alarm edges and command results from now on."""
+        state.connectionChanged.connect(self.on_connection)
+        state.alarmsChanged.connect(self.on_alarms)
+        state.lastResultChanged.connect(self.on_command_result)
+        if state.alarms is not None:
+            self._alarms = state.alarms  # edges from here on; the lamps show what is set now
+        self._last_connection = (state.connection.state, state.connection.message)
+
     @Slot(int)
     def on_alarms(self, alarms: int) -> None:
         """Log each alarm bit that was raised or cleared since the last call."""
@@ -316,20 +326,48 @@ class EventLogPanel(QWidget):
     def on_command_result(self, result: CommandResult) -> None:
         self.add_event("info" if result.ok else "error", self.tr("command"), command_result_text(result))
 
-    @Slot(object)
-    def on_connection(self, state_obj: Any) -> None:
+    @Slot(WorkerError)
+    def on_error(self, error: WorkerError) -> None:
+        self.add_event("error", self.operation_text(error.operation), error.message)
+
+    def operation_text(self, operation: str) -> str:
+        """The operator's word for a link operation (:class:`~app.link.types.Operation`)."""
+        names = {
+            Operation.STOP: self.tr("stop"),
+            Operation.PAUSE: self.tr("pause"),
+            Operation.RESUME: self.tr("resume"),
+            Operation.JOG: self.tr("jog"),
+            Operation.JOG_RELEASE: self.tr("jog release"),
+            Operation.JOG_SPEED: self.tr("jog speed"),
+            Operation.STEP: self.tr("incremental move"),
+            Operation.SET_MODE: self.tr("work mode"),
+            Operation.GO_ZERO: self.tr("go to zero"),
+            Operation.RUN_PROGRAM: self.tr("run program"),
+            Operation.CREATE_POINT: self.tr("create temp point"),
+            Operation.MOVE_TO_POINT: self.tr("move to temp point"),
+            Operation.UPLOAD_POINTS: self.tr("upload temp points"),
+            Operation.CANCEL_UPLOAD: self.tr("cancel upload"),
+            Operation.TEACH_DISABLE: self.tr("teach disable"),
+            Operation.POLL: self.tr("monitor"),
+            Operation.CONNECT: self.tr("connect"),
+            Operation.DISCONNECT: self.tr("disconnect"),
+            Operation.SHUTDOWN: self.tr("shutdown"),
+            Operation.CANARY: self.tr("restart check"),
+        }
+        return names.get(operation, operation)
+
+    @Slot(ConnectionState)
+    def on_connection(self, connection: ConnectionState) -> None:
         """Log link state changes (a repeat of the same state and message is not logged)."""
-        name = state_name(state_obj)
-        message = str(getattr(state_obj, "message", "") or "")
-        if (name, message) == self._last_connection:
+        key = (connection.state, connection.message)
+        if key == self._last_connection:
             return
-        self._last_connection = (name, message)
-        text, lamp = connection_display(state_obj)
-        endpoint = str(getattr(state_obj, "endpoint", "") or "")
-        parts = [text, *(p for p in (endpoint, message) if p)]
+        self._last_connection = key
+        text, lamp = connection_display(connection)
+        parts = [text, *(p for p in (connection.endpoint, connection.message) if p)]
         if lamp == LEVEL_ERROR:
             level = "error"
-        elif lamp == LEVEL_WARN and name != "CONNECTING":  # connecting is routine, reconnecting is not
+        elif lamp == LEVEL_WARN and connection.state is not LinkState.CONNECTING:  # connecting is routine
             level = "warning"
         else:
             level = "info"

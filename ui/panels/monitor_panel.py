@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.link.state import RobotState
 from app.models import Pose
 from ui.models.ring_buffer import RingBuffer
 from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
@@ -280,6 +281,10 @@ class MonitorPanel(QWidget):
         super().changeEvent(event)
 
     # --- slots ------------------------------------------------------------------------
+    def bind(self, state: RobotState) -> None:
+        """Record ``state``'s poses from now on."""
+        state.poseChanged.connect(self.on_pose)
+
     @Slot(object)
     def on_pose(self, pose: Pose, t: float | None = None) -> None:
         """Record one sample (``t``: monotonic seconds, default now). Cheap: no painting here."""

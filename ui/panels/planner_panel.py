@@ -29,7 +29,6 @@ from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, Signal, S
 from PySide6.QtWidgets import (
     QGroupBox,
     QLabel,
-    QMessageBox,
     QSizePolicy,
     QVBoxLayout,
     QWidget,
@@ -50,6 +49,8 @@ from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, SegmentKind
 from app.points.ledger import UploadReport
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.point_sync import PointSyncController
+from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.models.plan_columns import PLAN_COL_NAME
 from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
@@ -66,10 +67,8 @@ from ui.panels.planner_widgets import (
     SegmentEditorBox,
     planner_splitters,
 )
-from ui.panels.points_panel import PointSyncController
 
 ModelIndex = QModelIndex | QPersistentModelIndex
-ConfirmCallable = Callable[[str, str], bool]
 
 
 class PlannerPanel(QWidget):
@@ -87,14 +86,14 @@ class PlannerPanel(QWidget):
     def __init__(self, plans: PlanListModel, points: PointsModel,
                  run_controller: PlanRunController | None = None,
                  point_sync: PointSyncController | None = None, parent: QWidget | None = None, *,
-                 confirm: ConfirmCallable | None = None, limits: PlanLimits | None = None) -> None:
+                 confirm: ConfirmFn | None = None, limits: PlanLimits | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("PlannerPanel")
         self._plans = plans
         self._points = points
         self._runner = run_controller or PlanRunController(parent=self)
         self._sync = point_sync
-        self._confirm = confirm or self._ask
+        self._confirm = confirm or ask_confirmation(self)
         self.limits = limits or PlanLimits()
         self._issues: list[PlanIssue] = []
         self._summary_text = ""
@@ -262,7 +261,7 @@ class PlannerPanel(QWidget):
             selection.setCurrentIndex(self.segments.index(rows[0], 0), selection.SelectionFlag.NoUpdate)
             self.segment_view.scrollTo(self.segments.index(rows[0], 0))
 
-    def set_confirm(self, confirm: ConfirmCallable) -> None:
+    def set_confirm(self, confirm: ConfirmFn) -> None:
         """Replace the operator's yes/no question (tests answer without a dialog)."""
         self._confirm = confirm
 
@@ -476,12 +475,6 @@ class PlannerPanel(QWidget):
             start, assumed = plan_start(plan, self._points.ledger, self._pose())
             self._set_info(plan, estimate_plan(plan, self._points.ledger, start), assumed)
         self._update_actions()
-
-    def _ask(self, title: str, question: str) -> bool:
-        answer = QMessageBox.question(self, title, question,
-                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.Cancel,
-                                      QMessageBox.StandardButton.Cancel)
-        return answer == QMessageBox.StandardButton.Yes
 
     @Slot()
     def _update_actions(self, *_args: Any) -> None:

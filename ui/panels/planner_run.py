@@ -20,8 +20,8 @@ from app.plan.runner import RunOutcome, RunState
 from app.plan.segments import Plan
 from app.points.ledger import UploadReport
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.point_sync import PointSyncController
 from ui.models.points_model import PointsModel
-from ui.panels.points_panel import PointSyncController
 
 MAX_POINTS_LISTED = 20  # point ids quoted in the upload question
 

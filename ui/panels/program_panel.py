@@ -23,8 +23,8 @@ from PySide6.QtWidgets import (
 
 from app.protocol.enums import JOINT_AXIS_NAMES, PROGRAM_MOTION_MODE_TEXT, ProgramMotionMode
 from app.protocol.registers import NUM_AXES_TOTAL
+from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.i18n import protocol_text
-from ui.panels.step_panel import ConfirmFn, ask_confirmation
 
 _MODES: tuple[ProgramMotionMode, ...] = (ProgramMotionMode.SINGLE_STEP, ProgramMotionMode.SINGLE_RUN,
                                          ProgramMotionMode.CYCLE)

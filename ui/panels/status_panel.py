@@ -1,8 +1,9 @@
 """Controller status at a glance: link and RTT, mode, program state, alarm lamps, last command
 result and the controller clock with its drift from the PC clock.
 
-The panel only displays what its slots receive; it keeps no controller state of its own beyond
-what is needed to draw it.
+``bind(state)`` subscribes the panel to a :class:`~app.link.state.RobotState` (connection,
+status, alarms, RTT, last command result); the ``on_*`` slots take the payloads directly. The
+panel keeps no controller state of its own beyond what is needed to draw it.
 """
 
 from __future__ import annotations
@@ -23,6 +24,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.link.state import RobotState
+from app.link.types import ConnectionState
 from app.models import CommandResult, ControllerStatus
 from app.protocol.datetime_regs import ControllerClock
 from app.protocol.enums import (
@@ -98,7 +101,7 @@ class StatusPanel(QWidget):
         self.setObjectName("StatusPanel")
         self._alarms: int | None = None
         self._status: ControllerStatus | None = None
-        self._connection: Any = None
+        self._connection: ConnectionState | None = None
         self._rtt: float | None = None
         self._result: CommandResult | None = None
         self._clock: ControllerClock | None = None
@@ -252,6 +255,21 @@ class StatusPanel(QWidget):
         super().changeEvent(event)
 
     # --- slots ------------------------------------------------------------------------
+    def bind(self, state: RobotState) -> None:
+        """Show ``state``'s fields from now on, starting with their current values."""
+        state.connectionChanged.connect(self.on_connection)
+        state.statusChanged.connect(self.on_status)
+        state.alarmsChanged.connect(self.on_alarms)
+        state.rttChanged.connect(self.on_rtt)
+        state.lastResultChanged.connect(self.on_command_result)
+        self.on_connection(state.connection)
+        if state.status is not None:
+            self.on_status(state.status)
+        if state.rtt is not None:
+            self.on_rtt(state.rtt)
+        if state.last_result is not None:
+            self.on_command_result(state.last_result)
+
     @Slot(object)
     def on_status(self, status: ControllerStatus) -> None:
         """Mode, program state, alarm bits and (when read along) the clock."""
@@ -268,10 +286,9 @@ class StatusPanel(QWidget):
             self._alarms = alarms
             self._render_alarms()
 
-    @Slot(object)
-    def on_connection(self, state_obj: Any) -> None:
-        """Anything with ``.state.name`` and ``.message`` (optionally ``.endpoint``, ``.monitor_only``)."""
-        self._connection = state_obj
+    @Slot(ConnectionState)
+    def on_connection(self, connection: ConnectionState) -> None:
+        self._connection = connection
         self._render_connection()
 
     @Slot(float)
@@ -321,12 +338,13 @@ class StatusPanel(QWidget):
             self.other_alarm_lamp.setText(self.tr("other bits"))
 
     def _render_connection(self) -> None:
-        state_obj = self._connection
-        text, level = connection_display(state_obj)
+        connection = self._connection
+        assert connection is not None
+        text, level = connection_display(connection)
         self.link_lamp.setText(text)
         self.link_lamp.set_level(level)
-        parts = [str(p) for p in (getattr(state_obj, "endpoint", ""), getattr(state_obj, "message", "")) if p]
-        if getattr(state_obj, "monitor_only", False):
+        parts = [p for p in (connection.endpoint, connection.message) if p]
+        if connection.monitor_only:
             parts.append(self.tr("monitor only: writes blocked"))
         self.link_message.setText(" — ".join(parts))
         self.link_message.setVisible(bool(parts))

@@ -8,7 +8,6 @@ base frame (the controller's unit for GV225 depends on the frame).
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
 
 from PySide6.QtCore import QEvent, Signal, Slot
@@ -21,7 +20,6 @@ from PySide6.QtWidgets import (
     QGroupBox,
     QHBoxLayout,
     QLabel,
-    QMessageBox,
     QPushButton,
     QVBoxLayout,
     QWidget,
@@ -30,6 +28,7 @@ from PySide6.QtWidgets import (
 from app.link.client import StepFrame
 from app.protocol.enums import CARTESIAN_AXIS_NAMES, JOINT_AXIS_NAMES
 from app.protocol.registers import NUM_AXES_TOTAL, NUM_EXTERNAL_AXES, NUM_ROBOT_AXES
+from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 
 PRESETS: tuple[float, ...] = (0.1, 1.0, 10.0)
 DEFAULT_PRESET = 1.0
@@ -38,27 +37,12 @@ CONFIRM_ABOVE = 10.0  # an exact-values move with any |offset| above this asks f
 SPEED_DEFAULT = {StepFrame.JOINT: 5.0, StepFrame.BASE: 50.0}  # rpm, mm/s
 SPEED_MAX = {StepFrame.JOINT: 100.0, StepFrame.BASE: 2000.0}
 
-ConfirmFn = Callable[[str, str], bool]
-
-
 @dataclass(frozen=True)
 class StepRequest:
     frame: StepFrame
     offsets: tuple[float, float, float, float, float, float]
     ext_offsets: tuple[float, float, float, float, float]
     speed: float
-
-
-def ask_confirmation(parent: QWidget) -> ConfirmFn:
-    """The default confirmation: a Yes/No question box, No being the default."""
-
-    def confirm(title: str, text: str) -> bool:
-        answer = QMessageBox.question(parent, title, text,
-                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
-                                      QMessageBox.StandardButton.No)
-        return answer == QMessageBox.StandardButton.Yes
-
-    return confirm
 
 
 class StepPanel(QWidget):

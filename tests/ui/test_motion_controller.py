@@ -1,0 +1,88 @@
+"""MotionController with the typed fake link and the real panels: intents become requests, the
+gate follows ``link.state`` and plan runs, a jog ends when the link leaves CONNECTED."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import QWidget
+
+from app.link.types import ConnectionState, LinkState
+from app.protocol.enums import TeachFrame, WorkMode
+from tests.ui.fake_link import FakeLink
+from ui.controllers.motion import MotionController
+from ui.controllers.plan_run_controller import PlanRunController
+from ui.panels.control_bar import ControlBar
+from ui.panels.jog_panel import JogPanel
+from ui.panels.program_panel import ProgramPanel
+from ui.panels.step_panel import StepPanel
+
+
+class Rig:
+    def __init__(self, qtbot: Any, link: FakeLink) -> None:
+        self.host = QWidget()
+        qtbot.addWidget(self.host)
+        self.link = link
+        self.bar = ControlBar(self.host)
+        self.jog = JogPanel(self.host)
+        self.step = StepPanel(self.host)
+        self.program = ProgramPanel(self.host)
+        self.runs = PlanRunController(link)
+        self.motion = MotionController(link, self.bar, self.jog, self.step, self.program, self.runs)
+
+    def panels_enabled(self) -> bool:
+        return self.jog.axes_box.isEnabled() and self.step.move_button.isEnabled() \
+            and self.program.run_button.isEnabled()
+
+
+@pytest.fixture
+def rig(qtbot: Any) -> Rig:
+    return Rig(qtbot, FakeLink(connected=False))
+
+
+def test_the_gate_follows_the_link_state(rig: Rig) -> None:
+    changes: list[bool] = []
+    rig.motion.motionEnabledChanged.connect(changes.append)
+    assert not rig.motion.motion_enabled and not rig.panels_enabled()
+    rig.link.set_connected(True)
+    assert rig.motion.motion_enabled and rig.panels_enabled() and rig.bar.pause_button.isEnabled()
+    rig.link.set_connected(True, monitor_only=True)
+    assert not rig.motion.motion_enabled and not rig.panels_enabled()
+    assert rig.bar.stop_button.isEnabled()  # Stop stays reachable
+    rig.link.state.set_connection(ConnectionState(LinkState.NOT_ANSWERING, "silent"))
+    assert not rig.motion.motion_enabled
+    assert changes == [True, False]
+
+
+def test_a_plan_run_holds_the_panels_but_not_pause(rig: Rig) -> None:
+    rig.link.set_connected(True)
+    rig.runs.runningChanged.emit(True)
+    assert not rig.panels_enabled() and rig.bar.pause_button.isEnabled() and rig.motion.run_active
+    rig.runs.runningChanged.emit(False)
+    assert rig.panels_enabled()
+
+
+def test_a_held_jog_ends_when_the_link_stops_answering(qtbot: Any, rig: Rig) -> None:
+    rig.link.set_connected(True)
+    rig.host.show()
+    qtbot.mousePress(rig.jog.button(0, 1), Qt.MouseButton.LeftButton)
+    assert [c.args[:3] for c in rig.link.named("jog_press")] == [(TeachFrame(rig.jog.frame), 0, 1)]
+    rig.link.state.set_connection(ConnectionState(LinkState.NOT_ANSWERING, "silent"))
+    assert len(rig.link.named("jog_release")) == 1  # the dead-man, before anything else
+    qtbot.mouseRelease(rig.jog.button(0, 1), Qt.MouseButton.LeftButton)
+    assert len(rig.link.named("jog_release")) == 1
+
+
+def test_intents_become_requests(rig: Rig) -> None:
+    rig.link.set_connected(True)
+    rig.bar.stopRequested.emit()
+    rig.bar.pauseRequested.emit()
+    rig.bar.resumeRequested.emit()
+    rig.bar.modeRequested.emit(WorkMode.MANUAL)
+    rig.program.goZeroRequested.emit(2)
+    names = [c.name for c in rig.link.calls]
+    assert names == ["stop", "pause", "resume", "set_mode", "go_zero"]
+    assert rig.link.named("set_mode")[0].args == (WorkMode.MANUAL,)
+    assert rig.link.named("go_zero")[0].args == (2,)

@@ -1,0 +1,108 @@
+"""MotionController: the motion panels' intents become link requests; it gates them too.
+
+The control bar (stop / pause / resume / mode), the jog, step and program panels only emit
+intents; this controller sends them through the :class:`~app.link.robot_link.LinkPort`. It
+decides when motion controls are enabled (the link connected and writable, from
+``link.state``, and no plan running: Stop, Pause and Resume stay while a plan runs) and it is
+the dead-man's second hand: any jog ends when the link leaves CONNECTED, when a plan starts
+and before a mode change.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QObject, Signal, Slot
+
+from app.link.robot_link import LinkPort
+from app.link.types import ConnectionState, JogRequest
+from app.protocol.enums import ProgramMotionMode, WorkMode
+from ui.controllers.plan_run_controller import PlanRunController
+from ui.panels.control_bar import ControlBar
+from ui.panels.jog_panel import JogPanel
+from ui.panels.program_panel import ProgramPanel, ProgramRequest
+from ui.panels.step_panel import StepPanel, StepRequest
+
+__all__ = ["MotionController"]
+
+
+class MotionController(QObject):
+    """See the module docstring. ``motionEnabledChanged(bool)``: the link is writable (Pause /
+    Resume may go out); the jog / step / program panels are also held while a plan runs."""
+
+    motionEnabledChanged = Signal(bool)
+
+    def __init__(self, link: LinkPort, control_bar: ControlBar, jog: JogPanel, step: StepPanel,
+                 program: ProgramPanel, run_controller: PlanRunController,
+                 parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self._link = link
+        self._bar = control_bar
+        self._jog = jog
+        self._step = step
+        self._program = program
+        self._run_active = False
+        self._enabled = link.state.writable
+
+        control_bar.stopRequested.connect(link.stop)
+        control_bar.pauseRequested.connect(link.pause)
+        control_bar.resumeRequested.connect(link.resume)
+        control_bar.modeRequested.connect(self._on_mode_requested)
+        jog.jogPressed.connect(self._on_jog_pressed)
+        jog.jogReleased.connect(link.jog_release)
+        jog.ratioChanged.connect(link.set_jog_ratio)
+        step.stepRequested.connect(self._on_step_requested)
+        program.programRequested.connect(self._on_program_requested)
+        program.goZeroRequested.connect(link.go_zero)
+        link.state.connectionChanged.connect(self._on_connection)
+        run_controller.runningChanged.connect(self._on_run_active)
+        self._apply()
+
+    @property
+    def motion_enabled(self) -> bool:
+        return self._enabled
+
+    @property
+    def run_active(self) -> bool:
+        return self._run_active
+
+    @Slot(ConnectionState)
+    def _on_connection(self, connection: ConnectionState) -> None:
+        if not connection.connected:
+            self._jog.release_all()  # link lost: the worker makes it safe on return
+        self._apply()
+
+    @Slot(bool)
+    def _on_run_active(self, active: bool) -> None:
+        self._run_active = active
+        if active:
+            self._jog.release_all()
+        self._apply()
+
+    def _apply(self) -> None:
+        enabled = self._link.state.writable
+        panels_enabled = enabled and not self._run_active
+        self._jog.set_motion_enabled(panels_enabled)
+        self._step.set_motion_enabled(panels_enabled)
+        self._program.set_motion_enabled(panels_enabled)
+        self._bar.set_motion_enabled(enabled)
+        if enabled != self._enabled:
+            self._enabled = enabled
+            self.motionEnabledChanged.emit(enabled)
+
+    @Slot(object)
+    def _on_jog_pressed(self, request: JogRequest) -> None:
+        self._link.jog_press(request.frame, request.axis, request.direction, request.ratio,
+                             request.user, request.tool)
+
+    @Slot(object)
+    def _on_step_requested(self, request: StepRequest) -> None:
+        self._link.step(request.frame, request.offsets, request.ext_offsets, request.speed)
+
+    @Slot(object)
+    def _on_program_requested(self, request: ProgramRequest) -> None:
+        self._link.run_program(request.program_id, ProgramMotionMode(request.mode), request.cycles,
+                               request.speed_ratio)
+
+    @Slot(object)
+    def _on_mode_requested(self, mode: WorkMode) -> None:
+        self._jog.release_all()
+        self._link.set_mode(mode)
