@@ -26,14 +26,20 @@ Commands::
     points list   PROJECT
     points upload PROJECT [--ids 1,2,5-9 | --needed]
     points export PROJECT --csv OUT [--no-bom]
-    points import PROJECT --csv IN [--merge]        # creates PROJECT if it does not exist
+    points import PROJECT --csv IN [--merge] [--allow-empty]   # creates PROJECT if missing
     run PROJECT [--plan NAME] [--loops N] [--from K] [--from-loop I] [--single]
-                [--upload] [--check] [--max-speed MM_S]
+                [--no-upload] [--check] [--max-speed MM_S]
 
 Segment numbers on the command line and in messages count from 1. ``run`` checks the plan
-first (the GUI's checks): errors refuse to run; points that are not on the controller are
-uploaded with ``--upload``, otherwise the command says which ones to upload. A failed or
-interrupted run prints the ``--from`` / ``--from-loop`` that resumes it.
+first (the GUI's checks): errors refuse to run. A project file cannot know what the
+controller holds, so ``run`` uploads every point its plan uses before the first move, then
+guards each segment (:class:`app.points.guard.PointGuard`): restart canary check, the
+segment's points re-created from the project right before its move, the arrival pose
+verified after it. ``--no-upload`` skips the uploads (the operator answers for the
+controller's points); the arrival check stays. A failed or interrupted run prints the
+``--from`` / ``--from-loop`` that resumes it. Commands that write the project refuse while
+another TeachPad has it open (:mod:`app.points.lock`); ``points upload`` in monitor-only mode
+refuses before it reads the file.
 """
 
 from __future__ import annotations
@@ -54,23 +60,14 @@ from app.plan.segments import (
     PlanLimits,
     check_plan,
     estimate_plan,
-    ids_needing_upload,
     segment_timeouts,
 )
-from app.points.ledger import (
-    DEFAULT_LIMITS,
-    FileFormatError,
-    ImportMode,
-    PointLedger,
-    PointLimits,
-    TempPoint,
-    UploadReport,
-    apply_upload,
-    parse_id_list,
-    tool_text,
-    upload_points,
-)
+from app.points.guard import PointGuard, PointMismatch, PointNotCreated
+from app.points.ledger import EmptyImport, ImportMode, PointLedger
+from app.points.lock import live_owner
+from app.points.point import DEFAULT_LIMITS, FileFormatError, PointLimits, TempPoint, tool_text
 from app.points.project import Project, load_project, read_points_csv, save_project, write_points_csv
+from app.points.upload import UploadReport, apply_upload, parse_id_list, upload_points
 from app.protocol.enums import MoveStatus
 
 PROG = "teachpad-cli"
@@ -144,6 +141,8 @@ def register(subparsers: Any) -> None:
     p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="IN")
     p.add_argument("--merge", action="store_true",
                    help="update and add points, keep the others (default: replace all points)")
+    p.add_argument("--allow-empty", action="store_true",
+                   help="let a CSV without rows replace (delete) all points of the project")
     p.set_defaults(handler=_handler(cmd_points_import))
 
     r = subparsers.add_parser("run", help="run a plan of a project on the controller (function 3)")
@@ -154,7 +153,11 @@ def register(subparsers: Any) -> None:
                    help="start at segment K (counting from 1)")
     r.add_argument("--from-loop", type=int, default=1, metavar="I", help="start in loop I (to resume)")
     r.add_argument("--single", action="store_true", help="run segment K only")
-    r.add_argument("--upload", action="store_true", help="upload points the controller does not have")
+    r.add_argument("--no-upload", action="store_true",
+                   help="do not create the plan's points on the controller before and during the run: "
+                        "the operator is responsible for the controller holding exactly the project's "
+                        "points (the arrival pose is still checked after each segment)")
+    r.add_argument("--upload", action="store_true", help=argparse.SUPPRESS)  # the default now (old scripts)
     r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
     r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
                    help="highest speed a segment may have (default %(default)g mm/s)")
@@ -182,7 +185,26 @@ def _load(io: _Io, path: Path, limits: PointLimits) -> Project | None:
         return None
 
 
+def _endpoint(client: Any) -> str:
+    settings = getattr(client, "settings", None)
+    endpoint = getattr(settings, "endpoint", None)
+    return endpoint if isinstance(endpoint, str) else "controller"
+
+
+def _monitor_only(io: _Io, args: argparse.Namespace, what: str) -> bool:
+    """True (after saying so) when --monitor-only forbids ``what``; checked before any file I/O."""
+    if getattr(args, "monitor_only", False):
+        io.error(f"{what} writes to the controller: refused in monitor-only mode (nothing read or written)")
+        return True
+    return False
+
+
 def _save(io: _Io, project: Project, path: Path) -> bool:
+    owner = live_owner(path)
+    if owner is not None:
+        io.error(f"{path}: not saved: the project is open in a TeachPad ({owner.text}); "
+                 "close it there or make the change there")
+        return False
     try:
         save_project(project, path)
     except OSError as exc:
@@ -279,8 +301,10 @@ def cmd_points_list(args: argparse.Namespace, make_client: MakeClient, *, out: T
 
 def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
                       err: TextIO | None = None, close_client: bool = True) -> int:
-    """``points upload PROJECT [--ids ... | --needed]``; saves the sync states."""
+    """``points upload PROJECT [--ids ... | --needed]``; saves the upload history."""
     io = _Io(out, err)
+    if _monitor_only(io, args, "points upload"):
+        return EXIT_FAILED
     project = _load(io, args.project, _limits(args))
     if project is None:
         return EXIT_USAGE
@@ -307,6 +331,7 @@ def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out:
     try:
         client = make_client()
         report = _upload(io, project, points, client)
+        project.record_upload([o.point_id for o in report.outcomes if o.ok], _endpoint(client))
     except TeachPadError as exc:
         return _link_code(io, exc, "cannot upload")
     finally:
@@ -335,7 +360,8 @@ def cmd_points_export(args: argparse.Namespace, make_client: MakeClient, *, out:
 
 def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
                       err: TextIO | None = None, close_client: bool = True) -> int:
-    """``points import PROJECT --csv IN [--merge]``; the project is saved only if all rows are good."""
+    """``points import PROJECT --csv IN [--merge] [--allow-empty]``; the project is saved only if
+    all rows are good; a CSV without rows does not replace all points unless ``--allow-empty``."""
     io = _Io(out, err)
     limits = _limits(args)
     if args.project.exists():
@@ -347,7 +373,11 @@ def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out:
         project = Project(name=name, ledger=PointLedger((), limits))
     try:
         points = read_points_csv(args.csv_path, limits)
-        report = project.ledger.import_points(points, ImportMode.MERGE if args.merge else ImportMode.REPLACE)
+        report = project.ledger.import_points(points, ImportMode.MERGE if args.merge else ImportMode.REPLACE,
+                                              allow_empty=getattr(args, "allow_empty", False))
+    except EmptyImport as exc:
+        io.error(f"{args.csv_path}: {exc}; nothing changed (pass --allow-empty to do it)")
+        return EXIT_USAGE
     except InvalidInput as exc:
         io.error(str(exc))
         return EXIT_USAGE
@@ -381,14 +411,39 @@ def _pick_plan(io: _Io, project: Project, name: str | None) -> Plan | None:
     return None
 
 
+def _upload_plan_points(io: _Io, args: argparse.Namespace, project: Project, guard: PointGuard,
+                        plan_ids: list[int], client: Any) -> int:
+    """Create the plan's points before the first move; records the history in the project."""
+    io.print(f"uploading the plan's {len(plan_ids)} point(s): {', '.join(map(str, plan_ids))}")
+    try:
+        guard.ensure(client, plan_ids)
+    except KeyboardInterrupt:
+        io.error("interrupted while uploading: not running")
+        return EXIT_INTERRUPTED
+    except PointNotCreated as exc:
+        io.error(f"{exc}: not running")
+        return EXIT_FAILED
+    except TeachPadError as exc:
+        return _link_code(io, exc, "cannot upload the plan's points")
+    finally:
+        project.record_upload(sorted(guard.uploaded), _endpoint(client))
+    owner = live_owner(args.project)
+    if owner is None:
+        _save(io, project, args.project)  # the upload history; a failed save does not stop the run
+    io.print(f"uploaded {len(guard.uploaded)} point(s)")
+    return EXIT_OK
+
+
 def _points_lost(error: BaseException | None) -> bool:
     return isinstance(error, CommandRefused) and error.status.code == MoveStatus.BAD_END_POINT
 
 
 def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
             err: TextIO | None = None, close_client: bool = True) -> int:
-    """``run PROJECT [--plan NAME] ...``: check, upload if asked, run with a progress line."""
+    """``run PROJECT [--plan NAME] ...``: check, upload, run guarded with a progress line."""
     io = _Io(out, err)
+    if not args.check and _monitor_only(io, args, "run"):
+        return EXIT_FAILED
     project = _load(io, args.project, _limits(args))
     if project is None:
         return EXIT_USAGE
@@ -440,24 +495,22 @@ def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client
     est = estimate_plan(plan, ledger, pose, loops=loops)
     io.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
              f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}")
-    needed = ids_needing_upload(issues)
+    plan_ids = list(dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids))
     if args.check:
-        if needed:
-            io.print(f"needs upload: {', '.join(map(str, needed))}")
+        if args.no_upload:
+            io.print("--no-upload: the controller must already hold the plan's points")
+        else:
+            io.print(f"would upload: {', '.join(map(str, plan_ids))}")
         io.print("check only: not running")
         return EXIT_OK
-    if needed:
-        if not args.upload:
-            for issue in issues:
-                if issue.kind is IssueKind.NEEDS_UPLOAD:
-                    io.error(issue.message)
-            io.error(f"upload them first ({PROG} points upload {args.project} --ids "
-                     f"{','.join(map(str, needed))}) or pass --upload")
-            return EXIT_NEEDS_UPLOAD
-        report = _upload(io, project, [ledger.point(i) for i in needed], client)
-        saved = _save(io, project, args.project)
-        if _upload_code(report) != EXIT_OK or not saved:
-            return _upload_code(report) or EXIT_FAILED
+    guard = PointGuard({p.id: p for p in ledger}, refresh=not args.no_upload)
+    if args.no_upload:
+        io.warn(f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
+                f"{', '.join(map(str, plan_ids))} (the operator's responsibility)")
+    else:
+        code = _upload_plan_points(io, args, project, guard, plan_ids, client)
+        if code != EXIT_OK:
+            return code
 
     line = _ProgressLine(io.out)
 
@@ -468,7 +521,7 @@ def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client
     runner = PlanRunner(plan, loops=loops, start=start, start_loop=args.from_loop, single=args.single,
                         timeouts=segment_timeouts(plan, ledger, pose), progress=progress)
     try:
-        outcome = runner.run(client)
+        outcome = runner.run(client, guard)
     finally:
         line.done()
     if outcome.state is RunState.FINISHED:
@@ -476,12 +529,11 @@ def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client
         return EXIT_OK
     io.error(f"{outcome.state.value}: {outcome.message}")
     if _points_lost(outcome.error):
-        # "bad end point id": the controller no longer holds the ledger's points (it has most
-        # likely restarted): record that, so `run --upload` restores them before resuming
-        ledger.mark_all_unknown()
-        if _save(io, project, args.project):
-            io.error("the controller does not hold the points any more (restarted?): all points "
-                     "are marked unknown; resume with --upload to restore them first")
+        # "bad end point id": the controller does not hold the segment's points (restarted?)
+        io.error("the controller does not hold the plan's points (restarted?); resume without "
+                 "--no-upload so that they are created first")
+    if isinstance(outcome.error, PointMismatch | PointNotCreated):
+        io.error("nothing further was sent; the robot is where the message above says")
     if outcome.resume_from is not None:
         resume = f"--from {outcome.resume_from + 1}"
         if outcome.resume_loop and outcome.resume_loop > 1:

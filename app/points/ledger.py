@@ -92,6 +92,16 @@ class ImportReport:
         )
 
 
+class EmptyImport(InvalidInput):
+    """A replace-mode import without a single point: it would delete every point; refused
+    unless the caller asks for it explicitly (``allow_empty=True``)."""
+
+    def __init__(self, existing: int) -> None:
+        self.existing = existing
+        super().__init__(f"the file has no points: replacing with it would remove all {existing} point(s) "
+                         "of the project (merge it, or ask explicitly for an empty import)")
+
+
 class PointLedger:
     """The host's ordered list of temp points, unique ids, validated on every change.
 
@@ -264,10 +274,13 @@ class PointLedger:
         self._touch()
 
     def import_points(
-        self, points: Sequence[TempPoint], mode: ImportMode = ImportMode.REPLACE
+        self, points: Sequence[TempPoint], mode: ImportMode = ImportMode.REPLACE, *, allow_empty: bool = False
     ) -> ImportReport:
         """Import a parsed list. A point identical on the controller side to the one it
-        replaces keeps that one's sync state; others become ``CHANGED``."""
+        replaces keeps that one's sync state; others become ``CHANGED``. An empty list in
+        replace mode raises :class:`EmptyImport` unless ``allow_empty``."""
+        if not points and mode is ImportMode.REPLACE and not allow_empty:
+            raise EmptyImport(len(self._points))
         old = {p.id: p for p in self._points}
         seen: set[int] = set()
         for number, point in enumerate(points, start=1):
@@ -391,7 +404,8 @@ from app.points.upload import (  # noqa: E402
 __all__ = [
     "CONTROLLER_FIELDS", "CSV_COLUMNS", "CSV_REQUIRED", "DEFAULT_LIMITS", "EXT_FIELDS", "NAME_MAX_CHARS",
     "NOTE_MAX_CHARS", "POINT_FIELDS", "POSE_FIELDS", "SYNC_STATE_TEXT", "TOOL_MAX", "TOOL_NONE", "TR_CONTEXT",
-    "ZERO_EXT", "Ext5", "FieldError", "FileFormatError", "ImportMode", "ImportReport", "PointEdit",
+    "ZERO_EXT", "EmptyImport", "Ext5", "FieldError", "FileFormatError", "ImportMode", "ImportReport",
+    "PointEdit",
     "PointLedger", "PointLimits", "PointUploader", "Pose6", "SyncState", "TempPoint", "UploadOutcome",
     "UploadReport", "apply_upload", "decode_text", "make_point", "parse_float", "parse_id_list", "parse_int",
     "parse_point_id", "parse_points_csv", "parse_text", "parse_tool", "point_from_fields", "point_from_pose",
