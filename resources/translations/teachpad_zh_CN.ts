@@ -1486,23 +1486,23 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/ledger.py" line="131" />
+            <location filename="../../app/points/point.py" line="124" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host".</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/ledger.py" line="132" />
+            <location filename="../../app/points/point.py" line="125" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/ledger.py" line="133" />
+            <location filename="../../app/points/point.py" line="126" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/ledger.py" line="134" />
+            <location filename="../../app/points/point.py" line="127" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
@@ -1657,7 +1657,7 @@
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="617" />
+            <location filename="../../ui/models/points_model.py" line="618" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -1932,136 +1932,153 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="168" />
+            <location filename="../../ui/controllers/project_controller.py" line="191" />
             <source>Undo</source>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="170" />
+            <location filename="../../ui/controllers/project_controller.py" line="193" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="174" />
+            <location filename="../../ui/controllers/project_controller.py" line="197" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="175" />
+            <location filename="../../ui/controllers/project_controller.py" line="198" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="176" />
+            <location filename="../../ui/controllers/project_controller.py" line="199" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="177" />
+            <location filename="../../ui/controllers/project_controller.py" line="200" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="178" />
+            <location filename="../../ui/controllers/project_controller.py" line="201" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="179" />
+            <location filename="../../ui/controllers/project_controller.py" line="202" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="202" />
+            <location filename="../../ui/controllers/project_controller.py" line="225" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="235" />
+            <location filename="../../ui/controllers/project_controller.py" line="258" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="244" />
-            <location filename="../../ui/controllers/project_controller.py" line="247" />
+            <location filename="../../ui/controllers/project_controller.py" line="266" />
+            <location filename="../../ui/controllers/project_controller.py" line="302" />
+            <location filename="../../ui/controllers/project_controller.py" line="411" />
+            <source>Project in use</source>
+            <translation>工程正在使用中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_controller.py" line="271" />
+            <location filename="../../ui/controllers/project_controller.py" line="274" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="250" />
+            <location filename="../../ui/controllers/project_controller.py" line="277" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="262" />
+            <location filename="../../ui/controllers/project_controller.py" line="289" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="276" />
+            <location filename="../../ui/controllers/project_controller.py" line="307" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="286" />
+            <location filename="../../ui/controllers/project_controller.py" line="319" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="292" />
+            <location filename="../../ui/controllers/project_controller.py" line="325" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="299" />
-            <location filename="../../ui/controllers/project_controller.py" line="302" />
-            <location filename="../../ui/controllers/project_controller.py" line="311" />
+            <location filename="../../ui/controllers/project_controller.py" line="332" />
+            <location filename="../../ui/controllers/project_controller.py" line="335" />
+            <location filename="../../ui/controllers/project_controller.py" line="349" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="313" />
+            <location filename="../../ui/controllers/project_controller.py" line="351" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="319" />
+            <location filename="../../ui/controllers/project_controller.py" line="357" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="326" />
+            <location filename="../../ui/controllers/project_controller.py" line="364" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="328" />
+            <location filename="../../ui/controllers/project_controller.py" line="366" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="354" />
+            <location filename="../../ui/controllers/project_controller.py" line="392" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="381" />
-            <location filename="../../ui/controllers/project_controller.py" line="384" />
+            <location filename="../../ui/controllers/project_controller.py" line="427" />
+            <location filename="../../ui/controllers/project_controller.py" line="430" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="387" />
+            <location filename="../../ui/controllers/project_controller.py" line="433" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="420" />
+            <location filename="../../ui/controllers/project_controller.py" line="464" />
+            <source>Cannot lock {path}: {reason}</source>
+            <translation>无法锁定 {path}：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_controller.py" line="473" />
+            <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
+            <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_controller.py" line="509" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="423" />
+            <location filename="../../ui/controllers/project_controller.py" line="512" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>
@@ -2069,22 +2086,22 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectDialogs</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="78" />
+            <location filename="../../ui/controllers/project_controller.py" line="88" />
             <source>Unsaved changes</source>
             <translation>未保存的更改</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="79" />
+            <location filename="../../ui/controllers/project_controller.py" line="89" />
             <source>Save the changes to {name}?</source>
             <translation>保存对 {name} 的更改？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="90" />
+            <location filename="../../ui/controllers/project_controller.py" line="100" />
             <source>an unsaved project</source>
             <translation>未保存的工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="91" />
+            <location filename="../../ui/controllers/project_controller.py" line="101" />
             <source>TeachPad was not closed properly. An autosave of {what} is newer than the saved file:
 {autosave}
 
@@ -2095,27 +2112,37 @@ Recover it?</source>
 是否恢复？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="93" />
+            <location filename="../../ui/controllers/project_controller.py" line="103" />
             <source>Recover autosave</source>
             <translation>恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="99" />
+            <location filename="../../ui/controllers/project_controller.py" line="110" />
+            <source>The file has no points. Importing it in replace mode removes all {n} points of the project.
+
+Remove them all?</source>
+            <translation>该文件中没有点。以替换方式导入将删除工程中全部 {n} 个点。
+
+确定全部删除吗？</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_controller.py" line="118" />
             <source>Replace all points</source>
             <translation>替换全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="100" />
+            <location filename="../../ui/controllers/project_controller.py" line="119" />
             <source>Merge (update the same ids, append new ones)</source>
             <translation>合并（更新相同编号，追加新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="101" />
+            <location filename="../../ui/controllers/project_controller.py" line="112" />
+            <location filename="../../ui/controllers/project_controller.py" line="120" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="101" />
+            <location filename="../../ui/controllers/project_controller.py" line="120" />
             <source>Import mode:</source>
             <translation>导入方式：</translation>
         </message>
@@ -2343,27 +2370,27 @@ Recover it?</source>
     <context>
         <name>Runner</name>
         <message>
-            <location filename="../../app/plan/runner.py" line="80" />
+            <location filename="../../app/plan/runner.py" line="92" />
             <source>ready</source>
             <translation>就绪</translation>
         </message>
         <message>
-            <location filename="../../app/plan/runner.py" line="81" />
+            <location filename="../../app/plan/runner.py" line="93" />
             <source>running</source>
             <translation>运行中</translation>
         </message>
         <message>
-            <location filename="../../app/plan/runner.py" line="82" />
+            <location filename="../../app/plan/runner.py" line="94" />
             <source>finished</source>
             <translation>已完成</translation>
         </message>
         <message>
-            <location filename="../../app/plan/runner.py" line="83" />
+            <location filename="../../app/plan/runner.py" line="95" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../app/plan/runner.py" line="84" />
+            <location filename="../../app/plan/runner.py" line="96" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
