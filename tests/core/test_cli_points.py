@@ -140,7 +140,8 @@ def test_run_uploads_then_recreates_each_segments_points_before_its_move(
     cli = Cli()
     assert cli("run", str(demo), "--plan", "circle") == 0
     # up front: every point the plan uses; then each segment's (via, end) right before its move
-    assert [c["id"] for c in cli.client.creates] == [5, 6, 7, 8, 1] + [5] + [6, 7] + [8, 5] + [1]
+    up_front, per_segment = [5, 6, 7, 8, 1], [5, 6, 7, 8, 5, 1]
+    assert [c["id"] for c in cli.client.creates] == up_front + per_segment
     assert [(m["via"], m["end"]) for m in cli.client.moves] == [(None, 5), (6, 7), (8, 5), (None, 1)]
     assert all(m["timeout"] and m["timeout"] >= 10.0 for m in cli.client.moves)
     assert cli.client.gvs.get(99)  # the restart canary is armed
