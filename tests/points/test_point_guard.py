@@ -17,7 +17,7 @@ from app.points.point import make_point
 from app.protocol import registers
 
 MakeClient = Callable[..., Any]
-SPEED = 500.0  # mm/s: the moves below are 30 mm, a fraction of a second on the simulator
+SPEED = 120.0  # mm/s: 30 mm moves of 0.25 s (a much shorter move can end between two status polls)
 TOLERANCE = 0.01  # mm: the simulator reaches a point exactly (float32 on the wire)
 
 
