@@ -195,6 +195,9 @@ def test_monitor_only_upload_refuses_before_touching_the_file(demo: Path,
     unreadable = demo.with_name("missing.teachpad.json")  # not even opened: no "does not exist"
     assert cli("--monitor-only", "points", "upload", str(unreadable)) == cli_points.EXIT_FAILED
     assert "does not exist" not in capsys.readouterr().err
+    assert cli("--monitor-only", "run", str(demo), "--plan", "circle") == cli_points.EXIT_FAILED
+    assert cli.clients_made == 0 and demo.stat().st_mtime_ns == mtime
+    assert cli("--monitor-only", "run", str(demo), "--plan", "circle", "--check") == 0  # reads only
 
 
 def test_empty_csv_replace_import_needs_allow_empty(demo: Path, tmp_path: Path,

@@ -163,3 +163,22 @@ def test_lock_of_another_host_is_respected_and_a_corrupt_one_taken_over(tmp_path
     assert lock.held and again.held
     lock.release()
     assert not path.exists()
+
+
+def test_the_cli_does_not_write_a_project_open_in_a_teachpad(
+        other_teachpad: tuple[subprocess.Popen[str], Path], tmp_path: Path,
+        capsys: pytest.CaptureFixture[str]) -> None:
+    import argparse
+
+    from app.cli import points as cli_points
+
+    _child, project = other_teachpad
+    csv_path = tmp_path / "in.csv"
+    csv_path.write_text("id,x,y,z,a,b,c\n9,1,2,3,0,0,0\n", encoding="utf-8")
+    before = project.read_bytes()
+    parser = argparse.ArgumentParser()
+    cli_points.register(parser.add_subparsers(dest="command"))
+    args = parser.parse_args(["points", "import", str(project), "--csv", str(csv_path), "--merge"])
+    assert args.handler(args, lambda: None) == cli_points.EXIT_FAILED
+    assert "open in a TeachPad (process" in capsys.readouterr().err
+    assert project.read_bytes() == before
