@@ -115,6 +115,8 @@ def test_upload_selected_ids(demo: Path, capsys: pytest.CaptureFixture[str]) -> 
     assert sorted(project.upload_history) == [1, 2, 5, 6]  # history only
     assert project.upload_history[1].endpoint == "controller"
     assert "uploaded 4 point(s)" in capsys.readouterr().out
+    assert cli("points", "list", str(demo)) == 0
+    assert "unknown (last uploaded 20" in capsys.readouterr().out
     cli2 = Cli()
     assert cli2("points", "upload", str(demo), "--needed") == 0  # nothing is known to be there
     assert [c["id"] for c in cli2.client.creates] == [1, 2, 3, 4, 5, 6, 7, 8]
