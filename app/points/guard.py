@@ -163,9 +163,14 @@ class PointGuard:
         """Compare the arrival pose with the host's end point; :class:`PointMismatch` if off."""
         if not self.verify:
             return
+        mismatch = self.check_arrival(client.read_pose(), end_id)
+        if mismatch is not None:
+            raise mismatch
+
+    def check_arrival(self, pose: Pose, end_id: int) -> PointMismatch | None:
+        """The mismatch of ``pose`` with the host's end point, or None (for callers that have
+        the pose already, e.g. the GUI's step-by-step run with the link's latest pose)."""
         point = self.point(end_id)
-        pose = client.read_pose()
         distance = math.dist(pose.xyzabc[:3], point.xyz)
-        if not distance <= self._tolerance:
-            raise PointMismatch(point, pose, distance)
+        return None if distance <= self._tolerance else PointMismatch(point, pose, distance)
 
