@@ -1,6 +1,7 @@
 """``teachpad-cli`` commands for temp points and plans: ``points ...`` and ``run``.
 
-Plugging in: ``app/cli.py`` imports this module (it is in its ``PLUGIN_MODULES``) and calls
+``run`` lives in :mod:`app.cli.run_plan` (registered from here). Plugging in: ``app/cli.py``
+imports this module (it is in its ``PLUGIN_MODULES``) and calls
 ``register(subparsers)``, which adds ``points`` (list / upload / export / import) and ``run``
 and sets ``handler`` on each with ``set_defaults``. A handler can be called two ways:
 
@@ -26,14 +27,20 @@ Commands::
     points list   PROJECT
     points upload PROJECT [--ids 1,2,5-9 | --needed]
     points export PROJECT --csv OUT [--no-bom]
-    points import PROJECT --csv IN [--merge]        # creates PROJECT if it does not exist
+    points import PROJECT --csv IN [--merge] [--allow-empty]   # creates PROJECT if missing
     run PROJECT [--plan NAME] [--loops N] [--from K] [--from-loop I] [--single]
-                [--upload] [--check] [--max-speed MM_S]
+                [--no-upload] [--check] [--max-speed MM_S]
 
 Segment numbers on the command line and in messages count from 1. ``run`` checks the plan
-first (the GUI's checks): errors refuse to run; points that are not on the controller are
-uploaded with ``--upload``, otherwise the command says which ones to upload. A failed or
-interrupted run prints the ``--from`` / ``--from-loop`` that resumes it.
+first (the GUI's checks): errors refuse to run. A project file cannot know what the
+controller holds, so ``run`` uploads every point its plan uses before the first move, then
+guards each segment (:class:`app.points.guard.PointGuard`): restart canary check, the
+segment's points re-created from the project right before its move, the arrival pose
+verified after it. ``--no-upload`` skips the uploads (the operator answers for the
+controller's points); the arrival check stays. A failed or interrupted run prints the
+``--from`` / ``--from-loop`` that resumes it. Commands that write the project refuse while
+another TeachPad has it open (:mod:`app.points.lock`); ``points upload`` in monitor-only mode
+refuses before it reads the file.
 """
 
 from __future__ import annotations
@@ -45,27 +52,13 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from app.errors import CommandRefused, InvalidInput, LinkError, ResponseTimeout, TeachPadError
-from app.models import Pose
-from app.plan.checks import IssueKind, PlanLimits, check_plan, ids_needing_upload
-from app.plan.estimates import estimate_plan, segment_timeouts
-from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
-from app.plan.segments import Plan
-from app.points.ledger import (
-    DEFAULT_LIMITS,
-    FileFormatError,
-    ImportMode,
-    PointLedger,
-    PointLimits,
-    TempPoint,
-    UploadReport,
-    apply_upload,
-    parse_id_list,
-    tool_text,
-    upload_points,
-)
+from app.errors import InvalidInput, LinkError, ResponseTimeout, TeachPadError
+from app.plan.checks import PlanLimits
+from app.points.ledger import EmptyImport, ImportMode, PointLedger
+from app.points.lock import live_owner
+from app.points.point import DEFAULT_LIMITS, FileFormatError, PointLimits, TempPoint, tool_text
 from app.points.project import Project, load_project, read_points_csv, save_project, write_points_csv
-from app.protocol.enums import MoveStatus
+from app.points.upload import UploadReport, apply_upload, parse_id_list, upload_points
 
 PROG = "teachpad-cli"
 
@@ -138,6 +131,8 @@ def register(subparsers: Any) -> None:
     p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="IN")
     p.add_argument("--merge", action="store_true",
                    help="update and add points, keep the others (default: replace all points)")
+    p.add_argument("--allow-empty", action="store_true",
+                   help="let a CSV without rows replace (delete) all points of the project")
     p.set_defaults(handler=_handler(cmd_points_import))
 
     r = subparsers.add_parser("run", help="run a plan of a project on the controller (function 3)")
@@ -148,10 +143,16 @@ def register(subparsers: Any) -> None:
                    help="start at segment K (counting from 1)")
     r.add_argument("--from-loop", type=int, default=1, metavar="I", help="start in loop I (to resume)")
     r.add_argument("--single", action="store_true", help="run segment K only")
-    r.add_argument("--upload", action="store_true", help="upload points the controller does not have")
+    r.add_argument("--no-upload", action="store_true",
+                   help="do not create the plan's points on the controller before and during the run: "
+                        "the operator is responsible for the controller holding exactly the project's "
+                        "points (the arrival pose is still checked after each segment)")
+    r.add_argument("--upload", action="store_true", help=argparse.SUPPRESS)  # the default now (old scripts)
     r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
     r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
                    help="highest speed a segment may have (default %(default)g mm/s)")
+    from app.cli.run_plan import cmd_run  # imported here: run_plan uses this module's helpers
+
     r.set_defaults(handler=_handler(cmd_run))
 
 
@@ -176,7 +177,26 @@ def _load(io: _Io, path: Path, limits: PointLimits) -> Project | None:
         return None
 
 
+def _endpoint(client: Any) -> str:
+    settings = getattr(client, "settings", None)
+    endpoint = getattr(settings, "endpoint", None)
+    return endpoint if isinstance(endpoint, str) else "controller"
+
+
+def _monitor_only(io: _Io, args: argparse.Namespace, what: str) -> bool:
+    """True (after saying so) when --monitor-only forbids ``what``; checked before any file I/O."""
+    if getattr(args, "monitor_only", False):
+        io.error(f"{what} writes to the controller: refused in monitor-only mode (nothing read or written)")
+        return True
+    return False
+
+
 def _save(io: _Io, project: Project, path: Path) -> bool:
+    owner = live_owner(path)
+    if owner is not None:
+        io.error(f"{path}: not saved: the project is open in a TeachPad ({owner.text}); "
+                 "close it there or make the change there")
+        return False
     try:
         save_project(project, path)
     except OSError as exc:
@@ -265,6 +285,9 @@ def cmd_points_list(args: argparse.Namespace, make_client: MakeClient, *, out: T
     for p in project.ledger:
         pose = " ".join(f"{v:9.3f}" for v in p.xyzabc)
         state = p.sync.text + (f" ({p.sync_error})" if p.sync_error else "")
+        last = project.upload_history.get(p.id)
+        if last is not None:  # history: what this host did, not what the controller holds now
+            state += f" (last uploaded {last.time} to {last.endpoint})"
         io.print(f"{p.id:6d}  {p.name[:20]:20s} {pose}  {tool_text(p.tool):14s} {state}")
     for plan in project.plans:
         io.print(f"plan {plan.name!r}: {len(plan)} segment(s), loops {plan.loops or 'until stopped'}")
@@ -273,8 +296,10 @@ def cmd_points_list(args: argparse.Namespace, make_client: MakeClient, *, out: T
 
 def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
                       err: TextIO | None = None, close_client: bool = True) -> int:
-    """``points upload PROJECT [--ids ... | --needed]``; saves the sync states."""
+    """``points upload PROJECT [--ids ... | --needed]``; saves the upload history."""
     io = _Io(out, err)
+    if _monitor_only(io, args, "points upload"):
+        return EXIT_FAILED
     project = _load(io, args.project, _limits(args))
     if project is None:
         return EXIT_USAGE
@@ -301,6 +326,7 @@ def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out:
     try:
         client = make_client()
         report = _upload(io, project, points, client)
+        project.record_upload([o.point_id for o in report.outcomes if o.ok], _endpoint(client))
     except TeachPadError as exc:
         return _link_code(io, exc, "cannot upload")
     finally:
@@ -329,7 +355,8 @@ def cmd_points_export(args: argparse.Namespace, make_client: MakeClient, *, out:
 
 def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
                       err: TextIO | None = None, close_client: bool = True) -> int:
-    """``points import PROJECT --csv IN [--merge]``; the project is saved only if all rows are good."""
+    """``points import PROJECT --csv IN [--merge] [--allow-empty]``; the project is saved only if
+    all rows are good; a CSV without rows does not replace all points unless ``--allow-empty``."""
     io = _Io(out, err)
     limits = _limits(args)
     if args.project.exists():
@@ -341,7 +368,11 @@ def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out:
         project = Project(name=name, ledger=PointLedger((), limits))
     try:
         points = read_points_csv(args.csv_path, limits)
-        report = project.ledger.import_points(points, ImportMode.MERGE if args.merge else ImportMode.REPLACE)
+        report = project.ledger.import_points(points, ImportMode.MERGE if args.merge else ImportMode.REPLACE,
+                                              allow_empty=getattr(args, "allow_empty", False))
+    except EmptyImport as exc:
+        io.error(f"{args.csv_path}: {exc}; nothing changed (pass --allow-empty to do it)")
+        return EXIT_USAGE
     except InvalidInput as exc:
         io.error(str(exc))
         return EXIT_USAGE
@@ -353,138 +384,3 @@ def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out:
         if missing:
             io.warn(f"plan {plan.name!r} uses points that are gone: {', '.join(map(str, missing))}")
     return EXIT_OK
-
-
-# --- run ---------------------------------------------------------------------------------------
-
-
-def _pick_plan(io: _Io, project: Project, name: str | None) -> Plan | None:
-    if name is not None:
-        try:
-            return project.plan(name)
-        except InvalidInput as exc:
-            io.error(str(exc))
-            return None
-    if len(project.plans) == 1:
-        return project.plans[0]
-    if not project.plans:
-        io.error("the project has no plans")
-    else:
-        io.error(f"the project has {len(project.plans)} plans ({', '.join(project.plan_names())}): "
-                 "choose one with --plan")
-    return None
-
-
-def _points_lost(error: BaseException | None) -> bool:
-    return isinstance(error, CommandRefused) and error.status.code == MoveStatus.BAD_END_POINT
-
-
-def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-            err: TextIO | None = None, close_client: bool = True) -> int:
-    """``run PROJECT [--plan NAME] ...``: check, upload if asked, run with a progress line."""
-    io = _Io(out, err)
-    project = _load(io, args.project, _limits(args))
-    if project is None:
-        return EXIT_USAGE
-    plan = _pick_plan(io, project, args.plan)
-    if plan is None:
-        return EXIT_USAGE
-    loops = plan.loops if args.loops is None else args.loops
-    start = args.from_segment - 1
-    try:
-        limits = PlanLimits(max_speed=args.max_speed)
-        if loops < 0:
-            raise InvalidInput("--loops must be >= 0 (0 = until stopped)")
-        if not 0 <= start < len(plan):
-            raise InvalidInput(f"--from {args.from_segment}: the plan has segments 1..{len(plan)}")
-        if args.from_loop < 1 or (loops and args.from_loop > loops):
-            raise InvalidInput(f"--from-loop {args.from_loop}: the run has loops 1..{loops}")
-    except InvalidInput as exc:
-        io.error(str(exc))
-        return EXIT_USAGE
-
-    client: Any = None
-    try:
-        pose: Pose | None = None
-        if not args.check:
-            try:
-                client = make_client()
-                pose = client.read_pose()
-            except TeachPadError as exc:
-                return _link_code(io, exc, "cannot read the robot's pose")
-        return _run(io, args, project, plan, client, pose, limits, loops, start)
-    finally:
-        if close_client and client is not None:
-            client.close()
-
-
-def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client: Any, pose: Pose | None,
-         limits: PlanLimits, loops: int, start: int) -> int:
-    ledger = project.ledger
-    issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops)
-    for issue in issues:
-        if issue.kind is IssueKind.WARNING:
-            io.warn(issue.message)
-    errors = [i for i in issues if i.kind is IssueKind.ERROR]
-    if errors:
-        for issue in errors:
-            io.error(issue.message)
-        io.error(f"plan {plan.name!r} has {len(errors)} error(s): not running it")
-        return EXIT_USAGE
-    est = estimate_plan(plan, ledger, pose, loops=loops)
-    io.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
-             f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}")
-    needed = ids_needing_upload(issues)
-    if args.check:
-        if needed:
-            io.print(f"needs upload: {', '.join(map(str, needed))}")
-        io.print("check only: not running")
-        return EXIT_OK
-    if needed:
-        if not args.upload:
-            for issue in issues:
-                if issue.kind is IssueKind.NEEDS_UPLOAD:
-                    io.error(issue.message)
-            io.error(f"upload them first ({PROG} points upload {args.project} --ids "
-                     f"{','.join(map(str, needed))}) or pass --upload")
-            return EXIT_NEEDS_UPLOAD
-        report = _upload(io, project, [ledger.point(i) for i in needed], client)
-        saved = _save(io, project, args.project)
-        if _upload_code(report) != EXIT_OK or not saved:
-            return _upload_code(report) or EXIT_FAILED
-
-    line = _ProgressLine(io.out)
-
-    def progress(p: RunProgress) -> None:
-        if p.event is RunEvent.SEGMENT_STARTED:
-            line.show(f"{p.text}: {p.message}")
-
-    runner = PlanRunner(plan, loops=loops, start=start, start_loop=args.from_loop, single=args.single,
-                        timeouts=segment_timeouts(plan, ledger, pose), progress=progress)
-    try:
-        outcome = runner.run(client)
-    finally:
-        line.done()
-    if outcome.state is RunState.FINISHED:
-        io.print(f"done: {outcome.segments_done} segment(s)")
-        return EXIT_OK
-    io.error(f"{outcome.state.value}: {outcome.message}")
-    if _points_lost(outcome.error):
-        # "bad end point id": the controller no longer holds the ledger's points (it has most
-        # likely restarted): record that, so `run --upload` restores them before resuming
-        ledger.mark_all_unknown()
-        if _save(io, project, args.project):
-            io.error("the controller does not hold the points any more (restarted?): all points "
-                     "are marked unknown; resume with --upload to restore them first")
-    if outcome.resume_from is not None:
-        resume = f"--from {outcome.resume_from + 1}"
-        if outcome.resume_loop and outcome.resume_loop > 1:
-            resume += f" --from-loop {outcome.resume_loop}"
-        plan_arg = f" --plan {plan.name!r}" if len(project.plans) > 1 else ""
-        loops_arg = f" --loops {loops}" if args.loops is not None else ""
-        io.print(f"to resume: {PROG} run {args.project}{plan_arg} {resume}{loops_arg}")
-    if outcome.interrupted:
-        return EXIT_INTERRUPTED
-    if isinstance(outcome.error, LinkError | ResponseTimeout):
-        return EXIT_LINK
-    return EXIT_FAILED

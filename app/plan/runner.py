@@ -7,8 +7,10 @@
   however it likes (e.g. ``client.begin_command`` + ``CommandTracker``) and reports back with
   exactly one of ``runner.on_result(result)``, ``runner.on_error(exc)`` or
   ``runner.on_stopped()``. Then it asks for the next command.
-* **Blocking** (the CLI): ``runner.run(client)`` does that loop itself with
-  ``client.move_to_point(..., wait=True)``.
+* **Blocking** (the CLI): ``runner.run(client, guard)`` does that loop itself with
+  ``client.move_to_point(..., wait=True)``; the optional :class:`SegmentGuard`
+  (``app.points.guard.PointGuard``) re-creates each segment's points from the host's copy
+  right before its move and verifies the arrival pose after it.
 
 Every segment waits for its own completion before the next is sent. A failed segment (error,
 refusal, lost link) ends the run in ``FAILED`` with ``resume_from`` = that segment and
@@ -33,7 +35,7 @@ import enum
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Any, Protocol
 
 from app.errors import CommandStopped, CommandTimeout, InvalidInput, TeachPadError
 from app.models import CommandResult
@@ -58,6 +60,16 @@ class MoveClient(Protocol):
     ) -> CommandResult: ...
 
     def stop(self) -> None: ...
+
+
+class SegmentGuard(Protocol):
+    """Checks around each move of a blocking run (``app.points.guard.PointGuard`` fits):
+    ``before_segment`` may re-create the segment's points, ``after_segment`` may verify the
+    arrival; either raising a ``TeachPadError`` ends the run in FAILED at that segment."""
+
+    def before_segment(self, client: Any, point_ids: Sequence[int]) -> None: ...
+
+    def after_segment(self, client: Any, end_id: int) -> None: ...
 
 
 class RunState(enum.Enum):
@@ -337,11 +349,19 @@ class PlanRunner:
         self._stop.clear()
         self._state = RunState.READY
 
-    def run(self, client: MoveClient) -> RunOutcome:
-        """Blocking: send every segment with ``move_to_point(wait=True)`` until the run is over."""
+    def run(self, client: MoveClient, guard: SegmentGuard | None = None) -> RunOutcome:
+        """Blocking: send every segment with ``move_to_point(wait=True)`` until the run is over.
+
+        With a ``guard``, each segment's points are passed to ``guard.before_segment`` right
+        before its move, and its end point to ``guard.after_segment`` after a successful one.
+        """
         while (cmd := self.next_command()) is not None:
             try:
+                if guard is not None:
+                    guard.before_segment(client, cmd.segment.point_ids)
                 result = cmd.send(client, wait=True)
+                if guard is not None and result.ok:
+                    guard.after_segment(client, cmd.segment.end_id)
             except CommandTimeout as exc:
                 # The robot may still be moving: halt it before reporting.
                 note = self._halt(client)

@@ -12,7 +12,7 @@ Format (version 1; docs/PROJECT_FORMAT.md is the reference)::
       "points": [
         {"id": 1, "name": "原点", "x": 400.0, "y": 0.0, "z": 400.0, "a": 180.0, "b": 0.0, "c": 0.0,
          "e1": 0.0, "e2": 0.0, "e3": 0.0, "e4": 0.0, "e5": 0.0, "tool": 200, "note": "",
-         "sync": "unknown", "sync_error": ""}
+         "uploaded": {"time": "2025-01-31T09:00:00Z", "endpoint": "tcp 192.168.1.10:502"}}
       ],
       "plans": [
         {"name": "square", "loops": 1, "segments": [
@@ -24,30 +24,28 @@ Format (version 1; docs/PROJECT_FORMAT.md is the reference)::
       ]
     }
 
-A point's keys are the CSV columns plus ``sync`` (``unknown`` / ``on-controller`` /
-``changed`` / ``failed``) and ``sync_error``. Unknown keys are ignored; a different
-``format`` or ``version`` is refused. Loading parses and validates everything before it
-returns, so a bad file never half-replaces what the caller holds; errors are
-:class:`~app.points.ledger.FileFormatError` naming the item and field
-(``points[6] (id 12), field 'x': 'abc' is not a number``).
+A point's keys are the CSV columns plus ``uploaded`` (history: when and to which controller
+this host last uploaded the point). A file cannot know what a controller holds, so a loaded
+point is always ``unknown``; the ``sync`` / ``sync_error`` keys of older files are ignored and
+never written. Unknown keys are ignored; a different ``format`` or ``version`` is refused.
+Loading parses and validates everything before it returns, so a bad file never half-replaces
+what the caller holds; errors are :class:`~app.points.point.FileFormatError` naming the JSON
+path and field (``points[6] (id 12), field 'x': 'abc' is not a number``) and quote at most a
+short prefix of a bad value. Whatever loading accepts, saving can write (no NaN, no lone
+surrogates, no numbers beyond float range).
 
-Saving writes a temp file in the same directory, fsyncs it and ``os.replace``-s it over the
-target, so a crash leaves either the old file or the new one. The GUI autosaves next to the
-project (:func:`autosave_path`) and offers recovery when :func:`find_autosave` sees an
-autosave newer than the project.
+Saving is atomic (:mod:`app.points.atomic`); autosave and recovery live in
+:mod:`app.points.autosave`, the one-instance lock in :mod:`app.points.lock`.
 """
 
 from __future__ import annotations
 
-import contextlib
 import datetime as dt
 import json
+import math
 import os
-import stat
-import sys
-import uuid
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -61,38 +59,49 @@ from app.plan.segments import (
     validate_loops,
     validate_plan_name,
 )
-from app.points.ledger import (
+from app.points.atomic import MAX_FILE_BYTES, atomic_write_bytes, read_limited
+from app.points.csv_io import decode_text, parse_points_csv, points_to_csv
+from app.points.ledger import PointLedger
+from app.points.point import (
     DEFAULT_LIMITS,
     EXT_FIELDS,
     POSE_FIELDS,
     FieldError,
     FileFormatError,
-    PointLedger,
+    OversizedNumber,
     PointLimits,
     SyncState,
     TempPoint,
-    decode_text,
-    parse_points_csv,
+    has_surrogates,
     point_from_fields,
-    points_to_csv,
+    shown,
 )
 
 FORMAT_NAME = "teachpad-project"
 FORMAT_VERSION = 1
 PROJECT_SUFFIX = ".teachpad.json"
-AUTOSAVE_SUFFIX = ".autosave.json"
-MAX_FILE_BYTES = 64 * 1024 * 1024  # refuse absurd files before parsing them
+HISTORY_TEXT_MAX = 200  # longest upload time / endpoint text kept as history
 
 __all__ = [
-    "FORMAT_NAME", "FORMAT_VERSION", "FileFormatError", "Project", "atomic_write_bytes",
-    "autosave_path", "default_autosave_dir", "discard_autosave", "find_autosave", "load_project",
-    "parse_project", "project_from_dict", "project_to_dict", "read_points_csv", "save_autosave",
-    "save_project", "write_points_csv",
+    "AUTOSAVE_SUFFIX", "FORMAT_NAME", "FORMAT_VERSION", "MAX_FILE_BYTES", "PROJECT_SUFFIX", "FileFormatError",
+    "Project", "UploadRecord", "atomic_write_bytes", "autosave_path", "default_autosave_dir",
+    "discard_autosave", "find_autosave", "load_project", "parse_project", "project_from_dict",
+    "project_to_dict", "project_to_json", "read_points_csv", "save_autosave", "save_project",
+    "write_points_csv",
 ]
 
 
 def _now_iso() -> str:
     return dt.datetime.now(dt.UTC).replace(microsecond=0).isoformat().replace("+00:00", "Z")
+
+
+@dataclass(frozen=True)
+class UploadRecord:
+    """History: when this host last uploaded a point, and to which controller. Never proof that
+    the controller still holds it (it may have restarted, another tool may have overwritten it)."""
+
+    time: str
+    endpoint: str
 
 
 @dataclass(eq=False)
@@ -105,6 +114,8 @@ class Project:
     description: str = ""
     created: str = field(default_factory=_now_iso)
     modified: str = ""
+    #: point id -> the last upload of that point (history only; see :class:`UploadRecord`)
+    upload_history: dict[int, UploadRecord] = field(default_factory=dict)
     _revision: int = field(default=0, init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -121,6 +132,15 @@ class Project:
     def touch(self) -> None:
         """Count a metadata change."""
         self._revision += 1
+
+    def record_upload(self, point_ids: Iterable[int], endpoint: str, when: str | None = None) -> None:
+        """Note in the history that ``point_ids`` were just uploaded to ``endpoint``."""
+        stamp = when or _now_iso()
+        ids = list(point_ids)
+        for point_id in ids:
+            self.upload_history[point_id] = UploadRecord(stamp, endpoint[:HISTORY_TEXT_MAX])
+        if ids:
+            self._revision += 1
 
     # --- plans
     def plan_names(self) -> list[str]:
@@ -182,11 +202,13 @@ class Project:
 # --- JSON ------------------------------------------------------------------------------------
 
 
-def _point_to_dict(p: TempPoint) -> dict[str, Any]:
+def _point_to_dict(p: TempPoint, history: UploadRecord | None = None) -> dict[str, Any]:
     d: dict[str, Any] = {"id": p.id, "name": p.name}
     d.update(zip(POSE_FIELDS, p.xyzabc, strict=True))
     d.update(zip(EXT_FIELDS, p.ext, strict=True))
-    d.update({"tool": p.tool, "note": p.note, "sync": p.sync.value, "sync_error": p.sync_error})
+    d.update({"tool": p.tool, "note": p.note})
+    if history is not None:
+        d["uploaded"] = {"time": history.time, "endpoint": history.endpoint}
     return d
 
 
@@ -207,7 +229,7 @@ def project_to_dict(project: Project) -> dict[str, Any]:
         "description": project.description,
         "created": project.created,
         "modified": project.modified,
-        "points": [_point_to_dict(p) for p in project.ledger],
+        "points": [_point_to_dict(p, project.upload_history.get(p.id)) for p in project.ledger],
         "plans": [
             {"name": p.name, "loops": p.loops, "segments": [_segment_to_dict(s) for s in p.segments]}
             for p in project.plans
@@ -242,9 +264,35 @@ def project_to_json(project: Project) -> str:
 
 def _expect(value: object, kind: type | tuple[type, ...], where: str, name: str, what: str) -> Any:
     if not isinstance(value, kind) or (isinstance(value, bool) and kind is not bool):
-        raise FileFormatError(f"expected {what}, got {json.dumps(value, ensure_ascii=False)[:40]}",
-                              where=where, column=name or None)
+        raise FileFormatError(f"expected {what}, got {_json_shown(value)}", where=where, column=name or None)
     return value
+
+
+def _json_shown(value: object) -> str:
+    if isinstance(value, str | OversizedNumber) or (isinstance(value, int) and not isinstance(value, bool)):
+        return shown(value)
+    if isinstance(value, list | dict):
+        return "a list" if isinstance(value, list) else "an object"
+    return shown(json.dumps(value, ensure_ascii=False, allow_nan=True), 40)[1:-1]
+
+
+def _first_surrogate(value: object, path: str) -> str | None:
+    """JSON path of the first string (key or value) holding a lone surrogate, if any."""
+    stack: list[tuple[object, str]] = [(value, path)]
+    while stack:
+        item, where = stack.pop()
+        if isinstance(item, str):
+            if has_surrogates(item):
+                return where
+        elif isinstance(item, list):
+            stack.extend((v, f"{where}[{i}]") for i, v in reversed(list(enumerate(item))))
+        elif isinstance(item, dict):
+            for k, v in reversed(list(item.items())):
+                key_text = str(k)
+                if has_surrogates(key_text):
+                    return f"{where} (a key)"
+                stack.append((v, f"{where}.{key_text}" if where else key_text))
+    return None
 
 
 def _text_field(obj: Mapping[str, Any], key: str, where: str) -> str:
@@ -267,13 +315,17 @@ def _project_from_dict(data: object, limits: PointLimits) -> Project:
     if not isinstance(data, dict):
         raise FileFormatError("expected a JSON object at the top level")
     doc: dict[str, Any] = data
+    bad_text = _first_surrogate(doc, "")
+    if bad_text is not None:
+        raise FileFormatError("holds an invalid character (a lone surrogate, not Unicode text)",
+                              where=bad_text or top)
     if doc.get("format") != FORMAT_NAME:
-        raise FileFormatError(f"expected {FORMAT_NAME!r}, got {doc.get('format')!r}: not a TeachPad project",
-                              where=top, column="format")
+        raise FileFormatError(f"expected {FORMAT_NAME!r}, got {_json_shown(doc.get('format'))}: "
+                              "not a TeachPad project", where=top, column="format")
     version = doc.get("version")
     if version != FORMAT_VERSION or isinstance(version, bool):
         raise FileFormatError(
-            f"version {version!r} is not supported (this TeachPad reads version {FORMAT_VERSION})",
+            f"version {_json_shown(version)} is not supported (this TeachPad reads version {FORMAT_VERSION})",
             where=top, column="version",
         )
     name = _text_field(doc, "name", top) or "untitled"
@@ -283,28 +335,29 @@ def _project_from_dict(data: object, limits: PointLimits) -> Project:
 
     raw_points = _expect(doc.get("points", []), list, top, "points", "a list of points")
     points: list[TempPoint] = []
+    history: dict[int, UploadRecord] = {}
     seen: dict[int, int] = {}
     for i, raw in enumerate(raw_points):
         where = f"points[{i}]"
         obj = _expect(raw, dict, where, "", "an object")
-        if isinstance(obj.get("id"), int | float | str) and not isinstance(obj.get("id"), bool):
-            where = f"points[{i}] (id {obj['id']})"
+        raw_id = obj.get("id")
+        if isinstance(raw_id, int) and not isinstance(raw_id, bool) and abs(raw_id) < 10**9:
+            where = f"points[{i}] (id {raw_id})"
         try:
-            state_text = obj.get("sync", SyncState.UNKNOWN.value)
-            try:
-                state = SyncState.parse(str(state_text))
-            except ValueError as exc:
-                raise FieldError("sync", str(exc)) from None
-            point = point_from_fields(obj, limits, sync=state)
+            # A file cannot know what a controller holds: every loaded point is "unknown"
+            # (older files' "sync" / "sync_error" keys are ignored).
+            point = point_from_fields(obj, limits, sync=SyncState.UNKNOWN)
         except FieldError as exc:
             raise FileFormatError(exc.reason, where=where, column=exc.field) from None
-        if point.sync is SyncState.FAILED:
-            point = replace(point, sync_error=_text_field(obj, "sync_error", where))
+        where = f"points[{i}] (id {point.id})"
         if point.id in seen:
             raise FileFormatError(f"id {point.id} is already used by points[{seen[point.id]}]",
                                   where=where, column="id")
         seen[point.id] = i
         points.append(point)
+        record = _history_from(obj.get("uploaded"), where)
+        if record is not None:
+            history[point.id] = record
 
     raw_plans = _expect(doc.get("plans", []), list, top, "plans", "a list of plans")
     plans: list[Plan] = []
@@ -328,7 +381,16 @@ def _project_from_dict(data: object, limits: PointLimits) -> Project:
         plans.append(Plan(plan_name, segments, loops))
 
     return Project(name=name, ledger=PointLedger(points, limits), plans=plans,
-                   description=description, created=created, modified=modified)
+                   description=description, created=created, modified=modified, upload_history=history)
+
+
+def _history_from(raw: object, where: str) -> UploadRecord | None:
+    if raw is None:
+        return None
+    obj = _expect(raw, dict, where, "uploaded", "an object with time and endpoint")
+    when = _text_field(obj, "time", f"{where} uploaded")
+    endpoint = _text_field(obj, "endpoint", f"{where} uploaded")
+    return UploadRecord(when[:HISTORY_TEXT_MAX], endpoint[:HISTORY_TEXT_MAX])
 
 
 def _segment_from_dict(obj: Mapping[str, Any], where: str) -> Segment:
@@ -357,10 +419,21 @@ def _segment_from_dict(obj: Mapping[str, Any], where: str) -> Segment:
         raise FileFormatError(exc.reason, where=where, column=column) from None
 
 
+def _json_int(digits: str) -> int | OversizedNumber:
+    # int() refuses more than 4300 digits with a ValueError; no field needs more than a few.
+    return OversizedNumber(digits) if len(digits.lstrip("-")) > 300 else int(digits)
+
+
+def _json_float(text: str) -> float | OversizedNumber:
+    # json would turn 1e400 into inf; keep the text so the message says "too large".
+    number = float(text)
+    return number if math.isfinite(number) else OversizedNumber(text)
+
+
 def parse_project(text: str, limits: PointLimits = DEFAULT_LIMITS, *, path: str | None = None) -> Project:
     """A project from JSON text; :class:`FileFormatError` names where the text is wrong."""
     try:
-        data = json.loads(text)
+        data = json.loads(text, parse_int=_json_int, parse_float=_json_float)
     except json.JSONDecodeError as exc:
         raise FileFormatError(f"not valid JSON ({exc.msg})", path=path,
                               where=f"line {exc.lineno}, column {exc.colno}") from None
@@ -369,21 +442,9 @@ def parse_project(text: str, limits: PointLimits = DEFAULT_LIMITS, *, path: str 
     return project_from_dict(data, limits, path=path)
 
 
-def _read_bytes(path: Path) -> bytes:
-    try:
-        size = path.stat().st_size
-        if size > MAX_FILE_BYTES:
-            raise FileFormatError(f"the file is too large ({size} bytes)", path=str(path))
-        return path.read_bytes()
-    except FileNotFoundError:
-        raise FileFormatError("the file does not exist", path=str(path)) from None
-    except IsADirectoryError:
-        raise FileFormatError("is a directory, not a file", path=str(path)) from None
-
-
 def load_project(path: str | os.PathLike[str], limits: PointLimits = DEFAULT_LIMITS) -> Project:
     p = Path(path)
-    return parse_project(decode_text(_read_bytes(p), str(p)), limits, path=str(p))
+    return parse_project(decode_text(read_limited(p), str(p)), limits, path=str(p))
 
 
 def save_project(project: Project, path: str | os.PathLike[str], *, touch: bool = True) -> None:
@@ -398,7 +459,7 @@ def save_project(project: Project, path: str | os.PathLike[str], *, touch: bool 
 
 def read_points_csv(path: str | os.PathLike[str], limits: PointLimits = DEFAULT_LIMITS) -> list[TempPoint]:
     p = Path(path)
-    return parse_points_csv(decode_text(_read_bytes(p), str(p)), limits, path=str(p))
+    return parse_points_csv(decode_text(read_limited(p), str(p)), limits, path=str(p))
 
 
 def write_points_csv(path: str | os.PathLike[str], points: Iterable[TempPoint], *, bom: bool = True) -> None:
@@ -408,113 +469,13 @@ def write_points_csv(path: str | os.PathLike[str], points: Iterable[TempPoint], 
     atomic_write_bytes(path, (("\ufeff" + text) if bom else text).encode("utf-8"))
 
 
-# --- atomic save and autosave -----------------------------------------------------------------------
-
-
-def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
-    """Replace ``path`` with ``data`` so that a crash leaves the old file or the new, never a mix.
-
-    Temp file in the same directory (same filesystem), written in full, fsynced, then
-    ``os.replace``; the directory is fsynced afterwards where the OS allows it. On any error
-    the temp file is removed and the old file is untouched. Keeps an existing file's mode.
-    """
-    target = Path(path)
-    directory = target.parent
-    tmp = directory / f".{target.name}.{uuid.uuid4().hex[:8]}.tmp"
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
-    try:
-        try:
-            view = memoryview(data)
-            while view:
-                written = os.write(fd, view)
-                view = view[written:]
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-        with contextlib.suppress(FileNotFoundError):
-            os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode))
-        os.replace(tmp, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-    _fsync_dir(directory)
-
-
-def _fsync_dir(directory: Path) -> None:
-    # Makes the rename itself durable. Not possible on Windows, and some filesystems refuse
-    # it; the data is already safe either way, so a refusal is not an error.
-    if sys.platform == "win32":
-        return
-    with contextlib.suppress(OSError):
-        dfd = os.open(directory, os.O_RDONLY)
-        try:
-            os.fsync(dfd)
-        finally:
-            os.close(dfd)
-
-
-def default_autosave_dir() -> Path:
-    """Per-user directory for autosaves of projects that were never saved."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_STATE_HOME") or Path.home() / ".local" / "state")
-    return base / "teachpad" / "autosave"
-
-
-def autosave_path(project_path: str | os.PathLike[str] | None, *, user_dir: Path | None = None) -> Path:
-    """Where to autosave: ``demo.teachpad.json`` -> ``demo.teachpad.autosave.json`` next to
-    it; an unsaved project goes to ``<user_dir>/untitled.autosave.json``."""
-    if project_path is None:
-        return (user_dir or default_autosave_dir()) / f"untitled{AUTOSAVE_SUFFIX}"
-    p = Path(project_path)
-    stem = p.name[: -len(".json")] if p.name.endswith(".json") else p.name
-    return p.with_name(stem + AUTOSAVE_SUFFIX)
-
-
-def save_autosave(project: Project, project_path: str | os.PathLike[str] | None, *,
-                  user_dir: Path | None = None) -> Path:
-    """Write the autosave (atomically; ``modified`` untouched); returns its path."""
-    target = autosave_path(project_path, user_dir=user_dir)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(target, project_to_json(project).encode("utf-8"))
-    return target
-
-
-def find_autosave(
-    project_path: str | os.PathLike[str] | None, *, user_dir: Path | None = None
-) -> Path | None:
-    """The autosave to offer for recovery: it exists, differs from the project and is newer
-    (or the project file is gone). None otherwise."""
-    auto = autosave_path(project_path, user_dir=user_dir)
-    try:
-        auto_stat = auto.stat()
-    except FileNotFoundError:
-        return None
-    if project_path is None:
-        return auto
-    project = Path(project_path)
-    try:
-        project_stat = project.stat()
-    except FileNotFoundError:
-        return auto
-    if auto_stat.st_mtime_ns <= project_stat.st_mtime_ns:
-        return None
-    try:
-        if auto.read_bytes() == project.read_bytes():
-            return None
-    except OSError:
-        return auto
-    return auto
-
-
-def discard_autosave(project_path: str | os.PathLike[str] | None, *, user_dir: Path | None = None) -> bool:
-    """Remove the autosave (after a save, or when the user declines recovery)."""
-    try:
-        autosave_path(project_path, user_dir=user_dir).unlink()
-    except FileNotFoundError:
-        return False
-    return True
+# Older imports (``from app.points.project import find_autosave``) keep working. Imported last:
+# app.points.autosave refers back to this module.
+from app.points.autosave import (  # noqa: E402
+    AUTOSAVE_SUFFIX,
+    autosave_path,
+    default_autosave_dir,
+    discard_autosave,
+    find_autosave,
+    save_autosave,
+)

@@ -1392,23 +1392,23 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/ledger.py" line="131" />
+            <location filename="../../app/points/point.py" line="124" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host".</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/ledger.py" line="132" />
+            <location filename="../../app/points/point.py" line="125" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/ledger.py" line="133" />
+            <location filename="../../app/points/point.py" line="126" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/ledger.py" line="134" />
+            <location filename="../../app/points/point.py" line="127" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
@@ -1562,7 +1562,7 @@
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="403" />
+            <location filename="../../ui/models/points_model.py" line="404" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -1837,136 +1837,153 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="168" />
+            <location filename="../../ui/controllers/project_controller.py" line="128" />
             <source>Undo</source>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="170" />
+            <location filename="../../ui/controllers/project_controller.py" line="130" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="174" />
+            <location filename="../../ui/controllers/project_controller.py" line="134" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="175" />
+            <location filename="../../ui/controllers/project_controller.py" line="135" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="176" />
+            <location filename="../../ui/controllers/project_controller.py" line="136" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="177" />
+            <location filename="../../ui/controllers/project_controller.py" line="137" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="178" />
+            <location filename="../../ui/controllers/project_controller.py" line="138" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="179" />
+            <location filename="../../ui/controllers/project_controller.py" line="139" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="202" />
+            <location filename="../../ui/controllers/project_controller.py" line="162" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="235" />
+            <location filename="../../ui/controllers/project_controller.py" line="195" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="244" />
-            <location filename="../../ui/controllers/project_controller.py" line="247" />
+            <location filename="../../ui/controllers/project_controller.py" line="203" />
+            <location filename="../../ui/controllers/project_controller.py" line="239" />
+            <location filename="../../ui/controllers/project_controller.py" line="348" />
+            <source>Project in use</source>
+            <translation>工程正在使用中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_controller.py" line="208" />
+            <location filename="../../ui/controllers/project_controller.py" line="211" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="250" />
+            <location filename="../../ui/controllers/project_controller.py" line="214" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="262" />
+            <location filename="../../ui/controllers/project_controller.py" line="226" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="276" />
+            <location filename="../../ui/controllers/project_controller.py" line="244" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="286" />
+            <location filename="../../ui/controllers/project_controller.py" line="256" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="292" />
+            <location filename="../../ui/controllers/project_controller.py" line="262" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="299" />
-            <location filename="../../ui/controllers/project_controller.py" line="302" />
-            <location filename="../../ui/controllers/project_controller.py" line="311" />
+            <location filename="../../ui/controllers/project_controller.py" line="269" />
+            <location filename="../../ui/controllers/project_controller.py" line="272" />
+            <location filename="../../ui/controllers/project_controller.py" line="286" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="313" />
+            <location filename="../../ui/controllers/project_controller.py" line="288" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="319" />
+            <location filename="../../ui/controllers/project_controller.py" line="294" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="326" />
+            <location filename="../../ui/controllers/project_controller.py" line="301" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="328" />
+            <location filename="../../ui/controllers/project_controller.py" line="303" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="354" />
+            <location filename="../../ui/controllers/project_controller.py" line="329" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="381" />
-            <location filename="../../ui/controllers/project_controller.py" line="384" />
+            <location filename="../../ui/controllers/project_controller.py" line="364" />
+            <location filename="../../ui/controllers/project_controller.py" line="367" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="387" />
+            <location filename="../../ui/controllers/project_controller.py" line="370" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="420" />
+            <location filename="../../ui/controllers/project_controller.py" line="401" />
+            <source>Cannot lock {path}: {reason}</source>
+            <translation>无法锁定 {path}：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_controller.py" line="410" />
+            <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
+            <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_controller.py" line="446" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="423" />
+            <location filename="../../ui/controllers/project_controller.py" line="449" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>
@@ -1974,22 +1991,22 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectDialogs</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="78" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="39" />
             <source>Unsaved changes</source>
             <translation>未保存的更改</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="79" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="40" />
             <source>Save the changes to {name}?</source>
             <translation>保存对 {name} 的更改？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="90" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="51" />
             <source>an unsaved project</source>
             <translation>未保存的工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="91" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="52" />
             <source>TeachPad was not closed properly. An autosave of {what} is newer than the saved file:
 {autosave}
 
@@ -2000,27 +2017,37 @@ Recover it?</source>
 是否恢复？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="93" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="54" />
             <source>Recover autosave</source>
             <translation>恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="99" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="61" />
+            <source>The file has no points. Importing it in replace mode removes all {n} points of the project.
+
+Remove them all?</source>
+            <translation>该文件中没有点。以替换方式导入将删除工程中全部 {n} 个点。
+
+确定全部删除吗？</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_dialogs.py" line="69" />
             <source>Replace all points</source>
             <translation>替换全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="100" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="70" />
             <source>Merge (update the same ids, append new ones)</source>
             <translation>合并（更新相同编号，追加新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="101" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="63" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="71" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="101" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="71" />
             <source>Import mode:</source>
             <translation>导入方式：</translation>
         </message>
@@ -2248,27 +2275,27 @@ Recover it?</source>
     <context>
         <name>Runner</name>
         <message>
-            <location filename="../../app/plan/runner.py" line="80" />
+            <location filename="../../app/plan/runner.py" line="92" />
             <source>ready</source>
             <translation>就绪</translation>
         </message>
         <message>
-            <location filename="../../app/plan/runner.py" line="81" />
+            <location filename="../../app/plan/runner.py" line="93" />
             <source>running</source>
             <translation>运行中</translation>
         </message>
         <message>
-            <location filename="../../app/plan/runner.py" line="82" />
+            <location filename="../../app/plan/runner.py" line="94" />
             <source>finished</source>
             <translation>已完成</translation>
         </message>
         <message>
-            <location filename="../../app/plan/runner.py" line="83" />
+            <location filename="../../app/plan/runner.py" line="95" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../app/plan/runner.py" line="84" />
+            <location filename="../../app/plan/runner.py" line="96" />
             <source>failed</source>
             <translation>失败</translation>
         </message>

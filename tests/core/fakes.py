@@ -29,6 +29,17 @@ class FakeClient:
     creates: list[dict[str, Any]] = field(default_factory=list)
     stops: int = 0
     closed: bool = False
+    gvs: dict[int, float] = field(default_factory=dict)
+    #: the points the fake controller holds (id -> pose), from create_point; a move to one of
+    #: them puts ``pose`` there, like the simulator does (a move elsewhere leaves it)
+    stored: dict[int, tuple[float, ...]] = field(default_factory=dict)
+
+    def read_gv(self, n: int, count: int = 1) -> list[float]:
+        return [self.gvs.get(n + i, 0.0) for i in range(count)]
+
+    def write_gv(self, n: int, values: Sequence[float]) -> None:
+        for i, v in enumerate(values):
+            self.gvs[n + i] = float(v)
 
     def read_pose(self) -> Pose:
         return self.pose
@@ -37,6 +48,8 @@ class FakeClient:
                      tool: int = 200, wait: bool = True, timeout: float | None = None) -> CommandResult:
         n = len(self.creates)
         self.creates.append({"id": point_id, "pose": tuple(pose) if pose else None, "tool": tool})
+        if n not in self.create_script and pose is not None:
+            self.stored[point_id] = tuple(pose)
         return self._answer(self.create_script.get(n), CommandResult(
             RunCommand.CREATE_POINT, CommandKind.CREATE_POINT,
             CommandStatus(CommandKind.CREATE_POINT, 0xFF), True))
@@ -48,7 +61,10 @@ class FakeClient:
         self.moves.append({"end": end_id, "via": via_id, "orientation_changes": orientation_changes,
                            "ignore_middle": ignore_middle, "speed": speed, "tool": tool, "wait": wait,
                            "timeout": timeout})
-        return self._answer(self.move_script.get(n), DONE)
+        result = self._answer(self.move_script.get(n), DONE)
+        if result.ok and end_id in self.stored:
+            self.pose = Pose(*self.stored[end_id][:6])
+        return result
 
     def stop(self) -> None:
         self.stops += 1

@@ -32,7 +32,8 @@ class Cli:
 
     def __call__(self, *argv: str) -> int:
         parser = argparse.ArgumentParser(prog="teachpad-cli")
-        parser.add_argument("--host", default="127.0.0.1")  # a global option of the main parser
+        parser.add_argument("--host", default="127.0.0.1")  # global options of the main parser
+        parser.add_argument("--monitor-only", action="store_true")
         sub = parser.add_subparsers(dest="command", required=True)
         cli_points.register(sub)
         args = parser.parse_args(list(argv))
@@ -66,8 +67,8 @@ def test_export_import_round_trip(demo: Path, tmp_path: Path, capsys: pytest.Cap
     assert "1 added, 1 updated, 7 unchanged, 0 removed" in capsys.readouterr().out
     project = load_project(demo)
     assert len(project.ledger) == 9 and project.ledger.point(20).name == "新点"
-    assert project.ledger.point(2).x == 455 and project.ledger.point(2).sync is SyncState.CHANGED
-    assert project.ledger.point(1).sync is SyncState.UNKNOWN
+    assert project.ledger.point(2).x == 455
+    assert all(p.sync is SyncState.UNKNOWN for p in project.ledger)  # a loaded file never claims "synced"
     assert cli.clients_made == 0
 
 
@@ -109,12 +110,16 @@ def test_upload_selected_ids(demo: Path, capsys: pytest.CaptureFixture[str]) -> 
     assert [c["id"] for c in cli.client.creates] == [1, 2, 5, 6]
     assert cli.client.creates[1]["pose"] == (450.0, -150.0, 250.0, 180.0, 0.0, 0.0)
     assert cli.client.closed
-    ledger = load_project(demo).ledger
-    assert [p.id for p in ledger if p.sync is SyncState.ON_CONTROLLER] == [1, 2, 5, 6]
+    project = load_project(demo)
+    assert all(p.sync is SyncState.UNKNOWN for p in project.ledger)
+    assert sorted(project.upload_history) == [1, 2, 5, 6]  # history only
+    assert project.upload_history[1].endpoint == "controller"
     assert "uploaded 4 point(s)" in capsys.readouterr().out
+    assert cli("points", "list", str(demo)) == 0
+    assert "unknown (last uploaded 20" in capsys.readouterr().out
     cli2 = Cli()
-    assert cli2("points", "upload", str(demo), "--needed") == 0
-    assert [c["id"] for c in cli2.client.creates] == [3, 4, 7, 8]
+    assert cli2("points", "upload", str(demo), "--needed") == 0  # nothing is known to be there
+    assert [c["id"] for c in cli2.client.creates] == [1, 2, 3, 4, 5, 6, 7, 8]
     assert Cli()("points", "upload", str(demo), "--ids", "1,99") == cli_points.EXIT_USAGE
     assert Cli()("points", "upload", str(demo), "--ids", "x") == cli_points.EXIT_USAGE
 
@@ -123,8 +128,7 @@ def test_upload_with_lost_link_saves_what_was_done(demo: Path, capsys: pytest.Ca
     cli = Cli(FakeClient(create_script={2: LinkError("connection lost")}))
     assert cli("points", "upload", str(demo)) == cli_points.EXIT_LINK
     assert "not attempted: 3,4,5,6,7,8" in capsys.readouterr().err
-    ledger = load_project(demo).ledger
-    assert [p.id for p in ledger if p.sync is SyncState.ON_CONTROLLER] == [1, 2]
+    assert sorted(load_project(demo).upload_history) == [1, 2]
 
 
 def test_run_needs_a_plan_name_when_there_are_several(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -133,25 +137,82 @@ def test_run_needs_a_plan_name_when_there_are_several(demo: Path, capsys: pytest
     assert Cli()("run", str(demo), "--plan", "nope") == cli_points.EXIT_USAGE
 
 
-def test_run_refuses_when_points_are_not_on_the_controller(demo: Path,
-                                                           capsys: pytest.CaptureFixture[str]) -> None:
+def test_run_uploads_then_recreates_each_segments_points_before_its_move(
+        demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
     cli = Cli()
-    assert cli("run", str(demo), "--plan", "circle") == cli_points.EXIT_NEEDS_UPLOAD
-    err = capsys.readouterr().err
-    assert "--ids 1,5,6,7,8" in err and "or pass --upload" in err
-    assert cli.client.moves == [] and cli.client.closed
-
-
-def test_run_with_upload(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    cli = Cli()
-    assert cli("run", str(demo), "--plan", "circle", "--upload") == 0
-    assert sorted(c["id"] for c in cli.client.creates) == [1, 5, 6, 7, 8]
+    assert cli("run", str(demo), "--plan", "circle") == 0
+    # up front: every point the plan uses; then each segment's (via, end) right before its move
+    up_front, per_segment = [5, 6, 7, 8, 1], [5, 6, 7, 8, 5, 1]
+    assert [c["id"] for c in cli.client.creates] == up_front + per_segment
     assert [(m["via"], m["end"]) for m in cli.client.moves] == [(None, 5), (6, 7), (8, 5), (None, 1)]
     assert all(m["timeout"] and m["timeout"] >= 10.0 for m in cli.client.moves)
+    assert cli.client.gvs.get(99)  # the restart canary is armed
     out = capsys.readouterr().out
     assert "plan 'circle': 4 segment(s)" in out and "loop 1/1, segment 2/4: arc via P6 to P7" in out
     assert "done: 4 segment(s)" in out
-    assert load_project(demo).ledger.point(5).sync is SyncState.ON_CONTROLLER
+    project = load_project(demo)
+    assert project.ledger.point(5).sync is SyncState.UNKNOWN and 5 in project.upload_history
+    assert cli.client.closed
+
+
+def test_run_no_upload_sends_no_point_and_warns(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    client = FakeClient(stored={p.id: p.xyzabc for p in load_project(demo).ledger})
+    before = demo.read_bytes()
+    cli = Cli(client)
+    assert cli("run", str(demo), "--plan", "circle", "--no-upload") == 0
+    assert client.creates == [] and len(client.moves) == 4 and 99 not in client.gvs
+    assert "operator's responsibility" in capsys.readouterr().err
+    assert demo.read_bytes() == before
+
+
+def test_run_no_upload_stops_when_the_arm_arrives_elsewhere(demo: Path,
+                                                           capsys: pytest.CaptureFixture[str]) -> None:
+    """The controller holds a different P7 (another tool wrote it): the arrival check stops the run."""
+    stored = {p.id: p.xyzabc for p in load_project(demo).ledger}
+    stored[7] = (100.0, 100.0, 100.0, 180.0, 0.0, 0.0)
+    client = FakeClient(stored=stored)
+    assert Cli(client)("run", str(demo), "--plan", "circle", "--no-upload") == cli_points.EXIT_FAILED
+    err = capsys.readouterr().err
+    assert "segment 2/4" in err and "away from P7" in err and "overwritten by another tool" in err
+    assert [m["end"] for m in client.moves] == [5, 7]  # nothing sent after the mismatch
+
+
+def test_run_stops_before_moving_when_a_point_is_refused(demo: Path,
+                                                        capsys: pytest.CaptureFixture[str]) -> None:
+    from tests.core.fakes import failed
+
+    client = FakeClient(create_script={1: failed(1, "bad point")})
+    assert Cli(client)("run", str(demo), "--plan", "circle") == cli_points.EXIT_FAILED
+    assert "refused to create P6" in capsys.readouterr().err and client.moves == []
+
+
+def test_monitor_only_upload_refuses_before_touching_the_file(demo: Path,
+                                                             capsys: pytest.CaptureFixture[str]) -> None:
+    before = demo.read_bytes()
+    mtime = demo.stat().st_mtime_ns
+    cli = Cli()
+    assert cli("--monitor-only", "points", "upload", str(demo)) == cli_points.EXIT_FAILED
+    assert "monitor-only" in capsys.readouterr().err
+    assert cli.clients_made == 0 and demo.read_bytes() == before and demo.stat().st_mtime_ns == mtime
+    unreadable = demo.with_name("missing.teachpad.json")  # not even opened: no "does not exist"
+    assert cli("--monitor-only", "points", "upload", str(unreadable)) == cli_points.EXIT_FAILED
+    assert "does not exist" not in capsys.readouterr().err
+    assert cli("--monitor-only", "run", str(demo), "--plan", "circle") == cli_points.EXIT_FAILED
+    assert cli.clients_made == 0 and demo.stat().st_mtime_ns == mtime
+    assert cli("--monitor-only", "run", str(demo), "--plan", "circle", "--check") == 0  # reads only
+
+
+def test_empty_csv_replace_import_needs_allow_empty(demo: Path, tmp_path: Path,
+                                                    capsys: pytest.CaptureFixture[str]) -> None:
+    empty = tmp_path / "empty.csv"
+    empty.write_text("id,x,y,z,a,b,c\n", encoding="utf-8")
+    before = demo.read_bytes()
+    assert Cli()("points", "import", str(demo), "--csv", str(empty)) == cli_points.EXIT_USAGE
+    assert "--allow-empty" in capsys.readouterr().err and demo.read_bytes() == before
+    assert Cli()("points", "import", str(demo), "--csv", str(empty), "--merge") == 0
+    assert len(load_project(demo).ledger) == 8
+    assert Cli()("points", "import", str(demo), "--csv", str(empty), "--allow-empty") == 0
+    assert len(load_project(demo).ledger) == 0
 
 
 def test_run_failure_prints_how_to_resume(demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -189,7 +250,7 @@ def test_run_check_only_does_not_connect(demo: Path, capsys: pytest.CaptureFixtu
     cli = Cli()
     assert cli("run", str(demo), "--plan", "pick and place", "--check") == 0
     out = capsys.readouterr().out
-    assert "needs upload: 1, 2, 3, 4" in out and "check only" in out
+    assert "would upload: 2, 4, 3, 1" in out and "check only" in out
     assert cli.clients_made == 0
 
 
@@ -220,8 +281,7 @@ def test_ctrl_c_during_a_run_stops_the_robot(demo: Path, capsys: pytest.CaptureF
 def test_ctrl_c_during_upload_keeps_what_was_done(demo: Path) -> None:
     cli = Cli(FakeClient(create_script={3: KeyboardInterrupt()}))
     assert cli("points", "upload", str(demo)) == cli_points.EXIT_INTERRUPTED
-    ledger = load_project(demo).ledger
-    assert [p.id for p in ledger if p.sync is SyncState.ON_CONTROLLER] == [1, 2, 3]
+    assert sorted(load_project(demo).upload_history) == [1, 2, 3]
 
 
 def test_failed_segment_exit_code(demo: Path) -> None:
@@ -243,5 +303,5 @@ def test_through_the_main_cli(demo: Path, capsys: pytest.CaptureFixture[str],
     fake = FakeClient()
     monkeypatch.setattr(main_cli.CliContext, "client", property(lambda self: fake))
     assert main_cli.main(["run", str(demo), "--plan", "circle", "--upload"]) == 0
-    assert len(fake.moves) == 4 and len(fake.creates) == 5
+    assert len(fake.moves) == 4 and len(fake.creates) == 5 + 6
     assert not fake.closed  # the context owns the client (it closes its own, real one)

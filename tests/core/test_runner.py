@@ -5,8 +5,11 @@ from __future__ import annotations
 import pytest
 
 from app.errors import AlarmRaised, CommandRefused, CommandStopped, CommandTimeout, InvalidInput, LinkError
+from app.models import CommandResult
 from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
 from app.plan.segments import Plan, Segment
+from app.points.guard import PointGuard, PointMismatch, PointNotCreated
+from app.points.point import TempPoint, make_point
 from app.protocol.enums import CommandKind, CommandStatus
 from tests.core.fakes import DONE, FakeClient, failed
 
@@ -262,3 +265,60 @@ def test_runner_takes_a_snapshot_of_the_plan() -> None:
     p.remove(0)
     client = FakeClient()
     assert runner.run(client).ok and ends(client) == [1, 3, 4, 5]
+
+
+# --- the point guard around each segment ----------------------------------------------------------
+
+
+def _guard_points() -> dict[int, TempPoint]:
+    return {i: make_point(i, f"p{i}", (100.0 * i, 0, 300, 180, 0, 0)) for i in range(1, 6)}
+
+
+def test_guard_recreates_each_segments_points_right_before_its_move() -> None:
+    client = FakeClient()
+    guard = PointGuard(_guard_points())
+    calls: list[tuple[str, int]] = []
+    real_create, real_move = client.create_point, client.move_to_point
+
+    def create(point_id: int, **kwargs: object) -> CommandResult:
+        calls.append(("create", point_id))
+        return real_create(point_id, **kwargs)  # type: ignore[arg-type]
+
+    def move(end_id: int, **kwargs: object) -> CommandResult:
+        calls.append(("move", end_id))
+        return real_move(end_id, **kwargs)  # type: ignore[arg-type]
+
+    client.create_point = create  # type: ignore[method-assign]
+    client.move_to_point = move  # type: ignore[method-assign]
+    outcome = PlanRunner(plan()).run(client, guard)
+    assert outcome.ok
+    assert calls == [("create", 1), ("move", 1), ("create", 2), ("create", 3), ("move", 3),
+                     ("create", 4), ("move", 4), ("create", 5), ("move", 5)]
+
+
+def test_guard_mismatch_fails_at_that_segment_and_sends_nothing_more() -> None:
+    points = _guard_points()
+    client = FakeClient(stored={i: p.xyzabc for i, p in points.items()})
+    guard = PointGuard(points, refresh=False)
+    client.stored[4] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)  # the controller's P4 is not ours
+    outcome = PlanRunner(plan()).run(client, guard)
+    assert outcome.state is RunState.FAILED and isinstance(outcome.error, PointMismatch)
+    assert outcome.resume_from == 2 and ends(client) == [1, 3, 4]
+    assert "away from P4 'p4'" in outcome.message and client.creates == []
+
+
+def test_guard_refused_point_fails_before_the_move() -> None:
+    client = FakeClient(create_script={1: failed(1, "no")})
+    outcome = PlanRunner(plan()).run(client, PointGuard(_guard_points()))
+    assert outcome.state is RunState.FAILED and isinstance(outcome.error, PointNotCreated)
+    assert ends(client) == [1] and outcome.resume_from == 1 and "refused to create P2" in outcome.message
+
+
+def test_guard_restart_check_forgets_the_uploads() -> None:
+    client = FakeClient()
+    guard = PointGuard(_guard_points())
+    assert guard.ensure(client, [1, 2, 1]) == [1, 2]
+    assert guard.ensure(client, [1, 2, 3]) == [3]  # this process created 1 and 2 since the check
+    client.gvs.clear()  # the controller restarted: GV99 reads 0
+    assert guard.ensure(client, [1, 2, 3]) == [1, 2, 3] and guard.restarts == 1
+    assert client.gvs[99] != 0  # armed again

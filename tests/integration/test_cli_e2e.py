@@ -44,29 +44,16 @@ def sample_poses(path: Path) -> dict[int, tuple[float, ...]]:
     return {p.id: p.xyzabc for p in load_project(path).ledger}
 
 
-def test_upload_then_run_a_sample_plan(sim: Any, demo: Path, capsys: Capsys) -> None:
-    # The controller has no points yet: run refuses and says how to fix it; nothing moves.
-    assert teachpad_cli(sim.port, "run", str(demo), "--plan", "circle") == cli.EXIT_FAILED
-    err = capsys.readouterr().err
-    assert "is not on the controller" in err
-    assert f"teachpad-cli points upload {demo} --ids 1,5,6,7,8" in err
-    assert move_commands(sim) == 0
-
-    assert teachpad_cli(sim.port, "points", "upload", str(demo)) == cli.EXIT_OK
-    out = capsys.readouterr().out
-    assert "uploaded 8 point(s)" in out
-    assert "uploading 8/8: P8 'circle S'" in out  # one progress line per point (not a tty)
-    held = sim.state().points
-    for point_id, pose in sample_poses(demo).items():
-        assert_pose_at(held[point_id], pose, f"P{point_id} on the controller")
-    assert {p.sync for p in load_project(demo).ledger} == {SyncState.ON_CONTROLLER}  # saved
-
+def test_run_uploads_the_plans_points_then_runs(sim: Any, demo: Path, capsys: Capsys) -> None:
+    # The controller has no points yet: run creates the plan's points first, then runs.
     assert teachpad_cli(sim.port, "run", str(demo), "--plan", "circle") == cli.EXIT_OK
     captured = capsys.readouterr()
     assert captured.err == ""
     lines = captured.out.splitlines()
     assert re.match(r"plan 'circle': 4 segment\(s\), \d+\.\d mm per loop, loops 1, about ", lines[0])
     assert lines[1:] == [
+        "uploading the plan's 5 point(s): 5, 6, 7, 8, 1",
+        "uploaded 5 point(s)",
         f"loop 1/1, segment 1/4: line to P5, {FAST:g} mm/s",
         f"loop 1/1, segment 2/4: arc via P6 to P7, {FAST:g} mm/s",
         f"loop 1/1, segment 3/4: arc via P8 to P5, {FAST:g} mm/s",
@@ -74,13 +61,28 @@ def test_upload_then_run_a_sample_plan(sim: Any, demo: Path, capsys: Capsys) -> 
         "done: 4 segment(s)",
     ]
     assert move_commands(sim) == 4
+    held = sim.state().points
+    assert sorted(held) == [1, 5, 6, 7, 8]
+    for point_id, pose in sample_poses(demo).items():
+        if point_id in held:
+            assert_pose_at(held[point_id], pose, f"P{point_id} on the controller")
     state = sim.state()
     assert not state.moving
     assert_pose_at(state.pose, sample_poses(demo)[1], "the final pose")
+    project = load_project(demo)
+    assert {p.sync for p in project.ledger} == {SyncState.UNKNOWN}  # a file never says "synced"
+    assert sorted(project.upload_history) == [1, 5, 6, 7, 8]
+    assert project.upload_history[5].endpoint.endswith(str(sim.port))
+
+    assert teachpad_cli(sim.port, "points", "upload", str(demo)) == cli.EXIT_OK
+    out = capsys.readouterr().out
+    assert "uploaded 8 point(s)" in out
+    assert "uploading 8/8: P8 'circle S'" in out  # one progress line per point (not a tty)
+    assert sorted(load_project(demo).upload_history) == list(range(1, 9))
 
 
-def test_run_pick_and_place_two_loops_with_upload(sim: Any, demo: Path, capsys: Capsys) -> None:
-    """``run --upload`` creates only the points the plan needs, then runs both loops."""
+def test_run_pick_and_place_two_loops(sim: Any, demo: Path, capsys: Capsys) -> None:
+    """``run`` creates only the points the plan needs (``--upload``, the old flag, is accepted)."""
     code = teachpad_cli(sim.port, "run", str(demo), "--plan", "pick and place", "--upload")
     captured = capsys.readouterr()
     assert code == cli.EXIT_OK, captured.err
@@ -91,28 +93,25 @@ def test_run_pick_and_place_two_loops_with_upload(sim: Any, demo: Path, capsys: 
     assert progress[-1] == f"loop 2/2, segment 3/3: line to P1, {FAST:g} mm/s"
     assert len(progress) == 6 and captured.out.rstrip().endswith("done: 6 segment(s)")
     assert_pose_at(sim.state().pose, sample_poses(demo)[1], "the final pose")
-    ledger = load_project(demo).ledger
-    assert {p.id for p in ledger if p.sync is SyncState.ON_CONTROLLER} == {1, 2, 3, 4}
 
 
-def test_run_fails_at_the_segment_whose_point_the_controller_lost(
+def test_a_restarted_controller_gets_its_points_back_unless_no_upload(
     sim: Any, demo: Path, capsys: Capsys
 ) -> None:
     assert teachpad_cli(sim.port, "points", "upload", str(demo)) == cli.EXIT_OK
-    sim.restart_controller()  # the file still says "on controller"; the controller forgot
+    sim.restart_controller()  # the controller forgot every point
     capsys.readouterr()
-    assert teachpad_cli(sim.port, "run", str(demo), "--plan", "circle") == cli.EXIT_FAILED
+    # --no-upload: the operator said the controller holds the points; it does not
+    assert teachpad_cli(sim.port, "run", str(demo), "--plan", "circle", "--no-upload") == cli.EXIT_FAILED
     captured = capsys.readouterr()
-    assert "failed: segment 1/4 (loop 1/1): " in captured.err
-    assert "bad end point id" in captured.err
+    assert "operator's responsibility" in captured.err
+    assert "failed: segment 1/4 (loop 1/1): " in captured.err and "bad end point id" in captured.err
+    assert "resume without --no-upload" in captured.err
     assert f"to resume: teachpad-cli run {demo} --plan 'circle' --from 1" in captured.out
-    assert "all points are marked unknown" in captured.err
-    assert not sim.state().moving
-    assert {p.sync for p in load_project(demo).ledger} == {SyncState.UNKNOWN}  # saved
+    assert not sim.state().moving and move_commands(sim) == 1
 
-    # resume with --upload: the lost points are restored first, then the plan runs
-    assert teachpad_cli(sim.port, "run", str(demo), "--plan", "circle", "--from", "1",
-                        "--upload") == cli.EXIT_OK
+    # without it, run restores the lost points first, then the plan runs
+    assert teachpad_cli(sim.port, "run", str(demo), "--plan", "circle", "--from", "1") == cli.EXIT_OK
     assert_pose_at(sim.state().pose, sample_poses(demo)[1], "the final pose")
 
 

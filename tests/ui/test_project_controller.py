@@ -5,18 +5,22 @@ from __future__ import annotations
 
 import os
 import shutil
+import subprocess
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 
-from app.points.ledger import ImportMode
-from app.points.project import load_project
+from app.points.ledger import ImportMode, SyncState
+from app.points.lock import live_owner, lock_path
+from app.points.project import load_project, save_autosave
 from ui.controllers.project_controller import ProjectController
 from ui.models.point_columns import COL_X
 
-SAMPLES = Path(__file__).resolve().parents[2] / "resources" / "samples"
+ROOT = Path(__file__).resolve().parents[2]
+SAMPLES = ROOT / "resources" / "samples"
 
 
 class FakeDialogs:
@@ -29,6 +33,8 @@ class FakeDialogs:
         self.recover = True
         self.asked_recover: list[Path] = []
         self.import_mode: ImportMode | None = ImportMode.REPLACE
+        self.empty_import_ok = False
+        self.asked_empty: list[int] = []
 
     def open_path(self, title: str, filters: str) -> str | None:
         return self.paths.pop(0) if self.paths else None
@@ -48,6 +54,10 @@ class FakeDialogs:
 
     def ask_import_mode(self) -> ImportMode | None:
         return self.import_mode
+
+    def ask_empty_import(self, existing: int) -> bool:
+        self.asked_empty.append(existing)
+        return self.empty_import_ok
 
 
 @pytest.fixture
@@ -221,3 +231,85 @@ def test_save_as_and_actions(qtbot: Any, controller: ProjectController, dialogs:
     assert controller.action_undo.isEnabled()
     controller.action_undo.trigger()
     assert controller.project.ledger[0].x == 400.0
+
+
+# --- one instance per project ------------------------------------------------------------------
+
+
+@pytest.fixture
+def other_teachpad(project_file: Path) -> Iterator[subprocess.Popen[str]]:
+    """Another TeachPad process with ``project_file`` open (it holds the project's lock)."""
+    code = ("import sys; from app.points.lock import ProjectLock; lock = ProjectLock.acquire(sys.argv[1]); "
+            "print('locked', flush=True); sys.stdin.read(); lock.release()")
+    child = subprocess.Popen([sys.executable, "-c", code, str(project_file)], stdin=subprocess.PIPE,
+                             stdout=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert child.stdout is not None and child.stdout.readline().strip() == "locked"
+    try:
+        yield child
+    finally:
+        if child.poll() is None:
+            child.kill()
+        child.wait()
+        for stream in (child.stdin, child.stdout):
+            if stream is not None:
+                stream.close()
+
+
+def test_a_second_teachpad_says_the_project_is_open_instead_of_offering_its_autosave(
+        qtbot: Any, project_file: Path, dialogs: FakeDialogs, other_teachpad: subprocess.Popen[str]) -> None:
+    # the other TeachPad has unsaved edits in its (live) autosave, newer than the project
+    live = save_autosave(load_project(project_file), project_file)
+    stamp = project_file.stat().st_mtime_ns
+    os.utime(live, ns=(stamp + 10**9, stamp + 10**9))
+
+    second = ProjectController(dialogs=dialogs, autosave_interval=0)
+    assert not second.open_file(project_file)
+    assert second.path is None
+    assert dialogs.errors and dialogs.errors[-1][0] == "Project in use"
+    assert "is open in another TeachPad (process " + str(other_teachpad.pid) in dialogs.errors[-1][1]
+    assert not second.save_as(project_file)  # nor overwrite it under the other one's feet
+
+    # constructed on the path directly (e.g. from the command line): still no recovery offer
+    direct = ProjectController(load_project(project_file), project_file, dialogs=dialogs, autosave_interval=0)
+    assert direct.lock_owner is not None and direct.lock_owner.pid == other_teachpad.pid
+    assert direct.check_recovery() is None
+    assert not direct.offer_recovery()
+    assert dialogs.asked_recover == [] and live.exists()
+    assert "autosave belongs to that TeachPad" in dialogs.errors[-1][1]
+
+    # the other TeachPad closes: the project is ours, and its lock too
+    assert other_teachpad.stdin is not None
+    other_teachpad.stdin.close()
+    other_teachpad.wait()
+    assert direct.lock_owner is None
+    assert live_owner(project_file) is None and lock_path(project_file).exists()
+    direct.close()
+    assert not lock_path(project_file).exists()
+
+
+def test_the_lock_follows_the_open_project(qtbot: Any, controller: ProjectController, project_file: Path,
+                                           tmp_path: Path) -> None:
+    assert lock_path(project_file).exists()
+    other = tmp_path / "other.teachpad.json"
+    assert controller.save_as(other)
+    assert lock_path(other).exists() and not lock_path(project_file).exists()
+    assert controller.new_project()
+    assert not lock_path(other).exists()
+
+
+def test_loaded_points_are_unknown(qtbot: Any, controller: ProjectController) -> None:
+    assert all(p.sync is SyncState.UNKNOWN for p in controller.project.ledger)
+
+
+def test_an_empty_csv_replaces_the_points_only_when_confirmed(qtbot: Any, controller: ProjectController,
+                                                              dialogs: FakeDialogs, tmp_path: Path) -> None:
+    empty = tmp_path / "empty.csv"
+    empty.write_text("id,x,y,z,a,b,c\n", encoding="utf-8")
+    count = len(controller.project.ledger)
+    assert not controller.import_csv(empty, ImportMode.REPLACE)
+    assert dialogs.asked_empty == [count] and len(controller.project.ledger) == count
+    dialogs.empty_import_ok = True
+    assert controller.import_csv(empty, ImportMode.REPLACE)
+    assert len(controller.project.ledger) == 0
+    controller.undo_stack.undo()
+    assert len(controller.project.ledger) == count

@@ -16,6 +16,14 @@ Autosave: every :data:`AUTOSAVE_INTERVAL_S` seconds while the project has unsave
 project). A save removes it. At startup :meth:`ProjectController.check_recovery` returns an
 autosave newer than its project (a crash left it); :meth:`ProjectController.offer_recovery`
 asks and loads it. :meth:`ProjectController.close` stops the timer.
+
+One instance per project: the open project's lock file (:mod:`app.points.lock`) is taken when
+it is opened or saved under a new name and released when another project replaces it or the
+window closes. A project open in another running TeachPad is not opened here, and its live
+autosave is never offered for recovery: the operator is told where it is open instead.
+
+A loaded project's points are all *unknown* (a file cannot know what a controller holds).
+A CSV without points does not replace all points unless the operator confirms it.
 """
 
 from __future__ import annotations
@@ -26,10 +34,11 @@ from typing import Any
 
 from PySide6.QtCore import QObject, QTimer, Signal, Slot
 from PySide6.QtGui import QAction, QKeySequence, QUndoStack
-from PySide6.QtWidgets import QFileDialog, QInputDialog, QMessageBox, QWidget
 
 from app.errors import InvalidInput
-from app.points.ledger import FileFormatError, ImportMode
+from app.points.ledger import EmptyImport, ImportMode
+from app.points.lock import LockOwner, ProjectLock, ProjectLocked, live_owner
+from app.points.point import FileFormatError
 from app.points.project import (
     PROJECT_SUFFIX,
     Project,
@@ -42,67 +51,14 @@ from app.points.project import (
     save_project,
     write_points_csv,
 )
+from ui.controllers.project_dialogs import ProjectDialogs
 from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
 
 AUTOSAVE_INTERVAL_S = 60.0  # seconds between autosaves while there are unsaved changes
 SAVE_CHOICES = ("save", "discard", "cancel")
 
-
-class ProjectDialogs:
-    """Questions and file choosers of :class:`ProjectController` (Qt dialogs).
-
-    Tests pass an object with the same methods that answers without showing anything."""
-
-    def __init__(self, parent: QWidget | None = None) -> None:
-        self.parent = parent
-
-    def tr(self, text: str) -> str:
-        from PySide6.QtCore import QCoreApplication
-
-        return QCoreApplication.translate("ProjectDialogs", text)
-
-    def open_path(self, title: str, filters: str) -> str | None:
-        path, _ = QFileDialog.getOpenFileName(self.parent, title, "", filters)
-        return path or None
-
-    def save_path(self, title: str, filters: str, suggested: str) -> str | None:
-        path, _ = QFileDialog.getSaveFileName(self.parent, title, suggested, filters)
-        return path or None
-
-    def error(self, title: str, text: str) -> None:
-        QMessageBox.critical(self.parent, title, text)
-
-    def ask_save_changes(self, name: str) -> str:
-        """"save", "discard" or "cancel"."""
-        box = QMessageBox(QMessageBox.Icon.Question, self.tr("Unsaved changes"),
-                          self.tr("Save the changes to {name}?").format(name=name),
-                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
-                          | QMessageBox.StandardButton.Cancel, self.parent)
-        answer = box.exec()
-        if answer == QMessageBox.StandardButton.Save:
-            return "save"
-        if answer == QMessageBox.StandardButton.Discard:
-            return "discard"
-        return "cancel"
-
-    def ask_recover(self, autosave: Path, project_path: Path | None) -> bool:
-        what = str(project_path) if project_path else self.tr("an unsaved project")
-        text = self.tr("TeachPad was not closed properly. An autosave of {what} is newer than the saved "
-                       "file:\n{autosave}\n\nRecover it?").format(what=what, autosave=autosave)
-        answer = QMessageBox.question(self.parent, self.tr("Recover autosave"), text,
-                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
-                                      QMessageBox.StandardButton.Yes)
-        return answer == QMessageBox.StandardButton.Yes
-
-    def ask_import_mode(self) -> ImportMode | None:
-        replace_text = self.tr("Replace all points")
-        merge_text = self.tr("Merge (update the same ids, append new ones)")
-        choice, ok = QInputDialog.getItem(self.parent, self.tr("Import points"), self.tr("Import mode:"),
-                                          [replace_text, merge_text], 0, False)
-        if not ok:
-            return None
-        return ImportMode.MERGE if choice == merge_text else ImportMode.REPLACE
+__all__ = ["AUTOSAVE_INTERVAL_S", "SAVE_CHOICES", "ProjectController", "ProjectDialogs"]
 
 
 class ProjectController(QObject):
@@ -135,6 +91,10 @@ class ProjectController(QObject):
         self._saved_revision = self._project.revision
         self._autosaved_revision = self._project.revision
         self._dirty = False
+        self._lock: ProjectLock | None = None
+        self._foreign_lock: LockOwner | None = None  # another TeachPad has self._path open
+        if self._path is not None:
+            self._take_lock(self._path)
 
         self.undo_stack = QUndoStack(self)
         self.points_model = PointsModel(self._project, self.undo_stack, self)
@@ -238,6 +198,10 @@ class ProjectController(QObject):
             path = chosen
         if not self.maybe_save():
             return False
+        owner = live_owner(path)
+        if owner is not None:
+            self.dialogs.error(self.tr("Project in use"), self._in_use_text(Path(path), owner))
+            return False
         try:
             project = load_project(path, self._project.ledger.limits)
         except (FileFormatError, InvalidInput) as exc:
@@ -270,12 +234,18 @@ class ProjectController(QObject):
 
     def _save_to(self, target: Path) -> bool:
         old_autosave = self.autosave_file
+        owner = live_owner(target)
+        if owner is not None:
+            self.dialogs.error(self.tr("Project in use"), self._in_use_text(target, owner))
+            return False
         try:
             save_project(self._project, target)
         except OSError as exc:
             self.dialogs.error(self.tr("Cannot save project"), f"{target}: {exc.strerror or exc}")
             return False
         old_path, self._path = self._path, target
+        if old_path != target or self._lock is None:
+            self._take_lock(target)
         self._saved_revision = self._autosaved_revision = self._project.revision
         self.undo_stack.setClean()
         for stale in {old_autosave, self.autosave_file}:
@@ -306,7 +276,12 @@ class ProjectController(QObject):
             if mode is None:
                 return False
         try:
-            report = self.points_model.import_points(points, mode)
+            try:
+                report = self.points_model.import_points(points, mode)
+            except EmptyImport as exc:
+                if not self.dialogs.ask_empty_import(exc.existing):
+                    return False
+                report = self.points_model.import_points(points, mode, allow_empty=True)
         except InvalidInput as exc:
             self.dialogs.error(self.tr("Cannot import points"), str(exc))
             return False
@@ -358,12 +333,20 @@ class ProjectController(QObject):
         return written
 
     def check_recovery(self) -> Path | None:
-        """The autosave to offer at startup (newer than the project, or of an untitled one)."""
+        """The autosave to offer at startup (newer than the project, or of an untitled one);
+        None when another running TeachPad has the project open (its autosave is live)."""
+        if self.lock_owner is not None:
+            return None
         return find_autosave(self._path, user_dir=self._autosave_dir)
 
     def offer_recovery(self) -> bool:
         """Ask whether to recover :meth:`check_recovery`'s file; True when recovered.
-        Declining removes the autosave."""
+        Declining removes the autosave. When another TeachPad has the project open, says so
+        instead (its autosave is that TeachPad's work in progress, not a crash leftover)."""
+        owner = self.lock_owner
+        if owner is not None and self._path is not None:
+            self.dialogs.error(self.tr("Project in use"), self._in_use_text(self._path, owner))
+            return False
         found = self.check_recovery()
         if found is None:
             return False
@@ -389,8 +372,45 @@ class ProjectController(QObject):
 
     @Slot()
     def close(self) -> None:
-        """Stop autosaving (the window is closing; call :meth:`maybe_save` first)."""
+        """Stop autosaving and release the project's lock (the window is closing; call
+        :meth:`maybe_save` first)."""
         self._timer.stop()
+        self._release_lock()
+
+    @property
+    def lock_owner(self) -> LockOwner | None:
+        """Another running TeachPad that has this project open (None: the project is ours,
+        or untitled). When that TeachPad has gone, this one takes the lock."""
+        if self._path is None or (self._lock is not None and self._lock.held):
+            return None
+        owner = live_owner(self._path)
+        if owner is None:
+            self._take_lock(self._path)
+            return self._foreign_lock
+        return owner
+
+    # --- the one-instance lock
+    def _take_lock(self, path: Path) -> None:
+        self._release_lock()
+        self._foreign_lock = None
+        try:
+            self._lock = ProjectLock.acquire(path)
+        except ProjectLocked as exc:
+            self._foreign_lock = exc.owner
+        except OSError as exc:  # e.g. a read-only directory: work without a lock, and say so
+            self.statusMessage.emit(self.tr("Cannot lock {path}: {reason}").format(
+                path=path, reason=exc.strerror or exc))
+
+    def _release_lock(self) -> None:
+        if self._lock is not None:
+            self._lock.release()
+            self._lock = None
+
+    def _in_use_text(self, path: Path, owner: LockOwner) -> str:
+        return self.tr("{path} is open in another TeachPad (process {pid} on {host}, since {started}). "
+                       "Close it there first; its autosave belongs to that TeachPad and is not offered "
+                       "for recovery here.").format(path=path, pid=owner.pid, host=owner.host or "?",
+                                                    started=owner.started or "?")
 
     # --- internals
     def _replace(self, project: Project, path: Path | None, *, dirty: bool = False) -> None:
@@ -398,6 +418,12 @@ class ProjectController(QObject):
         self.undo_stack.clear()
         self._project = project
         self._path = path
+        if path != old_path:
+            if path is None:
+                self._release_lock()
+                self._foreign_lock = None
+            else:
+                self._take_lock(path)
         self._saved_revision = project.revision - (1 if dirty else 0)
         self._autosaved_revision = project.revision
         self.points_model.set_project(project)

@@ -396,10 +396,11 @@ class PointsModel(UndoableListModel):
         return row
 
     def import_points(self, points: Sequence[TempPoint],
-                      mode: ImportMode = ImportMode.REPLACE) -> ImportReport:
-        """Import parsed points (one undo step); the ledger is untouched when refused."""
+                      mode: ImportMode = ImportMode.REPLACE, *, allow_empty: bool = False) -> ImportReport:
+        """Import parsed points (one undo step); the ledger is untouched when refused (an empty
+        list in replace mode too, unless ``allow_empty``)."""
         scratch = PointLedger(self.ledger.snapshot(), self.ledger.limits)
-        report = scratch.import_points(points, mode)
+        report = scratch.import_points(points, mode, allow_empty=allow_empty)
         text = self.tr("Import {n} points").format(n=len(points))
         self._stack.push(_ReplaceAllCommand(self, self.ledger.snapshot(), scratch.snapshot(), text))
         return report

@@ -1,0 +1,197 @@
+"""``teachpad-cli run PROJECT ...``: check a plan, upload its points, run it guarded.
+
+Registered by :func:`app.cli.points.register` (see that module for the handler conventions
+and exit codes). A project file cannot know what the controller holds, so ``run`` creates
+every point its plan uses before the first move and guards each segment with
+:class:`app.points.guard.PointGuard` (restart canary, points re-created right before the move,
+arrival verified after it). ``--no-upload`` skips the uploads: the operator answers for the
+controller's points; the arrival check stays.
+"""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any, TextIO
+
+from app.cli.points import (
+    EXIT_FAILED,
+    EXIT_INTERRUPTED,
+    EXIT_LINK,
+    EXIT_OK,
+    EXIT_USAGE,
+    PROG,
+    MakeClient,
+    _endpoint,
+    _fmt_time,
+    _Io,
+    _limits,
+    _link_code,
+    _load,
+    _monitor_only,
+    _ProgressLine,
+    _save,
+)
+from app.errors import CommandRefused, InvalidInput, LinkError, ResponseTimeout, TeachPadError
+from app.models import Pose
+from app.plan.checks import IssueKind, PlanLimits, check_plan
+from app.plan.estimates import estimate_plan, segment_timeouts
+from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
+from app.plan.segments import Plan
+from app.points.guard import PointGuard, PointMismatch, PointNotCreated
+from app.points.lock import live_owner
+from app.points.project import Project
+from app.protocol.enums import MoveStatus
+
+
+def _pick_plan(io: _Io, project: Project, name: str | None) -> Plan | None:
+    if name is not None:
+        try:
+            return project.plan(name)
+        except InvalidInput as exc:
+            io.error(str(exc))
+            return None
+    if len(project.plans) == 1:
+        return project.plans[0]
+    if not project.plans:
+        io.error("the project has no plans")
+    else:
+        io.error(f"the project has {len(project.plans)} plans ({', '.join(project.plan_names())}): "
+                 "choose one with --plan")
+    return None
+
+
+def _upload_plan_points(io: _Io, args: argparse.Namespace, project: Project, guard: PointGuard,
+                        plan_ids: list[int], client: Any) -> int:
+    """Create the plan's points before the first move; records the history in the project."""
+    io.print(f"uploading the plan's {len(plan_ids)} point(s): {', '.join(map(str, plan_ids))}")
+    try:
+        guard.ensure(client, plan_ids)
+    except KeyboardInterrupt:
+        io.error("interrupted while uploading: not running")
+        return EXIT_INTERRUPTED
+    except PointNotCreated as exc:
+        io.error(f"{exc}: not running")
+        return EXIT_FAILED
+    except TeachPadError as exc:
+        return _link_code(io, exc, "cannot upload the plan's points")
+    finally:
+        project.record_upload(sorted(guard.uploaded), _endpoint(client))
+    owner = live_owner(args.project)
+    if owner is None:
+        _save(io, project, args.project)  # the upload history; a failed save does not stop the run
+    io.print(f"uploaded {len(guard.uploaded)} point(s)")
+    return EXIT_OK
+
+
+def _points_lost(error: BaseException | None) -> bool:
+    return isinstance(error, CommandRefused) and error.status.code == MoveStatus.BAD_END_POINT
+
+
+def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
+            err: TextIO | None = None, close_client: bool = True) -> int:
+    """``run PROJECT [--plan NAME] ...``: check, upload, run guarded with a progress line."""
+    io = _Io(out, err)
+    if not args.check and _monitor_only(io, args, "run"):
+        return EXIT_FAILED
+    project = _load(io, args.project, _limits(args))
+    if project is None:
+        return EXIT_USAGE
+    plan = _pick_plan(io, project, args.plan)
+    if plan is None:
+        return EXIT_USAGE
+    loops = plan.loops if args.loops is None else args.loops
+    start = args.from_segment - 1
+    try:
+        limits = PlanLimits(max_speed=args.max_speed)
+        if loops < 0:
+            raise InvalidInput("--loops must be >= 0 (0 = until stopped)")
+        if not 0 <= start < len(plan):
+            raise InvalidInput(f"--from {args.from_segment}: the plan has segments 1..{len(plan)}")
+        if args.from_loop < 1 or (loops and args.from_loop > loops):
+            raise InvalidInput(f"--from-loop {args.from_loop}: the run has loops 1..{loops}")
+    except InvalidInput as exc:
+        io.error(str(exc))
+        return EXIT_USAGE
+
+    client: Any = None
+    try:
+        pose: Pose | None = None
+        if not args.check:
+            try:
+                client = make_client()
+                pose = client.read_pose()
+            except TeachPadError as exc:
+                return _link_code(io, exc, "cannot read the robot's pose")
+        return _run(io, args, project, plan, client, pose, limits, loops, start)
+    finally:
+        if close_client and client is not None:
+            client.close()
+
+
+def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client: Any, pose: Pose | None,
+         limits: PlanLimits, loops: int, start: int) -> int:
+    ledger = project.ledger
+    issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops)
+    for issue in issues:
+        if issue.kind is IssueKind.WARNING:
+            io.warn(issue.message)
+    errors = [i for i in issues if i.kind is IssueKind.ERROR]
+    if errors:
+        for issue in errors:
+            io.error(issue.message)
+        io.error(f"plan {plan.name!r} has {len(errors)} error(s): not running it")
+        return EXIT_USAGE
+    est = estimate_plan(plan, ledger, pose, loops=loops)
+    io.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
+             f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}")
+    plan_ids = list(dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids))
+    if args.check:
+        if args.no_upload:
+            io.print("--no-upload: the controller must already hold the plan's points")
+        else:
+            io.print(f"would upload: {', '.join(map(str, plan_ids))}")
+        io.print("check only: not running")
+        return EXIT_OK
+    guard = PointGuard({p.id: p for p in ledger}, refresh=not args.no_upload)
+    if args.no_upload:
+        io.warn(f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
+                f"{', '.join(map(str, plan_ids))} (the operator's responsibility)")
+    else:
+        code = _upload_plan_points(io, args, project, guard, plan_ids, client)
+        if code != EXIT_OK:
+            return code
+
+    line = _ProgressLine(io.out)
+
+    def progress(p: RunProgress) -> None:
+        if p.event is RunEvent.SEGMENT_STARTED:
+            line.show(f"{p.text}: {p.message}")
+
+    runner = PlanRunner(plan, loops=loops, start=start, start_loop=args.from_loop, single=args.single,
+                        timeouts=segment_timeouts(plan, ledger, pose), progress=progress)
+    try:
+        outcome = runner.run(client, guard)
+    finally:
+        line.done()
+    if outcome.state is RunState.FINISHED:
+        io.print(f"done: {outcome.segments_done} segment(s)")
+        return EXIT_OK
+    io.error(f"{outcome.state.value}: {outcome.message}")
+    if _points_lost(outcome.error):
+        # "bad end point id": the controller does not hold the segment's points (restarted?)
+        io.error("the controller does not hold the plan's points (restarted?); resume without "
+                 "--no-upload so that they are created first")
+    if isinstance(outcome.error, PointMismatch | PointNotCreated):
+        io.error("nothing further was sent; the robot is where the message above says")
+    if outcome.resume_from is not None:
+        resume = f"--from {outcome.resume_from + 1}"
+        if outcome.resume_loop and outcome.resume_loop > 1:
+            resume += f" --from-loop {outcome.resume_loop}"
+        plan_arg = f" --plan {plan.name!r}" if len(project.plans) > 1 else ""
+        loops_arg = f" --loops {loops}" if args.loops is not None else ""
+        io.print(f"to resume: {PROG} run {args.project}{plan_arg} {resume}{loops_arg}")
+    if outcome.interrupted:
+        return EXIT_INTERRUPTED
+    if isinstance(outcome.error, LinkError | ResponseTimeout):
+        return EXIT_LINK
+    return EXIT_FAILED

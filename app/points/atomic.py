@@ -1,0 +1,132 @@
+"""Atomic file replacement, and reading files with a size limit.
+
+:func:`atomic_write_bytes` writes a temp file in the target's directory, fsyncs it and
+``os.replace``-s it over the target, so a crash (even ``kill -9``) leaves either the old file or
+the new one, never a mix. What a kill can leave is the temp file itself; its name is
+recognisably ours (:data:`TEMP_PREFIX` + target name + a random part + :data:`TEMP_SUFFIX`), and
+the next save of the same target removes such leftovers when they are older than
+:data:`STALE_TEMP_AGE` seconds (a younger one may belong to a save under way in another
+process; the instance lock of :mod:`app.points.lock` keeps that rare).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import stat
+import sys
+import time
+import uuid
+from pathlib import Path
+
+from app.points.point import FileFormatError
+
+TEMP_PREFIX = ".teachpad-tmp."
+TEMP_SUFFIX = ".tmp"
+#: A temp file of ours older than this (s) is a leftover of a killed save; tests may shrink it.
+STALE_TEMP_AGE = 60.0
+MAX_FILE_BYTES = 64 * 1024 * 1024  # refuse absurd files before reading them
+
+_RANDOM = re.compile(r"[0-9a-f]{12}")
+
+
+def temp_name(target: Path) -> Path:
+    """A fresh temp file name for a save of ``target``."""
+    return target.with_name(f"{TEMP_PREFIX}{target.name}.{uuid.uuid4().hex[:12]}{TEMP_SUFFIX}")
+
+
+def stale_temp_files(target: str | os.PathLike[str], *, min_age: float | None = None) -> list[Path]:
+    """Temp files a save of ``target`` left behind (exactly our pattern, older than ``min_age``)."""
+    path = Path(target)
+    age = STALE_TEMP_AGE if min_age is None else min_age
+    head = f"{TEMP_PREFIX}{path.name}."
+    found: list[Path] = []
+    now = time.time()
+    try:
+        entries = list(os.scandir(path.parent))
+    except OSError:
+        return []
+    for entry in entries:
+        name = entry.name
+        if not (name.startswith(head) and name.endswith(TEMP_SUFFIX)):
+            continue
+        if not _RANDOM.fullmatch(name[len(head): -len(TEMP_SUFFIX)]):
+            continue
+        try:
+            if not entry.is_file(follow_symlinks=False) or now - entry.stat().st_mtime < age:
+                continue
+        except OSError:
+            continue
+        found.append(Path(entry.path))
+    return found
+
+
+def clean_stale_temp_files(target: str | os.PathLike[str], *, min_age: float | None = None) -> int:
+    """Remove what :func:`stale_temp_files` finds; returns how many went."""
+    removed = 0
+    for leftover in stale_temp_files(target, min_age=min_age):
+        with contextlib.suppress(OSError):
+            leftover.unlink()
+            removed += 1
+    return removed
+
+
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
+    """Replace ``path`` with ``data`` so that a crash leaves the old file or the new, never a mix.
+
+    Temp file in the same directory (same filesystem), written in full, fsynced, then
+    ``os.replace``; the directory is fsynced afterwards where the OS allows it. On any error
+    the temp file is removed and the old file is untouched. Keeps an existing file's mode.
+    Removes stale temp files of earlier, killed saves of the same target first.
+    """
+    target = Path(path)
+    directory = target.parent
+    clean_stale_temp_files(target)
+    tmp = temp_name(target)
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    try:
+        try:
+            view = memoryview(data)
+            while view:
+                written = os.write(fd, view)
+                view = view[written:]
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+        with contextlib.suppress(FileNotFoundError):
+            os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode))
+        os.replace(tmp, target)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    _fsync_dir(directory)
+
+
+def _fsync_dir(directory: Path) -> None:
+    # Makes the rename itself durable. Not possible on Windows, and some filesystems refuse
+    # it; the data is already safe either way, so a refusal is not an error.
+    if sys.platform == "win32":
+        return
+    with contextlib.suppress(OSError):
+        dfd = os.open(directory, os.O_RDONLY)
+        try:
+            os.fsync(dfd)
+        finally:
+            os.close(dfd)
+
+
+def read_limited(path: Path, limit: int = MAX_FILE_BYTES) -> bytes:
+    """The file's bytes; :class:`FileFormatError` for a missing, too large or unreadable file."""
+    try:
+        size = path.stat().st_size
+        if size > limit:
+            raise FileFormatError(f"the file is too large ({size} bytes, at most {limit})", path=str(path))
+        return path.read_bytes()
+    except FileNotFoundError:
+        raise FileFormatError("the file does not exist", path=str(path)) from None
+    except IsADirectoryError:
+        raise FileFormatError("is a directory, not a file", path=str(path)) from None
+    except PermissionError:
+        raise FileFormatError("cannot be read (permission denied)", path=str(path)) from None

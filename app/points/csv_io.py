@@ -1,0 +1,108 @@
+"""Temp points as CSV (documented in docs/PROJECT_FORMAT.md).
+
+Header row with the columns ``id,name,x,y,z,a,b,c,e1,e2,e3,e4,e5,tool,note``; UTF-8, with or
+without a BOM; ``id`` and ``x``..``c`` are required, the others may be left out (defaults:
+empty name and note, external axes 0, tool 200 = none). Rows are numbered as a spreadsheet
+shows them: the header is row 1. A bad file is refused whole with a
+:class:`~app.points.point.FileFormatError` naming the row and the column.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+from collections.abc import Iterable
+
+from app.points.point import (
+    CSV_COLUMNS,
+    CSV_REQUIRED,
+    DEFAULT_LIMITS,
+    FieldError,
+    FileFormatError,
+    PointLimits,
+    TempPoint,
+    point_from_fields,
+    shown,
+)
+
+
+def _format_float(value: float) -> str:
+    return repr(float(value))
+
+
+def points_to_csv(points: Iterable[TempPoint]) -> str:
+    """The CSV text (no BOM) of ``points``, header first."""
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\r\n")
+    writer.writerow(CSV_COLUMNS)
+    for p in points:
+        writer.writerow(
+            [str(p.id), p.name, *(_format_float(v) for v in p.xyzabc),
+             *(_format_float(v) for v in p.ext), str(p.tool), p.note]
+        )
+    return out.getvalue()
+
+
+def decode_text(data: bytes, path: str | None = None) -> str:
+    """UTF-8 text, a leading BOM dropped; refuses other encodings with a hint."""
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise FileFormatError(
+            f"not UTF-8 text (bad byte at offset {exc.start}); save the file as UTF-8", path=path
+        ) from None
+
+
+def parse_points_csv(
+    text: str, limits: PointLimits = DEFAULT_LIMITS, *, path: str | None = None
+) -> list[TempPoint]:
+    """Parse CSV text fully; raises :class:`FileFormatError` naming the row and column."""
+    if text.startswith("\ufeff"):
+        text = text[1:]
+    reader = csv.reader(io.StringIO(text, newline=""), strict=True)
+    rows: list[list[str]] = []
+    try:
+        rows.extend(reader)
+    except csv.Error as exc:
+        reason = shown(str(exc), 80)[1:-1]
+        raise FileFormatError(f"not valid CSV ({reason})", path=path, row=len(rows) + 1) from None
+    header_at = next((i for i, r in enumerate(rows) if any(cell.strip() for cell in r)), None)
+    if header_at is None:
+        raise FileFormatError("the file is empty (expected a header row)", path=path, row=1)
+    header = [cell.strip().lower() for cell in rows[header_at]]
+    header_row = header_at + 1
+    for col, name in enumerate(header):
+        if name not in CSV_COLUMNS:
+            raise FileFormatError(
+                f"unknown column {shown(rows[header_at][col])} (expected: {','.join(CSV_COLUMNS)})",
+                path=path, row=header_row,
+            )
+        if header.index(name) != col:
+            raise FileFormatError("the column appears twice", path=path, row=header_row, column=name)
+    for name in CSV_COLUMNS:
+        if name in CSV_REQUIRED and name not in header:
+            raise FileFormatError(
+                "the column is missing from the header", path=path, row=header_row, column=name
+            )
+    points: list[TempPoint] = []
+    seen: dict[int, int] = {}
+    for number, cells in enumerate(rows[header_at + 1:], start=header_row + 1):
+        if not any(cell.strip() for cell in cells):
+            continue  # blank line
+        if len(cells) != len(header):
+            raise FileFormatError(
+                f"has {len(cells)} cells, the header has {len(header)} (truncated or extra cells?)",
+                path=path, row=number,
+            )
+        fields = dict(zip(header, cells, strict=True))
+        try:
+            point = point_from_fields(fields, limits)
+        except FieldError as exc:
+            raise FileFormatError(exc.reason, path=path, row=number, column=exc.field) from None
+        if point.id in seen:
+            raise FileFormatError(
+                f"id {point.id} is already used on row {seen[point.id]}", path=path, row=number, column="id"
+            )
+        seen[point.id] = number
+        points.append(point)
+    return points

@@ -1,0 +1,420 @@
+"""A temp point as the host keeps it: fields, validation and sync states.
+
+The controller forgets every temp point when its system logs in again (PROTOCOL.md section 5,
+function 2), and another tool may overwrite one at any time, so the host keeps the master
+copy (:mod:`app.points.ledger`) and re-creates points on the controller when they are needed.
+Each :class:`TempPoint` records whether the controller is known to hold it (:class:`SyncState`).
+
+Sync rules: a new, duplicated or imported-and-different point is ``CHANGED`` (not yet on the
+controller); editing ``id``, ``x``..``c`` or ``tool`` marks a point ``CHANGED``; ``name``,
+``note`` and ``e1``..``e5`` are host-only (function 2 stores six pose values and a tool frame,
+nothing else) and leave the state alone. A loaded file never says ``ON_CONTROLLER``: a file
+cannot know what a controller holds.
+
+Values from files and editors go through the ``parse_*`` functions, which refuse with a
+:class:`FieldError` naming the field; their messages quote at most :data:`QUOTE_CHARS`
+characters of a bad value (:func:`shown`).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+
+from app.errors import InvalidInput
+from app.models import Pose
+from app.protocol.enums import QT_TRANSLATE_NOOP
+from app.protocol.registers import TEMP_POINT_ID_MAX, TEMP_POINT_ID_MIN, TOOL_NONE
+
+TR_CONTEXT = "Points"
+
+Pose6 = tuple[float, float, float, float, float, float]
+Ext5 = tuple[float, float, float, float, float]
+
+POSE_FIELDS: tuple[str, ...] = ("x", "y", "z", "a", "b", "c")
+EXT_FIELDS: tuple[str, ...] = ("e1", "e2", "e3", "e4", "e5")
+#: The editable fields of a point, in table / CSV column order.
+POINT_FIELDS: tuple[str, ...] = ("id", "name", *POSE_FIELDS, *EXT_FIELDS, "tool", "note")
+CSV_COLUMNS = POINT_FIELDS
+CSV_REQUIRED: frozenset[str] = frozenset(("id", *POSE_FIELDS))
+#: Fields the controller stores: editing one of them makes the point "changed on host".
+CONTROLLER_FIELDS: frozenset[str] = frozenset(("id", *POSE_FIELDS, "tool"))
+
+TOOL_MAX = 199  # tool frames 0..199 are "tool N+1"; TOOL_NONE (200) is "no tool frame"
+NAME_MAX_CHARS = 200
+NOTE_MAX_CHARS = 2000
+ZERO_EXT: Ext5 = (0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+REASON_MAX_CHARS = 300
+
+
+class FileFormatError(InvalidInput):
+    """A points / project file the host refuses; names the row (or line) and the field.
+
+    ``str(error)`` reads e.g. ``points.csv: row 7, column 'x': 'abc' is not a number``.
+    """
+
+    def __init__(
+        self,
+        reason: str,
+        *,
+        path: str | None = None,
+        row: int | None = None,
+        column: str | None = None,
+        where: str | None = None,
+    ) -> None:
+        if len(reason) > REASON_MAX_CHARS:  # a safety net: a message never carries a whole bad value
+            reason = reason[:REASON_MAX_CHARS] + "..."
+        self.reason = reason
+        self.path = path
+        self.row = row
+        self.column = column
+        self.where = where
+        super().__init__(self._text())
+
+    def _text(self) -> str:
+        parts: list[str] = []
+        if self.where is not None:
+            parts.append(self.where)
+        elif self.row is not None:
+            parts.append(f"row {self.row}")
+        if self.column is not None:
+            parts.append(f"column '{self.column}'" if self.where is None else f"field '{self.column}'")
+        location = ", ".join(parts)
+        text = f"{location}: {self.reason}" if location else self.reason
+        return f"{self.path}: {text}" if self.path else text
+
+    def with_path(self, path: str) -> FileFormatError:
+        return FileFormatError(self.reason, path=path, row=self.row, column=self.column, where=self.where)
+
+
+class FieldError(InvalidInput):
+    """One field's value refused; ``field`` names it, ``reason`` says why."""
+
+    def __init__(self, field_name: str, reason: str) -> None:
+        super().__init__(f"{field_name}: {reason}")
+        self.field = field_name
+        self.reason = reason
+
+
+class SyncState(enum.Enum):
+    """Whether the controller holds the host's copy of a point."""
+
+    UNKNOWN = "unknown"  # e.g. after a reconnect: the controller may have restarted
+    ON_CONTROLLER = "on-controller"  # created on the controller with exactly these values
+    CHANGED = "changed"  # changed on the host (or new) since the last upload
+    FAILED = "failed"  # the last upload failed; TempPoint.sync_error says why
+
+    @property
+    def text(self) -> str:
+        return SYNC_STATE_TEXT[self]
+
+    @classmethod
+    def parse(cls, text: str) -> SyncState:
+        for member in cls:
+            if member.value == text:
+                return member
+        raise ValueError(f"unknown sync state {text!r} (expected one of: {', '.join(m.value for m in cls)})")
+
+
+SYNC_STATE_TEXT: dict[SyncState, str] = {
+    SyncState.UNKNOWN: QT_TRANSLATE_NOOP("Points", "unknown"),
+    SyncState.ON_CONTROLLER: QT_TRANSLATE_NOOP("Points", "on controller"),
+    SyncState.CHANGED: QT_TRANSLATE_NOOP("Points", "changed on host"),
+    SyncState.FAILED: QT_TRANSLATE_NOOP("Points", "upload failed"),
+}
+
+
+@dataclass(frozen=True)
+class PointLimits:
+    """Accepted temp point ids (a setting; PROTOCOL.md section 7)."""
+
+    id_min: int = TEMP_POINT_ID_MIN
+    id_max: int = TEMP_POINT_ID_MAX
+
+    def __post_init__(self) -> None:
+        if self.id_min < 0 or self.id_max < self.id_min:
+            raise InvalidInput(f"bad point id range {self.id_min}..{self.id_max}")
+
+
+DEFAULT_LIMITS = PointLimits()
+
+
+# --- field parsing (shared by the GUI editors, CSV and JSON) ------------------------------
+
+
+QUOTE_CHARS = 40  # at most this much of a bad value is quoted in a message
+INT_DIGITS_MAX = 30  # longer integers are refused as too large before int() sees them
+
+
+class OversizedNumber:
+    """A number too long to convert (a JSON decoder hook returns it instead of an ``int``:
+    Python refuses ``int()`` of more than 4300 digits). Every parse function refuses it."""
+
+    __slots__ = ("digits",)
+
+    def __init__(self, digits: str) -> None:
+        self.digits = digits
+
+    def __repr__(self) -> str:
+        return shown(self.digits)
+
+
+def shown(value: object, limit: int = QUOTE_CHARS) -> str:
+    """``repr``-like quote of a value for a message, at most ``limit`` characters of it."""
+    if isinstance(value, OversizedNumber):
+        text = value.digits
+        return (text[:limit] + f"... ({len(text)} digits)") if len(text) > limit else text
+    if isinstance(value, str):
+        cut = value[:limit]
+        quoted = repr(cut)
+        return quoted + f"... ({len(value)} characters)" if len(value) > limit else quoted
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10 ** limit:
+        return f"a {len(str(abs(value))) if value.bit_length() < 14000 else 'huge'}-digit number"
+    if isinstance(value, list | dict | tuple):
+        return f"a {type(value).__name__}"
+    text = repr(value)
+    return text if len(text) <= limit else text[:limit] + "..."
+
+
+def has_surrogates(text: str) -> bool:
+    """True when ``text`` holds a lone surrogate (no valid UTF-8 for it: saving would fail)."""
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return True
+    return False
+
+
+def parse_float(field_name: str, value: object) -> float:
+    """A finite float from a number or text; NaN, infinities and huge numbers are refused."""
+    if isinstance(value, bool):
+        raise FieldError(field_name, f"{shown(value)} is not a number")
+    if isinstance(value, OversizedNumber):
+        raise FieldError(field_name, f"{shown(value)} is too large")
+    if isinstance(value, int | float):
+        try:
+            number = float(value)
+        except OverflowError:
+            raise FieldError(field_name, f"{shown(value)} is too large") from None
+    elif isinstance(value, str):
+        text = value.strip()
+        if not text:
+            raise FieldError(field_name, "the value is empty")
+        try:
+            number = float(text)
+        except ValueError:
+            raise FieldError(field_name, f"{shown(text)} is not a number") from None
+        if not math.isfinite(number) and text.lstrip("+-").lower() not in ("inf", "infinity", "nan"):
+            raise FieldError(field_name, f"{shown(text)} is too large")
+    else:
+        raise FieldError(field_name, f"{shown(value)} is not a number")
+    if not math.isfinite(number):
+        raise FieldError(field_name, f"{shown(value)} is not a finite number")
+    return number
+
+
+def parse_int(field_name: str, value: object) -> int:
+    """An integer from an int, an integral float or text (``"5"``, ``"5.0"``)."""
+    if isinstance(value, bool):
+        raise FieldError(field_name, f"{shown(value)} is not an integer")
+    if isinstance(value, int):
+        if value.bit_length() > 100:
+            raise FieldError(field_name, f"{shown(value)} is too large")
+        return value
+    if isinstance(value, str) and len(value.strip().lstrip("+-")) > INT_DIGITS_MAX \
+            and value.strip().lstrip("+-").isdigit():
+        raise FieldError(field_name, f"{shown(value.strip())} is too large")
+    number = parse_float(field_name, value)
+    if not number.is_integer():
+        quoted = shown(value.strip() if isinstance(value, str) else value)
+        raise FieldError(field_name, f"{quoted} is not an integer")
+    if abs(number) >= 2.0 ** 100:
+        raise FieldError(field_name, f"{shown(value)} is too large")
+    return int(number)
+
+
+def parse_point_id(value: object, limits: PointLimits = DEFAULT_LIMITS, field_name: str = "id") -> int:
+    point_id = parse_int(field_name, value)
+    if not limits.id_min <= point_id <= limits.id_max:
+        raise FieldError(field_name, f"id {shown(point_id)} is outside {limits.id_min}..{limits.id_max}")
+    return point_id
+
+
+def parse_tool(value: object, field_name: str = "tool") -> int:
+    """Tool frame: 0..199 (tool N+1) or 200 (none)."""
+    tool = parse_int(field_name, value)
+    if not (0 <= tool <= TOOL_MAX or tool == TOOL_NONE):
+        raise FieldError(field_name, f"tool {shown(tool)} is not 0..{TOOL_MAX} or {TOOL_NONE} (none)")
+    return tool
+
+
+def parse_text(field_name: str, value: object, max_chars: int) -> str:
+    if value is None:
+        return ""
+    if not isinstance(value, str):
+        raise FieldError(field_name, f"{shown(value)} is not text")
+    if len(value) > max_chars:
+        raise FieldError(field_name, f"is longer than {max_chars} characters")
+    if has_surrogates(value):
+        raise FieldError(field_name, "holds an invalid character (a lone surrogate, not Unicode text)")
+    if any(ch in value for ch in "\x00\r\n") and field_name == "name":
+        raise FieldError(field_name, "must be one line")
+    return value
+
+
+def tool_text(tool: int) -> str:
+    """How the GUI and CLI show a tool frame."""
+    return "none" if tool == TOOL_NONE else f"tool {tool + 1} ({tool})"
+
+
+# --- the point -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TempPoint:
+    """One temp point as the host keeps it. Build through :func:`make_point` to validate."""
+
+    id: int
+    name: str = ""
+    x: float = 0.0
+    y: float = 0.0
+    z: float = 0.0
+    a: float = 0.0
+    b: float = 0.0
+    c: float = 0.0
+    ext: Ext5 = ZERO_EXT
+    tool: int = TOOL_NONE
+    note: str = ""
+    sync: SyncState = SyncState.CHANGED
+    sync_error: str = ""  # why the last upload failed (FAILED only)
+
+    @property
+    def xyzabc(self) -> Pose6:
+        return (self.x, self.y, self.z, self.a, self.b, self.c)
+
+    @property
+    def xyz(self) -> tuple[float, float, float]:
+        return (self.x, self.y, self.z)
+
+    @property
+    def needs_upload(self) -> bool:
+        return self.sync is not SyncState.ON_CONTROLLER
+
+    @property
+    def label(self) -> str:
+        """``P5`` or ``P5 'pick'`` for messages."""
+        return f"P{self.id} '{self.name}'" if self.name else f"P{self.id}"
+
+    def get(self, field_name: str) -> object:
+        """Value of a field of :data:`POINT_FIELDS` (``e1``..``e5`` from ``ext``)."""
+        if field_name in EXT_FIELDS:
+            return self.ext[EXT_FIELDS.index(field_name)]
+        if field_name in POINT_FIELDS:
+            value: object = getattr(self, field_name)
+            return value
+        raise FieldError(field_name, "no such field")
+
+    def same_on_controller(self, other: TempPoint) -> bool:
+        """True when the controller would hold the same data for both (id, pose, tool)."""
+        return self.id == other.id and self.xyzabc == other.xyzabc and self.tool == other.tool
+
+
+def make_point(
+    point_id: object,
+    name: object = "",
+    pose: Sequence[object] = (0.0,) * 6,
+    ext: Sequence[object] = ZERO_EXT,
+    tool: object = TOOL_NONE,
+    note: object = "",
+    *,
+    sync: SyncState = SyncState.CHANGED,
+    sync_error: str = "",
+    limits: PointLimits = DEFAULT_LIMITS,
+) -> TempPoint:
+    """A validated :class:`TempPoint`; raises :class:`FieldError` naming the bad field."""
+    if len(pose) != 6:
+        raise FieldError("pose", f"needs 6 values (x y z a b c), got {len(pose)}")
+    if len(ext) != 5:
+        raise FieldError("ext", f"needs 5 values (e1..e5), got {len(ext)}")
+    x, y, z, a, b, c = (parse_float(f, v) for f, v in zip(POSE_FIELDS, pose, strict=True))
+    e1, e2, e3, e4, e5 = (parse_float(f, v) for f, v in zip(EXT_FIELDS, ext, strict=True))
+    return TempPoint(
+        id=parse_point_id(point_id, limits),
+        name=parse_text("name", name, NAME_MAX_CHARS),
+        x=x, y=y, z=z, a=a, b=b, c=c,
+        ext=(e1, e2, e3, e4, e5),
+        tool=parse_tool(tool),
+        note=parse_text("note", note, NOTE_MAX_CHARS),
+        sync=sync,
+        sync_error=sync_error if sync is SyncState.FAILED else "",
+    )
+
+
+def point_from_pose(
+    point_id: int, pose: Pose, name: str = "", *, tool: int = TOOL_NONE, limits: PointLimits = DEFAULT_LIMITS
+) -> TempPoint:
+    """A new point at a live pose (e.g. "teach here")."""
+    return make_point(point_id, name, pose.xyzabc, pose.ext, tool, limits=limits)
+
+
+def point_from_fields(
+    fields: Mapping[str, object], limits: PointLimits = DEFAULT_LIMITS, *, sync: SyncState = SyncState.CHANGED
+) -> TempPoint:
+    """A point from a column -> value mapping (CSV row or JSON object); missing optional
+    fields take their defaults, empty optional text cells too."""
+
+    def optional(name: str, default: object) -> object:
+        value = fields.get(name, default)
+        blank = isinstance(value, str) and not value.strip()
+        return default if blank and name not in ("name", "note") else value
+
+    for required in CSV_REQUIRED:
+        if required not in fields:
+            raise FieldError(required, "the value is missing")
+    return make_point(
+        fields["id"],
+        optional("name", ""),
+        [fields[f] for f in POSE_FIELDS],
+        [optional(f, 0.0) for f in EXT_FIELDS],
+        optional("tool", TOOL_NONE),
+        optional("note", ""),
+        sync=sync,
+        limits=limits,
+    )
+
+
+def with_field(
+    point: TempPoint, field_name: str, value: object, limits: PointLimits = DEFAULT_LIMITS
+) -> TempPoint:
+    """``point`` with one field set (validated); applies the sync rules of the module doc."""
+    new: TempPoint
+    if field_name == "id":
+        new = replace(point, id=parse_point_id(value, limits))
+    elif field_name == "name":
+        new = replace(point, name=parse_text("name", value, NAME_MAX_CHARS))
+    elif field_name == "note":
+        new = replace(point, note=parse_text("note", value, NOTE_MAX_CHARS))
+    elif field_name in POSE_FIELDS:
+        pose = list(point.xyzabc)
+        pose[POSE_FIELDS.index(field_name)] = parse_float(field_name, value)
+        x, y, z, a, b, c = pose
+        new = replace(point, x=x, y=y, z=z, a=a, b=b, c=c)
+    elif field_name in EXT_FIELDS:
+        ext = list(point.ext)
+        ext[EXT_FIELDS.index(field_name)] = parse_float(field_name, value)
+        new = replace(point, ext=(ext[0], ext[1], ext[2], ext[3], ext[4]))
+    elif field_name == "tool":
+        new = replace(point, tool=parse_tool(value))
+    else:
+        raise FieldError(field_name, "no such field (or not editable)")
+    return _mark_changed(point, new)
+
+
+def _mark_changed(old: TempPoint, new: TempPoint) -> TempPoint:
+    if new.sync is not SyncState.CHANGED and not old.same_on_controller(new):
+        return replace(new, sync=SyncState.CHANGED, sync_error="")
+    return new

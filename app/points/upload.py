@@ -1,0 +1,138 @@
+"""Uploading temp points to the controller (function 2), and the id lists of the CLI."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Protocol
+
+from app.errors import InvalidInput, LinkError, ResponseTimeout, TeachPadError
+from app.models import CommandResult
+from app.points.point import SyncState, TempPoint
+
+if TYPE_CHECKING:
+    from app.points.ledger import PointLedger
+
+class PointUploader(Protocol):
+    """The part of ``RobotClient`` an upload needs (duck-typed)."""
+
+    def create_point(
+        self, point_id: int, *, pose: Sequence[float] | None = ..., tool: int = ..., wait: bool = ...
+    ) -> CommandResult: ...
+
+
+@dataclass(frozen=True)
+class UploadOutcome:
+    point_id: int
+    ok: bool
+    reason: str = ""
+    sent: TempPoint | None = None  # the values the controller now holds (ok only)
+
+
+@dataclass
+class UploadReport:
+    outcomes: list[UploadOutcome] = field(default_factory=list)
+    aborted: str | None = None  # why the upload stopped early (link lost, stop requested)
+    not_attempted: list[int] = field(default_factory=list)
+    interrupted: bool = False  # ended by Ctrl-C
+
+    @property
+    def ok_count(self) -> int:
+        return sum(1 for o in self.outcomes if o.ok)
+
+    @property
+    def failed(self) -> list[UploadOutcome]:
+        return [o for o in self.outcomes if not o.ok]
+
+    @property
+    def all_ok(self) -> bool:
+        return self.aborted is None and not self.failed
+
+
+def upload_points(
+    client: PointUploader,
+    points: Sequence[TempPoint],
+    *,
+    progress: Callable[[int, int], bool | None] | None = None,
+) -> UploadReport:
+    """Create ``points`` on the controller one by one (function 2 from GVs).
+
+    A point the controller refuses is recorded and the upload goes on; a lost link, Ctrl-C
+    or ``progress`` returning False ends it, leaving the rest (the interrupted point included)
+    in ``not_attempted``. Does not touch a ledger: apply the report with :func:`apply_upload`
+    in the ledger's thread.
+    """
+    report = UploadReport()
+    total = len(points)
+    for done, point in enumerate(points):
+        if progress is not None and progress(done, total) is False:
+            report.aborted = "stopped on request"
+            report.not_attempted = [p.id for p in points[done:]]
+            return report
+        try:
+            result = client.create_point(point.id, pose=point.xyzabc, tool=point.tool, wait=True)
+        except (LinkError, ResponseTimeout) as exc:
+            report.aborted = str(exc) or type(exc).__name__
+            report.not_attempted = [p.id for p in points[done:]]
+            return report
+        except KeyboardInterrupt:
+            # Keep what was done: the caller records it and the ledger stays truthful.
+            report.aborted = "interrupted"
+            report.interrupted = True
+            report.not_attempted = [p.id for p in points[done:]]
+            return report
+        except TeachPadError as exc:
+            report.outcomes.append(UploadOutcome(point.id, False, str(exc) or type(exc).__name__))
+            continue
+        if result.ok:
+            report.outcomes.append(UploadOutcome(point.id, True, sent=point))
+        else:
+            reason = result.message or (result.status.text if result.status else "failed")
+            report.outcomes.append(UploadOutcome(point.id, False, reason))
+    if progress is not None:
+        progress(total, total)
+    return report
+
+
+def apply_upload(ledger: PointLedger, report: UploadReport) -> list[int]:
+    """Record an upload's outcome in the ledger; returns the rows that changed.
+
+    A point edited on the host while it was being uploaded stays ``CHANGED``."""
+    rows: list[int] = []
+    for outcome in report.outcomes:
+        current = ledger.get(outcome.point_id)
+        if current is None:
+            continue
+        if outcome.ok:
+            if outcome.sent is not None and not current.same_on_controller(outcome.sent):
+                continue
+            rows.append(ledger.set_sync(outcome.point_id, SyncState.ON_CONTROLLER))
+        else:
+            rows.append(ledger.set_sync(outcome.point_id, SyncState.FAILED, outcome.reason))
+    return rows
+
+
+def parse_id_list(text: str) -> list[int]:
+    """``"1,2,5-9"`` -> ``[1, 2, 5, 6, 7, 8, 9]`` (order kept, duplicates dropped)."""
+    ids: list[int] = []
+    seen: set[int] = set()
+    for part in text.split(","):
+        item = part.strip()
+        if not item:
+            continue
+        lo_text, sep, hi_text = item.partition("-")
+        try:
+            if sep:
+                lo, hi = int(lo_text), int(hi_text)
+                if hi < lo:
+                    raise InvalidInput(f"bad id range {item!r}: {hi} < {lo}")
+                chunk = list(range(lo, hi + 1))
+            else:
+                chunk = [int(item)]
+        except ValueError:
+            raise InvalidInput(f"bad id list item {item!r} (use e.g. 1,2,5-9)") from None
+        for i in chunk:
+            if i not in seen:
+                seen.add(i)
+                ids.append(i)
+    return ids
