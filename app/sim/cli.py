@@ -14,6 +14,7 @@ from pymodbus.constants import ExcCodes
 
 from app.protocol.codec import WordOrder
 from app.protocol.enums import Alarm
+from app.sim.guard import WATCHDOG_TIMEOUT
 from app.sim.server import SimConfig, SimController
 
 log = logging.getLogger(__name__)
@@ -33,7 +34,7 @@ commands typed on stdin while running (one per line):
   exception off       answer normally again
   silent on|off       receive requests but never answer
   restart             the controller logs in again: temp points wiped, motion stopped
-  status              print the state (pose, joints, mode, alarms, GV291, points)
+  status              print the state (pose, joints, mode, alarms, GV291, points, bad frames)
   help                this list
   quit                stop the simulator
 """
@@ -42,7 +43,8 @@ commands typed on stdin while running (one per line):
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="teachpad-sim",
-        description="Simulated Bochuang robot controller (Modbus TCP slave) for TeachPad.",
+        description="Simulated Bochuang robot controller (Modbus TCP slave, or RTU on a serial line "
+                    "with --serial) for TeachPad.",
         epilog=COMMANDS_HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -58,9 +60,30 @@ def build_parser() -> argparse.ArgumentParser:
                         help="GV291 keeps its old value S seconds after a command")
     parser.add_argument("--rtu-framing", action="store_true", help="RTU framing over TCP instead of MBAP")
     parser.add_argument("--tick-hz", type=float, default=100.0, help="simulation rate (default 100)")
+    parser.add_argument("--watchdog", type=_watchdog, default=WATCHDOG_TIMEOUT, metavar="SECONDS|off",
+                        help="stop a teach jog when its connection closes or no request arrives for "
+                             f"SECONDS (default {WATCHDOG_TIMEOUT:g}; off: keep jogging, like a controller "
+                             "without a watchdog)")
+    serial = parser.add_argument_group("RTU on a serial line (instead of TCP)")
+    serial.add_argument("--serial", metavar="PORT", help="serial device to serve, e.g. /dev/ttyUSB0 or COM3")
+    serial.add_argument("--baud", type=int, default=115200, help="baud rate (default 115200)")
+    serial.add_argument("--parity", choices=["N", "E", "O"], default="N", help="parity (default N)")
+    serial.add_argument("--stopbits", type=int, choices=[1, 2], default=1, help="stop bits (default 1)")
     parser.add_argument("--no-stdin", action="store_true", help="do not read commands from stdin")
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     return parser
+
+
+def _watchdog(text: str) -> float | None:
+    if text.strip().lower() in ("off", "0", "none"):
+        return None
+    try:
+        seconds = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds or 'off', got {text[:20]!r}") from None
+    if not 0 < seconds <= 60:
+        raise argparse.ArgumentTypeError(f"watchdog must be in (0, 60] s or 'off', got {text[:20]!r}")
+    return seconds
 
 
 def execute(sim: SimController, line: str, out: TextIO) -> bool:
@@ -91,6 +114,10 @@ def execute(sim: SimController, line: str, out: TextIO) -> bool:
             print(f"mode {s.mode.name} program {s.program_state.name} alarms {int(s.alarms)} "
                   f"teach {'on' if s.teach_enabled else 'off'} ratio {s.teach_ratio:g} "
                   f"GV291 {s.command_status} points {len(s.points)}", file=out)
+            bad = sim.bad_frame_counts()
+            print(f"bad frames {sum(bad.values())}"
+                  + "".join(f", {n} {reason}" for reason, n in sorted(bad.items()))
+                  + f"; watchdog stops {len(sim.watchdog_events())}", file=out)
         elif cmd == "help":
             print(COMMANDS_HELP, file=out)
         elif cmd in ("quit", "exit"):
@@ -112,7 +139,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     config = SimConfig(host=args.host, port=args.port, unit=args.unit,
                        word_order=WordOrder.parse(args.word_order),
                        status_encoding=args.status_encoding, status_delay=args.status_delay,
-                       framer="rtu" if args.rtu_framing else "socket", tick_hz=args.tick_hz)
+                       framer="rtu" if args.rtu_framing else "socket", tick_hz=args.tick_hz,
+                       watchdog=args.watchdog, serial_port=args.serial, baudrate=args.baud,
+                       parity=args.parity, stopbits=args.stopbits)
     sim = SimController(config)
     try:
         sim.start()
@@ -120,8 +149,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"teachpad-sim: {exc}", file=sys.stderr)
         return 1
     done = threading.Event()
-    print(f"teachpad-sim listening on {config.host}:{sim.port} (unit {config.unit}); Ctrl-C to stop",
-          flush=True)
+    print(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop", flush=True)
 
     previous: dict[signal.Signals, object] = {}
     if threading.current_thread() is threading.main_thread():

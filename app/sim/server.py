@@ -295,7 +295,8 @@ class SimController:
         server: GuardedTcpServer | GuardedSerialServer
         if c.serial_port is not None:
             server = GuardedSerialServer(device, guard, port=c.serial_port, baudrate=c.baudrate,
-                                         parity=c.parity, stopbits=c.stopbits, trace_packet=self._trace_packet)
+                                         parity=c.parity, stopbits=c.stopbits,
+                                         trace_packet=self._trace_packet)
             await server.serve_forever(background=True)
         else:
             framer = FramerType.RTU if c.framer == "rtu" else FramerType.SOCKET

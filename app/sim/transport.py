@@ -40,7 +40,7 @@ from app.sim.guard import (
     ScreeningDecoder,
 )
 
-RECV_BUFFER_MAX = 1 << 16  # bytes a connection may buffer (MBAP: pipelined requests)
+RECV_BUFFER_MAX = 1 << 20  # bytes a connection may buffer (asyncio reads up to 256 KiB at once)
 RTU_BUFFER_MAX = 512  # bytes: two RTU frames; more is noise
 RTU_GAP_MIN = 0.02  # s: a partial RTU frame is dropped after this much silence (or 3.5 chars)
 SERIAL_REOPEN_DELAY = 1.0  # s before the server reopens a serial port that went away
