@@ -1,11 +1,12 @@
 """The simulated controller as a real Modbus server (pymodbus 3.16 ``SimDevice`` API).
 
-:class:`SimController` runs a :class:`~pymodbus.server.ModbusTcpServer` in its own asyncio
-loop on a daemon thread and a ticker thread that advances :class:`~app.sim.robot.SimRobot`
-at ``SimConfig.tick_hz``. Every request passes :meth:`SimController._action` (the SimDevice
-action), which, under :attr:`SimController.lock`, applies writes (commands, teach ratio) and
-refreshes the live registers (pose, joints, status, clock, GV291) so reads always see the
-current state.
+:class:`SimController` runs a Modbus TCP server (or RTU on a serial line, ``serial_port``) in
+its own asyncio loop on a daemon thread (:mod:`app.sim.transport`; request screening, the
+bad-frame log and the communication watchdog are in :mod:`app.sim.guard`) and a ticker thread
+that advances :class:`~app.sim.robot.SimRobot` at ``SimConfig.tick_hz``. Every request passes
+:meth:`SimController._action` (the SimDevice action), which, under :attr:`SimController.lock`,
+applies writes (commands, teach ratio) and refreshes the live registers (pose, joints, status,
+clock, GV291) so reads always see the current state.
 
 GV291 publication: on a 440 command with a status (0x40/0x41/0x42/0xE0/0x80/0x81) the old
 value stays for ``status_delay`` seconds, then 0 (INITIAL) shows for ``command_latency``
@@ -74,13 +75,7 @@ from app.protocol.registers import (
 )
 from app.sim.guard import CURRENT_CONNECTION, WATCHDOG_TIMEOUT, BadFrames, CommWatchdog
 from app.sim.robot import Pose6, SimRobot, StoredPoint, TraceSample
-from app.sim.transport import (
-    GuardedSerialServer,
-    GuardedTcpServer,
-    ServerGuard,
-    close_loop,
-    shutdown_server,
-)
+from app.sim.transport import GuardedSerialServer, GuardedTcpServer, ServerGuard, ServerRunner
 
 log = logging.getLogger(__name__)
 
@@ -90,7 +85,6 @@ ZERO_HOLD_MAX = 0.25
 _FC_WRITE_SINGLE = 6
 _STATUS_COMMANDS = frozenset({RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT,
                               RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE})
-_START_TIMEOUT = 5.0
 _GENERAL_REGISTERS = 200  # GV0..GV99 (registers 0..199): cleared by a controller restart
 _STOP_TIMEOUT = 2.0
 
@@ -196,9 +190,7 @@ class SimController:
         self.writes: list[WriteRecord] = []
         self._requests = 0
         self._port: int | None = None
-        self._loop: asyncio.AbstractEventLoop | None = None
-        self._server: GuardedTcpServer | GuardedSerialServer | None = None
-        self._loop_thread: threading.Thread | None = None
+        self._runner = ServerRunner()
         self._tick_thread: threading.Thread | None = None
         self._stop_event = threading.Event()
         self._started = False
@@ -252,31 +244,12 @@ class SimController:
         if self._started:
             raise RuntimeError("simulator already started")
         self._started = True
-        ready = threading.Event()
-        errors: list[BaseException] = []
-        loop = asyncio.new_event_loop()
-        self._loop = loop
-
-        def run_loop() -> None:
-            asyncio.set_event_loop(loop)
-            try:
-                loop.run_until_complete(self._serve())
-            except BaseException as exc:  # reported to start()
-                errors.append(exc)
-                ready.set()
-                self._close_loop(loop)
-                return
-            ready.set()
-            loop.run_forever()
-            self._close_loop(loop)
-
-        self._loop_thread = threading.Thread(target=run_loop, name="sim-modbus", daemon=True)
-        self._loop_thread.start()
-        if not ready.wait(_START_TIMEOUT) or errors:
-            self._loop_thread.join(_STOP_TIMEOUT)
+        try:
+            self._runner.start(self._serve, self.endpoint)
+        except OSError:
             self._stopped = True
-            raise OSError(f"simulator could not listen on {self.endpoint}: "
-                          f"{errors[0] if errors else 'timeout'}")
+            raise
+        self._port = self._runner.port
         self._tick_thread = threading.Thread(target=self._tick_loop, name="sim-ticker", daemon=True)
         self._tick_thread.start()
         log.info("simulator listening on %s (unit %s, %s framing, %s word order, status %s, watchdog %s)",
@@ -284,7 +257,7 @@ class SimController:
                  self.config.word_order.value, self.config.status_encoding,
                  f"{self.watchdog.timeout:g} s" if self.watchdog.enabled else "off")
 
-    async def _serve(self) -> None:
+    async def _serve(self) -> GuardedTcpServer | GuardedSerialServer:
         initial = [0] * REGISTER_SPACE
         self._init_registers(initial)
         device = SimDevice(self.config.unit,
@@ -303,10 +276,7 @@ class SimController:
             server = GuardedTcpServer(device, guard, framer=framer, address=(c.host, c.port),
                                       trace_packet=self._trace_packet)
             await server.serve_forever(background=True)
-            self._port = int(server.transport.sockets[0].getsockname()[1])
-        self._server = server
-
-    _close_loop = staticmethod(close_loop)
+        return server
 
     def stop(self) -> None:
         """Stop the server and the ticker. Idempotent and fast."""
@@ -315,15 +285,7 @@ class SimController:
             return
         self._stopped = True
         self._stop_event.set()
-        loop, server = self._loop, self._server
-        if loop is not None and server is not None and not loop.is_closed():
-            try:
-                asyncio.run_coroutine_threadsafe(shutdown_server(server), loop).result(_STOP_TIMEOUT)
-            except Exception as exc:  # the loop is going away anyway
-                log.warning("server shutdown: %s", exc)
-            loop.call_soon_threadsafe(loop.stop)
-        if self._loop_thread is not None:
-            self._loop_thread.join(_STOP_TIMEOUT)
+        self._runner.stop()
         if self._tick_thread is not None:
             self._tick_thread.join(_STOP_TIMEOUT)
         log.info("simulator stopped")
@@ -563,8 +525,7 @@ class SimController:
     @property
     def connections_count(self) -> int:
         """Clients connected right now."""
-        server = self._server
-        return 0 if server is None else len(server.active_connections)
+        return self._runner.connections_count
 
     def bad_frame_counts(self) -> dict[str, int]:
         """Rejected frames since start, by reason (``"illegal function"``, ``"bad CRC"``, ...)."""
@@ -662,17 +623,6 @@ class SimController:
 
     def drop_connections(self) -> int:
         """Close the sockets of the connected clients (the server keeps listening)."""
-        loop, server = self._loop, self._server
-        if loop is None or server is None or loop.is_closed():
-            return 0
-
-        async def drop() -> int:
-            conns = list(server.active_connections.values())
-            for conn in conns:
-                conn.close()
-            return len(conns)
-
-        count = int(asyncio.run_coroutine_threadsafe(drop(), loop).result(_STOP_TIMEOUT))
+        count = self._runner.drop_connections()
         log.info("dropped %d connection(s)", count)
         return count
-

@@ -17,9 +17,11 @@ from __future__ import annotations
 
 import asyncio
 import itertools
+import logging
+import threading
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Awaitable, Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -39,6 +41,8 @@ from app.sim.guard import (
     ScreenedSocketFramer,
     ScreeningDecoder,
 )
+
+log = logging.getLogger(__name__)
 
 RECV_BUFFER_MAX = 1 << 20  # bytes a connection may buffer (asyncio reads up to 256 KiB at once)
 RTU_BUFFER_MAX = 512  # bytes: two RTU frames; more is noise
@@ -186,3 +190,76 @@ def close_loop(loop: asyncio.AbstractEventLoop) -> None:
         loop.run_until_complete(asyncio.sleep(0))
     loop.run_until_complete(loop.shutdown_asyncgens())
     loop.close()
+
+
+class ServerRunner:
+    """A guarded server on its own asyncio loop in a daemon thread (``start``/``stop``)."""
+
+    START_TIMEOUT = 5.0  # s
+    STOP_TIMEOUT = 2.0  # s
+
+    def __init__(self) -> None:
+        self.port: int | None = None  # the bound TCP port (None on a serial line)
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._server: GuardedTcpServer | GuardedSerialServer | None = None
+        self._thread: threading.Thread | None = None
+
+    def start(self, serve: Callable[[], Awaitable[GuardedTcpServer | GuardedSerialServer]],
+              endpoint: str) -> None:
+        """Run ``serve()`` (which listens and returns the server) on a new loop; OSError if it fails."""
+        ready = threading.Event()
+        errors: list[BaseException] = []
+        loop = asyncio.new_event_loop()
+        self._loop = loop
+
+        def run_loop() -> None:
+            asyncio.set_event_loop(loop)
+            try:
+                self._server = loop.run_until_complete(serve())
+            except BaseException as exc:  # reported to start()
+                errors.append(exc)
+                ready.set()
+                close_loop(loop)
+                return
+            ready.set()
+            loop.run_forever()
+            close_loop(loop)
+
+        self._thread = threading.Thread(target=run_loop, name="sim-modbus", daemon=True)
+        self._thread.start()
+        if not ready.wait(self.START_TIMEOUT) or errors:
+            self._thread.join(self.STOP_TIMEOUT)
+            raise OSError(f"simulator could not listen on {endpoint}: {errors[0] if errors else 'timeout'}")
+        sockets = getattr(self._server.transport, "sockets", None) if self._server is not None else None
+        if sockets:
+            self.port = int(sockets[0].getsockname()[1])
+
+    def stop(self) -> None:
+        loop, server = self._loop, self._server
+        if loop is not None and server is not None and not loop.is_closed():
+            try:
+                asyncio.run_coroutine_threadsafe(shutdown_server(server), loop).result(self.STOP_TIMEOUT)
+            except Exception as exc:  # the loop is going away anyway
+                log.warning("server shutdown: %s", exc)
+            loop.call_soon_threadsafe(loop.stop)
+        if self._thread is not None:
+            self._thread.join(self.STOP_TIMEOUT)
+
+    @property
+    def connections_count(self) -> int:
+        server = self._server
+        return 0 if server is None else len(server.active_connections)
+
+    def drop_connections(self) -> int:
+        """Close the connected clients' sockets (the server keeps listening)."""
+        loop, server = self._loop, self._server
+        if loop is None or server is None or loop.is_closed():
+            return 0
+
+        async def drop() -> int:
+            conns = list(server.active_connections.values())
+            for conn in conns:
+                conn.close()
+            return len(conns)
+
+        return int(asyncio.run_coroutine_threadsafe(drop(), loop).result(self.STOP_TIMEOUT))
