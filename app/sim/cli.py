@@ -30,6 +30,7 @@ commands typed on stdin while running (one per line):
   delay SECONDS       delay every answer (0 = off)
   status-delay SECONDS  GV291 keeps its old value this long after a command
   drop                close the connections of the connected clients
+  watchdog SECONDS|off  stop a jog whose host went away (see --watchdog)
   exception CODE      answer every request with Modbus exception CODE (1-11)
   exception off       answer normally again
   silent on|off       receive requests but never answer
@@ -101,6 +102,11 @@ def execute(sim: SimController, line: str, out: TextIO) -> bool:
             sim.set_status_delay(float(args[0]))
         elif cmd == "drop" and not args:
             sim.drop_connections()
+        elif cmd == "watchdog" and len(args) == 1:
+            try:
+                sim.set_watchdog(_watchdog(args[0]))
+            except argparse.ArgumentTypeError as exc:
+                raise ValueError(str(exc)) from None
         elif cmd == "exception" and len(args) == 1:
             sim.set_exception(None if args[0] == "off" else ExcCodes(int(args[0], 0)))
         elif cmd == "silent" and len(args) == 1 and args[0] in ("on", "off"):

@@ -221,6 +221,11 @@ class CommWatchdog:
     def enabled(self) -> bool:
         return self.timeout is not None
 
+    def set_timeout(self, timeout: float | None) -> None:
+        """None or 0: off (a controller without a watchdog)."""
+        self.timeout = timeout if timeout and timeout > 0 else None
+        self._last_request = self._clock()
+
     def request(self) -> None:
         """A request arrived (any connection)."""
         self._last_request = self._clock()

@@ -610,6 +610,11 @@ class SimController:
         self._status_delay = max(0.0, float(seconds))
         log.info("status delay %.3f s", self._status_delay)
 
+    def set_watchdog(self, seconds: float | None) -> None:
+        """The communication watchdog's silence limit; None or 0 switches it off entirely."""
+        self.watchdog.set_timeout(seconds)
+        log.info("watchdog %s", f"{self.watchdog.timeout:g} s" if self.watchdog.enabled else "off")
+
     def set_silent(self, silent: bool) -> None:
         self._silent = bool(silent)
         log.info("silent %s", "on" if silent else "off")

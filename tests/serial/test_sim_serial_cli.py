@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
+import io
 import signal
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
 from app.link.client import ConnectionSettings, RobotClient
-from app.sim.cli import build_parser
+from app.sim.cli import build_parser, execute
 from app.sim.guard import WATCHDOG_TIMEOUT
 from tests.serial.relay import PtyRelay
 
@@ -51,3 +53,11 @@ def test_teachpad_sim_serves_a_serial_line() -> None:
         relay.close()
     assert proc.returncode == 0, err
     assert "teachpad-sim stopped" in out
+
+
+def test_watchdog_stdin_command(sim_factory: Any) -> None:
+    sim = sim_factory()
+    out = io.StringIO()
+    assert execute(sim, "watchdog off", out) and not sim.watchdog.enabled
+    assert execute(sim, "watchdog 0.5", out) and sim.watchdog.timeout == 0.5
+    assert execute(sim, "watchdog soon", out) and "bad command" in out.getvalue()
