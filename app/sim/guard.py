@@ -216,6 +216,9 @@ class CommWatchdog:
         self._clock = clock
         self._last_request = clock()
         self._owner: int | None = None
+        # added to the timeout on a slow serial line: the longest answer's time on the wire,
+        # during which the host cannot send its next request
+        self.allowance = 0.0
 
     @property
     def enabled(self) -> bool:
@@ -245,6 +248,6 @@ class CommWatchdog:
         if self.timeout is None or not jogging:
             return
         silent = self._clock() - self._last_request
-        if silent > self.timeout and self._stop_jog(f"no request for {silent:.3f} s "
-                                                    f"(watchdog {self.timeout:g} s)"):
+        if silent > self.timeout + self.allowance and self._stop_jog(
+                f"no request for {silent:.3f} s (watchdog {self.timeout:g} s)"):
             self._owner = None

@@ -47,6 +47,7 @@ log = logging.getLogger(__name__)
 RECV_BUFFER_MAX = 1 << 20  # bytes a connection may buffer (asyncio reads up to 256 KiB at once)
 RTU_BUFFER_MAX = 512  # bytes: two RTU frames; more is noise
 RTU_GAP_MIN = 0.02  # s: a partial RTU frame is dropped after this much silence (or 3.5 chars)
+RTU_ANSWER_MAX = 256  # bytes of the longest RTU answer (125 registers)
 SERIAL_REOPEN_DELAY = 1.0  # s before the server reopens a serial port that went away
 
 _ids = itertools.count(1)
@@ -152,6 +153,7 @@ class GuardedSerialServer(ModbusSerialServer):  # type: ignore[misc]
                          stopbits=stopbits, bytesize=8, reconnect_delay=SERIAL_REOPEN_DELAY,
                          trace_packet=trace_packet)
         guard.rtu_gap = max(guard.rtu_gap, 3.5 * 11 / baudrate)
+        guard.watchdog.allowance = RTU_ANSWER_MAX * 11 / baudrate  # 9600 baud: 0.29 s
         _screen(self, guard, FramerType.RTU)
 
     def callback_new_connection(self) -> GuardedHandler:

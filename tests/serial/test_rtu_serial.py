@@ -10,7 +10,7 @@ import pytest
 
 from app.errors import TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
-from app.protocol.enums import WorkMode
+from app.protocol.enums import TeachFrame, WorkMode
 from app.protocol.registers import REG_WORK_MODE
 from app.sim import SimConfig, SimController
 from tests.serial.relay import PtyRelay
@@ -71,3 +71,26 @@ def test_line_noise_before_a_request_is_dropped_at_the_silent_gap(
     relay.noise_before_next_request = b"\x01\x03\x07"  # looks like the start of a frame
     assert client.read_status().mode == 1
     assert sim.bad_frame_counts() == {"incomplete frame": 1}
+
+
+def test_a_host_polling_at_9600_baud_keeps_its_jog() -> None:
+    """The longest answer takes 0.29 s on a 9600 baud line: the watchdog allows for it."""
+    relay = PtyRelay(9600)
+    sim = SimController(SimConfig(serial_port=relay.sim_port, baudrate=9600))
+    client = RobotClient(ConnectionSettings(serial_port=relay.host_port, baudrate=9600, timeout=1.0))
+    try:
+        sim.start()
+        client.connect()
+        client.teach_enable(TeachFrame.JOINT, 0, 1)
+        client.teach_set_ratio(10.0)
+        assert sim.wait_for(lambda s: s.jogging, 5.0)
+        for _ in range(3):
+            client.read_registers(0, 125)  # 255 bytes back: 0.27 s on the wire
+        assert sim.state().jogging and sim.watchdog_events() == []
+        client.close()  # the serial line stays open on the simulator's side: silence stops the jog
+        assert sim.wait_for(lambda s: not s.jogging, 2.0)
+        assert "no request" in sim.watchdog_events()[0].detail
+    finally:
+        client.close()
+        sim.stop()
+        relay.close()
