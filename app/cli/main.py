@@ -63,7 +63,9 @@ EXIT_USAGE = 2
 EXIT_LINK = 3
 EXIT_INTERRUPTED = 130
 
-JOG_POLL_INTERVAL = 0.05  # s between status checks while a jog runs
+JOG_POLL_INTERVAL = 0.05  # s between status checks while a jog runs (keeps a watchdog fed)
+JOG_SECONDS_DEFAULT = 2.0  # s a jog runs when --seconds is not given
+JOG_SECONDS_MAX = 30.0  # s: no jog from the CLI runs longer
 WATCH_RATE_DEFAULT = 10.0  # Hz
 
 Registrar = Callable[[Any], None]  # register(subparsers: argparse._SubParsersAction)
@@ -226,6 +228,13 @@ def _word_order(text: str) -> WordOrder:
         return WordOrder.parse(text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _jog_seconds(text: str) -> float:
+    value = _positive_float(text)
+    if value > JOG_SECONDS_MAX:
+        raise argparse.ArgumentTypeError(f"a jog runs at most {JOG_SECONDS_MAX:g} s, got {text[:20]}")
+    return value
 
 
 def _positive_float(text: str) -> float:
@@ -489,14 +498,21 @@ def register_core(sub: Any) -> None:
     p.add_argument("--no-wait", action="store_true", help="return once the command is sent")
     p.set_defaults(handler=cmd_step)
 
-    p = sub.add_parser("jog", help="teach-mode jog for a while (function 4); always stops and disables")
+    p = sub.add_parser(
+        "jog", help="teach-mode jog for a bounded time (function 4); always stops and disables",
+        description="Jog one axis in teach mode, then write ratio 0 and disable teach mode. The jog is "
+                    f"bounded: it stops after --seconds (default {JOG_SECONDS_DEFAULT:g} s, at most "
+                    f"{JOG_SECONDS_MAX:g} s), on Ctrl-C and on any error. Example: "
+                    "teachpad-cli --host 192.168.1.10 jog --axis Z --dir + --ratio 10 --seconds 1.5")
     p.add_argument("--frame", choices=("base", "user", "tool", "joint"), default="base")
     p.add_argument("--user", type=int, default=0, metavar="N", help="user frame id (frame user)")
     p.add_argument("--tool", type=int, default=0, metavar="N", help="tool frame id (frame tool)")
     p.add_argument("--axis", required=True, help="X Y Z A B C, or J1..J11 in the joint frame")
     p.add_argument("--dir", required=True, help="+ or -")
-    p.add_argument("--ratio", type=float, required=True, help="speed ratio, 0 < N <= 100")
-    p.add_argument("--for", dest="duration", type=_positive_float, required=True, metavar="SECONDS")
+    p.add_argument("--ratio", type=float, required=True, help="speed ratio in percent, 0 < N <= 100")
+    p.add_argument("--seconds", "--for", dest="duration", type=_jog_seconds, default=JOG_SECONDS_DEFAULT,
+                   metavar="S", help=f"how long to jog, in seconds: 0 < S <= {JOG_SECONDS_MAX:g} "
+                                     f"(default {JOG_SECONDS_DEFAULT:g}); --for is the same")
     p.set_defaults(handler=cmd_jog)
 
     p = sub.add_parser("point", help="temp points (function 2)")

@@ -1,13 +1,14 @@
 """The simulated Bochuang controller: kinematics, motion, state machine, Modbus server.
 
-``SimController(SimConfig(...))`` is the Modbus TCP slave (``start``/``stop``/``port``,
-inspection and fault injection, see :mod:`app.sim.server`); ``SimRobot`` is the pure state
-machine it drives (:mod:`app.sim.robot`); :mod:`app.sim.kinematics` holds the DH model;
-``teachpad-sim`` is :func:`app.sim.cli.main`.
+``SimController(SimConfig(...))`` is the Modbus TCP slave, or RTU on a serial line
+(``start``/``stop``/``port``, inspection and fault injection, see :mod:`app.sim.server`; bad
+input and the communication watchdog in :mod:`app.sim.guard` and :mod:`app.sim.transport`);
+``SimRobot`` is the pure state machine it drives (:mod:`app.sim.robot`);
+:mod:`app.sim.kinematics` holds the DH model; ``teachpad-sim`` is :func:`app.sim.cli.main`.
 """
 
 from app.sim.robot import PROGRAMS, SimRobot, StoredPoint, TraceSample
-from app.sim.server import SimConfig, SimController, SimSnapshot, WriteRecord
+from app.sim.server import SimConfig, SimController, SimEvent, SimSnapshot, WriteRecord
 
-__all__ = ["PROGRAMS", "SimConfig", "SimController", "SimRobot", "SimSnapshot", "StoredPoint", "TraceSample",
-           "WriteRecord"]
+__all__ = ["PROGRAMS", "SimConfig", "SimController", "SimEvent", "SimRobot", "SimSnapshot", "StoredPoint",
+           "TraceSample", "WriteRecord"]

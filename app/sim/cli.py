@@ -14,6 +14,7 @@ from pymodbus.constants import ExcCodes
 
 from app.protocol.codec import WordOrder
 from app.protocol.enums import Alarm
+from app.sim.guard import WATCHDOG_TIMEOUT
 from app.sim.server import SimConfig, SimController
 
 log = logging.getLogger(__name__)
@@ -29,11 +30,12 @@ commands typed on stdin while running (one per line):
   delay SECONDS       delay every answer (0 = off)
   status-delay SECONDS  GV291 keeps its old value this long after a command
   drop                close the connections of the connected clients
+  watchdog SECONDS|off  stop a jog whose host went away (see --watchdog)
   exception CODE      answer every request with Modbus exception CODE (1-11)
   exception off       answer normally again
   silent on|off       receive requests but never answer
   restart             the controller logs in again: temp points wiped, motion stopped
-  status              print the state (pose, joints, mode, alarms, GV291, points)
+  status              print the state (pose, joints, mode, alarms, GV291, points, bad frames)
   help                this list
   quit                stop the simulator
 """
@@ -42,7 +44,8 @@ commands typed on stdin while running (one per line):
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="teachpad-sim",
-        description="Simulated Bochuang robot controller (Modbus TCP slave) for TeachPad.",
+        description="Simulated Bochuang robot controller (Modbus TCP slave, or RTU on a serial line "
+                    "with --serial) for TeachPad.",
         epilog=COMMANDS_HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -58,9 +61,30 @@ def build_parser() -> argparse.ArgumentParser:
                         help="GV291 keeps its old value S seconds after a command")
     parser.add_argument("--rtu-framing", action="store_true", help="RTU framing over TCP instead of MBAP")
     parser.add_argument("--tick-hz", type=float, default=100.0, help="simulation rate (default 100)")
+    parser.add_argument("--watchdog", type=_watchdog, default=WATCHDOG_TIMEOUT, metavar="SECONDS|off",
+                        help="stop a teach jog when its connection closes or no request arrives for "
+                             f"SECONDS (default {WATCHDOG_TIMEOUT:g}; off: keep jogging, like a controller "
+                             "without a watchdog)")
+    serial = parser.add_argument_group("RTU on a serial line (instead of TCP)")
+    serial.add_argument("--serial", metavar="PORT", help="serial device to serve, e.g. /dev/ttyUSB0 or COM3")
+    serial.add_argument("--baud", type=int, default=115200, help="baud rate (default 115200)")
+    serial.add_argument("--parity", choices=["N", "E", "O"], default="N", help="parity (default N)")
+    serial.add_argument("--stopbits", type=int, choices=[1, 2], default=1, help="stop bits (default 1)")
     parser.add_argument("--no-stdin", action="store_true", help="do not read commands from stdin")
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     return parser
+
+
+def _watchdog(text: str) -> float | None:
+    if text.strip().lower() in ("off", "0", "none"):
+        return None
+    try:
+        seconds = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds or 'off', got {text[:20]!r}") from None
+    if not 0 < seconds <= 60:
+        raise argparse.ArgumentTypeError(f"watchdog must be in (0, 60] s or 'off', got {text[:20]!r}")
+    return seconds
 
 
 def execute(sim: SimController, line: str, out: TextIO) -> bool:
@@ -78,6 +102,11 @@ def execute(sim: SimController, line: str, out: TextIO) -> bool:
             sim.set_status_delay(float(args[0]))
         elif cmd == "drop" and not args:
             sim.drop_connections()
+        elif cmd == "watchdog" and len(args) == 1:
+            try:
+                sim.set_watchdog(_watchdog(args[0]))
+            except argparse.ArgumentTypeError as exc:
+                raise ValueError(str(exc)) from None
         elif cmd == "exception" and len(args) == 1:
             sim.set_exception(None if args[0] == "off" else ExcCodes(int(args[0], 0)))
         elif cmd == "silent" and len(args) == 1 and args[0] in ("on", "off"):
@@ -91,6 +120,10 @@ def execute(sim: SimController, line: str, out: TextIO) -> bool:
             print(f"mode {s.mode.name} program {s.program_state.name} alarms {int(s.alarms)} "
                   f"teach {'on' if s.teach_enabled else 'off'} ratio {s.teach_ratio:g} "
                   f"GV291 {s.command_status} points {len(s.points)}", file=out)
+            bad = sim.bad_frame_counts()
+            print(f"bad frames {sum(bad.values())}"
+                  + "".join(f", {n} {reason}" for reason, n in sorted(bad.items()))
+                  + f"; watchdog stops {len(sim.watchdog_events())}", file=out)
         elif cmd == "help":
             print(COMMANDS_HELP, file=out)
         elif cmd in ("quit", "exit"):
@@ -112,7 +145,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     config = SimConfig(host=args.host, port=args.port, unit=args.unit,
                        word_order=WordOrder.parse(args.word_order),
                        status_encoding=args.status_encoding, status_delay=args.status_delay,
-                       framer="rtu" if args.rtu_framing else "socket", tick_hz=args.tick_hz)
+                       framer="rtu" if args.rtu_framing else "socket", tick_hz=args.tick_hz,
+                       watchdog=args.watchdog, serial_port=args.serial, baudrate=args.baud,
+                       parity=args.parity, stopbits=args.stopbits)
     sim = SimController(config)
     try:
         sim.start()
@@ -120,8 +155,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"teachpad-sim: {exc}", file=sys.stderr)
         return 1
     done = threading.Event()
-    print(f"teachpad-sim listening on {config.host}:{sim.port} (unit {config.unit}); Ctrl-C to stop",
-          flush=True)
+    print(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop", flush=True)
 
     previous: dict[signal.Signals, object] = {}
     if threading.current_thread() is threading.main_thread():

@@ -1,11 +1,12 @@
 """The simulated controller as a real Modbus server (pymodbus 3.16 ``SimDevice`` API).
 
-:class:`SimController` runs a :class:`~pymodbus.server.ModbusTcpServer` in its own asyncio
-loop on a daemon thread and a ticker thread that advances :class:`~app.sim.robot.SimRobot`
-at ``SimConfig.tick_hz``. Every request passes :meth:`SimController._action` (the SimDevice
-action), which, under :attr:`SimController.lock`, applies writes (commands, teach ratio) and
-refreshes the live registers (pose, joints, status, clock, GV291) so reads always see the
-current state.
+:class:`SimController` runs a Modbus TCP server (or RTU on a serial line, ``serial_port``) in
+its own asyncio loop on a daemon thread (:mod:`app.sim.transport`; request screening, the
+bad-frame log and the communication watchdog are in :mod:`app.sim.guard`) and a ticker thread
+that advances :class:`~app.sim.robot.SimRobot` at ``SimConfig.tick_hz``. Every request passes
+:meth:`SimController._action` (the SimDevice action), which, under :attr:`SimController.lock`,
+applies writes (commands, teach ratio) and refreshes the live registers (pose, joints, status,
+clock, GV291) so reads always see the current state.
 
 GV291 publication: on a 440 command with a status (0x40/0x41/0x42/0xE0/0x80/0x81) the old
 value stays for ``status_delay`` seconds, then 0 (INITIAL) shows for ``command_latency``
@@ -33,7 +34,6 @@ from typing import Literal
 
 from pymodbus.constants import ExcCodes
 from pymodbus.framer import FramerType
-from pymodbus.server import ModbusTcpServer
 from pymodbus.simulator import DataType, SimData, SimDevice
 
 from app import timing
@@ -73,7 +73,9 @@ from app.protocol.registers import (
     TEMP_POINT_ID_MIN,
     gv_reg,
 )
+from app.sim.guard import CURRENT_CONNECTION, WATCHDOG_TIMEOUT, BadFrames, CommWatchdog
 from app.sim.robot import Pose6, SimRobot, StoredPoint, TraceSample
+from app.sim.transport import GuardedSerialServer, GuardedTcpServer, ServerGuard, ServerRunner
 
 log = logging.getLogger(__name__)
 
@@ -83,7 +85,6 @@ ZERO_HOLD_MAX = 0.25
 _FC_WRITE_SINGLE = 6
 _STATUS_COMMANDS = frozenset({RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT,
                               RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE})
-_START_TIMEOUT = 5.0
 _GENERAL_REGISTERS = 200  # GV0..GV99 (registers 0..199): cleared by a controller restart
 _STOP_TIMEOUT = 2.0
 
@@ -106,6 +107,14 @@ class SimConfig:
     point_id_max: int = TEMP_POINT_ID_MAX
     work_mode: WorkMode = WorkMode.AUTO  # the mode at power-on
     response_delay: float = 0.0
+    # communication watchdog: stop a jog when its connection closes or no request arrives
+    # for this many seconds (None or 0: off)
+    watchdog: float | None = WATCHDOG_TIMEOUT
+    # RTU on a serial device instead of TCP (host/port/framer are then unused)
+    serial_port: str | None = None
+    baudrate: int = 115200
+    parity: Literal["N", "E", "O"] = "N"
+    stopbits: int = 1
 
     def __post_init__(self) -> None:
         if isinstance(self.word_order, str):
@@ -118,6 +127,11 @@ class SimConfig:
             raise ValueError(f"framer must be 'socket' or 'rtu', got {self.framer!r}")
         if not self.tick_hz > 0:
             raise ValueError("tick_hz must be > 0")
+        if self.watchdog is not None and not self.watchdog >= 0:
+            raise ValueError(f"watchdog must be None or >= 0 s, got {self.watchdog!r}")
+        if self.parity not in ("N", "E", "O") or self.stopbits not in (1, 2) or self.baudrate <= 0:
+            raise ValueError(f"serial settings: parity N/E/O, stop bits 1/2, baud > 0; got "
+                             f"{self.parity!r}, {self.stopbits!r}, {self.baudrate!r}")
 
 
 @dataclass(frozen=True)
@@ -128,6 +142,15 @@ class WriteRecord:
     function_code: int
     address: int
     values: tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class SimEvent:
+    """Something the controller did by itself: monotonic time, kind (``"watchdog"``), details."""
+
+    t: float
+    kind: str
+    detail: str
 
 
 @dataclass(frozen=True)
@@ -167,9 +190,7 @@ class SimController:
         self.writes: list[WriteRecord] = []
         self._requests = 0
         self._port: int | None = None
-        self._loop: asyncio.AbstractEventLoop | None = None
-        self._server: ModbusTcpServer | None = None
-        self._loop_thread: threading.Thread | None = None
+        self._runner = ServerRunner()
         self._tick_thread: threading.Thread | None = None
         self._stop_event = threading.Event()
         self._started = False
@@ -186,14 +207,29 @@ class SimController:
         self._hold_zero_until = 0.0
         self._zero_unread = False  # the 0 phase has not been seen by a host read yet
         self._wipe_general = False  # set by restart_controller(): clear GV0..GV99 on the next request
+        # bad input and the communication watchdog (app/sim/guard.py)
+        self.events: list[SimEvent] = []
+        self.bad_frames = BadFrames()
+        self.watchdog = CommWatchdog(self.config.watchdog, self._watchdog_stop)
+        self._registers: list[int] | None = None  # the server's register block, once seen
 
     # --- lifecycle ------------------------------------------------------------------------
     @property
     def port(self) -> int:
         """The bound TCP port (valid after :meth:`start`)."""
+        if self.config.serial_port is not None:
+            raise RuntimeError(f"the simulator serves the serial line {self.config.serial_port}, not TCP")
         if self._port is None:
             raise RuntimeError("simulator not started")
         return self._port
+
+    @property
+    def endpoint(self) -> str:
+        """``host:port``, or the serial device and its settings, for messages."""
+        c = self.config
+        if c.serial_port is not None:
+            return f"{c.serial_port} ({c.baudrate} baud, 8{c.parity}{c.stopbits})"
+        return f"{c.host}:{self._port if self._port is not None else c.port}"
 
     @property
     def host(self) -> str:
@@ -208,77 +244,39 @@ class SimController:
         if self._started:
             raise RuntimeError("simulator already started")
         self._started = True
-        ready = threading.Event()
-        errors: list[BaseException] = []
-        loop = asyncio.new_event_loop()
-        self._loop = loop
-
-        def run_loop() -> None:
-            asyncio.set_event_loop(loop)
-            try:
-                loop.run_until_complete(self._serve())
-            except BaseException as exc:  # reported to start()
-                errors.append(exc)
-                ready.set()
-                self._close_loop(loop)
-                return
-            ready.set()
-            loop.run_forever()
-            self._close_loop(loop)
-
-        self._loop_thread = threading.Thread(target=run_loop, name="sim-modbus", daemon=True)
-        self._loop_thread.start()
-        if not ready.wait(_START_TIMEOUT) or errors:
-            self._loop_thread.join(_STOP_TIMEOUT)
+        try:
+            self._runner.start(self._serve, self.endpoint)
+        except OSError:
             self._stopped = True
-            raise OSError(f"simulator could not listen on {self.config.host}:{self.config.port}: "
-                          f"{errors[0] if errors else 'timeout'}")
+            raise
+        self._port = self._runner.port
         self._tick_thread = threading.Thread(target=self._tick_loop, name="sim-ticker", daemon=True)
         self._tick_thread.start()
-        log.info("simulator listening on %s:%s (unit %s, %s framing, %s word order, status %s)",
-                 self.config.host, self._port, self.config.unit, self.config.framer,
-                 self.config.word_order.value, self.config.status_encoding)
+        log.info("simulator listening on %s (unit %s, %s framing, %s word order, status %s, watchdog %s)",
+                 self.endpoint, self.config.unit, "rtu" if self.config.serial_port else self.config.framer,
+                 self.config.word_order.value, self.config.status_encoding,
+                 f"{self.watchdog.timeout:g} s" if self.watchdog.enabled else "off")
 
-    async def _serve(self) -> None:
+    async def _serve(self) -> GuardedTcpServer | GuardedSerialServer:
         initial = [0] * REGISTER_SPACE
         self._init_registers(initial)
         device = SimDevice(self.config.unit,
                            simdata=[SimData(address=0, values=initial, datatype=DataType.REGISTERS)],
                            action=self._action)
-        framer = FramerType.RTU if self.config.framer == "rtu" else FramerType.SOCKET
-        server = ModbusTcpServer(device, framer=framer, address=(self.config.host, self.config.port),
-                                 trace_packet=self._trace_packet)
-        await server.serve_forever(background=True)
-        self._server = server
-        self._port = int(server.transport.sockets[0].getsockname()[1])
-
-    @staticmethod
-    async def _shutdown(server: ModbusTcpServer) -> None:
-        # Stop accepting first and let accepted connections finish their setup: closing the
-        # asyncio Server while an accept is half done makes the new transport's __init__ fail
-        # (Server._attach asserts) and leaks its socket.
-        loop = asyncio.get_running_loop()
-        for sock in server.transport.sockets:
-            loop.remove_reader(sock.fileno())
-        for _ in range(3):
-            await asyncio.sleep(0)
-        await server.shutdown()
-        await asyncio.sleep(0)
-
-    @staticmethod
-    def _close_loop(loop: asyncio.AbstractEventLoop) -> None:
-        """Cancel what is left (repeating: a cancelled task may start another), then close."""
-        for _ in range(10):
-            tasks = asyncio.all_tasks(loop)
-            if not tasks:
-                break
-            for task in tasks:
-                task.cancel()
-            loop.run_until_complete(asyncio.gather(*tasks, return_exceptions=True))
-        for _ in range(3):  # let closed transports release their sockets
-            loop.run_until_complete(asyncio.sleep(0))
-        loop.run_until_complete(loop.shutdown_asyncgens())
-        loop.close()
+        c = self.config
+        guard = ServerGuard(c.unit, self.bad_frames, self.watchdog)
+        server: GuardedTcpServer | GuardedSerialServer
+        if c.serial_port is not None:
+            server = GuardedSerialServer(device, guard, port=c.serial_port, baudrate=c.baudrate,
+                                         parity=c.parity, stopbits=c.stopbits,
+                                         trace_packet=self._trace_packet)
+            await server.serve_forever(background=True)
+        else:
+            framer = FramerType.RTU if c.framer == "rtu" else FramerType.SOCKET
+            server = GuardedTcpServer(device, guard, framer=framer, address=(c.host, c.port),
+                                      trace_packet=self._trace_packet)
+            await server.serve_forever(background=True)
+        return server
 
     def stop(self) -> None:
         """Stop the server and the ticker. Idempotent and fast."""
@@ -287,15 +285,7 @@ class SimController:
             return
         self._stopped = True
         self._stop_event.set()
-        loop, server = self._loop, self._server
-        if loop is not None and server is not None and not loop.is_closed():
-            try:
-                asyncio.run_coroutine_threadsafe(self._shutdown(server), loop).result(_STOP_TIMEOUT)
-            except Exception as exc:  # the loop is going away anyway
-                log.warning("server shutdown: %s", exc)
-            loop.call_soon_threadsafe(loop.stop)
-        if self._loop_thread is not None:
-            self._loop_thread.join(_STOP_TIMEOUT)
+        self._runner.stop()
         if self._tick_thread is not None:
             self._tick_thread.join(_STOP_TIMEOUT)
         log.info("simulator stopped")
@@ -321,6 +311,9 @@ class SimController:
                 except Exception:  # keep the simulator alive; the failure is in the log
                     log.exception("simulator tick failed")
                     self.robot.stop()
+                jogging = self.robot.jogging
+            self.watchdog.check(jogging)
+            self.bad_frames.flush()
             deadline += period
             if deadline < now:
                 deadline = now + period
@@ -335,8 +328,10 @@ class SimController:
                       registers: list[int], set_values: list[int] | list[bool] | None) -> ExcCodes | None:
         if set_values is None and function_code == _FC_WRITE_SINGLE:
             return None  # pymodbus reads a 0x06 write back: already handled
+        connection = CURRENT_CONNECTION.get()
         with self.lock:
             self._requests += 1
+            self._registers = registers
         if self._silent:
             return ExcCodes.DEVICE_FAILURE  # not executed; the answer is dropped by _trace_packet
         if self._response_delay > 0:
@@ -362,6 +357,9 @@ class SimController:
                 if result is not None:  # refused: the write is not stored
                     registers[offset : offset + len(values)] = before
                     return result
+                ratio = gv_reg(GV_PARAM3)
+                if self.robot.jogging and address <= ratio + 1 and ratio < address + len(values):
+                    self.watchdog.jog_written(connection)
             self._refresh(registers, start_address)
             status_reg = gv_reg(GV_COMMAND_STATUS)
             if (set_values is None and self._zero_unread and address <= status_reg < address + count
@@ -527,8 +525,30 @@ class SimController:
     @property
     def connections_count(self) -> int:
         """Clients connected right now."""
-        server = self._server
-        return 0 if server is None else len(server.active_connections)
+        return self._runner.connections_count
+
+    def bad_frame_counts(self) -> dict[str, int]:
+        """Rejected frames since start, by reason (``"illegal function"``, ``"bad CRC"``, ...)."""
+        return self.bad_frames.counts()
+
+    def watchdog_events(self) -> list[SimEvent]:
+        with self.lock:
+            return [e for e in self.events if e.kind == "watchdog"]
+
+    def _watchdog_stop(self, reason: str) -> bool:
+        """The watchdog fired: ratio 0 (GV203 reads 0 too), teach stays enabled."""
+        with self.lock:
+            robot = self.robot
+            if not robot.jogging:
+                return False
+            robot.set_teach_ratio(0.0, robot.jog_axis, robot.jog_direction)
+            regs = self._registers
+            if regs is not None:
+                r = gv_reg(GV_PARAM3)
+                regs[r : r + 2] = float_to_registers(0.0, self.config.word_order)
+            self.events.append(SimEvent(time.monotonic(), "watchdog", reason))
+        log.warning("watchdog: jog stopped (ratio 0, teach still enabled): %s", reason)
+        return True
 
     def writes_to(self, address: int) -> list[WriteRecord]:
         """Writes that covered ``address``, narrowed to that one register: ``values == (v,)``."""
@@ -590,6 +610,11 @@ class SimController:
         self._status_delay = max(0.0, float(seconds))
         log.info("status delay %.3f s", self._status_delay)
 
+    def set_watchdog(self, seconds: float | None) -> None:
+        """The communication watchdog's silence limit; None or 0 switches it off entirely."""
+        self.watchdog.set_timeout(seconds)
+        log.info("watchdog %s", f"{self.watchdog.timeout:g} s" if self.watchdog.enabled else "off")
+
     def set_silent(self, silent: bool) -> None:
         self._silent = bool(silent)
         log.info("silent %s", "on" if silent else "off")
@@ -603,17 +628,6 @@ class SimController:
 
     def drop_connections(self) -> int:
         """Close the sockets of the connected clients (the server keeps listening)."""
-        loop, server = self._loop, self._server
-        if loop is None or server is None or loop.is_closed():
-            return 0
-
-        async def drop() -> int:
-            conns = list(server.active_connections.values())
-            for conn in conns:
-                conn.close()
-            return len(conns)
-
-        count = int(asyncio.run_coroutine_threadsafe(drop(), loop).result(_STOP_TIMEOUT))
+        count = self._runner.drop_connections()
         log.info("dropped %d connection(s)", count)
         return count
-

@@ -4,102 +4,127 @@
     <context>
         <name>ConnectionDialog</name>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="115" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="147" />
             <source>Connect to controller</source>
             <translation>连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="116" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="148" />
             <source>Transport:</source>
             <translation>通信方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="117" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="149" />
             <source>Modbus TCP</source>
             <translation>Modbus TCP</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="118" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="150" />
             <source>Modbus RTU (serial)</source>
             <translation>Modbus RTU（串口）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="119" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="151" />
             <source>Host:</source>
             <translation>主机：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="120" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="152" />
             <source>Port:</source>
             <translation>端口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="121" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="153" />
             <source>Serial port:</source>
             <translation>串口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="122" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="154" />
+            <source>Refresh</source>
+            <translation>刷新</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="155" />
+            <source>List the serial ports of this computer again</source>
+            <translation>重新列出本机的串口</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="157" />
             <source>Baud rate:</source>
             <translation>波特率：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="123" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="158" />
             <source>Parity:</source>
             <translation>校验位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="124" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="159" />
             <source>none</source>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="124" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="159" />
             <source>even</source>
             <translation>偶校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="124" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="159" />
             <source>odd</source>
             <translation>奇校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="126" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="161" />
             <source>Stop bits:</source>
             <translation>停止位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="127" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="162" />
             <source>Unit id:</source>
             <translation>从站地址：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="128" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="163" />
             <source>Float word order:</source>
             <translation>浮点数字序：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="129" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="164" />
             <source>Low word first (CDAB, default)</source>
             <translation>低字在前（CDAB，默认）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="130" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="165" />
             <source>High word first (ABCD)</source>
             <translation>高字在前（ABCD）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="131" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="166" />
             <source>Timeout:</source>
             <translation>超时：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="132" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="167" />
             <source>Monitor only (never write to the controller)</source>
             <translation>仅监视（从不写入控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="180" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="190" />
+            <source>Could not list the serial ports ({error}); type the device name</source>
+            <translation>无法列出串口（{error}），请直接输入设备名</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="193" />
+            <source>Serial ports found: {n}</source>
+            <translation>找到的串口：{n} 个</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
+            <source>No serial port found; type the device name</source>
+            <translation>未找到串口，请直接输入设备名</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="244" />
             <source>a serial port is needed for RTU</source>
             <translation>RTU 方式需要指定串口</translation>
         </message>

@@ -110,13 +110,60 @@ def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) ->
 
 def test_jog_interrupted_still_stops_and_disables(csim: Any) -> None:
     code, err = interrupt_cli(csim, ["jog", "--frame", "joint", "--axis", "J1", "--dir", "-", "--ratio", "20",
-                                     "--for", "60"], lambda s: s.jogging)
+                                     "--seconds", "30"], lambda s: s.jogging)
     assert code == EXIT_INTERRUPTED
     assert one_line_error(err) == "teachpad-cli: error: interrupted"
     state = csim.state()
     assert not state.teach_enabled and not state.jogging and state.teach_ratio == 0
     # ratio 0 (GV203 = regs 406-407) was written after the jog started, then 440 <- 0x81
     assert csim.writes[-1].address == 440 and csim.writes[-1].values == (0x81,)
+
+
+def test_jog_killed_mid_jog_is_stopped_by_the_simulator_watchdog(csim: Any) -> None:
+    """kill -9 leaves no chance to clean up: the simulator's watchdog sees the connection close."""
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "app.cli.main", "--port", str(csim.port), "jog", "--frame", "base",
+         "--axis", "X", "--dir", "-", "--ratio", "30", "--seconds", "30"],
+        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+    try:
+        assert csim.wait_for(lambda s: s.jogging, 10.0)
+        start = csim.state()
+        assert csim.wait_for(lambda s: s.pose != start.pose, 5.0)  # the arm moves
+        killed = time.monotonic()
+        proc.kill()  # SIGKILL
+        proc.communicate(timeout=10)
+        assert csim.wait_for(lambda s: not s.jogging, 2.0)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    (event,) = csim.watchdog_events()
+    assert event.t - killed < 0.25, f"stopped {event.t - killed:.3f} s after the kill"
+    assert csim.state().teach_ratio == 0
+    # the CLI never wrote ratio 0: only its start of the jog is in the write log
+    ratio_writes = csim.writes_to(407)  # GV203's high word (30.0 = 0x41F0 0000)
+    assert ratio_writes and ratio_writes[-1].values == (0x41F0,) and ratio_writes[-1].t < killed
+    before = csim.state()
+    assert csim.wait_for(lambda s: s.t > before.t + 0.1, 5.0)
+    assert csim.state().pose == before.pose
+
+
+def test_jog_is_bounded_in_time(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
+    from app.cli.main import JOG_SECONDS_DEFAULT, JOG_SECONDS_MAX, build_parser
+
+    args = build_parser().parse_args(["jog", "--axis", "X", "--dir", "+", "--ratio", "10"])
+    assert args.duration == JOG_SECONDS_DEFAULT == 2.0 and JOG_SECONDS_MAX == 30.0
+    code, _, err = run(csim, capsys, "jog", "--axis", "X", "--dir", "+", "--ratio", "10", "--seconds", "31")
+    assert code == EXIT_USAGE and "at most 30 s" in err
+    started = time.monotonic()
+    code, _, _ = run(csim, capsys, "jog", "--axis", "X", "--dir", "+", "--ratio", "10", "--seconds", "0.3")
+    assert code == EXIT_OK and time.monotonic() - started < 5.0
+    ratio_writes = csim.writes_to(407)  # GV203's high word (10.0 = 0x4120 0000)
+    jog = next(w for w in ratio_writes if w.values == (0x4120,))
+    assert ratio_writes[-1].values == (0,)
+    assert 0.3 <= ratio_writes[-1].t - jog.t < 1.5
+    assert not csim.state().teach_enabled
 
 
 def test_jog_errors(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:

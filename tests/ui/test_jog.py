@@ -108,6 +108,7 @@ def test_closing_the_window_stops_the_jog_and_teach(qtbot: Any, sim: Any, window
 
 
 def test_link_loss_releases_and_reconnect_makes_safe(qtbot: Any, sim: Any, window: Any) -> None:
+    sim.set_watchdog(None)  # a controller without a communication watchdog
     _start_jog(qtbot, window, sim)
     with qtbot.waitSignal(window.link.connectionChanged, check_params_cb=is_state(LinkState.DOWN),
                           timeout=SIGNAL_TIMEOUT_MS):

@@ -206,6 +206,7 @@ def test_monitor_only_never_writes(qtbot: Any, sim: Any, link: RobotLink) -> Non
 
 
 def test_link_loss_then_reconnect_stops_the_jog_first(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    sim.set_watchdog(None)  # a controller without a communication watchdog
     connect(qtbot, link, sim)
     link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)

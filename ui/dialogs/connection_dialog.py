@@ -1,10 +1,12 @@
-"""Connect…: Modbus TCP or RTU (serial), unit id, word order, timeout, monitor-only."""
+"""Connect…: Modbus TCP or RTU (serial, the machine's ports listed), unit id, word order, timeout,
+monitor-only."""
 
 from __future__ import annotations
 
 import dataclasses
+from typing import NamedTuple
 
-from PySide6.QtCore import QEvent, Slot
+from PySide6.QtCore import QEvent, Qt, Slot
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -12,8 +14,10 @@ from PySide6.QtWidgets import (
     QDialogButtonBox,
     QDoubleSpinBox,
     QFormLayout,
+    QHBoxLayout,
     QLabel,
     QLineEdit,
+    QPushButton,
     QSpinBox,
     QStackedWidget,
     QVBoxLayout,
@@ -25,6 +29,20 @@ from app.protocol.codec import WordOrder
 
 _BAUDRATES = (9600, 19200, 38400, 57600, 115200, 230400)
 _PARITIES = ("N", "E", "O")
+
+
+class SerialPortInfo(NamedTuple):
+    device: str  # what to open: /dev/ttyUSB0, COM3
+    description: str  # what it is, as the system names it
+
+
+def available_serial_ports() -> list[SerialPortInfo]:
+    """The machine's serial ports (pyserial's ``comports()``), sorted by device name."""
+    from serial.tools import list_ports
+
+    ports = [SerialPortInfo(p.device, p.description if p.description not in (None, "n/a") else "")
+             for p in list_ports.comports()]
+    return sorted(ports, key=lambda p: p.device)
 
 
 class ConnectionDialog(QDialog):
@@ -53,8 +71,18 @@ class ConnectionDialog(QDialog):
         self.rtu_page = QWidget(self)
         rtu_form = QFormLayout(self.rtu_page)
         rtu_form.setContentsMargins(0, 0, 0, 0)
-        self.serial_edit = QLineEdit(self.rtu_page)
+        # editable: a port the system does not list (a pty, a symlink) can still be typed
+        self.serial_combo = QComboBox(self.rtu_page)
+        self.serial_combo.setEditable(True)
+        self.serial_combo.setInsertPolicy(QComboBox.InsertPolicy.NoInsert)
+        self.serial_edit: QLineEdit = self.serial_combo.lineEdit()
         self.serial_edit.setPlaceholderText("/dev/ttyUSB0, COM3")
+        self.refresh_button = QPushButton(self.rtu_page)
+        self.refresh_button.clicked.connect(self.refresh_serial_ports)
+        serial_row = QHBoxLayout()
+        serial_row.addWidget(self.serial_combo, 1)
+        serial_row.addWidget(self.refresh_button)
+        self.ports_note = QLabel(self.rtu_page)
         self.baud_combo = QComboBox(self.rtu_page)
         for baud in _BAUDRATES:
             self.baud_combo.addItem(str(baud), baud)
@@ -67,7 +95,8 @@ class ConnectionDialog(QDialog):
         self.baud_caption = QLabel(self.rtu_page)
         self.parity_caption = QLabel(self.rtu_page)
         self.stopbits_caption = QLabel(self.rtu_page)
-        rtu_form.addRow(self.serial_caption, self.serial_edit)
+        rtu_form.addRow(self.serial_caption, serial_row)
+        rtu_form.addRow(self.ports_note)
         rtu_form.addRow(self.baud_caption, self.baud_combo)
         rtu_form.addRow(self.parity_caption, self.parity_combo)
         rtu_form.addRow(self.stopbits_caption, self.stopbits_spin)
@@ -108,6 +137,9 @@ class ConnectionDialog(QDialog):
         layout = QVBoxLayout(self)
         layout.addLayout(form)
         layout.addWidget(self.buttons)
+        self._ports: list[SerialPortInfo] = []
+        self._ports_error: str | None = None
+        self.refresh_serial_ports()
         self.set_settings(self._base)
         self.retranslate()
 
@@ -119,6 +151,9 @@ class ConnectionDialog(QDialog):
         self.host_caption.setText(self.tr("Host:"))
         self.port_caption.setText(self.tr("Port:"))
         self.serial_caption.setText(self.tr("Serial port:"))
+        self.refresh_button.setText(self.tr("Refresh"))
+        self.refresh_button.setToolTip(self.tr("List the serial ports of this computer again"))
+        self._show_ports_note()
         self.baud_caption.setText(self.tr("Baud rate:"))
         self.parity_caption.setText(self.tr("Parity:"))
         for i, text in enumerate((self.tr("none"), self.tr("even"), self.tr("odd"))):
@@ -131,6 +166,35 @@ class ConnectionDialog(QDialog):
         self.timeout_caption.setText(self.tr("Timeout:"))
         self.monitor_check.setText(self.tr("Monitor only (never write to the controller)"))
 
+    @Slot()
+    def refresh_serial_ports(self) -> None:
+        """List the machine's serial ports again; what is typed in the field stays."""
+        typed = self.serial_edit.text()
+        self._ports_error = None
+        try:
+            self._ports = available_serial_ports()
+        except Exception as exc:  # the system refuses to list: say so; typing a port still works
+            self._ports, self._ports_error = [], str(exc)[:80]
+        self.serial_combo.blockSignals(True)
+        self.serial_combo.clear()
+        for port in self._ports:
+            self.serial_combo.addItem(port.device, port.device)
+            tip = f"{port.device}: {port.description}" if port.description else port.device
+            self.serial_combo.setItemData(self.serial_combo.count() - 1, tip, Qt.ItemDataRole.ToolTipRole)
+        self.serial_combo.setEditText(typed)
+        self.serial_combo.blockSignals(False)
+        self._show_ports_note()
+
+    def _show_ports_note(self) -> None:
+        if self._ports_error is not None:
+            text = self.tr("Could not list the serial ports ({error}); type the device name").format(
+                error=self._ports_error)
+        elif self._ports:
+            text = self.tr("Serial ports found: {n}").format(n=len(self._ports))
+        else:
+            text = self.tr("No serial port found; type the device name")
+        self.ports_note.setText(text)
+
     def changeEvent(self, event: QEvent) -> None:
         if event.type() == QEvent.Type.LanguageChange:
             self.retranslate()
@@ -142,7 +206,7 @@ class ConnectionDialog(QDialog):
         self.pages.setCurrentIndex(1 if rtu else 0)
         self.host_edit.setText(settings.host)
         self.port_spin.setValue(settings.port)
-        self.serial_edit.setText(settings.serial_port or "")
+        self.serial_combo.setEditText(settings.serial_port or "")
         index = self.baud_combo.findData(settings.baudrate)
         if index < 0:
             self.baud_combo.addItem(str(settings.baudrate), settings.baudrate)
