@@ -28,7 +28,6 @@ import logging
 import math
 import time
 from collections.abc import Callable, Iterable, Sequence
-from typing import Any
 
 from app import timing
 from app.errors import (
@@ -39,20 +38,40 @@ from app.errors import (
     ResponseTimeout,
     WriteBlocked,
 )
+from app.link.checks import (  # the command methods use the short private names
+    check_enum as _check_enum,
+)
+from app.link.checks import (
+    check_float as _check_float,
+)
+from app.link.checks import (
+    check_floats as _check_floats,
+)
+from app.link.checks import (
+    check_int as _check_int,
+)
+from app.link.checks import (
+    check_settings as _check_settings,
+)
+from app.link.checks import (
+    check_tool as _check_tool,
+)
+from app.link.checks import (
+    range_name as _range_name,
+)
+from app.link.decode import decode_pose, decode_status
 from app.link.stats import LinkStats
 from app.link.tracker import CommandTracker, command_text
 from app.link.transport import ConnectionSettings, TrafficObserver, TrafficRecord, Transport
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
-from app.protocol.codec import WordOrder, check_float32, decode_floats, encode_floats
+from app.protocol.codec import decode_floats, encode_floats
 from app.protocol.datetime_regs import ControllerClock, decode_clock
 from app.protocol.enums import (
-    Alarm,
     CommandKind,
     CommandStatus,
     ControllerMode,
     ProgramMotionMode,
-    ProgramState,
     RunCommand,
     TeachFrame,
     WorkMode,
@@ -84,90 +103,6 @@ class StepFrame(enum.Enum):
     @property
     def command(self) -> RunCommand:
         return RunCommand.STEP_JOINT if self is StepFrame.JOINT else RunCommand.STEP_BASE
-
-
-# --------------------------------------------------------------------------------------------
-# Input validation (before the wire)
-# --------------------------------------------------------------------------------------------
-
-
-def _check_int(value: object, lo: int, hi: int, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        if isinstance(value, float) and value.is_integer():
-            value = int(value)
-        else:
-            raise InvalidInput(f"{name} must be an integer, got {value!r}")
-    if not lo <= value <= hi:
-        raise InvalidInput(f"{name} must be in {lo}..{hi}, got {value}")
-    return value
-
-
-def _check_float(value: object, name: str, lo: float | None = None, hi: float | None = None,
-                 *, lo_open: bool = False) -> float:
-    try:
-        number = check_float32(value, name)  # type: ignore[arg-type]
-    except ValueError as exc:
-        raise InvalidInput(str(exc)) from None
-    if lo is not None and (number < lo or (lo_open and number == lo)):
-        bound = f"> {lo:g}" if lo_open else f">= {lo:g}"
-        raise InvalidInput(f"{name} must be {bound}, got {number:g}")
-    if hi is not None and number > hi:
-        raise InvalidInput(f"{name} must be <= {hi:g}, got {number:g}")
-    return number
-
-
-def _check_floats(values: Sequence[float], count: int, name: str) -> list[float]:
-    if isinstance(values, (str, bytes)):
-        raise InvalidInput(f"{name} must be {count} numbers")
-    items = list(values)
-    if len(items) != count:
-        raise InvalidInput(f"{name} needs {count} values, got {len(items)}")
-    return [_check_float(v, f"{name}[{i}]") for i, v in enumerate(items)]
-
-
-def _check_enum(value: Any, enum_type: type[enum.IntEnum], name: str) -> Any:
-    try:
-        return enum_type(value)
-    except (ValueError, TypeError):
-        allowed = ", ".join(f"{m.name.lower()} ({m.value})" for m in enum_type)
-        raise InvalidInput(f"{name} must be one of {allowed}, got {value!r}") from None
-
-
-def _check_tool(tool: int) -> int:
-    # GV245: 200 = no tool frame, N = tool N+1.
-    return _check_int(tool, 0, registers.TOOL_NONE, "tool frame")
-
-
-def _gv_name(register: int) -> str:
-    n, half = registers.reg_to_gv(register)
-    return f"GV{n}_{half}"
-
-
-def _range_name(address: int, count: int) -> str:
-    last = address + count - 1
-    if count == 1:
-        return f"register {address} ({_gv_name(address)})"
-    if address % 2 == 0 and last % 2 == 1:
-        first_gv, last_gv = address // 2, last // 2
-        gvs = f"GV{first_gv}" if first_gv == last_gv else f"GV{first_gv}..GV{last_gv}"
-    else:
-        gvs = f"{_gv_name(address)}..{_gv_name(last)}"
-    return f"registers {address}..{last} ({gvs})"
-
-
-def _check_settings(s: ConnectionSettings) -> None:
-    _check_int(s.port, 1, 0xFFFF, "port")
-    _check_int(s.unit, 0, 247, "unit id")
-    _check_float(s.timeout, "timeout", 0.0, lo_open=True)
-    _check_int(s.retries, 0, 100, "retries")
-    if not isinstance(s.word_order, WordOrder):
-        raise InvalidInput(f"word order must be a WordOrder, got {s.word_order!r}")
-    if s.framer not in ("socket", "rtu"):
-        raise InvalidInput(f"framer must be socket or rtu, got {s.framer!r}")
-    if s.parity not in ("N", "E", "O"):
-        raise InvalidInput(f"parity must be N, E or O, got {s.parity!r}")
-    if not s.point_id_min <= s.point_id_max:
-        raise InvalidInput("point_id_min must not exceed point_id_max")
 
 
 # --------------------------------------------------------------------------------------------
@@ -313,45 +248,15 @@ class RobotClient:
         ``timeout`` overrides the request timeout (the poller passes the poll timeout).
         """
         regs = self._read(registers.POSE_BLOCK_START, registers.POSE_BLOCK_COUNT, timeout)
-        order = self.settings.word_order
-
-        def gvs(gv: int, count: int) -> list[float]:
-            start = registers.gv_reg(gv) - registers.POSE_BLOCK_START
-            return decode_floats(regs[start : start + 2 * count], order)
-
-        x, y, z, a, b, c = gvs(registers.GV_POSE, 6)
-        e = gvs(registers.GV_EXT_AXES, registers.NUM_EXTERNAL_AXES)
-        joints = tuple(gvs(registers.GV_JOINTS, registers.NUM_ROBOT_AXES))
-        return Pose(x, y, z, a, b, c, ext=(e[0], e[1], e[2], e[3], e[4]), joints=joints)
+        return decode_pose(regs, self.settings.word_order)
 
     def read_status(self, with_clock: bool = False, *, timeout: float | None = None) -> ControllerStatus:
         """Table 2 (560..583) in one FC03; the clock (576..579) comes from the same block."""
         regs = self._read(registers.STATUS_BLOCK_START, registers.STATUS_BLOCK_COUNT, timeout)
-        status = self._decode_status(regs, with_clock)
+        status = decode_status(regs, self.settings.word_order,
+                               self.settings.datetime_layout if with_clock else None)
         self.last_status = status
         return status
-
-    def _decode_status(self, regs: Sequence[int], with_clock: bool) -> ControllerStatus:
-        base = registers.STATUS_BLOCK_START
-        mode_raw = regs[registers.REG_CONTROLLER_MODE - base]
-        state_raw = regs[registers.REG_PROGRAM_STATE - base]
-        mode: ControllerMode | int
-        state: ProgramState | int
-        try:
-            mode = ControllerMode(mode_raw)
-        except ValueError:
-            mode = mode_raw
-        try:
-            state = ProgramState(state_raw)
-        except ValueError:
-            state = state_raw
-        st = registers.gv_reg(registers.GV_COMMAND_STATUS) - base
-        code = decode_status_registers(regs[st : st + 2], self.settings.word_order)
-        clock = None
-        if with_clock:
-            cs = registers.gv_reg(registers.GV_DATE) - base
-            clock = decode_clock(regs[cs : cs + 4], self.settings.datetime_layout)
-        return ControllerStatus(mode, state, Alarm(regs[registers.REG_ALARMS - base]), code, clock)
 
     def read_clock(self) -> ControllerClock:
         return decode_clock(self._read(registers.gv_reg(registers.GV_DATE), 4), self.settings.datetime_layout)
