@@ -362,14 +362,13 @@ class Transport:
     def _flush_stray(self) -> None:
         try:
             dropped = self._stream.drain()
-        except _PeerClosed:  # the controller closed the idle link: open a fresh one
-            self._stream.close()
-            self.open()
-            return
-        except OSError:
+        except (_PeerClosed, OSError):
+            # The controller closed the idle link (restart, its own timeout): say so once; the
+            # next request opens a fresh link.
             self.close()
-            self.open()
-            return
+            message = f"lost the connection to the controller at {self.settings.endpoint}: it closed the link"
+            self._count("link_errors", message)
+            raise LinkError(message) from None
         if dropped:
             self._count("resyncs", f"dropped {dropped} stray bytes from {self.settings.endpoint}")
 

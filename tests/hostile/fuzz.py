@@ -6,9 +6,10 @@ Each request (a read of 1..125 registers, a 0x06 or a 0x10 write) is answered wi
 frame mutated once: a bit flipped or a byte replaced in a checked field, the frame cut short,
 bytes appended, inserted or deleted, the frame replaced by random bytes, or sent twice. The
 server hangs up after each answer (so a cut-short frame ends at once instead of after the
-timeout; the client reconnects before the next request). Modbus TCP has no checksum: a changed
-register value inside a read's data is a well-formed answer, so over TCP the register data of
-a read is left alone; over RTU the CRC covers it, and every byte is fair game.
+timeout) and the client closes its end too: each frame is tried on a fresh link. Modbus TCP
+has no checksum: a changed register value inside a read's data is a well-formed answer, so
+over TCP the register data of a read is left alone; over RTU the CRC covers it, and every byte
+is fair game.
 """
 
 from __future__ import annotations
@@ -112,6 +113,7 @@ def run(framing: Framing, frames: int, seed: int) -> FuzzFigures:
                     outcome = "accepted"
                     if result is not None and result != expected:
                         figures.wrong_values += 1
+                client.close()  # the server hung up: the next frame on a fresh link
                 assert server.last is not None
                 correct, sent = server.last
                 figures.frames += 1

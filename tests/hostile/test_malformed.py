@@ -207,3 +207,12 @@ def test_lost_during_a_request(server: HostileServer, client: RobotClient) -> No
                                         r"during the read of registers 560\.\.583"):
         client.read_registers(*STATUS)
     assert client.read_registers(*STATUS) == [bank_value(a) for a in range(560, 584)]
+
+
+def test_a_link_closed_while_idle_is_reported_once(server: HostileServer, client: RobotClient) -> None:
+    server.push(lambda a: Reply(a.correct, close=True))
+    assert client.read_registers(*STATUS) == [bank_value(a) for a in range(560, 584)]
+    with pytest.raises(LinkError, match=r"^lost the connection to the controller at 127\.0\.0\.1:\d+"):
+        client.read_registers(*STATUS)  # the hang-up is seen before or during this request
+    assert client.read_registers(*STATUS) == [bank_value(a) for a in range(560, 584)]
+    assert (client.stats.link_errors, client.stats.reconnects) == (1, 1)
