@@ -501,6 +501,9 @@ def test_silent_controller_times_out(sim: Any, make_client: MakeClient) -> None:
     assert str(info.value) == f"controller did not answer within 0.2 s (127.0.0.1:{sim.port})"
     sim.set_silent(False)
     assert c.read_status().mode is ControllerMode.AUTO
+    stats = c.stats
+    assert (stats.requests, stats.answers, stats.timeouts, stats.resyncs, stats.reconnects) == (2, 1, 1, 1, 1)
+    assert stats.last_error == str(info.value)
 
 
 def test_dead_server_then_reconnect(sim_factory: Any, make_client: MakeClient) -> None:
