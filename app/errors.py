@@ -17,6 +17,21 @@ class ResponseTimeout(TeachPadError):
     """The controller did not answer a request in time."""
 
 
+class MalformedResponse(TeachPadError):
+    """The controller answered, but the answer does not match the request (never used as a value).
+
+    ``field`` names what was wrong ("function", "byte count", "CRC", ...); ``expected`` and
+    ``got`` are its values (None when the answer was cut short or had bytes too many).
+    """
+
+    def __init__(self, message: str, *, field: str = "", expected: object = None,
+                 got: object = None) -> None:
+        super().__init__(message)
+        self.field = field
+        self.expected = expected
+        self.got = got
+
+
 class ModbusExceptionError(TeachPadError):
     """The controller answered with a Modbus exception."""
 

@@ -19,6 +19,7 @@ from typing import Any
 
 from pymodbus.client import ModbusTcpClient
 
+from app.link import frames
 from app.link.client import ConnectionSettings, RobotClient
 from app.protocol import registers as R  # noqa: N812
 from app.protocol.codec import encode_floats
@@ -204,6 +205,22 @@ def bench_upload(sim: SimController, n: int) -> dict[str, Any]:
     }
 
 
+def bench_answer_check(n: int) -> dict[str, float]:
+    """Microseconds to check one answer against its request (pose block: 100 registers)."""
+    request = frames.read_request(R.POSE_BLOCK_START, R.POSE_BLOCK_COUNT)
+    pdu = bytes([3, 200]) + bytes(range(200))
+    tcp = struct.pack(">HHHB", 7, 0, len(pdu) + 1, 1) + pdu
+    rtu_body = bytes([1]) + pdu
+    rtu = rtu_body + frames.crc16(rtu_body).to_bytes(2, "big")
+    out: dict[str, float] = {}
+    for framing, frame, tid in (("tcp", tcp, 7), ("rtu", rtu, 0)):
+        t0 = time.perf_counter()
+        for _ in range(n):
+            assert frames.frame_need(framing, request, 1, tid, frame) == len(frame)  # type: ignore[arg-type]
+        out[f"{framing}_us"] = 1e6 * (time.perf_counter() - t0) / n
+    return out
+
+
 def run(quick: bool) -> dict[str, Any]:
     sim = SimController(SimConfig(host="127.0.0.1", port=0))
     sim.start()
@@ -221,6 +238,7 @@ def run(quick: bool) -> dict[str, Any]:
     finally:
         instant.stop()
     return {
+        "answer_check": bench_answer_check(2000 if quick else 20000),
         "monitor_cycle": monitor,
         "upload_points": upload,
         "upload_points_instant_controller": upload_instant,

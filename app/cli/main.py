@@ -5,7 +5,8 @@
 
 Exit codes: 0 success; 1 the command failed (refused by the controller, Modbus exception,
 command timeout, alarm, stopped, or blocked by --monitor-only); 2 usage (bad arguments or
-values, nothing sent); 3 link problem (cannot connect, no answer in time); 130 interrupted
+values, nothing sent); 3 link problem (cannot connect, no answer in time, malformed answer);
+130 interrupted
 (Ctrl-C; a motion that was under way is stopped first). Errors are one line on stderr.
 
 Adding subcommands: a *registrar* is a callable ``register(subparsers)`` that adds parsers to
@@ -36,6 +37,7 @@ from app.errors import (
     AlarmRaised,
     InvalidInput,
     LinkError,
+    MalformedResponse,
     ResponseTimeout,
     TeachPadError,
 )
@@ -289,11 +291,14 @@ def _sigint_deferred() -> Iterator[None]:
 
 
 def cmd_status(ctx: CliContext) -> int:
+    # Monitoring reads use the poll timeout: a silent controller is reported at once. A read
+    # that fails raises, so nothing is printed that was not read cleanly.
     client = ctx.client
-    status = client.read_status(with_clock=True)
-    pose = client.read_pose()
+    timeout = ctx.settings.effective_poll_timeout
+    status = client.read_status(with_clock=True, timeout=timeout)
+    pose = client.read_pose(timeout=timeout)
     if ctx.args.json:
-        ctx.print(json.dumps(status_to_dict(pose, status)))
+        ctx.print(json.dumps({**status_to_dict(pose, status), "link": client.stats.as_dict()}))
     else:
         ctx.print(format_status(pose, status))
     return EXIT_OK
@@ -307,9 +312,10 @@ def cmd_watch(ctx: CliContext) -> int:
     next_t = start
     n = 0
     try:
+        timeout = ctx.settings.effective_poll_timeout
         while count <= 0 or n < count:
-            status = client.read_status()
-            pose = client.read_pose()
+            status = client.read_status(timeout=timeout)
+            pose = client.read_pose(timeout=timeout)
             ctx.print(format_watch_line(time.monotonic() - start, pose, status))
             n += 1
             if count > 0 and n >= count:
@@ -588,7 +594,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG,
         description="Talk to a Bochuang robot controller over Modbus.",
-        epilog="exit codes: 0 ok, 1 command failed/refused, 2 usage, 3 link/timeout, 130 interrupted",
+        epilog="exit codes: 0 ok, 1 command failed/refused, 2 usage, 3 link/timeout/malformed answer, "
+               "130 interrupted",
     )
     link = parser.add_argument_group("link")
     link.add_argument("--host", default="127.0.0.1")
@@ -602,7 +609,10 @@ def build_parser() -> argparse.ArgumentParser:
     link.add_argument("--word-order", type=_word_order, default=WordOrder.LOW_FIRST,
                       metavar="low-first|high-first")
     link.add_argument("--timeout", type=_positive_float, default=1.0, metavar="SECONDS",
-                      help="Modbus request timeout")
+                      help="Modbus request timeout of commands and one-off reads")
+    link.add_argument("--poll-timeout", type=_positive_float, default=None, metavar="SECONDS",
+                      help="timeout of the monitoring reads of status and watch (default: 0.15 "
+                           "over TCP, by baud rate over RTU)")
     link.add_argument("--monitor-only", action="store_true", help="refuse every write")
     parser.add_argument("-v", "--verbose", action="store_true", help="log every write and the link")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -615,7 +625,7 @@ def settings_from_args(args: argparse.Namespace) -> ConnectionSettings:
     return ConnectionSettings(
         host=args.host, port=args.port, unit=args.unit, serial_port=args.rtu, baudrate=args.baud,
         parity=args.parity, framer=args.framer, word_order=args.word_order, timeout=args.timeout,
-        monitor_only=args.monitor_only,
+        poll_timeout=args.poll_timeout, monitor_only=args.monitor_only,
     )
 
 
@@ -645,7 +655,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return handler(ctx)
     except InvalidInput as exc:
         return fail(EXIT_USAGE, str(exc))
-    except (LinkError, ResponseTimeout) as exc:
+    except (LinkError, ResponseTimeout, MalformedResponse) as exc:
         return fail(EXIT_LINK, str(exc))
     except TeachPadError as exc:
         return fail(EXIT_FAILED, str(exc))

@@ -1,7 +1,9 @@
 """RobotClient: one method per controller operation, typed results, typed errors.
 
-The client owns one synchronous pymodbus client (TCP, RTU over serial, or RTU framing over
-TCP for tests) and is not thread-safe: one thread owns it (the GUI worker, or the CLI).
+The client speaks through one :class:`~app.link.transport.Transport` (TCP, RTU over serial, or
+RTU framing over TCP for tests), which checks every answer against its request and counts what
+the wire did (:attr:`RobotClient.stats`). Not thread-safe: one thread owns it (the GUI worker,
+or the CLI).
 
 Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
@@ -13,48 +15,63 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
   dropped whenever the connection is (re)made or fails, and by :meth:`invalidate_cache`.
 * Control registers 440-445 are written with 0x06 only; raw multi-register writes that touch
   them are refused (:class:`InvalidInput`).
-* A request that timed out closes the link (the next request reconnects), so a late answer
-  is never read as the next request's.
+* A request that timed out or got a malformed answer closes the link (the next request
+  reconnects), so a late answer is never read as the next request's.
 * Traffic observers are called synchronously in the client's thread, inside the request:
   keep them short (the GUI should only queue the record).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import enum
 import logging
 import math
 import time
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
-from typing import Any, Literal
-
-from pymodbus.client import ModbusSerialClient, ModbusTcpClient
-from pymodbus.exceptions import ConnectionException, ModbusException, ModbusIOException
-from pymodbus.framer import FramerType
 
 from app import timing
 from app.errors import (
     InvalidInput,
     LinkError,
+    MalformedResponse,
     ModbusExceptionError,
     ResponseTimeout,
     WriteBlocked,
 )
+from app.link.checks import (  # the command methods use the short private names
+    check_enum as _check_enum,
+)
+from app.link.checks import (
+    check_float as _check_float,
+)
+from app.link.checks import (
+    check_floats as _check_floats,
+)
+from app.link.checks import (
+    check_int as _check_int,
+)
+from app.link.checks import (
+    check_settings as _check_settings,
+)
+from app.link.checks import (
+    check_tool as _check_tool,
+)
+from app.link.checks import (
+    range_name as _range_name,
+)
+from app.link.decode import decode_pose, decode_status
 from app.link.stats import LinkStats
 from app.link.tracker import CommandTracker, command_text
+from app.link.transport import ConnectionSettings, TrafficObserver, TrafficRecord, Transport
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
-from app.protocol.codec import WordOrder, check_float32, decode_floats, encode_floats
-from app.protocol.datetime_regs import ControllerClock, DateTimeLayout, decode_clock
+from app.protocol.codec import decode_floats, encode_floats
+from app.protocol.datetime_regs import ControllerClock, decode_clock
 from app.protocol.enums import (
-    Alarm,
     CommandKind,
     CommandStatus,
     ControllerMode,
     ProgramMotionMode,
-    ProgramState,
     RunCommand,
     TeachFrame,
     WorkMode,
@@ -64,6 +81,7 @@ from app.protocol.enums import (
 
 __all__ = [
     "ConnectionSettings",
+    "LinkStats",
     "RobotClient",
     "StepFrame",
     "TrafficRecord",
@@ -76,24 +94,6 @@ _CONTROL_REGISTERS = range(registers.REG_RUN_COMMAND, registers.REG_GO_ZERO + 1)
 _MAX_REGISTER = 0xFFFF
 _GENERAL_POSE_LAST_START = registers.GV_GENERAL_LAST - 5  # six GVs must fit in GV0..GV99
 
-_MODBUS_EXCEPTION_TEXT: dict[int, str] = {
-    0x01: "illegal function",
-    0x02: "illegal data address",
-    0x03: "illegal data value",
-    0x04: "server device failure",
-    0x05: "acknowledge",
-    0x06: "server device busy",
-    0x07: "negative acknowledge",
-    0x08: "memory parity error",
-    0x0A: "gateway path unavailable",
-    0x0B: "gateway target device failed to respond",
-}
-
-
-def _seconds(value: float) -> str:
-    return str(round(value, 3))
-
-
 class StepFrame(enum.Enum):
     """Frame of an incremental move (function 1)."""
 
@@ -105,153 +105,10 @@ class StepFrame(enum.Enum):
         return RunCommand.STEP_JOINT if self is StepFrame.JOINT else RunCommand.STEP_BASE
 
 
-@dataclass
-class ConnectionSettings:
-    """How to reach the controller, and the host-side limits."""
-
-    host: str = "127.0.0.1"
-    port: int = 502
-    unit: int = 1
-    serial_port: str | None = None  # RTU over a serial line when set
-    baudrate: int = 115200
-    parity: str = "N"
-    stopbits: int = 1
-    bytesize: int = 8
-    framer: Literal["socket", "rtu"] = "socket"  # "rtu" over TCP is for tests
-    word_order: WordOrder = WordOrder.LOW_FIRST
-    timeout: float = timing.REQUEST_TIMEOUT  # commands and one-off reads
-    retries: int = timing.REQUEST_RETRIES
-    poll_timeout: float | None = None  # monitoring reads; None: follows the transport (below)
-    monitor_only: bool = False
-    datetime_layout: DateTimeLayout = DateTimeLayout.SPLIT_WORDS
-    point_id_min: int = registers.TEMP_POINT_ID_MIN
-    point_id_max: int = registers.TEMP_POINT_ID_MAX
-
-    @property
-    def transport(self) -> Literal["tcp", "rtu"]:
-        """What the frames look like on the wire."""
-        return "rtu" if self.serial_port is not None or self.framer == "rtu" else "tcp"
-
-    @property
-    def effective_poll_timeout(self) -> float:
-        """The timeout of a monitoring read: short, so a silent controller is seen at once.
-
-        TCP: :data:`timing.POLL_TIMEOUT_TCP`. RTU: the time the largest poll answer takes on the
-        wire at the configured baud rate (11 bits a byte), twice, plus
-        :data:`timing.POLL_TIMEOUT_RTU_MARGIN` (9600 baud: about 0.57 s; 115200: about 0.14 s).
-        """
-        if self.poll_timeout is not None:
-            return self.poll_timeout
-        if self.transport == "tcp" and self.serial_port is None:
-            return timing.POLL_TIMEOUT_TCP
-        frame_bytes = 5 + 2 * registers.POSE_BLOCK_COUNT  # unit, fc, count, data, CRC
-        return timing.POLL_TIMEOUT_RTU_MARGIN + 2 * frame_bytes * 11 / max(self.baudrate, 1)
-
-    @property
-    def endpoint(self) -> str:
-        """``host:port`` or the serial device, for messages."""
-        return self.serial_port if self.serial_port is not None else f"{self.host}:{self.port}"
-
-
-@dataclass(frozen=True, slots=True)
-class TrafficRecord:
-    """One frame as on the wire (MBAP included for TCP, CRC included for RTU)."""
-
-    t: float  # time.time() when the frame was sent / decoded
-    direction: Literal["tx", "rx"]
-    frame: bytes
-    transport: Literal["tcp", "rtu"]
-
-
-# --------------------------------------------------------------------------------------------
-# Input validation (before the wire)
-# --------------------------------------------------------------------------------------------
-
-
-def _check_int(value: object, lo: int, hi: int, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, int):
-        if isinstance(value, float) and value.is_integer():
-            value = int(value)
-        else:
-            raise InvalidInput(f"{name} must be an integer, got {value!r}")
-    if not lo <= value <= hi:
-        raise InvalidInput(f"{name} must be in {lo}..{hi}, got {value}")
-    return value
-
-
-def _check_float(value: object, name: str, lo: float | None = None, hi: float | None = None,
-                 *, lo_open: bool = False) -> float:
-    try:
-        number = check_float32(value, name)  # type: ignore[arg-type]
-    except ValueError as exc:
-        raise InvalidInput(str(exc)) from None
-    if lo is not None and (number < lo or (lo_open and number == lo)):
-        bound = f"> {lo:g}" if lo_open else f">= {lo:g}"
-        raise InvalidInput(f"{name} must be {bound}, got {number:g}")
-    if hi is not None and number > hi:
-        raise InvalidInput(f"{name} must be <= {hi:g}, got {number:g}")
-    return number
-
-
-def _check_floats(values: Sequence[float], count: int, name: str) -> list[float]:
-    if isinstance(values, (str, bytes)):
-        raise InvalidInput(f"{name} must be {count} numbers")
-    items = list(values)
-    if len(items) != count:
-        raise InvalidInput(f"{name} needs {count} values, got {len(items)}")
-    return [_check_float(v, f"{name}[{i}]") for i, v in enumerate(items)]
-
-
-def _check_enum(value: Any, enum_type: type[enum.IntEnum], name: str) -> Any:
-    try:
-        return enum_type(value)
-    except (ValueError, TypeError):
-        allowed = ", ".join(f"{m.name.lower()} ({m.value})" for m in enum_type)
-        raise InvalidInput(f"{name} must be one of {allowed}, got {value!r}") from None
-
-
-def _check_tool(tool: int) -> int:
-    # GV245: 200 = no tool frame, N = tool N+1.
-    return _check_int(tool, 0, registers.TOOL_NONE, "tool frame")
-
-
-def _gv_name(register: int) -> str:
-    n, half = registers.reg_to_gv(register)
-    return f"GV{n}_{half}"
-
-
-def _range_name(address: int, count: int) -> str:
-    last = address + count - 1
-    if count == 1:
-        return f"register {address} ({_gv_name(address)})"
-    if address % 2 == 0 and last % 2 == 1:
-        first_gv, last_gv = address // 2, last // 2
-        gvs = f"GV{first_gv}" if first_gv == last_gv else f"GV{first_gv}..GV{last_gv}"
-    else:
-        gvs = f"{_gv_name(address)}..{_gv_name(last)}"
-    return f"registers {address}..{last} ({gvs})"
-
-
-def _check_settings(s: ConnectionSettings) -> None:
-    _check_int(s.port, 1, 0xFFFF, "port")
-    _check_int(s.unit, 0, 247, "unit id")
-    _check_float(s.timeout, "timeout", 0.0, lo_open=True)
-    _check_int(s.retries, 0, 100, "retries")
-    if not isinstance(s.word_order, WordOrder):
-        raise InvalidInput(f"word order must be a WordOrder, got {s.word_order!r}")
-    if s.framer not in ("socket", "rtu"):
-        raise InvalidInput(f"framer must be socket or rtu, got {s.framer!r}")
-    if s.parity not in ("N", "E", "O"):
-        raise InvalidInput(f"parity must be N, E or O, got {s.parity!r}")
-    if not s.point_id_min <= s.point_id_max:
-        raise InvalidInput("point_id_min must not exceed point_id_max")
-
-
 # --------------------------------------------------------------------------------------------
 # The client
 # --------------------------------------------------------------------------------------------
 
-TrafficObserver = Callable[[TrafficRecord], None]
 ProgressCallback = Callable[[int, int], bool]
 
 
@@ -261,10 +118,7 @@ class RobotClient:
     def __init__(self, settings: ConnectionSettings) -> None:
         _check_settings(settings)
         self.settings = settings
-        self._observers: list[TrafficObserver] = []
-        self._observing = False  # checked first on the hot path
-        self._rx_buffer = b""
-        self._mb: Any = self._make_modbus_client()
+        self._transport = Transport(settings, on_link_change=self.invalidate_cache)
         self._tool_cache: int | None = None
         self._user_frame_cache: int | None = None
         self._ext_cache: tuple[float, ...] | None = None
@@ -273,38 +127,18 @@ class RobotClient:
         self.last_status: ControllerStatus | None = None
         self.last_tracker: CommandTracker | None = None
         self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
-        self._stats = LinkStats()
 
-    # -- connection ----------------------------------------------------------------------
-    def _make_modbus_client(self) -> Any:
-        s = self.settings
-        common: dict[str, Any] = {
-            "timeout": s.timeout,
-            "retries": s.retries,
-            "trace_packet": self._trace_packet,
-            "trace_pdu": self._trace_pdu,
-        }
-        if s.serial_port is not None:
-            return ModbusSerialClient(
-                s.serial_port, framer=FramerType.RTU, baudrate=s.baudrate, parity=s.parity,
-                stopbits=s.stopbits, bytesize=s.bytesize, **common,
-            )
-        framer = FramerType.RTU if s.framer == "rtu" else FramerType.SOCKET
-        return ModbusTcpClient(s.host, port=s.port, framer=framer, **common)
-
+    # -- connection (the transport drops the caches whenever the link is made or lost) ---
     def connect(self) -> None:
-        """Open the link; raises :class:`LinkError` when the controller cannot be reached."""
-        self.invalidate_cache()
-        if not self._mb.connect():
-            raise LinkError(f"cannot connect to the controller at {self.settings.endpoint}")
+        """Open the link; :class:`LinkError` naming the cause when the controller cannot be reached."""
+        self._transport.open()
 
     def close(self) -> None:
-        self._mb.close()
-        self.invalidate_cache()
+        self._transport.close()
 
     @property
     def connected(self) -> bool:
-        return bool(self._mb.connected)
+        return self._transport.connected
 
     def __enter__(self) -> RobotClient:
         self.connect()
@@ -322,114 +156,18 @@ class RobotClient:
     @property
     def stats(self) -> LinkStats:
         """The link's counters so far (a snapshot)."""
-        return self._stats
-
-    def _count(self, field: str, error: str | None = None) -> None:
-        changes: dict[str, int | str] = {field: getattr(self._stats, field) + 1}
-        if error is not None:
-            changes["last_error"] = error
-        self._stats = dataclasses.replace(self._stats, **changes)  # type: ignore[arg-type]
+        return self._transport.stats
 
     # -- observers -----------------------------------------------------------------------
     def add_observer(self, cb: TrafficObserver) -> None:
-        self._observers.append(cb)
-        self._observing = True
+        self._transport.add_observer(cb)
 
     def remove_observer(self, cb: TrafficObserver) -> None:
-        if cb in self._observers:
-            self._observers.remove(cb)
-        self._observing = bool(self._observers)
+        self._transport.remove_observer(cb)
 
-    def _emit(self, direction: Literal["tx", "rx"], frame: bytes) -> None:
-        record = TrafficRecord(time.time(), direction, bytes(frame), self.settings.transport)
-        for cb in list(self._observers):
-            try:
-                cb(record)
-            except Exception:  # an observer must not break the link
-                _log.exception("traffic observer %r failed", cb)
-
-    def _trace_packet(self, sending: bool, data: bytes) -> bytes:
-        if not self._observing:
-            return data
-        if sending:
-            self._emit("tx", data)
-        else:
-            self._rx_buffer = data  # may be partial; emitted once a PDU is decoded from it
-        return data
-
-    def _trace_pdu(self, sending: bool, pdu: Any) -> Any:
-        if not self._observing or sending:
-            return pdu
-        buffer, self._rx_buffer = self._rx_buffer, b""
-        if buffer:
-            # The buffer may start with a late frame of an earlier request: keep the tail that
-            # is this PDU's frame (MBAP 7 + fc + data for TCP; unit + fc + data + CRC for RTU).
-            body = 1 + len(pdu.encode())
-            size = body + (7 if self.settings.transport == "tcp" else 3)
-            self._emit("rx", buffer[-size:] if len(buffer) > size else buffer)
-        return pdu
-
-    # -- the one place that talks to pymodbus --------------------------------------------
-    def _call(self, what: str, method: Callable[..., Any], *args: Any, timeout: float | None = None,
-              **kwargs: Any) -> Any:
-        was_connected = bool(self._mb.connected)
-        if not was_connected:
-            self.invalidate_cache()  # a new connection may mean a restarted controller
-        params = self._mb.comm_params
-        saved_timeout = params.timeout_connect
-        if timeout is not None:
-            params.timeout_connect = timeout  # pymodbus reads it per receive
-        self._count("requests")
-        try:
-            response = method(*args, device_id=self.settings.unit, **kwargs)
-        except ConnectionException as exc:
-            self.invalidate_cache()
-            self._mb.close()
-            verb = "lost the connection to" if was_connected else "cannot connect to"
-            message = f"{verb} the controller at {self.settings.endpoint}"
-            self._count("link_errors", message)
-            raise LinkError(message) from exc
-        except ModbusIOException as exc:
-            # A late answer would be read as the next request's: start again on a fresh link.
-            self.invalidate_cache()
-            self._mb.close()
-            total = (timeout or self.settings.timeout) * (self.settings.retries + 1)
-            message = f"controller did not answer within {_seconds(total)} s ({self.settings.endpoint})"
-            self._count("timeouts", message)
-            self._count("resyncs")
-            raise ResponseTimeout(message) from exc
-        except ModbusException as exc:
-            self.invalidate_cache()
-            raise LinkError(f"Modbus link error with {self.settings.endpoint}: {exc}") from exc
-        except OSError as exc:
-            self.invalidate_cache()
-            self._mb.close()
-            raise LinkError(f"link error with {self.settings.endpoint}: {exc}") from exc
-        finally:
-            params.timeout_connect = saved_timeout
-        if response is None:
-            raise ResponseTimeout(f"controller did not answer ({self.settings.endpoint})")
-        if response.isError():
-            code = int(getattr(response, "exception_code", 0))
-            text = _MODBUS_EXCEPTION_TEXT.get(code, f"exception code {code}")
-            message = f"controller refused {what}: {text}"
-            self._count("exceptions", message)
-            raise ModbusExceptionError(int(response.function_code) & 0x7F, code, message)
-        self._count("answers")
-        return response
-
+    # -- the transport: every answer is checked against its request ----------------------
     def _read(self, address: int, count: int, timeout: float | None = None) -> list[int]:
-        response = self._call(
-            f"read of {_range_name(address, count)}", self._mb.read_holding_registers,
-            address, count=count, timeout=timeout,
-        )
-        regs = [int(r) & 0xFFFF for r in response.registers]
-        if len(regs) < count:
-            raise ResponseTimeout(
-                f"controller answered {len(regs)} of {count} registers from {address} "
-                f"({self.settings.endpoint})"
-            )
-        return regs[:count]
+        return self._transport.read(f"read of {_range_name(address, count)}", address, count, timeout)
 
     def _require_writable(self, what: str) -> None:
         if self.settings.monitor_only:
@@ -446,11 +184,11 @@ class RobotClient:
                 raise InvalidInput("a single-register write takes one value")
             _log.debug("write 0x06 %s <- %d", name, values[0])
             self.write_count += 1
-            self._call(f"write to {name}", self._mb.write_register, address, int(values[0]))
+            self._transport.write_single(f"write to {name}", address, int(values[0]))
         else:
             _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
             self.write_count += 1
-            self._call(f"write to {name}", self._mb.write_registers, address, [int(v) for v in values])
+            self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values])
 
     def _write_floats(self, gv: int, values: Sequence[float]) -> None:
         self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order))
@@ -510,45 +248,15 @@ class RobotClient:
         ``timeout`` overrides the request timeout (the poller passes the poll timeout).
         """
         regs = self._read(registers.POSE_BLOCK_START, registers.POSE_BLOCK_COUNT, timeout)
-        order = self.settings.word_order
-
-        def gvs(gv: int, count: int) -> list[float]:
-            start = registers.gv_reg(gv) - registers.POSE_BLOCK_START
-            return decode_floats(regs[start : start + 2 * count], order)
-
-        x, y, z, a, b, c = gvs(registers.GV_POSE, 6)
-        e = gvs(registers.GV_EXT_AXES, registers.NUM_EXTERNAL_AXES)
-        joints = tuple(gvs(registers.GV_JOINTS, registers.NUM_ROBOT_AXES))
-        return Pose(x, y, z, a, b, c, ext=(e[0], e[1], e[2], e[3], e[4]), joints=joints)
+        return decode_pose(regs, self.settings.word_order)
 
     def read_status(self, with_clock: bool = False, *, timeout: float | None = None) -> ControllerStatus:
         """Table 2 (560..583) in one FC03; the clock (576..579) comes from the same block."""
         regs = self._read(registers.STATUS_BLOCK_START, registers.STATUS_BLOCK_COUNT, timeout)
-        status = self._decode_status(regs, with_clock)
+        status = decode_status(regs, self.settings.word_order,
+                               self.settings.datetime_layout if with_clock else None)
         self.last_status = status
         return status
-
-    def _decode_status(self, regs: Sequence[int], with_clock: bool) -> ControllerStatus:
-        base = registers.STATUS_BLOCK_START
-        mode_raw = regs[registers.REG_CONTROLLER_MODE - base]
-        state_raw = regs[registers.REG_PROGRAM_STATE - base]
-        mode: ControllerMode | int
-        state: ProgramState | int
-        try:
-            mode = ControllerMode(mode_raw)
-        except ValueError:
-            mode = mode_raw
-        try:
-            state = ProgramState(state_raw)
-        except ValueError:
-            state = state_raw
-        st = registers.gv_reg(registers.GV_COMMAND_STATUS) - base
-        code = decode_status_registers(regs[st : st + 2], self.settings.word_order)
-        clock = None
-        if with_clock:
-            cs = registers.gv_reg(registers.GV_DATE) - base
-            clock = decode_clock(regs[cs : cs + 4], self.settings.datetime_layout)
-        return ControllerStatus(mode, state, Alarm(regs[registers.REG_ALARMS - base]), code, clock)
 
     def read_clock(self) -> ControllerClock:
         return decode_clock(self._read(registers.gv_reg(registers.GV_DATE), 4), self.settings.datetime_layout)
@@ -748,7 +456,7 @@ class RobotClient:
                 tracker = self.begin_command(RunCommand.CREATE_POINT, status, None)
                 result = self.wait(tracker, raise_errors=False)
                 status = tracker.last_status or status
-            except (LinkError, ResponseTimeout, ModbusExceptionError) as exc:
+            except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
                 results.append(CommandResult(RunCommand.CREATE_POINT, kind, None, False, str(exc),
                                              {"point_id": float(point_id)}))
                 break

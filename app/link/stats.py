@@ -18,6 +18,7 @@ class LinkStats:
     exceptions: int = 0  # Modbus exception answers
     link_errors: int = 0  # connection refused / lost / OS errors
     resyncs: int = 0  # times the link was dropped and reopened (or flushed) to get back in step
+    reconnects: int = 0  # times the link was opened again after its first connection
     last_error: str = ""
 
     def as_dict(self) -> dict[str, int | str]:

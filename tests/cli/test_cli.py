@@ -257,9 +257,10 @@ def test_link_errors_exit_3(sim: Any, capsys: pytest.CaptureFixture[str]) -> Non
     code = main(["--port", str(free), "--timeout", "0.3", "status"])
     _, err = capsys.readouterr()
     assert code == EXIT_LINK
-    assert one_line_error(err) == f"teachpad-cli: error: cannot connect to the controller at 127.0.0.1:{free}"
+    assert one_line_error(err) == (f"teachpad-cli: error: cannot connect to the controller at "
+                                   f"127.0.0.1:{free}: connection refused")
     sim.set_silent(True)
-    code, _, err = run(sim, capsys, "--timeout", "0.2", "status", "--json")
+    code, _, err = run(sim, capsys, "--poll-timeout", "0.2", "status", "--json")
     assert code == EXIT_LINK
     assert one_line_error(err) == (f"teachpad-cli: error: controller did not answer within 0.2 s "
                                    f"(127.0.0.1:{sim.port})")

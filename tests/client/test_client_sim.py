@@ -501,6 +501,9 @@ def test_silent_controller_times_out(sim: Any, make_client: MakeClient) -> None:
     assert str(info.value) == f"controller did not answer within 0.2 s (127.0.0.1:{sim.port})"
     sim.set_silent(False)
     assert c.read_status().mode is ControllerMode.AUTO
+    stats = c.stats
+    assert (stats.requests, stats.answers, stats.timeouts, stats.resyncs, stats.reconnects) == (2, 1, 1, 1, 1)
+    assert stats.last_error == str(info.value)
 
 
 def test_dead_server_then_reconnect(sim_factory: Any, make_client: MakeClient) -> None:
@@ -511,7 +514,8 @@ def test_dead_server_then_reconnect(sim_factory: Any, make_client: MakeClient) -
     sim.stop()
     with pytest.raises(LinkError):
         c.read_status()
-    with pytest.raises(LinkError, match=rf"cannot connect to the controller at 127\.0\.0\.1:{port}$"):
+    with pytest.raises(LinkError, match=rf"^cannot reconnect to the controller at 127\.0\.0\.1:{port} "
+                                        r"\(the link was lost\): connection refused$"):
         c.read_status()
     assert not c.connected
     sim2 = sim_factory(port=port, command_latency=SCAN)
@@ -538,7 +542,8 @@ def test_connect_failure(make_client: MakeClient) -> None:
         config = type("C", (), {"framer": "socket", "word_order": WordOrder.LOW_FIRST})
 
     c = make_client(Dead(), connect=False, timeout=0.3)
-    with pytest.raises(LinkError, match=r"cannot connect to the controller at 127\.0\.0\.1:1$"):
+    with pytest.raises(LinkError, match=r"^cannot connect to the controller at 127\.0\.0\.1:1: "
+                                        r"connection refused$"):
         c.connect()
 
 
@@ -565,7 +570,7 @@ def test_observer_sees_the_seed_frames(sim: Any, make_client: MakeClient) -> Non
     def boom(*args: object) -> None:
         raise AssertionError("a record was built with nobody observing")
 
-    c._emit = boom  # type: ignore[method-assign]
+    c._transport._emit = boom  # type: ignore[method-assign]
     c.read_status()
     c.write_gv(200, [1.0])
     assert records == []

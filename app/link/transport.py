@@ -1,0 +1,443 @@
+"""The link to the controller: connection, one request at a time, every answer checked.
+
+:class:`Transport` sends a request built with pymodbus's framers and reads its answer itself,
+checking each field as it arrives (:func:`app.link.frames.frame_need`): transaction and
+protocol id, unit id, function code (or its exception), byte count, exact length, the write's
+echo, the RTU CRC. Why not pymodbus's own sync transaction: it decodes the answer by the
+answer's function code (an 0x04 answer to an 0x03 read became registers), silently skips frames
+of another unit/transaction until the timeout (a wrong answer looked like silence), ignores
+byte counts and echoes, and leaves stray bytes in the socket for the next request.
+
+Outcomes of a request: a checked answer; :class:`ModbusExceptionError` (a well-formed exception
+answer); :class:`MalformedResponse` (anything else that arrived, including an answer cut short
+or with bytes too many); :class:`ResponseTimeout` (silence); :class:`LinkError` (no link).
+After a malformed answer or a timeout the link resynchronises: a TCP link is dropped (the next
+request reopens it, so a late or garbled tail is never read as the next answer); a serial line
+has its input flushed. Before every request, bytes that arrived unasked (stray bytes after a
+good answer) are flushed, so they cannot poison the next answer.
+
+Not thread-safe: one thread owns a transport. Traffic observers are called synchronously in
+that thread, inside the request: keep them short.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import select
+import socket
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from app import timing
+from app.errors import (
+    LinkError,
+    MalformedResponse,
+    ModbusExceptionError,
+    ResponseTimeout,
+)
+from app.link import frames
+from app.link.frames import Request
+from app.link.stats import LinkStats
+from app.protocol import registers
+from app.protocol.codec import WordOrder
+from app.protocol.datetime_regs import DateTimeLayout
+
+__all__ = ["ConnectionSettings", "TrafficObserver", "TrafficRecord", "Transport"]
+
+_log = logging.getLogger(__name__)
+
+SIMULATOR_PORT = 5020  # the simulator's default port, hinted when 502 refuses
+_RECV_SIZE = 4096
+
+_MODBUS_EXCEPTION_TEXT: dict[int, str] = {
+    0x01: "illegal function",
+    0x02: "illegal data address",
+    0x03: "illegal data value",
+    0x04: "server device failure",
+    0x05: "acknowledge",
+    0x06: "server device busy",
+    0x07: "negative acknowledge",
+    0x08: "memory parity error",
+    0x0A: "gateway path unavailable",
+    0x0B: "gateway target device failed to respond",
+}
+
+
+def _seconds(value: float) -> str:
+    return str(round(value, 3))
+
+
+@dataclass
+class ConnectionSettings:
+    """How to reach the controller, and the host-side limits."""
+
+    host: str = "127.0.0.1"
+    port: int = 502
+    unit: int = 1
+    serial_port: str | None = None  # RTU over a serial line when set
+    baudrate: int = 115200
+    parity: str = "N"
+    stopbits: int = 1
+    bytesize: int = 8
+    framer: Literal["socket", "rtu"] = "socket"  # "rtu" over TCP is for tests
+    word_order: WordOrder = WordOrder.LOW_FIRST
+    timeout: float = timing.REQUEST_TIMEOUT  # commands and one-off reads
+    retries: int = timing.REQUEST_RETRIES
+    poll_timeout: float | None = None  # monitoring reads; None: follows the transport (below)
+    monitor_only: bool = False
+    datetime_layout: DateTimeLayout = DateTimeLayout.SPLIT_WORDS
+    point_id_min: int = registers.TEMP_POINT_ID_MIN
+    point_id_max: int = registers.TEMP_POINT_ID_MAX
+
+    @property
+    def transport(self) -> Literal["tcp", "rtu"]:
+        """What the frames look like on the wire."""
+        return "rtu" if self.serial_port is not None or self.framer == "rtu" else "tcp"
+
+    @property
+    def effective_poll_timeout(self) -> float:
+        """The timeout of a monitoring read: short, so a silent controller is seen at once.
+
+        TCP: :data:`timing.POLL_TIMEOUT_TCP`. RTU: the time the largest poll answer takes on the
+        wire at the configured baud rate (11 bits a byte), twice, plus
+        :data:`timing.POLL_TIMEOUT_RTU_MARGIN` (9600 baud: about 0.57 s; 115200: about 0.14 s).
+        """
+        if self.poll_timeout is not None:
+            return self.poll_timeout
+        if self.transport == "tcp" and self.serial_port is None:
+            return timing.POLL_TIMEOUT_TCP
+        frame_bytes = 5 + 2 * registers.POSE_BLOCK_COUNT  # unit, fc, count, data, CRC
+        return timing.POLL_TIMEOUT_RTU_MARGIN + 2 * frame_bytes * 11 / max(self.baudrate, 1)
+
+    @property
+    def endpoint(self) -> str:
+        """``host:port`` or the serial device, for messages."""
+        return self.serial_port if self.serial_port is not None else f"{self.host}:{self.port}"
+
+
+@dataclass(frozen=True, slots=True)
+class TrafficRecord:
+    """One frame as on the wire (MBAP included for TCP, CRC included for RTU)."""
+
+    t: float  # time.time() when the frame was sent / received
+    direction: Literal["tx", "rx"]
+    frame: bytes
+    transport: Literal["tcp", "rtu"]
+
+
+TrafficObserver = Callable[[TrafficRecord], None]
+
+
+class _PeerClosed(Exception):
+    """The other end closed the byte stream."""
+
+
+# --------------------------------------------------------------------------------------------
+# Byte streams: a TCP socket or a serial line
+# --------------------------------------------------------------------------------------------
+
+
+class _TcpStream:
+    def __init__(self, settings: ConnectionSettings) -> None:
+        self._settings = settings
+        self._sock: socket.socket | None = None
+
+    @property
+    def is_open(self) -> bool:
+        return self._sock is not None
+
+    def open(self, timeout: float) -> None:
+        s = self._settings
+        try:
+            sock = socket.create_connection((s.host, s.port), timeout=timeout)
+        except socket.gaierror:
+            raise LinkError(f"the host name {s.host[:60]!r} cannot be resolved") from None
+        except ConnectionRefusedError:
+            hint = (f" (nothing listens on port 502; the simulator's port is {SIMULATOR_PORT})"
+                    if s.port == 502 else "")
+            raise LinkError(f"connection refused{hint}") from None
+        except TimeoutError:
+            raise LinkError(f"no answer to the connection request within {_seconds(timeout)} s"
+                            ) from None
+        except OSError as exc:
+            raise LinkError(str(exc.strerror or exc).lower()) from None
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._sock = sock
+
+    def close(self) -> None:
+        if self._sock is not None:
+            try:
+                self._sock.close()
+            finally:
+                self._sock = None
+
+    def send(self, data: bytes) -> None:
+        assert self._sock is not None
+        self._sock.settimeout(None)
+        self._sock.sendall(data)
+
+    def recv(self, timeout: float) -> bytes:
+        """Whatever arrives within ``timeout`` (b"" for nothing); _PeerClosed at end of stream."""
+        assert self._sock is not None
+        self._sock.settimeout(max(timeout, 1e-4))
+        try:
+            data = self._sock.recv(_RECV_SIZE)
+        except TimeoutError:
+            return b""
+        if not data:
+            raise _PeerClosed
+        return data
+
+    def drain(self) -> int:
+        """Drop the bytes already waiting; their count. _PeerClosed when the peer hung up."""
+        assert self._sock is not None
+        dropped = 0
+        while select.select([self._sock], [], [], 0)[0]:
+            data = self._sock.recv(_RECV_SIZE)
+            if not data:
+                raise _PeerClosed
+            dropped += len(data)
+        return dropped
+
+
+class _SerialStream:
+    """RTU over a serial line (pyserial, which pymodbus[serial] brings)."""
+
+    def __init__(self, settings: ConnectionSettings) -> None:
+        self._settings = settings
+        self._port: Any = None
+
+    @property
+    def is_open(self) -> bool:
+        return self._port is not None
+
+    def open(self, timeout: float) -> None:
+        import serial
+
+        s = self._settings
+        try:
+            self._port = serial.Serial(s.serial_port, baudrate=s.baudrate, parity=s.parity,
+                                       stopbits=s.stopbits, bytesize=s.bytesize, timeout=timeout,
+                                       exclusive=True)
+        except (serial.SerialException, OSError, ValueError) as exc:
+            raise LinkError(f"cannot open the serial port: {exc}") from None
+
+    def close(self) -> None:
+        if self._port is not None:
+            try:
+                self._port.close()
+            finally:
+                self._port = None
+
+    def send(self, data: bytes) -> None:
+        self._port.write(data)
+        self._port.flush()
+
+    def recv(self, timeout: float) -> bytes:
+        self._port.timeout = max(timeout, 1e-4)
+        return bytes(self._port.read(max(1, self._port.in_waiting)))
+
+    def drain(self) -> int:
+        waiting = int(self._port.in_waiting)
+        self._port.reset_input_buffer()
+        return waiting
+
+
+# --------------------------------------------------------------------------------------------
+# The transport
+# --------------------------------------------------------------------------------------------
+
+
+class Transport:
+    """One request at a time over one link; every answer checked against its request."""
+
+    def __init__(self, settings: ConnectionSettings,
+                 on_link_change: Callable[[], None] | None = None) -> None:
+        self.settings = settings
+        self.framing: frames.Framing = settings.transport
+        self._stream: _TcpStream | _SerialStream = (
+            _SerialStream(settings) if settings.serial_port is not None else _TcpStream(settings))
+        self._on_link_change = on_link_change or (lambda: None)
+        self._observers: list[TrafficObserver] = []
+        self._observing = False  # checked first on the hot path
+        self._tid = 0
+        self._ever_connected = False
+        self._stats = LinkStats()
+
+    # -- statistics -----------------------------------------------------------------------
+    @property
+    def stats(self) -> LinkStats:
+        return self._stats
+
+    def _count(self, field: str, error: str | None = None) -> None:
+        changes: dict[str, Any] = {field: getattr(self._stats, field) + 1}
+        if error is not None:
+            changes["last_error"] = error
+        self._stats = dataclasses.replace(self._stats, **changes)
+
+    # -- connection -----------------------------------------------------------------------
+    @property
+    def connected(self) -> bool:
+        return self._stream.is_open
+
+    def open(self) -> None:
+        """Open the link (no-op when open); :class:`LinkError` naming the cause when it fails."""
+        if self._stream.is_open:
+            return
+        self._on_link_change()  # a new connection may mean a restarted controller
+        try:
+            self._stream.open(self.settings.timeout)
+        except LinkError as exc:
+            endpoint = self.settings.endpoint
+            message = (f"cannot reconnect to the controller at {endpoint} (the link was lost): {exc}"
+                       if self._ever_connected
+                       else f"cannot connect to the controller at {endpoint}: {exc}")
+            self._count("link_errors", message)
+            raise LinkError(message) from None
+        if self._ever_connected:
+            self._count("reconnects")
+        self._ever_connected = True
+
+    def close(self) -> None:
+        self._stream.close()
+        self._on_link_change()
+
+    def _resync(self, why: str) -> None:
+        """Get back in step after a malformed answer or a timeout."""
+        self._count("resyncs")
+        _log.debug("resync after %s", why)
+        if isinstance(self._stream, _SerialStream) and self._stream.is_open:
+            self._stream.drain()
+        else:
+            self.close()
+
+    # -- observers ------------------------------------------------------------------------
+    def add_observer(self, cb: TrafficObserver) -> None:
+        self._observers.append(cb)
+        self._observing = True
+
+    def remove_observer(self, cb: TrafficObserver) -> None:
+        if cb in self._observers:
+            self._observers.remove(cb)
+        self._observing = bool(self._observers)
+
+    def _emit(self, direction: Literal["tx", "rx"], frame: bytes) -> None:
+        record = TrafficRecord(time.time(), direction, bytes(frame), self.framing)
+        for cb in list(self._observers):
+            try:
+                cb(record)
+            except Exception:  # an observer must not break the link
+                _log.exception("traffic observer %r failed", cb)
+
+    # -- requests -------------------------------------------------------------------------
+    def read(self, what: str, address: int, count: int, timeout: float | None = None) -> list[int]:
+        """0x03: exactly ``count`` registers."""
+        _, data = self.execute(what, frames.read_request(address, count), timeout)
+        return [(data[i] << 8) | data[i + 1] for i in range(1, 1 + 2 * count, 2)]
+
+    def write_single(self, what: str, address: int, value: int) -> None:
+        self.execute(what, frames.write_single_request(address, value))
+
+    def write_multiple(self, what: str, address: int, values: Sequence[int]) -> None:
+        self.execute(what, frames.write_multiple_request(address, values))
+
+    def execute(self, what: str, request: Request, timeout: float | None = None) -> tuple[int, bytes]:
+        """Send ``request``; its checked answer as (function code, data)."""
+        timeout = self.settings.timeout if timeout is None else timeout
+        attempts = self.settings.retries + 1
+        for attempt in range(attempts):
+            try:
+                return self._exchange(what, request, timeout)
+            except ResponseTimeout:
+                if attempt + 1 == attempts:
+                    message = (f"controller did not answer within {_seconds(timeout * attempts)} s "
+                               f"({self.settings.endpoint})")
+                    self._stats = dataclasses.replace(self._stats, last_error=message)
+                    raise ResponseTimeout(message) from None
+        raise AssertionError("unreachable")  # pragma: no cover
+
+    def _flush_stray(self) -> None:
+        try:
+            dropped = self._stream.drain()
+        except (_PeerClosed, OSError):
+            # The controller closed the idle link (restart, its own timeout): say so once; the
+            # next request opens a fresh link.
+            self.close()
+            message = f"lost the connection to the controller at {self.settings.endpoint}: it closed the link"
+            self._count("link_errors", message)
+            raise LinkError(message) from None
+        if dropped:
+            self._count("resyncs", f"dropped {dropped} stray bytes from {self.settings.endpoint}")
+
+    def _lost(self, what: str) -> LinkError:
+        self.close()
+        message = f"lost the connection to the controller at {self.settings.endpoint} during the {what}"
+        self._count("link_errors", message)
+        return LinkError(message)
+
+    def _exchange(self, what: str, request: Request, timeout: float) -> tuple[int, bytes]:
+        self.open()
+        self._flush_stray()
+        unit = self.settings.unit
+        self._tid = self._tid % 65000 + 1 if self.framing == "tcp" else 0
+        tid = self._tid
+        frame = frames.encode_request(self.framing, request, unit, tid)
+        self._count("requests")
+        try:
+            self._stream.send(frame)
+        except OSError:
+            raise self._lost(what) from None
+        if self._observing:
+            self._emit("tx", frame)
+        buf = b""
+        deadline = time.monotonic() + timeout
+        try:
+            while True:
+                need = frames.frame_need(self.framing, request, unit, tid, buf)
+                if len(buf) >= need:
+                    break
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    if not buf:
+                        self._count("timeouts", f"no answer to the {what}")
+                        self._resync("a timeout")
+                        raise ResponseTimeout(f"no answer to the {what}")
+                    raise MalformedResponse(
+                        f"answer cut short: {len(buf)} of {need} bytes within {_seconds(timeout)} s",
+                        field="length", expected=need, got=len(buf))
+                try:
+                    buf += self._stream.recv(remaining)
+                except _PeerClosed:
+                    if not buf:
+                        raise self._lost(what) from None
+                    raise MalformedResponse(
+                        f"answer cut short: the controller closed the link after {len(buf)} of "
+                        f"{need} bytes", field="length", expected=need, got=len(buf)) from None
+                except OSError:
+                    raise self._lost(what) from None
+            if len(buf) > need:
+                raise MalformedResponse(f"{len(buf) - need} bytes more than the {need}-byte answer",
+                                        field="length", expected=need, got=len(buf))
+        except MalformedResponse as exc:
+            if self._observing and buf:
+                self._emit("rx", buf)
+            message = (f"malformed answer to the {what} from {self.settings.endpoint}: "
+                       f"{str(exc)[:200]}")
+            self._count("malformed", message)
+            self._resync("a malformed answer")
+            raise MalformedResponse(message, field=exc.field, expected=exc.expected,
+                                    got=exc.got) from None
+        if self._observing:
+            self._emit("rx", buf)
+        function, data = frames.decode_answer(self.framing, buf)
+        if function & 0x80:
+            code = data[0]
+            text = _MODBUS_EXCEPTION_TEXT.get(code, f"exception code {code}")
+            message = f"controller refused {what}: {text}"
+            self._count("exceptions", message)
+            raise ModbusExceptionError(function & 0x7F, code, message)
+        self._count("answers")
+        return function, data
