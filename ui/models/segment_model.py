@@ -83,7 +83,7 @@ class SegmentTableModel(UndoableListModel):
     def __init__(self, undo_stack: QUndoStack, ledger: PointLedger | None = None, parent: Any = None) -> None:
         super().__init__(undo_stack, parent)
         self._plan: Plan | None = None
-        self._ledger = ledger or PointLedger()
+        self._ledger = ledger if ledger is not None else PointLedger()  # an empty ledger is falsy
         self._issues: dict[int, list[PlanIssue]] = {}
         self._lengths: np.ndarray = np.empty(0)
         self._times: np.ndarray = np.empty(0)

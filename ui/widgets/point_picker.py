@@ -47,7 +47,8 @@ def parse_choice(text: str) -> int | None:
 class PointPicker(QComboBox):
     """An editable, searchable combo box of the existing points (see the module docstring)."""
 
-    def __init__(self, ledger: PointLedger, parent: QWidget | None = None, *, allow_blank: bool = False) -> None:
+    def __init__(self, ledger: PointLedger, parent: QWidget | None = None, *,
+                 allow_blank: bool = False) -> None:
         super().__init__(parent)
         self.setObjectName("PointPicker")
         self.setEditable(True)
