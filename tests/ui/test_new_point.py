@@ -43,4 +43,5 @@ def test_add_follows_the_freshness_of_a_real_link(qtbot: Any, link: RobotLink, s
     panel.action_add.trigger()
     copied = model.ledger[1]
     assert copied.xyzabc == model.ledger[0].xyzabc
-    assert "no live pose" in panel.status.text() and f"copied from P{model.ledger[0].id}" in panel.status.text()
+    text = panel.status.text()
+    assert "no live pose" in text and f"copied from P{model.ledger[0].id}" in text
