@@ -389,7 +389,7 @@ class MainWindow(QMainWindow):
     @Slot()
     def open_connection_dialog(self) -> None:
         self.jog_panel.release_all()
-        dialog = ConnectionDialog(self.settings.connection(), self)
+        dialog = ConnectionDialog.for_link(self.link, self.settings.connection(), self.settings.poll_hz, self)
         if dialog.exec() == ConnectionDialog.DialogCode.Accepted:
             self.connect_with(dialog.settings())
 

@@ -209,6 +209,19 @@ class PanelState:
     has_sync: bool  # a point uploader is attached
     sync_busy: bool
     uploading: bool
+    check_errors: int = 0  # errors the plan's checks found (warnings do not count)
+    first_error: str = ""  # the first of them, quoted in Run's tooltip
+
+
+class RunBlocker(enum.Enum):
+    """Why Run (and Run from here, Step) is disabled; the widget words it as Run's tooltip."""
+
+    NONE = "none"
+    NO_LINK = "no link"
+    RUNNING = "running"
+    NO_SEGMENTS = "no segments"
+    SYNC_BUSY = "sync busy"
+    CHECKS = "checks"  # the plan's checks found errors
 
 
 @dataclass(frozen=True)
@@ -229,12 +242,31 @@ class ActionStates:
     resume_from: bool
     upload_now: bool
     resume_from_visible: bool
+    run_blocker: RunBlocker = RunBlocker.NONE  # why ``run`` is False
+    first_error: str = ""  # the checks' first error when ``run_blocker`` is CHECKS
+
+
+def run_blocker(s: PanelState) -> RunBlocker:
+    """The first reason a run cannot start: no connection, a run going, no segments, an upload
+    in progress, then errors in the plan's checks (warnings do not block: the run asks first)."""
+    if not s.connected:
+        return RunBlocker.NO_LINK
+    if s.running:
+        return RunBlocker.RUNNING
+    if s.segments <= 0:
+        return RunBlocker.NO_SEGMENTS
+    if s.sync_busy:
+        return RunBlocker.SYNC_BUSY
+    if s.check_errors:
+        return RunBlocker.CHECKS
+    return RunBlocker.NONE
 
 
 def action_states(s: PanelState) -> ActionStates:
-    """Run needs a connection, no run going, segments and no upload in progress; edits need
-    a plan and no run; Stop also cancels an upload."""
-    can_start = s.connected and not s.running and s.segments > 0 and not s.sync_busy
+    """Run needs a connection, no run going, segments, no upload in progress and a plan whose
+    checks found no error; edits need a plan and no run; Stop also cancels an upload."""
+    blocker = run_blocker(s)
+    can_start = blocker is RunBlocker.NONE
     editable = s.has_plan and not s.running
     return ActionStates(
         add_plan=not s.running,
@@ -251,6 +283,8 @@ def action_states(s: PanelState) -> ActionStates:
         resume_from=s.connected and not s.running and s.can_resume and not s.sync_busy,
         upload_now=s.has_sync and s.connected and not s.running and not s.sync_busy,
         resume_from_visible=s.can_resume,
+        run_blocker=blocker,
+        first_error=s.first_error if blocker is RunBlocker.CHECKS else "",
     )
 
 
@@ -261,6 +295,7 @@ __all__ = [
     "PanelState",
     "PlanInfo",
     "RunBlock",
+    "RunBlocker",
     "RunGate",
     "RunKind",
     "SegmentEstimate",
@@ -270,6 +305,7 @@ __all__ = [
     "plan_info",
     "plan_start",
     "progress_bar",
+    "run_blocker",
     "run_gate",
     "run_kind",
     "summarize_checks",

@@ -4,127 +4,169 @@
     <context>
         <name>ConnectionDialog</name>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="147" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="169" />
             <source>Connect to controller</source>
             <translation>连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="148" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="170" />
             <source>Transport:</source>
             <translation>通信方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="149" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="171" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="208" />
             <source>Modbus TCP</source>
             <translation>Modbus TCP</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="150" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="172" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="208" />
             <source>Modbus RTU (serial)</source>
             <translation>Modbus RTU（串口）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="151" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="173" />
             <source>Host:</source>
             <translation>主机：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="152" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="174" />
             <source>Port:</source>
             <translation>端口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="153" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="175" />
             <source>Serial port:</source>
             <translation>串口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="154" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="176" />
             <source>Refresh</source>
             <translation>刷新</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="155" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="177" />
             <source>List the serial ports of this computer again</source>
             <translation>重新列出本机的串口</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="157" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="179" />
             <source>Baud rate:</source>
             <translation>波特率：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="158" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="180" />
             <source>Parity:</source>
             <translation>校验位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="159" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="181" />
             <source>none</source>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="159" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="181" />
             <source>even</source>
             <translation>偶校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="159" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="181" />
             <source>odd</source>
             <translation>奇校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="161" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="183" />
             <source>Stop bits:</source>
             <translation>停止位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="162" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="184" />
             <source>Unit id:</source>
             <translation>从站地址：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="163" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="185" />
             <source>Float word order:</source>
             <translation>浮点数字序：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="164" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="186" />
             <source>Low word first (CDAB, default)</source>
             <translation>低字在前（CDAB，默认）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="165" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="187" />
             <source>High word first (ABCD)</source>
             <translation>高字在前（ABCD）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="166" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="188" />
             <source>Timeout:</source>
             <translation>超时：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="167" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="189" />
             <source>Monitor only (never write to the controller)</source>
             <translation>仅监视（从不写入控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="190" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="210" />
+            <source>Connected to {where}</source>
+            <translation>已连接到 {where}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="211" />
+            <source>Connecting to {where}</source>
+            <translation>正在连接 {where}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="212" />
+            <source>Connected to {where}, but the controller does not answer</source>
+            <translation>已连接到 {where}，但控制器没有应答</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="213" />
+            <source>Connection to {where} lost; retrying</source>
+            <translation>与 {where} 的连接已断开，正在重试</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="214" />
+            <source>Not connected (last: {where})</source>
+            <translation>未连接（上次：{where}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="217" />
+            <source>{transport}, unit {unit}</source>
+            <translation>{transport}，站号 {unit}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="219" />
+            <source>Polling at {hz:g} Hz</source>
+            <translation>轮询频率 {hz:g} Hz</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="221" />
+            <source>Monitor only: nothing is written to the controller</source>
+            <translation>仅监视：不向控制器写入任何内容</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="248" />
             <source>Could not list the serial ports ({error}); type the device name</source>
             <translation>无法列出串口（{error}），请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="193" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="251" />
             <source>Serial ports found: {n}</source>
             <translation>找到的串口：{n} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="253" />
             <source>No serial port found; type the device name</source>
             <translation>未找到串口，请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="244" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="302" />
             <source>a serial port is needed for RTU</source>
             <translation>RTU 方式需要指定串口</translation>
         </message>
@@ -817,7 +859,7 @@
     <context>
         <name>PlanEdits</name>
         <message>
-            <location filename="../../ui/panels/planner_edit.py" line="73" />
+            <location filename="../../ui/panels/planner_edit.py" line="87" />
             <source>Deleted plan {name} (Ctrl+Z to undo)</source>
             <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
         </message>
@@ -896,58 +938,68 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="169" />
+            <location filename="../../ui/panels/plan_preview.py" line="183" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="170" />
+            <location filename="../../ui/panels/plan_preview.py" line="184" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="171" />
+            <location filename="../../ui/panels/plan_preview.py" line="185" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="240" />
+            <location filename="../../ui/panels/plan_preview.py" line="189" />
+            <source>Fit</source>
+            <translation>适应</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/plan_preview.py" line="190" />
+            <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
+            <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/plan_preview.py" line="279" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="242" />
+            <location filename="../../ui/panels/plan_preview.py" line="281" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="244" />
+            <location filename="../../ui/panels/plan_preview.py" line="283" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="245" />
+            <location filename="../../ui/panels/plan_preview.py" line="284" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="248" />
+            <location filename="../../ui/panels/plan_preview.py" line="287" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="252" />
+            <location filename="../../ui/panels/plan_preview.py" line="291" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="254" />
+            <location filename="../../ui/panels/plan_preview.py" line="293" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="255" />
+            <location filename="../../ui/panels/plan_preview.py" line="294" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -1066,350 +1118,388 @@
     <context>
         <name>PlannerActions</name>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="58" />
+            <location filename="../../ui/panels/planner_actions.py" line="60" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="58" />
+            <location filename="../../ui/panels/planner_actions.py" line="60" />
             <source>Add an empty plan</source>
             <translation>添加空轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="59" />
+            <location filename="../../ui/panels/planner_actions.py" line="61" />
             <source>Rename</source>
             <translation>重命名</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="59" />
+            <location filename="../../ui/panels/planner_actions.py" line="61" />
             <source>Rename the selected plan (F2)</source>
             <translation>重命名所选轨迹（F2）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="60" />
+            <location filename="../../ui/panels/planner_actions.py" line="62" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="60" />
+            <location filename="../../ui/panels/planner_actions.py" line="62" />
             <source>Copy the selected plan</source>
             <translation>复制所选轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="61" />
-            <location filename="../../ui/panels/planner_actions.py" line="64" />
+            <location filename="../../ui/panels/planner_actions.py" line="63" />
+            <location filename="../../ui/panels/planner_actions.py" line="66" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="61" />
+            <location filename="../../ui/panels/planner_actions.py" line="63" />
             <source>Delete the selected plan (Ctrl+Z to undo)</source>
             <translation>删除所选轨迹（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="62" />
+            <location filename="../../ui/panels/planner_actions.py" line="64" />
             <source>+ Line</source>
             <translation>+ 直线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="62" />
+            <location filename="../../ui/panels/planner_actions.py" line="64" />
             <source>Add a line segment after the selection (Ctrl+L)</source>
             <translation>在所选段之后添加直线段（Ctrl+L）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="63" />
+            <location filename="../../ui/panels/planner_actions.py" line="65" />
             <source>+ Arc</source>
             <translation>+ 圆弧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="63" />
+            <location filename="../../ui/panels/planner_actions.py" line="65" />
             <source>Add an arc segment after the selection</source>
             <translation>在所选段之后添加圆弧段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="64" />
+            <location filename="../../ui/panels/planner_actions.py" line="66" />
             <source>Delete the selected segments</source>
             <translation>删除所选段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="65" />
+            <location filename="../../ui/panels/planner_actions.py" line="67" />
             <source>Move the selected segments up (Alt+Up)</source>
             <translation>上移所选段（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="66" />
+            <location filename="../../ui/panels/planner_actions.py" line="68" />
             <source>Move the selected segments down (Alt+Down)</source>
             <translation>下移所选段（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="67" />
+            <location filename="../../ui/panels/planner_actions.py" line="69" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="67" />
+            <location filename="../../ui/panels/planner_actions.py" line="69" />
             <source>Check the plan from the robot's current pose</source>
             <translation>以机器人当前位姿检查轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="68" />
+            <location filename="../../ui/panels/planner_actions.py" line="70" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="68" />
+            <location filename="../../ui/panels/planner_actions.py" line="70" />
             <source>Upload the points the plan needs</source>
             <translation>上传轨迹所需的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="69" />
+            <location filename="../../ui/panels/planner_actions.py" line="71" />
             <source>Run</source>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="69" />
+            <location filename="../../ui/panels/planner_actions.py" line="71" />
             <source>Run the plan from the first segment (F5)</source>
             <translation>从第一段开始运行轨迹（F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="70" />
+            <location filename="../../ui/panels/planner_actions.py" line="72" />
             <source>Run from here</source>
             <translation>从此处运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="70" />
+            <location filename="../../ui/panels/planner_actions.py" line="72" />
             <source>Run from the selected segment (Shift+F5)</source>
             <translation>从所选段开始运行（Shift+F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="71" />
+            <location filename="../../ui/panels/planner_actions.py" line="73" />
             <source>Step</source>
             <translation>单步</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="71" />
+            <location filename="../../ui/panels/planner_actions.py" line="73" />
             <source>Run one segment, then stop (F10)</source>
             <translation>运行一段后停止（F10）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="72" />
+            <location filename="../../ui/panels/planner_actions.py" line="74" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="72" />
+            <location filename="../../ui/panels/planner_actions.py" line="74" />
             <source>Pause the motion</source>
             <translation>暂停运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="73" />
+            <location filename="../../ui/panels/planner_actions.py" line="75" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="73" />
+            <location filename="../../ui/panels/planner_actions.py" line="75" />
             <source>Resume the paused motion</source>
             <translation>继续已暂停的运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="74" />
+            <location filename="../../ui/panels/planner_actions.py" line="76" />
             <source>Stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="74" />
+            <location filename="../../ui/panels/planner_actions.py" line="76" />
             <source>Stop the robot and the run</source>
             <translation>停止机器人和轨迹运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="75" />
-            <location filename="../../ui/panels/planner_actions.py" line="84" />
+            <location filename="../../ui/panels/planner_actions.py" line="77" />
+            <location filename="../../ui/panels/planner_actions.py" line="89" />
             <source>Resume from segment</source>
             <translation>从该段继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="75" />
+            <location filename="../../ui/panels/planner_actions.py" line="77" />
             <source>Continue the stopped run</source>
             <translation>继续已停止的运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="83" />
+            <location filename="../../ui/panels/planner_actions.py" line="88" />
             <source>Resume from segment {k}</source>
             <translation>从第 {k} 段继续</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="109" />
+            <source>Run is disabled: the plan's checks found errors; fix them first</source>
+            <translation>无法运行：计划检查发现错误，请先修正</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="113" />
+            <source>Run is disabled: not connected to the controller</source>
+            <translation>无法运行：未连接控制器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="114" />
+            <source>Run is disabled: a run is going</source>
+            <translation>无法运行：正在运行中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="115" />
+            <source>Run is disabled: the plan has no segments</source>
+            <translation>无法运行：计划没有任何段</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="116" />
+            <source>Run is disabled: wait for the points' upload to finish</source>
+            <translation>无法运行：请等待点位上传完成</translation>
         </message>
     </context>
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="213" />
+            <location filename="../../ui/panels/planner_panel.py" line="214" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="391" />
+            <location filename="../../ui/panels/planner_panel.py" line="392" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="400" />
+            <location filename="../../ui/panels/planner_panel.py" line="401" />
             <source>Failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="400" />
+            <location filename="../../ui/panels/planner_panel.py" line="401" />
             <source>Stopped</source>
             <translation>已停止</translation>
         </message>
     </context>
     <context>
+        <name>PointPicker</name>
+        <message>
+            <location filename="../../ui/widgets/point_picker.py" line="119" />
+            <source>Point P{id} does not exist</source>
+            <translation>点 P{id} 不存在</translation>
+        </message>
+        <message>
+            <location filename="../../ui/widgets/point_picker.py" line="120" />
+            <source>Pick an existing point (type its id or part of its name)</source>
+            <translation>请选择已有的点（输入编号或名称的一部分）</translation>
+        </message>
+    </context>
+    <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="153" />
+            <location filename="../../ui/controllers/point_sync.py" line="161" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="164" />
+            <location filename="../../ui/controllers/point_sync.py" line="172" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="174" />
+            <location filename="../../ui/controllers/point_sync.py" line="182" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="176" />
+            <location filename="../../ui/controllers/point_sync.py" line="184" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="183" />
+            <location filename="../../ui/controllers/point_sync.py" line="191" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="209" />
+            <location filename="../../ui/controllers/point_sync.py" line="217" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="215" />
+            <location filename="../../ui/controllers/point_sync.py" line="223" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="218" />
+            <location filename="../../ui/controllers/point_sync.py" line="226" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="222" />
+            <location filename="../../ui/controllers/point_sync.py" line="230" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="224" />
+            <location filename="../../ui/controllers/point_sync.py" line="232" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="229" />
+            <location filename="../../ui/controllers/point_sync.py" line="237" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="245" />
+            <location filename="../../ui/controllers/point_sync.py" line="253" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="265" />
+            <location filename="../../ui/controllers/point_sync.py" line="273" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="268" />
+            <location filename="../../ui/controllers/point_sync.py" line="276" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="298" />
+            <location filename="../../ui/controllers/point_sync.py" line="306" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="312" />
+            <location filename="../../ui/controllers/point_sync.py" line="320" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="336" />
+            <location filename="../../ui/controllers/point_sync.py" line="344" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="341" />
+            <location filename="../../ui/controllers/point_sync.py" line="349" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="352" />
+            <location filename="../../ui/controllers/point_sync.py" line="360" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="356" />
+            <location filename="../../ui/controllers/point_sync.py" line="364" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="362" />
+            <location filename="../../ui/controllers/point_sync.py" line="370" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="369" />
+            <location filename="../../ui/controllers/point_sync.py" line="377" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="371" />
+            <location filename="../../ui/controllers/point_sync.py" line="379" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="380" />
+            <location filename="../../ui/controllers/point_sync.py" line="388" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="384" />
+            <location filename="../../ui/controllers/point_sync.py" line="392" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="422" />
+            <location filename="../../ui/controllers/point_sync.py" line="430" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="424" />
+            <location filename="../../ui/controllers/point_sync.py" line="432" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="440" />
+            <location filename="../../ui/controllers/point_sync.py" line="448" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="444" />
+            <location filename="../../ui/controllers/point_sync.py" line="452" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="448" />
+            <location filename="../../ui/controllers/point_sync.py" line="456" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -1692,7 +1782,7 @@
         </message>
         <message>
             <location filename="../../ui/panels/points_panel.py" line="261" />
-            <location filename="../../ui/panels/points_panel.py" line="401" />
+            <location filename="../../ui/panels/points_panel.py" line="413" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
@@ -1747,22 +1837,42 @@
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="364" />
+            <location filename="../../ui/panels/points_panel.py" line="351" />
+            <source>Added {point} at the robot's current pose</source>
+            <translation>已在机器人当前位姿添加 {point}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/points_panel.py" line="354" />
+            <source>pose copied from P{id}</source>
+            <translation>位姿复制自 P{id}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/points_panel.py" line="355" />
+            <source>pose set to zeros</source>
+            <translation>位姿设为零</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/points_panel.py" line="356" />
+            <source>Added {point}, not from the controller: no live pose ({why})</source>
+            <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/points_panel.py" line="376" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="367" />
+            <location filename="../../ui/panels/points_panel.py" line="379" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="390" />
+            <location filename="../../ui/panels/points_panel.py" line="402" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="394" />
+            <location filename="../../ui/panels/points_panel.py" line="406" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -1775,7 +1885,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="431" />
+            <location filename="../../ui/panels/points_panel.py" line="443" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -2471,37 +2581,37 @@ Remove them all?</source>
             <translation>第 {n} 段，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="365" />
+            <location filename="../../ui/models/segment_model.py" line="367" />
             <source>Edit segment {n} {column}</source>
             <translation>编辑第 {n} 段 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="376" />
+            <location filename="../../ui/models/segment_model.py" line="378" />
             <source>Add {kind} segment</source>
             <translation>添加{kind}段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="408" />
+            <location filename="../../ui/models/segment_model.py" line="412" />
             <source>Add {n} segments</source>
             <translation>添加 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="415" />
+            <location filename="../../ui/models/segment_model.py" line="419" />
             <source>Delete segment {n}</source>
             <translation>删除第 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="416" />
+            <location filename="../../ui/models/segment_model.py" line="420" />
             <source>Delete {n} segments</source>
             <translation>删除 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="432" />
+            <location filename="../../ui/models/segment_model.py" line="436" />
             <source>Move segment up</source>
             <translation>上移段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="432" />
+            <location filename="../../ui/models/segment_model.py" line="436" />
             <source>Move segment down</source>
             <translation>下移段</translation>
         </message>

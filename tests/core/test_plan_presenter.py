@@ -15,6 +15,7 @@ from app.plan.presenter import (
     Level,
     PanelState,
     RunBlock,
+    RunBlocker,
     RunKind,
     action_states,
     format_duration,
@@ -138,3 +139,23 @@ def test_actions_need_a_link_segments_and_no_upload() -> None:
     stopped = action_states(replace(IDLE, can_resume=True))
     assert stopped.resume_from and stopped.resume_from_visible
     assert not action_states(replace(IDLE, can_resume=True, connected=False)).resume_from
+
+
+def test_run_is_disabled_while_the_checks_find_errors() -> None:
+    """Errors disable Run, Run from here and Step, with the reason; warnings and points that
+    need an upload do not (the run asks, or offers the upload, first)."""
+    plan = Plan("broken", [Segment.line(11), Segment.line(99)])
+    checks = summarize_checks(check_plan(plan, ledger(), current_pose=(300, 0, 300)))
+    assert checks.errors == 1
+    state = replace(IDLE, check_errors=checks.errors, first_error=checks.first_row_error)
+    s = action_states(state)
+    assert not (s.run or s.run_from) and s.run_blocker is RunBlocker.CHECKS
+    assert s.first_error == "segment 2: end point P99 does not exist"
+    assert s.add_segment and s.edit_plan and s.delete_segment  # the operator can still fix it
+    fixed = action_states(replace(state, check_errors=0, first_error=""))
+    assert fixed.run and fixed.run_blocker is RunBlocker.NONE and fixed.first_error == ""
+    # the first reason wins: no link says so even when the checks fail too
+    assert action_states(replace(state, connected=False)).run_blocker is RunBlocker.NO_LINK
+    assert action_states(replace(state, running=True)).run_blocker is RunBlocker.RUNNING
+    assert action_states(replace(state, segments=0)).run_blocker is RunBlocker.NO_SEGMENTS
+    assert action_states(replace(state, sync_busy=True)).run_blocker is RunBlocker.SYNC_BUSY

@@ -128,3 +128,64 @@ def test_live_tcp(qtbot: Any, preview: PlanPreview) -> None:
     assert list(side.tcp.data["x"]) == [20.0] and list(side.tcp.data["y"]) == [30.0]
     preview.clear()
     assert top.tcp.data.shape[0] == 0
+
+
+# --- fitting every change (issue 9) -----------------------------------------------------------------
+
+
+def shows_all(preview: PlanPreview, xyz: list[tuple[float, float, float]]) -> bool:
+    """Every projection's view range holds every point of ``xyz``."""
+    for proj in preview.projections.values():
+        (x0, x1), (y0, y1) = proj.plot.getViewBox().viewRange()
+        for p in xyz:
+            if not (x0 <= p[proj.h] <= x1 and y0 <= p[proj.v] <= y1):
+                return False
+    return True
+
+
+def wheel(qtbot: Any, preview: PlanPreview, key: str = "top") -> None:
+    """The operator zooms one projection with the mouse wheel (a real wheel event)."""
+    from PySide6.QtCore import QPoint, QPointF, Qt
+    from PySide6.QtGui import QWheelEvent
+    from PySide6.QtWidgets import QApplication
+
+    plot = preview.projections[key].plot
+    centre = QPointF(plot.viewport().rect().center())
+    event = QWheelEvent(centre, QPointF(plot.viewport().mapToGlobal(centre.toPoint())), QPoint(0, 0),
+                        QPoint(0, 240), Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier,
+                        Qt.ScrollPhase.NoScrollPhase, False)
+    QApplication.sendEvent(plot.viewport(), event)
+
+
+def test_a_new_plan_shows_the_points_it_can_use(preview: PlanPreview, ledger: PointLedger) -> None:
+    preview.show_plan(Plan("new"), ledger, None, None)
+    top = preview.projections["top"]
+    assert top.points.data.shape[0] == len(ledger) and len(top.labels) == len(ledger)
+    assert shows_all(preview, [p.xyz for p in ledger])  # not an empty view fitted to nothing
+
+
+def test_every_change_refits_until_the_operator_zooms(qtbot: Any, preview: PlanPreview,
+                                                      ledger: PointLedger) -> None:
+    preview.show()
+    qtbot.waitExposed(preview)
+    ledger.append(make_point(8, "far", (2400, -1800, 1200, 180, 0, 0)))
+    plan = Plan("p", [Segment.line(5), Segment.line(7)])
+    preview.show_plan(plan, ledger, (400, 0, 450), None)
+    assert shows_all(preview, [(300, 0, 300), (500, 0, 300)]) and preview.follows_changes
+    plan.append(Segment.line(8))  # a segment added far away: the same plan, refitted
+    preview.show_plan(plan, ledger, (400, 0, 450), None)
+    assert shows_all(preview, [(2400, -1800, 1200), (300, 0, 300)])
+    plan.remove(2)
+    preview.show_plan(plan, ledger, (400, 0, 450), None)
+    assert not shows_all(preview, [(2400, -1800, 1200)])  # shrunk back to the plan
+
+    wheel(qtbot, preview)  # the operator zooms: their view stays through the next changes
+    assert not preview.follows_changes
+    zoomed = preview.projections["top"].plot.getViewBox().viewRange()
+    plan.append(Segment.line(8))
+    preview.show_plan(plan, ledger, (400, 0, 450), None)
+    assert preview.projections["top"].plot.getViewBox().viewRange() == zoomed
+    preview.fit_button.click()  # Fit: everything again, and the view follows the changes again
+    assert preview.follows_changes and shows_all(preview, [(2400, -1800, 1200), (300, 0, 300)])
+    preview.show_plan(Plan("other", [Segment.line(1)]), ledger, None, None)  # another plan: fitted
+    assert not shows_all(preview, [(2400, -1800, 1200)])

@@ -366,7 +366,11 @@ def test_panel_summary_and_upload_now_then_run(qtbot: Any, planner: PlannerPanel
 def test_panel_refuses_a_plan_with_errors(planner: PlannerPanel, link: FakeLink, project: Project) -> None:
     all_uploaded(project)
     planner.select_plan(1)
-    planner.segments.setData(planner.segments.index(2, COL_END), "42")
+    plan = planner.current_plan()
+    assert plan is not None
+    plan.replace(2, plan[2].with_field("end", 42))  # e.g. P42 was deleted: a picker offers no such id
+    planner.recheck()
+    assert not planner.action_run.isEnabled()
     assert planner.summary_text.startswith("1 error(s)")
     assert not planner.run(0)
     assert "Cannot run" in planner.status.text() and "P42 does not exist" in planner.status.text()

@@ -338,3 +338,50 @@ def test_points_with_other_ids_work(qtbot: Any) -> None:
     project.ledger.replace_all([make_point(10000, "last")])
     model = PointsModel(project, QUndoStack())
     assert model.next_id() == 0  # the highest id is at the limit: smallest free one
+
+
+# --- a new point's pose (issue 9: sane defaults) ----------------------------------------------------
+
+
+def test_add_takes_the_current_pose_while_the_link_is_fresh(panel: PointsPanel, link: FakeLink) -> None:
+    import time
+
+    link.state.set_pose(Pose(412.5, -30.0, 250.0, 180.0, 0.5, 90.0))
+    link.state.note_good_poll(time.monotonic())
+    assert link.state.fresh
+    panel.select_rows([1])
+    panel.action_add.trigger()
+    point = panel.model.ledger.point(9)
+    assert point.xyzabc == (412.5, -30.0, 250.0, 180.0, 0.5, 90.0)
+    assert "current pose" in panel.status.text() and "no live pose" not in panel.status.text()
+    link.set_connected(False)  # a lost link is never fresh (and stops the freshness timer)
+    panel.action_add.trigger()
+    assert panel.model.ledger.point(10).xyzabc == point.xyzabc and "no live pose" in panel.status.text()
+
+
+def test_add_without_a_live_pose_copies_a_point_and_says_so(qtbot: Any, panel: PointsPanel,
+                                                           link: FakeLink) -> None:
+    import time
+
+    link.state.set_freshness_limit(0.05)
+    link.state.set_pose(Pose(999.0, 999.0, 999.0, 0.0, 0.0, 0.0))
+    link.state.note_good_poll(time.monotonic())
+    qtbot.waitUntil(lambda: not link.state.fresh)  # the pose got old: not the robot's any more
+    panel.select_rows([1])
+    selected = panel.model.ledger[1]
+    panel.action_add.trigger()
+    point = panel.model.ledger.point(9)
+    assert point.xyzabc == selected.xyzabc and point.xyzabc[0] != 999.0  # never the stale pose
+    text = panel.status.text()
+    assert "not from the controller: no live pose" in text and f"copied from P{selected.id}" in text
+
+
+def test_add_to_an_empty_list_without_a_link_is_zeros_and_says_so(qtbot: Any) -> None:
+    from app.points.project import Project
+
+    model = PointsModel(Project(), QUndoStack())
+    panel = PointsPanel(model, PointSyncController(model), confirm=lambda title, text: False)
+    qtbot.addWidget(panel)
+    panel.action_add.trigger()
+    assert model.ledger[0].xyzabc == (0.0,) * 6
+    assert "no live pose (pose set to zeros)" in panel.status.text()

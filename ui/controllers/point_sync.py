@@ -29,6 +29,7 @@ from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport
 from app.protocol.registers import TOOL_NONE
+from ui.controllers.new_point import NewPointPose, new_point_pose
 from ui.models.point_columns import sync_text
 from ui.models.points_model import PointsModel
 from ui.widgets_common import command_status_text
@@ -130,6 +131,13 @@ class PointSyncController(QObject):
     @property
     def last_pose(self) -> Pose | None:
         return self._link.state.pose if self._link is not None else None
+
+    def new_point_pose(self, near_row: int | None = None) -> NewPointPose:
+        """The pose for a point added by hand: the robot's while the link is fresh, else the
+        point at ``near_row`` (default: the last one) or zeros (see :mod:`ui.controllers.new_point`)."""
+        state = self._link.state if self._link is not None else None
+        return new_point_pose(state is not None and state.fresh, state.pose if state is not None else None,
+                              self._model.ledger, near_row, self.teach_tool)
 
     @property
     def restore_offered(self) -> bool:

@@ -1,10 +1,13 @@
 """Connect…: Modbus TCP or RTU (serial, the machine's ports listed), unit id, word order, timeout,
-monitor-only."""
+monitor-only.
+
+Opened from a link (:meth:`ConnectionDialog.for_link`), it shows the connection in use (the
+link's settings, else the remembered ones), whether it is connected, and the poll rate."""
 
 from __future__ import annotations
 
 import dataclasses
-from typing import NamedTuple
+from typing import NamedTuple, Protocol
 
 from PySide6.QtCore import QEvent, Qt, Slot
 from PySide6.QtWidgets import (
@@ -25,6 +28,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.link.client import ConnectionSettings
+from app.link.types import ConnectionState, LinkState
 from app.protocol.codec import WordOrder
 
 _BAUDRATES = (9600, 19200, 38400, 57600, 115200, 230400)
@@ -45,13 +49,30 @@ def available_serial_ports() -> list[SerialPortInfo]:
     return sorted(ports, key=lambda p: p.device)
 
 
-class ConnectionDialog(QDialog):
-    """Edits a :class:`ConnectionSettings`; ``settings()`` returns the result."""
+class LinkView(Protocol):
+    """What the dialog reads of the link (:class:`~app.link.robot_link.RobotLink` fits)."""
 
-    def __init__(self, settings: ConnectionSettings | None = None, parent: QWidget | None = None) -> None:
+    @property
+    def connection(self) -> ConnectionState: ...
+
+    @property
+    def settings(self) -> ConnectionSettings | None: ...
+
+
+class ConnectionDialog(QDialog):
+    """Edits a :class:`ConnectionSettings`; ``settings()`` returns the result. ``connection``
+    and ``poll_hz``: the link's state and poll rate, shown above the form."""
+
+    def __init__(self, settings: ConnectionSettings | None = None, parent: QWidget | None = None, *,
+                 connection: ConnectionState | None = None, poll_hz: float | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("ConnectionDialog")
         self._base = settings or ConnectionSettings()
+        self._connection = connection
+        self._poll_hz = poll_hz
+        self.current_label = QLabel(self)  # the connection in use, connected or not
+        self.current_label.setWordWrap(True)
+        self.current_label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
 
         self.transport_combo = QComboBox(self)
         self.transport_combo.addItem("", "tcp")
@@ -135,6 +156,7 @@ class ConnectionDialog(QDialog):
         self.buttons.accepted.connect(self.accept)
         self.buttons.rejected.connect(self.reject)
         layout = QVBoxLayout(self)
+        layout.addWidget(self.current_label)
         layout.addLayout(form)
         layout.addWidget(self.buttons)
         self._ports: list[SerialPortInfo] = []
@@ -165,6 +187,42 @@ class ConnectionDialog(QDialog):
         self.order_combo.setItemText(1, self.tr("High word first (ABCD)"))
         self.timeout_caption.setText(self.tr("Timeout:"))
         self.monitor_check.setText(self.tr("Monitor only (never write to the controller)"))
+        self._show_current()
+
+    @classmethod
+    def for_link(cls, link: LinkView, saved: ConnectionSettings, poll_hz: float | None = None,
+                 parent: QWidget | None = None) -> ConnectionDialog:
+        """The dialog on the connection in use: the link's settings (the remembered ones when
+        the link has none yet), its state and the poll rate."""
+        return cls(link.settings or saved, parent, connection=link.connection, poll_hz=poll_hz)
+
+    def _show_current(self) -> None:
+        """"Connected to …" / "Not connected (…)", with the transport and the poll rate."""
+        state = self._connection
+        self.current_label.setVisible(state is not None)
+        if state is None:
+            return
+        s = self._base
+        where = (f"{s.serial_port} {s.baudrate} {s.bytesize}{s.parity}{s.stopbits}" if s.serial_port
+                 else f"{s.host}:{s.port}")
+        transport = self.tr("Modbus RTU (serial)") if s.transport == "rtu" else self.tr("Modbus TCP")
+        words = {
+            LinkState.CONNECTED: self.tr("Connected to {where}"),
+            LinkState.CONNECTING: self.tr("Connecting to {where}"),
+            LinkState.NOT_ANSWERING: self.tr("Connected to {where}, but the controller does not answer"),
+            LinkState.DOWN: self.tr("Connection to {where} lost; retrying"),
+            LinkState.DISCONNECTED: self.tr("Not connected (last: {where})"),
+        }
+        lines = [words[state.state].format(where=state.endpoint or where),
+                 self.tr("{transport}, unit {unit}").format(transport=transport, unit=s.unit)]
+        if self._poll_hz is not None:
+            lines.append(self.tr("Polling at {hz:g} Hz").format(hz=self._poll_hz))
+        if state.monitor_only or s.monitor_only:
+            lines.append(self.tr("Monitor only: nothing is written to the controller"))
+        if state.message and not state.connected:
+            lines.append(state.message[:120])
+        self.current_label.setText("\n".join(lines))
+        self.current_label.setStyleSheet("font-weight: bold;" if state.connected else "")
 
     @Slot()
     def refresh_serial_ports(self) -> None:

@@ -83,7 +83,7 @@ class SegmentTableModel(UndoableListModel):
     def __init__(self, undo_stack: QUndoStack, ledger: PointLedger | None = None, parent: Any = None) -> None:
         super().__init__(undo_stack, parent)
         self._plan: Plan | None = None
-        self._ledger = ledger or PointLedger()
+        self._ledger = ledger if ledger is not None else PointLedger()  # an empty ledger is falsy
         self._issues: dict[int, list[PlanIssue]] = {}
         self._lengths: np.ndarray = np.empty(0)
         self._times: np.ndarray = np.empty(0)
@@ -352,6 +352,8 @@ class SegmentTableModel(UndoableListModel):
             blank = value is None or (isinstance(value, str) and not value.strip())
             if not (name == "via" and blank):
                 value = parse_point_id(_strip_p(value), self._ledger.limits, name)
+                if value not in self._ledger:  # a segment only picks points that exist
+                    raise FieldError(name, f"point P{value} does not exist: pick one of the list")
         if name == "tool" and isinstance(value, str) and value.strip().lower() in TOOL_NONE_WORDS:
             value = TOOL_NONE
         new = old.with_field(name, value)
@@ -377,13 +379,17 @@ class SegmentTableModel(UndoableListModel):
         return at
 
     def default_segment(self, at: int, kind: SegmentKind) -> Segment:
+        """End = the point after the previous segment's end (the first point at the start);
+        an arc's middle point is that point and its end the one after. Refused (InvalidInput)
+        when there are not enough points: a segment never starts on an id that does not exist."""
         plan = self._require_plan()
         ids = self._ledger.ids()
         previous = plan[at - 1] if 0 < at <= len(plan) else None
+        if len(ids) < (2 if kind is SegmentKind.ARC else 1):
+            raise InvalidInput("an arc needs two points: add or teach points first" if ids
+                               else "there are no points yet: add or teach a point first")
 
         def after(pid: int | None) -> int:
-            if not ids:
-                return 0 if pid is None else pid
             if pid is None or pid not in ids:
                 return ids[0]
             return ids[(ids.index(pid) + 1) % len(ids)]
@@ -394,8 +400,6 @@ class SegmentTableModel(UndoableListModel):
         if kind is SegmentKind.ARC:
             via = after(start)
             end = after(via)
-            if end == via:
-                end = via + 1
             return Segment.arc(via, end, speed, tool=tool)
         return Segment.line(after(start), speed, tool=tool)
 

@@ -8,6 +8,11 @@ samples). On top: the selected segment (thick), the referenced points (one scatt
 labels for the first :data:`MAX_LABELS`), where the plan starts, and while a plan runs the
 live TCP (position and a short trail), repainted at most :data:`LIVE_FPS` times a second from
 the latest pose (poses arrive at the poll rate). Outside a run, poses are only remembered.
+
+The view fits every change (another plan, a segment added, removed or edited, a point moved)
+until the operator zooms or pans a projection (pyqtgraph's ``sigRangeChangedManually``): from
+then on the operator's view stays, until "Fit" (or another plan) fits again. A plan without
+segments shows all the project's points (the ones it can use), fitted, not an empty view.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ import pyqtgraph as pg
 from numpy.typing import NDArray
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
 from PySide6.QtGui import QResizeEvent
-from PySide6.QtWidgets import QBoxLayout, QHBoxLayout, QLabel, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QBoxLayout, QHBoxLayout, QLabel, QToolButton, QVBoxLayout, QWidget
 
 from app.models import Pose
 from app.plan.geometry import PlanPath, plan_path
@@ -114,6 +119,7 @@ class PlanPreview(QWidget):
         self._path: PlanPath | None = None
         self._selected: int | None = None
         self._previewed: Plan | None = None  # the plan the view range was fitted to
+        self._operator_view = False  # the operator zoomed / panned since the last fit
         self._pending: Pose | None = None
         self._live_wanted = False
         self._trail = np.full((2 * TRAIL_LENGTH, 3), np.nan)
@@ -133,6 +139,7 @@ class PlanPreview(QWidget):
             plot.setLabel("bottom", f"{AXIS_NAMES[h]} (mm)")
             plot.setLabel("left", f"{AXIS_NAMES[v]} (mm)")
             self.projections[key] = _Projection(plot, h, v)
+            plot.getViewBox().sigRangeChangedManually.connect(self._on_operator_view)
             title = QLabel(self)
             title.setStyleSheet(f"font-weight: bold; color: {COLOR_INK_SOFT};")
             self._titles[key] = title
@@ -148,11 +155,18 @@ class PlanPreview(QWidget):
         self.info.setMinimumWidth(INFO_MIN_WIDTH)
         self.info.setMaximumWidth(INFO_WIDTH)
         self.info.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self.fit_button = QToolButton(self)
+        self.fit_button.setObjectName("PlanPreviewFit")
+        self.fit_button.clicked.connect(self.fit)
+        side = QVBoxLayout()
+        side.setContentsMargins(0, 0, 0, 0)
+        side.addWidget(self.info, 1)
+        side.addWidget(self.fit_button, 0, Qt.AlignmentFlag.AlignLeft)
         # The lengths / times sit right of the plots, or below them on a narrow panel.
         layout = QBoxLayout(QBoxLayout.Direction.LeftToRight, self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addLayout(row, 1)
-        layout.addWidget(self.info)
+        layout.addLayout(side)
         self._layout = layout
         self.retranslate()
 
@@ -172,6 +186,9 @@ class PlanPreview(QWidget):
         }
         for key, title in self._titles.items():
             title.setText(names[key])
+        self.fit_button.setText(QCoreApplication.translate("PlanPreview", "Fit"))
+        self.fit_button.setToolTip(QCoreApplication.translate(
+            "PlanPreview", "Fit the views to the plan; they follow every change again until you zoom or pan"))
 
     def changeEvent(self, event: QEvent) -> None:
         if event.type() == QEvent.Type.LanguageChange:
@@ -184,8 +201,8 @@ class PlanPreview(QWidget):
         return self._path
 
     def set_path(self, path: PlanPath | None, *, keep_view: bool = False) -> None:
-        """The plan's sampled path (None: nothing to draw). ``keep_view``: the same plan was
-        edited, leave the operator's zoom alone (autorange otherwise)."""
+        """The plan's sampled path (None: nothing to draw). ``keep_view``: leave the view
+        range alone (the caller fits after drawing the points too)."""
         self._path = path
         for proj in self.projections.values():
             if path is None or path.xyz.shape[0] == 0:
@@ -224,16 +241,38 @@ class PlanPreview(QWidget):
 
     def show_plan(self, plan: Plan, ledger: PointLedger, start: Sequence[float] | None,
                   selected: int | None) -> None:
-        """Draw ``plan`` from ``start`` with the points it uses; the view range is fitted when
-        another plan is shown, kept while the same plan is redrawn."""
-        self.set_path(plan_path(plan, ledger, start), keep_view=plan is self._previewed)
+        """Draw ``plan`` from ``start`` with the points it uses (all the points while it has no
+        segments); the view fits another plan always, a change of the same plan unless the
+        operator zoomed or panned since the last fit."""
+        another = plan is not self._previewed
         self._previewed = plan
-        used = [ledger.get(pid) for pid in sorted(plan.point_ids())]
-        present = [p for p in used if p is not None]
+        self.set_path(plan_path(plan, ledger, start), keep_view=True)
+        if len(plan):
+            used = [ledger.get(pid) for pid in sorted(plan.point_ids())]
+            present = [p for p in used if p is not None]
+        else:
+            present = list(ledger)  # what a new plan can use
         self.set_points(np.array([p.xyz for p in present], dtype=np.float64).reshape(-1, 3),
                         [f"P{p.id}" for p in present])
         self.set_start(start)
         self.set_selected(selected)
+        if another or not self._operator_view:
+            self.fit()
+
+    @property
+    def follows_changes(self) -> bool:
+        """The view fits every change (the operator has not zoomed or panned since the last fit)."""
+        return not self._operator_view
+
+    @Slot()
+    def fit(self) -> None:
+        """Fit every projection to what it shows; the view follows the changes again."""
+        self._operator_view = False
+        self._auto_range()
+
+    @Slot()
+    def _on_operator_view(self, *_args: Any) -> None:
+        self._operator_view = True
 
     def show_info(self, info: PlanInfo) -> None:
         """The plan's lengths and times (worked out by :func:`app.plan.presenter.plan_info`)."""
@@ -256,6 +295,7 @@ class PlanPreview(QWidget):
         self.set_info("<br>".join(lines))
 
     def clear(self) -> None:
+        self._previewed = None
         self.set_path(None)
         self.set_points(np.empty((0, 3)))
         self.set_start(None)

@@ -10,7 +10,7 @@ from PySide6.QtCore import QObject, Qt
 from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QWidget
 
-from app.plan.presenter import ActionStates
+from app.plan.presenter import ActionStates, RunBlocker
 
 # name -> shortcut ("" for none), in the order the panel lists them
 SHORTCUTS: dict[str, str] = {
@@ -49,6 +49,8 @@ class PlannerActions(QObject):
             action.triggered.connect(slots[name])
             owner.addAction(action)
             self.all[name] = action
+        self._tips: dict[str, str] = {}
+        self._states: ActionStates | None = None
 
     def __getitem__(self, name: str) -> QAction:
         return self.all[name]
@@ -77,6 +79,9 @@ class PlannerActions(QObject):
         for name, (text, tip) in texts.items():
             self.all[name].setText(text)
             self.all[name].setToolTip(tip)
+            self._tips[name] = tip
+        if self._states is not None:
+            self._show_run_blocker(self._states)
 
     def set_resume_from(self, k: int | None) -> None:
         """``Resume from segment k`` (1-based), or the bare text when there is nothing to resume."""
@@ -95,3 +100,25 @@ class PlannerActions(QObject):
         }
         for name, on in enabled.items():
             self.all[name].setEnabled(on)
+        self._states = states
+        self._show_run_blocker(states)
+
+    def blocker_text(self, blocker: RunBlocker, first_error: str = "") -> str:
+        """Why Run is disabled, in the operator's words ("" when it is not)."""
+        if blocker is RunBlocker.CHECKS:
+            text = self.tr("Run is disabled: the plan's checks found errors; fix them first")
+            return f"{text}\n{first_error[:160]}" if first_error else text
+        return {
+            RunBlocker.NONE: "",
+            RunBlocker.NO_LINK: self.tr("Run is disabled: not connected to the controller"),
+            RunBlocker.RUNNING: self.tr("Run is disabled: a run is going"),
+            RunBlocker.NO_SEGMENTS: self.tr("Run is disabled: the plan has no segments"),
+            RunBlocker.SYNC_BUSY: self.tr("Run is disabled: wait for the points' upload to finish"),
+        }[blocker]
+
+    def _show_run_blocker(self, states: ActionStates) -> None:
+        """Run, Run from here and Step say in their tooltip why they are disabled."""
+        why = self.blocker_text(states.run_blocker, states.first_error)
+        for name in ("run", "run_from", "step"):
+            tip = self._tips.get(name, "")
+            self.all[name].setToolTip(f"{why}\n\n{tip}" if why and tip else why or tip)

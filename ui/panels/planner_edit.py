@@ -1,10 +1,11 @@
 """The planner's edits of the plan list and of the segments: add, rename, duplicate and delete
 plans; add, delete and move segments. The models make them undoable; this keeps the selection
-on what was edited and reports refusals on the panel's status line."""
+on what was edited and reports refusals on the panel's status line. :func:`install_point_pickers`
+puts the point pickers in the segment table's middle / end point columns."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Protocol
 
 from PySide6.QtCore import QObject, Slot
@@ -12,9 +13,22 @@ from PySide6.QtWidgets import QTableView
 
 from app.errors import InvalidInput
 from app.plan.segments import Plan, SegmentKind
-from ui.models.plan_columns import PLAN_COL_NAME
+from app.points.ledger import PointLedger
+from ui.models.plan_columns import COL_END, COL_VIA, PLAN_COL_NAME
 from ui.models.plan_model import PlanListModel
 from ui.models.segment_model import SegmentTableModel
+from ui.widgets.point_picker import PointPickerDelegate
+
+
+def install_point_pickers(view: QTableView, ledger: Callable[[], PointLedger]
+                          ) -> tuple[PointPickerDelegate, PointPickerDelegate]:
+    """Point pickers (existing points by id and name, no free number) for the middle point
+    (may stay blank) and the end point columns of ``view``; returns (middle, end)."""
+    via = PointPickerDelegate(ledger, view, allow_blank=True)
+    end = PointPickerDelegate(ledger, view)
+    view.setItemDelegateForColumn(COL_VIA, via)
+    view.setItemDelegateForColumn(COL_END, end)
+    return via, end
 
 
 class PlanEditView(Protocol):

@@ -57,7 +57,7 @@ from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
 from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_actions import PlannerActions
-from ui.panels.planner_edit import PlanEdits
+from ui.panels.planner_edit import PlanEdits, install_point_pickers
 from ui.panels.planner_run import PlanRunFlow
 from ui.panels.planner_widgets import (
     STATUS_COLOURS,
@@ -189,6 +189,7 @@ class PlannerPanel(QWidget):
         self.segments_box = SegmentEditorBox(self.segments, self._points, segment_actions, self.checks_bar,
                                              self)
         self.segment_view = self.segments_box.segment_view
+        self.point_pickers = install_point_pickers(self.segment_view, lambda: self._points.ledger)
 
         # right: preview
         self.preview = PlanPreview(self)
@@ -482,12 +483,14 @@ class PlannerPanel(QWidget):
         plan = self.current_plan()
         rows = self.selected_segments()
         sync = self._sync
+        errors = [i.message for i in self._issues if i.is_error]
         states = action_states(PanelState(
             connected=r.connected, running=r.running, paused=r.paused, can_resume=r.can_resume,
             has_plan=plan is not None, segments=len(plan) if plan is not None else 0, selected=bool(rows),
             can_move_up=self.segments.can_move(rows, -1), can_move_down=self.segments.can_move(rows, 1),
             has_sync=sync is not None, sync_busy=sync is not None and sync.busy,
-            uploading=sync is not None and sync.operation == "upload"))
+            uploading=sync is not None and sync.operation == "upload",
+            check_errors=len(errors), first_error=errors[0] if errors else ""))
         self.actions.apply(states)
         self.upload_button.setEnabled(self.action_upload_now.isEnabled())
         self.resume_from_button.setVisible(states.resume_from_visible)

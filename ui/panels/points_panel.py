@@ -334,15 +334,27 @@ class PointsPanel(QWidget):
 
     @Slot()
     def add_point(self) -> None:
+        """A new point after the selection, at the robot's current pose when the link is fresh;
+        else a copy of the selected (or last) point's pose, or zeros, and the status says so."""
         rows = self.selected_rows()
         at = rows[-1] + 1 if rows else None
+        start = self._controller.new_point_pose(rows[-1] if rows else None)
         try:
-            row = self._model.add_point(at)
+            row = self._model.add_point(at, pose=start.pose, tool=start.tool)
         except InvalidInput as exc:
             self.show_message(str(exc), LEVEL_ERROR)
             return
         self._clear_filter_for(row)
         self.select_rows([row])
+        label = self._model.ledger[row].label
+        if start.live:
+            self.show_message(self.tr("Added {point} at the robot's current pose").format(point=label),
+                              LEVEL_INFO)
+            return
+        why = (self.tr("pose copied from P{id}").format(id=start.copied_from)
+               if start.copied_from is not None else self.tr("pose set to zeros"))
+        self.show_message(self.tr("Added {point}, not from the controller: no live pose ({why})").format(
+            point=label, why=why), LEVEL_WARN)
 
     @Slot()
     def duplicate_selected(self) -> None:

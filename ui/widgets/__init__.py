@@ -1,0 +1,1 @@
+"""Small reusable widgets (pickers, editors) shared by the panels."""
