@@ -43,13 +43,14 @@ def test_target_outside_keep_in_names_axis_value_and_limit() -> None:
 
 def test_target_inside_keep_out_and_joint_and_speed() -> None:
     v = check_target(ENV, pose(350, 90, 100))
-    assert v is not None and (v.code, v.box, v.axis, v.limit) == (ViolationCode.KEEP_OUT, "fixture A", "Y", 100.0)
+    assert v is not None
+    assert (v.code, v.box, v.axis, v.limit) == (ViolationCode.KEEP_OUT, "fixture A", "Y", 100.0)
     v = check_target(ENV, pose(0, 0, 400), joints=(0, 140, 0))
     assert v is not None and (v.code, v.axis, v.limit) == (ViolationCode.JOINT_LIMIT, "J2", 135.0)
     v = check_target(ENV, pose(0, 0, 400), speed=300, reduced=True)
     assert v is not None and v.code is ViolationCode.SPEED and v.limit == 250 and "reduced-speed" in v.message
     assert check_target(ENV, pose(0, 0, 400), speed=300) is None
-    with pytest.raises(EnvelopeRefused, match="^step refused: .*keep-out zone 'fixture A'") as info:
+    with pytest.raises(EnvelopeRefused, match=r"^step refused: .*keep-out zone 'fixture A'") as info:
         require_target(ENV, pose(350, 0, 100), action="step")
     assert info.value.violation.code is ViolationCode.KEEP_OUT
 
@@ -104,7 +105,8 @@ def test_plan_through_a_keep_out_box_is_an_error_that_blocks_run() -> None:
                          Segment(SegmentKind.LINE, end_id=2, speed=100),  # crosses fixture A
                          Segment(SegmentKind.LINE, end_id=3, speed=600)])  # too fast
     violations = plan_violations(plan, ledger, ENV, pose(0, 0, 100))
-    assert [(v.segment, v.code) for v in violations] == [(1, ViolationCode.KEEP_OUT), (2, ViolationCode.SPEED)]
+    assert [(v.segment, v.code) for v in violations] == [(1, ViolationCode.KEEP_OUT),
+                                                         (2, ViolationCode.SPEED)]
     assert violations[0].message.startswith("segment 2: the path enters the keep-out zone 'fixture A'")
     issues = check_plan(plan, ledger, current_pose=pose(0, 0, 100), envelope=ENV)
     envelope_issues = [i for i in issues if i.code is IssueCode.OUTSIDE_ENVELOPE]

@@ -35,7 +35,8 @@ def test_margin_is_the_distance_covered_in_poll_period_plus_latency() -> None:
     stop = guard.decide(at(0, -100 + 7, 400), jog(1, 0))
     assert not stop.allow and stop.violation is not None
     v = stop.violation
-    assert (v.code, v.axis, v.value, v.limit, v.approaching) == (ViolationCode.KEEP_IN, "Y", -93.0, -100.0, True)
+    assert (v.code, v.axis, v.value, v.limit) == (ViolationCode.KEEP_IN, "Y", -93.0, -100.0)
+    assert v.approaching
     assert "within stopping distance" in stop.message
     # along the boundary, and back out, are allowed; a slower jog gets closer
     assert guard.decide(at(0, -99, 400), jog(0, 1)).allow
@@ -96,7 +97,8 @@ POLL = 0.02  # s, the worker's 50 Hz
 LATENCY = 0.1  # s, generous: the machine running the tests is shared
 
 
-def _jog_until_guard_stops(client: Any, guard: JogGuard, motion: JogMotion, timeout: float) -> tuple[bool, Pose]:
+def _jog_until_guard_stops(client: Any, guard: JogGuard, motion: JogMotion,
+                           timeout: float) -> tuple[bool, Pose]:
     """What the worker does while a jog button is held: poll the pose, ask the guard, write
     ratio 0 when it says stop. Returns (stopped by the guard, the pose it decided on)."""
     client.teach_set_ratio(motion.ratio)
