@@ -31,7 +31,7 @@ import threading
 import time
 import uuid
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -94,7 +94,10 @@ class AuditRecord:
         return dt.datetime.fromisoformat(self.host_time)
 
     def to_line(self) -> bytes:
-        return (json.dumps(asdict(self), ensure_ascii=False, separators=(",", ":")) + "\n").encode("utf-8")
+        doc = {"host_time": self.host_time, "kind": self.kind, "command": self.command, "role": self.role,
+               "result": self.result, "args": self.args, "detail": self.detail,
+               "controller_time": self.controller_time, "session": self.session, "seq": self.seq}
+        return (json.dumps(doc, ensure_ascii=False, separators=(",", ":")) + "\n").encode("utf-8")
 
     @classmethod
     def from_json(cls, data: object) -> AuditRecord:

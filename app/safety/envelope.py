@@ -25,6 +25,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from app.errors import InvalidInput, TeachPadError
+from app.models import Pose
 from app.plan.geometry import PointLike, segment_length, segment_path, xyz_of
 from app.plan.segments import FloatArray, Plan, Segment
 from app.points.ledger import PointLedger
@@ -291,6 +292,24 @@ def require_target(envelope: Envelope, pose: PointLike, joints: Sequence[float] 
     violation = check_target(envelope, pose, joints, speed=speed, reduced=reduced)
     if violation is not None:
         raise EnvelopeRefused(violation, action)
+
+
+def check_step(envelope: Envelope, pose: Pose, offsets: Sequence[float], *, joint: bool,
+               speed: float | None = None, reduced: bool = False) -> EnvelopeViolation | None:
+    """An incremental move (function 1) from ``pose``: base frame (``joint`` False) X Y Z
+    offsets in mm, a straight line checked whole, and its speed (mm/s); joint frame J1..J6
+    offsets in degrees against the joint limits (needs ``pose.joints``; the TCP's path of a
+    joint move needs the arm's kinematics and is the controller's to check)."""
+    if joint:
+        if pose.joints is None:
+            return None
+        target = [q + d for q, d in zip(pose.joints, offsets, strict=False)]
+        return check_joints(envelope, target)
+    if speed is not None and (too_fast := check_speed(envelope, speed, reduced)) is not None:
+        return too_fast
+    start = np.array((pose.x, pose.y, pose.z), dtype=np.float64)
+    end = start + np.asarray(list(offsets)[:3], dtype=np.float64)
+    return check_path(envelope, np.vstack((start, end)))
 
 
 def check_path(envelope: Envelope, xyz: FloatArray) -> EnvelopeViolation | None:

@@ -271,7 +271,7 @@ class IdleLock:
             raise InvalidInput("the idle time must be > 0 s")
         self.timeout = timeout
         self._clock = clock
-        self._on_lock = on_lock
+        self.on_lock = on_lock
         self._role = Role.OPERATOR
         self._last = clock()
 
@@ -300,6 +300,6 @@ class IdleLock:
         if self._role is not Role.OPERATOR and self._clock() - self._last >= self.timeout:
             previous = self._role
             self._role = Role.OPERATOR
-            if self._on_lock is not None:
-                self._on_lock(previous)
+            if self.on_lock is not None:
+                self.on_lock(previous)
         return self._role
