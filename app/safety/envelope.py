@@ -129,6 +129,13 @@ class Box:
         object.__setattr__(self, "lo", lo)
         object.__setattr__(self, "hi", hi)
 
+    def edges(self) -> FloatArray:
+        """(24, 3): the 12 edges as point pairs, for drawing (pyqtgraph ``connect="pairs"``)."""
+        lo, hi = self.lo, self.hi
+        corners = np.array([[(lo, hi)[(k >> i) & 1][i] for i in range(3)] for k in range(8)])
+        pairs = [(k, k | 1 << i) for k in range(8) for i in range(3) if not k >> i & 1]
+        return np.asarray(corners[np.array(pairs).reshape(-1)], dtype=np.float64)
+
     def contains(self, p: FloatArray) -> bool:
         return bool(np.all(p >= self.lo) and np.all(p <= self.hi))
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Protocol
 
 import numpy as np
 
@@ -53,6 +54,23 @@ class ArmSpeeds:
     linear: float = 250.0  # mm/s, Cartesian X/Y/Z jog
     joint: float = 30.0  # deg/s, joint jog
     tcp_in_joint_jog: float = 600.0  # mm/s, an upper bound of the TCP's speed in a joint jog
+
+
+class JogLike(Protocol):
+    """A jog: :class:`JogMotion`, or the worker's :class:`app.link.types.JogRequest` as it is."""
+
+    @property
+    def frame(self) -> TeachFrame: ...
+    @property
+    def axis(self) -> int: ...
+    @property
+    def direction(self) -> int: ...
+    @property
+    def ratio(self) -> float: ...
+
+
+def _sign(motion: JogLike) -> float:
+    return 1.0 if motion.direction else -1.0
 
 
 @dataclass(frozen=True)
@@ -125,14 +143,14 @@ class JogGuard:
         """Seconds until a stop decided at the next poll takes effect."""
         return self.poll_period + self.latency
 
-    def margin(self, motion: JogMotion) -> float:
+    def margin(self, motion: JogLike) -> float:
         """Look-ahead (mm; degrees for a joint against its limit) for ``motion``."""
         frac = max(0.0, motion.ratio) / 100.0
         if motion.frame is TeachFrame.JOINT:
             return self.speeds.tcp_in_joint_jog * frac * self.horizon + JOG_GUARD_EXTRA_MM
         return self.speeds.linear * frac * self.horizon + JOG_GUARD_EXTRA_MM
 
-    def decide(self, pose: Pose, motion: JogMotion) -> JogDecision:
+    def decide(self, pose: Pose, motion: JogLike) -> JogDecision:
         """Allow the jog ``motion`` from ``pose``, or say why to stop it now."""
         env = self.envelope
         p = np.array((pose.x, pose.y, pose.z), dtype=np.float64)
@@ -162,7 +180,7 @@ class JogGuard:
             return JogDecision(True, margin=margin, clearance=clearance, backing_out=True)
         return JogDecision(False, _approaching(env, p, violation), margin, clearance)
 
-    def _direction(self, pose: Pose, motion: JogMotion) -> FloatArray | None:
+    def _direction(self, pose: Pose, motion: JogLike) -> FloatArray | None:
         """Unit vector of the TCP's motion; None: it does not move; empty: not known."""
         if motion.frame is TeachFrame.JOINT or motion.frame is TeachFrame.USER:
             return np.empty(0)
@@ -170,12 +188,12 @@ class JogGuard:
             return None
         if motion.frame is TeachFrame.TOOL:
             column = abc_to_matrix(pose.a, pose.b, pose.c)[:, motion.axis]
-            return np.asarray(column * motion.sign, dtype=np.float64)
+            return np.asarray(column * _sign(motion), dtype=np.float64)
         unit = np.zeros(3)
-        unit[motion.axis] = motion.sign
+        unit[motion.axis] = _sign(motion)
         return unit
 
-    def _joint_decision(self, pose: Pose, motion: JogMotion) -> JogDecision | None:
+    def _joint_decision(self, pose: Pose, motion: JogLike) -> JogDecision | None:
         limits = self.envelope.joint_limits
         ax = motion.axis
         if pose.joints is None or ax >= len(limits) or ax >= len(pose.joints):
@@ -183,13 +201,13 @@ class JogGuard:
         lo, hi = limits[ax]
         q = pose.joints[ax]
         step = self.speeds.joint * motion.ratio / 100.0 * self.horizon + JOG_GUARD_EXTRA_DEG
-        ahead = q + motion.sign * step
+        ahead = q + _sign(motion) * step
         if lo <= ahead <= hi:
             return None
-        inward = (q > hi and motion.sign < 0) or (q < lo and motion.sign > 0)
+        inward = (q > hi and _sign(motion) < 0) or (q < lo and _sign(motion) > 0)
         if inward:
             return None
-        limit = hi if motion.sign > 0 else lo
+        limit = hi if _sign(motion) > 0 else lo
         past = q > hi or q < lo
         return JogDecision(False, EnvelopeViolation(ViolationCode.JOINT_LIMIT, q, limit, f"J{ax + 1}",
                                                     approaching=not past), step)

@@ -141,3 +141,18 @@ def test_a_jog_toward_a_boundary_stops_short_of_it_at_the_simulator(sim: Any, ma
     assert sim.wait_for(lambda s: s.pose[1] > final_y + 5.0, 3.0)
     client.teach_disable()
     assert decided_at.y > limit
+
+
+def test_the_workers_jog_request_is_accepted_as_it_is() -> None:
+    from app.link.types import JogRequest
+
+    guard = JogGuard(ENV, poll_period=0.02)
+    assert not guard.decide(at(0, -95, 400), JogRequest(TeachFrame.BASE, 1, 0, 40.0)).allow
+    assert guard.decide(at(0, -95, 400), JogRequest(TeachFrame.BASE, 1, 1, 40.0)).allow
+
+
+def test_box_edges_for_drawing() -> None:
+    edges = CELL.edges()
+    assert edges.shape == (24, 3)
+    lengths = sorted(float(abs(d).max()) for d in edges[1::2] - edges[::2])
+    assert lengths == [550.0] * 4 + [900.0] * 4 + [1600.0] * 4
