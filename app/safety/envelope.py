@@ -18,11 +18,13 @@ The jog guard lives in :mod:`app.safety.jog_guard`.
 from __future__ import annotations
 
 import enum
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
+from numpy.typing import NDArray
 
 from app.errors import InvalidInput, TeachPadError
 from app.models import Pose
@@ -129,6 +131,14 @@ class Box:
         object.__setattr__(self, "lo", lo)
         object.__setattr__(self, "hi", hi)
 
+    @functools.cached_property
+    def lo_array(self) -> FloatArray:
+        return np.asarray(self.lo, dtype=np.float64)
+
+    @functools.cached_property
+    def hi_array(self) -> FloatArray:
+        return np.asarray(self.hi, dtype=np.float64)
+
     def edges(self) -> FloatArray:
         """(24, 3): the 12 edges as point pairs, for drawing (pyqtgraph ``connect="pairs"``)."""
         lo, hi = self.lo, self.hi
@@ -137,11 +147,15 @@ class Box:
         return np.asarray(corners[np.array(pairs).reshape(-1)], dtype=np.float64)
 
     def contains(self, p: FloatArray) -> bool:
-        return bool(np.all(p >= self.lo) and np.all(p <= self.hi))
+        return bool(np.all(p >= self.lo_array) and np.all(p <= self.hi_array))
+
+    def inside_mask(self, pts: FloatArray) -> NDArray[np.bool_]:
+        """Per row of (n, 3) ``pts``: inside (or on) the box."""
+        return np.asarray(np.all((pts >= self.lo_array) & (pts <= self.hi_array), axis=1))
 
     def depth(self, p: FloatArray) -> tuple[int, float, float]:
         """(axis, value, face) of the nearest face: how ``p`` would leave (or entered) the box."""
-        lo, hi = np.asarray(self.lo), np.asarray(self.hi)
+        lo, hi = self.lo_array, self.hi_array
         d_lo, d_hi = p - lo, hi - p
         i_lo, i_hi = int(np.argmin(d_lo)), int(np.argmin(d_hi))
         if d_lo[i_lo] <= d_hi[i_hi]:
@@ -150,16 +164,38 @@ class Box:
 
     def clearance_inside(self, p: FloatArray) -> float:
         """Distance to the nearest face while inside (> 0); minus the distance to the box outside."""
-        lo, hi = np.asarray(self.lo), np.asarray(self.hi)
-        below, above = lo - p, p - hi
-        out = np.maximum(np.maximum(below, above), 0.0)
-        if np.any(out > 0):
-            return -float(np.linalg.norm(out))
-        return float(min(np.min(p - lo), np.min(hi - p)))
+        # plain floats: called on every jog poll, where numpy's per-call cost dominates
+        out2 = 0.0
+        inside = math.inf
+        for v, lo, hi in zip((float(p[0]), float(p[1]), float(p[2])), self.lo, self.hi, strict=True):
+            excess = max(lo - v, v - hi, 0.0)
+            out2 += excess * excess
+            inside = min(inside, v - lo, hi - v)
+        return -math.sqrt(out2) if out2 > 0 else inside
+
+    def chord_hits(self, a: FloatArray, b: FloatArray) -> bool:
+        """Whether the chord a -> b touches the box (slab test, plain floats)."""
+        t0, t1 = 0.0, 1.0
+        for i in range(3):
+            ai, di = float(a[i]), float(b[i]) - float(a[i])
+            lo, hi = self.lo[i], self.hi[i]
+            if di == 0.0:
+                if ai < lo or ai > hi:
+                    return False
+                continue
+            ta, tb = (lo - ai) / di, (hi - ai) / di
+            if ta > tb:
+                ta, tb = tb, ta
+            t0, t1 = max(t0, ta), min(t1, tb)
+            if t0 > t1:
+                return False
+        return True
 
     def segments_hit(self, a: FloatArray, b: FloatArray) -> int | None:
         """Index of the first chord ``a[k] -> b[k]`` that touches the box (slab test), or None."""
-        lo, hi = np.asarray(self.lo), np.asarray(self.hi)
+        if a.shape[0] <= 4:
+            return next((k for k in range(a.shape[0]) if self.chord_hits(a[k], b[k])), None)
+        lo, hi = self.lo_array, self.hi_array
         d = b - a
         with np.errstate(divide="ignore", invalid="ignore"):
             inv = 1.0 / d
@@ -175,7 +211,7 @@ class Box:
 
     def entry_point(self, a: FloatArray, b: FloatArray) -> FloatArray:
         """Where the chord a -> b first touches the box (``a`` if it starts inside)."""
-        lo, hi = np.asarray(self.lo), np.asarray(self.hi)
+        lo, hi = self.lo_array, self.hi_array
         d = b - a
         t_enter = 0.0
         for i in range(3):
@@ -247,20 +283,27 @@ class Envelope:
 # --- checks ---------------------------------------------------------------------------------
 
 
+def _outside_keep_in(box: Box, p: FloatArray) -> EnvelopeViolation:
+    lo, hi = box.lo_array, box.hi_array
+    i = int(np.argmax(np.maximum(lo - p, p - hi)))
+    limit = float(lo[i] if p[i] < lo[i] else hi[i])
+    return EnvelopeViolation(ViolationCode.KEEP_IN, float(p[i]), limit, AXIS_NAMES[i])
+
+
+def _inside_keep_out(zone: Box, p: FloatArray) -> EnvelopeViolation:
+    i, value, face = zone.depth(p)
+    return EnvelopeViolation(ViolationCode.KEEP_OUT, value, face, AXIS_NAMES[i], zone.name)
+
+
 def check_point(envelope: Envelope, xyz: FloatArray) -> EnvelopeViolation | None:
     """The Cartesian checks of one XYZ (mm)."""
     p = np.asarray(xyz, dtype=np.float64)
     box = envelope.keep_in
     if box is not None and not box.contains(p):
-        lo, hi = np.asarray(box.lo), np.asarray(box.hi)
-        excess = np.maximum(lo - p, p - hi)
-        i = int(np.argmax(excess))
-        limit = float(lo[i] if p[i] < lo[i] else hi[i])
-        return EnvelopeViolation(ViolationCode.KEEP_IN, float(p[i]), limit, AXIS_NAMES[i])
+        return _outside_keep_in(box, p)
     for zone in envelope.keep_out:
         if zone.contains(p):
-            i, value, face = zone.depth(p)
-            return EnvelopeViolation(ViolationCode.KEEP_OUT, value, face, AXIS_NAMES[i], zone.name)
+            return _inside_keep_out(zone, p)
     return None
 
 
@@ -325,19 +368,24 @@ def check_path(envelope: Envelope, xyz: FloatArray) -> EnvelopeViolation | None:
     pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
     if pts.shape[0] == 0:
         return None
-    if envelope.keep_in is not None:
-        for p in pts:
-            v = check_point(replace(envelope, keep_out=()), p)
-            if v is not None:
-                return v
+    box = envelope.keep_in
+    if box is not None:
+        outside = np.flatnonzero(~box.inside_mask(pts))
+        if outside.size:
+            return _outside_keep_in(box, pts[outside[0]])
     if pts.shape[0] == 1:
-        return check_point(replace(envelope, keep_in=None), pts[0])
+        for zone in envelope.keep_out:
+            if zone.contains(pts[0]):
+                return _inside_keep_out(zone, pts[0])
+        return None
     a, b = pts[:-1], pts[1:]
+    pmin, pmax = pts.min(axis=0), pts.max(axis=0)
     for zone in envelope.keep_out:
+        if np.any(pmax < zone.lo_array) or np.any(pmin > zone.hi_array):
+            continue  # the path's bounding box misses the zone
         k = zone.segments_hit(a, b)
         if k is not None:
-            i, value, face = zone.depth(zone.entry_point(a[k], b[k]))
-            return EnvelopeViolation(ViolationCode.KEEP_OUT, value, face, AXIS_NAMES[i], zone.name)
+            return _inside_keep_out(zone, zone.entry_point(a[k], b[k]))
     return None
 
 

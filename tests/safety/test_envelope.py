@@ -121,3 +121,16 @@ def test_plan_without_a_start_pose_checks_the_first_end_point_only() -> None:
     plan = Plan("p", [Segment(SegmentKind.LINE, end_id=1, speed=100), Segment(SegmentKind.LINE, end_id=2)])
     vs = plan_violations(plan, ledger, ENV)
     assert [(v.segment, v.code) for v in vs] == [(0, ViolationCode.KEEP_OUT), (1, ViolationCode.KEEP_OUT)]
+
+
+def test_scalar_and_vectorised_chord_tests_agree() -> None:
+    rng = np.random.default_rng(7)
+    box = Box("z", (-10.0, -20.0, -5.0), (10.0, 20.0, 5.0))
+    a = rng.uniform(-40, 40, size=(400, 3))
+    b = rng.uniform(-40, 40, size=(400, 3))
+    b[::7, 1] = a[::7, 1]  # chords parallel to a face
+    scalar = [box.chord_hits(a[k], b[k]) for k in range(len(a))]
+    assert any(scalar) and not all(scalar)
+    for k in range(len(a)):
+        hit = box.segments_hit(np.repeat(a[k:k + 1], 5, axis=0), np.repeat(b[k:k + 1], 5, axis=0))
+        assert (hit == 0) == scalar[k]
