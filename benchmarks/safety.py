@@ -23,8 +23,9 @@ from app.safety.audit import AuditLog, FsyncPolicy
 from app.safety.envelope import Box, Envelope, plan_violations
 from app.safety.jog_guard import JogGuard, JogMotion
 
-ENV = Envelope(keep_in=Box("cell", (-900, -900, 0), (900, 900, 1200)),
-               keep_out=tuple(Box(f"zone {i}", (i * 50.0, 600, 0), (i * 50.0 + 20, 700, 300)) for i in range(8)))
+# eight small zones among the plan's paths (z 350..450 around the plan's z = 400)
+ZONES = tuple(Box(f"zone {i}", (i * 50.0 - 200, 400, 350), (i * 50.0 - 180, 420, 450)) for i in range(8))
+ENV = Envelope(keep_in=Box("cell", (-900, -900, 0), (900, 900, 1200)), keep_out=ZONES)
 
 
 def _per_call_us(fn: Any, n: int) -> float:
@@ -42,7 +43,8 @@ def run(quick: bool = False) -> dict[str, Any]:
         with tempfile.TemporaryDirectory(dir=base) as d:
             log = AuditLog(Path(d), fsync=policy)
             n = (50 if quick else 300) if policy is FsyncPolicy.ALWAYS else (500 if quick else 3000)
-            audit[policy.value] = round(_per_call_us(lambda log=log: log.record_write(406, [0, 0x41A0]), n), 1)
+            per = _per_call_us(lambda log=log: log.record_write(406, [0, 0x41A0]), n)
+            audit[policy.value] = round(per, 1)
             log.close()
     out["audit_us_per_write_record"] = audit
     guard = JogGuard(ENV, poll_period=0.02)
