@@ -120,7 +120,8 @@ class AuditLog:
                  fsync: FsyncPolicy = FsyncPolicy.INTERVAL, max_file_bytes: int = MAX_FILE_BYTES,
                  max_total_bytes: int = MAX_TOTAL_BYTES, keep_days: int = KEEP_DAYS,
                  word_order: WordOrder = WordOrder.LOW_FIRST,
-                 now: Callable[[], dt.datetime] | None = None) -> None:
+                 now: Callable[[], dt.datetime] | None = None,
+                 on_error: Callable[[str], None] | None = None) -> None:
         self.directory = directory or default_audit_dir()
         self._role = role
         self.fsync = fsync
@@ -139,6 +140,11 @@ class AuditLog:
         self._clock: tuple[dt.datetime, float] | None = None
         self.session = uuid.uuid4().hex[:12]
         self._seq = 0
+        # A full disk must not stop a write (least of all a stop): records that cannot be
+        # written are counted, and on_error hears of each new problem once.
+        self.on_error = on_error
+        self.last_error: str | None = None
+        self.dropped = 0
 
     # --- context ---------------------------------------------------------------------------
     @property
@@ -168,8 +174,22 @@ class AuditLog:
                               role or self.role, result, dict(args or {}), _short(detail),
                               self._controller_time(), self.session, self._seq)
             self._seq += 1
-            self._append(rec.to_line(), now)
+            try:
+                self._append(rec.to_line(), now)
+            except OSError as exc:
+                self._failed(exc)
+            else:
+                self.last_error = None
             return rec
+
+    def _failed(self, exc: OSError) -> None:
+        self.dropped += 1
+        self._close_fd()
+        message = f"the audit trail cannot be written in {self.directory} ({exc.strerror or exc})"
+        if message != self.last_error:
+            self.last_error = message
+            if self.on_error is not None:
+                self.on_error(message)
 
     def record_write(self, address: int, values: Sequence[int], *, single: bool = False,
                      error: BaseException | None = None) -> AuditRecord:

@@ -176,3 +176,14 @@ def test_every_write_appears_once_also_after_kill_9(tmp_path: Path, sim: Any) ->
         sent = sorted(seq for t, seq in received if t == tag)
         assert all(seq == sent[-1] for t, seq in missing if t == tag)
     assert len(audit_files(tmp_path)) > 1  # rotated while being killed
+
+
+def test_an_unwritable_audit_never_blocks_the_write_and_says_so_once(tmp_path: Path) -> None:
+    blocker = tmp_path / "audit"
+    blocker.write_text("a file where the folder should be")
+    heard: list[str] = []
+    log = AuditLog(blocker, on_error=heard.append)
+    with log.writing(441, [1], single=True):
+        pass  # the write itself went out
+    log.record_write(441, [1], single=True)
+    assert log.dropped == 2 and len(heard) == 1 and "cannot be written" in heard[0]
