@@ -1,6 +1,8 @@
-"""``teachpad-cli support-bundle OUT.zip`` and ``teachpad-cli audit``: offline commands.
+"""``teachpad-cli support-bundle OUT.zip``, ``audit`` and ``roles``: offline commands.
 
-Neither talks to the controller. ``support-bundle`` writes the zip of
+None talks to the controller. ``roles`` lets an administrator set or clear the engineer's and
+administrator's passwords (read from the terminal, or one line of stdin; never an argument,
+so they stay out of the shell history) and see which are set. ``support-bundle`` writes the zip of
 :mod:`app.safety.bundle` (versions, the CLI's connection settings plus an optional settings
 file with secrets removed, the project, the safety profile, the audit trail of the last days,
 log files, recorded traffic). ``audit`` prints or exports the audit trail, filtered.
@@ -14,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
+import getpass
 import json
 import sys
 from pathlib import Path
@@ -22,6 +25,7 @@ from typing import Any
 from app.errors import InvalidInput
 from app.safety.audit import AuditFilter, ReadStats, default_audit_dir, export_csv, query
 from app.safety.bundle import DEFAULT_DAYS, write_support_bundle
+from app.safety.roles import Role, RoleStore, default_store_path
 
 ADMIN_NOTE = ("teachpad-cli is an administrator's tool: it is not limited by TeachPad's roles "
               "(anyone with a shell can read and write TeachPad's files).")
@@ -67,6 +71,18 @@ def register(subparsers: Any) -> None:
     p.add_argument("--result", choices=("ok", "failed", "blocked", "refused"))
     p.add_argument("--csv", type=Path, metavar="OUT", help="write CSV instead of printing")
     p.set_defaults(handler=cmd_audit)
+
+    p = subparsers.add_parser("roles", help="set or clear the GUI's role passwords (offline)",
+                              description="Passwords of TeachPad's roles. " + ADMIN_NOTE)
+    p.add_argument("--store", type=Path, help=f"the role store (default {default_store_path()})")
+    rsub = p.add_subparsers(dest="roles_command", metavar="ACTION", required=True)
+    r = rsub.add_parser("show", help="which roles have a password, and the idle time")
+    r.set_defaults(handler=cmd_roles)
+    for name, text in (("set-password", "set a role's password (asked for, not an argument)"),
+                       ("clear-password", "remove a role's password (nobody can log in as it)")):
+        r = rsub.add_parser(name, help=text)
+        r.add_argument("role", choices=("engineer", "administrator"))
+        r.set_defaults(handler=cmd_roles)
 
 
 def _read_text_lines(path: Path, what: str) -> list[str]:
@@ -121,4 +137,31 @@ def cmd_audit(ctx: Any) -> int:
             ctx.print(f"{r.host_time}  {r.role:<13} {r.result:<8} {r.command}{extra}")
     if stats.skipped:
         print(f"teachpad-cli: warning: {stats.skipped} damaged line(s) skipped", file=sys.stderr)
+    return 0
+
+
+def _read_password() -> str:
+    if sys.stdin.isatty():
+        first = getpass.getpass("new password: ")
+        if getpass.getpass("again: ") != first:
+            raise InvalidInput("the two passwords differ; nothing changed")
+        return first
+    return sys.stdin.readline().rstrip("\r\n")
+
+
+def cmd_roles(ctx: Any) -> int:
+    args = ctx.args
+    store = RoleStore(args.store or default_store_path())
+    if args.roles_command == "show":
+        for role in (Role.ENGINEER, Role.ADMINISTRATOR):
+            ctx.print(f"{role.text:<13} {'password set' if store.has_password(role) else 'no password'}")
+        ctx.print(f"idle lock     {store.idle_timeout:g} s")
+        return 0
+    role = Role.parse(args.role)
+    if args.roles_command == "clear-password":
+        store.clear_password(role, by=Role.ADMINISTRATOR)
+        ctx.print(f"password of the {role.text} role removed")
+        return 0
+    store.set_password(role, _read_password(), by=Role.ADMINISTRATOR)
+    ctx.print(f"password of the {role.text} role set")
     return 0

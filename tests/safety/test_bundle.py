@@ -101,3 +101,21 @@ def test_cli_support_bundle_and_audit(tmp_path: Path, files: dict[str, Path],
 def test_cli_help_says_it_is_an_administrators_tool(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["--help"]) == 0
     assert "administrator's tool" in capsys.readouterr().out
+
+
+def test_cli_roles(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                   capsys: pytest.CaptureFixture[str]) -> None:
+    import io
+
+    store = tmp_path / "roles.json"
+    monkeypatch.setattr("sys.stdin", io.StringIO("eng-secret\n"))
+    assert main(["roles", "--store", str(store), "set-password", "engineer"]) == 0
+    assert "eng-secret" not in store.read_text()
+    assert RoleStore(store).verify(Role.ENGINEER, "eng-secret")
+    monkeypatch.setattr("sys.stdin", io.StringIO("ab\n"))
+    assert main(["roles", "--store", str(store), "set-password", "administrator"]) == 2
+    assert "at least 4 characters" in capsys.readouterr().err
+    assert main(["roles", "--store", str(store), "show"]) == 0
+    assert "engineer      password set" in capsys.readouterr().out
+    assert main(["roles", "--store", str(store), "clear-password", "engineer"]) == 0
+    assert not RoleStore(store).has_password(Role.ENGINEER)
