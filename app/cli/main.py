@@ -576,7 +576,7 @@ def register_core(sub: Any) -> None:
 # Registrars run in order; other modules may append theirs.
 REGISTRARS: list[Registrar] = [register_core]
 # Optional modules with a ``register(subparsers)`` function, used when they exist.
-PLUGIN_MODULES: tuple[str, ...] = ("app.cli.points", "app.cli_run")
+PLUGIN_MODULES: tuple[str, ...] = ("app.cli.points", "app.cli_run", "app.cli.support")
 
 
 def _plugin_registrars() -> Iterator[Registrar]:
@@ -593,7 +593,8 @@ def _plugin_registrars() -> Iterator[Registrar]:
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG,
-        description="Talk to a Bochuang robot controller over Modbus.",
+        description="Talk to a Bochuang robot controller over Modbus. An administrator's tool: "
+                    "TeachPad's operator roles apply to the GUI, not here.",
         epilog="exit codes: 0 ok, 1 command failed/refused, 2 usage, 3 link/timeout/malformed answer, "
                "130 interrupted",
     )

@@ -21,6 +21,7 @@ from app.points.ledger import (
     SyncState,
     tool_text,
 )
+from app.safety.envelope import Envelope, plan_violations
 
 
 @dataclass(frozen=True)
@@ -65,6 +66,7 @@ class IssueCode(enum.Enum):
     TOOL_MISMATCH = "tool-mismatch"
     BAD_START = "bad-start"
     ARC_RESUME_PAST_MIDDLE = "arc-resume-past-middle"
+    OUTSIDE_ENVELOPE = "outside-envelope"  # an error: the segment leaves the safety envelope
 
 
 @dataclass(frozen=True)
@@ -127,13 +129,17 @@ def check_plan(
     *,
     start_index: int = 0,
     loops: int | None = None,
+    envelope: Envelope | None = None,
+    reduced_speed: bool = False,
 ) -> list[PlanIssue]:
     """Everything to fix (or know) before running ``plan`` from segment ``start_index``.
 
     ``current_pose`` is where the robot is now: the start of segment ``start_index``.
     Without it, an arc starting there is reported as unchecked (warning). With ``loops``
     other than 1, the first segment is also checked from the end of the last one.
-    Issues come sorted by segment; "needs upload" is reported once per point.
+    Issues come sorted by segment; "needs upload" is reported once per point. With an
+    ``envelope``, a segment that leaves it (sampled, arcs too) or runs faster than it allows
+    is an error (:data:`IssueCode.OUTSIDE_ENVELOPE`), which blocks Run.
     """
     limits = limits or PlanLimits()
     loops = plan.loops if loops is None else loops
@@ -217,6 +223,10 @@ def check_plan(
                     issues.append(PlanIssue(i, IssueKind.WARNING, IssueCode.ZERO_LENGTH,
                                             f"{_seg_name(i)}: the line goes nowhere "
                                             f"(start and end {length:.3g} mm apart){suffix}"))
+    if envelope is not None:
+        for v in plan_violations(plan, ledger, envelope, current_pose, start_index=start_index,
+                                 loops=loops, reduced=reduced_speed):
+            issues.append(PlanIssue(v.segment, IssueKind.ERROR, IssueCode.OUTSIDE_ENVELOPE, v.message))
     order = {IssueKind.ERROR: 0, IssueKind.NEEDS_UPLOAD: 1, IssueKind.WARNING: 2}
     issues.sort(key=lambda it: (-1 if it.segment is None else it.segment, order[it.kind]))
     return issues

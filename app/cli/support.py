@@ -1,0 +1,167 @@
+"""``teachpad-cli support-bundle OUT.zip``, ``audit`` and ``roles``: offline commands.
+
+None talks to the controller. ``roles`` lets an administrator set or clear the engineer's and
+administrator's passwords (read from the terminal, or one line of stdin; never an argument,
+so they stay out of the shell history) and see which are set. ``support-bundle`` writes the zip of
+:mod:`app.safety.bundle` (versions, the CLI's connection settings plus an optional settings
+file with secrets removed, the project, the safety profile, the audit trail of the last days,
+log files, recorded traffic). ``audit`` prints or exports the audit trail, filtered.
+
+teachpad-cli is an administrator's tool: whoever has a shell on the pendant PC can read and
+write every file TeachPad keeps, so a ``--role`` switch would protect nothing. Roles guard the
+GUI.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import getpass
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from app.errors import InvalidInput
+from app.safety.audit import AuditFilter, ReadStats, default_audit_dir, export_csv, query
+from app.safety.bundle import DEFAULT_DAYS, write_support_bundle
+from app.safety.roles import Role, RoleStore, default_store_path
+
+ADMIN_NOTE = ("teachpad-cli is an administrator's tool: it is not limited by TeachPad's roles "
+              "(anyone with a shell can read and write TeachPad's files).")
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text[:20]!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError("must be at least 1")
+    return value
+
+
+def _moment(text: str) -> dt.datetime:
+    try:
+        return dt.datetime.fromisoformat(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a date or time (YYYY-MM-DD[THH:MM]): {text[:20]!r}") from None
+
+
+def register(subparsers: Any) -> None:
+    p = subparsers.add_parser("support-bundle", help="write a zip for an integrator (offline)",
+                              description="Write a support bundle. " + ADMIN_NOTE)
+    p.add_argument("out", type=Path, metavar="OUT.zip")
+    p.add_argument("--project", type=Path, help="the project file to include")
+    p.add_argument("--profile", type=Path, help="the safety profile to include")
+    p.add_argument("--settings", type=Path, help="a JSON settings file (secrets are removed)")
+    p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
+    p.add_argument("--log-dir", type=Path, help="a folder of log files to include")
+    p.add_argument("--traffic", type=Path, help="a text file of recorded Modbus traffic")
+    p.add_argument("--days", type=_positive_int, default=DEFAULT_DAYS, help="how many days of records")
+    p.set_defaults(handler=cmd_support_bundle)
+
+    p = subparsers.add_parser("audit", help="show or export the audit trail (offline)",
+                              description="Show the audit trail. " + ADMIN_NOTE)
+    p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
+    p.add_argument("--from", dest="start", type=_moment, metavar="WHEN")
+    p.add_argument("--to", dest="end", type=_moment, metavar="WHEN")
+    p.add_argument("--role")
+    p.add_argument("--command", dest="command_text", metavar="TEXT", help="part of the command text")
+    p.add_argument("--result", choices=("ok", "failed", "blocked", "refused"))
+    p.add_argument("--csv", type=Path, metavar="OUT", help="write CSV instead of printing")
+    p.set_defaults(handler=cmd_audit)
+
+    p = subparsers.add_parser("roles", help="set or clear the GUI's role passwords (offline)",
+                              description="Passwords of TeachPad's roles. " + ADMIN_NOTE)
+    p.add_argument("--store", type=Path, help=f"the role store (default {default_store_path()})")
+    rsub = p.add_subparsers(dest="roles_command", metavar="ACTION", required=True)
+    r = rsub.add_parser("show", help="which roles have a password, and the idle time")
+    r.set_defaults(handler=cmd_roles)
+    for name, text in (("set-password", "set a role's password (asked for, not an argument)"),
+                       ("clear-password", "remove a role's password (nobody can log in as it)")):
+        r = rsub.add_parser(name, help=text)
+        r.add_argument("role", choices=("engineer", "administrator"))
+        r.set_defaults(handler=cmd_roles)
+
+
+def _read_text_lines(path: Path, what: str) -> list[str]:
+    try:
+        return path.read_text(encoding="utf-8", errors="replace").splitlines()
+    except OSError as exc:
+        raise InvalidInput(f"{what} {path.name} cannot be read ({exc.strerror or exc})") from None
+
+
+def cmd_support_bundle(ctx: Any) -> int:
+    args = ctx.args
+    settings: dict[str, Any] = {"cli connection": _settings_dict(ctx.settings)}
+    if args.settings is not None:
+        try:
+            settings["settings file"] = json.loads(args.settings.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise InvalidInput(f"settings file {args.settings.name} cannot be used "
+                               f"({str(exc)[:80]})") from None
+    for name in ("project", "profile"):
+        path = getattr(args, name)
+        if path is not None and not path.is_file():
+            raise InvalidInput(f"{name} file {str(path)[:60]} does not exist")
+    traffic = None if args.traffic is None else _read_text_lines(args.traffic, "traffic file")
+    manifest = write_support_bundle(
+        args.out, settings=settings, project=args.project, profile=args.profile,
+        audit_dir=args.audit_dir or default_audit_dir(), log_dir=args.log_dir, traffic=traffic,
+        days=args.days)
+    ctx.print(f"wrote {args.out} ({len(manifest.files)} files)")
+    for note in manifest.left_out:
+        ctx.print(f"  left out: {note}")
+    return 0
+
+
+def _settings_dict(settings: Any) -> dict[str, Any]:
+    fields = getattr(settings, "__dataclass_fields__", {})
+    return {name: getattr(settings, name) for name in fields}
+
+
+def cmd_audit(ctx: Any) -> int:
+    args = ctx.args
+    flt = AuditFilter(start=args.start, end=args.end, role=args.role, command=args.command_text,
+                      result=args.result)
+    stats = ReadStats()
+    records = query(args.audit_dir or default_audit_dir(), flt, stats)
+    if args.csv is not None:
+        with open(args.csv, "w", encoding="utf-8", newline="") as f:
+            n = export_csv(records, f)
+        ctx.print(f"wrote {n} records to {args.csv}")
+    else:
+        for r in records:
+            extra = f" - {r.detail}" if r.detail else ""
+            ctx.print(f"{r.host_time}  {r.role:<13} {r.result:<8} {r.command}{extra}")
+    if stats.skipped:
+        print(f"teachpad-cli: warning: {stats.skipped} damaged line(s) skipped", file=sys.stderr)
+    return 0
+
+
+def _read_password() -> str:
+    if sys.stdin.isatty():
+        first = getpass.getpass("new password: ")
+        if getpass.getpass("again: ") != first:
+            raise InvalidInput("the two passwords differ; nothing changed")
+        return first
+    return sys.stdin.readline().rstrip("\r\n")
+
+
+def cmd_roles(ctx: Any) -> int:
+    args = ctx.args
+    store = RoleStore(args.store or default_store_path())
+    if args.roles_command == "show":
+        for role in (Role.ENGINEER, Role.ADMINISTRATOR):
+            ctx.print(f"{role.text:<13} {'password set' if store.has_password(role) else 'no password'}")
+        ctx.print(f"idle lock     {store.idle_timeout:g} s")
+        return 0
+    role = Role.parse(args.role)
+    if args.roles_command == "clear-password":
+        store.clear_password(role, by=Role.ADMINISTRATOR)
+        ctx.print(f"password of the {role.text} role removed")
+        return 0
+    store.set_password(role, _read_password(), by=Role.ADMINISTRATOR)
+    ctx.print(f"password of the {role.text} role set")
+    return 0

@@ -1,0 +1,436 @@
+"""The audit trail: every write TeachPad sends and every refused action, one JSON line each.
+
+Files: ``<data dir>/audit/audit-YYYY-MM-DD.jsonl`` per (host, local) day; when a day's file
+reaches :data:`MAX_FILE_BYTES` the next part is ``audit-YYYY-MM-DD.1.jsonl``, ``.2`` ...
+(new files, never renames). After each new file, old ones go: older than ``keep_days``, then
+the oldest until the total is under ``max_total_bytes``.
+
+Crash safety: the file is opened with ``O_APPEND`` and each record is one ``os.write`` of a
+whole line, so a ``kill -9`` loses at most the record being written, and a partly written last
+line (possible only on a power cut or a full disk) is skipped by the reader and closed with a
+newline by the next writer before it appends. ``fsync`` guards against power loss, not process
+death (the page cache survives a killed process); :data:`FsyncPolicy.INTERVAL` (the default)
+syncs at most once per :data:`FSYNC_INTERVAL` seconds — see ``benchmarks`` in the report for the
+cost of syncing every line.
+
+A record is written *after* the write's outcome is known (one line per write, with its
+result), so each write appears exactly once; a crash during a write loses that one.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import datetime as dt
+import enum
+import json
+import os
+import re
+import sys
+import threading
+import time
+import uuid
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, TextIO
+
+from app.errors import TeachPadError, WriteBlocked
+from app.protocol.codec import WordOrder
+from app.protocol.naming import describe_registers, single_write_text, write_summary
+
+MAX_FILE_BYTES = 8 * 1024 * 1024
+MAX_TOTAL_BYTES = 256 * 1024 * 1024
+KEEP_DAYS = 90
+FSYNC_INTERVAL = 1.0  # s
+MAX_VALUES_KEPT = 64  # register values stored per write record
+MAX_DETAIL_CHARS = 300
+FILE_RE = re.compile(r"audit-(\d{4}-\d{2}-\d{2})(?:\.(\d+))?\.jsonl")
+
+
+class FsyncPolicy(enum.Enum):
+    ALWAYS = "always"  # every line: survives power loss, costs a disk flush per write
+    INTERVAL = "interval"  # at most once per FSYNC_INTERVAL
+    NEVER = "never"  # the OS decides (a killed process still loses nothing written)
+
+
+class Result:
+    OK = "ok"
+    FAILED = "failed"  # sent, and the controller or the link failed it
+    BLOCKED = "blocked"  # not sent: monitor-only
+    REFUSED = "refused"  # not sent: the host refused (envelope, role, bad value)
+
+
+def default_data_dir() -> Path:
+    """Per-user data directory of TeachPad."""
+    if sys.platform == "win32":
+        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
+    elif sys.platform == "darwin":
+        base = Path.home() / "Library" / "Application Support"
+    else:
+        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
+    return base / "teachpad"
+
+
+def default_audit_dir() -> Path:
+    return default_data_dir() / "audit"
+
+
+@dataclass(frozen=True)
+class AuditRecord:
+    host_time: str  # ISO 8601, local time with offset, milliseconds
+    kind: str  # "write", "refused", "login", "action"
+    command: str  # what, in words: "teach enable (440 ← 0x80)", "jog", ...
+    role: str
+    result: str  # Result.*
+    args: dict[str, Any] = field(default_factory=dict)
+    detail: str = ""  # the error or the reason, plain English
+    controller_time: str | None = None  # the controller's clock, estimated from its last read
+    session: str = ""  # one id per AuditLog: with seq, identifies a record
+    seq: int = 0
+
+    @property
+    def time(self) -> dt.datetime:
+        return dt.datetime.fromisoformat(self.host_time)
+
+    def to_line(self) -> bytes:
+        doc = {"host_time": self.host_time, "kind": self.kind, "command": self.command, "role": self.role,
+               "result": self.result, "args": self.args, "detail": self.detail,
+               "controller_time": self.controller_time, "session": self.session, "seq": self.seq}
+        return (json.dumps(doc, ensure_ascii=False, separators=(",", ":")) + "\n").encode("utf-8")
+
+    @classmethod
+    def from_json(cls, data: object) -> AuditRecord:
+        if not isinstance(data, dict):
+            raise ValueError("not an object")
+        known = {k: data[k] for k in cls.__dataclass_fields__ if k in data}
+        rec = cls(**known)
+        dt.datetime.fromisoformat(rec.host_time)  # must parse
+        return rec
+
+
+def _short(text: str, limit: int = MAX_DETAIL_CHARS) -> str:
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+class AuditLog:
+    """Appends records; thread-safe (the worker records writes, the GUI refusals)."""
+
+    def __init__(self, directory: Path | None = None, *, role: Callable[[], str] | str = "operator",
+                 fsync: FsyncPolicy = FsyncPolicy.INTERVAL, max_file_bytes: int = MAX_FILE_BYTES,
+                 max_total_bytes: int = MAX_TOTAL_BYTES, keep_days: int = KEEP_DAYS,
+                 word_order: WordOrder = WordOrder.LOW_FIRST,
+                 now: Callable[[], dt.datetime] | None = None,
+                 on_error: Callable[[str], None] | None = None) -> None:
+        self.directory = directory or default_audit_dir()
+        self._role = role
+        self.fsync = fsync
+        self.max_file_bytes = max_file_bytes
+        self.max_total_bytes = max_total_bytes
+        self.keep_days = keep_days
+        self.word_order = word_order
+        self._now = now or (lambda: dt.datetime.now().astimezone())
+        self._lock = threading.Lock()
+        self._fd: int | None = None
+        self._path: Path | None = None
+        self._size = 0
+        self._day = ""
+        self._last_sync = 0.0
+        self._unsynced = False
+        self._clock: tuple[dt.datetime, float] | None = None
+        self.session = uuid.uuid4().hex[:12]
+        self._seq = 0
+        # A full disk must not stop a write (least of all a stop): records that cannot be
+        # written are counted, and on_error hears of each new problem once.
+        self.on_error = on_error
+        self.last_error: str | None = None
+        self.dropped = 0
+
+    # --- context ---------------------------------------------------------------------------
+    @property
+    def role(self) -> str:
+        return self._role() if callable(self._role) else self._role
+
+    def set_role(self, role: Callable[[], str] | str) -> None:
+        self._role = role
+
+    def note_controller_clock(self, clock: dt.datetime | None, at: float | None = None) -> None:
+        """The controller's clock as just read (``at``: ``time.monotonic()`` of the read)."""
+        with self._lock:
+            self._clock = None if clock is None else (clock, time.monotonic() if at is None else at)
+
+    def _controller_time(self) -> str | None:
+        if self._clock is None:
+            return None
+        clock, at = self._clock
+        return (clock + dt.timedelta(seconds=time.monotonic() - at)).isoformat(timespec="seconds")
+
+    # --- recording --------------------------------------------------------------------------
+    def record(self, kind: str, command: str, *, result: str = Result.OK, args: dict[str, Any] | None = None,
+               detail: str = "", role: str | None = None) -> AuditRecord:
+        with self._lock:
+            now = self._now()
+            rec = AuditRecord(now.isoformat(timespec="milliseconds"), kind, command,
+                              role or self.role, result, dict(args or {}), _short(detail),
+                              self._controller_time(), self.session, self._seq)
+            self._seq += 1
+            try:
+                self._append(rec.to_line(), now)
+            except OSError as exc:
+                self._failed(exc)
+            else:
+                self.last_error = None
+            return rec
+
+    def _failed(self, exc: OSError) -> None:
+        self.dropped += 1
+        self._close_fd()
+        message = f"the audit trail cannot be written in {self.directory} ({exc.strerror or exc})"
+        if message != self.last_error:
+            self.last_error = message
+            if self.on_error is not None:
+                self.on_error(message)
+
+    def record_write(self, address: int, values: Sequence[int], *, single: bool = False,
+                     error: BaseException | None = None) -> AuditRecord:
+        """One write to the controller and how it ended (``error`` None: it succeeded)."""
+        vals = [int(v) for v in values]
+        try:
+            if single and len(vals) == 1:
+                command = single_write_text(address, vals[0])
+            else:
+                command = write_summary(address, describe_registers(address, vals, self.word_order))
+        except Exception:  # naming is a courtesy; never lose the record over it
+            command = f"write {len(vals)} register(s) at {address}"
+        if error is None:
+            result, detail = Result.OK, ""
+        elif isinstance(error, WriteBlocked):
+            result, detail = Result.BLOCKED, str(error)
+        else:
+            result, detail = Result.FAILED, str(error) or type(error).__name__
+        args = {"fc": 6 if single else 16, "address": address, "values": vals[:MAX_VALUES_KEPT]}
+        if len(vals) > MAX_VALUES_KEPT:
+            args["count"] = len(vals)
+        return self.record("write", command, result=result, args=args, detail=detail)
+
+    @contextlib.contextmanager
+    def writing(self, address: int, values: Sequence[int], *, single: bool = False) -> Iterator[None]:
+        """Wrap one write: records it with its outcome; errors pass through unchanged."""
+        try:
+            yield
+        except TeachPadError as exc:
+            self.record_write(address, values, single=single, error=exc)
+            raise
+        self.record_write(address, values, single=single)
+
+    def record_refused(self, action: str, reason: str, args: dict[str, Any] | None = None) -> AuditRecord:
+        """An action the host refused (envelope, role, bad value): nothing was sent."""
+        return self.record("refused", action, result=Result.REFUSED, args=args, detail=reason)
+
+    def close(self) -> None:
+        with self._lock:
+            self._close_fd()
+
+    def __enter__(self) -> AuditLog:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # --- files ------------------------------------------------------------------------------
+    def _close_fd(self) -> None:
+        if self._fd is not None:
+            with contextlib.suppress(OSError):
+                if self._unsynced and self.fsync is not FsyncPolicy.NEVER:
+                    os.fsync(self._fd)
+                os.close(self._fd)
+            self._fd = None
+            self._unsynced = False
+
+    def _append(self, line: bytes, now: dt.datetime) -> None:
+        day = now.date().isoformat()
+        if self._fd is None or day != self._day or self._size + len(line) > self.max_file_bytes:
+            self._open_for(day, len(line))
+        assert self._fd is not None
+        view = memoryview(line)
+        while view:
+            view = view[os.write(self._fd, view):]
+        self._size += len(line)
+        self._sync()
+
+    def _sync(self) -> None:
+        assert self._fd is not None
+        if self.fsync is FsyncPolicy.ALWAYS:
+            os.fsync(self._fd)
+            return
+        self._unsynced = True
+        if self.fsync is FsyncPolicy.INTERVAL and time.monotonic() - self._last_sync >= FSYNC_INTERVAL:
+            os.fsync(self._fd)
+            self._last_sync = time.monotonic()
+            self._unsynced = False
+
+    def _open_for(self, day: str, need: int) -> None:
+        self._close_fd()
+        self.directory.mkdir(parents=True, exist_ok=True)
+        parts = sorted((part, p) for p, d, part in _audit_files(self.directory) if d == day)
+        part = parts[-1][0] if parts else 0
+        while True:
+            path = self.directory / _file_name(day, part)
+            size = path.stat().st_size if path.exists() else 0
+            if size == 0 or size + need <= self.max_file_bytes:
+                break
+            part += 1
+        fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT | getattr(os, "O_BINARY", 0), 0o600)
+        if size and not _ends_with_newline(path):
+            os.write(fd, b"\n")  # close a line cut short by a crash; the reader skips it
+            size += 1
+        self._fd, self._path, self._size, self._day = fd, path, size, day
+        self._prune(keep=path)
+
+    def _prune(self, keep: Path) -> None:
+        files = sorted(((d, part, p) for p, d, part in _audit_files(self.directory)),
+                       key=lambda t: (t[0], t[1]))
+        cutoff = (self._now().date() - dt.timedelta(days=self.keep_days)).isoformat()
+        remaining: list[tuple[Path, int]] = []
+        for d, _, p in files:
+            if p == keep:
+                continue
+            if d < cutoff:
+                with contextlib.suppress(OSError):
+                    p.unlink()
+                continue
+            with contextlib.suppress(OSError):
+                remaining.append((p, p.stat().st_size))
+        total = sum(s for _, s in remaining) + self._size
+        for p, s in remaining:  # oldest first
+            if total <= self.max_total_bytes:
+                break
+            with contextlib.suppress(OSError):
+                p.unlink()
+                total -= s
+
+
+def _file_name(day: str, part: int) -> str:
+    return f"audit-{day}.jsonl" if part == 0 else f"audit-{day}.{part}.jsonl"
+
+
+def _audit_files(directory: Path) -> list[tuple[Path, str, int]]:
+    """(path, day, part) of every audit file in ``directory``."""
+    found = []
+    with contextlib.suppress(OSError):
+        for entry in os.scandir(directory):
+            m = FILE_RE.fullmatch(entry.name)
+            if m and entry.is_file():
+                found.append((Path(entry.path), m.group(1), int(m.group(2) or 0)))
+    return found
+
+
+def _ends_with_newline(path: Path) -> bool:
+    with open(path, "rb") as f:
+        f.seek(-1, os.SEEK_END)
+        return f.read(1) == b"\n"
+
+
+# --- reading ----------------------------------------------------------------------------------
+
+
+@dataclass
+class ReadStats:
+    files: int = 0
+    records: int = 0
+    skipped: int = 0  # lines that did not parse (a line cut short by a crash, damage)
+
+
+def audit_files(directory: Path, start: dt.date | None = None, end: dt.date | None = None) -> list[Path]:
+    """The audit files of days ``start``..``end`` (inclusive), in time order."""
+    out = []
+    for p, d, part in _audit_files(directory):
+        day = dt.date.fromisoformat(d)
+        if (start is None or day >= start) and (end is None or day <= end):
+            out.append((d, part, p))
+    return [p for _, _, p in sorted(out)]
+
+
+def read_records(directory: Path, start: dt.date | None = None, end: dt.date | None = None,
+                 stats: ReadStats | None = None) -> Iterator[AuditRecord]:
+    """Every record of days ``start``..``end``; lines that do not parse are skipped and counted."""
+    stats = stats if stats is not None else ReadStats()
+    for path in audit_files(directory, start, end):
+        stats.files += 1
+        try:
+            data = path.read_bytes()
+        except OSError:
+            continue
+        for raw in data.split(b"\n"):
+            if not raw.strip():
+                continue
+            try:
+                rec = AuditRecord.from_json(json.loads(raw.decode("utf-8")))
+            except (ValueError, TypeError, UnicodeDecodeError):
+                stats.skipped += 1
+                continue
+            stats.records += 1
+            yield rec
+
+
+@dataclass(frozen=True)
+class AuditFilter:
+    """What the viewer shows: a time range (host time), role, command text, result, kind."""
+
+    start: dt.datetime | None = None
+    end: dt.datetime | None = None
+    role: str | None = None
+    command: str | None = None  # case-insensitive substring
+    result: str | None = None
+    kind: str | None = None
+
+    def matches(self, rec: AuditRecord) -> bool:
+        if self.role is not None and rec.role != self.role:
+            return False
+        if self.result is not None and rec.result != self.result:
+            return False
+        if self.kind is not None and rec.kind != self.kind:
+            return False
+        if self.command and self.command.lower() not in rec.command.lower():
+            return False
+        if self.start is not None or self.end is not None:
+            t = rec.time
+            if self.start is not None and _cmp_time(t, self.start) < 0:
+                return False
+            if self.end is not None and _cmp_time(t, self.end) > 0:
+                return False
+        return True
+
+    def days(self) -> tuple[dt.date | None, dt.date | None]:
+        # a day's file may hold records of the day before near midnight across zones: widen by one
+        one = dt.timedelta(days=1)
+        return (None if self.start is None else self.start.date() - one,
+                None if self.end is None else self.end.date() + one)
+
+
+def _cmp_time(a: dt.datetime, b: dt.datetime) -> int:
+    if (a.tzinfo is None) != (b.tzinfo is None):
+        a, b = a.replace(tzinfo=None), b.replace(tzinfo=None)
+    return (a > b) - (a < b)
+
+
+def query(directory: Path, flt: AuditFilter | None = None,
+          stats: ReadStats | None = None) -> list[AuditRecord]:
+    flt = flt or AuditFilter()
+    start, end = flt.days()
+    return [r for r in read_records(directory, start, end, stats) if flt.matches(r)]
+
+
+CSV_COLUMNS = ("host_time", "controller_time", "role", "kind", "command", "result", "detail", "args")
+
+
+def export_csv(records: Iterable[AuditRecord], out: TextIO) -> int:
+    """Write records as CSV (args as JSON); returns how many."""
+    writer = csv.writer(out)
+    writer.writerow(CSV_COLUMNS)
+    n = 0
+    for r in records:
+        writer.writerow((r.host_time, r.controller_time or "", r.role, r.kind, r.command, r.result,
+                         r.detail, json.dumps(r.args, ensure_ascii=False)))
+        n += 1
+    return n

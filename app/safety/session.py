@@ -1,0 +1,157 @@
+"""One object for the GUI: the role in force, the envelope, reduced-speed mode and the audit.
+
+:class:`SafetySession` ties :class:`~app.safety.roles.RoleStore`,
+:class:`~app.safety.roles.IdleLock`, the profile's :class:`~app.safety.envelope.Envelope` and
+:class:`~app.safety.audit.AuditLog` together so that the GUI's wiring stays thin:
+
+* ``reason(action)`` for a control's enabled state and tooltip (no audit; called on every
+  repaint); ``require(action)`` when the user actually does it (refusals are audited);
+* ``login`` / ``logout`` / ``touch`` / ``poll_idle`` (audited: logins, wrong passwords, the
+  lock-back);
+* ``check_step`` / ``check_move`` / ``check_jog_start`` before sending (refusals are audited and
+  raised as :class:`~app.safety.envelope.EnvelopeRefused`), ``jog_guard(poll_period)`` for the
+  worker, ``set_reduced`` (on: anyone; off: engineer);
+* ``audit.record_write`` is the client's hook, and the audit's role follows the session.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+from app.errors import TeachPadError
+from app.models import Pose
+from app.plan.geometry import PointLike
+from app.plan.segments import Segment
+from app.points.ledger import PointLedger
+from app.safety.audit import AuditLog, Result
+from app.safety.envelope import (
+    Envelope,
+    EnvelopeRefused,
+    EnvelopeViolation,
+    check_segment,
+    check_step,
+)
+from app.safety.jog_guard import JOG_GUARD_LATENCY, ArmSpeeds, JogGuard, JogMotion
+from app.safety.roles import Action, IdleLock, Role, RoleStore, WrongPassword, permission_reason
+
+
+class PermissionRefused(TeachPadError):
+    """The role in force may not do this; the message says which role may."""
+
+    def __init__(self, role: Role, action: Action) -> None:
+        super().__init__(permission_reason(role, action) or action.value)
+        self.role = role
+        self.action = action
+
+
+class SafetySession:
+    def __init__(self, store: RoleStore, audit: AuditLog, envelope: Envelope | None = None, *,
+                 idle_lock: IdleLock | None = None, speeds: ArmSpeeds | None = None,
+                 on_role_changed: Callable[[Role], None] | None = None) -> None:
+        self.store = store
+        self.audit = audit
+        self.envelope = envelope or Envelope()
+        self.speeds = speeds or ArmSpeeds()
+        self.reduced = False
+        self._on_role_changed = on_role_changed
+        self.idle = idle_lock or IdleLock(store.idle_timeout)
+        self.idle.on_lock = self._locked  # the session owns the lock-back notification
+        audit.set_role(lambda: self.role.text)
+
+    # --- roles ------------------------------------------------------------------------------
+    @property
+    def role(self) -> Role:
+        return self.idle.role
+
+    def reason(self, action: Action) -> str | None:
+        """Why the role in force may not do ``action`` (None: it may). For tooltips."""
+        return permission_reason(self.role, action)
+
+    def require(self, action: Action, args: dict[str, Any] | None = None) -> None:
+        """Raise :class:`PermissionRefused` (audited) unless the role may do ``action``."""
+        why = self.reason(action)
+        if why is not None:
+            self.audit.record_refused(action.value, why, args)
+            raise PermissionRefused(self.role, action)
+
+    def login(self, role: Role, password: str) -> Role:
+        try:
+            self.store.login(role, password)
+        except WrongPassword as exc:
+            self.audit.record("login", f"log in as {role.text}", result=Result.REFUSED, detail=str(exc))
+            raise
+        self.idle.login(role)
+        self.audit.record("login", f"log in as {role.text}")
+        self._changed()
+        return role
+
+    def logout(self) -> None:
+        if self.role is not Role.OPERATOR:
+            self.audit.record("login", f"log out ({self.role.text})")
+            self.idle.logout()
+            self._changed()
+
+    def touch(self) -> None:
+        self.idle.touch()
+
+    def poll_idle(self) -> Role:
+        return self.idle.poll()
+
+    def _locked(self, previous: Role) -> None:
+        self.audit.record("login", f"locked back to operator after {self.idle.timeout:g} s idle",
+                          role=previous.text)
+        self._changed()
+
+    def _changed(self) -> None:
+        if self._on_role_changed is not None:
+            self._on_role_changed(self.role)
+
+    # --- envelope ---------------------------------------------------------------------------
+    def set_envelope(self, envelope: Envelope) -> None:
+        self.require(Action.EDIT_ENVELOPE)
+        self.envelope = envelope
+        self.audit.record("action", "edit envelope")
+
+    def set_reduced(self, on: bool) -> None:
+        if on == self.reduced:
+            return
+        self.require(Action.REDUCED_SPEED if on else Action.LEAVE_REDUCED_SPEED)
+        self.reduced = on
+        self.audit.record("action", "reduced speed on" if on else "reduced speed off")
+
+    def _refuse(self, action: str, violation: EnvelopeViolation | None, args: dict[str, Any]) -> None:
+        if violation is not None:
+            self.audit.record_refused(action, violation.message, args)
+            raise EnvelopeRefused(violation, action)
+
+    def check_step(self, pose: Pose, offsets: list[float], *, joint: bool,
+                   speed: float | None = None) -> None:
+        """Before a step (function 1): refused (audited) when it would leave the envelope."""
+        self.require(Action.STEP)
+        violation = check_step(self.envelope, pose, offsets, joint=joint, speed=None if joint else speed,
+                               reduced=self.reduced)
+        self._refuse("step", violation, {"offsets": list(offsets), "joint": joint})
+
+    def check_move(self, start: PointLike, segment: Segment, ledger: PointLedger) -> None:
+        """Before a move to a point (function 3) from ``start``."""
+        violation = check_segment(self.envelope, start, segment, ledger, reduced=self.reduced)
+        self._refuse("move to point", violation, {"end": segment.end_id, "via": segment.via_id,
+                                                  "speed": segment.speed})
+
+    def jog_guard(self, poll_period: float, latency: float = JOG_GUARD_LATENCY) -> JogGuard:
+        return JogGuard(self.envelope, poll_period=poll_period, latency=latency, speeds=self.speeds,
+                        reduced=self.reduced)
+
+    def jog_ratio(self, ratio: float) -> float:
+        """The ratio to send for a requested one (capped by the envelope and reduced mode)."""
+        return self.envelope.cap_jog_ratio(ratio, self.reduced)
+
+    def check_jog_start(self, pose: Pose, motion: JogMotion, poll_period: float) -> None:
+        """Before a jog starts: refused (audited) when it would already have to stop."""
+        self.require(Action.JOG)
+        decision = self.jog_guard(poll_period).decide(pose, motion)
+        if not decision.allow:
+            args = {"frame": motion.frame.name.lower(), "axis": motion.axis, "direction": motion.direction,
+                    "ratio": motion.ratio}
+            self._refuse("jog", decision.violation, args)

@@ -1,0 +1,189 @@
+"""The audit trail: records, rotation, a truncated last line, filters, CSV, and kill -9."""
+
+from __future__ import annotations
+
+import csv
+import datetime as dt
+import io
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from app.errors import LinkError, WriteBlocked
+from app.safety.audit import (
+    AuditFilter,
+    AuditLog,
+    FsyncPolicy,
+    ReadStats,
+    Result,
+    audit_files,
+    export_csv,
+    query,
+    read_records,
+)
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+class Clock:
+    def __init__(self, start: dt.datetime) -> None:
+        self.t = start
+
+    def __call__(self) -> dt.datetime:
+        return self.t
+
+
+def test_writes_and_refusals_are_recorded_with_role_result_and_both_clocks(tmp_path: Path) -> None:
+    role = ["engineer"]
+    log = AuditLog(tmp_path, role=lambda: role[0])
+    log.note_controller_clock(dt.datetime(2026, 1, 2, 3, 4, 5))
+    log.record_write(440, [0x80], single=True)
+    with pytest.raises(LinkError), log.writing(400, [0, 0x41F0], single=False):
+        raise LinkError("no answer from 10.0.0.5:502")
+    role[0] = "operator"
+    with pytest.raises(WriteBlocked), log.writing(441, [1], single=True):
+        raise WriteBlocked("monitor-only mode: write to reg 441 was not sent")
+    log.record_refused("jog", "Y = -593.0 mm is outside the allowed work space", {"axis": "Y"})
+    log.close()
+    recs = list(read_records(tmp_path))
+    assert [(r.kind, r.role, r.result) for r in recs] == [
+        ("write", "engineer", Result.OK), ("write", "engineer", Result.FAILED),
+        ("write", "operator", Result.BLOCKED), ("refused", "operator", Result.REFUSED)]
+    assert recs[0].command == "teach enable (440 ← 0x80)"
+    assert recs[0].args == {"fc": 6, "address": 440, "values": [0x80]}
+    assert recs[1].command.startswith("write GV200") and recs[1].detail == "no answer from 10.0.0.5:502"
+    assert recs[0].controller_time is not None and recs[0].controller_time.startswith("2026-01-02T03:04:0")
+    assert len({(r.session, r.seq) for r in recs}) == 4
+
+
+def test_one_file_per_day_rotation_and_size_cap(tmp_path: Path) -> None:
+    clock = Clock(dt.datetime(2026, 3, 1, 12, 0, tzinfo=dt.UTC))
+    log = AuditLog(tmp_path, now=clock, max_file_bytes=2000, max_total_bytes=7000, keep_days=30,
+                   fsync=FsyncPolicy.NEVER)
+    for i in range(40):
+        log.record("action", f"teach P{i}")
+    clock.t += dt.timedelta(days=1)
+    log.record("action", "next day")
+    log.close()
+    names = [p.name for p in audit_files(tmp_path)]
+    assert "audit-2026-03-02.jsonl" in names and all(p.stat().st_size <= 2000 for p in audit_files(tmp_path))
+    assert sum(p.stat().st_size for p in audit_files(tmp_path)) <= 7000
+    assert any(n.startswith("audit-2026-03-01.") and n.count(".") == 2 for n in names)  # rotated parts
+    # the oldest parts went first: what is left is the most recent of day one, in order
+    day1 = [r.command for r in read_records(tmp_path, dt.date(2026, 3, 1), dt.date(2026, 3, 1))]
+    assert day1 == [f"teach P{i}" for i in range(40 - len(day1), 40)]
+    # older than keep_days: removed when a new file is opened
+    clock.t += dt.timedelta(days=40)
+    AuditLog(tmp_path, now=clock, keep_days=30).record("action", "much later")
+    assert [p.name for p in audit_files(tmp_path)] == ["audit-2026-04-11.jsonl"]
+
+
+def test_a_line_cut_short_is_skipped_and_the_next_writer_starts_a_fresh_line(tmp_path: Path) -> None:
+    log = AuditLog(tmp_path)
+    log.record("action", "one")
+    log.close()
+    path = audit_files(tmp_path)[0]
+    with open(path, "ab") as f:
+        f.write(b'{"host_time":"2026-')  # a crash in the middle of a line
+    stats = ReadStats()
+    assert [r.command for r in read_records(tmp_path, stats=stats)] == ["one"] and stats.skipped == 1
+    log = AuditLog(tmp_path)
+    log.record("action", "two")
+    log.close()
+    stats = ReadStats()
+    assert [r.command for r in read_records(tmp_path, stats=stats)] == ["one", "two"] and stats.skipped == 1
+
+
+def test_filters_and_csv_export(tmp_path: Path) -> None:
+    clock = Clock(dt.datetime(2026, 5, 1, 8, 0).astimezone())
+    log = AuditLog(tmp_path, now=clock, role="operator")
+    log.record_write(441, [1], single=True)
+    clock.t += dt.timedelta(hours=2)
+    log.set_role("administrator")
+    log.record("action", "change connection", args={"host": "10.0.0.9"})
+    clock.t += dt.timedelta(days=1)
+    log.set_role("operator")
+    log.record_refused("delete point", "needs the engineer role", {"id": 3})
+    log.close()
+    assert [r.command for r in query(tmp_path, AuditFilter(role="administrator"))] == ["change connection"]
+    assert [r.command for r in query(tmp_path, AuditFilter(result=Result.REFUSED))] == ["delete point"]
+    assert [r.command for r in query(tmp_path, AuditFilter(command="STOP"))] == ["stop (441 ← 1)"]
+    window = AuditFilter(start=dt.datetime(2026, 5, 1, 9, 0).astimezone(),
+                         end=dt.datetime(2026, 5, 1, 23, 0).astimezone())
+    assert [r.command for r in query(tmp_path, window)] == ["change connection"]
+    out = io.StringIO()
+    assert export_csv(query(tmp_path), out) == 3
+    rows = list(csv.DictReader(io.StringIO(out.getvalue())))
+    assert rows[1]["role"] == "administrator" and rows[1]["args"] == '{"host": "10.0.0.9"}'
+
+
+CHILD = r"""
+import sys
+from pathlib import Path
+from app.link.client import ConnectionSettings, RobotClient
+from app.safety.audit import AuditLog, FsyncPolicy
+
+directory, port, tag = Path(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
+log = AuditLog(directory, role="operator", fsync=FsyncPolicy[sys.argv[4]], max_file_bytes=16 * 1024)
+client = RobotClient(ConnectionSettings(host="127.0.0.1", port=port))
+client.connect()
+seq = 0
+while True:
+    values = [seq & 0xFFFF, seq >> 16, tag, 0]
+    with log.writing(0, values):
+        client.write_registers(0, values)
+    seq += 1
+"""
+
+
+def test_every_write_appears_once_also_after_kill_9(tmp_path: Path, sim: Any) -> None:
+    # no fsync at all: a killed process loses nothing it wrote (the page cache survives it), so
+    # this holds for every policy; fsync is about power loss
+    policy = "NEVER"
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    kills = 4
+    for tag in range(1, kills + 1):
+        before = len(sim.writes)
+        argv = [sys.executable, "-c", CHILD, str(tmp_path), str(sim.port), str(tag), policy]
+        child = subprocess.Popen(argv, env=env, cwd=ROOT)
+        try:
+            deadline = time.monotonic() + 30.0
+            while len(sim.writes) < before + 150 + 40 * tag and child.poll() is None:
+                assert time.monotonic() < deadline, "the child wrote too little"
+                time.sleep(0.01)
+            assert child.poll() is None, "the child died by itself"
+        finally:
+            child.send_signal(signal.SIGKILL)
+            child.wait()
+    stats = ReadStats()
+    recs = [r for r in read_records(tmp_path, stats=stats) if r.kind == "write"]
+    assert stats.skipped <= kills  # at most a cut last line per kill (in practice none)
+    audited = [(r.args["values"][2], r.args["values"][0] | r.args["values"][1] << 16) for r in recs]
+    assert len(audited) == len(set(audited)), "a write was recorded twice"
+    assert all(r.result == Result.OK for r in recs)
+    received = [(w.values[2], w.values[0] | w.values[1] << 16) for w in sim.writes
+                if w.address == 0 and len(w.values) == 4]
+    assert set(audited) <= set(received)
+    missing = set(received) - set(audited)
+    assert len(missing) <= kills  # each kill may lose the write in flight, nothing else
+    for tag in range(1, kills + 1):  # and only the last one of each child
+        sent = sorted(seq for t, seq in received if t == tag)
+        assert all(seq == sent[-1] for t, seq in missing if t == tag)
+    assert len(audit_files(tmp_path)) > 1  # rotated while being killed
+
+
+def test_an_unwritable_audit_never_blocks_the_write_and_says_so_once(tmp_path: Path) -> None:
+    blocker = tmp_path / "audit"
+    blocker.write_text("a file where the folder should be")
+    heard: list[str] = []
+    log = AuditLog(blocker, on_error=heard.append)
+    with log.writing(441, [1], single=True):
+        pass  # the write itself went out
+    log.record_write(441, [1], single=True)
+    assert log.dropped == 2 and len(heard) == 1 and "cannot be written" in heard[0]
