@@ -43,12 +43,13 @@ from app.errors import (
     WriteBlocked,
 )
 from app.link.stats import LinkStats
-from app.link.tracker import CommandTracker, command_text
+from app.link.tracker import CommandTracker, CompletionRule, command_text
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.codec import WordOrder, check_float32, decode_floats, encode_floats
 from app.protocol.datetime_regs import ControllerClock, DateTimeLayout, decode_clock
 from app.protocol.enums import (
+    STATUS_SENTINEL,
     Alarm,
     CommandKind,
     CommandStatus,
@@ -126,6 +127,11 @@ class ConnectionSettings:
     datetime_layout: DateTimeLayout = DateTimeLayout.SPLIT_WORDS
     point_id_min: int = registers.TEMP_POINT_ID_MIN
     point_id_max: int = registers.TEMP_POINT_ID_MAX
+    # How command completion is proven (app/link/tracker.py): "sentinel" writes a sentinel into
+    # GV291 before each command, "observe" only reads it, "auto" probes GV291 once before the
+    # first command (never in monitor-only mode, which sends no command).
+    completion: Literal["auto", "sentinel", "observe"] = "auto"
+    unconfirmed_after: float | None = None  # s; None: timing.UNCONFIRMED_AFTER (observe rule)
 
     @property
     def transport(self) -> Literal["tcp", "rtu"]:
@@ -245,6 +251,10 @@ def _check_settings(s: ConnectionSettings) -> None:
         raise InvalidInput(f"parity must be N, E or O, got {s.parity!r}")
     if not s.point_id_min <= s.point_id_max:
         raise InvalidInput("point_id_min must not exceed point_id_max")
+    if s.completion not in ("auto", "sentinel", "observe"):
+        raise InvalidInput(f"completion must be auto, sentinel or observe, got {s.completion!r}")
+    if s.unconfirmed_after is not None:
+        _check_float(s.unconfirmed_after, "unconfirmed_after", 0.0, lo_open=True)
 
 
 # --------------------------------------------------------------------------------------------
@@ -274,6 +284,8 @@ class RobotClient:
         self.last_tracker: CommandTracker | None = None
         self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
         self._stats = LinkStats()
+        self._gv291_writable: bool | None = None  # completion "auto": None until probed
+        self._ack_latency = 0.0  # s, decaying maximum of the acknowledgement times seen
 
     # -- connection ----------------------------------------------------------------------
     def _make_modbus_client(self) -> Any:
@@ -623,10 +635,75 @@ class RobotClient:
             self._write_floats(registers.GV_USER_FRAME, [float(user)])
             self._user_frame_cache = user
 
+    # -- completion rule (see app/link/tracker.py) ---------------------------------------
+    @property
+    def completion_rule(self) -> CompletionRule | None:
+        """The rule in force; None while "auto" has not probed GV291 yet."""
+        mode = self.settings.completion
+        if mode != "auto":
+            return mode
+        if self._gv291_writable is None:
+            return None
+        return "sentinel" if self._gv291_writable else "observe"
+
+    def probe_gv291(self) -> bool:
+        """Does the controller keep what the host writes into GV291? (Completion "auto".)
+
+        Writes the sentinel, waits ``timing.SENTINEL_PROBE_SETTLE`` (a controller that
+        re-publishes its status every scan has overwritten it by then) and reads it back. A
+        Modbus exception (a read-only GV291) means no. Safe: GV291 only reports the last
+        command's result, which the next command overwrites; the probe runs just before a
+        command, never in monitor-only mode. The answer is kept for this client's lifetime.
+        """
+        self._require_writable("GV291 probe")
+        try:
+            self._write_floats(registers.GV_COMMAND_STATUS, [float(STATUS_SENTINEL)])
+        except ModbusExceptionError as exc:
+            _log.info("GV291 is read-only (%s): completion rule observe", exc)
+            writable = False
+        else:
+            time.sleep(timing.SENTINEL_PROBE_SETTLE)
+            writable = self.read_status().command_status_code == STATUS_SENTINEL
+            _log.info("GV291 %s: completion rule %s", "keeps the host's value" if writable
+                      else "ignores the host's writes", "sentinel" if writable else "observe")
+        self._gv291_writable = writable
+        return writable
+
+    def _unconfirmed_window(self) -> float:
+        """How long an unchanged 0xFF waits before "done, unconfirmed" (observe rule)."""
+        base = self.settings.unconfirmed_after
+        base = timing.UNCONFIRMED_AFTER if base is None else base
+        learned = timing.UNCONFIRMED_LATENCY_FACTOR * self._ack_latency
+        return min(max(base, learned), timing.ACK_TIMEOUT / 2)
+
+    def _learn_latency(self) -> None:
+        """Take the previous command's acknowledgement time into the decaying maximum."""
+        last = self.last_tracker
+        if last is None or last.result is None or last.ack_time is None or last.is_move:
+            return
+        self._ack_latency = max(last.ack_time - last.started, self._ack_latency * 0.95)
+
     def begin_command(self, command: RunCommand, before: ControllerStatus, before_pose: Pose | None,
                       *, timeout: float | None = None) -> CommandTracker:
-        """Write 440 <- ``command`` (parameters already written) and return its tracker."""
-        tracker = CommandTracker(command, before, before_pose, time.monotonic(), timeout=timeout)
+        """Write 440 <- ``command`` (parameters already written) and return its tracker.
+
+        With the sentinel rule GV291 <- sentinel goes out first (completion "auto" probes
+        GV291 before the first command).
+        """
+        rule: CompletionRule = "observe"
+        pre_code: int | None = None
+        if CommandKind.of(command) is not None:
+            self._learn_latency()
+            probe = self.settings.completion == "auto" and self._gv291_writable is None
+            if probe and not self.probe_gv291() and self.last_status is not None:
+                pre_code = self.last_status.command_status_code  # the freshest read
+            rule = self.completion_rule or "observe"
+            if rule == "sentinel":
+                self._write_floats(registers.GV_COMMAND_STATUS, [float(STATUS_SENTINEL)])
+                pre_code = STATUS_SENTINEL
+        tracker = CommandTracker(command, before, before_pose, time.monotonic(), timeout=timeout,
+                                 rule=rule, pre_code=pre_code,
+                                 unconfirmed_after=self._unconfirmed_window())
         self._last_kind = tracker.kind
         self.last_tracker = tracker
         self._write_control(registers.REG_RUN_COMMAND, int(command))

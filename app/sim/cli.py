@@ -14,7 +14,7 @@ from pymodbus.constants import ExcCodes
 
 from app.protocol.codec import WordOrder
 from app.protocol.enums import Alarm
-from app.sim.server import SimConfig, SimController
+from app.sim.server import GV291_MODES, TIMING_PROFILES, SimConfig, SimController
 
 log = logging.getLogger(__name__)
 
@@ -56,6 +56,13 @@ def build_parser() -> argparse.ArgumentParser:
                         help="GV291 as float32 (default) or integer in register 582")
     parser.add_argument("--status-delay", type=float, default=0.0, metavar="S",
                         help="GV291 keeps its old value S seconds after a command")
+    parser.add_argument("--timing", choices=list(TIMING_PROFILES), default="classic",
+                        help="GV291 timing: classic (0 held until read), fast (result within one scan), "
+                             "slow (tens of ms, seeded jitter); default classic")
+    parser.add_argument("--gv291", choices=list(GV291_MODES), default="ignored",
+                        help="a host's write to GV291: ignored (default), writable (kept until the next "
+                             "result) or read-only (exception 2)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the slow profile's jitter (default 0)")
     parser.add_argument("--rtu-framing", action="store_true", help="RTU framing over TCP instead of MBAP")
     parser.add_argument("--tick-hz", type=float, default=100.0, help="simulation rate (default 100)")
     parser.add_argument("--no-stdin", action="store_true", help="do not read commands from stdin")
@@ -112,7 +119,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     config = SimConfig(host=args.host, port=args.port, unit=args.unit,
                        word_order=WordOrder.parse(args.word_order),
                        status_encoding=args.status_encoding, status_delay=args.status_delay,
-                       framer="rtu" if args.rtu_framing else "socket", tick_hz=args.tick_hz)
+                       framer="rtu" if args.rtu_framing else "socket", tick_hz=args.tick_hz,
+                       timing=args.timing, gv291=args.gv291, seed=args.seed)
     sim = SimController(config)
     try:
         sim.start()
