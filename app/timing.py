@@ -23,7 +23,7 @@ ACK_BACKOFF_CAP = 0.01
 # shown an error by then). Raised at run time to UNCONFIRMED_LATENCY_FACTOR x the slowest
 # acknowledgement seen on the link. Must exceed the controller's command latency.
 UNCONFIRMED_AFTER = 0.05
-UNCONFIRMED_LATENCY_FACTOR = 3.0
+UNCONFIRMED_LATENCY_FACTOR = 2.0
 # Auto-detection of a writable GV291: wait this long after writing the sentinel before reading
 # it back, so a controller that re-publishes its status every scan has overwritten it by then.
 SENTINEL_PROBE_SETTLE = 0.05

@@ -62,6 +62,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--gv291", choices=list(GV291_MODES), default="ignored",
                         help="a host's write to GV291: ignored (default), writable (kept until the next "
                              "result) or read-only (exception 2)")
+    parser.add_argument("--refuse-point", type=int, action="append", default=[], metavar="ID",
+                        help="answer create point ID with status 1, bad point id (repeatable)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the slow profile's jitter (default 0)")
     parser.add_argument("--rtu-framing", action="store_true", help="RTU framing over TCP instead of MBAP")
     parser.add_argument("--tick-hz", type=float, default=100.0, help="simulation rate (default 100)")
@@ -122,6 +124,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                        framer="rtu" if args.rtu_framing else "socket", tick_hz=args.tick_hz,
                        timing=args.timing, gv291=args.gv291, seed=args.seed)
     sim = SimController(config)
+    for point_id in args.refuse_point:
+        sim.refuse_point(point_id)
     try:
         sim.start()
     except OSError as exc:

@@ -639,6 +639,15 @@ class SimController:
             self.robot.set_alarm(Alarm(bit), on)
         log.info("alarm %s %s", Alarm(bit).name, "on" if on else "off")
 
+    def refuse_point(self, point_id: int, refuse: bool = True) -> None:
+        """Answer a create point of ``point_id`` with status 1 (bad point id) from now on."""
+        with self.lock:
+            if refuse:
+                self.robot.refused_points.add(int(point_id))
+            else:
+                self.robot.refused_points.discard(int(point_id))
+        log.info("create point %d: %s", point_id, "refused from now on" if refuse else "accepted again")
+
     def set_response_delay(self, seconds: float) -> None:
         self._response_delay = max(0.0, float(seconds))
         log.info("response delay %.3f s", self._response_delay)
