@@ -215,6 +215,7 @@ class SimController:
         self._hold_zero_until = 0.0
         self._zero_unread = False  # the 0 phase has not been seen by a host read yet
         self._rng = random.Random(self.config.seed)  # the "slow" profile's jitter
+        self._motion_epoch = 0.0  # when the last move command was accepted (see _tick_loop)
         self._wipe_general = False  # set by restart_controller(): clear GV0..GV99 on the next request
 
     # --- lifecycle ------------------------------------------------------------------------
@@ -344,7 +345,9 @@ class SimController:
         deadline = last + period
         while not self._stop_event.wait(max(0.0, deadline - time.monotonic())):
             now = time.monotonic()
-            step = min(now - last, 0.1)  # a stalled thread must not teleport the arm
+            # a stalled thread must not teleport the arm, and a move starts when its command
+            # was accepted: the time the command's handler held the lock is not motion time
+            step = min(now - max(last, self._motion_epoch), 0.1)
             last = now
             with self.lock:
                 try:
@@ -572,6 +575,8 @@ class SimController:
             status = robot.teach_enable(p[0], p[3])
         elif command is RunCommand.TEACH_DISABLE:
             status = robot.teach_disable(p[3])
+        if command in (RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT):
+            self._motion_epoch = time.monotonic()
         log.info("%s -> status %s", command.name, status)
         return None
 
