@@ -830,9 +830,8 @@ class RobotClient:
                                              {"point_id": float(point_id)}))
                 break
             details = dict(result.details, point_id=float(point_id))
-            message = f"point {point_id}: {result.message}"
-            results.append(CommandResult(result.command, result.kind, result.status, result.ok,
-                                         message, details))
+            results.append(dataclasses.replace(result, message=f"point {point_id}: {result.message}",
+                                               details=details))
             if progress is not None and progress(index, total) is False:
                 break
         return results
