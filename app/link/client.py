@@ -11,6 +11,12 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 * **Cached parameters**: GV245 (tool), GV241 (user frame) and the external-axis offsets
   GV236-240 are written only when they differ from what this client last wrote; the cache is
   dropped whenever the connection is (re)made or fails, and by :meth:`invalidate_cache`.
+* **Completion rule** (``ConnectionSettings.completion``, see app/link/tracker.py): "sentinel"
+  writes GV291 <- 0xA5 before each create/teach/move command (one extra 0x10) so the
+  controller's own write proves the result; "observe" never writes GV291 and may end an
+  instant command *done, unconfirmed*; "auto" (default) probes once, before the first such
+  command: write the sentinel, wait ``SENTINEL_PROBE_SETTLE``, read it back -- kept: sentinel;
+  Modbus exception or overwritten: observe. Never in monitor-only mode (no command is sent).
 * Control registers 440-445 are written with 0x06 only; raw multi-register writes that touch
   them are refused (:class:`InvalidInput`).
 * A request that timed out closes the link (the next request reconnects), so a late answer
