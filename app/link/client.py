@@ -683,11 +683,13 @@ class RobotClient:
         return min(max(base, learned), timing.ACK_TIMEOUT / 2)
 
     def _learn_latency(self) -> None:
-        """Take the previous command's acknowledgement time into the decaying maximum."""
+        """Decay the learned latency by 5 % a command; take in the previous command's
+        acknowledgement time (an instant command that was seen to change GV291)."""
+        self._ack_latency *= 0.95
         last = self.last_tracker
         if last is None or last.result is None or last.ack_time is None or last.is_move:
             return
-        self._ack_latency = max(last.ack_time - last.started, self._ack_latency * 0.95)
+        self._ack_latency = max(last.ack_time - last.started, self._ack_latency)
 
     def begin_command(self, command: RunCommand, before: ControllerStatus, before_pose: Pose | None,
                       *, timeout: float | None = None) -> CommandTracker:
