@@ -107,6 +107,7 @@ _GENERAL_REGISTERS = 200  # GV0..GV99 (registers 0..199): cleared by a controlle
 _STOP_TIMEOUT = 2.0
 TIMING_PROFILES = ("classic", "fast", "slow")
 GV291_MODES = ("ignored", "writable", "read-only")
+_ANSWER_HOLD_MAX = 0.5  # s a move waits at most for its command's answer to go out
 _GV291_REGS = range(gv_reg(GV_COMMAND_STATUS), gv_reg(GV_COMMAND_STATUS) + 2)
 
 
@@ -215,7 +216,7 @@ class SimController:
         self._hold_zero_until = 0.0
         self._zero_unread = False  # the 0 phase has not been seen by a host read yet
         self._rng = random.Random(self.config.seed)  # the "slow" profile's jitter
-        self._motion_epoch = 0.0  # when the last move command was accepted (see _tick_loop)
+        self._move_unanswered: float | None = None  # when a move command not answered yet came
         self._wipe_general = False  # set by restart_controller(): clear GV0..GV99 on the next request
 
     # --- lifecycle ------------------------------------------------------------------------
@@ -345,22 +346,27 @@ class SimController:
         deadline = last + period
         while not self._stop_event.wait(max(0.0, deadline - time.monotonic())):
             now = time.monotonic()
-            # a stalled thread must not teleport the arm, and a move starts when its command
-            # was accepted: the time the command's handler held the lock is not motion time
-            step = min(now - max(last, self._motion_epoch), 0.1)
+            step = min(now - last, 0.1)  # a stalled thread must not teleport the arm
             last = now
-            with self.lock:
-                try:
-                    self.robot.tick(step)
-                except Exception:  # keep the simulator alive; the failure is in the log
-                    log.exception("simulator tick failed")
-                    self.robot.stop()
+            accepted = self._move_unanswered
+            # a move starts once its command is answered, as on a controller that answers
+            # within its scan: a busy simulator must not run a short move to its end before
+            # the host even has the answer
+            if accepted is None or now - accepted >= _ANSWER_HOLD_MAX:
+                with self.lock:
+                    try:
+                        self.robot.tick(step)
+                    except Exception:  # keep the simulator alive; the failure is in the log
+                        log.exception("simulator tick failed")
+                        self.robot.stop()
             deadline += period
             if deadline < now:
                 deadline = now + period
 
     # --- Modbus glue ----------------------------------------------------------------------
     def _trace_packet(self, sending: bool, data: bytes) -> bytes:
+        if sending:
+            self._move_unanswered = None  # the answer goes out: a move accepted may start
         if sending and self._silent:
             return b""  # silent: the request was received, the answer is swallowed
         return data
@@ -576,7 +582,7 @@ class SimController:
         elif command is RunCommand.TEACH_DISABLE:
             status = robot.teach_disable(p[3])
         if command in (RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT):
-            self._motion_epoch = time.monotonic()
+            self._move_unanswered = time.monotonic()
         log.info("%s -> status %s", command.name, status)
         return None
 
