@@ -346,7 +346,9 @@ class SimController:
         deadline = last + period
         while not self._stop_event.wait(max(0.0, deadline - time.monotonic())):
             now = time.monotonic()
-            step = min(now - last, 0.1)  # a stalled thread must not teleport the arm
+            # a stalled thread must not teleport the arm: at most two periods a tick, so even a
+            # short move spans several ticks a host can see (motion runs late, not in a jump)
+            step = min(now - last, 2 * period)
             last = now
             accepted = self._move_unanswered
             # a move starts once its command is answered, as on a controller that answers
