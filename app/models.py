@@ -55,3 +55,7 @@ class CommandResult:
     message: str = ""
     details: dict[str, float] = field(default_factory=dict)
     request_id: int | None = None  # the id RobotLink returned for the request (None: not from one)
+    # ok, but not proven: the controller's status never changed (GV291 kept the 0xFF it had
+    # before the command and the host cannot write a sentinel). Only for the idempotent instant
+    # commands (create point, teach enable/disable), never for moves; see app/link/tracker.py.
+    unconfirmed: bool = False

@@ -13,9 +13,20 @@ POLL_TIMEOUT_RTU_MARGIN = 0.1  # s added to twice the largest answer's time on t
 # Waiting for a command's GV291 result.
 STATUS_POLL_INTERVAL = 0.002  # s between status reads while waiting for a short command
 MOVE_POLL_INTERVAL = 0.01  # s between status reads while waiting for a motion
-ACK_POLL_INTERVAL = 0.0005  # s between status reads until GV291 leaves the pre-command code
-# Short commands (create point, teach) are read back to back (no sleep) for this long.
-SHORT_COMMAND_SPIN = 0.005
+# Status reads while waiting for a command's result back off: the first read follows the
+# command at once, then ACK_BACKOFF_FIRST, doubling, capped at ACK_BACKOFF_CAP (short
+# commands) or MOVE_POLL_INTERVAL (moves). No spinning on a real controller.
+ACK_BACKOFF_FIRST = 0.001
+ACK_BACKOFF_CAP = 0.01
+# Completion rule "observe" (GV291 not writable): an instant command whose status never moved
+# from the 0xFF it had before is "done, unconfirmed" after this long (the controller would have
+# shown an error by then). Raised at run time to UNCONFIRMED_LATENCY_FACTOR x the slowest
+# acknowledgement seen on the link. Must exceed the controller's command latency.
+UNCONFIRMED_AFTER = 0.05
+UNCONFIRMED_LATENCY_FACTOR = 2.0
+# Auto-detection of a writable GV291: wait this long after writing the sentinel before reading
+# it back, so a controller that re-publishes its status every scan has overwritten it by then.
+SENTINEL_PROBE_SETTLE = 0.05
 ACK_TIMEOUT = 2.0  # s for the controller to show it has taken a command (leave the stale code)
 CREATE_POINT_TIMEOUT = 3.0  # s for create-point / teach enable to finish
 MOVE_TIMEOUT_MIN = 10.0  # s; a move's timeout is max(this, 3 x its estimated duration)
@@ -30,3 +41,7 @@ LINK_LOSS_POLLS = 3  # consecutive failed polls before the link is declared down
 # Simulator.
 SIM_TICK_HZ = 100
 SIM_COMMAND_LATENCY = 0.001  # s from a create/teach command to its final GV291
+# Simulator timing profile "slow": the old GV291 stays for SIM_SLOW_PICKUP, then 0 shows for
+# SIM_SLOW_ZERO, then the result (each uniform in the range, seeded).
+SIM_SLOW_PICKUP = (0.005, 0.025)
+SIM_SLOW_ZERO = (0.002, 0.015)

@@ -16,6 +16,9 @@ Each figure is measured in the same run as a baseline:
   preview widget's (``ui.panels.plan_preview.PlanPreview``) redraw of the 1,000 segments, vs the
   same widget redrawing a 10-segment plan.
 
+Requests and time per created point on each simulator timing profile: see ``benchmarks.completion``
+(``completion_profiles``).
+
 Quick mode restores 500 points instead of 10,000 and repeats less.
 """
 
@@ -42,6 +45,7 @@ from app.points.ledger import PointLedger, SyncState, TempPoint, make_point, upl
 from app.points.project import Project, load_project, save_project
 from app.protocol import registers as R  # noqa: N812
 from app.sim import SimConfig, SimController
+from benchmarks import completion
 
 PROJECT_POINTS = 10_000
 PLAN_SEGMENTS = 1_000
@@ -368,6 +372,7 @@ def run(quick: bool) -> dict[str, Any]:
         out["project_load"]["save_project_ms"] = _ms(save_s)
         out["points_table_show"] = bench_show(load_project(path), repeats)
     out["restore_all"] = bench_restore(500 if quick else PROJECT_POINTS, 200 if quick else 1000)
+    out["completion_profiles"] = completion.bench_profiles(60 if quick else 300)
     out["plan_geometry"] = bench_plan(repeats)
     out["plan_preview"] = bench_preview(repeats)
     return out

@@ -255,6 +255,11 @@ def _upload(io: _Io, project: Project, points: Sequence[TempPoint], client: Any)
         line.done()
     apply_upload(project.ledger, report)
     io.print(f"uploaded {report.ok_count} point(s)")
+    unconfirmed = [o.point_id for o in report.outcomes if o.ok and o.unconfirmed]
+    if unconfirmed:
+        shown = ",".join(map(str, unconfirmed[:20])) + (",..." if len(unconfirmed) > 20 else "")
+        io.print(f"{len(unconfirmed)} of them unconfirmed: the controller reported no error but its "
+                 f"command status did not change (GV291 not writable): {shown}")
     for outcome in report.failed:
         io.error(f"P{outcome.point_id}: {outcome.reason}")
     if report.aborted:

@@ -92,3 +92,7 @@ def check_settings(s: ConnectionSettings) -> None:
         raise InvalidInput(f"parity must be N, E or O, got {s.parity!r}")
     if not s.point_id_min <= s.point_id_max:
         raise InvalidInput("point_id_min must not exceed point_id_max")
+    if s.completion not in ("auto", "sentinel", "observe"):
+        raise InvalidInput(f"completion must be auto, sentinel or observe, got {s.completion!r}")
+    if s.unconfirmed_after is not None:
+        check_float(s.unconfirmed_after, "unconfirmed_after", 0.0, lo_open=True)

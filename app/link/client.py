@@ -13,6 +13,12 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 * **Cached parameters**: GV245 (tool), GV241 (user frame) and the external-axis offsets
   GV236-240 are written only when they differ from what this client last wrote; the cache is
   dropped whenever the connection is (re)made or fails, and by :meth:`invalidate_cache`.
+* **Completion rule** (``ConnectionSettings.completion``, see app/link/tracker.py): "sentinel"
+  writes GV291 <- 0xA5 before each create/teach/move command (one extra 0x10) so the
+  controller's own write proves the result; "observe" never writes GV291 and may end an
+  instant command *done, unconfirmed*; "auto" (default) probes once, before the first such
+  command: write the sentinel, wait ``SENTINEL_PROBE_SETTLE``, read it back -- kept: sentinel;
+  Modbus exception or overwritten: observe. Never in monitor-only mode (no command is sent).
 * Control registers 440-445 are written with 0x06 only; raw multi-register writes that touch
   them are refused (:class:`InvalidInput`).
 * A request that timed out or got a malformed answer closes the link (the next request
@@ -23,6 +29,7 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import logging
 import math
@@ -61,13 +68,14 @@ from app.link.checks import (
 )
 from app.link.decode import decode_pose, decode_status
 from app.link.stats import LinkStats
-from app.link.tracker import CommandTracker, command_text
+from app.link.tracker import CommandTracker, CompletionRule, command_text
 from app.link.transport import ConnectionSettings, TrafficObserver, TrafficRecord, Transport
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.codec import decode_floats, encode_floats
 from app.protocol.datetime_regs import ControllerClock, decode_clock
 from app.protocol.enums import (
+    STATUS_SENTINEL,
     CommandKind,
     CommandStatus,
     ControllerMode,
@@ -127,6 +135,8 @@ class RobotClient:
         self.last_status: ControllerStatus | None = None
         self.last_tracker: CommandTracker | None = None
         self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
+        self._gv291_writable: bool | None = None  # completion "auto": None until probed
+        self._ack_latency = 0.0  # s, decaying maximum of the acknowledgement times seen
 
     # -- connection (the transport drops the caches whenever the link is made or lost) ---
     def connect(self) -> None:
@@ -331,10 +341,77 @@ class RobotClient:
             self._write_floats(registers.GV_USER_FRAME, [float(user)])
             self._user_frame_cache = user
 
+    # -- completion rule (see app/link/tracker.py) ---------------------------------------
+    @property
+    def completion_rule(self) -> CompletionRule | None:
+        """The rule in force; None while "auto" has not probed GV291 yet."""
+        mode = self.settings.completion
+        if mode != "auto":
+            return mode
+        if self._gv291_writable is None:
+            return None
+        return "sentinel" if self._gv291_writable else "observe"
+
+    def probe_gv291(self) -> bool:
+        """Does the controller keep what the host writes into GV291? (Completion "auto".)
+
+        Writes the sentinel, waits ``timing.SENTINEL_PROBE_SETTLE`` (a controller that
+        re-publishes its status every scan has overwritten it by then) and reads it back. A
+        Modbus exception (a read-only GV291) means no. Safe: GV291 only reports the last
+        command's result, which the next command overwrites; the probe runs just before a
+        command, never in monitor-only mode. The answer is kept for this client's lifetime.
+        """
+        self._require_writable("GV291 probe")
+        try:
+            self._write_floats(registers.GV_COMMAND_STATUS, [float(STATUS_SENTINEL)])
+        except ModbusExceptionError as exc:
+            _log.info("GV291 is read-only (%s): completion rule observe", exc)
+            writable = False
+        else:
+            time.sleep(timing.SENTINEL_PROBE_SETTLE)
+            writable = self.read_status().command_status_code == STATUS_SENTINEL
+            _log.info("GV291 %s: completion rule %s", "keeps the host's value" if writable
+                      else "ignores the host's writes", "sentinel" if writable else "observe")
+        self._gv291_writable = writable
+        return writable
+
+    def _unconfirmed_window(self) -> float:
+        """How long an unchanged 0xFF waits before "done, unconfirmed" (observe rule)."""
+        base = self.settings.unconfirmed_after
+        base = timing.UNCONFIRMED_AFTER if base is None else base
+        learned = timing.UNCONFIRMED_LATENCY_FACTOR * self._ack_latency
+        return min(max(base, learned), timing.ACK_TIMEOUT / 2)
+
+    def _learn_latency(self) -> None:
+        """Decay the learned latency by 5 % a command; take in the previous command's
+        acknowledgement time (an instant command that was seen to change GV291)."""
+        self._ack_latency *= 0.95
+        last = self.last_tracker
+        if last is None or last.result is None or last.ack_time is None or last.is_move:
+            return
+        self._ack_latency = max(last.ack_time - last.started, self._ack_latency)
+
     def begin_command(self, command: RunCommand, before: ControllerStatus, before_pose: Pose | None,
                       *, timeout: float | None = None) -> CommandTracker:
-        """Write 440 <- ``command`` (parameters already written) and return its tracker."""
-        tracker = CommandTracker(command, before, before_pose, time.monotonic(), timeout=timeout)
+        """Write 440 <- ``command`` (parameters already written) and return its tracker.
+
+        With the sentinel rule GV291 <- sentinel goes out first (completion "auto" probes
+        GV291 before the first command).
+        """
+        rule: CompletionRule = "observe"
+        pre_code: int | None = None
+        if CommandKind.of(command) is not None:
+            self._learn_latency()
+            probe = self.settings.completion == "auto" and self._gv291_writable is None
+            if probe and not self.probe_gv291() and self.last_status is not None:
+                pre_code = self.last_status.command_status_code  # the freshest read
+            rule = self.completion_rule or "observe"
+            if rule == "sentinel":
+                self._write_floats(registers.GV_COMMAND_STATUS, [float(STATUS_SENTINEL)])
+                pre_code = STATUS_SENTINEL
+        tracker = CommandTracker(command, before, before_pose, time.monotonic(), timeout=timeout,
+                                 rule=rule, pre_code=pre_code,
+                                 unconfirmed_after=self._unconfirmed_window())
         self._last_kind = tracker.kind
         self.last_tracker = tracker
         self._write_control(registers.REG_RUN_COMMAND, int(command))
@@ -461,9 +538,8 @@ class RobotClient:
                                              {"point_id": float(point_id)}))
                 break
             details = dict(result.details, point_id=float(point_id))
-            message = f"point {point_id}: {result.message}"
-            results.append(CommandResult(result.command, result.kind, result.status, result.ok,
-                                         message, details))
+            results.append(dataclasses.replace(result, message=f"point {point_id}: {result.message}",
+                                               details=details))
             if progress is not None and progress(index, total) is False:
                 break
         return results

@@ -3,18 +3,33 @@
 Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
 * **Completion detection** (the stale-0xFF problem) is :class:`CommandTracker`. A command is
-  *acknowledged* once GV291 has shown a value different from the code it held before the
-  command was sent, or — for moves — once the motion is visibly under way (program state
-  running/paused, status "moving", or the pose left its starting value). A terminal code
-  (0xFF or an error) ends the command only if GV291 has left the pre-command code at some
-  point since the command was sent; a code equal to the stale one never ends it. So an old
-  0xFF is never taken for the new command's, at the price that a controller which goes
-  0xFF -> 0 -> 0xFF faster than the host can read looks unacknowledged
-  (-> :class:`CommandTimeout` after ``timing.ACK_TIMEOUT``). To keep that window small the
-  first status read follows the command at once and, until GV291 has changed, reads follow
-  every ``timing.ACK_POLL_INTERVAL`` (for at most ``ACK_TIMEOUT``). A move that was seen
-  moving and has stopped while GV291 never left the stale code ends, after ``ACK_TIMEOUT``,
-  as a :class:`CommandTimeout` saying the result is unknown (never as success).
+  *acknowledged* once GV291 has shown a value different from its pre-command code, or -- for
+  moves -- once the motion is visibly under way (program state running/paused, status
+  "moving", or the pose left its starting value). A terminal code (0xFF or an error) ends the
+  command only if GV291 has left the pre-command code since the command was sent; a code equal
+  to the stale one never ends it as such. Two rules (``rule``), chosen per connection by the
+  client (``ConnectionSettings.completion``):
+
+  - ``"sentinel"`` (GV291 keeps what the host writes): the client writes
+    :data:`~app.protocol.enums.STATUS_SENTINEL` into GV291 just before the command, so the
+    pre-command code is the sentinel and the controller's own write of its result -- even
+    straight to 0xFF within one scan -- is the proof. Confirmed results only.
+  - ``"observe"`` (GV291 read-only): the pre-command code is whatever the controller showed.
+    A controller that goes 0xFF -> 0 -> 0xFF between two reads shows no change. For the
+    idempotent instant commands (create point, teach enable/disable), when the status stayed at
+    the 0xFF (done) it had before for ``unconfirmed_after`` seconds the command ends *done,
+    unconfirmed* (``ok=True, unconfirmed=True``): an error code would have been a visible
+    change, so this is never a success over a reported error. When it stayed at an *error*
+    code from before, the command ends refused (``unconfirmed=True``): the same error again, or
+    not taken -- never a success. Teach enable/disable are confirmed by the controller mode
+    (560 entering / leaving 2, Modbus teach) too. Moves never end unconfirmed: they confirm by
+    motion as above, and a move that was seen moving and stopped while GV291 never left the
+    stale code ends, after ``ACK_TIMEOUT``, as a :class:`CommandTimeout` saying the result is
+    unknown (never as success).
+* **Polling while waiting** backs off (:meth:`CommandTracker.poll_interval`): the first read
+  follows the command at once, then ``ACK_BACKOFF_FIRST``, doubling, capped at
+  ``ACK_BACKOFF_CAP`` (moves: ``MOVE_POLL_INTERVAL``), and never sleeping past the
+  unconfirmed deadline. No spinning: a real controller is not hammered.
 * **After a stop** the wait ends when the host sent the stop itself, or when a move that was
   seen under way shows program state *stopped* with GV291 at 0 (initial) for
   ``timing.STOP_SETTLE`` (a transient 0 just before 0xFF is not a stop).
@@ -22,20 +37,27 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
 from __future__ import annotations
 
+from typing import Literal
+
 from app import timing
 from app.errors import AlarmRaised, CommandRefused, CommandStopped, CommandTimeout, TeachPadError
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import (
     RUN_COMMAND_TEXT,
+    STATUS_DONE,
     CommandKind,
     CommandStatus,
+    ControllerMode,
     ProgramState,
     RunCommand,
     alarm_names,
+    controller_mode_text,
     decode_command_status,
 )
 
-__all__ = ["POSE_EPSILON", "CommandTracker", "command_text", "pose_moved"]
+__all__ = ["POSE_EPSILON", "CommandTracker", "CompletionRule", "command_text", "pose_moved"]
+
+CompletionRule = Literal["sentinel", "observe"]
 
 # A pose component that changed by more than this (mm or degrees) counts as motion.
 POSE_EPSILON = 1e-3
@@ -81,12 +103,17 @@ class CommandTracker:
         now: float,
         *,
         timeout: float | None = None,
+        rule: CompletionRule = "observe",
+        pre_code: int | None = None,
+        unconfirmed_after: float | None = None,
     ) -> None:
         self.command = command
         self.kind = CommandKind.of(command)
         self.before = before
         self.before_pose = before_pose
-        self.pre_code = before.command_status_code
+        self.rule: CompletionRule = rule
+        # "sentinel": the code the host wrote into GV291 just before the command
+        self.pre_code = before.command_status_code if pre_code is None else pre_code
         self.started = now
         self.is_move = self.kind is CommandKind.MOVE
         self.ack_timeout = timing.ACK_TIMEOUT
@@ -104,9 +131,14 @@ class CommandTracker:
         self.ack_time: float | None = None
         self.code_left_pre = False
         self.motion_seen = False
-        self.ack_poll_interval = timing.ACK_POLL_INTERVAL
-        self.poll_interval_after_ack = (timing.MOVE_POLL_INTERVAL if self.is_move
-                                        else timing.STATUS_POLL_INTERVAL)
+        self.backoff_first = timing.ACK_BACKOFF_FIRST
+        self.backoff_cap = timing.MOVE_POLL_INTERVAL if self.is_move else timing.ACK_BACKOFF_CAP
+        # observe rule, instant commands only: when a stale 0xFF / error counts as this command's
+        self.unconfirmed_after: float | None = None
+        if rule == "observe" and not self.is_move:
+            self.unconfirmed_after = (timing.UNCONFIRMED_AFTER if unconfirmed_after is None
+                                      else unconfirmed_after)
+        self.reads = 0
         self._stopped_since: float | None = None
         self._idle_since: float | None = None
         self._last_pose = before_pose
@@ -127,26 +159,23 @@ class CommandTracker:
         return decode_command_status(self.kind, code)
 
     def poll_interval(self, now: float) -> float:
-        """How long to wait before the next status read.
+        """How long to wait before the next status read: backoff from the command on.
 
-        Fast until GV291 has left the pre-command code (the controller may show 0, "received",
-        only briefly before the new final code), and for short commands until they end, for at
-        most the acknowledgement timeout.
+        ``ACK_BACKOFF_FIRST`` after the first read, doubling with every read, capped at
+        ``backoff_cap``; never past the moment an unchanged status counts as unconfirmed.
         """
-        # short commands (create point, teach) finish within a controller cycle or two once
-        # taken: keep reading fast after the acknowledgement too
-        short = self.kind is not CommandKind.MOVE
-        if short and now - self.started < timing.SHORT_COMMAND_SPIN:
-            return 0.0  # back to back: the round trip itself paces the reads
-        fast = not self.code_left_pre or short
-        if fast and now - self.started < self.ack_timeout:
-            return self.ack_poll_interval
-        return self.poll_interval_after_ack
+        interval = min(self.backoff_cap, self.backoff_first * 2.0 ** max(0, self.reads - 1))
+        if self.unconfirmed_after is not None and not self.acknowledged:
+            left = self.started + self.unconfirmed_after - now
+            if left > 0:
+                interval = min(interval, left)
+        return interval
 
     def update(self, status: ControllerStatus, pose: Pose | None, now: float) -> CommandResult | None:
         """Take one status read; return the result once the command has ended."""
         if self.result is not None:
             return self.result
+        self.reads += 1
         self.last_status = status
         code = status.command_status_code
         if status.alarms:
@@ -181,6 +210,13 @@ class CommandTracker:
                     ),
                     code, now,
                 )
+        elif self._teach_mode_changed(status):
+            decoded = self.decode(STATUS_DONE)
+            return self._finish(True, decoded, f"{self.text}: {decoded.text} (seen in the controller mode, "
+                                f"now {controller_mode_text(int(status.mode))})", now)
+        elif self.unconfirmed_after is not None and now - self.started >= self.unconfirmed_after \
+                and (self.decode(code).is_done or self.decode(code).is_error):
+            return self._unconfirmed(code, now)
         elif now - self.started >= self.ack_timeout:
             text = self.decode(self.pre_code).text
             return self._fail(
@@ -211,6 +247,30 @@ class CommandTracker:
         return self._fail(CommandStopped(f"{self.text} stopped by the host"), code, now)
 
     # -- internals -----------------------------------------------------------------------
+    def _teach_mode_changed(self, status: ControllerStatus) -> bool:
+        """Teach enable/disable proven by the controller mode (560) entering / leaving 2."""
+        teach = ControllerMode.MODBUS_TEACH
+        was, now_in = self.before.mode == teach, status.mode == teach
+        if self.command is RunCommand.TEACH_ENABLE:
+            return now_in and not was
+        if self.command is RunCommand.TEACH_DISABLE:
+            return was and not now_in
+        return False
+
+    def _unconfirmed(self, code: int, now: float) -> CommandResult:
+        """Observe rule: GV291 never moved from its pre-command code (0xFF or an error)."""
+        decoded = self.decode(code)
+        waited = _seconds(now - self.started)
+        if decoded.is_done:
+            message = (f"{self.text}: done, unconfirmed (command status stayed {code} '{decoded.text}' "
+                       f"as before the command for {waited} s; the controller reported no error)")
+            return self._finish(True, decoded, message, now, unconfirmed=True)
+        self.error = CommandRefused(
+            decoded, f"{self.text} refused (unconfirmed): command status stayed {code} '{decoded.text}' "
+                     f"from the previous command for {waited} s",
+        )
+        return self._finish(False, decoded, str(self.error), now, unconfirmed=True)
+
     def _note_motion(self, status: ControllerStatus, pose: Pose | None) -> bool:
         """Update ``motion_seen``; True when this read shows progress (for the stall timer)."""
         if not self.is_move:
@@ -262,8 +322,12 @@ class CommandTracker:
             details["ack_after"] = self.ack_time - self.started
         return details
 
-    def _finish(self, ok: bool, status: CommandStatus, message: str, now: float) -> CommandResult:
-        self.result = CommandResult(self.command, self.kind, status, ok, message, self._details(now))
+    def _finish(self, ok: bool, status: CommandStatus, message: str, now: float, *,
+                unconfirmed: bool = False) -> CommandResult:
+        details = self._details(now)
+        details["reads"] = float(self.reads)
+        self.result = CommandResult(self.command, self.kind, status, ok, message, details,
+                                    unconfirmed=unconfirmed)
         return self.result
 
     def _fail(self, error: TeachPadError, code: int, now: float) -> CommandResult:

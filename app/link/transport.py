@@ -91,6 +91,11 @@ class ConnectionSettings:
     datetime_layout: DateTimeLayout = DateTimeLayout.SPLIT_WORDS
     point_id_min: int = registers.TEMP_POINT_ID_MIN
     point_id_max: int = registers.TEMP_POINT_ID_MAX
+    # How command completion is proven (app/link/tracker.py): "sentinel" writes a sentinel into
+    # GV291 before each command, "observe" only reads it, "auto" probes GV291 once before the
+    # first command (never in monitor-only mode, which sends no command).
+    completion: Literal["auto", "sentinel", "observe"] = "auto"
+    unconfirmed_after: float | None = None  # s; None: timing.UNCONFIRMED_AFTER (observe rule)
 
     @property
     def transport(self) -> Literal["tcp", "rtu"]:

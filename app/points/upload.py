@@ -27,6 +27,7 @@ class UploadOutcome:
     ok: bool
     reason: str = ""
     sent: TempPoint | None = None  # the values the controller now holds (ok only)
+    unconfirmed: bool = False  # ok, but the controller's status never changed (CommandResult.unconfirmed)
 
 
 @dataclass
@@ -85,7 +86,7 @@ def upload_points(
             report.outcomes.append(UploadOutcome(point.id, False, str(exc) or type(exc).__name__))
             continue
         if result.ok:
-            report.outcomes.append(UploadOutcome(point.id, True, sent=point))
+            report.outcomes.append(UploadOutcome(point.id, True, sent=point, unconfirmed=result.unconfirmed))
         else:
             reason = result.message or (result.status.text if result.status else "failed")
             report.outcomes.append(UploadOutcome(point.id, False, reason))

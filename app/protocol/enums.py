@@ -168,6 +168,11 @@ class CommandKind(enum.Enum):
 
 STATUS_INITIAL = 0
 STATUS_DONE = 0xFF
+# What the host writes into GV291 just before a command when the controller keeps the host's
+# value (completion rule "sentinel", app/link/tracker.py): in no status table, an integral
+# float in 0..255 so both encodings decode it. Any other value read afterwards was written by
+# the controller, for this command.
+STATUS_SENTINEL = 0xA5
 
 
 class MoveStatus(enum.IntEnum):
@@ -257,6 +262,7 @@ _STATUS_TEXT: dict[CommandKind, dict[int, str]] = {
     CommandKind.TEACH: TEACH_STATUS_TEXT,
 }
 UNKNOWN_STATUS_TEXT = QT_TRANSLATE_NOOP("Protocol", "unknown status {code}")
+SENTINEL_STATUS_TEXT = QT_TRANSLATE_NOOP("Protocol", "sent, waiting for the controller")
 
 
 @dataclass(frozen=True)
@@ -279,6 +285,8 @@ class CommandStatus:
     @property
     def text(self) -> str:
         """English description (translate with context ``Protocol``)."""
+        if self.code == STATUS_SENTINEL:
+            return SENTINEL_STATUS_TEXT
         if self.kind is None:
             return MOVE_STATUS_TEXT.get(self.code, UNKNOWN_STATUS_TEXT.format(code=self.code))
         return _STATUS_TEXT[self.kind].get(self.code, UNKNOWN_STATUS_TEXT.format(code=self.code))
@@ -292,6 +300,11 @@ class CommandStatus:
         return self.code == STATUS_INITIAL
 
     @property
+    def is_pending(self) -> bool:
+        """The host's own sentinel: the controller has not written its result yet."""
+        return self.code == STATUS_SENTINEL
+
+    @property
     def is_moving(self) -> bool:
         return self.kind is CommandKind.MOVE and self.code == MoveStatus.MOVING
 
@@ -300,7 +313,7 @@ class CommandStatus:
         """A code that ends the command unsuccessfully (never true when the kind is unknown)."""
         if self.kind is None:
             return False
-        return not (self.is_done or self.is_initial or self.is_moving)
+        return not (self.is_done or self.is_initial or self.is_moving or self.is_pending)
 
 
 def decode_command_status(kind: CommandKind | None, code: int) -> CommandStatus:

@@ -15,7 +15,7 @@ from pymodbus.constants import ExcCodes
 from app.protocol.codec import WordOrder
 from app.protocol.enums import Alarm
 from app.sim.guard import WATCHDOG_TIMEOUT
-from app.sim.server import SimConfig, SimController
+from app.sim.server import GV291_MODES, TIMING_PROFILES, SimConfig, SimController
 
 log = logging.getLogger(__name__)
 
@@ -59,6 +59,15 @@ def build_parser() -> argparse.ArgumentParser:
                         help="GV291 as float32 (default) or integer in register 582")
     parser.add_argument("--status-delay", type=float, default=0.0, metavar="S",
                         help="GV291 keeps its old value S seconds after a command")
+    parser.add_argument("--timing", choices=list(TIMING_PROFILES), default="classic",
+                        help="GV291 timing: classic (0 held until read), fast (result within one scan), "
+                             "slow (tens of ms, seeded jitter); default classic")
+    parser.add_argument("--gv291", choices=list(GV291_MODES), default="ignored",
+                        help="a host's write to GV291: ignored (default), writable (kept until the next "
+                             "result) or read-only (exception 2)")
+    parser.add_argument("--refuse-point", type=int, action="append", default=[], metavar="ID",
+                        help="answer create point ID with status 1, bad point id (repeatable)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the slow profile's jitter (default 0)")
     parser.add_argument("--rtu-framing", action="store_true", help="RTU framing over TCP instead of MBAP")
     parser.add_argument("--tick-hz", type=float, default=100.0, help="simulation rate (default 100)")
     parser.add_argument("--watchdog", type=_watchdog, default=WATCHDOG_TIMEOUT, metavar="SECONDS|off",
@@ -147,8 +156,11 @@ def main(argv: Sequence[str] | None = None) -> int:
                        status_encoding=args.status_encoding, status_delay=args.status_delay,
                        framer="rtu" if args.rtu_framing else "socket", tick_hz=args.tick_hz,
                        watchdog=args.watchdog, serial_port=args.serial, baudrate=args.baud,
-                       parity=args.parity, stopbits=args.stopbits)
+                       parity=args.parity, stopbits=args.stopbits,
+                       timing=args.timing, gv291=args.gv291, seed=args.seed)
     sim = SimController(config)
+    for point_id in args.refuse_point:
+        sim.refuse_point(point_id)
     try:
         sim.start()
     except OSError as exc:

@@ -320,6 +320,7 @@ class SimRobot:
         self.command_status = STATUS_INITIAL
         self.last_kind: CommandKind | None = None
         self.points: dict[int, StoredPoint] = {}
+        self.refused_points: set[int] = set()  # fault injection: create point answers 1 for these
         self.time = 0.0
         # motion
         self.motion: _Motion | None = None
@@ -449,7 +450,7 @@ class SimRobot:
         """0xE0: store the current pose (``pose`` None) or ``pose`` under ``point_id``."""
         self.last_kind = CommandKind.CREATE_POINT
         pid = _as_int(point_id)
-        if pid is None or not self.point_id_min <= pid <= self.point_id_max:
+        if pid is None or not self.point_id_min <= pid <= self.point_id_max or pid in self.refused_points:
             log.info("create point refused: bad id %s", point_id)
             return self._finish(CreatePointStatus.BAD_POINT_ID)
         if pose is None:

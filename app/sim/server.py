@@ -18,6 +18,16 @@ question deterministic in tests: a host that polls always sees the 0 between two
 the old value for ``status_delay`` and then shows 0. Float32 by default, or the integer in
 register 582 (583 = 0) with ``status_encoding="int"``.
 
+That is the ``"classic"`` timing profile (``SimConfig.timing``), the one a polling host
+handles best. The others model controllers we may meet: ``"fast"`` -- the result replaces the
+old code within one scan (the next request sees it; the 0 is never visible, no read-hold);
+``"slow"`` -- the old code stays for a seeded random pickup time (``timing.SIM_SLOW_PICKUP``),
+then 0 shows for ``timing.SIM_SLOW_ZERO``, then the result, nothing held for a reader.
+``SimConfig.gv291`` says what a host's write to GV291 (registers 582/583) does: ``"ignored"``
+(acknowledged, overwritten by the next scan: the classic simulator), ``"writable"`` (the value
+stays until the controller writes its next result) or ``"read-only"`` (Modbus exception 2,
+illegal data address: what a controller that protects its status registers answers).
+
 Project extension: joints J1..J6 in GV250..GV255 (registers 500..511).
 """
 
@@ -26,6 +36,7 @@ from __future__ import annotations
 import asyncio
 import datetime as dt
 import logging
+import random
 import threading
 import time
 from collections.abc import Callable
@@ -39,7 +50,15 @@ from pymodbus.simulator import DataType, SimData, SimDevice
 from app import timing
 from app.protocol.codec import WordOrder, encode_floats, float_to_registers, registers_to_float
 from app.protocol.datetime_regs import DateTimeLayout, encode_clock
-from app.protocol.enums import Alarm, CommandKind, ControllerMode, ProgramState, RunCommand, WorkMode
+from app.protocol.enums import (
+    Alarm,
+    CommandKind,
+    ControllerMode,
+    ProgramState,
+    RunCommand,
+    WorkMode,
+    decode_status_registers,
+)
 from app.protocol.registers import (
     GV_COMMAND_STATUS,
     GV_DATE,
@@ -87,6 +106,10 @@ _STATUS_COMMANDS = frozenset({RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCo
                               RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE})
 _GENERAL_REGISTERS = 200  # GV0..GV99 (registers 0..199): cleared by a controller restart
 _STOP_TIMEOUT = 2.0
+TIMING_PROFILES = ("classic", "fast", "slow")
+GV291_MODES = ("ignored", "writable", "read-only")
+_ANSWER_HOLD_MAX = 0.5  # s a move waits at most for its command's answer to go out
+_GV291_REGS = range(gv_reg(GV_COMMAND_STATUS), gv_reg(GV_COMMAND_STATUS) + 2)
 
 
 @dataclass
@@ -115,6 +138,9 @@ class SimConfig:
     baudrate: int = 115200
     parity: Literal["N", "E", "O"] = "N"
     stopbits: int = 1
+    timing: Literal["classic", "fast", "slow"] = "classic"  # GV291 timing profile (module docstring)
+    gv291: Literal["ignored", "writable", "read-only"] = "ignored"  # what a host's write to GV291 does
+    seed: int = 0  # of the "slow" profile's jitter
 
     def __post_init__(self) -> None:
         if isinstance(self.word_order, str):
@@ -132,6 +158,10 @@ class SimConfig:
         if self.parity not in ("N", "E", "O") or self.stopbits not in (1, 2) or self.baudrate <= 0:
             raise ValueError(f"serial settings: parity N/E/O, stop bits 1/2, baud > 0; got "
                              f"{self.parity!r}, {self.stopbits!r}, {self.baudrate!r}")
+        if self.timing not in TIMING_PROFILES:
+            raise ValueError(f"timing must be one of {', '.join(TIMING_PROFILES)}, got {self.timing!r}")
+        if self.gv291 not in GV291_MODES:
+            raise ValueError(f"gv291 must be one of {', '.join(GV291_MODES)}, got {self.gv291!r}")
 
 
 @dataclass(frozen=True)
@@ -206,6 +236,8 @@ class SimController:
         self._hold_old_value = 0
         self._hold_zero_until = 0.0
         self._zero_unread = False  # the 0 phase has not been seen by a host read yet
+        self._rng = random.Random(self.config.seed)  # the "slow" profile's jitter
+        self._move_unanswered: float | None = None  # when a move command not answered yet came
         self._wipe_general = False  # set by restart_controller(): clear GV0..GV99 on the next request
         # bad input and the communication watchdog (app/sim/guard.py)
         self.events: list[SimEvent] = []
@@ -252,10 +284,12 @@ class SimController:
         self._port = self._runner.port
         self._tick_thread = threading.Thread(target=self._tick_loop, name="sim-ticker", daemon=True)
         self._tick_thread.start()
-        log.info("simulator listening on %s (unit %s, %s framing, %s word order, status %s, watchdog %s)",
+        log.info("simulator listening on %s (unit %s, %s framing, %s word order, status %s, watchdog %s, "
+                 "timing %s, GV291 %s)",
                  self.endpoint, self.config.unit, "rtu" if self.config.serial_port else self.config.framer,
                  self.config.word_order.value, self.config.status_encoding,
-                 f"{self.watchdog.timeout:g} s" if self.watchdog.enabled else "off")
+                 f"{self.watchdog.timeout:g} s" if self.watchdog.enabled else "off",
+                 self.config.timing, self.config.gv291)
 
     async def _serve(self) -> GuardedTcpServer | GuardedSerialServer:
         initial = [0] * REGISTER_SPACE
@@ -303,14 +337,21 @@ class SimController:
         deadline = last + period
         while not self._stop_event.wait(max(0.0, deadline - time.monotonic())):
             now = time.monotonic()
-            step = min(now - last, 0.1)  # a stalled thread must not teleport the arm
+            # a stalled thread must not teleport the arm: at most two periods a tick, so even a
+            # short move spans several ticks a host can see (motion runs late, not in a jump)
+            step = min(now - last, 2 * period)
             last = now
+            accepted = self._move_unanswered
+            # a move starts once its command is answered, as on a controller that answers
+            # within its scan: a busy simulator must not run a short move to its end before
+            # the host even has the answer
             with self.lock:
-                try:
-                    self.robot.tick(step)
-                except Exception:  # keep the simulator alive; the failure is in the log
-                    log.exception("simulator tick failed")
-                    self.robot.stop()
+                if accepted is None or now - accepted >= _ANSWER_HOLD_MAX:
+                    try:
+                        self.robot.tick(step)
+                    except Exception:  # keep the simulator alive; the failure is in the log
+                        log.exception("simulator tick failed")
+                        self.robot.stop()
                 jogging = self.robot.jogging
             self.watchdog.check(jogging)
             self.bad_frames.flush()
@@ -320,6 +361,8 @@ class SimController:
 
     # --- Modbus glue ----------------------------------------------------------------------
     def _trace_packet(self, sending: bool, data: bytes) -> bytes:
+        if sending:
+            self._move_unanswered = None  # the answer goes out: a move accepted may start
         if sending and self._silent:
             return b""  # silent: the request was received, the answer is swallowed
         return data
@@ -404,12 +447,34 @@ class SimController:
             return self.robot.command_status
 
     def _hold_status(self, latency: bool) -> None:
+        """Publish the old GV291 a while, then 0, then the robot's value (the timing profile)."""
         now = time.monotonic()
         old = self.published_status(now)
+        profile = self.config.timing
+        pickup = self._status_delay
+        zero = self.config.command_latency if latency else 0.0
+        if profile == "fast":
+            zero = 0.0
+        elif profile == "slow":
+            pickup += self._rng.uniform(*timing.SIM_SLOW_PICKUP)
+            zero = self._rng.uniform(*timing.SIM_SLOW_ZERO) if latency else 0.0
         self._hold_old_value = old
-        self._hold_old_until = now + self._status_delay
-        self._hold_zero_until = self._hold_old_until + (self.config.command_latency if latency else 0.0)
-        self._zero_unread = latency
+        self._hold_old_until = now + pickup
+        self._hold_zero_until = self._hold_old_until + zero
+        self._zero_unread = latency and profile == "classic"
+
+    def _host_wrote_status(self, regs: list[int], start: int) -> ExcCodes | None:
+        """A host's write covered GV291: refuse it, keep it, or let the next refresh overwrite it."""
+        mode = self.config.gv291
+        if mode == "read-only":
+            return ExcCodes.ILLEGAL_ADDRESS
+        if mode == "writable":
+            s = _GV291_REGS.start - start
+            self.robot.command_status = decode_status_registers(regs[s : s + 2], self.config.word_order)
+            self._hold_old_until = self._hold_zero_until = 0.0  # the host's value shows at once
+            self._zero_unread = False
+            log.info("host wrote GV291 = %d", self.robot.command_status)
+        return None
 
     def _refresh(self, regs: list[int], start: int) -> None:
         robot = self.robot
@@ -435,6 +500,10 @@ class SimController:
         """Act on the control registers a write covered (values already in ``regs``)."""
         covered = range(address, address + count)
         robot = self.robot
+        if _GV291_REGS.start in covered or _GV291_REGS.stop - 1 in covered:
+            refused = self._host_wrote_status(regs, start)
+            if refused is not None:
+                return refused
 
         def value(reg: int) -> int:
             return regs[reg - start]
@@ -473,9 +542,9 @@ class SimController:
         if command in _STATUS_COMMANDS:
             self._hold_status(latency=True)
             # moves show 6 (moving) as their own evidence; only the instant commands wait
-            # for a host to have seen the 0
-            self._zero_unread = command in (RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE,
-                                            RunCommand.TEACH_DISABLE)
+            # for a host to have seen the 0 (classic profile)
+            self._zero_unread = self._zero_unread and command in (
+                RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE)
         p = self._gvs(regs, start, GV_PARAM0, 6)
         speed = self._gv(regs, start, GV_EXPECTED_SPEED)
         ext = self._gvs(regs, start, GV_EXT_OFFSET0, NUM_EXTERNAL_AXES)
@@ -513,6 +582,8 @@ class SimController:
             status = robot.teach_enable(p[0], p[3])
         elif command is RunCommand.TEACH_DISABLE:
             status = robot.teach_disable(p[3])
+        if command in (RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT):
+            self._move_unanswered = time.monotonic()
         log.info("%s -> status %s", command.name, status)
         return None
 
@@ -601,6 +672,15 @@ class SimController:
         with self.lock:
             self.robot.set_alarm(Alarm(bit), on)
         log.info("alarm %s %s", Alarm(bit).name, "on" if on else "off")
+
+    def refuse_point(self, point_id: int, refuse: bool = True) -> None:
+        """Answer a create point of ``point_id`` with status 1 (bad point id) from now on."""
+        with self.lock:
+            if refuse:
+                self.robot.refused_points.add(int(point_id))
+            else:
+                self.robot.refused_points.discard(int(point_id))
+        log.info("create point %d: %s", point_id, "refused from now on" if refuse else "accepted again")
 
     def set_response_delay(self, seconds: float) -> None:
         self._response_delay = max(0.0, float(seconds))

@@ -2291,28 +2291,28 @@ Remove them all?</source>
         </message>
         <message>
             <location filename="../../app/protocol/enums.py" line="133" />
-            <location filename="../../app/protocol/enums.py" line="219" />
-            <location filename="../../app/protocol/enums.py" line="241" />
+            <location filename="../../app/protocol/enums.py" line="224" />
+            <location filename="../../app/protocol/enums.py" line="246" />
             <source>emergency stop</source>
             <translation>急停</translation>
         </message>
         <message>
             <location filename="../../app/protocol/enums.py" line="134" />
-            <location filename="../../app/protocol/enums.py" line="220" />
-            <location filename="../../app/protocol/enums.py" line="242" />
+            <location filename="../../app/protocol/enums.py" line="225" />
+            <location filename="../../app/protocol/enums.py" line="247" />
             <source>servo alarm</source>
             <translation>伺服报警</translation>
         </message>
         <message>
             <location filename="../../app/protocol/enums.py" line="135" />
-            <location filename="../../app/protocol/enums.py" line="221" />
-            <location filename="../../app/protocol/enums.py" line="243" />
+            <location filename="../../app/protocol/enums.py" line="226" />
+            <location filename="../../app/protocol/enums.py" line="248" />
             <source>brake alarm</source>
             <translation>抱闸报警</translation>
         </message>
         <message>
             <location filename="../../app/protocol/enums.py" line="136" />
-            <location filename="../../app/protocol/enums.py" line="245" />
+            <location filename="../../app/protocol/enums.py" line="250" />
             <source>algorithm alarm</source>
             <translation>算法报警</translation>
         </message>
@@ -2322,89 +2322,94 @@ Remove them all?</source>
             <translation>编码器角度报警</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="216" />
-            <location filename="../../app/protocol/enums.py" line="233" />
+            <location filename="../../app/protocol/enums.py" line="221" />
             <location filename="../../app/protocol/enums.py" line="238" />
+            <location filename="../../app/protocol/enums.py" line="243" />
             <source>initial</source>
             <translation>初始</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="217" />
+            <location filename="../../app/protocol/enums.py" line="222" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="218" />
-            <location filename="../../app/protocol/enums.py" line="240" />
+            <location filename="../../app/protocol/enums.py" line="223" />
+            <location filename="../../app/protocol/enums.py" line="245" />
             <source>work mode error</source>
             <translation>工作模式错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="222" />
-            <location filename="../../app/protocol/enums.py" line="244" />
+            <location filename="../../app/protocol/enums.py" line="227" />
+            <location filename="../../app/protocol/enums.py" line="249" />
             <source>bus servo initialisation error</source>
             <translation>总线伺服初始化错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="223" />
+            <location filename="../../app/protocol/enums.py" line="228" />
             <source>moving</source>
             <translation>运动中</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="224" />
+            <location filename="../../app/protocol/enums.py" line="229" />
             <source>data length error</source>
             <translation>数据长度错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="225" />
+            <location filename="../../app/protocol/enums.py" line="230" />
             <source>encoder angle read error</source>
             <translation>编码器角度读取错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="226" />
+            <location filename="../../app/protocol/enums.py" line="231" />
             <source>encoder angle update error</source>
             <translation>编码器角度更新错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="227" />
+            <location filename="../../app/protocol/enums.py" line="232" />
             <source>calculation error</source>
             <translation>计算错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="228" />
+            <location filename="../../app/protocol/enums.py" line="233" />
             <source>algorithm error while moving</source>
             <translation>运动中算法错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="229" />
+            <location filename="../../app/protocol/enums.py" line="234" />
             <source>motion timeout</source>
             <translation>运动超时</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="230" />
+            <location filename="../../app/protocol/enums.py" line="235" />
             <source>bad end point id</source>
             <translation>终点编号错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="234" />
             <location filename="../../app/protocol/enums.py" line="239" />
+            <location filename="../../app/protocol/enums.py" line="244" />
             <source>success</source>
             <translation>成功</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="235" />
+            <location filename="../../app/protocol/enums.py" line="240" />
             <source>bad point id</source>
             <translation>点编号错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="246" />
+            <location filename="../../app/protocol/enums.py" line="251" />
             <source>teach speed ratio not zero: enable/disable refused</source>
             <translation>示教速度比例不为零：拒绝使能/关闭</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="259" />
+            <location filename="../../app/protocol/enums.py" line="264" />
             <source>unknown status {code}</source>
             <translation>未知状态 {code}</translation>
+        </message>
+        <message>
+            <location filename="../../app/protocol/enums.py" line="265" />
+            <source>sent, waiting for the controller</source>
+            <translation>已发送，等待控制器结果</translation>
         </message>
     </context>
     <context>

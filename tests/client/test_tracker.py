@@ -9,6 +9,7 @@ from app.errors import AlarmRaised, CommandRefused, CommandStopped, CommandTimeo
 from app.link.tracker import CommandTracker
 from app.models import ControllerStatus, Pose
 from app.protocol.enums import (
+    STATUS_SENTINEL,
     Alarm,
     CommandKind,
     ControllerMode,
@@ -42,7 +43,7 @@ def feed(tracker: CommandTracker, steps: list[tuple[float, ControllerStatus, Pos
 
 
 def test_stale_done_is_not_taken_for_the_new_create_point() -> None:
-    tr = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0)
+    tr = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0, unconfirmed_after=1.0)
     # The old 0xFF lingers (status delay), then 0 (received), then the new 0xFF.
     i, result = feed(tr, [(0.01, st(DONE), None), (0.1, st(DONE), None), (0.2, st(0), None),
                           (0.3, st(DONE), None)])
@@ -55,13 +56,14 @@ def test_stale_done_is_not_taken_for_the_new_create_point() -> None:
 
 def test_unacknowledged_command_times_out_with_a_clear_message(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
-    tr = CommandTracker(RunCommand.TEACH_ENABLE, st(DONE), None, 0.0)
-    assert tr.update(st(DONE), None, 0.4) is None
-    result = tr.update(st(DONE), None, 0.5)
-    assert result is not None and not result.ok
+    # GV291 at 0 (initial, e.g. after power-on): a taken command would have changed it
+    tr = CommandTracker(RunCommand.TEACH_ENABLE, st(0), None, 0.0)
+    assert tr.update(st(0), None, 0.4) is None
+    result = tr.update(st(0), None, 0.5)
+    assert result is not None and not result.ok and not result.unconfirmed
     assert isinstance(tr.error, CommandTimeout)
     assert "did not acknowledge teach enable" in str(tr.error)
-    assert "255" in str(tr.error)
+    assert "'initial'" in str(tr.error)
 
 
 def test_error_code_after_ack_is_a_refusal_with_the_decoded_status() -> None:
@@ -204,13 +206,119 @@ def test_move_that_ends_without_a_status_update_is_unknown(monkeypatch: pytest.M
     assert "the arm moved and stopped" in result.message and "result is unknown" in result.message
 
 
-def test_poll_interval_is_fast_until_the_code_changes(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(timing, "ACK_POLL_INTERVAL", 0.001)
+def test_poll_interval_backs_off_to_the_cap(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "ACK_BACKOFF_FIRST", 0.001)
+    monkeypatch.setattr(timing, "ACK_BACKOFF_CAP", 0.01)
     monkeypatch.setattr(timing, "MOVE_POLL_INTERVAL", 0.02)
-    monkeypatch.setattr(timing, "ACK_TIMEOUT", 1.0)
     tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
-    tr.update(st(DONE, RUNNING), moved(1), 0.01)
-    assert tr.poll_interval(0.01) == 0.001  # acknowledged by motion, GV291 still stale
-    assert tr.poll_interval(1.5) == 0.02  # not forever
-    tr.update(st(6, RUNNING), moved(2), 0.02)
-    assert tr.poll_interval(0.02) == 0.02
+    intervals = []
+    for k in range(7):
+        tr.update(st(DONE, RUNNING), moved(k), 0.001 * k)
+        intervals.append(tr.poll_interval(0.001 * k))
+    assert intervals == [0.001, 0.002, 0.004, 0.008, 0.016, 0.02, 0.02]  # moves: capped by their poll
+    short = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0, rule="sentinel", pre_code=SENT)
+    for _ in range(6):
+        short.update(st(SENT), None, 0.0)
+    assert short.poll_interval(0.0) == 0.01  # never a spin, never slower than the cap
+
+
+def test_poll_interval_does_not_sleep_past_the_unconfirmed_deadline() -> None:
+    tr = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0, unconfirmed_after=0.05)
+    for _ in range(8):
+        tr.update(st(DONE), None, 0.046)
+    assert tr.poll_interval(0.046) == pytest.approx(0.004)
+
+
+# --- the completion rules on the timing profiles (tracker level; the wire: test_completion_profiles)
+
+SENT = STATUS_SENTINEL
+
+
+def sentinel(command: RunCommand) -> CommandTracker:
+    return CommandTracker(command, st(DONE), None, 0.0, rule="sentinel", pre_code=SENT)
+
+
+def test_sentinel_fast_result_straight_to_done_is_confirmed() -> None:
+    tr = sentinel(RunCommand.CREATE_POINT)
+    result = tr.update(st(DONE), None, 0.001)  # no 0 ever visible, the old code was 0xFF too
+    assert result is not None and result.ok and not result.unconfirmed
+    assert result.status.member is CreatePointStatus.DONE
+
+
+def test_sentinel_fast_error_is_reported() -> None:
+    tr = sentinel(RunCommand.CREATE_POINT)
+    result = tr.update(st(1), None, 0.001)
+    assert result is not None and not result.ok and isinstance(tr.error, CommandRefused)
+    assert "bad point id" in result.message
+
+
+def test_sentinel_slow_waits_through_the_sentinel_and_the_zero() -> None:
+    tr = sentinel(RunCommand.TEACH_DISABLE)
+    i, result = feed(tr, [(t / 1000, st(SENT), None) for t in range(1, 40, 5)]
+                     + [(0.045, st(0), None), (0.06, st(DONE), None)])
+    assert i == 9 and result.ok and not result.unconfirmed
+    assert result.details["ack_after"] == pytest.approx(0.045)
+
+
+def test_sentinel_that_stays_is_not_acknowledged(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
+    tr = sentinel(RunCommand.CREATE_POINT)
+    assert tr.update(st(SENT), None, 0.4) is None
+    result = tr.update(st(SENT), None, 0.5)
+    assert result is not None and not result.ok and isinstance(tr.error, CommandTimeout)
+    assert "sent, waiting for the controller" in result.message
+
+
+def test_observe_fast_unchanged_done_is_done_unconfirmed_after_the_window() -> None:
+    tr = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0, unconfirmed_after=0.05)
+    assert tr.update(st(DONE), None, 0.001) is None
+    assert tr.update(st(DONE), None, 0.049) is None
+    result = tr.update(st(DONE), None, 0.05)
+    assert result is not None and result.ok and result.unconfirmed
+    assert result.status.member is CreatePointStatus.DONE and tr.error is None
+    assert "done, unconfirmed" in result.message
+
+
+def test_observe_fast_error_is_a_change_and_never_unconfirmed() -> None:
+    tr = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0, unconfirmed_after=0.05)
+    result = tr.update(st(1), None, 0.001)
+    assert result is not None and not result.ok and not result.unconfirmed
+    assert isinstance(tr.error, CommandRefused)
+
+
+def test_observe_stale_error_is_refused_never_a_success() -> None:
+    tr = CommandTracker(RunCommand.CREATE_POINT, st(1), None, 0.0, unconfirmed_after=0.05)
+    assert tr.update(st(1), None, 0.01) is None
+    result = tr.update(st(1), None, 0.06)
+    assert result is not None and not result.ok and result.unconfirmed
+    assert isinstance(tr.error, CommandRefused) and "from the previous command" in result.message
+
+
+def test_observe_slow_change_inside_the_window_is_confirmed() -> None:
+    tr = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0, unconfirmed_after=0.05)
+    i, result = feed(tr, [(0.001, st(DONE), None), (0.02, st(DONE), None), (0.03, st(0), None),
+                          (0.04, st(DONE), None)])
+    assert i == 3 and result.ok and not result.unconfirmed
+
+
+def test_observe_moves_are_never_unconfirmed(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
+    tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0, unconfirmed_after=0.05)
+    assert tr.update(st(DONE), HOME, 0.1) is None
+    result = tr.update(st(DONE), HOME, 0.5)
+    assert result is not None and not result.ok and not result.unconfirmed
+    assert isinstance(tr.error, CommandTimeout)
+
+
+@pytest.mark.parametrize(("command", "before", "after"), [
+    (RunCommand.TEACH_ENABLE, ControllerMode.AUTO, ControllerMode.MODBUS_TEACH),
+    (RunCommand.TEACH_DISABLE, ControllerMode.MODBUS_TEACH, ControllerMode.AUTO),
+])
+def test_observe_teach_is_confirmed_by_the_controller_mode(command: RunCommand, before: ControllerMode,
+                                                          after: ControllerMode) -> None:
+    pre = ControllerStatus(before, STOPPED, Alarm.NONE, DONE)
+    tr = CommandTracker(command, pre, None, 0.0, unconfirmed_after=0.05)
+    assert tr.update(pre, None, 0.001) is None
+    result = tr.update(ControllerStatus(after, STOPPED, Alarm.NONE, DONE), None, 0.002)
+    assert result is not None and result.ok and not result.unconfirmed
+    assert result.status.member is TeachStatus.DONE

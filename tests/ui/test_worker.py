@@ -255,7 +255,9 @@ def test_refusals_and_exceptions_are_results(qtbot: Any, sim: Any, link: RobotLi
         link.go_zero(3)
     assert "illegal data address" in blocker.args[0].message
     sim.set_exception(None)
-    with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as blocker:
+    # a poll that read 412..511 (it covers 445) while the exception was on may report late: skip it
+    with qtbot.waitSignal(link.errorOccurred, check_params_cb=lambda e: e.operation != "poll",
+                          timeout=SIGNAL_TIMEOUT_MS) as blocker:
         link.step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0])
     error = blocker.args[0]
     assert error.operation == "step" and "zero" in error.message and "Traceback" not in error.message
