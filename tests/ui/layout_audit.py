@@ -119,7 +119,7 @@ def clipped_texts(root: QWidget) -> list[str]:
                 problems.append(f"{describe(widget)} elides on purpose but has no tooltip")
             continue
         if isinstance(widget, QLabel):
-            if not widget.text() or widget.pixmap() is not None and not widget.pixmap().isNull():
+            if not widget.text() or (widget.pixmap() is not None and not widget.pixmap().isNull()):
                 continue
             if widget.wordWrap():
                 needed = widget.heightForWidth(widget.width())

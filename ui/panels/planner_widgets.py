@@ -11,6 +11,7 @@ from PySide6.QtGui import QAction
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QComboBox,
+    QGridLayout,
     QGroupBox,
     QHBoxLayout,
     QHeaderView,
@@ -48,6 +49,7 @@ from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
 from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_OK, COLOR_WARN, COLOR_WARN_TEXT
+from ui.touch import mark_motion
 
 ModelIndex = QModelIndex | QPersistentModelIndex
 
@@ -56,6 +58,10 @@ SUMMARY_COLOURS: dict[Level, str] = {
     Level.OK: COLOR_OK, Level.INFO: COLOR_INFO, Level.WARN: COLOR_WARN, Level.ERROR: COLOR_ERROR,
 }
 STATUS_COLOURS: dict[Level, str] = {**SUMMARY_COLOURS, Level.WARN: COLOR_WARN_TEXT, Level.INFO: COLOR_OK}
+
+
+RUN_LABEL_LINES = 2
+PLAN_LIST_MIN_ROWS = 2  # the plan list scrolls below this; the run box keeps its room
 
 
 def action_button(action: QAction, *, bold: bool = False) -> QToolButton:
@@ -144,8 +150,18 @@ class PlanRunBox(QGroupBox):
         stop_button.setStyleSheet(f"QToolButton:enabled {{ color: {COLOR_ERROR}; }}")
         row2.addWidget(stop_button)
         self.resume_from_button = action_button(resume_from)
+        for row in (row1, row2):
+            for i in range(row.count()):
+                button = row.itemAt(i).widget()
+                if isinstance(button, QToolButton):
+                    mark_motion(button)
+        mark_motion(self.resume_from_button)
+        # the outcome of a run (a stop's reason can be long) gets room for RUN_LABEL_LINES
+        # lines from the start, so the box does not grow over its neighbours after a stop
         self.run_label = QLabel(self)
         self.run_label.setWordWrap(True)
+        self.run_label.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
+        self.run_label.setMinimumHeight(RUN_LABEL_LINES * self.run_label.fontMetrics().lineSpacing())
         self.run_progress = QProgressBar(self)
         self.run_progress.setTextVisible(False)
         self.run_progress.setMaximumHeight(10)
@@ -251,12 +267,13 @@ class PlanListBox(QGroupBox):
         view.verticalHeader().setVisible(False)
         view.verticalHeader().setDefaultSectionSize(24)
         header = view.horizontalHeader()
+        view.setMinimumHeight(header.sizeHint().height() + PLAN_LIST_MIN_ROWS * 24 + 2 * view.frameWidth())
         header.setSectionResizeMode(PLAN_COL_NAME, QHeaderView.ResizeMode.Stretch)
         header.setSectionResizeMode(1, QHeaderView.ResizeMode.ResizeToContents)
         header.setSectionResizeMode(2, QHeaderView.ResizeMode.ResizeToContents)
-        buttons = QHBoxLayout()
-        for action in actions:
-            buttons.addWidget(action_button(action))
+        buttons = QGridLayout()  # two per row: the plans column stays narrow
+        for i, action in enumerate(actions):
+            buttons.addWidget(action_button(action), i // 2, i % 2)
         buttons.setSpacing(3)
         layout = QVBoxLayout(self)
         layout.addWidget(view, 1)
@@ -317,19 +334,17 @@ class SegmentEditorBox(QGroupBox):
 
 def planner_splitters(parent: QWidget, plans_box: QWidget, run_box: QWidget, segments_box: QWidget,
                       preview_box: QWidget) -> tuple[QSplitter, QSplitter]:
-    """Plans (over the run box) and segments side by side on top, the preview across the full
-    width below: the three projections stay readable on a 1280 px screen. Returns (top, outer)."""
-    left = QWidget(parent)
-    left_layout = QVBoxLayout(left)
-    left_layout.setContentsMargins(0, 0, 0, 0)
-    left_layout.addWidget(plans_box, 1)
-    left_layout.addWidget(run_box)
+    """Plans, segments and the run box side by side on top (the order of the work), the preview
+    across the full width below: the three projections stay readable on a 1280 px screen, and
+    the top row is only as tall as its tallest box, so everything fits 1280×800. Returns (top, outer)."""
     top = QSplitter(Qt.Orientation.Horizontal, parent)
-    top.addWidget(left)
+    top.addWidget(plans_box)
     top.addWidget(segments_box)
+    top.addWidget(run_box)
     top.setStretchFactor(0, 0)
     top.setStretchFactor(1, 1)
-    top.setSizes([230, 1050])
+    top.setStretchFactor(2, 0)
+    top.setSizes([200, 1000, 240])
     top.setChildrenCollapsible(False)
     outer = QSplitter(Qt.Orientation.Vertical, parent)
     outer.addWidget(top)
