@@ -66,7 +66,7 @@ from ui.panels.status_panel import StatusPanel
 from ui.panels.step_panel import StepPanel
 from ui.panels.traffic_panel import TrafficPanel
 from ui.settings import AppSettings
-from ui.touch import apply_touch_mode, mark_motion, min_rows_height
+from ui.touch import apply_touch_mode, mark_motion, show_rows
 from ui.widgets_common import connection_display
 from ui.window_actions import WindowActions
 
@@ -167,7 +167,7 @@ class MainWindow(QMainWindow):
         self.event_dock.raise_()
         self.setCorner(Qt.Corner.BottomLeftCorner, area.LeftDockWidgetArea)  # status runs full height
         for panel in (self.event_log, self.traffic_panel):
-            panel.setMinimumHeight(min_rows_height(panel, panel.view, DOCK_MIN_ROWS))
+            show_rows(panel.view, DOCK_MIN_ROWS)
         # visibilityChanged(bool) says whether the dock can be seen: False while it is tabbed
         # behind the event log, when isVisible() still says True
         self._traffic_dock_shown = False
@@ -449,7 +449,8 @@ class MainWindow(QMainWindow):
     @Slot()
     def _size_docks(self) -> None:
         self.resizeDocks([self.status_dock], [STATUS_DOCK_WIDTH], Qt.Orientation.Horizontal)
-        self.resizeDocks([self.event_dock], [self.event_log.minimumHeight()], Qt.Orientation.Vertical)
+        self.resizeDocks([self.event_dock], [self.event_dock.minimumSizeHint().height()],
+                         Qt.Orientation.Vertical)
 
     def hideEvent(self, event: QHideEvent) -> None:
         self.jog_panel.release_all()

@@ -40,11 +40,13 @@ def motion_height(touch: bool) -> int:
     return TOUCH_MOTION_HEIGHT if touch else MOTION_MIN_HEIGHT
 
 
-def min_rows_height(panel: QWidget, view: QTableView, rows: int) -> int:
-    """The least height of ``panel`` at which ``view`` shows ``rows`` rows under its header."""
-    around = max(0, panel.sizeHint().height() - view.sizeHint().height())
-    header = view.horizontalHeader().sizeHint().height() if view.horizontalHeader().isVisible() else 0
-    return around + header + rows * view.verticalHeader().defaultSectionSize() + 2 * view.frameWidth()
+def show_rows(view: QTableView, rows: int) -> None:
+    """Make ``view`` at least tall enough for ``rows`` rows under its header (its panel and
+    dock grow from that)."""
+    header = view.horizontalHeader()
+    header_height = header.sizeHint().height() if not header.isHidden() else 0
+    view.setMinimumHeight(header_height + rows * view.verticalHeader().defaultSectionSize()
+                          + 2 * view.frameWidth())
 
 
 class RowsScrollArea(QScrollArea):

@@ -10,7 +10,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Sequence
 
-from PySide6.QtCore import QObject, Qt
+from PySide6.QtCore import QObject, QSize, Qt
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import QDockWidget, QMainWindow, QToolBar
 
@@ -120,7 +120,10 @@ class WindowActions(QObject):
         self.toolbar.addSeparator()
         for action in (self.stop_action, self.pause_action, self.resume_action):
             self.toolbar.addAction(action)
-        window.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.toolbar)
+        # in the menu bar's free right end, not a row of its own: the screen's height goes to
+        # the motion buttons (STOP, Pause and Resume are in the control bar as well)
+        self.toolbar.setIconSize(QSize(16, 16))
+        bar.setCornerWidget(self.toolbar, Qt.Corner.TopRightCorner)
         self.view_menu.addSeparator()
         self.view_menu.addAction(self.toolbar.toggleViewAction())
 

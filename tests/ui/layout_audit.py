@@ -115,7 +115,8 @@ def clipped_texts(root: QWidget) -> list[str]:
     problems: list[str] = []
     for widget in visible_widgets(root):
         if widget.property("elide"):
-            if not widget.toolTip():
+            shown = widget.text() if isinstance(widget, QLabel | QAbstractButton) else ""
+            if shown and not widget.toolTip():
                 problems.append(f"{describe(widget)} elides on purpose but has no tooltip")
             continue
         if isinstance(widget, QLabel):

@@ -214,8 +214,7 @@ class JogPanel(QWidget):
         speed_row.addWidget(self.speed_slider, 1)
         speed_row.addWidget(self.speed_value)
 
-        self.keys_label = QLabel(self)
-        self.keys_label.setWordWrap(True)
+        self.keys_label = QLabel(self)  # one short line; the whole hint is its tooltip
         self.keys_label.setStyleSheet("color: #5f6368;")
 
         layout = QVBoxLayout(self)
@@ -256,7 +255,8 @@ class JogPanel(QWidget):
             "Keyboard: click this panel, then hold {plus} (+) or {minus} (−) for axes 1–6; "
             "releasing the key stops."
         ).format(plus=plus, minus=minus)
-        self.keys_label.setText(self.tr("Keys: hold {plus} (+) or {minus} (−)").format(plus=plus, minus=minus))
+        short = self.tr("Keys: hold {plus} (+) or {minus} (−)")
+        self.keys_label.setText(short.format(plus=plus, minus=minus))
         self.keys_label.setToolTip(keys)
         self.setToolTip(keys)
         self._update_axes()

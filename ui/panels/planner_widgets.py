@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-from PySide6.QtCore import QAbstractItemModel, QModelIndex, QPersistentModelIndex, Qt
-from PySide6.QtGui import QAction
+from PySide6.QtCore import QAbstractItemModel, QModelIndex, QPersistentModelIndex, QRect, Qt
+from PySide6.QtGui import QAction, QResizeEvent
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QComboBox,
@@ -133,6 +133,55 @@ class PointRefDelegate(QStyledItemDelegate):
         model.setData(index, editor.itemData(found) if found >= 0 else text, Qt.ItemDataRole.EditRole)
 
 
+class LinesLabel(QLabel):
+    """Wrapped text in at most ``lines`` lines: a longer text ends in "…" and the whole of it
+    is in the tooltip. Its height never changes, so the box around it does not move."""
+
+    def __init__(self, lines: int, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self._lines = lines
+        self._full = ""
+        self.setProperty("elide", True)
+        self.setWordWrap(True)
+        self.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
+        self.setFixedHeight(lines * self.fontMetrics().lineSpacing() + 2)
+
+    def text(self) -> str:
+        """The whole text, also when the label shows it cut short."""
+        return self._full
+
+    def shown_text(self) -> str:
+        return super().text()
+
+    def setText(self, text: str) -> None:
+        self._full = text
+        self.setToolTip(text)
+        self._fit()
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        super().resizeEvent(event)
+        self._fit()
+
+    def _fit(self) -> None:
+        text = self._full
+        metrics = self.fontMetrics()
+        room = QRect(0, 0, max(1, self.width()), 10_000)
+        flags = int(Qt.TextFlag.TextWordWrap)
+
+        def fits(candidate: str) -> bool:
+            return metrics.boundingRect(room, flags, candidate).height() <= self.height()
+        if not fits(text):
+            low, high = 0, len(text)
+            while low < high:  # the longest prefix that fits with the ellipsis
+                middle = (low + high + 1) // 2
+                if fits(text[:middle].rstrip() + "…"):
+                    low = middle
+                else:
+                    high = middle - 1
+            text = text[:low].rstrip() + "…"
+        super().setText(text)
+
+
 class PlanRunBox(QGroupBox):
     """Run, Run from here, Step / Pause, Resume, Stop / Resume from k, and the run's progress."""
 
@@ -158,10 +207,7 @@ class PlanRunBox(QGroupBox):
         mark_motion(self.resume_from_button)
         # the outcome of a run (a stop's reason can be long) gets room for RUN_LABEL_LINES
         # lines from the start, so the box does not grow over its neighbours after a stop
-        self.run_label = QLabel(self)
-        self.run_label.setWordWrap(True)
-        self.run_label.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
-        self.run_label.setMinimumHeight(RUN_LABEL_LINES * self.run_label.fontMetrics().lineSpacing())
+        self.run_label = LinesLabel(RUN_LABEL_LINES, self)
         self.run_progress = QProgressBar(self)
         self.run_progress.setTextVisible(False)
         self.run_progress.setMaximumHeight(10)
