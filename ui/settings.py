@@ -1,4 +1,5 @@
-"""Remembered settings: language, touch mode, connection, poll rate, last project, window geometry (a QSettings wrapper).
+"""Remembered settings: language, touch mode, connection, poll rate, last project, window geometry
+(a QSettings wrapper).
 
 ``AppSettings()`` uses the user's settings store (organisation ``Bochuang``, application
 ``TeachPad``); tests and portable installs pass an explicit INI file

@@ -156,8 +156,8 @@ def test_points_primary_actions_and_docks_stay_visible(make_window: Callable[...
 
 
 @pytest.mark.parametrize("language", LANGUAGES)
-def test_joint_jog_fits_1280x800_without_scrolling(qtbot: Any, sim: Any,
-                                                   make_window: Callable[..., MainWindow], language: str) -> None:
+def test_joint_jog_fits_1280x800_without_scrolling(qtbot: Any, sim: Any, language: str,
+                                                   make_window: Callable[..., MainWindow]) -> None:
     window = make_window(language, SIZES[0])
     connect(qtbot, window.link, sim)
     qtbot.waitUntil(lambda: window.motion_enabled, timeout=SIGNAL_TIMEOUT_MS)
