@@ -115,11 +115,16 @@ def work_states(window: MainWindow) -> Iterator[str]:
 
 
 def check_window(window: MainWindow, language: str, touch: bool) -> list[str]:
+    """Every work state beside the joint jog, then every motion state beside the planner
+    after a stop (the two sides only share the window's width, which neither state changes)."""
     found: list[str] = []
+    window.jog_panel.set_frame(TeachFrame.JOINT)
     for work in work_states(window):
-        for motion in motion_states(window):
-            settle()
-            found += [f"[{motion} | {work}] {p}" for p in problems(window, language, touch)]
+        settle()
+        found += [f"[jog joint | {work}] {p}" for p in problems(window, language, touch)]
+    for motion in motion_states(window):
+        settle()
+        found += [f"[{motion} | planner after a stop] {p}" for p in problems(window, language, touch)]
     return sorted(set(found))
 
 
