@@ -16,7 +16,7 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QCoreApplication
+from PySide6.QtCore import QCoreApplication, QSize, Qt
 from PySide6.QtGui import QFontDatabase
 from PySide6.QtWidgets import QApplication, QMessageBox, QWidget
 
@@ -34,7 +34,14 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 )
 from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.keypad import KeypadDialog
-from ui.main_window import DOCK_MIN_ROWS, TAB_MONITOR, TAB_PLANNER, TAB_POINTS, MainWindow
+from ui.main_window import (
+    DOCK_MIN_ROWS,
+    STATUS_DOCK_WIDTH,
+    TAB_MONITOR,
+    TAB_PLANNER,
+    TAB_POINTS,
+    MainWindow,
+)
 from ui.touch import motion_height
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
@@ -76,6 +83,8 @@ def make_window_fixture(qtbot: Any, link: Any, app_settings: Any, translator: An
         window.show()
         qtbot.waitExposed(window)
         settle()
+        window.resizeDocks([window.status_dock], [STATUS_DOCK_WIDTH], Qt.Orientation.Horizontal)
+        settle()
         assert (window.width(), window.height()) == size
         return window
 
@@ -114,6 +123,18 @@ def work_states(window: MainWindow) -> Iterator[str]:
     yield "planner after a stop"
 
 
+def squeezed(window: MainWindow) -> list[str]:
+    """Qt squeezes widgets below their minimum (and clips them) when the window cannot give
+    every part its minimum: the central area and the status dock must both get theirs."""
+    found = []
+    for part, least in ((window.centralWidget(), window.centralWidget().minimumSizeHint()),
+                        (window.status_dock, QSize(STATUS_DOCK_WIDTH, 0))):
+        if part.width() < least.width() or part.height() < least.height():
+            found.append(f"{part.objectName() or 'central area'} is {part.width()}×{part.height()}, "
+                         f"needs {least.width()}×{least.height()}")
+    return found
+
+
 def check_window(window: MainWindow, language: str, touch: bool) -> list[str]:
     """Every work state beside the joint jog, then every motion state beside the planner
     after a stop (the two sides only share the window's width, which neither state changes)."""
@@ -121,10 +142,11 @@ def check_window(window: MainWindow, language: str, touch: bool) -> list[str]:
     window.jog_panel.set_frame(TeachFrame.JOINT)
     for work in work_states(window):
         settle()
-        found += [f"[jog joint | {work}] {p}" for p in problems(window, language, touch)]
+        found += [f"[jog joint | {work}] {p}" for p in problems(window, language, touch) + squeezed(window)]
     for motion in motion_states(window):
         settle()
-        found += [f"[{motion} | planner after a stop] {p}" for p in problems(window, language, touch)]
+        found += [f"[{motion} | planner after a stop] {p}"
+                  for p in problems(window, language, touch) + squeezed(window)]
     return sorted(set(found))
 
 

@@ -49,7 +49,7 @@ from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
 from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_OK, COLOR_WARN, COLOR_WARN_TEXT
-from ui.touch import mark_motion
+from ui.touch import RowsScrollArea, mark_motion
 
 ModelIndex = QModelIndex | QPersistentModelIndex
 
@@ -183,27 +183,24 @@ class LinesLabel(QLabel):
 
 
 class PlanRunBox(QGroupBox):
-    """Run, Run from here, Step / Pause, Resume, Stop / Resume from k, and the run's progress."""
+    """Run, Run from here / Step, Stop / Pause, Resume / Resume from k, and the run's progress.
+
+    Two buttons a row: the box stays narrow enough to sit beside the plans and the segments."""
 
     def __init__(self, run: QAction, run_from: QAction, step: QAction, pause: QAction, resume: QAction,
                  stop: QAction, resume_from: QAction, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        row1 = QHBoxLayout()
-        row1.addWidget(action_button(run, bold=True))
-        row1.addWidget(action_button(run_from))
-        row1.addWidget(action_button(step))
-        row2 = QHBoxLayout()
-        row2.addWidget(action_button(pause))
-        row2.addWidget(action_button(resume))
         stop_button = action_button(stop, bold=True)
         stop_button.setStyleSheet(f"QToolButton:enabled {{ color: {COLOR_ERROR}; }}")
-        row2.addWidget(stop_button)
+        buttons = QGridLayout()
+        buttons.setSpacing(3)
+        rows = ((action_button(run, bold=True), action_button(run_from)), (action_button(step), stop_button),
+                (action_button(pause), action_button(resume)))
+        for row, pair in enumerate(rows):
+            for column, button in enumerate(pair):
+                mark_motion(button)
+                buttons.addWidget(button, row, column)
         self.resume_from_button = action_button(resume_from)
-        for row in (row1, row2):
-            for i in range(row.count()):
-                button = row.itemAt(i).widget()
-                if isinstance(button, QToolButton):
-                    mark_motion(button)
         mark_motion(self.resume_from_button)
         # the outcome of a run (a stop's reason can be long) gets room for RUN_LABEL_LINES
         # lines from the start, so the box does not grow over its neighbours after a stop
@@ -212,8 +209,7 @@ class PlanRunBox(QGroupBox):
         self.run_progress.setTextVisible(False)
         self.run_progress.setMaximumHeight(10)
         layout = QVBoxLayout(self)
-        layout.addLayout(row1)
-        layout.addLayout(row2)
+        layout.addLayout(buttons)
         layout.addWidget(self.resume_from_button)
         layout.addWidget(self.run_progress)
         layout.addWidget(self.run_label)
@@ -368,6 +364,7 @@ class SegmentEditorBox(QGroupBox):
         buttons = QHBoxLayout()
         for action in actions:
             buttons.addWidget(action_button(action))
+        buttons.setSpacing(3)
         buttons.addStretch(1)
         layout = QVBoxLayout(self)
         layout.addLayout(buttons)
@@ -386,12 +383,15 @@ def planner_splitters(parent: QWidget, plans_box: QWidget, run_box: QWidget, seg
     top = QSplitter(Qt.Orientation.Horizontal, parent)
     top.addWidget(plans_box)
     top.addWidget(segments_box)
-    top.addWidget(run_box)
+    run_scroll = RowsScrollArea(run_box, parent)  # scrolls only with touch-size buttons on 800 px
+    run_scroll.setObjectName("PlanRunScroll")
+    top.addWidget(run_scroll)
     top.setStretchFactor(0, 0)
     top.setStretchFactor(1, 1)
     top.setStretchFactor(2, 0)
     top.setSizes([200, 1000, 240])
     top.setChildrenCollapsible(False)
+    top.setHandleWidth(4)  # three boxes in a row on a 1280 px screen: every pixel counts
     outer = QSplitter(Qt.Orientation.Vertical, parent)
     outer.addWidget(top)
     outer.addWidget(preview_box)
