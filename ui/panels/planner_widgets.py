@@ -61,6 +61,7 @@ STATUS_COLOURS: dict[Level, str] = {**SUMMARY_COLOURS, Level.WARN: COLOR_WARN_TE
 
 
 RUN_LABEL_LINES = 2
+SEGMENT_BUTTONS_PER_ROW = 3
 PLAN_LIST_MIN_ROWS = 2  # the plan list scrolls below this; the run box keeps its room
 
 
@@ -361,11 +362,14 @@ class SegmentEditorBox(QGroupBox):
         view.horizontalHeader().setStretchLastSection(True)
         for column in range(segments.columnCount()):
             view.setColumnWidth(column, SEGMENT_COLUMN_WIDTHS.get(column, 60))
-        buttons = QHBoxLayout()
-        for action in actions:
-            buttons.addWidget(action_button(action))
+        # three buttons a row: the box stays narrow beside the plans and the run box (the run
+        # box sets the row's height anyway)
+        buttons = QGridLayout()
         buttons.setSpacing(3)
-        buttons.addStretch(1)
+        per_row = SEGMENT_BUTTONS_PER_ROW
+        for i, action in enumerate(actions):
+            buttons.addWidget(action_button(action), i // per_row, i % per_row)
+        buttons.setColumnStretch(per_row, 1)
         layout = QVBoxLayout(self)
         layout.addLayout(buttons)
         layout.addWidget(view, 1)
