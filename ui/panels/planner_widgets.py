@@ -241,7 +241,8 @@ class PlanRunBox(QGroupBox):
 
 
 class PlanChecksBar(QWidget):
-    """The checks in one line under the segment table, with Upload now and Check."""
+    """The checks under the segment table (a line of their own: the column can be narrow),
+    with Upload now and Check below them."""
 
     def __init__(self, upload: Callable[[], None], check: Callable[[], None],
                  parent: QWidget | None = None) -> None:
@@ -253,11 +254,15 @@ class PlanChecksBar(QWidget):
         self.upload_button.clicked.connect(upload)
         self.check_button = QPushButton(self)
         self.check_button.clicked.connect(check)
-        layout = QHBoxLayout(self)
+        buttons = QHBoxLayout()
+        buttons.addStretch(1)
+        buttons.addWidget(self.upload_button)
+        buttons.addWidget(self.check_button)
+        layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.addWidget(self.summary, 1)
-        layout.addWidget(self.upload_button)
-        layout.addWidget(self.check_button)
+        layout.setSpacing(2)
+        layout.addWidget(self.summary)
+        layout.addLayout(buttons)
 
     def retranslate(self) -> None:
         self.upload_button.setText(self.tr("Upload now"))
@@ -401,6 +406,6 @@ def planner_splitters(parent: QWidget, plans_box: QWidget, run_box: QWidget, seg
     outer.addWidget(preview_box)
     outer.setStretchFactor(0, 1)
     outer.setStretchFactor(1, 1)
-    outer.setSizes([340, 400])
+    outer.setSizes([420, 300])  # the top row first: the run box and a few segment rows
     outer.setChildrenCollapsible(False)
     return top, outer
