@@ -214,6 +214,7 @@ class PlanRunBox(QGroupBox):
         layout.addWidget(self.resume_from_button)
         layout.addWidget(self.run_progress)
         layout.addWidget(self.run_label)
+        layout.addStretch(1)  # a tall box keeps its buttons at the top
 
     def retranslate(self) -> None:
         self.setTitle(self.tr("Run"))
