@@ -66,6 +66,7 @@ from ui.panels.status_panel import StatusPanel
 from ui.panels.step_panel import StepPanel
 from ui.panels.traffic_panel import TrafficPanel
 from ui.settings import AppSettings
+from ui.touch import apply_touch_mode, mark_motion, show_rows
 from ui.widgets_common import connection_display
 from ui.window_actions import WindowActions
 
@@ -73,7 +74,7 @@ DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size
 MIN_SIZE = (1024, 700)  # the layout stays usable down to this
 STATUS_DOCK_WIDTH = 265
 STATUS_DOCK_MAX_WIDTH = 320  # the status column never needs more; the work tabs get the rest
-DOCK_MIN_HEIGHT = 72  # px, the bottom docks (event log, traffic) at their smallest
+DOCK_MIN_ROWS = 5  # the bottom docks (event log, traffic) show at least this many rows
 TAB_MONITOR, TAB_POINTS, TAB_PLANNER = range(3)
 TAB_NAMES = ("monitor", "points", "planner")
 
@@ -166,7 +167,7 @@ class MainWindow(QMainWindow):
         self.event_dock.raise_()
         self.setCorner(Qt.Corner.BottomLeftCorner, area.LeftDockWidgetArea)  # status runs full height
         for panel in (self.event_log, self.traffic_panel):
-            panel.setMinimumHeight(DOCK_MIN_HEIGHT)  # a short log scrolls; the window fits 800 px
+            show_rows(panel.view, DOCK_MIN_ROWS)
         # visibilityChanged(bool) says whether the dock can be seen: False while it is tabbed
         # behind the event log, when isVisible() still says True
         self._traffic_dock_shown = False
@@ -180,7 +181,8 @@ class MainWindow(QMainWindow):
             tab_count=len(TAB_NAMES), set_language=self.set_language,
             language=translator.language if translator else "en", file_actions=self.project.file_actions(),
             edit_actions=[self.project.action_undo, self.project.action_redo],
-            docks=[self.status_dock, self.event_dock, self.traffic_dock])
+            docks=[self.status_dock, self.event_dock, self.traffic_dock],
+            set_touch_mode=self.set_touch_mode, touch_mode=settings.touch_mode)
         self.status_project = QLabel(self)
         self.status_link = QLabel(self)
         self.status_rtt = QLabel(self)
@@ -192,6 +194,9 @@ class MainWindow(QMainWindow):
         self.statusBar().addPermanentWidget(self.status_link)
 
         self._wire()
+        bar = self.control_bar
+        mark_motion(bar.stop_button, bar.pause_button, bar.resume_button)
+        self.set_touch_mode(settings.touch_mode)
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*self._default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])
@@ -405,6 +410,16 @@ class MainWindow(QMainWindow):
             "(Modbus TCP / RTU).<br><br>Esc stops all motion. Jog buttons and keys move only while held."
         ).format(version=__version__))
 
+    @property
+    def touch_mode(self) -> bool:
+        return self.settings.touch_mode
+
+    def set_touch_mode(self, on: bool) -> None:
+        """Bigger motion buttons and a keypad for number fields (remembered)."""
+        self.settings.touch_mode = on
+        apply_touch_mode((self.control_column, self.work_tabs), on)
+        self.menus.touch_action.setChecked(on)
+
     def set_language(self, code: str) -> None:
         """Switch the UI language at runtime and remember it."""
         self.jog_panel.release_all()
@@ -434,7 +449,8 @@ class MainWindow(QMainWindow):
     @Slot()
     def _size_docks(self) -> None:
         self.resizeDocks([self.status_dock], [STATUS_DOCK_WIDTH], Qt.Orientation.Horizontal)
-        self.resizeDocks([self.event_dock], [150], Qt.Orientation.Vertical)
+        self.resizeDocks([self.event_dock], [self.event_dock.minimumSizeHint().height()],
+                         Qt.Orientation.Vertical)
 
     def hideEvent(self, event: QHideEvent) -> None:
         self.jog_panel.release_all()

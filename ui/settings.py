@@ -1,4 +1,5 @@
-"""Remembered settings: language, connection, poll rate, last project, window geometry (a QSettings wrapper).
+"""Remembered settings: language, touch mode, connection, poll rate, last project, window geometry
+(a QSettings wrapper).
 
 ``AppSettings()`` uses the user's settings store (organisation ``Bochuang``, application
 ``TeachPad``); tests and portable installs pass an explicit INI file
@@ -70,6 +71,16 @@ class AppSettings:
     @language.setter
     def language(self, code: str) -> None:
         self._store.setValue("ui/language", code if code in LANGUAGES else DEFAULT_LANGUAGE)
+
+    # --- touch mode -------------------------------------------------------------------
+    @property
+    def touch_mode(self) -> bool:
+        """Bigger motion buttons and an on-screen keypad for number fields."""
+        return _to_bool(self._store.value("ui/touch_mode", False))
+
+    @touch_mode.setter
+    def touch_mode(self, on: bool) -> None:
+        self._store.setValue("ui/touch_mode", bool(on))
 
     # --- poll rate --------------------------------------------------------------------
     @property

@@ -10,7 +10,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Sequence
 
-from PySide6.QtCore import QObject, Qt
+from PySide6.QtCore import QObject, QSize, Qt
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import QDockWidget, QMainWindow, QToolBar
 
@@ -29,7 +29,8 @@ class WindowActions(QObject):
                  pause: Command, resume: Command, about: Command, show_tab: Callable[[int], object],
                  tab_count: int, set_language: Callable[[str], object], language: str,
                  file_actions: Sequence[QAction | None], edit_actions: Sequence[QAction],
-                 docks: Sequence[QDockWidget]) -> None:
+                 docks: Sequence[QDockWidget], set_touch_mode: Callable[[bool], object] | None = None,
+                 touch_mode: bool = False) -> None:
         super().__init__(window)
         self._window = window
         app_wide = Qt.ShortcutContext.ApplicationShortcut
@@ -54,6 +55,12 @@ class WindowActions(QObject):
             self.language_group.addAction(action)
             self.language_actions[code] = action
         self.language_actions.get(language, self.language_actions["en"]).setChecked(True)
+        self.touch_action = QAction(self)
+        self.touch_action.setObjectName("TouchModeAction")
+        self.touch_action.setCheckable(True)
+        self.touch_action.setChecked(touch_mode)
+        if set_touch_mode is not None:
+            self.touch_action.toggled.connect(set_touch_mode)
         self._make_menus(file_actions, edit_actions, docks)
 
     def _action(self, slot: Callable[[], object],
@@ -68,7 +75,8 @@ class WindowActions(QObject):
         return action
 
     def _make_menus(self, file_actions: Sequence[QAction | None], edit_actions: Sequence[QAction],
-                    docks: Sequence[QDockWidget]) -> None:
+                    docks: Sequence[QDockWidget], set_touch_mode: Callable[[bool], object] | None = None,
+                 touch_mode: bool = False) -> None:
         window = self._window
         bar = window.menuBar()
         self.file_menu = bar.addMenu("")
@@ -96,6 +104,8 @@ class WindowActions(QObject):
         self.view_menu.addSeparator()
         for dock in docks:
             self.view_menu.addAction(dock.toggleViewAction())
+        self.view_menu.addSeparator()
+        self.view_menu.addAction(self.touch_action)
         self.language_menu = bar.addMenu("")
         for action in self.language_actions.values():
             self.language_menu.addAction(action)
@@ -110,7 +120,10 @@ class WindowActions(QObject):
         self.toolbar.addSeparator()
         for action in (self.stop_action, self.pause_action, self.resume_action):
             self.toolbar.addAction(action)
-        window.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.toolbar)
+        # in the menu bar's free right end, not a row of its own: the screen's height goes to
+        # the motion buttons (STOP, Pause and Resume are in the control bar as well)
+        self.toolbar.setIconSize(QSize(16, 16))
+        bar.setCornerWidget(self.toolbar, Qt.Corner.TopRightCorner)
         self.view_menu.addSeparator()
         self.view_menu.addAction(self.toolbar.toggleViewAction())
 
@@ -137,3 +150,5 @@ class WindowActions(QObject):
         self.resume_action.setText(self.tr("&Resume"))
         self.resume_action.setToolTip(self.tr("Resume the paused move or program (F7)"))
         self.about_action.setText(self.tr("&About TeachPad"))
+        self.touch_action.setText(self.tr("&Touch mode"))
+        self.touch_action.setToolTip(self.tr("Bigger motion buttons and an on-screen keypad for numbers"))

@@ -458,201 +458,234 @@
     <context>
         <name>JogPanel</name>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="214" />
-            <source>Frame</source>
-            <translation>坐标系</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/jog_panel.py" line="216" />
+            <location filename="../../ui/panels/jog_panel.py" line="239" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="217" />
+            <location filename="../../ui/panels/jog_panel.py" line="240" />
             <source>User frame</source>
             <translation>用户坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="218" />
+            <location filename="../../ui/panels/jog_panel.py" line="241" />
             <source>Tool frame</source>
             <translation>工具坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="219" />
+            <location filename="../../ui/panels/jog_panel.py" line="242" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="223" />
+            <location filename="../../ui/panels/jog_panel.py" line="246" />
             <source>User no.:</source>
             <translation>用户坐标号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="224" />
+            <location filename="../../ui/panels/jog_panel.py" line="247" />
             <source>Tool no.:</source>
             <translation>工具号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="225" />
-            <source>Jog</source>
-            <translation>点动</translation>
+            <location filename="../../ui/panels/jog_panel.py" line="237" />
+            <source>Frame:</source>
+            <translation>坐标系：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="226" />
+            <location filename="../../ui/panels/jog_panel.py" line="248" />
             <source>External axes</source>
             <translation>外部轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="227" />
+            <location filename="../../ui/panels/jog_panel.py" line="249" />
             <source>HOLD TO MOVE — release to stop</source>
             <translation>按住运动 — 松开即停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="228" />
+            <location filename="../../ui/panels/jog_panel.py" line="250" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="233" />
+            <location filename="../../ui/panels/jog_panel.py" line="255" />
             <source>Keyboard: click this panel, then hold {plus} (+) or {minus} (−) for axes 1–6; releasing the key stops.</source>
             <translation>键盘：先单击本面板，再按住 {plus}（+）或 {minus}（−）点动第 1–6 轴；松开按键即停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="358" />
+            <location filename="../../ui/panels/jog_panel.py" line="258" />
+            <source>Keys: hold {plus} (+) or {minus} (−)</source>
+            <translation>按键：按住 {plus} (+) 或 {minus} (−)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/jog_panel.py" line="390" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="358" />
+            <location filename="../../ui/panels/jog_panel.py" line="390" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="359" />
+            <location filename="../../ui/panels/jog_panel.py" line="391" />
             <source>Hold: {axis} − ({unit})</source>
             <translation>按住：{axis} −（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="361" />
+            <location filename="../../ui/panels/jog_panel.py" line="393" />
             <source>Hold: {axis} + ({unit})</source>
             <translation>按住：{axis} +（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="372" />
+            <location filename="../../ui/panels/jog_panel.py" line="404" />
             <source>{ratio} %</source>
             <translation>{ratio} %</translation>
         </message>
     </context>
     <context>
+        <name>KeypadDialog</name>
+        <message>
+            <location filename="../../ui/keypad.py" line="91" />
+            <source>Enter a value</source>
+            <translation>输入数值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/keypad.py" line="92" />
+            <source>OK</source>
+            <translation>确定</translation>
+        </message>
+        <message>
+            <location filename="../../ui/keypad.py" line="93" />
+            <source>Cancel</source>
+            <translation>取消</translation>
+        </message>
+        <message>
+            <location filename="../../ui/keypad.py" line="94" />
+            <source>Delete the last digit</source>
+            <translation>删除最后一位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/keypad.py" line="95" />
+            <source>Clear</source>
+            <translation>清空</translation>
+        </message>
+        <message>
+            <location filename="../../ui/keypad.py" line="97" />
+            <source>From {low} to {high}</source>
+            <translation>范围：{low} 至 {high}</translation>
+        </message>
+    </context>
+    <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="245" />
+            <location filename="../../ui/main_window.py" line="250" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="246" />
+            <location filename="../../ui/main_window.py" line="251" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="247" />
+            <location filename="../../ui/main_window.py" line="252" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="251" />
+            <location filename="../../ui/main_window.py" line="256" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="252" />
+            <location filename="../../ui/main_window.py" line="257" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="253" />
+            <location filename="../../ui/main_window.py" line="258" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="286" />
+            <location filename="../../ui/main_window.py" line="291" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="274" />
+            <location filename="../../ui/main_window.py" line="279" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="302" />
+            <location filename="../../ui/main_window.py" line="307" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="304" />
+            <location filename="../../ui/main_window.py" line="309" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="309" />
+            <location filename="../../ui/main_window.py" line="314" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="322" />
+            <location filename="../../ui/main_window.py" line="327" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="333" />
+            <location filename="../../ui/main_window.py" line="338" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="339" />
+            <location filename="../../ui/main_window.py" line="344" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="335" />
             <location filename="../../ui/main_window.py" line="340" />
+            <location filename="../../ui/main_window.py" line="345" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="248" />
+            <location filename="../../ui/main_window.py" line="253" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="249" />
+            <location filename="../../ui/main_window.py" line="254" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="250" />
+            <location filename="../../ui/main_window.py" line="255" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="403" />
+            <location filename="../../ui/main_window.py" line="408" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="404" />
+            <location filename="../../ui/main_window.py" line="409" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="412" />
+            <location filename="../../ui/main_window.py" line="427" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="413" />
+            <location filename="../../ui/main_window.py" line="428" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -815,43 +848,43 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="204" />
+            <location filename="../../ui/panels/planner_widgets.py" line="269" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="205" />
+            <location filename="../../ui/panels/planner_widgets.py" line="270" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="224" />
+            <location filename="../../ui/panels/planner_widgets.py" line="289" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="227" />
+            <location filename="../../ui/panels/planner_widgets.py" line="292" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="229" />
+            <location filename="../../ui/panels/planner_widgets.py" line="294" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="231" />
+            <location filename="../../ui/panels/planner_widgets.py" line="296" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="234" />
+            <location filename="../../ui/panels/planner_widgets.py" line="299" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -867,7 +900,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="266" />
+            <location filename="../../ui/panels/planner_widgets.py" line="332" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1007,23 +1040,23 @@
     <context>
         <name>PlanRunBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="160" />
+            <location filename="../../ui/panels/planner_widgets.py" line="220" />
             <source>Run</source>
             <extracomment>Colour of a summary line by level (the status line uses the darker warning text).</extracomment>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="163" />
+            <location filename="../../ui/panels/planner_widgets.py" line="223" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="164" />
+            <location filename="../../ui/panels/planner_widgets.py" line="224" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="178" />
+            <location filename="../../ui/panels/planner_widgets.py" line="238" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
@@ -1685,194 +1718,194 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="245" />
+            <location filename="../../ui/panels/points_panel.py" line="264" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="245" />
+            <location filename="../../ui/panels/points_panel.py" line="264" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="247" />
+            <location filename="../../ui/panels/points_panel.py" line="266" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="247" />
+            <location filename="../../ui/panels/points_panel.py" line="266" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="248" />
+            <location filename="../../ui/panels/points_panel.py" line="267" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="248" />
+            <location filename="../../ui/panels/points_panel.py" line="267" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="249" />
+            <location filename="../../ui/panels/points_panel.py" line="268" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="250" />
+            <location filename="../../ui/panels/points_panel.py" line="269" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="251" />
+            <location filename="../../ui/panels/points_panel.py" line="270" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="252" />
+            <location filename="../../ui/panels/points_panel.py" line="271" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="253" />
+            <location filename="../../ui/panels/points_panel.py" line="272" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="254" />
+            <location filename="../../ui/panels/points_panel.py" line="273" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="255" />
+            <location filename="../../ui/panels/points_panel.py" line="274" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="256" />
+            <location filename="../../ui/panels/points_panel.py" line="275" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="257" />
+            <location filename="../../ui/panels/points_panel.py" line="276" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="257" />
+            <location filename="../../ui/panels/points_panel.py" line="276" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="258" />
-            <location filename="../../ui/panels/points_panel.py" line="274" />
+            <location filename="../../ui/panels/points_panel.py" line="277" />
+            <location filename="../../ui/panels/points_panel.py" line="293" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="259" />
+            <location filename="../../ui/panels/points_panel.py" line="278" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="260" />
+            <location filename="../../ui/panels/points_panel.py" line="279" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="261" />
-            <location filename="../../ui/panels/points_panel.py" line="413" />
+            <location filename="../../ui/panels/points_panel.py" line="280" />
+            <location filename="../../ui/panels/points_panel.py" line="432" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="262" />
+            <location filename="../../ui/panels/points_panel.py" line="281" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="263" />
+            <location filename="../../ui/panels/points_panel.py" line="282" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="263" />
+            <location filename="../../ui/panels/points_panel.py" line="282" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="264" />
+            <location filename="../../ui/panels/points_panel.py" line="283" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="269" />
+            <location filename="../../ui/panels/points_panel.py" line="288" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="270" />
+            <location filename="../../ui/panels/points_panel.py" line="289" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="271" />
+            <location filename="../../ui/panels/points_panel.py" line="290" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="272" />
+            <location filename="../../ui/panels/points_panel.py" line="291" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="275" />
+            <location filename="../../ui/panels/points_panel.py" line="294" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="276" />
+            <location filename="../../ui/panels/points_panel.py" line="295" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="351" />
+            <location filename="../../ui/panels/points_panel.py" line="370" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="354" />
+            <location filename="../../ui/panels/points_panel.py" line="373" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="355" />
+            <location filename="../../ui/panels/points_panel.py" line="374" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="356" />
+            <location filename="../../ui/panels/points_panel.py" line="375" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="376" />
+            <location filename="../../ui/panels/points_panel.py" line="395" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="379" />
+            <location filename="../../ui/panels/points_panel.py" line="398" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="402" />
+            <location filename="../../ui/panels/points_panel.py" line="421" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="406" />
+            <location filename="../../ui/panels/points_panel.py" line="425" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -1885,7 +1918,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="443" />
+            <location filename="../../ui/panels/points_panel.py" line="462" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -1893,78 +1926,78 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProgramPanel</name>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="102" />
+            <location filename="../../ui/panels/program_panel.py" line="103" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="103" />
+            <location filename="../../ui/panels/program_panel.py" line="104" />
             <source>Program no.:</source>
             <translation>程序号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="103" />
+            <location filename="../../ui/panels/program_panel.py" line="104" />
             <source>Run mode:</source>
             <translation>运行方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="103" />
+            <location filename="../../ui/panels/program_panel.py" line="104" />
             <source>Cycles:</source>
             <translation>循环次数：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="103" />
+            <location filename="../../ui/panels/program_panel.py" line="104" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="108" />
+            <location filename="../../ui/panels/program_panel.py" line="109" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="109" />
+            <location filename="../../ui/panels/program_panel.py" line="110" />
             <source>Number of cycles in cycle mode; 0 runs until stopped</source>
             <translation>循环模式下的循环次数；0 表示一直运行直到停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="110" />
+            <location filename="../../ui/panels/program_panel.py" line="111" />
             <source>Run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="111" />
-            <location filename="../../ui/panels/program_panel.py" line="113" />
+            <location filename="../../ui/panels/program_panel.py" line="112" />
+            <location filename="../../ui/panels/program_panel.py" line="114" />
             <source>Go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="112" />
+            <location filename="../../ui/panels/program_panel.py" line="113" />
             <source>All axes</source>
             <translation>所有轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="146" />
+            <location filename="../../ui/panels/program_panel.py" line="147" />
             <source>Run program {id} ({mode}) at {speed} %? The arm will move.</source>
             <translation>以 {speed} % 速度运行程序 {id}（{mode}）？机械臂将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="148" />
+            <location filename="../../ui/panels/program_panel.py" line="149" />
             <source>Confirm program run</source>
             <translation>确认运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="154" />
+            <location filename="../../ui/panels/program_panel.py" line="155" />
             <source>all axes</source>
             <translation>所有轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="155" />
+            <location filename="../../ui/panels/program_panel.py" line="156" />
             <source>Move {which} to zero? The arm will move.</source>
             <translation>将 {which} 回零？机械臂将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="156" />
+            <location filename="../../ui/panels/program_panel.py" line="157" />
             <source>Confirm go to zero</source>
             <translation>确认回零</translation>
         </message>
@@ -2443,7 +2476,7 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="315" />
+            <location filename="../../ui/panels/planner_widgets.py" line="385" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>
@@ -2747,97 +2780,97 @@ Remove them all?</source>
     <context>
         <name>StepPanel</name>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="143" />
+            <location filename="../../ui/panels/step_panel.py" line="156" />
             <source>Frame:</source>
             <translation>坐标系：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="144" />
+            <location filename="../../ui/panels/step_panel.py" line="157" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="145" />
+            <location filename="../../ui/panels/step_panel.py" line="158" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="146" />
+            <location filename="../../ui/panels/step_panel.py" line="159" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="147" />
+            <location filename="../../ui/panels/step_panel.py" line="160" />
             <source>Expected speed of the incremental move (GV225)</source>
             <translation>增量运动的期望速度（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="148" />
+            <location filename="../../ui/panels/step_panel.py" line="161" />
             <source>Increment per click (mm or °)</source>
             <translation>每次点击的增量（mm 或 °）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="149" />
+            <location filename="../../ui/panels/step_panel.py" line="162" />
             <source>Incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="150" />
+            <location filename="../../ui/panels/step_panel.py" line="163" />
             <source>Exact offset</source>
             <translation>精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="151" />
+            <location filename="../../ui/panels/step_panel.py" line="164" />
             <source>Move by values</source>
             <translation>按数值运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="152" />
+            <location filename="../../ui/panels/step_panel.py" line="165" />
             <source>Move every axis by its exact offset in one incremental move</source>
             <translation>以一次增量运动使各轴移动其精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="153" />
+            <location filename="../../ui/panels/step_panel.py" line="166" />
             <source>Clear values</source>
             <translation>清除数值</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="154" />
+            <location filename="../../ui/panels/step_panel.py" line="167" />
             <source>External axes J7–J11</source>
             <translation>外部轴 J7–J11</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="155" />
+            <location filename="../../ui/panels/step_panel.py" line="168" />
             <source>Show the external axes; while hidden their offsets are 0</source>
             <translation>显示外部轴；隐藏时其偏移量为 0</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="184" />
+            <location filename="../../ui/panels/step_panel.py" line="197" />
             <source>rpm</source>
             <translation>转/分</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="184" />
+            <location filename="../../ui/panels/step_panel.py" line="197" />
             <source>mm/s</source>
             <translation>mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="232" />
+            <location filename="../../ui/panels/step_panel.py" line="247" />
             <source>Move by {moves} at {speed} {unit}?</source>
             <translation>以 {speed} {unit} 运动 {moves}？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="234" />
+            <location filename="../../ui/panels/step_panel.py" line="249" />
             <source>Confirm incremental move</source>
             <translation>确认增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="258" />
+            <location filename="../../ui/panels/step_panel.py" line="273" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="258" />
+            <location filename="../../ui/panels/step_panel.py" line="273" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
@@ -2946,110 +2979,120 @@ Remove them all?</source>
     <context>
         <name>WindowActions</name>
         <message>
-            <location filename="../../ui/window_actions.py" line="118" />
+            <location filename="../../ui/window_actions.py" line="131" />
             <source>Show &amp;monitor</source>
             <translation>显示监视(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="118" />
+            <location filename="../../ui/window_actions.py" line="131" />
             <source>Show &amp;points</source>
             <translation>显示点位(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="119" />
+            <location filename="../../ui/window_actions.py" line="132" />
             <source>Show p&amp;lanner</source>
             <translation>显示轨迹规划(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="121" />
+            <location filename="../../ui/window_actions.py" line="134" />
             <source>&amp;File</source>
             <translation>文件(&amp;F)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="122" />
+            <location filename="../../ui/window_actions.py" line="135" />
             <source>&amp;Edit</source>
             <translation>编辑(&amp;E)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="123" />
+            <location filename="../../ui/window_actions.py" line="136" />
             <source>&amp;Motion</source>
             <translation>运动(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="124" />
+            <location filename="../../ui/window_actions.py" line="137" />
             <source>&amp;View</source>
             <translation>视图(&amp;V)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="125" />
+            <location filename="../../ui/window_actions.py" line="138" />
             <source>&amp;Language</source>
             <translation>语言(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="126" />
+            <location filename="../../ui/window_actions.py" line="139" />
             <source>&amp;Help</source>
             <translation>帮助(&amp;H)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="127" />
-            <location filename="../../ui/window_actions.py" line="128" />
+            <location filename="../../ui/window_actions.py" line="140" />
+            <location filename="../../ui/window_actions.py" line="141" />
             <source>Toolbar</source>
             <translation>工具栏</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="129" />
+            <location filename="../../ui/window_actions.py" line="142" />
             <source>&amp;Connect…</source>
             <translation>连接(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="130" />
+            <location filename="../../ui/window_actions.py" line="143" />
             <source>Connect to a controller (Ctrl+K)</source>
             <translation>连接控制器（Ctrl+K）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="131" />
+            <location filename="../../ui/window_actions.py" line="144" />
             <source>&amp;Disconnect</source>
             <translation>断开(&amp;D)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="132" />
+            <location filename="../../ui/window_actions.py" line="145" />
             <source>&amp;Quit</source>
             <translation>退出(&amp;Q)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="133" />
+            <location filename="../../ui/window_actions.py" line="146" />
             <source>&amp;Stop</source>
             <translation>停止(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="134" />
+            <location filename="../../ui/window_actions.py" line="147" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="135" />
+            <location filename="../../ui/window_actions.py" line="148" />
             <source>&amp;Pause</source>
             <translation>暂停(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="136" />
+            <location filename="../../ui/window_actions.py" line="149" />
             <source>Pause the current move or program (F6)</source>
             <translation>暂停当前运动或程序（F6）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="137" />
+            <location filename="../../ui/window_actions.py" line="150" />
             <source>&amp;Resume</source>
             <translation>继续(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="138" />
+            <location filename="../../ui/window_actions.py" line="151" />
             <source>Resume the paused move or program (F7)</source>
             <translation>继续已暂停的运动或程序（F7）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="139" />
+            <location filename="../../ui/window_actions.py" line="152" />
             <source>&amp;About TeachPad</source>
             <translation>关于 TeachPad(&amp;A)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="153" />
+            <source>&amp;Touch mode</source>
+            <translation>触摸模式(&amp;T)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="154" />
+            <source>Bigger motion buttons and an on-screen keypad for numbers</source>
+            <translation>更大的运动按钮，数字输入使用屏幕小键盘</translation>
         </message>
     </context>
 </TS>

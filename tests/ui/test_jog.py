@@ -146,6 +146,30 @@ def test_keyboard_jog_with_dead_man(qtbot: Any, sim: Any, window: Any) -> None:
     qtbot.waitUntil(lambda: _stopped_by_ratio_zero(sim), timeout=SIGNAL_TIMEOUT_MS)
 
 
+def test_keyboard_jog_lights_up_the_button_it_presses(qtbot: Any, sim: Any, window: Any) -> None:
+    connect(qtbot, window.link, sim)
+    panel = window.jog_panel
+    qtbot.waitUntil(lambda: panel.axes_box.isEnabled(), timeout=SIGNAL_TIMEOUT_MS)
+    panel.setFocus()
+    qtbot.waitUntil(lambda: panel.hasFocus(), timeout=SIGNAL_TIMEOUT_MS)
+    y_plus, z_minus = panel.button(1, 1), panel.button(2, 0)
+    QApplication.sendEvent(panel, _key(QEvent.Type.KeyPress, Qt.Key.Key_W))  # Y +
+    qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
+    assert y_plus.isDown() and not z_minus.isDown()
+    QApplication.sendEvent(panel, _key(QEvent.Type.KeyPress, Qt.Key.Key_D))  # Z − takes over
+    assert z_minus.isDown() and not y_plus.isDown()
+    QApplication.sendEvent(panel, _key(QEvent.Type.KeyRelease, Qt.Key.Key_W))  # the older key: Z goes on
+    assert z_minus.isDown()
+    QApplication.sendEvent(panel, _key(QEvent.Type.KeyRelease, Qt.Key.Key_D))
+    qtbot.waitUntil(lambda: _stopped_by_ratio_zero(sim), timeout=SIGNAL_TIMEOUT_MS)
+    assert not any(b.isDown() for b in (*panel.plus_buttons, *panel.minus_buttons))
+    QApplication.sendEvent(panel, _key(QEvent.Type.KeyPress, Qt.Key.Key_Q))  # X +, then the link drops
+    assert panel.button(0, 1).isDown()
+    window.link.disconnect()
+    qtbot.waitUntil(lambda: not panel.button(0, 1).isDown(), timeout=SIGNAL_TIMEOUT_MS)
+    assert not panel.is_jogging
+
+
 def test_joint_frame_shows_external_axes_and_jogs_them(qtbot: Any, sim: Any, window: Any) -> None:
     panel = window.jog_panel
     assert not panel.button(6, 1).isVisibleTo(panel)

@@ -30,6 +30,7 @@ from PySide6.QtWidgets import (
 from app.link.types import JogRequest
 from app.protocol.enums import CARTESIAN_AXIS_NAMES, JOINT_AXIS_NAMES, TeachFrame
 from app.protocol.registers import NUM_AXES_TOTAL, NUM_ROBOT_AXES, TOOL_NONE
+from ui.touch import MOTION_MIN_HEIGHT, RowsScrollArea, mark_motion
 
 DEFAULT_RATIO = 20
 # Keyboard jog: axis n (1..6) plus / minus. Letters on two rows of a QWERTY keyboard.
@@ -38,7 +39,8 @@ PLUS_KEYS: tuple[Qt.Key, ...] = (Qt.Key.Key_Q, Qt.Key.Key_W, Qt.Key.Key_E, Qt.Ke
 MINUS_KEYS: tuple[Qt.Key, ...] = (Qt.Key.Key_A, Qt.Key.Key_S, Qt.Key.Key_D, Qt.Key.Key_F, Qt.Key.Key_G,
                                   Qt.Key.Key_H)
 _FRAMES: tuple[TeachFrame, ...] = (TeachFrame.BASE, TeachFrame.USER, TeachFrame.TOOL, TeachFrame.JOINT)
-BUTTON_SIZE = 52
+BUTTON_WIDTH = 44  # px, the least width of a ± button (two columns of them fit the control column)
+EXTERNAL_COLUMN = 4  # grid column where the external axes start (joint frame: J7..J11 on the right)
 
 
 @dataclass(frozen=True)
@@ -59,8 +61,9 @@ class JogButton(QPushButton):
         self._held = False
         self.setAutoRepeat(False)
         self.setFocusPolicy(Qt.FocusPolicy.NoFocus)  # keep the keyboard focus on the panel
-        self.setMinimumSize(BUTTON_SIZE, BUTTON_SIZE - 18)
+        self.setMinimumSize(BUTTON_WIDTH, MOTION_MIN_HEIGHT)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
+        mark_motion(self)
         font = self.font()
         font.setPointSizeF(font.pointSizeF() * 1.3)
         font.setBold(True)
@@ -120,7 +123,9 @@ class JogPanel(QWidget):
         self._held: _Held | None = None
         self._motion_enabled = False
 
-        self.frame_box = QGroupBox(self)
+        # compact rows: 6 rows of 40 px buttons fit a 1280×800 screen under the docks
+        self.frame_box = QWidget(self)
+        self.frame_caption = QLabel(self.frame_box)
         self.frame_combo = QComboBox(self.frame_box)
         for frame in _FRAMES:
             self.frame_combo.addItem("", int(frame))
@@ -133,45 +138,63 @@ class JogPanel(QWidget):
         self.tool_spin = QSpinBox(self.frame_box)
         self.tool_spin.setRange(0, TOOL_NONE - 1)
         frame_row = QHBoxLayout(self.frame_box)
+        frame_row.setContentsMargins(0, 0, 0, 0)
+        frame_row.addWidget(self.frame_caption)
         frame_row.addWidget(self.frame_combo, 1)
         frame_row.addWidget(self.user_label)
         frame_row.addWidget(self.user_spin)
         frame_row.addWidget(self.tool_label)
         frame_row.addWidget(self.tool_spin)
 
+        # the rows scroll only where they cannot fit (touch mode on a 800 px screen)
         self.axes_box = QGroupBox(self)
-        grid = QGridLayout(self.axes_box)
+        self.axes_rows = QWidget()
+        self.axes_rows.setObjectName("JogAxes")
+        self.axes_scroll = RowsScrollArea(self.axes_rows, self.axes_box)
+        box_layout = QVBoxLayout(self.axes_box)
+        box_layout.setContentsMargins(4, 4, 4, 4)
+        box_layout.addWidget(self.axes_scroll)
+        grid = QGridLayout(self.axes_rows)
+        grid.setContentsMargins(0, 0, 0, 0)
         grid.setHorizontalSpacing(8)
-        grid.setVerticalSpacing(4)
+        grid.setVerticalSpacing(3)
         self.axis_labels: list[QLabel] = []
         self.minus_buttons: list[JogButton] = []
         self.plus_buttons: list[JogButton] = []
         for axis in range(NUM_AXES_TOTAL):
-            label = QLabel(self.axes_box)
+            label = QLabel(self.axes_rows)
             label.setAlignment(Qt.AlignmentFlag.AlignCenter)
-            label.setMinimumWidth(48)
+            label.setMinimumWidth(label.fontMetrics().horizontalAdvance("J11") + 8)
             font = label.font()
             font.setBold(True)
             font.setPointSizeF(font.pointSizeF() * 1.2)
             label.setFont(font)
-            minus = JogButton("−", self.axes_box)
-            plus = JogButton("+", self.axes_box)
+            minus = JogButton("−", self.axes_rows)
+            plus = JogButton("+", self.axes_rows)
             minus.setObjectName(f"jog_minus_{axis}")
             plus.setObjectName(f"jog_plus_{axis}")
             minus.held.connect(lambda a=axis: self._press("mouse", a, 0))
             plus.held.connect(lambda a=axis: self._press("mouse", a, 1))
             minus.letGo.connect(lambda: self._release("mouse"))
             plus.letGo.connect(lambda: self._release("mouse"))
-            row = axis if axis < NUM_ROBOT_AXES else axis + 1  # a gap before the external axes
-            grid.addWidget(minus, row, 0)
-            grid.addWidget(label, row, 1)
-            grid.addWidget(plus, row, 2)
+            # joint frame: J1..J6 on the left, the caption and J7..J11 on the right (11 rows
+            # of 40 px buttons would not fit a 800 px screen)
+            external = axis >= NUM_ROBOT_AXES
+            row = axis - NUM_ROBOT_AXES + 1 if external else axis
+            column = EXTERNAL_COLUMN if external else 0
+            grid.addWidget(minus, row, column)
+            grid.addWidget(label, row, column + 1)
+            grid.addWidget(plus, row, column + 2)
             self.axis_labels.append(label)
             self.minus_buttons.append(minus)
             self.plus_buttons.append(plus)
-        self.external_caption = QLabel(self.axes_box)
+        self.external_caption = QLabel(self.axes_rows)
         self.external_caption.setStyleSheet("color: #5f6368;")
-        grid.addWidget(self.external_caption, NUM_ROBOT_AXES, 0, 1, 3)
+        self.external_caption.setAlignment(Qt.AlignmentFlag.AlignCenter)
+        grid.addWidget(self.external_caption, 0, EXTERNAL_COLUMN, 1, 3)
+        grid.setColumnMinimumWidth(EXTERNAL_COLUMN - 1, 8)
+        grid.setRowStretch(NUM_ROBOT_AXES, 1)  # spare height below the rows, not between them
+        self._grid = grid
 
         self.hold_label = QLabel(self)
         self.hold_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
@@ -191,12 +214,12 @@ class JogPanel(QWidget):
         speed_row.addWidget(self.speed_slider, 1)
         speed_row.addWidget(self.speed_value)
 
-        self.keys_label = QLabel(self)
-        self.keys_label.setWordWrap(True)
+        self.keys_label = QLabel(self)  # one short line; the whole hint is its tooltip
         self.keys_label.setStyleSheet("color: #5f6368;")
 
         layout = QVBoxLayout(self)
-        layout.setContentsMargins(6, 6, 6, 6)
+        layout.setContentsMargins(6, 6, 6, 4)
+        layout.setSpacing(4)
         layout.addWidget(self.frame_box)
         layout.addLayout(speed_row)
         layout.addWidget(self.hold_label)
@@ -211,7 +234,7 @@ class JogPanel(QWidget):
 
     # --- texts ------------------------------------------------------------------------
     def retranslate(self) -> None:
-        self.frame_box.setTitle(self.tr("Frame"))
+        self.frame_caption.setText(self.tr("Frame:"))
         names = {
             TeachFrame.BASE: self.tr("Base frame"),
             TeachFrame.USER: self.tr("User frame"),
@@ -222,7 +245,6 @@ class JogPanel(QWidget):
             self.frame_combo.setItemText(i, names[frame])
         self.user_label.setText(self.tr("User no.:"))
         self.tool_label.setText(self.tr("Tool no.:"))
-        self.axes_box.setTitle(self.tr("Jog"))
         self.external_caption.setText(self.tr("External axes"))
         self.hold_label.setText(self.tr("HOLD TO MOVE — release to stop"))
         self.speed_caption.setText(self.tr("Speed:"))
@@ -233,7 +255,9 @@ class JogPanel(QWidget):
             "Keyboard: click this panel, then hold {plus} (+) or {minus} (−) for axes 1–6; "
             "releasing the key stops."
         ).format(plus=plus, minus=minus)
-        self.keys_label.setText(keys)
+        short = self.tr("Keys: hold {plus} (+) or {minus} (−)")
+        self.keys_label.setText(short.format(plus=plus, minus=minus))
+        self.keys_label.setToolTip(keys)
         self.setToolTip(keys)
         self._update_axes()
 
@@ -330,7 +354,9 @@ class JogPanel(QWidget):
         held = _Held(source, axis, direction)
         if self._held == held:
             return
+        self._light(self._held, False)
         self._held = held
+        self._light(held, True)
         frame = self.frame
         self.jogPressed.emit(JogRequest(frame, axis, direction, float(self.ratio),
                                         user=self.user_spin.value(), tool=self.tool_spin.value()))
@@ -339,8 +365,14 @@ class JogPanel(QWidget):
         held = self._held
         if held is None or held.source != source:
             return  # an older key let go while a newer one is held: the newer one goes on
+        self._light(held, False)
         self._held = None
         self.jogReleased.emit()
+
+    def _light(self, held: _Held | None, on: bool) -> None:
+        """A key jog shows its button pressed while the key is held (the mouse does that itself)."""
+        if held is not None and held.source != "mouse":
+            self.button(held.axis, held.direction).setDown(on)
 
     @Slot(int)
     def _on_frame_changed(self, _index: int) -> None:

@@ -6,11 +6,12 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-from PySide6.QtCore import QAbstractItemModel, QModelIndex, QPersistentModelIndex, Qt
-from PySide6.QtGui import QAction
+from PySide6.QtCore import QAbstractItemModel, QModelIndex, QPersistentModelIndex, QRect, Qt
+from PySide6.QtGui import QAction, QResizeEvent
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QComboBox,
+    QGridLayout,
     QGroupBox,
     QHBoxLayout,
     QHeaderView,
@@ -48,6 +49,7 @@ from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
 from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_OK, COLOR_WARN, COLOR_WARN_TEXT
+from ui.touch import RowsScrollArea, mark_motion
 
 ModelIndex = QModelIndex | QPersistentModelIndex
 
@@ -56,6 +58,11 @@ SUMMARY_COLOURS: dict[Level, str] = {
     Level.OK: COLOR_OK, Level.INFO: COLOR_INFO, Level.WARN: COLOR_WARN, Level.ERROR: COLOR_ERROR,
 }
 STATUS_COLOURS: dict[Level, str] = {**SUMMARY_COLOURS, Level.WARN: COLOR_WARN_TEXT, Level.INFO: COLOR_OK}
+
+
+RUN_LABEL_LINES = 2
+SEGMENT_BUTTONS_PER_ROW = 3
+PLAN_LIST_MIN_ROWS = 2  # the plan list scrolls below this; the run box keeps its room
 
 
 def action_button(action: QAction, *, bold: bool = False) -> QToolButton:
@@ -127,34 +134,87 @@ class PointRefDelegate(QStyledItemDelegate):
         model.setData(index, editor.itemData(found) if found >= 0 else text, Qt.ItemDataRole.EditRole)
 
 
+class LinesLabel(QLabel):
+    """Wrapped text in at most ``lines`` lines: a longer text ends in "…" and the whole of it
+    is in the tooltip. Its height never changes, so the box around it does not move."""
+
+    def __init__(self, lines: int, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self._lines = lines
+        self._full = ""
+        self.setProperty("elide", True)
+        self.setWordWrap(True)
+        self.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
+        self.setFixedHeight(lines * self.fontMetrics().lineSpacing() + 2)
+
+    def text(self) -> str:
+        """The whole text, also when the label shows it cut short."""
+        return self._full
+
+    def shown_text(self) -> str:
+        return super().text()
+
+    def setText(self, text: str) -> None:
+        self._full = text
+        self.setToolTip(text)
+        self._fit()
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        super().resizeEvent(event)
+        self._fit()
+
+    def _fit(self) -> None:
+        text = self._full
+        metrics = self.fontMetrics()
+        room = QRect(0, 0, max(1, self.width()), 10_000)
+        flags = int(Qt.TextFlag.TextWordWrap)
+
+        def fits(candidate: str) -> bool:
+            return metrics.boundingRect(room, flags, candidate).height() <= self.height()
+        if not fits(text):
+            low, high = 0, len(text)
+            while low < high:  # the longest prefix that fits with the ellipsis
+                middle = (low + high + 1) // 2
+                if fits(text[:middle].rstrip() + "…"):
+                    low = middle
+                else:
+                    high = middle - 1
+            text = text[:low].rstrip() + "…"
+        super().setText(text)
+
+
 class PlanRunBox(QGroupBox):
-    """Run, Run from here, Step / Pause, Resume, Stop / Resume from k, and the run's progress."""
+    """Run, Run from here / Step, Stop / Pause, Resume / Resume from k, and the run's progress.
+
+    Two buttons a row: the box stays narrow enough to sit beside the plans and the segments."""
 
     def __init__(self, run: QAction, run_from: QAction, step: QAction, pause: QAction, resume: QAction,
                  stop: QAction, resume_from: QAction, parent: QWidget | None = None) -> None:
         super().__init__(parent)
-        row1 = QHBoxLayout()
-        row1.addWidget(action_button(run, bold=True))
-        row1.addWidget(action_button(run_from))
-        row1.addWidget(action_button(step))
-        row2 = QHBoxLayout()
-        row2.addWidget(action_button(pause))
-        row2.addWidget(action_button(resume))
         stop_button = action_button(stop, bold=True)
         stop_button.setStyleSheet(f"QToolButton:enabled {{ color: {COLOR_ERROR}; }}")
-        row2.addWidget(stop_button)
+        buttons = QGridLayout()
+        buttons.setSpacing(3)
+        rows = ((action_button(run, bold=True), action_button(run_from)), (action_button(step), stop_button),
+                (action_button(pause), action_button(resume)))
+        for row, pair in enumerate(rows):
+            for column, button in enumerate(pair):
+                mark_motion(button)
+                buttons.addWidget(button, row, column)
         self.resume_from_button = action_button(resume_from)
-        self.run_label = QLabel(self)
-        self.run_label.setWordWrap(True)
+        mark_motion(self.resume_from_button)
+        # the outcome of a run (a stop's reason can be long) gets room for RUN_LABEL_LINES
+        # lines from the start, so the box does not grow over its neighbours after a stop
+        self.run_label = LinesLabel(RUN_LABEL_LINES, self)
         self.run_progress = QProgressBar(self)
         self.run_progress.setTextVisible(False)
         self.run_progress.setMaximumHeight(10)
         layout = QVBoxLayout(self)
-        layout.addLayout(row1)
-        layout.addLayout(row2)
+        layout.addLayout(buttons)
         layout.addWidget(self.resume_from_button)
         layout.addWidget(self.run_progress)
         layout.addWidget(self.run_label)
+        layout.addStretch(1)  # a tall box keeps its buttons at the top
 
     def retranslate(self) -> None:
         self.setTitle(self.tr("Run"))
@@ -182,7 +242,8 @@ class PlanRunBox(QGroupBox):
 
 
 class PlanChecksBar(QWidget):
-    """The checks in one line under the segment table, with Upload now and Check."""
+    """The checks under the segment table (a line of their own: the column can be narrow),
+    with Upload now and Check below them."""
 
     def __init__(self, upload: Callable[[], None], check: Callable[[], None],
                  parent: QWidget | None = None) -> None:
@@ -194,11 +255,15 @@ class PlanChecksBar(QWidget):
         self.upload_button.clicked.connect(upload)
         self.check_button = QPushButton(self)
         self.check_button.clicked.connect(check)
-        layout = QHBoxLayout(self)
+        buttons = QHBoxLayout()
+        buttons.addStretch(1)
+        buttons.addWidget(self.upload_button)
+        buttons.addWidget(self.check_button)
+        layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.addWidget(self.summary, 1)
-        layout.addWidget(self.upload_button)
-        layout.addWidget(self.check_button)
+        layout.setSpacing(2)
+        layout.addWidget(self.summary)
+        layout.addLayout(buttons)
 
     def retranslate(self) -> None:
         self.upload_button.setText(self.tr("Upload now"))
@@ -251,12 +316,13 @@ class PlanListBox(QGroupBox):
         view.verticalHeader().setVisible(False)
         view.verticalHeader().setDefaultSectionSize(24)
         header = view.horizontalHeader()
+        view.setMinimumHeight(header.sizeHint().height() + PLAN_LIST_MIN_ROWS * 24 + 2 * view.frameWidth())
         header.setSectionResizeMode(PLAN_COL_NAME, QHeaderView.ResizeMode.Stretch)
         header.setSectionResizeMode(1, QHeaderView.ResizeMode.ResizeToContents)
         header.setSectionResizeMode(2, QHeaderView.ResizeMode.ResizeToContents)
-        buttons = QHBoxLayout()
-        for action in actions:
-            buttons.addWidget(action_button(action))
+        buttons = QGridLayout()  # two per row: the plans column stays narrow
+        for i, action in enumerate(actions):
+            buttons.addWidget(action_button(action), i // 2, i % 2)
         buttons.setSpacing(3)
         layout = QVBoxLayout(self)
         layout.addWidget(view, 1)
@@ -302,10 +368,14 @@ class SegmentEditorBox(QGroupBox):
         view.horizontalHeader().setStretchLastSection(True)
         for column in range(segments.columnCount()):
             view.setColumnWidth(column, SEGMENT_COLUMN_WIDTHS.get(column, 60))
-        buttons = QHBoxLayout()
-        for action in actions:
-            buttons.addWidget(action_button(action))
-        buttons.addStretch(1)
+        # three buttons a row: the box stays narrow beside the plans and the run box (the run
+        # box sets the row's height anyway)
+        buttons = QGridLayout()
+        buttons.setSpacing(3)
+        per_row = SEGMENT_BUTTONS_PER_ROW
+        for i, action in enumerate(actions):
+            buttons.addWidget(action_button(action), i // per_row, i % per_row)
+        buttons.setColumnStretch(per_row, 1)
         layout = QVBoxLayout(self)
         layout.addLayout(buttons)
         layout.addWidget(view, 1)
@@ -317,25 +387,26 @@ class SegmentEditorBox(QGroupBox):
 
 def planner_splitters(parent: QWidget, plans_box: QWidget, run_box: QWidget, segments_box: QWidget,
                       preview_box: QWidget) -> tuple[QSplitter, QSplitter]:
-    """Plans (over the run box) and segments side by side on top, the preview across the full
-    width below: the three projections stay readable on a 1280 px screen. Returns (top, outer)."""
-    left = QWidget(parent)
-    left_layout = QVBoxLayout(left)
-    left_layout.setContentsMargins(0, 0, 0, 0)
-    left_layout.addWidget(plans_box, 1)
-    left_layout.addWidget(run_box)
+    """Plans, segments and the run box side by side on top (the order of the work), the preview
+    across the full width below: the three projections stay readable on a 1280 px screen, and
+    the top row is only as tall as its tallest box, so everything fits 1280×800. Returns (top, outer)."""
     top = QSplitter(Qt.Orientation.Horizontal, parent)
-    top.addWidget(left)
+    top.addWidget(plans_box)
     top.addWidget(segments_box)
+    run_scroll = RowsScrollArea(run_box, parent)  # scrolls only with touch-size buttons on 800 px
+    run_scroll.setObjectName("PlanRunScroll")
+    top.addWidget(run_scroll)
     top.setStretchFactor(0, 0)
     top.setStretchFactor(1, 1)
-    top.setSizes([230, 1050])
+    top.setStretchFactor(2, 0)
+    top.setSizes([200, 1000, 240])
     top.setChildrenCollapsible(False)
+    top.setHandleWidth(4)  # three boxes in a row on a 1280 px screen: every pixel counts
     outer = QSplitter(Qt.Orientation.Vertical, parent)
     outer.addWidget(top)
     outer.addWidget(preview_box)
     outer.setStretchFactor(0, 1)
     outer.setStretchFactor(1, 1)
-    outer.setSizes([340, 400])
+    outer.setSizes([420, 300])  # the top row first: the run box and a few segment rows
     outer.setChildrenCollapsible(False)
     return top, outer

@@ -44,6 +44,7 @@ from ui.controllers.point_sync import (
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COLUMNS, EXT_COLUMNS
 from ui.models.points_model import PointFilterProxy, PointsModel
+from ui.touch import MOTION_MIN_HEIGHT, mark_motion
 from ui.widgets_common import COLOR_ERROR, COLOR_OK, COLOR_WARN, COLOR_WARN_BG
 
 
@@ -124,20 +125,14 @@ class PointsPanel(QWidget):
         self.action_find = act(QKeySequence.StandardKey.Find, self._focus_find)
 
     def _build(self) -> None:
-        bar = QToolBar(self)
-        bar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
-        bar.addAction(self.action_teach)
-        teach_button = bar.widgetForAction(self.action_teach)
-        font = teach_button.font()
-        font.setBold(True)
-        teach_button.setFont(font)
-        bar.addSeparator()
-        for action in (self.action_add, self.action_duplicate, self.action_delete, self.action_move_up,
-                       self.action_move_down):
-            bar.addAction(action)
-        bar.addSeparator()
-        self.upload_button = QToolButton(self)
-        self.upload_button.setDefaultAction(self.action_upload_selected)
+        # The primary actions (teach, upload selected, restore all, move to point) are plain
+        # buttons in a row of their own: a toolbar would hide them behind » on a narrow screen.
+        self.primary_row = QWidget(self)
+        self.primary_row.setObjectName("PointsPrimary")
+        primary = QHBoxLayout(self.primary_row)
+        primary.setContentsMargins(0, 0, 0, 0)
+        self.teach_button = self._primary_button(self.action_teach, bold=True)
+        self.upload_button = self._primary_button(self.action_upload_selected)
         self.upload_button.setPopupMode(QToolButton.ToolButtonPopupMode.MenuButtonPopup)
         upload_menu = QMenu(self.upload_button)
         upload_menu.addAction(self.action_upload_selected)
@@ -145,16 +140,28 @@ class PointsPanel(QWidget):
         upload_menu.addAction(self.action_upload_all)
         upload_menu.addAction(self.action_restore_all)
         self.upload_button.setMenu(upload_menu)
-        bar.addWidget(self.upload_button)
-        bar.addSeparator()
-        bar.addAction(self.action_move_to)
+        self.restore_all_button = self._primary_button(self.action_restore_all)
+        self.move_to_button = self._primary_button(self.action_move_to)
+        mark_motion(self.move_to_button)
         self.speed = QDoubleSpinBox(self)
         self.speed.setRange(0.1, MAX_MOVE_SPEED)
         self.speed.setDecimals(1)
         self.speed.setValue(DEFAULT_MOVE_SPEED)
         self.speed.setSuffix(" mm/s")
         self.speed.setKeyboardTracking(False)
-        bar.addWidget(self.speed)
+        self.speed.setMinimumHeight(MOTION_MIN_HEIGHT)
+        for widget in (self.teach_button, self.upload_button, self.restore_all_button):
+            primary.addWidget(widget)
+        primary.addSpacing(12)
+        primary.addWidget(self.move_to_button)
+        primary.addWidget(self.speed)
+        primary.addStretch(1)
+
+        bar = QToolBar(self)
+        bar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
+        for action in (self.action_add, self.action_duplicate, self.action_delete, self.action_move_up,
+                       self.action_move_down):
+            bar.addAction(action)
         self.toolbar = bar
 
         self.find_edit = QLineEdit(self)
@@ -234,11 +241,23 @@ class PointsPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
         layout.setSpacing(4)
+        layout.addWidget(self.primary_row)
         layout.addLayout(top)
         layout.addWidget(self.banner)
         layout.addWidget(self.progress_row)
         layout.addWidget(table, 1)
         layout.addWidget(self.status)
+
+    def _primary_button(self, action: QAction, *, bold: bool = False) -> QToolButton:
+        button = QToolButton(self)
+        button.setDefaultAction(action)
+        button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
+        button.setMinimumHeight(MOTION_MIN_HEIGHT)
+        if bold:
+            font = button.font()
+            font.setBold(True)
+            button.setFont(font)
+        return button
 
     def retranslate(self) -> None:
         texts = {

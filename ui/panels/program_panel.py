@@ -25,6 +25,7 @@ from app.protocol.enums import JOINT_AXIS_NAMES, PROGRAM_MOTION_MODE_TEXT, Progr
 from app.protocol.registers import NUM_AXES_TOTAL
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.i18n import protocol_text
+from ui.touch import mark_motion
 
 _MODES: tuple[ProgramMotionMode, ...] = (ProgramMotionMode.SINGLE_STEP, ProgramMotionMode.SINGLE_RUN,
                                          ProgramMotionMode.CYCLE)
@@ -67,7 +68,7 @@ class ProgramPanel(QWidget):
         self.speed_spin.setValue(50)
         self.speed_spin.setSuffix(" %")
         self.run_button = QPushButton(self.program_box)
-        self.run_button.setMinimumHeight(40)
+        mark_motion(self.run_button)
         self.run_button.clicked.connect(self._run)
         self.captions = [QLabel(self.program_box) for _ in range(4)]
         for caption, field in zip(self.captions, (self.id_spin, self.mode_combo, self.cycles_spin,
@@ -84,7 +85,7 @@ class ProgramPanel(QWidget):
         self.zero_combo.addItem("", None)
         self.zero_combo.setCurrentIndex(NUM_AXES_TOTAL)  # all axes
         self.zero_button = QPushButton(self.zero_box)
-        self.zero_button.setMinimumHeight(40)
+        mark_motion(self.zero_button)
         self.zero_button.clicked.connect(self._go_zero)
         zero_row.addWidget(self.zero_combo, 1)
         zero_row.addWidget(self.zero_button)

@@ -29,6 +29,7 @@ from app.link.client import StepFrame
 from app.protocol.enums import CARTESIAN_AXIS_NAMES, JOINT_AXIS_NAMES
 from app.protocol.registers import NUM_AXES_TOTAL, NUM_EXTERNAL_AXES, NUM_ROBOT_AXES
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
+from ui.touch import RowsScrollArea, mark_motion
 
 PRESETS: tuple[float, ...] = (0.1, 1.0, 10.0)
 DEFAULT_PRESET = 1.0
@@ -86,23 +87,33 @@ class StepPanel(QWidget):
             preset_row.addWidget(button)
             self.preset_buttons.append(button)
 
+        # 11 rows of 40 px buttons do not fit a 800 px screen: the rows scroll (the robot axes
+        # fit without scrolling; the external axes are shown on demand)
         self.axes_box = QGroupBox(self)
-        grid = QGridLayout(self.axes_box)
+        self.axes_rows = QWidget()
+        self.axes_rows.setObjectName("StepAxes")
+        self.axes_scroll = RowsScrollArea(self.axes_rows, self.axes_box)
+        box_layout = QVBoxLayout(self.axes_box)
+        box_layout.setContentsMargins(4, 4, 4, 4)
+        box_layout.addWidget(self.axes_scroll)
+        grid = QGridLayout(self.axes_rows)
+        grid.setContentsMargins(0, 0, 0, 0)
         self.axis_labels: list[QLabel] = []
         self.minus_buttons: list[QPushButton] = []
         self.plus_buttons: list[QPushButton] = []
         self.value_spins: list[QDoubleSpinBox] = []
-        self.value_caption = QLabel(self.axes_box)
+        self.value_caption = QLabel(self.axes_rows)
         grid.addWidget(self.value_caption, 0, 3)
         for axis in range(NUM_AXES_TOTAL):
-            label = QLabel(self.axes_box)
-            minus = QPushButton("−", self.axes_box)
-            plus = QPushButton("+", self.axes_box)
+            label = QLabel(self.axes_rows)
+            minus = QPushButton("−", self.axes_rows)
+            plus = QPushButton("+", self.axes_rows)
+            mark_motion(minus, plus)
             minus.setObjectName(f"step_minus_{axis}")
             plus.setObjectName(f"step_plus_{axis}")
             minus.clicked.connect(lambda _=False, a=axis: self._step_one(a, -1.0))
             plus.clicked.connect(lambda _=False, a=axis: self._step_one(a, 1.0))
-            spin = QDoubleSpinBox(self.axes_box)
+            spin = QDoubleSpinBox(self.axes_rows)
             spin.setRange(-OFFSET_LIMIT, OFFSET_LIMIT)
             spin.setDecimals(3)
             spin.setSingleStep(DEFAULT_PRESET)
@@ -115,10 +126,12 @@ class StepPanel(QWidget):
             self.minus_buttons.append(minus)
             self.plus_buttons.append(plus)
             self.value_spins.append(spin)
-        self.external_check = QCheckBox(self.axes_box)
+        self.external_check = QCheckBox(self.axes_rows)
         self.external_check.toggled.connect(self._show_external)
-        grid.addWidget(self.external_check, NUM_AXES_TOTAL + 1, 0, 1, 4)
+        grid.addWidget(self.external_check, NUM_ROBOT_AXES + 1, 0, 1, 4)  # between J6 and J7
+        grid.setRowStretch(NUM_AXES_TOTAL + 2, 1)
         self.move_button = QPushButton(self)
+        mark_motion(self.move_button)
         self.move_button.clicked.connect(self._move_by_values)
         self.clear_button = QPushButton(self)
         self.clear_button.clicked.connect(self.clear_values)
@@ -218,6 +231,8 @@ class StepPanel(QWidget):
             for widget in (self.axis_labels[axis], self.minus_buttons[axis], self.plus_buttons[axis],
                            self.value_spins[axis]):
                 widget.setVisible(shown)
+        if shown:
+            self.axes_scroll.ensureWidgetVisible(self.minus_buttons[NUM_ROBOT_AXES])
 
     @Slot()
     def _move_by_values(self) -> None:

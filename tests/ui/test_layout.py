@@ -1,0 +1,253 @@
+"""The layout check: every panel and dialog, in English and Chinese, at 1280×800 and 1920×1080.
+
+On every tab (and the states that change a layout: jog frames, the step panel's external
+axes, the points banner and upload progress, the planner after a stop) no visible text is
+clipped, no two visible siblings overlap, motion buttons are tall enough (``layout_audit``).
+
+Chinese text is measured with the font Qt really uses. Where no CJK font is installed (CI
+installs only the Python packages), Qt measures missing glyphs as narrow boxes, so a clipped
+Chinese text cannot be told from a fitting one: the text check is skipped for zh_CN there,
+and only overlap and sizes are checked (they do not depend on glyph widths being right).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pytest
+from PySide6.QtCore import QCoreApplication, QSize, Qt
+from PySide6.QtGui import QFontDatabase
+from PySide6.QtWidgets import QApplication, QMessageBox, QWidget
+
+from app.protocol.enums import TeachFrame
+from tests.ui.layout_audit import clipped_texts, overlapping_siblings, small_motion_buttons
+from tests.ui.pendant_support import (  # noqa: F401 - fixtures
+    QT_LOG_IGNORE,
+    SIGNAL_TIMEOUT_MS,
+    app_settings_fixture,
+    connect,
+    fast_reconnect_fixture,
+    link_fixture,
+    project_dialogs_fixture,
+    translator_fixture,
+)
+from ui.dialogs.connection_dialog import ConnectionDialog
+from ui.keypad import KeypadDialog
+from ui.main_window import (
+    DOCK_MIN_ROWS,
+    STATUS_DOCK_WIDTH,
+    TAB_MONITOR,
+    TAB_PLANNER,
+    TAB_POINTS,
+    MainWindow,
+)
+from ui.touch import motion_height
+
+pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
+
+# Known problems in panels owned elsewhere, each with its reason; the check stays strict for the
+# rest. Remove an entry when its panel is fixed (an entry that no longer matches fails the test).
+KNOWN_ISSUES: dict[str, str] = {
+    # monitor_panel / widgets_common: connected, in Chinese at 1280×800, a Cartesian readout is
+    # laid out 1 px narrower than its minimum, so the number's box touches the unit's box
+    "zh_CN-1280x800-connected": (r"\[jog joint \| monitor\] QLabel '[-0-9.]+' in NumericReadout and "
+                                 r"QLabel 'mm' in NumericReadout overlap by 1×\d+ px"),
+}
+SIZES = ((1280, 800), (1920, 1080))
+LANGUAGES = ("en", "zh_CN")
+STOP_MESSAGE = "Stopped: the operator pressed STOP during segment 3 of 12 (the controller reported ESTOP)"
+
+
+def cjk_font_installed() -> bool:
+    return bool(QFontDatabase.families(QFontDatabase.WritingSystem.SimplifiedChinese))
+
+
+def settle() -> None:
+    """Let the posted layout requests run (no time passes: only queued events)."""
+    for _ in range(3):
+        QCoreApplication.sendPostedEvents()
+        QApplication.processEvents()
+
+
+def problems(root: QWidget, language: str, touch: bool) -> list[str]:
+    found = overlapping_siblings(root) + small_motion_buttons(root, motion_height(touch))
+    if language == "en" or cjk_font_installed():
+        found += clipped_texts(root)
+    return found
+
+
+@pytest.fixture(name="make_window")
+def make_window_fixture(qtbot: Any, link: Any, app_settings: Any, translator: Any, project_dialogs: Any,
+                        tmp_path: Any, sim: Any) -> Callable[..., MainWindow]:
+    def make(language: str, size: tuple[int, int], *, touch: bool = False,
+             connected: bool = True) -> MainWindow:
+        assert translator.set_language(language)
+        app_settings.touch_mode = touch
+        window = MainWindow(link, app_settings, translator, project_dialogs=project_dialogs,
+                            autosave_dir=tmp_path / "autosave")
+        window.confirm = lambda _title, _text: True
+        qtbot.addWidget(window)
+        window.resize(*size)
+        window.show()
+        qtbot.waitExposed(window)
+        settle()
+        window.resizeDocks([window.status_dock], [STATUS_DOCK_WIDTH], Qt.Orientation.Horizontal)
+        settle()
+        assert (window.width(), window.height()) == size
+        if connected:  # the status panel shows real values (wider), the motion banner goes
+            connect_window(qtbot, window, sim)
+        return window
+
+    return make
+
+
+def connect_window(qtbot: Any, window: MainWindow, sim: Any) -> None:
+    connect(qtbot, window.link, sim)
+    qtbot.waitUntil(lambda: window.motion_enabled and window.link.state.status is not None,
+                    timeout=SIGNAL_TIMEOUT_MS)
+    settle()
+
+
+def motion_states(window: MainWindow) -> Iterator[str]:
+    """Put the control column in each of its layouts in turn; yields a name for each."""
+    jog, step = window.jog_panel, window.step_panel
+    window.tabs.setCurrentWidget(jog)
+    for frame in (TeachFrame.BASE, TeachFrame.USER, TeachFrame.TOOL, TeachFrame.JOINT):
+        jog.set_frame(frame)
+        yield f"jog {frame.name.lower()}"
+    window.tabs.setCurrentWidget(step)
+    for external in (False, True):
+        step.external_check.setChecked(external)
+        yield f"step external={external}"
+    window.tabs.setCurrentWidget(window.program_panel)
+    yield "program"
+
+
+def work_states(window: MainWindow) -> Iterator[str]:
+    """Each work tab, the points tab also with its restore banner and upload progress, the
+    planner also after a stop (the run box shows the reason)."""
+    window.show_tab(TAB_MONITOR)
+    yield "monitor"
+    window.show_tab(TAB_POINTS)
+    yield "points"
+    sync = window.point_sync
+    sync.restoreOffered.emit(True)
+    sync.uploadProgress.emit(3, 12)
+    yield "points with banner and progress"
+    window.show_tab(TAB_PLANNER)
+    yield "planner"
+    window.planner_panel.run_box.show_ended(STOP_MESSAGE)
+    yield "planner after a stop"
+
+
+def squeezed(window: MainWindow) -> list[str]:
+    """Qt squeezes widgets below their minimum (and clips them) when the window cannot give
+    every part its minimum: the central area and the status dock must both get theirs."""
+    found = []
+    for part, least in ((window.centralWidget(), window.centralWidget().minimumSizeHint()),
+                        (window.status_dock, QSize(STATUS_DOCK_WIDTH, 0))):
+        if part.width() < least.width() or part.height() < least.height():
+            found.append(f"{part.objectName() or 'central area'} is {part.width()}×{part.height()}, "
+                         f"needs {least.width()}×{least.height()}")
+    return found
+
+
+def check_window(window: MainWindow, language: str, touch: bool) -> list[str]:
+    """Every work state beside the joint jog, then every motion state beside the planner
+    after a stop (the two sides only share the window's width, which neither state changes)."""
+    found: list[str] = []
+    window.jog_panel.set_frame(TeachFrame.JOINT)
+    for work in work_states(window):
+        settle()
+        found += [f"[jog joint | {work}] {p}" for p in problems(window, language, touch) + squeezed(window)]
+    for motion in motion_states(window):
+        settle()
+        found += [f"[{motion} | planner after a stop] {p}"
+                  for p in problems(window, language, touch) + squeezed(window)]
+    return sorted(set(found))
+
+
+def without_known(found: list[str], key: str) -> list[str]:
+    known = KNOWN_ISSUES.get(key)
+    if known is None:
+        return found
+    rest = [p for p in found if not re.match(known, p)]
+    assert len(rest) < len(found), f"known issue {key} no longer occurs: remove it from KNOWN_ISSUES"
+    return rest
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_main_window_layout(qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str,
+                            size: tuple[int, int]) -> None:
+    window = make_window(language, size, connected=False)
+    found = check_window(window, language, touch=False)
+    assert not found, "\n".join(found)
+    connect_window(qtbot, window, sim)
+    key = f"{language}-{size[0]}x{size[1]}-connected"
+    found = without_known(check_window(window, language, touch=False), key)
+    assert not found, "\n".join(found)
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_touch_mode_layout_at_1280x800(make_window: Callable[..., MainWindow], language: str) -> None:
+    window = make_window(language, SIZES[0], touch=True)
+    assert window.menus.touch_action.isChecked()
+    found = without_known(check_window(window, language, touch=True), f"{language}-1280x800-connected")
+    assert not found, "\n".join(found)
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_points_primary_actions_and_docks_stay_visible(make_window: Callable[..., MainWindow],
+                                                       size: tuple[int, int]) -> None:
+    window = make_window("en", size)
+    window.show_tab(TAB_POINTS)
+    settle()
+    points = window.points_panel
+    for button in (points.teach_button, points.upload_button, points.restore_all_button,
+                   points.move_to_button):
+        assert button.isVisible() and button.width() >= button.sizeHint().width(), button.text()
+    for dock, panel in ((window.event_dock, window.event_log), (window.traffic_dock, window.traffic_panel)):
+        dock.raise_()
+        settle()
+        rows = panel.view.viewport().height() / panel.view.verticalHeader().defaultSectionSize()
+        assert rows >= DOCK_MIN_ROWS, dock.objectName()
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_joint_jog_fits_1280x800_without_scrolling(language: str,
+                                                   make_window: Callable[..., MainWindow]) -> None:
+    window = make_window(language, SIZES[0])
+    window.jog_panel.set_frame(TeachFrame.JOINT)
+    settle()
+    jog = window.jog_panel
+    assert not jog.axes_scroll.verticalScrollBar().isVisible()
+    for axis in range(11):
+        for direction in (0, 1):
+            button = jog.button(axis, direction)
+            assert button.isVisible() and not button.visibleRegion().isEmpty()
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_dialogs_layout(qtbot: Any, app_settings: Any, translator: Any, language: str) -> None:
+    assert translator.set_language(language)
+    parent = QWidget()
+    qtbot.addWidget(parent)
+    connection = ConnectionDialog(app_settings.connection(), parent)
+    from PySide6.QtWidgets import QDoubleSpinBox
+
+    field = QDoubleSpinBox(parent)
+    field.setRange(-10_000.0, 10_000.0)
+    field.setDecimals(3)
+    keypad = KeypadDialog(field, parent)
+    question = QMessageBox(QMessageBox.Icon.Question, "Confirm program run",
+                           "Run program 1 (single run) at 50 %? The arm will move.",
+                           QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.Cancel, parent)
+    for dialog in (connection, keypad, question):
+        dialog.show()
+        qtbot.waitExposed(dialog)
+        settle()
+        assert problems(dialog, language, touch=False) == [], type(dialog).__name__
+        dialog.close()
