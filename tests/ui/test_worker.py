@@ -122,7 +122,7 @@ def test_jog_sequence_as_seen_by_the_simulator(qtbot: Any, sim: Any, link: Robot
     qtbot.waitUntil(lambda: not sim.state().jogging, timeout=SIGNAL_TIMEOUT_MS)
 
     # Idle: teach mode is switched off by itself.
-    monkeypatch.setattr(worker_module, "TEACH_IDLE_DISABLE", 0.1)
+    monkeypatch.setattr(timing, "TEACH_IDLE_DISABLE", 0.1)
     qtbot.waitUntil(lambda: not sim.state().teach_enabled, timeout=SIGNAL_TIMEOUT_MS)
     assert [v for _, v in register_writes(sim, 440)][-1] == 0x81
 
