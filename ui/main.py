@@ -58,10 +58,12 @@ _LISTENING = re.compile(r"listening on (?P<host>[^\s:]+):(?P<port>\d+)")
 class SimProcess:
     """The simulated controller in a child process (like a real controller: its own GIL)."""
 
-    def __init__(self, process: subprocess.Popen[str], host: str, port: int) -> None:
+    def __init__(self, process: subprocess.Popen[str], host: str, port: int,
+                 reader: threading.Thread | None = None) -> None:
         self.process = process
         self.host = host
         self.port = port
+        self._reader = reader
 
     @classmethod
     def start(cls, timeout: float = SIM_START_TIMEOUT) -> SimProcess:
@@ -81,7 +83,8 @@ class SimProcess:
                 lines.put(line)
             lines.put("")
 
-        threading.Thread(target=read_stdout, name="sim-stdout", daemon=True).start()
+        reader = threading.Thread(target=read_stdout, name="sim-stdout", daemon=True)
+        reader.start()
         try:
             while True:
                 line = lines.get(timeout=timeout)
@@ -89,12 +92,12 @@ class SimProcess:
                     raise RuntimeError(f"the simulator exited at start (exit code {process.wait()})")
                 found = _LISTENING.search(line)
                 if found:
-                    return cls(process, found["host"], int(found["port"]))
+                    return cls(process, found["host"], int(found["port"]), reader)
         except queue.Empty:
-            cls(process, "", 0).stop()
+            cls(process, "", 0, reader).stop()
             raise RuntimeError(f"the simulator did not start within {timeout:g} s") from None
         except BaseException:
-            cls(process, "", 0).stop()
+            cls(process, "", 0, reader).stop()
             raise
 
     def stop(self, timeout: float = SIM_STOP_TIMEOUT) -> int:
@@ -106,14 +109,19 @@ class SimProcess:
             except OSError:
                 pass
         try:
-            return process.wait(timeout)
+            code = process.wait(timeout)
         except subprocess.TimeoutExpired:
             process.terminate()
             try:
-                return process.wait(timeout)
+                code = process.wait(timeout)
             except subprocess.TimeoutExpired:
                 process.kill()
-                return process.wait()
+                code = process.wait()
+        if self._reader is not None:
+            self._reader.join(timeout)  # it ends at the pipe's end of file
+        if process.stdout is not None:
+            process.stdout.close()
+        return code
 
 
 def _size(text: str) -> tuple[int, int]:
