@@ -1,23 +1,31 @@
-"""Completion tracking of the one command under way (step, move, go to zero, run program, ...).
+"""The long commands (step, move to point, go to zero, run program, create point): their start
+and the completion tracking of the one under way.
 
-The regular polls feed the active command: a :class:`CommandTracker` (commands with GV291) or a
-:class:`MotionWatch` (run program and go to zero, which do not use GV291) until a
-:class:`CommandResult` comes out. Only one command is tracked at a time.
+:class:`MotionCommands` starts them without waiting (teach mode is left first); the regular
+polls then feed the active command through :class:`MotionTracker`: a :class:`CommandTracker`
+(commands with GV291) or a :class:`MotionWatch` (run program and go to zero, which do not use
+GV291) until a :class:`CommandResult` comes out. Only one motion at a time: a motion requested
+while another one or an upload is under way is refused.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
 from app import timing
+from app.errors import InvalidInput
+from app.link.client import RobotClient, StepFrame
+from app.link.host import WorkerHost
 from app.link.tracker import pose_moved
 from app.link.types import Operation
 from app.models import CommandResult, ControllerStatus, Pose
-from app.protocol.enums import ProgramState, RunCommand, alarm_names
+from app.protocol.enums import ProgramMotionMode, ProgramState, RunCommand, alarm_names
 
-__all__ = ["ActiveCommand", "Completion", "MotionTracker", "MotionWatch"]
+__all__ = ["ActiveCommand", "Completion", "MotionCommands", "MotionTracker", "MotionWatch"]
 
 
 class Completion(Protocol):
@@ -112,3 +120,67 @@ class MotionTracker:
             details.update(zip(("x", "y", "z", "a", "b", "c"), pose.xyzabc, strict=True))
             result = dataclasses.replace(result, details=details)
         return result, active.request_id
+
+
+class MotionCommands:
+    """The job bodies of the long commands (worker thread; errors propagate to the executor)."""
+
+    def __init__(self, host: WorkerHost) -> None:
+        self._host = host
+
+    def require_none(self, operation: str) -> None:
+        """Refuse ``operation`` while a motion or an upload is under way."""
+        host = self._host
+        busy = host.motion.motion_under_way
+        if busy is not None:
+            raise InvalidInput(f"{busy} is still under way: wait for it or press Stop")
+        if host.uploader.run is not None:
+            raise InvalidInput(f"{Operation.UPLOAD_POINTS} is still under way: wait for it, cancel it "
+                               "or press Stop")
+
+    def _begin(self, operation: str) -> RobotClient:
+        self.require_none(operation)
+        client = self._host.client_or_raise()
+        self._host.jog.leave_teach(self._host.poller.last_status)
+        return client
+
+    def _track(self, operation: str, completion: Completion, *, motion: bool) -> None:
+        self._host.motion.track(operation, completion, motion=motion, request_id=self._host.request_id)
+
+    def _track_last(self, client: RobotClient, operation: str, *, motion: bool) -> None:
+        tracker = client.last_tracker
+        assert tracker is not None
+        self._track(operation, tracker, motion=motion)
+
+    def step(self, frame: StepFrame, offsets: Sequence[float], ext: Sequence[float], speed: float) -> None:
+        client = self._begin(Operation.STEP)
+        client.step(frame, offsets, ext, speed, wait=False)
+        self._track_last(client, Operation.STEP, motion=True)
+
+    def move_to_point(self, end_id: int, via_id: int | None, orientation_changes: bool,
+                      ignore_middle: bool, speed: float, tool: int) -> None:
+        client = self._begin(Operation.MOVE_TO_POINT)
+        client.move_to_point(end_id, via_id=via_id, orientation_changes=orientation_changes,
+                             ignore_middle=ignore_middle, speed=speed, tool=tool, wait=False)
+        self._track_last(client, Operation.MOVE_TO_POINT, motion=True)
+
+    def go_zero(self, axis: int | None) -> None:
+        client = self._begin(Operation.GO_ZERO)
+        before = self._host.poller.last_pose
+        client.go_zero(axis)
+        which = "all axes" if axis is None else f"J{axis + 1}"
+        self._track(Operation.GO_ZERO, MotionWatch(None, f"go to zero ({which})", before, time.monotonic()),
+                    motion=True)
+
+    def run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int, speed_ratio: int) -> None:
+        client = self._begin(Operation.RUN_PROGRAM)
+        before = self._host.poller.last_pose
+        client.run_program(program_id, mode, cycles, speed_ratio)
+        watch = MotionWatch(RunCommand.RUN_PROGRAM, f"run program {program_id}", before, time.monotonic())
+        self._track(Operation.RUN_PROGRAM, watch, motion=True)
+
+    def create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> None:
+        self.require_none(Operation.CREATE_POINT)
+        client = self._host.client_or_raise()
+        client.create_point(point_id, pose=pose, tool=tool, wait=False)
+        self._track_last(client, Operation.CREATE_POINT, motion=False)

@@ -15,9 +15,10 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
   teach command or an upload, so a stop goes out right after the transaction in flight. A stop
   cancels the motion jobs queued before it; a release drops a jog press not yet started.
 * :class:`~app.link.jog.JogMachine` -- jog (function 4) and the dead-man.
-* :class:`~app.link.motion.MotionTracker` -- the one command under way (step, move to point, go
-  to zero, run program, create point) and its completion; a motion while another is under way is
-  refused, Stop clears it.
+* :class:`~app.link.motion.MotionCommands` / :class:`~app.link.motion.MotionTracker` -- the long
+  commands (step, move to point, go to zero, run program, create point), started without waiting,
+  and the completion of the one under way; a motion while another is under way is refused, Stop
+  clears it.
 * :class:`~app.link.upload.Uploader` -- chunked upload of many points, ``pointUploaded`` per
   point, ``uploadProgress``, one final ``commandFinished``; ``cancel_upload`` or a stop end it.
 * :class:`~app.link.capture.TrafficCapture`, RTT and link statistics.
@@ -45,7 +46,6 @@ from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot
 from app import timing
 from app.errors import (
     CommandRefused,
-    InvalidInput,
     LinkError,
     ModbusExceptionError,
     ResponseTimeout,
@@ -56,14 +56,14 @@ from app.link.capture import TrafficCapture
 from app.link.client import ConnectionSettings, RobotClient, StepFrame, TrafficRecord
 from app.link.jobs import JOG_PRESS, JOG_RATIO, Job, JobKind, JobQueue
 from app.link.jog import JogMachine, PreemptedError
-from app.link.motion import Completion, MotionTracker, MotionWatch
+from app.link.motion import MotionCommands, MotionTracker
 from app.link.poller import Poller
 from app.link.stats import LinkStats
 from app.link.supervisor import DEFAULT_CANARY_GV, LinkSupervisor
 from app.link.types import ConnectionState, JogRequest, LinkState, Operation, WorkerError
 from app.link.upload import RawItem, Uploader
 from app.models import CommandResult, ControllerStatus, Pose
-from app.protocol.enums import ProgramMotionMode, RunCommand, WorkMode
+from app.protocol.enums import ProgramMotionMode, WorkMode
 
 __all__ = ["DEFAULT_CANARY_GV", "SHUTDOWN_TIMEOUT_MS", "RobotWorker"]
 
@@ -113,6 +113,7 @@ class RobotWorker(QObject):
         self._reconnect_timer: QTimer | None = None
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
+        self.motions = MotionCommands(self)
         self.jog = JogMachine(self)
         self.uploader = Uploader(self)
         self.poller = Poller(self)
@@ -211,28 +212,29 @@ class RobotWorker(QObject):
     def request_step(self, frame: StepFrame, offsets: Sequence[float], ext_offsets: Sequence[float],
                      speed: float) -> int:
         offs, ext = tuple(offsets), tuple(ext_offsets)
-        return self.post(Operation.STEP, lambda: self._do_step(frame, offs, ext, speed), JobKind.MOTION)
+        return self.post(Operation.STEP, lambda: self.motions.step(frame, offs, ext, speed), JobKind.MOTION)
 
     def request_set_mode(self, mode: WorkMode) -> int:
         return self.post(Operation.SET_MODE, lambda: self._do_set_mode(mode))
 
     def request_go_zero(self, axis: int | None) -> int:
-        return self.post(Operation.GO_ZERO, lambda: self._do_go_zero(axis), JobKind.MOTION)
+        return self.post(Operation.GO_ZERO, lambda: self.motions.go_zero(axis), JobKind.MOTION)
 
     def request_run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int,
                             speed_ratio: int) -> int:
         return self.post(Operation.RUN_PROGRAM,
-                         lambda: self._do_run_program(program_id, mode, cycles, speed_ratio), JobKind.MOTION)
+                         lambda: self.motions.run_program(program_id, mode, cycles, speed_ratio),
+                         JobKind.MOTION)
 
     def request_create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> int:
         values = None if pose is None else tuple(pose)
-        return self.post(Operation.CREATE_POINT, lambda: self._do_create_point(point_id, values, tool))
+        return self.post(Operation.CREATE_POINT, lambda: self.motions.create_point(point_id, values, tool))
 
     def request_move_to_point(self, end_id: int, via_id: int | None, orientation_changes: bool,
                               ignore_middle: bool, speed: float, tool: int) -> int:
         return self.post(Operation.MOVE_TO_POINT,
-                         lambda: self._do_move_to_point(end_id, via_id, orientation_changes, ignore_middle,
-                                                        speed, tool),
+                         lambda: self.motions.move_to_point(end_id, via_id, orientation_changes,
+                                                            ignore_middle, speed, tool),
                          JobKind.MOTION)
 
     def request_upload_points(self, points: Iterable[tuple[int, Sequence[float], int]]) -> int:
@@ -418,17 +420,6 @@ class RobotWorker(QObject):
             self._current_seq = outer_seq
             self.request_id = outer_id
 
-    def _require_no_motion(self, operation: str) -> None:
-        busy = self.motion.motion_under_way
-        if busy is not None:
-            raise InvalidInput(f"{busy} is still under way: wait for it or press Stop")
-        if self.uploader.run is not None:
-            raise InvalidInput(f"{Operation.UPLOAD_POINTS} is still under way: wait for it, cancel it "
-                               "or press Stop")
-
-    def _track(self, operation: str, completion: Completion, *, motion: bool) -> None:
-        self.motion.track(operation, completion, motion=motion, request_id=self.request_id)
-
     def _done(self, text: str) -> None:
         self.emit_result(CommandResult(None, None, None, True, text))
 
@@ -477,59 +468,12 @@ class RobotWorker(QObject):
         self._done(f"work mode: {mode.name.lower()}")
 
     def _do_jog_press(self, request: JogRequest) -> None:
-        self._require_no_motion(Operation.JOG)
+        self.motions.require_none(Operation.JOG)
         self.jog.press(request)
 
     # --- long commands ------------------------------------------------------------------
-    def _begin_motion(self, operation: str) -> RobotClient:
-        self._require_no_motion(operation)
-        client = self.client_or_raise()
-        self.jog.leave_teach(self.poller.last_status)
-        return client
-
-    def _do_step(self, frame: StepFrame, offsets: Sequence[float], ext: Sequence[float],
-                 speed: float) -> None:
-        client = self._begin_motion(Operation.STEP)
-        client.step(frame, offsets, ext, speed, wait=False)
-        tracker = client.last_tracker
-        assert tracker is not None
-        self._track(Operation.STEP, tracker, motion=True)
-
-    def _do_move_to_point(self, end_id: int, via_id: int | None, orientation_changes: bool,
-                          ignore_middle: bool, speed: float, tool: int) -> None:
-        client = self._begin_motion(Operation.MOVE_TO_POINT)
-        client.move_to_point(end_id, via_id=via_id, orientation_changes=orientation_changes,
-                             ignore_middle=ignore_middle, speed=speed, tool=tool, wait=False)
-        tracker = client.last_tracker
-        assert tracker is not None
-        self._track(Operation.MOVE_TO_POINT, tracker, motion=True)
-
-    def _do_go_zero(self, axis: int | None) -> None:
-        client = self._begin_motion(Operation.GO_ZERO)
-        before = self.poller.last_pose
-        client.go_zero(axis)
-        which = "all axes" if axis is None else f"J{axis + 1}"
-        self._track(Operation.GO_ZERO, MotionWatch(None, f"go to zero ({which})", before, time.monotonic()),
-                    motion=True)
-
-    def _do_run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int,
-                        speed_ratio: int) -> None:
-        client = self._begin_motion(Operation.RUN_PROGRAM)
-        before = self.poller.last_pose
-        client.run_program(program_id, mode, cycles, speed_ratio)
-        watch = MotionWatch(RunCommand.RUN_PROGRAM, f"run program {program_id}", before, time.monotonic())
-        self._track(Operation.RUN_PROGRAM, watch, motion=True)
-
-    def _do_create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> None:
-        self._require_no_motion(Operation.CREATE_POINT)
-        client = self.client_or_raise()
-        client.create_point(point_id, pose=pose, tool=tool, wait=False)
-        tracker = client.last_tracker
-        assert tracker is not None
-        self._track(Operation.CREATE_POINT, tracker, motion=False)
-
     def _do_upload_points(self, raw: list[RawItem]) -> None:
         """Case 2.2 for many points, tool by tool; runs in chunks, see :class:`Uploader`."""
-        self._require_no_motion(Operation.UPLOAD_POINTS)
+        self.motions.require_none(Operation.UPLOAD_POINTS)
         if self.uploader.start(raw):
             self._uploadStep.emit()

@@ -68,3 +68,25 @@ def test_take_forgets_the_active_motion() -> None:
     assert tracker.motion_under_way == Operation.STEP
     active = tracker.take()
     assert active is not None and active.request_id == 3 and tracker.take() is None
+
+
+def test_motion_commands_start_without_waiting_and_refuse_a_second_motion(sim: object) -> None:
+    from app.errors import InvalidInput as Refused
+    from app.link.client import StepFrame
+    from app.link.motion import MotionCommands
+    from tests.link.harness import PartsHost
+
+    host = PartsHost()
+    try:
+        host.connect(sim)
+        commands = MotionCommands(host)
+        host.request_id = 4
+        commands.step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], (0.0,) * 5, 1.0)  # about 0.33 s
+        assert host.motion.active is not None and host.motion.active.request_id == 4
+        with pytest.raises(Refused, match="still under way"):
+            commands.go_zero(None)
+        with pytest.raises(Refused):  # nor a create point while it moves
+            commands.create_point(5, None, 200)
+        assert host.motion.motion_under_way == "step"
+    finally:
+        host.close()
