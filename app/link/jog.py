@@ -168,8 +168,8 @@ class JogMachine:
         A release or stop arriving in between ends the sequence before the ratio is written.
         """
         client = self._host.client_or_raise()
-        if not self._host.supervisor.answering:
-            raise LinkError("the controller is not answering: jog not started")
+        if not self._host.supervisor.answering:  # refused before the wire; not a link failure
+            raise TeachPadError("the controller is not answering: jog not started")
         if not 0.0 < request.ratio <= 100.0:
             raise InvalidInput(f"jog speed must be 1..100 %, got {request.ratio:g}")
         self.jog = request

@@ -6,7 +6,7 @@ from typing import Any
 
 import pytest
 
-from app.errors import LinkError
+from app.errors import LinkError, TeachPadError
 from app.link.jog import PreemptedError
 from app.link.types import JogRequest, LinkState
 from app.protocol.enums import TeachFrame
@@ -48,8 +48,9 @@ def test_silence_drops_the_jog_and_ratio_zero_goes_out_first_on_return(host: Par
     assert host.states()[-1] is LinkState.NOT_ANSWERING
     assert host.jog.jog is None
     assert any("jog stopped" in e.message for e in host.of("errorOccurred"))
-    with pytest.raises(LinkError):  # no new jog while the controller is silent
+    with pytest.raises(TeachPadError, match="not answering") as refused:  # no new jog while silent
         host.jog.press(_press())
+    assert not isinstance(refused.value, LinkError)  # refused before the wire: no link failure
     assert sim.state().jogging  # the controller keeps going until it hears us
     writes_before = len(sim.writes)
     sim.set_silent(False)
