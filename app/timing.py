@@ -16,6 +16,7 @@ MOVE_POLL_INTERVAL = 0.01  # s between status reads while waiting for a motion
 ACK_POLL_INTERVAL = 0.0005  # s between status reads until GV291 leaves the pre-command code
 # Short commands (create point, teach) are read back to back (no sleep) for this long.
 SHORT_COMMAND_SPIN = 0.005
+ACK_SPIN = 0.05  # s the worker reads GV291 back to back after a command until it changes
 ACK_TIMEOUT = 2.0  # s for the controller to show it has taken a command (leave the stale code)
 CREATE_POINT_TIMEOUT = 3.0  # s for create-point / teach enable to finish
 MOVE_TIMEOUT_MIN = 10.0  # s; a move's timeout is max(this, 3 x its estimated duration)

@@ -20,7 +20,7 @@ from app import timing
 from app.errors import InvalidInput
 from app.link.client import RobotClient, StepFrame
 from app.link.host import WorkerHost
-from app.link.tracker import pose_moved
+from app.link.tracker import CommandTracker, pose_moved
 from app.link.types import Operation
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import ProgramMotionMode, ProgramState, RunCommand, alarm_names
@@ -151,6 +151,26 @@ class MotionCommands:
         tracker = client.last_tracker
         assert tracker is not None
         self._track(operation, tracker, motion=motion)
+        self._acknowledge(client, tracker)
+
+    def _acknowledge(self, client: RobotClient, tracker: CommandTracker) -> None:
+        """GV291 read at once after the command, then fast for at most ``timing.ACK_SPIN``, until
+        it leaves the pre-command code. The polls alone could miss the whole 0xFF -> moving ->
+        0xFF window of a short command when the worker thread is late (a loaded machine): the
+        tracker could then never tell the new 0xFF from the stale one. A result found here is
+        kept by the tracker and published by the next poll, after that poll's pose and status."""
+        host = self._host
+        deadline = time.monotonic() + timing.ACK_SPIN
+        while True:
+            status = client.read_status(timeout=client.settings.effective_poll_timeout)
+            now = time.monotonic()
+            if tracker.update(status, None, now) is not None or tracker.code_left_pre or now >= deadline:
+                return
+            host.run_urgent()  # a stop goes out at once
+            active = host.motion.active
+            if active is None or active.completion is not tracker or not host.link_up:
+                return
+            time.sleep(tracker.ack_poll_interval)
 
     def step(self, frame: StepFrame, offsets: Sequence[float], ext: Sequence[float], speed: float) -> None:
         client = self._begin(Operation.STEP)

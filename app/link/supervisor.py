@@ -69,6 +69,7 @@ class LinkSupervisor:
                               bool(settings and settings.monitor_only))
         if new != self.state:
             self.state = new
+            _log.info("link %s %s%s", new.endpoint, state.value, f": {message}" if message else "")
             self._host.publish_connection(new)
 
     # --- connecting ----------------------------------------------------------------------
