@@ -215,9 +215,11 @@ class _Reaper(QObject):
 
     @Slot()
     def reap(self) -> None:
+        ended = self.sender()
         for entry in list(_detached):
             thread = entry[0]
-            if thread.wait(100):  # ``finished`` comes right before the end: this is short
+            # ``finished`` is emitted right before the thread ends: waiting for it is short.
+            if (thread is ended or thread.isFinished()) and thread.wait(1000):
                 _detached.remove(entry)
 
 

@@ -11,6 +11,7 @@ import pytest
 from PySide6.QtCore import QObject, QThread, Signal
 
 from app import timing
+from app.link import robot_link as robot_link_module
 from app.link.client import StepFrame
 from app.link.robot_link import RobotLink
 from app.link.stats import LinkStats
@@ -177,7 +178,9 @@ def test_shutdown_with_a_silent_controller_does_not_block_the_gui(qtbot: Any, si
     print(f"shutdown blocked the GUI {blocked * 1000:.0f} ms")
     assert blocked < 0.3 + 1.0  # the wait's bound, not the 2 s network timeout
     assert link.is_running  # still inside its safety write: kept alive, never destroyed running
-    qtbot.waitUntil(lambda: not link.is_running, timeout=10_000)  # it ends by itself
+    assert any(thread is link._thread for thread, _ in robot_link_module._detached)  # kept referenced
+    qtbot.waitUntil(lambda: not link.is_running, timeout=10_000)  # it ends by itself ...
+    qtbot.waitUntil(lambda: not robot_link_module._detached, timeout=10_000)  # ... and is let go
 
 
 def test_shutdown_writes_ratio_zero_and_ends_the_thread(qtbot: Any, sim: Any, link: RobotLink) -> None:
