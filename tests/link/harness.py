@@ -136,8 +136,17 @@ class PartsHost:
     def states(self) -> list[LinkState]:
         return [s.state for s in self.of("connectionChanged")]
 
+    def poll_until_answered(self, polls: int = 50) -> None:
+        """Poll until the link shows CONNECTED again (a loaded machine may need a few polls)."""
+        for _ in range(polls):
+            self.poller.poll_once()
+            if self.supervisor.answering:
+                return
+        raise AssertionError(f"no answer in {polls} polls: {self.out[-3:]}")
+
     def connect(self, sim: Any, **overrides: Any) -> None:
-        values: dict[str, Any] = {"host": "127.0.0.1", "port": sim.port, "timeout": 0.25}
+        # A roomy poll timeout: only the tests about silence make it short (the box may be loaded).
+        values: dict[str, Any] = {"host": "127.0.0.1", "port": sim.port, "timeout": 1.0, "poll_timeout": 1.0}
         values.update(overrides)
         self.supervisor.connect_to(ConnectionSettings(**values))
         assert self.link_up, self.out

@@ -40,7 +40,7 @@ def test_a_release_during_the_enable_ends_the_sequence_before_the_ratio(host: Pa
 
 
 def test_silence_drops_the_jog_and_ratio_zero_goes_out_first_on_return(host: PartsHost, sim: Any) -> None:
-    host.connect(sim, poll_timeout=0.05)
+    host.connect(sim, poll_timeout=0.3)
     host.jog.press(_press())
     assert sim.wait_for(lambda s: s.jogging)
     sim.set_silent(True)
@@ -54,7 +54,7 @@ def test_silence_drops_the_jog_and_ratio_zero_goes_out_first_on_return(host: Par
     assert sim.state().jogging  # the controller keeps going until it hears us
     writes_before = len(sim.writes)
     sim.set_silent(False)
-    host.poller.poll_once()
+    host.poll_until_answered()
     first = sim.writes[writes_before]
     assert first.address == 406 and first.values == (0, 0)  # GV203 = 0.0: the first write back
     assert not sim.state().jogging

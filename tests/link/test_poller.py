@@ -53,7 +53,7 @@ def test_a_poll_publishes_pose_status_then_freshness_then_the_result(host: Parts
 
 
 def test_one_silent_poll_is_not_answering_and_an_answer_is_connected_again(host: PartsHost, sim: Any) -> None:
-    host.connect(sim, poll_timeout=0.05)
+    host.connect(sim, poll_timeout=0.3)
     host.out.clear()
     sim.set_silent(True)
     host.poller.poll_once()
@@ -63,7 +63,7 @@ def test_one_silent_poll_is_not_answering_and_an_answer_is_connected_again(host:
     host.poller.poll_once()
     assert host.states() == [LinkState.NOT_ANSWERING]  # shown once
     sim.set_silent(False)
-    host.poller.poll_once()
+    host.poll_until_answered()
     assert host.states() == [LinkState.NOT_ANSWERING, LinkState.CONNECTED]
     assert "pollSucceeded" in host.names()
 
@@ -86,7 +86,7 @@ def test_poll_uses_the_poll_timeout_not_the_command_timeout(host: PartsHost, sim
 
     t0 = time.monotonic()
     host.poller.poll_once()
-    assert time.monotonic() - t0 < 1.0  # 0.05 s, far from the 2 s command timeout
+    assert time.monotonic() - t0 < 1.5  # 0.05 s (plus load), not the 2 s command timeout
     sim.set_silent(False)
 
 
