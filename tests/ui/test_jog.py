@@ -9,6 +9,7 @@ from PySide6.QtCore import QEvent, Qt
 from PySide6.QtGui import QKeyEvent
 from PySide6.QtWidgets import QApplication, QLineEdit
 
+from app import timing
 from app.link.types import LinkState
 from app.protocol.enums import ControllerMode, TeachFrame
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -30,9 +31,10 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
 
-def _start_jog(qtbot: Any, window: Any, sim: Any, axis: int = 0, direction: int = 1) -> Any:
+def _start_jog(qtbot: Any, window: Any, sim: Any, axis: int = 0, direction: int = 1,
+               **settings: Any) -> Any:
     """Press and hold a jog button until the simulator moves; returns the button."""
-    connect(qtbot, window.link, sim)
+    connect(qtbot, window.link, sim, **settings)
     qtbot.waitUntil(lambda: window.jog_panel.axes_box.isEnabled(), timeout=SIGNAL_TIMEOUT_MS)
     button = window.jog_panel.button(axis, direction)
     x0 = sim.state().pose[axis]
@@ -107,8 +109,10 @@ def test_closing_the_window_stops_the_jog_and_teach(qtbot: Any, sim: Any, window
     assert not window.link.is_running
 
 
-def test_link_loss_releases_and_reconnect_makes_safe(qtbot: Any, sim: Any, window: Any) -> None:
-    _start_jog(qtbot, window, sim)
+def test_link_loss_releases_and_reconnect_makes_safe(qtbot: Any, sim: Any, window: Any,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.3)
+    _start_jog(qtbot, window, sim, poll_timeout=0.5)
     with qtbot.waitSignal(window.link.connectionChanged, check_params_cb=is_state(LinkState.DOWN),
                           timeout=SIGNAL_TIMEOUT_MS):
         sim.set_silent(True)

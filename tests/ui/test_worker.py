@@ -212,8 +212,10 @@ def test_monitor_only_never_writes(qtbot: Any, sim: Any, link: RobotLink) -> Non
     assert sim.writes == []
 
 
-def test_link_loss_then_reconnect_stops_the_jog_first(qtbot: Any, sim: Any, link: RobotLink) -> None:
-    connect(qtbot, link, sim)
+def test_link_loss_then_reconnect_stops_the_jog_first(qtbot: Any, sim: Any, link: RobotLink,
+                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.3)
+    connect(qtbot, link, sim, poll_timeout=0.5)
     link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.DOWN),
