@@ -17,9 +17,6 @@ SIGNAL_TIMEOUT_MS = 5000
 # The offscreen platform warns when a top-level window gets size constraints; not our concern.
 QT_LOG_IGNORE = ("This plugin does not support propagateSizeHints",)
 REQUEST_TIMEOUT = 0.25  # s: a silent simulator is noticed quickly
-# Polls: roomy, so a loaded machine (the simulator shares the GIL in tests) does not show "not
-# answering"; the tests about silence pass ``poll_timeout=None`` (the product's default).
-POLL_TIMEOUT = 1.0
 
 
 @pytest.fixture(name="fast_reconnect")
@@ -57,8 +54,7 @@ def is_state(state: LinkState) -> Callable[[ConnectionState], bool]:
 
 
 def connection_settings(sim: Any, **overrides: Any) -> ConnectionSettings:
-    values: dict[str, Any] = {"host": "127.0.0.1", "port": sim.port, "timeout": REQUEST_TIMEOUT,
-                              "poll_timeout": POLL_TIMEOUT}
+    values: dict[str, Any] = {"host": "127.0.0.1", "port": sim.port, "timeout": REQUEST_TIMEOUT}
     values.update(overrides)
     return ConnectionSettings(**values)
 

@@ -31,9 +31,15 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
 
+# Polls with a roomy timeout: the simulator shares the GIL in tests and a loaded machine must not
+# show "not answering" (which drops the held jog); the link-loss test sets its own.
+POLL_TIMEOUT = 1.0
+
+
 def _start_jog(qtbot: Any, window: Any, sim: Any, axis: int = 0, direction: int = 1,
                **settings: Any) -> Any:
     """Press and hold a jog button until the simulator moves; returns the button."""
+    settings.setdefault("poll_timeout", POLL_TIMEOUT)
     connect(qtbot, window.link, sim, **settings)
     qtbot.waitUntil(lambda: window.jog_panel.axes_box.isEnabled(), timeout=SIGNAL_TIMEOUT_MS)
     button = window.jog_panel.button(axis, direction)

@@ -115,7 +115,7 @@ def test_link_stats_are_reported(qtbot: Any, sim: Any, rig: Rig, monkeypatch: py
 def test_a_silent_controller_is_not_answering_after_one_poll(qtbot: Any, sim: Any, link: RobotLink,
                                                              poll_hz: float) -> None:
     link.set_poll_rate(poll_hz)
-    connect(qtbot, link, sim, poll_timeout=None)  # the product's poll timeout (0.15 s on TCP)
+    connect(qtbot, link, sim)  # the product's poll timeout (0.15 s on TCP)
     states: list[ConnectionState] = []
     link.connectionChanged.connect(states.append)
     with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.NOT_ANSWERING),
@@ -168,7 +168,7 @@ def test_jog_during_silence_gets_ratio_zero_first_when_it_answers(qtbot: Any, si
 def test_shutdown_with_a_silent_controller_does_not_block_the_gui(qtbot: Any, sim: Any, link: RobotLink,
                                                                   monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(timing, "SHUTDOWN_WAIT", 0.3)
-    connect(qtbot, link, sim, timeout=2.0)  # commands (the safety writes) wait 2 s for an answer
+    connect(qtbot, link, sim, timeout=2.0, poll_timeout=1.0)  # the safety writes wait 2 s for an answer
     link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     sim.set_silent(True)
