@@ -27,6 +27,7 @@ UNCONFIRMED_LATENCY_FACTOR = 2.0
 # Auto-detection of a writable GV291: wait this long after writing the sentinel before reading
 # it back, so a controller that re-publishes its status every scan has overwritten it by then.
 SENTINEL_PROBE_SETTLE = 0.05
+ACK_SPIN = 0.05  # s the worker reads GV291 back to back after a command until it changes
 ACK_TIMEOUT = 2.0  # s for the controller to show it has taken a command (leave the stale code)
 CREATE_POINT_TIMEOUT = 3.0  # s for create-point / teach enable to finish
 MOVE_TIMEOUT_MIN = 10.0  # s; a move's timeout is max(this, 3 x its estimated duration)
@@ -36,7 +37,15 @@ STOP_SETTLE = 0.3  # s a moved command must read 'stopped' with GV291 = 0 before
 POLL_HZ_DEFAULT = 50
 CLOCK_POLL_PERIOD = 1.0  # s between date/time reads
 RECONNECT_BACKOFF = (0.2, 0.5, 1.0, 2.0, 5.0)  # s, last one repeats
-LINK_LOSS_POLLS = 3  # consecutive failed polls before the link is declared down
+LINK_LOSS_POLLS = 3  # consecutive failed transactions (refused, reset, command timeouts) -> link down
+NOT_ANSWERING_DOWN_AFTER = 3.0  # s of silence (polls timing out, link open) before the link is down
+RTT_REPORT_PERIOD = 0.5  # s between rttChanged / linkStatsChanged emissions
+TEACH_IDLE_DISABLE = 30.0  # s after the last jog release before teach mode is disabled
+TEACH_MODE_GRACE = 0.3  # s after teach enable during which a status without mode 2 is not "teach lost"
+UPLOAD_CHUNK_POINTS = 20  # points per event-loop turn of an upload, at most ...
+UPLOAD_CHUNK_SECONDS = 0.03  # ... or this long (s), whichever comes first
+UPLOAD_PROGRESS_PERIOD = 0.05  # s between uploadProgress emissions (the last one always goes out)
+SHUTDOWN_WAIT = 1.5  # s the GUI waits for the worker thread on shutdown before detaching it
 
 # Simulator.
 SIM_TICK_HZ = 100

@@ -1,6 +1,6 @@
 """``teachpad``: the desktop teach pendant.
 
-    teachpad --sim                      built-in simulator on a free loopback port
+    teachpad --sim                      the simulator, in its own process, on a free loopback port
     teachpad --host H --port P [--unit U]   a real controller (Modbus TCP)
     teachpad --lang zh_CN               language for this run (the menu remembers a choice)
     teachpad --project FILE             open this project (default: the last one)
@@ -11,14 +11,20 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
+import queue
+import re
+import subprocess
 import sys
+import threading
 from collections.abc import Sequence
+from pathlib import Path
 
 from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication
 
 from app.link.client import ConnectionSettings
-from app.link.robot_link import RobotLink
+from app.link.robot_link import RobotLink, wait_for_detached_threads
 from app.link.types import ConnectionState
 from app.models import Pose
 from app.protocol.enums import ProgramMotionMode
@@ -29,6 +35,93 @@ from ui.settings import APPLICATION, ORGANIZATION, AppSettings
 SCREENSHOT_SETTLE_MS = 1500  # after the first pose: let the plots fill and the panels paint
 SCREENSHOT_TIMEOUT_MS = 20_000  # give up when no pose arrives
 DEMO_PROGRAM = 1  # the simulator's "square 100 mm in XY"
+SIM_START_TIMEOUT = 20.0  # s for the simulator process to say which port it listens on
+SIM_STOP_TIMEOUT = 3.0  # s for it to stop after its stdin closed, before it is terminated
+THREADS_EXIT_WAIT = 5.0  # s at exit for a worker thread still stuck in a network call
+
+# The simulator's process: ``teachpad-sim`` on a free port, plus a watch on its stdin -- a pipe
+# from this process. The pipe closes when the window closes (SimProcess.stop) and also when this
+# process dies, however it dies: the simulator then stops by itself (SIGTERM to itself, which
+# teachpad-sim handles like Ctrl-C).
+_SIM_CHILD = """\
+import os, signal, sys, threading
+def _watch_parent():
+    sys.stdin.buffer.read()
+    os.kill(os.getpid(), signal.SIGTERM)
+threading.Thread(target=_watch_parent, name="parent-watch", daemon=True).start()
+from app.sim.cli import main
+raise SystemExit(main(sys.argv[1:]))
+"""
+_LISTENING = re.compile(r"listening on (?P<host>[^\s:]+):(?P<port>\d+)")
+
+
+class SimProcess:
+    """The simulated controller in a child process (like a real controller: its own GIL)."""
+
+    def __init__(self, process: subprocess.Popen[str], host: str, port: int,
+                 reader: threading.Thread | None = None) -> None:
+        self.process = process
+        self.host = host
+        self.port = port
+        self._reader = reader
+
+    @classmethod
+    def start(cls, timeout: float = SIM_START_TIMEOUT) -> SimProcess:
+        """Start ``teachpad-sim --port 0`` and wait until it says its port. Raises RuntimeError."""
+        root = str(Path(__file__).resolve().parent.parent)  # where ``app`` is, installed or not
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH", "")) if p)
+        env["PYTHONUNBUFFERED"] = "1"
+        process = subprocess.Popen(
+            [sys.executable, "-c", _SIM_CHILD, "--host", "127.0.0.1", "--port", "0", "--no-stdin"],
+            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env)
+        lines: queue.Queue[str] = queue.Queue()
+
+        def read_stdout() -> None:
+            assert process.stdout is not None
+            for line in process.stdout:  # drained to the end, so the child never blocks on it
+                lines.put(line)
+            lines.put("")
+
+        reader = threading.Thread(target=read_stdout, name="sim-stdout", daemon=True)
+        reader.start()
+        try:
+            while True:
+                line = lines.get(timeout=timeout)
+                if not line:
+                    raise RuntimeError(f"the simulator exited at start (exit code {process.wait()})")
+                found = _LISTENING.search(line)
+                if found:
+                    return cls(process, found["host"], int(found["port"]), reader)
+        except queue.Empty:
+            cls(process, "", 0, reader).stop()
+            raise RuntimeError(f"the simulator did not start within {timeout:g} s") from None
+        except BaseException:
+            cls(process, "", 0, reader).stop()
+            raise
+
+    def stop(self, timeout: float = SIM_STOP_TIMEOUT) -> int:
+        """Close its stdin (it stops by itself), terminate it if it does not; its exit code."""
+        process = self.process
+        if process.stdin is not None and not process.stdin.closed:
+            try:
+                process.stdin.close()
+            except OSError:
+                pass
+        try:
+            code = process.wait(timeout)
+        except subprocess.TimeoutExpired:
+            process.terminate()
+            try:
+                code = process.wait(timeout)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                code = process.wait()
+        if self._reader is not None:
+            self._reader.join(timeout)  # it ends at the pipe's end of file
+        if process.stdout is not None:
+            process.stdout.close()
+        return code
 
 
 def _size(text: str) -> tuple[int, int]:
@@ -123,14 +216,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not translator.set_language(language):
         print(f"teachpad: no translation for {language}, using English", file=sys.stderr)
 
-    sim = None
+    sim: SimProcess | None = None
     connection: ConnectionSettings | None = None
     if args.sim:
-        from app.sim import SimConfig, SimController
-
-        sim = SimController(SimConfig(host="127.0.0.1", port=0))
-        sim.start()
-        connection = ConnectionSettings(host="127.0.0.1", port=sim.port, unit=1,
+        try:
+            sim = SimProcess.start()
+        except (OSError, RuntimeError) as exc:
+            print(f"teachpad: could not start the simulator: {exc}", file=sys.stderr)
+            translator.uninstall()
+            return 1
+        connection = ConnectionSettings(host=sim.host, port=sim.port, unit=1,
                                         monitor_only=args.monitor_only)
     elif args.host:
         connection = dataclasses.replace(settings.connection(), host=args.host, port=args.port,
@@ -161,6 +256,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         link.shutdown()
         if sim is not None:
             sim.stop()
+        if not wait_for_detached_threads(THREADS_EXIT_WAIT):
+            print("teachpad: the link to the controller did not close in time", file=sys.stderr)
         translator.uninstall()
         window.deleteLater()
     return int(code)

@@ -21,12 +21,12 @@ from app.link.client import ConnectionSettings, StepFrame
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, RobotState
 from app.link.stats import LinkStats
 from app.link.types import ConnectionState, JogRequest, LinkState, WorkerError
-from app.link.worker import DEFAULT_CANARY_GV, SHUTDOWN_TIMEOUT_MS, RobotWorker
+from app.link.worker import DEFAULT_CANARY_GV, RobotWorker
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
 
-__all__ = ["LinkPort", "Pending", "RequestRouter", "RobotLink"]
+__all__ = ["LinkPort", "Pending", "RequestRouter", "RobotLink", "wait_for_detached_threads"]
 
 _log = logging.getLogger(__name__)
 
@@ -199,8 +199,8 @@ class RobotLink(QObject):
         self._disconnectRequested.connect(w.disconnect_link)
         self._pollRateRequested.connect(w.set_poll_rate)
         self._captureRequested.connect(w.set_traffic_capture)
-        self._shutdownRequested.connect(w.shutdown, Qt.ConnectionType.BlockingQueuedConnection)
-        self._shutdownRequested.connect(self._on_shut_down)  # after the worker's blocking stop
+        self._shutdownRequested.connect(w.shutdown, Qt.ConnectionType.QueuedConnection)
+        self._shutdownRequested.connect(self._on_shut_down)  # the GUI-side state: disconnected
         app = QCoreApplication.instance()
         if app is not None:
             app.aboutToQuit.connect(self.shutdown)
@@ -354,12 +354,59 @@ class RobotLink(QObject):
     # --- shutdown -----------------------------------------------------------------------
     @Slot()
     def shutdown(self) -> None:
-        """Stop jogging, close the client (blocking queued call), then end the thread. Idempotent."""
+        """Stop jogging and close the client, without blocking the GUI on the network. Idempotent.
+
+        The worker is asked with a queued call: it writes ratio 0 / teach disable, closes the
+        client and quits its own thread. The GUI waits at most :data:`app.timing.SHUTDOWN_WAIT`;
+        a worker still inside a network call (a dead controller) finishes on its own, and its
+        thread is kept referenced until it has ended: a running QThread is never destroyed."""
         if self._shut:
             return
         self._shut = True
-        if self._thread.isRunning():
-            self._shutdownRequested.emit()  # blocks until the worker has stopped motion and closed
-            self._thread.quit()
-            if not self._thread.wait(SHUTDOWN_TIMEOUT_MS):
-                _log.error("the robot worker thread did not end within %d ms", SHUTDOWN_TIMEOUT_MS)
+        thread = self._thread
+        if not thread.isRunning():
+            return
+        self._shutdownRequested.emit()  # queued: runs once the transaction in flight is over
+        wait_ms = max(1, round(timing.SHUTDOWN_WAIT * 1000))
+        if not thread.wait(wait_ms):
+            _log.warning("the robot worker is still inside a network call after %d ms; "
+                         "it ends on its own in the background", wait_ms)
+            _keep_until_finished(thread, self._worker)
+
+
+# Threads still running after shutdown's wait, kept referenced until they end (GUI thread only).
+_detached: list[tuple[QThread, QObject]] = []
+
+
+class _Reaper(QObject):
+    """Lives in the GUI thread; drops the references to detached threads once they ended."""
+
+    @Slot()
+    def reap(self) -> None:
+        ended = self.sender()
+        for entry in list(_detached):
+            thread = entry[0]
+            # ``finished`` is emitted right before the thread ends: waiting for it is short.
+            if (thread is ended or thread.isFinished()) and thread.wait(1000):
+                _detached.remove(entry)
+
+
+_reaper: _Reaper | None = None
+
+
+def _keep_until_finished(thread: QThread, worker: QObject) -> None:
+    global _reaper
+    if _reaper is None:
+        _reaper = _Reaper()
+    _detached.append((thread, worker))
+    thread.finished.connect(_reaper.reap, Qt.ConnectionType.QueuedConnection)
+
+
+def wait_for_detached_threads(timeout: float) -> bool:
+    """At the very end of the program: wait up to ``timeout`` s for detached worker threads.
+    True when none is left running."""
+    deadline_ms = max(1, round(timeout * 1000))
+    ok = all(thread.wait(deadline_ms) for thread, _ in list(_detached))
+    if ok:
+        _detached.clear()
+    return ok

@@ -9,6 +9,7 @@ from PySide6.QtCore import QEvent, Qt
 from PySide6.QtGui import QKeyEvent
 from PySide6.QtWidgets import QApplication, QLineEdit
 
+from app import timing
 from app.link.types import LinkState
 from app.protocol.enums import ControllerMode, TeachFrame
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -30,9 +31,16 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
 
-def _start_jog(qtbot: Any, window: Any, sim: Any, axis: int = 0, direction: int = 1) -> Any:
+# Polls with a roomy timeout: the simulator shares the GIL in tests and a loaded machine must not
+# show "not answering" (which drops the held jog); the link-loss test sets its own.
+POLL_TIMEOUT = 1.0
+
+
+def _start_jog(qtbot: Any, window: Any, sim: Any, axis: int = 0, direction: int = 1,
+               **settings: Any) -> Any:
     """Press and hold a jog button until the simulator moves; returns the button."""
-    connect(qtbot, window.link, sim)
+    settings.setdefault("poll_timeout", POLL_TIMEOUT)
+    connect(qtbot, window.link, sim, **settings)
     qtbot.waitUntil(lambda: window.jog_panel.axes_box.isEnabled(), timeout=SIGNAL_TIMEOUT_MS)
     button = window.jog_panel.button(axis, direction)
     x0 = sim.state().pose[axis]
@@ -107,9 +115,11 @@ def test_closing_the_window_stops_the_jog_and_teach(qtbot: Any, sim: Any, window
     assert not window.link.is_running
 
 
-def test_link_loss_releases_and_reconnect_makes_safe(qtbot: Any, sim: Any, window: Any) -> None:
+def test_link_loss_releases_and_reconnect_makes_safe(qtbot: Any, sim: Any, window: Any,
+                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.3)
     sim.set_watchdog(None)  # a controller without a communication watchdog
-    _start_jog(qtbot, window, sim)
+    _start_jog(qtbot, window, sim, poll_timeout=0.5)
     with qtbot.waitSignal(window.link.connectionChanged, check_params_cb=is_state(LinkState.DOWN),
                           timeout=SIGNAL_TIMEOUT_MS):
         sim.set_silent(True)

@@ -1,0 +1,89 @@
+"""What the worker's parts see of the worker: the Protocol between :class:`RobotWorker` and them.
+
+The parts (supervisor, poller, jog, upload, motion tracker, capture) live on the worker thread
+and never talk to Qt: they call the worker back through this interface, which turns their
+outputs into signals and runs the urgent jobs between two transactions.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Protocol
+
+from app.link.types import ConnectionState
+from app.models import CommandResult, ControllerStatus, Pose
+
+if TYPE_CHECKING:
+    from app.link.capture import TrafficCapture
+    from app.link.client import RobotClient, TrafficRecord
+    from app.link.jog import JogMachine
+    from app.link.motion import MotionTracker
+    from app.link.poller import Poller
+    from app.link.stats import LinkStats
+    from app.link.supervisor import LinkSupervisor
+    from app.link.upload import Uploader
+
+__all__ = ["WorkerHost", "WorkerOutputs"]
+
+
+class WorkerOutputs(Protocol):
+    """The worker's signals, as the parts emit them (each maps to one signal of RobotWorker)."""
+
+    def publish_pose(self, pose: Pose) -> None: ...
+    def publish_status(self, status: ControllerStatus) -> None: ...
+    def publish_alarms(self, alarms: int) -> None: ...
+    def publish_connection(self, state: ConnectionState) -> None: ...
+    def publish_rtt(self, ms: float) -> None: ...
+    def publish_poll(self, at: float) -> None: ...
+    def publish_link_stats(self, stats: LinkStats) -> None: ...
+    def publish_traffic(self, records: list[TrafficRecord]) -> None: ...
+    def publish_reconnected(self) -> None: ...
+    def publish_restarted(self) -> None: ...
+    def publish_upload_progress(self, done: int, total: int) -> None: ...
+    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None: ...
+
+
+class WorkerHost(WorkerOutputs, Protocol):
+    """The worker as its parts use it (worker thread only)."""
+
+    supervisor: LinkSupervisor
+    poller: Poller
+    jog: JogMachine
+    motion: MotionTracker
+    uploader: Uploader
+    capture: TrafficCapture
+    closed: bool
+    request_id: int | None  # of the job being executed (results and errors carry it)
+
+    @property
+    def client(self) -> RobotClient | None: ...
+
+    @property
+    def link_up(self) -> bool: ...
+
+    def client_or_raise(self) -> RobotClient: ...
+
+    def run_urgent(self) -> bool:
+        """Run the urgent jobs queued now (stop, release, ...); True if any ran."""
+        ...
+
+    def run_jobs(self) -> None: ...
+
+    def poll_if_due(self) -> None:
+        """A poll now if one is due (long jobs keep the monitor live)."""
+        ...
+
+    def fail_queued(self, message: str) -> None: ...
+
+    def flush_traffic(self) -> None: ...
+
+    def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None: ...
+
+    def emit_error(self, operation: str, message: str, request_id: int | None = -1) -> None: ...
+
+    def start_polling(self) -> None: ...
+
+    def stop_polling(self) -> None: ...
+
+    def start_reconnect(self, delay: float) -> None: ...
+
+    def stop_reconnect(self) -> None: ...

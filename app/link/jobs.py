@@ -1,0 +1,95 @@
+"""The worker's job queue: the only state shared between the GUI thread and the worker thread.
+
+Requests from any thread become :class:`Job` s; the worker pops them on its own thread. Urgent
+jobs (stop, pause, resume, jog release, cancel upload) come out before every other job; a newer
+job with the same ``coalesce`` key takes the place of a queued one (the jog press and the jog
+speed), and an urgent job can drop queued jobs by key (a release drops a press not yet started).
+"""
+
+from __future__ import annotations
+
+import enum
+import itertools
+import threading
+from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
+
+__all__ = ["JOG_PRESS", "JOG_RATIO", "Job", "JobKind", "JobQueue"]
+
+JOG_PRESS = "jog press"  # coalesce key of the jog press
+JOG_RATIO = "jog ratio"  # coalesce key of the live jog speed
+
+
+class JobKind(enum.Enum):
+    URGENT = "urgent"  # stop / pause / resume / jog release: ahead of everything
+    MOTION = "motion"  # cancelled by a stop queued after it
+    PLAIN = "plain"
+
+
+@dataclass
+class Job:
+    operation: str
+    run: Callable[[], None]
+    kind: JobKind
+    seq: int = 0
+    request_id: int = 0
+    coalesce: str | None = None  # a newer job with the same key replaces a queued one
+    needs_link: bool = True
+    cancels: tuple[str, ...] = ()  # an urgent job drops the queued jobs with these coalesce keys
+
+
+class JobQueue:
+    """Two deques under one lock; urgent jobs first. Safe to call from any thread."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._urgent: deque[Job] = deque()
+        self._normal: deque[Job] = deque()
+        self._seq = itertools.count(1)
+        self._ids = itertools.count(1)
+
+    def put(self, job: Job) -> int:
+        """Queue ``job``; returns its request id (unique, increasing, never 0). A coalesced job
+        takes the place of the queued one it replaces, which then never runs (and has no result)."""
+        with self._lock:
+            job.seq = next(self._seq)
+            job.request_id = next(self._ids)
+            if job.kind is JobKind.URGENT:
+                if job.cancels:  # e.g. a release drops a press still waiting: it must never start
+                    self._normal = deque(q for q in self._normal if q.coalesce not in job.cancels)
+                self._urgent.append(job)
+                return job.request_id
+            if job.coalesce is not None:
+                for i, queued in enumerate(self._normal):
+                    if queued.coalesce == job.coalesce:
+                        job.seq = queued.seq  # keep its place in the queue
+                        self._normal[i] = job
+                        return job.request_id
+            self._normal.append(job)
+            return job.request_id
+
+    def pop_urgent(self) -> Job | None:
+        with self._lock:
+            return self._urgent.popleft() if self._urgent else None
+
+    def pop(self) -> Job | None:
+        with self._lock:
+            if self._urgent:
+                return self._urgent.popleft()
+            return self._normal.popleft() if self._normal else None
+
+    def cancel(self, predicate: Callable[[Job], bool]) -> list[Job]:
+        """Remove and return the queued normal jobs matching ``predicate``."""
+        with self._lock:
+            cancelled = [job for job in self._normal if predicate(job)]
+            if cancelled:
+                self._normal = deque(job for job in self._normal if not predicate(job))
+            return cancelled
+
+    def clear(self) -> list[Job]:
+        with self._lock:
+            jobs = [*self._urgent, *self._normal]
+            self._urgent.clear()
+            self._normal.clear()
+            return jobs

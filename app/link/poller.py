@@ -1,0 +1,139 @@
+"""The poller: one read of status and pose per tick, published as signals (worker thread).
+
+Order of a poll: **status first, then pose** -- so when the status says a motion ended, the pose
+read after it is the final one -- with the urgent jobs run between the two reads. Then, in this
+order: ``poseChanged`` / ``statusChanged`` / ``alarmsChanged`` (each only on change),
+``pollSucceeded``, the restart canary, ``commandFinished`` of the command the poll completed,
+the RTT, the link statistics and the captured traffic. The clock (and the canary) are read
+every :data:`app.timing.CLOCK_POLL_PERIOD`. Polls use the poll timeout
+(``settings.effective_poll_timeout``), not the command timeout: a silent controller shows as
+``NOT_ANSWERING`` after one poll.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+from app import timing
+from app.errors import LinkError, ResponseTimeout, TeachPadError
+from app.link.capture import LinkStatsReporter, RttMeter
+from app.link.host import WorkerHost
+from app.link.types import Operation
+from app.models import ControllerStatus, Pose
+
+__all__ = ["Poller"]
+
+
+class Poller:
+    """Reads, publishes on change, feeds the active command and the jog's teach watch."""
+
+    def __init__(self, host: WorkerHost) -> None:
+        self._host = host
+        self.last_pose: Pose | None = None
+        self.last_status: ControllerStatus | None = None
+        self._last_alarms: int | None = None
+        self._next_clock = 0.0
+        self._error: str | None = None  # the last poll error reported (once per distinct error)
+        self.last_poll = 0.0  # monotonic time of the last poll attempt
+        self.rtt = RttMeter(timing.RTT_REPORT_PERIOD)
+        self.stats = LinkStatsReporter(timing.RTT_REPORT_PERIOD)
+
+    def reset(self, now: float) -> None:
+        """A link just came up."""
+        self._error = None
+        self._next_clock = now + timing.CLOCK_POLL_PERIOD
+        self.rtt.period = self.stats.period = timing.RTT_REPORT_PERIOD
+        self.rtt.reset(now)
+
+    def forget(self) -> None:
+        """The link was closed: the next values are published even if equal to the last ones."""
+        self.last_pose = None
+        self.last_status = None
+        self._last_alarms = None
+        self.rtt.forget()
+        self.stats.forget()
+
+    def publish(self, pose: Pose, status: ControllerStatus) -> None:
+        host = self._host
+        if pose != self.last_pose:
+            self.last_pose = pose
+            host.publish_pose(pose)
+        if status != self.last_status:
+            self.last_status = status
+            host.publish_status(status)
+        alarms = int(status.alarms)
+        if alarms != self._last_alarms:
+            self._last_alarms = alarms
+            host.publish_alarms(alarms)
+
+    def poll_once(self) -> None:
+        host = self._host
+        client = host.client
+        if client is None:
+            return
+        now = time.monotonic()
+        self.last_poll = now
+        with_clock = now >= self._next_clock
+        timeout = client.settings.effective_poll_timeout
+        canary: float | None = None
+        try:
+            t0 = time.perf_counter()
+            status = client.read_status(with_clock=with_clock, timeout=timeout)
+            t1 = time.perf_counter()
+            host.run_urgent()  # a stop goes out between the two reads
+            if not host.link_up:
+                return
+            t2 = time.perf_counter()
+            pose = client.read_pose(timeout=timeout)
+            t3 = time.perf_counter()
+            gv = host.supervisor.canary_gv
+            if with_clock and host.supervisor.canary_token is not None and gv is not None:
+                canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock
+        except ResponseTimeout as exc:
+            self._report_error(str(exc))
+            host.supervisor.poll_silent(str(exc), time.monotonic())
+            self._report_stats()
+            return
+        except LinkError as exc:
+            self._report_error(str(exc))
+            host.supervisor.transport_failed(str(exc))
+            self._report_stats()
+            return
+        except TeachPadError as exc:
+            self._report_error(str(exc))
+            return
+        answered = time.monotonic()
+        self._error = None
+        host.supervisor.poll_answered()
+        if not host.link_up:
+            return
+        if with_clock:
+            self._next_clock = now + timing.CLOCK_POLL_PERIOD
+        elif self.last_status is not None:
+            status = dataclasses.replace(status, clock=self.last_status.clock)
+        self.publish(pose, status)
+        host.publish_poll(answered)
+        if canary is not None:
+            host.supervisor.canary_read(canary)
+        done = host.motion.update(status, pose, answered)
+        if done is not None:
+            host.emit_result(*done)
+        host.jog.after_status(status, answered, idle=host.motion.active is None)
+        rtt = self.rtt.note((t1 - t0) + (t3 - t2), 2, answered)
+        if rtt is not None:
+            host.publish_rtt(rtt)
+        self._report_stats()
+        host.flush_traffic()
+
+    def _report_stats(self) -> None:
+        client = self._host.client
+        if client is not None:
+            stats = self.stats.due(client.stats, time.monotonic())
+            if stats is not None:
+                self._host.publish_link_stats(stats)
+
+    def _report_error(self, message: str) -> None:
+        if message != self._error:  # once per distinct error, not 50 times a second
+            self._error = message
+            self._host.emit_error(Operation.POLL, message)

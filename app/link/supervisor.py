@@ -1,0 +1,241 @@
+"""The link supervisor: connect, back off and retry, notice silence and restarts (worker thread).
+
+* **Connect**: open, read status and pose, make jogging safe, write the restart canary, go live
+  (``CONNECTED``), then the queued jobs run.
+* **Not answering**: a poll that times out with the link still open shows ``NOT_ANSWERING`` at
+  once (the held jog is dropped; ratio 0 goes out as soon as the controller answers again); a
+  good poll shows ``CONNECTED`` again. Silence lasting :data:`app.timing.NOT_ANSWERING_DOWN_AFTER`
+  declares the link down.
+* **Link loss**: :data:`app.timing.LINK_LOSS_POLLS` failed transactions in a row (refused, reset,
+  command timeouts) declare the link ``DOWN`` at once; reconnection follows
+  :data:`app.timing.RECONNECT_BACKOFF` by itself and ends with ``controllerReconnected``.
+* **Restart canary**: a random token in a spare GV, read back on the clock poll; a change means
+  the controller restarted under a live link (``controllerRestarted``).
+"""
+
+from __future__ import annotations
+
+import logging
+import random
+import time
+
+from app import timing
+from app.errors import LinkError, ResponseTimeout, TeachPadError
+from app.link.client import ConnectionSettings, RobotClient
+from app.link.host import WorkerHost
+from app.link.types import ConnectionState, LinkState, Operation
+from app.link.upload import UPLOAD_POSE_GV
+from app.models import CommandResult
+from app.protocol import registers
+
+__all__ = ["DEFAULT_CANARY_GV", "LinkSupervisor", "check_canary_gv"]
+
+_log = logging.getLogger(__name__)
+
+#: The spare general-purpose GV holding the restart canary (registers 198-199); None disables it.
+DEFAULT_CANARY_GV: int | None = 99
+
+
+def check_canary_gv(canary_gv: int | None) -> None:
+    if canary_gv is not None and not (UPLOAD_POSE_GV + 6 <= canary_gv <= registers.GV_GENERAL_LAST):
+        raise ValueError(f"the restart canary must be a spare general-purpose GV in "
+                         f"GV{UPLOAD_POSE_GV + 6}..GV{registers.GV_GENERAL_LAST} (uploads use "
+                         f"GV{UPLOAD_POSE_GV}..GV{UPLOAD_POSE_GV + 5}), got GV{canary_gv}")
+
+
+class LinkSupervisor:
+    """Owns the client and the link state."""
+
+    def __init__(self, host: WorkerHost, canary_gv: int | None) -> None:
+        check_canary_gv(canary_gv)
+        self._host = host
+        self.canary_gv = canary_gv
+        self.client: RobotClient | None = None
+        self.settings: ConnectionSettings | None = None
+        self.state = ConnectionState(LinkState.DISCONNECTED)
+        self.link_up = False
+        self.answering = True  # False while the link is up but polls time out
+        self._silent_since = 0.0
+        self._ever_connected = False
+        self._failures = 0
+        self._backoff_index = 0
+        self.canary_token: float | None = None  # what we wrote to the canary GV (None: not checking)
+        self._random = random.Random()
+
+    # --- state ----------------------------------------------------------------------------
+    def set_state(self, state: LinkState, message: str) -> None:
+        settings = self.settings
+        new = ConnectionState(state, message, settings.endpoint if settings else "",
+                              bool(settings and settings.monitor_only))
+        if new != self.state:
+            self.state = new
+            _log.info("link %s %s%s", new.endpoint, state.value, f": {message}" if message else "")
+            self._host.publish_connection(new)
+
+    # --- connecting ----------------------------------------------------------------------
+    def connect_to(self, settings: ConnectionSettings) -> None:
+        host = self._host
+        # Jobs queued since the GUI asked for this connection run once it is up.
+        self.close_link(Operation.CONNECT, LinkState.DISCONNECTED, "", emit=False, fail_queued=False)
+        self.settings = settings
+        self.client = RobotClient(settings)
+        host.capture.attach(self.client)
+        self._ever_connected = False
+        self._backoff_index = 0
+        host.jog.reset()
+        self.set_state(LinkState.CONNECTING, "")
+        self.try_connect()
+
+    def try_connect(self) -> None:
+        """One connection attempt: open, read status and pose, make jogging safe, go live."""
+        host = self._host
+        client = self.client
+        if host.closed or client is None or self.link_up:
+            return
+        try:
+            client.close()
+            client.connect()
+            status = client.read_status(with_clock=True)
+            pose = client.read_pose()
+            host.jog.make_teach_safe(status, self._ever_connected)
+        except TeachPadError as exc:
+            self.schedule_reconnect(str(exc))
+            return
+        self.link_up = True
+        self.answering = True
+        self._failures = 0
+        self._backoff_index = 0
+        reconnected = self._ever_connected
+        self._ever_connected = True
+        host.poller.reset(time.monotonic())
+        self.arm_canary()  # before the GUI hears of the link: a restart from now on is noticed
+        self.set_state(LinkState.CONNECTED, "")
+        host.poller.publish(pose, status)
+        if reconnected:
+            host.publish_reconnected()
+        host.start_polling()
+        host.run_jobs()
+
+    def schedule_reconnect(self, message: str) -> None:
+        backoff = timing.RECONNECT_BACKOFF
+        delay = backoff[min(self._backoff_index, len(backoff) - 1)]
+        self._backoff_index += 1
+        self.set_state(LinkState.DOWN, message)
+        if not self._host.closed:
+            self._host.start_reconnect(delay)
+
+    # --- the restart canary ----------------------------------------------------------------
+    def arm_canary(self) -> None:
+        """Write a fresh random token to the canary GV (not in monitor-only mode, not when disabled)."""
+        self.canary_token = None
+        client = self.client
+        gv = self.canary_gv
+        if gv is None or client is None or client.settings.monitor_only:
+            return
+        token = float(self._random.randint(1, 1 << 23))  # nonzero, exact in float32
+        try:
+            client.write_gv(gv, [token])
+        except TeachPadError as exc:
+            self._host.emit_error(Operation.CANARY, f"could not write the restart canary GV{gv}: {exc}", None)
+            if isinstance(exc, (LinkError, ResponseTimeout)):
+                self.transport_failed(str(exc))
+            return
+        self.canary_token = token
+
+    def canary_read(self, value: float) -> None:
+        """The canary GV as read on the clock poll; a foreign value means the controller restarted."""
+        if self.canary_token is None or value == self.canary_token:
+            return
+        _log.warning("restart canary GV%s reads %g instead of %g: the controller restarted",
+                     self.canary_gv, value, self.canary_token)
+        if self.client is not None:
+            self.client.invalidate_cache()  # GV245 and friends may have been reset too
+        self._host.publish_restarted()
+        self.arm_canary()
+
+    # --- failures ----------------------------------------------------------------------
+    def poll_answered(self) -> None:
+        """A good poll: back to CONNECTED after a silence (ratio 0 first if a jog was under way)."""
+        self._failures = 0
+        if self.answering:
+            return
+        self.answering = True
+        try:
+            self._host.jog.controller_answers()
+        except TeachPadError as exc:
+            self._host.emit_error(Operation.JOG_RELEASE, f"could not stop the jog: {exc}", None)
+            if isinstance(exc, (LinkError, ResponseTimeout)):
+                self.transport_failed(str(exc))
+                if not self.link_up:
+                    return
+        self.set_state(LinkState.CONNECTED, "")
+
+    def poll_silent(self, message: str, now: float) -> None:
+        """A poll timed out with the link open: NOT_ANSWERING at once; DOWN when it lasts."""
+        if self.answering:
+            self.answering = False
+            self._silent_since = now
+            self.set_state(LinkState.NOT_ANSWERING, message)
+            note = self._host.jog.controller_silent()
+            if note is not None:
+                self._host.emit_error(Operation.JOG, note, None)
+        elif now - self._silent_since >= timing.NOT_ANSWERING_DOWN_AFTER:
+            self.link_lost(message)
+
+    def transport_failed(self, message: str) -> None:
+        self._failures += 1
+        if self._failures >= timing.LINK_LOSS_POLLS:
+            self.link_lost(message)
+
+    def link_lost(self, message: str) -> None:
+        """Declare the link down at once; the reconnect timer takes over."""
+        if not self.link_up:
+            return
+        host = self._host
+        self.link_up = False
+        self.answering = True
+        self._failures = 0
+        host.stop_polling()
+        host.jog.link_lost()
+        self.canary_token = None
+        host.uploader.end(f"link lost: {message}")
+        self._fail_active("link lost while the command was under way; its outcome is unknown")
+        host.fail_queued("the link to the controller is down")
+        if self.client is not None:
+            self.client.close()
+        self._backoff_index = 0
+        self.schedule_reconnect(f"link lost: {message}")
+
+    def close_link(self, operation: str, state: LinkState, message: str, *, emit: bool = True,
+                   fail_queued: bool = True) -> None:
+        """Stop jogging and switch teach off (if the controller answers), close, stop retrying."""
+        host = self._host
+        host.stop_reconnect()
+        host.stop_polling()
+        client = self.client
+        if client is not None and self.link_up and not client.settings.monitor_only:
+            try:
+                host.jog.stop_jog_and_teach()
+            except TeachPadError as exc:
+                host.emit_error(operation, f"could not stop teach mode: {exc}", None)
+        self.canary_token = None
+        host.uploader.end(f"{operation}: the link was closed")
+        self._fail_active(f"{operation}: the link was closed while the command was under way")
+        if fail_queued:
+            host.fail_queued(f"{operation}: the link was closed")
+        self.link_up = False
+        self.answering = True
+        if client is not None:
+            host.capture.detach(client)
+            client.close()
+        self.client = None
+        host.poller.forget()
+        if emit:
+            self.set_state(state, message)
+
+    def _fail_active(self, message: str) -> None:
+        active = self._host.motion.take()
+        if active is not None:
+            result = CommandResult(None, None, None, False, f"{active.operation}: {message}")
+            self._host.emit_result(result, active.request_id)
+

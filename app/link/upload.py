@@ -1,0 +1,194 @@
+"""An upload of many temp points (case 2.2), run in chunks on the worker thread.
+
+Items ``(id, pose6, tool)`` are checked before the first write and grouped by tool frame (GV245
+written once per group). Each chunk is at most :data:`app.timing.UPLOAD_CHUNK_POINTS` points of
+one tool or :data:`app.timing.UPLOAD_CHUNK_SECONDS`; the worker queues the next chunk behind
+whatever arrived meanwhile, so polls and queued calls keep flowing. Between two points the
+urgent jobs run (stop, cancel, jog release) and a poll goes out when one is due.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+from app import timing
+from app.errors import InvalidInput, LinkError, ResponseTimeout, TeachPadError, WriteBlocked
+from app.link.client import RobotClient
+from app.link.host import WorkerHost
+from app.link.types import Operation
+from app.models import CommandResult
+from app.protocol import registers
+from app.protocol.enums import RunCommand
+
+__all__ = ["UPLOAD_POSE_GV", "UploadItem", "UploadRun", "Uploader", "check_upload_items", "group_by_tool"]
+
+UPLOAD_POSE_GV = 0  # an upload passes each pose in GV0..GV5 (case 2.2)
+_FLOAT32_MAX = 3.4028234663852886e38
+
+UploadItem = tuple[int, tuple[float, ...], int]  # (point id, pose X Y Z A B C, tool frame)
+RawItem = tuple[object, tuple[object, ...], object]
+
+
+@dataclass
+class UploadRun:
+    """An upload under way."""
+
+    request_id: int | None
+    items: list[UploadItem]  # grouped by tool frame: GV245 is written once per group
+    index: int = 0  # items attempted so far
+    good: int = 0
+    end: str | None = None  # why it ends early ("cancelled", "stopped", "link lost: ..."), once set
+    progress_at: float = 0.0  # when uploadProgress was last emitted
+    progress_done: int = -1  # the ``done`` it carried
+
+
+def group_by_tool(items: Iterable[UploadItem]) -> list[UploadItem]:
+    """Stable grouping: the tools in order of first appearance, each tool's points in input order."""
+    groups: dict[int, list[UploadItem]] = {}
+    for item in items:
+        groups.setdefault(item[2], []).append(item)
+    return [item for group in groups.values() for item in group]
+
+
+def check_upload_items(client: RobotClient, raw: Sequence[RawItem]) -> list[UploadItem]:
+    """Every item checked (id range, tool, six finite float32 values) before anything is written."""
+    lo, hi = client.settings.point_id_min, client.settings.point_id_max
+    items: list[UploadItem] = []
+    for pid, pose, tool in raw:
+        if isinstance(pid, bool) or not isinstance(pid, int) or not lo <= pid <= hi:
+            raise InvalidInput(f"point id must be an integer in {lo}..{hi}, got {str(pid)[:20]!r}")
+        if isinstance(tool, bool) or not isinstance(tool, int) or not 0 <= tool <= registers.TOOL_NONE:
+            raise InvalidInput(f"tool frame of point {pid} must be 0..{registers.TOOL_NONE}, "
+                               f"got {str(tool)[:20]!r}")
+        if len(pose) != 6:
+            raise InvalidInput(f"pose of point {pid} needs 6 values, got {len(pose)}")
+        values: list[float] = []
+        for v in pose:
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
+                    or abs(v) > _FLOAT32_MAX:
+                raise InvalidInput(f"pose of point {pid}: {str(v)[:20]!r} is not a finite float32")
+            values.append(float(v))
+        items.append((pid, tuple(values), tool))
+    return items
+
+
+class Uploader:
+    """The running upload (one at a time)."""
+
+    def __init__(self, host: WorkerHost) -> None:
+        self._host = host
+        self.run: UploadRun | None = None
+        self._busy = False  # inside a chunk (client.upload_points is running)
+
+    def start(self, raw: list[RawItem]) -> bool:
+        """Check and begin; True when chunks are to follow (the worker queues :meth:`step`)."""
+        host = self._host
+        client = host.client_or_raise()
+        if client.settings.monitor_only:
+            raise WriteBlocked(f"monitor-only mode: {Operation.UPLOAD_POINTS} was not sent")
+        items = group_by_tool(check_upload_items(client, raw))
+        if not items:
+            host.emit_result(CommandResult(RunCommand.CREATE_POINT, None, None, True,
+                                           "uploaded 0 of 0 points", {"uploaded": 0.0, "total": 0.0}))
+            return False
+        host.jog.leave_teach(host.poller.last_status)
+        self.run = UploadRun(host.request_id, items)
+        self._note_progress(self.run, force=True)
+        return True
+
+    def step(self) -> bool:
+        """One chunk; True if another chunk should be queued."""
+        host = self._host
+        upload = self.run
+        if upload is None or host.closed:
+            return False
+        if upload.end is None and upload.index < len(upload.items) and host.link_up:
+            host.poll_if_due()  # keep the monitor live even if the event loop favours queued calls
+            host.run_urgent()
+            if upload.end is None and host.link_up and self.run is upload:
+                self._chunk(upload)
+        if self.run is not upload:
+            return False  # ended meanwhile (link lost, closed)
+        if upload.end is not None or upload.index >= len(upload.items) or not host.link_up:
+            self.finish()
+            return False
+        return True
+
+    def _chunk(self, upload: UploadRun) -> None:
+        host = self._host
+        client = host.client_or_raise()
+        start = time.monotonic()
+        items = upload.items
+        first = upload.index
+        tool = items[first][2]
+        last = first
+        while last < len(items) and last - first < timing.UPLOAD_CHUNK_POINTS and items[last][2] == tool:
+            last += 1
+
+        def progress(done: int, total: int) -> bool:
+            host.run_urgent()  # stop / pause / cancel / jog release between two points
+            if upload.end is not None or not host.link_up or host.closed:
+                return False
+            host.poll_if_due()
+            return host.link_up and time.monotonic() - start < timing.UPLOAD_CHUNK_SECONDS
+
+        transport_error: str | None = None
+        self._busy = True
+        outer_id, host.request_id = host.request_id, upload.request_id
+        try:
+            chunk = [(pid, pose) for pid, pose, _ in items[first:last]]
+            results = client.upload_points(chunk, tool, progress, gv_start=UPLOAD_POSE_GV)
+        except (LinkError, ResponseTimeout) as exc:  # before the first point (status read, mode)
+            results, transport_error = [], str(exc)
+        except TeachPadError as exc:
+            results = []
+            upload.end = upload.end or str(exc)
+        finally:
+            self._busy = False
+            host.request_id = outer_id
+        for (point_id, _, _), result in zip(items[first:], results, strict=False):
+            upload.index += 1
+            if result.ok:
+                upload.good += 1
+                host.publish_point_uploaded(point_id, True, "")
+            else:
+                host.publish_point_uploaded(point_id, False, result.message or "failed")
+                if result.status is None:  # the link failed during this point: its outcome is unknown
+                    transport_error = result.message
+        if transport_error is not None:
+            upload.end = upload.end or transport_error
+            host.supervisor.transport_failed(transport_error)
+        self._note_progress(upload)
+
+    def _note_progress(self, upload: UploadRun, *, force: bool = False) -> None:
+        now = time.monotonic()
+        due = force or now - upload.progress_at >= timing.UPLOAD_PROGRESS_PERIOD
+        if upload.index != upload.progress_done and due:
+            upload.progress_at = now
+            upload.progress_done = upload.index
+            self._host.publish_upload_progress(upload.index, len(upload.items))
+
+    def end(self, reason: str) -> None:
+        """Ask the running upload to end before its next point (at once when between chunks)."""
+        upload = self.run
+        if upload is None:
+            return
+        if upload.end is None:
+            upload.end = reason
+        if not self._busy:
+            self.finish()
+
+    def finish(self) -> None:
+        """The batch's final commandFinished (after every pointUploaded), with the upload's request id."""
+        upload, self.run = self.run, None
+        if upload is None:
+            return
+        total = len(upload.items)
+        self._note_progress(upload, force=True)
+        text = f"uploaded {upload.good} of {total} points" + (f" ({upload.end})" if upload.end else "")
+        details = {"uploaded": float(upload.good), "attempted": float(upload.index), "total": float(total)}
+        result = CommandResult(RunCommand.CREATE_POINT, None, None, upload.good == total, text, details)
+        self._host.emit_result(result, upload.request_id)

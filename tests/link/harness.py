@@ -1,0 +1,155 @@
+"""A Qt-free host for the worker's parts: the real parts, composed like RobotWorker does, with
+every output recorded in order and the timers recorded instead of run."""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+from app.errors import LinkError
+from app.link.capture import TrafficCapture
+from app.link.client import ConnectionSettings, RobotClient, TrafficRecord
+from app.link.jog import JogMachine
+from app.link.motion import MotionTracker
+from app.link.poller import Poller
+from app.link.stats import LinkStats
+from app.link.supervisor import LinkSupervisor
+from app.link.types import ConnectionState, LinkState, WorkerError
+from app.link.upload import Uploader
+from app.models import CommandResult, ControllerStatus, Pose
+
+
+class PartsHost:
+    """Implements :class:`app.link.host.WorkerHost` without Qt; ``out`` lists (name, payload)."""
+
+    def __init__(self, canary_gv: int | None = None) -> None:
+        self.out: list[tuple[str, Any]] = []
+        self.closed = False
+        self.request_id: int | None = None
+        self.polling = False
+        self.reconnect_delays: list[float] = []
+        self.urgent: list[Any] = []  # callables run by run_urgent (like urgent jobs)
+        self.capture = TrafficCapture()
+        self.motion = MotionTracker()
+        self.jog = JogMachine(self)
+        self.uploader = Uploader(self)
+        self.poller = Poller(self)
+        self.supervisor = LinkSupervisor(self, canary_gv)
+
+    # --- what the parts call ---------------------------------------------------------------
+    @property
+    def client(self) -> RobotClient | None:
+        return self.supervisor.client
+
+    @property
+    def link_up(self) -> bool:
+        return self.supervisor.link_up
+
+    def client_or_raise(self) -> RobotClient:
+        if self.supervisor.client is None or not self.supervisor.link_up:
+            raise LinkError("not connected to a controller")
+        return self.supervisor.client
+
+    def run_urgent(self) -> bool:
+        ran = bool(self.urgent)
+        while self.urgent:
+            self.urgent.pop(0)()
+        return ran
+
+    def run_jobs(self) -> None:
+        self.run_urgent()
+
+    def poll_if_due(self) -> None:
+        pass
+
+    def fail_queued(self, message: str) -> None:
+        self.out.append(("failQueued", message))
+
+    def flush_traffic(self) -> None:
+        batch = self.capture.flush()
+        if batch is not None:
+            self.publish_traffic(batch)
+
+    def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None:
+        rid = self.request_id if request_id == -1 else request_id
+        self.out.append(("commandFinished", dataclasses.replace(result, request_id=rid)))
+
+    def emit_error(self, operation: str, message: str, request_id: int | None = -1) -> None:
+        rid = self.request_id if request_id == -1 else request_id
+        self.out.append(("errorOccurred", WorkerError(operation, message, rid)))
+
+    def start_polling(self) -> None:
+        self.polling = True
+
+    def stop_polling(self) -> None:
+        self.polling = False
+
+    def start_reconnect(self, delay: float) -> None:
+        self.reconnect_delays.append(delay)
+
+    def stop_reconnect(self) -> None:
+        pass
+
+    def publish_pose(self, pose: Pose) -> None:
+        self.out.append(("poseChanged", pose))
+
+    def publish_status(self, status: ControllerStatus) -> None:
+        self.out.append(("statusChanged", status))
+
+    def publish_alarms(self, alarms: int) -> None:
+        self.out.append(("alarmsChanged", alarms))
+
+    def publish_connection(self, state: ConnectionState) -> None:
+        self.out.append(("connectionChanged", state))
+
+    def publish_rtt(self, ms: float) -> None:
+        self.out.append(("rttChanged", ms))
+
+    def publish_poll(self, at: float) -> None:
+        self.out.append(("pollSucceeded", at))
+
+    def publish_link_stats(self, stats: LinkStats) -> None:
+        self.out.append(("linkStatsChanged", stats))
+
+    def publish_traffic(self, records: list[TrafficRecord]) -> None:
+        self.out.append(("trafficObserved", records))
+
+    def publish_reconnected(self) -> None:
+        self.out.append(("controllerReconnected", None))
+
+    def publish_restarted(self) -> None:
+        self.out.append(("controllerRestarted", None))
+
+    def publish_upload_progress(self, done: int, total: int) -> None:
+        self.out.append(("uploadProgress", (done, total)))
+
+    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None:
+        self.out.append(("pointUploaded", (point_id, ok, reason)))
+
+    # --- helpers for tests -----------------------------------------------------------------
+    def names(self) -> list[str]:
+        return [name for name, _ in self.out]
+
+    def of(self, name: str) -> list[Any]:
+        return [payload for n, payload in self.out if n == name]
+
+    def states(self) -> list[LinkState]:
+        return [s.state for s in self.of("connectionChanged")]
+
+    def poll_until_answered(self, polls: int = 50) -> None:
+        """Poll until the link shows CONNECTED again (a loaded machine may need a few polls)."""
+        for _ in range(polls):
+            self.poller.poll_once()
+            if self.supervisor.answering:
+                return
+        raise AssertionError(f"no answer in {polls} polls: {self.out[-3:]}")
+
+    def connect(self, sim: Any, **overrides: Any) -> None:
+        # A roomy poll timeout: only the tests about silence make it short (the box may be loaded).
+        values: dict[str, Any] = {"host": "127.0.0.1", "port": sim.port, "timeout": 1.0, "poll_timeout": 1.0}
+        values.update(overrides)
+        self.supervisor.connect_to(ConnectionSettings(**values))
+        assert self.link_up, self.out
+
+    def close(self) -> None:
+        self.supervisor.close_link("shutdown", LinkState.DISCONNECTED, "")

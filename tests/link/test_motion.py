@@ -1,0 +1,92 @@
+"""The motion tracker and the program-state watch (commands without GV291)."""
+
+from __future__ import annotations
+
+import pytest
+
+from app import timing
+from app.link.motion import MotionTracker, MotionWatch
+from app.link.types import Operation
+from app.models import CommandResult, ControllerStatus, Pose
+from app.protocol.enums import Alarm, ControllerMode, ProgramState, RunCommand
+
+IDLE = ControllerStatus(ControllerMode.AUTO, ProgramState.STOPPED, Alarm(0), 0)
+RUNNING = ControllerStatus(ControllerMode.AUTO, ProgramState.RUNNING, Alarm(0), 0)
+
+
+def _pose(x: float) -> Pose:
+    return Pose(x, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+def test_watch_needs_motion_then_standing_still() -> None:
+    watch = MotionWatch(RunCommand.RUN_PROGRAM, "run program 1", _pose(0), 0.0)
+    assert watch.update(IDLE, _pose(0), 0.1) is None  # not started yet
+    assert watch.update(RUNNING, _pose(5), 0.2) is None
+    assert watch.update(IDLE, _pose(10), 0.3) is None  # still moving
+    result = watch.update(IDLE, _pose(10), 0.4)
+    assert result is not None and result.ok and result.message == "run program 1: done"
+
+
+def test_watch_without_motion_is_refused_after_the_ack_timeout(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
+    watch = MotionWatch(None, "go to zero (all axes)", _pose(0), 0.0)
+    assert watch.update(IDLE, _pose(0), 0.4) is None
+    result = watch.update(IDLE, _pose(0), 0.6)
+    assert result is not None and not result.ok and "no motion within 0.5 s" in result.message
+
+
+def test_watch_ends_on_an_alarm() -> None:
+    watch = MotionWatch(None, "go to zero (J1)", _pose(0), 0.0)
+    alarm = ControllerStatus(ControllerMode.AUTO, ProgramState.STOPPED, Alarm.ESTOP, 0)
+    result = watch.update(alarm, _pose(0), 0.1)
+    assert result is not None and not result.ok and "alarm" in result.message
+
+
+class _Done:
+    def update(self, status: ControllerStatus, pose: Pose | None, now: float) -> CommandResult | None:
+        return CommandResult(RunCommand.CREATE_POINT, None, None, True, "created")
+
+    def stopped(self, now: float) -> CommandResult:
+        return CommandResult(None, None, None, False, "stopped")
+
+
+def test_tracker_hands_out_the_result_once_with_its_request_id() -> None:
+    tracker = MotionTracker()
+    assert tracker.update(IDLE, _pose(0), 0.0) is None
+    tracker.track(Operation.CREATE_POINT, _Done(), motion=False, request_id=7)
+    assert tracker.motion_under_way is None  # a short command does not block motions
+    done = tracker.update(IDLE, _pose(12.5), 0.0)
+    assert done is not None
+    result, rid = done
+    assert rid == 7 and result.details["x"] == 12.5  # create point reports the pose it saw
+    assert tracker.active is None and tracker.update(IDLE, _pose(0), 0.0) is None
+
+
+def test_take_forgets_the_active_motion() -> None:
+    tracker = MotionTracker()
+    tracker.track(Operation.STEP, _Done(), motion=True, request_id=3)
+    assert tracker.motion_under_way == Operation.STEP
+    active = tracker.take()
+    assert active is not None and active.request_id == 3 and tracker.take() is None
+
+
+def test_motion_commands_start_without_waiting_and_refuse_a_second_motion(sim: object) -> None:
+    from app.errors import InvalidInput as Refused
+    from app.link.client import StepFrame
+    from app.link.motion import MotionCommands
+    from tests.link.harness import PartsHost
+
+    host = PartsHost()
+    try:
+        host.connect(sim)
+        commands = MotionCommands(host)
+        host.request_id = 4
+        commands.step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], (0.0,) * 5, 1.0)  # about 0.33 s
+        assert host.motion.active is not None and host.motion.active.request_id == 4
+        with pytest.raises(Refused, match="still under way"):
+            commands.go_zero(None)
+        with pytest.raises(Refused):  # nor a create point while it moves
+            commands.create_point(5, None, 200)
+        assert host.motion.motion_under_way == "step"
+    finally:
+        host.close()

@@ -1,0 +1,75 @@
+"""The link supervisor: connect, backoff, link loss, the restart canary (no Qt)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+
+from app import timing
+from app.link.supervisor import LinkSupervisor, check_canary_gv
+from app.link.types import LinkState
+from tests.link.harness import PartsHost
+
+
+def test_connect_publishes_state_pose_and_status_then_polls(host: PartsHost, sim: Any) -> None:
+    host.connect(sim)
+    assert host.states() == [LinkState.CONNECTING, LinkState.CONNECTED]
+    assert {"poseChanged", "statusChanged"} <= set(host.names()) and host.polling
+    assert sim.writes == []  # canary off: connecting never writes
+
+
+def test_unreachable_backs_off(sim_factory: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "RECONNECT_BACKOFF", (0.1, 0.2))
+    sim = sim_factory()
+    port = sim.port
+    sim.stop()
+    parts = PartsHost()
+    from app.link.client import ConnectionSettings
+
+    parts.supervisor.connect_to(ConnectionSettings(host="127.0.0.1", port=port, timeout=0.2))
+    for _ in range(2):
+        parts.supervisor.try_connect()
+    assert parts.states() == [LinkState.CONNECTING, LinkState.DOWN]
+    assert parts.reconnect_delays == [0.1, 0.2, 0.2]  # the last delay repeats
+    parts.close()
+
+
+def test_transport_failures_in_a_row_take_the_link_down_and_fail_the_queue(host: PartsHost, sim: Any) -> None:
+    host.connect(sim)
+    for _ in range(timing.LINK_LOSS_POLLS - 1):
+        host.supervisor.transport_failed("reset")
+    assert host.link_up
+    host.supervisor.transport_failed("reset")
+    assert not host.link_up and host.states()[-1] is LinkState.DOWN
+    assert host.of("failQueued") == ["the link to the controller is down"]
+
+
+def test_reconnect_after_a_loss_says_reconnected(host: PartsHost, sim: Any) -> None:
+    host.connect(sim)
+    host.supervisor.link_lost("test")
+    host.supervisor.try_connect()
+    assert host.states()[-2:] == [LinkState.DOWN, LinkState.CONNECTED]
+    assert host.names().count("controllerReconnected") == 1
+
+
+def test_the_canary_notices_a_restart(sim: Any) -> None:
+    parts = PartsHost(canary_gv=99)
+    try:
+        parts.connect(sim)
+        token = parts.supervisor.canary_token
+        assert token is not None
+        parts.supervisor.canary_read(token)
+        assert "controllerRestarted" not in parts.names()
+        parts.supervisor.canary_read(0.0)
+        assert parts.names().count("controllerRestarted") == 1
+        assert parts.supervisor.canary_token not in (None, token)  # armed again
+    finally:
+        parts.close()
+
+
+def test_the_canary_must_be_a_spare_gv() -> None:
+    with pytest.raises(ValueError, match=r"GV0\.\.GV5"):
+        check_canary_gv(3)
+    with pytest.raises(ValueError):
+        LinkSupervisor(PartsHost(), 2)

@@ -1,0 +1,66 @@
+"""``teachpad --sim``: the simulator runs in its own process, stops with the window, and stops by
+itself when the GUI process dies (its stdin pipe closes)."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from ui.main import SimProcess
+
+pytestmark = pytest.mark.timeout(60)
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def _gone(pid: int, timeout: float) -> bool:
+    """True once process ``pid`` has exited (polled: it is not our child)."""
+    import os
+
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return True
+        try:  # a zombie of an exited parent is reaped by init; read its state
+            state = Path(f"/proc/{pid}/stat").read_text().split()[2]
+            if state == "Z":
+                return True
+        except OSError:
+            return True
+        time.sleep(0.05)
+    return False
+
+
+def test_the_simulator_process_answers_and_stops_cleanly(make_client: Any) -> None:
+    sim = SimProcess.start()
+    try:
+        assert sim.process.pid != 0 and sim.port > 0
+        client = make_client(port=sim.port)
+        assert client.read_status().alarms == 0
+        client.close()
+    finally:
+        code = sim.stop()
+    assert code == 0  # stopped by itself when its stdin closed, not killed
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="reads /proc")
+def test_the_simulator_stops_when_the_gui_process_dies() -> None:
+    parent = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent("""
+            import os
+            from ui.main import SimProcess
+            sim = SimProcess.start()
+            print(sim.process.pid, flush=True)
+            os._exit(3)  # a crash: no stop(), no cleanup
+        """)],
+        cwd=ROOT, capture_output=True, text=True, timeout=30, check=False)
+    assert parent.returncode == 3, parent.stderr
+    child = int(parent.stdout.split()[0])
+    assert _gone(child, 10.0)
