@@ -154,11 +154,12 @@ class MotionCommands:
         self._acknowledge(client, tracker)
 
     def _acknowledge(self, client: RobotClient, tracker: CommandTracker) -> None:
-        """GV291 read at once after the command, then with the tracker's backoff (1, 2, 4 ... ms)
-        for at most ``timing.ACK_SPIN``, until it leaves the pre-command code. The polls alone could miss the whole 0xFF -> moving ->
-        0xFF window of a short command when the worker thread is late (a loaded machine): the
-        tracker could then never tell the new 0xFF from the stale one. A result found here is
-        kept by the tracker and published by the next poll, after that poll's pose and status."""
+        """GV291 read at once after the command, then with the tracker's backoff (1, 2, 4 ...
+        ms) for at most ``timing.ACK_SPIN``, until it leaves the pre-command code. The polls
+        alone could miss the whole 0xFF -> moving -> 0xFF window of a short command when the
+        worker thread is late (a loaded machine): the tracker could then never tell the new 0xFF
+        from the stale one. A result found here is kept by the tracker and published by the next
+        poll, after that poll's pose and status."""
         host = self._host
         deadline = time.monotonic() + timing.ACK_SPIN
         while True:
