@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -65,6 +65,8 @@ class IssueCode(enum.Enum):
     TOOL_MISMATCH = "tool-mismatch"
     BAD_START = "bad-start"
     ARC_RESUME_PAST_MIDDLE = "arc-resume-past-middle"
+    UNREACHABLE = "unreachable"  # the robot model's IK finds no solution (app.view3d.reach)
+    JOINT_LIMIT = "joint-limit"  # reachable only past a joint limit of the robot model
 
 
 @dataclass(frozen=True)
@@ -83,6 +85,10 @@ class PlanIssue:
 
     def __str__(self) -> str:
         return f"{self.kind.value}: {self.message}"
+
+
+#: Reachability of a plan by a robot model: (plan, ledger, current pose) -> issues.
+ReachCheck = Callable[[Plan, PointLedger, PointLike | None], Sequence[PlanIssue]]
 
 
 def has_errors(issues: Sequence[PlanIssue]) -> bool:
@@ -127,6 +133,7 @@ def check_plan(
     *,
     start_index: int = 0,
     loops: int | None = None,
+    reach: ReachCheck | None = None,
 ) -> list[PlanIssue]:
     """Everything to fix (or know) before running ``plan`` from segment ``start_index``.
 
@@ -134,6 +141,8 @@ def check_plan(
     Without it, an arc starting there is reported as unchecked (warning). With ``loops``
     other than 1, the first segment is also checked from the end of the last one.
     Issues come sorted by segment; "needs upload" is reported once per point.
+    ``reach`` (e.g. :meth:`app.view3d.reach.ReachChecker.plan_issues`) adds the robot model's
+    reachability issues (:data:`IssueCode.UNREACHABLE`, :data:`IssueCode.JOINT_LIMIT`).
     """
     limits = limits or PlanLimits()
     loops = plan.loops if loops is None else loops
@@ -217,6 +226,8 @@ def check_plan(
                     issues.append(PlanIssue(i, IssueKind.WARNING, IssueCode.ZERO_LENGTH,
                                             f"{_seg_name(i)}: the line goes nowhere "
                                             f"(start and end {length:.3g} mm apart){suffix}"))
+    if reach is not None:
+        issues.extend(reach(plan, ledger, current_pose))
     order = {IssueKind.ERROR: 0, IssueKind.NEEDS_UPLOAD: 1, IssueKind.WARNING: 2}
     issues.sort(key=lambda it: (-1 if it.segment is None else it.segment, order[it.kind]))
     return issues
