@@ -69,12 +69,13 @@ class Camera:
 
     @property
     def eye(self) -> FloatArray:
-        return np.asarray(self.target, dtype=np.float64) - self._basis[2] * self.distance
+        eye = np.asarray(self.target, dtype=np.float64) - self._basis[2] * self.distance
+        return np.asarray(eye, dtype=np.float64)
 
     @property
     def basis(self) -> FloatArray:
         """(3, 3) rows: screen right, screen up, viewing direction (world)."""
-        return self._basis
+        return np.asarray(self._basis, dtype=np.float64)
 
     def focal(self, height: int) -> float:
         """Pixels per mm at unit depth (perspective) — or per mm (ortho, at the target)."""

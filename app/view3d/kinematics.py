@@ -57,7 +57,8 @@ class ArmModel:
 
     def __init__(self, profile: RobotProfile) -> None:
         self.profile = profile
-        self._rows = [(math.radians(j.offset_deg), j.d, j.a, math.radians(j.alpha_deg)) for j in profile.joints]
+        self._rows = [(math.radians(j.offset_deg), j.d, j.a, math.radians(j.alpha_deg))
+                      for j in profile.joints]
         self._base = profile.base_transform
         self._flange = profile.flange_transform
         self._limits = profile.limits
@@ -106,7 +107,8 @@ class ArmModel:
         return np.asarray([f[:3, 3] for f in frames[:-2]] + [frames[-1][:3, 3]], dtype=np.float64)
 
     def within_limits(self, q_deg: FloatArray, margin: float = 1e-6) -> bool:
-        return bool(np.all(q_deg >= self._limits[:, 0] - margin) and np.all(q_deg <= self._limits[:, 1] + margin))
+        lo, hi = self._limits[:, 0] - margin, self._limits[:, 1] + margin
+        return bool(np.all(q_deg >= lo) and np.all(q_deg <= hi))
 
     def _wrap_into_limits(self, q_deg: FloatArray) -> FloatArray:
         """Each angle moved by whole turns into its limits where that is possible."""

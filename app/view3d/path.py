@@ -31,6 +31,8 @@ Matrix = NDArray[np.float64]
 
 DRY_RUN_SAMPLES = 32  # per segment
 
+Pose6 = tuple[float, float, float, float, float, float]
+
 
 def start_of(plan: Plan, ledger: PointLedger, pose: Pose | None) -> tuple[FloatArray | None, Matrix | None]:
     """Where (XYZ) and how (rotation) the plan starts, or None for what is unknown."""
@@ -43,7 +45,8 @@ def start_of(plan: Plan, ledger: PointLedger, pose: Pose | None) -> tuple[FloatA
     return None, None
 
 
-def segment_rotations(plan: Plan, ledger: PointLedger, start_rot: Matrix | None) -> list[tuple[Matrix, Matrix]]:
+def segment_rotations(plan: Plan, ledger: PointLedger,
+                      start_rot: Matrix | None) -> list[tuple[Matrix, Matrix]]:
     """(start, end) tool rotation of each segment; unknown ends keep the previous rotation."""
     out: list[tuple[Matrix, Matrix]] = []
     current = start_rot
@@ -60,9 +63,9 @@ def segment_rotations(plan: Plan, ledger: PointLedger, start_rot: Matrix | None)
     return out
 
 
-def sample_poses(xyz: FloatArray, rots: tuple[Matrix, Matrix], fractions: FloatArray) -> list[tuple[float, ...]]:
+def sample_poses(xyz: FloatArray, rots: tuple[Matrix, Matrix], fractions: FloatArray) -> list[Pose6]:
     """X Y Z A B C of samples along one segment at the given 0..1 fractions."""
-    poses = []
+    poses: list[Pose6] = []
     for p, s in zip(xyz, fractions, strict=True):
         a, b, c = matrix_to_abc(slerp_matrix(rots[0], rots[1], float(s)))
         poses.append((float(p[0]), float(p[1]), float(p[2]), a, b, c))
@@ -100,7 +103,8 @@ class DryRun:
             steps = np.linalg.norm(np.diff(self.xyz, axis=1), axis=2)
             cum = np.concatenate([np.zeros((n, 1)), np.cumsum(steps, axis=1)], axis=1)
             total = cum[:, -1:]
-            self.along = np.where(total > 0, cum / np.where(total > 0, total, 1.0), np.linspace(0, 1, samples))
+            even = np.linspace(0.0, 1.0, samples)
+            self.along = np.where(total > 0, cum / np.where(total > 0, total, 1.0), even)
         else:
             self.along = np.zeros((0, samples))
 

@@ -117,7 +117,8 @@ def _joint(index: int, raw: object) -> JointSpec:
     values = {k: _number(f"{where} {k}", raw.get(k, 0.0)) for k in
               ("offset_deg", "d", "a", "alpha_deg", "min_deg", "max_deg")}
     if values["min_deg"] >= values["max_deg"]:
-        raise ProfileError(f"{where}: min_deg {values['min_deg']:g} is not below max_deg {values['max_deg']:g}")
+        raise ProfileError(f"{where}: min_deg {values['min_deg']:g} is not below "
+                           f"max_deg {values['max_deg']:g}")
     return JointSpec(name=name[:20], **values)
 
 
@@ -167,7 +168,8 @@ def parse_profile(text: str, label: str = "profile") -> RobotProfile:
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise ProfileError(f"{label}: not valid JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})") from exc
+        where = f"line {exc.lineno}, column {exc.colno}"
+        raise ProfileError(f"{label}: not valid JSON ({where}: {exc.msg})") from exc
     try:
         return profile_from_dict(data)
     except ProfileError as exc:

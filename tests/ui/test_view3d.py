@@ -66,7 +66,8 @@ def test_live_arm_follows_the_simulator(qtbot: Any, sim: Any, link: Any, window:
     panel.on_joints(joints)
     panel._update_arm()
     _draw(panel)
-    assert np.allclose(panel.canvas.drawn["flange"], panel.canvas.project(sim_kin.forward(joints)[:3, 3]), atol=1e-6)
+    expected = panel.canvas.project(sim_kin.forward(joints)[:3, 3])
+    assert np.allclose(panel.canvas.drawn["flange"], expected, atol=1e-6)
 
 
 def test_pose_without_joints_is_an_estimate(qtbot: Any, window: MainWindow) -> None:
@@ -79,7 +80,8 @@ def test_pose_without_joints_is_an_estimate(qtbot: Any, window: MainWindow) -> N
     _draw(panel)
     assert panel.tracker.estimated
     assert any("estimate" in text for text, _c in panel.canvas.badges)
-    assert np.allclose(panel.canvas.drawn["flange"], panel.canvas.project(sim_kin.forward(q)[:3, 3]), atol=0.5)
+    expected = panel.canvas.project(sim_kin.forward(q)[:3, 3])
+    assert np.allclose(panel.canvas.drawn["flange"], expected, atol=0.5)
 
 
 def test_selection_follows_the_table_and_the_view(qtbot: Any, window: MainWindow) -> None:
@@ -135,7 +137,8 @@ def test_dry_run_moves_the_arm_and_writes_nothing(qtbot: Any, sim: Any, link: An
     connect(qtbot, link, sim)
     panel = _panel(window, qtbot)
     window.planner_panel.select_plan(plan_row)
-    qtbot.waitUntil(lambda: panel.plan is window.planner_panel.current_plan() and panel.dry_bar.run is not None)
+    planner = window.planner_panel
+    qtbot.waitUntil(lambda: panel.plan is planner.current_plan() and panel.dry_bar.run is not None)
     bar = panel.dry_bar
     assert bar.run is not None and bar.run.duration > 0
     before = _sim_writes(sim)

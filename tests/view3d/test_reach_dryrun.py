@@ -52,7 +52,8 @@ def test_check_plan_reports_an_unreachable_point_only_when_asked(checker: ReachC
 
 def test_path_between_reachable_points_can_leave_the_reach(checker: ReachChecker) -> None:
     # two points on either side of the base, close to it: the straight line passes the J1 axis
-    ledger = PointLedger([make_point(1, "L", (-150, -300, 900, *DOWN)), make_point(2, "R", (-150, 300, 900, *DOWN))])
+    ledger = PointLedger([make_point(1, "L", (-150, -300, 900, *DOWN)),
+                          make_point(2, "R", (-150, 300, 900, *DOWN))])
     plan = Plan("through", [Segment.line(2)])
     start = Pose(-150, -300, 900, *DOWN)
     path = checker.path(plan, ledger, start)

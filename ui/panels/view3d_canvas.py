@@ -100,8 +100,8 @@ class View3DCanvas(QWidget):
     """Draws the scene; the panel feeds it. Signals: ``pointClicked(int)`` (a point id, -1 for
     a click on nothing), ``cameraChanged()``."""
 
-    pointClicked = Signal(int)  # noqa: N815
-    cameraChanged = Signal()  # noqa: N815
+    pointClicked = Signal(int)
+    cameraChanged = Signal()
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -207,7 +207,8 @@ class View3DCanvas(QWidget):
         self.set_camera(self.camera.fitted(self.scene_bounds(), aspect))
 
     def project(self, xyz: FloatArray) -> FloatArray:
-        return self.camera.project(np.asarray(xyz, dtype=np.float64).reshape(-1, 3), self.width(), self.height())[0]
+        pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+        return self.camera.project(pts, self.width(), self.height())[0]
 
     # --- painting --------------------------------------------------------------------------
     def paintEvent(self, event: QPaintEvent) -> None:

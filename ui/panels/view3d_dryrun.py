@@ -27,7 +27,7 @@ class DryRunBar(QWidget):
     """Play / pause, speed, scrubber and time. Signal ``stateChanged(object)`` with a
     :class:`DryRunState`, or None when the dry run is left (the live arm shows again)."""
 
-    stateChanged = Signal(object)  # noqa: N815
+    stateChanged = Signal(object)
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)

@@ -31,7 +31,8 @@ class View3DHost(QObject):
         self.tabs.addTab(self.panel, "")
         self.dock = QDockWidget(window)
         self.dock.setObjectName("View3DDock")
-        self.dock.setAllowedAreas(Qt.DockWidgetArea.RightDockWidgetArea | Qt.DockWidgetArea.LeftDockWidgetArea)
+        area = Qt.DockWidgetArea
+        self.dock.setAllowedAreas(area.RightDockWidgetArea | area.LeftDockWidgetArea)
         window.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
         self.dock.hide()
         self.dock.visibilityChanged.connect(self._on_dock_visible)

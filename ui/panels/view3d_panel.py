@@ -57,7 +57,7 @@ class View3DPanel(QWidget):
     """See the module docstring. Signal ``besideToggled(bool)``: the user wants the view beside
     the planner (True) or in its own tab (False)."""
 
-    besideToggled = Signal(bool)  # noqa: N815
+    besideToggled = Signal(bool)
 
     def __init__(self, points: PointsModel, parent: QWidget | None = None, *,
                  profile: RobotProfile | None = None) -> None:
@@ -174,7 +174,7 @@ class View3DPanel(QWidget):
         self.ortho_button.setText(self.tr("Orthographic"))
         self.ortho_button.setToolTip(self.tr("Parallel projection (no perspective)"))
         self.beside_button.setText(self.tr("Beside the planner"))
-        self.beside_button.setToolTip(self.tr("Show the 3D view next to the planner instead of in its own tab"))
+        self.beside_button.setToolTip(self.tr("Show the 3D view next to the planner, not in its own tab"))
         self.canvas.setToolTip(self.tr("Drag: rotate · Shift or right drag: pan · Wheel: zoom · "
                                        "Click a point: select it"))
         self._show_reach()
