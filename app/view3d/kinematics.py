@@ -169,6 +169,94 @@ class ArmModel:
         return self.inverse(pose_to_transform(x, y, z, a, b, c), seed_deg, **kwargs)  # type: ignore[arg-type]
 
 
+    # --- batched (one numpy pass for many targets: reachability of thousands of points) -----
+    def _frames_batch(self, q_deg: FloatArray) -> list[FloatArray]:
+        """(n, 4, 4) world transforms: base, after each joint, flange (n + 2 entries)."""
+        n = q_deg.shape[0]
+        t = np.broadcast_to(self._base, (n, 4, 4)).copy()
+        out = [t]
+        for i, (off, d, a, alpha) in enumerate(self._rows):
+            theta = np.radians(q_deg[:, i]) + off
+            ct, st = np.cos(theta), np.sin(theta)
+            ca, sa = math.cos(alpha), math.sin(alpha)
+            dh = np.zeros((n, 4, 4))
+            dh[:, 0, 0], dh[:, 0, 1], dh[:, 0, 2], dh[:, 0, 3] = ct, -st * ca, st * sa, a * ct
+            dh[:, 1, 0], dh[:, 1, 1], dh[:, 1, 2], dh[:, 1, 3] = st, ct * ca, -ct * sa, a * st
+            dh[:, 2, 1], dh[:, 2, 2], dh[:, 2, 3], dh[:, 3, 3] = sa, ca, d, 1.0
+            t = t @ dh
+            out.append(t)
+        out.append(t @ self._flange)
+        return out
+
+    def pointing_seeds(self, targets: FloatArray) -> FloatArray:
+        """Home joints with joint 1 turned towards each target (a good first guess)."""
+        seeds = np.tile(self.home, (targets.shape[0], 1))
+        local = (targets[:, :3, 3] - self._base[:3, 3]) @ self._base[:3, :3]
+        seeds[:, 0] = np.degrees(np.arctan2(local[:, 1], local[:, 0]))
+        return seeds
+
+    def inverse_batch(self, targets: FloatArray, seeds: FloatArray | None = None, *,
+                      max_iter: int = IK_MAX_ITER) -> tuple[FloatArray, list[Reach]]:
+        """IK of (n, 4, 4) targets at once: joints (n, dof), NaN rows where unreachable."""
+        n = targets.shape[0]
+        first = self.pointing_seeds(targets) if seeds is None else np.asarray(seeds, dtype=np.float64)
+        q = np.radians(first)
+        p_t, r_t = targets[:, :3, 3], targets[:, :3, :3]
+        far = np.linalg.norm(p_t - self._base[:3, 3], axis=1) > self.profile.reach + IK_POS_TOL_MM
+        done = np.zeros(n, dtype=bool)
+        eye = np.eye(6) * 0.25
+        for _ in range(max_iter + 1):
+            idx = np.flatnonzero(~far & ~done)
+            if not len(idx):
+                break
+            frames = self._frames_batch(np.degrees(q[idx]))
+            te = frames[-1]
+            dp = p_t[idx] - te[:, :3, 3]
+            dw = _rotation_error_batch(te[:, :3, :3], r_t[idx])
+            conv = (np.linalg.norm(dp, axis=1) < IK_POS_TOL_MM) & (np.linalg.norm(dw, axis=1) < IK_ROT_TOL_RAD)
+            done[idx[conv]] = True
+            keep = ~conv
+            if not keep.any():
+                break
+            pe = te[keep, :3, 3]
+            jac = np.empty((int(keep.sum()), 6, self.dof))
+            for i in range(self.dof):
+                z = frames[i][keep, :3, 2]
+                jac[:, :3, i] = np.cross(z, pe - frames[i][keep, :3, 3])
+                jac[:, 3:, i] = z * ROT_WEIGHT_MM
+            err = np.concatenate([dp[keep], dw[keep] * ROT_WEIGHT_MM], axis=1)
+            x = np.linalg.solve(jac @ jac.transpose(0, 2, 1) + eye, err[:, :, None])
+            dq = (jac.transpose(0, 2, 1) @ x)[:, :, 0]
+            step = np.max(np.abs(dq), axis=1)
+            dq *= np.minimum(1.0, MAX_STEP_RAD / np.maximum(step, 1e-12))[:, None]
+            q[idx[keep]] += dq
+        joints = np.full((n, self.dof), np.nan)
+        reach: list[Reach] = []
+        for k in range(n):
+            if not done[k]:
+                reach.append(Reach.UNREACHABLE)
+                continue
+            solution = self._wrap_into_limits(np.degrees(q[k]))
+            joints[k] = solution
+            reach.append(Reach.OK if self.within_limits(solution) else Reach.JOINT_LIMIT)
+        return joints, reach
+
+
+def _rotation_error_batch(r_current: FloatArray, r_target: FloatArray) -> FloatArray:
+    """(n, 3) rotation vectors taking each r_current to r_target."""
+    rel = r_target @ r_current.transpose(0, 2, 1)
+    cos = np.clip((np.trace(rel, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(cos)
+    vee = np.stack([rel[:, 2, 1] - rel[:, 1, 2], rel[:, 0, 2] - rel[:, 2, 0], rel[:, 1, 0] - rel[:, 0, 1]],
+                   axis=1)
+    sin = np.sin(angle)
+    factor = np.where(angle < 1e-9, 0.5, angle / (2.0 * np.where(sin > 1e-12, sin, 1.0)))
+    out = vee * factor[:, None]
+    for k in np.flatnonzero(math.pi - angle < 1e-6):  # half turns: the axis from the symmetric part
+        out[k] = _rotation_error(r_current[k], r_target[k])
+    return np.asarray(out, dtype=np.float64)
+
+
 def _rotation_error(r_current: Matrix, r_target: Matrix) -> FloatArray:
     """Rotation vector (rad, world frame) taking r_current to r_target."""
     rel = r_target @ r_current.T

@@ -3,8 +3,9 @@ cannot reach, or only past a joint limit.
 
 Results are cached per pose (points are re-checked only when they change). A path is checked
 at up to :data:`PATH_SAMPLES` samples per segment, fewer for long plans so that a plan costs
-at most about :data:`MAX_PATH_SAMPLES` IK solutions; each sample is seeded from the previous
-one's solution (a continuous path converges in a few iterations).
+at most about :data:`MAX_PATH_SAMPLES` IK solutions. New poses are solved together in one
+numpy batch (:meth:`ArmModel.inverse_batch`, seeded with joint 1 turned towards the target,
+then once more from the home joints).
 
 :meth:`ReachChecker.plan_issues` has the signature :func:`app.plan.checks.check_plan` takes as
 ``reach=``: the issues are warnings (:data:`IssueCode.UNREACHABLE`, :data:`IssueCode.JOINT_LIMIT`)
@@ -20,6 +21,7 @@ from typing import Final
 import numpy as np
 from numpy.typing import NDArray
 
+from app.geometry import pose_to_transform
 from app.models import Pose
 from app.plan.checks import IssueCode, IssueKind, PlanIssue
 from app.plan.geometry import PointLike, plan_path
@@ -53,30 +55,37 @@ class PathReach:
 
 
 class ReachChecker:
-    """Reachability of points and paths for one :class:`ArmModel` (cached)."""
+    """Reachability of points and paths for one :class:`ArmModel` (cached, batched IK)."""
 
     def __init__(self, model: ArmModel) -> None:
         self.model = model
         self._cache: dict[Pose6, Reach] = {}
 
-    def pose(self, pose: Sequence[float], seed: FloatArray | None = None) -> tuple[Reach, FloatArray | None]:
-        key: Pose6 = tuple(round(float(v), 4) for v in pose[:6])  # type: ignore[assignment]
-        cached = self._cache.get(key)
-        if cached is not None and seed is None:
-            return cached, None
-        result = self.model.inverse_pose(key, seed)
-        if result.reach is Reach.UNREACHABLE and seed is not None:
-            result = self.model.inverse_pose(key, None)
-        if len(self._cache) >= CACHE_SIZE:
-            self._cache.clear()
-        self._cache[key] = result.reach
-        return result.reach, result.joints
+    def poses(self, poses: Sequence[Sequence[float]]) -> list[Reach]:
+        """Reach of X Y Z A B C poses; the ones not seen before are solved in one batch."""
+        keys: list[Pose6] = [tuple(round(float(v), 4) for v in p[:6]) for p in poses]  # type: ignore[misc]
+        todo = list(dict.fromkeys(k for k in keys if k not in self._cache))
+        if todo:
+            targets = np.array([pose_to_transform(*k) for k in todo])
+            _joints, reach = self.model.inverse_batch(targets)
+            retry = [i for i, r in enumerate(reach) if r is not Reach.OK]
+            if retry:  # a second guess: the plain home joints
+                seeds = np.tile(self.model.home, (len(retry), 1))
+                _j2, again = self.model.inverse_batch(targets[retry], seeds)
+                for i, r in zip(retry, again, strict=True):
+                    if r is Reach.OK or (r is Reach.JOINT_LIMIT and reach[i] is Reach.UNREACHABLE):
+                        reach[i] = r
+            if len(self._cache) + len(todo) > CACHE_SIZE:
+                self._cache.clear()
+            self._cache.update(zip(todo, reach, strict=True))
+        return [self._cache.get(k, Reach.OK) for k in keys]
 
     def point(self, point: TempPoint) -> Reach:
-        return self.pose(point.xyzabc)[0]
+        return self.poses([point.xyzabc])[0]
 
     def points(self, points: Sequence[TempPoint]) -> dict[int, Reach]:
-        return {p.id: self.point(p) for p in points}
+        reach = self.poses([p.xyzabc for p in points])
+        return {p.id: r for p, r in zip(points, reach, strict=True)}
 
     def path(self, plan: Plan, ledger: PointLedger, pose: Pose | None) -> PathReach:
         n = len(plan)
@@ -86,22 +95,22 @@ class ReachChecker:
         rots = segment_rotations(plan, ledger, start_rot)
         xyz = path.xyz.reshape(n, k, 3)
         fractions = np.linspace(0.0, 1.0, k)
+        known = [i for i in range(n) if np.isfinite(xyz[i]).all()]
+        samples: list[Pose6] = []
+        for i in known:
+            samples.extend(sample_poses(xyz[i], rots[i], fractions))
+        solved = iter(self.poses(samples))
         reach: list[Reach] = []
         first_bad: list[Reach | None] = []
-        seed: FloatArray | None = None
+        known_set = set(known)
         for i in range(n):
-            bad: Reach | None = None
-            if not np.isfinite(xyz[i]).all():
+            if i not in known_set:
                 reach.extend([Reach.OK] * k)  # unknown: the other checks report it
                 first_bad.append(None)
                 continue
-            for p in sample_poses(xyz[i], rots[i], fractions):
-                r, joints = self.pose(p, seed)
-                seed = joints if joints is not None else seed
-                reach.append(r)
-                if r is not Reach.OK and bad is None:
-                    bad = r
-            first_bad.append(bad)
+            rows = [next(solved) for _ in range(k)]
+            reach.extend(rows)
+            first_bad.append(next((r for r in rows if r is not Reach.OK), None))
         return PathReach(path.xyz, tuple(reach), path.segment, tuple(first_bad))
 
     def plan_issues(self, plan: Plan, ledger: PointLedger, current_pose: PointLike | None) -> list[PlanIssue]:
