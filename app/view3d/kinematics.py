@@ -213,7 +213,8 @@ class ArmModel:
             te = frames[-1]
             dp = p_t[idx] - te[:, :3, 3]
             dw = _rotation_error_batch(te[:, :3, :3], r_t[idx])
-            conv = (np.linalg.norm(dp, axis=1) < IK_POS_TOL_MM) & (np.linalg.norm(dw, axis=1) < IK_ROT_TOL_RAD)
+            conv = ((np.linalg.norm(dp, axis=1) < IK_POS_TOL_MM)
+                    & (np.linalg.norm(dw, axis=1) < IK_ROT_TOL_RAD))
             done[idx[conv]] = True
             keep = ~conv
             if not keep.any():

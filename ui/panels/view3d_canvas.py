@@ -45,14 +45,16 @@ ROTATE_DEG_PER_PX: Final = 0.4
 ZOOM_PER_WHEEL_STEP: Final = 1.15  # one wheel notch (120)
 CLICK_SLOP_PX: Final = 4
 LOD_MAX_POINTS: Final = 2500  # markers drawn while dragging (thinned above this)
-LOD_MAX_PATH_ROWS: Final = 8000  # path samples drawn while dragging
+LOD_MAX_PATH_ROWS: Final = 6000  # path samples drawn while dragging
+LOD_MAX_ARROWS: Final = 200  # direction arrows drawn while dragging (none for longer plans)
+AA_MAX_PATH_ROWS: Final = 10_000  # longer paths are drawn without antialiasing
 MAX_LABELS: Final = 40  # point names drawn when few points are visible
 LABEL_MIN_PX_PER_MM: Final = 0.6  # or when zoomed in this far
 GRID_EXTENT_MM: Final = 1500.0
 GRID_STEP_MM: Final = 100.0
 AXIS_MM: Final = 150.0  # base frame axes
 TRIAD_MM: Final = 90.0  # TCP triad
-MARKER_PX: Final = 7.0
+MARKER_PX: Final = 7
 ARROW_PX: Final = 9.0
 COLOR_BACKGROUND: Final = "#f7f9fa"
 AXIS_COLORS: Final = (COLOR_CURVE_RED, COLOR_CURVE_GREEN, COLOR_CURVE_BLUE)  # X Y Z
@@ -60,10 +62,29 @@ COLOR_ARM: Final = "#546e7a"
 COLOR_GHOST_ARM: Final = "#8e24aa"  # the dry run's arm
 
 
-def _pen(color: str, width: float, style: Qt.PenStyle = Qt.PenStyle.SolidLine) -> QPen:
-    pen = QPen(QColor(color), width, style)
-    pen.setCapStyle(Qt.PenCapStyle.RoundCap)
+def _pen(color: str, width: float, *, round_cap: bool = False) -> QPen:
+    """Flat caps unless asked: round caps on thousands of antialiased lines cost seconds."""
+    pen = QPen(QColor(color), width)
+    pen.setCapStyle(Qt.PenCapStyle.RoundCap if round_cap else Qt.PenCapStyle.FlatCap)
     return pen
+
+
+def _sprite(color: str, size: int, ring: bool = False) -> QPixmap:
+    """A round marker, drawn once and stamped many times (drawPixmapFragments)."""
+    pix = QPixmap(size + 2, size + 2)
+    pix.fill(Qt.GlobalColor.transparent)
+    p = QPainter(pix)
+    p.setRenderHint(QPainter.RenderHint.Antialiasing)
+    if ring:
+        p.setPen(_pen(color, 2.0))
+        p.setBrush(Qt.BrushStyle.NoBrush)
+        p.drawEllipse(QRectF(2, 2, size - 2, size - 2))
+    else:
+        p.setPen(_pen(COLOR_WHITE, 1.0))
+        p.setBrush(QColor(color))
+        p.drawEllipse(QRectF(1, 1, size, size))
+    p.end()
+    return pix
 
 
 class _Buffers:
@@ -72,6 +93,29 @@ class _Buffers:
     def __init__(self) -> None:
         self.points = PrimitiveArray(QPointF, 2)
         self.lines = PrimitiveArray(QLineF, 4)
+        self.fragments = PrimitiveArray(QPainter.PixmapFragment, 10)
+        self.sprites: dict[tuple[str, int, bool], QPixmap] = {}
+
+    def draw_sprites(self, painter: QPainter, xy: FloatArray, color: str, size: int,
+                     ring: bool = False) -> None:
+        """One marker per row of ``xy`` (non-finite rows skipped), in one call."""
+        xy = xy[np.isfinite(xy).all(axis=1)]
+        if not len(xy):
+            return
+        key = (color, size, ring)
+        sprite = self.sprites.get(key)
+        if sprite is None:
+            sprite = self.sprites[key] = _sprite(color, size, ring)
+        self.fragments.resize(len(xy))
+        frag = self.fragments.ndarray()
+        frag[:, 0:2] = xy
+        frag[:, 2:4] = 0.0
+        frag[:, 4] = sprite.width()
+        frag[:, 5] = sprite.height()
+        frag[:, 6:8] = 1.0
+        frag[:, 8] = 0.0
+        frag[:, 9] = 1.0
+        painter.drawPixmapFragments(*self.fragments.drawargs(), sprite)
 
     def draw_points(self, painter: QPainter, xy: FloatArray) -> None:
         xy = xy[np.isfinite(xy).all(axis=1)]
@@ -124,6 +168,8 @@ class View3DCanvas(QWidget):
         self.point_ids = np.zeros(0, dtype=np.intp)
         self.point_names: list[str] = []
         self.point_colors: list[str] = []  # one colour per point
+        self._color_codes = np.zeros(0, dtype=np.intp)  # index into _color_names per point
+        self._color_names: list[str] = []
         self.point_bad = np.zeros(0, dtype=bool)
         self.selected_ids: set[int] = set()
         self.path_xyz = np.zeros((0, 3))
@@ -157,6 +203,9 @@ class View3DCanvas(QWidget):
         self.point_ids = np.asarray(ids, dtype=np.intp)
         self.point_names = list(names)
         self.point_colors = list(colors)
+        self._color_names = list(dict.fromkeys(self.point_colors))
+        lookup = {c: i for i, c in enumerate(self._color_names)}
+        self._color_codes = np.array([lookup[c] for c in self.point_colors], dtype=np.intp)
         self.point_bad = np.asarray(bad, dtype=bool)
         self.invalidate()
 
@@ -236,8 +285,8 @@ class View3DCanvas(QWidget):
         self._draw_dynamic(painter)
 
     def _draw_static(self, painter: QPainter, *, lod: bool) -> None:
-        painter.setRenderHint(QPainter.RenderHint.Antialiasing, not lod)
         cam, w, h = self.camera, self.width(), self.height()
+        painter.setRenderHint(QPainter.RenderHint.Antialiasing, False)
         # floor grid and its scale
         g = cam.project(self._grid.reshape(-1, 3), w, h)[0].reshape(-1, 4)
         painter.setPen(_pen(COLOR_GRID, 1))
@@ -254,19 +303,21 @@ class View3DCanvas(QWidget):
             path = self.path_xyz
             step = max(1, len(path) // LOD_MAX_PATH_ROWS) if lod else 1
             sxy = cam.project(path[::step], w, h)[0]
-            painter.setPen(_pen(COLOR_PATH, 2))
+            # antialiased when drawn in full and not huge (tens of thousands of AA lines are slow)
+            painter.setRenderHint(QPainter.RenderHint.Antialiasing, not lod and len(path) <= AA_MAX_PATH_ROWS)
+            painter.setPen(_pen(COLOR_PATH, 1 if lod else 2))
             self._buf.draw_lines(painter, _polyline_pairs(sxy))
             self._draw_arrows(painter, lod)
             full = cam.project(path, w, h)[0] if step > 1 else sxy
             self.drawn["path"] = full
             if self.path_bad.any():
-                painter.setPen(_pen(COLOR_ERROR, 6))
-                self._buf.draw_points(painter, full[self.path_bad])
+                self._buf.draw_sprites(painter, full[self.path_bad], COLOR_ERROR, 6)
             self.drawn["path_bad"] = full[self.path_bad]
             mids = cam.project(self.path_mids, w, h)[0]
             painter.setPen(_pen(COLOR_PATH, 1))
             painter.setBrush(QColor(COLOR_WHITE))
-            for x, y in mids[np.isfinite(mids).all(axis=1)][:500]:
+            shown = mids[np.isfinite(mids).all(axis=1)][: LOD_MAX_ARROWS if lod else 1000]
+            for x, y in shown:
                 painter.drawRect(QRectF(x - 4, y - 4, 8, 8))
             self.drawn["mids"] = mids
             if self.path_start is not None and np.isfinite(self.path_start).all():
@@ -284,14 +335,11 @@ class View3DCanvas(QWidget):
             keep = np.arange(len(pts))
             if lod and len(pts) > LOD_MAX_POINTS:
                 keep = keep[:: len(pts) // LOD_MAX_POINTS + 1]
-            colors = np.asarray(self.point_colors, dtype=object)
-            for color in dict.fromkeys(self.point_colors):
-                rows = keep[colors[keep] == color]
-                painter.setPen(_pen(color, MARKER_PX))
-                self._buf.draw_points(painter, pts[rows])
+            codes = self._color_codes[keep]
+            for code, color in enumerate(self._color_names):
+                self._buf.draw_sprites(painter, pts[keep[codes == code]], color, MARKER_PX)
             if self.point_bad.any():
-                painter.setPen(_pen(COLOR_ERROR, MARKER_PX + 3))
-                self._buf.draw_points(painter, pts[self.point_bad])
+                self._buf.draw_sprites(painter, pts[self.point_bad], COLOR_ERROR, MARKER_PX + 3)
             self.drawn["bad_points"] = pts[self.point_bad]
             if not lod:
                 self._draw_labels(painter, pts)
@@ -301,7 +349,7 @@ class View3DCanvas(QWidget):
     def _draw_arrows(self, painter: QPainter, lod: bool) -> None:
         """One arrowhead per segment at its middle sample, pointing along the path."""
         seg = self.path_segment
-        if not len(seg) or (lod and seg[-1] > LOD_MAX_PATH_ROWS // 8):
+        if not len(seg) or (lod and seg[-1] >= LOD_MAX_ARROWS):
             return
         k = int(np.count_nonzero(seg == seg[0]))
         rows = np.arange(k // 2, len(seg) - 1, k)
@@ -336,7 +384,7 @@ class View3DCanvas(QWidget):
         # the segment being run
         if self.active_segment is not None and len(self.path_xyz):
             rows = self.path_segment == self.active_segment
-            painter.setPen(_pen(COLOR_HIGHLIGHT, 5))
+            painter.setPen(_pen(COLOR_HIGHLIGHT, 5, round_cap=True))
             self._buf.draw_lines(painter, _polyline_pairs(cam.project(self.path_xyz[rows], w, h)[0]))
         # selected points
         sel = np.isin(self.point_ids, list(self.selected_ids)) if self.selected_ids else np.zeros(0, bool)
@@ -362,9 +410,9 @@ class View3DCanvas(QWidget):
             self.drawn.pop(key, None)
             return
         xy = cam.project(links, w, h)[0]
-        painter.setPen(_pen(color, 7))
+        painter.setPen(_pen(color, 7, round_cap=True))
         self._buf.draw_lines(painter, _polyline_pairs(xy))
-        painter.setPen(_pen(COLOR_INK, 10))
+        painter.setPen(_pen(COLOR_INK, 10, round_cap=True))
         self._buf.draw_points(painter, xy[:-1])
         # TCP triad at the flange
         origin = flange[:3, 3]
@@ -373,7 +421,7 @@ class View3DCanvas(QWidget):
         for i, axis_color in enumerate(AXIS_COLORS):
             painter.setPen(_pen(axis_color, 2.5))
             self._buf.draw_lines(painter, np.concatenate([tri[0], tri[i + 1]])[None, :])
-        painter.setPen(_pen(COLOR_HIGHLIGHT, 9))
+        painter.setPen(_pen(COLOR_HIGHLIGHT, 9, round_cap=True))
         self._buf.draw_points(painter, tri[:1])
         self.drawn[key] = tri[:1]
 

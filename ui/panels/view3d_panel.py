@@ -22,6 +22,7 @@ from typing import Any, Final
 
 import numpy as np
 from PySide6.QtCore import QEvent, QItemSelection, QTimer, Signal, Slot
+from PySide6.QtGui import QShowEvent
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
 
 from app.link.state import RobotState
@@ -43,7 +44,7 @@ LIVE_FPS: Final = 30
 TRACE_LENGTH: Final = 2000  # live TCP positions kept for the trace
 PATH_SAMPLES: Final = 24  # per segment for the ghost path
 MAX_PATH_ROWS: Final = 40_000  # fewer samples per segment for long plans
-REACH_MAX_POINTS: Final = 2000  # points checked for reach (more: only those the plan uses)
+REACH_MAX_POINTS: Final = 10_000  # points checked for reach (more: only those the plan uses)
 
 SYNC_COLORS: Final[dict[SyncState, str]] = {
     SyncState.ON_CONTROLLER: COLOR_OK,
@@ -240,9 +241,15 @@ class View3DPanel(QWidget):
         if not self._live_timer.isActive():
             self._live_timer.start()
 
+    def showEvent(self, event: QShowEvent) -> None:
+        super().showEvent(event)
+        self._update_arm()
+
     @Slot()
     def _update_arm(self) -> None:
-        """Draw the arm from the latest joints (or the pose through IK)."""
+        """Draw the arm from the latest joints (or the pose through IK); nothing while hidden."""
+        if not self.isVisible():
+            return
         if self._running and self._trace_n > 1:
             self.canvas.set_trace(self._trace[: self._trace_n].copy())
         if self._joints is not None:
