@@ -316,7 +316,8 @@ class View3DCanvas(QWidget):
             mids = cam.project(self.path_mids, w, h)[0]
             painter.setPen(_pen(COLOR_PATH, 1))
             painter.setBrush(QColor(COLOR_WHITE))
-            shown = mids[np.isfinite(mids).all(axis=1)][: LOD_MAX_ARROWS if lod else 1000]
+            shown = mids[np.isfinite(mids).all(axis=1)]
+            shown = shown[:0] if lod and len(shown) > LOD_MAX_ARROWS else shown[:1000]
             for x, y in shown:
                 painter.drawRect(QRectF(x - 4, y - 4, 8, 8))
             self.drawn["mids"] = mids
