@@ -23,6 +23,7 @@ sys.path.insert(0, str(REPO))
 from app import timing  # noqa: E402
 from app.link.client import ConnectionSettings  # noqa: E402
 from app.link.robot_link import RobotLink  # noqa: E402
+from app.plan.segments import Segment  # noqa: E402
 from app.sim import SimConfig, SimController  # noqa: E402
 from app.view3d.camera import Preset  # noqa: E402
 from ui.i18n import Translator  # noqa: E402
@@ -72,8 +73,12 @@ def main() -> None:
         panel.dry_bar.leave()
     # an unreachable point, used by the circle plan
     model = window.project.points_model
-    model.add_point(name="far", pose=(1300.0, 300.0, 350.0, 180.0, 0.0, 180.0))
+    model.add_point(name="far", pose=(1150.0, 250.0, 350.0, 180.0, 0.0, 180.0))
     window.planner_panel.select_plan(1)
+    far = max(p.id for p in model.ledger)
+    plan = window.planner_panel.current_plan()
+    plan.segments.insert(2, Segment.line(far, speed=100.0))  # a detour out of reach, for the picture
+    panel.refresh_scene()
     _spin(0.5)
     for lang in ("en", "zh_CN"):
         window.set_language(lang)
