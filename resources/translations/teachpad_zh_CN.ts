@@ -2874,7 +2874,7 @@ Remove them all?</source>
     <context>
         <name>View3DCanvas</name>
         <message>
-            <location filename="../../ui/panels/view3d_canvas.py" line="245" />
+            <location filename="../../ui/panels/view3d_canvas.py" line="294" />
             <source>grid %1 mm</source>
             <translation>网格 %1 mm</translation>
         </message>
@@ -2895,104 +2895,129 @@ Remove them all?</source>
     <context>
         <name>View3DPanel</name>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="167" />
+            <location filename="../../ui/panels/view3d_panel.py" line="184" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="167" />
+            <location filename="../../ui/panels/view3d_panel.py" line="184" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="167" />
+            <location filename="../../ui/panels/view3d_panel.py" line="184" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="168" />
+            <location filename="../../ui/panels/view3d_panel.py" line="185" />
             <source>Iso</source>
             <translation>轴测</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="171" />
+            <location filename="../../ui/panels/view3d_panel.py" line="188" />
             <source>Look at the scene from a preset direction</source>
             <translation>从预设方向观察场景</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="172" />
+            <location filename="../../ui/panels/view3d_panel.py" line="189" />
             <source>Fit all</source>
             <translation>全部显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="173" />
+            <location filename="../../ui/panels/view3d_panel.py" line="190" />
             <source>Show the arm, the points and the plan</source>
             <translation>显示机械臂、点位和轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="174" />
+            <location filename="../../ui/panels/view3d_panel.py" line="191" />
             <source>Orthographic</source>
             <translation>正交投影</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="175" />
+            <location filename="../../ui/panels/view3d_panel.py" line="192" />
             <source>Parallel projection (no perspective)</source>
             <translation>平行投影（无透视）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="176" />
+            <location filename="../../ui/panels/view3d_panel.py" line="193" />
+            <source>Robot model…</source>
+            <translation>机器人模型…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="194" />
+            <source>Robot model: %1. Load another robot model profile (JSON)</source>
+            <translation>机器人模型：%1。加载其他机器人模型配置文件（JSON）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="196" />
             <source>Beside the planner</source>
             <translation>在规划器旁显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="177" />
+            <location filename="../../ui/panels/view3d_panel.py" line="197" />
             <source>Show the 3D view next to the planner, not in its own tab</source>
             <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="178" />
+            <location filename="../../ui/panels/view3d_panel.py" line="198" />
             <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
             <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="260" />
+            <location filename="../../ui/panels/view3d_panel.py" line="224" />
+            <source>Robot model not loaded: %1</source>
+            <translation>未加载机器人模型：%1</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="233" />
+            <source>Load a robot model profile</source>
+            <translation>加载机器人模型配置文件</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="234" />
+            <source>Robot model profiles (*.json)</source>
+            <translation>机器人模型配置文件 (*.json)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="326" />
             <source>dry run: nothing is sent</source>
             <translation>空运行：不发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="262" />
+            <location filename="../../ui/panels/view3d_panel.py" line="328" />
             <source>no pose: home position shown</source>
             <translation>无位姿：显示原点姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="264" />
+            <location filename="../../ui/panels/view3d_panel.py" line="330" />
             <source>estimate (from the pose, no joint angles)</source>
             <translation>估算（由位姿求得，无关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="266" />
+            <location filename="../../ui/panels/view3d_panel.py" line="332" />
             <source>pose out of the model's reach</source>
             <translation>位姿超出模型可达范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="268" />
+            <location filename="../../ui/panels/view3d_panel.py" line="334" />
             <source>past a joint limit</source>
             <translation>超出关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="270" />
+            <location filename="../../ui/panels/view3d_panel.py" line="336" />
             <source>stale</source>
             <translation>数据过期</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="348" />
+            <location filename="../../ui/panels/view3d_panel.py" line="417" />
             <source>Out of the robot model's reach: %n point(s) (%1)</source>
             <translation>
                 <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="353" />
+            <location filename="../../ui/panels/view3d_panel.py" line="422" />
             <source>the path leaves the reach in %n segment(s) (%1)</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>

@@ -174,3 +174,28 @@ def test_beside_the_planner_and_back(qtbot: Any, window: MainWindow) -> None:
     assert window.work_tabs.indexOf(panel) >= 0
 
 
+
+
+def test_another_robot_model_and_a_bad_profile_file(qtbot: Any, window: MainWindow, tmp_path: Path) -> None:
+    import json
+
+    from app.view3d.profile import default_profile, profile_to_dict
+
+    panel = _panel(window, qtbot)
+    bad = tmp_path / "bad.json"
+    bad.write_text('{"format": "teachpad-robot-profile", "version": 2}', encoding="utf-8")
+    assert not panel.load_profile_file(str(bad))
+    assert "version 2 is not supported" in panel.message_label.text()
+    assert panel.model.profile == default_profile()
+    data = profile_to_dict(default_profile())
+    data["name"] = "longer forearm"
+    data["joints"][3]["d"] = 620.0
+    good = tmp_path / "long.json"
+    good.write_text(json.dumps(data), encoding="utf-8")
+    assert panel.load_profile_file(str(good))
+    assert panel.message_label.isHidden()
+    q = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    panel.on_joints(tuple(q))
+    panel._update_arm()
+    _draw(panel)
+    assert np.allclose(panel.canvas.drawn["flange"], panel.canvas.project(np.array([725.0, 0.0, 890.0])))

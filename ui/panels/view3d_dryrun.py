@@ -12,7 +12,7 @@ import time
 from typing import Final
 
 from PySide6.QtCore import QEvent, Qt, QTimer, Signal, Slot
-from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QPushButton, QSlider, QWidget
+from PySide6.QtWidgets import QComboBox, QHBoxLayout, QLabel, QSlider, QToolButton, QWidget
 
 from app.plan.presenter import format_duration
 from app.view3d.path import DryRun, DryRunState
@@ -35,10 +35,10 @@ class DryRunBar(QWidget):
         self.run: DryRun | None = None
         self.time = 0.0
         self._wall: float | None = None
-        self.play_button = QPushButton(self)
+        self.play_button = QToolButton(self)
         self.play_button.setCheckable(True)
         self.play_button.toggled.connect(self._on_play)
-        self.stop_button = QPushButton(self)
+        self.stop_button = QToolButton(self)
         self.stop_button.clicked.connect(self.leave)
         self.speed_box = QComboBox(self)
         for speed in SPEEDS:

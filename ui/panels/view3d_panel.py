@@ -22,8 +22,15 @@ from typing import Any, Final
 
 import numpy as np
 from PySide6.QtCore import QEvent, QItemSelection, QTimer, Signal, Slot
-from PySide6.QtGui import QShowEvent
-from PySide6.QtWidgets import QHBoxLayout, QLabel, QPushButton, QVBoxLayout, QWidget
+from PySide6.QtGui import QHideEvent, QShowEvent
+from PySide6.QtWidgets import (
+    QFileDialog,
+    QHBoxLayout,
+    QLabel,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
 
 from app.link.state import RobotState
 from app.models import Pose
@@ -33,7 +40,7 @@ from app.points.ledger import PointLedger, SyncState
 from app.view3d.camera import Preset
 from app.view3d.kinematics import ArmModel, ArmTracker, Reach
 from app.view3d.path import DryRun, DryRunState, start_of
-from app.view3d.profile import RobotProfile, default_profile
+from app.view3d.profile import ProfileError, RobotProfile, default_profile, load_profile
 from app.view3d.reach import PathReach, ReachChecker
 from ui.models.points_model import PointsModel
 from ui.palette import COLOR_CURVE_PURPLE, COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, COLOR_OK, COLOR_WARN
@@ -83,31 +90,39 @@ class View3DPanel(QWidget):
         self._dry: DryRunState | None = None
         self._fitted = False
         self._dry_joints: np.ndarray | None = None
+        self._scene_dirty = True
 
         self.canvas = View3DCanvas(self)
         self.canvas.pointClicked.connect(self._on_point_clicked)
         self.dry_bar = DryRunBar(self)
         self.dry_bar.stateChanged.connect(self._on_dry_state)
-        self.preset_buttons: dict[Preset, QPushButton] = {}
+        self.preset_buttons: dict[Preset, QToolButton] = {}
         bar = QHBoxLayout()
         bar.setContentsMargins(0, 0, 0, 0)
         for preset in Preset:
-            button = QPushButton(self)
+            button = QToolButton(self)
             button.clicked.connect(lambda _c=False, p=preset: self.set_preset(p))
             self.preset_buttons[preset] = button
             bar.addWidget(button)
-        self.fit_button = QPushButton(self)
+        self.fit_button = QToolButton(self)
         self.fit_button.clicked.connect(self.canvas.fit_all)
-        self.ortho_button = QPushButton(self)
+        self.ortho_button = QToolButton(self)
         self.ortho_button.setCheckable(True)
         self.ortho_button.toggled.connect(self._on_ortho)
-        self.beside_button = QPushButton(self)
+        self.beside_button = QToolButton(self)
         self.beside_button.setCheckable(True)
         self.beside_button.toggled.connect(self.besideToggled)
         for w in (self.fit_button, self.ortho_button):
             bar.addWidget(w)
         bar.addStretch(1)
+        self.profile_button = QToolButton(self)
+        self.profile_button.clicked.connect(self.choose_profile)
+        bar.addWidget(self.profile_button)
         bar.addWidget(self.beside_button)
+        self.message_label = QLabel(self)
+        self.message_label.setWordWrap(True)
+        self.message_label.setStyleSheet(f"color: {COLOR_ERROR};")
+        self.message_label.hide()
         self.reach_label = QLabel(self)
         self.reach_label.setWordWrap(True)
         self.reach_label.setStyleSheet(f"color: {COLOR_ERROR};")
@@ -115,6 +130,7 @@ class View3DPanel(QWidget):
         layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(bar)
         layout.addWidget(self.canvas, 1)
+        layout.addWidget(self.message_label)
         layout.addWidget(self.reach_label)
         layout.addWidget(self.dry_bar)
 
@@ -174,6 +190,9 @@ class View3DPanel(QWidget):
         self.fit_button.setToolTip(self.tr("Show the arm, the points and the plan"))
         self.ortho_button.setText(self.tr("Orthographic"))
         self.ortho_button.setToolTip(self.tr("Parallel projection (no perspective)"))
+        self.profile_button.setText(self.tr("Robot model…"))
+        self.profile_button.setToolTip(self.tr("Robot model: %1. Load another robot model profile (JSON)")
+                                       .replace("%1", self.model.profile.name))
         self.beside_button.setText(self.tr("Beside the planner"))
         self.beside_button.setToolTip(self.tr("Show the 3D view next to the planner, not in its own tab"))
         self.canvas.setToolTip(self.tr("Drag: rotate · Shift or right drag: pan · Wheel: zoom · "
@@ -187,6 +206,35 @@ class View3DPanel(QWidget):
         super().changeEvent(event)
 
     # --- camera --------------------------------------------------------------------------
+    def set_profile(self, profile: RobotProfile) -> None:
+        """Draw and check with another robot model."""
+        self.model = ArmModel(profile)
+        self.tracker = ArmTracker(self.model)
+        self.reach = ReachChecker(self.model)
+        self._dry_joints = None
+        self.retranslate()
+        self.refresh_scene()
+        self._update_arm()
+
+    def load_profile_file(self, path: str) -> bool:
+        """Load a profile file; a bad one is refused with the loader's message (kept model)."""
+        try:
+            profile = load_profile(path)
+        except ProfileError as exc:
+            self.message_label.setText(self.tr("Robot model not loaded: %1").replace("%1", str(exc)))
+            self.message_label.show()
+            return False
+        self.message_label.hide()
+        self.set_profile(profile)
+        return True
+
+    @Slot()
+    def choose_profile(self) -> None:
+        path, _filter = QFileDialog.getOpenFileName(self, self.tr("Load a robot model profile"), "",
+                                                    self.tr("Robot model profiles (*.json)"))
+        if path:
+            self.load_profile_file(path)
+
     def set_preset(self, preset: Preset) -> None:
         self.canvas.set_camera(self.canvas.camera.preset(preset))
         self.canvas.fit_all()
@@ -238,12 +286,23 @@ class View3DPanel(QWidget):
         self._trace_n += 1
 
     def _schedule_arm(self) -> None:
-        if not self._live_timer.isActive():
+        if self.isVisible() and not self._live_timer.isActive():
             self._live_timer.start()
 
     def showEvent(self, event: QShowEvent) -> None:
         super().showEvent(event)
+        if self._scene_dirty:
+            self.refresh_scene()
         self._update_arm()
+
+    def hideEvent(self, event: QHideEvent) -> None:
+        """Hidden (another tab, the window closed): no timers, no work until shown again."""
+        super().hideEvent(event)
+        self._live_timer.stop()
+        if self._scene_timer.isActive():
+            self._scene_timer.stop()
+            self._scene_dirty = True
+        self.dry_bar.play_button.setChecked(False)
 
     @Slot()
     def _update_arm(self) -> None:
@@ -280,7 +339,9 @@ class View3DPanel(QWidget):
     # --- scene ---------------------------------------------------------------------------
     @Slot()
     def _schedule_scene(self, *_args: object) -> None:
-        if not self._scene_timer.isActive():
+        if not self.isVisible():
+            self._scene_dirty = True
+        elif not self._scene_timer.isActive():
             self._scene_timer.start()
 
     @property
@@ -290,6 +351,7 @@ class View3DPanel(QWidget):
     @Slot()
     def refresh_scene(self) -> None:
         """Points, reach and the plan's path again (after an edit or another plan)."""
+        self._scene_dirty = False
         ledger = self.ledger
         points = list(ledger)
         plan = self._planner.current_plan() if self._planner is not None else None
