@@ -17,9 +17,8 @@ from typing import Final
 
 import numpy as np
 from numpy.typing import NDArray
-from pyqtgraph.Qt.internals import PrimitiveArray
-from PySide6.QtCore import QLineF, QPointF, QRectF, Qt, Signal
-from PySide6.QtGui import QColor, QFont, QMouseEvent, QPainter, QPaintEvent, QPen, QPixmap, QWheelEvent
+from PySide6.QtCore import QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QFont, QMouseEvent, QPainter, QPaintEvent, QPixmap, QWheelEvent
 from PySide6.QtWidgets import QWidget
 
 from app.view3d.camera import Camera, grid_lines, nice_step, pick
@@ -38,6 +37,7 @@ from ui.palette import (
     COLOR_TRAIL,
     COLOR_WHITE,
 )
+from ui.panels.view3d_draw import Buffers, pen, polyline_pairs
 
 FloatArray = NDArray[np.float64]
 
@@ -62,84 +62,6 @@ COLOR_ARM: Final = "#546e7a"
 COLOR_GHOST_ARM: Final = "#8e24aa"  # the dry run's arm
 
 
-def _pen(color: str, width: float, *, round_cap: bool = False) -> QPen:
-    """Flat caps unless asked: round caps on thousands of antialiased lines cost seconds."""
-    pen = QPen(QColor(color), width)
-    pen.setCapStyle(Qt.PenCapStyle.RoundCap if round_cap else Qt.PenCapStyle.FlatCap)
-    return pen
-
-
-def _sprite(color: str, size: int, ring: bool = False) -> QPixmap:
-    """A round marker, drawn once and stamped many times (drawPixmapFragments)."""
-    pix = QPixmap(size + 2, size + 2)
-    pix.fill(Qt.GlobalColor.transparent)
-    p = QPainter(pix)
-    p.setRenderHint(QPainter.RenderHint.Antialiasing)
-    if ring:
-        p.setPen(_pen(color, 2.0))
-        p.setBrush(Qt.BrushStyle.NoBrush)
-        p.drawEllipse(QRectF(2, 2, size - 2, size - 2))
-    else:
-        p.setPen(_pen(COLOR_WHITE, 1.0))
-        p.setBrush(QColor(color))
-        p.drawEllipse(QRectF(1, 1, size, size))
-    p.end()
-    return pix
-
-
-class _Buffers:
-    """Reusable native arrays for drawPoints / drawLines."""
-
-    def __init__(self) -> None:
-        self.points = PrimitiveArray(QPointF, 2)
-        self.lines = PrimitiveArray(QLineF, 4)
-        self.fragments = PrimitiveArray(QPainter.PixmapFragment, 10)
-        self.sprites: dict[tuple[str, int, bool], QPixmap] = {}
-
-    def draw_sprites(self, painter: QPainter, xy: FloatArray, color: str, size: int,
-                     ring: bool = False) -> None:
-        """One marker per row of ``xy`` (non-finite rows skipped), in one call."""
-        xy = xy[np.isfinite(xy).all(axis=1)]
-        if not len(xy):
-            return
-        key = (color, size, ring)
-        sprite = self.sprites.get(key)
-        if sprite is None:
-            sprite = self.sprites[key] = _sprite(color, size, ring)
-        self.fragments.resize(len(xy))
-        frag = self.fragments.ndarray()
-        frag[:, 0:2] = xy
-        frag[:, 2:4] = 0.0
-        frag[:, 4] = sprite.width()
-        frag[:, 5] = sprite.height()
-        frag[:, 6:8] = 1.0
-        frag[:, 8] = 0.0
-        frag[:, 9] = 1.0
-        painter.drawPixmapFragments(*self.fragments.drawargs(), sprite)
-
-    def draw_points(self, painter: QPainter, xy: FloatArray) -> None:
-        xy = xy[np.isfinite(xy).all(axis=1)]
-        if len(xy):
-            self.points.resize(len(xy))
-            self.points.ndarray()[:] = xy
-            painter.drawPoints(*self.points.drawargs())
-
-    def draw_lines(self, painter: QPainter, segs: FloatArray) -> None:
-        """``segs`` (k, 4): x1 y1 x2 y2 per line; rows with NaN are skipped."""
-        segs = segs[np.isfinite(segs).all(axis=1)]
-        if len(segs):
-            self.lines.resize(len(segs))
-            self.lines.ndarray()[:] = segs
-            painter.drawLines(*self.lines.drawargs())
-
-
-def _polyline_pairs(xy: FloatArray) -> FloatArray:
-    """(k, 4) lines between consecutive rows (NaN rows break the line)."""
-    if len(xy) < 2:
-        return np.zeros((0, 4))
-    return np.concatenate([xy[:-1], xy[1:]], axis=1)
-
-
 class View3DCanvas(QWidget):
     """Draws the scene; the panel feeds it. Signals: ``pointClicked(int)`` (a point id, -1 for
     a click on nothing), ``cameraChanged()``."""
@@ -153,7 +75,7 @@ class View3DCanvas(QWidget):
         self.setMinimumSize(200, 160)
         self.setFocusPolicy(Qt.FocusPolicy.ClickFocus)
         self.camera = Camera()
-        self._buf = _Buffers()
+        self._buf = Buffers()
         self._static: QPixmap | None = None
         self._dragging = False
         self._press: QPointF | None = None
@@ -289,14 +211,14 @@ class View3DCanvas(QWidget):
         painter.setRenderHint(QPainter.RenderHint.Antialiasing, False)
         # floor grid and its scale
         g = cam.project(self._grid.reshape(-1, 3), w, h)[0].reshape(-1, 4)
-        painter.setPen(_pen(COLOR_GRID, 1))
+        painter.setPen(pen(COLOR_GRID, 1))
         self._buf.draw_lines(painter, g)
         self.scale_text = self.tr("grid %1 mm").replace("%1", f"{GRID_STEP_MM:g}")
         # base frame
         axes = np.array([[0, 0, 0], [AXIS_MM, 0, 0], [0, AXIS_MM, 0], [0, 0, AXIS_MM]], dtype=np.float64)
         a = cam.project(axes, w, h)[0]
         for i, color in enumerate(AXIS_COLORS):
-            painter.setPen(_pen(color, 2))
+            painter.setPen(pen(color, 2))
             self._buf.draw_lines(painter, np.concatenate([a[0], a[i + 1]])[None, :])
         # the path: lines, unreachable samples, middle points, start, direction
         if len(self.path_xyz):
@@ -305,8 +227,8 @@ class View3DCanvas(QWidget):
             sxy = cam.project(path[::step], w, h)[0]
             # antialiased when drawn in full and not huge (tens of thousands of AA lines are slow)
             painter.setRenderHint(QPainter.RenderHint.Antialiasing, not lod and len(path) <= AA_MAX_PATH_ROWS)
-            painter.setPen(_pen(COLOR_PATH, 1 if lod else 2))
-            self._buf.draw_lines(painter, _polyline_pairs(sxy))
+            painter.setPen(pen(COLOR_PATH, 1 if lod else 2))
+            self._buf.draw_lines(painter, polyline_pairs(sxy))
             self._draw_arrows(painter, lod)
             full = cam.project(path, w, h)[0] if step > 1 else sxy
             self.drawn["path"] = full
@@ -314,7 +236,7 @@ class View3DCanvas(QWidget):
                 self._buf.draw_sprites(painter, full[self.path_bad], COLOR_ERROR, 6)
             self.drawn["path_bad"] = full[self.path_bad]
             mids = cam.project(self.path_mids, w, h)[0]
-            painter.setPen(_pen(COLOR_PATH, 1))
+            painter.setPen(pen(COLOR_PATH, 1))
             painter.setBrush(QColor(COLOR_WHITE))
             shown = mids[np.isfinite(mids).all(axis=1)]
             shown = shown[:0] if lod and len(shown) > LOD_MAX_ARROWS else shown[:1000]
@@ -324,7 +246,7 @@ class View3DCanvas(QWidget):
             if self.path_start is not None and np.isfinite(self.path_start).all():
                 sx, sy = cam.project(self.path_start, w, h)[0][0]
                 if np.isfinite(sx):
-                    painter.setPen(_pen(COLOR_START, 3))
+                    painter.setPen(pen(COLOR_START, 3))
                     painter.setBrush(QColor(COLOR_START))
                     painter.drawEllipse(QPointF(sx, sy), 6, 6)
         else:
@@ -363,7 +285,7 @@ class View3DCanvas(QWidget):
         tip = a[ok]
         left = tip - ARROW_PX * u + 0.5 * ARROW_PX * np.stack([-u[:, 1], u[:, 0]], axis=1)
         right = tip - ARROW_PX * u - 0.5 * ARROW_PX * np.stack([-u[:, 1], u[:, 0]], axis=1)
-        painter.setPen(_pen(COLOR_PATH, 2))
+        painter.setPen(pen(COLOR_PATH, 2))
         self._buf.draw_lines(painter, np.concatenate([np.concatenate([tip, left], axis=1),
                                                       np.concatenate([tip, right], axis=1)]))
 
@@ -385,21 +307,21 @@ class View3DCanvas(QWidget):
         # the segment being run
         if self.active_segment is not None and len(self.path_xyz):
             rows = self.path_segment == self.active_segment
-            painter.setPen(_pen(COLOR_HIGHLIGHT, 5, round_cap=True))
-            self._buf.draw_lines(painter, _polyline_pairs(cam.project(self.path_xyz[rows], w, h)[0]))
+            painter.setPen(pen(COLOR_HIGHLIGHT, 5, round_cap=True))
+            self._buf.draw_lines(painter, polyline_pairs(cam.project(self.path_xyz[rows], w, h)[0]))
         # selected points
         sel = np.isin(self.point_ids, list(self.selected_ids)) if self.selected_ids else np.zeros(0, bool)
         selected = self.drawn.get("points", np.zeros((0, 2)))
         selected = selected[sel] if len(sel) == len(selected) and len(sel) else np.zeros((0, 2))
         self.drawn["selected"] = selected
-        painter.setPen(_pen(COLOR_HIGHLIGHT, 2.5))
+        painter.setPen(pen(COLOR_HIGHLIGHT, 2.5))
         painter.setBrush(Qt.BrushStyle.NoBrush)
         for x, y in selected[np.isfinite(selected).all(axis=1)][:200]:
             painter.drawEllipse(QPointF(x, y), 8, 8)
         # live TCP trace
         if len(self.trace) > 1:
-            painter.setPen(_pen(COLOR_TRAIL, 2))
-            self._buf.draw_lines(painter, _polyline_pairs(cam.project(self.trace, w, h)[0]))
+            painter.setPen(pen(COLOR_TRAIL, 2))
+            self._buf.draw_lines(painter, polyline_pairs(cam.project(self.trace, w, h)[0]))
         self._draw_arm(painter, self.arm, self.flange, COLOR_ARM, "flange")
         self._draw_arm(painter, self.ghost_arm, self.ghost_flange, COLOR_GHOST_ARM, "ghost_flange")
         self._draw_overlay(painter)
@@ -411,18 +333,18 @@ class View3DCanvas(QWidget):
             self.drawn.pop(key, None)
             return
         xy = cam.project(links, w, h)[0]
-        painter.setPen(_pen(color, 7, round_cap=True))
-        self._buf.draw_lines(painter, _polyline_pairs(xy))
-        painter.setPen(_pen(COLOR_INK, 10, round_cap=True))
+        painter.setPen(pen(color, 7, round_cap=True))
+        self._buf.draw_lines(painter, polyline_pairs(xy))
+        painter.setPen(pen(COLOR_INK, 10, round_cap=True))
         self._buf.draw_points(painter, xy[:-1])
         # TCP triad at the flange
         origin = flange[:3, 3]
         ends = origin[None, :] + flange[:3, :3].T * TRIAD_MM
         tri = cam.project(np.vstack([origin, ends]), w, h)[0]
         for i, axis_color in enumerate(AXIS_COLORS):
-            painter.setPen(_pen(axis_color, 2.5))
+            painter.setPen(pen(axis_color, 2.5))
             self._buf.draw_lines(painter, np.concatenate([tri[0], tri[i + 1]])[None, :])
-        painter.setPen(_pen(COLOR_HIGHLIGHT, 9, round_cap=True))
+        painter.setPen(pen(COLOR_HIGHLIGHT, 9, round_cap=True))
         self._buf.draw_points(painter, tri[:1])
         self.drawn[key] = tri[:1]
 
@@ -437,7 +359,7 @@ class View3DCanvas(QWidget):
         for text, color in self.badges:
             width = metrics.horizontalAdvance(text) + 12
             rect = QRectF(x, 8, width, metrics.height() + 6)
-            painter.setPen(_pen(color, 1.5))
+            painter.setPen(pen(color, 1.5))
             painter.setBrush(QColor(COLOR_WHITE))
             painter.drawRoundedRect(rect, 4, 4)
             painter.setPen(QColor(color))
@@ -448,7 +370,7 @@ class View3DCanvas(QWidget):
         length = nice_step(80.0 / max(ppm, 1e-9))
         bar = length * ppm
         y = self.height() - 14
-        painter.setPen(_pen(COLOR_AXIS, 2))
+        painter.setPen(pen(COLOR_AXIS, 2))
         painter.drawLine(QPointF(10, y), QPointF(10 + bar, y))
         painter.drawLine(QPointF(10, y - 4), QPointF(10, y + 4))
         painter.drawLine(QPointF(10 + bar, y - 4), QPointF(10 + bar, y + 4))
