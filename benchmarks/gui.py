@@ -23,6 +23,10 @@ the traffic inspector brought to the front of its dock (it is tabified behind th
   subprocess is spawned (``CLOCK_MONOTONIC`` is shared between processes), with marks for
   each stage. Baseline: a bare ``QMainWindow`` of the same size in the same way.
 
+* **The 3D view** (``view3d``, :mod:`benchmarks.view3d`) -- frame times of rotating a scene of
+  10,000 point markers and a 1,000-segment plan, and ``streaming_view3d_shown`` among the
+  stalls: the streaming stall measurement again with the 3D tab in front.
+
 The simulator runs in this process (``sim_in_process``, as ``teachpad --sim`` runs it, sharing
 the GIL with the GUI) and, as a shorter cross-check, in its own process
 (``sim_separate_process``, like a controller on the network).
@@ -67,6 +71,7 @@ from ui.settings import AppSettings
 POLL_HZ = 100.0
 STALL_TIMER_MS = 1  # period of the probe timer that measures the GUI event loop's stalls
 STALL_THRESHOLD_MS = 50.0
+VIEW3D_SETTLE_S = 1.0  # after bringing the 3D tab to the front, before measuring its stalls
 STEADY_AFTER_S = 1.0
 WARMUP_SAMPLES = 5
 WAIT_TIMEOUT_S = 5.0  # for any single condition (connection, motion started, stop seen)
@@ -682,6 +687,15 @@ def bench_window(sim: SimHandle, stall_s: float, n_stop: int, rng: random.Random
             hidden["polls_per_s"] = (sim.requests() - requests0) / 2 / (time.perf_counter() - t0)
             hidden["monitor_shown"] = not window.monitor_panel.visibleRegion().isEmpty()
             stalls["streaming_monitor_hidden"] = hidden
+            # The same stream with the 3D view in front: the arm redrawn from every pose.
+            view3d = window.view3d.panel
+            window.work_tabs.setCurrentWidget(view3d)
+            _run_for(VIEW3D_SETTLE_S)  # its first paint and scene build are not the steady state
+            requests0, t0 = sim.requests(), time.perf_counter()
+            shown3d = measure_stalls(stall_s / 2)
+            shown3d["polls_per_s"] = (sim.requests() - requests0) / 2 / (time.perf_counter() - t0)
+            shown3d["view3d_shown"] = not view3d.canvas.visibleRegion().isEmpty()
+            stalls["streaming_view3d_shown"] = shown3d
             window.show_tab("monitor")
         out["event_loop_stall"] = stalls
         # End the streaming program the ordinary way before the stop-latency runs.
@@ -748,6 +762,9 @@ def run(quick: bool) -> dict[str, Any]:
     t1 = time.perf_counter()
     out["startup"] = bench_startup(1 if quick else 3)
     out["startup"]["suite_s"] = time.perf_counter() - t1
+    from benchmarks import view3d  # the 3D view's frame times (10,000 markers, 1,000 segments)
+
+    out["view3d"] = view3d.run(quick)
     out["suite_s"] = time.perf_counter() - t0
     return out
 

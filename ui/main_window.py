@@ -65,6 +65,7 @@ from ui.panels.program_panel import ProgramPanel
 from ui.panels.status_panel import StatusPanel
 from ui.panels.step_panel import StepPanel
 from ui.panels.traffic_panel import TrafficPanel
+from ui.panels.view3d_host import install_view3d
 from ui.settings import AppSettings
 from ui.touch import apply_touch_mode, mark_motion, show_rows
 from ui.widgets_common import connection_display
@@ -197,6 +198,7 @@ class MainWindow(QMainWindow):
         bar = self.control_bar
         mark_motion(bar.stop_button, bar.pause_button, bar.resume_button)
         self.set_touch_mode(settings.touch_mode)
+        self.view3d = install_view3d(self)  # the 3D tab (and its dock beside the planner)
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*self._default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -67,6 +67,8 @@ class IssueCode(enum.Enum):
     BAD_START = "bad-start"
     ARC_RESUME_PAST_MIDDLE = "arc-resume-past-middle"
     OUTSIDE_ENVELOPE = "outside-envelope"  # an error: the segment leaves the safety envelope
+    UNREACHABLE = "unreachable"  # the robot model's IK finds no solution (app.view3d.reach)
+    JOINT_LIMIT = "joint-limit"  # reachable only past a joint limit of the robot model
 
 
 @dataclass(frozen=True)
@@ -85,6 +87,10 @@ class PlanIssue:
 
     def __str__(self) -> str:
         return f"{self.kind.value}: {self.message}"
+
+
+#: Reachability of a plan by a robot model: (plan, ledger, current pose) -> issues.
+ReachCheck = Callable[[Plan, PointLedger, PointLike | None], Sequence[PlanIssue]]
 
 
 def has_errors(issues: Sequence[PlanIssue]) -> bool:
@@ -131,6 +137,7 @@ def check_plan(
     loops: int | None = None,
     envelope: Envelope | None = None,
     reduced_speed: bool = False,
+    reach: ReachCheck | None = None,
 ) -> list[PlanIssue]:
     """Everything to fix (or know) before running ``plan`` from segment ``start_index``.
 
@@ -140,6 +147,8 @@ def check_plan(
     Issues come sorted by segment; "needs upload" is reported once per point. With an
     ``envelope``, a segment that leaves it (sampled, arcs too) or runs faster than it allows
     is an error (:data:`IssueCode.OUTSIDE_ENVELOPE`), which blocks Run.
+    ``reach`` (e.g. :meth:`app.view3d.reach.ReachChecker.plan_issues`) adds the robot model's
+    reachability issues (:data:`IssueCode.UNREACHABLE`, :data:`IssueCode.JOINT_LIMIT`).
     """
     limits = limits or PlanLimits()
     loops = plan.loops if loops is None else loops
@@ -227,6 +236,8 @@ def check_plan(
         for v in plan_violations(plan, ledger, envelope, current_pose, start_index=start_index,
                                  loops=loops, reduced=reduced_speed):
             issues.append(PlanIssue(v.segment, IssueKind.ERROR, IssueCode.OUTSIDE_ENVELOPE, v.message))
+    if reach is not None:
+        issues.extend(reach(plan, ledger, current_pose))
     order = {IssueKind.ERROR: 0, IssueKind.NEEDS_UPLOAD: 1, IssueKind.WARNING: 2}
     issues.sort(key=lambda it: (-1 if it.segment is None else it.segment, order[it.kind]))
     return issues

@@ -237,6 +237,49 @@
         </message>
     </context>
     <context>
+        <name>DryRunBar</name>
+        <message>
+            <location filename="../../ui/panels/view3d_dryrun.py" line="66" />
+            <source>Dry run:</source>
+            <translation>空运行：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_dryrun.py" line="67" />
+            <source>Pause</source>
+            <translation>暂停</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_dryrun.py" line="67" />
+            <source>Play</source>
+            <translation>播放</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_dryrun.py" line="68" />
+            <source>Play the plan on the drawn arm; nothing is sent to the robot</source>
+            <translation>在绘制的机械臂上播放轨迹；不向机器人发送任何指令</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_dryrun.py" line="69" />
+            <source>Live arm</source>
+            <translation>实时机械臂</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_dryrun.py" line="70" />
+            <source>Leave the dry run and show the robot's arm again</source>
+            <translation>退出空运行，重新显示机器人的机械臂</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_dryrun.py" line="71" />
+            <source>Speed of the dry run, times the planned speed</source>
+            <translation>空运行速度（规划速度的倍数）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_dryrun.py" line="72" />
+            <source>Drag to any moment of the plan</source>
+            <translation>拖动到轨迹的任意时刻</translation>
+        </message>
+    </context>
+    <context>
         <name>EventLogModel</name>
         <message>
             <location filename="../../ui/panels/event_log.py" line="92" />
@@ -568,7 +611,7 @@
         <message>
             <location filename="../../ui/keypad.py" line="95" />
             <source>Clear</source>
-            <translation>清空</translation>
+            <translation>清除</translation>
         </message>
         <message>
             <location filename="../../ui/keypad.py" line="97" />
@@ -579,113 +622,113 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="250" />
+            <location filename="../../ui/main_window.py" line="252" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="251" />
+            <location filename="../../ui/main_window.py" line="253" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="252" />
+            <location filename="../../ui/main_window.py" line="254" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="256" />
+            <location filename="../../ui/main_window.py" line="258" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="257" />
+            <location filename="../../ui/main_window.py" line="259" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="258" />
+            <location filename="../../ui/main_window.py" line="260" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="291" />
+            <location filename="../../ui/main_window.py" line="293" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="279" />
+            <location filename="../../ui/main_window.py" line="281" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="307" />
+            <location filename="../../ui/main_window.py" line="309" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="309" />
+            <location filename="../../ui/main_window.py" line="311" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="314" />
+            <location filename="../../ui/main_window.py" line="316" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="327" />
+            <location filename="../../ui/main_window.py" line="329" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="338" />
+            <location filename="../../ui/main_window.py" line="340" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="344" />
+            <location filename="../../ui/main_window.py" line="346" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="340" />
-            <location filename="../../ui/main_window.py" line="345" />
+            <location filename="../../ui/main_window.py" line="342" />
+            <location filename="../../ui/main_window.py" line="347" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="253" />
+            <location filename="../../ui/main_window.py" line="255" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="254" />
+            <location filename="../../ui/main_window.py" line="256" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="255" />
+            <location filename="../../ui/main_window.py" line="257" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="408" />
+            <location filename="../../ui/main_window.py" line="410" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="409" />
+            <location filename="../../ui/main_window.py" line="411" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="427" />
+            <location filename="../../ui/main_window.py" line="429" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="428" />
+            <location filename="../../ui/main_window.py" line="430" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -2974,6 +3017,159 @@ Remove them all?</source>
             <location filename="../../ui/panels/traffic_panel.py" line="293" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
+        </message>
+    </context>
+    <context>
+        <name>View3DCanvas</name>
+        <message>
+            <location filename="../../ui/panels/view3d_canvas.py" line="216" />
+            <source>grid %1 mm</source>
+            <translation>网格 %1 mm</translation>
+        </message>
+    </context>
+    <context>
+        <name>View3DHost</name>
+        <message>
+            <location filename="../../ui/panels/view3d_host.py" line="46" />
+            <source>3D</source>
+            <translation>3D</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_host.py" line="47" />
+            <source>3D view</source>
+            <translation>3D 视图</translation>
+        </message>
+    </context>
+    <context>
+        <name>View3DPanel</name>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="184" />
+            <source>Top</source>
+            <translation>俯视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="184" />
+            <source>Front</source>
+            <translation>正视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="184" />
+            <source>Side</source>
+            <translation>侧视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="185" />
+            <source>Iso</source>
+            <translation>轴测</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="188" />
+            <source>Look at the scene from a preset direction</source>
+            <translation>从预设方向观察场景</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="189" />
+            <source>Fit all</source>
+            <translation>全部显示</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="190" />
+            <source>Show the arm, the points and the plan</source>
+            <translation>显示机械臂、点位和轨迹</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="191" />
+            <source>Orthographic</source>
+            <translation>正交投影</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="192" />
+            <source>Parallel projection (no perspective)</source>
+            <translation>平行投影（无透视）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="193" />
+            <source>Robot model…</source>
+            <translation>机器人模型…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="194" />
+            <source>Robot model: %1. Load another robot model profile (JSON)</source>
+            <translation>机器人模型：%1。加载其他机器人模型配置文件（JSON）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="196" />
+            <source>Beside the planner</source>
+            <translation>在规划器旁显示</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="197" />
+            <source>Show the 3D view next to the planner, not in its own tab</source>
+            <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="198" />
+            <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
+            <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="224" />
+            <source>Robot model not loaded: %1</source>
+            <translation>未加载机器人模型：%1</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="233" />
+            <source>Load a robot model profile</source>
+            <translation>加载机器人模型配置文件</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="234" />
+            <source>Robot model profiles (*.json)</source>
+            <translation>机器人模型配置文件 (*.json)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="326" />
+            <source>dry run: nothing is sent</source>
+            <translation>空运行：不发送任何指令</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="328" />
+            <source>no pose: home position shown</source>
+            <translation>无位姿：显示原点姿态</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="330" />
+            <source>estimate (from the pose, no joint angles)</source>
+            <translation>估算（由位姿求得，无关节角）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="332" />
+            <source>pose out of the model's reach</source>
+            <translation>位姿超出模型可达范围</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="334" />
+            <source>past a joint limit</source>
+            <translation>超出关节限位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="336" />
+            <source>stale</source>
+            <translation>数据过期</translation>
+        </message>
+        <message numerus="yes">
+            <location filename="../../ui/panels/view3d_panel.py" line="417" />
+            <source>Out of the robot model's reach: %n point(s) (%1)</source>
+            <translation>
+                <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
+            </translation>
+        </message>
+        <message numerus="yes">
+            <location filename="../../ui/panels/view3d_panel.py" line="422" />
+            <source>the path leaves the reach in %n segment(s) (%1)</source>
+            <translation>
+                <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>
+            </translation>
         </message>
     </context>
     <context>

@@ -66,7 +66,7 @@ def test_tabs_and_menus_in_both_languages(qtbot: Any, link: Any, app_settings: A
         window = MainWindow(link, app_settings, translator, project_dialogs=project_dialogs,
                             autosave_dir=tmp_path, shutdown_link_on_close=False)
         qtbot.addWidget(window)
-        assert window.work_tabs.count() == 3
+        assert window.work_tabs.count() == 4  # Monitor, Points, Planner, 3D (the view3d branch)
         assert window.work_tabs.widget(TAB_POINTS) is window.points_panel
         assert window.work_tabs.widget(TAB_PLANNER) is window.planner_panel
         assert all(window.work_tabs.tabText(i) for i in range(3))

@@ -1,0 +1,198 @@
+"""Robot model profiles: the arm's geometry as data (DH parameters, joint limits, base, flange).
+
+A profile is a JSON file (``"format": "teachpad-robot-profile"``, ``"version": 1``) with one
+entry per joint — standard (distal) Denavit-Hartenberg ``offset_deg``, ``d``, ``a``,
+``alpha_deg`` (mm, degrees; joint ``i`` rotates ``theta_i = q_i + offset_i`` about
+``z_{i-1}``) and its limits ``min_deg``/``max_deg`` — plus ``home_deg`` (the IK's first seed),
+``base`` (the robot base in the world, X Y Z A B C) and ``flange`` (the flange in the last DH
+frame, X Y Z A B C). A B C follow :mod:`app.geometry`. The simulator's arm is
+:func:`default_profile`. Kinematics of a profile are in :mod:`app.view3d.kinematics`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from importlib import resources
+from typing import Any, Final
+
+import numpy as np
+from numpy.typing import NDArray
+
+from app.errors import InvalidInput
+from app.geometry import pose_to_transform
+
+PROFILE_FORMAT: Final = "teachpad-robot-profile"
+PROFILE_VERSION: Final = 1
+DEFAULT_PROFILE_FILE: Final = "sim_arm.json"
+MAX_JOINTS: Final = 12
+MAX_FILE_BYTES: Final = 1_000_000
+_QUOTE_CHARS: Final = 40  # a bad value is quoted up to this many characters
+
+Matrix = NDArray[np.float64]
+
+
+class ProfileError(InvalidInput):
+    """A robot profile file that cannot be used; the message says where and why."""
+
+
+@dataclass(frozen=True)
+class JointSpec:
+    """One revolute joint: its DH row and limits (degrees, mm)."""
+
+    name: str
+    offset_deg: float
+    d: float
+    a: float
+    alpha_deg: float
+    min_deg: float
+    max_deg: float
+
+
+@dataclass(frozen=True)
+class RobotProfile:
+    """An arm: joints base -> flange, the home joints, base and flange offsets (X Y Z A B C)."""
+
+    name: str
+    joints: tuple[JointSpec, ...]
+    home_deg: tuple[float, ...]
+    base: tuple[float, float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    flange: tuple[float, float, float, float, float, float] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+    @property
+    def dof(self) -> int:
+        return len(self.joints)
+
+    @property
+    def limits(self) -> NDArray[np.float64]:
+        """(dof, 2) min, max in degrees."""
+        return np.array([(j.min_deg, j.max_deg) for j in self.joints], dtype=np.float64)
+
+    @property
+    def base_transform(self) -> Matrix:
+        return pose_to_transform(*self.base)
+
+    @property
+    def flange_transform(self) -> Matrix:
+        return pose_to_transform(*self.flange)
+
+    @property
+    def reach(self) -> float:
+        """An upper bound (mm) of how far the flange gets from the base origin."""
+        total = sum(math.hypot(j.a, j.d) for j in self.joints)
+        return total + math.sqrt(sum(v * v for v in self.flange[:3]))
+
+
+def _quote(value: object) -> str:
+    text = repr(value)
+    return text if len(text) <= _QUOTE_CHARS else text[: _QUOTE_CHARS - 1] + "…"
+
+
+def _number(where: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(float(value)):
+        raise ProfileError(f"{where}: {_quote(value)} is not a finite number")
+    return float(value)
+
+
+def _six(where: str, value: object) -> tuple[float, float, float, float, float, float]:
+    if not isinstance(value, list) or len(value) != 6:
+        raise ProfileError(f"{where}: expected a list of six numbers X Y Z A B C, got {_quote(value)}")
+    x, y, z, a, b, c = (_number(f"{where}[{i}]", v) for i, v in enumerate(value))
+    return (x, y, z, a, b, c)
+
+
+def _joint(index: int, raw: object) -> JointSpec:
+    where = f"joint {index + 1}"
+    if not isinstance(raw, dict):
+        raise ProfileError(f"{where}: expected an object with offset_deg, d, a, alpha_deg, min_deg, max_deg")
+    missing = [k for k in ("d", "a", "alpha_deg", "min_deg", "max_deg") if k not in raw]
+    if missing:
+        raise ProfileError(f"{where}: missing {', '.join(missing)}")
+    name = raw.get("name", f"J{index + 1}")
+    if not isinstance(name, str):
+        raise ProfileError(f"{where}: name {_quote(name)} is not text")
+    values = {k: _number(f"{where} {k}", raw.get(k, 0.0)) for k in
+              ("offset_deg", "d", "a", "alpha_deg", "min_deg", "max_deg")}
+    if values["min_deg"] >= values["max_deg"]:
+        raise ProfileError(f"{where}: min_deg {values['min_deg']:g} is not below "
+                           f"max_deg {values['max_deg']:g}")
+    return JointSpec(name=name[:20], **values)
+
+
+def profile_from_dict(data: object) -> RobotProfile:
+    """A profile from parsed JSON; :class:`ProfileError` says what is wrong."""
+    if not isinstance(data, dict):
+        raise ProfileError("a robot profile is a JSON object")
+    if data.get("format") != PROFILE_FORMAT:
+        raise ProfileError(f"not a robot profile: format is {_quote(data.get('format'))}, "
+                           f"expected '{PROFILE_FORMAT}'")
+    version = data.get("version")
+    if version != PROFILE_VERSION:
+        raise ProfileError(f"profile version {_quote(version)} is not supported (this TeachPad reads "
+                           f"version {PROFILE_VERSION})")
+    joints_raw = data.get("joints")
+    if not isinstance(joints_raw, list) or not 1 <= len(joints_raw) <= MAX_JOINTS:
+        raise ProfileError(f"joints: expected a list of 1 to {MAX_JOINTS} joints")
+    joints = tuple(_joint(i, raw) for i, raw in enumerate(joints_raw))
+    home_raw: Any = data.get("home_deg", [0.0] * len(joints))
+    if not isinstance(home_raw, list) or len(home_raw) != len(joints):
+        raise ProfileError(f"home_deg: expected {len(joints)} numbers, one per joint")
+    home = tuple(_number(f"home_deg[{i}]", v) for i, v in enumerate(home_raw))
+    name = data.get("name", "robot")
+    if not isinstance(name, str):
+        raise ProfileError(f"name {_quote(name)} is not text")
+    base = _six("base", data.get("base", [0.0] * 6))
+    flange = _six("flange", data.get("flange", [0.0] * 6))
+    return RobotProfile(name=name[:100], joints=joints, home_deg=home, base=base, flange=flange)
+
+
+def load_profile(path: str | os.PathLike[str]) -> RobotProfile:
+    """Read a profile file; :class:`ProfileError` names the file and the problem."""
+    label = os.fspath(path)
+    try:
+        if os.path.getsize(path) > MAX_FILE_BYTES:
+            raise ProfileError(f"{label}: too large for a robot profile (over {MAX_FILE_BYTES // 1000} kB)")
+        with open(path, encoding="utf-8") as handle:
+            text = handle.read()
+    except OSError as exc:
+        raise ProfileError(f"{label}: cannot read the robot profile ({exc.strerror or exc})") from exc
+    except UnicodeDecodeError as exc:
+        raise ProfileError(f"{label}: the robot profile is not UTF-8 text") from exc
+    return parse_profile(text, label)
+
+
+def parse_profile(text: str, label: str = "profile") -> RobotProfile:
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        where = f"line {exc.lineno}, column {exc.colno}"
+        raise ProfileError(f"{label}: not valid JSON ({where}: {exc.msg})") from exc
+    try:
+        return profile_from_dict(data)
+    except ProfileError as exc:
+        raise ProfileError(f"{label}: {exc}") from exc
+
+
+def profile_to_dict(profile: RobotProfile) -> dict[str, Any]:
+    return {
+        "format": PROFILE_FORMAT, "version": PROFILE_VERSION, "name": profile.name,
+        "joints": [{"name": j.name, "offset_deg": j.offset_deg, "d": j.d, "a": j.a, "alpha_deg": j.alpha_deg,
+                    "min_deg": j.min_deg, "max_deg": j.max_deg} for j in profile.joints],
+        "home_deg": list(profile.home_deg), "base": list(profile.base), "flange": list(profile.flange),
+    }
+
+
+def default_profile() -> RobotProfile:
+    """The simulator's arm (shipped with the package)."""
+    text = resources.files("app.view3d").joinpath("profiles", DEFAULT_PROFILE_FILE).read_text("utf-8")
+    return parse_profile(text, DEFAULT_PROFILE_FILE)
+
+
+def joints_array(q_deg: Sequence[float] | NDArray[np.float64], dof: int) -> NDArray[np.float64]:
+    arr = np.asarray(q_deg, dtype=np.float64).reshape(-1)
+    if arr.size < dof:
+        raise InvalidInput(f"{dof} joint angles are needed, got {arr.size}")
+    return np.asarray(arr[:dof], dtype=np.float64)

@@ -1,0 +1,1 @@
+"""Robot model profiles shipped with TeachPad (JSON, see :mod:`app.view3d.profile`)."""

@@ -1,0 +1,430 @@
+"""The 3D view's drawing surface: a QPainter projection of the scene (no OpenGL, so it draws
+under the offscreen platform and in tests).
+
+Everything is projected with one matrix product per layer (:class:`app.view3d.camera.Camera`)
+and drawn with one ``drawPoints``/``drawLines`` call per colour from numpy buffers (pyqtgraph's
+``PrimitiveArray``, no Python object per point). The camera-dependent static layers (grid,
+points, path) are cached in a pixmap while the camera stands still, so a live pose only
+redraws the arm; while the mouse drags, large scenes are thinned (level of detail) and drawn
+in full again on release. The canvas keeps the screen positions it drew last in
+:attr:`View3DCanvas.drawn` (tests and the benchmark read them).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Final
+
+import numpy as np
+from numpy.typing import NDArray
+from PySide6.QtCore import QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QFont, QMouseEvent, QPainter, QPaintEvent, QPixmap, QWheelEvent
+from PySide6.QtWidgets import QWidget
+
+from app.view3d.camera import Camera, grid_lines, nice_step, pick
+from ui.palette import (
+    COLOR_AXIS,
+    COLOR_CURVE_BLUE,
+    COLOR_CURVE_GREEN,
+    COLOR_CURVE_RED,
+    COLOR_ERROR,
+    COLOR_GRID,
+    COLOR_HIGHLIGHT,
+    COLOR_INK,
+    COLOR_INK_SOFT,
+    COLOR_PATH,
+    COLOR_START,
+    COLOR_TRAIL,
+    COLOR_WHITE,
+)
+from ui.panels.view3d_draw import Buffers, pen, polyline_pairs
+
+FloatArray = NDArray[np.float64]
+
+ROTATE_DEG_PER_PX: Final = 0.4
+ZOOM_PER_WHEEL_STEP: Final = 1.15  # one wheel notch (120)
+CLICK_SLOP_PX: Final = 4
+LOD_MAX_POINTS: Final = 2500  # markers drawn while dragging (thinned above this)
+LOD_MAX_PATH_ROWS: Final = 6000  # path samples drawn while dragging
+LOD_MAX_ARROWS: Final = 200  # direction arrows drawn while dragging (none for longer plans)
+AA_MAX_PATH_ROWS: Final = 10_000  # longer paths are drawn without antialiasing
+MAX_LABELS: Final = 40  # point names drawn when few points are visible
+LABEL_MIN_PX_PER_MM: Final = 0.6  # or when zoomed in this far
+GRID_EXTENT_MM: Final = 1500.0
+GRID_STEP_MM: Final = 100.0
+AXIS_MM: Final = 150.0  # base frame axes
+TRIAD_MM: Final = 90.0  # TCP triad
+MARKER_PX: Final = 7
+ARROW_PX: Final = 9.0
+COLOR_BACKGROUND: Final = "#f7f9fa"
+AXIS_COLORS: Final = (COLOR_CURVE_RED, COLOR_CURVE_GREEN, COLOR_CURVE_BLUE)  # X Y Z
+COLOR_ARM: Final = "#546e7a"
+COLOR_GHOST_ARM: Final = "#8e24aa"  # the dry run's arm
+
+
+class View3DCanvas(QWidget):
+    """Draws the scene; the panel feeds it. Signals: ``pointClicked(int)`` (a point id, -1 for
+    a click on nothing), ``cameraChanged()``."""
+
+    pointClicked = Signal(int)
+    cameraChanged = Signal()
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("View3DCanvas")
+        self.setMinimumSize(200, 160)
+        self.setFocusPolicy(Qt.FocusPolicy.ClickFocus)
+        self.camera = Camera()
+        self._buf = Buffers()
+        self._static: QPixmap | None = None
+        self._dragging = False
+        self._press: QPointF | None = None
+        self._last: QPointF | None = None
+        self._moved = False
+        self._button = Qt.MouseButton.NoButton
+        self.drawn: dict[str, FloatArray] = {}
+        self._grid = grid_lines(GRID_EXTENT_MM, GRID_STEP_MM)
+        self.scale_text = ""
+        # scene
+        self.point_xyz = np.zeros((0, 3))
+        self.point_ids = np.zeros(0, dtype=np.intp)
+        self.point_names: list[str] = []
+        self.point_colors: list[str] = []  # one colour per point
+        self._color_codes = np.zeros(0, dtype=np.intp)  # index into _color_names per point
+        self._color_names: list[str] = []
+        self.point_bad = np.zeros(0, dtype=bool)
+        self.selected_ids: set[int] = set()
+        self.path_xyz = np.zeros((0, 3))
+        self.path_segment = np.zeros(0, dtype=np.intp)
+        self.path_bad = np.zeros(0, dtype=bool)
+        self.path_mids = np.zeros((0, 3))
+        self.path_start: FloatArray | None = None
+        self.active_segment: int | None = None
+        self.arm: FloatArray | None = None  # (m, 3) polyline
+        self.arm_joints: FloatArray | None = None
+        self.flange: FloatArray | None = None  # 4x4
+        self.ghost_arm: FloatArray | None = None
+        self.ghost_flange: FloatArray | None = None
+        self.trace = np.zeros((0, 3))
+        self.badges: list[tuple[str, str]] = []  # (text, colour)
+
+    # --- scene setters ---------------------------------------------------------------------
+    def set_camera(self, camera: Camera) -> None:
+        self.camera = camera
+        self.invalidate()
+        self.cameraChanged.emit()
+
+    def invalidate(self) -> None:
+        """The static layers must be drawn again."""
+        self._static = None
+        self.update()
+
+    def set_points(self, xyz: FloatArray, ids: Sequence[int], names: Sequence[str],
+                   colors: Sequence[str], bad: NDArray[np.bool_]) -> None:
+        self.point_xyz = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+        self.point_ids = np.asarray(ids, dtype=np.intp)
+        self.point_names = list(names)
+        self.point_colors = list(colors)
+        self._color_names = list(dict.fromkeys(self.point_colors))
+        lookup = {c: i for i, c in enumerate(self._color_names)}
+        self._color_codes = np.array([lookup[c] for c in self.point_colors], dtype=np.intp)
+        self.point_bad = np.asarray(bad, dtype=bool)
+        self.invalidate()
+
+    def set_selected(self, ids: set[int]) -> None:
+        if ids != self.selected_ids:
+            self.selected_ids = set(ids)
+            self.update()
+
+    def set_path(self, xyz: FloatArray, segment: NDArray[np.intp], bad: NDArray[np.bool_],
+                 mids: FloatArray, start: FloatArray | None) -> None:
+        self.path_xyz = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+        self.path_segment = np.asarray(segment, dtype=np.intp)
+        self.path_bad = np.asarray(bad, dtype=bool)
+        self.path_mids = np.asarray(mids, dtype=np.float64).reshape(-1, 3)
+        self.path_start = start
+        self.invalidate()
+
+    def set_active_segment(self, index: int | None) -> None:
+        if index != self.active_segment:
+            self.active_segment = index
+            self.update()
+
+    def set_arm(self, links: FloatArray | None, joints: FloatArray | None, flange: FloatArray | None) -> None:
+        self.arm, self.arm_joints, self.flange = links, joints, flange
+        self.update()
+
+    def set_ghost_arm(self, links: FloatArray | None, flange: FloatArray | None) -> None:
+        self.ghost_arm, self.ghost_flange = links, flange
+        self.update()
+
+    def set_trace(self, xyz: FloatArray) -> None:
+        self.trace = xyz
+        self.update()
+
+    def set_badges(self, badges: list[tuple[str, str]]) -> None:
+        if badges != self.badges:
+            self.badges = badges
+            self.update()
+
+    def scene_bounds(self) -> FloatArray:
+        parts = [self.point_xyz, self.path_xyz, np.zeros((1, 3))]
+        if self.arm is not None:
+            parts.append(self.arm)
+        return np.concatenate(parts, axis=0)
+
+    def fit_all(self) -> None:
+        aspect = self.width() / max(1, self.height())
+        self.set_camera(self.camera.fitted(self.scene_bounds(), aspect))
+
+    def project(self, xyz: FloatArray) -> FloatArray:
+        pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+        return self.camera.project(pts, self.width(), self.height())[0]
+
+    # --- painting --------------------------------------------------------------------------
+    def paintEvent(self, event: QPaintEvent) -> None:
+        painter = QPainter(self)
+        self.render_scene(painter)
+        painter.end()
+
+    def render_scene(self, painter: QPainter) -> None:
+        """Draw everything with ``painter`` (the widget's, or an image's in the benchmark)."""
+        w, h = self.width(), self.height()
+        if self._dragging:
+            painter.fillRect(0, 0, w, h, QColor(COLOR_BACKGROUND))
+            self._draw_static(painter, lod=True)
+        else:
+            ratio = self.devicePixelRatioF()
+            if self._static is None or self._static.size() != self.size() * ratio:
+                pix = QPixmap(self.size() * ratio)
+                pix.setDevicePixelRatio(ratio)
+                pix.fill(QColor(COLOR_BACKGROUND))
+                p = QPainter(pix)
+                self._draw_static(p, lod=False)
+                p.end()
+                self._static = pix
+            painter.drawPixmap(0, 0, self._static)
+        self._draw_dynamic(painter)
+
+    def _draw_static(self, painter: QPainter, *, lod: bool) -> None:
+        cam, w, h = self.camera, self.width(), self.height()
+        painter.setRenderHint(QPainter.RenderHint.Antialiasing, False)
+        # floor grid and its scale
+        g = cam.project(self._grid.reshape(-1, 3), w, h)[0].reshape(-1, 4)
+        painter.setPen(pen(COLOR_GRID, 1))
+        self._buf.draw_lines(painter, g)
+        self.scale_text = self.tr("grid %1 mm").replace("%1", f"{GRID_STEP_MM:g}")
+        # base frame
+        axes = np.array([[0, 0, 0], [AXIS_MM, 0, 0], [0, AXIS_MM, 0], [0, 0, AXIS_MM]], dtype=np.float64)
+        a = cam.project(axes, w, h)[0]
+        for i, color in enumerate(AXIS_COLORS):
+            painter.setPen(pen(color, 2))
+            self._buf.draw_lines(painter, np.concatenate([a[0], a[i + 1]])[None, :])
+        # the path: lines, unreachable samples, middle points, start, direction
+        if len(self.path_xyz):
+            path = self.path_xyz
+            step = max(1, len(path) // LOD_MAX_PATH_ROWS) if lod else 1
+            sxy = cam.project(path[::step], w, h)[0]
+            # antialiased when drawn in full and not huge (tens of thousands of AA lines are slow)
+            painter.setRenderHint(QPainter.RenderHint.Antialiasing, not lod and len(path) <= AA_MAX_PATH_ROWS)
+            painter.setPen(pen(COLOR_PATH, 1 if lod else 2))
+            self._buf.draw_lines(painter, polyline_pairs(sxy))
+            self._draw_arrows(painter, lod)
+            full = cam.project(path, w, h)[0] if step > 1 else sxy
+            self.drawn["path"] = full
+            if self.path_bad.any():
+                self._buf.draw_sprites(painter, full[self.path_bad], COLOR_ERROR, 6)
+            self.drawn["path_bad"] = full[self.path_bad]
+            mids = cam.project(self.path_mids, w, h)[0]
+            painter.setPen(pen(COLOR_PATH, 1))
+            painter.setBrush(QColor(COLOR_WHITE))
+            shown = mids[np.isfinite(mids).all(axis=1)]
+            shown = shown[:0] if lod and len(shown) > LOD_MAX_ARROWS else shown[:1000]
+            for x, y in shown:
+                painter.drawRect(QRectF(x - 4, y - 4, 8, 8))
+            self.drawn["mids"] = mids
+            if self.path_start is not None and np.isfinite(self.path_start).all():
+                sx, sy = cam.project(self.path_start, w, h)[0][0]
+                if np.isfinite(sx):
+                    painter.setPen(pen(COLOR_START, 3))
+                    painter.setBrush(QColor(COLOR_START))
+                    painter.drawEllipse(QPointF(sx, sy), 6, 6)
+        else:
+            self.drawn["path"] = self.drawn["path_bad"] = self.drawn["mids"] = np.zeros((0, 2))
+        # the points, one drawPoints per colour
+        pts = cam.project(self.point_xyz, w, h)[0] if len(self.point_xyz) else np.zeros((0, 2))
+        self.drawn["points"] = pts
+        if len(pts):
+            keep = np.arange(len(pts))
+            if lod and len(pts) > LOD_MAX_POINTS:
+                keep = keep[:: len(pts) // LOD_MAX_POINTS + 1]
+            codes = self._color_codes[keep]
+            for code, color in enumerate(self._color_names):
+                self._buf.draw_sprites(painter, pts[keep[codes == code]], color, MARKER_PX)
+            if self.point_bad.any():
+                self._buf.draw_sprites(painter, pts[self.point_bad], COLOR_ERROR, MARKER_PX + 3)
+            self.drawn["bad_points"] = pts[self.point_bad]
+            if not lod:
+                self._draw_labels(painter, pts)
+        else:
+            self.drawn["bad_points"] = np.zeros((0, 2))
+
+    def _draw_arrows(self, painter: QPainter, lod: bool) -> None:
+        """One arrowhead per segment at its middle sample, pointing along the path."""
+        seg = self.path_segment
+        if not len(seg) or (lod and seg[-1] >= LOD_MAX_ARROWS):
+            return
+        k = int(np.count_nonzero(seg == seg[0]))
+        rows = np.arange(k // 2, len(seg) - 1, k)
+        a = self.project(self.path_xyz[rows])
+        b = self.project(self.path_xyz[rows + 1])
+        d = b - a
+        norm = np.hypot(d[:, 0], d[:, 1])
+        ok = np.isfinite(norm) & (norm > 1e-9)
+        u = d[ok] / norm[ok, None]
+        tip = a[ok]
+        left = tip - ARROW_PX * u + 0.5 * ARROW_PX * np.stack([-u[:, 1], u[:, 0]], axis=1)
+        right = tip - ARROW_PX * u - 0.5 * ARROW_PX * np.stack([-u[:, 1], u[:, 0]], axis=1)
+        painter.setPen(pen(COLOR_PATH, 2))
+        self._buf.draw_lines(painter, np.concatenate([np.concatenate([tip, left], axis=1),
+                                                      np.concatenate([tip, right], axis=1)]))
+
+    def _draw_labels(self, painter: QPainter, pts: FloatArray) -> None:
+        w, h = self.width(), self.height()
+        inside = np.flatnonzero(np.isfinite(pts).all(axis=1) & (pts[:, 0] >= 0) & (pts[:, 0] < w)
+                                & (pts[:, 1] >= 0) & (pts[:, 1] < h))
+        zoomed = self.camera.pixels_per_mm(h) >= LABEL_MIN_PX_PER_MM
+        if len(inside) > MAX_LABELS and not zoomed:
+            return
+        painter.setPen(QColor(COLOR_INK_SOFT))
+        painter.setFont(QFont(painter.font().family(), 8))
+        for row in inside[:MAX_LABELS * 2]:
+            painter.drawText(QPointF(pts[row, 0] + 6, pts[row, 1] - 6), self.point_names[row])
+
+    def _draw_dynamic(self, painter: QPainter) -> None:
+        painter.setRenderHint(QPainter.RenderHint.Antialiasing, True)
+        cam, w, h = self.camera, self.width(), self.height()
+        # the segment being run
+        if self.active_segment is not None and len(self.path_xyz):
+            rows = self.path_segment == self.active_segment
+            painter.setPen(pen(COLOR_HIGHLIGHT, 5, round_cap=True))
+            self._buf.draw_lines(painter, polyline_pairs(cam.project(self.path_xyz[rows], w, h)[0]))
+        # selected points
+        sel = np.isin(self.point_ids, list(self.selected_ids)) if self.selected_ids else np.zeros(0, bool)
+        selected = self.drawn.get("points", np.zeros((0, 2)))
+        selected = selected[sel] if len(sel) == len(selected) and len(sel) else np.zeros((0, 2))
+        self.drawn["selected"] = selected
+        painter.setPen(pen(COLOR_HIGHLIGHT, 2.5))
+        painter.setBrush(Qt.BrushStyle.NoBrush)
+        for x, y in selected[np.isfinite(selected).all(axis=1)][:200]:
+            painter.drawEllipse(QPointF(x, y), 8, 8)
+        # live TCP trace
+        if len(self.trace) > 1:
+            painter.setPen(pen(COLOR_TRAIL, 2))
+            self._buf.draw_lines(painter, polyline_pairs(cam.project(self.trace, w, h)[0]))
+        self._draw_arm(painter, self.arm, self.flange, COLOR_ARM, "flange")
+        self._draw_arm(painter, self.ghost_arm, self.ghost_flange, COLOR_GHOST_ARM, "ghost_flange")
+        self._draw_overlay(painter)
+
+    def _draw_arm(self, painter: QPainter, links: FloatArray | None, flange: FloatArray | None,
+                  color: str, key: str) -> None:
+        cam, w, h = self.camera, self.width(), self.height()
+        if links is None or flange is None:
+            self.drawn.pop(key, None)
+            return
+        xy = cam.project(links, w, h)[0]
+        painter.setPen(pen(color, 7, round_cap=True))
+        self._buf.draw_lines(painter, polyline_pairs(xy))
+        painter.setPen(pen(COLOR_INK, 10, round_cap=True))
+        self._buf.draw_points(painter, xy[:-1])
+        # TCP triad at the flange
+        origin = flange[:3, 3]
+        ends = origin[None, :] + flange[:3, :3].T * TRIAD_MM
+        tri = cam.project(np.vstack([origin, ends]), w, h)[0]
+        for i, axis_color in enumerate(AXIS_COLORS):
+            painter.setPen(pen(axis_color, 2.5))
+            self._buf.draw_lines(painter, np.concatenate([tri[0], tri[i + 1]])[None, :])
+        painter.setPen(pen(COLOR_HIGHLIGHT, 9, round_cap=True))
+        self._buf.draw_points(painter, tri[:1])
+        self.drawn[key] = tri[:1]
+
+    def _draw_overlay(self, painter: QPainter) -> None:
+        """Badges (top left) and the grid's scale (bottom left)."""
+        painter.setRenderHint(QPainter.RenderHint.Antialiasing, True)
+        font = QFont(painter.font())
+        font.setBold(True)
+        painter.setFont(font)
+        metrics = painter.fontMetrics()
+        x = 8
+        for text, color in self.badges:
+            width = metrics.horizontalAdvance(text) + 12
+            rect = QRectF(x, 8, width, metrics.height() + 6)
+            painter.setPen(pen(color, 1.5))
+            painter.setBrush(QColor(COLOR_WHITE))
+            painter.drawRoundedRect(rect, 4, 4)
+            painter.setPen(QColor(color))
+            painter.drawText(rect, Qt.AlignmentFlag.AlignCenter, text)
+            x += int(width) + 6
+        # scale bar: the grid step at the target's depth, rounded to a nice length
+        ppm = self.camera.pixels_per_mm(self.height())
+        length = nice_step(80.0 / max(ppm, 1e-9))
+        bar = length * ppm
+        y = self.height() - 14
+        painter.setPen(pen(COLOR_AXIS, 2))
+        painter.drawLine(QPointF(10, y), QPointF(10 + bar, y))
+        painter.drawLine(QPointF(10, y - 4), QPointF(10, y + 4))
+        painter.drawLine(QPointF(10 + bar, y - 4), QPointF(10 + bar, y + 4))
+        painter.setPen(QColor(COLOR_INK))
+        painter.setFont(QFont(painter.font().family(), 8))
+        painter.drawText(QPointF(16 + bar, y + 4), f"{length:g} mm · {self.scale_text}")
+
+    # --- mouse -----------------------------------------------------------------------------
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        self._press = self._last = event.position()
+        self._moved = False
+        self._button = event.button()
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        if self._last is None or self._press is None:
+            return
+        pos = event.position()
+        if not self._moved and (pos - self._press).manhattanLength() < CLICK_SLOP_PX:
+            return
+        self._moved = self._dragging = True
+        dx, dy = pos.x() - self._last.x(), pos.y() - self._last.y()
+        self._last = pos
+        pan = (self._button in (Qt.MouseButton.RightButton, Qt.MouseButton.MiddleButton)
+               or bool(event.modifiers() & Qt.KeyboardModifier.ShiftModifier))
+        if pan:
+            self.set_camera(self.camera.panned(dx, dy, self.height()))
+        else:
+            self.set_camera(self.camera.orbited(-dx * ROTATE_DEG_PER_PX, dy * ROTATE_DEG_PER_PX))
+
+    def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        was_drag = self._moved
+        self._press = self._last = None
+        self._moved = False
+        if self._dragging:
+            self._dragging = False
+            self.invalidate()
+        if not was_drag and event.button() == Qt.MouseButton.LeftButton:
+            self.click_at(event.position().x(), event.position().y())
+
+    def click_at(self, x: float, y: float) -> int | None:
+        """Pick the point under (x, y) and say so with ``pointClicked``."""
+        pts = self.drawn.get("points")
+        if pts is None or len(pts) != len(self.point_ids):
+            pts = self.project(self.point_xyz) if len(self.point_xyz) else np.zeros((0, 2))
+        row = pick(pts, (x, y))
+        self.pointClicked.emit(-1 if row is None else int(self.point_ids[row]))
+        return None if row is None else int(self.point_ids[row])
+
+    def wheelEvent(self, event: QWheelEvent) -> None:
+        steps = event.angleDelta().y() / 120.0
+        if steps:
+            self.set_camera(self.camera.zoomed(ZOOM_PER_WHEEL_STEP**steps))
+
+    def set_dragging(self, dragging: bool) -> None:
+        """Level of detail on or off (the benchmark simulates a drag with it)."""
+        self._dragging = dragging
+        self.invalidate()
