@@ -62,9 +62,24 @@ def goals(out: dict[str, Any]) -> dict[str, Any]:
             value = int(value)
         number = value if isinstance(value, int | float) else None
         met = None if bound is None or number is None else number <= bound
-        goal = "report only" if bound is None else f"≤ {bound:g}{unit}"
+        if bound is None:
+            goal = "report only"
+        else:
+            goal = "no (0)" if bound == 0 and not unit else f"≤ {bound:g}{unit}"
         entries.append({"key": key, "what": what, "value": round(number, 3) if number is not None else value,
                         "goal": goal, "bound": bound, "met": met})
     judged = [e for e in entries if e["met"] is not None]
+    missing = [e["key"] for e in entries if e["bound"] is not None and e["met"] is None]
     return {"entries": entries, "met": sum(1 for e in judged if e["met"]), "judged": len(judged),
-            "all_met": bool(judged) and all(e["met"] for e in judged)}
+            "missing": missing, "all_met": bool(judged) and not missing and all(e["met"] for e in judged)}
+
+
+def table(result: dict[str, Any]) -> str:
+    """The goals as text lines (``make bench`` writes them to stderr; stdout stays one JSON)."""
+    lines = []
+    for e in result["entries"]:
+        mark = {True: "met", False: "NOT MET", None: "-"}[e["met"]]
+        lines.append(f"{e['what'][:66]:<66} {e['value']!s:>10}  {e['goal']:<12} {mark}")
+    lines.append(f"goals met: {result['met']} of {result['judged']} judged"
+                 + (f"; missing: {len(result['missing'])}" if result["missing"] else ""))
+    return "\n".join(lines)

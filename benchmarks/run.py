@@ -16,7 +16,7 @@ import sys
 import time
 from typing import Any
 
-from benchmarks.goals import goals
+from benchmarks.goals import goals, table
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -61,6 +61,7 @@ def main(argv: list[str] | None = None) -> int:
     out["goals"] = goals(out)
     json.dump(out, sys.stdout, indent=2, sort_keys=True)
     sys.stdout.write("\n")
+    sys.stderr.write(table(out["goals"]) + "\n")
     return 0
 
 
