@@ -344,9 +344,14 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
     for i, raw in enumerate(raw_points):
         if type(raw) is dict:
             fast = fast_point_from_fields(raw, limits, sync=unknown)
-            if fast is not None and fast.id not in seen and raw.get("uploaded") is None:
+            if fast is not None and fast.id not in seen:
                 seen[fast.id] = i
                 points.append(fast)
+                uploaded = raw.get("uploaded")
+                if uploaded is not None:
+                    record = _history_from(uploaded, f"points[{i}] (id {fast.id})")
+                    if record is not None:
+                        history[fast.id] = record
                 continue
         where = f"points[{i}]"
         obj = _expect(raw, dict, where, "", "an object")

@@ -109,3 +109,15 @@ def test_ledger_quick_check_agrees_with_make_point() -> None:
     with pytest.raises(FieldError):
         PointLedger([bad])
     assert len(PointLedger([good])) == 1
+
+
+def test_upload_history_on_the_fast_path() -> None:
+    good = dict(GOOD, uploaded={"time": "2025-01-31T09:00:00Z", "endpoint": "tcp 1.2.3.4:502"})
+    project = parse_project(_doc([good]))
+    assert project.upload_history[7].endpoint == "tcp 1.2.3.4:502"
+    bad = dict(GOOD, uploaded={"time": 5, "endpoint": ""})
+    with pytest.raises(FileFormatError) as fast:
+        parse_project(_doc([bad]))
+    with pytest.raises(FileFormatError) as exact:
+        _parse_project_exact(_doc([bad]), PointLimits(), path=None)
+    assert str(fast.value) == str(exact.value) and "points[0] (id 7) uploaded" in str(fast.value)
