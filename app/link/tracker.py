@@ -37,6 +37,7 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
 from __future__ import annotations
 
+import math
 from typing import Literal
 
 from app import timing
@@ -61,6 +62,8 @@ CompletionRule = Literal["sentinel", "observe"]
 
 # A pose component that changed by more than this (mm or degrees) counts as motion.
 POSE_EPSILON = 1e-3
+# A move is at its end point when the TCP is this close (mm) to the X Y Z the host sent for it.
+ARRIVAL_TOLERANCE = 0.5
 
 
 # --------------------------------------------------------------------------------------------
@@ -108,6 +111,9 @@ class CommandTracker:
         unconfirmed_after: float | None = None,
     ) -> None:
         self.command = command
+        # Move to point: the X Y Z this host sent for the end point, when it knows it. A move whose
+        # GV291 never left the stale code, seen moving and now still at the target, ended there.
+        self.target: tuple[float, float, float] | None = None
         self.kind = CommandKind.of(command)
         self.before = before
         self.before_pose = before_pose
@@ -201,7 +207,12 @@ class CommandTracker:
             stopped = self._check_stopped(status, code, now)
             if stopped is not None:
                 return stopped
-            if self._moved_without_status(status, progressed, now):
+            at_target = self._at_target(pose)
+            if self._moved_without_status(status, progressed, now, at_target=at_target):
+                if at_target:
+                    done = self.decode(STATUS_DONE)
+                    return self._finish(True, done, f"{self.text}: {done.text} (arrived at the point; "
+                                        f"the command status did not change)", now)
                 text = self.decode(self.pre_code).text
                 return self._fail(
                     CommandTimeout(
@@ -305,8 +316,10 @@ class CommandTracker:
             code, now,
         )
 
-    def _moved_without_status(self, status: ControllerStatus, progressed: bool, now: float) -> bool:
-        """A move seen under way has been still for a while and GV291 never left the stale code."""
+    def _moved_without_status(self, status: ControllerStatus, progressed: bool, now: float, *,
+                              at_target: bool = False) -> bool:
+        """A move seen under way has been still for a while and GV291 never left the stale code
+        (still at its target: after ``stop_settle``; elsewhere: also after ``ack_timeout``)."""
         if not self.is_move or self.code_left_pre or not self.motion_seen:
             return False
         if status.program_state != ProgramState.STOPPED or progressed:
@@ -314,7 +327,14 @@ class CommandTracker:
             return False
         if self._idle_since is None:
             self._idle_since = now
-        return now - self._idle_since >= self.stop_settle and now - self.started >= self.ack_timeout
+        settled = now - self._idle_since >= self.stop_settle
+        return settled and (at_target or now - self.started >= self.ack_timeout)
+
+    def _at_target(self, pose: Pose | None) -> bool:
+        """The arm stands at the end point this host sent (within ARRIVAL_TOLERANCE mm)."""
+        if self.target is None or pose is None:
+            return False
+        return math.dist(pose.xyzabc[:3], self.target) <= ARRIVAL_TOLERANCE
 
     def _details(self, now: float) -> dict[str, float]:
         details = {"elapsed": now - self.started}
