@@ -40,6 +40,7 @@ from PySide6.QtWidgets import (
     QSizePolicy,
     QSplitter,
     QTabWidget,
+    QToolBar,
     QVBoxLayout,
     QWidget,
 )
@@ -55,12 +56,15 @@ from ui.controllers.project_controller import ProjectController, ProjectDialogs
 from ui.dialogs.confirm import ConfirmFn
 from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import Translator
+from ui.panels.alarm_banner import AlarmBanner
+from ui.panels.alarm_list import AlarmListPanel
 from ui.panels.control_bar import ControlBar
 from ui.panels.event_log import EventLogPanel
 from ui.panels.jog_panel import JogPanel
 from ui.panels.monitor_panel import MonitorPanel
 from ui.panels.planner_panel import PlannerPanel
 from ui.panels.points_panel import PointsPanel
+from ui.panels.pose_strip import PoseStrip
 from ui.panels.program_panel import ProgramPanel
 from ui.panels.status_panel import StatusPanel
 from ui.panels.step_panel import StepPanel
@@ -155,6 +159,7 @@ class MainWindow(QMainWindow):
         self.status_panel = StatusPanel(self)
         self.traffic_panel = TrafficPanel(self)
         self.event_log = EventLogPanel(self)
+        self.alarm_list = AlarmListPanel(self)
         area = Qt.DockWidgetArea
         self.status_dock = self._dock("StatusDock", self.status_panel, area.LeftDockWidgetArea)
         # QMainWindow hands a narrow window's spare width to the docks as well: a status
@@ -163,6 +168,8 @@ class MainWindow(QMainWindow):
         self.event_dock = self._dock("EventLogDock", self.event_log, area.BottomDockWidgetArea)
         self.traffic_dock = self._dock("TrafficDock", self.traffic_panel, area.BottomDockWidgetArea)
         self.tabifyDockWidget(self.event_dock, self.traffic_dock)
+        self.alarm_dock = self._dock("AlarmDock", self.alarm_list, area.BottomDockWidgetArea)
+        self.tabifyDockWidget(self.event_dock, self.alarm_dock)
         self.event_dock.raise_()
         self.setCorner(Qt.Corner.BottomLeftCorner, area.LeftDockWidgetArea)  # status runs full height
         for panel in (self.event_log, self.traffic_panel):
@@ -180,7 +187,8 @@ class MainWindow(QMainWindow):
             tab_count=len(TAB_NAMES), set_language=self.set_language,
             language=translator.language if translator else "en", file_actions=self.project.file_actions(),
             edit_actions=[self.project.action_undo, self.project.action_redo],
-            docks=[self.status_dock, self.event_dock, self.traffic_dock])
+            docks=[self.status_dock, self.event_dock, self.traffic_dock, self.alarm_dock])
+        self._compose_strip_and_banner()
         self.status_project = QLabel(self)
         self.status_link = QLabel(self)
         self.status_rtt = QLabel(self)
@@ -196,6 +204,8 @@ class MainWindow(QMainWindow):
         self.resize(*self._default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])
         self._docks_sized = self._restore_window()  # else sized at the first show
+        self.alarm_banner.sync()  # shown exactly while an alarm is set, whatever was saved
+        self.pose_bar.setVisible(True)
         app = QApplication.instance()
         self._app_state_connected = isinstance(app, QApplication)
         if isinstance(app, QApplication):
@@ -219,9 +229,26 @@ class MainWindow(QMainWindow):
         self.addDockWidget(area, dock)
         return dock
 
+    def _compose_strip_and_banner(self) -> None:
+        """Window-wide rows above everything: the alarm banner (only while an alarm is set), the
+        main toolbar, then the pose strip (always). Neither can be moved or hidden by hand."""
+        self.alarm_banner = AlarmBanner(self)
+        self.insertToolBar(self.menus.toolbar, self.alarm_banner)
+        self.insertToolBarBreak(self.menus.toolbar)
+        self.pose_strip = PoseStrip(self)
+        self.pose_bar = QToolBar(self)
+        self.pose_bar.setObjectName("PoseStripBar")
+        self.pose_bar.setMovable(False)
+        self.pose_bar.setFloatable(False)
+        self.pose_bar.toggleViewAction().setVisible(False)
+        self.pose_bar.addWidget(self.pose_strip)
+        self.addToolBarBreak(Qt.ToolBarArea.TopToolBarArea)
+        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.pose_bar)
+
     def _wire(self) -> None:
         link, state = self.link, self.link.state
-        for panel in (self.monitor_panel, self.status_panel, self.event_log, self.control_bar):
+        for panel in (self.monitor_panel, self.status_panel, self.event_log, self.control_bar,
+                      self.pose_strip, self.alarm_banner, self.alarm_list):
             panel.bind(state)
         state.connectionChanged.connect(self._show_connection)
         state.rttChanged.connect(self._show_rtt)
@@ -251,6 +278,7 @@ class MainWindow(QMainWindow):
         self.status_dock.setWindowTitle(self.tr("Status"))
         self.event_dock.setWindowTitle(self.tr("Event log"))
         self.traffic_dock.setWindowTitle(self.tr("Modbus traffic"))
+        self.alarm_dock.setWindowTitle(self.tr("Alarms"))
         self.menus.retranslate()
         self.project.retranslate()
         self._on_project_title(self.project.title)
