@@ -2,6 +2,136 @@
 <!DOCTYPE TS>
 <TS version="2.1" language="zh_CN">
     <context>
+        <name>AlarmBanner</name>
+        <message>
+            <location filename="../../ui/panels/alarm_banner.py" line="35" />
+            <source>alarm bit {bit}</source>
+            <translation>报警位 {bit}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_banner.py" line="114" />
+            <source>ALARM: {names}</source>
+            <translation>报警：{names}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_banner.py" line="116" />
+            <source>(last known: the link is not live)</source>
+            <translation>（最后已知：通信未实时）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_banner.py" line="119" />
+            <source>Motion controls are held until the alarm is reset. STOP stays available.</source>
+            <translation>报警复位前运动控制已锁定。停止按钮始终可用。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_banner.py" line="123" />
+            <source>Register 562 = {word}</source>
+            <translation>寄存器 562 = {word}</translation>
+        </message>
+    </context>
+    <context>
+        <name>AlarmListPanel</name>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="88" />
+            <source>Alarm</source>
+            <translation>报警</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="88" />
+            <source>Meaning</source>
+            <translation>含义</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="88" />
+            <source>What to do</source>
+            <translation>处理方法</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="89" />
+            <source>Raised</source>
+            <translation>触发时间</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="89" />
+            <source>Cleared</source>
+            <translation>清除时间</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="107" />
+            <location filename="../../ui/panels/alarm_list.py" line="115" />
+            <source>active</source>
+            <translation>未清除</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="113" />
+            <source>raised {raised}, cleared {cleared}</source>
+            <translation>触发 {raised}，清除 {cleared}</translation>
+        </message>
+    </context>
+    <context>
+        <name>Alarms</name>
+        <message>
+            <location filename="../../app/alarm_history.py" line="37" />
+            <source>The emergency stop circuit is open: servo power is off.</source>
+            <translation>急停回路断开：伺服已断电。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="38" />
+            <source>A servo drive reported a fault.</source>
+            <translation>伺服驱动器报告故障。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="39" />
+            <source>A holding brake did not release or engage as commanded.</source>
+            <translation>抱闸未按指令松开或抱紧。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="40" />
+            <source>The motion planner rejected a move (out of reach, singularity or limit).</source>
+            <translation>运动规划拒绝了该运动（超出范围、奇异点或限位）。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="42" />
+            <source>An axis encoder angle is implausible or was lost.</source>
+            <translation>某轴编码器角度异常或丢失。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="45" />
+            <source>Make the cell safe, release the emergency stop button, then reset the alarm on the controller.</source>
+            <translation>确认现场安全，松开急停按钮，然后在控制器上复位报警。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="47" />
+            <source>Read the drive's fault code on the controller, remove the cause, then reset the alarm.</source>
+            <translation>在控制器上查看驱动器故障码，排除原因后复位报警。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="49" />
+            <source>Do not move the arm; check the brake wiring and power, then reset the alarm.</source>
+            <translation>不要移动机械臂；检查抱闸接线和电源，然后复位报警。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="51" />
+            <source>Check the target point and speed, reset the alarm, then move to a reachable point.</source>
+            <translation>检查目标点和速度，复位报警，然后移动到可达的点。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="53" />
+            <source>Check the encoder cable; the zero position may need recalibration before moving.</source>
+            <translation>检查编码器电缆；运动前可能需要重新标定零点。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="56" />
+            <source>A bit the protocol does not document.</source>
+            <translation>协议未说明的报警位。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="57" />
+            <source>Read the alarm on the controller's own pendant.</source>
+            <translation>请在控制器自带的示教器上查看报警。</translation>
+        </message>
+    </context>
+    <context>
         <name>ConnectionDialog</name>
         <message>
             <location filename="../../ui/dialogs/connection_dialog.py" line="115" />
@@ -107,62 +237,68 @@
     <context>
         <name>ControlBar</name>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="97" />
+            <location filename="../../ui/panels/control_bar.py" line="130" />
             <source>STOP</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="98" />
+            <location filename="../../ui/panels/control_bar.py" line="131" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="99" />
+            <location filename="../../ui/panels/control_bar.py" line="132" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="100" />
+            <location filename="../../ui/panels/control_bar.py" line="133" />
             <source>Pause the current move or program</source>
             <translation>暂停当前运动或程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="101" />
+            <location filename="../../ui/panels/control_bar.py" line="134" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="102" />
+            <location filename="../../ui/panels/control_bar.py" line="135" />
             <source>Resume the paused move or program</source>
             <translation>继续已暂停的运动或程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="103" />
+            <location filename="../../ui/panels/control_bar.py" line="222" />
+            <source>unknown</source>
+            <translation>未知</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/control_bar.py" line="226" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="104" />
+            <location filename="../../ui/panels/control_bar.py" line="136" />
             <source>Manual</source>
             <translation>手动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="105" />
+            <location filename="../../ui/panels/control_bar.py" line="137" />
             <source>Switch the controller to manual mode</source>
             <translation>将控制器切换到手动模式</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="106" />
+            <location filename="../../ui/panels/control_bar.py" line="138" />
             <source>Auto</source>
             <translation>自动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="107" />
+            <location filename="../../ui/panels/control_bar.py" line="139" />
             <source>Switch the controller to auto mode (needed for Modbus motion)</source>
             <translation>将控制器切换到自动模式（Modbus 运动需要自动模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="152" />
+            <location filename="../../ui/panels/control_bar.py" line="223" />
+            <location filename="../../ui/panels/control_bar.py" line="224" />
             <source>Mode:
 {mode}</source>
             <translation>模式：
@@ -479,113 +615,118 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="245" />
+            <location filename="../../ui/main_window.py" line="272" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="246" />
+            <location filename="../../ui/main_window.py" line="273" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="247" />
+            <location filename="../../ui/main_window.py" line="274" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="251" />
+            <location filename="../../ui/main_window.py" line="278" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="252" />
+            <location filename="../../ui/main_window.py" line="279" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="253" />
+            <location filename="../../ui/main_window.py" line="280" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="286" />
+            <location filename="../../ui/main_window.py" line="314" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="274" />
+            <location filename="../../ui/main_window.py" line="302" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="302" />
+            <location filename="../../ui/main_window.py" line="330" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="304" />
+            <location filename="../../ui/main_window.py" line="332" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="309" />
+            <location filename="../../ui/main_window.py" line="337" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="322" />
+            <location filename="../../ui/main_window.py" line="350" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="333" />
+            <location filename="../../ui/main_window.py" line="361" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="339" />
+            <location filename="../../ui/main_window.py" line="367" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="335" />
-            <location filename="../../ui/main_window.py" line="340" />
+            <location filename="../../ui/main_window.py" line="363" />
+            <location filename="../../ui/main_window.py" line="368" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="248" />
+            <location filename="../../ui/main_window.py" line="275" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="249" />
+            <location filename="../../ui/main_window.py" line="276" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="250" />
+            <location filename="../../ui/main_window.py" line="277" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="403" />
+            <location filename="../../ui/main_window.py" line="281" />
+            <source>Alarms</source>
+            <translation>报警</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="431" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="404" />
+            <location filename="../../ui/main_window.py" line="432" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="412" />
+            <location filename="../../ui/main_window.py" line="440" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="413" />
+            <location filename="../../ui/main_window.py" line="441" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -593,94 +734,104 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="256" />
+            <location filename="../../ui/panels/monitor_panel.py" line="228" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="256" />
+            <location filename="../../ui/panels/monitor_panel.py" line="228" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="257" />
+            <location filename="../../ui/panels/monitor_panel.py" line="229" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="259" />
+            <location filename="../../ui/panels/monitor_panel.py" line="231" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="263" />
+            <location filename="../../ui/panels/monitor_panel.py" line="235" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="264" />
+            <location filename="../../ui/panels/monitor_panel.py" line="236" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="265" />
+            <location filename="../../ui/panels/monitor_panel.py" line="237" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="266" />
+            <location filename="../../ui/panels/monitor_panel.py" line="238" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="267" />
+            <location filename="../../ui/panels/monitor_panel.py" line="239" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="268" />
+            <location filename="../../ui/panels/monitor_panel.py" line="240" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="269" />
+            <location filename="../../ui/panels/monitor_panel.py" line="241" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="270" />
+            <location filename="../../ui/panels/monitor_panel.py" line="242" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="271" />
+            <location filename="../../ui/panels/monitor_panel.py" line="243" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="272" />
+            <location filename="../../ui/panels/monitor_panel.py" line="244" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="272" />
+            <location filename="../../ui/panels/monitor_panel.py" line="244" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="273" />
+            <location filename="../../ui/panels/monitor_panel.py" line="245" />
             <source>TCP path, top view (X–Y)</source>
             <translation>TCP 轨迹俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="444" />
+            <location filename="../../ui/panels/monitor_panel.py" line="265" />
+            <source>Stale: not confirmed by the controller within the freshness limit</source>
+            <translation>数据过期：未在时效内得到控制器确认</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="460" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="446" />
+            <location filename="../../ui/panels/monitor_panel.py" line="462" />
             <source>paused</source>
             <translation>已暂停</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="464" />
+            <source>values stale (grey): no fresh data from the controller</source>
+            <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
     </context>
     <context>
@@ -1756,6 +1907,81 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         </message>
     </context>
     <context>
+        <name>PoseStrip</name>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="58" />
+            <source>live</source>
+            <translation>实时</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="59" />
+            <source>stale {age} s</source>
+            <translation>过期 {age} 秒</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="60" />
+            <source>stale</source>
+            <translation>过期</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="61" />
+            <location filename="../../ui/panels/pose_strip.py" line="241" />
+            <location filename="../../ui/panels/pose_strip.py" line="242" />
+            <source>unknown</source>
+            <translation>未知</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="63" />
+            <source>disconnected</source>
+            <translation>未连接</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="64" />
+            <source>connecting</source>
+            <translation>连接中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="65" />
+            <source>not answering</source>
+            <translation>无应答</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="66" />
+            <source>link down</source>
+            <translation>通信中断</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="163" />
+            <source>mm</source>
+            <translation>mm</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="164" />
+            <source>Mode</source>
+            <translation>模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="165" />
+            <source>Program</source>
+            <translation>程序</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="166" />
+            <source>The controller's work mode (register 560)</source>
+            <translation>控制器工作模式（寄存器 560）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="167" />
+            <source>The controller's program state (register 561)</source>
+            <translation>控制器程序状态（寄存器 561）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="168" />
+            <source>Whether the values shown were confirmed by the controller within the freshness limit</source>
+            <translation>显示的数值是否在时效内得到控制器确认</translation>
+        </message>
+    </context>
+    <context>
         <name>ProgramPanel</name>
         <message>
             <location filename="../../ui/panels/program_panel.py" line="102" />
@@ -2457,124 +2683,141 @@ Recover it?</source>
     <context>
         <name>StatusPanel</name>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="219" />
+            <location filename="../../ui/panels/status_panel.py" line="225" />
             <source>Link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="220" />
+            <location filename="../../ui/panels/status_panel.py" line="226" />
             <source>Controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="221" />
+            <location filename="../../ui/panels/status_panel.py" line="227" />
+            <location filename="../../ui/panels/status_panel.py" line="295" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="223" />
+            <location filename="../../ui/panels/status_panel.py" line="227" />
+            <location filename="../../ui/panels/status_panel.py" line="295" />
+            <source>Alarms (last known)</source>
+            <translation>报警（最后已知）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/status_panel.py" line="229" />
             <source>State:</source>
             <translation>状态：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="224" />
+            <location filename="../../ui/panels/status_panel.py" line="230" />
             <source>RTT:</source>
             <translation>往返时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="225" />
+            <location filename="../../ui/panels/status_panel.py" line="231" />
             <source>Mode:</source>
             <translation>模式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="226" />
+            <location filename="../../ui/panels/status_panel.py" line="232" />
             <source>Program:</source>
             <translation>程序：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="227" />
+            <location filename="../../ui/panels/status_panel.py" line="233" />
             <source>Last command:</source>
             <translation>上一条命令：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="228" />
+            <location filename="../../ui/panels/status_panel.py" line="234" />
             <source>Clock:</source>
             <translation>系统时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="229" />
+            <location filename="../../ui/panels/status_panel.py" line="235" />
             <source>Drift:</source>
             <translation>时差：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="230" />
+            <location filename="../../ui/panels/status_panel.py" line="236" />
             <source>Round-trip time of the last poll</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="234" />
+            <location filename="../../ui/panels/status_panel.py" line="240" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="235" />
+            <location filename="../../ui/panels/status_panel.py" line="241" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="238" />
+            <location filename="../../ui/panels/status_panel.py" line="244" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="246" />
+            <location filename="../../ui/panels/status_panel.py" line="251" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="336" />
+            <location filename="../../ui/panels/status_panel.py" line="344" />
+            <source>unknown</source>
+            <translation>未知</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/status_panel.py" line="362" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="338" />
+            <location filename="../../ui/panels/status_panel.py" line="364" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="348" />
+            <location filename="../../ui/panels/status_panel.py" line="374" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="354" />
+            <location filename="../../ui/panels/status_panel.py" line="380" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="367" />
+            <location filename="../../ui/panels/status_panel.py" line="393" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="375" />
+            <location filename="../../ui/panels/status_panel.py" line="401" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="379" />
+            <location filename="../../ui/panels/status_panel.py" line="405" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="383" />
+            <location filename="../../ui/panels/status_panel.py" line="409" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="390" />
+            <location filename="../../ui/panels/status_panel.py" line="415" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/status_panel.py" line="417" />
+            <source>{time} (stale)</source>
+            <translation>{time}（已过期）</translation>
         </message>
     </context>
     <context>
