@@ -4,27 +4,27 @@
     <context>
         <name>AlarmBanner</name>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="35" />
+            <location filename="../../ui/panels/alarm_banner.py" line="37" />
             <source>alarm bit {bit}</source>
             <translation>报警位 {bit}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="114" />
+            <location filename="../../ui/panels/alarm_banner.py" line="128" />
             <source>ALARM: {names}</source>
             <translation>报警：{names}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="116" />
+            <location filename="../../ui/panels/alarm_banner.py" line="130" />
             <source>(last known: the link is not live)</source>
             <translation>（最后已知：通信未实时）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="119" />
+            <location filename="../../ui/panels/alarm_banner.py" line="133" />
             <source>Motion controls are held until the alarm is reset. STOP stays available.</source>
             <translation>报警复位前运动控制已锁定。停止按钮始终可用。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="123" />
+            <location filename="../../ui/panels/alarm_banner.py" line="142" />
             <source>Register 562 = {word}</source>
             <translation>寄存器 562 = {word}</translation>
         </message>
@@ -734,102 +734,102 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="228" />
+            <location filename="../../ui/panels/monitor_panel.py" line="230" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="228" />
+            <location filename="../../ui/panels/monitor_panel.py" line="230" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="229" />
+            <location filename="../../ui/panels/monitor_panel.py" line="231" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="231" />
+            <location filename="../../ui/panels/monitor_panel.py" line="233" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="235" />
+            <location filename="../../ui/panels/monitor_panel.py" line="237" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="236" />
+            <location filename="../../ui/panels/monitor_panel.py" line="238" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="237" />
+            <location filename="../../ui/panels/monitor_panel.py" line="239" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="238" />
+            <location filename="../../ui/panels/monitor_panel.py" line="240" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="239" />
+            <location filename="../../ui/panels/monitor_panel.py" line="241" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="240" />
+            <location filename="../../ui/panels/monitor_panel.py" line="242" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="241" />
+            <location filename="../../ui/panels/monitor_panel.py" line="243" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="242" />
+            <location filename="../../ui/panels/monitor_panel.py" line="244" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="243" />
+            <location filename="../../ui/panels/monitor_panel.py" line="245" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="244" />
+            <location filename="../../ui/panels/monitor_panel.py" line="246" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="244" />
+            <location filename="../../ui/panels/monitor_panel.py" line="246" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="245" />
-            <source>TCP path, top view (X–Y)</source>
-            <translation>TCP 轨迹俯视图（X–Y）</translation>
+            <location filename="../../ui/panels/monitor_panel.py" line="247" />
+            <source>Top view (X–Y)</source>
+            <translation>俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="265" />
+            <location filename="../../ui/panels/monitor_panel.py" line="267" />
             <source>Stale: not confirmed by the controller within the freshness limit</source>
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="460" />
+            <location filename="../../ui/panels/monitor_panel.py" line="462" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="462" />
+            <location filename="../../ui/panels/monitor_panel.py" line="464" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="464" />
+            <location filename="../../ui/panels/monitor_panel.py" line="466" />
             <source>values stale (grey): no fresh data from the controller</source>
             <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
@@ -1925,8 +1925,8 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         </message>
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="61" />
+            <location filename="../../ui/panels/pose_strip.py" line="240" />
             <location filename="../../ui/panels/pose_strip.py" line="241" />
-            <location filename="../../ui/panels/pose_strip.py" line="242" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
@@ -1951,32 +1951,32 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="163" />
+            <location filename="../../ui/panels/pose_strip.py" line="162" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="164" />
+            <location filename="../../ui/panels/pose_strip.py" line="163" />
             <source>Mode</source>
             <translation>模式</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="165" />
+            <location filename="../../ui/panels/pose_strip.py" line="164" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="166" />
+            <location filename="../../ui/panels/pose_strip.py" line="165" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="167" />
+            <location filename="../../ui/panels/pose_strip.py" line="166" />
             <source>The controller's program state (register 561)</source>
             <translation>控制器程序状态（寄存器 561）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="168" />
+            <location filename="../../ui/panels/pose_strip.py" line="167" />
             <source>Whether the values shown were confirmed by the controller within the freshness limit</source>
             <translation>显示的数值是否在时效内得到控制器确认</translation>
         </message>
@@ -2815,9 +2815,9 @@ Recover it?</source>
             <translation>{drift} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="417" />
-            <source>{time} (stale)</source>
-            <translation>{time}（已过期）</translation>
+            <location filename="../../ui/panels/status_panel.py" line="419" />
+            <source>{value} (stale)</source>
+            <translation>{value}（已过期）</translation>
         </message>
     </context>
     <context>

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import html
 
-from PySide6.QtCore import QCoreApplication, QEvent, Qt, Slot
+from PySide6.QtCore import QCoreApplication, QEvent, QSize, Qt, Slot
 from PySide6.QtWidgets import QLabel, QSizePolicy, QToolBar, QWidget
 
 from app.alarm_history import (
@@ -25,6 +25,8 @@ from app.protocol.enums import ALARM_TEXT, TR_CONTEXT
 from ui.palette import COLOR_ALARM_BANNER, COLOR_ALARM_BANNER_TEXT, COLOR_ERROR_DARK
 
 __all__ = ["AlarmBanner", "alarm_name"]
+
+BANNER_HINT_WIDTH = 200  # px: the text's size hint in the toolbar (it stretches to the window)
 
 
 def alarm_name(bit: int) -> str:
@@ -42,6 +44,17 @@ def alarm_advice(bit: int) -> str:
     return QCoreApplication.translate(TR_ALARMS, UNKNOWN_ADVICE)
 
 
+class _BannerText(QLabel):
+    """A label that asks a toolbar for little width and takes what is there (Expanding): a
+    toolbar moves a widget whose size hint does not fit into its overflow menu."""
+
+    def sizeHint(self) -> QSize:
+        return QSize(BANNER_HINT_WIDTH, super().sizeHint().height())
+
+    def minimumSizeHint(self) -> QSize:
+        return QSize(BANNER_HINT_WIDTH, super().minimumSizeHint().height())
+
+
 class AlarmBanner(QToolBar):
     """See the module docstring. ``bind(state)``; ``text()`` is what it says (plain)."""
 
@@ -54,12 +67,13 @@ class AlarmBanner(QToolBar):
         self.setContextMenuPolicy(Qt.ContextMenuPolicy.PreventContextMenu)
         self.setStyleSheet(f"QToolBar#AlarmBanner {{ background: {COLOR_ALARM_BANNER};"
                            f" border: 2px solid {COLOR_ERROR_DARK}; padding: 2px; spacing: 0px; }}")
-        self.label = QLabel(self)
+        self.label = _BannerText(self)
         self.label.setObjectName("AlarmBannerText")
-        self.label.setWordWrap(True)
+        # one line per alarm, no wrapping: a wrapping label in a toolbar asks for its height at a
+        # narrow width and the banner grows to several times its text
+        self.label.setWordWrap(False)
         self.label.setTextFormat(Qt.TextFormat.RichText)
-        self.label.setStyleSheet(f"QLabel {{ color: {COLOR_ALARM_BANNER_TEXT}; font-size: 15px;"
-                                 " padding: 4px 10px; }")
+        self.label.setStyleSheet(f"QLabel {{ color: {COLOR_ALARM_BANNER_TEXT}; padding: 2px 8px; }}")
         self.label.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Preferred)
         self.addWidget(self.label)
         self._state: RobotState | None = None
@@ -114,11 +128,16 @@ class AlarmBanner(QToolBar):
         title = self.tr("ALARM: {names}").format(names=names)
         if self._state is not None and not self._state.fresh:
             title += " " + self.tr("(last known: the link is not live)")
-        lines = [f"{alarm_name(b)}: {alarm_advice(b)}" for b in bits]
+        held = ""
         if blocks_motion(self._alarms):
-            lines.append(self.tr("Motion controls are held until the alarm is reset. STOP stays available."))
-        self._plain = "\n".join([title, *lines])
+            held = self.tr("Motion controls are held until the alarm is reset. STOP stays available.")
+        lines = [f"{alarm_name(b)}: {alarm_advice(b)}" for b in bits]
+        self._plain = "\n".join([f"{title} — {held}" if held else title, *lines])
+        head = f"<span style='font-size:16px'><b>{html.escape(title)}</b></span>"
+        if held:
+            head += f" &nbsp;—&nbsp; <b>{html.escape(held)}</b>"
         body = "<br>".join(html.escape(line) for line in lines)
-        self.label.setText(f"<b style='font-size:17px'>{html.escape(title)}</b><br>{body}")
-        self.label.setToolTip(self.tr("Register 562 = {word}").format(word=f"0x{self._alarms:04X}"))
+        self.label.setText(f"{head}<br>{body}")
+        self.label.setToolTip(self._plain)
+        self.setToolTip(self.tr("Register 562 = {word}").format(word=f"0x{self._alarms:04X}"))
 

@@ -193,6 +193,8 @@ class MonitorPanel(QWidget):
             self.curves[name] = curve
 
         self.trace_plot.setAspectLocked(True)
+        # room on the right for the last bottom tick label (else clipped at the plot's edge)
+        self.trace_plot.getPlotItem().layout.setContentsMargins(2, 2, 16, 2)
         self.trace_curve = pg.PlotCurveItem(pen=pg.mkPen(_TRACE_COLOR, width=2))
         self.trace_plot.addItem(self.trace_curve)
         self.trace_marker = pg.ScatterPlotItem(size=11, brush=pg.mkBrush("#ff6f00"), pen=pg.mkPen("#263238"))
@@ -242,7 +244,7 @@ class MonitorPanel(QWidget):
         self.xyz_plot.setLabel("left", self.tr("position"), units=mm)
         self.abc_plot.setLabel("left", self.tr("orientation"), units=deg)
         self.abc_plot.setLabel("bottom", self.tr("time"), units=self.tr("s"))
-        self.trace_plot.setTitle(self.tr("TCP path, top view (X–Y)"), color="#263238", size="10pt")
+        self.trace_plot.setTitle(self.tr("Top view (X–Y)"), color="#263238", size="10pt")
         self.trace_plot.setLabel("bottom", "X", units=mm)
         self.trace_plot.setLabel("left", "Y", units=mm)
         self._update_status_text()

@@ -82,10 +82,9 @@ def _tr(text: str) -> str:
     return QCoreApplication.translate(CTX, text)
 
 
-def _chip_style(background: str, color: str, *, italic: bool = False) -> str:
-    style = "italic" if italic else "normal"
+def _chip_style(background: str, color: str) -> str:
     return (f"QLabel {{ background-color: {background}; color: {color}; border: 1px solid {COLOR_BORDER};"
-            f" border-radius: 5px; padding: 2px 8px; font-style: {style}; }}")
+            " border-radius: 5px; padding: 2px 8px; }")
 
 
 class PoseStrip(QFrame):
@@ -238,8 +237,8 @@ class PoseStrip(QFrame):
     def _show_status(self) -> None:
         status = self._state.status if self._state is not None else None
         if status is None or not self.is_live():
-            self._set_chip(self.mode_chip, self.tr("unknown"), _UNKNOWN_COLORS, italic=True)
-            self._set_chip(self.program_chip, self.tr("unknown"), _UNKNOWN_COLORS, italic=True)
+            self._set_chip(self.mode_chip, self.tr("unknown"), _UNKNOWN_COLORS)
+            self._set_chip(self.program_chip, self.tr("unknown"), _UNKNOWN_COLORS)
             return
         try:
             mode: ControllerMode | None = ControllerMode(int(status.mode))
@@ -259,14 +258,14 @@ class PoseStrip(QFrame):
         self._set_chip(self.program_chip, text, _PROGRAM_COLORS[program] if program is not None
                        else (COLOR_ERROR, COLOR_WHITE))
 
-    def _set_chip(self, chip: QLabel, text: str, colors: tuple[str, str], *, italic: bool = False) -> None:
+    def _set_chip(self, chip: QLabel, text: str, colors: tuple[str, str]) -> None:
         metrics = chip.fontMetrics()
         room = chip.maximumWidth() - CHIP_PADDING
         shown = metrics.elidedText(text, Qt.TextElideMode.ElideRight, max(room, 10))
         if chip.text() != shown:
             chip.setText(shown)
         chip.setToolTip(text if shown != text else chip.toolTip())
-        sheet = _chip_style(*colors, italic=italic)
+        sheet = _chip_style(*colors)
         if chip.styleSheet() != sheet:
             chip.setStyleSheet(sheet)
 

@@ -7,7 +7,7 @@ panel keeps no controller state of its own beyond what is needed to draw it.
 
 Staleness: while ``state.fresh`` is False (no good poll within the freshness limit, or the link
 not CONNECTED) the mode and program lamps read "unknown" in grey and the clock and drift turn
-grey with "(stale)": nothing here looks live that isn't. The alarm lamps keep the last known
+grey and italic, the drift marked "(stale)": nothing here looks live that isn't. The alarm lamps keep the last known
 bits (an alarm is never hidden by a silent link) under a "last known" title.
 """
 
@@ -412,9 +412,11 @@ class StatusPanel(QWidget):
             self.drift_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
             return
         stamp = clock.value.strftime("%Y-%m-%d %H:%M:%S")
-        self.drift_label.setText(self.tr("{drift} s").format(drift=f"{drift:+.0f}"))
-        if not self._fresh:  # the last reading, no longer ticking: grey, marked
-            self.clock_label.setText(self.tr("{time} (stale)").format(time=stamp))
+        drift_text = self.tr("{drift} s").format(drift=f"{drift:+.0f}")
+        self.drift_label.setText(drift_text)
+        if not self._fresh:  # the last reading, no longer ticking: grey, italic, marked stale
+            self.clock_label.setText(stamp)
+            self.drift_label.setText(self.tr("{value} (stale)").format(value=drift_text))
             self.clock_label.setStyleSheet(f"color: {COLOR_NEUTRAL}; font-style: italic;")
             self.drift_label.setStyleSheet(f"color: {COLOR_NEUTRAL}; font-style: italic;")
             return
