@@ -1022,58 +1022,58 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="169" />
+            <location filename="../../ui/panels/plan_preview.py" line="172" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="170" />
+            <location filename="../../ui/panels/plan_preview.py" line="173" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="171" />
+            <location filename="../../ui/panels/plan_preview.py" line="174" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="240" />
+            <location filename="../../ui/panels/plan_preview.py" line="243" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="242" />
+            <location filename="../../ui/panels/plan_preview.py" line="245" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="244" />
+            <location filename="../../ui/panels/plan_preview.py" line="247" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="245" />
+            <location filename="../../ui/panels/plan_preview.py" line="248" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="248" />
+            <location filename="../../ui/panels/plan_preview.py" line="251" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="252" />
+            <location filename="../../ui/panels/plan_preview.py" line="255" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="254" />
+            <location filename="../../ui/panels/plan_preview.py" line="257" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="255" />
+            <location filename="../../ui/panels/plan_preview.py" line="258" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -1909,74 +1909,74 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>PoseStrip</name>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="58" />
+            <location filename="../../ui/panels/pose_strip.py" line="63" />
             <source>live</source>
             <translation>实时</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="59" />
+            <location filename="../../ui/panels/pose_strip.py" line="64" />
             <source>stale {age} s</source>
             <translation>过期 {age} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="60" />
+            <location filename="../../ui/panels/pose_strip.py" line="65" />
             <source>stale</source>
             <translation>过期</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="61" />
-            <location filename="../../ui/panels/pose_strip.py" line="240" />
-            <location filename="../../ui/panels/pose_strip.py" line="241" />
+            <location filename="../../ui/panels/pose_strip.py" line="66" />
+            <location filename="../../ui/panels/pose_strip.py" line="270" />
+            <location filename="../../ui/panels/pose_strip.py" line="271" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="63" />
+            <location filename="../../ui/panels/pose_strip.py" line="68" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="64" />
+            <location filename="../../ui/panels/pose_strip.py" line="69" />
             <source>connecting</source>
             <translation>连接中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="65" />
+            <location filename="../../ui/panels/pose_strip.py" line="70" />
             <source>not answering</source>
             <translation>无应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="66" />
+            <location filename="../../ui/panels/pose_strip.py" line="71" />
             <source>link down</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="162" />
+            <location filename="../../ui/panels/pose_strip.py" line="192" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="163" />
+            <location filename="../../ui/panels/pose_strip.py" line="193" />
             <source>Mode</source>
             <translation>模式</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="164" />
+            <location filename="../../ui/panels/pose_strip.py" line="194" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="165" />
+            <location filename="../../ui/panels/pose_strip.py" line="195" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="166" />
+            <location filename="../../ui/panels/pose_strip.py" line="196" />
             <source>The controller's program state (register 561)</source>
             <translation>控制器程序状态（寄存器 561）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="167" />
+            <location filename="../../ui/panels/pose_strip.py" line="197" />
             <source>Whether the values shown were confirmed by the controller within the freshness limit</source>
             <translation>显示的数值是否在时效内得到控制器确认</translation>
         </message>

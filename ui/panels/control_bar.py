@@ -44,9 +44,9 @@ MODE_COLORS: dict[int | None, tuple[str, str]] = {
 UNKNOWN_MODE_COLORS = ("#c62828", "#ffffff")
 BUTTON_HEIGHT = 34
 STOP_PIXELS = 20  # STOP's font size
-STOP_MIN_WIDTH = 96  # px, whatever its text
+STOP_MIN_WIDTH = 90  # px, whatever its text
 MODE_PIXELS = 15  # the mode badge's font size
-MODE_PADDING = 24  # px: the badge's left + right padding
+MODE_PADDING = 14  # px: the badge's left + right padding
 MODE_MAX_WIDTH = 150  # px: a wider mode text wraps at a space or elides (tooltip: full text)
 
 

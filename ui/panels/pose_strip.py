@@ -8,14 +8,18 @@ value or text in every shipped language, so nothing moves when a text changes.
 When the values are not fresh (no good poll within the state's freshness limit, or the link
 not CONNECTED) the numbers keep their last known value but turn grey and italic, the chips say
 "unknown", and the freshness part counts the age up once a second. Nothing looks live that isn't.
+
+Width: the strip asks for its compact width (no units, no chip captions) and takes what it is
+given; given less than its full width (a 1024 px window) it hides the units and the captions.
+That depends on the width only, never on a text, and a toolbar never moves it to its overflow.
 """
 
 from __future__ import annotations
 
 import math
 
-from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
-from PySide6.QtGui import QFont, QHideEvent, QShowEvent
+from PySide6.QtCore import QCoreApplication, QEvent, QSize, Qt, QTimer, Slot
+from PySide6.QtGui import QFont, QHideEvent, QResizeEvent, QShowEvent
 from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QSizePolicy, QWidget
 
 from app.link.state import RobotState
@@ -54,6 +58,7 @@ AGE_TICK_MS = 1000  # the stale age counts up at this period (only while stale a
 VALUE_SAMPLE = "-8888.88"  # the widest value the strip keeps room for
 VALUE_POINTS = 12.0
 CHIP_PADDING = 20  # px: the chips' left + right padding and border
+CHIP_SLACK = 4  # px more than the widest text: elision measures a pixel or two wider
 # Freshness texts (the "stale" one gets its age).
 _LIVE = QT_TRANSLATE_NOOP("PoseStrip", "live")
 _STALE = QT_TRANSLATE_NOOP("PoseStrip", "stale {age} s")
@@ -142,18 +147,43 @@ class PoseStrip(QFrame):
             layout.addWidget(widget)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         self.retranslate()
+        self._optional = [*self.units.values(), self.mode_caption, self.program_caption]
+        self._full_width = layout.sizeHint().width()
+        spacing = layout.spacing()
+        self._compact_width = self._full_width - sum(w.maximumWidth() + spacing for w in self._optional)
+        self._compact = False
+
+    def sizeHint(self) -> QSize:
+        return QSize(self._compact_width, super().sizeHint().height())
+
+    def minimumSizeHint(self) -> QSize:
+        return QSize(self._compact_width, super().minimumSizeHint().height())
+
+    @property
+    def compact(self) -> bool:
+        """Units and chip captions hidden: the strip has less than its full width."""
+        return self._compact
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        compact = event.size().width() < self._full_width
+        if compact != self._compact:
+            self._compact = compact
+            for widget in self._optional:
+                widget.setVisible(not compact)
+        super().resizeEvent(event)
 
     def _fix_widths(self) -> None:
         # an undocumented mode code ("unknown status 7") is rare: it elides, the tooltip has it
         proto = [t for text in CONTROLLER_MODE_TEXT.values() for t in both_languages(TR_CONTEXT, text)]
         unknown = both_languages(CTX, _UNKNOWN)
-        self.mode_chip.setFixedWidth(fit_width(self.mode_chip, [*proto, *unknown], CHIP_PADDING))
+        pad = CHIP_PADDING + CHIP_SLACK
+        self.mode_chip.setFixedWidth(fit_width(self.mode_chip, [*proto, *unknown], pad))
         program = [t for text in PROGRAM_STATE_TEXT.values() for t in both_languages(TR_CONTEXT, text)]
-        self.program_chip.setFixedWidth(fit_width(self.program_chip, [*program, *unknown], CHIP_PADDING))
+        self.program_chip.setFixedWidth(fit_width(self.program_chip, [*program, *unknown], pad))
         fresh = [t for text in (_LIVE, _STALE_NO_AGE, *_LINK_TEXT.values())
                  for t in both_languages(CTX, text)]
         fresh += [t.format(age=888) for t in both_languages(CTX, _STALE)]
-        self.freshness.setFixedWidth(fit_width(self.freshness, fresh, CHIP_PADDING))
+        self.freshness.setFixedWidth(fit_width(self.freshness, fresh, pad))
         self.mode_caption.setFixedWidth(fit_width(self.mode_caption, both_languages(CTX, "Mode"), 4))
         self.program_caption.setFixedWidth(fit_width(self.program_caption, both_languages(CTX, "Program"), 4))
 
