@@ -32,7 +32,8 @@ from ui.widgets_common import LEVEL_OFF
 POSE = Pose(512.25, -3.5, 400.0, 180.0, 0.0, -90.0)
 
 
-def status(mode: int = ControllerMode.AUTO, program: int = ProgramState.STOPPED, alarms: int = 0) -> ControllerStatus:
+def status(mode: int = ControllerMode.AUTO, program: int = ProgramState.STOPPED,
+           alarms: int = 0) -> ControllerStatus:
     return ControllerStatus(mode, program, Alarm(alarms), 0xFF)
 
 
@@ -64,12 +65,14 @@ def test_the_strip_shows_pose_mode_and_program_live(strip: PoseStrip, link: Fake
     assert strip.freshness_text() == "stale" and strip.value_text("X") == "—"
     poll(link, st=status(ControllerMode.MANUAL, ProgramState.RUNNING))
     assert strip.is_live() and strip.freshness_text() == "live"
-    assert [strip.value_text(a) for a in "XYZABC"] == ["512.25", "-3.50", "400.00", "180.00", "0.00", "-90.00"]
+    shown = [strip.value_text(a) for a in "XYZABC"]
+    assert shown == ["512.25", "-3.50", "400.00", "180.00", "0.00", "-90.00"]
     assert strip.mode_chip.text() == "manual" and strip.program_chip.text() == "running"
     assert strip.values["X"].property("stale") is False
 
 
-def test_the_strip_goes_stale_after_silence_and_live_again(qtbot: Any, strip: PoseStrip, link: FakeLink) -> None:
+def test_the_strip_goes_stale_after_silence_and_live_again(qtbot: Any, strip: PoseStrip,
+                                                           link: FakeLink) -> None:
     link.state.set_freshness_limit(0.05)
     poll(link)
     assert strip.is_live()

@@ -6,9 +6,10 @@ status, alarms, RTT, last command result); the ``on_*`` slots take the payloads 
 panel keeps no controller state of its own beyond what is needed to draw it.
 
 Staleness: while ``state.fresh`` is False (no good poll within the freshness limit, or the link
-not CONNECTED) the mode and program lamps read "unknown" in grey and the clock and drift turn
-grey and italic, the drift marked "(stale)": nothing here looks live that isn't. The alarm lamps keep the last known
-bits (an alarm is never hidden by a silent link) under a "last known" title.
+not CONNECTED) the mode and program lamps read "unknown" in grey, the clock and drift turn grey
+and italic and the drift is marked "(stale)": nothing here looks live that isn't. The alarm
+lamps keep the last known bits (an alarm is never hidden by a silent link) under a "last known"
+title.
 """
 
 from __future__ import annotations
