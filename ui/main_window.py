@@ -260,6 +260,8 @@ class MainWindow(QMainWindow):
         self.motion = MotionController(link, self.control_bar, self.jog_panel, self.step_panel,
                                        self.program_panel, self.run_controller, self)
         self.run_controller.runningChanged.connect(self.points_panel.set_run_active)
+        self.motion.alarmHoldChanged.connect(self.points_panel.set_alarm_hold)
+        self.motion.alarmHoldChanged.connect(self.planner_panel.set_alarm_hold)
         project = self.project
         project.titleChanged.connect(self._on_project_title)
         project.pathChanged.connect(self._on_project_path)
