@@ -287,3 +287,13 @@ def jog_request() -> Any:
     from app.link.types import JogRequest
 
     return JogRequest(TeachFrame.BASE, 0, 1, 20.0)
+
+
+def test_the_strip_redraws_at_the_paint_rate_and_ends_on_the_latest_pose(qtbot: Any, strip: PoseStrip,
+                                                                         link: FakeLink) -> None:
+    poll(link, Pose(1.0, 0, 0, 0, 0, 0))
+    assert strip.value_text("X") == "1.00"  # the first pose at once
+    for i in range(2, 50):  # a burst at the poll rate: coalesced
+        poll(link, Pose(float(i), 0, 0, 0, 0, 0))
+    assert strip.value_text("X") == "1.00"
+    qtbot.waitUntil(lambda: strip.value_text("X") == "49.00", timeout=2000)

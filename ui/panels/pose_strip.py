@@ -55,6 +55,7 @@ __all__ = ["AGE_TICK_MS", "PoseStrip"]
 
 CTX = "PoseStrip"
 AGE_TICK_MS = 1000  # the stale age counts up at this period (only while stale and shown)
+PAINT_INTERVAL_MS = 34  # poses arrive at the poll rate; the numbers are redrawn at <= 30 Hz
 VALUE_SAMPLE = "-8888.88"  # the widest value the strip keeps room for
 VALUE_POINTS = 12.0
 CHIP_PADDING = 20  # px: the chips' left + right padding and border
@@ -103,6 +104,12 @@ class PoseStrip(QFrame):
         self._age_timer = QTimer(self)
         self._age_timer.setInterval(AGE_TICK_MS)
         self._age_timer.timeout.connect(self._show_freshness)
+        # leading edge: a pose is drawn at once, then at most once per interval (the latest)
+        self._paint_timer = QTimer(self)
+        self._paint_timer.setSingleShot(True)
+        self._paint_timer.setInterval(PAINT_INTERVAL_MS)
+        self._paint_timer.timeout.connect(self._on_paint_timer)
+        self._pose_dirty = False
 
         bold = QFont(self.font())
         bold.setBold(True)
@@ -224,7 +231,19 @@ class PoseStrip(QFrame):
 
     @Slot(Pose)
     def _on_pose(self, _pose: Pose) -> None:
+        if self._paint_timer.isActive():
+            self._pose_dirty = True
+            return
         self._show_pose()
+        if self.isVisible():
+            self._paint_timer.start()
+
+    @Slot()
+    def _on_paint_timer(self) -> None:
+        if self._pose_dirty:
+            self._pose_dirty = False
+            self._show_pose()
+            self._paint_timer.start()
 
     @Slot(ControllerStatus)
     def _on_status(self, _status: ControllerStatus) -> None:
@@ -246,6 +265,7 @@ class PoseStrip(QFrame):
         self._update_timer()
 
     def _show_pose(self) -> None:
+        self._pose_dirty = False
         pose = self._state.pose if self._state is not None else None
         live = self.is_live()
         color = COLOR_INK if live else COLOR_STALE
@@ -332,4 +352,5 @@ class PoseStrip(QFrame):
 
     def hideEvent(self, event: QHideEvent) -> None:
         self._age_timer.stop()
+        self._paint_timer.stop()
         super().hideEvent(event)
