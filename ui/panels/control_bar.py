@@ -188,8 +188,9 @@ class ControlBar(QWidget):
         self.resume_button.setEnabled(self._motion_enabled and not self._alarm_hold)
 
     def mode_text(self) -> str:
-        """The controller's mode as shown (translated), without the caption."""
-        mode = self._mode
+        """The controller's mode as shown (translated), without the caption; "" while unknown
+        (no status yet, or the link is not live)."""
+        mode = self._mode if self._live else None
         return "" if mode is None else protocol_text(controller_mode_text(int(mode)))
 
     # --- internals --------------------------------------------------------------------
