@@ -2,6 +2,136 @@
 <!DOCTYPE TS>
 <TS version="2.1" language="zh_CN">
     <context>
+        <name>AlarmBanner</name>
+        <message>
+            <location filename="../../ui/panels/alarm_banner.py" line="37" />
+            <source>alarm bit {bit}</source>
+            <translation>报警位 {bit}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_banner.py" line="128" />
+            <source>ALARM: {names}</source>
+            <translation>报警：{names}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_banner.py" line="130" />
+            <source>(last known: the link is not live)</source>
+            <translation>（最后已知：通信未实时）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_banner.py" line="133" />
+            <source>Motion controls are held until the alarm is reset. STOP stays available.</source>
+            <translation>报警复位前运动控制已锁定。停止按钮始终可用。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_banner.py" line="142" />
+            <source>Register 562 = {word}</source>
+            <translation>寄存器 562 = {word}</translation>
+        </message>
+    </context>
+    <context>
+        <name>AlarmListPanel</name>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="88" />
+            <source>Alarm</source>
+            <translation>报警</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="88" />
+            <source>Meaning</source>
+            <translation>含义</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="88" />
+            <source>What to do</source>
+            <translation>处理方法</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="89" />
+            <source>Raised</source>
+            <translation>触发时间</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="89" />
+            <source>Cleared</source>
+            <translation>清除时间</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="107" />
+            <location filename="../../ui/panels/alarm_list.py" line="115" />
+            <source>active</source>
+            <translation>未清除</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/alarm_list.py" line="113" />
+            <source>raised {raised}, cleared {cleared}</source>
+            <translation>触发 {raised}，清除 {cleared}</translation>
+        </message>
+    </context>
+    <context>
+        <name>Alarms</name>
+        <message>
+            <location filename="../../app/alarm_history.py" line="37" />
+            <source>The emergency stop circuit is open: servo power is off.</source>
+            <translation>急停回路断开：伺服已断电。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="38" />
+            <source>A servo drive reported a fault.</source>
+            <translation>伺服驱动器报告故障。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="39" />
+            <source>A holding brake did not release or engage as commanded.</source>
+            <translation>抱闸未按指令松开或抱紧。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="40" />
+            <source>The motion planner rejected a move (out of reach, singularity or limit).</source>
+            <translation>运动规划拒绝了该运动（超出范围、奇异点或限位）。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="42" />
+            <source>An axis encoder angle is implausible or was lost.</source>
+            <translation>某轴编码器角度异常或丢失。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="45" />
+            <source>Make the cell safe, release the emergency stop button, then reset the alarm on the controller.</source>
+            <translation>确认现场安全，松开急停按钮，然后在控制器上复位报警。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="47" />
+            <source>Read the drive's fault code on the controller, remove the cause, then reset the alarm.</source>
+            <translation>在控制器上查看驱动器故障码，排除原因后复位报警。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="49" />
+            <source>Do not move the arm; check the brake wiring and power, then reset the alarm.</source>
+            <translation>不要移动机械臂；检查抱闸接线和电源，然后复位报警。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="51" />
+            <source>Check the target point and speed, reset the alarm, then move to a reachable point.</source>
+            <translation>检查目标点和速度，复位报警，然后移动到可达的点。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="53" />
+            <source>Check the encoder cable; the zero position may need recalibration before moving.</source>
+            <translation>检查编码器电缆；运动前可能需要重新标定零点。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="56" />
+            <source>A bit the protocol does not document.</source>
+            <translation>协议未说明的报警位。</translation>
+        </message>
+        <message>
+            <location filename="../../app/alarm_history.py" line="57" />
+            <source>Read the alarm on the controller's own pendant.</source>
+            <translation>请在控制器自带的示教器上查看报警。</translation>
+        </message>
+    </context>
+    <context>
         <name>ConnectionDialog</name>
         <message>
             <location filename="../../ui/dialogs/connection_dialog.py" line="169" />
@@ -174,62 +304,68 @@
     <context>
         <name>ControlBar</name>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="97" />
+            <location filename="../../ui/panels/control_bar.py" line="130" />
             <source>STOP</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="98" />
+            <location filename="../../ui/panels/control_bar.py" line="131" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="99" />
+            <location filename="../../ui/panels/control_bar.py" line="132" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="100" />
+            <location filename="../../ui/panels/control_bar.py" line="133" />
             <source>Pause the current move or program</source>
             <translation>暂停当前运动或程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="101" />
+            <location filename="../../ui/panels/control_bar.py" line="134" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="102" />
+            <location filename="../../ui/panels/control_bar.py" line="135" />
             <source>Resume the paused move or program</source>
             <translation>继续已暂停的运动或程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="103" />
+            <location filename="../../ui/panels/control_bar.py" line="223" />
+            <source>unknown</source>
+            <translation>未知</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/control_bar.py" line="227" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="104" />
+            <location filename="../../ui/panels/control_bar.py" line="136" />
             <source>Manual</source>
             <translation>手动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="105" />
+            <location filename="../../ui/panels/control_bar.py" line="137" />
             <source>Switch the controller to manual mode</source>
             <translation>将控制器切换到手动模式</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="106" />
+            <location filename="../../ui/panels/control_bar.py" line="138" />
             <source>Auto</source>
             <translation>自动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="107" />
+            <location filename="../../ui/panels/control_bar.py" line="139" />
             <source>Switch the controller to auto mode (needed for Modbus motion)</source>
             <translation>将控制器切换到自动模式（Modbus 运动需要自动模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="152" />
+            <location filename="../../ui/panels/control_bar.py" line="224" />
+            <location filename="../../ui/panels/control_bar.py" line="225" />
             <source>Mode:
 {mode}</source>
             <translation>模式：
@@ -622,113 +758,118 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="252" />
+            <location filename="../../ui/main_window.py" line="281" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="253" />
+            <location filename="../../ui/main_window.py" line="282" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="254" />
+            <location filename="../../ui/main_window.py" line="283" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="258" />
+            <location filename="../../ui/main_window.py" line="287" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="259" />
+            <location filename="../../ui/main_window.py" line="288" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="260" />
+            <location filename="../../ui/main_window.py" line="289" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="293" />
+            <location filename="../../ui/main_window.py" line="323" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="281" />
+            <location filename="../../ui/main_window.py" line="311" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="309" />
+            <location filename="../../ui/main_window.py" line="339" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="311" />
+            <location filename="../../ui/main_window.py" line="341" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="316" />
+            <location filename="../../ui/main_window.py" line="346" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="329" />
+            <location filename="../../ui/main_window.py" line="359" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="340" />
+            <location filename="../../ui/main_window.py" line="370" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="346" />
+            <location filename="../../ui/main_window.py" line="376" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="342" />
-            <location filename="../../ui/main_window.py" line="347" />
+            <location filename="../../ui/main_window.py" line="372" />
+            <location filename="../../ui/main_window.py" line="377" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="255" />
+            <location filename="../../ui/main_window.py" line="284" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="256" />
+            <location filename="../../ui/main_window.py" line="285" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="257" />
+            <location filename="../../ui/main_window.py" line="286" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="410" />
+            <location filename="../../ui/main_window.py" line="290" />
+            <source>Alarms</source>
+            <translation>报警</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="440" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="411" />
+            <location filename="../../ui/main_window.py" line="441" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="429" />
+            <location filename="../../ui/main_window.py" line="459" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="430" />
+            <location filename="../../ui/main_window.py" line="460" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -736,94 +877,104 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="256" />
+            <location filename="../../ui/panels/monitor_panel.py" line="230" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="256" />
+            <location filename="../../ui/panels/monitor_panel.py" line="230" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="257" />
+            <location filename="../../ui/panels/monitor_panel.py" line="231" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="259" />
+            <location filename="../../ui/panels/monitor_panel.py" line="233" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="263" />
+            <location filename="../../ui/panels/monitor_panel.py" line="237" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="264" />
+            <location filename="../../ui/panels/monitor_panel.py" line="238" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="265" />
+            <location filename="../../ui/panels/monitor_panel.py" line="239" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="266" />
+            <location filename="../../ui/panels/monitor_panel.py" line="240" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="267" />
+            <location filename="../../ui/panels/monitor_panel.py" line="241" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="268" />
+            <location filename="../../ui/panels/monitor_panel.py" line="242" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="269" />
+            <location filename="../../ui/panels/monitor_panel.py" line="243" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="270" />
+            <location filename="../../ui/panels/monitor_panel.py" line="244" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="271" />
+            <location filename="../../ui/panels/monitor_panel.py" line="245" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="272" />
+            <location filename="../../ui/panels/monitor_panel.py" line="246" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="272" />
+            <location filename="../../ui/panels/monitor_panel.py" line="246" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="273" />
-            <source>TCP path, top view (X–Y)</source>
-            <translation>TCP 轨迹俯视图（X–Y）</translation>
+            <location filename="../../ui/panels/monitor_panel.py" line="247" />
+            <source>Top view (X–Y)</source>
+            <translation>俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="444" />
+            <location filename="../../ui/panels/monitor_panel.py" line="267" />
+            <source>Stale: not confirmed by the controller within the freshness limit</source>
+            <translation>数据过期：未在时效内得到控制器确认</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="462" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="446" />
+            <location filename="../../ui/panels/monitor_panel.py" line="464" />
             <source>paused</source>
             <translation>已暂停</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="466" />
+            <source>values stale (grey): no fresh data from the controller</source>
+            <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
     </context>
     <context>
@@ -1014,68 +1165,68 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="183" />
+            <location filename="../../ui/panels/plan_preview.py" line="186" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="184" />
+            <location filename="../../ui/panels/plan_preview.py" line="187" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="185" />
+            <location filename="../../ui/panels/plan_preview.py" line="188" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="189" />
+            <location filename="../../ui/panels/plan_preview.py" line="192" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="190" />
+            <location filename="../../ui/panels/plan_preview.py" line="193" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="279" />
+            <location filename="../../ui/panels/plan_preview.py" line="282" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="281" />
+            <location filename="../../ui/panels/plan_preview.py" line="284" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="283" />
+            <location filename="../../ui/panels/plan_preview.py" line="286" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="284" />
+            <location filename="../../ui/panels/plan_preview.py" line="287" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="287" />
+            <location filename="../../ui/panels/plan_preview.py" line="290" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="291" />
+            <location filename="../../ui/panels/plan_preview.py" line="294" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="293" />
+            <location filename="../../ui/panels/plan_preview.py" line="296" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="294" />
+            <location filename="../../ui/panels/plan_preview.py" line="297" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -1394,22 +1545,22 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="214" />
+            <location filename="../../ui/panels/planner_panel.py" line="215" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="392" />
+            <location filename="../../ui/panels/planner_panel.py" line="393" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="401" />
+            <location filename="../../ui/panels/planner_panel.py" line="402" />
             <source>Failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="401" />
+            <location filename="../../ui/panels/planner_panel.py" line="402" />
             <source>Stopped</source>
             <translation>已停止</translation>
         </message>
@@ -1761,194 +1912,194 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="264" />
+            <location filename="../../ui/panels/points_panel.py" line="265" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="264" />
+            <location filename="../../ui/panels/points_panel.py" line="265" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="266" />
+            <location filename="../../ui/panels/points_panel.py" line="267" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="266" />
+            <location filename="../../ui/panels/points_panel.py" line="267" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="267" />
+            <location filename="../../ui/panels/points_panel.py" line="268" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="267" />
+            <location filename="../../ui/panels/points_panel.py" line="268" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="268" />
+            <location filename="../../ui/panels/points_panel.py" line="269" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="269" />
+            <location filename="../../ui/panels/points_panel.py" line="270" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="270" />
+            <location filename="../../ui/panels/points_panel.py" line="271" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="271" />
+            <location filename="../../ui/panels/points_panel.py" line="272" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="272" />
+            <location filename="../../ui/panels/points_panel.py" line="273" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="273" />
+            <location filename="../../ui/panels/points_panel.py" line="274" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="274" />
+            <location filename="../../ui/panels/points_panel.py" line="275" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="275" />
+            <location filename="../../ui/panels/points_panel.py" line="276" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="276" />
+            <location filename="../../ui/panels/points_panel.py" line="277" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="276" />
+            <location filename="../../ui/panels/points_panel.py" line="277" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="277" />
-            <location filename="../../ui/panels/points_panel.py" line="293" />
+            <location filename="../../ui/panels/points_panel.py" line="278" />
+            <location filename="../../ui/panels/points_panel.py" line="294" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="278" />
+            <location filename="../../ui/panels/points_panel.py" line="279" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="279" />
+            <location filename="../../ui/panels/points_panel.py" line="280" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="280" />
-            <location filename="../../ui/panels/points_panel.py" line="432" />
+            <location filename="../../ui/panels/points_panel.py" line="281" />
+            <location filename="../../ui/panels/points_panel.py" line="440" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="281" />
+            <location filename="../../ui/panels/points_panel.py" line="282" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="282" />
+            <location filename="../../ui/panels/points_panel.py" line="283" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="282" />
+            <location filename="../../ui/panels/points_panel.py" line="283" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="284" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="288" />
+            <location filename="../../ui/panels/points_panel.py" line="289" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="289" />
+            <location filename="../../ui/panels/points_panel.py" line="290" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="290" />
+            <location filename="../../ui/panels/points_panel.py" line="291" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="291" />
+            <location filename="../../ui/panels/points_panel.py" line="292" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="294" />
+            <location filename="../../ui/panels/points_panel.py" line="295" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="295" />
+            <location filename="../../ui/panels/points_panel.py" line="296" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="370" />
+            <location filename="../../ui/panels/points_panel.py" line="376" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="373" />
+            <location filename="../../ui/panels/points_panel.py" line="379" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="374" />
+            <location filename="../../ui/panels/points_panel.py" line="380" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="375" />
+            <location filename="../../ui/panels/points_panel.py" line="381" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="395" />
+            <location filename="../../ui/panels/points_panel.py" line="401" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="398" />
+            <location filename="../../ui/panels/points_panel.py" line="404" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="421" />
+            <location filename="../../ui/panels/points_panel.py" line="429" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="425" />
+            <location filename="../../ui/panels/points_panel.py" line="433" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -1961,9 +2112,84 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="462" />
+            <location filename="../../ui/panels/points_panel.py" line="470" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
+        </message>
+    </context>
+    <context>
+        <name>PoseStrip</name>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="64" />
+            <source>live</source>
+            <translation>实时</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="65" />
+            <source>stale {age} s</source>
+            <translation>过期 {age} 秒</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="66" />
+            <source>stale</source>
+            <translation>过期</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="67" />
+            <location filename="../../ui/panels/pose_strip.py" line="290" />
+            <location filename="../../ui/panels/pose_strip.py" line="291" />
+            <source>unknown</source>
+            <translation>未知</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="69" />
+            <source>disconnected</source>
+            <translation>未连接</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="70" />
+            <source>connecting</source>
+            <translation>连接中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="71" />
+            <source>not answering</source>
+            <translation>无应答</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="72" />
+            <source>link down</source>
+            <translation>通信中断</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="199" />
+            <source>mm</source>
+            <translation>mm</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="200" />
+            <source>Mode</source>
+            <translation>模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="201" />
+            <source>Program</source>
+            <translation>程序</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="202" />
+            <source>The controller's work mode (register 560)</source>
+            <translation>控制器工作模式（寄存器 560）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="203" />
+            <source>The controller's program state (register 561)</source>
+            <translation>控制器程序状态（寄存器 561）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/pose_strip.py" line="204" />
+            <source>Whether the values shown were confirmed by the controller within the freshness limit</source>
+            <translation>显示的数值是否在时效内得到控制器确认</translation>
         </message>
     </context>
     <context>
@@ -2700,124 +2926,141 @@ Remove them all?</source>
     <context>
         <name>StatusPanel</name>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="219" />
+            <location filename="../../ui/panels/status_panel.py" line="226" />
             <source>Link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="220" />
+            <location filename="../../ui/panels/status_panel.py" line="227" />
             <source>Controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="221" />
+            <location filename="../../ui/panels/status_panel.py" line="228" />
+            <location filename="../../ui/panels/status_panel.py" line="296" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="223" />
+            <location filename="../../ui/panels/status_panel.py" line="228" />
+            <location filename="../../ui/panels/status_panel.py" line="296" />
+            <source>Alarms (last known)</source>
+            <translation>报警（最后已知）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/status_panel.py" line="230" />
             <source>State:</source>
             <translation>状态：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="224" />
+            <location filename="../../ui/panels/status_panel.py" line="231" />
             <source>RTT:</source>
             <translation>往返时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="225" />
+            <location filename="../../ui/panels/status_panel.py" line="232" />
             <source>Mode:</source>
             <translation>模式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="226" />
+            <location filename="../../ui/panels/status_panel.py" line="233" />
             <source>Program:</source>
             <translation>程序：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="227" />
+            <location filename="../../ui/panels/status_panel.py" line="234" />
             <source>Last command:</source>
             <translation>上一条命令：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="228" />
+            <location filename="../../ui/panels/status_panel.py" line="235" />
             <source>Clock:</source>
             <translation>系统时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="229" />
+            <location filename="../../ui/panels/status_panel.py" line="236" />
             <source>Drift:</source>
             <translation>时差：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="230" />
+            <location filename="../../ui/panels/status_panel.py" line="237" />
             <source>Round-trip time of the last poll</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="234" />
+            <location filename="../../ui/panels/status_panel.py" line="241" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="235" />
+            <location filename="../../ui/panels/status_panel.py" line="242" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="238" />
+            <location filename="../../ui/panels/status_panel.py" line="245" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="246" />
+            <location filename="../../ui/panels/status_panel.py" line="252" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="336" />
+            <location filename="../../ui/panels/status_panel.py" line="345" />
+            <source>unknown</source>
+            <translation>未知</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/status_panel.py" line="363" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="338" />
+            <location filename="../../ui/panels/status_panel.py" line="365" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="348" />
+            <location filename="../../ui/panels/status_panel.py" line="375" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="354" />
+            <location filename="../../ui/panels/status_panel.py" line="381" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="367" />
+            <location filename="../../ui/panels/status_panel.py" line="394" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="375" />
+            <location filename="../../ui/panels/status_panel.py" line="402" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="379" />
+            <location filename="../../ui/panels/status_panel.py" line="406" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="383" />
+            <location filename="../../ui/panels/status_panel.py" line="410" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="390" />
+            <location filename="../../ui/panels/status_panel.py" line="416" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/status_panel.py" line="420" />
+            <source>{value} (stale)</source>
+            <translation>{value}（已过期）</translation>
         </message>
     </context>
     <context>
@@ -2959,62 +3202,62 @@ Remove them all?</source>
     <context>
         <name>TrafficPanel</name>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="135" />
+            <location filename="../../ui/panels/traffic_panel.py" line="137" />
             <source>Filter: bytes or meaning</source>
             <translation>过滤：字节或含义</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="136" />
+            <location filename="../../ui/panels/traffic_panel.py" line="138" />
             <source>Hide polls</source>
             <translation>隐藏轮询</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="138" />
+            <location filename="../../ui/panels/traffic_panel.py" line="140" />
             <source>Hide the periodic reads of 412.. (pose) and 560.. (status)</source>
             <translation>隐藏对 412..（位姿）和 560..（状态）的周期读取</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="140" />
+            <location filename="../../ui/panels/traffic_panel.py" line="142" />
             <source>Pause capture</source>
             <translation>暂停抓包</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="141" />
+            <location filename="../../ui/panels/traffic_panel.py" line="143" />
             <source>Stop recording frames (the worker stops building them)</source>
             <translation>停止记录报文（后台不再生成报文记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="142" />
+            <location filename="../../ui/panels/traffic_panel.py" line="144" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="143" />
+            <location filename="../../ui/panels/traffic_panel.py" line="145" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="261" />
+            <location filename="../../ui/panels/traffic_panel.py" line="263" />
             <source>Export traffic</source>
             <translation>导出通信报文</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="262" />
+            <location filename="../../ui/panels/traffic_panel.py" line="264" />
             <source>CSV files (*.csv);;Text files (*.txt);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;文本文件 (*.txt);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="289" />
+            <location filename="../../ui/panels/traffic_panel.py" line="291" />
             <source>{n} frames</source>
             <translation>{n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="291" />
+            <location filename="../../ui/panels/traffic_panel.py" line="293" />
             <source>{shown} of {n} frames shown</source>
             <translation>显示 {shown} / {n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="293" />
+            <location filename="../../ui/panels/traffic_panel.py" line="295" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
         </message>
