@@ -41,6 +41,7 @@ Usage: python -m benchmarks.gui [--quick]   (``benchmarks.run`` calls :func:`run
 
 from __future__ import annotations
 
+import functools
 import gc
 import itertools
 import json
@@ -320,6 +321,14 @@ class _Counters(QObject):
         self.state = state
 
 
+def _more_poses(counters: _Counters, before: int) -> bool:
+    return counters.poses > before
+
+
+def _stop_sent(counters: _Counters, first: int) -> bool:
+    return any(r.message == "stop: sent" for r in counters.results[first:])
+
+
 class _PaintCounter(QObject):
     def __init__(self) -> None:
         super().__init__()
@@ -385,11 +394,11 @@ def bench_stop_gui(window: MainWindow, sim: SimHandle, counters: _Counters, n: i
         # (Re)start the motion and wait until the simulator runs it and a poll has seen it.
         start = sim.write_count()
         link.run_program(STOP_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
-        if not _wait_until(lambda s=start: _motion_started(sim, s)):
+        if not _wait_until(functools.partial(_motion_started, sim, start)):
             failures += 1
             continue
         poses = counters.poses
-        if not _wait_until(lambda p=poses: counters.poses > p):
+        if not _wait_until(functools.partial(_more_poses, counters, poses)):
             failures += 1
             continue
         # Just after a poll: a uniform delay over one poll period (posted input: over one paint
@@ -414,7 +423,7 @@ def bench_stop_gui(window: MainWindow, sim: SimHandle, counters: _Counters, n: i
             continue
         # Let the worker finish the stop job ("stop: sent") before the next run request.
         done = int(pending["results"])
-        if not _wait_until(lambda d=done: any(r.message == "stop: sent" for r in counters.results[d:])):
+        if not _wait_until(functools.partial(_stop_sent, counters, done)):
             failures += 1
         if i >= WARMUP_SAMPLES:
             latencies.append(found[0].t - float(pending["t0"]))

@@ -58,16 +58,17 @@ class RowsScrollArea(QScrollArea):
         self.setFrameShape(QFrame.Shape.NoFrame)
         self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
         self.setWidget(rows)
+        self._rows = rows
 
     def _width(self, inner: QSize) -> int:
         return inner.width() + self.verticalScrollBar().sizeHint().width() + 2 * self.frameWidth()
 
     def minimumSizeHint(self) -> QSize:
-        inner = self.widget().minimumSizeHint()
+        inner = self._rows.minimumSizeHint()
         return QSize(self._width(inner), min(inner.height(), SCROLL_MIN_ROWS_HEIGHT))
 
     def sizeHint(self) -> QSize:
-        inner = self.widget().sizeHint()
+        inner = self._rows.sizeHint()
         return QSize(self._width(inner), inner.height())
 
 

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import pytest
 
 from app import timing
 from app.errors import AlarmRaised, CommandRefused, CommandStopped, CommandTimeout
 from app.link.tracker import CommandTracker
-from app.models import ControllerStatus, Pose
+from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import (
     STATUS_SENTINEL,
     Alarm,
@@ -33,13 +35,22 @@ def moved(dx: float) -> Pose:
     return Pose(100.0 + dx, 0.0, 500.0, 180.0, 0.0, 0.0)
 
 
-def feed(tracker: CommandTracker, steps: list[tuple[float, ControllerStatus, Pose | None]]):
-    """Feed (t, status, pose) samples; return (index, result) of the first result, or (None, None)."""
+Step = tuple[float, ControllerStatus, Pose | None]
+
+
+def feed(tracker: CommandTracker, steps: Sequence[Step]) -> tuple[int, CommandResult]:
+    """Feed (t, status, pose) samples; return (index, result) of the first result (fail if none)."""
     for i, (t, status, pose) in enumerate(steps):
         result = tracker.update(status, pose, t)
         if result is not None:
             return i, result
-    return None, None
+    pytest.fail(f"no result after {len(steps)} samples")
+
+
+def feed_silent(tracker: CommandTracker, steps: Sequence[Step]) -> None:
+    """Feed (t, status, pose) samples that must all pass without a result."""
+    for t, status, pose in steps:
+        assert tracker.update(status, pose, t) is None
 
 
 def test_stale_done_is_not_taken_for_the_new_create_point() -> None:
@@ -49,7 +60,7 @@ def test_stale_done_is_not_taken_for_the_new_create_point() -> None:
                           (0.3, st(DONE), None)])
     assert i == 3
     assert result.ok and result.kind is CommandKind.CREATE_POINT
-    assert result.status.member is CreatePointStatus.DONE
+    assert result.status is not None and result.status.member is CreatePointStatus.DONE
     assert result.details["ack_after"] == pytest.approx(0.2)
     assert tr.error is None
 
@@ -95,8 +106,8 @@ def test_move_acknowledged_by_motion_still_waits_for_a_fresh_done() -> None:
     tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
     steps = [(0.01, st(DONE, RUNNING), moved(1)), (0.05, st(DONE, RUNNING), moved(5)),
              (0.10, st(DONE, STOPPED), moved(10)), (0.2, st(DONE, STOPPED), moved(10))]
-    i, result = feed(tr, steps)
-    assert i is None and tr.acknowledged and tr.motion_seen
+    feed_silent(tr, steps)
+    assert tr.acknowledged and tr.motion_seen
     i, result = feed(tr, [(0.25, st(0), moved(10)), (0.26, st(DONE), moved(10))])
     assert i == 1 and result.ok
 
@@ -200,7 +211,7 @@ def test_move_that_ends_without_a_status_update_is_unknown(monkeypatch: pytest.M
     tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
     steps = [(0.01, st(DONE, RUNNING), moved(1)), (0.05, st(DONE, STOPPED), moved(2)),
              (0.5, st(DONE, STOPPED), moved(2)), (0.99, st(DONE, STOPPED), moved(2))]
-    assert feed(tr, steps) == (None, None)
+    feed_silent(tr, steps)
     result = tr.update(st(DONE, STOPPED), moved(2), 1.0)
     assert result is not None and isinstance(tr.error, CommandTimeout)
     assert "the arm moved and stopped" in result.message and "result is unknown" in result.message
@@ -242,7 +253,7 @@ def test_sentinel_fast_result_straight_to_done_is_confirmed() -> None:
     tr = sentinel(RunCommand.CREATE_POINT)
     result = tr.update(st(DONE), None, 0.001)  # no 0 ever visible, the old code was 0xFF too
     assert result is not None and result.ok and not result.unconfirmed
-    assert result.status.member is CreatePointStatus.DONE
+    assert result.status is not None and result.status.member is CreatePointStatus.DONE
 
 
 def test_sentinel_fast_error_is_reported() -> None:
@@ -275,7 +286,8 @@ def test_observe_fast_unchanged_done_is_done_unconfirmed_after_the_window() -> N
     assert tr.update(st(DONE), None, 0.049) is None
     result = tr.update(st(DONE), None, 0.05)
     assert result is not None and result.ok and result.unconfirmed
-    assert result.status.member is CreatePointStatus.DONE and tr.error is None
+    assert result.status is not None and result.status.member is CreatePointStatus.DONE
+    assert tr.error is None
     assert "done, unconfirmed" in result.message
 
 
@@ -321,7 +333,7 @@ def test_observe_teach_is_confirmed_by_the_controller_mode(command: RunCommand, 
     assert tr.update(pre, None, 0.001) is None
     result = tr.update(ControllerStatus(after, STOPPED, Alarm.NONE, DONE), None, 0.002)
     assert result is not None and result.ok and not result.unconfirmed
-    assert result.status.member is TeachStatus.DONE
+    assert result.status is not None and result.status.member is TeachStatus.DONE
 
 
 def test_a_move_whose_status_never_changed_is_done_when_it_stands_at_its_target() -> None:

@@ -63,7 +63,8 @@ class FakeClient:
                            "timeout": timeout})
         result = self._answer(self.move_script.get(n), DONE)
         if result.ok and end_id in self.stored:
-            self.pose = Pose(*self.stored[end_id][:6])
+            x, y, z, a, b, c = self.stored[end_id][:6]
+            self.pose = Pose(x, y, z, a, b, c)
         return result
 
     def stop(self) -> None:

@@ -168,7 +168,7 @@ def test_run_no_upload_sends_no_point_and_warns(demo: Path, capsys: pytest.Captu
 def test_run_no_upload_stops_when_the_arm_arrives_elsewhere(demo: Path,
                                                            capsys: pytest.CaptureFixture[str]) -> None:
     """The controller holds a different P7 (another tool wrote it): the arrival check stops the run."""
-    stored = {p.id: p.xyzabc for p in load_project(demo).ledger}
+    stored: dict[int, tuple[float, ...]] = {p.id: p.xyzabc for p in load_project(demo).ledger}
     stored[7] = (100.0, 100.0, 100.0, 180.0, 0.0, 0.0)
     client = FakeClient(stored=stored)
     assert Cli(client)("run", str(demo), "--plan", "circle", "--no-upload") == cli_points.EXIT_FAILED

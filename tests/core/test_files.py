@@ -174,7 +174,7 @@ def test_project_round_trip(tmp_path: Path) -> None:
 
 
 def _doc(**changes: object) -> dict[str, object]:
-    doc = json.loads(project_to_json(sample_project()))
+    doc: dict[str, object] = json.loads(project_to_json(sample_project()))
     doc.update(changes)
     return doc
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import random
+from collections.abc import Sequence
 from pathlib import Path
 
 import pytest
@@ -187,7 +188,7 @@ NASTY_NUMBERS: list[object] = [
 ]
 
 
-def _pick(rng: random.Random, pool: list[object], good: object, p_good: float = 0.97) -> object:
+def _pick(rng: random.Random, pool: Sequence[object], good: object, p_good: float = 0.97) -> object:
     return good if rng.random() < p_good else rng.choice(pool)
 
 

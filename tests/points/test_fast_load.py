@@ -4,6 +4,7 @@ builds exactly what the careful path builds and refuses with the careful path's 
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 
 import pytest
 
@@ -23,7 +24,7 @@ GOOD = {"id": 7, "name": "原点", "x": 1.5, "y": -2.0, "z": 3.0, "a": 180.0, "b
         "e1": 0.0, "e2": 1.0, "e3": 0.0, "e4": 0.0, "e5": 0.0, "tool": 3, "note": "two\nlines"}
 
 
-def _doc(points: list[object]) -> str:
+def _doc(points: Sequence[object]) -> str:
     return json.dumps({"format": "teachpad-project", "version": 1, "name": "t", "points": points,
                        "plans": []}, ensure_ascii=False)
 

@@ -157,7 +157,8 @@ def test_pause_resume_stop() -> None:
     j = robot.joints[0]
     robot.tick(0.2)
     assert robot.joints[0] == j
-    assert robot.program_state is ProgramState.PAUSED
+    paused = robot.program_state  # a local, so mypy does not keep the attribute narrowed
+    assert paused is ProgramState.PAUSED
     assert robot.command_status == MoveStatus.MOVING
     assert robot.resume()
     robot.tick(0.1)
@@ -171,7 +172,8 @@ def test_teach_jog_joint_frame_stops_at_the_limit() -> None:
     robot = SimRobot()
     assert robot.teach_enable(TeachFrame.JOINT, 5) == TeachStatus.RATIO_NOT_ZERO
     assert robot.teach_enable(TeachFrame.JOINT, 0) == 0xFF
-    assert robot.controller_mode is ControllerMode.MODBUS_TEACH
+    teaching = robot.controller_mode  # a local, so mypy does not keep the attribute narrowed
+    assert teaching is ControllerMode.MODBUS_TEACH
     robot.set_teach_ratio(100, 4, 1)  # J5 positive at 30 deg/s
     robot.tick(0.5)
     assert robot.joints[4] == pytest.approx(kin.HOME_JOINTS[4] + JOG_MAX_JOINT * 0.5)

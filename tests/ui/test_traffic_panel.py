@@ -140,10 +140,11 @@ def test_rows_show_time_direction_seed_hex_and_meaning(panel: TrafficPanel) -> N
 
 
 def test_decoding_is_lazy_and_cached(panel: TrafficPanel, monkeypatch: pytest.MonkeyPatch) -> None:
+    import app.protocol.frames as frames
     import ui.models.traffic_model as traffic
 
     calls: list[bytes] = []
-    real = traffic.decode_frame
+    real = frames.decode_frame  # the function the model module imported
 
     def counting(data: bytes, **kwargs: Any) -> Any:
         calls.append(bytes(data))

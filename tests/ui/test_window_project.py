@@ -24,7 +24,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     window_fixture,
 )
 from ui.main_window import TAB_PLANNER, TAB_POINTS, MainWindow
-from ui.panels.monitor_panel import MonitorPanel, unwrap_degrees
+from ui.panels.monitor_panel import MonitorPanel
+from ui.panels.monitor_plots import unwrap_degrees
 from ui.settings import AppSettings
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]

@@ -96,7 +96,9 @@ class ConnectionDialog(QDialog):
         self.serial_combo = QComboBox(self.rtu_page)
         self.serial_combo.setEditable(True)
         self.serial_combo.setInsertPolicy(QComboBox.InsertPolicy.NoInsert)
-        self.serial_edit: QLineEdit = self.serial_combo.lineEdit()
+        serial_edit = self.serial_combo.lineEdit()
+        assert serial_edit is not None  # an editable combo box always has its line edit
+        self.serial_edit: QLineEdit = serial_edit
         self.serial_edit.setPlaceholderText("/dev/ttyUSB0, COM3")
         self.refresh_button = QPushButton(self.rtu_page)
         self.refresh_button.clicked.connect(self.refresh_serial_ports)

@@ -30,6 +30,7 @@ from PySide6.QtWidgets import (
     QGroupBox,
     QLabel,
     QSizePolicy,
+    QTableView,
     QVBoxLayout,
     QWidget,
 )
@@ -157,8 +158,8 @@ class PlannerPanel(QWidget):
             "run_from": self.run_from_selected, "step": self.step, "pause": self._runner.pause,
             "resume": self._runner.resume, "stop": self.stop, "resume_from": self.resume_from,
         }
-        self.actions = PlannerActions(self, slots)
-        a = self.actions
+        self.planner_actions = PlannerActions(self, slots)
+        a = self.planner_actions
         self.action_add_plan, self.action_rename_plan = a["add_plan"], a["rename_plan"]
         self.action_duplicate_plan, self.action_delete_plan = a["duplicate_plan"], a["delete_plan"]
         self.action_add_line, self.action_add_arc = a["add_line"], a["add_arc"]
@@ -173,7 +174,7 @@ class PlannerPanel(QWidget):
         # left: plans + run controls
         self.plans_box = PlanListBox(self._plans, [self.action_add_plan, self.action_rename_plan,
                                                    self.action_duplicate_plan, self.action_delete_plan], self)
-        self.plan_view = self.plans_box.plan_view
+        self.plan_view: QTableView = self.plans_box.plan_view
         self.run_box = PlanRunBox(self.action_run, self.action_run_from, self.action_step, self.action_pause,
                                   self.action_resume, self.action_stop, self.action_resume_from, self)
         self.resume_from_button = self.run_box.resume_from_button
@@ -189,11 +190,11 @@ class PlannerPanel(QWidget):
                            self.action_segment_up, self.action_segment_down]
         self.segments_box = SegmentEditorBox(self.segments, self._points, segment_actions, self.checks_bar,
                                              self)
-        self.segment_view = self.segments_box.segment_view
+        self.segment_view: QTableView = self.segments_box.segment_view
         self.point_pickers = install_point_pickers(self.segment_view, lambda: self._points.ledger)
 
         # right: preview
-        self.preview = PlanPreview(self)
+        self.preview: PlanPreview = PlanPreview(self)
         self.preview_box = QGroupBox(self)
         preview_layout = QVBoxLayout(self.preview_box)
         preview_layout.addWidget(self.preview)
@@ -208,7 +209,7 @@ class PlannerPanel(QWidget):
         layout.addWidget(self.status)
 
     def retranslate(self) -> None:
-        self.actions.retranslate()
+        self.planner_actions.retranslate()
         self.plans_box.retranslate()
         self.run_box.retranslate()
         self.segments_box.retranslate()
@@ -407,7 +408,7 @@ class PlannerPanel(QWidget):
 
     def _update_resume_text(self) -> None:
         k = self._runner.resume_from if self._runner.can_resume else None
-        self.actions.set_resume_from(k + 1 if k is not None else None)
+        self.planner_actions.set_resume_from(k + 1 if k is not None else None)
 
     @Slot()
     def _on_plans_reset(self) -> None:
@@ -497,9 +498,9 @@ class PlannerPanel(QWidget):
             has_sync=sync is not None, sync_busy=sync is not None and sync.busy,
             uploading=sync is not None and sync.operation == "upload",
             check_errors=len(errors), first_error=errors[0] if errors else ""))
-        self.actions.apply(states)
+        self.planner_actions.apply(states)
         if self._alarm_hold:  # an e-stop / servo alarm: nothing that starts motion (Stop, Pause stay)
             for name in ("run", "run_from", "step", "resume", "resume_from"):
-                self.actions.all[name].setEnabled(False)
+                self.planner_actions.all[name].setEnabled(False)
         self.upload_button.setEnabled(self.action_upload_now.isEnabled())
         self.resume_from_button.setVisible(states.resume_from_visible)

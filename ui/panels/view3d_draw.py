@@ -68,7 +68,8 @@ class Buffers:
         frag[:, 6:8] = 1.0
         frag[:, 8] = 0.0
         frag[:, 9] = 1.0
-        painter.drawPixmapFragments(*self.fragments.drawargs(), sprite)
+        fragments, count = self.fragments.drawargs()  # (the array's pointer, its length)
+        painter.drawPixmapFragments(fragments, count, sprite)
 
     def draw_points(self, painter: QPainter, xy: FloatArray) -> None:
         xy = xy[np.isfinite(xy).all(axis=1)]
