@@ -97,7 +97,8 @@ def _patch_qt() -> None:
         _timers.add(self)
         timer_start(self, *args)
 
-    QThread.start = tracked_thread_start  # type: ignore[method-assign]
+    # patching Qt's methods: the stubs' overloads are not a replacement's concern
+    QThread.start = tracked_thread_start  # type: ignore[method-assign,assignment]
     QTimer.start = tracked_timer_start  # type: ignore[method-assign]
     _patched = True
 

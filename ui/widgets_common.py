@@ -24,18 +24,18 @@ from app.protocol.enums import (
     TR_CONTEXT,
     UNKNOWN_STATUS_TEXT,
 )
-from ui.palette import (  # re-exported ("X as X"): panels import the state colours from here
-    COLOR_BORDER as COLOR_BORDER,
-    COLOR_ERROR as COLOR_ERROR,
-    COLOR_ERROR_BG as COLOR_ERROR_BG,
-    COLOR_INFO as COLOR_INFO,
-    COLOR_NEUTRAL as COLOR_NEUTRAL,
-    COLOR_NEUTRAL_BG as COLOR_NEUTRAL_BG,
-    COLOR_OK as COLOR_OK,
-    COLOR_OK_BG as COLOR_OK_BG,
-    COLOR_WARN as COLOR_WARN,
-    COLOR_WARN_BG as COLOR_WARN_BG,
-    COLOR_WHITE as COLOR_WHITE,
+from ui.palette import (  # re-exported: panels import the state colours from here
+    COLOR_BORDER,
+    COLOR_ERROR,
+    COLOR_ERROR_BG,  # noqa: F401
+    COLOR_INFO,
+    COLOR_NEUTRAL,
+    COLOR_NEUTRAL_BG,
+    COLOR_OK,
+    COLOR_OK_BG,  # noqa: F401
+    COLOR_WARN,
+    COLOR_WARN_BG,  # noqa: F401
+    COLOR_WHITE,
 )
 
 TR = "Panels"

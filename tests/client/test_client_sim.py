@@ -209,7 +209,12 @@ def test_upload_points_batched(sim_factory: Any, make_client: MakeClient) -> Non
     points = [(i, [300.0 + i, 10.0, 400.0, 180.0, 0.0, float(i)]) for i in range(1, 31)]
     points.insert(10, (150, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]))  # the controller refuses id 150
     seen: list[tuple[int, int]] = []
-    results = c.upload_points(points, progress=lambda done, total: seen.append((done, total)) or True)
+
+    def progress(done: int, total: int) -> bool:
+        seen.append((done, total))
+        return True
+
+    results = c.upload_points(points, progress=progress)
     assert len(results) == 31 and seen[-1] == (31, 31)
     assert [r.details["point_id"] for r in results] == [float(p[0]) for p in points]
     failed = [r for r in results if not r.ok]
@@ -424,7 +429,7 @@ def test_invalid_input_is_refused_before_the_wire(sim: Any, make_client: MakeCli
         lambda: c.step(StepFrame.BASE, [1, 0, 0]),
         lambda: c.step(StepFrame.BASE, [0] * 6),
         lambda: c.step(StepFrame.BASE, [1, 0, 0, 0, 0, 0], speed=0),
-        lambda: c.step("base", [1, 0, 0, 0, 0, 0]),
+        lambda: c.step("base", [1, 0, 0, 0, 0, 0]),  # type: ignore[arg-type]  # a wrong type on purpose
         lambda: c.create_point(101),
         lambda: c.create_point(-1),
         lambda: c.create_point(1, pose=[0, 0, 0, 0, 0, math.inf]),
@@ -571,7 +576,7 @@ def test_observer_sees_the_seed_frames(sim: Any, make_client: MakeClient) -> Non
     def boom(*args: object) -> None:
         raise AssertionError("a record was built with nobody observing")
 
-    c._transport._emit = boom  # type: ignore[method-assign]
+    c._transport._emit = boom  # type: ignore[method-assign,assignment]  # a tripwire, not the real signature
     c.read_status()
     c.write_gv(200, [1.0])
     assert records == []
@@ -663,4 +668,4 @@ def test_settings_are_checked() -> None:
     for bad in ({"port": 0}, {"unit": 300}, {"timeout": 0}, {"framer": "ascii"}, {"parity": "X"},
                 {"point_id_min": 5, "point_id_max": 1}, {"word_order": "low-first"}):
         with pytest.raises(InvalidInput):
-            RobotClient(ConnectionSettings(**bad))  # type: ignore[arg-type]
+            RobotClient(ConnectionSettings(**bad))

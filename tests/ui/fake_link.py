@@ -111,7 +111,7 @@ class FakeLink(QObject):
 
     def upload_points(self, points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
                       tool: int = 200) -> int:
-        items = [(p[0], tuple(p[1]), p[2] if len(p) > 2 else tool) for p in points]  # type: ignore[misc]
+        items = [(p[0], tuple(p[1]), p[2] if len(p) > 2 else tool) for p in points]
         return self._record("upload_points", items)
 
     def cancel_upload(self) -> int:

@@ -98,7 +98,12 @@ def test_step_preset_and_exact_values(qtbot: Any, sim: Any, window: Any) -> None
     z = sim.state().pose[2]
     panel.set_values([0.0, 0.0, -25.0])
     asked: list[str] = []
-    window.confirm = lambda _title, text: asked.append(text) is None and False  # "No"
+
+    def answer_no(_title: str, text: str) -> bool:
+        asked.append(text)
+        return False
+
+    window.confirm = answer_no
     qtbot.mouseClick(panel.move_button, Qt.MouseButton.LeftButton)
     assert asked and "Z -25" in asked[0] and "mm/s" in asked[0]
     window.confirm = lambda _title, _text: True
@@ -113,7 +118,12 @@ def test_program_and_go_zero_ask_first(qtbot: Any, sim: Any, window: Any) -> Non
     _connected(qtbot, window, sim)
     panel = window.program_panel
     questions: list[tuple[str, str]] = []
-    window.confirm = lambda title, text: questions.append((title, text)) is None and False
+
+    def answer_no(title: str, text: str) -> bool:
+        questions.append((title, text))
+        return False
+
+    window.confirm = answer_no
     qtbot.mouseClick(panel.run_button, Qt.MouseButton.LeftButton)
     panel.set_zero_axis(None)
     qtbot.mouseClick(panel.zero_button, Qt.MouseButton.LeftButton)

@@ -146,7 +146,9 @@ def squeezed(window: MainWindow) -> list[str]:
     """Qt squeezes widgets below their minimum (and clips them) when the window cannot give
     every part its minimum: the central area and the status dock must both get theirs."""
     found = []
-    for part, least in ((window.centralWidget(), window.centralWidget().minimumSizeHint()),
+    central = window.centralWidget()
+    assert central is not None
+    for part, least in ((central, central.minimumSizeHint()),
                         (window.status_dock, QSize(STATUS_DOCK_WIDTH, 0))):
         if part.width() < least.width() or part.height() < least.height():
             found.append(f"{part.objectName() or 'central area'} is {part.width()}×{part.height()}, "

@@ -11,7 +11,7 @@ from PySide6.QtGui import QImage
 from app.link.client import ConnectionSettings
 from app.link.types import LinkState
 from app.protocol.codec import WordOrder
-from app.protocol.enums import Alarm, WorkMode
+from app.protocol.enums import Alarm, TeachFrame, WorkMode
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,
@@ -94,7 +94,7 @@ def test_live_pose_reaches_the_monitor(qtbot: Any, sim: Any, window: MainWindow)
     readout = window.monitor_panel.readouts["X"]
     qtbot.waitUntil(lambda: readout.value is not None and abs(readout.value - x) < 1e-3,
                     timeout=SIGNAL_TIMEOUT_MS)
-    window.link.jog_press(0, 0, 1, 100.0)
+    window.link.jog_press(TeachFrame.BASE, 0, 1, 100.0)
     qtbot.waitUntil(lambda: readout.value is not None and readout.value > x + 5.0, timeout=SIGNAL_TIMEOUT_MS)
     window.link.jog_release()
 

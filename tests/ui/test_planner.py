@@ -303,6 +303,15 @@ def test_start_needs_a_connection(runner: PlanRunController, link: FakeLink, pro
 # --- the panel -------------------------------------------------------------------------------------
 
 
+# Read through calls: mypy would keep an asserted attribute narrowed across the run's steps.
+def is_live(planner: PlannerPanel) -> bool:
+    return planner.preview.live
+
+
+def is_locked(planner: PlannerPanel) -> bool:
+    return planner.segments.locked
+
+
 @pytest.fixture
 def planner(qtbot: Any, project: Project, link: FakeLink) -> Iterator[PlannerPanel]:
     stack = QUndoStack()
@@ -344,23 +353,23 @@ def test_panel_summary_and_upload_now_then_run(qtbot: Any, planner: PlannerPanel
     assert moves(link) == [(5, None)]
     assert "The robot will move" in planner.questions[1]  # type: ignore[attr-defined]
     assert planner.summary_text == "Checks passed: ready to run"
-    assert planner.segments.locked and not planner.action_add_line.isEnabled()
-    assert planner.preview.live
+    assert is_locked(planner) and not planner.action_add_line.isEnabled()
+    assert is_live(planner)
     link.finish_move()
     assert "Segment 2 of 4, loop 1 of 1" in planner.run_label.text()
     with qtbot.waitSignal(planner.run_controller.runFinished):
         link.finish_move(False, code=3, message="servo alarm")
-    assert not planner.segments.locked and not planner.preview.live
+    assert not is_locked(planner) and not is_live(planner)
     assert planner.action_resume_from.isEnabled()
     assert planner.action_resume_from.text() == "Resume from segment 2"
     assert planner.selected_segments() == [1]
     planner.answers.append(True)  # type: ignore[attr-defined]
     planner.resume_from()
-    assert moves(link)[-1] == (7, 6) and planner.preview.live
+    assert moves(link)[-1] == (7, 6) and is_live(planner)
     with qtbot.waitSignal(planner.run_controller.runFinished):
         for _ in range(3):
             link.finish_move()
-    assert not planner.preview.live and "Finished" in planner.run_label.text()
+    assert not is_live(planner) and "Finished" in planner.run_label.text()
 
 
 def test_panel_refuses_a_plan_with_errors(planner: PlannerPanel, link: FakeLink, project: Project) -> None:
@@ -405,7 +414,8 @@ def test_panel_undo_of_other_plan_switches_to_it(planner: PlannerPanel) -> None:
     planner.select_plan(1)
     planner.segments.undo_stack.undo()
     assert planner.current_plan() is planner.segments.plan
-    assert planner.current_plan() is not None and planner.current_plan().name == "pick and place"
+    plan = planner.current_plan()
+    assert plan is not None and plan.name == "pick and place"
     assert planner.plan_view.currentIndex().row() == 0
 
 

@@ -62,6 +62,7 @@ def test_picker_lists_points_by_id_and_name_and_searches(qtbot: Any, project: Pr
     assert picker.count() == len(project.ledger) and picker.ids == project.ledger.ids()
     assert picker.itemText(4) == "P5 — circle W" == point_choice_text(5, "circle W")
     completer = picker.completer()
+    assert completer is not None
     completer.setCompletionPrefix("CIRCLE")  # any part of the name, any case
     assert completer.completionCount() == 4
     completer.setCompletionPrefix("p7")
@@ -76,10 +77,12 @@ def test_picker_shows_a_missing_point_in_red(qtbot: Any, project: Project) -> No
     qtbot.addWidget(picker)
     picker.set_point_id(42)
     assert picker.currentText() == "P42" and picker.point_id() is None and not picker.is_valid()
-    assert "color" in picker.lineEdit().styleSheet() and "P42 does not exist" in picker.toolTip()
-    picker.lineEdit().setText("P3")  # typing an existing id is fine again
-    assert picker.point_id() == 3 and picker.lineEdit().styleSheet() == ""
-    picker.lineEdit().setText("")
+    edit = picker.lineEdit()
+    assert edit is not None
+    assert "color" in edit.styleSheet() and "P42 does not exist" in picker.toolTip()
+    edit.setText("P3")  # typing an existing id is fine again
+    assert picker.point_id() == 3 and edit.styleSheet() == ""
+    edit.setText("")
     assert not picker.is_valid()  # an end point may not stay blank
     blank_ok = PointPicker(project.ledger, allow_blank=True)  # an arc's middle point may
     qtbot.addWidget(blank_ok)

@@ -103,7 +103,7 @@ def test_freshness_turns_stale_without_a_good_poll(qtbot: Any, state: RobotState
     assert not state.fresh
     with qtbot.waitSignal(state.freshnessChanged, check_params_cb=lambda fresh: fresh, timeout=1000):
         state.note_good_poll(time.monotonic())
-    assert state.fresh and state.age() is not None and state.age() < 0.05  # type: ignore[operator]
+    assert state.fresh and state.age() is not None and state.age() < 0.05
     with qtbot.waitSignal(state.freshnessChanged, check_params_cb=lambda fresh: not fresh, timeout=1000):
         pass  # no poll: the timer turns it stale
     age = state.age()

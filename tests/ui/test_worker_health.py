@@ -49,16 +49,16 @@ class Rig(QObject):
 
     def __init__(self) -> None:
         super().__init__()
-        self.thread = QThread()
+        self.worker_thread = QThread()  # not self.thread: that would shadow QObject.thread()
         self.worker = RobotWorker(timing.POLL_HZ_DEFAULT, canary_gv=None)
-        self.worker.moveToThread(self.thread)
-        self.thread.started.connect(self.worker.start)
+        self.worker.moveToThread(self.worker_thread)
+        self.worker_thread.started.connect(self.worker.start)
         for name in ("poseChanged", "statusChanged", "pollSucceeded", "linkStatsChanged",
                      "commandFinished", "connectionChanged", "stopped"):
             getattr(self.worker, name).connect(getattr(self, name))
         self.connectTo.connect(self.worker.connect_to)
         self.shutdown.connect(self.worker.shutdown)
-        self.thread.start()
+        self.worker_thread.start()
 
     def connect_sim(self, qtbot: Any, sim: Any, **overrides: Any) -> None:
         with qtbot.waitSignal(self.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED),
@@ -75,7 +75,7 @@ def rig(qtbot: Any, fast_reconnect: None) -> Iterator[Rig]:
     finally:
         with qtbot.waitSignal(made.stopped, timeout=SIGNAL_TIMEOUT_MS):
             made.shutdown.emit()
-        assert made.thread.wait(SIGNAL_TIMEOUT_MS)
+        assert made.worker_thread.wait(SIGNAL_TIMEOUT_MS)
 
 
 def test_command_finished_comes_after_the_pose_and_status_of_its_poll(qtbot: Any, sim: Any, rig: Rig) -> None:
