@@ -57,8 +57,8 @@ class RowsScrollArea(QScrollArea):
         self.setWidgetResizable(True)
         self.setFrameShape(QFrame.Shape.NoFrame)
         self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self._rows = rows  # before setWidget(): it asks for the size hints
         self.setWidget(rows)
-        self._rows = rows
 
     def _width(self, inner: QSize) -> int:
         return inner.width() + self.verticalScrollBar().sizeHint().width() + 2 * self.frameWidth()

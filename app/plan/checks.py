@@ -15,7 +15,7 @@ import numpy as np
 
 from app.errors import InvalidInput
 from app.plan.geometry import PointLike, arc_geometry, xyz_of
-from app.plan.segments import FloatArray, Plan
+from app.plan.segments import FloatArray, Plan, Segment
 from app.points.ledger import (
     PointLedger,
     SyncState,
@@ -159,13 +159,36 @@ def check_plan(
     if not 0 <= start_index < n:
         return [PlanIssue(None, IssueKind.ERROR, IssueCode.BAD_START,
                           f"cannot start at segment {start_index + 1}: the plan has {n} segments")]
-    ends: list[FloatArray | None] = []
+    ends = [None if (end := ledger.get(seg.end_id)) is None else xyz_of(end) for seg in plan.segments]
+    issues.extend(_point_issues(plan, ledger, limits))
+    # Geometry, from where each segment starts when it runs: segment start_index from the
+    # current pose, the others from the previous end; with more loops, segment 0 also from
+    # the last end, and the segments before start_index run on later loops.
+    start_pose = None if current_pose is None else xyz_of(current_pose)
+    for i, seg in enumerate(plan.segments):
+        for start, context in _segment_starts(i, n, start_index, loops != 1, start_pose, ends):
+            issues.extend(_geometry_issues(i, seg, start, context, ends, ledger, limits,
+                                           pose_unknown=i == start_index and current_pose is None,
+                                           resumed=i == start_index))
+    if envelope is not None:
+        for v in plan_violations(plan, ledger, envelope, current_pose, start_index=start_index,
+                                 loops=loops, reduced=reduced_speed):
+            issues.append(PlanIssue(v.segment, IssueKind.ERROR, IssueCode.OUTSIDE_ENVELOPE, v.message))
+    if reach is not None:
+        issues.extend(reach(plan, ledger, current_pose))
+    order = {IssueKind.ERROR: 0, IssueKind.NEEDS_UPLOAD: 1, IssueKind.WARNING: 2}
+    issues.sort(key=lambda it: (-1 if it.segment is None else it.segment, order[it.kind]))
+    return issues
+
+
+def _point_issues(plan: Plan, ledger: PointLedger, limits: PlanLimits) -> list[PlanIssue]:
+    """Speeds, arcs without a middle, missing points, points to upload, tool mismatches."""
+    issues: list[PlanIssue] = []
     upload_reported: set[int] = set()
     for i, seg in enumerate(plan.segments):
         name = _seg_name(i)
         end = ledger.get(seg.end_id)
         via = ledger.get(seg.via_id) if seg.via_id is not None else None
-        ends.append(None if end is None else xyz_of(end))
         if not 0 < seg.speed <= limits.max_speed:
             issues.append(PlanIssue(i, IssueKind.ERROR, IssueCode.BAD_SPEED,
                                     f"{name}: speed {seg.speed:g} mm/s is not in "
@@ -190,57 +213,55 @@ def check_plan(
                 issues.append(PlanIssue(i, IssueKind.WARNING, IssueCode.TOOL_MISMATCH,
                                         f"{name}: {point.label} was taught with {tool_text(point.tool)}, "
                                         f"the segment moves with {tool_text(seg.tool)}", pid))
-    # Geometry, from where each segment starts when it runs: segment start_index from the
-    # current pose, the others from the previous end; with more loops, segment 0 also from
-    # the last end, and the segments before start_index run on later loops.
-    start_pose = None if current_pose is None else xyz_of(current_pose)
-    more_loops = loops != 1
-    for i, seg in enumerate(plan.segments):
-        starts: list[tuple[FloatArray | None, str]] = []
-        if i == start_index:
-            starts.append((start_pose, "from the current pose"))
-        if i > 0 and (i > start_index or more_loops):
-            later = "" if i > start_index else f"on loops after the first, starting at the end of segment {i}"
-            starts.append((ends[i - 1], later))
-        if i == 0 and more_loops:
-            starts.append((ends[n - 1], f"on loops after the first, starting at the end of segment {n}"))
-        end_xyz = ends[i]
-        via_pt = ledger.get(seg.via_id) if seg.via_id is not None else None
-        for start, context in starts:
-            suffix = f" ({context})" if context else ""
-            if seg.is_arc:
-                if via_pt is None or end_xyz is None:
-                    continue
-                if start is None:
-                    if i == start_index and current_pose is None:
-                        issues.append(PlanIssue(i, IssueKind.WARNING, IssueCode.ARC_START_UNKNOWN,
-                                                f"{_seg_name(i)}: the arc starts at the robot's current "
-                                                "pose, which is not known: its shape is not checked"))
-                    continue
-                problem = _arc_issue(start, xyz_of(via_pt), end_xyz, limits)
-                if problem is not None:
-                    issues.append(PlanIssue(i, IssueKind.ERROR, problem[0],
-                                            f"{_seg_name(i)}: {problem[1]}{suffix}"))
-                elif i == start_index and i > 0 and (planned_start := ends[i - 1]) is not None:
-                    detour = _arc_detour(start, planned_start, xyz_of(via_pt), end_xyz)
-                    if detour is not None:
-                        issues.append(PlanIssue(i, detour[0], IssueCode.ARC_RESUME_PAST_MIDDLE,
-                                                f"{_seg_name(i)}: {detour[1]}"))
-            elif start is not None and end_xyz is not None:
-                length = float(np.linalg.norm(end_xyz - start))
-                if length < limits.zero_length:
-                    issues.append(PlanIssue(i, IssueKind.WARNING, IssueCode.ZERO_LENGTH,
-                                            f"{_seg_name(i)}: the line goes nowhere "
-                                            f"(start and end {length:.3g} mm apart){suffix}"))
-    if envelope is not None:
-        for v in plan_violations(plan, ledger, envelope, current_pose, start_index=start_index,
-                                 loops=loops, reduced=reduced_speed):
-            issues.append(PlanIssue(v.segment, IssueKind.ERROR, IssueCode.OUTSIDE_ENVELOPE, v.message))
-    if reach is not None:
-        issues.extend(reach(plan, ledger, current_pose))
-    order = {IssueKind.ERROR: 0, IssueKind.NEEDS_UPLOAD: 1, IssueKind.WARNING: 2}
-    issues.sort(key=lambda it: (-1 if it.segment is None else it.segment, order[it.kind]))
     return issues
+
+
+def _segment_starts(i: int, n: int, start_index: int, more_loops: bool, start_pose: FloatArray | None,
+                    ends: Sequence[FloatArray | None]) -> list[tuple[FloatArray | None, str]]:
+    """Where segment ``i`` starts when it runs, each with the context for the message."""
+    starts: list[tuple[FloatArray | None, str]] = []
+    if i == start_index:
+        starts.append((start_pose, "from the current pose"))
+    if i > 0 and (i > start_index or more_loops):
+        later = "" if i > start_index else f"on loops after the first, starting at the end of segment {i}"
+        starts.append((ends[i - 1], later))
+    if i == 0 and more_loops:
+        starts.append((ends[n - 1], f"on loops after the first, starting at the end of segment {n}"))
+    return starts
+
+
+def _geometry_issues(i: int, seg: Segment, start: FloatArray | None, context: str,
+                     ends: Sequence[FloatArray | None], ledger: PointLedger, limits: PlanLimits, *,
+                     pose_unknown: bool, resumed: bool) -> list[PlanIssue]:
+    """The shape of segment ``i`` run from ``start``: a usable arc, a line that goes somewhere."""
+    suffix = f" ({context})" if context else ""
+    end_xyz = ends[i]
+    if not seg.is_arc:
+        if start is None or end_xyz is None:
+            return []
+        length = float(np.linalg.norm(end_xyz - start))
+        if length >= limits.zero_length:
+            return []
+        return [PlanIssue(i, IssueKind.WARNING, IssueCode.ZERO_LENGTH,
+                          f"{_seg_name(i)}: the line goes nowhere "
+                          f"(start and end {length:.3g} mm apart){suffix}")]
+    via_pt = ledger.get(seg.via_id) if seg.via_id is not None else None
+    if via_pt is None or end_xyz is None:
+        return []
+    if start is None:
+        if not pose_unknown:
+            return []
+        return [PlanIssue(i, IssueKind.WARNING, IssueCode.ARC_START_UNKNOWN,
+                          f"{_seg_name(i)}: the arc starts at the robot's current "
+                          "pose, which is not known: its shape is not checked")]
+    problem = _arc_issue(start, xyz_of(via_pt), end_xyz, limits)
+    if problem is not None:
+        return [PlanIssue(i, IssueKind.ERROR, problem[0], f"{_seg_name(i)}: {problem[1]}{suffix}")]
+    if resumed and i > 0 and (planned_start := ends[i - 1]) is not None:
+        detour = _arc_detour(start, planned_start, xyz_of(via_pt), end_xyz)
+        if detour is not None:
+            return [PlanIssue(i, detour[0], IssueCode.ARC_RESUME_PAST_MIDDLE, f"{_seg_name(i)}: {detour[1]}")]
+    return []
 
 
 def _arc_detour(start: FloatArray, planned_start: FloatArray, via: FloatArray,
