@@ -153,19 +153,7 @@ def _parse_pdu(pdu: bytes, direction: Direction | None, errors: list[str]) -> _P
         return out
     out.is_response = _looks_like_response(fc, body) if direction is None else direction == "rx"
     if fc == FunctionCode.READ_HOLDING_REGISTERS and out.is_response:
-        if not body:
-            errors.append("truncated read response: byte count missing")
-            return out
-        byte_count, data = body[0], body[1:]
-        if byte_count % 2:
-            errors.append(f"odd byte count {byte_count}")
-        if len(data) != byte_count:
-            errors.append(f"byte count {byte_count}, but {len(data)} data bytes")
-        out.values = _words(data[:byte_count])
-        out.count = len(out.values)
-        out.complete = len(data) == byte_count and byte_count % 2 == 0 and byte_count > 0
-        if byte_count == 0:
-            errors.append("byte count 0")
+        _parse_read_response(body, out, errors)
         return out
     if fc == FunctionCode.WRITE_SINGLE_REGISTER:
         what = "write register " + ("echo" if out.is_response else "request")
@@ -173,7 +161,29 @@ def _parse_pdu(pdu: bytes, direction: Direction | None, errors: list[str]) -> _P
             out.address, value = _words(body[:4])
             out.values, out.count, out.complete = (value,), 1, True
         return out
-    # FC03 request, FC10 request or FC10 response: address and quantity first.
+    _parse_addressed(fc, body, out, errors)
+    return out
+
+
+def _parse_read_response(body: bytes, out: _Pdu, errors: list[str]) -> None:
+    """An FC03 response: byte count, then the register values."""
+    if not body:
+        errors.append("truncated read response: byte count missing")
+        return
+    byte_count, data = body[0], body[1:]
+    if byte_count % 2:
+        errors.append(f"odd byte count {byte_count}")
+    if len(data) != byte_count:
+        errors.append(f"byte count {byte_count}, but {len(data)} data bytes")
+    out.values = _words(data[:byte_count])
+    out.count = len(out.values)
+    out.complete = len(data) == byte_count and byte_count % 2 == 0 and byte_count > 0
+    if byte_count == 0:
+        errors.append("byte count 0")
+
+
+def _parse_addressed(fc: int, body: bytes, out: _Pdu, errors: list[str]) -> None:
+    """An FC03 request, FC10 request or FC10 response: address and quantity first."""
     if fc == FunctionCode.READ_HOLDING_REGISTERS:
         what = "read request"
     else:
@@ -183,7 +193,7 @@ def _parse_pdu(pdu: bytes, direction: Direction | None, errors: list[str]) -> _P
         errors.append(f"truncated {what}: {len(body)} of at least {needed} bytes")
         if len(body) >= 2:
             out.address = _words(body[:2])[0]
-        return out
+        return
     out.address, out.count = _words(body[:4])
     is_write = fc == FunctionCode.WRITE_MULTIPLE_REGISTERS
     limit = regs.MAX_WRITE_REGISTERS if is_write else regs.MAX_READ_REGISTERS
@@ -192,7 +202,7 @@ def _parse_pdu(pdu: bytes, direction: Direction | None, errors: list[str]) -> _P
         out.complete = len(body) == 4
         if len(body) > 4:
             errors.append(f"{len(body) - 4} extra bytes after the {what}")
-        return out
+        return
     byte_count, data = body[4], body[5:]
     good = True
     if byte_count != 2 * out.count:
@@ -203,7 +213,6 @@ def _parse_pdu(pdu: bytes, direction: Direction | None, errors: list[str]) -> _P
         good = False
     out.values = _words(data[:byte_count])
     out.complete = good
-    return out
 
 
 def _pairing_errors(pdu: _Pdu, unit: int | None, request: DecodedFrame, errors: list[str]) -> None:
