@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import ctypes
 import os
+import sys
+import threading
 import weakref
 from collections.abc import Iterator
 from typing import Any
@@ -77,6 +80,28 @@ def make_client() -> Iterator[Any]:
 # --- Qt leak check (napari-style): a test must not leave a QThread running or a QTimer active.
 _threads: weakref.WeakSet[Any] = weakref.WeakSet()
 _timers: weakref.WeakSet[Any] = weakref.WeakSet()
+_trace_hooked: weakref.WeakSet[Any] = weakref.WeakSet()
+
+
+def _install_trace_hook() -> None:
+    """Run in a QThread as it starts: give it the tracer ``threading.settrace`` gives Python
+    threads, so coverage (pytest-cov) measures the worker's code too. Nothing without a tracer.
+
+    PySide6 enters Python from a QThread with PyGILState_Ensure/Release, which makes and drops
+    a thread state per call (and the trace function with it): one extra Ensure, released when
+    the thread finishes, keeps a single thread state (and the tracer) for the thread's life."""
+    hook = threading.gettrace()
+    if hook is None:
+        return
+    from PySide6.QtCore import Qt, QThread
+
+    state = ctypes.pythonapi.PyGILState_Ensure()
+    thread = QThread.currentThread()
+    thread.finished.connect(lambda: ctypes.pythonapi.PyGILState_Release(state),
+                            Qt.ConnectionType.DirectConnection)
+    sys.settrace(hook)
+
+
 _patched = False
 
 
@@ -84,13 +109,16 @@ def _patch_qt() -> None:
     global _patched
     if _patched:
         return
-    from PySide6.QtCore import QThread, QTimer
+    from PySide6.QtCore import Qt, QThread, QTimer
 
     thread_start = QThread.start
     timer_start = QTimer.start
 
     def tracked_thread_start(self: Any, *args: Any) -> None:
         _threads.add(self)
+        if self not in _trace_hooked:
+            _trace_hooked.add(self)
+            self.started.connect(_install_trace_hook, Qt.ConnectionType.DirectConnection)
         thread_start(self, *args)
 
     def tracked_timer_start(self: Any, *args: Any) -> None:
