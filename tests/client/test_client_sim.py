@@ -304,7 +304,7 @@ def test_host_stop_and_pause_resume(sim: Any, make_client: MakeClient) -> None:
     assert sim.wait_for(lambda s: not s.paused, 2.0)
     c.stop()
     assert tracker.finished
-    with pytest.raises(CommandStopped, match="stopped by the host"):
+    with pytest.raises(CommandStopped, match="stopped by the operator"):
         c.wait(tracker)
     assert sim.wait_for(lambda s: not s.moving, 2.0)
 

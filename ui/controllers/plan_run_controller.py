@@ -16,6 +16,7 @@ from ``link.state`` (:class:`~app.link.state.RobotState`).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 from PySide6.QtCore import QObject, Signal, Slot
@@ -27,6 +28,7 @@ from app.models import CommandResult, Pose
 from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
+from ui.messages import error_text, result_text
 
 
 class PlanRunController(QObject):
@@ -258,6 +260,9 @@ class PlanRunController(QObject):
         current = runner.current
         missing = (not result.ok and result.status is not None
                    and result.status.code == MoveStatus.BAD_END_POINT and current is not None)
+        if not result.ok:
+            # the runner keeps the reason as text: give it the operator's language
+            result = dataclasses.replace(result, message=result_text(result))
         runner.on_result(result)
         if missing and current is not None:
             self.pointsMissing.emit(list(current.segment.point_ids))
@@ -268,14 +273,14 @@ class PlanRunController(QObject):
         if move is not self._move or runner is None or runner.state is not RunState.RUNNING:
             return
         self._move = None
-        runner.on_error(TeachPadError(error.message))
+        runner.on_error(TeachPadError(error_text(error)))
         self._after_report()
 
     def _on_stop_failed(self, stop: Pending, error: WorkerError) -> None:
         runner = self._runner
         if stop is self._stop and runner is not None and runner.state is RunState.RUNNING \
                 and runner.stop_requested:
-            runner.on_stopped(error.message)
+            runner.on_stopped(error_text(error))
             self._finish()
 
     @Slot(ConnectionState)

@@ -40,6 +40,7 @@ from app.link.state import RobotState
 from app.link.types import ConnectionState, LinkState, Operation, WorkerError
 from app.models import CommandResult
 from app.protocol.enums import ALARM_BITS, ALARM_TEXT, TR_CONTEXT
+from ui.messages import error_text, result_level, result_text
 from ui.widgets_common import (
     COLOR_ERROR,
     COLOR_ERROR_BG,
@@ -47,7 +48,6 @@ from ui.widgets_common import (
     LEVEL_ERROR,
     LEVEL_WARN,
     atomic_write_text,
-    command_result_text,
     connection_display,
     export_with_dialog,
     monospace_font,
@@ -324,11 +324,11 @@ class EventLogPanel(QWidget):
 
     @Slot(object)
     def on_command_result(self, result: CommandResult) -> None:
-        self.add_event("info" if result.ok else "error", self.tr("command"), command_result_text(result))
+        self.add_event(result_level(result), self.tr("command"), result_text(result))
 
     @Slot(WorkerError)
     def on_error(self, error: WorkerError) -> None:
-        self.add_event("error", self.operation_text(error.operation), error.message)
+        self.add_event("error", self.operation_text(error.operation), error_text(error))
 
     def operation_text(self, operation: str) -> str:
         """The operator's word for a link operation (:class:`~app.link.types.Operation`)."""
