@@ -37,8 +37,8 @@ class TeachPadError(Exception):
             self.code = code
         self.params: dict[str, Any] = dict(params or {})
 
-    @property
-    def reason(self) -> Reason:
+    def as_reason(self) -> Reason:
+        """Its code and arguments (a method: some subclasses keep a text ``reason`` attribute)."""
         return Reason(self.code, dict(self.params))
 
 

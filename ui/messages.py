@@ -192,7 +192,8 @@ def _envelope(args: Mapping[str, Any]) -> str:
         axis=args.get("axis", ""), box=args.get("box", ""), unit=unit,
         value=_number(float(args.get("value", 0.0))), limit=_number(float(args.get("limit", 0.0))))
     if args.get("reduced"):
-        text += _tr(_REDUCED)
+        end = text[-1] if text[-1:] in ("。", ".") else ""
+        text = text[: len(text) - len(end)] + _tr(_REDUCED) + end
     return _tr(_ENVELOPE_PREFIX).format(text=text)
 
 
@@ -276,7 +277,7 @@ def error_text(error: WorkerError | TeachPadError | Reason) -> str:
     if isinstance(error, Reason):
         return reason_text(error) or error.code
     if isinstance(error, TeachPadError):
-        return reason_text(error.reason) or str(error)
+        return reason_text(error.as_reason()) or str(error)
     if error.reason is not None:
         text = reason_text(error.reason)
         if text is not None:

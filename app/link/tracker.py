@@ -288,7 +288,7 @@ class CommandTracker:
             code="refused_unconfirmed", params=self._args(seconds=float(waited)),
         )
         return self._finish(False, decoded, str(self.error), now, unconfirmed=True,
-                            reason=self.error.reason)
+                            reason=self.error.as_reason())
 
     def _note_motion(self, status: ControllerStatus, pose: Pose | None) -> bool:
         """Update ``motion_seen``; True when this read shows progress (for the stall timer)."""
@@ -356,4 +356,4 @@ class CommandTracker:
 
     def _fail(self, error: TeachPadError, code: int, now: float) -> CommandResult:
         self.error = error
-        return self._finish(False, self.decode(code), str(error), now, reason=error.reason)
+        return self._finish(False, self.decode(code), str(error), now, reason=error.as_reason())

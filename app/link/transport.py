@@ -232,7 +232,7 @@ class _SerialStream:
                                        exclusive=True)
         except (serial.SerialException, OSError, ValueError) as exc:
             raise LinkError(f"cannot open the serial port: {exc}", code="serial_open_failed",
-                            params={"port": s.serial_port[:60]}) from None
+                            params={"port": (s.serial_port or "")[:60]}) from None
 
     def close(self) -> None:
         if self._port is not None:

@@ -72,7 +72,7 @@ class WorkerError:
                        request_id: int | None = None) -> WorkerError:
         """The error for ``exc``: its English text and, for a typed error, its reason."""
         if isinstance(exc, TeachPadError):
-            return cls(operation, str(exc), request_id, exc.reason)
+            return cls(operation, str(exc), request_id, exc.as_reason())
         return cls(operation, f"{type(exc).__name__}: {str(exc)[:200]}", request_id,
                    Reason("unexpected", {"type": type(exc).__name__}))
 

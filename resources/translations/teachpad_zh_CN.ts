@@ -691,6 +691,374 @@
         </message>
     </context>
     <context>
+        <name>Messages</name>
+        <message>
+            <location filename="../../ui/messages.py" line="47" />
+            <source>{command}: {status}.</source>
+            <translation>{command}：{status}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="48" />
+            <source>{command}: done, not confirmed by the controller.</source>
+            <translation>{command}：已完成，控制器未确认。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="49" />
+            <source>{command}: done (the controller is now in {mode} mode).</source>
+            <translation>{command}：已完成（控制器现处于{mode}模式）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="50" />
+            <source>{command} refused by the controller: {status}.</source>
+            <translation>控制器拒绝了{command}：{status}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="51" />
+            <source>{command} not taken: the controller still shows “{status}” from the previous command.</source>
+            <translation>{command}未被执行：控制器仍显示上一条命令的“{status}”。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="52" />
+            <source>{command} ended by an alarm: {alarms}.</source>
+            <translation>{command}因报警而中止：{alarms}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="53" />
+            <source>{command}: the controller did not acknowledge it within {seconds} s.</source>
+            <translation>{command}：控制器在 {seconds} s 内未确认。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="54" />
+            <source>{command} did not finish within {seconds} s (last status: {status}).</source>
+            <translation>{command}未在 {seconds} s 内完成（最后状态：{status}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="55" />
+            <source>{command}: the arm moved and stopped, but the controller did not report the result.</source>
+            <translation>{command}：机械臂已运动并停止，但控制器未报告结果。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="56" />
+            <source>{command}: stopped by the operator.</source>
+            <translation>{command}：已由操作员停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="57" />
+            <source>{command}: stopped by the controller.</source>
+            <translation>{command}：已被控制器停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="59" />
+            <source>Lost the connection to the controller at {endpoint}.</source>
+            <translation>与控制器 {endpoint} 的连接已断开。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="60" />
+            <source>The controller at {endpoint} closed the connection.</source>
+            <translation>控制器 {endpoint} 关闭了连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="61" />
+            <source>The host name {host} cannot be resolved.</source>
+            <translation>无法解析主机名 {host}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="62" />
+            <source>Connection refused: nothing listens on port {port}.</source>
+            <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="63" />
+            <source>No answer to the connection request within {seconds} s.</source>
+            <translation>连接请求在 {seconds} s 内无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="64" />
+            <source>The connection could not be opened.</source>
+            <translation>无法建立连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="65" />
+            <source>Cannot open the serial port {port}.</source>
+            <translation>无法打开串口 {port}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="66" />
+            <source>The controller at {endpoint} did not answer within {seconds} s.</source>
+            <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="67" />
+            <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
+            <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="68" />
+            <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
+            <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="69" />
+            <source>Monitor-only mode: nothing was sent to the controller.</source>
+            <translation>仅监视模式：未向控制器发送任何内容。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="70" />
+            <source>Invalid value: nothing was sent.</source>
+            <translation>数值无效：未发送。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="71" />
+            <source>Unexpected internal error; the log has the details.</source>
+            <translation>意外的内部错误；详情见日志。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="76" />
+            <source>No connection to the controller.</source>
+            <translation>未连接控制器。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="77" />
+            <source>The controller closed the connection.</source>
+            <translation>控制器关闭了连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="78" />
+            <source>Connection refused by the controller.</source>
+            <translation>控制器拒绝了连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="79" />
+            <source>The controller did not answer.</source>
+            <translation>控制器无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="80" />
+            <source>Malformed answer from the controller.</source>
+            <translation>控制器的应答格式错误。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="81" />
+            <source>Cannot open the serial port.</source>
+            <translation>无法打开串口。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="82" />
+            <source>The host name cannot be resolved.</source>
+            <translation>无法解析主机名。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="83" />
+            <source>No answer to the connection request.</source>
+            <translation>连接请求无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="84" />
+            <source>{command} did not finish in time.</source>
+            <translation>{command}未按时完成。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="85" />
+            <source>{command}: the controller did not acknowledge it.</source>
+            <translation>{command}：控制器未确认。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="86" />
+            <source>{command} ended by an alarm.</source>
+            <translation>{command}因报警而中止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="87" />
+            <source>{command} refused by the controller.</source>
+            <translation>控制器拒绝了{command}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="88" />
+            <source>{command}: done.</source>
+            <translation>{command}：已完成。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="89" />
+            <source>The controller refused the request (Modbus exception).</source>
+            <translation>控制器拒绝了请求（Modbus 异常）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="92" />
+            <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
+            <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="93" />
+            <source>Cannot connect to the controller at {endpoint}: {cause}</source>
+            <translation>无法连接控制器 {endpoint}：{cause}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="94" />
+            <source>The command</source>
+            <translation>该命令</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="95" />
+            <source>Failed.</source>
+            <translation>失败。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="98" />
+            <source>length</source>
+            <translation>长度</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="99" />
+            <source>function code</source>
+            <translation>功能码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="100" />
+            <source>byte count</source>
+            <translation>字节数</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="101" />
+            <source>exception code</source>
+            <translation>异常码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="102" />
+            <source>address</source>
+            <translation>地址</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="103" />
+            <source>value</source>
+            <translation>数值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="104" />
+            <source>quantity</source>
+            <translation>数量</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="105" />
+            <source>transaction id</source>
+            <translation>事务标识</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="106" />
+            <source>protocol id</source>
+            <translation>协议标识</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="107" />
+            <source>unit id</source>
+            <translation>站号</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="108" />
+            <source>CRC</source>
+            <translation>CRC 校验</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="112" />
+            <source>illegal function</source>
+            <translation>非法功能</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="113" />
+            <source>illegal data address</source>
+            <translation>非法数据地址</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="114" />
+            <source>illegal data value</source>
+            <translation>非法数据值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="115" />
+            <source>server device failure</source>
+            <translation>从站设备故障</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="116" />
+            <source>acknowledge</source>
+            <translation>已确认，处理中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="117" />
+            <source>server device busy</source>
+            <translation>从站设备忙</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="118" />
+            <source>negative acknowledge</source>
+            <translation>否定应答</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="119" />
+            <source>memory parity error</source>
+            <translation>存储奇偶校验错误</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="120" />
+            <source>gateway path unavailable</source>
+            <translation>网关路径不可用</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="121" />
+            <source>gateway target device failed to respond</source>
+            <translation>网关目标设备无响应</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="123" />
+            <source>unknown exception</source>
+            <translation>未知异常</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="127" />
+            <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
+            <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="128" />
+            <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
+            <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="129" />
+            <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
+            <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="130" />
+            <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
+            <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="131" />
+            <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
+            <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="132" />
+            <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
+            <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="134" />
+            <source>Refused by the safety envelope: {text}</source>
+            <translation>安全边界拒绝：{text}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="135" />
+            <source>segment {n}: </source>
+            <translation>第 {n} 段：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="136" />
+            <source> (reduced-speed mode)</source>
+            <translation>（减速模式）</translation>
+        </message>
+    </context>
+    <context>
         <name>MonitorPanel</name>
         <message>
             <location filename="../../ui/panels/monitor_panel.py" line="256" />
@@ -1387,152 +1755,157 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="161" />
+            <location filename="../../ui/controllers/point_sync.py" line="158" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="172" />
+            <location filename="../../ui/controllers/point_sync.py" line="169" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="182" />
+            <location filename="../../ui/controllers/point_sync.py" line="179" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="184" />
+            <location filename="../../ui/controllers/point_sync.py" line="181" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="191" />
+            <location filename="../../ui/controllers/point_sync.py" line="188" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="217" />
+            <location filename="../../ui/controllers/point_sync.py" line="214" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="223" />
+            <location filename="../../ui/controllers/point_sync.py" line="220" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="226" />
+            <location filename="../../ui/controllers/point_sync.py" line="223" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="230" />
+            <location filename="../../ui/controllers/point_sync.py" line="227" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="232" />
+            <location filename="../../ui/controllers/point_sync.py" line="229" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="237" />
+            <location filename="../../ui/controllers/point_sync.py" line="234" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="253" />
+            <location filename="../../ui/controllers/point_sync.py" line="250" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="273" />
+            <location filename="../../ui/controllers/point_sync.py" line="270" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="276" />
+            <location filename="../../ui/controllers/point_sync.py" line="273" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="306" />
+            <location filename="../../ui/controllers/point_sync.py" line="303" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="320" />
+            <location filename="../../ui/controllers/point_sync.py" line="317" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="344" />
+            <location filename="../../ui/controllers/point_sync.py" line="341" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="349" />
+            <location filename="../../ui/controllers/point_sync.py" line="346" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="360" />
+            <location filename="../../ui/controllers/point_sync.py" line="357" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="364" />
+            <location filename="../../ui/controllers/point_sync.py" line="361" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="370" />
+            <location filename="../../ui/controllers/point_sync.py" line="367" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="377" />
+            <location filename="../../ui/controllers/point_sync.py" line="374" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="379" />
+            <location filename="../../ui/controllers/point_sync.py" line="376" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="388" />
+            <location filename="../../ui/controllers/point_sync.py" line="385" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="392" />
+            <location filename="../../ui/controllers/point_sync.py" line="389" />
+            <source>Move to P{id} stopped by the operator</source>
+            <translation>运动到 P{id} 已由操作员停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/point_sync.py" line="393" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="430" />
+            <location filename="../../ui/controllers/point_sync.py" line="431" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="432" />
+            <location filename="../../ui/controllers/point_sync.py" line="434" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="448" />
+            <location filename="../../ui/controllers/point_sync.py" line="450" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="452" />
+            <location filename="../../ui/controllers/point_sync.py" line="454" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="456" />
+            <location filename="../../ui/controllers/point_sync.py" line="458" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
