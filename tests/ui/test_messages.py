@@ -206,7 +206,8 @@ def test_every_error_kind_reads_in_chinese(zh: None) -> None:
         assert worker_error.message == str(error)  # English beside the reason
         assert worker_error.request_id == 7
         assert error_text(worker_error) == error_text(error)
-    assert error_text(_errors()[5]) == ("无法重新连接控制器 192.168.1.10:502：连接被拒绝：端口 502 上没有服务在监听。")
+    assert error_text(_errors()[5]) == ("无法重新连接控制器 192.168.1.10:502："
+                                        "连接被拒绝：端口 502 上没有服务在监听。")
 
 
 def test_an_error_without_a_reason_falls_back_to_its_message(zh: None) -> None:
