@@ -28,8 +28,8 @@ from app.protocol.enums import (
     controller_mode_text,
 )
 
-__all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "error_text", "reason_text",
-           "result_level", "result_text"]
+__all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "error_text", "operation_text", "reason_text",
+           "result_level", "result_text", "status_text"]
 
 CONTEXT = "Messages"
 LEVEL_INFO = "info"
@@ -55,6 +55,16 @@ _TEMPLATES: dict[str, str] = {
     "result_unknown": QT_TRANSLATE_NOOP("Messages", "{command}: the arm moved and stopped, but the controller did not report the result."),  # noqa: E501
     "stopped_by_operator": QT_TRANSLATE_NOOP("Messages", "{command}: stopped by the operator."),
     "stopped_by_controller": QT_TRANSLATE_NOOP("Messages", "{command}: stopped by the controller."),
+    "sent": QT_TRANSLATE_NOOP("Messages", "{command}: sent (not waited for)."),
+    "no_motion": QT_TRANSLATE_NOOP("Messages", "{command}: no motion within {seconds} s (refused by the controller, or already there)."),  # noqa: E501
+    "program_not_started": QT_TRANSLATE_NOOP("Messages", "Program {program} did not start: no such program, or the controller refused it."),  # noqa: E501
+    "upload_done": QT_TRANSLATE_NOOP("Messages", "Uploaded {uploaded} of {total} points."),
+    # requests the worker handles without a GV291 status (stop, pause, mode...)
+    "request_done": QT_TRANSLATE_NOOP("Messages", "{operation}: sent."),
+    "request_failed": QT_TRANSLATE_NOOP("Messages", "{operation}: failed."),
+    "busy": QT_TRANSLATE_NOOP("Messages", "{operation} is still under way: wait for it or press Stop."),
+    "link_shut_down": QT_TRANSLATE_NOOP("Messages", "The link is shut down: nothing was sent."),
+    "not_connected": QT_TRANSLATE_NOOP("Messages", "Not connected to a controller: nothing was sent."),
     # the link
     "link_lost": QT_TRANSLATE_NOOP("Messages", "Lost the connection to the controller at {endpoint}."),
     "link_closed": QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} closed the connection."),
@@ -93,6 +103,30 @@ _RECONNECT = QT_TRANSLATE_NOOP("Messages", "Cannot reconnect to the controller a
 _CONNECT = QT_TRANSLATE_NOOP("Messages", "Cannot connect to the controller at {endpoint}: {cause}")
 _A_COMMAND = QT_TRANSLATE_NOOP("Messages", "The command")
 _FAILED = QT_TRANSLATE_NOOP("Messages", "Failed.")
+
+_OPERATIONS: dict[str, str] = {  # app.link.types.Operation values
+    "stop": QT_TRANSLATE_NOOP("Messages", "stop"),
+    "pause": QT_TRANSLATE_NOOP("Messages", "pause"),
+    "resume": QT_TRANSLATE_NOOP("Messages", "resume"),
+    "jog": QT_TRANSLATE_NOOP("Messages", "jog"),
+    "jog release": QT_TRANSLATE_NOOP("Messages", "jog release"),
+    "jog speed": QT_TRANSLATE_NOOP("Messages", "jog speed"),
+    "step": QT_TRANSLATE_NOOP("Messages", "incremental move"),
+    "set mode": QT_TRANSLATE_NOOP("Messages", "work mode"),
+    "go to zero": QT_TRANSLATE_NOOP("Messages", "go to zero"),
+    "run program": QT_TRANSLATE_NOOP("Messages", "run program"),
+    "create point": QT_TRANSLATE_NOOP("Messages", "create temp point"),
+    "move to point": QT_TRANSLATE_NOOP("Messages", "move to temp point"),
+    "upload points": QT_TRANSLATE_NOOP("Messages", "upload temp points"),
+    "cancel upload": QT_TRANSLATE_NOOP("Messages", "cancel upload"),
+    "teach disable": QT_TRANSLATE_NOOP("Messages", "teach disable"),
+    "poll": QT_TRANSLATE_NOOP("Messages", "monitor"),
+    "connect": QT_TRANSLATE_NOOP("Messages", "connect"),
+    "disconnect": QT_TRANSLATE_NOOP("Messages", "disconnect"),
+    "shutdown": QT_TRANSLATE_NOOP("Messages", "shutdown"),
+    "restart check": QT_TRANSLATE_NOOP("Messages", "restart check"),
+}
+_AN_OPERATION = QT_TRANSLATE_NOOP("Messages", "request")
 
 _FIELDS: dict[str, str] = {
     "length": QT_TRANSLATE_NOOP("Messages", "length"),
@@ -154,6 +188,11 @@ def _command_name(command: Any) -> str:
     return _tr(RUN_COMMAND_TEXT[member], "Protocol") if member in RUN_COMMAND_TEXT else _tr(_A_COMMAND)
 
 
+def operation_text(operation: str) -> str:
+    """An :class:`~app.link.types.Operation` name in the operator's language."""
+    return _tr(_OPERATIONS.get(operation, _AN_OPERATION))
+
+
 def status_text(status: CommandStatus) -> str:
     """GV291 in words, translated (context "Protocol")."""
     if status.text == UNKNOWN_STATUS_TEXT.format(code=status.code):
@@ -210,6 +249,8 @@ def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
         out["status"] = status
     if "alarms" in args:
         out["alarms"] = _alarms(int(args["alarms"]))
+    if "operation" in args:
+        out["operation"] = operation_text(str(args["operation"]))
     if "mode" in args:
         out["mode"] = _tr(controller_mode_text(int(args["mode"])), "Protocol")
     if "field" in args:

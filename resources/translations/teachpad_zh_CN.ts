@@ -332,117 +332,17 @@
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="336" />
-            <source>stop</source>
-            <translation>停止</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="337" />
-            <source>pause</source>
-            <translation>暂停</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="338" />
-            <source>resume</source>
-            <translation>继续</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="339" />
-            <source>jog</source>
-            <translation>点动</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="340" />
-            <source>jog release</source>
-            <translation>点动松开</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="341" />
-            <source>jog speed</source>
-            <translation>点动速度</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="342" />
-            <source>incremental move</source>
-            <translation>增量运动</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="343" />
-            <source>work mode</source>
-            <translation>工作模式</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="344" />
-            <source>go to zero</source>
-            <translation>回零</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="345" />
-            <source>run program</source>
-            <translation>运行程序</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="346" />
-            <source>create temp point</source>
-            <translation>创建临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="347" />
-            <source>move to temp point</source>
-            <translation>运动至临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="348" />
-            <source>upload temp points</source>
-            <translation>上传临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="349" />
-            <source>cancel upload</source>
-            <translation>取消上传</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="350" />
-            <source>teach disable</source>
-            <translation>示教禁止</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="351" />
-            <source>monitor</source>
-            <translation>监视</translation>
-        </message>
-        <message>
             <location filename="../../ui/panels/event_log.py" line="352" />
-            <source>connect</source>
-            <translation>连接</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="353" />
-            <source>disconnect</source>
-            <translation>断开</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="354" />
-            <source>shutdown</source>
-            <translation>关闭</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="355" />
-            <source>restart check</source>
-            <translation>重启检测</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="374" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="399" />
+            <location filename="../../ui/panels/event_log.py" line="377" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="400" />
+            <location filename="../../ui/panels/event_log.py" line="378" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -748,312 +648,462 @@
             <translation>{command}：已被控制器停止。</translation>
         </message>
         <message>
+            <location filename="../../ui/messages.py" line="58" />
+            <source>{command}: sent (not waited for).</source>
+            <translation>{command}：已发送（未等待结果）。</translation>
+        </message>
+        <message>
             <location filename="../../ui/messages.py" line="59" />
+            <source>{command}: no motion within {seconds} s (refused by the controller, or already there).</source>
+            <translation>{command}：{seconds} s 内没有运动（被控制器拒绝，或已在目标位置）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="60" />
+            <source>Program {program} did not start: no such program, or the controller refused it.</source>
+            <translation>程序 {program} 未启动：没有该程序，或控制器拒绝执行。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="61" />
+            <source>Uploaded {uploaded} of {total} points.</source>
+            <translation>已上传 {uploaded}/{total} 个点。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="63" />
+            <source>{operation}: sent.</source>
+            <translation>{operation}：已发送。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="64" />
+            <source>{operation}: failed.</source>
+            <translation>{operation}：失败。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="65" />
+            <source>{operation} is still under way: wait for it or press Stop.</source>
+            <translation>{operation}仍在进行：请等待其结束或按停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="66" />
+            <source>The link is shut down: nothing was sent.</source>
+            <translation>通信链路已关闭：未发送任何内容。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="67" />
+            <source>Not connected to a controller: nothing was sent.</source>
+            <translation>未连接控制器：未发送任何内容。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="69" />
             <source>Lost the connection to the controller at {endpoint}.</source>
             <translation>与控制器 {endpoint} 的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="60" />
+            <location filename="../../ui/messages.py" line="70" />
             <source>The controller at {endpoint} closed the connection.</source>
             <translation>控制器 {endpoint} 关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="61" />
+            <location filename="../../ui/messages.py" line="71" />
             <source>The host name {host} cannot be resolved.</source>
             <translation>无法解析主机名 {host}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="62" />
+            <location filename="../../ui/messages.py" line="72" />
             <source>Connection refused: nothing listens on port {port}.</source>
             <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="63" />
+            <location filename="../../ui/messages.py" line="73" />
             <source>No answer to the connection request within {seconds} s.</source>
             <translation>连接请求在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="64" />
+            <location filename="../../ui/messages.py" line="74" />
             <source>The connection could not be opened.</source>
             <translation>无法建立连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="65" />
+            <location filename="../../ui/messages.py" line="75" />
             <source>Cannot open the serial port {port}.</source>
             <translation>无法打开串口 {port}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="66" />
+            <location filename="../../ui/messages.py" line="76" />
             <source>The controller at {endpoint} did not answer within {seconds} s.</source>
             <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="67" />
+            <location filename="../../ui/messages.py" line="77" />
             <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
             <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="68" />
+            <location filename="../../ui/messages.py" line="78" />
             <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="69" />
+            <location filename="../../ui/messages.py" line="79" />
             <source>Monitor-only mode: nothing was sent to the controller.</source>
             <translation>仅监视模式：未向控制器发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="70" />
+            <location filename="../../ui/messages.py" line="80" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="71" />
+            <location filename="../../ui/messages.py" line="81" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="76" />
+            <location filename="../../ui/messages.py" line="86" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="77" />
+            <location filename="../../ui/messages.py" line="87" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="78" />
+            <location filename="../../ui/messages.py" line="88" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="79" />
+            <location filename="../../ui/messages.py" line="89" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="80" />
+            <location filename="../../ui/messages.py" line="90" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="81" />
+            <location filename="../../ui/messages.py" line="91" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="82" />
+            <location filename="../../ui/messages.py" line="92" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="83" />
+            <location filename="../../ui/messages.py" line="93" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="84" />
+            <location filename="../../ui/messages.py" line="94" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="85" />
+            <location filename="../../ui/messages.py" line="95" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="86" />
+            <location filename="../../ui/messages.py" line="96" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="87" />
+            <location filename="../../ui/messages.py" line="97" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="88" />
+            <location filename="../../ui/messages.py" line="98" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="89" />
+            <location filename="../../ui/messages.py" line="99" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="92" />
+            <location filename="../../ui/messages.py" line="102" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="93" />
+            <location filename="../../ui/messages.py" line="103" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="94" />
+            <location filename="../../ui/messages.py" line="104" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="95" />
+            <location filename="../../ui/messages.py" line="105" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="98" />
+            <location filename="../../ui/messages.py" line="108" />
+            <source>stop</source>
+            <translation>停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="109" />
+            <source>pause</source>
+            <translation>暂停</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="110" />
+            <source>resume</source>
+            <translation>继续</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="111" />
+            <source>jog</source>
+            <translation>点动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="112" />
+            <source>jog release</source>
+            <translation>点动松开</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="113" />
+            <source>jog speed</source>
+            <translation>点动速度</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="114" />
+            <source>incremental move</source>
+            <translation>增量运动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="115" />
+            <source>work mode</source>
+            <translation>工作模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="116" />
+            <source>go to zero</source>
+            <translation>回零</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="117" />
+            <source>run program</source>
+            <translation>运行程序</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="118" />
+            <source>create temp point</source>
+            <translation>创建临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="119" />
+            <source>move to temp point</source>
+            <translation>运动至临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="120" />
+            <source>upload temp points</source>
+            <translation>上传临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="121" />
+            <source>cancel upload</source>
+            <translation>取消上传</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="122" />
+            <source>teach disable</source>
+            <translation>示教禁止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="123" />
+            <source>monitor</source>
+            <translation>监视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="124" />
+            <source>connect</source>
+            <translation>连接</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="125" />
+            <source>disconnect</source>
+            <translation>断开</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="126" />
+            <source>shutdown</source>
+            <translation>关闭</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="127" />
+            <source>restart check</source>
+            <translation>重启检测</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="129" />
+            <source>request</source>
+            <translation>请求</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="132" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="99" />
+            <location filename="../../ui/messages.py" line="133" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="100" />
+            <location filename="../../ui/messages.py" line="134" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="101" />
+            <location filename="../../ui/messages.py" line="135" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="102" />
+            <location filename="../../ui/messages.py" line="136" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="103" />
+            <location filename="../../ui/messages.py" line="137" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="104" />
+            <location filename="../../ui/messages.py" line="138" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="105" />
+            <location filename="../../ui/messages.py" line="139" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="106" />
+            <location filename="../../ui/messages.py" line="140" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="107" />
+            <location filename="../../ui/messages.py" line="141" />
             <source>unit id</source>
             <translation>站号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="108" />
+            <location filename="../../ui/messages.py" line="142" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="112" />
+            <location filename="../../ui/messages.py" line="146" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="113" />
+            <location filename="../../ui/messages.py" line="147" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="114" />
+            <location filename="../../ui/messages.py" line="148" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="115" />
+            <location filename="../../ui/messages.py" line="149" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="116" />
+            <location filename="../../ui/messages.py" line="150" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="117" />
+            <location filename="../../ui/messages.py" line="151" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="118" />
+            <location filename="../../ui/messages.py" line="152" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="119" />
+            <location filename="../../ui/messages.py" line="153" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="120" />
+            <location filename="../../ui/messages.py" line="154" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="121" />
+            <location filename="../../ui/messages.py" line="155" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="123" />
+            <location filename="../../ui/messages.py" line="157" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="127" />
+            <location filename="../../ui/messages.py" line="161" />
             <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="128" />
+            <location filename="../../ui/messages.py" line="162" />
             <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
             <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="129" />
+            <location filename="../../ui/messages.py" line="163" />
             <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
             <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="130" />
+            <location filename="../../ui/messages.py" line="164" />
             <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
             <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="131" />
+            <location filename="../../ui/messages.py" line="165" />
             <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
             <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="132" />
+            <location filename="../../ui/messages.py" line="166" />
             <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
             <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="134" />
+            <location filename="../../ui/messages.py" line="168" />
             <source>Refused by the safety envelope: {text}</source>
             <translation>安全边界拒绝：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="135" />
+            <location filename="../../ui/messages.py" line="169" />
             <source>segment {n}: </source>
             <translation>第 {n} 段：</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="136" />
+            <location filename="../../ui/messages.py" line="170" />
             <source> (reduced-speed mode)</source>
             <translation>（减速模式）</translation>
         </message>

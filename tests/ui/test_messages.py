@@ -221,3 +221,24 @@ def test_the_english_stays_plain_for_the_cli() -> None:
     error = CommandRefused(CommandStatus(CommandKind.MOVE, 13), params={"command": 0x42})
     assert error.as_reason().code == "command_refused"
     assert "bad end point id" in str(error)
+
+
+def test_the_codes_the_worker_and_the_cli_use_read_in_chinese(zh: None) -> None:
+    from ui.messages import operation_text
+
+    reasons = [
+        Reason("sent", {"command": int(RunCommand.STEP_BASE)}),
+        Reason("no_motion", {"command": int(RunCommand.RUN_PROGRAM), "seconds": 2.0}),
+        Reason("program_not_started", {"program": 99}),
+        Reason("upload_done", {"uploaded": 3, "total": 5}),
+        Reason("busy", {"operation": Operation.UPLOAD_POINTS}),
+        Reason("link_shut_down"),
+        Reason("not_connected"),
+        *(Reason("request_done", {"operation": op}) for name, op in vars(Operation).items() if name.isupper()),
+    ]
+    for reason in reasons:
+        assert_chinese(error_text(reason))
+    for name, op in vars(Operation).items():
+        if name.isupper():
+            assert_chinese(operation_text(op))
+    assert error_text(Reason("request_done", {"operation": Operation.STOP})) == "停止：已发送。"
