@@ -234,7 +234,8 @@ def test_the_codes_the_worker_and_the_cli_use_read_in_chinese(zh: None) -> None:
         Reason("busy", {"operation": Operation.UPLOAD_POINTS}),
         Reason("link_shut_down"),
         Reason("not_connected"),
-        *(Reason("request_done", {"operation": op}) for name, op in vars(Operation).items() if name.isupper()),
+        *(Reason("request_done", {"operation": op})
+          for name, op in vars(Operation).items() if name.isupper()),
     ]
     for reason in reasons:
         assert_chinese(error_text(reason))
