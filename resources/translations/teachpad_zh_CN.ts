@@ -1480,6 +1480,34 @@
         </message>
     </context>
     <context>
+        <name>PlanRunController</name>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="192" />
+            <source>Failed: {reason}</source>
+            <translation>失败：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="192" />
+            <source>Stopped: {reason}</source>
+            <translation>已停止：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="194" />
+            <source>Failed at segment {n}: {reason}</source>
+            <translation>在第 {n} 段失败：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="195" />
+            <source>Stopped at segment {n}: {reason}</source>
+            <translation>在第 {n} 段停止：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="210" />
+            <source>stopped by the operator</source>
+            <translation>已由操作员停止</translation>
+        </message>
+    </context>
+    <context>
         <name>PlanRunFlow</name>
         <message>
             <location filename="../../ui/panels/planner_run.py" line="68" />
@@ -1777,16 +1805,6 @@
             <location filename="../../ui/panels/planner_panel.py" line="392" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="401" />
-            <source>Failed</source>
-            <translation>失败</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="401" />
-            <source>Stopped</source>
-            <translation>已停止</translation>
         </message>
     </context>
     <context>
