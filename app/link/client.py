@@ -42,6 +42,7 @@ from app.errors import (
     LinkError,
     MalformedResponse,
     ModbusExceptionError,
+    Reason,
     ResponseTimeout,
     WriteBlocked,
 )
@@ -441,7 +442,8 @@ class RobotClient:
     def _finish(self, tracker: CommandTracker, wait: bool) -> CommandResult:
         if wait:
             return self.wait(tracker)
-        return CommandResult(tracker.command, tracker.kind, None, True, f"{tracker.text}: sent")
+        return CommandResult(tracker.command, tracker.kind, None, True, f"{tracker.text}: sent",
+                             reason=Reason("sent", {"command": int(tracker.command)}))
 
     def _check_point_id(self, point_id: int, name: str = "point id") -> int:
         return _check_int(point_id, self.settings.point_id_min, self.settings.point_id_max, name)
@@ -542,7 +544,7 @@ class RobotClient:
                 status = tracker.last_status or status
             except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
                 results.append(CommandResult(RunCommand.CREATE_POINT, kind, None, False, str(exc),
-                                             {"point_id": float(point_id)}))
+                                             {"point_id": float(point_id)}, reason=exc.as_reason()))
                 break
             details = dict(result.details, point_id=float(point_id))
             results.append(dataclasses.replace(result, message=f"point {point_id}: {result.message}",

@@ -511,117 +511,17 @@
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="336" />
-            <source>stop</source>
-            <translation>停止</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="337" />
-            <source>pause</source>
-            <translation>暂停</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="338" />
-            <source>resume</source>
-            <translation>继续</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="339" />
-            <source>jog</source>
-            <translation>点动</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="340" />
-            <source>jog release</source>
-            <translation>点动松开</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="341" />
-            <source>jog speed</source>
-            <translation>点动速度</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="342" />
-            <source>incremental move</source>
-            <translation>增量运动</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="343" />
-            <source>work mode</source>
-            <translation>工作模式</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="344" />
-            <source>go to zero</source>
-            <translation>回零</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="345" />
-            <source>run program</source>
-            <translation>运行程序</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="346" />
-            <source>create temp point</source>
-            <translation>创建临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="347" />
-            <source>move to temp point</source>
-            <translation>运动至临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="348" />
-            <source>upload temp points</source>
-            <translation>上传临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="349" />
-            <source>cancel upload</source>
-            <translation>取消上传</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="350" />
-            <source>teach disable</source>
-            <translation>示教禁止</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="351" />
-            <source>monitor</source>
-            <translation>监视</translation>
-        </message>
-        <message>
             <location filename="../../ui/panels/event_log.py" line="352" />
-            <source>connect</source>
-            <translation>连接</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="353" />
-            <source>disconnect</source>
-            <translation>断开</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="354" />
-            <source>shutdown</source>
-            <translation>关闭</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="355" />
-            <source>restart check</source>
-            <translation>重启检测</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="374" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="399" />
+            <location filename="../../ui/panels/event_log.py" line="377" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="400" />
+            <location filename="../../ui/panels/event_log.py" line="378" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -747,7 +647,7 @@
         <message>
             <location filename="../../ui/keypad.py" line="95" />
             <source>Clear</source>
-            <translation>清除</translation>
+            <translation>清空</translation>
         </message>
         <message>
             <location filename="../../ui/keypad.py" line="97" />
@@ -875,6 +775,524 @@
         </message>
     </context>
     <context>
+        <name>Messages</name>
+        <message>
+            <location filename="../../ui/messages.py" line="47" />
+            <source>{command}: {status}.</source>
+            <translation>{command}：{status}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="48" />
+            <source>{command}: done, not confirmed by the controller.</source>
+            <translation>{command}：已完成，控制器未确认。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="49" />
+            <source>{command}: done (the controller is now in {mode} mode).</source>
+            <translation>{command}：已完成（控制器现处于{mode}模式）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="50" />
+            <source>{command} refused by the controller: {status}.</source>
+            <translation>控制器拒绝了{command}：{status}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="51" />
+            <source>{command} not taken: the controller still shows “{status}” from the previous command.</source>
+            <translation>{command}未被执行：控制器仍显示上一条命令的“{status}”。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="52" />
+            <source>{command} ended by an alarm: {alarms}.</source>
+            <translation>{command}因报警而中止：{alarms}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="53" />
+            <source>{command}: the controller did not acknowledge it within {seconds} s.</source>
+            <translation>{command}：控制器在 {seconds} s 内未确认。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="54" />
+            <source>{command} did not finish within {seconds} s (last status: {status}).</source>
+            <translation>{command}未在 {seconds} s 内完成（最后状态：{status}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="55" />
+            <source>{command}: the arm moved and stopped, but the controller did not report the result.</source>
+            <translation>{command}：机械臂已运动并停止，但控制器未报告结果。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="56" />
+            <source>{command}: stopped by the operator.</source>
+            <translation>{command}：已由操作员停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="57" />
+            <source>{command}: stopped by the controller.</source>
+            <translation>{command}：已被控制器停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="58" />
+            <source>{command}: sent (not waited for).</source>
+            <translation>{command}：已发送（未等待结果）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="59" />
+            <source>{command}: no motion within {seconds} s (refused by the controller, or already there).</source>
+            <translation>{command}：{seconds} s 内没有运动（被控制器拒绝，或已在目标位置）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="60" />
+            <source>Program {program} did not start: no such program, or the controller refused it.</source>
+            <translation>程序 {program} 未启动：没有该程序，或控制器拒绝执行。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="61" />
+            <source>Uploaded {uploaded} of {total} points.</source>
+            <translation>已上传 {uploaded}/{total} 个点。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="63" />
+            <source>{operation}: sent.</source>
+            <translation>{operation}：已发送。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="64" />
+            <source>{operation}: failed.</source>
+            <translation>{operation}：失败。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="65" />
+            <source>{operation} is still under way: wait for it or press Stop.</source>
+            <translation>{operation}仍在进行：请等待其结束或按停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="66" />
+            <source>The link is shut down: nothing was sent.</source>
+            <translation>通信链路已关闭：未发送任何内容。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="67" />
+            <source>Not connected to a controller: nothing was sent.</source>
+            <translation>未连接控制器：未发送任何内容。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="69" />
+            <source>Lost the connection to the controller at {endpoint}.</source>
+            <translation>与控制器 {endpoint} 的连接已断开。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="70" />
+            <source>The controller at {endpoint} closed the connection.</source>
+            <translation>控制器 {endpoint} 关闭了连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="71" />
+            <source>The host name {host} cannot be resolved.</source>
+            <translation>无法解析主机名 {host}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="72" />
+            <source>Connection refused: nothing listens on port {port}.</source>
+            <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="73" />
+            <source>No answer to the connection request within {seconds} s.</source>
+            <translation>连接请求在 {seconds} s 内无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="74" />
+            <source>The connection could not be opened.</source>
+            <translation>无法建立连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="75" />
+            <source>Cannot open the serial port {port}.</source>
+            <translation>无法打开串口 {port}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="76" />
+            <source>The controller at {endpoint} did not answer within {seconds} s.</source>
+            <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="77" />
+            <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
+            <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="78" />
+            <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
+            <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="79" />
+            <source>Monitor-only mode: nothing was sent to the controller.</source>
+            <translation>仅监视模式：未向控制器发送任何内容。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="80" />
+            <source>Invalid value: nothing was sent.</source>
+            <translation>数值无效：未发送。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="81" />
+            <source>Unexpected internal error; the log has the details.</source>
+            <translation>意外的内部错误；详情见日志。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="86" />
+            <source>No connection to the controller.</source>
+            <translation>未连接控制器。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="87" />
+            <source>The controller closed the connection.</source>
+            <translation>控制器关闭了连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="88" />
+            <source>Connection refused by the controller.</source>
+            <translation>控制器拒绝了连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="89" />
+            <source>The controller did not answer.</source>
+            <translation>控制器无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="90" />
+            <source>Malformed answer from the controller.</source>
+            <translation>控制器的应答格式错误。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="91" />
+            <source>Cannot open the serial port.</source>
+            <translation>无法打开串口。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="92" />
+            <source>The host name cannot be resolved.</source>
+            <translation>无法解析主机名。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="93" />
+            <source>No answer to the connection request.</source>
+            <translation>连接请求无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="94" />
+            <source>{command} did not finish in time.</source>
+            <translation>{command}未按时完成。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="95" />
+            <source>{command}: the controller did not acknowledge it.</source>
+            <translation>{command}：控制器未确认。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="96" />
+            <source>{command} ended by an alarm.</source>
+            <translation>{command}因报警而中止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="97" />
+            <source>{command} refused by the controller.</source>
+            <translation>控制器拒绝了{command}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="98" />
+            <source>{command}: done.</source>
+            <translation>{command}：已完成。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="99" />
+            <source>The controller refused the request (Modbus exception).</source>
+            <translation>控制器拒绝了请求（Modbus 异常）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="102" />
+            <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
+            <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="103" />
+            <source>Cannot connect to the controller at {endpoint}: {cause}</source>
+            <translation>无法连接控制器 {endpoint}：{cause}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="104" />
+            <source>The command</source>
+            <translation>该命令</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="105" />
+            <source>Failed.</source>
+            <translation>失败。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="108" />
+            <source>stop</source>
+            <translation>停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="109" />
+            <source>pause</source>
+            <translation>暂停</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="110" />
+            <source>resume</source>
+            <translation>继续</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="111" />
+            <source>jog</source>
+            <translation>点动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="112" />
+            <source>jog release</source>
+            <translation>点动松开</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="113" />
+            <source>jog speed</source>
+            <translation>点动速度</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="114" />
+            <source>incremental move</source>
+            <translation>增量运动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="115" />
+            <source>work mode</source>
+            <translation>工作模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="116" />
+            <source>go to zero</source>
+            <translation>回零</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="117" />
+            <source>run program</source>
+            <translation>运行程序</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="118" />
+            <source>create temp point</source>
+            <translation>创建临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="119" />
+            <source>move to temp point</source>
+            <translation>运动至临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="120" />
+            <source>upload temp points</source>
+            <translation>上传临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="121" />
+            <source>cancel upload</source>
+            <translation>取消上传</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="122" />
+            <source>teach disable</source>
+            <translation>示教禁止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="123" />
+            <source>monitor</source>
+            <translation>监视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="124" />
+            <source>connect</source>
+            <translation>连接</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="125" />
+            <source>disconnect</source>
+            <translation>断开</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="126" />
+            <source>shutdown</source>
+            <translation>关闭</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="127" />
+            <source>restart check</source>
+            <translation>重启检测</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="129" />
+            <source>request</source>
+            <translation>请求</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="132" />
+            <source>length</source>
+            <translation>长度</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="133" />
+            <source>function code</source>
+            <translation>功能码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="134" />
+            <source>byte count</source>
+            <translation>字节数</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="135" />
+            <source>exception code</source>
+            <translation>异常码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="136" />
+            <source>address</source>
+            <translation>地址</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="137" />
+            <source>value</source>
+            <translation>数值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="138" />
+            <source>quantity</source>
+            <translation>数量</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="139" />
+            <source>transaction id</source>
+            <translation>事务标识</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="140" />
+            <source>protocol id</source>
+            <translation>协议标识</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="141" />
+            <source>unit id</source>
+            <translation>站号</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="142" />
+            <source>CRC</source>
+            <translation>CRC 校验</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="146" />
+            <source>illegal function</source>
+            <translation>非法功能</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="147" />
+            <source>illegal data address</source>
+            <translation>非法数据地址</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="148" />
+            <source>illegal data value</source>
+            <translation>非法数据值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="149" />
+            <source>server device failure</source>
+            <translation>从站设备故障</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="150" />
+            <source>acknowledge</source>
+            <translation>已确认，处理中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="151" />
+            <source>server device busy</source>
+            <translation>从站设备忙</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="152" />
+            <source>negative acknowledge</source>
+            <translation>否定应答</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="153" />
+            <source>memory parity error</source>
+            <translation>存储奇偶校验错误</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="154" />
+            <source>gateway path unavailable</source>
+            <translation>网关路径不可用</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="155" />
+            <source>gateway target device failed to respond</source>
+            <translation>网关目标设备无响应</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="157" />
+            <source>unknown exception</source>
+            <translation>未知异常</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="161" />
+            <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
+            <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="162" />
+            <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
+            <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="163" />
+            <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
+            <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="164" />
+            <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
+            <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="165" />
+            <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
+            <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="166" />
+            <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
+            <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="168" />
+            <source>Refused by the safety envelope: {text}</source>
+            <translation>安全边界拒绝：{text}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="169" />
+            <source>segment {n}: </source>
+            <translation>第 {n} 段：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="170" />
+            <source> (reduced-speed mode)</source>
+            <translation>（减速模式）</translation>
+        </message>
+    </context>
+    <context>
         <name>MonitorPanel</name>
         <message>
             <location filename="../../ui/panels/monitor_panel.py" line="230" />
@@ -962,6 +1380,11 @@
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="466" />
+            <source>values stale (grey): no fresh data from the controller</source>
+            <translation>数值已过期（灰色）：控制器无新数据</translation>
+        </message>
+        <message>
             <location filename="../../ui/panels/monitor_panel.py" line="462" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
@@ -970,11 +1393,6 @@
             <location filename="../../ui/panels/monitor_panel.py" line="464" />
             <source>paused</source>
             <translation>已暂停</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="466" />
-            <source>values stale (grey): no fresh data from the controller</source>
-            <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
     </context>
     <context>
@@ -1256,88 +1674,116 @@
         </message>
     </context>
     <context>
+        <name>PlanRunController</name>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="192" />
+            <source>Failed: {reason}</source>
+            <translation>失败：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="192" />
+            <source>Stopped: {reason}</source>
+            <translation>已停止：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="194" />
+            <source>Failed at segment {n}: {reason}</source>
+            <translation>在第 {n} 段失败：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="195" />
+            <source>Stopped at segment {n}: {reason}</source>
+            <translation>在第 {n} 段停止：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="210" />
+            <source>stopped by the operator</source>
+            <translation>已由操作员停止</translation>
+        </message>
+    </context>
+    <context>
         <name>PlanRunFlow</name>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="68" />
+            <location filename="../../ui/panels/planner_run.py" line="69" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="71" />
+            <location filename="../../ui/panels/planner_run.py" line="72" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="83" />
+            <location filename="../../ui/panels/planner_run.py" line="84" />
             <source>Not connected to a controller</source>
             <translation>未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="92" />
+            <location filename="../../ui/panels/planner_run.py" line="93" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="98" />
+            <location filename="../../ui/panels/planner_run.py" line="99" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="100" />
+            <location filename="../../ui/panels/planner_run.py" line="101" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="102" />
+            <location filename="../../ui/panels/planner_run.py" line="103" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="103" />
+            <location filename="../../ui/panels/planner_run.py" line="104" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="115" />
+            <location filename="../../ui/panels/planner_run.py" line="116" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="117" />
+            <location filename="../../ui/panels/planner_run.py" line="118" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="119" />
+            <location filename="../../ui/panels/planner_run.py" line="120" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="121" />
+            <location filename="../../ui/panels/planner_run.py" line="122" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="122" />
+            <location filename="../../ui/panels/planner_run.py" line="123" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="125" />
+            <location filename="../../ui/panels/planner_run.py" line="126" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="129" />
+            <location filename="../../ui/panels/planner_run.py" line="130" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="178" />
+            <location filename="../../ui/panels/planner_run.py" line="185" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
@@ -1554,16 +2000,6 @@
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="402" />
-            <source>Failed</source>
-            <translation>失败</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="402" />
-            <source>Stopped</source>
-            <translation>已停止</translation>
-        </message>
     </context>
     <context>
         <name>PointPicker</name>
@@ -1581,152 +2017,157 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="161" />
+            <location filename="../../ui/controllers/point_sync.py" line="158" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="172" />
+            <location filename="../../ui/controllers/point_sync.py" line="169" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="182" />
+            <location filename="../../ui/controllers/point_sync.py" line="179" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="184" />
+            <location filename="../../ui/controllers/point_sync.py" line="181" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="191" />
+            <location filename="../../ui/controllers/point_sync.py" line="188" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="217" />
+            <location filename="../../ui/controllers/point_sync.py" line="214" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="223" />
+            <location filename="../../ui/controllers/point_sync.py" line="220" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="226" />
+            <location filename="../../ui/controllers/point_sync.py" line="223" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="230" />
+            <location filename="../../ui/controllers/point_sync.py" line="227" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="232" />
+            <location filename="../../ui/controllers/point_sync.py" line="229" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="237" />
+            <location filename="../../ui/controllers/point_sync.py" line="234" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="253" />
+            <location filename="../../ui/controllers/point_sync.py" line="250" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="273" />
+            <location filename="../../ui/controllers/point_sync.py" line="270" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="276" />
+            <location filename="../../ui/controllers/point_sync.py" line="273" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="306" />
+            <location filename="../../ui/controllers/point_sync.py" line="303" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="320" />
+            <location filename="../../ui/controllers/point_sync.py" line="317" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="344" />
+            <location filename="../../ui/controllers/point_sync.py" line="341" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="349" />
+            <location filename="../../ui/controllers/point_sync.py" line="346" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="360" />
+            <location filename="../../ui/controllers/point_sync.py" line="357" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="364" />
+            <location filename="../../ui/controllers/point_sync.py" line="361" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="370" />
+            <location filename="../../ui/controllers/point_sync.py" line="367" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="377" />
+            <location filename="../../ui/controllers/point_sync.py" line="374" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="379" />
+            <location filename="../../ui/controllers/point_sync.py" line="376" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="388" />
+            <location filename="../../ui/controllers/point_sync.py" line="385" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="392" />
+            <location filename="../../ui/controllers/point_sync.py" line="389" />
+            <source>Move to P{id} stopped by the operator</source>
+            <translation>运动到 P{id} 已由操作员停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/point_sync.py" line="393" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="430" />
+            <location filename="../../ui/controllers/point_sync.py" line="431" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="432" />
+            <location filename="../../ui/controllers/point_sync.py" line="434" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="448" />
+            <location filename="../../ui/controllers/point_sync.py" line="450" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="452" />
+            <location filename="../../ui/controllers/point_sync.py" line="454" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="456" />
+            <location filename="../../ui/controllers/point_sync.py" line="458" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -2149,7 +2590,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="70" />
             <source>connecting</source>
-            <translation>连接中</translation>
+            <translation>正在连接</translation>
         </message>
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="71" />
@@ -2159,7 +2600,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="72" />
             <source>link down</source>
-            <translation>通信中断</translation>
+            <translation>链路中断</translation>
         </message>
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="199" />

@@ -145,7 +145,7 @@ def test_host_sent_stop_ends_the_wait() -> None:
     assert tr.update(st(6, RUNNING), moved(1), 0.01) is None
     result = tr.stopped(0.02)
     assert not result.ok and isinstance(tr.error, CommandStopped)
-    assert "stopped by the host" in result.message
+    assert "stopped by the operator" in result.message
     # Later reads do not change the outcome.
     assert tr.update(st(DONE), moved(1), 0.03) is result
 

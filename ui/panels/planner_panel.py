@@ -399,9 +399,9 @@ class PlannerPanel(QWidget):
             if k is not None and self.current_plan() is run_plan:
                 self.select_segments([k])
             level = "error" if outcome.state is RunState.FAILED else "warn"
-            label = self.tr("Failed") if outcome.state is RunState.FAILED else self.tr("Stopped")
-            self.run_box.show_ended(f"{label}: {outcome.message}")
-            self.show_message(f"{label}: {outcome.message}", level)
+            text = self._runner.outcome_text(outcome)
+            self.run_box.show_ended(text)
+            self.show_message(text, level)
         self._update_resume_text()
         self._update_actions()
 
