@@ -56,6 +56,7 @@ from ui.controllers.project_controller import ProjectController, ProjectDialogs
 from ui.dialogs.confirm import ConfirmFn
 from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import Translator
+from ui.messages import error_text
 from ui.panels.alarm_banner import AlarmBanner
 from ui.panels.alarm_list import AlarmListPanel
 from ui.panels.control_bar import ControlBar
@@ -348,7 +349,7 @@ class MainWindow(QMainWindow):
     @Slot(WorkerError)
     def _on_error(self, error: WorkerError) -> None:
         operation = self.event_log.operation_text(error.operation)
-        self.statusBar().showMessage(f"{operation}: {error.message}", 8000)
+        self.statusBar().showMessage(f"{operation}: {error_text(error)}", 8000)
 
     @Slot(str)
     def _show_message(self, text: str) -> None:

@@ -103,6 +103,7 @@ _RECONNECT = QT_TRANSLATE_NOOP("Messages", "Cannot reconnect to the controller a
 _CONNECT = QT_TRANSLATE_NOOP("Messages", "Cannot connect to the controller at {endpoint}: {cause}")
 _A_COMMAND = QT_TRANSLATE_NOOP("Messages", "The command")
 _FAILED = QT_TRANSLATE_NOOP("Messages", "Failed.")
+_FAILED_WITH = QT_TRANSLATE_NOOP("Messages", "Failed: {message}")
 
 _OPERATIONS: dict[str, str] = {  # app.link.types.Operation values
     "stop": QT_TRANSLATE_NOOP("Messages", "stop"),
@@ -292,6 +293,10 @@ def reason_text(reason: Reason) -> str | None:
 def result_text(result: CommandResult) -> str:
     """How a command ended, as one sentence ("Last command", the event log, status lines)."""
     reason = result.reason
+    if reason is None and not result.ok and result.status is None:
+        # nothing structured: a failure without a controller status is not "refused"; say what
+        # we have (the English message) rather than guess a cause
+        return _tr(_FAILED_WITH).format(message=result.message) if result.message else _tr(_FAILED)
     if reason is None:
         reason = Reason("done" if result.ok else "command_refused",
                         {"command": int(result.command) if result.command is not None else None,
