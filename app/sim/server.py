@@ -92,8 +92,10 @@ from app.protocol.registers import (
     TEMP_POINT_ID_MIN,
     gv_reg,
 )
+from app.sim.commands import StoredPoint
 from app.sim.guard import CURRENT_CONNECTION, WATCHDOG_TIMEOUT, BadFrames, CommWatchdog
-from app.sim.robot import Pose6, SimRobot, StoredPoint, TraceSample
+from app.sim.motion import Pose6, TraceSample
+from app.sim.robot import SimRobot
 from app.sim.transport import GuardedSerialServer, GuardedTcpServer, ServerGuard, ServerRunner
 
 log = logging.getLogger(__name__)
