@@ -9,9 +9,10 @@ input and the communication watchdog in :mod:`app.sim.guard` and :mod:`app.sim.t
 """
 
 from app.sim.commands import StoredPoint
+from app.sim.config import SimConfig, SimEvent, SimSnapshot, WriteRecord
 from app.sim.motion import TraceSample
 from app.sim.robot import PROGRAMS, SimRobot
-from app.sim.server import SimConfig, SimController, SimEvent, SimSnapshot, WriteRecord
+from app.sim.server import SimController
 
 __all__ = ["PROGRAMS", "SimConfig", "SimController", "SimEvent", "SimRobot", "SimSnapshot", "StoredPoint",
            "TraceSample", "WriteRecord"]
