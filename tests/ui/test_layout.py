@@ -49,12 +49,7 @@ pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)
 
 # Known problems in panels owned elsewhere, each with its reason; the check stays strict for the
 # rest. Remove an entry when its panel is fixed (an entry that no longer matches fails the test).
-KNOWN_ISSUES: dict[str, str] = {
-    # monitor_panel / widgets_common: connected, in Chinese at 1280×800, a Cartesian readout is
-    # laid out 1 px narrower than its minimum, so the number's box touches the unit's box
-    "zh_CN-1280x800-connected": (r"\[jog joint \| monitor\] QLabel '[-0-9.]+' in NumericReadout and "
-                                 r"QLabel 'mm' in NumericReadout overlap by 1×\d+ px"),
-}
+KNOWN_ISSUES: dict[str, str] = {}
 SIZES = ((1280, 800), (1920, 1080))
 LANGUAGES = ("en", "zh_CN")
 STOP_MESSAGE = "Stopped: the operator pressed STOP during segment 3 of 12 (the controller reported ESTOP)"
