@@ -248,6 +248,7 @@ class MainWindow(QMainWindow):
         self.pose_bar.setMovable(False)
         self.pose_bar.setFloatable(False)
         self.pose_bar.toggleViewAction().setVisible(False)
+        self.pose_bar.setStyleSheet("QToolBar { padding: 0px; spacing: 0px; border: none; }")  # every px
         self.pose_bar.addWidget(self.pose_strip)
         self.addToolBarBreak(Qt.ToolBarArea.TopToolBarArea)
         self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.pose_bar)
