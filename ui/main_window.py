@@ -289,6 +289,9 @@ class MainWindow(QMainWindow):
         self.event_dock.setWindowTitle(self.tr("Event log"))
         self.traffic_dock.setWindowTitle(self.tr("Modbus traffic"))
         self.alarm_dock.setWindowTitle(self.tr("Alarms"))
+        # room for the widest RTT from the start: the status bar does not shift when one arrives
+        widest_rtt = self.tr("RTT {ms} ms").format(ms="9999.9")
+        self.status_rtt.setMinimumWidth(self.status_rtt.fontMetrics().horizontalAdvance(widest_rtt) + 8)
         self.menus.retranslate()
         self.project.retranslate()
         self._on_project_title(self.project.title)

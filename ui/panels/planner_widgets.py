@@ -62,6 +62,7 @@ STATUS_COLOURS: dict[Level, str] = {**SUMMARY_COLOURS, Level.WARN: COLOR_WARN_TE
 
 RUN_LABEL_LINES = 2
 SEGMENT_BUTTONS_PER_ROW = 5
+SUMMARY_MIN_WIDTH = 120  # px, the checks' summary beside Upload now / Check (it wraps)
 PLAN_LIST_MIN_ROWS = 2  # the plan list scrolls below this; the run box keeps its room
 
 
@@ -242,8 +243,8 @@ class PlanRunBox(QGroupBox):
 
 
 class PlanChecksBar(QWidget):
-    """The checks under the segment table (a line of their own: the column can be narrow),
-    with Upload now and Check below them."""
+    """The checks under the segment table (wrapped to the room left), Upload now and Check on
+    their right: one row, the table keeps the height."""
 
     def __init__(self, upload: Callable[[], None], check: Callable[[], None],
                  parent: QWidget | None = None) -> None:
@@ -255,15 +256,13 @@ class PlanChecksBar(QWidget):
         self.upload_button.clicked.connect(upload)
         self.check_button = QPushButton(self)
         self.check_button.clicked.connect(check)
-        buttons = QHBoxLayout()
-        buttons.addStretch(1)
-        buttons.addWidget(self.upload_button)
-        buttons.addWidget(self.check_button)
-        layout = QVBoxLayout(self)
+        self.summary.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
+        self.summary.setMinimumWidth(SUMMARY_MIN_WIDTH)
+        layout = QHBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.setSpacing(2)
-        layout.addWidget(self.summary)
-        layout.addLayout(buttons)
+        layout.addWidget(self.summary, 1)
+        layout.addWidget(self.upload_button, 0, Qt.AlignmentFlag.AlignTop)
+        layout.addWidget(self.check_button, 0, Qt.AlignmentFlag.AlignTop)
 
     def retranslate(self) -> None:
         self.upload_button.setText(self.tr("Upload now"))
