@@ -124,7 +124,8 @@ def main() -> None:
         window.set_language(lang)
         _show(window, "monitor", 0, TeachFrame.BASE)
         sim.set_silent(True)
-        _spin(3.5)
+        _wait(lambda: not window.pose_strip.is_live(), 5.0)
+        _spin(1.2)  # the age counts up once
         save("stale_zh_CN_1280x800" if readme else f"stale_{lang}_1280x800")
         sim.set_silent(False)
         _wait(lambda: window.motion_enabled, 15.0)
