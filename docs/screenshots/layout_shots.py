@@ -35,9 +35,12 @@ from ui.settings import AppSettings  # noqa: E402
 SIZES = ((1280, 800), (1920, 1080))
 LANGUAGES = ("en", "zh_CN")
 # each work tab beside one motion tab (the joint frame is the tallest jog layout)
-PAIRS = (("monitor", 0, TeachFrame.JOINT), ("points", 1, None), ("planner", 2, None), ("view3d", 0, TeachFrame.BASE))
-README = {"main_en_1280x800": ("en", SIZES[0], "monitor"), "main_zh_CN_1920x1080": ("zh_CN", SIZES[1], "monitor"),
-          "planner_en_1280x800": ("en", SIZES[0], "planner"), "planner_en_1920x1080": ("en", SIZES[1], "planner"),
+PAIRS = (("monitor", 0, TeachFrame.JOINT), ("points", 1, None), ("planner", 2, None),
+         ("view3d", 0, TeachFrame.BASE))
+README = {"main_en_1280x800": ("en", SIZES[0], "monitor"),
+          "main_zh_CN_1920x1080": ("zh_CN", SIZES[1], "monitor"),
+          "planner_en_1280x800": ("en", SIZES[0], "planner"),
+          "planner_en_1920x1080": ("en", SIZES[1], "planner"),
           "points_zh_CN_1920x1080": ("zh_CN", SIZES[1], "points")}
 
 
@@ -70,7 +73,7 @@ def main() -> None:
     readme = "--readme" in sys.argv
     out = REPO / "docs" / "screenshots" if readme else Path(next(a for a in sys.argv[1:] if a != "--readme"))
     out.mkdir(parents=True, exist_ok=True)
-    app = QApplication(sys.argv[:1])
+    _app = QApplication(sys.argv[:1])  # kept alive to the end
     sim = SimController(SimConfig(host="127.0.0.1", port=0))
     sim.start()
     link = RobotLink(poll_hz=timing.POLL_HZ_DEFAULT, canary_gv=None)
