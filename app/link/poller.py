@@ -22,7 +22,12 @@ from app.link.host import WorkerHost
 from app.link.types import Operation
 from app.models import ControllerStatus, Pose
 
-__all__ = ["Poller"]
+__all__ = ["JOG_POLL_HZ_MIN", "Poller"]
+
+#: While a jog is held (or teach mode moves at a non-zero ratio) the poller keeps at least this
+#: rate whatever the GUI's setting: the controller's watchdog (0.3 s on the simulator) stops a jog
+#: that sees no traffic, so a slow poll setting (below ~3.4 Hz) would stop the operator's own jog.
+JOG_POLL_HZ_MIN = 10.0
 
 
 class Poller:
@@ -38,6 +43,13 @@ class Poller:
         self.last_poll = 0.0  # monotonic time of the last poll attempt
         self.rtt = RttMeter(timing.RTT_REPORT_PERIOD)
         self.stats = LinkStatsReporter(timing.RTT_REPORT_PERIOD)
+
+    def rate(self, setting_hz: float) -> float:
+        """The poll rate to use now: the GUI's setting, at least :data:`JOG_POLL_HZ_MIN` while jogging."""
+        jog = self._host.jog
+        if jog.jog is not None or (jog.teach.enabled and jog.teach.ratio != 0.0):
+            return max(setting_hz, JOG_POLL_HZ_MIN)
+        return setting_hz
 
     def reset(self, now: float) -> None:
         """A link just came up."""

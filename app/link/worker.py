@@ -39,6 +39,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import time
+from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 
 from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot
@@ -109,6 +110,9 @@ class RobotWorker(QObject):
         self.request_id: int | None = None  # request id of the job being executed
         self._current_seq = 0  # sequence number of the job being executed
         self._in_urgent = False
+        # Short commands (create point) that wait for the one being tracked to end: GV291 tells
+        # only one command's outcome at a time, so a second one goes out after the first ended.
+        self._held: deque[Job] = deque()
         self._poll_timer: QTimer | None = None
         self._reconnect_timer: QTimer | None = None
         self.capture = TrafficCapture()
@@ -177,7 +181,15 @@ class RobotWorker(QObject):
             self.capture.set(on, self.supervisor.client)
 
     def _poll_interval_ms(self) -> int:
-        return max(1, round(1000.0 / self._poll_hz))
+        return max(1, round(1000.0 / self.poller.rate(self._poll_hz)))
+
+    def _follow_poll_rate(self) -> None:
+        """Keep the timer at the poller's rate (faster while jogging, see ``Poller.rate``)."""
+        timer = self._poll_timer
+        if timer is not None and timer.isActive():
+            interval = self._poll_interval_ms()
+            if timer.interval() != interval:
+                timer.setInterval(interval)
 
     # --- requests (any thread) ----------------------------------------------------------
     def post(self, operation: str, run: Callable[[], None], kind: JobKind = JobKind.PLAIN,
@@ -262,7 +274,7 @@ class RobotWorker(QObject):
         return client
 
     def poll_if_due(self) -> None:
-        if time.monotonic() - self.poller.last_poll >= 1.0 / self._poll_hz:
+        if time.monotonic() - self.poller.last_poll >= 1.0 / self.poller.rate(self._poll_hz):
             self._poll()
 
     def start_polling(self) -> None:
@@ -335,7 +347,8 @@ class RobotWorker(QObject):
         self.errorOccurred.emit(WorkerError(operation, message, rid))
 
     def fail_queued(self, message: str) -> None:
-        for job in self._jobs.clear():
+        held, self._held = list(self._held), deque()
+        for job in [*held, *self._jobs.clear()]:
             if job.needs_link:
                 self.emit_error(job.operation, message, job.request_id)
 
@@ -351,6 +364,8 @@ class RobotWorker(QObject):
         self.run_jobs()
         if self.link_up and not self.closed:
             self._poll()
+            if self._held and self.motion.active is None:
+                self.run_jobs()  # the tracked command just ended: the held one goes out now
 
     def _poll(self) -> None:
         """One poll; results emitted from here belong to no request (even inside a job)."""
@@ -373,8 +388,14 @@ class RobotWorker(QObject):
     # --- job execution (worker thread) --------------------------------------------------
     def run_jobs(self) -> None:
         while not self.closed:
-            job = self._jobs.pop()
+            job = self._jobs.pop_urgent()
+            if job is None and self._held and self.motion.active is None:
+                self._execute(self._held.popleft(), held=True)
+                continue
             if job is None:
+                job = self._jobs.pop()
+            if job is None:
+                self._follow_poll_rate()
                 return
             self._execute(job)
 
@@ -392,9 +413,19 @@ class RobotWorker(QObject):
             self._in_urgent = False
         return ran
 
-    def _execute(self, job: Job) -> None:
+    def _must_wait(self, job: Job) -> bool:
+        """A create point while another command is tracked (or held before it) waits its turn."""
+        if job.operation != Operation.CREATE_POINT:
+            return False
+        active = self.motion.active
+        return bool(self._held) or (active is not None and not active.motion)
+
+    def _execute(self, job: Job, *, held: bool = False) -> None:
         if job.needs_link and not self.link_up:
             self.emit_error(job.operation, "not connected to a controller", job.request_id)
+            return
+        if not held and self._must_wait(job):
+            self._held.append(job)
             return
         outer_seq, self._current_seq = self._current_seq, job.seq
         outer_id, self.request_id = self.request_id, job.request_id
