@@ -98,7 +98,7 @@ class LinkPort(Protocol):
     controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
     controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
     uploadProgress: SignalInstance  # noqa: N815 - (int, int) points done, total of the running upload
-    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str) point id, ok, reason
+    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str, bool) point id, ok, reason, unconfirmed
 
     @property
     def state(self) -> RobotState: ...
@@ -153,7 +153,7 @@ class RobotLink(QObject):
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815
     uploadProgress = Signal(int, int)  # noqa: N815
-    pointUploaded = Signal(int, bool, str)  # noqa: N815
+    pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
 
     _connectRequested = Signal(object)  # noqa: N815
     _disconnectRequested = Signal()  # noqa: N815

@@ -90,7 +90,7 @@ class RobotWorker(QObject):
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815 - the canary GV changed while the link stayed up
     uploadProgress = Signal(int, int)  # noqa: N815 - points done, total
-    pointUploaded = Signal(int, bool, str)  # noqa: N815 - point id, ok, reason ("" when ok)
+    pointUploaded = Signal(int, bool, str, bool)  # noqa: N815 - point id, ok, reason ("" when ok), unconfirmed
     stopped = Signal()  # the worker has closed the link and is quitting its thread (shutdown)
 
     # Wakes the worker from any thread (a queued call, since the worker lives in its thread).
@@ -331,8 +331,8 @@ class RobotWorker(QObject):
     def publish_upload_progress(self, done: int, total: int) -> None:
         self.uploadProgress.emit(done, total)
 
-    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None:
-        self.pointUploaded.emit(point_id, ok, reason)
+    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
+        self.pointUploaded.emit(point_id, ok, reason, unconfirmed)
 
     def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None:
         """``commandFinished`` with the request id (default: the job being executed)."""

@@ -1540,42 +1540,42 @@
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="379" />
+            <location filename="../../ui/controllers/point_sync.py" line="381" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="388" />
+            <location filename="../../ui/controllers/point_sync.py" line="390" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="392" />
+            <location filename="../../ui/controllers/point_sync.py" line="394" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="430" />
+            <location filename="../../ui/controllers/point_sync.py" line="433" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="432" />
+            <location filename="../../ui/controllers/point_sync.py" line="435" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="448" />
+            <location filename="../../ui/controllers/point_sync.py" line="451" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="452" />
+            <location filename="../../ui/controllers/point_sync.py" line="455" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="456" />
+            <location filename="../../ui/controllers/point_sync.py" line="459" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -1583,37 +1583,42 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/point.py" line="124" />
+            <location filename="../../app/points/point.py" line="127" />
             <source>unknown</source>
-            <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host".</extracomment>
+            <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="125" />
+            <location filename="../../app/points/point.py" line="128" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="126" />
+            <location filename="../../app/points/point.py" line="129" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="127" />
+            <location filename="../../app/points/point.py" line="130" />
             <source>upload failed</source>
             <translation>上传失败</translation>
+        </message>
+        <message>
+            <location filename="../../app/points/point.py" line="131" />
+            <source>on controller, unconfirmed</source>
+            <translation>已在控制器上（未确认）</translation>
         </message>
     </context>
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/models/point_columns.py" line="64" />
+            <location filename="../../ui/models/point_columns.py" line="66" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/models/point_columns.py" line="65" />
+            <location filename="../../ui/models/point_columns.py" line="67" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
         </message>
@@ -1698,62 +1703,67 @@
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="240" />
+            <location filename="../../ui/models/points_model.py" line="236" />
+            <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
+            <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/points_model.py" line="243" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="270" />
+            <location filename="../../ui/models/points_model.py" line="273" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="288" />
+            <location filename="../../ui/models/points_model.py" line="291" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="319" />
+            <location filename="../../ui/models/points_model.py" line="322" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="345" />
+            <location filename="../../ui/models/points_model.py" line="348" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="346" />
+            <location filename="../../ui/models/points_model.py" line="349" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="363" />
+            <location filename="../../ui/models/points_model.py" line="366" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="364" />
+            <location filename="../../ui/models/points_model.py" line="367" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="379" />
+            <location filename="../../ui/models/points_model.py" line="382" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="379" />
+            <location filename="../../ui/models/points_model.py" line="382" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="395" />
+            <location filename="../../ui/models/points_model.py" line="398" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="404" />
+            <location filename="../../ui/models/points_model.py" line="407" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -3043,129 +3053,129 @@ Remove them all?</source>
     <context>
         <name>View3DPanel</name>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="184" />
+            <location filename="../../ui/panels/view3d_panel.py" line="185" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="184" />
+            <location filename="../../ui/panels/view3d_panel.py" line="185" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="184" />
+            <location filename="../../ui/panels/view3d_panel.py" line="185" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="185" />
+            <location filename="../../ui/panels/view3d_panel.py" line="186" />
             <source>Iso</source>
             <translation>轴测</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="188" />
+            <location filename="../../ui/panels/view3d_panel.py" line="189" />
             <source>Look at the scene from a preset direction</source>
             <translation>从预设方向观察场景</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="189" />
+            <location filename="../../ui/panels/view3d_panel.py" line="190" />
             <source>Fit all</source>
             <translation>全部显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="190" />
+            <location filename="../../ui/panels/view3d_panel.py" line="191" />
             <source>Show the arm, the points and the plan</source>
             <translation>显示机械臂、点位和轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="191" />
+            <location filename="../../ui/panels/view3d_panel.py" line="192" />
             <source>Orthographic</source>
             <translation>正交投影</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="192" />
+            <location filename="../../ui/panels/view3d_panel.py" line="193" />
             <source>Parallel projection (no perspective)</source>
             <translation>平行投影（无透视）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="193" />
+            <location filename="../../ui/panels/view3d_panel.py" line="194" />
             <source>Robot model…</source>
             <translation>机器人模型…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="194" />
+            <location filename="../../ui/panels/view3d_panel.py" line="195" />
             <source>Robot model: %1. Load another robot model profile (JSON)</source>
             <translation>机器人模型：%1。加载其他机器人模型配置文件（JSON）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="196" />
+            <location filename="../../ui/panels/view3d_panel.py" line="197" />
             <source>Beside the planner</source>
             <translation>在规划器旁显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="197" />
+            <location filename="../../ui/panels/view3d_panel.py" line="198" />
             <source>Show the 3D view next to the planner, not in its own tab</source>
             <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="198" />
+            <location filename="../../ui/panels/view3d_panel.py" line="199" />
             <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
             <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="224" />
+            <location filename="../../ui/panels/view3d_panel.py" line="225" />
             <source>Robot model not loaded: %1</source>
             <translation>未加载机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="233" />
+            <location filename="../../ui/panels/view3d_panel.py" line="234" />
             <source>Load a robot model profile</source>
             <translation>加载机器人模型配置文件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="234" />
+            <location filename="../../ui/panels/view3d_panel.py" line="235" />
             <source>Robot model profiles (*.json)</source>
             <translation>机器人模型配置文件 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="326" />
+            <location filename="../../ui/panels/view3d_panel.py" line="327" />
             <source>dry run: nothing is sent</source>
             <translation>空运行：不发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="328" />
+            <location filename="../../ui/panels/view3d_panel.py" line="329" />
             <source>no pose: home position shown</source>
             <translation>无位姿：显示原点姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="330" />
+            <location filename="../../ui/panels/view3d_panel.py" line="331" />
             <source>estimate (from the pose, no joint angles)</source>
             <translation>估算（由位姿求得，无关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="332" />
+            <location filename="../../ui/panels/view3d_panel.py" line="333" />
             <source>pose out of the model's reach</source>
             <translation>位姿超出模型可达范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="334" />
+            <location filename="../../ui/panels/view3d_panel.py" line="335" />
             <source>past a joint limit</source>
             <translation>超出关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="336" />
+            <location filename="../../ui/panels/view3d_panel.py" line="337" />
             <source>stale</source>
             <translation>数据过期</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="417" />
+            <location filename="../../ui/panels/view3d_panel.py" line="418" />
             <source>Out of the robot model's reach: %n point(s) (%1)</source>
             <translation>
                 <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="422" />
+            <location filename="../../ui/panels/view3d_panel.py" line="423" />
             <source>the path leaves the reach in %n segment(s) (%1)</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>
