@@ -16,7 +16,7 @@ import dataclasses
 import time
 
 from app import timing
-from app.errors import LinkError, ResponseTimeout, TeachPadError
+from app.errors import LinkError, MalformedResponse, ResponseTimeout, TeachPadError
 from app.link.capture import LinkStatsReporter, RttMeter
 from app.link.host import WorkerHost
 from app.link.types import Operation
@@ -107,7 +107,10 @@ class Poller:
             host.supervisor.poll_silent(str(exc), time.monotonic())
             self._report_stats()
             return
-        except LinkError as exc:
+        except (LinkError, MalformedResponse) as exc:
+            # A malformed answer is a failed poll: the transport counted it and resynchronised
+            # (a TCP link is reopened by the next request); none of its values are published;
+            # LINK_LOSS_POLLS of them in a row take the link down like any failed transaction.
             self._report_error(str(exc))
             host.supervisor.transport_failed(str(exc))
             self._report_stats()

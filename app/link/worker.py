@@ -48,6 +48,7 @@ from app import timing
 from app.errors import (
     CommandRefused,
     LinkError,
+    MalformedResponse,
     ModbusExceptionError,
     ResponseTimeout,
     TeachPadError,
@@ -435,7 +436,8 @@ class RobotWorker(QObject):
             pass
         except WriteBlocked as exc:
             self.emit_error(job.operation, str(exc))
-        except (LinkError, ResponseTimeout) as exc:
+        except (LinkError, ResponseTimeout, MalformedResponse) as exc:
+            # Malformed: the transport already resynchronised; the command's outcome is unknown.
             self.emit_error(job.operation, str(exc))
             self.supervisor.transport_failed(str(exc))
         except ModbusExceptionError as exc:
