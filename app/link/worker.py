@@ -153,7 +153,7 @@ class RobotWorker(QObject):
         """Queued from the GUI: stop motion, close, hand the object back, quit this thread."""
         if self.closed:
             return
-        self.supervisor.close_link(Operation.SHUTDOWN, LinkState.DISCONNECTED, "")
+        self.supervisor.close_link(Operation.SHUTDOWN, LinkState.DISCONNECTED, "", short=True)
         self.closed = True
         for timer in (self._poll_timer, self._reconnect_timer):
             if timer is not None:
