@@ -99,6 +99,9 @@ class Poller:
             t2 = time.perf_counter()
             pose = client.read_pose(timeout=timeout)
             t3 = time.perf_counter()
+            host.run_urgent()  # and before this poll's publishing: a stop waits one read at most
+            if not host.link_up:
+                return
             gv = host.supervisor.canary_gv
             if with_clock and host.supervisor.canary_token is not None and gv is not None:
                 canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock

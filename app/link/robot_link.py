@@ -11,6 +11,7 @@ tests use a small fake that fits too).
 from __future__ import annotations
 
 import logging
+import sys
 from collections.abc import Iterable, Sequence
 from typing import Protocol
 
@@ -29,6 +30,12 @@ from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
 __all__ = ["LinkPort", "Pending", "RequestRouter", "RobotLink", "wait_for_detached_threads"]
 
 _log = logging.getLogger(__name__)
+
+#: The interpreter's GIL switch interval while a link exists (s). CPython's default, 5 ms, is
+#: how long the worker thread can wait for the GIL while the GUI thread runs Python (a paint, a
+#: slot): a Stop posted by the GUI then sat up to 5 ms before its write. 0.5 ms bounds that wait;
+#: the cost is more frequent GIL hand-offs, only when two threads want it at once.
+GIL_SWITCH_INTERVAL = 0.0005
 
 
 class Pending(QObject):
@@ -165,6 +172,8 @@ class RobotLink(QObject):
                  canary_gv: int | None = DEFAULT_CANARY_GV,
                  freshness_limit: float = DEFAULT_FRESHNESS_LIMIT) -> None:
         super().__init__(parent)
+        if sys.getswitchinterval() > GIL_SWITCH_INTERVAL:
+            sys.setswitchinterval(GIL_SWITCH_INTERVAL)  # see GIL_SWITCH_INTERVAL: a stop never waits 5 ms
         self._settings: ConnectionSettings | None = None
         self._state = RobotState(self, freshness_limit=freshness_limit)
         self._router = RequestRouter()

@@ -38,11 +38,12 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import threading
 import time
 from collections import deque
 from collections.abc import Callable, Iterable, Sequence
 
-from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot
+from PySide6.QtCore import QCoreApplication, QObject, Qt, QThread, QTimer, Signal, Slot
 
 from app import timing
 from app.errors import (
@@ -70,6 +71,12 @@ from app.protocol.enums import ProgramMotionMode, WorkMode
 __all__ = ["DEFAULT_CANARY_GV", "SHUTDOWN_TIMEOUT_MS", "RobotWorker"]
 
 _log = logging.getLogger(__name__)
+
+#: How long a thread that posts a Stop waits (GIL released) for the worker to send it (s). While
+#: it waits, the poster (the GUI thread) cannot hold the GIL the worker needs to write the stop:
+#: measured, that wait was most of a Stop's latency (the worker waiting for a busy GUI thread's
+#: GIL, the in-flight poll finishing in slow motion). A rare event: a short freeze is the price.
+STOP_HANDOFF_WAIT = 0.005
 
 #: Kept for importers; the GUI's shutdown waits :data:`app.timing.SHUTDOWN_WAIT` (read at use time).
 SHUTDOWN_TIMEOUT_MS = round(timing.SHUTDOWN_WAIT * 1000)
@@ -110,6 +117,7 @@ class RobotWorker(QObject):
         self.closed = False
         self.request_id: int | None = None  # request id of the job being executed
         self._current_seq = 0  # sequence number of the job being executed
+        self._current_job: Job | None = None
         self._in_urgent = False
         # Short commands (create point) that wait for the one being tracked to end: GV291 tells
         # only one command's outcome at a time, so a second one goes out after the first ended.
@@ -194,15 +202,22 @@ class RobotWorker(QObject):
 
     # --- requests (any thread) ----------------------------------------------------------
     def post(self, operation: str, run: Callable[[], None], kind: JobKind = JobKind.PLAIN,
-             *, coalesce: str | None = None, needs_link: bool = True, cancels: tuple[str, ...] = ()) -> int:
+             *, coalesce: str | None = None, needs_link: bool = True, cancels: tuple[str, ...] = (),
+             sent: threading.Event | None = None) -> int:
         """Queue a job and wake the worker; returns the request id its results will carry."""
         request_id = self._jobs.put(Job(operation, run, kind, coalesce=coalesce, needs_link=needs_link,
-                                        cancels=cancels))
+                                        cancels=cancels, sent=sent))
         self._wake.emit()
         return request_id
 
     def request_stop(self) -> int:
-        return self.post(Operation.STOP, self._do_stop, JobKind.URGENT)
+        """Queue the stop first in line; from another thread, wait (GIL released) until the worker
+        has written it, at most :data:`STOP_HANDOFF_WAIT`, so nothing of the caller's runs first."""
+        sent = threading.Event()
+        request_id = self.post(Operation.STOP, self._do_stop, JobKind.URGENT, sent=sent)
+        if self.thread() is not QThread.currentThread() and self.thread().isRunning():
+            sent.wait(STOP_HANDOFF_WAIT)
+        return request_id
 
     def request_pause(self) -> int:
         return self.post(Operation.PAUSE, self._do_pause, JobKind.URGENT)
@@ -430,6 +445,7 @@ class RobotWorker(QObject):
             return
         outer_seq, self._current_seq = self._current_seq, job.seq
         outer_id, self.request_id = self.request_id, job.request_id
+        outer_job, self._current_job = self._current_job, job
         try:
             job.run()
         except PreemptedError:
@@ -450,8 +466,11 @@ class RobotWorker(QObject):
             _log.exception("%s failed", job.operation)
             self.emit_error(job.operation, f"internal error: {type(exc).__name__}: {str(exc)[:200]}")
         finally:
+            if job.sent is not None:
+                job.sent.set()  # also when it failed: the poster waits no longer
             self._current_seq = outer_seq
             self.request_id = outer_id
+            self._current_job = outer_job
 
     def _done(self, text: str) -> None:
         self.emit_result(CommandResult(None, None, None, True, text))
@@ -464,6 +483,9 @@ class RobotWorker(QObject):
         client = self.client_or_raise()
         client.stop()  # first: nothing else goes out before the stop
         now = time.monotonic()
+        job = self._current_job
+        if job is not None and job.sent is not None:
+            job.sent.set()  # the poster (the GUI thread) may go on
         self.uploader.end("stopped")
         self.jog.on_stop()
         active = self.motion.take()
