@@ -18,10 +18,18 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
 * :class:`~app.link.motion.MotionCommands` / :class:`~app.link.motion.MotionTracker` -- the long
   commands (step, move to point, go to zero, run program, create point), started without waiting,
   and the completion of the one under way; a motion while another is under way is refused, Stop
-  clears it.
+  clears it. A create point while another short command is being tracked waits in the worker
+  (``_held``) until that one's outcome is known (GV291 tells one command at a time), then goes
+  out: every request ends once, with its own result.
 * :class:`~app.link.upload.Uploader` -- chunked upload of many points, ``pointUploaded`` per
   point, ``uploadProgress``, one final ``commandFinished``; ``cancel_upload`` or a stop end it.
 * :class:`~app.link.capture.TrafficCapture`, RTT and link statistics.
+
+Stop latency: :meth:`RobotWorker.request_stop` queues the stop first in line and, from the GUI
+thread, waits (GIL released, at most :data:`STOP_HANDOFF_WAIT`) until the worker has written it;
+the worker runs urgent jobs between any two transactions (also right after a poll's pose read,
+before publishing), and ``_do_stop`` writes before any bookkeeping. Bound: the transaction in
+flight (one round trip) plus the stop's own write, unless the OS does not schedule the worker.
 
 Every :class:`RobotLink` command returns an ``int`` request id; each :class:`CommandResult` /
 :class:`WorkerError` it causes carries it. Every failure becomes a signal, never an exception in
