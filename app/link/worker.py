@@ -49,9 +49,8 @@ import logging
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Iterable, Sequence
 
-from PySide6.QtCore import QCoreApplication, QObject, Qt, QThread, QTimer, Signal, Slot
+from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot
 
 from app import timing
 from app.errors import (
@@ -64,33 +63,28 @@ from app.errors import (
     WriteBlocked,
 )
 from app.link.capture import TrafficCapture
-from app.link.client import ConnectionSettings, RobotClient, StepFrame, TrafficRecord
-from app.link.jobs import JOG_PRESS, JOG_RATIO, Job, JobKind, JobQueue
+from app.link.client import ConnectionSettings, RobotClient, TrafficRecord
+from app.link.jobs import Job, JobKind, JobQueue
 from app.link.jog import JogMachine, PreemptedError
 from app.link.motion import MotionCommands, MotionTracker
 from app.link.poller import Poller
+from app.link.requests import STOP_HANDOFF_WAIT, WorkerRequests
 from app.link.stats import LinkStats
 from app.link.supervisor import DEFAULT_CANARY_GV, LinkSupervisor
 from app.link.types import ConnectionState, JogRequest, LinkState, Operation, WorkerError
 from app.link.upload import RawItem, Uploader
 from app.models import CommandResult, ControllerStatus, Pose
-from app.protocol.enums import ProgramMotionMode, WorkMode
+from app.protocol.enums import WorkMode
 
-__all__ = ["DEFAULT_CANARY_GV", "SHUTDOWN_TIMEOUT_MS", "RobotWorker"]
+__all__ = ["DEFAULT_CANARY_GV", "SHUTDOWN_TIMEOUT_MS", "STOP_HANDOFF_WAIT", "RobotWorker"]
 
 _log = logging.getLogger(__name__)
-
-#: How long a thread that posts a Stop waits (GIL released) for the worker to send it (s). While
-#: it waits, the poster (the GUI thread) cannot hold the GIL the worker needs to write the stop:
-#: measured, that wait was most of a Stop's latency (the worker waiting for a busy GUI thread's
-#: GIL, the in-flight poll finishing in slow motion). A rare event: a short freeze is the price.
-STOP_HANDOFF_WAIT = 0.005
 
 #: Kept for importers; the GUI's shutdown waits :data:`app.timing.SHUTDOWN_WAIT` (read at use time).
 SHUTDOWN_TIMEOUT_MS = round(timing.SHUTDOWN_WAIT * 1000)
 
 
-class RobotWorker(QObject):
+class RobotWorker(WorkerRequests, QObject):
     """Owns the RobotClient in the worker thread and composes the parts; see the module docstring."""
 
     poseChanged = Signal(Pose)  # noqa: N815
@@ -127,6 +121,7 @@ class RobotWorker(QObject):
         self._current_seq = 0  # sequence number of the job being executed
         self._current_job: Job | None = None
         self._in_urgent = False
+        self._worker_ident: int | None = None  # the worker thread, once started (request_stop)
         # Short commands (create point) that wait for the one being tracked to end: GV291 tells
         # only one command's outcome at a time, so a second one goes out after the first ended.
         self._held: deque[Job] = deque()
@@ -144,6 +139,7 @@ class RobotWorker(QObject):
     @Slot()
     def start(self) -> None:
         """Run by ``QThread.started``: the timers are created here, in the worker thread."""
+        self._worker_ident = threading.get_ident()
         self._poll_timer = QTimer(self)
         self._poll_timer.setTimerType(Qt.TimerType.PreciseTimer)
         self._poll_timer.setInterval(self._poll_interval_ms())
@@ -171,6 +167,7 @@ class RobotWorker(QObject):
             return
         self.supervisor.close_link(Operation.SHUTDOWN, LinkState.DISCONNECTED, "", short=True)
         self.closed = True
+        self._worker_ident = None
         for timer in (self._poll_timer, self._reconnect_timer):
             if timer is not None:
                 timer.stop()
@@ -207,80 +204,6 @@ class RobotWorker(QObject):
             interval = self._poll_interval_ms()
             if timer.interval() != interval:
                 timer.setInterval(interval)
-
-    # --- requests (any thread) ----------------------------------------------------------
-    def post(self, operation: str, run: Callable[[], None], kind: JobKind = JobKind.PLAIN,
-             *, coalesce: str | None = None, needs_link: bool = True, cancels: tuple[str, ...] = (),
-             sent: threading.Event | None = None) -> int:
-        """Queue a job and wake the worker; returns the request id its results will carry."""
-        request_id = self._jobs.put(Job(operation, run, kind, coalesce=coalesce, needs_link=needs_link,
-                                        cancels=cancels, sent=sent))
-        self._wake.emit()
-        return request_id
-
-    def request_stop(self) -> int:
-        """Queue the stop first in line; from another thread, wait (GIL released) until the worker
-        has written it, at most :data:`STOP_HANDOFF_WAIT`, so nothing of the caller's runs first."""
-        sent = threading.Event()
-        request_id = self.post(Operation.STOP, self._do_stop, JobKind.URGENT, sent=sent)
-        if self.thread() is not QThread.currentThread() and self.thread().isRunning():
-            sent.wait(STOP_HANDOFF_WAIT)
-        return request_id
-
-    def request_pause(self) -> int:
-        return self.post(Operation.PAUSE, self._do_pause, JobKind.URGENT)
-
-    def request_resume(self) -> int:
-        return self.post(Operation.RESUME, self._do_resume, JobKind.URGENT)
-
-    def request_jog_press(self, request: JogRequest) -> int:
-        return self.post(Operation.JOG, lambda: self._do_jog_press(request), JobKind.MOTION,
-                         coalesce=JOG_PRESS)
-
-    def request_jog_release(self) -> int:
-        return self.post(Operation.JOG_RELEASE, self.jog.release, JobKind.URGENT, needs_link=False,
-                         cancels=(JOG_PRESS, JOG_RATIO))
-
-    def request_jog_ratio(self, ratio: float) -> int:
-        return self.post(Operation.JOG_SPEED, lambda: self.jog.set_ratio(ratio), JobKind.MOTION,
-                         coalesce=JOG_RATIO)
-
-    def request_step(self, frame: StepFrame, offsets: Sequence[float], ext_offsets: Sequence[float],
-                     speed: float) -> int:
-        offs, ext = tuple(offsets), tuple(ext_offsets)
-        return self.post(Operation.STEP, lambda: self.motions.step(frame, offs, ext, speed), JobKind.MOTION)
-
-    def request_set_mode(self, mode: WorkMode) -> int:
-        return self.post(Operation.SET_MODE, lambda: self._do_set_mode(mode))
-
-    def request_go_zero(self, axis: int | None) -> int:
-        return self.post(Operation.GO_ZERO, lambda: self.motions.go_zero(axis), JobKind.MOTION)
-
-    def request_run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int,
-                            speed_ratio: int) -> int:
-        return self.post(Operation.RUN_PROGRAM,
-                         lambda: self.motions.run_program(program_id, mode, cycles, speed_ratio),
-                         JobKind.MOTION)
-
-    def request_create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> int:
-        values = None if pose is None else tuple(pose)
-        return self.post(Operation.CREATE_POINT, lambda: self.motions.create_point(point_id, values, tool))
-
-    def request_move_to_point(self, end_id: int, via_id: int | None, orientation_changes: bool,
-                              ignore_middle: bool, speed: float, tool: int) -> int:
-        return self.post(Operation.MOVE_TO_POINT,
-                         lambda: self.motions.move_to_point(end_id, via_id, orientation_changes,
-                                                            ignore_middle, speed, tool),
-                         JobKind.MOTION)
-
-    def request_upload_points(self, points: Iterable[tuple[int, Sequence[float], int]]) -> int:
-        """Items (id, pose6, tool); copied here, checked in the worker before the first write."""
-        items: list[RawItem] = [(pid, tuple(pose), tool) for pid, pose, tool in points]
-        return self.post(Operation.UPLOAD_POINTS, lambda: self._do_upload_points(items), JobKind.MOTION)
-
-    def request_cancel_upload(self) -> int:
-        """End the running upload after the point in progress, without a controller stop."""
-        return self.post(Operation.CANCEL_UPLOAD, self._do_cancel_upload, JobKind.URGENT, needs_link=False)
 
     # --- the host of the parts (worker thread) ------------------------------------------
     @property
