@@ -67,6 +67,7 @@ class PointsPanel(QWidget):
         self._controller = controller or PointSyncController(model, parent=self)
         self._confirm = confirm or ask_confirmation(self)
         self._run_active = False
+        self._alarm_hold = False  # an e-stop / servo alarm: no move-to (MotionController.alarmHoldChanged)
 
         self.proxy = PointFilterProxy(self)
         self.proxy.setSourceModel(model)
@@ -338,6 +339,11 @@ class PointsPanel(QWidget):
         self._run_active = active
         self._update_actions()
 
+    def set_alarm_hold(self, hold: bool) -> None:
+        """An emergency stop or servo alarm is set: no move-to (teach and upload move nothing)."""
+        self._alarm_hold = bool(hold)
+        self._update_actions()
+
     @Slot(str, str)
     def show_message(self, text: str, level: str = LEVEL_INFO) -> None:
         colour = {LEVEL_ERROR: COLOR_ERROR, LEVEL_WARN: "#8a5300", LEVEL_INFO: COLOR_OK}.get(level, "")
@@ -416,6 +422,8 @@ class PointsPanel(QWidget):
 
     @Slot()
     def move_to_selected(self) -> None:
+        if self._alarm_hold:
+            return  # the action is disabled; a call that still arrives moves nothing
         rows = self.selected_rows()
         if len(rows) != 1:
             self.show_message(self.tr("Select one point to move to"), LEVEL_WARN)
@@ -503,5 +511,5 @@ class PointsPanel(QWidget):
         self.restore_button.setEnabled(link_ok and has_points)
         self.action_cancel_upload.setEnabled(c.operation == "upload")
         self.cancel_button.setEnabled(c.operation == "upload")
-        self.action_move_to.setEnabled(link_ok and len(rows) == 1)
+        self.action_move_to.setEnabled(link_ok and len(rows) == 1 and not self._alarm_hold)
         self.upload_button.setEnabled(link_ok and has_points)
