@@ -40,7 +40,7 @@ def test_asking_for_the_panel_builds_it_in_its_tab(qtbot: Any, window: MainWindo
     assert tabs.indexOf(panel) == count - 1
 
 
-def test_building_the_window_does_not_import_the_3d_view() -> None:
+def test_building_the_window_does_not_import_the_3d_view_nor_pyqtgraph() -> None:
     code = textwrap.dedent("""
         import sys, tempfile
         from pathlib import Path
@@ -53,9 +53,10 @@ def test_building_the_window_does_not_import_the_3d_view() -> None:
         link = RobotLink()
         w = MainWindow(link, AppSettings.from_file(tmp / "s.ini"), autosave_dir=tmp / "a")
         print("view3d_panel" if "ui.panels.view3d_panel" in sys.modules else "lazy")
+        print("pyqtgraph" if "pyqtgraph" in sys.modules else "lazy")
         w.close(); link.shutdown()
     """)
     out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60,
                          env={**__import__("os").environ, "QT_QPA_PLATFORM": "offscreen"}, check=False)
     assert out.returncode == 0, out.stderr[-2000:]
-    assert out.stdout.strip().splitlines()[-1] == "lazy"
+    assert out.stdout.strip().splitlines()[-2:] == ["lazy", "lazy"]  # neither the 3D view nor pyqtgraph
