@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from PySide6.QtCore import QEvent, QSignalBlocker, QSize, Qt, QTimer, Slot
-from PySide6.QtGui import QCloseEvent, QHideEvent, QResizeEvent, QShowEvent
+from PySide6.QtGui import QCloseEvent, QHideEvent, QPaintEvent, QResizeEvent, QShowEvent
 from PySide6.QtWidgets import (
     QComboBox,
     QGridLayout,
@@ -183,6 +183,7 @@ class MonitorPanel(QWidget):
 
         # Plots: built after the window's first paint (_build_plots); a placeholder keeps their place.
         self._plots_built = False
+        self._plots_scheduled = False
         plots = QWidget(self)
         plots.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
         self._plots_slot = plots
@@ -418,6 +419,11 @@ class MonitorPanel(QWidget):
             if rel > row[0]:
                 self._history.append((rel, *row[1:]))
                 self._latest_row = (rel, *row[1:])
+        if not self._plots_built and not self._plots_scheduled:  # before the first paint
+            if self._readouts_dirty:
+                self._readouts_dirty = False
+                self._paint_readouts()
+            return
         self.refresh()
 
     @Slot()
@@ -544,11 +550,16 @@ class MonitorPanel(QWidget):
         if self._plots_built:
             self._readouts_dirty = True
             self.refresh()
-        else:  # the first show: readouts now, the plots after this paint (the next refresh)
+        else:  # the first show: readouts now, the plots after the first paint (paintEvent)
             self._readouts_dirty = False
             self._paint_readouts()
-            QTimer.singleShot(0, self, self.refresh)
         self._timer.start()
+
+    def paintEvent(self, event: QPaintEvent) -> None:
+        super().paintEvent(event)
+        if not self._plots_built and not self._plots_scheduled:
+            self._plots_scheduled = True  # the window's first paint is under way: plots right after it
+            QTimer.singleShot(0, self, self.refresh)
 
     def hideEvent(self, event: QHideEvent) -> None:
         self._timer.stop()
