@@ -249,6 +249,7 @@ class MainWindow(QMainWindow):
         self.pose_bar.setMovable(False)
         self.pose_bar.setFloatable(False)
         self.pose_bar.toggleViewAction().setVisible(False)
+        self.pose_bar.setStyleSheet("QToolBar { padding: 0px; spacing: 0px; border: none; }")  # every px
         self.pose_bar.addWidget(self.pose_strip)
         self.addToolBarBreak(Qt.ToolBarArea.TopToolBarArea)
         self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.pose_bar)
@@ -289,6 +290,9 @@ class MainWindow(QMainWindow):
         self.event_dock.setWindowTitle(self.tr("Event log"))
         self.traffic_dock.setWindowTitle(self.tr("Modbus traffic"))
         self.alarm_dock.setWindowTitle(self.tr("Alarms"))
+        # room for the widest RTT from the start: the status bar does not shift when one arrives
+        widest_rtt = self.tr("RTT {ms} ms").format(ms="9999.9")
+        self.status_rtt.setMinimumWidth(self.status_rtt.fontMetrics().horizontalAdvance(widest_rtt) + 8)
         self.menus.retranslate()
         self.project.retranslate()
         self._on_project_title(self.project.title)

@@ -492,6 +492,11 @@ class RobotClient:
             self._ext_cache = ext
         self._write_floats(registers.GV_EXPECTED_SPEED, [speed])
         tracker = self.begin_command(command, before, before_pose, timeout=timeout)
+        if before_pose is not None and frame is StepFrame.BASE and not any(ext):
+            x, y, z = before_pose.xyzabc[:3]
+            tracker.target = (x + offs[0], y + offs[1], z + offs[2])
+        elif before_pose is not None and frame is StepFrame.JOINT and before_pose.joints and not any(ext):
+            tracker.target_joints = tuple(q + d for q, d in zip(before_pose.joints, offs, strict=False))
         return self._finish(tracker, wait)
 
     @staticmethod

@@ -71,6 +71,7 @@ CompletionRule = Literal["sentinel", "observe"]
 POSE_EPSILON = 1e-3
 # A move is at its end point when the TCP is this close (mm) to the X Y Z the host sent for it.
 ARRIVAL_TOLERANCE = 0.5
+ARRIVAL_TOLERANCE_DEG = 0.05  # the same for a joint step's joint angles (degrees)
 
 
 # --------------------------------------------------------------------------------------------
@@ -121,6 +122,7 @@ class CommandTracker:
         # Move to point: the X Y Z this host sent for the end point, when it knows it. A move whose
         # GV291 never left the stale code, seen moving and now still at the target, ended there.
         self.target: tuple[float, float, float] | None = None
+        self.target_joints: tuple[float, ...] | None = None  # a joint step: J1..J6 where it ends
         self.kind = CommandKind.of(command)
         self.before = before
         self.before_pose = before_pose
@@ -352,10 +354,16 @@ class CommandTracker:
         return settled and (at_target or now - self.started >= self.ack_timeout)
 
     def _at_target(self, pose: Pose | None) -> bool:
-        """The arm stands at the end point this host sent (within ARRIVAL_TOLERANCE mm)."""
-        if self.target is None or pose is None:
+        """The arm stands where this host sent it: the end point's X Y Z (within
+        ARRIVAL_TOLERANCE mm) or a joint step's J1..J6 (within ARRIVAL_TOLERANCE_DEG)."""
+        if pose is None:
             return False
-        return math.dist(pose.xyzabc[:3], self.target) <= ARRIVAL_TOLERANCE
+        if self.target is not None:
+            return math.dist(pose.xyzabc[:3], self.target) <= ARRIVAL_TOLERANCE
+        if self.target_joints is not None and pose.joints:
+            return all(abs(q - t) <= ARRIVAL_TOLERANCE_DEG
+                       for q, t in zip(pose.joints, self.target_joints, strict=False))
+        return False
 
     def _details(self, now: float) -> dict[str, float]:
         details = {"elapsed": now - self.started}

@@ -658,118 +658,119 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="282" />
+            <location filename="../../ui/main_window.py" line="283" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="283" />
+            <location filename="../../ui/main_window.py" line="284" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="284" />
+            <location filename="../../ui/main_window.py" line="285" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="288" />
+            <location filename="../../ui/main_window.py" line="289" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="289" />
+            <location filename="../../ui/main_window.py" line="290" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="290" />
+            <location filename="../../ui/main_window.py" line="291" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="324" />
+            <location filename="../../ui/main_window.py" line="328" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="312" />
+            <location filename="../../ui/main_window.py" line="316" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="340" />
+            <location filename="../../ui/main_window.py" line="344" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="342" />
+            <location filename="../../ui/main_window.py" line="346" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="347" />
+            <location filename="../../ui/main_window.py" line="294" />
+            <location filename="../../ui/main_window.py" line="351" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="360" />
+            <location filename="../../ui/main_window.py" line="364" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="371" />
+            <location filename="../../ui/main_window.py" line="375" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="377" />
+            <location filename="../../ui/main_window.py" line="381" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="373" />
-            <location filename="../../ui/main_window.py" line="378" />
+            <location filename="../../ui/main_window.py" line="377" />
+            <location filename="../../ui/main_window.py" line="382" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="285" />
+            <location filename="../../ui/main_window.py" line="286" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="286" />
+            <location filename="../../ui/main_window.py" line="287" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="287" />
+            <location filename="../../ui/main_window.py" line="288" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="291" />
+            <location filename="../../ui/main_window.py" line="292" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="441" />
+            <location filename="../../ui/main_window.py" line="445" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="442" />
+            <location filename="../../ui/main_window.py" line="446" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="460" />
+            <location filename="../../ui/main_window.py" line="464" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="461" />
+            <location filename="../../ui/main_window.py" line="465" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -1465,43 +1466,43 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="269" />
+            <location filename="../../ui/panels/planner_widgets.py" line="268" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="270" />
+            <location filename="../../ui/panels/planner_widgets.py" line="269" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="289" />
+            <location filename="../../ui/panels/planner_widgets.py" line="288" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="292" />
+            <location filename="../../ui/panels/planner_widgets.py" line="291" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="294" />
+            <location filename="../../ui/panels/planner_widgets.py" line="293" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="296" />
+            <location filename="../../ui/panels/planner_widgets.py" line="295" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="299" />
+            <location filename="../../ui/panels/planner_widgets.py" line="298" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -1517,7 +1518,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="332" />
+            <location filename="../../ui/panels/planner_widgets.py" line="331" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1588,68 +1589,68 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="186" />
+            <location filename="../../ui/panels/plan_preview.py" line="187" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="187" />
+            <location filename="../../ui/panels/plan_preview.py" line="188" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="188" />
+            <location filename="../../ui/panels/plan_preview.py" line="189" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="192" />
+            <location filename="../../ui/panels/plan_preview.py" line="193" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="193" />
+            <location filename="../../ui/panels/plan_preview.py" line="194" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="282" />
+            <location filename="../../ui/panels/plan_preview.py" line="283" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="284" />
+            <location filename="../../ui/panels/plan_preview.py" line="285" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="286" />
+            <location filename="../../ui/panels/plan_preview.py" line="287" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="287" />
+            <location filename="../../ui/panels/plan_preview.py" line="288" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="290" />
+            <location filename="../../ui/panels/plan_preview.py" line="291" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="294" />
+            <location filename="../../ui/panels/plan_preview.py" line="295" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="296" />
+            <location filename="../../ui/panels/plan_preview.py" line="297" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="297" />
+            <location filename="../../ui/panels/plan_preview.py" line="298" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -1657,23 +1658,23 @@
     <context>
         <name>PlanRunBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="220" />
+            <location filename="../../ui/panels/planner_widgets.py" line="221" />
             <source>Run</source>
             <extracomment>Colour of a summary line by level (the status line uses the darker warning text).</extracomment>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="223" />
+            <location filename="../../ui/panels/planner_widgets.py" line="224" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="224" />
+            <location filename="../../ui/panels/planner_widgets.py" line="225" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="238" />
+            <location filename="../../ui/panels/planner_widgets.py" line="239" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
@@ -3201,7 +3202,7 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="385" />
+            <location filename="../../ui/panels/planner_widgets.py" line="384" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>

@@ -14,7 +14,7 @@ from app.protocol.codec import encode_floats
 from app.protocol.enums import STATUS_SENTINEL
 from app.protocol.registers import GV_COMMAND_STATUS, GV_PARAM0, gv_reg
 from app.sim.cli import build_parser
-from app.sim.server import SimConfig
+from app.sim.config import SimConfig
 from tests.sim.conftest import Bus, poll
 
 CREATE = 0xE0

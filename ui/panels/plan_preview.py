@@ -54,6 +54,7 @@ LIVE_FPS = 30
 TRAIL_LENGTH = 600  # live TCP positions kept for the trail
 INFO_WIDTH = 210  # px, the lengths / times column (at most)
 INFO_MIN_WIDTH = 140  # px, on a narrow window
+PLOT_MIN_HEIGHT = 80  # px: the planner's top row (segments, run box) needs the height at 1280×800
 INFO_BELOW_WIDTH = 620  # px: a narrower preview shows the lengths / times below the plots
 
 #: (key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.
@@ -80,7 +81,7 @@ def _style_plot(plot: pg.PlotWidget) -> None:
     plot.setMenuEnabled(False)
     plot.setAspectLocked(True)
     plot.getViewBox().setDefaultPadding(0.12)  # room for the point labels at the edges
-    plot.setMinimumSize(90, 110)
+    plot.setMinimumSize(90, PLOT_MIN_HEIGHT)
 
 
 class _Projection:

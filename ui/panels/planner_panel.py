@@ -2,9 +2,9 @@
 
 Layout: on the left the plan list (name, loops, segments; add / duplicate / delete, rename
 and loops edited in place) and the run controls (Run, Run from here, Step, Pause, Resume,
-Stop, Resume from k; progress "segment k of n, loop i of m"); in the middle the segment table
-(editable, undoable) with the checks on their rows and a summary line; on the right the
-preview (top / front / side) with lengths and times.
+Stop, Resume from k; progress "segment k of n, loop i of m") below them; on the right the
+segment table (editable, undoable) with the checks on their rows and a summary line, and the
+preview (top / front / side) with lengths and times below it.
 
 Checks (:func:`app.plan.checks.check_plan`), estimates and the preview are recomputed whenever the
 plan, the points or the selection change. Before a run the checks are made again from the

@@ -141,7 +141,7 @@ class StatusPanel(QWidget):
         self.mode_label = Lamp("—", self._ctrl_box, point_size=_LAMP_POINTS + 1)
         self.program_label = Lamp("—", self._ctrl_box, point_size=_LAMP_POINTS + 1)
         self.clock_label = QLabel("—", self._ctrl_box)
-        self.clock_label.setFont(monospace_font(12))
+        self.clock_label.setFont(monospace_font(10))  # "YYYY-MM-DD hh:mm:ss" fits the narrow status dock
         self.drift_label = QLabel("", self._ctrl_box)
         self.drift_label.setFont(monospace_font(11))
         self.command_label = QLabel("", self._ctrl_box)
