@@ -1301,102 +1301,105 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="230" />
+            <location filename="../../ui/panels/monitor_panel.py" line="269" />
+            <location filename="../../ui/panels/monitor_panel.py" line="288" />
             <source>mm</source>
+            <extracomment>Attributes that exist once the plots are built (asking for one builds them).</extracomment>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="230" />
+            <location filename="../../ui/panels/monitor_panel.py" line="269" />
+            <location filename="../../ui/panels/monitor_panel.py" line="288" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="231" />
+            <location filename="../../ui/panels/monitor_panel.py" line="270" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="233" />
+            <location filename="../../ui/panels/monitor_panel.py" line="272" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="237" />
+            <location filename="../../ui/panels/monitor_panel.py" line="276" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="238" />
+            <location filename="../../ui/panels/monitor_panel.py" line="277" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="239" />
+            <location filename="../../ui/panels/monitor_panel.py" line="278" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="240" />
+            <location filename="../../ui/panels/monitor_panel.py" line="279" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="241" />
+            <location filename="../../ui/panels/monitor_panel.py" line="280" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="242" />
+            <location filename="../../ui/panels/monitor_panel.py" line="281" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="243" />
+            <location filename="../../ui/panels/monitor_panel.py" line="282" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="244" />
+            <location filename="../../ui/panels/monitor_panel.py" line="289" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="245" />
+            <location filename="../../ui/panels/monitor_panel.py" line="290" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="246" />
+            <location filename="../../ui/panels/monitor_panel.py" line="291" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="246" />
+            <location filename="../../ui/panels/monitor_panel.py" line="291" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="247" />
+            <location filename="../../ui/panels/monitor_panel.py" line="292" />
             <source>Top view (X–Y)</source>
             <translation>俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="267" />
+            <location filename="../../ui/panels/monitor_panel.py" line="311" />
             <source>Stale: not confirmed by the controller within the freshness limit</source>
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="466" />
+            <location filename="../../ui/panels/monitor_panel.py" line="517" />
             <source>values stale (grey): no fresh data from the controller</source>
             <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="462" />
+            <location filename="../../ui/panels/monitor_panel.py" line="513" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="464" />
+            <location filename="../../ui/panels/monitor_panel.py" line="515" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -1589,68 +1592,68 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="187" />
+            <location filename="../../ui/panels/plan_preview.py" line="230" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="188" />
+            <location filename="../../ui/panels/plan_preview.py" line="231" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="189" />
+            <location filename="../../ui/panels/plan_preview.py" line="232" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="193" />
+            <location filename="../../ui/panels/plan_preview.py" line="236" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="194" />
+            <location filename="../../ui/panels/plan_preview.py" line="237" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="283" />
+            <location filename="../../ui/panels/plan_preview.py" line="328" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="285" />
+            <location filename="../../ui/panels/plan_preview.py" line="330" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="287" />
+            <location filename="../../ui/panels/plan_preview.py" line="332" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="288" />
+            <location filename="../../ui/panels/plan_preview.py" line="333" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="291" />
+            <location filename="../../ui/panels/plan_preview.py" line="336" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="295" />
+            <location filename="../../ui/panels/plan_preview.py" line="340" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="297" />
+            <location filename="../../ui/panels/plan_preview.py" line="342" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="298" />
+            <location filename="../../ui/panels/plan_preview.py" line="343" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
