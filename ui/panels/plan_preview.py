@@ -153,6 +153,10 @@ class PlanPreview(QWidget):
         self._titles: dict[str, QLabel] = {}
         self._points: tuple[FloatArray, list[str]] = (np.empty((0, 3)), [])
         self._start: tuple[float, float, float] | None = None
+        # Until the plots exist, a placeholder asks for the room they will (layouts stay the same).
+        self._slot: QWidget | None = QWidget(self)
+        self._slot.setMinimumSize(len(PROJECTIONS) * 90 + 12, 110 + QLabel().sizeHint().height())
+        row.addWidget(self._slot, 1)
         self.info = QLabel(self)
         self.info.setWordWrap(True)
         self.info.setStyleSheet(f"color: {COLOR_INK_SOFT};")
@@ -190,6 +194,10 @@ class PlanPreview(QWidget):
             return
         import pyqtgraph as pg  # deferred: see the module docstring
 
+        if self._slot is not None:
+            self._row.removeWidget(self._slot)
+            self._slot.deleteLater()
+            self._slot = None
         for key, h, v in PROJECTIONS:
             plot = pg.PlotWidget(self)
             _style_plot(plot)
