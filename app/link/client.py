@@ -29,12 +29,13 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import enum
 import logging
 import math
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 
 from app import timing
 from app.errors import (
@@ -136,6 +137,7 @@ class RobotClient:
         self.last_status: ControllerStatus | None = None
         self.last_tracker: CommandTracker | None = None
         self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
+        self._io_timeout: float | None = None  # see io_timeout()
         self._gv291_writable: bool | None = None  # completion "auto": None until probed
         # X Y Z of the points this client created from given poses (a move whose GV291 never
         # changed may be confirmed by arriving there, see CommandTracker's ``target``)
@@ -181,14 +183,28 @@ class RobotClient:
 
     # -- the transport: every answer is checked against its request ----------------------
     def _read(self, address: int, count: int, timeout: float | None = None) -> list[int]:
+        timeout = self._io_timeout if timeout is None else timeout
         return self._transport.read(f"read of {_range_name(address, count)}", address, count, timeout)
+
+    @contextlib.contextmanager
+    def io_timeout(self, seconds: float) -> Iterator[None]:
+        """Every transaction inside waits at most ``seconds`` per attempt (unless it passes its
+        own ``timeout``): the shutdown's ratio 0 / teach disable must not hang on a dead controller."""
+        outer, self._io_timeout = self._io_timeout, float(seconds)
+        try:
+            yield
+        finally:
+            self._io_timeout = outer
 
     def _require_writable(self, what: str) -> None:
         if self.settings.monitor_only:
             raise WriteBlocked(f"monitor-only mode: {what} was not sent")
 
-    def _write(self, address: int, values: Sequence[int], *, single: bool = False) -> None:
-        """The write guard: every write to the controller passes here."""
+    def _write(self, address: int, values: Sequence[int], *, single: bool = False,
+               timeout: float | None = None) -> None:
+        """The write guard: every write to the controller passes here. ``timeout`` (s per attempt)
+        overrides the request timeout (default: :meth:`io_timeout`'s, else the settings')."""
+        timeout = self._io_timeout if timeout is None else timeout
         name = _range_name(address, len(values))
         self._require_writable(f"write to {name}")
         if not values:
@@ -198,14 +214,14 @@ class RobotClient:
                 raise InvalidInput("a single-register write takes one value")
             _log.debug("write 0x06 %s <- %d", name, values[0])
             self.write_count += 1
-            self._transport.write_single(f"write to {name}", address, int(values[0]))
+            self._transport.write_single(f"write to {name}", address, int(values[0]), timeout)
         else:
             _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
             self.write_count += 1
-            self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values])
+            self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values], timeout)
 
-    def _write_floats(self, gv: int, values: Sequence[float]) -> None:
-        self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order))
+    def _write_floats(self, gv: int, values: Sequence[float], timeout: float | None = None) -> None:
+        self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order), timeout=timeout)
 
     def _write_control(self, register: int, value: int) -> None:
         self._write(register, [value], single=True)
@@ -612,10 +628,10 @@ class RobotClient:
         self._teach_frame = frame
         return self._finish(tracker, wait)
 
-    def teach_set_ratio(self, ratio: float) -> None:
-        """GV203 <- ratio: > 0 moves, 0 stops the jog (teach stays enabled)."""
+    def teach_set_ratio(self, ratio: float, *, timeout: float | None = None) -> None:
+        """GV203 <- ratio: > 0 moves, 0 stops the jog (teach stays enabled). ``timeout``: s per attempt."""
         ratio = _check_float(ratio, "speed ratio", 0.0, 100.0)
-        self._write_floats(registers.GV_PARAM3, [ratio])
+        self._write_floats(registers.GV_PARAM3, [ratio], timeout)
 
     def teach_set_axis(self, axis: int, direction: int) -> None:
         """Ratio 0 first, then GV201-202 (same frame); start again with :meth:`teach_set_ratio`."""

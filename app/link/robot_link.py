@@ -11,6 +11,7 @@ tests use a small fake that fits too).
 from __future__ import annotations
 
 import logging
+import sys
 from collections.abc import Iterable, Sequence
 from typing import Protocol
 
@@ -29,6 +30,12 @@ from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
 __all__ = ["LinkPort", "Pending", "RequestRouter", "RobotLink", "wait_for_detached_threads"]
 
 _log = logging.getLogger(__name__)
+
+#: The interpreter's GIL switch interval while a link exists (s). CPython's default, 5 ms, is
+#: how long the worker thread can wait for the GIL while the GUI thread runs Python (a paint, a
+#: slot): a Stop posted by the GUI then sat up to 5 ms before its write. 0.5 ms bounds that wait;
+#: the cost is more frequent GIL hand-offs, only when two threads want it at once.
+GIL_SWITCH_INTERVAL = 0.0005
 
 
 class Pending(QObject):
@@ -98,7 +105,7 @@ class LinkPort(Protocol):
     controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
     controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
     uploadProgress: SignalInstance  # noqa: N815 - (int, int) points done, total of the running upload
-    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str) point id, ok, reason
+    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str, bool) point id, ok, reason, unconfirmed
 
     @property
     def state(self) -> RobotState: ...
@@ -153,7 +160,7 @@ class RobotLink(QObject):
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815
     uploadProgress = Signal(int, int)  # noqa: N815
-    pointUploaded = Signal(int, bool, str)  # noqa: N815
+    pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
 
     _connectRequested = Signal(object)  # noqa: N815
     _disconnectRequested = Signal()  # noqa: N815
@@ -165,6 +172,8 @@ class RobotLink(QObject):
                  canary_gv: int | None = DEFAULT_CANARY_GV,
                  freshness_limit: float = DEFAULT_FRESHNESS_LIMIT) -> None:
         super().__init__(parent)
+        if sys.getswitchinterval() > GIL_SWITCH_INTERVAL:
+            sys.setswitchinterval(GIL_SWITCH_INTERVAL)  # see GIL_SWITCH_INTERVAL: a stop never waits 5 ms
         self._settings: ConnectionSettings | None = None
         self._state = RobotState(self, freshness_limit=freshness_limit)
         self._router = RequestRouter()

@@ -348,11 +348,12 @@ class Transport:
         _, data = self.execute(what, frames.read_request(address, count), timeout)
         return [(data[i] << 8) | data[i + 1] for i in range(1, 1 + 2 * count, 2)]
 
-    def write_single(self, what: str, address: int, value: int) -> None:
-        self.execute(what, frames.write_single_request(address, value))
+    def write_single(self, what: str, address: int, value: int, timeout: float | None = None) -> None:
+        self.execute(what, frames.write_single_request(address, value), timeout)
 
-    def write_multiple(self, what: str, address: int, values: Sequence[int]) -> None:
-        self.execute(what, frames.write_multiple_request(address, values))
+    def write_multiple(self, what: str, address: int, values: Sequence[int],
+                       timeout: float | None = None) -> None:
+        self.execute(what, frames.write_multiple_request(address, values), timeout)
 
     def execute(self, what: str, request: Request, timeout: float | None = None) -> tuple[int, bytes]:
         """Send ``request``; its checked answer as (function code, data)."""

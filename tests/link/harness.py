@@ -123,8 +123,8 @@ class PartsHost:
     def publish_upload_progress(self, done: int, total: int) -> None:
         self.out.append(("uploadProgress", (done, total)))
 
-    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None:
-        self.out.append(("pointUploaded", (point_id, ok, reason)))
+    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
+        self.out.append(("pointUploaded", (point_id, ok, reason, unconfirmed)))
 
     # --- helpers for tests -----------------------------------------------------------------
     def names(self) -> list[str]:

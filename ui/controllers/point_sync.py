@@ -373,6 +373,8 @@ class PointSyncController(QObject):
         except InvalidInput as exc:
             self._say(self.tr("Teach P{id}: {reason}").format(id=point_id, reason=str(exc)), LEVEL_ERROR)
             return
+        if result.unconfirmed:  # created without an error, but not proven: not "on controller"
+            self._model.set_sync(point_id, SyncState.UNCONFIRMED)
         self._say(self.tr("Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}").format(
             id=point_id, x=pose.x, y=pose.y, z=pose.z), LEVEL_INFO)
         self.pointTaught.emit(point_id)
@@ -395,13 +397,14 @@ class PointSyncController(QObject):
             self.moveFinished.emit(False, reason)
 
     # upload
-    @Slot(int, bool, str)
-    def _on_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None:
+    @Slot(int, bool, str, bool)
+    def _on_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
         upload = self._upload
         if upload is None or point_id not in upload.points:
             return
         sent = upload.points[point_id]
-        outcome = UploadOutcome(point_id, True, sent=sent) if ok else UploadOutcome(point_id, False, reason)
+        outcome = (UploadOutcome(point_id, True, sent=sent, unconfirmed=unconfirmed) if ok
+                   else UploadOutcome(point_id, False, reason))
         upload.report.outcomes.append(outcome)
         upload.pending.append(outcome)
 

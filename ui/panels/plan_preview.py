@@ -13,15 +13,18 @@ The view fits every change (another plan, a segment added, removed or edited, a 
 until the operator zooms or pans a projection (pyqtgraph's ``sigRangeChangedManually``): from
 then on the operator's view stays, until "Fit" (or another plan) fits again. A plan without
 segments shows all the project's points (the ones it can use), fitted, not an empty view.
+
+The plots are built on first show (or when ``projections`` is asked for): the planner is a hidden
+tab at start, so the window's first paint does not wait for pyqtgraph. Until then the setters
+only remember what to draw; the build draws it.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pyqtgraph as pg
 from numpy.typing import NDArray
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
 from PySide6.QtGui import QResizeEvent
@@ -43,6 +46,9 @@ from ui.palette import (
     COLOR_TRAIL,
 )
 
+if TYPE_CHECKING:
+    import pyqtgraph as pg
+
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
 LIVE_FPS = 30
 TRAIL_LENGTH = 600  # live TCP positions kept for the trail
@@ -59,6 +65,8 @@ FloatArray = NDArray[np.float64]
 
 
 def _style_plot(plot: pg.PlotWidget) -> None:
+    import pyqtgraph as pg  # deferred: see the module docstring
+
     plot.setBackground("w")
     item = plot.getPlotItem()
     item.showGrid(x=True, y=True, alpha=0.25)
@@ -80,6 +88,8 @@ class _Projection:
     """The items of one projection."""
 
     def __init__(self, plot: pg.PlotWidget, h: int, v: int) -> None:
+        import pyqtgraph as pg  # deferred: see the module docstring
+
         self.plot = plot
         self.h = h
         self.v = v
@@ -98,6 +108,8 @@ class _Projection:
             plot.addItem(item)
 
     def set_labels(self, xyz: FloatArray, texts: Sequence[str]) -> None:
+        import pyqtgraph as pg
+
         for label in self.labels:
             self.plot.removeItem(label)
         self.labels = []
@@ -128,6 +140,7 @@ class PlanPreview(QWidget):
         self._live_wanted = False
         self._trail = np.full((2 * TRAIL_LENGTH, 3), np.nan)
         self._trail_count = 0
+        self._last_tcp: Pose | None = None
         self._live_timer = QTimer(self)
         self._live_timer.setInterval(int(1000 / LIVE_FPS))
         self._live_timer.timeout.connect(self._paint_live)
@@ -135,23 +148,15 @@ class PlanPreview(QWidget):
         row = QHBoxLayout()
         row.setContentsMargins(0, 0, 0, 0)
         row.setSpacing(6)
-        self.projections: dict[str, _Projection] = {}
+        self._row = row
+        self._projections: dict[str, _Projection] = {}  # empty until built (setters only remember)
         self._titles: dict[str, QLabel] = {}
-        for key, h, v in PROJECTIONS:
-            plot = pg.PlotWidget(self)
-            _style_plot(plot)
-            plot.setLabel("bottom", f"{AXIS_NAMES[h]} (mm)")
-            plot.setLabel("left", f"{AXIS_NAMES[v]} (mm)")
-            self.projections[key] = _Projection(plot, h, v)
-            plot.getViewBox().sigRangeChangedManually.connect(self._on_operator_view)
-            title = QLabel(self)
-            title.setStyleSheet(f"font-weight: bold; color: {COLOR_INK_SOFT};")
-            self._titles[key] = title
-            cell = QVBoxLayout()
-            cell.setSpacing(0)
-            cell.addWidget(title)
-            cell.addWidget(plot, 1)
-            row.addLayout(cell, 1)
+        self._points: tuple[FloatArray, list[str]] = (np.empty((0, 3)), [])
+        self._start: tuple[float, float, float] | None = None
+        # Until the plots exist, a placeholder asks for the room they will (layouts stay the same).
+        self._slot: QWidget | None = QWidget(self)
+        self._slot.setMinimumSize(len(PROJECTIONS) * 90 + 12, 110 + QLabel().sizeHint().height())
+        row.addWidget(self._slot, 1)
         self.info = QLabel(self)
         self.info.setWordWrap(True)
         self.info.setStyleSheet(f"color: {COLOR_INK_SOFT};")
@@ -173,6 +178,52 @@ class PlanPreview(QWidget):
         layout.addLayout(side)
         self._layout = layout
         self.retranslate()
+
+    @property
+    def projections(self) -> dict[str, _Projection]:
+        """Key -> the projection's plot items (built now if they were not yet)."""
+        self._build_plots()
+        return self._projections
+
+    @property
+    def plots_built(self) -> bool:
+        return bool(self._projections)
+
+    def _build_plots(self) -> None:
+        if self._projections:
+            return
+        import pyqtgraph as pg  # deferred: see the module docstring
+
+        if self._slot is not None:
+            self._row.removeWidget(self._slot)
+            self._slot.deleteLater()
+            self._slot = None
+        for key, h, v in PROJECTIONS:
+            plot = pg.PlotWidget(self)
+            _style_plot(plot)
+            plot.setLabel("bottom", f"{AXIS_NAMES[h]} (mm)")
+            plot.setLabel("left", f"{AXIS_NAMES[v]} (mm)")
+            self._projections[key] = _Projection(plot, h, v)
+            plot.getViewBox().sigRangeChangedManually.connect(self._on_operator_view)
+            title = QLabel(self)
+            title.setStyleSheet(f"font-weight: bold; color: {COLOR_INK_SOFT};")
+            self._titles[key] = title
+            cell = QVBoxLayout()
+            cell.setSpacing(0)
+            cell.addWidget(title)
+            cell.addWidget(plot, 1)
+            self._row.addLayout(cell, 1)
+            title.show()  # children made after their parent was shown are hidden until shown
+            plot.show()
+        self.retranslate()
+        # draw what the setters remembered
+        operator_view = self._operator_view
+        self.set_path(self._path, keep_view=True)
+        self.set_points(*self._points)
+        self.set_start(self._start)
+        self._paint_trail()
+        self._auto_range()
+        self._operator_view = operator_view
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         below = event.size().width() < INFO_BELOW_WIDTH
@@ -208,7 +259,7 @@ class PlanPreview(QWidget):
         """The plan's sampled path (None: nothing to draw). ``keep_view``: leave the view
         range alone (the caller fits after drawing the points too)."""
         self._path = path
-        for proj in self.projections.values():
+        for proj in self._projections.values():
             if path is None or path.xyz.shape[0] == 0:
                 proj.path.setData([], [])
             else:
@@ -220,13 +271,15 @@ class PlanPreview(QWidget):
     def set_points(self, xyz: FloatArray | Sequence[Sequence[float]], labels: Sequence[str] = ()) -> None:
         """Points to mark (the plan's points), with labels (the first :data:`MAX_LABELS`)."""
         arr = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
-        for proj in self.projections.values():
+        self._points = (arr, list(labels))
+        for proj in self._projections.values():
             proj.points.setData(arr[:, proj.h], arr[:, proj.v])
             proj.set_labels(arr, list(labels))
 
     def set_start(self, xyz: Sequence[float] | FloatArray | None) -> None:
         """Where the plan starts (the robot's pose, or an assumed start)."""
-        for proj in self.projections.values():
+        self._start = None if xyz is None else (float(xyz[0]), float(xyz[1]), float(xyz[2]))
+        for proj in self._projections.values():
             if xyz is None:
                 proj.start.setData([], [])
             else:
@@ -312,14 +365,14 @@ class PlanPreview(QWidget):
             hit = np.flatnonzero(path.segment == index)
             if hit.size:
                 rows = path.xyz[hit[0]:hit[-1] + 1]
-        for proj in self.projections.values():
+        for proj in self._projections.values():
             if rows is None:
                 proj.selected.setData([], [])
             else:
                 proj.selected.setData(rows[:, proj.h], rows[:, proj.v], connect="finite")
 
     def _auto_range(self) -> None:
-        for proj in self.projections.values():
+        for proj in self._projections.values():
             proj.plot.getPlotItem().enableAutoRange()
             proj.plot.getPlotItem().autoRange()
 
@@ -349,7 +402,8 @@ class PlanPreview(QWidget):
         self._pending = None
         self._trail[:] = np.nan
         self._trail_count = 0
-        for proj in self.projections.values():
+        self._last_tcp = None
+        for proj in self._projections.values():
             proj.tcp.setData([], [])
             proj.trail.setData([], [])
 
@@ -368,16 +422,24 @@ class PlanPreview(QWidget):
         self._trail[k] = xyz
         self._trail[k + TRAIL_LENGTH] = xyz
         self._trail_count += 1
+        self._last_tcp = pose
+        self._paint_trail()
+
+    def _paint_trail(self) -> None:
+        if not self._trail_count or not self._projections:
+            return
+        k = (self._trail_count - 1) % TRAIL_LENGTH
         n = min(self._trail_count, TRAIL_LENGTH)
         end = k + 1 + TRAIL_LENGTH if self._trail_count > TRAIL_LENGTH else k + 1
         view = self._trail[end - n:end]
-        for proj in self.projections.values():
+        for proj in self._projections.values():
             proj.trail.setData(view[:, proj.h], view[:, proj.v])
-        self._paint_tcp(pose)
+        if self._last_tcp is not None:
+            self._paint_tcp(self._last_tcp)
 
     def _paint_tcp(self, pose: Pose) -> None:
         xyz = (pose.x, pose.y, pose.z)
-        for proj in self.projections.values():
+        for proj in self._projections.values():
             proj.tcp.setData([xyz[proj.h]], [xyz[proj.v]])
 
     def hideEvent(self, event: Any) -> None:
@@ -385,6 +447,7 @@ class PlanPreview(QWidget):
         super().hideEvent(event)
 
     def showEvent(self, event: Any) -> None:
+        self._build_plots()
         super().showEvent(event)
         if self._live_wanted and not self._live_timer.isActive():
             self._live_timer.start()
