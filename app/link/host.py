@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Protocol
 
+from app.errors import Reason
 from app.link.types import ConnectionState
 from app.models import CommandResult, ControllerStatus, Pose
 
@@ -79,7 +80,10 @@ class WorkerHost(WorkerOutputs, Protocol):
 
     def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None: ...
 
-    def emit_error(self, operation: str, message: str, request_id: int | None = -1) -> None: ...
+    def emit_error(self, operation: str, message: str, request_id: int | None = -1,
+                   reason: Reason | None = None) -> None: ...
+
+    def emit_exception(self, operation: str, exc: BaseException, request_id: int | None = -1) -> None: ...
 
     def start_polling(self) -> None: ...
 

@@ -106,7 +106,7 @@ class Poller:
             if with_clock and host.supervisor.canary_token is not None and gv is not None:
                 canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock
         except ResponseTimeout as exc:
-            self._report_error(str(exc))
+            self._report_error(exc)
             host.supervisor.poll_silent(str(exc), time.monotonic())
             self._report_stats()
             return
@@ -114,12 +114,12 @@ class Poller:
             # A malformed answer is a failed poll: the transport counted it and resynchronised
             # (a TCP link is reopened by the next request); none of its values are published;
             # LINK_LOSS_POLLS of them in a row take the link down like any failed transaction.
-            self._report_error(str(exc))
+            self._report_error(exc)
             host.supervisor.transport_failed(str(exc))
             self._report_stats()
             return
         except TeachPadError as exc:
-            self._report_error(str(exc))
+            self._report_error(exc)
             return
         answered = time.monotonic()
         self._error = None
@@ -151,7 +151,8 @@ class Poller:
             if stats is not None:
                 self._host.publish_link_stats(stats)
 
-    def _report_error(self, message: str) -> None:
+    def _report_error(self, exc: TeachPadError) -> None:
+        message = str(exc)
         if message != self._error:  # once per distinct error, not 50 times a second
             self._error = message
-            self._host.emit_error(Operation.POLL, message)
+            self._host.emit_exception(Operation.POLL, exc)

@@ -58,6 +58,7 @@ from app.errors import (
     LinkError,
     MalformedResponse,
     ModbusExceptionError,
+    Reason,
     ResponseTimeout,
     TeachPadError,
     WriteBlocked,
@@ -288,10 +289,17 @@ class RobotWorker(WorkerRequests, QObject):
             result = dataclasses.replace(result, request_id=rid)
         self.commandFinished.emit(result)
 
-    def emit_error(self, operation: str, message: str, request_id: int | None = -1) -> None:
-        """``errorOccurred`` with the request id (default: the job being executed)."""
+    def emit_error(self, operation: str, message: str, request_id: int | None = -1,
+                   reason: Reason | None = None) -> None:
+        """``errorOccurred`` with the request id (default: the job being executed) and, when the
+        cause is known, its reason (code + arguments) for the operator's language."""
         rid = self.request_id if request_id == -1 else request_id
-        self.errorOccurred.emit(WorkerError(operation, message, rid))
+        self.errorOccurred.emit(WorkerError(operation, message, rid, reason))
+
+    def emit_exception(self, operation: str, exc: BaseException, request_id: int | None = -1) -> None:
+        """``errorOccurred`` for ``exc`` (its English text and, for a typed error, its reason)."""
+        rid = self.request_id if request_id == -1 else request_id
+        self.errorOccurred.emit(WorkerError.from_exception(operation, exc, rid))
 
     def fail_queued(self, message: str) -> None:
         held, self._held = list(self._held), deque()
@@ -369,7 +377,8 @@ class RobotWorker(WorkerRequests, QObject):
 
     def _execute(self, job: Job, *, held: bool = False) -> None:
         if job.needs_link and not self.link_up:
-            self.emit_error(job.operation, "not connected to a controller", job.request_id)
+            self.emit_error(job.operation, "not connected to a controller", job.request_id,
+                            Reason("not_connected"))
             return
         if not held and self._must_wait(job):
             self._held.append(job)
@@ -382,20 +391,22 @@ class RobotWorker(WorkerRequests, QObject):
         except PreemptedError:
             pass
         except WriteBlocked as exc:
-            self.emit_error(job.operation, str(exc))
+            self.emit_exception(job.operation, exc)
         except (LinkError, ResponseTimeout, MalformedResponse) as exc:
             # Malformed: the transport already resynchronised; the command's outcome is unknown.
-            self.emit_error(job.operation, str(exc))
+            self.emit_exception(job.operation, exc)
             self.supervisor.transport_failed(str(exc))
         except ModbusExceptionError as exc:
-            self.emit_result(CommandResult(None, None, None, False, f"{job.operation}: {exc}"))
+            self.emit_result(CommandResult(None, None, None, False, f"{job.operation}: {exc}",
+                                           reason=exc.as_reason()))
         except CommandRefused as exc:
-            self.emit_result(CommandResult(None, exc.status.kind, exc.status, False, str(exc)))
+            self.emit_result(CommandResult(None, exc.status.kind, exc.status, False, str(exc),
+                                           reason=exc.as_reason()))
         except TeachPadError as exc:  # InvalidInput and the rest
-            self.emit_error(job.operation, str(exc))
+            self.emit_exception(job.operation, exc)
         except Exception as exc:  # a bug: report it plainly, keep the worker alive
             _log.exception("%s failed", job.operation)
-            self.emit_error(job.operation, f"internal error: {type(exc).__name__}: {str(exc)[:200]}")
+            self.emit_exception(job.operation, exc)
         finally:
             if job.sent is not None:
                 job.sent.set()  # also when it failed: the poster waits no longer
