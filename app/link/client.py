@@ -29,6 +29,7 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import enum
 import logging
@@ -86,6 +87,7 @@ from app.protocol.enums import (
     decode_command_status,
     decode_status_registers,
 )
+from app.safety.audit import AuditLog
 
 __all__ = [
     "ConnectionSettings",
@@ -137,6 +139,7 @@ class RobotClient:
         self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
         self._gv291_writable: bool | None = None  # completion "auto": None until probed
         self._ack_latency = 0.0  # s, decaying maximum of the acknowledgement times seen
+        self.audit: AuditLog | None = None  # every write (and monitor-only block) is recorded here
 
     # -- connection (the transport drops the caches whenever the link is made or lost) ---
     def connect(self) -> None:
@@ -185,20 +188,22 @@ class RobotClient:
 
     def _write(self, address: int, values: Sequence[int], *, single: bool = False) -> None:
         """The write guard: every write to the controller passes here."""
-        name = _range_name(address, len(values))
-        self._require_writable(f"write to {name}")
-        if not values:
-            raise InvalidInput("nothing to write")
-        if single:
-            if len(values) != 1:
-                raise InvalidInput("a single-register write takes one value")
-            _log.debug("write 0x06 %s <- %d", name, values[0])
-            self.write_count += 1
-            self._transport.write_single(f"write to {name}", address, int(values[0]))
-        else:
-            _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
-            self.write_count += 1
-            self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values])
+        ctx = self.audit.writing(address, values, single=single) if self.audit else contextlib.nullcontext()
+        with ctx:
+            name = _range_name(address, len(values))
+            self._require_writable(f"write to {name}")
+            if not values:
+                raise InvalidInput("nothing to write")
+            if single:
+                if len(values) != 1:
+                    raise InvalidInput("a single-register write takes one value")
+                _log.debug("write 0x06 %s <- %d", name, values[0])
+                self.write_count += 1
+                self._transport.write_single(f"write to {name}", address, int(values[0]))
+            else:
+                _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
+                self.write_count += 1
+                self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values])
 
     def _write_floats(self, gv: int, values: Sequence[float]) -> None:
         self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order))

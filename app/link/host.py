@@ -21,6 +21,8 @@ if TYPE_CHECKING:
     from app.link.stats import LinkStats
     from app.link.supervisor import LinkSupervisor
     from app.link.upload import Uploader
+    from app.safety.audit import AuditLog
+    from app.safety.envelope import EnvelopeViolation
 
 __all__ = ["WorkerHost", "WorkerOutputs"]
 
@@ -40,6 +42,7 @@ class WorkerOutputs(Protocol):
     def publish_restarted(self) -> None: ...
     def publish_upload_progress(self, done: int, total: int) -> None: ...
     def publish_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None: ...
+    def publish_guard_stop(self, violation: EnvelopeViolation) -> None: ...
 
 
 class WorkerHost(WorkerOutputs, Protocol):
@@ -52,6 +55,7 @@ class WorkerHost(WorkerOutputs, Protocol):
     uploader: Uploader
     capture: TrafficCapture
     closed: bool
+    audit: AuditLog | None  # given to each new client (thread-safe)
     request_id: int | None  # of the job being executed (results and errors carry it)
 
     @property
