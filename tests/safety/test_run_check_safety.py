@@ -28,9 +28,10 @@ def _profile(tmp_path: Path, envelope: Envelope) -> Path:
 
 def test_a_plan_outside_the_keep_in_box_is_refused(demo: Path, tmp_path: Path,
                                                     capsys: pytest.CaptureFixture[str]) -> None:
-    tiny = _profile(tmp_path, Envelope(keep_in=Box("cell", (9000.0, 9000.0, 9000.0), (9001.0, 9001.0, 9001.0))))
+    tiny = _profile(tmp_path, Envelope(keep_in=Box("cell", (9000.0,) * 3, (9001.0,) * 3)))
     cli = Cli()
-    assert cli("run", str(demo), "--plan", "circle", "--check", "--safety", str(tiny)) == cli_points.EXIT_USAGE
+    code = cli("run", str(demo), "--plan", "circle", "--check", "--safety", str(tiny))
+    assert code == cli_points.EXIT_USAGE
     err = capsys.readouterr().err
     assert "outside the allowed work space" in err and "not running it" in err
     assert cli.clients_made == 0
@@ -38,11 +39,14 @@ def test_a_plan_outside_the_keep_in_box_is_refused(demo: Path, tmp_path: Path,
 
 def test_a_roomy_envelope_passes(demo: Path, tmp_path: Path) -> None:
     roomy = _profile(tmp_path, Envelope(keep_in=Box("cell", (-9000.0,) * 3, (9000.0,) * 3)))
-    assert Cli()("run", str(demo), "--plan", "circle", "--check", "--safety", str(roomy)) == cli_points.EXIT_OK
+    code = Cli()("run", str(demo), "--plan", "circle", "--check", "--safety", str(roomy))
+    assert code == cli_points.EXIT_OK
 
 
-def test_a_bad_profile_is_a_usage_error(demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_bad_profile_is_a_usage_error(demo: Path, tmp_path: Path,
+                                        capsys: pytest.CaptureFixture[str]) -> None:
     bad = tmp_path / "bad.safety.json"
     bad.write_text("{", encoding="utf-8")
-    assert Cli()("run", str(demo), "--plan", "circle", "--check", "--safety", str(bad)) == cli_points.EXIT_USAGE
+    code = Cli()("run", str(demo), "--plan", "circle", "--check", "--safety", str(bad))
+    assert code == cli_points.EXIT_USAGE
     assert "safety profile" in capsys.readouterr().err
