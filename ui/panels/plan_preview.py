@@ -32,6 +32,7 @@ from app.plan.geometry import PlanPath, plan_path
 from app.plan.presenter import PlanInfo
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger
+from app.safety.envelope import Envelope
 from ui.palette import (
     COLOR_AXIS,
     COLOR_HIGHLIGHT,
@@ -42,6 +43,8 @@ from ui.palette import (
     COLOR_TCP,
     COLOR_TRAIL,
 )
+from ui.palette import COLOR_ERROR as COLOR_KEEP_OUT
+from ui.palette import COLOR_OK as COLOR_KEEP_IN
 
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
 LIVE_FPS = 30
@@ -88,6 +91,14 @@ class _Projection:
         self.trail = pg.PlotCurveItem(pen=pg.mkPen(COLOR_TRAIL, width=2))
         self.tcp = pg.ScatterPlotItem(size=13, symbol="o", brush=pg.mkBrush(COLOR_TCP),
                                       pen=pg.mkPen(COLOR_INK))
+        # the safety envelope: each box's 12 edges projected (its outline rectangle), dashed
+        self.keep_in = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_IN, width=1, style=Qt.PenStyle.DashLine),
+                                        connect="pairs")
+        self.keep_out = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_OUT, width=2, style=Qt.PenStyle.DashLine),
+                                         connect="pairs")
+        for item in (self.keep_in, self.keep_out):
+            item.setZValue(-1)
+            plot.addItem(item)
         self.labels: list[pg.TextItem] = []
         for z, item in enumerate((self.path, self.selected, self.points, self.start, self.trail, self.tcp)):
             item.setZValue(z)
@@ -293,6 +304,15 @@ class PlanPreview(QWidget):
         lines.append(self.tr("Start: end of the last segment (robot pose unknown)") if info.assumed_start
                      else self.tr("Start: the robot's current pose"))
         self.set_info("<br>".join(lines))
+
+    def set_envelope(self, envelope: Envelope | None) -> None:
+        """Outline the keep-in box and the keep-out boxes in every projection (None: none)."""
+        keep_in = envelope.keep_in.edges() if envelope is not None and envelope.keep_in else np.empty((0, 3))
+        zones = [b.edges() for b in envelope.keep_out] if envelope is not None else []
+        keep_out = np.vstack(zones) if zones else np.empty((0, 3))
+        for proj in self.projections.values():
+            proj.keep_in.setData(keep_in[:, proj.h], keep_in[:, proj.v])
+            proj.keep_out.setData(keep_out[:, proj.h], keep_out[:, proj.v])
 
     def clear(self) -> None:
         self._previewed = None

@@ -48,6 +48,7 @@ from app.plan.presenter import (
 from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, SegmentKind
 from app.points.ledger import UploadReport
+from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
@@ -95,6 +96,8 @@ class PlannerPanel(QWidget):
         self._sync = point_sync
         self._confirm = confirm or ask_confirmation(self)
         self.limits = limits or PlanLimits()
+        self.envelope: Envelope | None = None  # the safety envelope: set_envelope
+        self.reduced_speed = False
         self._issues: list[PlanIssue] = []
         self._summary_text = ""
         self._pose_known = False
@@ -280,6 +283,12 @@ class PlannerPanel(QWidget):
         return self._runner.last_pose
 
     @Slot()
+    def set_envelope(self, envelope: Envelope | None, reduced_speed: bool = False) -> None:
+        """The safety envelope the checks (and Run) use; its boxes are drawn in the preview."""
+        self.envelope, self.reduced_speed = envelope, reduced_speed
+        self.preview.set_envelope(envelope)
+        self.recheck()
+
     def recheck(self) -> None:
         """Checks, estimates and preview of the plan on display."""
         plan = self.current_plan()
@@ -292,7 +301,8 @@ class PlannerPanel(QWidget):
             return
         pose = self._pose()
         start, assumed = plan_start(plan, ledger, pose)
-        self._issues = check_plan(plan, ledger, self.limits, pose, loops=plan.loops)
+        self._issues = check_plan(plan, ledger, self.limits, pose, loops=plan.loops, envelope=self.envelope,
+                                  reduced_speed=self.reduced_speed)
         self.segments.set_issues(self._issues)
         estimate = estimate_plan(plan, ledger, start)
         self.segments.set_estimate(estimate.lengths, estimate.times)
