@@ -27,6 +27,7 @@ from typing import Any
 
 from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, Signal, Slot
 from PySide6.QtWidgets import (
+    QAbstractItemView,
     QGroupBox,
     QLabel,
     QSizePolicy,
@@ -283,6 +284,19 @@ class PlannerPanel(QWidget):
         return self._runner.last_pose
 
     @Slot()
+    def set_edit_permission(self, reason: str | None) -> None:
+        """Role gating: plan and segment edits only while ``reason`` is None (else disabled, not
+        hidden, with ``reason`` as the tooltip); runs stay the operator's."""
+        self.actions.edit_reason = reason
+        for view in (self.plan_view, self.segment_view):
+            if reason:
+                if view.property("editTriggers") is None:
+                    view.setProperty("editTriggers", int(view.editTriggers().value))
+                view.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+            elif view.property("editTriggers") is not None:
+                view.setEditTriggers(QAbstractItemView.EditTrigger(view.property("editTriggers")))
+        self._update_actions()
+
     def set_envelope(self, envelope: Envelope | None, reduced_speed: bool = False) -> None:
         """The safety envelope the checks (and Run) use; its boxes are drawn in the preview."""
         self.envelope, self.reduced_speed = envelope, reduced_speed

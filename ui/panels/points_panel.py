@@ -67,6 +67,7 @@ class PointsPanel(QWidget):
         self._controller = controller or PointSyncController(model, parent=self)
         self._confirm = confirm or ask_confirmation(self)
         self._run_active = False
+        self._edit_reason: str | None = None  # why the role may not edit points (None: it may)
 
         self.proxy = PointFilterProxy(self)
         self.proxy.setSourceModel(model)
@@ -333,6 +334,15 @@ class PointsPanel(QWidget):
         self._confirm = confirm
 
     @Slot(bool)
+    def set_edit_permission(self, reason: str | None) -> None:
+        """Role gating: add / duplicate / delete / reorder / cell edits only while ``reason`` is
+        None; else disabled (not hidden) with ``reason`` as the tooltip."""
+        self._edit_reason = reason
+        triggers = QAbstractItemView.EditTrigger
+        self.table.setEditTriggers(triggers.NoEditTriggers if reason else triggers.DoubleClicked
+                                   | triggers.EditKeyPressed | triggers.AnyKeyPressed)
+        self.retranslate()  # the usual tooltips back; _update_actions puts the reason on top
+
     def set_run_active(self, active: bool) -> None:
         """A plan is running: no teach / upload / move from here."""
         self._run_active = active
@@ -505,3 +515,10 @@ class PointsPanel(QWidget):
         self.cancel_button.setEnabled(c.operation == "upload")
         self.action_move_to.setEnabled(link_ok and len(rows) == 1)
         self.upload_button.setEnabled(link_ok and has_points)
+        edits = (self.action_add, self.action_duplicate, self.action_delete, self.action_move_up,
+                 self.action_move_down)
+        self.action_add.setEnabled(True)
+        for action in edits:
+            action.setEnabled(action.isEnabled() and self._edit_reason is None)
+            if self._edit_reason:
+                action.setToolTip(self._edit_reason)
