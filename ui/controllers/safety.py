@@ -169,6 +169,12 @@ class SafetyController(QObject):
     def _poll_idle(self) -> None:
         self.session.poll_idle()
 
+    def set_idle_polling(self, on: bool) -> None:
+        if on:
+            self._idle_timer.start()
+        else:
+            self._idle_timer.stop()
+
     def set_idle_timeout(self, seconds: float) -> None:
         self.session.idle.timeout = seconds
 

@@ -70,8 +70,14 @@ class SafetyMenu(QObject):
         self.retranslate()
 
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
-        if watched is self.window and event.type() == QEvent.Type.LanguageChange:
-            self.retranslate()
+        if watched is self.window:
+            kind = event.type()
+            if kind == QEvent.Type.LanguageChange:
+                self.retranslate()
+            elif kind == QEvent.Type.Show:
+                self.safety.set_idle_polling(True)
+            elif kind in (QEvent.Type.Hide, QEvent.Type.Close):
+                self.safety.set_idle_polling(False)  # no timer outlives the window
         return False
 
     def retranslate(self) -> None:

@@ -342,6 +342,7 @@ class PointsPanel(QWidget):
         self.table.setEditTriggers(triggers.NoEditTriggers if reason else triggers.DoubleClicked
                                    | triggers.EditKeyPressed | triggers.AnyKeyPressed)
         self.retranslate()  # the usual tooltips back; _update_actions puts the reason on top
+        self._update_actions()
 
     def set_run_active(self, active: bool) -> None:
         """A plan is running: no teach / upload / move from here."""
