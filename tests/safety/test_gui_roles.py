@@ -14,9 +14,7 @@ import pytest
 from app.safety.audit import query
 from app.safety.envelope import Box, Envelope
 from app.safety.profile import load_profile
-from app.safety.roles import Action, Role
-from ui.controllers.safety_menu import SafetyMenu, install_safety
-from ui.panels.audit_viewer import AuditViewer
+from app.safety.roles import Action, Role, WrongPassword
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     app_settings_fixture,
@@ -26,6 +24,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     translator_fixture,
     window_fixture,
 )
+from ui.controllers.safety_menu import SafetyMenu, install_safety
+from ui.panels.audit_viewer import AuditViewer
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
@@ -62,7 +62,7 @@ def test_an_engineer_edits_points_an_operator_does_not(qtbot: Any, menu: SafetyM
     assert not panel.action_add.isEnabled() and "engineer" in panel.action_add.toolTip()
     assert not panel.table.editTriggers()
     assert not window.planner_panel.actions["add_plan"].isEnabled()
-    with pytest.raises(Exception, match="[Ww]rong password"):
+    with pytest.raises(WrongPassword, match="wrong password"):
         menu.safety.login(Role.ENGINEER, "nope")
     menu.safety.login(Role.ENGINEER, PASSWORD)
     assert panel.action_add.isEnabled() and panel.table.editTriggers()
