@@ -259,7 +259,6 @@ class SafetyController(QObject):
 
     def violation_text(self, v: EnvelopeViolation) -> str:
         """:class:`EnvelopeViolation` in the operator's language."""
-        where = "" if v.segment is None else self.tr("Segment {k}: ").format(k=v.segment + 1)
         if v.approaching:
             if v.box:
                 text = self.tr("{axis} = {value:.1f} is within stopping distance of the keep-out zone "
@@ -279,7 +278,10 @@ class SafetyController(QObject):
         else:
             text = (self.tr("Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode")
                     if v.reduced else self.tr("Jog speed {value:g} % is above the {limit:g} % allowed"))
-        return where + text.format(axis=v.axis, value=v.value, limit=v.limit, box=v.box)
+        text = text.format(axis=v.axis, value=v.value, limit=v.limit, box=v.box)
+        if v.segment is None:
+            return text
+        return self.tr("Segment {k}: {text}").format(k=v.segment + 1, text=text)
 
     @Slot(object)
     def _on_guard_stopped(self, violation: EnvelopeViolation) -> None:

@@ -96,8 +96,9 @@ class SafetyMenu(QObject):
     @Slot()
     def _update(self, *_args: Any) -> None:
         safety = self.safety
-        self.role_label.setText(self.tr("Role: {role}").format(role=safety.role_name(safety.role))
-                                + (self.tr(" · reduced speed") if safety.session.reduced else ""))
+        role = safety.role_name(safety.role)
+        text = self.tr("Role: {role} · reduced speed") if safety.session.reduced else self.tr("Role: {role}")
+        self.role_label.setText(text.format(role=role))
         self.logout_action.setEnabled(safety.role is not Role.OPERATOR)
         self.reduced_action.blockSignals(True)
         self.reduced_action.setChecked(safety.session.reduced)
@@ -105,6 +106,10 @@ class SafetyMenu(QObject):
         leave = safety.reason(Action.LEAVE_REDUCED_SPEED)
         self.reduced_action.setToolTip(leave if safety.session.reduced and leave else
                                        self.tr("Cap jog and move speeds (anyone may switch it on)"))
+
+    def source_name(self) -> str:
+        """The event log's source column for safety messages."""
+        return self.tr("safety")
 
     @Slot(bool)
     def _on_reduced(self, on: bool) -> None:
@@ -178,7 +183,7 @@ def install_safety(window: Any, *, scrypt_n: int | None = None) -> SafetyMenu:
     if view3d is not None:
         safety.attach_view(view3d.panel.canvas)
     if hasattr(window, "event_log"):
-        safety.message.connect(lambda text: window.event_log.add_event("warning", window.tr("safety"), text))
+        safety.message.connect(lambda text: window.event_log.add_event("warning", menu.source_name(), text))
     safety.message.connect(lambda text: window.statusBar().showMessage(text, 8000))
     if safety.problem:
         safety.message.emit(safety.problem)

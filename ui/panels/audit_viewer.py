@@ -136,10 +136,11 @@ class AuditViewer(QDialog):
         stats = ReadStats()
         records = query(self.directory, self.current_filter(), stats)
         self.model.set_records(records)
-        text = self.tr("{n} records").format(n=len(self.model.records))
+        n = len(self.model.records)
+        text = self.tr("{n} records")
         if stats.skipped:
-            text += self.tr(" ({n} damaged lines skipped)").format(n=stats.skipped)
-        self.status.setText(text)
+            text = self.tr("{n} records ({skipped} damaged lines skipped)")
+        self.status.setText(text.format(n=n, skipped=stats.skipped))
         self.table.scrollToBottom()
 
     def _ask_path(self, suggested: str) -> str | None:
