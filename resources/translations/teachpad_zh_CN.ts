@@ -33,116 +33,171 @@
             <source>Detail</source>
             <translation>详情</translation>
         </message>
-    </context>
-    <context>
-        <name>AuditViewer</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="76" />
-            <source>Audit trail</source>
-            <translation>审计记录</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="86" />
-            <source>Any role</source>
-            <translation>任意角色</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="87" />
+            <location filename="../../ui/panels/audit_viewer.py" line="72" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="87" />
+            <location filename="../../ui/panels/audit_viewer.py" line="72" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="88" />
+            <location filename="../../ui/panels/audit_viewer.py" line="73" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="89" />
+            <location filename="../../ui/panels/audit_viewer.py" line="74" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="92" />
-            <source>Command contains…</source>
-            <translation>命令包含…</translation>
+            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <source>write</source>
+            <translation>写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="94" />
-            <source>Any result</source>
-            <translation>任意结果</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="95" />
-            <source>ok</source>
-            <translation>成功</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="95" />
-            <source>failed</source>
-            <translation>失败</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="96" />
-            <source>blocked</source>
-            <translation>已阻止</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="96" />
+            <location filename="../../ui/panels/audit_viewer.py" line="75" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <source>login</source>
+            <translation>登录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <source>action</source>
+            <translation>操作</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <source>ok</source>
+            <translation>成功</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <source>failed</source>
+            <translation>失败</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="77" />
+            <source>blocked</source>
+            <translation>已阻止</translation>
+        </message>
+    </context>
+    <context>
+        <name>AuditViewer</name>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="87" />
+            <source>Audit trail</source>
+            <translation>审计记录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="97" />
+            <source>Any role</source>
+            <translation>任意角色</translation>
+        </message>
+        <message>
             <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <source>operator</source>
+            <translation>操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <source>engineer</source>
+            <translation>工程师</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="99" />
+            <source>administrator</source>
+            <translation>管理员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="100" />
+            <source>administrator (CLI)</source>
+            <translation>管理员（命令行）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="103" />
+            <source>Command contains…</source>
+            <translation>命令包含…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="105" />
+            <source>Any result</source>
+            <translation>任意结果</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="106" />
+            <source>ok</source>
+            <translation>成功</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="106" />
+            <source>failed</source>
+            <translation>失败</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="107" />
+            <source>blocked</source>
+            <translation>已阻止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="107" />
+            <source>refused</source>
+            <translation>已拒绝</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="109" />
             <source>Show</source>
             <translation>显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="100" />
+            <location filename="../../ui/panels/audit_viewer.py" line="111" />
             <source>Export CSV…</source>
             <translation>导出 CSV…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="110" />
+            <location filename="../../ui/panels/audit_viewer.py" line="121" />
             <source>From</source>
             <translation>从</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="110" />
+            <location filename="../../ui/panels/audit_viewer.py" line="121" />
             <source>to</source>
             <translation>到</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="140" />
+            <location filename="../../ui/panels/audit_viewer.py" line="151" />
             <source>{n} records</source>
             <translation>{n} 条记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="142" />
+            <location filename="../../ui/panels/audit_viewer.py" line="153" />
             <source>{n} records ({skipped} damaged lines skipped)</source>
             <translation>{n} 条记录（跳过 {skipped} 行损坏的记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="147" />
+            <location filename="../../ui/panels/audit_viewer.py" line="158" />
             <source>Export the audit trail</source>
             <translation>导出审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="148" />
+            <location filename="../../ui/panels/audit_viewer.py" line="159" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="159" />
+            <location filename="../../ui/panels/audit_viewer.py" line="170" />
             <source>Cannot write {file}: {why}</source>
             <translation>无法写入 {file}：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="162" />
+            <location filename="../../ui/panels/audit_viewer.py" line="173" />
             <source>{n} records exported to {file}</source>
             <translation>已将 {n} 条记录导出到 {file}</translation>
         </message>

@@ -63,7 +63,18 @@ class AuditModel(QAbstractTableModel):
         col = self.COLUMNS[index.column()]
         if col == "time":
             return r.host_time.replace("T", " ")[:23]
-        return str(getattr(r, col))
+        value = str(getattr(r, col))
+        if col in ("role", "kind", "result"):  # the file keeps English keys; the table shows words
+            return self._words().get(value, value)
+        return value
+
+    def _words(self) -> dict[str, str]:
+        return {"operator": self.tr("operator"), "engineer": self.tr("engineer"),
+                "administrator": self.tr("administrator"),
+                "administrator (cli)": self.tr("administrator (CLI)"),
+                "write": self.tr("write"), "refused": self.tr("refused"), "login": self.tr("login"),
+                "action": self.tr("action"), "ok": self.tr("ok"), "failed": self.tr("failed"),
+                "blocked": self.tr("blocked")}
 
 
 class AuditViewer(QDialog):
