@@ -173,6 +173,7 @@ class SafetyMenu(QObject):
 def install_safety(window: Any, *, scrypt_n: int | None = None) -> SafetyMenu:
     """Compose the guard rails onto ``window`` (a :class:`ui.main_window.MainWindow`)."""
     safety = SafetyController(window.link, window.settings.store, window, scrypt_n=scrypt_n)
+    safety.set_poll_rate(window.settings.poll_hz)  # the jog guard's margin follows the poll period
     menu = SafetyMenu(window, safety)
     safety.gate(window.menus.connect_action, Action.CONNECTION)
     safety.gate(menu.envelope_action, Action.EDIT_ENVELOPE)
