@@ -21,7 +21,7 @@ from typing import Any
 
 from PySide6.QtCore import QEvent, QObject, QSettings, QTimer, Signal, Slot
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QApplication, QWidget
+from PySide6.QtWidgets import QAbstractItemView, QApplication, QWidget
 
 from app import timing
 from app.errors import TeachPadError
@@ -45,6 +45,16 @@ def safety_paths(store: QSettings) -> tuple[Path, Path, Path]:
         base = Path(store.fileName()).parent / "safety"
         return base / "roles.json", base / "audit", base / PROFILE_NAME
     return default_store_path(), default_audit_dir(), default_config_dir() / PROFILE_NAME
+
+
+def lock_editing(view: QAbstractItemView, locked: bool) -> None:
+    """Role gating of a table's cell edits: off while ``locked``, its own triggers back after."""
+    if locked:
+        if view.property("safetyEditTriggers") is None:
+            view.setProperty("safetyEditTriggers", int(view.editTriggers().value))
+        view.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+    elif view.property("safetyEditTriggers") is not None:
+        view.setEditTriggers(QAbstractItemView.EditTrigger(view.property("safetyEditTriggers")))
 
 
 class SafetyController(QObject):

@@ -27,7 +27,6 @@ from typing import Any
 
 from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, Signal, Slot
 from PySide6.QtWidgets import (
-    QAbstractItemView,
     QGroupBox,
     QLabel,
     QSizePolicy,
@@ -52,6 +51,7 @@ from app.points.ledger import UploadReport
 from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
+from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.models.plan_columns import PLAN_COL_NAME
 from ui.models.plan_model import PlanListModel
@@ -289,12 +289,7 @@ class PlannerPanel(QWidget):
         hidden, with ``reason`` as the tooltip); runs stay the operator's."""
         self.actions.edit_reason = reason
         for view in (self.plan_view, self.segment_view):
-            if reason:
-                if view.property("editTriggers") is None:
-                    view.setProperty("editTriggers", int(view.editTriggers().value))
-                view.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
-            elif view.property("editTriggers") is not None:
-                view.setEditTriggers(QAbstractItemView.EditTrigger(view.property("editTriggers")))
+            lock_editing(view, reason is not None)
         self._update_actions()
 
     def set_envelope(self, envelope: Envelope | None, reduced_speed: bool = False) -> None:

@@ -41,6 +41,7 @@ from ui.controllers.point_sync import (
     MAX_MOVE_SPEED,
     PointSyncController,
 )
+from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COLUMNS, EXT_COLUMNS
 from ui.models.points_model import PointFilterProxy, PointsModel
@@ -338,9 +339,7 @@ class PointsPanel(QWidget):
         """Role gating: add / duplicate / delete / reorder / cell edits only while ``reason`` is
         None; else disabled (not hidden) with ``reason`` as the tooltip."""
         self._edit_reason = reason
-        triggers = QAbstractItemView.EditTrigger
-        self.table.setEditTriggers(triggers.NoEditTriggers if reason else triggers.DoubleClicked
-                                   | triggers.EditKeyPressed | triggers.AnyKeyPressed)
+        lock_editing(self.table, reason is not None)
         self.retranslate()  # the usual tooltips back; _update_actions puts the reason on top
         self._update_actions()
 
