@@ -1700,17 +1700,17 @@
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="416" />
+            <location filename="../../ui/panels/planner_panel.py" line="411" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="425" />
+            <location filename="../../ui/panels/planner_panel.py" line="420" />
             <source>Failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="425" />
+            <location filename="../../ui/panels/planner_panel.py" line="420" />
             <source>Stopped</source>
             <translation>已停止</translation>
         </message>
@@ -2062,154 +2062,154 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="265" />
+            <location filename="../../ui/panels/points_panel.py" line="267" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="265" />
+            <location filename="../../ui/panels/points_panel.py" line="267" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="267" />
+            <location filename="../../ui/panels/points_panel.py" line="269" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="267" />
+            <location filename="../../ui/panels/points_panel.py" line="269" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="268" />
+            <location filename="../../ui/panels/points_panel.py" line="270" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="268" />
+            <location filename="../../ui/panels/points_panel.py" line="270" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="269" />
+            <location filename="../../ui/panels/points_panel.py" line="271" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="270" />
+            <location filename="../../ui/panels/points_panel.py" line="272" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="271" />
+            <location filename="../../ui/panels/points_panel.py" line="273" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="272" />
+            <location filename="../../ui/panels/points_panel.py" line="274" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="273" />
+            <location filename="../../ui/panels/points_panel.py" line="275" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="274" />
+            <location filename="../../ui/panels/points_panel.py" line="276" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="275" />
+            <location filename="../../ui/panels/points_panel.py" line="277" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="276" />
+            <location filename="../../ui/panels/points_panel.py" line="278" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="277" />
+            <location filename="../../ui/panels/points_panel.py" line="279" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="277" />
+            <location filename="../../ui/panels/points_panel.py" line="279" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="278" />
-            <location filename="../../ui/panels/points_panel.py" line="294" />
+            <location filename="../../ui/panels/points_panel.py" line="280" />
+            <location filename="../../ui/panels/points_panel.py" line="296" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="279" />
+            <location filename="../../ui/panels/points_panel.py" line="281" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="280" />
+            <location filename="../../ui/panels/points_panel.py" line="282" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="281" />
-            <location filename="../../ui/panels/points_panel.py" line="443" />
+            <location filename="../../ui/panels/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="447" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="282" />
+            <location filename="../../ui/panels/points_panel.py" line="284" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="285" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="285" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="284" />
+            <location filename="../../ui/panels/points_panel.py" line="286" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="289" />
+            <location filename="../../ui/panels/points_panel.py" line="291" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="290" />
+            <location filename="../../ui/panels/points_panel.py" line="292" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="291" />
+            <location filename="../../ui/panels/points_panel.py" line="293" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="292" />
+            <location filename="../../ui/panels/points_panel.py" line="294" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="295" />
+            <location filename="../../ui/panels/points_panel.py" line="297" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="296" />
+            <location filename="../../ui/panels/points_panel.py" line="298" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
@@ -2249,7 +2249,7 @@
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="436" />
+            <location filename="../../ui/panels/points_panel.py" line="440" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -2262,7 +2262,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="473" />
+            <location filename="../../ui/panels/points_panel.py" line="477" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -2879,77 +2879,77 @@ Remove them all?</source>
     <context>
         <name>SafetyController</name>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="107" />
+            <location filename="../../ui/controllers/safety.py" line="119" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="107" />
+            <location filename="../../ui/controllers/safety.py" line="119" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="108" />
+            <location filename="../../ui/controllers/safety.py" line="120" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="114" />
+            <location filename="../../ui/controllers/safety.py" line="126" />
             <source>Needs the {need} role (you are {role}); log in from the Safety menu</source>
             <translation>需要{need}角色（当前为{role}）；请从“安全”菜单登录</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="264" />
+            <location filename="../../ui/controllers/safety.py" line="287" />
             <source>{axis} = {value:.1f} is within stopping distance of the keep-out zone '{box}' (at {limit:.1f})</source>
             <translation>{axis} = {value:.1f}，已进入禁区“{box}”的停止距离内（边界 {limit:.1f}）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="267" />
+            <location filename="../../ui/controllers/safety.py" line="290" />
             <source>{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}</source>
             <translation>{axis} = {value:.1f}，已进入限位 {limit:.1f} 的停止距离内</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="269" />
+            <location filename="../../ui/controllers/safety.py" line="292" />
             <source>{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)</source>
             <translation>{axis} = {value:.1f} mm 超出允许的工作空间（限值 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="271" />
+            <location filename="../../ui/controllers/safety.py" line="294" />
             <source>The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, its face at {limit:.1f} mm)</source>
             <translation>路径进入禁区“{box}”（{axis} = {value:.1f} mm，边界在 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="274" />
+            <location filename="../../ui/controllers/safety.py" line="297" />
             <source>{axis} = {value:.1f}° is beyond its limit {limit:.1f}°</source>
             <translation>{axis} = {value:.1f}° 超出限位 {limit:.1f}°</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="276" />
+            <location filename="../../ui/controllers/safety.py" line="299" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode</source>
             <translation>速度 {value:g} mm/s 超过降速模式允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="277" />
+            <location filename="../../ui/controllers/safety.py" line="300" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed</source>
             <translation>速度 {value:g} mm/s 超过允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="279" />
+            <location filename="../../ui/controllers/safety.py" line="302" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode</source>
             <translation>点动速度 {value:g} % 超过降速模式允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="280" />
+            <location filename="../../ui/controllers/safety.py" line="303" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed</source>
             <translation>点动速度 {value:g} % 超过允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="284" />
+            <location filename="../../ui/controllers/safety.py" line="307" />
             <source>Segment {k}: {text}</source>
             <translation>第 {k} 段：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="289" />
+            <location filename="../../ui/controllers/safety.py" line="312" />
             <source>Jog stopped before the limit: {why}</source>
             <translation>点动已在到达边界前停止：{why}</translation>
         </message>

@@ -159,3 +159,25 @@ def test_support_bundle_leaves_passwords_out(menu: SafetyMenu, window: Any, tmp_
     assert "versions.json" in names and any(n.startswith("audit/") for n in names)
     assert "events.txt" in names and "traffic.txt" in names
     assert "secret" not in json.dumps(settings)
+
+
+def test_a_move_to_a_point_outside_the_work_space_is_refused_before_sending(
+        qtbot: Any, sim: Any, menu: SafetyMenu, window: Any) -> None:
+    from tests.ui.pendant_support import connect
+
+    assert window.project.open_file(SAMPLE)
+    connect(qtbot, window.link, sim, poll_timeout=1.0)
+    qtbot.waitUntil(lambda: window.link.state.pose is not None, timeout=5000)
+    ledger = window.project.points_model.ledger
+    target = max(ledger, key=lambda p: p.xyz[1])  # the point furthest along +Y
+    menu.safety.login(Role.ENGINEER, PASSWORD)
+    menu.safety.save_envelope(Envelope(keep_in=Box("cell", (-5000.0, -5000.0, -5000.0),
+                                                   (5000.0, target.xyz[1] - 10.0, 5000.0))))
+    panel = window.points_panel
+    panel.select_rows([window.project.points_model.row_of(target.id)])
+    writes = len(sim.writes)
+    panel.move_to_selected()
+    assert "outside the allowed work space" in panel.status.text()
+    assert len(sim.writes) == writes  # nothing went out
+    refused = [r for r in query(menu.safety.audit_dir) if r.result == "refused"]
+    assert refused[-1].command == "move to point"

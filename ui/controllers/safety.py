@@ -26,6 +26,8 @@ from PySide6.QtWidgets import QAbstractItemView, QApplication, QWidget
 from app import timing
 from app.errors import TeachPadError
 from app.link.robot_link import RobotLink
+from app.plan.segments import Segment
+from app.points.ledger import PointLedger
 from app.safety.audit import AuditLog, default_audit_dir
 from app.safety.envelope import Envelope, EnvelopeRefused, EnvelopeViolation, ViolationCode
 from app.safety.profile import SafetyProfile, load_profile, save_profile
@@ -266,6 +268,17 @@ class SafetyController(QObject):
         except EnvelopeRefused as exc:
             return self.refusal(exc)
         return None
+
+    def check_move_to(self, pose: Any, point_id: int, speed: float, ledger: PointLedger) -> str | None:
+        """Move to a point in a straight line (function 3) from ``pose`` (None: not known, the
+        target and the speed are checked)."""
+        start = pose if pose is not None else ledger.get(point_id)
+        if start is None:
+            return None  # an unknown point: the move refuses it itself
+        try:
+            return self.check_move(start, Segment.line(point_id, speed), ledger)
+        except TeachPadError as exc:
+            return str(exc)
 
     def violation_text(self, v: EnvelopeViolation) -> str:
         """:class:`EnvelopeViolation` in the operator's language."""

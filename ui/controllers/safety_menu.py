@@ -178,6 +178,8 @@ def install_safety(window: Any, *, scrypt_n: int | None = None) -> SafetyMenu:
     safety.gate(window.menus.connect_action, Action.CONNECTION)
     safety.gate(menu.envelope_action, Action.EDIT_ENVELOPE)
     safety.gate_panel(window.points_panel, Action.EDIT_POINTS)
+    window.points_panel.move_check = lambda point_id, speed: safety.check_move_to(
+        window.link.state.pose, point_id, speed, window.project.points_model.ledger)
     safety.gate_panel(window.planner_panel, Action.EDIT_PLANS)
     safety.attach_view(window.planner_panel)
     view3d = getattr(window, "view3d", None)

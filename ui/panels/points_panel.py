@@ -69,6 +69,7 @@ class PointsPanel(QWidget):
         self._confirm = confirm or ask_confirmation(self)
         self._run_active = False
         self._edit_reason: str | None = None  # why the role may not edit points (None: it may)
+        self.move_check: Callable[[int, float], str | None] | None = None  # the envelope: why not (None: go)
 
         self.proxy = PointFilterProxy(self)
         self.proxy.setSourceModel(model)
@@ -432,6 +433,10 @@ class PointsPanel(QWidget):
             return
         point = self._model.point_at(rows[0])
         speed = self.speed.value()
+        refused = self.move_check(point.id, speed) if self.move_check is not None else None
+        if refused:
+            self.show_message(refused, LEVEL_ERROR)
+            return
         question = self.tr("Move the robot in a straight line to {point}?\n\n"
                            "X {x:.3f}  Y {y:.3f}  Z {z:.3f}\nA {a:.3f}  B {b:.3f}  C {c:.3f}\n"
                            "Speed {v} mm/s").format(point=point.label, x=point.x, y=point.y, z=point.z,
