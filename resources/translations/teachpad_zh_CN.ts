@@ -2792,58 +2792,78 @@ Remove them all?</source>
     <context>
         <name>RoleDialog</name>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="28" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="29" />
             <source>Log in</source>
             <translation>登录</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="35" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="36" />
             <source>Now: {role}</source>
             <translation>当前：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="39" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="40" />
             <source>Set this role's password</source>
             <translation>设置此角色的密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="41" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="44" />
+            <source> min</source>
+            <translation> 分钟</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="47" />
+            <source>Back to operator after this idle time</source>
+            <translation>空闲这么久后回到操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="50" />
             <source>Log out (operator)</source>
             <translation>注销（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="44" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="53" />
             <source>Role:</source>
             <translation>角色：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="45" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="54" />
             <source>Password:</source>
             <translation>密码：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="70" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="55" />
+            <source>Lock back after:</source>
+            <translation>空闲锁定时间：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="80" />
             <source>No administrator password is set yet: choose the administrator role, type a password and press “Set this role's password”.</source>
             <translation>尚未设置管理员密码：请选择管理员角色，输入密码，然后按“设置此角色的密码”。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="73" />
             <location filename="../../ui/dialogs/role_dialog.py" line="83" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="93" />
             <source>No password is set for this role; an administrator sets it.</source>
             <translation>此角色尚未设置密码；请由管理员设置。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="81" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="91" />
             <source>Wrong password for the {role} role</source>
             <translation>{role}角色的密码错误</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="100" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="105" />
+            <source>The setting could not be saved: {why}</source>
+            <translation>无法保存设置：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="119" />
             <source>The password could not be saved: {why}</source>
             <translation>无法保存密码：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="104" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="123" />
             <source>Password set for the {role} role</source>
             <translation>已设置{role}角色的密码</translation>
         </message>

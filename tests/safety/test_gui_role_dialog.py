@@ -39,6 +39,10 @@ def test_first_admin_password_then_log_in_and_out(qtbot: Any, tmp_path: Path) ->
     assert safety.role is Role.ADMINISTRATOR and dialog.result() == RoleDialog.DialogCode.Accepted
     again = RoleDialog(safety)
     qtbot.addWidget(again)
+    assert again.idle.isEnabled()  # the administrator chooses the idle time
+    again.idle.setValue(2)
+    assert safety.session.idle.timeout == 120.0 and '"idle_timeout": 120.0' in (
+        tmp_path / "safety" / "roles.json").read_text(encoding="utf-8")
     again.log_out()
     assert safety.role is Role.OPERATOR
     stored = (tmp_path / "safety" / "roles.json").read_text(encoding="utf-8")

@@ -11,12 +11,13 @@ from PySide6.QtWidgets import (
     QLabel,
     QLineEdit,
     QPushButton,
+    QSpinBox,
     QVBoxLayout,
     QWidget,
 )
 
 from app.errors import InvalidInput, TeachPadError
-from app.safety.roles import Role, WrongPassword
+from app.safety.roles import Action, Role, WrongPassword
 from ui.controllers.safety import SafetyController
 
 
@@ -38,11 +39,20 @@ class RoleDialog(QDialog):
         self.error.setStyleSheet("color: #c62828;")
         self.set_password_button = QPushButton(self.tr("Set this role's password"), self)
         self.set_password_button.clicked.connect(self.set_password)
+        self.idle = QSpinBox(self)  # the administrator chooses the idle time before the lock-back
+        self.idle.setRange(1, 240)
+        self.idle.setSuffix(self.tr(" min"))
+        self.idle.setValue(max(1, round(safety.session.store.idle_timeout / 60)))
+        self.idle.setEnabled(safety.role is Role.ADMINISTRATOR)
+        tip = safety.reason(Action.MANAGE_ROLES) or self.tr("Back to operator after this idle time")
+        self.idle.setToolTip(tip)
+        self.idle.valueChanged.connect(self._set_idle)
         self.logout_button = QPushButton(self.tr("Log out (operator)"), self)
         self.logout_button.clicked.connect(self.log_out)
         form = QFormLayout()
         form.addRow(self.tr("Role:"), self.role_box)
         form.addRow(self.tr("Password:"), self.password)
+        form.addRow(self.tr("Lock back after:"), self.idle)
         std = QDialogButtonBox.StandardButton
         buttons = QDialogButtonBox(std.Ok | std.Cancel, self)
         buttons.accepted.connect(self.log_in)
@@ -84,6 +94,15 @@ class RoleDialog(QDialog):
             self.password.selectAll()
             return
         self.accept()
+
+    def _set_idle(self, minutes: int) -> None:
+        store = self._safety.session.store
+        store.idle_timeout = minutes * 60.0
+        self._safety.set_idle_timeout(store.idle_timeout)
+        try:
+            store.save()
+        except OSError as exc:
+            self.error.setText(self.tr("The setting could not be saved: {why}").format(why=str(exc)[:120]))
 
     def log_out(self) -> None:
         self._safety.logout()
