@@ -34,8 +34,8 @@ SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.t
 CHEAP_SCRYPT = 2**4  # tests only: the real cost is 2**14
 
 
-@pytest.fixture
-def menu(window: Any) -> SafetyMenu:
+@pytest.fixture(name="menu")
+def menu_fixture(window: Any) -> SafetyMenu:
     existing = getattr(window, "safety_menu", None)
     menu = existing if existing is not None else install_safety(window, scrypt_n=CHEAP_SCRYPT)
     store = menu.safety.session.store

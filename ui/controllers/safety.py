@@ -262,6 +262,17 @@ class SafetyController(QObject):
             return self.refusal(exc)
         return None
 
+    def check_jog(self, pose: Any, request: Any) -> str | None:
+        """Before a jog press (``request`` a JogRequest, its ratio already capped): None, or why
+        it would stop at once (audited). The worker's guard decides again on every poll."""
+        if pose is None:
+            return None
+        try:
+            self.session.check_jog_start(pose, request, self.poll_period)
+        except (EnvelopeRefused, PermissionRefused) as exc:
+            return self.refusal(exc)
+        return None
+
     def check_move(self, start: Any, segment: Any, ledger: Any) -> str | None:
         try:
             self.session.check_move(start, segment, ledger)
