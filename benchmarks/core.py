@@ -166,9 +166,11 @@ def bench_upload(sim: SimController, n: int) -> dict[str, Any]:
     client = RobotClient(ConnectionSettings(host=host, port=port))
     client.connect()
     try:
+        requests0 = sim.requests_count
         t0 = time.perf_counter()
         results = client.upload_points(points)
         batched_s = time.perf_counter() - t0
+        requests = sim.requests_count - requests0
     finally:
         client.close()
     failed = sum(1 for r in results if not r.ok)
@@ -201,6 +203,8 @@ def bench_upload(sim: SimController, n: int) -> dict[str, Any]:
         "rtt_ms": rtt["p50_ms"],
         "ratio_batched_vs_seed": batched_s / seed_s,
         "ratio_batched_vs_bound": batched_s / bound_s,
+        "requests_per_point": requests / n,
+        "ratio_requests_vs_bound": requests / n / min_tx_per_point,
         "points_per_s_batched": n / batched_s,
     }
 

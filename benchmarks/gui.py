@@ -26,6 +26,11 @@ the traffic inspector brought to the front of its dock (it is tabified behind th
 * **The 3D view** (``view3d``, :mod:`benchmarks.view3d`) -- frame times of rotating a scene of
   10,000 point markers and a 1,000-segment plan, and ``streaming_view3d_shown`` among the
   stalls: the streaming stall measurement again with the 3D tab in front.
+* **Busy neighbour** -- ``sim_separate_process.event_loop_stall.streaming_busy``: the streaming
+  figures again while one ``while True: pass`` process per extra core loads the machine.
+* **Memory** (``run_memory``, called by ``benchmarks.run`` as ``gui.memory``) -- VmRSS of a
+  ``teachpad --sim`` process idle after its first pose, then every few seconds over a soak
+  streaming a program with the traffic inspector shown (``--long``: 10 minutes, every 30 s).
 
 The simulator runs in this process (``sim_in_process``, as ``teachpad --sim`` runs it, sharing
 the GIL with the GUI) and, as a shorter cross-check, in its own process
@@ -612,8 +617,11 @@ def bench_startup(runs: int) -> dict[str, Any]:
 
 def bench_window(sim: SimHandle, stall_s: float, n_stop: int, rng: random.Random, *,
                  complete: bool = True, n_posted: int = 0, stop_budget_s: float = float("inf"),
-                 posted_budget_s: float = float("inf")) -> dict[str, Any]:
+                 posted_budget_s: float = float("inf"), busy_s: float = 0.0) -> dict[str, Any]:
     """Stalls and stop latency with one main window on ``sim`` (see the module docstring).
+
+    ``busy_s`` > 0 adds ``streaming_busy``: the same stream measured for ``busy_s`` while a
+    busy neighbour (:class:`BusyNeighbour`) loads every other core.
 
     ``complete`` False (the cross-check with the simulator in another process) leaves out the
     disconnected stall baseline, the posted-input stops and the bare stops under polling.
@@ -676,6 +684,8 @@ def bench_window(sim: SimHandle, stall_s: float, n_stop: int, rng: random.Random
         streaming["traffic_shown"] = not traffic.visibleRegion().isEmpty()
         streaming["monitor_shown"] = not window.monitor_panel.visibleRegion().isEmpty()
         stalls["streaming"] = streaming
+        if busy_s > 0:
+            stalls["streaming_busy"] = _measure_streaming_busy(window, sim, counters, busy_s)
         if complete:
             idle_max = stalls["disconnected"]["max_ms"]
             stalls["ratio_max_streaming_vs_disconnected"] = streaming["max_ms"] / idle_max
@@ -758,7 +768,7 @@ def run(quick: bool) -> dict[str, Any]:
     # The simulator in its own process, as a real controller would be: no GIL shared with it.
     stall_s, n_stop, stop_budget = (2.0, 20, 2.0) if quick else (4.0, 60, 3.0)
     out["sim_separate_process"] = _with_sim(RemoteSim, lambda sim: bench_window(
-        sim, stall_s, n_stop, rng, complete=False, stop_budget_s=stop_budget))
+        sim, stall_s, n_stop, rng, complete=False, stop_budget_s=stop_budget, busy_s=stall_s))
     t1 = time.perf_counter()
     out["startup"] = bench_startup(1 if quick else 3)
     out["startup"]["suite_s"] = time.perf_counter() - t1
@@ -767,6 +777,153 @@ def run(quick: bool) -> dict[str, Any]:
     out["view3d"] = view3d.run(quick)
     out["suite_s"] = time.perf_counter() - t0
     return out
+
+
+# --------------------------------------------------------------------------------------------
+# 4. A busy neighbour, and memory (idle RSS after start-up, a soak)
+# --------------------------------------------------------------------------------------------
+
+
+class BusyNeighbour:
+    """A parallel CPU load: one ``while True: pass`` child process per core beyond the first
+    (at least one), for the life of the ``with`` block -- the operator PC's other work."""
+
+    def __init__(self, procs: int | None = None) -> None:
+        self.procs = procs if procs is not None else max(1, (os.cpu_count() or 2) - 1)
+        self._children: list[subprocess.Popen[bytes]] = []
+
+    def __enter__(self) -> BusyNeighbour:
+        for _ in range(self.procs):
+            self._children.append(subprocess.Popen([sys.executable, "-c", "while True: pass"]))
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        for child in self._children:  # only the children started here, by their handles
+            child.kill()
+        for child in self._children:
+            child.wait()
+        self._children.clear()
+
+
+def _measure_streaming_busy(window: MainWindow, sim: SimHandle, counters: _Counters,
+                            seconds: float) -> dict[str, Any]:
+    """The streaming figures again, with :class:`BusyNeighbour` running."""
+    with BusyNeighbour() as busy:
+        _run_for(0.2)  # let the neighbours reach full speed
+        poses0, frames0, requests0 = counters.poses, counters.traffic_frames, sim.requests()
+        t0 = time.perf_counter()
+        out = measure_stalls(seconds)
+        elapsed = time.perf_counter() - t0
+        out["polls_per_s"] = (sim.requests() - requests0) / 2 / elapsed
+    out["poses_per_s"] = (counters.poses - poses0) / elapsed
+    out["traffic_frames_per_s"] = (counters.traffic_frames - frames0) / elapsed
+    out["busy_neighbour_procs"] = busy.procs
+    out["monitor_shown"] = not window.monitor_panel.visibleRegion().isEmpty()
+    out["traffic_shown"] = not window.traffic_panel.visibleRegion().isEmpty()
+    return out
+
+
+MEMORY_SETTLE_S = 3.0  # after the first pose, before the idle RSS is read
+SOAK_LONG_S, SOAK_LONG_EVERY_S = 600.0, 30.0  # --long: a 10-minute soak, RSS every 30 s
+
+# ``python -c``; argv: settings INI, window size, soak seconds, sample period. ``teachpad --sim``
+# with the window's first pose as the start; after MEMORY_SETTLE_S the idle RSS, then a
+# streaming program (the 100 mm square, cycled) with RSS every period. Lines "RSS {json}".
+_MEMORY_CHILD = r"""
+import gc, json, os, sys, time
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+from PySide6.QtCore import QTimer
+from PySide6.QtWidgets import QApplication
+import ui.main as teachpad
+from app.protocol.enums import ProgramMotionMode
+settings_path, size, soak_s, every_s, settle_s, program = sys.argv[1:7]
+soak_s, every_s, settle_s, program = float(soak_s), float(every_s), float(settle_s), int(program)
+
+def rss_mb():
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    return float("nan")
+
+def report(kind, **extra):
+    print("RSS " + json.dumps(dict(kind=kind, t=time.monotonic(), rss_mb=rss_mb(), **extra)), flush=True)
+
+class Probe(teachpad.MainWindow):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._bench_started = False
+        self.link.poseChanged.connect(self._bench_pose)
+        QTimer.singleShot(int(1000 * (soak_s + settle_s + 120)), QApplication.instance().quit)
+    def _bench_pose(self, _pose):
+        if self._bench_started:
+            return
+        self._bench_started = True
+        report("first_pose")
+        QTimer.singleShot(int(1000 * settle_s), self._bench_idle)
+    def _bench_idle(self):
+        gc.collect()
+        report("idle")
+        self.traffic_dock.raise_()  # the inspector shown too: its capture is part of the soak
+        self.link.run_program(program, ProgramMotionMode.CYCLE, 0, 100)
+        self._bench_t0 = time.monotonic()
+        self._bench_timer = QTimer(self)
+        self._bench_timer.timeout.connect(self._bench_sample)
+        self._bench_timer.start(int(1000 * every_s))
+    def _bench_sample(self):
+        report("soak", traffic_rows=self.traffic_panel.model.rowCount())
+        if time.monotonic() - self._bench_t0 >= soak_s - 1e-3:
+            self.link.stop()
+            QApplication.instance().quit()
+teachpad.MainWindow = Probe
+teachpad.main(["--sim", "--settings", settings_path, "--size", size])
+"""
+
+
+def bench_memory(soak_s: float, every_s: float) -> dict[str, Any]:
+    """RSS of a ``teachpad --sim`` process: idle after start-up, then over a streaming soak."""
+    with tempfile.TemporaryDirectory(prefix="teachpad-bench-") as tmp:
+        user = Path(tmp)
+        env = dict(os.environ, QT_QPA_PLATFORM="offscreen", PYTHONPATH=str(REPO),
+                   **{f"XDG_{d}_HOME": str(user / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")})
+        args = [str(user / "teachpad.ini"), "{}x{}".format(*DEFAULT_SIZE), str(soak_s), str(every_s),
+                str(MEMORY_SETTLE_S), str(STREAM_PROGRAM)]
+        proc = subprocess.run([sys.executable, "-c", _MEMORY_CHILD, *args], cwd=REPO, env=env,
+                              capture_output=True, text=True, check=False,
+                              timeout=STARTUP_TIMEOUT_S + MEMORY_SETTLE_S + soak_s + 120)
+    rows = [json.loads(x[4:]) for x in proc.stdout.splitlines() if x.startswith("RSS ")]
+    idle = next((r for r in rows if r["kind"] == "idle"), None)
+    if proc.returncode != 0 or idle is None:
+        raise RuntimeError(f"memory child failed, rc={proc.returncode}: {proc.stderr[-2000:]}")
+    soak = [r for r in rows if r["kind"] == "soak"]
+    out: dict[str, Any] = {
+        "what": "VmRSS of teachpad --sim (the GUI process), idle connected, then streaming program "
+                f"{STREAM_PROGRAM} at {POLL_HZ:g} Hz polling",
+        "idle_rss_mb": round(idle["rss_mb"], 1),
+        "first_pose_rss_mb": round(next(r["rss_mb"] for r in rows if r["kind"] == "first_pose"), 1),
+    }
+    if soak:
+        samples = [round(r["rss_mb"], 1) for r in soak]
+        minutes = (soak[-1]["t"] - soak[0]["t"]) / 60.0
+        # growth from the first soak sample (plots and traffic buffers filled) to the last
+        growth = samples[-1] - samples[0]
+        out["soak"] = {
+            "seconds": round(soak[-1]["t"] - idle["t"], 1),
+            "every_s": every_s,
+            "rss_mb": samples,
+            "traffic_rows": [r.get("traffic_rows") for r in soak],
+            "peak_rss_mb": max(samples),
+            "growth_mb": round(growth, 1),
+            "growth_mb_per_10min": round(10.0 * growth / minutes, 1) if minutes > 0 else None,
+        }
+    return out
+
+
+def run_memory(quick: bool, long: bool) -> dict[str, Any]:
+    """``gui.memory``: the idle RSS; a soak of 10 minutes with ``long``, else a short one."""
+    if long:
+        return bench_memory(SOAK_LONG_S, SOAK_LONG_EVERY_S)
+    return bench_memory(10.0, 5.0) if quick else bench_memory(60.0, 10.0)
 
 
 if __name__ == "__main__":

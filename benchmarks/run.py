@@ -1,6 +1,9 @@
 """`make bench`: run every benchmark and print one JSON object.
 
-Usage: python -m benchmarks.run [--quick] [--only core,gui,points]
+Usage: python -m benchmarks.run [--quick] [--long] [--only core,gui,points]
+
+``goals`` (:mod:`benchmarks.goals`) prints each of the issue's figures beside its goal.
+``--long`` adds the 10-minute memory soak (``gui.memory.soak``).
 """
 
 from __future__ import annotations
@@ -13,10 +16,13 @@ import sys
 import time
 from typing import Any
 
+from benchmarks.goals import goals, table
+
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="small N and short windows")
+    parser.add_argument("--long", action="store_true", help="memory soak of 10 minutes (RSS every 30 s)")
     parser.add_argument("--only", default="core,gui,points", help="comma-separated suites")
     args = parser.parse_args(argv)
     suites = {s.strip() for s in args.only.split(",") if s.strip()}
@@ -29,6 +35,7 @@ def main(argv: list[str] | None = None) -> int:
             "platform": platform.platform(),
         },
         "quick": args.quick,
+        "long": args.long,
     }
     t0 = time.perf_counter()
     if "core" in suites:
@@ -42,6 +49,7 @@ def main(argv: list[str] | None = None) -> int:
             out["gui"] = {"skipped": str(exc)}
         else:
             out["gui"] = gui.run(args.quick)
+            out["gui"]["memory"] = gui.run_memory(args.quick, args.long)
     if "points" in suites:
         try:
             from benchmarks import points
@@ -52,8 +60,10 @@ def main(argv: list[str] | None = None) -> int:
     if "safety" in suites:  # not in the default set: --only safety (or core,gui,points,safety)
         out["safety"] = __import__("benchmarks.safety", fromlist=["run"]).run(args.quick)
     out["total_s"] = time.perf_counter() - t0
+    out["goals"] = goals(out)
     json.dump(out, sys.stdout, indent=2, sort_keys=True)
     sys.stdout.write("\n")
+    sys.stderr.write(table(out["goals"]) + "\n")
     return 0
 
 

@@ -40,6 +40,7 @@ from PySide6.QtWidgets import (
     QSizePolicy,
     QSplitter,
     QTabWidget,
+    QToolBar,
     QVBoxLayout,
     QWidget,
 )
@@ -48,19 +49,25 @@ from app import __version__
 from app.link.client import ConnectionSettings
 from app.link.robot_link import RobotLink
 from app.link.types import ConnectionState, LinkState, WorkerError
+from app.safety.roles import Action
 from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController, ProjectDialogs
+from ui.controllers.safety_menu import install_safety
 from ui.dialogs.confirm import ConfirmFn
 from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import Translator
+from ui.messages import error_text
+from ui.panels.alarm_banner import AlarmBanner
+from ui.panels.alarm_list import AlarmListPanel
 from ui.panels.control_bar import ControlBar
 from ui.panels.event_log import EventLogPanel
 from ui.panels.jog_panel import JogPanel
 from ui.panels.monitor_panel import MonitorPanel
 from ui.panels.planner_panel import PlannerPanel
 from ui.panels.points_panel import PointsPanel
+from ui.panels.pose_strip import PoseStrip
 from ui.panels.program_panel import ProgramPanel
 from ui.panels.status_panel import StatusPanel
 from ui.panels.step_panel import StepPanel
@@ -157,6 +164,7 @@ class MainWindow(QMainWindow):
         self.status_panel = StatusPanel(self)
         self.traffic_panel = TrafficPanel(self)
         self.event_log = EventLogPanel(self)
+        self.alarm_list = AlarmListPanel(self)
         area = Qt.DockWidgetArea
         self.status_dock = self._dock("StatusDock", self.status_panel, area.LeftDockWidgetArea)
         # QMainWindow hands a narrow window's spare width to the docks as well: a status
@@ -165,6 +173,8 @@ class MainWindow(QMainWindow):
         self.event_dock = self._dock("EventLogDock", self.event_log, area.BottomDockWidgetArea)
         self.traffic_dock = self._dock("TrafficDock", self.traffic_panel, area.BottomDockWidgetArea)
         self.tabifyDockWidget(self.event_dock, self.traffic_dock)
+        self.alarm_dock = self._dock("AlarmDock", self.alarm_list, area.BottomDockWidgetArea)
+        self.tabifyDockWidget(self.event_dock, self.alarm_dock)
         self.event_dock.raise_()
         self.setCorner(Qt.Corner.BottomLeftCorner, area.LeftDockWidgetArea)  # status runs full height
         for panel in (self.event_log, self.traffic_panel):
@@ -182,8 +192,9 @@ class MainWindow(QMainWindow):
             tab_count=len(TAB_NAMES), set_language=self.set_language,
             language=translator.language if translator else "en", file_actions=self.project.file_actions(),
             edit_actions=[self.project.action_undo, self.project.action_redo],
-            docks=[self.status_dock, self.event_dock, self.traffic_dock],
+            docks=[self.status_dock, self.event_dock, self.traffic_dock, self.alarm_dock],
             set_touch_mode=self.set_touch_mode, touch_mode=settings.touch_mode)
+        self._compose_strip_and_banner()
         self.status_project = QLabel(self)
         self.status_link = QLabel(self)
         self.status_rtt = QLabel(self)
@@ -199,10 +210,14 @@ class MainWindow(QMainWindow):
         mark_motion(bar.stop_button, bar.pause_button, bar.resume_button)
         self.set_touch_mode(settings.touch_mode)
         self.view3d = install_view3d(self)  # the 3D tab (and its dock beside the planner)
+        self.safety_menu = install_safety(self)  # roles, envelope, audit trail (the Safety menu)
+        self.motion.safety = self.safety_menu.safety
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*self._default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])
         self._docks_sized = self._restore_window()  # else sized at the first show
+        self.alarm_banner.sync()  # shown exactly while an alarm is set, whatever was saved
+        self.pose_bar.setVisible(True)
         app = QApplication.instance()
         self._app_state_connected = isinstance(app, QApplication)
         if isinstance(app, QApplication):
@@ -226,9 +241,26 @@ class MainWindow(QMainWindow):
         self.addDockWidget(area, dock)
         return dock
 
+    def _compose_strip_and_banner(self) -> None:
+        """Window-wide rows above everything (the main toolbar sits in the menu bar's corner):
+        the alarm banner (only while an alarm is set), then the pose strip (always). Neither can
+        be moved or hidden by hand."""
+        self.alarm_banner = AlarmBanner(self)
+        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.alarm_banner)
+        self.pose_strip = PoseStrip(self)
+        self.pose_bar = QToolBar(self)
+        self.pose_bar.setObjectName("PoseStripBar")
+        self.pose_bar.setMovable(False)
+        self.pose_bar.setFloatable(False)
+        self.pose_bar.toggleViewAction().setVisible(False)
+        self.pose_bar.addWidget(self.pose_strip)
+        self.addToolBarBreak(Qt.ToolBarArea.TopToolBarArea)
+        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.pose_bar)
+
     def _wire(self) -> None:
         link, state = self.link, self.link.state
-        for panel in (self.monitor_panel, self.status_panel, self.event_log, self.control_bar):
+        for panel in (self.monitor_panel, self.status_panel, self.event_log, self.control_bar,
+                      self.pose_strip, self.alarm_banner, self.alarm_list):
             panel.bind(state)
         state.connectionChanged.connect(self._show_connection)
         state.rttChanged.connect(self._show_rtt)
@@ -240,6 +272,8 @@ class MainWindow(QMainWindow):
         self.motion = MotionController(link, self.control_bar, self.jog_panel, self.step_panel,
                                        self.program_panel, self.run_controller, self)
         self.run_controller.runningChanged.connect(self.points_panel.set_run_active)
+        self.motion.alarmHoldChanged.connect(self.points_panel.set_alarm_hold)
+        self.motion.alarmHoldChanged.connect(self.planner_panel.set_alarm_hold)
         project = self.project
         project.titleChanged.connect(self._on_project_title)
         project.pathChanged.connect(self._on_project_path)
@@ -258,6 +292,7 @@ class MainWindow(QMainWindow):
         self.status_dock.setWindowTitle(self.tr("Status"))
         self.event_dock.setWindowTitle(self.tr("Event log"))
         self.traffic_dock.setWindowTitle(self.tr("Modbus traffic"))
+        self.alarm_dock.setWindowTitle(self.tr("Alarms"))
         self.menus.retranslate()
         self.project.retranslate()
         self._on_project_title(self.project.title)
@@ -318,7 +353,7 @@ class MainWindow(QMainWindow):
     @Slot(WorkerError)
     def _on_error(self, error: WorkerError) -> None:
         operation = self.event_log.operation_text(error.operation)
-        self.statusBar().showMessage(f"{operation}: {error.message}", 8000)
+        self.statusBar().showMessage(f"{operation}: {error_text(error)}", 8000)
 
     @Slot(str)
     def _show_message(self, text: str) -> None:
@@ -396,9 +431,12 @@ class MainWindow(QMainWindow):
     @Slot()
     def open_connection_dialog(self) -> None:
         self.jog_panel.release_all()
+        if not self.safety_menu.safety.allowed(Action.CONNECTION):  # the administrator's (audited)
+            return
         dialog = ConnectionDialog.for_link(self.link, self.settings.connection(), self.settings.poll_hz, self)
         if dialog.exec() == ConnectionDialog.DialogCode.Accepted:
             self.connect_with(dialog.settings())
+            self.safety_menu.safety.set_poll_rate(self.settings.poll_hz)
 
     def connect_with(self, settings: ConnectionSettings) -> None:
         """Remember ``settings`` and connect (the link retries by itself until it succeeds)."""

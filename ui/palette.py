@@ -45,3 +45,9 @@ COLOR_CURVE_RED: Final = "#d62728"
 COLOR_CURVE_GREEN: Final = "#2ca02c"
 COLOR_CURVE_BLUE: Final = "#1f77b4"
 COLOR_CURVE_PURPLE: Final = "#6a1b9a"
+
+# --- staleness and alarms (the pose strip, the alarm banner) --------------------------------
+COLOR_STALE: Final = "#90a4ae"  # a value not confirmed within the freshness limit
+COLOR_STALE_BG: Final = "#eceff1"
+COLOR_ALARM_BANNER: Final = "#b71c1c"  # the window-wide alarm banner's background
+COLOR_ALARM_BANNER_TEXT: Final = "#ffffff"

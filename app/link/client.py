@@ -43,6 +43,7 @@ from app.errors import (
     LinkError,
     MalformedResponse,
     ModbusExceptionError,
+    Reason,
     ResponseTimeout,
     WriteBlocked,
 )
@@ -138,6 +139,9 @@ class RobotClient:
         self.last_tracker: CommandTracker | None = None
         self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
         self._gv291_writable: bool | None = None  # completion "auto": None until probed
+        # X Y Z of the points this client created from given poses (a move whose GV291 never
+        # changed may be confirmed by arriving there, see CommandTracker's ``target``)
+        self._sent_points: dict[int, tuple[float, float, float]] = {}
         self._ack_latency = 0.0  # s, decaying maximum of the acknowledgement times seen
         self.audit: AuditLog | None = None  # every write (and monitor-only block) is recorded here
 
@@ -443,7 +447,8 @@ class RobotClient:
     def _finish(self, tracker: CommandTracker, wait: bool) -> CommandResult:
         if wait:
             return self.wait(tracker)
-        return CommandResult(tracker.command, tracker.kind, None, True, f"{tracker.text}: sent")
+        return CommandResult(tracker.command, tracker.kind, None, True, f"{tracker.text}: sent",
+                             reason=Reason("sent", {"command": int(tracker.command)}))
 
     def _check_point_id(self, point_id: int, name: str = "point id") -> int:
         return _check_int(point_id, self.settings.point_id_min, self.settings.point_id_max, name)
@@ -506,6 +511,9 @@ class RobotClient:
         else:
             self._write_floats(gv_start, values)
             self._write_floats(registers.GV_PARAM0, [float(point_id), 1.0, float(gv_start)])
+        self._sent_points.pop(point_id, None)  # from the current pose: not known here
+        if values is not None:
+            self._sent_points[point_id] = (values[0], values[1], values[2])
         self._write_tool(tool)
         tracker = self.begin_command(RunCommand.CREATE_POINT, before, None, timeout=timeout)
         return self._finish(tracker, wait)
@@ -535,12 +543,13 @@ class RobotClient:
             try:
                 self._write_floats(gv_start, values)
                 self._write_floats(registers.GV_PARAM0, [float(point_id), 1.0, float(gv_start)])
+                self._sent_points[point_id] = (values[0], values[1], values[2])
                 tracker = self.begin_command(RunCommand.CREATE_POINT, status, None)
                 result = self.wait(tracker, raise_errors=False)
                 status = tracker.last_status or status
             except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
                 results.append(CommandResult(RunCommand.CREATE_POINT, kind, None, False, str(exc),
-                                             {"point_id": float(point_id)}))
+                                             {"point_id": float(point_id)}, reason=exc.as_reason()))
                 break
             details = dict(result.details, point_id=float(point_id))
             results.append(dataclasses.replace(result, message=f"point {point_id}: {result.message}",
@@ -571,6 +580,7 @@ class RobotClient:
         self._write_floats(registers.GV_EXPECTED_SPEED, [speed])
         self._write_tool(tool)
         tracker = self.begin_command(RunCommand.MOVE_TO_POINT, before, before_pose, timeout=timeout)
+        tracker.target = self._sent_points.get(end_id)
         return self._finish(tracker, wait)
 
     # -- function 4: teach (jog) ---------------------------------------------------------

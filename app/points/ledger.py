@@ -42,6 +42,7 @@ from app.points.point import (
     SyncState,
     TempPoint,
     _mark_changed,
+    is_valid_point,
     make_point,
     parse_float,
     parse_int,
@@ -116,6 +117,15 @@ class PointLedger:
         self.revision = 0
         self.replace_all(points)
         self.revision = 0
+
+    @classmethod
+    def from_checked(cls, points: list[TempPoint], limits: PointLimits = DEFAULT_LIMITS) -> PointLedger:
+        """A ledger over ``points`` that the caller has just validated (each built by
+        ``make_point`` / ``point_from_fields`` with ``limits``, ids unique): nothing is checked
+        twice. Project loading uses it; everything else goes through the checking constructor."""
+        ledger = cls((), limits)
+        ledger._points = points
+        return ledger
 
     # --- reading
     @property
@@ -379,7 +389,10 @@ class PointLedger:
         self.revision += 1
 
     def _check_fields(self, point: TempPoint) -> None:
-        # Re-validate: a TempPoint may have been built directly.
+        # Re-validate: a TempPoint may have been built directly. The quick check passes the
+        # usual point; make_point says what is wrong with the others.
+        if is_valid_point(point, self._limits):
+            return
         make_point(point.id, point.name, point.xyzabc, point.ext, point.tool, point.note, limits=self._limits)
 
     def _check_point(self, point: TempPoint, ignore_row: int | None) -> None:

@@ -44,6 +44,7 @@ import datetime as dt
 import json
 import math
 import os
+import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -72,6 +73,7 @@ from app.points.point import (
     PointLimits,
     SyncState,
     TempPoint,
+    fast_point_from_fields,
     has_surrogates,
     point_from_fields,
     shown,
@@ -301,21 +303,22 @@ def _text_field(obj: Mapping[str, Any], key: str, where: str) -> str:
 
 
 def project_from_dict(
-    data: object, limits: PointLimits = DEFAULT_LIMITS, *, path: str | None = None
+    data: object, limits: PointLimits = DEFAULT_LIMITS, *, path: str | None = None, scan_text: bool = True
 ) -> Project:
-    """Validate a decoded JSON document fully and build the project."""
+    """Validate a decoded JSON document fully and build the project. ``scan_text=False``
+    skips the search for lone surrogates (the caller knows the document has none)."""
     try:
-        return _project_from_dict(data, limits)
+        return _project_from_dict(data, limits, scan_text=scan_text)
     except FileFormatError as exc:
         raise exc.with_path(path) if path else exc from None
 
 
-def _project_from_dict(data: object, limits: PointLimits) -> Project:
+def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = True) -> Project:
     top = "the file"
     if not isinstance(data, dict):
         raise FileFormatError("expected a JSON object at the top level")
     doc: dict[str, Any] = data
-    bad_text = _first_surrogate(doc, "")
+    bad_text = _first_surrogate(doc, "") if scan_text else None
     if bad_text is not None:
         raise FileFormatError("holds an invalid character (a lone surrogate, not Unicode text)",
                               where=bad_text or top)
@@ -337,7 +340,19 @@ def _project_from_dict(data: object, limits: PointLimits) -> Project:
     points: list[TempPoint] = []
     history: dict[int, UploadRecord] = {}
     seen: dict[int, int] = {}
+    unknown = SyncState.UNKNOWN
     for i, raw in enumerate(raw_points):
+        if type(raw) is dict:
+            fast = fast_point_from_fields(raw, limits, sync=unknown)
+            if fast is not None and fast.id not in seen:
+                seen[fast.id] = i
+                points.append(fast)
+                uploaded = raw.get("uploaded")
+                if uploaded is not None:
+                    record = _history_from(uploaded, f"points[{i}] (id {fast.id})")
+                    if record is not None:
+                        history[fast.id] = record
+                continue
         where = f"points[{i}]"
         obj = _expect(raw, dict, where, "", "an object")
         raw_id = obj.get("id")
@@ -380,7 +395,7 @@ def _project_from_dict(data: object, limits: PointLimits) -> Project:
             segments.append(_segment_from_dict(seg, seg_where))
         plans.append(Plan(plan_name, segments, loops))
 
-    return Project(name=name, ledger=PointLedger(points, limits), plans=plans,
+    return Project(name=name, ledger=PointLedger.from_checked(points, limits), plans=plans,
                    description=description, created=created, modified=modified, upload_history=history)
 
 
@@ -430,8 +445,30 @@ def _json_float(text: str) -> float | OversizedNumber:
     return number if math.isfinite(number) else OversizedNumber(text)
 
 
+# A JSON escape that decodes to a surrogate (\\ud800..\\udfff); only these, or surrogates in
+# the text itself, can put a lone surrogate into the decoded document.
+_SURROGATE_ESCAPE = re.compile(r"\\u[dD][89a-fA-F]")
+
+
 def parse_project(text: str, limits: PointLimits = DEFAULT_LIMITS, *, path: str | None = None) -> Project:
-    """A project from JSON text; :class:`FileFormatError` names where the text is wrong."""
+    """A project from JSON text; :class:`FileFormatError` names where the text is wrong.
+
+    Fast path first: the stock decoder (C, no per-number hooks) and the point fast path; the
+    surrogate scan only when the text could hold one. Any refusal (or a number the stock
+    decoder cannot take) re-runs the exact path below, so every message is the careful one."""
+    try:
+        data = json.loads(text)
+    except (ValueError, RecursionError):  # bad JSON, an int of > 4300 digits, deep nesting
+        return _parse_project_exact(text, limits, path=path)
+    scan = has_surrogates(text) or _SURROGATE_ESCAPE.search(text) is not None
+    try:
+        return project_from_dict(data, limits, path=path, scan_text=scan)
+    except FileFormatError:
+        return _parse_project_exact(text, limits, path=path)
+
+
+def _parse_project_exact(text: str, limits: PointLimits, *, path: str | None) -> Project:
+    """Decode with hooks that keep oversized numbers as text (for "too large" messages)."""
     try:
         data = json.loads(text, parse_int=_json_int, parse_float=_json_float)
     except json.JSONDecodeError as exc:

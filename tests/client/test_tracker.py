@@ -145,7 +145,7 @@ def test_host_sent_stop_ends_the_wait() -> None:
     assert tr.update(st(6, RUNNING), moved(1), 0.01) is None
     result = tr.stopped(0.02)
     assert not result.ok and isinstance(tr.error, CommandStopped)
-    assert "stopped by the host" in result.message
+    assert "stopped by the operator" in result.message
     # Later reads do not change the outcome.
     assert tr.update(st(DONE), moved(1), 0.03) is result
 
@@ -322,3 +322,26 @@ def test_observe_teach_is_confirmed_by_the_controller_mode(command: RunCommand, 
     result = tr.update(ControllerStatus(after, STOPPED, Alarm.NONE, DONE), None, 0.002)
     assert result is not None and result.ok and not result.unconfirmed
     assert result.status.member is TeachStatus.DONE
+
+
+def test_a_move_whose_status_never_changed_is_done_when_it_stands_at_its_target() -> None:
+    """A short move on a fast controller with a read-only GV291: 0xFF before and after, the
+    arm went and stopped. At the X Y Z the host sent for the end point, it ended there."""
+    tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
+    tr.target = (150.0, 0.0, 500.0)
+    steps = [(0.01, st(DONE), moved(20.0)), (0.05, st(DONE), moved(50.0)),
+             (0.1, st(DONE), moved(50.0)), (0.3, st(DONE), moved(50.0)), (0.41, st(DONE), moved(50.0))]
+    i, result = feed(tr, steps)
+    assert i == 4 and result.ok and not result.unconfirmed  # after stop_settle, long before ack_timeout
+    assert "arrived at the point" in result.message
+
+
+def test_a_move_whose_status_never_changed_stopping_elsewhere_stays_unknown(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
+    tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
+    tr.target = (150.0, 0.0, 500.0)  # the arm stops 10 mm short: not confirmed
+    steps = [(0.01, st(DONE), moved(20.0)), (0.05, st(DONE), moved(40.0)),
+             (0.4, st(DONE), moved(40.0)), (0.8, st(DONE), moved(40.0))]
+    i, result = feed(tr, steps)
+    assert i == 3 and not result.ok and "result is unknown" in result.message

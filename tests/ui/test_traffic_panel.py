@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -419,3 +420,38 @@ def test_long_frames_are_cut_in_the_cell_but_complete_in_tooltip_and_export(
     assert tip.startswith("209 bytes") and tip.replace("\n", " ").endswith(full[-20:])
     panel.export_to(tmp_path / "t.txt")
     assert full in (tmp_path / "t.txt").read_text(encoding="utf-8")
+
+
+def test_a_100hz_stream_updates_the_visible_table_at_most_at_the_flush_rate(
+    qtbot: Any, panel: TrafficPanel
+) -> None:
+    from PySide6.QtCore import QTimer
+
+    from ui.panels.traffic_panel import FLUSH_INTERVAL_MS
+
+    panel.show()
+    qtbot.waitExposed(panel)
+    inserts: list[float] = []
+    panel.model.rowsInserted.connect(lambda *_: inserts.append(time.monotonic()))
+    wire = Wire()
+    fed = [0]
+
+    def poll() -> None:
+        panel.on_traffic(wire.poll_pose() + wire.poll_status())
+        fed[0] += 1
+
+    timer = QTimer()
+    timer.setInterval(10)  # 100 Hz, one batch per poll as the worker sends it
+    timer.timeout.connect(poll)
+    t0 = time.monotonic()
+    timer.start()
+    try:
+        qtbot.waitUntil(lambda: fed[0] >= 40 and len(inserts) >= 2, timeout=10_000)
+    finally:
+        timer.stop()
+    elapsed_ms = 1000.0 * (time.monotonic() - t0)
+    # a coarse timer may fire 5 % early: each insert is >= 0.95 x the interval after the last
+    assert len(inserts) <= elapsed_ms / (0.95 * FLUSH_INTERVAL_MS) + 1
+    assert len(inserts) < fed[0]  # batched, not one insert per poll
+    panel.flush()
+    assert panel.model.rowCount() == 4 * fed[0]  # nothing lost

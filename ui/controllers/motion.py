@@ -6,16 +6,27 @@ decides when motion controls are enabled (the link connected and writable, from
 ``link.state``, and no plan running: Stop, Pause and Resume stay while a plan runs) and it is
 the dead-man's second hand: any jog ends when the link leaves CONNECTED, when a plan starts
 and before a mode change.
+
+Alarm hold: while the controller reports an emergency stop or a servo alarm
+(:data:`app.alarm_history.BLOCKING_ALARMS`) the jog, step and program panels and Resume are
+disabled, any jog is released, and a jog / step / program intent that still arrives is dropped
+(never written). Stop stays enabled whatever happens. ``alarmHoldChanged(bool)`` tells the other
+panels that start motion (points' move-to, the planner's run).
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 from PySide6.QtCore import QObject, Signal, Slot
 
+from app.alarm_history import blocks_motion
+from app.link.client import StepFrame
 from app.link.robot_link import LinkPort
 from app.link.types import ConnectionState, JogRequest
 from app.protocol.enums import ProgramMotionMode, WorkMode
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.safety import SafetyController
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
 from ui.panels.program_panel import ProgramPanel, ProgramRequest
@@ -29,6 +40,7 @@ class MotionController(QObject):
     Resume may go out); the jog / step / program panels are also held while a plan runs."""
 
     motionEnabledChanged = Signal(bool)
+    alarmHoldChanged = Signal(bool)
 
     def __init__(self, link: LinkPort, control_bar: ControlBar, jog: JogPanel, step: StepPanel,
                  program: ProgramPanel, run_controller: PlanRunController,
@@ -41,6 +53,8 @@ class MotionController(QObject):
         self._program = program
         self._run_active = False
         self._enabled = link.state.writable
+        self._alarm_hold = blocks_motion(link.state.alarms)
+        self.safety: SafetyController | None = None  # the guard rails (set by install_safety)
 
         control_bar.stopRequested.connect(link.stop)
         control_bar.pauseRequested.connect(link.pause)
@@ -48,11 +62,12 @@ class MotionController(QObject):
         control_bar.modeRequested.connect(self._on_mode_requested)
         jog.jogPressed.connect(self._on_jog_pressed)
         jog.jogReleased.connect(link.jog_release)
-        jog.ratioChanged.connect(link.set_jog_ratio)
+        jog.ratioChanged.connect(self._on_ratio_changed)
         step.stepRequested.connect(self._on_step_requested)
         program.programRequested.connect(self._on_program_requested)
-        program.goZeroRequested.connect(link.go_zero)
+        program.goZeroRequested.connect(self._on_go_zero)
         link.state.connectionChanged.connect(self._on_connection)
+        link.state.alarmsChanged.connect(self._on_alarms)
         run_controller.runningChanged.connect(self._on_run_active)
         self._apply()
 
@@ -63,6 +78,22 @@ class MotionController(QObject):
     @property
     def run_active(self) -> bool:
         return self._run_active
+
+    @property
+    def alarm_hold(self) -> bool:
+        """An emergency stop or servo alarm is set: motion controls are held (Stop is not)."""
+        return self._alarm_hold
+
+    @Slot(int)
+    def _on_alarms(self, alarms: int) -> None:
+        hold = blocks_motion(alarms)
+        if hold == self._alarm_hold:
+            return
+        self._alarm_hold = hold
+        if hold:
+            self._jog.release_all()
+        self._apply()
+        self.alarmHoldChanged.emit(hold)
 
     @Slot(ConnectionState)
     def _on_connection(self, connection: ConnectionState) -> None:
@@ -79,28 +110,58 @@ class MotionController(QObject):
 
     def _apply(self) -> None:
         enabled = self._link.state.writable
-        panels_enabled = enabled and not self._run_active
+        panels_enabled = enabled and not self._run_active and not self._alarm_hold
         self._jog.set_motion_enabled(panels_enabled)
         self._step.set_motion_enabled(panels_enabled)
         self._program.set_motion_enabled(panels_enabled)
         self._bar.set_motion_enabled(enabled)
+        self._bar.set_alarm_hold(self._alarm_hold)
         if enabled != self._enabled:
             self._enabled = enabled
             self.motionEnabledChanged.emit(enabled)
 
     @Slot(object)
     def _on_jog_pressed(self, request: JogRequest) -> None:
+        if self._alarm_hold:
+            return  # the panel is disabled; an intent already queued is dropped, not written
+        safety = self.safety
+        if safety is not None:  # the envelope: the ratio capped, a jog over a boundary refused
+            request = dataclasses.replace(request, ratio=safety.jog_ratio(request.ratio))
+            refused = safety.check_jog(self._link.state.pose, request)
+            if refused:
+                safety.message.emit(refused)
+                return
         self._link.jog_press(request.frame, request.axis, request.direction, request.ratio,
                              request.user, request.tool)
 
+    @Slot(float)
+    def _on_ratio_changed(self, ratio: float) -> None:
+        self._link.set_jog_ratio(self.safety.jog_ratio(ratio) if self.safety is not None else ratio)
+
     @Slot(object)
     def _on_step_requested(self, request: StepRequest) -> None:
+        if self._alarm_hold:
+            return
+        safety, pose = self.safety, self._link.state.pose
+        if safety is not None and pose is not None:
+            refused = safety.check_step(pose, list(request.offsets), joint=request.frame is StepFrame.JOINT,
+                                        speed=request.speed)
+            if refused:
+                safety.message.emit(refused)
+                return
         self._link.step(request.frame, request.offsets, request.ext_offsets, request.speed)
 
     @Slot(object)
     def _on_program_requested(self, request: ProgramRequest) -> None:
+        if self._alarm_hold:
+            return
         self._link.run_program(request.program_id, ProgramMotionMode(request.mode), request.cycles,
                                request.speed_ratio)
+
+    @Slot(object)
+    def _on_go_zero(self, axis: int | None) -> None:
+        if not self._alarm_hold:
+            self._link.go_zero(axis)
 
     @Slot(object)
     def _on_mode_requested(self, mode: WorkMode) -> None:

@@ -149,11 +149,11 @@ class SafetyController(QObject):
     def _apply(self, target: QAction | QWidget, action: Action) -> None:
         why = self.reason(action)
         target.setEnabled(why is None)
-        base = target.property("safetyTip")
-        if base is None:
-            base = target.toolTip() if why is None else ""
-            target.setProperty("safetyTip", base)
-        target.setToolTip(why if why is not None else str(base))
+        shown = target.property("safetyReason")
+        if shown is None or target.toolTip() != shown:  # the tooltip is the control's own (retranslated)
+            target.setProperty("safetyTip", target.toolTip())
+        target.setProperty("safetyReason", why)
+        target.setToolTip(why if why is not None else str(target.property("safetyTip") or ""))
 
     def refresh(self) -> None:
         for target, action in self._gated:

@@ -12,7 +12,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QEvent, QObject, Slot
+from PySide6.QtCore import QEvent, QObject, QTimer, Slot
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QFileDialog, QLabel, QMenu, QMessageBox
 
@@ -88,8 +88,11 @@ class SafetyMenu(QObject):
         self.envelope_action.setText(self.tr("Safety &envelope…"))
         self.audit_action.setText(self.tr("&Audit trail…"))
         self.bundle_action.setText(self.tr("Write a &support bundle…"))
-        for target in (self.envelope_action,):
-            target.setProperty("safetyTip", None)
+        QTimer.singleShot(0, self._refresh)  # after the window's own retranslate (it sets tooltips)
+        self._update()
+
+    @Slot()
+    def _refresh(self) -> None:
         self.safety.refresh()
         self._update()
 

@@ -2,8 +2,15 @@
 
 Poll rate and paint rate are separate clocks: ``on_pose`` (called at the poll rate, 50–200 Hz)
 only stores the sample in preallocated ring buffers; a QTimer at ≤ 30 Hz, running only while the
-panel is visible, updates the readouts and hands contiguous buffer views to the curves, and does
-nothing when no sample arrived since the last paint.
+panel is visible, updates the readouts and hands contiguous buffer views to the curves.
+
+Plots keep time: the pose only changes (and ``poseChanged`` only fires) while the arm moves, so
+each display tick also appends the last pose at the current time while the values are fresh,
+and the time axis ends at "now": it scrolls at a steady rate when the arm is still, and a
+silent link leaves a visible gap instead of a flat line that looks live. Hidden, the timer stops
+and nothing is appended or painted. Stale values (``RobotState.fresh`` False) grey the readouts.
+The top view fits its trace (at least ``TRACE_MIN_SPAN_MM`` wide, so a standing arm's single
+point still gets readable axis labels).
 """
 
 from __future__ import annotations
@@ -31,6 +38,7 @@ from PySide6.QtWidgets import (
 from app.link.state import RobotState
 from app.models import Pose
 from ui.models.ring_buffer import RingBuffer
+from ui.panels.monitor_plots import add_legend, style_plot, unwrap_degrees
 from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
 
 PAINT_HZ = 30
@@ -64,48 +72,8 @@ _SMALL_POINTS_MAX = 18.0
 REFERENCE_WIDTH = 760  # px of panel width at which the readouts use _BIG_POINTS / _SMALL_POINTS
 MIN_SCALE = 0.55  # readouts shrink down to this on a narrow panel (then the panel's minimum width)
 MIN_WIDTH = 420  # px: the panel's minimum width (the readouts' fonts shrink to fit)
-
-
-def unwrap_degrees(previous_raw: float, previous_unwrapped: float, raw: float) -> float:
-    """Continue an unwrapped angle: the step from ``previous_raw`` to ``raw`` taken the short way
-    round (so -179 -> +179 is a 2 degree step, not 358), added to ``previous_unwrapped``."""
-    step = (raw - previous_raw + 180.0) % 360.0 - 180.0
-    return previous_unwrapped + step
-
-
-def _add_legend(plot: pg.PlotWidget) -> None:
-    """A compact one-row legend in the top-right corner, translucent so the curves show through."""
-    plot.addLegend(
-        offset=(-4, 2),  # negative x: anchored to the right edge
-        colCount=3,
-        labelTextColor="#263238",
-        brush=pg.mkBrush(255, 255, 255, 150),
-        pen=pg.mkPen(176, 190, 197, 160),
-        verSpacing=-6,
-        horSpacing=8,
-    )
-
-
-GRID_COLOR = "#dde3e6"
-
-
-def _style_plot(plot: pg.PlotWidget) -> None:
-    plot.setBackground("w")
-    item = plot.getPlotItem()
-    item.showGrid(x=True, y=True)
-    for name in ("left", "bottom"):
-        axis = item.getAxis(name)
-        # an opaque light grid: a translucent one (alpha < 1) is blended on every repaint and
-        # cost ~3x the paint time of the three plots at 30 Hz (benchmarks/gui.py)
-        axis.setTickPen(pg.mkPen(GRID_COLOR))
-        axis.setStyle(tickAlpha=255, maxTickLevel=1)  # major and minor lines only
-        axis.setZValue(-100)  # grid behind the curves
-        axis.enableAutoSIPrefix(False)  # "1500 mm", never "1.5 kmm"
-        axis.setPen(pg.mkPen("#455a64"))
-        axis.setTextPen(pg.mkPen("#263238"))
-    plot.setMenuEnabled(False)
-    plot.setMinimumHeight(90)
-    plot.setMinimumWidth(120)
+TRACE_MIN_SPAN_MM = 50.0  # the top view never zooms in closer than this (readable labels)
+TRACE_PADDING = 0.08  # fraction of the span around the trace
 
 
 class MonitorPanel(QWidget):
@@ -125,6 +93,10 @@ class MonitorPanel(QWidget):
         self._trace = RingBuffer(trace_capacity, 2)
         self._t0: float | None = None
         self._latest: Pose | None = None
+        self._latest_row: tuple[float, ...] | None = None  # the last history row appended
+        self._held_time = False  # the last sample came with an explicit time: no hold samples
+        self._fresh = True  # unbound: every pose is taken as live
+        self._now = time.monotonic  # the display clock (tests may replace it)
         self._readouts_dirty = False
         self._painted_history = -1  # RingBuffer.total at the last paint (-1: force)
         self._painted_trace = -1
@@ -137,7 +109,7 @@ class MonitorPanel(QWidget):
 
         self._timer = QTimer(self)
         self._timer.setInterval(PAINT_INTERVAL_MS)
-        self._timer.timeout.connect(self.refresh)
+        self._timer.timeout.connect(self._tick)
 
         self._build_ui()
 
@@ -208,19 +180,21 @@ class MonitorPanel(QWidget):
         self.abc_plot = pg.PlotWidget(self)
         self.trace_plot = pg.PlotWidget(self)
         for plot in (self.xyz_plot, self.abc_plot, self.trace_plot):
-            _style_plot(plot)
+            style_plot(plot)
         self.abc_plot.setXLink(self.xyz_plot)
         self.xyz_plot.getPlotItem().hideAxis("bottom")
         self.curves: dict[str, pg.PlotCurveItem] = {}
         for name in _CARTESIAN:
             plot = self.xyz_plot if name in "XYZ" else self.abc_plot
             if name in ("X", "A"):
-                _add_legend(plot)
+                add_legend(plot)
             curve = pg.PlotCurveItem(pen=pg.mkPen(_PLOT_COLORS[name], width=2), name=name)
             plot.addItem(curve)
             self.curves[name] = curve
 
         self.trace_plot.setAspectLocked(True)
+        # room on the right for the last bottom tick label (else clipped at the plot's edge)
+        self.trace_plot.getPlotItem().layout.setContentsMargins(2, 2, 16, 2)
         self.trace_curve = pg.PlotCurveItem(pen=pg.mkPen(_TRACE_COLOR, width=2))
         self.trace_plot.addItem(self.trace_curve)
         self.trace_marker = pg.ScatterPlotItem(size=11, brush=pg.mkBrush("#ff6f00"), pen=pg.mkPen("#263238"))
@@ -270,7 +244,7 @@ class MonitorPanel(QWidget):
         self.xyz_plot.setLabel("left", self.tr("position"), units=mm)
         self.abc_plot.setLabel("left", self.tr("orientation"), units=deg)
         self.abc_plot.setLabel("bottom", self.tr("time"), units=self.tr("s"))
-        self.trace_plot.setTitle(self.tr("TCP path, top view (X–Y)"), color="#263238", size="10pt")
+        self.trace_plot.setTitle(self.tr("Top view (X–Y)"), color="#263238", size="10pt")
         self.trace_plot.setLabel("bottom", "X", units=mm)
         self.trace_plot.setLabel("left", "Y", units=mm)
         self._update_status_text()
@@ -282,8 +256,23 @@ class MonitorPanel(QWidget):
 
     # --- slots ------------------------------------------------------------------------
     def bind(self, state: RobotState) -> None:
-        """Record ``state``'s poses from now on."""
+        """Record ``state``'s poses from now on; grey the readouts while they are stale."""
         state.poseChanged.connect(self.on_pose)
+        state.freshnessChanged.connect(self.on_freshness)
+        self.on_freshness(state.fresh)
+
+    @Slot(bool)
+    def on_freshness(self, fresh: bool) -> None:
+        self._fresh = bool(fresh)
+        tip = "" if fresh else self.tr("Stale: not confirmed by the controller within the freshness limit")
+        for readout in self.readouts.values():
+            readout.setEnabled(self._fresh)
+            readout.setToolTip(tip)
+        self._update_status_text()
+
+    @property
+    def fresh(self) -> bool:
+        return self._fresh
 
     @Slot(object)
     def on_pose(self, pose: Pose, t: float | None = None) -> None:
@@ -292,8 +281,9 @@ class MonitorPanel(QWidget):
         self._readouts_dirty = True
         if not all(map(math.isfinite, pose.xyzabc)):
             return  # shown as "—"; kept out of the plots (skipFiniteCheck trusts the data)
+        self._held_time = t is not None
         if t is None:
-            t = time.monotonic()
+            t = self._now()
         if self._t0 is None:
             self._t0 = t
         rel = t - self._t0
@@ -304,7 +294,9 @@ class MonitorPanel(QWidget):
             unwrapped = [unwrap_degrees(p, u, r)
                          for p, u, r in zip(self._angle_raw, self._angle_unwrapped, raw, strict=True)]
         self._angle_raw, self._angle_unwrapped = raw, unwrapped
-        self._history.append((rel, pose.x, pose.y, pose.z, *unwrapped))
+        row = (rel, pose.x, pose.y, pose.z, *unwrapped)
+        self._history.append(row)
+        self._latest_row = row
         trace = self._trace
         if (
             not len(trace)
@@ -325,6 +317,7 @@ class MonitorPanel(QWidget):
         self._angle_raw = None
         self._t0 = None
         self._latest = None
+        self._latest_row = None
         self._readouts_dirty = True
         self._painted_history = -1
         self._painted_trace = -1
@@ -374,6 +367,17 @@ class MonitorPanel(QWidget):
 
     # --- painting ---------------------------------------------------------------------
     @Slot()
+    def _tick(self) -> None:
+        """The display clock: hold the last fresh pose at "now", then paint."""
+        row = self._latest_row
+        if row is not None and self._t0 is not None and self._fresh and not self._held_time:
+            rel = self._now() - self._t0
+            if rel > row[0]:
+                self._history.append((rel, *row[1:]))
+                self._latest_row = (rel, *row[1:])
+        self.refresh()
+
+    @Slot()
     def refresh(self) -> None:
         """One paint tick: readouts, then plots if new samples arrived (called by the timer)."""
         if self._readouts_dirty:
@@ -381,7 +385,7 @@ class MonitorPanel(QWidget):
             self._paint_readouts()
         if self._paused:
             return
-        if self._history.total != self._painted_history:
+        if self._history.total != self._painted_history or (self._t0 is not None and not self._held_time):
             self._painted_history = self._history.total
             self._paint_history()
         if self._trace.total != self._painted_trace:
@@ -420,6 +424,8 @@ class MonitorPanel(QWidget):
             return
         t = history.view(_T, n)
         t_end = float(t[-1])
+        if self._t0 is not None and not self._held_time:
+            t_end = max(t_end, self._now() - self._t0)  # the axis ends at "now", also when stale
         start = int(np.searchsorted(t, t_end - self._window_s, side="left"))
         count = n - start
         step = max(1, -(-count // MAX_PLOT_POINTS))
@@ -439,11 +445,25 @@ class MonitorPanel(QWidget):
         xs, ys = trace.view(0, n), trace.view(1, n)
         self.trace_curve.setData(xs, ys, skipFiniteCheck=True)
         self.trace_marker.setData([float(xs[-1])], [float(ys[-1])])
+        self._fit_trace(float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
+
+    def _fit_trace(self, x0: float, x1: float, y0: float, y1: float) -> None:
+        """Show the whole trace, at least TRACE_MIN_SPAN_MM wide and tall, centred."""
+        half = max(x1 - x0, y1 - y0, TRACE_MIN_SPAN_MM) / 2.0
+        cx, cy = (x0 + x1) / 2.0, (y0 + y1) / 2.0
+        view = self.trace_plot.getPlotItem().getViewBox()
+        view.setRange(xRange=(cx - half, cx + half), yRange=(cy - half, cy + half), padding=TRACE_PADDING)
+
+    def trace_view_range(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        (x0, x1), (y0, y1) = self.trace_plot.getPlotItem().getViewBox().viewRange()
+        return (x0, x1), (y0, y1)
 
     def _update_status_text(self) -> None:
         text = self.tr("Plots: last {n} s").format(n=f"{self._window_s:g}")
         if self._paused:
             text += " — " + self.tr("paused")
+        if not self._fresh:
+            text += " — " + self.tr("values stale (grey): no fresh data from the controller")
         self._status.setText(text)
 
     @Slot(int)

@@ -69,6 +69,9 @@ def _style_plot(plot: pg.PlotWidget) -> None:
         axis.enableAutoSIPrefix(False)
         axis.setPen(pg.mkPen(COLOR_AXIS))
         axis.setTextPen(pg.mkPen(COLOR_INK))
+    # a fixed left axis: an auto-sized one changes the view's width with its tick labels, and an
+    # aspect-locked view then changes its range, hence its labels: an endless relayout when narrow
+    item.getAxis("left").setWidth(44)
     plot.setMenuEnabled(False)
     plot.setAspectLocked(True)
     plot.getViewBox().setDefaultPadding(0.12)  # room for the point labels at the edges

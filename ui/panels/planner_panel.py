@@ -102,6 +102,7 @@ class PlannerPanel(QWidget):
         self._issues: list[PlanIssue] = []
         self._summary_text = ""
         self._pose_known = False
+        self._alarm_hold = False
 
         self.segments = SegmentTableModel(plans.undo_stack, points.ledger, self)
         self.run_flow = PlanRunFlow(self, self._runner, point_sync, points, self)
@@ -417,9 +418,9 @@ class PlannerPanel(QWidget):
             if k is not None and self.current_plan() is run_plan:
                 self.select_segments([k])
             level = "error" if outcome.state is RunState.FAILED else "warn"
-            label = self.tr("Failed") if outcome.state is RunState.FAILED else self.tr("Stopped")
-            self.run_box.show_ended(f"{label}: {outcome.message}")
-            self.show_message(f"{label}: {outcome.message}", level)
+            text = self._runner.outcome_text(outcome)
+            self.run_box.show_ended(text)
+            self.show_message(text, level)
         self._update_resume_text()
         self._update_actions()
 
@@ -496,6 +497,11 @@ class PlannerPanel(QWidget):
             self._set_info(plan, estimate_plan(plan, self._points.ledger, start), assumed)
         self._update_actions()
 
+    def set_alarm_hold(self, hold: bool) -> None:
+        """An emergency stop or servo alarm is set (MotionController.alarmHoldChanged)."""
+        self._alarm_hold = bool(hold)
+        self._update_actions()
+
     @Slot()
     def _update_actions(self, *_args: Any) -> None:
         r = self._runner
@@ -511,5 +517,8 @@ class PlannerPanel(QWidget):
             uploading=sync is not None and sync.operation == "upload",
             check_errors=len(errors), first_error=errors[0] if errors else ""))
         self.actions.apply(states)
+        if self._alarm_hold:  # an e-stop / servo alarm: nothing that starts motion (Stop, Pause stay)
+            for name in ("run", "run_from", "step", "resume", "resume_from"):
+                self.actions.all[name].setEnabled(False)
         self.upload_button.setEnabled(self.action_upload_now.isEnabled())
         self.resume_from_button.setVisible(states.resume_from_visible)

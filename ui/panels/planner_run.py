@@ -13,7 +13,7 @@ from typing import Protocol
 
 from PySide6.QtCore import QObject
 
-from app.errors import TeachPadError
+from app.errors import InvalidInput, TeachPadError
 from app.plan.checks import PlanIssue, PlanLimits, check_plan, ids_needing_upload
 from app.plan.presenter import RunBlock, RunKind, run_gate, run_kind
 from app.plan.runner import RunOutcome, RunState
@@ -22,6 +22,7 @@ from app.points.ledger import UploadReport
 from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
+from ui.messages import error_text
 from ui.models.points_model import PointsModel
 
 MAX_POINTS_LISTED = 20  # point ids quoted in the upload question
@@ -147,7 +148,13 @@ class PlanRunFlow(QObject):
                 self.run_plan = plan
                 self._run_revision = plan.revision
                 self._runner.start(plan, start=start, start_loop=loop, single=single)
-        except (TeachPadError, RuntimeError) as exc:
+        except InvalidInput as exc:  # a bad start segment: its own English words are the detail
+            self._view.show_message(str(exc), "error")
+            return False
+        except TeachPadError as exc:  # no link, monitor-only...: in the operator's language
+            self._view.show_message(error_text(exc), "error")
+            return False
+        except RuntimeError as exc:
             self._view.show_message(str(exc), "error")
             return False
         return True

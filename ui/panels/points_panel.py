@@ -68,6 +68,7 @@ class PointsPanel(QWidget):
         self._controller = controller or PointSyncController(model, parent=self)
         self._confirm = confirm or ask_confirmation(self)
         self._run_active = False
+        self._alarm_hold = False  # an e-stop / servo alarm: no move-to (MotionController.alarmHoldChanged)
         self._edit_reason: str | None = None  # why the role may not edit points (None: it may)
         self.move_check: Callable[[int, float], str | None] | None = None  # the envelope: why not (None: go)
 
@@ -349,6 +350,11 @@ class PointsPanel(QWidget):
         self._run_active = active
         self._update_actions()
 
+    def set_alarm_hold(self, hold: bool) -> None:
+        """An emergency stop or servo alarm is set: no move-to (teach and upload move nothing)."""
+        self._alarm_hold = bool(hold)
+        self._update_actions()
+
     @Slot(str, str)
     def show_message(self, text: str, level: str = LEVEL_INFO) -> None:
         colour = {LEVEL_ERROR: COLOR_ERROR, LEVEL_WARN: "#8a5300", LEVEL_INFO: COLOR_OK}.get(level, "")
@@ -427,6 +433,8 @@ class PointsPanel(QWidget):
 
     @Slot()
     def move_to_selected(self) -> None:
+        if self._alarm_hold:
+            return  # the action is disabled; a call that still arrives moves nothing
         rows = self.selected_rows()
         if len(rows) != 1:
             self.show_message(self.tr("Select one point to move to"), LEVEL_WARN)
@@ -518,7 +526,7 @@ class PointsPanel(QWidget):
         self.restore_button.setEnabled(link_ok and has_points)
         self.action_cancel_upload.setEnabled(c.operation == "upload")
         self.cancel_button.setEnabled(c.operation == "upload")
-        self.action_move_to.setEnabled(link_ok and len(rows) == 1)
+        self.action_move_to.setEnabled(link_ok and len(rows) == 1 and not self._alarm_hold)
         self.upload_button.setEnabled(link_ok and has_points)
         edits = (self.action_add, self.action_duplicate, self.action_delete, self.action_move_up,
                  self.action_move_down)

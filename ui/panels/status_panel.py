@@ -4,6 +4,12 @@ result and the controller clock with its drift from the PC clock.
 ``bind(state)`` subscribes the panel to a :class:`~app.link.state.RobotState` (connection,
 status, alarms, RTT, last command result); the ``on_*`` slots take the payloads directly. The
 panel keeps no controller state of its own beyond what is needed to draw it.
+
+Staleness: while ``state.fresh`` is False (no good poll within the freshness limit, or the link
+not CONNECTED) the mode and program lamps read "unknown" in grey, the clock and drift turn grey
+and italic and the drift is marked "(stale)": nothing here looks live that isn't. The alarm
+lamps keep the last known bits (an alarm is never hidden by a silent link) under a "last known"
+title.
 """
 
 from __future__ import annotations
@@ -40,6 +46,8 @@ from app.protocol.enums import (
     ProgramState,
 )
 from app.protocol.registers import GV_DATE
+from ui import messages
+from ui.messages import result_level, result_text
 from ui.widgets_common import (
     COLOR_ERROR,
     COLOR_NEUTRAL,
@@ -52,7 +60,6 @@ from ui.widgets_common import (
     LEVEL_WARN,
     AlarmLamp,
     Lamp,
-    command_result_text,
     connection_display,
     monospace_font,
 )
@@ -106,6 +113,7 @@ class StatusPanel(QWidget):
         self._result: CommandResult | None = None
         self._clock: ControllerClock | None = None
         self._drift: float | None = None
+        self._fresh = True  # unbound: every payload shown is taken as live
         self._build_ui()
         self.retranslate()
 
@@ -218,7 +226,7 @@ class StatusPanel(QWidget):
         """(Re)set every user-visible text: at construction and on a language change."""
         self._link_box.setTitle(self.tr("Link"))
         self._ctrl_box.setTitle(self.tr("Controller"))
-        self._alarm_box.setTitle(self.tr("Alarms"))
+        self._alarm_box.setTitle(self.tr("Alarms") if self._fresh else self.tr("Alarms (last known)"))
         rows = self._row_labels
         rows["state"].setText(self.tr("State:"))
         rows["rtt"].setText(self.tr("RTT:"))
@@ -239,8 +247,7 @@ class StatusPanel(QWidget):
         else:
             self._render_connection()
         self._render_rtt()
-        if self._status is not None:
-            self._render_status()
+        self._render_status()
         self._render_alarms()
         if self._result is None:
             self.command_label.setText(self.tr("none yet"))
@@ -262,6 +269,8 @@ class StatusPanel(QWidget):
         state.alarmsChanged.connect(self.on_alarms)
         state.rttChanged.connect(self.on_rtt)
         state.lastResultChanged.connect(self.on_command_result)
+        state.freshnessChanged.connect(self.on_freshness)
+        self._fresh = state.fresh
         self.on_connection(state.connection)
         if state.status is not None:
             self.on_status(state.status)
@@ -278,6 +287,21 @@ class StatusPanel(QWidget):
         self.on_alarms(int(status.alarms))
         if status.clock is not None:
             self.on_clock(status.clock)
+
+    @Slot(bool)
+    def on_freshness(self, fresh: bool) -> None:
+        """Grey out (or bring back) what only a fresh poll can confirm."""
+        if fresh == self._fresh:
+            return
+        self._fresh = fresh
+        self._alarm_box.setTitle(self.tr("Alarms") if fresh else self.tr("Alarms (last known)"))
+        self._render_status()
+        if self._clock is not None:
+            self._render_clock()
+
+    @property
+    def fresh(self) -> bool:
+        return self._fresh
 
     @Slot(int)
     def on_alarms(self, alarms: int) -> None:
@@ -317,7 +341,11 @@ class StatusPanel(QWidget):
     # --- drawing ----------------------------------------------------------------------
     def _render_status(self) -> None:
         status = self._status
-        assert status is not None
+        if status is None or not self._fresh:
+            for lamp in (self.mode_label, self.program_label):
+                lamp.setText("—" if status is None else self.tr("unknown"))
+                lamp.set_level(LEVEL_OFF)
+            return
         mode, text = _enum_text(ControllerMode, CONTROLLER_MODE_TEXT, int(status.mode))
         self.mode_label.setText(text)
         self.mode_label.set_level(_MODE_LEVEL.get(mode, LEVEL_ERROR))
@@ -358,9 +386,11 @@ class StatusPanel(QWidget):
     def _render_result(self) -> None:
         result = self._result
         assert result is not None
-        self.command_label.setText(command_result_text(result))
+        self.command_label.setText(result_text(result))  # one sentence, the operator's language
         self.command_label.setProperty("ok", bool(result.ok))
-        color = COLOR_OK if result.ok else COLOR_ERROR
+        level = result_level(result)  # the operator's own stop is not a failure
+        color = {messages.LEVEL_INFO: COLOR_OK if result.ok else COLOR_NEUTRAL,
+                 messages.LEVEL_WARNING: COLOR_WARN}.get(level, COLOR_ERROR)
         self.command_label.setStyleSheet(f"color: {color}; font-weight: bold;")
         tip = []
         if result.status is not None:
@@ -385,9 +415,17 @@ class StatusPanel(QWidget):
             self.drift_label.setText("—")
             self.drift_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
             return
-        self.clock_label.setText(clock.value.strftime("%Y-%m-%d %H:%M:%S"))
+        stamp = clock.value.strftime("%Y-%m-%d %H:%M:%S")
+        drift_text = self.tr("{drift} s").format(drift=f"{drift:+.0f}")
+        self.drift_label.setText(drift_text)
+        if not self._fresh:  # the last reading, no longer ticking: grey, italic, marked stale
+            self.clock_label.setText(stamp)
+            self.drift_label.setText(self.tr("{value} (stale)").format(value=drift_text))
+            self.clock_label.setStyleSheet(f"color: {COLOR_NEUTRAL}; font-style: italic;")
+            self.drift_label.setStyleSheet(f"color: {COLOR_NEUTRAL}; font-style: italic;")
+            return
+        self.clock_label.setText(stamp)
         self.clock_label.setStyleSheet("")
-        self.drift_label.setText(self.tr("{drift} s").format(drift=f"{drift:+.0f}"))
         if abs(drift) > CLOCK_DRIFT_ERROR_S:
             color = COLOR_ERROR
         elif abs(drift) > CLOCK_DRIFT_WARN_S:
