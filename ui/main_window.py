@@ -49,10 +49,12 @@ from app import __version__
 from app.link.client import ConnectionSettings
 from app.link.robot_link import RobotLink
 from app.link.types import ConnectionState, LinkState, WorkerError
+from app.safety.roles import Action
 from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController, ProjectDialogs
+from ui.controllers.safety_menu import install_safety
 from ui.dialogs.confirm import ConfirmFn
 from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import Translator
@@ -208,6 +210,8 @@ class MainWindow(QMainWindow):
         mark_motion(bar.stop_button, bar.pause_button, bar.resume_button)
         self.set_touch_mode(settings.touch_mode)
         self.view3d = install_view3d(self)  # the 3D tab (and its dock beside the planner)
+        self.safety_menu = install_safety(self)  # roles, envelope, audit trail (the Safety menu)
+        self.motion.safety = self.safety_menu.safety
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*self._default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])
@@ -431,9 +435,12 @@ class MainWindow(QMainWindow):
     @Slot()
     def open_connection_dialog(self) -> None:
         self.jog_panel.release_all()
+        if not self.safety_menu.safety.allowed(Action.CONNECTION):  # the administrator's (audited)
+            return
         dialog = ConnectionDialog.for_link(self.link, self.settings.connection(), self.settings.poll_hz, self)
         if dialog.exec() == ConnectionDialog.DialogCode.Accepted:
             self.connect_with(dialog.settings())
+            self.safety_menu.safety.set_poll_rate(self.settings.poll_hz)
 
     def connect_with(self, settings: ConnectionSettings) -> None:
         """Remember ``settings`` and connect (the link retries by itself until it succeeds)."""

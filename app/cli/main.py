@@ -73,6 +73,7 @@ from app.protocol.enums import (
     WorkMode,
     alarm_names,
 )
+from app.safety.audit import AuditLog
 
 PROG = "teachpad-cli"
 
@@ -108,6 +109,8 @@ class CliContext:
     def client(self) -> RobotClient:
         if self._client is None:
             client = RobotClient(self.settings)
+            # The CLI is an administrator's tool; its writes go to the same audit trail as the GUI's.
+            client.audit = AuditLog(role="administrator (cli)", word_order=self.settings.word_order)
             self._client = client
             client.connect()
         return self._client

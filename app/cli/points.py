@@ -175,6 +175,8 @@ def register(subparsers: Any) -> None:
                         "points (the arrival pose is still checked after each segment)")
     r.add_argument("--upload", action="store_true", help=argparse.SUPPRESS)  # the default now (old scripts)
     r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
+    r.add_argument("--safety", metavar="PROFILE",
+                   help="a safety profile (.safety.json): the plan must stay in its envelope")
     r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
                    help="highest speed a segment may have (default %(default)g mm/s)")
     from app.cli.run_plan import cmd_run  # imported here: run_plan uses this module's helpers

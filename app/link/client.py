@@ -88,6 +88,7 @@ from app.protocol.enums import (
     decode_command_status,
     decode_status_registers,
 )
+from app.safety.audit import AuditLog
 
 __all__ = [
     "ConnectionSettings",
@@ -143,6 +144,7 @@ class RobotClient:
         # changed may be confirmed by arriving there, see CommandTracker's ``target``)
         self._sent_points: dict[int, tuple[float, float, float]] = {}
         self._ack_latency = 0.0  # s, decaying maximum of the acknowledgement times seen
+        self.audit: AuditLog | None = None  # every write (and monitor-only block) is recorded here
 
     # -- connection (the transport drops the caches whenever the link is made or lost) ---
     def connect(self) -> None:
@@ -202,23 +204,27 @@ class RobotClient:
 
     def _write(self, address: int, values: Sequence[int], *, single: bool = False,
                timeout: float | None = None) -> None:
-        """The write guard: every write to the controller passes here. ``timeout`` (s per attempt)
-        overrides the request timeout (default: :meth:`io_timeout`'s, else the settings')."""
+        """The write guard: every write to the controller passes here (and, with an audit trail,
+        is recorded there once, blocked ones too). ``timeout`` (s per attempt) overrides the
+        request timeout (default: :meth:`io_timeout`'s, else the settings')."""
         timeout = self._io_timeout if timeout is None else timeout
-        name = _range_name(address, len(values))
-        self._require_writable(f"write to {name}")
-        if not values:
-            raise InvalidInput("nothing to write")
-        if single:
-            if len(values) != 1:
-                raise InvalidInput("a single-register write takes one value")
-            _log.debug("write 0x06 %s <- %d", name, values[0])
-            self.write_count += 1
-            self._transport.write_single(f"write to {name}", address, int(values[0]), timeout)
-        else:
-            _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
-            self.write_count += 1
-            self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values], timeout)
+        ctx = self.audit.writing(address, values, single=single) if self.audit else contextlib.nullcontext()
+        with ctx:
+            name = _range_name(address, len(values))
+            self._require_writable(f"write to {name}")
+            if not values:
+                raise InvalidInput("nothing to write")
+            if single:
+                if len(values) != 1:
+                    raise InvalidInput("a single-register write takes one value")
+                _log.debug("write 0x06 %s <- %d", name, values[0])
+                self.write_count += 1
+                self._transport.write_single(f"write to {name}", address, int(values[0]), timeout)
+            else:
+                _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
+                self.write_count += 1
+                self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values],
+                                               timeout)
 
     def _write_floats(self, gv: int, values: Sequence[float], timeout: float | None = None) -> None:
         self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order), timeout=timeout)

@@ -22,6 +22,8 @@ if TYPE_CHECKING:
     from app.link.stats import LinkStats
     from app.link.supervisor import LinkSupervisor
     from app.link.upload import Uploader
+    from app.safety.audit import AuditLog
+    from app.safety.envelope import EnvelopeViolation
 
 __all__ = ["WorkerHost", "WorkerOutputs"]
 
@@ -43,6 +45,8 @@ class WorkerOutputs(Protocol):
     def publish_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
         """``unconfirmed``: ok, but the controller's status never changed (observe rule)."""
 
+    def publish_guard_stop(self, violation: EnvelopeViolation) -> None: ...
+
 
 class WorkerHost(WorkerOutputs, Protocol):
     """The worker as its parts use it (worker thread only)."""
@@ -54,6 +58,7 @@ class WorkerHost(WorkerOutputs, Protocol):
     uploader: Uploader
     capture: TrafficCapture
     closed: bool
+    audit: AuditLog | None  # given to each new client (thread-safe)
     request_id: int | None  # of the job being executed (results and errors carry it)
 
     @property

@@ -99,6 +99,7 @@ class Poller:
             t2 = time.perf_counter()
             pose = client.read_pose(timeout=timeout)
             t3 = time.perf_counter()
+            guard_stop = host.jog.guard_pose(pose)  # ratio 0 before the TCP crosses a boundary
             host.run_urgent()  # and before this poll's publishing: a stop waits one read at most
             if not host.link_up:
                 return
@@ -126,8 +127,12 @@ class Poller:
         host.supervisor.poll_answered()
         if not host.link_up:
             return
+        if guard_stop is not None:
+            host.publish_guard_stop(guard_stop)
         if with_clock:
             self._next_clock = now + timing.CLOCK_POLL_PERIOD
+            if client.audit is not None and status.clock is not None:
+                client.audit.note_controller_clock(status.clock.value, now)
         elif self.last_status is not None:
             status = dataclasses.replace(status, clock=self.last_status.clock)
         self.publish(pose, status)

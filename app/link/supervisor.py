@@ -79,6 +79,7 @@ class LinkSupervisor:
         self.close_link(Operation.CONNECT, LinkState.DISCONNECTED, "", emit=False, fail_queued=False)
         self.settings = settings
         self.client = RobotClient(settings)
+        self.client.audit = getattr(host, "audit", None)  # the audit trail records every write
         host.capture.attach(self.client)
         self._ever_connected = False
         self._backoff_index = 0

@@ -76,6 +76,9 @@ from app.link.types import ConnectionState, JogRequest, LinkState, Operation, Wo
 from app.link.upload import RawItem, Uploader
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import WorkMode
+from app.safety.audit import AuditLog
+from app.safety.envelope import EnvelopeViolation
+from app.safety.jog_guard import JogGuard
 
 __all__ = ["DEFAULT_CANARY_GV", "SHUTDOWN_TIMEOUT_MS", "STOP_HANDOFF_WAIT", "RobotWorker"]
 
@@ -102,6 +105,7 @@ class RobotWorker(WorkerRequests, QObject):
     controllerRestarted = Signal()  # noqa: N815 - the canary GV changed while the link stayed up
     uploadProgress = Signal(int, int)  # noqa: N815 - points done, total
     pointUploaded = Signal(int, bool, str, bool)  # noqa: N815 - point id, ok, reason ("" when ok), unconfirmed
+    jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard wrote ratio 0
     stopped = Signal()  # the worker has closed the link and is quitting its thread (shutdown)
 
     # Wakes the worker from any thread (a queued call, since the worker lives in its thread).
@@ -118,6 +122,7 @@ class RobotWorker(WorkerRequests, QObject):
         self._uploadStep.connect(self._upload_step, Qt.ConnectionType.QueuedConnection)
         # Everything below is touched only in the worker thread.
         self.closed = False
+        self.audit: AuditLog | None = None  # set before connecting (set_audit); thread-safe
         self.request_id: int | None = None  # request id of the job being executed
         self._current_seq = 0  # sequence number of the job being executed
         self._current_job: Job | None = None
@@ -189,6 +194,19 @@ class RobotWorker(WorkerRequests, QObject):
         self._poll_hz = float(hz)
         if self._poll_timer is not None:
             self._poll_timer.setInterval(self._poll_interval_ms())
+
+    @Slot(object)
+    def set_jog_guard(self, guard: JogGuard | None) -> None:
+        """The safety envelope's jog guard (immutable, so safe to pass between threads); None: off."""
+        self.jog.guard = guard
+
+    @Slot(object)
+    def set_audit(self, audit: AuditLog | None) -> None:
+        """The audit trail for the writes of the next connections (and of the current one)."""
+        self.audit = audit
+        client = self.supervisor.client
+        if client is not None:
+            client.audit = audit
 
     @Slot(bool)
     def set_traffic_capture(self, on: bool) -> None:
@@ -281,6 +299,9 @@ class RobotWorker(WorkerRequests, QObject):
 
     def publish_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
         self.pointUploaded.emit(point_id, ok, reason, unconfirmed)
+
+    def publish_guard_stop(self, violation: EnvelopeViolation) -> None:
+        self.jogGuardStopped.emit(violation)
 
     def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None:
         """``commandFinished`` with the request id (default: the job being executed)."""

@@ -132,6 +132,207 @@
         </message>
     </context>
     <context>
+        <name>AuditModel</name>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <source>Time</source>
+            <translation>时间</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <source>Role</source>
+            <translation>角色</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <source>Kind</source>
+            <translation>类型</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <source>Command</source>
+            <translation>命令</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <source>Result</source>
+            <translation>结果</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="57" />
+            <source>Detail</source>
+            <translation>详情</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="72" />
+            <source>operator</source>
+            <translation>操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="72" />
+            <source>engineer</source>
+            <translation>工程师</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="73" />
+            <source>administrator</source>
+            <translation>管理员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="74" />
+            <source>administrator (CLI)</source>
+            <translation>管理员（命令行）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <source>write</source>
+            <translation>写入</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <source>refused</source>
+            <translation>已拒绝</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <source>login</source>
+            <translation>登录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <source>action</source>
+            <translation>操作</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <source>ok</source>
+            <translation>成功</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <source>failed</source>
+            <translation>失败</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="77" />
+            <source>blocked</source>
+            <translation>已阻止</translation>
+        </message>
+    </context>
+    <context>
+        <name>AuditViewer</name>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="87" />
+            <source>Audit trail</source>
+            <translation>审计记录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="97" />
+            <source>Any role</source>
+            <translation>任意角色</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <source>operator</source>
+            <translation>操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <source>engineer</source>
+            <translation>工程师</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="99" />
+            <source>administrator</source>
+            <translation>管理员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="100" />
+            <source>administrator (CLI)</source>
+            <translation>管理员（命令行）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="103" />
+            <source>Command contains…</source>
+            <translation>命令包含…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="105" />
+            <source>Any result</source>
+            <translation>任意结果</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="106" />
+            <source>ok</source>
+            <translation>成功</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="106" />
+            <source>failed</source>
+            <translation>失败</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="107" />
+            <source>blocked</source>
+            <translation>已阻止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="107" />
+            <source>refused</source>
+            <translation>已拒绝</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="109" />
+            <source>Show</source>
+            <translation>显示</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="111" />
+            <source>Export CSV…</source>
+            <translation>导出 CSV…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="121" />
+            <source>From</source>
+            <translation>从</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="121" />
+            <source>to</source>
+            <translation>到</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="151" />
+            <source>{n} records</source>
+            <translation>{n} 条记录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="153" />
+            <source>{n} records ({skipped} damaged lines skipped)</source>
+            <translation>{n} 条记录（跳过 {skipped} 行损坏的记录）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="158" />
+            <source>Export the audit trail</source>
+            <translation>导出审计记录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="159" />
+            <source>CSV files (*.csv)</source>
+            <translation>CSV 文件 (*.csv)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="170" />
+            <source>Cannot write {file}: {why}</source>
+            <translation>无法写入 {file}：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="173" />
+            <source>{n} records exported to {file}</source>
+            <translation>已将 {n} 条记录导出到 {file}</translation>
+        </message>
+    </context>
+    <context>
         <name>ConnectionDialog</name>
         <message>
             <location filename="../../ui/dialogs/connection_dialog.py" line="169" />
@@ -416,6 +617,105 @@
         </message>
     </context>
     <context>
+        <name>EnvelopeDialog</name>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="53" />
+            <source>Safety envelope</source>
+            <translation>安全范围</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="55" />
+            <source>Check joint limits</source>
+            <translation>检查关节限位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="58" />
+            <source>Min (°)</source>
+            <translation>最小 (°)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="58" />
+            <source>Max (°)</source>
+            <translation>最大 (°)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="65" />
+            <source>Keep the TCP inside this box</source>
+            <translation>TCP 必须留在此长方体内</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="72" />
+            <source>Name</source>
+            <translation>名称</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="78" />
+            <source>Add zone</source>
+            <translation>添加禁区</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="80" />
+            <source>Remove zone</source>
+            <translation>删除禁区</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="90" />
+            <source>Revision {n}</source>
+            <translation>版本 {n}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="94" />
+            <source>Joint limits</source>
+            <translation>关节限位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="98" />
+            <source>Work space (keep-in box)</source>
+            <translation>工作空间（允许区域）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="107" />
+            <source>Keep-out zones</source>
+            <translation>禁入区域</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="115" />
+            <source>Speeds</source>
+            <translation>速度</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="117" />
+            <source>Max jog speed:</source>
+            <translation>最大点动速度：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="118" />
+            <source>Max TCP speed (moves, plans):</source>
+            <translation>最大 TCP 速度（移动、计划）：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="119" />
+            <source>Reduced mode jog speed:</source>
+            <translation>降速模式点动速度：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="120" />
+            <source>Reduced mode TCP speed:</source>
+            <translation>降速模式 TCP 速度：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="141" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="174" />
+            <source>zone {n}</source>
+            <translation>禁区 {n}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="158" />
+            <source>{what}: '{text}' is not a number</source>
+            <translation>{what}：“{text}”不是数字</translation>
+        </message>
+    </context>
+    <context>
         <name>EventLogModel</name>
         <message>
             <location filename="../../ui/panels/event_log.py" line="92" />
@@ -658,119 +958,119 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="283" />
+            <location filename="../../ui/main_window.py" line="287" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="284" />
+            <location filename="../../ui/main_window.py" line="288" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="285" />
+            <location filename="../../ui/main_window.py" line="289" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="289" />
+            <location filename="../../ui/main_window.py" line="293" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="290" />
+            <location filename="../../ui/main_window.py" line="294" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="291" />
+            <location filename="../../ui/main_window.py" line="295" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="328" />
+            <location filename="../../ui/main_window.py" line="332" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="316" />
+            <location filename="../../ui/main_window.py" line="320" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="344" />
+            <location filename="../../ui/main_window.py" line="348" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="346" />
+            <location filename="../../ui/main_window.py" line="350" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="294" />
-            <location filename="../../ui/main_window.py" line="351" />
+            <location filename="../../ui/main_window.py" line="298" />
+            <location filename="../../ui/main_window.py" line="355" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="364" />
+            <location filename="../../ui/main_window.py" line="368" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="375" />
+            <location filename="../../ui/main_window.py" line="379" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="381" />
+            <location filename="../../ui/main_window.py" line="385" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="377" />
-            <location filename="../../ui/main_window.py" line="382" />
+            <location filename="../../ui/main_window.py" line="381" />
+            <location filename="../../ui/main_window.py" line="386" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="286" />
+            <location filename="../../ui/main_window.py" line="290" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="287" />
+            <location filename="../../ui/main_window.py" line="291" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="288" />
+            <location filename="../../ui/main_window.py" line="292" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="292" />
+            <location filename="../../ui/main_window.py" line="296" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="445" />
+            <location filename="../../ui/main_window.py" line="452" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="446" />
+            <location filename="../../ui/main_window.py" line="453" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="464" />
+            <location filename="../../ui/main_window.py" line="471" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="465" />
+            <location filename="../../ui/main_window.py" line="472" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -1592,68 +1892,68 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="238" />
+            <location filename="../../ui/panels/plan_preview.py" line="259" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="239" />
+            <location filename="../../ui/panels/plan_preview.py" line="260" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="240" />
+            <location filename="../../ui/panels/plan_preview.py" line="261" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="244" />
+            <location filename="../../ui/panels/plan_preview.py" line="265" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="245" />
+            <location filename="../../ui/panels/plan_preview.py" line="266" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="336" />
+            <location filename="../../ui/panels/plan_preview.py" line="357" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="338" />
+            <location filename="../../ui/panels/plan_preview.py" line="359" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="340" />
+            <location filename="../../ui/panels/plan_preview.py" line="361" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="341" />
+            <location filename="../../ui/panels/plan_preview.py" line="362" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="344" />
+            <location filename="../../ui/panels/plan_preview.py" line="365" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="348" />
+            <location filename="../../ui/panels/plan_preview.py" line="369" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="350" />
+            <location filename="../../ui/panels/plan_preview.py" line="371" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="351" />
+            <location filename="../../ui/panels/plan_preview.py" line="372" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -1713,86 +2013,86 @@
     <context>
         <name>PlanRunFlow</name>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="69" />
+            <location filename="../../ui/panels/planner_run.py" line="72" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="72" />
+            <location filename="../../ui/panels/planner_run.py" line="75" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="84" />
+            <location filename="../../ui/panels/planner_run.py" line="87" />
             <source>Not connected to a controller</source>
             <translation>未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="93" />
+            <location filename="../../ui/panels/planner_run.py" line="97" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="99" />
+            <location filename="../../ui/panels/planner_run.py" line="103" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="101" />
+            <location filename="../../ui/panels/planner_run.py" line="105" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="103" />
+            <location filename="../../ui/panels/planner_run.py" line="107" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="104" />
+            <location filename="../../ui/panels/planner_run.py" line="108" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="116" />
+            <location filename="../../ui/panels/planner_run.py" line="120" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="118" />
+            <location filename="../../ui/panels/planner_run.py" line="122" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="120" />
+            <location filename="../../ui/panels/planner_run.py" line="124" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="122" />
+            <location filename="../../ui/panels/planner_run.py" line="126" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="123" />
+            <location filename="../../ui/panels/planner_run.py" line="127" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="126" />
+            <location filename="../../ui/panels/planner_run.py" line="130" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="130" />
+            <location filename="../../ui/panels/planner_run.py" line="134" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="185" />
+            <location filename="../../ui/panels/planner_run.py" line="189" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
@@ -1800,199 +2100,200 @@
     <context>
         <name>PlannerActions</name>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="60" />
+            <location filename="../../ui/panels/planner_actions.py" line="65" />
             <source>Add</source>
+            <extracomment>The plan edits (engineer and up); the rest (run, step, pause, ...) is the operator's.</extracomment>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="60" />
+            <location filename="../../ui/panels/planner_actions.py" line="65" />
             <source>Add an empty plan</source>
             <translation>添加空轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="61" />
+            <location filename="../../ui/panels/planner_actions.py" line="66" />
             <source>Rename</source>
             <translation>重命名</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="61" />
+            <location filename="../../ui/panels/planner_actions.py" line="66" />
             <source>Rename the selected plan (F2)</source>
             <translation>重命名所选轨迹（F2）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="62" />
+            <location filename="../../ui/panels/planner_actions.py" line="67" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="62" />
+            <location filename="../../ui/panels/planner_actions.py" line="67" />
             <source>Copy the selected plan</source>
             <translation>复制所选轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="63" />
-            <location filename="../../ui/panels/planner_actions.py" line="66" />
+            <location filename="../../ui/panels/planner_actions.py" line="68" />
+            <location filename="../../ui/panels/planner_actions.py" line="71" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="63" />
+            <location filename="../../ui/panels/planner_actions.py" line="68" />
             <source>Delete the selected plan (Ctrl+Z to undo)</source>
             <translation>删除所选轨迹（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="64" />
+            <location filename="../../ui/panels/planner_actions.py" line="69" />
             <source>+ Line</source>
             <translation>+ 直线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="64" />
+            <location filename="../../ui/panels/planner_actions.py" line="69" />
             <source>Add a line segment after the selection (Ctrl+L)</source>
             <translation>在所选段之后添加直线段（Ctrl+L）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="65" />
+            <location filename="../../ui/panels/planner_actions.py" line="70" />
             <source>+ Arc</source>
             <translation>+ 圆弧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="65" />
+            <location filename="../../ui/panels/planner_actions.py" line="70" />
             <source>Add an arc segment after the selection</source>
             <translation>在所选段之后添加圆弧段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="66" />
+            <location filename="../../ui/panels/planner_actions.py" line="71" />
             <source>Delete the selected segments</source>
             <translation>删除所选段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="67" />
+            <location filename="../../ui/panels/planner_actions.py" line="72" />
             <source>Move the selected segments up (Alt+Up)</source>
             <translation>上移所选段（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="68" />
+            <location filename="../../ui/panels/planner_actions.py" line="73" />
             <source>Move the selected segments down (Alt+Down)</source>
             <translation>下移所选段（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="69" />
+            <location filename="../../ui/panels/planner_actions.py" line="74" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="69" />
+            <location filename="../../ui/panels/planner_actions.py" line="74" />
             <source>Check the plan from the robot's current pose</source>
             <translation>以机器人当前位姿检查轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="70" />
+            <location filename="../../ui/panels/planner_actions.py" line="75" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="70" />
+            <location filename="../../ui/panels/planner_actions.py" line="75" />
             <source>Upload the points the plan needs</source>
             <translation>上传轨迹所需的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="71" />
+            <location filename="../../ui/panels/planner_actions.py" line="76" />
             <source>Run</source>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="71" />
+            <location filename="../../ui/panels/planner_actions.py" line="76" />
             <source>Run the plan from the first segment (F5)</source>
             <translation>从第一段开始运行轨迹（F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="72" />
+            <location filename="../../ui/panels/planner_actions.py" line="77" />
             <source>Run from here</source>
             <translation>从此处运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="72" />
+            <location filename="../../ui/panels/planner_actions.py" line="77" />
             <source>Run from the selected segment (Shift+F5)</source>
             <translation>从所选段开始运行（Shift+F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="73" />
+            <location filename="../../ui/panels/planner_actions.py" line="78" />
             <source>Step</source>
             <translation>单步</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="73" />
+            <location filename="../../ui/panels/planner_actions.py" line="78" />
             <source>Run one segment, then stop (F10)</source>
             <translation>运行一段后停止（F10）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="74" />
+            <location filename="../../ui/panels/planner_actions.py" line="79" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="74" />
+            <location filename="../../ui/panels/planner_actions.py" line="79" />
             <source>Pause the motion</source>
             <translation>暂停运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="75" />
+            <location filename="../../ui/panels/planner_actions.py" line="80" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="75" />
+            <location filename="../../ui/panels/planner_actions.py" line="80" />
             <source>Resume the paused motion</source>
             <translation>继续已暂停的运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="76" />
+            <location filename="../../ui/panels/planner_actions.py" line="81" />
             <source>Stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="76" />
+            <location filename="../../ui/panels/planner_actions.py" line="81" />
             <source>Stop the robot and the run</source>
             <translation>停止机器人和轨迹运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="77" />
-            <location filename="../../ui/panels/planner_actions.py" line="89" />
+            <location filename="../../ui/panels/planner_actions.py" line="82" />
+            <location filename="../../ui/panels/planner_actions.py" line="94" />
             <source>Resume from segment</source>
             <translation>从该段继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="77" />
+            <location filename="../../ui/panels/planner_actions.py" line="82" />
             <source>Continue the stopped run</source>
             <translation>继续已停止的运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="88" />
+            <location filename="../../ui/panels/planner_actions.py" line="93" />
             <source>Resume from segment {k}</source>
             <translation>从第 {k} 段继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="109" />
+            <location filename="../../ui/panels/planner_actions.py" line="117" />
             <source>Run is disabled: the plan's checks found errors; fix them first</source>
             <translation>无法运行：计划检查发现错误，请先修正</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="113" />
+            <location filename="../../ui/panels/planner_actions.py" line="121" />
             <source>Run is disabled: not connected to the controller</source>
             <translation>无法运行：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="114" />
+            <location filename="../../ui/panels/planner_actions.py" line="122" />
             <source>Run is disabled: a run is going</source>
             <translation>无法运行：正在运行中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="115" />
+            <location filename="../../ui/panels/planner_actions.py" line="123" />
             <source>Run is disabled: the plan has no segments</source>
             <translation>无法运行：计划没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="116" />
+            <location filename="../../ui/panels/planner_actions.py" line="124" />
             <source>Run is disabled: wait for the points' upload to finish</source>
             <translation>无法运行：请等待点位上传完成</translation>
         </message>
@@ -2000,12 +2301,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="215" />
+            <location filename="../../ui/panels/planner_panel.py" line="219" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="393" />
+            <location filename="../../ui/panels/planner_panel.py" line="412" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -2372,194 +2673,194 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="265" />
+            <location filename="../../ui/panels/points_panel.py" line="268" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="265" />
+            <location filename="../../ui/panels/points_panel.py" line="268" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="267" />
+            <location filename="../../ui/panels/points_panel.py" line="270" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="267" />
+            <location filename="../../ui/panels/points_panel.py" line="270" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="268" />
+            <location filename="../../ui/panels/points_panel.py" line="271" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="268" />
+            <location filename="../../ui/panels/points_panel.py" line="271" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="269" />
+            <location filename="../../ui/panels/points_panel.py" line="272" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="270" />
+            <location filename="../../ui/panels/points_panel.py" line="273" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="271" />
+            <location filename="../../ui/panels/points_panel.py" line="274" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="272" />
+            <location filename="../../ui/panels/points_panel.py" line="275" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="273" />
+            <location filename="../../ui/panels/points_panel.py" line="276" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="274" />
+            <location filename="../../ui/panels/points_panel.py" line="277" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="275" />
+            <location filename="../../ui/panels/points_panel.py" line="278" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="276" />
+            <location filename="../../ui/panels/points_panel.py" line="279" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="277" />
+            <location filename="../../ui/panels/points_panel.py" line="280" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="277" />
+            <location filename="../../ui/panels/points_panel.py" line="280" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="278" />
-            <location filename="../../ui/panels/points_panel.py" line="294" />
+            <location filename="../../ui/panels/points_panel.py" line="281" />
+            <location filename="../../ui/panels/points_panel.py" line="297" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="279" />
+            <location filename="../../ui/panels/points_panel.py" line="282" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="280" />
+            <location filename="../../ui/panels/points_panel.py" line="283" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="281" />
-            <location filename="../../ui/panels/points_panel.py" line="440" />
+            <location filename="../../ui/panels/points_panel.py" line="284" />
+            <location filename="../../ui/panels/points_panel.py" line="455" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="282" />
+            <location filename="../../ui/panels/points_panel.py" line="285" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="286" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="286" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="284" />
+            <location filename="../../ui/panels/points_panel.py" line="287" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="289" />
+            <location filename="../../ui/panels/points_panel.py" line="292" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="290" />
+            <location filename="../../ui/panels/points_panel.py" line="293" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="291" />
+            <location filename="../../ui/panels/points_panel.py" line="294" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="292" />
+            <location filename="../../ui/panels/points_panel.py" line="295" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="295" />
+            <location filename="../../ui/panels/points_panel.py" line="298" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="296" />
+            <location filename="../../ui/panels/points_panel.py" line="299" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="376" />
+            <location filename="../../ui/panels/points_panel.py" line="387" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="379" />
+            <location filename="../../ui/panels/points_panel.py" line="390" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="380" />
+            <location filename="../../ui/panels/points_panel.py" line="391" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="381" />
+            <location filename="../../ui/panels/points_panel.py" line="392" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="401" />
+            <location filename="../../ui/panels/points_panel.py" line="412" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="404" />
+            <location filename="../../ui/panels/points_panel.py" line="415" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="429" />
+            <location filename="../../ui/panels/points_panel.py" line="440" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="433" />
+            <location filename="../../ui/panels/points_panel.py" line="448" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -2572,7 +2873,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="470" />
+            <location filename="../../ui/panels/points_panel.py" line="485" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -3175,6 +3476,85 @@ Remove them all?</source>
         </message>
     </context>
     <context>
+        <name>RoleDialog</name>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="29" />
+            <source>Log in</source>
+            <translation>登录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="36" />
+            <source>Now: {role}</source>
+            <translation>当前：{role}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="40" />
+            <source>Set this role's password</source>
+            <translation>设置此角色的密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="44" />
+            <source> min</source>
+            <translation> 分钟</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="47" />
+            <source>Back to operator after this idle time</source>
+            <translation>空闲这么久后回到操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="50" />
+            <source>Log out (operator)</source>
+            <translation>注销（回到操作员）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="53" />
+            <source>Role:</source>
+            <translation>角色：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="54" />
+            <source>Password:</source>
+            <translation>密码：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="55" />
+            <source>Lock back after:</source>
+            <translation>空闲锁定时间：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="80" />
+            <source>No administrator password is set yet: choose the administrator role, type a password and press “Set this role's password”.</source>
+            <translation>尚未设置管理员密码：请选择管理员角色，输入密码，然后按“设置此角色的密码”。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="83" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="93" />
+            <source>No password is set for this role; an administrator sets it.</source>
+            <translation>此角色尚未设置密码；请由管理员设置。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="91" />
+            <source>Wrong password for the {role} role</source>
+            <translation>{role}角色的密码错误</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="105" />
+            <source>The setting could not be saved: {why}</source>
+            <translation>无法保存设置：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="119" />
+            <source>The password could not be saved: {why}</source>
+            <translation>无法保存密码：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="123" />
+            <source>Password set for the {role} role</source>
+            <translation>已设置{role}角色的密码</translation>
+        </message>
+    </context>
+    <context>
         <name>Runner</name>
         <message>
             <location filename="../../app/plan/runner.py" line="92" />
@@ -3200,6 +3580,167 @@ Remove them all?</source>
             <location filename="../../app/plan/runner.py" line="96" />
             <source>failed</source>
             <translation>失败</translation>
+        </message>
+    </context>
+    <context>
+        <name>SafetyController</name>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="119" />
+            <source>operator</source>
+            <translation>操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="119" />
+            <source>engineer</source>
+            <translation>工程师</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="120" />
+            <source>administrator</source>
+            <translation>管理员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="126" />
+            <source>Needs the {need} role (you are {role}); log in from the Safety menu</source>
+            <translation>需要{need}角色（当前为{role}）；请从“安全”菜单登录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="298" />
+            <source>{axis} = {value:.1f} is within stopping distance of the keep-out zone '{box}' (at {limit:.1f})</source>
+            <translation>{axis} = {value:.1f}，已进入禁区“{box}”的停止距离内（边界 {limit:.1f}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="301" />
+            <source>{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}</source>
+            <translation>{axis} = {value:.1f}，已进入限位 {limit:.1f} 的停止距离内</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="303" />
+            <source>{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)</source>
+            <translation>{axis} = {value:.1f} mm 超出允许的工作空间（限值 {limit:.1f} mm）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="305" />
+            <source>The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, its face at {limit:.1f} mm)</source>
+            <translation>路径进入禁区“{box}”（{axis} = {value:.1f} mm，边界在 {limit:.1f} mm）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="308" />
+            <source>{axis} = {value:.1f}° is beyond its limit {limit:.1f}°</source>
+            <translation>{axis} = {value:.1f}° 超出限位 {limit:.1f}°</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="310" />
+            <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode</source>
+            <translation>速度 {value:g} mm/s 超过降速模式允许的 {limit:g} mm/s</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="311" />
+            <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed</source>
+            <translation>速度 {value:g} mm/s 超过允许的 {limit:g} mm/s</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="313" />
+            <source>Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode</source>
+            <translation>点动速度 {value:g} % 超过降速模式允许的 {limit:g} %</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="314" />
+            <source>Jog speed {value:g} % is above the {limit:g} % allowed</source>
+            <translation>点动速度 {value:g} % 超过允许的 {limit:g} %</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="318" />
+            <source>Segment {k}: {text}</source>
+            <translation>第 {k} 段：{text}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="323" />
+            <source>Jog stopped before the limit: {why}</source>
+            <translation>点动已在到达边界前停止：{why}</translation>
+        </message>
+    </context>
+    <context>
+        <name>SafetyMenu</name>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="84" />
+            <source>&amp;Safety</source>
+            <translation>安全(&amp;S)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="85" />
+            <source>Log &amp;in…</source>
+            <translation>登录(&amp;I)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="86" />
+            <source>Log &amp;out (operator)</source>
+            <translation>注销(&amp;O)（回到操作员）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="87" />
+            <source>&amp;Reduced speed</source>
+            <translation>降速模式(&amp;R)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="88" />
+            <source>Safety &amp;envelope…</source>
+            <translation>安全范围(&amp;E)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="89" />
+            <source>&amp;Audit trail…</source>
+            <translation>审计记录(&amp;A)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="90" />
+            <source>Write a &amp;support bundle…</source>
+            <translation>生成支持包(&amp;S)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="103" />
+            <source>Role: {role} · reduced speed</source>
+            <translation>角色：{role} · 降速模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="103" />
+            <source>Role: {role}</source>
+            <translation>角色：{role}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="111" />
+            <source>Cap jog and move speeds (anyone may switch it on)</source>
+            <translation>限制点动与移动速度（任何人都可开启）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="115" />
+            <source>safety</source>
+            <translation>安全</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="138" />
+            <source>Zip files (*.zip)</source>
+            <translation>Zip 文件 (*.zip)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="145" />
+            <source>Write a support bundle</source>
+            <translation>生成支持包</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="166" />
+            <source>The support bundle could not be written: {why}</source>
+            <translation>无法生成支持包：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="167" />
+            <source>Support bundle</source>
+            <translation>支持包</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="171" />
+            <source>Support bundle written: {file} ({n} files)</source>
+            <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
     </context>
     <context>
@@ -3725,7 +4266,7 @@ Remove them all?</source>
     <context>
         <name>View3DCanvas</name>
         <message>
-            <location filename="../../ui/panels/view3d_canvas.py" line="216" />
+            <location filename="../../ui/panels/view3d_canvas.py" line="227" />
             <source>grid %1 mm</source>
             <translation>网格 %1 mm</translation>
         </message>

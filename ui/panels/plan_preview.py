@@ -35,6 +35,7 @@ from app.plan.geometry import PlanPath, plan_path
 from app.plan.presenter import PlanInfo
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger
+from app.safety.envelope import Envelope
 from ui.palette import (
     COLOR_AXIS,
     COLOR_HIGHLIGHT,
@@ -45,6 +46,8 @@ from ui.palette import (
     COLOR_TCP,
     COLOR_TRAIL,
 )
+from ui.palette import COLOR_ERROR as COLOR_KEEP_OUT
+from ui.palette import COLOR_OK as COLOR_KEEP_IN
 
 if TYPE_CHECKING:
     import pyqtgraph as pg
@@ -102,10 +105,28 @@ class _Projection:
         self.trail = pg.PlotCurveItem(pen=pg.mkPen(COLOR_TRAIL, width=2))
         self.tcp = pg.ScatterPlotItem(size=13, symbol="o", brush=pg.mkBrush(COLOR_TCP),
                                       pen=pg.mkPen(COLOR_INK))
+        # the safety envelope (added at the first envelope): each box's 12 edges projected, dashed
+        self.keep_in: pg.PlotCurveItem | None = None
+        self.keep_out: pg.PlotCurveItem | None = None
         self.labels: list[pg.TextItem] = []
         for z, item in enumerate((self.path, self.selected, self.points, self.start, self.trail, self.tcp)):
             item.setZValue(z)
             plot.addItem(item)
+
+    def set_boxes(self, keep_in: FloatArray, keep_out: FloatArray) -> None:
+        """Outline rectangles of the envelope's boxes (point pairs of :meth:`Box.edges`)."""
+        if self.keep_in is None or self.keep_out is None:
+            if not len(keep_in) and not len(keep_out):
+                return
+            dash = Qt.PenStyle.DashLine
+            pairs = "pairs"
+            self.keep_in = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_IN, width=1, style=dash), connect=pairs)
+            self.keep_out = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_OUT, width=2, style=dash), connect=pairs)
+            for item in (self.keep_in, self.keep_out):
+                item.setZValue(-1)
+                self.plot.addItem(item)
+        self.keep_in.setData(keep_in[:, self.h], keep_in[:, self.v])
+        self.keep_out.setData(keep_out[:, self.h], keep_out[:, self.v])
 
     def set_labels(self, xyz: FloatArray, texts: Sequence[str]) -> None:
         import pyqtgraph as pg
@@ -350,6 +371,14 @@ class PlanPreview(QWidget):
         lines.append(self.tr("Start: end of the last segment (robot pose unknown)") if info.assumed_start
                      else self.tr("Start: the robot's current pose"))
         self.set_info("<br>".join(lines))
+
+    def set_envelope(self, envelope: Envelope | None) -> None:
+        """Outline the keep-in box and the keep-out boxes in every projection (None: none)."""
+        keep_in = envelope.keep_in.edges() if envelope is not None and envelope.keep_in else np.empty((0, 3))
+        zones = [b.edges() for b in envelope.keep_out] if envelope is not None else []
+        keep_out = np.vstack(zones) if zones else np.empty((0, 3))
+        for proj in self.projections.values():
+            proj.set_boxes(keep_in, keep_out)
 
     def clear(self) -> None:
         self._previewed = None

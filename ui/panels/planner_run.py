@@ -19,6 +19,7 @@ from app.plan.presenter import RunBlock, RunKind, run_gate, run_kind
 from app.plan.runner import RunOutcome, RunState
 from app.plan.segments import Plan
 from app.points.ledger import UploadReport
+from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
 from ui.messages import error_text
@@ -31,6 +32,8 @@ class PlannerView(Protocol):
     """What the flow needs of the planner panel."""
 
     limits: PlanLimits
+    envelope: Envelope | None  # the safety envelope (None: none loaded)
+    reduced_speed: bool
 
     @property
     def issues(self) -> list[PlanIssue]: ...
@@ -84,7 +87,8 @@ class PlanRunFlow(QObject):
             view.show_message(self.tr("Not connected to a controller"), "error")
             return False
         issues = check_plan(plan, self._points.ledger, view.limits, self._runner.last_pose, start_index=start,
-                            loops=1 if single else plan.loops)
+                            loops=1 if single else plan.loops, envelope=view.envelope,
+                            reduced_speed=view.reduced_speed)
         summary = view.show_issues(issues, plan)
         gate = run_gate(issues)
         if gate.block is RunBlock.ERRORS and (first := gate.first_error) is not None:
