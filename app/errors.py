@@ -1,20 +1,57 @@
-"""Typed errors of the core. Each carries a message an operator can read."""
+"""Typed errors of the core. Each carries a message an operator can read.
+
+``str(exc)`` is plain English (the CLI prints it). Beside it every error has a :class:`Reason`:
+a stable ``code`` and its arguments (numbers, register names, enum values -- never English
+sentences), which the GUI turns into a sentence in the operator's language (``ui/messages.py``).
+"""
 
 from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
 
 from app.protocol.enums import CommandStatus
 
 
+@dataclass(frozen=True)
+class Reason:
+    """Why something ended, as a code and its arguments (translated by the GUI)."""
+
+    code: str
+    args: Mapping[str, Any] = field(default_factory=dict)
+
+
 class TeachPadError(Exception):
-    """Base of every error the core raises on purpose."""
+    """Base of every error the core raises on purpose.
+
+    ``code`` names the kind (a class default, or given per raise); ``params`` are its arguments.
+    """
+
+    code = "error"
+
+    def __init__(self, message: str = "", *, code: str | None = None,
+                 params: Mapping[str, Any] | None = None) -> None:
+        super().__init__(message)
+        if code is not None:
+            self.code = code
+        self.params: dict[str, Any] = dict(params or {})
+
+    def as_reason(self) -> Reason:
+        """Its code and arguments (a method: some subclasses keep a text ``reason`` attribute)."""
+        return Reason(self.code, dict(self.params))
 
 
 class LinkError(TeachPadError):
     """No connection to the controller (refused, dropped, not connected)."""
 
+    code = "link_lost"
+
 
 class ResponseTimeout(TeachPadError):
     """The controller did not answer a request in time."""
+
+    code = "no_answer"
 
 
 class MalformedResponse(TeachPadError):
@@ -24,9 +61,12 @@ class MalformedResponse(TeachPadError):
     ``got`` are its values (None when the answer was cut short or had bytes too many).
     """
 
+    code = "malformed_answer"
+
     def __init__(self, message: str, *, field: str = "", expected: object = None,
                  got: object = None) -> None:
-        super().__init__(message)
+        super().__init__(message, params={"field": field, "expected": _short(expected),
+                                          "got": _short(got)})
         self.field = field
         self.expected = expected
         self.got = got
@@ -35,8 +75,10 @@ class MalformedResponse(TeachPadError):
 class ModbusExceptionError(TeachPadError):
     """The controller answered with a Modbus exception."""
 
+    code = "modbus_exception"
+
     def __init__(self, function_code: int, exception_code: int, message: str) -> None:
-        super().__init__(message)
+        super().__init__(message, params={"function": function_code, "exception": exception_code})
         self.function_code = function_code
         self.exception_code = exception_code
 
@@ -44,30 +86,56 @@ class ModbusExceptionError(TeachPadError):
 class WriteBlocked(TeachPadError):
     """A write was refused before the wire because the client is monitor-only."""
 
+    code = "monitor_only"
+
 
 class CommandRefused(TeachPadError):
     """The controller refused or failed a command; ``status`` is GV291 decoded."""
 
-    def __init__(self, status: CommandStatus, message: str | None = None) -> None:
-        super().__init__(message or f"command failed: {status.text} (status {status.code})")
+    code = "command_refused"
+
+    def __init__(self, status: CommandStatus, message: str | None = None, *,
+                 code: str | None = None, params: Mapping[str, Any] | None = None) -> None:
+        super().__init__(message or f"command failed: {status.text} (status {status.code})",
+                         code=code, params={"kind": status.kind.value if status.kind else None,
+                                            "status": status.code, **(params or {})})
         self.status = status
 
 
 class CommandTimeout(TeachPadError):
-    """A command did not complete in time."""
+    """A command did not complete in time (codes: command_timeout, not_acknowledged,
+    result_unknown)."""
+
+    code = "command_timeout"
 
 
 class AlarmRaised(TeachPadError):
     """An alarm appeared while waiting for a command to complete."""
 
-    def __init__(self, alarms: int, message: str) -> None:
-        super().__init__(message)
+    code = "alarm_while_waiting"
+
+    def __init__(self, alarms: int, message: str, *,
+                 params: Mapping[str, Any] | None = None) -> None:
+        super().__init__(message, params={"alarms": alarms, **(params or {})})
         self.alarms = alarms
 
 
 class CommandStopped(TeachPadError):
-    """The wait ended because the motion was stopped (by us or the controller)."""
+    """The wait ended because the motion was stopped (codes: stopped_by_operator, the host sent
+    the stop; stopped_by_controller)."""
+
+    code = "stopped_by_controller"
 
 
 class InvalidInput(TeachPadError, ValueError):
     """A value the host refuses before sending (range, NaN, unknown enum)."""
+
+    code = "invalid_input"
+
+
+def _short(value: object, limit: int = 24) -> object:
+    """A bad value quoted in a reason: numbers as they are, anything else cut to a short prefix."""
+    if value is None or isinstance(value, int | float):
+        return value
+    text = value.hex() if isinstance(value, bytes | bytearray) else str(value)
+    return text if len(text) <= limit else text[:limit] + "…"

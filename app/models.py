@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from app.errors import Reason
 from app.protocol.datetime_regs import ControllerClock
 from app.protocol.enums import (
     Alarm,
@@ -59,3 +60,11 @@ class CommandResult:
     # before the command and the host cannot write a sentinel). Only for the idempotent instant
     # commands (create point, teach enable/disable), never for moves; see app/link/tracker.py.
     unconfirmed: bool = False
+    # why it ended, as a code and arguments beside the English ``message`` (see app/errors.py;
+    # ui/messages.py renders it). None: an older producer; the GUI falls back to ``message``.
+    reason: Reason | None = None
+
+    @property
+    def stopped_by_operator(self) -> bool:
+        """The operator's own stop ended it: not a failure (ok is False, shown neutral)."""
+        return self.reason is not None and self.reason.code == "stopped_by_operator"

@@ -15,7 +15,7 @@ from typing import Any
 
 from app.link.client import ConnectionSettings, RobotClient
 from app.sim import SimConfig, SimController
-from app.sim.server import GV291_MODES, TIMING_PROFILES
+from app.sim.config import GV291_MODES, TIMING_PROFILES
 
 
 def _poses(n: int) -> list[tuple[int, list[float]]]:

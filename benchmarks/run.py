@@ -57,6 +57,8 @@ def main(argv: list[str] | None = None) -> int:
             out["points"] = {"skipped": str(exc)}
         else:
             out["points"] = points.run(args.quick)
+    if "safety" in suites:  # not in the default set: --only safety (or core,gui,points,safety)
+        out["safety"] = __import__("benchmarks.safety", fromlist=["run"]).run(args.quick)
     out["total_s"] = time.perf_counter() - t0
     out["goals"] = goals(out)
     json.dump(out, sys.stdout, indent=2, sort_keys=True)

@@ -15,6 +15,12 @@ import pytest
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 
+@pytest.fixture(autouse=True, scope="session")
+def _private_data_dir(tmp_path_factory: pytest.TempPathFactory) -> None:
+    """The audit trail (CLI clients write one) goes to a temporary data directory, not $HOME."""
+    os.environ["XDG_DATA_HOME"] = str(tmp_path_factory.mktemp("xdg-data"))
+
+
 @pytest.fixture
 def sim() -> Iterator[Any]:
     """A running simulated controller on 127.0.0.1:<free port>, stopped after the test."""

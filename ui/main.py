@@ -20,8 +20,8 @@ import threading
 from collections.abc import Sequence
 from pathlib import Path
 
-from PySide6.QtCore import QTimer
-from PySide6.QtWidgets import QApplication
+from PySide6.QtCore import QEvent, QObject, QTimer, Signal
+from PySide6.QtWidgets import QApplication, QWidget
 
 from app.link.client import ConnectionSettings
 from app.link.robot_link import RobotLink, wait_for_detached_threads
@@ -124,6 +124,64 @@ class SimProcess:
         return code
 
 
+class _SimStarter(QObject):
+    """Starts the simulator process after the window's first paint, off the GUI thread.
+
+    The child needs ~0.5 s (an interpreter, pymodbus) before it says its port: waiting for it
+    before building the window made the first paint that much later. Here the window paints
+    first; then a thread starts the child and waits for its port; ``started`` (GUI thread,
+    queued) carries the SimProcess, or ``failed`` the reason.
+    """
+
+    started = Signal(object)
+    failed = Signal(str)
+
+    def __init__(self, window: QWidget) -> None:
+        super().__init__()
+        self.sim: SimProcess | None = None
+        self._thread: threading.Thread | None = None
+        self._closed = False
+        self._lock = threading.Lock()
+        self._window = window
+        window.installEventFilter(self)
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if watched is self._window and event.type() == QEvent.Type.Paint and self._thread is None:
+            self._window.removeEventFilter(self)
+            QTimer.singleShot(0, self.start)  # after this paint, on the next turn of the loop
+        return False
+
+    def start(self) -> None:
+        if self._thread is None:
+            self._thread = threading.Thread(target=self._run, name="sim-start", daemon=True)
+            self._thread.start()
+
+    def _run(self) -> None:
+        try:
+            sim = SimProcess.start()
+        except (OSError, RuntimeError) as exc:
+            self.failed.emit(str(exc))
+            return
+        with self._lock:
+            closed = self._closed
+            if not closed:
+                self.sim = sim
+        if closed:  # the window closed meanwhile
+            sim.stop()
+            return
+        self.started.emit(sim)
+
+    def close(self, timeout: float = SIM_START_TIMEOUT) -> None:
+        """Stop the simulator (and one still starting: it is stopped as soon as it is up)."""
+        with self._lock:
+            self._closed = True
+            sim, self.sim = self.sim, None
+        if sim is not None:
+            sim.stop()
+        elif self._thread is not None:
+            self._thread.join(timeout)
+
+
 def _size(text: str) -> tuple[int, int]:
     try:
         width, height = (int(v) for v in text.lower().split("x"))
@@ -216,18 +274,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not translator.set_language(language):
         print(f"teachpad: no translation for {language}, using English", file=sys.stderr)
 
-    sim: SimProcess | None = None
     connection: ConnectionSettings | None = None
-    if args.sim:
-        try:
-            sim = SimProcess.start()
-        except (OSError, RuntimeError) as exc:
-            print(f"teachpad: could not start the simulator: {exc}", file=sys.stderr)
-            translator.uninstall()
-            return 1
-        connection = ConnectionSettings(host=sim.host, port=sim.port, unit=1,
-                                        monitor_only=args.monitor_only)
-    elif args.host:
+    if args.host and not args.sim:
         connection = dataclasses.replace(settings.connection(), host=args.host, port=args.port,
                                          unit=args.unit, serial_port=None, framer="socket",
                                          monitor_only=args.monitor_only)
@@ -240,13 +288,29 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.tab:
         window.show_tab(args.tab)
     shot = _Screenshot(window, link, args.screenshot, app) if args.screenshot else None
+    starter: _SimStarter | None = None
+    failure: list[str] = []
+    if args.sim:  # the simulator starts after the first paint (see _SimStarter)
+        starter = _SimStarter(window)
+
+        def sim_started(sim: SimProcess) -> None:
+            link.connect_to(ConnectionSettings(host=sim.host, port=sim.port, unit=1,
+                                               monitor_only=args.monitor_only))
+            if args.demo:
+                link.run_program(DEMO_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
+
+        def sim_failed(reason: str) -> None:
+            print(f"teachpad: could not start the simulator: {reason}", file=sys.stderr)
+            failure.append(reason)
+            app.exit(1)
+
+        starter.started.connect(sim_started)
+        starter.failed.connect(sim_failed)
     window.show()
     # A screenshot run never stops on a question: it opens only what it was given.
     window.start_project(args.project, reopen_last=not args.screenshot, offer_recovery=not args.screenshot)
     if connection is not None:
         link.connect_to(connection)
-        if args.demo:
-            link.run_program(DEMO_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
     try:
         code = app.exec()
     finally:
@@ -254,8 +318,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             shot.cancel()
         window.close()  # saves the window state and shuts the link down (stops any jog)
         link.shutdown()
-        if sim is not None:
-            sim.stop()
+        if starter is not None:
+            starter.close()
         if not wait_for_detached_threads(THREADS_EXIT_WAIT):
             print("teachpad: the link to the controller did not close in time", file=sys.stderr)
         translator.uninstall()

@@ -49,13 +49,16 @@ from app import __version__
 from app.link.client import ConnectionSettings
 from app.link.robot_link import RobotLink
 from app.link.types import ConnectionState, LinkState, WorkerError
+from app.safety.roles import Action
 from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController, ProjectDialogs
+from ui.controllers.safety_menu import install_safety
 from ui.dialogs.confirm import ConfirmFn
 from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import Translator
+from ui.messages import error_text
 from ui.panels.alarm_banner import AlarmBanner
 from ui.panels.alarm_list import AlarmListPanel
 from ui.panels.control_bar import ControlBar
@@ -207,6 +210,8 @@ class MainWindow(QMainWindow):
         mark_motion(bar.stop_button, bar.pause_button, bar.resume_button)
         self.set_touch_mode(settings.touch_mode)
         self.view3d = install_view3d(self)  # the 3D tab (and its dock beside the planner)
+        self.safety_menu = install_safety(self)  # roles, envelope, audit trail (the Safety menu)
+        self.motion.safety = self.safety_menu.safety
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*self._default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])
@@ -248,6 +253,7 @@ class MainWindow(QMainWindow):
         self.pose_bar.setMovable(False)
         self.pose_bar.setFloatable(False)
         self.pose_bar.toggleViewAction().setVisible(False)
+        self.pose_bar.setStyleSheet("QToolBar { padding: 0px; spacing: 0px; border: none; }")  # every px
         self.pose_bar.addWidget(self.pose_strip)
         self.addToolBarBreak(Qt.ToolBarArea.TopToolBarArea)
         self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.pose_bar)
@@ -288,6 +294,9 @@ class MainWindow(QMainWindow):
         self.event_dock.setWindowTitle(self.tr("Event log"))
         self.traffic_dock.setWindowTitle(self.tr("Modbus traffic"))
         self.alarm_dock.setWindowTitle(self.tr("Alarms"))
+        # room for the widest RTT from the start: the status bar does not shift when one arrives
+        widest_rtt = self.tr("RTT {ms} ms").format(ms="9999.9")
+        self.status_rtt.setMinimumWidth(self.status_rtt.fontMetrics().horizontalAdvance(widest_rtt) + 8)
         self.menus.retranslate()
         self.project.retranslate()
         self._on_project_title(self.project.title)
@@ -348,7 +357,7 @@ class MainWindow(QMainWindow):
     @Slot(WorkerError)
     def _on_error(self, error: WorkerError) -> None:
         operation = self.event_log.operation_text(error.operation)
-        self.statusBar().showMessage(f"{operation}: {error.message}", 8000)
+        self.statusBar().showMessage(f"{operation}: {error_text(error)}", 8000)
 
     @Slot(str)
     def _show_message(self, text: str) -> None:
@@ -426,9 +435,12 @@ class MainWindow(QMainWindow):
     @Slot()
     def open_connection_dialog(self) -> None:
         self.jog_panel.release_all()
+        if not self.safety_menu.safety.allowed(Action.CONNECTION):  # the administrator's (audited)
+            return
         dialog = ConnectionDialog.for_link(self.link, self.settings.connection(), self.settings.poll_hz, self)
         if dialog.exec() == ConnectionDialog.DialogCode.Accepted:
             self.connect_with(dialog.settings())
+            self.safety_menu.safety.set_poll_rate(self.settings.poll_hz)
 
     def connect_with(self, settings: ConnectionSettings) -> None:
         """Remember ``settings`` and connect (the link retries by itself until it succeeds)."""

@@ -25,6 +25,7 @@ import contextlib
 import importlib
 import json
 import logging
+import os
 import signal
 import sys
 import threading
@@ -33,8 +34,24 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, TextIO
 
+from app.cli.format import (
+    JOG_SECONDS_MAX,
+    _axis_index,
+    _jog_seconds,
+    _num,
+    _parse_direction,
+    _parse_step_offsets,
+    _parse_zero_axis,
+    _positive_float,
+    _word_order,
+    format_status,
+    format_watch_line,
+    status_to_dict,
+)
+from app.cli.help import add_examples
 from app.errors import (
     AlarmRaised,
+    CommandRefused,
     InvalidInput,
     LinkError,
     MalformedResponse,
@@ -42,7 +59,8 @@ from app.errors import (
     TeachPadError,
 )
 from app.link.client import ConnectionSettings, RobotClient, StepFrame
-from app.models import ControllerStatus, Pose
+from app.link.tracker import pose_moved
+from app.models import Pose
 from app.protocol import registers
 from app.protocol.codec import WordOrder, decode_floats, encode_floats
 from app.protocol.enums import (
@@ -50,12 +68,12 @@ from app.protocol.enums import (
     JOINT_AXIS_NAMES,
     CommandStatus,
     ProgramMotionMode,
+    ProgramState,
     TeachFrame,
     WorkMode,
     alarm_names,
-    controller_mode_text,
-    program_state_text,
 )
+from app.safety.audit import AuditLog
 
 PROG = "teachpad-cli"
 
@@ -67,8 +85,11 @@ EXIT_INTERRUPTED = 130
 
 JOG_POLL_INTERVAL = 0.05  # s between status checks while a jog runs (keeps a watchdog fed)
 JOG_SECONDS_DEFAULT = 2.0  # s a jog runs when --seconds is not given
-JOG_SECONDS_MAX = 30.0  # s: no jog from the CLI runs longer
 WATCH_RATE_DEFAULT = 10.0  # Hz
+# A program the controller accepted shows program state running (or has moved the arm) within
+# this time; one that stays stopped was not started (unknown id, or refused).
+PROGRAM_START_TIMEOUT = 1.0  # s
+PROGRAM_START_POLL = 0.02  # s between status reads while waiting for the start
 
 Registrar = Callable[[Any], None]  # register(subparsers: argparse._SubParsersAction)
 Handler = Callable[["CliContext"], int]
@@ -88,6 +109,8 @@ class CliContext:
     def client(self) -> RobotClient:
         if self._client is None:
             client = RobotClient(self.settings)
+            # The CLI is an administrator's tool; its writes go to the same audit trail as the GUI's.
+            client.audit = AuditLog(role="administrator (cli)", word_order=self.settings.word_order)
             self._client = client
             client.connect()
         return self._client
@@ -101,152 +124,6 @@ class CliContext:
     def close(self) -> None:
         if self._client is not None:
             self._client.close()
-
-
-# --------------------------------------------------------------------------------------------
-# Formatting
-# --------------------------------------------------------------------------------------------
-
-
-def _num(value: float) -> str:
-    return f"{value:.3f}"
-
-
-def status_to_dict(pose: Pose, status: ControllerStatus) -> dict[str, Any]:
-    """The JSON shape of ``status --json``."""
-    code = status.command_status_code
-    decoded = CommandStatus(None, code)
-    clock = status.clock
-    return {
-        "pose": dict(zip(("x", "y", "z", "a", "b", "c"), pose.xyzabc, strict=True)),
-        "external_axes": list(pose.ext),
-        "joints": list(pose.joints) if pose.joints is not None else None,
-        "mode": {"value": int(status.mode), "name": controller_mode_text(int(status.mode))},
-        "program_state": {"value": int(status.program_state),
-                          "name": program_state_text(int(status.program_state))},
-        "alarms": {"value": int(status.alarms), "names": alarm_names(int(status.alarms))},
-        "command_status": {"code": code, "text": decoded.text},
-        "clock": None if clock is None else {
-            "iso": clock.value.isoformat() if clock.value is not None else None,
-            "raw": list(clock.raw),
-            "raw_hex": clock.raw_hex,
-        },
-    }
-
-
-def format_status(pose: Pose, status: ControllerStatus) -> str:
-    data = status_to_dict(pose, status)
-    cart = "  ".join(f"{n} {_num(v)}" for n, v in zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True))
-    ext = "  ".join(f"EJ{i} {_num(v)}" for i, v in enumerate(pose.ext, start=1))
-    joints = ("  ".join(f"J{i} {_num(v)}" for i, v in enumerate(pose.joints, start=1))
-              if pose.joints is not None else "-")
-    alarms = ", ".join(data["alarms"]["names"]) or "none"
-    lines = [
-        f"pose      {cart}",
-        f"external  {ext}",
-        f"joints    {joints}",
-        f"mode      {data['mode']['name']} ({data['mode']['value']})",
-        f"program   {data['program_state']['name']} ({data['program_state']['value']})",
-        f"alarms    {alarms} ({data['alarms']['value']})",
-        f"command   {data['command_status']['code']} {data['command_status']['text']}",
-    ]
-    clock = data["clock"]
-    if clock is not None:
-        when = clock["iso"].replace("T", " ") if clock["iso"] else "invalid"
-        lines.append(f"clock     {when} (raw {clock['raw_hex']})")
-    return "\n".join(lines)
-
-
-def format_watch_line(elapsed: float, pose: Pose, status: ControllerStatus) -> str:
-    cart = " ".join(f"{n}={_num(v)}" for n, v in zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True))
-    alarms = ",".join(alarm_names(int(status.alarms))) or "none"
-    return (f"t={elapsed:.3f} {cart} mode={controller_mode_text(int(status.mode))} "
-            f"program={program_state_text(int(status.program_state))} alarms={alarms} "
-            f"cmd={status.command_status_code}")
-
-
-# --------------------------------------------------------------------------------------------
-# Argument helpers
-# --------------------------------------------------------------------------------------------
-
-
-def _axis_index(name: str, joint_frame: bool) -> int:
-    key = name.strip().upper()
-    names = JOINT_AXIS_NAMES if joint_frame else CARTESIAN_AXIS_NAMES
-    if key in names:
-        return names.index(key)
-    frame = "joint frame" if joint_frame else "this frame"
-    raise InvalidInput(f"axis {name!r} does not exist in the {frame} (use {', '.join(names)})")
-
-
-def _parse_direction(text: str) -> int:
-    key = text.strip().lower()
-    if key in ("+", "pos", "positive", "1"):
-        return 1
-    if key in ("-", "neg", "negative", "0"):
-        return 0
-    raise InvalidInput(f"direction must be + or -, got {text!r}")
-
-
-def _parse_step_offsets(frame: StepFrame, items: Sequence[str]) -> tuple[list[float], list[float]]:
-    offsets = [0.0] * registers.NUM_ROBOT_AXES
-    ext = [0.0] * registers.NUM_EXTERNAL_AXES
-    main_names = JOINT_AXIS_NAMES[:6] if frame is StepFrame.JOINT else CARTESIAN_AXIS_NAMES
-    ext_names = JOINT_AXIS_NAMES[6:]
-    if not items:
-        raise InvalidInput(f"step needs offsets like {main_names[0]}=10")
-    for item in items:
-        name, sep, value_text = item.partition("=")
-        if not sep:
-            raise InvalidInput(f"offset {item!r} is not AXIS=VALUE")
-        key = name.strip().upper()
-        try:
-            value = float(value_text)
-        except ValueError:
-            raise InvalidInput(f"offset {item!r}: {value_text!r} is not a number") from None
-        if key in main_names:
-            offsets[main_names.index(key)] = value
-        elif key in ext_names:
-            ext[ext_names.index(key)] = value
-        else:
-            allowed = ", ".join((*main_names, *ext_names))
-            raise InvalidInput(f"axis {name!r} is not valid for a {frame.value} step (use {allowed})")
-    return offsets, ext
-
-
-def _parse_zero_axis(text: str) -> int | None:
-    key = text.strip().upper()
-    if key == "ALL":
-        return None
-    if key in JOINT_AXIS_NAMES:
-        return JOINT_AXIS_NAMES.index(key)
-    if key.isdigit() and 1 <= int(key) <= registers.NUM_AXES_TOTAL:
-        return int(key) - 1
-    raise InvalidInput(f"zero: axis must be J1..J11, 1..11 or all, got {text!r}")
-
-
-def _word_order(text: str) -> WordOrder:
-    try:
-        return WordOrder.parse(text)
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def _jog_seconds(text: str) -> float:
-    value = _positive_float(text)
-    if value > JOG_SECONDS_MAX:
-        raise argparse.ArgumentTypeError(f"a jog runs at most {JOG_SECONDS_MAX:g} s, got {text[:20]}")
-    return value
-
-
-def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not value > 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"must be a positive number, got {text}")
-    return value
 
 
 # --------------------------------------------------------------------------------------------
@@ -437,8 +314,27 @@ _PROGRAM_MODES = {"step": ProgramMotionMode.SINGLE_STEP, "single": ProgramMotion
 
 def cmd_program_run(ctx: CliContext) -> int:
     args = ctx.args
-    ctx.client.run_program(args.id, _PROGRAM_MODES[args.mode], cycles=args.cycles, speed_ratio=args.speed)
-    return _report(ctx, f"program {args.id} started ({args.mode})")
+    client = ctx.client
+    before = client.read_pose()
+    client.run_program(args.id, _PROGRAM_MODES[args.mode], cycles=args.cycles, speed_ratio=args.speed)
+    # The controller answers a run command only through its state: wait to see the program run.
+    deadline = time.monotonic() + PROGRAM_START_TIMEOUT
+    while True:
+        status = client.read_status()
+        if status.alarms:
+            names = ", ".join(alarm_names(int(status.alarms)))
+            raise AlarmRaised(int(status.alarms), f"program {args.id} not started: alarm {names}")
+        if status.program_state in (ProgramState.RUNNING, ProgramState.PAUSED):
+            return _report(ctx, f"program {args.id} running ({args.mode})")
+        if pose_moved(client.read_pose(), before):
+            return _report(ctx, f"program {args.id} ran and ended ({args.mode})")
+        if time.monotonic() >= deadline:
+            raise CommandRefused(
+                CommandStatus(None, status.command_status_code),
+                f"the controller did not start program {args.id}: its program state stayed stopped for "
+                f"{PROGRAM_START_TIMEOUT:g} s (no such program, or the controller refused it)",
+                code="program_not_started", params={"program": args.id})
+        time.sleep(PROGRAM_START_POLL)
 
 
 def cmd_stop(ctx: CliContext) -> int:
@@ -488,16 +384,18 @@ def register_core(sub: Any) -> None:
     p.set_defaults(handler=cmd_status)
 
     p = sub.add_parser("watch", help="stream one status line per sample")
-    p.add_argument("--rate", type=_positive_float, default=WATCH_RATE_DEFAULT, metavar="HZ")
+    p.add_argument("--rate", type=_positive_float, default=WATCH_RATE_DEFAULT, metavar="HZ",
+                   help="samples per second, Hz (default %(default)g)")
     p.add_argument("--count", type=int, default=0, metavar="N", help="stop after N lines (0: until Ctrl-C)")
     p.set_defaults(handler=cmd_watch)
 
     p = sub.add_parser("mode", help="set the work mode")
-    p.add_argument("mode", choices=("auto", "manual"))
+    p.add_argument("mode", choices=("auto", "manual"), help="auto or manual (register 444)")
     p.set_defaults(handler=cmd_mode)
 
     p = sub.add_parser("step", help="incremental move (function 1), e.g. step --frame base X=10 Z=-5")
-    p.add_argument("--frame", choices=("joint", "base"), required=True)
+    p.add_argument("--frame", choices=("joint", "base"), required=True,
+                   help="joint: offsets in degrees per joint; base: X Y Z in mm, A B C in degrees")
     p.add_argument("offsets", nargs="+", metavar="AXIS=VALUE",
                    help="J1..J11 (joint) or X Y Z A B C (+ J7..J11) (base)")
     p.add_argument("--speed", type=_positive_float, default=10.0, help="rpm (joint) or mm/s (base)")
@@ -510,7 +408,8 @@ def register_core(sub: Any) -> None:
                     f"bounded: it stops after --seconds (default {JOG_SECONDS_DEFAULT:g} s, at most "
                     f"{JOG_SECONDS_MAX:g} s), on Ctrl-C and on any error. Example: "
                     "teachpad-cli --host 192.168.1.10 jog --axis Z --dir + --ratio 10 --seconds 1.5")
-    p.add_argument("--frame", choices=("base", "user", "tool", "joint"), default="base")
+    p.add_argument("--frame", choices=("base", "user", "tool", "joint"), default="base",
+                   help="the frame the axis belongs to (default %(default)s)")
     p.add_argument("--user", type=int, default=0, metavar="N", help="user frame id (frame user)")
     p.add_argument("--tool", type=int, default=0, metavar="N", help="tool frame id (frame tool)")
     p.add_argument("--axis", required=True, help="X Y Z A B C, or J1..J11 in the joint frame")
@@ -524,37 +423,44 @@ def register_core(sub: Any) -> None:
     p = sub.add_parser("point", help="temp points (function 2)")
     psub = p.add_subparsers(dest="point_command", metavar="ACTION", required=True)
     pc = psub.add_parser("create", help="create or overwrite a temp point")
-    pc.add_argument("id", type=int)
+    pc.add_argument("id", type=int, help="temp point id, 1..10000")
     src = pc.add_mutually_exclusive_group()
     src.add_argument("--from-pose", action="store_true", help="from the current pose (default)")
-    src.add_argument("--xyzabc", type=float, nargs=6, metavar=("X", "Y", "Z", "A", "B", "C"))
+    src.add_argument("--xyzabc", type=float, nargs=6, metavar=("X", "Y", "Z", "A", "B", "C"),
+                     help="the pose: X Y Z in mm, A B C in degrees (base frame)")
     pc.add_argument("--tool", type=int, default=registers.TOOL_NONE, metavar="N",
                     help="GV245: 200 none (default), N = tool N+1")
     pc.add_argument("--gv-start", type=int, default=0, metavar="N", help="first of the six pose GVs")
     pc.set_defaults(handler=cmd_point_create)
 
     p = sub.add_parser("move", help="move to a temp point: line, or arc with --via (function 3)")
-    p.add_argument("id", type=int)
-    p.add_argument("--via", type=int, metavar="MID", help="middle point of an arc")
-    p.add_argument("--speed", type=_positive_float, default=50.0)
-    p.add_argument("--keep-orientation", action="store_true")
-    p.add_argument("--ignore-middle", action="store_true")
-    p.add_argument("--tool", type=int, default=registers.TOOL_NONE, metavar="N")
-    p.add_argument("--no-wait", action="store_true")
-    p.add_argument("--wait-timeout", type=_positive_float, default=None, metavar="SECONDS")
+    p.add_argument("id", type=int, help="temp point id of the end point, 1..10000")
+    p.add_argument("--via", type=int, metavar="MID", help="temp point id of an arc's middle point")
+    p.add_argument("--speed", type=_positive_float, default=50.0, help="mm/s (default %(default)g)")
+    p.add_argument("--keep-orientation", action="store_true",
+                   help="keep the tool's orientation (A B C) along an arc")
+    p.add_argument("--ignore-middle", action="store_true",
+                   help="arc: use the middle point's position only, not its orientation")
+    p.add_argument("--tool", type=int, default=registers.TOOL_NONE, metavar="N",
+                   help=f"tool frame id ({registers.TOOL_NONE}: none, the default)")
+    p.add_argument("--no-wait", action="store_true", help="return once the command is sent")
+    p.add_argument("--wait-timeout", type=_positive_float, default=None, metavar="SECONDS",
+                   help="give up waiting after this many seconds (default: by distance and speed)")
     p.set_defaults(handler=cmd_move)
 
     p = sub.add_parser("zero", help="go to zero: one axis (J1..J11) or all")
-    p.add_argument("axis", metavar="AXIS|all")
+    p.add_argument("axis", metavar="AXIS|all", help="J1..J11, or all")
     p.set_defaults(handler=cmd_zero)
 
     p = sub.add_parser("program", help="controller programs")
     psub = p.add_subparsers(dest="program_command", metavar="ACTION", required=True)
     pr = psub.add_parser("run", help="run a program")
-    pr.add_argument("id", type=int)
-    pr.add_argument("--mode", choices=tuple(_PROGRAM_MODES), default="single")
+    pr.add_argument("id", type=int, help="program id on the controller (register 446)")
+    pr.add_argument("--mode", choices=tuple(_PROGRAM_MODES), default="single",
+                    help="step: one segment; single: one run; cycle: --cycles runs (default %(default)s)")
     pr.add_argument("--cycles", type=int, default=1, help="cycle count (0: endless)")
-    pr.add_argument("--speed", type=int, default=100, help="speed ratio 1..100")
+    pr.add_argument("--speed", type=int, default=100,
+                    help="speed ratio in percent, 1..100 (default %(default)s)")
     pr.set_defaults(handler=cmd_program_run)
 
     for name, handler, text in (("stop", cmd_stop, "stop the motion or program"),
@@ -563,13 +469,15 @@ def register_core(sub: Any) -> None:
         p.set_defaults(handler=handler)
 
     p = sub.add_parser("read", help="read GVs (float32)")
-    p.add_argument("gv", type=int, metavar="GV")
-    p.add_argument("count", type=int, nargs="?", default=1, metavar="COUNT")
+    p.add_argument("gv", type=int, metavar="GV", help="first GV number, 0..299 (e.g. 291)")
+    p.add_argument("count", type=int, nargs="?", default=1, metavar="COUNT",
+                   help="how many GVs (default 1)")
     p.set_defaults(handler=cmd_read)
 
     p = sub.add_parser("write", help="write GVs (float32, one 0x10)")
-    p.add_argument("gv", type=int, metavar="GV")
-    p.add_argument("values", type=float, nargs="+", metavar="VALUE")
+    p.add_argument("gv", type=int, metavar="GV", help="first GV number, 0..299")
+    p.add_argument("values", type=float, nargs="+", metavar="VALUE",
+                   help="float32 values, written to GV, GV+1, ... (units as the GV's meaning)")
     p.set_defaults(handler=cmd_write)
 
 
@@ -599,16 +507,19 @@ def build_parser() -> argparse.ArgumentParser:
                "130 interrupted",
     )
     link = parser.add_argument_group("link")
-    link.add_argument("--host", default="127.0.0.1")
-    link.add_argument("--port", type=int, default=502)
+    link.add_argument("--host", default="127.0.0.1",
+                      help="controller's IP address or host name (default %(default)s)")
+    link.add_argument("--port", type=int, default=502, help="Modbus TCP port (default %(default)s)")
     link.add_argument("--unit", type=int, default=1, help="Modbus unit (slave) id")
     link.add_argument("--rtu", metavar="PORT", help="Modbus RTU on this serial port instead of TCP")
-    link.add_argument("--baud", type=int, default=115200)
-    link.add_argument("--parity", choices=("N", "E", "O"), default="N")
+    link.add_argument("--baud", type=int, default=115200, help="RTU baud rate, bit/s (default %(default)s)")
+    link.add_argument("--parity", choices=("N", "E", "O"), default="N",
+                      help="RTU parity: none, even, odd (default %(default)s)")
     link.add_argument("--framer", choices=("socket", "rtu"), default="socket",
                       help="frame format over TCP (rtu: RTU frames over a TCP socket)")
     link.add_argument("--word-order", type=_word_order, default=WordOrder.LOW_FIRST,
-                      metavar="low-first|high-first")
+                      metavar="low-first|high-first",
+                      help="float32 word order of the controller (default low-first)")
     link.add_argument("--timeout", type=_positive_float, default=1.0, metavar="SECONDS",
                       help="Modbus request timeout of commands and one-off reads")
     link.add_argument("--poll-timeout", type=_positive_float, default=None, metavar="SECONDS",
@@ -619,6 +530,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for registrar in (*REGISTRARS, *_plugin_registrars()):
         registrar(sub)
+    add_examples(parser)
     return parser
 
 
@@ -638,7 +550,30 @@ def _configure_logging(verbose: bool) -> None:
         logging.getLogger("pymodbus").setLevel(logging.CRITICAL)
 
 
+def _quiet_broken_pipe() -> None:
+    """The reader of our output went away (``status | head -1``): say nothing more.
+
+    Later writes and the interpreter's final flush go to /dev/null, so no BrokenPipeError
+    traceback reaches the terminal. The exit code is 0: the reader had what it wanted (a script
+    with ``set -o pipefail`` does not fail because ``head`` stopped reading).
+    """
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    try:
+        code = _main(argv)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        _quiet_broken_pipe()
+        return EXIT_OK
+    return code
+
+
+def _main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     try:
         args = parser.parse_args(argv)
@@ -662,6 +597,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return fail(EXIT_FAILED, str(exc))
     except KeyboardInterrupt:
         return fail(EXIT_INTERRUPTED, "interrupted")
+    except BrokenPipeError:
+        _quiet_broken_pipe()
+        return EXIT_OK
     finally:
         ctx.close()
 

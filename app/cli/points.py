@@ -48,6 +48,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import unicodedata
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
@@ -104,31 +105,56 @@ def _handler(command: Command) -> Callable[..., int]:
     return handler
 
 
+_PROJECT_HELP = "the project file (.tpproj)"
+NAME_WIDTH = 20  # terminal columns of the name in ``points list``
+
+
+def display_width(text: str) -> int:
+    """Terminal columns of ``text``: wide (CJK) characters take two, combining marks none."""
+    return sum(0 if unicodedata.combining(c) else 2 if unicodedata.east_asian_width(c) in "WF" else 1
+               for c in text)
+
+
+def fit_width(text: str, width: int) -> str:
+    """``text`` cut to ``width`` terminal columns (with "…" when cut) and padded to exactly it."""
+    if display_width(text) > width:
+        out, used = "", 0
+        for c in text:
+            w = display_width(c)
+            if used + w > width - 1:
+                break
+            out, used = out + c, used + w
+        text = out + "…"
+    return text + " " * (width - display_width(text))
+
+
 def register(subparsers: Any) -> None:
     """Add ``points`` and ``run`` to the main parser's subparsers."""
     points = subparsers.add_parser("points", help="temp points of a project: list, upload, export, import")
     psub = points.add_subparsers(dest="points_command", metavar="ACTION", required=True)
 
     p = psub.add_parser("list", help="print the points and plans of a project")
-    p.add_argument("project", type=Path)
+    p.add_argument("project", type=Path, help=_PROJECT_HELP)
     p.set_defaults(handler=_handler(cmd_points_list))
 
     p = psub.add_parser("upload", help="create the project's points on the controller (function 2)")
-    p.add_argument("project", type=Path)
+    p.add_argument("project", type=Path, help=_PROJECT_HELP)
     group = p.add_mutually_exclusive_group()
     group.add_argument("--ids", help="ids to upload, e.g. 1,2,5-9 (default: all)")
     group.add_argument("--needed", action="store_true", help="only points not known to be on the controller")
     p.set_defaults(handler=_handler(cmd_points_upload))
 
     p = psub.add_parser("export", help="write the project's points to a CSV file")
-    p.add_argument("project", type=Path)
-    p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="OUT")
+    p.add_argument("project", type=Path, help=_PROJECT_HELP)
+    p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="OUT",
+                   help="the CSV file to write (mm, degrees)")
     p.add_argument("--no-bom", action="store_true", help="write UTF-8 without a byte order mark")
     p.set_defaults(handler=_handler(cmd_points_export))
 
     p = psub.add_parser("import", help="read points from a CSV file into the project")
-    p.add_argument("project", type=Path)
-    p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="IN")
+    p.add_argument("project", type=Path, help=_PROJECT_HELP)
+    p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="IN",
+                   help="the CSV file to read (mm, degrees)")
     p.add_argument("--merge", action="store_true",
                    help="update and add points, keep the others (default: replace all points)")
     p.add_argument("--allow-empty", action="store_true",
@@ -136,7 +162,7 @@ def register(subparsers: Any) -> None:
     p.set_defaults(handler=_handler(cmd_points_import))
 
     r = subparsers.add_parser("run", help="run a plan of a project on the controller (function 3)")
-    r.add_argument("project", type=Path)
+    r.add_argument("project", type=Path, help=_PROJECT_HELP)
     r.add_argument("--plan", help="plan name (needed when the project has several)")
     r.add_argument("--loops", type=int, help="loop count (default: the plan's; 0 = until stopped)")
     r.add_argument("--from", type=int, default=1, dest="from_segment", metavar="K",
@@ -149,6 +175,8 @@ def register(subparsers: Any) -> None:
                         "points (the arrival pose is still checked after each segment)")
     r.add_argument("--upload", action="store_true", help=argparse.SUPPRESS)  # the default now (old scripts)
     r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
+    r.add_argument("--safety", metavar="PROFILE",
+                   help="a safety profile (.safety.json): the plan must stay in its envelope")
     r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
                    help="highest speed a segment may have (default %(default)g mm/s)")
     from app.cli.run_plan import cmd_run  # imported here: run_plan uses this module's helpers
@@ -293,7 +321,7 @@ def cmd_points_list(args: argparse.Namespace, make_client: MakeClient, *, out: T
         last = project.upload_history.get(p.id)
         if last is not None:  # history: what this host did, not what the controller holds now
             state += f" (last uploaded {last.time} to {last.endpoint})"
-        io.print(f"{p.id:6d}  {p.name[:20]:20s} {pose}  {tool_text(p.tool):14s} {state}")
+        io.print(f"{p.id:6d}  {fit_width(p.name, NAME_WIDTH)} {pose}  {tool_text(p.tool):14s} {state}")
     for plan in project.plans:
         io.print(f"plan {plan.name!r}: {len(plan)} segment(s), loops {plan.loops or 'until stopped'}")
     return EXIT_OK

@@ -41,6 +41,8 @@ from app.points.guard import PointGuard, PointMismatch, PointNotCreated
 from app.points.lock import live_owner
 from app.points.project import Project
 from app.protocol.enums import MoveStatus
+from app.safety.envelope import Envelope
+from app.safety.profile import load_profile
 
 
 def _pick_plan(io: _Io, project: Project, name: str | None) -> Plan | None:
@@ -113,6 +115,13 @@ def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | 
         io.error(str(exc))
         return EXIT_USAGE
 
+    envelope: Envelope | None = None
+    if getattr(args, "safety", None):
+        try:
+            envelope = load_profile(args.safety).envelope
+        except TeachPadError as exc:
+            io.error(str(exc))
+            return EXIT_USAGE
     client: Any = None
     try:
         pose: Pose | None = None
@@ -122,16 +131,16 @@ def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | 
                 pose = client.read_pose()
             except TeachPadError as exc:
                 return _link_code(io, exc, "cannot read the robot's pose")
-        return _run(io, args, project, plan, client, pose, limits, loops, start)
+        return _run(io, args, project, plan, client, pose, limits, loops, start, envelope)
     finally:
         if close_client and client is not None:
             client.close()
 
 
 def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client: Any, pose: Pose | None,
-         limits: PlanLimits, loops: int, start: int) -> int:
+         limits: PlanLimits, loops: int, start: int, envelope: Envelope | None = None) -> int:
     ledger = project.ledger
-    issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops)
+    issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops, envelope=envelope)
     for issue in issues:
         if issue.kind is IssueKind.WARNING:
             io.warn(issue.message)

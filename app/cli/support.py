@@ -51,24 +51,28 @@ def _moment(text: str) -> dt.datetime:
 def register(subparsers: Any) -> None:
     p = subparsers.add_parser("support-bundle", help="write a zip for an integrator (offline)",
                               description="Write a support bundle. " + ADMIN_NOTE)
-    p.add_argument("out", type=Path, metavar="OUT.zip")
+    p.add_argument("out", type=Path, metavar="OUT.zip", help="the zip file to write")
     p.add_argument("--project", type=Path, help="the project file to include")
     p.add_argument("--profile", type=Path, help="the safety profile to include")
     p.add_argument("--settings", type=Path, help="a JSON settings file (secrets are removed)")
     p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
     p.add_argument("--log-dir", type=Path, help="a folder of log files to include")
     p.add_argument("--traffic", type=Path, help="a text file of recorded Modbus traffic")
-    p.add_argument("--days", type=_positive_int, default=DEFAULT_DAYS, help="how many days of records")
+    p.add_argument("--days", type=_positive_int, default=DEFAULT_DAYS,
+                   help="how many days of records, counted back from now (default %(default)s)")
     p.set_defaults(handler=cmd_support_bundle)
 
     p = subparsers.add_parser("audit", help="show or export the audit trail (offline)",
                               description="Show the audit trail. " + ADMIN_NOTE)
     p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
-    p.add_argument("--from", dest="start", type=_moment, metavar="WHEN")
-    p.add_argument("--to", dest="end", type=_moment, metavar="WHEN")
-    p.add_argument("--role")
+    p.add_argument("--from", dest="start", type=_moment, metavar="WHEN",
+                   help="first moment, local time YYYY-MM-DD[THH:MM]")
+    p.add_argument("--to", dest="end", type=_moment, metavar="WHEN",
+                   help="last moment, local time YYYY-MM-DD[THH:MM]")
+    p.add_argument("--role", help="only records of this role (operator, engineer, administrator)")
     p.add_argument("--command", dest="command_text", metavar="TEXT", help="part of the command text")
-    p.add_argument("--result", choices=("ok", "failed", "blocked", "refused"))
+    p.add_argument("--result", choices=("ok", "failed", "blocked", "refused"),
+                   help="only records with this result")
     p.add_argument("--csv", type=Path, metavar="OUT", help="write CSV instead of printing")
     p.set_defaults(handler=cmd_audit)
 
@@ -81,7 +85,7 @@ def register(subparsers: Any) -> None:
     for name, text in (("set-password", "set a role's password (asked for, not an argument)"),
                        ("clear-password", "remove a role's password (nobody can log in as it)")):
         r = rsub.add_parser(name, help=text)
-        r.add_argument("role", choices=("engineer", "administrator"))
+        r.add_argument("role", choices=("engineer", "administrator"), help="the role")
         r.set_defaults(handler=cmd_roles)
 
 

@@ -29,12 +29,13 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import enum
 import logging
 import math
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 
 from app import timing
 from app.errors import (
@@ -42,6 +43,7 @@ from app.errors import (
     LinkError,
     MalformedResponse,
     ModbusExceptionError,
+    Reason,
     ResponseTimeout,
     WriteBlocked,
 )
@@ -86,6 +88,7 @@ from app.protocol.enums import (
     decode_command_status,
     decode_status_registers,
 )
+from app.safety.audit import AuditLog
 
 __all__ = [
     "ConnectionSettings",
@@ -135,11 +138,13 @@ class RobotClient:
         self.last_status: ControllerStatus | None = None
         self.last_tracker: CommandTracker | None = None
         self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
+        self._io_timeout: float | None = None  # see io_timeout()
         self._gv291_writable: bool | None = None  # completion "auto": None until probed
         # X Y Z of the points this client created from given poses (a move whose GV291 never
         # changed may be confirmed by arriving there, see CommandTracker's ``target``)
         self._sent_points: dict[int, tuple[float, float, float]] = {}
         self._ack_latency = 0.0  # s, decaying maximum of the acknowledgement times seen
+        self.audit: AuditLog | None = None  # every write (and monitor-only block) is recorded here
 
     # -- connection (the transport drops the caches whenever the link is made or lost) ---
     def connect(self) -> None:
@@ -180,31 +185,49 @@ class RobotClient:
 
     # -- the transport: every answer is checked against its request ----------------------
     def _read(self, address: int, count: int, timeout: float | None = None) -> list[int]:
+        timeout = self._io_timeout if timeout is None else timeout
         return self._transport.read(f"read of {_range_name(address, count)}", address, count, timeout)
+
+    @contextlib.contextmanager
+    def io_timeout(self, seconds: float) -> Iterator[None]:
+        """Every transaction inside waits at most ``seconds`` per attempt (unless it passes its
+        own ``timeout``): the shutdown's ratio 0 / teach disable must not hang on a dead controller."""
+        outer, self._io_timeout = self._io_timeout, float(seconds)
+        try:
+            yield
+        finally:
+            self._io_timeout = outer
 
     def _require_writable(self, what: str) -> None:
         if self.settings.monitor_only:
             raise WriteBlocked(f"monitor-only mode: {what} was not sent")
 
-    def _write(self, address: int, values: Sequence[int], *, single: bool = False) -> None:
-        """The write guard: every write to the controller passes here."""
-        name = _range_name(address, len(values))
-        self._require_writable(f"write to {name}")
-        if not values:
-            raise InvalidInput("nothing to write")
-        if single:
-            if len(values) != 1:
-                raise InvalidInput("a single-register write takes one value")
-            _log.debug("write 0x06 %s <- %d", name, values[0])
-            self.write_count += 1
-            self._transport.write_single(f"write to {name}", address, int(values[0]))
-        else:
-            _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
-            self.write_count += 1
-            self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values])
+    def _write(self, address: int, values: Sequence[int], *, single: bool = False,
+               timeout: float | None = None) -> None:
+        """The write guard: every write to the controller passes here (and, with an audit trail,
+        is recorded there once, blocked ones too). ``timeout`` (s per attempt) overrides the
+        request timeout (default: :meth:`io_timeout`'s, else the settings')."""
+        timeout = self._io_timeout if timeout is None else timeout
+        ctx = self.audit.writing(address, values, single=single) if self.audit else contextlib.nullcontext()
+        with ctx:
+            name = _range_name(address, len(values))
+            self._require_writable(f"write to {name}")
+            if not values:
+                raise InvalidInput("nothing to write")
+            if single:
+                if len(values) != 1:
+                    raise InvalidInput("a single-register write takes one value")
+                _log.debug("write 0x06 %s <- %d", name, values[0])
+                self.write_count += 1
+                self._transport.write_single(f"write to {name}", address, int(values[0]), timeout)
+            else:
+                _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
+                self.write_count += 1
+                self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values],
+                                               timeout)
 
-    def _write_floats(self, gv: int, values: Sequence[float]) -> None:
-        self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order))
+    def _write_floats(self, gv: int, values: Sequence[float], timeout: float | None = None) -> None:
+        self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order), timeout=timeout)
 
     def _write_control(self, register: int, value: int) -> None:
         self._write(register, [value], single=True)
@@ -441,7 +464,8 @@ class RobotClient:
     def _finish(self, tracker: CommandTracker, wait: bool) -> CommandResult:
         if wait:
             return self.wait(tracker)
-        return CommandResult(tracker.command, tracker.kind, None, True, f"{tracker.text}: sent")
+        return CommandResult(tracker.command, tracker.kind, None, True, f"{tracker.text}: sent",
+                             reason=Reason("sent", {"command": int(tracker.command)}))
 
     def _check_point_id(self, point_id: int, name: str = "point id") -> int:
         return _check_int(point_id, self.settings.point_id_min, self.settings.point_id_max, name)
@@ -474,6 +498,11 @@ class RobotClient:
             self._ext_cache = ext
         self._write_floats(registers.GV_EXPECTED_SPEED, [speed])
         tracker = self.begin_command(command, before, before_pose, timeout=timeout)
+        if before_pose is not None and frame is StepFrame.BASE and not any(ext):
+            x, y, z = before_pose.xyzabc[:3]
+            tracker.target = (x + offs[0], y + offs[1], z + offs[2])
+        elif before_pose is not None and frame is StepFrame.JOINT and before_pose.joints and not any(ext):
+            tracker.target_joints = tuple(q + d for q, d in zip(before_pose.joints, offs, strict=False))
         return self._finish(tracker, wait)
 
     @staticmethod
@@ -542,7 +571,7 @@ class RobotClient:
                 status = tracker.last_status or status
             except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
                 results.append(CommandResult(RunCommand.CREATE_POINT, kind, None, False, str(exc),
-                                             {"point_id": float(point_id)}))
+                                             {"point_id": float(point_id)}, reason=exc.as_reason()))
                 break
             details = dict(result.details, point_id=float(point_id))
             results.append(dataclasses.replace(result, message=f"point {point_id}: {result.message}",
@@ -605,10 +634,10 @@ class RobotClient:
         self._teach_frame = frame
         return self._finish(tracker, wait)
 
-    def teach_set_ratio(self, ratio: float) -> None:
-        """GV203 <- ratio: > 0 moves, 0 stops the jog (teach stays enabled)."""
+    def teach_set_ratio(self, ratio: float, *, timeout: float | None = None) -> None:
+        """GV203 <- ratio: > 0 moves, 0 stops the jog (teach stays enabled). ``timeout``: s per attempt."""
         ratio = _check_float(ratio, "speed ratio", 0.0, 100.0)
-        self._write_floats(registers.GV_PARAM3, [ratio])
+        self._write_floats(registers.GV_PARAM3, [ratio], timeout)
 
     def teach_set_axis(self, axis: int, direction: int) -> None:
         """Ratio 0 first, then GV201-202 (same frame); start again with :meth:`teach_set_ratio`."""

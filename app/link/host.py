@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Protocol
 
+from app.errors import Reason
 from app.link.types import ConnectionState
 from app.models import CommandResult, ControllerStatus, Pose
 
@@ -21,6 +22,8 @@ if TYPE_CHECKING:
     from app.link.stats import LinkStats
     from app.link.supervisor import LinkSupervisor
     from app.link.upload import Uploader
+    from app.safety.audit import AuditLog
+    from app.safety.envelope import EnvelopeViolation
 
 __all__ = ["WorkerHost", "WorkerOutputs"]
 
@@ -39,7 +42,10 @@ class WorkerOutputs(Protocol):
     def publish_reconnected(self) -> None: ...
     def publish_restarted(self) -> None: ...
     def publish_upload_progress(self, done: int, total: int) -> None: ...
-    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None: ...
+    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
+        """``unconfirmed``: ok, but the controller's status never changed (observe rule)."""
+
+    def publish_guard_stop(self, violation: EnvelopeViolation) -> None: ...
 
 
 class WorkerHost(WorkerOutputs, Protocol):
@@ -52,6 +58,7 @@ class WorkerHost(WorkerOutputs, Protocol):
     uploader: Uploader
     capture: TrafficCapture
     closed: bool
+    audit: AuditLog | None  # given to each new client (thread-safe)
     request_id: int | None  # of the job being executed (results and errors carry it)
 
     @property
@@ -78,7 +85,10 @@ class WorkerHost(WorkerOutputs, Protocol):
 
     def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None: ...
 
-    def emit_error(self, operation: str, message: str, request_id: int | None = -1) -> None: ...
+    def emit_error(self, operation: str, message: str, request_id: int | None = -1,
+                   reason: Reason | None = None) -> None: ...
+
+    def emit_exception(self, operation: str, exc: BaseException, request_id: int | None = -1) -> None: ...
 
     def start_polling(self) -> None: ...
 

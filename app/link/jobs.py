@@ -37,6 +37,7 @@ class Job:
     coalesce: str | None = None  # a newer job with the same key replaces a queued one
     needs_link: bool = True
     cancels: tuple[str, ...] = ()  # an urgent job drops the queued jobs with these coalesce keys
+    sent: threading.Event | None = None  # set by the worker once the job's first write is out (stop)
 
 
 class JobQueue:

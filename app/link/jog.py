@@ -18,8 +18,10 @@ from app.errors import CommandRefused, InvalidInput, LinkError, TeachPadError
 from app.link.host import WorkerHost
 from app.link.tracker import CommandTracker
 from app.link.types import JogRequest, Operation
-from app.models import CommandResult, ControllerStatus
+from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import ControllerMode, TeachFrame, controller_mode_text
+from app.safety.envelope import EnvelopeRefused, EnvelopeViolation
+from app.safety.jog_guard import JogGuard
 
 __all__ = ["JogMachine", "PreemptedError", "TeachState"]
 
@@ -48,6 +50,7 @@ class JogMachine:
         self._serial = 0
         self.released_at = 0.0
         self.ratio_zero_pending = False  # the controller went silent while jogging: ratio 0 on return
+        self.guard: JogGuard | None = None  # the safety envelope's jog guard (immutable; set by the GUI)
 
     # --- state ----------------------------------------------------------------------------
     def reset(self) -> None:
@@ -172,6 +175,7 @@ class JogMachine:
             raise TeachPadError("the controller is not answering: jog not started")
         if not 0.0 < request.ratio <= 100.0:
             raise InvalidInput(f"jog speed must be 1..100 %, got {request.ratio:g}")
+        self._require_guard(request)  # refused before teach mode is even switched on
         self.jog = request
         self._serial += 1
         serial = self._serial
@@ -183,6 +187,7 @@ class JogMachine:
                 teach.axis = (request.axis, request.direction)
                 self._check(serial)
             if teach.ratio != request.ratio:
+                self._require_guard(request)
                 client.teach_set_ratio(request.ratio)
                 teach.ratio = request.ratio
             return
@@ -207,8 +212,39 @@ class JogMachine:
             self._host.emit_result(result)
             return
         self._check(serial)
+        self._require_guard(request)  # the pose may have moved on while teach mode came up
         client.teach_set_ratio(request.ratio)
         self.teach.ratio = request.ratio
+
+    # --- the jog guard (the safety envelope) ---------------------------------------------
+    def _require_guard(self, request: JogRequest) -> None:
+        """Raise :class:`EnvelopeRefused` (nothing written) when the guard would stop this jog now.
+        Without a pose yet there is nothing to decide on: the first poll decides."""
+        guard, pose = self.guard, self._host.poller.last_pose
+        if guard is None or pose is None:
+            return
+        decision = guard.decide(pose, request)
+        if not decision.allow and decision.violation is not None:
+            self.end_jog()
+            if self.teach.enabled and self.teach.ratio != 0.0:  # a jog under way stops too
+                self._host.client_or_raise().teach_set_ratio(0.0)
+                self.teach.ratio = 0.0
+            raise EnvelopeRefused(decision.violation, "jog")
+
+    def guard_pose(self, pose: Pose) -> EnvelopeViolation | None:
+        """Per poll, right after the pose is read: stop a jog heading over a boundary (ratio 0
+        first, the jog ends; teach stays on, as after a release). Returns why it stopped."""
+        jog, guard, client = self.jog, self.guard, self._host.client
+        if jog is None or guard is None or client is None or jog.ratio <= 0:
+            return None
+        decision = guard.decide(pose, jog)
+        if decision.allow or decision.violation is None:
+            return None
+        if self.teach.enabled and not client.settings.monitor_only:
+            client.teach_set_ratio(0.0)
+            self.teach.ratio = 0.0
+        self.end_jog()
+        return decision.violation
 
     def release(self) -> None:
         """The dead-man: ratio 0, teach stays enabled (disabled later when idle)."""
@@ -230,6 +266,7 @@ class JogMachine:
             raise InvalidInput(f"jog speed must be 1..100 %, got {ratio:g}")
         self.jog = dataclasses.replace(jog, ratio=ratio)
         if self.teach.enabled and self.teach.ratio != 0.0 and self.teach.ratio != ratio:
+            self._require_guard(self.jog)
             self._host.client_or_raise().teach_set_ratio(ratio)
             self.teach.ratio = ratio
 

@@ -16,13 +16,18 @@ import dataclasses
 import time
 
 from app import timing
-from app.errors import LinkError, ResponseTimeout, TeachPadError
+from app.errors import LinkError, MalformedResponse, ResponseTimeout, TeachPadError
 from app.link.capture import LinkStatsReporter, RttMeter
 from app.link.host import WorkerHost
 from app.link.types import Operation
 from app.models import ControllerStatus, Pose
 
-__all__ = ["Poller"]
+__all__ = ["JOG_POLL_HZ_MIN", "Poller"]
+
+#: While a jog is held (or teach mode moves at a non-zero ratio) the poller keeps at least this
+#: rate whatever the GUI's setting: the controller's watchdog (0.3 s on the simulator) stops a jog
+#: that sees no traffic, so a slow poll setting (below ~3.4 Hz) would stop the operator's own jog.
+JOG_POLL_HZ_MIN = 10.0
 
 
 class Poller:
@@ -38,6 +43,13 @@ class Poller:
         self.last_poll = 0.0  # monotonic time of the last poll attempt
         self.rtt = RttMeter(timing.RTT_REPORT_PERIOD)
         self.stats = LinkStatsReporter(timing.RTT_REPORT_PERIOD)
+
+    def rate(self, setting_hz: float) -> float:
+        """The poll rate to use now: the GUI's setting, at least :data:`JOG_POLL_HZ_MIN` while jogging."""
+        jog = self._host.jog
+        if jog.jog is not None or (jog.teach.enabled and jog.teach.ratio != 0.0):
+            return max(setting_hz, JOG_POLL_HZ_MIN)
+        return setting_hz
 
     def reset(self, now: float) -> None:
         """A link just came up."""
@@ -87,29 +99,40 @@ class Poller:
             t2 = time.perf_counter()
             pose = client.read_pose(timeout=timeout)
             t3 = time.perf_counter()
+            guard_stop = host.jog.guard_pose(pose)  # ratio 0 before the TCP crosses a boundary
+            host.run_urgent()  # and before this poll's publishing: a stop waits one read at most
+            if not host.link_up:
+                return
             gv = host.supervisor.canary_gv
             if with_clock and host.supervisor.canary_token is not None and gv is not None:
                 canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock
         except ResponseTimeout as exc:
-            self._report_error(str(exc))
+            self._report_error(exc)
             host.supervisor.poll_silent(str(exc), time.monotonic())
             self._report_stats()
             return
-        except LinkError as exc:
-            self._report_error(str(exc))
+        except (LinkError, MalformedResponse) as exc:
+            # A malformed answer is a failed poll: the transport counted it and resynchronised
+            # (a TCP link is reopened by the next request); none of its values are published;
+            # LINK_LOSS_POLLS of them in a row take the link down like any failed transaction.
+            self._report_error(exc)
             host.supervisor.transport_failed(str(exc))
             self._report_stats()
             return
         except TeachPadError as exc:
-            self._report_error(str(exc))
+            self._report_error(exc)
             return
         answered = time.monotonic()
         self._error = None
         host.supervisor.poll_answered()
         if not host.link_up:
             return
+        if guard_stop is not None:
+            host.publish_guard_stop(guard_stop)
         if with_clock:
             self._next_clock = now + timing.CLOCK_POLL_PERIOD
+            if client.audit is not None and status.clock is not None:
+                client.audit.note_controller_clock(status.clock.value, now)
         elif self.last_status is not None:
             status = dataclasses.replace(status, clock=self.last_status.clock)
         self.publish(pose, status)
@@ -133,7 +156,8 @@ class Poller:
             if stats is not None:
                 self._host.publish_link_stats(stats)
 
-    def _report_error(self, message: str) -> None:
+    def _report_error(self, exc: TeachPadError) -> None:
+        message = str(exc)
         if message != self._error:  # once per distinct error, not 50 times a second
             self._error = message
-            self._host.emit_error(Operation.POLL, message)
+            self._host.emit_exception(Operation.POLL, exc)

@@ -11,6 +11,7 @@ tests use a small fake that fits too).
 from __future__ import annotations
 
 import logging
+import sys
 from collections.abc import Iterable, Sequence
 from typing import Protocol
 
@@ -25,10 +26,18 @@ from app.link.worker import DEFAULT_CANARY_GV, RobotWorker
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
+from app.safety.audit import AuditLog
+from app.safety.jog_guard import JogGuard
 
 __all__ = ["LinkPort", "Pending", "RequestRouter", "RobotLink", "wait_for_detached_threads"]
 
 _log = logging.getLogger(__name__)
+
+#: The interpreter's GIL switch interval while a link exists (s). CPython's default, 5 ms, is
+#: how long the worker thread can wait for the GIL while the GUI thread runs Python (a paint, a
+#: slot): a Stop posted by the GUI then sat up to 5 ms before its write. 0.5 ms bounds that wait;
+#: the cost is more frequent GIL hand-offs, only when two threads want it at once.
+GIL_SWITCH_INTERVAL = 0.0005
 
 
 class Pending(QObject):
@@ -98,7 +107,7 @@ class LinkPort(Protocol):
     controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
     controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
     uploadProgress: SignalInstance  # noqa: N815 - (int, int) points done, total of the running upload
-    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str) point id, ok, reason
+    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str, bool) point id, ok, reason, unconfirmed
 
     @property
     def state(self) -> RobotState: ...
@@ -153,18 +162,23 @@ class RobotLink(QObject):
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815
     uploadProgress = Signal(int, int)  # noqa: N815
-    pointUploaded = Signal(int, bool, str)  # noqa: N815
+    pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
+    jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard stopped a jog
 
     _connectRequested = Signal(object)  # noqa: N815
     _disconnectRequested = Signal()  # noqa: N815
     _shutdownRequested = Signal()  # noqa: N815
     _pollRateRequested = Signal(float)  # noqa: N815
     _captureRequested = Signal(bool)  # noqa: N815
+    _guardRequested = Signal(object)  # noqa: N815
+    _auditRequested = Signal(object)  # noqa: N815
 
     def __init__(self, parent: QObject | None = None, *, poll_hz: float = timing.POLL_HZ_DEFAULT,
                  canary_gv: int | None = DEFAULT_CANARY_GV,
                  freshness_limit: float = DEFAULT_FRESHNESS_LIMIT) -> None:
         super().__init__(parent)
+        if sys.getswitchinterval() > GIL_SWITCH_INTERVAL:
+            sys.setswitchinterval(GIL_SWITCH_INTERVAL)  # see GIL_SWITCH_INTERVAL: a stop never waits 5 ms
         self._settings: ConnectionSettings | None = None
         self._state = RobotState(self, freshness_limit=freshness_limit)
         self._router = RequestRouter()
@@ -193,12 +207,15 @@ class RobotLink(QObject):
                                (w.controllerReconnected, self.controllerReconnected),
                                (w.controllerRestarted, self.controllerRestarted),
                                (w.uploadProgress, self.uploadProgress),
-                               (w.pointUploaded, self.pointUploaded)):
+                               (w.pointUploaded, self.pointUploaded),
+                               (w.jogGuardStopped, self.jogGuardStopped)):
             source.connect(target)
         self._connectRequested.connect(w.connect_to)
         self._disconnectRequested.connect(w.disconnect_link)
         self._pollRateRequested.connect(w.set_poll_rate)
         self._captureRequested.connect(w.set_traffic_capture)
+        self._guardRequested.connect(w.set_jog_guard)
+        self._auditRequested.connect(w.set_audit)
         self._shutdownRequested.connect(w.shutdown, Qt.ConnectionType.QueuedConnection)
         self._shutdownRequested.connect(self._on_shut_down)  # the GUI-side state: disconnected
         app = QCoreApplication.instance()
@@ -274,6 +291,16 @@ class RobotLink(QObject):
     def set_poll_rate(self, hz: float) -> None:
         if not self._shut:
             self._pollRateRequested.emit(float(hz))
+
+    def set_jog_guard(self, guard: JogGuard | None) -> None:
+        """The jog guard the worker applies on every poll during a jog (None: no envelope)."""
+        if not self._shut:
+            self._guardRequested.emit(guard)
+
+    def set_audit(self, audit: AuditLog | None) -> None:
+        """The audit trail every write of this link goes to (call before :meth:`connect_to`)."""
+        if not self._shut:
+            self._auditRequested.emit(audit)
 
     def set_traffic_capture(self, on: bool) -> None:
         """Reference-counted: capture runs while at least one user asked for it."""

@@ -79,6 +79,7 @@ class LinkSupervisor:
         self.close_link(Operation.CONNECT, LinkState.DISCONNECTED, "", emit=False, fail_queued=False)
         self.settings = settings
         self.client = RobotClient(settings)
+        self.client.audit = getattr(host, "audit", None)  # the audit trail records every write
         host.capture.attach(self.client)
         self._ever_connected = False
         self._backoff_index = 0
@@ -207,15 +208,22 @@ class LinkSupervisor:
         self.schedule_reconnect(f"link lost: {message}")
 
     def close_link(self, operation: str, state: LinkState, message: str, *, emit: bool = True,
-                   fail_queued: bool = True) -> None:
-        """Stop jogging and switch teach off (if the controller answers), close, stop retrying."""
+                   fail_queued: bool = True, short: bool = False) -> None:
+        """Stop jogging and switch teach off (if the controller answers), close, stop retrying.
+
+        ``short`` (shutdown): those safety transactions wait at most the poll timeout each, so a
+        dead controller cannot hold the window's close for the request timeout."""
         host = self._host
         host.stop_reconnect()
         host.stop_polling()
         client = self.client
         if client is not None and self.link_up and not client.settings.monitor_only:
             try:
-                host.jog.stop_jog_and_teach()
+                if short:
+                    with client.io_timeout(client.settings.effective_poll_timeout):
+                        host.jog.stop_jog_and_teach()
+                else:
+                    host.jog.stop_jog_and_teach()
             except TeachPadError as exc:
                 host.emit_error(operation, f"could not stop teach mode: {exc}", None)
         self.canary_token = None

@@ -41,7 +41,14 @@ import math
 from typing import Literal
 
 from app import timing
-from app.errors import AlarmRaised, CommandRefused, CommandStopped, CommandTimeout, TeachPadError
+from app.errors import (
+    AlarmRaised,
+    CommandRefused,
+    CommandStopped,
+    CommandTimeout,
+    Reason,
+    TeachPadError,
+)
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import (
     RUN_COMMAND_TEXT,
@@ -64,6 +71,7 @@ CompletionRule = Literal["sentinel", "observe"]
 POSE_EPSILON = 1e-3
 # A move is at its end point when the TCP is this close (mm) to the X Y Z the host sent for it.
 ARRIVAL_TOLERANCE = 0.5
+ARRIVAL_TOLERANCE_DEG = 0.05  # the same for a joint step's joint angles (degrees)
 
 
 # --------------------------------------------------------------------------------------------
@@ -114,6 +122,7 @@ class CommandTracker:
         # Move to point: the X Y Z this host sent for the end point, when it knows it. A move whose
         # GV291 never left the stale code, seen moving and now still at the target, ended there.
         self.target: tuple[float, float, float] | None = None
+        self.target_joints: tuple[float, ...] | None = None  # a joint step: J1..J6 where it ends
         self.kind = CommandKind.of(command)
         self.before = before
         self.before_pose = before_pose
@@ -187,7 +196,8 @@ class CommandTracker:
         if status.alarms:
             names = ", ".join(alarm_names(int(status.alarms))) or str(int(status.alarms))
             return self._fail(
-                AlarmRaised(int(status.alarms), f"{self.text}: alarm while waiting: {names}"),
+                AlarmRaised(int(status.alarms), f"{self.text}: alarm while waiting: {names}",
+                            params=self._args()),
                 code, now,
             )
         if code != self.pre_code:
@@ -200,9 +210,11 @@ class CommandTracker:
             decoded = self.decode(code)
             # A terminal code counts only once GV291 has left the stale pre-command value.
             if self.code_left_pre and decoded.is_done:
-                return self._finish(True, decoded, f"{self.text}: {decoded.text}", now)
+                return self._finish(True, decoded, f"{self.text}: {decoded.text}", now,
+                                    reason=Reason("done", self._args(status=code)))
             if self.code_left_pre and decoded.is_error:
-                err = CommandRefused(decoded, f"{self.text} refused: {decoded.text} (status {code})")
+                err = CommandRefused(decoded, f"{self.text} refused: {decoded.text} (status {code})",
+                                     params=self._args())
                 return self._fail(err, code, now)
             stopped = self._check_stopped(status, code, now)
             if stopped is not None:
@@ -212,19 +224,22 @@ class CommandTracker:
                 if at_target:
                     done = self.decode(STATUS_DONE)
                     return self._finish(True, done, f"{self.text}: {done.text} (arrived at the point; "
-                                        f"the command status did not change)", now)
+                                        f"the command status did not change)", now,
+                                        reason=Reason("done", self._args(status=STATUS_DONE)))
                 text = self.decode(self.pre_code).text
                 return self._fail(
                     CommandTimeout(
                         f"{self.text}: the arm moved and stopped, but the command status stayed "
-                        f"{self.pre_code} '{text}' from before the command; the result is unknown"
+                        f"{self.pre_code} '{text}' from before the command; the result is unknown",
+                        code="result_unknown", params=self._args(status=self.pre_code),
                     ),
                     code, now,
                 )
         elif self._teach_mode_changed(status):
             decoded = self.decode(STATUS_DONE)
             return self._finish(True, decoded, f"{self.text}: {decoded.text} (seen in the controller mode, "
-                                f"now {controller_mode_text(int(status.mode))})", now)
+                                f"now {controller_mode_text(int(status.mode))})", now,
+                                reason=Reason("done_by_mode", self._args(mode=int(status.mode))))
         elif self.unconfirmed_after is not None and now - self.started >= self.unconfirmed_after \
                 and (self.decode(code).is_done or self.decode(code).is_error):
             return self._unconfirmed(code, now)
@@ -233,7 +248,9 @@ class CommandTracker:
             return self._fail(
                 CommandTimeout(
                     f"controller did not acknowledge {self.text} within {_seconds(self.ack_timeout)} s "
-                    f"(command status stayed {self.pre_code} '{text}' from before the command)"
+                    f"(command status stayed {self.pre_code} '{text}' from before the command)",
+                    code="not_acknowledged",
+                    params=self._args(seconds=round(self.ack_timeout, 3), status=self.pre_code),
                 ),
                 code, now,
             )
@@ -244,7 +261,8 @@ class CommandTracker:
             return self._fail(
                 CommandTimeout(
                     f"{self.text} did not complete within {_seconds(self._budget)} s "
-                    f"(last command status {code} '{decoded.text}')"
+                    f"(last command status {code} '{decoded.text}')",
+                    code="command_timeout", params=self._args(seconds=round(self._budget, 3), status=code),
                 ),
                 code, now,
             )
@@ -255,7 +273,8 @@ class CommandTracker:
         if self.result is not None:
             return self.result
         code = self.last_status.command_status_code if self.last_status else self.pre_code
-        return self._fail(CommandStopped(f"{self.text} stopped by the host"), code, now)
+        return self._fail(CommandStopped(f"{self.text} stopped by the operator",
+                                         code="stopped_by_operator", params=self._args()), code, now)
 
     # -- internals -----------------------------------------------------------------------
     def _teach_mode_changed(self, status: ControllerStatus) -> bool:
@@ -275,12 +294,15 @@ class CommandTracker:
         if decoded.is_done:
             message = (f"{self.text}: done, unconfirmed (command status stayed {code} '{decoded.text}' "
                        f"as before the command for {waited} s; the controller reported no error)")
-            return self._finish(True, decoded, message, now, unconfirmed=True)
+            return self._finish(True, decoded, message, now, unconfirmed=True,
+                                reason=Reason("done_unconfirmed", self._args(status=code)))
         self.error = CommandRefused(
             decoded, f"{self.text} refused (unconfirmed): command status stayed {code} '{decoded.text}' "
                      f"from the previous command for {waited} s",
+            code="refused_unconfirmed", params=self._args(seconds=float(waited)),
         )
-        return self._finish(False, decoded, str(self.error), now, unconfirmed=True)
+        return self._finish(False, decoded, str(self.error), now, unconfirmed=True,
+                            reason=self.error.as_reason())
 
     def _note_motion(self, status: ControllerStatus, pose: Pose | None) -> bool:
         """Update ``motion_seen``; True when this read shows progress (for the stall timer)."""
@@ -312,7 +334,8 @@ class CommandTracker:
         if now - self._stopped_since < self.stop_settle:
             return None
         return self._fail(
-            CommandStopped(f"{self.text} stopped: program state returned to stopped without 'done'"),
+            CommandStopped(f"{self.text} stopped: program state returned to stopped without 'done'",
+                           params=self._args()),
             code, now,
         )
 
@@ -331,10 +354,16 @@ class CommandTracker:
         return settled and (at_target or now - self.started >= self.ack_timeout)
 
     def _at_target(self, pose: Pose | None) -> bool:
-        """The arm stands at the end point this host sent (within ARRIVAL_TOLERANCE mm)."""
-        if self.target is None or pose is None:
+        """The arm stands where this host sent it: the end point's X Y Z (within
+        ARRIVAL_TOLERANCE mm) or a joint step's J1..J6 (within ARRIVAL_TOLERANCE_DEG)."""
+        if pose is None:
             return False
-        return math.dist(pose.xyzabc[:3], self.target) <= ARRIVAL_TOLERANCE
+        if self.target is not None:
+            return math.dist(pose.xyzabc[:3], self.target) <= ARRIVAL_TOLERANCE
+        if self.target_joints is not None and pose.joints:
+            return all(abs(q - t) <= ARRIVAL_TOLERANCE_DEG
+                       for q, t in zip(pose.joints, self.target_joints, strict=False))
+        return False
 
     def _details(self, now: float) -> dict[str, float]:
         details = {"elapsed": now - self.started}
@@ -342,14 +371,18 @@ class CommandTracker:
             details["ack_after"] = self.ack_time - self.started
         return details
 
+    def _args(self, **extra: object) -> dict[str, object]:
+        """A reason's arguments: the command (its number) and what the caller adds."""
+        return {"command": int(self.command), **extra}
+
     def _finish(self, ok: bool, status: CommandStatus, message: str, now: float, *,
-                unconfirmed: bool = False) -> CommandResult:
+                unconfirmed: bool = False, reason: Reason | None = None) -> CommandResult:
         details = self._details(now)
         details["reads"] = float(self.reads)
         self.result = CommandResult(self.command, self.kind, status, ok, message, details,
-                                    unconfirmed=unconfirmed)
+                                    unconfirmed=unconfirmed, reason=reason)
         return self.result
 
     def _fail(self, error: TeachPadError, code: int, now: float) -> CommandResult:
         self.error = error
-        return self._finish(False, self.decode(code), str(error), now)
+        return self._finish(False, self.decode(code), str(error), now, reason=error.as_reason())

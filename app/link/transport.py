@@ -159,16 +159,19 @@ class _TcpStream:
         try:
             sock = socket.create_connection((s.host, s.port), timeout=timeout)
         except socket.gaierror:
-            raise LinkError(f"the host name {s.host[:60]!r} cannot be resolved") from None
+            raise LinkError(f"the host name {s.host[:60]!r} cannot be resolved", code="host_unresolved",
+                            params={"host": s.host[:60]}) from None
         except ConnectionRefusedError:
             hint = (f" (nothing listens on port 502; the simulator's port is {SIMULATOR_PORT})"
                     if s.port == 502 else "")
-            raise LinkError(f"connection refused{hint}") from None
+            raise LinkError(f"connection refused{hint}", code="connection_refused",
+                            params={"port": s.port}) from None
         except TimeoutError:
-            raise LinkError(f"no answer to the connection request within {_seconds(timeout)} s"
-                            ) from None
+            raise LinkError(f"no answer to the connection request within {_seconds(timeout)} s",
+                            code="connect_timeout", params={"seconds": timeout}) from None
         except OSError as exc:
-            raise LinkError(str(exc.strerror or exc).lower()) from None
+            raise LinkError(str(exc.strerror or exc).lower(), code="connect_failed",
+                            params={"errno": exc.errno}) from None
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self._sock = sock
 
@@ -228,7 +231,8 @@ class _SerialStream:
                                        stopbits=s.stopbits, bytesize=s.bytesize, timeout=timeout,
                                        exclusive=True)
         except (serial.SerialException, OSError, ValueError) as exc:
-            raise LinkError(f"cannot open the serial port: {exc}") from None
+            raise LinkError(f"cannot open the serial port: {exc}", code="serial_open_failed",
+                            params={"port": (s.serial_port or "")[:60]}) from None
 
     def close(self) -> None:
         if self._port is not None:
@@ -301,7 +305,8 @@ class Transport:
                        if self._ever_connected
                        else f"cannot connect to the controller at {endpoint}: {exc}")
             self._count("link_errors", message)
-            raise LinkError(message) from None
+            raise LinkError(message, code=exc.code, params={
+                **exc.params, "endpoint": endpoint, "reconnect": self._ever_connected}) from None
         if self._ever_connected:
             self._count("reconnects")
         self._ever_connected = True
@@ -343,11 +348,12 @@ class Transport:
         _, data = self.execute(what, frames.read_request(address, count), timeout)
         return [(data[i] << 8) | data[i + 1] for i in range(1, 1 + 2 * count, 2)]
 
-    def write_single(self, what: str, address: int, value: int) -> None:
-        self.execute(what, frames.write_single_request(address, value))
+    def write_single(self, what: str, address: int, value: int, timeout: float | None = None) -> None:
+        self.execute(what, frames.write_single_request(address, value), timeout)
 
-    def write_multiple(self, what: str, address: int, values: Sequence[int]) -> None:
-        self.execute(what, frames.write_multiple_request(address, values))
+    def write_multiple(self, what: str, address: int, values: Sequence[int],
+                       timeout: float | None = None) -> None:
+        self.execute(what, frames.write_multiple_request(address, values), timeout)
 
     def execute(self, what: str, request: Request, timeout: float | None = None) -> tuple[int, bytes]:
         """Send ``request``; its checked answer as (function code, data)."""
@@ -361,7 +367,9 @@ class Transport:
                     message = (f"controller did not answer within {_seconds(timeout * attempts)} s "
                                f"({self.settings.endpoint})")
                     self._stats = dataclasses.replace(self._stats, last_error=message)
-                    raise ResponseTimeout(message) from None
+                    raise ResponseTimeout(message, params={
+                        "seconds": round(timeout * attempts, 3), "endpoint": self.settings.endpoint,
+                    }) from None
         raise AssertionError("unreachable")  # pragma: no cover
 
     def _flush_stray(self) -> None:
@@ -373,7 +381,8 @@ class Transport:
             self.close()
             message = f"lost the connection to the controller at {self.settings.endpoint}: it closed the link"
             self._count("link_errors", message)
-            raise LinkError(message) from None
+            raise LinkError(message, code="link_closed",
+                            params={"endpoint": self.settings.endpoint}) from None
         if dropped:
             self._count("resyncs", f"dropped {dropped} stray bytes from {self.settings.endpoint}")
 
@@ -381,7 +390,7 @@ class Transport:
         self.close()
         message = f"lost the connection to the controller at {self.settings.endpoint} during the {what}"
         self._count("link_errors", message)
-        return LinkError(message)
+        return LinkError(message, params={"endpoint": self.settings.endpoint})
 
     def _exchange(self, what: str, request: Request, timeout: float) -> tuple[int, bytes]:
         self.open()
@@ -433,8 +442,9 @@ class Transport:
                        f"{str(exc)[:200]}")
             self._count("malformed", message)
             self._resync("a malformed answer")
-            raise MalformedResponse(message, field=exc.field, expected=exc.expected,
-                                    got=exc.got) from None
+            error = MalformedResponse(message, field=exc.field, expected=exc.expected, got=exc.got)
+            error.params["endpoint"] = self.settings.endpoint
+            raise error from None
         if self._observing:
             self._emit("rx", buf)
         function, data = frames.decode_answer(self.framing, buf)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import enum
 from dataclasses import dataclass
 
+from app.errors import Reason, TeachPadError
 from app.protocol.enums import TeachFrame
 
 __all__ = ["ConnectionState", "JogRequest", "LinkState", "Operation", "WorkerError"]
@@ -62,8 +63,18 @@ class WorkerError:
     """Something that went wrong, for the operator: which operation and why."""
 
     operation: str
-    message: str
+    message: str  # plain English (logs, CLI)
     request_id: int | None = None  # the request it belongs to (None: polls, the link itself)
+    reason: Reason | None = None  # code + arguments the GUI translates (None: only ``message``)
+
+    @classmethod
+    def from_exception(cls, operation: str, exc: BaseException,
+                       request_id: int | None = None) -> WorkerError:
+        """The error for ``exc``: its English text and, for a typed error, its reason."""
+        if isinstance(exc, TeachPadError):
+            return cls(operation, str(exc), request_id, exc.as_reason())
+        return cls(operation, f"{type(exc).__name__}: {str(exc)[:200]}", request_id,
+                   Reason("unexpected", {"type": type(exc).__name__}))
 
 
 @dataclass(frozen=True)

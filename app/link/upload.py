@@ -153,7 +153,7 @@ class Uploader:
             upload.index += 1
             if result.ok:
                 upload.good += 1
-                host.publish_point_uploaded(point_id, True, "")
+                host.publish_point_uploaded(point_id, True, "", result.unconfirmed)
             else:
                 host.publish_point_uploaded(point_id, False, result.message or "failed")
                 if result.status is None:  # the link failed during this point: its outcome is unknown

@@ -18,10 +18,18 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
 * :class:`~app.link.motion.MotionCommands` / :class:`~app.link.motion.MotionTracker` -- the long
   commands (step, move to point, go to zero, run program, create point), started without waiting,
   and the completion of the one under way; a motion while another is under way is refused, Stop
-  clears it.
+  clears it. A create point while another short command is being tracked waits in the worker
+  (``_held``) until that one's outcome is known (GV291 tells one command at a time), then goes
+  out: every request ends once, with its own result.
 * :class:`~app.link.upload.Uploader` -- chunked upload of many points, ``pointUploaded`` per
   point, ``uploadProgress``, one final ``commandFinished``; ``cancel_upload`` or a stop end it.
 * :class:`~app.link.capture.TrafficCapture`, RTT and link statistics.
+
+Stop latency: :meth:`RobotWorker.request_stop` queues the stop first in line and, from the GUI
+thread, waits (GIL released, at most :data:`STOP_HANDOFF_WAIT`) until the worker has written it;
+the worker runs urgent jobs between any two transactions (also right after a poll's pose read,
+before publishing), and ``_do_stop`` writes before any bookkeeping. Bound: the transaction in
+flight (one round trip) plus the stop's own write, unless the OS does not schedule the worker.
 
 Every :class:`RobotLink` command returns an ``int`` request id; each :class:`CommandResult` /
 :class:`WorkerError` it causes carries it. Every failure becomes a signal, never an exception in
@@ -38,8 +46,9 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import threading
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections import deque
 
 from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot
 
@@ -47,25 +56,31 @@ from app import timing
 from app.errors import (
     CommandRefused,
     LinkError,
+    MalformedResponse,
     ModbusExceptionError,
+    Reason,
     ResponseTimeout,
     TeachPadError,
     WriteBlocked,
 )
 from app.link.capture import TrafficCapture
-from app.link.client import ConnectionSettings, RobotClient, StepFrame, TrafficRecord
-from app.link.jobs import JOG_PRESS, JOG_RATIO, Job, JobKind, JobQueue
+from app.link.client import ConnectionSettings, RobotClient, TrafficRecord
+from app.link.jobs import Job, JobKind, JobQueue
 from app.link.jog import JogMachine, PreemptedError
 from app.link.motion import MotionCommands, MotionTracker
 from app.link.poller import Poller
+from app.link.requests import STOP_HANDOFF_WAIT, WorkerRequests
 from app.link.stats import LinkStats
 from app.link.supervisor import DEFAULT_CANARY_GV, LinkSupervisor
 from app.link.types import ConnectionState, JogRequest, LinkState, Operation, WorkerError
 from app.link.upload import RawItem, Uploader
 from app.models import CommandResult, ControllerStatus, Pose
-from app.protocol.enums import ProgramMotionMode, WorkMode
+from app.protocol.enums import WorkMode
+from app.safety.audit import AuditLog
+from app.safety.envelope import EnvelopeViolation
+from app.safety.jog_guard import JogGuard
 
-__all__ = ["DEFAULT_CANARY_GV", "SHUTDOWN_TIMEOUT_MS", "RobotWorker"]
+__all__ = ["DEFAULT_CANARY_GV", "SHUTDOWN_TIMEOUT_MS", "STOP_HANDOFF_WAIT", "RobotWorker"]
 
 _log = logging.getLogger(__name__)
 
@@ -73,7 +88,7 @@ _log = logging.getLogger(__name__)
 SHUTDOWN_TIMEOUT_MS = round(timing.SHUTDOWN_WAIT * 1000)
 
 
-class RobotWorker(QObject):
+class RobotWorker(WorkerRequests, QObject):
     """Owns the RobotClient in the worker thread and composes the parts; see the module docstring."""
 
     poseChanged = Signal(Pose)  # noqa: N815
@@ -89,7 +104,8 @@ class RobotWorker(QObject):
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815 - the canary GV changed while the link stayed up
     uploadProgress = Signal(int, int)  # noqa: N815 - points done, total
-    pointUploaded = Signal(int, bool, str)  # noqa: N815 - point id, ok, reason ("" when ok)
+    pointUploaded = Signal(int, bool, str, bool)  # noqa: N815 - point id, ok, reason ("" when ok), unconfirmed
+    jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard wrote ratio 0
     stopped = Signal()  # the worker has closed the link and is quitting its thread (shutdown)
 
     # Wakes the worker from any thread (a queued call, since the worker lives in its thread).
@@ -106,9 +122,15 @@ class RobotWorker(QObject):
         self._uploadStep.connect(self._upload_step, Qt.ConnectionType.QueuedConnection)
         # Everything below is touched only in the worker thread.
         self.closed = False
+        self.audit: AuditLog | None = None  # set before connecting (set_audit); thread-safe
         self.request_id: int | None = None  # request id of the job being executed
         self._current_seq = 0  # sequence number of the job being executed
+        self._current_job: Job | None = None
         self._in_urgent = False
+        self._worker_ident: int | None = None  # the worker thread, once started (request_stop)
+        # Short commands (create point) that wait for the one being tracked to end: GV291 tells
+        # only one command's outcome at a time, so a second one goes out after the first ended.
+        self._held: deque[Job] = deque()
         self._poll_timer: QTimer | None = None
         self._reconnect_timer: QTimer | None = None
         self.capture = TrafficCapture()
@@ -123,6 +145,7 @@ class RobotWorker(QObject):
     @Slot()
     def start(self) -> None:
         """Run by ``QThread.started``: the timers are created here, in the worker thread."""
+        self._worker_ident = threading.get_ident()
         self._poll_timer = QTimer(self)
         self._poll_timer.setTimerType(Qt.TimerType.PreciseTimer)
         self._poll_timer.setInterval(self._poll_interval_ms())
@@ -148,8 +171,9 @@ class RobotWorker(QObject):
         """Queued from the GUI: stop motion, close, hand the object back, quit this thread."""
         if self.closed:
             return
-        self.supervisor.close_link(Operation.SHUTDOWN, LinkState.DISCONNECTED, "")
+        self.supervisor.close_link(Operation.SHUTDOWN, LinkState.DISCONNECTED, "", short=True)
         self.closed = True
+        self._worker_ident = None
         for timer in (self._poll_timer, self._reconnect_timer):
             if timer is not None:
                 timer.stop()
@@ -171,80 +195,34 @@ class RobotWorker(QObject):
         if self._poll_timer is not None:
             self._poll_timer.setInterval(self._poll_interval_ms())
 
+    @Slot(object)
+    def set_jog_guard(self, guard: JogGuard | None) -> None:
+        """The safety envelope's jog guard (immutable, so safe to pass between threads); None: off."""
+        self.jog.guard = guard
+
+    @Slot(object)
+    def set_audit(self, audit: AuditLog | None) -> None:
+        """The audit trail for the writes of the next connections (and of the current one)."""
+        self.audit = audit
+        client = self.supervisor.client
+        if client is not None:
+            client.audit = audit
+
     @Slot(bool)
     def set_traffic_capture(self, on: bool) -> None:
         if not self.closed:
             self.capture.set(on, self.supervisor.client)
 
     def _poll_interval_ms(self) -> int:
-        return max(1, round(1000.0 / self._poll_hz))
+        return max(1, round(1000.0 / self.poller.rate(self._poll_hz)))
 
-    # --- requests (any thread) ----------------------------------------------------------
-    def post(self, operation: str, run: Callable[[], None], kind: JobKind = JobKind.PLAIN,
-             *, coalesce: str | None = None, needs_link: bool = True, cancels: tuple[str, ...] = ()) -> int:
-        """Queue a job and wake the worker; returns the request id its results will carry."""
-        request_id = self._jobs.put(Job(operation, run, kind, coalesce=coalesce, needs_link=needs_link,
-                                        cancels=cancels))
-        self._wake.emit()
-        return request_id
-
-    def request_stop(self) -> int:
-        return self.post(Operation.STOP, self._do_stop, JobKind.URGENT)
-
-    def request_pause(self) -> int:
-        return self.post(Operation.PAUSE, self._do_pause, JobKind.URGENT)
-
-    def request_resume(self) -> int:
-        return self.post(Operation.RESUME, self._do_resume, JobKind.URGENT)
-
-    def request_jog_press(self, request: JogRequest) -> int:
-        return self.post(Operation.JOG, lambda: self._do_jog_press(request), JobKind.MOTION,
-                         coalesce=JOG_PRESS)
-
-    def request_jog_release(self) -> int:
-        return self.post(Operation.JOG_RELEASE, self.jog.release, JobKind.URGENT, needs_link=False,
-                         cancels=(JOG_PRESS, JOG_RATIO))
-
-    def request_jog_ratio(self, ratio: float) -> int:
-        return self.post(Operation.JOG_SPEED, lambda: self.jog.set_ratio(ratio), JobKind.MOTION,
-                         coalesce=JOG_RATIO)
-
-    def request_step(self, frame: StepFrame, offsets: Sequence[float], ext_offsets: Sequence[float],
-                     speed: float) -> int:
-        offs, ext = tuple(offsets), tuple(ext_offsets)
-        return self.post(Operation.STEP, lambda: self.motions.step(frame, offs, ext, speed), JobKind.MOTION)
-
-    def request_set_mode(self, mode: WorkMode) -> int:
-        return self.post(Operation.SET_MODE, lambda: self._do_set_mode(mode))
-
-    def request_go_zero(self, axis: int | None) -> int:
-        return self.post(Operation.GO_ZERO, lambda: self.motions.go_zero(axis), JobKind.MOTION)
-
-    def request_run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int,
-                            speed_ratio: int) -> int:
-        return self.post(Operation.RUN_PROGRAM,
-                         lambda: self.motions.run_program(program_id, mode, cycles, speed_ratio),
-                         JobKind.MOTION)
-
-    def request_create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> int:
-        values = None if pose is None else tuple(pose)
-        return self.post(Operation.CREATE_POINT, lambda: self.motions.create_point(point_id, values, tool))
-
-    def request_move_to_point(self, end_id: int, via_id: int | None, orientation_changes: bool,
-                              ignore_middle: bool, speed: float, tool: int) -> int:
-        return self.post(Operation.MOVE_TO_POINT,
-                         lambda: self.motions.move_to_point(end_id, via_id, orientation_changes,
-                                                            ignore_middle, speed, tool),
-                         JobKind.MOTION)
-
-    def request_upload_points(self, points: Iterable[tuple[int, Sequence[float], int]]) -> int:
-        """Items (id, pose6, tool); copied here, checked in the worker before the first write."""
-        items: list[RawItem] = [(pid, tuple(pose), tool) for pid, pose, tool in points]
-        return self.post(Operation.UPLOAD_POINTS, lambda: self._do_upload_points(items), JobKind.MOTION)
-
-    def request_cancel_upload(self) -> int:
-        """End the running upload after the point in progress, without a controller stop."""
-        return self.post(Operation.CANCEL_UPLOAD, self._do_cancel_upload, JobKind.URGENT, needs_link=False)
+    def _follow_poll_rate(self) -> None:
+        """Keep the timer at the poller's rate (faster while jogging, see ``Poller.rate``)."""
+        timer = self._poll_timer
+        if timer is not None and timer.isActive():
+            interval = self._poll_interval_ms()
+            if timer.interval() != interval:
+                timer.setInterval(interval)
 
     # --- the host of the parts (worker thread) ------------------------------------------
     @property
@@ -262,7 +240,7 @@ class RobotWorker(QObject):
         return client
 
     def poll_if_due(self) -> None:
-        if time.monotonic() - self.poller.last_poll >= 1.0 / self._poll_hz:
+        if time.monotonic() - self.poller.last_poll >= 1.0 / self.poller.rate(self._poll_hz):
             self._poll()
 
     def start_polling(self) -> None:
@@ -319,8 +297,11 @@ class RobotWorker(QObject):
     def publish_upload_progress(self, done: int, total: int) -> None:
         self.uploadProgress.emit(done, total)
 
-    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None:
-        self.pointUploaded.emit(point_id, ok, reason)
+    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
+        self.pointUploaded.emit(point_id, ok, reason, unconfirmed)
+
+    def publish_guard_stop(self, violation: EnvelopeViolation) -> None:
+        self.jogGuardStopped.emit(violation)
 
     def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None:
         """``commandFinished`` with the request id (default: the job being executed)."""
@@ -329,13 +310,21 @@ class RobotWorker(QObject):
             result = dataclasses.replace(result, request_id=rid)
         self.commandFinished.emit(result)
 
-    def emit_error(self, operation: str, message: str, request_id: int | None = -1) -> None:
-        """``errorOccurred`` with the request id (default: the job being executed)."""
+    def emit_error(self, operation: str, message: str, request_id: int | None = -1,
+                   reason: Reason | None = None) -> None:
+        """``errorOccurred`` with the request id (default: the job being executed) and, when the
+        cause is known, its reason (code + arguments) for the operator's language."""
         rid = self.request_id if request_id == -1 else request_id
-        self.errorOccurred.emit(WorkerError(operation, message, rid))
+        self.errorOccurred.emit(WorkerError(operation, message, rid, reason))
+
+    def emit_exception(self, operation: str, exc: BaseException, request_id: int | None = -1) -> None:
+        """``errorOccurred`` for ``exc`` (its English text and, for a typed error, its reason)."""
+        rid = self.request_id if request_id == -1 else request_id
+        self.errorOccurred.emit(WorkerError.from_exception(operation, exc, rid))
 
     def fail_queued(self, message: str) -> None:
-        for job in self._jobs.clear():
+        held, self._held = list(self._held), deque()
+        for job in [*held, *self._jobs.clear()]:
             if job.needs_link:
                 self.emit_error(job.operation, message, job.request_id)
 
@@ -351,6 +340,8 @@ class RobotWorker(QObject):
         self.run_jobs()
         if self.link_up and not self.closed:
             self._poll()
+            if self._held and self.motion.active is None:
+                self.run_jobs()  # the tracked command just ended: the held one goes out now
 
     def _poll(self) -> None:
         """One poll; results emitted from here belong to no request (even inside a job)."""
@@ -373,8 +364,14 @@ class RobotWorker(QObject):
     # --- job execution (worker thread) --------------------------------------------------
     def run_jobs(self) -> None:
         while not self.closed:
-            job = self._jobs.pop()
+            job = self._jobs.pop_urgent()
+            if job is None and self._held and self.motion.active is None:
+                self._execute(self._held.popleft(), held=True)
+                continue
             if job is None:
+                job = self._jobs.pop()
+            if job is None:
+                self._follow_poll_rate()
                 return
             self._execute(job)
 
@@ -392,33 +389,51 @@ class RobotWorker(QObject):
             self._in_urgent = False
         return ran
 
-    def _execute(self, job: Job) -> None:
+    def _must_wait(self, job: Job) -> bool:
+        """A create point while another command is tracked (or held before it) waits its turn."""
+        if job.operation != Operation.CREATE_POINT:
+            return False
+        active = self.motion.active
+        return bool(self._held) or (active is not None and not active.motion)
+
+    def _execute(self, job: Job, *, held: bool = False) -> None:
         if job.needs_link and not self.link_up:
-            self.emit_error(job.operation, "not connected to a controller", job.request_id)
+            self.emit_error(job.operation, "not connected to a controller", job.request_id,
+                            Reason("not_connected"))
+            return
+        if not held and self._must_wait(job):
+            self._held.append(job)
             return
         outer_seq, self._current_seq = self._current_seq, job.seq
         outer_id, self.request_id = self.request_id, job.request_id
+        outer_job, self._current_job = self._current_job, job
         try:
             job.run()
         except PreemptedError:
             pass
         except WriteBlocked as exc:
-            self.emit_error(job.operation, str(exc))
-        except (LinkError, ResponseTimeout) as exc:
-            self.emit_error(job.operation, str(exc))
+            self.emit_exception(job.operation, exc)
+        except (LinkError, ResponseTimeout, MalformedResponse) as exc:
+            # Malformed: the transport already resynchronised; the command's outcome is unknown.
+            self.emit_exception(job.operation, exc)
             self.supervisor.transport_failed(str(exc))
         except ModbusExceptionError as exc:
-            self.emit_result(CommandResult(None, None, None, False, f"{job.operation}: {exc}"))
+            self.emit_result(CommandResult(None, None, None, False, f"{job.operation}: {exc}",
+                                           reason=exc.as_reason()))
         except CommandRefused as exc:
-            self.emit_result(CommandResult(None, exc.status.kind, exc.status, False, str(exc)))
+            self.emit_result(CommandResult(None, exc.status.kind, exc.status, False, str(exc),
+                                           reason=exc.as_reason()))
         except TeachPadError as exc:  # InvalidInput and the rest
-            self.emit_error(job.operation, str(exc))
+            self.emit_exception(job.operation, exc)
         except Exception as exc:  # a bug: report it plainly, keep the worker alive
             _log.exception("%s failed", job.operation)
-            self.emit_error(job.operation, f"internal error: {type(exc).__name__}: {str(exc)[:200]}")
+            self.emit_exception(job.operation, exc)
         finally:
+            if job.sent is not None:
+                job.sent.set()  # also when it failed: the poster waits no longer
             self._current_seq = outer_seq
             self.request_id = outer_id
+            self._current_job = outer_job
 
     def _done(self, text: str) -> None:
         self.emit_result(CommandResult(None, None, None, True, text))
@@ -431,6 +446,9 @@ class RobotWorker(QObject):
         client = self.client_or_raise()
         client.stop()  # first: nothing else goes out before the stop
         now = time.monotonic()
+        job = self._current_job
+        if job is not None and job.sent is not None:
+            job.sent.set()  # the poster (the GUI thread) may go on
         self.uploader.end("stopped")
         self.jog.on_stop()
         active = self.motion.take()

@@ -369,7 +369,7 @@ class PointLedger:
     def mark_all_unknown(self) -> list[int]:
         """After a controller restart or reconnect: nothing is known to be on the controller.
         ``CHANGED`` points stay ``CHANGED``. Returns the rows that changed."""
-        known = (SyncState.ON_CONTROLLER, SyncState.FAILED)
+        known = (SyncState.ON_CONTROLLER, SyncState.UNCONFIRMED, SyncState.FAILED)
         rows = [r for r, p in enumerate(self._points) if p.sync in known]
         for r in rows:
             self._points[r] = replace(self._points[r], sync=SyncState.UNKNOWN, sync_error="")

@@ -107,6 +107,9 @@ class SyncState(enum.Enum):
     ON_CONTROLLER = "on-controller"  # created on the controller with exactly these values
     CHANGED = "changed"  # changed on the host (or new) since the last upload
     FAILED = "failed"  # the last upload failed; TempPoint.sync_error says why
+    #: Sent without an error, but the controller's status never changed (observe rule): most
+    #: likely on the controller, not proven. Still needs an upload before a move relies on it.
+    UNCONFIRMED = "unconfirmed"
 
     @property
     def text(self) -> str:
@@ -125,6 +128,7 @@ SYNC_STATE_TEXT: dict[SyncState, str] = {
     SyncState.ON_CONTROLLER: QT_TRANSLATE_NOOP("Points", "on controller"),
     SyncState.CHANGED: QT_TRANSLATE_NOOP("Points", "changed on host"),
     SyncState.FAILED: QT_TRANSLATE_NOOP("Points", "upload failed"),
+    SyncState.UNCONFIRMED: QT_TRANSLATE_NOOP("Points", "on controller, unconfirmed"),
 }
 
 

@@ -34,23 +34,21 @@ path and field (``points[6] (id 12), field 'x': 'abc' is not a number``) and quo
 short prefix of a bad value. Whatever loading accepts, saving can write (no NaN, no lone
 surrogates, no numbers beyond float range).
 
-Saving is atomic (:mod:`app.points.atomic`); autosave and recovery live in
+The project in memory (:class:`Project`) lives in :mod:`app.points.project_model`; this module
+is the file format. Saving is atomic (:mod:`app.points.atomic`); autosave and recovery live in
 :mod:`app.points.autosave`, the one-instance lock in :mod:`app.points.lock`.
 """
 
 from __future__ import annotations
 
-import datetime as dt
 import json
 import math
 import os
 import re
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from app.errors import InvalidInput
 from app.plan.segments import (
     Plan,
     Segment,
@@ -78,11 +76,11 @@ from app.points.point import (
     point_from_fields,
     shown,
 )
+from app.points.project_model import HISTORY_TEXT_MAX, Project, UploadRecord, now_iso
 
 FORMAT_NAME = "teachpad-project"
 FORMAT_VERSION = 1
 PROJECT_SUFFIX = ".teachpad.json"
-HISTORY_TEXT_MAX = 200  # longest upload time / endpoint text kept as history
 
 __all__ = [
     "AUTOSAVE_SUFFIX", "FORMAT_NAME", "FORMAT_VERSION", "MAX_FILE_BYTES", "PROJECT_SUFFIX", "FileFormatError",
@@ -92,113 +90,6 @@ __all__ = [
     "write_points_csv",
 ]
 
-
-def _now_iso() -> str:
-    return dt.datetime.now(dt.UTC).replace(microsecond=0).isoformat().replace("+00:00", "Z")
-
-
-@dataclass(frozen=True)
-class UploadRecord:
-    """History: when this host last uploaded a point, and to which controller. Never proof that
-    the controller still holds it (it may have restarted, another tool may have overwritten it)."""
-
-    time: str
-    endpoint: str
-
-
-@dataclass(eq=False)
-class Project:
-    """Points, plans and metadata. Plan names are unique (compared after stripping)."""
-
-    name: str = "untitled"
-    ledger: PointLedger = field(default_factory=PointLedger)
-    plans: list[Plan] = field(default_factory=list)
-    description: str = ""
-    created: str = field(default_factory=_now_iso)
-    modified: str = ""
-    #: point id -> the last upload of that point (history only; see :class:`UploadRecord`)
-    upload_history: dict[int, UploadRecord] = field(default_factory=dict)
-    _revision: int = field(default=0, init=False, repr=False)
-
-    def __post_init__(self) -> None:
-        names = [p.name for p in self.plans]
-        for name in names:
-            if names.count(name) > 1:
-                raise InvalidInput(f"two plans are named {name!r}")
-
-    @property
-    def revision(self) -> int:
-        """Changes whenever the project, its ledger or a plan changes (dirty tracking)."""
-        return self._revision + self.ledger.revision + sum(p.revision for p in self.plans)
-
-    def touch(self) -> None:
-        """Count a metadata change."""
-        self._revision += 1
-
-    def record_upload(self, point_ids: Iterable[int], endpoint: str, when: str | None = None) -> None:
-        """Note in the history that ``point_ids`` were just uploaded to ``endpoint``."""
-        stamp = when or _now_iso()
-        ids = list(point_ids)
-        for point_id in ids:
-            self.upload_history[point_id] = UploadRecord(stamp, endpoint[:HISTORY_TEXT_MAX])
-        if ids:
-            self._revision += 1
-
-    # --- plans
-    def plan_names(self) -> list[str]:
-        return [p.name for p in self.plans]
-
-    def plan(self, name: str) -> Plan:
-        for p in self.plans:
-            if p.name == name.strip():
-                return p
-        raise InvalidInput(f"no plan named {name!r} (plans: {', '.join(self.plan_names()) or 'none'})")
-
-    def add_plan(self, plan: Plan, row: int | None = None) -> int:
-        if plan.name in self.plan_names():
-            raise InvalidInput(f"a plan named {plan.name!r} already exists")
-        row = len(self.plans) if row is None else max(0, min(row, len(self.plans)))
-        self.plans.insert(row, plan)
-        self._revision += 1
-        return row
-
-    def remove_plan(self, row: int) -> Plan:
-        plan = self.plans.pop(row)
-        self._revision += 1
-        return plan
-
-    def rename_plan(self, row: int, name: str) -> str:
-        new = validate_plan_name(name)
-        if any(p.name == new for i, p in enumerate(self.plans) if i != row):
-            raise InvalidInput(f"a plan named {new!r} already exists")
-        return self.plans[row].rename(new)
-
-    def unique_plan_name(self, base: str = "plan") -> str:
-        names = set(self.plan_names())
-        if base not in names:
-            return base
-        k = 2
-        while f"{base} {k}" in names:
-            k += 1
-        return f"{base} {k}"
-
-    # --- cross references
-    def references(self, point_id: int) -> list[tuple[str, int]]:
-        """``(plan name, segment index)`` of every segment that uses ``point_id``."""
-        return [
-            (p.name, i) for p in self.plans for i, seg in enumerate(p.segments) if point_id in seg.point_ids
-        ]
-
-    def renumber_point(self, row: int, new_id: int) -> list[tuple[str, list[int]]]:
-        """Change a point's id and follow it in every plan; returns ``(plan, rows)`` changed."""
-        old_id = self.ledger[row].id
-        self.ledger.set_field(row, "id", new_id)
-        changed: list[tuple[str, list[int]]] = []
-        for p in self.plans:
-            rows = p.replace_point_id(old_id, new_id)
-            if rows:
-                changed.append((p.name, rows))
-        return changed
 
 
 # --- JSON ------------------------------------------------------------------------------------
@@ -487,7 +378,7 @@ def load_project(path: str | os.PathLike[str], limits: PointLimits = DEFAULT_LIM
 def save_project(project: Project, path: str | os.PathLike[str], *, touch: bool = True) -> None:
     """Write the project atomically; sets ``modified`` (unless ``touch`` is False)."""
     if touch:
-        project.modified = _now_iso()
+        project.modified = now_iso()
     atomic_write_bytes(path, project_to_json(project).encode("utf-8"))
 
 

@@ -107,7 +107,8 @@ def apply_upload(ledger: PointLedger, report: UploadReport) -> list[int]:
         if outcome.ok:
             if outcome.sent is not None and not current.same_on_controller(outcome.sent):
                 continue
-            rows.append(ledger.set_sync(outcome.point_id, SyncState.ON_CONTROLLER))
+            state = SyncState.UNCONFIRMED if outcome.unconfirmed else SyncState.ON_CONTROLLER
+            rows.append(ledger.set_sync(outcome.point_id, state))
         else:
             rows.append(ledger.set_sync(outcome.point_id, SyncState.FAILED, outcome.reason))
     return rows

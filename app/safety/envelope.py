@@ -103,9 +103,14 @@ class EnvelopeViolation:
 class EnvelopeRefused(TeachPadError):
     """An action was refused before the wire because it would leave the safety envelope."""
 
+    code = "envelope_refused"
+
     def __init__(self, violation: EnvelopeViolation, action: str = "") -> None:
         prefix = f"{action} refused: " if action else "refused: "
-        super().__init__(prefix + violation.message)
+        v = violation
+        super().__init__(prefix + violation.message, params={
+            "violation": v.code.value, "value": v.value, "limit": v.limit, "axis": v.axis,
+            "box": v.box, "segment": v.segment, "reduced": v.reduced, "approaching": v.approaching})
         self.violation = violation
 
 

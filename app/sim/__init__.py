@@ -3,12 +3,16 @@
 ``SimController(SimConfig(...))`` is the Modbus TCP slave, or RTU on a serial line
 (``start``/``stop``/``port``, inspection and fault injection, see :mod:`app.sim.server`; bad
 input and the communication watchdog in :mod:`app.sim.guard` and :mod:`app.sim.transport`);
-``SimRobot`` is the pure state machine it drives (:mod:`app.sim.robot`);
+``SimRobot`` is the pure state machine it drives (:mod:`app.sim.robot`, its commands in
+:mod:`app.sim.commands`, its motion segments in :mod:`app.sim.motion`);
 :mod:`app.sim.kinematics` holds the DH model; ``teachpad-sim`` is :func:`app.sim.cli.main`.
 """
 
-from app.sim.robot import PROGRAMS, SimRobot, StoredPoint, TraceSample
-from app.sim.server import SimConfig, SimController, SimEvent, SimSnapshot, WriteRecord
+from app.sim.commands import StoredPoint
+from app.sim.config import SimConfig, SimEvent, SimSnapshot, WriteRecord
+from app.sim.motion import TraceSample
+from app.sim.robot import PROGRAMS, SimRobot
+from app.sim.server import SimController
 
 __all__ = ["PROGRAMS", "SimConfig", "SimController", "SimEvent", "SimRobot", "SimSnapshot", "StoredPoint",
            "TraceSample", "WriteRecord"]

@@ -14,8 +14,9 @@ from pymodbus.constants import ExcCodes
 
 from app.protocol.codec import WordOrder
 from app.protocol.enums import Alarm
+from app.sim.config import GV291_MODES, TIMING_PROFILES, SimConfig
 from app.sim.guard import WATCHDOG_TIMEOUT
-from app.sim.server import GV291_MODES, TIMING_PROFILES, SimConfig, SimController
+from app.sim.server import SimController
 
 log = logging.getLogger(__name__)
 

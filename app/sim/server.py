@@ -8,205 +8,51 @@ that advances :class:`~app.sim.robot.SimRobot` at ``SimConfig.tick_hz``. Every r
 applies writes (commands, teach ratio) and refreshes the live registers (pose, joints, status,
 clock, GV291) so reads always see the current state.
 
-GV291 publication: on a 440 command with a status (0x40/0x41/0x42/0xE0/0x80/0x81) the old
-value stays for ``status_delay`` seconds, then 0 (INITIAL) shows for ``command_latency``
-seconds — and, for the instant commands (create point, teach enable/disable), until a host has
-read GV291 at least once (at most ``ZERO_HOLD_MAX`` seconds) —
-then the robot's value (6 while moving, 0xFF done, or the error). The read rule emulates a
-controller whose cycle is slower than the host's poll, and makes the fresh-versus-stale
-question deterministic in tests: a host that polls always sees the 0 between two 0xFF. A stop (441) keeps
-the old value for ``status_delay`` and then shows 0. Float32 by default, or the integer in
-register 582 (583 = 0) with ``status_encoding="int"``.
-
-That is the ``"classic"`` timing profile (``SimConfig.timing``), the one a polling host
-handles best. The others model controllers we may meet: ``"fast"`` -- the result replaces the
-old code within one scan (the next request sees it; the 0 is never visible, no read-hold);
-``"slow"`` -- the old code stays for a seeded random pickup time (``timing.SIM_SLOW_PICKUP``),
-then 0 shows for ``timing.SIM_SLOW_ZERO``, then the result, nothing held for a reader.
-``SimConfig.gv291`` says what a host's write to GV291 (registers 582/583) does: ``"ignored"``
-(acknowledged, overwritten by the next scan: the classic simulator), ``"writable"`` (the value
-stays until the controller writes its next result) or ``"read-only"`` (Modbus exception 2,
-illegal data address: what a controller that protects its status registers answers).
-
-Project extension: joints J1..J6 in GV250..GV255 (registers 500..511).
+The parts: :mod:`app.sim.config` (settings and records), :mod:`app.sim.register_image` (the
+live registers), :mod:`app.sim.execute` (what a write does), :mod:`app.sim.status` (GV291
+publication and the timing profiles ``SimConfig.timing``). ``SimConfig.gv291`` says what a
+host's write to GV291 (registers 582/583) does: ``"ignored"`` (acknowledged, overwritten by the
+next scan: the classic simulator), ``"writable"`` (the value stays until the controller writes
+its next result) or ``"read-only"`` (Modbus exception 2, illegal data address: what a
+controller that protects its status registers answers).
 """
 
 from __future__ import annotations
 
 import asyncio
-import datetime as dt
 import logging
-import random
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Literal
 
 from pymodbus.constants import ExcCodes
 from pymodbus.framer import FramerType
 from pymodbus.simulator import DataType, SimData, SimDevice
 
-from app import timing
-from app.protocol.codec import WordOrder, encode_floats, float_to_registers, registers_to_float
-from app.protocol.datetime_regs import DateTimeLayout, encode_clock
-from app.protocol.enums import (
-    Alarm,
-    CommandKind,
-    ControllerMode,
-    ProgramState,
-    RunCommand,
-    WorkMode,
-    decode_status_registers,
-)
+from app.protocol.codec import float_to_registers
+from app.protocol.enums import Alarm
 from app.protocol.registers import (
     GV_COMMAND_STATUS,
-    GV_DATE,
-    GV_EXPECTED_SPEED,
-    GV_EXT_AXES,
-    GV_EXT_OFFSET0,
-    GV_JOINTS,
-    GV_PARAM0,
-    GV_PARAM1,
-    GV_PARAM2,
     GV_PARAM3,
-    GV_POSE,
-    GV_TOOL_FRAME,
-    NUM_EXTERNAL_AXES,
-    NUM_ROBOT_AXES,
-    REG_ALARMS,
-    REG_CONTROLLER_MODE,
-    REG_CYCLE_COUNT,
-    REG_GO_ZERO,
-    REG_PAUSE,
-    REG_PROGRAM_ID,
-    REG_PROGRAM_MODE,
-    REG_PROGRAM_SPEED,
-    REG_PROGRAM_STATE,
-    REG_RESUME,
-    REG_RUN_COMMAND,
-    REG_STOP,
-    REG_WORK_MODE,
     REGISTER_SPACE,
-    TEMP_POINT_ID_MAX,
-    TEMP_POINT_ID_MIN,
     gv_reg,
 )
-from app.sim.guard import CURRENT_CONNECTION, WATCHDOG_TIMEOUT, BadFrames, CommWatchdog
-from app.sim.robot import Pose6, SimRobot, StoredPoint, TraceSample
+from app.sim.commands import StoredPoint
+from app.sim.config import SimConfig, SimEvent, SimSnapshot, WriteRecord
+from app.sim.execute import CommandExecutor
+from app.sim.guard import CURRENT_CONNECTION, BadFrames, CommWatchdog
+from app.sim.motion import Pose6, TraceSample
+from app.sim.register_image import RegisterImage
+from app.sim.robot import SimRobot
+from app.sim.status import StatusPublisher
 from app.sim.transport import GuardedSerialServer, GuardedTcpServer, ServerGuard, ServerRunner
 
 log = logging.getLogger(__name__)
 
-# Longest time the 0 ("received") phase of GV291 waits for a host to read it.
-ZERO_HOLD_MAX = 0.25
-
 _FC_WRITE_SINGLE = 6
-_STATUS_COMMANDS = frozenset({RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT,
-                              RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE})
 _GENERAL_REGISTERS = 200  # GV0..GV99 (registers 0..199): cleared by a controller restart
 _STOP_TIMEOUT = 2.0
-TIMING_PROFILES = ("classic", "fast", "slow")
-GV291_MODES = ("ignored", "writable", "read-only")
 _ANSWER_HOLD_MAX = 0.5  # s a move waits at most for its command's answer to go out
-_GV291_REGS = range(gv_reg(GV_COMMAND_STATUS), gv_reg(GV_COMMAND_STATUS) + 2)
-
-
-@dataclass
-class SimConfig:
-    """Settings of the simulated controller (``port=0`` picks a free port)."""
-
-    host: str = "127.0.0.1"
-    port: int = 5020
-    unit: int = 1
-    word_order: WordOrder = WordOrder.LOW_FIRST
-    status_encoding: Literal["float", "int"] = "float"
-    status_delay: float = 0.0
-    tick_hz: float = timing.SIM_TICK_HZ
-    framer: Literal["socket", "rtu"] = "socket"
-    command_latency: float = timing.SIM_COMMAND_LATENCY
-    datetime_layout: DateTimeLayout = DateTimeLayout.SPLIT_WORDS
-    point_id_min: int = TEMP_POINT_ID_MIN
-    point_id_max: int = TEMP_POINT_ID_MAX
-    work_mode: WorkMode = WorkMode.AUTO  # the mode at power-on
-    response_delay: float = 0.0
-    # communication watchdog: stop a jog when its connection closes or no request arrives
-    # for this many seconds (None or 0: off)
-    watchdog: float | None = WATCHDOG_TIMEOUT
-    # RTU on a serial device instead of TCP (host/port/framer are then unused)
-    serial_port: str | None = None
-    baudrate: int = 115200
-    parity: Literal["N", "E", "O"] = "N"
-    stopbits: int = 1
-    timing: Literal["classic", "fast", "slow"] = "classic"  # GV291 timing profile (module docstring)
-    gv291: Literal["ignored", "writable", "read-only"] = "ignored"  # what a host's write to GV291 does
-    seed: int = 0  # of the "slow" profile's jitter
-
-    def __post_init__(self) -> None:
-        if isinstance(self.word_order, str):
-            self.word_order = WordOrder.parse(self.word_order)
-        if isinstance(self.datetime_layout, str):
-            self.datetime_layout = DateTimeLayout(self.datetime_layout)
-        if self.status_encoding not in ("float", "int"):
-            raise ValueError(f"status_encoding must be 'float' or 'int', got {self.status_encoding!r}")
-        if self.framer not in ("socket", "rtu"):
-            raise ValueError(f"framer must be 'socket' or 'rtu', got {self.framer!r}")
-        if not self.tick_hz > 0:
-            raise ValueError("tick_hz must be > 0")
-        if self.watchdog is not None and not self.watchdog >= 0:
-            raise ValueError(f"watchdog must be None or >= 0 s, got {self.watchdog!r}")
-        if self.parity not in ("N", "E", "O") or self.stopbits not in (1, 2) or self.baudrate <= 0:
-            raise ValueError(f"serial settings: parity N/E/O, stop bits 1/2, baud > 0; got "
-                             f"{self.parity!r}, {self.stopbits!r}, {self.baudrate!r}")
-        if self.timing not in TIMING_PROFILES:
-            raise ValueError(f"timing must be one of {', '.join(TIMING_PROFILES)}, got {self.timing!r}")
-        if self.gv291 not in GV291_MODES:
-            raise ValueError(f"gv291 must be one of {', '.join(GV291_MODES)}, got {self.gv291!r}")
-
-
-@dataclass(frozen=True)
-class WriteRecord:
-    """One write request as received: monotonic time, function code, first address, values."""
-
-    t: float
-    function_code: int
-    address: int
-    values: tuple[int, ...]
-
-
-@dataclass(frozen=True)
-class SimEvent:
-    """Something the controller did by itself: monotonic time, kind (``"watchdog"``), details."""
-
-    t: float
-    kind: str
-    detail: str
-
-
-@dataclass(frozen=True)
-class SimSnapshot:
-    """A consistent copy of the controller's state (what a host could read, and more)."""
-
-    t: float  # robot clock (s)
-    pose: Pose6  # X Y Z A B C, base frame
-    joints: tuple[float, ...]  # J1..J11
-    work_mode: WorkMode
-    mode: ControllerMode  # register 560
-    program_state: ProgramState  # register 561
-    alarms: Alarm  # register 562
-    teach_enabled: bool
-    teach_frame: int
-    teach_ratio: float
-    jogging: bool
-    command_status: int  # GV291 as published now
-    last_kind: CommandKind | None
-    points: dict[int, Pose6] = field(default_factory=dict)
-    moving: bool = False  # a move, go-to-zero or program is under way (also when paused)
-    paused: bool = False
-
-    @property
-    def ext(self) -> tuple[float, ...]:
-        return self.joints[NUM_ROBOT_AXES:]
 
 
 class SimController:
@@ -231,12 +77,11 @@ class SimController:
         self._silent = False
         self._exception: ExcCodes | None = None
         self._exception_range: range | None = None
-        # GV291 publication hold (see module docstring)
-        self._hold_old_until = 0.0
-        self._hold_old_value = 0
-        self._hold_zero_until = 0.0
-        self._zero_unread = False  # the 0 phase has not been seen by a host read yet
-        self._rng = random.Random(self.config.seed)  # the "slow" profile's jitter
+        # GV291 publication hold (app/sim/status.py), the register image, the command execution
+        self.status = StatusPublisher(self.config.timing, self.config.command_latency, self.config.seed)
+        self.image = RegisterImage(self.config)
+        self.executor = CommandExecutor(self.robot, self.config, self.image, self.status,
+                                        lambda: self._status_delay, self._move_accepted)
         self._move_unanswered: float | None = None  # when a move command not answered yet came
         self._wipe_general = False  # set by restart_controller(): clear GV0..GV99 on the next request
         # bad input and the communication watchdog (app/sim/guard.py)
@@ -293,7 +138,9 @@ class SimController:
 
     async def _serve(self) -> GuardedTcpServer | GuardedSerialServer:
         initial = [0] * REGISTER_SPACE
-        self._init_registers(initial)
+        self.image.init(initial)
+        with self.lock:
+            self._refresh(initial, 0)
         device = SimDevice(self.config.unit,
                            simdata=[SimData(address=0, values=initial, datatype=DataType.REGISTERS)],
                            action=self._action)
@@ -396,7 +243,7 @@ class SimController:
                          " ".join(f"{v:04X}" for v in values))
                 before = registers[offset : offset + len(values)]
                 registers[offset : offset + len(values)] = values
-                result = self._handle_write(registers, start_address, address, len(values))
+                result = self.executor.handle_write(registers, start_address, address, len(values))
                 if result is not None:  # refused: the write is not stored
                     registers[offset : offset + len(values)] = before
                     return result
@@ -405,187 +252,22 @@ class SimController:
                     self.watchdog.jog_written(connection)
             self._refresh(registers, start_address)
             status_reg = gv_reg(GV_COMMAND_STATUS)
-            if (set_values is None and self._zero_unread and address <= status_reg < address + count
-                    and time.monotonic() >= self._hold_old_until):
-                self._zero_unread = False  # a host has now seen the 0
+            if set_values is None and address <= status_reg < address + count:
+                self.status.seen(time.monotonic())  # a host has now seen the 0 (if it shows)
         return None
 
     # --- registers ------------------------------------------------------------------------
-    def _init_registers(self, regs: list[int]) -> None:
-        regs[REG_PROGRAM_ID] = 1
-        regs[REG_PROGRAM_MODE] = 1
-        regs[REG_CYCLE_COUNT] = 1
-        regs[REG_PROGRAM_SPEED] = 100
-        regs[REG_WORK_MODE] = int(self.config.work_mode)
-        self._put_floats(regs, 0, gv_reg(GV_EXPECTED_SPEED), [10.0])
-        self._put_floats(regs, 0, gv_reg(GV_TOOL_FRAME), [200.0])
-        self._put_floats(regs, 0, gv_reg(GV_PARAM0), [0.0] * 6)
-        with self.lock:
-            self._refresh(regs, 0)
-
-    def _put_floats(self, regs: list[int], start: int, address: int, values: list[float]) -> None:
-        encoded = encode_floats(values, self.config.word_order)
-        regs[address - start : address - start + len(encoded)] = encoded
-
-    def _gv(self, regs: list[int], start: int, n: int) -> float:
-        a = gv_reg(n) - start
-        return registers_to_float(regs[a : a + 2], self.config.word_order)
-
-    def _gvs(self, regs: list[int], start: int, n: int, count: int) -> list[float]:
-        return [self._gv(regs, start, n + i) for i in range(count)]
-
     def published_status(self, now: float | None = None) -> int:
         """GV291 as a host reads it right now (honours status_delay / command_latency)."""
         now = time.monotonic() if now is None else now
         with self.lock:
-            if now < self._hold_old_until:
-                return self._hold_old_value
-            if now < self._hold_zero_until:
-                return 0
-            if self._zero_unread and now < self._hold_old_until + ZERO_HOLD_MAX:
-                return 0
-            return self.robot.command_status
-
-    def _hold_status(self, latency: bool) -> None:
-        """Publish the old GV291 a while, then 0, then the robot's value (the timing profile)."""
-        now = time.monotonic()
-        old = self.published_status(now)
-        profile = self.config.timing
-        pickup = self._status_delay
-        zero = self.config.command_latency if latency else 0.0
-        if profile == "fast":
-            zero = 0.0
-        elif profile == "slow":
-            pickup += self._rng.uniform(*timing.SIM_SLOW_PICKUP)
-            zero = self._rng.uniform(*timing.SIM_SLOW_ZERO) if latency else 0.0
-        self._hold_old_value = old
-        self._hold_old_until = now + pickup
-        self._hold_zero_until = self._hold_old_until + zero
-        self._zero_unread = latency and profile == "classic"
-
-    def _host_wrote_status(self, regs: list[int], start: int) -> ExcCodes | None:
-        """A host's write covered GV291: refuse it, keep it, or let the next refresh overwrite it."""
-        mode = self.config.gv291
-        if mode == "read-only":
-            return ExcCodes.ILLEGAL_ADDRESS
-        if mode == "writable":
-            s = _GV291_REGS.start - start
-            self.robot.command_status = decode_status_registers(regs[s : s + 2], self.config.word_order)
-            self._hold_old_until = self._hold_zero_until = 0.0  # the host's value shows at once
-            self._zero_unread = False
-            log.info("host wrote GV291 = %d", self.robot.command_status)
-        return None
+            return self.status.published(now, self.robot.command_status)
 
     def _refresh(self, regs: list[int], start: int) -> None:
-        robot = self.robot
-        self._put_floats(regs, start, gv_reg(GV_POSE), list(robot.pose))
-        joints = [float(v) for v in robot.joints]
-        ext = joints[NUM_ROBOT_AXES : NUM_ROBOT_AXES + NUM_EXTERNAL_AXES]
-        self._put_floats(regs, start, gv_reg(GV_EXT_AXES), ext)
-        self._put_floats(regs, start, gv_reg(GV_JOINTS), joints[:NUM_ROBOT_AXES])
-        regs[REG_CONTROLLER_MODE - start] = int(robot.controller_mode)
-        regs[REG_PROGRAM_STATE - start] = int(robot.program_state)
-        regs[REG_ALARMS - start] = int(robot.alarms) & 0xFFFF
-        clock = encode_clock(dt.datetime.now(), self.config.datetime_layout)
-        d = gv_reg(GV_DATE) - start
-        regs[d : d + 4] = clock
-        status = self.published_status()
-        s = gv_reg(GV_COMMAND_STATUS) - start
-        if self.config.status_encoding == "int":
-            regs[s : s + 2] = [status & 0xFFFF, 0]
-        else:
-            regs[s : s + 2] = float_to_registers(float(status), self.config.word_order)
+        self.image.refresh(regs, start, self.robot, self.published_status())
 
-    def _handle_write(self, regs: list[int], start: int, address: int, count: int) -> ExcCodes | None:
-        """Act on the control registers a write covered (values already in ``regs``)."""
-        covered = range(address, address + count)
-        robot = self.robot
-        if _GV291_REGS.start in covered or _GV291_REGS.stop - 1 in covered:
-            refused = self._host_wrote_status(regs, start)
-            if refused is not None:
-                return refused
-
-        def value(reg: int) -> int:
-            return regs[reg - start]
-
-        if REG_WORK_MODE in covered:
-            if not robot.set_work_mode(value(REG_WORK_MODE)):
-                return ExcCodes.ILLEGAL_VALUE
-            log.info("work mode -> %s", robot.work_mode.name)
-        if REG_STOP in covered and value(REG_STOP) == 1:
-            self._hold_status(latency=False)
-            robot.stop()
-            log.info("stop")
-        if REG_PAUSE in covered and value(REG_PAUSE) == 1:
-            log.info("pause%s", "" if robot.pause() else " (nothing to pause)")
-        if REG_RESUME in covered and value(REG_RESUME) == 1:
-            log.info("resume%s", "" if robot.resume() else " (nothing paused)")
-        if REG_GO_ZERO in covered:
-            axis = value(REG_GO_ZERO)
-            log.info("go to zero %s: %s", "all" if axis == 11 else f"J{axis + 1}",
-                     "started" if robot.go_zero(axis) else "refused")
-        ratio_regs = range(gv_reg(GV_PARAM3), gv_reg(GV_PARAM3) + 2)
-        if robot.teach_enabled and (ratio_regs.start in covered or ratio_regs.stop - 1 in covered):
-            robot.set_teach_ratio(self._gv(regs, start, GV_PARAM3), self._gv(regs, start, GV_PARAM1),
-                                  self._gv(regs, start, GV_PARAM2))
-        if REG_RUN_COMMAND in covered:
-            return self._run_command(regs, start, value(REG_RUN_COMMAND))
-        return None
-
-    def _run_command(self, regs: list[int], start: int, code: int) -> ExcCodes | None:
-        try:
-            command = RunCommand(code)
-        except ValueError:
-            log.warning("unknown run command 0x%02X refused", code)
-            return ExcCodes.ILLEGAL_VALUE
-        robot = self.robot
-        if command in _STATUS_COMMANDS:
-            self._hold_status(latency=True)
-            # moves show 6 (moving) as their own evidence; only the instant commands wait
-            # for a host to have seen the 0 (classic profile)
-            self._zero_unread = self._zero_unread and command in (
-                RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE)
-        p = self._gvs(regs, start, GV_PARAM0, 6)
-        speed = self._gv(regs, start, GV_EXPECTED_SPEED)
-        ext = self._gvs(regs, start, GV_EXT_OFFSET0, NUM_EXTERNAL_AXES)
-        tool = self._gv(regs, start, GV_TOOL_FRAME)
-        status: int | None = None
-        if command is RunCommand.RUN_PROGRAM:
-            ok = robot.run_program(regs[REG_PROGRAM_ID - start], regs[REG_PROGRAM_MODE - start],
-                                   regs[REG_CYCLE_COUNT - start], regs[REG_PROGRAM_SPEED - start])
-            log.info("run program %d: %s", regs[REG_PROGRAM_ID - start], "started" if ok else "refused")
-            return None
-        if command is RunCommand.STEP_JOINT:
-            status = robot.step_joint(p + ext, speed)
-        elif command is RunCommand.STEP_BASE:
-            status = robot.step_base(p, speed, ext)
-        elif command is RunCommand.MOVE_TO_POINT:
-            status = robot.move_to_point(p[0], p[1], p[2], p[3], speed, tool)
-        elif command is RunCommand.CREATE_POINT:
-            source = p[1]
-            pose: list[float] | None = None
-            if source == 1:
-                first = robot.gv_source_ok(p[2])
-                if first is None:
-                    robot.last_kind = CommandKind.CREATE_POINT
-                    robot.command_status = 1
-                    log.info("create point %s refused: GV202 = %s is not a GV index 0..94", p[0], p[2])
-                    return None
-                pose = self._gvs(regs, start, first, 6)
-            elif source != 0:
-                robot.last_kind = CommandKind.CREATE_POINT
-                robot.command_status = 1
-                log.info("create point %s refused: GV201 = %s (0 current pose, 1 from GVs)", p[0], source)
-                return None
-            status = robot.create_point(p[0], pose, tool)
-        elif command is RunCommand.TEACH_ENABLE:
-            status = robot.teach_enable(p[0], p[3])
-        elif command is RunCommand.TEACH_DISABLE:
-            status = robot.teach_disable(p[3])
-        if command in (RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT):
-            self._move_unanswered = time.monotonic()
-        log.info("%s -> status %s", command.name, status)
-        return None
+    def _move_accepted(self) -> None:
+        self._move_unanswered = time.monotonic()
 
     # --- inspection -----------------------------------------------------------------------
     @property
@@ -657,8 +339,7 @@ class SimController:
         """The controller's system logs in again: temp points wiped, motion stopped, teach off."""
         with self.lock:
             self.robot.restart()
-            self._hold_old_until = self._hold_zero_until = 0.0
-            self._zero_unread = False
+            self.status.release()
             self._wipe_general = True  # GV0..GV99 read 0 from the next request on
         log.info("controller restarted: temp points and GV0-GV99 wiped")
 

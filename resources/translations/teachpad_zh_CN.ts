@@ -132,6 +132,207 @@
         </message>
     </context>
     <context>
+        <name>AuditModel</name>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <source>Time</source>
+            <translation>时间</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <source>Role</source>
+            <translation>角色</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <source>Kind</source>
+            <translation>类型</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <source>Command</source>
+            <translation>命令</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <source>Result</source>
+            <translation>结果</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="57" />
+            <source>Detail</source>
+            <translation>详情</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="72" />
+            <source>operator</source>
+            <translation>操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="72" />
+            <source>engineer</source>
+            <translation>工程师</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="73" />
+            <source>administrator</source>
+            <translation>管理员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="74" />
+            <source>administrator (CLI)</source>
+            <translation>管理员（命令行）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <source>write</source>
+            <translation>写入</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <source>refused</source>
+            <translation>已拒绝</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <source>login</source>
+            <translation>登录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <source>action</source>
+            <translation>操作</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <source>ok</source>
+            <translation>成功</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <source>failed</source>
+            <translation>失败</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="77" />
+            <source>blocked</source>
+            <translation>已阻止</translation>
+        </message>
+    </context>
+    <context>
+        <name>AuditViewer</name>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="87" />
+            <source>Audit trail</source>
+            <translation>审计记录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="97" />
+            <source>Any role</source>
+            <translation>任意角色</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <source>operator</source>
+            <translation>操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <source>engineer</source>
+            <translation>工程师</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="99" />
+            <source>administrator</source>
+            <translation>管理员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="100" />
+            <source>administrator (CLI)</source>
+            <translation>管理员（命令行）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="103" />
+            <source>Command contains…</source>
+            <translation>命令包含…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="105" />
+            <source>Any result</source>
+            <translation>任意结果</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="106" />
+            <source>ok</source>
+            <translation>成功</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="106" />
+            <source>failed</source>
+            <translation>失败</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="107" />
+            <source>blocked</source>
+            <translation>已阻止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="107" />
+            <source>refused</source>
+            <translation>已拒绝</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="109" />
+            <source>Show</source>
+            <translation>显示</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="111" />
+            <source>Export CSV…</source>
+            <translation>导出 CSV…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="121" />
+            <source>From</source>
+            <translation>从</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="121" />
+            <source>to</source>
+            <translation>到</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="151" />
+            <source>{n} records</source>
+            <translation>{n} 条记录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="153" />
+            <source>{n} records ({skipped} damaged lines skipped)</source>
+            <translation>{n} 条记录（跳过 {skipped} 行损坏的记录）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="158" />
+            <source>Export the audit trail</source>
+            <translation>导出审计记录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="159" />
+            <source>CSV files (*.csv)</source>
+            <translation>CSV 文件 (*.csv)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="170" />
+            <source>Cannot write {file}: {why}</source>
+            <translation>无法写入 {file}：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="173" />
+            <source>{n} records exported to {file}</source>
+            <translation>已将 {n} 条记录导出到 {file}</translation>
+        </message>
+    </context>
+    <context>
         <name>ConnectionDialog</name>
         <message>
             <location filename="../../ui/dialogs/connection_dialog.py" line="169" />
@@ -416,6 +617,105 @@
         </message>
     </context>
     <context>
+        <name>EnvelopeDialog</name>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="53" />
+            <source>Safety envelope</source>
+            <translation>安全范围</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="55" />
+            <source>Check joint limits</source>
+            <translation>检查关节限位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="58" />
+            <source>Min (°)</source>
+            <translation>最小 (°)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="58" />
+            <source>Max (°)</source>
+            <translation>最大 (°)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="65" />
+            <source>Keep the TCP inside this box</source>
+            <translation>TCP 必须留在此长方体内</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="72" />
+            <source>Name</source>
+            <translation>名称</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="78" />
+            <source>Add zone</source>
+            <translation>添加禁区</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="80" />
+            <source>Remove zone</source>
+            <translation>删除禁区</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="90" />
+            <source>Revision {n}</source>
+            <translation>版本 {n}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="94" />
+            <source>Joint limits</source>
+            <translation>关节限位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="98" />
+            <source>Work space (keep-in box)</source>
+            <translation>工作空间（允许区域）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="107" />
+            <source>Keep-out zones</source>
+            <translation>禁入区域</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="115" />
+            <source>Speeds</source>
+            <translation>速度</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="117" />
+            <source>Max jog speed:</source>
+            <translation>最大点动速度：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="118" />
+            <source>Max TCP speed (moves, plans):</source>
+            <translation>最大 TCP 速度（移动、计划）：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="119" />
+            <source>Reduced mode jog speed:</source>
+            <translation>降速模式点动速度：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="120" />
+            <source>Reduced mode TCP speed:</source>
+            <translation>降速模式 TCP 速度：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="141" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="174" />
+            <source>zone {n}</source>
+            <translation>禁区 {n}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="158" />
+            <source>{what}: '{text}' is not a number</source>
+            <translation>{what}：“{text}”不是数字</translation>
+        </message>
+    </context>
+    <context>
         <name>EventLogModel</name>
         <message>
             <location filename="../../ui/panels/event_log.py" line="92" />
@@ -511,117 +811,17 @@
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="336" />
-            <source>stop</source>
-            <translation>停止</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="337" />
-            <source>pause</source>
-            <translation>暂停</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="338" />
-            <source>resume</source>
-            <translation>继续</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="339" />
-            <source>jog</source>
-            <translation>点动</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="340" />
-            <source>jog release</source>
-            <translation>点动松开</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="341" />
-            <source>jog speed</source>
-            <translation>点动速度</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="342" />
-            <source>incremental move</source>
-            <translation>增量运动</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="343" />
-            <source>work mode</source>
-            <translation>工作模式</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="344" />
-            <source>go to zero</source>
-            <translation>回零</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="345" />
-            <source>run program</source>
-            <translation>运行程序</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="346" />
-            <source>create temp point</source>
-            <translation>创建临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="347" />
-            <source>move to temp point</source>
-            <translation>运动至临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="348" />
-            <source>upload temp points</source>
-            <translation>上传临时点</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="349" />
-            <source>cancel upload</source>
-            <translation>取消上传</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="350" />
-            <source>teach disable</source>
-            <translation>示教禁止</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="351" />
-            <source>monitor</source>
-            <translation>监视</translation>
-        </message>
-        <message>
             <location filename="../../ui/panels/event_log.py" line="352" />
-            <source>connect</source>
-            <translation>连接</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="353" />
-            <source>disconnect</source>
-            <translation>断开</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="354" />
-            <source>shutdown</source>
-            <translation>关闭</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="355" />
-            <source>restart check</source>
-            <translation>重启检测</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/event_log.py" line="374" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="399" />
+            <location filename="../../ui/panels/event_log.py" line="377" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="400" />
+            <location filename="../../ui/panels/event_log.py" line="378" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -747,7 +947,7 @@
         <message>
             <location filename="../../ui/keypad.py" line="95" />
             <source>Clear</source>
-            <translation>清除</translation>
+            <translation>清空</translation>
         </message>
         <message>
             <location filename="../../ui/keypad.py" line="97" />
@@ -758,223 +958,750 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="281" />
+            <location filename="../../ui/main_window.py" line="287" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="282" />
+            <location filename="../../ui/main_window.py" line="288" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="283" />
+            <location filename="../../ui/main_window.py" line="289" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="287" />
+            <location filename="../../ui/main_window.py" line="293" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="288" />
+            <location filename="../../ui/main_window.py" line="294" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="289" />
+            <location filename="../../ui/main_window.py" line="295" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="323" />
+            <location filename="../../ui/main_window.py" line="332" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="311" />
+            <location filename="../../ui/main_window.py" line="320" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="339" />
+            <location filename="../../ui/main_window.py" line="348" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="341" />
+            <location filename="../../ui/main_window.py" line="350" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="346" />
+            <location filename="../../ui/main_window.py" line="298" />
+            <location filename="../../ui/main_window.py" line="355" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="359" />
+            <location filename="../../ui/main_window.py" line="368" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="370" />
+            <location filename="../../ui/main_window.py" line="379" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="376" />
+            <location filename="../../ui/main_window.py" line="385" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="372" />
-            <location filename="../../ui/main_window.py" line="377" />
+            <location filename="../../ui/main_window.py" line="381" />
+            <location filename="../../ui/main_window.py" line="386" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="284" />
+            <location filename="../../ui/main_window.py" line="290" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="285" />
+            <location filename="../../ui/main_window.py" line="291" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="286" />
+            <location filename="../../ui/main_window.py" line="292" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="290" />
+            <location filename="../../ui/main_window.py" line="296" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="440" />
+            <location filename="../../ui/main_window.py" line="452" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="441" />
+            <location filename="../../ui/main_window.py" line="453" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="459" />
+            <location filename="../../ui/main_window.py" line="471" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="460" />
+            <location filename="../../ui/main_window.py" line="472" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
     </context>
     <context>
+        <name>Messages</name>
+        <message>
+            <location filename="../../ui/messages.py" line="47" />
+            <source>{command}: {status}.</source>
+            <translation>{command}：{status}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="48" />
+            <source>{command}: done, not confirmed by the controller.</source>
+            <translation>{command}：已完成，控制器未确认。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="49" />
+            <source>{command}: done (the controller is now in {mode} mode).</source>
+            <translation>{command}：已完成（控制器现处于{mode}模式）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="50" />
+            <source>{command} refused by the controller: {status}.</source>
+            <translation>控制器拒绝了{command}：{status}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="51" />
+            <source>{command} not taken: the controller still shows “{status}” from the previous command.</source>
+            <translation>{command}未被执行：控制器仍显示上一条命令的“{status}”。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="52" />
+            <source>{command} ended by an alarm: {alarms}.</source>
+            <translation>{command}因报警而中止：{alarms}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="53" />
+            <source>{command}: the controller did not acknowledge it within {seconds} s.</source>
+            <translation>{command}：控制器在 {seconds} s 内未确认。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="54" />
+            <source>{command} did not finish within {seconds} s (last status: {status}).</source>
+            <translation>{command}未在 {seconds} s 内完成（最后状态：{status}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="55" />
+            <source>{command}: the arm moved and stopped, but the controller did not report the result.</source>
+            <translation>{command}：机械臂已运动并停止，但控制器未报告结果。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="56" />
+            <source>{command}: stopped by the operator.</source>
+            <translation>{command}：已由操作员停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="57" />
+            <source>{command}: stopped by the controller.</source>
+            <translation>{command}：已被控制器停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="58" />
+            <source>{command}: sent (not waited for).</source>
+            <translation>{command}：已发送（未等待结果）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="59" />
+            <source>{command}: no motion within {seconds} s (refused by the controller, or already there).</source>
+            <translation>{command}：{seconds} s 内没有运动（被控制器拒绝，或已在目标位置）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="60" />
+            <source>Program {program} did not start: no such program, or the controller refused it.</source>
+            <translation>程序 {program} 未启动：没有该程序，或控制器拒绝执行。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="61" />
+            <source>Uploaded {uploaded} of {total} points.</source>
+            <translation>已上传 {uploaded}/{total} 个点。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="63" />
+            <source>{operation}: sent.</source>
+            <translation>{operation}：已发送。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="64" />
+            <source>{operation}: failed.</source>
+            <translation>{operation}：失败。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="65" />
+            <source>{operation} is still under way: wait for it or press Stop.</source>
+            <translation>{operation}仍在进行：请等待其结束或按停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="66" />
+            <source>The link is shut down: nothing was sent.</source>
+            <translation>通信链路已关闭：未发送任何内容。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="67" />
+            <source>Not connected to a controller: nothing was sent.</source>
+            <translation>未连接控制器：未发送任何内容。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="69" />
+            <source>Lost the connection to the controller at {endpoint}.</source>
+            <translation>与控制器 {endpoint} 的连接已断开。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="70" />
+            <source>The controller at {endpoint} closed the connection.</source>
+            <translation>控制器 {endpoint} 关闭了连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="71" />
+            <source>The host name {host} cannot be resolved.</source>
+            <translation>无法解析主机名 {host}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="72" />
+            <source>Connection refused: nothing listens on port {port}.</source>
+            <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="73" />
+            <source>No answer to the connection request within {seconds} s.</source>
+            <translation>连接请求在 {seconds} s 内无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="74" />
+            <source>The connection could not be opened.</source>
+            <translation>无法建立连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="75" />
+            <source>Cannot open the serial port {port}.</source>
+            <translation>无法打开串口 {port}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="76" />
+            <source>The controller at {endpoint} did not answer within {seconds} s.</source>
+            <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="77" />
+            <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
+            <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="78" />
+            <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
+            <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="79" />
+            <source>Monitor-only mode: nothing was sent to the controller.</source>
+            <translation>仅监视模式：未向控制器发送任何内容。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="80" />
+            <source>Invalid value: nothing was sent.</source>
+            <translation>数值无效：未发送。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="81" />
+            <source>Unexpected internal error; the log has the details.</source>
+            <translation>意外的内部错误；详情见日志。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="86" />
+            <source>No connection to the controller.</source>
+            <translation>未连接控制器。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="87" />
+            <source>The controller closed the connection.</source>
+            <translation>控制器关闭了连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="88" />
+            <source>Connection refused by the controller.</source>
+            <translation>控制器拒绝了连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="89" />
+            <source>The controller did not answer.</source>
+            <translation>控制器无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="90" />
+            <source>Malformed answer from the controller.</source>
+            <translation>控制器的应答格式错误。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="91" />
+            <source>Cannot open the serial port.</source>
+            <translation>无法打开串口。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="92" />
+            <source>The host name cannot be resolved.</source>
+            <translation>无法解析主机名。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="93" />
+            <source>No answer to the connection request.</source>
+            <translation>连接请求无应答。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="94" />
+            <source>{command} did not finish in time.</source>
+            <translation>{command}未按时完成。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="95" />
+            <source>{command}: the controller did not acknowledge it.</source>
+            <translation>{command}：控制器未确认。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="96" />
+            <source>{command} ended by an alarm.</source>
+            <translation>{command}因报警而中止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="97" />
+            <source>{command} refused by the controller.</source>
+            <translation>控制器拒绝了{command}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="98" />
+            <source>{command}: done.</source>
+            <translation>{command}：已完成。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="99" />
+            <source>The controller refused the request (Modbus exception).</source>
+            <translation>控制器拒绝了请求（Modbus 异常）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="102" />
+            <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
+            <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="103" />
+            <source>Cannot connect to the controller at {endpoint}: {cause}</source>
+            <translation>无法连接控制器 {endpoint}：{cause}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="104" />
+            <source>The command</source>
+            <translation>该命令</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="105" />
+            <source>Failed.</source>
+            <translation>失败。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="106" />
+            <source>Failed: {message}</source>
+            <translation>失败：{message}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="109" />
+            <source>stop</source>
+            <translation>停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="110" />
+            <source>pause</source>
+            <translation>暂停</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="111" />
+            <source>resume</source>
+            <translation>继续</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="112" />
+            <source>jog</source>
+            <translation>点动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="113" />
+            <source>jog release</source>
+            <translation>点动松开</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="114" />
+            <source>jog speed</source>
+            <translation>点动速度</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="115" />
+            <source>incremental move</source>
+            <translation>增量运动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="116" />
+            <source>work mode</source>
+            <translation>工作模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="117" />
+            <source>go to zero</source>
+            <translation>回零</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="118" />
+            <source>run program</source>
+            <translation>运行程序</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="119" />
+            <source>create temp point</source>
+            <translation>创建临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="120" />
+            <source>move to temp point</source>
+            <translation>运动至临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="121" />
+            <source>upload temp points</source>
+            <translation>上传临时点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="122" />
+            <source>cancel upload</source>
+            <translation>取消上传</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="123" />
+            <source>teach disable</source>
+            <translation>示教禁止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="124" />
+            <source>monitor</source>
+            <translation>监视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="125" />
+            <source>connect</source>
+            <translation>连接</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="126" />
+            <source>disconnect</source>
+            <translation>断开</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="127" />
+            <source>shutdown</source>
+            <translation>关闭</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="128" />
+            <source>restart check</source>
+            <translation>重启检测</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="130" />
+            <source>request</source>
+            <translation>请求</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="133" />
+            <source>length</source>
+            <translation>长度</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="134" />
+            <source>function code</source>
+            <translation>功能码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="135" />
+            <source>byte count</source>
+            <translation>字节数</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="136" />
+            <source>exception code</source>
+            <translation>异常码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="137" />
+            <source>address</source>
+            <translation>地址</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="138" />
+            <source>value</source>
+            <translation>数值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="139" />
+            <source>quantity</source>
+            <translation>数量</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="140" />
+            <source>transaction id</source>
+            <translation>事务标识</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="141" />
+            <source>protocol id</source>
+            <translation>协议标识</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="142" />
+            <source>unit id</source>
+            <translation>站号</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="143" />
+            <source>CRC</source>
+            <translation>CRC 校验</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="147" />
+            <source>illegal function</source>
+            <translation>非法功能</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="148" />
+            <source>illegal data address</source>
+            <translation>非法数据地址</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="149" />
+            <source>illegal data value</source>
+            <translation>非法数据值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="150" />
+            <source>server device failure</source>
+            <translation>从站设备故障</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="151" />
+            <source>acknowledge</source>
+            <translation>已确认，处理中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="152" />
+            <source>server device busy</source>
+            <translation>从站设备忙</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="153" />
+            <source>negative acknowledge</source>
+            <translation>否定应答</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="154" />
+            <source>memory parity error</source>
+            <translation>存储奇偶校验错误</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="155" />
+            <source>gateway path unavailable</source>
+            <translation>网关路径不可用</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="156" />
+            <source>gateway target device failed to respond</source>
+            <translation>网关目标设备无响应</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="158" />
+            <source>unknown exception</source>
+            <translation>未知异常</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="162" />
+            <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
+            <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="163" />
+            <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
+            <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="164" />
+            <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
+            <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="165" />
+            <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
+            <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="166" />
+            <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
+            <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="167" />
+            <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
+            <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="169" />
+            <source>Refused by the safety envelope: {text}</source>
+            <translation>安全边界拒绝：{text}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="170" />
+            <source>segment {n}: </source>
+            <translation>第 {n} 段：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="171" />
+            <source> (reduced-speed mode)</source>
+            <translation>（减速模式）</translation>
+        </message>
+    </context>
+    <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="230" />
+            <location filename="../../ui/panels/monitor_panel.py" line="269" />
+            <location filename="../../ui/panels/monitor_panel.py" line="288" />
             <source>mm</source>
+            <extracomment>Attributes that exist once the plots are built (asking for one builds them).</extracomment>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="230" />
+            <location filename="../../ui/panels/monitor_panel.py" line="269" />
+            <location filename="../../ui/panels/monitor_panel.py" line="288" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="231" />
+            <location filename="../../ui/panels/monitor_panel.py" line="270" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="233" />
+            <location filename="../../ui/panels/monitor_panel.py" line="272" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="237" />
+            <location filename="../../ui/panels/monitor_panel.py" line="276" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="238" />
+            <location filename="../../ui/panels/monitor_panel.py" line="277" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="239" />
+            <location filename="../../ui/panels/monitor_panel.py" line="278" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="240" />
+            <location filename="../../ui/panels/monitor_panel.py" line="279" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="241" />
+            <location filename="../../ui/panels/monitor_panel.py" line="280" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="242" />
+            <location filename="../../ui/panels/monitor_panel.py" line="281" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="243" />
+            <location filename="../../ui/panels/monitor_panel.py" line="282" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="244" />
+            <location filename="../../ui/panels/monitor_panel.py" line="289" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="245" />
+            <location filename="../../ui/panels/monitor_panel.py" line="290" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="246" />
+            <location filename="../../ui/panels/monitor_panel.py" line="291" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="246" />
+            <location filename="../../ui/panels/monitor_panel.py" line="291" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="247" />
+            <location filename="../../ui/panels/monitor_panel.py" line="292" />
             <source>Top view (X–Y)</source>
             <translation>俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="267" />
+            <location filename="../../ui/panels/monitor_panel.py" line="311" />
             <source>Stale: not confirmed by the controller within the freshness limit</source>
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="462" />
+            <location filename="../../ui/panels/monitor_panel.py" line="517" />
+            <source>values stale (grey): no fresh data from the controller</source>
+            <translation>数值已过期（灰色）：控制器无新数据</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="513" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="464" />
+            <location filename="../../ui/panels/monitor_panel.py" line="515" />
             <source>paused</source>
             <translation>已暂停</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="466" />
-            <source>values stale (grey): no fresh data from the controller</source>
-            <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
     </context>
     <context>
@@ -1042,43 +1769,43 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="269" />
+            <location filename="../../ui/panels/planner_widgets.py" line="268" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="270" />
+            <location filename="../../ui/panels/planner_widgets.py" line="269" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="289" />
+            <location filename="../../ui/panels/planner_widgets.py" line="288" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="292" />
+            <location filename="../../ui/panels/planner_widgets.py" line="291" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="294" />
+            <location filename="../../ui/panels/planner_widgets.py" line="293" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="296" />
+            <location filename="../../ui/panels/planner_widgets.py" line="295" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="299" />
+            <location filename="../../ui/panels/planner_widgets.py" line="298" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -1094,7 +1821,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="332" />
+            <location filename="../../ui/panels/planner_widgets.py" line="331" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1165,68 +1892,68 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="186" />
+            <location filename="../../ui/panels/plan_preview.py" line="259" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="187" />
+            <location filename="../../ui/panels/plan_preview.py" line="260" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="188" />
+            <location filename="../../ui/panels/plan_preview.py" line="261" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="192" />
+            <location filename="../../ui/panels/plan_preview.py" line="265" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="193" />
+            <location filename="../../ui/panels/plan_preview.py" line="266" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="282" />
+            <location filename="../../ui/panels/plan_preview.py" line="357" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="284" />
+            <location filename="../../ui/panels/plan_preview.py" line="359" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="286" />
+            <location filename="../../ui/panels/plan_preview.py" line="361" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="287" />
+            <location filename="../../ui/panels/plan_preview.py" line="362" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="290" />
+            <location filename="../../ui/panels/plan_preview.py" line="365" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="294" />
+            <location filename="../../ui/panels/plan_preview.py" line="369" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="296" />
+            <location filename="../../ui/panels/plan_preview.py" line="371" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="297" />
+            <location filename="../../ui/panels/plan_preview.py" line="372" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -1234,110 +1961,138 @@
     <context>
         <name>PlanRunBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="220" />
+            <location filename="../../ui/panels/planner_widgets.py" line="221" />
             <source>Run</source>
             <extracomment>Colour of a summary line by level (the status line uses the darker warning text).</extracomment>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="223" />
+            <location filename="../../ui/panels/planner_widgets.py" line="224" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="224" />
+            <location filename="../../ui/panels/planner_widgets.py" line="225" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="238" />
+            <location filename="../../ui/panels/planner_widgets.py" line="239" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
     </context>
     <context>
+        <name>PlanRunController</name>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="192" />
+            <source>Failed: {reason}</source>
+            <translation>失败：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="192" />
+            <source>Stopped: {reason}</source>
+            <translation>已停止：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="194" />
+            <source>Failed at segment {n}: {reason}</source>
+            <translation>在第 {n} 段失败：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="195" />
+            <source>Stopped at segment {n}: {reason}</source>
+            <translation>在第 {n} 段停止：{reason}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="210" />
+            <source>stopped by the operator</source>
+            <translation>已由操作员停止</translation>
+        </message>
+    </context>
+    <context>
         <name>PlanRunFlow</name>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="68" />
+            <location filename="../../ui/panels/planner_run.py" line="72" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="71" />
+            <location filename="../../ui/panels/planner_run.py" line="75" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="83" />
+            <location filename="../../ui/panels/planner_run.py" line="87" />
             <source>Not connected to a controller</source>
             <translation>未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="92" />
+            <location filename="../../ui/panels/planner_run.py" line="97" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="98" />
+            <location filename="../../ui/panels/planner_run.py" line="103" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="100" />
+            <location filename="../../ui/panels/planner_run.py" line="105" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="102" />
+            <location filename="../../ui/panels/planner_run.py" line="107" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="103" />
+            <location filename="../../ui/panels/planner_run.py" line="108" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="115" />
+            <location filename="../../ui/panels/planner_run.py" line="120" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="117" />
+            <location filename="../../ui/panels/planner_run.py" line="122" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="119" />
+            <location filename="../../ui/panels/planner_run.py" line="124" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="121" />
+            <location filename="../../ui/panels/planner_run.py" line="126" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="122" />
+            <location filename="../../ui/panels/planner_run.py" line="127" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="125" />
+            <location filename="../../ui/panels/planner_run.py" line="130" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="129" />
+            <location filename="../../ui/panels/planner_run.py" line="134" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="178" />
+            <location filename="../../ui/panels/planner_run.py" line="189" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
@@ -1345,199 +2100,200 @@
     <context>
         <name>PlannerActions</name>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="60" />
+            <location filename="../../ui/panels/planner_actions.py" line="65" />
             <source>Add</source>
+            <extracomment>The plan edits (engineer and up); the rest (run, step, pause, ...) is the operator's.</extracomment>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="60" />
+            <location filename="../../ui/panels/planner_actions.py" line="65" />
             <source>Add an empty plan</source>
             <translation>添加空轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="61" />
+            <location filename="../../ui/panels/planner_actions.py" line="66" />
             <source>Rename</source>
             <translation>重命名</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="61" />
+            <location filename="../../ui/panels/planner_actions.py" line="66" />
             <source>Rename the selected plan (F2)</source>
             <translation>重命名所选轨迹（F2）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="62" />
+            <location filename="../../ui/panels/planner_actions.py" line="67" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="62" />
+            <location filename="../../ui/panels/planner_actions.py" line="67" />
             <source>Copy the selected plan</source>
             <translation>复制所选轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="63" />
-            <location filename="../../ui/panels/planner_actions.py" line="66" />
+            <location filename="../../ui/panels/planner_actions.py" line="68" />
+            <location filename="../../ui/panels/planner_actions.py" line="71" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="63" />
+            <location filename="../../ui/panels/planner_actions.py" line="68" />
             <source>Delete the selected plan (Ctrl+Z to undo)</source>
             <translation>删除所选轨迹（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="64" />
+            <location filename="../../ui/panels/planner_actions.py" line="69" />
             <source>+ Line</source>
             <translation>+ 直线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="64" />
+            <location filename="../../ui/panels/planner_actions.py" line="69" />
             <source>Add a line segment after the selection (Ctrl+L)</source>
             <translation>在所选段之后添加直线段（Ctrl+L）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="65" />
+            <location filename="../../ui/panels/planner_actions.py" line="70" />
             <source>+ Arc</source>
             <translation>+ 圆弧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="65" />
+            <location filename="../../ui/panels/planner_actions.py" line="70" />
             <source>Add an arc segment after the selection</source>
             <translation>在所选段之后添加圆弧段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="66" />
+            <location filename="../../ui/panels/planner_actions.py" line="71" />
             <source>Delete the selected segments</source>
             <translation>删除所选段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="67" />
+            <location filename="../../ui/panels/planner_actions.py" line="72" />
             <source>Move the selected segments up (Alt+Up)</source>
             <translation>上移所选段（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="68" />
+            <location filename="../../ui/panels/planner_actions.py" line="73" />
             <source>Move the selected segments down (Alt+Down)</source>
             <translation>下移所选段（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="69" />
+            <location filename="../../ui/panels/planner_actions.py" line="74" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="69" />
+            <location filename="../../ui/panels/planner_actions.py" line="74" />
             <source>Check the plan from the robot's current pose</source>
             <translation>以机器人当前位姿检查轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="70" />
+            <location filename="../../ui/panels/planner_actions.py" line="75" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="70" />
+            <location filename="../../ui/panels/planner_actions.py" line="75" />
             <source>Upload the points the plan needs</source>
             <translation>上传轨迹所需的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="71" />
+            <location filename="../../ui/panels/planner_actions.py" line="76" />
             <source>Run</source>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="71" />
+            <location filename="../../ui/panels/planner_actions.py" line="76" />
             <source>Run the plan from the first segment (F5)</source>
             <translation>从第一段开始运行轨迹（F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="72" />
+            <location filename="../../ui/panels/planner_actions.py" line="77" />
             <source>Run from here</source>
             <translation>从此处运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="72" />
+            <location filename="../../ui/panels/planner_actions.py" line="77" />
             <source>Run from the selected segment (Shift+F5)</source>
             <translation>从所选段开始运行（Shift+F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="73" />
+            <location filename="../../ui/panels/planner_actions.py" line="78" />
             <source>Step</source>
             <translation>单步</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="73" />
+            <location filename="../../ui/panels/planner_actions.py" line="78" />
             <source>Run one segment, then stop (F10)</source>
             <translation>运行一段后停止（F10）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="74" />
+            <location filename="../../ui/panels/planner_actions.py" line="79" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="74" />
+            <location filename="../../ui/panels/planner_actions.py" line="79" />
             <source>Pause the motion</source>
             <translation>暂停运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="75" />
+            <location filename="../../ui/panels/planner_actions.py" line="80" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="75" />
+            <location filename="../../ui/panels/planner_actions.py" line="80" />
             <source>Resume the paused motion</source>
             <translation>继续已暂停的运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="76" />
+            <location filename="../../ui/panels/planner_actions.py" line="81" />
             <source>Stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="76" />
+            <location filename="../../ui/panels/planner_actions.py" line="81" />
             <source>Stop the robot and the run</source>
             <translation>停止机器人和轨迹运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="77" />
-            <location filename="../../ui/panels/planner_actions.py" line="89" />
+            <location filename="../../ui/panels/planner_actions.py" line="82" />
+            <location filename="../../ui/panels/planner_actions.py" line="94" />
             <source>Resume from segment</source>
             <translation>从该段继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="77" />
+            <location filename="../../ui/panels/planner_actions.py" line="82" />
             <source>Continue the stopped run</source>
             <translation>继续已停止的运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="88" />
+            <location filename="../../ui/panels/planner_actions.py" line="93" />
             <source>Resume from segment {k}</source>
             <translation>从第 {k} 段继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="109" />
+            <location filename="../../ui/panels/planner_actions.py" line="117" />
             <source>Run is disabled: the plan's checks found errors; fix them first</source>
             <translation>无法运行：计划检查发现错误，请先修正</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="113" />
+            <location filename="../../ui/panels/planner_actions.py" line="121" />
             <source>Run is disabled: not connected to the controller</source>
             <translation>无法运行：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="114" />
+            <location filename="../../ui/panels/planner_actions.py" line="122" />
             <source>Run is disabled: a run is going</source>
             <translation>无法运行：正在运行中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="115" />
+            <location filename="../../ui/panels/planner_actions.py" line="123" />
             <source>Run is disabled: the plan has no segments</source>
             <translation>无法运行：计划没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="116" />
+            <location filename="../../ui/panels/planner_actions.py" line="124" />
             <source>Run is disabled: wait for the points' upload to finish</source>
             <translation>无法运行：请等待点位上传完成</translation>
         </message>
@@ -1545,24 +2301,14 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="215" />
+            <location filename="../../ui/panels/planner_panel.py" line="219" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="393" />
+            <location filename="../../ui/panels/planner_panel.py" line="412" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="402" />
-            <source>Failed</source>
-            <translation>失败</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_panel.py" line="402" />
-            <source>Stopped</source>
-            <translation>已停止</translation>
         </message>
     </context>
     <context>
@@ -1581,152 +2327,157 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="161" />
+            <location filename="../../ui/controllers/point_sync.py" line="158" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="172" />
+            <location filename="../../ui/controllers/point_sync.py" line="169" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="182" />
+            <location filename="../../ui/controllers/point_sync.py" line="179" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="184" />
+            <location filename="../../ui/controllers/point_sync.py" line="181" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="191" />
+            <location filename="../../ui/controllers/point_sync.py" line="188" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="217" />
+            <location filename="../../ui/controllers/point_sync.py" line="214" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="223" />
+            <location filename="../../ui/controllers/point_sync.py" line="220" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="226" />
+            <location filename="../../ui/controllers/point_sync.py" line="223" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="230" />
+            <location filename="../../ui/controllers/point_sync.py" line="227" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="232" />
+            <location filename="../../ui/controllers/point_sync.py" line="229" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="237" />
+            <location filename="../../ui/controllers/point_sync.py" line="234" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="253" />
+            <location filename="../../ui/controllers/point_sync.py" line="250" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="273" />
+            <location filename="../../ui/controllers/point_sync.py" line="270" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="276" />
+            <location filename="../../ui/controllers/point_sync.py" line="273" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="306" />
+            <location filename="../../ui/controllers/point_sync.py" line="303" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="320" />
+            <location filename="../../ui/controllers/point_sync.py" line="317" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="344" />
+            <location filename="../../ui/controllers/point_sync.py" line="341" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="349" />
+            <location filename="../../ui/controllers/point_sync.py" line="346" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="360" />
+            <location filename="../../ui/controllers/point_sync.py" line="357" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="364" />
+            <location filename="../../ui/controllers/point_sync.py" line="361" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="370" />
+            <location filename="../../ui/controllers/point_sync.py" line="367" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="377" />
+            <location filename="../../ui/controllers/point_sync.py" line="374" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="379" />
+            <location filename="../../ui/controllers/point_sync.py" line="378" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="388" />
+            <location filename="../../ui/controllers/point_sync.py" line="387" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="392" />
+            <location filename="../../ui/controllers/point_sync.py" line="391" />
+            <source>Move to P{id} stopped by the operator</source>
+            <translation>运动到 P{id} 已由操作员停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/point_sync.py" line="395" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="430" />
+            <location filename="../../ui/controllers/point_sync.py" line="434" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="432" />
+            <location filename="../../ui/controllers/point_sync.py" line="437" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="448" />
+            <location filename="../../ui/controllers/point_sync.py" line="453" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="452" />
+            <location filename="../../ui/controllers/point_sync.py" line="457" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="456" />
+            <location filename="../../ui/controllers/point_sync.py" line="461" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -1734,37 +2485,42 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/point.py" line="124" />
+            <location filename="../../app/points/point.py" line="127" />
             <source>unknown</source>
-            <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host".</extracomment>
+            <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="125" />
+            <location filename="../../app/points/point.py" line="128" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="126" />
+            <location filename="../../app/points/point.py" line="129" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="127" />
+            <location filename="../../app/points/point.py" line="130" />
             <source>upload failed</source>
             <translation>上传失败</translation>
+        </message>
+        <message>
+            <location filename="../../app/points/point.py" line="131" />
+            <source>on controller, unconfirmed</source>
+            <translation>已在控制器上（未确认）</translation>
         </message>
     </context>
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/models/point_columns.py" line="64" />
+            <location filename="../../ui/models/point_columns.py" line="66" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/models/point_columns.py" line="65" />
+            <location filename="../../ui/models/point_columns.py" line="67" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
         </message>
@@ -1849,62 +2605,67 @@
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="240" />
+            <location filename="../../ui/models/points_model.py" line="236" />
+            <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
+            <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/points_model.py" line="243" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="270" />
+            <location filename="../../ui/models/points_model.py" line="273" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="288" />
+            <location filename="../../ui/models/points_model.py" line="291" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="319" />
+            <location filename="../../ui/models/points_model.py" line="322" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="345" />
+            <location filename="../../ui/models/points_model.py" line="348" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="346" />
+            <location filename="../../ui/models/points_model.py" line="349" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="363" />
+            <location filename="../../ui/models/points_model.py" line="366" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="364" />
+            <location filename="../../ui/models/points_model.py" line="367" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="379" />
+            <location filename="../../ui/models/points_model.py" line="382" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="379" />
+            <location filename="../../ui/models/points_model.py" line="382" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="395" />
+            <location filename="../../ui/models/points_model.py" line="398" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="404" />
+            <location filename="../../ui/models/points_model.py" line="407" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -1912,194 +2673,194 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="265" />
+            <location filename="../../ui/panels/points_panel.py" line="268" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="265" />
+            <location filename="../../ui/panels/points_panel.py" line="268" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="267" />
+            <location filename="../../ui/panels/points_panel.py" line="270" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="267" />
+            <location filename="../../ui/panels/points_panel.py" line="270" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="268" />
+            <location filename="../../ui/panels/points_panel.py" line="271" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="268" />
+            <location filename="../../ui/panels/points_panel.py" line="271" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="269" />
+            <location filename="../../ui/panels/points_panel.py" line="272" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="270" />
+            <location filename="../../ui/panels/points_panel.py" line="273" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="271" />
+            <location filename="../../ui/panels/points_panel.py" line="274" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="272" />
+            <location filename="../../ui/panels/points_panel.py" line="275" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="273" />
+            <location filename="../../ui/panels/points_panel.py" line="276" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="274" />
+            <location filename="../../ui/panels/points_panel.py" line="277" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="275" />
+            <location filename="../../ui/panels/points_panel.py" line="278" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="276" />
+            <location filename="../../ui/panels/points_panel.py" line="279" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="277" />
+            <location filename="../../ui/panels/points_panel.py" line="280" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="277" />
+            <location filename="../../ui/panels/points_panel.py" line="280" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="278" />
-            <location filename="../../ui/panels/points_panel.py" line="294" />
+            <location filename="../../ui/panels/points_panel.py" line="281" />
+            <location filename="../../ui/panels/points_panel.py" line="297" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="279" />
+            <location filename="../../ui/panels/points_panel.py" line="282" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="280" />
+            <location filename="../../ui/panels/points_panel.py" line="283" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="281" />
-            <location filename="../../ui/panels/points_panel.py" line="440" />
+            <location filename="../../ui/panels/points_panel.py" line="284" />
+            <location filename="../../ui/panels/points_panel.py" line="455" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="282" />
+            <location filename="../../ui/panels/points_panel.py" line="285" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="286" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="286" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="284" />
+            <location filename="../../ui/panels/points_panel.py" line="287" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="289" />
+            <location filename="../../ui/panels/points_panel.py" line="292" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="290" />
+            <location filename="../../ui/panels/points_panel.py" line="293" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="291" />
+            <location filename="../../ui/panels/points_panel.py" line="294" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="292" />
+            <location filename="../../ui/panels/points_panel.py" line="295" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="295" />
+            <location filename="../../ui/panels/points_panel.py" line="298" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="296" />
+            <location filename="../../ui/panels/points_panel.py" line="299" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="376" />
+            <location filename="../../ui/panels/points_panel.py" line="387" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="379" />
+            <location filename="../../ui/panels/points_panel.py" line="390" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="380" />
+            <location filename="../../ui/panels/points_panel.py" line="391" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="381" />
+            <location filename="../../ui/panels/points_panel.py" line="392" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="401" />
+            <location filename="../../ui/panels/points_panel.py" line="412" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="404" />
+            <location filename="../../ui/panels/points_panel.py" line="415" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="429" />
+            <location filename="../../ui/panels/points_panel.py" line="440" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="433" />
+            <location filename="../../ui/panels/points_panel.py" line="448" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -2112,7 +2873,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="470" />
+            <location filename="../../ui/panels/points_panel.py" line="485" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -2149,7 +2910,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="70" />
             <source>connecting</source>
-            <translation>连接中</translation>
+            <translation>正在连接</translation>
         </message>
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="71" />
@@ -2159,7 +2920,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="72" />
             <source>link down</source>
-            <translation>通信中断</translation>
+            <translation>链路中断</translation>
         </message>
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="199" />
@@ -2715,6 +3476,85 @@ Remove them all?</source>
         </message>
     </context>
     <context>
+        <name>RoleDialog</name>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="29" />
+            <source>Log in</source>
+            <translation>登录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="36" />
+            <source>Now: {role}</source>
+            <translation>当前：{role}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="40" />
+            <source>Set this role's password</source>
+            <translation>设置此角色的密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="44" />
+            <source> min</source>
+            <translation> 分钟</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="47" />
+            <source>Back to operator after this idle time</source>
+            <translation>空闲这么久后回到操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="50" />
+            <source>Log out (operator)</source>
+            <translation>注销（回到操作员）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="53" />
+            <source>Role:</source>
+            <translation>角色：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="54" />
+            <source>Password:</source>
+            <translation>密码：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="55" />
+            <source>Lock back after:</source>
+            <translation>空闲锁定时间：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="80" />
+            <source>No administrator password is set yet: choose the administrator role, type a password and press “Set this role's password”.</source>
+            <translation>尚未设置管理员密码：请选择管理员角色，输入密码，然后按“设置此角色的密码”。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="83" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="93" />
+            <source>No password is set for this role; an administrator sets it.</source>
+            <translation>此角色尚未设置密码；请由管理员设置。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="91" />
+            <source>Wrong password for the {role} role</source>
+            <translation>{role}角色的密码错误</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="105" />
+            <source>The setting could not be saved: {why}</source>
+            <translation>无法保存设置：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="119" />
+            <source>The password could not be saved: {why}</source>
+            <translation>无法保存密码：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="123" />
+            <source>Password set for the {role} role</source>
+            <translation>已设置{role}角色的密码</translation>
+        </message>
+    </context>
+    <context>
         <name>Runner</name>
         <message>
             <location filename="../../app/plan/runner.py" line="92" />
@@ -2743,9 +3583,170 @@ Remove them all?</source>
         </message>
     </context>
     <context>
+        <name>SafetyController</name>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="119" />
+            <source>operator</source>
+            <translation>操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="119" />
+            <source>engineer</source>
+            <translation>工程师</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="120" />
+            <source>administrator</source>
+            <translation>管理员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="126" />
+            <source>Needs the {need} role (you are {role}); log in from the Safety menu</source>
+            <translation>需要{need}角色（当前为{role}）；请从“安全”菜单登录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="298" />
+            <source>{axis} = {value:.1f} is within stopping distance of the keep-out zone '{box}' (at {limit:.1f})</source>
+            <translation>{axis} = {value:.1f}，已进入禁区“{box}”的停止距离内（边界 {limit:.1f}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="301" />
+            <source>{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}</source>
+            <translation>{axis} = {value:.1f}，已进入限位 {limit:.1f} 的停止距离内</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="303" />
+            <source>{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)</source>
+            <translation>{axis} = {value:.1f} mm 超出允许的工作空间（限值 {limit:.1f} mm）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="305" />
+            <source>The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, its face at {limit:.1f} mm)</source>
+            <translation>路径进入禁区“{box}”（{axis} = {value:.1f} mm，边界在 {limit:.1f} mm）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="308" />
+            <source>{axis} = {value:.1f}° is beyond its limit {limit:.1f}°</source>
+            <translation>{axis} = {value:.1f}° 超出限位 {limit:.1f}°</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="310" />
+            <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode</source>
+            <translation>速度 {value:g} mm/s 超过降速模式允许的 {limit:g} mm/s</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="311" />
+            <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed</source>
+            <translation>速度 {value:g} mm/s 超过允许的 {limit:g} mm/s</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="313" />
+            <source>Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode</source>
+            <translation>点动速度 {value:g} % 超过降速模式允许的 {limit:g} %</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="314" />
+            <source>Jog speed {value:g} % is above the {limit:g} % allowed</source>
+            <translation>点动速度 {value:g} % 超过允许的 {limit:g} %</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="318" />
+            <source>Segment {k}: {text}</source>
+            <translation>第 {k} 段：{text}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety.py" line="323" />
+            <source>Jog stopped before the limit: {why}</source>
+            <translation>点动已在到达边界前停止：{why}</translation>
+        </message>
+    </context>
+    <context>
+        <name>SafetyMenu</name>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="84" />
+            <source>&amp;Safety</source>
+            <translation>安全(&amp;S)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="85" />
+            <source>Log &amp;in…</source>
+            <translation>登录(&amp;I)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="86" />
+            <source>Log &amp;out (operator)</source>
+            <translation>注销(&amp;O)（回到操作员）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="87" />
+            <source>&amp;Reduced speed</source>
+            <translation>降速模式(&amp;R)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="88" />
+            <source>Safety &amp;envelope…</source>
+            <translation>安全范围(&amp;E)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="89" />
+            <source>&amp;Audit trail…</source>
+            <translation>审计记录(&amp;A)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="90" />
+            <source>Write a &amp;support bundle…</source>
+            <translation>生成支持包(&amp;S)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="103" />
+            <source>Role: {role} · reduced speed</source>
+            <translation>角色：{role} · 降速模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="103" />
+            <source>Role: {role}</source>
+            <translation>角色：{role}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="111" />
+            <source>Cap jog and move speeds (anyone may switch it on)</source>
+            <translation>限制点动与移动速度（任何人都可开启）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="115" />
+            <source>safety</source>
+            <translation>安全</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="138" />
+            <source>Zip files (*.zip)</source>
+            <translation>Zip 文件 (*.zip)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="145" />
+            <source>Write a support bundle</source>
+            <translation>生成支持包</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="166" />
+            <source>The support bundle could not be written: {why}</source>
+            <translation>无法生成支持包：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="167" />
+            <source>Support bundle</source>
+            <translation>支持包</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="171" />
+            <source>Support bundle written: {file} ({n} files)</source>
+            <translation>支持包已生成：{file}（{n} 个文件）</translation>
+        </message>
+    </context>
+    <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="385" />
+            <location filename="../../ui/panels/planner_widgets.py" line="384" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>
@@ -2926,139 +3927,139 @@ Remove them all?</source>
     <context>
         <name>StatusPanel</name>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="226" />
+            <location filename="../../ui/panels/status_panel.py" line="227" />
             <source>Link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="227" />
+            <location filename="../../ui/panels/status_panel.py" line="228" />
             <source>Controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="228" />
-            <location filename="../../ui/panels/status_panel.py" line="296" />
+            <location filename="../../ui/panels/status_panel.py" line="229" />
+            <location filename="../../ui/panels/status_panel.py" line="297" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="228" />
-            <location filename="../../ui/panels/status_panel.py" line="296" />
+            <location filename="../../ui/panels/status_panel.py" line="229" />
+            <location filename="../../ui/panels/status_panel.py" line="297" />
             <source>Alarms (last known)</source>
             <translation>报警（最后已知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="230" />
+            <location filename="../../ui/panels/status_panel.py" line="231" />
             <source>State:</source>
             <translation>状态：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="231" />
+            <location filename="../../ui/panels/status_panel.py" line="232" />
             <source>RTT:</source>
             <translation>往返时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="232" />
+            <location filename="../../ui/panels/status_panel.py" line="233" />
             <source>Mode:</source>
             <translation>模式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="233" />
+            <location filename="../../ui/panels/status_panel.py" line="234" />
             <source>Program:</source>
             <translation>程序：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="234" />
+            <location filename="../../ui/panels/status_panel.py" line="235" />
             <source>Last command:</source>
             <translation>上一条命令：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="235" />
+            <location filename="../../ui/panels/status_panel.py" line="236" />
             <source>Clock:</source>
             <translation>系统时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="236" />
+            <location filename="../../ui/panels/status_panel.py" line="237" />
             <source>Drift:</source>
             <translation>时差：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="237" />
+            <location filename="../../ui/panels/status_panel.py" line="238" />
             <source>Round-trip time of the last poll</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="241" />
+            <location filename="../../ui/panels/status_panel.py" line="242" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="242" />
+            <location filename="../../ui/panels/status_panel.py" line="243" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="245" />
+            <location filename="../../ui/panels/status_panel.py" line="246" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="252" />
+            <location filename="../../ui/panels/status_panel.py" line="253" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="345" />
+            <location filename="../../ui/panels/status_panel.py" line="346" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="363" />
+            <location filename="../../ui/panels/status_panel.py" line="364" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="365" />
+            <location filename="../../ui/panels/status_panel.py" line="366" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="375" />
+            <location filename="../../ui/panels/status_panel.py" line="376" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="381" />
+            <location filename="../../ui/panels/status_panel.py" line="382" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="394" />
+            <location filename="../../ui/panels/status_panel.py" line="397" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="402" />
+            <location filename="../../ui/panels/status_panel.py" line="405" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="406" />
+            <location filename="../../ui/panels/status_panel.py" line="409" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="410" />
+            <location filename="../../ui/panels/status_panel.py" line="413" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="416" />
+            <location filename="../../ui/panels/status_panel.py" line="419" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="420" />
+            <location filename="../../ui/panels/status_panel.py" line="423" />
             <source>{value} (stale)</source>
             <translation>{value}（已过期）</translation>
         </message>
@@ -3265,7 +4266,7 @@ Remove them all?</source>
     <context>
         <name>View3DCanvas</name>
         <message>
-            <location filename="../../ui/panels/view3d_canvas.py" line="216" />
+            <location filename="../../ui/panels/view3d_canvas.py" line="227" />
             <source>grid %1 mm</source>
             <translation>网格 %1 mm</translation>
         </message>
@@ -3273,12 +4274,12 @@ Remove them all?</source>
     <context>
         <name>View3DHost</name>
         <message>
-            <location filename="../../ui/panels/view3d_host.py" line="46" />
+            <location filename="../../ui/panels/view3d_host.py" line="95" />
             <source>3D</source>
             <translation>3D</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_host.py" line="47" />
+            <location filename="../../ui/panels/view3d_host.py" line="96" />
             <source>3D view</source>
             <translation>3D 视图</translation>
         </message>
@@ -3286,129 +4287,129 @@ Remove them all?</source>
     <context>
         <name>View3DPanel</name>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="184" />
+            <location filename="../../ui/panels/view3d_panel.py" line="185" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="184" />
+            <location filename="../../ui/panels/view3d_panel.py" line="185" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="184" />
+            <location filename="../../ui/panels/view3d_panel.py" line="185" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="185" />
+            <location filename="../../ui/panels/view3d_panel.py" line="186" />
             <source>Iso</source>
             <translation>轴测</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="188" />
+            <location filename="../../ui/panels/view3d_panel.py" line="189" />
             <source>Look at the scene from a preset direction</source>
             <translation>从预设方向观察场景</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="189" />
+            <location filename="../../ui/panels/view3d_panel.py" line="190" />
             <source>Fit all</source>
             <translation>全部显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="190" />
+            <location filename="../../ui/panels/view3d_panel.py" line="191" />
             <source>Show the arm, the points and the plan</source>
             <translation>显示机械臂、点位和轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="191" />
+            <location filename="../../ui/panels/view3d_panel.py" line="192" />
             <source>Orthographic</source>
             <translation>正交投影</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="192" />
+            <location filename="../../ui/panels/view3d_panel.py" line="193" />
             <source>Parallel projection (no perspective)</source>
             <translation>平行投影（无透视）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="193" />
+            <location filename="../../ui/panels/view3d_panel.py" line="194" />
             <source>Robot model…</source>
             <translation>机器人模型…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="194" />
+            <location filename="../../ui/panels/view3d_panel.py" line="195" />
             <source>Robot model: %1. Load another robot model profile (JSON)</source>
             <translation>机器人模型：%1。加载其他机器人模型配置文件（JSON）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="196" />
+            <location filename="../../ui/panels/view3d_panel.py" line="197" />
             <source>Beside the planner</source>
             <translation>在规划器旁显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="197" />
+            <location filename="../../ui/panels/view3d_panel.py" line="198" />
             <source>Show the 3D view next to the planner, not in its own tab</source>
             <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="198" />
+            <location filename="../../ui/panels/view3d_panel.py" line="199" />
             <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
             <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="224" />
+            <location filename="../../ui/panels/view3d_panel.py" line="225" />
             <source>Robot model not loaded: %1</source>
             <translation>未加载机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="233" />
+            <location filename="../../ui/panels/view3d_panel.py" line="234" />
             <source>Load a robot model profile</source>
             <translation>加载机器人模型配置文件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="234" />
+            <location filename="../../ui/panels/view3d_panel.py" line="235" />
             <source>Robot model profiles (*.json)</source>
             <translation>机器人模型配置文件 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="326" />
+            <location filename="../../ui/panels/view3d_panel.py" line="327" />
             <source>dry run: nothing is sent</source>
             <translation>空运行：不发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="328" />
+            <location filename="../../ui/panels/view3d_panel.py" line="329" />
             <source>no pose: home position shown</source>
             <translation>无位姿：显示原点姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="330" />
+            <location filename="../../ui/panels/view3d_panel.py" line="331" />
             <source>estimate (from the pose, no joint angles)</source>
             <translation>估算（由位姿求得，无关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="332" />
+            <location filename="../../ui/panels/view3d_panel.py" line="333" />
             <source>pose out of the model's reach</source>
             <translation>位姿超出模型可达范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="334" />
+            <location filename="../../ui/panels/view3d_panel.py" line="335" />
             <source>past a joint limit</source>
             <translation>超出关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="336" />
+            <location filename="../../ui/panels/view3d_panel.py" line="337" />
             <source>stale</source>
             <translation>数据过期</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="417" />
+            <location filename="../../ui/panels/view3d_panel.py" line="418" />
             <source>Out of the robot model's reach: %n point(s) (%1)</source>
             <translation>
                 <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="422" />
+            <location filename="../../ui/panels/view3d_panel.py" line="423" />
             <source>the path leaves the reach in %n segment(s) (%1)</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>

@@ -218,7 +218,7 @@ def test_plain_commands(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     assert csim.state().work_mode is WorkMode.MANUAL
     assert run(csim, capsys, "mode", "auto")[0] == EXIT_OK
     code, out, _ = run(csim, capsys, "program", "run", "2", "--mode", "single", "--speed", "50")
-    assert code == EXIT_OK and "program 2 started" in out
+    assert code == EXIT_OK and "program 2 running" in out
     assert csim.wait_for(lambda s: s.moving, 2.0)
     assert run(csim, capsys, "pause")[0] == EXIT_OK
     assert csim.wait_for(lambda s: s.paused, 2.0)

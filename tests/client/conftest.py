@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 
 from app import timing
-from app.sim.server import GV291_MODES, TIMING_PROFILES
+from app.sim.config import GV291_MODES, TIMING_PROFILES
 
 # every pair: ("classic" | "fast" | "slow", "ignored" | "writable" | "read-only")
 SIM_PROFILES = [pytest.param((t, g), id=f"{t}-{g}") for t in TIMING_PROFILES for g in GV291_MODES]

@@ -309,8 +309,10 @@ def test_host_stop_and_pause_resume(sim: Any, make_client: MakeClient) -> None:
     assert sim.wait_for(lambda s: not s.paused, 2.0)
     c.stop()
     assert tracker.finished
-    with pytest.raises(CommandStopped, match="stopped by the host"):
+    with pytest.raises(CommandStopped, match="stopped by the operator") as stopped:
         c.wait(tracker)
+    assert stopped.value.code == "stopped_by_operator"  # its own outcome, not a failure kind
+    assert tracker.result is not None and tracker.result.stopped_by_operator
     assert sim.wait_for(lambda s: not s.moving, 2.0)
 
 

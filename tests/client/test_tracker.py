@@ -156,7 +156,7 @@ def test_host_sent_stop_ends_the_wait() -> None:
     assert tr.update(st(6, RUNNING), moved(1), 0.01) is None
     result = tr.stopped(0.02)
     assert not result.ok and isinstance(tr.error, CommandStopped)
-    assert "stopped by the host" in result.message
+    assert "stopped by the operator" in result.message
     # Later reads do not change the outcome.
     assert tr.update(st(DONE), moved(1), 0.03) is result
 
@@ -357,3 +357,12 @@ def test_a_move_whose_status_never_changed_stopping_elsewhere_stays_unknown(
              (0.4, st(DONE), moved(40.0)), (0.8, st(DONE), moved(40.0))]
     i, result = feed(tr, steps)
     assert i == 3 and not result.ok and "result is unknown" in result.message
+
+
+def test_a_joint_step_whose_status_never_changed_is_done_at_its_target_joints() -> None:
+    before = Pose(100.0, 0.0, 500.0, 180.0, 0.0, 0.0, joints=(0.0,) * 6)
+    tr = CommandTracker(RunCommand.STEP_JOINT, st(DONE), before, 0.0)
+    tr.target_joints = (5.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    there = Pose(101.0, 9.0, 500.0, 180.0, 0.0, 5.0, joints=(5.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    i, result = feed(tr, [(0.01, st(DONE), there), (0.1, st(DONE), there), (0.41, st(DONE), there)])
+    assert i == 2 and result.ok

@@ -6,7 +6,7 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from app.errors import LinkError
+from app.errors import LinkError, Reason
 from app.link.capture import TrafficCapture
 from app.link.client import ConnectionSettings, RobotClient, TrafficRecord
 from app.link.jog import JogMachine
@@ -74,9 +74,14 @@ class PartsHost:
         rid = self.request_id if request_id == -1 else request_id
         self.out.append(("commandFinished", dataclasses.replace(result, request_id=rid)))
 
-    def emit_error(self, operation: str, message: str, request_id: int | None = -1) -> None:
+    def emit_error(self, operation: str, message: str, request_id: int | None = -1,
+                   reason: Reason | None = None) -> None:
         rid = self.request_id if request_id == -1 else request_id
-        self.out.append(("errorOccurred", WorkerError(operation, message, rid)))
+        self.out.append(("errorOccurred", WorkerError(operation, message, rid, reason)))
+
+    def emit_exception(self, operation: str, exc: BaseException, request_id: int | None = -1) -> None:
+        rid = self.request_id if request_id == -1 else request_id
+        self.out.append(("errorOccurred", WorkerError.from_exception(operation, exc, rid)))
 
     def start_polling(self) -> None:
         self.polling = True
@@ -123,8 +128,8 @@ class PartsHost:
     def publish_upload_progress(self, done: int, total: int) -> None:
         self.out.append(("uploadProgress", (done, total)))
 
-    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None:
-        self.out.append(("pointUploaded", (point_id, ok, reason)))
+    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
+        self.out.append(("pointUploaded", (point_id, ok, reason, unconfirmed)))
 
     # --- helpers for tests -----------------------------------------------------------------
     def names(self) -> list[str]:

@@ -19,7 +19,8 @@ from app.protocol.enums import (
     WorkMode,
 )
 from app.sim import kinematics as kin
-from app.sim.robot import JOG_MAX_JOINT, PROGRAMS, SimRobot
+from app.sim.motion import JOG_MAX_JOINT
+from app.sim.robot import PROGRAMS, SimRobot
 
 DT = 0.01
 

@@ -14,8 +14,9 @@ from app.protocol.codec import encode_floats
 from app.protocol.enums import STATUS_SENTINEL
 from app.protocol.registers import GV_COMMAND_STATUS, GV_PARAM0, gv_reg
 from app.sim.cli import build_parser
-from app.sim.server import SimConfig
-from tests.sim.conftest import Bus, poll
+from app.sim.config import SimConfig
+from app.sim.status import StatusPublisher
+from tests.sim.conftest import Bus
 
 CREATE = 0xE0
 GV291 = gv_reg(GV_COMMAND_STATUS)
@@ -54,25 +55,26 @@ def test_classic_profile_holds_the_zero_until_read(sim_factory: Any, make_bus: C
     assert codes_until_done(bus)[0] == 0
 
 
-def test_slow_profile_keeps_the_old_code_then_zero_with_jitter(sim_factory: Any,
-                                                              make_bus: Callable[..., Bus]) -> None:
-    sim = sim_factory(timing="slow", seed=1)
-    bus = make_bus(sim.port)
-    create(bus, 1)
-    poll(bus.status, lambda code: code == 0xFF)
-    pickups = []
-    for pid in (2, 3, 4, 5):
-        create(bus, pid)
-        t0 = time.monotonic()
-        seen = [bus.status()]
-        while seen[-1] != 0:  # the old 0xFF first (nothing taken yet), then 0
-            seen.append(bus.status())
-            assert time.monotonic() - t0 < 1.0, seen
-        pickups.append(time.monotonic() - t0)
-        assert seen[0] == 0xFF
-        assert poll(bus.status, lambda code: code != 0) == 0xFF
+def test_slow_profile_keeps_the_old_code_then_zero_with_jitter() -> None:
+    """The slow profile's schedule, on the simulator's own clock: the old code for a seeded pickup
+    of tens of ms, then 0 for a few ms, then the result; the pickups differ (jitter). (Timed at the
+    wire from the host, a loaded test machine reads late and the check measured the host, not the
+    simulator; the wire order is covered by the client tests over all nine profiles.)"""
+    publisher = StatusPublisher("slow", command_latency=0.001, seed=1)
     lo, hi = timing.SIM_SLOW_PICKUP
-    assert all(lo * 0.8 <= t <= hi + 0.05 for t in pickups), pickups  # tens of ms
+    zlo, zhi = timing.SIM_SLOW_ZERO
+    pickups = []
+    for start in (10.0, 20.0, 30.0, 40.0):
+        publisher.hold(start, 0xFF, pickup=0.0, latency=True, read_hold=True)
+        samples = [(start + k * 0.0005, publisher.published(start + k * 0.0005, 0xFF)) for k in range(200)]
+        zero = [t for t, code in samples if code == 0]
+        assert samples[0][1] == 0xFF and zero, samples[:5]  # the old code first, then 0
+        pickup = zero[0] - start
+        assert lo - 0.0005 <= pickup <= hi + 0.0005
+        assert zlo - 0.001 <= zero[-1] - zero[0] + 0.0005 <= zhi + 0.001
+        assert samples[-1][1] == 0xFF  # then the result
+        assert all(code in (0, 0xFF) for _, code in samples)
+        pickups.append(pickup)
     assert max(pickups) - min(pickups) > 0.002, pickups  # jitter
 
 

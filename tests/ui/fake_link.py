@@ -39,7 +39,7 @@ class FakeLink(QObject):
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815
     uploadProgress = Signal(int, int)  # noqa: N815
-    pointUploaded = Signal(int, bool, str)  # noqa: N815
+    pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
     called = Signal(str)
 
     def __init__(self, connected: bool = True) -> None:
@@ -145,10 +145,10 @@ class FakeLink(QObject):
 
     def point_ok(self, *point_ids: int) -> None:
         for point_id in point_ids:
-            self.pointUploaded.emit(point_id, True, "")
+            self.pointUploaded.emit(point_id, True, "", False)
 
     def point_failed(self, point_id: int, message: str) -> None:
-        self.pointUploaded.emit(point_id, False, message)
+        self.pointUploaded.emit(point_id, False, message, False)
 
     def upload_summary(self, uploaded: int, total: int, reason: str = "") -> None:
         text = f"uploaded {uploaded} of {total} points" + (f" ({reason})" if reason else "")

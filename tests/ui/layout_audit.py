@@ -9,7 +9,8 @@ shell when a layout looks wrong). Each returns a list of readable problems, empt
   is clipped when the height it needs for its width is more than it has. A widget that elides
   on purpose carries the dynamic property ``elide=True`` and must have a tooltip instead.
 * Overlap: two visible sibling widgets whose geometries intersect (Qt's own helper children,
-  named ``qt_*``, popups and empty unstyled labels, which paint nothing, are left out).
+  named ``qt_*``, popups, empty unstyled labels, which paint nothing, and widgets wholly outside
+  their parent, where Qt parks the docks tabbed behind the current one, are left out).
 * Motion buttons (dynamic property ``motion=True``): at least ``min_height`` px high.
 """
 
@@ -166,7 +167,8 @@ def overlapping_siblings(root: QWidget) -> list[str]:
     for parent in visible_widgets(root):
         children = [c for c in parent.findChildren(QWidget, options=Qt.FindChildOption.FindDirectChildrenOnly)
                     if c.isVisible() and not c.isWindow() and not c.objectName().startswith("qt_")
-                    and c.width() > 0 and c.height() > 0 and not paints_nothing(c)]
+                    and c.width() > 0 and c.height() > 0 and not paints_nothing(c)
+                    and c.geometry().intersects(parent.rect())]
         for i, first in enumerate(children):
             for second in children[i + 1:]:
                 if first.geometry().intersects(second.geometry()):

@@ -103,8 +103,8 @@ def test_command_results(panel: EventLogPanel) -> None:
         )
     )
     assert messages(panel) == [
-        ("info", "incremental move (base): done"),
-        ("error", "create temp point: bad point id — point 10001"),
+        ("info", "incremental move (base): done."),
+        ("error", "create temp point refused by the controller: bad point id."),
     ]
 
 

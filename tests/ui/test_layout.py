@@ -43,18 +43,13 @@ from ui.main_window import (
     TAB_POINTS,
     MainWindow,
 )
-from ui.touch import motion_height
+from ui.touch import SCROLL_MIN_ROWS_HEIGHT, motion_height
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
 # Known problems in panels owned elsewhere, each with its reason; the check stays strict for the
 # rest. Remove an entry when its panel is fixed (an entry that no longer matches fails the test).
-KNOWN_ISSUES: dict[str, str] = {
-    # monitor_panel / widgets_common: connected, in Chinese at 1280×800, a Cartesian readout is
-    # laid out 1 px narrower than its minimum, so the number's box touches the unit's box
-    "zh_CN-1280x800-connected": (r"\[jog joint \| monitor\] QLabel '[-0-9.]+' in NumericReadout and "
-                                 r"QLabel 'mm' in NumericReadout overlap by 1×\d+ px"),
-}
+KNOWN_ISSUES: dict[str, str] = {}
 SIZES = ((1280, 800), (1920, 1080))
 LANGUAGES = ("en", "zh_CN")
 STOP_MESSAGE = "Stopped: the operator pressed STOP during segment 3 of 12 (the controller reported ESTOP)"
@@ -199,6 +194,17 @@ def test_touch_mode_layout_at_1280x800(make_window: Callable[..., MainWindow], l
     assert window.menus.touch_action.isChecked()
     found = without_known(check_window(window, language, touch=True), f"{language}-1280x800-connected")
     assert not found, "\n".join(found)
+    # Decided: in touch mode the joint jog scrolls at 1280×800. Six rows of 56 px buttons (J1..J6
+    # beside J7..J11) need ~350 px under the control bar, frame and speed rows; the only ways to
+    # win that height would shrink the touch targets or drop the bottom docks. The scroll area
+    # keeps every button full size and reachable, and shows at least three rows at once.
+    window.jog_panel.set_frame(TeachFrame.JOINT)
+    window.tabs.setCurrentWidget(window.jog_panel)
+    settle()
+    scroll = window.jog_panel.axes_scroll
+    assert scroll.verticalScrollBar().isVisible(), "touch joint jog fits now: drop the scroll decision"
+    assert scroll.viewport().height() >= SCROLL_MIN_ROWS_HEIGHT
+    assert scroll.verticalScrollBar().maximum() + scroll.viewport().height() >= scroll.widget().height()
 
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")

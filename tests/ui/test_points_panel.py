@@ -273,7 +273,7 @@ def test_move_to_point_asks_first(qtbot: Any, panel: PointsPanel, link: FakeLink
     assert call.args == (2, None) and call.kwargs["speed"] == 120.0 and call.kwargs["tool"] == 200
     with qtbot.waitSignal(panel.controller.moveFinished) as done:
         link.finish_move(False, code=13, message="bad end-point id")
-    assert done.args[0] is False and "bad end-point id" in done.args[1]
+    assert done.args[0] is False and "bad end point id" in done.args[1]  # GV291 13, in words
 
 
 def test_move_to_a_point_not_on_the_controller_is_refused(panel: PointsPanel, link: FakeLink,

@@ -222,13 +222,21 @@ def test_concurrent_requests_each_get_their_own_result(qtbot: Any, sim: Any, lin
     assert sim.state().points[22] == pytest.approx(target)
 
 
-@pytest.mark.xfail(strict=True, reason="worker: a second create_point while the first is still tracked "
-                                       "replaces it (RobotWorker._track), so the first request never ends")
 def test_two_creates_in_a_row_each_get_their_own_result(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    """The second create waits in the worker until the first one's outcome is known (GV291 tells
+    one command at a time), then goes out: each request ends once, with its own result."""
     connect(qtbot, link, sim)
+    target = (400.0, 10.0, 300.0, 180.0, 0.0, 0.0)
     first = link.track(link.create_point(21))
-    second = link.track(link.create_point(22, (400.0, 10.0, 300.0, 180.0, 0.0, 0.0)))
-    _outcomes(qtbot, first, second, timeout=2000)  # each takes ~25 ms on the simulator
+    second = link.track(link.create_point(22, target))
+    third = link.track(link.create_point(23, target))
+    outcomes = _outcomes(qtbot, first, second, third)
+    assert all(len(v) == 1 for v in outcomes.values())
+    for pending in (first, second, third):
+        assert pending.result is not None and pending.result.ok, pending.result
+        assert pending.result.request_id == pending.request_id
+    assert sim.state().points[22] == pytest.approx(target) and 21 in sim.state().points
+    assert sim.state().points[23] == pytest.approx(target)
 
 
 def test_the_state_follows_the_link(qtbot: Any, sim: Any, qapp: Any, fast_reconnect: None) -> None:

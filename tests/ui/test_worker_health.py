@@ -193,3 +193,21 @@ def test_shutdown_writes_ratio_zero_and_ends_the_thread(qtbot: Any, sim: Any, li
     link.shutdown()
     assert not link.is_running
     assert ratio_writes(sim)[-1] == 0.0 and not sim.state().teach_enabled
+
+
+def test_a_silent_controller_is_reported_with_a_reason_the_ui_can_translate(
+        qtbot: Any, sim: Any, link: RobotLink) -> None:
+    """The poll's error carries its cause as a code (no_answer) beside the English text, so the
+    Chinese UI never shows "controller did not answer within ..."."""
+    from app.link.types import WorkerError
+    from ui.messages import error_text
+
+    connect(qtbot, link, sim, poll_timeout=0.3)
+    with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS,
+                          check_params_cb=lambda e: e.operation == "poll") as blocker:
+        sim.set_silent(True)
+    error: WorkerError = blocker.args[0]
+    assert error.reason is not None and error.reason.code == "no_answer"
+    assert "did not answer" in error.message  # the CLI's and the log's English stays
+    assert error_text(error)  # and the UI has a sentence for it
+    sim.set_silent(False)

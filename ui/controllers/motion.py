@@ -16,13 +16,17 @@ panels that start motion (points' move-to, the planner's run).
 
 from __future__ import annotations
 
+import dataclasses
+
 from PySide6.QtCore import QObject, Signal, Slot
 
 from app.alarm_history import blocks_motion
+from app.link.client import StepFrame
 from app.link.robot_link import LinkPort
 from app.link.types import ConnectionState, JogRequest
 from app.protocol.enums import ProgramMotionMode, WorkMode
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.safety import SafetyController
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
 from ui.panels.program_panel import ProgramPanel, ProgramRequest
@@ -50,6 +54,7 @@ class MotionController(QObject):
         self._run_active = False
         self._enabled = link.state.writable
         self._alarm_hold = blocks_motion(link.state.alarms)
+        self.safety: SafetyController | None = None  # the guard rails (set by install_safety)
 
         control_bar.stopRequested.connect(link.stop)
         control_bar.pauseRequested.connect(link.pause)
@@ -57,7 +62,7 @@ class MotionController(QObject):
         control_bar.modeRequested.connect(self._on_mode_requested)
         jog.jogPressed.connect(self._on_jog_pressed)
         jog.jogReleased.connect(link.jog_release)
-        jog.ratioChanged.connect(link.set_jog_ratio)
+        jog.ratioChanged.connect(self._on_ratio_changed)
         step.stepRequested.connect(self._on_step_requested)
         program.programRequested.connect(self._on_program_requested)
         program.goZeroRequested.connect(self._on_go_zero)
@@ -119,13 +124,31 @@ class MotionController(QObject):
     def _on_jog_pressed(self, request: JogRequest) -> None:
         if self._alarm_hold:
             return  # the panel is disabled; an intent already queued is dropped, not written
+        safety = self.safety
+        if safety is not None:  # the envelope: the ratio capped, a jog over a boundary refused
+            request = dataclasses.replace(request, ratio=safety.jog_ratio(request.ratio))
+            refused = safety.check_jog(self._link.state.pose, request)
+            if refused:
+                safety.message.emit(refused)
+                return
         self._link.jog_press(request.frame, request.axis, request.direction, request.ratio,
                              request.user, request.tool)
+
+    @Slot(float)
+    def _on_ratio_changed(self, ratio: float) -> None:
+        self._link.set_jog_ratio(self.safety.jog_ratio(ratio) if self.safety is not None else ratio)
 
     @Slot(object)
     def _on_step_requested(self, request: StepRequest) -> None:
         if self._alarm_hold:
             return
+        safety, pose = self.safety, self._link.state.pose
+        if safety is not None and pose is not None:
+            refused = safety.check_step(pose, list(request.offsets), joint=request.frame is StepFrame.JOINT,
+                                        speed=request.speed)
+            if refused:
+                safety.message.emit(refused)
+                return
         self._link.step(request.frame, request.offsets, request.ext_offsets, request.speed)
 
     @Slot(object)

@@ -16,17 +16,19 @@ from ``link.state`` (:class:`~app.link.state.RobotState`).
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 from PySide6.QtCore import QObject, Signal, Slot
 
-from app.errors import LinkError, TeachPadError
+from app.errors import LinkError, Reason, TeachPadError
 from app.link.robot_link import LinkPort, Pending
 from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult, Pose
 from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
+from ui.messages import error_text, result_text
 
 
 class PlanRunController(QObject):
@@ -57,6 +59,7 @@ class PlanRunController(QObject):
         self._paused = False
         self._connected = False
         self._outcome: RunOutcome | None = None
+        self.end_reason = ""  # why the last run stopped or failed, translated (outcome_text)
         self._progress: RunProgress | None = None
         self._sent: list[int] = []  # segment indices sent, in order (for tests and the log)
         self._move: Pending | None = None  # the outcome of the segment under way
@@ -142,6 +145,7 @@ class PlanRunController(QObject):
                                   progress=self._on_progress)
         self._plan = plan if isinstance(plan, Plan) else None
         self._outcome = None
+        self.end_reason = ""
         self._sent = []
         self._set_paused(False)
         self.runningChanged.emit(True)
@@ -164,6 +168,7 @@ class PlanRunController(QObject):
         link = self._require_link()
         runner.resume()
         self._outcome = None
+        self.end_reason = ""
         self._set_paused(False)
         self.runningChanged.emit(True)
         self._send_next(link)
@@ -179,6 +184,17 @@ class PlanRunController(QObject):
             self._link.resume()
             self._set_paused(False)
 
+    def outcome_text(self, outcome: RunOutcome) -> str:
+        """How a stopped or failed run ended, in the operator's language (one sentence)."""
+        failed = outcome.state is RunState.FAILED
+        reason = self.end_reason or outcome.message
+        if outcome.resume_from is None:
+            text = self.tr("Failed: {reason}") if failed else self.tr("Stopped: {reason}")
+            return text.format(reason=reason)
+        text = (self.tr("Failed at segment {n}: {reason}") if failed
+                else self.tr("Stopped at segment {n}: {reason}"))
+        return text.format(n=outcome.resume_from + 1, reason=reason)
+
     def stop(self) -> None:
         """Stop the robot and the run. The run ends when the link reports the stopped move
         (at once when no move is out, or when the link is down)."""
@@ -191,6 +207,7 @@ class PlanRunController(QObject):
         if runner is None or runner.state.is_over:
             return
         runner.request_stop()
+        self.end_reason = self.tr("stopped by the operator")
         self._set_paused(False)
         if runner.state is not RunState.RUNNING or not self._connected:
             runner.on_stopped()
@@ -258,6 +275,10 @@ class PlanRunController(QObject):
         current = runner.current
         missing = (not result.ok and result.status is not None
                    and result.status.code == MoveStatus.BAD_END_POINT and current is not None)
+        if not result.ok:
+            # the runner keeps the reason as text: give it the operator's language
+            self.end_reason = result_text(result)
+            result = dataclasses.replace(result, message=self.end_reason)
         runner.on_result(result)
         if missing and current is not None:
             self.pointsMissing.emit(list(current.segment.point_ids))
@@ -268,14 +289,16 @@ class PlanRunController(QObject):
         if move is not self._move or runner is None or runner.state is not RunState.RUNNING:
             return
         self._move = None
-        runner.on_error(TeachPadError(error.message))
+        self.end_reason = error_text(error)
+        runner.on_error(TeachPadError(self.end_reason))
         self._after_report()
 
     def _on_stop_failed(self, stop: Pending, error: WorkerError) -> None:
         runner = self._runner
         if stop is self._stop and runner is not None and runner.state is RunState.RUNNING \
                 and runner.stop_requested:
-            runner.on_stopped(error.message)
+            self.end_reason = error_text(error)
+            runner.on_stopped(self.end_reason)
             self._finish()
 
     @Slot(ConnectionState)
@@ -284,5 +307,7 @@ class PlanRunController(QObject):
         runner = self._runner
         if not state.connected and runner is not None and runner.state is RunState.RUNNING:
             self._move = None
+            where = {"endpoint": state.endpoint} if state.endpoint else {}
+            self.end_reason = error_text(Reason("link_lost", where))
             runner.on_error(LinkError(f"link lost: {state.message or 'link lost'}"))
             self._finish()

@@ -30,9 +30,9 @@ from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport
 from app.protocol.registers import TOOL_NONE
 from ui.controllers.new_point import NewPointPose, new_point_pose
+from ui.messages import error_text, result_text
 from ui.models.point_columns import sync_text
 from ui.models.points_model import PointsModel
-from ui.widgets_common import command_status_text
 
 DEFAULT_MOVE_SPEED = 50.0  # mm/s for "move to point"
 MAX_MOVE_SPEED = 1000.0
@@ -44,11 +44,8 @@ LEVEL_ERROR = "error"
 
 
 def result_reason(result: CommandResult) -> str:
-    """The decoded reason of a failed result (GV291 meaning and the worker's message)."""
-    status = command_status_text(result) if result.status is not None else ""
-    if result.message and status and status not in result.message:
-        return f"{status} — {result.message}"
-    return result.message or status or "failed"
+    """Why a result ended, one translated sentence (ui/messages.py)."""
+    return result_text(result)
 
 
 def _pose_from_details(details: dict[str, float], fallback: Pose | None) -> Pose | None:
@@ -323,7 +320,7 @@ class PointSyncController(QObject):
     def _on_error(self, pending: Pending, error: WorkerError) -> None:
         if pending is self._pending:
             self._pending = None
-            self._abort(error.message)
+            self._abort(error_text(error))
 
     def _on_result(self, pending: Pending, result: CommandResult) -> None:
         if pending is not self._pending:
@@ -376,6 +373,8 @@ class PointSyncController(QObject):
         except InvalidInput as exc:
             self._say(self.tr("Teach P{id}: {reason}").format(id=point_id, reason=str(exc)), LEVEL_ERROR)
             return
+        if result.unconfirmed:  # created without an error, but not proven: not "on controller"
+            self._model.set_sync(point_id, SyncState.UNCONFIRMED)
         self._say(self.tr("Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}").format(
             id=point_id, x=pose.x, y=pose.y, z=pose.z), LEVEL_INFO)
         self.pointTaught.emit(point_id)
@@ -387,6 +386,10 @@ class PointSyncController(QObject):
         if result.ok:
             self._say(self.tr("Reached P{id}").format(id=point_id), LEVEL_INFO)
             self.moveFinished.emit(True, "")
+        elif result.stopped_by_operator:
+            reason = result_reason(result)
+            self._say(self.tr("Move to P{id} stopped by the operator").format(id=point_id), LEVEL_INFO)
+            self.moveFinished.emit(False, reason)
         else:
             reason = result_reason(result)
             self._say(self.tr("Move to P{id} failed: {reason}").format(id=point_id, reason=reason),
@@ -394,13 +397,14 @@ class PointSyncController(QObject):
             self.moveFinished.emit(False, reason)
 
     # upload
-    @Slot(int, bool, str)
-    def _on_point_uploaded(self, point_id: int, ok: bool, reason: str) -> None:
+    @Slot(int, bool, str, bool)
+    def _on_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
         upload = self._upload
         if upload is None or point_id not in upload.points:
             return
         sent = upload.points[point_id]
-        outcome = UploadOutcome(point_id, True, sent=sent) if ok else UploadOutcome(point_id, False, reason)
+        outcome = (UploadOutcome(point_id, True, sent=sent, unconfirmed=unconfirmed) if ok
+                   else UploadOutcome(point_id, False, reason))
         upload.report.outcomes.append(outcome)
         upload.pending.append(outcome)
 
@@ -429,7 +433,8 @@ class PointSyncController(QObject):
         elif upload.cancelled:
             self._finish_upload(aborted=self.tr("cancelled"))
         else:
-            reason = upload.link_lost or _batch_reason(result.message) or self.tr("stopped")
+            batch = result_text(result) if result.reason else _batch_reason(result.message)
+            reason = upload.link_lost or batch or self.tr("stopped")
             self._finish_upload(aborted=reason)
 
     def _finish_upload(self, aborted: str | None) -> None:

@@ -22,6 +22,7 @@ from ui.palette import (
     COLOR_OK,
     COLOR_OK_BG,
     COLOR_WARN_BG,
+    COLOR_WARN_DARK,
     COLOR_WARN_TEXT,
 )
 
@@ -51,6 +52,7 @@ SYNC_COLOURS: dict[SyncState, tuple[str, str]] = {  # state -> (text, background
     SyncState.ON_CONTROLLER: (COLOR_OK, COLOR_OK_BG),
     SyncState.CHANGED: (COLOR_WARN_TEXT, COLOR_WARN_BG),
     SyncState.FAILED: (COLOR_ERROR, COLOR_ERROR_BG),
+    SyncState.UNCONFIRMED: (COLOR_WARN_DARK, COLOR_OK_BG),  # likely there: green ground, amber text
 }
 
 

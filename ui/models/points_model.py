@@ -233,6 +233,9 @@ class PointsModel(UndoableListModel):
                                            "restarted or the link was lost): upload it before moving to it"),
                 SyncState.ON_CONTROLLER: self.tr("The controller holds this point with these values"),
                 SyncState.CHANGED: self.tr("Changed on the host (or new) since the last upload"),
+                SyncState.UNCONFIRMED: self.tr("Sent without an error, but the controller's status never "
+                                               "changed: most likely there, not proven; upload it again "
+                                               "before moving to it"),
             }[point.sync]
         if name == "note" and point.note:
             return point.note
@@ -416,9 +419,9 @@ class PointsModel(UndoableListModel):
     def apply_upload(self, report: UploadReport) -> list[int]:
         """Record an upload (see :func:`app.points.ledger.apply_upload`); returns the rows changed."""
         for outcome in report.outcomes:
-            if outcome.ok and outcome.sent is not None:
+            if outcome.ok and outcome.sent is not None and not outcome.unconfirmed:
                 self._on_controller[outcome.point_id] = outcome.sent
-            elif not outcome.ok:
+            else:  # failed, or not proven to be there
                 self._on_controller.pop(outcome.point_id, None)
         rows = apply_upload(self.ledger, report)
         self._sync_rows_changed(rows)

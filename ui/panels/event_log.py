@@ -37,9 +37,10 @@ from PySide6.QtWidgets import (
 )
 
 from app.link.state import RobotState
-from app.link.types import ConnectionState, LinkState, Operation, WorkerError
+from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult
 from app.protocol.enums import ALARM_BITS, ALARM_TEXT, TR_CONTEXT
+from ui.messages import error_text, operation_text, result_level, result_text
 from ui.widgets_common import (
     COLOR_ERROR,
     COLOR_ERROR_BG,
@@ -47,7 +48,6 @@ from ui.widgets_common import (
     LEVEL_ERROR,
     LEVEL_WARN,
     atomic_write_text,
-    command_result_text,
     connection_display,
     export_with_dialog,
     monospace_font,
@@ -324,37 +324,15 @@ class EventLogPanel(QWidget):
 
     @Slot(object)
     def on_command_result(self, result: CommandResult) -> None:
-        self.add_event("info" if result.ok else "error", self.tr("command"), command_result_text(result))
+        self.add_event(result_level(result), self.tr("command"), result_text(result))
 
     @Slot(WorkerError)
     def on_error(self, error: WorkerError) -> None:
-        self.add_event("error", self.operation_text(error.operation), error.message)
+        self.add_event("error", self.operation_text(error.operation), error_text(error))
 
     def operation_text(self, operation: str) -> str:
         """The operator's word for a link operation (:class:`~app.link.types.Operation`)."""
-        names = {
-            Operation.STOP: self.tr("stop"),
-            Operation.PAUSE: self.tr("pause"),
-            Operation.RESUME: self.tr("resume"),
-            Operation.JOG: self.tr("jog"),
-            Operation.JOG_RELEASE: self.tr("jog release"),
-            Operation.JOG_SPEED: self.tr("jog speed"),
-            Operation.STEP: self.tr("incremental move"),
-            Operation.SET_MODE: self.tr("work mode"),
-            Operation.GO_ZERO: self.tr("go to zero"),
-            Operation.RUN_PROGRAM: self.tr("run program"),
-            Operation.CREATE_POINT: self.tr("create temp point"),
-            Operation.MOVE_TO_POINT: self.tr("move to temp point"),
-            Operation.UPLOAD_POINTS: self.tr("upload temp points"),
-            Operation.CANCEL_UPLOAD: self.tr("cancel upload"),
-            Operation.TEACH_DISABLE: self.tr("teach disable"),
-            Operation.POLL: self.tr("monitor"),
-            Operation.CONNECT: self.tr("connect"),
-            Operation.DISCONNECT: self.tr("disconnect"),
-            Operation.SHUTDOWN: self.tr("shutdown"),
-            Operation.CANARY: self.tr("restart check"),
-        }
-        return names.get(operation, operation)
+        return operation_text(operation)
 
     @Slot(ConnectionState)
     def on_connection(self, connection: ConnectionState) -> None:

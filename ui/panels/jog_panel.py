@@ -152,12 +152,12 @@ class JogPanel(QWidget):
         self.axes_rows.setObjectName("JogAxes")
         self.axes_scroll = RowsScrollArea(self.axes_rows, self.axes_box)
         box_layout = QVBoxLayout(self.axes_box)
-        box_layout.setContentsMargins(4, 4, 4, 4)
+        box_layout.setContentsMargins(4, 0, 4, 2)  # 11 joint axes fit 1280×800 in Chinese too
         box_layout.addWidget(self.axes_scroll)
         grid = QGridLayout(self.axes_rows)
         grid.setContentsMargins(0, 0, 0, 0)
         grid.setHorizontalSpacing(8)
-        grid.setVerticalSpacing(3)
+        grid.setVerticalSpacing(2)
         self.axis_labels: list[QLabel] = []
         self.minus_buttons: list[JogButton] = []
         self.plus_buttons: list[JogButton] = []

@@ -17,11 +17,11 @@ from __future__ import annotations
 
 import math
 import time
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pyqtgraph as pg
 from PySide6.QtCore import QEvent, QSignalBlocker, QSize, Qt, QTimer, Slot
-from PySide6.QtGui import QCloseEvent, QHideEvent, QResizeEvent, QShowEvent
+from PySide6.QtGui import QCloseEvent, QHideEvent, QPaintEvent, QResizeEvent, QShowEvent
 from PySide6.QtWidgets import (
     QComboBox,
     QGridLayout,
@@ -40,6 +40,12 @@ from app.models import Pose
 from ui.models.ring_buffer import RingBuffer
 from ui.panels.monitor_plots import add_legend, style_plot, unwrap_degrees
 from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
+
+if TYPE_CHECKING:  # imported when the plots are built: after the window's first paint
+    import pyqtgraph as pg
+
+#: Attributes that exist once the plots are built (asking for one builds them).
+_PLOT_ATTRIBUTES = frozenset({"xyz_plot", "abc_plot", "trace_plot", "curves", "trace_curve", "trace_marker"})
 
 PAINT_HZ = 30
 PAINT_INTERVAL_MS = math.ceil(1000 / PAINT_HZ)  # 34 ms: never faster than PAINT_HZ
@@ -175,7 +181,47 @@ class MonitorPanel(QWidget):
         controls.addStretch(1)
         controls.addWidget(self.clear_trace_button)
 
-        # Plots.
+        # Plots: built after the window's first paint (_build_plots); a placeholder keeps their place.
+        self._plots_built = False
+        self._plots_scheduled = False
+        plots = QWidget(self)
+        plots.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        self._plots_slot = plots
+
+        self._status = QLabel(self)
+        self._status.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(6, 6, 6, 6)
+        layout.setSpacing(6)
+        layout.addWidget(cart)
+        layout.addWidget(axes)
+        layout.addLayout(controls)
+        layout.addWidget(plots, 1)
+        layout.addWidget(self._status)
+        self._layout = layout
+        self.retranslate()
+
+    # --- the plots, built on first need ------------------------------------------------
+    def __getattr__(self, name: str) -> Any:
+        """The plot attributes (``xyz_plot``, ``curves``, ...) build the plots when asked for first."""
+        if name in _PLOT_ATTRIBUTES and not self.__dict__.get("_plots_built", True):
+            self._build_plots()
+            return getattr(self, name)
+        raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+
+    @property
+    def plots_built(self) -> bool:
+        return self._plots_built
+
+    @Slot()
+    def _build_plots(self) -> None:
+        """The pyqtgraph plots, and pyqtgraph's import (~0.3 s): after the window's first paint."""
+        if self._plots_built:
+            return
+        self._plots_built = True
+        import pyqtgraph as pg
+
         self.xyz_plot = pg.PlotWidget(self)
         self.abc_plot = pg.PlotWidget(self)
         self.trace_plot = pg.PlotWidget(self)
@@ -212,18 +258,11 @@ class MonitorPanel(QWidget):
         plots.setChildrenCollapsible(False)
         plots.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
 
-        self._status = QLabel(self)
-        self._status.setStyleSheet(f"color: {COLOR_NEUTRAL};")
-
-        layout = QVBoxLayout(self)
-        layout.setContentsMargins(6, 6, 6, 6)
-        layout.setSpacing(6)
-        layout.addWidget(cart)
-        layout.addWidget(axes)
-        layout.addLayout(controls)
-        layout.addWidget(plots, 1)
-        layout.addWidget(self._status)
-        self.retranslate()
+        self._layout.replaceWidget(self._plots_slot, plots)
+        self._plots_slot.deleteLater()
+        plots.show()  # made after the panel was shown: hidden until shown
+        self._retranslate_plots()
+        self._painted_history = self._painted_trace = -1  # paint what was recorded meanwhile
 
     def retranslate(self) -> None:
         """(Re)set every user-visible text: at construction and on a language change."""
@@ -241,13 +280,18 @@ class MonitorPanel(QWidget):
         self.pause_button.setToolTip(self.tr("Freeze the plots; samples keep being recorded"))
         self.clear_trace_button.setText(self.tr("Clear trace"))
         self.clear_trace_button.setToolTip(self.tr("Erase the X–Y path trace"))
+        self._update_status_text()
+        if self._plots_built:
+            self._retranslate_plots()
+
+    def _retranslate_plots(self) -> None:
+        mm, deg = self.tr("mm"), self.tr("°")
         self.xyz_plot.setLabel("left", self.tr("position"), units=mm)
         self.abc_plot.setLabel("left", self.tr("orientation"), units=deg)
         self.abc_plot.setLabel("bottom", self.tr("time"), units=self.tr("s"))
         self.trace_plot.setTitle(self.tr("Top view (X–Y)"), color="#263238", size="10pt")
         self.trace_plot.setLabel("bottom", "X", units=mm)
         self.trace_plot.setLabel("left", "Y", units=mm)
-        self._update_status_text()
 
     def changeEvent(self, event: QEvent) -> None:
         if event.type() == QEvent.Type.LanguageChange:
@@ -375,11 +419,18 @@ class MonitorPanel(QWidget):
             if rel > row[0]:
                 self._history.append((rel, *row[1:]))
                 self._latest_row = (rel, *row[1:])
+        if not self._plots_built and not self._plots_scheduled:  # before the first paint
+            if self._readouts_dirty:
+                self._readouts_dirty = False
+                self._paint_readouts()
+            return
         self.refresh()
 
     @Slot()
     def refresh(self) -> None:
         """One paint tick: readouts, then plots if new samples arrived (called by the timer)."""
+        if not self._plots_built:
+            self._build_plots()
         if self._readouts_dirty:
             self._readouts_dirty = False
             self._paint_readouts()
@@ -496,9 +547,19 @@ class MonitorPanel(QWidget):
     # --- timer follows visibility -------------------------------------------------------
     def showEvent(self, event: QShowEvent) -> None:
         super().showEvent(event)
-        self._readouts_dirty = True
-        self.refresh()
+        if self._plots_built:
+            self._readouts_dirty = True
+            self.refresh()
+        else:  # the first show: readouts now, the plots after the first paint (paintEvent)
+            self._readouts_dirty = False
+            self._paint_readouts()
         self._timer.start()
+
+    def paintEvent(self, event: QPaintEvent) -> None:
+        super().paintEvent(event)
+        if not self._plots_built and not self._plots_scheduled:
+            self._plots_scheduled = True  # the window's first paint is under way: plots right after it
+            QTimer.singleShot(0, self, self.refresh)
 
     def hideEvent(self, event: QHideEvent) -> None:
         self._timer.stop()

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
-import pyqtgraph as pg
+from typing import TYPE_CHECKING
+
 from PySide6.QtGui import QFont
+
+if TYPE_CHECKING:  # imported when the first plot is built (the window's first paint goes first)
+    import pyqtgraph as pg
 
 __all__ = ["AXIS_TICK_POINTS", "GRID_COLOR", "LEFT_AXIS_WIDTH", "add_legend", "style_plot", "unwrap_degrees"]
 
@@ -21,6 +25,8 @@ def unwrap_degrees(previous_raw: float, previous_unwrapped: float, raw: float) -
 
 def add_legend(plot: pg.PlotWidget) -> None:
     """A compact one-row legend in the top-right corner, translucent so the curves show through."""
+    import pyqtgraph as pg
+
     plot.addLegend(
         offset=(-4, 2),  # negative x: anchored to the right edge
         colCount=3,
@@ -33,6 +39,8 @@ def add_legend(plot: pg.PlotWidget) -> None:
 
 
 def style_plot(plot: pg.PlotWidget) -> None:
+    import pyqtgraph as pg
+
     plot.setBackground("w")
     item = plot.getPlotItem()
     item.showGrid(x=True, y=True)

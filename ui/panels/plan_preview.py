@@ -13,15 +13,18 @@ The view fits every change (another plan, a segment added, removed or edited, a 
 until the operator zooms or pans a projection (pyqtgraph's ``sigRangeChangedManually``): from
 then on the operator's view stays, until "Fit" (or another plan) fits again. A plan without
 segments shows all the project's points (the ones it can use), fitted, not an empty view.
+
+The plots are built on first show (or when ``projections`` is asked for): the planner is a hidden
+tab at start, so the window's first paint does not wait for pyqtgraph. Until then the setters
+only remember what to draw; the build draws it.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pyqtgraph as pg
 from numpy.typing import NDArray
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
 from PySide6.QtGui import QResizeEvent
@@ -32,6 +35,7 @@ from app.plan.geometry import PlanPath, plan_path
 from app.plan.presenter import PlanInfo
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger
+from app.safety.envelope import Envelope
 from ui.palette import (
     COLOR_AXIS,
     COLOR_HIGHLIGHT,
@@ -42,12 +46,18 @@ from ui.palette import (
     COLOR_TCP,
     COLOR_TRAIL,
 )
+from ui.palette import COLOR_ERROR as COLOR_KEEP_OUT
+from ui.palette import COLOR_OK as COLOR_KEEP_IN
+
+if TYPE_CHECKING:
+    import pyqtgraph as pg
 
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
 LIVE_FPS = 30
 TRAIL_LENGTH = 600  # live TCP positions kept for the trail
 INFO_WIDTH = 210  # px, the lengths / times column (at most)
 INFO_MIN_WIDTH = 140  # px, on a narrow window
+PLOT_MIN_HEIGHT = 80  # px: the planner's top row (segments, run box) needs the height at 1280×800
 INFO_BELOW_WIDTH = 620  # px: a narrower preview shows the lengths / times below the plots
 
 #: (key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.
@@ -58,6 +68,8 @@ FloatArray = NDArray[np.float64]
 
 
 def _style_plot(plot: pg.PlotWidget) -> None:
+    import pyqtgraph as pg  # deferred: see the module docstring
+
     plot.setBackground("w")
     item = plot.getPlotItem()
     item.showGrid(x=True, y=True, alpha=0.25)
@@ -72,13 +84,15 @@ def _style_plot(plot: pg.PlotWidget) -> None:
     plot.setMenuEnabled(False)
     plot.setAspectLocked(True)
     plot.getViewBox().setDefaultPadding(0.12)  # room for the point labels at the edges
-    plot.setMinimumSize(90, 110)
+    plot.setMinimumSize(90, PLOT_MIN_HEIGHT)
 
 
 class _Projection:
     """The items of one projection."""
 
     def __init__(self, plot: pg.PlotWidget, h: int, v: int) -> None:
+        import pyqtgraph as pg  # deferred: see the module docstring
+
         self.plot = plot
         self.h = h
         self.v = v
@@ -91,12 +105,32 @@ class _Projection:
         self.trail = pg.PlotCurveItem(pen=pg.mkPen(COLOR_TRAIL, width=2))
         self.tcp = pg.ScatterPlotItem(size=13, symbol="o", brush=pg.mkBrush(COLOR_TCP),
                                       pen=pg.mkPen(COLOR_INK))
+        # the safety envelope (added at the first envelope): each box's 12 edges projected, dashed
+        self.keep_in: pg.PlotCurveItem | None = None
+        self.keep_out: pg.PlotCurveItem | None = None
         self.labels: list[pg.TextItem] = []
         for z, item in enumerate((self.path, self.selected, self.points, self.start, self.trail, self.tcp)):
             item.setZValue(z)
             plot.addItem(item)
 
+    def set_boxes(self, keep_in: FloatArray, keep_out: FloatArray) -> None:
+        """Outline rectangles of the envelope's boxes (point pairs of :meth:`Box.edges`)."""
+        if self.keep_in is None or self.keep_out is None:
+            if not len(keep_in) and not len(keep_out):
+                return
+            dash = Qt.PenStyle.DashLine
+            pairs = "pairs"
+            self.keep_in = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_IN, width=1, style=dash), connect=pairs)
+            self.keep_out = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_OUT, width=2, style=dash), connect=pairs)
+            for item in (self.keep_in, self.keep_out):
+                item.setZValue(-1)
+                self.plot.addItem(item)
+        self.keep_in.setData(keep_in[:, self.h], keep_in[:, self.v])
+        self.keep_out.setData(keep_out[:, self.h], keep_out[:, self.v])
+
     def set_labels(self, xyz: FloatArray, texts: Sequence[str]) -> None:
+        import pyqtgraph as pg
+
         for label in self.labels:
             self.plot.removeItem(label)
         self.labels = []
@@ -127,6 +161,7 @@ class PlanPreview(QWidget):
         self._live_wanted = False
         self._trail = np.full((2 * TRAIL_LENGTH, 3), np.nan)
         self._trail_count = 0
+        self._last_tcp: Pose | None = None
         self._live_timer = QTimer(self)
         self._live_timer.setInterval(int(1000 / LIVE_FPS))
         self._live_timer.timeout.connect(self._paint_live)
@@ -134,23 +169,15 @@ class PlanPreview(QWidget):
         row = QHBoxLayout()
         row.setContentsMargins(0, 0, 0, 0)
         row.setSpacing(6)
-        self.projections: dict[str, _Projection] = {}
+        self._row = row
+        self._projections: dict[str, _Projection] = {}  # empty until built (setters only remember)
         self._titles: dict[str, QLabel] = {}
-        for key, h, v in PROJECTIONS:
-            plot = pg.PlotWidget(self)
-            _style_plot(plot)
-            plot.setLabel("bottom", f"{AXIS_NAMES[h]} (mm)")
-            plot.setLabel("left", f"{AXIS_NAMES[v]} (mm)")
-            self.projections[key] = _Projection(plot, h, v)
-            plot.getViewBox().sigRangeChangedManually.connect(self._on_operator_view)
-            title = QLabel(self)
-            title.setStyleSheet(f"font-weight: bold; color: {COLOR_INK_SOFT};")
-            self._titles[key] = title
-            cell = QVBoxLayout()
-            cell.setSpacing(0)
-            cell.addWidget(title)
-            cell.addWidget(plot, 1)
-            row.addLayout(cell, 1)
+        self._points: tuple[FloatArray, list[str]] = (np.empty((0, 3)), [])
+        self._start: tuple[float, float, float] | None = None
+        # Until the plots exist, a placeholder asks for the room they will (layouts stay the same).
+        self._slot: QWidget | None = QWidget(self)
+        self._slot.setMinimumSize(len(PROJECTIONS) * 90 + 12, 110 + QLabel().sizeHint().height())
+        row.addWidget(self._slot, 1)
         self.info = QLabel(self)
         self.info.setWordWrap(True)
         self.info.setStyleSheet(f"color: {COLOR_INK_SOFT};")
@@ -172,6 +199,52 @@ class PlanPreview(QWidget):
         layout.addLayout(side)
         self._layout = layout
         self.retranslate()
+
+    @property
+    def projections(self) -> dict[str, _Projection]:
+        """Key -> the projection's plot items (built now if they were not yet)."""
+        self._build_plots()
+        return self._projections
+
+    @property
+    def plots_built(self) -> bool:
+        return bool(self._projections)
+
+    def _build_plots(self) -> None:
+        if self._projections:
+            return
+        import pyqtgraph as pg  # deferred: see the module docstring
+
+        if self._slot is not None:
+            self._row.removeWidget(self._slot)
+            self._slot.deleteLater()
+            self._slot = None
+        for key, h, v in PROJECTIONS:
+            plot = pg.PlotWidget(self)
+            _style_plot(plot)
+            plot.setLabel("bottom", f"{AXIS_NAMES[h]} (mm)")
+            plot.setLabel("left", f"{AXIS_NAMES[v]} (mm)")
+            self._projections[key] = _Projection(plot, h, v)
+            plot.getViewBox().sigRangeChangedManually.connect(self._on_operator_view)
+            title = QLabel(self)
+            title.setStyleSheet(f"font-weight: bold; color: {COLOR_INK_SOFT};")
+            self._titles[key] = title
+            cell = QVBoxLayout()
+            cell.setSpacing(0)
+            cell.addWidget(title)
+            cell.addWidget(plot, 1)
+            self._row.addLayout(cell, 1)
+            title.show()  # children made after their parent was shown are hidden until shown
+            plot.show()
+        self.retranslate()
+        # draw what the setters remembered
+        operator_view = self._operator_view
+        self.set_path(self._path, keep_view=True)
+        self.set_points(*self._points)
+        self.set_start(self._start)
+        self._paint_trail()
+        self._auto_range()
+        self._operator_view = operator_view
 
     def resizeEvent(self, event: QResizeEvent) -> None:
         below = event.size().width() < INFO_BELOW_WIDTH
@@ -207,7 +280,7 @@ class PlanPreview(QWidget):
         """The plan's sampled path (None: nothing to draw). ``keep_view``: leave the view
         range alone (the caller fits after drawing the points too)."""
         self._path = path
-        for proj in self.projections.values():
+        for proj in self._projections.values():
             if path is None or path.xyz.shape[0] == 0:
                 proj.path.setData([], [])
             else:
@@ -219,13 +292,15 @@ class PlanPreview(QWidget):
     def set_points(self, xyz: FloatArray | Sequence[Sequence[float]], labels: Sequence[str] = ()) -> None:
         """Points to mark (the plan's points), with labels (the first :data:`MAX_LABELS`)."""
         arr = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
-        for proj in self.projections.values():
+        self._points = (arr, list(labels))
+        for proj in self._projections.values():
             proj.points.setData(arr[:, proj.h], arr[:, proj.v])
             proj.set_labels(arr, list(labels))
 
     def set_start(self, xyz: Sequence[float] | FloatArray | None) -> None:
         """Where the plan starts (the robot's pose, or an assumed start)."""
-        for proj in self.projections.values():
+        self._start = None if xyz is None else (float(xyz[0]), float(xyz[1]), float(xyz[2]))
+        for proj in self._projections.values():
             if xyz is None:
                 proj.start.setData([], [])
             else:
@@ -297,6 +372,14 @@ class PlanPreview(QWidget):
                      else self.tr("Start: the robot's current pose"))
         self.set_info("<br>".join(lines))
 
+    def set_envelope(self, envelope: Envelope | None) -> None:
+        """Outline the keep-in box and the keep-out boxes in every projection (None: none)."""
+        keep_in = envelope.keep_in.edges() if envelope is not None and envelope.keep_in else np.empty((0, 3))
+        zones = [b.edges() for b in envelope.keep_out] if envelope is not None else []
+        keep_out = np.vstack(zones) if zones else np.empty((0, 3))
+        for proj in self.projections.values():
+            proj.set_boxes(keep_in, keep_out)
+
     def clear(self) -> None:
         self._previewed = None
         self.set_path(None)
@@ -311,14 +394,14 @@ class PlanPreview(QWidget):
             hit = np.flatnonzero(path.segment == index)
             if hit.size:
                 rows = path.xyz[hit[0]:hit[-1] + 1]
-        for proj in self.projections.values():
+        for proj in self._projections.values():
             if rows is None:
                 proj.selected.setData([], [])
             else:
                 proj.selected.setData(rows[:, proj.h], rows[:, proj.v], connect="finite")
 
     def _auto_range(self) -> None:
-        for proj in self.projections.values():
+        for proj in self._projections.values():
             proj.plot.getPlotItem().enableAutoRange()
             proj.plot.getPlotItem().autoRange()
 
@@ -348,7 +431,8 @@ class PlanPreview(QWidget):
         self._pending = None
         self._trail[:] = np.nan
         self._trail_count = 0
-        for proj in self.projections.values():
+        self._last_tcp = None
+        for proj in self._projections.values():
             proj.tcp.setData([], [])
             proj.trail.setData([], [])
 
@@ -367,16 +451,24 @@ class PlanPreview(QWidget):
         self._trail[k] = xyz
         self._trail[k + TRAIL_LENGTH] = xyz
         self._trail_count += 1
+        self._last_tcp = pose
+        self._paint_trail()
+
+    def _paint_trail(self) -> None:
+        if not self._trail_count or not self._projections:
+            return
+        k = (self._trail_count - 1) % TRAIL_LENGTH
         n = min(self._trail_count, TRAIL_LENGTH)
         end = k + 1 + TRAIL_LENGTH if self._trail_count > TRAIL_LENGTH else k + 1
         view = self._trail[end - n:end]
-        for proj in self.projections.values():
+        for proj in self._projections.values():
             proj.trail.setData(view[:, proj.h], view[:, proj.v])
-        self._paint_tcp(pose)
+        if self._last_tcp is not None:
+            self._paint_tcp(self._last_tcp)
 
     def _paint_tcp(self, pose: Pose) -> None:
         xyz = (pose.x, pose.y, pose.z)
-        for proj in self.projections.values():
+        for proj in self._projections.values():
             proj.tcp.setData([xyz[proj.h]], [xyz[proj.v]])
 
     def hideEvent(self, event: Any) -> None:
@@ -384,6 +476,7 @@ class PlanPreview(QWidget):
         super().hideEvent(event)
 
     def showEvent(self, event: Any) -> None:
+        self._build_plots()
         super().showEvent(event)
         if self._live_wanted and not self._live_timer.isActive():
             self._live_timer.start()

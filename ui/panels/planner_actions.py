@@ -34,6 +34,10 @@ SHORTCUTS: dict[str, str] = {
     "resume_from": "",
 }
 
+#: The plan edits (engineer and up); the rest (run, step, pause, ...) is the operator's.
+EDIT_ACTIONS = frozenset({"add_plan", "rename_plan", "duplicate_plan", "delete_plan", "add_line", "add_arc",
+                          "delete_segment", "segment_up", "segment_down"})
+
 
 class PlannerActions(QObject):
     """One ``QAction`` per planner command, owned by ``owner`` (shortcuts work inside it)."""
@@ -51,6 +55,7 @@ class PlannerActions(QObject):
             self.all[name] = action
         self._tips: dict[str, str] = {}
         self._states: ActionStates | None = None
+        self.edit_reason: str | None = None  # role gating: why plan edits are not allowed (None: they are)
 
     def __getitem__(self, name: str) -> QAction:
         return self.all[name]
@@ -99,7 +104,10 @@ class PlannerActions(QObject):
             "resume_from": states.resume_from, "upload_now": states.upload_now,
         }
         for name, on in enabled.items():
-            self.all[name].setEnabled(on)
+            gated = self.edit_reason is not None and name in EDIT_ACTIONS
+            self.all[name].setEnabled(on and not gated)
+            if name in EDIT_ACTIONS:
+                self.all[name].setToolTip(self.edit_reason or self._tips.get(name, ""))
         self._states = states
         self._show_run_blocker(states)
 

@@ -2,9 +2,9 @@
 
 Layout: on the left the plan list (name, loops, segments; add / duplicate / delete, rename
 and loops edited in place) and the run controls (Run, Run from here, Step, Pause, Resume,
-Stop, Resume from k; progress "segment k of n, loop i of m"); in the middle the segment table
-(editable, undoable) with the checks on their rows and a summary line; on the right the
-preview (top / front / side) with lengths and times.
+Stop, Resume from k; progress "segment k of n, loop i of m") below them; on the right the
+segment table (editable, undoable) with the checks on their rows and a summary line, and the
+preview (top / front / side) with lengths and times below it.
 
 Checks (:func:`app.plan.checks.check_plan`), estimates and the preview are recomputed whenever the
 plan, the points or the selection change. Before a run the checks are made again from the
@@ -49,8 +49,10 @@ from app.plan.presenter import (
 from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, SegmentKind
 from app.points.ledger import UploadReport
+from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
+from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.models.plan_columns import PLAN_COL_NAME
 from ui.models.plan_model import PlanListModel
@@ -96,6 +98,8 @@ class PlannerPanel(QWidget):
         self._sync = point_sync
         self._confirm = confirm or ask_confirmation(self)
         self.limits = limits or PlanLimits()
+        self.envelope: Envelope | None = None  # the safety envelope: set_envelope
+        self.reduced_speed = False
         self._issues: list[PlanIssue] = []
         self._summary_text = ""
         self._pose_known = False
@@ -282,6 +286,20 @@ class PlannerPanel(QWidget):
         return self._runner.last_pose
 
     @Slot()
+    def set_edit_permission(self, reason: str | None) -> None:
+        """Role gating: plan and segment edits only while ``reason`` is None (else disabled, not
+        hidden, with ``reason`` as the tooltip); runs stay the operator's."""
+        self.actions.edit_reason = reason
+        for view in (self.plan_view, self.segment_view):
+            lock_editing(view, reason is not None)
+        self._update_actions()
+
+    def set_envelope(self, envelope: Envelope | None, reduced_speed: bool = False) -> None:
+        """The safety envelope the checks (and Run) use; its boxes are drawn in the preview."""
+        self.envelope, self.reduced_speed = envelope, reduced_speed
+        self.preview.set_envelope(envelope)
+        self.recheck()
+
     def recheck(self) -> None:
         """Checks, estimates and preview of the plan on display."""
         plan = self.current_plan()
@@ -294,7 +312,8 @@ class PlannerPanel(QWidget):
             return
         pose = self._pose()
         start, assumed = plan_start(plan, ledger, pose)
-        self._issues = check_plan(plan, ledger, self.limits, pose, loops=plan.loops)
+        self._issues = check_plan(plan, ledger, self.limits, pose, loops=plan.loops, envelope=self.envelope,
+                                  reduced_speed=self.reduced_speed)
         self.segments.set_issues(self._issues)
         estimate = estimate_plan(plan, ledger, start)
         self.segments.set_estimate(estimate.lengths, estimate.times)
@@ -400,9 +419,9 @@ class PlannerPanel(QWidget):
             if k is not None and self.current_plan() is run_plan:
                 self.select_segments([k])
             level = "error" if outcome.state is RunState.FAILED else "warn"
-            label = self.tr("Failed") if outcome.state is RunState.FAILED else self.tr("Stopped")
-            self.run_box.show_ended(f"{label}: {outcome.message}")
-            self.show_message(f"{label}: {outcome.message}", level)
+            text = self._runner.outcome_text(outcome)
+            self.run_box.show_ended(text)
+            self.show_message(text, level)
         self._update_resume_text()
         self._update_actions()
 

@@ -13,14 +13,16 @@ from typing import Protocol
 
 from PySide6.QtCore import QObject
 
-from app.errors import TeachPadError
+from app.errors import InvalidInput, TeachPadError
 from app.plan.checks import PlanIssue, PlanLimits, check_plan, ids_needing_upload
 from app.plan.presenter import RunBlock, RunKind, run_gate, run_kind
 from app.plan.runner import RunOutcome, RunState
 from app.plan.segments import Plan
 from app.points.ledger import UploadReport
+from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
+from ui.messages import error_text
 from ui.models.points_model import PointsModel
 
 MAX_POINTS_LISTED = 20  # point ids quoted in the upload question
@@ -30,6 +32,8 @@ class PlannerView(Protocol):
     """What the flow needs of the planner panel."""
 
     limits: PlanLimits
+    envelope: Envelope | None  # the safety envelope (None: none loaded)
+    reduced_speed: bool
 
     @property
     def issues(self) -> list[PlanIssue]: ...
@@ -83,7 +87,8 @@ class PlanRunFlow(QObject):
             view.show_message(self.tr("Not connected to a controller"), "error")
             return False
         issues = check_plan(plan, self._points.ledger, view.limits, self._runner.last_pose, start_index=start,
-                            loops=1 if single else plan.loops)
+                            loops=1 if single else plan.loops, envelope=view.envelope,
+                            reduced_speed=view.reduced_speed)
         summary = view.show_issues(issues, plan)
         gate = run_gate(issues)
         if gate.block is RunBlock.ERRORS and (first := gate.first_error) is not None:
@@ -143,7 +148,13 @@ class PlanRunFlow(QObject):
                 self.run_plan = plan
                 self._run_revision = plan.revision
                 self._runner.start(plan, start=start, start_loop=loop, single=single)
-        except (TeachPadError, RuntimeError) as exc:
+        except InvalidInput as exc:  # a bad start segment: its own English words are the detail
+            self._view.show_message(str(exc), "error")
+            return False
+        except TeachPadError as exc:  # no link, monitor-only...: in the operator's language
+            self._view.show_message(error_text(exc), "error")
+            return False
+        except RuntimeError as exc:
             self._view.show_message(str(exc), "error")
             return False
         return True

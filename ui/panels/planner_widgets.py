@@ -61,7 +61,8 @@ STATUS_COLOURS: dict[Level, str] = {**SUMMARY_COLOURS, Level.WARN: COLOR_WARN_TE
 
 
 RUN_LABEL_LINES = 2
-SEGMENT_BUTTONS_PER_ROW = 3
+SEGMENT_BUTTONS_PER_ROW = 5
+SUMMARY_MIN_WIDTH = 120  # px, the checks' summary beside Upload now / Check (it wraps)
 PLAN_LIST_MIN_ROWS = 2  # the plan list scrolls below this; the run box keeps its room
 
 
@@ -242,8 +243,8 @@ class PlanRunBox(QGroupBox):
 
 
 class PlanChecksBar(QWidget):
-    """The checks under the segment table (a line of their own: the column can be narrow),
-    with Upload now and Check below them."""
+    """The checks under the segment table (wrapped to the room left), Upload now and Check on
+    their right: one row, the table keeps the height."""
 
     def __init__(self, upload: Callable[[], None], check: Callable[[], None],
                  parent: QWidget | None = None) -> None:
@@ -255,15 +256,13 @@ class PlanChecksBar(QWidget):
         self.upload_button.clicked.connect(upload)
         self.check_button = QPushButton(self)
         self.check_button.clicked.connect(check)
-        buttons = QHBoxLayout()
-        buttons.addStretch(1)
-        buttons.addWidget(self.upload_button)
-        buttons.addWidget(self.check_button)
-        layout = QVBoxLayout(self)
+        self.summary.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
+        self.summary.setMinimumWidth(SUMMARY_MIN_WIDTH)
+        layout = QHBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.setSpacing(2)
-        layout.addWidget(self.summary)
-        layout.addLayout(buttons)
+        layout.addWidget(self.summary, 1)
+        layout.addWidget(self.upload_button, 0, Qt.AlignmentFlag.AlignTop)
+        layout.addWidget(self.check_button, 0, Qt.AlignmentFlag.AlignTop)
 
     def retranslate(self) -> None:
         self.upload_button.setText(self.tr("Upload now"))
@@ -368,8 +367,8 @@ class SegmentEditorBox(QGroupBox):
         view.horizontalHeader().setStretchLastSection(True)
         for column in range(segments.columnCount()):
             view.setColumnWidth(column, SEGMENT_COLUMN_WIDTHS.get(column, 60))
-        # three buttons a row: the box stays narrow beside the plans and the run box (the run
-        # box sets the row's height anyway)
+        # all five buttons in one row: the box has the work column's width, and every row of
+        # height goes to the table at 1280×800
         buttons = QGridLayout()
         buttons.setSpacing(3)
         per_row = SEGMENT_BUTTONS_PER_ROW
@@ -387,26 +386,35 @@ class SegmentEditorBox(QGroupBox):
 
 def planner_splitters(parent: QWidget, plans_box: QWidget, run_box: QWidget, segments_box: QWidget,
                       preview_box: QWidget) -> tuple[QSplitter, QSplitter]:
-    """Plans, segments and the run box side by side on top (the order of the work), the preview
-    across the full width below: the three projections stay readable on a 1280 px screen, and
-    the top row is only as tall as its tallest box, so everything fits 1280×800. Returns (top, outer)."""
-    top = QSplitter(Qt.Orientation.Horizontal, parent)
-    top.addWidget(plans_box)
-    top.addWidget(segments_box)
+    """A narrow left column with the plans above the run box (the order of the work), and the
+    work column: the segment table above the preview. At 1280×800 the work tab is only ~600 px
+    wide: three boxes side by side left the segment table 180 px wide with one row showing; this
+    way it gets all but the left column's width and half the height. Returns (work column, outer)."""
+    left = QSplitter(Qt.Orientation.Vertical, parent)
+    left.setObjectName("PlannerLeftColumn")
+    left.addWidget(plans_box)
     run_scroll = RowsScrollArea(run_box, parent)  # scrolls only with touch-size buttons on 800 px
     run_scroll.setObjectName("PlanRunScroll")
-    top.addWidget(run_scroll)
-    top.setStretchFactor(0, 0)
-    top.setStretchFactor(1, 1)
-    top.setStretchFactor(2, 0)
-    top.setSizes([200, 1000, 240])
-    top.setChildrenCollapsible(False)
-    top.setHandleWidth(4)  # three boxes in a row on a 1280 px screen: every pixel counts
-    outer = QSplitter(Qt.Orientation.Vertical, parent)
-    outer.addWidget(top)
-    outer.addWidget(preview_box)
-    outer.setStretchFactor(0, 1)
+    left.addWidget(run_scroll)
+    left.setStretchFactor(0, 1)
+    left.setStretchFactor(1, 0)
+    left.setChildrenCollapsible(False)
+    left.setHandleWidth(4)
+    work = QSplitter(Qt.Orientation.Vertical, parent)
+    work.setObjectName("PlannerWorkColumn")
+    work.addWidget(segments_box)
+    work.addWidget(preview_box)
+    work.setStretchFactor(0, 1)
+    work.setStretchFactor(1, 1)
+    work.setSizes([320, 280])  # a few segment rows first, then the projections
+    work.setChildrenCollapsible(False)
+    work.setHandleWidth(4)
+    outer = QSplitter(Qt.Orientation.Horizontal, parent)
+    outer.addWidget(left)
+    outer.addWidget(work)
+    outer.setStretchFactor(0, 0)
     outer.setStretchFactor(1, 1)
-    outer.setSizes([420, 300])  # the top row first: the run box and a few segment rows
+    outer.setSizes([220, 1000])
     outer.setChildrenCollapsible(False)
-    return top, outer
+    outer.setHandleWidth(4)  # every pixel counts on a 1280 px screen
+    return work, outer

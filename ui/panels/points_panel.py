@@ -41,6 +41,7 @@ from ui.controllers.point_sync import (
     MAX_MOVE_SPEED,
     PointSyncController,
 )
+from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COLUMNS, EXT_COLUMNS
 from ui.models.points_model import PointFilterProxy, PointsModel
@@ -68,6 +69,8 @@ class PointsPanel(QWidget):
         self._confirm = confirm or ask_confirmation(self)
         self._run_active = False
         self._alarm_hold = False  # an e-stop / servo alarm: no move-to (MotionController.alarmHoldChanged)
+        self._edit_reason: str | None = None  # why the role may not edit points (None: it may)
+        self.move_check: Callable[[int, float], str | None] | None = None  # the envelope: why not (None: go)
 
         self.proxy = PointFilterProxy(self)
         self.proxy.setSourceModel(model)
@@ -334,6 +337,14 @@ class PointsPanel(QWidget):
         self._confirm = confirm
 
     @Slot(bool)
+    def set_edit_permission(self, reason: str | None) -> None:
+        """Role gating: add / duplicate / delete / reorder / cell edits only while ``reason`` is
+        None; else disabled (not hidden) with ``reason`` as the tooltip."""
+        self._edit_reason = reason
+        lock_editing(self.table, reason is not None)
+        self.retranslate()  # the usual tooltips back; _update_actions puts the reason on top
+        self._update_actions()
+
     def set_run_active(self, active: bool) -> None:
         """A plan is running: no teach / upload / move from here."""
         self._run_active = active
@@ -430,6 +441,10 @@ class PointsPanel(QWidget):
             return
         point = self._model.point_at(rows[0])
         speed = self.speed.value()
+        refused = self.move_check(point.id, speed) if self.move_check is not None else None
+        if refused:
+            self.show_message(refused, LEVEL_ERROR)
+            return
         question = self.tr("Move the robot in a straight line to {point}?\n\n"
                            "X {x:.3f}  Y {y:.3f}  Z {z:.3f}\nA {a:.3f}  B {b:.3f}  C {c:.3f}\n"
                            "Speed {v} mm/s").format(point=point.label, x=point.x, y=point.y, z=point.z,
@@ -513,3 +528,10 @@ class PointsPanel(QWidget):
         self.cancel_button.setEnabled(c.operation == "upload")
         self.action_move_to.setEnabled(link_ok and len(rows) == 1 and not self._alarm_hold)
         self.upload_button.setEnabled(link_ok and has_points)
+        edits = (self.action_add, self.action_duplicate, self.action_delete, self.action_move_up,
+                 self.action_move_down)
+        self.action_add.setEnabled(True)
+        for action in edits:
+            action.setEnabled(action.isEnabled() and self._edit_reason is None)
+            if self._edit_reason:
+                action.setToolTip(self._edit_reason)

@@ -46,6 +46,8 @@ from app.protocol.enums import (
     ProgramState,
 )
 from app.protocol.registers import GV_DATE
+from ui import messages
+from ui.messages import result_level, result_text
 from ui.widgets_common import (
     COLOR_ERROR,
     COLOR_NEUTRAL,
@@ -58,7 +60,6 @@ from ui.widgets_common import (
     LEVEL_WARN,
     AlarmLamp,
     Lamp,
-    command_result_text,
     connection_display,
     monospace_font,
 )
@@ -140,7 +141,7 @@ class StatusPanel(QWidget):
         self.mode_label = Lamp("—", self._ctrl_box, point_size=_LAMP_POINTS + 1)
         self.program_label = Lamp("—", self._ctrl_box, point_size=_LAMP_POINTS + 1)
         self.clock_label = QLabel("—", self._ctrl_box)
-        self.clock_label.setFont(monospace_font(12))
+        self.clock_label.setFont(monospace_font(10))  # "YYYY-MM-DD hh:mm:ss" fits the narrow status dock
         self.drift_label = QLabel("", self._ctrl_box)
         self.drift_label.setFont(monospace_font(11))
         self.command_label = QLabel("", self._ctrl_box)
@@ -385,9 +386,11 @@ class StatusPanel(QWidget):
     def _render_result(self) -> None:
         result = self._result
         assert result is not None
-        self.command_label.setText(command_result_text(result))
+        self.command_label.setText(result_text(result))  # one sentence, the operator's language
         self.command_label.setProperty("ok", bool(result.ok))
-        color = COLOR_OK if result.ok else COLOR_ERROR
+        level = result_level(result)  # the operator's own stop is not a failure
+        color = {messages.LEVEL_INFO: COLOR_OK if result.ok else COLOR_NEUTRAL,
+                 messages.LEVEL_WARNING: COLOR_WARN}.get(level, COLOR_ERROR)
         self.command_label.setStyleSheet(f"color: {color}; font-weight: bold;")
         tip = []
         if result.status is not None:

@@ -125,11 +125,11 @@ class TrafficPanel(QWidget):
         bar.addWidget(self.pause_button)
         bar.addWidget(self.clear_button)
         bar.addWidget(self.export_button)
+        bar.addWidget(self.count_label)  # in the tool row: the bottom dock is short at 800 px
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
         layout.addLayout(bar)
         layout.addWidget(self.view, 1)
-        layout.addWidget(self.count_label)
         self.retranslate()
 
     def retranslate(self) -> None:

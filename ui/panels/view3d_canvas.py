@@ -21,6 +21,7 @@ from PySide6.QtCore import QPointF, QRectF, Qt, Signal
 from PySide6.QtGui import QColor, QFont, QMouseEvent, QPainter, QPaintEvent, QPixmap, QWheelEvent
 from PySide6.QtWidgets import QWidget
 
+from app.safety.envelope import Envelope
 from app.view3d.camera import Camera, grid_lines, nice_step, pick
 from ui.palette import (
     COLOR_AXIS,
@@ -32,6 +33,7 @@ from ui.palette import (
     COLOR_HIGHLIGHT,
     COLOR_INK,
     COLOR_INK_SOFT,
+    COLOR_OK,
     COLOR_PATH,
     COLOR_START,
     COLOR_TRAIL,
@@ -107,6 +109,8 @@ class View3DCanvas(QWidget):
         self.ghost_flange: FloatArray | None = None
         self.trace = np.zeros((0, 3))
         self.badges: list[tuple[str, str]] = []  # (text, colour)
+        self.keep_in_edges = np.zeros((0, 3))  # the safety envelope's boxes: point pairs (Box.edges)
+        self.keep_out_edges = np.zeros((0, 3))
 
     # --- scene setters ---------------------------------------------------------------------
     def set_camera(self, camera: Camera) -> None:
@@ -129,6 +133,13 @@ class View3DCanvas(QWidget):
         lookup = {c: i for i, c in enumerate(self._color_names)}
         self._color_codes = np.array([lookup[c] for c in self.point_colors], dtype=np.intp)
         self.point_bad = np.asarray(bad, dtype=bool)
+        self.invalidate()
+
+    def set_envelope(self, envelope: Envelope | None) -> None:
+        """Draw the keep-in box (green) and the keep-out boxes (red) as wire frames."""
+        self.keep_in_edges = envelope.keep_in.edges() if envelope and envelope.keep_in else np.zeros((0, 3))
+        zones = [b.edges() for b in envelope.keep_out] if envelope else []
+        self.keep_out_edges = np.vstack(zones) if zones else np.zeros((0, 3))
         self.invalidate()
 
     def set_selected(self, ids: set[int]) -> None:
@@ -220,6 +231,11 @@ class View3DCanvas(QWidget):
         for i, color in enumerate(AXIS_COLORS):
             painter.setPen(pen(color, 2))
             self._buf.draw_lines(painter, np.concatenate([a[0], a[i + 1]])[None, :])
+        # the safety envelope's boxes
+        for edges, color in ((self.keep_in_edges, COLOR_OK), (self.keep_out_edges, COLOR_ERROR)):
+            if len(edges):
+                painter.setPen(pen(color, 1.5))
+                self._buf.draw_lines(painter, cam.project(edges, w, h)[0].reshape(-1, 4))
         # the path: lines, unreachable samples, middle points, start, direction
         if len(self.path_xyz):
             path = self.path_xyz

@@ -1,34 +1,35 @@
 """Where the 3D view lives in the main window: its own work tab ("3D"), or a dock beside the
 planner when the panel's "Beside the planner" button is on (the planner tab comes to the front).
 
-:func:`install_view3d` is the window's only line about it: it builds the panel, connects it to
-the robot's state, the points table, the planner and the run controller, and keeps the tab's
-title translated.
+:func:`install_view3d` is the window's only line about it. The panel is built the first time
+it is needed (its tab comes to the front, or someone asks for :attr:`View3DHost.panel`): until
+then the tab holds an empty placeholder, so the window's first paint does not wait for the 3D
+view's module (and the pyqtgraph it imports). Once built it is connected to the robot's state,
+the points table, the planner and the run controller, and its tab title is kept translated.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QObject, Qt, Slot
-from PySide6.QtWidgets import QDockWidget
+from PySide6.QtWidgets import QDockWidget, QWidget
 
-from ui.panels.view3d_panel import View3DPanel
+if TYPE_CHECKING:
+    from ui.panels.view3d_panel import View3DPanel
 
 
 class View3DHost(QObject):
-    """Moves the panel between its tab and the dock."""
+    """Builds the panel on first use and moves it between its tab and the dock."""
 
     def __init__(self, window: Any) -> None:
         super().__init__(window)
         self.window = window
-        self.panel = View3DPanel(window.project.points_model, window)
-        self.panel.bind(window.link.state)
-        self.panel.attach_points(window.points_panel)
-        self.panel.attach_planner(window.planner_panel)
-        self.panel.attach_runner(window.run_controller)
+        self._panel: View3DPanel | None = None
         self.tabs = window.work_tabs
-        self.tabs.addTab(self.panel, "")
+        self._placeholder: QWidget | None = QWidget()
+        self._placeholder.setObjectName("View3DPlaceholder")
+        self.tabs.addTab(self._placeholder, "")
         self.dock = QDockWidget(window)
         self.dock.setObjectName("View3DDock")
         area = Qt.DockWidgetArea
@@ -36,42 +37,92 @@ class View3DHost(QObject):
         window.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, self.dock)
         self.dock.hide()
         self.dock.visibilityChanged.connect(self._on_dock_visible)
-        self.panel.besideToggled.connect(self.set_beside)
-        self.panel.installEventFilter(self)
+        self.tabs.currentChanged.connect(self._on_tab)
         self.retranslate()
 
+    @property
+    def panel(self) -> View3DPanel:
+        """The 3D view (built now if it was not yet)."""
+        if self._panel is None:
+            self._panel = self._build()
+        return self._panel
+
+    @property
+    def built(self) -> bool:
+        return self._panel is not None
+
+    def _build(self) -> View3DPanel:
+        from ui.panels.view3d_panel import View3DPanel  # deferred: see the module docstring
+
+        window = self.window
+        panel = View3DPanel(window.project.points_model, window)
+        panel.bind(window.link.state)
+        panel.attach_points(window.points_panel)
+        panel.attach_planner(window.planner_panel)
+        panel.attach_runner(window.run_controller)
+        panel.besideToggled.connect(self.set_beside)
+        panel.installEventFilter(self)
+        placeholder, self._placeholder = self._placeholder, None
+        index = self.tabs.indexOf(placeholder) if placeholder is not None else -1
+        if index >= 0:
+            current = self.tabs.currentIndex() == index
+            self.tabs.blockSignals(True)
+            try:
+                self.tabs.insertTab(index, panel, "")
+                self.tabs.removeTab(index + 1)
+                if current:
+                    self.tabs.setCurrentIndex(index)
+            finally:
+                self.tabs.blockSignals(False)
+        if placeholder is not None:
+            placeholder.deleteLater()
+        self._panel = panel
+        self.retranslate()
+        return panel
+
+    @Slot(int)
+    def _on_tab(self, index: int) -> None:
+        if self._placeholder is not None and self.tabs.widget(index) is self._placeholder:
+            self.panel  # noqa: B018 - builds it, in place of the placeholder
+
+    def _tab_widget(self) -> QWidget | None:
+        return self._panel if self._panel is not None else self._placeholder
+
     def retranslate(self) -> None:
-        index = self.tabs.indexOf(self.panel)
+        widget = self._tab_widget()
+        index = self.tabs.indexOf(widget) if widget is not None else -1
         if index >= 0:
             self.tabs.setTabText(index, self.tr("3D"))
         self.dock.setWindowTitle(self.tr("3D view"))
 
     def eventFilter(self, watched: QObject, event: Any) -> bool:
-        if watched is self.panel and event.type() == event.Type.LanguageChange:
+        if watched is self._panel and event.type() == event.Type.LanguageChange:
             self.retranslate()
         return False
 
     @Slot(bool)
     def set_beside(self, beside: bool) -> None:
-        if beside and self.dock.widget() is not self.panel:
-            self.tabs.removeTab(self.tabs.indexOf(self.panel))
-            self.dock.setWidget(self.panel)
+        panel = self.panel
+        if beside and self.dock.widget() is not panel:
+            self.tabs.removeTab(self.tabs.indexOf(panel))
+            self.dock.setWidget(panel)
             self.dock.show()
             self.tabs.setCurrentWidget(self.window.planner_panel)
-        elif not beside and self.dock.widget() is self.panel:
+        elif not beside and self.dock.widget() is panel:
             self.dock.setWidget(None)  # type: ignore[arg-type]
             self.dock.hide()
-            self.tabs.addTab(self.panel, "")
-            self.panel.show()
+            self.tabs.addTab(panel, "")
+            panel.show()
             self.retranslate()
-        self.panel.beside_button.blockSignals(True)
-        self.panel.beside_button.setChecked(beside)
-        self.panel.beside_button.blockSignals(False)
+        panel.beside_button.blockSignals(True)
+        panel.beside_button.setChecked(beside)
+        panel.beside_button.blockSignals(False)
 
     @Slot(bool)
     def _on_dock_visible(self, visible: bool) -> None:
         # closing the dock (its X) puts the view back into its tab
-        if not visible and self.dock.widget() is self.panel and not self.dock.isVisible():
+        if not visible and self._panel is not None and self.dock.widget() is self._panel \
+                and not self.dock.isVisible():
             self.set_beside(False)
 
 

@@ -57,6 +57,7 @@ SYNC_COLORS: Final[dict[SyncState, str]] = {
     SyncState.ON_CONTROLLER: COLOR_OK,
     SyncState.CHANGED: COLOR_WARN,
     SyncState.FAILED: COLOR_CURVE_PURPLE,
+    SyncState.UNCONFIRMED: COLOR_WARN,
     SyncState.UNKNOWN: COLOR_NEUTRAL,
 }
 

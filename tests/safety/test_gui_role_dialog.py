@@ -1,0 +1,50 @@
+"""The role dialog: the first administrator password, a wrong password, logging in and out."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QSettings
+
+from app.safety.roles import Role
+from ui.controllers.safety import SafetyController
+from ui.dialogs.role_dialog import RoleDialog
+
+
+def _safety(qtbot: Any, tmp_path: Path) -> SafetyController:
+    store = QSettings(str(tmp_path / "t.ini"), QSettings.Format.IniFormat)
+    safety = SafetyController(None, store, scrypt_n=2**4)
+    safety.set_idle_polling(False)
+    return safety
+
+
+def test_first_admin_password_then_log_in_and_out(qtbot: Any, tmp_path: Path) -> None:
+    safety = _safety(qtbot, tmp_path)
+    assert safety.audit_dir == tmp_path / "safety" / "audit"  # beside the INI file, not in $HOME
+    dialog = RoleDialog(safety)
+    qtbot.addWidget(dialog)
+    assert "No administrator password" in dialog.error.text()
+    dialog.role_box.setCurrentIndex(dialog.role_box.findData(Role.ADMINISTRATOR))
+    assert dialog.set_password_button.isEnabled()  # the first one: anyone
+    dialog.password.setText("root-pw")
+    dialog.set_password()
+    assert safety.session.store.has_password(Role.ADMINISTRATOR)
+    assert not dialog.set_password_button.isEnabled()  # now only an administrator
+    dialog.password.setText("wrong")
+    dialog.log_in()
+    assert "Wrong password" in dialog.error.text() and safety.role is Role.OPERATOR
+    dialog.password.setText("root-pw")
+    dialog.log_in()
+    assert safety.role is Role.ADMINISTRATOR and dialog.result() == RoleDialog.DialogCode.Accepted
+    again = RoleDialog(safety)
+    qtbot.addWidget(again)
+    assert again.idle.isEnabled()  # the administrator chooses the idle time
+    again.idle.setValue(2)
+    assert safety.session.idle.timeout == 120.0 and '"idle_timeout": 120.0' in (
+        tmp_path / "safety" / "roles.json").read_text(encoding="utf-8")
+    again.log_out()
+    assert safety.role is Role.OPERATOR
+    stored = (tmp_path / "safety" / "roles.json").read_text(encoding="utf-8")
+    assert "root-pw" not in stored and "scrypt" in stored.lower()
+    safety.close()

@@ -1,0 +1,336 @@
+"""The guard rails in the GUI: one :class:`SafetyController` holding the :class:`SafetySession`.
+
+* **Roles**: every gated control is registered with :meth:`SafetyController.gate` (an action or
+  a widget and the :class:`~app.safety.roles.Action` it performs); on each role change it is
+  enabled or disabled with a tooltip naming the role it needs — never hidden. Panels with their
+  own enable logic get ``set_edit_permission(reason)`` instead (points, planner).
+* **Idle lock**: an application event filter calls ``touch()`` on every key or mouse press; a
+  :data:`IDLE_POLL_MS` timer calls ``poll_idle()``, which locks back to operator.
+* **Envelope**: loaded from the profile file, edited in :class:`~ui.dialogs.envelope_dialog.
+  EnvelopeDialog`; pushed to the planner (checks, preview), the 3D view and the worker's jog
+  guard (with reduced-speed mode) whenever it or the mode changes.
+* **Audit**: the link's :class:`~app.safety.audit.AuditLog` follows the role in force.
+
+Files: next to an INI settings file (tests, portable installs) or in the user's directories.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QEvent, QObject, QSettings, QTimer, Signal, Slot
+from PySide6.QtGui import QAction
+from PySide6.QtWidgets import QAbstractItemView, QApplication, QWidget
+
+from app import timing
+from app.errors import TeachPadError
+from app.link.robot_link import RobotLink
+from app.plan.segments import Segment
+from app.points.ledger import PointLedger
+from app.safety.audit import AuditLog, default_audit_dir
+from app.safety.envelope import Envelope, EnvelopeRefused, EnvelopeViolation, ViolationCode
+from app.safety.profile import SafetyProfile, load_profile, save_profile
+from app.safety.roles import REQUIRED_ROLE, Action, Role, RoleStore, default_config_dir, default_store_path
+from app.safety.session import PermissionRefused, SafetySession
+
+IDLE_POLL_MS = 1000
+PROFILE_NAME = "envelope.safety.json"
+_TOUCH_EVENTS = (QEvent.Type.MouseButtonPress, QEvent.Type.KeyPress, QEvent.Type.TouchBegin,
+                 QEvent.Type.Wheel)
+
+
+def safety_paths(store: QSettings) -> tuple[Path, Path, Path]:
+    """(role store, audit directory, envelope profile) for a settings store: beside an INI file
+    (tests and portable installs keep everything together), else the user's directories."""
+    if store.format() == QSettings.Format.IniFormat and store.fileName():
+        base = Path(store.fileName()).parent / "safety"
+        return base / "roles.json", base / "audit", base / PROFILE_NAME
+    return default_store_path(), default_audit_dir(), default_config_dir() / PROFILE_NAME
+
+
+def lock_editing(view: QAbstractItemView, locked: bool) -> None:
+    """Role gating of a table's cell edits: off while ``locked``, its own triggers back after."""
+    if locked:
+        if view.property("safetyEditTriggers") is None:
+            view.setProperty("safetyEditTriggers", int(view.editTriggers().value))
+        view.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
+    elif view.property("safetyEditTriggers") is not None:
+        view.setEditTriggers(QAbstractItemView.EditTrigger(view.property("safetyEditTriggers")))
+
+
+class SafetyController(QObject):
+    """See the module docstring. ``session`` is the Qt-free core; ``message`` reports refusals."""
+
+    roleChanged = Signal(object)
+    envelopeChanged = Signal(object)
+    reducedChanged = Signal(bool)
+    message = Signal(str)  # a refusal or a problem, already translated, for the event log / status
+
+    def __init__(self, link: RobotLink | None, store: QSettings, parent: QObject | None = None, *,
+                 scrypt_n: int | None = None) -> None:
+        super().__init__(parent)
+        self.link = link
+        roles_path, audit_dir, self.profile_path = safety_paths(store)
+        self.audit_dir = audit_dir
+        try:
+            roles = RoleStore(roles_path) if scrypt_n is None else RoleStore(roles_path, scrypt_n=scrypt_n)
+        except TeachPadError as exc:  # a damaged store: operator only, and say so
+            roles = RoleStore(roles_path.with_name("roles-unreadable.json"))
+            self._problem = str(exc)
+        else:
+            self._problem = ""
+        audit = AuditLog(audit_dir, on_error=lambda text: self.message.emit(text))
+        self.profile = SafetyProfile()
+        if self.profile_path.exists():
+            try:
+                self.profile = load_profile(self.profile_path)
+            except TeachPadError as exc:
+                self._problem = str(exc)
+        self.session = SafetySession(roles, audit, self.profile.envelope, on_role_changed=self._role_changed)
+        self._gated: list[tuple[QAction | QWidget, Action]] = []
+        self._panels: list[Any] = []  # objects with set_edit_permission(reason)
+        self._views: list[Any] = []  # objects with set_envelope(envelope[, reduced])
+        self.poll_period = 1.0 / timing.POLL_HZ_DEFAULT
+        if link is not None:
+            link.set_audit(audit)
+            link.jogGuardStopped.connect(self._on_guard_stopped)
+            link.connectionChanged.connect(self._on_connection)
+        self._idle_timer = QTimer(self)
+        self._idle_timer.setInterval(IDLE_POLL_MS)
+        self._idle_timer.timeout.connect(self._poll_idle)
+        self._idle_timer.start()
+        app = QApplication.instance()
+        if app is not None:
+            app.installEventFilter(self)
+        self._push_guard()
+
+    @property
+    def problem(self) -> str:
+        """A problem met while loading the role store or the profile ("" when none)."""
+        return self._problem
+
+    # --- roles --------------------------------------------------------------------------------
+    @property
+    def role(self) -> Role:
+        return self.session.role
+
+    def role_name(self, role: Role) -> str:
+        return {Role.OPERATOR: self.tr("operator"), Role.ENGINEER: self.tr("engineer"),
+                Role.ADMINISTRATOR: self.tr("administrator")}[role]
+
+    def reason(self, action: Action) -> str | None:
+        """Why the role in force may not do ``action``, translated (None: it may)."""
+        if self.session.reason(action) is None:
+            return None
+        return self.tr("Needs the {need} role (you are {role}); log in from the Safety menu").format(
+            need=self.role_name(REQUIRED_ROLE[action]), role=self.role_name(self.role))
+
+    def allowed(self, action: Action, *, say: bool = True) -> bool:
+        """``require`` for a control that was used: audited, with a translated message."""
+        try:
+            self.session.require(action)
+        except PermissionRefused:
+            if say:
+                self.message.emit(self.reason(action) or "")
+            return False
+        return True
+
+    def gate(self, target: QAction | QWidget, action: Action) -> None:
+        """Enable ``target`` only for roles that may do ``action`` (tooltip says why not)."""
+        self._gated.append((target, action))
+        self._apply(target, action)
+
+    def gate_panel(self, panel: Any, action: Action) -> None:
+        """A panel with its own enable logic: ``panel.set_edit_permission(reason)``."""
+        self._panels.append((panel, action))
+        panel.set_edit_permission(self.reason(action))
+
+    def _apply(self, target: QAction | QWidget, action: Action) -> None:
+        why = self.reason(action)
+        target.setEnabled(why is None)
+        shown = target.property("safetyReason")
+        if shown is None or target.toolTip() != shown:  # the tooltip is the control's own (retranslated)
+            target.setProperty("safetyTip", target.toolTip())
+        target.setProperty("safetyReason", why)
+        target.setToolTip(why if why is not None else str(target.property("safetyTip") or ""))
+
+    def refresh(self) -> None:
+        for target, action in self._gated:
+            self._apply(target, action)
+        for panel, action in self._panels:
+            panel.set_edit_permission(self.reason(action))
+
+    def login(self, role: Role, password: str) -> None:
+        """Raises :class:`~app.safety.roles.WrongPassword` (audited)."""
+        self.session.login(role, password)
+
+    def logout(self) -> None:
+        self.session.logout()
+
+    def _role_changed(self, _role: Role) -> None:
+        self.refresh()
+        self.roleChanged.emit(self.role)
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() in _TOUCH_EVENTS:
+            self.session.touch()
+        return False
+
+    @Slot()
+    def _poll_idle(self) -> None:
+        self.session.poll_idle()
+
+    def set_idle_polling(self, on: bool) -> None:
+        if on:
+            self._idle_timer.start()
+        else:
+            self._idle_timer.stop()
+
+    def set_idle_timeout(self, seconds: float) -> None:
+        self.session.idle.timeout = seconds
+
+    # --- envelope and reduced speed ------------------------------------------------------------
+    @property
+    def envelope(self) -> Envelope:
+        return self.session.envelope
+
+    def attach_view(self, view: Any) -> None:
+        """An object drawing or checking with the envelope: ``set_envelope(envelope)`` (the
+        planner: ``set_envelope(envelope, reduced)``)."""
+        self._views.append(view)
+        self._push_view(view)
+
+    def _push_view(self, view: Any) -> None:
+        try:
+            view.set_envelope(self.envelope, self.session.reduced)
+        except TypeError:
+            view.set_envelope(self.envelope)
+
+    def save_envelope(self, envelope: Envelope) -> SafetyProfile:
+        """Set (role checked, audited) and save the profile atomically with its next revision."""
+        self.session.set_envelope(envelope)
+        self.profile = save_profile(self.profile_path, SafetyProfile(self.profile.robot, envelope,
+                                                                     self.profile.revision))
+        self._envelope_changed()
+        return self.profile
+
+    def set_reduced(self, on: bool) -> bool:
+        """Reduced-speed mode on (anyone) or off (engineer); False (and a message) when refused."""
+        try:
+            self.session.set_reduced(on)
+        except PermissionRefused:
+            self.message.emit(self.reason(Action.LEAVE_REDUCED_SPEED) or "")
+            return False
+        self._envelope_changed()
+        self.reducedChanged.emit(self.session.reduced)
+        return True
+
+    def _envelope_changed(self) -> None:
+        for view in self._views:
+            self._push_view(view)
+        self._push_guard()
+        self.envelopeChanged.emit(self.envelope)
+
+    def set_poll_rate(self, hz: float) -> None:
+        if hz > 0:
+            self.poll_period = 1.0 / hz
+            self._push_guard()
+
+    def _push_guard(self) -> None:
+        if self.link is not None:
+            self.link.set_jog_guard(self.session.jog_guard(self.poll_period))
+
+    def jog_ratio(self, ratio: float) -> float:
+        return self.session.jog_ratio(ratio)
+
+    # --- checks before sending ------------------------------------------------------------------
+    def refusal(self, exc: TeachPadError) -> str:
+        """A refusal in the operator's language."""
+        if isinstance(exc, EnvelopeRefused):
+            return self.violation_text(exc.violation)
+        if isinstance(exc, PermissionRefused):
+            return self.reason(exc.action) or str(exc)
+        return str(exc)
+
+    def check_step(self, pose: Any, offsets: list[float], *, joint: bool,
+                   speed: float | None = None) -> str | None:
+        """None when the step may go; else the translated reason (the refusal is audited)."""
+        try:
+            self.session.check_step(pose, offsets, joint=joint, speed=speed)
+        except (EnvelopeRefused, PermissionRefused) as exc:
+            return self.refusal(exc)
+        return None
+
+    def check_jog(self, pose: Any, request: Any) -> str | None:
+        """Before a jog press (``request`` a JogRequest, its ratio already capped): None, or why
+        it would stop at once (audited). The worker's guard decides again on every poll."""
+        if pose is None:
+            return None
+        try:
+            self.session.check_jog_start(pose, request, self.poll_period)
+        except (EnvelopeRefused, PermissionRefused) as exc:
+            return self.refusal(exc)
+        return None
+
+    def check_move(self, start: Any, segment: Any, ledger: Any) -> str | None:
+        try:
+            self.session.check_move(start, segment, ledger)
+        except EnvelopeRefused as exc:
+            return self.refusal(exc)
+        return None
+
+    def check_move_to(self, pose: Any, point_id: int, speed: float, ledger: PointLedger) -> str | None:
+        """Move to a point in a straight line (function 3) from ``pose`` (None: not known, the
+        target and the speed are checked)."""
+        start = pose if pose is not None else ledger.get(point_id)
+        if start is None:
+            return None  # an unknown point: the move refuses it itself
+        try:
+            return self.check_move(start, Segment.line(point_id, speed), ledger)
+        except TeachPadError as exc:
+            return str(exc)
+
+    def violation_text(self, v: EnvelopeViolation) -> str:
+        """:class:`EnvelopeViolation` in the operator's language."""
+        if v.approaching:
+            if v.box:
+                text = self.tr("{axis} = {value:.1f} is within stopping distance of the keep-out zone "
+                               "'{box}' (at {limit:.1f})")
+            else:
+                text = self.tr("{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}")
+        elif v.code is ViolationCode.KEEP_IN:
+            text = self.tr("{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)")
+        elif v.code is ViolationCode.KEEP_OUT:
+            text = self.tr("The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, "
+                           "its face at {limit:.1f} mm)")
+        elif v.code is ViolationCode.JOINT_LIMIT:
+            text = self.tr("{axis} = {value:.1f}° is beyond its limit {limit:.1f}°")
+        elif v.code is ViolationCode.SPEED:
+            text = (self.tr("Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode")
+                    if v.reduced else self.tr("Speed {value:g} mm/s is above the {limit:g} mm/s allowed"))
+        else:
+            text = (self.tr("Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode")
+                    if v.reduced else self.tr("Jog speed {value:g} % is above the {limit:g} % allowed"))
+        text = text.format(axis=v.axis, value=v.value, limit=v.limit, box=v.box)
+        if v.segment is None:
+            return text
+        return self.tr("Segment {k}: {text}").format(k=v.segment + 1, text=text)
+
+    @Slot(object)
+    def _on_guard_stopped(self, violation: EnvelopeViolation) -> None:
+        why = self.violation_text(violation)
+        self.message.emit(self.tr("Jog stopped before the limit: {why}").format(why=why))
+
+    @Slot(object)
+    def _on_connection(self, _state: object) -> None:
+        settings = self.link.settings if self.link is not None else None
+        if settings is not None:  # the audit describes float writes in the link's word order
+            self.session.audit.word_order = settings.word_order
+
+    def close(self) -> None:
+        self._idle_timer.stop()
+        app = QApplication.instance()
+        if app is not None:
+            app.removeEventFilter(self)
+        self.session.audit.close()

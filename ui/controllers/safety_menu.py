@@ -1,0 +1,196 @@
+"""The Safety menu and the window's role gating, composed onto the main window in one call.
+
+:func:`install_safety` creates the :class:`SafetyController`, gates the window's controls by
+role (connection: administrator; point and plan edits, the envelope: engineer), feeds the
+envelope to the planner, the 3D view and the worker, and adds the menu: log in / out,
+reduced speed, envelope, audit trail, support bundle; a status-bar label shows the role.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from PySide6.QtCore import QEvent, QObject, QTimer, Slot
+from PySide6.QtGui import QAction
+from PySide6.QtWidgets import QFileDialog, QLabel, QMenu, QMessageBox
+
+from app.errors import TeachPadError
+from app.safety.bundle import write_support_bundle
+from app.safety.roles import Action, Role
+from ui.controllers.safety import SafetyController
+from ui.dialogs.envelope_dialog import EnvelopeDialog
+from ui.dialogs.role_dialog import RoleDialog
+from ui.panels.audit_viewer import AuditViewer
+
+
+class SafetyMenu(QObject):
+    """See the module docstring. ``save_path(title, suggested)`` is replaceable (tests)."""
+
+    def __init__(self, window: Any, safety: SafetyController) -> None:
+        super().__init__(window)
+        self.window = window
+        self.safety = safety
+        self.save_path = self._ask_save_path
+        self.login_action = QAction(self)
+        self.login_action.triggered.connect(self.open_role_dialog)
+        self.logout_action = QAction(self)
+        self.logout_action.triggered.connect(safety.logout)
+        self.reduced_action = QAction(self)
+        self.reduced_action.setObjectName("ReducedSpeedAction")
+        self.reduced_action.setCheckable(True)
+        self.reduced_action.toggled.connect(self._on_reduced)
+        self.envelope_action = QAction(self)
+        self.envelope_action.setObjectName("EnvelopeAction")
+        self.envelope_action.triggered.connect(self.open_envelope_dialog)
+        self.audit_action = QAction(self)
+        self.audit_action.triggered.connect(self.open_audit_viewer)
+        self.bundle_action = QAction(self)
+        self.bundle_action.triggered.connect(self.write_bundle)
+        self.menu = QMenu(window)
+        for action in (self.login_action, self.logout_action, None, self.reduced_action, self.envelope_action,
+                       None, self.audit_action, self.bundle_action):
+            if action is None:
+                self.menu.addSeparator()
+            else:
+                self.menu.addAction(action)
+        bar = window.menuBar()
+        help_menu = getattr(getattr(window, "menus", None), "help_menu", None)
+        if help_menu is not None:
+            bar.insertMenu(help_menu.menuAction(), self.menu)
+        else:
+            bar.addMenu(self.menu)
+        self.role_label = QLabel(window)
+        self.role_label.setObjectName("RoleLabel")
+        window.statusBar().addPermanentWidget(self.role_label)
+        safety.roleChanged.connect(self._update)
+        safety.reducedChanged.connect(self._update)
+        window.installEventFilter(self)
+        self.retranslate()
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if watched is self.window:
+            kind = event.type()
+            if kind == QEvent.Type.LanguageChange:
+                self.retranslate()
+            elif kind == QEvent.Type.Show:
+                self.safety.set_idle_polling(True)
+            elif kind in (QEvent.Type.Hide, QEvent.Type.Close):
+                self.safety.set_idle_polling(False)  # no timer outlives the window
+        return False
+
+    def retranslate(self) -> None:
+        self.menu.setTitle(self.tr("&Safety"))
+        self.login_action.setText(self.tr("Log &in…"))
+        self.logout_action.setText(self.tr("Log &out (operator)"))
+        self.reduced_action.setText(self.tr("&Reduced speed"))
+        self.envelope_action.setText(self.tr("Safety &envelope…"))
+        self.audit_action.setText(self.tr("&Audit trail…"))
+        self.bundle_action.setText(self.tr("Write a &support bundle…"))
+        QTimer.singleShot(0, self._refresh)  # after the window's own retranslate (it sets tooltips)
+        self._update()
+
+    @Slot()
+    def _refresh(self) -> None:
+        self.safety.refresh()
+        self._update()
+
+    @Slot()
+    def _update(self, *_args: Any) -> None:
+        safety = self.safety
+        role = safety.role_name(safety.role)
+        text = self.tr("Role: {role} · reduced speed") if safety.session.reduced else self.tr("Role: {role}")
+        self.role_label.setText(text.format(role=role))
+        self.logout_action.setEnabled(safety.role is not Role.OPERATOR)
+        self.reduced_action.blockSignals(True)
+        self.reduced_action.setChecked(safety.session.reduced)
+        self.reduced_action.blockSignals(False)
+        leave = safety.reason(Action.LEAVE_REDUCED_SPEED)
+        self.reduced_action.setToolTip(leave if safety.session.reduced and leave else
+                                       self.tr("Cap jog and move speeds (anyone may switch it on)"))
+
+    def source_name(self) -> str:
+        """The event log's source column for safety messages."""
+        return self.tr("safety")
+
+    @Slot(bool)
+    def _on_reduced(self, on: bool) -> None:
+        if not self.safety.set_reduced(on):
+            self._update()
+
+    # --- dialogs -------------------------------------------------------------------------------
+    @Slot()
+    def open_role_dialog(self) -> None:
+        RoleDialog(self.safety, self.window).exec()
+
+    @Slot()
+    def open_envelope_dialog(self) -> None:
+        if self.safety.allowed(Action.EDIT_ENVELOPE):
+            EnvelopeDialog(self.safety, self.window).exec()
+
+    @Slot()
+    def open_audit_viewer(self) -> None:
+        viewer = AuditViewer(self.safety.audit_dir, self.window)
+        viewer.exec()
+
+    def _ask_save_path(self, title: str, suggested: str) -> str | None:
+        path, _ = QFileDialog.getSaveFileName(self.window, title, suggested, self.tr("Zip files (*.zip)"))
+        return path or None
+
+    @Slot()
+    def write_bundle(self) -> Path | None:
+        """The support bundle: versions, settings without passwords, project, profile, audit,
+        event log and the recent Modbus traffic, in one zip."""
+        path = self.save_path(self.tr("Write a support bundle"), "teachpad-support.zip")
+        if not path:
+            return None
+        window = self.window
+        store = window.settings.store
+        settings = {key: store.value(key) for key in store.allKeys()}
+        project = window.project.path if getattr(window, "project", None) is not None else None
+        profile = self.safety.profile_path if self.safety.profile_path.exists() else None
+        try:
+            with tempfile.TemporaryDirectory() as tmp:
+                events = traffic = None
+                if hasattr(window, "event_log"):
+                    window.event_log.export_to(Path(tmp) / "events.txt")
+                    events = (Path(tmp) / "events.txt").read_text(encoding="utf-8").splitlines()
+                if hasattr(window, "traffic_panel"):
+                    window.traffic_panel.export_to(Path(tmp) / "traffic.txt", visible_only=False)
+                    traffic = (Path(tmp) / "traffic.txt").read_text(encoding="utf-8").splitlines()
+                manifest = write_support_bundle(path, settings=settings, project=project, profile=profile,
+                                                audit_dir=self.safety.audit_dir, events=events,
+                                                traffic=traffic)
+        except (OSError, TeachPadError) as exc:
+            why = self.tr("The support bundle could not be written: {why}").format(why=str(exc)[:200])
+            QMessageBox.warning(window, self.tr("Support bundle"), why)
+            return None
+        self.safety.session.audit.record("action", "support bundle written",
+                                         args={"files": len(manifest.files)})
+        window.statusBar().showMessage(self.tr("Support bundle written: {file} ({n} files)").format(
+            file=Path(path).name, n=len(manifest.files)), 8000)
+        return Path(path)
+
+
+def install_safety(window: Any, *, scrypt_n: int | None = None) -> SafetyMenu:
+    """Compose the guard rails onto ``window`` (a :class:`ui.main_window.MainWindow`)."""
+    safety = SafetyController(window.link, window.settings.store, window, scrypt_n=scrypt_n)
+    safety.set_poll_rate(window.settings.poll_hz)  # the jog guard's margin follows the poll period
+    menu = SafetyMenu(window, safety)
+    safety.gate(window.menus.connect_action, Action.CONNECTION)
+    safety.gate(menu.envelope_action, Action.EDIT_ENVELOPE)
+    safety.gate_panel(window.points_panel, Action.EDIT_POINTS)
+    window.points_panel.move_check = lambda point_id, speed: safety.check_move_to(
+        window.link.state.pose, point_id, speed, window.project.points_model.ledger)
+    safety.gate_panel(window.planner_panel, Action.EDIT_PLANS)
+    safety.attach_view(window.planner_panel)
+    view3d = getattr(window, "view3d", None)
+    if view3d is not None:
+        safety.attach_view(view3d.panel.canvas)
+    if hasattr(window, "event_log"):
+        safety.message.connect(lambda text: window.event_log.add_event("warning", menu.source_name(), text))
+    safety.message.connect(lambda text: window.statusBar().showMessage(text, 8000))
+    if safety.problem:
+        safety.message.emit(safety.problem)
+    return menu

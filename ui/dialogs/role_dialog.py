@@ -1,0 +1,124 @@
+"""Switch role (operator / engineer / administrator) with a password; an administrator also sets
+the passwords. The first administrator password is set here while none exists yet."""
+
+from __future__ import annotations
+
+from PySide6.QtWidgets import (
+    QComboBox,
+    QDialog,
+    QDialogButtonBox,
+    QFormLayout,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
+
+from app.errors import InvalidInput, TeachPadError
+from app.safety.roles import Action, Role, WrongPassword
+from ui.controllers.safety import SafetyController
+
+
+class RoleDialog(QDialog):
+    def __init__(self, safety: SafetyController, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("RoleDialog")
+        self._safety = safety
+        self.setWindowTitle(self.tr("Log in"))
+        self.role_box = QComboBox(self)
+        for role in Role:
+            self.role_box.addItem(safety.role_name(role), role)
+        self.role_box.setCurrentIndex(int(max(Role.ENGINEER, safety.role)))
+        self.password = QLineEdit(self)
+        self.password.setEchoMode(QLineEdit.EchoMode.Password)
+        self.current = QLabel(self.tr("Now: {role}").format(role=safety.role_name(safety.role)), self)
+        self.error = QLabel(self)
+        self.error.setWordWrap(True)
+        self.error.setStyleSheet("color: #c62828;")
+        self.set_password_button = QPushButton(self.tr("Set this role's password"), self)
+        self.set_password_button.clicked.connect(self.set_password)
+        self.idle = QSpinBox(self)  # the administrator chooses the idle time before the lock-back
+        self.idle.setRange(1, 240)
+        self.idle.setSuffix(self.tr(" min"))
+        self.idle.setValue(max(1, round(safety.session.store.idle_timeout / 60)))
+        self.idle.setEnabled(safety.role is Role.ADMINISTRATOR)
+        tip = safety.reason(Action.MANAGE_ROLES) or self.tr("Back to operator after this idle time")
+        self.idle.setToolTip(tip)
+        self.idle.valueChanged.connect(self._set_idle)
+        self.logout_button = QPushButton(self.tr("Log out (operator)"), self)
+        self.logout_button.clicked.connect(self.log_out)
+        form = QFormLayout()
+        form.addRow(self.tr("Role:"), self.role_box)
+        form.addRow(self.tr("Password:"), self.password)
+        form.addRow(self.tr("Lock back after:"), self.idle)
+        std = QDialogButtonBox.StandardButton
+        buttons = QDialogButtonBox(std.Ok | std.Cancel, self)
+        buttons.accepted.connect(self.log_in)
+        buttons.rejected.connect(self.reject)
+        layout = QVBoxLayout(self)
+        layout.addWidget(self.current)
+        layout.addLayout(form)
+        layout.addWidget(self.error)
+        layout.addWidget(self.set_password_button)
+        layout.addWidget(self.logout_button)
+        layout.addWidget(buttons)
+        self.role_box.currentIndexChanged.connect(self._update)
+        self._update()
+
+    def _role(self) -> Role:
+        return Role(self.role_box.currentData())
+
+    def _update(self) -> None:
+        store = self._safety.session.store
+        first = not store.has_password(Role.ADMINISTRATOR)
+        may_manage = self._safety.role is Role.ADMINISTRATOR or first
+        self.set_password_button.setEnabled(may_manage and self._role() is not Role.OPERATOR)
+        hint = ""
+        if first:
+            hint = self.tr("No administrator password is set yet: choose the administrator role, type a "
+                           "password and press \u201cSet this role's password\u201d.")
+        elif self._role() is not Role.OPERATOR and not store.has_password(self._role()):
+            hint = self.tr("No password is set for this role; an administrator sets it.")
+        self.error.setText(hint)
+
+    def log_in(self) -> None:
+        role = self._role()
+        try:
+            self._safety.login(role, self.password.text())
+        except WrongPassword:
+            self.error.setText(self.tr("Wrong password for the {role} role").format(
+                role=self._safety.role_name(role)) if self._safety.session.store.has_password(role)
+                else self.tr("No password is set for this role; an administrator sets it."))
+            self.password.selectAll()
+            return
+        self.accept()
+
+    def _set_idle(self, minutes: int) -> None:
+        store = self._safety.session.store
+        store.idle_timeout = minutes * 60.0
+        self._safety.set_idle_timeout(store.idle_timeout)
+        try:
+            store.save()
+        except OSError as exc:
+            self.error.setText(self.tr("The setting could not be saved: {why}").format(why=str(exc)[:120]))
+
+    def log_out(self) -> None:
+        self._safety.logout()
+        self.accept()
+
+    def set_password(self) -> None:
+        role = self._role()
+        try:
+            self._safety.session.store.set_password(role, self.password.text(), by=self._safety.role)
+        except InvalidInput as exc:
+            self.error.setText(str(exc))
+            return
+        except (OSError, TeachPadError) as exc:
+            self.error.setText(self.tr("The password could not be saved: {why}").format(why=str(exc)[:120]))
+            return
+        self._safety.session.audit.record("action", f"set the {role.text} password")
+        name = self._safety.role_name(role)
+        self.error.setText(self.tr("Password set for the {role} role").format(role=name))
+        self._update()

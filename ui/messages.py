@@ -1,0 +1,331 @@
+"""Results and errors in the operator's language.
+
+The core reports why a command ended or what went wrong as a :class:`~app.errors.Reason` (a
+stable code and its arguments) beside a plain English message (logs, CLI). Here a reason
+becomes one translated sentence: :func:`result_text` for a :class:`CommandResult`,
+:func:`error_text` for a :class:`WorkerError` or a typed error. Command, status and alarm names
+reuse the "Protocol" translations. Something without a reason (an older producer) falls back to
+its English message.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from PySide6.QtCore import QCoreApplication
+
+from app.errors import Reason, TeachPadError
+from app.link.types import WorkerError
+from app.models import CommandResult
+from app.protocol.enums import (
+    RUN_COMMAND_TEXT,
+    UNKNOWN_STATUS_TEXT,
+    CommandKind,
+    CommandStatus,
+    RunCommand,
+    alarm_names,
+    controller_mode_text,
+)
+
+__all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "error_text", "operation_text", "reason_text",
+           "result_level", "result_text", "status_text"]
+
+CONTEXT = "Messages"
+LEVEL_INFO = "info"
+LEVEL_WARNING = "warning"
+LEVEL_ERROR = "error"
+
+
+def QT_TRANSLATE_NOOP(context: str, text: str) -> str:
+    return text
+
+
+# code -> sentence; placeholders are filled with already translated / formatted values.
+_TEMPLATES: dict[str, str] = {
+    # how a command ended
+    "done": QT_TRANSLATE_NOOP("Messages", "{command}: {status}."),
+    "done_unconfirmed": QT_TRANSLATE_NOOP("Messages", "{command}: done, not confirmed by the controller."),
+    "done_by_mode": QT_TRANSLATE_NOOP("Messages", "{command}: done (the controller is now in {mode} mode)."),
+    "command_refused": QT_TRANSLATE_NOOP("Messages", "{command} refused by the controller: {status}."),
+    "refused_unconfirmed": QT_TRANSLATE_NOOP("Messages", "{command} not taken: the controller still shows \u201c{status}\u201d from the previous command."),  # noqa: E501
+    "alarm_while_waiting": QT_TRANSLATE_NOOP("Messages", "{command} ended by an alarm: {alarms}."),
+    "not_acknowledged": QT_TRANSLATE_NOOP("Messages", "{command}: the controller did not acknowledge it within {seconds} s."),  # noqa: E501
+    "command_timeout": QT_TRANSLATE_NOOP("Messages", "{command} did not finish within {seconds} s (last status: {status})."),  # noqa: E501
+    "result_unknown": QT_TRANSLATE_NOOP("Messages", "{command}: the arm moved and stopped, but the controller did not report the result."),  # noqa: E501
+    "stopped_by_operator": QT_TRANSLATE_NOOP("Messages", "{command}: stopped by the operator."),
+    "stopped_by_controller": QT_TRANSLATE_NOOP("Messages", "{command}: stopped by the controller."),
+    "sent": QT_TRANSLATE_NOOP("Messages", "{command}: sent (not waited for)."),
+    "no_motion": QT_TRANSLATE_NOOP("Messages", "{command}: no motion within {seconds} s (refused by the controller, or already there)."),  # noqa: E501
+    "program_not_started": QT_TRANSLATE_NOOP("Messages", "Program {program} did not start: no such program, or the controller refused it."),  # noqa: E501
+    "upload_done": QT_TRANSLATE_NOOP("Messages", "Uploaded {uploaded} of {total} points."),
+    # requests the worker handles without a GV291 status (stop, pause, mode...)
+    "request_done": QT_TRANSLATE_NOOP("Messages", "{operation}: sent."),
+    "request_failed": QT_TRANSLATE_NOOP("Messages", "{operation}: failed."),
+    "busy": QT_TRANSLATE_NOOP("Messages", "{operation} is still under way: wait for it or press Stop."),
+    "link_shut_down": QT_TRANSLATE_NOOP("Messages", "The link is shut down: nothing was sent."),
+    "not_connected": QT_TRANSLATE_NOOP("Messages", "Not connected to a controller: nothing was sent."),
+    # the link
+    "link_lost": QT_TRANSLATE_NOOP("Messages", "Lost the connection to the controller at {endpoint}."),
+    "link_closed": QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} closed the connection."),
+    "host_unresolved": QT_TRANSLATE_NOOP("Messages", "The host name {host} cannot be resolved."),
+    "connection_refused": QT_TRANSLATE_NOOP("Messages", "Connection refused: nothing listens on port {port}."),  # noqa: E501
+    "connect_timeout": QT_TRANSLATE_NOOP("Messages", "No answer to the connection request within {seconds} s."),  # noqa: E501
+    "connect_failed": QT_TRANSLATE_NOOP("Messages", "The connection could not be opened."),
+    "serial_open_failed": QT_TRANSLATE_NOOP("Messages", "Cannot open the serial port {port}."),
+    "no_answer": QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} did not answer within {seconds} s."),  # noqa: E501
+    "malformed_answer": QT_TRANSLATE_NOOP("Messages", "Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}."),  # noqa: E501
+    "modbus_exception": QT_TRANSLATE_NOOP("Messages", "The controller refused the request: Modbus exception {exception} ({name})."),  # noqa: E501
+    "monitor_only": QT_TRANSLATE_NOOP("Messages", "Monitor-only mode: nothing was sent to the controller."),
+    "invalid_input": QT_TRANSLATE_NOOP("Messages", "Invalid value: nothing was sent."),
+    "unexpected": QT_TRANSLATE_NOOP("Messages", "Unexpected internal error; the log has the details."),
+}
+
+# A reason whose arguments lack a placeholder of the full sentence uses this one.
+_BARE: dict[str, str] = {
+    "link_lost": QT_TRANSLATE_NOOP("Messages", "No connection to the controller."),
+    "link_closed": QT_TRANSLATE_NOOP("Messages", "The controller closed the connection."),
+    "connection_refused": QT_TRANSLATE_NOOP("Messages", "Connection refused by the controller."),
+    "no_answer": QT_TRANSLATE_NOOP("Messages", "The controller did not answer."),
+    "malformed_answer": QT_TRANSLATE_NOOP("Messages", "Malformed answer from the controller."),
+    "serial_open_failed": QT_TRANSLATE_NOOP("Messages", "Cannot open the serial port."),
+    "host_unresolved": QT_TRANSLATE_NOOP("Messages", "The host name cannot be resolved."),
+    "connect_timeout": QT_TRANSLATE_NOOP("Messages", "No answer to the connection request."),
+    "command_timeout": QT_TRANSLATE_NOOP("Messages", "{command} did not finish in time."),
+    "not_acknowledged": QT_TRANSLATE_NOOP("Messages", "{command}: the controller did not acknowledge it."),
+    "alarm_while_waiting": QT_TRANSLATE_NOOP("Messages", "{command} ended by an alarm."),
+    "command_refused": QT_TRANSLATE_NOOP("Messages", "{command} refused by the controller."),
+    "done": QT_TRANSLATE_NOOP("Messages", "{command}: done."),
+    "modbus_exception": QT_TRANSLATE_NOOP("Messages", "The controller refused the request (Modbus exception)."),  # noqa: E501
+}
+
+_RECONNECT = QT_TRANSLATE_NOOP("Messages", "Cannot reconnect to the controller at {endpoint}: {cause}")
+_CONNECT = QT_TRANSLATE_NOOP("Messages", "Cannot connect to the controller at {endpoint}: {cause}")
+_A_COMMAND = QT_TRANSLATE_NOOP("Messages", "The command")
+_FAILED = QT_TRANSLATE_NOOP("Messages", "Failed.")
+_FAILED_WITH = QT_TRANSLATE_NOOP("Messages", "Failed: {message}")
+
+_OPERATIONS: dict[str, str] = {  # app.link.types.Operation values
+    "stop": QT_TRANSLATE_NOOP("Messages", "stop"),
+    "pause": QT_TRANSLATE_NOOP("Messages", "pause"),
+    "resume": QT_TRANSLATE_NOOP("Messages", "resume"),
+    "jog": QT_TRANSLATE_NOOP("Messages", "jog"),
+    "jog release": QT_TRANSLATE_NOOP("Messages", "jog release"),
+    "jog speed": QT_TRANSLATE_NOOP("Messages", "jog speed"),
+    "step": QT_TRANSLATE_NOOP("Messages", "incremental move"),
+    "set mode": QT_TRANSLATE_NOOP("Messages", "work mode"),
+    "go to zero": QT_TRANSLATE_NOOP("Messages", "go to zero"),
+    "run program": QT_TRANSLATE_NOOP("Messages", "run program"),
+    "create point": QT_TRANSLATE_NOOP("Messages", "create temp point"),
+    "move to point": QT_TRANSLATE_NOOP("Messages", "move to temp point"),
+    "upload points": QT_TRANSLATE_NOOP("Messages", "upload temp points"),
+    "cancel upload": QT_TRANSLATE_NOOP("Messages", "cancel upload"),
+    "teach disable": QT_TRANSLATE_NOOP("Messages", "teach disable"),
+    "poll": QT_TRANSLATE_NOOP("Messages", "monitor"),
+    "connect": QT_TRANSLATE_NOOP("Messages", "connect"),
+    "disconnect": QT_TRANSLATE_NOOP("Messages", "disconnect"),
+    "shutdown": QT_TRANSLATE_NOOP("Messages", "shutdown"),
+    "restart check": QT_TRANSLATE_NOOP("Messages", "restart check"),
+}
+_AN_OPERATION = QT_TRANSLATE_NOOP("Messages", "request")
+
+_FIELDS: dict[str, str] = {
+    "length": QT_TRANSLATE_NOOP("Messages", "length"),
+    "function": QT_TRANSLATE_NOOP("Messages", "function code"),
+    "byte count": QT_TRANSLATE_NOOP("Messages", "byte count"),
+    "exception code": QT_TRANSLATE_NOOP("Messages", "exception code"),
+    "address": QT_TRANSLATE_NOOP("Messages", "address"),
+    "value": QT_TRANSLATE_NOOP("Messages", "value"),
+    "quantity": QT_TRANSLATE_NOOP("Messages", "quantity"),
+    "transaction id": QT_TRANSLATE_NOOP("Messages", "transaction id"),
+    "protocol id": QT_TRANSLATE_NOOP("Messages", "protocol id"),
+    "unit id": QT_TRANSLATE_NOOP("Messages", "unit id"),
+    "CRC": QT_TRANSLATE_NOOP("Messages", "CRC"),
+}
+
+_MODBUS_EXCEPTIONS: dict[int, str] = {
+    0x01: QT_TRANSLATE_NOOP("Messages", "illegal function"),
+    0x02: QT_TRANSLATE_NOOP("Messages", "illegal data address"),
+    0x03: QT_TRANSLATE_NOOP("Messages", "illegal data value"),
+    0x04: QT_TRANSLATE_NOOP("Messages", "server device failure"),
+    0x05: QT_TRANSLATE_NOOP("Messages", "acknowledge"),
+    0x06: QT_TRANSLATE_NOOP("Messages", "server device busy"),
+    0x07: QT_TRANSLATE_NOOP("Messages", "negative acknowledge"),
+    0x08: QT_TRANSLATE_NOOP("Messages", "memory parity error"),
+    0x0A: QT_TRANSLATE_NOOP("Messages", "gateway path unavailable"),
+    0x0B: QT_TRANSLATE_NOOP("Messages", "gateway target device failed to respond"),
+}
+_UNKNOWN_EXCEPTION = QT_TRANSLATE_NOOP("Messages", "unknown exception")
+
+# the safety envelope (app/safety/envelope.py ViolationCode values)
+_ENVELOPE: dict[str, str] = {
+    "keep_in": QT_TRANSLATE_NOOP("Messages", "{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit})."),  # noqa: E501
+    "keep_out": QT_TRANSLATE_NOOP("Messages", "{where}the path enters the keep-out zone \u201c{box}\u201d ({axis} = {value} {unit}, its face is at {limit} {unit})."),  # noqa: E501
+    "joint_limit": QT_TRANSLATE_NOOP("Messages", "{where}{axis} = {value}° is past its limit {limit}°."),
+    "speed": QT_TRANSLATE_NOOP("Messages", "{where}speed {value} mm/s is above the {limit} mm/s allowed."),
+    "jog_ratio": QT_TRANSLATE_NOOP("Messages", "{where}jog speed {value}% is above the {limit}% allowed."),
+    "approaching": QT_TRANSLATE_NOOP("Messages", "{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}."),  # noqa: E501
+}
+_ENVELOPE_PREFIX = QT_TRANSLATE_NOOP("Messages", "Refused by the safety envelope: {text}")
+_SEGMENT = QT_TRANSLATE_NOOP("Messages", "segment {n}: ")
+_REDUCED = QT_TRANSLATE_NOOP("Messages", " (reduced-speed mode)")
+
+
+def _tr(text: str, context: str = CONTEXT) -> str:
+    return QCoreApplication.translate(context, text)
+
+
+def _number(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.1f}" if abs(value) >= 10 else f"{value:g}"
+    return str(value)
+
+
+def _command_name(command: Any) -> str:
+    try:
+        member = RunCommand(int(command))
+    except (TypeError, ValueError):
+        return _tr(_A_COMMAND)
+    return _tr(RUN_COMMAND_TEXT[member], "Protocol") if member in RUN_COMMAND_TEXT else _tr(_A_COMMAND)
+
+
+def operation_text(operation: str) -> str:
+    """An :class:`~app.link.types.Operation` name in the operator's language."""
+    return _tr(_OPERATIONS.get(operation, _AN_OPERATION))
+
+
+def status_text(status: CommandStatus) -> str:
+    """GV291 in words, translated (context "Protocol")."""
+    if status.text == UNKNOWN_STATUS_TEXT.format(code=status.code):
+        return _tr(UNKNOWN_STATUS_TEXT, "Protocol").format(code=status.code)
+    return _tr(status.text, "Protocol")
+
+
+def _status(args: Mapping[str, Any]) -> str | None:
+    if "status" not in args:
+        return None
+    kind: CommandKind | None = None
+    if args.get("kind") is not None:
+        kind = CommandKind(args["kind"])
+    elif "command" in args:
+        try:
+            kind = CommandKind.of(RunCommand(int(args["command"])))
+        except ValueError:
+            kind = None
+    return status_text(CommandStatus(kind, int(args["status"])))
+
+
+def _alarms(mask: int) -> str:
+    return "、".join(_tr(name, "Protocol") if not name.startswith("bit ") else name[4:]
+                    for name in alarm_names(mask))
+
+
+def _envelope(args: Mapping[str, Any]) -> str:
+    code = "approaching" if args.get("approaching") else str(args.get("violation", ""))
+    template = _ENVELOPE.get(code)
+    if template is None:
+        return _tr(_TEMPLATES["invalid_input"])
+    unit = "°" if args.get("violation") == "joint_limit" else "mm"
+    segment = args.get("segment")
+    text = _tr(template).format(
+        where="" if segment is None else _tr(_SEGMENT).format(n=int(segment) + 1),
+        axis=args.get("axis", ""), box=args.get("box", ""), unit=unit,
+        value=_number(float(args.get("value", 0.0))), limit=_number(float(args.get("limit", 0.0))))
+    if args.get("reduced"):
+        end = text[-1] if text[-1:] in ("。", ".") else ""
+        text = text[: len(text) - len(end)] + _tr(_REDUCED) + end
+    return _tr(_ENVELOPE_PREFIX).format(text=text)
+
+
+def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
+    """The placeholders of ``code``'s sentence, formatted and translated from its arguments."""
+    out: dict[str, str] = {"command": _command_name(args.get("command"))}
+    for key, value in args.items():
+        if key in ("command", "kind") or value is None:
+            continue
+        out[key] = _number(value) if isinstance(value, int | float) and not isinstance(value, bool) \
+            else str(value)
+    status = _status(args)
+    if status is not None:
+        out["status"] = status
+    if "alarms" in args:
+        out["alarms"] = _alarms(int(args["alarms"]))
+    if "operation" in args:
+        out["operation"] = operation_text(str(args["operation"]))
+    if "mode" in args:
+        out["mode"] = _tr(controller_mode_text(int(args["mode"])), "Protocol")
+    if "field" in args:
+        field = str(args["field"])
+        if field in _FIELDS:
+            out["field"] = _tr(_FIELDS[field])
+        else:
+            out.pop("field", None)
+    if code == "modbus_exception" and "exception" in args:
+        out["name"] = _tr(_MODBUS_EXCEPTIONS.get(int(args["exception"]), _UNKNOWN_EXCEPTION))
+    return out
+
+
+def reason_text(reason: Reason) -> str | None:
+    """One translated sentence for ``reason``; None for a code this module does not know."""
+    args = reason.args
+    if reason.code == "envelope_refused":
+        return _envelope(args)
+    template = _TEMPLATES.get(reason.code)
+    if template is None:
+        return None
+    fields = _fields(reason.code, args)
+    try:
+        text = _tr(template).format(**fields)
+    except KeyError:
+        bare = _BARE.get(reason.code)
+        if bare is None:
+            return None
+        try:
+            text = _tr(bare).format(**fields)
+        except KeyError:
+            return None
+    if "reconnect" in args and "endpoint" in args:
+        wrapper = _RECONNECT if args["reconnect"] else _CONNECT
+        text = _tr(wrapper).format(endpoint=args["endpoint"], cause=text)
+    return text
+
+
+def result_text(result: CommandResult) -> str:
+    """How a command ended, as one sentence ("Last command", the event log, status lines)."""
+    reason = result.reason
+    if reason is None and not result.ok and result.status is None:
+        # nothing structured: a failure without a controller status is not "refused"; say what
+        # we have (the English message) rather than guess a cause
+        return _tr(_FAILED_WITH).format(message=result.message) if result.message else _tr(_FAILED)
+    if reason is None:
+        reason = Reason("done" if result.ok else "command_refused",
+                        {"command": int(result.command) if result.command is not None else None,
+                         **({"status": result.status.code,
+                             "kind": result.status.kind.value if result.status.kind else None}
+                            if result.status is not None else {})})
+        if result.ok and result.unconfirmed:
+            reason = Reason("done_unconfirmed", reason.args)
+    text = reason_text(reason)
+    if text is None:
+        return result.message or _tr(_FAILED)
+    return text
+
+
+def result_level(result: CommandResult) -> str:
+    """info for success and the operator's own stop, warning for an unconfirmed success."""
+    if result.ok:
+        return LEVEL_WARNING if result.unconfirmed else LEVEL_INFO
+    return LEVEL_INFO if result.stopped_by_operator else LEVEL_ERROR
+
+
+def error_text(error: WorkerError | TeachPadError | Reason) -> str:
+    """What went wrong, as one sentence; the English message when there is no known reason."""
+    if isinstance(error, Reason):
+        return reason_text(error) or error.code
+    if isinstance(error, TeachPadError):
+        return reason_text(error.as_reason()) or str(error)
+    if error.reason is not None:
+        text = reason_text(error.reason)
+        if text is not None:
+            return text
+    return error.message
