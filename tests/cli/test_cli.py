@@ -150,7 +150,8 @@ def test_jog_killed_mid_jog_is_stopped_by_the_simulator_watchdog(csim: Any) -> N
 
 
 def test_jog_is_bounded_in_time(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
-    from app.cli.main import JOG_SECONDS_DEFAULT, JOG_SECONDS_MAX, build_parser
+    from app.cli.format import JOG_SECONDS_MAX
+    from app.cli.main import JOG_SECONDS_DEFAULT, build_parser
 
     args = build_parser().parse_args(["jog", "--axis", "X", "--dir", "+", "--ratio", "10"])
     assert args.duration == JOG_SECONDS_DEFAULT == 2.0 and JOG_SECONDS_MAX == 30.0

@@ -17,6 +17,8 @@ from app.link.supervisor import LinkSupervisor
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.link.upload import Uploader
 from app.models import CommandResult, ControllerStatus, Pose
+from app.safety.audit import AuditLog
+from app.safety.envelope import EnvelopeViolation
 
 
 class PartsHost:
@@ -29,6 +31,7 @@ class PartsHost:
         self.polling = False
         self.reconnect_delays: list[float] = []
         self.urgent: list[Any] = []  # callables run by run_urgent (like urgent jobs)
+        self.audit: AuditLog | None = None
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
         self.jog = JogMachine(self)
@@ -118,6 +121,9 @@ class PartsHost:
 
     def publish_traffic(self, records: list[TrafficRecord]) -> None:
         self.out.append(("trafficObserved", records))
+
+    def publish_guard_stop(self, violation: EnvelopeViolation) -> None:
+        self.out.append(("jogGuardStopped", violation))
 
     def publish_reconnected(self) -> None:
         self.out.append(("controllerReconnected", None))

@@ -61,12 +61,12 @@ def test_an_engineer_edits_points_an_operator_does_not(qtbot: Any, menu: SafetyM
     panel = window.points_panel
     assert not panel.action_add.isEnabled() and "engineer" in panel.action_add.toolTip()
     assert not panel.table.editTriggers()
-    assert not window.planner_panel.actions["add_plan"].isEnabled()
+    assert not window.planner_panel.planner_actions["add_plan"].isEnabled()
     with pytest.raises(WrongPassword, match="wrong password"):
         menu.safety.login(Role.ENGINEER, "nope")
     menu.safety.login(Role.ENGINEER, PASSWORD)
     assert panel.action_add.isEnabled() and panel.table.editTriggers()
-    assert window.planner_panel.actions["add_plan"].isEnabled()
+    assert window.planner_panel.planner_actions["add_plan"].isEnabled()
     n = len(window.project.points_model.ledger)
     panel.action_add.trigger()
     assert len(window.project.points_model.ledger) == n + 1
@@ -104,7 +104,9 @@ def test_envelope_dialog_saves_and_draws_the_boxes(qtbot: Any, menu: SafetyMenu,
     qtbot.addWidget(dialog)
     dialog.keep_in_on.setChecked(True)
     dialog.add_button.click()
-    dialog.keep_out.item(0, 0).setText("fixture")
+    name_cell = dialog.keep_out.item(0, 0)
+    assert name_cell is not None
+    name_cell.setText("fixture")
     with qtbot.waitSignal(menu.safety.envelopeChanged, timeout=2000):
         dialog.save()
     saved = load_profile(menu.safety.profile_path)
@@ -114,7 +116,9 @@ def test_envelope_dialog_saves_and_draws_the_boxes(qtbot: Any, menu: SafetyMenu,
     view3d = getattr(window, "view3d", None)
     if view3d is not None:
         assert len(view3d.panel.canvas.keep_out_edges) == 24
-    dialog.keep_out.item(0, 1).setText("abc")  # not a number: refused, the dialog stays
+    x_cell = dialog.keep_out.item(0, 1)
+    assert x_cell is not None
+    x_cell.setText("abc")  # not a number: refused, the dialog stays
     dialog.save()
     assert "not a number" in dialog.error.text()
 

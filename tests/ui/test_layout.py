@@ -204,7 +204,9 @@ def test_touch_mode_layout_at_1280x800(make_window: Callable[..., MainWindow], l
     scroll = window.jog_panel.axes_scroll
     assert scroll.verticalScrollBar().isVisible(), "touch joint jog fits now: drop the scroll decision"
     assert scroll.viewport().height() >= SCROLL_MIN_ROWS_HEIGHT
-    assert scroll.verticalScrollBar().maximum() + scroll.viewport().height() >= scroll.widget().height()
+    rows = scroll.widget()
+    assert rows is not None
+    assert scroll.verticalScrollBar().maximum() + scroll.viewport().height() >= rows.height()
 
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")

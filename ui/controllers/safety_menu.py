@@ -9,6 +9,7 @@ reduced speed, envelope, audit trail, support bundle; a status-bar label shows t
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +33,7 @@ class SafetyMenu(QObject):
         super().__init__(window)
         self.window = window
         self.safety = safety
-        self.save_path = self._ask_save_path
+        self.save_path: Callable[[str, str], str | None] = self._ask_save_path
         self.login_action = QAction(self)
         self.login_action.triggered.connect(self.open_role_dialog)
         self.logout_action = QAction(self)

@@ -289,7 +289,7 @@ class PlannerPanel(QWidget):
     def set_edit_permission(self, reason: str | None) -> None:
         """Role gating: plan and segment edits only while ``reason`` is None (else disabled, not
         hidden, with ``reason`` as the tooltip); runs stay the operator's."""
-        self.actions.edit_reason = reason
+        self.planner_actions.edit_reason = reason
         for view in (self.plan_view, self.segment_view):
             lock_editing(view, reason is not None)
         self._update_actions()
