@@ -57,18 +57,23 @@ class RowsScrollArea(QScrollArea):
         self.setWidgetResizable(True)
         self.setFrameShape(QFrame.Shape.NoFrame)
         self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
-        self._rows = rows  # before setWidget(): it asks for the size hints
         self.setWidget(rows)
 
     def _width(self, inner: QSize) -> int:
         return inner.width() + self.verticalScrollBar().sizeHint().width() + 2 * self.frameWidth()
 
     def minimumSizeHint(self) -> QSize:
-        inner = self._rows.minimumSizeHint()
+        rows = self.widget()
+        if rows is None:  # (only while being built)
+            return super().minimumSizeHint()
+        inner = rows.minimumSizeHint()
         return QSize(self._width(inner), min(inner.height(), SCROLL_MIN_ROWS_HEIGHT))
 
     def sizeHint(self) -> QSize:
-        inner = self._rows.sizeHint()
+        rows = self.widget()
+        if rows is None:
+            return super().sizeHint()
+        inner = rows.sizeHint()
         return QSize(self._width(inner), inner.height())
 
 
