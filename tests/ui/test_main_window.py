@@ -118,7 +118,8 @@ def test_errors_reach_the_event_log(qtbot: Any, window: MainWindow) -> None:
     with qtbot.waitSignal(window.link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS):
         window.menus.stop_action.trigger()  # not connected
     last = list(window.event_log.model.events())[-1]
-    assert (last.level, last.source, last.text) == ("error", "stop", "not connected to a controller")
+    assert (last.level, last.source, last.text) == (
+        "error", "stop", "Not connected to a controller: nothing was sent.")
 
 
 def test_window_state_is_remembered(qtbot: Any, link: Any, app_settings: AppSettings,

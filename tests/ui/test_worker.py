@@ -10,6 +10,7 @@ import pytest
 from pymodbus.constants import ExcCodes
 
 from app import timing
+from app.errors import Reason
 from app.link import worker as worker_module
 from app.link.client import StepFrame
 from app.link.robot_link import RobotLink
@@ -275,7 +276,8 @@ def test_refusals_and_exceptions_are_results(qtbot: Any, sim: Any, link: RobotLi
 def test_commands_while_disconnected_are_errors(qtbot: Any, link: RobotLink) -> None:
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as blocker:
         request_id = link.stop()
-    assert blocker.args[0] == WorkerError("stop", "not connected to a controller", request_id)
+    assert blocker.args[0] == WorkerError("stop", "not connected to a controller", request_id,
+                                          Reason("not_connected"))
 
 
 def test_unreachable_controller_goes_down_and_shuts_down_cleanly(qtbot: Any, sim_factory: Any,

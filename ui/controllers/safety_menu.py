@@ -187,8 +187,8 @@ def install_safety(window: Any, *, scrypt_n: int | None = None) -> SafetyMenu:
     safety.gate_panel(window.planner_panel, Action.EDIT_PLANS)
     safety.attach_view(window.planner_panel)
     view3d = getattr(window, "view3d", None)
-    if view3d is not None:
-        safety.attach_view(view3d.panel.canvas)
+    if view3d is not None:  # the 3D view is built on first show: attach it then
+        view3d.on_built(lambda panel: safety.attach_view(panel.canvas))
     if hasattr(window, "event_log"):
         safety.message.connect(lambda text: window.event_log.add_event("warning", menu.source_name(), text))
     safety.message.connect(lambda text: window.statusBar().showMessage(text, 8000))

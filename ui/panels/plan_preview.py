@@ -118,6 +118,8 @@ class _Projection:
         if self.keep_in is None or self.keep_out is None:
             if not len(keep_in) and not len(keep_out):
                 return
+            import pyqtgraph as pg  # deferred: see the module docstring
+
             dash = Qt.PenStyle.DashLine
             pairs = "pairs"
             self.keep_in = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_IN, width=1, style=dash), connect=pairs)
@@ -175,6 +177,7 @@ class PlanPreview(QWidget):
         self._points: tuple[FloatArray, list[str]] = (np.empty((0, 3)), [])
         self._start: tuple[float, float, float] | None = None
         # Until the plots exist, a placeholder asks for the room they will (layouts stay the same).
+        self._boxes: tuple[FloatArray, FloatArray] = (np.empty((0, 3)), np.empty((0, 3)))  # envelope
         self._slot: QWidget | None = QWidget(self)
         self._slot.setMinimumSize(len(PROJECTIONS) * 90 + 12, 110 + QLabel().sizeHint().height())
         row.addWidget(self._slot, 1)
@@ -217,6 +220,7 @@ class PlanPreview(QWidget):
 
         if self._slot is not None:
             self._row.removeWidget(self._slot)
+            self._slot.hide()  # at once: deleteLater waits for the event loop
             self._slot.deleteLater()
             self._slot = None
         for key, h, v in PROJECTIONS:
@@ -238,6 +242,8 @@ class PlanPreview(QWidget):
             plot.show()
         self.retranslate()
         # draw what the setters remembered
+        for proj in self._projections.values():
+            proj.set_boxes(*self._boxes)
         operator_view = self._operator_view
         self.set_path(self._path, keep_view=True)
         self.set_points(*self._points)
@@ -377,8 +383,10 @@ class PlanPreview(QWidget):
         keep_in = envelope.keep_in.edges() if envelope is not None and envelope.keep_in else np.empty((0, 3))
         zones = [b.edges() for b in envelope.keep_out] if envelope is not None else []
         keep_out = np.vstack(zones) if zones else np.empty((0, 3))
-        for proj in self.projections.values():
-            proj.set_boxes(keep_in, keep_out)
+        self._boxes = (keep_in, keep_out)
+        if self.plots_built:  # else drawn when the plots are built (first show)
+            for proj in self._projections.values():
+                proj.set_boxes(keep_in, keep_out)
 
     def clear(self) -> None:
         self._previewed = None

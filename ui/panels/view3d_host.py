@@ -10,6 +10,7 @@ the points table, the planner and the run controller, and its tab title is kept 
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QObject, Qt, Slot
@@ -27,6 +28,7 @@ class View3DHost(QObject):
         self.window = window
         self._panel: View3DPanel | None = None
         self.tabs = window.work_tabs
+        self._when_built: list[Callable[[View3DPanel], object]] = []
         self._placeholder: QWidget | None = QWidget()
         self._placeholder.setObjectName("View3DPlaceholder")
         self.tabs.addTab(self._placeholder, "")
@@ -50,6 +52,14 @@ class View3DHost(QObject):
     @property
     def built(self) -> bool:
         return self._panel is not None
+
+    def on_built(self, callback: Callable[[View3DPanel], object]) -> None:
+        """Call ``callback(panel)`` once the panel exists (now, if it does): what the view needs
+        from elsewhere (the safety envelope) must not build it before its tab is shown."""
+        if self._panel is not None:
+            callback(self._panel)
+        else:
+            self._when_built.append(callback)
 
     def _build(self) -> View3DPanel:
         from ui.panels.view3d_panel import View3DPanel  # deferred: see the module docstring
@@ -78,6 +88,9 @@ class View3DHost(QObject):
             placeholder.deleteLater()
         self._panel = panel
         self.retranslate()
+        for callback in self._when_built:
+            callback(panel)
+        self._when_built.clear()
         return panel
 
     @Slot(int)
