@@ -44,6 +44,7 @@ from app.link.stats import LinkStats
 from app.protocol import registers
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
+from app.protocol.exceptions import exception_text
 
 __all__ = ["ConnectionSettings", "TrafficObserver", "TrafficRecord", "Transport"]
 
@@ -51,20 +52,6 @@ _log = logging.getLogger(__name__)
 
 SIMULATOR_PORT = 5020  # the simulator's default port, hinted when 502 refuses
 _RECV_SIZE = 4096
-
-_MODBUS_EXCEPTION_TEXT: dict[int, str] = {
-    0x01: "illegal function",
-    0x02: "illegal data address",
-    0x03: "illegal data value",
-    0x04: "server device failure",
-    0x05: "acknowledge",
-    0x06: "server device busy",
-    0x07: "negative acknowledge",
-    0x08: "memory parity error",
-    0x0A: "gateway path unavailable",
-    0x0B: "gateway target device failed to respond",
-}
-
 
 def _seconds(value: float) -> str:
     return str(round(value, 3))
@@ -450,7 +437,7 @@ class Transport:
         function, data = frames.decode_answer(self.framing, buf)
         if function & 0x80:
             code = data[0]
-            text = _MODBUS_EXCEPTION_TEXT.get(code, f"exception code {code}")
+            text = exception_text(code, f"exception code {code}")
             message = f"controller refused {what}: {text}"
             self._count("exceptions", message)
             raise ModbusExceptionError(function & 0x7F, code, message)
