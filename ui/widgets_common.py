@@ -267,16 +267,6 @@ def command_status_text(result: CommandResult) -> str:
     return QCoreApplication.translate(TR_CONTEXT, status.text)
 
 
-def command_result_text(result: CommandResult) -> str:
-    """``"<command>: <status>"`` plus the result's message when it has one."""
-    text = QCoreApplication.translate("Panels", "{command}: {status}").format(
-        command=command_name(result), status=command_status_text(result)
-    )
-    if result.message:
-        text = f"{text} — {result.message}"
-    return text
-
-
 def export_with_dialog(parent: QWidget, title: str, default_name: str, filters: str,
                        export: Callable[[str], object]) -> None:
     """Ask for a file name, run ``export(path)``; a failed write is shown, never raised."""

@@ -335,169 +335,169 @@
     <context>
         <name>ConnectionDialog</name>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="169" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="171" />
             <source>Connect to controller</source>
             <translation>连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="170" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="172" />
             <source>Transport:</source>
             <translation>通信方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="171" />
-            <location filename="../../ui/dialogs/connection_dialog.py" line="208" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="173" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="210" />
             <source>Modbus TCP</source>
             <translation>Modbus TCP</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="172" />
-            <location filename="../../ui/dialogs/connection_dialog.py" line="208" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="174" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="210" />
             <source>Modbus RTU (serial)</source>
             <translation>Modbus RTU（串口）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="173" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="175" />
             <source>Host:</source>
             <translation>主机：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="174" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="176" />
             <source>Port:</source>
             <translation>端口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="175" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="177" />
             <source>Serial port:</source>
             <translation>串口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="176" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="178" />
             <source>Refresh</source>
             <translation>刷新</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="177" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="179" />
             <source>List the serial ports of this computer again</source>
             <translation>重新列出本机的串口</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="179" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="181" />
             <source>Baud rate:</source>
             <translation>波特率：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="180" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="182" />
             <source>Parity:</source>
             <translation>校验位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="181" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="183" />
             <source>none</source>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="181" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="183" />
             <source>even</source>
             <translation>偶校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="181" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="183" />
             <source>odd</source>
             <translation>奇校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="183" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="185" />
             <source>Stop bits:</source>
             <translation>停止位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="184" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="186" />
             <source>Unit id:</source>
             <translation>从站地址：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="185" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="187" />
             <source>Float word order:</source>
             <translation>浮点数字序：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="186" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="188" />
             <source>Low word first (CDAB, default)</source>
             <translation>低字在前（CDAB，默认）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="187" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="189" />
             <source>High word first (ABCD)</source>
             <translation>高字在前（ABCD）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="188" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="190" />
             <source>Timeout:</source>
             <translation>超时：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="189" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="191" />
             <source>Monitor only (never write to the controller)</source>
             <translation>仅监视（从不写入控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="210" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="212" />
             <source>Connected to {where}</source>
             <translation>已连接到 {where}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="211" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="213" />
             <source>Connecting to {where}</source>
             <translation>正在连接 {where}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="212" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="214" />
             <source>Connected to {where}, but the controller does not answer</source>
             <translation>已连接到 {where}，但控制器没有应答</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="213" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="215" />
             <source>Connection to {where} lost; retrying</source>
             <translation>与 {where} 的连接已断开，正在重试</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="214" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="216" />
             <source>Not connected (last: {where})</source>
             <translation>未连接（上次：{where}）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="217" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="219" />
             <source>{transport}, unit {unit}</source>
             <translation>{transport}，站号 {unit}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="219" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="221" />
             <source>Polling at {hz:g} Hz</source>
             <translation>轮询频率 {hz:g} Hz</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="221" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="223" />
             <source>Monitor only: nothing is written to the controller</source>
             <translation>仅监视：不向控制器写入任何内容</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="248" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="250" />
             <source>Could not list the serial ports ({error}); type the device name</source>
             <translation>无法列出串口（{error}），请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="251" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="253" />
             <source>Serial ports found: {n}</source>
             <translation>找到的串口：{n} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="253" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="255" />
             <source>No serial port found; type the device name</source>
             <translation>未找到串口，请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="302" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="304" />
             <source>a serial port is needed for RTU</source>
             <translation>RTU 方式需要指定串口</translation>
         </message>
@@ -829,7 +829,7 @@
     <context>
         <name>Export</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="289" />
+            <location filename="../../ui/widgets_common.py" line="279" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -1746,11 +1746,6 @@
             <source>done</source>
             <translation>完成</translation>
         </message>
-        <message>
-            <location filename="../../ui/widgets_common.py" line="272" />
-            <source>{command}: {status}</source>
-            <translation>{command}：{status}</translation>
-        </message>
     </context>
     <context>
         <name>Plan</name>
@@ -1892,68 +1887,68 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="259" />
+            <location filename="../../ui/panels/plan_preview.py" line="265" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="260" />
+            <location filename="../../ui/panels/plan_preview.py" line="266" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="261" />
+            <location filename="../../ui/panels/plan_preview.py" line="267" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="265" />
+            <location filename="../../ui/panels/plan_preview.py" line="271" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="266" />
+            <location filename="../../ui/panels/plan_preview.py" line="272" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="357" />
+            <location filename="../../ui/panels/plan_preview.py" line="363" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="359" />
+            <location filename="../../ui/panels/plan_preview.py" line="365" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="361" />
+            <location filename="../../ui/panels/plan_preview.py" line="367" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="362" />
+            <location filename="../../ui/panels/plan_preview.py" line="368" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="365" />
+            <location filename="../../ui/panels/plan_preview.py" line="371" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="369" />
+            <location filename="../../ui/panels/plan_preview.py" line="375" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="371" />
+            <location filename="../../ui/panels/plan_preview.py" line="377" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="372" />
+            <location filename="../../ui/panels/plan_preview.py" line="378" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -2301,12 +2296,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="219" />
+            <location filename="../../ui/panels/planner_panel.py" line="220" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="412" />
+            <location filename="../../ui/panels/planner_panel.py" line="413" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -3663,82 +3658,82 @@ Remove them all?</source>
     <context>
         <name>SafetyMenu</name>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="84" />
+            <location filename="../../ui/controllers/safety_menu.py" line="85" />
             <source>&amp;Safety</source>
             <translation>安全(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="85" />
+            <location filename="../../ui/controllers/safety_menu.py" line="86" />
             <source>Log &amp;in…</source>
             <translation>登录(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="86" />
+            <location filename="../../ui/controllers/safety_menu.py" line="87" />
             <source>Log &amp;out (operator)</source>
             <translation>注销(&amp;O)（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="87" />
+            <location filename="../../ui/controllers/safety_menu.py" line="88" />
             <source>&amp;Reduced speed</source>
             <translation>降速模式(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="88" />
+            <location filename="../../ui/controllers/safety_menu.py" line="89" />
             <source>Safety &amp;envelope…</source>
             <translation>安全范围(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="89" />
+            <location filename="../../ui/controllers/safety_menu.py" line="90" />
             <source>&amp;Audit trail…</source>
             <translation>审计记录(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="90" />
+            <location filename="../../ui/controllers/safety_menu.py" line="91" />
             <source>Write a &amp;support bundle…</source>
             <translation>生成支持包(&amp;S)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="103" />
+            <location filename="../../ui/controllers/safety_menu.py" line="104" />
             <source>Role: {role} · reduced speed</source>
             <translation>角色：{role} · 降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="103" />
+            <location filename="../../ui/controllers/safety_menu.py" line="104" />
             <source>Role: {role}</source>
             <translation>角色：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="111" />
+            <location filename="../../ui/controllers/safety_menu.py" line="112" />
             <source>Cap jog and move speeds (anyone may switch it on)</source>
             <translation>限制点动与移动速度（任何人都可开启）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="115" />
+            <location filename="../../ui/controllers/safety_menu.py" line="116" />
             <source>safety</source>
             <translation>安全</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="138" />
+            <location filename="../../ui/controllers/safety_menu.py" line="139" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="145" />
+            <location filename="../../ui/controllers/safety_menu.py" line="146" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="166" />
+            <location filename="../../ui/controllers/safety_menu.py" line="167" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="167" />
+            <location filename="../../ui/controllers/safety_menu.py" line="168" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="171" />
+            <location filename="../../ui/controllers/safety_menu.py" line="172" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
@@ -4274,12 +4269,12 @@ Remove them all?</source>
     <context>
         <name>View3DHost</name>
         <message>
-            <location filename="../../ui/panels/view3d_host.py" line="95" />
+            <location filename="../../ui/panels/view3d_host.py" line="108" />
             <source>3D</source>
             <translation>3D</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_host.py" line="96" />
+            <location filename="../../ui/panels/view3d_host.py" line="109" />
             <source>3D view</source>
             <translation>3D 视图</translation>
         </message>
