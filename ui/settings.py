@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import os
+from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import QByteArray, QSettings
@@ -17,6 +18,8 @@ from PySide6.QtCore import QByteArray, QSettings
 from app import timing
 from app.link.client import ConnectionSettings
 from app.protocol.codec import WordOrder
+from app.safety import register_profile as regprofile
+from app.safety.roles import default_config_dir
 
 ORGANIZATION = "Bochuang"
 APPLICATION = "TeachPad"
@@ -97,7 +100,11 @@ class AppSettings:
 
     # --- connection -------------------------------------------------------------------
     def connection(self) -> ConnectionSettings:
-        """The last connection settings (defaults for what was never saved)."""
+        """The last connection settings (defaults for what was never saved), with the register
+        profile in force applied (see the register profile block below)."""
+        return self.register_profile()[0].apply(self._remembered_connection())
+
+    def _remembered_connection(self) -> ConnectionSettings:
         defaults = ConnectionSettings()
         values: dict[str, Any] = {}
         for key, kind in _CONNECTION_KEYS.items():
@@ -123,6 +130,28 @@ class AppSettings:
             value = getattr(settings, key)
             self._store.setValue(f"connection/{key}", "" if value is None else value)
         self._store.setValue("connection/word_order", settings.word_order.name)
+
+    # --- register profile (issue 12, guard rails: the safety block) -------------------------
+    # The protocol decisions that vary between controllers (word order, unit id, completion rule,
+    # poll timeout, date/time layout, point ids) live in a register profile file, not in these
+    # keys: only an administrator changes it (Safety -> Register profile...). ``connection()``
+    # returns the remembered connection with the profile in force applied.
+    def register_profile_path(self) -> Path:
+        """The profile in force: beside an INI settings file (tests, portable installs), else in
+        the user's config folder (next to the role store and the envelope)."""
+        store = self._store
+        if store.format() == QSettings.Format.IniFormat and store.fileName():
+            return Path(store.fileName()).parent / "safety" / regprofile.PROFILE_NAME
+        return default_config_dir() / regprofile.PROFILE_NAME
+
+    def register_profile(self) -> tuple[regprofile.RegisterProfile, str]:
+        """(the profile in force, a problem reading it or ""). No file yet: the profile the
+        remembered connection implies (so nothing changes until an administrator saves one)."""
+        try:
+            fallback = regprofile.RegisterProfile.from_connection(self._remembered_connection())
+        except regprofile.RegisterProfileError:  # a remembered value out of range
+            fallback = regprofile.RegisterProfile()
+        return regprofile.active_profile(self.register_profile_path(), fallback)
 
     # --- project ----------------------------------------------------------------------
     @property

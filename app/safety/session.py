@@ -11,15 +11,19 @@
 * ``check_step`` / ``check_move`` / ``check_jog_start`` before sending (refusals are audited and
   raised as :class:`~app.safety.envelope.EnvelopeRefused`), ``jog_guard(poll_period)`` for the
   worker, ``set_reduced`` (on: anyone; off: engineer);
+* ``set_register_profile`` (administrator; saved atomically, audited with what changed),
+  ``set_password`` / ``clear_password`` / ``set_idle_timeout`` (administrator, audited; never a
+  password in the audit);
 * ``audit.record_write`` is the client's hook, and the audit's role follows the session.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from typing import Any
 
-from app.errors import TeachPadError
+from app.errors import InvalidInput, TeachPadError
 from app.models import Pose
 from app.plan.geometry import PointLike
 from app.plan.segments import Segment
@@ -33,6 +37,7 @@ from app.safety.envelope import (
     check_step,
 )
 from app.safety.jog_guard import JOG_GUARD_LATENCY, ArmSpeeds, JogGuard, JogMotion
+from app.safety.register_profile import RegisterProfile, save_register_profile
 from app.safety.roles import Action, IdleLock, Role, RoleStore, WrongPassword, permission_reason
 
 
@@ -106,6 +111,48 @@ class SafetySession:
     def _changed(self) -> None:
         if self._on_role_changed is not None:
             self._on_role_changed(self.role)
+
+    # --- administration ---------------------------------------------------------------------
+    def set_register_profile(self, path: str | os.PathLike[str], profile: RegisterProfile,
+                             current: RegisterProfile | None = None) -> RegisterProfile:
+        """Save ``profile`` as the one in force (administrator only, audited with the fields that
+        changed from ``current``); returns it as saved (its next revision)."""
+        changes = current.changes(profile) if current is not None else profile.protocol_dict()
+        self.require(Action.REGISTER_PROFILE, {"name": profile.name, "changes": changes})
+        saved = save_register_profile(path, profile)
+        self.audit.record("action", "change register profile",
+                          args={"name": saved.name, "revision": saved.revision, "changes": changes})
+        return saved
+
+    def set_password(self, role: Role, password: str) -> None:
+        """Set or change ``role``'s password (administrator; the first one: anyone, while no
+        administrator password exists). Audited without the password."""
+        if self.store.has_password(Role.ADMINISTRATOR):
+            self.require(Action.MANAGE_ROLES, {"role": role.text})
+        changed = self.store.has_password(role)
+        self.store.set_password(role, password, by=self.role)
+        self.audit.record("action", f"{'change' if changed else 'set'} the {role.text} password")
+
+    def clear_password(self, role: Role) -> None:
+        """Remove ``role``'s password (administrator). The administrator's own cannot be cleared:
+        without it anyone could set a new one and become administrator."""
+        self.require(Action.MANAGE_ROLES, {"role": role.text})
+        if role is Role.ADMINISTRATOR:
+            why = "the administrator password can be changed, not removed (anyone could then set it)"
+            self.audit.record_refused("clear the administrator password", why)
+            raise InvalidInput(why)
+        self.store.clear_password(role, by=self.role)
+        self.audit.record("action", f"clear the {role.text} password")
+
+    def set_idle_timeout(self, seconds: float) -> None:
+        """The idle time before the lock-back to operator (administrator; saved, audited)."""
+        self.require(Action.MANAGE_ROLES, {"idle_timeout": seconds})
+        if not seconds > 0:
+            raise InvalidInput("the idle time must be > 0 s")
+        self.store.idle_timeout = float(seconds)
+        self.idle.timeout = float(seconds)
+        self.store.save()
+        self.audit.record("action", "set the idle lock time", args={"seconds": float(seconds)})
 
     # --- envelope ---------------------------------------------------------------------------
     def set_envelope(self, envelope: Envelope) -> None:

@@ -1,9 +1,15 @@
 """The Safety menu and the window's role gating, composed onto the main window in one call.
 
 :func:`install_safety` creates the :class:`SafetyController`, gates the window's controls by
-role (connection: administrator; point and plan edits, the envelope: engineer), feeds the
-envelope to the planner, the 3D view and the worker, and adds the menu: log in / out,
-reduced speed, envelope, audit trail, support bundle; a status-bar label shows the role.
+role (connection, register profile, passwords: administrator; point and plan edits, the envelope:
+engineer), feeds the envelope to the planner, the 3D view and the worker, and adds the menu: log
+in / out, reduced speed, envelope, register profile, passwords and lock, audit trail, support
+bundle; a status-bar label shows the role.
+
+The register profile in force is a file beside the settings (``AppSettings.register_profile_path``);
+``AppSettings.connection()`` applies it, so every connection made from the remembered settings
+uses it. :meth:`SafetyMenu.apply_register_profile` saves a new one (administrator, audited) and can
+reconnect the link at once with it.
 """
 
 from __future__ import annotations
@@ -18,10 +24,15 @@ from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QFileDialog, QLabel, QMenu, QMessageBox
 
 from app.errors import TeachPadError
+from app.link.types import LinkState
 from app.safety.bundle import write_support_bundle
+from app.safety.register_profile import RegisterProfile
 from app.safety.roles import Action, Role
+from app.safety.session import PermissionRefused
 from ui.controllers.safety import SafetyController
 from ui.dialogs.envelope_dialog import EnvelopeDialog
+from ui.dialogs.password_dialog import PasswordDialog
+from ui.dialogs.register_profile_dialog import RegisterProfileDialog
 from ui.dialogs.role_dialog import RoleDialog
 from ui.panels.audit_viewer import AuditViewer
 
@@ -45,13 +56,20 @@ class SafetyMenu(QObject):
         self.envelope_action = QAction(self)
         self.envelope_action.setObjectName("EnvelopeAction")
         self.envelope_action.triggered.connect(self.open_envelope_dialog)
+        self.register_profile_action = QAction(self)
+        self.register_profile_action.setObjectName("RegisterProfileAction")
+        self.register_profile_action.triggered.connect(self.open_register_profile_dialog)
+        self.passwords_action = QAction(self)
+        self.passwords_action.setObjectName("PasswordsAction")
+        self.passwords_action.triggered.connect(self.open_password_dialog)
         self.audit_action = QAction(self)
         self.audit_action.triggered.connect(self.open_audit_viewer)
         self.bundle_action = QAction(self)
         self.bundle_action.triggered.connect(self.write_bundle)
         self.menu = QMenu(window)
         for action in (self.login_action, self.logout_action, None, self.reduced_action, self.envelope_action,
-                       None, self.audit_action, self.bundle_action):
+                       None, self.register_profile_action, self.passwords_action, None, self.audit_action,
+                       self.bundle_action):
             if action is None:
                 self.menu.addSeparator()
             else:
@@ -87,6 +105,12 @@ class SafetyMenu(QObject):
         self.logout_action.setText(self.tr("Log &out (operator)"))
         self.reduced_action.setText(self.tr("&Reduced speed"))
         self.envelope_action.setText(self.tr("Safety &envelope…"))
+        self.register_profile_action.setText(self.tr("Re&gister profile…"))
+        self.register_profile_action.setToolTip(self.tr("Word order, unit id, completion rule, poll timeout "
+                                                        "(administrator)"))
+        self.passwords_action.setText(self.tr("&Passwords and lock…"))
+        self.passwords_action.setToolTip(self.tr("Set, change or clear passwords; the idle lock time "
+                                                 "(administrator)"))
         self.audit_action.setText(self.tr("&Audit trail…"))
         self.bundle_action.setText(self.tr("Write a &support bundle…"))
         QTimer.singleShot(0, self._refresh)  # after the window's own retranslate (it sets tooltips)
@@ -129,6 +153,47 @@ class SafetyMenu(QObject):
     def open_envelope_dialog(self) -> None:
         if self.safety.allowed(Action.EDIT_ENVELOPE):
             EnvelopeDialog(self.safety, self.window).exec()
+
+    @Slot()
+    def open_password_dialog(self) -> None:
+        if self.safety.allowed(Action.MANAGE_ROLES):
+            PasswordDialog(self.safety, self.window).exec()
+
+    def register_profile(self) -> RegisterProfile:
+        """The register profile in force."""
+        return self.window.settings.register_profile()[0]  # type: ignore[no-any-return]
+
+    def register_profile_dialog(self) -> RegisterProfileDialog:
+        link = self.window.link
+        connected = link.settings is not None and link.connection.state is not LinkState.DISCONNECTED
+        return RegisterProfileDialog(self.register_profile(), self.apply_register_profile, self.window,
+                                     reason=self.safety.reason(Action.REGISTER_PROFILE), connected=connected)
+
+    @Slot()
+    def open_register_profile_dialog(self) -> None:
+        if self.safety.allowed(Action.REGISTER_PROFILE):
+            self.register_profile_dialog().exec()
+
+    def apply_register_profile(self, profile: RegisterProfile, reconnect: bool = False) -> str | None:
+        """Save ``profile`` as the one in force (administrator only: refused and audited otherwise)
+        and, with ``reconnect``, connect the link again with it. None when done, else why not."""
+        window = self.window
+        try:
+            saved = self.safety.session.set_register_profile(window.settings.register_profile_path(), profile,
+                                                             self.register_profile())
+        except PermissionRefused:
+            why = self.safety.reason(Action.REGISTER_PROFILE) or ""
+            self.safety.message.emit(why)
+            return why
+        except (OSError, TeachPadError) as exc:
+            return self.tr("The register profile could not be saved: {why}").format(why=str(exc)[:200])
+        link = window.link
+        if reconnect and link.settings is not None:
+            window.jog_panel.release_all()
+            link.connect_to(saved.apply(link.settings))
+        text = self.tr("Register profile \u201c{name}\u201d saved (revision {rev})")
+        window.statusBar().showMessage(text.format(name=saved.name, rev=saved.revision), 8000)
+        return None
 
     @Slot()
     def open_audit_viewer(self) -> None:
@@ -181,6 +246,8 @@ def install_safety(window: Any, *, scrypt_n: int | None = None) -> SafetyMenu:
     menu = SafetyMenu(window, safety)
     safety.gate(window.menus.connect_action, Action.CONNECTION)
     safety.gate(menu.envelope_action, Action.EDIT_ENVELOPE)
+    safety.gate(menu.register_profile_action, Action.REGISTER_PROFILE)
+    safety.gate(menu.passwords_action, Action.MANAGE_ROLES)
     safety.gate_panel(window.points_panel, Action.EDIT_POINTS)
     window.points_panel.move_check = lambda point_id, speed: safety.check_move_to(
         window.link.state.pose, point_id, speed, window.project.points_model.ledger)
@@ -194,4 +261,7 @@ def install_safety(window: Any, *, scrypt_n: int | None = None) -> SafetyMenu:
     safety.message.connect(lambda text: window.statusBar().showMessage(text, 8000))
     if safety.problem:
         safety.message.emit(safety.problem)
+    register_problem = window.settings.register_profile()[1]
+    if register_problem:
+        safety.message.emit(register_problem)
     return menu

@@ -2,7 +2,12 @@
 monitor-only.
 
 Opened from a link (:meth:`ConnectionDialog.for_link`), it shows the connection in use (the
-link's settings, else the remembered ones), whether it is connected, and the poll rate."""
+link's settings, else the remembered ones), whether it is connected, and the poll rate.
+
+Given a register profile (``for_link`` derives it from the remembered settings, which carry the
+profile in force), the unit id and the word order are the profile's: shown, not editable here
+(an administrator changes them in Safety -> Register profile...), and :meth:`settings` applies the
+whole profile to the connection."""
 
 from __future__ import annotations
 
@@ -30,6 +35,7 @@ from PySide6.QtWidgets import (
 from app.link.client import ConnectionSettings
 from app.link.types import ConnectionState, LinkState
 from app.protocol.codec import WordOrder
+from app.safety.register_profile import RegisterProfile
 
 _BAUDRATES = (9600, 19200, 38400, 57600, 115200, 230400)
 _PARITIES = ("N", "E", "O")
@@ -64,10 +70,12 @@ class ConnectionDialog(QDialog):
     and ``poll_hz``: the link's state and poll rate, shown above the form."""
 
     def __init__(self, settings: ConnectionSettings | None = None, parent: QWidget | None = None, *,
-                 connection: ConnectionState | None = None, poll_hz: float | None = None) -> None:
+                 connection: ConnectionState | None = None, poll_hz: float | None = None,
+                 profile: RegisterProfile | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("ConnectionDialog")
         self._base = settings or ConnectionSettings()
+        self.profile = profile
         self._connection = connection
         self._poll_hz = poll_hz
         self.current_label = QLabel(self)  # the connection in use, connected or not
@@ -140,6 +148,9 @@ class ConnectionDialog(QDialog):
         self.timeout_spin.setSingleStep(0.1)
         self.timeout_spin.setSuffix(" s")
         self.monitor_check = QCheckBox(self)
+        self.profile_note = QLabel(self)  # "unit and word order: from the register profile"
+        self.profile_note.setWordWrap(True)
+        self.profile_note.setVisible(profile is not None)
 
         self.transport_caption = QLabel(self)
         self.unit_caption = QLabel(self)
@@ -150,6 +161,7 @@ class ConnectionDialog(QDialog):
         form.addRow(self.pages)
         form.addRow(self.unit_caption, self.unit_spin)
         form.addRow(self.order_caption, self.order_combo)
+        form.addRow(self.profile_note)
         form.addRow(self.timeout_caption, self.timeout_spin)
         form.addRow(self.monitor_check)
 
@@ -189,6 +201,12 @@ class ConnectionDialog(QDialog):
         self.order_combo.setItemText(1, self.tr("High word first (ABCD)"))
         self.timeout_caption.setText(self.tr("Timeout:"))
         self.monitor_check.setText(self.tr("Monitor only (never write to the controller)"))
+        if self.profile is not None:
+            note = self.tr("Unit id and word order come from the register profile (Safety → Register "
+                           "profile…, administrator).")
+            self.profile_note.setText(note)
+            for widget in (self.unit_spin, self.order_combo):
+                widget.setToolTip(note)
         self._show_current()
 
     @classmethod
@@ -196,7 +214,8 @@ class ConnectionDialog(QDialog):
                  parent: QWidget | None = None) -> ConnectionDialog:
         """The dialog on the connection in use: the link's settings (the remembered ones when
         the link has none yet), its state and the poll rate."""
-        return cls(link.settings or saved, parent, connection=link.connection, poll_hz=poll_hz)
+        return cls(link.settings or saved, parent, connection=link.connection, poll_hz=poll_hz,
+                   profile=RegisterProfile.from_connection(saved))
 
     def _show_current(self) -> None:
         """"Connected to …" / "Not connected (…)", with the transport and the poll rate."""
@@ -274,15 +293,18 @@ class ConnectionDialog(QDialog):
         self.baud_combo.setCurrentIndex(index)
         self.parity_combo.setCurrentIndex(max(0, self.parity_combo.findData(settings.parity)))
         self.stopbits_spin.setValue(settings.stopbits)
-        self.unit_spin.setValue(settings.unit)
-        self.order_combo.setCurrentIndex(max(0, self.order_combo.findData(settings.word_order.value)))
+        shown = settings if self.profile is None else self.profile.apply(settings)
+        self.unit_spin.setValue(shown.unit)
+        self.order_combo.setCurrentIndex(max(0, self.order_combo.findData(shown.word_order.value)))
+        for widget in (self.unit_spin, self.order_combo):
+            widget.setEnabled(self.profile is None)
         self.timeout_spin.setValue(settings.timeout)
         self.monitor_check.setChecked(settings.monitor_only)
 
     def settings(self) -> ConnectionSettings:
         rtu = self.transport_combo.currentData() == "rtu"
         serial = self.serial_edit.text().strip() if rtu else ""
-        return dataclasses.replace(
+        edited = dataclasses.replace(
             self._base,
             host=self.host_edit.text().strip() or "127.0.0.1",
             port=self.port_spin.value(),
@@ -296,6 +318,7 @@ class ConnectionDialog(QDialog):
             timeout=self.timeout_spin.value(),
             monitor_only=self.monitor_check.isChecked(),
         )
+        return edited if self.profile is None else self.profile.apply(edited)
 
     @Slot()
     def accept(self) -> None:

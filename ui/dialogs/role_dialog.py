@@ -1,5 +1,6 @@
-"""Switch role (operator / engineer / administrator) with a password; an administrator also sets
-the passwords. The first administrator password is set here while none exists yet."""
+"""Switch role (operator / engineer / administrator) with a password. The first administrator
+password is set here while none exists yet; after that, passwords and the idle lock time are the
+administrator's (Safety -> Passwords and lock..., :mod:`ui.dialogs.password_dialog`)."""
 
 from __future__ import annotations
 
@@ -11,13 +12,12 @@ from PySide6.QtWidgets import (
     QLabel,
     QLineEdit,
     QPushButton,
-    QSpinBox,
     QVBoxLayout,
     QWidget,
 )
 
 from app.errors import InvalidInput, TeachPadError
-from app.safety.roles import Action, Role, WrongPassword
+from app.safety.roles import Role, WrongPassword
 from ui.controllers.safety import SafetyController
 
 
@@ -37,22 +37,14 @@ class RoleDialog(QDialog):
         self.error = QLabel(self)
         self.error.setWordWrap(True)
         self.error.setStyleSheet("color: #c62828;")
+        # only while no administrator password exists (the first one); then Passwords and lock
         self.set_password_button = QPushButton(self.tr("Set this role's password"), self)
         self.set_password_button.clicked.connect(self.set_password)
-        self.idle = QSpinBox(self)  # the administrator chooses the idle time before the lock-back
-        self.idle.setRange(1, 240)
-        self.idle.setSuffix(self.tr(" min"))
-        self.idle.setValue(max(1, round(safety.session.store.idle_timeout / 60)))
-        self.idle.setEnabled(safety.role is Role.ADMINISTRATOR)
-        tip = safety.reason(Action.MANAGE_ROLES) or self.tr("Back to operator after this idle time")
-        self.idle.setToolTip(tip)
-        self.idle.valueChanged.connect(self._set_idle)
         self.logout_button = QPushButton(self.tr("Log out (operator)"), self)
         self.logout_button.clicked.connect(self.log_out)
         form = QFormLayout()
         form.addRow(self.tr("Role:"), self.role_box)
         form.addRow(self.tr("Password:"), self.password)
-        form.addRow(self.tr("Lock back after:"), self.idle)
         std = QDialogButtonBox.StandardButton
         buttons = QDialogButtonBox(std.Ok | std.Cancel, self)
         buttons.accepted.connect(self.log_in)
@@ -73,8 +65,8 @@ class RoleDialog(QDialog):
     def _update(self) -> None:
         store = self._safety.session.store
         first = not store.has_password(Role.ADMINISTRATOR)
-        may_manage = self._safety.role is Role.ADMINISTRATOR or first
-        self.set_password_button.setEnabled(may_manage and self._role() is not Role.OPERATOR)
+        self.set_password_button.setVisible(first)
+        self.set_password_button.setEnabled(first and self._role() is Role.ADMINISTRATOR)
         hint = ""
         if first:
             hint = self.tr("No administrator password is set yet: choose the administrator role, type a "
@@ -95,15 +87,6 @@ class RoleDialog(QDialog):
             return
         self.accept()
 
-    def _set_idle(self, minutes: int) -> None:
-        store = self._safety.session.store
-        store.idle_timeout = minutes * 60.0
-        self._safety.set_idle_timeout(store.idle_timeout)
-        try:
-            store.save()
-        except OSError as exc:
-            self.error.setText(self.tr("The setting could not be saved: {why}").format(why=str(exc)[:120]))
-
     def log_out(self) -> None:
         self._safety.logout()
         self.accept()
@@ -111,14 +94,13 @@ class RoleDialog(QDialog):
     def set_password(self) -> None:
         role = self._role()
         try:
-            self._safety.session.store.set_password(role, self.password.text(), by=self._safety.role)
+            self._safety.session.set_password(role, self.password.text())
         except InvalidInput as exc:
             self.error.setText(str(exc))
             return
         except (OSError, TeachPadError) as exc:
             self.error.setText(self.tr("The password could not be saved: {why}").format(why=str(exc)[:120]))
             return
-        self._safety.session.audit.record("action", f"set the {role.text} password")
         name = self._safety.role_name(role)
         self.error.setText(self.tr("Password set for the {role} role").format(role=name))
         self._update()
