@@ -41,10 +41,7 @@ def test_first_admin_password_then_log_in_and_out(qtbot: Any, tmp_path: Path) ->
     assert admin is Role.ADMINISTRATOR and dialog.result() == RoleDialog.DialogCode.Accepted
     again = RoleDialog(safety)
     qtbot.addWidget(again)
-    assert again.idle.isEnabled()  # the administrator chooses the idle time
-    again.idle.setValue(2)
-    assert safety.session.idle.timeout == 120.0 and '"idle_timeout": 120.0' in (
-        tmp_path / "safety" / "roles.json").read_text(encoding="utf-8")
+    assert again.set_password_button.isHidden()  # passwords are now the Passwords screen's
     again.log_out()
     assert safety.role is Role.OPERATOR
     stored = (tmp_path / "safety" / "roles.json").read_text(encoding="utf-8")
