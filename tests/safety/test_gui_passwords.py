@@ -41,6 +41,12 @@ def safety_fixture(qtbot: Any, tmp_path: Path) -> Any:
     controller.close()
 
 
+def _cell(dialog: PasswordDialog, role: Role) -> str:
+    item = dialog.table.item(int(role), 1)
+    assert item is not None
+    return item.text()
+
+
 def _roles_file(tmp_path: Path) -> str:
     return (tmp_path / "safety" / "roles.json").read_text(encoding="utf-8")
 
@@ -49,7 +55,7 @@ def test_an_administrator_sets_changes_and_clears_passwords(qtbot: Any, safety: 
     safety.login(Role.ADMINISTRATOR, ADMIN_PW)
     dialog = PasswordDialog(safety)
     qtbot.addWidget(dialog)
-    state = [dialog.table.item(int(role), 1).text() for role in Role]
+    state = [_cell(dialog, role) for role in Role]
     assert state[0].startswith("not needed") and state[1].startswith("not set") and state[2] == "set"
     dialog.table.selectRow(int(Role.ENGINEER))
     assert not dialog.clear_button.isEnabled()  # nothing to clear yet
@@ -60,7 +66,7 @@ def test_an_administrator_sets_changes_and_clears_passwords(qtbot: Any, safety: 
     dialog.password.setText("eng-1")
     dialog.repeat.setText("eng-1")
     dialog.set_password()
-    assert dialog.table.item(int(Role.ENGINEER), 1).text() == "set" and dialog.password.text() == ""
+    assert _cell(dialog, Role.ENGINEER) == "set" and dialog.password.text() == ""
     assert safety.session.store.verify(Role.ENGINEER, "eng-1")
     dialog.password.setText("eng-22")
     dialog.repeat.setText("eng-22")
@@ -69,7 +75,7 @@ def test_an_administrator_sets_changes_and_clears_passwords(qtbot: Any, safety: 
     assert "eng-1" not in _roles_file(tmp_path) and "scrypt" in _roles_file(tmp_path)
     dialog.clear_button.click()
     assert not safety.session.store.has_password(Role.ENGINEER)
-    assert dialog.table.item(int(Role.ENGINEER), 1).text().startswith("not set")
+    assert _cell(dialog, Role.ENGINEER).startswith("not set")
     dialog.table.selectRow(int(Role.ADMINISTRATOR))
     assert not dialog.clear_button.isEnabled()  # changed, never removed (anyone could then set it)
     with pytest.raises(InvalidInput, match="changed, not removed"):
