@@ -13,8 +13,11 @@ death (the page cache survives a killed process); :data:`FsyncPolicy.INTERVAL` (
 syncs at most once per :data:`FSYNC_INTERVAL` seconds — see ``benchmarks`` in the report for the
 cost of syncing every line.
 
-A record is written *after* the write's outcome is known (one line per write, with its
-result), so each write appears exactly once; a crash during a write loses that one.
+Write-ahead: :meth:`AuditLog.writing` (the client's write guard) appends the write's line
+(result ``pending``) *before* the request goes out, and a short ``outcome`` line (``args.ref`` =
+the write's ``seq``) once it is answered. The reader merges the two into one record, so every write
+the controller may have received is in the file exactly once, also after a ``kill -9``: a write
+whose outcome line never came reads as ``unknown`` ("sent; TeachPad stopped before the answer").
 """
 
 from __future__ import annotations
@@ -30,12 +33,13 @@ import sys
 import threading
 import time
 import uuid
+from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TextIO
 
-from app.errors import TeachPadError, WriteBlocked
+from app.errors import WriteBlocked
 from app.protocol.codec import WordOrder
 from app.protocol.naming import describe_registers, single_write_text, write_summary
 
@@ -59,6 +63,13 @@ class Result:
     FAILED = "failed"  # sent, and the controller or the link failed it
     BLOCKED = "blocked"  # not sent: monitor-only
     REFUSED = "refused"  # not sent: the host refused (envelope, role, bad value)
+    PENDING = "pending"  # in the file only: sent, its outcome line follows (merged by the reader)
+    UNKNOWN = "unknown"  # sent, no outcome recorded (TeachPad stopped before the answer)
+
+
+OUTCOME = "outcome"  # the kind of a write's second line (merged into the write by the reader)
+UNKNOWN_DETAIL = "sent; TeachPad stopped before the answer was recorded"
+MAX_OUTCOME_LAG = 4096  # records read after a pending write before the reader stops waiting
 
 
 def default_data_dir() -> Path:
@@ -107,6 +118,14 @@ class AuditRecord:
         rec = cls(**known)
         dt.datetime.fromisoformat(rec.host_time)  # must parse
         return rec
+
+
+def _write_result(error: BaseException | None) -> tuple[str, str]:
+    if error is None:
+        return Result.OK, ""
+    if isinstance(error, WriteBlocked):
+        return Result.BLOCKED, str(error)
+    return Result.FAILED, str(error) or type(error).__name__
 
 
 def _short(text: str, limit: int = MAX_DETAIL_CHARS) -> str:
@@ -192,8 +211,9 @@ class AuditLog:
                 self.on_error(message)
 
     def record_write(self, address: int, values: Sequence[int], *, single: bool = False,
-                     error: BaseException | None = None) -> AuditRecord:
-        """One write to the controller and how it ended (``error`` None: it succeeded)."""
+                     error: BaseException | None = None, pending: bool = False) -> AuditRecord:
+        """One write to the controller and how it ended (``error`` None: it succeeded; ``pending``:
+        not known yet, an outcome line follows -- see :meth:`writing`)."""
         vals = [int(v) for v in values]
         try:
             if single and len(vals) == 1:
@@ -202,12 +222,7 @@ class AuditLog:
                 command = write_summary(address, describe_registers(address, vals, self.word_order))
         except Exception:  # naming is a courtesy; never lose the record over it
             command = f"write {len(vals)} register(s) at {address}"
-        if error is None:
-            result, detail = Result.OK, ""
-        elif isinstance(error, WriteBlocked):
-            result, detail = Result.BLOCKED, str(error)
-        else:
-            result, detail = Result.FAILED, str(error) or type(error).__name__
+        result, detail = (Result.PENDING, "") if pending else _write_result(error)
         args = {"fc": 6 if single else 16, "address": address, "values": vals[:MAX_VALUES_KEPT]}
         if len(vals) > MAX_VALUES_KEPT:
             args["count"] = len(vals)
@@ -215,13 +230,20 @@ class AuditLog:
 
     @contextlib.contextmanager
     def writing(self, address: int, values: Sequence[int], *, single: bool = False) -> Iterator[None]:
-        """Wrap one write: records it with its outcome; errors pass through unchanged."""
+        """Wrap one write, write-ahead: its line (``pending``) before the request goes out, its
+        outcome line after; the reader merges them. Errors pass through unchanged."""
+        intent = self.record_write(address, values, single=single, pending=True)
         try:
             yield
-        except TeachPadError as exc:
-            self.record_write(address, values, single=single, error=exc)
+        except Exception as exc:
+            self._record_outcome(intent, exc)
             raise
-        self.record_write(address, values, single=single)
+        self._record_outcome(intent, None)
+
+    def _record_outcome(self, intent: AuditRecord, error: BaseException | None) -> None:
+        result, detail = _write_result(error)
+        self.record(OUTCOME, intent.command, result=result, args={"ref": intent.seq}, detail=detail,
+                    role=intent.role)
 
     def record_refused(self, action: str, reason: str, args: dict[str, Any] | None = None) -> AuditRecord:
         """An action the host refused (envelope, role, bad value): nothing was sent."""
@@ -339,6 +361,7 @@ class ReadStats:
     files: int = 0
     records: int = 0
     skipped: int = 0  # lines that did not parse (a line cut short by a crash, damage)
+    unknown: int = 0  # writes sent whose outcome was never recorded (TeachPad stopped)
 
 
 def audit_files(directory: Path, start: dt.date | None = None, end: dt.date | None = None) -> list[Path]:
@@ -351,10 +374,24 @@ def audit_files(directory: Path, start: dt.date | None = None, end: dt.date | No
     return [p for _, _, p in sorted(out)]
 
 
+class _Slot:
+    """A record waiting in file order; a pending write waits for its outcome line."""
+
+    __slots__ = ("pending", "record")
+
+    def __init__(self, record: AuditRecord) -> None:
+        self.record, self.pending = record, record.result == Result.PENDING
+
+
 def read_records(directory: Path, start: dt.date | None = None, end: dt.date | None = None,
                  stats: ReadStats | None = None) -> Iterator[AuditRecord]:
-    """Every record of days ``start``..``end``; lines that do not parse are skipped and counted."""
+    """Every record of days ``start``..``end``, in file order; lines that do not parse are skipped
+    and counted. A write's outcome line is merged into the write (see the module docstring); a
+    write without one within :data:`MAX_OUTCOME_LAG` records (the process died) ends ``unknown``,
+    so at most that many records are held back."""
     stats = stats if stats is not None else ReadStats()
+    held: deque[_Slot] = deque()
+    waiting: dict[tuple[str, int], _Slot] = {}
     for path in audit_files(directory, start, end):
         stats.files += 1
         try:
@@ -369,8 +406,33 @@ def read_records(directory: Path, start: dt.date | None = None, end: dt.date | N
             except (ValueError, TypeError, UnicodeDecodeError):
                 stats.skipped += 1
                 continue
-            stats.records += 1
-            yield rec
+            if rec.kind == OUTCOME:
+                ref = rec.args.get("ref")
+                slot = waiting.pop((rec.session, ref), None) if isinstance(ref, int) else None
+                if slot is not None:
+                    slot.pending = False
+                    slot.record = replace(slot.record, result=rec.result, detail=rec.detail)
+            else:  # (an outcome whose write is outside the range read shows nothing)
+                held.append(_Slot(rec))
+                if held[-1].pending:
+                    waiting[(rec.session, rec.seq)] = held[-1]
+            if len(held) > MAX_OUTCOME_LAG:  # the oldest waits in vain: its process died
+                _give_up(held[0], stats)
+                waiting.pop((held[0].record.session, held[0].record.seq), None)
+            while held and not held[0].pending:
+                stats.records += 1
+                yield held.popleft().record
+    for slot in held:
+        if slot.pending:
+            _give_up(slot, stats)
+        stats.records += 1
+        yield slot.record
+
+
+def _give_up(slot: _Slot, stats: ReadStats) -> None:
+    slot.pending = False
+    slot.record = replace(slot.record, result=Result.UNKNOWN, detail=UNKNOWN_DETAIL)
+    stats.unknown += 1
 
 
 @dataclass(frozen=True)

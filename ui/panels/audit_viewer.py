@@ -74,7 +74,7 @@ class AuditModel(QAbstractTableModel):
                 "administrator (cli)": self.tr("administrator (CLI)"),
                 "write": self.tr("write"), "refused": self.tr("refused"), "login": self.tr("login"),
                 "action": self.tr("action"), "ok": self.tr("ok"), "failed": self.tr("failed"),
-                "blocked": self.tr("blocked")}
+                "blocked": self.tr("blocked"), "unknown": self.tr("unknown")}
 
 
 class AuditViewer(QDialog):
@@ -104,7 +104,8 @@ class AuditViewer(QDialog):
         self.result_box = QComboBox(self)
         self.result_box.addItem(self.tr("Any result"), None)
         for value, text in ((Result.OK, self.tr("ok")), (Result.FAILED, self.tr("failed")),
-                            (Result.BLOCKED, self.tr("blocked")), (Result.REFUSED, self.tr("refused"))):
+                            (Result.BLOCKED, self.tr("blocked")), (Result.REFUSED, self.tr("refused")),
+                            (Result.UNKNOWN, self.tr("unknown"))):
             self.result_box.addItem(text, value)
         self.refresh_button = QPushButton(self.tr("Show"), self)
         self.refresh_button.clicked.connect(self.refresh)
@@ -151,7 +152,9 @@ class AuditViewer(QDialog):
         text = self.tr("{n} records")
         if stats.skipped:
             text = self.tr("{n} records ({skipped} damaged lines skipped)")
-        self.status.setText(text.format(n=n, skipped=stats.skipped))
+        if stats.unknown:  # sent when TeachPad stopped: what the controller did is not recorded
+            text += " " + self.tr("{unknown} writes without a recorded answer (TeachPad stopped)")
+        self.status.setText(text.format(n=n, skipped=stats.skipped, unknown=stats.unknown))
         self.table.scrollToBottom()
 
     def _ask_path(self, suggested: str) -> str | None:
