@@ -218,6 +218,11 @@
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="77" />
+            <source>unknown</source>
+            <translation>未知</translation>
+        </message>
     </context>
     <context>
         <name>AuditViewer</name>
@@ -282,52 +287,62 @@
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="109" />
+            <location filename="../../ui/panels/audit_viewer.py" line="108" />
+            <source>unknown</source>
+            <translation>未知</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="110" />
             <source>Show</source>
             <translation>显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="111" />
+            <location filename="../../ui/panels/audit_viewer.py" line="112" />
             <source>Export CSV…</source>
             <translation>导出 CSV…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="121" />
+            <location filename="../../ui/panels/audit_viewer.py" line="122" />
             <source>From</source>
             <translation>从</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="121" />
+            <location filename="../../ui/panels/audit_viewer.py" line="122" />
             <source>to</source>
             <translation>到</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="151" />
+            <location filename="../../ui/panels/audit_viewer.py" line="152" />
             <source>{n} records</source>
             <translation>{n} 条记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="153" />
+            <location filename="../../ui/panels/audit_viewer.py" line="154" />
             <source>{n} records ({skipped} damaged lines skipped)</source>
             <translation>{n} 条记录（跳过 {skipped} 行损坏的记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="158" />
+            <location filename="../../ui/panels/audit_viewer.py" line="156" />
+            <source>{unknown} writes without a recorded answer (TeachPad stopped)</source>
+            <translation>{unknown} 条写入没有记录应答（TeachPad 已停止）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="161" />
             <source>Export the audit trail</source>
             <translation>导出审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="159" />
+            <location filename="../../ui/panels/audit_viewer.py" line="162" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="170" />
+            <location filename="../../ui/panels/audit_viewer.py" line="173" />
             <source>Cannot write {file}: {why}</source>
             <translation>无法写入 {file}：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="173" />
+            <location filename="../../ui/panels/audit_viewer.py" line="176" />
             <source>{n} records exported to {file}</source>
             <translation>已将 {n} 条记录导出到 {file}</translation>
         </message>
@@ -335,169 +350,174 @@
     <context>
         <name>ConnectionDialog</name>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="171" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="183" />
             <source>Connect to controller</source>
             <translation>连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="172" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="184" />
             <source>Transport:</source>
             <translation>通信方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="173" />
-            <location filename="../../ui/dialogs/connection_dialog.py" line="210" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="185" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="229" />
             <source>Modbus TCP</source>
             <translation>Modbus TCP</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="174" />
-            <location filename="../../ui/dialogs/connection_dialog.py" line="210" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="186" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="229" />
             <source>Modbus RTU (serial)</source>
             <translation>Modbus RTU（串口）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="175" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="187" />
             <source>Host:</source>
             <translation>主机：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="176" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="188" />
             <source>Port:</source>
             <translation>端口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="177" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="189" />
             <source>Serial port:</source>
             <translation>串口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="178" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="190" />
             <source>Refresh</source>
             <translation>刷新</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="179" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="191" />
             <source>List the serial ports of this computer again</source>
             <translation>重新列出本机的串口</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="181" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="193" />
             <source>Baud rate:</source>
             <translation>波特率：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="182" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="194" />
             <source>Parity:</source>
             <translation>校验位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="183" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
             <source>none</source>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="183" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
             <source>even</source>
             <translation>偶校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="183" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
             <source>odd</source>
             <translation>奇校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="185" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="197" />
             <source>Stop bits:</source>
             <translation>停止位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="186" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="198" />
             <source>Unit id:</source>
             <translation>从站地址：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="187" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="199" />
             <source>Float word order:</source>
             <translation>浮点数字序：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="188" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="200" />
             <source>Low word first (CDAB, default)</source>
             <translation>低字在前（CDAB，默认）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="189" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="201" />
             <source>High word first (ABCD)</source>
             <translation>高字在前（ABCD）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="190" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="202" />
             <source>Timeout:</source>
             <translation>超时：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="191" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="203" />
             <source>Monitor only (never write to the controller)</source>
             <translation>仅监视（从不写入控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="212" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="205" />
+            <source>Unit id and word order come from the register profile (Safety → Register profile…, administrator).</source>
+            <translation>站号和字序取自寄存器配置（安全 → 寄存器配置…，管理员）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="231" />
             <source>Connected to {where}</source>
             <translation>已连接到 {where}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="213" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="232" />
             <source>Connecting to {where}</source>
             <translation>正在连接 {where}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="214" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="233" />
             <source>Connected to {where}, but the controller does not answer</source>
             <translation>已连接到 {where}，但控制器没有应答</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="215" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="234" />
             <source>Connection to {where} lost; retrying</source>
             <translation>与 {where} 的连接已断开，正在重试</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="216" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="235" />
             <source>Not connected (last: {where})</source>
             <translation>未连接（上次：{where}）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="219" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="238" />
             <source>{transport}, unit {unit}</source>
             <translation>{transport}，站号 {unit}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="221" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="240" />
             <source>Polling at {hz:g} Hz</source>
             <translation>轮询频率 {hz:g} Hz</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="223" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="242" />
             <source>Monitor only: nothing is written to the controller</source>
             <translation>仅监视：不向控制器写入任何内容</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="250" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="269" />
             <source>Could not list the serial ports ({error}); type the device name</source>
             <translation>无法列出串口（{error}），请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="253" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="272" />
             <source>Serial ports found: {n}</source>
             <translation>找到的串口：{n} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="255" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="274" />
             <source>No serial port found; type the device name</source>
             <translation>未找到串口，请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="304" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="327" />
             <source>a serial port is needed for RTU</source>
             <translation>RTU 方式需要指定串口</translation>
         </message>
@@ -1745,6 +1765,109 @@
             <location filename="../../ui/widgets_common.py" line="263" />
             <source>done</source>
             <translation>完成</translation>
+        </message>
+    </context>
+    <context>
+        <name>PasswordDialog</name>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="90" />
+            <source>Passwords and lock</source>
+            <translation>密码与锁定</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="91" />
+            <source>Role</source>
+            <translation>角色</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="91" />
+            <source>Password</source>
+            <translation>密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="92" />
+            <source>New password:</source>
+            <translation>新密码：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="93" />
+            <source>Repeat:</source>
+            <translation>再次输入：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="94" />
+            <source>Set / change password</source>
+            <translation>设置/修改密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="95" />
+            <source>Clear password</source>
+            <translation>清除密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="96" />
+            <source>Lock back to operator after:</source>
+            <translation>空闲多久后退回操作员：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="97" />
+            <source> min</source>
+            <translation> 分钟</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="109" />
+            <source>not needed (the pendant starts as operator)</source>
+            <translation>不需要（示教器以操作员身份启动）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="111" />
+            <source>set</source>
+            <translation>已设置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="113" />
+            <source>not set (nobody can log in as this role)</source>
+            <translation>未设置（无人能以此角色登录）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="142" />
+            <source>The administrator password can be changed, not removed</source>
+            <translation>管理员密码只能修改，不能清除</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="156" />
+            <source>The two passwords differ</source>
+            <translation>两次输入的密码不一致</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="164" />
+            <source>Not set: {why}</source>
+            <translation>未设置：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="169" />
+            <source>Password set for the {role} role</source>
+            <translation>已设置{role}角色的密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="182" />
+            <source>Not cleared: {why}</source>
+            <translation>未清除：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="184" />
+            <source>Password cleared for the {role} role</source>
+            <translation>已清除{role}角色的密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="196" />
+            <source>The setting could not be saved: {why}</source>
+            <translation>无法保存设置：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/password_dialog.py" line="198" />
+            <source>The window locks back to operator after {n} min without input</source>
+            <translation>无操作 {n} 分钟后窗口退回操作员</translation>
         </message>
     </context>
     <context>
@@ -3471,6 +3594,181 @@ Remove them all?</source>
         </message>
     </context>
     <context>
+        <name>RegisterProfileDialog</name>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="131" />
+            <source>Register profile</source>
+            <extracomment>apply(profile, reconnect) -&gt; None when saved, else the reason (already in the user's language)</extracomment>
+            <translation>寄存器配置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="132" />
+            <source>Name:</source>
+            <translation>名称：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="132" />
+            <source>Float word order:</source>
+            <translation>浮点数字序：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="132" />
+            <source>Unit id:</source>
+            <translation>从站地址：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="133" />
+            <source>Command completion:</source>
+            <translation>指令完成判定：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="133" />
+            <source>Unconfirmed after:</source>
+            <translation>未确认判定时间：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="133" />
+            <source>Poll timeout:</source>
+            <translation>轮询超时：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="134" />
+            <source>Date/time layout:</source>
+            <translation>日期/时间格式：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="134" />
+            <source>Lowest point id:</source>
+            <translation>最小点号：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="134" />
+            <source>Highest point id:</source>
+            <translation>最大点号：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="137" />
+            <source>Low word first (CDAB, default)</source>
+            <translation>低字在前（CDAB，默认）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="138" />
+            <source>High word first (ABCD)</source>
+            <translation>高字在前（ABCD）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="139" />
+            <source>automatic (probe GV291 once)</source>
+            <translation>自动（试探一次 GV291）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="140" />
+            <source>sentinel (GV291 keeps what the host writes)</source>
+            <translation>哨兵值（GV291 保留上位机写入的值）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="141" />
+            <source>observe (GV291 read-only or ignores writes)</source>
+            <translation>观察（GV291 只读或忽略写入）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="143" />
+            <source>split words (576 = year, 577 = month·256 + day)</source>
+            <translation>分字（576 = 年，577 = 月·256 + 日）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="144" />
+            <source>packed 32-bit (year in the high word)</source>
+            <translation>32 位打包（年在高字）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="145" />
+            <source>automatic</source>
+            <translation>自动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="146" />
+            <source>automatic (by transport)</source>
+            <translation>自动（按通信方式）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="147" />
+            <source>Reconnect now to apply it</source>
+            <translation>立即重新连接以应用</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="148" />
+            <source>Otherwise it applies at the next connection</source>
+            <translation>否则在下次连接时生效</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="149" />
+            <source>Load…</source>
+            <translation>载入…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="150" />
+            <source>Save as…</source>
+            <translation>另存为…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="151" />
+            <source>Defaults</source>
+            <translation>默认值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="153" />
+            <source>Save and apply</source>
+            <translation>保存并应用</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="172" />
+            <source>In force: “{name}”, revision {rev}, saved {saved}</source>
+            <translation>当前生效：“{name}”，第 {rev} 版，保存于 {saved}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="175" />
+            <source>In force: the remembered connection settings (no register profile saved yet)</source>
+            <translation>当前生效：记住的连接设置（尚未保存寄存器配置）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="214" />
+            <source>Not loaded: {why}</source>
+            <translation>未载入：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="217" />
+            <source>Loaded “{name}” from {file}; press Save and apply to use it</source>
+            <translation>已从 {file} 载入“{name}”；按“保存并应用”后生效</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="232" />
+            <source>Cannot write {file}: {why}</source>
+            <translation>无法写入 {file}：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="235" />
+            <source>Saved to {file}</source>
+            <translation>已保存到 {file}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="251" />
+            <source>Load a register profile</source>
+            <translation>载入寄存器配置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="252" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="257" />
+            <source>Register profiles (*.json)</source>
+            <translation>寄存器配置 (*.json)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="256" />
+            <source>Save the register profile as</source>
+            <translation>寄存器配置另存为</translation>
+        </message>
+    </context>
+    <context>
         <name>RoleDialog</name>
         <message>
             <location filename="../../ui/dialogs/role_dialog.py" line="29" />
@@ -3483,68 +3781,48 @@ Remove them all?</source>
             <translation>当前：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="40" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="41" />
             <source>Set this role's password</source>
             <translation>设置此角色的密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="44" />
-            <source> min</source>
-            <translation> 分钟</translation>
-        </message>
-        <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="47" />
-            <source>Back to operator after this idle time</source>
-            <translation>空闲这么久后回到操作员</translation>
-        </message>
-        <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="50" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="43" />
             <source>Log out (operator)</source>
             <translation>注销（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="53" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="46" />
             <source>Role:</source>
             <translation>角色：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="54" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="47" />
             <source>Password:</source>
             <translation>密码：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="55" />
-            <source>Lock back after:</source>
-            <translation>空闲锁定时间：</translation>
-        </message>
-        <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="80" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="72" />
             <source>No administrator password is set yet: choose the administrator role, type a password and press “Set this role's password”.</source>
             <translation>尚未设置管理员密码：请选择管理员角色，输入密码，然后按“设置此角色的密码”。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="83" />
-            <location filename="../../ui/dialogs/role_dialog.py" line="93" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="75" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="85" />
             <source>No password is set for this role; an administrator sets it.</source>
             <translation>此角色尚未设置密码；请由管理员设置。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="91" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="83" />
             <source>Wrong password for the {role} role</source>
             <translation>{role}角色的密码错误</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="105" />
-            <source>The setting could not be saved: {why}</source>
-            <translation>无法保存设置：{why}</translation>
-        </message>
-        <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="119" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="102" />
             <source>The password could not be saved: {why}</source>
             <translation>无法保存密码：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="123" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="105" />
             <source>Password set for the {role} role</source>
             <translation>已设置{role}角色的密码</translation>
         </message>
@@ -3658,82 +3936,112 @@ Remove them all?</source>
     <context>
         <name>SafetyMenu</name>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="85" />
+            <location filename="../../ui/controllers/safety_menu.py" line="103" />
             <source>&amp;Safety</source>
             <translation>安全(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="86" />
+            <location filename="../../ui/controllers/safety_menu.py" line="104" />
             <source>Log &amp;in…</source>
             <translation>登录(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="87" />
+            <location filename="../../ui/controllers/safety_menu.py" line="105" />
             <source>Log &amp;out (operator)</source>
             <translation>注销(&amp;O)（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="88" />
+            <location filename="../../ui/controllers/safety_menu.py" line="106" />
             <source>&amp;Reduced speed</source>
             <translation>降速模式(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="89" />
+            <location filename="../../ui/controllers/safety_menu.py" line="107" />
             <source>Safety &amp;envelope…</source>
             <translation>安全范围(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="90" />
+            <location filename="../../ui/controllers/safety_menu.py" line="108" />
+            <source>Re&amp;gister profile…</source>
+            <translation>寄存器配置(&amp;G)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="109" />
+            <source>Word order, unit id, completion rule, poll timeout (administrator)</source>
+            <translation>字序、站号、完成判定、轮询超时（管理员）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="111" />
+            <source>&amp;Passwords and lock…</source>
+            <translation>密码与锁定(&amp;P)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="112" />
+            <source>Set, change or clear passwords; the idle lock time (administrator)</source>
+            <translation>设置、修改或清除密码；空闲锁定时间（管理员）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="114" />
             <source>&amp;Audit trail…</source>
             <translation>审计记录(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="91" />
+            <location filename="../../ui/controllers/safety_menu.py" line="115" />
             <source>Write a &amp;support bundle…</source>
             <translation>生成支持包(&amp;S)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="104" />
+            <location filename="../../ui/controllers/safety_menu.py" line="128" />
             <source>Role: {role} · reduced speed</source>
             <translation>角色：{role} · 降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="104" />
+            <location filename="../../ui/controllers/safety_menu.py" line="128" />
             <source>Role: {role}</source>
             <translation>角色：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="112" />
+            <location filename="../../ui/controllers/safety_menu.py" line="136" />
             <source>Cap jog and move speeds (anyone may switch it on)</source>
             <translation>限制点动与移动速度（任何人都可开启）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="116" />
+            <location filename="../../ui/controllers/safety_menu.py" line="140" />
             <source>safety</source>
             <translation>安全</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="139" />
+            <location filename="../../ui/controllers/safety_menu.py" line="189" />
+            <source>The register profile could not be saved: {why}</source>
+            <translation>寄存器配置无法保存：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="194" />
+            <source>Register profile “{name}” saved (revision {rev})</source>
+            <translation>寄存器配置“{name}”已保存（第 {rev} 版）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/safety_menu.py" line="204" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="146" />
+            <location filename="../../ui/controllers/safety_menu.py" line="211" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="167" />
+            <location filename="../../ui/controllers/safety_menu.py" line="232" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="168" />
+            <location filename="../../ui/controllers/safety_menu.py" line="233" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="172" />
+            <location filename="../../ui/controllers/safety_menu.py" line="237" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
