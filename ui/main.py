@@ -199,7 +199,7 @@ def build_parser() -> argparse.ArgumentParser:
     target.add_argument("--sim", action="store_true", help="start the built-in simulator and connect to it")
     target.add_argument("--host", help="controller address (Modbus TCP)")
     parser.add_argument("--port", type=int, default=502, help="Modbus TCP port (default 502)")
-    parser.add_argument("--unit", type=int, default=1, help="Modbus unit id (default 1)")
+    parser.add_argument("--unit", type=int, help="Modbus unit id (default: the register profile's, 1)")
     parser.add_argument("--monitor-only", action="store_true", help="never write to the controller")
     parser.add_argument("--lang", choices=sorted(LANGUAGE_NAMES), help="user interface language")
     parser.add_argument("--poll-hz", type=float, help="pose/status poll rate (default 50)")
@@ -276,8 +276,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     connection: ConnectionSettings | None = None
     if args.host and not args.sim:
-        connection = dataclasses.replace(settings.connection(), host=args.host, port=args.port,
-                                         unit=args.unit, serial_port=None, framer="socket",
+        remembered = settings.connection()  # with the register profile in force
+        connection = dataclasses.replace(remembered, host=args.host, port=args.port,
+                                         unit=remembered.unit if args.unit is None else args.unit,
+                                         serial_port=None, framer="socket",
                                          monitor_only=args.monitor_only)
         settings.save_connection(connection)
 

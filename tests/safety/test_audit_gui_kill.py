@@ -1,8 +1,8 @@
 """The GUI's writes are in the audit file exactly once, also after a ``kill -9`` of the GUI.
 
 The real pendant (``ui.main.main``: window, safety, link, worker thread) runs in a child process,
-offscreen, connected to the simulator of this test; a hook sends a batch of temp point uploads
-through the window's link (several writes per point). Once the simulator has received a few
+offscreen, connected to the simulator of this test (unit 7, from the register profile); a hook
+sends a batch of temp point uploads through the window's link (several writes per point). Once the simulator has received a few
 hundred writes the child is killed with SIGKILL. Then, at the simulator's write log against the
 audit file: every write the controller received is in the audit, once, in the order received
 (write-ahead: the line goes to the file before the request goes out); only the very last audited
@@ -22,6 +22,7 @@ from typing import Any
 import pytest
 
 from app.safety.audit import ReadStats, Result, audit_files, read_records
+from app.safety.register_profile import PROFILE_NAME, RegisterProfile, save_register_profile
 from ui.panels.audit_viewer import AuditViewer
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -70,7 +71,11 @@ def _write_key(fc: int, address: int, values: Any) -> tuple[int, int, tuple[int,
 
 
 @pytest.mark.timeout(60)
-def test_gui_writes_are_audited_once_also_after_kill_9(tmp_path: Path, sim: Any, qtbot: Any) -> None:
+def test_gui_writes_are_audited_once_also_after_kill_9(tmp_path: Path, sim_factory: Any, qtbot: Any) -> None:
+    # The controller answers unit 7 only: the GUI gets there because the register profile in force
+    # (beside its settings file) says so -- applied at start-up, not overridden by --unit's default.
+    sim = sim_factory(unit=7)
+    save_register_profile(tmp_path / "safety" / PROFILE_NAME, RegisterProfile("unit 7", unit=7))
     env = {**os.environ, "PYTHONPATH": str(ROOT), "QT_QPA_PLATFORM": "offscreen",
            "XDG_CONFIG_HOME": str(tmp_path / "config"), "XDG_DATA_HOME": str(tmp_path / "data")}
     argv = [sys.executable, "-c", CHILD, str(POINTS), "--host", "127.0.0.1", "--port", str(sim.port),
