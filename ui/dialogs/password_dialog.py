@@ -45,7 +45,10 @@ class PasswordDialog(QDialog):
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.SingleSelection)
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.verticalHeader().hide()
-        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Stretch)
+        header = self.table.horizontalHeader()
+        header.setSectionResizeMode(0, QHeaderView.ResizeMode.ResizeToContents)
+        header.setSectionResizeMode(1, QHeaderView.ResizeMode.Stretch)
+        self.table.setWordWrap(False)
         self.table.itemSelectionChanged.connect(self._update_buttons)
         self.password = QLineEdit(self)
         self.repeat = QLineEdit(self)
@@ -84,6 +87,17 @@ class PasswordDialog(QDialog):
         layout.addWidget(self.buttons)
         self.retranslate()
         self.table.selectRow(int(Role.ENGINEER))
+        self._fit_table()
+
+    def _fit_table(self) -> None:
+        """Three rows, shown whole: the table as tall as its rows, the dialog as wide as its text."""
+        table = self.table
+        table.resizeColumnsToContents()
+        rows = sum(table.rowHeight(r) for r in range(table.rowCount()))
+        table.setFixedHeight(rows + table.horizontalHeader().sizeHint().height() + 2 * table.frameWidth() + 6)
+        texts = [item.text() for r in range(table.rowCount()) if (item := table.item(r, 1)) is not None]
+        widest = max((table.fontMetrics().horizontalAdvance(t) for t in texts), default=0)
+        table.setMinimumWidth(table.columnWidth(0) + widest + 24 + 2 * table.frameWidth())
 
     # --- view ---------------------------------------------------------------------------------
     def retranslate(self) -> None:
