@@ -3,7 +3,8 @@
 Contents (each only when given): ``versions.json`` (Python, the platform, TeachPad, pymodbus,
 PySide6 and pyqtgraph when installed, numpy), ``settings.json`` (passwords, hashes, salts,
 secrets and tokens removed: see :func:`redact`), ``project/<file>``, ``safety-profile.json``,
-``audit/`` (the audit files of the last ``days`` days), ``events.txt`` (the event log's lines),
+``register-profile.json`` (word order, unit id, completion rule... in force), ``audit/`` (the
+audit files of the last ``days`` days), ``events.txt`` (the event log's lines),
 ``logs/`` (files of a log directory changed in the last ``days`` days), ``traffic.txt`` (recent
 Modbus traffic), and ``manifest.json`` listing what is inside and what was left out, and why.
 
@@ -99,8 +100,9 @@ class _Writer:
 
 
 def build_support_bundle(*, settings: Mapping[str, Any] | None = None, project: Path | None = None,
-                         profile: Path | None = None, audit_dir: Path | None = None,
-                         events: Iterable[str] | None = None, log_dir: Path | None = None,
+                         profile: Path | None = None, register_profile: Path | None = None,
+                         audit_dir: Path | None = None, events: Iterable[str] | None = None,
+                         log_dir: Path | None = None,
                          traffic: Iterable[str] | None = None, days: int = DEFAULT_DAYS,
                          now: dt.datetime | None = None) -> tuple[bytes, BundleManifest]:
     """The zip's bytes and its manifest."""
@@ -119,6 +121,8 @@ def build_support_bundle(*, settings: Mapping[str, Any] | None = None, project: 
             w.file(f"project/{project.name}", project)
         if profile is not None:
             w.file("safety-profile.json", profile)
+        if register_profile is not None:
+            w.file("register-profile.json", register_profile)
         first_day = now.date() - dt.timedelta(days=days - 1)
         if audit_dir is not None:
             found = audit_files(audit_dir, first_day, now.date())

@@ -1,13 +1,14 @@
 """The GUI's writes are in the audit file exactly once, also after a ``kill -9`` of the GUI.
 
 The real pendant (``ui.main.main``: window, safety, link, worker thread) runs in a child process,
-offscreen, connected to the simulator of this test (unit 7, from the register profile); a hook
-sends a batch of temp point uploads through the window's link (several writes per point). Once the simulator has received a few
-hundred writes the child is killed with SIGKILL. Then, at the simulator's write log against the
-audit file: every write the controller received is in the audit, once, in the order received
-(write-ahead: the line goes to the file before the request goes out); only the very last audited
-write may be missing at the simulator or unanswered, and reads as ``unknown``. A torn last line
-(what a power cut can leave) is skipped by the reader, and the viewer says so.
+offscreen, connected to the simulator of this test (unit 7, from the register profile); a hook sends
+a batch of temp point uploads through the window's link (several writes per point). Once the
+simulator has received a few hundred writes the child is killed with SIGKILL. Then, at the
+simulator's write log against the audit file: every write the controller received is in the audit,
+once, in the order received (write-ahead: the line goes to the file before the request goes out);
+only the very last audited write may be missing at the simulator or unanswered, and reads as
+``unknown``. A torn last line (what a power cut can leave) is skipped by the reader, and the viewer
+says so.
 """
 
 from __future__ import annotations

@@ -5,6 +5,7 @@ change is audited, and it really changes how the controller's floats are read.""
 from __future__ import annotations
 
 import json
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -210,3 +211,14 @@ def test_load_and_save_as_in_the_dialog(menu: SafetyMenu, qtbot: Any, tmp_path: 
     dialog.open_path = lambda: str(tmp_path / "junk.json")
     dialog.load()
     assert "not a TeachPad register profile" in dialog.error.text()
+
+
+def test_the_support_bundle_carries_the_register_profile(menu: SafetyMenu, tmp_path: Path) -> None:
+    menu.safety.login(Role.ADMINISTRATOR, PASSWORD)
+    assert menu.apply_register_profile(HIGH) is None
+    out = tmp_path / "bundle.zip"
+    menu.save_path = lambda _t, _s: str(out)
+    assert menu.write_bundle() == out
+    with zipfile.ZipFile(out) as zf:
+        doc = json.loads(zf.read("register-profile.json"))
+    assert doc["name"] == HIGH.name and doc["word_order"] == "high-first" and doc["revision"] == 1

@@ -216,6 +216,9 @@ class SafetyMenu(QObject):
         settings = {key: store.value(key) for key in store.allKeys()}
         project = window.project.path if getattr(window, "project", None) is not None else None
         profile = self.safety.profile_path if self.safety.profile_path.exists() else None
+        register_profile: Path | None = window.settings.register_profile_path()
+        if register_profile is not None and not register_profile.exists():
+            register_profile = None
         try:
             with tempfile.TemporaryDirectory() as tmp:
                 events = traffic = None
@@ -225,9 +228,10 @@ class SafetyMenu(QObject):
                 if hasattr(window, "traffic_panel"):
                     window.traffic_panel.export_to(Path(tmp) / "traffic.txt", visible_only=False)
                     traffic = (Path(tmp) / "traffic.txt").read_text(encoding="utf-8").splitlines()
-                manifest = write_support_bundle(path, settings=settings, project=project, profile=profile,
-                                                audit_dir=self.safety.audit_dir, events=events,
-                                                traffic=traffic)
+                manifest = write_support_bundle(
+                    path, settings=settings, project=project, profile=profile,
+                    register_profile=register_profile, audit_dir=self.safety.audit_dir, events=events,
+                    traffic=traffic)
         except (OSError, TeachPadError) as exc:
             why = self.tr("The support bundle could not be written: {why}").format(why=str(exc)[:200])
             QMessageBox.warning(window, self.tr("Support bundle"), why)
