@@ -81,12 +81,15 @@ def test_opens_on_the_link_connection_and_says_it_is_connected(qtbot: Any, link:
     sim = sim_factory(unit=7, word_order=WordOrder.HIGH_FIRST)
     used = connect(qtbot, link, sim, unit=7, word_order=WordOrder.HIGH_FIRST, monitor_only=True,
                    timeout=0.4)
-    saved = ConnectionSettings(host="10.0.0.9", port=1502)  # remembered, older: not shown
+    # remembered, older: where is not shown; unit and word order are the register profile's (which
+    # the remembered settings carry), shown read-only
+    saved = ConnectionSettings(host="10.0.0.9", port=1502, unit=7, word_order=WordOrder.HIGH_FIRST)
     dialog = ConnectionDialog.for_link(link, saved, poll_hz=40.0)
     qtbot.addWidget(dialog)
     assert dialog.host_edit.text() == "127.0.0.1" and dialog.port_spin.value() == sim.port
     assert dialog.unit_spin.value() == 7 and dialog.monitor_check.isChecked()
     assert dialog.order_combo.currentData() == WordOrder.HIGH_FIRST.value
+    assert not dialog.unit_spin.isEnabled() and not dialog.order_combo.isEnabled()
     assert dialog.transport_combo.currentData() == "tcp"
     text = dialog.current_label.text()
     assert f"Connected to 127.0.0.1:{sim.port}" in text and "unit 7" in text
