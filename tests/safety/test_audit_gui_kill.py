@@ -29,7 +29,7 @@ from ui.panels.audit_viewer import AuditViewer
 ROOT = Path(__file__).resolve().parents[2]
 POINTS = 5000  # more than get sent before the kill
 KILL_AFTER_WRITES = 300
-START_TIMEOUT = 15.0  # s for the child to start, connect and send KILL_AFTER_WRITES writes
+START_TIMEOUT = 18.0  # s for the child to start, connect and send KILL_AFTER_WRITES writes
 
 CHILD = r"""
 import sys
