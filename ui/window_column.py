@@ -20,13 +20,10 @@ from ui.panels.step_panel import StepPanel
 
 __all__ = ["ControlColumn"]
 
-TR_CONTEXT = "MainWindow"  # the column was part of the window: its texts keep their translations
+# The column was part of the window: its texts keep the "MainWindow" translation context.
 BANNER_STYLE = ("QLabel { background: #fff1d6; color: #7a4a00; border: 1px solid #ef8f00;"
                 " border-radius: 4px; padding: 4px; font-weight: bold; }")
 
-
-def _tr(text: str) -> str:
-    return QCoreApplication.translate(TR_CONTEXT, text)
 
 
 class ControlColumn(QWidget):
@@ -66,9 +63,9 @@ class ControlColumn(QWidget):
         self._show_banner()
 
     def retranslate(self) -> None:
-        self.tabs.setTabText(0, _tr("Jog"))
-        self.tabs.setTabText(1, _tr("Step"))
-        self.tabs.setTabText(2, _tr("Program"))
+        self.tabs.setTabText(0, QCoreApplication.translate("MainWindow", "Jog"))
+        self.tabs.setTabText(1, QCoreApplication.translate("MainWindow", "Step"))
+        self.tabs.setTabText(2, QCoreApplication.translate("MainWindow", "Program"))
         self._show_banner()
 
     @Slot(ConnectionState)
@@ -80,7 +77,9 @@ class ControlColumn(QWidget):
         connection = state.connection if state is not None else None
         writable = state is not None and state.writable
         if connection is not None and connection.connected and connection.monitor_only:
-            self.motion_banner.setText(_tr("Monitor only: motion controls are disabled"))
+            self.motion_banner.setText(QCoreApplication.translate(
+                "MainWindow", "Monitor only: motion controls are disabled"))
         elif connection is None or not connection.connected:
-            self.motion_banner.setText(_tr("Not connected: motion controls are disabled"))
+            self.motion_banner.setText(QCoreApplication.translate(
+                "MainWindow", "Not connected: motion controls are disabled"))
         self.motion_banner.setVisible(not writable)

@@ -21,14 +21,11 @@ from ui.touch import show_rows
 
 __all__ = ["WindowDocks"]
 
-TR_CONTEXT = "MainWindow"  # the docks were the window's: their titles keep their translations
+# The docks were the window's: their titles keep the "MainWindow" translation context.
 STATUS_DOCK_WIDTH = 265
 STATUS_DOCK_MAX_WIDTH = 320  # the status column never needs more; the work tabs get the rest
 DOCK_MIN_ROWS = 5  # the bottom docks (event log, traffic) show at least this many rows
 
-
-def _tr(text: str) -> str:
-    return QCoreApplication.translate(TR_CONTEXT, text)
 
 
 class WindowDocks(QObject):
@@ -85,10 +82,10 @@ class WindowDocks(QObject):
         return dock
 
     def retranslate(self) -> None:
-        self.status_dock.setWindowTitle(_tr("Status"))
-        self.event_dock.setWindowTitle(_tr("Event log"))
-        self.traffic_dock.setWindowTitle(_tr("Modbus traffic"))
-        self.alarm_dock.setWindowTitle(_tr("Alarms"))
+        self.status_dock.setWindowTitle(QCoreApplication.translate("MainWindow", "Status"))
+        self.event_dock.setWindowTitle(QCoreApplication.translate("MainWindow", "Event log"))
+        self.traffic_dock.setWindowTitle(QCoreApplication.translate("MainWindow", "Modbus traffic"))
+        self.alarm_dock.setWindowTitle(QCoreApplication.translate("MainWindow", "Alarms"))
 
     @Slot()
     def size_first_time(self) -> None:

@@ -17,12 +17,9 @@ from ui.widgets_common import connection_display
 
 __all__ = ["MESSAGE_MS", "WindowStatusBar"]
 
-TR_CONTEXT = "MainWindow"  # these labels were the window's: their texts keep their translations
+# These labels were the window's: their texts keep the "MainWindow" translation context.
 MESSAGE_MS = 8000  # how long a transient status-bar message stays
 
-
-def _tr(text: str) -> str:
-    return QCoreApplication.translate(TR_CONTEXT, text)
 
 
 class WindowStatusBar(QObject):
@@ -52,7 +49,7 @@ class WindowStatusBar(QObject):
 
     def retranslate(self) -> None:
         # room for the widest RTT from the start: the status bar does not shift when one arrives
-        widest_rtt = _tr("RTT {ms} ms").format(ms="9999.9")
+        widest_rtt = QCoreApplication.translate("MainWindow", "RTT {ms} ms").format(ms="9999.9")
         self.rtt_label.setMinimumWidth(self.rtt_label.fontMetrics().horizontalAdvance(widest_rtt) + 8)
         if self._state is not None and self._state.rtt is not None:
             self._show_rtt(self._state.rtt)
@@ -64,7 +61,8 @@ class WindowStatusBar(QObject):
 
     def show_project(self, title: str, path: str) -> None:
         self._project_title = title
-        self.project_label.setText(_tr("Project: {name}").format(name=title))
+        self.project_label.setText(
+            QCoreApplication.translate("MainWindow", "Project: {name}").format(name=title))
         self.project_label.setToolTip(path)
 
     @Slot(ConnectionState)
@@ -78,8 +76,9 @@ class WindowStatusBar(QObject):
         text, _level = connection_display(connection)
         self.link_label.setText(text)
         self.link_label.setToolTip(connection.message)
-        self.monitor_only_label.setText(_tr("MONITOR ONLY") if connection.monitor_only else "")
+        monitor_only = QCoreApplication.translate("MainWindow", "MONITOR ONLY")
+        self.monitor_only_label.setText(monitor_only if connection.monitor_only else "")
 
     @Slot(float)
     def _show_rtt(self, ms: float) -> None:
-        self.rtt_label.setText(_tr("RTT {ms} ms").format(ms=f"{ms:.1f}"))
+        self.rtt_label.setText(QCoreApplication.translate("MainWindow", "RTT {ms} ms").format(ms=f"{ms:.1f}"))
