@@ -209,7 +209,6 @@ class PointsPanel(QWidget):
         """Replace the operator's yes/no question (tests answer without a dialog)."""
         self._confirm = confirm
 
-    @Slot(bool)
     def set_edit_permission(self, reason: str | None) -> None:
         """Role gating: add / duplicate / delete / reorder / cell edits only while ``reason`` is
         None; else disabled (not hidden) with ``reason`` as the tooltip."""
