@@ -163,7 +163,7 @@ class MainWindow(QMainWindow):
         self.alarm_banner.sync()  # shown exactly while an alarm is set, whatever was saved
         self.pose_bar.setVisible(True)
         app = QApplication.instance()
-        self._app_state_connected = isinstance(app, QApplication)
+        self._app_state_hooked = isinstance(app, QApplication)
         if isinstance(app, QApplication):
             app.applicationStateChanged.connect(self._on_application_state)
         self.retranslate()
@@ -389,8 +389,8 @@ class MainWindow(QMainWindow):
         self.project.close()
         self.settings.save_window(self.saveGeometry(), self.saveState())
         self.settings.sync()
-        if self._app_state_connected:
-            self._app_state_connected = False
+        if self._app_state_hooked:
+            self._app_state_hooked = False
             app = QApplication.instance()
             if isinstance(app, QApplication):
                 app.applicationStateChanged.disconnect(self._on_application_state)
