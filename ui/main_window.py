@@ -2,12 +2,16 @@
 
 Layout (fits 1280×800 and grows to 1920×1080): on the left the control column (control bar
 with the big STOP, then the Jog / Step / Program tabs); on the right the work tabs
-Monitor | Points | Planner; docks: Status (left, narrow), Event log and Modbus traffic (bottom,
-tabified). STOP stays visible whatever tab is shown.
+Monitor | Points | Planner | 3D; docks: Status (left, narrow), Event log, Modbus traffic and
+Alarms (bottom, tabified). STOP stays visible whatever tab is shown.
 
 The window only composes: the robot's state lives in one :class:`~app.link.state.RobotState`
-(``link.state``) and every panel subscribes to the fields it shows (``panel.bind(state)``);
-controllers turn the panels' intents into link requests. One :class:`ProjectController` owns
+(``link.state``) and every panel and part subscribes to the fields it shows
+(``part.bind(state)``), the window keeps no copy; controllers turn the panels' intents into link
+requests. Its parts: :class:`~ui.window_column.ControlColumn` (the left column),
+:class:`~ui.window_docks.WindowDocks`, :class:`~ui.window_status.WindowStatusBar`,
+:class:`~ui.window_actions.WindowActions` (menus, toolbar); the window keeps their widgets under
+its own names too (``window.control_bar``, ``window.event_log``, ``window.status_link``...). One :class:`ProjectController` owns
 the open project (File and Edit menus); the points panel and the planner share its models, a
 :class:`PointSyncController` and a :class:`PlanRunController`; a :class:`MotionController`
 drives the motion panels and enables them only while the link is up and writable (not
