@@ -11,11 +11,11 @@ The window only composes: the robot's state lives in one :class:`~app.link.state
 requests. Its parts: :class:`~ui.window_column.ControlColumn` (the left column),
 :class:`~ui.window_docks.WindowDocks`, :class:`~ui.window_status.WindowStatusBar`,
 :class:`~ui.window_actions.WindowActions` (menus, toolbar); the window keeps their widgets under
-its own names too (``window.control_bar``, ``window.event_log``, ``window.status_link``...). One :class:`ProjectController` owns
-the open project (File and Edit menus); the points panel and the planner share its models, a
-:class:`PointSyncController` and a :class:`PlanRunController`; a :class:`MotionController`
-drives the motion panels and enables them only while the link is up and writable (not
-monitor-only). Any jog ends when the window loses the focus, is hidden or closed, and when the
+its own names too (``window.control_bar``, ``window.event_log``, ``window.status_link``...).
+One :class:`ProjectController` owns the open project (File and Edit menus); the points panel
+and the planner share its models, a :class:`PointSyncController` and a
+:class:`PlanRunController`; a :class:`MotionController` drives the motion panels and enables
+them only while the link is up and writable (not monitor-only). Any jog ends when the window loses the focus, is hidden or closed, and when the
 link goes down.
 
 Close order: jog release first (before any question), then "save changes?" (Cancel keeps the
