@@ -15,8 +15,8 @@ its own names too (``window.control_bar``, ``window.event_log``, ``window.status
 One :class:`ProjectController` owns the open project (File and Edit menus); the points panel
 and the planner share its models, a :class:`PointSyncController` and a
 :class:`PlanRunController`; a :class:`MotionController` drives the motion panels and enables
-them only while the link is up and writable (not monitor-only). Any jog ends when the window loses the focus, is hidden or closed, and when the
-link goes down.
+them only while the link is up and writable (not monitor-only). Any jog ends when the window
+loses the focus, is hidden or closed, and when the link goes down.
 
 Close order: jog release first (before any question), then "save changes?" (Cancel keeps the
 window and the link), then the window state is saved and the link shut down.
