@@ -2,17 +2,21 @@
 
 Layout (fits 1280×800 and grows to 1920×1080): on the left the control column (control bar
 with the big STOP, then the Jog / Step / Program tabs); on the right the work tabs
-Monitor | Points | Planner; docks: Status (left, narrow), Event log and Modbus traffic (bottom,
-tabified). STOP stays visible whatever tab is shown.
+Monitor | Points | Planner | 3D; docks: Status (left, narrow), Event log, Modbus traffic and
+Alarms (bottom, tabified). STOP stays visible whatever tab is shown.
 
 The window only composes: the robot's state lives in one :class:`~app.link.state.RobotState`
-(``link.state``) and every panel subscribes to the fields it shows (``panel.bind(state)``);
-controllers turn the panels' intents into link requests. One :class:`ProjectController` owns
-the open project (File and Edit menus); the points panel and the planner share its models, a
-:class:`PointSyncController` and a :class:`PlanRunController`; a :class:`MotionController`
-drives the motion panels and enables them only while the link is up and writable (not
-monitor-only). Any jog ends when the window loses the focus, is hidden or closed, and when the
-link goes down.
+(``link.state``) and every panel and part subscribes to the fields it shows
+(``part.bind(state)``), the window keeps no copy; controllers turn the panels' intents into link
+requests. Its parts: :class:`~ui.window_column.ControlColumn` (the left column),
+:class:`~ui.window_docks.WindowDocks`, :class:`~ui.window_status.WindowStatusBar`,
+:class:`~ui.window_actions.WindowActions` (menus, toolbar); the window keeps their widgets under
+its own names too (``window.control_bar``, ``window.event_log``, ``window.status_link``...).
+One :class:`ProjectController` owns the open project (File and Edit menus); the points panel
+and the planner share its models, a :class:`PointSyncController` and a
+:class:`PlanRunController`; a :class:`MotionController` drives the motion panels and enables
+them only while the link is up and writable (not monitor-only). Any jog ends when the window
+loses the focus, is hidden or closed, and when the link goes down.
 
 Close order: jog release first (before any question), then "save changes?" (Cancel keeps the
 window and the link), then the window state is saved and the link shut down.
@@ -33,8 +37,6 @@ from PySide6.QtGui import (
 )
 from PySide6.QtWidgets import (
     QApplication,
-    QDockWidget,
-    QLabel,
     QMainWindow,
     QMessageBox,
     QSizePolicy,
@@ -48,7 +50,7 @@ from PySide6.QtWidgets import (
 from app import __version__
 from app.link.client import ConnectionSettings
 from app.link.robot_link import RobotLink
-from app.link.types import ConnectionState, LinkState, WorkerError
+from app.link.types import WorkerError
 from app.safety.roles import Action
 from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
@@ -60,29 +62,20 @@ from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import Translator
 from ui.messages import error_text
 from ui.panels.alarm_banner import AlarmBanner
-from ui.panels.alarm_list import AlarmListPanel
-from ui.panels.control_bar import ControlBar
-from ui.panels.event_log import EventLogPanel
-from ui.panels.jog_panel import JogPanel
 from ui.panels.monitor_panel import MonitorPanel
 from ui.panels.planner_panel import PlannerPanel
 from ui.panels.points_panel import PointsPanel
 from ui.panels.pose_strip import PoseStrip
-from ui.panels.program_panel import ProgramPanel
-from ui.panels.status_panel import StatusPanel
-from ui.panels.step_panel import StepPanel
-from ui.panels.traffic_panel import TrafficPanel
 from ui.panels.view3d_host import install_view3d
 from ui.settings import AppSettings
-from ui.touch import apply_touch_mode, mark_motion, show_rows
-from ui.widgets_common import connection_display
+from ui.touch import apply_touch_mode, mark_motion
 from ui.window_actions import WindowActions
+from ui.window_column import ControlColumn
+from ui.window_docks import WindowDocks
+from ui.window_status import WindowStatusBar
 
 DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size
 MIN_SIZE = (1024, 700)  # the layout stays usable down to this
-STATUS_DOCK_WIDTH = 265
-STATUS_DOCK_MAX_WIDTH = 320  # the status column never needs more; the work tabs get the rest
-DOCK_MIN_ROWS = 5  # the bottom docks (event log, traffic) show at least this many rows
 TAB_MONITOR, TAB_POINTS, TAB_PLANNER = range(3)
 TAB_NAMES = ("monitor", "points", "planner")
 
@@ -99,7 +92,6 @@ class MainWindow(QMainWindow):
         self.settings = settings
         self.translator = translator
         self.shutdown_link_on_close = shutdown_link_on_close
-        self._traffic_capture = False
         self._close_accepted = False
 
         # --- the project and its controllers (no widgets) ---------------------------------
@@ -109,30 +101,10 @@ class MainWindow(QMainWindow):
         self.run_controller = PlanRunController(link, self)
 
         # --- left: control bar + motion tabs ----------------------------------------------
-        self.control_bar = ControlBar(self)
-        self.jog_panel = JogPanel(self)
-        self.step_panel = StepPanel(self)
-        self.program_panel = ProgramPanel(self)
-        self.tabs = QTabWidget(self)
-        self.tabs.setObjectName("MotionTabs")
-        self.tabs.addTab(self.jog_panel, "")
-        self.tabs.addTab(self.step_panel, "")
-        self.tabs.addTab(self.program_panel, "")
-        self.tabs.currentChanged.connect(lambda _i: self.jog_panel.release_all())
-        self.motion_banner = QLabel(self)
-        self.motion_banner.setAlignment(Qt.AlignmentFlag.AlignCenter)
-        self.motion_banner.setWordWrap(True)
-        self.motion_banner.setStyleSheet(
-            "QLabel { background: #fff1d6; color: #7a4a00; border: 1px solid #ef8f00;"
-            " border-radius: 4px; padding: 4px; font-weight: bold; }")
-        self.control_column = QWidget(self)
-        self.control_column.setObjectName("ControlColumn")
-        column = QVBoxLayout(self.control_column)
-        column.setContentsMargins(0, 0, 0, 0)
-        column.addWidget(self.control_bar)
-        column.addWidget(self.motion_banner)
-        column.addWidget(self.tabs, 1)
-        self.control_column.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Expanding)
+        self.control_column = column = ControlColumn(self)
+        self.control_bar, self.motion_banner = column.control_bar, column.motion_banner
+        self.tabs, self.jog_panel = column.tabs, column.jog_panel
+        self.step_panel, self.program_panel = column.step_panel, column.program_panel
 
         # --- right: the work tabs ---------------------------------------------------------
         self.monitor_panel = MonitorPanel(self)
@@ -161,29 +133,11 @@ class MainWindow(QMainWindow):
         self.setCentralWidget(central)
 
         # --- docks: the display panels --------------------------------------------------
-        self.status_panel = StatusPanel(self)
-        self.traffic_panel = TrafficPanel(self)
-        self.event_log = EventLogPanel(self)
-        self.alarm_list = AlarmListPanel(self)
-        area = Qt.DockWidgetArea
-        self.status_dock = self._dock("StatusDock", self.status_panel, area.LeftDockWidgetArea)
-        # QMainWindow hands a narrow window's spare width to the docks as well: a status
-        # column wider than this only steals room from the work tabs
-        self.status_dock.setMaximumWidth(STATUS_DOCK_MAX_WIDTH)
-        self.event_dock = self._dock("EventLogDock", self.event_log, area.BottomDockWidgetArea)
-        self.traffic_dock = self._dock("TrafficDock", self.traffic_panel, area.BottomDockWidgetArea)
-        self.tabifyDockWidget(self.event_dock, self.traffic_dock)
-        self.alarm_dock = self._dock("AlarmDock", self.alarm_list, area.BottomDockWidgetArea)
-        self.tabifyDockWidget(self.event_dock, self.alarm_dock)
-        self.event_dock.raise_()
-        self.setCorner(Qt.Corner.BottomLeftCorner, area.LeftDockWidgetArea)  # status runs full height
-        for panel in (self.event_log, self.traffic_panel):
-            show_rows(panel.view, DOCK_MIN_ROWS)
-        # visibilityChanged(bool) says whether the dock can be seen: False while it is tabbed
-        # behind the event log, when isVisible() still says True
-        self._traffic_dock_shown = False
-        self.traffic_dock.visibilityChanged.connect(self._on_traffic_dock_visibility)
-        self.traffic_panel.captureEnabledChanged.connect(self._update_traffic_capture)
+        self.docks = docks = WindowDocks(self, link)
+        self.status_panel, self.event_log = docks.status_panel, docks.event_log
+        self.traffic_panel, self.alarm_list = docks.traffic_panel, docks.alarm_list
+        self.status_dock, self.event_dock = docks.status_dock, docks.event_dock
+        self.traffic_dock, self.alarm_dock = docks.traffic_dock, docks.alarm_dock
 
         # --- actions, menus, toolbar, status bar ---------------------------------------
         self.menus = WindowActions(
@@ -192,18 +146,12 @@ class MainWindow(QMainWindow):
             tab_count=len(TAB_NAMES), set_language=self.set_language,
             language=translator.language if translator else "en", file_actions=self.project.file_actions(),
             edit_actions=[self.project.action_undo, self.project.action_redo],
-            docks=[self.status_dock, self.event_dock, self.traffic_dock, self.alarm_dock],
-            set_touch_mode=self.set_touch_mode, touch_mode=settings.touch_mode)
+            docks=docks.docks, set_touch_mode=self.set_touch_mode, touch_mode=settings.touch_mode)
         self._compose_strip_and_banner()
-        self.status_project = QLabel(self)
-        self.status_link = QLabel(self)
-        self.status_rtt = QLabel(self)
-        self.status_monitor_only = QLabel(self)
-        self.status_monitor_only.setStyleSheet("color: #c62828; font-weight: bold;")
-        self.statusBar().addPermanentWidget(self.status_monitor_only)
-        self.statusBar().addPermanentWidget(self.status_project)
-        self.statusBar().addPermanentWidget(self.status_rtt)
-        self.statusBar().addPermanentWidget(self.status_link)
+        self.status_bar = WindowStatusBar(self.statusBar())
+        labels = self.status_bar
+        self.status_link, self.status_rtt = labels.link_label, labels.rtt_label
+        self.status_project, self.status_monitor_only = labels.project_label, labels.monitor_only_label
 
         self._wire()
         bar = self.control_bar
@@ -219,7 +167,7 @@ class MainWindow(QMainWindow):
         self.alarm_banner.sync()  # shown exactly while an alarm is set, whatever was saved
         self.pose_bar.setVisible(True)
         app = QApplication.instance()
-        self._app_state_connected = isinstance(app, QApplication)
+        self._app_state_hooked = isinstance(app, QApplication)
         if isinstance(app, QApplication):
             app.applicationStateChanged.connect(self._on_application_state)
         self.retranslate()
@@ -234,13 +182,6 @@ class MainWindow(QMainWindow):
         return max(width, MIN_SIZE[0]), max(height, MIN_SIZE[1])
 
     # --- construction -----------------------------------------------------------------
-    def _dock(self, name: str, widget: QWidget, area: Qt.DockWidgetArea) -> QDockWidget:
-        dock = QDockWidget(self)
-        dock.setObjectName(name)
-        dock.setWidget(widget)
-        self.addDockWidget(area, dock)
-        return dock
-
     def _compose_strip_and_banner(self) -> None:
         """Window-wide rows above everything (the main toolbar sits in the menu bar's corner):
         the alarm banner (only while an alarm is set), then the pose strip (always). Neither can
@@ -259,15 +200,14 @@ class MainWindow(QMainWindow):
         self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.pose_bar)
 
     def _wire(self) -> None:
+        """Every part follows the link's RobotState itself; the window keeps no copy of it."""
         link, state = self.link, self.link.state
         for panel in (self.monitor_panel, self.status_panel, self.event_log, self.control_bar,
-                      self.pose_strip, self.alarm_banner, self.alarm_list):
+                      self.pose_strip, self.alarm_banner, self.alarm_list, self.control_column,
+                      self.menus, self.status_bar):
             panel.bind(state)
-        state.connectionChanged.connect(self._show_connection)
-        state.rttChanged.connect(self._show_rtt)
-        link.errorOccurred.connect(self.event_log.on_error)
+        state.connectionChanged.connect(self._update_title)
         link.errorOccurred.connect(self._on_error)
-        link.trafficObserved.connect(self.traffic_panel.on_traffic)
         link.controllerReconnected.connect(self._on_reconnected)
         link.controllerRestarted.connect(self._on_restarted)
         self.motion = MotionController(link, self.control_bar, self.jog_panel, self.step_panel,
@@ -284,23 +224,12 @@ class MainWindow(QMainWindow):
     # --- texts ------------------------------------------------------------------------
     def retranslate(self) -> None:
         self._update_title()
-        self.tabs.setTabText(0, self.tr("Jog"))
-        self.tabs.setTabText(1, self.tr("Step"))
-        self.tabs.setTabText(2, self.tr("Program"))
         self.work_tabs.setTabText(TAB_MONITOR, self.tr("Monitor"))
         self.work_tabs.setTabText(TAB_POINTS, self.tr("Points"))
         self.work_tabs.setTabText(TAB_PLANNER, self.tr("Planner"))
-        self.status_dock.setWindowTitle(self.tr("Status"))
-        self.event_dock.setWindowTitle(self.tr("Event log"))
-        self.traffic_dock.setWindowTitle(self.tr("Modbus traffic"))
-        self.alarm_dock.setWindowTitle(self.tr("Alarms"))
-        # room for the widest RTT from the start: the status bar does not shift when one arrives
-        widest_rtt = self.tr("RTT {ms} ms").format(ms="9999.9")
-        self.status_rtt.setMinimumWidth(self.status_rtt.fontMetrics().horizontalAdvance(widest_rtt) + 8)
-        self.menus.retranslate()
-        self.project.retranslate()
+        for part in (self.control_column, self.docks, self.status_bar, self.menus, self.project):
+            part.retranslate()
         self._on_project_title(self.project.title)
-        self._show_connection()
 
     def changeEvent(self, event: QEvent) -> None:
         kind = event.type()
@@ -315,6 +244,7 @@ class MainWindow(QMainWindow):
             self.jog_panel.release_all()
         return super().event(event)
 
+    @Slot()
     def _update_title(self) -> None:
         endpoint = self.link.state.connection.endpoint
         parts = [self.tr("TeachPad"), self.project.title]
@@ -322,51 +252,23 @@ class MainWindow(QMainWindow):
             parts.append(endpoint)
         self.setWindowTitle(" — ".join(parts))
 
-    # --- link -> the window's own labels ----------------------------------------------------
-    @Slot()
-    def _show_connection(self) -> None:
-        connection: ConnectionState = self.link.state.connection
-        text, _level = connection_display(connection)
-        self.status_link.setText(text)
-        self.status_link.setToolTip(connection.message)
-        self.status_monitor_only.setText(self.tr("MONITOR ONLY") if connection.monitor_only else "")
-        self.menus.disconnect_action.setEnabled(connection.state is not LinkState.DISCONNECTED)
-        self._update_title()
-        self._update_motion_enabled()
-
+    # --- link -> the window ----------------------------------------------------------------
     @property
     def motion_enabled(self) -> bool:
         return self.motion.motion_enabled
 
-    @Slot()
-    def _update_motion_enabled(self) -> None:
-        connection = self.link.state.connection
-        enabled = self.link.state.writable
-        self.menus.pause_action.setEnabled(enabled)
-        self.menus.resume_action.setEnabled(enabled)
-        if connection.connected and connection.monitor_only:
-            self.motion_banner.setText(self.tr("Monitor only: motion controls are disabled"))
-        elif not connection.connected:
-            self.motion_banner.setText(self.tr("Not connected: motion controls are disabled"))
-        self.motion_banner.setVisible(not enabled)
-
-    @Slot(float)
-    def _show_rtt(self, ms: float) -> None:
-        self.status_rtt.setText(self.tr("RTT {ms} ms").format(ms=f"{ms:.1f}"))
-
     @Slot(WorkerError)
     def _on_error(self, error: WorkerError) -> None:
         operation = self.event_log.operation_text(error.operation)
-        self.statusBar().showMessage(f"{operation}: {error_text(error)}", 8000)
+        self.status_bar.show_message(f"{operation}: {error_text(error)}")
 
     @Slot(str)
     def _show_message(self, text: str) -> None:
-        self.statusBar().showMessage(text, 8000)
+        self.status_bar.show_message(text)
 
     @Slot(str)
     def _on_project_title(self, title: str) -> None:
-        self.status_project.setText(self.tr("Project: {name}").format(name=title))
-        self.status_project.setToolTip(str(self.project.path or ""))
+        self.status_bar.show_project(title, str(self.project.path or ""))
         self._update_title()
 
     @Slot(str)
@@ -384,19 +286,6 @@ class MainWindow(QMainWindow):
     def _on_reconnected(self) -> None:
         text = self.tr("Reconnected to the controller: jog stopped and teach mode switched off")
         self.event_log.add_event("warning", self.tr("link"), text)
-
-    @Slot(bool)
-    def _on_traffic_dock_visibility(self, shown: bool) -> None:
-        self._traffic_dock_shown = shown
-        self._update_traffic_capture()
-
-    @Slot()
-    def _update_traffic_capture(self) -> None:
-        # the worker builds traffic records only while someone can read them
-        want = self._traffic_dock_shown and self.traffic_panel.capture_enabled()
-        if want != self._traffic_capture:
-            self._traffic_capture = want
-            self.link.set_traffic_capture(want)
 
     # --- confirmation (one setter for every panel that asks) --------------------------
     @property
@@ -488,13 +377,7 @@ class MainWindow(QMainWindow):
         super().showEvent(event)
         if not self._docks_sized:  # first start: a narrow status dock, a short log
             self._docks_sized = True
-            QTimer.singleShot(0, self, self._size_docks)  # once the layout has its real size
-
-    @Slot()
-    def _size_docks(self) -> None:
-        self.resizeDocks([self.status_dock], [STATUS_DOCK_WIDTH], Qt.Orientation.Horizontal)
-        self.resizeDocks([self.event_dock], [self.event_dock.minimumSizeHint().height()],
-                         Qt.Orientation.Vertical)
+            QTimer.singleShot(0, self.docks, self.docks.size_first_time)  # once the layout is real
 
     def hideEvent(self, event: QHideEvent) -> None:
         self.jog_panel.release_all()
@@ -510,8 +393,8 @@ class MainWindow(QMainWindow):
         self.project.close()
         self.settings.save_window(self.saveGeometry(), self.saveState())
         self.settings.sync()
-        if self._app_state_connected:
-            self._app_state_connected = False
+        if self._app_state_hooked:
+            self._app_state_hooked = False
             app = QApplication.instance()
             if isinstance(app, QApplication):
                 app.applicationStateChanged.disconnect(self._on_application_state)

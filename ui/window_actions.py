@@ -3,6 +3,11 @@
 :class:`WindowActions` builds them on a :class:`QMainWindow` from the callables it is given
 (the window composes; this only lays out commands). Stop, Pause and Resume work application
 wide (also from floating docks); every other shortcut works in the window.
+
+Once bound to the link's :class:`~app.link.state.RobotState` (:meth:`WindowActions.bind`),
+Disconnect is enabled unless the link is disconnected, Pause and Resume only while it is
+writable (connected, not monitor-only); Stop always. They read the state when it changes and
+keep no copy of it.
 """
 
 from __future__ import annotations
@@ -10,10 +15,12 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Sequence
 
-from PySide6.QtCore import QObject, QSize, Qt
+from PySide6.QtCore import QObject, QSize, Qt, Slot
 from PySide6.QtGui import QAction, QActionGroup, QKeySequence
 from PySide6.QtWidgets import QDockWidget, QMainWindow, QToolBar
 
+from app.link.state import RobotState
+from app.link.types import ConnectionState, LinkState
 from ui.i18n import LANGUAGE_NAMES
 
 __all__ = ["WindowActions"]
@@ -33,6 +40,7 @@ class WindowActions(QObject):
                  touch_mode: bool = False) -> None:
         super().__init__(window)
         self._window = window
+        self._state: RobotState | None = None
         app_wide = Qt.ShortcutContext.ApplicationShortcut
         self.connect_action = self._action(connect, "Ctrl+K")
         self.disconnect_action = self._action(disconnect, "Ctrl+Shift+K")
@@ -74,9 +82,21 @@ class WindowActions(QObject):
         self._window.addAction(action)
         return action
 
+    def bind(self, state: RobotState) -> None:
+        """Enable Disconnect, Pause and Resume from ``state`` (see the module docstring)."""
+        self._state = state
+        state.connectionChanged.connect(self._on_connection)
+        self._on_connection(state.connection)
+
+    @Slot(ConnectionState)
+    def _on_connection(self, connection: ConnectionState) -> None:
+        writable = self._state is not None and self._state.writable
+        self.disconnect_action.setEnabled(connection.state is not LinkState.DISCONNECTED)
+        self.pause_action.setEnabled(writable)
+        self.resume_action.setEnabled(writable)
+
     def _make_menus(self, file_actions: Sequence[QAction | None], edit_actions: Sequence[QAction],
-                    docks: Sequence[QDockWidget], set_touch_mode: Callable[[bool], object] | None = None,
-                 touch_mode: bool = False) -> None:
+                    docks: Sequence[QDockWidget]) -> None:
         window = self._window
         bar = window.menuBar()
         self.file_menu = bar.addMenu("")

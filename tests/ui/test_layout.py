@@ -36,14 +36,13 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.keypad import KeypadDialog
 from ui.main_window import (
-    DOCK_MIN_ROWS,
-    STATUS_DOCK_WIDTH,
     TAB_MONITOR,
     TAB_PLANNER,
     TAB_POINTS,
     MainWindow,
 )
 from ui.touch import SCROLL_MIN_ROWS_HEIGHT, motion_height
+from ui.window_docks import DOCK_MIN_ROWS, STATUS_DOCK_WIDTH
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 

@@ -192,4 +192,4 @@ def test_traffic_inspector_shows_decoded_frames_from_the_simulator(
     assert any(t.endswith("01 06 01 BC 00 00") for t in texts(COL_BYTES))
     # hidden behind the event log, nothing is captured any more
     window.event_dock.raise_()
-    qtbot.waitUntil(lambda: not window._traffic_capture, timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(lambda: not window.docks.traffic_capture, timeout=SIGNAL_TIMEOUT_MS)

@@ -7,8 +7,10 @@
 * **Idle lock**: an application event filter calls ``touch()`` on every key or mouse press; a
   :data:`IDLE_POLL_MS` timer calls ``poll_idle()``, which locks back to operator.
 * **Envelope**: loaded from the profile file, edited in :class:`~ui.dialogs.envelope_dialog.
-  EnvelopeDialog`; pushed to the planner (checks, preview), the 3D view and the worker's jog
-  guard (with reduced-speed mode) whenever it or the mode changes.
+  EnvelopeDialog`; pushed whenever it or the mode changes to the views that draw it
+  (:class:`EnvelopeView`: the 3D view's canvas; the planner hands it to its 2D preview), to the
+  checks that use it with the speed caps (:class:`EnvelopeChecker`: the planner) and to the
+  worker's jog guard (with reduced-speed mode). The seams are Protocols checked by mypy.
 * **Audit**: the link's :class:`~app.safety.audit.AuditLog` follows the role in force.
 
 Files: next to an INI settings file (tests, portable installs) or in the user's directories.
@@ -17,7 +19,7 @@ Files: next to an INI settings file (tests, portable installs) or in the user's 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Protocol
 
 from PySide6.QtCore import QEvent, QObject, QSettings, QTimer, Signal, Slot
 from PySide6.QtGui import QAction
@@ -26,10 +28,14 @@ from PySide6.QtWidgets import QAbstractItemView, QApplication, QWidget
 from app import timing
 from app.errors import TeachPadError
 from app.link.robot_link import RobotLink
+from app.link.types import ConnectionState, JogRequest
+from app.models import Pose
+from app.plan.geometry import PointLike
 from app.plan.segments import Segment
 from app.points.ledger import PointLedger
 from app.safety.audit import AuditLog, default_audit_dir
 from app.safety.envelope import Envelope, EnvelopeRefused, EnvelopeViolation, ViolationCode
+from app.safety.jog_guard import JogMotion
 from app.safety.profile import SafetyProfile, load_profile, save_profile
 from app.safety.roles import REQUIRED_ROLE, Action, Role, RoleStore, default_config_dir, default_store_path
 from app.safety.session import PermissionRefused, SafetySession
@@ -38,6 +44,25 @@ IDLE_POLL_MS = 1000
 PROFILE_NAME = "envelope.safety.json"
 _TOUCH_EVENTS = (QEvent.Type.MouseButtonPress, QEvent.Type.KeyPress, QEvent.Type.TouchBegin,
                  QEvent.Type.Wheel)
+
+
+class EnvelopeView(Protocol):
+    """Draws the envelope (the 3D view's canvas, the planner's 2D preview)."""
+
+    def set_envelope(self, envelope: Envelope | None) -> None: ...
+
+
+class EnvelopeChecker(Protocol):
+    """Checks with the envelope and the speed caps of the mode in force (the planner)."""
+
+    def set_envelope(self, envelope: Envelope | None, reduced_speed: bool) -> None: ...
+
+
+class EditGated(Protocol):
+    """A panel with its own enable logic: edits only while ``reason`` is None (the points
+    table, the planner); else disabled, not hidden, with ``reason`` as the tooltip."""
+
+    def set_edit_permission(self, reason: str | None) -> None: ...
 
 
 def safety_paths(store: QSettings) -> tuple[Path, Path, Path]:
@@ -89,8 +114,9 @@ class SafetyController(QObject):
                 self._problem = str(exc)
         self.session = SafetySession(roles, audit, self.profile.envelope, on_role_changed=self._role_changed)
         self._gated: list[tuple[QAction | QWidget, Action]] = []
-        self._panels: list[Any] = []  # objects with set_edit_permission(reason)
-        self._views: list[Any] = []  # objects with set_envelope(envelope[, reduced])
+        self._panels: list[tuple[EditGated, Action]] = []
+        self._views: list[EnvelopeView] = []
+        self._checkers: list[EnvelopeChecker] = []
         self.poll_period = 1.0 / timing.POLL_HZ_DEFAULT
         if link is not None:
             link.set_audit(audit)
@@ -141,7 +167,7 @@ class SafetyController(QObject):
         self._gated.append((target, action))
         self._apply(target, action)
 
-    def gate_panel(self, panel: Any, action: Action) -> None:
+    def gate_panel(self, panel: EditGated, action: Action) -> None:
         """A panel with its own enable logic: ``panel.set_edit_permission(reason)``."""
         self._panels.append((panel, action))
         panel.set_edit_permission(self.reason(action))
@@ -195,17 +221,16 @@ class SafetyController(QObject):
     def envelope(self) -> Envelope:
         return self.session.envelope
 
-    def attach_view(self, view: Any) -> None:
-        """An object drawing or checking with the envelope: ``set_envelope(envelope)`` (the
-        planner: ``set_envelope(envelope, reduced)``)."""
+    def attach_view(self, view: EnvelopeView) -> None:
+        """A view that draws the envelope: given it now and whenever it changes."""
         self._views.append(view)
-        self._push_view(view)
+        view.set_envelope(self.envelope)
 
-    def _push_view(self, view: Any) -> None:
-        try:
-            view.set_envelope(self.envelope, self.session.reduced)
-        except TypeError:
-            view.set_envelope(self.envelope)
+    def attach_checker(self, checker: EnvelopeChecker) -> None:
+        """Checks that use the envelope and the speed caps: given both now and on every change
+        of either (the envelope, reduced-speed mode)."""
+        self._checkers.append(checker)
+        checker.set_envelope(self.envelope, self.session.reduced)
 
     def save_envelope(self, envelope: Envelope) -> SafetyProfile:
         """Set (role checked, audited) and save the profile atomically with its next revision."""
@@ -228,7 +253,9 @@ class SafetyController(QObject):
 
     def _envelope_changed(self) -> None:
         for view in self._views:
-            self._push_view(view)
+            view.set_envelope(self.envelope)
+        for checker in self._checkers:
+            checker.set_envelope(self.envelope, self.session.reduced)
         self._push_guard()
         self.envelopeChanged.emit(self.envelope)
 
@@ -253,7 +280,7 @@ class SafetyController(QObject):
             return self.reason(exc.action) or str(exc)
         return str(exc)
 
-    def check_step(self, pose: Any, offsets: list[float], *, joint: bool,
+    def check_step(self, pose: Pose, offsets: list[float], *, joint: bool,
                    speed: float | None = None) -> str | None:
         """None when the step may go; else the translated reason (the refusal is audited)."""
         try:
@@ -262,25 +289,27 @@ class SafetyController(QObject):
             return self.refusal(exc)
         return None
 
-    def check_jog(self, pose: Any, request: Any) -> str | None:
-        """Before a jog press (``request`` a JogRequest, its ratio already capped): None, or why
-        it would stop at once (audited). The worker's guard decides again on every poll."""
+    def check_jog(self, pose: Pose | None, request: JogRequest) -> str | None:
+        """Before a jog press (``request``'s ratio already capped): None, or why it would stop at
+        once (audited). The worker's guard decides again on every poll."""
         if pose is None:
             return None
+        motion = JogMotion(request.frame, request.axis, request.direction, request.ratio)
         try:
-            self.session.check_jog_start(pose, request, self.poll_period)
+            self.session.check_jog_start(pose, motion, self.poll_period)
         except (EnvelopeRefused, PermissionRefused) as exc:
             return self.refusal(exc)
         return None
 
-    def check_move(self, start: Any, segment: Any, ledger: Any) -> str | None:
+    def check_move(self, start: PointLike, segment: Segment, ledger: PointLedger) -> str | None:
         try:
             self.session.check_move(start, segment, ledger)
         except EnvelopeRefused as exc:
             return self.refusal(exc)
         return None
 
-    def check_move_to(self, pose: Any, point_id: int, speed: float, ledger: PointLedger) -> str | None:
+    def check_move_to(self, pose: Pose | None, point_id: int, speed: float,
+                      ledger: PointLedger) -> str | None:
         """Move to a point in a straight line (function 3) from ``pose`` (None: not known, the
         target and the speed are checked)."""
         start = pose if pose is not None else ledger.get(point_id)
@@ -322,8 +351,8 @@ class SafetyController(QObject):
         why = self.violation_text(violation)
         self.message.emit(self.tr("Jog stopped before the limit: {why}").format(why=why))
 
-    @Slot(object)
-    def _on_connection(self, _state: object) -> None:
+    @Slot(ConnectionState)
+    def _on_connection(self, _state: ConnectionState) -> None:
         settings = self.link.settings if self.link is not None else None
         if settings is not None:  # the audit describes float writes in the link's word order
             self.session.audit.word_order = settings.word_order

@@ -17,7 +17,7 @@ from __future__ import annotations
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QEvent, QObject, QTimer, Slot
 from PySide6.QtGui import QAction
@@ -36,11 +36,14 @@ from ui.dialogs.register_profile_dialog import RegisterProfileDialog
 from ui.dialogs.role_dialog import RoleDialog
 from ui.panels.audit_viewer import AuditViewer
 
+if TYPE_CHECKING:  # the window composes this menu; only its type is needed here
+    from ui.main_window import MainWindow
+
 
 class SafetyMenu(QObject):
     """See the module docstring. ``save_path(title, suggested)`` is replaceable (tests)."""
 
-    def __init__(self, window: Any, safety: SafetyController) -> None:
+    def __init__(self, window: MainWindow, safety: SafetyController) -> None:
         super().__init__(window)
         self.window = window
         self.safety = safety
@@ -74,12 +77,7 @@ class SafetyMenu(QObject):
                 self.menu.addSeparator()
             else:
                 self.menu.addAction(action)
-        bar = window.menuBar()
-        help_menu = getattr(getattr(window, "menus", None), "help_menu", None)
-        if help_menu is not None:
-            bar.insertMenu(help_menu.menuAction(), self.menu)
-        else:
-            bar.addMenu(self.menu)
+        window.menuBar().insertMenu(window.menus.help_menu.menuAction(), self.menu)
         self.role_label = QLabel(window)
         self.role_label.setObjectName("RoleLabel")
         window.statusBar().addPermanentWidget(self.role_label)
@@ -161,7 +159,7 @@ class SafetyMenu(QObject):
 
     def register_profile(self) -> RegisterProfile:
         """The register profile in force."""
-        return self.window.settings.register_profile()[0]  # type: ignore[no-any-return]
+        return self.window.settings.register_profile()[0]
 
     def register_profile_dialog(self) -> RegisterProfileDialog:
         link = self.window.link
@@ -214,20 +212,17 @@ class SafetyMenu(QObject):
         window = self.window
         store = window.settings.store
         settings = {key: store.value(key) for key in store.allKeys()}
-        project = window.project.path if getattr(window, "project", None) is not None else None
+        project = window.project.path
         profile = self.safety.profile_path if self.safety.profile_path.exists() else None
         register_profile: Path | None = window.settings.register_profile_path()
         if register_profile is not None and not register_profile.exists():
             register_profile = None
         try:
             with tempfile.TemporaryDirectory() as tmp:
-                events = traffic = None
-                if hasattr(window, "event_log"):
-                    window.event_log.export_to(Path(tmp) / "events.txt")
-                    events = (Path(tmp) / "events.txt").read_text(encoding="utf-8").splitlines()
-                if hasattr(window, "traffic_panel"):
-                    window.traffic_panel.export_to(Path(tmp) / "traffic.txt", visible_only=False)
-                    traffic = (Path(tmp) / "traffic.txt").read_text(encoding="utf-8").splitlines()
+                window.event_log.export_to(Path(tmp) / "events.txt")
+                events = (Path(tmp) / "events.txt").read_text(encoding="utf-8").splitlines()
+                window.traffic_panel.export_to(Path(tmp) / "traffic.txt", visible_only=False)
+                traffic = (Path(tmp) / "traffic.txt").read_text(encoding="utf-8").splitlines()
                 manifest = write_support_bundle(
                     path, settings=settings, project=project, profile=profile,
                     register_profile=register_profile, audit_dir=self.safety.audit_dir, events=events,
@@ -243,8 +238,8 @@ class SafetyMenu(QObject):
         return Path(path)
 
 
-def install_safety(window: Any, *, scrypt_n: int | None = None) -> SafetyMenu:
-    """Compose the guard rails onto ``window`` (a :class:`ui.main_window.MainWindow`)."""
+def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> SafetyMenu:
+    """Compose the guard rails onto ``window`` (its 3D view already installed)."""
     safety = SafetyController(window.link, window.settings.store, window, scrypt_n=scrypt_n)
     safety.set_poll_rate(window.settings.poll_hz)  # the jog guard's margin follows the poll period
     menu = SafetyMenu(window, safety)
@@ -256,12 +251,10 @@ def install_safety(window: Any, *, scrypt_n: int | None = None) -> SafetyMenu:
     window.points_panel.move_check = lambda point_id, speed: safety.check_move_to(
         window.link.state.pose, point_id, speed, window.project.points_model.ledger)
     safety.gate_panel(window.planner_panel, Action.EDIT_PLANS)
-    safety.attach_view(window.planner_panel)
-    view3d = getattr(window, "view3d", None)
-    if view3d is not None:  # the 3D view is built on first show: attach it then
-        view3d.on_built(lambda panel: safety.attach_view(panel.canvas))
-    if hasattr(window, "event_log"):
-        safety.message.connect(lambda text: window.event_log.add_event("warning", menu.source_name(), text))
+    safety.attach_checker(window.planner_panel)  # its checks, and its 2D preview draws it
+    # the 3D view is built on first show: its canvas is attached then
+    window.view3d.on_built(lambda panel: safety.attach_view(panel.canvas))
+    safety.message.connect(lambda text: window.event_log.add_event("warning", menu.source_name(), text))
     safety.message.connect(lambda text: window.statusBar().showMessage(text, 8000))
     if safety.problem:
         safety.message.emit(safety.problem)

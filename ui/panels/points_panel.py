@@ -1,8 +1,10 @@
 """The temp point panel: the ledger table, teach, upload / restore, move to a point.
 
-The widget: toolbar, reconnect banner, upload progress, the table (filter by id / name, E1..E5
-hideable) and a status line. The robot side (teach, upload, restore, move and their outcomes)
-is a :class:`~ui.controllers.point_sync.PointSyncController`, shared with the planner.
+The widget: the action bar (primary buttons, edit toolbar, filter by id / name, E1..E5), the
+reconnect banner, upload progress, the table and a status line; those widgets are built in
+:mod:`ui.panels.points_parts`, this module holds the actions and decides what is enabled. The
+robot side (teach, upload, restore, move and their outcomes) is a
+:class:`~ui.controllers.point_sync.PointSyncController`, shared with the planner.
 """
 
 from __future__ import annotations
@@ -10,43 +12,18 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable
 from typing import Any
 
-from PySide6.QtCore import QEvent, QModelIndex, QPoint, Qt, Signal, Slot
+from PySide6.QtCore import QEvent, QModelIndex, Qt, Signal, Slot
 from PySide6.QtGui import QAction, QKeySequence
-from PySide6.QtWidgets import (
-    QAbstractItemView,
-    QDoubleSpinBox,
-    QFrame,
-    QHBoxLayout,
-    QHeaderView,
-    QLabel,
-    QLineEdit,
-    QMenu,
-    QProgressBar,
-    QPushButton,
-    QSizePolicy,
-    QTableView,
-    QToolBar,
-    QToolButton,
-    QVBoxLayout,
-    QWidget,
-)
+from PySide6.QtWidgets import QLabel, QSizePolicy, QVBoxLayout, QWidget
 
 from app.errors import InvalidInput
 from app.points.ledger import UploadReport
-from ui.controllers.point_sync import (
-    DEFAULT_MOVE_SPEED,
-    LEVEL_ERROR,
-    LEVEL_INFO,
-    LEVEL_WARN,
-    MAX_MOVE_SPEED,
-    PointSyncController,
-)
+from ui.controllers.point_sync import LEVEL_ERROR, LEVEL_INFO, LEVEL_WARN, PointSyncController
 from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
-from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COLUMNS, EXT_COLUMNS
 from ui.models.points_model import PointFilterProxy, PointsModel
-from ui.touch import MOTION_MIN_HEIGHT, mark_motion
-from ui.widgets_common import COLOR_ERROR, COLOR_OK, COLOR_WARN, COLOR_WARN_BG
+from ui.panels.points_parts import PointsActionBar, PointsTable, RestoreBanner, UploadProgressRow
+from ui.widgets_common import COLOR_ERROR, COLOR_OK
 
 
 class PointsPanel(QWidget):
@@ -129,113 +106,28 @@ class PointsPanel(QWidget):
         self.action_find = act(QKeySequence.StandardKey.Find, self._focus_find)
 
     def _build(self) -> None:
-        # The primary actions (teach, upload selected, restore all, move to point) are plain
-        # buttons in a row of their own: a toolbar would hide them behind » on a narrow screen.
-        self.primary_row = QWidget(self)
-        self.primary_row.setObjectName("PointsPrimary")
-        primary = QHBoxLayout(self.primary_row)
-        primary.setContentsMargins(0, 0, 0, 0)
-        self.teach_button = self._primary_button(self.action_teach, bold=True)
-        self.upload_button = self._primary_button(self.action_upload_selected)
-        self.upload_button.setPopupMode(QToolButton.ToolButtonPopupMode.MenuButtonPopup)
-        upload_menu = QMenu(self.upload_button)
-        upload_menu.addAction(self.action_upload_selected)
-        upload_menu.addAction(self.action_upload_needed)
-        upload_menu.addAction(self.action_upload_all)
-        upload_menu.addAction(self.action_restore_all)
-        self.upload_button.setMenu(upload_menu)
-        self.restore_all_button = self._primary_button(self.action_restore_all)
-        self.move_to_button = self._primary_button(self.action_move_to)
-        mark_motion(self.move_to_button)
-        self.speed = QDoubleSpinBox(self)
-        self.speed.setRange(0.1, MAX_MOVE_SPEED)
-        self.speed.setDecimals(1)
-        self.speed.setValue(DEFAULT_MOVE_SPEED)
-        self.speed.setSuffix(" mm/s")
-        self.speed.setKeyboardTracking(False)
-        self.speed.setMinimumHeight(MOTION_MIN_HEIGHT)
-        for widget in (self.teach_button, self.upload_button, self.restore_all_button):
-            primary.addWidget(widget)
-        primary.addSpacing(12)
-        primary.addWidget(self.move_to_button)
-        primary.addWidget(self.speed)
-        primary.addStretch(1)
-
-        bar = QToolBar(self)
-        bar.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
-        for action in (self.action_add, self.action_duplicate, self.action_delete, self.action_move_up,
-                       self.action_move_down):
-            bar.addAction(action)
-        self.toolbar = bar
-
-        self.find_edit = QLineEdit(self)
-        self.find_edit.setClearButtonEnabled(True)
-        self.find_edit.setMaximumWidth(220)
+        bar = PointsActionBar(
+            self, teach=self.action_teach, upload_selected=self.action_upload_selected,
+            upload_needed=self.action_upload_needed, upload_all=self.action_upload_all,
+            restore_all=self.action_restore_all, move_to=self.action_move_to, show_ext=self.action_show_ext,
+            edits=(self.action_add, self.action_duplicate, self.action_delete, self.action_move_up,
+                   self.action_move_down))
+        self.action_bar = bar
+        self.primary_row, self.toolbar = bar.primary_row, bar.toolbar
+        self.teach_button, self.upload_button = bar.teach_button, bar.upload_button
+        self.restore_all_button, self.move_to_button = bar.restore_all_button, bar.move_to_button
+        self.speed, self.find_edit = bar.speed, bar.find_edit
         self.find_edit.textChanged.connect(self.proxy.set_filter_text)
-        self.ext_button = QToolButton(self)
-        self.ext_button.setDefaultAction(self.action_show_ext)
-        self.ext_button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
 
-        top = QHBoxLayout()
-        top.setContentsMargins(0, 0, 0, 0)
-        top.addWidget(bar, 1)
-        self.find_label = QLabel(self)
-        top.addWidget(self.find_label)
-        top.addWidget(self.find_edit)
-        top.addWidget(self.ext_button)
+        self.banner = RestoreBanner(self._controller.restore_all, self)
+        self.restore_button = self.banner.restore_button
+        self.progress_row = UploadProgressRow(self._controller.cancel_upload, self)
+        self.progress, self.cancel_button = self.progress_row.progress, self.progress_row.cancel_button
 
-        # banner: the controller may have lost its points
-        self.banner = QFrame(self)
-        self.banner.setObjectName("restoreBanner")
-        self.banner.setStyleSheet(f"#restoreBanner {{ background: {COLOR_WARN_BG}; "
-                                  f"border: 1px solid {COLOR_WARN}; border-radius: 4px; }}")
-        banner_row = QHBoxLayout(self.banner)
-        banner_row.setContentsMargins(8, 4, 8, 4)
-        self.banner_label = QLabel(self.banner)
-        self.banner_label.setWordWrap(True)
-        self.restore_button = QPushButton(self.banner)
-        self.restore_button.clicked.connect(self._controller.restore_all)
-        font = self.restore_button.font()
-        font.setBold(True)
-        self.restore_button.setFont(font)
-        banner_row.addWidget(self.banner_label, 1)
-        banner_row.addWidget(self.restore_button)
-
-        # upload progress
-        self.progress_row = QWidget(self)
-        progress = QHBoxLayout(self.progress_row)
-        progress.setContentsMargins(0, 0, 0, 0)
-        self.progress_label = QLabel(self.progress_row)
-        self.progress = QProgressBar(self.progress_row)
-        self.progress.setTextVisible(True)
-        self.cancel_button = QPushButton(self.progress_row)
-        self.cancel_button.clicked.connect(self._controller.cancel_upload)
-        progress.addWidget(self.progress_label)
-        progress.addWidget(self.progress, 1)
-        progress.addWidget(self.cancel_button)
-        self.progress_row.hide()
-
-        table = QTableView(self)
-        table.setModel(self.proxy)
-        table.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
-        table.setSelectionMode(QAbstractItemView.SelectionMode.ExtendedSelection)
-        table.setEditTriggers(QAbstractItemView.EditTrigger.DoubleClicked
-                              | QAbstractItemView.EditTrigger.EditKeyPressed
-                              | QAbstractItemView.EditTrigger.AnyKeyPressed)
-        table.setAlternatingRowColors(True)
-        table.setWordWrap(False)
-        table.verticalHeader().setVisible(False)
-        table.verticalHeader().setDefaultSectionSize(24)
-        header = table.horizontalHeader()
-        header.setSectionResizeMode(QHeaderView.ResizeMode.Interactive)
-        header.setStretchLastSection(True)
-        widths = {COL_ID: 56, COL_NAME: 150, COL_SYNC: 130, COLUMNS.index("tool"): 70}
-        widths.update(dict.fromkeys(EXT_COLUMNS, 62))  # usually zero: narrower than the pose
-        for column in range(len(COLUMNS)):
-            table.setColumnWidth(column, widths.get(column, 80))
-        table.setContextMenuPolicy(Qt.ContextMenuPolicy.CustomContextMenu)
-        table.customContextMenuRequested.connect(self._context_menu)
-        self.table = table
+        self.table = PointsTable((self.action_move_to, self.action_upload_selected, None, self.action_teach,
+                                  self.action_add, self.action_duplicate, self.action_delete), self)
+        self.table.setModel(self.proxy)
+        self.table.size_columns()
         self._show_ext(False)
 
         self.status = QLabel(self)
@@ -245,23 +137,10 @@ class PointsPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
         layout.setSpacing(4)
-        layout.addWidget(self.primary_row)
-        layout.addLayout(top)
-        layout.addWidget(self.banner)
-        layout.addWidget(self.progress_row)
-        layout.addWidget(table, 1)
+        for widget in (bar.primary_row, bar.edit_row, self.banner, self.progress_row):
+            layout.addWidget(widget)
+        layout.addWidget(self.table, 1)
         layout.addWidget(self.status)
-
-    def _primary_button(self, action: QAction, *, bold: bool = False) -> QToolButton:
-        button = QToolButton(self)
-        button.setDefaultAction(action)
-        button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextOnly)
-        button.setMinimumHeight(MOTION_MIN_HEIGHT)
-        if bold:
-            font = button.font()
-            font.setBold(True)
-            button.setFont(font)
-        return button
 
     def retranslate(self) -> None:
         texts = {
@@ -289,14 +168,8 @@ class PointsPanel(QWidget):
         for action, (text, tip) in texts.items():
             action.setText(text)
             action.setToolTip(tip or text)
-        self.speed.setToolTip(self.tr("Speed of Move to point"))
-        self.find_label.setText(self.tr("Find:"))
-        self.find_edit.setPlaceholderText(self.tr("id or name"))
-        self.banner_label.setText(self.tr("The controller restarted or the link was re-established: its temp "
-                                          "points may be gone. Re-create them before running a plan."))
-        self.restore_button.setText(self.tr("Restore all"))
-        self.cancel_button.setText(self.tr("Cancel"))
-        self.progress_label.setText(self.tr("Uploading"))
+        for part in (self.action_bar, self.banner, self.progress_row):
+            part.retranslate()
         self._model.retranslate()
 
     def changeEvent(self, event: QEvent) -> None:
@@ -336,7 +209,6 @@ class PointsPanel(QWidget):
         """Replace the operator's yes/no question (tests answer without a dialog)."""
         self._confirm = confirm
 
-    @Slot(bool)
     def set_edit_permission(self, reason: str | None) -> None:
         """Role gating: add / duplicate / delete / reorder / cell edits only while ``reason`` is
         None; else disabled (not hidden) with ``reason`` as the tooltip."""
@@ -461,13 +333,11 @@ class PointsPanel(QWidget):
             self.find_edit.clear()
 
     def _focus_find(self) -> None:
-        self.find_edit.setFocus()
-        self.find_edit.selectAll()
+        self.action_bar.focus_find()
 
     @Slot(bool)
     def _show_ext(self, shown: bool) -> None:
-        for column in EXT_COLUMNS:
-            self.table.setColumnHidden(column, not shown)
+        self.table.show_ext(shown)
 
     @Slot(str)
     def _on_rejected(self, text: str) -> None:
@@ -479,10 +349,7 @@ class PointsPanel(QWidget):
 
     @Slot(int, int)
     def _on_upload_progress(self, done: int, total: int) -> None:
-        self.progress_row.show()
-        self.progress.setRange(0, max(total, 1))
-        self.progress.setValue(done)
-        self.progress.setFormat(self.tr("%v of %m points"))
+        self.progress_row.show_progress(done, total)
 
     @Slot(object)
     def _on_upload_finished(self, report: UploadReport) -> None:
@@ -494,19 +361,6 @@ class PointsPanel(QWidget):
         if row is not None:
             self._clear_filter_for(row)
             self.select_rows([row])
-
-    def _context_menu(self, pos: QPoint) -> None:
-        index = self.table.indexAt(pos)
-        if index.isValid() and not self.table.selectionModel().isRowSelected(index.row(), QModelIndex()):
-            self.table.selectRow(index.row())
-        menu = QMenu(self)
-        for action in (self.action_move_to, self.action_upload_selected, None, self.action_teach,
-                       self.action_add, self.action_duplicate, self.action_delete):
-            if action is None:
-                menu.addSeparator()
-            else:
-                menu.addAction(action)
-        menu.popup(self.table.viewport().mapToGlobal(pos))
 
     @Slot()
     def _update_actions(self, *_args: Any) -> None:

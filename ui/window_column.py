@@ -1,0 +1,85 @@
+"""The main window's control column: the control bar (the big STOP), the motion banner and the
+Jog / Step / Program tabs, on the window's left whatever work tab is shown.
+
+The banner says why the motion controls are off ("Not connected", "Monitor only"); it reads the
+link's :class:`~app.link.state.RobotState` when it changes and keeps no copy of it. Which
+controls are enabled is :class:`~ui.controllers.motion.MotionController`'s business.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QCoreApplication, Qt, Slot
+from PySide6.QtWidgets import QLabel, QSizePolicy, QTabWidget, QVBoxLayout, QWidget
+
+from app.link.state import RobotState
+from app.link.types import ConnectionState
+from ui.panels.control_bar import ControlBar
+from ui.panels.jog_panel import JogPanel
+from ui.panels.program_panel import ProgramPanel
+from ui.panels.step_panel import StepPanel
+
+__all__ = ["ControlColumn"]
+
+# The column was part of the window: its texts keep the "MainWindow" translation context.
+BANNER_STYLE = ("QLabel { background: #fff1d6; color: #7a4a00; border: 1px solid #ef8f00;"
+                " border-radius: 4px; padding: 4px; font-weight: bold; }")
+
+
+
+class ControlColumn(QWidget):
+    """``control_bar``, ``motion_banner``, ``tabs`` (``jog_panel``, ``step_panel``,
+    ``program_panel``). Changing the motion tab releases any held jog."""
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("ControlColumn")
+        self._state: RobotState | None = None
+        self.control_bar = ControlBar(self)
+        self.jog_panel = JogPanel(self)
+        self.step_panel = StepPanel(self)
+        self.program_panel = ProgramPanel(self)
+        self.tabs = QTabWidget(self)
+        self.tabs.setObjectName("MotionTabs")
+        self.tabs.addTab(self.jog_panel, "")
+        self.tabs.addTab(self.step_panel, "")
+        self.tabs.addTab(self.program_panel, "")
+        self.tabs.currentChanged.connect(lambda _i: self.jog_panel.release_all())
+        self.motion_banner = QLabel(self)
+        self.motion_banner.setAlignment(Qt.AlignmentFlag.AlignCenter)
+        self.motion_banner.setWordWrap(True)
+        self.motion_banner.setStyleSheet(BANNER_STYLE)
+        column = QVBoxLayout(self)
+        column.setContentsMargins(0, 0, 0, 0)
+        column.addWidget(self.control_bar)
+        column.addWidget(self.motion_banner)
+        column.addWidget(self.tabs, 1)
+        self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Expanding)
+        self.retranslate()
+
+    def bind(self, state: RobotState) -> None:
+        """Follow ``state``: the banner shows while the link is not writable, and says why."""
+        self._state = state
+        state.connectionChanged.connect(self._on_connection)
+        self._show_banner()
+
+    def retranslate(self) -> None:
+        self.tabs.setTabText(0, QCoreApplication.translate("MainWindow", "Jog"))
+        self.tabs.setTabText(1, QCoreApplication.translate("MainWindow", "Step"))
+        self.tabs.setTabText(2, QCoreApplication.translate("MainWindow", "Program"))
+        self._show_banner()
+
+    @Slot(ConnectionState)
+    def _on_connection(self, _connection: ConnectionState) -> None:
+        self._show_banner()
+
+    def _show_banner(self) -> None:
+        state = self._state
+        connection = state.connection if state is not None else None
+        writable = state is not None and state.writable
+        if connection is not None and connection.connected and connection.monitor_only:
+            self.motion_banner.setText(QCoreApplication.translate(
+                "MainWindow", "Monitor only: motion controls are disabled"))
+        elif connection is None or not connection.connected:
+            self.motion_banner.setText(QCoreApplication.translate(
+                "MainWindow", "Not connected: motion controls are disabled"))
+        self.motion_banner.setVisible(not writable)

@@ -1,0 +1,84 @@
+"""The main window's status bar: its permanent labels, each following what it shows.
+
+Right to left: the link (``connected``, ``not answering``..., its message as tooltip), the mean
+poll round trip, the open project, and a red MONITOR ONLY while the link is monitor-only. The
+link labels read the link's :class:`~app.link.state.RobotState` when it changes (no copy kept);
+transient messages (errors, refusals, the panels' notes) show for :data:`MESSAGE_MS`.
+"""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QCoreApplication, QObject, Slot
+from PySide6.QtWidgets import QLabel, QStatusBar
+
+from app.link.state import RobotState
+from app.link.types import ConnectionState
+from ui.widgets_common import connection_display
+
+__all__ = ["MESSAGE_MS", "WindowStatusBar"]
+
+# These labels were the window's: their texts keep the "MainWindow" translation context.
+MESSAGE_MS = 8000  # how long a transient status-bar message stays
+
+
+
+class WindowStatusBar(QObject):
+    """The labels ``monitor_only_label``, ``project_label``, ``rtt_label`` and ``link_label`` on ``bar``."""
+
+    def __init__(self, bar: QStatusBar) -> None:
+        super().__init__(bar)
+        self.bar = bar
+        self._state: RobotState | None = None
+        self._project_title = ""
+        self.project_label = QLabel(bar)
+        self.link_label = QLabel(bar)
+        self.rtt_label = QLabel(bar)
+        self.monitor_only_label = QLabel(bar)
+        self.monitor_only_label.setStyleSheet("color: #c62828; font-weight: bold;")
+        for label in (self.monitor_only_label, self.project_label, self.rtt_label, self.link_label):
+            bar.addPermanentWidget(label)
+        self.retranslate()
+
+    def bind(self, state: RobotState) -> None:
+        self._state = state
+        state.connectionChanged.connect(self._on_connection)
+        state.rttChanged.connect(self._show_rtt)
+        self._show_connection()
+        if state.rtt is not None:
+            self._show_rtt(state.rtt)
+
+    def retranslate(self) -> None:
+        # room for the widest RTT from the start: the status bar does not shift when one arrives
+        widest_rtt = QCoreApplication.translate("MainWindow", "RTT {ms} ms").format(ms="9999.9")
+        self.rtt_label.setMinimumWidth(self.rtt_label.fontMetrics().horizontalAdvance(widest_rtt) + 8)
+        if self._state is not None and self._state.rtt is not None:
+            self._show_rtt(self._state.rtt)
+        self.show_project(self._project_title, self.project_label.toolTip())
+        self._show_connection()
+
+    def show_message(self, text: str) -> None:
+        self.bar.showMessage(text, MESSAGE_MS)
+
+    def show_project(self, title: str, path: str) -> None:
+        self._project_title = title
+        self.project_label.setText(
+            QCoreApplication.translate("MainWindow", "Project: {name}").format(name=title))
+        self.project_label.setToolTip(path)
+
+    @Slot(ConnectionState)
+    def _on_connection(self, _connection: ConnectionState) -> None:
+        self._show_connection()
+
+    def _show_connection(self) -> None:
+        if self._state is None:
+            return
+        connection = self._state.connection
+        text, _level = connection_display(connection)
+        self.link_label.setText(text)
+        self.link_label.setToolTip(connection.message)
+        monitor_only = QCoreApplication.translate("MainWindow", "MONITOR ONLY")
+        self.monitor_only_label.setText(monitor_only if connection.monitor_only else "")
+
+    @Slot(float)
+    def _show_rtt(self, ms: float) -> None:
+        self.rtt_label.setText(QCoreApplication.translate("MainWindow", "RTT {ms} ms").format(ms=f"{ms:.1f}"))
