@@ -176,8 +176,8 @@ def test_a_point_the_controller_does_not_create_fails_the_segment_before_it_move
     since = len(sim.writes)
     outcome = bench.run()
     assert outcome.state is RunState.FAILED and outcome.resume_from == 1
-    assert bench.runs.outcome_text(outcome) == (
-        "Failed at segment 2: The controller did not create P2 'b' again before the move: the arm was not moved.")
+    assert bench.runs.outcome_text(outcome) == ("Failed at segment 2: The controller did not create P2 'b' "
+                                                "again before the move: the arm was not moved.")
     assert bench.commands(since) == [CREATE, MOVE, CREATE]
     assert _near(sim.state().pose, bench.host(1))
     assert bench.project.ledger.point(2).sync is SyncState.FAILED
