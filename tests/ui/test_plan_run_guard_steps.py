@@ -43,7 +43,8 @@ def runs(qtbot: Any, link: FakeLink, project: Project) -> PlanRunController:
 
 
 def _at(link: FakeLink, xyzabc: tuple[float, ...]) -> None:
-    link.state.set_pose(Pose(*xyzabc, ext=(0.0,) * 5))
+    x, y, z, a, b, c = xyzabc
+    link.state.set_pose(Pose(x, y, z, a, b, c, ext=(0.0,) * 5))
 
 
 def test_points_first_then_the_move_then_the_arrival(qtbot: Any, runs: PlanRunController, link: FakeLink,
