@@ -52,7 +52,7 @@ def _upload(qtbot: Any, sync: PointSyncController, start: Any) -> UploadReport:
 
 def test_gui_uploads_record_the_history_in_the_project(qtbot: Any, sim: Any, link: RobotLink,
                                                         project: ProjectController) -> None:
-    connect(qtbot, link, sim)
+    connect(qtbot, link, sim, poll_timeout=1.0)  # a loaded machine: see test_plan_run_guard.POLL_TIMEOUT
     sync = PointSyncController(project.points_model, link)
     data = project.points_model.project
     endpoint = f"127.0.0.1:{sim.port}"
