@@ -98,7 +98,7 @@ class MainWindow(QMainWindow):
         self.project = ProjectController(dialogs=project_dialogs or ProjectDialogs(self),
                                          autosave_dir=autosave_dir, parent=self)
         self.point_sync = PointSyncController(self.project.points_model, link, self)
-        self.run_controller = PlanRunController(link, self)
+        self.run_controller = PlanRunController(link, self, points=self.project.points_model)
 
         # --- left: control bar + motion tabs ----------------------------------------------
         self.control_column = column = ControlColumn(self)

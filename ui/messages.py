@@ -79,6 +79,11 @@ _TEMPLATES: dict[str, str] = {
     "monitor_only": QT_TRANSLATE_NOOP("Messages", "Monitor-only mode: nothing was sent to the controller."),
     "invalid_input": QT_TRANSLATE_NOOP("Messages", "Invalid value: nothing was sent."),
     "unexpected": QT_TRANSLATE_NOOP("Messages", "Unexpected internal error; the log has the details."),
+    # a plan run's point guard (app/points/guard.py, ui/controllers/run_points.py)
+    "point_mismatch": QT_TRANSLATE_NOOP("Messages", "The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming."),  # noqa: E501
+    "point_not_created": QT_TRANSLATE_NOOP("Messages", "The controller did not create {point} again before the move: the arm was not moved."),  # noqa: E501
+    "point_missing": QT_TRANSLATE_NOOP("Messages", "The project has no point {point}: the arm was not moved."),  # noqa: E501
+    "arrival_unknown": QT_TRANSLATE_NOOP("Messages", "The arm's position after the move to {point} is not known: the run is stopped."),  # noqa: E501
 }
 
 # A reason whose arguments lack a placeholder of the full sentence uses this one.

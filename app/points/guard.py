@@ -44,7 +44,12 @@ ARRIVAL_TOLERANCE_MM = 1.0
 
 
 class PointMismatch(TeachPadError):
-    """The arm did not arrive at the host's copy of a point (overwritten by another tool?)."""
+    """The arm did not arrive at the host's copy of a point (overwritten by another tool?).
+
+    Reason ``point_mismatch`` with ``point`` (label), ``got`` / ``want`` ("x, y, z" in mm) and
+    ``distance`` (mm, two decimals), all preformatted text."""
+
+    code = "point_mismatch"
 
     def __init__(self, point: TempPoint, pose: Pose, distance: float) -> None:
         self.point = point
@@ -55,11 +60,15 @@ class PointMismatch(TeachPadError):
         super().__init__(
             f"the arm stopped at ({got}), {distance:.2f} mm away from {point.label} at ({want}): the "
             "controller's copy of the point differs from this project's (overwritten by another tool?). "
-            "The run is stopped; check the point and the robot before resuming")
+            "The run is stopped; check the point and the robot before resuming",
+            params={"point": point.label, "got": got, "want": want, "distance": f"{distance:.2f}"})
 
 
 class PointNotCreated(TeachPadError):
-    """The controller refused to create a point the plan needs."""
+    """The controller refused to create a point the plan needs (reason ``point_not_created``,
+    ``point`` = its label), or the project has no such point (``point_missing``)."""
+
+    code = "point_not_created"
 
 
 class GuardClient(Protocol):
@@ -101,7 +110,8 @@ class PointGuard:
         try:
             return self._points[point_id]
         except KeyError:
-            raise PointNotCreated(f"the project has no point P{point_id}") from None
+            raise PointNotCreated(f"the project has no point P{point_id}", code="point_missing",
+                                  params={"point": f"P{point_id}"}) from None
 
     # --- restart check
     def arm(self, client: GuardClient) -> None:
@@ -131,7 +141,8 @@ class PointGuard:
         self.created.append(point.id)
         if not result.ok:
             reason = result.message or (result.status.text if result.status is not None else "failed")
-            raise PointNotCreated(f"the controller refused to create {point.label}: {reason}")
+            raise PointNotCreated(f"the controller refused to create {point.label}: {reason}",
+                                  params={"point": point.label, "cause": reason})
         self._uploaded.add(point.id)
 
     def ensure(self, client: GuardClient, point_ids: Iterable[int]) -> list[int]:

@@ -978,119 +978,119 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/main_window.py" line="287" />
+            <location filename="../../ui/window_column.py" line="66" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="288" />
+            <location filename="../../ui/window_column.py" line="67" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="289" />
+            <location filename="../../ui/window_column.py" line="68" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="293" />
+            <location filename="../../ui/window_docks.py" line="85" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="294" />
+            <location filename="../../ui/window_docks.py" line="86" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="295" />
+            <location filename="../../ui/window_docks.py" line="87" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="332" />
+            <location filename="../../ui/window_status.py" line="79" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="320" />
+            <location filename="../../ui/main_window.py" line="250" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="348" />
+            <location filename="../../ui/window_column.py" line="80" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="350" />
+            <location filename="../../ui/window_column.py" line="83" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="298" />
-            <location filename="../../ui/main_window.py" line="355" />
+            <location filename="../../ui/window_status.py" line="52" />
+            <location filename="../../ui/window_status.py" line="84" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="368" />
+            <location filename="../../ui/window_status.py" line="65" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="379" />
+            <location filename="../../ui/main_window.py" line="281" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="385" />
+            <location filename="../../ui/main_window.py" line="287" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="381" />
-            <location filename="../../ui/main_window.py" line="386" />
+            <location filename="../../ui/main_window.py" line="283" />
+            <location filename="../../ui/main_window.py" line="288" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="290" />
+            <location filename="../../ui/main_window.py" line="227" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="291" />
+            <location filename="../../ui/main_window.py" line="228" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="292" />
+            <location filename="../../ui/main_window.py" line="229" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="296" />
+            <location filename="../../ui/window_docks.py" line="88" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="452" />
+            <location filename="../../ui/main_window.py" line="341" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="453" />
+            <location filename="../../ui/main_window.py" line="342" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="471" />
+            <location filename="../../ui/main_window.py" line="360" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="472" />
+            <location filename="../../ui/main_window.py" line="361" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -1263,357 +1263,377 @@
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
+            <location filename="../../ui/messages.py" line="83" />
+            <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
+            <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="84" />
+            <source>The controller did not create {point} again before the move: the arm was not moved.</source>
+            <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="85" />
+            <source>The project has no point {point}: the arm was not moved.</source>
+            <translation>项目中没有点 {point}：机械臂未移动。</translation>
+        </message>
+        <message>
             <location filename="../../ui/messages.py" line="86" />
+            <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
+            <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="91" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="87" />
+            <location filename="../../ui/messages.py" line="92" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="88" />
+            <location filename="../../ui/messages.py" line="93" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="89" />
+            <location filename="../../ui/messages.py" line="94" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="90" />
+            <location filename="../../ui/messages.py" line="95" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="91" />
+            <location filename="../../ui/messages.py" line="96" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="92" />
+            <location filename="../../ui/messages.py" line="97" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="93" />
+            <location filename="../../ui/messages.py" line="98" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="94" />
+            <location filename="../../ui/messages.py" line="99" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="95" />
+            <location filename="../../ui/messages.py" line="100" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="96" />
+            <location filename="../../ui/messages.py" line="101" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="97" />
+            <location filename="../../ui/messages.py" line="102" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="98" />
+            <location filename="../../ui/messages.py" line="103" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="99" />
+            <location filename="../../ui/messages.py" line="104" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="102" />
+            <location filename="../../ui/messages.py" line="107" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="103" />
+            <location filename="../../ui/messages.py" line="108" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="104" />
+            <location filename="../../ui/messages.py" line="109" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="105" />
+            <location filename="../../ui/messages.py" line="110" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="106" />
+            <location filename="../../ui/messages.py" line="111" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="109" />
+            <location filename="../../ui/messages.py" line="114" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="110" />
+            <location filename="../../ui/messages.py" line="115" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="111" />
+            <location filename="../../ui/messages.py" line="116" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="112" />
+            <location filename="../../ui/messages.py" line="117" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="113" />
+            <location filename="../../ui/messages.py" line="118" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="114" />
+            <location filename="../../ui/messages.py" line="119" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="115" />
+            <location filename="../../ui/messages.py" line="120" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="116" />
+            <location filename="../../ui/messages.py" line="121" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="117" />
+            <location filename="../../ui/messages.py" line="122" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="118" />
+            <location filename="../../ui/messages.py" line="123" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="119" />
+            <location filename="../../ui/messages.py" line="124" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="120" />
+            <location filename="../../ui/messages.py" line="125" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="121" />
+            <location filename="../../ui/messages.py" line="126" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="122" />
+            <location filename="../../ui/messages.py" line="127" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="123" />
+            <location filename="../../ui/messages.py" line="128" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="124" />
+            <location filename="../../ui/messages.py" line="129" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="125" />
+            <location filename="../../ui/messages.py" line="130" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="126" />
+            <location filename="../../ui/messages.py" line="131" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="127" />
+            <location filename="../../ui/messages.py" line="132" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="128" />
+            <location filename="../../ui/messages.py" line="133" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="130" />
+            <location filename="../../ui/messages.py" line="135" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="133" />
+            <location filename="../../ui/messages.py" line="138" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="134" />
+            <location filename="../../ui/messages.py" line="139" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="135" />
+            <location filename="../../ui/messages.py" line="140" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="136" />
+            <location filename="../../ui/messages.py" line="141" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="137" />
+            <location filename="../../ui/messages.py" line="142" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="138" />
+            <location filename="../../ui/messages.py" line="143" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="139" />
+            <location filename="../../ui/messages.py" line="144" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="140" />
+            <location filename="../../ui/messages.py" line="145" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="141" />
+            <location filename="../../ui/messages.py" line="146" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="142" />
+            <location filename="../../ui/messages.py" line="147" />
             <source>unit id</source>
             <translation>站号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="143" />
+            <location filename="../../ui/messages.py" line="148" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="147" />
+            <location filename="../../ui/messages.py" line="152" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="148" />
+            <location filename="../../ui/messages.py" line="153" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="149" />
+            <location filename="../../ui/messages.py" line="154" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="150" />
+            <location filename="../../ui/messages.py" line="155" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="151" />
+            <location filename="../../ui/messages.py" line="156" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="152" />
+            <location filename="../../ui/messages.py" line="157" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="153" />
+            <location filename="../../ui/messages.py" line="158" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="154" />
+            <location filename="../../ui/messages.py" line="159" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="155" />
+            <location filename="../../ui/messages.py" line="160" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="156" />
+            <location filename="../../ui/messages.py" line="161" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="158" />
+            <location filename="../../ui/messages.py" line="163" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="162" />
+            <location filename="../../ui/messages.py" line="167" />
             <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="163" />
+            <location filename="../../ui/messages.py" line="168" />
             <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
             <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="164" />
+            <location filename="../../ui/messages.py" line="169" />
             <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
             <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="165" />
+            <location filename="../../ui/messages.py" line="170" />
             <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
             <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="166" />
+            <location filename="../../ui/messages.py" line="171" />
             <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
             <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="167" />
+            <location filename="../../ui/messages.py" line="172" />
             <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
             <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="169" />
+            <location filename="../../ui/messages.py" line="174" />
             <source>Refused by the safety envelope: {text}</source>
             <translation>安全边界拒绝：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="170" />
+            <location filename="../../ui/messages.py" line="175" />
             <source>segment {n}: </source>
             <translation>第 {n} 段：</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="171" />
+            <location filename="../../ui/messages.py" line="176" />
             <source> (reduced-speed mode)</source>
             <translation>（减速模式）</translation>
         </message>
@@ -1770,102 +1790,102 @@
     <context>
         <name>PasswordDialog</name>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="90" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="104" />
             <source>Passwords and lock</source>
             <translation>密码与锁定</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="91" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="105" />
             <source>Role</source>
             <translation>角色</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="91" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="105" />
             <source>Password</source>
             <translation>密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="92" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="106" />
             <source>New password:</source>
             <translation>新密码：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="93" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="107" />
             <source>Repeat:</source>
             <translation>再次输入：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="94" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="108" />
             <source>Set / change password</source>
             <translation>设置/修改密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="95" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="109" />
             <source>Clear password</source>
             <translation>清除密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="96" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="110" />
             <source>Lock back to operator after:</source>
             <translation>空闲多久后退回操作员：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="97" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="111" />
             <source> min</source>
             <translation> 分钟</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="109" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="123" />
             <source>not needed (the pendant starts as operator)</source>
             <translation>不需要（示教器以操作员身份启动）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="111" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="125" />
             <source>set</source>
             <translation>已设置</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="113" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="127" />
             <source>not set (nobody can log in as this role)</source>
             <translation>未设置（无人能以此角色登录）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="142" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="156" />
             <source>The administrator password can be changed, not removed</source>
             <translation>管理员密码只能修改，不能清除</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="156" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="170" />
             <source>The two passwords differ</source>
             <translation>两次输入的密码不一致</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="164" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="178" />
             <source>Not set: {why}</source>
             <translation>未设置：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="169" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="183" />
             <source>Password set for the {role} role</source>
             <translation>已设置{role}角色的密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="182" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="196" />
             <source>Not cleared: {why}</source>
             <translation>未清除：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="184" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="198" />
             <source>Password cleared for the {role} role</source>
             <translation>已清除{role}角色的密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="196" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="210" />
             <source>The setting could not be saved: {why}</source>
             <translation>无法保存设置：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="198" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="212" />
             <source>The window locks back to operator after {n} min without input</source>
             <translation>无操作 {n} 分钟后窗口退回操作员</translation>
         </message>
@@ -2103,27 +2123,27 @@
     <context>
         <name>PlanRunController</name>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="192" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="231" />
             <source>Failed: {reason}</source>
             <translation>失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="192" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="231" />
             <source>Stopped: {reason}</source>
             <translation>已停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="194" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="233" />
             <source>Failed at segment {n}: {reason}</source>
             <translation>在第 {n} 段失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="195" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="234" />
             <source>Stopped at segment {n}: {reason}</source>
             <translation>在第 {n} 段停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="210" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="249" />
             <source>stopped by the operator</source>
             <translation>已由操作员停止</translation>
         </message>
@@ -2445,157 +2465,157 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="158" />
+            <location filename="../../ui/controllers/point_sync.py" line="161" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="169" />
+            <location filename="../../ui/controllers/point_sync.py" line="172" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="179" />
+            <location filename="../../ui/controllers/point_sync.py" line="182" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="181" />
+            <location filename="../../ui/controllers/point_sync.py" line="184" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="188" />
+            <location filename="../../ui/controllers/point_sync.py" line="191" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="214" />
+            <location filename="../../ui/controllers/point_sync.py" line="217" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="220" />
+            <location filename="../../ui/controllers/point_sync.py" line="223" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="223" />
+            <location filename="../../ui/controllers/point_sync.py" line="226" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="227" />
+            <location filename="../../ui/controllers/point_sync.py" line="230" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="229" />
+            <location filename="../../ui/controllers/point_sync.py" line="232" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="234" />
+            <location filename="../../ui/controllers/point_sync.py" line="237" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="250" />
+            <location filename="../../ui/controllers/point_sync.py" line="253" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="270" />
+            <location filename="../../ui/controllers/point_sync.py" line="273" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="273" />
+            <location filename="../../ui/controllers/point_sync.py" line="276" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="303" />
+            <location filename="../../ui/controllers/point_sync.py" line="301" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="317" />
+            <location filename="../../ui/controllers/point_sync.py" line="315" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="341" />
+            <location filename="../../ui/controllers/point_sync.py" line="339" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="346" />
+            <location filename="../../ui/controllers/point_sync.py" line="344" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="357" />
+            <location filename="../../ui/controllers/point_sync.py" line="355" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="361" />
+            <location filename="../../ui/controllers/point_sync.py" line="359" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="367" />
+            <location filename="../../ui/controllers/point_sync.py" line="365" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="374" />
+            <location filename="../../ui/controllers/point_sync.py" line="372" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="378" />
+            <location filename="../../ui/controllers/point_sync.py" line="376" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="387" />
+            <location filename="../../ui/controllers/point_sync.py" line="385" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="391" />
+            <location filename="../../ui/controllers/point_sync.py" line="389" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="395" />
+            <location filename="../../ui/controllers/point_sync.py" line="393" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="434" />
+            <location filename="../../ui/controllers/point_sync.py" line="436" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="437" />
+            <location filename="../../ui/controllers/point_sync.py" line="439" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="453" />
+            <location filename="../../ui/controllers/point_sync.py" line="455" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="457" />
+            <location filename="../../ui/controllers/point_sync.py" line="459" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="461" />
+            <location filename="../../ui/controllers/point_sync.py" line="463" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -2791,194 +2811,194 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="268" />
+            <location filename="../../ui/panels/points_panel.py" line="147" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="268" />
+            <location filename="../../ui/panels/points_panel.py" line="147" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="270" />
+            <location filename="../../ui/panels/points_panel.py" line="149" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="270" />
+            <location filename="../../ui/panels/points_panel.py" line="149" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="271" />
+            <location filename="../../ui/panels/points_panel.py" line="150" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="271" />
+            <location filename="../../ui/panels/points_panel.py" line="150" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="272" />
+            <location filename="../../ui/panels/points_panel.py" line="151" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="273" />
+            <location filename="../../ui/panels/points_panel.py" line="152" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="274" />
+            <location filename="../../ui/panels/points_panel.py" line="153" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="275" />
+            <location filename="../../ui/panels/points_panel.py" line="154" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="276" />
+            <location filename="../../ui/panels/points_panel.py" line="155" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="277" />
+            <location filename="../../ui/panels/points_panel.py" line="156" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="278" />
+            <location filename="../../ui/panels/points_panel.py" line="157" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="279" />
+            <location filename="../../ui/panels/points_panel.py" line="158" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="280" />
+            <location filename="../../ui/panels/points_panel.py" line="159" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="280" />
+            <location filename="../../ui/panels/points_panel.py" line="159" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="281" />
-            <location filename="../../ui/panels/points_panel.py" line="297" />
+            <location filename="../../ui/panels/points_panel.py" line="160" />
+            <location filename="../../ui/panels/points_parts.py" line="151" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="282" />
+            <location filename="../../ui/panels/points_panel.py" line="161" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="283" />
+            <location filename="../../ui/panels/points_panel.py" line="162" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="284" />
-            <location filename="../../ui/panels/points_panel.py" line="455" />
+            <location filename="../../ui/panels/points_panel.py" line="163" />
+            <location filename="../../ui/panels/points_panel.py" line="327" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="285" />
+            <location filename="../../ui/panels/points_panel.py" line="164" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="286" />
+            <location filename="../../ui/panels/points_panel.py" line="165" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="286" />
+            <location filename="../../ui/panels/points_panel.py" line="165" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="287" />
+            <location filename="../../ui/panels/points_panel.py" line="166" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="292" />
+            <location filename="../../ui/panels/points_parts.py" line="120" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="293" />
+            <location filename="../../ui/panels/points_parts.py" line="121" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="294" />
+            <location filename="../../ui/panels/points_parts.py" line="122" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="295" />
+            <location filename="../../ui/panels/points_parts.py" line="148" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="298" />
+            <location filename="../../ui/panels/points_parts.py" line="172" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="299" />
+            <location filename="../../ui/panels/points_parts.py" line="173" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="387" />
+            <location filename="../../ui/panels/points_panel.py" line="259" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="390" />
+            <location filename="../../ui/panels/points_panel.py" line="262" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="391" />
+            <location filename="../../ui/panels/points_panel.py" line="263" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="392" />
+            <location filename="../../ui/panels/points_panel.py" line="264" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="412" />
+            <location filename="../../ui/panels/points_panel.py" line="284" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="415" />
+            <location filename="../../ui/panels/points_panel.py" line="287" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="440" />
+            <location filename="../../ui/panels/points_panel.py" line="312" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="448" />
+            <location filename="../../ui/panels/points_panel.py" line="320" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -2991,7 +3011,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="485" />
+            <location filename="../../ui/panels/points_parts.py" line="179" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -3858,77 +3878,77 @@ Remove them all?</source>
     <context>
         <name>SafetyController</name>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="119" />
+            <location filename="../../ui/controllers/safety.py" line="145" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="119" />
+            <location filename="../../ui/controllers/safety.py" line="145" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="120" />
+            <location filename="../../ui/controllers/safety.py" line="146" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="126" />
+            <location filename="../../ui/controllers/safety.py" line="152" />
             <source>Needs the {need} role (you are {role}); log in from the Safety menu</source>
             <translation>需要{need}角色（当前为{role}）；请从“安全”菜单登录</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="298" />
+            <location filename="../../ui/controllers/safety.py" line="327" />
             <source>{axis} = {value:.1f} is within stopping distance of the keep-out zone '{box}' (at {limit:.1f})</source>
             <translation>{axis} = {value:.1f}，已进入禁区“{box}”的停止距离内（边界 {limit:.1f}）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="301" />
+            <location filename="../../ui/controllers/safety.py" line="330" />
             <source>{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}</source>
             <translation>{axis} = {value:.1f}，已进入限位 {limit:.1f} 的停止距离内</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="303" />
+            <location filename="../../ui/controllers/safety.py" line="332" />
             <source>{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)</source>
             <translation>{axis} = {value:.1f} mm 超出允许的工作空间（限值 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="305" />
+            <location filename="../../ui/controllers/safety.py" line="334" />
             <source>The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, its face at {limit:.1f} mm)</source>
             <translation>路径进入禁区“{box}”（{axis} = {value:.1f} mm，边界在 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="308" />
+            <location filename="../../ui/controllers/safety.py" line="337" />
             <source>{axis} = {value:.1f}° is beyond its limit {limit:.1f}°</source>
             <translation>{axis} = {value:.1f}° 超出限位 {limit:.1f}°</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="310" />
+            <location filename="../../ui/controllers/safety.py" line="339" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode</source>
             <translation>速度 {value:g} mm/s 超过降速模式允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="311" />
+            <location filename="../../ui/controllers/safety.py" line="340" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed</source>
             <translation>速度 {value:g} mm/s 超过允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="313" />
+            <location filename="../../ui/controllers/safety.py" line="342" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode</source>
             <translation>点动速度 {value:g} % 超过降速模式允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="314" />
+            <location filename="../../ui/controllers/safety.py" line="343" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed</source>
             <translation>点动速度 {value:g} % 超过允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="318" />
+            <location filename="../../ui/controllers/safety.py" line="347" />
             <source>Segment {k}: {text}</source>
             <translation>第 {k} 段：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="323" />
+            <location filename="../../ui/controllers/safety.py" line="352" />
             <source>Jog stopped before the limit: {why}</source>
             <translation>点动已在到达边界前停止：{why}</translation>
         </message>
@@ -3936,112 +3956,112 @@ Remove them all?</source>
     <context>
         <name>SafetyMenu</name>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="103" />
+            <location filename="../../ui/controllers/safety_menu.py" line="101" />
             <source>&amp;Safety</source>
             <translation>安全(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="104" />
+            <location filename="../../ui/controllers/safety_menu.py" line="102" />
             <source>Log &amp;in…</source>
             <translation>登录(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="105" />
+            <location filename="../../ui/controllers/safety_menu.py" line="103" />
             <source>Log &amp;out (operator)</source>
             <translation>注销(&amp;O)（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="106" />
+            <location filename="../../ui/controllers/safety_menu.py" line="104" />
             <source>&amp;Reduced speed</source>
             <translation>降速模式(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="107" />
+            <location filename="../../ui/controllers/safety_menu.py" line="105" />
             <source>Safety &amp;envelope…</source>
             <translation>安全范围(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="108" />
+            <location filename="../../ui/controllers/safety_menu.py" line="106" />
             <source>Re&amp;gister profile…</source>
             <translation>寄存器配置(&amp;G)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="109" />
+            <location filename="../../ui/controllers/safety_menu.py" line="107" />
             <source>Word order, unit id, completion rule, poll timeout (administrator)</source>
             <translation>字序、站号、完成判定、轮询超时（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="111" />
+            <location filename="../../ui/controllers/safety_menu.py" line="109" />
             <source>&amp;Passwords and lock…</source>
             <translation>密码与锁定(&amp;P)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="112" />
+            <location filename="../../ui/controllers/safety_menu.py" line="110" />
             <source>Set, change or clear passwords; the idle lock time (administrator)</source>
             <translation>设置、修改或清除密码；空闲锁定时间（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="114" />
+            <location filename="../../ui/controllers/safety_menu.py" line="112" />
             <source>&amp;Audit trail…</source>
             <translation>审计记录(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="115" />
+            <location filename="../../ui/controllers/safety_menu.py" line="113" />
             <source>Write a &amp;support bundle…</source>
             <translation>生成支持包(&amp;S)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="128" />
+            <location filename="../../ui/controllers/safety_menu.py" line="126" />
             <source>Role: {role} · reduced speed</source>
             <translation>角色：{role} · 降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="128" />
+            <location filename="../../ui/controllers/safety_menu.py" line="126" />
             <source>Role: {role}</source>
             <translation>角色：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="136" />
+            <location filename="../../ui/controllers/safety_menu.py" line="134" />
             <source>Cap jog and move speeds (anyone may switch it on)</source>
             <translation>限制点动与移动速度（任何人都可开启）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="140" />
+            <location filename="../../ui/controllers/safety_menu.py" line="138" />
             <source>safety</source>
             <translation>安全</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="189" />
+            <location filename="../../ui/controllers/safety_menu.py" line="187" />
             <source>The register profile could not be saved: {why}</source>
             <translation>寄存器配置无法保存：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="194" />
+            <location filename="../../ui/controllers/safety_menu.py" line="192" />
             <source>Register profile “{name}” saved (revision {rev})</source>
             <translation>寄存器配置“{name}”已保存（第 {rev} 版）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="204" />
+            <location filename="../../ui/controllers/safety_menu.py" line="202" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="211" />
+            <location filename="../../ui/controllers/safety_menu.py" line="209" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="232" />
+            <location filename="../../ui/controllers/safety_menu.py" line="231" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="233" />
+            <location filename="../../ui/controllers/safety_menu.py" line="232" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="237" />
+            <location filename="../../ui/controllers/safety_menu.py" line="236" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
@@ -4722,118 +4742,118 @@ Remove them all?</source>
     <context>
         <name>WindowActions</name>
         <message>
-            <location filename="../../ui/window_actions.py" line="131" />
+            <location filename="../../ui/window_actions.py" line="151" />
             <source>Show &amp;monitor</source>
             <translation>显示监视(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="131" />
+            <location filename="../../ui/window_actions.py" line="151" />
             <source>Show &amp;points</source>
             <translation>显示点位(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="132" />
+            <location filename="../../ui/window_actions.py" line="152" />
             <source>Show p&amp;lanner</source>
             <translation>显示轨迹规划(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="134" />
+            <location filename="../../ui/window_actions.py" line="154" />
             <source>&amp;File</source>
             <translation>文件(&amp;F)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="135" />
+            <location filename="../../ui/window_actions.py" line="155" />
             <source>&amp;Edit</source>
             <translation>编辑(&amp;E)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="136" />
+            <location filename="../../ui/window_actions.py" line="156" />
             <source>&amp;Motion</source>
             <translation>运动(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="137" />
+            <location filename="../../ui/window_actions.py" line="157" />
             <source>&amp;View</source>
             <translation>视图(&amp;V)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="138" />
+            <location filename="../../ui/window_actions.py" line="158" />
             <source>&amp;Language</source>
             <translation>语言(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="139" />
+            <location filename="../../ui/window_actions.py" line="159" />
             <source>&amp;Help</source>
             <translation>帮助(&amp;H)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="140" />
-            <location filename="../../ui/window_actions.py" line="141" />
+            <location filename="../../ui/window_actions.py" line="160" />
+            <location filename="../../ui/window_actions.py" line="161" />
             <source>Toolbar</source>
             <translation>工具栏</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="142" />
+            <location filename="../../ui/window_actions.py" line="162" />
             <source>&amp;Connect…</source>
             <translation>连接(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="143" />
+            <location filename="../../ui/window_actions.py" line="163" />
             <source>Connect to a controller (Ctrl+K)</source>
             <translation>连接控制器（Ctrl+K）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="144" />
+            <location filename="../../ui/window_actions.py" line="164" />
             <source>&amp;Disconnect</source>
             <translation>断开(&amp;D)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="145" />
+            <location filename="../../ui/window_actions.py" line="165" />
             <source>&amp;Quit</source>
             <translation>退出(&amp;Q)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="146" />
+            <location filename="../../ui/window_actions.py" line="166" />
             <source>&amp;Stop</source>
             <translation>停止(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="147" />
+            <location filename="../../ui/window_actions.py" line="167" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="148" />
+            <location filename="../../ui/window_actions.py" line="168" />
             <source>&amp;Pause</source>
             <translation>暂停(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="149" />
+            <location filename="../../ui/window_actions.py" line="169" />
             <source>Pause the current move or program (F6)</source>
             <translation>暂停当前运动或程序（F6）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="150" />
+            <location filename="../../ui/window_actions.py" line="170" />
             <source>&amp;Resume</source>
             <translation>继续(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="151" />
+            <location filename="../../ui/window_actions.py" line="171" />
             <source>Resume the paused move or program (F7)</source>
             <translation>继续已暂停的运动或程序（F7）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="152" />
+            <location filename="../../ui/window_actions.py" line="172" />
             <source>&amp;About TeachPad</source>
             <translation>关于 TeachPad(&amp;A)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="153" />
+            <location filename="../../ui/window_actions.py" line="173" />
             <source>&amp;Touch mode</source>
             <translation>触摸模式(&amp;T)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="154" />
+            <location filename="../../ui/window_actions.py" line="174" />
             <source>Bigger motion buttons and an on-screen keypad for numbers</source>
             <translation>更大的运动按钮，数字输入使用屏幕小键盘</translation>
         </message>

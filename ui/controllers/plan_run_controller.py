@@ -11,7 +11,19 @@ Each segment's outcome comes back on its own :class:`~app.link.robot_link.Pendin
 (``link.track(link.move_to_point(...))``: the link matches request ids, including "cancelled by
 Stop" and refusals); everything else (acknowledgements, other panels' commands) never reaches
 the run. A failed stop request of ours ends a run that is stopping. Connection and pose come
-from ``link.state`` (:class:`~app.link.state.RobotState`).
+from ``link.state`` (:class:`~app.link.state.RobotState`), never a copy kept here.
+
+**The point guard** (given a :class:`~ui.models.points_model.PointsModel`: ``points=`` or
+:meth:`PlanRunController.set_points`; the main window always gives one): the controller's temp
+points are never assumed (:mod:`ui.controllers.run_points`). Before each segment's move its
+points are created again from the ledger, in the worker thread (one ``link.upload_points``
+request; the move goes out when it has succeeded, or on Resume when the operator paused
+meanwhile), and after the move the pose polled with its completion is compared with the
+ledger's end point. A point that is not created, or an arrival off by more than 1 mm (the point
+was overwritten by another tool), ends the run in ``FAILED`` at that segment with a sentence
+from :mod:`ui.messages`; nothing further moves. ``segmentPrepared(int, object)`` (index, point
+ids) is emitted right before each guarded move is sent. Without a points model the run is
+not guarded (unit tests of the sequencing only).
 """
 
 from __future__ import annotations
@@ -25,10 +37,14 @@ from app.errors import LinkError, Reason, TeachPadError
 from app.link.robot_link import LinkPort, Pending
 from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult, Pose
-from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState
+from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState, SegmentCommand
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
+from ui.controllers.run_points import RunPoints, SegmentPoints
 from ui.messages import error_text, result_text
+from ui.models.points_model import PointsModel
+
+POSE_DETAIL_KEYS: tuple[str, ...] = ("x", "y", "z", "a", "b", "c")
 
 
 class PlanRunController(QObject):
@@ -36,10 +52,13 @@ class PlanRunController(QObject):
 
     Signals: ``runningChanged(bool)``, ``pausedChanged(bool)``, ``progressChanged(object)``
     (:class:`RunProgress`, every segment start / end), ``segmentStarted(int, int)`` (0-based
-    index, 1-based loop), ``runFinished(object)`` (:class:`RunOutcome`), ``connectedChanged(bool)``,
+    index, 1-based loop), ``runFinished(object)`` (:class:`RunOutcome`), ``connectedChanged(bool)``
+    (``link.state.connected``, at each connection change of the state),
     ``poseChanged(object)`` (the link's pose, forwarded for the preview), ``pointsMissing(object)``
     (list of point ids: the controller answered "bad end point id", so it does not hold the
-    segment's points — e.g. it restarted without the link noticing).
+    segment's points — e.g. it restarted without the link noticing), ``segmentPrepared(int,
+    object)`` (index, list of point ids re-created: the guarded move goes out next),
+    ``pointMismatch(int)`` (end point id: the arm did not arrive at the ledger's copy).
     """
 
     runningChanged = Signal(bool)
@@ -50,14 +69,20 @@ class PlanRunController(QObject):
     connectedChanged = Signal(bool)
     poseChanged = Signal(object)
     pointsMissing = Signal(object)
+    segmentPrepared = Signal(int, object)
+    pointMismatch = Signal(int)
 
-    def __init__(self, link: LinkPort | None = None, parent: QObject | None = None) -> None:
+    def __init__(self, link: LinkPort | None = None, parent: QObject | None = None, *,
+                 points: PointsModel | None = None) -> None:
         super().__init__(parent)
         self._link: LinkPort | None = None
         self._runner: PlanRunner | None = None
         self._plan: Plan | None = None
         self._paused = False
-        self._connected = False
+        self._guard: RunPoints | None = RunPoints(points) if points is not None else None
+        self._upload: Pending | None = None  # the re-creation of the running segment's points
+        self._prepared: SegmentPoints | None = None  # the running segment's points, as sent
+        self._held: SegmentCommand | None = None  # created while paused: the move waits for Resume
         self._outcome: RunOutcome | None = None
         self.end_reason = ""  # why the last run stopped or failed, translated (outcome_text)
         self._progress: RunProgress | None = None
@@ -73,7 +98,16 @@ class PlanRunController(QObject):
         self._link = link
         link.state.connectionChanged.connect(self._on_connection)
         link.state.poseChanged.connect(self.poseChanged)
-        self._set_connected(link.state.connected)
+        link.pointUploaded.connect(self._on_point_uploaded)
+
+    def set_points(self, points: PointsModel) -> None:
+        """Guard every run from now on with this ledger (see the module docstring)."""
+        self._guard = RunPoints(points)
+
+    @property
+    def guarded(self) -> bool:
+        """Runs re-create each segment's points and check the arrival."""
+        return self._guard is not None
 
     # --- state
     @property
@@ -82,7 +116,8 @@ class PlanRunController(QObject):
 
     @property
     def connected(self) -> bool:
-        return self._connected
+        """The link's connection (``link.state``), never a copy."""
+        return self._link is not None and self._link.state.connected
 
     @property
     def running(self) -> bool:
@@ -179,10 +214,14 @@ class PlanRunController(QObject):
             self._set_paused(True)
 
     def resume(self) -> None:
-        """Resume a paused move (not to be confused with :meth:`resume_run`)."""
+        """Resume a paused move (not to be confused with :meth:`resume_run`); a move held
+        because the operator paused while its points were being created goes out now."""
         if self.running and self._paused and self._link is not None:
             self._link.resume()
             self._set_paused(False)
+            held, self._held = self._held, None
+            if held is not None:
+                self._send_move(self._link, held)
 
     def outcome_text(self, outcome: RunOutcome) -> str:
         """How a stopped or failed run ended, in the operator's language (one sentence)."""
@@ -209,13 +248,16 @@ class PlanRunController(QObject):
         runner.request_stop()
         self.end_reason = self.tr("stopped by the operator")
         self._set_paused(False)
-        if runner.state is not RunState.RUNNING or not self._connected:
+        if runner.state is not RunState.RUNNING or not self.connected \
+                or (self._move is None and self._upload is None):
+            # nothing out that could report the stop (e.g. a move held by a pause)
+            self._clear_segment()
             runner.on_stopped()
             self._finish()
 
     # --- internals
     def _require_link(self) -> LinkPort:
-        if self._link is None or not self._connected:
+        if self._link is None or not self.connected:
             raise LinkError("not connected to a controller")
         return self._link
 
@@ -223,11 +265,6 @@ class PlanRunController(QObject):
         if paused != self._paused:
             self._paused = paused
             self.pausedChanged.emit(paused)
-
-    def _set_connected(self, connected: bool) -> None:
-        if connected != self._connected:
-            self._connected = connected
-            self.connectedChanged.emit(connected)
 
     def _on_progress(self, progress: RunProgress) -> None:
         self._progress = progress
@@ -242,7 +279,82 @@ class PlanRunController(QObject):
         if command is None:
             self._finish()
             return
+        if self._guard is not None:
+            self._prepare(link, self._guard, command)
+        else:
+            self._send_move(link, command)
+
+    def _prepare(self, link: LinkPort, guard: RunPoints, command: SegmentCommand) -> None:
+        """Create the segment's points from the ledger (worker thread); the move follows."""
+        try:
+            prepared = guard.begin(command.segment)
+        except TeachPadError as exc:
+            self._fail_segment(exc)
+            return
+        self._prepared = prepared
+        upload = link.track(link.upload_points(prepared.items()))
+        self._upload = upload
+        upload.finished.connect(lambda result: self._on_upload(upload, result))
+        upload.failed.connect(lambda error: self._on_upload_error(upload, error))
+
+    def _on_upload(self, upload: Pending, result: CommandResult) -> None:
+        runner, guard, link = self._runner, self._guard, self._link
+        if upload is not self._upload or runner is None or runner.state is not RunState.RUNNING \
+                or guard is None or link is None:
+            return
+        self._upload = None
+        prepared = guard.finish_upload(link.state.connection.endpoint)
+        guard.clear()
+        command = runner.current
+        assert command is not None and prepared is not None
+        if runner.stop_requested:
+            self._clear_segment()
+            runner.on_stopped(self.end_reason or "stopped by the operator")
+            self._finish()
+        elif not (result.ok and prepared.all_created):
+            self._fail_segment(guard.not_created(prepared))
+        elif self._paused:
+            self._held = command  # Resume sends it
+        else:
+            self._send_move(link, command)
+
+    def _on_upload_error(self, upload: Pending, error: WorkerError) -> None:
+        runner = self._runner
+        if upload is not self._upload or runner is None or runner.state is not RunState.RUNNING:
+            return
+        self._upload = None
+        if self._guard is not None:
+            self._guard.finish_upload(self._link.state.connection.endpoint if self._link else "")
+            self._guard.clear()
+        self.end_reason = error_text(error)
+        self._clear_segment()
+        runner.on_error(TeachPadError(self.end_reason))
+        self._after_report()
+
+    def _fail_segment(self, error: TeachPadError) -> None:
+        """End the run at the running segment with ``error`` (its sentence is the end reason)."""
+        runner = self._runner
+        assert runner is not None
+        self.end_reason = error_text(error)
+        self._clear_segment()
+        runner.on_error(error)
+        self._after_report()
+
+    def _clear_segment(self) -> None:
+        self._upload = None
+        self._prepared = None
+        self._held = None
+        if self._guard is not None:
+            self._guard.clear()
+
+    def _on_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
+        if self._upload is not None and self._guard is not None:
+            self._guard.on_point_uploaded(point_id, ok, reason, unconfirmed)
+
+    def _send_move(self, link: LinkPort, command: SegmentCommand) -> None:
         seg = command.segment
+        if self._prepared is not None:
+            self.segmentPrepared.emit(command.index, list(self._prepared.points))
         self._sent.append(command.index)
         move = link.track(link.move_to_point(
             seg.end_id, seg.via_id, orientation_changes=seg.orientation_changes,
@@ -272,6 +384,13 @@ class PlanRunController(QObject):
         if move is not self._move or runner is None or runner.state is not RunState.RUNNING:
             return
         self._move = None
+        prepared, self._prepared = self._prepared, None
+        if result.ok and prepared is not None and self._guard is not None:
+            error = self._guard.check_arrival(prepared, _pose_of(result, self.last_pose))
+            if error is not None:
+                self.pointMismatch.emit(prepared.end_id)
+                self._fail_segment(error)
+                return
         current = runner.current
         missing = (not result.ok and result.status is not None
                    and result.status.code == MoveStatus.BAD_END_POINT and current is not None)
@@ -289,6 +408,7 @@ class PlanRunController(QObject):
         if move is not self._move or runner is None or runner.state is not RunState.RUNNING:
             return
         self._move = None
+        self._prepared = None
         self.end_reason = error_text(error)
         runner.on_error(TeachPadError(self.end_reason))
         self._after_report()
@@ -297,17 +417,31 @@ class PlanRunController(QObject):
         runner = self._runner
         if stop is self._stop and runner is not None and runner.state is RunState.RUNNING \
                 and runner.stop_requested:
+            self._clear_segment()
             self.end_reason = error_text(error)
             runner.on_stopped(self.end_reason)
             self._finish()
 
     @Slot(ConnectionState)
     def _on_connection(self, state: ConnectionState) -> None:
-        self._set_connected(state.connected)
+        self.connectedChanged.emit(state.connected)
         runner = self._runner
         if not state.connected and runner is not None and runner.state is RunState.RUNNING:
             self._move = None
+            if self._upload is not None and self._guard is not None:
+                self._guard.finish_upload(state.endpoint)  # what the worker reported so far
+            self._clear_segment()
             where = {"endpoint": state.endpoint} if state.endpoint else {}
             self.end_reason = error_text(Reason("link_lost", where))
             runner.on_error(LinkError(f"link lost: {state.message or 'link lost'}"))
             self._finish()
+
+
+def _pose_of(result: CommandResult, fallback: Pose | None) -> Pose | None:
+    """The pose that came with the result (``x``..``c`` details), else the link's latest pose:
+    the poll that completed the move publishes its pose before the result."""
+    details = result.details
+    if all(k in details for k in POSE_DETAIL_KEYS):
+        x, y, z, a, b, c = (float(details[k]) for k in POSE_DETAIL_KEYS)
+        return Pose(x, y, z, a, b, c, ext=fallback.ext if fallback else (0.0,) * 5)
+    return fallback

@@ -11,7 +11,10 @@ own :class:`~app.link.robot_link.Pending` (``link.track(request_id)``), so nothi
 ids. Connection and pose are read from ``link.state`` (:class:`~app.link.state.RobotState`). An
 upload is one request: ``pointUploaded`` marks each point on the controller / failed as it goes
 (applied to the ledger at each ``uploadProgress`` and at the end, so a cancel or a lost link
-half way leaves exact states), and the batch's result ends it. Teach reads the pose back from
+half way leaves exact states), and the batch's result ends it. The points the controller
+created go into the project's upload history as they are applied (``project.record_upload``
+with the link's endpoint, like the CLI's ``points upload``): history only, never proof that
+the controller still holds them. Teach reads the pose back from
 the ``x``..``c`` details that the link adds to a successful create-point result (the pose
 polled together with the completion); without them it uses the state's latest pose.
 """
@@ -72,7 +75,8 @@ class _Upload:
 class PointSyncController(QObject):
     """Teach / upload / restore / move for the ledger through the link (GUI thread).
 
-    Signals: ``busyChanged(bool)``, ``connectedChanged(bool)``, ``statusMessage(str, str)``
+    Signals: ``busyChanged(bool)``, ``connectedChanged(bool)`` (``link.state.connected``, at each
+    connection change of the state), ``statusMessage(str, str)``
     (text, level "info" / "warn" / "error"), ``pointTaught(int)`` (id), ``uploadProgress(int,
     int)`` (points done, total), ``uploadFinished(object)`` (:class:`UploadReport` of the whole
     request), ``restoreOffered(bool)`` (show / hide "Restore all"), ``moveFinished(bool, str)``.
@@ -92,7 +96,6 @@ class PointSyncController(QObject):
         super().__init__(parent)
         self._model = model
         self._link: LinkPort | None = None
-        self._connected = False
         self._operation = ""  # "teach" | "upload" | "move" | ""
         self._teach_id: int | None = None
         self._teach_name = ""
@@ -115,7 +118,8 @@ class PointSyncController(QObject):
 
     @property
     def connected(self) -> bool:
-        return self._connected
+        """The link's connection (``link.state``), never a copy."""
+        return self._link is not None and self._link.state.connected
 
     @property
     def busy(self) -> bool:
@@ -149,7 +153,6 @@ class PointSyncController(QObject):
         link.controllerRestarted.connect(self._on_reconnected)  # the same path: the points may be gone
         link.uploadProgress.connect(self._on_upload_progress)
         link.pointUploaded.connect(self._on_point_uploaded)
-        self._set_connected(link.state.connected)
 
     # --- operations (return False, with a statusMessage, when they cannot start)
     def teach(self, name: str = "") -> int | None:
@@ -266,7 +269,7 @@ class PointSyncController(QObject):
         pending.failed.connect(lambda error: self._on_error(pending, error))
 
     def _ready(self, what: str) -> LinkPort | None:
-        if self._link is None or not self._connected:
+        if self._link is None or not self.connected:
             self._say(self.tr("{what}: not connected to a controller").format(what=what), LEVEL_ERROR)
             return None
         if self._operation:
@@ -285,11 +288,6 @@ class PointSyncController(QObject):
         if was != bool(operation):
             self.busyChanged.emit(bool(operation))
 
-    def _set_connected(self, connected: bool) -> None:
-        if connected != self._connected:
-            self._connected = connected
-            self.connectedChanged.emit(connected)
-
     def _offer_restore(self, offered: bool) -> None:
         if offered != self._restore_offered:
             self._restore_offered = offered
@@ -298,7 +296,7 @@ class PointSyncController(QObject):
     @Slot(ConnectionState)
     def _on_connection(self, state: ConnectionState) -> None:
         connected = state.connected
-        self._set_connected(connected)
+        self.connectedChanged.emit(connected)
         if not connected and self._operation:
             reason = state.message or self.tr("link lost")
             if self._upload is not None:
@@ -413,6 +411,10 @@ class PointSyncController(QObject):
         upload = self._upload
         if upload is not None and upload.pending:
             batch, upload.pending = upload.pending, []
+            created = [o.point_id for o in batch if o.ok]
+            if created:  # before the sync states: the project's dirty check follows syncChanged
+                endpoint = self._link.state.connection.endpoint if self._link is not None else ""
+                self._model.project.record_upload(created, endpoint or "controller")
             self._model.apply_upload(UploadReport(outcomes=batch))
 
     @Slot(int, int)

@@ -1,0 +1,162 @@
+"""The guarded run's sequencing, step by step, on the typed fake link (the tests play the
+worker): upload of the segment's points first, then the move, then the arrival check."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pytest
+from PySide6.QtGui import QUndoStack
+
+from app.link.types import WorkerError
+from app.models import Pose
+from app.plan.runner import RunState
+from app.plan.segments import Plan, Segment
+from app.points.ledger import SyncState
+from app.points.point import make_point
+from app.points.project import Project
+from tests.ui.fake_link import FakeLink
+from tests.ui.pendant_support import translator_fixture  # noqa: F401 - fixture
+from ui.controllers.plan_run_controller import PlanRunController
+from ui.models.points_model import PointsModel
+
+P1 = (400.0, 0.0, 300.0, 180.0, 0.0, 0.0)
+P2 = (430.0, 0.0, 300.0, 180.0, 0.0, 0.0)
+P3 = (430.0, 30.0, 300.0, 180.0, 0.0, 0.0)
+
+
+@pytest.fixture
+def project() -> Project:
+    project = Project(plans=[Plan("p", [Segment.line(1), Segment.arc(2, 3)])])
+    project.ledger.replace_all([make_point(1, "", P1, tool=3), make_point(2, "", P2), make_point(3, "", P3)])
+    return project
+
+
+@pytest.fixture
+def link() -> FakeLink:
+    return FakeLink()
+
+
+@pytest.fixture
+def runs(qtbot: Any, link: FakeLink, project: Project) -> PlanRunController:
+    return PlanRunController(link, points=PointsModel(project, QUndoStack()))
+
+
+def _at(link: FakeLink, xyzabc: tuple[float, ...]) -> None:
+    x, y, z, a, b, c = xyzabc
+    link.state.set_pose(Pose(x, y, z, a, b, c, ext=(0.0,) * 5))
+
+
+def test_points_first_then_the_move_then_the_arrival(qtbot: Any, runs: PlanRunController, link: FakeLink,
+                                                    project: Project) -> None:
+    assert runs.guarded
+    runs.run(project.plans[0])
+    assert [c.name for c in link.calls] == ["upload_points"]
+    assert link.named("upload_points")[0].args[0] == [(1, P1, 3)]  # the ledger's values and tool
+    link.point_ok(1)
+    link.upload_summary(1, 1)
+    assert [c.name for c in link.calls] == ["upload_points", "move_to_point"]
+    _at(link, P1)
+    link.finish_move()
+    # the arc: its middle and end points, then the move through them
+    assert link.named("upload_points")[1].args[0] == [(2, P2, 200), (3, P3, 200)]
+    link.point_ok(2, 3)
+    link.upload_summary(2, 2)
+    assert link.named("move_to_point")[1].args[:2] == (3, 2)
+    _at(link, P3)
+    with qtbot.waitSignal(runs.runFinished) as finished:
+        link.finish_move()
+    assert finished.args[0].state is RunState.FINISHED
+
+
+def test_an_arrival_elsewhere_fails_the_run_and_marks_the_point_unknown(
+        qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project) -> None:
+    runs.run(project.plans[0])
+    link.point_ok(1)
+    link.upload_summary(1, 1)
+    _at(link, P2)  # 30 mm off P1
+    with qtbot.waitSignal(runs.runFinished) as finished, qtbot.waitSignal(runs.pointMismatch) as mismatch:
+        link.finish_move()
+    outcome = finished.args[0]
+    assert outcome.state is RunState.FAILED and outcome.resume_from == 0 and mismatch.args == [1]
+    assert "30.00 mm from P1" in runs.outcome_text(outcome)
+    assert project.ledger.point(1).sync is SyncState.UNKNOWN
+    assert len(link.named("upload_points")) == 1  # nothing more was sent
+
+
+def test_an_arrival_without_a_pose_is_not_taken_as_done(qtbot: Any, runs: PlanRunController,
+                                                       link: FakeLink, project: Project) -> None:
+    runs.step(project.plans[0], 0)
+    link.point_ok(1)
+    link.upload_summary(1, 1)
+    with qtbot.waitSignal(runs.runFinished) as finished:
+        link.finish_move()
+    assert finished.args[0].state is RunState.FAILED
+    assert "position after the move to P1 is not known" in runs.outcome_text(finished.args[0])
+
+
+def test_link_lost_while_the_points_are_created(qtbot: Any, runs: PlanRunController, link: FakeLink,
+                                               project: Project) -> None:
+    runs.step(project.plans[0], 1)
+    link.point_ok(2)  # P2 made it, P3 did not
+    with qtbot.waitSignal(runs.runFinished) as finished:
+        link.set_connected(False, "connection reset")
+    assert finished.args[0].state is RunState.FAILED and finished.args[0].resume_from == 1
+    assert link.named("move_to_point") == []
+    assert project.ledger.point(2).sync is SyncState.ON_CONTROLLER and set(project.upload_history) == {2}
+    link.upload_summary(1, 2, "link lost")  # the worker's late summary: not the run's any more
+    assert not runs.running and link.named("move_to_point") == []
+
+
+def test_an_upload_the_worker_refuses_ends_the_run(qtbot: Any, runs: PlanRunController, link: FakeLink,
+                                                  project: Project) -> None:
+    runs.run(project.plans[0])
+    with qtbot.waitSignal(runs.runFinished) as finished:
+        link.errorOccurred.emit(WorkerError("upload points", "jog is still under way",
+                                            link.last_id("upload_points")))
+    assert finished.args[0].state is RunState.FAILED and link.named("move_to_point") == []
+    assert "jog is still under way" in runs.outcome_text(finished.args[0])
+
+
+def test_a_stop_during_the_upload_ends_the_run_stopped(qtbot: Any, runs: PlanRunController, link: FakeLink,
+                                                      project: Project) -> None:
+    runs.run(project.plans[0])
+    runs.stop()
+    assert runs.running  # until the worker ends the upload
+    with qtbot.waitSignal(runs.runFinished) as finished:
+        link.upload_summary(0, 1, "stopped")
+    assert finished.args[0].state is RunState.STOPPED and finished.args[0].resume_from == 0
+    assert link.named("move_to_point") == []
+
+
+def test_a_stop_after_the_upload_ended_in_the_worker_sends_no_move(qtbot: Any, runs: PlanRunController,
+                                                                   link: FakeLink, project: Project) -> None:
+    runs.run(project.plans[0])
+    link.point_ok(1)
+    runs.stop()  # the upload's good summary is still on its way
+    with qtbot.waitSignal(runs.runFinished) as finished:
+        link.upload_summary(1, 1)
+    assert finished.args[0].state is RunState.STOPPED and link.named("move_to_point") == []
+
+
+def test_without_a_points_model_the_run_is_not_guarded(link: FakeLink, project: Project) -> None:
+    runs = PlanRunController(link)
+    assert not runs.guarded
+    runs.run(project.plans[0])
+    assert [c.name for c in link.calls] == ["move_to_point"]
+    runs.set_points(PointsModel(project, QUndoStack()))
+    assert runs.guarded
+
+
+def test_the_guard_speaks_chinese(qtbot: Any, translator: Any, runs: PlanRunController, link: FakeLink,
+                                  project: Project) -> None:
+    assert translator.set_language("zh_CN")
+    runs.run(project.plans[0])
+    link.point_ok(1)
+    link.upload_summary(1, 1)
+    _at(link, P2)
+    with qtbot.waitSignal(runs.runFinished) as finished:
+        link.finish_move()
+    text = runs.outcome_text(finished.args[0])
+    assert "机械臂停在 (430.00, 0.00, 300.00)，距 P1 (400.00, 0.00, 300.00) 30.00 mm" in text
+    assert "在第 1 段失败" in text
