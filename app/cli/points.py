@@ -1,13 +1,12 @@
-"""``teachpad-cli`` commands for temp points and plans: ``points ...`` and ``run``.
+"""``teachpad-cli points ...``: the temp points of a project (list, upload, export, import).
 
-``run`` lives in :mod:`app.cli.run_plan` (registered from here). Plugging in: ``app/cli.py``
-imports this module (it is in its ``PLUGIN_MODULES``) and calls
-``register(subparsers)``, which adds ``points`` (list / upload / export / import) and ``run``
-and sets ``handler`` on each with ``set_defaults``. A handler can be called two ways:
+:func:`register` adds ``points`` to the main parser (``app/cli/main.py`` lists it with the other
+modules' registrars); ``run`` lives in :mod:`app.cli.run_plan`, which shares this module's
+helpers. A handler can be called two ways:
 
-* ``args.handler(ctx)`` with ``app.cli.main.CliContext`` (what ``app/cli.py`` does): uses
-  ``ctx.args``, the lazily connected ``ctx.client``, ``ctx.out`` / ``ctx.err``; the context
-  closes the client.
+* ``args.handler(ctx)`` with :class:`app.cli.context.CliContext` (what ``app/cli/main.py``
+  does): uses ``ctx.args``, the lazily connected ``ctx.client``, ``ctx.out`` / ``ctx.err``;
+  the context closes the client.
 * ``args.handler(args, make_client)``: ``make_client()`` returns a connected ``RobotClient``
   built from the global options (``--host --port --unit`` ...); the handler closes it.
 
@@ -16,10 +15,8 @@ Either way the client is asked for only by commands that talk to the controller
 ``read_pose``, ``create_point``, ``move_to_point``, ``stop`` (duck-typed). The ``cmd_*``
 functions take ``(args, make_client, *, out=None, err=None, close_client=True)``.
 
-Exit codes, as ``app/cli.py``: 0 ok; 1 failed (controller refused, run failed or stopped,
-points not on the controller without ``--upload``); 2 usage (bad arguments, a malformed
-file, a plan with errors; nothing sent); 3 link (cannot connect, no answer); 130 interrupted
-(Ctrl-C; a motion under way is stopped first). Global options read when the main parser
+Exit codes: :class:`app.cli.exit_codes.ExitCode` (points not on the controller without
+``--upload`` is FAILED; a malformed file is USAGE). Global options read when the main parser
 defines them: ``point_id_min``, ``point_id_max`` (accepted temp point ids, default 0..10000).
 
 Commands::
@@ -28,19 +25,10 @@ Commands::
     points upload PROJECT [--ids 1,2,5-9 | --needed]
     points export PROJECT --csv OUT [--no-bom]
     points import PROJECT --csv IN [--merge] [--allow-empty]   # creates PROJECT if missing
-    run PROJECT [--plan NAME] [--loops N] [--from K] [--from-loop I] [--single]
-                [--no-upload] [--check] [--max-speed MM_S]
 
-Segment numbers on the command line and in messages count from 1. ``run`` checks the plan
-first (the GUI's checks): errors refuse to run. A project file cannot know what the
-controller holds, so ``run`` uploads every point its plan uses before the first move, then
-guards each segment (:class:`app.points.guard.PointGuard`): restart canary check, the
-segment's points re-created from the project right before its move, the arrival pose
-verified after it. ``--no-upload`` skips the uploads (the operator answers for the
-controller's points); the arrival check stays. A failed or interrupted run prints the
-``--from`` / ``--from-loop`` that resumes it. Commands that write the project refuse while
-another TeachPad has it open (:mod:`app.points.lock`); ``points upload`` in monitor-only mode
-refuses before it reads the file.
+Commands that write the project refuse while another TeachPad has it open
+(:mod:`app.points.lock`); ``points upload`` in monitor-only mode refuses before it reads the
+file.
 """
 
 from __future__ import annotations
@@ -53,22 +41,21 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from app.errors import InvalidInput, LinkError, ResponseTimeout, TeachPadError
-from app.plan.checks import PlanLimits
+from app.cli.context import PROG
+from app.cli.exit_codes import ExitCode, exit_code_for
+from app.errors import InvalidInput, TeachPadError
 from app.points.ledger import EmptyImport, ImportMode, PointLedger
 from app.points.lock import live_owner
 from app.points.point import DEFAULT_LIMITS, FileFormatError, PointLimits, TempPoint, tool_text
 from app.points.project import Project, load_project, read_points_csv, save_project, write_points_csv
 from app.points.upload import UploadReport, apply_upload, parse_id_list, upload_points
 
-PROG = "teachpad-cli"
-
-EXIT_OK = 0
-EXIT_FAILED = 1
-EXIT_USAGE = 2
-EXIT_LINK = 3
-EXIT_INTERRUPTED = 130
-EXIT_NEEDS_UPLOAD = EXIT_FAILED
+# The table's members under the names callers imported before the table existed.
+EXIT_OK = ExitCode.OK
+EXIT_FAILED = ExitCode.FAILED
+EXIT_USAGE = ExitCode.USAGE
+EXIT_LINK = ExitCode.LINK
+EXIT_INTERRUPTED = ExitCode.INTERRUPTED
 
 MakeClient = Callable[[], Any]
 Command = Callable[..., int]
@@ -129,7 +116,7 @@ def fit_width(text: str, width: int) -> str:
 
 
 def register(subparsers: Any) -> None:
-    """Add ``points`` and ``run`` to the main parser's subparsers."""
+    """Add ``points`` (list / upload / export / import) to the main parser's subcommands."""
     points = subparsers.add_parser("points", help="temp points of a project: list, upload, export, import")
     psub = points.add_subparsers(dest="points_command", metavar="ACTION", required=True)
 
@@ -160,28 +147,6 @@ def register(subparsers: Any) -> None:
     p.add_argument("--allow-empty", action="store_true",
                    help="let a CSV without rows replace (delete) all points of the project")
     p.set_defaults(handler=_handler(cmd_points_import))
-
-    r = subparsers.add_parser("run", help="run a plan of a project on the controller (function 3)")
-    r.add_argument("project", type=Path, help=_PROJECT_HELP)
-    r.add_argument("--plan", help="plan name (needed when the project has several)")
-    r.add_argument("--loops", type=int, help="loop count (default: the plan's; 0 = until stopped)")
-    r.add_argument("--from", type=int, default=1, dest="from_segment", metavar="K",
-                   help="start at segment K (counting from 1)")
-    r.add_argument("--from-loop", type=int, default=1, metavar="I", help="start in loop I (to resume)")
-    r.add_argument("--single", action="store_true", help="run segment K only")
-    r.add_argument("--no-upload", action="store_true",
-                   help="do not create the plan's points on the controller before and during the run: "
-                        "the operator is responsible for the controller holding exactly the project's "
-                        "points (the arrival pose is still checked after each segment)")
-    r.add_argument("--upload", action="store_true", help=argparse.SUPPRESS)  # the default now (old scripts)
-    r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
-    r.add_argument("--safety", metavar="PROFILE",
-                   help="a safety profile (.safety.json): the plan must stay in its envelope")
-    r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
-                   help="highest speed a segment may have (default %(default)g mm/s)")
-    from app.cli.run_plan import cmd_run  # imported here: run_plan uses this module's helpers
-
-    r.set_defaults(handler=_handler(cmd_run))
 
 
 # --- helpers ------------------------------------------------------------------------------------
@@ -233,9 +198,9 @@ def _save(io: _Io, project: Project, path: Path) -> bool:
     return True
 
 
-def _link_code(io: _Io, exc: TeachPadError, what: str) -> int:
+def _link_code(io: _Io, exc: TeachPadError, what: str) -> ExitCode:
     io.error(f"{what}: {exc}")
-    return EXIT_LINK if isinstance(exc, LinkError | ResponseTimeout) else EXIT_FAILED
+    return exit_code_for(exc)
 
 
 def _fmt_time(seconds: float) -> str:
@@ -296,24 +261,24 @@ def _upload(io: _Io, project: Project, points: Sequence[TempPoint], client: Any)
     return report
 
 
-def _upload_code(report: UploadReport) -> int:
+def _upload_code(report: UploadReport) -> ExitCode:
     if report.interrupted:
-        return EXIT_INTERRUPTED
+        return ExitCode.INTERRUPTED
     if report.aborted:
-        return EXIT_LINK
-    return EXIT_OK if report.all_ok else EXIT_FAILED
+        return ExitCode.LINK
+    return ExitCode.OK if report.all_ok else ExitCode.FAILED
 
 
 # --- points ------------------------------------------------------------------------------------
 
 
 def cmd_points_list(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                    err: TextIO | None = None, close_client: bool = True) -> int:
+                    err: TextIO | None = None, close_client: bool = True) -> ExitCode:
     """``points list PROJECT``."""
     io = _Io(out, err)
     project = _load(io, args.project, _limits(args))
     if project is None:
-        return EXIT_USAGE
+        return ExitCode.USAGE
     io.print(f"{project.name}: {len(project.ledger)} point(s), {len(project.plans)} plan(s)")
     for p in project.ledger:
         pose = " ".join(f"{v:9.3f}" for v in p.xyzabc)
@@ -324,29 +289,29 @@ def cmd_points_list(args: argparse.Namespace, make_client: MakeClient, *, out: T
         io.print(f"{p.id:6d}  {fit_width(p.name, NAME_WIDTH)} {pose}  {tool_text(p.tool):14s} {state}")
     for plan in project.plans:
         io.print(f"plan {plan.name!r}: {len(plan)} segment(s), loops {plan.loops or 'until stopped'}")
-    return EXIT_OK
+    return ExitCode.OK
 
 
 def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                      err: TextIO | None = None, close_client: bool = True) -> int:
+                      err: TextIO | None = None, close_client: bool = True) -> ExitCode:
     """``points upload PROJECT [--ids ... | --needed]``; saves the upload history."""
     io = _Io(out, err)
     if _monitor_only(io, args, "points upload"):
-        return EXIT_FAILED
+        return ExitCode.FAILED
     project = _load(io, args.project, _limits(args))
     if project is None:
-        return EXIT_USAGE
+        return ExitCode.USAGE
     ledger = project.ledger
     if args.ids:
         try:
             ids = parse_id_list(args.ids)
         except InvalidInput as exc:
             io.error(str(exc))
-            return EXIT_USAGE
+            return ExitCode.USAGE
         missing = [i for i in ids if i not in ledger]
         if missing:
             io.error(f"no point with id {', '.join(map(str, missing))} in {args.project}")
-            return EXIT_USAGE
+            return ExitCode.USAGE
         points = [ledger.point(i) for i in ids]
     elif args.needed:
         points = ledger.needing_upload()
@@ -354,7 +319,7 @@ def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out:
         points = list(ledger)
     if not points:
         io.print("nothing to upload")
-        return EXIT_OK
+        return ExitCode.OK
     client: Any = None
     try:
         client = make_client()
@@ -366,28 +331,28 @@ def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out:
         if close_client and client is not None:
             client.close()
     if not _save(io, project, args.project):
-        return EXIT_FAILED
+        return ExitCode.FAILED
     return _upload_code(report)
 
 
 def cmd_points_export(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                      err: TextIO | None = None, close_client: bool = True) -> int:
+                      err: TextIO | None = None, close_client: bool = True) -> ExitCode:
     """``points export PROJECT --csv OUT``."""
     io = _Io(out, err)
     project = _load(io, args.project, _limits(args))
     if project is None:
-        return EXIT_USAGE
+        return ExitCode.USAGE
     try:
         write_points_csv(args.csv_path, project.ledger, bom=not args.no_bom)
     except OSError as exc:
         io.error(f"{args.csv_path}: could not write: {exc}")
-        return EXIT_FAILED
+        return ExitCode.FAILED
     io.print(f"wrote {len(project.ledger)} point(s) to {args.csv_path}")
-    return EXIT_OK
+    return ExitCode.OK
 
 
 def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                      err: TextIO | None = None, close_client: bool = True) -> int:
+                      err: TextIO | None = None, close_client: bool = True) -> ExitCode:
     """``points import PROJECT --csv IN [--merge] [--allow-empty]``; the project is saved only if
     all rows are good; a CSV without rows does not replace all points unless ``--allow-empty``."""
     io = _Io(out, err)
@@ -395,7 +360,7 @@ def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out:
     if args.project.exists():
         project = _load(io, args.project, limits)
         if project is None:
-            return EXIT_USAGE
+            return ExitCode.USAGE
     else:
         name = args.project.name.removesuffix(".json").removesuffix(".teachpad")
         project = Project(name=name, ledger=PointLedger((), limits))
@@ -405,15 +370,15 @@ def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out:
                                               allow_empty=getattr(args, "allow_empty", False))
     except EmptyImport as exc:
         io.error(f"{args.csv_path}: {exc}; nothing changed (pass --allow-empty to do it)")
-        return EXIT_USAGE
+        return ExitCode.USAGE
     except InvalidInput as exc:
         io.error(str(exc))
-        return EXIT_USAGE
+        return ExitCode.USAGE
     if not _save(io, project, args.project):
-        return EXIT_FAILED
+        return ExitCode.FAILED
     io.print(f"imported {len(points)} point(s) into {args.project}: {report.text}")
     for plan in project.plans:
         missing = sorted(i for i in plan.point_ids() if i not in project.ledger)
         if missing:
             io.warn(f"plan {plan.name!r} uses points that are gone: {', '.join(map(str, missing))}")
-    return EXIT_OK
+    return ExitCode.OK

@@ -1,28 +1,33 @@
 """``teachpad-cli run PROJECT ...``: check a plan, upload its points, run it guarded.
 
-Registered by :func:`app.cli.points.register` (see that module for the handler conventions
-and exit codes). A project file cannot know what the controller holds, so ``run`` creates
-every point its plan uses before the first move and guards each segment with
+:func:`register` adds ``run`` to the main parser; the handler conventions and the helpers are
+:mod:`app.cli.points`'s, the exit codes :class:`app.cli.exit_codes.ExitCode`. Segment numbers
+on the command line and in messages count from 1. ``run`` checks the plan first (the GUI's
+checks): errors refuse to run (USAGE). A project file cannot know what the controller holds,
+so ``run`` creates every point its plan uses before the first move and guards each segment with
 :class:`app.points.guard.PointGuard` (restart canary, points re-created right before the move,
 arrival verified after it). ``--no-upload`` skips the uploads: the operator answers for the
-controller's points; the arrival check stays.
+controller's points; the arrival check stays. A failed or interrupted run prints the
+``--from`` / ``--from-loop`` that resumes it.
+
+    run PROJECT [--plan NAME] [--loops N] [--from K] [--from-loop I] [--single]
+                [--no-upload] [--check] [--safety PROFILE] [--max-speed MM_S]
 """
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 from typing import Any, TextIO
 
+from app.cli.context import PROG
+from app.cli.exit_codes import ExitCode, exit_code_for
 from app.cli.points import (
-    EXIT_FAILED,
-    EXIT_INTERRUPTED,
-    EXIT_LINK,
-    EXIT_OK,
-    EXIT_USAGE,
-    PROG,
+    _PROJECT_HELP,
     MakeClient,
     _endpoint,
     _fmt_time,
+    _handler,
     _Io,
     _limits,
     _link_code,
@@ -31,7 +36,7 @@ from app.cli.points import (
     _ProgressLine,
     _save,
 )
-from app.errors import CommandRefused, InvalidInput, LinkError, ResponseTimeout, TeachPadError
+from app.errors import CommandRefused, InvalidInput, TeachPadError
 from app.models import Pose
 from app.plan.checks import IssueKind, PlanLimits, check_plan
 from app.plan.estimates import estimate_plan, segment_timeouts
@@ -43,6 +48,29 @@ from app.points.project import Project
 from app.protocol.enums import MoveStatus
 from app.safety.envelope import Envelope
 from app.safety.profile import load_profile
+
+
+def register(subparsers: Any) -> None:
+    """Add ``run`` to the main parser's subcommands."""
+    r = subparsers.add_parser("run", help="run a plan of a project on the controller (function 3)")
+    r.add_argument("project", type=Path, help=_PROJECT_HELP)
+    r.add_argument("--plan", help="plan name (needed when the project has several)")
+    r.add_argument("--loops", type=int, help="loop count (default: the plan's; 0 = until stopped)")
+    r.add_argument("--from", type=int, default=1, dest="from_segment", metavar="K",
+                   help="start at segment K (counting from 1)")
+    r.add_argument("--from-loop", type=int, default=1, metavar="I", help="start in loop I (to resume)")
+    r.add_argument("--single", action="store_true", help="run segment K only")
+    r.add_argument("--no-upload", action="store_true",
+                   help="do not create the plan's points on the controller before and during the run: "
+                        "the operator is responsible for the controller holding exactly the project's "
+                        "points (the arrival pose is still checked after each segment)")
+    r.add_argument("--upload", action="store_true", help=argparse.SUPPRESS)  # the default now (old scripts)
+    r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
+    r.add_argument("--safety", metavar="PROFILE",
+                   help="a safety profile (.safety.json): the plan must stay in its envelope")
+    r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
+                   help="highest speed a segment may have (default %(default)g mm/s)")
+    r.set_defaults(handler=_handler(cmd_run))
 
 
 def _pick_plan(io: _Io, project: Project, name: str | None) -> Plan | None:
@@ -63,17 +91,17 @@ def _pick_plan(io: _Io, project: Project, name: str | None) -> Plan | None:
 
 
 def _upload_plan_points(io: _Io, args: argparse.Namespace, project: Project, guard: PointGuard,
-                        plan_ids: list[int], client: Any) -> int:
+                        plan_ids: list[int], client: Any) -> ExitCode:
     """Create the plan's points before the first move; records the history in the project."""
     io.print(f"uploading the plan's {len(plan_ids)} point(s): {', '.join(map(str, plan_ids))}")
     try:
         guard.ensure(client, plan_ids)
     except KeyboardInterrupt:
         io.error("interrupted while uploading: not running")
-        return EXIT_INTERRUPTED
+        return ExitCode.INTERRUPTED
     except PointNotCreated as exc:
         io.error(f"{exc}: not running")
-        return EXIT_FAILED
+        return ExitCode.FAILED
     except TeachPadError as exc:
         return _link_code(io, exc, "cannot upload the plan's points")
     finally:
@@ -82,7 +110,7 @@ def _upload_plan_points(io: _Io, args: argparse.Namespace, project: Project, gua
     if owner is None:
         _save(io, project, args.project)  # the upload history; a failed save does not stop the run
     io.print(f"uploaded {len(guard.uploaded)} point(s)")
-    return EXIT_OK
+    return ExitCode.OK
 
 
 def _points_lost(error: BaseException | None) -> bool:
@@ -90,17 +118,17 @@ def _points_lost(error: BaseException | None) -> bool:
 
 
 def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-            err: TextIO | None = None, close_client: bool = True) -> int:
+            err: TextIO | None = None, close_client: bool = True) -> ExitCode:
     """``run PROJECT [--plan NAME] ...``: check, upload, run guarded with a progress line."""
     io = _Io(out, err)
     if not args.check and _monitor_only(io, args, "run"):
-        return EXIT_FAILED
+        return ExitCode.FAILED
     project = _load(io, args.project, _limits(args))
     if project is None:
-        return EXIT_USAGE
+        return ExitCode.USAGE
     plan = _pick_plan(io, project, args.plan)
     if plan is None:
-        return EXIT_USAGE
+        return ExitCode.USAGE
     loops = plan.loops if args.loops is None else args.loops
     start = args.from_segment - 1
     try:
@@ -113,7 +141,7 @@ def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | 
             raise InvalidInput(f"--from-loop {args.from_loop}: the run has loops 1..{loops}")
     except InvalidInput as exc:
         io.error(str(exc))
-        return EXIT_USAGE
+        return ExitCode.USAGE
 
     envelope: Envelope | None = None
     if getattr(args, "safety", None):
@@ -121,7 +149,7 @@ def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | 
             envelope = load_profile(args.safety).envelope
         except TeachPadError as exc:
             io.error(str(exc))
-            return EXIT_USAGE
+            return ExitCode.USAGE
     client: Any = None
     try:
         pose: Pose | None = None
@@ -138,7 +166,7 @@ def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | 
 
 
 def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client: Any, pose: Pose | None,
-         limits: PlanLimits, loops: int, start: int, envelope: Envelope | None = None) -> int:
+         limits: PlanLimits, loops: int, start: int, envelope: Envelope | None = None) -> ExitCode:
     ledger = project.ledger
     issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops, envelope=envelope)
     for issue in issues:
@@ -149,7 +177,7 @@ def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client
         for issue in errors:
             io.error(issue.message)
         io.error(f"plan {plan.name!r} has {len(errors)} error(s): not running it")
-        return EXIT_USAGE
+        return ExitCode.USAGE
     est = estimate_plan(plan, ledger, pose, loops=loops)
     io.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
              f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}")
@@ -160,14 +188,14 @@ def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client
         else:
             io.print(f"would upload: {', '.join(map(str, plan_ids))}")
         io.print("check only: not running")
-        return EXIT_OK
+        return ExitCode.OK
     guard = PointGuard({p.id: p for p in ledger}, refresh=not args.no_upload)
     if args.no_upload:
         io.warn(f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
                 f"{', '.join(map(str, plan_ids))} (the operator's responsibility)")
     else:
         code = _upload_plan_points(io, args, project, guard, plan_ids, client)
-        if code != EXIT_OK:
+        if code != ExitCode.OK:
             return code
 
     line = _ProgressLine(io.out)
@@ -184,7 +212,7 @@ def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client
         line.done()
     if outcome.state is RunState.FINISHED:
         io.print(f"done: {outcome.segments_done} segment(s)")
-        return EXIT_OK
+        return ExitCode.OK
     io.error(f"{outcome.state.value}: {outcome.message}")
     if _points_lost(outcome.error):
         # "bad end point id": the controller does not hold the segment's points (restarted?)
@@ -200,7 +228,7 @@ def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client
         loops_arg = f" --loops {loops}" if args.loops is not None else ""
         io.print(f"to resume: {PROG} run {args.project}{plan_arg} {resume}{loops_arg}")
     if outcome.interrupted:
-        return EXIT_INTERRUPTED
-    if isinstance(outcome.error, LinkError | ResponseTimeout):
-        return EXIT_LINK
-    return EXIT_FAILED
+        return ExitCode.INTERRUPTED
+    if isinstance(outcome.error, TeachPadError):
+        return exit_code_for(outcome.error)
+    return ExitCode.FAILED

@@ -10,6 +10,7 @@ from typing import Any
 import pytest
 
 from app.cli import points as cli_points
+from app.cli import run_plan
 from app.errors import CommandRefused, LinkError
 from app.points.ledger import SyncState
 from app.points.project import load_project
@@ -36,6 +37,7 @@ class Cli:
         parser.add_argument("--monitor-only", action="store_true")
         sub = parser.add_subparsers(dest="command", required=True)
         cli_points.register(sub)
+        run_plan.register(sub)
         args = parser.parse_args(list(argv))
         code: int = args.handler(args, self.make_client)
         return code
