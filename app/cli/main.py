@@ -68,6 +68,8 @@ EXIT_USAGE = ExitCode.USAGE
 EXIT_LINK = ExitCode.LINK
 EXIT_INTERRUPTED = ExitCode.INTERRUPTED
 
+_PATH_SHOWN = 100  # characters of a path in an error message
+
 _DESCRIPTION = ("Talk to a Bochuang robot controller over Modbus. An administrator's tool: "
                 "TeachPad's operator roles apply to the GUI, not here.")
 
@@ -167,10 +169,13 @@ def _main(argv: Sequence[str] | None = None) -> int:
 
 
 def _error_text(exc: BaseException) -> str:
-    """One line: a typed error says what happened; a file error names the file, briefly."""
+    """One line: a typed error says what happened; a file error names the file (its end, when
+    the path is long: the name tells more than the folders above it)."""
     if isinstance(exc, OSError) and not isinstance(exc, TeachPadError):
-        where = f"{str(exc.filename)[:80]}: " if exc.filename else ""
-        return f"{where}{exc.strerror or exc}"
+        path = str(exc.filename or "")
+        if len(path) > _PATH_SHOWN:
+            path = "…" + path[-(_PATH_SHOWN - 1):]
+        return f"{path}: {exc.strerror or exc}" if path else str(exc.strerror or exc)
     return str(exc)
 
 
