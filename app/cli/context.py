@@ -37,11 +37,17 @@ class CliContext:
     settings: ConnectionSettings
     out: TextIO = field(default_factory=lambda: sys.stdout)
     err: TextIO = field(default_factory=lambda: sys.stderr)
+    #: where the client comes from (default: a RobotClient from ``settings``, with the audit
+    #: trail); the context closes it either way
+    connect: Callable[[], RobotClient] | None = None
     _client: RobotClient | None = None
 
     @property
     def client(self) -> RobotClient:
         if self._client is None:
+            if self.connect is not None:
+                self._client = self.connect()
+                return self._client
             client = RobotClient(self.settings)
             # The CLI is an administrator's tool; its writes go to the same audit trail as the GUI's.
             client.audit = AuditLog(role="administrator (cli)", word_order=self.settings.word_order)
@@ -54,6 +60,10 @@ class CliContext:
 
     def warn(self, message: str) -> None:
         print(f"{PROG}: warning: {message}", file=self.err, flush=True)
+
+    def error(self, message: str) -> None:
+        """Say what went wrong (one line) for a command that returns its exit code itself."""
+        print(f"{PROG}: error: {message}", file=self.err, flush=True)
 
     def report(self, message: str) -> ExitCode:
         """Print the one line a command that only sends something says; it succeeded."""

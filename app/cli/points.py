@@ -2,18 +2,10 @@
 
 :func:`register` adds ``points`` to the main parser (``app/cli/main.py`` lists it with the other
 modules' registrars); ``run`` lives in :mod:`app.cli.run_plan`, which shares this module's
-helpers. A handler can be called two ways:
-
-* ``args.handler(ctx)`` with :class:`app.cli.context.CliContext` (what ``app/cli/main.py``
-  does): uses ``ctx.args``, the lazily connected ``ctx.client``, ``ctx.out`` / ``ctx.err``;
-  the context closes the client.
-* ``args.handler(args, make_client)``: ``make_client()`` returns a connected ``RobotClient``
-  built from the global options (``--host --port --unit`` ...); the handler closes it.
-
-Either way the client is asked for only by commands that talk to the controller
-(``points upload``, ``run`` without ``--check``), at most once. Of ``RobotClient`` they use
-``read_pose``, ``create_point``, ``move_to_point``, ``stop`` (duck-typed). The ``cmd_*``
-functions take ``(args, make_client, *, out=None, err=None, close_client=True)``.
+helpers. Handlers are ``cmd_*(ctx: CliContext) -> ExitCode`` like every command's (see
+:mod:`app.cli.context`); they report their own errors (one line each, a file's errors can be
+several) and return the code. ``ctx.client`` is asked for only by commands that talk to the
+controller (``points upload``, ``run`` without ``--check``); the context closes it.
 
 Exit codes: :class:`app.cli.exit_codes.ExitCode` (points not on the controller without
 ``--upload`` is FAILED; a malformed file is USAGE). Global options read when the main parser
@@ -35,13 +27,12 @@ from __future__ import annotations
 
 import argparse
 import math
-import sys
 import unicodedata
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from app.cli.context import PROG
+from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode, exit_code_for
 from app.errors import InvalidInput, TeachPadError
 from app.points.ledger import EmptyImport, ImportMode, PointLedger
@@ -57,39 +48,6 @@ EXIT_USAGE = ExitCode.USAGE
 EXIT_LINK = ExitCode.LINK
 EXIT_INTERRUPTED = ExitCode.INTERRUPTED
 
-MakeClient = Callable[[], Any]
-Command = Callable[..., int]
-
-
-class _Io:
-    def __init__(self, out: TextIO | None, err: TextIO | None) -> None:
-        self.out = out or sys.stdout
-        self.err = err or sys.stderr
-
-    def print(self, text: str) -> None:
-        print(text, file=self.out, flush=True)
-
-    def error(self, text: str) -> None:
-        print(f"{PROG}: error: {text}", file=self.err, flush=True)
-
-    def warn(self, text: str) -> None:
-        print(f"{PROG}: warning: {text}", file=self.err, flush=True)
-
-
-def _handler(command: Command) -> Callable[..., int]:
-    """``handler(ctx)`` or ``handler(args, make_client)`` around a ``cmd_*`` function."""
-
-    def handler(*call: Any) -> int:
-        if len(call) == 2:
-            args, make_client = call
-            return command(args, make_client)
-        (ctx,) = call
-        return command(ctx.args, lambda: ctx.client, out=getattr(ctx, "out", None),
-                       err=getattr(ctx, "err", None), close_client=False)
-
-    handler.__name__ = command.__name__
-    handler.__doc__ = command.__doc__
-    return handler
 
 
 _PROJECT_HELP = "the project file (.tpproj)"
@@ -122,21 +80,21 @@ def register(subparsers: Any) -> None:
 
     p = psub.add_parser("list", help="print the points and plans of a project")
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
-    p.set_defaults(handler=_handler(cmd_points_list))
+    p.set_defaults(handler=cmd_points_list)
 
     p = psub.add_parser("upload", help="create the project's points on the controller (function 2)")
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
     group = p.add_mutually_exclusive_group()
     group.add_argument("--ids", help="ids to upload, e.g. 1,2,5-9 (default: all)")
     group.add_argument("--needed", action="store_true", help="only points not known to be on the controller")
-    p.set_defaults(handler=_handler(cmd_points_upload))
+    p.set_defaults(handler=cmd_points_upload)
 
     p = psub.add_parser("export", help="write the project's points to a CSV file")
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
     p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="OUT",
                    help="the CSV file to write (mm, degrees)")
     p.add_argument("--no-bom", action="store_true", help="write UTF-8 without a byte order mark")
-    p.set_defaults(handler=_handler(cmd_points_export))
+    p.set_defaults(handler=cmd_points_export)
 
     p = psub.add_parser("import", help="read points from a CSV file into the project")
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
@@ -146,7 +104,7 @@ def register(subparsers: Any) -> None:
                    help="update and add points, keep the others (default: replace all points)")
     p.add_argument("--allow-empty", action="store_true",
                    help="let a CSV without rows replace (delete) all points of the project")
-    p.set_defaults(handler=_handler(cmd_points_import))
+    p.set_defaults(handler=cmd_points_import)
 
 
 # --- helpers ------------------------------------------------------------------------------------
@@ -162,11 +120,11 @@ def _limits(args: argparse.Namespace) -> PointLimits:
     )
 
 
-def _load(io: _Io, path: Path, limits: PointLimits) -> Project | None:
+def _load(ctx: CliContext, path: Path, limits: PointLimits) -> Project | None:
     try:
         return load_project(path, limits)
     except FileFormatError as exc:
-        io.error(str(exc))
+        ctx.error(str(exc))
         return None
 
 
@@ -176,30 +134,30 @@ def _endpoint(client: Any) -> str:
     return endpoint if isinstance(endpoint, str) else "controller"
 
 
-def _monitor_only(io: _Io, args: argparse.Namespace, what: str) -> bool:
+def _monitor_only(ctx: CliContext, args: argparse.Namespace, what: str) -> bool:
     """True (after saying so) when --monitor-only forbids ``what``; checked before any file I/O."""
     if getattr(args, "monitor_only", False):
-        io.error(f"{what} writes to the controller: refused in monitor-only mode (nothing read or written)")
+        ctx.error(f"{what} writes to the controller: refused in monitor-only mode (nothing read or written)")
         return True
     return False
 
 
-def _save(io: _Io, project: Project, path: Path) -> bool:
+def _save(ctx: CliContext, project: Project, path: Path) -> bool:
     owner = live_owner(path)
     if owner is not None:
-        io.error(f"{path}: not saved: the project is open in a TeachPad ({owner.text}); "
+        ctx.error(f"{path}: not saved: the project is open in a TeachPad ({owner.text}); "
                  "close it there or make the change there")
         return False
     try:
         save_project(project, path)
     except OSError as exc:
-        io.error(f"{path}: could not save: {exc}")
+        ctx.error(f"{path}: could not save: {exc}")
         return False
     return True
 
 
-def _link_code(io: _Io, exc: TeachPadError, what: str) -> ExitCode:
-    io.error(f"{what}: {exc}")
+def _link_code(ctx: CliContext, exc: TeachPadError, what: str) -> ExitCode:
+    ctx.error(f"{what}: {exc}")
     return exit_code_for(exc)
 
 
@@ -235,8 +193,8 @@ class _ProgressLine:
         self.width = 0
 
 
-def _upload(io: _Io, project: Project, points: Sequence[TempPoint], client: Any) -> UploadReport:
-    line = _ProgressLine(io.out)
+def _upload(ctx: CliContext, project: Project, points: Sequence[TempPoint], client: Any) -> UploadReport:
+    line = _ProgressLine(ctx.out)
 
     def progress(done: int, total: int) -> None:
         if done < total:
@@ -247,17 +205,17 @@ def _upload(io: _Io, project: Project, points: Sequence[TempPoint], client: Any)
     finally:
         line.done()
     apply_upload(project.ledger, report)
-    io.print(f"uploaded {report.ok_count} point(s)")
+    ctx.print(f"uploaded {report.ok_count} point(s)")
     unconfirmed = [o.point_id for o in report.outcomes if o.ok and o.unconfirmed]
     if unconfirmed:
         shown = ",".join(map(str, unconfirmed[:20])) + (",..." if len(unconfirmed) > 20 else "")
-        io.print(f"{len(unconfirmed)} of them unconfirmed: the controller reported no error but its "
+        ctx.print(f"{len(unconfirmed)} of them unconfirmed: the controller reported no error but its "
                  f"command status did not change (GV291 not writable): {shown}")
     for outcome in report.failed:
-        io.error(f"P{outcome.point_id}: {outcome.reason}")
+        ctx.error(f"P{outcome.point_id}: {outcome.reason}")
     if report.aborted:
         left = ",".join(str(i) for i in report.not_attempted)
-        io.error(f"upload stopped ({report.aborted}); not attempted: {left}")
+        ctx.error(f"upload stopped ({report.aborted}); not attempted: {left}")
     return report
 
 
@@ -272,33 +230,31 @@ def _upload_code(report: UploadReport) -> ExitCode:
 # --- points ------------------------------------------------------------------------------------
 
 
-def cmd_points_list(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                    err: TextIO | None = None, close_client: bool = True) -> ExitCode:
+def cmd_points_list(ctx: CliContext) -> ExitCode:
     """``points list PROJECT``."""
-    io = _Io(out, err)
-    project = _load(io, args.project, _limits(args))
+    args = ctx.args
+    project = _load(ctx, args.project, _limits(args))
     if project is None:
         return ExitCode.USAGE
-    io.print(f"{project.name}: {len(project.ledger)} point(s), {len(project.plans)} plan(s)")
+    ctx.print(f"{project.name}: {len(project.ledger)} point(s), {len(project.plans)} plan(s)")
     for p in project.ledger:
         pose = " ".join(f"{v:9.3f}" for v in p.xyzabc)
         state = p.sync.text + (f" ({p.sync_error})" if p.sync_error else "")
         last = project.upload_history.get(p.id)
         if last is not None:  # history: what this host did, not what the controller holds now
             state += f" (last uploaded {last.time} to {last.endpoint})"
-        io.print(f"{p.id:6d}  {fit_width(p.name, NAME_WIDTH)} {pose}  {tool_text(p.tool):14s} {state}")
+        ctx.print(f"{p.id:6d}  {fit_width(p.name, NAME_WIDTH)} {pose}  {tool_text(p.tool):14s} {state}")
     for plan in project.plans:
-        io.print(f"plan {plan.name!r}: {len(plan)} segment(s), loops {plan.loops or 'until stopped'}")
+        ctx.print(f"plan {plan.name!r}: {len(plan)} segment(s), loops {plan.loops or 'until stopped'}")
     return ExitCode.OK
 
 
-def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                      err: TextIO | None = None, close_client: bool = True) -> ExitCode:
+def cmd_points_upload(ctx: CliContext) -> ExitCode:
     """``points upload PROJECT [--ids ... | --needed]``; saves the upload history."""
-    io = _Io(out, err)
-    if _monitor_only(io, args, "points upload"):
+    args = ctx.args
+    if _monitor_only(ctx, args, "points upload"):
         return ExitCode.FAILED
-    project = _load(io, args.project, _limits(args))
+    project = _load(ctx, args.project, _limits(args))
     if project is None:
         return ExitCode.USAGE
     ledger = project.ledger
@@ -306,11 +262,11 @@ def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out:
         try:
             ids = parse_id_list(args.ids)
         except InvalidInput as exc:
-            io.error(str(exc))
+            ctx.error(str(exc))
             return ExitCode.USAGE
         missing = [i for i in ids if i not in ledger]
         if missing:
-            io.error(f"no point with id {', '.join(map(str, missing))} in {args.project}")
+            ctx.error(f"no point with id {', '.join(map(str, missing))} in {args.project}")
             return ExitCode.USAGE
         points = [ledger.point(i) for i in ids]
     elif args.needed:
@@ -318,47 +274,41 @@ def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out:
     else:
         points = list(ledger)
     if not points:
-        io.print("nothing to upload")
+        ctx.print("nothing to upload")
         return ExitCode.OK
-    client: Any = None
     try:
-        client = make_client()
-        report = _upload(io, project, points, client)
+        client = ctx.client
+        report = _upload(ctx, project, points, client)
         project.record_upload([o.point_id for o in report.outcomes if o.ok], _endpoint(client))
     except TeachPadError as exc:
-        return _link_code(io, exc, "cannot upload")
-    finally:
-        if close_client and client is not None:
-            client.close()
-    if not _save(io, project, args.project):
+        return _link_code(ctx, exc, "cannot upload")
+    if not _save(ctx, project, args.project):
         return ExitCode.FAILED
     return _upload_code(report)
 
 
-def cmd_points_export(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                      err: TextIO | None = None, close_client: bool = True) -> ExitCode:
+def cmd_points_export(ctx: CliContext) -> ExitCode:
     """``points export PROJECT --csv OUT``."""
-    io = _Io(out, err)
-    project = _load(io, args.project, _limits(args))
+    args = ctx.args
+    project = _load(ctx, args.project, _limits(args))
     if project is None:
         return ExitCode.USAGE
     try:
         write_points_csv(args.csv_path, project.ledger, bom=not args.no_bom)
     except OSError as exc:
-        io.error(f"{args.csv_path}: could not write: {exc}")
+        ctx.error(f"{args.csv_path}: could not write: {exc}")
         return ExitCode.FAILED
-    io.print(f"wrote {len(project.ledger)} point(s) to {args.csv_path}")
+    ctx.print(f"wrote {len(project.ledger)} point(s) to {args.csv_path}")
     return ExitCode.OK
 
 
-def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                      err: TextIO | None = None, close_client: bool = True) -> ExitCode:
+def cmd_points_import(ctx: CliContext) -> ExitCode:
     """``points import PROJECT --csv IN [--merge] [--allow-empty]``; the project is saved only if
     all rows are good; a CSV without rows does not replace all points unless ``--allow-empty``."""
-    io = _Io(out, err)
+    args = ctx.args
     limits = _limits(args)
     if args.project.exists():
-        project = _load(io, args.project, limits)
+        project = _load(ctx, args.project, limits)
         if project is None:
             return ExitCode.USAGE
     else:
@@ -369,16 +319,16 @@ def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out:
         report = project.ledger.import_points(points, ImportMode.MERGE if args.merge else ImportMode.REPLACE,
                                               allow_empty=getattr(args, "allow_empty", False))
     except EmptyImport as exc:
-        io.error(f"{args.csv_path}: {exc}; nothing changed (pass --allow-empty to do it)")
+        ctx.error(f"{args.csv_path}: {exc}; nothing changed (pass --allow-empty to do it)")
         return ExitCode.USAGE
     except InvalidInput as exc:
-        io.error(str(exc))
+        ctx.error(str(exc))
         return ExitCode.USAGE
-    if not _save(io, project, args.project):
+    if not _save(ctx, project, args.project):
         return ExitCode.FAILED
-    io.print(f"imported {len(points)} point(s) into {args.project}: {report.text}")
+    ctx.print(f"imported {len(points)} point(s) into {args.project}: {report.text}")
     for plan in project.plans:
         missing = sorted(i for i in plan.point_ids() if i not in project.ledger)
         if missing:
-            io.warn(f"plan {plan.name!r} uses points that are gone: {', '.join(map(str, missing))}")
+            ctx.warn(f"plan {plan.name!r} uses points that are gone: {', '.join(map(str, missing))}")
     return ExitCode.OK

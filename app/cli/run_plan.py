@@ -1,8 +1,8 @@
 """``teachpad-cli run PROJECT ...``: check a plan, upload its points, run it guarded.
 
-:func:`register` adds ``run`` to the main parser; the handler conventions and the helpers are
-:mod:`app.cli.points`'s, the exit codes :class:`app.cli.exit_codes.ExitCode`. Segment numbers
-on the command line and in messages count from 1. ``run`` checks the plan first (the GUI's
+:func:`register` adds ``run`` to the main parser; the helpers are :mod:`app.cli.points`'s, the
+exit codes :class:`app.cli.exit_codes.ExitCode`. Segment numbers on the command line and in
+messages count from 1. ``run`` checks the plan first (the GUI's
 checks): errors refuse to run (USAGE). A project file cannot know what the controller holds,
 so ``run`` creates every point its plan uses before the first move and guards each segment with
 :class:`app.points.guard.PointGuard` (restart canary, points re-created right before the move,
@@ -18,17 +18,14 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any
 
-from app.cli.context import PROG
+from app.cli.context import PROG, CliContext
 from app.cli.exit_codes import ExitCode, exit_code_for
 from app.cli.points import (
     _PROJECT_HELP,
-    MakeClient,
     _endpoint,
     _fmt_time,
-    _handler,
-    _Io,
     _limits,
     _link_code,
     _load,
@@ -37,6 +34,7 @@ from app.cli.points import (
     _save,
 )
 from app.errors import CommandRefused, InvalidInput, TeachPadError
+from app.link.client import RobotClient
 from app.models import Pose
 from app.plan.checks import IssueKind, PlanLimits, check_plan
 from app.plan.estimates import estimate_plan, segment_timeouts
@@ -70,46 +68,46 @@ def register(subparsers: Any) -> None:
                    help="a safety profile (.safety.json): the plan must stay in its envelope")
     r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
                    help="highest speed a segment may have (default %(default)g mm/s)")
-    r.set_defaults(handler=_handler(cmd_run))
+    r.set_defaults(handler=cmd_run)
 
 
-def _pick_plan(io: _Io, project: Project, name: str | None) -> Plan | None:
+def _pick_plan(ctx: CliContext, project: Project, name: str | None) -> Plan | None:
     if name is not None:
         try:
             return project.plan(name)
         except InvalidInput as exc:
-            io.error(str(exc))
+            ctx.error(str(exc))
             return None
     if len(project.plans) == 1:
         return project.plans[0]
     if not project.plans:
-        io.error("the project has no plans")
+        ctx.error("the project has no plans")
     else:
-        io.error(f"the project has {len(project.plans)} plans ({', '.join(project.plan_names())}): "
+        ctx.error(f"the project has {len(project.plans)} plans ({', '.join(project.plan_names())}): "
                  "choose one with --plan")
     return None
 
 
-def _upload_plan_points(io: _Io, args: argparse.Namespace, project: Project, guard: PointGuard,
+def _upload_plan_points(ctx: CliContext, args: argparse.Namespace, project: Project, guard: PointGuard,
                         plan_ids: list[int], client: Any) -> ExitCode:
     """Create the plan's points before the first move; records the history in the project."""
-    io.print(f"uploading the plan's {len(plan_ids)} point(s): {', '.join(map(str, plan_ids))}")
+    ctx.print(f"uploading the plan's {len(plan_ids)} point(s): {', '.join(map(str, plan_ids))}")
     try:
         guard.ensure(client, plan_ids)
     except KeyboardInterrupt:
-        io.error("interrupted while uploading: not running")
+        ctx.error("interrupted while uploading: not running")
         return ExitCode.INTERRUPTED
     except PointNotCreated as exc:
-        io.error(f"{exc}: not running")
+        ctx.error(f"{exc}: not running")
         return ExitCode.FAILED
     except TeachPadError as exc:
-        return _link_code(io, exc, "cannot upload the plan's points")
+        return _link_code(ctx, exc, "cannot upload the plan's points")
     finally:
         project.record_upload(sorted(guard.uploaded), _endpoint(client))
     owner = live_owner(args.project)
     if owner is None:
-        _save(io, project, args.project)  # the upload history; a failed save does not stop the run
-    io.print(f"uploaded {len(guard.uploaded)} point(s)")
+        _save(ctx, project, args.project)  # the upload history; a failed save does not stop the run
+    ctx.print(f"uploaded {len(guard.uploaded)} point(s)")
     return ExitCode.OK
 
 
@@ -117,16 +115,15 @@ def _points_lost(error: BaseException | None) -> bool:
     return isinstance(error, CommandRefused) and error.status.code == MoveStatus.BAD_END_POINT
 
 
-def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-            err: TextIO | None = None, close_client: bool = True) -> ExitCode:
+def cmd_run(ctx: CliContext) -> ExitCode:
     """``run PROJECT [--plan NAME] ...``: check, upload, run guarded with a progress line."""
-    io = _Io(out, err)
-    if not args.check and _monitor_only(io, args, "run"):
+    args = ctx.args
+    if not args.check and _monitor_only(ctx, args, "run"):
         return ExitCode.FAILED
-    project = _load(io, args.project, _limits(args))
+    project = _load(ctx, args.project, _limits(args))
     if project is None:
         return ExitCode.USAGE
-    plan = _pick_plan(io, project, args.plan)
+    plan = _pick_plan(ctx, project, args.plan)
     if plan is None:
         return ExitCode.USAGE
     loops = plan.loops if args.loops is None else args.loops
@@ -140,7 +137,7 @@ def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | 
         if args.from_loop < 1 or (loops and args.from_loop > loops):
             raise InvalidInput(f"--from-loop {args.from_loop}: the run has loops 1..{loops}")
     except InvalidInput as exc:
-        io.error(str(exc))
+        ctx.error(str(exc))
         return ExitCode.USAGE
 
     envelope: Envelope | None = None
@@ -148,57 +145,54 @@ def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | 
         try:
             envelope = load_profile(args.safety).envelope
         except TeachPadError as exc:
-            io.error(str(exc))
+            ctx.error(str(exc))
             return ExitCode.USAGE
-    client: Any = None
-    try:
-        pose: Pose | None = None
-        if not args.check:
-            try:
-                client = make_client()
-                pose = client.read_pose()
-            except TeachPadError as exc:
-                return _link_code(io, exc, "cannot read the robot's pose")
-        return _run(io, args, project, plan, client, pose, limits, loops, start, envelope)
-    finally:
-        if close_client and client is not None:
-            client.close()
+    client: RobotClient | None = None
+    pose: Pose | None = None
+    if not args.check:
+        try:
+            client = ctx.client
+            pose = client.read_pose()
+        except TeachPadError as exc:
+            return _link_code(ctx, exc, "cannot read the robot's pose")
+    return _run(ctx, args, project, plan, client, pose, limits, loops, start, envelope)
 
 
-def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client: Any, pose: Pose | None,
-         limits: PlanLimits, loops: int, start: int, envelope: Envelope | None = None) -> ExitCode:
+def _run(ctx: CliContext, args: argparse.Namespace, project: Project, plan: Plan, client: Any,
+         pose: Pose | None, limits: PlanLimits, loops: int, start: int,
+         envelope: Envelope | None = None) -> ExitCode:
     ledger = project.ledger
     issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops, envelope=envelope)
     for issue in issues:
         if issue.kind is IssueKind.WARNING:
-            io.warn(issue.message)
+            ctx.warn(issue.message)
     errors = [i for i in issues if i.kind is IssueKind.ERROR]
     if errors:
         for issue in errors:
-            io.error(issue.message)
-        io.error(f"plan {plan.name!r} has {len(errors)} error(s): not running it")
+            ctx.error(issue.message)
+        ctx.error(f"plan {plan.name!r} has {len(errors)} error(s): not running it")
         return ExitCode.USAGE
     est = estimate_plan(plan, ledger, pose, loops=loops)
-    io.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
+    ctx.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
              f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}")
     plan_ids = list(dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids))
     if args.check:
         if args.no_upload:
-            io.print("--no-upload: the controller must already hold the plan's points")
+            ctx.print("--no-upload: the controller must already hold the plan's points")
         else:
-            io.print(f"would upload: {', '.join(map(str, plan_ids))}")
-        io.print("check only: not running")
+            ctx.print(f"would upload: {', '.join(map(str, plan_ids))}")
+        ctx.print("check only: not running")
         return ExitCode.OK
     guard = PointGuard({p.id: p for p in ledger}, refresh=not args.no_upload)
     if args.no_upload:
-        io.warn(f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
+        ctx.warn(f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
                 f"{', '.join(map(str, plan_ids))} (the operator's responsibility)")
     else:
-        code = _upload_plan_points(io, args, project, guard, plan_ids, client)
+        code = _upload_plan_points(ctx, args, project, guard, plan_ids, client)
         if code != ExitCode.OK:
             return code
 
-    line = _ProgressLine(io.out)
+    line = _ProgressLine(ctx.out)
 
     def progress(p: RunProgress) -> None:
         if p.event is RunEvent.SEGMENT_STARTED:
@@ -211,22 +205,22 @@ def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client
     finally:
         line.done()
     if outcome.state is RunState.FINISHED:
-        io.print(f"done: {outcome.segments_done} segment(s)")
+        ctx.print(f"done: {outcome.segments_done} segment(s)")
         return ExitCode.OK
-    io.error(f"{outcome.state.value}: {outcome.message}")
+    ctx.error(f"{outcome.state.value}: {outcome.message}")
     if _points_lost(outcome.error):
         # "bad end point id": the controller does not hold the segment's points (restarted?)
-        io.error("the controller does not hold the plan's points (restarted?); resume without "
+        ctx.error("the controller does not hold the plan's points (restarted?); resume without "
                  "--no-upload so that they are created first")
     if isinstance(outcome.error, PointMismatch | PointNotCreated):
-        io.error("nothing further was sent; the robot is where the message above says")
+        ctx.error("nothing further was sent; the robot is where the message above says")
     if outcome.resume_from is not None:
         resume = f"--from {outcome.resume_from + 1}"
         if outcome.resume_loop and outcome.resume_loop > 1:
             resume += f" --from-loop {outcome.resume_loop}"
         plan_arg = f" --plan {plan.name!r}" if len(project.plans) > 1 else ""
         loops_arg = f" --loops {loops}" if args.loops is not None else ""
-        io.print(f"to resume: {PROG} run {args.project}{plan_arg} {resume}{loops_arg}")
+        ctx.print(f"to resume: {PROG} run {args.project}{plan_arg} {resume}{loops_arg}")
     if outcome.interrupted:
         return ExitCode.INTERRUPTED
     if isinstance(outcome.error, TeachPadError):
