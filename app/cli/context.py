@@ -39,14 +39,14 @@ class CliContext:
     err: TextIO = field(default_factory=lambda: sys.stderr)
     #: where the client comes from (default: a RobotClient from ``settings``, with the audit
     #: trail); the context closes it either way
-    connect: Callable[[], RobotClient] | None = None
+    make_client: Callable[[], RobotClient] | None = None
     _client: RobotClient | None = None
 
     @property
     def client(self) -> RobotClient:
         if self._client is None:
-            if self.connect is not None:
-                self._client = self.connect()
+            if self.make_client is not None:
+                self._client = self.make_client()
                 return self._client
             client = RobotClient(self.settings)
             # The CLI is an administrator's tool; its writes go to the same audit trail as the GUI's.

@@ -32,7 +32,6 @@ from typing import Any
 
 from app.cli import controller, points, run_plan, support
 from app.cli.context import PROG, CliContext, Handler
-from app.cli.controller import JOG_SECONDS_DEFAULT
 from app.cli.exit_codes import EPILOG, ExitCode, exit_code_for
 from app.cli.format import _positive_float, _word_order
 from app.cli.help import add_examples
@@ -46,7 +45,6 @@ __all__ = [
     "EXIT_LINK",
     "EXIT_OK",
     "EXIT_USAGE",
-    "JOG_SECONDS_DEFAULT",
     "PROG",
     "REGISTRARS",
     "CliContext",

@@ -42,7 +42,7 @@ class Cli:
         cli_points.register(sub)
         run_plan.register(sub)
         args = parser.parse_args(list(argv))
-        ctx = CliContext(args, ConnectionSettings(), connect=self.make_client)
+        ctx = CliContext(args, ConnectionSettings(), make_client=self.make_client)
         try:
             code: int = args.handler(ctx)
         finally:
