@@ -1,25 +1,14 @@
-"""``teachpad-cli`` commands for temp points and plans: ``points ...`` and ``run``.
+"""``teachpad-cli points ...``: the temp points of a project (list, upload, export, import).
 
-``run`` lives in :mod:`app.cli.run_plan` (registered from here). Plugging in: ``app/cli.py``
-imports this module (it is in its ``PLUGIN_MODULES``) and calls
-``register(subparsers)``, which adds ``points`` (list / upload / export / import) and ``run``
-and sets ``handler`` on each with ``set_defaults``. A handler can be called two ways:
+:func:`register` adds ``points`` to the main parser (``app/cli/main.py`` lists it with the other
+modules' registrars); ``run`` lives in :mod:`app.cli.run_plan`, which shares this module's
+helpers. Handlers are ``cmd_*(ctx: CliContext) -> ExitCode`` like every command's (see
+:mod:`app.cli.context`); they report their own errors (one line each, a file's errors can be
+several) and return the code. ``ctx.client`` is asked for only by commands that talk to the
+controller (``points upload``, ``run`` without ``--check``); the context closes it.
 
-* ``args.handler(ctx)`` with ``app.cli.main.CliContext`` (what ``app/cli.py`` does): uses
-  ``ctx.args``, the lazily connected ``ctx.client``, ``ctx.out`` / ``ctx.err``; the context
-  closes the client.
-* ``args.handler(args, make_client)``: ``make_client()`` returns a connected ``RobotClient``
-  built from the global options (``--host --port --unit`` ...); the handler closes it.
-
-Either way the client is asked for only by commands that talk to the controller
-(``points upload``, ``run`` without ``--check``), at most once. Of ``RobotClient`` they use
-``read_pose``, ``create_point``, ``move_to_point``, ``stop`` (duck-typed). The ``cmd_*``
-functions take ``(args, make_client, *, out=None, err=None, close_client=True)``.
-
-Exit codes, as ``app/cli.py``: 0 ok; 1 failed (controller refused, run failed or stopped,
-points not on the controller without ``--upload``); 2 usage (bad arguments, a malformed
-file, a plan with errors; nothing sent); 3 link (cannot connect, no answer); 130 interrupted
-(Ctrl-C; a motion under way is stopped first). Global options read when the main parser
+Exit codes: :class:`app.cli.exit_codes.ExitCode` (points not on the controller without
+``--upload`` is FAILED; a malformed file is USAGE). Global options read when the main parser
 defines them: ``point_id_min``, ``point_id_max`` (accepted temp point ids, default 0..10000).
 
 Commands::
@@ -28,81 +17,37 @@ Commands::
     points upload PROJECT [--ids 1,2,5-9 | --needed]
     points export PROJECT --csv OUT [--no-bom]
     points import PROJECT --csv IN [--merge] [--allow-empty]   # creates PROJECT if missing
-    run PROJECT [--plan NAME] [--loops N] [--from K] [--from-loop I] [--single]
-                [--no-upload] [--check] [--max-speed MM_S]
 
-Segment numbers on the command line and in messages count from 1. ``run`` checks the plan
-first (the GUI's checks): errors refuse to run. A project file cannot know what the
-controller holds, so ``run`` uploads every point its plan uses before the first move, then
-guards each segment (:class:`app.points.guard.PointGuard`): restart canary check, the
-segment's points re-created from the project right before its move, the arrival pose
-verified after it. ``--no-upload`` skips the uploads (the operator answers for the
-controller's points); the arrival check stays. A failed or interrupted run prints the
-``--from`` / ``--from-loop`` that resumes it. Commands that write the project refuse while
-another TeachPad has it open (:mod:`app.points.lock`); ``points upload`` in monitor-only mode
-refuses before it reads the file.
+Commands that write the project refuse while another TeachPad has it open
+(:mod:`app.points.lock`); ``points upload`` in monitor-only mode refuses before it reads the
+file.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import sys
 import unicodedata
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from app.errors import InvalidInput, LinkError, ResponseTimeout, TeachPadError
-from app.plan.checks import PlanLimits
+from app.cli.context import CliContext
+from app.cli.exit_codes import ExitCode, exit_code_for
+from app.errors import InvalidInput, TeachPadError
 from app.points.ledger import EmptyImport, ImportMode, PointLedger
 from app.points.lock import live_owner
 from app.points.point import DEFAULT_LIMITS, FileFormatError, PointLimits, TempPoint, tool_text
 from app.points.project import Project, load_project, read_points_csv, save_project, write_points_csv
 from app.points.upload import UploadReport, apply_upload, parse_id_list, upload_points
 
-PROG = "teachpad-cli"
+# The table's members under the names callers imported before the table existed.
+EXIT_OK = ExitCode.OK
+EXIT_FAILED = ExitCode.FAILED
+EXIT_USAGE = ExitCode.USAGE
+EXIT_LINK = ExitCode.LINK
+EXIT_INTERRUPTED = ExitCode.INTERRUPTED
 
-EXIT_OK = 0
-EXIT_FAILED = 1
-EXIT_USAGE = 2
-EXIT_LINK = 3
-EXIT_INTERRUPTED = 130
-EXIT_NEEDS_UPLOAD = EXIT_FAILED
-
-MakeClient = Callable[[], Any]
-Command = Callable[..., int]
-
-
-class _Io:
-    def __init__(self, out: TextIO | None, err: TextIO | None) -> None:
-        self.out = out or sys.stdout
-        self.err = err or sys.stderr
-
-    def print(self, text: str) -> None:
-        print(text, file=self.out, flush=True)
-
-    def error(self, text: str) -> None:
-        print(f"{PROG}: error: {text}", file=self.err, flush=True)
-
-    def warn(self, text: str) -> None:
-        print(f"{PROG}: warning: {text}", file=self.err, flush=True)
-
-
-def _handler(command: Command) -> Callable[..., int]:
-    """``handler(ctx)`` or ``handler(args, make_client)`` around a ``cmd_*`` function."""
-
-    def handler(*call: Any) -> int:
-        if len(call) == 2:
-            args, make_client = call
-            return command(args, make_client)
-        (ctx,) = call
-        return command(ctx.args, lambda: ctx.client, out=getattr(ctx, "out", None),
-                       err=getattr(ctx, "err", None), close_client=False)
-
-    handler.__name__ = command.__name__
-    handler.__doc__ = command.__doc__
-    return handler
 
 
 _PROJECT_HELP = "the project file (.tpproj)"
@@ -129,27 +74,27 @@ def fit_width(text: str, width: int) -> str:
 
 
 def register(subparsers: Any) -> None:
-    """Add ``points`` and ``run`` to the main parser's subparsers."""
+    """Add ``points`` (list / upload / export / import) to the main parser's subcommands."""
     points = subparsers.add_parser("points", help="temp points of a project: list, upload, export, import")
     psub = points.add_subparsers(dest="points_command", metavar="ACTION", required=True)
 
     p = psub.add_parser("list", help="print the points and plans of a project")
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
-    p.set_defaults(handler=_handler(cmd_points_list))
+    p.set_defaults(handler=cmd_points_list)
 
     p = psub.add_parser("upload", help="create the project's points on the controller (function 2)")
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
     group = p.add_mutually_exclusive_group()
     group.add_argument("--ids", help="ids to upload, e.g. 1,2,5-9 (default: all)")
     group.add_argument("--needed", action="store_true", help="only points not known to be on the controller")
-    p.set_defaults(handler=_handler(cmd_points_upload))
+    p.set_defaults(handler=cmd_points_upload)
 
     p = psub.add_parser("export", help="write the project's points to a CSV file")
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
     p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="OUT",
                    help="the CSV file to write (mm, degrees)")
     p.add_argument("--no-bom", action="store_true", help="write UTF-8 without a byte order mark")
-    p.set_defaults(handler=_handler(cmd_points_export))
+    p.set_defaults(handler=cmd_points_export)
 
     p = psub.add_parser("import", help="read points from a CSV file into the project")
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
@@ -159,29 +104,7 @@ def register(subparsers: Any) -> None:
                    help="update and add points, keep the others (default: replace all points)")
     p.add_argument("--allow-empty", action="store_true",
                    help="let a CSV without rows replace (delete) all points of the project")
-    p.set_defaults(handler=_handler(cmd_points_import))
-
-    r = subparsers.add_parser("run", help="run a plan of a project on the controller (function 3)")
-    r.add_argument("project", type=Path, help=_PROJECT_HELP)
-    r.add_argument("--plan", help="plan name (needed when the project has several)")
-    r.add_argument("--loops", type=int, help="loop count (default: the plan's; 0 = until stopped)")
-    r.add_argument("--from", type=int, default=1, dest="from_segment", metavar="K",
-                   help="start at segment K (counting from 1)")
-    r.add_argument("--from-loop", type=int, default=1, metavar="I", help="start in loop I (to resume)")
-    r.add_argument("--single", action="store_true", help="run segment K only")
-    r.add_argument("--no-upload", action="store_true",
-                   help="do not create the plan's points on the controller before and during the run: "
-                        "the operator is responsible for the controller holding exactly the project's "
-                        "points (the arrival pose is still checked after each segment)")
-    r.add_argument("--upload", action="store_true", help=argparse.SUPPRESS)  # the default now (old scripts)
-    r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
-    r.add_argument("--safety", metavar="PROFILE",
-                   help="a safety profile (.safety.json): the plan must stay in its envelope")
-    r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
-                   help="highest speed a segment may have (default %(default)g mm/s)")
-    from app.cli.run_plan import cmd_run  # imported here: run_plan uses this module's helpers
-
-    r.set_defaults(handler=_handler(cmd_run))
+    p.set_defaults(handler=cmd_points_import)
 
 
 # --- helpers ------------------------------------------------------------------------------------
@@ -197,11 +120,11 @@ def _limits(args: argparse.Namespace) -> PointLimits:
     )
 
 
-def _load(io: _Io, path: Path, limits: PointLimits) -> Project | None:
+def _load(ctx: CliContext, path: Path, limits: PointLimits) -> Project | None:
     try:
         return load_project(path, limits)
     except FileFormatError as exc:
-        io.error(str(exc))
+        ctx.error(str(exc))
         return None
 
 
@@ -211,31 +134,31 @@ def _endpoint(client: Any) -> str:
     return endpoint if isinstance(endpoint, str) else "controller"
 
 
-def _monitor_only(io: _Io, args: argparse.Namespace, what: str) -> bool:
+def _monitor_only(ctx: CliContext, args: argparse.Namespace, what: str) -> bool:
     """True (after saying so) when --monitor-only forbids ``what``; checked before any file I/O."""
     if getattr(args, "monitor_only", False):
-        io.error(f"{what} writes to the controller: refused in monitor-only mode (nothing read or written)")
+        ctx.error(f"{what} writes to the controller: refused in monitor-only mode (nothing read or written)")
         return True
     return False
 
 
-def _save(io: _Io, project: Project, path: Path) -> bool:
+def _save(ctx: CliContext, project: Project, path: Path) -> bool:
     owner = live_owner(path)
     if owner is not None:
-        io.error(f"{path}: not saved: the project is open in a TeachPad ({owner.text}); "
+        ctx.error(f"{path}: not saved: the project is open in a TeachPad ({owner.text}); "
                  "close it there or make the change there")
         return False
     try:
         save_project(project, path)
     except OSError as exc:
-        io.error(f"{path}: could not save: {exc}")
+        ctx.error(f"{path}: could not save: {exc}")
         return False
     return True
 
 
-def _link_code(io: _Io, exc: TeachPadError, what: str) -> int:
-    io.error(f"{what}: {exc}")
-    return EXIT_LINK if isinstance(exc, LinkError | ResponseTimeout) else EXIT_FAILED
+def _link_code(ctx: CliContext, exc: TeachPadError, what: str) -> ExitCode:
+    ctx.error(f"{what}: {exc}")
+    return exit_code_for(exc)
 
 
 def _fmt_time(seconds: float) -> str:
@@ -270,8 +193,8 @@ class _ProgressLine:
         self.width = 0
 
 
-def _upload(io: _Io, project: Project, points: Sequence[TempPoint], client: Any) -> UploadReport:
-    line = _ProgressLine(io.out)
+def _upload(ctx: CliContext, project: Project, points: Sequence[TempPoint], client: Any) -> UploadReport:
+    line = _ProgressLine(ctx.out)
 
     def progress(done: int, total: int) -> None:
         if done < total:
@@ -282,120 +205,112 @@ def _upload(io: _Io, project: Project, points: Sequence[TempPoint], client: Any)
     finally:
         line.done()
     apply_upload(project.ledger, report)
-    io.print(f"uploaded {report.ok_count} point(s)")
+    ctx.print(f"uploaded {report.ok_count} point(s)")
     unconfirmed = [o.point_id for o in report.outcomes if o.ok and o.unconfirmed]
     if unconfirmed:
         shown = ",".join(map(str, unconfirmed[:20])) + (",..." if len(unconfirmed) > 20 else "")
-        io.print(f"{len(unconfirmed)} of them unconfirmed: the controller reported no error but its "
+        ctx.print(f"{len(unconfirmed)} of them unconfirmed: the controller reported no error but its "
                  f"command status did not change (GV291 not writable): {shown}")
     for outcome in report.failed:
-        io.error(f"P{outcome.point_id}: {outcome.reason}")
+        ctx.error(f"P{outcome.point_id}: {outcome.reason}")
     if report.aborted:
         left = ",".join(str(i) for i in report.not_attempted)
-        io.error(f"upload stopped ({report.aborted}); not attempted: {left}")
+        ctx.error(f"upload stopped ({report.aborted}); not attempted: {left}")
     return report
 
 
-def _upload_code(report: UploadReport) -> int:
+def _upload_code(report: UploadReport) -> ExitCode:
     if report.interrupted:
-        return EXIT_INTERRUPTED
+        return ExitCode.INTERRUPTED
     if report.aborted:
-        return EXIT_LINK
-    return EXIT_OK if report.all_ok else EXIT_FAILED
+        return ExitCode.LINK
+    return ExitCode.OK if report.all_ok else ExitCode.FAILED
 
 
 # --- points ------------------------------------------------------------------------------------
 
 
-def cmd_points_list(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                    err: TextIO | None = None, close_client: bool = True) -> int:
+def cmd_points_list(ctx: CliContext) -> ExitCode:
     """``points list PROJECT``."""
-    io = _Io(out, err)
-    project = _load(io, args.project, _limits(args))
+    args = ctx.args
+    project = _load(ctx, args.project, _limits(args))
     if project is None:
-        return EXIT_USAGE
-    io.print(f"{project.name}: {len(project.ledger)} point(s), {len(project.plans)} plan(s)")
+        return ExitCode.USAGE
+    ctx.print(f"{project.name}: {len(project.ledger)} point(s), {len(project.plans)} plan(s)")
     for p in project.ledger:
         pose = " ".join(f"{v:9.3f}" for v in p.xyzabc)
         state = p.sync.text + (f" ({p.sync_error})" if p.sync_error else "")
         last = project.upload_history.get(p.id)
         if last is not None:  # history: what this host did, not what the controller holds now
             state += f" (last uploaded {last.time} to {last.endpoint})"
-        io.print(f"{p.id:6d}  {fit_width(p.name, NAME_WIDTH)} {pose}  {tool_text(p.tool):14s} {state}")
+        ctx.print(f"{p.id:6d}  {fit_width(p.name, NAME_WIDTH)} {pose}  {tool_text(p.tool):14s} {state}")
     for plan in project.plans:
-        io.print(f"plan {plan.name!r}: {len(plan)} segment(s), loops {plan.loops or 'until stopped'}")
-    return EXIT_OK
+        ctx.print(f"plan {plan.name!r}: {len(plan)} segment(s), loops {plan.loops or 'until stopped'}")
+    return ExitCode.OK
 
 
-def cmd_points_upload(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                      err: TextIO | None = None, close_client: bool = True) -> int:
+def cmd_points_upload(ctx: CliContext) -> ExitCode:
     """``points upload PROJECT [--ids ... | --needed]``; saves the upload history."""
-    io = _Io(out, err)
-    if _monitor_only(io, args, "points upload"):
-        return EXIT_FAILED
-    project = _load(io, args.project, _limits(args))
+    args = ctx.args
+    if _monitor_only(ctx, args, "points upload"):
+        return ExitCode.FAILED
+    project = _load(ctx, args.project, _limits(args))
     if project is None:
-        return EXIT_USAGE
+        return ExitCode.USAGE
     ledger = project.ledger
     if args.ids:
         try:
             ids = parse_id_list(args.ids)
         except InvalidInput as exc:
-            io.error(str(exc))
-            return EXIT_USAGE
+            ctx.error(str(exc))
+            return ExitCode.USAGE
         missing = [i for i in ids if i not in ledger]
         if missing:
-            io.error(f"no point with id {', '.join(map(str, missing))} in {args.project}")
-            return EXIT_USAGE
+            ctx.error(f"no point with id {', '.join(map(str, missing))} in {args.project}")
+            return ExitCode.USAGE
         points = [ledger.point(i) for i in ids]
     elif args.needed:
         points = ledger.needing_upload()
     else:
         points = list(ledger)
     if not points:
-        io.print("nothing to upload")
-        return EXIT_OK
-    client: Any = None
+        ctx.print("nothing to upload")
+        return ExitCode.OK
     try:
-        client = make_client()
-        report = _upload(io, project, points, client)
+        client = ctx.client
+        report = _upload(ctx, project, points, client)
         project.record_upload([o.point_id for o in report.outcomes if o.ok], _endpoint(client))
     except TeachPadError as exc:
-        return _link_code(io, exc, "cannot upload")
-    finally:
-        if close_client and client is not None:
-            client.close()
-    if not _save(io, project, args.project):
-        return EXIT_FAILED
+        return _link_code(ctx, exc, "cannot upload")
+    if not _save(ctx, project, args.project):
+        return ExitCode.FAILED
     return _upload_code(report)
 
 
-def cmd_points_export(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                      err: TextIO | None = None, close_client: bool = True) -> int:
+def cmd_points_export(ctx: CliContext) -> ExitCode:
     """``points export PROJECT --csv OUT``."""
-    io = _Io(out, err)
-    project = _load(io, args.project, _limits(args))
+    args = ctx.args
+    project = _load(ctx, args.project, _limits(args))
     if project is None:
-        return EXIT_USAGE
+        return ExitCode.USAGE
     try:
         write_points_csv(args.csv_path, project.ledger, bom=not args.no_bom)
     except OSError as exc:
-        io.error(f"{args.csv_path}: could not write: {exc}")
-        return EXIT_FAILED
-    io.print(f"wrote {len(project.ledger)} point(s) to {args.csv_path}")
-    return EXIT_OK
+        ctx.error(f"{args.csv_path}: could not write: {exc}")
+        return ExitCode.FAILED
+    ctx.print(f"wrote {len(project.ledger)} point(s) to {args.csv_path}")
+    return ExitCode.OK
 
 
-def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-                      err: TextIO | None = None, close_client: bool = True) -> int:
+def cmd_points_import(ctx: CliContext) -> ExitCode:
     """``points import PROJECT --csv IN [--merge] [--allow-empty]``; the project is saved only if
     all rows are good; a CSV without rows does not replace all points unless ``--allow-empty``."""
-    io = _Io(out, err)
+    args = ctx.args
     limits = _limits(args)
     if args.project.exists():
-        project = _load(io, args.project, limits)
+        project = _load(ctx, args.project, limits)
         if project is None:
-            return EXIT_USAGE
+            return ExitCode.USAGE
     else:
         name = args.project.name.removesuffix(".json").removesuffix(".teachpad")
         project = Project(name=name, ledger=PointLedger((), limits))
@@ -404,16 +319,16 @@ def cmd_points_import(args: argparse.Namespace, make_client: MakeClient, *, out:
         report = project.ledger.import_points(points, ImportMode.MERGE if args.merge else ImportMode.REPLACE,
                                               allow_empty=getattr(args, "allow_empty", False))
     except EmptyImport as exc:
-        io.error(f"{args.csv_path}: {exc}; nothing changed (pass --allow-empty to do it)")
-        return EXIT_USAGE
+        ctx.error(f"{args.csv_path}: {exc}; nothing changed (pass --allow-empty to do it)")
+        return ExitCode.USAGE
     except InvalidInput as exc:
-        io.error(str(exc))
-        return EXIT_USAGE
-    if not _save(io, project, args.project):
-        return EXIT_FAILED
-    io.print(f"imported {len(points)} point(s) into {args.project}: {report.text}")
+        ctx.error(str(exc))
+        return ExitCode.USAGE
+    if not _save(ctx, project, args.project):
+        return ExitCode.FAILED
+    ctx.print(f"imported {len(points)} point(s) into {args.project}: {report.text}")
     for plan in project.plans:
         missing = sorted(i for i in plan.point_ids() if i not in project.ledger)
         if missing:
-            io.warn(f"plan {plan.name!r} uses points that are gone: {', '.join(map(str, missing))}")
-    return EXIT_OK
+            ctx.warn(f"plan {plan.name!r} uses points that are gone: {', '.join(map(str, missing))}")
+    return ExitCode.OK

@@ -1,29 +1,31 @@
 """``teachpad-cli run PROJECT ...``: check a plan, upload its points, run it guarded.
 
-Registered by :func:`app.cli.points.register` (see that module for the handler conventions
-and exit codes). A project file cannot know what the controller holds, so ``run`` creates
-every point its plan uses before the first move and guards each segment with
+:func:`register` adds ``run`` to the main parser; the helpers are :mod:`app.cli.points`'s, the
+exit codes :class:`app.cli.exit_codes.ExitCode`. Segment numbers on the command line and in
+messages count from 1. ``run`` checks the plan first (the GUI's
+checks): errors refuse to run (USAGE). A project file cannot know what the controller holds,
+so ``run`` creates every point its plan uses before the first move and guards each segment with
 :class:`app.points.guard.PointGuard` (restart canary, points re-created right before the move,
 arrival verified after it). ``--no-upload`` skips the uploads: the operator answers for the
-controller's points; the arrival check stays.
+controller's points; the arrival check stays. A failed or interrupted run prints the
+``--from`` / ``--from-loop`` that resumes it.
+
+    run PROJECT [--plan NAME] [--loops N] [--from K] [--from-loop I] [--single]
+                [--no-upload] [--check] [--safety PROFILE] [--max-speed MM_S]
 """
 
 from __future__ import annotations
 
 import argparse
-from typing import Any, TextIO
+from pathlib import Path
+from typing import Any
 
+from app.cli.context import PROG, CliContext
+from app.cli.exit_codes import ExitCode, exit_code_for
 from app.cli.points import (
-    EXIT_FAILED,
-    EXIT_INTERRUPTED,
-    EXIT_LINK,
-    EXIT_OK,
-    EXIT_USAGE,
-    PROG,
-    MakeClient,
+    _PROJECT_HELP,
     _endpoint,
     _fmt_time,
-    _Io,
     _limits,
     _link_code,
     _load,
@@ -31,7 +33,8 @@ from app.cli.points import (
     _ProgressLine,
     _save,
 )
-from app.errors import CommandRefused, InvalidInput, LinkError, ResponseTimeout, TeachPadError
+from app.errors import CommandRefused, InvalidInput, TeachPadError
+from app.link.client import RobotClient
 from app.models import Pose
 from app.plan.checks import IssueKind, PlanLimits, check_plan
 from app.plan.estimates import estimate_plan, segment_timeouts
@@ -45,62 +48,84 @@ from app.safety.envelope import Envelope
 from app.safety.profile import load_profile
 
 
-def _pick_plan(io: _Io, project: Project, name: str | None) -> Plan | None:
+def register(subparsers: Any) -> None:
+    """Add ``run`` to the main parser's subcommands."""
+    r = subparsers.add_parser("run", help="run a plan of a project on the controller (function 3)")
+    r.add_argument("project", type=Path, help=_PROJECT_HELP)
+    r.add_argument("--plan", help="plan name (needed when the project has several)")
+    r.add_argument("--loops", type=int, help="loop count (default: the plan's; 0 = until stopped)")
+    r.add_argument("--from", type=int, default=1, dest="from_segment", metavar="K",
+                   help="start at segment K (counting from 1)")
+    r.add_argument("--from-loop", type=int, default=1, metavar="I", help="start in loop I (to resume)")
+    r.add_argument("--single", action="store_true", help="run segment K only")
+    r.add_argument("--no-upload", action="store_true",
+                   help="do not create the plan's points on the controller before and during the run: "
+                        "the operator is responsible for the controller holding exactly the project's "
+                        "points (the arrival pose is still checked after each segment)")
+    r.add_argument("--upload", action="store_true", help=argparse.SUPPRESS)  # the default now (old scripts)
+    r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
+    r.add_argument("--safety", metavar="PROFILE",
+                   help="a safety profile (.safety.json): the plan must stay in its envelope")
+    r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
+                   help="highest speed a segment may have (default %(default)g mm/s)")
+    r.set_defaults(handler=cmd_run)
+
+
+def _pick_plan(ctx: CliContext, project: Project, name: str | None) -> Plan | None:
     if name is not None:
         try:
             return project.plan(name)
         except InvalidInput as exc:
-            io.error(str(exc))
+            ctx.error(str(exc))
             return None
     if len(project.plans) == 1:
         return project.plans[0]
     if not project.plans:
-        io.error("the project has no plans")
+        ctx.error("the project has no plans")
     else:
-        io.error(f"the project has {len(project.plans)} plans ({', '.join(project.plan_names())}): "
+        ctx.error(f"the project has {len(project.plans)} plans ({', '.join(project.plan_names())}): "
                  "choose one with --plan")
     return None
 
 
-def _upload_plan_points(io: _Io, args: argparse.Namespace, project: Project, guard: PointGuard,
-                        plan_ids: list[int], client: Any) -> int:
+def _upload_plan_points(ctx: CliContext, args: argparse.Namespace, project: Project, guard: PointGuard,
+                        plan_ids: list[int], client: Any) -> ExitCode:
     """Create the plan's points before the first move; records the history in the project."""
-    io.print(f"uploading the plan's {len(plan_ids)} point(s): {', '.join(map(str, plan_ids))}")
+    ctx.print(f"uploading the plan's {len(plan_ids)} point(s): {', '.join(map(str, plan_ids))}")
     try:
         guard.ensure(client, plan_ids)
     except KeyboardInterrupt:
-        io.error("interrupted while uploading: not running")
-        return EXIT_INTERRUPTED
+        ctx.error("interrupted while uploading: not running")
+        return ExitCode.INTERRUPTED
     except PointNotCreated as exc:
-        io.error(f"{exc}: not running")
-        return EXIT_FAILED
+        ctx.error(f"{exc}: not running")
+        return ExitCode.FAILED
     except TeachPadError as exc:
-        return _link_code(io, exc, "cannot upload the plan's points")
+        return _link_code(ctx, exc, "cannot upload the plan's points")
     finally:
         project.record_upload(sorted(guard.uploaded), _endpoint(client))
     owner = live_owner(args.project)
     if owner is None:
-        _save(io, project, args.project)  # the upload history; a failed save does not stop the run
-    io.print(f"uploaded {len(guard.uploaded)} point(s)")
-    return EXIT_OK
+        _save(ctx, project, args.project)  # the upload history; a failed save does not stop the run
+    ctx.print(f"uploaded {len(guard.uploaded)} point(s)")
+    return ExitCode.OK
 
 
 def _points_lost(error: BaseException | None) -> bool:
     return isinstance(error, CommandRefused) and error.status.code == MoveStatus.BAD_END_POINT
 
 
-def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | None = None,
-            err: TextIO | None = None, close_client: bool = True) -> int:
+def cmd_run(ctx: CliContext) -> ExitCode:
     """``run PROJECT [--plan NAME] ...``: check, upload, run guarded with a progress line."""
-    io = _Io(out, err)
-    if not args.check and _monitor_only(io, args, "run"):
-        return EXIT_FAILED
-    project = _load(io, args.project, _limits(args))
+    args = ctx.args
+    if not args.check and _monitor_only(ctx, args, "run"):
+        return ExitCode.FAILED
+    project = _load(ctx, args.project, _limits(args))
     if project is None:
-        return EXIT_USAGE
-    plan = _pick_plan(io, project, args.plan)
+        return ExitCode.USAGE
+    plan = _pick_plan(ctx, project, args.plan)
     if plan is None:
-        return EXIT_USAGE
+        return ExitCode.USAGE
     loops = plan.loops if args.loops is None else args.loops
     start = args.from_segment - 1
     try:
@@ -112,65 +137,62 @@ def cmd_run(args: argparse.Namespace, make_client: MakeClient, *, out: TextIO | 
         if args.from_loop < 1 or (loops and args.from_loop > loops):
             raise InvalidInput(f"--from-loop {args.from_loop}: the run has loops 1..{loops}")
     except InvalidInput as exc:
-        io.error(str(exc))
-        return EXIT_USAGE
+        ctx.error(str(exc))
+        return ExitCode.USAGE
 
     envelope: Envelope | None = None
     if getattr(args, "safety", None):
         try:
             envelope = load_profile(args.safety).envelope
         except TeachPadError as exc:
-            io.error(str(exc))
-            return EXIT_USAGE
-    client: Any = None
-    try:
-        pose: Pose | None = None
-        if not args.check:
-            try:
-                client = make_client()
-                pose = client.read_pose()
-            except TeachPadError as exc:
-                return _link_code(io, exc, "cannot read the robot's pose")
-        return _run(io, args, project, plan, client, pose, limits, loops, start, envelope)
-    finally:
-        if close_client and client is not None:
-            client.close()
+            ctx.error(str(exc))
+            return ExitCode.USAGE
+    client: RobotClient | None = None
+    pose: Pose | None = None
+    if not args.check:
+        try:
+            client = ctx.client
+            pose = client.read_pose()
+        except TeachPadError as exc:
+            return _link_code(ctx, exc, "cannot read the robot's pose")
+    return _run(ctx, args, project, plan, client, pose, limits, loops, start, envelope)
 
 
-def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client: Any, pose: Pose | None,
-         limits: PlanLimits, loops: int, start: int, envelope: Envelope | None = None) -> int:
+def _run(ctx: CliContext, args: argparse.Namespace, project: Project, plan: Plan, client: Any,
+         pose: Pose | None, limits: PlanLimits, loops: int, start: int,
+         envelope: Envelope | None = None) -> ExitCode:
     ledger = project.ledger
     issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops, envelope=envelope)
     for issue in issues:
         if issue.kind is IssueKind.WARNING:
-            io.warn(issue.message)
+            ctx.warn(issue.message)
     errors = [i for i in issues if i.kind is IssueKind.ERROR]
     if errors:
         for issue in errors:
-            io.error(issue.message)
-        io.error(f"plan {plan.name!r} has {len(errors)} error(s): not running it")
-        return EXIT_USAGE
+            ctx.error(issue.message)
+        ctx.error(f"plan {plan.name!r} has {len(errors)} error(s): not running it")
+        return ExitCode.USAGE
     est = estimate_plan(plan, ledger, pose, loops=loops)
-    io.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
+    ctx.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
              f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}")
     plan_ids = list(dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids))
     if args.check:
         if args.no_upload:
-            io.print("--no-upload: the controller must already hold the plan's points")
+            ctx.print("--no-upload: the controller must already hold the plan's points")
         else:
-            io.print(f"would upload: {', '.join(map(str, plan_ids))}")
-        io.print("check only: not running")
-        return EXIT_OK
+            ctx.print(f"would upload: {', '.join(map(str, plan_ids))}")
+        ctx.print("check only: not running")
+        return ExitCode.OK
     guard = PointGuard({p.id: p for p in ledger}, refresh=not args.no_upload)
     if args.no_upload:
-        io.warn(f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
+        ctx.warn(f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
                 f"{', '.join(map(str, plan_ids))} (the operator's responsibility)")
     else:
-        code = _upload_plan_points(io, args, project, guard, plan_ids, client)
-        if code != EXIT_OK:
+        code = _upload_plan_points(ctx, args, project, guard, plan_ids, client)
+        if code != ExitCode.OK:
             return code
 
-    line = _ProgressLine(io.out)
+    line = _ProgressLine(ctx.out)
 
     def progress(p: RunProgress) -> None:
         if p.event is RunEvent.SEGMENT_STARTED:
@@ -183,24 +205,24 @@ def _run(io: _Io, args: argparse.Namespace, project: Project, plan: Plan, client
     finally:
         line.done()
     if outcome.state is RunState.FINISHED:
-        io.print(f"done: {outcome.segments_done} segment(s)")
-        return EXIT_OK
-    io.error(f"{outcome.state.value}: {outcome.message}")
+        ctx.print(f"done: {outcome.segments_done} segment(s)")
+        return ExitCode.OK
+    ctx.error(f"{outcome.state.value}: {outcome.message}")
     if _points_lost(outcome.error):
         # "bad end point id": the controller does not hold the segment's points (restarted?)
-        io.error("the controller does not hold the plan's points (restarted?); resume without "
+        ctx.error("the controller does not hold the plan's points (restarted?); resume without "
                  "--no-upload so that they are created first")
     if isinstance(outcome.error, PointMismatch | PointNotCreated):
-        io.error("nothing further was sent; the robot is where the message above says")
+        ctx.error("nothing further was sent; the robot is where the message above says")
     if outcome.resume_from is not None:
         resume = f"--from {outcome.resume_from + 1}"
         if outcome.resume_loop and outcome.resume_loop > 1:
             resume += f" --from-loop {outcome.resume_loop}"
         plan_arg = f" --plan {plan.name!r}" if len(project.plans) > 1 else ""
         loops_arg = f" --loops {loops}" if args.loops is not None else ""
-        io.print(f"to resume: {PROG} run {args.project}{plan_arg} {resume}{loops_arg}")
+        ctx.print(f"to resume: {PROG} run {args.project}{plan_arg} {resume}{loops_arg}")
     if outcome.interrupted:
-        return EXIT_INTERRUPTED
-    if isinstance(outcome.error, LinkError | ResponseTimeout):
-        return EXIT_LINK
-    return EXIT_FAILED
+        return ExitCode.INTERRUPTED
+    if isinstance(outcome.error, TeachPadError):
+        return exit_code_for(outcome.error)
+    return ExitCode.FAILED

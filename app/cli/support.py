@@ -22,6 +22,8 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from app.cli.context import CliContext
+from app.cli.exit_codes import ExitCode
 from app.errors import InvalidInput
 from app.safety.audit import AuditFilter, ReadStats, default_audit_dir, export_csv, query
 from app.safety.bundle import DEFAULT_DAYS, write_support_bundle
@@ -96,7 +98,7 @@ def _read_text_lines(path: Path, what: str) -> list[str]:
         raise InvalidInput(f"{what} {path.name} cannot be read ({exc.strerror or exc})") from None
 
 
-def cmd_support_bundle(ctx: Any) -> int:
+def cmd_support_bundle(ctx: CliContext) -> ExitCode:
     args = ctx.args
     settings: dict[str, Any] = {"cli connection": _settings_dict(ctx.settings)}
     if args.settings is not None:
@@ -117,7 +119,7 @@ def cmd_support_bundle(ctx: Any) -> int:
     ctx.print(f"wrote {args.out} ({len(manifest.files)} files)")
     for note in manifest.left_out:
         ctx.print(f"  left out: {note}")
-    return 0
+    return ExitCode.OK
 
 
 def _settings_dict(settings: Any) -> dict[str, Any]:
@@ -125,7 +127,7 @@ def _settings_dict(settings: Any) -> dict[str, Any]:
     return {name: getattr(settings, name) for name in fields}
 
 
-def cmd_audit(ctx: Any) -> int:
+def cmd_audit(ctx: CliContext) -> ExitCode:
     args = ctx.args
     flt = AuditFilter(start=args.start, end=args.end, role=args.role, command=args.command_text,
                       result=args.result)
@@ -140,8 +142,8 @@ def cmd_audit(ctx: Any) -> int:
             extra = f" - {r.detail}" if r.detail else ""
             ctx.print(f"{r.host_time}  {r.role:<13} {r.result:<8} {r.command}{extra}")
     if stats.skipped:
-        print(f"teachpad-cli: warning: {stats.skipped} damaged line(s) skipped", file=sys.stderr)
-    return 0
+        ctx.warn(f"{stats.skipped} damaged line(s) skipped")
+    return ExitCode.OK
 
 
 def _read_password() -> str:
@@ -153,19 +155,19 @@ def _read_password() -> str:
     return sys.stdin.readline().rstrip("\r\n")
 
 
-def cmd_roles(ctx: Any) -> int:
+def cmd_roles(ctx: CliContext) -> ExitCode:
     args = ctx.args
     store = RoleStore(args.store or default_store_path())
     if args.roles_command == "show":
         for role in (Role.ENGINEER, Role.ADMINISTRATOR):
             ctx.print(f"{role.text:<13} {'password set' if store.has_password(role) else 'no password'}")
         ctx.print(f"idle lock     {store.idle_timeout:g} s")
-        return 0
+        return ExitCode.OK
     role = Role.parse(args.role)
     if args.roles_command == "clear-password":
         store.clear_password(role, by=Role.ADMINISTRATOR)
         ctx.print(f"password of the {role.text} role removed")
-        return 0
+        return ExitCode.OK
     store.set_password(role, _read_password(), by=Role.ADMINISTRATOR)
     ctx.print(f"password of the {role.text} role set")
-    return 0
+    return ExitCode.OK

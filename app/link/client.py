@@ -1,9 +1,9 @@
 """RobotClient: one method per controller operation, typed results, typed errors.
 
-The client speaks through one :class:`~app.link.transport.Transport` (TCP, RTU over serial, or
-RTU framing over TCP for tests), which checks every answer against its request and counts what
-the wire did (:attr:`RobotClient.stats`). Not thread-safe: one thread owns it (the GUI worker,
-or the CLI).
+The commands and their completion, over :class:`~app.link.register_client.RegisterClient`
+(the link, the write guard, raw register access and the pose/status reads, which RobotClient
+inherits: ``connect``, ``read_pose``, ``read_status``, ``write_gv``, ``stats`` ...). Not
+thread-safe: one thread owns it (the GUI worker, or the CLI).
 
 Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
@@ -19,23 +19,16 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
   instant command *done, unconfirmed*; "auto" (default) probes once, before the first such
   command: write the sentinel, wait ``SENTINEL_PROBE_SETTLE``, read it back -- kept: sentinel;
   Modbus exception or overwritten: observe. Never in monitor-only mode (no command is sent).
-* Control registers 440-445 are written with 0x06 only; raw multi-register writes that touch
-  them are refused (:class:`InvalidInput`).
-* A request that timed out or got a malformed answer closes the link (the next request
-  reconnects), so a late answer is never read as the next request's.
-* Traffic observers are called synchronously in the client's thread, inside the request:
-  keep them short (the GUI should only queue the record).
 """
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import enum
 import logging
 import math
 import time
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 from app import timing
 from app.errors import (
@@ -45,37 +38,14 @@ from app.errors import (
     ModbusExceptionError,
     Reason,
     ResponseTimeout,
-    WriteBlocked,
 )
-from app.link.checks import (  # the command methods use the short private names
-    check_enum as _check_enum,
-)
-from app.link.checks import (
-    check_float as _check_float,
-)
-from app.link.checks import (
-    check_floats as _check_floats,
-)
-from app.link.checks import (
-    check_int as _check_int,
-)
-from app.link.checks import (
-    check_settings as _check_settings,
-)
-from app.link.checks import (
-    check_tool as _check_tool,
-)
-from app.link.checks import (
-    range_name as _range_name,
-)
-from app.link.decode import decode_pose, decode_status
+from app.link.checks import check_enum, check_float, check_floats, check_int, check_tool
+from app.link.register_client import RegisterClient
 from app.link.stats import LinkStats
 from app.link.tracker import CommandTracker, CompletionRule, command_text
-from app.link.transport import ConnectionSettings, TrafficObserver, TrafficRecord, Transport
+from app.link.transport import ConnectionSettings, TrafficRecord
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
-from app.protocol.codec import decode_floats, encode_floats
-from app.protocol.datetime_regs import ControllerClock, decode_clock
 from app.protocol.enums import (
     STATUS_SENTINEL,
     CommandKind,
@@ -88,11 +58,11 @@ from app.protocol.enums import (
     decode_command_status,
     decode_status_registers,
 )
-from app.safety.audit import AuditLog
 
 __all__ = [
     "ConnectionSettings",
     "LinkStats",
+    "RegisterClient",
     "RobotClient",
     "StepFrame",
     "TrafficRecord",
@@ -100,10 +70,8 @@ __all__ = [
 
 _log = logging.getLogger(__name__)
 
-
-_CONTROL_REGISTERS = range(registers.REG_RUN_COMMAND, registers.REG_GO_ZERO + 1)  # 440..445: 0x06 only
-_MAX_REGISTER = 0xFFFF
 _GENERAL_POSE_LAST_START = registers.GV_GENERAL_LAST - 5  # six GVs must fit in GV0..GV99
+
 
 class StepFrame(enum.Enum):
     """Frame of an incremental move (function 1)."""
@@ -116,186 +84,31 @@ class StepFrame(enum.Enum):
         return RunCommand.STEP_JOINT if self is StepFrame.JOINT else RunCommand.STEP_BASE
 
 
-# --------------------------------------------------------------------------------------------
-# The client
-# --------------------------------------------------------------------------------------------
-
 ProgressCallback = Callable[[int, int], bool]
 
 
-class RobotClient:
+class RobotClient(RegisterClient):
     """One method per controller operation. Blocking; owned by one thread."""
 
     def __init__(self, settings: ConnectionSettings) -> None:
-        _check_settings(settings)
-        self.settings = settings
-        self._transport = Transport(settings, on_link_change=self.invalidate_cache)
-        self._tool_cache: int | None = None
+        self._tool_cache: int | None = None  # before the link exists: it drops these caches
         self._user_frame_cache: int | None = None
         self._ext_cache: tuple[float, ...] | None = None
+        super().__init__(settings)
         self._last_kind: CommandKind | None = None
         self._teach_frame: TeachFrame | None = None
-        self.last_status: ControllerStatus | None = None
         self.last_tracker: CommandTracker | None = None
-        self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
-        self._io_timeout: float | None = None  # see io_timeout()
         self._gv291_writable: bool | None = None  # completion "auto": None until probed
         # X Y Z of the points this client created from given poses (a move whose GV291 never
         # changed may be confirmed by arriving there, see CommandTracker's ``target``)
         self._sent_points: dict[int, tuple[float, float, float]] = {}
         self._ack_latency = 0.0  # s, decaying maximum of the acknowledgement times seen
-        self.audit: AuditLog | None = None  # every write (and monitor-only block) is recorded here
-
-    # -- connection (the transport drops the caches whenever the link is made or lost) ---
-    def connect(self) -> None:
-        """Open the link; :class:`LinkError` naming the cause when the controller cannot be reached."""
-        self._transport.open()
-
-    def close(self) -> None:
-        self._transport.close()
-
-    @property
-    def connected(self) -> bool:
-        return self._transport.connected
-
-    def __enter__(self) -> RobotClient:
-        self.connect()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
     def invalidate_cache(self) -> None:
         """Forget which tool / user frame / external offsets were written last."""
         self._tool_cache = None
         self._user_frame_cache = None
         self._ext_cache = None
-
-    @property
-    def stats(self) -> LinkStats:
-        """The link's counters so far (a snapshot)."""
-        return self._transport.stats
-
-    # -- observers -----------------------------------------------------------------------
-    def add_observer(self, cb: TrafficObserver) -> None:
-        self._transport.add_observer(cb)
-
-    def remove_observer(self, cb: TrafficObserver) -> None:
-        self._transport.remove_observer(cb)
-
-    # -- the transport: every answer is checked against its request ----------------------
-    def _read(self, address: int, count: int, timeout: float | None = None) -> list[int]:
-        timeout = self._io_timeout if timeout is None else timeout
-        return self._transport.read(f"read of {_range_name(address, count)}", address, count, timeout)
-
-    @contextlib.contextmanager
-    def io_timeout(self, seconds: float) -> Iterator[None]:
-        """Every transaction inside waits at most ``seconds`` per attempt (unless it passes its
-        own ``timeout``): the shutdown's ratio 0 / teach disable must not hang on a dead controller."""
-        outer, self._io_timeout = self._io_timeout, float(seconds)
-        try:
-            yield
-        finally:
-            self._io_timeout = outer
-
-    def _require_writable(self, what: str) -> None:
-        if self.settings.monitor_only:
-            raise WriteBlocked(f"monitor-only mode: {what} was not sent")
-
-    def _write(self, address: int, values: Sequence[int], *, single: bool = False,
-               timeout: float | None = None) -> None:
-        """The write guard: every write to the controller passes here (and, with an audit trail,
-        is recorded there once, blocked ones too). ``timeout`` (s per attempt) overrides the
-        request timeout (default: :meth:`io_timeout`'s, else the settings')."""
-        timeout = self._io_timeout if timeout is None else timeout
-        ctx = self.audit.writing(address, values, single=single) if self.audit else contextlib.nullcontext()
-        with ctx:
-            name = _range_name(address, len(values))
-            self._require_writable(f"write to {name}")
-            if not values:
-                raise InvalidInput("nothing to write")
-            if single:
-                if len(values) != 1:
-                    raise InvalidInput("a single-register write takes one value")
-                _log.debug("write 0x06 %s <- %d", name, values[0])
-                self.write_count += 1
-                self._transport.write_single(f"write to {name}", address, int(values[0]), timeout)
-            else:
-                _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
-                self.write_count += 1
-                self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values],
-                                               timeout)
-
-    def _write_floats(self, gv: int, values: Sequence[float], timeout: float | None = None) -> None:
-        self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order), timeout=timeout)
-
-    def _write_control(self, register: int, value: int) -> None:
-        self._write(register, [value], single=True)
-
-    # -- raw access ----------------------------------------------------------------------
-    def read_registers(self, addr: int, count: int) -> list[int]:
-        addr = _check_int(addr, 0, _MAX_REGISTER, "register address")
-        count = _check_int(count, 1, _MAX_REGISTER + 1 - addr, "register count")
-        out: list[int] = []
-        while count > 0:
-            n = min(count, registers.MAX_READ_REGISTERS)
-            out.extend(self._read(addr, n))
-            addr += n
-            count -= n
-        return out
-
-    def write_register(self, addr: int, value: int) -> None:
-        """0x06 write of one register (the way 440..445 must be written)."""
-        addr = _check_int(addr, 0, _MAX_REGISTER, "register address")
-        value = _check_int(value, 0, 0xFFFF, "register value")
-        self._write(addr, [value], single=True)
-
-    def write_registers(self, addr: int, values: Sequence[int]) -> None:
-        """0x10 write (split every 123 registers); refuses the control registers 440..445."""
-        addr = _check_int(addr, 0, _MAX_REGISTER, "register address")
-        regs = [_check_int(v, 0, 0xFFFF, "register value") for v in values]
-        if not regs:
-            raise InvalidInput("nothing to write")
-        if addr + len(regs) - 1 > _MAX_REGISTER:
-            raise InvalidInput("write goes past register 65535")
-        end = addr + len(regs)
-        if addr < _CONTROL_REGISTERS.stop and end > _CONTROL_REGISTERS.start:
-            raise InvalidInput(
-                "registers 440..445 (GV220..GV222) are control registers written one at a time "
-                "with 0x06; use write_register or the command methods"
-            )
-        for i in range(0, len(regs), registers.MAX_WRITE_REGISTERS):
-            self._write(addr + i, regs[i : i + registers.MAX_WRITE_REGISTERS])
-
-    def read_gv(self, n: int, count: int = 1) -> list[float]:
-        n = _check_int(n, 0, _MAX_REGISTER // 2, "GV index")
-        count = _check_int(count, 1, (_MAX_REGISTER + 1) // 2 - n, "GV count")
-        return decode_floats(self.read_registers(registers.gv_reg(n), 2 * count), self.settings.word_order)
-
-    def write_gv(self, n: int, values: Sequence[float]) -> None:
-        n = _check_int(n, 0, _MAX_REGISTER // 2, "GV index")
-        floats = [_check_float(v, f"GV{n + i}") for i, v in enumerate(values)]
-        self.write_registers(registers.gv_reg(n), encode_floats(floats, self.settings.word_order))
-
-    # -- reads ---------------------------------------------------------------------------
-    def read_pose(self, *, timeout: float | None = None) -> Pose:
-        """Pose, external axes and joints (GV206..GV255) in one FC03 of 100 registers.
-
-        ``timeout`` overrides the request timeout (the poller passes the poll timeout).
-        """
-        regs = self._read(registers.POSE_BLOCK_START, registers.POSE_BLOCK_COUNT, timeout)
-        return decode_pose(regs, self.settings.word_order)
-
-    def read_status(self, with_clock: bool = False, *, timeout: float | None = None) -> ControllerStatus:
-        """Table 2 (560..583) in one FC03; the clock (576..579) comes from the same block."""
-        regs = self._read(registers.STATUS_BLOCK_START, registers.STATUS_BLOCK_COUNT, timeout)
-        status = decode_status(regs, self.settings.word_order,
-                               self.settings.datetime_layout if with_clock else None)
-        self.last_status = status
-        return status
-
-    def read_clock(self) -> ControllerClock:
-        return decode_clock(self._read(registers.gv_reg(registers.GV_DATE), 4), self.settings.datetime_layout)
 
     def command_status(self) -> CommandStatus:
         """GV291 decoded with the table of the last command this client sent."""
@@ -304,7 +117,7 @@ class RobotClient:
 
     # -- plain commands (no GV291) -------------------------------------------------------
     def set_work_mode(self, mode: WorkMode) -> None:
-        mode = _check_enum(mode, WorkMode, "work mode")
+        mode = check_enum(mode, WorkMode, "work mode")
         self._write_control(registers.REG_WORK_MODE, int(mode))
 
     def stop(self) -> None:
@@ -322,7 +135,7 @@ class RobotClient:
     def go_zero(self, axis: int | None) -> None:
         """Send one axis (0..10 = J1..J11) or all axes (None) to zero."""
         last_axis = registers.NUM_AXES_TOTAL - 1
-        value = registers.GO_ZERO_ALL if axis is None else _check_int(axis, 0, last_axis, "axis")
+        value = registers.GO_ZERO_ALL if axis is None else check_int(axis, 0, last_axis, "axis")
         self._require_writable("go to zero")
         self._ensure_auto(self.read_status())
         self._write_control(registers.REG_GO_ZERO, value)
@@ -330,10 +143,10 @@ class RobotClient:
     def run_program(self, program_id: int, mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
                     cycles: int = 1, speed_ratio: int = 100) -> None:
         """446..449 in one 0x10, then 440 <- 0x01."""
-        program_id = _check_int(program_id, 0, 0xFFFF, "program id")
-        motion = _check_enum(mode, ProgramMotionMode, "program motion mode")
-        cycles = _check_int(cycles, 0, 0xFFFF, "cycle count")
-        speed_ratio = _check_int(speed_ratio, 1, 100, "program speed ratio")
+        program_id = check_int(program_id, 0, 0xFFFF, "program id")
+        motion = check_enum(mode, ProgramMotionMode, "program motion mode")
+        cycles = check_int(cycles, 0, 0xFFFF, "cycle count")
+        speed_ratio = check_int(speed_ratio, 1, 100, "program speed ratio")
         self._require_writable("run program")
         self._ensure_auto(self.read_status())
         self._write(registers.REG_PROGRAM_ID, [program_id, int(motion), cycles, speed_ratio])
@@ -468,7 +281,7 @@ class RobotClient:
                              reason=Reason("sent", {"command": int(tracker.command)}))
 
     def _check_point_id(self, point_id: int, name: str = "point id") -> int:
-        return _check_int(point_id, self.settings.point_id_min, self.settings.point_id_max, name)
+        return check_int(point_id, self.settings.point_id_min, self.settings.point_id_max, name)
 
     # -- function 1: incremental move ----------------------------------------------------
     def step(self, frame: StepFrame, offsets: Sequence[float],
@@ -481,11 +294,11 @@ class RobotClient:
         """
         if not isinstance(frame, StepFrame):
             raise InvalidInput(f"step frame must be joint or base, got {frame!r}")
-        offs = _check_floats(offsets, registers.NUM_ROBOT_AXES, "offsets")
-        ext = tuple(_check_floats(ext_offsets, registers.NUM_EXTERNAL_AXES, "external offsets"))
-        speed = _check_float(speed, "speed", 0.0, lo_open=True)
+        offs = check_floats(offsets, registers.NUM_ROBOT_AXES, "offsets")
+        ext = tuple(check_floats(ext_offsets, registers.NUM_EXTERNAL_AXES, "external offsets"))
+        speed = check_float(speed, "speed", 0.0, lo_open=True)
         if timeout is not None:
-            timeout = _check_float(timeout, "timeout", 0.0, lo_open=True)
+            timeout = check_float(timeout, "timeout", 0.0, lo_open=True)
         if not any(offs) and not any(ext):
             raise InvalidInput("step: every offset is zero, nothing to move")
         if timeout is None:
@@ -522,11 +335,11 @@ class RobotClient:
                      timeout: float | None = None) -> CommandResult:
         """Create (or overwrite) a temp point from the current pose, or from ``pose`` via GVs."""
         point_id = self._check_point_id(point_id)
-        tool = _check_tool(tool)
-        values = None if pose is None else _check_floats(pose, 6, "pose")
-        gv_start = _check_int(gv_start, registers.GV_GENERAL_FIRST, _GENERAL_POSE_LAST_START, "first pose GV")
+        tool = check_tool(tool)
+        values = None if pose is None else check_floats(pose, 6, "pose")
+        gv_start = check_int(gv_start, registers.GV_GENERAL_FIRST, _GENERAL_POSE_LAST_START, "first pose GV")
         if timeout is not None:
-            timeout = _check_float(timeout, "timeout", 0.0, lo_open=True)
+            timeout = check_float(timeout, "timeout", 0.0, lo_open=True)
         before, _ = self._prepare(RunCommand.CREATE_POINT)
         if values is None:
             self._write_floats(registers.GV_PARAM0, [float(point_id), 0.0])
@@ -550,10 +363,10 @@ class RobotClient:
         error or timeout ends the batch after a failed result for that point; ``progress``
         (done, total) returning False cancels after the current point.
         """
-        items = [(self._check_point_id(pid), _check_floats(pose, 6, f"pose of point {pid}"))
+        items = [(self._check_point_id(pid), check_floats(pose, 6, f"pose of point {pid}"))
                  for pid, pose in points]
-        tool = _check_tool(tool)
-        gv_start = _check_int(gv_start, registers.GV_GENERAL_FIRST, _GENERAL_POSE_LAST_START, "first pose GV")
+        tool = check_tool(tool)
+        gv_start = check_int(gv_start, registers.GV_GENERAL_FIRST, _GENERAL_POSE_LAST_START, "first pose GV")
         results: list[CommandResult] = []
         if not items:
             return results
@@ -592,10 +405,10 @@ class RobotClient:
             if via_id == end_id:
                 raise InvalidInput("the arc's middle point must differ from its end point")
             motion = float(via_id)
-        speed = _check_float(speed, "speed", 0.0, lo_open=True)
-        tool = _check_tool(tool)
+        speed = check_float(speed, "speed", 0.0, lo_open=True)
+        tool = check_tool(tool)
         if timeout is not None:
-            timeout = _check_float(timeout, "timeout", 0.0, lo_open=True)
+            timeout = check_float(timeout, "timeout", 0.0, lo_open=True)
         before, before_pose = self._prepare(RunCommand.MOVE_TO_POINT)
         self._write_floats(registers.GV_PARAM0, [motion, float(end_id), 1.0 if orientation_changes else 0.0,
                                          1.0 if ignore_middle else 0.0])
@@ -609,21 +422,21 @@ class RobotClient:
     def _check_axis(self, frame: TeachFrame | None, axis: int) -> int:
         joint = frame in (TeachFrame.JOINT, None)
         top = (registers.NUM_AXES_TOTAL if joint else registers.NUM_ROBOT_AXES) - 1
-        return _check_int(axis, 0, top, "axis")
+        return check_int(axis, 0, top, "axis")
 
     @staticmethod
     def _check_direction(direction: int) -> int:
-        return _check_int(direction, 0, 1, "direction (0 negative, 1 positive)")
+        return check_int(direction, 0, 1, "direction (0 negative, 1 positive)")
 
     def teach_enable(self, frame: TeachFrame, axis: int, direction: int, *, user_frame: int = 0,
                      tool_frame: int = 0, wait: bool = True,
                      timeout: float | None = None) -> CommandResult:
         """GV200-203 = (frame, axis, direction, 0) in one 0x10, GV241/GV245 if needed, 440 <- 0x80."""
-        frame = _check_enum(frame, TeachFrame, "teach frame")
+        frame = check_enum(frame, TeachFrame, "teach frame")
         axis = self._check_axis(frame, axis)
         direction = self._check_direction(direction)
-        user_frame = _check_int(user_frame, 0, 0xFFFF, "user frame")
-        tool_frame = _check_tool(tool_frame)
+        user_frame = check_int(user_frame, 0, 0xFFFF, "user frame")
+        tool_frame = check_tool(tool_frame)
         before, _ = self._prepare(RunCommand.TEACH_ENABLE)
         self._write_floats(registers.GV_PARAM0, [float(frame), float(axis), float(direction), 0.0])
         if frame is TeachFrame.USER:
@@ -636,7 +449,7 @@ class RobotClient:
 
     def teach_set_ratio(self, ratio: float, *, timeout: float | None = None) -> None:
         """GV203 <- ratio: > 0 moves, 0 stops the jog (teach stays enabled). ``timeout``: s per attempt."""
-        ratio = _check_float(ratio, "speed ratio", 0.0, 100.0)
+        ratio = check_float(ratio, "speed ratio", 0.0, 100.0)
         self._write_floats(registers.GV_PARAM3, [ratio], timeout)
 
     def teach_set_axis(self, axis: int, direction: int) -> None:

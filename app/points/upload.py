@@ -6,7 +6,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol
 
-from app.errors import InvalidInput, LinkError, ResponseTimeout, TeachPadError
+from app.errors import InvalidInput, LinkError, MalformedResponse, ResponseTimeout, TeachPadError
 from app.models import CommandResult
 from app.points.point import SyncState, TempPoint
 
@@ -72,7 +72,7 @@ def upload_points(
             return report
         try:
             result = client.create_point(point.id, pose=point.xyzabc, tool=point.tool, wait=True)
-        except (LinkError, ResponseTimeout) as exc:
+        except (LinkError, ResponseTimeout, MalformedResponse) as exc:  # the link was closed
             report.aborted = str(exc) or type(exc).__name__
             report.not_attempted = [p.id for p in points[done:]]
             return report

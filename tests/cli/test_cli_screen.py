@@ -12,8 +12,9 @@ from typing import Any
 
 import pytest
 
+from app.cli.exit_codes import ExitCode
 from app.cli.help import EXAMPLES, help_defects, walk
-from app.cli.main import EXIT_FAILED, EXIT_OK, build_parser, main
+from app.cli.main import build_parser, main
 from app.cli.points import display_width, fit_width
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -35,7 +36,7 @@ def test_the_walk_finds_an_option_without_help() -> None:
 
 
 def test_a_command_help_shows_units_and_its_example(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["move", "--help"]) == EXIT_OK
+    assert main(["move", "--help"]) == ExitCode.OK
     out = capsys.readouterr().out
     assert "mm/s" in out and "example: teachpad-cli move 12 --via 11 --speed 80" in out
 
@@ -48,7 +49,7 @@ def test_status_into_a_closed_pipe_ends_quietly(sim: Any) -> None:
     proc.stdout.close()  # like head after its first line
     _, err = proc.communicate(timeout=30)
     assert err.decode() == ""
-    assert proc.returncode == EXIT_OK
+    assert proc.returncode == ExitCode.OK
 
 
 @pytest.mark.skipif(shutil.which("head") is None or shutil.which("bash") is None, reason="needs a shell")
@@ -57,13 +58,13 @@ def test_status_piped_into_head_prints_one_line_and_no_traceback(sim: Any) -> No
     done = subprocess.run(["bash", "-c", cmd], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert done.stderr == ""
     assert len(done.stdout.splitlines()) == 1
-    assert done.returncode == EXIT_OK
+    assert done.returncode == ExitCode.OK
 
 
 def test_program_run_of_an_unknown_program_is_an_error(sim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     code = main(["--port", str(sim.port), "program", "run", "99"])
     out, err = capsys.readouterr()
-    assert code == EXIT_FAILED and out == ""
+    assert code == ExitCode.FAILED and out == ""
     assert err.startswith("teachpad-cli: error: the controller did not start program 99")
     assert len(err.strip().splitlines()) == 1
     assert not sim.state().moving
@@ -79,7 +80,7 @@ def test_fit_width_counts_wide_characters_twice() -> None:
 def test_points_list_aligns_chinese_names(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     demo = tmp_path / "demo.teachpad.json"
     shutil.copy(SAMPLES / "demo.teachpad.json", demo)
-    assert main(["points", "list", str(demo)]) == EXIT_OK
+    assert main(["points", "list", str(demo)]) == ExitCode.OK
     out = capsys.readouterr().out
     pose = re.compile(r"(\s+-?\d+\.\d{3}){6}")
     ends = {display_width(line[: m.end()]) for line in out.splitlines() if (m := pose.search(line))}

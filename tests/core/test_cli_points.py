@@ -10,7 +10,10 @@ from typing import Any
 import pytest
 
 from app.cli import points as cli_points
+from app.cli import run_plan
+from app.cli.context import CliContext
 from app.errors import CommandRefused, LinkError
+from app.link.client import ConnectionSettings
 from app.points.ledger import SyncState
 from app.points.project import load_project
 from app.protocol.enums import CommandKind, CommandStatus
@@ -20,7 +23,8 @@ SAMPLES = Path(__file__).resolve().parents[2] / "resources" / "samples"
 
 
 class Cli:
-    """Runs a command like app/cli.py will: parse, then ``args.handler(args, make_client)``."""
+    """Runs a command like app/cli/main.py: parse, then ``args.handler(ctx)`` with this fake
+    client behind ``ctx.client``; the context closes it."""
 
     def __init__(self, client: Any = None) -> None:
         self.client = client or FakeClient()
@@ -36,8 +40,13 @@ class Cli:
         parser.add_argument("--monitor-only", action="store_true")
         sub = parser.add_subparsers(dest="command", required=True)
         cli_points.register(sub)
+        run_plan.register(sub)
         args = parser.parse_args(list(argv))
-        code: int = args.handler(args, self.make_client)
+        ctx = CliContext(args, ConnectionSettings(), make_client=self.make_client)
+        try:
+            code: int = args.handler(ctx)
+        finally:
+            ctx.close()
         return code
 
 
@@ -292,7 +301,7 @@ def test_failed_segment_exit_code(demo: Path) -> None:
 
 def test_through_the_main_cli(demo: Path, capsys: pytest.CaptureFixture[str],
                               monkeypatch: pytest.MonkeyPatch) -> None:
-    """app/cli.py finds this module as a plugin and calls handler(ctx)."""
+    """app/cli/main.py registers this module and calls handler(ctx)."""
     from app.cli import main as main_cli
 
     assert main_cli.main(["points", "list", str(demo)]) == 0

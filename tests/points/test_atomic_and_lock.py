@@ -171,6 +171,8 @@ def test_the_cli_does_not_write_a_project_open_in_a_teachpad(
     import argparse
 
     from app.cli import points as cli_points
+    from app.cli.context import CliContext
+    from app.link.client import ConnectionSettings
 
     _child, project = other_teachpad
     csv_path = tmp_path / "in.csv"
@@ -179,6 +181,6 @@ def test_the_cli_does_not_write_a_project_open_in_a_teachpad(
     parser = argparse.ArgumentParser()
     cli_points.register(parser.add_subparsers(dest="command"))
     args = parser.parse_args(["points", "import", str(project), "--csv", str(csv_path), "--merge"])
-    assert args.handler(args, lambda: None) == cli_points.EXIT_FAILED
+    assert args.handler(CliContext(args, ConnectionSettings())) == cli_points.EXIT_FAILED
     assert "open in a TeachPad (process" in capsys.readouterr().err
     assert project.read_bytes() == before

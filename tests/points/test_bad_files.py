@@ -13,6 +13,8 @@ from pathlib import Path
 import pytest
 
 from app.cli import points as cli_points
+from app.cli.context import CliContext
+from app.link.client import ConnectionSettings
 from app.points.csv_io import parse_points_csv, points_to_csv
 from app.points.point import QUOTE_CHARS, FileFormatError
 from app.points.project import load_project, parse_project, project_to_json, read_points_csv, save_project
@@ -114,7 +116,7 @@ def test_a_bad_project_through_the_cli_is_a_message_not_a_traceback(
     parser = argparse.ArgumentParser()
     cli_points.register(parser.add_subparsers(dest="command"))
     args = parser.parse_args(parser_args)
-    assert args.handler(args, lambda: None) == cli_points.EXIT_USAGE
+    assert args.handler(CliContext(args, ConnectionSettings())) == cli_points.EXIT_USAGE
     err = capsys.readouterr().err
     assert "field 'x'" in err and "too large" in err and "Traceback" not in err
     assert len(err) < MESSAGE_MAX + len(str(path))

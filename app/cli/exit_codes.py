@@ -1,0 +1,62 @@
+"""teachpad-cli's exit codes: the one table, and which failure maps to which code.
+
+Every command returns a member of :class:`ExitCode`; an error that escapes a command is mapped
+by :func:`exit_code_for` (``app/cli/main.py`` does it once for every command). The same table
+is printed at the end of ``teachpad-cli --help`` (:data:`EPILOG`) and in the README's CLI
+section.
+"""
+
+from __future__ import annotations
+
+import enum
+
+from app.errors import InvalidInput, LinkError, MalformedResponse, ResponseTimeout, TeachPadError
+
+__all__ = ["EPILOG", "LINK_ERRORS", "ExitCode", "exit_code_for"]
+
+
+class ExitCode(enum.IntEnum):
+    """What a ``teachpad-cli`` run ended with (the process's exit status)."""
+
+    OK = 0
+    #: the command ran and failed: refused by the controller, Modbus exception, command
+    #: timeout, alarm, stopped, blocked by --monitor-only, a file that cannot be written
+    FAILED = 1
+    #: bad arguments or values, an unreadable or malformed input file, a plan with errors:
+    #: nothing was sent
+    USAGE = 2
+    #: the link: cannot connect, no answer in time, a malformed answer
+    LINK = 3
+    #: Ctrl-C (a motion that was under way is stopped first)
+    INTERRUPTED = 130
+
+    @property
+    def meaning(self) -> str:
+        return _MEANING[self]
+
+
+_MEANING = {
+    ExitCode.OK: "ok",
+    ExitCode.FAILED: "command failed or refused (controller, alarm, timeout of the command, monitor-only)",
+    ExitCode.USAGE: "usage: bad arguments, values or input files (nothing sent)",
+    ExitCode.LINK: "link: cannot connect, no answer in time, malformed answer",
+    ExitCode.INTERRUPTED: "interrupted (Ctrl-C; a motion under way is stopped first)",
+}
+
+#: The errors that mean the link, not the command, failed.
+LINK_ERRORS: tuple[type[TeachPadError], ...] = (LinkError, ResponseTimeout, MalformedResponse)
+
+#: The end of ``teachpad-cli --help``: the table, one code a line.
+EPILOG = "exit codes:\n" + "\n".join(f"  {int(code):>3}  {code.meaning}" for code in ExitCode)
+
+
+def exit_code_for(error: BaseException) -> ExitCode:
+    """The exit code of a run that ended with ``error`` (a :class:`TeachPadError`, an
+    ``OSError`` of a file, or Ctrl-C)."""
+    if isinstance(error, KeyboardInterrupt):
+        return ExitCode.INTERRUPTED
+    if isinstance(error, InvalidInput):
+        return ExitCode.USAGE
+    if isinstance(error, LINK_ERRORS):
+        return ExitCode.LINK
+    return ExitCode.FAILED  # a TeachPadError of the command, or a file that cannot be written

@@ -1,0 +1,205 @@
+"""RegisterClient: the controller's registers over one checked link, with the one write guard.
+
+The lower half of :class:`~app.link.client.RobotClient` (which adds the commands and their
+completion on top): it owns the :class:`~app.link.transport.Transport` (TCP, RTU over serial,
+or RTU framing over TCP for tests), which checks every answer against its request and counts
+what the wire did (:attr:`RegisterClient.stats`); every write passes :meth:`_write` (monitor-only
+mode, the audit trail); raw register/GV access refuses bad values before anything is sent; the
+pose and status blocks are read and decoded here. Not thread-safe: one thread owns it.
+
+* Control registers 440-445 are written with 0x06 only; raw multi-register writes that touch
+  them are refused (:class:`InvalidInput`).
+* A request that timed out or got a malformed answer closes the link (the next request
+  reconnects), so a late answer is never read as the next request's.
+* Traffic observers are called synchronously in the client's thread, inside the request:
+  keep them short (the GUI should only queue the record).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+from collections.abc import Iterator, Sequence
+from typing import Self
+
+from app.errors import InvalidInput, WriteBlocked
+from app.link.checks import check_float, check_int, check_settings, range_name
+from app.link.decode import decode_pose, decode_status
+from app.link.stats import LinkStats
+from app.link.transport import ConnectionSettings, TrafficObserver, Transport
+from app.models import ControllerStatus, Pose
+from app.protocol import registers
+from app.protocol.codec import decode_floats, encode_floats
+from app.protocol.datetime_regs import ControllerClock, decode_clock
+from app.safety.audit import AuditLog
+
+__all__ = ["RegisterClient"]
+
+_log = logging.getLogger(__name__)
+
+CONTROL_REGISTERS = range(registers.REG_RUN_COMMAND, registers.REG_GO_ZERO + 1)  # 440..445: 0x06 only
+MAX_REGISTER = 0xFFFF
+
+
+class RegisterClient:
+    """Registers, GVs and the pose/status blocks of one controller. Blocking; owned by one thread."""
+
+    def __init__(self, settings: ConnectionSettings) -> None:
+        check_settings(settings)
+        self.settings = settings
+        self._transport = Transport(settings, on_link_change=self.invalidate_cache)
+        self.last_status: ControllerStatus | None = None
+        self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
+        self._io_timeout: float | None = None  # see io_timeout()
+        self.audit: AuditLog | None = None  # every write (and monitor-only block) is recorded here
+
+    # -- connection ----------------------------------------------------------------------
+    def connect(self) -> None:
+        """Open the link; :class:`LinkError` naming the cause when the controller cannot be reached."""
+        self._transport.open()
+
+    def close(self) -> None:
+        self._transport.close()
+
+    @property
+    def connected(self) -> bool:
+        return self._transport.connected
+
+    def __enter__(self) -> Self:
+        self.connect()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def invalidate_cache(self) -> None:
+        """Called whenever the link is made or lost: forget what was cached about the controller.
+
+        Nothing at this layer; :class:`~app.link.client.RobotClient` drops its parameter cache.
+        """
+
+    @property
+    def stats(self) -> LinkStats:
+        """The link's counters so far (a snapshot)."""
+        return self._transport.stats
+
+    # -- observers -----------------------------------------------------------------------
+    def add_observer(self, cb: TrafficObserver) -> None:
+        self._transport.add_observer(cb)
+
+    def remove_observer(self, cb: TrafficObserver) -> None:
+        self._transport.remove_observer(cb)
+
+    # -- the transport: every answer is checked against its request ----------------------
+    def _read(self, address: int, count: int, timeout: float | None = None) -> list[int]:
+        timeout = self._io_timeout if timeout is None else timeout
+        return self._transport.read(f"read of {range_name(address, count)}", address, count, timeout)
+
+    @contextlib.contextmanager
+    def io_timeout(self, seconds: float) -> Iterator[None]:
+        """Every transaction inside waits at most ``seconds`` per attempt (unless it passes its
+        own ``timeout``): the shutdown's ratio 0 / teach disable must not hang on a dead controller."""
+        outer, self._io_timeout = self._io_timeout, float(seconds)
+        try:
+            yield
+        finally:
+            self._io_timeout = outer
+
+    def _require_writable(self, what: str) -> None:
+        if self.settings.monitor_only:
+            raise WriteBlocked(f"monitor-only mode: {what} was not sent")
+
+    def _write(self, address: int, values: Sequence[int], *, single: bool = False,
+               timeout: float | None = None) -> None:
+        """The write guard: every write to the controller passes here (and, with an audit trail,
+        is recorded there once, blocked ones too). ``timeout`` (s per attempt) overrides the
+        request timeout (default: :meth:`io_timeout`'s, else the settings')."""
+        timeout = self._io_timeout if timeout is None else timeout
+        ctx = self.audit.writing(address, values, single=single) if self.audit else contextlib.nullcontext()
+        with ctx:
+            name = range_name(address, len(values))
+            self._require_writable(f"write to {name}")
+            if not values:
+                raise InvalidInput("nothing to write")
+            if single:
+                if len(values) != 1:
+                    raise InvalidInput("a single-register write takes one value")
+                _log.debug("write 0x06 %s <- %d", name, values[0])
+                self.write_count += 1
+                self._transport.write_single(f"write to {name}", address, int(values[0]), timeout)
+            else:
+                _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
+                self.write_count += 1
+                self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values],
+                                               timeout)
+
+    def _write_floats(self, gv: int, values: Sequence[float], timeout: float | None = None) -> None:
+        self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order), timeout=timeout)
+
+    def _write_control(self, register: int, value: int) -> None:
+        self._write(register, [value], single=True)
+
+    # -- raw access ----------------------------------------------------------------------
+    def read_registers(self, addr: int, count: int) -> list[int]:
+        addr = check_int(addr, 0, MAX_REGISTER, "register address")
+        count = check_int(count, 1, MAX_REGISTER + 1 - addr, "register count")
+        out: list[int] = []
+        while count > 0:
+            n = min(count, registers.MAX_READ_REGISTERS)
+            out.extend(self._read(addr, n))
+            addr += n
+            count -= n
+        return out
+
+    def write_register(self, addr: int, value: int) -> None:
+        """0x06 write of one register (the way 440..445 must be written)."""
+        addr = check_int(addr, 0, MAX_REGISTER, "register address")
+        value = check_int(value, 0, 0xFFFF, "register value")
+        self._write(addr, [value], single=True)
+
+    def write_registers(self, addr: int, values: Sequence[int]) -> None:
+        """0x10 write (split every 123 registers); refuses the control registers 440..445."""
+        addr = check_int(addr, 0, MAX_REGISTER, "register address")
+        regs = [check_int(v, 0, 0xFFFF, "register value") for v in values]
+        if not regs:
+            raise InvalidInput("nothing to write")
+        if addr + len(regs) - 1 > MAX_REGISTER:
+            raise InvalidInput("write goes past register 65535")
+        end = addr + len(regs)
+        if addr < CONTROL_REGISTERS.stop and end > CONTROL_REGISTERS.start:
+            raise InvalidInput(
+                "registers 440..445 (GV220..GV222) are control registers written one at a time "
+                "with 0x06; use write_register or the command methods"
+            )
+        for i in range(0, len(regs), registers.MAX_WRITE_REGISTERS):
+            self._write(addr + i, regs[i : i + registers.MAX_WRITE_REGISTERS])
+
+    def read_gv(self, n: int, count: int = 1) -> list[float]:
+        n = check_int(n, 0, MAX_REGISTER // 2, "GV index")
+        count = check_int(count, 1, (MAX_REGISTER + 1) // 2 - n, "GV count")
+        return decode_floats(self.read_registers(registers.gv_reg(n), 2 * count), self.settings.word_order)
+
+    def write_gv(self, n: int, values: Sequence[float]) -> None:
+        n = check_int(n, 0, MAX_REGISTER // 2, "GV index")
+        floats = [check_float(v, f"GV{n + i}") for i, v in enumerate(values)]
+        self.write_registers(registers.gv_reg(n), encode_floats(floats, self.settings.word_order))
+
+    # -- the pose and status blocks ------------------------------------------------------
+    def read_pose(self, *, timeout: float | None = None) -> Pose:
+        """Pose, external axes and joints (GV206..GV255) in one FC03 of 100 registers.
+
+        ``timeout`` overrides the request timeout (the poller passes the poll timeout).
+        """
+        regs = self._read(registers.POSE_BLOCK_START, registers.POSE_BLOCK_COUNT, timeout)
+        return decode_pose(regs, self.settings.word_order)
+
+    def read_status(self, with_clock: bool = False, *, timeout: float | None = None) -> ControllerStatus:
+        """Table 2 (560..583) in one FC03; the clock (576..579) comes from the same block."""
+        regs = self._read(registers.STATUS_BLOCK_START, registers.STATUS_BLOCK_COUNT, timeout)
+        status = decode_status(regs, self.settings.word_order,
+                               self.settings.datetime_layout if with_clock else None)
+        self.last_status = status
+        return status
+
+    def read_clock(self) -> ControllerClock:
+        return decode_clock(self._read(registers.gv_reg(registers.GV_DATE), 4), self.settings.datetime_layout)
