@@ -8,8 +8,10 @@ numpy batch (:meth:`ArmModel.inverse_batch`, seeded with joint 1 turned towards 
 then once more from the home joints).
 
 :meth:`ReachChecker.plan_issues` has the signature :func:`app.plan.checks.check_plan` takes as
-``reach=``: the issues are warnings (:data:`IssueCode.UNREACHABLE`, :data:`IssueCode.JOINT_LIMIT`)
-because the profile is a model of the arm, which the controller has the last word on.
+``reach=``: the issues (:data:`IssueCode.UNREACHABLE`, :data:`IssueCode.JOINT_LIMIT`) are errors,
+which block Run like the other errors: a pose the arm cannot take (or only past a joint limit)
+would stop the controller mid-plan. (The profile is a model of the arm: a wrong verdict is
+fixed by loading the right profile.)
 """
 
 from __future__ import annotations
@@ -137,7 +139,7 @@ class ReachChecker:
 def _issue(index: int, reach: Reach, what: str, point_id: int | None) -> PlanIssue:
     name = f"segment {index + 1}"
     if reach is Reach.JOINT_LIMIT:
-        return PlanIssue(index, IssueKind.WARNING, IssueCode.JOINT_LIMIT,
+        return PlanIssue(index, IssueKind.ERROR, IssueCode.JOINT_LIMIT,
                          f"{name}: {what} passes a joint limit of the robot model", point_id)
-    return PlanIssue(index, IssueKind.WARNING, IssueCode.UNREACHABLE,
+    return PlanIssue(index, IssueKind.ERROR, IssueCode.UNREACHABLE,
                      f"{name}: {what} is out of the robot model's reach", point_id)
