@@ -1,7 +1,9 @@
 """Reachability by a robot profile: taught points and sampled plan paths that the profile's IK
 cannot reach, or only past a joint limit.
 
-Results are cached per pose (points are re-checked only when they change). A path is checked
+Results are cached per pose (points are re-checked only when they change), and
+:meth:`ReachChecker.plan_issues` remembers its last answer (same segments, points and start:
+no work at all). A path is checked
 at up to :data:`PATH_SAMPLES` samples per segment, fewer for long plans so that a plan costs
 at most about :data:`MAX_PATH_SAMPLES` IK solutions. New poses are solved together in one
 numpy batch (:meth:`ArmModel.inverse_batch`, seeded with joint 1 turned towards the target,
@@ -62,6 +64,7 @@ class ReachChecker:
     def __init__(self, model: ArmModel) -> None:
         self.model = model
         self._cache: dict[Pose6, Reach] = {}
+        self._last: tuple[object, tuple[PlanIssue, ...]] | None = None  # plan_issues' last answer
 
     def poses(self, poses: Sequence[Sequence[float]]) -> list[Reach]:
         """Reach of X Y Z A B C poses; the ones not seen before are solved in one batch."""
@@ -118,17 +121,30 @@ class ReachChecker:
     def plan_issues(self, plan: Plan, ledger: PointLedger, current_pose: PointLike | None) -> list[PlanIssue]:
         """Reach issues of a plan (for ``check_plan(..., reach=checker.plan_issues)``)."""
         pose = current_pose if isinstance(current_pose, Pose) else None
+        used = [p for pid in dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids)
+                if (p := ledger.get(pid)) is not None]
+        # the same plan, points and start as last time (a recheck after an unrelated change)
+        key = (tuple(plan.segments), tuple((p.id, p.label, p.xyzabc) for p in used),
+               None if pose is None else tuple(round(float(v), 3) for v in pose.xyzabc))
+        if self._last is not None and self._last[0] == key:
+            return list(self._last[1])
+        issues = self._plan_issues(plan, ledger, pose, used)
+        self._last = (key, tuple(issues))
+        return issues
+
+    def _plan_issues(self, plan: Plan, ledger: PointLedger, pose: Pose | None,
+                     used: list[TempPoint]) -> list[PlanIssue]:
         issues: list[PlanIssue] = []
+        point_reach = self.points(used)  # one batch
         reported: set[int] = set()
         for i, seg in enumerate(plan.segments):
             for pid in seg.point_ids:
                 point = ledger.get(pid)
-                if point is None or pid in reported:
+                r = point_reach.get(pid, Reach.OK)
+                if point is None or pid in reported or r is Reach.OK:
                     continue
-                r = self.point(point)
-                if r is not Reach.OK:
-                    reported.add(pid)
-                    issues.append(_issue(i, r, f"{point.label}", pid))
+                reported.add(pid)
+                issues.append(_issue(i, r, f"{point.label}", pid))
         path = self.path(plan, ledger, pose)
         for i, bad in enumerate(path.first_bad):
             if bad is not None and not any(it.segment == i for it in issues):

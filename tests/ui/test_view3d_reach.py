@@ -42,7 +42,8 @@ def _set_x(window: MainWindow, point_id: int, x: float) -> None:
 
 
 def _reach_issues(window: MainWindow) -> list[Any]:
-    return [i for i in window.planner_panel.issues if i.code in (IssueCode.UNREACHABLE, IssueCode.JOINT_LIMIT)]
+    reach = (IssueCode.UNREACHABLE, IssueCode.JOINT_LIMIT)
+    return [i for i in window.planner_panel.issues if i.code in reach]
 
 
 def test_unreachable_point_blocks_run_in_the_planner(qtbot: Any, sim: Any, link: Any,
