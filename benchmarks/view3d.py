@@ -3,7 +3,8 @@
 
 * ``rotate_frame_ms``: what a mouse drag costs per frame -- the camera turns 2° and the whole
   scene is projected and drawn again with the drag's level of detail (markers thinned to
-  ``LOD_MAX_POINTS``, no antialiasing, no labels), into a QImage of the canvas's size (the
+  ``LOD_MAX_POINTS`` and only those projected, the path to ``LOD_MAX_PATH_ROWS`` rows, no
+  antialiasing, no labels), into a QImage of the canvas's size (the
   raster engine, as the widget's backing store). ``rotate_fps`` = 1000 / median.
   ``rotate_frame_cpu_ms``: the same frames in CPU time of the GUI thread (what a frame costs
   when the machine's other work does not take the core away; ``rotate_fps_cpu`` from its median).
@@ -134,6 +135,7 @@ def run(quick: bool = False) -> dict[str, Any]:
     return {
         "points": N_POINTS, "segments": N_SEGMENTS, "path_rows": len(path.xyz),
         "canvas_px": list(CANVAS_SIZE), "lod_max_points": view3d_canvas.LOD_MAX_POINTS,
+        "lod_max_path_rows": view3d_canvas.LOD_MAX_PATH_ROWS,
         "rotate_frame_ms": rot, "rotate_fps": 1000.0 / rot["median"],
         "rotate_fps_p95": 1000.0 / rot["p95"],
         "rotate_frame_cpu_ms": _summary(rotate_cpu),
