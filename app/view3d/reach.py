@@ -68,7 +68,10 @@ class ReachChecker:
 
     def poses(self, poses: Sequence[Sequence[float]]) -> list[Reach]:
         """Reach of X Y Z A B C poses; the ones not seen before are solved in one batch."""
-        keys: list[Pose6] = [tuple(round(float(v), 4) for v in p[:6]) for p in poses]  # type: ignore[misc]
+        if not len(poses):
+            return []
+        rounded = np.round(np.array([p[:6] for p in poses], dtype=np.float64), 4)  # one array op
+        keys: list[Pose6] = list(map(tuple, rounded.tolist()))
         todo = list(dict.fromkeys(k for k in keys if k not in self._cache))
         if todo:
             targets = np.array([pose_to_transform(*k) for k in todo])
