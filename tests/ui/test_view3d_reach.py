@@ -21,7 +21,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     window_fixture,
 )
 from ui.main_window import MainWindow
-from ui.models.points_model import COL_X
+from ui.models.point_columns import COL_X
 from ui.panels.view3d_robot import RobotModelSource
 from ui.settings import AppSettings
 
