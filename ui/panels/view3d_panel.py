@@ -1,7 +1,8 @@
 """3D view panel: the arm, the taught points and the selected plan, from any angle.
 
 The arm is drawn from a robot model profile (:mod:`app.view3d.profile`, the simulator's arm by
-default): from the controller's joint angles when it reports them, else from the pose through
+default; the window's :class:`~ui.panels.view3d_robot.RobotModelSource`, whose reach checker the
+planner's checks share): from the controller's joint angles when it reports them, else from the pose through
 the profile's IK — then an "estimate" badge says so; "stale" when the robot's state is not
 fresh. Points are markers coloured by sync state; the selection follows the points table both
 ways. The selected plan is a ghost path (lines and true arcs of :mod:`app.plan.geometry`,
