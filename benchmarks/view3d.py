@@ -3,7 +3,8 @@
 
 * ``rotate_frame_ms``: what a mouse drag costs per frame -- the camera turns 2° and the whole
   scene is projected and drawn again with the drag's level of detail (markers thinned to
-  ``LOD_MAX_POINTS``, no antialiasing, no labels), into a QImage of the canvas's size (the
+  ``LOD_MAX_POINTS`` and only those projected, the path to ``LOD_MAX_PATH_ROWS`` rows, no
+  antialiasing, no labels), into a QImage of the canvas's size (the
   raster engine, as the widget's backing store). ``rotate_fps`` = 1000 / median.
   ``rotate_frame_cpu_ms``: the same frames in CPU time of the GUI thread (what a frame costs
   when the machine's other work does not take the core away; ``rotate_fps_cpu`` from its median).
@@ -12,6 +13,8 @@
 * ``live_frame_ms``: a new arm pose with the camera still (cached static layers + the arm).
 * ``reach_points_s`` / ``reach_path_s``: IK of every point / of the plan's path samples (one
   batch each, cold cache).
+* ``plan_reach_cold_s`` / ``plan_reach_again_ms`` / ``plan_reach_point_moved_ms``: the
+  planner's reach check of the whole plan: cold, repeated, and after one point moved.
 
 Usage: python -m benchmarks.view3d [--quick]  (``benchmarks.gui.run`` adds it as ``view3d``).
 """
@@ -68,6 +71,30 @@ def _pct(values: list[float], q: float) -> float:
 
 def _summary(ms: list[float]) -> dict[str, float]:
     return {"median": statistics.median(ms), "p95": _pct(ms, 0.95), "max": max(ms), "n": len(ms)}
+
+
+def _planner_reach(model: ArmModel, ledger: PointLedger, plan: Plan) -> dict[str, float]:
+    """The planner's reach check (``ReachChecker.plan_issues``, on the GUI thread): the whole
+    plan with a cold cache, the same again (a recheck after an unrelated change), and after
+    one of its points moved (an edit)."""
+    checker = ReachChecker(model)
+    t0 = time.perf_counter()
+    checker.plan_issues(plan, ledger, None)
+    cold = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    checker.plan_issues(plan, ledger, None)
+    again = time.perf_counter() - t0
+    moved = []
+    for k in range(3):
+        row = ledger.row_of(plan[k].end_id)
+        assert row is not None
+        p = ledger[row]
+        ledger.replace(row, make_point(p.id, p.name, (p.x + 1.0, p.y, p.z, p.a, p.b, p.c)))
+        t0 = time.perf_counter()
+        checker.plan_issues(plan, ledger, None)
+        moved.append(time.perf_counter() - t0)
+    return {"plan_reach_cold_s": cold, "plan_reach_again_ms": again * 1000.0,
+            "plan_reach_point_moved_ms": statistics.median(moved) * 1000.0}
 
 
 def run(quick: bool = False) -> dict[str, Any]:
@@ -128,12 +155,14 @@ def run(quick: bool = False) -> dict[str, Any]:
     t0 = time.perf_counter()
     checker.path(plan, ledger, None)
     reach_path_s = time.perf_counter() - t0
+    planner = _planner_reach(model, ledger, plan)
     canvas.deleteLater()
     app.processEvents()
     rot = _summary(rotate)
     return {
         "points": N_POINTS, "segments": N_SEGMENTS, "path_rows": len(path.xyz),
         "canvas_px": list(CANVAS_SIZE), "lod_max_points": view3d_canvas.LOD_MAX_POINTS,
+        "lod_max_path_rows": view3d_canvas.LOD_MAX_PATH_ROWS,
         "rotate_frame_ms": rot, "rotate_fps": 1000.0 / rot["median"],
         "rotate_fps_p95": 1000.0 / rot["p95"],
         "rotate_frame_cpu_ms": _summary(rotate_cpu),
@@ -143,6 +172,7 @@ def run(quick: bool = False) -> dict[str, Any]:
         "reach_points": n_reach, "reach_points_s": reach_points_s,
         "reach_points_unreachable": sum(1 for r in reach.values() if r.value != "ok"),
         "reach_path_s": reach_path_s,
+        **planner,
         "load_avg_1m": os.getloadavg()[0],
     }
 

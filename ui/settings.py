@@ -175,3 +175,13 @@ class AppSettings:
     def save_window(self, geometry: QByteArray, state: QByteArray) -> None:
         self._store.setValue("window/geometry", geometry)
         self._store.setValue("window/state", state)
+
+    # --- 3D view: the robot model profile (view3d-reach) -------------------------------
+    @property
+    def robot_profile_path(self) -> str:
+        """The robot model profile file loaded last ("" for the default profile)."""
+        return str(self._store.value("view3d/robot_profile", "") or "")
+
+    @robot_profile_path.setter
+    def robot_profile_path(self, path: str) -> None:
+        self._store.setValue("view3d/robot_profile", str(path))

@@ -66,6 +66,9 @@ def segment_rotations(plan: Plan, ledger: PointLedger,
 def sample_poses(xyz: FloatArray, rots: tuple[Matrix, Matrix], fractions: FloatArray) -> list[Pose6]:
     """X Y Z A B C of samples along one segment at the given 0..1 fractions."""
     poses: list[Pose6] = []
+    if rots[0] is rots[1] or np.array_equal(rots[0], rots[1]):  # orientation kept: one A B C for all
+        a, b, c = matrix_to_abc(rots[0])
+        return [(float(p[0]), float(p[1]), float(p[2]), a, b, c) for p in xyz]
     for p, s in zip(xyz, fractions, strict=True):
         a, b, c = matrix_to_abc(slerp_matrix(rots[0], rots[1], float(s)))
         poses.append((float(p[0]), float(p[1]), float(p[2]), a, b, c))

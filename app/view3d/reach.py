@@ -1,15 +1,19 @@
 """Reachability by a robot profile: taught points and sampled plan paths that the profile's IK
 cannot reach, or only past a joint limit.
 
-Results are cached per pose (points are re-checked only when they change). A path is checked
+Results are cached per pose (points are re-checked only when they change), and
+:meth:`ReachChecker.plan_issues` remembers its last answer (same segments, points and start:
+no work at all). A path is checked
 at up to :data:`PATH_SAMPLES` samples per segment, fewer for long plans so that a plan costs
 at most about :data:`MAX_PATH_SAMPLES` IK solutions. New poses are solved together in one
 numpy batch (:meth:`ArmModel.inverse_batch`, seeded with joint 1 turned towards the target,
 then once more from the home joints).
 
 :meth:`ReachChecker.plan_issues` has the signature :func:`app.plan.checks.check_plan` takes as
-``reach=``: the issues are warnings (:data:`IssueCode.UNREACHABLE`, :data:`IssueCode.JOINT_LIMIT`)
-because the profile is a model of the arm, which the controller has the last word on.
+``reach=``: the issues (:data:`IssueCode.UNREACHABLE`, :data:`IssueCode.JOINT_LIMIT`) are errors,
+which block Run like the other errors: a pose the arm cannot take (or only past a joint limit)
+would stop the controller mid-plan. (The profile is a model of the arm: a wrong verdict is
+fixed by loading the right profile.)
 """
 
 from __future__ import annotations
@@ -60,10 +64,14 @@ class ReachChecker:
     def __init__(self, model: ArmModel) -> None:
         self.model = model
         self._cache: dict[Pose6, Reach] = {}
+        self._last: tuple[object, tuple[PlanIssue, ...]] | None = None  # plan_issues' last answer
 
     def poses(self, poses: Sequence[Sequence[float]]) -> list[Reach]:
         """Reach of X Y Z A B C poses; the ones not seen before are solved in one batch."""
-        keys: list[Pose6] = [tuple(round(float(v), 4) for v in p[:6]) for p in poses]  # type: ignore[misc]
+        if not len(poses):
+            return []
+        rounded = np.round(np.array([p[:6] for p in poses], dtype=np.float64), 4)  # one array op
+        keys: list[Pose6] = list(map(tuple, rounded.tolist()))
         todo = list(dict.fromkeys(k for k in keys if k not in self._cache))
         if todo:
             targets = np.array([pose_to_transform(*k) for k in todo])
@@ -116,17 +124,30 @@ class ReachChecker:
     def plan_issues(self, plan: Plan, ledger: PointLedger, current_pose: PointLike | None) -> list[PlanIssue]:
         """Reach issues of a plan (for ``check_plan(..., reach=checker.plan_issues)``)."""
         pose = current_pose if isinstance(current_pose, Pose) else None
+        used = [p for pid in dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids)
+                if (p := ledger.get(pid)) is not None]
+        # the same plan, points and start as last time (a recheck after an unrelated change)
+        key = (tuple(plan.segments), tuple((p.id, p.label, p.xyzabc) for p in used),
+               None if pose is None else tuple(round(float(v), 3) for v in pose.xyzabc))
+        if self._last is not None and self._last[0] == key:
+            return list(self._last[1])
+        issues = self._plan_issues(plan, ledger, pose, used)
+        self._last = (key, tuple(issues))
+        return issues
+
+    def _plan_issues(self, plan: Plan, ledger: PointLedger, pose: Pose | None,
+                     used: list[TempPoint]) -> list[PlanIssue]:
         issues: list[PlanIssue] = []
+        point_reach = self.points(used)  # one batch
         reported: set[int] = set()
         for i, seg in enumerate(plan.segments):
             for pid in seg.point_ids:
                 point = ledger.get(pid)
-                if point is None or pid in reported:
+                r = point_reach.get(pid, Reach.OK)
+                if point is None or pid in reported or r is Reach.OK:
                     continue
-                r = self.point(point)
-                if r is not Reach.OK:
-                    reported.add(pid)
-                    issues.append(_issue(i, r, f"{point.label}", pid))
+                reported.add(pid)
+                issues.append(_issue(i, r, f"{point.label}", pid))
         path = self.path(plan, ledger, pose)
         for i, bad in enumerate(path.first_bad):
             if bad is not None and not any(it.segment == i for it in issues):
@@ -137,7 +158,7 @@ class ReachChecker:
 def _issue(index: int, reach: Reach, what: str, point_id: int | None) -> PlanIssue:
     name = f"segment {index + 1}"
     if reach is Reach.JOINT_LIMIT:
-        return PlanIssue(index, IssueKind.WARNING, IssueCode.JOINT_LIMIT,
+        return PlanIssue(index, IssueKind.ERROR, IssueCode.JOINT_LIMIT,
                          f"{name}: {what} passes a joint limit of the robot model", point_id)
-    return PlanIssue(index, IssueKind.WARNING, IssueCode.UNREACHABLE,
+    return PlanIssue(index, IssueKind.ERROR, IssueCode.UNREACHABLE,
                      f"{name}: {what} is out of the robot model's reach", point_id)

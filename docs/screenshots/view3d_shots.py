@@ -2,10 +2,11 @@
 
 Run from the repository root under a real X server with a CJK font::
 
-    xvfb-run -a -s "-screen 0 1600x1000x24" .venv/bin/python docs/screenshots/view3d_shots.py
+    xvfb-run -a -s "-screen 0 1920x1080x24" .venv/bin/python docs/screenshots/view3d_shots.py
 
 It starts the simulator, opens the demo project, connects, and saves: the live arm with the
-ghost path of each demo plan, a dry run mid-way, and an unreachable point in red.
+ghost path of each demo plan, a dry run mid-way, and an unreachable point in red (the view
+beside the planner, whose checks list shows the error and whose Run is disabled).
 """
 
 from __future__ import annotations
@@ -23,7 +24,6 @@ sys.path.insert(0, str(REPO))
 from app import timing  # noqa: E402
 from app.link.client import ConnectionSettings  # noqa: E402
 from app.link.robot_link import RobotLink  # noqa: E402
-from app.plan.segments import Segment  # noqa: E402
 from app.sim import SimConfig, SimController  # noqa: E402
 from app.view3d.camera import Preset  # noqa: E402
 from ui.i18n import Translator  # noqa: E402
@@ -71,22 +71,28 @@ def main() -> None:
         _spin(0.3)
         window.work_tabs.grab().save(str(OUT / f"view3d_dryrun_{suffix}.png"))
         panel.dry_bar.leave()
-    # an unreachable point, used by the circle plan
+    # an unreachable point, used by the circle plan: red in the view, an error in the planner's
+    # checks (the view beside the planner), Run disabled
     model = window.project.points_model
     model.add_point(name="far", pose=(1150.0, 250.0, 350.0, 180.0, 0.0, 180.0))
-    window.planner_panel.select_plan(1)
+    planner = window.planner_panel
+    planner.select_plan(1)
     far = max(p.id for p in model.ledger)
-    plan = window.planner_panel.current_plan()
-    plan.segments.insert(2, Segment.line(far, speed=100.0))  # a detour out of reach, for the picture
-    panel.refresh_scene()
+    row = planner.segments.insert_segment(2)  # a detour out of reach, for the picture
+    planner.segments.edit_field(row, "end", far)
+    planner.select_segments([row])
+    window.resize(1900, 1040)  # room for the planner and the view beside it
+    panel.beside_button.setChecked(True)
     _spin(0.5)
     for lang in ("en", "zh_CN"):
         window.set_language(lang)
         panel.set_preset(Preset.ISO)
         _spin(0.3)
-        window.work_tabs.grab().save(str(OUT / f"view3d_unreachable_{'zh' if lang != 'en' else 'en'}.png"))
+        window.grab().save(str(OUT / f"view3d_unreachable_{'zh' if lang != 'en' else 'en'}.png"))
+    panel.beside_button.setChecked(False)
     link.shutdown()
     sim.stop()
+    window.project.dialogs.ask_save_changes = lambda _name: "discard"  # the detour is not kept
     window.close()
     app.processEvents()
 

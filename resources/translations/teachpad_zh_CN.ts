@@ -1867,7 +1867,7 @@
         <message>
             <location filename="../../ui/dialogs/password_dialog.py" line="183" />
             <source>Password set for the {role} role</source>
-            <translation>已设置{role}角色的密码</translation>
+            <translation>已为{role}角色设置密码</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/password_dialog.py" line="196" />
@@ -1882,7 +1882,7 @@
         <message>
             <location filename="../../ui/dialogs/password_dialog.py" line="210" />
             <source>The setting could not be saved: {why}</source>
-            <translation>无法保存设置：{why}</translation>
+            <translation>设置无法保存：{why}</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/password_dialog.py" line="212" />
@@ -2151,86 +2151,86 @@
     <context>
         <name>PlanRunFlow</name>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="72" />
+            <location filename="../../ui/panels/planner_run.py" line="70" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="75" />
+            <location filename="../../ui/panels/planner_run.py" line="73" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="87" />
+            <location filename="../../ui/panels/planner_run.py" line="85" />
             <source>Not connected to a controller</source>
             <translation>未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="97" />
+            <location filename="../../ui/panels/planner_run.py" line="94" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="103" />
+            <location filename="../../ui/panels/planner_run.py" line="100" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="105" />
+            <location filename="../../ui/panels/planner_run.py" line="102" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="107" />
+            <location filename="../../ui/panels/planner_run.py" line="104" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="108" />
+            <location filename="../../ui/panels/planner_run.py" line="105" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="120" />
+            <location filename="../../ui/panels/planner_run.py" line="117" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="122" />
+            <location filename="../../ui/panels/planner_run.py" line="119" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="124" />
+            <location filename="../../ui/panels/planner_run.py" line="121" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="126" />
+            <location filename="../../ui/panels/planner_run.py" line="123" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="127" />
+            <location filename="../../ui/panels/planner_run.py" line="124" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="130" />
+            <location filename="../../ui/panels/planner_run.py" line="127" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="134" />
+            <location filename="../../ui/panels/planner_run.py" line="131" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="189" />
+            <location filename="../../ui/panels/planner_run.py" line="186" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
@@ -2439,12 +2439,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="220" />
+            <location filename="../../ui/panels/planner_panel.py" line="205" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="413" />
+            <location filename="../../ui/panels/planner_panel.py" line="378" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -3629,12 +3629,12 @@ Remove them all?</source>
         <message>
             <location filename="../../ui/dialogs/register_profile_dialog.py" line="132" />
             <source>Float word order:</source>
-            <translation>浮点数字序：</translation>
+            <translation>浮点字序：</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/register_profile_dialog.py" line="132" />
             <source>Unit id:</source>
-            <translation>从站地址：</translation>
+            <translation>站号：</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/register_profile_dialog.py" line="133" />
@@ -3786,6 +3786,14 @@ Remove them all?</source>
             <location filename="../../ui/dialogs/register_profile_dialog.py" line="256" />
             <source>Save the register profile as</source>
             <translation>寄存器配置另存为</translation>
+        </message>
+    </context>
+    <context>
+        <name>RobotModelSource</name>
+        <message>
+            <location filename="../../ui/panels/view3d_robot.py" line="97" />
+            <source>The robot model remembered from the last session could not be loaded: %1. The default robot model (%2) is used.</source>
+            <translation>上次使用的机器人模型无法加载：%1。现使用默认机器人模型（%2）。</translation>
         </message>
     </context>
     <context>
@@ -4597,12 +4605,13 @@ Remove them all?</source>
     <context>
         <name>View3DHost</name>
         <message>
-            <location filename="../../ui/panels/view3d_host.py" line="108" />
+            <location filename="../../ui/panels/view3d_host.py" line="119" />
             <source>3D</source>
             <translation>3D</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_host.py" line="109" />
+            <location filename="../../ui/panels/view3d_host.py" line="120" />
+            <location filename="../../ui/panels/view3d_host.py" line="129" />
             <source>3D view</source>
             <translation>3D 视图</translation>
         </message>
@@ -4610,129 +4619,129 @@ Remove them all?</source>
     <context>
         <name>View3DPanel</name>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="185" />
+            <location filename="../../ui/panels/view3d_panel.py" line="190" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="185" />
+            <location filename="../../ui/panels/view3d_panel.py" line="190" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="185" />
+            <location filename="../../ui/panels/view3d_panel.py" line="190" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="186" />
+            <location filename="../../ui/panels/view3d_panel.py" line="191" />
             <source>Iso</source>
             <translation>轴测</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="189" />
+            <location filename="../../ui/panels/view3d_panel.py" line="194" />
             <source>Look at the scene from a preset direction</source>
             <translation>从预设方向观察场景</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="190" />
+            <location filename="../../ui/panels/view3d_panel.py" line="195" />
             <source>Fit all</source>
             <translation>全部显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="191" />
+            <location filename="../../ui/panels/view3d_panel.py" line="196" />
             <source>Show the arm, the points and the plan</source>
             <translation>显示机械臂、点位和轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="192" />
+            <location filename="../../ui/panels/view3d_panel.py" line="197" />
             <source>Orthographic</source>
             <translation>正交投影</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="193" />
+            <location filename="../../ui/panels/view3d_panel.py" line="198" />
             <source>Parallel projection (no perspective)</source>
             <translation>平行投影（无透视）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="194" />
+            <location filename="../../ui/panels/view3d_panel.py" line="199" />
             <source>Robot model…</source>
             <translation>机器人模型…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="195" />
+            <location filename="../../ui/panels/view3d_panel.py" line="200" />
             <source>Robot model: %1. Load another robot model profile (JSON)</source>
             <translation>机器人模型：%1。加载其他机器人模型配置文件（JSON）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="197" />
+            <location filename="../../ui/panels/view3d_panel.py" line="202" />
             <source>Beside the planner</source>
             <translation>在规划器旁显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="198" />
+            <location filename="../../ui/panels/view3d_panel.py" line="203" />
             <source>Show the 3D view next to the planner, not in its own tab</source>
             <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="199" />
+            <location filename="../../ui/panels/view3d_panel.py" line="204" />
             <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
             <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="225" />
+            <location filename="../../ui/panels/view3d_panel.py" line="237" />
             <source>Robot model not loaded: %1</source>
             <translation>未加载机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="234" />
+            <location filename="../../ui/panels/view3d_panel.py" line="249" />
             <source>Load a robot model profile</source>
             <translation>加载机器人模型配置文件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="235" />
+            <location filename="../../ui/panels/view3d_panel.py" line="250" />
             <source>Robot model profiles (*.json)</source>
             <translation>机器人模型配置文件 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="327" />
+            <location filename="../../ui/panels/view3d_panel.py" line="342" />
             <source>dry run: nothing is sent</source>
             <translation>空运行：不发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="329" />
+            <location filename="../../ui/panels/view3d_panel.py" line="344" />
             <source>no pose: home position shown</source>
             <translation>无位姿：显示原点姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="331" />
+            <location filename="../../ui/panels/view3d_panel.py" line="346" />
             <source>estimate (from the pose, no joint angles)</source>
             <translation>估算（由位姿求得，无关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="333" />
+            <location filename="../../ui/panels/view3d_panel.py" line="348" />
             <source>pose out of the model's reach</source>
             <translation>位姿超出模型可达范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="335" />
+            <location filename="../../ui/panels/view3d_panel.py" line="350" />
             <source>past a joint limit</source>
             <translation>超出关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="337" />
+            <location filename="../../ui/panels/view3d_panel.py" line="352" />
             <source>stale</source>
             <translation>数据过期</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="418" />
+            <location filename="../../ui/panels/view3d_panel.py" line="433" />
             <source>Out of the robot model's reach: %n point(s) (%1)</source>
             <translation>
                 <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="423" />
+            <location filename="../../ui/panels/view3d_panel.py" line="438" />
             <source>the path leaves the reach in %n segment(s) (%1)</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>

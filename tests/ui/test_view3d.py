@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 from PySide6.QtCore import QPoint, Qt
+from PySide6.QtGui import QImage, QPainter
 
 from app.plan.checks import IssueCode
 from app.sim import kinematics as sim_kin
@@ -199,3 +200,37 @@ def test_another_robot_model_and_a_bad_profile_file(qtbot: Any, window: MainWind
     panel._update_arm()
     _draw(panel)
     assert np.allclose(panel.canvas.drawn["flange"], panel.canvas.project(np.array([725.0, 0.0, 890.0])))
+
+
+def test_drag_level_of_detail_keeps_selection_and_red_points(qtbot: Any) -> None:
+    """While dragging only every k-th marker is projected and drawn, but the selected and the
+    unreachable ones are always drawn where the full projection puts them."""
+    from ui.panels.view3d_canvas import LOD_MAX_POINTS, View3DCanvas
+
+    canvas = View3DCanvas()
+    qtbot.addWidget(canvas)
+    canvas.resize(600, 400)
+    n = 3 * LOD_MAX_POINTS
+    rng = np.random.default_rng(3)
+    xyz = np.column_stack([rng.uniform(200, 700, n), rng.uniform(-400, 400, n), rng.uniform(50, 700, n)])
+    bad = np.zeros(n, dtype=bool)
+    bad[[1, 4, n - 2]] = True  # not on the thinned rows
+    canvas.set_points(xyz, list(range(1, n + 1)), [f"P{i}" for i in range(1, n + 1)], ["#2e7d32"] * n, bad)
+    canvas.set_selected({2, n})
+    canvas.fit_all()
+    full = canvas.project(xyz)
+    def draw() -> None:
+        image = QImage(600, 400, QImage.Format.Format_ARGB32_Premultiplied)
+        painter = QPainter(image)
+        canvas.render_scene(painter)
+        painter.end()
+
+    canvas.set_dragging(True)
+    draw()
+    assert len(canvas.drawn["points"]) < n
+    assert np.allclose(canvas.drawn["bad_points"], full[bad])
+    assert np.allclose(canvas.drawn["selected"], full[[1, n - 1]])
+    assert canvas.click_at(*full[5]) == 6  # picking projects everything again
+    canvas.set_dragging(False)
+    draw()
+    assert np.allclose(canvas.drawn["points"], full)

@@ -45,7 +45,7 @@ def test_check_plan_reports_an_unreachable_point_only_when_asked(checker: ReachC
     assert not any(i.code in (IssueCode.UNREACHABLE, IssueCode.JOINT_LIMIT) for i in before)
     issues = check_plan(plan, ledger, current_pose=pose, reach=checker.plan_issues)
     reach = [i for i in issues if i.code is IssueCode.UNREACHABLE]
-    assert [(i.segment, i.point_id, i.kind) for i in reach] == [(2, 9, IssueKind.WARNING)]
+    assert [(i.segment, i.point_id, i.kind) for i in reach] == [(2, 9, IssueKind.ERROR)]
     assert reach[0].message.startswith("segment 3: ") and "out of the robot model's reach" in reach[0].message
     assert [i for i in issues if i.code not in (IssueCode.UNREACHABLE,)] == before
 

@@ -6,7 +6,8 @@ Stop, Resume from k; progress "segment k of n, loop i of m") below them; on the 
 segment table (editable, undoable) with the checks on their rows and a summary line, and the
 preview (top / front / side) with lengths and times below it.
 
-Checks (:func:`app.plan.checks.check_plan`), estimates and the preview are recomputed whenever the
+Checks (:func:`app.plan.checks.check_plan`, with the robot model's reach once
+:meth:`PlannerPanel.set_reach` gave it), estimates and the preview are recomputed whenever the
 plan, the points or the selection change. Before a run the checks are made again from the
 robot's current pose: errors refuse the run, points that need an upload are offered for upload
 ("1 point needs upload — Upload now?") and the run starts when the upload succeeded.
@@ -17,7 +18,8 @@ injectable ``confirm(title, text) -> bool`` callable.
 
 What is shown is worked out without Qt by :mod:`app.plan.presenter`. The panel composes its
 parts: ``planner_actions`` (the QActions), ``planner_widgets`` (plan list, segment editor, run
-box, checks bar), ``planner_edit`` (plan and segment edits), ``planner_run`` (the run flow).
+box, checks bar), ``planner_checks`` (the checks list, estimates, preview), ``planner_edit``
+(plan and segment edits), ``planner_run`` (the run flow).
 """
 
 from __future__ import annotations
@@ -26,26 +28,11 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, Signal, Slot
-from PySide6.QtWidgets import (
-    QGroupBox,
-    QLabel,
-    QSizePolicy,
-    QTableView,
-    QVBoxLayout,
-    QWidget,
-)
+from PySide6.QtWidgets import QGroupBox, QLabel, QSizePolicy, QTableView, QVBoxLayout, QWidget
 
 from app.models import Pose
-from app.plan.checks import PlanIssue, PlanLimits, check_plan
-from app.plan.estimates import PlanEstimate, estimate_plan
-from app.plan.presenter import (
-    Level,
-    PanelState,
-    action_states,
-    plan_info,
-    plan_start,
-    summarize_checks,
-)
+from app.plan.checks import PlanIssue, PlanLimits, ReachCheck
+from app.plan.presenter import Level, PanelState, action_states
 from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, SegmentKind
 from app.points.ledger import UploadReport
@@ -60,6 +47,7 @@ from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
 from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_actions import PlannerActions
+from ui.panels.planner_checks import PlannerChecks
 from ui.panels.planner_edit import PlanEdits, install_point_pickers
 from ui.panels.planner_run import PlanRunFlow
 from ui.panels.planner_widgets import (
@@ -97,11 +85,6 @@ class PlannerPanel(QWidget):
         self._runner = run_controller or PlanRunController(parent=self)
         self._sync = point_sync
         self._confirm = confirm or ask_confirmation(self)
-        self.limits = limits or PlanLimits()
-        self.envelope: Envelope | None = None  # the safety envelope: set_envelope
-        self.reduced_speed = False
-        self._issues: list[PlanIssue] = []
-        self._summary_text = ""
         self._pose_known = False
         self._alarm_hold = False
 
@@ -114,6 +97,8 @@ class PlannerPanel(QWidget):
         self.delete_segments, self.move_segments = e.delete_segments, e.move_segments
         self._make_actions()
         self._build()
+        self.checks = PlannerChecks(self.segments, self.preview, self.checks_bar, lambda: self._points.ledger,
+                                    self._pose, point_sync is not None, limits)
         self.retranslate()
 
         plans.modelReset.connect(self._on_plans_reset)
@@ -186,7 +171,7 @@ class PlannerPanel(QWidget):
         self.run_progress = self.run_box.run_progress
 
         # middle: segments
-        self.checks_bar = PlanChecksBar(self.upload_needed, self.recheck, self)
+        self.checks_bar: PlanChecksBar = PlanChecksBar(self.upload_needed, self.recheck, self)
         self.summary = self.checks_bar.summary
         self.upload_button = self.checks_bar.upload_button
         self.check_button = self.checks_bar.check_button
@@ -240,11 +225,11 @@ class PlannerPanel(QWidget):
 
     @property
     def issues(self) -> list[PlanIssue]:
-        return list(self._issues)
+        return list(self.checks.issues)
 
     @property
     def summary_text(self) -> str:
-        return self._summary_text
+        return self.checks.summary_text
 
     def current_plan(self) -> Plan | None:
         return self.segments.plan
@@ -296,42 +281,23 @@ class PlannerPanel(QWidget):
 
     def set_envelope(self, envelope: Envelope | None, reduced_speed: bool = False) -> None:
         """The safety envelope the checks (and Run) use; its boxes are drawn in the preview."""
-        self.envelope, self.reduced_speed = envelope, reduced_speed
+        self.checks.envelope, self.checks.reduced_speed = envelope, reduced_speed
         self.preview.set_envelope(envelope)
+        self.recheck()
+
+    def set_reach(self, reach: ReachCheck | None) -> None:
+        """The robot model's reach check (the 3D view's): its errors block Run like the others."""
+        self.checks.reach = reach
         self.recheck()
 
     def recheck(self) -> None:
         """Checks, estimates and preview of the plan on display."""
-        plan = self.current_plan()
-        ledger = self._points.ledger
-        if plan is None:
-            self._issues = []
-            self.preview.clear()
-            self._set_summary([], None)
-            self.preview.set_info("")
-            return
-        pose = self._pose()
-        start, assumed = plan_start(plan, ledger, pose)
-        self._issues = check_plan(plan, ledger, self.limits, pose, loops=plan.loops, envelope=self.envelope,
-                                  reduced_speed=self.reduced_speed)
-        self.segments.set_issues(self._issues)
-        estimate = estimate_plan(plan, ledger, start)
-        self.segments.set_estimate(estimate.lengths, estimate.times)
-        self.preview.show_plan(plan, ledger, start, self._selected_index())
-        self._set_summary(self._issues, plan)
-        self._set_info(plan, estimate, assumed)
+        self.checks.recheck(self.current_plan(), self._selected_index())
+        self._update_actions()
 
     def _selected_index(self) -> int | None:
         rows = self.selected_segments()
         return rows[0] if rows else None
-
-    def _set_summary(self, issues: Sequence[PlanIssue], plan: Plan | None) -> None:
-        checks = summarize_checks(issues) if plan is not None else None
-        self._summary_text = self.checks_bar.show_checks(checks, self._sync is not None)
-        self._update_actions()
-
-    def _set_info(self, plan: Plan, estimate: PlanEstimate, assumed: bool) -> None:
-        self.preview.show_info(plan_info(plan, estimate, self._selected_index(), assumed))
 
     # --- running (the flow: planner_run.py)
     def confirm(self, title: str, text: str) -> bool:
@@ -339,10 +305,9 @@ class PlannerPanel(QWidget):
 
     def show_issues(self, issues: list[PlanIssue], plan: Plan) -> str:
         """Show checks made for a run on the rows and the summary; returns the summary."""
-        self._issues = issues
-        self.segments.set_issues(issues)
-        self._set_summary(issues, plan)
-        return self._summary_text
+        summary = self.checks.show(issues, plan)
+        self._update_actions()
+        return summary
 
     def run(self, start: int = 0, single: bool = False, *, resume: bool = False) -> bool:
         """Check, offer an upload, confirm, then run from ``start`` (``single``: one segment).
@@ -492,10 +457,7 @@ class PlannerPanel(QWidget):
     def _on_segment_selection(self, *_args: Any) -> None:
         index = self._selected_index()
         self.preview.set_selected(index)
-        plan = self.current_plan()
-        if plan is not None and len(plan):
-            start, assumed = plan_start(plan, self._points.ledger, self._pose())
-            self._set_info(plan, estimate_plan(plan, self._points.ledger, start), assumed)
+        self.checks.show_info(self.current_plan(), index)
         self._update_actions()
 
     def set_alarm_hold(self, hold: bool) -> None:
@@ -509,7 +471,7 @@ class PlannerPanel(QWidget):
         plan = self.current_plan()
         rows = self.selected_segments()
         sync = self._sync
-        errors = [i.message for i in self._issues if i.is_error]
+        errors = [i.message for i in self.checks.issues if i.is_error]
         states = action_states(PanelState(
             connected=r.connected, running=r.running, paused=r.paused, can_resume=r.can_resume,
             has_plan=plan is not None, segments=len(plan) if plan is not None else 0, selected=bool(rows),

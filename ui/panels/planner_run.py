@@ -14,16 +14,16 @@ from typing import Protocol
 from PySide6.QtCore import QObject
 
 from app.errors import InvalidInput, TeachPadError
-from app.plan.checks import PlanIssue, PlanLimits, check_plan, ids_needing_upload
+from app.plan.checks import PlanIssue, ids_needing_upload
 from app.plan.presenter import RunBlock, RunKind, run_gate, run_kind
 from app.plan.runner import RunOutcome, RunState
 from app.plan.segments import Plan
 from app.points.ledger import UploadReport
-from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
 from ui.messages import error_text
 from ui.models.points_model import PointsModel
+from ui.panels.planner_checks import PlannerChecks
 
 MAX_POINTS_LISTED = 20  # point ids quoted in the upload question
 
@@ -31,9 +31,7 @@ MAX_POINTS_LISTED = 20  # point ids quoted in the upload question
 class PlannerView(Protocol):
     """What the flow needs of the planner panel."""
 
-    limits: PlanLimits
-    envelope: Envelope | None  # the safety envelope (None: none loaded)
-    reduced_speed: bool
+    checks: PlannerChecks  # the checks list's check_plan (limits, envelope, reach)
 
     @property
     def issues(self) -> list[PlanIssue]: ...
@@ -86,9 +84,8 @@ class PlanRunFlow(QObject):
         if not self._runner.connected:
             view.show_message(self.tr("Not connected to a controller"), "error")
             return False
-        issues = check_plan(plan, self._points.ledger, view.limits, self._runner.last_pose, start_index=start,
-                            loops=1 if single else plan.loops, envelope=view.envelope,
-                            reduced_speed=view.reduced_speed)
+        issues = view.checks.check(plan, self._runner.last_pose, start_index=start,
+                                   loops=1 if single else plan.loops)
         summary = view.show_issues(issues, plan)
         gate = run_gate(issues)
         if gate.block is RunBlock.ERRORS and (first := gate.first_error) is not None:

@@ -39,7 +39,7 @@ from ui.palette import (
     COLOR_TRAIL,
     COLOR_WHITE,
 )
-from ui.panels.view3d_draw import Buffers, pen, polyline_pairs
+from ui.panels.view3d_draw import Buffers, pen
 
 FloatArray = NDArray[np.float64]
 
@@ -47,7 +47,7 @@ ROTATE_DEG_PER_PX: Final = 0.4
 ZOOM_PER_WHEEL_STEP: Final = 1.15  # one wheel notch (120)
 CLICK_SLOP_PX: Final = 4
 LOD_MAX_POINTS: Final = 2500  # markers drawn while dragging (thinned above this)
-LOD_MAX_PATH_ROWS: Final = 6000  # path samples drawn while dragging
+LOD_MAX_PATH_ROWS: Final = 4000  # path samples drawn while dragging
 LOD_MAX_ARROWS: Final = 200  # direction arrows drawn while dragging (none for longer plans)
 AA_MAX_PATH_ROWS: Final = 10_000  # longer paths are drawn without antialiasing
 MAX_LABELS: Final = 40  # point names drawn when few points are visible
@@ -240,24 +240,20 @@ class View3DCanvas(QWidget):
         if len(self.path_xyz):
             path = self.path_xyz
             step = max(1, len(path) // LOD_MAX_PATH_ROWS) if lod else 1
-            sxy = cam.project(path[::step], w, h)[0]
+            sxy = cam.project(path[::step], w, h)[0]  # while dragging: every step-th row only
             # antialiased when drawn in full and not huge (tens of thousands of AA lines are slow)
             painter.setRenderHint(QPainter.RenderHint.Antialiasing, not lod and len(path) <= AA_MAX_PATH_ROWS)
             painter.setPen(pen(COLOR_PATH, 1 if lod else 2))
-            self._buf.draw_lines(painter, polyline_pairs(sxy))
+            self._buf.draw_polyline(painter, sxy)
             self._draw_arrows(painter, lod)
-            full = cam.project(path, w, h)[0] if step > 1 else sxy
-            self.drawn["path"] = full
-            if self.path_bad.any():
-                self._buf.draw_sprites(painter, full[self.path_bad], COLOR_ERROR, 6)
-            self.drawn["path_bad"] = full[self.path_bad]
+            self.drawn["path"] = sxy
+            bad = sxy[self.path_bad] if step == 1 else cam.project(path[self.path_bad], w, h)[0]
+            if len(bad):
+                self._buf.draw_sprites(painter, bad, COLOR_ERROR, 6)
+            self.drawn["path_bad"] = bad
             mids = cam.project(self.path_mids, w, h)[0]
-            painter.setPen(pen(COLOR_PATH, 1))
-            painter.setBrush(QColor(COLOR_WHITE))
-            shown = mids[np.isfinite(mids).all(axis=1)]
-            shown = shown[:0] if lod and len(shown) > LOD_MAX_ARROWS else shown[:1000]
-            for x, y in shown:
-                painter.drawRect(QRectF(x - 4, y - 4, 8, 8))
+            if not (lod and len(mids) > LOD_MAX_ARROWS):
+                self._buf.draw_sprites(painter, mids, COLOR_PATH, 8, square=True)
             self.drawn["mids"] = mids
             if self.path_start is not None and np.isfinite(self.path_start).all():
                 sx, sy = cam.project(self.path_start, w, h)[0][0]
@@ -267,19 +263,20 @@ class View3DCanvas(QWidget):
                     painter.drawEllipse(QPointF(sx, sy), 6, 6)
         else:
             self.drawn["path"] = self.drawn["path_bad"] = self.drawn["mids"] = np.zeros((0, 2))
-        # the points, one drawPoints per colour
-        pts = cam.project(self.point_xyz, w, h)[0] if len(self.point_xyz) else np.zeros((0, 2))
+        # the points, one drawPixmapFragments per colour; while dragging only every k-th is
+        # projected and drawn (drawn["points"] then holds those, and picking projects again)
+        n = len(self.point_xyz)
+        k = n // LOD_MAX_POINTS + 1 if lod and n > LOD_MAX_POINTS else 1
+        pts = cam.project(self.point_xyz[::k], w, h)[0] if n else np.zeros((0, 2))
         self.drawn["points"] = pts
-        if len(pts):
-            keep = np.arange(len(pts))
-            if lod and len(pts) > LOD_MAX_POINTS:
-                keep = keep[:: len(pts) // LOD_MAX_POINTS + 1]
-            codes = self._color_codes[keep]
+        if n:
+            codes = self._color_codes[::k]
             for code, color in enumerate(self._color_names):
-                self._buf.draw_sprites(painter, pts[keep[codes == code]], color, MARKER_PX)
-            if self.point_bad.any():
-                self._buf.draw_sprites(painter, pts[self.point_bad], COLOR_ERROR, MARKER_PX + 3)
-            self.drawn["bad_points"] = pts[self.point_bad]
+                self._buf.draw_sprites(painter, pts[codes == code], color, MARKER_PX)
+            bad = pts[self.point_bad] if k == 1 else cam.project(self.point_xyz[self.point_bad], w, h)[0]
+            if len(bad):
+                self._buf.draw_sprites(painter, bad, COLOR_ERROR, MARKER_PX + 3)
+            self.drawn["bad_points"] = bad
             if not lod:
                 self._draw_labels(painter, pts)
         else:
@@ -324,11 +321,10 @@ class View3DCanvas(QWidget):
         if self.active_segment is not None and len(self.path_xyz):
             rows = self.path_segment == self.active_segment
             painter.setPen(pen(COLOR_HIGHLIGHT, 5, round_cap=True))
-            self._buf.draw_lines(painter, polyline_pairs(cam.project(self.path_xyz[rows], w, h)[0]))
-        # selected points
-        sel = np.isin(self.point_ids, list(self.selected_ids)) if self.selected_ids else np.zeros(0, bool)
-        selected = self.drawn.get("points", np.zeros((0, 2)))
-        selected = selected[sel] if len(sel) == len(selected) and len(sel) else np.zeros((0, 2))
+            self._buf.draw_polyline(painter, cam.project(self.path_xyz[rows], w, h)[0])
+        # selected points (projected here: a few, and right while dragging too)
+        sel = np.isin(self.point_ids, list(self.selected_ids)) if self.selected_ids else None
+        selected = cam.project(self.point_xyz[sel], w, h)[0] if sel is not None else np.zeros((0, 2))
         self.drawn["selected"] = selected
         painter.setPen(pen(COLOR_HIGHLIGHT, 2.5))
         painter.setBrush(Qt.BrushStyle.NoBrush)
@@ -337,7 +333,7 @@ class View3DCanvas(QWidget):
         # live TCP trace
         if len(self.trace) > 1:
             painter.setPen(pen(COLOR_TRAIL, 2))
-            self._buf.draw_lines(painter, polyline_pairs(cam.project(self.trace, w, h)[0]))
+            self._buf.draw_polyline(painter, cam.project(self.trace, w, h)[0])
         self._draw_arm(painter, self.arm, self.flange, COLOR_ARM, "flange")
         self._draw_arm(painter, self.ghost_arm, self.ghost_flange, COLOR_GHOST_ARM, "ghost_flange")
         self._draw_overlay(painter)
@@ -350,7 +346,7 @@ class View3DCanvas(QWidget):
             return
         xy = cam.project(links, w, h)[0]
         painter.setPen(pen(color, 7, round_cap=True))
-        self._buf.draw_lines(painter, polyline_pairs(xy))
+        self._buf.draw_polyline(painter, xy)
         painter.setPen(pen(COLOR_INK, 10, round_cap=True))
         self._buf.draw_points(painter, xy[:-1])
         # TCP triad at the flange

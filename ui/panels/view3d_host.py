@@ -1,7 +1,11 @@
 """Where the 3D view lives in the main window: its own work tab ("3D"), or a dock beside the
 planner when the panel's "Beside the planner" button is on (the planner tab comes to the front).
 
-:func:`install_view3d` is the window's only line about it. The panel is built the first time
+:func:`install_view3d` is the window's only line about it. It also sets up the active robot
+model (:class:`~ui.panels.view3d_robot.RobotModelSource`: the profile remembered in the settings,
+or the default one, saying in the event log why a remembered one could not be loaded) and gives
+its reach check to the planner, whose checks list then shows what the 3D view marks red and
+follows a change of profile. The panel is built the first time
 it is needed (its tab comes to the front, or someone asks for :attr:`View3DHost.panel`): until
 then the tab holds an empty placeholder, so the window's first paint does not wait for the 3D
 view's module (and the pyqtgraph it imports). Once built it is connected to the robot's state,
@@ -16,6 +20,8 @@ from typing import TYPE_CHECKING, Any
 from PySide6.QtCore import QObject, Qt, Slot
 from PySide6.QtWidgets import QDockWidget, QWidget
 
+from ui.panels.view3d_robot import RobotModelSource
+
 if TYPE_CHECKING:
     from ui.panels.view3d_panel import View3DPanel
 
@@ -26,6 +32,11 @@ class View3DHost(QObject):
     def __init__(self, window: Any) -> None:
         super().__init__(window)
         self.window = window
+        self.robot = RobotModelSource(getattr(window, "settings", None), self)
+        self.robot.problemRaised.connect(self._on_profile_problem)
+        self.robot.profileChanged.connect(lambda _p: window.planner_panel.recheck())
+        self.robot.restore()
+        window.planner_panel.set_reach(self.robot.plan_issues)
         self._panel: View3DPanel | None = None
         self.tabs = window.work_tabs
         self._when_built: list[Callable[[View3DPanel], object]] = []
@@ -65,7 +76,7 @@ class View3DHost(QObject):
         from ui.panels.view3d_panel import View3DPanel  # deferred: see the module docstring
 
         window = self.window
-        panel = View3DPanel(window.project.points_model, window)
+        panel = View3DPanel(window.project.points_model, window, robot=self.robot)
         panel.bind(window.link.state)
         panel.attach_points(window.points_panel)
         panel.attach_planner(window.planner_panel)
@@ -112,6 +123,10 @@ class View3DHost(QObject):
         if watched is self._panel and event.type() == event.Type.LanguageChange:
             self.retranslate()
         return False
+
+    @Slot(str)
+    def _on_profile_problem(self, text: str) -> None:
+        self.window.event_log.add_event("warning", self.tr("3D view"), text)
 
     @Slot(bool)
     def set_beside(self, beside: bool) -> None:

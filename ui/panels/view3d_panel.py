@@ -1,7 +1,8 @@
 """3D view panel: the arm, the taught points and the selected plan, from any angle.
 
 The arm is drawn from a robot model profile (:mod:`app.view3d.profile`, the simulator's arm by
-default): from the controller's joint angles when it reports them, else from the pose through
+default; the window's :class:`~ui.panels.view3d_robot.RobotModelSource`, whose reach checker the
+planner's checks share): from the controller's joint angles when it reports them, else from the pose through
 the profile's IK — then an "estimate" badge says so; "stale" when the robot's state is not
 fresh. Points are markers coloured by sync state; the selection follows the points table both
 ways. The selected plan is a ghost path (lines and true arcs of :mod:`app.plan.geometry`,
@@ -38,14 +39,15 @@ from app.plan.geometry import plan_path
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger, SyncState
 from app.view3d.camera import Preset
-from app.view3d.kinematics import ArmModel, ArmTracker, Reach
+from app.view3d.kinematics import ArmTracker, Reach
 from app.view3d.path import DryRun, DryRunState, start_of
-from app.view3d.profile import ProfileError, RobotProfile, default_profile, load_profile
+from app.view3d.profile import RobotProfile
 from app.view3d.reach import PathReach, ReachChecker
 from ui.models.points_model import PointsModel
 from ui.palette import COLOR_CURVE_PURPLE, COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, COLOR_OK, COLOR_WARN
 from ui.panels.view3d_canvas import View3DCanvas
 from ui.panels.view3d_dryrun import DryRunBar
+from ui.panels.view3d_robot import RobotModelSource
 
 LIVE_FPS: Final = 30
 TRACE_LENGTH: Final = 2000  # live TCP positions kept for the trace
@@ -69,13 +71,13 @@ class View3DPanel(QWidget):
     besideToggled = Signal(bool)
 
     def __init__(self, points: PointsModel, parent: QWidget | None = None, *,
-                 profile: RobotProfile | None = None) -> None:
+                 robot: RobotModelSource | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("View3DPanel")
         self._points = points
-        self.model = ArmModel(profile or default_profile())
+        self.robot = robot or RobotModelSource(parent=self)  # the window's, shared with the planner
+        self.model = self.robot.model
         self.tracker = ArmTracker(self.model)
-        self.reach = ReachChecker(self.model)
         self.plan: Plan | None = None
         self.path_reach: PathReach | None = None
         self.point_reach: dict[int, Reach] = {}
@@ -123,7 +125,10 @@ class View3DPanel(QWidget):
         self.message_label = QLabel(self)
         self.message_label.setWordWrap(True)
         self.message_label.setStyleSheet(f"color: {COLOR_ERROR};")
-        self.message_label.hide()
+        self.message_label.setVisible(bool(self.robot.problem))
+        self.message_label.setText(self.robot.problem)
+        self.robot.profileChanged.connect(self._on_profile)
+        self.robot.problemRaised.connect(self._show_problem)
         self.reach_label = QLabel(self)
         self.reach_label.setWordWrap(True)
         self.reach_label.setStyleSheet(f"color: {COLOR_ERROR};")
@@ -207,11 +212,19 @@ class View3DPanel(QWidget):
         super().changeEvent(event)
 
     # --- camera --------------------------------------------------------------------------
+    @property
+    def reach(self) -> ReachChecker:
+        """The active profile's reach checker (the planner's checks use the same one)."""
+        return self.robot.reach
+
     def set_profile(self, profile: RobotProfile) -> None:
-        """Draw and check with another robot model."""
-        self.model = ArmModel(profile)
+        """Draw and check with another robot model (the planner's checks follow)."""
+        self.robot.set_profile(profile)
+
+    @Slot(object)
+    def _on_profile(self, _profile: RobotProfile) -> None:
+        self.model = self.robot.model
         self.tracker = ArmTracker(self.model)
-        self.reach = ReachChecker(self.model)
         self._dry_joints = None
         self.retranslate()
         self.refresh_scene()
@@ -219,15 +232,17 @@ class View3DPanel(QWidget):
 
     def load_profile_file(self, path: str) -> bool:
         """Load a profile file; a bad one is refused with the loader's message (kept model)."""
-        try:
-            profile = load_profile(path)
-        except ProfileError as exc:
-            self.message_label.setText(self.tr("Robot model not loaded: %1").replace("%1", str(exc)))
-            self.message_label.show()
+        error = self.robot.load_file(path)
+        if error is not None:
+            self._show_problem(self.tr("Robot model not loaded: %1").replace("%1", error))
             return False
         self.message_label.hide()
-        self.set_profile(profile)
         return True
+
+    @Slot(str)
+    def _show_problem(self, text: str) -> None:
+        self.message_label.setText(text)
+        self.message_label.show()
 
     @Slot()
     def choose_profile(self) -> None:
