@@ -49,7 +49,6 @@ def _at(link: FakeLink, xyzabc: tuple[float, ...]) -> None:
 
 def test_points_first_then_the_move_then_the_arrival(qtbot: Any, runs: PlanRunController, link: FakeLink,
                                                     project: Project) -> None:
-    assert runs.guarded
     runs.run(project.plans[0])
     assert [c.name for c in link.calls] == ["upload_points"]
     assert link.named("upload_points")[0].args[0] == [(1, P1, 3)]  # the ledger's values and tool
@@ -139,13 +138,13 @@ def test_a_stop_after_the_upload_ended_in_the_worker_sends_no_move(qtbot: Any, r
     assert finished.args[0].state is RunState.STOPPED and link.named("move_to_point") == []
 
 
-def test_without_a_points_model_the_run_is_not_guarded(link: FakeLink, project: Project) -> None:
-    runs = PlanRunController(link)
-    assert not runs.guarded
+def test_there_is_no_unguarded_run(link: FakeLink, project: Project) -> None:
+    model = PointsModel(project, QUndoStack())
+    runs = PlanRunController(points=model)  # as the planner panel builds its own: the link comes later
+    runs.set_link(link)
+    assert runs.points is model
     runs.run(project.plans[0])
-    assert [c.name for c in link.calls] == ["move_to_point"]
-    runs.set_points(PointsModel(project, QUndoStack()))
-    assert runs.guarded
+    assert [c.name for c in link.calls] == ["upload_points"]  # the points first, never a bare move
 
 
 def test_the_guard_speaks_chinese(qtbot: Any, translator: Any, runs: PlanRunController, link: FakeLink,
