@@ -4,7 +4,8 @@
 points and messages live there) around the non-blocking robot link: it sends segment k with
 ``link.move_to_point(...)`` and sends segment k+1 only after the link's ``commandFinished``
 for segment k. Pause / resume / stop are forwarded to the link. A failed segment, a refused
-command or a lost link ends the run in ``FAILED`` at that segment; :meth:`resume_run`
+command, a lost link or a controller that is not answering (each said as such, through
+:mod:`ui.messages`) ends the run in ``FAILED`` at that segment; :meth:`resume_run`
 continues from it ("Resume from k").
 
 Each segment's outcome comes back on its own :class:`~app.link.robot_link.Pending`
@@ -32,9 +33,9 @@ from collections.abc import Sequence
 
 from PySide6.QtCore import QObject, Signal, Slot
 
-from app.errors import LinkError, Reason, TeachPadError
+from app.errors import LinkError, ResponseTimeout, TeachPadError
 from app.link.robot_link import LinkPort, Pending
-from app.link.types import ConnectionState, WorkerError
+from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult, Pose
 from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState, SegmentCommand
 from app.plan.segments import Plan, Segment
@@ -421,10 +422,20 @@ class PlanRunController(QObject):
             if self._upload is not None:
                 self._guard.finish_upload(state.endpoint)  # what the worker reported so far
             self._clear_segment()
-            where = {"endpoint": state.endpoint} if state.endpoint else {}
-            self.end_reason = error_text(Reason("link_lost", where))
-            runner.on_error(LinkError(f"link lost: {state.message or 'link lost'}"))
+            error = _connection_error(state)
+            self.end_reason = error_text(error)
+            runner.on_error(error)
             self._finish()
+
+
+def _connection_error(state: ConnectionState) -> TeachPadError:
+    """Why a run ends when the link leaves CONNECTED: a controller that went silent while the
+    connection stays open (``NOT_ANSWERING``) is not a lost link, and is not said as one."""
+    where = {"endpoint": state.endpoint} if state.endpoint else {}
+    if state.state is LinkState.NOT_ANSWERING:
+        return ResponseTimeout(f"the controller is not answering: {state.message or 'no answer'}",
+                               code="run_not_answering", params=where)
+    return LinkError(f"link lost: {state.message or 'link lost'}", params=where)
 
 
 def _pose_of(result: CommandResult, fallback: Pose | None) -> Pose | None:
