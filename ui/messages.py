@@ -334,3 +334,9 @@ def error_text(error: WorkerError | TeachPadError | Reason) -> str:
         if text is not None:
             return text
     return error.message
+
+
+# A GUI plan run ended because the controller went silent while the connection stays open
+# (LinkState.NOT_ANSWERING, ui/controllers/plan_run_controller.py): not a lost link.
+_TEMPLATES["run_not_answering"] = QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.")  # noqa: E501
+_BARE["run_not_answering"] = QT_TRANSLATE_NOOP("Messages", "The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.")  # noqa: E501

@@ -1637,6 +1637,16 @@
             <source> (reduced-speed mode)</source>
             <translation>（减速模式）</translation>
         </message>
+        <message>
+            <location filename="../../ui/messages.py" line="341" />
+            <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
+            <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="342" />
+            <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
+            <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
+        </message>
     </context>
     <context>
         <name>MonitorPanel</name>
@@ -2123,27 +2133,27 @@
     <context>
         <name>PlanRunController</name>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="231" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="227" />
             <source>Failed: {reason}</source>
             <translation>失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="231" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="227" />
             <source>Stopped: {reason}</source>
             <translation>已停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="233" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="229" />
             <source>Failed at segment {n}: {reason}</source>
             <translation>在第 {n} 段失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="234" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="230" />
             <source>Stopped at segment {n}: {reason}</source>
             <translation>在第 {n} 段停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="249" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="245" />
             <source>stopped by the operator</source>
             <translation>已由操作员停止</translation>
         </message>

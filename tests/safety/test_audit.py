@@ -16,7 +16,7 @@ from typing import Any
 import pytest
 
 from app.errors import LinkError, WriteBlocked
-from app.safety import audit
+from app.safety import audit, audit_read
 from app.safety.audit import (
     AuditFilter,
     AuditLog,
@@ -217,7 +217,7 @@ def test_a_write_is_one_record_also_when_its_outcome_line_is_in_the_next_file(tm
 
 def test_an_unanswered_write_does_not_hold_back_what_follows(tmp_path: Path,
                                                               monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(audit, "MAX_OUTCOME_LAG", 5)
+    monkeypatch.setattr(audit_read, "MAX_OUTCOME_LAG", 5)
     log = AuditLog(tmp_path)
     log.record_write(6, [7], single=True, pending=True)  # never answered: its process died
     for i in range(12):
@@ -226,3 +226,10 @@ def test_an_unanswered_write_does_not_hold_back_what_follows(tmp_path: Path,
     reader = read_records(tmp_path)
     first = next(reader)  # out after MAX_OUTCOME_LAG records, not after the whole trail
     assert first.result == Result.UNKNOWN and len(list(reader)) == 12
+
+
+def test_the_reader_lives_in_audit_read_and_is_re_exported() -> None:
+    # importers (app/cli/support.py, ui/panels/audit_viewer.py) keep `from app.safety.audit import ...`
+    for name in audit_read.__all__:
+        assert getattr(audit, name) is getattr(audit_read, name), name
+    assert query.__module__ == "app.safety.audit_read"

@@ -7,13 +7,16 @@ from typing import Any
 
 import pytest
 from PySide6.QtCore import Qt
+from PySide6.QtGui import QUndoStack
 from PySide6.QtWidgets import QWidget
 
 from app.link.types import ConnectionState, LinkState
+from app.points.project import Project
 from app.protocol.enums import TeachFrame, WorkMode
 from tests.ui.fake_link import FakeLink
 from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.models.points_model import PointsModel
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
 from ui.panels.program_panel import ProgramPanel
@@ -29,7 +32,7 @@ class Rig:
         self.jog = JogPanel(self.host)
         self.step = StepPanel(self.host)
         self.program = ProgramPanel(self.host)
-        self.runs = PlanRunController(link)
+        self.runs = PlanRunController(link, points=PointsModel(Project(), QUndoStack()))
         self.motion = MotionController(link, self.bar, self.jog, self.step, self.program, self.runs)
 
     def panels_enabled(self) -> bool:

@@ -15,6 +15,8 @@ import pytest
 from PySide6.QtGui import QUndoStack
 
 from app.link.robot_link import RobotLink
+from app.link.types import LinkState
+from app.models import Pose
 from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, Segment
 from app.points.ledger import SyncState
@@ -26,6 +28,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,
     fast_reconnect_fixture,
+    is_state,
     link_fixture,
     register_writes,
 )
@@ -237,3 +240,38 @@ def test_a_stop_while_a_move_is_held_by_a_pause_ends_the_run(bench: Bench, sim: 
         bench.runs.stop()
     assert finished.args[0].state is RunState.STOPPED and finished.args[0].resume_from == 0
     assert MOVE not in bench.commands(since)
+
+
+def test_a_controller_that_stops_answering_ends_the_run_as_not_answering(bench: Bench, sim: Any,
+                                                                         link: RobotLink) -> None:
+    """The controller goes silent mid-move while the link stays open: the run ends at that
+    segment, said as *not answering* (not as a lost link), and nothing further is sent."""
+    slow = Plan("slow", [Segment.line(1, 5.0), Segment.line(2, SPEED)])  # 30 mm at 5 mm/s: 6 s
+    since = len(sim.writes)
+    start = link.state.pose
+    assert start is not None
+    bench.runs.run(slow)
+    # a poll has shown the arm on its way: the move request itself was answered (its
+    # acknowledgement reads no pose), the silence hits the polls that follow the motion
+    bench.qtbot.waitUntil(lambda: _moved(link, start), timeout=SIGNAL_TIMEOUT_MS)
+    at_end: list[LinkState] = []
+    bench.runs.runFinished.connect(lambda _o: at_end.append(link.state.connection.state))
+    with bench.qtbot.waitSignal(bench.runs.runFinished, timeout=RUN_TIMEOUT_MS) as finished:
+        sim.set_silent(True)
+    outcome = finished.args[0]
+    assert outcome.state is RunState.FAILED and outcome.resume_from == 0
+    assert at_end == [LinkState.NOT_ANSWERING]  # the connection is still open
+    text = bench.runs.outcome_text(outcome)
+    assert text.startswith(f"Failed at segment 1: The controller at 127.0.0.1:{sim.port} is not answering "
+                           "(the connection is still open): no further segment is sent."), text
+    assert "Lost the connection" not in text
+    with bench.qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED),
+                                timeout=SIGNAL_TIMEOUT_MS):
+        sim.set_silent(False)
+    # at the simulator: segment 1's point and move, nothing after them
+    assert bench.commands(since) == [CREATE, MOVE] and bench.runs.sent_segments == [0]
+
+
+def _moved(link: RobotLink, start: Pose) -> bool:
+    pose = link.state.pose
+    return pose is not None and math.dist(pose.xyzabc[:3], start.xyzabc[:3]) > 0.5

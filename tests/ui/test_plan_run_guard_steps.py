@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 from PySide6.QtGui import QUndoStack
 
-from app.link.types import WorkerError
+from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import Pose
 from app.plan.runner import RunState
 from app.plan.segments import Plan, Segment
@@ -49,7 +49,6 @@ def _at(link: FakeLink, xyzabc: tuple[float, ...]) -> None:
 
 def test_points_first_then_the_move_then_the_arrival(qtbot: Any, runs: PlanRunController, link: FakeLink,
                                                     project: Project) -> None:
-    assert runs.guarded
     runs.run(project.plans[0])
     assert [c.name for c in link.calls] == ["upload_points"]
     assert link.named("upload_points")[0].args[0] == [(1, P1, 3)]  # the ledger's values and tool
@@ -139,13 +138,13 @@ def test_a_stop_after_the_upload_ended_in_the_worker_sends_no_move(qtbot: Any, r
     assert finished.args[0].state is RunState.STOPPED and link.named("move_to_point") == []
 
 
-def test_without_a_points_model_the_run_is_not_guarded(link: FakeLink, project: Project) -> None:
-    runs = PlanRunController(link)
-    assert not runs.guarded
+def test_there_is_no_unguarded_run(link: FakeLink, project: Project) -> None:
+    model = PointsModel(project, QUndoStack())
+    runs = PlanRunController(points=model)  # as the planner panel builds its own: the link comes later
+    runs.set_link(link)
+    assert runs.points is model
     runs.run(project.plans[0])
-    assert [c.name for c in link.calls] == ["move_to_point"]
-    runs.set_points(PointsModel(project, QUndoStack()))
-    assert runs.guarded
+    assert [c.name for c in link.calls] == ["upload_points"]  # the points first, never a bare move
 
 
 def test_the_guard_speaks_chinese(qtbot: Any, translator: Any, runs: PlanRunController, link: FakeLink,
@@ -160,3 +159,39 @@ def test_the_guard_speaks_chinese(qtbot: Any, translator: Any, runs: PlanRunCont
     text = runs.outcome_text(finished.args[0])
     assert "机械臂停在 (430.00, 0.00, 300.00)，距 P1 (400.00, 0.00, 300.00) 30.00 mm" in text
     assert "在第 1 段失败" in text
+
+
+
+def _link_leaves_connected(qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project,
+                           link_state: LinkState) -> str:
+    """Segment 1's move is out when the link leaves CONNECTED: how the run's end reads."""
+    runs.run(project.plans[0])
+    link.point_ok(1)
+    link.upload_summary(1, 1)
+    assert link.named("move_to_point")
+    with qtbot.waitSignal(runs.runFinished) as finished:
+        link.state.set_connection(ConnectionState(link_state, "no answer", "fake:502"))
+    outcome = finished.args[0]
+    assert outcome.state is RunState.FAILED and outcome.resume_from == 0
+    return runs.outcome_text(outcome)
+
+
+@pytest.mark.parametrize(("link_state", "sentence"), [
+    (LinkState.NOT_ANSWERING, "The controller at fake:502 is not answering (the connection is still open): "
+                              "no further segment is sent. The arm may still finish its current move; "
+                              "check the robot before resuming."),
+    (LinkState.DOWN, "Lost the connection to the controller at fake:502."),
+])
+def test_a_silent_controller_is_not_a_lost_link(qtbot: Any, runs: PlanRunController, link: FakeLink,
+                                               project: Project, link_state: LinkState,
+                                               sentence: str) -> None:
+    text = _link_leaves_connected(qtbot, runs, link, project, link_state)
+    assert text == f"Failed at segment 1: {sentence}"
+
+
+def test_not_answering_speaks_chinese(qtbot: Any, translator: Any, runs: PlanRunController, link: FakeLink,
+                                      project: Project) -> None:
+    assert translator.set_language("zh_CN")
+    text = _link_leaves_connected(qtbot, runs, link, project, LinkState.NOT_ANSWERING)
+    assert "在第 1 段失败" in text and "控制器 fake:502 无应答（连接仍然打开）：不再发送后续段。" in text
+    assert "断开" not in text

@@ -1,5 +1,8 @@
 """Planner: plan and segment models (model tester, validation, undo), checks on their rows,
-the run controller's sequencing with a fake link, and the panel's run / upload flow."""
+the run controller's sequencing with a fake link, and the panel's run / upload flow.
+
+Every run is guarded (each segment's points created again, then the move, then the arrival
+checked): :class:`Worker` plays the worker's side of that on the fake link."""
 
 from __future__ import annotations
 
@@ -12,6 +15,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 
 from app.link.types import WorkerError
+from app.models import Pose
 from app.plan.checks import IssueKind
 from app.plan.runner import RunState
 from app.plan.segments import Segment, SegmentKind
@@ -190,8 +194,8 @@ def test_issues_shown_on_their_rows(segments: SegmentTableModel, project: Projec
 
 
 @pytest.fixture
-def runner(qtbot: Any, link: FakeLink) -> PlanRunController:
-    return PlanRunController(link)
+def runner(qtbot: Any, link: FakeLink, project: Project) -> PlanRunController:
+    return PlanRunController(link, points=PointsModel(project, QUndoStack()))
 
 
 @pytest.fixture
@@ -199,19 +203,58 @@ def link() -> FakeLink:
     return FakeLink()
 
 
+class Worker:
+    """The worker's side of a guarded run on the fake link: each upload the run asks for creates
+    all its points, and a move that ends well leaves the arm at its end point (the pose polled
+    with the completion), as the simulator does."""
+
+    def __init__(self, link: FakeLink, project: Project) -> None:
+        self.link = link
+        self.project = project
+        self._answered: set[int] = set()
+
+    def create_points(self) -> None:
+        """Answer the latest upload (if not yet answered): every point created."""
+        uploads = self.link.named("upload_points")
+        if not uploads or uploads[-1].request_id in self._answered:
+            return
+        self._answered.add(uploads[-1].request_id)
+        ids = [point_id for point_id, _, _ in uploads[-1].args[0]]
+        self.link.point_ok(*ids)
+        self.link.upload_summary(len(ids), len(ids))
+
+    def finish_move(self, ok: bool = True, code: int = 0xFF, message: str = "") -> None:
+        """The latest move ends (see :meth:`FakeLink.finish_move`); the next segment's points are
+        then created at once."""
+        if ok:
+            end = self.link.named("move_to_point")[-1].args[0]
+            x, y, z, a, b, c = self.project.ledger.point(end).xyzabc
+            self.link.state.set_pose(Pose(x, y, z, a, b, c, ext=(0.0,) * 5))
+        self.link.finish_move(ok, code, message)
+        self.create_points()
+
+
+@pytest.fixture
+def worker(link: FakeLink, project: Project) -> Worker:
+    return Worker(link, project)
+
+
 def moves(link: FakeLink) -> list[tuple[int, int | None]]:
     return [(c.args[0], c.args[1]) for c in link.named("move_to_point")]
 
 
 def test_segments_sent_in_order_each_after_the_previous_result(qtbot: Any, runner: PlanRunController,
-                                                               link: FakeLink, project: Project) -> None:
+                                                               link: FakeLink, project: Project,
+                                                               worker: Worker) -> None:
     plan = project.plans[0]  # line P2, arc P4 -> P3, line P1; 2 loops
     with qtbot.waitSignal(runner.runningChanged, check_params_cb=lambda running: running):
         runner.run(plan)
+    assert moves(link) == []  # the segment's points are created first
+    worker.create_points()
     assert moves(link) == [(2, None)]
     call = link.named("move_to_point")[0]
     assert call.kwargs == {"orientation_changes": True, "ignore_middle": False, "speed": 100.0, "tool": 200}
-    link.finish_move()
+    worker.finish_move()
     assert moves(link) == [(2, None), (3, 4)]
     assert link.named("move_to_point")[1].kwargs["orientation_changes"] is False  # "kept"
     link.commandFinished.emit(_ack("pause: sent"))  # not a move result: ignored
@@ -219,7 +262,7 @@ def test_segments_sent_in_order_each_after_the_previous_result(qtbot: Any, runne
     assert runner.progress is not None and runner.progress.text == "loop 1/2, segment 2/3"
     with qtbot.waitSignal(runner.runFinished) as finished:
         for _ in range(5):
-            link.finish_move()
+            worker.finish_move()
     assert moves(link) == [(2, None), (3, 4), (1, None)] * 2
     assert finished.args[0].state is RunState.FINISHED and not runner.running
 
@@ -231,8 +274,9 @@ def _ack(text: str) -> Any:
 
 
 def test_pause_resume_stop_are_forwarded(qtbot: Any, runner: PlanRunController, link: FakeLink,
-                                         project: Project) -> None:
+                                         project: Project, worker: Worker) -> None:
     runner.run(project.plans[1])
+    worker.create_points()
     runner.pause()
     assert runner.paused and link.named("pause")
     runner.resume()
@@ -247,34 +291,39 @@ def test_pause_resume_stop_are_forwarded(qtbot: Any, runner: PlanRunController, 
 
 
 def test_error_at_segment_k_stops_and_resume_from_k_continues(qtbot: Any, runner: PlanRunController,
-                                                              link: FakeLink, project: Project) -> None:
+                                                              link: FakeLink, project: Project,
+                                                              worker: Worker) -> None:
     runner.run(project.plans[1])  # circle: P5, arc P6->P7, arc P8->P5, P1
-    link.finish_move()
+    worker.create_points()
+    worker.finish_move()
     with qtbot.waitSignal(runner.runFinished) as finished:
-        link.finish_move(False, code=3, message="servo alarm")
+        worker.finish_move(False, code=3, message="servo alarm")
     outcome = finished.args[0]
     assert outcome.state is RunState.FAILED and outcome.resume_from == 1
     assert "segment 2/4" in outcome.message and "servo alarm" in outcome.message
     assert runner.can_resume
     runner.resume_run()
+    worker.create_points()
     assert moves(link) == [(5, None), (7, 6), (7, 6)]
     with qtbot.waitSignal(runner.runFinished) as finished:
         for _ in range(3):
-            link.finish_move()
+            worker.finish_move()
     assert finished.args[0].state is RunState.FINISHED
     assert moves(link)[3:] == [(5, 8), (1, None)]
 
 
 def test_lost_link_and_refusal_end_the_run(qtbot: Any, runner: PlanRunController, link: FakeLink,
-                                           project: Project) -> None:
+                                           project: Project, worker: Worker) -> None:
     runner.run(project.plans[1])
+    worker.create_points()
     with qtbot.waitSignal(runner.runFinished) as finished:
         link.set_connected(False, "connection reset")
     assert finished.args[0].state is RunState.FAILED and "connection reset" in finished.args[0].message
     link.set_connected(True)
     runner.resume_run()
-    link.errorOccurred.emit(WorkerError("move to point", "another request's error",
-                                      link.last_id("move_to_point") - 1))
+    worker.create_points()
+    previous_move = link.named("move_to_point")[-2].request_id  # the one the lost link ended
+    link.errorOccurred.emit(WorkerError("move to point", "another request's error", previous_move))
     assert runner.running  # not ours
     with qtbot.waitSignal(runner.runFinished) as finished:
         link.errorOccurred.emit(WorkerError("move to point", "jog is still under way",
@@ -283,10 +332,11 @@ def test_lost_link_and_refusal_end_the_run(qtbot: Any, runner: PlanRunController
 
 
 def test_step_runs_one_segment(qtbot: Any, runner: PlanRunController, link: FakeLink,
-                               project: Project) -> None:
+                               project: Project, worker: Worker) -> None:
     runner.step(project.plans[1], 2)
+    worker.create_points()
     with qtbot.waitSignal(runner.runFinished) as finished:
-        link.finish_move()
+        worker.finish_move()
     assert moves(link) == [(5, 8)]
     assert finished.args[0].state is RunState.FINISHED and finished.args[0].next_position == (3, 1)
 
@@ -324,7 +374,7 @@ def planner(qtbot: Any, project: Project, link: FakeLink) -> Iterator[PlannerPan
         questions.append(text)
         return answers.pop(0) if answers else False
 
-    panel = PlannerPanel(PlanListModel(project, stack), points, PlanRunController(link), sync,
+    panel = PlannerPanel(PlanListModel(project, stack), points, PlanRunController(link, points=points), sync,
                          confirm=confirm)
     panel.answers = answers  # type: ignore[attr-defined]
     panel.questions = questions  # type: ignore[attr-defined]
@@ -337,7 +387,7 @@ def planner(qtbot: Any, project: Project, link: FakeLink) -> Iterator[PlannerPan
 
 
 def test_panel_summary_and_upload_now_then_run(qtbot: Any, planner: PlannerPanel, link: FakeLink,
-                                               project: Project) -> None:
+                                               project: Project, worker: Worker) -> None:
     planner.select_plan(1)
     assert planner.summary_text.startswith("5 point(s) need upload")
     assert planner.upload_button.isVisibleTo(planner)
@@ -350,25 +400,27 @@ def test_panel_summary_and_upload_now_then_run(qtbot: Any, planner: PlannerPanel
     link.point_ok(1, 5, 6, 7, 8)
     with qtbot.waitSignal(planner.run_controller.runningChanged):
         link.upload_summary(5, 5)
+    worker.create_points()  # the run's own: segment 1's point again, right before its move
     assert moves(link) == [(5, None)]
     assert "The robot will move" in planner.questions[1]  # type: ignore[attr-defined]
     assert planner.summary_text == "Checks passed: ready to run"
     assert is_locked(planner) and not planner.action_add_line.isEnabled()
     assert is_live(planner)
-    link.finish_move()
+    worker.finish_move()
     assert "Segment 2 of 4, loop 1 of 1" in planner.run_label.text()
     with qtbot.waitSignal(planner.run_controller.runFinished):
-        link.finish_move(False, code=3, message="servo alarm")
+        worker.finish_move(False, code=3, message="servo alarm")
     assert not is_locked(planner) and not is_live(planner)
     assert planner.action_resume_from.isEnabled()
     assert planner.action_resume_from.text() == "Resume from segment 2"
     assert planner.selected_segments() == [1]
     planner.answers.append(True)  # type: ignore[attr-defined]
     planner.resume_from()
+    worker.create_points()
     assert moves(link)[-1] == (7, 6) and is_live(planner)
     with qtbot.waitSignal(planner.run_controller.runFinished):
         for _ in range(3):
-            link.finish_move()
+            worker.finish_move()
     assert not is_live(planner) and "Finished" in planner.run_label.text()
 
 
@@ -388,19 +440,21 @@ def test_panel_refuses_a_plan_with_errors(planner: PlannerPanel, link: FakeLink,
 
 
 def test_panel_step_and_run_from_here(qtbot: Any, planner: PlannerPanel, link: FakeLink,
-                                      project: Project) -> None:
+                                      project: Project, worker: Worker) -> None:
     all_uploaded(project)
     planner.select_plan(1)
     planner.select_segments([2])
     planner.answers.append(True)  # type: ignore[attr-defined]
     planner.action_step.trigger()
+    worker.create_points()
     assert moves(link) == [(5, 8)]
     with qtbot.waitSignal(planner.run_controller.runFinished):
-        link.finish_move()
+        worker.finish_move()
     assert planner.selected_segments() == [3]  # the next step
     planner.answers.append(True)  # type: ignore[attr-defined]
     planner.select_segments([1])
     planner.action_run_from.trigger()
+    worker.create_points()
     assert moves(link)[-1] == (7, 6)
     planner.action_stop.trigger()
     with qtbot.waitSignal(planner.run_controller.runFinished):
@@ -471,13 +525,15 @@ def test_many_segments_plan(planner: PlannerPanel, project: Project) -> None:
 
 
 def test_bad_end_point_marks_points_unknown_and_offers_restore(qtbot: Any, planner: PlannerPanel,
-                                                              link: FakeLink, project: Project) -> None:
+                                                              link: FakeLink, project: Project,
+                                                              worker: Worker) -> None:
     all_uploaded(project)
     planner.select_plan(1)
     sync = planner.point_sync
     assert sync is not None and not sync.restore_offered
     planner.answers.append(True)  # type: ignore[attr-defined]
     assert planner.run(0)
+    worker.create_points()
     with qtbot.waitSignal(sync.restoreOffered):
         link.finish_move(False, code=13, message="move to temp point refused: bad end point id")
     assert project.ledger.point(5).sync is SyncState.UNKNOWN
@@ -486,20 +542,22 @@ def test_bad_end_point_marks_points_unknown_and_offers_restore(qtbot: Any, plann
 
 
 def test_resume_after_an_edit_runs_the_edited_segments(qtbot: Any, planner: PlannerPanel, link: FakeLink,
-                                                       project: Project) -> None:
+                                                       project: Project, worker: Worker) -> None:
     all_uploaded(project)
     planner.select_plan(1)
     planner.answers.append(True)  # type: ignore[attr-defined]
     assert planner.run(0)
-    link.finish_move()
+    worker.create_points()
+    worker.finish_move()
     with qtbot.waitSignal(planner.run_controller.runFinished):
-        link.finish_move(False, code=12, message="motion timeout")
+        worker.finish_move(False, code=12, message="motion timeout")
     assert planner.segments.setData(planner.segments.index(1, COL_SPEED), "20")
     planner.answers.append(True)  # type: ignore[attr-defined]
     planner.action_resume_from.trigger()
+    worker.create_points()
     last = link.named("move_to_point")[-1]
     assert (last.args, last.kwargs["speed"]) == ((7, 6), 20.0)
     with qtbot.waitSignal(planner.run_controller.runFinished) as finished:
         for _ in range(3):
-            link.finish_move()
+            worker.finish_move()
     assert finished.args[0].state is RunState.FINISHED

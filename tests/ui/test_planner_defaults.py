@@ -41,7 +41,7 @@ def link() -> FakeLink:
 def planner(qtbot: Any, project: Project, link: FakeLink) -> Iterator[PlannerPanel]:
     stack = QUndoStack()
     points = PointsModel(project, stack)
-    panel = PlannerPanel(PlanListModel(project, stack), points, PlanRunController(link),
+    panel = PlannerPanel(PlanListModel(project, stack), points, PlanRunController(link, points=points),
                          PointSyncController(points, link), confirm=lambda title, text: False)
     qtbot.addWidget(panel)
     panel.resize(1280, 700)
@@ -142,7 +142,7 @@ def test_no_segment_without_points(qtbot: Any, link: FakeLink) -> None:
     project = Project(ledger=PointLedger(), plans=[Plan("empty")])
     stack = QUndoStack()
     points = PointsModel(project, stack)
-    panel = PlannerPanel(PlanListModel(project, stack), points, PlanRunController(link),
+    panel = PlannerPanel(PlanListModel(project, stack), points, PlanRunController(link, points=points),
                          confirm=lambda title, text: False)
     qtbot.addWidget(panel)
     panel.action_add_line.trigger()

@@ -89,8 +89,9 @@ def test_gui_uploads_record_the_history_in_the_project(qtbot: Any, sim: Any, lin
 
 def test_connected_is_the_link_states(qtbot: Any) -> None:
     link = FakeLink(connected=False)
-    runs = PlanRunController(link)
-    sync = PointSyncController(project_model(), link)
+    points = project_model()
+    runs = PlanRunController(link, points=points)
+    sync = PointSyncController(points, link)
     assert not runs.connected and not sync.connected
     with qtbot.waitSignal(runs.connectedChanged, check_params_cb=bool), \
             qtbot.waitSignal(sync.connectedChanged, check_params_cb=bool):

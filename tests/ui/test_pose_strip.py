@@ -10,14 +10,17 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
+from PySide6.QtGui import QUndoStack
 from PySide6.QtWidgets import QApplication, QMainWindow, QWidget
 
 from app.models import ControllerStatus, Pose
+from app.points.project import Project
 from app.protocol.enums import Alarm, ControllerMode, ProgramState, TeachFrame
 from tests.ui.fake_link import FakeLink
 from tests.ui.pendant_support import translator_fixture  # noqa: F401 - fixture
 from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.models.points_model import PointsModel
 from ui.panels.alarm_banner import AlarmBanner
 from ui.panels.alarm_list import COL_ADVICE, COL_CLEARED, COL_MEANING, COL_RAISED, AlarmListPanel
 from ui.panels.control_bar import ControlBar
@@ -265,7 +268,8 @@ def test_an_estop_holds_motion_but_not_stop(qtbot: Any, link: FakeLink) -> None:
     host = QWidget()
     qtbot.addWidget(host)
     bar, jog, step, program = ControlBar(host), JogPanel(host), StepPanel(host), ProgramPanel(host)
-    motion = MotionController(link, bar, jog, step, program, PlanRunController(link))
+    motion = MotionController(link, bar, jog, step, program,
+                              PlanRunController(link, points=PointsModel(Project(), QUndoStack())))
     holds: list[bool] = []
     motion.alarmHoldChanged.connect(holds.append)
     assert jog.axes_box.isEnabled()

@@ -4,7 +4,8 @@
 points and messages live there) around the non-blocking robot link: it sends segment k with
 ``link.move_to_point(...)`` and sends segment k+1 only after the link's ``commandFinished``
 for segment k. Pause / resume / stop are forwarded to the link. A failed segment, a refused
-command or a lost link ends the run in ``FAILED`` at that segment; :meth:`resume_run`
+command, a lost link or a controller that is not answering (each said as such, through
+:mod:`ui.messages`) ends the run in ``FAILED`` at that segment; :meth:`resume_run`
 continues from it ("Resume from k").
 
 Each segment's outcome comes back on its own :class:`~app.link.robot_link.Pending`
@@ -13,17 +14,16 @@ Stop" and refusals); everything else (acknowledgements, other panels' commands) 
 the run. A failed stop request of ours ends a run that is stopping. Connection and pose come
 from ``link.state`` (:class:`~app.link.state.RobotState`), never a copy kept here.
 
-**The point guard** (given a :class:`~ui.models.points_model.PointsModel`: ``points=`` or
-:meth:`PlanRunController.set_points`; the main window always gives one): the controller's temp
-points are never assumed (:mod:`ui.controllers.run_points`). Before each segment's move its
+**The point guard** (every run; the :class:`~ui.models.points_model.PointsModel` given as
+``points=`` is mandatory): the controller's temp points are never assumed
+(:mod:`ui.controllers.run_points`). Before each segment's move its
 points are created again from the ledger, in the worker thread (one ``link.upload_points``
 request; the move goes out when it has succeeded, or on Resume when the operator paused
 meanwhile), and after the move the pose polled with its completion is compared with the
 ledger's end point. A point that is not created, or an arrival off by more than 1 mm (the point
 was overwritten by another tool), ends the run in ``FAILED`` at that segment with a sentence
 from :mod:`ui.messages`; nothing further moves. ``segmentPrepared(int, object)`` (index, point
-ids) is emitted right before each guarded move is sent. Without a points model the run is
-not guarded (unit tests of the sequencing only).
+ids) is emitted right before each move is sent. There is no unguarded run.
 """
 
 from __future__ import annotations
@@ -33,9 +33,9 @@ from collections.abc import Sequence
 
 from PySide6.QtCore import QObject, Signal, Slot
 
-from app.errors import LinkError, Reason, TeachPadError
+from app.errors import LinkError, ResponseTimeout, TeachPadError
 from app.link.robot_link import LinkPort, Pending
-from app.link.types import ConnectionState, WorkerError
+from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult, Pose
 from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState, SegmentCommand
 from app.plan.segments import Plan, Segment
@@ -73,13 +73,13 @@ class PlanRunController(QObject):
     pointMismatch = Signal(int)
 
     def __init__(self, link: LinkPort | None = None, parent: QObject | None = None, *,
-                 points: PointsModel | None = None) -> None:
+                 points: PointsModel) -> None:
         super().__init__(parent)
         self._link: LinkPort | None = None
         self._runner: PlanRunner | None = None
         self._plan: Plan | None = None
         self._paused = False
-        self._guard: RunPoints | None = RunPoints(points) if points is not None else None
+        self._guard = RunPoints(points)  # every run is guarded: there is no other path
         self._upload: Pending | None = None  # the re-creation of the running segment's points
         self._prepared: SegmentPoints | None = None  # the running segment's points, as sent
         self._held: SegmentCommand | None = None  # created while paused: the move waits for Resume
@@ -100,14 +100,10 @@ class PlanRunController(QObject):
         link.state.poseChanged.connect(self.poseChanged)
         link.pointUploaded.connect(self._on_point_uploaded)
 
-    def set_points(self, points: PointsModel) -> None:
-        """Guard every run from now on with this ledger (see the module docstring)."""
-        self._guard = RunPoints(points)
-
     @property
-    def guarded(self) -> bool:
-        """Runs re-create each segment's points and check the arrival."""
-        return self._guard is not None
+    def points(self) -> PointsModel:
+        """The ledger every run's points are created from (the point guard's)."""
+        return self._guard.model
 
     # --- state
     @property
@@ -279,10 +275,7 @@ class PlanRunController(QObject):
         if command is None:
             self._finish()
             return
-        if self._guard is not None:
-            self._prepare(link, self._guard, command)
-        else:
-            self._send_move(link, command)
+        self._prepare(link, self._guard, command)
 
     def _prepare(self, link: LinkPort, guard: RunPoints, command: SegmentCommand) -> None:
         """Create the segment's points from the ledger (worker thread); the move follows."""
@@ -300,7 +293,7 @@ class PlanRunController(QObject):
     def _on_upload(self, upload: Pending, result: CommandResult) -> None:
         runner, guard, link = self._runner, self._guard, self._link
         if upload is not self._upload or runner is None or runner.state is not RunState.RUNNING \
-                or guard is None or link is None:
+                or link is None:
             return
         self._upload = None
         prepared = guard.finish_upload(link.state.connection.endpoint)
@@ -323,9 +316,8 @@ class PlanRunController(QObject):
         if upload is not self._upload or runner is None or runner.state is not RunState.RUNNING:
             return
         self._upload = None
-        if self._guard is not None:
-            self._guard.finish_upload(self._link.state.connection.endpoint if self._link else "")
-            self._guard.clear()
+        self._guard.finish_upload(self._link.state.connection.endpoint if self._link else "")
+        self._guard.clear()
         self.end_reason = error_text(error)
         self._clear_segment()
         runner.on_error(TeachPadError(self.end_reason))
@@ -344,17 +336,16 @@ class PlanRunController(QObject):
         self._upload = None
         self._prepared = None
         self._held = None
-        if self._guard is not None:
-            self._guard.clear()
+        self._guard.clear()
 
     def _on_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
-        if self._upload is not None and self._guard is not None:
+        if self._upload is not None:
             self._guard.on_point_uploaded(point_id, ok, reason, unconfirmed)
 
     def _send_move(self, link: LinkPort, command: SegmentCommand) -> None:
         seg = command.segment
-        if self._prepared is not None:
-            self.segmentPrepared.emit(command.index, list(self._prepared.points))
+        assert self._prepared is not None  # created by _prepare, or the move is not sent
+        self.segmentPrepared.emit(command.index, list(self._prepared.points))
         self._sent.append(command.index)
         move = link.track(link.move_to_point(
             seg.end_id, seg.via_id, orientation_changes=seg.orientation_changes,
@@ -385,7 +376,7 @@ class PlanRunController(QObject):
             return
         self._move = None
         prepared, self._prepared = self._prepared, None
-        if result.ok and prepared is not None and self._guard is not None:
+        if result.ok and prepared is not None:
             error = self._guard.check_arrival(prepared, _pose_of(result, self.last_pose))
             if error is not None:
                 self.pointMismatch.emit(prepared.end_id)
@@ -428,13 +419,23 @@ class PlanRunController(QObject):
         runner = self._runner
         if not state.connected and runner is not None and runner.state is RunState.RUNNING:
             self._move = None
-            if self._upload is not None and self._guard is not None:
+            if self._upload is not None:
                 self._guard.finish_upload(state.endpoint)  # what the worker reported so far
             self._clear_segment()
-            where = {"endpoint": state.endpoint} if state.endpoint else {}
-            self.end_reason = error_text(Reason("link_lost", where))
-            runner.on_error(LinkError(f"link lost: {state.message or 'link lost'}"))
+            error = _connection_error(state)
+            self.end_reason = error_text(error)
+            runner.on_error(error)
             self._finish()
+
+
+def _connection_error(state: ConnectionState) -> TeachPadError:
+    """Why a run ends when the link leaves CONNECTED: a controller that went silent while the
+    connection stays open (``NOT_ANSWERING``) is not a lost link, and is not said as one."""
+    where = {"endpoint": state.endpoint} if state.endpoint else {}
+    if state.state is LinkState.NOT_ANSWERING:
+        return ResponseTimeout(f"the controller is not answering: {state.message or 'no answer'}",
+                               code="run_not_answering", params=where)
+    return LinkError(f"link lost: {state.message or 'link lost'}", params=where)
 
 
 def _pose_of(result: CommandResult, fallback: Pose | None) -> Pose | None:

@@ -82,7 +82,7 @@ class PlannerPanel(QWidget):
         self.setObjectName("PlannerPanel")
         self._plans = plans
         self._points = points
-        self._runner = run_controller or PlanRunController(parent=self)
+        self._runner = run_controller or PlanRunController(parent=self, points=points)
         self._sync = point_sync
         self._confirm = confirm or ask_confirmation(self)
         self._pose_known = False
