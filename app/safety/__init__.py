@@ -6,7 +6,8 @@
 * :mod:`app.safety.jog_guard` — stop a jog before a boundary, allow jogging back out.
 * :mod:`app.safety.profile` — the envelope on disk (JSON, versioned, atomic).
 * :mod:`app.safety.roles` — operator / engineer / administrator, scrypt passwords, idle lock.
-* :mod:`app.safety.audit` — the append-only JSON-lines audit trail, its reader and CSV export.
+* :mod:`app.safety.audit` — the append-only JSON-lines audit trail (write-ahead); :mod:`app.safety.audit_read`
+  its reader, filters and CSV export.
 * :mod:`app.safety.bundle` — the support bundle zip.
 * :mod:`app.safety.session` — one object tying them together for the GUI.
 """
