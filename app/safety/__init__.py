@@ -9,5 +9,7 @@
 * :mod:`app.safety.audit` — the append-only JSON-lines audit trail (write-ahead); :mod:`app.safety.audit_read`
   its reader, filters and CSV export.
 * :mod:`app.safety.bundle` — the support bundle zip.
+* :mod:`app.safety.register_profile` — what varies between controllers (word order, unit, completion
+  rule, poll timeout), versioned JSON, changed by the administrator only.
 * :mod:`app.safety.session` — one object tying them together for the GUI.
 """
