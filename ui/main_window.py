@@ -58,7 +58,7 @@ from ui.controllers.safety_menu import install_safety
 from ui.dialogs.confirm import ConfirmFn
 from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import Translator
-from ui.messages import error_text
+from ui.messages import connection_text, error_text
 from ui.panels.alarm_banner import AlarmBanner
 from ui.panels.alarm_list import AlarmListPanel
 from ui.panels.control_bar import ControlBar
@@ -328,7 +328,7 @@ class MainWindow(QMainWindow):
         connection: ConnectionState = self.link.state.connection
         text, _level = connection_display(connection)
         self.status_link.setText(text)
-        self.status_link.setToolTip(connection.message)
+        self.status_link.setToolTip(connection_text(connection))
         self.status_monitor_only.setText(self.tr("MONITOR ONLY") if connection.monitor_only else "")
         self.menus.disconnect_action.setEnabled(connection.state is not LinkState.DISCONNECTED)
         self._update_title()

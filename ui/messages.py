@@ -16,7 +16,7 @@ from typing import Any
 from PySide6.QtCore import QCoreApplication
 
 from app.errors import Reason, TeachPadError
-from app.link.types import WorkerError
+from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult
 from app.protocol.enums import (
     RUN_COMMAND_TEXT,
@@ -28,8 +28,8 @@ from app.protocol.enums import (
     controller_mode_text,
 )
 
-__all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "error_text", "operation_text", "reason_text",
-           "result_level", "result_text", "status_text"]
+__all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "connection_text", "error_text", "operation_text",
+           "reason_text", "result_level", "result_text", "status_text"]
 
 CONTEXT = "Messages"
 LEVEL_INFO = "info"
@@ -79,6 +79,10 @@ _TEMPLATES: dict[str, str] = {
     "monitor_only": QT_TRANSLATE_NOOP("Messages", "Monitor-only mode: nothing was sent to the controller."),
     "invalid_input": QT_TRANSLATE_NOOP("Messages", "Invalid value: nothing was sent."),
     "unexpected": QT_TRANSLATE_NOOP("Messages", "Unexpected internal error; the log has the details."),
+    # the link's own state and the commands it cut short (app/link/supervisor.py)
+    "link_was_shut_down": QT_TRANSLATE_NOOP("Messages", "The link was shut down."),
+    "outcome_unknown_link_lost": QT_TRANSLATE_NOOP("Messages", "{operation}: the connection was lost while it was under way; its outcome is unknown."),  # noqa: E501
+    "outcome_unknown_link_closed": QT_TRANSLATE_NOOP("Messages", "{operation}: the connection was closed while it was under way."),  # noqa: E501
 }
 
 # A reason whose arguments lack a placeholder of the full sentence uses this one.
@@ -329,3 +333,11 @@ def error_text(error: WorkerError | TeachPadError | Reason) -> str:
         if text is not None:
             return text
     return error.message
+
+
+def connection_text(connection: ConnectionState) -> str:
+    """Why the link is in its state, as one sentence ("" when there is nothing to say); the
+    English message only from a producer that gives no reason."""
+    if connection.reason is not None:
+        return reason_text(connection.reason) or ""
+    return connection.message

@@ -30,7 +30,7 @@ from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport
 from app.protocol.registers import TOOL_NONE
 from ui.controllers.new_point import NewPointPose, new_point_pose
-from ui.messages import error_text, result_text
+from ui.messages import connection_text, error_text, result_text
 from ui.models.point_columns import sync_text
 from ui.models.points_model import PointsModel
 
@@ -300,7 +300,7 @@ class PointSyncController(QObject):
         connected = state.connected
         self._set_connected(connected)
         if not connected and self._operation:
-            reason = state.message or self.tr("link lost")
+            reason = connection_text(state) or self.tr("link lost")
             if self._upload is not None:
                 # The worker still reports the points it finished, then ends the batch: wait for it.
                 self._upload.link_lost = reason

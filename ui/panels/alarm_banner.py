@@ -30,6 +30,7 @@ from ui.palette import COLOR_ALARM_BANNER, COLOR_ALARM_BANNER_TEXT, COLOR_ERROR_
 __all__ = ["AlarmBanner", "alarm_name"]
 
 BANNER_HINT_WIDTH = 200  # px: the text's size hint in the toolbar (it stretches to the window)
+BANNER_FONT_SCALE = 1.15  # a little larger than the window's text: it must not be missed
 BANNER_PADDING_PX = 2  # px above and below the line (the toolbar adds no chrome of its own)
 # a line of both scripts: the fixed height fits Latin and CJK glyphs (the CJK fallback is taller)
 _SAMPLE = "ALARM Ågy 报警急停"
@@ -63,6 +64,7 @@ class _BannerText(QLabel):
         self.setTextFormat(Qt.TextFormat.PlainText)
         font = self.font()
         font.setBold(True)
+        font.setPointSizeF(font.pointSizeF() * BANNER_FONT_SCALE)
         self.setFont(font)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         self.setFixedHeight(QFontMetrics(font).boundingRect(_SAMPLE).height() + 2 * BANNER_PADDING_PX)
@@ -102,7 +104,9 @@ class AlarmBanner(QToolBar):
         self.setStyleSheet(f"QToolBar#AlarmBanner {{ background: {COLOR_ALARM_BANNER};"
                            f" border: none; border-bottom: 2px solid {COLOR_ERROR_DARK};"
                            f" padding: 0px; spacing: 0px; }}")
-        self.layout().setContentsMargins(0, 0, 0, 0)
+        layout = self.layout()
+        if layout is not None:
+            layout.setContentsMargins(0, 0, 0, 0)
         self.label = _BannerText(self)
         self.label.setObjectName("AlarmBannerText")
         self.label.setStyleSheet(f"QLabel {{ color: {COLOR_ALARM_BANNER_TEXT}; padding: 0px 8px; }}")
