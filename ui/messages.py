@@ -18,6 +18,8 @@ from PySide6.QtCore import QCoreApplication
 from app.errors import Reason, TeachPadError
 from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult
+from app.plan.checks import IssueKind, PlanIssue
+from app.points.point import SYNC_STATE_TEXT, SyncState
 from app.protocol.enums import (
     RUN_COMMAND_TEXT,
     UNKNOWN_STATUS_TEXT,
@@ -27,9 +29,11 @@ from app.protocol.enums import (
     alarm_names,
     controller_mode_text,
 )
+from app.protocol.registers import TOOL_NONE
 
-__all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "connection_text", "error_text", "operation_text",
-           "reason_text", "result_level", "result_text", "status_text"]
+__all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "connection_text", "error_text", "issue_line",
+           "issue_text", "operation_text", "reason_text", "refusal_text", "result_level", "result_text",
+           "status_text"]
 
 CONTEXT = "Messages"
 LEVEL_INFO = "info"
@@ -224,7 +228,7 @@ def _alarms(mask: int) -> str:
                     for name in alarm_names(mask))
 
 
-def _envelope(args: Mapping[str, Any]) -> str:
+def _envelope(args: Mapping[str, Any], prefix: bool = True) -> str:
     code = "approaching" if args.get("approaching") else str(args.get("violation", ""))
     template = _ENVELOPE.get(code)
     if template is None:
@@ -238,7 +242,7 @@ def _envelope(args: Mapping[str, Any]) -> str:
     if args.get("reduced"):
         end = text[-1] if text[-1:] in ("。", ".") else ""
         text = text[: len(text) - len(end)] + _tr(_REDUCED) + end
-    return _tr(_ENVELOPE_PREFIX).format(text=text)
+    return _tr(_ENVELOPE_PREFIX).format(text=text) if prefix else text
 
 
 def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
@@ -341,3 +345,100 @@ def connection_text(connection: ConnectionState) -> str:
     if connection.reason is not None:
         return reason_text(connection.reason) or ""
     return connection.message
+
+
+# --- the plan's checks (app/plan/checks.py: IssueCode values and their args) -------------------
+_ISSUES: dict[str, str] = {
+    "empty-plan": QT_TRANSLATE_NOOP("Messages", "Plan \u201c{plan}\u201d has no segments."),
+    "bad-start": QT_TRANSLATE_NOOP("Messages", "Cannot start at segment {start}: the plan has {segments} segments."),  # noqa: E501
+    "bad-speed": QT_TRANSLATE_NOOP("Messages", "speed {speed} mm/s is not in (0, {max}] mm/s."),
+    "arc-no-middle": QT_TRANSLATE_NOOP("Messages", "the arc has no middle point."),
+    "missing-point/middle": QT_TRANSLATE_NOOP("Messages", "middle point P{id} does not exist."),
+    "missing-point/end": QT_TRANSLATE_NOOP("Messages", "end point P{id} does not exist."),
+    "needs-upload": QT_TRANSLATE_NOOP("Messages", "{point} is not on the controller ({sync}); upload it."),
+    "tool-mismatch": QT_TRANSLATE_NOOP("Messages", "{point} was taught with {point_tool}, the segment moves with {segment_tool}."),  # noqa: E501
+    "zero-length": QT_TRANSLATE_NOOP("Messages", "the line goes nowhere (start and end {length} mm apart){where}."),  # noqa: E501
+    "arc-start-unknown": QT_TRANSLATE_NOOP("Messages", "the arc starts at the robot's current pose, which is not known: its shape is not checked."),  # noqa: E501
+    "arc-points-coincide/start-middle": QT_TRANSLATE_NOOP("Messages", "the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
+    "arc-points-coincide/middle-end": QT_TRANSLATE_NOOP("Messages", "the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
+    "arc-points-coincide/start-end": QT_TRANSLATE_NOOP("Messages", "the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
+    "arc-collinear": QT_TRANSLATE_NOOP("Messages", "the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}."),  # noqa: E501
+    "arc-resume-past-middle/past": QT_TRANSLATE_NOOP("Messages", "the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before."),  # noqa: E501
+    "arc-resume-past-middle/larger": QT_TRANSLATE_NOOP("Messages", "sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here."),  # noqa: E501
+    "unreachable/point": QT_TRANSLATE_NOOP("Messages", "{point} is out of the robot model's reach."),
+    "unreachable/path": QT_TRANSLATE_NOOP("Messages", "the path is out of the robot model's reach."),
+    "joint-limit/point": QT_TRANSLATE_NOOP("Messages", "{point} passes a joint limit of the robot model."),
+    "joint-limit/path": QT_TRANSLATE_NOOP("Messages", "the path passes a joint limit of the robot model."),
+}
+_FROM_CURRENT_POSE = QT_TRANSLATE_NOOP("Messages", " (from the current pose)")
+_FROM_LATER_LOOPS = QT_TRANSLATE_NOOP("Messages", " (on loops after the first, starting at the end of segment {after})")  # noqa: E501
+_ISSUE_KINDS = {IssueKind.ERROR: "error", IssueKind.NEEDS_UPLOAD: "needs upload",
+                IssueKind.WARNING: "warning"}  # the "SegmentTableModel" translations
+
+
+def _tool(tool: Any) -> str:
+    """A tool frame as the points table shows it (translations of "PointsModel")."""
+    if int(tool) == TOOL_NONE:
+        return QCoreApplication.translate("PointsModel", "none")
+    return QCoreApplication.translate("PointsModel", "tool {n}").format(n=int(tool) + 1)
+
+
+def _issue_key(issue: PlanIssue) -> str:
+    code, args = issue.code.value, issue.args
+    if code == "missing-point":
+        return f"{code}/{args.get('role')}"
+    if code == "arc-points-coincide":
+        return f"{code}/{args.get('pair')}"
+    if code == "arc-resume-past-middle":
+        return f"{code}/{'past' if args.get('past_middle') else 'larger'}"
+    if code in ("unreachable", "joint-limit"):
+        return f"{code}/{'point' if args.get('point') else 'path'}"
+    return code
+
+
+def issue_text(issue: PlanIssue) -> str:
+    """One check of a plan as a sentence in the operator's language ("segment 2: ..."); the
+    issue's English message when it carries no arguments this module knows."""
+    args = issue.args
+    if issue.code.value == "outside-envelope" and args:
+        return _envelope(args, prefix=False)
+    template = _ISSUES.get(_issue_key(issue))
+    if template is None:
+        return issue.message
+    fields: dict[str, str] = {k: _number(v) if isinstance(v, int | float) and not isinstance(v, bool)
+                              else str(v) for k, v in args.items()}
+    source = args.get("from")
+    fields["where"] = (_tr(_FROM_CURRENT_POSE) if source == "current_pose"
+                       else _tr(_FROM_LATER_LOOPS).format(after=args.get("after", "?"))
+                       if source == "later_loops" else "")
+    if "sync" in args:
+        try:
+            fields["sync"] = _tr(SYNC_STATE_TEXT[SyncState(args["sync"])], "Points")
+        except (ValueError, KeyError):
+            fields["sync"] = str(args["sync"])
+    for key in ("point_tool", "segment_tool"):
+        if key in args:
+            fields[key] = _tool(args[key])
+    try:
+        text = _tr(template).format(**fields)
+    except (KeyError, ValueError):
+        return issue.message
+    if issue.segment is None:
+        return text
+    return _tr(_SEGMENT).format(n=issue.segment + 1) + text
+
+
+def issue_line(issue: PlanIssue) -> str:
+    """An issue with its kind ("error: segment 2: ..."), for lists and tooltips."""
+    kind = QCoreApplication.translate("SegmentTableModel", _ISSUE_KINDS[issue.kind])
+    return f"{kind}: {issue_text(issue)}"
+
+
+def refusal_text(exc: BaseException) -> str:
+    """Why the core refused an edit or a file, in the operator's language when the error
+    carries a specific code this module words; else its English text."""
+    if isinstance(exc, TeachPadError) and exc.code not in ("error", "invalid_input"):
+        text = reason_text(exc.as_reason())
+        if text is not None:
+            return text
+    return str(exc)

@@ -138,6 +138,8 @@ def _issue(index: int, reach: Reach, what: str, point_id: int | None) -> PlanIss
     name = f"segment {index + 1}"
     if reach is Reach.JOINT_LIMIT:
         return PlanIssue(index, IssueKind.WARNING, IssueCode.JOINT_LIMIT,
-                         f"{name}: {what} passes a joint limit of the robot model", point_id)
+                         f"{name}: {what} passes a joint limit of the robot model", point_id,
+                         args={"point": what} if point_id is not None else {})
     return PlanIssue(index, IssueKind.WARNING, IssueCode.UNREACHABLE,
-                     f"{name}: {what} is out of the robot model's reach", point_id)
+                     f"{name}: {what} is out of the robot model's reach", point_id,
+                     args={"point": what} if point_id is not None else {})

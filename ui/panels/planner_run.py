@@ -22,7 +22,7 @@ from app.points.ledger import UploadReport
 from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
-from ui.messages import error_text
+from ui.messages import error_text, issue_text
 from ui.models.points_model import PointsModel
 
 MAX_POINTS_LISTED = 20  # point ids quoted in the upload question
@@ -90,12 +90,12 @@ class PlanRunFlow(QObject):
                             loops=1 if single else plan.loops, envelope=view.envelope,
                             reduced_speed=view.reduced_speed)
         summary = view.show_issues(issues, plan)
-        gate = run_gate(issues)
+        gate = run_gate(issues, issue_text)
         if gate.block is RunBlock.ERRORS and (first := gate.first_error) is not None:
             if first.segment is not None:
                 view.select_segments([first.segment])
             view.show_message(self.tr("Cannot run: {summary}. First: {message}").format(
-                summary=summary.split("\n")[0], message=first.message), "error")
+                summary=summary.split("\n")[0], message=issue_text(first)), "error")
             return False
         if gate.block is RunBlock.UPLOAD:
             needs = list(gate.uploads)
@@ -125,7 +125,7 @@ class PlanRunFlow(QObject):
         else:
             what = self.tr("Run plan '{name}'?").format(name=plan.name)
         text = what + "\n\n" + self.tr("The robot will move.")
-        warnings = run_gate(self._view.issues).warnings
+        warnings = run_gate(self._view.issues, issue_text).warnings
         if warnings:
             text += "\n\n" + self.tr("Warnings:") + "\n" + "\n".join(f"• {w}" for w in warnings)
         return text
