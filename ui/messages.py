@@ -19,7 +19,7 @@ from app.errors import Reason, TeachPadError
 from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult
 from app.plan.checks import IssueKind, PlanIssue
-from app.points.point import SYNC_STATE_TEXT, SyncState
+from app.points.point import SYNC_STATE_TEXT, FieldError, SyncState
 from app.protocol.enums import (
     RUN_COMMAND_TEXT,
     UNKNOWN_STATUS_TEXT,
@@ -87,6 +87,16 @@ _TEMPLATES: dict[str, str] = {
     "link_was_shut_down": QT_TRANSLATE_NOOP("Messages", "The link was shut down."),
     "outcome_unknown_link_lost": QT_TRANSLATE_NOOP("Messages", "{operation}: the connection was lost while it was under way; its outcome is unknown."),  # noqa: E501
     "outcome_unknown_link_closed": QT_TRANSLATE_NOOP("Messages", "{operation}: the connection was closed while it was under way."),  # noqa: E501
+    # the point ledger's refusals (app/points/ledger.py): parts of a sentence ("P3, ID: refused, ...")
+    "points_outside_range": QT_TRANSLATE_NOOP("Messages", "points outside {id_min}..{id_max}: {ids}"),
+    "no_such_point": QT_TRANSLATE_NOOP("Messages", "there is no point P{id}"),
+    "no_free_point_id": QT_TRANSLATE_NOOP("Messages", "no free point id left in {start}..{id_max}"),
+    "no_such_row": QT_TRANSLATE_NOOP("Messages", "there is no row {row}"),
+    "cannot_move_row": QT_TRANSLATE_NOOP("Messages", "cannot move row {src} to {dst} in {rows} rows"),
+    "duplicate_row_id": QT_TRANSLATE_NOOP("Messages", "row {row}: id {id} is already used on row {other}"),
+    "import_duplicate_id": QT_TRANSLATE_NOOP("Messages", "imported point {number}: id {id} appears twice"),
+    "point_id_taken": QT_TRANSLATE_NOOP("Messages", "id {id} is already used by {point}"),
+    "empty_import": QT_TRANSLATE_NOOP("Messages", "the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)"),  # noqa: E501
 }
 
 # A reason whose arguments lack a placeholder of the full sentence uses this one.
@@ -436,9 +446,10 @@ def issue_line(issue: PlanIssue) -> str:
 
 def refusal_text(exc: BaseException) -> str:
     """Why the core refused an edit or a file, in the operator's language when the error
-    carries a specific code this module words; else its English text."""
+    carries a specific code this module words; else its English text (a field's own reason
+    for a :class:`~app.points.point.FieldError`)."""
     if isinstance(exc, TeachPadError) and exc.code not in ("error", "invalid_input"):
         text = reason_text(exc.as_reason())
         if text is not None:
             return text
-    return str(exc)
+    return exc.reason if isinstance(exc, FieldError) else str(exc)

@@ -22,6 +22,7 @@ import enum
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
 from app.errors import InvalidInput
 from app.models import Pose
@@ -94,8 +95,9 @@ class FileFormatError(InvalidInput):
 class FieldError(InvalidInput):
     """One field's value refused; ``field`` names it, ``reason`` says why."""
 
-    def __init__(self, field_name: str, reason: str) -> None:
-        super().__init__(f"{field_name}: {reason}")
+    def __init__(self, field_name: str, reason: str, *, code: str | None = None,
+                 params: Mapping[str, Any] | None = None) -> None:
+        super().__init__(f"{field_name}: {reason}", code=code, params=params)
         self.field = field_name
         self.reason = reason
 

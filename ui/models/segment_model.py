@@ -36,7 +36,7 @@ from app.plan.segments import (
 )
 from app.points.ledger import FieldError, PointLedger, parse_point_id
 from app.protocol.registers import TOOL_NONE
-from ui.messages import issue_line
+from ui.messages import issue_line, refusal_text
 from ui.models.plan_columns import (
     COL_END,
     COL_IGNORE,
@@ -339,7 +339,7 @@ class SegmentTableModel(UndoableListModel):
         try:
             return self.edit_field(row, name, value)
         except InvalidInput as exc:
-            reason = exc.reason if isinstance(exc, FieldError) else str(exc)
+            reason = refusal_text(exc)
             self.editRejected.emit(self.tr("Segment {n}, {column}: refused, {reason}").format(
                 n=row + 1, column=self._headers[column], reason=reason))
             return False

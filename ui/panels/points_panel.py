@@ -43,6 +43,7 @@ from ui.controllers.point_sync import (
 )
 from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
+from ui.messages import refusal_text
 from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COLUMNS, EXT_COLUMNS
 from ui.models.points_model import PointFilterProxy, PointsModel
 from ui.touch import MOTION_MIN_HEIGHT, mark_motion
@@ -378,7 +379,7 @@ class PointsPanel(QWidget):
         try:
             row = self._model.add_point(at, pose=start.pose, tool=start.tool)
         except InvalidInput as exc:
-            self.show_message(str(exc), LEVEL_ERROR)
+            self.show_message(refusal_text(exc), LEVEL_ERROR)
             return
         self._clear_filter_for(row)
         self.select_rows([row])
@@ -397,7 +398,7 @@ class PointsPanel(QWidget):
         try:
             rows = self._model.duplicate_rows(self.selected_rows())
         except InvalidInput as exc:
-            self.show_message(str(exc), LEVEL_ERROR)
+            self.show_message(refusal_text(exc), LEVEL_ERROR)
             return
         self.select_rows(rows)
 
