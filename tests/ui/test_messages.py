@@ -8,7 +8,7 @@ remain: only units, register names, numbers, "Modbus", host:port and the like.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -279,7 +279,8 @@ def _plan_issues() -> list[Any]:
     from app.plan.segments import Plan, Segment, SegmentKind
     from app.points.ledger import PointLedger, SyncState, make_point
     from app.safety.envelope import EnvelopeRefused
-    from app.view3d.reach import Reach, _issue
+    from app.view3d.kinematics import Reach
+    from app.view3d.reach import _issue
 
     on = SyncState.ON_CONTROLLER
     ledger = PointLedger([
@@ -359,7 +360,7 @@ def test_the_ledgers_refusals_read_in_chinese(zh: None) -> None:
 
     ledger = PointLedger([make_point(1, "一", (0, 0, 0, 0, 0, 0)), make_point(2, "二", (1, 0, 0, 0, 0, 0))])
     point = make_point(2, "二", (1, 0, 0, 0, 0, 0))
-    attempts = [
+    attempts: list[Callable[[], object]] = [
         lambda: ledger.point(99),
         lambda: ledger.set_sync(99, ledger[0].sync),
         lambda: ledger.remove_rows([7]),

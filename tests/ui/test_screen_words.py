@@ -64,7 +64,9 @@ def test_the_event_log_speaks_the_new_language_after_a_switch(qtbot: Any, sim: A
     english = [_cell(log, row, COL_MESSAGE) for row in range(log.model.rowCount())]
     assert any("connected" in text for text in english) and "Alarm raised: emergency stop" in english
     assert translator.set_language("zh_CN")
-    messages = lambda: [_cell(log, r, COL_MESSAGE) for r in range(log.model.rowCount())]  # noqa: E731
+    def messages() -> list[str]:
+        return [_cell(log, r, COL_MESSAGE) for r in range(log.model.rowCount())]
+
     qtbot.waitUntil(lambda: "报警触发：急停" in messages(), timeout=SIGNAL_TIMEOUT_MS)
     rows = range(log.model.rowCount())
     for row in rows[:-1]:
