@@ -30,7 +30,7 @@ from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport
 from app.protocol.registers import TOOL_NONE
 from ui.controllers.new_point import NewPointPose, new_point_pose
-from ui.messages import connection_text, error_text, result_text
+from ui.messages import connection_text, error_text, refusal_text, result_text
 from ui.models.point_columns import sync_text
 from ui.models.points_model import PointsModel
 
@@ -161,7 +161,7 @@ class PointSyncController(QObject):
         try:
             point_id = self._model.next_id()
         except InvalidInput as exc:
-            self._say(str(exc), LEVEL_ERROR)
+            self._say(refusal_text(exc), LEVEL_ERROR)
             return None
         self._teach_id = point_id
         self._teach_name = name
@@ -371,7 +371,7 @@ class PointSyncController(QObject):
         try:
             self._model.add_taught_point(point_id, pose, name=self._teach_name, tool=self.teach_tool)
         except InvalidInput as exc:
-            self._say(self.tr("Teach P{id}: {reason}").format(id=point_id, reason=str(exc)), LEVEL_ERROR)
+            self._say(self.tr("Teach P{id}: {reason}").format(id=point_id, reason=refusal_text(exc)), LEVEL_ERROR)
             return
         if result.unconfirmed:  # created without an error, but not proven: not "on controller"
             self._model.set_sync(point_id, SyncState.UNCONFIRMED)

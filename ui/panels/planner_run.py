@@ -22,7 +22,7 @@ from app.points.ledger import UploadReport
 from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
-from ui.messages import error_text, issue_text
+from ui.messages import error_text, issue_text, refusal_text
 from ui.models.points_model import PointsModel
 
 MAX_POINTS_LISTED = 20  # point ids quoted in the upload question
@@ -148,8 +148,8 @@ class PlanRunFlow(QObject):
                 self.run_plan = plan
                 self._run_revision = plan.revision
                 self._runner.start(plan, start=start, start_loop=loop, single=single)
-        except InvalidInput as exc:  # a bad start segment: its own English words are the detail
-            self._view.show_message(str(exc), "error")
+        except InvalidInput as exc:  # a bad start segment
+            self._view.show_message(refusal_text(exc), "error")
             return False
         except TeachPadError as exc:  # no link, monitor-only...: in the operator's language
             self._view.show_message(error_text(exc), "error")
