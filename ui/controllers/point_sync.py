@@ -371,7 +371,8 @@ class PointSyncController(QObject):
         try:
             self._model.add_taught_point(point_id, pose, name=self._teach_name, tool=self.teach_tool)
         except InvalidInput as exc:
-            self._say(self.tr("Teach P{id}: {reason}").format(id=point_id, reason=refusal_text(exc)), LEVEL_ERROR)
+            why = refusal_text(exc)
+            self._say(self.tr("Teach P{id}: {reason}").format(id=point_id, reason=why), LEVEL_ERROR)
             return
         if result.unconfirmed:  # created without an error, but not proven: not "on controller"
             self._model.set_sync(point_id, SyncState.UNCONFIRMED)
