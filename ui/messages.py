@@ -19,7 +19,7 @@ from app.errors import Reason, TeachPadError
 from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult
 from app.plan.checks import IssueKind, PlanIssue
-from app.points.point import SYNC_STATE_TEXT, FieldError, SyncState
+from app.points.point import SYNC_STATE_TEXT, FieldError, FileFormatError, SyncState
 from app.protocol.enums import (
     RUN_COMMAND_TEXT,
     UNKNOWN_STATUS_TEXT,
@@ -97,6 +97,27 @@ _TEMPLATES: dict[str, str] = {
     "import_duplicate_id": QT_TRANSLATE_NOOP("Messages", "imported point {number}: id {id} appears twice"),
     "point_id_taken": QT_TRANSLATE_NOOP("Messages", "id {id} is already used by {point}"),
     "empty_import": QT_TRANSLATE_NOOP("Messages", "the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)"),  # noqa: E501
+    # a point's field refused (app/points/point.py), in a cell edit or a file
+    "not_a_number": QT_TRANSLATE_NOOP("Messages", "{value} is not a number"),
+    "too_large": QT_TRANSLATE_NOOP("Messages", "{value} is too large"),
+    "value_empty": QT_TRANSLATE_NOOP("Messages", "the value is empty"),
+    "not_finite": QT_TRANSLATE_NOOP("Messages", "{value} is not a finite number"),
+    "not_integer": QT_TRANSLATE_NOOP("Messages", "{value} is not an integer"),
+    "id_out_of_range": QT_TRANSLATE_NOOP("Messages", "id {value} is outside {id_min}..{id_max}"),
+    "bad_tool": QT_TRANSLATE_NOOP("Messages", "tool {value} is not 0..{max} or {none} (none)"),
+    "not_text": QT_TRANSLATE_NOOP("Messages", "the value is not text"),
+    "too_long": QT_TRANSLATE_NOOP("Messages", "the text is longer than {max} characters"),
+    "bad_character": QT_TRANSLATE_NOOP("Messages", "holds an invalid character (a lone surrogate, not Unicode text)"),  # noqa: E501
+    "not_one_line": QT_TRANSLATE_NOOP("Messages", "must be one line"),
+    "value_missing": QT_TRANSLATE_NOOP("Messages", "the value is missing"),
+    # a points CSV file refused (app/points/csv_io.py)
+    "not_utf8": QT_TRANSLATE_NOOP("Messages", "not UTF-8 text (bad byte at offset {offset}); save the file as UTF-8"),  # noqa: E501
+    "empty_file": QT_TRANSLATE_NOOP("Messages", "the file is empty (expected a header row)"),
+    "unknown_column": QT_TRANSLATE_NOOP("Messages", "unknown column {name} (expected: {expected})"),
+    "column_twice": QT_TRANSLATE_NOOP("Messages", "the column appears twice"),
+    "column_missing": QT_TRANSLATE_NOOP("Messages", "the column is missing from the header"),
+    "cell_count": QT_TRANSLATE_NOOP("Messages", "has {cells} cells, the header has {header} (truncated or extra cells?)"),  # noqa: E501
+    "row_id_taken": QT_TRANSLATE_NOOP("Messages", "id {id} is already used on row {other}"),
 }
 
 # A reason whose arguments lack a placeholder of the full sentence uses this one.
@@ -448,8 +469,34 @@ def refusal_text(exc: BaseException) -> str:
     """Why the core refused an edit or a file, in the operator's language when the error
     carries a specific code this module words; else its English text (a field's own reason
     for a :class:`~app.points.point.FieldError`)."""
+    if isinstance(exc, FileFormatError):
+        return _file_text(exc) or str(exc)
     if isinstance(exc, TeachPadError) and exc.code not in ("error", "invalid_input"):
         text = reason_text(exc.as_reason())
         if text is not None:
             return text
     return exc.reason if isinstance(exc, FieldError) else str(exc)
+
+
+_AT_ROW_COLUMN = QT_TRANSLATE_NOOP("Messages", "row {row}, column '{column}': {problem}")
+_AT_ROW = QT_TRANSLATE_NOOP("Messages", "row {row}: {problem}")
+_AT_COLUMN = QT_TRANSLATE_NOOP("Messages", "column '{column}': {problem}")
+_IN_FILE = QT_TRANSLATE_NOOP("Messages", "{file}: {text}")
+
+
+def _file_text(exc: FileFormatError) -> str | None:
+    """A refused file's problem with its row and column; None when the problem has no code this
+    module words (the English text is then shown whole, not half translated)."""
+    problem = reason_text(exc.problem) if exc.problem is not None else None
+    if problem is None or exc.where is not None:
+        return None
+    if exc.row is not None and exc.column is not None:
+        text = _tr(_AT_ROW_COLUMN).format(row=exc.row, column=exc.column, problem=problem)
+    elif exc.row is not None:
+        text = _tr(_AT_ROW).format(row=exc.row, problem=problem)
+    elif exc.column is not None:
+        text = _tr(_AT_COLUMN).format(column=exc.column, problem=problem)
+    else:
+        text = problem
+    file = exc.params.get("file")
+    return _tr(_IN_FILE).format(file=file, text=text) if file else text

@@ -1303,469 +1303,584 @@
             <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
         </message>
         <message>
+            <location filename="../../ui/messages.py" line="101" />
+            <source>{value} is not a number</source>
+            <translation>{value} 不是数字</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="102" />
+            <source>{value} is too large</source>
+            <translation>{value} 太大</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="103" />
+            <source>the value is empty</source>
+            <translation>值为空</translation>
+        </message>
+        <message>
             <location filename="../../ui/messages.py" line="104" />
+            <source>{value} is not a finite number</source>
+            <translation>{value} 不是有限的数</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="105" />
+            <source>{value} is not an integer</source>
+            <translation>{value} 不是整数</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="106" />
+            <source>id {value} is outside {id_min}..{id_max}</source>
+            <translation>编号 {value} 超出 {id_min}..{id_max}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="107" />
+            <source>tool {value} is not 0..{max} or {none} (none)</source>
+            <translation>工具 {value} 不在 0..{max} 范围内，也不是 {none}（无）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="108" />
+            <source>the value is not text</source>
+            <translation>值不是文本</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="109" />
+            <source>the text is longer than {max} characters</source>
+            <translation>文本超过 {max} 个字符</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="110" />
+            <source>holds an invalid character (a lone surrogate, not Unicode text)</source>
+            <translation>含有无效字符（孤立的代理项，不是 Unicode 文本）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="111" />
+            <source>must be one line</source>
+            <translation>必须为单行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="112" />
+            <source>the value is missing</source>
+            <translation>缺少该值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="114" />
+            <source>not UTF-8 text (bad byte at offset {offset}); save the file as UTF-8</source>
+            <translation>不是 UTF-8 文本（偏移 {offset} 处有无效字节）；请将文件另存为 UTF-8</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="115" />
+            <source>the file is empty (expected a header row)</source>
+            <translation>文件为空（应有表头行）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="116" />
+            <source>unknown column {name} (expected: {expected})</source>
+            <translation>未知列 {name}（应为：{expected}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="117" />
+            <source>the column appears twice</source>
+            <translation>该列出现了两次</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="118" />
+            <source>the column is missing from the header</source>
+            <translation>表头中缺少该列</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="119" />
+            <source>has {cells} cells, the header has {header} (truncated or extra cells?)</source>
+            <translation>有 {cells} 个单元格，表头有 {header} 个（被截断或有多余单元格？）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="120" />
+            <source>id {id} is already used on row {other}</source>
+            <translation>编号 {id} 已在第 {other} 行使用</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="125" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="105" />
+            <location filename="../../ui/messages.py" line="126" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="106" />
+            <location filename="../../ui/messages.py" line="127" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="107" />
+            <location filename="../../ui/messages.py" line="128" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="108" />
+            <location filename="../../ui/messages.py" line="129" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="109" />
+            <location filename="../../ui/messages.py" line="130" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="110" />
+            <location filename="../../ui/messages.py" line="131" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="111" />
+            <location filename="../../ui/messages.py" line="132" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="112" />
+            <location filename="../../ui/messages.py" line="133" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="113" />
+            <location filename="../../ui/messages.py" line="134" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="114" />
+            <location filename="../../ui/messages.py" line="135" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="115" />
+            <location filename="../../ui/messages.py" line="136" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="116" />
+            <location filename="../../ui/messages.py" line="137" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="117" />
+            <location filename="../../ui/messages.py" line="138" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="120" />
+            <location filename="../../ui/messages.py" line="141" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="121" />
+            <location filename="../../ui/messages.py" line="142" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="122" />
+            <location filename="../../ui/messages.py" line="143" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="123" />
+            <location filename="../../ui/messages.py" line="144" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="124" />
+            <location filename="../../ui/messages.py" line="145" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="127" />
+            <location filename="../../ui/messages.py" line="148" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="128" />
+            <location filename="../../ui/messages.py" line="149" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="129" />
+            <location filename="../../ui/messages.py" line="150" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="130" />
+            <location filename="../../ui/messages.py" line="151" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="131" />
+            <location filename="../../ui/messages.py" line="152" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="132" />
+            <location filename="../../ui/messages.py" line="153" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="133" />
+            <location filename="../../ui/messages.py" line="154" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="134" />
+            <location filename="../../ui/messages.py" line="155" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="135" />
+            <location filename="../../ui/messages.py" line="156" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="136" />
+            <location filename="../../ui/messages.py" line="157" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="137" />
+            <location filename="../../ui/messages.py" line="158" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="138" />
+            <location filename="../../ui/messages.py" line="159" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="139" />
+            <location filename="../../ui/messages.py" line="160" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="140" />
+            <location filename="../../ui/messages.py" line="161" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="141" />
+            <location filename="../../ui/messages.py" line="162" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="142" />
+            <location filename="../../ui/messages.py" line="163" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="143" />
+            <location filename="../../ui/messages.py" line="164" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="144" />
+            <location filename="../../ui/messages.py" line="165" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="145" />
+            <location filename="../../ui/messages.py" line="166" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="146" />
+            <location filename="../../ui/messages.py" line="167" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="148" />
+            <location filename="../../ui/messages.py" line="169" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="151" />
+            <location filename="../../ui/messages.py" line="172" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="152" />
+            <location filename="../../ui/messages.py" line="173" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="153" />
+            <location filename="../../ui/messages.py" line="174" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="154" />
+            <location filename="../../ui/messages.py" line="175" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="155" />
+            <location filename="../../ui/messages.py" line="176" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="156" />
+            <location filename="../../ui/messages.py" line="177" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="157" />
+            <location filename="../../ui/messages.py" line="178" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="158" />
+            <location filename="../../ui/messages.py" line="179" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="159" />
+            <location filename="../../ui/messages.py" line="180" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="160" />
+            <location filename="../../ui/messages.py" line="181" />
             <source>unit id</source>
             <translation>站号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="161" />
+            <location filename="../../ui/messages.py" line="182" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="165" />
+            <location filename="../../ui/messages.py" line="186" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="166" />
+            <location filename="../../ui/messages.py" line="187" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="167" />
+            <location filename="../../ui/messages.py" line="188" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="168" />
+            <location filename="../../ui/messages.py" line="189" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="169" />
+            <location filename="../../ui/messages.py" line="190" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="170" />
+            <location filename="../../ui/messages.py" line="191" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="171" />
+            <location filename="../../ui/messages.py" line="192" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="172" />
+            <location filename="../../ui/messages.py" line="193" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="173" />
+            <location filename="../../ui/messages.py" line="194" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="174" />
+            <location filename="../../ui/messages.py" line="195" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="176" />
+            <location filename="../../ui/messages.py" line="197" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="180" />
+            <location filename="../../ui/messages.py" line="201" />
             <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="181" />
+            <location filename="../../ui/messages.py" line="202" />
             <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
             <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="182" />
+            <location filename="../../ui/messages.py" line="203" />
             <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
             <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="183" />
+            <location filename="../../ui/messages.py" line="204" />
             <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
             <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="184" />
+            <location filename="../../ui/messages.py" line="205" />
             <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
             <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="185" />
+            <location filename="../../ui/messages.py" line="206" />
             <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
             <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="187" />
+            <location filename="../../ui/messages.py" line="208" />
             <source>Refused by the safety envelope: {text}</source>
             <translation>安全边界拒绝：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="188" />
+            <location filename="../../ui/messages.py" line="209" />
             <source>segment {n}: </source>
             <translation>第 {n} 段：</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="189" />
+            <location filename="../../ui/messages.py" line="210" />
             <source> (reduced-speed mode)</source>
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="362" />
+            <location filename="../../ui/messages.py" line="383" />
             <source>Plan “{plan}” has no segments.</source>
             <translation>规划“{plan}”没有任何段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="363" />
+            <location filename="../../ui/messages.py" line="384" />
             <source>Cannot start at segment {start}: the plan has {segments} segments.</source>
             <translation>无法从第 {start} 段开始：该规划只有 {segments} 段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="364" />
+            <location filename="../../ui/messages.py" line="385" />
             <source>speed {speed} mm/s is not in (0, {max}] mm/s.</source>
             <translation>速度 {speed} mm/s 不在 (0, {max}] mm/s 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="365" />
+            <location filename="../../ui/messages.py" line="386" />
             <source>the arc has no middle point.</source>
             <translation>圆弧没有中间点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="366" />
+            <location filename="../../ui/messages.py" line="387" />
             <source>middle point P{id} does not exist.</source>
             <translation>中间点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="367" />
+            <location filename="../../ui/messages.py" line="388" />
             <source>end point P{id} does not exist.</source>
             <translation>终点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="368" />
+            <location filename="../../ui/messages.py" line="389" />
             <source>{point} is not on the controller ({sync}); upload it.</source>
             <translation>{point} 不在控制器上（{sync}）；请上传。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="369" />
+            <location filename="../../ui/messages.py" line="390" />
             <source>{point} was taught with {point_tool}, the segment moves with {segment_tool}.</source>
             <translation>{point} 示教时的工具为“{point_tool}”，该段运动的工具为“{segment_tool}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="370" />
+            <location filename="../../ui/messages.py" line="391" />
             <source>the line goes nowhere (start and end {length} mm apart){where}.</source>
             <translation>直线没有移动（起点与终点相距 {length} mm）{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="371" />
+            <location filename="../../ui/messages.py" line="392" />
             <source>the arc starts at the robot's current pose, which is not known: its shape is not checked.</source>
             <translation>圆弧从机器人的当前位姿开始，但当前位姿未知：未检查其形状。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="372" />
+            <location filename="../../ui/messages.py" line="393" />
             <source>the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与中间点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="373" />
+            <location filename="../../ui/messages.py" line="394" />
             <source>the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的中间点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="374" />
+            <location filename="../../ui/messages.py" line="395" />
             <source>the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="375" />
+            <location filename="../../ui/messages.py" line="396" />
             <source>the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}.</source>
             <translation>圆弧的三个点（几乎）在一条直线上：中间点距起点—终点连线仅 {offset} mm（至少需要 {tolerance} mm）；请改用直线{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="376" />
+            <location filename="../../ui/messages.py" line="397" />
             <source>the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before.</source>
             <translation>机械臂停在圆弧中间点之后：从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；请用直线移动到终点，或从前一段开始运行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="377" />
+            <location filename="../../ui/messages.py" line="398" />
             <source>sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here.</source>
             <translation>从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；从此处运行前请检查预览。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="378" />
+            <location filename="../../ui/messages.py" line="399" />
             <source>{point} is out of the robot model's reach.</source>
             <translation>{point} 超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="379" />
+            <location filename="../../ui/messages.py" line="400" />
             <source>the path is out of the robot model's reach.</source>
             <translation>路径超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="380" />
+            <location filename="../../ui/messages.py" line="401" />
             <source>{point} passes a joint limit of the robot model.</source>
             <translation>{point} 会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="381" />
+            <location filename="../../ui/messages.py" line="402" />
             <source>the path passes a joint limit of the robot model.</source>
             <translation>路径会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="383" />
+            <location filename="../../ui/messages.py" line="404" />
             <source> (from the current pose)</source>
             <translation>（从当前位姿出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="384" />
+            <location filename="../../ui/messages.py" line="405" />
             <source> (on loops after the first, starting at the end of segment {after})</source>
             <translation>（第一轮之后的循环中，从第 {after} 段的终点出发）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="481" />
+            <source>row {row}, column '{column}': {problem}</source>
+            <translation>第 {row} 行，“{column}”列：{problem}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="483" />
+            <source>column '{column}': {problem}</source>
+            <translation>“{column}”列：{problem}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="482" />
+            <source>row {row}: {problem}</source>
+            <translation>第 {row} 行：{problem}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="484" />
+            <source>{file}: {text}</source>
+            <translation>{file}：{text}</translation>
         </message>
     </context>
     <context>
@@ -1978,7 +2093,7 @@
     <context>
         <name>PlanEdits</name>
         <message>
-            <location filename="../../ui/panels/planner_edit.py" line="87" />
+            <location filename="../../ui/panels/planner_edit.py" line="88" />
             <source>Deleted plan {name} (Ctrl+Z to undo)</source>
             <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
         </message>
@@ -2597,52 +2712,52 @@
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="374" />
+            <location filename="../../ui/controllers/point_sync.py" line="375" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="378" />
+            <location filename="../../ui/controllers/point_sync.py" line="379" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="387" />
+            <location filename="../../ui/controllers/point_sync.py" line="388" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="391" />
+            <location filename="../../ui/controllers/point_sync.py" line="392" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="395" />
+            <location filename="../../ui/controllers/point_sync.py" line="396" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="434" />
+            <location filename="../../ui/controllers/point_sync.py" line="435" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="437" />
+            <location filename="../../ui/controllers/point_sync.py" line="438" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="453" />
+            <location filename="../../ui/controllers/point_sync.py" line="454" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="457" />
+            <location filename="../../ui/controllers/point_sync.py" line="458" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="461" />
+            <location filename="../../ui/controllers/point_sync.py" line="462" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -2650,28 +2765,28 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/point.py" line="129" />
+            <location filename="../../app/points/point.py" line="139" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="130" />
+            <location filename="../../app/points/point.py" line="140" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="131" />
+            <location filename="../../app/points/point.py" line="141" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="132" />
+            <location filename="../../app/points/point.py" line="142" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="133" />
+            <location filename="../../app/points/point.py" line="143" />
             <source>on controller, unconfirmed</source>
             <translation>已在控制器上（未确认）</translation>
         </message>
@@ -2679,14 +2794,14 @@
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/messages.py" line="392" />
+            <location filename="../../ui/messages.py" line="413" />
             <location filename="../../ui/models/point_columns.py" line="66" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="393" />
+            <location filename="../../ui/messages.py" line="414" />
             <location filename="../../ui/models/point_columns.py" line="67" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
@@ -3202,153 +3317,153 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="128" />
+            <location filename="../../ui/controllers/project_controller.py" line="129" />
             <source>Undo</source>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="130" />
+            <location filename="../../ui/controllers/project_controller.py" line="131" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="134" />
+            <location filename="../../ui/controllers/project_controller.py" line="135" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="135" />
+            <location filename="../../ui/controllers/project_controller.py" line="136" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="136" />
+            <location filename="../../ui/controllers/project_controller.py" line="137" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="137" />
+            <location filename="../../ui/controllers/project_controller.py" line="138" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="138" />
+            <location filename="../../ui/controllers/project_controller.py" line="139" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="139" />
+            <location filename="../../ui/controllers/project_controller.py" line="140" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="162" />
+            <location filename="../../ui/controllers/project_controller.py" line="163" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="195" />
+            <location filename="../../ui/controllers/project_controller.py" line="196" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="203" />
-            <location filename="../../ui/controllers/project_controller.py" line="239" />
-            <location filename="../../ui/controllers/project_controller.py" line="348" />
+            <location filename="../../ui/controllers/project_controller.py" line="204" />
+            <location filename="../../ui/controllers/project_controller.py" line="240" />
+            <location filename="../../ui/controllers/project_controller.py" line="349" />
             <source>Project in use</source>
             <translation>工程正在使用中</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="208" />
-            <location filename="../../ui/controllers/project_controller.py" line="211" />
+            <location filename="../../ui/controllers/project_controller.py" line="209" />
+            <location filename="../../ui/controllers/project_controller.py" line="212" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="214" />
+            <location filename="../../ui/controllers/project_controller.py" line="215" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="226" />
+            <location filename="../../ui/controllers/project_controller.py" line="227" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="244" />
+            <location filename="../../ui/controllers/project_controller.py" line="245" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="256" />
+            <location filename="../../ui/controllers/project_controller.py" line="257" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="262" />
+            <location filename="../../ui/controllers/project_controller.py" line="263" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="269" />
-            <location filename="../../ui/controllers/project_controller.py" line="272" />
-            <location filename="../../ui/controllers/project_controller.py" line="286" />
+            <location filename="../../ui/controllers/project_controller.py" line="270" />
+            <location filename="../../ui/controllers/project_controller.py" line="273" />
+            <location filename="../../ui/controllers/project_controller.py" line="287" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="288" />
+            <location filename="../../ui/controllers/project_controller.py" line="289" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="294" />
+            <location filename="../../ui/controllers/project_controller.py" line="295" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="301" />
+            <location filename="../../ui/controllers/project_controller.py" line="302" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="303" />
+            <location filename="../../ui/controllers/project_controller.py" line="304" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="329" />
+            <location filename="../../ui/controllers/project_controller.py" line="330" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="364" />
-            <location filename="../../ui/controllers/project_controller.py" line="367" />
+            <location filename="../../ui/controllers/project_controller.py" line="365" />
+            <location filename="../../ui/controllers/project_controller.py" line="368" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="370" />
+            <location filename="../../ui/controllers/project_controller.py" line="371" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="401" />
+            <location filename="../../ui/controllers/project_controller.py" line="402" />
             <source>Cannot lock {path}: {reason}</source>
             <translation>无法锁定 {path}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="410" />
+            <location filename="../../ui/controllers/project_controller.py" line="411" />
             <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
             <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="446" />
+            <location filename="../../ui/controllers/project_controller.py" line="447" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="449" />
+            <location filename="../../ui/controllers/project_controller.py" line="450" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>

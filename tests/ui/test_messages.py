@@ -47,9 +47,9 @@ from ui.messages import LEVEL_ERROR, LEVEL_INFO, LEVEL_WARNING, error_text, resu
 
 QM = Path(__file__).resolve().parents[2] / "ui" / "i18n" / "teachpad_zh_CN.qm"
 ENDPOINT = "192.168.1.10:502"
-# what may stay ASCII in a Chinese sentence: units, register and protocol names, numbers, addresses
-ALLOWED = re.compile(r"\d+(\.\d+)+:\d+|Modbus|TCP|RTU|CRC|GV\d+|COM\d+|mm/s|mm|\bs\b|\b[XYZABC]\b|"
-                     r"\bJ\d+\b|\bP\d+\b|0x[0-9A-Fa-f]+")
+# what may stay ASCII in a Chinese sentence: units, register, protocol and format names, numbers, addresses
+ALLOWED = re.compile(r"\d+(\.\d+)+:\d+|Modbus|TCP|RTU|CRC|UTF-8|Unicode|CSV|JSON|GV\d+|COM\d+|mm/s|mm|"
+                     r"\bs\b|\b[XYZABC]\b|\bJ\d+\b|\bP\d+\b|0x[0-9A-Fa-f]+")
 
 
 @pytest.fixture
@@ -385,3 +385,63 @@ def test_the_ledgers_refusals_read_in_chinese(zh: None) -> None:
                      "point_id_taken"}
     assert isinstance(EmptyImport(3), InvalidInput)
     assert refusal_text(InvalidInput("speed must be positive")) == "speed must be positive"  # no code: as is
+
+
+def _without_quoted(text: str) -> str:
+    """A refusal without the operator's own quoted input and the column names it quotes."""
+    return re.sub(r"'[^']*'|“[^”]*”", "", text)
+
+
+def test_a_points_fields_and_files_refusals_read_in_chinese(zh: None) -> None:
+    from app.points.csv_io import decode_text, parse_points_csv
+    from app.points.point import FieldError, FileFormatError, make_point
+    from ui.messages import refusal_text
+
+    fields: list[Callable[[], object]] = [
+        lambda: make_point(1, "一", ("abc", 0, 0, 0, 0, 0)),
+        lambda: make_point(1, "一", ("", 0, 0, 0, 0, 0)),
+        lambda: make_point(1, "一", ("1e999", 0, 0, 0, 0, 0)),
+        lambda: make_point(1, "一", ("inf", 0, 0, 0, 0, 0)),
+        lambda: make_point("1.5", "一"),
+        lambda: make_point(100000, "一"),
+        lambda: make_point(1, "一", tool=500),
+        lambda: make_point(1, 5),
+        lambda: make_point(1, "一" * 300),
+        lambda: make_point(1, "一\n二"),
+    ]
+    codes = set()
+    for attempt in fields:
+        with pytest.raises(FieldError) as caught:
+            attempt()
+        codes.add(caught.value.code)
+        assert_chinese(_without_quoted(refusal_text(caught.value)))
+    assert codes >= {"not_a_number", "value_empty", "too_large", "not_finite", "not_integer",
+                     "id_out_of_range", "bad_tool", "not_text", "too_long", "not_one_line"}
+    header = "id,name,x,y,z,a,b,c"
+    files = [
+        "",
+        "id,名字\n",
+        "id,id,x\n",
+        "id,name,x,y\n",
+        f"{header}\n1,一,0,0\n",
+        f"{header}\n1,一,abc,0,0,0,0,0\n",
+        f"{header}\n1,一,0,0,0,0,0,0\n1,二,0,0,0,0,0,0\n",
+    ]
+    problems = set()
+    for text in files:
+        with pytest.raises(FileFormatError) as refused:
+            parse_points_csv(text, path="/data/点位.csv")
+        assert refused.value.problem is not None, str(refused.value)
+        problems.add(refused.value.problem.code)
+        shown = refusal_text(refused.value)
+        assert shown.startswith("点位.csv：") and "/data" not in shown
+        columns = "id,name,x,y,z,a,b,c,e1,e2,e3,e4,e5,tool,note"
+        assert_chinese(_without_quoted(shown).replace(columns, "").replace("点位.csv", "点位"))
+    assert problems == {"empty_file", "unknown_column", "column_twice", "column_missing", "cell_count",
+                        "not_a_number", "row_id_taken"}
+    with pytest.raises(FileFormatError) as bad_bytes:
+        decode_text(b"\xff\xfe1", path="p.csv")
+    assert_chinese(refusal_text(bad_bytes.value).replace("p.csv", ""))
+    # a problem without a code is shown whole in English, never half translated
+    bare = FileFormatError("expected a JSON object at the top level", path="a.teachpad.json")
+    assert refusal_text(bare) == str(bare)
