@@ -16,8 +16,10 @@ from typing import Any
 from PySide6.QtCore import QCoreApplication
 
 from app.errors import Reason, TeachPadError
-from app.link.types import WorkerError
+from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult
+from app.plan.checks import IssueKind, PlanIssue
+from app.points.point import SYNC_STATE_TEXT, FieldError, FileFormatError, SyncState
 from app.protocol.enums import (
     RUN_COMMAND_TEXT,
     UNKNOWN_STATUS_TEXT,
@@ -27,9 +29,11 @@ from app.protocol.enums import (
     alarm_names,
     controller_mode_text,
 )
+from app.protocol.registers import TOOL_NONE
 
-__all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "error_text", "operation_text", "reason_text",
-           "result_level", "result_text", "status_text"]
+__all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "connection_text", "error_text", "issue_line",
+           "issue_text", "operation_text", "reason_text", "refusal_text", "result_level", "result_text",
+           "status_text"]
 
 CONTEXT = "Messages"
 LEVEL_INFO = "info"
@@ -84,6 +88,41 @@ _TEMPLATES: dict[str, str] = {
     "point_not_created": QT_TRANSLATE_NOOP("Messages", "The controller did not create {point} again before the move: the arm was not moved."),  # noqa: E501
     "point_missing": QT_TRANSLATE_NOOP("Messages", "The project has no point {point}: the arm was not moved."),  # noqa: E501
     "arrival_unknown": QT_TRANSLATE_NOOP("Messages", "The arm's position after the move to {point} is not known: the run is stopped."),  # noqa: E501
+    # the link's own state and the commands it cut short (app/link/supervisor.py)
+    "link_was_shut_down": QT_TRANSLATE_NOOP("Messages", "The link was shut down."),
+    "outcome_unknown_link_lost": QT_TRANSLATE_NOOP("Messages", "{operation}: the connection was lost while it was under way; its outcome is unknown."),  # noqa: E501
+    "outcome_unknown_link_closed": QT_TRANSLATE_NOOP("Messages", "{operation}: the connection was closed while it was under way."),  # noqa: E501
+    # the point ledger's refusals (app/points/ledger.py): parts of a sentence ("P3, ID: refused, ...")
+    "points_outside_range": QT_TRANSLATE_NOOP("Messages", "points outside {id_min}..{id_max}: {ids}"),
+    "no_such_point": QT_TRANSLATE_NOOP("Messages", "there is no point P{id}"),
+    "no_free_point_id": QT_TRANSLATE_NOOP("Messages", "no free point id left in {start}..{id_max}"),
+    "no_such_row": QT_TRANSLATE_NOOP("Messages", "there is no row {row}"),
+    "cannot_move_row": QT_TRANSLATE_NOOP("Messages", "cannot move row {src} to {dst} in {rows} rows"),
+    "duplicate_row_id": QT_TRANSLATE_NOOP("Messages", "row {row}: id {id} is already used on row {other}"),
+    "import_duplicate_id": QT_TRANSLATE_NOOP("Messages", "imported point {number}: id {id} appears twice"),
+    "point_id_taken": QT_TRANSLATE_NOOP("Messages", "id {id} is already used by {point}"),
+    "empty_import": QT_TRANSLATE_NOOP("Messages", "the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)"),  # noqa: E501
+    # a point's field refused (app/points/point.py), in a cell edit or a file
+    "not_a_number": QT_TRANSLATE_NOOP("Messages", "{value} is not a number"),
+    "too_large": QT_TRANSLATE_NOOP("Messages", "{value} is too large"),
+    "value_empty": QT_TRANSLATE_NOOP("Messages", "the value is empty"),
+    "not_finite": QT_TRANSLATE_NOOP("Messages", "{value} is not a finite number"),
+    "not_integer": QT_TRANSLATE_NOOP("Messages", "{value} is not an integer"),
+    "id_out_of_range": QT_TRANSLATE_NOOP("Messages", "id {value} is outside {id_min}..{id_max}"),
+    "bad_tool": QT_TRANSLATE_NOOP("Messages", "tool {value} is not 0..{max} or {none} (none)"),
+    "not_text": QT_TRANSLATE_NOOP("Messages", "the value is not text"),
+    "too_long": QT_TRANSLATE_NOOP("Messages", "the text is longer than {max} characters"),
+    "bad_character": QT_TRANSLATE_NOOP("Messages", "holds an invalid character (a lone surrogate, not Unicode text)"),  # noqa: E501
+    "not_one_line": QT_TRANSLATE_NOOP("Messages", "must be one line"),
+    "value_missing": QT_TRANSLATE_NOOP("Messages", "the value is missing"),
+    # a points CSV file refused (app/points/csv_io.py)
+    "not_utf8": QT_TRANSLATE_NOOP("Messages", "not UTF-8 text (bad byte at offset {offset}); save the file as UTF-8"),  # noqa: E501
+    "empty_file": QT_TRANSLATE_NOOP("Messages", "the file is empty (expected a header row)"),
+    "unknown_column": QT_TRANSLATE_NOOP("Messages", "unknown column {name} (expected: {expected})"),
+    "column_twice": QT_TRANSLATE_NOOP("Messages", "the column appears twice"),
+    "column_missing": QT_TRANSLATE_NOOP("Messages", "the column is missing from the header"),
+    "cell_count": QT_TRANSLATE_NOOP("Messages", "has {cells} cells, the header has {header} (truncated or extra cells?)"),  # noqa: E501
+    "row_id_taken": QT_TRANSLATE_NOOP("Messages", "id {id} is already used on row {other}"),
 }
 
 # A reason whose arguments lack a placeholder of the full sentence uses this one.
@@ -225,7 +264,7 @@ def _alarms(mask: int) -> str:
                     for name in alarm_names(mask))
 
 
-def _envelope(args: Mapping[str, Any]) -> str:
+def _envelope(args: Mapping[str, Any], prefix: bool = True) -> str:
     code = "approaching" if args.get("approaching") else str(args.get("violation", ""))
     template = _ENVELOPE.get(code)
     if template is None:
@@ -239,7 +278,7 @@ def _envelope(args: Mapping[str, Any]) -> str:
     if args.get("reduced"):
         end = text[-1] if text[-1:] in ("。", ".") else ""
         text = text[: len(text) - len(end)] + _tr(_REDUCED) + end
-    return _tr(_ENVELOPE_PREFIX).format(text=text)
+    return _tr(_ENVELOPE_PREFIX).format(text=text) if prefix else text
 
 
 def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
@@ -340,3 +379,133 @@ def error_text(error: WorkerError | TeachPadError | Reason) -> str:
 # (LinkState.NOT_ANSWERING, ui/controllers/plan_run_controller.py): not a lost link.
 _TEMPLATES["run_not_answering"] = QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.")  # noqa: E501
 _BARE["run_not_answering"] = QT_TRANSLATE_NOOP("Messages", "The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.")  # noqa: E501
+def connection_text(connection: ConnectionState) -> str:
+    """Why the link is in its state, as one sentence ("" when there is nothing to say); the
+    English message only from a producer that gives no reason."""
+    if connection.reason is not None:
+        return reason_text(connection.reason) or ""
+    return connection.message
+
+
+# --- the plan's checks (app/plan/checks.py: IssueCode values and their args) -------------------
+_ISSUES: dict[str, str] = {
+    "empty-plan": QT_TRANSLATE_NOOP("Messages", "Plan \u201c{plan}\u201d has no segments."),
+    "bad-start": QT_TRANSLATE_NOOP("Messages", "Cannot start at segment {start}: the plan has {segments} segments."),  # noqa: E501
+    "bad-speed": QT_TRANSLATE_NOOP("Messages", "speed {speed} mm/s is not in (0, {max}] mm/s."),
+    "arc-no-middle": QT_TRANSLATE_NOOP("Messages", "the arc has no middle point."),
+    "missing-point/middle": QT_TRANSLATE_NOOP("Messages", "middle point P{id} does not exist."),
+    "missing-point/end": QT_TRANSLATE_NOOP("Messages", "end point P{id} does not exist."),
+    "needs-upload": QT_TRANSLATE_NOOP("Messages", "{point} is not on the controller ({sync}); upload it."),
+    "tool-mismatch": QT_TRANSLATE_NOOP("Messages", "{point} was taught with {point_tool}, the segment moves with {segment_tool}."),  # noqa: E501
+    "zero-length": QT_TRANSLATE_NOOP("Messages", "the line goes nowhere (start and end {length} mm apart){where}."),  # noqa: E501
+    "arc-start-unknown": QT_TRANSLATE_NOOP("Messages", "the arc starts at the robot's current pose, which is not known: its shape is not checked."),  # noqa: E501
+    "arc-points-coincide/start-middle": QT_TRANSLATE_NOOP("Messages", "the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
+    "arc-points-coincide/middle-end": QT_TRANSLATE_NOOP("Messages", "the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
+    "arc-points-coincide/start-end": QT_TRANSLATE_NOOP("Messages", "the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
+    "arc-collinear": QT_TRANSLATE_NOOP("Messages", "the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}."),  # noqa: E501
+    "arc-resume-past-middle/past": QT_TRANSLATE_NOOP("Messages", "the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before."),  # noqa: E501
+    "arc-resume-past-middle/larger": QT_TRANSLATE_NOOP("Messages", "sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here."),  # noqa: E501
+    "unreachable/point": QT_TRANSLATE_NOOP("Messages", "{point} is out of the robot model's reach."),
+    "unreachable/path": QT_TRANSLATE_NOOP("Messages", "the path is out of the robot model's reach."),
+    "joint-limit/point": QT_TRANSLATE_NOOP("Messages", "{point} passes a joint limit of the robot model."),
+    "joint-limit/path": QT_TRANSLATE_NOOP("Messages", "the path passes a joint limit of the robot model."),
+}
+_FROM_CURRENT_POSE = QT_TRANSLATE_NOOP("Messages", " (from the current pose)")
+_FROM_LATER_LOOPS = QT_TRANSLATE_NOOP("Messages", " (on loops after the first, starting at the end of segment {after})")  # noqa: E501
+_ISSUE_KINDS = {IssueKind.ERROR: "error", IssueKind.NEEDS_UPLOAD: "needs upload",
+                IssueKind.WARNING: "warning"}  # the "SegmentTableModel" translations
+
+
+def _tool(tool: Any) -> str:
+    """A tool frame as the points table shows it (translations of "PointsModel")."""
+    if int(tool) == TOOL_NONE:
+        return QCoreApplication.translate("PointsModel", "none")
+    return QCoreApplication.translate("PointsModel", "tool {n}").format(n=int(tool) + 1)
+
+
+def _issue_key(issue: PlanIssue) -> str:
+    code, args = issue.code.value, issue.args
+    if code == "missing-point":
+        return f"{code}/{args.get('role')}"
+    if code == "arc-points-coincide":
+        return f"{code}/{args.get('pair')}"
+    if code == "arc-resume-past-middle":
+        return f"{code}/{'past' if args.get('past_middle') else 'larger'}"
+    if code in ("unreachable", "joint-limit"):
+        return f"{code}/{'point' if args.get('point') else 'path'}"
+    return code
+
+
+def issue_text(issue: PlanIssue) -> str:
+    """One check of a plan as a sentence in the operator's language ("segment 2: ..."); the
+    issue's English message when it carries no arguments this module knows."""
+    args = issue.args
+    if issue.code.value == "outside-envelope" and args:
+        return _envelope(args, prefix=False)
+    template = _ISSUES.get(_issue_key(issue))
+    if template is None:
+        return issue.message
+    fields: dict[str, str] = {k: _number(v) if isinstance(v, int | float) and not isinstance(v, bool)
+                              else str(v) for k, v in args.items()}
+    source = args.get("from")
+    fields["where"] = (_tr(_FROM_CURRENT_POSE) if source == "current_pose"
+                       else _tr(_FROM_LATER_LOOPS).format(after=args.get("after", "?"))
+                       if source == "later_loops" else "")
+    if "sync" in args:
+        try:
+            fields["sync"] = _tr(SYNC_STATE_TEXT[SyncState(args["sync"])], "Points")
+        except (ValueError, KeyError):
+            fields["sync"] = str(args["sync"])
+    for key in ("point_tool", "segment_tool"):
+        if key in args:
+            fields[key] = _tool(args[key])
+    try:
+        text = _tr(template).format(**fields)
+    except (KeyError, ValueError):
+        return issue.message
+    if issue.segment is None:
+        return text
+    return _tr(_SEGMENT).format(n=issue.segment + 1) + text
+
+
+def issue_line(issue: PlanIssue) -> str:
+    """An issue with its kind ("error: segment 2: ..."), for lists and tooltips."""
+    kind = QCoreApplication.translate("SegmentTableModel", _ISSUE_KINDS[issue.kind])
+    return f"{kind}: {issue_text(issue)}"
+
+
+def refusal_text(exc: BaseException) -> str:
+    """Why the core refused an edit or a file, in the operator's language when the error
+    carries a specific code this module words; else its English text (a field's own reason
+    for a :class:`~app.points.point.FieldError`)."""
+    if isinstance(exc, FileFormatError):
+        return _file_text(exc) or str(exc)
+    if isinstance(exc, TeachPadError) and exc.code not in ("error", "invalid_input"):
+        text = reason_text(exc.as_reason())
+        if text is not None:
+            return text
+    return exc.reason if isinstance(exc, FieldError) else str(exc)
+
+
+_AT_ROW_COLUMN = QT_TRANSLATE_NOOP("Messages", "row {row}, column '{column}': {problem}")
+_AT_ROW = QT_TRANSLATE_NOOP("Messages", "row {row}: {problem}")
+_AT_COLUMN = QT_TRANSLATE_NOOP("Messages", "column '{column}': {problem}")
+_IN_FILE = QT_TRANSLATE_NOOP("Messages", "{file}: {text}")
+
+
+def _file_text(exc: FileFormatError) -> str | None:
+    """A refused file's problem with its row and column; None when the problem has no code this
+    module words (the English text is then shown whole, not half translated)."""
+    problem = reason_text(exc.problem) if exc.problem is not None else None
+    if problem is None or exc.where is not None:
+        return None
+    if exc.row is not None and exc.column is not None:
+        text = _tr(_AT_ROW_COLUMN).format(row=exc.row, column=exc.column, problem=problem)
+    elif exc.row is not None:
+        text = _tr(_AT_ROW).format(row=exc.row, problem=problem)
+    elif exc.column is not None:
+        text = _tr(_AT_COLUMN).format(column=exc.column, problem=problem)
+    else:
+        text = problem
+    file = exc.params.get("file")
+    return _tr(_IN_FILE).format(file=file, text=text) if file else text

@@ -13,6 +13,7 @@ from PySide6.QtWidgets import QLabel, QStatusBar
 
 from app.link.state import RobotState
 from app.link.types import ConnectionState
+from ui.messages import connection_text
 from ui.widgets_common import connection_display
 
 __all__ = ["MESSAGE_MS", "WindowStatusBar"]
@@ -75,7 +76,7 @@ class WindowStatusBar(QObject):
         connection = self._state.connection
         text, _level = connection_display(connection)
         self.link_label.setText(text)
-        self.link_label.setToolTip(connection.message)
+        self.link_label.setToolTip(connection_text(connection))
         monitor_only = QCoreApplication.translate("MainWindow", "MONITOR ONLY")
         self.monitor_only_label.setText(monitor_only if connection.monitor_only else "")
 

@@ -108,7 +108,7 @@ class Poller:
                 canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock
         except ResponseTimeout as exc:
             self._report_error(exc)
-            host.supervisor.poll_silent(str(exc), time.monotonic())
+            host.supervisor.poll_silent(exc, time.monotonic())
             self._report_stats()
             return
         except (LinkError, MalformedResponse) as exc:
@@ -116,7 +116,7 @@ class Poller:
             # (a TCP link is reopened by the next request); none of its values are published;
             # LINK_LOSS_POLLS of them in a row take the link down like any failed transaction.
             self._report_error(exc)
-            host.supervisor.transport_failed(str(exc))
+            host.supervisor.transport_failed(exc)
             self._report_stats()
             return
         except TeachPadError as exc:

@@ -18,6 +18,7 @@ from typing import Protocol
 from PySide6.QtCore import QCoreApplication, QObject, Qt, QThread, QTimer, Signal, SignalInstance, Slot
 
 from app import timing
+from app.errors import Reason
 from app.link.client import ConnectionSettings, StepFrame
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, RobotState
 from app.link.stats import LinkStats
@@ -259,7 +260,8 @@ class RobotLink(QObject):
     def _on_shut_down(self) -> None:
         """Nothing is live after a shutdown: the state says so (and its freshness timer stops)."""
         endpoint = self._state.connection.endpoint
-        shut = ConnectionState(LinkState.DISCONNECTED, "the link was shut down", endpoint)
+        shut = ConnectionState(LinkState.DISCONNECTED, "the link was shut down", endpoint,
+                               reason=Reason("link_was_shut_down"))
         self._state.set_connection(shut)
 
     @Slot(CommandResult)

@@ -20,7 +20,7 @@ import random
 import time
 
 from app import timing
-from app.errors import LinkError, ResponseTimeout, TeachPadError
+from app.errors import LinkError, Reason, ResponseTimeout, TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
 from app.link.host import WorkerHost
 from app.link.types import ConnectionState, LinkState, Operation
@@ -28,7 +28,11 @@ from app.link.upload import UPLOAD_POSE_GV
 from app.models import CommandResult
 from app.protocol import registers
 
-__all__ = ["DEFAULT_CANARY_GV", "LinkSupervisor", "check_canary_gv"]
+__all__ = ["DEFAULT_CANARY_GV", "Cause", "LinkSupervisor", "check_canary_gv"]
+
+#: Why the link changed: the typed error (its reason goes to the GUI), or only English text
+#: (the link-loss reason without a detail then).
+Cause = TeachPadError | str
 
 _log = logging.getLogger(__name__)
 
@@ -63,10 +67,10 @@ class LinkSupervisor:
         self._random = random.Random()
 
     # --- state ----------------------------------------------------------------------------
-    def set_state(self, state: LinkState, message: str) -> None:
+    def set_state(self, state: LinkState, message: str, reason: Reason | None = None) -> None:
         settings = self.settings
         new = ConnectionState(state, message, settings.endpoint if settings else "",
-                              bool(settings and settings.monitor_only))
+                              bool(settings and settings.monitor_only), reason)
         if new != self.state:
             self.state = new
             _log.info("link %s %s%s", new.endpoint, state.value, f": {message}" if message else "")
@@ -100,7 +104,7 @@ class LinkSupervisor:
             pose = client.read_pose()
             host.jog.make_teach_safe(status, self._ever_connected)
         except TeachPadError as exc:
-            self.schedule_reconnect(str(exc))
+            self.schedule_reconnect(exc)
             return
         self.link_up = True
         self.answering = True
@@ -117,11 +121,11 @@ class LinkSupervisor:
         host.start_polling()
         host.run_jobs()
 
-    def schedule_reconnect(self, message: str) -> None:
+    def schedule_reconnect(self, cause: Cause, prefix: str = "") -> None:
         backoff = timing.RECONNECT_BACKOFF
         delay = backoff[min(self._backoff_index, len(backoff) - 1)]
         self._backoff_index += 1
-        self.set_state(LinkState.DOWN, message)
+        self.set_state(LinkState.DOWN, prefix + str(cause), self._reason(cause))
         if not self._host.closed:
             self._host.start_reconnect(delay)
 
@@ -137,9 +141,10 @@ class LinkSupervisor:
         try:
             client.write_gv(gv, [token])
         except TeachPadError as exc:
-            self._host.emit_error(Operation.CANARY, f"could not write the restart canary GV{gv}: {exc}", None)
+            self._host.emit_error(Operation.CANARY, f"could not write the restart canary GV{gv}: {exc}", None,
+                                  exc.as_reason())
             if isinstance(exc, (LinkError, ResponseTimeout)):
-                self.transport_failed(str(exc))
+                self.transport_failed(exc)
             return
         self.canary_token = token
 
@@ -164,31 +169,40 @@ class LinkSupervisor:
         try:
             self._host.jog.controller_answers()
         except TeachPadError as exc:
-            self._host.emit_error(Operation.JOG_RELEASE, f"could not stop the jog: {exc}", None)
+            self._host.emit_error(Operation.JOG_RELEASE, f"could not stop the jog: {exc}", None,
+                                  exc.as_reason())
             if isinstance(exc, (LinkError, ResponseTimeout)):
-                self.transport_failed(str(exc))
+                self.transport_failed(exc)
                 if not self.link_up:
                     return
         self.set_state(LinkState.CONNECTED, "")
 
-    def poll_silent(self, message: str, now: float) -> None:
+    def poll_silent(self, cause: Cause, now: float) -> None:
         """A poll timed out with the link open: NOT_ANSWERING at once; DOWN when it lasts."""
         if self.answering:
             self.answering = False
             self._silent_since = now
-            self.set_state(LinkState.NOT_ANSWERING, message)
+            self.set_state(LinkState.NOT_ANSWERING, str(cause), self._reason(cause))
             note = self._host.jog.controller_silent()
             if note is not None:
                 self._host.emit_error(Operation.JOG, note, None)
         elif now - self._silent_since >= timing.NOT_ANSWERING_DOWN_AFTER:
-            self.link_lost(message)
+            self.link_lost(cause)
 
-    def transport_failed(self, message: str) -> None:
+    def transport_failed(self, cause: Cause) -> None:
         self._failures += 1
         if self._failures >= timing.LINK_LOSS_POLLS:
-            self.link_lost(message)
+            self.link_lost(cause)
 
-    def link_lost(self, message: str) -> None:
+    def _reason(self, cause: Cause) -> Reason:
+        """The GUI's reason for ``cause``: the typed error's own, else "link lost" (its English
+        text is a detail for the log)."""
+        if isinstance(cause, TeachPadError):
+            return cause.as_reason()
+        settings = self.settings
+        return Reason("link_lost", {"endpoint": settings.endpoint} if settings else {})
+
+    def link_lost(self, cause: Cause) -> None:
         """Declare the link down at once; the reconnect timer takes over."""
         if not self.link_up:
             return
@@ -199,13 +213,14 @@ class LinkSupervisor:
         host.stop_polling()
         host.jog.link_lost()
         self.canary_token = None
-        host.uploader.end(f"link lost: {message}")
-        self._fail_active("link lost while the command was under way; its outcome is unknown")
+        host.uploader.end(f"link lost: {cause}")
+        self._fail_active("link lost while the command was under way; its outcome is unknown",
+                          "outcome_unknown_link_lost")
         host.fail_queued("the link to the controller is down")
         if self.client is not None:
             self.client.close()
         self._backoff_index = 0
-        self.schedule_reconnect(f"link lost: {message}")
+        self.schedule_reconnect(cause, "link lost: ")
 
     def close_link(self, operation: str, state: LinkState, message: str, *, emit: bool = True,
                    fail_queued: bool = True, short: bool = False) -> None:
@@ -225,10 +240,11 @@ class LinkSupervisor:
                 else:
                     host.jog.stop_jog_and_teach()
             except TeachPadError as exc:
-                host.emit_error(operation, f"could not stop teach mode: {exc}", None)
+                host.emit_error(operation, f"could not stop teach mode: {exc}", None, exc.as_reason())
         self.canary_token = None
         host.uploader.end(f"{operation}: the link was closed")
-        self._fail_active(f"{operation}: the link was closed while the command was under way")
+        self._fail_active(f"{operation}: the link was closed while the command was under way",
+                          "outcome_unknown_link_closed")
         if fail_queued:
             host.fail_queued(f"{operation}: the link was closed")
         self.link_up = False
@@ -241,9 +257,10 @@ class LinkSupervisor:
         if emit:
             self.set_state(state, message)
 
-    def _fail_active(self, message: str) -> None:
+    def _fail_active(self, message: str, code: str) -> None:
         active = self._host.motion.take()
         if active is not None:
-            result = CommandResult(None, None, None, False, f"{active.operation}: {message}")
+            result = CommandResult(None, None, None, False, f"{active.operation}: {message}",
+                                   reason=Reason(code, {"operation": active.operation}))
             self._host.emit_result(result, active.request_id)
 

@@ -46,12 +46,15 @@ class LinkState(enum.Enum):
 
 @dataclass(frozen=True)
 class ConnectionState:
-    """Link state for the GUI; ``message`` says why in plain English."""
+    """Link state for the GUI: ``message`` says why in plain English (logs, CLI); ``reason`` is
+    the same as a code and its arguments, which the GUI turns into the operator's language
+    (None: nothing to say, as when connected or disconnected by request)."""
 
     state: LinkState
     message: str = ""
     endpoint: str = ""
     monitor_only: bool = False
+    reason: Reason | None = None
 
     @property
     def connected(self) -> bool:

@@ -416,7 +416,7 @@ class RobotWorker(WorkerRequests, QObject):
         except (LinkError, ResponseTimeout, MalformedResponse) as exc:
             # Malformed: the transport already resynchronised; the command's outcome is unknown.
             self.emit_exception(job.operation, exc)
-            self.supervisor.transport_failed(str(exc))
+            self.supervisor.transport_failed(exc)
         except ModbusExceptionError as exc:
             self.emit_result(CommandResult(None, None, None, False, f"{job.operation}: {exc}",
                                            reason=exc.as_reason()))

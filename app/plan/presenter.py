@@ -3,14 +3,16 @@ plan starts, the estimate lines, what a run needs first, the run's progress and 
 are enabled. The planner widget (``ui/panels/planner_panel.py``) only translates and draws.
 
 Texts that reach the operator are translated by the widget; this module gives it counts,
-levels, numbers and the issues' own (English) messages.
+levels, numbers and the issues worded by the widget's own ``text`` function (an issue's code and
+arguments in the operator's language, ``ui/messages.issue_text``); without one, the issues'
+English messages (the CLI, tests).
 """
 
 from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from app.models import Pose
@@ -20,6 +22,12 @@ from app.plan.segments import Plan
 from app.points.ledger import PointLedger
 
 XYZ = tuple[float, float, float]
+IssueText = Callable[[PlanIssue], str]  # one issue as a sentence
+
+
+def english(issue: PlanIssue) -> str:
+    """An issue's own message (plain English)."""
+    return issue.message
 
 ENDLESS = "∞"
 
@@ -58,16 +66,18 @@ class CheckSummary:
         return Level.WARN if self.warnings else Level.OK
 
 
-def summarize_checks(issues: Sequence[PlanIssue]) -> CheckSummary:
-    """Count the issues by kind; keep the first row error and the whole-plan messages."""
-    row_errors = [i.message for i in issues if i.kind is IssueKind.ERROR and i.segment is not None]
+def summarize_checks(issues: Sequence[PlanIssue], text: IssueText = english,
+                     line: IssueText = str) -> CheckSummary:
+    """Count the issues by kind; keep the first row error and the whole-plan messages (worded by
+    ``text``); ``line`` words an issue with its kind for the details."""
+    row_errors = [text(i) for i in issues if i.kind is IssueKind.ERROR and i.segment is not None]
     return CheckSummary(
         errors=sum(1 for i in issues if i.kind is IssueKind.ERROR),
         warnings=sum(1 for i in issues if i.kind is IssueKind.WARNING),
         uploads=tuple(ids_needing_upload(issues)),
         first_row_error=row_errors[0] if row_errors else "",
-        whole_plan=tuple(i.message for i in issues if i.segment is None),
-        details="\n".join(str(i) for i in issues),
+        whole_plan=tuple(text(i) for i in issues if i.segment is None),
+        details="\n".join(line(i) for i in issues),
     )
 
 
@@ -153,11 +163,12 @@ class RunGate:
 MAX_WARNINGS_SHOWN = 8
 
 
-def run_gate(issues: Sequence[PlanIssue]) -> RunGate:
-    """Errors refuse the run; points that need an upload come next; warnings are quoted."""
+def run_gate(issues: Sequence[PlanIssue], text: IssueText = english) -> RunGate:
+    """Errors refuse the run; points that need an upload come next; warnings are quoted
+    (worded by ``text``)."""
     errors = [i for i in issues if i.kind is IssueKind.ERROR]
     uploads = tuple(ids_needing_upload(issues))
-    warnings = tuple(i.message for i in issues if i.kind is IssueKind.WARNING)[:MAX_WARNINGS_SHOWN]
+    warnings = tuple(text(i) for i in issues if i.kind is IssueKind.WARNING)[:MAX_WARNINGS_SHOWN]
     if errors:
         block = RunBlock.ERRORS
     elif uploads:

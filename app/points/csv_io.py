@@ -13,6 +13,7 @@ import csv
 import io
 from collections.abc import Iterable
 
+from app.errors import Reason
 from app.points.point import (
     CSV_COLUMNS,
     CSV_REQUIRED,
@@ -49,7 +50,8 @@ def decode_text(data: bytes, path: str | None = None) -> str:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise FileFormatError(
-            f"not UTF-8 text (bad byte at offset {exc.start}); save the file as UTF-8", path=path
+            f"not UTF-8 text (bad byte at offset {exc.start}); save the file as UTF-8", path=path,
+            problem=Reason("not_utf8", {"offset": exc.start}),
         ) from None
 
 
@@ -68,7 +70,8 @@ def parse_points_csv(
         raise FileFormatError(f"not valid CSV ({reason})", path=path, row=len(rows) + 1) from None
     header_at = next((i for i, r in enumerate(rows) if any(cell.strip() for cell in r)), None)
     if header_at is None:
-        raise FileFormatError("the file is empty (expected a header row)", path=path, row=1)
+        raise FileFormatError("the file is empty (expected a header row)", path=path, row=1,
+                              problem=Reason("empty_file"))
     header = [cell.strip().lower() for cell in rows[header_at]]
     header_row = header_at + 1
     for col, name in enumerate(header):
@@ -76,13 +79,17 @@ def parse_points_csv(
             raise FileFormatError(
                 f"unknown column {shown(rows[header_at][col])} (expected: {','.join(CSV_COLUMNS)})",
                 path=path, row=header_row,
+                problem=Reason("unknown_column", {"name": shown(rows[header_at][col]),
+                                                  "expected": ",".join(CSV_COLUMNS)}),
             )
         if header.index(name) != col:
-            raise FileFormatError("the column appears twice", path=path, row=header_row, column=name)
+            raise FileFormatError("the column appears twice", path=path, row=header_row, column=name,
+                                  problem=Reason("column_twice"))
     for name in CSV_COLUMNS:
         if name in CSV_REQUIRED and name not in header:
             raise FileFormatError(
-                "the column is missing from the header", path=path, row=header_row, column=name
+                "the column is missing from the header", path=path, row=header_row, column=name,
+                problem=Reason("column_missing"),
             )
     points: list[TempPoint] = []
     seen: dict[int, int] = {}
@@ -93,15 +100,18 @@ def parse_points_csv(
             raise FileFormatError(
                 f"has {len(cells)} cells, the header has {len(header)} (truncated or extra cells?)",
                 path=path, row=number,
+                problem=Reason("cell_count", {"cells": len(cells), "header": len(header)}),
             )
         fields = dict(zip(header, cells, strict=True))
         try:
             point = point_from_fields(fields, limits)
         except FieldError as exc:
-            raise FileFormatError(exc.reason, path=path, row=number, column=exc.field) from None
+            raise FileFormatError(exc.reason, path=path, row=number, column=exc.field,
+                                  problem=exc.as_reason()) from None
         if point.id in seen:
             raise FileFormatError(
-                f"id {point.id} is already used on row {seen[point.id]}", path=path, row=number, column="id"
+                f"id {point.id} is already used on row {seen[point.id]}", path=path, row=number, column="id",
+                problem=Reason("row_id_taken", {"id": point.id, "other": seen[point.id]}),
             )
         seen[point.id] = number
         points.append(point)

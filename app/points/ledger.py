@@ -97,10 +97,18 @@ class EmptyImport(InvalidInput):
     """A replace-mode import without a single point: it would delete every point; refused
     unless the caller asks for it explicitly (``allow_empty=True``)."""
 
+    code = "empty_import"
+
     def __init__(self, existing: int) -> None:
         self.existing = existing
         super().__init__(f"the file has no points: replacing with it would remove all {existing} point(s) "
-                         "of the project (merge it, or ask explicitly for an empty import)")
+                         "of the project (merge it, or ask explicitly for an empty import)",
+                         params={"existing": existing})
+
+
+def _no_such_point(point_id: int) -> InvalidInput:
+    return InvalidInput(f"there is no point with id {point_id}", code="no_such_point",
+                        params={"id": point_id})
 
 
 class PointLedger:
@@ -137,7 +145,9 @@ class PointLedger:
         outside = [p.id for p in self._points if not limits.id_min <= p.id <= limits.id_max]
         if outside:
             shown = ", ".join(map(str, outside[:10])) + (" ..." if len(outside) > 10 else "")
-            raise InvalidInput(f"points outside {limits.id_min}..{limits.id_max}: {shown}")
+            raise InvalidInput(f"points outside {limits.id_min}..{limits.id_max}: {shown}",
+                               code="points_outside_range",
+                               params={"id_min": limits.id_min, "id_max": limits.id_max, "ids": shown})
         self._limits = limits
 
     def __len__(self) -> int:
@@ -173,7 +183,7 @@ class PointLedger:
         """The point with ``point_id``; :class:`InvalidInput` if there is none."""
         found = self.get(point_id)
         if found is None:
-            raise InvalidInput(f"there is no point with id {point_id}")
+            raise _no_such_point(point_id)
         return found
 
     def next_free_id(self, after: int | None = None) -> int:
@@ -183,7 +193,8 @@ class PointLedger:
         for candidate in range(start, self._limits.id_max + 1):
             if candidate not in used:
                 return candidate
-        raise InvalidInput(f"no free point id left in {start}..{self._limits.id_max}")
+        raise InvalidInput(f"no free point id left in {start}..{self._limits.id_max}",
+                           code="no_free_point_id", params={"start": start, "id_max": self._limits.id_max})
 
     def find(self, text: str) -> list[int]:
         """Rows matching ``text``: the point with that id first, then names containing it
@@ -254,7 +265,7 @@ class PointLedger:
         unique = sorted(set(rows))
         for row in unique:
             if not 0 <= row < len(self._points):
-                raise InvalidInput(f"no row {row}")
+                raise InvalidInput(f"no row {row}", code="no_such_row", params={"row": row})
         removed = [(row, self._points[row]) for row in unique]
         for row in reversed(unique):
             del self._points[row]
@@ -265,7 +276,9 @@ class PointLedger:
     def move(self, src: int, dst: int) -> None:
         """Move the point at ``src`` so that it ends at index ``dst`` (undo: ``move(dst, src)``)."""
         if not (0 <= src < len(self._points) and 0 <= dst < len(self._points)):
-            raise InvalidInput(f"cannot move row {src} to {dst} in {len(self._points)} rows")
+            raise InvalidInput(f"cannot move row {src} to {dst} in {len(self._points)} rows",
+                               code="cannot_move_row",
+                               params={"src": src, "dst": dst, "rows": len(self._points)})
         if src == dst:
             return
         self._points.insert(dst, self._points.pop(src))
@@ -278,7 +291,9 @@ class PointLedger:
         for row, point in enumerate(new):
             self._check_fields(point)
             if point.id in seen:
-                raise InvalidInput(f"row {row}: id {point.id} is already used on row {seen[point.id]}")
+                raise InvalidInput(f"row {row}: id {point.id} is already used on row {seen[point.id]}",
+                                   code="duplicate_row_id",
+                                   params={"row": row, "id": point.id, "other": seen[point.id]})
             seen[point.id] = row
         self._points = new
         self._touch()
@@ -295,7 +310,8 @@ class PointLedger:
         seen: set[int] = set()
         for number, point in enumerate(points, start=1):
             if point.id in seen:
-                raise InvalidInput(f"imported point {number}: id {point.id} appears twice")
+                raise InvalidInput(f"imported point {number}: id {point.id} appears twice",
+                                   code="import_duplicate_id", params={"number": number, "id": point.id})
             seen.add(point.id)
         incoming: list[TempPoint] = []
         added = updated = unchanged = 0
@@ -358,7 +374,7 @@ class PointLedger:
         """Record the controller's side of a point; returns its row."""
         row = self.row_of(point_id)
         if row is None:
-            raise InvalidInput(f"there is no point with id {point_id}")
+            raise _no_such_point(point_id)
         old = self._points[row]
         new = replace(old, sync=state, sync_error=reason if state is SyncState.FAILED else "")
         if new != old:
@@ -399,7 +415,9 @@ class PointLedger:
         self._check_fields(point)
         row = self.row_of(point.id)
         if row is not None and row != ignore_row:
-            raise FieldError("id", f"id {point.id} is already used by {self._points[row].label}")
+            taken = self._points[row].label
+            raise FieldError("id", f"id {point.id} is already used by {taken}", code="point_id_taken",
+                             params={"id": point.id, "point": taken})
 
 
 # Older imports (``from app.points.ledger import parse_points_csv``) keep working: the CSV and

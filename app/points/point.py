@@ -20,10 +20,12 @@ from __future__ import annotations
 
 import enum
 import math
+import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
+from typing import Any
 
-from app.errors import InvalidInput
+from app.errors import InvalidInput, Reason
 from app.models import Pose
 from app.protocol.enums import QT_TRANSLATE_NOOP
 from app.protocol.registers import TEMP_POINT_ID_MAX, TEMP_POINT_ID_MIN, TOOL_NONE
@@ -55,7 +57,11 @@ class FileFormatError(InvalidInput):
     """A points / project file the host refuses; names the row (or line) and the field.
 
     ``str(error)`` reads e.g. ``points.csv: row 7, column 'x': 'abc' is not a number``.
+    ``problem`` is the reason as a code and its arguments (None: only the English ``reason``);
+    the error's own reason (code ``file_format``) adds the file name, row and column.
     """
+
+    code = "file_format"
 
     def __init__(
         self,
@@ -65,6 +71,7 @@ class FileFormatError(InvalidInput):
         row: int | None = None,
         column: str | None = None,
         where: str | None = None,
+        problem: Reason | None = None,
     ) -> None:
         if len(reason) > REASON_MAX_CHARS:  # a safety net: a message never carries a whole bad value
             reason = reason[:REASON_MAX_CHARS] + "..."
@@ -73,7 +80,10 @@ class FileFormatError(InvalidInput):
         self.row = row
         self.column = column
         self.where = where
-        super().__init__(self._text())
+        self.problem = problem
+        super().__init__(self._text(), params={
+            "file": os.path.basename(path) if path else None, "row": row, "column": column,
+            "where": where, "problem": problem})
 
     def _text(self) -> str:
         parts: list[str] = []
@@ -88,14 +98,16 @@ class FileFormatError(InvalidInput):
         return f"{self.path}: {text}" if self.path else text
 
     def with_path(self, path: str) -> FileFormatError:
-        return FileFormatError(self.reason, path=path, row=self.row, column=self.column, where=self.where)
+        return FileFormatError(self.reason, path=path, row=self.row, column=self.column, where=self.where,
+                               problem=self.problem)
 
 
 class FieldError(InvalidInput):
     """One field's value refused; ``field`` names it, ``reason`` says why."""
 
-    def __init__(self, field_name: str, reason: str) -> None:
-        super().__init__(f"{field_name}: {reason}")
+    def __init__(self, field_name: str, reason: str, *, code: str | None = None,
+                 params: Mapping[str, Any] | None = None) -> None:
+        super().__init__(f"{field_name}: {reason}", code=code, params=params)
         self.field = field_name
         self.reason = reason
 
@@ -196,55 +208,69 @@ def has_surrogates(text: str) -> bool:
 def parse_float(field_name: str, value: object) -> float:
     """A finite float from a number or text; NaN, infinities and huge numbers are refused."""
     if isinstance(value, bool):
-        raise FieldError(field_name, f"{shown(value)} is not a number")
+        raise FieldError(field_name, f"{shown(value)} is not a number", code="not_a_number",
+                         params={"value": shown(value)})
     if isinstance(value, OversizedNumber):
-        raise FieldError(field_name, f"{shown(value)} is too large")
+        raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
+                         params={"value": shown(value)})
     if isinstance(value, int | float):
         try:
             number = float(value)
         except OverflowError:
-            raise FieldError(field_name, f"{shown(value)} is too large") from None
+            raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
+                             params={"value": shown(value)}) from None
     elif isinstance(value, str):
         text = value.strip()
         if not text:
-            raise FieldError(field_name, "the value is empty")
+            raise FieldError(field_name, "the value is empty", code="value_empty")
         try:
             number = float(text)
         except ValueError:
-            raise FieldError(field_name, f"{shown(text)} is not a number") from None
+            raise FieldError(field_name, f"{shown(text)} is not a number", code="not_a_number",
+                             params={"value": shown(text)}) from None
         if not math.isfinite(number) and text.lstrip("+-").lower() not in ("inf", "infinity", "nan"):
-            raise FieldError(field_name, f"{shown(text)} is too large")
+            raise FieldError(field_name, f"{shown(text)} is too large", code="too_large",
+                             params={"value": shown(text)})
     else:
-        raise FieldError(field_name, f"{shown(value)} is not a number")
+        raise FieldError(field_name, f"{shown(value)} is not a number", code="not_a_number",
+                         params={"value": shown(value)})
     if not math.isfinite(number):
-        raise FieldError(field_name, f"{shown(value)} is not a finite number")
+        raise FieldError(field_name, f"{shown(value)} is not a finite number", code="not_finite",
+                         params={"value": shown(value)})
     return number
 
 
 def parse_int(field_name: str, value: object) -> int:
     """An integer from an int, an integral float or text (``"5"``, ``"5.0"``)."""
     if isinstance(value, bool):
-        raise FieldError(field_name, f"{shown(value)} is not an integer")
+        raise FieldError(field_name, f"{shown(value)} is not an integer", code="not_integer",
+                         params={"value": shown(value)})
     if isinstance(value, int):
         if value.bit_length() > 100:
-            raise FieldError(field_name, f"{shown(value)} is too large")
+            raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
+                             params={"value": shown(value)})
         return value
     if isinstance(value, str) and len(value.strip().lstrip("+-")) > INT_DIGITS_MAX \
             and value.strip().lstrip("+-").isdigit():
-        raise FieldError(field_name, f"{shown(value.strip())} is too large")
+        raise FieldError(field_name, f"{shown(value.strip())} is too large", code="too_large",
+                         params={"value": shown(value.strip())})
     number = parse_float(field_name, value)
     if not number.is_integer():
         quoted = shown(value.strip() if isinstance(value, str) else value)
-        raise FieldError(field_name, f"{quoted} is not an integer")
+        raise FieldError(field_name, f"{quoted} is not an integer", code="not_integer",
+                         params={"value": quoted})
     if abs(number) >= 2.0 ** 100:
-        raise FieldError(field_name, f"{shown(value)} is too large")
+        raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
+                         params={"value": shown(value)})
     return int(number)
 
 
 def parse_point_id(value: object, limits: PointLimits = DEFAULT_LIMITS, field_name: str = "id") -> int:
     point_id = parse_int(field_name, value)
     if not limits.id_min <= point_id <= limits.id_max:
-        raise FieldError(field_name, f"id {shown(point_id)} is outside {limits.id_min}..{limits.id_max}")
+        raise FieldError(field_name, f"id {shown(point_id)} is outside {limits.id_min}..{limits.id_max}",
+                         code="id_out_of_range",
+                         params={"value": shown(point_id), "id_min": limits.id_min, "id_max": limits.id_max})
     return point_id
 
 
@@ -252,7 +278,8 @@ def parse_tool(value: object, field_name: str = "tool") -> int:
     """Tool frame: 0..199 (tool N+1) or 200 (none)."""
     tool = parse_int(field_name, value)
     if not (0 <= tool <= TOOL_MAX or tool == TOOL_NONE):
-        raise FieldError(field_name, f"tool {shown(tool)} is not 0..{TOOL_MAX} or {TOOL_NONE} (none)")
+        raise FieldError(field_name, f"tool {shown(tool)} is not 0..{TOOL_MAX} or {TOOL_NONE} (none)",
+                         code="bad_tool", params={"value": shown(tool), "max": TOOL_MAX, "none": TOOL_NONE})
     return tool
 
 
@@ -260,13 +287,15 @@ def parse_text(field_name: str, value: object, max_chars: int) -> str:
     if value is None:
         return ""
     if not isinstance(value, str):
-        raise FieldError(field_name, f"{shown(value)} is not text")
+        raise FieldError(field_name, f"{shown(value)} is not text", code="not_text")
     if len(value) > max_chars:
-        raise FieldError(field_name, f"is longer than {max_chars} characters")
+        raise FieldError(field_name, f"is longer than {max_chars} characters", code="too_long",
+                         params={"max": max_chars})
     if has_surrogates(value):
-        raise FieldError(field_name, "holds an invalid character (a lone surrogate, not Unicode text)")
+        raise FieldError(field_name, "holds an invalid character (a lone surrogate, not Unicode text)",
+                         code="bad_character")
     if any(ch in value for ch in "\x00\r\n") and field_name == "name":
-        raise FieldError(field_name, "must be one line")
+        raise FieldError(field_name, "must be one line", code="not_one_line")
     return value
 
 
@@ -436,7 +465,7 @@ def point_from_fields(
 
     for required in CSV_REQUIRED:
         if required not in fields:
-            raise FieldError(required, "the value is missing")
+            raise FieldError(required, "the value is missing", code="value_missing")
     return make_point(
         fields["id"],
         optional("name", ""),

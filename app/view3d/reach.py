@@ -159,6 +159,8 @@ def _issue(index: int, reach: Reach, what: str, point_id: int | None) -> PlanIss
     name = f"segment {index + 1}"
     if reach is Reach.JOINT_LIMIT:
         return PlanIssue(index, IssueKind.ERROR, IssueCode.JOINT_LIMIT,
-                         f"{name}: {what} passes a joint limit of the robot model", point_id)
+                         f"{name}: {what} passes a joint limit of the robot model", point_id,
+                         args={"point": what} if point_id is not None else {})
     return PlanIssue(index, IssueKind.ERROR, IssueCode.UNREACHABLE,
-                     f"{name}: {what} is out of the robot model's reach", point_id)
+                     f"{name}: {what} is out of the robot model's reach", point_id,
+                     args={"point": what} if point_id is not None else {})

@@ -118,9 +118,16 @@ def main() -> None:
             save(f"touch_{lang}_1280x800_planner")
         window.set_touch_mode(False)
         sim.set_alarm(Alarm.ESTOP, True)
-        _wait(lambda: not window.motion_enabled or window.alarm_banner.isVisible())
+        _wait(lambda: window.alarm_banner.isVisible())
         _show(window, "points", 0, TeachFrame.BASE)
         save("alarm_en_1280x800" if readme else f"alarm_{lang}_1280x800")
+        if not readme:  # the tallest layouts under the banner, and the larger size
+            _show(window, "monitor", 0, TeachFrame.JOINT)
+            save(f"alarm_{lang}_1280x800_monitor+joint")
+            window.resize(*SIZES[1])
+            _show(window, "planner", 0, TeachFrame.BASE)
+            save(f"alarm_{lang}_1920x1080_planner")
+            window.resize(*SIZES[0])
         sim.set_alarm(Alarm.ESTOP, False)
         _spin(1.0)
     for lang in ("zh_CN",) if readme else LANGUAGES:

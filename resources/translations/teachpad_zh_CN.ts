@@ -4,27 +4,27 @@
     <context>
         <name>AlarmBanner</name>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="37" />
+            <location filename="../../ui/panels/alarm_banner.py" line="44" />
             <source>alarm bit {bit}</source>
             <translation>报警位 {bit}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="128" />
+            <location filename="../../ui/panels/alarm_banner.py" line="164" />
             <source>ALARM: {names}</source>
             <translation>报警：{names}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="130" />
+            <location filename="../../ui/panels/alarm_banner.py" line="166" />
             <source>(last known: the link is not live)</source>
             <translation>（最后已知：通信未实时）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="133" />
+            <location filename="../../ui/panels/alarm_banner.py" line="169" />
             <source>Motion controls are held until the alarm is reset. STOP stays available.</source>
             <translation>报警复位前运动控制已锁定。停止按钮始终可用。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="142" />
+            <location filename="../../ui/panels/alarm_banner.py" line="175" />
             <source>Register 562 = {word}</source>
             <translation>寄存器 562 = {word}</translation>
         </message>
@@ -350,174 +350,174 @@
     <context>
         <name>ConnectionDialog</name>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="183" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="184" />
             <source>Connect to controller</source>
             <translation>连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="184" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="185" />
             <source>Transport:</source>
             <translation>通信方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="185" />
-            <location filename="../../ui/dialogs/connection_dialog.py" line="229" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="186" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="230" />
             <source>Modbus TCP</source>
             <translation>Modbus TCP</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="186" />
-            <location filename="../../ui/dialogs/connection_dialog.py" line="229" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="187" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="230" />
             <source>Modbus RTU (serial)</source>
             <translation>Modbus RTU（串口）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="187" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="188" />
             <source>Host:</source>
             <translation>主机：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="188" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="189" />
             <source>Port:</source>
             <translation>端口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="189" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="190" />
             <source>Serial port:</source>
             <translation>串口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="190" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="191" />
             <source>Refresh</source>
             <translation>刷新</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="191" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="192" />
             <source>List the serial ports of this computer again</source>
             <translation>重新列出本机的串口</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="193" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="194" />
             <source>Baud rate:</source>
             <translation>波特率：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="194" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
             <source>Parity:</source>
             <translation>校验位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="196" />
             <source>none</source>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="196" />
             <source>even</source>
             <translation>偶校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="196" />
             <source>odd</source>
             <translation>奇校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="197" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="198" />
             <source>Stop bits:</source>
             <translation>停止位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="198" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="199" />
             <source>Unit id:</source>
             <translation>从站地址：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="199" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="200" />
             <source>Float word order:</source>
             <translation>浮点数字序：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="200" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="201" />
             <source>Low word first (CDAB, default)</source>
             <translation>低字在前（CDAB，默认）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="201" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="202" />
             <source>High word first (ABCD)</source>
             <translation>高字在前（ABCD）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="202" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="203" />
             <source>Timeout:</source>
             <translation>超时：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="203" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="204" />
             <source>Monitor only (never write to the controller)</source>
             <translation>仅监视（从不写入控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="205" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="206" />
             <source>Unit id and word order come from the register profile (Safety → Register profile…, administrator).</source>
             <translation>站号和字序取自寄存器配置（安全 → 寄存器配置…，管理员）。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="231" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="232" />
             <source>Connected to {where}</source>
             <translation>已连接到 {where}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="232" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="233" />
             <source>Connecting to {where}</source>
             <translation>正在连接 {where}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="233" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="234" />
             <source>Connected to {where}, but the controller does not answer</source>
             <translation>已连接到 {where}，但控制器没有应答</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="234" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="235" />
             <source>Connection to {where} lost; retrying</source>
             <translation>与 {where} 的连接已断开，正在重试</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="235" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="236" />
             <source>Not connected (last: {where})</source>
             <translation>未连接（上次：{where}）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="238" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="239" />
             <source>{transport}, unit {unit}</source>
             <translation>{transport}，站号 {unit}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="240" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="241" />
             <source>Polling at {hz:g} Hz</source>
             <translation>轮询频率 {hz:g} Hz</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="242" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="243" />
             <source>Monitor only: nothing is written to the controller</source>
             <translation>仅监视：不向控制器写入任何内容</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="269" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="271" />
             <source>Could not list the serial ports ({error}); type the device name</source>
             <translation>无法列出串口（{error}），请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="272" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="274" />
             <source>Serial ports found: {n}</source>
             <translation>找到的串口：{n} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="274" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="276" />
             <source>No serial port found; type the device name</source>
             <translation>未找到串口，请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="327" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="329" />
             <source>a serial port is needed for RTU</source>
             <translation>RTU 方式需要指定串口</translation>
         </message>
@@ -738,37 +738,37 @@
     <context>
         <name>EventLogModel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="92" />
+            <location filename="../../ui/panels/event_log.py" line="110" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="93" />
+            <location filename="../../ui/panels/event_log.py" line="111" />
             <source>Level</source>
             <translation>级别</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="94" />
+            <location filename="../../ui/panels/event_log.py" line="112" />
             <source>Source</source>
             <translation>来源</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="95" />
+            <location filename="../../ui/panels/event_log.py" line="113" />
             <source>Message</source>
             <translation>消息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="98" />
+            <location filename="../../ui/panels/event_log.py" line="116" />
             <source>Info</source>
             <translation>信息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="99" />
+            <location filename="../../ui/panels/event_log.py" line="117" />
             <source>Warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="100" />
+            <location filename="../../ui/panels/event_log.py" line="118" />
             <source>Error</source>
             <translation>错误</translation>
         </message>
@@ -776,72 +776,72 @@
     <context>
         <name>EventLogPanel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="263" />
+            <location filename="../../ui/panels/event_log.py" line="284" />
             <source>Show:</source>
             <translation>显示：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="264" />
+            <location filename="../../ui/panels/event_log.py" line="285" />
             <source>All events</source>
             <translation>全部事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="265" />
+            <location filename="../../ui/panels/event_log.py" line="286" />
             <source>Warnings and errors</source>
             <translation>警告和错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="266" />
+            <location filename="../../ui/panels/event_log.py" line="287" />
             <source>Errors only</source>
             <translation>仅错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="267" />
+            <location filename="../../ui/panels/event_log.py" line="288" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="268" />
+            <location filename="../../ui/panels/event_log.py" line="289" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="308" />
+            <location filename="../../ui/panels/event_log.py" line="345" />
             <source>alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="315" />
+            <location filename="../../ui/panels/event_log.py" line="342" />
             <source>Alarm raised: {name}</source>
             <translation>报警触发：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="317" />
+            <location filename="../../ui/panels/event_log.py" line="342" />
             <source>Alarm cleared: {name}</source>
             <translation>报警解除：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="323" />
+            <location filename="../../ui/panels/event_log.py" line="351" />
             <source>bit {n}</source>
             <translation>第 {n} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="327" />
+            <location filename="../../ui/panels/event_log.py" line="355" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="352" />
+            <location filename="../../ui/panels/event_log.py" line="385" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="377" />
+            <location filename="../../ui/panels/event_log.py" line="410" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="378" />
+            <location filename="../../ui/panels/event_log.py" line="411" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -1008,7 +1008,7 @@
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/window_status.py" line="79" />
+            <location filename="../../ui/window_status.py" line="80" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
@@ -1028,13 +1028,13 @@
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/window_status.py" line="52" />
-            <location filename="../../ui/window_status.py" line="84" />
+            <location filename="../../ui/window_status.py" line="53" />
+            <location filename="../../ui/window_status.py" line="85" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/window_status.py" line="65" />
+            <location filename="../../ui/window_status.py" line="66" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
@@ -1098,554 +1098,839 @@
     <context>
         <name>Messages</name>
         <message>
-            <location filename="../../ui/messages.py" line="47" />
+            <location filename="../../ui/messages.py" line="51" />
             <source>{command}: {status}.</source>
             <translation>{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="48" />
+            <location filename="../../ui/messages.py" line="52" />
             <source>{command}: done, not confirmed by the controller.</source>
             <translation>{command}：已完成，控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="49" />
+            <location filename="../../ui/messages.py" line="53" />
             <source>{command}: done (the controller is now in {mode} mode).</source>
             <translation>{command}：已完成（控制器现处于{mode}模式）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="50" />
+            <location filename="../../ui/messages.py" line="54" />
             <source>{command} refused by the controller: {status}.</source>
             <translation>控制器拒绝了{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="51" />
+            <location filename="../../ui/messages.py" line="55" />
             <source>{command} not taken: the controller still shows “{status}” from the previous command.</source>
             <translation>{command}未被执行：控制器仍显示上一条命令的“{status}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="52" />
+            <location filename="../../ui/messages.py" line="56" />
             <source>{command} ended by an alarm: {alarms}.</source>
             <translation>{command}因报警而中止：{alarms}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="53" />
+            <location filename="../../ui/messages.py" line="57" />
             <source>{command}: the controller did not acknowledge it within {seconds} s.</source>
             <translation>{command}：控制器在 {seconds} s 内未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="54" />
+            <location filename="../../ui/messages.py" line="58" />
             <source>{command} did not finish within {seconds} s (last status: {status}).</source>
             <translation>{command}未在 {seconds} s 内完成（最后状态：{status}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="55" />
+            <location filename="../../ui/messages.py" line="59" />
             <source>{command}: the arm moved and stopped, but the controller did not report the result.</source>
             <translation>{command}：机械臂已运动并停止，但控制器未报告结果。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="56" />
+            <location filename="../../ui/messages.py" line="60" />
             <source>{command}: stopped by the operator.</source>
             <translation>{command}：已由操作员停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="57" />
+            <location filename="../../ui/messages.py" line="61" />
             <source>{command}: stopped by the controller.</source>
             <translation>{command}：已被控制器停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="58" />
+            <location filename="../../ui/messages.py" line="62" />
             <source>{command}: sent (not waited for).</source>
             <translation>{command}：已发送（未等待结果）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="59" />
+            <location filename="../../ui/messages.py" line="63" />
             <source>{command}: no motion within {seconds} s (refused by the controller, or already there).</source>
             <translation>{command}：{seconds} s 内没有运动（被控制器拒绝，或已在目标位置）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="60" />
+            <location filename="../../ui/messages.py" line="64" />
             <source>Program {program} did not start: no such program, or the controller refused it.</source>
             <translation>程序 {program} 未启动：没有该程序，或控制器拒绝执行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="61" />
+            <location filename="../../ui/messages.py" line="65" />
             <source>Uploaded {uploaded} of {total} points.</source>
             <translation>已上传 {uploaded}/{total} 个点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="63" />
+            <location filename="../../ui/messages.py" line="67" />
             <source>{operation}: sent.</source>
             <translation>{operation}：已发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="64" />
+            <location filename="../../ui/messages.py" line="68" />
             <source>{operation}: failed.</source>
             <translation>{operation}：失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="65" />
+            <location filename="../../ui/messages.py" line="69" />
             <source>{operation} is still under way: wait for it or press Stop.</source>
             <translation>{operation}仍在进行：请等待其结束或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="66" />
+            <location filename="../../ui/messages.py" line="70" />
             <source>The link is shut down: nothing was sent.</source>
             <translation>通信链路已关闭：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="67" />
+            <location filename="../../ui/messages.py" line="71" />
             <source>Not connected to a controller: nothing was sent.</source>
             <translation>未连接控制器：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="69" />
+            <location filename="../../ui/messages.py" line="73" />
             <source>Lost the connection to the controller at {endpoint}.</source>
             <translation>与控制器 {endpoint} 的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="70" />
+            <location filename="../../ui/messages.py" line="74" />
             <source>The controller at {endpoint} closed the connection.</source>
             <translation>控制器 {endpoint} 关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="71" />
+            <location filename="../../ui/messages.py" line="75" />
             <source>The host name {host} cannot be resolved.</source>
             <translation>无法解析主机名 {host}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="72" />
+            <location filename="../../ui/messages.py" line="76" />
             <source>Connection refused: nothing listens on port {port}.</source>
             <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="73" />
+            <location filename="../../ui/messages.py" line="77" />
             <source>No answer to the connection request within {seconds} s.</source>
             <translation>连接请求在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="74" />
+            <location filename="../../ui/messages.py" line="78" />
             <source>The connection could not be opened.</source>
             <translation>无法建立连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="75" />
+            <location filename="../../ui/messages.py" line="79" />
             <source>Cannot open the serial port {port}.</source>
             <translation>无法打开串口 {port}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="76" />
+            <location filename="../../ui/messages.py" line="80" />
             <source>The controller at {endpoint} did not answer within {seconds} s.</source>
             <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="77" />
+            <location filename="../../ui/messages.py" line="81" />
             <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
             <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="78" />
+            <location filename="../../ui/messages.py" line="82" />
             <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="79" />
+            <location filename="../../ui/messages.py" line="83" />
             <source>Monitor-only mode: nothing was sent to the controller.</source>
             <translation>仅监视模式：未向控制器发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="80" />
+            <location filename="../../ui/messages.py" line="84" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="81" />
+            <location filename="../../ui/messages.py" line="85" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="83" />
+            <location filename="../../ui/messages.py" line="87" />
             <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
             <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="84" />
+            <location filename="../../ui/messages.py" line="88" />
             <source>The controller did not create {point} again before the move: the arm was not moved.</source>
             <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="85" />
+            <location filename="../../ui/messages.py" line="89" />
             <source>The project has no point {point}: the arm was not moved.</source>
             <translation>项目中没有点 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="86" />
+            <location filename="../../ui/messages.py" line="90" />
             <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
             <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="91" />
+            <location filename="../../ui/messages.py" line="92" />
+            <source>The link was shut down.</source>
+            <translation>通信链路已关闭。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="93" />
+            <source>{operation}: the connection was lost while it was under way; its outcome is unknown.</source>
+            <translation>{operation}：执行期间连接中断，结果未知。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="94" />
+            <source>{operation}: the connection was closed while it was under way.</source>
+            <translation>{operation}：执行期间连接被关闭。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="96" />
+            <source>points outside {id_min}..{id_max}: {ids}</source>
+            <translation>超出 {id_min}..{id_max} 范围的点：{ids}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="97" />
+            <source>there is no point P{id}</source>
+            <translation>不存在点 P{id}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="98" />
+            <source>no free point id left in {start}..{id_max}</source>
+            <translation>{start}..{id_max} 范围内已没有空闲的点编号</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="99" />
+            <source>there is no row {row}</source>
+            <translation>不存在第 {row} 行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="100" />
+            <source>cannot move row {src} to {dst} in {rows} rows</source>
+            <translation>无法在 {rows} 行中将第 {src} 行移到第 {dst} 行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="101" />
+            <source>row {row}: id {id} is already used on row {other}</source>
+            <translation>第 {row} 行：编号 {id} 已被第 {other} 行使用</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="102" />
+            <source>imported point {number}: id {id} appears twice</source>
+            <translation>导入的第 {number} 个点：编号 {id} 出现了两次</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="103" />
+            <source>id {id} is already used by {point}</source>
+            <translation>编号 {id} 已被 {point} 使用</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="104" />
+            <source>the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)</source>
+            <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="106" />
+            <source>{value} is not a number</source>
+            <translation>{value} 不是数字</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="107" />
+            <source>{value} is too large</source>
+            <translation>{value} 太大</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="108" />
+            <source>the value is empty</source>
+            <translation>值为空</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="109" />
+            <source>{value} is not a finite number</source>
+            <translation>{value} 不是有限的数</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="110" />
+            <source>{value} is not an integer</source>
+            <translation>{value} 不是整数</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="111" />
+            <source>id {value} is outside {id_min}..{id_max}</source>
+            <translation>编号 {value} 超出 {id_min}..{id_max}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="112" />
+            <source>tool {value} is not 0..{max} or {none} (none)</source>
+            <translation>工具 {value} 不在 0..{max} 范围内，也不是 {none}（无）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="113" />
+            <source>the value is not text</source>
+            <translation>值不是文本</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="114" />
+            <source>the text is longer than {max} characters</source>
+            <translation>文本超过 {max} 个字符</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="115" />
+            <source>holds an invalid character (a lone surrogate, not Unicode text)</source>
+            <translation>含有无效字符（孤立的代理项，不是 Unicode 文本）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="116" />
+            <source>must be one line</source>
+            <translation>必须为单行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="117" />
+            <source>the value is missing</source>
+            <translation>缺少该值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="119" />
+            <source>not UTF-8 text (bad byte at offset {offset}); save the file as UTF-8</source>
+            <translation>不是 UTF-8 文本（偏移 {offset} 处有无效字节）；请将文件另存为 UTF-8</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="120" />
+            <source>the file is empty (expected a header row)</source>
+            <translation>文件为空（应有表头行）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="121" />
+            <source>unknown column {name} (expected: {expected})</source>
+            <translation>未知列 {name}（应为：{expected}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="122" />
+            <source>the column appears twice</source>
+            <translation>该列出现了两次</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="123" />
+            <source>the column is missing from the header</source>
+            <translation>表头中缺少该列</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="124" />
+            <source>has {cells} cells, the header has {header} (truncated or extra cells?)</source>
+            <translation>有 {cells} 个单元格，表头有 {header} 个（被截断或有多余单元格？）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="125" />
+            <source>id {id} is already used on row {other}</source>
+            <translation>编号 {id} 已在第 {other} 行使用</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="130" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="92" />
+            <location filename="../../ui/messages.py" line="131" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="93" />
+            <location filename="../../ui/messages.py" line="132" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="94" />
+            <location filename="../../ui/messages.py" line="133" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="95" />
+            <location filename="../../ui/messages.py" line="134" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="96" />
+            <location filename="../../ui/messages.py" line="135" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="97" />
+            <location filename="../../ui/messages.py" line="136" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="98" />
+            <location filename="../../ui/messages.py" line="137" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="99" />
+            <location filename="../../ui/messages.py" line="138" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="100" />
+            <location filename="../../ui/messages.py" line="139" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="101" />
+            <location filename="../../ui/messages.py" line="140" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="102" />
+            <location filename="../../ui/messages.py" line="141" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="103" />
+            <location filename="../../ui/messages.py" line="142" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="104" />
+            <location filename="../../ui/messages.py" line="143" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="107" />
+            <location filename="../../ui/messages.py" line="146" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="108" />
+            <location filename="../../ui/messages.py" line="147" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="109" />
+            <location filename="../../ui/messages.py" line="148" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="110" />
+            <location filename="../../ui/messages.py" line="149" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="111" />
+            <location filename="../../ui/messages.py" line="150" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="114" />
+            <location filename="../../ui/messages.py" line="153" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="115" />
+            <location filename="../../ui/messages.py" line="154" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="116" />
+            <location filename="../../ui/messages.py" line="155" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="117" />
+            <location filename="../../ui/messages.py" line="156" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="118" />
+            <location filename="../../ui/messages.py" line="157" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="119" />
+            <location filename="../../ui/messages.py" line="158" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="120" />
+            <location filename="../../ui/messages.py" line="159" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="121" />
+            <location filename="../../ui/messages.py" line="160" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="122" />
+            <location filename="../../ui/messages.py" line="161" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="123" />
+            <location filename="../../ui/messages.py" line="162" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="124" />
+            <location filename="../../ui/messages.py" line="163" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="125" />
+            <location filename="../../ui/messages.py" line="164" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="126" />
+            <location filename="../../ui/messages.py" line="165" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="127" />
+            <location filename="../../ui/messages.py" line="166" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="128" />
+            <location filename="../../ui/messages.py" line="167" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="129" />
+            <location filename="../../ui/messages.py" line="168" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="130" />
+            <location filename="../../ui/messages.py" line="169" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="131" />
+            <location filename="../../ui/messages.py" line="170" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="132" />
+            <location filename="../../ui/messages.py" line="171" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="133" />
+            <location filename="../../ui/messages.py" line="172" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="135" />
+            <location filename="../../ui/messages.py" line="174" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="138" />
+            <location filename="../../ui/messages.py" line="177" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="139" />
+            <location filename="../../ui/messages.py" line="178" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="140" />
+            <location filename="../../ui/messages.py" line="179" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="141" />
+            <location filename="../../ui/messages.py" line="180" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="142" />
+            <location filename="../../ui/messages.py" line="181" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="143" />
+            <location filename="../../ui/messages.py" line="182" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="144" />
+            <location filename="../../ui/messages.py" line="183" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="145" />
+            <location filename="../../ui/messages.py" line="184" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="146" />
+            <location filename="../../ui/messages.py" line="185" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="147" />
+            <location filename="../../ui/messages.py" line="186" />
             <source>unit id</source>
             <translation>站号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="148" />
+            <location filename="../../ui/messages.py" line="187" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="152" />
+            <location filename="../../ui/messages.py" line="191" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="153" />
+            <location filename="../../ui/messages.py" line="192" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="154" />
+            <location filename="../../ui/messages.py" line="193" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="155" />
+            <location filename="../../ui/messages.py" line="194" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="156" />
+            <location filename="../../ui/messages.py" line="195" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="157" />
+            <location filename="../../ui/messages.py" line="196" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="158" />
+            <location filename="../../ui/messages.py" line="197" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="159" />
+            <location filename="../../ui/messages.py" line="198" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="160" />
+            <location filename="../../ui/messages.py" line="199" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="161" />
+            <location filename="../../ui/messages.py" line="200" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="163" />
+            <location filename="../../ui/messages.py" line="202" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="167" />
+            <location filename="../../ui/messages.py" line="206" />
             <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="168" />
+            <location filename="../../ui/messages.py" line="207" />
             <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
             <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="169" />
+            <location filename="../../ui/messages.py" line="208" />
             <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
             <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="170" />
+            <location filename="../../ui/messages.py" line="209" />
             <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
             <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="171" />
+            <location filename="../../ui/messages.py" line="210" />
             <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
             <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="172" />
+            <location filename="../../ui/messages.py" line="211" />
             <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
             <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="174" />
+            <location filename="../../ui/messages.py" line="213" />
             <source>Refused by the safety envelope: {text}</source>
             <translation>安全边界拒绝：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="175" />
+            <location filename="../../ui/messages.py" line="214" />
             <source>segment {n}: </source>
             <translation>第 {n} 段：</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="176" />
+            <location filename="../../ui/messages.py" line="215" />
             <source> (reduced-speed mode)</source>
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="341" />
+            <location filename="../../ui/messages.py" line="380" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="342" />
+            <location filename="../../ui/messages.py" line="381" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="392" />
+            <source>Plan “{plan}” has no segments.</source>
+            <translation>规划“{plan}”没有任何段。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="393" />
+            <source>Cannot start at segment {start}: the plan has {segments} segments.</source>
+            <translation>无法从第 {start} 段开始：该规划只有 {segments} 段。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="394" />
+            <source>speed {speed} mm/s is not in (0, {max}] mm/s.</source>
+            <translation>速度 {speed} mm/s 不在 (0, {max}] mm/s 范围内。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="395" />
+            <source>the arc has no middle point.</source>
+            <translation>圆弧没有中间点。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="396" />
+            <source>middle point P{id} does not exist.</source>
+            <translation>中间点 P{id} 不存在。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="397" />
+            <source>end point P{id} does not exist.</source>
+            <translation>终点 P{id} 不存在。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="398" />
+            <source>{point} is not on the controller ({sync}); upload it.</source>
+            <translation>{point} 不在控制器上（{sync}）；请上传。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="399" />
+            <source>{point} was taught with {point_tool}, the segment moves with {segment_tool}.</source>
+            <translation>{point} 示教时的工具为“{point_tool}”，该段运动的工具为“{segment_tool}”。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="400" />
+            <source>the line goes nowhere (start and end {length} mm apart){where}.</source>
+            <translation>直线没有移动（起点与终点相距 {length} mm）{where}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="401" />
+            <source>the arc starts at the robot's current pose, which is not known: its shape is not checked.</source>
+            <translation>圆弧从机器人的当前位姿开始，但当前位姿未知：未检查其形状。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="402" />
+            <source>the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
+            <translation>圆弧的起点与中间点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="403" />
+            <source>the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
+            <translation>圆弧的中间点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="404" />
+            <source>the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
+            <translation>圆弧的起点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="405" />
+            <source>the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}.</source>
+            <translation>圆弧的三个点（几乎）在一条直线上：中间点距起点—终点连线仅 {offset} mm（至少需要 {tolerance} mm）；请改用直线{where}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="406" />
+            <source>the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before.</source>
+            <translation>机械臂停在圆弧中间点之后：从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；请用直线移动到终点，或从前一段开始运行。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="407" />
+            <source>sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here.</source>
+            <translation>从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；从此处运行前请检查预览。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="408" />
+            <source>{point} is out of the robot model's reach.</source>
+            <translation>{point} 超出机器人模型的可达范围。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="409" />
+            <source>the path is out of the robot model's reach.</source>
+            <translation>路径超出机器人模型的可达范围。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="410" />
+            <source>{point} passes a joint limit of the robot model.</source>
+            <translation>{point} 会超过机器人模型的关节限位。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="411" />
+            <source>the path passes a joint limit of the robot model.</source>
+            <translation>路径会超过机器人模型的关节限位。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="413" />
+            <source> (from the current pose)</source>
+            <translation>（从当前位姿出发）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="414" />
+            <source> (on loops after the first, starting at the end of segment {after})</source>
+            <translation>（第一轮之后的循环中，从第 {after} 段的终点出发）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="490" />
+            <source>row {row}, column '{column}': {problem}</source>
+            <translation>第 {row} 行，“{column}”列：{problem}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="492" />
+            <source>column '{column}': {problem}</source>
+            <translation>“{column}”列：{problem}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="491" />
+            <source>row {row}: {problem}</source>
+            <translation>第 {row} 行：{problem}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="493" />
+            <source>{file}: {text}</source>
+            <translation>{file}：{text}</translation>
         </message>
     </context>
     <context>
@@ -1961,7 +2246,7 @@
     <context>
         <name>PlanEdits</name>
         <message>
-            <location filename="../../ui/panels/planner_edit.py" line="87" />
+            <location filename="../../ui/panels/planner_edit.py" line="88" />
             <source>Deleted plan {name} (Ctrl+Z to undo)</source>
             <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
         </message>
@@ -1977,62 +2262,62 @@
     <context>
         <name>PlanListModel</name>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="101" />
+            <location filename="../../ui/models/plan_model.py" line="102" />
             <source>Plan</source>
             <translation>轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="101" />
+            <location filename="../../ui/models/plan_model.py" line="102" />
             <source>Loops</source>
             <translation>循环次数</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="101" />
+            <location filename="../../ui/models/plan_model.py" line="102" />
             <source>Segments</source>
             <translation>段数</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="153" />
+            <location filename="../../ui/models/plan_model.py" line="154" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="157" />
+            <location filename="../../ui/models/plan_model.py" line="158" />
             <source>How many times the plan runs (0 = until stopped)</source>
             <translation>轨迹运行次数（0 = 直到停止）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="182" />
+            <location filename="../../ui/models/plan_model.py" line="183" />
             <source>Plan: refused, {reason}</source>
             <translation>轨迹：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="188" />
+            <location filename="../../ui/models/plan_model.py" line="189" />
             <source>plan</source>
             <translation>轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="192" />
+            <location filename="../../ui/models/plan_model.py" line="193" />
             <source>Add plan {name}</source>
             <translation>添加轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="200" />
+            <location filename="../../ui/models/plan_model.py" line="201" />
             <source>Duplicate plan {name}</source>
             <translation>复制轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="205" />
+            <location filename="../../ui/models/plan_model.py" line="206" />
             <source>Delete plan {name}</source>
             <translation>删除轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="215" />
+            <location filename="../../ui/models/plan_model.py" line="216" />
             <source>Rename plan {old} to {new}</source>
             <translation>将轨迹 {old} 重命名为 {new}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="224" />
+            <location filename="../../ui/models/plan_model.py" line="225" />
             <source>Set loops of {name} to {n}</source>
             <translation>将轨迹 {name} 的循环次数设为 {n}</translation>
         </message>
@@ -2449,12 +2734,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="205" />
+            <location filename="../../ui/panels/planner_panel.py" line="206" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="378" />
+            <location filename="../../ui/panels/planner_panel.py" line="379" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -2580,52 +2865,52 @@
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="372" />
+            <location filename="../../ui/controllers/point_sync.py" line="373" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="376" />
+            <location filename="../../ui/controllers/point_sync.py" line="377" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="385" />
+            <location filename="../../ui/controllers/point_sync.py" line="386" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="389" />
+            <location filename="../../ui/controllers/point_sync.py" line="390" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="393" />
+            <location filename="../../ui/controllers/point_sync.py" line="394" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="436" />
+            <location filename="../../ui/controllers/point_sync.py" line="437" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="439" />
+            <location filename="../../ui/controllers/point_sync.py" line="440" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="455" />
+            <location filename="../../ui/controllers/point_sync.py" line="456" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="459" />
+            <location filename="../../ui/controllers/point_sync.py" line="460" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="463" />
+            <location filename="../../ui/controllers/point_sync.py" line="464" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -2633,28 +2918,28 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/point.py" line="127" />
+            <location filename="../../app/points/point.py" line="139" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="128" />
+            <location filename="../../app/points/point.py" line="140" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="129" />
+            <location filename="../../app/points/point.py" line="141" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="130" />
+            <location filename="../../app/points/point.py" line="142" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="131" />
+            <location filename="../../app/points/point.py" line="143" />
             <source>on controller, unconfirmed</source>
             <translation>已在控制器上（未确认）</translation>
         </message>
@@ -2662,158 +2947,160 @@
     <context>
         <name>PointsModel</name>
         <message>
+            <location filename="../../ui/messages.py" line="422" />
             <location filename="../../ui/models/point_columns.py" line="66" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
+            <location filename="../../ui/messages.py" line="423" />
             <location filename="../../ui/models/point_columns.py" line="67" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="140" />
+            <location filename="../../ui/models/points_model.py" line="141" />
             <source>ID</source>
             <translation>编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="140" />
+            <location filename="../../ui/models/points_model.py" line="141" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="140" />
+            <location filename="../../ui/models/points_model.py" line="141" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="141" />
+            <location filename="../../ui/models/points_model.py" line="142" />
             <source>Sync</source>
             <translation>同步状态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="141" />
+            <location filename="../../ui/models/points_model.py" line="142" />
             <source>Note</source>
             <translation>备注</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="144" />
+            <location filename="../../ui/models/points_model.py" line="145" />
             <source>Temp point id on the controller</source>
             <translation>控制器上的临时点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="145" />
+            <location filename="../../ui/models/points_model.py" line="146" />
             <source>Tool frame (200 = none)</source>
             <translation>工具坐标系（200 = 无）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="146" />
+            <location filename="../../ui/models/points_model.py" line="147" />
             <source>Whether the controller holds this point</source>
             <translation>控制器上是否有此点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="147" />
+            <location filename="../../ui/models/points_model.py" line="148" />
             <source>mm, base frame</source>
             <translation>毫米，基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="148" />
+            <location filename="../../ui/models/points_model.py" line="149" />
             <source>degrees</source>
             <translation>度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="150" />
+            <location filename="../../ui/models/points_model.py" line="151" />
             <source>External axis (recorded only: the controller does not store it)</source>
             <translation>外部轴（仅记录：控制器不保存）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="229" />
+            <location filename="../../ui/models/points_model.py" line="230" />
             <source>no reason given</source>
             <translation>未给出原因</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="230" />
+            <location filename="../../ui/models/points_model.py" line="231" />
             <source>Upload failed: {reason}</source>
             <translation>上传失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="232" />
+            <location filename="../../ui/models/points_model.py" line="233" />
             <source>Not known whether the controller holds this point (it restarted or the link was lost): upload it before moving to it</source>
             <translation>不确定控制器上是否有此点（控制器已重启或通信曾中断）：运动到该点前请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="234" />
+            <location filename="../../ui/models/points_model.py" line="235" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="235" />
+            <location filename="../../ui/models/points_model.py" line="236" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="236" />
+            <location filename="../../ui/models/points_model.py" line="237" />
             <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
             <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="243" />
+            <location filename="../../ui/models/points_model.py" line="244" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="273" />
+            <location filename="../../ui/models/points_model.py" line="274" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="291" />
+            <location filename="../../ui/models/points_model.py" line="294" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="322" />
+            <location filename="../../ui/models/points_model.py" line="325" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="348" />
+            <location filename="../../ui/models/points_model.py" line="351" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="349" />
+            <location filename="../../ui/models/points_model.py" line="352" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="366" />
+            <location filename="../../ui/models/points_model.py" line="369" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="367" />
+            <location filename="../../ui/models/points_model.py" line="370" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="382" />
+            <location filename="../../ui/models/points_model.py" line="385" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="382" />
+            <location filename="../../ui/models/points_model.py" line="385" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="398" />
+            <location filename="../../ui/models/points_model.py" line="403" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="407" />
+            <location filename="../../ui/models/points_model.py" line="412" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -2821,124 +3108,124 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="147" />
+            <location filename="../../ui/panels/points_panel.py" line="148" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="147" />
+            <location filename="../../ui/panels/points_panel.py" line="148" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="149" />
+            <location filename="../../ui/panels/points_panel.py" line="150" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="149" />
+            <location filename="../../ui/panels/points_panel.py" line="150" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="150" />
+            <location filename="../../ui/panels/points_panel.py" line="151" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="150" />
+            <location filename="../../ui/panels/points_panel.py" line="151" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="151" />
+            <location filename="../../ui/panels/points_panel.py" line="152" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="152" />
+            <location filename="../../ui/panels/points_panel.py" line="153" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="153" />
+            <location filename="../../ui/panels/points_panel.py" line="154" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="154" />
+            <location filename="../../ui/panels/points_panel.py" line="155" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="155" />
+            <location filename="../../ui/panels/points_panel.py" line="156" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="156" />
+            <location filename="../../ui/panels/points_panel.py" line="157" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="157" />
+            <location filename="../../ui/panels/points_panel.py" line="158" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="158" />
+            <location filename="../../ui/panels/points_panel.py" line="159" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="159" />
+            <location filename="../../ui/panels/points_panel.py" line="160" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="159" />
+            <location filename="../../ui/panels/points_panel.py" line="160" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="160" />
+            <location filename="../../ui/panels/points_panel.py" line="161" />
             <location filename="../../ui/panels/points_parts.py" line="151" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="161" />
+            <location filename="../../ui/panels/points_panel.py" line="162" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="162" />
+            <location filename="../../ui/panels/points_panel.py" line="163" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="163" />
-            <location filename="../../ui/panels/points_panel.py" line="327" />
+            <location filename="../../ui/panels/points_panel.py" line="164" />
+            <location filename="../../ui/panels/points_panel.py" line="328" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="164" />
+            <location filename="../../ui/panels/points_panel.py" line="165" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="165" />
+            <location filename="../../ui/panels/points_panel.py" line="166" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="165" />
+            <location filename="../../ui/panels/points_panel.py" line="166" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="166" />
+            <location filename="../../ui/panels/points_panel.py" line="167" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
@@ -2973,42 +3260,42 @@
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="259" />
+            <location filename="../../ui/panels/points_panel.py" line="260" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="262" />
+            <location filename="../../ui/panels/points_panel.py" line="263" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="263" />
+            <location filename="../../ui/panels/points_panel.py" line="264" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="264" />
+            <location filename="../../ui/panels/points_panel.py" line="265" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="284" />
+            <location filename="../../ui/panels/points_panel.py" line="285" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="287" />
+            <location filename="../../ui/panels/points_panel.py" line="288" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="312" />
+            <location filename="../../ui/panels/points_panel.py" line="313" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="320" />
+            <location filename="../../ui/panels/points_panel.py" line="321" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -3183,153 +3470,153 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="128" />
+            <location filename="../../ui/controllers/project_controller.py" line="129" />
             <source>Undo</source>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="130" />
+            <location filename="../../ui/controllers/project_controller.py" line="131" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="134" />
+            <location filename="../../ui/controllers/project_controller.py" line="135" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="135" />
+            <location filename="../../ui/controllers/project_controller.py" line="136" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="136" />
+            <location filename="../../ui/controllers/project_controller.py" line="137" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="137" />
+            <location filename="../../ui/controllers/project_controller.py" line="138" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="138" />
+            <location filename="../../ui/controllers/project_controller.py" line="139" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="139" />
+            <location filename="../../ui/controllers/project_controller.py" line="140" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="162" />
+            <location filename="../../ui/controllers/project_controller.py" line="163" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="195" />
+            <location filename="../../ui/controllers/project_controller.py" line="196" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="203" />
-            <location filename="../../ui/controllers/project_controller.py" line="239" />
-            <location filename="../../ui/controllers/project_controller.py" line="348" />
+            <location filename="../../ui/controllers/project_controller.py" line="204" />
+            <location filename="../../ui/controllers/project_controller.py" line="240" />
+            <location filename="../../ui/controllers/project_controller.py" line="349" />
             <source>Project in use</source>
             <translation>工程正在使用中</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="208" />
-            <location filename="../../ui/controllers/project_controller.py" line="211" />
+            <location filename="../../ui/controllers/project_controller.py" line="209" />
+            <location filename="../../ui/controllers/project_controller.py" line="212" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="214" />
+            <location filename="../../ui/controllers/project_controller.py" line="215" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="226" />
+            <location filename="../../ui/controllers/project_controller.py" line="227" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="244" />
+            <location filename="../../ui/controllers/project_controller.py" line="245" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="256" />
+            <location filename="../../ui/controllers/project_controller.py" line="257" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="262" />
+            <location filename="../../ui/controllers/project_controller.py" line="263" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="269" />
-            <location filename="../../ui/controllers/project_controller.py" line="272" />
-            <location filename="../../ui/controllers/project_controller.py" line="286" />
+            <location filename="../../ui/controllers/project_controller.py" line="270" />
+            <location filename="../../ui/controllers/project_controller.py" line="273" />
+            <location filename="../../ui/controllers/project_controller.py" line="287" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="288" />
+            <location filename="../../ui/controllers/project_controller.py" line="289" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="294" />
+            <location filename="../../ui/controllers/project_controller.py" line="295" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="301" />
+            <location filename="../../ui/controllers/project_controller.py" line="302" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="303" />
+            <location filename="../../ui/controllers/project_controller.py" line="304" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="329" />
+            <location filename="../../ui/controllers/project_controller.py" line="330" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="364" />
-            <location filename="../../ui/controllers/project_controller.py" line="367" />
+            <location filename="../../ui/controllers/project_controller.py" line="365" />
+            <location filename="../../ui/controllers/project_controller.py" line="368" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="370" />
+            <location filename="../../ui/controllers/project_controller.py" line="371" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="401" />
+            <location filename="../../ui/controllers/project_controller.py" line="402" />
             <source>Cannot lock {path}: {reason}</source>
             <translation>无法锁定 {path}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="410" />
+            <location filename="../../ui/controllers/project_controller.py" line="411" />
             <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
             <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="446" />
+            <location filename="../../ui/controllers/project_controller.py" line="447" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="449" />
+            <location filename="../../ui/controllers/project_controller.py" line="450" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>

@@ -188,8 +188,10 @@ class _Prefix(QTranslator):
         return False
 
 
-def test_language_change_retranslates_levels_not_messages(qtbot: Any, panel: EventLogPanel) -> None:
+def test_language_change_retranslates_levels_and_payload_lines_not_written_texts(
+        qtbot: Any, panel: EventLogPanel) -> None:
     panel.add_event("warning", "s", "as logged", WHEN)
+    panel.on_alarms(int(Alarm.SERVO))  # logged from a payload: rendered again after the switch
     translator = _Prefix()
     app = QCoreApplication.instance()
     assert app is not None
@@ -197,8 +199,9 @@ def test_language_change_retranslates_levels_not_messages(qtbot: Any, panel: Eve
     try:
         qtbot.waitUntil(lambda: cell(panel, 0, COL_LEVEL) == "中 Warning", timeout=2000)
         assert cell(panel, 0, COL_MESSAGE) == "as logged"
+        assert cell(panel, 1, COL_MESSAGE) == "中 Alarm raised: 中 servo alarm"
         assert panel.level_combo.itemText(2) == "中 Errors only"
-        panel.on_alarms(int(Alarm.ESTOP))
-        assert cell(panel, 1, COL_MESSAGE) == "中 Alarm raised: 中 emergency stop"
+        panel.on_alarms(int(Alarm.ESTOP | Alarm.SERVO))
+        assert cell(panel, 2, COL_MESSAGE) == "中 Alarm raised: 中 emergency stop"
     finally:
         app.removeTranslator(translator)

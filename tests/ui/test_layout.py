@@ -2,7 +2,8 @@
 
 On every tab (and the states that change a layout: jog frames, the step panel's external
 axes, the points banner and upload progress, the planner after a stop) no visible text is
-clipped, no two visible siblings overlap, motion buttons are tall enough (``layout_audit``).
+clipped, no two visible siblings overlap, motion buttons are tall enough (``layout_audit``);
+connected, again with the alarm banner up (an emergency stop raised at the simulator).
 
 Chinese text is measured with the font Qt really uses. Where no CJK font is installed (CI
 installs only the Python packages), Qt measures missing glyphs as narrow boxes, so a clipped
@@ -21,7 +22,7 @@ from PySide6.QtCore import QCoreApplication, QSize, Qt
 from PySide6.QtGui import QFontDatabase
 from PySide6.QtWidgets import QApplication, QMessageBox, QWidget
 
-from app.protocol.enums import TeachFrame
+from app.protocol.enums import Alarm, TeachFrame
 from tests.ui.layout_audit import clipped_texts, overlapping_siblings, small_motion_buttons
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
@@ -185,6 +186,35 @@ def test_main_window_layout(qtbot: Any, sim: Any, make_window: Callable[..., Mai
     key = f"{language}-{size[0]}x{size[1]}-connected"
     found = without_known(check_window(window, language, touch=False), key)
     assert not found, "\n".join(found)
+
+
+def raise_estop(qtbot: Any, window: MainWindow, sim: Any) -> None:
+    """An emergency stop at the simulator: the banner is up and the motion controls are held."""
+    sim.set_alarm(Alarm.ESTOP, True)
+    qtbot.waitUntil(lambda: window.alarm_banner.isVisible() and not window.jog_panel.axes_box.isEnabled(),
+                    timeout=SIGNAL_TIMEOUT_MS)
+    settle()
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_main_window_layout_with_an_alarm(qtbot: Any, sim: Any, make_window: Callable[..., MainWindow],
+                                          language: str, size: tuple[int, int]) -> None:
+    window = make_window(language, size)
+    raise_estop(qtbot, window, sim)
+    found = check_window(window, language, touch=False)
+    assert window.alarm_banner.isVisible()
+    assert not found, "\n".join(found)
+    # more alarms do not make the banner taller (the window below it does not move)
+    banner = window.alarm_banner
+    height = banner.height()
+    for bit in (Alarm.SERVO, Alarm.ENCODER):
+        sim.set_alarm(bit, True)
+    qtbot.waitUntil(lambda: banner.alarms == int(Alarm.ESTOP | Alarm.SERVO | Alarm.ENCODER),
+                    timeout=SIGNAL_TIMEOUT_MS)
+    settle()
+    assert banner.height() == height and not squeezed(window)
+    assert banner.label.toolTip().count("\n") == 3  # the whole text, one line per alarm
 
 
 @pytest.mark.parametrize("language", LANGUAGES)

@@ -8,8 +8,9 @@ remain: only units, register names, numbers, "Modbus", host:port and the like.
 from __future__ import annotations
 
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 from PySide6.QtCore import QCoreApplication, QTranslator
@@ -30,6 +31,7 @@ from app.errors import (
 from app.link.tracker import CommandTracker
 from app.link.types import Operation, WorkerError
 from app.models import CommandResult, ControllerStatus
+from app.plan.checks import IssueCode, IssueKind
 from app.protocol.enums import (
     _STATUS_TEXT,
     STATUS_SENTINEL,
@@ -45,9 +47,9 @@ from ui.messages import LEVEL_ERROR, LEVEL_INFO, LEVEL_WARNING, error_text, resu
 
 QM = Path(__file__).resolve().parents[2] / "ui" / "i18n" / "teachpad_zh_CN.qm"
 ENDPOINT = "192.168.1.10:502"
-# what may stay ASCII in a Chinese sentence: units, register and protocol names, numbers, addresses
-ALLOWED = re.compile(r"\d+(\.\d+)+:\d+|Modbus|TCP|RTU|CRC|GV\d+|COM\d+|mm/s|mm|\bs\b|\b[XYZABC]\b|"
-                     r"\bJ\d+\b|\bP\d+\b|0x[0-9A-Fa-f]+")
+# what may stay ASCII in a Chinese sentence: units, register, protocol and format names, numbers, addresses
+ALLOWED = re.compile(r"\d+(\.\d+)+:\d+|Modbus|TCP|RTU|CRC|UTF-8|Unicode|CSV|JSON|GV\d+|COM\d+|mm/s|mm|"
+                     r"\bs\b|\b[XYZABC]\b|\bJ\d+\b|\bP\d+\b|0x[0-9A-Fa-f]+")
 
 
 @pytest.fixture
@@ -243,3 +245,203 @@ def test_the_codes_the_worker_and_the_cli_use_read_in_chinese(zh: None) -> None:
         if name.isupper():
             assert_chinese(operation_text(op))
     assert error_text(Reason("request_done", {"operation": Operation.STOP})) == "停止：已发送。"
+
+
+# --- the link's state, the plan's checks and the ledger's refusals (issue 9) -----------------------
+def test_the_link_states_and_cut_short_commands_read_in_chinese(zh: None) -> None:
+    from app.link.types import ConnectionState, LinkState
+    from ui.messages import connection_text
+
+    states = [
+        ConnectionState(LinkState.NOT_ANSWERING, "no answer", ENDPOINT,
+                        reason=ResponseTimeout("no answer", params={"seconds": 0.2, "endpoint": ENDPOINT})
+                        .as_reason()),
+        ConnectionState(LinkState.DOWN, "link lost: x", ENDPOINT,
+                        reason=Reason("link_lost", {"endpoint": ENDPOINT})),
+        ConnectionState(LinkState.DOWN, "link lost: x", ENDPOINT, reason=Reason("link_lost")),
+        ConnectionState(LinkState.DOWN, "cannot reconnect", ENDPOINT, reason=_errors()[5].as_reason()),
+        ConnectionState(LinkState.DISCONNECTED, "the link was shut down", ENDPOINT,
+                        reason=Reason("link_was_shut_down")),
+    ]
+    for state in states:
+        assert_chinese(connection_text(state))
+    assert connection_text(ConnectionState(LinkState.CONNECTED)) == ""
+    assert connection_text(ConnectionState(LinkState.DOWN, "older producer")) == "older producer"
+    for code in ("outcome_unknown_link_lost", "outcome_unknown_link_closed"):
+        result = CommandResult(None, None, None, False, "move to point: link lost",
+                               reason=Reason(code, {"operation": Operation.MOVE_TO_POINT}))
+        assert_chinese(result_text(result))
+
+
+def _plan_issues() -> list[Any]:
+    """At least one issue of every code, from the real checks (and the reach check's wording)."""
+    from app.plan.checks import PlanIssue, check_plan
+    from app.plan.segments import Plan, Segment, SegmentKind
+    from app.points.ledger import PointLedger, SyncState, make_point
+    from app.safety.envelope import EnvelopeRefused
+    from app.view3d.kinematics import Reach
+    from app.view3d.reach import _issue
+
+    on = SyncState.ON_CONTROLLER
+    ledger = PointLedger([
+        make_point(1, "原点", (400, 0, 450, 180, 0, 0), sync=on),
+        make_point(5, "西", (300, 0, 300, 180, 0, 0), sync=on),
+        make_point(6, "北", (400, 100, 300, 180, 0, 0), sync=on),
+        make_point(7, "东", (500, 0, 300, 180, 0, 0), sync=on),
+        make_point(8, "南", (400, -100, 300, 180, 0, 0), sync=on),
+        make_point(9, "中", (400, 0, 300, 180, 0, 0), sync=on),
+        make_point(10, "又西", (300, 0, 300.05, 180, 0, 0), sync=on),
+        make_point(11, "新", (350, 50, 300, 180, 0, 0), sync=SyncState.CHANGED),
+        make_point(13, "工具点", (450, 50, 300, 180, 0, 0), tool=0, sync=on),
+    ])
+    home = (400.0, 0.0, 450.0)
+    circle = Plan("圆", [Segment.line(5, 100), Segment.arc(6, 7, 50), Segment.arc(8, 5, 50)])
+    wrap = Plan("环", [Segment.arc(9, 7), Segment.line(5)], loops=3)
+    issues: list[PlanIssue] = [
+        *check_plan(Plan("空"), ledger),
+        *check_plan(wrap, ledger, current_pose=ledger.point(6), start_index=2),
+        *check_plan(Plan("p", [Segment.line(5, 0), Segment.arc(99, 7), Segment.line(42), Segment.line(11)]),
+                    ledger, current_pose=home),
+        *check_plan(Plan("p", [Segment.line(1), Segment.line(13)]), ledger, current_pose=home),
+        *check_plan(Plan("p", [Segment.arc(9, 7)]), ledger),
+        *check_plan(Plan("p", [Segment.line(5), Segment.arc(9, 7)]), ledger, current_pose=home),
+        *check_plan(wrap, ledger, current_pose=ledger.point(6)),
+        *check_plan(Plan("p", [Segment.line(5), Segment.arc(10, 7)]), ledger, current_pose=home),
+        *check_plan(Plan("p", [Segment.line(5), Segment.arc(7, 5)]), ledger, current_pose=home),
+        *check_plan(Plan("p", [Segment.line(7), Segment(SegmentKind.ARC, 6)]), ledger, current_pose=home),
+        *check_plan(circle, ledger, current_pose=(470.7, 70.7, 300, 180, 0, 0), start_index=1),
+        *check_plan(circle, ledger, current_pose=(520.0, -40.0, 300, 180, 0, 0), start_index=1),
+    ]
+    violation = EnvelopeViolation(ViolationCode.KEEP_OUT, 10.0, 0.0, axis="Z", box="夹具", segment=1)
+    issues += [
+        PlanIssue(1, IssueKind.ERROR, IssueCode.OUTSIDE_ENVELOPE, violation.message,
+                  args=EnvelopeRefused(violation).as_reason().args),
+        _issue(0, Reach.UNREACHABLE, "P5 西", 5), _issue(1, Reach.UNREACHABLE, "the path", None),
+        _issue(0, Reach.JOINT_LIMIT, "P5 西", 5), _issue(1, Reach.JOINT_LIMIT, "the path", None),
+    ]
+    return issues
+
+
+def test_every_plan_check_reads_in_chinese(zh: None) -> None:
+    from ui.messages import issue_line, issue_text
+
+    issues = _plan_issues()
+    assert {i.code for i in issues} == set(IssueCode), "an issue code is not covered"
+    keys = set()
+    for issue in issues:
+        text = issue_text(issue)
+        assert text != issue.message, f"{issue.code}: no wording for {dict(issue.args)}"
+        assert_chinese(text)
+        assert_chinese(issue_line(issue))
+        variant = ("role", "pair", "past_middle", "from")
+        keys.add((issue.code, tuple(sorted(str(issue.args[k]) for k in variant if k in issue.args))))
+    assert len(keys) >= 18  # the variants: both roles, the three pairs, past / larger, both contexts
+    missing = next(i for i in issues if i.code is IssueCode.MISSING_POINT)
+    assert issue_text(missing) == "第 2 段：中间点 P99 不存在。"
+
+
+def test_the_plan_checks_stay_english_for_the_cli() -> None:
+    from app.plan.presenter import run_gate, summarize_checks
+
+    issues = _plan_issues()
+    summary = summarize_checks(issues)
+    first = next(i for i in issues if i.is_error and i.segment is not None)
+    assert summary.first_row_error == first.message and first.message.startswith("segment ")
+    assert summary.details.split("\n")[0] == str(issues[0])
+    warnings = run_gate(issues).warnings
+    assert warnings and warnings == tuple(i.message for i in issues
+                                          if i.kind is IssueKind.WARNING)[:len(warnings)]
+
+
+def test_the_ledgers_refusals_read_in_chinese(zh: None) -> None:
+    from app.points.ledger import EmptyImport, ImportMode, PointLedger, make_point
+    from app.points.point import PointLimits
+    from ui.messages import refusal_text
+
+    ledger = PointLedger([make_point(1, "一", (0, 0, 0, 0, 0, 0)), make_point(2, "二", (1, 0, 0, 0, 0, 0))])
+    point = make_point(2, "二", (1, 0, 0, 0, 0, 0))
+    attempts: list[Callable[[], object]] = [
+        lambda: ledger.point(99),
+        lambda: ledger.set_sync(99, ledger[0].sync),
+        lambda: ledger.remove_rows([7]),
+        lambda: ledger.move(0, 5),
+        lambda: ledger.replace_all([point, point]),
+        lambda: ledger.import_points([point, point], ImportMode.MERGE),
+        lambda: ledger.import_points([]),
+        lambda: ledger.set_limits(PointLimits(id_min=5, id_max=10)),
+        lambda: PointLedger([make_point(1, "一", (0, 0, 0, 0, 0, 0))], PointLimits(id_min=1, id_max=1))
+        .next_free_id(),
+        lambda: ledger.replace(0, make_point(2, "一", (0, 0, 0, 0, 0, 0))),
+    ]
+    codes = set()
+    for attempt in attempts:
+        with pytest.raises(InvalidInput) as caught:
+            attempt()
+        codes.add(caught.value.code)
+        assert_chinese(refusal_text(caught.value))
+        assert re.search("[a-z]{3}", str(caught.value))  # English for logs and the CLI
+    assert codes == {"no_such_point", "no_such_row", "cannot_move_row", "duplicate_row_id",
+                     "import_duplicate_id", "empty_import", "points_outside_range", "no_free_point_id",
+                     "point_id_taken"}
+    assert isinstance(EmptyImport(3), InvalidInput)
+    assert refusal_text(InvalidInput("speed must be positive")) == "speed must be positive"  # no code: as is
+
+
+def _without_quoted(text: str) -> str:
+    """A refusal without the operator's own quoted input and the column names it quotes."""
+    return re.sub(r"'[^']*'|“[^”]*”", "", text)
+
+
+def test_a_points_fields_and_files_refusals_read_in_chinese(zh: None) -> None:
+    from app.points.csv_io import decode_text, parse_points_csv
+    from app.points.point import FieldError, FileFormatError, make_point
+    from ui.messages import refusal_text
+
+    fields: list[Callable[[], object]] = [
+        lambda: make_point(1, "一", ("abc", 0, 0, 0, 0, 0)),
+        lambda: make_point(1, "一", ("", 0, 0, 0, 0, 0)),
+        lambda: make_point(1, "一", ("1e999", 0, 0, 0, 0, 0)),
+        lambda: make_point(1, "一", ("inf", 0, 0, 0, 0, 0)),
+        lambda: make_point("1.5", "一"),
+        lambda: make_point(100000, "一"),
+        lambda: make_point(1, "一", tool=500),
+        lambda: make_point(1, 5),
+        lambda: make_point(1, "一" * 300),
+        lambda: make_point(1, "一\n二"),
+    ]
+    codes = set()
+    for attempt in fields:
+        with pytest.raises(FieldError) as caught:
+            attempt()
+        codes.add(caught.value.code)
+        assert_chinese(_without_quoted(refusal_text(caught.value)))
+    assert codes >= {"not_a_number", "value_empty", "too_large", "not_finite", "not_integer",
+                     "id_out_of_range", "bad_tool", "not_text", "too_long", "not_one_line"}
+    header = "id,name,x,y,z,a,b,c"
+    files = [
+        "",
+        "id,名字\n",
+        "id,id,x\n",
+        "id,name,x,y\n",
+        f"{header}\n1,一,0,0\n",
+        f"{header}\n1,一,abc,0,0,0,0,0\n",
+        f"{header}\n1,一,0,0,0,0,0,0\n1,二,0,0,0,0,0,0\n",
+    ]
+    problems = set()
+    for text in files:
+        with pytest.raises(FileFormatError) as refused:
+            parse_points_csv(text, path="/data/点位.csv")
+        assert refused.value.problem is not None, str(refused.value)
+        problems.add(refused.value.problem.code)
+        shown = refusal_text(refused.value)
+        assert shown.startswith("点位.csv：") and "/data" not in shown
+        columns = "id,name,x,y,z,a,b,c,e1,e2,e3,e4,e5,tool,note"
+        assert_chinese(_without_quoted(shown).replace(columns, "").replace("点位.csv", "点位"))
+    assert problems == {"empty_file", "unknown_column", "column_twice", "column_missing", "cell_count",
+                        "not_a_number", "row_id_taken"}
+    with pytest.raises(FileFormatError) as bad_bytes:
+        decode_text(b"\xff\xfe1", path="p.csv")
+    assert_chinese(refusal_text(bad_bytes.value).replace("p.csv", ""))
+    # a problem without a code is shown whole in English, never half translated
+    bare = FileFormatError("expected a JSON object at the top level", path="a.teachpad.json")
+    assert refusal_text(bare) == str(bare)

@@ -33,7 +33,7 @@ from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport
 from app.protocol.registers import TOOL_NONE
 from ui.controllers.new_point import NewPointPose, new_point_pose
-from ui.messages import error_text, result_text
+from ui.messages import connection_text, error_text, refusal_text, result_text
 from ui.models.point_columns import sync_text
 from ui.models.points_model import PointsModel
 
@@ -164,7 +164,7 @@ class PointSyncController(QObject):
         try:
             point_id = self._model.next_id()
         except InvalidInput as exc:
-            self._say(str(exc), LEVEL_ERROR)
+            self._say(refusal_text(exc), LEVEL_ERROR)
             return None
         self._teach_id = point_id
         self._teach_name = name
@@ -298,7 +298,7 @@ class PointSyncController(QObject):
         connected = state.connected
         self.connectedChanged.emit(connected)
         if not connected and self._operation:
-            reason = state.message or self.tr("link lost")
+            reason = connection_text(state) or self.tr("link lost")
             if self._upload is not None:
                 # The worker still reports the points it finished, then ends the batch: wait for it.
                 self._upload.link_lost = reason
@@ -369,7 +369,8 @@ class PointSyncController(QObject):
         try:
             self._model.add_taught_point(point_id, pose, name=self._teach_name, tool=self.teach_tool)
         except InvalidInput as exc:
-            self._say(self.tr("Teach P{id}: {reason}").format(id=point_id, reason=str(exc)), LEVEL_ERROR)
+            why = refusal_text(exc)
+            self._say(self.tr("Teach P{id}: {reason}").format(id=point_id, reason=why), LEVEL_ERROR)
             return
         if result.unconfirmed:  # created without an error, but not proven: not "on controller"
             self._model.set_sync(point_id, SyncState.UNCONFIRMED)

@@ -52,6 +52,7 @@ from app.points.project import (
     write_points_csv,
 )
 from ui.controllers.project_dialogs import ProjectDialogs
+from ui.messages import refusal_text
 from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
 
@@ -205,7 +206,7 @@ class ProjectController(QObject):
         try:
             project = load_project(path, self._project.ledger.limits)
         except (FileFormatError, InvalidInput) as exc:
-            self.dialogs.error(self.tr("Cannot open project"), str(exc))
+            self.dialogs.error(self.tr("Cannot open project"), refusal_text(exc))
             return False
         except OSError as exc:
             self.dialogs.error(self.tr("Cannot open project"), f"{path}: {exc.strerror or exc}")
@@ -266,7 +267,7 @@ class ProjectController(QObject):
         try:
             points = read_points_csv(path, self._project.ledger.limits)
         except (FileFormatError, InvalidInput) as exc:
-            self.dialogs.error(self.tr("Cannot import points"), str(exc))
+            self.dialogs.error(self.tr("Cannot import points"), refusal_text(exc))
             return False
         except OSError as exc:
             self.dialogs.error(self.tr("Cannot import points"), f"{path}: {exc.strerror or exc}")
@@ -283,7 +284,7 @@ class ProjectController(QObject):
                     return False
                 report = self.points_model.import_points(points, mode, allow_empty=True)
         except InvalidInput as exc:
-            self.dialogs.error(self.tr("Cannot import points"), str(exc))
+            self.dialogs.error(self.tr("Cannot import points"), refusal_text(exc))
             return False
         self.statusMessage.emit(self.tr("Imported {path}: {report}").format(path=path, report=report.text))
         return True
@@ -361,7 +362,7 @@ class ProjectController(QObject):
         try:
             project = load_project(autosave, self._project.ledger.limits)
         except (FileFormatError, InvalidInput) as exc:
-            self.dialogs.error(self.tr("Cannot recover autosave"), str(exc))
+            self.dialogs.error(self.tr("Cannot recover autosave"), refusal_text(exc))
             return False
         except OSError as exc:
             self.dialogs.error(self.tr("Cannot recover autosave"), f"{autosave}: {exc.strerror or exc}")

@@ -36,6 +36,7 @@ from app.link.client import ConnectionSettings
 from app.link.types import ConnectionState, LinkState
 from app.protocol.codec import WordOrder
 from app.safety.register_profile import RegisterProfile
+from ui.messages import connection_text
 
 _BAUDRATES = (9600, 19200, 38400, 57600, 115200, 230400)
 _PARITIES = ("N", "E", "O")
@@ -240,8 +241,9 @@ class ConnectionDialog(QDialog):
             lines.append(self.tr("Polling at {hz:g} Hz").format(hz=self._poll_hz))
         if state.monitor_only or s.monitor_only:
             lines.append(self.tr("Monitor only: nothing is written to the controller"))
-        if state.message and not state.connected:
-            lines.append(state.message[:120])
+        why = connection_text(state)
+        if why and not state.connected:
+            lines.append(why[:120])
         self.current_label.setText("\n".join(lines))
         self.current_label.setStyleSheet("font-weight: bold;" if state.connected else "")
 

@@ -26,6 +26,7 @@ from app.plan.segments import (
 )
 from app.points.ledger import FieldError
 from app.points.project import Project
+from ui.messages import refusal_text
 from ui.models.plan_columns import (
     PLAN_COL_LOOPS,
     PLAN_COL_NAME,
@@ -178,7 +179,7 @@ class PlanListModel(QAbstractTableModel):
             if index.column() == PLAN_COL_LOOPS:
                 return self.set_loops(index.row(), value)
         except InvalidInput as exc:
-            reason = exc.reason if isinstance(exc, FieldError) else str(exc)
+            reason = refusal_text(exc)
             self.editRejected.emit(self.tr("Plan: refused, {reason}").format(reason=reason))
         return False
 

@@ -49,6 +49,7 @@ from app.points.ledger import (
 )
 from app.points.project import Project
 from app.protocol.registers import TOOL_NONE
+from ui.messages import refusal_text
 from ui.models.point_columns import (
     COL_C,
     COL_ID,
@@ -268,7 +269,7 @@ class PointsModel(UndoableListModel):
         return True
 
     def refusal_text(self, point: TempPoint, name: str, exc: InvalidInput) -> str:
-        reason = exc.reason if isinstance(exc, FieldError) else str(exc)
+        reason = refusal_text(exc)
         column = self._headers[COLUMNS.index(name)] if name in COLUMNS else name
         return self.tr("{point}, {column}: refused, {reason}").format(point=point.label, column=column,
                                                                   reason=reason)
@@ -285,7 +286,9 @@ class PointsModel(UndoableListModel):
         if name == "id":
             other = self.ledger.row_of(new.id)
             if other is not None and other != row:
-                raise FieldError("id", f"id {new.id} is already used by {self.ledger[other].label}")
+                taken = self.ledger[other].label
+                raise FieldError("id", f"id {new.id} is already used by {taken}", code="point_id_taken",
+                                 params={"id": new.id, "point": taken})
         after = self._follow_id(old.id, new.id) if old.id != new.id else None
         column = self._headers[COLUMNS.index(name)] if name in COLUMNS else name
         text = self.tr("Edit {point} {column}").format(point=old.label, column=column)
@@ -391,7 +394,9 @@ class PointsModel(UndoableListModel):
         point = point_from_pose(point_id, pose, name, tool=tool, limits=self.ledger.limits)
         point = replace(point, sync=SyncState.ON_CONTROLLER)
         if self.ledger.row_of(point_id) is not None:
-            raise FieldError("id", f"id {point_id} is already used by {self.ledger.point(point_id).label}")
+            taken = self.ledger.point(point_id).label
+            raise FieldError("id", f"id {point_id} is already used by {taken}", code="point_id_taken",
+                             params={"id": point_id, "point": taken})
         self._on_controller[point_id] = point
         row = len(self.ledger)
         self._stack.push(InsertRowsCommand(self, self.ledger, [(row, point)],

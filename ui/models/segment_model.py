@@ -36,6 +36,7 @@ from app.plan.segments import (
 )
 from app.points.ledger import FieldError, PointLedger, parse_point_id
 from app.protocol.registers import TOOL_NONE
+from ui.messages import issue_line, refusal_text
 from ui.models.plan_columns import (
     COL_END,
     COL_IGNORE,
@@ -55,7 +56,6 @@ from ui.models.plan_columns import (
     SEG_COLUMNS,
     ModelIndex,
     issue_icon,
-    issue_kind_text,
     kind_text,
     orientation_text,
 )
@@ -302,7 +302,7 @@ class SegmentTableModel(UndoableListModel):
             issues = self._issues.get(row)
             if not issues:
                 return self.tr("Segment {n}: no problems found").format(n=row + 1)
-            return "\n".join(f"{issue_kind_text(i.kind)}: {i.message}" for i in issues)
+            return "\n".join(issue_line(i) for i in issues)
         if column in (COL_VIA, COL_END):
             pid = seg.via_id if column == COL_VIA else seg.end_id
             if pid is not None and self._ledger.get(pid) is None:
@@ -339,7 +339,7 @@ class SegmentTableModel(UndoableListModel):
         try:
             return self.edit_field(row, name, value)
         except InvalidInput as exc:
-            reason = exc.reason if isinstance(exc, FieldError) else str(exc)
+            reason = refusal_text(exc)
             self.editRejected.emit(self.tr("Segment {n}, {column}: refused, {reason}").format(
                 n=row + 1, column=self._headers[column], reason=reason))
             return False

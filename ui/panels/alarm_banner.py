@@ -4,13 +4,16 @@ It names every set alarm in the operator's language with what to do about it, an
 motion controls are held. It is a toolbar that cannot be moved, floated or hidden by hand: it
 shows exactly while the controller reports an alarm (the last known word when the link is stale,
 marked as such) and hides itself when every bit is clear.
+
+It is one line of fixed height whatever the number of alarms (the window below it must not
+shrink as alarms come and go; at 1280×800 every pixel counts): the names and the hold first,
+then what to do, elided at the window's edge; the tooltip and the Alarms dock have all of it.
 """
 
 from __future__ import annotations
 
-import html
-
 from PySide6.QtCore import QCoreApplication, QEvent, QSize, Qt, Slot
+from PySide6.QtGui import QFontMetrics, QResizeEvent
 from PySide6.QtWidgets import QLabel, QSizePolicy, QToolBar, QWidget
 
 from app.alarm_history import (
@@ -27,6 +30,10 @@ from ui.palette import COLOR_ALARM_BANNER, COLOR_ALARM_BANNER_TEXT, COLOR_ERROR_
 __all__ = ["AlarmBanner", "alarm_name"]
 
 BANNER_HINT_WIDTH = 200  # px: the text's size hint in the toolbar (it stretches to the window)
+BANNER_FONT_SCALE = 1.15  # a little larger than the window's text: it must not be missed
+BANNER_PADDING_PX = 2  # px above and below the line (the toolbar adds no chrome of its own)
+# a line of both scripts: the fixed height fits Latin and CJK glyphs (the CJK fallback is taller)
+_SAMPLE = "ALARM Ågy 报警急停"
 
 
 def alarm_name(bit: int) -> str:
@@ -45,14 +52,43 @@ def alarm_advice(bit: int) -> str:
 
 
 class _BannerText(QLabel):
-    """A label that asks a toolbar for little width and takes what is there (Expanding): a
-    toolbar moves a widget whose size hint does not fit into its overflow menu."""
+    """One bold line of fixed height, elided at its width (``elide``: the layout check expects
+    the tooltip to hold the whole text). It asks a toolbar for little width and takes what is
+    there (Expanding): a toolbar moves a widget whose size hint does not fit into its overflow menu."""
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self._full = ""
+        self.setProperty("elide", True)
+        self.setWordWrap(False)
+        self.setTextFormat(Qt.TextFormat.PlainText)
+        font = self.font()
+        font.setBold(True)
+        font.setPointSizeF(font.pointSizeF() * BANNER_FONT_SCALE)
+        self.setFont(font)
+        self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
+        self.setFixedHeight(QFontMetrics(font).boundingRect(_SAMPLE).height() + 2 * BANNER_PADDING_PX)
+
+    def full_text(self) -> str:
+        return self._full
+
+    def set_full_text(self, text: str) -> None:
+        self._full = text
+        self._elide()
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        super().resizeEvent(event)
+        self._elide()
+
+    def _elide(self) -> None:
+        room = self.contentsRect().width() - 2 * self.margin()
+        self.setText(self.fontMetrics().elidedText(self._full, Qt.TextElideMode.ElideRight, max(room, 10)))
 
     def sizeHint(self) -> QSize:
-        return QSize(BANNER_HINT_WIDTH, super().sizeHint().height())
+        return QSize(BANNER_HINT_WIDTH, self.height())
 
     def minimumSizeHint(self) -> QSize:
-        return QSize(BANNER_HINT_WIDTH, super().minimumSizeHint().height())
+        return QSize(BANNER_HINT_WIDTH, self.height())
 
 
 class AlarmBanner(QToolBar):
@@ -66,15 +102,14 @@ class AlarmBanner(QToolBar):
         self.toggleViewAction().setVisible(False)  # not in the window's context menu: not closable
         self.setContextMenuPolicy(Qt.ContextMenuPolicy.PreventContextMenu)
         self.setStyleSheet(f"QToolBar#AlarmBanner {{ background: {COLOR_ALARM_BANNER};"
-                           f" border: 2px solid {COLOR_ERROR_DARK}; padding: 2px; spacing: 0px; }}")
+                           f" border: none; border-bottom: 2px solid {COLOR_ERROR_DARK};"
+                           f" padding: 0px; spacing: 0px; }}")
+        layout = self.layout()
+        if layout is not None:
+            layout.setContentsMargins(0, 0, 0, 0)
         self.label = _BannerText(self)
         self.label.setObjectName("AlarmBannerText")
-        # one line per alarm, no wrapping: a wrapping label in a toolbar asks for its height at a
-        # narrow width and the banner grows to several times its text
-        self.label.setWordWrap(False)
-        self.label.setTextFormat(Qt.TextFormat.RichText)
-        self.label.setStyleSheet(f"QLabel {{ color: {COLOR_ALARM_BANNER_TEXT}; padding: 2px 8px; }}")
-        self.label.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Preferred)
+        self.label.setStyleSheet(f"QLabel {{ color: {COLOR_ALARM_BANNER_TEXT}; padding: 0px 8px; }}")
         self.addWidget(self.label)
         self._state: RobotState | None = None
         self._alarms = 0
@@ -121,7 +156,8 @@ class AlarmBanner(QToolBar):
     def _render(self) -> None:
         if not self._alarms:
             self._plain = ""
-            self.label.setText("")
+            self.label.set_full_text("")
+            self.label.setToolTip("")
             return
         bits = alarm_bits(self._alarms)
         names = ", ".join(alarm_name(b) for b in bits)
@@ -132,12 +168,9 @@ class AlarmBanner(QToolBar):
         if blocks_motion(self._alarms):
             held = self.tr("Motion controls are held until the alarm is reset. STOP stays available.")
         lines = [f"{alarm_name(b)}: {alarm_advice(b)}" for b in bits]
-        self._plain = "\n".join([f"{title} — {held}" if held else title, *lines])
-        head = f"<span style='font-size:16px'><b>{html.escape(title)}</b></span>"
-        if held:
-            head += f" &nbsp;—&nbsp; <b>{html.escape(held)}</b>"
-        body = "<br>".join(html.escape(line) for line in lines)
-        self.label.setText(f"{head}<br>{body}")
+        head = f"{title} — {held}" if held else title
+        self._plain = "\n".join([head, *lines])
+        self.label.set_full_text("   ".join([head, *lines]))
         self.label.setToolTip(self._plain)
         self.setToolTip(self.tr("Register 562 = {word}").format(word=f"0x{self._alarms:04X}"))
 

@@ -2,13 +2,18 @@
 
 ``add_event`` is the general entry; ``on_alarms``, ``on_command_result`` and ``on_connection``
 turn the worker's payloads into events (alarm bits are logged on their transitions only).
+
+An event logged from a payload keeps that payload (the reason code and its arguments, the alarm
+bit, the link state) in a small function that renders its source and text: on a language
+change every such line is rendered again, so the log reads in one language.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as dt
 import os
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -40,7 +45,7 @@ from app.link.state import RobotState
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult
 from app.protocol.enums import ALARM_BITS, ALARM_TEXT, TR_CONTEXT
-from ui.messages import error_text, operation_text, result_level, result_text
+from ui.messages import connection_text, error_text, operation_text, result_level, result_text
 from ui.widgets_common import (
     COLOR_ERROR,
     COLOR_ERROR_BG,
@@ -58,6 +63,8 @@ MAX_EVENTS_DEFAULT = 5000
 COL_TIME, COL_LEVEL, COL_SOURCE, COL_MESSAGE = range(4)
 _COLUMN_COUNT = 4
 
+Words = str | Callable[[], str]  # a text as written, or a function rendering it in the current language
+
 
 @dataclass(frozen=True, slots=True)
 class LogEvent:
@@ -65,10 +72,21 @@ class LogEvent:
     level: str  # one of LEVELS
     source: str
     text: str
+    # render source / text again in the current language (None: the text was logged as written)
+    source_of: Callable[[], str] | None = dataclasses.field(default=None, compare=False, repr=False)
+    text_of: Callable[[], str] | None = dataclasses.field(default=None, compare=False, repr=False)
 
     @property
     def severity(self) -> int:
         return LEVELS.index(self.level)
+
+    def rendered(self) -> LogEvent:
+        """This event with its source and text rendered in the current language."""
+        if self.source_of is None and self.text_of is None:
+            return self
+        return dataclasses.replace(
+            self, source=self.source if self.source_of is None else self.source_of(),
+            text=self.text if self.text_of is None else self.text_of())
 
 
 class EventLogModel(QAbstractTableModel):
@@ -101,13 +119,16 @@ class EventLogModel(QAbstractTableModel):
         }
 
     def retranslate(self) -> None:
-        """Headers and level names in the current language (logged messages stay as written)."""
+        """Headers, level names and every event logged from a payload in the current language
+        (a text added as written stays as written)."""
         self._set_texts()
         self.headerDataChanged.emit(Qt.Orientation.Horizontal, 0, _COLUMN_COUNT - 1)
         if self._events:
+            self._events = [event.rendered() for event in self._events]
             last = len(self._events) - 1
             self.dataChanged.emit(
-                self.index(0, COL_LEVEL), self.index(last, COL_LEVEL), [Qt.ItemDataRole.DisplayRole]
+                self.index(0, 0), self.index(last, _COLUMN_COUNT - 1),
+                [Qt.ItemDataRole.DisplayRole, Qt.ItemDataRole.ToolTipRole]
             )
 
     @property
@@ -274,11 +295,17 @@ class EventLogPanel(QWidget):
         super().changeEvent(event)
 
     # --- entries ----------------------------------------------------------------------
-    def add_event(self, level: str, source: str, text: str, when: dt.datetime | None = None) -> LogEvent:
-        """Log one event; ``level`` is "info", "warning" or "error"; ``when`` defaults to now."""
+    def add_event(self, level: str, source: Words, text: Words, when: dt.datetime | None = None) -> LogEvent:
+        """Log one event; ``level`` is "info", "warning" or "error"; ``when`` defaults to now.
+
+        ``source`` and ``text`` are texts as written, or functions that render them in the
+        current language (called now and again after a language change)."""
         if level not in LEVELS:
             raise ValueError(f"level must be one of {LEVELS}, got {level!r}")
-        event = LogEvent(when or dt.datetime.now(), level, source, text)
+        source_of = source if callable(source) else None
+        text_of = text if callable(text) else None
+        event = LogEvent(when or dt.datetime.now(), level, source if isinstance(source, str) else "",
+                         text if isinstance(text, str) else "", source_of, text_of).rendered()
         bar = self.view.verticalScrollBar()
         follow = bar.value() >= bar.maximum() - 2
         self.model.add(event)
@@ -305,16 +332,17 @@ class EventLogPanel(QWidget):
         changed = alarms ^ previous
         if not changed:
             return
-        source = self.tr("alarm")
         for bit in range(16):
             mask = 1 << bit
-            if not changed & mask:
-                continue
-            name = self._alarm_name(mask)
-            if alarms & mask:
-                self.add_event("error", source, self.tr("Alarm raised: {name}").format(name=name))
-            else:
-                self.add_event("info", source, self.tr("Alarm cleared: {name}").format(name=name))
+            if changed & mask:
+                self._log_alarm(mask, bool(alarms & mask))
+
+    def _log_alarm(self, mask: int, raised: bool) -> None:
+        def text() -> str:
+            words = self.tr("Alarm raised: {name}") if raised else self.tr("Alarm cleared: {name}")
+            return words.format(name=self._alarm_name(mask))
+
+        self.add_event("error" if raised else "info", lambda: self.tr("alarm"), text)
 
     def _alarm_name(self, mask: int) -> str:
         for bit in ALARM_BITS:
@@ -324,11 +352,11 @@ class EventLogPanel(QWidget):
 
     @Slot(object)
     def on_command_result(self, result: CommandResult) -> None:
-        self.add_event(result_level(result), self.tr("command"), result_text(result))
+        self.add_event(result_level(result), lambda: self.tr("command"), lambda: result_text(result))
 
     @Slot(WorkerError)
     def on_error(self, error: WorkerError) -> None:
-        self.add_event("error", self.operation_text(error.operation), error_text(error))
+        self.add_event("error", lambda: self.operation_text(error.operation), lambda: error_text(error))
 
     def operation_text(self, operation: str) -> str:
         """The operator's word for a link operation (:class:`~app.link.types.Operation`)."""
@@ -341,15 +369,20 @@ class EventLogPanel(QWidget):
         if key == self._last_connection:
             return
         self._last_connection = key
-        text, lamp = connection_display(connection)
-        parts = [text, *(p for p in (connection.endpoint, connection.message) if p)]
+        _text, lamp = connection_display(connection)
+
+        def text() -> str:
+            parts = [connection_display(connection)[0],
+                     *(p for p in (connection.endpoint, connection_text(connection)) if p)]
+            return " — ".join(parts)
+
         if lamp == LEVEL_ERROR:
             level = "error"
         elif lamp == LEVEL_WARN and connection.state is not LinkState.CONNECTING:  # connecting is routine
             level = "warning"
         else:
             level = "info"
-        self.add_event(level, self.tr("link"), " — ".join(parts))
+        self.add_event(level, lambda: self.tr("link"), text)
 
     @Slot()
     def clear(self) -> None:

@@ -14,6 +14,9 @@ __all__ = ["AXIS_TICK_POINTS", "GRID_COLOR", "LEFT_AXIS_WIDTH", "add_legend", "s
 AXIS_TICK_POINTS = 9.0
 LEFT_AXIS_WIDTH = 52  # px: room for "-8888" labels, so the plots do not shift as values change
 GRID_COLOR = "#dde3e6"
+# px: two stacked plots + the tiles above them set the Monitor tab's height, the tallest tab; with
+# the alarm banner up at 1280x800 (Chinese fonts are taller) 2 x 90 px did not fit
+PLOT_MIN_HEIGHT = 80
 
 
 def unwrap_degrees(previous_raw: float, previous_unwrapped: float, raw: float) -> float:
@@ -59,5 +62,5 @@ def style_plot(plot: pg.PlotWidget) -> None:
         axis.setStyle(tickFont=font)
     item.getAxis("left").setWidth(LEFT_AXIS_WIDTH)
     plot.setMenuEnabled(False)
-    plot.setMinimumHeight(90)
+    plot.setMinimumHeight(PLOT_MIN_HEIGHT)
     plot.setMinimumWidth(120)

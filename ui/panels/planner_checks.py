@@ -19,6 +19,7 @@ from app.plan.presenter import plan_info, plan_start, summarize_checks
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger
 from app.safety.envelope import Envelope
+from ui.messages import issue_line, issue_text
 from ui.models.segment_model import SegmentTableModel
 from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_widgets import PlanChecksBar
@@ -70,7 +71,7 @@ class PlannerChecks:
         """Show ``issues`` on the rows and the summary line; returns the summary."""
         self.issues = list(issues)
         self._segments.set_issues(self.issues)
-        checks = summarize_checks(issues) if plan is not None else None
+        checks = summarize_checks(issues, issue_text, issue_line) if plan is not None else None
         self.summary_text = self._bar.show_checks(checks, self._has_sync)
         return self.summary_text
 

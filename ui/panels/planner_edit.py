@@ -14,6 +14,7 @@ from PySide6.QtWidgets import QTableView
 from app.errors import InvalidInput
 from app.plan.segments import Plan, SegmentKind
 from app.points.ledger import PointLedger
+from ui.messages import refusal_text
 from ui.models.plan_columns import COL_END, COL_VIA, PLAN_COL_NAME
 from ui.models.plan_model import PlanListModel
 from ui.models.segment_model import SegmentTableModel
@@ -95,7 +96,7 @@ class PlanEdits(QObject):
         try:
             row = self._segments.insert_segment(at, kind)
         except InvalidInput as exc:
-            self._view.show_message(str(exc), "error")
+            self._view.show_message(refusal_text(exc), "error")
             return
         self._view.select_segments([row])
 
@@ -105,7 +106,7 @@ class PlanEdits(QObject):
         try:
             n = self._segments.remove_rows(rows)
         except InvalidInput as exc:
-            self._view.show_message(str(exc), "error")
+            self._view.show_message(refusal_text(exc), "error")
             return
         if n:
             left = min(rows[0], self._segments.rowCount() - 1)
@@ -115,6 +116,6 @@ class PlanEdits(QObject):
         try:
             rows = self._segments.move_rows(self._view.selected_segments(), delta)
         except InvalidInput as exc:
-            self._view.show_message(str(exc), "error")
+            self._view.show_message(refusal_text(exc), "error")
             return
         self._view.select_segments(rows)

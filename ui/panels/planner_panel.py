@@ -41,6 +41,7 @@ from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
+from ui.messages import issue_text
 from ui.models.plan_columns import PLAN_COL_NAME
 from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
@@ -471,7 +472,7 @@ class PlannerPanel(QWidget):
         plan = self.current_plan()
         rows = self.selected_segments()
         sync = self._sync
-        errors = [i.message for i in self.checks.issues if i.is_error]
+        errors = [issue_text(i) for i in self.checks.issues if i.is_error]
         states = action_states(PanelState(
             connected=r.connected, running=r.running, paused=r.paused, can_resume=r.can_resume,
             has_plan=plan is not None, segments=len(plan) if plan is not None else 0, selected=bool(rows),

@@ -21,7 +21,7 @@ from app.plan.segments import Plan
 from app.points.ledger import UploadReport
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
-from ui.messages import error_text
+from ui.messages import error_text, issue_text, refusal_text
 from ui.models.points_model import PointsModel
 from ui.panels.planner_checks import PlannerChecks
 
@@ -87,12 +87,12 @@ class PlanRunFlow(QObject):
         issues = view.checks.check(plan, self._runner.last_pose, start_index=start,
                                    loops=1 if single else plan.loops)
         summary = view.show_issues(issues, plan)
-        gate = run_gate(issues)
+        gate = run_gate(issues, issue_text)
         if gate.block is RunBlock.ERRORS and (first := gate.first_error) is not None:
             if first.segment is not None:
                 view.select_segments([first.segment])
             view.show_message(self.tr("Cannot run: {summary}. First: {message}").format(
-                summary=summary.split("\n")[0], message=first.message), "error")
+                summary=summary.split("\n")[0], message=issue_text(first)), "error")
             return False
         if gate.block is RunBlock.UPLOAD:
             needs = list(gate.uploads)
@@ -122,7 +122,7 @@ class PlanRunFlow(QObject):
         else:
             what = self.tr("Run plan '{name}'?").format(name=plan.name)
         text = what + "\n\n" + self.tr("The robot will move.")
-        warnings = run_gate(self._view.issues).warnings
+        warnings = run_gate(self._view.issues, issue_text).warnings
         if warnings:
             text += "\n\n" + self.tr("Warnings:") + "\n" + "\n".join(f"• {w}" for w in warnings)
         return text
@@ -145,8 +145,8 @@ class PlanRunFlow(QObject):
                 self.run_plan = plan
                 self._run_revision = plan.revision
                 self._runner.start(plan, start=start, start_loop=loop, single=single)
-        except InvalidInput as exc:  # a bad start segment: its own English words are the detail
-            self._view.show_message(str(exc), "error")
+        except InvalidInput as exc:  # a bad start segment
+            self._view.show_message(refusal_text(exc), "error")
             return False
         except TeachPadError as exc:  # no link, monitor-only...: in the operator's language
             self._view.show_message(error_text(exc), "error")

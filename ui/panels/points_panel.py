@@ -21,6 +21,7 @@ from app.points.ledger import UploadReport
 from ui.controllers.point_sync import LEVEL_ERROR, LEVEL_INFO, LEVEL_WARN, PointSyncController
 from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
+from ui.messages import refusal_text
 from ui.models.points_model import PointFilterProxy, PointsModel
 from ui.panels.points_parts import PointsActionBar, PointsTable, RestoreBanner, UploadProgressRow
 from ui.widgets_common import COLOR_ERROR, COLOR_OK
@@ -250,7 +251,7 @@ class PointsPanel(QWidget):
         try:
             row = self._model.add_point(at, pose=start.pose, tool=start.tool)
         except InvalidInput as exc:
-            self.show_message(str(exc), LEVEL_ERROR)
+            self.show_message(refusal_text(exc), LEVEL_ERROR)
             return
         self._clear_filter_for(row)
         self.select_rows([row])
@@ -269,7 +270,7 @@ class PointsPanel(QWidget):
         try:
             rows = self._model.duplicate_rows(self.selected_rows())
         except InvalidInput as exc:
-            self.show_message(str(exc), LEVEL_ERROR)
+            self.show_message(refusal_text(exc), LEVEL_ERROR)
             return
         self.select_rows(rows)
 

@@ -47,7 +47,7 @@ from app.protocol.enums import (
 )
 from app.protocol.registers import GV_DATE
 from ui import messages
-from ui.messages import result_level, result_text
+from ui.messages import connection_text, result_level, result_text
 from ui.widgets_common import (
     COLOR_ERROR,
     COLOR_NEUTRAL,
@@ -371,7 +371,7 @@ class StatusPanel(QWidget):
         text, level = connection_display(connection)
         self.link_lamp.setText(text)
         self.link_lamp.set_level(level)
-        parts = [p for p in (connection.endpoint, connection.message) if p]
+        parts = [p for p in (connection.endpoint, connection_text(connection)) if p]
         if connection.monitor_only:
             parts.append(self.tr("monitor only: writes blocked"))
         self.link_message.setText(" — ".join(parts))
