@@ -263,9 +263,9 @@ class MonitorPanel(QWidget):
     def on_freshness(self, fresh: bool) -> None:
         self._fresh = bool(fresh)
         tip = "" if fresh else self.tr("Stale: not confirmed by the controller within the freshness limit")
-        for readout in self.readouts.values():
-            readout.setEnabled(self._fresh)
-            readout.setToolTip(tip)
+        for box in (self._cart_box, self._axes_box):  # the readouts follow their box
+            box.setEnabled(self._fresh)
+            box.setToolTip(tip)
         self._update_status_text()
 
     @property

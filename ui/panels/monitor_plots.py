@@ -41,6 +41,7 @@ GRID_COLOR = "#dde3e6"
 MAX_PLOT_POINTS = 2500
 MIN_PLOT_POINTS = 1000
 POINTS_PER_PIXEL = 2
+CURVE_WIDTH = 1  # px, the time curves (see MonitorPlots)
 # Curves keep a view of the ring buffer until the scene repaints; never hand them the whole
 # buffer, so samples arriving before that repaint cannot overwrite what they show.
 PAINT_MARGIN = 512
@@ -102,6 +103,8 @@ def style_plot(plot: pg.PlotWidget) -> None:
         font = QFont()
         font.setPointSizeF(AXIS_TICK_POINTS)
         axis.setStyle(tickFont=font)
+    for name in ("top", "right"):  # hidden, but linked to the view: no label update per new range
+        item.getAxis(name).enableAutoSIPrefix(False)
     item.getAxis("left").setWidth(LEFT_AXIS_WIDTH)
     plot.setMenuEnabled(False)
     plot.setMinimumHeight(90)
@@ -126,7 +129,9 @@ class MonitorPlots:
             plot = self.xyz_plot if name in "XYZ" else self.abc_plot
             if name in ("X", "A"):
                 add_legend(plot)
-            curve = pg.PlotCurveItem(pen=pg.mkPen(_PLOT_COLORS[name], width=2), name=name)
+            # 1 px: the raster engine's fast path; a 2 px pen is stroked as polygons and cost
+            # about half of the monitor's frame time (benchmarks/streaming.py, plots at 25 Hz)
+            curve = pg.PlotCurveItem(pen=pg.mkPen(_PLOT_COLORS[name], width=CURVE_WIDTH), name=name)
             plot.addItem(curve)
             self.curves[name] = curve
 

@@ -100,6 +100,7 @@ class PoseStrip(QFrame):
         super().__init__(parent)
         self.setObjectName("PoseStrip")
         self.setFrameShape(QFrame.Shape.StyledPanel)
+        self.setAutoFillBackground(True)  # opaque: a new value repaints the strip, not the window under it
         self._state: RobotState | None = None
         self._age_timer = QTimer(self)
         self._age_timer.setInterval(AGE_TICK_MS)
