@@ -5,6 +5,7 @@ that are hidden do no formatting work while poses and traffic stream in."""
 
 from __future__ import annotations
 
+import itertools
 import time
 from collections.abc import Iterator
 from typing import Any
@@ -64,7 +65,7 @@ def test_frames_are_at_least_one_interval_apart(qtbot: Any, clock: DisplayClock)
 
     clock.request(view)
     qtbot.waitUntil(lambda: len(stamps) == 4, timeout=3000)
-    gaps = [b - a for a, b in zip(stamps, stamps[1:], strict=False)]
+    gaps = [b - a for a, b in itertools.pairwise(stamps)]
     assert min(gaps) >= 0.95 * clock.interval_ms / 1000.0  # a coarse timer may be 5 % early
 
 
@@ -162,17 +163,16 @@ def test_a_hidden_monitor_formats_and_plots_nothing(qtbot: Any, link: FakeLink,
 
 
 def test_a_hidden_traffic_panel_decodes_and_formats_nothing(qtbot: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    from app.protocol.frames import decode_frame as original
     from benchmarks.traffic import Feed
-    from ui.models import traffic_model
 
     decoded: list[bytes] = []
-    original = traffic_model.decode_frame
 
     def counting(data: bytes, **kwargs: Any) -> Any:
         decoded.append(bytes(data))
         return original(data, **kwargs)
 
-    monkeypatch.setattr(traffic_model, "decode_frame", counting)
+    monkeypatch.setattr("ui.models.traffic_model.decode_frame", counting)
     panel = TrafficPanel(clock=DisplayClock(interval_ms=5))
     qtbot.addWidget(panel)
     label = panel.count_label.text()
