@@ -162,7 +162,8 @@ def test_a_hidden_monitor_formats_and_plots_nothing(qtbot: Any, link: FakeLink,
     assert monitor.sample_count == 200  # recorded all the same: the plots are whole when shown
 
 
-def test_a_hidden_traffic_panel_decodes_and_formats_nothing(qtbot: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_hidden_traffic_panel_decodes_and_formats_nothing(qtbot: Any,
+                                                           monkeypatch: pytest.MonkeyPatch) -> None:
     from app.protocol.frames import decode_frame as original
     from benchmarks.traffic import Feed
 
