@@ -26,8 +26,6 @@ from PySide6.QtCore import QEvent, QSignalBlocker, QSize, QTimer, Slot
 from PySide6.QtGui import QCloseEvent, QHideEvent, QPaintEvent, QResizeEvent, QShowEvent
 from PySide6.QtWidgets import (
     QComboBox,
-    QGridLayout,
-    QGroupBox,
     QHBoxLayout,
     QLabel,
     QPushButton,
@@ -48,6 +46,7 @@ from ui.panels.monitor_plots import (
     MonitorPlots,
     unwrap_degrees,
 )
+from ui.panels.monitor_readouts import BIG_POINTS_MAX, MIN_WIDTH, ReadoutBoxes, readout_scale
 from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
 
 __all__ = ["MAX_PLOT_POINTS", "PAINT_INTERVAL_MS", "PAINT_MARGIN", "TRACE_MIN_SPAN_MM", "MonitorPanel"]
@@ -61,13 +60,7 @@ DEFAULT_WINDOW_S = 30
 HISTORY_CAPACITY = 16384  # samples: the longest window at up to ~270 Hz
 TRACE_CAPACITY = 20000  # X–Y path points
 TRACE_MIN_STEP_MM = 0.05  # a standing robot does not fill the trace with one point
-_BIG_POINTS = 22.0  # readout sizes at REFERENCE_WIDTH; they follow the panel's width (see resizeEvent)
-_SMALL_POINTS = 13.0
-_BIG_POINTS_MAX = 34.0
-_SMALL_POINTS_MAX = 18.0
-REFERENCE_WIDTH = 760  # px of panel width at which the readouts use _BIG_POINTS / _SMALL_POINTS
-MIN_SCALE = 0.55  # readouts shrink down to this on a narrow panel (then the panel's minimum width)
-MIN_WIDTH = 420  # px: the panel's minimum width (the readouts' fonts shrink to fit)
+_BIG_POINTS_MAX = BIG_POINTS_MAX
 
 
 class MonitorPanel(QWidget):
@@ -108,43 +101,11 @@ class MonitorPanel(QWidget):
 
     # --- UI ---------------------------------------------------------------------------
     def _build_ui(self) -> None:
-        self.readouts: dict[str, NumericReadout] = {}
-
-        cart = QGroupBox(self)
-        self._cart_box = cart
-        grid = QGridLayout(cart)
-        grid.setContentsMargins(6, 6, 6, 6)
-        grid.setHorizontalSpacing(8)
-        grid.setVerticalSpacing(6)
-        for i, name in enumerate(_CARTESIAN):
-            readout = NumericReadout(name, "", point_size=_BIG_POINTS, parent=cart)
-            self.readouts[name] = readout
-            grid.addWidget(readout, i // 3, i % 3)
-
-        # Joints (when published) above the external axes, six columns, one box.
-        axes = QGroupBox(self)
-        axes_grid = QGridLayout(axes)
-        axes_grid.setContentsMargins(6, 4, 6, 4)
-        axes_grid.setHorizontalSpacing(6)
-        axes_grid.setVerticalSpacing(4)
-        self._joint_readouts: list[NumericReadout] = []
-        for i in range(1, 7):
-            readout = NumericReadout(
-                f"J{i}", "", point_size=_SMALL_POINTS, width_chars=8, unit_room="", parent=axes
-            )
-            readout.setVisible(False)  # shown once a pose carries joint angles
-            self.readouts[f"J{i}"] = readout
-            self._joint_readouts.append(readout)
-            axes_grid.addWidget(readout, 0, i - 1)
-        for i in range(1, 6):
-            readout = NumericReadout(
-                f"EJ{i}", "", point_size=_SMALL_POINTS, width_chars=8, unit_room="", parent=axes
-            )
-            self.readouts[f"EJ{i}"] = readout
-            axes_grid.addWidget(readout, 1, i - 1)
-        for column in range(6):
-            axes_grid.setColumnStretch(column, 1)
-        self._axes_box = axes
+        boxes = ReadoutBoxes(self)
+        self.readouts: dict[str, NumericReadout] = boxes.readouts
+        self._readout_boxes = boxes
+        self._cart_box, self._axes_box = boxes.cart_box, boxes.axes_box
+        self._joint_readouts = boxes.joint_readouts
 
         # Plot controls.
         self.window_combo = QComboBox(self)
@@ -181,8 +142,8 @@ class MonitorPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
         layout.setSpacing(6)
-        layout.addWidget(cart)
-        layout.addWidget(axes)
+        layout.addWidget(boxes.cart_box)
+        layout.addWidget(boxes.axes_box)
         layout.addLayout(controls)
         layout.addWidget(plots, 1)
         layout.addWidget(self._status)
@@ -456,18 +417,11 @@ class MonitorPanel(QWidget):
         return QSize(min(hint.width(), MIN_WIDTH), hint.height())
 
     def readout_scale(self, width: int) -> float:
-        """Readout size factor for a panel ``width`` px wide (1.0 at REFERENCE_WIDTH)."""
-        return min(max((width - 40) / (REFERENCE_WIDTH - 40), MIN_SCALE), _BIG_POINTS_MAX / _BIG_POINTS)
+        """Readout size factor for a panel ``width`` px wide (1.0 at its reference width)."""
+        return readout_scale(width)
 
     def resizeEvent(self, event: QResizeEvent) -> None:
-        # Numbers as big as the panel allows: readable from a distance at 1920 px, still whole at 1280 px.
-        scale = self.readout_scale(event.size().width())
-        big = round(_BIG_POINTS * scale, 1)
-        # six small readouts share a row: about 13 character cells each at ~0.85 pt per px
-        fit = (event.size().width() - 60) / 6 / (13 * 0.85)
-        small = round(min(_SMALL_POINTS * scale, _SMALL_POINTS_MAX, fit), 1)
-        for name, readout in self.readouts.items():
-            readout.set_point_size(big if name in _CARTESIAN else max(small, 8.0))
+        self._readout_boxes.fit_width(event.size().width())  # numbers as big as the panel allows
         super().resizeEvent(event)
 
     # --- frames follow visibility --------------------------------------------------------
