@@ -12,8 +12,8 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-from PySide6.QtCore import QCoreApplication, Qt
-from PySide6.QtGui import QFont, QFontDatabase
+from PySide6.QtCore import QCoreApplication, QSize, Qt
+from PySide6.QtGui import QFont, QFontDatabase, QPainter, QPaintEvent, QPalette
 from PySide6.QtWidgets import QFileDialog, QFrame, QHBoxLayout, QLabel, QMessageBox, QSizePolicy, QWidget
 
 from app.link.types import ConnectionState, LinkState
@@ -114,11 +114,45 @@ class AlarmLamp(Lamp):
         self.set_level(LEVEL_ERROR if active else LEVEL_OFF)
 
 
+class _Digits(QWidget):
+    """A readout's number, painted on its own opaque background with a size hint that does not
+    follow the text. A new value repaints this rectangle only; a QLabel's ``setText`` re-lays
+    out every parent up to the window and repaints the backgrounds under it, which at the
+    monitor's frame rate was a good part of the GUI thread's time (benchmarks/streaming.py)."""
+
+    def __init__(self, text: str, parent: QWidget) -> None:
+        super().__init__(parent)
+        self._text = text
+        self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
+        self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Preferred)
+
+    def text(self) -> str:
+        return self._text
+
+    def setText(self, text: str) -> None:  # QLabel's name: the readout's API
+        if text != self._text:
+            self._text = text
+            self.update()
+
+    def sizeHint(self) -> QSize:
+        return QSize(self.minimumWidth(), self.fontMetrics().height())
+
+    def minimumSizeHint(self) -> QSize:
+        return self.sizeHint()
+
+    def paintEvent(self, event: QPaintEvent) -> None:
+        painter = QPainter(self)
+        palette = self.palette()  # the disabled (stale) colours while disabled
+        painter.fillRect(event.rect(), palette.window())
+        painter.setPen(palette.color(QPalette.ColorRole.WindowText))
+        painter.drawText(self.rect(), Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter, self._text)
+
+
 class NumericReadout(QFrame):
     """A large fixed-decimal number with its caption and unit, e.g. ``X  -123.456 mm``.
 
-    ``set_value`` only touches the label when the shown text changes, so calling it at the
-    paint rate with an unchanged value costs nothing.
+    ``set_value`` only touches the number when the shown text changes, so calling it at the
+    paint rate with an unchanged value costs nothing; a change repaints the number alone.
     """
 
     PLACEHOLDER = "—"
@@ -137,6 +171,7 @@ class NumericReadout(QFrame):
         super().__init__(parent)
         self.setFrameShape(QFrame.Shape.StyledPanel)
         self.setObjectName("NumericReadout")
+        self.setAutoFillBackground(True)  # a tile of its own: the number's repaint stops here
         self._decimals = decimals
         self._value: float | None = None
 
@@ -146,10 +181,7 @@ class NumericReadout(QFrame):
 
         self._caption = QLabel(caption, self)
         self._caption.setStyleSheet(f"color: {COLOR_NEUTRAL};")
-        self._number = QLabel(self.PLACEHOLDER, self)
-        self._number.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
-        self._number.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Preferred)
-        self._number.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self._number = _Digits(self.PLACEHOLDER, self)
         self._unit = QLabel(unit, self)
         self._unit.setStyleSheet(f"color: {COLOR_NEUTRAL};")
         self.set_point_size(point_size)

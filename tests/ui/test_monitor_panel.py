@@ -89,9 +89,10 @@ def test_joints_appear_with_the_first_pose_that_has_them(panel: MonitorPanel) ->
 
 
 def test_curves_get_data_after_the_paint_timer_fires(qtbot: Any, shown: MonitorPanel) -> None:
-    assert shown.paint_timer_active
+    assert not shown.paint_timer_active  # nothing to show: no frames
     for i in range(50):
         shown.on_pose(pose(i, 2 * i, 3 * i), t=100.0 + i * 0.02)
+    assert shown.paint_timer_active
     curve = shown.curves["Y"]
     qtbot.waitUntil(lambda: curve.xData is not None and len(curve.xData) == 50, timeout=2000)
     assert curve.yData[-1] == 98.0
@@ -209,6 +210,9 @@ def test_clear_forgets_everything(panel: MonitorPanel) -> None:
 
 
 def test_paint_timer_runs_only_while_visible(qtbot: Any, shown: MonitorPanel) -> None:
+    shown.on_pose(pose(1))  # live samples: the time axis keeps time, a frame after each frame
+    assert shown.paint_timer_active
+    qtbot.waitUntil(lambda: shown.readouts["X"].text() == "1.000", timeout=2000)
     assert shown.paint_timer_active
     shown.hide()
     assert not shown.paint_timer_active

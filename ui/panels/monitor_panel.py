@@ -1,14 +1,17 @@
 """Live position monitor: big XYZABC / external-axis / joint readouts, rolling plots, X–Y trace.
 
 Poll rate and paint rate are separate clocks: ``on_pose`` (called at the poll rate, 50–200 Hz)
-only stores the sample in preallocated ring buffers; a QTimer at ≤ 30 Hz, running only while the
-panel is visible, updates the readouts and hands contiguous buffer views to the curves.
+only stores the sample in preallocated ring buffers; the frames of the application's
+:class:`~ui.display_clock.DisplayClock` (≤ 25 Hz, shared with the pose strip and the traffic
+table so that they repaint together), taken only while the panel is visible, update the
+readouts and hand contiguous buffer views to the curves (:mod:`ui.panels.monitor_plots`).
 
 Plots keep time: the pose only changes (and ``poseChanged`` only fires) while the arm moves, so
-each display tick also appends the last pose at the current time while the values are fresh,
+each frame also appends the last pose at the current time while the values are fresh,
 and the time axis ends at "now": it scrolls at a steady rate when the arm is still, and a
-silent link leaves a visible gap instead of a flat line that looks live. Hidden, the timer stops
-and nothing is appended or painted. Stale values (``RobotState.fresh`` False) grey the readouts.
+silent link leaves a visible gap instead of a flat line that looks live. Hidden, the panel takes
+no frames: nothing is appended, formatted or painted. Stale values (``RobotState.fresh`` False)
+grey the readouts.
 The top view fits its trace (at least ``TRACE_MIN_SPAN_MM`` wide, so a standing arm's single
 point still gets readable axis labels).
 """
@@ -17,69 +20,47 @@ from __future__ import annotations
 
 import math
 import time
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
-import numpy as np
-from PySide6.QtCore import QEvent, QSignalBlocker, QSize, Qt, QTimer, Slot
+from PySide6.QtCore import QEvent, QSignalBlocker, QSize, QTimer, Slot
 from PySide6.QtGui import QCloseEvent, QHideEvent, QPaintEvent, QResizeEvent, QShowEvent
 from PySide6.QtWidgets import (
     QComboBox,
-    QGridLayout,
-    QGroupBox,
     QHBoxLayout,
     QLabel,
     QPushButton,
     QSizePolicy,
-    QSplitter,
     QVBoxLayout,
     QWidget,
 )
 
 from app.link.state import RobotState
 from app.models import Pose
+from ui.display_clock import DISPLAY_INTERVAL_MS, DisplayClock
 from ui.models.ring_buffer import RingBuffer
-from ui.panels.monitor_plots import add_legend, style_plot, unwrap_degrees
+from ui.panels.monitor_plots import CARTESIAN as _CARTESIAN
+from ui.panels.monitor_plots import (
+    MAX_PLOT_POINTS,
+    PAINT_MARGIN,
+    TRACE_MIN_SPAN_MM,
+    MonitorPlots,
+    unwrap_degrees,
+)
+from ui.panels.monitor_readouts import BIG_POINTS_MAX, MIN_WIDTH, ReadoutBoxes, readout_scale
 from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
 
-if TYPE_CHECKING:  # imported when the plots are built: after the window's first paint
-    import pyqtgraph as pg
+__all__ = ["MAX_PLOT_POINTS", "PAINT_INTERVAL_MS", "PAINT_MARGIN", "TRACE_MIN_SPAN_MM", "MonitorPanel"]
 
 #: Attributes that exist once the plots are built (asking for one builds them).
 _PLOT_ATTRIBUTES = frozenset({"xyz_plot", "abc_plot", "trace_plot", "curves", "trace_curve", "trace_marker"})
 
-PAINT_HZ = 30
-PAINT_INTERVAL_MS = math.ceil(1000 / PAINT_HZ)  # 34 ms: never faster than PAINT_HZ
+PAINT_INTERVAL_MS = DISPLAY_INTERVAL_MS  # the display clock's frame period (<= 25 Hz)
 WINDOW_CHOICES_S: tuple[int, ...] = (10, 30, 60)
 DEFAULT_WINDOW_S = 30
 HISTORY_CAPACITY = 16384  # samples: the longest window at up to ~270 Hz
 TRACE_CAPACITY = 20000  # X–Y path points
 TRACE_MIN_STEP_MM = 0.05  # a standing robot does not fill the trace with one point
-MAX_PLOT_POINTS = 2500  # per curve; longer windows are drawn with a stride (still a view)
-# Curves keep a view of the ring buffer until the scene repaints; never hand them the whole
-# buffer, so samples arriving before that repaint cannot overwrite what they show.
-PAINT_MARGIN = 512
-
-# History channels.
-_T, _X, _Y, _Z, _A, _B, _C = range(7)
-_CARTESIAN = ("X", "Y", "Z", "A", "B", "C")
-_PLOT_COLORS = {
-    "X": "#d62728",
-    "Y": "#2ca02c",
-    "Z": "#1f77b4",
-    "A": "#d62728",
-    "B": "#2ca02c",
-    "C": "#1f77b4",
-}
-_TRACE_COLOR = "#6a1b9a"
-_BIG_POINTS = 22.0  # readout sizes at REFERENCE_WIDTH; they follow the panel's width (see resizeEvent)
-_SMALL_POINTS = 13.0
-_BIG_POINTS_MAX = 34.0
-_SMALL_POINTS_MAX = 18.0
-REFERENCE_WIDTH = 760  # px of panel width at which the readouts use _BIG_POINTS / _SMALL_POINTS
-MIN_SCALE = 0.55  # readouts shrink down to this on a narrow panel (then the panel's minimum width)
-MIN_WIDTH = 420  # px: the panel's minimum width (the readouts' fonts shrink to fit)
-TRACE_MIN_SPAN_MM = 50.0  # the top view never zooms in closer than this (readable labels)
-TRACE_PADDING = 0.08  # fraction of the span around the trace
+_BIG_POINTS_MAX = BIG_POINTS_MAX
 
 
 class MonitorPanel(QWidget):
@@ -91,6 +72,7 @@ class MonitorPanel(QWidget):
         *,
         history_capacity: int = HISTORY_CAPACITY,
         trace_capacity: int = TRACE_CAPACITY,
+        clock: DisplayClock | None = None,
     ) -> None:
         super().__init__(parent)
         self.setObjectName("MonitorPanel")
@@ -113,51 +95,17 @@ class MonitorPanel(QWidget):
         self._angle_raw: list[float] | None = None
         self._angle_unwrapped = [0.0, 0.0, 0.0]
 
-        self._timer = QTimer(self)
-        self._timer.setInterval(PAINT_INTERVAL_MS)
-        self._timer.timeout.connect(self._tick)
-
+        self._clock = clock if clock is not None else DisplayClock.shared()
+        self._shown = False  # between showEvent and hideEvent: frames are taken
         self._build_ui()
 
     # --- UI ---------------------------------------------------------------------------
     def _build_ui(self) -> None:
-        self.readouts: dict[str, NumericReadout] = {}
-
-        cart = QGroupBox(self)
-        self._cart_box = cart
-        grid = QGridLayout(cart)
-        grid.setContentsMargins(6, 6, 6, 6)
-        grid.setHorizontalSpacing(8)
-        grid.setVerticalSpacing(6)
-        for i, name in enumerate(_CARTESIAN):
-            readout = NumericReadout(name, "", point_size=_BIG_POINTS, parent=cart)
-            self.readouts[name] = readout
-            grid.addWidget(readout, i // 3, i % 3)
-
-        # Joints (when published) above the external axes, six columns, one box.
-        axes = QGroupBox(self)
-        axes_grid = QGridLayout(axes)
-        axes_grid.setContentsMargins(6, 4, 6, 4)
-        axes_grid.setHorizontalSpacing(6)
-        axes_grid.setVerticalSpacing(4)
-        self._joint_readouts: list[NumericReadout] = []
-        for i in range(1, 7):
-            readout = NumericReadout(
-                f"J{i}", "", point_size=_SMALL_POINTS, width_chars=8, unit_room="", parent=axes
-            )
-            readout.setVisible(False)  # shown once a pose carries joint angles
-            self.readouts[f"J{i}"] = readout
-            self._joint_readouts.append(readout)
-            axes_grid.addWidget(readout, 0, i - 1)
-        for i in range(1, 6):
-            readout = NumericReadout(
-                f"EJ{i}", "", point_size=_SMALL_POINTS, width_chars=8, unit_room="", parent=axes
-            )
-            self.readouts[f"EJ{i}"] = readout
-            axes_grid.addWidget(readout, 1, i - 1)
-        for column in range(6):
-            axes_grid.setColumnStretch(column, 1)
-        self._axes_box = axes
+        boxes = ReadoutBoxes(self)
+        self.readouts: dict[str, NumericReadout] = boxes.readouts
+        self._readout_boxes = boxes
+        self._cart_box, self._axes_box = boxes.cart_box, boxes.axes_box
+        self._joint_readouts = boxes.joint_readouts
 
         # Plot controls.
         self.window_combo = QComboBox(self)
@@ -194,8 +142,8 @@ class MonitorPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
         layout.setSpacing(6)
-        layout.addWidget(cart)
-        layout.addWidget(axes)
+        layout.addWidget(boxes.cart_box)
+        layout.addWidget(boxes.axes_box)
         layout.addLayout(controls)
         layout.addWidget(plots, 1)
         layout.addWidget(self._status)
@@ -220,47 +168,14 @@ class MonitorPanel(QWidget):
         if self._plots_built:
             return
         self._plots_built = True
-        import pyqtgraph as pg
-
-        self.xyz_plot = pg.PlotWidget(self)
-        self.abc_plot = pg.PlotWidget(self)
-        self.trace_plot = pg.PlotWidget(self)
-        for plot in (self.xyz_plot, self.abc_plot, self.trace_plot):
-            style_plot(plot)
-        self.abc_plot.setXLink(self.xyz_plot)
-        self.xyz_plot.getPlotItem().hideAxis("bottom")
-        self.curves: dict[str, pg.PlotCurveItem] = {}
-        for name in _CARTESIAN:
-            plot = self.xyz_plot if name in "XYZ" else self.abc_plot
-            if name in ("X", "A"):
-                add_legend(plot)
-            curve = pg.PlotCurveItem(pen=pg.mkPen(_PLOT_COLORS[name], width=2), name=name)
-            plot.addItem(curve)
-            self.curves[name] = curve
-
-        self.trace_plot.setAspectLocked(True)
-        # room on the right for the last bottom tick label (else clipped at the plot's edge)
-        self.trace_plot.getPlotItem().layout.setContentsMargins(2, 2, 16, 2)
-        self.trace_curve = pg.PlotCurveItem(pen=pg.mkPen(_TRACE_COLOR, width=2))
-        self.trace_plot.addItem(self.trace_curve)
-        self.trace_marker = pg.ScatterPlotItem(size=11, brush=pg.mkBrush("#ff6f00"), pen=pg.mkPen("#263238"))
-        self.trace_plot.addItem(self.trace_marker)
-
-        time_plots = QSplitter(Qt.Orientation.Vertical, self)
-        time_plots.addWidget(self.xyz_plot)
-        time_plots.addWidget(self.abc_plot)
-        time_plots.setChildrenCollapsible(False)
-        plots = QSplitter(Qt.Orientation.Horizontal, self)
-        plots.addWidget(time_plots)
-        plots.addWidget(self.trace_plot)
-        plots.setStretchFactor(0, 2)
-        plots.setStretchFactor(1, 1)
-        plots.setChildrenCollapsible(False)
-        plots.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
-
-        self._layout.replaceWidget(self._plots_slot, plots)
+        plots = MonitorPlots(self)
+        self._plots = plots
+        self.xyz_plot, self.abc_plot, self.trace_plot = plots.xyz_plot, plots.abc_plot, plots.trace_plot
+        self.curves = plots.curves
+        self.trace_curve, self.trace_marker = plots.trace_curve, plots.trace_marker
+        self._layout.replaceWidget(self._plots_slot, plots.widget)
         self._plots_slot.deleteLater()
-        plots.show()  # made after the panel was shown: hidden until shown
+        plots.widget.show()  # made after the panel was shown: hidden until shown
         self._retranslate_plots()
         self._painted_history = self._painted_trace = -1  # paint what was recorded meanwhile
 
@@ -309,9 +224,9 @@ class MonitorPanel(QWidget):
     def on_freshness(self, fresh: bool) -> None:
         self._fresh = bool(fresh)
         tip = "" if fresh else self.tr("Stale: not confirmed by the controller within the freshness limit")
-        for readout in self.readouts.values():
-            readout.setEnabled(self._fresh)
-            readout.setToolTip(tip)
+        for box in (self._cart_box, self._axes_box):  # the readouts follow their box
+            box.setEnabled(self._fresh)
+            box.setToolTip(tip)
         self._update_status_text()
 
     @property
@@ -323,6 +238,8 @@ class MonitorPanel(QWidget):
         """Record one sample (``t``: monotonic seconds, default now). Cheap: no painting here."""
         self._latest = pose
         self._readouts_dirty = True
+        if self._shown:
+            self._clock.request(self._tick)
         if not all(map(math.isfinite, pose.xyzabc)):
             return  # shown as "—"; kept out of the plots (skipFiniteCheck trusts the data)
         self._held_time = t is not None
@@ -399,7 +316,8 @@ class MonitorPanel(QWidget):
 
     @property
     def paint_timer_active(self) -> bool:
-        return self._timer.isActive()
+        """The panel waits for a display frame (only while shown)."""
+        return self._clock.is_requested(self._tick)
 
     @property
     def sample_count(self) -> int:
@@ -412,13 +330,14 @@ class MonitorPanel(QWidget):
     # --- painting ---------------------------------------------------------------------
     @Slot()
     def _tick(self) -> None:
-        """The display clock: hold the last fresh pose at "now", then paint."""
-        row = self._latest_row
-        if row is not None and self._t0 is not None and self._fresh and not self._held_time:
-            rel = self._now() - self._t0
-            if rel > row[0]:
-                self._history.append((rel, *row[1:]))
-                self._latest_row = (rel, *row[1:])
+        """A display frame: hold the last fresh pose at "now", paint, and ask for the next frame
+        while the time axis has to keep time."""
+        row, now = self._latest_row, self._relative_now()
+        if row is not None and now is not None and self._fresh and now > row[0]:
+            self._history.append((now, *row[1:]))
+            self._latest_row = (now, *row[1:])
+        if self._shown and now is not None:
+            self._clock.request(self._tick)
         if not self._plots_built and not self._plots_scheduled:  # before the first paint
             if self._readouts_dirty:
                 self._readouts_dirty = False
@@ -428,7 +347,7 @@ class MonitorPanel(QWidget):
 
     @Slot()
     def refresh(self) -> None:
-        """One paint tick: readouts, then plots if new samples arrived (called by the timer)."""
+        """One frame: readouts, then plots if new samples arrived (called by the display clock)."""
         if not self._plots_built:
             self._build_plots()
         if self._readouts_dirty:
@@ -436,12 +355,20 @@ class MonitorPanel(QWidget):
             self._paint_readouts()
         if self._paused:
             return
-        if self._history.total != self._painted_history or (self._t0 is not None and not self._held_time):
+        now = self._relative_now()
+        if self._history.total != self._painted_history or now is not None:
             self._painted_history = self._history.total
-            self._paint_history()
+            self._plots.paint_history(self._history, self._window_s, now)
         if self._trace.total != self._painted_trace:
             self._painted_trace = self._trace.total
-            self._paint_trace()
+            self._plots.paint_trace(self._trace)
+
+    def _relative_now(self) -> float | None:
+        """The display clock's "now" on the plots' time axis; None when the axis does not keep
+        time (no sample yet, or the samples came with their own times)."""
+        if self._t0 is None or self._held_time:
+            return None
+        return self._now() - self._t0
 
     def _paint_readouts(self) -> None:
         pose = self._latest
@@ -466,48 +393,8 @@ class MonitorPanel(QWidget):
         """Whether the joint readouts are shown (after the first pose with joint angles)."""
         return self._joint_readouts[0].isVisibleTo(self)
 
-    def _paint_history(self) -> None:
-        history = self._history
-        n = min(len(history), history.capacity - PAINT_MARGIN)
-        if n <= 0:
-            for curve in self.curves.values():
-                curve.setData([], [])
-            return
-        t = history.view(_T, n)
-        t_end = float(t[-1])
-        if self._t0 is not None and not self._held_time:
-            t_end = max(t_end, self._now() - self._t0)  # the axis ends at "now", also when stale
-        start = int(np.searchsorted(t, t_end - self._window_s, side="left"))
-        count = n - start
-        step = max(1, -(-count // MAX_PLOT_POINTS))
-        first = start + (count - 1) % step  # keep the newest sample on the stride
-        t_view = t[first::step]
-        for channel, name in enumerate(_CARTESIAN, start=_X):
-            self.curves[name].setData(t_view, history.view(channel, n)[first::step], skipFiniteCheck=True)
-        self.xyz_plot.setXRange(max(0.0, t_end - self._window_s), max(t_end, self._window_s), padding=0)
-
-    def _paint_trace(self) -> None:
-        trace = self._trace
-        n = min(len(trace), trace.capacity - PAINT_MARGIN)
-        if n <= 0:
-            self.trace_curve.setData([], [])
-            self.trace_marker.setData([], [])
-            return
-        xs, ys = trace.view(0, n), trace.view(1, n)
-        self.trace_curve.setData(xs, ys, skipFiniteCheck=True)
-        self.trace_marker.setData([float(xs[-1])], [float(ys[-1])])
-        self._fit_trace(float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
-
-    def _fit_trace(self, x0: float, x1: float, y0: float, y1: float) -> None:
-        """Show the whole trace, at least TRACE_MIN_SPAN_MM wide and tall, centred."""
-        half = max(x1 - x0, y1 - y0, TRACE_MIN_SPAN_MM) / 2.0
-        cx, cy = (x0 + x1) / 2.0, (y0 + y1) / 2.0
-        view = self.trace_plot.getPlotItem().getViewBox()
-        view.setRange(xRange=(cx - half, cx + half), yRange=(cy - half, cy + half), padding=TRACE_PADDING)
-
     def trace_view_range(self) -> tuple[tuple[float, float], tuple[float, float]]:
-        (x0, x1), (y0, y1) = self.trace_plot.getPlotItem().getViewBox().viewRange()
-        return (x0, x1), (y0, y1)
+        return self._plots.trace_view_range()
 
     def _update_status_text(self) -> None:
         text = self.tr("Plots: last {n} s").format(n=f"{self._window_s:g}")
@@ -530,30 +417,25 @@ class MonitorPanel(QWidget):
         return QSize(min(hint.width(), MIN_WIDTH), hint.height())
 
     def readout_scale(self, width: int) -> float:
-        """Readout size factor for a panel ``width`` px wide (1.0 at REFERENCE_WIDTH)."""
-        return min(max((width - 40) / (REFERENCE_WIDTH - 40), MIN_SCALE), _BIG_POINTS_MAX / _BIG_POINTS)
+        """Readout size factor for a panel ``width`` px wide (1.0 at its reference width)."""
+        return readout_scale(width)
 
     def resizeEvent(self, event: QResizeEvent) -> None:
-        # Numbers as big as the panel allows: readable from a distance at 1920 px, still whole at 1280 px.
-        scale = self.readout_scale(event.size().width())
-        big = round(_BIG_POINTS * scale, 1)
-        # six small readouts share a row: about 13 character cells each at ~0.85 pt per px
-        fit = (event.size().width() - 60) / 6 / (13 * 0.85)
-        small = round(min(_SMALL_POINTS * scale, _SMALL_POINTS_MAX, fit), 1)
-        for name, readout in self.readouts.items():
-            readout.set_point_size(big if name in _CARTESIAN else max(small, 8.0))
+        self._readout_boxes.fit_width(event.size().width())  # numbers as big as the panel allows
         super().resizeEvent(event)
 
-    # --- timer follows visibility -------------------------------------------------------
+    # --- frames follow visibility --------------------------------------------------------
     def showEvent(self, event: QShowEvent) -> None:
         super().showEvent(event)
+        self._shown = True
         if self._plots_built:
             self._readouts_dirty = True
             self.refresh()
         else:  # the first show: readouts now, the plots after the first paint (paintEvent)
             self._readouts_dirty = False
             self._paint_readouts()
-        self._timer.start()
+        if self._relative_now() is not None:
+            self._clock.request(self._tick)  # the time axis keeps time
 
     def paintEvent(self, event: QPaintEvent) -> None:
         super().paintEvent(event)
@@ -562,9 +444,11 @@ class MonitorPanel(QWidget):
             QTimer.singleShot(0, self, self.refresh)
 
     def hideEvent(self, event: QHideEvent) -> None:
-        self._timer.stop()
+        self._shown = False
+        self._clock.cancel(self._tick)
         super().hideEvent(event)
 
     def closeEvent(self, event: QCloseEvent) -> None:
-        self._timer.stop()
+        self._shown = False
+        self._clock.cancel(self._tick)
         super().closeEvent(event)

@@ -1,15 +1,37 @@
-"""The monitor's plot helpers: angle unwrapping, plot styling and the compact legend."""
+"""The monitor's plots: XYZ and ABC over time, the X–Y top view, and their helpers.
+
+:class:`MonitorPlots` builds the pyqtgraph widgets (pyqtgraph is imported only then, after the
+window's first paint) and draws from the monitor's ring buffers: contiguous views, no copies,
+a stride when a window holds more samples than the plot has pixels to show them.
+"""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import numpy as np
+from PySide6.QtCore import Qt
 from PySide6.QtGui import QFont
+from PySide6.QtWidgets import QSizePolicy, QSplitter, QWidget
+
+from ui.models.ring_buffer import RingBuffer
 
 if TYPE_CHECKING:  # imported when the first plot is built (the window's first paint goes first)
     import pyqtgraph as pg
 
-__all__ = ["AXIS_TICK_POINTS", "GRID_COLOR", "LEFT_AXIS_WIDTH", "add_legend", "style_plot", "unwrap_degrees"]
+__all__ = [
+    "AXIS_TICK_POINTS",
+    "CARTESIAN",
+    "GRID_COLOR",
+    "LEFT_AXIS_WIDTH",
+    "MAX_PLOT_POINTS",
+    "MIN_PLOT_POINTS",
+    "PAINT_MARGIN",
+    "MonitorPlots",
+    "add_legend",
+    "style_plot",
+    "unwrap_degrees",
+]
 
 AXIS_TICK_POINTS = 9.0
 LEFT_AXIS_WIDTH = 52  # px: room for "-8888" labels, so the plots do not shift as values change
@@ -17,6 +39,30 @@ GRID_COLOR = "#dde3e6"
 # px: two stacked plots + the tiles above them set the Monitor tab's height, the tallest tab; with
 # the alarm banner up at 1280x800 (Chinese fonts are taller) 2 x 90 px did not fit
 PLOT_MIN_HEIGHT = 80
+# Points per curve: two per pixel of the plot's width, within these bounds; longer windows are
+# drawn with a stride (still a view). Drawing 2 px wide lines costs in proportion to the points.
+MAX_PLOT_POINTS = 2500
+MIN_PLOT_POINTS = 1000
+POINTS_PER_PIXEL = 2
+CURVE_WIDTH = 1  # px, the time curves (see MonitorPlots)
+# Curves keep a view of the ring buffer until the scene repaints; never hand them the whole
+# buffer, so samples arriving before that repaint cannot overwrite what they show.
+PAINT_MARGIN = 512
+TRACE_MIN_SPAN_MM = 50.0  # the top view never zooms in closer than this (readable labels)
+TRACE_PADDING = 0.08  # fraction of the span around the trace
+
+# History channels: time, then X Y Z and the unwrapped A B C.
+T, X = 0, 1
+CARTESIAN = ("X", "Y", "Z", "A", "B", "C")
+_PLOT_COLORS = {
+    "X": "#d62728",
+    "Y": "#2ca02c",
+    "Z": "#1f77b4",
+    "A": "#d62728",
+    "B": "#2ca02c",
+    "C": "#1f77b4",
+}
+_TRACE_COLOR = "#6a1b9a"
 
 
 def unwrap_degrees(previous_raw: float, previous_unwrapped: float, raw: float) -> float:
@@ -60,7 +106,116 @@ def style_plot(plot: pg.PlotWidget) -> None:
         font = QFont()
         font.setPointSizeF(AXIS_TICK_POINTS)
         axis.setStyle(tickFont=font)
+    for name in ("top", "right"):  # hidden, but linked to the view: no label update per new range
+        item.getAxis(name).enableAutoSIPrefix(False)
     item.getAxis("left").setWidth(LEFT_AXIS_WIDTH)
     plot.setMenuEnabled(False)
     plot.setMinimumHeight(PLOT_MIN_HEIGHT)
     plot.setMinimumWidth(120)
+
+
+class MonitorPlots:
+    """The three plots in their splitters (``widget``), drawn from the monitor's ring buffers."""
+
+    def __init__(self, parent: QWidget) -> None:
+        import pyqtgraph as pg
+
+        self.xyz_plot = pg.PlotWidget(parent)
+        self.abc_plot = pg.PlotWidget(parent)
+        self.trace_plot = pg.PlotWidget(parent)
+        for plot in (self.xyz_plot, self.abc_plot, self.trace_plot):
+            style_plot(plot)
+        self.abc_plot.setXLink(self.xyz_plot)
+        self.xyz_plot.getPlotItem().hideAxis("bottom")
+        self.curves: dict[str, pg.PlotCurveItem] = {}
+        for name in CARTESIAN:
+            plot = self.xyz_plot if name in "XYZ" else self.abc_plot
+            if name in ("X", "A"):
+                add_legend(plot)
+            # 1 px: the raster engine's fast path; a 2 px pen is stroked as polygons and cost
+            # about half of the monitor's frame time (benchmarks/streaming.py, plots at 25 Hz)
+            curve = pg.PlotCurveItem(pen=pg.mkPen(_PLOT_COLORS[name], width=CURVE_WIDTH), name=name)
+            plot.addItem(curve)
+            self.curves[name] = curve
+
+        self.trace_plot.setAspectLocked(True)
+        # room on the right for the last bottom tick label (else clipped at the plot's edge)
+        self.trace_plot.getPlotItem().layout.setContentsMargins(2, 2, 16, 2)
+        self.trace_curve = pg.PlotCurveItem(pen=pg.mkPen(_TRACE_COLOR, width=2))
+        self.trace_plot.addItem(self.trace_curve)
+        self.trace_marker = pg.ScatterPlotItem(size=11, brush=pg.mkBrush("#ff6f00"), pen=pg.mkPen("#263238"))
+        self.trace_plot.addItem(self.trace_marker)
+        self._trace_range: tuple[float, float, float] | None = None  # centre x, y and half span set last
+        self._x_range: tuple[float, float] | None = None
+
+        time_plots = QSplitter(Qt.Orientation.Vertical, parent)
+        time_plots.addWidget(self.xyz_plot)
+        time_plots.addWidget(self.abc_plot)
+        time_plots.setChildrenCollapsible(False)
+        plots = QSplitter(Qt.Orientation.Horizontal, parent)
+        plots.addWidget(time_plots)
+        plots.addWidget(self.trace_plot)
+        plots.setStretchFactor(0, 2)
+        plots.setStretchFactor(1, 1)
+        plots.setChildrenCollapsible(False)
+        plots.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        self.widget = plots
+
+    def max_points(self) -> int:
+        """Points per curve worth drawing: two per pixel of the time plots' width, bounded."""
+        width = int(self.xyz_plot.width())
+        return min(MAX_PLOT_POINTS, max(MIN_PLOT_POINTS, POINTS_PER_PIXEL * width))
+
+    def paint_history(self, history: RingBuffer, window_s: float, now: float | None) -> None:
+        """The time plots: the last ``window_s`` seconds, ending at ``now`` (relative time) or at
+        the newest sample, whichever is later."""
+        n = min(len(history), history.capacity - PAINT_MARGIN)
+        if n <= 0:
+            for curve in self.curves.values():
+                curve.setData([], [])
+            return
+        t = history.view(T, n)
+        t_end = float(t[-1]) if now is None else max(float(t[-1]), now)
+        start = int(np.searchsorted(t, t_end - window_s, side="left"))
+        count = n - start
+        step = max(1, -(-count // self.max_points()))
+        first = start + (count - 1) % step  # keep the newest sample on the stride
+        t_view = t[first::step]
+        for channel, name in enumerate(CARTESIAN, start=X):
+            self.curves[name].setData(t_view, history.view(channel, n)[first::step], skipFiniteCheck=True)
+        x_range = (max(0.0, t_end - window_s), max(t_end, window_s))
+        if x_range != self._x_range:
+            self._x_range = x_range
+            self.xyz_plot.setXRange(*x_range, padding=0)
+
+    def paint_trace(self, trace: RingBuffer) -> None:
+        n = min(len(trace), trace.capacity - PAINT_MARGIN)
+        if n <= 0:
+            self.trace_curve.setData([], [])
+            self.trace_marker.setData([], [])
+            return
+        xs, ys = trace.view(0, n), trace.view(1, n)
+        self.trace_curve.setData(xs, ys, skipFiniteCheck=True)
+        self.trace_marker.setData([float(xs[-1])], [float(ys[-1])])
+        self._fit_trace(float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
+
+    def _fit_trace(self, x0: float, x1: float, y0: float, y1: float) -> None:
+        """Show the whole trace, at least TRACE_MIN_SPAN_MM wide and tall, centred; the view is
+        only touched when that range changes (a new range re-lays out both axes)."""
+        half = max(x1 - x0, y1 - y0, TRACE_MIN_SPAN_MM) / 2.0
+        wanted = ((x0 + x1) / 2.0, (y0 + y1) / 2.0, half)
+        if wanted == self._trace_range:
+            return
+        self._trace_range = wanted
+        cx, cy, _ = wanted
+        view = self.trace_plot.getPlotItem().getViewBox()
+        view.setRange(xRange=(cx - half, cx + half), yRange=(cy - half, cy + half), padding=TRACE_PADDING)
+
+    def forget_ranges(self) -> None:
+        """Set the view ranges again at the next paint (after the plots were cleared or resized)."""
+        self._trace_range = None
+        self._x_range = None
+
+    def trace_view_range(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        (x0, x1), (y0, y1) = self.trace_plot.getPlotItem().getViewBox().viewRange()
+        return (x0, x1), (y0, y1)

@@ -35,6 +35,7 @@ from app.protocol.enums import (
     ControllerMode,
     ProgramState,
 )
+from ui.display_clock import DisplayClock
 from ui.palette import (
     COLOR_BORDER,
     COLOR_ERROR,
@@ -55,7 +56,6 @@ __all__ = ["AGE_TICK_MS", "PoseStrip"]
 
 CTX = "PoseStrip"
 AGE_TICK_MS = 1000  # the stale age counts up at this period (only while stale and shown)
-PAINT_INTERVAL_MS = 34  # poses arrive at the poll rate; the numbers are redrawn at <= 30 Hz
 VALUE_SAMPLE = "-8888.88"  # the widest value the strip keeps room for
 VALUE_POINTS = 12.0
 CHIP_PADDING = 20  # px: the chips' left + right padding and border
@@ -96,20 +96,20 @@ def _chip_style(background: str, color: str) -> str:
 class PoseStrip(QFrame):
     """See the module docstring. ``is_live()``: the strip shows fresh values now."""
 
-    def __init__(self, parent: QWidget | None = None) -> None:
+    def __init__(self, parent: QWidget | None = None, *, clock: DisplayClock | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("PoseStrip")
         self.setFrameShape(QFrame.Shape.StyledPanel)
+        self.setAutoFillBackground(True)  # opaque: a new value repaints the strip, not the window under it
         self._state: RobotState | None = None
         self._age_timer = QTimer(self)
         self._age_timer.setInterval(AGE_TICK_MS)
         self._age_timer.timeout.connect(self._show_freshness)
-        # leading edge: a pose is drawn at once, then at most once per interval (the latest)
-        self._paint_timer = QTimer(self)
-        self._paint_timer.setSingleShot(True)
-        self._paint_timer.setInterval(PAINT_INTERVAL_MS)
-        self._paint_timer.timeout.connect(self._on_paint_timer)
-        self._pose_dirty = False
+        # Poses arrive at the poll rate; the numbers are redrawn in the display clock's frames
+        # (with the monitor's): the first pose after a quiet spell at once, then the latest one
+        # per frame. Hidden, nothing is drawn until shown.
+        self._clock = clock if clock is not None else DisplayClock.shared()
+        self._shown_style: bool | None = None  # the liveness the value labels are styled for
 
         bold = QFont(self.font())
         bold.setBold(True)
@@ -127,7 +127,8 @@ class PoseStrip(QFrame):
             value.setObjectName(f"PoseStripValue{name}")
             value.setFont(monospace_font(VALUE_POINTS, bold=True))
             value.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
-            value.setFixedWidth(fit_width(value, [VALUE_SAMPLE], padding=4))
+            # a fixed size: a new value repaints the label only, never re-lays out the window
+            value.setFixedSize(fit_width(value, [VALUE_SAMPLE], padding=4), value.sizeHint().height())
             unit = QLabel(self)
             unit.setStyleSheet(f"color: {COLOR_NEUTRAL};")
             unit.setFixedWidth(fit_width(unit, [*both_languages("PoseStrip", "mm"), "°"], padding=2))
@@ -231,19 +232,8 @@ class PoseStrip(QFrame):
 
     @Slot(Pose)
     def _on_pose(self, _pose: Pose) -> None:
-        if self._paint_timer.isActive():
-            self._pose_dirty = True
-            return
-        self._show_pose()
-        if self.isVisible():
-            self._paint_timer.start()
-
-    @Slot()
-    def _on_paint_timer(self) -> None:
-        if self._pose_dirty:
-            self._pose_dirty = False
-            self._show_pose()
-            self._paint_timer.start()
+        if self.isVisible():  # hidden: showEvent draws the latest
+            self._clock.run_or_request(self._show_pose)
 
     @Slot(ControllerStatus)
     def _on_status(self, _status: ControllerStatus) -> None:
@@ -265,24 +255,25 @@ class PoseStrip(QFrame):
         self._update_timer()
 
     def _show_pose(self) -> None:
-        self._pose_dirty = False
         pose = self._state.pose if self._state is not None else None
         live = self.is_live()
-        color = COLOR_INK if live else COLOR_STALE
-        style = "normal" if live else "italic"
-        background = "transparent" if live else COLOR_STALE_BG
-        sheet = f"QLabel {{ color: {color}; font-style: {style}; background: {background}; }}"
-        for i, name in enumerate(CARTESIAN_AXIS_NAMES):
+        if live != self._shown_style:
+            self._shown_style = live
+            color = COLOR_INK if live else COLOR_STALE
+            style = "normal" if live else "italic"
+            background = "transparent" if live else COLOR_STALE_BG
+            sheet = f"QLabel {{ color: {color}; font-style: {style}; background: {background}; }}"
+            for label in self.values.values():
+                label.setStyleSheet(sheet)
+                label.setProperty("stale", not live)
+        values = pose.xyzabc if pose is not None else (math.nan,) * len(CARTESIAN_AXIS_NAMES)
+        for name, value in zip(CARTESIAN_AXIS_NAMES, values, strict=True):
             label = self.values[name]
-            value = pose.xyzabc[i] if pose is not None else math.nan
             text = f"{value:.2f}" if math.isfinite(value) else "—"
             if text.startswith("-") and text.strip("-0.") == "":
                 text = text[1:]  # no "-0.00" flicker
             if label.text() != text:
                 label.setText(text)
-            if label.styleSheet() != sheet:
-                label.setStyleSheet(sheet)
-            label.setProperty("stale", not live)
 
     def _show_status(self) -> None:
         status = self._state.status if self._state is not None else None
@@ -352,5 +343,5 @@ class PoseStrip(QFrame):
 
     def hideEvent(self, event: QHideEvent) -> None:
         self._age_timer.stop()
-        self._paint_timer.stop()
+        self._clock.cancel(self._show_pose)
         super().hideEvent(event)

@@ -1,9 +1,12 @@
 """Modbus traffic inspector: every frame on the wire, decoded on demand.
 
 ``on_traffic(records)`` takes a batch of ``TrafficRecord``-like objects (``t``, ``direction``,
-``frame``, ``transport``) and inserts it with one ``beginInsertRows``. The table and its filter
-are :mod:`ui.models.traffic_model`: frames are decoded only when a row's meaning is shown,
-filtered on or exported, so 100 Hz traffic does not stall the GUI.
+``frame``, ``transport``). While the panel is shown, batches are gathered and inserted with one
+``beginInsertRows`` at most every ``FLUSH_INTERVAL_MS``, in a frame of the display clock (so the
+table repaints together with the monitor and the pose strip, not on its own). The table and its
+filter are :mod:`ui.models.traffic_model`: frames are decoded only when a row's meaning is shown,
+filtered on or exported, so 100 Hz traffic does not stall the GUI. Hidden, rows go straight into
+the model without formatting anything (no count text, no scrolling, no decoding).
 """
 
 from __future__ import annotations
@@ -21,7 +24,7 @@ from PySide6.QtCore import (
     Signal,
     Slot,
 )
-from PySide6.QtGui import QFontMetrics, QGuiApplication, QHideEvent
+from PySide6.QtGui import QFontMetrics, QGuiApplication, QHideEvent, QShowEvent
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QCheckBox,
@@ -37,6 +40,7 @@ from PySide6.QtWidgets import (
 
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
+from ui.display_clock import DisplayClock
 from ui.models.traffic_model import (
     COL_BYTES,
     COL_DIRECTION,
@@ -53,9 +57,11 @@ from ui.widgets_common import (
 )
 
 FILTER_DEBOUNCE_MS = 200  # typing in the filter box re-filters once the user pauses
-# At most 10 table updates a second while the panel is visible: 20 Hz cost 1.5x the GUI-thread
-# CPU (python -m benchmarks.traffic), and nobody reads 400 frames a second.
-FLUSH_INTERVAL_MS = 100
+# At most 5 table updates a second while the panel is visible, each in a display-clock frame:
+# every update scrolls a screenful of new rows whose meaning is decoded when painted (a pose
+# answer ~1.5 ms), so the cost follows this rate (20 Hz cost 1.5x 10 Hz, 10 Hz 1.6x 5 Hz:
+# python -m benchmarks.traffic); nobody reads 400 frames a second.
+FLUSH_INTERVAL_MS = 200
 _BUSY_CURSOR_ROWS = 2000
 
 
@@ -64,8 +70,10 @@ class TrafficPanel(QWidget):
 
     captureEnabledChanged = Signal(bool)
 
-    def __init__(self, parent: QWidget | None = None, *, max_rows: int = MAX_ROWS_DEFAULT) -> None:
+    def __init__(self, parent: QWidget | None = None, *, max_rows: int = MAX_ROWS_DEFAULT,
+                 clock: DisplayClock | None = None) -> None:
         super().__init__(parent)
+        self._clock = clock if clock is not None else DisplayClock.shared()
         self.setObjectName("TrafficPanel")
         self._capture = True
         self.model = TrafficModel(self, max_rows=max_rows)
@@ -80,7 +88,7 @@ class TrafficPanel(QWidget):
         self._flush_timer = QTimer(self)
         self._flush_timer.setSingleShot(True)
         self._flush_timer.setInterval(FLUSH_INTERVAL_MS)
-        self._flush_timer.timeout.connect(self.flush)
+        self._flush_timer.timeout.connect(self._flush_in_next_frame)
         self._filter_timer = QTimer(self)
         self._filter_timer.setSingleShot(True)
         self._filter_timer.setInterval(FILTER_DEBOUNCE_MS)
@@ -163,16 +171,21 @@ class TrafficPanel(QWidget):
         if not self._capture or not records:
             return
         if not self.isVisible():
-            self._insert(records)
+            self.model.append_records(records)  # no painting, no formatting: showEvent catches up
             return
         self._pending.extend(records)
-        if not self._flush_timer.isActive():
+        if not self._flush_timer.isActive() and not self._clock.is_requested(self.flush):
             self._flush_timer.start()
+
+    @Slot()
+    def _flush_in_next_frame(self) -> None:
+        self._clock.request(self.flush)
 
     @Slot()
     def flush(self) -> None:
         """Insert the gathered records now."""
         self._flush_timer.stop()
+        self._clock.cancel(self.flush)
         if self._pending:
             records, self._pending = self._pending, []
             self._insert(records)
@@ -294,6 +307,12 @@ class TrafficPanel(QWidget):
         if not self._capture:
             text += " — " + self.tr("capture paused")
         self.count_label.setText(text)
+
+    def showEvent(self, event: QShowEvent) -> None:
+        super().showEvent(event)
+        if not self.view.selectionModel().hasSelection():
+            self.view.scrollToBottom()  # rows that came while hidden: follow the newest
+        self._update_count()
 
     def hideEvent(self, event: QHideEvent) -> None:
         self.flush()
