@@ -33,7 +33,7 @@ from typing import Any
 from app.cli import controller, points, run_plan, support
 from app.cli.context import PROG, CliContext, Handler
 from app.cli.exit_codes import EPILOG, ExitCode, exit_code_for
-from app.cli.format import _positive_float, _word_order
+from app.cli.format import parse_positive_float, parse_word_order
 from app.cli.help import add_examples
 from app.errors import TeachPadError
 from app.link.client import ConnectionSettings
@@ -88,12 +88,12 @@ def build_parser() -> argparse.ArgumentParser:
                       help="RTU parity: none, even, odd (default %(default)s)")
     link.add_argument("--framer", choices=("socket", "rtu"), default="socket",
                       help="frame format over TCP (rtu: RTU frames over a TCP socket)")
-    link.add_argument("--word-order", type=_word_order, default=WordOrder.LOW_FIRST,
+    link.add_argument("--word-order", type=parse_word_order, default=WordOrder.LOW_FIRST,
                       metavar="low-first|high-first",
                       help="float32 word order of the controller (default low-first)")
-    link.add_argument("--timeout", type=_positive_float, default=1.0, metavar="SECONDS",
+    link.add_argument("--timeout", type=parse_positive_float, default=1.0, metavar="SECONDS",
                       help="Modbus request timeout of commands and one-off reads")
-    link.add_argument("--poll-timeout", type=_positive_float, default=None, metavar="SECONDS",
+    link.add_argument("--poll-timeout", type=parse_positive_float, default=None, metavar="SECONDS",
                       help="timeout of the monitoring reads of status and watch (default: 0.15 "
                            "over TCP, by baud rate over RTU)")
     link.add_argument("--monitor-only", action="store_true", help="refuse every write")

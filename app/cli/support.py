@@ -14,8 +14,6 @@ GUI.
 
 from __future__ import annotations
 
-import argparse
-import datetime as dt
 import getpass
 import json
 import sys
@@ -24,6 +22,7 @@ from typing import Any
 
 from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode
+from app.cli.format import parse_moment, parse_positive_int
 from app.errors import InvalidInput
 from app.safety.audit import AuditFilter, ReadStats, default_audit_dir, export_csv, query
 from app.safety.bundle import DEFAULT_DAYS, write_support_bundle
@@ -31,23 +30,6 @@ from app.safety.roles import Role, RoleStore, default_store_path
 
 ADMIN_NOTE = ("teachpad-cli is an administrator's tool: it is not limited by TeachPad's roles "
               "(anyone with a shell can read and write TeachPad's files).")
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text[:20]!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError("must be at least 1")
-    return value
-
-
-def _moment(text: str) -> dt.datetime:
-    try:
-        return dt.datetime.fromisoformat(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a date or time (YYYY-MM-DD[THH:MM]): {text[:20]!r}") from None
 
 
 def register(subparsers: Any) -> None:
@@ -60,16 +42,16 @@ def register(subparsers: Any) -> None:
     p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
     p.add_argument("--log-dir", type=Path, help="a folder of log files to include")
     p.add_argument("--traffic", type=Path, help="a text file of recorded Modbus traffic")
-    p.add_argument("--days", type=_positive_int, default=DEFAULT_DAYS,
+    p.add_argument("--days", type=parse_positive_int, default=DEFAULT_DAYS,
                    help="how many days of records, counted back from now (default %(default)s)")
     p.set_defaults(handler=cmd_support_bundle)
 
     p = subparsers.add_parser("audit", help="show or export the audit trail (offline)",
                               description="Show the audit trail. " + ADMIN_NOTE)
     p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
-    p.add_argument("--from", dest="start", type=_moment, metavar="WHEN",
+    p.add_argument("--from", dest="start", type=parse_moment, metavar="WHEN",
                    help="first moment, local time YYYY-MM-DD[THH:MM]")
-    p.add_argument("--to", dest="end", type=_moment, metavar="WHEN",
+    p.add_argument("--to", dest="end", type=parse_moment, metavar="WHEN",
                    help="last moment, local time YYYY-MM-DD[THH:MM]")
     p.add_argument("--role", help="only records of this role (operator, engineer, administrator)")
     p.add_argument("--command", dest="command_text", metavar="TEXT", help="part of the command text")
