@@ -200,8 +200,8 @@ def _run(ctx: CliContext, args: argparse.Namespace, project: Project, plan: Plan
         for issue in errors:
             ctx.error(issue.message)
         code = _refusal_code(errors)
-        why = "out of the robot model's reach" if code is ExitCode.FAILED else f"{len(errors)} error(s)"
-        ctx.error(f"plan {plan.name!r} has {why}: not running it")
+        what = " (out of the robot model's reach)" if code is ExitCode.FAILED else ""
+        ctx.error(f"plan {plan.name!r} has {len(errors)} error(s){what}: not running it")
         return code
     est = estimate_plan(plan, ledger, pose, loops=loops)
     ctx.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
