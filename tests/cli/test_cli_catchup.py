@@ -177,7 +177,8 @@ def test_settings_take_every_profile_field_and_the_flags_win(tmp_path: Path) -> 
     ({"poll_timeout": "soon"}, "poll_timeout"),
 ])
 def test_a_malformed_register_profile_is_usage_naming_file_and_field(
-        sim: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str], edit: dict[str, Any], field: str) -> None:
+        sim: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str], edit: dict[str, Any],
+        field: str) -> None:
     path = write_register_profile(tmp_path / "bad.registers.json", RegisterProfile(), **edit)
     code, out, err = run_cli(capsys, "--port", str(sim.port), "--register-profile", str(path), "zero", "all")
     assert code == ExitCode.USAGE and out == ""
