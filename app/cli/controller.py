@@ -17,15 +17,15 @@ from app.cli.context import CliContext, sigint_deferred, wait_motion
 from app.cli.exit_codes import ExitCode
 from app.cli.format import (
     JOG_SECONDS_MAX,
-    _axis_index,
-    _jog_seconds,
-    _num,
-    _parse_direction,
-    _parse_step_offsets,
-    _parse_zero_axis,
-    _positive_float,
+    format_number,
     format_status,
     format_watch_line,
+    parse_axis,
+    parse_direction,
+    parse_jog_seconds,
+    parse_positive_float,
+    parse_step_offsets,
+    parse_zero_axis,
     status_to_dict,
 )
 from app.errors import AlarmRaised, CommandRefused, InvalidInput, TeachPadError
@@ -110,7 +110,7 @@ def cmd_mode(ctx: CliContext) -> ExitCode:
 
 def cmd_step(ctx: CliContext) -> ExitCode:
     frame = StepFrame(ctx.args.frame)
-    offsets, ext = _parse_step_offsets(frame, ctx.args.offsets)
+    offsets, ext = parse_step_offsets(frame, ctx.args.offsets)
     client = ctx.client
     result = wait_motion(ctx, lambda: client.step(frame, offsets, ext, speed=ctx.args.speed,
                                                    wait=not ctx.args.no_wait))
@@ -122,14 +122,14 @@ def cmd_step(ctx: CliContext) -> ExitCode:
 
 def _pose_line(pose: Pose) -> str:
     pairs = zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True)
-    return "pose " + " ".join(f"{n}={_num(v)}" for n, v in pairs)
+    return "pose " + " ".join(f"{n}={format_number(v)}" for n, v in pairs)
 
 
 def cmd_jog(ctx: CliContext) -> ExitCode:
     args = ctx.args
     frame = TeachFrame[args.frame.upper()]
-    axis = _axis_index(args.axis, frame is TeachFrame.JOINT)
-    direction = _parse_direction(args.dir)
+    axis = parse_axis(args.axis, frame is TeachFrame.JOINT)
+    direction = parse_direction(args.dir)
     ratio = float(args.ratio)
     if not 0 < ratio <= 100:
         raise InvalidInput(f"jog ratio must be in (0, 100], got {args.ratio}")
@@ -196,7 +196,7 @@ def cmd_move(ctx: CliContext) -> ExitCode:
 
 
 def cmd_zero(ctx: CliContext) -> ExitCode:
-    axis = _parse_zero_axis(ctx.args.axis)
+    axis = parse_zero_axis(ctx.args.axis)
     ctx.client.go_zero(axis)
     target = "all axes" if axis is None else JOINT_AXIS_NAMES[axis]
     return ctx.report(f"go to zero sent ({target})")
@@ -278,7 +278,7 @@ def register(sub: Any) -> None:
     p.set_defaults(handler=cmd_status)
 
     p = sub.add_parser("watch", help="stream one status line per sample")
-    p.add_argument("--rate", type=_positive_float, default=WATCH_RATE_DEFAULT, metavar="HZ",
+    p.add_argument("--rate", type=parse_positive_float, default=WATCH_RATE_DEFAULT, metavar="HZ",
                    help="samples per second, Hz (default %(default)g)")
     p.add_argument("--count", type=int, default=0, metavar="N", help="stop after N lines (0: until Ctrl-C)")
     p.set_defaults(handler=cmd_watch)
@@ -292,7 +292,7 @@ def register(sub: Any) -> None:
                    help="joint: offsets in degrees per joint; base: X Y Z in mm, A B C in degrees")
     p.add_argument("offsets", nargs="+", metavar="AXIS=VALUE",
                    help="J1..J11 (joint) or X Y Z A B C (+ J7..J11) (base)")
-    p.add_argument("--speed", type=_positive_float, default=10.0, help="rpm (joint) or mm/s (base)")
+    p.add_argument("--speed", type=parse_positive_float, default=10.0, help="rpm (joint) or mm/s (base)")
     p.add_argument("--no-wait", action="store_true", help="return once the command is sent")
     p.set_defaults(handler=cmd_step)
 
@@ -309,7 +309,7 @@ def register(sub: Any) -> None:
     p.add_argument("--axis", required=True, help="X Y Z A B C, or J1..J11 in the joint frame")
     p.add_argument("--dir", required=True, help="+ or -")
     p.add_argument("--ratio", type=float, required=True, help="speed ratio in percent, 0 < N <= 100")
-    p.add_argument("--seconds", "--for", dest="duration", type=_jog_seconds, default=JOG_SECONDS_DEFAULT,
+    p.add_argument("--seconds", "--for", dest="duration", type=parse_jog_seconds, default=JOG_SECONDS_DEFAULT,
                    metavar="S", help=f"how long to jog, in seconds: 0 < S <= {JOG_SECONDS_MAX:g} "
                                      f"(default {JOG_SECONDS_DEFAULT:g}); --for is the same")
     p.set_defaults(handler=cmd_jog)
@@ -330,7 +330,7 @@ def register(sub: Any) -> None:
     p = sub.add_parser("move", help="move to a temp point: line, or arc with --via (function 3)")
     p.add_argument("id", type=int, help="temp point id of the end point, 1..10000")
     p.add_argument("--via", type=int, metavar="MID", help="temp point id of an arc's middle point")
-    p.add_argument("--speed", type=_positive_float, default=50.0, help="mm/s (default %(default)g)")
+    p.add_argument("--speed", type=parse_positive_float, default=50.0, help="mm/s (default %(default)g)")
     p.add_argument("--keep-orientation", action="store_true",
                    help="keep the tool's orientation (A B C) along an arc")
     p.add_argument("--ignore-middle", action="store_true",
@@ -338,7 +338,7 @@ def register(sub: Any) -> None:
     p.add_argument("--tool", type=int, default=registers.TOOL_NONE, metavar="N",
                    help=f"tool frame id ({registers.TOOL_NONE}: none, the default)")
     p.add_argument("--no-wait", action="store_true", help="return once the command is sent")
-    p.add_argument("--wait-timeout", type=_positive_float, default=None, metavar="SECONDS",
+    p.add_argument("--wait-timeout", type=parse_positive_float, default=None, metavar="SECONDS",
                    help="give up waiting after this many seconds (default: by distance and speed)")
     p.set_defaults(handler=cmd_move)
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import enum
 
 from app.errors import InvalidInput, LinkError, MalformedResponse, ResponseTimeout, TeachPadError
+from app.safety.register_profile import RegisterProfileError
 
 __all__ = ["EPILOG", "LINK_ERRORS", "ExitCode", "exit_code_for"]
 
@@ -20,7 +21,8 @@ class ExitCode(enum.IntEnum):
 
     OK = 0
     #: the command ran and failed: refused by the controller, Modbus exception, command
-    #: timeout, alarm, stopped, blocked by --monitor-only, a file that cannot be written
+    #: timeout, alarm, stopped, blocked by --monitor-only, a plan the robot model cannot reach,
+    #: a file that cannot be written
     FAILED = 1
     #: bad arguments or values, an unreadable or malformed input file, a plan with errors:
     #: nothing was sent
@@ -37,7 +39,8 @@ class ExitCode(enum.IntEnum):
 
 _MEANING = {
     ExitCode.OK: "ok",
-    ExitCode.FAILED: "command failed or refused (controller, alarm, timeout of the command, monitor-only)",
+    ExitCode.FAILED: ("command failed or refused (controller, alarm, timeout of the command, monitor-only, "
+                      "out of the robot's reach)"),
     ExitCode.USAGE: "usage: bad arguments, values or input files (nothing sent)",
     ExitCode.LINK: "link: cannot connect, no answer in time, malformed answer",
     ExitCode.INTERRUPTED: "interrupted (Ctrl-C; a motion under way is stopped first)",
@@ -55,7 +58,7 @@ def exit_code_for(error: BaseException) -> ExitCode:
     ``OSError`` of a file, or Ctrl-C)."""
     if isinstance(error, KeyboardInterrupt):
         return ExitCode.INTERRUPTED
-    if isinstance(error, InvalidInput):
+    if isinstance(error, InvalidInput | RegisterProfileError):  # bad arguments or input files
         return ExitCode.USAGE
     if isinstance(error, LINK_ERRORS):
         return ExitCode.LINK

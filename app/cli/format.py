@@ -1,8 +1,14 @@
-"""teachpad-cli's output formats and argument parsers (the pure parts of app/cli/main.py)."""
+"""teachpad-cli's output formats and argument parsers (the pure parts of app/cli/main.py).
+
+The ``parse_*`` functions are public: argparse ``type=`` callables (they raise
+``argparse.ArgumentTypeError``) and the parsers of command words (they raise
+:class:`~app.errors.InvalidInput`), shared by every command module.
+"""
 
 from __future__ import annotations
 
 import argparse
+import datetime as dt
 from collections.abc import Sequence
 from typing import Any
 
@@ -20,13 +26,30 @@ from app.protocol.enums import (
     program_state_text,
 )
 
+__all__ = [
+    "JOG_SECONDS_MAX",
+    "format_number",
+    "format_status",
+    "format_watch_line",
+    "parse_axis",
+    "parse_direction",
+    "parse_jog_seconds",
+    "parse_moment",
+    "parse_positive_float",
+    "parse_positive_int",
+    "parse_step_offsets",
+    "parse_word_order",
+    "parse_zero_axis",
+    "status_to_dict",
+]
+
 JOG_SECONDS_MAX = 30.0  # s: no jog from the CLI runs longer
 # --------------------------------------------------------------------------------------------
 # Formatting
 # --------------------------------------------------------------------------------------------
 
 
-def _num(value: float) -> str:
+def format_number(value: float) -> str:
     return f"{value:.3f}"
 
 
@@ -54,9 +77,10 @@ def status_to_dict(pose: Pose, status: ControllerStatus) -> dict[str, Any]:
 
 def format_status(pose: Pose, status: ControllerStatus) -> str:
     data = status_to_dict(pose, status)
-    cart = "  ".join(f"{n} {_num(v)}" for n, v in zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True))
-    ext = "  ".join(f"EJ{i} {_num(v)}" for i, v in enumerate(pose.ext, start=1))
-    joints = ("  ".join(f"J{i} {_num(v)}" for i, v in enumerate(pose.joints, start=1))
+    cart = "  ".join(f"{n} {format_number(v)}"
+                     for n, v in zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True))
+    ext = "  ".join(f"EJ{i} {format_number(v)}" for i, v in enumerate(pose.ext, start=1))
+    joints = ("  ".join(f"J{i} {format_number(v)}" for i, v in enumerate(pose.joints, start=1))
               if pose.joints is not None else "-")
     alarms = ", ".join(data["alarms"]["names"]) or "none"
     lines = [
@@ -76,7 +100,7 @@ def format_status(pose: Pose, status: ControllerStatus) -> str:
 
 
 def format_watch_line(elapsed: float, pose: Pose, status: ControllerStatus) -> str:
-    cart = " ".join(f"{n}={_num(v)}" for n, v in zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True))
+    cart = " ".join(f"{n}={format_number(v)}" for n, v in zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True))
     alarms = ",".join(alarm_names(int(status.alarms))) or "none"
     return (f"t={elapsed:.3f} {cart} mode={controller_mode_text(int(status.mode))} "
             f"program={program_state_text(int(status.program_state))} alarms={alarms} "
@@ -88,7 +112,7 @@ def format_watch_line(elapsed: float, pose: Pose, status: ControllerStatus) -> s
 # --------------------------------------------------------------------------------------------
 
 
-def _axis_index(name: str, joint_frame: bool) -> int:
+def parse_axis(name: str, joint_frame: bool) -> int:
     key = name.strip().upper()
     names = JOINT_AXIS_NAMES if joint_frame else CARTESIAN_AXIS_NAMES
     if key in names:
@@ -97,7 +121,7 @@ def _axis_index(name: str, joint_frame: bool) -> int:
     raise InvalidInput(f"axis {name[:8]!r} does not exist in the {frame} (use {', '.join(names)})")
 
 
-def _parse_direction(text: str) -> int:
+def parse_direction(text: str) -> int:
     key = text.strip().lower()
     if key in ("+", "pos", "positive", "1"):
         return 1
@@ -106,7 +130,7 @@ def _parse_direction(text: str) -> int:
     raise InvalidInput(f"direction must be + or -, got {text!r}")
 
 
-def _parse_step_offsets(frame: StepFrame, items: Sequence[str]) -> tuple[list[float], list[float]]:
+def parse_step_offsets(frame: StepFrame, items: Sequence[str]) -> tuple[list[float], list[float]]:
     offsets = [0.0] * registers.NUM_ROBOT_AXES
     ext = [0.0] * registers.NUM_EXTERNAL_AXES
     main_names = JOINT_AXIS_NAMES[:6] if frame is StepFrame.JOINT else CARTESIAN_AXIS_NAMES
@@ -132,7 +156,7 @@ def _parse_step_offsets(frame: StepFrame, items: Sequence[str]) -> tuple[list[fl
     return offsets, ext
 
 
-def _parse_zero_axis(text: str) -> int | None:
+def parse_zero_axis(text: str) -> int | None:
     key = text.strip().upper()
     if key == "ALL":
         return None
@@ -143,21 +167,21 @@ def _parse_zero_axis(text: str) -> int | None:
     raise InvalidInput(f"zero: axis must be J1..J11, 1..11 or all, got {text!r}")
 
 
-def _word_order(text: str) -> WordOrder:
+def parse_word_order(text: str) -> WordOrder:
     try:
         return WordOrder.parse(text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
-def _jog_seconds(text: str) -> float:
-    value = _positive_float(text)
+def parse_jog_seconds(text: str) -> float:
+    value = parse_positive_float(text)
     if value > JOG_SECONDS_MAX:
         raise argparse.ArgumentTypeError(f"a jog runs at most {JOG_SECONDS_MAX:g} s, got {text[:20]}")
     return value
 
 
-def _positive_float(text: str) -> float:
+def parse_positive_float(text: str) -> float:
     try:
         value = float(text)
     except ValueError:
@@ -167,3 +191,19 @@ def _positive_float(text: str) -> float:
     return value
 
 
+def parse_positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a whole number: {text[:20]!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError("must be at least 1")
+    return value
+
+
+def parse_moment(text: str) -> dt.datetime:
+    """A local date or time, ``YYYY-MM-DD[THH:MM[:SS]]``."""
+    try:
+        return dt.datetime.fromisoformat(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a date or time (YYYY-MM-DD[THH:MM]): {text[:20]!r}") from None

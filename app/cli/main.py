@@ -1,7 +1,12 @@
 """teachpad-cli: script the controller from a shell.
 
-    teachpad-cli [--host H --port P --unit U | --rtu DEV --baud B --parity N] [--word-order W]
-                 [--timeout S] [--monitor-only] COMMAND ...
+    teachpad-cli [--host H --port P | --rtu DEV --baud B --parity N] [--timeout S]
+                 [--register-profile FILE] [--unit U] [--word-order W] [--completion C]
+                 [--poll-timeout S] [--monitor-only] COMMAND ...
+
+The connection options say where the controller is; ``--register-profile`` how its registers
+read (:mod:`app.safety.register_profile`, as the GUI applies it); ``--unit``, ``--word-order``,
+``--completion`` and ``--poll-timeout`` override the profile's field (:func:`settings_from_args`).
 
 Every command, by the module whose ``register`` adds it (:data:`REGISTRARS`, in this order):
 
@@ -23,21 +28,29 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import logging
 import os
 import sys
 import textwrap
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import Any
 
 from app.cli import controller, points, run_plan, support
 from app.cli.context import PROG, CliContext, Handler
 from app.cli.exit_codes import EPILOG, ExitCode, exit_code_for
-from app.cli.format import _positive_float, _word_order
+from app.cli.format import parse_positive_float, parse_word_order
 from app.cli.help import add_examples
-from app.errors import TeachPadError
+from app.errors import InvalidInput, TeachPadError
 from app.link.client import ConnectionSettings
-from app.protocol.codec import WordOrder
+from app.safety.register_profile import (
+    COMPLETION_MODES,
+    PROFILE_NAME,
+    UNIT_RANGE,
+    load_register_profile,
+)
+from app.safety.roles import default_config_dir
 
 __all__ = [
     "EXIT_FAILED",
@@ -81,21 +94,32 @@ def build_parser() -> argparse.ArgumentParser:
     link.add_argument("--host", default="127.0.0.1",
                       help="controller's IP address or host name (default %(default)s)")
     link.add_argument("--port", type=int, default=502, help="Modbus TCP port (default %(default)s)")
-    link.add_argument("--unit", type=int, default=1, help="Modbus unit (slave) id")
     link.add_argument("--rtu", metavar="PORT", help="Modbus RTU on this serial port instead of TCP")
     link.add_argument("--baud", type=int, default=115200, help="RTU baud rate, bit/s (default %(default)s)")
     link.add_argument("--parity", choices=("N", "E", "O"), default="N",
                       help="RTU parity: none, even, odd (default %(default)s)")
     link.add_argument("--framer", choices=("socket", "rtu"), default="socket",
                       help="frame format over TCP (rtu: RTU frames over a TCP socket)")
-    link.add_argument("--word-order", type=_word_order, default=WordOrder.LOW_FIRST,
-                      metavar="low-first|high-first",
-                      help="float32 word order of the controller (default low-first)")
-    link.add_argument("--timeout", type=_positive_float, default=1.0, metavar="SECONDS",
+    link.add_argument("--timeout", type=parse_positive_float, default=1.0, metavar="SECONDS",
                       help="Modbus request timeout of commands and one-off reads")
-    link.add_argument("--poll-timeout", type=_positive_float, default=None, metavar="SECONDS",
-                      help="timeout of the monitoring reads of status and watch (default: 0.15 "
-                           "over TCP, by baud rate over RTU)")
+    regs = parser.add_argument_group("register profile", textwrap.fill(
+        "How the controller's registers read. --register-profile applies a register profile file "
+        "(.registers.json, as saved by the GUI's Safety > Register profile; the GUI's own is "
+        f"{_shown_path(default_config_dir() / PROFILE_NAME)}); the options below override the "
+        "profile's field of the same name.", 90))
+    regs.add_argument("--register-profile", type=Path, metavar="FILE",
+                      help="apply this register profile (word order, unit id, completion rule, poll "
+                           "timeout, date/time layout, point ids)")
+    regs.add_argument("--unit", type=int, default=None,
+                      help="Modbus unit (slave) id (default: the register profile's, else 1)")
+    regs.add_argument("--word-order", type=parse_word_order, default=None,
+                      metavar="low-first|high-first",
+                      help="float32 word order of the controller (default: the profile's, else low-first)")
+    regs.add_argument("--completion", choices=COMPLETION_MODES, default=None,
+                      help="how a command's completion is told (default: the profile's, else auto)")
+    regs.add_argument("--poll-timeout", type=parse_positive_float, default=None, metavar="SECONDS",
+                      help="timeout of the monitoring reads of status and watch (default: the "
+                           "profile's, else 0.15 over TCP, by baud rate over RTU)")
     link.add_argument("--monitor-only", action="store_true", help="refuse every write")
     parser.add_argument("-v", "--verbose", action="store_true", help="log every write and the link")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -105,12 +129,31 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: Options that override the register profile's field of the same name (when given).
+PROFILE_OVERRIDES: tuple[str, ...] = ("unit", "word_order", "completion", "poll_timeout")
+
+
 def settings_from_args(args: argparse.Namespace) -> ConnectionSettings:
-    return ConnectionSettings(
-        host=args.host, port=args.port, unit=args.unit, serial_port=args.rtu, baudrate=args.baud,
-        parity=args.parity, framer=args.framer, word_order=args.word_order, timeout=args.timeout,
-        poll_timeout=args.poll_timeout, monitor_only=args.monitor_only,
+    """Where to connect (the link options), how the registers read (``--register-profile``,
+    else the defaults), then each explicit override (``--unit``, ``--word-order``, ...).
+
+    Raises :class:`RegisterProfileError` (a usage error) for a profile that cannot be used."""
+    where = ConnectionSettings(
+        host=args.host, port=args.port, serial_port=args.rtu, baudrate=args.baud,
+        parity=args.parity, framer=args.framer, timeout=args.timeout, monitor_only=args.monitor_only,
     )
+    path = getattr(args, "register_profile", None)
+    settings = where if path is None else load_register_profile(path).apply(where)
+    overrides = {name: value for name in PROFILE_OVERRIDES
+                 if (value := getattr(args, name, None)) is not None}
+    if "unit" in overrides and not UNIT_RANGE[0] <= overrides["unit"] <= UNIT_RANGE[1]:
+        raise InvalidInput(f"--unit must be {UNIT_RANGE[0]}..{UNIT_RANGE[1]}, got {overrides['unit']}")
+    return dataclasses.replace(settings, **overrides)
+
+
+def _shown_path(path: Path) -> str:
+    text = str(path)
+    return text if len(text) <= _PATH_SHOWN else "…" + text[-(_PATH_SHOWN - 1):]
 
 
 def _configure_logging(verbose: bool) -> None:
@@ -151,7 +194,12 @@ def _main(argv: Sequence[str] | None = None) -> int:
     except SystemExit as exc:  # --help (0), or a usage error already printed by argparse (2)
         return exc.code if isinstance(exc.code, int) else ExitCode.USAGE
     _configure_logging(args.verbose)
-    ctx = CliContext(args, settings_from_args(args))
+    try:
+        settings = settings_from_args(args)
+    except TeachPadError as exc:  # a register profile that cannot be used, a bad --unit
+        print(f"{PROG}: error: {exc}", file=sys.stderr, flush=True)
+        return exit_code_for(exc)
+    ctx = CliContext(args, settings)
     handler: Handler = args.handler
     try:
         return handler(ctx)

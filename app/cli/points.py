@@ -9,7 +9,8 @@ controller (``points upload``, ``run`` without ``--check``); the context closes 
 
 Exit codes: :class:`app.cli.exit_codes.ExitCode` (points not on the controller without
 ``--upload`` is FAILED; a malformed file is USAGE). Global options read when the main parser
-defines them: ``point_id_min``, ``point_id_max`` (accepted temp point ids, default 0..10000).
+defines them: ``point_id_min``, ``point_id_max`` (accepted temp point ids; default: the register
+profile's, else 0..10000).
 
 Commands::
 
@@ -37,7 +38,7 @@ from app.cli.exit_codes import ExitCode, exit_code_for
 from app.errors import InvalidInput, TeachPadError
 from app.points.ledger import EmptyImport, ImportMode, PointLedger
 from app.points.lock import live_owner
-from app.points.point import DEFAULT_LIMITS, FileFormatError, PointLimits, TempPoint, tool_text
+from app.points.point import FileFormatError, PointLimits, TempPoint, tool_text
 from app.points.project import Project, load_project, read_points_csv, save_project, write_points_csv
 from app.points.upload import UploadReport, apply_upload, parse_id_list, upload_points
 
@@ -110,14 +111,14 @@ def register(subparsers: Any) -> None:
 # --- helpers ------------------------------------------------------------------------------------
 
 
-def _limits(args: argparse.Namespace) -> PointLimits:
-    lo = getattr(args, "point_id_min", None)
-    hi = getattr(args, "point_id_max", None)
-    if lo is None and hi is None:
-        return DEFAULT_LIMITS
-    return PointLimits(
-        DEFAULT_LIMITS.id_min if lo is None else lo, DEFAULT_LIMITS.id_max if hi is None else hi
-    )
+def _limits(ctx: CliContext) -> PointLimits:
+    """The accepted temp point ids: the global options when a parser defines them, else the
+    connection settings' (the register profile's, or the defaults)."""
+    lo = getattr(ctx.args, "point_id_min", None)
+    hi = getattr(ctx.args, "point_id_max", None)
+    settings = ctx.settings
+    return PointLimits(settings.point_id_min if lo is None else lo,
+                       settings.point_id_max if hi is None else hi)
 
 
 def _load(ctx: CliContext, path: Path, limits: PointLimits) -> Project | None:
@@ -233,7 +234,7 @@ def _upload_code(report: UploadReport) -> ExitCode:
 def cmd_points_list(ctx: CliContext) -> ExitCode:
     """``points list PROJECT``."""
     args = ctx.args
-    project = _load(ctx, args.project, _limits(args))
+    project = _load(ctx, args.project, _limits(ctx))
     if project is None:
         return ExitCode.USAGE
     ctx.print(f"{project.name}: {len(project.ledger)} point(s), {len(project.plans)} plan(s)")
@@ -254,7 +255,7 @@ def cmd_points_upload(ctx: CliContext) -> ExitCode:
     args = ctx.args
     if _monitor_only(ctx, args, "points upload"):
         return ExitCode.FAILED
-    project = _load(ctx, args.project, _limits(args))
+    project = _load(ctx, args.project, _limits(ctx))
     if project is None:
         return ExitCode.USAGE
     ledger = project.ledger
@@ -290,7 +291,7 @@ def cmd_points_upload(ctx: CliContext) -> ExitCode:
 def cmd_points_export(ctx: CliContext) -> ExitCode:
     """``points export PROJECT --csv OUT``."""
     args = ctx.args
-    project = _load(ctx, args.project, _limits(args))
+    project = _load(ctx, args.project, _limits(ctx))
     if project is None:
         return ExitCode.USAGE
     try:
@@ -306,7 +307,7 @@ def cmd_points_import(ctx: CliContext) -> ExitCode:
     """``points import PROJECT --csv IN [--merge] [--allow-empty]``; the project is saved only if
     all rows are good; a CSV without rows does not replace all points unless ``--allow-empty``."""
     args = ctx.args
-    limits = _limits(args)
+    limits = _limits(ctx)
     if args.project.exists():
         project = _load(ctx, args.project, limits)
         if project is None:

@@ -2,16 +2,18 @@
 
 :func:`register` adds ``run`` to the main parser; the helpers are :mod:`app.cli.points`'s, the
 exit codes :class:`app.cli.exit_codes.ExitCode`. Segment numbers on the command line and in
-messages count from 1. ``run`` checks the plan first (the GUI's
-checks): errors refuse to run (USAGE). A project file cannot know what the controller holds,
-so ``run`` creates every point its plan uses before the first move and guards each segment with
-:class:`app.points.guard.PointGuard` (restart canary, points re-created right before the move,
-arrival verified after it). ``--no-upload`` skips the uploads: the operator answers for the
-controller's points; the arrival check stays. A failed or interrupted run prints the
-``--from`` / ``--from-loop`` that resumes it.
+messages count from 1. ``run`` checks the plan first (the GUI's checks, reach by the robot model
+of ``--robot-profile`` included): errors refuse to run (USAGE; FAILED when the only errors are
+points or path samples the robot model cannot reach). A project file cannot know what the
+controller holds, so ``run`` creates every point its plan uses before the first move and guards
+each segment with :class:`app.points.guard.PointGuard` (restart canary, points re-created right
+before the move, arrival verified after it). ``--no-upload`` skips the uploads: the operator
+answers for the controller's points; the arrival check stays. A failed or interrupted run prints
+the ``--from`` / ``--from-loop`` that resumes it.
 
     run PROJECT [--plan NAME] [--loops N] [--from K] [--from-loop I] [--single]
-                [--no-upload] [--check] [--safety PROFILE] [--max-speed MM_S]
+                [--no-upload] [--check] [--safety PROFILE] [--robot-profile FILE]
+                [--max-speed MM_S]
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ from app.cli.points import (
 from app.errors import CommandRefused, InvalidInput, TeachPadError
 from app.link.client import RobotClient
 from app.models import Pose
-from app.plan.checks import IssueKind, PlanLimits, check_plan
+from app.plan.checks import IssueCode, IssueKind, PlanIssue, PlanLimits, ReachCheck, check_plan
 from app.plan.estimates import estimate_plan, segment_timeouts
 from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
 from app.plan.segments import Plan
@@ -46,6 +48,14 @@ from app.points.project import Project
 from app.protocol.enums import MoveStatus
 from app.safety.envelope import Envelope
 from app.safety.profile import load_profile
+from app.view3d.kinematics import ArmModel
+from app.view3d.profile import DEFAULT_PROFILE_FILE, default_profile
+from app.view3d.profile import load_profile as load_robot_profile
+from app.view3d.reach import ReachChecker
+
+#: The checks that say the robot (its model) cannot do the plan: a refusal (FAILED), where the
+#: other errors say the plan or the command line is wrong (USAGE).
+REACH_CODES = frozenset({IssueCode.UNREACHABLE, IssueCode.JOINT_LIMIT})
 
 
 def register(subparsers: Any) -> None:
@@ -66,6 +76,10 @@ def register(subparsers: Any) -> None:
     r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
     r.add_argument("--safety", metavar="PROFILE",
                    help="a safety profile (.safety.json): the plan must stay in its envelope")
+    r.add_argument("--robot-profile", type=Path, metavar="FILE",
+                   help="the robot model (.json, as the GUI's 3D view loads it) whose reach every point "
+                        "and the sampled path must stay in (default: the simulator's arm, "
+                        f"{DEFAULT_PROFILE_FILE})")
     r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
                    help="highest speed a segment may have (default %(default)g mm/s)")
     r.set_defaults(handler=cmd_run)
@@ -120,7 +134,7 @@ def cmd_run(ctx: CliContext) -> ExitCode:
     args = ctx.args
     if not args.check and _monitor_only(ctx, args, "run"):
         return ExitCode.FAILED
-    project = _load(ctx, args.project, _limits(args))
+    project = _load(ctx, args.project, _limits(ctx))
     if project is None:
         return ExitCode.USAGE
     plan = _pick_plan(ctx, project, args.plan)
@@ -141,12 +155,13 @@ def cmd_run(ctx: CliContext) -> ExitCode:
         return ExitCode.USAGE
 
     envelope: Envelope | None = None
-    if getattr(args, "safety", None):
-        try:
+    try:
+        if getattr(args, "safety", None):
             envelope = load_profile(args.safety).envelope
-        except TeachPadError as exc:
-            ctx.error(str(exc))
-            return ExitCode.USAGE
+        reach = reach_check(getattr(args, "robot_profile", None))
+    except TeachPadError as exc:
+        ctx.error(str(exc))
+        return ExitCode.USAGE
     client: RobotClient | None = None
     pose: Pose | None = None
     if not args.check:
@@ -155,14 +170,28 @@ def cmd_run(ctx: CliContext) -> ExitCode:
             pose = client.read_pose()
         except TeachPadError as exc:
             return _link_code(ctx, exc, "cannot read the robot's pose")
-    return _run(ctx, args, project, plan, client, pose, limits, loops, start, envelope)
+    return _run(ctx, args, project, plan, client, pose, limits, loops, start, envelope, reach)
+
+
+def reach_check(path: Path | str | None) -> ReachCheck:
+    """The planner's reach check (``check_plan(..., reach=...)``) of the robot model in ``path``
+    (the default profile when None), as the GUI's 3D view builds it. A file that cannot be used
+    raises :class:`~app.view3d.profile.ProfileError` (InvalidInput), naming the file."""
+    profile = default_profile() if path is None else load_robot_profile(path)
+    return ReachChecker(ArmModel(profile)).plan_issues
+
+
+def _refusal_code(errors: list[PlanIssue]) -> ExitCode:
+    """Only reach errors: the robot cannot do a valid plan (FAILED); any other: USAGE."""
+    return ExitCode.FAILED if all(i.code in REACH_CODES for i in errors) else ExitCode.USAGE
 
 
 def _run(ctx: CliContext, args: argparse.Namespace, project: Project, plan: Plan, client: Any,
          pose: Pose | None, limits: PlanLimits, loops: int, start: int,
-         envelope: Envelope | None = None) -> ExitCode:
+         envelope: Envelope | None = None, reach: ReachCheck | None = None) -> ExitCode:
     ledger = project.ledger
-    issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops, envelope=envelope)
+    issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops, envelope=envelope,
+                        reach=reach)
     for issue in issues:
         if issue.kind is IssueKind.WARNING:
             ctx.warn(issue.message)
@@ -170,8 +199,10 @@ def _run(ctx: CliContext, args: argparse.Namespace, project: Project, plan: Plan
     if errors:
         for issue in errors:
             ctx.error(issue.message)
-        ctx.error(f"plan {plan.name!r} has {len(errors)} error(s): not running it")
-        return ExitCode.USAGE
+        code = _refusal_code(errors)
+        what = " (out of the robot model's reach)" if code is ExitCode.FAILED else ""
+        ctx.error(f"plan {plan.name!r} has {len(errors)} error(s){what}: not running it")
+        return code
     est = estimate_plan(plan, ledger, pose, loops=loops)
     ctx.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
              f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}")

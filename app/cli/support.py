@@ -5,7 +5,8 @@ administrator's passwords (read from the terminal, or one line of stdin; never a
 so they stay out of the shell history) and see which are set. ``support-bundle`` writes the zip of
 :mod:`app.safety.bundle` (versions, the CLI's connection settings plus an optional settings
 file with secrets removed, the project, the safety profile, the audit trail of the last days,
-log files, recorded traffic). ``audit`` prints or exports the audit trail, filtered.
+log files, recorded traffic). ``audit`` prints or exports the audit trail, filtered, and says how
+many of the records shown are writes whose answer was never recorded (result ``unknown``).
 
 teachpad-cli is an administrator's tool: whoever has a shell on the pendant PC can read and
 write every file TeachPad keeps, so a ``--role`` switch would protect nothing. Roles guard the
@@ -14,8 +15,6 @@ GUI.
 
 from __future__ import annotations
 
-import argparse
-import datetime as dt
 import getpass
 import json
 import sys
@@ -24,30 +23,17 @@ from typing import Any
 
 from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode
+from app.cli.format import parse_moment, parse_positive_int
 from app.errors import InvalidInput
-from app.safety.audit import AuditFilter, ReadStats, default_audit_dir, export_csv, query
+from app.safety.audit import AuditFilter, AuditRecord, ReadStats, Result, default_audit_dir, export_csv, query
 from app.safety.bundle import DEFAULT_DAYS, write_support_bundle
 from app.safety.roles import Role, RoleStore, default_store_path
 
+#: What ``audit --result`` filters by (a write's outcome; ``pending`` exists only inside the file).
+AUDIT_RESULTS = (Result.OK, Result.FAILED, Result.BLOCKED, Result.REFUSED, Result.UNKNOWN)
+
 ADMIN_NOTE = ("teachpad-cli is an administrator's tool: it is not limited by TeachPad's roles "
               "(anyone with a shell can read and write TeachPad's files).")
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a whole number: {text[:20]!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError("must be at least 1")
-    return value
-
-
-def _moment(text: str) -> dt.datetime:
-    try:
-        return dt.datetime.fromisoformat(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"not a date or time (YYYY-MM-DD[THH:MM]): {text[:20]!r}") from None
 
 
 def register(subparsers: Any) -> None:
@@ -60,21 +46,22 @@ def register(subparsers: Any) -> None:
     p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
     p.add_argument("--log-dir", type=Path, help="a folder of log files to include")
     p.add_argument("--traffic", type=Path, help="a text file of recorded Modbus traffic")
-    p.add_argument("--days", type=_positive_int, default=DEFAULT_DAYS,
+    p.add_argument("--days", type=parse_positive_int, default=DEFAULT_DAYS,
                    help="how many days of records, counted back from now (default %(default)s)")
     p.set_defaults(handler=cmd_support_bundle)
 
     p = subparsers.add_parser("audit", help="show or export the audit trail (offline)",
                               description="Show the audit trail. " + ADMIN_NOTE)
     p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
-    p.add_argument("--from", dest="start", type=_moment, metavar="WHEN",
+    p.add_argument("--from", dest="start", type=parse_moment, metavar="WHEN",
                    help="first moment, local time YYYY-MM-DD[THH:MM]")
-    p.add_argument("--to", dest="end", type=_moment, metavar="WHEN",
+    p.add_argument("--to", dest="end", type=parse_moment, metavar="WHEN",
                    help="last moment, local time YYYY-MM-DD[THH:MM]")
     p.add_argument("--role", help="only records of this role (operator, engineer, administrator)")
     p.add_argument("--command", dest="command_text", metavar="TEXT", help="part of the command text")
-    p.add_argument("--result", choices=("ok", "failed", "blocked", "refused"),
-                   help="only records with this result")
+    p.add_argument("--result", choices=AUDIT_RESULTS,
+                   help="only records with this result (unknown: writes sent whose answer was never "
+                        "recorded, TeachPad stopped first)")
     p.add_argument("--csv", type=Path, metavar="OUT", help="write CSV instead of printing")
     p.set_defaults(handler=cmd_audit)
 
@@ -128,22 +115,34 @@ def _settings_dict(settings: Any) -> dict[str, Any]:
 
 
 def cmd_audit(ctx: CliContext) -> ExitCode:
+    """Print (or write as CSV) the records that match, then say how many of them are writes whose
+    answer was never recorded (``unknown``: the controller may or may not have acted on them)."""
     args = ctx.args
     flt = AuditFilter(start=args.start, end=args.end, role=args.role, command=args.command_text,
                       result=args.result)
     stats = ReadStats()
     records = query(args.audit_dir or default_audit_dir(), flt, stats)
+    unknown = unknown_count(records)
     if args.csv is not None:
         with open(args.csv, "w", encoding="utf-8", newline="") as f:
             n = export_csv(records, f)
-        ctx.print(f"wrote {n} records to {args.csv}")
+        ctx.print(f"wrote {n} records to {args.csv} ({unknown} unknown)")
     else:
         for r in records:
             extra = f" - {r.detail}" if r.detail else ""
             ctx.print(f"{r.host_time}  {r.role:<13} {r.result:<8} {r.command}{extra}")
+    if unknown and args.result != Result.UNKNOWN:
+        ctx.warn(f"{unknown} write(s) with result unknown: sent, but TeachPad stopped before the answer "
+                 "was recorded (check the robot); list them with --result unknown")
     if stats.skipped:
         ctx.warn(f"{stats.skipped} damaged line(s) skipped")
     return ExitCode.OK
+
+
+def unknown_count(records: list[AuditRecord]) -> int:
+    """Writes among ``records`` sent whose answer was never recorded (the reader's
+    ``ReadStats.unknown`` counts them in every file read; this, in the records shown)."""
+    return sum(1 for r in records if r.result == Result.UNKNOWN)
 
 
 def _read_password() -> str:
