@@ -38,7 +38,7 @@ def test_views_draw_the_envelope_and_the_planner_checks_with_the_mode(qtbot: Any
     planner: EnvelopeChecker = window.planner_panel
     gated: list[EditGated] = [window.points_panel, window.planner_panel]
     assert canvas is not preview and planner is window.planner_panel and len(gated) == 2
-    assert not window.planner_panel.reduced_speed
+    assert not window.planner_panel.checks.reduced_speed
 
     safety.login(Role.ENGINEER, PASSWORD)
     with qtbot.waitSignal(safety.envelopeChanged, timeout=2000):
@@ -46,9 +46,9 @@ def test_views_draw_the_envelope_and_the_planner_checks_with_the_mode(qtbot: Any
     assert len(window.view3d.panel.canvas.keep_out_edges) == 24
     top = window.planner_panel.preview.projections["top"].keep_out
     assert top is not None and len(top.xData) == 24
-    assert window.planner_panel.envelope == safety.envelope and not window.planner_panel.reduced_speed
+    assert window.planner_panel.checks.envelope == safety.envelope and not window.planner_panel.checks.reduced_speed
 
     with qtbot.waitSignal(safety.reducedChanged, timeout=2000):
         assert safety.set_reduced(True)
-    assert window.planner_panel.reduced_speed  # the checks use the reduced caps now
+    assert window.planner_panel.checks.reduced_speed  # the checks use the reduced caps now
     assert len(window.view3d.panel.canvas.keep_out_edges) == 24  # still drawn
