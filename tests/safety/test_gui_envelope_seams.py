@@ -46,7 +46,8 @@ def test_views_draw_the_envelope_and_the_planner_checks_with_the_mode(qtbot: Any
     assert len(window.view3d.panel.canvas.keep_out_edges) == 24
     top = window.planner_panel.preview.projections["top"].keep_out
     assert top is not None and len(top.xData) == 24
-    assert window.planner_panel.checks.envelope == safety.envelope and not window.planner_panel.checks.reduced_speed
+    checks = window.planner_panel.checks
+    assert checks.envelope == safety.envelope and not checks.reduced_speed
 
     with qtbot.waitSignal(safety.reducedChanged, timeout=2000):
         assert safety.set_reduced(True)
