@@ -25,11 +25,15 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
   point, ``uploadProgress``, one final ``commandFinished``; ``cancel_upload`` or a stop end it.
 * :class:`~app.link.capture.TrafficCapture`, RTT and link statistics.
 
-Stop latency: :meth:`RobotWorker.request_stop` queues the stop first in line and, from the GUI
-thread, waits (GIL released, at most :data:`STOP_HANDOFF_WAIT`) until the worker has written it;
-the worker runs urgent jobs between any two transactions (also right after a poll's pose read,
-before publishing), and ``_do_stop`` writes before any bookkeeping. Bound: the transaction in
-flight (one round trip) plus the stop's own write, unless the OS does not schedule the worker.
+Stop latency: :meth:`RobotWorker.request_stop` writes the stop at once from the calling thread on
+the stop line (:mod:`app.link.stop_line`, a second TCP connection kept for Stop) when the
+controller has one; bound: the caller's own send. The stop job then also writes it on the main
+link, after the transaction in flight (the ordering guarantee), and reads the line's answer.
+Without a stop line (serial, monitor-only, a one-connection controller) the stop is queued first
+in line and the GUI thread waits (GIL released, at most :data:`STOP_HANDOFF_WAIT`) until the
+worker has written it; the worker runs urgent jobs between any two transactions, and
+``_do_stop`` writes before any bookkeeping. Bound: the transaction in flight (one round trip) plus
+the stop's own write, unless the OS does not schedule the worker.
 
 Every :class:`RobotLink` command returns an ``int`` request id; each :class:`CommandResult` /
 :class:`WorkerError` it causes carries it. Every failure becomes a signal, never an exception in
@@ -71,10 +75,12 @@ from app.link.motion import MotionCommands, MotionTracker
 from app.link.poller import Poller
 from app.link.requests import STOP_HANDOFF_WAIT, WorkerRequests
 from app.link.stats import LinkStats
+from app.link.stop_line import StopLine, StopSent
 from app.link.supervisor import DEFAULT_CANARY_GV, LinkSupervisor
 from app.link.types import ConnectionState, JogRequest, LinkState, Operation, WorkerError
 from app.link.upload import RawItem, Uploader
 from app.models import CommandResult, ControllerStatus, Pose
+from app.protocol import registers
 from app.protocol.enums import WorkMode
 from app.safety.audit import AuditLog
 from app.safety.envelope import EnvelopeViolation
@@ -140,6 +146,8 @@ class RobotWorker(WorkerRequests, QObject):
         self.uploader = Uploader(self)
         self.poller = Poller(self)
         self.supervisor = LinkSupervisor(self, canary_gv)  # raises on a bad canary GV
+        self.stop_line = StopLine()  # the stop's own connection; send_stop from any thread
+        self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
 
     # --- lifecycle (worker thread) ------------------------------------------------------
     @Slot()
@@ -158,6 +166,7 @@ class RobotWorker(WorkerRequests, QObject):
     def connect_to(self, settings: ConnectionSettings) -> None:
         """(Re)connect with ``settings``; retries by itself until :meth:`disconnect_link`."""
         if not self.closed:
+            self.stop_line.reset(settings if self.use_stop_line else None)
             self.supervisor.connect_to(settings)
 
     @Slot()
@@ -248,8 +257,11 @@ class RobotWorker(WorkerRequests, QObject):
             self._poll_timer.start(self._poll_interval_ms())
 
     def stop_polling(self) -> None:
+        """The main link went down or is being closed (the stop line goes with it)."""
         if self._poll_timer is not None:
             self._poll_timer.stop()
+        # link_up is already False when the link was lost, still True when it is being closed
+        self.stop_line.main_link_closed(time.monotonic(), lost=not self.supervisor.link_up)
 
     def start_reconnect(self, delay: float) -> None:
         if self._reconnect_timer is not None and not self.closed:
@@ -342,6 +354,8 @@ class RobotWorker(WorkerRequests, QObject):
             self._poll()
             if self._held and self.motion.active is None:
                 self.run_jobs()  # the tracked command just ended: the held one goes out now
+            if self.link_up:
+                self.stop_line.maintain(time.monotonic())  # open when due, keep alive
 
     def _poll(self) -> None:
         """One poll; results emitted from here belong to no request (even inside a job)."""
@@ -442,9 +456,13 @@ class RobotWorker(WorkerRequests, QObject):
         self.emit_result(CommandResult(None, None, None, False, text), request_id)
 
     # --- plain and urgent commands ------------------------------------------------------
-    def _do_stop(self) -> None:
+    def _do_stop(self, on_line: StopSent | None = None) -> None:
+        """The stop job. ``on_line``: the caller already wrote it on the stop line; it goes out on
+        the main link too, after the transaction in flight, so nothing written before it runs after."""
         client = self.client_or_raise()
         client.stop()  # first: nothing else goes out before the stop
+        if on_line is not None:
+            self._collect_stop_line()
         now = time.monotonic()
         job = self._current_job
         if job is not None and job.sent is not None:
@@ -458,6 +476,21 @@ class RobotWorker(WorkerRequests, QObject):
         if active is not None:
             self.emit_result(active.completion.stopped(now), active.request_id)
         self._done("stop: sent")
+
+    def _collect_stop_line(self) -> None:
+        """The stop line's answer: checked, audited, shown in the traffic; a bad one closes the line."""
+        sent, answer, problem = self.stop_line.collect()
+        if sent is None:
+            return
+        if self.capture.on:
+            self.capture.observe(TrafficRecord(sent.at, "tx", sent.frame, "tcp"))
+            if answer:
+                self.capture.observe(TrafficRecord(time.time(), "rx", answer, "tcp"))
+        if self.audit is not None:
+            self.audit.record_write(registers.REG_STOP, [1], single=True,
+                                    error=LinkError(problem) if problem else None)
+        if problem is not None:  # the stop went out on the main link as well
+            _log.warning("stop line: %s; the stop went out on the main link too", problem)
 
     def _do_cancel_upload(self) -> None:
         """No controller stop: the upload ends after the point in progress; queued uploads are dropped."""
