@@ -32,11 +32,16 @@ import socket
 import threading
 import time
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from app.errors import LinkError, MalformedResponse, ResponseTimeout
 from app.link import frames
-from app.link.client import ConnectionSettings
+from app.link.client import ConnectionSettings, TrafficRecord
 from app.protocol import registers
+
+if TYPE_CHECKING:
+    from app.link.capture import TrafficCapture
+    from app.safety.audit import AuditLog
 
 __all__ = ["KEEPALIVE", "PROBATION", "RETRY_DELAYS", "StopLine", "StopSent"]
 
@@ -167,6 +172,22 @@ class StopLine:
                 self._fail(f"the stop's answer: {exc}", time.monotonic())
                 return pending, b"", str(exc)
             return pending, answer, None
+
+    def report(self, capture: TrafficCapture, audit: AuditLog | None) -> None:
+        """:meth:`collect`, then the stop's frames to the traffic capture and its write to the
+        audit trail (worker thread); a bad answer is logged (the main link's stop went out too)."""
+        sent, answer, problem = self.collect()
+        if sent is None:
+            return
+        if capture.on:
+            capture.observe(TrafficRecord(sent.at, "tx", sent.frame, "tcp"))
+            if answer:
+                capture.observe(TrafficRecord(time.time(), "rx", answer, "tcp"))
+        if audit is not None:
+            audit.record_write(registers.REG_STOP, [1], single=True,
+                               error=LinkError(problem) if problem else None)
+        if problem is not None:
+            _log.warning("stop line: %s; the stop went out on the main link too", problem)
 
     def close(self) -> None:
         with self._lock:

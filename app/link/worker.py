@@ -16,30 +16,21 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
   cancels the motion jobs queued before it; a release drops a jog press not yet started.
 * :class:`~app.link.jog.JogMachine` -- jog (function 4) and the dead-man.
 * :class:`~app.link.motion.MotionCommands` / :class:`~app.link.motion.MotionTracker` -- the long
-  commands (step, move to point, go to zero, run program, create point), started without waiting,
-  and the completion of the one under way; a motion while another is under way is refused, Stop
-  clears it. A create point while another short command is being tracked waits in the worker
-  (``_held``) until that one's outcome is known (GV291 tells one command at a time), then goes
-  out: every request ends once, with its own result.
+  commands, started without waiting, and the completion of the one under way (one motion at a
+  time; Stop clears it). A create point while another short command is tracked waits in
+  ``_held`` until that one's outcome is known (GV291 tells one command at a time).
 * :class:`~app.link.upload.Uploader` -- chunked upload of many points, ``pointUploaded`` per
   point, ``uploadProgress``, one final ``commandFinished``; ``cancel_upload`` or a stop end it.
 * :class:`~app.link.capture.TrafficCapture`, RTT and link statistics.
 
-Stop latency: :meth:`RobotWorker.request_stop` writes the stop at once from the calling thread on
-the stop line (:mod:`app.link.stop_line`, a second TCP connection kept for Stop) when the
-controller has one; bound: the caller's own send. The stop job then also writes it on the main
-link, after the transaction in flight (the ordering guarantee), and reads the line's answer.
-Without a stop line (serial, monitor-only, a one-connection controller) the stop is queued first
-in line and the GUI thread waits (GIL released, at most :data:`STOP_HANDOFF_WAIT`) until the
-worker has written it; the worker runs urgent jobs between any two transactions, and
-``_do_stop`` writes before any bookkeeping. Bound: the transaction in flight (one round trip) plus
-the stop's own write, unless the OS does not schedule the worker.
+Stop latency: :meth:`RobotWorker.request_stop` writes the stop from the calling thread on the stop
+line (:mod:`app.link.stop_line`) when there is one; the stop job then writes it on the main link
+too, after the transaction in flight (ordering), and reads the line's answer. Without a line the
+GUI thread waits (GIL released, at most :data:`STOP_HANDOFF_WAIT`) for the worker to write it.
 
 Every :class:`RobotLink` command returns an ``int`` request id; each :class:`CommandResult` /
-:class:`WorkerError` it causes carries it. Every failure becomes a signal, never an exception in
-the GUI thread: ``commandFinished`` carries the outcome of every command that reached the
-controller (success, refusal, Modbus exception, timeout, stop); ``errorOccurred`` carries
-everything else (link down, monitor-only refusals, invalid input, failed reads), in plain English.
+:class:`WorkerError` it causes carries it. Every failure becomes a signal (``commandFinished``:
+the outcome of every command that reached the controller; ``errorOccurred``: everything else).
 
 Shutdown is a queued call: the worker stops motion (ratio 0, teach disable), closes the client,
 hands itself back to the GUI thread and quits its own thread; :class:`RobotLink` waits a short
@@ -80,7 +71,6 @@ from app.link.supervisor import DEFAULT_CANARY_GV, LinkSupervisor
 from app.link.types import ConnectionState, JogRequest, LinkState, Operation, WorkerError
 from app.link.upload import RawItem, Uploader
 from app.models import CommandResult, ControllerStatus, Pose
-from app.protocol import registers
 from app.protocol.enums import WorkMode
 from app.safety.audit import AuditLog
 from app.safety.envelope import EnvelopeViolation
@@ -257,7 +247,6 @@ class RobotWorker(WorkerRequests, QObject):
             self._poll_timer.start(self._poll_interval_ms())
 
     def stop_polling(self) -> None:
-        """The main link went down or is being closed (the stop line goes with it)."""
         if self._poll_timer is not None:
             self._poll_timer.stop()
         # link_up is already False when the link was lost, still True when it is being closed
@@ -457,12 +446,11 @@ class RobotWorker(WorkerRequests, QObject):
 
     # --- plain and urgent commands ------------------------------------------------------
     def _do_stop(self, on_line: StopSent | None = None) -> None:
-        """The stop job. ``on_line``: the caller already wrote it on the stop line; it goes out on
-        the main link too, after the transaction in flight, so nothing written before it runs after."""
+        """``on_line``: already sent on the stop line; the main link's copy keeps the order."""
         client = self.client_or_raise()
         client.stop()  # first: nothing else goes out before the stop
-        if on_line is not None:
-            self._collect_stop_line()
+        if on_line is not None:  # its answer: checked, audited, shown in the traffic
+            self.stop_line.report(self.capture, self.audit)
         now = time.monotonic()
         job = self._current_job
         if job is not None and job.sent is not None:
@@ -476,21 +464,6 @@ class RobotWorker(WorkerRequests, QObject):
         if active is not None:
             self.emit_result(active.completion.stopped(now), active.request_id)
         self._done("stop: sent")
-
-    def _collect_stop_line(self) -> None:
-        """The stop line's answer: checked, audited, shown in the traffic; a bad one closes the line."""
-        sent, answer, problem = self.stop_line.collect()
-        if sent is None:
-            return
-        if self.capture.on:
-            self.capture.observe(TrafficRecord(sent.at, "tx", sent.frame, "tcp"))
-            if answer:
-                self.capture.observe(TrafficRecord(time.time(), "rx", answer, "tcp"))
-        if self.audit is not None:
-            self.audit.record_write(registers.REG_STOP, [1], single=True,
-                                    error=LinkError(problem) if problem else None)
-        if problem is not None:  # the stop went out on the main link as well
-            _log.warning("stop line: %s; the stop went out on the main link too", problem)
 
     def _do_cancel_upload(self) -> None:
         """No controller stop: the upload ends after the point in progress; queued uploads are dropped."""
