@@ -70,7 +70,7 @@ from app.link.checks import (
 )
 from app.link.decode import decode_pose, decode_status
 from app.link.stats import LinkStats
-from app.link.tracker import CommandTracker, CompletionRule, command_text
+from app.link.tracker import CommandTracker, CompletionRule, ResultPacer, command_text
 from app.link.transport import ConnectionSettings, TrafficObserver, TrafficRecord, Transport
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
@@ -144,6 +144,7 @@ class RobotClient:
         # changed may be confirmed by arriving there, see CommandTracker's ``target``)
         self._sent_points: dict[int, tuple[float, float, float]] = {}
         self._ack_latency = 0.0  # s, decaying maximum of the acknowledgement times seen
+        self._pacer = ResultPacer()  # when results show on this link (tracker.py)
         self.audit: AuditLog | None = None  # every write (and monitor-only block) is recorded here
 
     # -- connection (the transport drops the caches whenever the link is made or lost) ---
@@ -437,7 +438,7 @@ class RobotClient:
                 pre_code = STATUS_SENTINEL
         tracker = CommandTracker(command, before, before_pose, time.monotonic(), timeout=timeout,
                                  rule=rule, pre_code=pre_code,
-                                 unconfirmed_after=self._unconfirmed_window())
+                                 unconfirmed_after=self._unconfirmed_window(), pacer=self._pacer)
         self._last_kind = tracker.kind
         self.last_tracker = tracker
         self._write_control(registers.REG_RUN_COMMAND, int(command))
