@@ -103,11 +103,12 @@ def _seconds(value: float) -> str:
 class ResultPacer:
     """When, after an instant command (create point, teach), its result usually shows (per link).
 
-    ``estimate`` (s after the first status read that follows the command) times the tracker's
-    second read. The first read goes out at once (a fast controller's result; the classic
-    controller's 0, "received"); a fixed 1 ms backoff after it overshot on a loaded host and
-    still read a 1 ms controller a third time now and then. Here the second read is due at
-    ``estimate``, learned from each confirmed result: found in time -> the estimate shrinks by
+    ``estimate`` (s after the read that first showed the command *taken* -- GV291 left its old
+    code, e.g. the classic controller's 0, "received" -- with no result yet) times the next read.
+    Reads before that keep the plain backoff (a slow controller's short 0 phase must not be
+    skipped: the observe rule needs to see it). A fixed 1 ms backoff after the 0 overshot on a
+    loaded host and still read a 1 ms controller a third time now and then. Here the read after
+    it is due at ``estimate``, learned from each confirmed result: found in time -> it shrinks by
     :data:`DECAY` (it probes a little earlier next time); missed -> it grows to :data:`GROW`
     times the time of the read that missed (later reads back off as before). A steady
     controller is read twice per command, with an extra read in about one command of ten (the
@@ -198,6 +199,7 @@ class CommandTracker:
         self.pacer = None if self.is_move else pacer
         self._read_at = math.inf  # when the next read goes out (monotonic), planned by poll_interval
         self._sent: list[float] = []  # when each read went out (monotonic)
+        self._ack_read = 0  # how many reads it took to see the command taken (GV291 left the old code)
         self._stopped_since: float | None = None
         self._idle_since: float | None = None
         self._last_pose = before_pose
@@ -223,11 +225,12 @@ class CommandTracker:
         ``ACK_BACKOFF_FIRST`` after the first read, doubling with every read, capped at
         ``backoff_cap``; never past the moment an unchanged status counts as unconfirmed.
         """
-        estimate = self.pacer.estimate if self.pacer is not None and self._sent else None
-        if estimate is not None and self.reads == 1:
-            interval = max(0.0, self._sent[0] + estimate - now)  # when the result usually shows
-        elif estimate is not None:
-            interval = min(self.backoff_cap, self.backoff_first * 2.0 ** (self.reads - 2))
+        ack = self._ack_read  # reads up to the one that showed the command taken (0: not yet)
+        if self.pacer is not None and ack and self.reads == ack:
+            # taken, no result yet: the next read when this controller's results usually show
+            interval = max(0.0, self._sent[ack - 1] + self.pacer.estimate - now)
+        elif self.pacer is not None and ack:
+            interval = min(self.backoff_cap, self.backoff_first * 2.0 ** (self.reads - ack - 1))
         else:
             interval = min(self.backoff_cap, self.backoff_first * 2.0 ** max(0, self.reads - 1))
         if self.unconfirmed_after is not None and not self.acknowledged:
@@ -254,6 +257,8 @@ class CommandTracker:
                 code, now,
             )
         if code != self.pre_code:
+            if not self.code_left_pre:
+                self._ack_read = self.reads
             self.code_left_pre = True
         progressed = self._note_motion(status, pose)
         if not self.acknowledged and (self.code_left_pre or self.motion_seen):
@@ -432,11 +437,12 @@ class CommandTracker:
                 unconfirmed: bool = False, reason: Reason | None = None) -> CommandResult:
         details = self._details(now)
         details["reads"] = float(self.reads)
-        if self.pacer is not None and self._sent and not unconfirmed and self.code_left_pre:
-            # a result this controller showed: when it was there (paced from the second read on)
-            first = self._sent[0]
-            missed = self._sent[-2] - first if len(self._sent) > 2 else None
-            self.pacer.learn(missed, self._sent[-1] - first)
+        ack = self._ack_read
+        if self.pacer is not None and not unconfirmed and 0 < ack < self.reads:
+            # a result seen after the read that showed the command taken: how long after it
+            taken = self._sent[ack - 1]
+            missed = self._sent[-2] - taken if self.reads > ack + 1 else None
+            self.pacer.learn(missed, self._sent[-1] - taken)
         self.result = CommandResult(self.command, self.kind, status, ok, message, details,
                                     unconfirmed=unconfirmed, reason=reason)
         return self.result

@@ -418,3 +418,19 @@ def test_unconfirmed_and_move_results_teach_the_pacer_nothing() -> None:
     assert result is not None and result.unconfirmed and pacer.estimate == 0.002
     move = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0, pacer=pacer)
     assert move.pacer is None  # moves keep their own poll
+
+
+def test_reads_before_the_command_is_seen_taken_keep_the_backoff(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A slow controller's short 0 phase must not be skipped (the observe rule needs it)."""
+    monkeypatch.setattr(timing, "ACK_BACKOFF_FIRST", 0.001)
+    pacer = ResultPacer()
+    pacer.estimate = 0.02
+    tr = _paced(pacer, 0.0)
+    assert tr.update(st(DONE), None, 0.001) is None  # the old code: not taken yet
+    assert tr.poll_interval(0.001) == pytest.approx(0.001)
+    assert tr.update(st(DONE), None, 0.002) is None
+    assert tr.poll_interval(0.002) == pytest.approx(0.002)
+    assert tr.update(st(0), None, 0.004) is None  # taken: the next read when results usually show
+    assert tr.poll_interval(0.004) == pytest.approx(0.02)
+    assert tr.update(st(DONE), None, 0.024) is not None
+    assert pacer.estimate == pytest.approx(0.02 * ResultPacer.DECAY)
