@@ -11,9 +11,8 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
 * :class:`~app.link.poller.Poller` -- status then pose per tick, one signal per changed datum,
   then ``pollSucceeded``, then the ``commandFinished`` that poll completed.
 * :class:`~app.link.jobs.JobQueue` -- urgent jobs (stop, pause, resume, jog release, cancel
-  upload) first; they also run between any two transactions of a poll, a jog sequence, a short
-  teach command or an upload, so a stop goes out right after the transaction in flight. A stop
-  cancels the motion jobs queued before it; a release drops a jog press not yet started.
+  upload) first, also between any two transactions of a poll, a jog, a teach command or an
+  upload. A stop cancels the motion jobs queued before it; a release drops a queued jog press.
 * :class:`~app.link.jog.JogMachine` -- jog (function 4) and the dead-man.
 * :class:`~app.link.motion.MotionCommands` / :class:`~app.link.motion.MotionTracker` -- the long
   commands, started without waiting, and the completion of the one under way (one motion at a
@@ -32,9 +31,8 @@ Every :class:`RobotLink` command returns an ``int`` request id; each :class:`Com
 :class:`WorkerError` it causes carries it. Every failure becomes a signal (``commandFinished``:
 the outcome of every command that reached the controller; ``errorOccurred``: everything else).
 
-Shutdown is a queued call: the worker stops motion (ratio 0, teach disable), closes the client,
-hands itself back to the GUI thread and quits its own thread; :class:`RobotLink` waits a short
-while and never destroys a running thread. See docs/DESIGN.md, "Worker / RobotLink".
+Shutdown is a queued call: the worker stops motion, closes the client, hands itself back to the
+GUI thread and quits its thread (docs/DESIGN.md, "Worker / RobotLink").
 """
 
 from __future__ import annotations
@@ -445,12 +443,13 @@ class RobotWorker(WorkerRequests, QObject):
         self.emit_result(CommandResult(None, None, None, False, text), request_id)
 
     # --- plain and urgent commands ------------------------------------------------------
-    def _do_stop(self, on_line: StopSent | None = None) -> None:
-        """``on_line``: already sent on the stop line; the main link's copy keeps the order."""
+    def _do_stop(self, on_line: StopSent | None = None) -> None:  # on_line: sent on the stop line
         client = self.client_or_raise()
-        client.stop()  # first: nothing else goes out before the stop
-        if on_line is not None:  # its answer: checked, audited, shown in the traffic
-            self.stop_line.report(self.capture, self.audit)
+        try:
+            client.stop()  # first: nothing else goes out before the stop
+        finally:
+            if on_line is not None:  # its answer: checked, audited, shown in the traffic
+                self.stop_line.report(self.capture, self.audit)
         now = time.monotonic()
         job = self._current_job
         if job is not None and job.sent is not None:
