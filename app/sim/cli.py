@@ -168,8 +168,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"teachpad-sim: {exc}", file=sys.stderr)
         return 1
     done = threading.Event()
-    print(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop", flush=True)
-
     previous: dict[signal.Signals, object] = {}
     if threading.current_thread() is threading.main_thread():
         def on_signal(signum: int, _frame: object) -> None:
@@ -178,6 +176,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         for sig in (signal.SIGINT, signal.SIGTERM):
             previous[sig] = signal.signal(sig, on_signal)
+    # Only now: a parent that reads this line may stop us with SIGTERM at once (ui.main.SimProcess).
+    print(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop", flush=True)
 
     if not args.no_stdin:
         def read_stdin() -> None:
