@@ -117,7 +117,7 @@ class ResultPacer:
 
     DECAY = 0.98
     GROW = 1.25
-    MAX_ESTIMATE = 0.25  # s: beyond this the plain backoff is as good
+    MAX_ESTIMATE = 0.1  # s: a read at least every 0.1 s while a command is under way
     FLOOR = 1e-4  # s: a miss raises the estimate to at least GROW x this
 
     def __init__(self) -> None:
