@@ -42,7 +42,7 @@ from app.errors import (
 from app.link.checks import check_enum, check_float, check_floats, check_int, check_tool
 from app.link.register_client import RegisterClient
 from app.link.stats import LinkStats
-from app.link.tracker import CommandTracker, CompletionRule, command_text
+from app.link.tracker import CommandTracker, CompletionRule, ResultPacer, command_text
 from app.link.transport import ConnectionSettings, TrafficRecord
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
@@ -103,6 +103,7 @@ class RobotClient(RegisterClient):
         # changed may be confirmed by arriving there, see CommandTracker's ``target``)
         self._sent_points: dict[int, tuple[float, float, float]] = {}
         self._ack_latency = 0.0  # s, decaying maximum of the acknowledgement times seen
+        self._pacer = ResultPacer()  # when results show on this link (tracker.py)
 
     def invalidate_cache(self) -> None:
         """Forget which tool / user frame / external offsets were written last."""
@@ -250,7 +251,7 @@ class RobotClient(RegisterClient):
                 pre_code = STATUS_SENTINEL
         tracker = CommandTracker(command, before, before_pose, time.monotonic(), timeout=timeout,
                                  rule=rule, pre_code=pre_code,
-                                 unconfirmed_after=self._unconfirmed_window())
+                                 unconfirmed_after=self._unconfirmed_window(), pacer=self._pacer)
         self._last_kind = tracker.kind
         self.last_tracker = tracker
         self._write_control(registers.REG_RUN_COMMAND, int(command))

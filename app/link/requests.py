@@ -19,6 +19,7 @@ from app.protocol.enums import ProgramMotionMode, WorkMode
 if TYPE_CHECKING:
     from app.link.jog import JogMachine
     from app.link.motion import MotionCommands
+    from app.link.stop_line import StopLine, StopSent
 
 __all__ = ["STOP_HANDOFF_WAIT", "WorkerRequests"]
 
@@ -37,13 +38,14 @@ class WorkerRequests:
     """``post`` and the ``request_*`` methods of :class:`~app.link.worker.RobotWorker`."""
 
     if TYPE_CHECKING:  # provided by RobotWorker
+        stop_line: StopLine
         _jobs: JobQueue
         _wake: _Wake
         _worker_ident: int | None  # threading.get_ident() of the worker thread while it runs
         jog: JogMachine
         motions: MotionCommands
 
-        def _do_stop(self) -> None: ...
+        def _do_stop(self, on_line: StopSent | None = None) -> None: ...
         def _do_pause(self) -> None: ...
         def _do_resume(self) -> None: ...
         def _do_cancel_upload(self) -> None: ...
@@ -61,12 +63,15 @@ class WorkerRequests:
         return request_id
 
     def request_stop(self) -> int:
-        """Queue the stop first in line; from another thread, wait (GIL released) until the worker
-        has written it, at most :data:`STOP_HANDOFF_WAIT`, so nothing of the caller's runs first."""
+        """Write the stop now on the stop line when there is one (app/link/stop_line.py), then queue
+        the stop job first in line (the main link's stop, the line's answer, the bookkeeping).
+        Without a stop line, from another thread, wait (GIL released) until the worker has written
+        it, at most :data:`STOP_HANDOFF_WAIT`, so nothing of the caller's runs first."""
+        on_line = self.stop_line.send_stop()
         sent = threading.Event()
-        request_id = self.post(Operation.STOP, self._do_stop, JobKind.URGENT, sent=sent)
+        request_id = self.post(Operation.STOP, lambda: self._do_stop(on_line), JobKind.URGENT, sent=sent)
         worker = self._worker_ident
-        if worker is not None and worker != threading.get_ident():
+        if on_line is None and worker is not None and worker != threading.get_ident():
             sent.wait(STOP_HANDOFF_WAIT)
         return request_id
 

@@ -176,7 +176,9 @@ class RobotLink(QObject):
 
     def __init__(self, parent: QObject | None = None, *, poll_hz: float = timing.POLL_HZ_DEFAULT,
                  canary_gv: int | None = DEFAULT_CANARY_GV,
-                 freshness_limit: float = DEFAULT_FRESHNESS_LIMIT) -> None:
+                 freshness_limit: float = DEFAULT_FRESHNESS_LIMIT, stop_line: bool = True) -> None:
+        """``stop_line`` False: never open the stop's own connection (app/link/stop_line.py);
+        every stop goes through the worker's queue on the main link."""
         super().__init__(parent)
         if sys.getswitchinterval() > GIL_SWITCH_INTERVAL:
             sys.setswitchinterval(GIL_SWITCH_INTERVAL)  # see GIL_SWITCH_INTERVAL: a stop never waits 5 ms
@@ -188,6 +190,7 @@ class RobotLink(QObject):
         self._thread = QThread()
         self._thread.setObjectName("RobotWorker")
         self._worker = RobotWorker(poll_hz, canary_gv=canary_gv)
+        self._worker.use_stop_line = stop_line
         self._worker.moveToThread(self._thread)
         self._thread.started.connect(self._worker.start)
         w = self._worker

@@ -29,7 +29,11 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 * **Polling while waiting** backs off (:meth:`CommandTracker.poll_interval`): the first read
   follows the command at once, then ``ACK_BACKOFF_FIRST``, doubling, capped at
   ``ACK_BACKOFF_CAP`` (moves: ``MOVE_POLL_INTERVAL``), and never sleeping past the
-  unconfirmed deadline. No spinning: a real controller is not hammered.
+  unconfirmed deadline. No spinning: a real controller is not hammered. For the instant
+  commands a :class:`ResultPacer` (one per connection) times the second read: when this
+  controller's results usually show, learned from the commands before, so a steady
+  controller is read about twice per command (the first read, then the result) and a slow
+  or jittery one backs off as before.
 * **After a stop** the wait ends when the host sent the stop itself, or when a move that was
   seen under way shows program state *stopped* with GV291 at 0 (initial) for
   ``timing.STOP_SETTLE`` (a transient 0 just before 0xFF is not a stop).
@@ -63,7 +67,7 @@ from app.protocol.enums import (
     decode_command_status,
 )
 
-__all__ = ["POSE_EPSILON", "CommandTracker", "CompletionRule", "command_text", "pose_moved"]
+__all__ = ["POSE_EPSILON", "CommandTracker", "CompletionRule", "ResultPacer", "command_text", "pose_moved"]
 
 CompletionRule = Literal["sentinel", "observe"]
 
@@ -96,6 +100,42 @@ def _seconds(value: float) -> str:
     return str(round(value, 3))
 
 
+class ResultPacer:
+    """When, after an instant command (create point, teach), its result usually shows (per link).
+
+    ``estimate`` (s after the read that first showed the command *taken* -- GV291 left its old
+    code, e.g. the classic controller's 0, "received" -- with no result yet) times the next read.
+    Reads before that keep the plain backoff (a slow controller's short 0 phase must not be
+    skipped: the observe rule needs to see it). A fixed 1 ms backoff after the 0 overshot on a
+    loaded host and still read a 1 ms controller a third time now and then. Here the read after
+    it is due at ``estimate``, learned from each confirmed result: found in time -> it shrinks by
+    :data:`DECAY` (it probes a little earlier next time); missed -> it grows to :data:`GROW`
+    times the time of the read that missed (later reads back off as before). A steady
+    controller is read twice per command, with an extra read in about one command of ten (the
+    probe); a jittery one is read later rather than more often. Never a tight loop.
+    """
+
+    DECAY = 0.98
+    GROW = 1.25
+    MAX_ESTIMATE = 0.1  # s: a read at least every 0.1 s while a command is under way
+    FLOOR = 1e-4  # s: a miss raises the estimate to at least GROW x this
+
+    def __init__(self) -> None:
+        # Optimistic at first: the second read follows the first at once (an instant controller's
+        # result is there), and a slower controller's first misses raise it geometrically.
+        self.estimate = 0.0
+
+    def learn(self, missed: float | None, found: float) -> None:
+        """A confirmed result: ``found`` = when the read that saw it was sent, ``missed`` = when
+        the last read before it was sent (None: no read after the first missed), in s after the
+        first read."""
+        if missed is None:
+            value = min(self.estimate, found) * self.DECAY
+        else:
+            value = max(self.estimate, missed, self.FLOOR) * self.GROW
+        self.estimate = min(max(value, 0.0), self.MAX_ESTIMATE)
+
+
 class CommandTracker:
     """Decides how a command ended from successive status reads (see the module docstring).
 
@@ -117,6 +157,7 @@ class CommandTracker:
         rule: CompletionRule = "observe",
         pre_code: int | None = None,
         unconfirmed_after: float | None = None,
+        pacer: ResultPacer | None = None,
     ) -> None:
         self.command = command
         # Move to point: the X Y Z this host sent for the end point, when it knows it. A move whose
@@ -154,6 +195,11 @@ class CommandTracker:
             self.unconfirmed_after = (timing.UNCONFIRMED_AFTER if unconfirmed_after is None
                                       else unconfirmed_after)
         self.reads = 0
+        # instant commands: the second read is timed by the pacer (see ResultPacer)
+        self.pacer = None if self.is_move else pacer
+        self._read_at = math.inf  # when the next read goes out (monotonic), planned by poll_interval
+        self._sent: list[float] = []  # when each read went out (monotonic)
+        self._ack_read = 0  # how many reads it took to see the command taken (GV291 left the old code)
         self._stopped_since: float | None = None
         self._idle_since: float | None = None
         self._last_pose = before_pose
@@ -179,11 +225,19 @@ class CommandTracker:
         ``ACK_BACKOFF_FIRST`` after the first read, doubling with every read, capped at
         ``backoff_cap``; never past the moment an unchanged status counts as unconfirmed.
         """
-        interval = min(self.backoff_cap, self.backoff_first * 2.0 ** max(0, self.reads - 1))
+        ack = self._ack_read  # reads up to the one that showed the command taken (0: not yet)
+        if self.pacer is not None and ack and self.reads == ack:
+            # taken, no result yet: the next read when this controller's results usually show
+            interval = max(0.0, self._sent[ack - 1] + self.pacer.estimate - now)
+        elif self.pacer is not None and ack:
+            interval = min(self.backoff_cap, self.backoff_first * 2.0 ** (self.reads - ack - 1))
+        else:
+            interval = min(self.backoff_cap, self.backoff_first * 2.0 ** max(0, self.reads - 1))
         if self.unconfirmed_after is not None and not self.acknowledged:
             left = self.started + self.unconfirmed_after - now
             if left > 0:
                 interval = min(interval, left)
+        self._read_at = now + interval
         return interval
 
     def update(self, status: ControllerStatus, pose: Pose | None, now: float) -> CommandResult | None:
@@ -191,6 +245,8 @@ class CommandTracker:
         if self.result is not None:
             return self.result
         self.reads += 1
+        self._sent.append(min(self._read_at, now))  # an unplanned read (a poll): its answer's time
+        self._read_at = math.inf
         self.last_status = status
         code = status.command_status_code
         if status.alarms:
@@ -201,6 +257,8 @@ class CommandTracker:
                 code, now,
             )
         if code != self.pre_code:
+            if not self.code_left_pre:
+                self._ack_read = self.reads
             self.code_left_pre = True
         progressed = self._note_motion(status, pose)
         if not self.acknowledged and (self.code_left_pre or self.motion_seen):
@@ -379,6 +437,12 @@ class CommandTracker:
                 unconfirmed: bool = False, reason: Reason | None = None) -> CommandResult:
         details = self._details(now)
         details["reads"] = float(self.reads)
+        ack = self._ack_read
+        if self.pacer is not None and not unconfirmed and 0 < ack < self.reads:
+            # a result seen after the read that showed the command taken: how long after it
+            taken = self._sent[ack - 1]
+            missed = self._sent[-2] - taken if self.reads > ack + 1 else None
+            self.pacer.learn(missed, self._sent[-1] - taken)
         self.result = CommandResult(self.command, self.kind, status, ok, message, details,
                                     unconfirmed=unconfirmed, reason=reason)
         return self.result

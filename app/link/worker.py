@@ -11,35 +11,28 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
 * :class:`~app.link.poller.Poller` -- status then pose per tick, one signal per changed datum,
   then ``pollSucceeded``, then the ``commandFinished`` that poll completed.
 * :class:`~app.link.jobs.JobQueue` -- urgent jobs (stop, pause, resume, jog release, cancel
-  upload) first; they also run between any two transactions of a poll, a jog sequence, a short
-  teach command or an upload, so a stop goes out right after the transaction in flight. A stop
-  cancels the motion jobs queued before it; a release drops a jog press not yet started.
+  upload) first, also between any two transactions of a poll, a jog, a teach command or an
+  upload. A stop cancels the motion jobs queued before it; a release drops a queued jog press.
 * :class:`~app.link.jog.JogMachine` -- jog (function 4) and the dead-man.
 * :class:`~app.link.motion.MotionCommands` / :class:`~app.link.motion.MotionTracker` -- the long
-  commands (step, move to point, go to zero, run program, create point), started without waiting,
-  and the completion of the one under way; a motion while another is under way is refused, Stop
-  clears it. A create point while another short command is being tracked waits in the worker
-  (``_held``) until that one's outcome is known (GV291 tells one command at a time), then goes
-  out: every request ends once, with its own result.
+  commands, started without waiting, and the completion of the one under way (one motion at a
+  time; Stop clears it). A create point while another short command is tracked waits in
+  ``_held`` until that one's outcome is known (GV291 tells one command at a time).
 * :class:`~app.link.upload.Uploader` -- chunked upload of many points, ``pointUploaded`` per
   point, ``uploadProgress``, one final ``commandFinished``; ``cancel_upload`` or a stop end it.
 * :class:`~app.link.capture.TrafficCapture`, RTT and link statistics.
 
-Stop latency: :meth:`RobotWorker.request_stop` queues the stop first in line and, from the GUI
-thread, waits (GIL released, at most :data:`STOP_HANDOFF_WAIT`) until the worker has written it;
-the worker runs urgent jobs between any two transactions (also right after a poll's pose read,
-before publishing), and ``_do_stop`` writes before any bookkeeping. Bound: the transaction in
-flight (one round trip) plus the stop's own write, unless the OS does not schedule the worker.
+Stop latency: :meth:`RobotWorker.request_stop` writes the stop from the calling thread on the stop
+line (:mod:`app.link.stop_line`) when there is one; the stop job then writes it on the main link
+too, after the transaction in flight (ordering), and reads the line's answer. Without a line the
+GUI thread waits (GIL released, at most :data:`STOP_HANDOFF_WAIT`) for the worker to write it.
 
 Every :class:`RobotLink` command returns an ``int`` request id; each :class:`CommandResult` /
-:class:`WorkerError` it causes carries it. Every failure becomes a signal, never an exception in
-the GUI thread: ``commandFinished`` carries the outcome of every command that reached the
-controller (success, refusal, Modbus exception, timeout, stop); ``errorOccurred`` carries
-everything else (link down, monitor-only refusals, invalid input, failed reads), in plain English.
+:class:`WorkerError` it causes carries it. Every failure becomes a signal (``commandFinished``:
+the outcome of every command that reached the controller; ``errorOccurred``: everything else).
 
-Shutdown is a queued call: the worker stops motion (ratio 0, teach disable), closes the client,
-hands itself back to the GUI thread and quits its own thread; :class:`RobotLink` waits a short
-while and never destroys a running thread. See docs/DESIGN.md, "Worker / RobotLink".
+Shutdown is a queued call: the worker stops motion, closes the client, hands itself back to the
+GUI thread and quits its thread (docs/DESIGN.md, "Worker / RobotLink").
 """
 
 from __future__ import annotations
@@ -71,6 +64,7 @@ from app.link.motion import MotionCommands, MotionTracker
 from app.link.poller import Poller
 from app.link.requests import STOP_HANDOFF_WAIT, WorkerRequests
 from app.link.stats import LinkStats
+from app.link.stop_line import StopLine, StopSent
 from app.link.supervisor import DEFAULT_CANARY_GV, LinkSupervisor
 from app.link.types import ConnectionState, JogRequest, LinkState, Operation, WorkerError
 from app.link.upload import RawItem, Uploader
@@ -140,6 +134,8 @@ class RobotWorker(WorkerRequests, QObject):
         self.uploader = Uploader(self)
         self.poller = Poller(self)
         self.supervisor = LinkSupervisor(self, canary_gv)  # raises on a bad canary GV
+        self.stop_line = StopLine()  # the stop's own connection; send_stop from any thread
+        self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
 
     # --- lifecycle (worker thread) ------------------------------------------------------
     @Slot()
@@ -158,6 +154,7 @@ class RobotWorker(WorkerRequests, QObject):
     def connect_to(self, settings: ConnectionSettings) -> None:
         """(Re)connect with ``settings``; retries by itself until :meth:`disconnect_link`."""
         if not self.closed:
+            self.stop_line.reset(settings if self.use_stop_line else None)
             self.supervisor.connect_to(settings)
 
     @Slot()
@@ -250,6 +247,8 @@ class RobotWorker(WorkerRequests, QObject):
     def stop_polling(self) -> None:
         if self._poll_timer is not None:
             self._poll_timer.stop()
+        # link_up is already False when the link was lost, still True when it is being closed
+        self.stop_line.main_link_closed(time.monotonic(), lost=not self.supervisor.link_up)
 
     def start_reconnect(self, delay: float) -> None:
         if self._reconnect_timer is not None and not self.closed:
@@ -342,6 +341,8 @@ class RobotWorker(WorkerRequests, QObject):
             self._poll()
             if self._held and self.motion.active is None:
                 self.run_jobs()  # the tracked command just ended: the held one goes out now
+            if self.link_up:
+                self.stop_line.maintain(time.monotonic())  # open when due, keep alive
 
     def _poll(self) -> None:
         """One poll; results emitted from here belong to no request (even inside a job)."""
@@ -442,9 +443,13 @@ class RobotWorker(WorkerRequests, QObject):
         self.emit_result(CommandResult(None, None, None, False, text), request_id)
 
     # --- plain and urgent commands ------------------------------------------------------
-    def _do_stop(self) -> None:
+    def _do_stop(self, on_line: StopSent | None = None) -> None:  # on_line: sent on the stop line
         client = self.client_or_raise()
-        client.stop()  # first: nothing else goes out before the stop
+        try:
+            client.stop()  # first: nothing else goes out before the stop
+        finally:
+            if on_line is not None:  # its answer: checked, audited, shown in the traffic
+                self.stop_line.report(self.capture, self.audit)
         now = time.monotonic()
         job = self._current_job
         if job is not None and job.sent is not None:

@@ -170,7 +170,9 @@ def test_stop_goes_out_before_queued_commands_and_polls(qtbot: Any, sim: Any, li
     qtbot.waitUntil(lambda: len(cancelled) == 4, timeout=SIGNAL_TIMEOUT_MS)
     sim.set_response_delay(0.0)
     writes = sim.writes[writes_before:]
-    assert [w.address for w in writes] == [441]  # the stop, and nothing that was queued
+    # the stop (on the stop line at once, and on the main link after the read in flight), and
+    # nothing that was queued
+    assert [w.address for w in writes] in ([441], [441, 441])
     # On the wire: the first request sent after the one in flight is the stop.
     qtbot.waitUntil(lambda: any(f.frame[7] == 0x06 for f in frames if f.direction == "tx"),
                     timeout=SIGNAL_TIMEOUT_MS)
@@ -432,10 +434,17 @@ def test_stop_during_a_large_upload_is_serviced_promptly(qtbot: Any, sim: Any, l
     assert created_at_stop < total  # the stop went out while the upload was still going
     assert "stopped" in done.args[0].message
     after = sim.writes[writes_before:]
-    stop_index = next(i for i, w in enumerate(after) if w.address == 441)
-    assert stop_index <= 4  # at most the point in progress finished before the stop (3 writes)
-    assert not any(w.address == 440 for w in after[stop_index:])  # no point started after it
-    assert len(sim.state().points) == done.args[0].details["uploaded"]
+    stops = [i for i, w in enumerate(after) if w.address == 441]
+    first, last = stops[0], stops[-1]  # the stop line's stop, then the main link's (or one stop)
+    assert first <= 4  # at most the point in progress finished before the stop (3 writes)
+    # between the two: at most the rest of the point the worker was writing when the stop came
+    assert last - first - 1 <= 3
+    assert not any(w.address == 440 for w in after[last:])  # no point started after it
+    # The controller holds every point reported uploaded, and at most the one in progress when the
+    # stop line's stop came: its status was reset by the stop, so it is reported failed (never a
+    # false success).
+    held, uploaded = len(sim.state().points), int(done.args[0].details["uploaded"])
+    assert uploaded <= held <= uploaded + 1
 
 
 def test_upload_tool_per_point_writes_gv245_once_per_tool(qtbot: Any, sim: Any, link: RobotLink) -> None:
