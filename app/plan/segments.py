@@ -170,7 +170,7 @@ class Segment:
             "orientation": self.orientation, "ignore_middle": self.ignore_middle, "tool": self.tool,
         }
         if field_name not in values:
-            raise FieldError(field_name, "no such field", code="no_such_field", params={"field": field_name})
+            raise FieldError(field_name, "no such field", code="no_such_field", params={"name": field_name})
         return values[field_name]
 
     def with_field(self, field_name: str, value: object) -> Segment:
@@ -190,7 +190,7 @@ class Segment:
             return replace(self, ignore_middle=_parse_bool("ignore_middle", value))
         if field_name == "tool":
             return replace(self, tool=parse_tool(value))
-        raise FieldError(field_name, "no such field", code="no_such_field", params={"field": field_name})
+        raise FieldError(field_name, "no such field", code="no_such_field", params={"name": field_name})
 
     @property
     def text(self) -> str:
