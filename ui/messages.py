@@ -29,12 +29,12 @@ from app.protocol.enums import (
     alarm_names,
     controller_mode_text,
 )
-from ui.messages_files import FILE_TEMPLATES, file_fields, file_text
+from ui.messages_files import FILE_TEMPLATES, file_fields, file_text, os_problem
 from ui.messages_plan import _number, _tr, envelope_text, issue_line, issue_text
 
 __all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "connection_text", "error_text", "issue_line",
-           "issue_text", "operation_text", "reason_text", "refusal_text", "result_level", "result_text",
-           "status_text"]
+           "issue_text", "operation_text", "os_error_text", "reason_text", "refusal_text", "result_level",
+           "result_text", "status_text"]
 
 CONTEXT = "Messages"
 LEVEL_INFO = "info"
@@ -343,3 +343,9 @@ def refusal_text(exc: BaseException) -> str:
         if text is not None:
             return text
     return exc.reason if isinstance(exc, FieldError) else str(exc)
+
+
+def os_error_text(path: object, exc: OSError) -> str:
+    """A file the system would not open or write, in the operator's language ("a.csv: ...")."""
+    code, args = os_problem(exc)
+    return refusal_text(FileFormatError(exc.strerror or str(exc), path=str(path), problem=Reason(code, args)))

@@ -47,6 +47,12 @@ FILE_TEMPLATES: dict[str, str] = {
     "cell_count": QT_TRANSLATE_NOOP("Messages", "has {cells} cells, the header has {header} (truncated or extra cells?)"),  # noqa: E501
     "row_id_taken": QT_TRANSLATE_NOOP("Messages", "id {id} is already used on row {other}"),
     "not_csv": QT_TRANSLATE_NOOP("Messages", "not valid CSV (a quote is not closed, or a stray character)"),
+    # a file that cannot be read at all (app/points/atomic.py read_limited), or an OSError's errno
+    "file_too_large": QT_TRANSLATE_NOOP("Messages", "the file is too large ({size} bytes, at most {limit})"),
+    "no_such_file": QT_TRANSLATE_NOOP("Messages", "the file does not exist"),
+    "is_a_directory": QT_TRANSLATE_NOOP("Messages", "is a folder, not a file"),
+    "permission_denied": QT_TRANSLATE_NOOP("Messages", "permission denied"),
+    "os_error": QT_TRANSLATE_NOOP("Messages", "the system refused the file (error {errno})"),
     # a project file refused (app/points/project.py)
     "not_json": QT_TRANSLATE_NOOP("Messages", "not valid JSON"),
     "json_too_deep": QT_TRANSLATE_NOOP("Messages", "not valid JSON (nested too deeply)"),
@@ -154,3 +160,15 @@ def file_text(exc: FileFormatError, problem: str | None) -> str | None:
         text = problem
     file = exc.params.get("file")
     return _tr(_IN_FILE).format(file=file, text=text) if file else text
+
+
+_OS_CODES = {FileNotFoundError: "no_such_file", IsADirectoryError: "is_a_directory",
+             PermissionError: "permission_denied"}
+
+
+def os_problem(exc: OSError) -> tuple[str, dict[str, Any]]:
+    """An OSError as a file problem's code and arguments (its strerror is the system's English)."""
+    for kind, code in _OS_CODES.items():
+        if isinstance(exc, kind):
+            return code, {}
+    return "os_error", {"errno": exc.errno if exc.errno is not None else "?"}
