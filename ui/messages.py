@@ -70,6 +70,11 @@ _TEMPLATES: dict[str, str] = {
     "busy": QT_TRANSLATE_NOOP("Messages", "{operation} is still under way: wait for it or press Stop."),
     "link_shut_down": QT_TRANSLATE_NOOP("Messages", "The link is shut down: nothing was sent."),
     "not_connected": QT_TRANSLATE_NOOP("Messages", "Not connected to a controller: nothing was sent."),
+    # the jog (app/link/jog.py)
+    "jog_stopped_silent": QT_TRANSLATE_NOOP("Messages", "Jog stopped: the controller is not answering (speed 0 is sent as soon as it answers)."),  # noqa: E501
+    "left_teach_mode": QT_TRANSLATE_NOOP("Messages", "Jog stopped: the controller left teach mode (now in {mode} mode)."),  # noqa: E501
+    "jog_not_answering": QT_TRANSLATE_NOOP("Messages", "The controller is not answering: the jog was not started."),  # noqa: E501
+    "bad_jog_ratio": QT_TRANSLATE_NOOP("Messages", "Jog speed {value}% is not within 1..100%."),
     # the link
     "link_lost": QT_TRANSLATE_NOOP("Messages", "Lost the connection to the controller at {endpoint}."),
     "link_closed": QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} closed the connection."),
