@@ -1991,12 +1991,12 @@
         <message>
             <location filename="../../ui/messages_files.py" line="59" />
             <source>not a project: expected a JSON object at the top level</source>
-            <translation>不是项目文件：顶层应为 JSON 对象</translation>
+            <translation>不是工程文件：顶层应为 JSON 对象</translation>
         </message>
         <message>
             <location filename="../../ui/messages_files.py" line="60" />
             <source>not a TeachPad project (format {got}, expected {expected})</source>
-            <translation>不是 TeachPad 项目文件（格式为 {got}，应为 {expected}）</translation>
+            <translation>不是 TeachPad 工程文件（格式为 {got}，应为 {expected}）</translation>
         </message>
         <message>
             <location filename="../../ui/messages_files.py" line="61" />
@@ -2016,7 +2016,7 @@
         <message>
             <location filename="../../ui/messages_files.py" line="64" />
             <source>another plan is named “{name}”</source>
-            <translation>已有另一个名为“{name}”的计划</translation>
+            <translation>已有另一个名为“{name}”的轨迹</translation>
         </message>
         <message>
             <location filename="../../ui/messages_files.py" line="66" />
@@ -2046,7 +2046,7 @@
         <message>
             <location filename="../../ui/messages_files.py" line="71" />
             <source>a plan needs a name</source>
-            <translation>计划需要一个名称</translation>
+            <translation>轨迹需要一个名称</translation>
         </message>
         <message>
             <location filename="../../ui/messages_files.py" line="72" />
@@ -2101,7 +2101,7 @@
         <message>
             <location filename="../../ui/messages_files.py" line="86" />
             <source>a list of plans</source>
-            <translation>计划列表</translation>
+            <translation>轨迹列表</translation>
         </message>
         <message>
             <location filename="../../ui/messages_files.py" line="87" />
@@ -2147,17 +2147,17 @@
         <message>
             <location filename="../../ui/messages_files.py" line="102" />
             <source>plan {number}</source>
-            <translation>第 {number} 个计划</translation>
+            <translation>第 {number} 条轨迹</translation>
         </message>
         <message>
             <location filename="../../ui/messages_files.py" line="103" />
             <source>plan {number} “{name}”</source>
-            <translation>第 {number} 个计划“{name}”</translation>
+            <translation>第 {number} 条轨迹“{name}”</translation>
         </message>
         <message>
             <location filename="../../ui/messages_files.py" line="104" />
             <source>plan {number} “{name}”, segment {segment}</source>
-            <translation>第 {number} 个计划“{name}”第 {segment} 段</translation>
+            <translation>第 {number} 条轨迹“{name}”第 {segment} 段</translation>
         </message>
         <message>
             <location filename="../../ui/messages_files.py" line="105" />
