@@ -82,9 +82,8 @@ class JogMachine:
         if not jogging:
             return None
         self.ratio_zero_pending = True
-        self._host.emit_error(
-            Operation.JOG, "jog stopped: the controller is not answering (speed 0 is sent as soon as it answers)",
-            None, Reason("jog_stopped_silent"))
+        note = "jog stopped: the controller is not answering (speed 0 is sent as soon as it answers)"
+        self._host.emit_error(Operation.JOG, note, None, Reason("jog_stopped_silent"))
         return None
 
     def controller_answers(self) -> None:

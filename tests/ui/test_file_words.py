@@ -41,7 +41,10 @@ def controller(qtbot: Any, zh: None, tmp_path: Path) -> Iterator[tuple[ProjectCo
     ctl.close()
 
 
-def test_a_malformed_project_is_refused_in_chinese(qtbot: Any, controller: tuple[ProjectController, FakeDialogs],
+Controller = tuple[ProjectController, FakeDialogs]
+
+
+def test_a_malformed_project_is_refused_in_chinese(qtbot: Any, controller: Controller,
                                                    tmp_path: Path) -> None:
     ctl, dialogs = controller
     before = ctl.project
@@ -51,7 +54,8 @@ def test_a_malformed_project_is_refused_in_chinese(qtbot: Any, controller: tuple
     assert not ctl.open_file(bad)
     title, shown = dialogs.errors[-1]
     assert title == "无法打开工程"
-    assert shown == "坏.teachpad.json：第 1 条轨迹“pick and place”第 1 段，字段“type”：'circle' 不是直线或圆弧", shown
+    assert shown == ("坏.teachpad.json：第 1 条轨迹“pick and place”第 1 段，字段“type”："
+                     "'circle' 不是直线或圆弧"), shown
     assert ctl.project is before  # nothing half replaced
     bad.write_text("{\"format\": ", encoding="utf-8")
     assert not ctl.open_file(bad)
@@ -60,8 +64,7 @@ def test_a_malformed_project_is_refused_in_chinese(qtbot: Any, controller: tuple
     assert dialogs.errors[-1][1] == "没有.teachpad.json：文件不存在"
 
 
-def test_an_import_reports_and_refuses_in_chinese(qtbot: Any, controller: tuple[ProjectController, FakeDialogs],
-                                                  tmp_path: Path) -> None:
+def test_an_import_reports_and_refuses_in_chinese(qtbot: Any, controller: Controller, tmp_path: Path) -> None:
     ctl, dialogs = controller
     bad = tmp_path / "点.csv"
     bad.write_text('id,name,x,y,z,a,b,c\n1,"a,0,0,0,0,0,0\n', encoding="utf-8")
@@ -81,7 +84,8 @@ def test_an_import_reports_and_refuses_in_chinese(qtbot: Any, controller: tuple[
     (COL_END, "99", "点 P99 不存在：请从列表中选择"),
     (COL_VIA, "7", "圆弧的中间点必须与终点不同"),
 ])
-def test_a_segment_edit_is_refused_in_chinese(qtbot: Any, zh: None, column: int, value: str, reason: str) -> None:
+def test_a_segment_edit_is_refused_in_chinese(qtbot: Any, zh: None, column: int, value: str,
+                                              reason: str) -> None:
     project = load_project(SAMPLES / "demo.teachpad.json")
     model = SegmentTableModel(QUndoStack(), project.ledger)
     model.set_plan(project.plans[1])  # circle: line, arc, arc, line

@@ -50,8 +50,8 @@ QM = Path(__file__).resolve().parents[2] / "ui" / "i18n" / "teachpad_zh_CN.qm"
 ENDPOINT = "192.168.1.10:502"
 # what may stay ASCII in a Chinese sentence: units, register, protocol, format and product names, numbers,
 # addresses
-ALLOWED = re.compile(r"\d+(\.\d+)+:\d+|Modbus|TeachPad|TCP|RTU|CRC|UTF-8|Unicode|CSV|JSON|GV\d+|COM\d+|mm/s|mm|"
-                     r"\bs\b|\b[XYZABC]\b|\bJ\d+\b|\bP\d+\b|0x[0-9A-Fa-f]+")
+ALLOWED = re.compile(r"\d+(\.\d+)+:\d+|Modbus|TeachPad|TCP|RTU|CRC|UTF-8|Unicode|CSV|JSON|GV\d+|COM\d+|"
+                     r"mm/s|mm|\bs\b|\b[XYZABC]\b|\bJ\d+\b|\bP\d+\b|0x[0-9A-Fa-f]+")
 
 
 @pytest.fixture
@@ -518,9 +518,10 @@ def test_a_malformed_project_reads_in_chinese(zh: None) -> None:
         left = _without_quoted(shown).replace("工程.teachpad.json", "")
         assert_chinese(re.sub(r"\[[\d, ]*\]", "", left))
         assert str(error).startswith("/data/")  # the English whole for logs and the CLI
-    assert problems >= {"not_json", "not_json_object", "json_too_deep", "not_a_project", "version_unsupported",
-                        "expected_type", "not_a_number", "point_id_twice", "plan_name_taken", "plan_name_empty",
-                        "bad_loops", "value_missing", "not_segment_kind", "not_orientation", "not_yes_no",
+    assert problems >= {"not_json", "not_json_object", "json_too_deep", "not_a_project",
+                        "version_unsupported", "expected_type", "not_a_number", "point_id_twice",
+                        "plan_name_taken", "plan_name_empty", "bad_loops", "value_missing",
+                        "not_segment_kind", "not_orientation", "not_yes_no",
                         "negative_point_id", "line_has_no_middle", "bad_character"}
     assert places >= {None, "place_file", "place_line", "place_point", "place_point_id", "place_point_upload",
                       "place_plan", "place_plan_named", "place_segment", "place_json_path"}
@@ -551,12 +552,14 @@ def test_segment_jog_and_unreadable_file_codes_read_in_chinese(zh: None, tmp_pat
                        .replace("nothing.teachpad.json", "").replace(tmp_path.name, ""))
     assert codes == {"cannot_move_segment", "no_such_field", "plan_name_format", "not_csv", "no_such_file",
                      "is_a_directory"}
-    for code, args in [("arc_needs_middle", {}), ("segment_point_missing", {"id": 7}),
-                       ("speed_not_positive", {"speed": "0"}), ("arc_same_points", {}),
-                       ("file_too_large", {"size": 9, "limit": 8}), ("permission_denied", {}),
-                       ("os_error", {"errno": 28}), ("jog_stopped_silent", {}),
-                       ("left_teach_mode", {"mode": int(ControllerMode.MANUAL)}), ("jog_not_answering", {}),
-                       ("bad_jog_ratio", {"value": "120"})]:
+    codes_args: list[tuple[str, dict[str, Any]]] = [
+        ("arc_needs_middle", {}), ("segment_point_missing", {"id": 7}), ("speed_not_positive", {"speed": "0"}),
+        ("arc_same_points", {}), ("file_too_large", {"size": 9, "limit": 8}), ("permission_denied", {}),
+        ("os_error", {"errno": 28}), ("jog_stopped_silent", {}),
+        ("left_teach_mode", {"mode": int(ControllerMode.MANUAL)}), ("jog_not_answering", {}),
+        ("bad_jog_ratio", {"value": "120"}),
+    ]
+    for code, args in codes_args:
         assert_chinese(error_text(Reason(code, args)))
     assert_chinese(os_error_text("a", PermissionError(13, "Permission denied")).replace("a：", "："))
     assert_chinese(os_error_text("a", OSError(28, "No space left on device")).replace("a：", "："))
