@@ -553,7 +553,8 @@ def test_segment_jog_and_unreadable_file_codes_read_in_chinese(zh: None, tmp_pat
     assert codes == {"cannot_move_segment", "no_such_field", "plan_name_format", "not_csv", "no_such_file",
                      "is_a_directory"}
     codes_args: list[tuple[str, dict[str, Any]]] = [
-        ("arc_needs_middle", {}), ("segment_point_missing", {"id": 7}), ("speed_not_positive", {"speed": "0"}),
+        ("arc_needs_middle", {}), ("segment_point_missing", {"id": 7}),
+        ("speed_not_positive", {"speed": "0"}),
         ("arc_same_points", {}), ("file_too_large", {"size": 9, "limit": 8}), ("permission_denied", {}),
         ("os_error", {"errno": 28}), ("jog_stopped_silent", {}),
         ("left_teach_mode", {"mode": int(ControllerMode.MANUAL)}), ("jog_not_answering", {}),
