@@ -44,4 +44,5 @@ def test_a_jog_stopped_by_a_silent_controller_reads_in_chinese(qtbot: Any, sim: 
     assert_chinese(error_text(note))
     # the dead-man on its return: speed 0 before anything else
     qtbot.waitUntil(lambda: link.state.connection.state is LinkState.CONNECTED, timeout=SIGNAL_TIMEOUT_MS)
-    qtbot.waitUntil(lambda: bool(ratio_writes(sim)) and ratio_writes(sim)[-1] == 0.0, timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(lambda: bool(ratio_writes(sim)) and ratio_writes(sim)[-1] == 0.0,
+                    timeout=SIGNAL_TIMEOUT_MS)
