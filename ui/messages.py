@@ -6,6 +6,9 @@ becomes one translated sentence: :func:`result_text` for a :class:`CommandResult
 :func:`error_text` for a :class:`WorkerError` or a typed error. Command, status and alarm names
 reuse the "Protocol" translations. Something without a reason (an older producer) falls back to
 its English message.
+
+The plan's checks and the safety envelope are worded in :mod:`ui.messages_plan`, refused values
+and files in :mod:`ui.messages_files`; both are re-exported here.
 """
 
 from __future__ import annotations
@@ -13,13 +16,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from PySide6.QtCore import QCoreApplication
-
 from app.errors import Reason, TeachPadError
 from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult
-from app.plan.checks import IssueKind, PlanIssue
-from app.points.point import SYNC_STATE_TEXT, FieldError, FileFormatError, SyncState
+from app.points.point import FieldError, FileFormatError
 from app.protocol.enums import (
     RUN_COMMAND_TEXT,
     UNKNOWN_STATUS_TEXT,
@@ -29,11 +29,12 @@ from app.protocol.enums import (
     alarm_names,
     controller_mode_text,
 )
-from app.protocol.registers import TOOL_NONE
+from ui.messages_files import FILE_TEMPLATES, file_fields, file_text, os_problem
+from ui.messages_plan import _number, _tr, envelope_text, issue_line, issue_text
 
 __all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "connection_text", "error_text", "issue_line",
-           "issue_text", "operation_text", "reason_text", "refusal_text", "result_level", "result_text",
-           "status_text"]
+           "issue_text", "operation_text", "os_error_text", "reason_text", "refusal_text", "result_level",
+           "result_text", "status_text"]
 
 CONTEXT = "Messages"
 LEVEL_INFO = "info"
@@ -69,6 +70,11 @@ _TEMPLATES: dict[str, str] = {
     "busy": QT_TRANSLATE_NOOP("Messages", "{operation} is still under way: wait for it or press Stop."),
     "link_shut_down": QT_TRANSLATE_NOOP("Messages", "The link is shut down: nothing was sent."),
     "not_connected": QT_TRANSLATE_NOOP("Messages", "Not connected to a controller: nothing was sent."),
+    # the jog (app/link/jog.py)
+    "jog_stopped_silent": QT_TRANSLATE_NOOP("Messages", "Jog stopped: the controller is not answering (speed 0 is sent as soon as it answers)."),  # noqa: E501
+    "left_teach_mode": QT_TRANSLATE_NOOP("Messages", "Jog stopped: the controller left teach mode (now in {mode} mode)."),  # noqa: E501
+    "jog_not_answering": QT_TRANSLATE_NOOP("Messages", "The controller is not answering: the jog was not started."),  # noqa: E501
+    "bad_jog_ratio": QT_TRANSLATE_NOOP("Messages", "Jog speed {value}% is not within 1..100%."),
     # the link
     "link_lost": QT_TRANSLATE_NOOP("Messages", "Lost the connection to the controller at {endpoint}."),
     "link_closed": QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} closed the connection."),
@@ -102,28 +108,9 @@ _TEMPLATES: dict[str, str] = {
     "import_duplicate_id": QT_TRANSLATE_NOOP("Messages", "imported point {number}: id {id} appears twice"),
     "point_id_taken": QT_TRANSLATE_NOOP("Messages", "id {id} is already used by {point}"),
     "empty_import": QT_TRANSLATE_NOOP("Messages", "the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)"),  # noqa: E501
-    # a point's field refused (app/points/point.py), in a cell edit or a file
-    "not_a_number": QT_TRANSLATE_NOOP("Messages", "{value} is not a number"),
-    "too_large": QT_TRANSLATE_NOOP("Messages", "{value} is too large"),
-    "value_empty": QT_TRANSLATE_NOOP("Messages", "the value is empty"),
-    "not_finite": QT_TRANSLATE_NOOP("Messages", "{value} is not a finite number"),
-    "not_integer": QT_TRANSLATE_NOOP("Messages", "{value} is not an integer"),
-    "id_out_of_range": QT_TRANSLATE_NOOP("Messages", "id {value} is outside {id_min}..{id_max}"),
-    "bad_tool": QT_TRANSLATE_NOOP("Messages", "tool {value} is not 0..{max} or {none} (none)"),
-    "not_text": QT_TRANSLATE_NOOP("Messages", "the value is not text"),
-    "too_long": QT_TRANSLATE_NOOP("Messages", "the text is longer than {max} characters"),
-    "bad_character": QT_TRANSLATE_NOOP("Messages", "holds an invalid character (a lone surrogate, not Unicode text)"),  # noqa: E501
-    "not_one_line": QT_TRANSLATE_NOOP("Messages", "must be one line"),
-    "value_missing": QT_TRANSLATE_NOOP("Messages", "the value is missing"),
-    # a points CSV file refused (app/points/csv_io.py)
-    "not_utf8": QT_TRANSLATE_NOOP("Messages", "not UTF-8 text (bad byte at offset {offset}); save the file as UTF-8"),  # noqa: E501
-    "empty_file": QT_TRANSLATE_NOOP("Messages", "the file is empty (expected a header row)"),
-    "unknown_column": QT_TRANSLATE_NOOP("Messages", "unknown column {name} (expected: {expected})"),
-    "column_twice": QT_TRANSLATE_NOOP("Messages", "the column appears twice"),
-    "column_missing": QT_TRANSLATE_NOOP("Messages", "the column is missing from the header"),
-    "cell_count": QT_TRANSLATE_NOOP("Messages", "has {cells} cells, the header has {header} (truncated or extra cells?)"),  # noqa: E501
-    "row_id_taken": QT_TRANSLATE_NOOP("Messages", "id {id} is already used on row {other}"),
 }
+
+_TEMPLATES.update(FILE_TEMPLATES)  # refused values and files (ui/messages_files.py)
 
 # A reason whose arguments lack a placeholder of the full sentence uses this one.
 _BARE: dict[str, str] = {
@@ -201,29 +188,6 @@ _MODBUS_EXCEPTIONS: dict[int, str] = {
 }
 _UNKNOWN_EXCEPTION = QT_TRANSLATE_NOOP("Messages", "unknown exception")
 
-# the safety envelope (app/safety/envelope.py ViolationCode values)
-_ENVELOPE: dict[str, str] = {
-    "keep_in": QT_TRANSLATE_NOOP("Messages", "{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit})."),  # noqa: E501
-    "keep_out": QT_TRANSLATE_NOOP("Messages", "{where}the path enters the keep-out zone \u201c{box}\u201d ({axis} = {value} {unit}, its face is at {limit} {unit})."),  # noqa: E501
-    "joint_limit": QT_TRANSLATE_NOOP("Messages", "{where}{axis} = {value}° is past its limit {limit}°."),
-    "speed": QT_TRANSLATE_NOOP("Messages", "{where}speed {value} mm/s is above the {limit} mm/s allowed."),
-    "jog_ratio": QT_TRANSLATE_NOOP("Messages", "{where}jog speed {value}% is above the {limit}% allowed."),
-    "approaching": QT_TRANSLATE_NOOP("Messages", "{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}."),  # noqa: E501
-}
-_ENVELOPE_PREFIX = QT_TRANSLATE_NOOP("Messages", "Refused by the safety envelope: {text}")
-_SEGMENT = QT_TRANSLATE_NOOP("Messages", "segment {n}: ")
-_REDUCED = QT_TRANSLATE_NOOP("Messages", " (reduced-speed mode)")
-
-
-def _tr(text: str, context: str = CONTEXT) -> str:
-    return QCoreApplication.translate(context, text)
-
-
-def _number(value: Any) -> str:
-    if isinstance(value, float):
-        return f"{value:.1f}" if abs(value) >= 10 else f"{value:g}"
-    return str(value)
-
 
 def _command_name(command: Any) -> str:
     try:
@@ -264,22 +228,6 @@ def _alarms(mask: int) -> str:
                     for name in alarm_names(mask))
 
 
-def _envelope(args: Mapping[str, Any], prefix: bool = True) -> str:
-    code = "approaching" if args.get("approaching") else str(args.get("violation", ""))
-    template = _ENVELOPE.get(code)
-    if template is None:
-        return _tr(_TEMPLATES["invalid_input"])
-    unit = "°" if args.get("violation") == "joint_limit" else "mm"
-    segment = args.get("segment")
-    text = _tr(template).format(
-        where="" if segment is None else _tr(_SEGMENT).format(n=int(segment) + 1),
-        axis=args.get("axis", ""), box=args.get("box", ""), unit=unit,
-        value=_number(float(args.get("value", 0.0))), limit=_number(float(args.get("limit", 0.0))))
-    if args.get("reduced"):
-        end = text[-1] if text[-1:] in ("。", ".") else ""
-        text = text[: len(text) - len(end)] + _tr(_REDUCED) + end
-    return _tr(_ENVELOPE_PREFIX).format(text=text) if prefix else text
-
 
 def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
     """The placeholders of ``code``'s sentence, formatted and translated from its arguments."""
@@ -304,6 +252,7 @@ def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
             out["field"] = _tr(_FIELDS[field])
         else:
             out.pop("field", None)
+    file_fields(code, args, out)
     if code == "modbus_exception" and "exception" in args:
         out["name"] = _tr(_MODBUS_EXCEPTIONS.get(int(args["exception"]), _UNKNOWN_EXCEPTION))
     return out
@@ -313,7 +262,7 @@ def reason_text(reason: Reason) -> str | None:
     """One translated sentence for ``reason``; None for a code this module does not know."""
     args = reason.args
     if reason.code == "envelope_refused":
-        return _envelope(args)
+        return envelope_text(args)
     template = _TEMPLATES.get(reason.code)
     if template is None:
         return None
@@ -387,99 +336,13 @@ def connection_text(connection: ConnectionState) -> str:
     return connection.message
 
 
-# --- the plan's checks (app/plan/checks.py: IssueCode values and their args) -------------------
-_ISSUES: dict[str, str] = {
-    "empty-plan": QT_TRANSLATE_NOOP("Messages", "Plan \u201c{plan}\u201d has no segments."),
-    "bad-start": QT_TRANSLATE_NOOP("Messages", "Cannot start at segment {start}: the plan has {segments} segments."),  # noqa: E501
-    "bad-speed": QT_TRANSLATE_NOOP("Messages", "speed {speed} mm/s is not in (0, {max}] mm/s."),
-    "arc-no-middle": QT_TRANSLATE_NOOP("Messages", "the arc has no middle point."),
-    "missing-point/middle": QT_TRANSLATE_NOOP("Messages", "middle point P{id} does not exist."),
-    "missing-point/end": QT_TRANSLATE_NOOP("Messages", "end point P{id} does not exist."),
-    "needs-upload": QT_TRANSLATE_NOOP("Messages", "{point} is not on the controller ({sync}); upload it."),
-    "tool-mismatch": QT_TRANSLATE_NOOP("Messages", "{point} was taught with {point_tool}, the segment moves with {segment_tool}."),  # noqa: E501
-    "zero-length": QT_TRANSLATE_NOOP("Messages", "the line goes nowhere (start and end {length} mm apart){where}."),  # noqa: E501
-    "arc-start-unknown": QT_TRANSLATE_NOOP("Messages", "the arc starts at the robot's current pose, which is not known: its shape is not checked."),  # noqa: E501
-    "arc-points-coincide/start-middle": QT_TRANSLATE_NOOP("Messages", "the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
-    "arc-points-coincide/middle-end": QT_TRANSLATE_NOOP("Messages", "the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
-    "arc-points-coincide/start-end": QT_TRANSLATE_NOOP("Messages", "the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
-    "arc-collinear": QT_TRANSLATE_NOOP("Messages", "the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}."),  # noqa: E501
-    "arc-resume-past-middle/past": QT_TRANSLATE_NOOP("Messages", "the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before."),  # noqa: E501
-    "arc-resume-past-middle/larger": QT_TRANSLATE_NOOP("Messages", "sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here."),  # noqa: E501
-    "unreachable/point": QT_TRANSLATE_NOOP("Messages", "{point} is out of the robot model's reach."),
-    "unreachable/path": QT_TRANSLATE_NOOP("Messages", "the path is out of the robot model's reach."),
-    "joint-limit/point": QT_TRANSLATE_NOOP("Messages", "{point} passes a joint limit of the robot model."),
-    "joint-limit/path": QT_TRANSLATE_NOOP("Messages", "the path passes a joint limit of the robot model."),
-}
-_FROM_CURRENT_POSE = QT_TRANSLATE_NOOP("Messages", " (from the current pose)")
-_FROM_LATER_LOOPS = QT_TRANSLATE_NOOP("Messages", " (on loops after the first, starting at the end of segment {after})")  # noqa: E501
-_ISSUE_KINDS = {IssueKind.ERROR: "error", IssueKind.NEEDS_UPLOAD: "needs upload",
-                IssueKind.WARNING: "warning"}  # the "SegmentTableModel" translations
-
-
-def _tool(tool: Any) -> str:
-    """A tool frame as the points table shows it (translations of "PointsModel")."""
-    if int(tool) == TOOL_NONE:
-        return QCoreApplication.translate("PointsModel", "none")
-    return QCoreApplication.translate("PointsModel", "tool {n}").format(n=int(tool) + 1)
-
-
-def _issue_key(issue: PlanIssue) -> str:
-    code, args = issue.code.value, issue.args
-    if code == "missing-point":
-        return f"{code}/{args.get('role')}"
-    if code == "arc-points-coincide":
-        return f"{code}/{args.get('pair')}"
-    if code == "arc-resume-past-middle":
-        return f"{code}/{'past' if args.get('past_middle') else 'larger'}"
-    if code in ("unreachable", "joint-limit"):
-        return f"{code}/{'point' if args.get('point') else 'path'}"
-    return code
-
-
-def issue_text(issue: PlanIssue) -> str:
-    """One check of a plan as a sentence in the operator's language ("segment 2: ..."); the
-    issue's English message when it carries no arguments this module knows."""
-    args = issue.args
-    if issue.code.value == "outside-envelope" and args:
-        return _envelope(args, prefix=False)
-    template = _ISSUES.get(_issue_key(issue))
-    if template is None:
-        return issue.message
-    fields: dict[str, str] = {k: _number(v) if isinstance(v, int | float) and not isinstance(v, bool)
-                              else str(v) for k, v in args.items()}
-    source = args.get("from")
-    fields["where"] = (_tr(_FROM_CURRENT_POSE) if source == "current_pose"
-                       else _tr(_FROM_LATER_LOOPS).format(after=args.get("after", "?"))
-                       if source == "later_loops" else "")
-    if "sync" in args:
-        try:
-            fields["sync"] = _tr(SYNC_STATE_TEXT[SyncState(args["sync"])], "Points")
-        except (ValueError, KeyError):
-            fields["sync"] = str(args["sync"])
-    for key in ("point_tool", "segment_tool"):
-        if key in args:
-            fields[key] = _tool(args[key])
-    try:
-        text = _tr(template).format(**fields)
-    except (KeyError, ValueError):
-        return issue.message
-    if issue.segment is None:
-        return text
-    return _tr(_SEGMENT).format(n=issue.segment + 1) + text
-
-
-def issue_line(issue: PlanIssue) -> str:
-    """An issue with its kind ("error: segment 2: ..."), for lists and tooltips."""
-    kind = QCoreApplication.translate("SegmentTableModel", _ISSUE_KINDS[issue.kind])
-    return f"{kind}: {issue_text(issue)}"
-
-
 def refusal_text(exc: BaseException) -> str:
     """Why the core refused an edit or a file, in the operator's language when the error
     carries a specific code this module words; else its English text (a field's own reason
     for a :class:`~app.points.point.FieldError`)."""
     if isinstance(exc, FileFormatError):
-        return _file_text(exc) or str(exc)
+        problem = reason_text(exc.problem) if exc.problem is not None else None
+        return file_text(exc, problem) or str(exc)
     if isinstance(exc, TeachPadError) and exc.code not in ("error", "invalid_input"):
         text = reason_text(exc.as_reason())
         if text is not None:
@@ -487,25 +350,7 @@ def refusal_text(exc: BaseException) -> str:
     return exc.reason if isinstance(exc, FieldError) else str(exc)
 
 
-_AT_ROW_COLUMN = QT_TRANSLATE_NOOP("Messages", "row {row}, column '{column}': {problem}")
-_AT_ROW = QT_TRANSLATE_NOOP("Messages", "row {row}: {problem}")
-_AT_COLUMN = QT_TRANSLATE_NOOP("Messages", "column '{column}': {problem}")
-_IN_FILE = QT_TRANSLATE_NOOP("Messages", "{file}: {text}")
-
-
-def _file_text(exc: FileFormatError) -> str | None:
-    """A refused file's problem with its row and column; None when the problem has no code this
-    module words (the English text is then shown whole, not half translated)."""
-    problem = reason_text(exc.problem) if exc.problem is not None else None
-    if problem is None or exc.where is not None:
-        return None
-    if exc.row is not None and exc.column is not None:
-        text = _tr(_AT_ROW_COLUMN).format(row=exc.row, column=exc.column, problem=problem)
-    elif exc.row is not None:
-        text = _tr(_AT_ROW).format(row=exc.row, problem=problem)
-    elif exc.column is not None:
-        text = _tr(_AT_COLUMN).format(column=exc.column, problem=problem)
-    else:
-        text = problem
-    file = exc.params.get("file")
-    return _tr(_IN_FILE).format(file=file, text=text) if file else text
+def os_error_text(path: object, exc: OSError) -> str:
+    """A file the system would not open or write, in the operator's language ("a.csv: ...")."""
+    code, args = os_problem(exc)
+    return refusal_text(FileFormatError(exc.strerror or str(exc), path=str(path), problem=Reason(code, args)))

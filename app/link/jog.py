@@ -14,7 +14,7 @@ import time
 from dataclasses import dataclass
 
 from app import timing
-from app.errors import CommandRefused, InvalidInput, LinkError, TeachPadError
+from app.errors import CommandRefused, InvalidInput, LinkError, Reason, TeachPadError
 from app.link.host import WorkerHost
 from app.link.tracker import CommandTracker
 from app.link.types import JogRequest, Operation
@@ -75,13 +75,16 @@ class JogMachine:
 
     def controller_silent(self) -> str | None:
         """The controller stopped answering: drop the held jog (ratio 0 goes out on its return).
-        Returns a message for the operator when a jog was under way."""
+        When a jog was under way the operator is told (an error with its reason, code
+        ``jog_stopped_silent``); returns None: nothing is left for the caller to say."""
         jogging = self.jog is not None or (self.teach.enabled and self.teach.ratio != 0.0)
         self.end_jog()
         if not jogging:
             return None
         self.ratio_zero_pending = True
-        return "jog stopped: the controller is not answering (speed 0 is sent as soon as it answers)"
+        note = "jog stopped: the controller is not answering (speed 0 is sent as soon as it answers)"
+        self._host.emit_error(Operation.JOG, note, None, Reason("jog_stopped_silent"))
+        return None
 
     def controller_answers(self) -> None:
         """The dead-man after a silence: ratio 0 before anything else, if a jog was under way."""
@@ -116,7 +119,7 @@ class JogMachine:
             return
         client = self._host.client  # also while connecting, before the link is declared up
         if client is None:
-            raise LinkError("not connected to a controller")
+            raise LinkError("not connected to a controller", code="not_connected")
         client.teach_set_ratio(0.0)
         self.teach.ratio = 0.0
         client.teach_disable(wait=False)
@@ -137,13 +140,14 @@ class JogMachine:
             if self.jog is not None:
                 self.end_jog()
                 mode = controller_mode_text(int(status.mode))
-                self._host.emit_error(Operation.JOG, f"the controller left teach mode (mode now: {mode})")
+                self._host.emit_error(Operation.JOG, f"the controller left teach mode (mode now: {mode})",
+                                      reason=Reason("left_teach_mode", {"mode": int(status.mode)}))
         elif (teach.enabled or self.teach_dirty) and self.jog is None and idle \
                 and now - self.released_at >= timing.TEACH_IDLE_DISABLE:
             try:
                 self.stop_jog_and_teach()
             except TeachPadError as exc:
-                self._host.emit_error(Operation.TEACH_DISABLE, str(exc))
+                self._host.emit_exception(Operation.TEACH_DISABLE, exc)
 
     def on_stop(self) -> None:
         """A stop went out: the jog ends, ratio 0 if teach is on and moving."""
@@ -172,9 +176,10 @@ class JogMachine:
         """
         client = self._host.client_or_raise()
         if not self._host.supervisor.answering:  # refused before the wire; not a link failure
-            raise TeachPadError("the controller is not answering: jog not started")
+            raise TeachPadError("the controller is not answering: jog not started", code="jog_not_answering")
         if not 0.0 < request.ratio <= 100.0:
-            raise InvalidInput(f"jog speed must be 1..100 %, got {request.ratio:g}")
+            raise InvalidInput(f"jog speed must be 1..100 %, got {request.ratio:g}", code="bad_jog_ratio",
+                               params={"value": f"{request.ratio:g}"})
         self._require_guard(request)  # refused before teach mode is even switched on
         self.jog = request
         self._serial += 1
@@ -263,7 +268,8 @@ class JogMachine:
         if jog is None:
             return
         if not 0.0 < ratio <= 100.0:
-            raise InvalidInput(f"jog speed must be 1..100 %, got {ratio:g}")
+            raise InvalidInput(f"jog speed must be 1..100 %, got {ratio:g}", code="bad_jog_ratio",
+                               params={"value": f"{ratio:g}"})
         self.jog = dataclasses.replace(jog, ratio=ratio)
         if self.teach.enabled and self.teach.ratio != 0.0 and self.teach.ratio != ratio:
             self._require_guard(self.jog)
@@ -300,7 +306,7 @@ class JogMachine:
         host = self._host
         client = host.client
         if client is None:
-            raise LinkError("not connected to a controller")
+            raise LinkError("not connected to a controller", code="not_connected")
         while True:
             now = time.monotonic()
             result = tracker.update(client.read_status(), None, now)

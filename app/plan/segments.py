@@ -32,12 +32,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from app.errors import InvalidInput
-from app.points.ledger import (
-    FieldError,
-    parse_float,
-    parse_int,
-    parse_tool,
-)
+from app.points.fields import FieldError, parse_float, parse_int, parse_tool, shown
 from app.protocol.enums import QT_TRANSLATE_NOOP
 from app.protocol.registers import TOOL_NONE
 
@@ -82,7 +77,8 @@ def _parse_bool(field_name: str, value: object) -> bool:
             return True
         if key in ("0", "false", "no", "off"):
             return False
-    raise FieldError(field_name, f"{value!r} is not yes/no")
+    raise FieldError(field_name, f"{value!r} is not yes/no", code="not_yes_no",
+                     params={"value": shown(value)})
 
 
 def parse_kind(value: object) -> SegmentKind:
@@ -93,7 +89,8 @@ def parse_kind(value: object) -> SegmentKind:
         for kind in SegmentKind:
             if kind.value == key:
                 return kind
-    raise FieldError("kind", f"{value!r} is not 'line' or 'arc'")
+    raise FieldError("kind", f"{value!r} is not 'line' or 'arc'", code="not_segment_kind",
+                     params={"value": shown(value)})
 
 
 def parse_orientation(value: object) -> bool:
@@ -106,13 +103,15 @@ def parse_orientation(value: object) -> bool:
             return False
     if isinstance(value, bool):
         return value
-    raise FieldError("orientation", f"{value!r} is not '{ORIENTATION_CHANGES}' or '{ORIENTATION_KEPT}'")
+    raise FieldError("orientation", f"{value!r} is not '{ORIENTATION_CHANGES}' or '{ORIENTATION_KEPT}'",
+                     code="not_orientation", params={"value": shown(value)})
 
 
 def _parse_ref(field_name: str, value: object) -> int:
     point_id = parse_int(field_name, value)
     if point_id < 0:
-        raise FieldError(field_name, f"point id {point_id} is negative")
+        raise FieldError(field_name, f"point id {point_id} is negative", code="negative_point_id",
+                         params={"id": point_id})
     return point_id
 
 
@@ -171,7 +170,7 @@ class Segment:
             "orientation": self.orientation, "ignore_middle": self.ignore_middle, "tool": self.tool,
         }
         if field_name not in values:
-            raise FieldError(field_name, "no such field")
+            raise FieldError(field_name, "no such field", code="no_such_field", params={"name": field_name})
         return values[field_name]
 
     def with_field(self, field_name: str, value: object) -> Segment:
@@ -191,7 +190,7 @@ class Segment:
             return replace(self, ignore_middle=_parse_bool("ignore_middle", value))
         if field_name == "tool":
             return replace(self, tool=parse_tool(value))
-        raise FieldError(field_name, "no such field")
+        raise FieldError(field_name, "no such field", code="no_such_field", params={"name": field_name})
 
     @property
     def text(self) -> str:
@@ -202,17 +201,19 @@ class Segment:
 
 def validate_plan_name(name: object) -> str:
     if not isinstance(name, str) or not name.strip():
-        raise FieldError("name", "a plan needs a name")
+        raise FieldError("name", "a plan needs a name", code="plan_name_empty")
     text = name.strip()
     if len(text) > PLAN_NAME_MAX_CHARS or any(ch in text for ch in "\r\n\x00"):
-        raise FieldError("name", f"must be one line of at most {PLAN_NAME_MAX_CHARS} characters")
+        raise FieldError("name", f"must be one line of at most {PLAN_NAME_MAX_CHARS} characters",
+                         code="plan_name_format", params={"max": PLAN_NAME_MAX_CHARS})
     return text
 
 
 def validate_loops(value: object) -> int:
     loops = parse_int("loops", value)
     if not 0 <= loops <= MAX_LOOPS:
-        raise FieldError("loops", f"{loops} is not 0 (endless) .. {MAX_LOOPS}")
+        raise FieldError("loops", f"{loops} is not 0 (endless) .. {MAX_LOOPS}", code="bad_loops",
+                         params={"value": loops, "max": MAX_LOOPS})
     return loops
 
 
@@ -271,7 +272,8 @@ class Plan:
         """Move segment ``src`` so that it ends at index ``dst`` (undo: ``move(dst, src)``)."""
         n = len(self.segments)
         if not (0 <= src < n and 0 <= dst < n):
-            raise InvalidInput(f"cannot move segment {src} to {dst} in {n} segments")
+            raise InvalidInput(f"cannot move segment {src} to {dst} in {n} segments",
+                               code="cannot_move_segment", params={"src": src, "dst": dst, "segments": n})
         if src != dst:
             self.segments.insert(dst, self.segments.pop(src))
             self.revision += 1

@@ -20,6 +20,7 @@ import time
 import uuid
 from pathlib import Path
 
+from app.errors import Reason
 from app.points.point import FileFormatError
 
 TEMP_PREFIX = ".teachpad-tmp."
@@ -122,11 +123,15 @@ def read_limited(path: Path, limit: int = MAX_FILE_BYTES) -> bytes:
     try:
         size = path.stat().st_size
         if size > limit:
-            raise FileFormatError(f"the file is too large ({size} bytes, at most {limit})", path=str(path))
+            raise FileFormatError(f"the file is too large ({size} bytes, at most {limit})", path=str(path),
+                                  problem=Reason("file_too_large", {"size": size, "limit": limit}))
         return path.read_bytes()
     except FileNotFoundError:
-        raise FileFormatError("the file does not exist", path=str(path)) from None
+        raise FileFormatError("the file does not exist", path=str(path),
+                              problem=Reason("no_such_file")) from None
     except IsADirectoryError:
-        raise FileFormatError("is a directory, not a file", path=str(path)) from None
+        raise FileFormatError("is a directory, not a file", path=str(path),
+                              problem=Reason("is_a_directory")) from None
     except PermissionError:
-        raise FileFormatError("cannot be read (permission denied)", path=str(path)) from None
+        raise FileFormatError("cannot be read (permission denied)", path=str(path),
+                              problem=Reason("permission_denied")) from None

@@ -67,7 +67,9 @@ def parse_points_csv(
         rows.extend(reader)
     except csv.Error as exc:
         reason = shown(str(exc), 80)[1:-1]
-        raise FileFormatError(f"not valid CSV ({reason})", path=path, row=len(rows) + 1) from None
+        # the csv module's own detail stays in the English text; the GUI says "not valid CSV"
+        raise FileFormatError(f"not valid CSV ({reason})", path=path, row=len(rows) + 1,
+                              problem=Reason("not_csv")) from None
     header_at = next((i for i, r in enumerate(rows) if any(cell.strip() for cell in r)), None)
     if header_at is None:
         raise FileFormatError("the file is empty (expected a header row)", path=path, row=1,

@@ -11,9 +11,9 @@ controller); editing ``id``, ``x``..``c`` or ``tool`` marks a point ``CHANGED``;
 nothing else) and leave the state alone. A loaded file never says ``ON_CONTROLLER``: a file
 cannot know what a controller holds.
 
-Values from files and editors go through the ``parse_*`` functions, which refuse with a
-:class:`FieldError` naming the field; their messages quote at most :data:`QUOTE_CHARS`
-characters of a bad value (:func:`shown`).
+Values from files and editors go through the ``parse_*`` functions of
+:mod:`app.points.fields` (re-exported here), which refuse with a :class:`FieldError` naming the
+field and quote at most :data:`QUOTE_CHARS` characters of a bad value (:func:`shown`).
 """
 
 from __future__ import annotations
@@ -23,12 +23,39 @@ import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import Any
 
 from app.errors import InvalidInput, Reason
 from app.models import Pose
+from app.points.fields import (
+    DEFAULT_LIMITS,
+    INT_DIGITS_MAX,
+    NAME_MAX_CHARS,
+    NOTE_MAX_CHARS,
+    QUOTE_CHARS,
+    TOOL_MAX,
+    FieldError,
+    OversizedNumber,
+    PointLimits,
+    has_surrogates,
+    parse_float,
+    parse_int,
+    parse_point_id,
+    parse_text,
+    parse_tool,
+    shown,
+    tool_text,
+)
 from app.protocol.enums import QT_TRANSLATE_NOOP
-from app.protocol.registers import TEMP_POINT_ID_MAX, TEMP_POINT_ID_MIN, TOOL_NONE
+from app.protocol.registers import TOOL_NONE
+
+__all__ = [  # the field parsing lives in app.points.fields; re-exported for older imports
+    "CONTROLLER_FIELDS", "CSV_COLUMNS", "CSV_REQUIRED", "DEFAULT_LIMITS", "EXT_FIELDS", "INT_DIGITS_MAX",
+    "NAME_MAX_CHARS", "NOTE_MAX_CHARS", "POINT_FIELDS", "POSE_FIELDS", "QUOTE_CHARS", "SYNC_STATE_TEXT",
+    "TOOL_MAX", "ZERO_EXT", "FieldError", "FileFormatError", "OversizedNumber", "PointLimits", "SyncState",
+    "TempPoint", "fast_point_from_fields", "has_surrogates", "is_valid_point", "make_point", "parse_float",
+    "parse_int", "parse_point_id", "parse_text", "parse_tool", "point_from_fields", "point_from_pose",
+    "shown", "tool_text", "with_field",
+]
 
 TR_CONTEXT = "Points"
 
@@ -44,9 +71,6 @@ CSV_REQUIRED: frozenset[str] = frozenset(("id", *POSE_FIELDS))
 #: Fields the controller stores: editing one of them makes the point "changed on host".
 CONTROLLER_FIELDS: frozenset[str] = frozenset(("id", *POSE_FIELDS, "tool"))
 
-TOOL_MAX = 199  # tool frames 0..199 are "tool N+1"; TOOL_NONE (200) is "no tool frame"
-NAME_MAX_CHARS = 200
-NOTE_MAX_CHARS = 2000
 ZERO_EXT: Ext5 = (0.0, 0.0, 0.0, 0.0, 0.0)
 
 
@@ -58,7 +82,8 @@ class FileFormatError(InvalidInput):
 
     ``str(error)`` reads e.g. ``points.csv: row 7, column 'x': 'abc' is not a number``.
     ``problem`` is the reason as a code and its arguments (None: only the English ``reason``);
-    the error's own reason (code ``file_format``) adds the file name, row and column.
+    ``place`` is ``where`` as a code and its arguments (``place_point`` {index, id}, ...); the
+    error's own reason (code ``file_format``) adds the file name, row and column.
     """
 
     code = "file_format"
@@ -72,6 +97,7 @@ class FileFormatError(InvalidInput):
         column: str | None = None,
         where: str | None = None,
         problem: Reason | None = None,
+        place: Reason | None = None,
     ) -> None:
         if len(reason) > REASON_MAX_CHARS:  # a safety net: a message never carries a whole bad value
             reason = reason[:REASON_MAX_CHARS] + "..."
@@ -81,9 +107,10 @@ class FileFormatError(InvalidInput):
         self.column = column
         self.where = where
         self.problem = problem
+        self.place = place
         super().__init__(self._text(), params={
             "file": os.path.basename(path) if path else None, "row": row, "column": column,
-            "where": where, "problem": problem})
+            "where": where, "problem": problem, "place": place})
 
     def _text(self) -> str:
         parts: list[str] = []
@@ -99,17 +126,7 @@ class FileFormatError(InvalidInput):
 
     def with_path(self, path: str) -> FileFormatError:
         return FileFormatError(self.reason, path=path, row=self.row, column=self.column, where=self.where,
-                               problem=self.problem)
-
-
-class FieldError(InvalidInput):
-    """One field's value refused; ``field`` names it, ``reason`` says why."""
-
-    def __init__(self, field_name: str, reason: str, *, code: str | None = None,
-                 params: Mapping[str, Any] | None = None) -> None:
-        super().__init__(f"{field_name}: {reason}", code=code, params=params)
-        self.field = field_name
-        self.reason = reason
+                               problem=self.problem, place=self.place)
 
 
 class SyncState(enum.Enum):
@@ -142,166 +159,6 @@ SYNC_STATE_TEXT: dict[SyncState, str] = {
     SyncState.FAILED: QT_TRANSLATE_NOOP("Points", "upload failed"),
     SyncState.UNCONFIRMED: QT_TRANSLATE_NOOP("Points", "on controller, unconfirmed"),
 }
-
-
-@dataclass(frozen=True)
-class PointLimits:
-    """Accepted temp point ids (a setting; PROTOCOL.md section 7)."""
-
-    id_min: int = TEMP_POINT_ID_MIN
-    id_max: int = TEMP_POINT_ID_MAX
-
-    def __post_init__(self) -> None:
-        if self.id_min < 0 or self.id_max < self.id_min:
-            raise InvalidInput(f"bad point id range {self.id_min}..{self.id_max}")
-
-
-DEFAULT_LIMITS = PointLimits()
-
-
-# --- field parsing (shared by the GUI editors, CSV and JSON) ------------------------------
-
-
-QUOTE_CHARS = 40  # at most this much of a bad value is quoted in a message
-INT_DIGITS_MAX = 30  # longer integers are refused as too large before int() sees them
-
-
-class OversizedNumber:
-    """A number too long to convert (a JSON decoder hook returns it instead of an ``int``:
-    Python refuses ``int()`` of more than 4300 digits). Every parse function refuses it."""
-
-    __slots__ = ("digits",)
-
-    def __init__(self, digits: str) -> None:
-        self.digits = digits
-
-    def __repr__(self) -> str:
-        return shown(self.digits)
-
-
-def shown(value: object, limit: int = QUOTE_CHARS) -> str:
-    """``repr``-like quote of a value for a message, at most ``limit`` characters of it."""
-    if isinstance(value, OversizedNumber):
-        text = value.digits
-        return (text[:limit] + f"... ({len(text)} digits)") if len(text) > limit else text
-    if isinstance(value, str):
-        cut = value[:limit]
-        quoted = repr(cut)
-        return quoted + f"... ({len(value)} characters)" if len(value) > limit else quoted
-    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10 ** limit:
-        return f"a {len(str(abs(value))) if value.bit_length() < 14000 else 'huge'}-digit number"
-    if isinstance(value, list | dict | tuple):
-        return f"a {type(value).__name__}"
-    text = repr(value)
-    return text if len(text) <= limit else text[:limit] + "..."
-
-
-def has_surrogates(text: str) -> bool:
-    """True when ``text`` holds a lone surrogate (no valid UTF-8 for it: saving would fail)."""
-    try:
-        text.encode("utf-8")
-    except UnicodeEncodeError:
-        return True
-    return False
-
-
-def parse_float(field_name: str, value: object) -> float:
-    """A finite float from a number or text; NaN, infinities and huge numbers are refused."""
-    if isinstance(value, bool):
-        raise FieldError(field_name, f"{shown(value)} is not a number", code="not_a_number",
-                         params={"value": shown(value)})
-    if isinstance(value, OversizedNumber):
-        raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
-                         params={"value": shown(value)})
-    if isinstance(value, int | float):
-        try:
-            number = float(value)
-        except OverflowError:
-            raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
-                             params={"value": shown(value)}) from None
-    elif isinstance(value, str):
-        text = value.strip()
-        if not text:
-            raise FieldError(field_name, "the value is empty", code="value_empty")
-        try:
-            number = float(text)
-        except ValueError:
-            raise FieldError(field_name, f"{shown(text)} is not a number", code="not_a_number",
-                             params={"value": shown(text)}) from None
-        if not math.isfinite(number) and text.lstrip("+-").lower() not in ("inf", "infinity", "nan"):
-            raise FieldError(field_name, f"{shown(text)} is too large", code="too_large",
-                             params={"value": shown(text)})
-    else:
-        raise FieldError(field_name, f"{shown(value)} is not a number", code="not_a_number",
-                         params={"value": shown(value)})
-    if not math.isfinite(number):
-        raise FieldError(field_name, f"{shown(value)} is not a finite number", code="not_finite",
-                         params={"value": shown(value)})
-    return number
-
-
-def parse_int(field_name: str, value: object) -> int:
-    """An integer from an int, an integral float or text (``"5"``, ``"5.0"``)."""
-    if isinstance(value, bool):
-        raise FieldError(field_name, f"{shown(value)} is not an integer", code="not_integer",
-                         params={"value": shown(value)})
-    if isinstance(value, int):
-        if value.bit_length() > 100:
-            raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
-                             params={"value": shown(value)})
-        return value
-    if isinstance(value, str) and len(value.strip().lstrip("+-")) > INT_DIGITS_MAX \
-            and value.strip().lstrip("+-").isdigit():
-        raise FieldError(field_name, f"{shown(value.strip())} is too large", code="too_large",
-                         params={"value": shown(value.strip())})
-    number = parse_float(field_name, value)
-    if not number.is_integer():
-        quoted = shown(value.strip() if isinstance(value, str) else value)
-        raise FieldError(field_name, f"{quoted} is not an integer", code="not_integer",
-                         params={"value": quoted})
-    if abs(number) >= 2.0 ** 100:
-        raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
-                         params={"value": shown(value)})
-    return int(number)
-
-
-def parse_point_id(value: object, limits: PointLimits = DEFAULT_LIMITS, field_name: str = "id") -> int:
-    point_id = parse_int(field_name, value)
-    if not limits.id_min <= point_id <= limits.id_max:
-        raise FieldError(field_name, f"id {shown(point_id)} is outside {limits.id_min}..{limits.id_max}",
-                         code="id_out_of_range",
-                         params={"value": shown(point_id), "id_min": limits.id_min, "id_max": limits.id_max})
-    return point_id
-
-
-def parse_tool(value: object, field_name: str = "tool") -> int:
-    """Tool frame: 0..199 (tool N+1) or 200 (none)."""
-    tool = parse_int(field_name, value)
-    if not (0 <= tool <= TOOL_MAX or tool == TOOL_NONE):
-        raise FieldError(field_name, f"tool {shown(tool)} is not 0..{TOOL_MAX} or {TOOL_NONE} (none)",
-                         code="bad_tool", params={"value": shown(tool), "max": TOOL_MAX, "none": TOOL_NONE})
-    return tool
-
-
-def parse_text(field_name: str, value: object, max_chars: int) -> str:
-    if value is None:
-        return ""
-    if not isinstance(value, str):
-        raise FieldError(field_name, f"{shown(value)} is not text", code="not_text")
-    if len(value) > max_chars:
-        raise FieldError(field_name, f"is longer than {max_chars} characters", code="too_long",
-                         params={"max": max_chars})
-    if has_surrogates(value):
-        raise FieldError(field_name, "holds an invalid character (a lone surrogate, not Unicode text)",
-                         code="bad_character")
-    if any(ch in value for ch in "\x00\r\n") and field_name == "name":
-        raise FieldError(field_name, "must be one line", code="not_one_line")
-    return value
-
-
-def tool_text(tool: int) -> str:
-    """How the GUI and CLI show a tool frame."""
-    return "none" if tool == TOOL_NONE else f"tool {tool + 1} ({tool})"
 
 
 # --- the point -------------------------------------------------------------------------------

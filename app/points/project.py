@@ -49,6 +49,7 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from app.errors import Reason
 from app.plan.segments import (
     Plan,
     Segment,
@@ -155,9 +156,36 @@ def project_to_json(project: Project) -> str:
     return "{\n" + ",\n".join(lines) + "\n}\n"
 
 
-def _expect(value: object, kind: type | tuple[type, ...], where: str, name: str, what: str) -> Any:
+# Where in the file: the English text and the same as a code with arguments (for the GUI).
+Place = tuple[str, Reason]
+_TOP: Place = ("the file", Reason("place_file"))
+# what a value should have been: the English words and the code the GUI words
+_EXPECTED = {"text": "text", "points": "a list of points", "plans": "a list of plans",
+             "segments": "a list of segments", "object": "an object",
+             "uploaded": "an object with time and endpoint"}
+
+
+def _refuse(message: str, problem: Reason | None, where: Place, column: str | None = None) -> FileFormatError:
+    return FileFormatError(message, where=where[0], place=where[1], column=column, problem=problem)
+
+
+def _field_problem(exc: FieldError) -> Reason | None:
+    """A field's refusal as a problem (None for one without a specific code)."""
+    return exc.as_reason() if exc.code != "invalid_input" else None
+
+
+def _point_place(index: int, point_id: int | None = None) -> Place:
+    if point_id is None:
+        return f"points[{index}]", Reason("place_point", {"index": index})
+    return f"points[{index}] (id {point_id})", Reason("place_point_id", {"index": index, "id": point_id})
+
+
+def _expect(value: object, kind: type | tuple[type, ...], where: Place, name: str, what: str) -> Any:
     if not isinstance(value, kind) or (isinstance(value, bool) and kind is not bool):
-        raise FileFormatError(f"expected {what}, got {_json_shown(value)}", where=where, column=name or None)
+        got = ({"got_kind": "list" if isinstance(value, list) else "object"}
+               if isinstance(value, list | dict) else {"got": _json_shown(value)})
+        raise _refuse(f"expected {_EXPECTED[what]}, got {_json_shown(value)}",
+                      Reason("expected_type", {"expected": what, **got}), where, name or None)
     return value
 
 
@@ -169,26 +197,26 @@ def _json_shown(value: object) -> str:
     return shown(json.dumps(value, ensure_ascii=False, allow_nan=True), 40)[1:-1]
 
 
-def _first_surrogate(value: object, path: str) -> str | None:
-    """JSON path of the first string (key or value) holding a lone surrogate, if any."""
+def _first_surrogate(value: object, path: str) -> Place | None:
+    """Where the first string (key or value) holding a lone surrogate is, if any."""
     stack: list[tuple[object, str]] = [(value, path)]
     while stack:
         item, where = stack.pop()
         if isinstance(item, str):
             if has_surrogates(item):
-                return where
+                return (where, Reason("place_json_path", {"path": where})) if where else _TOP
         elif isinstance(item, list):
             stack.extend((v, f"{where}[{i}]") for i, v in reversed(list(enumerate(item))))
         elif isinstance(item, dict):
             for k, v in reversed(list(item.items())):
                 key_text = str(k)
                 if has_surrogates(key_text):
-                    return f"{where} (a key)"
+                    return f"{where} (a key)", Reason("place_json_key", {"path": where})
                 stack.append((v, f"{where}.{key_text}" if where else key_text))
     return None
 
 
-def _text_field(obj: Mapping[str, Any], key: str, where: str) -> str:
+def _text_field(obj: Mapping[str, Any], key: str, where: Place) -> str:
     value = obj.get(key, "")
     return str(_expect("" if value is None else value, str, where, key, "text"))
 
@@ -205,29 +233,31 @@ def project_from_dict(
 
 
 def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = True) -> Project:
-    top = "the file"
+    top = _TOP
     if not isinstance(data, dict):
-        raise FileFormatError("expected a JSON object at the top level")
+        raise FileFormatError("expected a JSON object at the top level", problem=Reason("not_json_object"))
     doc: dict[str, Any] = data
     bad_text = _first_surrogate(doc, "") if scan_text else None
     if bad_text is not None:
-        raise FileFormatError("holds an invalid character (a lone surrogate, not Unicode text)",
-                              where=bad_text or top)
+        raise _refuse("holds an invalid character (a lone surrogate, not Unicode text)",
+                      Reason("bad_character"), bad_text)
     if doc.get("format") != FORMAT_NAME:
-        raise FileFormatError(f"expected {FORMAT_NAME!r}, got {_json_shown(doc.get('format'))}: "
-                              "not a TeachPad project", where=top, column="format")
+        got = _json_shown(doc.get("format"))
+        raise _refuse(f"expected {FORMAT_NAME!r}, got {got}: not a TeachPad project",
+                      Reason("not_a_project", {"expected": repr(FORMAT_NAME), "got": got}), top, "format")
     version = doc.get("version")
     if version != FORMAT_VERSION or isinstance(version, bool):
-        raise FileFormatError(
-            f"version {_json_shown(version)} is not supported (this TeachPad reads version {FORMAT_VERSION})",
-            where=top, column="version",
+        got = _json_shown(version)
+        raise _refuse(
+            f"version {got} is not supported (this TeachPad reads version {FORMAT_VERSION})",
+            Reason("version_unsupported", {"version": got, "supported": FORMAT_VERSION}), top, "version",
         )
     name = _text_field(doc, "name", top) or "untitled"
     description = _text_field(doc, "description", top)
     created = _text_field(doc, "created", top)
     modified = _text_field(doc, "modified", top)
 
-    raw_points = _expect(doc.get("points", []), list, top, "points", "a list of points")
+    raw_points = _expect(doc.get("points", []), list, top, "points", "points")
     points: list[TempPoint] = []
     history: dict[int, UploadRecord] = {}
     seen: dict[int, int] = {}
@@ -240,49 +270,51 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
                 points.append(fast)
                 uploaded = raw.get("uploaded")
                 if uploaded is not None:
-                    record = _history_from(uploaded, f"points[{i}] (id {fast.id})")
+                    record = _history_from(uploaded, i, fast.id)
                     if record is not None:
                         history[fast.id] = record
                 continue
-        where = f"points[{i}]"
-        obj = _expect(raw, dict, where, "", "an object")
+        where = _point_place(i)
+        obj = _expect(raw, dict, where, "", "object")
         raw_id = obj.get("id")
         if isinstance(raw_id, int) and not isinstance(raw_id, bool) and abs(raw_id) < 10**9:
-            where = f"points[{i}] (id {raw_id})"
+            where = _point_place(i, raw_id)
         try:
             # A file cannot know what a controller holds: every loaded point is "unknown"
             # (older files' "sync" / "sync_error" keys are ignored).
             point = point_from_fields(obj, limits, sync=SyncState.UNKNOWN)
         except FieldError as exc:
-            raise FileFormatError(exc.reason, where=where, column=exc.field) from None
-        where = f"points[{i}] (id {point.id})"
+            raise _refuse(exc.reason, _field_problem(exc), where, exc.field) from None
+        where = _point_place(i, point.id)
         if point.id in seen:
-            raise FileFormatError(f"id {point.id} is already used by points[{seen[point.id]}]",
-                                  where=where, column="id")
+            raise _refuse(f"id {point.id} is already used by points[{seen[point.id]}]",
+                          Reason("point_id_twice", {"id": point.id, "other": seen[point.id]}), where, "id")
         seen[point.id] = i
         points.append(point)
-        record = _history_from(obj.get("uploaded"), where)
+        record = _history_from(obj.get("uploaded"), i, point.id)
         if record is not None:
             history[point.id] = record
 
-    raw_plans = _expect(doc.get("plans", []), list, top, "plans", "a list of plans")
+    raw_plans = _expect(doc.get("plans", []), list, top, "plans", "plans")
     plans: list[Plan] = []
     for i, raw in enumerate(raw_plans):
-        where = f"plans[{i}]"
-        obj = _expect(raw, dict, where, "", "an object")
+        where = (f"plans[{i}]", Reason("place_plan", {"index": i}))
+        obj = _expect(raw, dict, where, "", "object")
         try:
             plan_name = validate_plan_name(obj.get("name"))
             loops = validate_loops(obj.get("loops", 1))
         except FieldError as exc:
-            raise FileFormatError(exc.reason, where=where, column=exc.field) from None
-        where = f"plans[{i}] ({plan_name!r})"
+            raise _refuse(exc.reason, _field_problem(exc), where, exc.field) from None
+        where = (f"plans[{i}] ({plan_name!r})", Reason("place_plan_named", {"index": i, "name": plan_name}))
         if plan_name in (p.name for p in plans):
-            raise FileFormatError(f"another plan is named {plan_name!r}", where=where, column="name")
+            raise _refuse(f"another plan is named {plan_name!r}",
+                          Reason("plan_name_taken", {"name": plan_name}), where, "name")
         segments: list[Segment] = []
-        raw_segments = _expect(obj.get("segments", []), list, where, "segments", "a list of segments")
+        raw_segments = _expect(obj.get("segments", []), list, where, "segments", "segments")
         for j, raw_seg in enumerate(raw_segments):
-            seg_where = f"{where} segment {j + 1}"
-            seg = _expect(raw_seg, dict, seg_where, "", "an object")
+            seg_where = (f"{where[0]} segment {j + 1}",
+                         Reason("place_segment", {"index": i, "name": plan_name, "segment": j + 1}))
+            seg = _expect(raw_seg, dict, seg_where, "", "object")
             segments.append(_segment_from_dict(seg, seg_where))
         plans.append(Plan(plan_name, segments, loops))
 
@@ -290,26 +322,28 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
                    description=description, created=created, modified=modified, upload_history=history)
 
 
-def _history_from(raw: object, where: str) -> UploadRecord | None:
+def _history_from(raw: object, index: int, point_id: int) -> UploadRecord | None:
     if raw is None:
         return None
-    obj = _expect(raw, dict, where, "uploaded", "an object with time and endpoint")
-    when = _text_field(obj, "time", f"{where} uploaded")
-    endpoint = _text_field(obj, "endpoint", f"{where} uploaded")
+    where = _point_place(index, point_id)
+    obj = _expect(raw, dict, where, "uploaded", "uploaded")
+    inner: Place = (f"{where[0]} uploaded", Reason("place_point_upload", {"index": index, "id": point_id}))
+    when = _text_field(obj, "time", inner)
+    endpoint = _text_field(obj, "endpoint", inner)
     return UploadRecord(when[:HISTORY_TEXT_MAX], endpoint[:HISTORY_TEXT_MAX])
 
 
-def _segment_from_dict(obj: Mapping[str, Any], where: str) -> Segment:
+def _segment_from_dict(obj: Mapping[str, Any], where: Place) -> Segment:
     for key in ("type", "end"):
         if key not in obj:
-            raise FileFormatError("the value is missing", where=where, column=key)
+            raise _refuse("the value is missing", Reason("value_missing"), where, key)
     try:
         kind = parse_kind(obj["type"])
         via = obj.get("via")
         if kind is SegmentKind.ARC and via is None:
-            raise FieldError("via", "an arc needs its middle point")
+            raise FieldError("via", "an arc needs its middle point", code="arc_needs_middle")
         if kind is SegmentKind.LINE and via is not None:
-            raise FieldError("via", "a line has no middle point")
+            raise FieldError("via", "a line has no middle point", code="line_has_no_middle")
         kwargs: dict[str, Any] = {}
         if "speed" in obj:
             kwargs["speed"] = obj["speed"]
@@ -322,7 +356,7 @@ def _segment_from_dict(obj: Mapping[str, Any], where: str) -> Segment:
         return Segment(kind, obj["end"], via, **kwargs)
     except FieldError as exc:
         column = "type" if exc.field == "kind" else exc.field  # the file's key for the kind
-        raise FileFormatError(exc.reason, where=where, column=column) from None
+        raise _refuse(exc.reason, _field_problem(exc), where, column) from None
 
 
 def _json_int(digits: str) -> int | OversizedNumber:
@@ -364,9 +398,11 @@ def _parse_project_exact(text: str, limits: PointLimits, *, path: str | None) ->
         data = json.loads(text, parse_int=_json_int, parse_float=_json_float)
     except json.JSONDecodeError as exc:
         raise FileFormatError(f"not valid JSON ({exc.msg})", path=path,
-                              where=f"line {exc.lineno}, column {exc.colno}") from None
+                              where=f"line {exc.lineno}, column {exc.colno}", problem=Reason("not_json"),
+                              place=Reason("place_line", {"line": exc.lineno, "column": exc.colno})) from None
     except RecursionError:
-        raise FileFormatError("not valid JSON (nested too deeply)", path=path) from None
+        raise FileFormatError("not valid JSON (nested too deeply)", path=path,
+                              problem=Reason("json_too_deep")) from None
     return project_from_dict(data, limits, path=path)
 
 

@@ -1098,837 +1098,1094 @@
     <context>
         <name>Messages</name>
         <message>
-            <location filename="../../ui/messages.py" line="51" />
+            <location filename="../../ui/messages.py" line="52" />
             <source>{command}: {status}.</source>
             <translation>{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="52" />
+            <location filename="../../ui/messages.py" line="53" />
             <source>{command}: done, not confirmed by the controller.</source>
             <translation>{command}：已完成，控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="53" />
+            <location filename="../../ui/messages.py" line="54" />
             <source>{command}: done (the controller is now in {mode} mode).</source>
             <translation>{command}：已完成（控制器现处于{mode}模式）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="54" />
+            <location filename="../../ui/messages.py" line="55" />
             <source>{command} refused by the controller: {status}.</source>
             <translation>控制器拒绝了{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="55" />
+            <location filename="../../ui/messages.py" line="56" />
             <source>{command} not taken: the controller still shows “{status}” from the previous command.</source>
             <translation>{command}未被执行：控制器仍显示上一条命令的“{status}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="56" />
+            <location filename="../../ui/messages.py" line="57" />
             <source>{command} ended by an alarm: {alarms}.</source>
             <translation>{command}因报警而中止：{alarms}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="57" />
+            <location filename="../../ui/messages.py" line="58" />
             <source>{command}: the controller did not acknowledge it within {seconds} s.</source>
             <translation>{command}：控制器在 {seconds} s 内未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="58" />
+            <location filename="../../ui/messages.py" line="59" />
             <source>{command} did not finish within {seconds} s (last status: {status}).</source>
             <translation>{command}未在 {seconds} s 内完成（最后状态：{status}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="59" />
+            <location filename="../../ui/messages.py" line="60" />
             <source>{command}: the arm moved and stopped, but the controller did not report the result.</source>
             <translation>{command}：机械臂已运动并停止，但控制器未报告结果。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="60" />
+            <location filename="../../ui/messages.py" line="61" />
             <source>{command}: stopped by the operator.</source>
             <translation>{command}：已由操作员停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="61" />
+            <location filename="../../ui/messages.py" line="62" />
             <source>{command}: stopped by the controller.</source>
             <translation>{command}：已被控制器停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="62" />
+            <location filename="../../ui/messages.py" line="63" />
             <source>{command}: sent (not waited for).</source>
             <translation>{command}：已发送（未等待结果）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="63" />
+            <location filename="../../ui/messages.py" line="64" />
             <source>{command}: no motion within {seconds} s (refused by the controller, or already there).</source>
             <translation>{command}：{seconds} s 内没有运动（被控制器拒绝，或已在目标位置）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="64" />
+            <location filename="../../ui/messages.py" line="65" />
             <source>Program {program} did not start: no such program, or the controller refused it.</source>
             <translation>程序 {program} 未启动：没有该程序，或控制器拒绝执行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="65" />
+            <location filename="../../ui/messages.py" line="66" />
             <source>Uploaded {uploaded} of {total} points.</source>
             <translation>已上传 {uploaded}/{total} 个点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="67" />
+            <location filename="../../ui/messages.py" line="68" />
             <source>{operation}: sent.</source>
             <translation>{operation}：已发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="68" />
+            <location filename="../../ui/messages.py" line="69" />
             <source>{operation}: failed.</source>
             <translation>{operation}：失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="69" />
+            <location filename="../../ui/messages.py" line="70" />
             <source>{operation} is still under way: wait for it or press Stop.</source>
             <translation>{operation}仍在进行：请等待其结束或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="70" />
+            <location filename="../../ui/messages.py" line="71" />
             <source>The link is shut down: nothing was sent.</source>
             <translation>通信链路已关闭：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="71" />
+            <location filename="../../ui/messages.py" line="72" />
             <source>Not connected to a controller: nothing was sent.</source>
             <translation>未连接控制器：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="73" />
+            <location filename="../../ui/messages.py" line="74" />
+            <source>Jog stopped: the controller is not answering (speed 0 is sent as soon as it answers).</source>
+            <translation>点动已停止：控制器无应答（一旦应答即发送速度 0）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="75" />
+            <source>Jog stopped: the controller left teach mode (now in {mode} mode).</source>
+            <translation>点动已停止：控制器已退出示教模式（当前为{mode}模式）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="76" />
+            <source>The controller is not answering: the jog was not started.</source>
+            <translation>控制器无应答：点动未启动。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="77" />
+            <source>Jog speed {value}% is not within 1..100%.</source>
+            <translation>点动速度 {value}% 不在 1..100% 范围内。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="79" />
             <source>Lost the connection to the controller at {endpoint}.</source>
             <translation>与控制器 {endpoint} 的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="74" />
+            <location filename="../../ui/messages.py" line="80" />
             <source>The controller at {endpoint} closed the connection.</source>
             <translation>控制器 {endpoint} 关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="75" />
+            <location filename="../../ui/messages.py" line="81" />
             <source>The host name {host} cannot be resolved.</source>
             <translation>无法解析主机名 {host}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="76" />
+            <location filename="../../ui/messages.py" line="82" />
             <source>Connection refused: nothing listens on port {port}.</source>
             <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="77" />
+            <location filename="../../ui/messages.py" line="83" />
             <source>No answer to the connection request within {seconds} s.</source>
             <translation>连接请求在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="78" />
+            <location filename="../../ui/messages.py" line="84" />
             <source>The connection could not be opened.</source>
             <translation>无法建立连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="79" />
+            <location filename="../../ui/messages.py" line="85" />
             <source>Cannot open the serial port {port}.</source>
             <translation>无法打开串口 {port}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="80" />
+            <location filename="../../ui/messages.py" line="86" />
             <source>The controller at {endpoint} did not answer within {seconds} s.</source>
             <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="81" />
+            <location filename="../../ui/messages.py" line="87" />
             <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
             <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="82" />
+            <location filename="../../ui/messages.py" line="88" />
             <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="83" />
+            <location filename="../../ui/messages.py" line="89" />
             <source>Monitor-only mode: nothing was sent to the controller.</source>
             <translation>仅监视模式：未向控制器发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="84" />
+            <location filename="../../ui/messages.py" line="90" />
+            <location filename="../../ui/messages_plan.py" line="26" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="85" />
+            <location filename="../../ui/messages.py" line="91" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="87" />
+            <location filename="../../ui/messages.py" line="93" />
             <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
             <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="88" />
+            <location filename="../../ui/messages.py" line="94" />
             <source>The controller did not create {point} again before the move: the arm was not moved.</source>
             <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="89" />
+            <location filename="../../ui/messages.py" line="95" />
             <source>The project has no point {point}: the arm was not moved.</source>
             <translation>项目中没有点 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="90" />
+            <location filename="../../ui/messages.py" line="96" />
             <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
             <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="92" />
+            <location filename="../../ui/messages.py" line="98" />
             <source>The link was shut down.</source>
             <translation>通信链路已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="93" />
+            <location filename="../../ui/messages.py" line="99" />
             <source>{operation}: the connection was lost while it was under way; its outcome is unknown.</source>
             <translation>{operation}：执行期间连接中断，结果未知。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="94" />
+            <location filename="../../ui/messages.py" line="100" />
             <source>{operation}: the connection was closed while it was under way.</source>
             <translation>{operation}：执行期间连接被关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="96" />
+            <location filename="../../ui/messages.py" line="102" />
             <source>points outside {id_min}..{id_max}: {ids}</source>
             <translation>超出 {id_min}..{id_max} 范围的点：{ids}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="97" />
+            <location filename="../../ui/messages.py" line="103" />
             <source>there is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="98" />
+            <location filename="../../ui/messages.py" line="104" />
             <source>no free point id left in {start}..{id_max}</source>
             <translation>{start}..{id_max} 范围内已没有空闲的点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="99" />
+            <location filename="../../ui/messages.py" line="105" />
             <source>there is no row {row}</source>
             <translation>不存在第 {row} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="100" />
+            <location filename="../../ui/messages.py" line="106" />
             <source>cannot move row {src} to {dst} in {rows} rows</source>
             <translation>无法在 {rows} 行中将第 {src} 行移到第 {dst} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="101" />
+            <location filename="../../ui/messages.py" line="107" />
             <source>row {row}: id {id} is already used on row {other}</source>
             <translation>第 {row} 行：编号 {id} 已被第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="102" />
+            <location filename="../../ui/messages.py" line="108" />
             <source>imported point {number}: id {id} appears twice</source>
             <translation>导入的第 {number} 个点：编号 {id} 出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="103" />
+            <location filename="../../ui/messages.py" line="109" />
             <source>id {id} is already used by {point}</source>
             <translation>编号 {id} 已被 {point} 使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="104" />
+            <location filename="../../ui/messages.py" line="110" />
             <source>the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)</source>
             <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="106" />
+            <location filename="../../ui/messages_files.py" line="29" />
             <source>{value} is not a number</source>
             <translation>{value} 不是数字</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="107" />
+            <location filename="../../ui/messages_files.py" line="30" />
             <source>{value} is too large</source>
             <translation>{value} 太大</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="108" />
+            <location filename="../../ui/messages_files.py" line="31" />
             <source>the value is empty</source>
             <translation>值为空</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="109" />
+            <location filename="../../ui/messages_files.py" line="32" />
             <source>{value} is not a finite number</source>
             <translation>{value} 不是有限的数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="110" />
+            <location filename="../../ui/messages_files.py" line="33" />
             <source>{value} is not an integer</source>
             <translation>{value} 不是整数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="111" />
+            <location filename="../../ui/messages_files.py" line="34" />
             <source>id {value} is outside {id_min}..{id_max}</source>
             <translation>编号 {value} 超出 {id_min}..{id_max}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="112" />
+            <location filename="../../ui/messages_files.py" line="35" />
             <source>tool {value} is not 0..{max} or {none} (none)</source>
             <translation>工具 {value} 不在 0..{max} 范围内，也不是 {none}（无）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="113" />
+            <location filename="../../ui/messages_files.py" line="36" />
             <source>the value is not text</source>
             <translation>值不是文本</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="114" />
+            <location filename="../../ui/messages_files.py" line="37" />
             <source>the text is longer than {max} characters</source>
             <translation>文本超过 {max} 个字符</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="115" />
+            <location filename="../../ui/messages_files.py" line="38" />
             <source>holds an invalid character (a lone surrogate, not Unicode text)</source>
             <translation>含有无效字符（孤立的代理项，不是 Unicode 文本）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="116" />
+            <location filename="../../ui/messages_files.py" line="39" />
             <source>must be one line</source>
             <translation>必须为单行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="117" />
+            <location filename="../../ui/messages_files.py" line="40" />
             <source>the value is missing</source>
             <translation>缺少该值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="119" />
+            <location filename="../../ui/messages_files.py" line="42" />
             <source>not UTF-8 text (bad byte at offset {offset}); save the file as UTF-8</source>
             <translation>不是 UTF-8 文本（偏移 {offset} 处有无效字节）；请将文件另存为 UTF-8</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="120" />
+            <location filename="../../ui/messages_files.py" line="43" />
             <source>the file is empty (expected a header row)</source>
             <translation>文件为空（应有表头行）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="121" />
+            <location filename="../../ui/messages_files.py" line="44" />
             <source>unknown column {name} (expected: {expected})</source>
             <translation>未知列 {name}（应为：{expected}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="122" />
+            <location filename="../../ui/messages_files.py" line="45" />
             <source>the column appears twice</source>
             <translation>该列出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="123" />
+            <location filename="../../ui/messages_files.py" line="46" />
             <source>the column is missing from the header</source>
             <translation>表头中缺少该列</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="124" />
+            <location filename="../../ui/messages_files.py" line="47" />
             <source>has {cells} cells, the header has {header} (truncated or extra cells?)</source>
             <translation>有 {cells} 个单元格，表头有 {header} 个（被截断或有多余单元格？）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="125" />
+            <location filename="../../ui/messages_files.py" line="48" />
             <source>id {id} is already used on row {other}</source>
             <translation>编号 {id} 已在第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="130" />
+            <location filename="../../ui/messages.py" line="117" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="131" />
+            <location filename="../../ui/messages.py" line="118" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="132" />
+            <location filename="../../ui/messages.py" line="119" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="133" />
+            <location filename="../../ui/messages.py" line="120" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="134" />
+            <location filename="../../ui/messages.py" line="121" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="135" />
+            <location filename="../../ui/messages.py" line="122" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="136" />
+            <location filename="../../ui/messages.py" line="123" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="137" />
+            <location filename="../../ui/messages.py" line="124" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="138" />
+            <location filename="../../ui/messages.py" line="125" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="139" />
+            <location filename="../../ui/messages.py" line="126" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="140" />
+            <location filename="../../ui/messages.py" line="127" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="141" />
+            <location filename="../../ui/messages.py" line="128" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="142" />
+            <location filename="../../ui/messages.py" line="129" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="143" />
+            <location filename="../../ui/messages.py" line="130" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="146" />
+            <location filename="../../ui/messages.py" line="133" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="147" />
+            <location filename="../../ui/messages.py" line="134" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="148" />
+            <location filename="../../ui/messages.py" line="135" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="149" />
+            <location filename="../../ui/messages.py" line="136" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="150" />
+            <location filename="../../ui/messages.py" line="137" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="153" />
+            <location filename="../../ui/messages.py" line="140" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="154" />
+            <location filename="../../ui/messages.py" line="141" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="155" />
+            <location filename="../../ui/messages.py" line="142" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="156" />
+            <location filename="../../ui/messages.py" line="143" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="157" />
+            <location filename="../../ui/messages.py" line="144" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="158" />
+            <location filename="../../ui/messages.py" line="145" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="159" />
+            <location filename="../../ui/messages.py" line="146" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="160" />
+            <location filename="../../ui/messages.py" line="147" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="161" />
+            <location filename="../../ui/messages.py" line="148" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="162" />
+            <location filename="../../ui/messages.py" line="149" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="163" />
+            <location filename="../../ui/messages.py" line="150" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="164" />
+            <location filename="../../ui/messages.py" line="151" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="165" />
+            <location filename="../../ui/messages.py" line="152" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="166" />
+            <location filename="../../ui/messages.py" line="153" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="167" />
+            <location filename="../../ui/messages.py" line="154" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="168" />
+            <location filename="../../ui/messages.py" line="155" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="169" />
+            <location filename="../../ui/messages.py" line="156" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="170" />
+            <location filename="../../ui/messages.py" line="157" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="171" />
+            <location filename="../../ui/messages.py" line="158" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="172" />
+            <location filename="../../ui/messages.py" line="159" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="174" />
+            <location filename="../../ui/messages.py" line="161" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="177" />
+            <location filename="../../ui/messages.py" line="164" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="178" />
+            <location filename="../../ui/messages.py" line="165" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="179" />
+            <location filename="../../ui/messages.py" line="166" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="180" />
+            <location filename="../../ui/messages.py" line="167" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="181" />
+            <location filename="../../ui/messages.py" line="168" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="182" />
+            <location filename="../../ui/messages.py" line="169" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="183" />
+            <location filename="../../ui/messages.py" line="170" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="184" />
+            <location filename="../../ui/messages.py" line="171" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="185" />
+            <location filename="../../ui/messages.py" line="172" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="186" />
+            <location filename="../../ui/messages.py" line="173" />
             <source>unit id</source>
             <translation>站号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="187" />
+            <location filename="../../ui/messages.py" line="174" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="191" />
+            <location filename="../../ui/messages.py" line="178" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="192" />
+            <location filename="../../ui/messages.py" line="179" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="193" />
+            <location filename="../../ui/messages.py" line="180" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="194" />
+            <location filename="../../ui/messages.py" line="181" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="195" />
+            <location filename="../../ui/messages.py" line="182" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="196" />
+            <location filename="../../ui/messages.py" line="183" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="197" />
+            <location filename="../../ui/messages.py" line="184" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="198" />
+            <location filename="../../ui/messages.py" line="185" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="199" />
+            <location filename="../../ui/messages.py" line="186" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="200" />
+            <location filename="../../ui/messages.py" line="187" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="202" />
+            <location filename="../../ui/messages.py" line="189" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="206" />
+            <location filename="../../ui/messages_plan.py" line="30" />
             <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="207" />
+            <location filename="../../ui/messages_plan.py" line="31" />
             <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
             <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="208" />
+            <location filename="../../ui/messages_plan.py" line="32" />
             <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
             <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="209" />
+            <location filename="../../ui/messages_plan.py" line="33" />
             <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
             <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="210" />
+            <location filename="../../ui/messages_plan.py" line="34" />
             <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
             <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="211" />
+            <location filename="../../ui/messages_plan.py" line="35" />
             <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
             <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="213" />
+            <location filename="../../ui/messages_plan.py" line="37" />
             <source>Refused by the safety envelope: {text}</source>
             <translation>安全边界拒绝：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="214" />
+            <location filename="../../ui/messages_plan.py" line="38" />
             <source>segment {n}: </source>
             <translation>第 {n} 段：</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="215" />
+            <location filename="../../ui/messages_plan.py" line="39" />
             <source> (reduced-speed mode)</source>
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="380" />
+            <location filename="../../ui/messages.py" line="329" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="381" />
+            <location filename="../../ui/messages.py" line="330" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="392" />
+            <location filename="../../ui/messages_plan.py" line="71" />
             <source>Plan “{plan}” has no segments.</source>
             <translation>规划“{plan}”没有任何段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="393" />
+            <location filename="../../ui/messages_plan.py" line="72" />
             <source>Cannot start at segment {start}: the plan has {segments} segments.</source>
             <translation>无法从第 {start} 段开始：该规划只有 {segments} 段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="394" />
+            <location filename="../../ui/messages_plan.py" line="73" />
             <source>speed {speed} mm/s is not in (0, {max}] mm/s.</source>
             <translation>速度 {speed} mm/s 不在 (0, {max}] mm/s 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="395" />
+            <location filename="../../ui/messages_plan.py" line="74" />
             <source>the arc has no middle point.</source>
             <translation>圆弧没有中间点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="396" />
+            <location filename="../../ui/messages_plan.py" line="75" />
             <source>middle point P{id} does not exist.</source>
             <translation>中间点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="397" />
+            <location filename="../../ui/messages_plan.py" line="76" />
             <source>end point P{id} does not exist.</source>
             <translation>终点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="398" />
+            <location filename="../../ui/messages_plan.py" line="77" />
             <source>{point} is not on the controller ({sync}); upload it.</source>
             <translation>{point} 不在控制器上（{sync}）；请上传。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="399" />
+            <location filename="../../ui/messages_plan.py" line="78" />
             <source>{point} was taught with {point_tool}, the segment moves with {segment_tool}.</source>
             <translation>{point} 示教时的工具为“{point_tool}”，该段运动的工具为“{segment_tool}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="400" />
+            <location filename="../../ui/messages_plan.py" line="79" />
             <source>the line goes nowhere (start and end {length} mm apart){where}.</source>
             <translation>直线没有移动（起点与终点相距 {length} mm）{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="401" />
+            <location filename="../../ui/messages_plan.py" line="80" />
             <source>the arc starts at the robot's current pose, which is not known: its shape is not checked.</source>
             <translation>圆弧从机器人的当前位姿开始，但当前位姿未知：未检查其形状。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="402" />
+            <location filename="../../ui/messages_plan.py" line="81" />
             <source>the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与中间点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="403" />
+            <location filename="../../ui/messages_plan.py" line="82" />
             <source>the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的中间点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="404" />
+            <location filename="../../ui/messages_plan.py" line="83" />
             <source>the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="405" />
+            <location filename="../../ui/messages_plan.py" line="84" />
             <source>the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}.</source>
             <translation>圆弧的三个点（几乎）在一条直线上：中间点距起点—终点连线仅 {offset} mm（至少需要 {tolerance} mm）；请改用直线{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="406" />
+            <location filename="../../ui/messages_plan.py" line="85" />
             <source>the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before.</source>
             <translation>机械臂停在圆弧中间点之后：从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；请用直线移动到终点，或从前一段开始运行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="407" />
+            <location filename="../../ui/messages_plan.py" line="86" />
             <source>sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here.</source>
             <translation>从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；从此处运行前请检查预览。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="408" />
+            <location filename="../../ui/messages_plan.py" line="87" />
             <source>{point} is out of the robot model's reach.</source>
             <translation>{point} 超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="409" />
+            <location filename="../../ui/messages_plan.py" line="88" />
             <source>the path is out of the robot model's reach.</source>
             <translation>路径超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="410" />
+            <location filename="../../ui/messages_plan.py" line="89" />
             <source>{point} passes a joint limit of the robot model.</source>
             <translation>{point} 会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="411" />
+            <location filename="../../ui/messages_plan.py" line="90" />
             <source>the path passes a joint limit of the robot model.</source>
             <translation>路径会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="413" />
+            <location filename="../../ui/messages_plan.py" line="92" />
             <source> (from the current pose)</source>
             <translation>（从当前位姿出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="414" />
+            <location filename="../../ui/messages_plan.py" line="93" />
             <source> (on loops after the first, starting at the end of segment {after})</source>
             <translation>（第一轮之后的循环中，从第 {after} 段的终点出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="490" />
+            <location filename="../../ui/messages_files.py" line="110" />
             <source>row {row}, column '{column}': {problem}</source>
             <translation>第 {row} 行，“{column}”列：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="492" />
+            <location filename="../../ui/messages_files.py" line="112" />
             <source>column '{column}': {problem}</source>
             <translation>“{column}”列：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="491" />
+            <location filename="../../ui/messages_files.py" line="111" />
             <source>row {row}: {problem}</source>
             <translation>第 {row} 行：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="493" />
+            <location filename="../../ui/messages_files.py" line="49" />
+            <source>not valid CSV (a quote is not closed, or a stray character)</source>
+            <translation>不是有效的 CSV 文件（引号未闭合，或有多余字符）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="51" />
+            <source>the file is too large ({size} bytes, at most {limit})</source>
+            <translation>文件过大（{size} 字节，最多 {limit}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="52" />
+            <source>the file does not exist</source>
+            <translation>文件不存在</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="53" />
+            <source>is a folder, not a file</source>
+            <translation>是文件夹，不是文件</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="54" />
+            <source>permission denied</source>
+            <translation>没有访问权限</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="55" />
+            <source>the system refused the file (error {errno})</source>
+            <translation>系统拒绝访问该文件（错误 {errno}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="57" />
+            <source>not valid JSON</source>
+            <translation>不是有效的 JSON</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="58" />
+            <source>not valid JSON (nested too deeply)</source>
+            <translation>不是有效的 JSON（嵌套层数过多）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="59" />
+            <source>not a project: expected a JSON object at the top level</source>
+            <translation>不是工程文件：顶层应为 JSON 对象</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="60" />
+            <source>not a TeachPad project (format {got}, expected {expected})</source>
+            <translation>不是 TeachPad 工程文件（格式为 {got}，应为 {expected}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="61" />
+            <source>version {version} is not supported (this TeachPad reads version {supported})</source>
+            <translation>不支持版本 {version}（本 TeachPad 读取版本 {supported}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="62" />
+            <source>expected {expected}, got {got}</source>
+            <translation>应为{expected}，实际为 {got}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="63" />
+            <source>id {id} is already used by point {other_number}</source>
+            <translation>编号 {id} 已被第 {other_number} 个点使用</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="64" />
+            <source>another plan is named “{name}”</source>
+            <translation>已有另一个名为“{name}”的轨迹</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="66" />
+            <source>{value} is not yes or no</source>
+            <translation>{value} 不是“是”或“否”</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="67" />
+            <source>{value} is not a line or an arc</source>
+            <translation>{value} 不是直线或圆弧</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="68" />
+            <source>{value} is not “changes” or “kept”</source>
+            <translation>{value} 不是“变化”或“保持”</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="69" />
+            <source>point id {id} is negative</source>
+            <translation>点编号 {id} 为负数</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="70" />
+            <source>there is no field “{name}”</source>
+            <translation>没有字段“{name}”</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="71" />
+            <source>a plan needs a name</source>
+            <translation>轨迹需要一个名称</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="72" />
+            <source>the name must be one line of at most {max} characters</source>
+            <translation>名称必须为单行，最多 {max} 个字符</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="73" />
+            <source>{value} loops: give 0 (endless) to {max}</source>
+            <translation>循环次数 {value} 无效：请输入 0（无限）到 {max}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="74" />
+            <source>cannot move segment {src} to {dst} in {segments} segments</source>
+            <translation>无法在 {segments} 段中把第 {src} 段移到第 {dst} 段</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="75" />
+            <source>an arc needs its middle point</source>
+            <translation>圆弧需要中间点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="76" />
+            <source>a line has no middle point</source>
+            <translation>直线没有中间点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="77" />
+            <source>point P{id} does not exist: pick one of the list</source>
+            <translation>点 P{id} 不存在：请从列表中选择</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="78" />
+            <source>{speed} mm/s: the speed must be above 0</source>
+            <translation>{speed} mm/s：速度必须大于 0</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="79" />
+            <source>an arc's middle point must differ from its end point</source>
+            <translation>圆弧的中间点必须与终点不同</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="84" />
+            <source>text</source>
+            <translation>文本</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="85" />
+            <source>a list of points</source>
+            <translation>点列表</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="86" />
+            <source>a list of plans</source>
+            <translation>轨迹列表</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="87" />
+            <source>a list of segments</source>
+            <translation>段列表</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="88" />
+            <location filename="../../ui/messages_files.py" line="93" />
+            <source>an object</source>
+            <translation>对象</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="89" />
+            <source>an object with time and endpoint</source>
+            <translation>包含时间和端点的对象</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="92" />
+            <source>a list</source>
+            <translation>列表</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="98" />
+            <source>the file</source>
+            <translation>文件</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="99" />
+            <source>point {number}</source>
+            <translation>第 {number} 个点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="100" />
+            <source>point {number} (id {id})</source>
+            <translation>第 {number} 个点（编号 {id}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="101" />
+            <source>point {number} (id {id}), upload history</source>
+            <translation>第 {number} 个点（编号 {id}）的上传记录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="102" />
+            <source>plan {number}</source>
+            <translation>第 {number} 条轨迹</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="103" />
+            <source>plan {number} “{name}”</source>
+            <translation>第 {number} 条轨迹“{name}”</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="104" />
+            <source>plan {number} “{name}”, segment {segment}</source>
+            <translation>第 {number} 条轨迹“{name}”第 {segment} 段</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="105" />
+            <source>line {line}, column {column}</source>
+            <translation>第 {line} 行第 {column} 列</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="106" />
+            <source>at “{path}”</source>
+            <translation>位于“{path}”</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="107" />
+            <source>a key at “{path}”</source>
+            <translation>位于“{path}”的键</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="113" />
+            <source>{place}, field '{column}': {problem}</source>
+            <translation>{place}，字段“{column}”：{problem}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="114" />
+            <source>{place}: {problem}</source>
+            <translation>{place}：{problem}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="115" />
             <source>{file}: {text}</source>
             <translation>{file}：{text}</translation>
         </message>
@@ -2188,13 +2445,13 @@
     <context>
         <name>Plan</name>
         <message>
-            <location filename="../../app/plan/segments.py" line="66" />
+            <location filename="../../app/plan/segments.py" line="61" />
             <source>line</source>
             <extracomment>Editable fields of a segment, in table column order.</extracomment>
             <translation>直线</translation>
         </message>
         <message>
-            <location filename="../../app/plan/segments.py" line="67" />
+            <location filename="../../app/plan/segments.py" line="62" />
             <source>arc</source>
             <translation>圆弧</translation>
         </message>
@@ -2918,28 +3175,28 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/point.py" line="139" />
+            <location filename="../../app/points/point.py" line="156" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="140" />
+            <location filename="../../app/points/point.py" line="157" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="141" />
+            <location filename="../../app/points/point.py" line="158" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="142" />
+            <location filename="../../app/points/point.py" line="159" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="143" />
+            <location filename="../../app/points/point.py" line="160" />
             <source>on controller, unconfirmed</source>
             <translation>已在控制器上（未确认）</translation>
         </message>
@@ -2947,14 +3204,14 @@
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/messages.py" line="422" />
+            <location filename="../../ui/messages_plan.py" line="101" />
             <location filename="../../ui/models/point_columns.py" line="66" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="423" />
+            <location filename="../../ui/messages_plan.py" line="102" />
             <location filename="../../ui/models/point_columns.py" line="67" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
@@ -3522,7 +3779,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         <message>
             <location filename="../../ui/controllers/project_controller.py" line="204" />
             <location filename="../../ui/controllers/project_controller.py" line="240" />
-            <location filename="../../ui/controllers/project_controller.py" line="349" />
+            <location filename="../../ui/controllers/project_controller.py" line="352" />
             <source>Project in use</source>
             <translation>工程正在使用中</translation>
         </message>
@@ -3566,57 +3823,62 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         </message>
         <message>
             <location filename="../../ui/controllers/project_controller.py" line="289" />
+            <source>{added} added, {updated} updated, {unchanged} unchanged, {removed} removed</source>
+            <translation>新增 {added} 个，更新 {updated} 个，未变 {unchanged} 个，删除 {removed} 个</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_controller.py" line="291" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="295" />
+            <location filename="../../ui/controllers/project_controller.py" line="297" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="302" />
+            <location filename="../../ui/controllers/project_controller.py" line="304" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="304" />
+            <location filename="../../ui/controllers/project_controller.py" line="306" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="330" />
+            <location filename="../../ui/controllers/project_controller.py" line="332" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="365" />
             <location filename="../../ui/controllers/project_controller.py" line="368" />
+            <location filename="../../ui/controllers/project_controller.py" line="371" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="371" />
+            <location filename="../../ui/controllers/project_controller.py" line="374" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="402" />
+            <location filename="../../ui/controllers/project_controller.py" line="405" />
             <source>Cannot lock {path}: {reason}</source>
             <translation>无法锁定 {path}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="411" />
+            <location filename="../../ui/controllers/project_controller.py" line="414" />
             <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
             <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="447" />
+            <location filename="../../ui/controllers/project_controller.py" line="450" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="450" />
+            <location filename="../../ui/controllers/project_controller.py" line="453" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>
@@ -4517,37 +4779,37 @@ Remove them all?</source>
             <translation>第 {n} 段，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="367" />
+            <location filename="../../ui/models/segment_model.py" line="370" />
             <source>Edit segment {n} {column}</source>
             <translation>编辑第 {n} 段 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="378" />
+            <location filename="../../ui/models/segment_model.py" line="381" />
             <source>Add {kind} segment</source>
             <translation>添加{kind}段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="412" />
+            <location filename="../../ui/models/segment_model.py" line="415" />
             <source>Add {n} segments</source>
             <translation>添加 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="419" />
+            <location filename="../../ui/models/segment_model.py" line="422" />
             <source>Delete segment {n}</source>
             <translation>删除第 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="420" />
+            <location filename="../../ui/models/segment_model.py" line="423" />
             <source>Delete {n} segments</source>
             <translation>删除 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="436" />
+            <location filename="../../ui/models/segment_model.py" line="439" />
             <source>Move segment up</source>
             <translation>上移段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="436" />
+            <location filename="../../ui/models/segment_model.py" line="439" />
             <source>Move segment down</source>
             <translation>下移段</translation>
         </message>

@@ -32,6 +32,7 @@ from app.link.tracker import CommandTracker
 from app.link.types import Operation, WorkerError
 from app.models import CommandResult, ControllerStatus
 from app.plan.checks import IssueCode, IssueKind
+from app.points.point import FileFormatError
 from app.protocol.enums import (
     _STATUS_TEXT,
     STATUS_SENTINEL,
@@ -47,9 +48,10 @@ from ui.messages import LEVEL_ERROR, LEVEL_INFO, LEVEL_WARNING, error_text, resu
 
 QM = Path(__file__).resolve().parents[2] / "ui" / "i18n" / "teachpad_zh_CN.qm"
 ENDPOINT = "192.168.1.10:502"
-# what may stay ASCII in a Chinese sentence: units, register, protocol and format names, numbers, addresses
-ALLOWED = re.compile(r"\d+(\.\d+)+:\d+|Modbus|TCP|RTU|CRC|UTF-8|Unicode|CSV|JSON|GV\d+|COM\d+|mm/s|mm|"
-                     r"\bs\b|\b[XYZABC]\b|\bJ\d+\b|\bP\d+\b|0x[0-9A-Fa-f]+")
+# what may stay ASCII in a Chinese sentence: units, register, protocol, format and product names, numbers,
+# addresses
+ALLOWED = re.compile(r"\d+(\.\d+)+:\d+|Modbus|TeachPad|TCP|RTU|CRC|UTF-8|Unicode|CSV|JSON|GV\d+|COM\d+|"
+                     r"mm/s|mm|\bs\b|\b[XYZABC]\b|\bJ\d+\b|\bP\d+\b|0x[0-9A-Fa-f]+")
 
 
 @pytest.fixture
@@ -445,3 +447,120 @@ def test_a_points_fields_and_files_refusals_read_in_chinese(zh: None) -> None:
     # a problem without a code is shown whole in English, never half translated
     bare = FileFormatError("expected a JSON object at the top level", path="a.teachpad.json")
     assert refusal_text(bare) == str(bare)
+
+
+# --- project files, segment edits, the jog, unreadable files (issue 9, words2) ---------------------
+def _project_texts() -> list[str]:
+    """One malformed project per problem code (and per place) the loader names."""
+    import json
+
+    sample = json.loads((Path(__file__).resolve().parents[2] / "resources" / "samples"
+                         / "demo.teachpad.json").read_text(encoding="utf-8"))
+
+    def changed(edit: Callable[[dict[str, Any]], None]) -> str:
+        doc = json.loads(json.dumps(sample))
+        edit(doc)
+        return json.dumps(doc, ensure_ascii=False)
+
+    def point(key: str, value: object) -> Callable[[dict[str, Any]], None]:
+        return lambda d: d["points"][1].__setitem__(key, value)
+
+    def segment(key: str, value: object, plan: int = 0, seg: int = 0) -> Callable[[dict[str, Any]], None]:
+        return lambda d: d["plans"][plan]["segments"][seg].__setitem__(key, value)
+
+    def delete(key: str) -> Callable[[dict[str, Any]], None]:
+        return lambda d: d["plans"][0]["segments"][0].pop(key)
+
+    return [
+        "{\"format\": ",
+        "[1, 2]",
+        "[" * 100000,
+        changed(lambda d: d.__setitem__("format", "other")),
+        changed(lambda d: d.__setitem__("version", 7)),
+        changed(lambda d: d.__setitem__("points", {})),
+        changed(lambda d: d.__setitem__("plans", "none")),
+        changed(lambda d: d.__setitem__("name", 5)),
+        changed(lambda d: d["points"].__setitem__(0, 5)),
+        changed(point("x", "abc")),
+        changed(point("id", sample["points"][0]["id"])),
+        changed(point("uploaded", [1])),
+        changed(point("uploaded", {"time": 5, "endpoint": ""})),
+        changed(lambda d: d["plans"].__setitem__(0, [])),
+        changed(lambda d: d["plans"][1].__setitem__("name", d["plans"][0]["name"])),
+        changed(lambda d: d["plans"][0].__setitem__("name", "")),
+        changed(lambda d: d["plans"][0].__setitem__("loops", 10**7)),
+        changed(lambda d: d["plans"][0].__setitem__("segments", {})),
+        changed(lambda d: d["plans"][0]["segments"].__setitem__(0, 1)),
+        changed(delete("end")),
+        changed(segment("type", "circle")),
+        changed(segment("orientation", "sideways")),
+        changed(segment("ignore_middle", "maybe")),
+        changed(segment("end", -3)),
+        changed(segment("via", 2)),
+        changed(lambda d: d["points"][1].__setitem__("name", "\ud800")),
+    ]
+
+
+def test_a_malformed_project_reads_in_chinese(zh: None) -> None:
+    from app.points.project import parse_project
+    from ui.messages import refusal_text
+
+    problems, places = set(), set()
+    for text in _project_texts():
+        with pytest.raises(FileFormatError) as refused:
+            parse_project(text, path="/data/工程.teachpad.json")
+        error = refused.value
+        assert error.problem is not None, str(error)
+        problems.add(error.problem.code)
+        places.add(error.place.code if error.place is not None else None)
+        shown = refusal_text(error)
+        assert shown.startswith("工程.teachpad.json：") and "/data" not in shown, shown
+        left = _without_quoted(shown).replace("工程.teachpad.json", "")
+        assert_chinese(re.sub(r"\[[\d, ]*\]", "", left))
+        assert str(error).startswith("/data/")  # the English whole for logs and the CLI
+    assert problems >= {"not_json", "not_json_object", "json_too_deep", "not_a_project",
+                        "version_unsupported", "expected_type", "not_a_number", "point_id_twice",
+                        "plan_name_taken", "plan_name_empty", "bad_loops", "value_missing",
+                        "not_segment_kind", "not_orientation", "not_yes_no",
+                        "negative_point_id", "line_has_no_middle", "bad_character"}
+    assert places >= {None, "place_file", "place_line", "place_point", "place_point_id", "place_point_upload",
+                      "place_plan", "place_plan_named", "place_segment", "place_json_path"}
+
+
+def test_segment_jog_and_unreadable_file_codes_read_in_chinese(zh: None, tmp_path: Path) -> None:
+    from app.plan.segments import Plan, Segment
+    from app.points.csv_io import parse_points_csv
+    from app.points.project import load_project
+    from ui.messages import os_error_text, refusal_text
+
+    refusals: list[Callable[[], object]] = [
+        lambda: Plan("p", [Segment.line(1), Segment.line(2)]).move(0, 9),
+        lambda: Segment.line(1).with_field("colour", 1),
+        lambda: Segment.line(1).get("colour"),
+        lambda: Plan("p").rename("a\nb"),
+        lambda: parse_points_csv('id,name,x,y,z,a,b,c\n1,"a,0,0,0,0,0,0\n'),
+        lambda: load_project(tmp_path / "nothing.teachpad.json"),
+        lambda: load_project(tmp_path),
+    ]
+    codes = set()
+    for attempt in refusals:
+        with pytest.raises(InvalidInput) as caught:
+            attempt()
+        error = caught.value
+        codes.add(error.problem.code if isinstance(error, FileFormatError) and error.problem else error.code)
+        assert_chinese(_without_quoted(refusal_text(error)).replace(str(tmp_path), "")
+                       .replace("nothing.teachpad.json", "").replace(tmp_path.name, ""))
+    assert codes == {"cannot_move_segment", "no_such_field", "plan_name_format", "not_csv", "no_such_file",
+                     "is_a_directory"}
+    codes_args: list[tuple[str, dict[str, Any]]] = [
+        ("arc_needs_middle", {}), ("segment_point_missing", {"id": 7}),
+        ("speed_not_positive", {"speed": "0"}),
+        ("arc_same_points", {}), ("file_too_large", {"size": 9, "limit": 8}), ("permission_denied", {}),
+        ("os_error", {"errno": 28}), ("jog_stopped_silent", {}),
+        ("left_teach_mode", {"mode": int(ControllerMode.MANUAL)}), ("jog_not_answering", {}),
+        ("bad_jog_ratio", {"value": "120"}),
+    ]
+    for code, args in codes_args:
+        assert_chinese(error_text(Reason(code, args)))
+    assert_chinese(os_error_text("a", PermissionError(13, "Permission denied")).replace("a：", "："))
+    assert_chinese(os_error_text("a", OSError(28, "No space left on device")).replace("a：", "："))

@@ -104,12 +104,12 @@ def test_segment_display(segments: SegmentTableModel) -> None:
     ("column", "value", "reason"),
     [
         (COL_SPEED, "abc", "'abc' is not a number"),
-        (COL_SPEED, "0", "must be > 0"),
+        (COL_SPEED, "0", "must be above 0"),
         (COL_SPEED, "nan", "not a finite number"),
         (COL_END, "x", "not a number"),
         (COL_END, "20000", "outside"),
         (COL_VIA, "7", "must differ from its end point"),
-        (COL_KIND, "circle", "is not 'line' or 'arc'"),
+        (COL_KIND, "circle", "is not a line or an arc"),
     ],
 )
 def test_bad_segment_input_is_refused(qtbot: Any, segments: SegmentTableModel, column: int, value: str,

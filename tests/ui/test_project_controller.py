@@ -200,7 +200,7 @@ def test_malformed_project_is_refused(qtbot: Any, controller: ProjectController,
     bad.write_text(text, encoding="utf-8")
     project = controller.project
     assert not controller.open_file(bad)
-    assert "points[1] (id 2)" in dialogs.errors[-1][1] and "field 'x'" in dialogs.errors[-1][1]
+    assert "point 2 (id 2)" in dialogs.errors[-1][1] and "field 'x'" in dialogs.errors[-1][1]
     assert controller.project is project
 
 

@@ -59,6 +59,8 @@ def test_the_event_log_speaks_the_new_language_after_a_switch(qtbot: Any, sim: A
     qtbot.addWidget(log)
     log.bind(link.state)
     connect(qtbot, link, sim)
+    # the first status (alarms 0) first: arriving after the injected bit it would log "cleared"
+    qtbot.waitUntil(lambda: link.state.alarms is not None, timeout=SIGNAL_TIMEOUT_MS)
     log.on_alarms(1)  # an emergency stop raised
     log.add_event("info", "safety", "written as it was")  # a text logged as written stays so
     english = [_cell(log, row, COL_MESSAGE) for row in range(log.model.rowCount())]

@@ -52,7 +52,7 @@ from app.points.project import (
     write_points_csv,
 )
 from ui.controllers.project_dialogs import ProjectDialogs
-from ui.messages import refusal_text
+from ui.messages import os_error_text, refusal_text
 from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
 
@@ -209,7 +209,7 @@ class ProjectController(QObject):
             self.dialogs.error(self.tr("Cannot open project"), refusal_text(exc))
             return False
         except OSError as exc:
-            self.dialogs.error(self.tr("Cannot open project"), f"{path}: {exc.strerror or exc}")
+            self.dialogs.error(self.tr("Cannot open project"), os_error_text(path, exc))
             return False
         self._replace(project, Path(path))
         self.statusMessage.emit(self.tr("Opened {path}").format(path=path))
@@ -242,7 +242,7 @@ class ProjectController(QObject):
         try:
             save_project(self._project, target)
         except OSError as exc:
-            self.dialogs.error(self.tr("Cannot save project"), f"{target}: {exc.strerror or exc}")
+            self.dialogs.error(self.tr("Cannot save project"), os_error_text(target, exc))
             return False
         old_path, self._path = self._path, target
         if old_path != target or self._lock is None:
@@ -270,7 +270,7 @@ class ProjectController(QObject):
             self.dialogs.error(self.tr("Cannot import points"), refusal_text(exc))
             return False
         except OSError as exc:
-            self.dialogs.error(self.tr("Cannot import points"), f"{path}: {exc.strerror or exc}")
+            self.dialogs.error(self.tr("Cannot import points"), os_error_text(path, exc))
             return False
         if mode is None:
             mode = self.dialogs.ask_import_mode()
@@ -286,7 +286,9 @@ class ProjectController(QObject):
         except InvalidInput as exc:
             self.dialogs.error(self.tr("Cannot import points"), refusal_text(exc))
             return False
-        self.statusMessage.emit(self.tr("Imported {path}: {report}").format(path=path, report=report.text))
+        counts = self.tr("{added} added, {updated} updated, {unchanged} unchanged, {removed} removed").format(
+            added=report.added, updated=report.updated, unchanged=report.unchanged, removed=report.removed)
+        self.statusMessage.emit(self.tr("Imported {path}: {report}").format(path=path, report=counts))
         return True
 
     def export_csv(self, path: str | os.PathLike[str] | None = None) -> bool:
@@ -299,7 +301,7 @@ class ProjectController(QObject):
         try:
             write_points_csv(path, self._project.ledger)
         except OSError as exc:
-            self.dialogs.error(self.tr("Cannot export points"), f"{path}: {exc.strerror or exc}")
+            self.dialogs.error(self.tr("Cannot export points"), os_error_text(path, exc))
             return False
         self.statusMessage.emit(self.tr("Exported {n} points to {path}").format(
             n=len(self._project.ledger), path=path))
@@ -327,7 +329,8 @@ class ProjectController(QObject):
         try:
             written = save_autosave(self._project, self._path, user_dir=self._autosave_dir)
         except OSError as exc:
-            self.statusMessage.emit(self.tr("Autosave failed: {reason}").format(reason=exc.strerror or exc))
+            self.statusMessage.emit(self.tr("Autosave failed: {reason}").format(
+                reason=os_error_text(self._path or self._project.name, exc)))
             return None
         self._autosaved_revision = revision
         self.autosaved.emit(str(written))
@@ -365,7 +368,7 @@ class ProjectController(QObject):
             self.dialogs.error(self.tr("Cannot recover autosave"), refusal_text(exc))
             return False
         except OSError as exc:
-            self.dialogs.error(self.tr("Cannot recover autosave"), f"{autosave}: {exc.strerror or exc}")
+            self.dialogs.error(self.tr("Cannot recover autosave"), os_error_text(autosave, exc))
             return False
         self._replace(project, self._path, dirty=True)
         self.statusMessage.emit(self.tr("Recovered the autosave {path}").format(path=autosave))
@@ -400,7 +403,7 @@ class ProjectController(QObject):
             self._foreign_lock = exc.owner
         except OSError as exc:  # e.g. a read-only directory: work without a lock, and say so
             self.statusMessage.emit(self.tr("Cannot lock {path}: {reason}").format(
-                path=path, reason=exc.strerror or exc))
+                path=path, reason=os_error_text(path, exc)))
 
     def _release_lock(self) -> None:
         if self._lock is not None:

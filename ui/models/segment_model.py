@@ -353,14 +353,17 @@ class SegmentTableModel(UndoableListModel):
             if not (name == "via" and blank):
                 value = parse_point_id(_strip_p(value), self._ledger.limits, name)
                 if value not in self._ledger:  # a segment only picks points that exist
-                    raise FieldError(name, f"point P{value} does not exist: pick one of the list")
+                    raise FieldError(name, f"point P{value} does not exist: pick one of the list",
+                                     code="segment_point_missing", params={"id": value})
         if name == "tool" and isinstance(value, str) and value.strip().lower() in TOOL_NONE_WORDS:
             value = TOOL_NONE
         new = old.with_field(name, value)
         if new.speed <= 0:
-            raise FieldError("speed", f"{new.speed:g} mm/s: the speed must be > 0")
+            raise FieldError("speed", f"{new.speed:g} mm/s: the speed must be > 0", code="speed_not_positive",
+                             params={"speed": f"{new.speed:g}"})
         if new.is_arc and new.via_id is not None and new.via_id == new.end_id:
-            raise FieldError(name, "an arc's middle point must differ from its end point")
+            raise FieldError(name, "an arc's middle point must differ from its end point",
+                             code="arc_same_points")
         if new == old:
             return False
         column = self._headers[SEG_COLUMNS.index(name)] if name in SEG_COLUMNS else name
@@ -468,4 +471,5 @@ def _is_checked(value: Any) -> bool:
         return value
     if isinstance(value, int):
         return value == Qt.CheckState.Checked.value
-    raise FieldError("ignore_middle", f"{value!r} is not a check state")
+    raise FieldError("ignore_middle", f"{value!r} is not a check state", code="not_yes_no",
+                     params={"value": repr(value)[:40]})
