@@ -849,7 +849,7 @@
     <context>
         <name>Export</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="279" />
+            <location filename="../../ui/widgets_common.py" line="311" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -2193,105 +2193,105 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="269" />
-            <location filename="../../ui/panels/monitor_panel.py" line="288" />
+            <location filename="../../ui/panels/monitor_panel.py" line="184" />
+            <location filename="../../ui/panels/monitor_panel.py" line="203" />
             <source>mm</source>
             <extracomment>Attributes that exist once the plots are built (asking for one builds them).</extracomment>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="269" />
-            <location filename="../../ui/panels/monitor_panel.py" line="288" />
+            <location filename="../../ui/panels/monitor_panel.py" line="184" />
+            <location filename="../../ui/panels/monitor_panel.py" line="203" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="270" />
+            <location filename="../../ui/panels/monitor_panel.py" line="185" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="272" />
+            <location filename="../../ui/panels/monitor_panel.py" line="187" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="276" />
+            <location filename="../../ui/panels/monitor_panel.py" line="191" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="277" />
+            <location filename="../../ui/panels/monitor_panel.py" line="192" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="278" />
+            <location filename="../../ui/panels/monitor_panel.py" line="193" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="279" />
+            <location filename="../../ui/panels/monitor_panel.py" line="194" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="280" />
+            <location filename="../../ui/panels/monitor_panel.py" line="195" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="281" />
+            <location filename="../../ui/panels/monitor_panel.py" line="196" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="282" />
+            <location filename="../../ui/panels/monitor_panel.py" line="197" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="289" />
+            <location filename="../../ui/panels/monitor_panel.py" line="204" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="290" />
+            <location filename="../../ui/panels/monitor_panel.py" line="205" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="291" />
+            <location filename="../../ui/panels/monitor_panel.py" line="206" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="291" />
+            <location filename="../../ui/panels/monitor_panel.py" line="206" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="292" />
+            <location filename="../../ui/panels/monitor_panel.py" line="207" />
             <source>Top view (X–Y)</source>
             <translation>俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="311" />
+            <location filename="../../ui/panels/monitor_panel.py" line="226" />
             <source>Stale: not confirmed by the controller within the freshness limit</source>
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="517" />
+            <location filename="../../ui/panels/monitor_panel.py" line="404" />
             <source>values stale (grey): no fresh data from the controller</source>
             <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="513" />
+            <location filename="../../ui/panels/monitor_panel.py" line="400" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="515" />
+            <location filename="../../ui/panels/monitor_panel.py" line="402" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -2299,42 +2299,42 @@
     <context>
         <name>Panels</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="236" />
+            <location filename="../../ui/widgets_common.py" line="268" />
             <source>connected</source>
             <translation>已连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="237" />
+            <location filename="../../ui/widgets_common.py" line="269" />
             <source>connecting</source>
             <translation>正在连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="240" />
+            <location filename="../../ui/widgets_common.py" line="272" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="239" />
+            <location filename="../../ui/widgets_common.py" line="271" />
             <source>link down</source>
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="264" />
+            <location filename="../../ui/widgets_common.py" line="296" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="255" />
+            <location filename="../../ui/widgets_common.py" line="287" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="238" />
+            <location filename="../../ui/widgets_common.py" line="270" />
             <source>not answering</source>
             <translation>无应答</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="263" />
+            <location filename="../../ui/widgets_common.py" line="295" />
             <source>done</source>
             <translation>完成</translation>
         </message>
@@ -3589,8 +3589,8 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         </message>
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="67" />
-            <location filename="../../ui/panels/pose_strip.py" line="290" />
-            <location filename="../../ui/panels/pose_strip.py" line="291" />
+            <location filename="../../ui/panels/pose_strip.py" line="281" />
+            <location filename="../../ui/panels/pose_strip.py" line="282" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
@@ -3615,32 +3615,32 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="199" />
+            <location filename="../../ui/panels/pose_strip.py" line="200" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="200" />
+            <location filename="../../ui/panels/pose_strip.py" line="201" />
             <source>Mode</source>
             <translation>模式</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="201" />
+            <location filename="../../ui/panels/pose_strip.py" line="202" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="202" />
+            <location filename="../../ui/panels/pose_strip.py" line="203" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="203" />
+            <location filename="../../ui/panels/pose_strip.py" line="204" />
             <source>The controller's program state (register 561)</source>
             <translation>控制器程序状态（寄存器 561）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="204" />
+            <location filename="../../ui/panels/pose_strip.py" line="205" />
             <source>Whether the values shown were confirmed by the controller within the freshness limit</source>
             <translation>显示的数值是否在时效内得到控制器确认</translation>
         </message>
@@ -5093,62 +5093,62 @@ Remove them all?</source>
     <context>
         <name>TrafficPanel</name>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="137" />
+            <location filename="../../ui/panels/traffic_panel.py" line="145" />
             <source>Filter: bytes or meaning</source>
             <translation>过滤：字节或含义</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="138" />
+            <location filename="../../ui/panels/traffic_panel.py" line="146" />
             <source>Hide polls</source>
             <translation>隐藏轮询</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="140" />
+            <location filename="../../ui/panels/traffic_panel.py" line="148" />
             <source>Hide the periodic reads of 412.. (pose) and 560.. (status)</source>
             <translation>隐藏对 412..（位姿）和 560..（状态）的周期读取</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="142" />
+            <location filename="../../ui/panels/traffic_panel.py" line="150" />
             <source>Pause capture</source>
             <translation>暂停抓包</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="143" />
+            <location filename="../../ui/panels/traffic_panel.py" line="151" />
             <source>Stop recording frames (the worker stops building them)</source>
             <translation>停止记录报文（后台不再生成报文记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="144" />
+            <location filename="../../ui/panels/traffic_panel.py" line="152" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="145" />
+            <location filename="../../ui/panels/traffic_panel.py" line="153" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="263" />
+            <location filename="../../ui/panels/traffic_panel.py" line="276" />
             <source>Export traffic</source>
             <translation>导出通信报文</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="264" />
+            <location filename="../../ui/panels/traffic_panel.py" line="277" />
             <source>CSV files (*.csv);;Text files (*.txt);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;文本文件 (*.txt);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="291" />
+            <location filename="../../ui/panels/traffic_panel.py" line="304" />
             <source>{n} frames</source>
             <translation>{n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="293" />
+            <location filename="../../ui/panels/traffic_panel.py" line="306" />
             <source>{shown} of {n} frames shown</source>
             <translation>显示 {shown} / {n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="295" />
+            <location filename="../../ui/panels/traffic_panel.py" line="308" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
         </message>
