@@ -94,10 +94,18 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
     assert not state.teach_enabled and state.teach_ratio == 0 and not state.jogging
 
 
+_WITH_CTRL_C = ("import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+                "runpy.run_module('app.cli.main', run_name='__main__')")
+
+
 def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) -> tuple[int, str]:
-    """Run teachpad-cli in a subprocess, press Ctrl-C once ``started(state)``; (exit code, stderr)."""
+    """Run teachpad-cli in a subprocess, press Ctrl-C once ``started(state)``; (exit code, stderr).
+
+    The child gets Python's own Ctrl-C handler back: a test runner started in the background
+    (``pytest ... &`` from a script) has SIGINT ignored, its children inherit that, and Python
+    then leaves Ctrl-C ignored -- the CLI would never see it (right for a background job)."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli.main", "--port", str(csim.port), *args],
+        [sys.executable, "-c", _WITH_CTRL_C, "--port", str(csim.port), *args],
         cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     try:
