@@ -36,7 +36,8 @@ SCREENSHOT_SETTLE_MS = 1500  # after the first pose: let the plots fill and the 
 SCREENSHOT_TIMEOUT_MS = 20_000  # give up when no pose arrives
 DEMO_PROGRAM = 1  # the simulator's "square 100 mm in XY"
 SIM_START_TIMEOUT = 20.0  # s for the simulator process to say which port it listens on
-SIM_STOP_TIMEOUT = 3.0  # s for it to stop after its stdin closed, before it is terminated
+SIM_STOP_TIMEOUT = 10.0  # s for it to stop after its stdin closed, before it is terminated (a loaded
+# machine needs seconds to wind an interpreter down; this waits after the window has closed)
 THREADS_EXIT_WAIT = 5.0  # s at exit for a worker thread still stuck in a network call
 
 # The simulator's process: ``teachpad-sim`` on a free port, plus a watch on its stdin -- a pipe

@@ -83,33 +83,48 @@ IK_MAX_ITER: Final = 100
 _ROT_WEIGHT_MM: Final = 500.0  # mm per radian when mixing position and orientation errors
 
 
-def _dh_matrix(theta: float, row: DHRow) -> Matrix:
-    alpha = math.radians(row.alpha_deg)
-    ct, st = math.cos(theta), math.sin(theta)
-    ca, sa = math.cos(alpha), math.sin(alpha)
-    return np.array(
-        [
-            [ct, -st * ca, st * sa, row.a * ct],
-            [st, ct * ca, -ct * sa, row.a * st],
-            [0.0, sa, ca, row.d],
-            [0.0, 0.0, 0.0, 1.0],
+# Per joint: (offset rad, d, a, cos alpha, sin alpha), computed once (the IK calls this a lot).
+_DH_CONST: Final[tuple[tuple[float, float, float, float, float], ...]] = tuple(
+    (math.radians(r.offset_deg), r.d, r.a, math.cos(math.radians(r.alpha_deg)),
+     math.sin(math.radians(r.alpha_deg)))
+    for r in DH_TABLE
+)
+
+
+def _frame_stack(q_deg: JointsLike) -> Matrix:
+    """Base-to-frame transforms T0..T6 as one (7, 4, 4) array (T0 is identity).
+
+    Plain float arithmetic, one array at the end: the IK calls this for every iteration, and
+    numpy's per-call overhead on 4x4 matrices cost more than the arithmetic itself."""
+    rows = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]]
+    chain = [rows]
+    for qi, (offset, d, a, ca, sa) in zip(q_deg[:6], _DH_CONST, strict=True):
+        theta = math.radians(float(qi)) + offset
+        ct, st = math.cos(theta), math.sin(theta)
+        # rows @ DH(theta), DH = [[ct, -st ca, st sa, a ct], [st, ct ca, -ct sa, a st],
+        #                        [0, sa, ca, d], [0, 0, 0, 1]]
+        rows = [
+            [
+                r0 * ct + r1 * st,
+                (r1 * ct - r0 * st) * ca + r2 * sa,
+                (r0 * st - r1 * ct) * sa + r2 * ca,
+                a * (r0 * ct + r1 * st) + r2 * d + r3,
+            ]
+            for r0, r1, r2, r3 in rows
         ]
-    )
+        chain.append(rows)
+    return np.array([[*m, [0.0, 0.0, 0.0, 1.0]] for m in chain], dtype=np.float64)
 
 
 def _frames(q_deg: JointsLike) -> list[Matrix]:
     """Base-to-frame transforms T0..T6 (T0 is identity)."""
-    frames = [np.eye(4)]
-    t = np.eye(4)
-    for qi, row in zip(q_deg[:6], DH_TABLE, strict=True):
-        t = t @ _dh_matrix(math.radians(qi + row.offset_deg), row)
-        frames.append(t)
-    return frames
+    return list(_frame_stack(q_deg))
 
 
 def forward(q_deg: JointsLike) -> Matrix:
     """4x4 flange transform of joints J1..J6 (degrees)."""
-    return _frames(q_deg)[-1]
+    flange: Matrix = _frame_stack(q_deg)[-1]
+    return flange
 
 
 def forward_pose(q_deg: JointsLike) -> Pose6:
@@ -131,14 +146,20 @@ def pose6_to_transform(pose: Sequence[float]) -> Matrix:
 
 def jacobian(q_deg: JointsLike) -> Matrix:
     """Geometric Jacobian (6x6): rows vx vy vz (mm/rad) wx wy wz (rad/rad)."""
-    frames = _frames(q_deg)
-    pe = frames[-1][:3, 3]
-    jac = np.zeros((6, 6))
-    for i in range(6):
-        z = frames[i][:3, 2]
-        p = frames[i][:3, 3]
-        jac[:3, i] = np.cross(z, pe - p)
-        jac[3:, i] = z
+    return _jacobian_of(_frame_stack(q_deg))
+
+
+def _jacobian_of(frames: Matrix) -> Matrix:
+    """The Jacobian from the (7, 4, 4) frames T0..T6 (all six columns at once)."""
+    z = frames[:6, :3, 2]
+    lever = frames[6, :3, 3] - frames[:6, :3, 3]
+    linear = np.empty((6, 3))
+    linear[:, 0] = z[:, 1] * lever[:, 2] - z[:, 2] * lever[:, 1]
+    linear[:, 1] = z[:, 2] * lever[:, 0] - z[:, 0] * lever[:, 2]
+    linear[:, 2] = z[:, 0] * lever[:, 1] - z[:, 1] * lever[:, 0]
+    jac = np.empty((6, 6))
+    jac[:3, :] = linear.T
+    jac[3:, :] = z.T
     return jac
 
 
@@ -173,14 +194,15 @@ def inverse(target: Matrix, seed_deg: JointsLike, *, max_iter: int = IK_MAX_ITER
     lam = 0.5
     for _ in range(max_iter + 1):
         q_deg: Vector = np.asarray(np.degrees(q), dtype=np.float64)
-        t = forward(q_deg)
+        frames = _frame_stack(q_deg)  # once per iteration: the pose and the Jacobian share them
+        t = frames[-1]
         dp = p_target - t[:3, 3]
         dw = rotation_error(t[:3, :3], r_target)
         if float(np.linalg.norm(dp)) < IK_POS_TOL_MM and float(np.linalg.norm(dw)) < IK_ROT_TOL_RAD:
             result = np.asarray(q_deg, dtype=np.float64)
             return result if within_limits(result) else None
         err = np.concatenate([dp, dw * _ROT_WEIGHT_MM])
-        jac = jacobian(q_deg)
+        jac = _jacobian_of(frames)
         jac[3:, :] *= _ROT_WEIGHT_MM
         jjt = jac @ jac.T
         # Damping grows near singularities (small singular values), as in Nakamura's DLS.

@@ -22,6 +22,9 @@ from app.protocol.enums import Alarm, WorkMode
 
 ROOT = Path(__file__).resolve().parents[2]
 SCAN = 0.02  # see tests/client/test_client_sim.py
+# s for a teachpad-cli child to get going, or to wind down after Ctrl-C: generous, a loaded
+# machine (load 12 on 2 cores) took more than 10 s
+CHILD_TIMEOUT = 30.0
 
 
 def run(sim: Any, capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
@@ -71,7 +74,7 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
         cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     try:
-        assert csim.wait_for(lambda s: s.jogging, 10.0)
+        assert csim.wait_for(lambda s: s.jogging, CHILD_TIMEOUT)
         ys = []
         deadline = time.monotonic() + 5.0
         while csim.state().jogging and time.monotonic() < deadline:
@@ -81,7 +84,7 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
             if data["mode"]["name"] == "Modbus teach":  # the jog may end between two reads
                 ys.append(data["pose"]["y"])
         assert len(ys) >= 3 and ys == sorted(ys) and ys[-1] > ys[0]
-        out, err = proc.communicate(timeout=10)
+        out, err = proc.communicate(timeout=CHILD_TIMEOUT)
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -92,16 +95,24 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
     assert not state.teach_enabled and state.teach_ratio == 0 and not state.jogging
 
 
+_WITH_CTRL_C = ("import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+                "runpy.run_module('app.cli.main', run_name='__main__')")
+
+
 def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) -> tuple[int, str]:
-    """Run teachpad-cli in a subprocess, press Ctrl-C once ``started(state)``; (exit code, stderr)."""
+    """Run teachpad-cli in a subprocess, press Ctrl-C once ``started(state)``; (exit code, stderr).
+
+    The child gets Python's own Ctrl-C handler back: a test runner started in the background
+    (``pytest ... &`` from a script) has SIGINT ignored, its children inherit that, and Python
+    then leaves Ctrl-C ignored -- the CLI would never see it (right for a background job)."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli.main", "--port", str(csim.port), *args],
+        [sys.executable, "-c", _WITH_CTRL_C, "--port", str(csim.port), *args],
         cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     try:
-        assert csim.wait_for(started, 10.0)
+        assert csim.wait_for(started, CHILD_TIMEOUT)
         proc.send_signal(signal.SIGINT)
-        _, err = proc.communicate(timeout=10)
+        _, err = proc.communicate(timeout=CHILD_TIMEOUT)
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -128,12 +139,12 @@ def test_jog_killed_mid_jog_is_stopped_by_the_simulator_watchdog(csim: Any) -> N
         cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )
     try:
-        assert csim.wait_for(lambda s: s.jogging, 10.0)
+        assert csim.wait_for(lambda s: s.jogging, CHILD_TIMEOUT)
         start = csim.state()
         assert csim.wait_for(lambda s: s.pose != start.pose, 5.0)  # the arm moves
         killed = time.monotonic()
         proc.kill()  # SIGKILL
-        proc.communicate(timeout=10)
+        proc.communicate(timeout=CHILD_TIMEOUT)
         assert csim.wait_for(lambda s: not s.jogging, 2.0)
     finally:
         if proc.poll() is None:

@@ -26,7 +26,9 @@ def line(request: pytest.FixtureRequest) -> Iterator[tuple[PtyRelay, SimControll
     client: RobotClient | None = None
     try:
         sim.start()
-        client = RobotClient(ConnectionSettings(serial_port=relay.host_port, baudrate=baud, timeout=0.3))
+        # 1 s: at 9600 baud the pose answer alone is 0.24 s on the wire; 0.3 s left a loaded
+        # machine 60 ms for the relay, the simulator and the host (a timeout under load)
+        client = RobotClient(ConnectionSettings(serial_port=relay.host_port, baudrate=baud, timeout=1.0))
         client.connect()
         yield relay, sim, client
     finally:
