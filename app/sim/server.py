@@ -53,10 +53,6 @@ _FC_WRITE_SINGLE = 6
 _GENERAL_REGISTERS = 200  # GV0..GV99 (registers 0..199): cleared by a controller restart
 _STOP_TIMEOUT = 2.0
 _ANSWER_HOLD_MAX = 0.5  # s a move waits at most for its command's answer to go out
-# s a move waits at most for a host to read GV291 once it no longer shows the old code: so a
-# host that reads at all sees the move's own status (0 or 6) before its final 0xFF, even when
-# its thread stalls for a whole short move (a loaded machine); the observe rule needs that
-_SEEN_HOLD_MAX = 0.5
 
 
 class SimController:
@@ -87,7 +83,6 @@ class SimController:
         self.executor = CommandExecutor(self.robot, self.config, self.image, self.status,
                                         lambda: self._status_delay, self._move_accepted)
         self._move_unanswered: float | None = None  # when a move command not answered yet came
-        self._move_unseen: float | None = None  # when a move came whose status no host has read yet
         self._wipe_general = False  # set by restart_controller(): clear GV0..GV99 on the next request
         # bad input and the communication watchdog (app/sim/guard.py)
         self.events: list[SimEvent] = []
@@ -193,14 +188,12 @@ class SimController:
             # short move spans several ticks a host can see (motion runs late, not in a jump)
             step = min(now - last, 2 * period)
             last = now
-            accepted, unseen = self._move_unanswered, self._move_unseen
+            accepted = self._move_unanswered
             # a move starts once its command is answered, as on a controller that answers
-            # within its scan, and once a host has read its fresh status: a busy simulator must
-            # not run a short move to its end before the host even has the answer
-            held = (accepted is not None and now - accepted < _ANSWER_HOLD_MAX) or (
-                unseen is not None and now - unseen < _SEEN_HOLD_MAX)
+            # within its scan: a busy simulator must not run a short move to its end before
+            # the host even has the answer
             with self.lock:
-                if not held:
+                if accepted is None or now - accepted >= _ANSWER_HOLD_MAX:
                     try:
                         self.robot.tick(step)
                     except Exception:  # keep the simulator alive; the failure is in the log
@@ -260,10 +253,7 @@ class SimController:
             self._refresh(registers, start_address)
             status_reg = gv_reg(GV_COMMAND_STATUS)
             if set_values is None and address <= status_reg < address + count:
-                now = time.monotonic()
-                self.status.seen(now)  # a host has now seen the 0 (if it shows)
-                if self.status.fresh(now):
-                    self._move_unseen = None  # ... and a move's own status: it may run
+                self.status.seen(time.monotonic())  # a host has now seen the 0 (if it shows)
         return None
 
     # --- registers ------------------------------------------------------------------------
@@ -277,7 +267,7 @@ class SimController:
         self.image.refresh(regs, start, self.robot, self.published_status())
 
     def _move_accepted(self) -> None:
-        self._move_unanswered = self._move_unseen = time.monotonic()
+        self._move_unanswered = time.monotonic()
 
     # --- inspection -----------------------------------------------------------------------
     @property

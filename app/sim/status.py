@@ -71,10 +71,6 @@ class StatusPublisher:
         self._hold_old_until = self._hold_zero_until = 0.0
         self._zero_unread = False
 
-    def fresh(self, now: float) -> bool:
-        """The old code is gone at ``now``: a read shows the command's own status."""
-        return now >= self._hold_old_until
-
     def seen(self, now: float) -> None:
         """A host read GV291 at ``now``: once the old code is gone, the 0 has been seen."""
         if self._zero_unread and now >= self._hold_old_until:
