@@ -312,11 +312,14 @@ class RobotClient(RegisterClient):
             self._ext_cache = ext
         self._write_floats(registers.GV_EXPECTED_SPEED, [speed])
         tracker = self.begin_command(command, before, before_pose, timeout=timeout)
-        if before_pose is not None and frame is StepFrame.BASE and not any(ext):
+        if before_pose is not None and frame is StepFrame.BASE:
             x, y, z = before_pose.xyzabc[:3]
             tracker.target = (x + offs[0], y + offs[1], z + offs[2])
-        elif before_pose is not None and frame is StepFrame.JOINT and before_pose.joints and not any(ext):
+        elif before_pose is not None and frame is StepFrame.JOINT and before_pose.joints:
             tracker.target_joints = tuple(q + d for q, d in zip(before_pose.joints, offs, strict=False))
+        if before_pose is not None and any(ext) and (tracker.target or tracker.target_joints):
+            # the external axes are reported too (GV212..216): they must have arrived as well
+            tracker.target_ext = tuple(e + d for e, d in zip(before_pose.ext, ext, strict=False))
         return self._finish(tracker, wait)
 
     @staticmethod

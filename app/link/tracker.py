@@ -164,6 +164,7 @@ class CommandTracker:
         # GV291 never left the stale code, seen moving and now still at the target, ended there.
         self.target: tuple[float, float, float] | None = None
         self.target_joints: tuple[float, ...] | None = None  # a joint step: J1..J6 where it ends
+        self.target_ext: tuple[float, ...] | None = None  # a step that moves external axes: E1..E5
         self.kind = CommandKind.of(command)
         self.before = before
         self.before_pose = before_pose
@@ -415,6 +416,9 @@ class CommandTracker:
         """The arm stands where this host sent it: the end point's X Y Z (within
         ARRIVAL_TOLERANCE mm) or a joint step's J1..J6 (within ARRIVAL_TOLERANCE_DEG)."""
         if pose is None:
+            return False
+        if self.target_ext is not None and not all(
+                abs(e - t) <= ARRIVAL_TOLERANCE for e, t in zip(pose.ext, self.target_ext, strict=False)):
             return False
         if self.target is not None:
             return math.dist(pose.xyzabc[:3], self.target) <= ARRIVAL_TOLERANCE

@@ -368,6 +368,28 @@ def test_a_joint_step_whose_status_never_changed_is_done_at_its_target_joints() 
     assert i == 2 and result.ok
 
 
+
+def test_a_step_that_moves_external_axes_is_done_only_when_they_arrived_too(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    """A joint step of J1 and E1 whose whole move a stalled host missed (0xFF before and after):
+    done when J1..J6 and E1..E5 stand where the host sent them; E1 short of it stays unknown."""
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
+    before = Pose(100.0, 0.0, 500.0, 180.0, 0.0, 0.0, joints=(0.0,) * 6)
+    ext_target = (3.0, 0.0, 0.0, 0.0, 0.0)
+    joints_there = (5.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    there = Pose(101.0, 9.0, 500.0, 180.0, 0.0, 5.0, ext=ext_target, joints=joints_there)
+    short = Pose(101.0, 9.0, 500.0, 180.0, 0.0, 5.0, ext=(1.0, 0.0, 0.0, 0.0, 0.0), joints=joints_there)
+    tr = CommandTracker(RunCommand.STEP_JOINT, st(DONE), before, 0.0)
+    tr.target_joints, tr.target_ext = joints_there, ext_target
+    i, result = feed(tr, [(0.01, st(DONE), there), (0.1, st(DONE), there), (0.41, st(DONE), there)])
+    assert i == 2 and result.ok and "arrived at the point" in result.message
+    tr = CommandTracker(RunCommand.STEP_JOINT, st(DONE), before, 0.0)
+    tr.target_joints, tr.target_ext = joints_there, ext_target
+    i, result = feed(tr, [(0.01, st(DONE), short), (0.1, st(DONE), short), (0.41, st(DONE), short),
+                          (0.8, st(DONE), short)])
+    assert i == 3 and not result.ok and "result is unknown" in result.message
+
+
 # --- the result pacer: when the second status read of an instant command goes out
 
 
