@@ -14,6 +14,7 @@ The envelopes and the encoders are in ``framing.py``, the exception texts in ``e
 
 from __future__ import annotations
 
+import struct
 from collections import OrderedDict, deque
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -102,7 +103,8 @@ class _Pdu:
 
 
 def _words(data: bytes) -> tuple[int, ...]:
-    return tuple(int.from_bytes(data[i : i + 2], "big") for i in range(0, len(data) - 1, 2))
+    count = len(data) // 2  # a trailing odd byte is left out
+    return struct.unpack(f">{count}H", data[: 2 * count])
 
 
 def _looks_like_response(function: int, body: bytes) -> bool:

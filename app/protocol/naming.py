@@ -7,16 +7,18 @@ turn them into the short English texts of the traffic inspector and the logs.
 
 from __future__ import annotations
 
+import bisect
 import datetime as dt
 import enum
 import math
 import struct
+from array import array
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Final
 
 from app.protocol import registers as regs
-from app.protocol.codec import WordOrder, registers_to_float
+from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout, decode_clock
 from app.protocol.enums import (
     CARTESIAN_AXIS_NAMES,
@@ -33,6 +35,7 @@ from app.protocol.enums import (
     decode_status_registers,
     program_state_text,
 )
+from app.protocol.float_text import format_float32
 
 SUMMARY_LIST_LIMIT: Final = 8  # values shown in a summary before "…"
 
@@ -81,38 +84,6 @@ class RegisterItem:
         """``GV202 orientation = 1.0 (changes)``."""
         who = f"{self.name} {self.role}" if self.role else self.name
         return f"{who} = {self.text}"
-
-
-def format_float32(value: float) -> str:
-    """The shortest text that reads back as the same float32 (``30.0``, ``0.1``, ``-1.0``)."""
-    if math.isnan(value):
-        return "nan"
-    if math.isinf(value):
-        return "inf" if value > 0 else "-inf"
-    try:
-        packed = struct.pack(">f", value)
-    except OverflowError:
-        return repr(value)
-
-    def shortened(digits: int) -> float | None:
-        candidate = float(f"{value:.{digits}g}")
-        try:
-            return candidate if struct.pack(">f", candidate) == packed else None
-        except OverflowError:
-            return None
-
-    # 9 significant digits always read back as the same float32; find the fewest that do
-    # (a binary search: this runs for every value the inspector shows).
-    low, high = 1, 9
-    best = shortened(high)
-    while low < high:
-        middle = (low + high) // 2
-        candidate = shortened(middle)
-        if candidate is None:
-            low = middle + 1
-        else:
-            best, high = candidate, middle
-    return repr(best if best is not None else value)
 
 
 def _integral(value: float) -> int | None:
@@ -310,10 +281,26 @@ def _gv_role(n: int, params_for: RunCommand | None) -> _GvRole:
     return _FIXED_GV_ROLES.get(n, ("", None))
 
 
-def _float_item(address: int, raw: tuple[int, ...], order: WordOrder, params_for: RunCommand | None
+# Decoded items by what decides them: a robot streaming its pose changes a few GVs per answer
+# and the rest repeat, so most items of an answer were made for an earlier one. Frozen items
+# are shared; each cache is cleared when full.
+ITEM_CACHE_SIZE: Final = 4096
+_FloatKey = tuple[int, int, int, bool, RunCommand | None]  # reg, words, low first, params_for
+_FLOAT_ITEMS: dict[_FloatKey, RegisterItem] = {}
+_INT_ITEMS: dict[tuple[int, int], RegisterItem] = {}
+_PARAM_GVS: Final = frozenset(n for roles in _PARAM_ROLES.values() for n in roles)
+# Registers decoded apart from GVs (table 1's integers, the status block with the clock and GV291).
+_APART: Final = _NOT_FLOAT | frozenset(_INT_REGISTERS)
+_APART_SORTED: Final = sorted(_APART)
+_WORD: Final = struct.Struct(">HH")
+_FLOAT: Final = struct.Struct(">f")
+
+
+def _float_item(address: int, raw: tuple[int, int], order: WordOrder, params_for: RunCommand | None
                 ) -> RegisterItem:
     n = address // 2
-    value = registers_to_float(raw, order)
+    high, low = (raw[1], raw[0]) if order is WordOrder.LOW_FIRST else raw
+    value: float = _FLOAT.unpack(_WORD.pack(high, low))[0]
     role, meaning = _gv_role(n, params_for)
     text = format_float32(value)
     extra = meaning(value) if meaning is not None else None
@@ -322,8 +309,53 @@ def _float_item(address: int, raw: tuple[int, ...], order: WordOrder, params_for
     return RegisterItem(address, raw, ItemKind.FLOAT, f"GV{n}", role, value, text)
 
 
+def _float_run(address: int, words: Sequence[int], start: int, end: int, order: WordOrder,
+               params_for: RunCommand | None, items: list[RegisterItem]) -> None:
+    """The GVs of ``words[start:end]`` (an even count from an even register), cached."""
+    low_first = order is WordOrder.LOW_FIRST
+    cache = _FLOAT_ITEMS
+    for k in range(start, end, 2):
+        reg = address + k
+        first, second = words[k], words[k + 1]
+        params = params_for if reg >> 1 in _PARAM_GVS else None
+        key = (reg, first, second, low_first, params)
+        item = cache.get(key)
+        if item is None:
+            item = _float_item(reg, (first, second), order, params)
+            if len(cache) >= ITEM_CACHE_SIZE:
+                cache.clear()
+            cache[key] = item
+        items.append(item)
+
+
+def _run_end(address: int, start: int, count: int) -> int:
+    """End of the run of whole GVs from ``words[start]`` (its register even and not apart)."""
+    reg = address + start
+    k = bisect.bisect_left(_APART_SORTED, reg)
+    apart = _APART_SORTED[k] if k < len(_APART_SORTED) else reg + count
+    return start + 2 * ((min(apart, address + count) - reg) // 2)
+
+
+def _int_item(reg: int, value: int, spec: _IntRegister) -> RegisterItem:
+    key = (reg, value)
+    item = _INT_ITEMS.get(key)
+    if item is None:
+        item = RegisterItem(reg, (value,), ItemKind.INTEGER, f"reg {reg}", spec.role, value, spec.text(value))
+        if len(_INT_ITEMS) >= ITEM_CACHE_SIZE:
+            _INT_ITEMS.clear()
+        _INT_ITEMS[key] = item
+    return item
+
+
 def _raw_item(address: int, value: int) -> RegisterItem:
     return RegisterItem(address, (value,), ItemKind.RAW, f"reg {address}", "", value, f"0x{value:04X}")
+
+
+def _words(values: Sequence[int]) -> list[int]:
+    try:
+        return array("H", values).tolist()  # 16-bit integers already: the usual case, in C
+    except (OverflowError, TypeError):
+        return [int(v) & 0xFFFF for v in values]
 
 
 def describe_registers(
@@ -345,20 +377,23 @@ def describe_registers(
     """
     if address < 0:
         raise ValueError(f"register address must be >= 0, got {address}")
-    words = [int(v) & 0xFFFF for v in values]
-    kind = CommandKind.of(last_command) if last_command is not None else None
+    words = _words(values)
+    count = len(words)
     items: list[RegisterItem] = []
     # A run from an odd GV register is not reading GVs: show its registers raw.
     floats = address % 2 == 0 or address in _NOT_FLOAT
     i = 0
-    while i < len(words):
+    while i < count:
         reg = address + i
-        left = len(words) - i
+        left = count - i
+        if floats and reg % 2 == 0 and left >= 2 and reg not in _APART and reg + 1 not in _APART:
+            end = _run_end(address, i, count)
+            _float_run(address, words, i, end, word_order, params_for, items)
+            i = end
+            continue
         spec = _INT_REGISTERS.get(reg)
         if spec is not None:
-            value = words[i]
-            items.append(RegisterItem(reg, (value,), ItemKind.INTEGER, f"reg {reg}", spec.role, value,
-                                      spec.text(value)))
+            items.append(_int_item(reg, words[i], spec))
             i += 1
         elif reg == _CLOCK_START and left >= _CLOCK_COUNT:
             raw = tuple(words[i : i + _CLOCK_COUNT])
@@ -368,12 +403,10 @@ def describe_registers(
             i += _CLOCK_COUNT
         elif reg == _COMMAND_STATUS_REG and left >= 2:
             raw = tuple(words[i : i + 2])
+            kind = CommandKind.of(last_command) if last_command is not None else None
             status = decode_command_status(kind, decode_status_registers(raw, word_order))
             text = f"{status.text} (0x{status.code:02X})"
             items.append(RegisterItem(reg, raw, ItemKind.COMMAND_STATUS, "GV291", "", status.code, text))
-            i += 2
-        elif floats and reg % 2 == 0 and left >= 2 and reg not in _NOT_FLOAT and reg + 1 not in _NOT_FLOAT:
-            items.append(_float_item(reg, (words[i], words[i + 1]), word_order, params_for))
             i += 2
         else:
             items.append(_raw_item(reg, words[i]))
@@ -414,6 +447,22 @@ def limited_list(texts: Sequence[str], limit: int = SUMMARY_LIST_LIMIT) -> str:
     return ", ".join(texts[:limit]) + f", … (+{len(texts) - limit})"
 
 
+def _listed(items: Sequence[RegisterItem], text: Callable[[RegisterItem], str],
+            limit: int = SUMMARY_LIST_LIMIT) -> str:
+    """``limited_list`` of ``text(item)``, formatting only the items it shows."""
+    if len(items) <= limit:
+        return ", ".join(map(text, items))
+    return ", ".join(map(text, items[:limit])) + f", … (+{len(items) - limit})"
+
+
+def _text(item: RegisterItem) -> str:
+    return item.text
+
+
+def _short(item: RegisterItem) -> str:
+    return item.short
+
+
 def _plain(items: Sequence[RegisterItem]) -> bool:
     """Items that read best as one list of values: role-less GVs, or raw registers."""
     return bool(items) and (all(it.kind is ItemKind.FLOAT and not it.role for it in items)
@@ -432,18 +481,18 @@ def summarize_registers(address: int, items: Sequence[RegisterItem]) -> str:
     label = range_label(address, items[-1].last - address + 1)
     shown = _summary_items(items)
     if _plain(shown):
-        return f"{label} = {limited_list([it.text for it in shown])}"
-    return f"{label}: {limited_list([it.short for it in shown])}"
+        return f"{label} = {_listed(shown, _text)}"
+    return f"{label}: {_listed(shown, _short)}"
 
 
 def write_summary(address: int, items: Sequence[RegisterItem]) -> str:
     if _plain(items):
         count = items[-1].last - address + 1
         who = _gv_span(address, count) if items[0].kind is ItemKind.FLOAT else range_label(address, count)
-        return f"write {who} = {limited_list([it.text for it in items])}"
+        return f"write {who} = {_listed(items, _text)}"
     if len(items) == 1:
         return f"write {items[0].label}"
-    return f"write {limited_list([it.short for it in items])}"
+    return f"write {_listed(items, _short)}"
 
 
 def single_write_text(address: int, value: int) -> str:

@@ -4,8 +4,13 @@
   a widget and the :class:`~app.safety.roles.Action` it performs); on each role change it is
   enabled or disabled with a tooltip naming the role it needs — never hidden. Panels with their
   own enable logic get ``set_edit_permission(reason)`` instead (points, planner).
-* **Idle lock**: an application event filter calls ``touch()`` on every key or mouse press; a
-  :data:`IDLE_POLL_MS` timer calls ``poll_idle()``, which locks back to operator.
+* **Idle lock**: ``touch()`` on every key or mouse press, wheel turn or touch; a
+  :data:`IDLE_POLL_MS` timer calls ``poll_idle()``, which locks back to operator. The input is
+  seen by an event filter on each window (:class:`QWindow`), where the window system delivers
+  it before it is passed on to the widget under the cursor or with the focus: an
+  application-wide filter would bring every event of every object (paints, timers, queued
+  calls: thousands a second while streaming) into Python. Windows are picked up when the focus
+  moves (a dialog, a new window) and on every idle poll (a popup); installing twice is a no-op.
 * **Envelope**: loaded from the profile file, edited in :class:`~ui.dialogs.envelope_dialog.
   EnvelopeDialog`; pushed whenever it or the mode changes to the views that draw it
   (:class:`EnvelopeView`: the 3D view's canvas; the planner hands it to its 2D preview), to the
@@ -22,8 +27,8 @@ from pathlib import Path
 from typing import Protocol
 
 from PySide6.QtCore import QEvent, QObject, QSettings, QTimer, Signal, Slot
-from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QAbstractItemView, QApplication, QWidget
+from PySide6.QtGui import QAction, QGuiApplication
+from PySide6.QtWidgets import QAbstractItemView, QWidget
 
 from app import timing
 from app.errors import TeachPadError
@@ -126,9 +131,18 @@ class SafetyController(QObject):
         self._idle_timer.setInterval(IDLE_POLL_MS)
         self._idle_timer.timeout.connect(self._poll_idle)
         self._idle_timer.start()
-        app = QApplication.instance()
-        if app is not None:
-            app.installEventFilter(self)
+        # A window may come before the focus moves to it or just after: look at once and again
+        # when the event loop is back (a zero timer, started at most once at a time).
+        self._look_again = QTimer(self)
+        self._look_again.setSingleShot(True)
+        self._look_again.setInterval(0)
+        self._look_again.timeout.connect(self._watch_windows)
+        app = QGuiApplication.instance()
+        self._app = app if isinstance(app, QGuiApplication) else None
+        if self._app is not None:
+            self._app.focusWindowChanged.connect(self._focus_moved)
+            self._app.focusObjectChanged.connect(self._focus_moved)
+        self._watch_windows()
         self._push_guard()
 
     @property
@@ -199,16 +213,30 @@ class SafetyController(QObject):
         self.roleChanged.emit(self.role)
 
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        # Installed on windows only (see the module docstring): input, and a few window events.
         if event.type() in _TOUCH_EVENTS:
             self.session.touch()
         return False
 
     @Slot()
+    def _focus_moved(self) -> None:
+        self._watch_windows()
+        self._look_again.start()
+
+    @Slot()
+    def _watch_windows(self) -> None:
+        """Watch every window for operator input (the ones already watched are left as they are)."""
+        for window in QGuiApplication.allWindows():
+            window.installEventFilter(self)
+
+    @Slot()
     def _poll_idle(self) -> None:
+        self._watch_windows()
         self.session.poll_idle()
 
     def set_idle_polling(self, on: bool) -> None:
         if on:
+            self._watch_windows()
             self._idle_timer.start()
         else:
             self._idle_timer.stop()
@@ -359,7 +387,11 @@ class SafetyController(QObject):
 
     def close(self) -> None:
         self._idle_timer.stop()
-        app = QApplication.instance()
-        if app is not None:
-            app.removeEventFilter(self)
+        self._look_again.stop()
+        if self._app is not None:
+            self._app.focusWindowChanged.disconnect(self._focus_moved)
+            self._app.focusObjectChanged.disconnect(self._focus_moved)
+            self._app = None
+        for window in QGuiApplication.allWindows():
+            window.removeEventFilter(self)
         self.session.audit.close()
