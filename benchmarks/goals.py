@@ -2,11 +2,17 @@
 
 Each entry: ``{"key": dotted path, "value": v, "goal": "≤ 15 %", "bound": 15.0, "met": bool}``;
 ``met`` is None when the figure is missing (a suite skipped) or carries no goal (report only).
+A figure without samples is null in the JSON with a ``not_measured`` reason beside it (see
+:func:`guarded` and ``benchmarks.gui_common.not_measured``); its goal entry says "not measured"
+(``status``) and carries that reason.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
+
+NOT_MEASURED = "not measured"
 
 # (dotted key, bound or None (report only), unit for the goal text, what it is)
 GOALS: tuple[tuple[str, float | None, str, str], ...] = (
@@ -45,10 +51,36 @@ def lookup(data: dict[str, Any], key: str) -> Any:
     return node
 
 
+def guarded(name: str, body: Callable[[], dict[str, Any]]) -> dict[str, Any]:
+    """``body()``, or -- when it fails (a saturated machine, a child that died) -- the figure
+    reported as not measured with the reason, so that one figure never ends the whole run."""
+    try:
+        return body()
+    except Exception as exc:  # the benchmark reports, it does not crash
+        return {"not_measured": f"{name} failed: {type(exc).__name__}: {str(exc)[:300]}"}
+
+
+def reason_for(data: dict[str, Any], key: str) -> str | None:
+    """The nearest ``not_measured`` reason on the way to ``key`` (deepest first)."""
+    node: Any = data
+    found: str | None = None
+    for part in key.split("."):
+        if not isinstance(node, dict):
+            break
+        if isinstance(node.get("not_measured"), str):
+            found = node["not_measured"]
+        if part not in node:
+            break
+        node = node[part]
+    if isinstance(node, dict) and isinstance(node.get("not_measured"), str):
+        found = node["not_measured"]
+    return found
+
+
 def derive(out: dict[str, Any]) -> None:
     """Figures the goals read that no suite writes directly."""
     startup = lookup(out, "gui.startup.teachpad_sim")
-    if isinstance(startup, dict):
+    if isinstance(startup, dict) and startup.get("first_paint_ms") is not None:
         # the start-up child marks sim_start_begin when SimController.start runs in the GUI process
         out["gui"]["startup"]["sim_in_gui_process"] = int("sim_start_begin_ms" in startup)
 
@@ -66,8 +98,14 @@ def goals(out: dict[str, Any]) -> dict[str, Any]:
             goal = "report only"
         else:
             goal = "no (0)" if bound == 0 and not unit else f"≤ {bound:g}{unit}"
-        entries.append({"key": key, "what": what, "value": round(number, 3) if number is not None else value,
-                        "goal": goal, "bound": bound, "met": met})
+        entry = {"key": key, "what": what, "value": round(number, 3) if number is not None else value,
+                 "goal": goal, "bound": bound, "met": met}
+        if number is None:
+            entry["status"] = NOT_MEASURED
+            reason = reason_for(out, key)
+            if reason is not None:
+                entry["reason"] = reason
+        entries.append(entry)
     judged = [e for e in entries if e["met"] is not None]
     missing = [e["key"] for e in entries if e["bound"] is not None and e["met"] is None]
     return {"entries": entries, "met": sum(1 for e in judged if e["met"]), "judged": len(judged),
@@ -79,7 +117,8 @@ def table(result: dict[str, Any]) -> str:
     lines = []
     for e in result["entries"]:
         mark = {True: "met", False: "NOT MET", None: "-"}[e["met"]]
-        lines.append(f"{e['what'][:66]:<66} {e['value']!s:>10}  {e['goal']:<12} {mark}")
+        value = e["value"] if e.get("status") != NOT_MEASURED else NOT_MEASURED
+        lines.append(f"{e['what'][:66]:<66} {value!s:>12}  {e['goal']:<12} {mark}")
     lines.append(f"goals met: {result['met']} of {result['judged']} judged"
                  + (f"; missing: {len(result['missing'])}" if result["missing"] else ""))
     return "\n".join(lines)

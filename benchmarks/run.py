@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from benchmarks.goals import goals, table
+from benchmarks.goals import goals, guarded, table
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -57,24 +57,25 @@ def main(argv: list[str] | None = None) -> int:
     if "core" in suites:
         from benchmarks import core
 
-        out["core"] = core.run(args.quick)
+        out["core"] = guarded("core", lambda: core.run(args.quick))
     if "gui" in suites:
         try:
             from benchmarks import gui
         except ImportError as exc:  # suite not written yet
             out["gui"] = {"skipped": str(exc)}
         else:
-            out["gui"] = gui.run(args.quick)
-            out["gui"]["memory"] = gui.run_memory(args.quick, args.long)
+            out["gui"] = guarded("gui", lambda: gui.run(args.quick))
+            out["gui"]["memory"] = guarded("gui.memory", lambda: gui.run_memory(args.quick, args.long))
     if "points" in suites:
         try:
             from benchmarks import points
         except ImportError as exc:
             out["points"] = {"skipped": str(exc)}
         else:
-            out["points"] = points.run(args.quick)
+            out["points"] = guarded("points", lambda: points.run(args.quick))
     if "safety" in suites:  # not in the default set: --only safety (or core,gui,points,safety)
-        out["safety"] = __import__("benchmarks.safety", fromlist=["run"]).run(args.quick)
+        safety = __import__("benchmarks.safety", fromlist=["run"])
+        out["safety"] = guarded("safety", lambda: safety.run(args.quick))
     out["total_s"] = time.perf_counter() - t0
     out["goals"] = goals(out)
     json.dump(out, sys.stdout, indent=2, sort_keys=True)

@@ -22,6 +22,9 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
   point, ``uploadProgress``, one final ``commandFinished``; ``cancel_upload`` or a stop end it.
 * :class:`~app.link.capture.TrafficCapture`, RTT and link statistics.
 
+The job bodies (``_do_stop`` ...) are in :mod:`app.link.commands`, the request API in
+:mod:`app.link.requests`.
+
 Stop latency: :meth:`RobotWorker.request_stop` writes the stop from the calling thread on the stop
 line (:mod:`app.link.stop_line`) when there is one; the stop job then writes it on the main link
 too, after the transaction in flight (ordering), and reads the line's answer. Without a line the
@@ -58,18 +61,18 @@ from app.errors import (
 )
 from app.link.capture import TrafficCapture
 from app.link.client import ConnectionSettings, RobotClient, TrafficRecord
-from app.link.jobs import Job, JobKind, JobQueue
+from app.link.commands import WorkerCommands
+from app.link.jobs import Job, JobQueue
 from app.link.jog import JogMachine, PreemptedError
 from app.link.motion import MotionCommands, MotionTracker
 from app.link.poller import Poller
 from app.link.requests import STOP_HANDOFF_WAIT, WorkerRequests
 from app.link.stats import LinkStats
-from app.link.stop_line import StopLine, StopSent
+from app.link.stop_line import StopLine
 from app.link.supervisor import DEFAULT_CANARY_GV, LinkSupervisor
-from app.link.types import ConnectionState, JogRequest, LinkState, Operation, WorkerError
-from app.link.upload import RawItem, Uploader
+from app.link.types import ConnectionState, LinkState, Operation, WorkerError
+from app.link.upload import Uploader
 from app.models import CommandResult, ControllerStatus, Pose
-from app.protocol.enums import WorkMode
 from app.safety.audit import AuditLog
 from app.safety.envelope import EnvelopeViolation
 from app.safety.jog_guard import JogGuard
@@ -82,7 +85,7 @@ _log = logging.getLogger(__name__)
 SHUTDOWN_TIMEOUT_MS = round(timing.SHUTDOWN_WAIT * 1000)
 
 
-class RobotWorker(WorkerRequests, QObject):
+class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     """Owns the RobotClient in the worker thread and composes the parts; see the module docstring."""
 
     poseChanged = Signal(Pose)  # noqa: N815
@@ -435,68 +438,3 @@ class RobotWorker(WorkerRequests, QObject):
             self._current_seq = outer_seq
             self.request_id = outer_id
             self._current_job = outer_job
-
-    def _done(self, text: str) -> None:
-        self.emit_result(CommandResult(None, None, None, True, text))
-
-    def _failed(self, text: str, request_id: int | None = -1) -> None:
-        self.emit_result(CommandResult(None, None, None, False, text), request_id)
-
-    # --- plain and urgent commands ------------------------------------------------------
-    def _do_stop(self, on_line: StopSent | None = None) -> None:  # on_line: sent on the stop line
-        client = self.client_or_raise()
-        try:
-            client.stop()  # first: nothing else goes out before the stop
-        finally:
-            if on_line is not None:  # its answer: checked, audited, shown in the traffic
-                self.stop_line.report(self.capture, self.audit)
-        now = time.monotonic()
-        job = self._current_job
-        if job is not None and job.sent is not None:
-            job.sent.set()  # the poster (the GUI thread) may go on
-        self.uploader.end("stopped")
-        self.jog.on_stop()
-        active = self.motion.take()
-        stop_seq = self._current_seq
-        for job in self._jobs.cancel(lambda j: j.kind is JobKind.MOTION and j.seq < stop_seq):
-            self._failed(f"{job.operation}: cancelled by Stop", job.request_id)
-        if active is not None:
-            self.emit_result(active.completion.stopped(now), active.request_id)
-        self._done("stop: sent")
-
-    def _do_cancel_upload(self) -> None:
-        """No controller stop: the upload ends after the point in progress; queued uploads are dropped."""
-        for job in self._jobs.cancel(lambda j: j.operation == Operation.UPLOAD_POINTS):
-            self._failed(f"{job.operation}: cancelled", job.request_id)
-        if self.uploader.run is None:
-            self._done(f"{Operation.CANCEL_UPLOAD}: no upload under way")
-            return
-        self.uploader.end("cancelled")
-        self._done(f"{Operation.CANCEL_UPLOAD}: the upload ends after the current point")
-
-    def _do_pause(self) -> None:
-        self.client_or_raise().pause()
-        self._done("pause: sent")
-
-    def _do_resume(self) -> None:
-        self.client_or_raise().resume()
-        self._done("resume: sent")
-
-    def _do_set_mode(self, mode: WorkMode) -> None:
-        mode = WorkMode(mode)
-        client = self.client_or_raise()
-        if mode is WorkMode.MANUAL:
-            self.jog.stop_jog_and_teach()
-        client.set_work_mode(mode)
-        self._done(f"work mode: {mode.name.lower()}")
-
-    def _do_jog_press(self, request: JogRequest) -> None:
-        self.motions.require_none(Operation.JOG)
-        self.jog.press(request)
-
-    # --- long commands ------------------------------------------------------------------
-    def _do_upload_points(self, raw: list[RawItem]) -> None:
-        """Case 2.2 for many points, tool by tool; runs in chunks, see :class:`Uploader`."""
-        self.motions.require_none(Operation.UPLOAD_POINTS)
-        if self.uploader.start(raw):
-            self._uploadStep.emit()

@@ -52,3 +52,31 @@ def test_busy_neighbour_ends_its_processes() -> None:
         assert len(children) == 1 and children[0].poll() is None
     assert all(child.poll() is not None for child in children)
     assert BusyNeighbour().procs == max(1, (os.cpu_count() or 2) - 1)
+
+
+def test_a_figure_without_samples_is_null_with_a_reason() -> None:
+    from benchmarks.gui_common import _summary_ms, ratio
+
+    empty = _summary_ms([], "the time budget ran out before a stop was measured")
+    assert empty["n"] == 0 and empty["p50_ms"] is None and empty["p99_ms"] is None
+    assert empty["not_measured"].startswith("the time budget")
+    assert ratio(empty["p50_ms"], 1.0) is None and ratio(2.0, 0.0) is None and ratio(2.0, 1.0) == 2.0
+    out = {"gui": {"sim_separate_process": {"stop_latency": {"gui_stop_button": empty}}}}
+    result = goals(out)
+    entry = next(e for e in result["entries"]
+                 if e["key"] == "gui.sim_separate_process.stop_latency.gui_stop_button.p99_ms")
+    assert entry["status"] == "not measured" and entry["met"] is None
+    assert entry["reason"].startswith("the time budget")
+    assert "not measured" in table(result) and result["all_met"] is False
+
+
+def test_a_failing_suite_is_reported_not_raised() -> None:
+    from benchmarks.goals import guarded
+
+    def broken() -> dict[str, object]:
+        raise KeyError("p50_ms")
+
+    out = {"gui": {"startup": guarded("startup", broken)}}
+    assert "KeyError" in out["gui"]["startup"]["not_measured"]
+    entry = next(e for e in goals(out)["entries"] if e["key"] == "gui.startup.ratio_first_paint_vs_bare")
+    assert entry["status"] == "not measured" and "startup failed" in entry["reason"]

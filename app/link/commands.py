@@ -1,0 +1,120 @@
+"""What the worker's jobs do: the plain, urgent and long commands of the worker.
+
+A mixin of :class:`~app.link.worker.RobotWorker` (kept apart from the worker's lifecycle, job
+execution and signals, like :mod:`app.link.requests`): every method runs in the worker thread as
+the body of one job, reports through ``emit_result`` and raises typed errors that
+:meth:`RobotWorker._execute` turns into signals.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import TYPE_CHECKING, Protocol
+
+from app.link.jobs import JobKind
+from app.link.types import JogRequest, Operation
+from app.link.upload import RawItem
+from app.models import CommandResult
+from app.protocol.enums import WorkMode
+
+if TYPE_CHECKING:
+    from app.link.capture import TrafficCapture
+    from app.link.client import RobotClient
+    from app.link.jobs import Job, JobQueue
+    from app.link.jog import JogMachine
+    from app.link.motion import MotionCommands, MotionTracker
+    from app.link.stop_line import StopLine, StopSent
+    from app.link.upload import Uploader
+    from app.safety.audit import AuditLog
+
+__all__ = ["WorkerCommands"]
+
+
+class _Step(Protocol):
+    def emit(self) -> None: ...
+
+
+class WorkerCommands:
+    """The ``_do_*`` job bodies of :class:`~app.link.worker.RobotWorker` (worker thread)."""
+
+    if TYPE_CHECKING:  # provided by RobotWorker
+        audit: AuditLog | None
+        capture: TrafficCapture
+        jog: JogMachine
+        motion: MotionTracker
+        motions: MotionCommands
+        stop_line: StopLine
+        uploader: Uploader
+        _jobs: JobQueue
+        _current_job: Job | None
+        _current_seq: int
+        _uploadStep: _Step  # noqa: N815
+
+        def client_or_raise(self) -> RobotClient: ...
+        def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None: ...
+
+
+    def _done(self, text: str) -> None:
+        self.emit_result(CommandResult(None, None, None, True, text))
+
+    def _failed(self, text: str, request_id: int | None = -1) -> None:
+        self.emit_result(CommandResult(None, None, None, False, text), request_id)
+
+    # --- plain and urgent commands ------------------------------------------------------
+    def _do_stop(self, on_line: StopSent | None = None) -> None:  # on_line: sent on the stop line
+        client = self.client_or_raise()
+        try:
+            client.stop()  # first: nothing else goes out before the stop
+        finally:
+            if on_line is not None:  # its answer: checked, audited, shown in the traffic
+                self.stop_line.report(self.capture, self.audit)
+        now = time.monotonic()
+        job = self._current_job
+        if job is not None and job.sent is not None:
+            job.sent.set()  # the poster (the GUI thread) may go on
+        self.uploader.end("stopped")
+        self.jog.on_stop()
+        active = self.motion.take()
+        stop_seq = self._current_seq
+        for job in self._jobs.cancel(lambda j: j.kind is JobKind.MOTION and j.seq < stop_seq):
+            self._failed(f"{job.operation}: cancelled by Stop", job.request_id)
+        if active is not None:
+            self.emit_result(active.completion.stopped(now), active.request_id)
+        self._done("stop: sent")
+
+    def _do_cancel_upload(self) -> None:
+        """No controller stop: the upload ends after the point in progress; queued uploads are dropped."""
+        for job in self._jobs.cancel(lambda j: j.operation == Operation.UPLOAD_POINTS):
+            self._failed(f"{job.operation}: cancelled", job.request_id)
+        if self.uploader.run is None:
+            self._done(f"{Operation.CANCEL_UPLOAD}: no upload under way")
+            return
+        self.uploader.end("cancelled")
+        self._done(f"{Operation.CANCEL_UPLOAD}: the upload ends after the current point")
+
+    def _do_pause(self) -> None:
+        self.client_or_raise().pause()
+        self._done("pause: sent")
+
+    def _do_resume(self) -> None:
+        self.client_or_raise().resume()
+        self._done("resume: sent")
+
+    def _do_set_mode(self, mode: WorkMode) -> None:
+        mode = WorkMode(mode)
+        client = self.client_or_raise()
+        if mode is WorkMode.MANUAL:
+            self.jog.stop_jog_and_teach()
+        client.set_work_mode(mode)
+        self._done(f"work mode: {mode.name.lower()}")
+
+    def _do_jog_press(self, request: JogRequest) -> None:
+        self.motions.require_none(Operation.JOG)
+        self.jog.press(request)
+
+    # --- long commands ------------------------------------------------------------------
+    def _do_upload_points(self, raw: list[RawItem]) -> None:
+        """Case 2.2 for many points, tool by tool; runs in chunks, see :class:`Uploader`."""
+        self.motions.require_none(Operation.UPLOAD_POINTS)
+        if self.uploader.start(raw):
+            self._uploadStep.emit()

@@ -1,0 +1,151 @@
+"""Stop latency (``stop_latency``): the GUI Stop button and the bare pymodbus floor; see
+:mod:`benchmarks.gui`."""
+
+from __future__ import annotations
+
+import functools
+import os
+import random
+import threading
+import time
+from typing import Any
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+from pymodbus.client import ModbusTcpClient
+from PySide6.QtCore import QCoreApplication, QEvent, QPointF, Qt, QTimer
+from PySide6.QtGui import QMouseEvent
+
+from app.protocol import registers as R  # noqa: N812
+from app.protocol.enums import ProgramMotionMode
+from app.sim import WriteRecord
+from benchmarks.gui_common import (
+    INPUT_PHASE_SPREAD_S,
+    POLL_HZ,
+    STOP_PROGRAM,
+    WARMUP_SAMPLES,
+    SimHandle,
+    _Counters,
+    _more_poses,
+    _motion_started,
+    _stop_sent,
+    _stop_write_after,
+    _summary_ms,
+    _wait_until,
+)
+from ui.main_window import MainWindow
+
+# --------------------------------------------------------------------------------------------
+# 1. Stop latency
+# --------------------------------------------------------------------------------------------
+
+
+def bench_stop_gui(window: MainWindow, sim: SimHandle, counters: _Counters, n: int, rng: random.Random,
+                   *, posted: bool = False, budget_s: float = float("inf")) -> dict[str, Any]:
+    """Stop at a random phase of the 100 Hz poll while program STOP_PROGRAM runs.
+
+    ``posted`` False: the Stop button's ``click()`` from a GUI-thread timer, t0 just before it
+    (the application's own path, click to wire). ``posted`` True: a mouse press and release
+    posted to the Stop button from another thread at a random time, t0 just before posting
+    (what an operator's click meets: the event loop has to get to it first).
+    Ends early, with fewer samples, after ``budget_s`` (a saturated GUI makes each sample slow).
+    """
+    link = window.link
+    button = window.control_bar.stop_button
+    spread = INPUT_PHASE_SPREAD_S if posted else 1.0 / POLL_HZ
+    latencies: list[float] = []
+    failures = 0
+    pending: dict[str, float | int] = {}
+    found: list[WriteRecord] = []
+    clicker = QTimer()
+    clicker.setSingleShot(True)
+    clicker.setTimerType(Qt.TimerType.PreciseTimer)
+
+    def click() -> None:
+        pending["t0"] = time.monotonic()
+        button.click()
+
+    def post_click(local: QPointF, screen: QPointF) -> None:  # runs in a timer thread
+        left, none, plain = Qt.MouseButton.LeftButton, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier
+        press = QMouseEvent(QEvent.Type.MouseButtonPress, local, screen, left, left, plain)
+        release = QMouseEvent(QEvent.Type.MouseButtonRelease, local, screen, left, none, plain)
+        pending["t0"] = time.monotonic()
+        QCoreApplication.postEvent(button, press)
+        QCoreApplication.postEvent(button, release)
+
+    def stop_seen() -> bool:
+        record = _stop_write_after(sim, int(pending["index"]))
+        if record is not None:
+            found.append(record)
+        return record is not None
+
+    clicker.timeout.connect(click)
+    deadline = time.monotonic() + budget_s
+    out: dict[str, Any] = {"budget_exhausted": False}
+    for i in range(n + WARMUP_SAMPLES):
+        if time.monotonic() > deadline:
+            out["budget_exhausted"] = True
+            break
+        # (Re)start the motion and wait until the simulator runs it and a poll has seen it.
+        start = sim.write_count()
+        link.run_program(STOP_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
+        if not _wait_until(functools.partial(_motion_started, sim, start)):
+            failures += 1
+            continue
+        poses = counters.poses
+        if not _wait_until(functools.partial(_more_poses, counters, poses)):
+            failures += 1
+            continue
+        # Just after a poll: a uniform delay over one poll period (posted input: over one paint
+        # period of the monitor, several polls) spreads the stop over the cycle.
+        found.clear()
+        pending.clear()
+        pending["index"] = sim.write_count()
+        pending["results"] = len(counters.results)
+        delay = rng.uniform(0.0, spread)
+        poster: threading.Timer | None = None
+        if posted:
+            local = QPointF(button.rect().center())
+            poster = threading.Timer(delay, post_click, (local, button.mapToGlobal(local)))
+            poster.start()
+        else:
+            clicker.start(int(1000.0 * delay))
+        seen = _wait_until(lambda: "t0" in pending) and _wait_until(stop_seen)
+        if poster is not None:
+            poster.join()
+        if not seen:
+            failures += 1
+            continue
+        # Let the worker finish the stop job ("stop: sent") before the next run request.
+        done = int(pending["results"])
+        if not _wait_until(functools.partial(_stop_sent, counters, done)):
+            failures += 1
+        if i >= WARMUP_SAMPLES:
+            latencies.append(found[0].t - float(pending["t0"]))
+    reason = ("the time budget ran out before a stop was measured" if out["budget_exhausted"]
+              else f"no stop measured ({failures} attempts failed)")
+    out.update(_summary_ms(latencies, reason))
+    out["failures"] = failures
+    return out
+
+
+def bench_stop_bare(sim: SimHandle, n: int, rng: random.Random) -> dict[str, Any]:
+    """441 <- 1 from a bare pymodbus client in a plain loop (random pauses, for the phase)."""
+    client = ModbusTcpClient("127.0.0.1", port=sim.port, timeout=1.0)
+    if not client.connect():
+        raise RuntimeError("bare pymodbus client could not connect to the simulator")
+    latencies: list[float] = []
+    try:
+        for i in range(n + WARMUP_SAMPLES):
+            time.sleep(rng.uniform(0.0, 1.0 / POLL_HZ))
+            index = sim.write_count()
+            t0 = time.monotonic()
+            client.write_register(R.REG_STOP, 1, device_id=sim.unit)
+            record = _stop_write_after(sim, index)
+            if record is None:
+                raise RuntimeError("the simulator did not log the bare client's stop")
+            if i >= WARMUP_SAMPLES:
+                latencies.append(record.t - t0)
+    finally:
+        client.close()
+    return _summary_ms(latencies)
