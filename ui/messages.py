@@ -98,6 +98,9 @@ _TEMPLATES: dict[str, str] = {
     "link_was_shut_down": QT_TRANSLATE_NOOP("Messages", "The link was shut down."),
     "outcome_unknown_link_lost": QT_TRANSLATE_NOOP("Messages", "{operation}: the connection was lost while it was under way; its outcome is unknown."),  # noqa: E501
     "outcome_unknown_link_closed": QT_TRANSLATE_NOOP("Messages", "{operation}: the connection was closed while it was under way."),  # noqa: E501
+    # queued requests the link never sent (app/link/worker.py fail_queued)
+    "queued_link_down": QT_TRANSLATE_NOOP("Messages", "{operation}: not sent, the connection to the controller is down."),  # noqa: E501
+    "queued_link_closed": QT_TRANSLATE_NOOP("Messages", "{operation}: not sent, the connection was closed."),
     # the point ledger's refusals (app/points/ledger.py): parts of a sentence ("P3, ID: refused, ...")
     "points_outside_range": QT_TRANSLATE_NOOP("Messages", "points outside {id_min}..{id_max}: {ids}"),
     "no_such_point": QT_TRANSLATE_NOOP("Messages", "there is no point P{id}"),

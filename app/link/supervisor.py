@@ -216,7 +216,7 @@ class LinkSupervisor:
         host.uploader.end(f"link lost: {cause}")
         self._fail_active("link lost while the command was under way; its outcome is unknown",
                           "outcome_unknown_link_lost")
-        host.fail_queued("the link to the controller is down")
+        host.fail_queued("the link to the controller is down: not sent", "queued_link_down")
         if self.client is not None:
             self.client.close()
         self._backoff_index = 0
@@ -246,7 +246,7 @@ class LinkSupervisor:
         self._fail_active(f"{operation}: the link was closed while the command was under way",
                           "outcome_unknown_link_closed")
         if fail_queued:
-            host.fail_queued(f"{operation}: the link was closed")
+            host.fail_queued(f"{operation}: the link was closed: not sent", "queued_link_closed")
         self.link_up = False
         self.answering = True
         if client is not None:

@@ -324,11 +324,12 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         rid = self.request_id if request_id == -1 else request_id
         self.errorOccurred.emit(WorkerError.from_exception(operation, exc, rid))
 
-    def fail_queued(self, message: str) -> None:
+    def fail_queued(self, message: str, code: str | None = None) -> None:
         held, self._held = list(self._held), deque()
         for job in [*held, *self._jobs.clear()]:
             if job.needs_link:
-                self.emit_error(job.operation, message, job.request_id)
+                reason = Reason(code, {"operation": job.operation}) if code else None
+                self.emit_error(job.operation, message, job.request_id, reason=reason)
 
     # --- timers and queued calls (worker thread) ----------------------------------------
     @Slot()

@@ -35,12 +35,10 @@ from app.protocol.framing import (
     split_rtu,
     split_tcp,
 )
-from app.protocol.naming import (
-    RegisterItem,
-    describe_registers,
+from app.protocol.naming import RegisterItem, describe_registers, run_command_of
+from app.protocol.summaries import (
     limited_list,
     range_label,
-    run_command_of,
     single_write_text,
     summarize_registers,
     write_summary,

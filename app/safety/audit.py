@@ -40,7 +40,8 @@ from typing import Any
 
 from app.errors import WriteBlocked
 from app.protocol.codec import WordOrder
-from app.protocol.naming import describe_registers, single_write_text, write_summary
+from app.protocol.naming import describe_registers
+from app.protocol.summaries import single_write_text, write_summary
 from app.safety.audit_read import (
     CSV_COLUMNS,
     FILE_RE,

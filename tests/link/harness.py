@@ -65,7 +65,7 @@ class PartsHost:
     def poll_if_due(self) -> None:
         pass
 
-    def fail_queued(self, message: str) -> None:
+    def fail_queued(self, message: str, code: str | None = None) -> None:
         self.out.append(("failQueued", message))
 
     def flush_traffic(self) -> None:

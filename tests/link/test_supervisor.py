@@ -42,7 +42,7 @@ def test_transport_failures_in_a_row_take_the_link_down_and_fail_the_queue(host:
     assert host.link_up
     host.supervisor.transport_failed("reset")
     assert not host.link_up and host.states()[-1] is LinkState.DOWN
-    assert host.of("failQueued") == ["the link to the controller is down"]
+    assert host.of("failQueued") == ["the link to the controller is down: not sent"]
 
 
 def test_reconnect_after_a_loss_says_reconnected(host: PartsHost, sim: Any) -> None:

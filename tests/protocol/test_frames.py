@@ -20,13 +20,7 @@ from app.protocol.framing import (
     encode_response,
     encode_write_gv,
 )
-from app.protocol.naming import (
-    ItemKind,
-    describe_registers,
-    format_float32,
-    range_label,
-    single_write_text,
-)
+from app.protocol.naming import ItemKind, describe_registers, format_float32
 from app.protocol.registers import (
     GV_EXPECTED_SPEED,
     GV_PARAM0,
@@ -42,6 +36,7 @@ from app.protocol.registers import (
     STATUS_BLOCK_START,
     gv_reg,
 )
+from app.protocol.summaries import range_label, single_write_text
 
 FC03 = FunctionCode.READ_HOLDING_REGISTERS
 FC06 = FunctionCode.WRITE_SINGLE_REGISTER

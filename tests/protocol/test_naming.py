@@ -11,7 +11,7 @@ from app.protocol import naming
 from app.protocol.codec import WordOrder, encode_floats, float_to_registers
 from app.protocol.enums import RunCommand
 from app.protocol.float_text import _search_float32_text, format_float32
-from app.protocol.naming import ItemKind, describe_registers, summarize_registers
+from app.protocol.naming import ItemKind, describe_registers
 from app.protocol.registers import (
     GV_PARAM0,
     POSE_BLOCK_COUNT,
@@ -22,6 +22,7 @@ from app.protocol.registers import (
     REG_RUN_COMMAND,
     gv_reg,
 )
+from app.protocol.summaries import summarize_registers
 
 _F32 = struct.Struct(">f")
 

@@ -273,6 +273,10 @@ def test_the_link_states_and_cut_short_commands_read_in_chinese(zh: None) -> Non
         result = CommandResult(None, None, None, False, "move to point: link lost",
                                reason=Reason(code, {"operation": Operation.MOVE_TO_POINT}))
         assert_chinese(result_text(result))
+    for code in ("queued_link_down", "queued_link_closed"):  # requests the link never sent
+        error = WorkerError(Operation.MOVE_TO_POINT, "not sent", 7,
+                            reason=Reason(code, {"operation": Operation.MOVE_TO_POINT}))
+        assert_chinese(error_text(error))
 
 
 def _plan_issues() -> list[Any]:
