@@ -23,6 +23,7 @@ sim: $(STAMP)
 
 lint: $(STAMP)
 	$(BIN)/ruff check app ui tests benchmarks
+	$(BIN)/ruff format --check app ui tests benchmarks
 	$(BIN)/mypy
 	$(BIN)/lint-imports
 

@@ -37,21 +37,28 @@ ALARM_MEANING: dict[Alarm, str] = {
     Alarm.ESTOP: QT_TRANSLATE_NOOP("Alarms", "The emergency stop circuit is open: servo power is off."),
     Alarm.SERVO: QT_TRANSLATE_NOOP("Alarms", "A servo drive reported a fault."),
     Alarm.BRAKE: QT_TRANSLATE_NOOP("Alarms", "A holding brake did not release or engage as commanded."),
-    Alarm.ALGORITHM: QT_TRANSLATE_NOOP("Alarms", "The motion planner rejected a move (out of reach, "
-                                                 "singularity or limit)."),
+    Alarm.ALGORITHM: QT_TRANSLATE_NOOP(
+        "Alarms", "The motion planner rejected a move (out of reach, singularity or limit)."
+    ),
     Alarm.ENCODER: QT_TRANSLATE_NOOP("Alarms", "An axis encoder angle is implausible or was lost."),
 }
 ALARM_ADVICE: dict[Alarm, str] = {
-    Alarm.ESTOP: QT_TRANSLATE_NOOP("Alarms", "Make the cell safe, release the emergency stop button, "
-                                             "then reset the alarm on the controller."),
-    Alarm.SERVO: QT_TRANSLATE_NOOP("Alarms", "Read the drive's fault code on the controller, remove "
-                                             "the cause, then reset the alarm."),
-    Alarm.BRAKE: QT_TRANSLATE_NOOP("Alarms", "Do not move the arm; check the brake wiring and power, "
-                                             "then reset the alarm."),
-    Alarm.ALGORITHM: QT_TRANSLATE_NOOP("Alarms", "Check the target point and speed, reset the alarm, "
-                                                 "then move to a reachable point."),
-    Alarm.ENCODER: QT_TRANSLATE_NOOP("Alarms", "Check the encoder cable; the zero position may need "
-                                               "recalibration before moving."),
+    Alarm.ESTOP: QT_TRANSLATE_NOOP(
+        "Alarms",
+        "Make the cell safe, release the emergency stop button, then reset the alarm on the controller.",
+    ),
+    Alarm.SERVO: QT_TRANSLATE_NOOP(
+        "Alarms", "Read the drive's fault code on the controller, remove the cause, then reset the alarm."
+    ),
+    Alarm.BRAKE: QT_TRANSLATE_NOOP(
+        "Alarms", "Do not move the arm; check the brake wiring and power, then reset the alarm."
+    ),
+    Alarm.ALGORITHM: QT_TRANSLATE_NOOP(
+        "Alarms", "Check the target point and speed, reset the alarm, then move to a reachable point."
+    ),
+    Alarm.ENCODER: QT_TRANSLATE_NOOP(
+        "Alarms", "Check the encoder cable; the zero position may need recalibration before moving."
+    ),
 }
 UNKNOWN_MEANING = QT_TRANSLATE_NOOP("Alarms", "A bit the protocol does not document.")
 UNKNOWN_ADVICE = QT_TRANSLATE_NOOP("Alarms", "Read the alarm on the controller's own pendant.")

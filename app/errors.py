@@ -30,8 +30,9 @@ class TeachPadError(Exception):
 
     code = "error"
 
-    def __init__(self, message: str = "", *, code: str | None = None,
-                 params: Mapping[str, Any] | None = None) -> None:
+    def __init__(
+        self, message: str = "", *, code: str | None = None, params: Mapping[str, Any] | None = None
+    ) -> None:
         super().__init__(message)
         if code is not None:
             self.code = code
@@ -63,10 +64,8 @@ class MalformedResponse(TeachPadError):
 
     code = "malformed_answer"
 
-    def __init__(self, message: str, *, field: str = "", expected: object = None,
-                 got: object = None) -> None:
-        super().__init__(message, params={"field": field, "expected": _short(expected),
-                                          "got": _short(got)})
+    def __init__(self, message: str, *, field: str = "", expected: object = None, got: object = None) -> None:
+        super().__init__(message, params={"field": field, "expected": _short(expected), "got": _short(got)})
         self.field = field
         self.expected = expected
         self.got = got
@@ -94,11 +93,23 @@ class CommandRefused(TeachPadError):
 
     code = "command_refused"
 
-    def __init__(self, status: CommandStatus, message: str | None = None, *,
-                 code: str | None = None, params: Mapping[str, Any] | None = None) -> None:
-        super().__init__(message or f"command failed: {status.text} (status {status.code})",
-                         code=code, params={"kind": status.kind.value if status.kind else None,
-                                            "status": status.code, **(params or {})})
+    def __init__(
+        self,
+        status: CommandStatus,
+        message: str | None = None,
+        *,
+        code: str | None = None,
+        params: Mapping[str, Any] | None = None,
+    ) -> None:
+        super().__init__(
+            message or f"command failed: {status.text} (status {status.code})",
+            code=code,
+            params={
+                "kind": status.kind.value if status.kind else None,
+                "status": status.code,
+                **(params or {}),
+            },
+        )
         self.status = status
 
 
@@ -114,8 +125,7 @@ class AlarmRaised(TeachPadError):
 
     code = "alarm_while_waiting"
 
-    def __init__(self, alarms: int, message: str, *,
-                 params: Mapping[str, Any] | None = None) -> None:
+    def __init__(self, alarms: int, message: str, *, params: Mapping[str, Any] | None = None) -> None:
         super().__init__(message, params={"alarms": alarms, **(params or {})})
         self.alarms = alarms
 

@@ -19,8 +19,10 @@ from app.sim.config import GV291_MODES, TIMING_PROFILES
 
 
 def _poses(n: int) -> list[tuple[int, list[float]]]:
-    return [(i, [300.0 + i % 100, -100.0 + i % 50, 300.0 + i % 20, 180.0, 0.0, float(i % 90)])
-            for i in range(1, n + 1)]
+    return [
+        (i, [300.0 + i % 100, -100.0 + i % 50, 300.0 + i % 20, 180.0, 0.0, float(i % 90)])
+        for i in range(1, n + 1)
+    ]
 
 
 def bench_profile(timing: str, gv291: str, n: int) -> dict[str, Any]:
@@ -58,5 +60,6 @@ def bench_profile(timing: str, gv291: str, n: int) -> dict[str, Any]:
 
 
 def bench_profiles(n: int) -> dict[str, Any]:
-    return {f"{t}_{g.replace('-', '_')}": bench_profile(t, g, n)
-            for t in TIMING_PROFILES for g in GV291_MODES}
+    return {
+        f"{t}_{g.replace('-', '_')}": bench_profile(t, g, n) for t in TIMING_PROFILES for g in GV291_MODES
+    }

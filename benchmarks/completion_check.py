@@ -52,8 +52,12 @@ def build_project(n: int) -> Project:
 
 def cli(port: int, *argv: str) -> tuple[int, str, str, float]:
     t0 = time.perf_counter()
-    proc = subprocess.run([sys.executable, "-m", "app.cli.main", "--host", "127.0.0.1", "--port", str(port),
-                           *argv], capture_output=True, text=True, check=False)
+    proc = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "--host", "127.0.0.1", "--port", str(port), *argv],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
     return proc.returncode, proc.stdout, proc.stderr, time.perf_counter() - t0
 
 
@@ -74,27 +78,45 @@ def main(argv: list[str] | None = None) -> int:
             before = sim.requests_count
             code, out, err, upload_s = cli(sim.port, "points", "upload", str(path))
             requests = sim.requests_count - before
-            reported = [line.split(": P", 1)[1].split(":", 1)[0]
-                        for line in err.splitlines() if ": P" in line]
+            reported = [
+                line.split(": P", 1)[1].split(":", 1)[0] for line in err.splitlines() if ": P" in line
+            ]
             held = sim.state().points
             ledger = load_project(path).ledger
             claimed = [p for p in ledger if p.sync is SyncState.ON_CONTROLLER]
-            false_ok = [p.id for p in claimed if p.id not in held  # float32 on the wire: compare to 1e-3
-                        or any(abs(a - b) > 1e-3 for a, b in zip(held[p.id], p.xyzabc, strict=True))]
+            false_ok = [
+                p.id
+                for p in claimed
+                if p.id not in held  # float32 on the wire: compare to 1e-3
+                or any(abs(a - b) > 1e-3 for a, b in zip(held[p.id], p.xyzabc, strict=True))
+            ]
             missing = [p.id for p in ledger if p.id != args.refuse and p.id not in held]
-            unconfirmed = next((int(line.split()[0]) for line in out.splitlines()
-                                if "unconfirmed" in line), 0)
+            unconfirmed = next(
+                (int(line.split()[0]) for line in out.splitlines() if "unconfirmed" in line), 0
+            )
             run_code, run_out, run_err, run_s = cli(sim.port, "run", str(path), "--plan", "helix")
     finally:
         sim.stop()
-    print(json.dumps({
-        "profile": f"{args.timing}/{args.gv291}", "points": args.points, "upload_exit": code,
-        "failed_reported": reported, "false_successes": len(false_ok), "missing_on_controller": len(missing),
-        "unconfirmed": unconfirmed, "requests_per_point": round(requests / args.points, 2),
-        "upload_s": round(upload_s, 1), "ms_per_point": round(1000 * upload_s / args.points, 2),
-        "run_exit": run_code, "run_s": round(run_s, 1),
-        "run_tail": (run_out.strip().splitlines() or [""])[-1][:120], "run_err": run_err.strip()[:200],
-    }))
+    print(
+        json.dumps(
+            {
+                "profile": f"{args.timing}/{args.gv291}",
+                "points": args.points,
+                "upload_exit": code,
+                "failed_reported": reported,
+                "false_successes": len(false_ok),
+                "missing_on_controller": len(missing),
+                "unconfirmed": unconfirmed,
+                "requests_per_point": round(requests / args.points, 2),
+                "upload_s": round(upload_s, 1),
+                "ms_per_point": round(1000 * upload_s / args.points, 2),
+                "run_exit": run_code,
+                "run_s": round(run_s, 1),
+                "run_tail": (run_out.strip().splitlines() or [""])[-1][:120],
+                "run_err": run_err.strip()[:200],
+            }
+        )
+    )
     return 0
 
 

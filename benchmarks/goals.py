@@ -16,26 +16,62 @@ NOT_MEASURED = "not measured"
 
 # (dotted key, bound or None (report only), unit for the goal text, what it is)
 GOALS: tuple[tuple[str, float | None, str, str], ...] = (
-    ("gui.sim_separate_process.event_loop_stall.streaming.gui_thread_cpu_pct", 15.0, " %",
-     "GUI-thread CPU while streaming at 100 Hz, monitor + traffic shown"),
-    ("gui.sim_separate_process.event_loop_stall.streaming.p99_ms", 16.0, " ms",
-     "event-loop p99 while streaming (simulator in its own process)"),
-    ("gui.sim_separate_process.event_loop_stall.streaming_busy.p99_ms", 16.0, " ms",
-     "event-loop p99 while streaming, busy second core"),
-    ("gui.sim_separate_process.event_loop_stall.streaming_busy.gui_thread_cpu_pct", 15.0, " %",
-     "GUI-thread CPU while streaming, busy second core"),
-    ("gui.startup.sim_in_gui_process", 0.0, "",
-     "teachpad --sim runs the simulator in its own process (0 = yes)"),
-    ("gui.sim_separate_process.stop_latency.gui_stop_button.p99_ms", 2.0, " ms",
-     "stop, GUI button -> write at the simulator, polling 100 Hz, p99"),
+    (
+        "gui.sim_separate_process.event_loop_stall.streaming.gui_thread_cpu_pct",
+        15.0,
+        " %",
+        "GUI-thread CPU while streaming at 100 Hz, monitor + traffic shown",
+    ),
+    (
+        "gui.sim_separate_process.event_loop_stall.streaming.p99_ms",
+        16.0,
+        " ms",
+        "event-loop p99 while streaming (simulator in its own process)",
+    ),
+    (
+        "gui.sim_separate_process.event_loop_stall.streaming_busy.p99_ms",
+        16.0,
+        " ms",
+        "event-loop p99 while streaming, busy second core",
+    ),
+    (
+        "gui.sim_separate_process.event_loop_stall.streaming_busy.gui_thread_cpu_pct",
+        15.0,
+        " %",
+        "GUI-thread CPU while streaming, busy second core",
+    ),
+    (
+        "gui.startup.sim_in_gui_process",
+        0.0,
+        "",
+        "teachpad --sim runs the simulator in its own process (0 = yes)",
+    ),
+    (
+        "gui.sim_separate_process.stop_latency.gui_stop_button.p99_ms",
+        2.0,
+        " ms",
+        "stop, GUI button -> write at the simulator, polling 100 Hz, p99",
+    ),
     ("gui.startup.ratio_first_paint_vs_bare", 3.0, "x", "first window paint vs a bare QMainWindow"),
-    ("points.project_load.ratio_load_vs_json", 3.0, "x",
-     "load a 10,000-point project vs json.load of the same file"),
-    ("core.upload_points.ratio_batched_vs_bound", 1.1, "x",
-     "upload points vs the minimal-transactions bound"),
+    (
+        "points.project_load.ratio_load_vs_json",
+        3.0,
+        "x",
+        "load a 10,000-point project vs json.load of the same file",
+    ),
+    (
+        "core.upload_points.ratio_batched_vs_bound",
+        1.1,
+        "x",
+        "upload points vs the minimal-transactions bound",
+    ),
     ("points.restore_all.ratio_vs_bound", 1.1, "x", "restore all points vs the minimal-transactions bound"),
-    ("core.upload_points_instant_controller.ratio_requests_vs_bound", 1.3, "x",
-     "requests on the wire per created point (instant controller) vs the bound"),
+    (
+        "core.upload_points_instant_controller.ratio_requests_vs_bound",
+        1.3,
+        "x",
+        "requests on the wire per created point (instant controller) vs the bound",
+    ),
     ("gui.memory.soak.growth_mb", 10.0, " MB", "RSS growth over the soak (10 minutes with --long)"),
     ("gui.memory.idle_rss_mb", None, " MB", "idle RSS of the GUI process after start-up (report only)"),
     ("core.monitor_cycle.ratio_robot_vs_bare", None, "x", "monitor cycle vs bare pymodbus (report only)"),
@@ -98,8 +134,14 @@ def goals(out: dict[str, Any]) -> dict[str, Any]:
             goal = "report only"
         else:
             goal = "no (0)" if bound == 0 and not unit else f"≤ {bound:g}{unit}"
-        entry = {"key": key, "what": what, "value": round(number, 3) if number is not None else value,
-                 "goal": goal, "bound": bound, "met": met}
+        entry = {
+            "key": key,
+            "what": what,
+            "value": round(number, 3) if number is not None else value,
+            "goal": goal,
+            "bound": bound,
+            "met": met,
+        }
         if number is None:
             entry["status"] = NOT_MEASURED
             reason = reason_for(out, key)
@@ -108,8 +150,13 @@ def goals(out: dict[str, Any]) -> dict[str, Any]:
         entries.append(entry)
     judged = [e for e in entries if e["met"] is not None]
     missing = [e["key"] for e in entries if e["bound"] is not None and e["met"] is None]
-    return {"entries": entries, "met": sum(1 for e in judged if e["met"]), "judged": len(judged),
-            "missing": missing, "all_met": bool(judged) and not missing and all(e["met"] for e in judged)}
+    return {
+        "entries": entries,
+        "met": sum(1 for e in judged if e["met"]),
+        "judged": len(judged),
+        "missing": missing,
+        "all_met": bool(judged) and not missing and all(e["met"] for e in judged),
+    }
 
 
 def table(result: dict[str, Any]) -> str:
@@ -119,6 +166,8 @@ def table(result: dict[str, Any]) -> str:
         mark = {True: "met", False: "NOT MET", None: "-"}[e["met"]]
         value = e["value"] if e.get("status") != NOT_MEASURED else NOT_MEASURED
         lines.append(f"{e['what'][:66]:<66} {value!s:>12}  {e['goal']:<12} {mark}")
-    lines.append(f"goals met: {result['met']} of {result['judged']} judged"
-                 + (f"; missing: {len(result['missing'])}" if result["missing"] else ""))
+    lines.append(
+        f"goals met: {result['met']} of {result['judged']} judged"
+        + (f"; missing: {len(result['missing'])}" if result["missing"] else "")
+    )
     return "\n".join(lines)

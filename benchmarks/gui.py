@@ -87,9 +87,24 @@ from ui.main_window import DEFAULT_SIZE, MainWindow
 from ui.settings import AppSettings
 
 # Re-exported: benchmarks.streaming and the tests import these from here.
-__all__ = ["POLL_HZ", "STREAM_PROGRAM", "BusyNeighbour", "RemoteSim", "_Counters", "_PaintCounter",
-           "_motion_started", "_qapp", "_run_for", "_wait_until", "bench_startup", "bench_window", "guarded",
-           "measure_stalls", "run", "run_memory"]
+__all__ = [
+    "POLL_HZ",
+    "STREAM_PROGRAM",
+    "BusyNeighbour",
+    "RemoteSim",
+    "_Counters",
+    "_PaintCounter",
+    "_motion_started",
+    "_qapp",
+    "_run_for",
+    "_wait_until",
+    "bench_startup",
+    "bench_window",
+    "guarded",
+    "measure_stalls",
+    "run",
+    "run_memory",
+]
 
 
 # --------------------------------------------------------------------------------------------
@@ -97,9 +112,18 @@ __all__ = ["POLL_HZ", "STREAM_PROGRAM", "BusyNeighbour", "RemoteSim", "_Counters
 # --------------------------------------------------------------------------------------------
 
 
-def bench_window(sim: SimHandle, stall_s: float, n_stop: int, rng: random.Random, *,
-                 complete: bool = True, n_posted: int = 0, stop_budget_s: float = float("inf"),
-                 posted_budget_s: float = float("inf"), busy_s: float = 0.0) -> dict[str, Any]:
+def bench_window(
+    sim: SimHandle,
+    stall_s: float,
+    n_stop: int,
+    rng: random.Random,
+    *,
+    complete: bool = True,
+    n_posted: int = 0,
+    stop_budget_s: float = float("inf"),
+    posted_budget_s: float = float("inf"),
+    busy_s: float = 0.0,
+) -> dict[str, Any]:
     """Stalls and stop latency with one main window on ``sim`` (see the module docstring).
 
     ``busy_s`` > 0 adds ``streaming_busy``: the same stream measured for ``busy_s`` while a
@@ -123,8 +147,11 @@ def bench_window(sim: SimHandle, stall_s: float, n_stop: int, rng: random.Random
     window: MainWindow | None = None
     out: dict[str, Any] = {}
     try:
-        window = MainWindow(link, AppSettings.from_file(Path(tmp.name) / "bench.ini"),
-                            autosave_dir=Path(tmp.name) / "autosave")
+        window = MainWindow(
+            link,
+            AppSettings.from_file(Path(tmp.name) / "bench.ini"),
+            autosave_dir=Path(tmp.name) / "autosave",
+        )
         # The offscreen screen is 800x800 and would clamp the window: use the desktop default.
         window.resize(*DEFAULT_SIZE)
         window.show_tab("monitor")
@@ -207,8 +234,9 @@ def bench_window(sim: SimHandle, stall_s: float, n_stop: int, rng: random.Random
         }
         lap("stop_clicks")
         if complete:
-            stops["gui_posted_mouse_click"] = bench_stop_gui(window, sim, counters, n_posted, rng,
-                                                             posted=True, budget_s=posted_budget_s)
+            stops["gui_posted_mouse_click"] = bench_stop_gui(
+                window, sim, counters, n_posted, rng, posted=True, budget_s=posted_budget_s
+            )
             lap("stop_posted_input")
             stops["bare_pymodbus_while_polling"] = bench_stop_bare(sim, n_stop, rng)
         out["stop_latency"] = stops
@@ -245,14 +273,32 @@ def run(quick: bool) -> dict[str, Any]:
     # Sample counts, and time budgets that keep the suite bounded when the GUI is saturated.
     stall_s, n_stop, n_posted = (3.0, 50, 30) if quick else (10.0, 200, 100)
     stop_budget, posted_budget = (4.0, 3.0) if quick else (10.0, 6.0)
-    out["sim_in_process"] = guarded("sim_in_process", lambda: _with_sim(LocalSim, lambda sim: bench_window(
-        sim, stall_s, n_stop, rng, n_posted=n_posted, stop_budget_s=stop_budget,
-        posted_budget_s=posted_budget)))
+    out["sim_in_process"] = guarded(
+        "sim_in_process",
+        lambda: _with_sim(
+            LocalSim,
+            lambda sim: bench_window(
+                sim,
+                stall_s,
+                n_stop,
+                rng,
+                n_posted=n_posted,
+                stop_budget_s=stop_budget,
+                posted_budget_s=posted_budget,
+            ),
+        ),
+    )
     # The simulator in its own process, as a real controller would be: no GIL shared with it.
     stall_s, n_stop, stop_budget = (2.0, 20, 2.0) if quick else (4.0, 60, 3.0)
-    out["sim_separate_process"] = guarded("sim_separate_process", lambda: _with_sim(
-        RemoteSim, lambda sim: bench_window(sim, stall_s, n_stop, rng, complete=False,
-                                            stop_budget_s=stop_budget, busy_s=stall_s)))
+    out["sim_separate_process"] = guarded(
+        "sim_separate_process",
+        lambda: _with_sim(
+            RemoteSim,
+            lambda sim: bench_window(
+                sim, stall_s, n_stop, rng, complete=False, stop_budget_s=stop_budget, busy_s=stall_s
+            ),
+        ),
+    )
     t1 = time.perf_counter()
     out["startup"] = guarded("startup", lambda: bench_startup(1 if quick else 3))
     out["startup"]["suite_s"] = time.perf_counter() - t1

@@ -203,8 +203,15 @@ class RemoteSim:
 
     def __init__(self) -> None:
         env = dict(os.environ, PYTHONPATH=str(REPO))
-        self._proc = subprocess.Popen([sys.executable, "-c", _SIM_HOST_CHILD], cwd=REPO, env=env, text=True,
-                                      stdin=subprocess.PIPE, stdout=subprocess.PIPE, bufsize=1)
+        self._proc = subprocess.Popen(
+            [sys.executable, "-c", _SIM_HOST_CHILD],
+            cwd=REPO,
+            env=env,
+            text=True,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            bufsize=1,
+        )
         self.port, self.unit = self._read()
 
     def _read(self) -> Any:
@@ -251,8 +258,9 @@ def _per_100hz(figures: dict[str, Any]) -> None:
     """Add ``gui_thread_cpu_pct_per_100hz``: the GUI thread's CPU per poll delivered, scaled to
     100 polls a second (a loaded machine delivers fewer polls, and so less work, than asked)."""
     if "gui_thread_cpu_pct" in figures and figures.get("polls_per_s", 0) > 0:
-        figures["gui_thread_cpu_pct_per_100hz"] = (figures["gui_thread_cpu_pct"] * POLL_HZ
-                                                   / figures["polls_per_s"])
+        figures["gui_thread_cpu_pct_per_100hz"] = (
+            figures["gui_thread_cpu_pct"] * POLL_HZ / figures["polls_per_s"]
+        )
 
 
 def _stop_write_after(sim: SimHandle, start: int) -> WriteRecord | None:

@@ -83,13 +83,29 @@ def bench_memory(soak_s: float, every_s: float) -> dict[str, Any]:
     """RSS of a ``teachpad --sim`` process: idle after start-up, then over a streaming soak."""
     with tempfile.TemporaryDirectory(prefix="teachpad-bench-") as tmp:
         user = Path(tmp)
-        env = dict(os.environ, QT_QPA_PLATFORM="offscreen", PYTHONPATH=str(REPO),
-                   **{f"XDG_{d}_HOME": str(user / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")})
-        args = [str(user / "teachpad.ini"), "{}x{}".format(*DEFAULT_SIZE), str(soak_s), str(every_s),
-                str(MEMORY_SETTLE_S), str(STREAM_PROGRAM)]
-        proc = subprocess.run([sys.executable, "-c", _MEMORY_CHILD, *args], cwd=REPO, env=env,
-                              capture_output=True, text=True, check=False,
-                              timeout=STARTUP_TIMEOUT_S + MEMORY_SETTLE_S + soak_s + 120)
+        env = dict(
+            os.environ,
+            QT_QPA_PLATFORM="offscreen",
+            PYTHONPATH=str(REPO),
+            **{f"XDG_{d}_HOME": str(user / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
+        )
+        args = [
+            str(user / "teachpad.ini"),
+            "{}x{}".format(*DEFAULT_SIZE),
+            str(soak_s),
+            str(every_s),
+            str(MEMORY_SETTLE_S),
+            str(STREAM_PROGRAM),
+        ]
+        proc = subprocess.run(
+            [sys.executable, "-c", _MEMORY_CHILD, *args],
+            cwd=REPO,
+            env=env,
+            capture_output=True,
+            text=True,
+            check=False,
+            timeout=STARTUP_TIMEOUT_S + MEMORY_SETTLE_S + soak_s + 120,
+        )
     rows = [json.loads(x[4:]) for x in proc.stdout.splitlines() if x.startswith("RSS ")]
     idle = next((r for r in rows if r["kind"] == "idle"), None)
     if proc.returncode != 0 or idle is None:
@@ -97,7 +113,7 @@ def bench_memory(soak_s: float, every_s: float) -> dict[str, Any]:
     soak = [r for r in rows if r["kind"] == "soak"]
     out: dict[str, Any] = {
         "what": "VmRSS of teachpad --sim (the GUI process), idle connected, then streaming program "
-                f"{STREAM_PROGRAM} at {POLL_HZ:g} Hz polling",
+        f"{STREAM_PROGRAM} at {POLL_HZ:g} Hz polling",
         "idle_rss_mb": round(idle["rss_mb"], 1),
         "first_pose_rss_mb": round(next(r["rss_mb"] for r in rows if r["kind"] == "first_pose"), 1),
     }

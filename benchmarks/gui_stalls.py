@@ -49,10 +49,16 @@ def measure_stalls(seconds: float) -> dict[str, Any]:
     cpu_gui, cpu_process = time.thread_time() - cpu_gui, time.process_time() - cpu_process
     gaps = [b - a for a, b in itertools.pairwise(stamps)]
     if not gaps:
-        return {**not_measured("the probe timer fired less than twice (event loop starved)",
-                               ("p50_ms", "p99_ms", "p999_ms", "max_ms")),
-                "firings": len(stamps), "seconds": wall,
-                "gui_thread_cpu_pct": 100.0 * cpu_gui / wall, "process_cpu_pct": 100.0 * cpu_process / wall}
+        return {
+            **not_measured(
+                "the probe timer fired less than twice (event loop starved)",
+                ("p50_ms", "p99_ms", "p999_ms", "max_ms"),
+            ),
+            "firings": len(stamps),
+            "seconds": wall,
+            "gui_thread_cpu_pct": 100.0 * cpu_gui / wall,
+            "process_cpu_pct": 100.0 * cpu_process / wall,
+        }
     gaps_ms = [1000.0 * g for g in gaps]
     worst = max(range(len(gaps)), key=gaps.__getitem__)
     # gaps that start after the first second: the steady state, without start-of-stream work
@@ -76,7 +82,6 @@ def measure_stalls(seconds: float) -> dict[str, Any]:
         "gui_thread_cpu_pct": 100.0 * cpu_gui / wall,
         "process_cpu_pct": 100.0 * cpu_process / wall,
     }
-
 
 
 # --------------------------------------------------------------------------------------------
@@ -105,8 +110,9 @@ class BusyNeighbour:
         self._children.clear()
 
 
-def _measure_streaming_busy(window: MainWindow, sim: SimHandle, counters: _Counters,
-                            seconds: float) -> dict[str, Any]:
+def _measure_streaming_busy(
+    window: MainWindow, sim: SimHandle, counters: _Counters, seconds: float
+) -> dict[str, Any]:
     """The streaming figures again, with :class:`BusyNeighbour` running."""
     with BusyNeighbour() as busy:
         _run_for(0.2)  # let the neighbours reach full speed

@@ -110,17 +110,28 @@ def _startup_once(kind: str, home: Path, run: int) -> dict[str, float]:
     # A fresh settings file and per-user directories: no saved layout, project or autosave to
     # restore (a recovery question would wait for an answer).
     user = home / f"{kind}{run}"
-    env = dict(os.environ, QT_QPA_PLATFORM="offscreen", PYTHONPATH=str(REPO),
-               **{f"XDG_{d}_HOME": str(user / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")})
+    env = dict(
+        os.environ,
+        QT_QPA_PLATFORM="offscreen",
+        PYTHONPATH=str(REPO),
+        **{f"XDG_{d}_HOME": str(user / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
+    )
     args = [kind, str(user / "teachpad.ini"), "{}x{}".format(*DEFAULT_SIZE)]
     t_spawn = time.monotonic()
-    proc = subprocess.run([sys.executable, "-c", _STARTUP_CHILD, *args], cwd=REPO, env=env,
-                          capture_output=True, text=True, timeout=STARTUP_TIMEOUT_S, check=False)
+    proc = subprocess.run(
+        [sys.executable, "-c", _STARTUP_CHILD, *args],
+        cwd=REPO,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=STARTUP_TIMEOUT_S,
+        check=False,
+    )
     t_exit = time.monotonic()
     line = next((x for x in proc.stdout.splitlines() if x.startswith("BENCH ")), None)
     if proc.returncode != 0 or line is None:
         raise RuntimeError(f"start-up child ({kind}) failed, rc={proc.returncode}: {proc.stderr[-2000:]}")
-    marks = json.loads(line[len("BENCH "):])
+    marks = json.loads(line[len("BENCH ") :])
     out = {f"{name}_ms": 1000.0 * (t - t_spawn) for name, t in marks.items()}
     out["process_total_ms"] = 1000.0 * (t_exit - t_spawn)
     return out
@@ -150,6 +161,7 @@ def bench_startup(runs: int) -> dict[str, Any]:
             continue
         keys = sorted(set.intersection(*(set(m) for m in runs_marks)))
         out[name] = {k: statistics.median(m[k] for m in runs_marks) for k in keys}
-    out["ratio_first_paint_vs_bare"] = ratio(out["teachpad_sim"].get("first_paint_ms"),
-                                             out["bare_qmainwindow"].get("first_paint_ms"))
+    out["ratio_first_paint_vs_bare"] = ratio(
+        out["teachpad_sim"].get("first_paint_ms"), out["bare_qmainwindow"].get("first_paint_ms")
+    )
     return out

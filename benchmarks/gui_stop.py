@@ -40,8 +40,16 @@ from ui.main_window import MainWindow
 # --------------------------------------------------------------------------------------------
 
 
-def bench_stop_gui(window: MainWindow, sim: SimHandle, counters: _Counters, n: int, rng: random.Random,
-                   *, posted: bool = False, budget_s: float = float("inf")) -> dict[str, Any]:
+def bench_stop_gui(
+    window: MainWindow,
+    sim: SimHandle,
+    counters: _Counters,
+    n: int,
+    rng: random.Random,
+    *,
+    posted: bool = False,
+    budget_s: float = float("inf"),
+) -> dict[str, Any]:
     """Stop at a random phase of the 100 Hz poll while program STOP_PROGRAM runs.
 
     ``posted`` False: the Stop button's ``click()`` from a GUI-thread timer, t0 just before it
@@ -122,8 +130,11 @@ def bench_stop_gui(window: MainWindow, sim: SimHandle, counters: _Counters, n: i
             failures += 1
         if i >= WARMUP_SAMPLES:
             latencies.append(found[0].t - float(pending["t0"]))
-    reason = ("the time budget ran out before a stop was measured" if out["budget_exhausted"]
-              else f"no stop measured ({failures} attempts failed)")
+    reason = (
+        "the time budget ran out before a stop was measured"
+        if out["budget_exhausted"]
+        else f"no stop measured ({failures} attempts failed)"
+    )
     out.update(_summary_ms(latencies, reason))
     out["failures"] = failures
     return out

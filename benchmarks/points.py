@@ -69,8 +69,13 @@ def _median_ms(fn: Callable[[], object], repeats: int) -> float:
 def _points(n: int) -> list[TempPoint]:
     """``n`` points in front of the arm, tool down; ids 1..n."""
     return [
-        make_point(i, f"p{i}", (300.0 + i % 100, -100.0 + i % 50, 300.0 + i % 20, 180.0, 0.0, float(i % 90)),
-                   note="bench" if i % 10 == 0 else "", sync=SyncState.UNKNOWN)
+        make_point(
+            i,
+            f"p{i}",
+            (300.0 + i % 100, -100.0 + i % 50, 300.0 + i % 20, 180.0, 0.0, float(i % 90)),
+            note="bench" if i % 10 == 0 else "",
+            sync=SyncState.UNKNOWN,
+        )
         for i in range(1, n + 1)
     ]
 
@@ -90,8 +95,13 @@ def bench_load(path: Path, repeats: int) -> dict[str, Any]:
     load_ms = [_median_ms(product, 1) for _ in range(repeats)]
     json_ms = [_median_ms(baseline, 1) for _ in range(repeats)]
     load, base = statistics.median(load_ms), statistics.median(json_ms)
-    return {"points": PROJECT_POINTS, "file_bytes": path.stat().st_size, "load_project_ms": load,
-            "json_load_ms": base, "ratio_load_vs_json": round(load / base, 2)}
+    return {
+        "points": PROJECT_POINTS,
+        "file_bytes": path.stat().st_size,
+        "load_project_ms": load,
+        "json_load_ms": base,
+        "ratio_load_vs_json": round(load / base, 2),
+    }
 
 
 def _qt_app() -> Any:
@@ -187,9 +197,13 @@ def bench_show(project: Project, repeats: int) -> dict[str, Any]:
     product_ms = [_ms(show(product)) for _ in range(repeats)]
     baseline_ms = [_ms(show(MinimalModel)) for _ in range(repeats)]
     shown, base = statistics.median(product_ms), statistics.median(baseline_ms)
-    return {"points": rows, "show_ms": shown, "minimal_model_show_ms": base,
-            "ratio_vs_minimal_model": round(shown / base, 2),
-            "what": "PointsModel + PointFilterProxy + QTableView, construction to first paint (offscreen)"}
+    return {
+        "points": rows,
+        "show_ms": shown,
+        "minimal_model_show_ms": base,
+        "ratio_vs_minimal_model": round(shown / base, 2),
+        "what": "PointsModel + PointFilterProxy + QTableView, construction to first paint (offscreen)",
+    }
 
 
 # --- restore all -----------------------------------------------------------------------------------
@@ -273,8 +287,11 @@ def _plan(segments: int) -> tuple[Plan, PointLedger]:
     pts = []
     for i in range(1, count + 1):
         t = 0.35 * i
-        pts.append(make_point(i, "", (450.0 + 80.0 * math.cos(t), 80.0 * math.sin(t), 300.0 + 0.05 * i,
-                                      180.0, 0.0, 0.0)))
+        pts.append(
+            make_point(
+                i, "", (450.0 + 80.0 * math.cos(t), 80.0 * math.sin(t), 300.0 + 0.05 * i, 180.0, 0.0, 0.0)
+            )
+        )
     ledger = PointLedger(pts)
     segs: list[Segment] = []
     pid = 1
@@ -354,9 +371,13 @@ def bench_preview(repeats: int) -> dict[str, Any]:
         preview.deleteLater()
         app.processEvents()
     redraw_big, redraw_small = statistics.median(big_ms), statistics.median(small_ms)
-    return {"segments": PLAN_SEGMENTS, "redraw_ms": redraw_big, "redraw_10_segments_ms": redraw_small,
-            "ratio_vs_10_segments": round(redraw_big / redraw_small, 2),
-            "what": "PlanPreview.set_path (3 projections) until all three plots painted (offscreen)"}
+    return {
+        "segments": PLAN_SEGMENTS,
+        "redraw_ms": redraw_big,
+        "redraw_10_segments_ms": redraw_small,
+        "ratio_vs_10_segments": round(redraw_big / redraw_small, 2),
+        "what": "PlanPreview.set_path (3 projections) until all three plots painted (offscreen)",
+    }
 
 
 def run(quick: bool) -> dict[str, Any]:

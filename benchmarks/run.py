@@ -32,8 +32,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--quick", action="store_true", help="small N and short windows")
     parser.add_argument("--long", action="store_true", help="memory soak of 10 minutes (RSS every 30 s)")
     parser.add_argument("--only", default="core,gui,points", help="comma-separated suites")
-    parser.add_argument("--no-compile", action="store_true",
-                        help="do not compile app/ and ui/ first (start-up then includes compiling)")
+    parser.add_argument(
+        "--no-compile",
+        action="store_true",
+        help="do not compile app/ and ui/ first (start-up then includes compiling)",
+    )
     args = parser.parse_args(argv)
     suites = {s.strip() for s in args.only.split(",") if s.strip()}
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")

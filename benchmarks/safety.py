@@ -52,15 +52,26 @@ def run(quick: bool = False) -> dict[str, Any]:
     motion = JogMotion(TeachFrame.BASE, 1, 1, 50.0)
     out["jog_guard_us_per_decision"] = round(_per_call_us(lambda: guard.decide(pose, motion), 2000), 1)
     n = 20 if quick else 100
-    ledger = PointLedger([make_point(i + 1, pose=(400 * (i % 2) - 200, 300 * ((i // 2) % 2) - 150, 400,
-                                                  180, 0, 0)) for i in range(n + 1)])
-    segs = [Segment(SegmentKind.ARC, end_id=i + 2, via_id=i + 1, speed=100) if i % 2 else
-            Segment(SegmentKind.LINE, end_id=i + 1, speed=100) for i in range(n)]
+    ledger = PointLedger(
+        [
+            make_point(i + 1, pose=(400 * (i % 2) - 200, 300 * ((i // 2) % 2) - 150, 400, 180, 0, 0))
+            for i in range(n + 1)
+        ]
+    )
+    segs = [
+        Segment(SegmentKind.ARC, end_id=i + 2, via_id=i + 1, speed=100)
+        if i % 2
+        else Segment(SegmentKind.LINE, end_id=i + 1, speed=100)
+        for i in range(n)
+    ]
     plan = Plan("bench", segs)
     t0 = time.perf_counter()
     found = plan_violations(plan, ledger, ENV, Pose(0, 0, 400, 180, 0, 0))
-    out["plan_check_ms"] = {"segments": n, "ms": round((time.perf_counter() - t0) * 1e3, 1),
-                            "violations": len(found)}
+    out["plan_check_ms"] = {
+        "segments": n,
+        "ms": round((time.perf_counter() - t0) * 1e3, 1),
+        "violations": len(found),
+    }
     return out
 
 

@@ -65,8 +65,17 @@ from benchmarks.traffic import Feed
 from ui.main_window import DEFAULT_SIZE, MainWindow
 from ui.settings import AppSettings
 
-_KEYS = ("gui_thread_cpu_pct", "gui_thread_cpu_pct_per_100hz", "process_cpu_pct", "p50_ms", "p99_ms",
-         "max_ms", "time_in_gaps_over_16ms_pct", "polls_per_s", "poses_per_s")
+_KEYS = (
+    "gui_thread_cpu_pct",
+    "gui_thread_cpu_pct_per_100hz",
+    "process_cpu_pct",
+    "p50_ms",
+    "p99_ms",
+    "max_ms",
+    "time_in_gaps_over_16ms_pct",
+    "polls_per_s",
+    "poses_per_s",
+)
 
 
 @contextmanager
@@ -77,8 +86,11 @@ def streaming_window(sim: RemoteSim) -> Iterator[tuple[MainWindow, _Counters]]:
     link = RobotLink(poll_hz=POLL_HZ)
     window: MainWindow | None = None
     try:
-        window = MainWindow(link, AppSettings.from_file(Path(tmp.name) / "bench.ini"),
-                            autosave_dir=Path(tmp.name) / "autosave")
+        window = MainWindow(
+            link,
+            AppSettings.from_file(Path(tmp.name) / "bench.ini"),
+            autosave_dir=Path(tmp.name) / "autosave",
+        )
         window.resize(*DEFAULT_SIZE)
         window.show_tab("monitor")
         counters = _Counters(link)
@@ -112,8 +124,12 @@ def streaming_window(sim: RemoteSim) -> Iterator[tuple[MainWindow, _Counters]]:
         tmp.cleanup()
 
 
-def _stream(sim: RemoteSim, counters: _Counters, seconds: float, profiler: cProfile.Profile | None,
-            ) -> dict[str, Any]:
+def _stream(
+    sim: RemoteSim,
+    counters: _Counters,
+    seconds: float,
+    profiler: cProfile.Profile | None,
+) -> dict[str, Any]:
     poses0, requests0 = counters.poses, sim.requests()
     if profiler is not None:
         profiler.enable()
@@ -128,8 +144,9 @@ def _stream(sim: RemoteSim, counters: _Counters, seconds: float, profiler: cProf
     return {k: round(out[k], 2) for k in _KEYS if k in out}
 
 
-def run_once(seconds: float, *, busy: bool, variants: bool, profiler: cProfile.Profile | None
-             ) -> dict[str, Any]:
+def run_once(
+    seconds: float, *, busy: bool, variants: bool, profiler: cProfile.Profile | None
+) -> dict[str, Any]:
     sim = RemoteSim()
     try:
         with streaming_window(sim) as (window, counters):
@@ -162,8 +179,11 @@ def run_synthetic(seconds: float, profiler: cProfile.Profile | None) -> dict[str
     link = RobotLink(poll_hz=POLL_HZ)
     window: MainWindow | None = None
     try:
-        window = MainWindow(link, AppSettings.from_file(Path(tmp.name) / "bench.ini"),
-                            autosave_dir=Path(tmp.name) / "autosave")
+        window = MainWindow(
+            link,
+            AppSettings.from_file(Path(tmp.name) / "bench.ini"),
+            autosave_dir=Path(tmp.name) / "autosave",
+        )
         window.resize(*DEFAULT_SIZE)
         window.show_tab("monitor")
         painted = _PaintCounter()
@@ -184,8 +204,16 @@ def run_synthetic(seconds: float, profiler: cProfile.Profile | None) -> dict[str
             nonlocal polls
             polls += 1
             angle = 2.0 * math.pi * polls / 400.0  # a 100 mm circle in 4 s, the orientation turning
-            state.set_pose(Pose(400.0 + 50.0 * math.cos(angle), 50.0 * math.sin(angle), 300.0,
-                                180.0, 0.0, 90.0 + 10.0 * math.sin(angle)))
+            state.set_pose(
+                Pose(
+                    400.0 + 50.0 * math.cos(angle),
+                    50.0 * math.sin(angle),
+                    300.0,
+                    180.0,
+                    0.0,
+                    90.0 + 10.0 * math.sin(angle),
+                )
+            )
             state.set_status(status)
             state.note_good_poll(time.monotonic())
             link.trafficObserved.emit(feed.batch())
@@ -228,28 +256,38 @@ def run_synthetic(seconds: float, profiler: cProfile.Profile | None) -> dict[str
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__,
-                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
     parser.add_argument("--seconds", type=float, default=4.0, help="length of each streaming window")
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--busy", action="store_true", help="also with a busy neighbour on the other core")
     parser.add_argument("--variants", action="store_true", help="also with the monitor / the traffic hidden")
-    parser.add_argument("--synthetic", action="store_true",
-                        help="feed the window from a GUI-thread timer (no worker, no simulator)")
+    parser.add_argument(
+        "--synthetic",
+        action="store_true",
+        help="feed the window from a GUI-thread timer (no worker, no simulator)",
+    )
     parser.add_argument("--profile", help="write a cProfile of the GUI thread's streaming windows here")
     parser.add_argument("--top", type=int, default=30, help="functions printed from the profile")
     args = parser.parse_args(argv)
     profiler = cProfile.Profile() if args.profile else None
-    runs = [run_synthetic(args.seconds, profiler) if args.synthetic else
-            run_once(args.seconds, busy=args.busy, variants=args.variants, profiler=profiler)
-            for _ in range(args.repeat)]
+    runs = [
+        run_synthetic(args.seconds, profiler)
+        if args.synthetic
+        else run_once(args.seconds, busy=args.busy, variants=args.variants, profiler=profiler)
+        for _ in range(args.repeat)
+    ]
     medians: dict[str, Any] = {}
     for part in runs[0]:
         if part == "load_avg_1m":
             medians[part] = statistics.median(r[part] for r in runs)
             continue
-        medians[part] = {k: round(statistics.median(r[part][k] for r in runs), 2)
-                         for k in runs[0][part] if not isinstance(runs[0][part][k], bool)}
+        medians[part] = {
+            k: round(statistics.median(r[part][k] for r in runs), 2)
+            for k in runs[0][part]
+            if not isinstance(runs[0][part][k], bool)
+        }
     json.dump({"runs": runs, "median": medians}, sys.stdout, indent=2)
     sys.stdout.write("\n")
     if profiler is not None:

@@ -92,11 +92,15 @@ def run(seconds: float = 5.0) -> dict[str, Any]:
     hidden = measure(app, panel.on_traffic, seconds)
     panel.clear()
     return {
-        "poll_hz": POLL_HZ, "frames_per_poll": 4, "seconds": seconds,
+        "poll_hz": POLL_HZ,
+        "frames_per_poll": 4,
+        "seconds": seconds,
         "what": "GUI-thread CPU, % of one core, per 100 Hz of polling traffic (normalised per batch)",
         "timer_only_pct": round(base, 2),
-        "shown_pct": round(shown, 2), "shown_cost_pct": round(shown - base, 2),
-        "hidden_pct": round(hidden, 2), "hidden_cost_pct": round(hidden - base, 2),
+        "shown_pct": round(shown, 2),
+        "shown_cost_pct": round(shown - base, 2),
+        "hidden_pct": round(hidden, 2),
+        "hidden_cost_pct": round(hidden - base, 2),
         "rows_after_shown": rows_shown,
     }
 

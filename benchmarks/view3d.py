@@ -53,10 +53,13 @@ SYNC_STATES = list(SyncState)
 
 
 def _scene(rng: np.random.Generator) -> tuple[PointLedger, Plan]:
-    xyz = np.column_stack([rng.uniform(150, 750, N_POINTS), rng.uniform(-500, 500, N_POINTS),
-                           rng.uniform(50, 800, N_POINTS)])
-    points = [make_point(i + 1, f"P{i + 1}", (*xyz[i], 180.0, 0.0, 180.0), sync=SYNC_STATES[i % 4])
-              for i in range(N_POINTS)]
+    xyz = np.column_stack(
+        [rng.uniform(150, 750, N_POINTS), rng.uniform(-500, 500, N_POINTS), rng.uniform(50, 800, N_POINTS)]
+    )
+    points = [
+        make_point(i + 1, f"P{i + 1}", (*xyz[i], 180.0, 0.0, 180.0), sync=SYNC_STATES[i % 4])
+        for i in range(N_POINTS)
+    ]
     segments = []
     for k in range(N_SEGMENTS):
         a, b = 2 * k + 1, 2 * k + 2
@@ -93,8 +96,11 @@ def _planner_reach(model: ArmModel, ledger: PointLedger, plan: Plan) -> dict[str
         t0 = time.perf_counter()
         checker.plan_issues(plan, ledger, None)
         moved.append(time.perf_counter() - t0)
-    return {"plan_reach_cold_s": cold, "plan_reach_again_ms": again * 1000.0,
-            "plan_reach_point_moved_ms": statistics.median(moved) * 1000.0}
+    return {
+        "plan_reach_cold_s": cold,
+        "plan_reach_again_ms": again * 1000.0,
+        "plan_reach_point_moved_ms": statistics.median(moved) * 1000.0,
+    }
 
 
 def run(quick: bool = False) -> dict[str, Any]:
@@ -111,8 +117,13 @@ def run(quick: bool = False) -> dict[str, Any]:
     path = plan_path(plan, ledger, points[0].xyzabc, PATH_SAMPLES)
     path_ms = (time.perf_counter() - t0) * 1000.0
     colors = [SYNC_COLORS[p.sync] for p in points]
-    canvas.set_points(np.array([p.xyz for p in points]), [p.id for p in points], [p.label for p in points],
-                      colors, np.zeros(N_POINTS, dtype=bool))
+    canvas.set_points(
+        np.array([p.xyz for p in points]),
+        [p.id for p in points],
+        [p.label for p in points],
+        colors,
+        np.zeros(N_POINTS, dtype=bool),
+    )
     mids = np.array([p.xyz for s in plan.segments if s.via_id is not None and (p := ledger.get(s.via_id))])
     canvas.set_path(path.xyz, path.segment, np.zeros(len(path.xyz), dtype=bool), mids, path.xyz[0])
     canvas.set_camera(canvas.camera.preset(Preset.ISO))
@@ -160,16 +171,22 @@ def run(quick: bool = False) -> dict[str, Any]:
     app.processEvents()
     rot = _summary(rotate)
     return {
-        "points": N_POINTS, "segments": N_SEGMENTS, "path_rows": len(path.xyz),
-        "canvas_px": list(CANVAS_SIZE), "lod_max_points": view3d_canvas.LOD_MAX_POINTS,
+        "points": N_POINTS,
+        "segments": N_SEGMENTS,
+        "path_rows": len(path.xyz),
+        "canvas_px": list(CANVAS_SIZE),
+        "lod_max_points": view3d_canvas.LOD_MAX_POINTS,
         "lod_max_path_rows": view3d_canvas.LOD_MAX_PATH_ROWS,
-        "rotate_frame_ms": rot, "rotate_fps": 1000.0 / rot["median"],
+        "rotate_frame_ms": rot,
+        "rotate_fps": 1000.0 / rot["median"],
         "rotate_fps_p95": 1000.0 / rot["p95"],
         "rotate_frame_cpu_ms": _summary(rotate_cpu),
         "rotate_fps_cpu": 1000.0 / statistics.median(rotate_cpu),
-        "still_frame_ms": _summary(still), "live_frame_ms": _summary(live),
+        "still_frame_ms": _summary(still),
+        "live_frame_ms": _summary(live),
         "plan_path_ms": path_ms,
-        "reach_points": n_reach, "reach_points_s": reach_points_s,
+        "reach_points": n_reach,
+        "reach_points_s": reach_points_s,
         "reach_points_unreachable": sum(1 for r in reach.values() if r.value != "ok"),
         "reach_path_s": reach_path_s,
         **planner,

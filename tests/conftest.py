@@ -106,8 +106,9 @@ def _install_trace_hook() -> None:
 
     state = ctypes.pythonapi.PyGILState_Ensure()
     thread = QThread.currentThread()
-    thread.finished.connect(lambda: ctypes.pythonapi.PyGILState_Release(state),
-                            Qt.ConnectionType.DirectConnection)
+    thread.finished.connect(
+        lambda: ctypes.pythonapi.PyGILState_Release(state), Qt.ConnectionType.DirectConnection
+    )
     sys.settrace(hook)
 
 
@@ -152,18 +153,15 @@ def _qt_leak_check(request: pytest.FixtureRequest) -> Iterator[None]:
     before_timers = set(map(id, _timers))
     yield
     leaked_threads = [
-        t for t in list(_threads)
-        if id(t) not in before_threads and shiboken6.isValid(t) and t.isRunning()
+        t for t in list(_threads) if id(t) not in before_threads and shiboken6.isValid(t) and t.isRunning()
     ]
     leaked_timers = [
-        t for t in list(_timers)
-        if id(t) not in before_timers and shiboken6.isValid(t) and t.isActive()
+        t for t in list(_timers) if id(t) not in before_timers and shiboken6.isValid(t) and t.isActive()
     ]
     _threads.clear()
     _timers.clear()
     if leaked_threads or leaked_timers:
         pytest.fail(
-            f"test leaked {len(leaked_threads)} running QThread(s) and "
-            f"{len(leaked_timers)} active QTimer(s)",
+            f"test leaked {len(leaked_threads)} running QThread(s) and {len(leaked_timers)} active QTimer(s)",
             pytrace=False,
         )

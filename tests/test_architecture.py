@@ -6,8 +6,9 @@ import ast
 from pathlib import Path
 
 APP = Path(__file__).resolve().parent.parent / "app"
-QT_ALLOWED = {APP / "link" / name: {"PySide6.QtCore", "PySide6"}
-              for name in ("worker.py", "robot_link.py", "state.py")}
+QT_ALLOWED = {
+    APP / "link" / name: {"PySide6.QtCore", "PySide6"} for name in ("worker.py", "robot_link.py", "state.py")
+}
 
 
 def _imports(path: Path) -> set[str]:

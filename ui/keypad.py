@@ -76,8 +76,9 @@ class KeypadDialog(QDialog):
         self.retranslate()
         self._show()
 
-    def _key(self, key: str, text: str, grid: QGridLayout, row: int, column: int,
-             rows: int = 1) -> QPushButton:
+    def _key(
+        self, key: str, text: str, grid: QGridLayout, row: int, column: int, rows: int = 1
+    ) -> QPushButton:
         button = QPushButton(text, self)
         button.setObjectName(f"key_{key}")
         button.setMinimumSize(KEYPAD_KEY_SIZE, KEYPAD_KEY_SIZE * rows + 6 * (rows - 1))
@@ -141,8 +142,14 @@ class KeypadDialog(QDialog):
         self._show()
 
     def keyPressEvent(self, event: QKeyEvent) -> None:
-        keys = {Qt.Key.Key_Backspace: "back", Qt.Key.Key_Minus: "sign", Qt.Key.Key_Period: ".",
-                Qt.Key.Key_Comma: ".", Qt.Key.Key_Return: "ok", Qt.Key.Key_Enter: "ok"}
+        keys = {
+            Qt.Key.Key_Backspace: "back",
+            Qt.Key.Key_Minus: "sign",
+            Qt.Key.Key_Period: ".",
+            Qt.Key.Key_Comma: ".",
+            Qt.Key.Key_Return: "ok",
+            Qt.Key.Key_Enter: "ok",
+        }
         text = event.text()
         if text.isdigit():
             self.press(text)
@@ -169,8 +176,12 @@ class _KeypadOpener(QObject):
         field.lineEdit().installEventFilter(self)
 
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
-        if (self.enabled and event.type() == QEvent.Type.MouseButtonRelease
-                and self._field.isEnabled() and not self._field.isReadOnly()):
+        if (
+            self.enabled
+            and event.type() == QEvent.Type.MouseButtonRelease
+            and self._field.isEnabled()
+            and not self._field.isReadOnly()
+        ):
             self.open()
             return True
         return super().eventFilter(watched, event)

@@ -1,10 +1,10 @@
 """``teachpad``: the desktop teach pendant.
 
-    teachpad --sim                      the simulator, in its own process, on a free loopback port
-    teachpad --host H --port P [--unit U]   a real controller (Modbus TCP)
-    teachpad --lang zh_CN               language for this run (the menu remembers a choice)
-    teachpad --project FILE             open this project (default: the last one)
-    teachpad --sim --screenshot out.png --size 1400x900 [--tab planner]   render once connected, save, exit
+teachpad --sim                      the simulator, in its own process, on a free loopback port
+teachpad --host H --port P [--unit U]   a real controller (Modbus TCP)
+teachpad --lang zh_CN               language for this run (the menu remembers a choice)
+teachpad --project FILE             open this project (default: the last one)
+teachpad --sim --screenshot out.png --size 1400x900 [--tab planner]   render once connected, save, exit
 """
 
 from __future__ import annotations
@@ -59,8 +59,9 @@ _LISTENING = re.compile(r"listening on (?P<host>[^\s:]+):(?P<port>\d+)")
 class SimProcess:
     """The simulated controller in a child process (like a real controller: its own GIL)."""
 
-    def __init__(self, process: subprocess.Popen[str], host: str, port: int,
-                 reader: threading.Thread | None = None) -> None:
+    def __init__(
+        self, process: subprocess.Popen[str], host: str, port: int, reader: threading.Thread | None = None
+    ) -> None:
         self.process = process
         self.host = host
         self.port = port
@@ -75,7 +76,11 @@ class SimProcess:
         env["PYTHONUNBUFFERED"] = "1"
         process = subprocess.Popen(
             [sys.executable, "-c", _SIM_CHILD, "--host", "127.0.0.1", "--port", "0", "--no-stdin"],
-            stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env)
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
         lines: queue.Queue[str] = queue.Queue()
 
         def read_stdout() -> None:
@@ -217,8 +222,9 @@ def _size(text: str) -> tuple[int, int]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="teachpad",
-                                     description="Teach pendant for Bochuang robot controllers")
+    parser = argparse.ArgumentParser(
+        prog="teachpad", description="Teach pendant for Bochuang robot controllers"
+    )
     target = parser.add_mutually_exclusive_group()
     target.add_argument("--sim", action="store_true", help="start the built-in simulator and connect to it")
     target.add_argument("--host", help="controller address (Modbus TCP)")
@@ -229,12 +235,16 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--poll-hz", type=float, help="pose/status poll rate (default 50)")
     parser.add_argument("--settings", metavar="FILE", help="keep settings in this INI file")
     parser.add_argument("--size", type=_size, metavar="WxH", help="window size, e.g. 1400x900")
-    parser.add_argument("--screenshot", metavar="PNG",
-                        help="save the window once connected with a pose, then exit")
+    parser.add_argument(
+        "--screenshot", metavar="PNG", help="save the window once connected with a pose, then exit"
+    )
     parser.add_argument("--project", metavar="FILE", help="open this project (.teachpad.json) at start")
     parser.add_argument("--tab", choices=TAB_NAMES, help="work tab to show first")
-    parser.add_argument("--demo", action="store_true",
-                        help=f"with --sim: run the simulator's program {DEMO_PROGRAM} in a loop")
+    parser.add_argument(
+        "--demo",
+        action="store_true",
+        help=f"with --sim: run the simulator's program {DEMO_PROGRAM} in a loop",
+    )
     return parser
 
 
@@ -301,10 +311,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     connection: ConnectionSettings | None = None
     if args.host and not args.sim:
         remembered = settings.connection()  # with the register profile in force
-        connection = dataclasses.replace(remembered, host=args.host, port=args.port,
-                                         unit=remembered.unit if args.unit is None else args.unit,
-                                         serial_port=None, framer="socket",
-                                         monitor_only=args.monitor_only)
+        connection = dataclasses.replace(
+            remembered,
+            host=args.host,
+            port=args.port,
+            unit=remembered.unit if args.unit is None else args.unit,
+            serial_port=None,
+            framer="socket",
+            monitor_only=args.monitor_only,
+        )
         settings.save_connection(connection)
 
     link = RobotLink(poll_hz=args.poll_hz or settings.poll_hz)
@@ -320,8 +335,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         starter = _SimStarter(window)
 
         def sim_started(sim: SimProcess) -> None:
-            link.connect_to(ConnectionSettings(host=sim.host, port=sim.port, unit=1,
-                                               monitor_only=args.monitor_only))
+            link.connect_to(
+                ConnectionSettings(host=sim.host, port=sim.port, unit=1, monitor_only=args.monitor_only)
+            )
             if args.demo:
                 link.run_program(DEMO_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
 
@@ -333,8 +349,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         starter.started.connect(sim_started)
         starter.failed.connect(sim_failed)
     # After the first paint; a screenshot run never stops on a question: it opens only what it was given.
-    _AfterFirstPaint(window, lambda: window.start_project(
-        args.project, reopen_last=not args.screenshot, offer_recovery=not args.screenshot))
+    _AfterFirstPaint(
+        window,
+        lambda: window.start_project(
+            args.project, reopen_last=not args.screenshot, offer_recovery=not args.screenshot
+        ),
+    )
     window.show()
     if connection is not None:
         link.connect_to(connection)

@@ -83,9 +83,17 @@ TAB_NAMES = ("monitor", "points", "planner")
 class MainWindow(QMainWindow):
     """See the module docstring. ``confirm`` (settable) is used by every panel that asks."""
 
-    def __init__(self, link: RobotLink, settings: AppSettings, translator: Translator | None = None,
-                 parent: QWidget | None = None, *, shutdown_link_on_close: bool = True,
-                 project_dialogs: Any = None, autosave_dir: str | os.PathLike[str] | None = None) -> None:
+    def __init__(
+        self,
+        link: RobotLink,
+        settings: AppSettings,
+        translator: Translator | None = None,
+        parent: QWidget | None = None,
+        *,
+        shutdown_link_on_close: bool = True,
+        project_dialogs: Any = None,
+        autosave_dir: str | os.PathLike[str] | None = None,
+    ) -> None:
         super().__init__(parent)
         self.setObjectName("MainWindow")
         self.link = link
@@ -95,8 +103,9 @@ class MainWindow(QMainWindow):
         self._close_accepted = False
 
         # --- the project and its controllers (no widgets) ---------------------------------
-        self.project = ProjectController(dialogs=project_dialogs or ProjectDialogs(self),
-                                         autosave_dir=autosave_dir, parent=self)
+        self.project = ProjectController(
+            dialogs=project_dialogs or ProjectDialogs(self), autosave_dir=autosave_dir, parent=self
+        )
         self.point_sync = PointSyncController(self.project.points_model, link, self)
         self.run_controller = PlanRunController(link, self, points=self.project.points_model)
 
@@ -109,8 +118,9 @@ class MainWindow(QMainWindow):
         # --- right: the work tabs ---------------------------------------------------------
         self.monitor_panel = MonitorPanel(self)
         self.points_panel = PointsPanel(self.project.points_model, self.point_sync, self)
-        self.planner_panel = PlannerPanel(self.project.plans_model, self.project.points_model,
-                                          self.run_controller, self.point_sync, self)
+        self.planner_panel = PlannerPanel(
+            self.project.plans_model, self.project.points_model, self.run_controller, self.point_sync, self
+        )
         self.work_tabs = QTabWidget(self)
         self.work_tabs.setObjectName("WorkTabs")
         self.work_tabs.addTab(self.monitor_panel, "")
@@ -141,12 +151,23 @@ class MainWindow(QMainWindow):
 
         # --- actions, menus, toolbar, status bar ---------------------------------------
         self.menus = WindowActions(
-            self, connect=self.open_connection_dialog, disconnect=link.disconnect, stop=link.stop,
-            pause=link.pause, resume=link.resume, about=self.show_about, show_tab=self.show_tab,
-            tab_count=len(TAB_NAMES), set_language=self.set_language,
-            language=translator.language if translator else "en", file_actions=self.project.file_actions(),
+            self,
+            connect=self.open_connection_dialog,
+            disconnect=link.disconnect,
+            stop=link.stop,
+            pause=link.pause,
+            resume=link.resume,
+            about=self.show_about,
+            show_tab=self.show_tab,
+            tab_count=len(TAB_NAMES),
+            set_language=self.set_language,
+            language=translator.language if translator else "en",
+            file_actions=self.project.file_actions(),
             edit_actions=[self.project.action_undo, self.project.action_redo],
-            docks=docks.docks, set_touch_mode=self.set_touch_mode, touch_mode=settings.touch_mode)
+            docks=docks.docks,
+            set_touch_mode=self.set_touch_mode,
+            touch_mode=settings.touch_mode,
+        )
         self._compose_strip_and_banner()
         self.status_bar = WindowStatusBar(self.statusBar())
         labels = self.status_bar
@@ -202,16 +223,32 @@ class MainWindow(QMainWindow):
     def _wire(self) -> None:
         """Every part follows the link's RobotState itself; the window keeps no copy of it."""
         link, state = self.link, self.link.state
-        for panel in (self.monitor_panel, self.status_panel, self.event_log, self.control_bar,
-                      self.pose_strip, self.alarm_banner, self.alarm_list, self.control_column,
-                      self.menus, self.status_bar):
+        for panel in (
+            self.monitor_panel,
+            self.status_panel,
+            self.event_log,
+            self.control_bar,
+            self.pose_strip,
+            self.alarm_banner,
+            self.alarm_list,
+            self.control_column,
+            self.menus,
+            self.status_bar,
+        ):
             panel.bind(state)
         state.connectionChanged.connect(self._update_title)
         link.errorOccurred.connect(self._on_error)
         link.controllerReconnected.connect(self._on_reconnected)
         link.controllerRestarted.connect(self._on_restarted)
-        self.motion = MotionController(link, self.control_bar, self.jog_panel, self.step_panel,
-                                       self.program_panel, self.run_controller, self)
+        self.motion = MotionController(
+            link,
+            self.control_bar,
+            self.jog_panel,
+            self.step_panel,
+            self.program_panel,
+            self.run_controller,
+            self,
+        )
         self.run_controller.runningChanged.connect(self.points_panel.set_run_active)
         self.motion.alarmHoldChanged.connect(self.points_panel.set_alarm_hold)
         self.motion.alarmHoldChanged.connect(self.planner_panel.set_alarm_hold)
@@ -278,8 +315,9 @@ class MainWindow(QMainWindow):
 
     @Slot()
     def _on_restarted(self) -> None:
-        text = self.tr("The controller restarted (its temp points are gone): "
-                       "restore them from the Points tab")
+        text = self.tr(
+            "The controller restarted (its temp points are gone): restore them from the Points tab"
+        )
         self.event_log.add_event("warning", self.tr("link"), text)
 
     @Slot()
@@ -306,8 +344,13 @@ class MainWindow(QMainWindow):
             index = TAB_NAMES.index(index)
         self.work_tabs.setCurrentIndex(index)
 
-    def start_project(self, path: str | os.PathLike[str] | None = None, *, reopen_last: bool = True,
-                      offer_recovery: bool = True) -> bool:
+    def start_project(
+        self,
+        path: str | os.PathLike[str] | None = None,
+        *,
+        reopen_last: bool = True,
+        offer_recovery: bool = True,
+    ) -> bool:
         """At startup: open ``path`` (else the last project, if it still exists), then offer to
         recover an autosave a crash left behind. True when a project was opened or recovered."""
         opened = False
@@ -338,10 +381,14 @@ class MainWindow(QMainWindow):
 
     @Slot()
     def show_about(self) -> None:
-        QMessageBox.about(self, self.tr("About TeachPad"), self.tr(
-            "<b>TeachPad {version}</b><br>Desktop teach pendant for Bochuang robot controllers "
-            "(Modbus TCP / RTU).<br><br>Esc stops all motion. Jog buttons and keys move only while held."
-        ).format(version=__version__))
+        QMessageBox.about(
+            self,
+            self.tr("About TeachPad"),
+            self.tr(
+                "<b>TeachPad {version}</b><br>Desktop teach pendant for Bochuang robot controllers "
+                "(Modbus TCP / RTU).<br><br>Esc stops all motion. Jog buttons and keys move only while held."
+            ).format(version=__version__),
+        )
 
     @property
     def touch_mode(self) -> bool:
@@ -357,8 +404,9 @@ class MainWindow(QMainWindow):
         """Switch the UI language at runtime and remember it."""
         self.jog_panel.release_all()
         if self.translator is not None and not self.translator.set_language(code):
-            self.event_log.add_event("warning", self.tr("language"),
-                                     self.tr("No translation file for {code}").format(code=code))
+            self.event_log.add_event(
+                "warning", self.tr("language"), self.tr("No translation file for {code}").format(code=code)
+            )
             code = self.translator.language
         self.settings.language = code
         # Qt posts LanguageChange to the windows: deliver it now so the switch is immediate.
@@ -409,4 +457,3 @@ class MainWindow(QMainWindow):
             self.restoreGeometry(geometry)
         state = self.settings.window_state()
         return state is not None and self.restoreState(state)
-

@@ -32,9 +32,22 @@ from app.protocol.enums import (
 from ui.messages_files import FILE_TEMPLATES, file_fields, file_text, os_problem
 from ui.messages_plan import _number, _tr, envelope_text, issue_line, issue_text
 
-__all__ = ["LEVEL_ERROR", "LEVEL_INFO", "LEVEL_WARNING", "connection_text", "error_text", "issue_line",
-           "issue_text", "operation_text", "os_error_text", "reason_text", "refusal_text", "result_level",
-           "result_text", "status_text"]
+__all__ = [
+    "LEVEL_ERROR",
+    "LEVEL_INFO",
+    "LEVEL_WARNING",
+    "connection_text",
+    "error_text",
+    "issue_line",
+    "issue_text",
+    "operation_text",
+    "os_error_text",
+    "reason_text",
+    "refusal_text",
+    "result_level",
+    "result_text",
+    "status_text",
+]
 
 CONTEXT = "Messages"
 LEVEL_INFO = "info"
@@ -53,16 +66,29 @@ _TEMPLATES: dict[str, str] = {
     "done_unconfirmed": QT_TRANSLATE_NOOP("Messages", "{command}: done, not confirmed by the controller."),
     "done_by_mode": QT_TRANSLATE_NOOP("Messages", "{command}: done (the controller is now in {mode} mode)."),
     "command_refused": QT_TRANSLATE_NOOP("Messages", "{command} refused by the controller: {status}."),
-    "refused_unconfirmed": QT_TRANSLATE_NOOP("Messages", "{command} not taken: the controller still shows \u201c{status}\u201d from the previous command."),  # noqa: E501
+    "refused_unconfirmed": QT_TRANSLATE_NOOP(
+        "Messages",
+        "{command} not taken: the controller still shows \u201c{status}\u201d from the previous command.",
+    ),
     "alarm_while_waiting": QT_TRANSLATE_NOOP("Messages", "{command} ended by an alarm: {alarms}."),
-    "not_acknowledged": QT_TRANSLATE_NOOP("Messages", "{command}: the controller did not acknowledge it within {seconds} s."),  # noqa: E501
-    "command_timeout": QT_TRANSLATE_NOOP("Messages", "{command} did not finish within {seconds} s (last status: {status})."),  # noqa: E501
-    "result_unknown": QT_TRANSLATE_NOOP("Messages", "{command}: the arm moved and stopped, but the controller did not report the result."),  # noqa: E501
+    "not_acknowledged": QT_TRANSLATE_NOOP(
+        "Messages", "{command}: the controller did not acknowledge it within {seconds} s."
+    ),
+    "command_timeout": QT_TRANSLATE_NOOP(
+        "Messages", "{command} did not finish within {seconds} s (last status: {status})."
+    ),
+    "result_unknown": QT_TRANSLATE_NOOP(
+        "Messages", "{command}: the arm moved and stopped, but the controller did not report the result."
+    ),
     "stopped_by_operator": QT_TRANSLATE_NOOP("Messages", "{command}: stopped by the operator."),
     "stopped_by_controller": QT_TRANSLATE_NOOP("Messages", "{command}: stopped by the controller."),
     "sent": QT_TRANSLATE_NOOP("Messages", "{command}: sent (not waited for)."),
-    "no_motion": QT_TRANSLATE_NOOP("Messages", "{command}: no motion within {seconds} s (refused by the controller, or already there)."),  # noqa: E501
-    "program_not_started": QT_TRANSLATE_NOOP("Messages", "Program {program} did not start: no such program, or the controller refused it."),  # noqa: E501
+    "no_motion": QT_TRANSLATE_NOOP(
+        "Messages", "{command}: no motion within {seconds} s (refused by the controller, or already there)."
+    ),
+    "program_not_started": QT_TRANSLATE_NOOP(
+        "Messages", "Program {program} did not start: no such program, or the controller refused it."
+    ),
     "upload_done": QT_TRANSLATE_NOOP("Messages", "Uploaded {uploaded} of {total} points."),
     # requests the worker handles without a GV291 status (stop, pause, mode...)
     "request_done": QT_TRANSLATE_NOOP("Messages", "{operation}: sent."),
@@ -71,35 +97,67 @@ _TEMPLATES: dict[str, str] = {
     "link_shut_down": QT_TRANSLATE_NOOP("Messages", "The link is shut down: nothing was sent."),
     "not_connected": QT_TRANSLATE_NOOP("Messages", "Not connected to a controller: nothing was sent."),
     # the jog (app/link/jog.py)
-    "jog_stopped_silent": QT_TRANSLATE_NOOP("Messages", "Jog stopped: the controller is not answering (speed 0 is sent as soon as it answers)."),  # noqa: E501
-    "left_teach_mode": QT_TRANSLATE_NOOP("Messages", "Jog stopped: the controller left teach mode (now in {mode} mode)."),  # noqa: E501
-    "jog_not_answering": QT_TRANSLATE_NOOP("Messages", "The controller is not answering: the jog was not started."),  # noqa: E501
+    "jog_stopped_silent": QT_TRANSLATE_NOOP(
+        "Messages", "Jog stopped: the controller is not answering (speed 0 is sent as soon as it answers)."
+    ),
+    "left_teach_mode": QT_TRANSLATE_NOOP(
+        "Messages", "Jog stopped: the controller left teach mode (now in {mode} mode)."
+    ),
+    "jog_not_answering": QT_TRANSLATE_NOOP(
+        "Messages", "The controller is not answering: the jog was not started."
+    ),
     "bad_jog_ratio": QT_TRANSLATE_NOOP("Messages", "Jog speed {value}% is not within 1..100%."),
     # the link
     "link_lost": QT_TRANSLATE_NOOP("Messages", "Lost the connection to the controller at {endpoint}."),
     "link_closed": QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} closed the connection."),
     "host_unresolved": QT_TRANSLATE_NOOP("Messages", "The host name {host} cannot be resolved."),
-    "connection_refused": QT_TRANSLATE_NOOP("Messages", "Connection refused: nothing listens on port {port}."),  # noqa: E501
-    "connect_timeout": QT_TRANSLATE_NOOP("Messages", "No answer to the connection request within {seconds} s."),  # noqa: E501
+    "connection_refused": QT_TRANSLATE_NOOP(
+        "Messages", "Connection refused: nothing listens on port {port}."
+    ),
+    "connect_timeout": QT_TRANSLATE_NOOP(
+        "Messages", "No answer to the connection request within {seconds} s."
+    ),
     "connect_failed": QT_TRANSLATE_NOOP("Messages", "The connection could not be opened."),
     "serial_open_failed": QT_TRANSLATE_NOOP("Messages", "Cannot open the serial port {port}."),
-    "no_answer": QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} did not answer within {seconds} s."),  # noqa: E501
-    "malformed_answer": QT_TRANSLATE_NOOP("Messages", "Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}."),  # noqa: E501
-    "modbus_exception": QT_TRANSLATE_NOOP("Messages", "The controller refused the request: Modbus exception {exception} ({name})."),  # noqa: E501
+    "no_answer": QT_TRANSLATE_NOOP(
+        "Messages", "The controller at {endpoint} did not answer within {seconds} s."
+    ),
+    "malformed_answer": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.",
+    ),
+    "modbus_exception": QT_TRANSLATE_NOOP(
+        "Messages", "The controller refused the request: Modbus exception {exception} ({name})."
+    ),
     "monitor_only": QT_TRANSLATE_NOOP("Messages", "Monitor-only mode: nothing was sent to the controller."),
     "invalid_input": QT_TRANSLATE_NOOP("Messages", "Invalid value: nothing was sent."),
     "unexpected": QT_TRANSLATE_NOOP("Messages", "Unexpected internal error; the log has the details."),
     # a plan run's point guard (app/points/guard.py, ui/controllers/run_points.py)
-    "point_mismatch": QT_TRANSLATE_NOOP("Messages", "The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming."),  # noqa: E501
-    "point_not_created": QT_TRANSLATE_NOOP("Messages", "The controller did not create {point} again before the move: the arm was not moved."),  # noqa: E501
-    "point_missing": QT_TRANSLATE_NOOP("Messages", "The project has no point {point}: the arm was not moved."),  # noqa: E501
-    "arrival_unknown": QT_TRANSLATE_NOOP("Messages", "The arm's position after the move to {point} is not known: the run is stopped."),  # noqa: E501
+    "point_mismatch": QT_TRANSLATE_NOOP(
+        "Messages",
+        "The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.",
+    ),
+    "point_not_created": QT_TRANSLATE_NOOP(
+        "Messages", "The controller did not create {point} again before the move: the arm was not moved."
+    ),
+    "point_missing": QT_TRANSLATE_NOOP(
+        "Messages", "The project has no point {point}: the arm was not moved."
+    ),
+    "arrival_unknown": QT_TRANSLATE_NOOP(
+        "Messages", "The arm's position after the move to {point} is not known: the run is stopped."
+    ),
     # the link's own state and the commands it cut short (app/link/supervisor.py)
     "link_was_shut_down": QT_TRANSLATE_NOOP("Messages", "The link was shut down."),
-    "outcome_unknown_link_lost": QT_TRANSLATE_NOOP("Messages", "{operation}: the connection was lost while it was under way; its outcome is unknown."),  # noqa: E501
-    "outcome_unknown_link_closed": QT_TRANSLATE_NOOP("Messages", "{operation}: the connection was closed while it was under way."),  # noqa: E501
+    "outcome_unknown_link_lost": QT_TRANSLATE_NOOP(
+        "Messages", "{operation}: the connection was lost while it was under way; its outcome is unknown."
+    ),
+    "outcome_unknown_link_closed": QT_TRANSLATE_NOOP(
+        "Messages", "{operation}: the connection was closed while it was under way."
+    ),
     # queued requests the link never sent (app/link/worker.py fail_queued)
-    "queued_link_down": QT_TRANSLATE_NOOP("Messages", "{operation}: not sent, the connection to the controller is down."),  # noqa: E501
+    "queued_link_down": QT_TRANSLATE_NOOP(
+        "Messages", "{operation}: not sent, the connection to the controller is down."
+    ),
     "queued_link_closed": QT_TRANSLATE_NOOP("Messages", "{operation}: not sent, the connection was closed."),
     # the point ledger's refusals (app/points/ledger.py): parts of a sentence ("P3, ID: refused, ...")
     "points_outside_range": QT_TRANSLATE_NOOP("Messages", "points outside {id_min}..{id_max}: {ids}"),
@@ -110,7 +168,10 @@ _TEMPLATES: dict[str, str] = {
     "duplicate_row_id": QT_TRANSLATE_NOOP("Messages", "row {row}: id {id} is already used on row {other}"),
     "import_duplicate_id": QT_TRANSLATE_NOOP("Messages", "imported point {number}: id {id} appears twice"),
     "point_id_taken": QT_TRANSLATE_NOOP("Messages", "id {id} is already used by {point}"),
-    "empty_import": QT_TRANSLATE_NOOP("Messages", "the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)"),  # noqa: E501
+    "empty_import": QT_TRANSLATE_NOOP(
+        "Messages",
+        "the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)",
+    ),
 }
 
 _TEMPLATES.update(FILE_TEMPLATES)  # refused values and files (ui/messages_files.py)
@@ -130,7 +191,9 @@ _BARE: dict[str, str] = {
     "alarm_while_waiting": QT_TRANSLATE_NOOP("Messages", "{command} ended by an alarm."),
     "command_refused": QT_TRANSLATE_NOOP("Messages", "{command} refused by the controller."),
     "done": QT_TRANSLATE_NOOP("Messages", "{command}: done."),
-    "modbus_exception": QT_TRANSLATE_NOOP("Messages", "The controller refused the request (Modbus exception)."),  # noqa: E501
+    "modbus_exception": QT_TRANSLATE_NOOP(
+        "Messages", "The controller refused the request (Modbus exception)."
+    ),
 }
 
 _RECONNECT = QT_TRANSLATE_NOOP("Messages", "Cannot reconnect to the controller at {endpoint}: {cause}")
@@ -227,9 +290,9 @@ def _status(args: Mapping[str, Any]) -> str | None:
 
 
 def _alarms(mask: int) -> str:
-    return "、".join(_tr(name, "Protocol") if not name.startswith("bit ") else name[4:]
-                    for name in alarm_names(mask))
-
+    return "、".join(
+        _tr(name, "Protocol") if not name.startswith("bit ") else name[4:] for name in alarm_names(mask)
+    )
 
 
 def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
@@ -238,8 +301,9 @@ def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
     for key, value in args.items():
         if key in ("command", "kind") or value is None:
             continue
-        out[key] = _number(value) if isinstance(value, int | float) and not isinstance(value, bool) \
-            else str(value)
+        out[key] = (
+            _number(value) if isinstance(value, int | float) and not isinstance(value, bool) else str(value)
+        )
     status = _status(args)
     if status is not None:
         out["status"] = status
@@ -294,11 +358,20 @@ def result_text(result: CommandResult) -> str:
         # we have (the English message) rather than guess a cause
         return _tr(_FAILED_WITH).format(message=result.message) if result.message else _tr(_FAILED)
     if reason is None:
-        reason = Reason("done" if result.ok else "command_refused",
-                        {"command": int(result.command) if result.command is not None else None,
-                         **({"status": result.status.code,
-                             "kind": result.status.kind.value if result.status.kind else None}
-                            if result.status is not None else {})})
+        reason = Reason(
+            "done" if result.ok else "command_refused",
+            {
+                "command": int(result.command) if result.command is not None else None,
+                **(
+                    {
+                        "status": result.status.code,
+                        "kind": result.status.kind.value if result.status.kind else None,
+                    }
+                    if result.status is not None
+                    else {}
+                ),
+            },
+        )
         if result.ok and result.unconfirmed:
             reason = Reason("done_unconfirmed", reason.args)
     text = reason_text(reason)
@@ -329,8 +402,16 @@ def error_text(error: WorkerError | TeachPadError | Reason) -> str:
 
 # A GUI plan run ended because the controller went silent while the connection stays open
 # (LinkState.NOT_ANSWERING, ui/controllers/plan_run_controller.py): not a lost link.
-_TEMPLATES["run_not_answering"] = QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.")  # noqa: E501
-_BARE["run_not_answering"] = QT_TRANSLATE_NOOP("Messages", "The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.")  # noqa: E501
+_TEMPLATES["run_not_answering"] = QT_TRANSLATE_NOOP(
+    "Messages",
+    "The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.",
+)
+_BARE["run_not_answering"] = QT_TRANSLATE_NOOP(
+    "Messages",
+    "The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.",
+)
+
+
 def connection_text(connection: ConnectionState) -> str:
     """Why the link is in its state, as one sentence ("" when there is nothing to say); the
     English message only from a producer that gives no reason."""

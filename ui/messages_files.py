@@ -35,16 +35,22 @@ FILE_TEMPLATES: dict[str, str] = {
     "bad_tool": QT_TRANSLATE_NOOP("Messages", "tool {value} is not 0..{max} or {none} (none)"),
     "not_text": QT_TRANSLATE_NOOP("Messages", "the value is not text"),
     "too_long": QT_TRANSLATE_NOOP("Messages", "the text is longer than {max} characters"),
-    "bad_character": QT_TRANSLATE_NOOP("Messages", "holds an invalid character (a lone surrogate, not Unicode text)"),  # noqa: E501
+    "bad_character": QT_TRANSLATE_NOOP(
+        "Messages", "holds an invalid character (a lone surrogate, not Unicode text)"
+    ),
     "not_one_line": QT_TRANSLATE_NOOP("Messages", "must be one line"),
     "value_missing": QT_TRANSLATE_NOOP("Messages", "the value is missing"),
     # a points CSV file refused (app/points/csv_io.py)
-    "not_utf8": QT_TRANSLATE_NOOP("Messages", "not UTF-8 text (bad byte at offset {offset}); save the file as UTF-8"),  # noqa: E501
+    "not_utf8": QT_TRANSLATE_NOOP(
+        "Messages", "not UTF-8 text (bad byte at offset {offset}); save the file as UTF-8"
+    ),
     "empty_file": QT_TRANSLATE_NOOP("Messages", "the file is empty (expected a header row)"),
     "unknown_column": QT_TRANSLATE_NOOP("Messages", "unknown column {name} (expected: {expected})"),
     "column_twice": QT_TRANSLATE_NOOP("Messages", "the column appears twice"),
     "column_missing": QT_TRANSLATE_NOOP("Messages", "the column is missing from the header"),
-    "cell_count": QT_TRANSLATE_NOOP("Messages", "has {cells} cells, the header has {header} (truncated or extra cells?)"),  # noqa: E501
+    "cell_count": QT_TRANSLATE_NOOP(
+        "Messages", "has {cells} cells, the header has {header} (truncated or extra cells?)"
+    ),
     "row_id_taken": QT_TRANSLATE_NOOP("Messages", "id {id} is already used on row {other}"),
     "not_csv": QT_TRANSLATE_NOOP("Messages", "not valid CSV (a quote is not closed, or a stray character)"),
     # a file that cannot be read at all (app/points/atomic.py read_limited), or an OSError's errno
@@ -56,25 +62,39 @@ FILE_TEMPLATES: dict[str, str] = {
     # a project file refused (app/points/project.py)
     "not_json": QT_TRANSLATE_NOOP("Messages", "not valid JSON"),
     "json_too_deep": QT_TRANSLATE_NOOP("Messages", "not valid JSON (nested too deeply)"),
-    "not_json_object": QT_TRANSLATE_NOOP("Messages", "not a project: expected a JSON object at the top level"),  # noqa: E501
-    "not_a_project": QT_TRANSLATE_NOOP("Messages", "not a TeachPad project (format {got}, expected {expected})"),  # noqa: E501
-    "version_unsupported": QT_TRANSLATE_NOOP("Messages", "version {version} is not supported (this TeachPad reads version {supported})"),  # noqa: E501
+    "not_json_object": QT_TRANSLATE_NOOP(
+        "Messages", "not a project: expected a JSON object at the top level"
+    ),
+    "not_a_project": QT_TRANSLATE_NOOP(
+        "Messages", "not a TeachPad project (format {got}, expected {expected})"
+    ),
+    "version_unsupported": QT_TRANSLATE_NOOP(
+        "Messages", "version {version} is not supported (this TeachPad reads version {supported})"
+    ),
     "expected_type": QT_TRANSLATE_NOOP("Messages", "expected {expected}, got {got}"),
     "point_id_twice": QT_TRANSLATE_NOOP("Messages", "id {id} is already used by point {other_number}"),
     "plan_name_taken": QT_TRANSLATE_NOOP("Messages", "another plan is named \u201c{name}\u201d"),
     # a plan's segments and names refused (app/plan/segments.py, ui/models/segment_model.py)
     "not_yes_no": QT_TRANSLATE_NOOP("Messages", "{value} is not yes or no"),
     "not_segment_kind": QT_TRANSLATE_NOOP("Messages", "{value} is not a line or an arc"),
-    "not_orientation": QT_TRANSLATE_NOOP("Messages", "{value} is not \u201cchanges\u201d or \u201ckept\u201d"),  # noqa: E501
+    "not_orientation": QT_TRANSLATE_NOOP(
+        "Messages", "{value} is not \u201cchanges\u201d or \u201ckept\u201d"
+    ),
     "negative_point_id": QT_TRANSLATE_NOOP("Messages", "point id {id} is negative"),
     "no_such_field": QT_TRANSLATE_NOOP("Messages", "there is no field \u201c{name}\u201d"),
     "plan_name_empty": QT_TRANSLATE_NOOP("Messages", "a plan needs a name"),
-    "plan_name_format": QT_TRANSLATE_NOOP("Messages", "the name must be one line of at most {max} characters"),  # noqa: E501
+    "plan_name_format": QT_TRANSLATE_NOOP(
+        "Messages", "the name must be one line of at most {max} characters"
+    ),
     "bad_loops": QT_TRANSLATE_NOOP("Messages", "{value} loops: give 0 (endless) to {max}"),
-    "cannot_move_segment": QT_TRANSLATE_NOOP("Messages", "cannot move segment {src} to {dst} in {segments} segments"),  # noqa: E501
+    "cannot_move_segment": QT_TRANSLATE_NOOP(
+        "Messages", "cannot move segment {src} to {dst} in {segments} segments"
+    ),
     "arc_needs_middle": QT_TRANSLATE_NOOP("Messages", "an arc needs its middle point"),
     "line_has_no_middle": QT_TRANSLATE_NOOP("Messages", "a line has no middle point"),
-    "segment_point_missing": QT_TRANSLATE_NOOP("Messages", "point P{id} does not exist: pick one of the list"),  # noqa: E501
+    "segment_point_missing": QT_TRANSLATE_NOOP(
+        "Messages", "point P{id} does not exist: pick one of the list"
+    ),
     "speed_not_positive": QT_TRANSLATE_NOOP("Messages", "{speed} mm/s: the speed must be above 0"),
     "arc_same_points": QT_TRANSLATE_NOOP("Messages", "an arc's middle point must differ from its end point"),
 }
@@ -148,8 +168,11 @@ def file_text(exc: FileFormatError, problem: str | None) -> str | None:
         place = _place_text(exc)
         if place is None:
             return None
-        text = (_tr(_AT_PLACE_FIELD).format(place=place, column=column, problem=problem) if column
-                else _tr(_AT_PLACE).format(place=place, problem=problem))
+        text = (
+            _tr(_AT_PLACE_FIELD).format(place=place, column=column, problem=problem)
+            if column
+            else _tr(_AT_PLACE).format(place=place, problem=problem)
+        )
     elif exc.row is not None and column is not None:
         text = _tr(_AT_ROW_COLUMN).format(row=exc.row, column=column, problem=problem)
     elif exc.row is not None:
@@ -162,8 +185,11 @@ def file_text(exc: FileFormatError, problem: str | None) -> str | None:
     return _tr(_IN_FILE).format(file=file, text=text) if file else text
 
 
-_OS_CODES = {FileNotFoundError: "no_such_file", IsADirectoryError: "is_a_directory",
-             PermissionError: "permission_denied"}
+_OS_CODES = {
+    FileNotFoundError: "no_such_file",
+    IsADirectoryError: "is_a_directory",
+    PermissionError: "permission_denied",
+}
 
 
 def os_problem(exc: OSError) -> tuple[str, dict[str, Any]]:

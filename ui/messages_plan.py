@@ -27,12 +27,19 @@ _INVALID_INPUT = QT_TRANSLATE_NOOP("Messages", "Invalid value: nothing was sent.
 
 # the safety envelope (app/safety/envelope.py ViolationCode values)
 _ENVELOPE: dict[str, str] = {
-    "keep_in": QT_TRANSLATE_NOOP("Messages", "{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit})."),  # noqa: E501
-    "keep_out": QT_TRANSLATE_NOOP("Messages", "{where}the path enters the keep-out zone \u201c{box}\u201d ({axis} = {value} {unit}, its face is at {limit} {unit})."),  # noqa: E501
+    "keep_in": QT_TRANSLATE_NOOP(
+        "Messages", "{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit})."
+    ),
+    "keep_out": QT_TRANSLATE_NOOP(
+        "Messages",
+        "{where}the path enters the keep-out zone \u201c{box}\u201d ({axis} = {value} {unit}, its face is at {limit} {unit}).",
+    ),
     "joint_limit": QT_TRANSLATE_NOOP("Messages", "{where}{axis} = {value}° is past its limit {limit}°."),
     "speed": QT_TRANSLATE_NOOP("Messages", "{where}speed {value} mm/s is above the {limit} mm/s allowed."),
     "jog_ratio": QT_TRANSLATE_NOOP("Messages", "{where}jog speed {value}% is above the {limit}% allowed."),
-    "approaching": QT_TRANSLATE_NOOP("Messages", "{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}."),  # noqa: E501
+    "approaching": QT_TRANSLATE_NOOP(
+        "Messages", "{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}."
+    ),
 }
 _ENVELOPE_PREFIX = QT_TRANSLATE_NOOP("Messages", "Refused by the safety envelope: {text}")
 _SEGMENT = QT_TRANSLATE_NOOP("Messages", "segment {n}: ")
@@ -48,6 +55,7 @@ def _number(value: Any) -> str:
         return f"{value:.1f}" if abs(value) >= 10 else f"{value:g}"
     return str(value)
 
+
 def envelope_text(args: Mapping[str, Any], prefix: bool = True) -> str:
     code = "approaching" if args.get("approaching") else str(args.get("violation", ""))
     template = _ENVELOPE.get(code)
@@ -57,42 +65,77 @@ def envelope_text(args: Mapping[str, Any], prefix: bool = True) -> str:
     segment = args.get("segment")
     text = _tr(template).format(
         where="" if segment is None else _tr(_SEGMENT).format(n=int(segment) + 1),
-        axis=args.get("axis", ""), box=args.get("box", ""), unit=unit,
-        value=_number(float(args.get("value", 0.0))), limit=_number(float(args.get("limit", 0.0))))
+        axis=args.get("axis", ""),
+        box=args.get("box", ""),
+        unit=unit,
+        value=_number(float(args.get("value", 0.0))),
+        limit=_number(float(args.get("limit", 0.0))),
+    )
     if args.get("reduced"):
         end = text[-1] if text[-1:] in ("。", ".") else ""
         text = text[: len(text) - len(end)] + _tr(_REDUCED) + end
     return _tr(_ENVELOPE_PREFIX).format(text=text) if prefix else text
 
 
-
 # --- the plan's checks (app/plan/checks.py: IssueCode values and their args) -------------------
 _ISSUES: dict[str, str] = {
     "empty-plan": QT_TRANSLATE_NOOP("Messages", "Plan \u201c{plan}\u201d has no segments."),
-    "bad-start": QT_TRANSLATE_NOOP("Messages", "Cannot start at segment {start}: the plan has {segments} segments."),  # noqa: E501
+    "bad-start": QT_TRANSLATE_NOOP(
+        "Messages", "Cannot start at segment {start}: the plan has {segments} segments."
+    ),
     "bad-speed": QT_TRANSLATE_NOOP("Messages", "speed {speed} mm/s is not in (0, {max}] mm/s."),
     "arc-no-middle": QT_TRANSLATE_NOOP("Messages", "the arc has no middle point."),
     "missing-point/middle": QT_TRANSLATE_NOOP("Messages", "middle point P{id} does not exist."),
     "missing-point/end": QT_TRANSLATE_NOOP("Messages", "end point P{id} does not exist."),
     "needs-upload": QT_TRANSLATE_NOOP("Messages", "{point} is not on the controller ({sync}); upload it."),
-    "tool-mismatch": QT_TRANSLATE_NOOP("Messages", "{point} was taught with {point_tool}, the segment moves with {segment_tool}."),  # noqa: E501
-    "zero-length": QT_TRANSLATE_NOOP("Messages", "the line goes nowhere (start and end {length} mm apart){where}."),  # noqa: E501
-    "arc-start-unknown": QT_TRANSLATE_NOOP("Messages", "the arc starts at the robot's current pose, which is not known: its shape is not checked."),  # noqa: E501
-    "arc-points-coincide/start-middle": QT_TRANSLATE_NOOP("Messages", "the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
-    "arc-points-coincide/middle-end": QT_TRANSLATE_NOOP("Messages", "the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
-    "arc-points-coincide/start-end": QT_TRANSLATE_NOOP("Messages", "the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}."),  # noqa: E501
-    "arc-collinear": QT_TRANSLATE_NOOP("Messages", "the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}."),  # noqa: E501
-    "arc-resume-past-middle/past": QT_TRANSLATE_NOOP("Messages", "the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before."),  # noqa: E501
-    "arc-resume-past-middle/larger": QT_TRANSLATE_NOOP("Messages", "sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here."),  # noqa: E501
+    "tool-mismatch": QT_TRANSLATE_NOOP(
+        "Messages", "{point} was taught with {point_tool}, the segment moves with {segment_tool}."
+    ),
+    "zero-length": QT_TRANSLATE_NOOP(
+        "Messages", "the line goes nowhere (start and end {length} mm apart){where}."
+    ),
+    "arc-start-unknown": QT_TRANSLATE_NOOP(
+        "Messages",
+        "the arc starts at the robot's current pose, which is not known: its shape is not checked.",
+    ),
+    "arc-points-coincide/start-middle": QT_TRANSLATE_NOOP(
+        "Messages",
+        "the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}.",
+    ),
+    "arc-points-coincide/middle-end": QT_TRANSLATE_NOOP(
+        "Messages",
+        "the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.",
+    ),
+    "arc-points-coincide/start-end": QT_TRANSLATE_NOOP(
+        "Messages",
+        "the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.",
+    ),
+    "arc-collinear": QT_TRANSLATE_NOOP(
+        "Messages",
+        "the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}.",
+    ),
+    "arc-resume-past-middle/past": QT_TRANSLATE_NOOP(
+        "Messages",
+        "the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before.",
+    ),
+    "arc-resume-past-middle/larger": QT_TRANSLATE_NOOP(
+        "Messages",
+        "sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here.",
+    ),
     "unreachable/point": QT_TRANSLATE_NOOP("Messages", "{point} is out of the robot model's reach."),
     "unreachable/path": QT_TRANSLATE_NOOP("Messages", "the path is out of the robot model's reach."),
     "joint-limit/point": QT_TRANSLATE_NOOP("Messages", "{point} passes a joint limit of the robot model."),
     "joint-limit/path": QT_TRANSLATE_NOOP("Messages", "the path passes a joint limit of the robot model."),
 }
 _FROM_CURRENT_POSE = QT_TRANSLATE_NOOP("Messages", " (from the current pose)")
-_FROM_LATER_LOOPS = QT_TRANSLATE_NOOP("Messages", " (on loops after the first, starting at the end of segment {after})")  # noqa: E501
-_ISSUE_KINDS = {IssueKind.ERROR: "error", IssueKind.NEEDS_UPLOAD: "needs upload",
-                IssueKind.WARNING: "warning"}  # the "SegmentTableModel" translations
+_FROM_LATER_LOOPS = QT_TRANSLATE_NOOP(
+    "Messages", " (on loops after the first, starting at the end of segment {after})"
+)
+_ISSUE_KINDS = {
+    IssueKind.ERROR: "error",
+    IssueKind.NEEDS_UPLOAD: "needs upload",
+    IssueKind.WARNING: "warning",
+}  # the "SegmentTableModel" translations
 
 
 def _tool(tool: Any) -> str:
@@ -124,12 +167,18 @@ def issue_text(issue: PlanIssue) -> str:
     template = _ISSUES.get(_issue_key(issue))
     if template is None:
         return issue.message
-    fields: dict[str, str] = {k: _number(v) if isinstance(v, int | float) and not isinstance(v, bool)
-                              else str(v) for k, v in args.items()}
+    fields: dict[str, str] = {
+        k: _number(v) if isinstance(v, int | float) and not isinstance(v, bool) else str(v)
+        for k, v in args.items()
+    }
     source = args.get("from")
-    fields["where"] = (_tr(_FROM_CURRENT_POSE) if source == "current_pose"
-                       else _tr(_FROM_LATER_LOOPS).format(after=args.get("after", "?"))
-                       if source == "later_loops" else "")
+    fields["where"] = (
+        _tr(_FROM_CURRENT_POSE)
+        if source == "current_pose"
+        else _tr(_FROM_LATER_LOOPS).format(after=args.get("after", "?"))
+        if source == "later_loops"
+        else ""
+    )
     if "sync" in args:
         try:
             fields["sync"] = _tr(SYNC_STATE_TEXT[SyncState(args["sync"])], "Points")
@@ -151,4 +200,3 @@ def issue_line(issue: PlanIssue) -> str:
     """An issue with its kind ("error: segment 2: ..."), for lists and tooltips."""
     kind = QCoreApplication.translate("SegmentTableModel", _ISSUE_KINDS[issue.kind])
     return f"{kind}: {issue_text(issue)}"
-

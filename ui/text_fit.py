@@ -43,6 +43,5 @@ def both_languages(context: str, source: str) -> list[str]:
 def fit_width(widget: QWidget, texts: Iterable[str], padding: int = 0) -> int:
     """Pixels for the widest of ``texts`` in ``widget``'s font (every line), plus ``padding``."""
     metrics = QFontMetrics(widget.font())
-    widest = max((metrics.horizontalAdvance(line) for text in texts for line in text.split("\n")),
-                 default=0)
+    widest = max((metrics.horizontalAdvance(line) for text in texts for line in text.split("\n")), default=0)
     return widest + padding

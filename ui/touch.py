@@ -45,8 +45,9 @@ def show_rows(view: QTableView, rows: int) -> None:
     dock grow from that)."""
     header = view.horizontalHeader()
     header_height = header.sizeHint().height() if not header.isHidden() else 0
-    view.setMinimumHeight(header_height + rows * view.verticalHeader().defaultSectionSize()
-                          + 2 * view.frameWidth())
+    view.setMinimumHeight(
+        header_height + rows * view.verticalHeader().defaultSectionSize() + 2 * view.frameWidth()
+    )
 
 
 class RowsScrollArea(QScrollArea):

@@ -299,8 +299,9 @@ def command_status_text(result: CommandResult) -> str:
     return QCoreApplication.translate(TR_CONTEXT, status.text)
 
 
-def export_with_dialog(parent: QWidget, title: str, default_name: str, filters: str,
-                       export: Callable[[str], object]) -> None:
+def export_with_dialog(
+    parent: QWidget, title: str, default_name: str, filters: str, export: Callable[[str], object]
+) -> None:
     """Ask for a file name, run ``export(path)``; a failed write is shown, never raised."""
     path, _ = QFileDialog.getSaveFileName(parent, title, default_name, filters)
     if not path:
@@ -308,5 +309,10 @@ def export_with_dialog(parent: QWidget, title: str, default_name: str, filters: 
     try:
         export(path)
     except OSError as exc:
-        QMessageBox.warning(parent, title, QCoreApplication.translate(
-            "Export", "Could not write {path}: {error}").format(path=path, error=exc))
+        QMessageBox.warning(
+            parent,
+            title,
+            QCoreApplication.translate("Export", "Could not write {path}: {error}").format(
+                path=path, error=exc
+            ),
+        )

@@ -32,12 +32,26 @@ class WindowActions(QObject):
     """Actions (``connect_action``, ``stop_action``, ``tab_actions``, ``language_actions``, ...),
     the menus (``file_menu`` ... ``help_menu``) and the toolbar of ``window``."""
 
-    def __init__(self, window: QMainWindow, *, connect: Command, disconnect: Command, stop: Command,
-                 pause: Command, resume: Command, about: Command, show_tab: Callable[[int], object],
-                 tab_count: int, set_language: Callable[[str], object], language: str,
-                 file_actions: Sequence[QAction | None], edit_actions: Sequence[QAction],
-                 docks: Sequence[QDockWidget], set_touch_mode: Callable[[bool], object] | None = None,
-                 touch_mode: bool = False) -> None:
+    def __init__(
+        self,
+        window: QMainWindow,
+        *,
+        connect: Command,
+        disconnect: Command,
+        stop: Command,
+        pause: Command,
+        resume: Command,
+        about: Command,
+        show_tab: Callable[[int], object],
+        tab_count: int,
+        set_language: Callable[[str], object],
+        language: str,
+        file_actions: Sequence[QAction | None],
+        edit_actions: Sequence[QAction],
+        docks: Sequence[QDockWidget],
+        set_touch_mode: Callable[[bool], object] | None = None,
+        touch_mode: bool = False,
+    ) -> None:
         super().__init__(window)
         self._window = window
         self._state: RobotState | None = None
@@ -50,8 +64,9 @@ class WindowActions(QObject):
         self.pause_action = self._action(pause, Qt.Key.Key_F6, context=app_wide)
         self.resume_action = self._action(resume, Qt.Key.Key_F7, context=app_wide)
         self.about_action = self._action(about)
-        self.tab_actions = [self._action(functools.partial(show_tab, i), f"Ctrl+{i + 1}")
-                            for i in range(tab_count)]
+        self.tab_actions = [
+            self._action(functools.partial(show_tab, i), f"Ctrl+{i + 1}") for i in range(tab_count)
+        ]
         self.language_group = QActionGroup(self)
         self.language_group.setExclusive(True)
         self.language_actions: dict[str, QAction] = {}
@@ -71,9 +86,13 @@ class WindowActions(QObject):
             self.touch_action.toggled.connect(set_touch_mode)
         self._make_menus(file_actions, edit_actions, docks)
 
-    def _action(self, slot: Callable[[], object],
-                shortcut: QKeySequence | QKeySequence.StandardKey | Qt.Key | str | None = None, *,
-                context: Qt.ShortcutContext = Qt.ShortcutContext.WindowShortcut) -> QAction:
+    def _action(
+        self,
+        slot: Callable[[], object],
+        shortcut: QKeySequence | QKeySequence.StandardKey | Qt.Key | str | None = None,
+        *,
+        context: Qt.ShortcutContext = Qt.ShortcutContext.WindowShortcut,
+    ) -> QAction:
         action = QAction(self)
         if shortcut is not None:
             action.setShortcut(QKeySequence(shortcut))
@@ -95,8 +114,12 @@ class WindowActions(QObject):
         self.pause_action.setEnabled(writable)
         self.resume_action.setEnabled(writable)
 
-    def _make_menus(self, file_actions: Sequence[QAction | None], edit_actions: Sequence[QAction],
-                    docks: Sequence[QDockWidget]) -> None:
+    def _make_menus(
+        self,
+        file_actions: Sequence[QAction | None],
+        edit_actions: Sequence[QAction],
+        docks: Sequence[QDockWidget],
+    ) -> None:
         window = self._window
         bar = window.menuBar()
         self.file_menu = bar.addMenu("")
@@ -148,8 +171,11 @@ class WindowActions(QObject):
         self.view_menu.addAction(self.toolbar.toggleViewAction())
 
     def retranslate(self) -> None:
-        for action, text in zip(self.tab_actions, (self.tr("Show &monitor"), self.tr("Show &points"),
-                                                   self.tr("Show p&lanner")), strict=True):
+        for action, text in zip(
+            self.tab_actions,
+            (self.tr("Show &monitor"), self.tr("Show &points"), self.tr("Show p&lanner")),
+            strict=True,
+        ):
             action.setText(text)
         self.file_menu.setTitle(self.tr("&File"))
         self.edit_menu.setTitle(self.tr("&Edit"))

@@ -21,9 +21,10 @@ from ui.panels.step_panel import StepPanel
 __all__ = ["ControlColumn"]
 
 # The column was part of the window: its texts keep the "MainWindow" translation context.
-BANNER_STYLE = ("QLabel { background: #fff1d6; color: #7a4a00; border: 1px solid #ef8f00;"
-                " border-radius: 4px; padding: 4px; font-weight: bold; }")
-
+BANNER_STYLE = (
+    "QLabel { background: #fff1d6; color: #7a4a00; border: 1px solid #ef8f00;"
+    " border-radius: 4px; padding: 4px; font-weight: bold; }"
+)
 
 
 class ControlColumn(QWidget):
@@ -77,9 +78,11 @@ class ControlColumn(QWidget):
         connection = state.connection if state is not None else None
         writable = state is not None and state.writable
         if connection is not None and connection.connected and connection.monitor_only:
-            self.motion_banner.setText(QCoreApplication.translate(
-                "MainWindow", "Monitor only: motion controls are disabled"))
+            self.motion_banner.setText(
+                QCoreApplication.translate("MainWindow", "Monitor only: motion controls are disabled")
+            )
         elif connection is None or not connection.connected:
-            self.motion_banner.setText(QCoreApplication.translate(
-                "MainWindow", "Not connected: motion controls are disabled"))
+            self.motion_banner.setText(
+                QCoreApplication.translate("MainWindow", "Not connected: motion controls are disabled")
+            )
         self.motion_banner.setVisible(not writable)

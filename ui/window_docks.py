@@ -27,7 +27,6 @@ STATUS_DOCK_MAX_WIDTH = 320  # the status column never needs more; the work tabs
 DOCK_MIN_ROWS = 5  # the bottom docks (event log, traffic) show at least this many rows
 
 
-
 class WindowDocks(QObject):
     """The panels (``status_panel``, ``event_log``, ``traffic_panel``, ``alarm_list``) and their
     docks (``status_dock``, ``event_dock``, ``traffic_dock``, ``alarm_dock``) on ``window``."""
@@ -92,8 +91,9 @@ class WindowDocks(QObject):
         """A narrow status dock, a short log (once the layout has its real size)."""
         window = self._window
         window.resizeDocks([self.status_dock], [STATUS_DOCK_WIDTH], Qt.Orientation.Horizontal)
-        window.resizeDocks([self.event_dock], [self.event_dock.minimumSizeHint().height()],
-                           Qt.Orientation.Vertical)
+        window.resizeDocks(
+            [self.event_dock], [self.event_dock.minimumSizeHint().height()], Qt.Orientation.Vertical
+        )
 
     @Slot(bool)
     def _on_traffic_dock_visibility(self, shown: bool) -> None:

@@ -22,7 +22,6 @@ __all__ = ["MESSAGE_MS", "WindowStatusBar"]
 MESSAGE_MS = 8000  # how long a transient status-bar message stays
 
 
-
 class WindowStatusBar(QObject):
     """The labels ``monitor_only_label``, ``project_label``, ``rtt_label`` and ``link_label`` on ``bar``."""
 
@@ -63,7 +62,8 @@ class WindowStatusBar(QObject):
     def show_project(self, title: str, path: str) -> None:
         self._project_title = title
         self.project_label.setText(
-            QCoreApplication.translate("MainWindow", "Project: {name}").format(name=title))
+            QCoreApplication.translate("MainWindow", "Project: {name}").format(name=title)
+        )
         self.project_label.setToolTip(path)
 
     @Slot(ConnectionState)

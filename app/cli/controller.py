@@ -112,8 +112,9 @@ def cmd_step(ctx: CliContext) -> ExitCode:
     frame = StepFrame(ctx.args.frame)
     offsets, ext = parse_step_offsets(frame, ctx.args.offsets)
     client = ctx.client
-    result = wait_motion(ctx, lambda: client.step(frame, offsets, ext, speed=ctx.args.speed,
-                                                   wait=not ctx.args.no_wait))
+    result = wait_motion(
+        ctx, lambda: client.step(frame, offsets, ext, speed=ctx.args.speed, wait=not ctx.args.no_wait)
+    )
     ctx.print(result.message)
     if not ctx.args.no_wait:
         ctx.print(_pose_line(client.read_pose()))
@@ -185,10 +186,19 @@ def cmd_point_create(ctx: CliContext) -> ExitCode:
 def cmd_move(ctx: CliContext) -> ExitCode:
     args = ctx.args
     client = ctx.client
-    result = wait_motion(ctx, lambda: client.move_to_point(
-        args.id, via_id=args.via, orientation_changes=not args.keep_orientation,
-        ignore_middle=args.ignore_middle, speed=args.speed, tool=args.tool, wait=not args.no_wait,
-        timeout=args.wait_timeout))
+    result = wait_motion(
+        ctx,
+        lambda: client.move_to_point(
+            args.id,
+            via_id=args.via,
+            orientation_changes=not args.keep_orientation,
+            ignore_middle=args.ignore_middle,
+            speed=args.speed,
+            tool=args.tool,
+            wait=not args.no_wait,
+            timeout=args.wait_timeout,
+        ),
+    )
     ctx.print(result.message)
     if not args.no_wait:
         ctx.print(_pose_line(client.read_pose()))
@@ -202,8 +212,11 @@ def cmd_zero(ctx: CliContext) -> ExitCode:
     return ctx.report(f"go to zero sent ({target})")
 
 
-_PROGRAM_MODES = {"step": ProgramMotionMode.SINGLE_STEP, "single": ProgramMotionMode.SINGLE_RUN,
-                  "cycle": ProgramMotionMode.CYCLE}
+_PROGRAM_MODES = {
+    "step": ProgramMotionMode.SINGLE_STEP,
+    "single": ProgramMotionMode.SINGLE_RUN,
+    "cycle": ProgramMotionMode.CYCLE,
+}
 
 
 def cmd_program_run(ctx: CliContext) -> ExitCode:
@@ -227,7 +240,9 @@ def cmd_program_run(ctx: CliContext) -> ExitCode:
                 CommandStatus(None, status.command_status_code),
                 f"the controller did not start program {args.id}: its program state stayed stopped for "
                 f"{PROGRAM_START_TIMEOUT:g} s (no such program, or the controller refused it)",
-                code="program_not_started", params={"program": args.id})
+                code="program_not_started",
+                params={"program": args.id},
+            )
         time.sleep(PROGRAM_START_POLL)
 
 
@@ -278,8 +293,13 @@ def register(sub: Any) -> None:
     p.set_defaults(handler=cmd_status)
 
     p = sub.add_parser("watch", help="stream one status line per sample")
-    p.add_argument("--rate", type=parse_positive_float, default=WATCH_RATE_DEFAULT, metavar="HZ",
-                   help="samples per second, Hz (default %(default)g)")
+    p.add_argument(
+        "--rate",
+        type=parse_positive_float,
+        default=WATCH_RATE_DEFAULT,
+        metavar="HZ",
+        help="samples per second, Hz (default %(default)g)",
+    )
     p.add_argument("--count", type=int, default=0, metavar="N", help="stop after N lines (0: until Ctrl-C)")
     p.set_defaults(handler=cmd_watch)
 
@@ -288,30 +308,48 @@ def register(sub: Any) -> None:
     p.set_defaults(handler=cmd_mode)
 
     p = sub.add_parser("step", help="incremental move (function 1), e.g. step --frame base X=10 Z=-5")
-    p.add_argument("--frame", choices=("joint", "base"), required=True,
-                   help="joint: offsets in degrees per joint; base: X Y Z in mm, A B C in degrees")
-    p.add_argument("offsets", nargs="+", metavar="AXIS=VALUE",
-                   help="J1..J11 (joint) or X Y Z A B C (+ J7..J11) (base)")
+    p.add_argument(
+        "--frame",
+        choices=("joint", "base"),
+        required=True,
+        help="joint: offsets in degrees per joint; base: X Y Z in mm, A B C in degrees",
+    )
+    p.add_argument(
+        "offsets", nargs="+", metavar="AXIS=VALUE", help="J1..J11 (joint) or X Y Z A B C (+ J7..J11) (base)"
+    )
     p.add_argument("--speed", type=parse_positive_float, default=10.0, help="rpm (joint) or mm/s (base)")
     p.add_argument("--no-wait", action="store_true", help="return once the command is sent")
     p.set_defaults(handler=cmd_step)
 
     p = sub.add_parser(
-        "jog", help="teach-mode jog for a bounded time (function 4); always stops and disables",
+        "jog",
+        help="teach-mode jog for a bounded time (function 4); always stops and disables",
         description="Jog one axis in teach mode, then write ratio 0 and disable teach mode. The jog is "
-                    f"bounded: it stops after --seconds (default {JOG_SECONDS_DEFAULT:g} s, at most "
-                    f"{JOG_SECONDS_MAX:g} s), on Ctrl-C and on any error. Example: "
-                    "teachpad-cli --host 192.168.1.10 jog --axis Z --dir + --ratio 10 --seconds 1.5")
-    p.add_argument("--frame", choices=("base", "user", "tool", "joint"), default="base",
-                   help="the frame the axis belongs to (default %(default)s)")
+        f"bounded: it stops after --seconds (default {JOG_SECONDS_DEFAULT:g} s, at most "
+        f"{JOG_SECONDS_MAX:g} s), on Ctrl-C and on any error. Example: "
+        "teachpad-cli --host 192.168.1.10 jog --axis Z --dir + --ratio 10 --seconds 1.5",
+    )
+    p.add_argument(
+        "--frame",
+        choices=("base", "user", "tool", "joint"),
+        default="base",
+        help="the frame the axis belongs to (default %(default)s)",
+    )
     p.add_argument("--user", type=int, default=0, metavar="N", help="user frame id (frame user)")
     p.add_argument("--tool", type=int, default=0, metavar="N", help="tool frame id (frame tool)")
     p.add_argument("--axis", required=True, help="X Y Z A B C, or J1..J11 in the joint frame")
     p.add_argument("--dir", required=True, help="+ or -")
     p.add_argument("--ratio", type=float, required=True, help="speed ratio in percent, 0 < N <= 100")
-    p.add_argument("--seconds", "--for", dest="duration", type=parse_jog_seconds, default=JOG_SECONDS_DEFAULT,
-                   metavar="S", help=f"how long to jog, in seconds: 0 < S <= {JOG_SECONDS_MAX:g} "
-                                     f"(default {JOG_SECONDS_DEFAULT:g}); --for is the same")
+    p.add_argument(
+        "--seconds",
+        "--for",
+        dest="duration",
+        type=parse_jog_seconds,
+        default=JOG_SECONDS_DEFAULT,
+        metavar="S",
+        help=f"how long to jog, in seconds: 0 < S <= {JOG_SECONDS_MAX:g} "
+        f"(default {JOG_SECONDS_DEFAULT:g}); --for is the same",
+    )
     p.set_defaults(handler=cmd_jog)
 
     p = sub.add_parser("point", help="temp points (function 2)")
@@ -320,10 +358,20 @@ def register(sub: Any) -> None:
     pc.add_argument("id", type=int, help="temp point id, 1..10000")
     src = pc.add_mutually_exclusive_group()
     src.add_argument("--from-pose", action="store_true", help="from the current pose (default)")
-    src.add_argument("--xyzabc", type=float, nargs=6, metavar=("X", "Y", "Z", "A", "B", "C"),
-                     help="the pose: X Y Z in mm, A B C in degrees (base frame)")
-    pc.add_argument("--tool", type=int, default=registers.TOOL_NONE, metavar="N",
-                    help="GV245: 200 none (default), N = tool N+1")
+    src.add_argument(
+        "--xyzabc",
+        type=float,
+        nargs=6,
+        metavar=("X", "Y", "Z", "A", "B", "C"),
+        help="the pose: X Y Z in mm, A B C in degrees (base frame)",
+    )
+    pc.add_argument(
+        "--tool",
+        type=int,
+        default=registers.TOOL_NONE,
+        metavar="N",
+        help="GV245: 200 none (default), N = tool N+1",
+    )
     pc.add_argument("--gv-start", type=int, default=0, metavar="N", help="first of the six pose GVs")
     pc.set_defaults(handler=cmd_point_create)
 
@@ -331,15 +379,29 @@ def register(sub: Any) -> None:
     p.add_argument("id", type=int, help="temp point id of the end point, 1..10000")
     p.add_argument("--via", type=int, metavar="MID", help="temp point id of an arc's middle point")
     p.add_argument("--speed", type=parse_positive_float, default=50.0, help="mm/s (default %(default)g)")
-    p.add_argument("--keep-orientation", action="store_true",
-                   help="keep the tool's orientation (A B C) along an arc")
-    p.add_argument("--ignore-middle", action="store_true",
-                   help="arc: use the middle point's position only, not its orientation")
-    p.add_argument("--tool", type=int, default=registers.TOOL_NONE, metavar="N",
-                   help=f"tool frame id ({registers.TOOL_NONE}: none, the default)")
+    p.add_argument(
+        "--keep-orientation", action="store_true", help="keep the tool's orientation (A B C) along an arc"
+    )
+    p.add_argument(
+        "--ignore-middle",
+        action="store_true",
+        help="arc: use the middle point's position only, not its orientation",
+    )
+    p.add_argument(
+        "--tool",
+        type=int,
+        default=registers.TOOL_NONE,
+        metavar="N",
+        help=f"tool frame id ({registers.TOOL_NONE}: none, the default)",
+    )
     p.add_argument("--no-wait", action="store_true", help="return once the command is sent")
-    p.add_argument("--wait-timeout", type=parse_positive_float, default=None, metavar="SECONDS",
-                   help="give up waiting after this many seconds (default: by distance and speed)")
+    p.add_argument(
+        "--wait-timeout",
+        type=parse_positive_float,
+        default=None,
+        metavar="SECONDS",
+        help="give up waiting after this many seconds (default: by distance and speed)",
+    )
     p.set_defaults(handler=cmd_move)
 
     p = sub.add_parser("zero", help="go to zero: one axis (J1..J11) or all")
@@ -350,26 +412,38 @@ def register(sub: Any) -> None:
     psub = p.add_subparsers(dest="program_command", metavar="ACTION", required=True)
     pr = psub.add_parser("run", help="run a program")
     pr.add_argument("id", type=int, help="program id on the controller (register 446)")
-    pr.add_argument("--mode", choices=tuple(_PROGRAM_MODES), default="single",
-                    help="step: one segment; single: one run; cycle: --cycles runs (default %(default)s)")
+    pr.add_argument(
+        "--mode",
+        choices=tuple(_PROGRAM_MODES),
+        default="single",
+        help="step: one segment; single: one run; cycle: --cycles runs (default %(default)s)",
+    )
     pr.add_argument("--cycles", type=int, default=1, help="cycle count (0: endless)")
-    pr.add_argument("--speed", type=int, default=100,
-                    help="speed ratio in percent, 1..100 (default %(default)s)")
+    pr.add_argument(
+        "--speed", type=int, default=100, help="speed ratio in percent, 1..100 (default %(default)s)"
+    )
     pr.set_defaults(handler=cmd_program_run)
 
-    for name, handler, text in (("stop", cmd_stop, "stop the motion or program"),
-                                ("pause", cmd_pause, "pause"), ("resume", cmd_resume, "resume")):
+    for name, handler, text in (
+        ("stop", cmd_stop, "stop the motion or program"),
+        ("pause", cmd_pause, "pause"),
+        ("resume", cmd_resume, "resume"),
+    ):
         p = sub.add_parser(name, help=text)
         p.set_defaults(handler=handler)
 
     p = sub.add_parser("read", help="read GVs (float32)")
     p.add_argument("gv", type=int, metavar="GV", help="first GV number, 0..299 (e.g. 291)")
-    p.add_argument("count", type=int, nargs="?", default=1, metavar="COUNT",
-                   help="how many GVs (default 1)")
+    p.add_argument("count", type=int, nargs="?", default=1, metavar="COUNT", help="how many GVs (default 1)")
     p.set_defaults(handler=cmd_read)
 
     p = sub.add_parser("write", help="write GVs (float32, one 0x10)")
     p.add_argument("gv", type=int, metavar="GV", help="first GV number, 0..299")
-    p.add_argument("values", type=float, nargs="+", metavar="VALUE",
-                   help="float32 values, written to GV, GV+1, ... (units as the GV's meaning)")
+    p.add_argument(
+        "values",
+        type=float,
+        nargs="+",
+        metavar="VALUE",
+        help="float32 values, written to GV, GV+1, ... (units as the GV's meaning)",
+    )
     p.set_defaults(handler=cmd_write)

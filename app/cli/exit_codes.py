@@ -39,8 +39,10 @@ class ExitCode(enum.IntEnum):
 
 _MEANING = {
     ExitCode.OK: "ok",
-    ExitCode.FAILED: ("command failed or refused (controller, alarm, timeout of the command, monitor-only, "
-                      "out of the robot's reach)"),
+    ExitCode.FAILED: (
+        "command failed or refused (controller, alarm, timeout of the command, monitor-only, "
+        "out of the robot's reach)"
+    ),
     ExitCode.USAGE: "usage: bad arguments, values or input files (nothing sent)",
     ExitCode.LINK: "link: cannot connect, no answer in time, malformed answer",
     ExitCode.INTERRUPTED: "interrupted (Ctrl-C; a motion under way is stopped first)",

@@ -63,11 +63,15 @@ def status_to_dict(pose: Pose, status: ControllerStatus) -> dict[str, Any]:
         "external_axes": list(pose.ext),
         "joints": list(pose.joints) if pose.joints is not None else None,
         "mode": {"value": int(status.mode), "name": controller_mode_text(int(status.mode))},
-        "program_state": {"value": int(status.program_state),
-                          "name": program_state_text(int(status.program_state))},
+        "program_state": {
+            "value": int(status.program_state),
+            "name": program_state_text(int(status.program_state)),
+        },
         "alarms": {"value": int(status.alarms), "names": alarm_names(int(status.alarms))},
         "command_status": {"code": code, "text": decoded.text},
-        "clock": None if clock is None else {
+        "clock": None
+        if clock is None
+        else {
             "iso": clock.value.isoformat() if clock.value is not None else None,
             "raw": list(clock.raw),
             "raw_hex": clock.raw_hex,
@@ -77,11 +81,15 @@ def status_to_dict(pose: Pose, status: ControllerStatus) -> dict[str, Any]:
 
 def format_status(pose: Pose, status: ControllerStatus) -> str:
     data = status_to_dict(pose, status)
-    cart = "  ".join(f"{n} {format_number(v)}"
-                     for n, v in zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True))
+    cart = "  ".join(
+        f"{n} {format_number(v)}" for n, v in zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True)
+    )
     ext = "  ".join(f"EJ{i} {format_number(v)}" for i, v in enumerate(pose.ext, start=1))
-    joints = ("  ".join(f"J{i} {format_number(v)}" for i, v in enumerate(pose.joints, start=1))
-              if pose.joints is not None else "-")
+    joints = (
+        "  ".join(f"J{i} {format_number(v)}" for i, v in enumerate(pose.joints, start=1))
+        if pose.joints is not None
+        else "-"
+    )
     alarms = ", ".join(data["alarms"]["names"]) or "none"
     lines = [
         f"pose      {cart}",
@@ -102,9 +110,11 @@ def format_status(pose: Pose, status: ControllerStatus) -> str:
 def format_watch_line(elapsed: float, pose: Pose, status: ControllerStatus) -> str:
     cart = " ".join(f"{n}={format_number(v)}" for n, v in zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True))
     alarms = ",".join(alarm_names(int(status.alarms))) or "none"
-    return (f"t={elapsed:.3f} {cart} mode={controller_mode_text(int(status.mode))} "
-            f"program={program_state_text(int(status.program_state))} alarms={alarms} "
-            f"cmd={status.command_status_code}")
+    return (
+        f"t={elapsed:.3f} {cart} mode={controller_mode_text(int(status.mode))} "
+        f"program={program_state_text(int(status.program_state))} alarms={alarms} "
+        f"cmd={status.command_status_code}"
+    )
 
 
 # --------------------------------------------------------------------------------------------

@@ -69,8 +69,12 @@ __all__ = [
 Registrar = Callable[[Any], None]  # register(subparsers: argparse._SubParsersAction)
 
 #: Every command module's ``register(subparsers)``, in the order of ``--help``.
-REGISTRARS: tuple[Registrar, ...] = (controller.register, points.register, run_plan.register,
-                                     support.register)
+REGISTRARS: tuple[Registrar, ...] = (
+    controller.register,
+    points.register,
+    run_plan.register,
+    support.register,
+)
 
 # The table's members under the names callers imported before the table existed.
 EXIT_OK = ExitCode.OK
@@ -81,45 +85,89 @@ EXIT_INTERRUPTED = ExitCode.INTERRUPTED
 
 _PATH_SHOWN = 100  # characters of a path in an error message
 
-_DESCRIPTION = ("Talk to a Bochuang robot controller over Modbus. An administrator's tool: "
-                "TeachPad's operator roles apply to the GUI, not here.")
+_DESCRIPTION = (
+    "Talk to a Bochuang robot controller over Modbus. An administrator's tool: "
+    "TeachPad's operator roles apply to the GUI, not here."
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog=PROG, description=textwrap.fill(_DESCRIPTION, 90), epilog=EPILOG,
+        prog=PROG,
+        description=textwrap.fill(_DESCRIPTION, 90),
+        epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,  # keeps the exit code table's lines
     )
     link = parser.add_argument_group("link")
-    link.add_argument("--host", default="127.0.0.1",
-                      help="controller's IP address or host name (default %(default)s)")
+    link.add_argument(
+        "--host", default="127.0.0.1", help="controller's IP address or host name (default %(default)s)"
+    )
     link.add_argument("--port", type=int, default=502, help="Modbus TCP port (default %(default)s)")
     link.add_argument("--rtu", metavar="PORT", help="Modbus RTU on this serial port instead of TCP")
     link.add_argument("--baud", type=int, default=115200, help="RTU baud rate, bit/s (default %(default)s)")
-    link.add_argument("--parity", choices=("N", "E", "O"), default="N",
-                      help="RTU parity: none, even, odd (default %(default)s)")
-    link.add_argument("--framer", choices=("socket", "rtu"), default="socket",
-                      help="frame format over TCP (rtu: RTU frames over a TCP socket)")
-    link.add_argument("--timeout", type=parse_positive_float, default=1.0, metavar="SECONDS",
-                      help="Modbus request timeout of commands and one-off reads")
-    regs = parser.add_argument_group("register profile", textwrap.fill(
-        "How the controller's registers read. --register-profile applies a register profile file "
-        "(.registers.json, as saved by the GUI's Safety > Register profile; the GUI's own is "
-        f"{_shown_path(default_config_dir() / PROFILE_NAME)}); the options below override the "
-        "profile's field of the same name.", 90))
-    regs.add_argument("--register-profile", type=Path, metavar="FILE",
-                      help="apply this register profile (word order, unit id, completion rule, poll "
-                           "timeout, date/time layout, point ids)")
-    regs.add_argument("--unit", type=int, default=None,
-                      help="Modbus unit (slave) id (default: the register profile's, else 1)")
-    regs.add_argument("--word-order", type=parse_word_order, default=None,
-                      metavar="low-first|high-first",
-                      help="float32 word order of the controller (default: the profile's, else low-first)")
-    regs.add_argument("--completion", choices=COMPLETION_MODES, default=None,
-                      help="how a command's completion is told (default: the profile's, else auto)")
-    regs.add_argument("--poll-timeout", type=parse_positive_float, default=None, metavar="SECONDS",
-                      help="timeout of the monitoring reads of status and watch (default: the "
-                           "profile's, else 0.15 over TCP, by baud rate over RTU)")
+    link.add_argument(
+        "--parity",
+        choices=("N", "E", "O"),
+        default="N",
+        help="RTU parity: none, even, odd (default %(default)s)",
+    )
+    link.add_argument(
+        "--framer",
+        choices=("socket", "rtu"),
+        default="socket",
+        help="frame format over TCP (rtu: RTU frames over a TCP socket)",
+    )
+    link.add_argument(
+        "--timeout",
+        type=parse_positive_float,
+        default=1.0,
+        metavar="SECONDS",
+        help="Modbus request timeout of commands and one-off reads",
+    )
+    regs = parser.add_argument_group(
+        "register profile",
+        textwrap.fill(
+            "How the controller's registers read. --register-profile applies a register profile file "
+            "(.registers.json, as saved by the GUI's Safety > Register profile; the GUI's own is "
+            f"{_shown_path(default_config_dir() / PROFILE_NAME)}); the options below override the "
+            "profile's field of the same name.",
+            90,
+        ),
+    )
+    regs.add_argument(
+        "--register-profile",
+        type=Path,
+        metavar="FILE",
+        help="apply this register profile (word order, unit id, completion rule, poll "
+        "timeout, date/time layout, point ids)",
+    )
+    regs.add_argument(
+        "--unit",
+        type=int,
+        default=None,
+        help="Modbus unit (slave) id (default: the register profile's, else 1)",
+    )
+    regs.add_argument(
+        "--word-order",
+        type=parse_word_order,
+        default=None,
+        metavar="low-first|high-first",
+        help="float32 word order of the controller (default: the profile's, else low-first)",
+    )
+    regs.add_argument(
+        "--completion",
+        choices=COMPLETION_MODES,
+        default=None,
+        help="how a command's completion is told (default: the profile's, else auto)",
+    )
+    regs.add_argument(
+        "--poll-timeout",
+        type=parse_positive_float,
+        default=None,
+        metavar="SECONDS",
+        help="timeout of the monitoring reads of status and watch (default: the "
+        "profile's, else 0.15 over TCP, by baud rate over RTU)",
+    )
     link.add_argument("--monitor-only", action="store_true", help="refuse every write")
     parser.add_argument("-v", "--verbose", action="store_true", help="log every write and the link")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -139,13 +187,20 @@ def settings_from_args(args: argparse.Namespace) -> ConnectionSettings:
 
     Raises :class:`RegisterProfileError` (a usage error) for a profile that cannot be used."""
     where = ConnectionSettings(
-        host=args.host, port=args.port, serial_port=args.rtu, baudrate=args.baud,
-        parity=args.parity, framer=args.framer, timeout=args.timeout, monitor_only=args.monitor_only,
+        host=args.host,
+        port=args.port,
+        serial_port=args.rtu,
+        baudrate=args.baud,
+        parity=args.parity,
+        framer=args.framer,
+        timeout=args.timeout,
+        monitor_only=args.monitor_only,
     )
     path = getattr(args, "register_profile", None)
     settings = where if path is None else load_register_profile(path).apply(where)
-    overrides = {name: value for name in PROFILE_OVERRIDES
-                 if (value := getattr(args, name, None)) is not None}
+    overrides = {
+        name: value for name in PROFILE_OVERRIDES if (value := getattr(args, name, None)) is not None
+    }
     if "unit" in overrides and not UNIT_RANGE[0] <= overrides["unit"] <= UNIT_RANGE[1]:
         raise InvalidInput(f"--unit must be {UNIT_RANGE[0]}..{UNIT_RANGE[1]}, got {overrides['unit']}")
     return dataclasses.replace(settings, **overrides)
@@ -153,7 +208,7 @@ def settings_from_args(args: argparse.Namespace) -> ConnectionSettings:
 
 def _shown_path(path: Path) -> str:
     text = str(path)
-    return text if len(text) <= _PATH_SHOWN else "…" + text[-(_PATH_SHOWN - 1):]
+    return text if len(text) <= _PATH_SHOWN else "…" + text[-(_PATH_SHOWN - 1) :]
 
 
 def _configure_logging(verbose: bool) -> None:
@@ -220,7 +275,7 @@ def _error_text(exc: BaseException) -> str:
     if isinstance(exc, OSError) and not isinstance(exc, TeachPadError):
         path = str(exc.filename or "")
         if len(path) > _PATH_SHOWN:
-            path = "…" + path[-(_PATH_SHOWN - 1):]
+            path = "…" + path[-(_PATH_SHOWN - 1) :]
         return f"{path}: {exc.strerror or exc}" if path else str(exc.strerror or exc)
     return str(exc)
 

@@ -50,15 +50,15 @@ EXIT_LINK = ExitCode.LINK
 EXIT_INTERRUPTED = ExitCode.INTERRUPTED
 
 
-
 _PROJECT_HELP = "the project file (.tpproj)"
 NAME_WIDTH = 20  # terminal columns of the name in ``points list``
 
 
 def display_width(text: str) -> int:
     """Terminal columns of ``text``: wide (CJK) characters take two, combining marks none."""
-    return sum(0 if unicodedata.combining(c) else 2 if unicodedata.east_asian_width(c) in "WF" else 1
-               for c in text)
+    return sum(
+        0 if unicodedata.combining(c) else 2 if unicodedata.east_asian_width(c) in "WF" else 1 for c in text
+    )
 
 
 def fit_width(text: str, width: int) -> str:
@@ -92,19 +92,37 @@ def register(subparsers: Any) -> None:
 
     p = psub.add_parser("export", help="write the project's points to a CSV file")
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
-    p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="OUT",
-                   help="the CSV file to write (mm, degrees)")
+    p.add_argument(
+        "--csv",
+        type=Path,
+        required=True,
+        dest="csv_path",
+        metavar="OUT",
+        help="the CSV file to write (mm, degrees)",
+    )
     p.add_argument("--no-bom", action="store_true", help="write UTF-8 without a byte order mark")
     p.set_defaults(handler=cmd_points_export)
 
     p = psub.add_parser("import", help="read points from a CSV file into the project")
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
-    p.add_argument("--csv", type=Path, required=True, dest="csv_path", metavar="IN",
-                   help="the CSV file to read (mm, degrees)")
-    p.add_argument("--merge", action="store_true",
-                   help="update and add points, keep the others (default: replace all points)")
-    p.add_argument("--allow-empty", action="store_true",
-                   help="let a CSV without rows replace (delete) all points of the project")
+    p.add_argument(
+        "--csv",
+        type=Path,
+        required=True,
+        dest="csv_path",
+        metavar="IN",
+        help="the CSV file to read (mm, degrees)",
+    )
+    p.add_argument(
+        "--merge",
+        action="store_true",
+        help="update and add points, keep the others (default: replace all points)",
+    )
+    p.add_argument(
+        "--allow-empty",
+        action="store_true",
+        help="let a CSV without rows replace (delete) all points of the project",
+    )
     p.set_defaults(handler=cmd_points_import)
 
 
@@ -117,8 +135,9 @@ def _limits(ctx: CliContext) -> PointLimits:
     lo = getattr(ctx.args, "point_id_min", None)
     hi = getattr(ctx.args, "point_id_max", None)
     settings = ctx.settings
-    return PointLimits(settings.point_id_min if lo is None else lo,
-                       settings.point_id_max if hi is None else hi)
+    return PointLimits(
+        settings.point_id_min if lo is None else lo, settings.point_id_max if hi is None else hi
+    )
 
 
 def _load(ctx: CliContext, path: Path, limits: PointLimits) -> Project | None:
@@ -146,8 +165,10 @@ def _monitor_only(ctx: CliContext, args: argparse.Namespace, what: str) -> bool:
 def _save(ctx: CliContext, project: Project, path: Path) -> bool:
     owner = live_owner(path)
     if owner is not None:
-        ctx.error(f"{path}: not saved: the project is open in a TeachPad ({owner.text}); "
-                 "close it there or make the change there")
+        ctx.error(
+            f"{path}: not saved: the project is open in a TeachPad ({owner.text}); "
+            "close it there or make the change there"
+        )
         return False
     try:
         save_project(project, path)
@@ -210,8 +231,10 @@ def _upload(ctx: CliContext, project: Project, points: Sequence[TempPoint], clie
     unconfirmed = [o.point_id for o in report.outcomes if o.ok and o.unconfirmed]
     if unconfirmed:
         shown = ",".join(map(str, unconfirmed[:20])) + (",..." if len(unconfirmed) > 20 else "")
-        ctx.print(f"{len(unconfirmed)} of them unconfirmed: the controller reported no error but its "
-                 f"command status did not change (GV291 not writable): {shown}")
+        ctx.print(
+            f"{len(unconfirmed)} of them unconfirmed: the controller reported no error but its "
+            f"command status did not change (GV291 not writable): {shown}"
+        )
     for outcome in report.failed:
         ctx.error(f"P{outcome.point_id}: {outcome.reason}")
     if report.aborted:
@@ -317,8 +340,11 @@ def cmd_points_import(ctx: CliContext) -> ExitCode:
         project = Project(name=name, ledger=PointLedger((), limits))
     try:
         points = read_points_csv(args.csv_path, limits)
-        report = project.ledger.import_points(points, ImportMode.MERGE if args.merge else ImportMode.REPLACE,
-                                              allow_empty=getattr(args, "allow_empty", False))
+        report = project.ledger.import_points(
+            points,
+            ImportMode.MERGE if args.merge else ImportMode.REPLACE,
+            allow_empty=getattr(args, "allow_empty", False),
+        )
     except EmptyImport as exc:
         ctx.error(f"{args.csv_path}: {exc}; nothing changed (pass --allow-empty to do it)")
         return ExitCode.USAGE

@@ -64,24 +64,45 @@ def register(subparsers: Any) -> None:
     r.add_argument("project", type=Path, help=_PROJECT_HELP)
     r.add_argument("--plan", help="plan name (needed when the project has several)")
     r.add_argument("--loops", type=int, help="loop count (default: the plan's; 0 = until stopped)")
-    r.add_argument("--from", type=int, default=1, dest="from_segment", metavar="K",
-                   help="start at segment K (counting from 1)")
+    r.add_argument(
+        "--from",
+        type=int,
+        default=1,
+        dest="from_segment",
+        metavar="K",
+        help="start at segment K (counting from 1)",
+    )
     r.add_argument("--from-loop", type=int, default=1, metavar="I", help="start in loop I (to resume)")
     r.add_argument("--single", action="store_true", help="run segment K only")
-    r.add_argument("--no-upload", action="store_true",
-                   help="do not create the plan's points on the controller before and during the run: "
-                        "the operator is responsible for the controller holding exactly the project's "
-                        "points (the arrival pose is still checked after each segment)")
+    r.add_argument(
+        "--no-upload",
+        action="store_true",
+        help="do not create the plan's points on the controller before and during the run: "
+        "the operator is responsible for the controller holding exactly the project's "
+        "points (the arrival pose is still checked after each segment)",
+    )
     r.add_argument("--upload", action="store_true", help=argparse.SUPPRESS)  # the default now (old scripts)
     r.add_argument("--check", action="store_true", help="check and estimate only; do not connect or move")
-    r.add_argument("--safety", metavar="PROFILE",
-                   help="a safety profile (.safety.json): the plan must stay in its envelope")
-    r.add_argument("--robot-profile", type=Path, metavar="FILE",
-                   help="the robot model (.json, as the GUI's 3D view loads it) whose reach every point "
-                        "and the sampled path must stay in (default: the simulator's arm, "
-                        f"{DEFAULT_PROFILE_FILE})")
-    r.add_argument("--max-speed", type=float, default=PlanLimits().max_speed, metavar="MM_S",
-                   help="highest speed a segment may have (default %(default)g mm/s)")
+    r.add_argument(
+        "--safety",
+        metavar="PROFILE",
+        help="a safety profile (.safety.json): the plan must stay in its envelope",
+    )
+    r.add_argument(
+        "--robot-profile",
+        type=Path,
+        metavar="FILE",
+        help="the robot model (.json, as the GUI's 3D view loads it) whose reach every point "
+        "and the sampled path must stay in (default: the simulator's arm, "
+        f"{DEFAULT_PROFILE_FILE})",
+    )
+    r.add_argument(
+        "--max-speed",
+        type=float,
+        default=PlanLimits().max_speed,
+        metavar="MM_S",
+        help="highest speed a segment may have (default %(default)g mm/s)",
+    )
     r.set_defaults(handler=cmd_run)
 
 
@@ -97,13 +118,21 @@ def _pick_plan(ctx: CliContext, project: Project, name: str | None) -> Plan | No
     if not project.plans:
         ctx.error("the project has no plans")
     else:
-        ctx.error(f"the project has {len(project.plans)} plans ({', '.join(project.plan_names())}): "
-                 "choose one with --plan")
+        ctx.error(
+            f"the project has {len(project.plans)} plans ({', '.join(project.plan_names())}): "
+            "choose one with --plan"
+        )
     return None
 
 
-def _upload_plan_points(ctx: CliContext, args: argparse.Namespace, project: Project, guard: PointGuard,
-                        plan_ids: list[int], client: Any) -> ExitCode:
+def _upload_plan_points(
+    ctx: CliContext,
+    args: argparse.Namespace,
+    project: Project,
+    guard: PointGuard,
+    plan_ids: list[int],
+    client: Any,
+) -> ExitCode:
     """Create the plan's points before the first move; records the history in the project."""
     ctx.print(f"uploading the plan's {len(plan_ids)} point(s): {', '.join(map(str, plan_ids))}")
     try:
@@ -186,12 +215,23 @@ def _refusal_code(errors: list[PlanIssue]) -> ExitCode:
     return ExitCode.FAILED if all(i.code in REACH_CODES for i in errors) else ExitCode.USAGE
 
 
-def _run(ctx: CliContext, args: argparse.Namespace, project: Project, plan: Plan, client: Any,
-         pose: Pose | None, limits: PlanLimits, loops: int, start: int,
-         envelope: Envelope | None = None, reach: ReachCheck | None = None) -> ExitCode:
+def _run(
+    ctx: CliContext,
+    args: argparse.Namespace,
+    project: Project,
+    plan: Plan,
+    client: Any,
+    pose: Pose | None,
+    limits: PlanLimits,
+    loops: int,
+    start: int,
+    envelope: Envelope | None = None,
+    reach: ReachCheck | None = None,
+) -> ExitCode:
     ledger = project.ledger
-    issues = check_plan(plan, ledger, limits, pose, start_index=start, loops=loops, envelope=envelope,
-                        reach=reach)
+    issues = check_plan(
+        plan, ledger, limits, pose, start_index=start, loops=loops, envelope=envelope, reach=reach
+    )
     for issue in issues:
         if issue.kind is IssueKind.WARNING:
             ctx.warn(issue.message)
@@ -204,8 +244,10 @@ def _run(ctx: CliContext, args: argparse.Namespace, project: Project, plan: Plan
         ctx.error(f"plan {plan.name!r} has {len(errors)} error(s){what}: not running it")
         return code
     est = estimate_plan(plan, ledger, pose, loops=loops)
-    ctx.print(f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
-             f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}")
+    ctx.print(
+        f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
+        f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}"
+    )
     plan_ids = list(dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids))
     if args.check:
         if args.no_upload:
@@ -216,8 +258,10 @@ def _run(ctx: CliContext, args: argparse.Namespace, project: Project, plan: Plan
         return ExitCode.OK
     guard = PointGuard({p.id: p for p in ledger}, refresh=not args.no_upload)
     if args.no_upload:
-        ctx.warn(f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
-                f"{', '.join(map(str, plan_ids))} (the operator's responsibility)")
+        ctx.warn(
+            f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
+            f"{', '.join(map(str, plan_ids))} (the operator's responsibility)"
+        )
     else:
         code = _upload_plan_points(ctx, args, project, guard, plan_ids, client)
         if code != ExitCode.OK:
@@ -229,8 +273,15 @@ def _run(ctx: CliContext, args: argparse.Namespace, project: Project, plan: Plan
         if p.event is RunEvent.SEGMENT_STARTED:
             line.show(f"{p.text}: {p.message}")
 
-    runner = PlanRunner(plan, loops=loops, start=start, start_loop=args.from_loop, single=args.single,
-                        timeouts=segment_timeouts(plan, ledger, pose), progress=progress)
+    runner = PlanRunner(
+        plan,
+        loops=loops,
+        start=start,
+        start_loop=args.from_loop,
+        single=args.single,
+        timeouts=segment_timeouts(plan, ledger, pose),
+        progress=progress,
+    )
     try:
         outcome = runner.run(client, guard)
     finally:
@@ -241,8 +292,10 @@ def _run(ctx: CliContext, args: argparse.Namespace, project: Project, plan: Plan
     ctx.error(f"{outcome.state.value}: {outcome.message}")
     if _points_lost(outcome.error):
         # "bad end point id": the controller does not hold the segment's points (restarted?)
-        ctx.error("the controller does not hold the plan's points (restarted?); resume without "
-                 "--no-upload so that they are created first")
+        ctx.error(
+            "the controller does not hold the plan's points (restarted?); resume without "
+            "--no-upload so that they are created first"
+        )
     if isinstance(outcome.error, PointMismatch | PointNotCreated):
         ctx.error("nothing further was sent; the robot is where the message above says")
     if outcome.resume_from is not None:

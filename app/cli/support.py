@@ -32,13 +32,18 @@ from app.safety.roles import Role, RoleStore, default_store_path
 #: What ``audit --result`` filters by (a write's outcome; ``pending`` exists only inside the file).
 AUDIT_RESULTS = (Result.OK, Result.FAILED, Result.BLOCKED, Result.REFUSED, Result.UNKNOWN)
 
-ADMIN_NOTE = ("teachpad-cli is an administrator's tool: it is not limited by TeachPad's roles "
-              "(anyone with a shell can read and write TeachPad's files).")
+ADMIN_NOTE = (
+    "teachpad-cli is an administrator's tool: it is not limited by TeachPad's roles "
+    "(anyone with a shell can read and write TeachPad's files)."
+)
 
 
 def register(subparsers: Any) -> None:
-    p = subparsers.add_parser("support-bundle", help="write a zip for an integrator (offline)",
-                              description="Write a support bundle. " + ADMIN_NOTE)
+    p = subparsers.add_parser(
+        "support-bundle",
+        help="write a zip for an integrator (offline)",
+        description="Write a support bundle. " + ADMIN_NOTE,
+    )
     p.add_argument("out", type=Path, metavar="OUT.zip", help="the zip file to write")
     p.add_argument("--project", type=Path, help="the project file to include")
     p.add_argument("--profile", type=Path, help="the safety profile to include")
@@ -46,33 +51,58 @@ def register(subparsers: Any) -> None:
     p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
     p.add_argument("--log-dir", type=Path, help="a folder of log files to include")
     p.add_argument("--traffic", type=Path, help="a text file of recorded Modbus traffic")
-    p.add_argument("--days", type=parse_positive_int, default=DEFAULT_DAYS,
-                   help="how many days of records, counted back from now (default %(default)s)")
+    p.add_argument(
+        "--days",
+        type=parse_positive_int,
+        default=DEFAULT_DAYS,
+        help="how many days of records, counted back from now (default %(default)s)",
+    )
     p.set_defaults(handler=cmd_support_bundle)
 
-    p = subparsers.add_parser("audit", help="show or export the audit trail (offline)",
-                              description="Show the audit trail. " + ADMIN_NOTE)
+    p = subparsers.add_parser(
+        "audit",
+        help="show or export the audit trail (offline)",
+        description="Show the audit trail. " + ADMIN_NOTE,
+    )
     p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
-    p.add_argument("--from", dest="start", type=parse_moment, metavar="WHEN",
-                   help="first moment, local time YYYY-MM-DD[THH:MM]")
-    p.add_argument("--to", dest="end", type=parse_moment, metavar="WHEN",
-                   help="last moment, local time YYYY-MM-DD[THH:MM]")
+    p.add_argument(
+        "--from",
+        dest="start",
+        type=parse_moment,
+        metavar="WHEN",
+        help="first moment, local time YYYY-MM-DD[THH:MM]",
+    )
+    p.add_argument(
+        "--to",
+        dest="end",
+        type=parse_moment,
+        metavar="WHEN",
+        help="last moment, local time YYYY-MM-DD[THH:MM]",
+    )
     p.add_argument("--role", help="only records of this role (operator, engineer, administrator)")
     p.add_argument("--command", dest="command_text", metavar="TEXT", help="part of the command text")
-    p.add_argument("--result", choices=AUDIT_RESULTS,
-                   help="only records with this result (unknown: writes sent whose answer was never "
-                        "recorded, TeachPad stopped first)")
+    p.add_argument(
+        "--result",
+        choices=AUDIT_RESULTS,
+        help="only records with this result (unknown: writes sent whose answer was never "
+        "recorded, TeachPad stopped first)",
+    )
     p.add_argument("--csv", type=Path, metavar="OUT", help="write CSV instead of printing")
     p.set_defaults(handler=cmd_audit)
 
-    p = subparsers.add_parser("roles", help="set or clear the GUI's role passwords (offline)",
-                              description="Passwords of TeachPad's roles. " + ADMIN_NOTE)
+    p = subparsers.add_parser(
+        "roles",
+        help="set or clear the GUI's role passwords (offline)",
+        description="Passwords of TeachPad's roles. " + ADMIN_NOTE,
+    )
     p.add_argument("--store", type=Path, help=f"the role store (default {default_store_path()})")
     rsub = p.add_subparsers(dest="roles_command", metavar="ACTION", required=True)
     r = rsub.add_parser("show", help="which roles have a password, and the idle time")
     r.set_defaults(handler=cmd_roles)
-    for name, text in (("set-password", "set a role's password (asked for, not an argument)"),
-                       ("clear-password", "remove a role's password (nobody can log in as it)")):
+    for name, text in (
+        ("set-password", "set a role's password (asked for, not an argument)"),
+        ("clear-password", "remove a role's password (nobody can log in as it)"),
+    ):
         r = rsub.add_parser(name, help=text)
         r.add_argument("role", choices=("engineer", "administrator"), help="the role")
         r.set_defaults(handler=cmd_roles)
@@ -92,17 +122,24 @@ def cmd_support_bundle(ctx: CliContext) -> ExitCode:
         try:
             settings["settings file"] = json.loads(args.settings.read_text(encoding="utf-8"))
         except (OSError, ValueError) as exc:
-            raise InvalidInput(f"settings file {args.settings.name} cannot be used "
-                               f"({str(exc)[:80]})") from None
+            raise InvalidInput(
+                f"settings file {args.settings.name} cannot be used ({str(exc)[:80]})"
+            ) from None
     for name in ("project", "profile"):
         path = getattr(args, name)
         if path is not None and not path.is_file():
             raise InvalidInput(f"{name} file {str(path)[:60]} does not exist")
     traffic = None if args.traffic is None else _read_text_lines(args.traffic, "traffic file")
     manifest = write_support_bundle(
-        args.out, settings=settings, project=args.project, profile=args.profile,
-        audit_dir=args.audit_dir or default_audit_dir(), log_dir=args.log_dir, traffic=traffic,
-        days=args.days)
+        args.out,
+        settings=settings,
+        project=args.project,
+        profile=args.profile,
+        audit_dir=args.audit_dir or default_audit_dir(),
+        log_dir=args.log_dir,
+        traffic=traffic,
+        days=args.days,
+    )
     ctx.print(f"wrote {args.out} ({len(manifest.files)} files)")
     for note in manifest.left_out:
         ctx.print(f"  left out: {note}")
@@ -118,8 +155,9 @@ def cmd_audit(ctx: CliContext) -> ExitCode:
     """Print (or write as CSV) the records that match, then say how many of them are writes whose
     answer was never recorded (``unknown``: the controller may or may not have acted on them)."""
     args = ctx.args
-    flt = AuditFilter(start=args.start, end=args.end, role=args.role, command=args.command_text,
-                      result=args.result)
+    flt = AuditFilter(
+        start=args.start, end=args.end, role=args.role, command=args.command_text, result=args.result
+    )
     stats = ReadStats()
     records = query(args.audit_dir or default_audit_dir(), flt, stats)
     unknown = unknown_count(records)
@@ -132,8 +170,10 @@ def cmd_audit(ctx: CliContext) -> ExitCode:
             extra = f" - {r.detail}" if r.detail else ""
             ctx.print(f"{r.host_time}  {r.role:<13} {r.result:<8} {r.command}{extra}")
     if unknown and args.result != Result.UNKNOWN:
-        ctx.warn(f"{unknown} write(s) with result unknown: sent, but TeachPad stopped before the answer "
-                 "was recorded (check the robot); list them with --result unknown")
+        ctx.warn(
+            f"{unknown} write(s) with result unknown: sent, but TeachPad stopped before the answer "
+            "was recorded (check the robot); list them with --result unknown"
+        )
     if stats.skipped:
         ctx.warn(f"{stats.skipped} damaged line(s) skipped")
     return ExitCode.OK

@@ -11,8 +11,16 @@ from app.link.transport import ConnectionSettings
 from app.protocol import registers
 from app.protocol.codec import WordOrder, check_float32
 
-__all__ = ["check_enum", "check_float", "check_floats", "check_int", "check_settings", "check_tool",
-           "gv_name", "range_name"]
+__all__ = [
+    "check_enum",
+    "check_float",
+    "check_floats",
+    "check_int",
+    "check_settings",
+    "check_tool",
+    "gv_name",
+    "range_name",
+]
 
 
 def check_int(value: object, lo: int, hi: int, name: str) -> int:
@@ -26,8 +34,9 @@ def check_int(value: object, lo: int, hi: int, name: str) -> int:
     return value
 
 
-def check_float(value: object, name: str, lo: float | None = None, hi: float | None = None,
-                 *, lo_open: bool = False) -> float:
+def check_float(
+    value: object, name: str, lo: float | None = None, hi: float | None = None, *, lo_open: bool = False
+) -> float:
     try:
         number = check_float32(value, name)  # type: ignore[arg-type]
     except ValueError as exc:

@@ -141,8 +141,13 @@ class RobotClient(RegisterClient):
         self._ensure_auto(self.read_status())
         self._write_control(registers.REG_GO_ZERO, value)
 
-    def run_program(self, program_id: int, mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
-                    cycles: int = 1, speed_ratio: int = 100) -> None:
+    def run_program(
+        self,
+        program_id: int,
+        mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
+        cycles: int = 1,
+        speed_ratio: int = 100,
+    ) -> None:
         """446..449 in one 0x10, then 440 <- 0x01."""
         program_id = check_int(program_id, 0, 0xFFFF, "program id")
         motion = check_enum(mode, ProgramMotionMode, "program motion mode")
@@ -210,8 +215,11 @@ class RobotClient(RegisterClient):
         else:
             time.sleep(timing.SENTINEL_PROBE_SETTLE)
             writable = self.read_status().command_status_code == STATUS_SENTINEL
-            _log.info("GV291 %s: completion rule %s", "keeps the host's value" if writable
-                      else "ignores the host's writes", "sentinel" if writable else "observe")
+            _log.info(
+                "GV291 %s: completion rule %s",
+                "keeps the host's value" if writable else "ignores the host's writes",
+                "sentinel" if writable else "observe",
+            )
         self._gv291_writable = writable
         return writable
 
@@ -231,8 +239,14 @@ class RobotClient(RegisterClient):
             return
         self._ack_latency = max(last.ack_time - last.started, self._ack_latency)
 
-    def begin_command(self, command: RunCommand, before: ControllerStatus, before_pose: Pose | None,
-                      *, timeout: float | None = None) -> CommandTracker:
+    def begin_command(
+        self,
+        command: RunCommand,
+        before: ControllerStatus,
+        before_pose: Pose | None,
+        *,
+        timeout: float | None = None,
+    ) -> CommandTracker:
         """Write 440 <- ``command`` (parameters already written) and return its tracker.
 
         With the sentinel rule GV291 <- sentinel goes out first (completion "auto" probes
@@ -249,9 +263,17 @@ class RobotClient(RegisterClient):
             if rule == "sentinel":
                 self._write_floats(registers.GV_COMMAND_STATUS, [float(STATUS_SENTINEL)])
                 pre_code = STATUS_SENTINEL
-        tracker = CommandTracker(command, before, before_pose, time.monotonic(), timeout=timeout,
-                                 rule=rule, pre_code=pre_code,
-                                 unconfirmed_after=self._unconfirmed_window(), pacer=self._pacer)
+        tracker = CommandTracker(
+            command,
+            before,
+            before_pose,
+            time.monotonic(),
+            timeout=timeout,
+            rule=rule,
+            pre_code=pre_code,
+            unconfirmed_after=self._unconfirmed_window(),
+            pacer=self._pacer,
+        )
         self._last_kind = tracker.kind
         self.last_tracker = tracker
         self._write_control(registers.REG_RUN_COMMAND, int(command))
@@ -278,16 +300,29 @@ class RobotClient(RegisterClient):
     def _finish(self, tracker: CommandTracker, wait: bool) -> CommandResult:
         if wait:
             return self.wait(tracker)
-        return CommandResult(tracker.command, tracker.kind, None, True, f"{tracker.text}: sent",
-                             reason=Reason("sent", {"command": int(tracker.command)}))
+        return CommandResult(
+            tracker.command,
+            tracker.kind,
+            None,
+            True,
+            f"{tracker.text}: sent",
+            reason=Reason("sent", {"command": int(tracker.command)}),
+        )
 
     def _check_point_id(self, point_id: int, name: str = "point id") -> int:
         return check_int(point_id, self.settings.point_id_min, self.settings.point_id_max, name)
 
     # -- function 1: incremental move ----------------------------------------------------
-    def step(self, frame: StepFrame, offsets: Sequence[float],
-             ext_offsets: Sequence[float] = (0.0,) * registers.NUM_EXTERNAL_AXES, speed: float = 10.0,
-             *, wait: bool = True, timeout: float | None = None) -> CommandResult:
+    def step(
+        self,
+        frame: StepFrame,
+        offsets: Sequence[float],
+        ext_offsets: Sequence[float] = (0.0,) * registers.NUM_EXTERNAL_AXES,
+        speed: float = 10.0,
+        *,
+        wait: bool = True,
+        timeout: float | None = None,
+    ) -> CommandResult:
         """Incremental move: GV200-205 (one 0x10), GV236-240 when needed, GV225, 440 <- 0x40/0x41.
 
         ``offsets`` are J1..J6 (degrees, joint frame) or X Y Z A B C (mm, degrees, base
@@ -323,8 +358,9 @@ class RobotClient(RegisterClient):
         return self._finish(tracker, wait)
 
     @staticmethod
-    def _step_timeout(frame: StepFrame, offs: Sequence[float], ext: Sequence[float],
-                      speed: float) -> float | None:
+    def _step_timeout(
+        frame: StepFrame, offs: Sequence[float], ext: Sequence[float], speed: float
+    ) -> float | None:
         """max(MOVE_TIMEOUT_MIN, 3 x the estimated duration) when that exceeds the minimum."""
         if frame is StepFrame.JOINT:
             duration = max(abs(v) for v in (*offs, *ext)) / (speed * 6.0)  # rpm -> deg/s
@@ -334,9 +370,16 @@ class RobotClient(RegisterClient):
         return estimate if estimate > timing.MOVE_TIMEOUT_MIN else None
 
     # -- function 2: create temp point ---------------------------------------------------
-    def create_point(self, point_id: int, *, pose: Sequence[float] | None = None, gv_start: int = 0,
-                     tool: int = registers.TOOL_NONE, wait: bool = True,
-                     timeout: float | None = None) -> CommandResult:
+    def create_point(
+        self,
+        point_id: int,
+        *,
+        pose: Sequence[float] | None = None,
+        gv_start: int = 0,
+        tool: int = registers.TOOL_NONE,
+        wait: bool = True,
+        timeout: float | None = None,
+    ) -> CommandResult:
         """Create (or overwrite) a temp point from the current pose, or from ``pose`` via GVs."""
         point_id = self._check_point_id(point_id)
         tool = check_tool(tool)
@@ -357,9 +400,14 @@ class RobotClient(RegisterClient):
         tracker = self.begin_command(RunCommand.CREATE_POINT, before, None, timeout=timeout)
         return self._finish(tracker, wait)
 
-    def upload_points(self, points: Iterable[tuple[int, Sequence[float]]], tool: int = registers.TOOL_NONE,
-                      progress: ProgressCallback | None = None, *,
-                      gv_start: int = 0) -> list[CommandResult]:
+    def upload_points(
+        self,
+        points: Iterable[tuple[int, Sequence[float]]],
+        tool: int = registers.TOOL_NONE,
+        progress: ProgressCallback | None = None,
+        *,
+        gv_start: int = 0,
+    ) -> list[CommandResult]:
         """Batched case 2.2: per point GV0-5 (one 0x10), GV200-202 (one 0x10), 440 <- 0xE0, polls.
 
         Every point is validated before the first write. Returns one result per point tried,
@@ -367,8 +415,9 @@ class RobotClient(RegisterClient):
         error or timeout ends the batch after a failed result for that point; ``progress``
         (done, total) returning False cancels after the current point.
         """
-        items = [(self._check_point_id(pid), check_floats(pose, 6, f"pose of point {pid}"))
-                 for pid, pose in points]
+        items = [
+            (self._check_point_id(pid), check_floats(pose, 6, f"pose of point {pid}")) for pid, pose in points
+        ]
         tool = check_tool(tool)
         gv_start = check_int(gv_start, registers.GV_GENERAL_FIRST, _GENERAL_POSE_LAST_START, "first pose GV")
         results: list[CommandResult] = []
@@ -387,20 +436,39 @@ class RobotClient(RegisterClient):
                 result = self.wait(tracker, raise_errors=False)
                 status = tracker.last_status or status
             except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
-                results.append(CommandResult(RunCommand.CREATE_POINT, kind, None, False, str(exc),
-                                             {"point_id": float(point_id)}, reason=exc.as_reason()))
+                results.append(
+                    CommandResult(
+                        RunCommand.CREATE_POINT,
+                        kind,
+                        None,
+                        False,
+                        str(exc),
+                        {"point_id": float(point_id)},
+                        reason=exc.as_reason(),
+                    )
+                )
                 break
             details = dict(result.details, point_id=float(point_id))
-            results.append(dataclasses.replace(result, message=f"point {point_id}: {result.message}",
-                                               details=details))
+            results.append(
+                dataclasses.replace(result, message=f"point {point_id}: {result.message}", details=details)
+            )
             if progress is not None and progress(index, total) is False:
                 break
         return results
 
     # -- function 3: move to temp point --------------------------------------------------
-    def move_to_point(self, end_id: int, *, via_id: int | None = None, orientation_changes: bool = True,
-                      ignore_middle: bool = False, speed: float = 50.0, tool: int = registers.TOOL_NONE,
-                      wait: bool = True, timeout: float | None = None) -> CommandResult:
+    def move_to_point(
+        self,
+        end_id: int,
+        *,
+        via_id: int | None = None,
+        orientation_changes: bool = True,
+        ignore_middle: bool = False,
+        speed: float = 50.0,
+        tool: int = registers.TOOL_NONE,
+        wait: bool = True,
+        timeout: float | None = None,
+    ) -> CommandResult:
         """Line (``via_id`` None) or arc through ``via_id``: GV200-203 one 0x10, GV225, GV245, 0x42."""
         end_id = self._check_point_id(end_id, "end point id")
         motion = -1.0
@@ -414,8 +482,10 @@ class RobotClient(RegisterClient):
         if timeout is not None:
             timeout = check_float(timeout, "timeout", 0.0, lo_open=True)
         before, before_pose = self._prepare(RunCommand.MOVE_TO_POINT)
-        self._write_floats(registers.GV_PARAM0, [motion, float(end_id), 1.0 if orientation_changes else 0.0,
-                                         1.0 if ignore_middle else 0.0])
+        self._write_floats(
+            registers.GV_PARAM0,
+            [motion, float(end_id), 1.0 if orientation_changes else 0.0, 1.0 if ignore_middle else 0.0],
+        )
         self._write_floats(registers.GV_EXPECTED_SPEED, [speed])
         self._write_tool(tool)
         tracker = self.begin_command(RunCommand.MOVE_TO_POINT, before, before_pose, timeout=timeout)
@@ -432,9 +502,17 @@ class RobotClient(RegisterClient):
     def _check_direction(direction: int) -> int:
         return check_int(direction, 0, 1, "direction (0 negative, 1 positive)")
 
-    def teach_enable(self, frame: TeachFrame, axis: int, direction: int, *, user_frame: int = 0,
-                     tool_frame: int = 0, wait: bool = True,
-                     timeout: float | None = None) -> CommandResult:
+    def teach_enable(
+        self,
+        frame: TeachFrame,
+        axis: int,
+        direction: int,
+        *,
+        user_frame: int = 0,
+        tool_frame: int = 0,
+        wait: bool = True,
+        timeout: float | None = None,
+    ) -> CommandResult:
         """GV200-203 = (frame, axis, direction, 0) in one 0x10, GV241/GV245 if needed, 440 <- 0x80."""
         frame = check_enum(frame, TeachFrame, "teach frame")
         axis = self._check_axis(frame, axis)

@@ -53,7 +53,6 @@ class WorkerCommands:
         def client_or_raise(self) -> RobotClient: ...
         def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None: ...
 
-
     def _done(self, text: str) -> None:
         self.emit_result(CommandResult(None, None, None, True, text))
 

@@ -26,8 +26,9 @@ def decode_pose(regs: Sequence[int], order: WordOrder) -> Pose:
     return Pose(x, y, z, a, b, c, ext=(e[0], e[1], e[2], e[3], e[4]), joints=joints)
 
 
-def decode_status(regs: Sequence[int], order: WordOrder,
-                  clock_layout: DateTimeLayout | None) -> ControllerStatus:
+def decode_status(
+    regs: Sequence[int], order: WordOrder, clock_layout: DateTimeLayout | None
+) -> ControllerStatus:
     """Table 2 (560..583); the clock too when ``clock_layout`` is given."""
     base = registers.STATUS_BLOCK_START
     mode_raw = regs[registers.REG_CONTROLLER_MODE - base]

@@ -66,18 +66,17 @@ class Request:
 
 
 def read_request(address: int, count: int) -> Request:
-    return Request(FC_READ_HOLDING, address, count, 0,
-                   struct.pack(">BHH", FC_READ_HOLDING, address, count))
+    return Request(FC_READ_HOLDING, address, count, 0, struct.pack(">BHH", FC_READ_HOLDING, address, count))
 
 
 def write_single_request(address: int, value: int) -> Request:
-    return Request(FC_WRITE_SINGLE, address, 1, value,
-                   struct.pack(">BHH", FC_WRITE_SINGLE, address, value))
+    return Request(FC_WRITE_SINGLE, address, 1, value, struct.pack(">BHH", FC_WRITE_SINGLE, address, value))
 
 
 def write_multiple_request(address: int, values: Sequence[int]) -> Request:
-    data = struct.pack(f">BHHB{len(values)}H", FC_WRITE_MULTIPLE, address, len(values),
-                       2 * len(values), *values)
+    data = struct.pack(
+        f">BHHB{len(values)}H", FC_WRITE_MULTIPLE, address, len(values), 2 * len(values), *values
+    )
     return Request(FC_WRITE_MULTIPLE, address, len(values), 0, data)
 
 
@@ -106,18 +105,26 @@ def _answer_pdu_size(request: Request, buf: bytes, at: int) -> int | None:
     if fc == request.function | 0x80:
         return 2  # function | 0x80, exception code
     if fc != request.function:
-        raise _bad("function", request.function, fc,
-                   f"controller answered function {_hex(fc)} to {_FUNCTION_TEXT[request.function]} "
-                   f"({_hex(request.function)})")
+        raise _bad(
+            "function",
+            request.function,
+            fc,
+            f"controller answered function {_hex(fc)} to {_FUNCTION_TEXT[request.function]} "
+            f"({_hex(request.function)})",
+        )
     if request.function != FC_READ_HOLDING:
         return 5  # function, address, value or quantity
     if len(buf) <= at + 1:
         return None
     byte_count = buf[at + 1]
     if byte_count != 2 * request.count:
-        raise _bad("byte count", 2 * request.count, byte_count,
-                   f"byte count {byte_count}, expected {2 * request.count} for {request.count} "
-                   f"register{'s' if request.count != 1 else ''}")
+        raise _bad(
+            "byte count",
+            2 * request.count,
+            byte_count,
+            f"byte count {byte_count}, expected {2 * request.count} for {request.count} "
+            f"register{'s' if request.count != 1 else ''}",
+        )
     return 2 + byte_count
 
 
@@ -131,14 +138,26 @@ def _check_pdu(request: Request, pdu: bytes) -> None:
         return
     address, second = struct.unpack_from(">HH", pdu, 1)
     if address != request.address:
-        raise _bad("address", request.address, address,
-                   f"the write's answer echoes address {address}, expected {request.address}")
+        raise _bad(
+            "address",
+            request.address,
+            address,
+            f"the write's answer echoes address {address}, expected {request.address}",
+        )
     if request.function == FC_WRITE_SINGLE and second != request.value:
-        raise _bad("value", request.value, second,
-                   f"the write's answer echoes value {second}, expected {request.value}")
+        raise _bad(
+            "value",
+            request.value,
+            second,
+            f"the write's answer echoes value {second}, expected {request.value}",
+        )
     if request.function == FC_WRITE_MULTIPLE and second != request.count:
-        raise _bad("quantity", request.count, second,
-                   f"the write's answer echoes {second} registers, expected {request.count}")
+        raise _bad(
+            "quantity",
+            request.count,
+            second,
+            f"the write's answer echoes {second} registers, expected {request.count}",
+        )
 
 
 def frame_need(framing: Framing, request: Request, unit: int, tid: int, buf: bytes) -> int:
@@ -151,8 +170,12 @@ def frame_need(framing: Framing, request: Request, unit: int, tid: int, buf: byt
             return _MBAP + 1
         got_tid, protocol, length, got_unit = struct.unpack_from(">HHHB", buf)
         if got_tid != tid:
-            raise _bad("transaction id", tid, got_tid,
-                       f"transaction id {got_tid}, expected {tid} (an answer to another request)")
+            raise _bad(
+                "transaction id",
+                tid,
+                got_tid,
+                f"transaction id {got_tid}, expected {tid} (an answer to another request)",
+            )
         if protocol != 0:
             raise _bad("protocol id", 0, protocol, f"MBAP protocol id {protocol}, expected 0")
         if got_unit != unit:
@@ -161,8 +184,7 @@ def frame_need(framing: Framing, request: Request, unit: int, tid: int, buf: byt
         if size is None:
             return _MBAP + 2
         if length != 1 + size:
-            raise _bad("length", 1 + size, length,
-                       f"MBAP length field {length}, expected {1 + size}")
+            raise _bad("length", 1 + size, length, f"MBAP length field {length}, expected {1 + size}")
         total = _MBAP + size
         if len(buf) >= total:
             _check_pdu(request, buf[_MBAP:total])

@@ -134,16 +134,26 @@ class JogMachine:
     def after_status(self, status: ControllerStatus, now: float, *, idle: bool) -> None:
         """Per good poll: teach mode ended by the controller, or idle long enough to switch it off."""
         teach = self.teach
-        if teach.enabled and status.mode != ControllerMode.MODBUS_TEACH \
-                and now - teach.enabled_at > timing.TEACH_MODE_GRACE:
+        if (
+            teach.enabled
+            and status.mode != ControllerMode.MODBUS_TEACH
+            and now - teach.enabled_at > timing.TEACH_MODE_GRACE
+        ):
             self.teach = TeachState()  # e-stop, manual, go to zero, program... ended it
             if self.jog is not None:
                 self.end_jog()
                 mode = controller_mode_text(int(status.mode))
-                self._host.emit_error(Operation.JOG, f"the controller left teach mode (mode now: {mode})",
-                                      reason=Reason("left_teach_mode", {"mode": int(status.mode)}))
-        elif (teach.enabled or self.teach_dirty) and self.jog is None and idle \
-                and now - self.released_at >= timing.TEACH_IDLE_DISABLE:
+                self._host.emit_error(
+                    Operation.JOG,
+                    f"the controller left teach mode (mode now: {mode})",
+                    reason=Reason("left_teach_mode", {"mode": int(status.mode)}),
+                )
+        elif (
+            (teach.enabled or self.teach_dirty)
+            and self.jog is None
+            and idle
+            and now - self.released_at >= timing.TEACH_IDLE_DISABLE
+        ):
             try:
                 self.stop_jog_and_teach()
             except TeachPadError as exc:
@@ -178,8 +188,11 @@ class JogMachine:
         if not self._host.supervisor.answering:  # refused before the wire; not a link failure
             raise TeachPadError("the controller is not answering: jog not started", code="jog_not_answering")
         if not 0.0 < request.ratio <= 100.0:
-            raise InvalidInput(f"jog speed must be 1..100 %, got {request.ratio:g}", code="bad_jog_ratio",
-                               params={"value": f"{request.ratio:g}"})
+            raise InvalidInput(
+                f"jog speed must be 1..100 %, got {request.ratio:g}",
+                code="bad_jog_ratio",
+                params={"value": f"{request.ratio:g}"},
+            )
         self._require_guard(request)  # refused before teach mode is even switched on
         self.jog = request
         self._serial += 1
@@ -202,10 +215,17 @@ class JogMachine:
             self._check(serial)
             self.disable_teach()
             self._check(serial)
-        client.teach_enable(request.frame, request.axis, request.direction, user_frame=request.user,
-                            tool_frame=request.tool, wait=False)
-        self.teach = TeachState(True, request.frame_key, (request.axis, request.direction), 0.0,
-                                time.monotonic())
+        client.teach_enable(
+            request.frame,
+            request.axis,
+            request.direction,
+            user_frame=request.user,
+            tool_frame=request.tool,
+            wait=False,
+        )
+        self.teach = TeachState(
+            True, request.frame_key, (request.axis, request.direction), 0.0, time.monotonic()
+        )
         tracker = client.last_tracker
         assert tracker is not None
         result = self.await_short(tracker, urgent=True)  # a release meanwhile writes ratio 0
@@ -268,8 +288,11 @@ class JogMachine:
         if jog is None:
             return
         if not 0.0 < ratio <= 100.0:
-            raise InvalidInput(f"jog speed must be 1..100 %, got {ratio:g}", code="bad_jog_ratio",
-                               params={"value": f"{ratio:g}"})
+            raise InvalidInput(
+                f"jog speed must be 1..100 %, got {ratio:g}",
+                code="bad_jog_ratio",
+                params={"value": f"{ratio:g}"},
+            )
         self.jog = dataclasses.replace(jog, ratio=ratio)
         if self.teach.enabled and self.teach.ratio != 0.0 and self.teach.ratio != ratio:
             self._require_guard(self.jog)
@@ -292,8 +315,11 @@ class JogMachine:
 
     def leave_teach(self, last_status: ControllerStatus | None) -> None:
         """Before a motion of another kind: ratio 0 and teach disable (the controller refuses otherwise)."""
-        if not (self.teach.enabled or self.teach_dirty
-                or (last_status is not None and last_status.mode == ControllerMode.MODBUS_TEACH)):
+        if not (
+            self.teach.enabled
+            or self.teach_dirty
+            or (last_status is not None and last_status.mode == ControllerMode.MODBUS_TEACH)
+        ):
             return
         self.end_jog()
         self._host.client_or_raise().teach_set_ratio(0.0)

@@ -66,8 +66,11 @@ class MotionWatch:
                 self._seen = True
             elif now - self.started >= self.ack_timeout:
                 return self._result(
-                    False, f"{self.text}: no motion within {self.ack_timeout:g} s "
-                    "(refused by the controller, or already there)", now)
+                    False,
+                    f"{self.text}: no motion within {self.ack_timeout:g} s "
+                    "(refused by the controller, or already there)",
+                    now,
+                )
             return None
         if not running and not moved:
             return self._result(True, f"{self.text}: done", now)
@@ -105,8 +108,9 @@ class MotionTracker:
         active, self.active = self.active, None
         return active
 
-    def update(self, status: ControllerStatus, pose: Pose,
-               now: float) -> tuple[CommandResult, int | None] | None:
+    def update(
+        self, status: ControllerStatus, pose: Pose, now: float
+    ) -> tuple[CommandResult, int | None] | None:
         """Feed one poll (status read before pose); the result and its request id once it ended."""
         active = self.active
         if active is None:
@@ -135,8 +139,9 @@ class MotionCommands:
         if busy is not None:
             raise InvalidInput(f"{busy} is still under way: wait for it or press Stop")
         if host.uploader.run is not None:
-            raise InvalidInput(f"{Operation.UPLOAD_POINTS} is still under way: wait for it, cancel it "
-                               "or press Stop")
+            raise InvalidInput(
+                f"{Operation.UPLOAD_POINTS} is still under way: wait for it, cancel it or press Stop"
+            )
 
     def _begin(self, operation: str) -> RobotClient:
         self.require_none(operation)
@@ -178,11 +183,25 @@ class MotionCommands:
         client.step(frame, offsets, ext, speed, wait=False)
         self._track_last(client, Operation.STEP, motion=True)
 
-    def move_to_point(self, end_id: int, via_id: int | None, orientation_changes: bool,
-                      ignore_middle: bool, speed: float, tool: int) -> None:
+    def move_to_point(
+        self,
+        end_id: int,
+        via_id: int | None,
+        orientation_changes: bool,
+        ignore_middle: bool,
+        speed: float,
+        tool: int,
+    ) -> None:
         client = self._begin(Operation.MOVE_TO_POINT)
-        client.move_to_point(end_id, via_id=via_id, orientation_changes=orientation_changes,
-                             ignore_middle=ignore_middle, speed=speed, tool=tool, wait=False)
+        client.move_to_point(
+            end_id,
+            via_id=via_id,
+            orientation_changes=orientation_changes,
+            ignore_middle=ignore_middle,
+            speed=speed,
+            tool=tool,
+            wait=False,
+        )
         self._track_last(client, Operation.MOVE_TO_POINT, motion=True)
 
     def go_zero(self, axis: int | None) -> None:
@@ -190,8 +209,11 @@ class MotionCommands:
         before = self._host.poller.last_pose
         client.go_zero(axis)
         which = "all axes" if axis is None else f"J{axis + 1}"
-        self._track(Operation.GO_ZERO, MotionWatch(None, f"go to zero ({which})", before, time.monotonic()),
-                    motion=True)
+        self._track(
+            Operation.GO_ZERO,
+            MotionWatch(None, f"go to zero ({which})", before, time.monotonic()),
+            motion=True,
+        )
 
     def run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int, speed_ratio: int) -> None:
         client = self._begin(Operation.RUN_PROGRAM)

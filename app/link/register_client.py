@@ -109,8 +109,9 @@ class RegisterClient:
         if self.settings.monitor_only:
             raise WriteBlocked(f"monitor-only mode: {what} was not sent")
 
-    def _write(self, address: int, values: Sequence[int], *, single: bool = False,
-               timeout: float | None = None) -> None:
+    def _write(
+        self, address: int, values: Sequence[int], *, single: bool = False, timeout: float | None = None
+    ) -> None:
         """The write guard: every write to the controller passes here (and, with an audit trail,
         is recorded there once, blocked ones too). ``timeout`` (s per attempt) overrides the
         request timeout (default: :meth:`io_timeout`'s, else the settings')."""
@@ -130,8 +131,7 @@ class RegisterClient:
             else:
                 _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
                 self.write_count += 1
-                self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values],
-                                               timeout)
+                self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values], timeout)
 
     def _write_floats(self, gv: int, values: Sequence[float], timeout: float | None = None) -> None:
         self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order), timeout=timeout)
@@ -196,8 +196,9 @@ class RegisterClient:
     def read_status(self, with_clock: bool = False, *, timeout: float | None = None) -> ControllerStatus:
         """Table 2 (560..583) in one FC03; the clock (576..579) comes from the same block."""
         regs = self._read(registers.STATUS_BLOCK_START, registers.STATUS_BLOCK_COUNT, timeout)
-        status = decode_status(regs, self.settings.word_order,
-                               self.settings.datetime_layout if with_clock else None)
+        status = decode_status(
+            regs, self.settings.word_order, self.settings.datetime_layout if with_clock else None
+        )
         self.last_status = status
         return status
 

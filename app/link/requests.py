@@ -53,12 +53,21 @@ class WorkerRequests:
         def _do_jog_press(self, request: JogRequest) -> None: ...
         def _do_upload_points(self, raw: list[RawItem]) -> None: ...
 
-    def post(self, operation: str, run: Callable[[], None], kind: JobKind = JobKind.PLAIN,
-             *, coalesce: str | None = None, needs_link: bool = True, cancels: tuple[str, ...] = (),
-             sent: threading.Event | None = None) -> int:
+    def post(
+        self,
+        operation: str,
+        run: Callable[[], None],
+        kind: JobKind = JobKind.PLAIN,
+        *,
+        coalesce: str | None = None,
+        needs_link: bool = True,
+        cancels: tuple[str, ...] = (),
+        sent: threading.Event | None = None,
+    ) -> int:
         """Queue a job and wake the worker; returns the request id its results will carry."""
-        request_id = self._jobs.put(Job(operation, run, kind, coalesce=coalesce, needs_link=needs_link,
-                                        cancels=cancels, sent=sent))
+        request_id = self._jobs.put(
+            Job(operation, run, kind, coalesce=coalesce, needs_link=needs_link, cancels=cancels, sent=sent)
+        )
         self._wake.emit()
         return request_id
 
@@ -82,19 +91,27 @@ class WorkerRequests:
         return self.post(Operation.RESUME, self._do_resume, JobKind.URGENT)
 
     def request_jog_press(self, request: JogRequest) -> int:
-        return self.post(Operation.JOG, lambda: self._do_jog_press(request), JobKind.MOTION,
-                         coalesce=JOG_PRESS)
+        return self.post(
+            Operation.JOG, lambda: self._do_jog_press(request), JobKind.MOTION, coalesce=JOG_PRESS
+        )
 
     def request_jog_release(self) -> int:
-        return self.post(Operation.JOG_RELEASE, self.jog.release, JobKind.URGENT, needs_link=False,
-                         cancels=(JOG_PRESS, JOG_RATIO))
+        return self.post(
+            Operation.JOG_RELEASE,
+            self.jog.release,
+            JobKind.URGENT,
+            needs_link=False,
+            cancels=(JOG_PRESS, JOG_RATIO),
+        )
 
     def request_jog_ratio(self, ratio: float) -> int:
-        return self.post(Operation.JOG_SPEED, lambda: self.jog.set_ratio(ratio), JobKind.MOTION,
-                         coalesce=JOG_RATIO)
+        return self.post(
+            Operation.JOG_SPEED, lambda: self.jog.set_ratio(ratio), JobKind.MOTION, coalesce=JOG_RATIO
+        )
 
-    def request_step(self, frame: StepFrame, offsets: Sequence[float], ext_offsets: Sequence[float],
-                     speed: float) -> int:
+    def request_step(
+        self, frame: StepFrame, offsets: Sequence[float], ext_offsets: Sequence[float], speed: float
+    ) -> int:
         offs, ext = tuple(offsets), tuple(ext_offsets)
         return self.post(Operation.STEP, lambda: self.motions.step(frame, offs, ext, speed), JobKind.MOTION)
 
@@ -104,22 +121,35 @@ class WorkerRequests:
     def request_go_zero(self, axis: int | None) -> int:
         return self.post(Operation.GO_ZERO, lambda: self.motions.go_zero(axis), JobKind.MOTION)
 
-    def request_run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int,
-                            speed_ratio: int) -> int:
-        return self.post(Operation.RUN_PROGRAM,
-                         lambda: self.motions.run_program(program_id, mode, cycles, speed_ratio),
-                         JobKind.MOTION)
+    def request_run_program(
+        self, program_id: int, mode: ProgramMotionMode, cycles: int, speed_ratio: int
+    ) -> int:
+        return self.post(
+            Operation.RUN_PROGRAM,
+            lambda: self.motions.run_program(program_id, mode, cycles, speed_ratio),
+            JobKind.MOTION,
+        )
 
     def request_create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> int:
         values = None if pose is None else tuple(pose)
         return self.post(Operation.CREATE_POINT, lambda: self.motions.create_point(point_id, values, tool))
 
-    def request_move_to_point(self, end_id: int, via_id: int | None, orientation_changes: bool,
-                              ignore_middle: bool, speed: float, tool: int) -> int:
-        return self.post(Operation.MOVE_TO_POINT,
-                         lambda: self.motions.move_to_point(end_id, via_id, orientation_changes,
-                                                            ignore_middle, speed, tool),
-                         JobKind.MOTION)
+    def request_move_to_point(
+        self,
+        end_id: int,
+        via_id: int | None,
+        orientation_changes: bool,
+        ignore_middle: bool,
+        speed: float,
+        tool: int,
+    ) -> int:
+        return self.post(
+            Operation.MOVE_TO_POINT,
+            lambda: self.motions.move_to_point(
+                end_id, via_id, orientation_changes, ignore_middle, speed, tool
+            ),
+            JobKind.MOTION,
+        )
 
     def request_upload_points(self, points: Iterable[tuple[int, Sequence[float], int]]) -> int:
         """Items (id, pose6, tool); copied here, checked in the worker before the first write."""

@@ -121,30 +121,48 @@ class LinkPort(Protocol):
 
     def resume(self) -> int: ...
 
-    def jog_press(self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0,
-                  tool: int = 0) -> int: ...
+    def jog_press(
+        self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0, tool: int = 0
+    ) -> int: ...
 
     def jog_release(self) -> int: ...
 
     def set_jog_ratio(self, ratio: float) -> int: ...
 
-    def step(self, frame: StepFrame, offsets: Sequence[float], ext_offsets: Sequence[float] = ...,
-             speed: float = ...) -> int: ...
+    def step(
+        self,
+        frame: StepFrame,
+        offsets: Sequence[float],
+        ext_offsets: Sequence[float] = ...,
+        speed: float = ...,
+    ) -> int: ...
 
     def set_mode(self, mode: WorkMode) -> int: ...
 
     def go_zero(self, axis: int | None) -> int: ...
 
-    def run_program(self, program_id: int, mode: ProgramMotionMode = ..., cycles: int = ...,
-                    speed_ratio: int = ...) -> int: ...
+    def run_program(
+        self, program_id: int, mode: ProgramMotionMode = ..., cycles: int = ..., speed_ratio: int = ...
+    ) -> int: ...
 
     def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = ...) -> int: ...
 
-    def move_to_point(self, end_id: int, via_id: int | None = None, *, orientation_changes: bool = ...,
-                      ignore_middle: bool = ..., speed: float = ..., tool: int = ...) -> int: ...
+    def move_to_point(
+        self,
+        end_id: int,
+        via_id: int | None = None,
+        *,
+        orientation_changes: bool = ...,
+        ignore_middle: bool = ...,
+        speed: float = ...,
+        tool: int = ...,
+    ) -> int: ...
 
-    def upload_points(self, points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
-                      tool: int = ...) -> int: ...
+    def upload_points(
+        self,
+        points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
+        tool: int = ...,
+    ) -> int: ...
 
     def cancel_upload(self) -> int: ...
 
@@ -174,9 +192,15 @@ class RobotLink(QObject):
     _guardRequested = Signal(object)  # noqa: N815
     _auditRequested = Signal(object)  # noqa: N815
 
-    def __init__(self, parent: QObject | None = None, *, poll_hz: float = timing.POLL_HZ_DEFAULT,
-                 canary_gv: int | None = DEFAULT_CANARY_GV,
-                 freshness_limit: float = DEFAULT_FRESHNESS_LIMIT, stop_line: bool = True) -> None:
+    def __init__(
+        self,
+        parent: QObject | None = None,
+        *,
+        poll_hz: float = timing.POLL_HZ_DEFAULT,
+        canary_gv: int | None = DEFAULT_CANARY_GV,
+        freshness_limit: float = DEFAULT_FRESHNESS_LIMIT,
+        stop_line: bool = True,
+    ) -> None:
         """``stop_line`` False: never open the stop's own connection (app/link/stop_line.py);
         every stop goes through the worker's queue on the main link."""
         super().__init__(parent)
@@ -205,14 +229,18 @@ class RobotLink(QObject):
         w.commandFinished.connect(self._on_result)
         w.errorOccurred.connect(self._on_error)
         w.connectionChanged.connect(self._on_connection)
-        for source, target in ((w.poseChanged, self.poseChanged), (w.statusChanged, self.statusChanged),
-                               (w.alarmsChanged, self.alarmsChanged), (w.rttChanged, self.rttChanged),
-                               (w.trafficObserved, self.trafficObserved),
-                               (w.controllerReconnected, self.controllerReconnected),
-                               (w.controllerRestarted, self.controllerRestarted),
-                               (w.uploadProgress, self.uploadProgress),
-                               (w.pointUploaded, self.pointUploaded),
-                               (w.jogGuardStopped, self.jogGuardStopped)):
+        for source, target in (
+            (w.poseChanged, self.poseChanged),
+            (w.statusChanged, self.statusChanged),
+            (w.alarmsChanged, self.alarmsChanged),
+            (w.rttChanged, self.rttChanged),
+            (w.trafficObserved, self.trafficObserved),
+            (w.controllerReconnected, self.controllerReconnected),
+            (w.controllerRestarted, self.controllerRestarted),
+            (w.uploadProgress, self.uploadProgress),
+            (w.pointUploaded, self.pointUploaded),
+            (w.jogGuardStopped, self.jogGuardStopped),
+        ):
             source.connect(target)
         self._connectRequested.connect(w.connect_to)
         self._disconnectRequested.connect(w.disconnect_link)
@@ -263,8 +291,9 @@ class RobotLink(QObject):
     def _on_shut_down(self) -> None:
         """Nothing is live after a shutdown: the state says so (and its freshness timer stops)."""
         endpoint = self._state.connection.endpoint
-        shut = ConnectionState(LinkState.DISCONNECTED, "the link was shut down", endpoint,
-                               reason=Reason("link_was_shut_down"))
+        shut = ConnectionState(
+            LinkState.DISCONNECTED, "the link was shut down", endpoint, reason=Reason("link_was_shut_down")
+        )
         self._state.set_connection(shut)
 
     @Slot(CommandResult)
@@ -326,8 +355,9 @@ class RobotLink(QObject):
     def resume(self) -> int:
         return 0 if self._shut else self._worker.request_resume()
 
-    def jog_press(self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0,
-                  tool: int = 0) -> int:
+    def jog_press(
+        self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0, tool: int = 0
+    ) -> int:
         if self._shut:
             return 0
         request = JogRequest(TeachFrame(frame), axis, direction, ratio, user, tool)
@@ -339,9 +369,13 @@ class RobotLink(QObject):
     def set_jog_ratio(self, ratio: float) -> int:
         return 0 if self._shut else self._worker.request_jog_ratio(ratio)
 
-    def step(self, frame: StepFrame, offsets: Sequence[float],
-             ext_offsets: Sequence[float] = (0.0,) * registers.NUM_EXTERNAL_AXES,
-             speed: float = 10.0) -> int:
+    def step(
+        self,
+        frame: StepFrame,
+        offsets: Sequence[float],
+        ext_offsets: Sequence[float] = (0.0,) * registers.NUM_EXTERNAL_AXES,
+        speed: float = 10.0,
+    ) -> int:
         return 0 if self._shut else self._worker.request_step(frame, offsets, ext_offsets, speed)
 
     def set_mode(self, mode: WorkMode) -> int:
@@ -350,24 +384,41 @@ class RobotLink(QObject):
     def go_zero(self, axis: int | None) -> int:
         return 0 if self._shut else self._worker.request_go_zero(axis)
 
-    def run_program(self, program_id: int, mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
-                    cycles: int = 1, speed_ratio: int = 100) -> int:
+    def run_program(
+        self,
+        program_id: int,
+        mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
+        cycles: int = 1,
+        speed_ratio: int = 100,
+    ) -> int:
         return 0 if self._shut else self._worker.request_run_program(program_id, mode, cycles, speed_ratio)
 
-    def create_point(self, point_id: int, pose: Sequence[float] | None = None,
-                     tool: int = registers.TOOL_NONE) -> int:
+    def create_point(
+        self, point_id: int, pose: Sequence[float] | None = None, tool: int = registers.TOOL_NONE
+    ) -> int:
         return 0 if self._shut else self._worker.request_create_point(point_id, pose, tool)
 
-    def move_to_point(self, end_id: int, via_id: int | None = None, *, orientation_changes: bool = True,
-                      ignore_middle: bool = False, speed: float = 50.0,
-                      tool: int = registers.TOOL_NONE) -> int:
+    def move_to_point(
+        self,
+        end_id: int,
+        via_id: int | None = None,
+        *,
+        orientation_changes: bool = True,
+        ignore_middle: bool = False,
+        speed: float = 50.0,
+        tool: int = registers.TOOL_NONE,
+    ) -> int:
         if self._shut:
             return 0
-        return self._worker.request_move_to_point(end_id, via_id, orientation_changes, ignore_middle, speed,
-                                                  tool)
+        return self._worker.request_move_to_point(
+            end_id, via_id, orientation_changes, ignore_middle, speed, tool
+        )
 
-    def upload_points(self, points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
-                      tool: int = registers.TOOL_NONE) -> int:
+    def upload_points(
+        self,
+        points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
+        tool: int = registers.TOOL_NONE,
+    ) -> int:
         """Create temp points from (id, pose6, tool) items ((id, pose6) items take ``tool``).
 
         The worker groups them by tool frame (GV245 written once per group) and reports each
@@ -401,8 +452,11 @@ class RobotLink(QObject):
         self._shutdownRequested.emit()  # queued: runs once the transaction in flight is over
         wait_ms = max(1, round(timing.SHUTDOWN_WAIT * 1000))
         if not thread.wait(wait_ms):
-            _log.warning("the robot worker is still inside a network call after %d ms; "
-                         "it ends on its own in the background", wait_ms)
+            _log.warning(
+                "the robot worker is still inside a network call after %d ms; "
+                "it ends on its own in the background",
+                wait_ms,
+            )
             _keep_until_finished(thread, self._worker)
 
 

@@ -54,8 +54,9 @@ class RobotState(QObject):
     rttChanged = Signal(float)  # noqa: N815
     statsChanged = Signal(LinkStats)  # noqa: N815
 
-    def __init__(self, parent: QObject | None = None, *,
-                 freshness_limit: float = DEFAULT_FRESHNESS_LIMIT) -> None:
+    def __init__(
+        self, parent: QObject | None = None, *, freshness_limit: float = DEFAULT_FRESHNESS_LIMIT
+    ) -> None:
         super().__init__(parent)
         if freshness_limit <= 0:
             raise ValueError(f"the freshness limit must be > 0 s, got {freshness_limit:g}")

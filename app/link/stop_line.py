@@ -125,8 +125,7 @@ class StopLine:
 
     @staticmethod
     def usable(settings: ConnectionSettings) -> bool:
-        return (not settings.monitor_only and settings.serial_port is None
-                and settings.transport == "tcp")
+        return not settings.monitor_only and settings.serial_port is None and settings.transport == "tcp"
 
     def main_link_closed(self, now: float, *, lost: bool) -> None:
         """The main link was ``lost`` or closed: close the line too. Lost within
@@ -136,8 +135,10 @@ class StopLine:
                 return
             if lost and now - self.opened_at < PROBATION:
                 self.enabled = False
-                self.why_not = (f"the main link was lost {now - self.opened_at:.1f} s after the stop "
-                                "line opened: the controller seems to accept one connection only")
+                self.why_not = (
+                    f"the main link was lost {now - self.opened_at:.1f} s after the stop "
+                    "line opened: the controller seems to accept one connection only"
+                )
                 _log.warning("stop line off for this connection: %s", self.why_not)
             self._drop("")
 
@@ -184,8 +185,9 @@ class StopLine:
             if answer:
                 capture.observe(TrafficRecord(time.time(), "rx", answer, "tcp"))
         if audit is not None:
-            audit.record_write(registers.REG_STOP, [1], single=True,
-                               error=LinkError(problem) if problem else None)
+            audit.record_write(
+                registers.REG_STOP, [1], single=True, error=LinkError(problem) if problem else None
+            )
         if problem is not None:
             _log.warning("stop line: %s; the stop went out on the main link too", problem)
 
@@ -279,10 +281,13 @@ class StopLine:
                 raise LinkError("the controller closed the stop line")
             buf += data
         if len(buf) > need:
-            raise MalformedResponse(f"{len(buf) - need} bytes more than the {need}-byte answer",
-                                    field="length", expected=need, got=len(buf))
+            raise MalformedResponse(
+                f"{len(buf) - need} bytes more than the {need}-byte answer",
+                field="length",
+                expected=need,
+                got=len(buf),
+            )
         function, data = frames.decode_answer("tcp", buf)
         if function & 0x80:
             raise LinkError(f"the controller refused a request on the stop line (exception {data[0]})")
         return buf
-

@@ -42,9 +42,11 @@ DEFAULT_CANARY_GV: int | None = 99
 
 def check_canary_gv(canary_gv: int | None) -> None:
     if canary_gv is not None and not (UPLOAD_POSE_GV + 6 <= canary_gv <= registers.GV_GENERAL_LAST):
-        raise ValueError(f"the restart canary must be a spare general-purpose GV in "
-                         f"GV{UPLOAD_POSE_GV + 6}..GV{registers.GV_GENERAL_LAST} (uploads use "
-                         f"GV{UPLOAD_POSE_GV}..GV{UPLOAD_POSE_GV + 5}), got GV{canary_gv}")
+        raise ValueError(
+            f"the restart canary must be a spare general-purpose GV in "
+            f"GV{UPLOAD_POSE_GV + 6}..GV{registers.GV_GENERAL_LAST} (uploads use "
+            f"GV{UPLOAD_POSE_GV}..GV{UPLOAD_POSE_GV + 5}), got GV{canary_gv}"
+        )
 
 
 class LinkSupervisor:
@@ -69,8 +71,13 @@ class LinkSupervisor:
     # --- state ----------------------------------------------------------------------------
     def set_state(self, state: LinkState, message: str, reason: Reason | None = None) -> None:
         settings = self.settings
-        new = ConnectionState(state, message, settings.endpoint if settings else "",
-                              bool(settings and settings.monitor_only), reason)
+        new = ConnectionState(
+            state,
+            message,
+            settings.endpoint if settings else "",
+            bool(settings and settings.monitor_only),
+            reason,
+        )
         if new != self.state:
             self.state = new
             _log.info("link %s %s%s", new.endpoint, state.value, f": {message}" if message else "")
@@ -141,8 +148,9 @@ class LinkSupervisor:
         try:
             client.write_gv(gv, [token])
         except TeachPadError as exc:
-            self._host.emit_error(Operation.CANARY, f"could not write the restart canary GV{gv}: {exc}", None,
-                                  exc.as_reason())
+            self._host.emit_error(
+                Operation.CANARY, f"could not write the restart canary GV{gv}: {exc}", None, exc.as_reason()
+            )
             if isinstance(exc, (LinkError, ResponseTimeout)):
                 self.transport_failed(exc)
             return
@@ -152,8 +160,12 @@ class LinkSupervisor:
         """The canary GV as read on the clock poll; a foreign value means the controller restarted."""
         if self.canary_token is None or value == self.canary_token:
             return
-        _log.warning("restart canary GV%s reads %g instead of %g: the controller restarted",
-                     self.canary_gv, value, self.canary_token)
+        _log.warning(
+            "restart canary GV%s reads %g instead of %g: the controller restarted",
+            self.canary_gv,
+            value,
+            self.canary_token,
+        )
         if self.client is not None:
             self.client.invalidate_cache()  # GV245 and friends may have been reset too
         self._host.publish_restarted()
@@ -169,8 +181,9 @@ class LinkSupervisor:
         try:
             self._host.jog.controller_answers()
         except TeachPadError as exc:
-            self._host.emit_error(Operation.JOG_RELEASE, f"could not stop the jog: {exc}", None,
-                                  exc.as_reason())
+            self._host.emit_error(
+                Operation.JOG_RELEASE, f"could not stop the jog: {exc}", None, exc.as_reason()
+            )
             if isinstance(exc, (LinkError, ResponseTimeout)):
                 self.transport_failed(exc)
                 if not self.link_up:
@@ -214,16 +227,25 @@ class LinkSupervisor:
         host.jog.link_lost()
         self.canary_token = None
         host.uploader.end(f"link lost: {cause}")
-        self._fail_active("link lost while the command was under way; its outcome is unknown",
-                          "outcome_unknown_link_lost")
+        self._fail_active(
+            "link lost while the command was under way; its outcome is unknown", "outcome_unknown_link_lost"
+        )
         host.fail_queued("the link to the controller is down: not sent", "queued_link_down")
         if self.client is not None:
             self.client.close()
         self._backoff_index = 0
         self.schedule_reconnect(cause, "link lost: ")
 
-    def close_link(self, operation: str, state: LinkState, message: str, *, emit: bool = True,
-                   fail_queued: bool = True, short: bool = False) -> None:
+    def close_link(
+        self,
+        operation: str,
+        state: LinkState,
+        message: str,
+        *,
+        emit: bool = True,
+        fail_queued: bool = True,
+        short: bool = False,
+    ) -> None:
         """Stop jogging and switch teach off (if the controller answers), close, stop retrying.
 
         ``short`` (shutdown): those safety transactions wait at most the poll timeout each, so a
@@ -243,8 +265,9 @@ class LinkSupervisor:
                 host.emit_error(operation, f"could not stop teach mode: {exc}", None, exc.as_reason())
         self.canary_token = None
         host.uploader.end(f"{operation}: the link was closed")
-        self._fail_active(f"{operation}: the link was closed while the command was under way",
-                          "outcome_unknown_link_closed")
+        self._fail_active(
+            f"{operation}: the link was closed while the command was under way", "outcome_unknown_link_closed"
+        )
         if fail_queued:
             host.fail_queued(f"{operation}: the link was closed: not sent", "queued_link_closed")
         self.link_up = False
@@ -260,7 +283,12 @@ class LinkSupervisor:
     def _fail_active(self, message: str, code: str) -> None:
         active = self._host.motion.take()
         if active is not None:
-            result = CommandResult(None, None, None, False, f"{active.operation}: {message}",
-                                   reason=Reason(code, {"operation": active.operation}))
+            result = CommandResult(
+                None,
+                None,
+                None,
+                False,
+                f"{active.operation}: {message}",
+                reason=Reason(code, {"operation": active.operation}),
+            )
             self._host.emit_result(result, active.request_id)
-

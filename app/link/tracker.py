@@ -193,8 +193,9 @@ class CommandTracker:
         # observe rule, instant commands only: when a stale 0xFF / error counts as this command's
         self.unconfirmed_after: float | None = None
         if rule == "observe" and not self.is_move:
-            self.unconfirmed_after = (timing.UNCONFIRMED_AFTER if unconfirmed_after is None
-                                      else unconfirmed_after)
+            self.unconfirmed_after = (
+                timing.UNCONFIRMED_AFTER if unconfirmed_after is None else unconfirmed_after
+            )
         self.reads = 0
         # instant commands: the second read is timed by the pacer (see ResultPacer)
         self.pacer = None if self.is_move else pacer
@@ -253,9 +254,11 @@ class CommandTracker:
         if status.alarms:
             names = ", ".join(alarm_names(int(status.alarms))) or str(int(status.alarms))
             return self._fail(
-                AlarmRaised(int(status.alarms), f"{self.text}: alarm while waiting: {names}",
-                            params=self._args()),
-                code, now,
+                AlarmRaised(
+                    int(status.alarms), f"{self.text}: alarm while waiting: {names}", params=self._args()
+                ),
+                code,
+                now,
             )
         if code != self.pre_code:
             if not self.code_left_pre:
@@ -269,11 +272,17 @@ class CommandTracker:
             decoded = self.decode(code)
             # A terminal code counts only once GV291 has left the stale pre-command value.
             if self.code_left_pre and decoded.is_done:
-                return self._finish(True, decoded, f"{self.text}: {decoded.text}", now,
-                                    reason=Reason("done", self._args(status=code)))
+                return self._finish(
+                    True,
+                    decoded,
+                    f"{self.text}: {decoded.text}",
+                    now,
+                    reason=Reason("done", self._args(status=code)),
+                )
             if self.code_left_pre and decoded.is_error:
-                err = CommandRefused(decoded, f"{self.text} refused: {decoded.text} (status {code})",
-                                     params=self._args())
+                err = CommandRefused(
+                    decoded, f"{self.text} refused: {decoded.text} (status {code})", params=self._args()
+                )
                 return self._fail(err, code, now)
             stopped = self._check_stopped(status, code, now)
             if stopped is not None:
@@ -282,25 +291,39 @@ class CommandTracker:
             if self._moved_without_status(status, progressed, now, at_target=at_target):
                 if at_target:
                     done = self.decode(STATUS_DONE)
-                    return self._finish(True, done, f"{self.text}: {done.text} (arrived at the point; "
-                                        f"the command status did not change)", now,
-                                        reason=Reason("done", self._args(status=STATUS_DONE)))
+                    return self._finish(
+                        True,
+                        done,
+                        f"{self.text}: {done.text} (arrived at the point; the command status did not change)",
+                        now,
+                        reason=Reason("done", self._args(status=STATUS_DONE)),
+                    )
                 text = self.decode(self.pre_code).text
                 return self._fail(
                     CommandTimeout(
                         f"{self.text}: the arm moved and stopped, but the command status stayed "
                         f"{self.pre_code} '{text}' from before the command; the result is unknown",
-                        code="result_unknown", params=self._args(status=self.pre_code),
+                        code="result_unknown",
+                        params=self._args(status=self.pre_code),
                     ),
-                    code, now,
+                    code,
+                    now,
                 )
         elif self._teach_mode_changed(status):
             decoded = self.decode(STATUS_DONE)
-            return self._finish(True, decoded, f"{self.text}: {decoded.text} (seen in the controller mode, "
-                                f"now {controller_mode_text(int(status.mode))})", now,
-                                reason=Reason("done_by_mode", self._args(mode=int(status.mode))))
-        elif self.unconfirmed_after is not None and now - self.started >= self.unconfirmed_after \
-                and (self.decode(code).is_done or self.decode(code).is_error):
+            return self._finish(
+                True,
+                decoded,
+                f"{self.text}: {decoded.text} (seen in the controller mode, "
+                f"now {controller_mode_text(int(status.mode))})",
+                now,
+                reason=Reason("done_by_mode", self._args(mode=int(status.mode))),
+            )
+        elif (
+            self.unconfirmed_after is not None
+            and now - self.started >= self.unconfirmed_after
+            and (self.decode(code).is_done or self.decode(code).is_error)
+        ):
             return self._unconfirmed(code, now)
         elif now - self.started >= self.ack_timeout:
             text = self.decode(self.pre_code).text
@@ -311,7 +334,8 @@ class CommandTracker:
                     code="not_acknowledged",
                     params=self._args(seconds=round(self.ack_timeout, 3), status=self.pre_code),
                 ),
-                code, now,
+                code,
+                now,
             )
         if progressed and self.hard_timeout is None:
             self._deadline = now + self._budget
@@ -321,9 +345,11 @@ class CommandTracker:
                 CommandTimeout(
                     f"{self.text} did not complete within {_seconds(self._budget)} s "
                     f"(last command status {code} '{decoded.text}')",
-                    code="command_timeout", params=self._args(seconds=round(self._budget, 3), status=code),
+                    code="command_timeout",
+                    params=self._args(seconds=round(self._budget, 3), status=code),
                 ),
-                code, now,
+                code,
+                now,
             )
         return None
 
@@ -332,8 +358,13 @@ class CommandTracker:
         if self.result is not None:
             return self.result
         code = self.last_status.command_status_code if self.last_status else self.pre_code
-        return self._fail(CommandStopped(f"{self.text} stopped by the operator",
-                                         code="stopped_by_operator", params=self._args()), code, now)
+        return self._fail(
+            CommandStopped(
+                f"{self.text} stopped by the operator", code="stopped_by_operator", params=self._args()
+            ),
+            code,
+            now,
+        )
 
     # -- internals -----------------------------------------------------------------------
     def _teach_mode_changed(self, status: ControllerStatus) -> bool:
@@ -351,17 +382,28 @@ class CommandTracker:
         decoded = self.decode(code)
         waited = _seconds(now - self.started)
         if decoded.is_done:
-            message = (f"{self.text}: done, unconfirmed (command status stayed {code} '{decoded.text}' "
-                       f"as before the command for {waited} s; the controller reported no error)")
-            return self._finish(True, decoded, message, now, unconfirmed=True,
-                                reason=Reason("done_unconfirmed", self._args(status=code)))
+            message = (
+                f"{self.text}: done, unconfirmed (command status stayed {code} '{decoded.text}' "
+                f"as before the command for {waited} s; the controller reported no error)"
+            )
+            return self._finish(
+                True,
+                decoded,
+                message,
+                now,
+                unconfirmed=True,
+                reason=Reason("done_unconfirmed", self._args(status=code)),
+            )
         self.error = CommandRefused(
-            decoded, f"{self.text} refused (unconfirmed): command status stayed {code} '{decoded.text}' "
-                     f"from the previous command for {waited} s",
-            code="refused_unconfirmed", params=self._args(seconds=float(waited)),
+            decoded,
+            f"{self.text} refused (unconfirmed): command status stayed {code} '{decoded.text}' "
+            f"from the previous command for {waited} s",
+            code="refused_unconfirmed",
+            params=self._args(seconds=float(waited)),
         )
-        return self._finish(False, decoded, str(self.error), now, unconfirmed=True,
-                            reason=self.error.as_reason())
+        return self._finish(
+            False, decoded, str(self.error), now, unconfirmed=True, reason=self.error.as_reason()
+        )
 
     def _note_motion(self, status: ControllerStatus, pose: Pose | None) -> bool:
         """Update ``motion_seen``; True when this read shows progress (for the stall timer)."""
@@ -384,8 +426,13 @@ class CommandTracker:
         return progressed
 
     def _check_stopped(self, status: ControllerStatus, code: int, now: float) -> CommandResult | None:
-        if not (self.is_move and self.motion_seen and status.program_state == ProgramState.STOPPED
-                and self.code_left_pre and self.decode(code).is_initial):
+        if not (
+            self.is_move
+            and self.motion_seen
+            and status.program_state == ProgramState.STOPPED
+            and self.code_left_pre
+            and self.decode(code).is_initial
+        ):
             self._stopped_since = None
             return None
         if self._stopped_since is None:
@@ -393,13 +440,16 @@ class CommandTracker:
         if now - self._stopped_since < self.stop_settle:
             return None
         return self._fail(
-            CommandStopped(f"{self.text} stopped: program state returned to stopped without 'done'",
-                           params=self._args()),
-            code, now,
+            CommandStopped(
+                f"{self.text} stopped: program state returned to stopped without 'done'", params=self._args()
+            ),
+            code,
+            now,
         )
 
-    def _moved_without_status(self, status: ControllerStatus, progressed: bool, now: float, *,
-                              at_target: bool = False) -> bool:
+    def _moved_without_status(
+        self, status: ControllerStatus, progressed: bool, now: float, *, at_target: bool = False
+    ) -> bool:
         """A move seen under way has been still for a while and GV291 never left the stale code
         (still at its target: after ``stop_settle``; elsewhere: also after ``ack_timeout``)."""
         if not self.is_move or self.code_left_pre or not self.motion_seen:
@@ -418,13 +468,16 @@ class CommandTracker:
         if pose is None:
             return False
         if self.target_ext is not None and not all(
-                abs(e - t) <= ARRIVAL_TOLERANCE for e, t in zip(pose.ext, self.target_ext, strict=False)):
+            abs(e - t) <= ARRIVAL_TOLERANCE for e, t in zip(pose.ext, self.target_ext, strict=False)
+        ):
             return False
         if self.target is not None:
             return math.dist(pose.xyzabc[:3], self.target) <= ARRIVAL_TOLERANCE
         if self.target_joints is not None and pose.joints:
-            return all(abs(q - t) <= ARRIVAL_TOLERANCE_DEG
-                       for q, t in zip(pose.joints, self.target_joints, strict=False))
+            return all(
+                abs(q - t) <= ARRIVAL_TOLERANCE_DEG
+                for q, t in zip(pose.joints, self.target_joints, strict=False)
+            )
         return False
 
     def _details(self, now: float) -> dict[str, float]:
@@ -437,8 +490,16 @@ class CommandTracker:
         """A reason's arguments: the command (its number) and what the caller adds."""
         return {"command": int(self.command), **extra}
 
-    def _finish(self, ok: bool, status: CommandStatus, message: str, now: float, *,
-                unconfirmed: bool = False, reason: Reason | None = None) -> CommandResult:
+    def _finish(
+        self,
+        ok: bool,
+        status: CommandStatus,
+        message: str,
+        now: float,
+        *,
+        unconfirmed: bool = False,
+        reason: Reason | None = None,
+    ) -> CommandResult:
         details = self._details(now)
         details["reads"] = float(self.reads)
         ack = self._ack_read
@@ -447,8 +508,9 @@ class CommandTracker:
             taken = self._sent[ack - 1]
             missed = self._sent[-2] - taken if self.reads > ack + 1 else None
             self.pacer.learn(missed, self._sent[-1] - taken)
-        self.result = CommandResult(self.command, self.kind, status, ok, message, details,
-                                    unconfirmed=unconfirmed, reason=reason)
+        self.result = CommandResult(
+            self.command, self.kind, status, ok, message, details, unconfirmed=unconfirmed, reason=reason
+        )
         return self.result
 
     def _fail(self, error: TeachPadError, code: int, now: float) -> CommandResult:

@@ -53,6 +53,7 @@ _log = logging.getLogger(__name__)
 SIMULATOR_PORT = 5020  # the simulator's default port, hinted when 502 refuses
 _RECV_SIZE = 4096
 
+
 def _seconds(value: float) -> str:
     return str(round(value, 3))
 
@@ -146,19 +147,30 @@ class _TcpStream:
         try:
             sock = socket.create_connection((s.host, s.port), timeout=timeout)
         except socket.gaierror:
-            raise LinkError(f"the host name {s.host[:60]!r} cannot be resolved", code="host_unresolved",
-                            params={"host": s.host[:60]}) from None
+            raise LinkError(
+                f"the host name {s.host[:60]!r} cannot be resolved",
+                code="host_unresolved",
+                params={"host": s.host[:60]},
+            ) from None
         except ConnectionRefusedError:
-            hint = (f" (nothing listens on port 502; the simulator's port is {SIMULATOR_PORT})"
-                    if s.port == 502 else "")
-            raise LinkError(f"connection refused{hint}", code="connection_refused",
-                            params={"port": s.port}) from None
+            hint = (
+                f" (nothing listens on port 502; the simulator's port is {SIMULATOR_PORT})"
+                if s.port == 502
+                else ""
+            )
+            raise LinkError(
+                f"connection refused{hint}", code="connection_refused", params={"port": s.port}
+            ) from None
         except TimeoutError:
-            raise LinkError(f"no answer to the connection request within {_seconds(timeout)} s",
-                            code="connect_timeout", params={"seconds": timeout}) from None
+            raise LinkError(
+                f"no answer to the connection request within {_seconds(timeout)} s",
+                code="connect_timeout",
+                params={"seconds": timeout},
+            ) from None
         except OSError as exc:
-            raise LinkError(str(exc.strerror or exc).lower(), code="connect_failed",
-                            params={"errno": exc.errno}) from None
+            raise LinkError(
+                str(exc.strerror or exc).lower(), code="connect_failed", params={"errno": exc.errno}
+            ) from None
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self._sock = sock
 
@@ -214,12 +226,21 @@ class _SerialStream:
 
         s = self._settings
         try:
-            self._port = serial.Serial(s.serial_port, baudrate=s.baudrate, parity=s.parity,
-                                       stopbits=s.stopbits, bytesize=s.bytesize, timeout=timeout,
-                                       exclusive=True)
+            self._port = serial.Serial(
+                s.serial_port,
+                baudrate=s.baudrate,
+                parity=s.parity,
+                stopbits=s.stopbits,
+                bytesize=s.bytesize,
+                timeout=timeout,
+                exclusive=True,
+            )
         except (serial.SerialException, OSError, ValueError) as exc:
-            raise LinkError(f"cannot open the serial port: {exc}", code="serial_open_failed",
-                            params={"port": (s.serial_port or "")[:60]}) from None
+            raise LinkError(
+                f"cannot open the serial port: {exc}",
+                code="serial_open_failed",
+                params={"port": (s.serial_port or "")[:60]},
+            ) from None
 
     def close(self) -> None:
         if self._port is not None:
@@ -250,12 +271,14 @@ class _SerialStream:
 class Transport:
     """One request at a time over one link; every answer checked against its request."""
 
-    def __init__(self, settings: ConnectionSettings,
-                 on_link_change: Callable[[], None] | None = None) -> None:
+    def __init__(
+        self, settings: ConnectionSettings, on_link_change: Callable[[], None] | None = None
+    ) -> None:
         self.settings = settings
         self.framing: frames.Framing = settings.transport
         self._stream: _TcpStream | _SerialStream = (
-            _SerialStream(settings) if settings.serial_port is not None else _TcpStream(settings))
+            _SerialStream(settings) if settings.serial_port is not None else _TcpStream(settings)
+        )
         self._on_link_change = on_link_change or (lambda: None)
         self._observers: list[TrafficObserver] = []
         self._observing = False  # checked first on the hot path
@@ -288,12 +311,17 @@ class Transport:
             self._stream.open(self.settings.timeout)
         except LinkError as exc:
             endpoint = self.settings.endpoint
-            message = (f"cannot reconnect to the controller at {endpoint} (the link was lost): {exc}"
-                       if self._ever_connected
-                       else f"cannot connect to the controller at {endpoint}: {exc}")
+            message = (
+                f"cannot reconnect to the controller at {endpoint} (the link was lost): {exc}"
+                if self._ever_connected
+                else f"cannot connect to the controller at {endpoint}: {exc}"
+            )
             self._count("link_errors", message)
-            raise LinkError(message, code=exc.code, params={
-                **exc.params, "endpoint": endpoint, "reconnect": self._ever_connected}) from None
+            raise LinkError(
+                message,
+                code=exc.code,
+                params={**exc.params, "endpoint": endpoint, "reconnect": self._ever_connected},
+            ) from None
         if self._ever_connected:
             self._count("reconnects")
         self._ever_connected = True
@@ -338,8 +366,9 @@ class Transport:
     def write_single(self, what: str, address: int, value: int, timeout: float | None = None) -> None:
         self.execute(what, frames.write_single_request(address, value), timeout)
 
-    def write_multiple(self, what: str, address: int, values: Sequence[int],
-                       timeout: float | None = None) -> None:
+    def write_multiple(
+        self, what: str, address: int, values: Sequence[int], timeout: float | None = None
+    ) -> None:
         self.execute(what, frames.write_multiple_request(address, values), timeout)
 
     def execute(self, what: str, request: Request, timeout: float | None = None) -> tuple[int, bytes]:
@@ -351,12 +380,18 @@ class Transport:
                 return self._exchange(what, request, timeout)
             except ResponseTimeout:
                 if attempt + 1 == attempts:
-                    message = (f"controller did not answer within {_seconds(timeout * attempts)} s "
-                               f"({self.settings.endpoint})")
+                    message = (
+                        f"controller did not answer within {_seconds(timeout * attempts)} s "
+                        f"({self.settings.endpoint})"
+                    )
                     self._stats = dataclasses.replace(self._stats, last_error=message)
-                    raise ResponseTimeout(message, params={
-                        "seconds": round(timeout * attempts, 3), "endpoint": self.settings.endpoint,
-                    }) from None
+                    raise ResponseTimeout(
+                        message,
+                        params={
+                            "seconds": round(timeout * attempts, 3),
+                            "endpoint": self.settings.endpoint,
+                        },
+                    ) from None
         raise AssertionError("unreachable")  # pragma: no cover
 
     def _flush_stray(self) -> None:
@@ -368,8 +403,9 @@ class Transport:
             self.close()
             message = f"lost the connection to the controller at {self.settings.endpoint}: it closed the link"
             self._count("link_errors", message)
-            raise LinkError(message, code="link_closed",
-                            params={"endpoint": self.settings.endpoint}) from None
+            raise LinkError(
+                message, code="link_closed", params={"endpoint": self.settings.endpoint}
+            ) from None
         if dropped:
             self._count("resyncs", f"dropped {dropped} stray bytes from {self.settings.endpoint}")
 
@@ -408,25 +444,34 @@ class Transport:
                         raise ResponseTimeout(f"no answer to the {what}")
                     raise MalformedResponse(
                         f"answer cut short: {len(buf)} of {need} bytes within {_seconds(timeout)} s",
-                        field="length", expected=need, got=len(buf))
+                        field="length",
+                        expected=need,
+                        got=len(buf),
+                    )
                 try:
                     buf += self._stream.recv(remaining)
                 except _PeerClosed:
                     if not buf:
                         raise self._lost(what) from None
                     raise MalformedResponse(
-                        f"answer cut short: the controller closed the link after {len(buf)} of "
-                        f"{need} bytes", field="length", expected=need, got=len(buf)) from None
+                        f"answer cut short: the controller closed the link after {len(buf)} of {need} bytes",
+                        field="length",
+                        expected=need,
+                        got=len(buf),
+                    ) from None
                 except OSError:
                     raise self._lost(what) from None
             if len(buf) > need:
-                raise MalformedResponse(f"{len(buf) - need} bytes more than the {need}-byte answer",
-                                        field="length", expected=need, got=len(buf))
+                raise MalformedResponse(
+                    f"{len(buf) - need} bytes more than the {need}-byte answer",
+                    field="length",
+                    expected=need,
+                    got=len(buf),
+                )
         except MalformedResponse as exc:
             if self._observing and buf:
                 self._emit("rx", buf)
-            message = (f"malformed answer to the {what} from {self.settings.endpoint}: "
-                       f"{str(exc)[:200]}")
+            message = f"malformed answer to the {what} from {self.settings.endpoint}: {str(exc)[:200]}"
             self._count("malformed", message)
             self._resync("a malformed answer")
             error = MalformedResponse(message, field=exc.field, expected=exc.expected, got=exc.got)

@@ -71,13 +71,16 @@ class WorkerError:
     reason: Reason | None = None  # code + arguments the GUI translates (None: only ``message``)
 
     @classmethod
-    def from_exception(cls, operation: str, exc: BaseException,
-                       request_id: int | None = None) -> WorkerError:
+    def from_exception(cls, operation: str, exc: BaseException, request_id: int | None = None) -> WorkerError:
         """The error for ``exc``: its English text and, for a typed error, its reason."""
         if isinstance(exc, TeachPadError):
             return cls(operation, str(exc), request_id, exc.as_reason())
-        return cls(operation, f"{type(exc).__name__}: {str(exc)[:200]}", request_id,
-                   Reason("unexpected", {"type": type(exc).__name__}))
+        return cls(
+            operation,
+            f"{type(exc).__name__}: {str(exc)[:200]}",
+            request_id,
+            Reason("unexpected", {"type": type(exc).__name__}),
+        )
 
 
 @dataclass(frozen=True)
@@ -93,5 +96,8 @@ class JogRequest:
 
     @property
     def frame_key(self) -> tuple[TeachFrame, int, int]:
-        return (self.frame, self.user if self.frame is TeachFrame.USER else 0,
-                self.tool if self.frame is TeachFrame.TOOL else 0)
+        return (
+            self.frame,
+            self.user if self.frame is TeachFrame.USER else 0,
+            self.tool if self.frame is TeachFrame.TOOL else 0,
+        )

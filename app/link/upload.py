@@ -61,14 +61,19 @@ def check_upload_items(client: RobotClient, raw: Sequence[RawItem]) -> list[Uplo
         if isinstance(pid, bool) or not isinstance(pid, int) or not lo <= pid <= hi:
             raise InvalidInput(f"point id must be an integer in {lo}..{hi}, got {str(pid)[:20]!r}")
         if isinstance(tool, bool) or not isinstance(tool, int) or not 0 <= tool <= registers.TOOL_NONE:
-            raise InvalidInput(f"tool frame of point {pid} must be 0..{registers.TOOL_NONE}, "
-                               f"got {str(tool)[:20]!r}")
+            raise InvalidInput(
+                f"tool frame of point {pid} must be 0..{registers.TOOL_NONE}, got {str(tool)[:20]!r}"
+            )
         if len(pose) != 6:
             raise InvalidInput(f"pose of point {pid} needs 6 values, got {len(pose)}")
         values: list[float] = []
         for v in pose:
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) \
-                    or abs(v) > _FLOAT32_MAX:
+            if (
+                isinstance(v, bool)
+                or not isinstance(v, (int, float))
+                or not math.isfinite(v)
+                or abs(v) > _FLOAT32_MAX
+            ):
                 raise InvalidInput(f"pose of point {pid}: {str(v)[:20]!r} is not a finite float32")
             values.append(float(v))
         items.append((pid, tuple(values), tool))
@@ -91,8 +96,16 @@ class Uploader:
             raise WriteBlocked(f"monitor-only mode: {Operation.UPLOAD_POINTS} was not sent")
         items = group_by_tool(check_upload_items(client, raw))
         if not items:
-            host.emit_result(CommandResult(RunCommand.CREATE_POINT, None, None, True,
-                                           "uploaded 0 of 0 points", {"uploaded": 0.0, "total": 0.0}))
+            host.emit_result(
+                CommandResult(
+                    RunCommand.CREATE_POINT,
+                    None,
+                    None,
+                    True,
+                    "uploaded 0 of 0 points",
+                    {"uploaded": 0.0, "total": 0.0},
+                )
+            )
             return False
         host.jog.leave_teach(host.poller.last_status)
         self.run = UploadRun(host.request_id, items)

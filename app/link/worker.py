@@ -110,8 +110,9 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     # The next chunk of an upload, one event-loop turn later (polls and queued calls in between).
     _uploadStep = Signal()  # noqa: N815
 
-    def __init__(self, poll_hz: float = timing.POLL_HZ_DEFAULT, *,
-                 canary_gv: int | None = DEFAULT_CANARY_GV) -> None:
+    def __init__(
+        self, poll_hz: float = timing.POLL_HZ_DEFAULT, *, canary_gv: int | None = DEFAULT_CANARY_GV
+    ) -> None:
         super().__init__()
         self._poll_hz = float(poll_hz)
         self._jobs = JobQueue()
@@ -312,8 +313,9 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
             result = dataclasses.replace(result, request_id=rid)
         self.commandFinished.emit(result)
 
-    def emit_error(self, operation: str, message: str, request_id: int | None = -1,
-                   reason: Reason | None = None) -> None:
+    def emit_error(
+        self, operation: str, message: str, request_id: int | None = -1, reason: Reason | None = None
+    ) -> None:
         """``errorOccurred`` with the request id (default: the job being executed) and, when the
         cause is known, its reason (code + arguments) for the operator's language."""
         rid = self.request_id if request_id == -1 else request_id
@@ -403,8 +405,9 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
 
     def _execute(self, job: Job, *, held: bool = False) -> None:
         if job.needs_link and not self.link_up:
-            self.emit_error(job.operation, "not connected to a controller", job.request_id,
-                            Reason("not_connected"))
+            self.emit_error(
+                job.operation, "not connected to a controller", job.request_id, Reason("not_connected")
+            )
             return
         if not held and self._must_wait(job):
             self._held.append(job)
@@ -423,11 +426,13 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
             self.emit_exception(job.operation, exc)
             self.supervisor.transport_failed(exc)
         except ModbusExceptionError as exc:
-            self.emit_result(CommandResult(None, None, None, False, f"{job.operation}: {exc}",
-                                           reason=exc.as_reason()))
+            self.emit_result(
+                CommandResult(None, None, None, False, f"{job.operation}: {exc}", reason=exc.as_reason())
+            )
         except CommandRefused as exc:
-            self.emit_result(CommandResult(None, exc.status.kind, exc.status, False, str(exc),
-                                           reason=exc.as_reason()))
+            self.emit_result(
+                CommandResult(None, exc.status.kind, exc.status, False, str(exc), reason=exc.as_reason())
+            )
         except TeachPadError as exc:  # InvalidInput and the rest
             self.emit_exception(job.operation, exc)
         except Exception as exc:  # a bug: report it plainly, keep the worker alive

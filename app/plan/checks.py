@@ -107,7 +107,6 @@ def ids_needing_upload(issues: Sequence[PlanIssue]) -> list[int]:
     return sorted({i.point_id for i in issues if i.kind is IssueKind.NEEDS_UPLOAD and i.point_id is not None})
 
 
-
 def _seg_name(index: int) -> str:
     return f"segment {index + 1}"
 
@@ -121,16 +120,22 @@ def _arc_issue(
     if min(d_sm, d_me, d_se) < tol:
         pair = "start-middle" if d_sm < tol else ("middle-end" if d_me < tol else "start-end")
         which = pair.replace("-", " and ")
-        return IssueCode.ARC_POINTS_COINCIDE, (
-            f"the arc's {which} points coincide (closer than {tol:g} mm): three distinct points are needed"
-        ), {"pair": pair, "tolerance": tol}
+        return (
+            IssueCode.ARC_POINTS_COINCIDE,
+            (f"the arc's {which} points coincide (closer than {tol:g} mm): three distinct points are needed"),
+            {"pair": pair, "tolerance": tol},
+        )
     # distance of M from the line S-E
     off = float(np.linalg.norm(np.cross(m - s, e - s))) / d_se
     if off < limits.collinear_tolerance:
-        return IssueCode.ARC_COLLINEAR, (
-            f"the arc's three points are (nearly) on one line: the middle point is {off:.3g} mm off the "
-            f"start-end line (at least {limits.collinear_tolerance:g} mm needed); use a line instead"
-        ), {"offset": float(f"{off:.3g}"), "tolerance": limits.collinear_tolerance}
+        return (
+            IssueCode.ARC_COLLINEAR,
+            (
+                f"the arc's three points are (nearly) on one line: the middle point is {off:.3g} mm off the "
+                f"start-end line (at least {limits.collinear_tolerance:g} mm needed); use a line instead"
+            ),
+            {"offset": float(f"{off:.3g}"), "tolerance": limits.collinear_tolerance},
+        )
     return None
 
 
@@ -162,12 +167,25 @@ def check_plan(
     issues: list[PlanIssue] = []
     n = len(plan.segments)
     if n == 0:
-        return [PlanIssue(None, IssueKind.ERROR, IssueCode.EMPTY_PLAN, f"plan '{plan.name}' has no segments",
-                          args={"plan": plan.name})]
+        return [
+            PlanIssue(
+                None,
+                IssueKind.ERROR,
+                IssueCode.EMPTY_PLAN,
+                f"plan '{plan.name}' has no segments",
+                args={"plan": plan.name},
+            )
+        ]
     if not 0 <= start_index < n:
-        return [PlanIssue(None, IssueKind.ERROR, IssueCode.BAD_START,
-                          f"cannot start at segment {start_index + 1}: the plan has {n} segments",
-                          args={"start": start_index + 1, "segments": n})]
+        return [
+            PlanIssue(
+                None,
+                IssueKind.ERROR,
+                IssueCode.BAD_START,
+                f"cannot start at segment {start_index + 1}: the plan has {n} segments",
+                args={"start": start_index + 1, "segments": n},
+            )
+        ]
     ends = [None if (end := ledger.get(seg.end_id)) is None else xyz_of(end) for seg in plan.segments]
     issues.extend(_point_issues(plan, ledger, limits))
     # Geometry, from where each segment starts when it runs: segment start_index from the
@@ -176,14 +194,32 @@ def check_plan(
     start_pose = None if current_pose is None else xyz_of(current_pose)
     for i, seg in enumerate(plan.segments):
         for start, context in _segment_starts(i, n, start_index, loops != 1, start_pose, ends):
-            issues.extend(_geometry_issues(i, seg, start, context, ends, ledger, limits,
-                                           pose_unknown=i == start_index and current_pose is None,
-                                           resumed=i == start_index))
+            issues.extend(
+                _geometry_issues(
+                    i,
+                    seg,
+                    start,
+                    context,
+                    ends,
+                    ledger,
+                    limits,
+                    pose_unknown=i == start_index and current_pose is None,
+                    resumed=i == start_index,
+                )
+            )
     if envelope is not None:
-        for v in plan_violations(plan, ledger, envelope, current_pose, start_index=start_index,
-                                 loops=loops, reduced=reduced_speed):
-            issues.append(PlanIssue(v.segment, IssueKind.ERROR, IssueCode.OUTSIDE_ENVELOPE, v.message,
-                                    args=EnvelopeRefused(v).as_reason().args))
+        for v in plan_violations(
+            plan, ledger, envelope, current_pose, start_index=start_index, loops=loops, reduced=reduced_speed
+        ):
+            issues.append(
+                PlanIssue(
+                    v.segment,
+                    IssueKind.ERROR,
+                    IssueCode.OUTSIDE_ENVELOPE,
+                    v.message,
+                    args=EnvelopeRefused(v).as_reason().args,
+                )
+            )
     if reach is not None:
         issues.extend(reach(plan, ledger, current_pose))
     order = {IssueKind.ERROR: 0, IssueKind.NEEDS_UPLOAD: 1, IssueKind.WARNING: 2}
@@ -200,33 +236,59 @@ def _point_issues(plan: Plan, ledger: PointLedger, limits: PlanLimits) -> list[P
         end = ledger.get(seg.end_id)
         via = ledger.get(seg.via_id) if seg.via_id is not None else None
         if not 0 < seg.speed <= limits.max_speed:
-            issues.append(PlanIssue(i, IssueKind.ERROR, IssueCode.BAD_SPEED,
-                                    f"{name}: speed {seg.speed:g} mm/s is not in "
-                                    f"(0, {limits.max_speed:g}] mm/s",
-                                    args={"speed": seg.speed, "max": limits.max_speed}))
+            issues.append(
+                PlanIssue(
+                    i,
+                    IssueKind.ERROR,
+                    IssueCode.BAD_SPEED,
+                    f"{name}: speed {seg.speed:g} mm/s is not in (0, {limits.max_speed:g}] mm/s",
+                    args={"speed": seg.speed, "max": limits.max_speed},
+                )
+            )
         if seg.is_arc and seg.via_id is None:
-            issues.append(PlanIssue(i, IssueKind.ERROR, IssueCode.ARC_NO_MIDDLE,
-                                    f"{name}: the arc has no middle point"))
+            issues.append(
+                PlanIssue(i, IssueKind.ERROR, IssueCode.ARC_NO_MIDDLE, f"{name}: the arc has no middle point")
+            )
         for role, pid, point in (("middle", seg.via_id, via), ("end", seg.end_id, end)):
             if pid is None:
                 continue
             if point is None:
-                issues.append(PlanIssue(i, IssueKind.ERROR, IssueCode.MISSING_POINT,
-                                        f"{name}: {role} point P{pid} does not exist", pid,
-                                        args={"role": role, "id": pid}))
+                issues.append(
+                    PlanIssue(
+                        i,
+                        IssueKind.ERROR,
+                        IssueCode.MISSING_POINT,
+                        f"{name}: {role} point P{pid} does not exist",
+                        pid,
+                        args={"role": role, "id": pid},
+                    )
+                )
                 continue
             if point.needs_upload and pid not in upload_reported:
                 upload_reported.add(pid)
                 why = point.sync.text + (f": {point.sync_error}" if point.sync is SyncState.FAILED else "")
-                issues.append(PlanIssue(i, IssueKind.NEEDS_UPLOAD, IssueCode.NEEDS_UPLOAD,
-                                        f"{name}: {point.label} is not on the controller ({why}); upload it",
-                                        pid, args={"point": point.label, "sync": point.sync.value}))
+                issues.append(
+                    PlanIssue(
+                        i,
+                        IssueKind.NEEDS_UPLOAD,
+                        IssueCode.NEEDS_UPLOAD,
+                        f"{name}: {point.label} is not on the controller ({why}); upload it",
+                        pid,
+                        args={"point": point.label, "sync": point.sync.value},
+                    )
+                )
             if point.tool != seg.tool:
-                issues.append(PlanIssue(i, IssueKind.WARNING, IssueCode.TOOL_MISMATCH,
-                                        f"{name}: {point.label} was taught with {tool_text(point.tool)}, "
-                                        f"the segment moves with {tool_text(seg.tool)}", pid,
-                                        args={"point": point.label, "point_tool": point.tool,
-                                              "segment_tool": seg.tool}))
+                issues.append(
+                    PlanIssue(
+                        i,
+                        IssueKind.WARNING,
+                        IssueCode.TOOL_MISMATCH,
+                        f"{name}: {point.label} was taught with {tool_text(point.tool)}, "
+                        f"the segment moves with {tool_text(seg.tool)}",
+                        pid,
+                        args={"point": point.label, "point_tool": point.tool, "segment_tool": seg.tool},
+                    )
+                )
     return issues
 
 
@@ -234,26 +296,53 @@ def _point_issues(plan: Plan, ledger: PointLedger, limits: PlanLimits) -> list[P
 Context = tuple[str, dict[str, Any]] | None
 
 
-def _segment_starts(i: int, n: int, start_index: int, more_loops: bool, start_pose: FloatArray | None,
-                    ends: Sequence[FloatArray | None]) -> list[tuple[FloatArray | None, Context]]:
+def _segment_starts(
+    i: int,
+    n: int,
+    start_index: int,
+    more_loops: bool,
+    start_pose: FloatArray | None,
+    ends: Sequence[FloatArray | None],
+) -> list[tuple[FloatArray | None, Context]]:
     """Where segment ``i`` starts when it runs, each with the context for the message."""
     starts: list[tuple[FloatArray | None, Context]] = []
     if i == start_index:
         starts.append((start_pose, ("from the current pose", {"from": "current_pose"})))
     if i > 0 and (i > start_index or more_loops):
-        later: Context = None if i > start_index else (
-            f"on loops after the first, starting at the end of segment {i}",
-            {"from": "later_loops", "after": i})
+        later: Context = (
+            None
+            if i > start_index
+            else (
+                f"on loops after the first, starting at the end of segment {i}",
+                {"from": "later_loops", "after": i},
+            )
+        )
         starts.append((ends[i - 1], later))
     if i == 0 and more_loops:
-        starts.append((ends[n - 1], (f"on loops after the first, starting at the end of segment {n}",
-                                     {"from": "later_loops", "after": n})))
+        starts.append(
+            (
+                ends[n - 1],
+                (
+                    f"on loops after the first, starting at the end of segment {n}",
+                    {"from": "later_loops", "after": n},
+                ),
+            )
+        )
     return starts
 
 
-def _geometry_issues(i: int, seg: Segment, start: FloatArray | None, context: Context,
-                     ends: Sequence[FloatArray | None], ledger: PointLedger, limits: PlanLimits, *,
-                     pose_unknown: bool, resumed: bool) -> list[PlanIssue]:
+def _geometry_issues(
+    i: int,
+    seg: Segment,
+    start: FloatArray | None,
+    context: Context,
+    ends: Sequence[FloatArray | None],
+    ledger: PointLedger,
+    limits: PlanLimits,
+    *,
+    pose_unknown: bool,
+    resumed: bool,
+) -> list[PlanIssue]:
     """The shape of segment ``i`` run from ``start``: a usable arc, a line that goes somewhere."""
     suffix = f" ({context[0]})" if context else ""
     where: dict[str, Any] = context[1] if context else {}
@@ -264,33 +353,59 @@ def _geometry_issues(i: int, seg: Segment, start: FloatArray | None, context: Co
         length = float(np.linalg.norm(end_xyz - start))
         if length >= limits.zero_length:
             return []
-        return [PlanIssue(i, IssueKind.WARNING, IssueCode.ZERO_LENGTH,
-                          f"{_seg_name(i)}: the line goes nowhere "
-                          f"(start and end {length:.3g} mm apart){suffix}",
-                          args={"length": float(f"{length:.3g}"), **where})]
+        return [
+            PlanIssue(
+                i,
+                IssueKind.WARNING,
+                IssueCode.ZERO_LENGTH,
+                f"{_seg_name(i)}: the line goes nowhere (start and end {length:.3g} mm apart){suffix}",
+                args={"length": float(f"{length:.3g}"), **where},
+            )
+        ]
     via_pt = ledger.get(seg.via_id) if seg.via_id is not None else None
     if via_pt is None or end_xyz is None:
         return []
     if start is None:
         if not pose_unknown:
             return []
-        return [PlanIssue(i, IssueKind.WARNING, IssueCode.ARC_START_UNKNOWN,
-                          f"{_seg_name(i)}: the arc starts at the robot's current "
-                          "pose, which is not known: its shape is not checked")]
+        return [
+            PlanIssue(
+                i,
+                IssueKind.WARNING,
+                IssueCode.ARC_START_UNKNOWN,
+                f"{_seg_name(i)}: the arc starts at the robot's current "
+                "pose, which is not known: its shape is not checked",
+            )
+        ]
     problem = _arc_issue(start, xyz_of(via_pt), end_xyz, limits)
     if problem is not None:
-        return [PlanIssue(i, IssueKind.ERROR, problem[0], f"{_seg_name(i)}: {problem[1]}{suffix}",
-                          args={**problem[2], **where})]
+        return [
+            PlanIssue(
+                i,
+                IssueKind.ERROR,
+                problem[0],
+                f"{_seg_name(i)}: {problem[1]}{suffix}",
+                args={**problem[2], **where},
+            )
+        ]
     if resumed and i > 0 and (planned_start := ends[i - 1]) is not None:
         detour = _arc_detour(start, planned_start, xyz_of(via_pt), end_xyz)
         if detour is not None:
-            return [PlanIssue(i, detour[0], IssueCode.ARC_RESUME_PAST_MIDDLE, f"{_seg_name(i)}: {detour[1]}",
-                              args=detour[2])]
+            return [
+                PlanIssue(
+                    i,
+                    detour[0],
+                    IssueCode.ARC_RESUME_PAST_MIDDLE,
+                    f"{_seg_name(i)}: {detour[1]}",
+                    args=detour[2],
+                )
+            ]
     return []
 
 
-def _arc_detour(start: FloatArray, planned_start: FloatArray, via: FloatArray,
-                end: FloatArray) -> tuple[IssueKind, str, dict[str, Any]] | None:
+def _arc_detour(
+    start: FloatArray, planned_start: FloatArray, via: FloatArray, end: FloatArray
+) -> tuple[IssueKind, str, dict[str, Any]] | None:
     """Why an arc sent from ``start`` would not follow the planned arc, or None.
 
     An arc interrupted past its middle point and sent again from where the arm stopped goes
@@ -315,11 +430,22 @@ def _arc_detour(start: FloatArray, planned_start: FloatArray, via: FloatArray,
     larger = sweep_now > sweep_planned + math.radians(ARC_RESUME_TOLERANCE_DEG)
     if not (past_middle or larger):
         return None
-    swing = (f"sent from here the arc would swing {math.degrees(sweep_now):.0f}° round through the "
-             f"middle point (planned {math.degrees(sweep_planned):.0f}°)")
-    args = {"sweep": round(math.degrees(sweep_now)), "planned": round(math.degrees(sweep_planned)),
-            "past_middle": past_middle}
+    swing = (
+        f"sent from here the arc would swing {math.degrees(sweep_now):.0f}° round through the "
+        f"middle point (planned {math.degrees(sweep_planned):.0f}°)"
+    )
+    args = {
+        "sweep": round(math.degrees(sweep_now)),
+        "planned": round(math.degrees(sweep_planned)),
+        "past_middle": past_middle,
+    }
     if past_middle:
-        return IssueKind.ERROR, (f"the arm stopped past the arc's middle point: {swing}; move to the "
-                                 "end point with a line, or run from the segment before"), args
+        return (
+            IssueKind.ERROR,
+            (
+                f"the arm stopped past the arc's middle point: {swing}; move to the "
+                "end point with a line, or run from the segment before"
+            ),
+            args,
+        )
     return IssueKind.WARNING, f"{swing}; check the preview before running from here", args

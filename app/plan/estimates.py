@@ -35,7 +35,6 @@ def move_timeout(estimate: float) -> float:
     return max(float(timing.MOVE_TIMEOUT_MIN), 3.0 * estimate)
 
 
-
 @dataclass(frozen=True)
 class PlanEstimate:
     """Lengths (mm) and times (s) of a plan.
@@ -60,8 +59,14 @@ class PlanEstimate:
     unknown: tuple[int, ...]
 
 
-def estimate_plan(plan: Plan, ledger: PointLedger, start: PointLike | None = None, *,
-                  loops: int | None = None, overhead: float = SEGMENT_OVERHEAD_S) -> PlanEstimate:
+def estimate_plan(
+    plan: Plan,
+    ledger: PointLedger,
+    start: PointLike | None = None,
+    *,
+    loops: int | None = None,
+    overhead: float = SEGMENT_OVERHEAD_S,
+) -> PlanEstimate:
     loops = plan.loops if loops is None else loops
     geo = plan_geometry(plan, ledger, start)
     speeds = np.array([seg.speed for seg in plan.segments], dtype=np.float64)
@@ -85,10 +90,17 @@ def estimate_plan(plan: Plan, ledger: PointLedger, start: PointLike | None = Non
         total_length = loop_length + (loops - 1) * next_length
         total_time = loop_time + (loops - 1) * next_time
     return PlanEstimate(
-        lengths=geo.lengths, times=np.asarray(times, dtype=np.float64), loop_length=loop_length,
-        loop_time=loop_time, next_loop_length=next_length, next_loop_time=next_time,
-        wrap_length=wrap_length, wrap_time=wrap_time, loops=loops,
-        total_length=total_length, total_time=total_time,
+        lengths=geo.lengths,
+        times=np.asarray(times, dtype=np.float64),
+        loop_length=loop_length,
+        loop_time=loop_time,
+        next_loop_length=next_length,
+        next_loop_time=next_time,
+        wrap_length=wrap_length,
+        wrap_time=wrap_time,
+        loops=loops,
+        total_length=total_length,
+        total_time=total_time,
         unknown=tuple(int(i) for i in np.flatnonzero(~known)),
     )
 

@@ -59,16 +59,28 @@ class ArcGeometry:
 
     def rows(self, mask: NDArray[np.bool_]) -> ArcGeometry:
         """The arcs selected by a boolean mask."""
-        return ArcGeometry(self.centre[mask], self.radius[mask], self.normal[mask], self.u[mask],
-                           self.v[mask], self.via_angle[mask], self.sweep[mask])
+        return ArcGeometry(
+            self.centre[mask],
+            self.radius[mask],
+            self.normal[mask],
+            self.u[mask],
+            self.v[mask],
+            self.via_angle[mask],
+            self.sweep[mask],
+        )
 
     def masked(self, keep: NDArray[np.bool_]) -> ArcGeometry:
         """Same rows, NaN where ``keep`` is False."""
         k1, k2 = keep, keep[:, None]
-        return ArcGeometry(np.where(k2, self.centre, np.nan), np.where(k1, self.radius, np.nan),
-                           np.where(k2, self.normal, np.nan), np.where(k2, self.u, np.nan),
-                           np.where(k2, self.v, np.nan), np.where(k1, self.via_angle, np.nan),
-                           np.where(k1, self.sweep, np.nan))
+        return ArcGeometry(
+            np.where(k2, self.centre, np.nan),
+            np.where(k1, self.radius, np.nan),
+            np.where(k2, self.normal, np.nan),
+            np.where(k2, self.u, np.nan),
+            np.where(k2, self.v, np.nan),
+            np.where(k1, self.via_angle, np.nan),
+            np.where(k1, self.sweep, np.nan),
+        )
 
 
 def _rows_dot(p: FloatArray, q: FloatArray) -> FloatArray:
@@ -109,9 +121,7 @@ def arc_geometry(s: FloatArray, m: FloatArray, e: FloatArray, eps: float = 1e-9)
     return ArcGeometry(centre, radius, normal, u, v, via_angle, sweep).masked(ok)
 
 
-def _sample_arcs(
-    s: FloatArray, m: FloatArray, e: FloatArray, geo: ArcGeometry, samples: int
-) -> FloatArray:
+def _sample_arcs(s: FloatArray, m: FloatArray, e: FloatArray, geo: ArcGeometry, samples: int) -> FloatArray:
     """(n, samples, 3) points along each arc, with S, M and E themselves among them.
 
     The angle is piecewise linear in the sample number so that sample ``j`` is exactly M;
@@ -126,8 +136,9 @@ def _sample_arcs(
     # fraction along each half (0..1)
     h1 = np.where(first, t[None, :] / t_m, 0.0)
     h2 = np.where(first, 0.0, (t[None, :] - t_m) / (1.0 - t_m))
-    theta = np.where(first, geo.via_angle[:, None] * h1,
-                     geo.via_angle[:, None] + (geo.sweep - geo.via_angle)[:, None] * h2)
+    theta = np.where(
+        first, geo.via_angle[:, None] * h1, geo.via_angle[:, None] + (geo.sweep - geo.via_angle)[:, None] * h2
+    )
     pts = geo.centre[:, None, :] + geo.radius[:, None, None] * (
         np.cos(theta)[:, :, None] * geo.u[:, None, :] + np.sin(theta)[:, :, None] * geo.v[:, None, :]
     )
@@ -167,8 +178,9 @@ def _resolve(seg: Segment, ledger: PointLedger) -> tuple[FloatArray, FloatArray 
     return xyz_of(end), xyz_of(via)
 
 
-def segment_path(start_pose: PointLike, segment: Segment, ledger: PointLedger,
-                 samples: int = DEFAULT_SAMPLES) -> FloatArray:
+def segment_path(
+    start_pose: PointLike, segment: Segment, ledger: PointLedger, samples: int = DEFAULT_SAMPLES
+) -> FloatArray:
     """(samples, 3) XYZ along one segment from ``start_pose``, both ends included.
 
     Raises :class:`InvalidInput` for a missing point or an arc whose points define no circle
@@ -251,8 +263,12 @@ class PlanPath:
     segment: NDArray[np.intp]  # (n * samples,)
 
 
-def plan_path(plan: Plan | Sequence[Segment], ledger: PointLedger, start: PointLike | None = None,
-              samples: int = DEFAULT_SAMPLES) -> PlanPath:
+def plan_path(
+    plan: Plan | Sequence[Segment],
+    ledger: PointLedger,
+    start: PointLike | None = None,
+    samples: int = DEFAULT_SAMPLES,
+) -> PlanPath:
     """Sample every segment (vectorised). Arcs are true circles; an arc whose points define
     no circle is drawn as the polyline through them."""
     if samples < 3:

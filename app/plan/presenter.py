@@ -29,6 +29,7 @@ def english(issue: PlanIssue) -> str:
     """An issue's own message (plain English)."""
     return issue.message
 
+
 ENDLESS = "∞"
 
 
@@ -66,8 +67,9 @@ class CheckSummary:
         return Level.WARN if self.warnings else Level.OK
 
 
-def summarize_checks(issues: Sequence[PlanIssue], text: IssueText = english,
-                     line: IssueText = str) -> CheckSummary:
+def summarize_checks(
+    issues: Sequence[PlanIssue], text: IssueText = english, line: IssueText = str
+) -> CheckSummary:
     """Count the issues by kind; keep the first row error and the whole-plan messages (worded by
     ``text``); ``line`` words an issue with its kind for the details."""
     row_errors = [text(i) for i in issues if i.kind is IssueKind.ERROR and i.segment is not None]
@@ -137,10 +139,16 @@ def plan_info(plan: Plan, estimate: PlanEstimate, selected: int | None, assumed_
         if math.isfinite(length):
             chosen = SegmentEstimate(selected + 1, format_length(length), format_duration(time))
     return PlanInfo(
-        name=plan.name, segments=len(plan), loops=plan.loops,
-        loop_length=format_length(estimate.loop_length), loop_time=format_duration(estimate.loop_time),
-        total_length=format_length(estimate.total_length), total_time=format_duration(estimate.total_time),
-        unknown=tuple(i + 1 for i in estimate.unknown[:10]), selected=chosen, assumed_start=assumed_start,
+        name=plan.name,
+        segments=len(plan),
+        loops=plan.loops,
+        loop_length=format_length(estimate.loop_length),
+        loop_time=format_duration(estimate.loop_time),
+        total_length=format_length(estimate.total_length),
+        total_time=format_duration(estimate.total_time),
+        unknown=tuple(i + 1 for i in estimate.unknown[:10]),
+        selected=chosen,
+        assumed_start=assumed_start,
     )
 
 

@@ -270,8 +270,16 @@ class PlanRunner:
         return self._stop.is_set()
 
     def outcome(self) -> RunOutcome:
-        return RunOutcome(self._state, self._message, self.resume_from, self.resume_loop, self._done,
-                          self._error, self._position, self._interrupted)
+        return RunOutcome(
+            self._state,
+            self._message,
+            self.resume_from,
+            self.resume_loop,
+            self._done,
+            self._error,
+            self._position,
+            self._interrupted,
+        )
 
     # --- driving
     def request_stop(self) -> None:
@@ -397,13 +405,17 @@ class PlanRunner:
     def _where(self, cmd: SegmentCommand, reason: str) -> str:
         return f"segment {cmd.index + 1}/{cmd.count} ({_loop_text(cmd.loop, cmd.loops)}): {reason}"
 
-    def _end(self, state: RunState, message: str, resume: tuple[int, int] | None,
-             at: SegmentCommand | None = None) -> None:
+    def _end(
+        self, state: RunState, message: str, resume: tuple[int, int] | None, at: SegmentCommand | None = None
+    ) -> None:
         self._state = state
         self._message = message
         self._resume = resume if state is not RunState.FINISHED else None
-        event = {RunState.FINISHED: RunEvent.FINISHED, RunState.STOPPED: RunEvent.STOPPED,
-                 RunState.FAILED: RunEvent.FAILED}[state]
+        event = {
+            RunState.FINISHED: RunEvent.FINISHED,
+            RunState.STOPPED: RunEvent.STOPPED,
+            RunState.FAILED: RunEvent.FAILED,
+        }[state]
         index, loop = (at.index, at.loop) if at else (resume or self._position or (self.count - 1, 1))
         self._emit(event, index, loop, message)
 

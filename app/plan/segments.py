@@ -77,8 +77,9 @@ def _parse_bool(field_name: str, value: object) -> bool:
             return True
         if key in ("0", "false", "no", "off"):
             return False
-    raise FieldError(field_name, f"{value!r} is not yes/no", code="not_yes_no",
-                     params={"value": shown(value)})
+    raise FieldError(
+        field_name, f"{value!r} is not yes/no", code="not_yes_no", params={"value": shown(value)}
+    )
 
 
 def parse_kind(value: object) -> SegmentKind:
@@ -89,8 +90,9 @@ def parse_kind(value: object) -> SegmentKind:
         for kind in SegmentKind:
             if kind.value == key:
                 return kind
-    raise FieldError("kind", f"{value!r} is not 'line' or 'arc'", code="not_segment_kind",
-                     params={"value": shown(value)})
+    raise FieldError(
+        "kind", f"{value!r} is not 'line' or 'arc'", code="not_segment_kind", params={"value": shown(value)}
+    )
 
 
 def parse_orientation(value: object) -> bool:
@@ -103,15 +105,20 @@ def parse_orientation(value: object) -> bool:
             return False
     if isinstance(value, bool):
         return value
-    raise FieldError("orientation", f"{value!r} is not '{ORIENTATION_CHANGES}' or '{ORIENTATION_KEPT}'",
-                     code="not_orientation", params={"value": shown(value)})
+    raise FieldError(
+        "orientation",
+        f"{value!r} is not '{ORIENTATION_CHANGES}' or '{ORIENTATION_KEPT}'",
+        code="not_orientation",
+        params={"value": shown(value)},
+    )
 
 
 def _parse_ref(field_name: str, value: object) -> int:
     point_id = parse_int(field_name, value)
     if point_id < 0:
-        raise FieldError(field_name, f"point id {point_id} is negative", code="negative_point_id",
-                         params={"id": point_id})
+        raise FieldError(
+            field_name, f"point id {point_id} is negative", code="negative_point_id", params={"id": point_id}
+        )
     return point_id
 
 
@@ -166,8 +173,13 @@ class Segment:
     def get(self, field_name: str) -> object:
         """Value of a field of :data:`SEGMENT_FIELDS`."""
         values: dict[str, object] = {
-            "kind": self.kind, "via": self.via_id, "end": self.end_id, "speed": self.speed,
-            "orientation": self.orientation, "ignore_middle": self.ignore_middle, "tool": self.tool,
+            "kind": self.kind,
+            "via": self.via_id,
+            "end": self.end_id,
+            "speed": self.speed,
+            "orientation": self.orientation,
+            "ignore_middle": self.ignore_middle,
+            "tool": self.tool,
         }
         if field_name not in values:
             raise FieldError(field_name, "no such field", code="no_such_field", params={"name": field_name})
@@ -204,16 +216,24 @@ def validate_plan_name(name: object) -> str:
         raise FieldError("name", "a plan needs a name", code="plan_name_empty")
     text = name.strip()
     if len(text) > PLAN_NAME_MAX_CHARS or any(ch in text for ch in "\r\n\x00"):
-        raise FieldError("name", f"must be one line of at most {PLAN_NAME_MAX_CHARS} characters",
-                         code="plan_name_format", params={"max": PLAN_NAME_MAX_CHARS})
+        raise FieldError(
+            "name",
+            f"must be one line of at most {PLAN_NAME_MAX_CHARS} characters",
+            code="plan_name_format",
+            params={"max": PLAN_NAME_MAX_CHARS},
+        )
     return text
 
 
 def validate_loops(value: object) -> int:
     loops = parse_int("loops", value)
     if not 0 <= loops <= MAX_LOOPS:
-        raise FieldError("loops", f"{loops} is not 0 (endless) .. {MAX_LOOPS}", code="bad_loops",
-                         params={"value": loops, "max": MAX_LOOPS})
+        raise FieldError(
+            "loops",
+            f"{loops} is not 0 (endless) .. {MAX_LOOPS}",
+            code="bad_loops",
+            params={"value": loops, "max": MAX_LOOPS},
+        )
     return loops
 
 
@@ -272,8 +292,11 @@ class Plan:
         """Move segment ``src`` so that it ends at index ``dst`` (undo: ``move(dst, src)``)."""
         n = len(self.segments)
         if not (0 <= src < n and 0 <= dst < n):
-            raise InvalidInput(f"cannot move segment {src} to {dst} in {n} segments",
-                               code="cannot_move_segment", params={"src": src, "dst": dst, "segments": n})
+            raise InvalidInput(
+                f"cannot move segment {src} to {dst} in {n} segments",
+                code="cannot_move_segment",
+                params={"src": src, "dst": dst, "segments": n},
+            )
         if src != dst:
             self.segments.insert(dst, self.segments.pop(src))
             self.revision += 1

@@ -52,7 +52,7 @@ def stale_temp_files(target: str | os.PathLike[str], *, min_age: float | None = 
         name = entry.name
         if not (name.startswith(head) and name.endswith(TEMP_SUFFIX)):
             continue
-        if not _RANDOM.fullmatch(name[len(head): -len(TEMP_SUFFIX)]):
+        if not _RANDOM.fullmatch(name[len(head) : -len(TEMP_SUFFIX)]):
             continue
         try:
             if not entry.is_file(follow_symlinks=False) or now - entry.stat().st_mtime < age:
@@ -123,15 +123,21 @@ def read_limited(path: Path, limit: int = MAX_FILE_BYTES) -> bytes:
     try:
         size = path.stat().st_size
         if size > limit:
-            raise FileFormatError(f"the file is too large ({size} bytes, at most {limit})", path=str(path),
-                                  problem=Reason("file_too_large", {"size": size, "limit": limit}))
+            raise FileFormatError(
+                f"the file is too large ({size} bytes, at most {limit})",
+                path=str(path),
+                problem=Reason("file_too_large", {"size": size, "limit": limit}),
+            )
         return path.read_bytes()
     except FileNotFoundError:
-        raise FileFormatError("the file does not exist", path=str(path),
-                              problem=Reason("no_such_file")) from None
+        raise FileFormatError(
+            "the file does not exist", path=str(path), problem=Reason("no_such_file")
+        ) from None
     except IsADirectoryError:
-        raise FileFormatError("is a directory, not a file", path=str(path),
-                              problem=Reason("is_a_directory")) from None
+        raise FileFormatError(
+            "is a directory, not a file", path=str(path), problem=Reason("is_a_directory")
+        ) from None
     except PermissionError:
-        raise FileFormatError("cannot be read (permission denied)", path=str(path),
-                              problem=Reason("permission_denied")) from None
+        raise FileFormatError(
+            "cannot be read (permission denied)", path=str(path), problem=Reason("permission_denied")
+        ) from None

@@ -40,8 +40,9 @@ def autosave_path(project_path: str | os.PathLike[str] | None, *, user_dir: Path
     return p.with_name(stem + AUTOSAVE_SUFFIX)
 
 
-def save_autosave(project: Project, project_path: str | os.PathLike[str] | None, *,
-                  user_dir: Path | None = None) -> Path:
+def save_autosave(
+    project: Project, project_path: str | os.PathLike[str] | None, *, user_dir: Path | None = None
+) -> Path:
     """Write the autosave (atomically; ``modified`` untouched); returns its path."""
     target = autosave_path(project_path, user_dir=user_dir)
     target.parent.mkdir(parents=True, exist_ok=True)

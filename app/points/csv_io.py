@@ -38,8 +38,14 @@ def points_to_csv(points: Iterable[TempPoint]) -> str:
     writer.writerow(CSV_COLUMNS)
     for p in points:
         writer.writerow(
-            [str(p.id), p.name, *(_format_float(v) for v in p.xyzabc),
-             *(_format_float(v) for v in p.ext), str(p.tool), p.note]
+            [
+                str(p.id),
+                p.name,
+                *(_format_float(v) for v in p.xyzabc),
+                *(_format_float(v) for v in p.ext),
+                str(p.tool),
+                p.note,
+            ]
         )
     return out.getvalue()
 
@@ -50,7 +56,8 @@ def decode_text(data: bytes, path: str | None = None) -> str:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise FileFormatError(
-            f"not UTF-8 text (bad byte at offset {exc.start}); save the file as UTF-8", path=path,
+            f"not UTF-8 text (bad byte at offset {exc.start}); save the file as UTF-8",
+            path=path,
             problem=Reason("not_utf8", {"offset": exc.start}),
         ) from None
 
@@ -68,51 +75,68 @@ def parse_points_csv(
     except csv.Error as exc:
         reason = shown(str(exc), 80)[1:-1]
         # the csv module's own detail stays in the English text; the GUI says "not valid CSV"
-        raise FileFormatError(f"not valid CSV ({reason})", path=path, row=len(rows) + 1,
-                              problem=Reason("not_csv")) from None
+        raise FileFormatError(
+            f"not valid CSV ({reason})", path=path, row=len(rows) + 1, problem=Reason("not_csv")
+        ) from None
     header_at = next((i for i, r in enumerate(rows) if any(cell.strip() for cell in r)), None)
     if header_at is None:
-        raise FileFormatError("the file is empty (expected a header row)", path=path, row=1,
-                              problem=Reason("empty_file"))
+        raise FileFormatError(
+            "the file is empty (expected a header row)", path=path, row=1, problem=Reason("empty_file")
+        )
     header = [cell.strip().lower() for cell in rows[header_at]]
     header_row = header_at + 1
     for col, name in enumerate(header):
         if name not in CSV_COLUMNS:
             raise FileFormatError(
                 f"unknown column {shown(rows[header_at][col])} (expected: {','.join(CSV_COLUMNS)})",
-                path=path, row=header_row,
-                problem=Reason("unknown_column", {"name": shown(rows[header_at][col]),
-                                                  "expected": ",".join(CSV_COLUMNS)}),
+                path=path,
+                row=header_row,
+                problem=Reason(
+                    "unknown_column", {"name": shown(rows[header_at][col]), "expected": ",".join(CSV_COLUMNS)}
+                ),
             )
         if header.index(name) != col:
-            raise FileFormatError("the column appears twice", path=path, row=header_row, column=name,
-                                  problem=Reason("column_twice"))
+            raise FileFormatError(
+                "the column appears twice",
+                path=path,
+                row=header_row,
+                column=name,
+                problem=Reason("column_twice"),
+            )
     for name in CSV_COLUMNS:
         if name in CSV_REQUIRED and name not in header:
             raise FileFormatError(
-                "the column is missing from the header", path=path, row=header_row, column=name,
+                "the column is missing from the header",
+                path=path,
+                row=header_row,
+                column=name,
                 problem=Reason("column_missing"),
             )
     points: list[TempPoint] = []
     seen: dict[int, int] = {}
-    for number, cells in enumerate(rows[header_at + 1:], start=header_row + 1):
+    for number, cells in enumerate(rows[header_at + 1 :], start=header_row + 1):
         if not any(cell.strip() for cell in cells):
             continue  # blank line
         if len(cells) != len(header):
             raise FileFormatError(
                 f"has {len(cells)} cells, the header has {len(header)} (truncated or extra cells?)",
-                path=path, row=number,
+                path=path,
+                row=number,
                 problem=Reason("cell_count", {"cells": len(cells), "header": len(header)}),
             )
         fields = dict(zip(header, cells, strict=True))
         try:
             point = point_from_fields(fields, limits)
         except FieldError as exc:
-            raise FileFormatError(exc.reason, path=path, row=number, column=exc.field,
-                                  problem=exc.as_reason()) from None
+            raise FileFormatError(
+                exc.reason, path=path, row=number, column=exc.field, problem=exc.as_reason()
+            ) from None
         if point.id in seen:
             raise FileFormatError(
-                f"id {point.id} is already used on row {seen[point.id]}", path=path, row=number, column="id",
+                f"id {point.id} is already used on row {seen[point.id]}",
+                path=path,
+                row=number,
+                column="id",
                 problem=Reason("row_id_taken", {"id": point.id, "other": seen[point.id]}),
             )
         seen[point.id] = number

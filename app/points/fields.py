@@ -20,15 +20,21 @@ TOOL_MAX = 199  # tool frames 0..199 are "tool N+1"; TOOL_NONE (200) is "no tool
 NAME_MAX_CHARS = 200
 NOTE_MAX_CHARS = 2000
 
+
 class FieldError(InvalidInput):
     """One field's value refused; ``field`` names it, ``reason`` says why."""
 
-    def __init__(self, field_name: str, reason: str, *, code: str | None = None,
-                 params: Mapping[str, Any] | None = None) -> None:
+    def __init__(
+        self,
+        field_name: str,
+        reason: str,
+        *,
+        code: str | None = None,
+        params: Mapping[str, Any] | None = None,
+    ) -> None:
         super().__init__(f"{field_name}: {reason}", code=code, params=params)
         self.field = field_name
         self.reason = reason
-
 
 
 @dataclass(frozen=True)
@@ -44,7 +50,6 @@ class PointLimits:
 
 
 DEFAULT_LIMITS = PointLimits()
-
 
 
 QUOTE_CHARS = 40  # at most this much of a bad value is quoted in a message
@@ -73,7 +78,7 @@ def shown(value: object, limit: int = QUOTE_CHARS) -> str:
         cut = value[:limit]
         quoted = repr(cut)
         return quoted + f"... ({len(value)} characters)" if len(value) > limit else quoted
-    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10 ** limit:
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) >= 10**limit:
         return f"a {len(str(abs(value))) if value.bit_length() < 14000 else 'huge'}-digit number"
     if isinstance(value, list | dict | tuple):
         return f"a {type(value).__name__}"
@@ -93,17 +98,20 @@ def has_surrogates(text: str) -> bool:
 def parse_float(field_name: str, value: object) -> float:
     """A finite float from a number or text; NaN, infinities and huge numbers are refused."""
     if isinstance(value, bool):
-        raise FieldError(field_name, f"{shown(value)} is not a number", code="not_a_number",
-                         params={"value": shown(value)})
+        raise FieldError(
+            field_name, f"{shown(value)} is not a number", code="not_a_number", params={"value": shown(value)}
+        )
     if isinstance(value, OversizedNumber):
-        raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
-                         params={"value": shown(value)})
+        raise FieldError(
+            field_name, f"{shown(value)} is too large", code="too_large", params={"value": shown(value)}
+        )
     if isinstance(value, int | float):
         try:
             number = float(value)
         except OverflowError:
-            raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
-                             params={"value": shown(value)}) from None
+            raise FieldError(
+                field_name, f"{shown(value)} is too large", code="too_large", params={"value": shown(value)}
+            ) from None
     elif isinstance(value, str):
         text = value.strip()
         if not text:
@@ -111,51 +119,78 @@ def parse_float(field_name: str, value: object) -> float:
         try:
             number = float(text)
         except ValueError:
-            raise FieldError(field_name, f"{shown(text)} is not a number", code="not_a_number",
-                             params={"value": shown(text)}) from None
+            raise FieldError(
+                field_name,
+                f"{shown(text)} is not a number",
+                code="not_a_number",
+                params={"value": shown(text)},
+            ) from None
         if not math.isfinite(number) and text.lstrip("+-").lower() not in ("inf", "infinity", "nan"):
-            raise FieldError(field_name, f"{shown(text)} is too large", code="too_large",
-                             params={"value": shown(text)})
+            raise FieldError(
+                field_name, f"{shown(text)} is too large", code="too_large", params={"value": shown(text)}
+            )
     else:
-        raise FieldError(field_name, f"{shown(value)} is not a number", code="not_a_number",
-                         params={"value": shown(value)})
+        raise FieldError(
+            field_name, f"{shown(value)} is not a number", code="not_a_number", params={"value": shown(value)}
+        )
     if not math.isfinite(number):
-        raise FieldError(field_name, f"{shown(value)} is not a finite number", code="not_finite",
-                         params={"value": shown(value)})
+        raise FieldError(
+            field_name,
+            f"{shown(value)} is not a finite number",
+            code="not_finite",
+            params={"value": shown(value)},
+        )
     return number
 
 
 def parse_int(field_name: str, value: object) -> int:
     """An integer from an int, an integral float or text (``"5"``, ``"5.0"``)."""
     if isinstance(value, bool):
-        raise FieldError(field_name, f"{shown(value)} is not an integer", code="not_integer",
-                         params={"value": shown(value)})
+        raise FieldError(
+            field_name,
+            f"{shown(value)} is not an integer",
+            code="not_integer",
+            params={"value": shown(value)},
+        )
     if isinstance(value, int):
         if value.bit_length() > 100:
-            raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
-                             params={"value": shown(value)})
+            raise FieldError(
+                field_name, f"{shown(value)} is too large", code="too_large", params={"value": shown(value)}
+            )
         return value
-    if isinstance(value, str) and len(value.strip().lstrip("+-")) > INT_DIGITS_MAX \
-            and value.strip().lstrip("+-").isdigit():
-        raise FieldError(field_name, f"{shown(value.strip())} is too large", code="too_large",
-                         params={"value": shown(value.strip())})
+    if (
+        isinstance(value, str)
+        and len(value.strip().lstrip("+-")) > INT_DIGITS_MAX
+        and value.strip().lstrip("+-").isdigit()
+    ):
+        raise FieldError(
+            field_name,
+            f"{shown(value.strip())} is too large",
+            code="too_large",
+            params={"value": shown(value.strip())},
+        )
     number = parse_float(field_name, value)
     if not number.is_integer():
         quoted = shown(value.strip() if isinstance(value, str) else value)
-        raise FieldError(field_name, f"{quoted} is not an integer", code="not_integer",
-                         params={"value": quoted})
-    if abs(number) >= 2.0 ** 100:
-        raise FieldError(field_name, f"{shown(value)} is too large", code="too_large",
-                         params={"value": shown(value)})
+        raise FieldError(
+            field_name, f"{quoted} is not an integer", code="not_integer", params={"value": quoted}
+        )
+    if abs(number) >= 2.0**100:
+        raise FieldError(
+            field_name, f"{shown(value)} is too large", code="too_large", params={"value": shown(value)}
+        )
     return int(number)
 
 
 def parse_point_id(value: object, limits: PointLimits = DEFAULT_LIMITS, field_name: str = "id") -> int:
     point_id = parse_int(field_name, value)
     if not limits.id_min <= point_id <= limits.id_max:
-        raise FieldError(field_name, f"id {shown(point_id)} is outside {limits.id_min}..{limits.id_max}",
-                         code="id_out_of_range",
-                         params={"value": shown(point_id), "id_min": limits.id_min, "id_max": limits.id_max})
+        raise FieldError(
+            field_name,
+            f"id {shown(point_id)} is outside {limits.id_min}..{limits.id_max}",
+            code="id_out_of_range",
+            params={"value": shown(point_id), "id_min": limits.id_min, "id_max": limits.id_max},
+        )
     return point_id
 
 
@@ -163,8 +198,12 @@ def parse_tool(value: object, field_name: str = "tool") -> int:
     """Tool frame: 0..199 (tool N+1) or 200 (none)."""
     tool = parse_int(field_name, value)
     if not (0 <= tool <= TOOL_MAX or tool == TOOL_NONE):
-        raise FieldError(field_name, f"tool {shown(tool)} is not 0..{TOOL_MAX} or {TOOL_NONE} (none)",
-                         code="bad_tool", params={"value": shown(tool), "max": TOOL_MAX, "none": TOOL_NONE})
+        raise FieldError(
+            field_name,
+            f"tool {shown(tool)} is not 0..{TOOL_MAX} or {TOOL_NONE} (none)",
+            code="bad_tool",
+            params={"value": shown(tool), "max": TOOL_MAX, "none": TOOL_NONE},
+        )
     return tool
 
 
@@ -174,11 +213,15 @@ def parse_text(field_name: str, value: object, max_chars: int) -> str:
     if not isinstance(value, str):
         raise FieldError(field_name, f"{shown(value)} is not text", code="not_text")
     if len(value) > max_chars:
-        raise FieldError(field_name, f"is longer than {max_chars} characters", code="too_long",
-                         params={"max": max_chars})
+        raise FieldError(
+            field_name, f"is longer than {max_chars} characters", code="too_long", params={"max": max_chars}
+        )
     if has_surrogates(value):
-        raise FieldError(field_name, "holds an invalid character (a lone surrogate, not Unicode text)",
-                         code="bad_character")
+        raise FieldError(
+            field_name,
+            "holds an invalid character (a lone surrogate, not Unicode text)",
+            code="bad_character",
+        )
     if any(ch in value for ch in "\x00\r\n") and field_name == "name":
         raise FieldError(field_name, "must be one line", code="not_one_line")
     return value
@@ -187,4 +230,3 @@ def parse_text(field_name: str, value: object, max_chars: int) -> str:
 def tool_text(tool: int) -> str:
     """How the GUI and CLI show a tool frame."""
     return "none" if tool == TOOL_NONE else f"tool {tool + 1} ({tool})"
-

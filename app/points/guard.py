@@ -61,7 +61,8 @@ class PointMismatch(TeachPadError):
             f"the arm stopped at ({got}), {distance:.2f} mm away from {point.label} at ({want}): the "
             "controller's copy of the point differs from this project's (overwritten by another tool?). "
             "The run is stopped; check the point and the robot before resuming",
-            params={"point": point.label, "got": got, "want": want, "distance": f"{distance:.2f}"})
+            params={"point": point.label, "got": got, "want": want, "distance": f"{distance:.2f}"},
+        )
 
 
 class PointNotCreated(TeachPadError):
@@ -88,9 +89,16 @@ class GuardClient(Protocol):
 class PointGuard:
     """Keeps a run's points honest (see the module docstring). One per process and controller."""
 
-    def __init__(self, points: Mapping[int, TempPoint], *, refresh: bool = True, verify: bool = True,
-                 canary_gv: int | None = CANARY_GV, tolerance_mm: float | None = None,
-                 rng: random.Random | None = None) -> None:
+    def __init__(
+        self,
+        points: Mapping[int, TempPoint],
+        *,
+        refresh: bool = True,
+        verify: bool = True,
+        canary_gv: int | None = CANARY_GV,
+        tolerance_mm: float | None = None,
+        rng: random.Random | None = None,
+    ) -> None:
         self._points = dict(points)
         self.refresh = refresh
         self.verify = verify
@@ -110,8 +118,11 @@ class PointGuard:
         try:
             return self._points[point_id]
         except KeyError:
-            raise PointNotCreated(f"the project has no point P{point_id}", code="point_missing",
-                                  params={"point": f"P{point_id}"}) from None
+            raise PointNotCreated(
+                f"the project has no point P{point_id}",
+                code="point_missing",
+                params={"point": f"P{point_id}"},
+            ) from None
 
     # --- restart check
     def arm(self, client: GuardClient) -> None:
@@ -141,8 +152,10 @@ class PointGuard:
         self.created.append(point.id)
         if not result.ok:
             reason = result.message or (result.status.text if result.status is not None else "failed")
-            raise PointNotCreated(f"the controller refused to create {point.label}: {reason}",
-                                  params={"point": point.label, "cause": reason})
+            raise PointNotCreated(
+                f"the controller refused to create {point.label}: {reason}",
+                params={"point": point.label, "cause": reason},
+            )
         self._uploaded.add(point.id)
 
     def ensure(self, client: GuardClient, point_ids: Iterable[int]) -> list[int]:
@@ -184,4 +197,3 @@ class PointGuard:
         point = self.point(end_id)
         distance = math.dist(pose.xyzabc[:3], point.xyz)
         return None if distance <= self._tolerance else PointMismatch(point, pose, distance)
-

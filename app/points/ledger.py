@@ -101,14 +101,17 @@ class EmptyImport(InvalidInput):
 
     def __init__(self, existing: int) -> None:
         self.existing = existing
-        super().__init__(f"the file has no points: replacing with it would remove all {existing} point(s) "
-                         "of the project (merge it, or ask explicitly for an empty import)",
-                         params={"existing": existing})
+        super().__init__(
+            f"the file has no points: replacing with it would remove all {existing} point(s) "
+            "of the project (merge it, or ask explicitly for an empty import)",
+            params={"existing": existing},
+        )
 
 
 def _no_such_point(point_id: int) -> InvalidInput:
-    return InvalidInput(f"there is no point with id {point_id}", code="no_such_point",
-                        params={"id": point_id})
+    return InvalidInput(
+        f"there is no point with id {point_id}", code="no_such_point", params={"id": point_id}
+    )
 
 
 class PointLedger:
@@ -145,9 +148,11 @@ class PointLedger:
         outside = [p.id for p in self._points if not limits.id_min <= p.id <= limits.id_max]
         if outside:
             shown = ", ".join(map(str, outside[:10])) + (" ..." if len(outside) > 10 else "")
-            raise InvalidInput(f"points outside {limits.id_min}..{limits.id_max}: {shown}",
-                               code="points_outside_range",
-                               params={"id_min": limits.id_min, "id_max": limits.id_max, "ids": shown})
+            raise InvalidInput(
+                f"points outside {limits.id_min}..{limits.id_max}: {shown}",
+                code="points_outside_range",
+                params={"id_min": limits.id_min, "id_max": limits.id_max, "ids": shown},
+            )
         self._limits = limits
 
     def __len__(self) -> int:
@@ -193,8 +198,11 @@ class PointLedger:
         for candidate in range(start, self._limits.id_max + 1):
             if candidate not in used:
                 return candidate
-        raise InvalidInput(f"no free point id left in {start}..{self._limits.id_max}",
-                           code="no_free_point_id", params={"start": start, "id_max": self._limits.id_max})
+        raise InvalidInput(
+            f"no free point id left in {start}..{self._limits.id_max}",
+            code="no_free_point_id",
+            params={"start": start, "id_max": self._limits.id_max},
+        )
 
     def find(self, text: str) -> list[int]:
         """Rows matching ``text``: the point with that id first, then names containing it
@@ -210,9 +218,7 @@ class PointLedger:
         if row is not None:
             rows.append(row)
         folded = needle.casefold()
-        rows.extend(
-            r for r, p in enumerate(self._points) if folded in p.name.casefold() and r not in rows
-        )
+        rows.extend(r for r, p in enumerate(self._points) if folded in p.name.casefold() and r not in rows)
         return rows
 
     def needing_upload(self) -> list[TempPoint]:
@@ -276,9 +282,11 @@ class PointLedger:
     def move(self, src: int, dst: int) -> None:
         """Move the point at ``src`` so that it ends at index ``dst`` (undo: ``move(dst, src)``)."""
         if not (0 <= src < len(self._points) and 0 <= dst < len(self._points)):
-            raise InvalidInput(f"cannot move row {src} to {dst} in {len(self._points)} rows",
-                               code="cannot_move_row",
-                               params={"src": src, "dst": dst, "rows": len(self._points)})
+            raise InvalidInput(
+                f"cannot move row {src} to {dst} in {len(self._points)} rows",
+                code="cannot_move_row",
+                params={"src": src, "dst": dst, "rows": len(self._points)},
+            )
         if src == dst:
             return
         self._points.insert(dst, self._points.pop(src))
@@ -291,9 +299,11 @@ class PointLedger:
         for row, point in enumerate(new):
             self._check_fields(point)
             if point.id in seen:
-                raise InvalidInput(f"row {row}: id {point.id} is already used on row {seen[point.id]}",
-                                   code="duplicate_row_id",
-                                   params={"row": row, "id": point.id, "other": seen[point.id]})
+                raise InvalidInput(
+                    f"row {row}: id {point.id} is already used on row {seen[point.id]}",
+                    code="duplicate_row_id",
+                    params={"row": row, "id": point.id, "other": seen[point.id]},
+                )
             seen[point.id] = row
         self._points = new
         self._touch()
@@ -310,8 +320,11 @@ class PointLedger:
         seen: set[int] = set()
         for number, point in enumerate(points, start=1):
             if point.id in seen:
-                raise InvalidInput(f"imported point {number}: id {point.id} appears twice",
-                                   code="import_duplicate_id", params={"number": number, "id": point.id})
+                raise InvalidInput(
+                    f"imported point {number}: id {point.id} appears twice",
+                    code="import_duplicate_id",
+                    params={"number": number, "id": point.id},
+                )
             seen.add(point.id)
         incoming: list[TempPoint] = []
         added = updated = unchanged = 0
@@ -362,8 +375,15 @@ class PointLedger:
         """Set x..c (and e1..e5) at once, e.g. "touch up to the current pose"."""
         old = self._points[row]
         checked = make_point(
-            old.id, old.name, pose, old.ext if ext is None else ext, old.tool, old.note,
-            sync=old.sync, sync_error=old.sync_error, limits=self._limits,
+            old.id,
+            old.name,
+            pose,
+            old.ext if ext is None else ext,
+            old.tool,
+            old.note,
+            sync=old.sync,
+            sync_error=old.sync_error,
+            limits=self._limits,
         )
         new = _mark_changed(old, checked)
         if new != old:
@@ -416,8 +436,12 @@ class PointLedger:
         row = self.row_of(point.id)
         if row is not None and row != ignore_row:
             taken = self._points[row].label
-            raise FieldError("id", f"id {point.id} is already used by {taken}", code="point_id_taken",
-                             params={"id": point.id, "point": taken})
+            raise FieldError(
+                "id",
+                f"id {point.id} is already used by {taken}",
+                code="point_id_taken",
+                params={"id": point.id, "point": taken},
+            )
 
 
 # Older imports (``from app.points.ledger import parse_points_csv``) keep working: the CSV and
@@ -433,12 +457,49 @@ from app.points.upload import (  # noqa: E402
 )
 
 __all__ = [
-    "CONTROLLER_FIELDS", "CSV_COLUMNS", "CSV_REQUIRED", "DEFAULT_LIMITS", "EXT_FIELDS", "NAME_MAX_CHARS",
-    "NOTE_MAX_CHARS", "POINT_FIELDS", "POSE_FIELDS", "SYNC_STATE_TEXT", "TOOL_MAX", "TOOL_NONE", "TR_CONTEXT",
-    "ZERO_EXT", "EmptyImport", "Ext5", "FieldError", "FileFormatError", "ImportMode", "ImportReport",
+    "CONTROLLER_FIELDS",
+    "CSV_COLUMNS",
+    "CSV_REQUIRED",
+    "DEFAULT_LIMITS",
+    "EXT_FIELDS",
+    "NAME_MAX_CHARS",
+    "NOTE_MAX_CHARS",
+    "POINT_FIELDS",
+    "POSE_FIELDS",
+    "SYNC_STATE_TEXT",
+    "TOOL_MAX",
+    "TOOL_NONE",
+    "TR_CONTEXT",
+    "ZERO_EXT",
+    "EmptyImport",
+    "Ext5",
+    "FieldError",
+    "FileFormatError",
+    "ImportMode",
+    "ImportReport",
     "PointEdit",
-    "PointLedger", "PointLimits", "PointUploader", "Pose6", "SyncState", "TempPoint", "UploadOutcome",
-    "UploadReport", "apply_upload", "decode_text", "make_point", "parse_float", "parse_id_list", "parse_int",
-    "parse_point_id", "parse_points_csv", "parse_text", "parse_tool", "point_from_fields", "point_from_pose",
-    "points_to_csv", "tool_text", "upload_points", "with_field",
+    "PointLedger",
+    "PointLimits",
+    "PointUploader",
+    "Pose6",
+    "SyncState",
+    "TempPoint",
+    "UploadOutcome",
+    "UploadReport",
+    "apply_upload",
+    "decode_text",
+    "make_point",
+    "parse_float",
+    "parse_id_list",
+    "parse_int",
+    "parse_point_id",
+    "parse_points_csv",
+    "parse_text",
+    "parse_tool",
+    "point_from_fields",
+    "point_from_pose",
+    "points_to_csv",
+    "tool_text",
+    "upload_points",
+    "with_field",
 ]

@@ -55,9 +55,11 @@ class ProjectLocked(InvalidInput):
     def __init__(self, project: Path, owner: LockOwner) -> None:
         self.project = project
         self.owner = owner
-        super().__init__(f"{project}: the project is open in another TeachPad ({owner.text}); "
-                         f"close it there first (or remove {lock_path(project).name} if that TeachPad "
-                         "is gone)")
+        super().__init__(
+            f"{project}: the project is open in another TeachPad ({owner.text}); "
+            f"close it there first (or remove {lock_path(project).name} if that TeachPad "
+            "is gone)"
+        )
 
 
 def _host() -> str:
@@ -93,8 +95,12 @@ def _read_owner(path: Path) -> LockOwner | None:
             raw = f.read(_LOCK_MAX_BYTES)
         data = json.loads(raw.decode("utf-8"))
         pid, host, started = data["pid"], data["host"], data.get("started", "")
-        if not isinstance(pid, int) or isinstance(pid, bool) or not isinstance(host, str) \
-                or not isinstance(started, str):
+        if (
+            not isinstance(pid, int)
+            or isinstance(pid, bool)
+            or not isinstance(host, str)
+            or not isinstance(started, str)
+        ):
             return None
         return LockOwner(pid, host[:200], started[:40])
     except (OSError, ValueError, KeyError, TypeError):
@@ -135,8 +141,11 @@ class ProjectLock:
         return lock
 
     def _take(self) -> None:
-        me = LockOwner(os.getpid(), _host(),
-                       dt.datetime.now(dt.UTC).replace(microsecond=0).isoformat().replace("+00:00", "Z"))
+        me = LockOwner(
+            os.getpid(),
+            _host(),
+            dt.datetime.now(dt.UTC).replace(microsecond=0).isoformat().replace("+00:00", "Z"),
+        )
         payload = json.dumps({"pid": me.pid, "host": me.host, "started": me.started, "app": "teachpad"})
         for _attempt in range(3):
             try:

@@ -49,12 +49,40 @@ from app.protocol.enums import QT_TRANSLATE_NOOP
 from app.protocol.registers import TOOL_NONE
 
 __all__ = [  # the field parsing lives in app.points.fields; re-exported for older imports
-    "CONTROLLER_FIELDS", "CSV_COLUMNS", "CSV_REQUIRED", "DEFAULT_LIMITS", "EXT_FIELDS", "INT_DIGITS_MAX",
-    "NAME_MAX_CHARS", "NOTE_MAX_CHARS", "POINT_FIELDS", "POSE_FIELDS", "QUOTE_CHARS", "SYNC_STATE_TEXT",
-    "TOOL_MAX", "ZERO_EXT", "FieldError", "FileFormatError", "OversizedNumber", "PointLimits", "SyncState",
-    "TempPoint", "fast_point_from_fields", "has_surrogates", "is_valid_point", "make_point", "parse_float",
-    "parse_int", "parse_point_id", "parse_text", "parse_tool", "point_from_fields", "point_from_pose",
-    "shown", "tool_text", "with_field",
+    "CONTROLLER_FIELDS",
+    "CSV_COLUMNS",
+    "CSV_REQUIRED",
+    "DEFAULT_LIMITS",
+    "EXT_FIELDS",
+    "INT_DIGITS_MAX",
+    "NAME_MAX_CHARS",
+    "NOTE_MAX_CHARS",
+    "POINT_FIELDS",
+    "POSE_FIELDS",
+    "QUOTE_CHARS",
+    "SYNC_STATE_TEXT",
+    "TOOL_MAX",
+    "ZERO_EXT",
+    "FieldError",
+    "FileFormatError",
+    "OversizedNumber",
+    "PointLimits",
+    "SyncState",
+    "TempPoint",
+    "fast_point_from_fields",
+    "has_surrogates",
+    "is_valid_point",
+    "make_point",
+    "parse_float",
+    "parse_int",
+    "parse_point_id",
+    "parse_text",
+    "parse_tool",
+    "point_from_fields",
+    "point_from_pose",
+    "shown",
+    "tool_text",
+    "with_field",
 ]
 
 TR_CONTEXT = "Points"
@@ -108,9 +136,17 @@ class FileFormatError(InvalidInput):
         self.where = where
         self.problem = problem
         self.place = place
-        super().__init__(self._text(), params={
-            "file": os.path.basename(path) if path else None, "row": row, "column": column,
-            "where": where, "problem": problem, "place": place})
+        super().__init__(
+            self._text(),
+            params={
+                "file": os.path.basename(path) if path else None,
+                "row": row,
+                "column": column,
+                "where": where,
+                "problem": problem,
+                "place": place,
+            },
+        )
 
     def _text(self) -> str:
         parts: list[str] = []
@@ -125,8 +161,15 @@ class FileFormatError(InvalidInput):
         return f"{self.path}: {text}" if self.path else text
 
     def with_path(self, path: str) -> FileFormatError:
-        return FileFormatError(self.reason, path=path, row=self.row, column=self.column, where=self.where,
-                               problem=self.problem, place=self.place)
+        return FileFormatError(
+            self.reason,
+            path=path,
+            row=self.row,
+            column=self.column,
+            where=self.where,
+            problem=self.problem,
+            place=self.place,
+        )
 
 
 class SyncState(enum.Enum):
@@ -235,7 +278,12 @@ def make_point(
     return TempPoint(
         id=parse_point_id(point_id, limits),
         name=parse_text("name", name, NAME_MAX_CHARS),
-        x=x, y=y, z=z, a=a, b=b, c=c,
+        x=x,
+        y=y,
+        z=z,
+        a=a,
+        b=b,
+        c=c,
         ext=(e1, e2, e3, e4, e5),
         tool=parse_tool(tool),
         note=parse_text("note", note, NOTE_MAX_CHARS),
@@ -261,11 +309,23 @@ def fast_point_from_fields(
     tool = get("tool", TOOL_NONE)
     name = get("name", "")
     note = get("note", "")
-    if (type(pid) is not int or type(tool) is not int or type(name) is not str or type(note) is not str
-            or type(x) is not float or type(y) is not float or type(z) is not float
-            or type(a) is not float or type(b) is not float or type(c) is not float
-            or type(e1) is not float or type(e2) is not float or type(e3) is not float
-            or type(e4) is not float or type(e5) is not float):
+    if (
+        type(pid) is not int
+        or type(tool) is not int
+        or type(name) is not str
+        or type(note) is not str
+        or type(x) is not float
+        or type(y) is not float
+        or type(z) is not float
+        or type(a) is not float
+        or type(b) is not float
+        or type(c) is not float
+        or type(e1) is not float
+        or type(e2) is not float
+        or type(e3) is not float
+        or type(e4) is not float
+        or type(e5) is not float
+    ):
         return None
     # one sum checks all eleven: NaN / inf propagate; an overflowing sum only sends a valid
     # point down the slow path
@@ -282,9 +342,25 @@ def fast_point_from_fields(
     # The frozen dataclass's __init__ sets 13 fields one by one through object.__setattr__
     # (a third of a load's time); filling __dict__ at once builds the same, equal object.
     point: TempPoint = _new(TempPoint)
-    _set(point, "__dict__", {"id": pid, "name": name, "x": x, "y": y, "z": z, "a": a, "b": b, "c": c,
-                             "ext": (e1, e2, e3, e4, e5), "tool": tool, "note": note, "sync": sync,
-                             "sync_error": ""})
+    _set(
+        point,
+        "__dict__",
+        {
+            "id": pid,
+            "name": name,
+            "x": x,
+            "y": y,
+            "z": z,
+            "a": a,
+            "b": b,
+            "c": c,
+            "ext": (e1, e2, e3, e4, e5),
+            "tool": tool,
+            "note": note,
+            "sync": sync,
+            "sync_error": "",
+        },
+    )
     return point
 
 
@@ -295,11 +371,31 @@ _set = object.__setattr__
 def is_valid_point(point: TempPoint, limits: PointLimits = DEFAULT_LIMITS) -> bool:
     """True when ``point`` holds values :func:`make_point` would accept (a quick check; False
     means: run :func:`make_point` for the message)."""
-    return fast_point_from_fields(
-        {"id": point.id, "name": point.name, "x": point.x, "y": point.y, "z": point.z, "a": point.a,
-         "b": point.b, "c": point.c, "e1": point.ext[0], "e2": point.ext[1], "e3": point.ext[2],
-         "e4": point.ext[3], "e5": point.ext[4], "tool": point.tool, "note": point.note}, limits,
-    ) is not None if len(point.ext) == 5 else False
+    return (
+        fast_point_from_fields(
+            {
+                "id": point.id,
+                "name": point.name,
+                "x": point.x,
+                "y": point.y,
+                "z": point.z,
+                "a": point.a,
+                "b": point.b,
+                "c": point.c,
+                "e1": point.ext[0],
+                "e2": point.ext[1],
+                "e3": point.ext[2],
+                "e4": point.ext[3],
+                "e5": point.ext[4],
+                "tool": point.tool,
+                "note": point.note,
+            },
+            limits,
+        )
+        is not None
+        if len(point.ext) == 5
+        else False
+    )
 
 
 def point_from_pose(

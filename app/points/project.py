@@ -84,13 +84,29 @@ FORMAT_VERSION = 1
 PROJECT_SUFFIX = ".teachpad.json"
 
 __all__ = [
-    "AUTOSAVE_SUFFIX", "FORMAT_NAME", "FORMAT_VERSION", "MAX_FILE_BYTES", "PROJECT_SUFFIX", "FileFormatError",
-    "Project", "UploadRecord", "atomic_write_bytes", "autosave_path", "default_autosave_dir",
-    "discard_autosave", "find_autosave", "load_project", "parse_project", "project_from_dict",
-    "project_to_dict", "project_to_json", "read_points_csv", "save_autosave", "save_project",
+    "AUTOSAVE_SUFFIX",
+    "FORMAT_NAME",
+    "FORMAT_VERSION",
+    "MAX_FILE_BYTES",
+    "PROJECT_SUFFIX",
+    "FileFormatError",
+    "Project",
+    "UploadRecord",
+    "atomic_write_bytes",
+    "autosave_path",
+    "default_autosave_dir",
+    "discard_autosave",
+    "find_autosave",
+    "load_project",
+    "parse_project",
+    "project_from_dict",
+    "project_to_dict",
+    "project_to_json",
+    "read_points_csv",
+    "save_autosave",
+    "save_project",
     "write_points_csv",
 ]
-
 
 
 # --- JSON ------------------------------------------------------------------------------------
@@ -110,8 +126,15 @@ def _segment_to_dict(s: Segment) -> dict[str, Any]:
     d: dict[str, Any] = {"type": s.kind.value}
     if s.is_arc:
         d["via"] = s.via_id
-    d.update({"end": s.end_id, "speed": s.speed, "orientation": s.orientation,
-              "ignore_middle": s.ignore_middle, "tool": s.tool})
+    d.update(
+        {
+            "end": s.end_id,
+            "speed": s.speed,
+            "orientation": s.orientation,
+            "ignore_middle": s.ignore_middle,
+            "tool": s.tool,
+        }
+    )
     return d
 
 
@@ -160,9 +183,14 @@ def project_to_json(project: Project) -> str:
 Place = tuple[str, Reason]
 _TOP: Place = ("the file", Reason("place_file"))
 # what a value should have been: the English words and the code the GUI words
-_EXPECTED = {"text": "text", "points": "a list of points", "plans": "a list of plans",
-             "segments": "a list of segments", "object": "an object",
-             "uploaded": "an object with time and endpoint"}
+_EXPECTED = {
+    "text": "text",
+    "points": "a list of points",
+    "plans": "a list of plans",
+    "segments": "a list of segments",
+    "object": "an object",
+    "uploaded": "an object with time and endpoint",
+}
 
 
 def _refuse(message: str, problem: Reason | None, where: Place, column: str | None = None) -> FileFormatError:
@@ -182,10 +210,17 @@ def _point_place(index: int, point_id: int | None = None) -> Place:
 
 def _expect(value: object, kind: type | tuple[type, ...], where: Place, name: str, what: str) -> Any:
     if not isinstance(value, kind) or (isinstance(value, bool) and kind is not bool):
-        got = ({"got_kind": "list" if isinstance(value, list) else "object"}
-               if isinstance(value, list | dict) else {"got": _json_shown(value)})
-        raise _refuse(f"expected {_EXPECTED[what]}, got {_json_shown(value)}",
-                      Reason("expected_type", {"expected": what, **got}), where, name or None)
+        got = (
+            {"got_kind": "list" if isinstance(value, list) else "object"}
+            if isinstance(value, list | dict)
+            else {"got": _json_shown(value)}
+        )
+        raise _refuse(
+            f"expected {_EXPECTED[what]}, got {_json_shown(value)}",
+            Reason("expected_type", {"expected": what, **got}),
+            where,
+            name or None,
+        )
     return value
 
 
@@ -239,18 +274,27 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
     doc: dict[str, Any] = data
     bad_text = _first_surrogate(doc, "") if scan_text else None
     if bad_text is not None:
-        raise _refuse("holds an invalid character (a lone surrogate, not Unicode text)",
-                      Reason("bad_character"), bad_text)
+        raise _refuse(
+            "holds an invalid character (a lone surrogate, not Unicode text)",
+            Reason("bad_character"),
+            bad_text,
+        )
     if doc.get("format") != FORMAT_NAME:
         got = _json_shown(doc.get("format"))
-        raise _refuse(f"expected {FORMAT_NAME!r}, got {got}: not a TeachPad project",
-                      Reason("not_a_project", {"expected": repr(FORMAT_NAME), "got": got}), top, "format")
+        raise _refuse(
+            f"expected {FORMAT_NAME!r}, got {got}: not a TeachPad project",
+            Reason("not_a_project", {"expected": repr(FORMAT_NAME), "got": got}),
+            top,
+            "format",
+        )
     version = doc.get("version")
     if version != FORMAT_VERSION or isinstance(version, bool):
         got = _json_shown(version)
         raise _refuse(
             f"version {got} is not supported (this TeachPad reads version {FORMAT_VERSION})",
-            Reason("version_unsupported", {"version": got, "supported": FORMAT_VERSION}), top, "version",
+            Reason("version_unsupported", {"version": got, "supported": FORMAT_VERSION}),
+            top,
+            "version",
         )
     name = _text_field(doc, "name", top) or "untitled"
     description = _text_field(doc, "description", top)
@@ -287,8 +331,12 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
             raise _refuse(exc.reason, _field_problem(exc), where, exc.field) from None
         where = _point_place(i, point.id)
         if point.id in seen:
-            raise _refuse(f"id {point.id} is already used by points[{seen[point.id]}]",
-                          Reason("point_id_twice", {"id": point.id, "other": seen[point.id]}), where, "id")
+            raise _refuse(
+                f"id {point.id} is already used by points[{seen[point.id]}]",
+                Reason("point_id_twice", {"id": point.id, "other": seen[point.id]}),
+                where,
+                "id",
+            )
         seen[point.id] = i
         points.append(point)
         record = _history_from(obj.get("uploaded"), i, point.id)
@@ -307,19 +355,32 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
             raise _refuse(exc.reason, _field_problem(exc), where, exc.field) from None
         where = (f"plans[{i}] ({plan_name!r})", Reason("place_plan_named", {"index": i, "name": plan_name}))
         if plan_name in (p.name for p in plans):
-            raise _refuse(f"another plan is named {plan_name!r}",
-                          Reason("plan_name_taken", {"name": plan_name}), where, "name")
+            raise _refuse(
+                f"another plan is named {plan_name!r}",
+                Reason("plan_name_taken", {"name": plan_name}),
+                where,
+                "name",
+            )
         segments: list[Segment] = []
         raw_segments = _expect(obj.get("segments", []), list, where, "segments", "segments")
         for j, raw_seg in enumerate(raw_segments):
-            seg_where = (f"{where[0]} segment {j + 1}",
-                         Reason("place_segment", {"index": i, "name": plan_name, "segment": j + 1}))
+            seg_where = (
+                f"{where[0]} segment {j + 1}",
+                Reason("place_segment", {"index": i, "name": plan_name, "segment": j + 1}),
+            )
             seg = _expect(raw_seg, dict, seg_where, "", "object")
             segments.append(_segment_from_dict(seg, seg_where))
         plans.append(Plan(plan_name, segments, loops))
 
-    return Project(name=name, ledger=PointLedger.from_checked(points, limits), plans=plans,
-                   description=description, created=created, modified=modified, upload_history=history)
+    return Project(
+        name=name,
+        ledger=PointLedger.from_checked(points, limits),
+        plans=plans,
+        description=description,
+        created=created,
+        modified=modified,
+        upload_history=history,
+    )
 
 
 def _history_from(raw: object, index: int, point_id: int) -> UploadRecord | None:
@@ -397,12 +458,17 @@ def _parse_project_exact(text: str, limits: PointLimits, *, path: str | None) ->
     try:
         data = json.loads(text, parse_int=_json_int, parse_float=_json_float)
     except json.JSONDecodeError as exc:
-        raise FileFormatError(f"not valid JSON ({exc.msg})", path=path,
-                              where=f"line {exc.lineno}, column {exc.colno}", problem=Reason("not_json"),
-                              place=Reason("place_line", {"line": exc.lineno, "column": exc.colno})) from None
+        raise FileFormatError(
+            f"not valid JSON ({exc.msg})",
+            path=path,
+            where=f"line {exc.lineno}, column {exc.colno}",
+            problem=Reason("not_json"),
+            place=Reason("place_line", {"line": exc.lineno, "column": exc.colno}),
+        ) from None
     except RecursionError:
-        raise FileFormatError("not valid JSON (nested too deeply)", path=path,
-                              problem=Reason("json_too_deep")) from None
+        raise FileFormatError(
+            "not valid JSON (nested too deeply)", path=path, problem=Reason("json_too_deep")
+        ) from None
     return project_from_dict(data, limits, path=path)
 
 

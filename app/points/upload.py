@@ -13,6 +13,7 @@ from app.points.point import SyncState, TempPoint
 if TYPE_CHECKING:
     from app.points.ledger import PointLedger
 
+
 class PointUploader(Protocol):
     """The part of ``RobotClient`` an upload needs (duck-typed)."""
 

@@ -24,8 +24,14 @@ class WordOrder(enum.Enum):
     def parse(cls, text: str) -> WordOrder:
         """Accept ``low-first``/``high-first`` (and ``little``/``big``)."""
         key = text.strip().lower()
-        aliases = {"little": cls.LOW_FIRST, "low": cls.LOW_FIRST, "cdab": cls.LOW_FIRST,
-                   "big": cls.HIGH_FIRST, "high": cls.HIGH_FIRST, "abcd": cls.HIGH_FIRST}
+        aliases = {
+            "little": cls.LOW_FIRST,
+            "low": cls.LOW_FIRST,
+            "cdab": cls.LOW_FIRST,
+            "big": cls.HIGH_FIRST,
+            "high": cls.HIGH_FIRST,
+            "abcd": cls.HIGH_FIRST,
+        }
         for member in cls:
             if member.value == key:
                 return member

@@ -321,9 +321,7 @@ def decode_command_status(kind: CommandKind | None, code: int) -> CommandStatus:
     return CommandStatus(kind, int(code))
 
 
-def decode_status_registers(
-    regs: Sequence[int], order: WordOrder = WordOrder.LOW_FIRST
-) -> int:
+def decode_status_registers(regs: Sequence[int], order: WordOrder = WordOrder.LOW_FIRST) -> int:
     """GV291 from its two registers (582, 583), either encoding (PROTOCOL.md section 7).
 
     A finite integral float32 in 0..255 wins; otherwise register 582 as uint16. (An integer

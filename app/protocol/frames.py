@@ -227,16 +227,24 @@ def _pairing_errors(pdu: _Pdu, unit: int | None, request: DecodedFrame, errors: 
         errors.append(f"unit {unit} answers a request to unit {request.unit}")
     if pdu.is_exception or not pdu.complete:
         return
-    if function == FunctionCode.READ_HOLDING_REGISTERS and request.count is not None \
-            and len(pdu.values) != request.count:
+    if (
+        function == FunctionCode.READ_HOLDING_REGISTERS
+        and request.count is not None
+        and len(pdu.values) != request.count
+    ):
         errors.append(f"{len(pdu.values)} registers returned, {request.count} requested")
     elif function == FunctionCode.WRITE_SINGLE_REGISTER and (pdu.address, pdu.values) != (
-            request.address, request.values):
+        request.address,
+        request.values,
+    ):
         errors.append("the echo differs from the request")
     elif function == FunctionCode.WRITE_MULTIPLE_REGISTERS and (pdu.address, pdu.count) != (
-            request.address, request.count):
-        errors.append(f"acknowledges {pdu.address}+{pdu.count}, the request wrote "
-                      f"{request.address}+{request.count}")
+        request.address,
+        request.count,
+    ):
+        errors.append(
+            f"acknowledges {pdu.address}+{pdu.count}, the request wrote {request.address}+{request.count}"
+        )
 
 
 def decode_frame(
@@ -267,7 +275,8 @@ def decode_frame(
     else:
         unit, pdu_bytes = split_rtu(raw, errors)
     header_ok = not (transport == "tcp" and len(raw) < MBAP_SIZE) and not (
-        transport == "rtu" and len(raw) < RTU_MIN_SIZE)
+        transport == "rtu" and len(raw) < RTU_MIN_SIZE
+    )
     pdu = _parse_pdu(pdu_bytes, direction, errors) if header_ok else _Pdu(is_response=direction == "rx")
     if request is not None and not pdu.is_response:
         request = None  # only a response answers a request
@@ -275,23 +284,49 @@ def decode_frame(
         _pairing_errors(pdu, unit, request, errors)
 
     address = pdu.address
-    if (pdu.function_code == FunctionCode.READ_HOLDING_REGISTERS and pdu.is_response and request is not None
-            and request.function == FunctionCode.READ_HOLDING_REGISTERS):
+    if (
+        pdu.function_code == FunctionCode.READ_HOLDING_REGISTERS
+        and pdu.is_response
+        and request is not None
+        and request.function == FunctionCode.READ_HOLDING_REGISTERS
+    ):
         address = request.address
     items: tuple[RegisterItem, ...] = ()
     if address is not None and pdu.values:
-        items = describe_registers(address, pdu.values, word_order, last_command=last_command,
-                                   params_for=params_for, clock_layout=clock_layout)
+        items = describe_registers(
+            address,
+            pdu.values,
+            word_order,
+            last_command=last_command,
+            params_for=params_for,
+            clock_layout=clock_layout,
+        )
     command: RunCommand | None = None
-    if (pdu.function_code == FunctionCode.WRITE_SINGLE_REGISTER and not pdu.is_response and pdu.complete
-            and address == regs.REG_RUN_COMMAND):
+    if (
+        pdu.function_code == FunctionCode.WRITE_SINGLE_REGISTER
+        and not pdu.is_response
+        and pdu.complete
+        and address == regs.REG_RUN_COMMAND
+    ):
         command = run_command_of(pdu.values[0])
     summary = _frame_summary(header_ok, pdu, address, items)
     return DecodedFrame(
-        raw=raw, transport=transport, transaction_id=tid, unit=unit,
-        function_code=pdu.function_code, is_response=pdu.is_response, is_exception=pdu.is_exception,
-        exception_code=pdu.exception_code, address=address, count=pdu.count, values=pdu.values,
-        items=items, summary=summary, errors=tuple(errors), command=command, request=request,
+        raw=raw,
+        transport=transport,
+        transaction_id=tid,
+        unit=unit,
+        function_code=pdu.function_code,
+        is_response=pdu.is_response,
+        is_exception=pdu.is_exception,
+        exception_code=pdu.exception_code,
+        address=address,
+        count=pdu.count,
+        values=pdu.values,
+        items=items,
+        summary=summary,
+        errors=tuple(errors),
+        command=command,
+        request=request,
     )
 
 
@@ -387,9 +422,16 @@ class FrameDecoder:
         return self._decode(raw, "rx", self._take(raw))
 
     def _decode(self, raw: bytes, direction: Direction, request: DecodedFrame | None) -> DecodedFrame:
-        return decode_frame(raw, transport=self.transport, direction=direction, word_order=self.word_order,
-                            last_command=self.last_command, params_for=self.params_for,
-                            clock_layout=self.clock_layout, request=request)
+        return decode_frame(
+            raw,
+            transport=self.transport,
+            direction=direction,
+            word_order=self.word_order,
+            last_command=self.last_command,
+            params_for=self.params_for,
+            clock_layout=self.clock_layout,
+            request=request,
+        )
 
     def _guess_direction(self, raw: bytes) -> Direction:
         probe = decode_frame(raw, transport=self.transport, word_order=self.word_order)
@@ -430,7 +472,6 @@ class FrameDecoder:
                     self._in_order.popleft()
                 return request
         return None
-
 
 
 __all__ = ["DecodedFrame", "FrameDecoder", "decode_frame"]

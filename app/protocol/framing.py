@@ -61,6 +61,7 @@ def crc16(data: bytes) -> int:
         crc = (crc >> 8) ^ _CRC_TABLE[(crc ^ byte) & 0xFF]
     return crc
 
+
 # --- Envelopes ----------------------------------------------------------------------------
 
 
@@ -87,7 +88,6 @@ def split_rtu(data: bytes, errors: list[str]) -> tuple[int | None, bytes]:
     if sent != expected:
         errors.append(f"bad CRC 0x{sent:04X}, expected 0x{expected:04X}")
     return data[0], body[1:]
-
 
 
 # --- Encoding -----------------------------------------------------------------------------
@@ -192,8 +192,14 @@ def encode_write_gv(
     """FC10 writing float32 ``values`` to ``GVn``, ``GVn+1``, … (``encode_write_gv(200, 30.0)``)."""
     floats = [float(values)] if isinstance(values, (int, float)) else [float(v) for v in values]
     registers = encode_floats(floats, word_order)
-    return encode_request(FunctionCode.WRITE_MULTIPLE_REGISTERS, regs.gv_reg(n), registers,
-                          transaction_id=transaction_id, unit=unit, transport=transport)
+    return encode_request(
+        FunctionCode.WRITE_MULTIPLE_REGISTERS,
+        regs.gv_reg(n),
+        registers,
+        transaction_id=transaction_id,
+        unit=unit,
+        transport=transport,
+    )
 
 
 __all__ = [

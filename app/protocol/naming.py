@@ -215,16 +215,23 @@ class _IntRegister:
     hex_value: bool = False
 
 
-def _int_register(role: str, text: Callable[[int], str], *, bare: bool = False, hex_value: bool = False,
-                  action: Callable[[int], str] | None = None) -> _IntRegister:
+def _int_register(
+    role: str,
+    text: Callable[[int], str],
+    *,
+    bare: bool = False,
+    hex_value: bool = False,
+    action: Callable[[int], str] | None = None,
+) -> _IntRegister:
     if action is None:
         action = (lambda _v: role) if bare else (lambda v: f"{role} {text(v)}")
     return _IntRegister(role, text, action, hex_value)
 
 
 _INT_REGISTERS: dict[int, _IntRegister] = {
-    regs.REG_RUN_COMMAND: _int_register("run command", _run_command_text, action=_run_command_text,
-                                        hex_value=True),
+    regs.REG_RUN_COMMAND: _int_register(
+        "run command", _run_command_text, action=_run_command_text, hex_value=True
+    ),
     regs.REG_STOP: _int_register("stop", str, bare=True),
     regs.REG_PAUSE: _int_register("pause", str, bare=True),
     regs.REG_RESUME: _int_register("resume", str, bare=True),
@@ -246,14 +253,19 @@ _CLOCK_COUNT: Final = 4
 _COMMAND_STATUS_REG: Final = regs.gv_reg(regs.GV_COMMAND_STATUS)  # 582
 # Registers that never hold a float: table 1's integers and the whole status block.
 _NOT_FLOAT: Final = frozenset(
-    [*range(regs.REG_RUN_COMMAND, regs.REG_PROGRAM_SPEED + 1), regs.REG_RESOURCE_TYPE,
-     regs.REG_RESOURCE_PARAM,
-     *range(regs.STATUS_BLOCK_START, regs.STATUS_BLOCK_START + regs.STATUS_BLOCK_COUNT)]
+    [
+        *range(regs.REG_RUN_COMMAND, regs.REG_PROGRAM_SPEED + 1),
+        regs.REG_RESOURCE_TYPE,
+        regs.REG_RESOURCE_PARAM,
+        *range(regs.STATUS_BLOCK_START, regs.STATUS_BLOCK_START + regs.STATUS_BLOCK_COUNT),
+    ]
 )
 # Unused registers inside the status block: listed as items, left out of summaries.
 _STATUS_SPARE: Final = frozenset(
-    r for r in range(regs.STATUS_BLOCK_START, regs.STATUS_BLOCK_START + regs.STATUS_BLOCK_COUNT)
-    if r not in _INT_REGISTERS and not _CLOCK_START <= r < _CLOCK_START + _CLOCK_COUNT
+    r
+    for r in range(regs.STATUS_BLOCK_START, regs.STATUS_BLOCK_START + regs.STATUS_BLOCK_COUNT)
+    if r not in _INT_REGISTERS
+    and not _CLOCK_START <= r < _CLOCK_START + _CLOCK_COUNT
     and r not in (_COMMAND_STATUS_REG, _COMMAND_STATUS_REG + 1)
 )
 
@@ -296,8 +308,9 @@ _WORD: Final = struct.Struct(">HH")
 _FLOAT: Final = struct.Struct(">f")
 
 
-def _float_item(address: int, raw: tuple[int, int], order: WordOrder, params_for: RunCommand | None
-                ) -> RegisterItem:
+def _float_item(
+    address: int, raw: tuple[int, int], order: WordOrder, params_for: RunCommand | None
+) -> RegisterItem:
     n = address // 2
     high, low = (raw[1], raw[0]) if order is WordOrder.LOW_FIRST else raw
     value: float = _FLOAT.unpack(_WORD.pack(high, low))[0]
@@ -309,8 +322,15 @@ def _float_item(address: int, raw: tuple[int, int], order: WordOrder, params_for
     return RegisterItem(address, raw, ItemKind.FLOAT, f"GV{n}", role, value, text)
 
 
-def _float_run(address: int, words: Sequence[int], start: int, end: int, order: WordOrder,
-               params_for: RunCommand | None, items: list[RegisterItem]) -> None:
+def _float_run(
+    address: int,
+    words: Sequence[int],
+    start: int,
+    end: int,
+    order: WordOrder,
+    params_for: RunCommand | None,
+    items: list[RegisterItem],
+) -> None:
     """The GVs of ``words[start:end]`` (an even count from an even register), cached."""
     low_first = order is WordOrder.LOW_FIRST
     cache = _FLOAT_ITEMS

@@ -24,8 +24,12 @@ def _gv_span(address: int, count: int) -> str:
 
 def _is_gv_run(address: int, count: int) -> bool:
     """Whole GVs from an even address, none of them an integer register."""
-    return (address % 2 == 0 and count % 2 == 0 and count > 0
-            and not any(r in _NOT_FLOAT for r in range(address, address + count)))
+    return (
+        address % 2 == 0
+        and count % 2 == 0
+        and count > 0
+        and not any(r in _NOT_FLOAT for r in range(address, address + count))
+    )
 
 
 def range_label(address: int, count: int) -> str:
@@ -47,8 +51,9 @@ def limited_list(texts: Sequence[str], limit: int = SUMMARY_LIST_LIMIT) -> str:
     return ", ".join(texts[:limit]) + f", … (+{len(texts) - limit})"
 
 
-def _listed(items: Sequence[RegisterItem], text: Callable[[RegisterItem], str],
-            limit: int = SUMMARY_LIST_LIMIT) -> str:
+def _listed(
+    items: Sequence[RegisterItem], text: Callable[[RegisterItem], str], limit: int = SUMMARY_LIST_LIMIT
+) -> str:
     """``limited_list`` of ``text(item)``, formatting only the items it shows."""
     if len(items) <= limit:
         return ", ".join(map(text, items))
@@ -65,8 +70,10 @@ def _short(item: RegisterItem) -> str:
 
 def _plain(items: Sequence[RegisterItem]) -> bool:
     """Items that read best as one list of values: role-less GVs, or raw registers."""
-    return bool(items) and (all(it.kind is ItemKind.FLOAT and not it.role for it in items)
-                            or all(it.kind is ItemKind.RAW for it in items))
+    return bool(items) and (
+        all(it.kind is ItemKind.FLOAT and not it.role for it in items)
+        or all(it.kind is ItemKind.RAW for it in items)
+    )
 
 
 def _summary_items(items: Sequence[RegisterItem]) -> list[RegisterItem]:

@@ -130,12 +130,19 @@ def _short(text: str, limit: int = MAX_DETAIL_CHARS) -> str:
 class AuditLog:
     """Appends records; thread-safe (the worker records writes, the GUI refusals)."""
 
-    def __init__(self, directory: Path | None = None, *, role: Callable[[], str] | str = "operator",
-                 fsync: FsyncPolicy = FsyncPolicy.INTERVAL, max_file_bytes: int = MAX_FILE_BYTES,
-                 max_total_bytes: int = MAX_TOTAL_BYTES, keep_days: int = KEEP_DAYS,
-                 word_order: WordOrder = WordOrder.LOW_FIRST,
-                 now: Callable[[], dt.datetime] | None = None,
-                 on_error: Callable[[str], None] | None = None) -> None:
+    def __init__(
+        self,
+        directory: Path | None = None,
+        *,
+        role: Callable[[], str] | str = "operator",
+        fsync: FsyncPolicy = FsyncPolicy.INTERVAL,
+        max_file_bytes: int = MAX_FILE_BYTES,
+        max_total_bytes: int = MAX_TOTAL_BYTES,
+        keep_days: int = KEEP_DAYS,
+        word_order: WordOrder = WordOrder.LOW_FIRST,
+        now: Callable[[], dt.datetime] | None = None,
+        on_error: Callable[[str], None] | None = None,
+    ) -> None:
         self.directory = directory or default_audit_dir()
         self._role = role
         self.fsync = fsync
@@ -180,13 +187,30 @@ class AuditLog:
         return (clock + dt.timedelta(seconds=time.monotonic() - at)).isoformat(timespec="seconds")
 
     # --- recording --------------------------------------------------------------------------
-    def record(self, kind: str, command: str, *, result: str = Result.OK, args: dict[str, Any] | None = None,
-               detail: str = "", role: str | None = None) -> AuditRecord:
+    def record(
+        self,
+        kind: str,
+        command: str,
+        *,
+        result: str = Result.OK,
+        args: dict[str, Any] | None = None,
+        detail: str = "",
+        role: str | None = None,
+    ) -> AuditRecord:
         with self._lock:
             now = self._now()
-            rec = AuditRecord(now.isoformat(timespec="milliseconds"), kind, command,
-                              role or self.role, result, dict(args or {}), _short(detail),
-                              self._controller_time(), self.session, self._seq)
+            rec = AuditRecord(
+                now.isoformat(timespec="milliseconds"),
+                kind,
+                command,
+                role or self.role,
+                result,
+                dict(args or {}),
+                _short(detail),
+                self._controller_time(),
+                self.session,
+                self._seq,
+            )
             self._seq += 1
             try:
                 self._append(rec.to_line(), now)
@@ -205,8 +229,15 @@ class AuditLog:
             if self.on_error is not None:
                 self.on_error(message)
 
-    def record_write(self, address: int, values: Sequence[int], *, single: bool = False,
-                     error: BaseException | None = None, pending: bool = False) -> AuditRecord:
+    def record_write(
+        self,
+        address: int,
+        values: Sequence[int],
+        *,
+        single: bool = False,
+        error: BaseException | None = None,
+        pending: bool = False,
+    ) -> AuditRecord:
         """One write to the controller and how it ended (``error`` None: it succeeded; ``pending``:
         not known yet, an outcome line follows -- see :meth:`writing`)."""
         vals = [int(v) for v in values]
@@ -237,8 +268,9 @@ class AuditLog:
 
     def _record_outcome(self, intent: AuditRecord, error: BaseException | None) -> None:
         result, detail = _write_result(error)
-        self.record(OUTCOME, intent.command, result=result, args={"ref": intent.seq}, detail=detail,
-                    role=intent.role)
+        self.record(
+            OUTCOME, intent.command, result=result, args={"ref": intent.seq}, detail=detail, role=intent.role
+        )
 
     def record_refused(self, action: str, reason: str, args: dict[str, Any] | None = None) -> AuditRecord:
         """An action the host refused (envelope, role, bad value): nothing was sent."""
@@ -271,7 +303,7 @@ class AuditLog:
         assert self._fd is not None
         view = memoryview(line)
         while view:
-            view = view[os.write(self._fd, view):]
+            view = view[os.write(self._fd, view) :]
         self._size += len(line)
         self._sync()
 
@@ -305,8 +337,9 @@ class AuditLog:
         self._prune(keep=path)
 
     def _prune(self, keep: Path) -> None:
-        files = sorted(((d, part, p) for p, d, part in audit_file_parts(self.directory)),
-                       key=lambda t: (t[0], t[1]))
+        files = sorted(
+            ((d, part, p) for p, d, part in audit_file_parts(self.directory)), key=lambda t: (t[0], t[1])
+        )
         cutoff = (self._now().date() - dt.timedelta(days=self.keep_days)).isoformat()
         remaining: list[tuple[Path, int]] = []
         for d, _, p in files:
@@ -331,5 +364,3 @@ def _ends_with_newline(path: Path) -> bool:
     with open(path, "rb") as f:
         f.seek(-1, os.SEEK_END)
         return f.read(1) == b"\n"
-
-

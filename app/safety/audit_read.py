@@ -80,9 +80,18 @@ class AuditRecord:
         return dt.datetime.fromisoformat(self.host_time)
 
     def to_line(self) -> bytes:
-        doc = {"host_time": self.host_time, "kind": self.kind, "command": self.command, "role": self.role,
-               "result": self.result, "args": self.args, "detail": self.detail,
-               "controller_time": self.controller_time, "session": self.session, "seq": self.seq}
+        doc = {
+            "host_time": self.host_time,
+            "kind": self.kind,
+            "command": self.command,
+            "role": self.role,
+            "result": self.result,
+            "args": self.args,
+            "detail": self.detail,
+            "controller_time": self.controller_time,
+            "session": self.session,
+            "seq": self.seq,
+        }
         return (json.dumps(doc, ensure_ascii=False, separators=(",", ":")) + "\n").encode("utf-8")
 
     @classmethod
@@ -137,8 +146,9 @@ class _Slot:
         self.record, self.pending = record, record.result == Result.PENDING
 
 
-def read_records(directory: Path, start: dt.date | None = None, end: dt.date | None = None,
-                 stats: ReadStats | None = None) -> Iterator[AuditRecord]:
+def read_records(
+    directory: Path, start: dt.date | None = None, end: dt.date | None = None, stats: ReadStats | None = None
+) -> Iterator[AuditRecord]:
     """Every record of days ``start``..``end``, in file order; lines that do not parse are skipped
     and counted. A write's outcome line is merged into the write (see the module docstring); a
     write without one within :data:`MAX_OUTCOME_LAG` records (the process died) ends ``unknown``,
@@ -220,8 +230,10 @@ class AuditFilter:
     def days(self) -> tuple[dt.date | None, dt.date | None]:
         # a day's file may hold records of the day before near midnight across zones: widen by one
         one = dt.timedelta(days=1)
-        return (None if self.start is None else self.start.date() - one,
-                None if self.end is None else self.end.date() + one)
+        return (
+            None if self.start is None else self.start.date() - one,
+            None if self.end is None else self.end.date() + one,
+        )
 
 
 def _cmp_time(a: dt.datetime, b: dt.datetime) -> int:
@@ -230,8 +242,9 @@ def _cmp_time(a: dt.datetime, b: dt.datetime) -> int:
     return (a > b) - (a < b)
 
 
-def query(directory: Path, flt: AuditFilter | None = None,
-          stats: ReadStats | None = None) -> list[AuditRecord]:
+def query(
+    directory: Path, flt: AuditFilter | None = None, stats: ReadStats | None = None
+) -> list[AuditRecord]:
     flt = flt or AuditFilter()
     start, end = flt.days()
     return [r for r in read_records(directory, start, end, stats) if flt.matches(r)]
@@ -246,7 +259,17 @@ def export_csv(records: Iterable[AuditRecord], out: TextIO) -> int:
     writer.writerow(CSV_COLUMNS)
     n = 0
     for r in records:
-        writer.writerow((r.host_time, r.controller_time or "", r.role, r.kind, r.command, r.result,
-                         r.detail, json.dumps(r.args, ensure_ascii=False)))
+        writer.writerow(
+            (
+                r.host_time,
+                r.controller_time or "",
+                r.role,
+                r.kind,
+                r.command,
+                r.result,
+                r.detail,
+                json.dumps(r.args, ensure_ascii=False),
+            )
+        )
         n += 1
     return n

@@ -50,8 +50,12 @@ class BundleManifest:
 
 def versions() -> dict[str, str]:
     """Versions of everything a bug report needs; packages found by their metadata (not imported)."""
-    out = {"teachpad": app.__version__, "python": sys.version.split()[0],
-           "platform": platform.platform(), "machine": platform.machine()}
+    out = {
+        "teachpad": app.__version__,
+        "python": sys.version.split()[0],
+        "platform": platform.platform(),
+        "machine": platform.machine(),
+    }
     for dist in _DISTRIBUTIONS:
         try:
             out[dist] = importlib.metadata.version(dist)
@@ -99,12 +103,19 @@ class _Writer:
         self.manifest.files.append(name)
 
 
-def build_support_bundle(*, settings: Mapping[str, Any] | None = None, project: Path | None = None,
-                         profile: Path | None = None, register_profile: Path | None = None,
-                         audit_dir: Path | None = None, events: Iterable[str] | None = None,
-                         log_dir: Path | None = None,
-                         traffic: Iterable[str] | None = None, days: int = DEFAULT_DAYS,
-                         now: dt.datetime | None = None) -> tuple[bytes, BundleManifest]:
+def build_support_bundle(
+    *,
+    settings: Mapping[str, Any] | None = None,
+    project: Path | None = None,
+    profile: Path | None = None,
+    register_profile: Path | None = None,
+    audit_dir: Path | None = None,
+    events: Iterable[str] | None = None,
+    log_dir: Path | None = None,
+    traffic: Iterable[str] | None = None,
+    days: int = DEFAULT_DAYS,
+    now: dt.datetime | None = None,
+) -> tuple[bytes, BundleManifest]:
     """The zip's bytes and its manifest."""
     if days < 1:
         raise InvalidInput("days must be at least 1")
@@ -140,9 +151,20 @@ def build_support_bundle(*, settings: Mapping[str, Any] | None = None, project: 
         if traffic is not None:
             w.text("traffic.txt", "".join(line.rstrip("\n") + "\n" for line in traffic))
         manifest.files.append("manifest.json")
-        zf.writestr("manifest.json", json.dumps(
-            {"created": manifest.created, "days": days, "files": manifest.files,
-             "left_out": manifest.left_out}, indent=2, ensure_ascii=False) + "\n")
+        zf.writestr(
+            "manifest.json",
+            json.dumps(
+                {
+                    "created": manifest.created,
+                    "days": days,
+                    "files": manifest.files,
+                    "left_out": manifest.left_out,
+                },
+                indent=2,
+                ensure_ascii=False,
+            )
+            + "\n",
+        )
     return buf.getvalue(), manifest
 
 

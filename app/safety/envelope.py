@@ -73,15 +73,21 @@ class EnvelopeViolation:
             joint = self.code is ViolationCode.JOINT_LIMIT
             edge = "its limit" if joint else "the edge of the allowed work space"
             zone = f"the keep-out zone '{self.box}'" if self.box else edge
-            return (f"{where}{self.axis} = {self.value:.1f} {unit} is within stopping distance of {zone} "
-                    f"at {self.limit:.1f} {unit}")
+            return (
+                f"{where}{self.axis} = {self.value:.1f} {unit} is within stopping distance of {zone} "
+                f"at {self.limit:.1f} {unit}"
+            )
         if self.code is ViolationCode.KEEP_IN:
             side = "below" if self.value < self.limit else "above"
-            text = (f"{self.axis} = {self.value:.1f} {unit} is outside the allowed work space "
-                    f"({side} its limit {self.limit:.1f} {unit})")
+            text = (
+                f"{self.axis} = {self.value:.1f} {unit} is outside the allowed work space "
+                f"({side} its limit {self.limit:.1f} {unit})"
+            )
         elif self.code is ViolationCode.KEEP_OUT:
-            text = (f"the path enters the keep-out zone '{self.box}' ({self.axis} = {self.value:.1f} {unit}, "
-                    f"its face is at {self.limit:.1f} {unit})")
+            text = (
+                f"the path enters the keep-out zone '{self.box}' ({self.axis} = {self.value:.1f} {unit}, "
+                f"its face is at {self.limit:.1f} {unit})"
+            )
         elif self.code is ViolationCode.JOINT_LIMIT:
             side = "below" if self.value < self.limit else "above"
             text = f"{self.axis} = {self.value:.1f}° is {side} its limit {self.limit:.1f}°"
@@ -108,9 +114,19 @@ class EnvelopeRefused(TeachPadError):
     def __init__(self, violation: EnvelopeViolation, action: str = "") -> None:
         prefix = f"{action} refused: " if action else "refused: "
         v = violation
-        super().__init__(prefix + violation.message, params={
-            "violation": v.code.value, "value": v.value, "limit": v.limit, "axis": v.axis,
-            "box": v.box, "segment": v.segment, "reduced": v.reduced, "approaching": v.approaching})
+        super().__init__(
+            prefix + violation.message,
+            params={
+                "violation": v.code.value,
+                "value": v.value,
+                "limit": v.limit,
+                "axis": v.axis,
+                "box": v.box,
+                "segment": v.segment,
+                "reduced": v.reduced,
+                "approaching": v.approaching,
+            },
+        )
         self.violation = violation
 
 
@@ -253,8 +269,9 @@ class Envelope:
     reduced_speed: float = REDUCED_SPEED_DEFAULT  # mm/s cap in reduced-speed mode
 
     def __post_init__(self) -> None:
-        limits = tuple(_check_pair(lo, hi, f"J{i + 1} limits")
-                       for i, (lo, hi) in enumerate(self.joint_limits))
+        limits = tuple(
+            _check_pair(lo, hi, f"J{i + 1} limits") for i, (lo, hi) in enumerate(self.joint_limits)
+        )
         object.__setattr__(self, "joint_limits", limits)
         object.__setattr__(self, "keep_out", tuple(self.keep_out))
         _positive(self.max_jog_ratio, "the maximum jog speed (%)", 100.0)
@@ -333,24 +350,46 @@ def check_jog_ratio(envelope: Envelope, ratio: float, reduced: bool = False) -> 
     return None
 
 
-def check_target(envelope: Envelope, pose: PointLike, joints: Sequence[float] | None = None, *,
-                 speed: float | None = None, reduced: bool = False) -> EnvelopeViolation | None:
+def check_target(
+    envelope: Envelope,
+    pose: PointLike,
+    joints: Sequence[float] | None = None,
+    *,
+    speed: float | None = None,
+    reduced: bool = False,
+) -> EnvelopeViolation | None:
     """A step or move target (and its joints, its speed, when known): the first violation."""
-    return (check_point(envelope, xyz_of(pose))
-            or (check_joints(envelope, joints) if joints is not None else None)
-            or (check_speed(envelope, speed, reduced) if speed is not None else None))
+    return (
+        check_point(envelope, xyz_of(pose))
+        or (check_joints(envelope, joints) if joints is not None else None)
+        or (check_speed(envelope, speed, reduced) if speed is not None else None)
+    )
 
 
-def require_target(envelope: Envelope, pose: PointLike, joints: Sequence[float] | None = None, *,
-                   speed: float | None = None, reduced: bool = False, action: str = "") -> None:
+def require_target(
+    envelope: Envelope,
+    pose: PointLike,
+    joints: Sequence[float] | None = None,
+    *,
+    speed: float | None = None,
+    reduced: bool = False,
+    action: str = "",
+) -> None:
     """:func:`check_target`, raising :class:`EnvelopeRefused` for a violation."""
     violation = check_target(envelope, pose, joints, speed=speed, reduced=reduced)
     if violation is not None:
         raise EnvelopeRefused(violation, action)
 
 
-def check_step(envelope: Envelope, pose: Pose, offsets: Sequence[float], *, joint: bool,
-               speed: float | None = None, reduced: bool = False) -> EnvelopeViolation | None:
+def check_step(
+    envelope: Envelope,
+    pose: Pose,
+    offsets: Sequence[float],
+    *,
+    joint: bool,
+    speed: float | None = None,
+    reduced: bool = False,
+) -> EnvelopeViolation | None:
     """An incremental move (function 1) from ``pose``: base frame (``joint`` False) X Y Z
     offsets in mm, a straight line checked whole, and its speed (mm/s); joint frame J1..J6
     offsets in degrees against the joint limits (needs ``pose.joints``; the TCP's path of a
@@ -401,8 +440,9 @@ def _samples_for(start: PointLike, segment: Segment, ledger: PointLedger) -> int
     return int(min(MAX_SAMPLES_PER_SEGMENT, max(16, math.ceil(length / ARC_SAMPLE_STEP_MM) + 1)))
 
 
-def check_segment(envelope: Envelope, start: PointLike, segment: Segment, ledger: PointLedger, *,
-                  reduced: bool = False) -> EnvelopeViolation | None:
+def check_segment(
+    envelope: Envelope, start: PointLike, segment: Segment, ledger: PointLedger, *, reduced: bool = False
+) -> EnvelopeViolation | None:
     """One plan segment from ``start``: its speed, then its path (arcs sampled finely).
 
     Raises :class:`InvalidInput` for a missing point or an arc that defines no circle (the
@@ -414,9 +454,16 @@ def check_segment(envelope: Envelope, start: PointLike, segment: Segment, ledger
     return check_path(envelope, path)
 
 
-def plan_violations(plan: Plan, ledger: PointLedger, envelope: Envelope,
-                    current_pose: PointLike | None = None, *, start_index: int = 0,
-                    loops: int | None = None, reduced: bool = False) -> list[EnvelopeViolation]:
+def plan_violations(
+    plan: Plan,
+    ledger: PointLedger,
+    envelope: Envelope,
+    current_pose: PointLike | None = None,
+    *,
+    start_index: int = 0,
+    loops: int | None = None,
+    reduced: bool = False,
+) -> list[EnvelopeViolation]:
     """The first violation of each segment that leaves the envelope (``segment`` set).
 
     Segments start where they will run from: ``start_index`` at ``current_pose`` (only its end
@@ -451,9 +498,11 @@ def plan_violations(plan: Plan, ledger: PointLedger, envelope: Envelope,
         if found is None and not starts:
             end = ledger.get(seg.end_id)
             via = ledger.get(seg.via_id) if seg.via_id is not None else None
-            found = (check_speed(envelope, seg.speed, reduced)
-                     or (check_point(envelope, xyz_of(end)) if end is not None else None)
-                     or (check_point(envelope, xyz_of(via)) if via is not None else None))
+            found = (
+                check_speed(envelope, seg.speed, reduced)
+                or (check_point(envelope, xyz_of(end)) if end is not None else None)
+                or (check_point(envelope, xyz_of(via)) if via is not None else None)
+            )
         if found is not None:
             out.append(found.at_segment(i))
     return out

@@ -128,8 +128,15 @@ def nearest_boundary(envelope: Envelope, p: FloatArray) -> EnvelopeViolation | N
 class JogGuard:
     """Decides, on every poll during a jog, whether it may go on. Pure: no I/O, no clock."""
 
-    def __init__(self, envelope: Envelope, *, poll_period: float, latency: float = JOG_GUARD_LATENCY,
-                 speeds: ArmSpeeds | None = None, reduced: bool = False) -> None:
+    def __init__(
+        self,
+        envelope: Envelope,
+        *,
+        poll_period: float,
+        latency: float = JOG_GUARD_LATENCY,
+        speeds: ArmSpeeds | None = None,
+        reduced: bool = False,
+    ) -> None:
         if not (poll_period > 0 and latency >= 0):
             raise ValueError("poll period must be > 0 and latency >= 0")
         self.envelope = envelope
@@ -209,12 +216,16 @@ class JogGuard:
             return None
         limit = hi if _sign(motion) > 0 else lo
         past = q > hi or q < lo
-        return JogDecision(False, EnvelopeViolation(ViolationCode.JOINT_LIMIT, q, limit, f"J{ax + 1}",
-                                                    approaching=not past), step)
+        return JogDecision(
+            False,
+            EnvelopeViolation(ViolationCode.JOINT_LIMIT, q, limit, f"J{ax + 1}", approaching=not past),
+            step,
+        )
 
 
-def _approaching(env: Envelope, p: FloatArray,
-                 violation: EnvelopeViolation | None) -> EnvelopeViolation | None:
+def _approaching(
+    env: Envelope, p: FloatArray, violation: EnvelopeViolation | None
+) -> EnvelopeViolation | None:
     """Mark a stop before the boundary as such (the pose itself is still inside)."""
     if violation is None or check_point(env, p) is not None:
         return violation

@@ -99,8 +99,15 @@ def envelope_from_dict(data: object, where: str = "envelope") -> Envelope:
     """Build an envelope from its JSON form; :class:`ProfileError` names the bad field."""
     if not isinstance(data, dict):
         raise ProfileError(f"{where}: expected an object")
-    known = {"joint_limits", "keep_in", "keep_out", "max_jog_ratio", "max_speed",
-             "reduced_jog_ratio", "reduced_speed"}
+    known = {
+        "joint_limits",
+        "keep_in",
+        "keep_out",
+        "max_jog_ratio",
+        "max_speed",
+        "reduced_jog_ratio",
+        "reduced_speed",
+    }
     unknown = sorted(set(data) - known)
     if unknown:
         raise ProfileError(f"{where}: unknown field {_short(unknown[0])}")
@@ -120,8 +127,10 @@ def envelope_from_dict(data: object, where: str = "envelope") -> Envelope:
         raise ProfileError(f"{where}.keep_out: expected a list of zones")
     keep_out = tuple(_box_from(b, f"{where}.keep_out[{i + 1}]") for i, b in enumerate(keep_out_raw))
     defaults = Envelope()
-    numbers = {name: _number(data.get(name, getattr(defaults, name)), f"{where}.{name}")
-               for name in ("max_jog_ratio", "max_speed", "reduced_jog_ratio", "reduced_speed")}
+    numbers = {
+        name: _number(data.get(name, getattr(defaults, name)), f"{where}.{name}")
+        for name in ("max_jog_ratio", "max_speed", "reduced_jog_ratio", "reduced_speed")
+    }
     try:
         return Envelope(tuple(joints), keep_in, keep_out, **numbers)
     except InvalidInput as exc:
@@ -129,8 +138,14 @@ def envelope_from_dict(data: object, where: str = "envelope") -> Envelope:
 
 
 def profile_to_json(profile: SafetyProfile) -> str:
-    doc = {"format": FORMAT, "version": VERSION, "robot": profile.robot, "revision": profile.revision,
-           "saved": profile.saved, "envelope": envelope_to_dict(profile.envelope)}
+    doc = {
+        "format": FORMAT,
+        "version": VERSION,
+        "robot": profile.robot,
+        "revision": profile.revision,
+        "saved": profile.saved,
+        "envelope": envelope_to_dict(profile.envelope),
+    }
     return json.dumps(doc, indent=2, ensure_ascii=False) + "\n"
 
 
@@ -145,8 +160,9 @@ def profile_from_json(text: str, source: str = "the safety profile") -> SafetyPr
     if not isinstance(version, int) or isinstance(version, bool):
         raise ProfileError(f"{source}: the format version is missing")
     if version > VERSION:
-        raise ProfileError(f"{source} was written by a newer TeachPad (format {version}; this one reads "
-                           f"up to {VERSION})")
+        raise ProfileError(
+            f"{source} was written by a newer TeachPad (format {version}; this one reads up to {VERSION})"
+        )
     robot, revision, saved = doc.get("robot", ""), doc.get("revision", 0), doc.get("saved", "")
     if not isinstance(robot, str) or not isinstance(saved, str):
         raise ProfileError(f"{source}: 'robot' and 'saved' must be text")
@@ -173,8 +189,9 @@ def load_profile(path: str | os.PathLike[str]) -> SafetyProfile:
     return profile_from_json(text, f"safety profile {p.name}")
 
 
-def save_profile(path: str | os.PathLike[str], profile: SafetyProfile,
-                 now: dt.datetime | None = None) -> SafetyProfile:
+def save_profile(
+    path: str | os.PathLike[str], profile: SafetyProfile, now: dt.datetime | None = None
+) -> SafetyProfile:
     """Write atomically with the next revision; returns the profile as saved."""
     stamp = (now or dt.datetime.now(dt.UTC)).isoformat(timespec="seconds")
     saved = replace(profile, revision=profile.revision + 1, saved=stamp)

@@ -56,8 +56,16 @@ UNIT_RANGE = (0, 247)
 POLL_TIMEOUT_RANGE = (0.02, 10.0)  # s
 UNCONFIRMED_RANGE = (0.005, 5.0)  # s
 POINT_ID_RANGE = (0, 65535)
-_FIELDS = ("word_order", "unit", "completion", "unconfirmed_after", "poll_timeout", "datetime_layout",
-           "point_id_min", "point_id_max")
+_FIELDS = (
+    "word_order",
+    "unit",
+    "completion",
+    "unconfirmed_after",
+    "poll_timeout",
+    "datetime_layout",
+    "point_id_min",
+    "point_id_max",
+)
 
 
 class RegisterProfileError(TeachPadError):
@@ -116,8 +124,10 @@ class RegisterProfile:
 
     def summary(self) -> str:
         """One line for messages: ``'cell 3' rev 2: low-first, unit 1, completion auto``."""
-        return (f"{self.name!r} rev {self.revision}: {self.word_order.value}, unit {self.unit}, "
-                f"completion {self.completion}")
+        return (
+            f"{self.name!r} rev {self.revision}: {self.word_order.value}, unit {self.unit}, "
+            f"completion {self.completion}"
+        )
 
 
 def _check(p: RegisterProfile, where: str) -> None:
@@ -132,20 +142,29 @@ def _check(p: RegisterProfile, where: str) -> None:
         raise bad("datetime_layout", "must be split-words or packed32")
     if p.completion not in COMPLETION_MODES:
         raise bad("completion", f"must be one of {', '.join(COMPLETION_MODES)}, got {_short(p.completion)}")
-    for name, lo, hi in (("unit", *UNIT_RANGE), ("point_id_min", *POINT_ID_RANGE),
-                         ("point_id_max", *POINT_ID_RANGE)):
+    for name, lo, hi in (
+        ("unit", *UNIT_RANGE),
+        ("point_id_min", *POINT_ID_RANGE),
+        ("point_id_max", *POINT_ID_RANGE),
+    ):
         value = getattr(p, name)
         if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
             raise bad(name, f"must be a whole number {lo}..{hi}, got {_short(value)}")
     if p.point_id_min > p.point_id_max:
         raise bad("point_id_min", f"({p.point_id_min}) is above point_id_max ({p.point_id_max})")
-    for name, lo_f, hi_f in (("poll_timeout", *POLL_TIMEOUT_RANGE),
-                             ("unconfirmed_after", *UNCONFIRMED_RANGE)):
+    for name, lo_f, hi_f in (
+        ("poll_timeout", *POLL_TIMEOUT_RANGE),
+        ("unconfirmed_after", *UNCONFIRMED_RANGE),
+    ):
         value = getattr(p, name)
         if value is None:
             continue
-        if (isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value)
-                or not lo_f <= value <= hi_f):
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, int | float)
+            or not math.isfinite(value)
+            or not lo_f <= value <= hi_f
+        ):
             raise bad(name, f"must be empty (automatic) or {lo_f:g}..{hi_f:g} s, got {_short(value)}")
     if isinstance(p.revision, bool) or not isinstance(p.revision, int) or p.revision < 0:
         raise bad("revision", "must be a whole number >= 0")
@@ -155,8 +174,13 @@ def _check(p: RegisterProfile, where: str) -> None:
 
 
 def profile_to_json(profile: RegisterProfile) -> str:
-    doc: dict[str, Any] = {"format": FORMAT, "version": VERSION, "name": profile.name,
-                           "revision": profile.revision, "saved": profile.saved}
+    doc: dict[str, Any] = {
+        "format": FORMAT,
+        "version": VERSION,
+        "name": profile.name,
+        "revision": profile.revision,
+        "saved": profile.saved,
+    }
     doc.update(profile.protocol_dict())
     return json.dumps(doc, indent=2, ensure_ascii=False) + "\n"
 
@@ -172,8 +196,9 @@ def profile_from_json(text: str, source: str = "the register profile") -> Regist
     if not isinstance(version, int) or isinstance(version, bool):
         raise RegisterProfileError(f"{source}: the format version is missing")
     if version > VERSION:
-        raise RegisterProfileError(f"{source} was written by a newer TeachPad (format {version}; this one "
-                                   f"reads up to {VERSION})")
+        raise RegisterProfileError(
+            f"{source} was written by a newer TeachPad (format {version}; this one reads up to {VERSION})"
+        )
     unknown = sorted(set(doc) - {"format", "version", "name", "revision", "saved", *_FIELDS})
     if unknown:
         raise RegisterProfileError(f"{source}: unknown field {_short(unknown[0])}")
@@ -190,8 +215,9 @@ def profile_from_json(text: str, source: str = "the register profile") -> Regist
                 values[name] = kind(raw)
             except ValueError:
                 choices = ", ".join(member.value for member in kind)
-                raise RegisterProfileError(f"{source}: {name} must be one of {choices}, got "
-                                           f"{_short(raw)}") from None
+                raise RegisterProfileError(
+                    f"{source}: {name} must be one of {choices}, got {_short(raw)}"
+                ) from None
     for name in ("poll_timeout", "unconfirmed_after"):  # JSON has one number type
         if isinstance(values[name], int) and not isinstance(values[name], bool):
             values[name] = float(values[name])
@@ -215,8 +241,9 @@ def load_register_profile(path: str | os.PathLike[str]) -> RegisterProfile:
     return profile_from_json(text, f"register profile {p.name}")
 
 
-def save_register_profile(path: str | os.PathLike[str], profile: RegisterProfile,
-                          now: dt.datetime | None = None) -> RegisterProfile:
+def save_register_profile(
+    path: str | os.PathLike[str], profile: RegisterProfile, now: dt.datetime | None = None
+) -> RegisterProfile:
     """Write atomically with the next revision; returns the profile as saved."""
     stamp = (now or dt.datetime.now(dt.UTC)).isoformat(timespec="seconds")
     saved = dataclasses.replace(profile, revision=profile.revision + 1, saved=stamp)
@@ -239,5 +266,7 @@ def active_profile(path: Path, fallback: RegisterProfile) -> tuple[RegisterProfi
     try:
         return load_register_profile(path), ""
     except RegisterProfileError as exc:
-        return fallback, (f"{exc}; the remembered connection settings are used until an administrator "
-                          "saves a register profile")
+        return fallback, (
+            f"{exc}; the remembered connection settings are used until an administrator "
+            "saves a register profile"
+        )

@@ -155,8 +155,14 @@ class PasswordHash:
         return hmac.compare_digest(_scrypt(password, self.salt, self.n, self.r, self.p), self.digest)
 
     def to_dict(self) -> dict[str, object]:
-        return {"scheme": "scrypt", "salt": self.salt.hex(), "hash": self.digest.hex(),
-                "n": self.n, "r": self.r, "p": self.p}
+        return {
+            "scheme": "scrypt",
+            "salt": self.salt.hex(),
+            "hash": self.digest.hex(),
+            "n": self.n,
+            "r": self.r,
+            "p": self.p,
+        }
 
     @classmethod
     def from_dict(cls, data: object) -> PasswordHash:
@@ -170,8 +176,9 @@ class PasswordHash:
 
 
 def _scrypt(password: str, salt: bytes, n: int, r: int, p: int) -> bytes:
-    return hashlib.scrypt(password.encode("utf-8"), salt=salt, n=n, r=r, p=p, dklen=HASH_BYTES,
-                          maxmem=256 * 1024 * 1024)
+    return hashlib.scrypt(
+        password.encode("utf-8"), salt=salt, n=n, r=r, p=p, dklen=HASH_BYTES, maxmem=256 * 1024 * 1024
+    )
 
 
 class RoleStore:
@@ -189,8 +196,10 @@ class RoleStore:
         try:
             doc = json.loads(read_limited(self.path, 1024 * 1024).decode("utf-8"))
         except (FileFormatError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise RoleStoreError(f"the role store {self.path.name} cannot be read ({exc}); an "
-                                 "administrator must restore or delete it") from None
+            raise RoleStoreError(
+                f"the role store {self.path.name} cannot be read ({exc}); an "
+                "administrator must restore or delete it"
+            ) from None
         if not isinstance(doc, dict) or doc.get("format") != STORE_FORMAT:
             raise RoleStoreError(f"{self.path.name} is not a TeachPad role store")
         version = doc.get("version")
@@ -204,15 +213,20 @@ class RoleStore:
                 role = Role.parse(str(name))
                 self._hashes[role] = PasswordHash.from_dict(data)
             except (InvalidInput, ValueError, KeyError) as exc:
-                raise RoleStoreError(f"{self.path.name}: the entry for {str(name)[:20]!r} is damaged "
-                                     f"({exc})") from None
+                raise RoleStoreError(
+                    f"{self.path.name}: the entry for {str(name)[:20]!r} is damaged ({exc})"
+                ) from None
         idle = doc.get("idle_timeout", IDLE_TIMEOUT_DEFAULT)
         if isinstance(idle, int | float) and not isinstance(idle, bool) and idle > 0:
             self.idle_timeout = float(idle)
 
     def save(self) -> None:
-        doc = {"format": STORE_FORMAT, "version": STORE_VERSION, "idle_timeout": self.idle_timeout,
-               "passwords": {role.text: h.to_dict() for role, h in sorted(self._hashes.items())}}
+        doc = {
+            "format": STORE_FORMAT,
+            "version": STORE_VERSION,
+            "idle_timeout": self.idle_timeout,
+            "passwords": {role.text: h.to_dict() for role, h in sorted(self._hashes.items())},
+        }
         self.path.parent.mkdir(parents=True, exist_ok=True)
         atomic_write_bytes(self.path, (json.dumps(doc, indent=2) + "\n").encode("utf-8"))
         with contextlib.suppress(OSError):
@@ -265,8 +279,13 @@ class IdleLock:
     is injectable (``time.monotonic`` by default). ``on_lock`` is called once per lock-back.
     """
 
-    def __init__(self, timeout: float = IDLE_TIMEOUT_DEFAULT, *, clock: Callable[[], float] = time.monotonic,
-                 on_lock: Callable[[Role], None] | None = None) -> None:
+    def __init__(
+        self,
+        timeout: float = IDLE_TIMEOUT_DEFAULT,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        on_lock: Callable[[Role], None] | None = None,
+    ) -> None:
         if not timeout > 0:
             raise InvalidInput("the idle time must be > 0 s")
         self.timeout = timeout

@@ -51,9 +51,16 @@ class PermissionRefused(TeachPadError):
 
 
 class SafetySession:
-    def __init__(self, store: RoleStore, audit: AuditLog, envelope: Envelope | None = None, *,
-                 idle_lock: IdleLock | None = None, speeds: ArmSpeeds | None = None,
-                 on_role_changed: Callable[[Role], None] | None = None) -> None:
+    def __init__(
+        self,
+        store: RoleStore,
+        audit: AuditLog,
+        envelope: Envelope | None = None,
+        *,
+        idle_lock: IdleLock | None = None,
+        speeds: ArmSpeeds | None = None,
+        on_role_changed: Callable[[Role], None] | None = None,
+    ) -> None:
         self.store = store
         self.audit = audit
         self.envelope = envelope or Envelope()
@@ -104,8 +111,9 @@ class SafetySession:
         return self.idle.poll()
 
     def _locked(self, previous: Role) -> None:
-        self.audit.record("login", f"locked back to operator after {self.idle.timeout:g} s idle",
-                          role=previous.text)
+        self.audit.record(
+            "login", f"locked back to operator after {self.idle.timeout:g} s idle", role=previous.text
+        )
         self._changed()
 
     def _changed(self) -> None:
@@ -113,15 +121,19 @@ class SafetySession:
             self._on_role_changed(self.role)
 
     # --- administration ---------------------------------------------------------------------
-    def set_register_profile(self, path: str | os.PathLike[str], profile: RegisterProfile,
-                             current: RegisterProfile | None = None) -> RegisterProfile:
+    def set_register_profile(
+        self, path: str | os.PathLike[str], profile: RegisterProfile, current: RegisterProfile | None = None
+    ) -> RegisterProfile:
         """Save ``profile`` as the one in force (administrator only, audited with the fields that
         changed from ``current``); returns it as saved (its next revision)."""
         changes = current.changes(profile) if current is not None else profile.protocol_dict()
         self.require(Action.REGISTER_PROFILE, {"name": profile.name, "changes": changes})
         saved = save_register_profile(path, profile)
-        self.audit.record("action", "change register profile",
-                          args={"name": saved.name, "revision": saved.revision, "changes": changes})
+        self.audit.record(
+            "action",
+            "change register profile",
+            args={"name": saved.name, "revision": saved.revision, "changes": changes},
+        )
         return saved
 
     def set_password(self, role: Role, password: str) -> None:
@@ -172,23 +184,27 @@ class SafetySession:
             self.audit.record_refused(action, violation.message, args)
             raise EnvelopeRefused(violation, action)
 
-    def check_step(self, pose: Pose, offsets: list[float], *, joint: bool,
-                   speed: float | None = None) -> None:
+    def check_step(
+        self, pose: Pose, offsets: list[float], *, joint: bool, speed: float | None = None
+    ) -> None:
         """Before a step (function 1): refused (audited) when it would leave the envelope."""
         self.require(Action.STEP)
-        violation = check_step(self.envelope, pose, offsets, joint=joint, speed=None if joint else speed,
-                               reduced=self.reduced)
+        violation = check_step(
+            self.envelope, pose, offsets, joint=joint, speed=None if joint else speed, reduced=self.reduced
+        )
         self._refuse("step", violation, {"offsets": list(offsets), "joint": joint})
 
     def check_move(self, start: PointLike, segment: Segment, ledger: PointLedger) -> None:
         """Before a move to a point (function 3) from ``start``."""
         violation = check_segment(self.envelope, start, segment, ledger, reduced=self.reduced)
-        self._refuse("move to point", violation, {"end": segment.end_id, "via": segment.via_id,
-                                                  "speed": segment.speed})
+        self._refuse(
+            "move to point", violation, {"end": segment.end_id, "via": segment.via_id, "speed": segment.speed}
+        )
 
     def jog_guard(self, poll_period: float, latency: float = JOG_GUARD_LATENCY) -> JogGuard:
-        return JogGuard(self.envelope, poll_period=poll_period, latency=latency, speeds=self.speeds,
-                        reduced=self.reduced)
+        return JogGuard(
+            self.envelope, poll_period=poll_period, latency=latency, speeds=self.speeds, reduced=self.reduced
+        )
 
     def jog_ratio(self, ratio: float) -> float:
         """The ratio to send for a requested one (capped by the envelope and reduced mode)."""
@@ -199,6 +215,10 @@ class SafetySession:
         self.require(Action.JOG)
         decision = self.jog_guard(poll_period).decide(pose, motion)
         if not decision.allow:
-            args = {"frame": motion.frame.name.lower(), "axis": motion.axis, "direction": motion.direction,
-                    "ratio": motion.ratio}
+            args = {
+                "frame": motion.frame.name.lower(),
+                "axis": motion.axis,
+                "direction": motion.direction,
+                "ratio": motion.ratio,
+            }
             self._refuse("jog", decision.violation, args)

@@ -14,5 +14,14 @@ from app.sim.motion import TraceSample
 from app.sim.robot import PROGRAMS, SimRobot
 from app.sim.server import SimController
 
-__all__ = ["PROGRAMS", "SimConfig", "SimController", "SimEvent", "SimRobot", "SimSnapshot", "StoredPoint",
-           "TraceSample", "WriteRecord"]
+__all__ = [
+    "PROGRAMS",
+    "SimConfig",
+    "SimController",
+    "SimEvent",
+    "SimRobot",
+    "SimSnapshot",
+    "StoredPoint",
+    "TraceSample",
+    "WriteRecord",
+]

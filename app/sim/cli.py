@@ -21,8 +21,11 @@ from app.sim.server import SimController
 log = logging.getLogger(__name__)
 
 ALARM_NAMES: dict[str, Alarm] = {
-    "estop": Alarm.ESTOP, "servo": Alarm.SERVO, "brake": Alarm.BRAKE,
-    "algorithm": Alarm.ALGORITHM, "encoder": Alarm.ENCODER,
+    "estop": Alarm.ESTOP,
+    "servo": Alarm.SERVO,
+    "brake": Alarm.BRAKE,
+    "algorithm": Alarm.ALGORITHM,
+    "encoder": Alarm.ENCODER,
 }
 
 COMMANDS_HELP = """\
@@ -46,35 +49,66 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="teachpad-sim",
         description="Simulated Bochuang robot controller (Modbus TCP slave, or RTU on a serial line "
-                    "with --serial) for TeachPad.",
+        "with --serial) for TeachPad.",
         epilog=COMMANDS_HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     parser.add_argument("--port", type=int, default=5020, help="TCP port (default 5020, 0 = any free port)")
     parser.add_argument("--unit", type=int, default=1, help="Modbus unit id (default 1)")
-    parser.add_argument("--word-order", choices=[w.value for w in WordOrder],
-                        default=WordOrder.LOW_FIRST.value,
-                        help="word order of float32 values (default low-first)")
-    parser.add_argument("--status-encoding", choices=["float", "int"], default="float",
-                        help="GV291 as float32 (default) or integer in register 582")
-    parser.add_argument("--status-delay", type=float, default=0.0, metavar="S",
-                        help="GV291 keeps its old value S seconds after a command")
-    parser.add_argument("--timing", choices=list(TIMING_PROFILES), default="classic",
-                        help="GV291 timing: classic (0 held until read), fast (result within one scan), "
-                             "slow (tens of ms, seeded jitter); default classic")
-    parser.add_argument("--gv291", choices=list(GV291_MODES), default="ignored",
-                        help="a host's write to GV291: ignored (default), writable (kept until the next "
-                             "result) or read-only (exception 2)")
-    parser.add_argument("--refuse-point", type=int, action="append", default=[], metavar="ID",
-                        help="answer create point ID with status 1, bad point id (repeatable)")
+    parser.add_argument(
+        "--word-order",
+        choices=[w.value for w in WordOrder],
+        default=WordOrder.LOW_FIRST.value,
+        help="word order of float32 values (default low-first)",
+    )
+    parser.add_argument(
+        "--status-encoding",
+        choices=["float", "int"],
+        default="float",
+        help="GV291 as float32 (default) or integer in register 582",
+    )
+    parser.add_argument(
+        "--status-delay",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="GV291 keeps its old value S seconds after a command",
+    )
+    parser.add_argument(
+        "--timing",
+        choices=list(TIMING_PROFILES),
+        default="classic",
+        help="GV291 timing: classic (0 held until read), fast (result within one scan), "
+        "slow (tens of ms, seeded jitter); default classic",
+    )
+    parser.add_argument(
+        "--gv291",
+        choices=list(GV291_MODES),
+        default="ignored",
+        help="a host's write to GV291: ignored (default), writable (kept until the next "
+        "result) or read-only (exception 2)",
+    )
+    parser.add_argument(
+        "--refuse-point",
+        type=int,
+        action="append",
+        default=[],
+        metavar="ID",
+        help="answer create point ID with status 1, bad point id (repeatable)",
+    )
     parser.add_argument("--seed", type=int, default=0, help="seed of the slow profile's jitter (default 0)")
     parser.add_argument("--rtu-framing", action="store_true", help="RTU framing over TCP instead of MBAP")
     parser.add_argument("--tick-hz", type=float, default=100.0, help="simulation rate (default 100)")
-    parser.add_argument("--watchdog", type=_watchdog, default=WATCHDOG_TIMEOUT, metavar="SECONDS|off",
-                        help="stop a teach jog when its connection closes or no request arrives for "
-                             f"SECONDS (default {WATCHDOG_TIMEOUT:g}; off: keep jogging, like a controller "
-                             "without a watchdog)")
+    parser.add_argument(
+        "--watchdog",
+        type=_watchdog,
+        default=WATCHDOG_TIMEOUT,
+        metavar="SECONDS|off",
+        help="stop a teach jog when its connection closes or no request arrives for "
+        f"SECONDS (default {WATCHDOG_TIMEOUT:g}; off: keep jogging, like a controller "
+        "without a watchdog)",
+    )
     serial = parser.add_argument_group("RTU on a serial line (instead of TCP)")
     serial.add_argument("--serial", metavar="PORT", help="serial device to serve, e.g. /dev/ttyUSB0 or COM3")
     serial.add_argument("--baud", type=int, default=115200, help="baud rate (default 115200)")
@@ -127,13 +161,19 @@ def execute(sim: SimController, line: str, out: TextIO) -> bool:
             s = sim.state()
             print(f"pose {' '.join(f'{v:.3f}' for v in s.pose)}", file=out)
             print(f"joints {' '.join(f'{v:.3f}' for v in s.joints)}", file=out)
-            print(f"mode {s.mode.name} program {s.program_state.name} alarms {int(s.alarms)} "
-                  f"teach {'on' if s.teach_enabled else 'off'} ratio {s.teach_ratio:g} "
-                  f"GV291 {s.command_status} points {len(s.points)}", file=out)
+            print(
+                f"mode {s.mode.name} program {s.program_state.name} alarms {int(s.alarms)} "
+                f"teach {'on' if s.teach_enabled else 'off'} ratio {s.teach_ratio:g} "
+                f"GV291 {s.command_status} points {len(s.points)}",
+                file=out,
+            )
             bad = sim.bad_frame_counts()
-            print(f"bad frames {sum(bad.values())}"
-                  + "".join(f", {n} {reason}" for reason, n in sorted(bad.items()))
-                  + f"; watchdog stops {len(sim.watchdog_events())}", file=out)
+            print(
+                f"bad frames {sum(bad.values())}"
+                + "".join(f", {n} {reason}" for reason, n in sorted(bad.items()))
+                + f"; watchdog stops {len(sim.watchdog_events())}",
+                file=out,
+            )
         elif cmd == "help":
             print(COMMANDS_HELP, file=out)
         elif cmd in ("quit", "exit"):
@@ -148,17 +188,30 @@ def execute(sim: SimController, line: str, out: TextIO) -> bool:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    logging.basicConfig(level=logging.DEBUG if args.verbose else logging.INFO,
-                        format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    logging.basicConfig(
+        level=logging.DEBUG if args.verbose else logging.INFO,
+        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
+    )
     if not args.verbose:
         logging.getLogger("pymodbus").setLevel(logging.WARNING)
-    config = SimConfig(host=args.host, port=args.port, unit=args.unit,
-                       word_order=WordOrder.parse(args.word_order),
-                       status_encoding=args.status_encoding, status_delay=args.status_delay,
-                       framer="rtu" if args.rtu_framing else "socket", tick_hz=args.tick_hz,
-                       watchdog=args.watchdog, serial_port=args.serial, baudrate=args.baud,
-                       parity=args.parity, stopbits=args.stopbits,
-                       timing=args.timing, gv291=args.gv291, seed=args.seed)
+    config = SimConfig(
+        host=args.host,
+        port=args.port,
+        unit=args.unit,
+        word_order=WordOrder.parse(args.word_order),
+        status_encoding=args.status_encoding,
+        status_delay=args.status_delay,
+        framer="rtu" if args.rtu_framing else "socket",
+        tick_hz=args.tick_hz,
+        watchdog=args.watchdog,
+        serial_port=args.serial,
+        baudrate=args.baud,
+        parity=args.parity,
+        stopbits=args.stopbits,
+        timing=args.timing,
+        gv291=args.gv291,
+        seed=args.seed,
+    )
     sim = SimController(config)
     for point_id in args.refuse_point:
         sim.refuse_point(point_id)
@@ -170,6 +223,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     done = threading.Event()
     previous: dict[signal.Signals, object] = {}
     if threading.current_thread() is threading.main_thread():
+
         def on_signal(signum: int, _frame: object) -> None:
             log.info("signal %d: stopping", signum)
             done.set()
@@ -181,6 +235,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     print(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop", flush=True)
 
     if not args.no_stdin:
+
         def read_stdin() -> None:
             for line in sys.stdin:
                 if not execute(sim, line, sys.stdout):

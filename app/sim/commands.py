@@ -97,10 +97,13 @@ class ControllerCommands:
     def _move_refusal(self) -> int | None:
         if self.work_mode is WorkMode.MANUAL or self.teach_enabled or self.busy:
             return MoveStatus.WORK_MODE_ERROR
-        for bit, code in ((Alarm.ESTOP, MoveStatus.ESTOP), (Alarm.SERVO, MoveStatus.SERVO_ALARM),
-                          (Alarm.BRAKE, MoveStatus.BRAKE_ALARM),
-                          (Alarm.ENCODER, MoveStatus.ENCODER_READ_ERROR),
-                          (Alarm.ALGORITHM, MoveStatus.CALCULATION_ERROR)):
+        for bit, code in (
+            (Alarm.ESTOP, MoveStatus.ESTOP),
+            (Alarm.SERVO, MoveStatus.SERVO_ALARM),
+            (Alarm.BRAKE, MoveStatus.BRAKE_ALARM),
+            (Alarm.ENCODER, MoveStatus.ENCODER_READ_ERROR),
+            (Alarm.ALGORITHM, MoveStatus.CALCULATION_ERROR),
+        ):
             if self.alarms & bit:
                 return int(code)
         return None
@@ -108,9 +111,12 @@ class ControllerCommands:
     def _teach_refusal(self) -> int | None:
         if self.work_mode is WorkMode.MANUAL or self.busy:
             return TeachStatus.WORK_MODE_ERROR
-        for bit, code in ((Alarm.ESTOP, TeachStatus.ESTOP), (Alarm.SERVO, TeachStatus.SERVO_ALARM),
-                          (Alarm.BRAKE, TeachStatus.BRAKE_ALARM),
-                          (Alarm.ALGORITHM, TeachStatus.ALGORITHM_ALARM)):
+        for bit, code in (
+            (Alarm.ESTOP, TeachStatus.ESTOP),
+            (Alarm.SERVO, TeachStatus.SERVO_ALARM),
+            (Alarm.BRAKE, TeachStatus.BRAKE_ALARM),
+            (Alarm.ALGORITHM, TeachStatus.ALGORITHM_ALARM),
+        ):
             if self.alarms & bit:
                 return int(code)
         return None
@@ -147,8 +153,11 @@ class ControllerCommands:
         values = [float(v) for v in offsets[:6]] + [0.0] * (6 - len(offsets[:6]))
         ext = np.zeros(NUM_AXES_TOTAL - NUM_ROBOT_AXES)
         ext[: len(ext_offsets)] = [float(v) for v in ext_offsets[: len(ext)]]
-        if not (math.isfinite(speed) and speed > 0) or not all(map(math.isfinite, values)) \
-                or not np.all(np.isfinite(ext)):
+        if (
+            not (math.isfinite(speed) and speed > 0)
+            or not all(map(math.isfinite, values))
+            or not np.all(np.isfinite(ext))
+        ):
             return self._finish(MoveStatus.CALCULATION_ERROR)
         pose = self._pose
         target_pose = [pose[i] + values[i] for i in range(6)]
@@ -156,8 +165,9 @@ class ControllerCommands:
         p1 = np.array(target_pose[:3])
         r1 = abc_to_matrix(target_pose[3], target_pose[4], target_pose[5])
         ext0 = self.joints[NUM_ROBOT_AXES:].copy()
-        motion = CartesianMotion(Line(p0, p1), self._flange[:3, :3].copy(), r1,
-                                  min(speed, MAX_LINEAR_SPEED), ext0, ext0 + ext)
+        motion = CartesianMotion(
+            Line(p0, p1), self._flange[:3, :3].copy(), r1, min(speed, MAX_LINEAR_SPEED), ext0, ext0 + ext
+        )
         if not motion.check(self.joints):
             log.info("base step refused: path unreachable")
             return self._finish(MoveStatus.CALCULATION_ERROR)
@@ -192,8 +202,15 @@ class ControllerCommands:
         return idx
 
     # --- function 3: move to temp point ---------------------------------------------------
-    def move_to_point(self, via: float, end: float, orientation_changes: float, ignore_middle: float,
-                      speed: float, tool: float = 200.0) -> int:
+    def move_to_point(
+        self,
+        via: float,
+        end: float,
+        orientation_changes: float,
+        ignore_middle: float,
+        speed: float,
+        tool: float = 200.0,
+    ) -> int:
         """0x42: line (via = -1) or arc through point ``via`` to point ``end``.
 
         GV203 "ignore the middle point" (project decision, PROTOCOL.md leaves it open): the arc
@@ -297,8 +314,15 @@ class ControllerCommands:
             self.trace.clear()
 
     def _jog(self, dt: float) -> None:
-        moved = jog_step(self.joints, self._flange, self.teach_frame, self.jog_axis, self.jog_direction,
-                         self.teach_ratio, dt)
+        moved = jog_step(
+            self.joints,
+            self._flange,
+            self.teach_frame,
+            self.jog_axis,
+            self.jog_direction,
+            self.teach_ratio,
+            dt,
+        )
         if moved is None:
             if not self._jog_blocked:
                 log.info("jog stopped at the workspace / joint limit")

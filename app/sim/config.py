@@ -61,8 +61,10 @@ class SimConfig:
         if self.watchdog is not None and not self.watchdog >= 0:
             raise ValueError(f"watchdog must be None or >= 0 s, got {self.watchdog!r}")
         if self.parity not in ("N", "E", "O") or self.stopbits not in (1, 2) or self.baudrate <= 0:
-            raise ValueError(f"serial settings: parity N/E/O, stop bits 1/2, baud > 0; got "
-                             f"{self.parity!r}, {self.stopbits!r}, {self.baudrate!r}")
+            raise ValueError(
+                f"serial settings: parity N/E/O, stop bits 1/2, baud > 0; got "
+                f"{self.parity!r}, {self.stopbits!r}, {self.baudrate!r}"
+            )
         if self.timing not in TIMING_PROFILES:
             raise ValueError(f"timing must be one of {', '.join(TIMING_PROFILES)}, got {self.timing!r}")
         if self.gv291 not in GV291_MODES:

@@ -42,8 +42,16 @@ from app.sim.status import StatusPublisher
 
 log = logging.getLogger(__name__)
 
-_STATUS_COMMANDS = frozenset({RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT,
-                              RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE})
+_STATUS_COMMANDS = frozenset(
+    {
+        RunCommand.STEP_JOINT,
+        RunCommand.STEP_BASE,
+        RunCommand.MOVE_TO_POINT,
+        RunCommand.CREATE_POINT,
+        RunCommand.TEACH_ENABLE,
+        RunCommand.TEACH_DISABLE,
+    }
+)
 _GV291_REGS = range(gv_reg(GV_COMMAND_STATUS), gv_reg(GV_COMMAND_STATUS) + 2)
 
 
@@ -53,8 +61,15 @@ class CommandExecutor:
     ``status_delay`` gives the pickup time of GV291 now (fault injection may change it);
     ``move_accepted`` is called when a move command was accepted (it starts once answered)."""
 
-    def __init__(self, robot: SimRobot, config: SimConfig, image: RegisterImage, status: StatusPublisher,
-                 status_delay: Callable[[], float], move_accepted: Callable[[], None]) -> None:
+    def __init__(
+        self,
+        robot: SimRobot,
+        config: SimConfig,
+        image: RegisterImage,
+        status: StatusPublisher,
+        status_delay: Callable[[], float],
+        move_accepted: Callable[[], None],
+    ) -> None:
         self.robot = robot
         self.config = config
         self.image = image
@@ -63,8 +78,13 @@ class CommandExecutor:
         self._move_accepted = move_accepted
 
     def _hold(self, *, latency: bool, read_hold: bool) -> None:
-        self.status.hold(time.monotonic(), self.robot.command_status, pickup=self._status_delay(),
-                         latency=latency, read_hold=read_hold)
+        self.status.hold(
+            time.monotonic(),
+            self.robot.command_status,
+            pickup=self._status_delay(),
+            latency=latency,
+            read_hold=read_hold,
+        )
 
     def handle_write(self, regs: list[int], start: int, address: int, count: int) -> ExcCodes | None:
         """Act on the control registers a write covered (values already in ``regs``)."""
@@ -92,13 +112,17 @@ class CommandExecutor:
             log.info("resume%s", "" if robot.resume() else " (nothing paused)")
         if REG_GO_ZERO in covered:
             axis = value(REG_GO_ZERO)
-            log.info("go to zero %s: %s", "all" if axis == 11 else f"J{axis + 1}",
-                     "started" if robot.go_zero(axis) else "refused")
+            log.info(
+                "go to zero %s: %s",
+                "all" if axis == 11 else f"J{axis + 1}",
+                "started" if robot.go_zero(axis) else "refused",
+            )
         ratio_regs = range(gv_reg(GV_PARAM3), gv_reg(GV_PARAM3) + 2)
         if robot.teach_enabled and (ratio_regs.start in covered or ratio_regs.stop - 1 in covered):
             gv = self.image.gv
-            robot.set_teach_ratio(gv(regs, start, GV_PARAM3), gv(regs, start, GV_PARAM1),
-                                  gv(regs, start, GV_PARAM2))
+            robot.set_teach_ratio(
+                gv(regs, start, GV_PARAM3), gv(regs, start, GV_PARAM1), gv(regs, start, GV_PARAM2)
+            )
         if REG_RUN_COMMAND in covered:
             return self._run_command(regs, start, value(REG_RUN_COMMAND))
         return None
@@ -113,16 +137,23 @@ class CommandExecutor:
         if command in _STATUS_COMMANDS:
             # moves show 6 (moving) as their own evidence; only the instant commands wait
             # for a host to have seen the 0 (classic profile)
-            self._hold(latency=True, read_hold=command in (
-                RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE))
+            self._hold(
+                latency=True,
+                read_hold=command
+                in (RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE),
+            )
         p = self.image.gvs(regs, start, GV_PARAM0, 6)
         speed = self.image.gv(regs, start, GV_EXPECTED_SPEED)
         ext = self.image.gvs(regs, start, GV_EXT_OFFSET0, NUM_EXTERNAL_AXES)
         tool = self.image.gv(regs, start, GV_TOOL_FRAME)
         status: int | None = None
         if command is RunCommand.RUN_PROGRAM:
-            ok = robot.run_program(regs[REG_PROGRAM_ID - start], regs[REG_PROGRAM_MODE - start],
-                                   regs[REG_CYCLE_COUNT - start], regs[REG_PROGRAM_SPEED - start])
+            ok = robot.run_program(
+                regs[REG_PROGRAM_ID - start],
+                regs[REG_PROGRAM_MODE - start],
+                regs[REG_CYCLE_COUNT - start],
+                regs[REG_PROGRAM_SPEED - start],
+            )
             log.info("run program %d: %s", regs[REG_PROGRAM_ID - start], "started" if ok else "refused")
             return None
         if command is RunCommand.STEP_JOINT:

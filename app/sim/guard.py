@@ -52,8 +52,9 @@ MBAP_LENGTH_MIN = 2  # unit + function code
 MBAP_LENGTH_MAX = 512
 
 # The simulator's connection id of the request being served (set per connection task).
-CURRENT_CONNECTION: contextvars.ContextVar[int | None] = contextvars.ContextVar("sim_connection",
-                                                                               default=None)
+CURRENT_CONNECTION: contextvars.ContextVar[int | None] = contextvars.ContextVar(
+    "sim_connection", default=None
+)
 
 
 def hex_sample(data: bytes) -> str:
@@ -65,8 +66,9 @@ def hex_sample(data: bytes) -> str:
 class BadFrames:
     """Counters of rejected frames by reason, and a rate-limited log of them."""
 
-    def __init__(self, period: float = BAD_FRAME_LOG_PERIOD,
-                 clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self, period: float = BAD_FRAME_LOG_PERIOD, clock: Callable[[], float] = time.monotonic
+    ) -> None:
         self.period = period
         self._clock = clock
         self._lock = threading.Lock()
@@ -82,12 +84,16 @@ class BadFrames:
             if now < self._window_end:
                 self._held[reason] += 1
                 if self._held_sample is None:
-                    self._held_sample = (reason, frame[:SAMPLE_BYTES + 1])
+                    self._held_sample = (reason, frame[: SAMPLE_BYTES + 1])
                 return
             self._flush_locked()
             self._window_end = now + self.period
-        log.warning("bad frame rejected (%s): %s; more are counted and summarised every %g s",
-                    reason, hex_sample(frame), self.period)
+        log.warning(
+            "bad frame rejected (%s): %s; more are counted and summarised every %g s",
+            reason,
+            hex_sample(frame),
+            self.period,
+        )
 
     def flush(self) -> None:
         """Log the summary of a finished period (the ticker calls this)."""
@@ -100,8 +106,11 @@ class BadFrames:
             return
         total = sum(self._held.values())
         reasons = ", ".join(f"{n} {reason}" for reason, n in self._held.most_common())
-        sample = "" if self._held_sample is None else \
-            f"; sample ({self._held_sample[0]}): {hex_sample(self._held_sample[1])}"
+        sample = (
+            ""
+            if self._held_sample is None
+            else f"; sample ({self._held_sample[0]}): {hex_sample(self._held_sample[1])}"
+        )
         log.warning("%d more bad frame(s) rejected within %g s: %s%s", total, self.period, reasons, sample)
         self._held.clear()
         self._held_sample = None
@@ -209,8 +218,12 @@ class CommWatchdog:
     ticker (silence); it returns True when it stopped a jog.
     """
 
-    def __init__(self, timeout: float | None, stop_jog: Callable[[str], bool],
-                 clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(
+        self,
+        timeout: float | None,
+        stop_jog: Callable[[str], bool],
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
         self.timeout = timeout if timeout and timeout > 0 else None
         self._stop_jog = stop_jog
         self._clock = clock
@@ -249,5 +262,6 @@ class CommWatchdog:
             return
         silent = self._clock() - self._last_request
         if silent > self.timeout + self.allowance and self._stop_jog(
-                f"no request for {silent:.3f} s (watchdog {self.timeout:g} s)"):
+            f"no request for {silent:.3f} s (watchdog {self.timeout:g} s)"
+        ):
             self._owner = None

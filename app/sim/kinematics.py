@@ -85,8 +85,13 @@ _ROT_WEIGHT_MM: Final = 500.0  # mm per radian when mixing position and orientat
 
 # Per joint: (offset rad, d, a, cos alpha, sin alpha), computed once (the IK calls this a lot).
 _DH_CONST: Final[tuple[tuple[float, float, float, float, float], ...]] = tuple(
-    (math.radians(r.offset_deg), r.d, r.a, math.cos(math.radians(r.alpha_deg)),
-     math.sin(math.radians(r.alpha_deg)))
+    (
+        math.radians(r.offset_deg),
+        r.d,
+        r.a,
+        math.cos(math.radians(r.alpha_deg)),
+        math.sin(math.radians(r.alpha_deg)),
+    )
     for r in DH_TABLE
 )
 

@@ -114,7 +114,8 @@ class Arc(Geometry):
             raise ValueError("arc points coincide")
         # circumcentre
         centre = p1 + (np.dot(b, b) * np.cross(normal, a) + np.dot(a, a) * np.cross(b, normal)) / (
-            2.0 * nn * nn)
+            2.0 * nn * nn
+        )
         self.centre = centre
         self.radius = float(np.linalg.norm(p1 - centre))
         n = normal / nn
@@ -131,8 +132,9 @@ class Arc(Geometry):
 
     def point(self, s: float) -> Vector:
         th = s * self.angle
-        return np.asarray(self.centre + self.radius * (math.cos(th) * self.u + math.sin(th) * self.v),
-                          dtype=np.float64)
+        return np.asarray(
+            self.centre + self.radius * (math.cos(th) * self.u + math.sin(th) * self.v), dtype=np.float64
+        )
 
 
 class CartesianMotion(Motion):
@@ -142,8 +144,16 @@ class CartesianMotion(Motion):
     r0 -> middle -> r1, reaching the middle point's orientation at the middle point.
     """
 
-    def __init__(self, geometry: Geometry, r0: Matrix, r1: Matrix, speed: float,
-                 ext0: Vector, ext1: Vector, via: tuple[Matrix, float] | None = None) -> None:
+    def __init__(
+        self,
+        geometry: Geometry,
+        r0: Matrix,
+        r1: Matrix,
+        speed: float,
+        ext0: Vector,
+        ext1: Vector,
+        via: tuple[Matrix, float] | None = None,
+    ) -> None:
         self.geometry = geometry
         self.r0, self.r1 = r0, r1
         self.via = via if via is not None and 0.0 < via[1] < 1.0 else None
@@ -195,8 +205,9 @@ class CartesianMotion(Motion):
         return s >= 1.0
 
 
-def jog_step(joints: Vector, flange: Matrix, frame: TeachFrame, axis: int, direction: int,
-             ratio: float, dt: float) -> Vector | None:
+def jog_step(
+    joints: Vector, flange: Matrix, frame: TeachFrame, axis: int, direction: int, ratio: float, dt: float
+) -> Vector | None:
     """The joints after ``dt`` seconds of jogging ``axis`` in ``frame`` at ``ratio`` (0..100).
 
     A joint jog stops at the joint limit (the joints come back unchanged); a Cartesian jog

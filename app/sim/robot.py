@@ -104,9 +104,14 @@ def _line_segment(dx: float, dy: float, dz: float) -> Segment:
     def build(robot: SimRobot, ratio: float) -> Motion | None:
         t = robot.flange()
         p0 = t[:3, 3].copy()
-        motion = CartesianMotion(Line(p0, p0 + np.array([dx, dy, dz])), t[:3, :3], t[:3, :3],
-                                  PROGRAM_LINEAR_SPEED * ratio, robot.joints[NUM_ROBOT_AXES:].copy(),
-                                  robot.joints[NUM_ROBOT_AXES:].copy())
+        motion = CartesianMotion(
+            Line(p0, p0 + np.array([dx, dy, dz])),
+            t[:3, :3],
+            t[:3, :3],
+            PROGRAM_LINEAR_SPEED * ratio,
+            robot.joints[NUM_ROBOT_AXES:].copy(),
+            robot.joints[NUM_ROBOT_AXES:].copy(),
+        )
         return motion if motion.check(robot.joints) else None
 
     return build
@@ -115,10 +120,24 @@ def _line_segment(dx: float, dy: float, dz: float) -> Segment:
 #: id -> (name, segments). 1: a 100 mm square in XY; 2: a joint wiggle of J1 and J4;
 #: 3: an external-axis shuttle on J7.
 PROGRAMS: Final[dict[int, tuple[str, tuple[Segment, ...]]]] = {
-    1: ("square 100 mm in XY", (_line_segment(100, 0, 0), _line_segment(0, 100, 0),
-                                _line_segment(-100, 0, 0), _line_segment(0, -100, 0))),
-    2: ("joint wiggle J1/J4", (_joint_segment({0: 15.0}), _joint_segment({0: -15.0}),
-                               _joint_segment({3: 20.0}), _joint_segment({3: -20.0}))),
+    1: (
+        "square 100 mm in XY",
+        (
+            _line_segment(100, 0, 0),
+            _line_segment(0, 100, 0),
+            _line_segment(-100, 0, 0),
+            _line_segment(0, -100, 0),
+        ),
+    ),
+    2: (
+        "joint wiggle J1/J4",
+        (
+            _joint_segment({0: 15.0}),
+            _joint_segment({0: -15.0}),
+            _joint_segment({3: 20.0}),
+            _joint_segment({3: -20.0}),
+        ),
+    ),
     3: ("external axis J7 shuttle", (_joint_segment({6: 100.0}), _joint_segment({6: -100.0}))),
 }
 
@@ -137,8 +156,13 @@ class _ProgramRun:
 class SimRobot(ControllerCommands):
     """The controller's state and the arm's motion. Not thread-safe: callers lock."""
 
-    def __init__(self, *, point_id_min: int = TEMP_POINT_ID_MIN, point_id_max: int = TEMP_POINT_ID_MAX,
-                 work_mode: WorkMode = WorkMode.AUTO) -> None:
+    def __init__(
+        self,
+        *,
+        point_id_min: int = TEMP_POINT_ID_MIN,
+        point_id_max: int = TEMP_POINT_ID_MAX,
+        work_mode: WorkMode = WorkMode.AUTO,
+    ) -> None:
         self.point_id_min = point_id_min
         self.point_id_max = point_id_max
         self.joints: Vector = np.zeros(NUM_AXES_TOTAL)
@@ -322,8 +346,11 @@ class SimRobot(ControllerCommands):
         else:
             self.alarms &= ~bit
         if on and bit & (Alarm.ESTOP | Alarm.SERVO | Alarm.BRAKE):
-            code = MoveStatus.ESTOP if bit & Alarm.ESTOP else (
-                MoveStatus.SERVO_ALARM if bit & Alarm.SERVO else MoveStatus.BRAKE_ALARM)
+            code = (
+                MoveStatus.ESTOP
+                if bit & Alarm.ESTOP
+                else (MoveStatus.SERVO_ALARM if bit & Alarm.SERVO else MoveStatus.BRAKE_ALARM)
+            )
             self._abort(code)
             self._teach_off()
 
@@ -375,4 +402,3 @@ class SimRobot(ControllerCommands):
 
     def trajectory(self) -> list[TraceSample]:
         return list(self.trace)
-

@@ -61,8 +61,11 @@ class SimController:
     def __init__(self, config: SimConfig | None = None) -> None:
         self.config = config or SimConfig()
         self.lock = threading.RLock()
-        self.robot = SimRobot(point_id_min=self.config.point_id_min, point_id_max=self.config.point_id_max,
-                              work_mode=self.config.work_mode)
+        self.robot = SimRobot(
+            point_id_min=self.config.point_id_min,
+            point_id_max=self.config.point_id_max,
+            work_mode=self.config.work_mode,
+        )
         self.writes: list[WriteRecord] = []
         self._requests = 0
         self._port: int | None = None
@@ -80,8 +83,9 @@ class SimController:
         # GV291 publication hold (app/sim/status.py), the register image, the command execution
         self.status = StatusPublisher(self.config.timing, self.config.command_latency, self.config.seed)
         self.image = RegisterImage(self.config)
-        self.executor = CommandExecutor(self.robot, self.config, self.image, self.status,
-                                        lambda: self._status_delay, self._move_accepted)
+        self.executor = CommandExecutor(
+            self.robot, self.config, self.image, self.status, lambda: self._status_delay, self._move_accepted
+        )
         self._move_unanswered: float | None = None  # when a move command not answered yet came
         self._wipe_general = False  # set by restart_controller(): clear GV0..GV99 on the next request
         # bad input and the communication watchdog (app/sim/guard.py)
@@ -129,33 +133,48 @@ class SimController:
         self._port = self._runner.port
         self._tick_thread = threading.Thread(target=self._tick_loop, name="sim-ticker", daemon=True)
         self._tick_thread.start()
-        log.info("simulator listening on %s (unit %s, %s framing, %s word order, status %s, watchdog %s, "
-                 "timing %s, GV291 %s)",
-                 self.endpoint, self.config.unit, "rtu" if self.config.serial_port else self.config.framer,
-                 self.config.word_order.value, self.config.status_encoding,
-                 f"{self.watchdog.timeout:g} s" if self.watchdog.enabled else "off",
-                 self.config.timing, self.config.gv291)
+        log.info(
+            "simulator listening on %s (unit %s, %s framing, %s word order, status %s, watchdog %s, "
+            "timing %s, GV291 %s)",
+            self.endpoint,
+            self.config.unit,
+            "rtu" if self.config.serial_port else self.config.framer,
+            self.config.word_order.value,
+            self.config.status_encoding,
+            f"{self.watchdog.timeout:g} s" if self.watchdog.enabled else "off",
+            self.config.timing,
+            self.config.gv291,
+        )
 
     async def _serve(self) -> GuardedTcpServer | GuardedSerialServer:
         initial = [0] * REGISTER_SPACE
         self.image.init(initial)
         with self.lock:
             self._refresh(initial, 0)
-        device = SimDevice(self.config.unit,
-                           simdata=[SimData(address=0, values=initial, datatype=DataType.REGISTERS)],
-                           action=self._action)
+        device = SimDevice(
+            self.config.unit,
+            simdata=[SimData(address=0, values=initial, datatype=DataType.REGISTERS)],
+            action=self._action,
+        )
         c = self.config
         guard = ServerGuard(c.unit, self.bad_frames, self.watchdog)
         server: GuardedTcpServer | GuardedSerialServer
         if c.serial_port is not None:
-            server = GuardedSerialServer(device, guard, port=c.serial_port, baudrate=c.baudrate,
-                                         parity=c.parity, stopbits=c.stopbits,
-                                         trace_packet=self._trace_packet)
+            server = GuardedSerialServer(
+                device,
+                guard,
+                port=c.serial_port,
+                baudrate=c.baudrate,
+                parity=c.parity,
+                stopbits=c.stopbits,
+                trace_packet=self._trace_packet,
+            )
             await server.serve_forever(background=True)
         else:
             framer = FramerType.RTU if c.framer == "rtu" else FramerType.SOCKET
-            server = GuardedTcpServer(device, guard, framer=framer, address=(c.host, c.port),
-                                      trace_packet=self._trace_packet)
+            server = GuardedTcpServer(
+                device, guard, framer=framer, address=(c.host, c.port), trace_packet=self._trace_packet
+            )
             await server.serve_forever(background=True)
         return server
 
@@ -214,8 +233,15 @@ class SimController:
             return b""  # silent: the request was received, the answer is swallowed
         return data
 
-    async def _action(self, function_code: int, start_address: int, address: int, count: int,
-                      registers: list[int], set_values: list[int] | list[bool] | None) -> ExcCodes | None:
+    async def _action(
+        self,
+        function_code: int,
+        start_address: int,
+        address: int,
+        count: int,
+        registers: list[int],
+        set_values: list[int] | list[bool] | None,
+    ) -> ExcCodes | None:
         if set_values is None and function_code == _FC_WRITE_SINGLE:
             return None  # pymodbus reads a 0x06 write back: already handled
         connection = CURRENT_CONNECTION.get()
@@ -239,8 +265,12 @@ class SimController:
             if set_values is not None:
                 values = [int(v) & 0xFFFF for v in set_values]
                 self.writes.append(WriteRecord(time.monotonic(), function_code, address, tuple(values)))
-                log.info("write fc=0x%02X address=%d values=%s", function_code, address,
-                         " ".join(f"{v:04X}" for v in values))
+                log.info(
+                    "write fc=0x%02X address=%d values=%s",
+                    function_code,
+                    address,
+                    " ".join(f"{v:04X}" for v in values),
+                )
                 before = registers[offset : offset + len(values)]
                 registers[offset : offset + len(values)] = values
                 result = self.executor.handle_write(registers, start_address, address, len(values))
@@ -306,18 +336,33 @@ class SimController:
     def writes_to(self, address: int) -> list[WriteRecord]:
         """Writes that covered ``address``, narrowed to that one register: ``values == (v,)``."""
         with self.lock:
-            return [WriteRecord(w.t, w.function_code, address, (w.values[address - w.address],))
-                    for w in self.writes if w.address <= address < w.address + len(w.values)]
+            return [
+                WriteRecord(w.t, w.function_code, address, (w.values[address - w.address],))
+                for w in self.writes
+                if w.address <= address < w.address + len(w.values)
+            ]
 
     def state(self) -> SimSnapshot:
         with self.lock:
             r = self.robot
             return SimSnapshot(
-                t=r.time, pose=r.pose, joints=tuple(float(v) for v in r.joints), work_mode=r.work_mode,
-                mode=r.controller_mode, program_state=r.program_state, alarms=r.alarms,
-                teach_enabled=r.teach_enabled, teach_frame=int(r.teach_frame), teach_ratio=r.teach_ratio,
-                jogging=r.jogging, command_status=self.published_status(), last_kind=r.last_kind,
-                points={k: v.pose for k, v in r.points.items()}, moving=r.busy, paused=r.paused)
+                t=r.time,
+                pose=r.pose,
+                joints=tuple(float(v) for v in r.joints),
+                work_mode=r.work_mode,
+                mode=r.controller_mode,
+                program_state=r.program_state,
+                alarms=r.alarms,
+                teach_enabled=r.teach_enabled,
+                teach_frame=int(r.teach_frame),
+                teach_ratio=r.teach_ratio,
+                jogging=r.jogging,
+                command_status=self.published_status(),
+                last_kind=r.last_kind,
+                points={k: v.pose for k, v in r.points.items()},
+                moving=r.busy,
+                paused=r.paused,
+            )
 
     def trajectory(self) -> list[TraceSample]:
         """Samples (robot time, pose, joints) recorded each tick since the last motion started."""
@@ -384,8 +429,11 @@ class SimController:
         """Answer requests touching ``addresses`` (None: all) with Modbus exception ``code``."""
         self._exception_range = addresses
         self._exception = None if code is None else ExcCodes(code)
-        log.info("exception %s%s", "off" if code is None else int(code),
-                 "" if addresses is None else f" on {addresses.start}..{addresses.stop - 1}")
+        log.info(
+            "exception %s%s",
+            "off" if code is None else int(code),
+            "" if addresses is None else f" on {addresses.start}..{addresses.stop - 1}",
+        )
 
     def drop_connections(self) -> int:
         """Close the sockets of the connected clients (the server keeps listening)."""

@@ -137,8 +137,15 @@ class GuardedHandler(ServerRequestHandler):  # type: ignore[misc]  # pymodbus is
 
 
 class GuardedTcpServer(ModbusTcpServer):  # type: ignore[misc]
-    def __init__(self, device: SimDevice, guard: ServerGuard, *, framer: FramerType,
-                 address: tuple[str, int], trace_packet: Callable[[bool, bytes], bytes]) -> None:
+    def __init__(
+        self,
+        device: SimDevice,
+        guard: ServerGuard,
+        *,
+        framer: FramerType,
+        address: tuple[str, int],
+        trace_packet: Callable[[bool, bytes], bytes],
+    ) -> None:
         super().__init__(device, framer=framer, address=address, trace_packet=trace_packet)
         _screen(self, guard, framer)
 
@@ -147,11 +154,28 @@ class GuardedTcpServer(ModbusTcpServer):  # type: ignore[misc]
 
 
 class GuardedSerialServer(ModbusSerialServer):  # type: ignore[misc]
-    def __init__(self, device: SimDevice, guard: ServerGuard, *, port: str, baudrate: int, parity: str,
-                 stopbits: int, trace_packet: Callable[[bool, bytes], bytes]) -> None:
-        super().__init__(device, framer=FramerType.RTU, port=port, baudrate=baudrate, parity=parity,
-                         stopbits=stopbits, bytesize=8, reconnect_delay=SERIAL_REOPEN_DELAY,
-                         trace_packet=trace_packet)
+    def __init__(
+        self,
+        device: SimDevice,
+        guard: ServerGuard,
+        *,
+        port: str,
+        baudrate: int,
+        parity: str,
+        stopbits: int,
+        trace_packet: Callable[[bool, bytes], bytes],
+    ) -> None:
+        super().__init__(
+            device,
+            framer=FramerType.RTU,
+            port=port,
+            baudrate=baudrate,
+            parity=parity,
+            stopbits=stopbits,
+            bytesize=8,
+            reconnect_delay=SERIAL_REOPEN_DELAY,
+            trace_packet=trace_packet,
+        )
         guard.rtu_gap = max(guard.rtu_gap, 3.5 * 11 / baudrate)
         guard.watchdog.allowance = RTU_ANSWER_MAX * 11 / baudrate  # 9600 baud: 0.29 s
         _screen(self, guard, FramerType.RTU)
@@ -206,8 +230,9 @@ class ServerRunner:
         self._server: GuardedTcpServer | GuardedSerialServer | None = None
         self._thread: threading.Thread | None = None
 
-    def start(self, serve: Callable[[], Awaitable[GuardedTcpServer | GuardedSerialServer]],
-              endpoint: str) -> None:
+    def start(
+        self, serve: Callable[[], Awaitable[GuardedTcpServer | GuardedSerialServer]], endpoint: str
+    ) -> None:
         """Run ``serve()`` (which listens and returns the server) on a new loop; OSError if it fails."""
         ready = threading.Event()
         errors: list[BaseException] = []

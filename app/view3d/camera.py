@@ -143,8 +143,12 @@ class Camera:
         return replace(self, target=(float(centre[0]), float(centre[1]), float(centre[2])), distance=distance)
 
 
-def pick(screen: FloatArray, pos: tuple[float, float], radius: float = PICK_RADIUS_PX,
-         depth: FloatArray | None = None) -> int | None:
+def pick(
+    screen: FloatArray,
+    pos: tuple[float, float],
+    radius: float = PICK_RADIUS_PX,
+    depth: FloatArray | None = None,
+) -> int | None:
     """Index of the marker nearest ``pos`` within ``radius`` pixels (the nearer to the eye on
     a tie within a pixel), or None."""
     if not len(screen):

@@ -48,8 +48,14 @@ class IKResult:
 def _dh(theta: float, d: float, a: float, alpha: float) -> Matrix:
     ct, st = math.cos(theta), math.sin(theta)
     ca, sa = math.cos(alpha), math.sin(alpha)
-    return np.array([[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st],
-                     [0.0, sa, ca, d], [0.0, 0.0, 0.0, 1.0]])
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, a * ct],
+            [st, ct * ca, -ct * sa, a * st],
+            [0.0, sa, ca, d],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
 
 
 class ArmModel:
@@ -57,8 +63,9 @@ class ArmModel:
 
     def __init__(self, profile: RobotProfile) -> None:
         self.profile = profile
-        self._rows = [(math.radians(j.offset_deg), j.d, j.a, math.radians(j.alpha_deg))
-                      for j in profile.joints]
+        self._rows = [
+            (math.radians(j.offset_deg), j.d, j.a, math.radians(j.alpha_deg)) for j in profile.joints
+        ]
         self._base = profile.base_transform
         self._flange = profile.flange_transform
         self._limits = profile.limits
@@ -130,8 +137,14 @@ class ArmModel:
             jac[3:, i] = z
         return jac
 
-    def inverse(self, target: Matrix, seed_deg: Sequence[float] | FloatArray | None = None, *,
-                max_iter: int = IK_MAX_ITER, position_only: bool = False) -> IKResult:
+    def inverse(
+        self,
+        target: Matrix,
+        seed_deg: Sequence[float] | FloatArray | None = None,
+        *,
+        max_iter: int = IK_MAX_ITER,
+        position_only: bool = False,
+    ) -> IKResult:
         """Joints reaching the 4x4 ``target`` from ``seed_deg`` (the home joints if None)."""
         p_target = target[:3, 3]
         if float(np.linalg.norm(p_target - self._base[:3, 3])) > self.profile.reach + IK_POS_TOL_MM:
@@ -162,12 +175,12 @@ class ArmModel:
             q = q + dq
         return IKResult(None, Reach.UNREACHABLE)
 
-    def inverse_pose(self, pose: Sequence[float], seed_deg: Sequence[float] | FloatArray | None = None,
-                     **kwargs: object) -> IKResult:
+    def inverse_pose(
+        self, pose: Sequence[float], seed_deg: Sequence[float] | FloatArray | None = None, **kwargs: object
+    ) -> IKResult:
         """IK of an X Y Z A B C pose."""
         x, y, z, a, b, c = (float(v) for v in pose[:6])
         return self.inverse(pose_to_transform(x, y, z, a, b, c), seed_deg, **kwargs)  # type: ignore[arg-type]
-
 
     # --- batched (one numpy pass for many targets: reachability of thousands of points) -----
     def _frames_batch(self, q_deg: FloatArray) -> list[FloatArray]:
@@ -195,8 +208,9 @@ class ArmModel:
         seeds[:, 0] = np.degrees(np.arctan2(local[:, 1], local[:, 0]))
         return seeds
 
-    def inverse_batch(self, targets: FloatArray, seeds: FloatArray | None = None, *,
-                      max_iter: int = IK_MAX_ITER) -> tuple[FloatArray, list[Reach]]:
+    def inverse_batch(
+        self, targets: FloatArray, seeds: FloatArray | None = None, *, max_iter: int = IK_MAX_ITER
+    ) -> tuple[FloatArray, list[Reach]]:
         """IK of (n, 4, 4) targets at once: joints (n, dof), NaN rows where unreachable."""
         n = targets.shape[0]
         first = self.pointing_seeds(targets) if seeds is None else np.asarray(seeds, dtype=np.float64)
@@ -213,8 +227,9 @@ class ArmModel:
             te = frames[-1]
             dp = p_t[idx] - te[:, :3, 3]
             dw = _rotation_error_batch(te[:, :3, :3], r_t[idx])
-            conv = ((np.linalg.norm(dp, axis=1) < IK_POS_TOL_MM)
-                    & (np.linalg.norm(dw, axis=1) < IK_ROT_TOL_RAD))
+            conv = (np.linalg.norm(dp, axis=1) < IK_POS_TOL_MM) & (
+                np.linalg.norm(dw, axis=1) < IK_ROT_TOL_RAD
+            )
             done[idx[conv]] = True
             keep = ~conv
             if not keep.any():
@@ -248,8 +263,9 @@ def _rotation_error_batch(r_current: FloatArray, r_target: FloatArray) -> FloatA
     rel = r_target @ r_current.transpose(0, 2, 1)
     cos = np.clip((np.trace(rel, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
     angle = np.arccos(cos)
-    vee = np.stack([rel[:, 2, 1] - rel[:, 1, 2], rel[:, 0, 2] - rel[:, 2, 0], rel[:, 1, 0] - rel[:, 0, 1]],
-                   axis=1)
+    vee = np.stack(
+        [rel[:, 2, 1] - rel[:, 1, 2], rel[:, 0, 2] - rel[:, 2, 0], rel[:, 1, 0] - rel[:, 0, 1]], axis=1
+    )
     sin = np.sin(angle)
     factor = np.where(angle < 1e-9, 0.5, angle / (2.0 * np.where(sin > 1e-12, sin, 1.0)))
     out = vee * factor[:, None]

@@ -45,8 +45,9 @@ def start_of(plan: Plan, ledger: PointLedger, pose: Pose | None) -> tuple[FloatA
     return None, None
 
 
-def segment_rotations(plan: Plan, ledger: PointLedger,
-                      start_rot: Matrix | None) -> list[tuple[Matrix, Matrix]]:
+def segment_rotations(
+    plan: Plan, ledger: PointLedger, start_rot: Matrix | None
+) -> list[tuple[Matrix, Matrix]]:
     """(start, end) tool rotation of each segment; unknown ends keep the previous rotation."""
     out: list[tuple[Matrix, Matrix]] = []
     current = start_rot
@@ -86,8 +87,14 @@ class DryRunState:
 class DryRun:
     """The plan's first loop as a timeline: :meth:`at` gives where the tool is at a time."""
 
-    def __init__(self, plan: Plan, ledger: PointLedger, pose: Pose | None,
-                 samples: int = DRY_RUN_SAMPLES, overhead: float = SEGMENT_OVERHEAD_S) -> None:
+    def __init__(
+        self,
+        plan: Plan,
+        ledger: PointLedger,
+        pose: Pose | None,
+        samples: int = DRY_RUN_SAMPLES,
+        overhead: float = SEGMENT_OVERHEAD_S,
+    ) -> None:
         start, start_rot = start_of(plan, ledger, pose)
         path = plan_path(plan, ledger, start, samples)
         est = estimate_plan(plan, ledger, start, loops=1, overhead=overhead)

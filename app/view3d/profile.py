@@ -114,11 +114,14 @@ def _joint(index: int, raw: object) -> JointSpec:
     name = raw.get("name", f"J{index + 1}")
     if not isinstance(name, str):
         raise ProfileError(f"{where}: name {_quote(name)} is not text")
-    values = {k: _number(f"{where} {k}", raw.get(k, 0.0)) for k in
-              ("offset_deg", "d", "a", "alpha_deg", "min_deg", "max_deg")}
+    values = {
+        k: _number(f"{where} {k}", raw.get(k, 0.0))
+        for k in ("offset_deg", "d", "a", "alpha_deg", "min_deg", "max_deg")
+    }
     if values["min_deg"] >= values["max_deg"]:
-        raise ProfileError(f"{where}: min_deg {values['min_deg']:g} is not below "
-                           f"max_deg {values['max_deg']:g}")
+        raise ProfileError(
+            f"{where}: min_deg {values['min_deg']:g} is not below max_deg {values['max_deg']:g}"
+        )
     return JointSpec(name=name[:20], **values)
 
 
@@ -127,12 +130,15 @@ def profile_from_dict(data: object) -> RobotProfile:
     if not isinstance(data, dict):
         raise ProfileError("a robot profile is a JSON object")
     if data.get("format") != PROFILE_FORMAT:
-        raise ProfileError(f"not a robot profile: format is {_quote(data.get('format'))}, "
-                           f"expected '{PROFILE_FORMAT}'")
+        raise ProfileError(
+            f"not a robot profile: format is {_quote(data.get('format'))}, expected '{PROFILE_FORMAT}'"
+        )
     version = data.get("version")
     if version != PROFILE_VERSION:
-        raise ProfileError(f"profile version {_quote(version)} is not supported (this TeachPad reads "
-                           f"version {PROFILE_VERSION})")
+        raise ProfileError(
+            f"profile version {_quote(version)} is not supported (this TeachPad reads "
+            f"version {PROFILE_VERSION})"
+        )
     joints_raw = data.get("joints")
     if not isinstance(joints_raw, list) or not 1 <= len(joints_raw) <= MAX_JOINTS:
         raise ProfileError(f"joints: expected a list of 1 to {MAX_JOINTS} joints")
@@ -178,10 +184,24 @@ def parse_profile(text: str, label: str = "profile") -> RobotProfile:
 
 def profile_to_dict(profile: RobotProfile) -> dict[str, Any]:
     return {
-        "format": PROFILE_FORMAT, "version": PROFILE_VERSION, "name": profile.name,
-        "joints": [{"name": j.name, "offset_deg": j.offset_deg, "d": j.d, "a": j.a, "alpha_deg": j.alpha_deg,
-                    "min_deg": j.min_deg, "max_deg": j.max_deg} for j in profile.joints],
-        "home_deg": list(profile.home_deg), "base": list(profile.base), "flange": list(profile.flange),
+        "format": PROFILE_FORMAT,
+        "version": PROFILE_VERSION,
+        "name": profile.name,
+        "joints": [
+            {
+                "name": j.name,
+                "offset_deg": j.offset_deg,
+                "d": j.d,
+                "a": j.a,
+                "alpha_deg": j.alpha_deg,
+                "min_deg": j.min_deg,
+                "max_deg": j.max_deg,
+            }
+            for j in profile.joints
+        ],
+        "home_deg": list(profile.home_deg),
+        "base": list(profile.base),
+        "flange": list(profile.flange),
     }
 
 

@@ -124,19 +124,26 @@ class ReachChecker:
     def plan_issues(self, plan: Plan, ledger: PointLedger, current_pose: PointLike | None) -> list[PlanIssue]:
         """Reach issues of a plan (for ``check_plan(..., reach=checker.plan_issues)``)."""
         pose = current_pose if isinstance(current_pose, Pose) else None
-        used = [p for pid in dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids)
-                if (p := ledger.get(pid)) is not None]
+        used = [
+            p
+            for pid in dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids)
+            if (p := ledger.get(pid)) is not None
+        ]
         # the same plan, points and start as last time (a recheck after an unrelated change)
-        key = (tuple(plan.segments), tuple((p.id, p.label, p.xyzabc) for p in used),
-               None if pose is None else tuple(round(float(v), 3) for v in pose.xyzabc))
+        key = (
+            tuple(plan.segments),
+            tuple((p.id, p.label, p.xyzabc) for p in used),
+            None if pose is None else tuple(round(float(v), 3) for v in pose.xyzabc),
+        )
         if self._last is not None and self._last[0] == key:
             return list(self._last[1])
         issues = self._plan_issues(plan, ledger, pose, used)
         self._last = (key, tuple(issues))
         return issues
 
-    def _plan_issues(self, plan: Plan, ledger: PointLedger, pose: Pose | None,
-                     used: list[TempPoint]) -> list[PlanIssue]:
+    def _plan_issues(
+        self, plan: Plan, ledger: PointLedger, pose: Pose | None, used: list[TempPoint]
+    ) -> list[PlanIssue]:
         issues: list[PlanIssue] = []
         point_reach = self.points(used)  # one batch
         reported: set[int] = set()
@@ -158,9 +165,19 @@ class ReachChecker:
 def _issue(index: int, reach: Reach, what: str, point_id: int | None) -> PlanIssue:
     name = f"segment {index + 1}"
     if reach is Reach.JOINT_LIMIT:
-        return PlanIssue(index, IssueKind.ERROR, IssueCode.JOINT_LIMIT,
-                         f"{name}: {what} passes a joint limit of the robot model", point_id,
-                         args={"point": what} if point_id is not None else {})
-    return PlanIssue(index, IssueKind.ERROR, IssueCode.UNREACHABLE,
-                     f"{name}: {what} is out of the robot model's reach", point_id,
-                     args={"point": what} if point_id is not None else {})
+        return PlanIssue(
+            index,
+            IssueKind.ERROR,
+            IssueCode.JOINT_LIMIT,
+            f"{name}: {what} passes a joint limit of the robot model",
+            point_id,
+            args={"point": what} if point_id is not None else {},
+        )
+    return PlanIssue(
+        index,
+        IssueKind.ERROR,
+        IssueCode.UNREACHABLE,
+        f"{name}: {what} is out of the robot model's reach",
+        point_id,
+        args={"point": what} if point_id is not None else {},
+    )

@@ -9,22 +9,22 @@
             <translation>报警位 {bit}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="164" />
+            <location filename="../../ui/panels/alarm_banner.py" line="166" />
             <source>ALARM: {names}</source>
             <translation>报警：{names}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="166" />
+            <location filename="../../ui/panels/alarm_banner.py" line="168" />
             <source>(last known: the link is not live)</source>
             <translation>（最后已知：通信未实时）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="169" />
+            <location filename="../../ui/panels/alarm_banner.py" line="171" />
             <source>Motion controls are held until the alarm is reset. STOP stays available.</source>
             <translation>报警复位前运动控制已锁定。停止按钮始终可用。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="175" />
+            <location filename="../../ui/panels/alarm_banner.py" line="177" />
             <source>Register 562 = {word}</source>
             <translation>寄存器 562 = {word}</translation>
         </message>
@@ -32,38 +32,38 @@
     <context>
         <name>AlarmListPanel</name>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="88" />
+            <location filename="../../ui/panels/alarm_list.py" line="90" />
             <source>Alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="88" />
+            <location filename="../../ui/panels/alarm_list.py" line="91" />
             <source>Meaning</source>
             <translation>含义</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="88" />
+            <location filename="../../ui/panels/alarm_list.py" line="92" />
             <source>What to do</source>
             <translation>处理方法</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="89" />
+            <location filename="../../ui/panels/alarm_list.py" line="93" />
             <source>Raised</source>
             <translation>触发时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="89" />
+            <location filename="../../ui/panels/alarm_list.py" line="94" />
             <source>Cleared</source>
             <translation>清除时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="107" />
-            <location filename="../../ui/panels/alarm_list.py" line="115" />
+            <location filename="../../ui/panels/alarm_list.py" line="114" />
+            <location filename="../../ui/panels/alarm_list.py" line="122" />
             <source>active</source>
             <translation>未清除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="113" />
+            <location filename="../../ui/panels/alarm_list.py" line="120" />
             <source>raised {raised}, cleared {cleared}</source>
             <translation>触发 {raised}，清除 {cleared}</translation>
         </message>
@@ -91,42 +91,42 @@
             <translation>运动规划拒绝了该运动（超出范围、奇异点或限位）。</translation>
         </message>
         <message>
-            <location filename="../../app/alarm_history.py" line="42" />
+            <location filename="../../app/alarm_history.py" line="43" />
             <source>An axis encoder angle is implausible or was lost.</source>
             <translation>某轴编码器角度异常或丢失。</translation>
         </message>
         <message>
-            <location filename="../../app/alarm_history.py" line="45" />
+            <location filename="../../app/alarm_history.py" line="46" />
             <source>Make the cell safe, release the emergency stop button, then reset the alarm on the controller.</source>
             <translation>确认现场安全，松开急停按钮，然后在控制器上复位报警。</translation>
         </message>
         <message>
-            <location filename="../../app/alarm_history.py" line="47" />
+            <location filename="../../app/alarm_history.py" line="50" />
             <source>Read the drive's fault code on the controller, remove the cause, then reset the alarm.</source>
             <translation>在控制器上查看驱动器故障码，排除原因后复位报警。</translation>
         </message>
         <message>
-            <location filename="../../app/alarm_history.py" line="49" />
+            <location filename="../../app/alarm_history.py" line="53" />
             <source>Do not move the arm; check the brake wiring and power, then reset the alarm.</source>
             <translation>不要移动机械臂；检查抱闸接线和电源，然后复位报警。</translation>
         </message>
         <message>
-            <location filename="../../app/alarm_history.py" line="51" />
+            <location filename="../../app/alarm_history.py" line="56" />
             <source>Check the target point and speed, reset the alarm, then move to a reachable point.</source>
             <translation>检查目标点和速度，复位报警，然后移动到可达的点。</translation>
         </message>
         <message>
-            <location filename="../../app/alarm_history.py" line="53" />
+            <location filename="../../app/alarm_history.py" line="59" />
             <source>Check the encoder cable; the zero position may need recalibration before moving.</source>
             <translation>检查编码器电缆；运动前可能需要重新标定零点。</translation>
         </message>
         <message>
-            <location filename="../../app/alarm_history.py" line="56" />
+            <location filename="../../app/alarm_history.py" line="63" />
             <source>A bit the protocol does not document.</source>
             <translation>协议未说明的报警位。</translation>
         </message>
         <message>
-            <location filename="../../app/alarm_history.py" line="57" />
+            <location filename="../../app/alarm_history.py" line="64" />
             <source>Read the alarm on the controller's own pendant.</source>
             <translation>请在控制器自带的示教器上查看报警。</translation>
         </message>
@@ -134,92 +134,92 @@
     <context>
         <name>AuditModel</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <location filename="../../ui/panels/audit_viewer.py" line="58" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <location filename="../../ui/panels/audit_viewer.py" line="59" />
             <source>Role</source>
             <translation>角色</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <location filename="../../ui/panels/audit_viewer.py" line="60" />
             <source>Kind</source>
             <translation>类型</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <location filename="../../ui/panels/audit_viewer.py" line="61" />
             <source>Command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="56" />
+            <location filename="../../ui/panels/audit_viewer.py" line="62" />
             <source>Result</source>
             <translation>结果</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="57" />
+            <location filename="../../ui/panels/audit_viewer.py" line="63" />
             <source>Detail</source>
             <translation>详情</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="72" />
+            <location filename="../../ui/panels/audit_viewer.py" line="80" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="72" />
+            <location filename="../../ui/panels/audit_viewer.py" line="81" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="73" />
+            <location filename="../../ui/panels/audit_viewer.py" line="82" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="74" />
+            <location filename="../../ui/panels/audit_viewer.py" line="83" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <location filename="../../ui/panels/audit_viewer.py" line="84" />
             <source>write</source>
             <translation>写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <location filename="../../ui/panels/audit_viewer.py" line="85" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="75" />
+            <location filename="../../ui/panels/audit_viewer.py" line="86" />
             <source>login</source>
             <translation>登录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <location filename="../../ui/panels/audit_viewer.py" line="87" />
             <source>action</source>
             <translation>操作</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <location filename="../../ui/panels/audit_viewer.py" line="88" />
             <source>ok</source>
             <translation>成功</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="76" />
+            <location filename="../../ui/panels/audit_viewer.py" line="89" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="77" />
+            <location filename="../../ui/panels/audit_viewer.py" line="90" />
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="77" />
+            <location filename="../../ui/panels/audit_viewer.py" line="91" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
@@ -227,122 +227,122 @@
     <context>
         <name>AuditViewer</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="87" />
+            <location filename="../../ui/panels/audit_viewer.py" line="107" />
             <source>Audit trail</source>
             <translation>审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="97" />
+            <location filename="../../ui/panels/audit_viewer.py" line="117" />
             <source>Any role</source>
             <translation>任意角色</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <location filename="../../ui/panels/audit_viewer.py" line="119" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <location filename="../../ui/panels/audit_viewer.py" line="120" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="99" />
+            <location filename="../../ui/panels/audit_viewer.py" line="121" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="100" />
+            <location filename="../../ui/panels/audit_viewer.py" line="122" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="103" />
+            <location filename="../../ui/panels/audit_viewer.py" line="126" />
             <source>Command contains…</source>
             <translation>命令包含…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="105" />
+            <location filename="../../ui/panels/audit_viewer.py" line="128" />
             <source>Any result</source>
             <translation>任意结果</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="106" />
+            <location filename="../../ui/panels/audit_viewer.py" line="130" />
             <source>ok</source>
             <translation>成功</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="106" />
+            <location filename="../../ui/panels/audit_viewer.py" line="131" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="107" />
+            <location filename="../../ui/panels/audit_viewer.py" line="132" />
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="107" />
+            <location filename="../../ui/panels/audit_viewer.py" line="133" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="108" />
+            <location filename="../../ui/panels/audit_viewer.py" line="134" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="110" />
+            <location filename="../../ui/panels/audit_viewer.py" line="137" />
             <source>Show</source>
             <translation>显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="112" />
+            <location filename="../../ui/panels/audit_viewer.py" line="139" />
             <source>Export CSV…</source>
             <translation>导出 CSV…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="122" />
+            <location filename="../../ui/panels/audit_viewer.py" line="149" />
             <source>From</source>
             <translation>从</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="122" />
+            <location filename="../../ui/panels/audit_viewer.py" line="149" />
             <source>to</source>
             <translation>到</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="152" />
+            <location filename="../../ui/panels/audit_viewer.py" line="182" />
             <source>{n} records</source>
             <translation>{n} 条记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="154" />
+            <location filename="../../ui/panels/audit_viewer.py" line="184" />
             <source>{n} records ({skipped} damaged lines skipped)</source>
             <translation>{n} 条记录（跳过 {skipped} 行损坏的记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="156" />
+            <location filename="../../ui/panels/audit_viewer.py" line="186" />
             <source>{unknown} writes without a recorded answer (TeachPad stopped)</source>
             <translation>{unknown} 条写入没有记录应答（TeachPad 已停止）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="161" />
+            <location filename="../../ui/panels/audit_viewer.py" line="192" />
             <source>Export the audit trail</source>
             <translation>导出审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="162" />
+            <location filename="../../ui/panels/audit_viewer.py" line="192" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="173" />
+            <location filename="../../ui/panels/audit_viewer.py" line="205" />
             <source>Cannot write {file}: {why}</source>
             <translation>无法写入 {file}：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="176" />
+            <location filename="../../ui/panels/audit_viewer.py" line="208" />
             <source>{n} records exported to {file}</source>
             <translation>已将 {n} 条记录导出到 {file}</translation>
         </message>
@@ -350,174 +350,174 @@
     <context>
         <name>ConnectionDialog</name>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="184" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="193" />
             <source>Connect to controller</source>
             <translation>连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="185" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="194" />
             <source>Transport:</source>
             <translation>通信方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="186" />
-            <location filename="../../ui/dialogs/connection_dialog.py" line="230" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="254" />
             <source>Modbus TCP</source>
             <translation>Modbus TCP</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="187" />
-            <location filename="../../ui/dialogs/connection_dialog.py" line="230" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="196" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="254" />
             <source>Modbus RTU (serial)</source>
             <translation>Modbus RTU（串口）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="188" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="197" />
             <source>Host:</source>
             <translation>主机：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="189" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="198" />
             <source>Port:</source>
             <translation>端口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="190" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="199" />
             <source>Serial port:</source>
             <translation>串口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="191" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="200" />
             <source>Refresh</source>
             <translation>刷新</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="192" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="201" />
             <source>List the serial ports of this computer again</source>
             <translation>重新列出本机的串口</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="194" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="203" />
             <source>Baud rate:</source>
             <translation>波特率：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="204" />
             <source>Parity:</source>
             <translation>校验位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="196" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="205" />
             <source>none</source>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="196" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="205" />
             <source>even</source>
             <translation>偶校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="196" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="205" />
             <source>odd</source>
             <translation>奇校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="198" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="207" />
             <source>Stop bits:</source>
             <translation>停止位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="199" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="208" />
             <source>Unit id:</source>
             <translation>从站地址：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="200" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="209" />
             <source>Float word order:</source>
             <translation>浮点数字序：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="201" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="210" />
             <source>Low word first (CDAB, default)</source>
             <translation>低字在前（CDAB，默认）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="202" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="211" />
             <source>High word first (ABCD)</source>
             <translation>高字在前（ABCD）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="203" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="212" />
             <source>Timeout:</source>
             <translation>超时：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="204" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="213" />
             <source>Monitor only (never write to the controller)</source>
             <translation>仅监视（从不写入控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="206" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="216" />
             <source>Unit id and word order come from the register profile (Safety → Register profile…, administrator).</source>
             <translation>站号和字序取自寄存器配置（安全 → 寄存器配置…，管理员）。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="232" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="256" />
             <source>Connected to {where}</source>
             <translation>已连接到 {where}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="233" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="257" />
             <source>Connecting to {where}</source>
             <translation>正在连接 {where}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="234" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="258" />
             <source>Connected to {where}, but the controller does not answer</source>
             <translation>已连接到 {where}，但控制器没有应答</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="235" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="259" />
             <source>Connection to {where} lost; retrying</source>
             <translation>与 {where} 的连接已断开，正在重试</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="236" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="260" />
             <source>Not connected (last: {where})</source>
             <translation>未连接（上次：{where}）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="239" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="264" />
             <source>{transport}, unit {unit}</source>
             <translation>{transport}，站号 {unit}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="241" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="267" />
             <source>Polling at {hz:g} Hz</source>
             <translation>轮询频率 {hz:g} Hz</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="243" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="269" />
             <source>Monitor only: nothing is written to the controller</source>
             <translation>仅监视：不向控制器写入任何内容</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="271" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="297" />
             <source>Could not list the serial ports ({error}); type the device name</source>
             <translation>无法列出串口（{error}），请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="274" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="301" />
             <source>Serial ports found: {n}</source>
             <translation>找到的串口：{n} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="276" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="303" />
             <source>No serial port found; type the device name</source>
             <translation>未找到串口，请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="329" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="356" />
             <source>a serial port is needed for RTU</source>
             <translation>RTU 方式需要指定串口</translation>
         </message>
@@ -525,68 +525,68 @@
     <context>
         <name>ControlBar</name>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="130" />
+            <location filename="../../ui/panels/control_bar.py" line="131" />
             <source>STOP</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="131" />
+            <location filename="../../ui/panels/control_bar.py" line="132" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="132" />
+            <location filename="../../ui/panels/control_bar.py" line="133" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="133" />
+            <location filename="../../ui/panels/control_bar.py" line="134" />
             <source>Pause the current move or program</source>
             <translation>暂停当前运动或程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="134" />
+            <location filename="../../ui/panels/control_bar.py" line="135" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="135" />
+            <location filename="../../ui/panels/control_bar.py" line="136" />
             <source>Resume the paused move or program</source>
             <translation>继续已暂停的运动或程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="223" />
+            <location filename="../../ui/panels/control_bar.py" line="224" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="227" />
+            <location filename="../../ui/panels/control_bar.py" line="228" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="136" />
+            <location filename="../../ui/panels/control_bar.py" line="137" />
             <source>Manual</source>
             <translation>手动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="137" />
+            <location filename="../../ui/panels/control_bar.py" line="138" />
             <source>Switch the controller to manual mode</source>
             <translation>将控制器切换到手动模式</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="138" />
+            <location filename="../../ui/panels/control_bar.py" line="139" />
             <source>Auto</source>
             <translation>自动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="139" />
+            <location filename="../../ui/panels/control_bar.py" line="140" />
             <source>Switch the controller to auto mode (needed for Modbus motion)</source>
             <translation>将控制器切换到自动模式（Modbus 运动需要自动模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/control_bar.py" line="224" />
             <location filename="../../ui/panels/control_bar.py" line="225" />
+            <location filename="../../ui/panels/control_bar.py" line="226" />
             <source>Mode:
 {mode}</source>
             <translation>模式：
@@ -664,73 +664,73 @@
             <translation>TCP 必须留在此长方体内</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="72" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="73" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="78" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="79" />
             <source>Add zone</source>
             <translation>添加禁区</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="80" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="81" />
             <source>Remove zone</source>
             <translation>删除禁区</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="90" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="91" />
             <source>Revision {n}</source>
             <translation>版本 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="94" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="95" />
             <source>Joint limits</source>
             <translation>关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="98" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="99" />
             <source>Work space (keep-in box)</source>
             <translation>工作空间（允许区域）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="107" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="108" />
             <source>Keep-out zones</source>
             <translation>禁入区域</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="115" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="116" />
             <source>Speeds</source>
             <translation>速度</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="117" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="118" />
             <source>Max jog speed:</source>
             <translation>最大点动速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="118" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="119" />
             <source>Max TCP speed (moves, plans):</source>
             <translation>最大 TCP 速度（移动、计划）：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="119" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="120" />
             <source>Reduced mode jog speed:</source>
             <translation>降速模式点动速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="120" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="121" />
             <source>Reduced mode TCP speed:</source>
             <translation>降速模式 TCP 速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="141" />
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="174" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="143" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="181" />
             <source>zone {n}</source>
             <translation>禁区 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="158" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="160" />
             <source>{what}: '{text}' is not a number</source>
             <translation>{what}：“{text}”不是数字</translation>
         </message>
@@ -738,37 +738,37 @@
     <context>
         <name>EventLogModel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="110" />
+            <location filename="../../ui/panels/event_log.py" line="112" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="111" />
+            <location filename="../../ui/panels/event_log.py" line="113" />
             <source>Level</source>
             <translation>级别</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="112" />
+            <location filename="../../ui/panels/event_log.py" line="114" />
             <source>Source</source>
             <translation>来源</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="113" />
+            <location filename="../../ui/panels/event_log.py" line="115" />
             <source>Message</source>
             <translation>消息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="116" />
+            <location filename="../../ui/panels/event_log.py" line="118" />
             <source>Info</source>
             <translation>信息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="117" />
+            <location filename="../../ui/panels/event_log.py" line="119" />
             <source>Warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="118" />
+            <location filename="../../ui/panels/event_log.py" line="120" />
             <source>Error</source>
             <translation>错误</translation>
         </message>
@@ -776,72 +776,72 @@
     <context>
         <name>EventLogPanel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="284" />
+            <location filename="../../ui/panels/event_log.py" line="287" />
             <source>Show:</source>
             <translation>显示：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="285" />
+            <location filename="../../ui/panels/event_log.py" line="288" />
             <source>All events</source>
             <translation>全部事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="286" />
+            <location filename="../../ui/panels/event_log.py" line="289" />
             <source>Warnings and errors</source>
             <translation>警告和错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="287" />
+            <location filename="../../ui/panels/event_log.py" line="290" />
             <source>Errors only</source>
             <translation>仅错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="288" />
+            <location filename="../../ui/panels/event_log.py" line="291" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="289" />
+            <location filename="../../ui/panels/event_log.py" line="292" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="345" />
+            <location filename="../../ui/panels/event_log.py" line="354" />
             <source>alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="342" />
+            <location filename="../../ui/panels/event_log.py" line="351" />
             <source>Alarm raised: {name}</source>
             <translation>报警触发：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="342" />
+            <location filename="../../ui/panels/event_log.py" line="351" />
             <source>Alarm cleared: {name}</source>
             <translation>报警解除：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="351" />
+            <location filename="../../ui/panels/event_log.py" line="360" />
             <source>bit {n}</source>
             <translation>第 {n} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="355" />
+            <location filename="../../ui/panels/event_log.py" line="364" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="385" />
+            <location filename="../../ui/panels/event_log.py" line="396" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="410" />
+            <location filename="../../ui/panels/event_log.py" line="423" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="411" />
+            <location filename="../../ui/panels/event_log.py" line="425" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -849,7 +849,7 @@
     <context>
         <name>Export</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="311" />
+            <location filename="../../ui/widgets_common.py" line="315" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -857,87 +857,87 @@
     <context>
         <name>JogPanel</name>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="239" />
+            <location filename="../../ui/panels/jog_panel.py" line="251" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="240" />
+            <location filename="../../ui/panels/jog_panel.py" line="252" />
             <source>User frame</source>
             <translation>用户坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="241" />
+            <location filename="../../ui/panels/jog_panel.py" line="253" />
             <source>Tool frame</source>
             <translation>工具坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="242" />
+            <location filename="../../ui/panels/jog_panel.py" line="254" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="246" />
+            <location filename="../../ui/panels/jog_panel.py" line="258" />
             <source>User no.:</source>
             <translation>用户坐标号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="247" />
+            <location filename="../../ui/panels/jog_panel.py" line="259" />
             <source>Tool no.:</source>
             <translation>工具号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="237" />
+            <location filename="../../ui/panels/jog_panel.py" line="249" />
             <source>Frame:</source>
             <translation>坐标系：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="248" />
+            <location filename="../../ui/panels/jog_panel.py" line="260" />
             <source>External axes</source>
             <translation>外部轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="249" />
+            <location filename="../../ui/panels/jog_panel.py" line="261" />
             <source>HOLD TO MOVE — release to stop</source>
             <translation>按住运动 — 松开即停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="250" />
+            <location filename="../../ui/panels/jog_panel.py" line="262" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="255" />
+            <location filename="../../ui/panels/jog_panel.py" line="267" />
             <source>Keyboard: click this panel, then hold {plus} (+) or {minus} (−) for axes 1–6; releasing the key stops.</source>
             <translation>键盘：先单击本面板，再按住 {plus}（+）或 {minus}（−）点动第 1–6 轴；松开按键即停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="258" />
+            <location filename="../../ui/panels/jog_panel.py" line="270" />
             <source>Keys: hold {plus} (+) or {minus} (−)</source>
             <translation>按键：按住 {plus} (+) 或 {minus} (−)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="390" />
+            <location filename="../../ui/panels/jog_panel.py" line="410" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="390" />
+            <location filename="../../ui/panels/jog_panel.py" line="410" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="391" />
+            <location filename="../../ui/panels/jog_panel.py" line="412" />
             <source>Hold: {axis} − ({unit})</source>
             <translation>按住：{axis} −（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="393" />
+            <location filename="../../ui/panels/jog_panel.py" line="415" />
             <source>Hold: {axis} + ({unit})</source>
             <translation>按住：{axis} +（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="404" />
+            <location filename="../../ui/panels/jog_panel.py" line="426" />
             <source>{ratio} %</source>
             <translation>{ratio} %</translation>
         </message>
@@ -945,32 +945,32 @@
     <context>
         <name>KeypadDialog</name>
         <message>
-            <location filename="../../ui/keypad.py" line="91" />
+            <location filename="../../ui/keypad.py" line="92" />
             <source>Enter a value</source>
             <translation>输入数值</translation>
         </message>
         <message>
-            <location filename="../../ui/keypad.py" line="92" />
+            <location filename="../../ui/keypad.py" line="93" />
             <source>OK</source>
             <translation>确定</translation>
         </message>
         <message>
-            <location filename="../../ui/keypad.py" line="93" />
+            <location filename="../../ui/keypad.py" line="94" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/keypad.py" line="94" />
+            <location filename="../../ui/keypad.py" line="95" />
             <source>Delete the last digit</source>
             <translation>删除最后一位</translation>
         </message>
         <message>
-            <location filename="../../ui/keypad.py" line="95" />
+            <location filename="../../ui/keypad.py" line="96" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/keypad.py" line="97" />
+            <location filename="../../ui/keypad.py" line="98" />
             <source>From {low} to {high}</source>
             <translation>范围：{low} 至 {high}</translation>
         </message>
@@ -978,32 +978,32 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/window_column.py" line="66" />
+            <location filename="../../ui/window_column.py" line="67" />
             <source>Jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="67" />
+            <location filename="../../ui/window_column.py" line="68" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="68" />
+            <location filename="../../ui/window_column.py" line="69" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="85" />
+            <location filename="../../ui/window_docks.py" line="84" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="86" />
+            <location filename="../../ui/window_docks.py" line="85" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="87" />
+            <location filename="../../ui/window_docks.py" line="86" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
@@ -1013,84 +1013,84 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="250" />
+            <location filename="../../ui/main_window.py" line="287" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="80" />
+            <location filename="../../ui/window_column.py" line="82" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="83" />
+            <location filename="../../ui/window_column.py" line="86" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/window_status.py" line="53" />
+            <location filename="../../ui/window_status.py" line="52" />
             <location filename="../../ui/window_status.py" line="85" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/window_status.py" line="66" />
+            <location filename="../../ui/window_status.py" line="65" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="281" />
+            <location filename="../../ui/main_window.py" line="319" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="287" />
+            <location filename="../../ui/main_window.py" line="325" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="283" />
-            <location filename="../../ui/main_window.py" line="288" />
+            <location filename="../../ui/main_window.py" line="321" />
+            <location filename="../../ui/main_window.py" line="326" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="227" />
+            <location filename="../../ui/main_window.py" line="264" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="228" />
+            <location filename="../../ui/main_window.py" line="265" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="229" />
+            <location filename="../../ui/main_window.py" line="266" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="88" />
+            <location filename="../../ui/window_docks.py" line="87" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="341" />
+            <location filename="../../ui/main_window.py" line="386" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="342" />
+            <location filename="../../ui/main_window.py" line="388" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="360" />
+            <location filename="../../ui/main_window.py" line="408" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="361" />
+            <location filename="../../ui/main_window.py" line="408" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -1098,278 +1098,278 @@
     <context>
         <name>Messages</name>
         <message>
-            <location filename="../../ui/messages.py" line="52" />
+            <location filename="../../ui/messages.py" line="65" />
             <source>{command}: {status}.</source>
             <translation>{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="53" />
+            <location filename="../../ui/messages.py" line="66" />
             <source>{command}: done, not confirmed by the controller.</source>
             <translation>{command}：已完成，控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="54" />
+            <location filename="../../ui/messages.py" line="67" />
             <source>{command}: done (the controller is now in {mode} mode).</source>
             <translation>{command}：已完成（控制器现处于{mode}模式）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="55" />
+            <location filename="../../ui/messages.py" line="68" />
             <source>{command} refused by the controller: {status}.</source>
             <translation>控制器拒绝了{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="56" />
+            <location filename="../../ui/messages.py" line="69" />
             <source>{command} not taken: the controller still shows “{status}” from the previous command.</source>
             <translation>{command}未被执行：控制器仍显示上一条命令的“{status}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="57" />
+            <location filename="../../ui/messages.py" line="73" />
             <source>{command} ended by an alarm: {alarms}.</source>
             <translation>{command}因报警而中止：{alarms}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="58" />
+            <location filename="../../ui/messages.py" line="74" />
             <source>{command}: the controller did not acknowledge it within {seconds} s.</source>
             <translation>{command}：控制器在 {seconds} s 内未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="59" />
+            <location filename="../../ui/messages.py" line="77" />
             <source>{command} did not finish within {seconds} s (last status: {status}).</source>
             <translation>{command}未在 {seconds} s 内完成（最后状态：{status}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="60" />
+            <location filename="../../ui/messages.py" line="80" />
             <source>{command}: the arm moved and stopped, but the controller did not report the result.</source>
             <translation>{command}：机械臂已运动并停止，但控制器未报告结果。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="61" />
+            <location filename="../../ui/messages.py" line="83" />
             <source>{command}: stopped by the operator.</source>
             <translation>{command}：已由操作员停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="62" />
+            <location filename="../../ui/messages.py" line="84" />
             <source>{command}: stopped by the controller.</source>
             <translation>{command}：已被控制器停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="63" />
+            <location filename="../../ui/messages.py" line="85" />
             <source>{command}: sent (not waited for).</source>
             <translation>{command}：已发送（未等待结果）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="64" />
+            <location filename="../../ui/messages.py" line="86" />
             <source>{command}: no motion within {seconds} s (refused by the controller, or already there).</source>
             <translation>{command}：{seconds} s 内没有运动（被控制器拒绝，或已在目标位置）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="65" />
+            <location filename="../../ui/messages.py" line="89" />
             <source>Program {program} did not start: no such program, or the controller refused it.</source>
             <translation>程序 {program} 未启动：没有该程序，或控制器拒绝执行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="66" />
+            <location filename="../../ui/messages.py" line="92" />
             <source>Uploaded {uploaded} of {total} points.</source>
             <translation>已上传 {uploaded}/{total} 个点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="68" />
+            <location filename="../../ui/messages.py" line="94" />
             <source>{operation}: sent.</source>
             <translation>{operation}：已发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="69" />
+            <location filename="../../ui/messages.py" line="95" />
             <source>{operation}: failed.</source>
             <translation>{operation}：失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="70" />
+            <location filename="../../ui/messages.py" line="96" />
             <source>{operation} is still under way: wait for it or press Stop.</source>
             <translation>{operation}仍在进行：请等待其结束或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="71" />
+            <location filename="../../ui/messages.py" line="97" />
             <source>The link is shut down: nothing was sent.</source>
             <translation>通信链路已关闭：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="72" />
+            <location filename="../../ui/messages.py" line="98" />
             <source>Not connected to a controller: nothing was sent.</source>
             <translation>未连接控制器：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="74" />
+            <location filename="../../ui/messages.py" line="100" />
             <source>Jog stopped: the controller is not answering (speed 0 is sent as soon as it answers).</source>
             <translation>点动已停止：控制器无应答（一旦应答即发送速度 0）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="75" />
+            <location filename="../../ui/messages.py" line="103" />
             <source>Jog stopped: the controller left teach mode (now in {mode} mode).</source>
             <translation>点动已停止：控制器已退出示教模式（当前为{mode}模式）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="76" />
+            <location filename="../../ui/messages.py" line="106" />
             <source>The controller is not answering: the jog was not started.</source>
             <translation>控制器无应答：点动未启动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="77" />
+            <location filename="../../ui/messages.py" line="109" />
             <source>Jog speed {value}% is not within 1..100%.</source>
             <translation>点动速度 {value}% 不在 1..100% 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="79" />
+            <location filename="../../ui/messages.py" line="111" />
             <source>Lost the connection to the controller at {endpoint}.</source>
             <translation>与控制器 {endpoint} 的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="80" />
+            <location filename="../../ui/messages.py" line="112" />
             <source>The controller at {endpoint} closed the connection.</source>
             <translation>控制器 {endpoint} 关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="81" />
+            <location filename="../../ui/messages.py" line="113" />
             <source>The host name {host} cannot be resolved.</source>
             <translation>无法解析主机名 {host}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="82" />
+            <location filename="../../ui/messages.py" line="114" />
             <source>Connection refused: nothing listens on port {port}.</source>
             <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="83" />
+            <location filename="../../ui/messages.py" line="117" />
             <source>No answer to the connection request within {seconds} s.</source>
             <translation>连接请求在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="84" />
+            <location filename="../../ui/messages.py" line="120" />
             <source>The connection could not be opened.</source>
             <translation>无法建立连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="85" />
+            <location filename="../../ui/messages.py" line="121" />
             <source>Cannot open the serial port {port}.</source>
             <translation>无法打开串口 {port}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="86" />
+            <location filename="../../ui/messages.py" line="122" />
             <source>The controller at {endpoint} did not answer within {seconds} s.</source>
             <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="87" />
+            <location filename="../../ui/messages.py" line="125" />
             <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
             <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="88" />
+            <location filename="../../ui/messages.py" line="129" />
             <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="89" />
+            <location filename="../../ui/messages.py" line="132" />
             <source>Monitor-only mode: nothing was sent to the controller.</source>
             <translation>仅监视模式：未向控制器发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="90" />
+            <location filename="../../ui/messages.py" line="133" />
             <location filename="../../ui/messages_plan.py" line="26" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="91" />
+            <location filename="../../ui/messages.py" line="134" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="93" />
+            <location filename="../../ui/messages.py" line="136" />
             <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
             <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="94" />
+            <location filename="../../ui/messages.py" line="140" />
             <source>The controller did not create {point} again before the move: the arm was not moved.</source>
             <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="95" />
+            <location filename="../../ui/messages.py" line="143" />
             <source>The project has no point {point}: the arm was not moved.</source>
             <translation>项目中没有点 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="96" />
+            <location filename="../../ui/messages.py" line="146" />
             <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
             <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="98" />
+            <location filename="../../ui/messages.py" line="150" />
             <source>The link was shut down.</source>
             <translation>通信链路已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="99" />
+            <location filename="../../ui/messages.py" line="151" />
             <source>{operation}: the connection was lost while it was under way; its outcome is unknown.</source>
             <translation>{operation}：执行期间连接中断，结果未知。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="100" />
+            <location filename="../../ui/messages.py" line="154" />
             <source>{operation}: the connection was closed while it was under way.</source>
             <translation>{operation}：执行期间连接被关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="102" />
+            <location filename="../../ui/messages.py" line="158" />
             <source>{operation}: not sent, the connection to the controller is down.</source>
             <translation>{operation}：未发送，与控制器的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="103" />
+            <location filename="../../ui/messages.py" line="161" />
             <source>{operation}: not sent, the connection was closed.</source>
             <translation>{operation}：未发送，连接已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="105" />
+            <location filename="../../ui/messages.py" line="163" />
             <source>points outside {id_min}..{id_max}: {ids}</source>
             <translation>超出 {id_min}..{id_max} 范围的点：{ids}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="106" />
+            <location filename="../../ui/messages.py" line="164" />
             <source>there is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="107" />
+            <location filename="../../ui/messages.py" line="165" />
             <source>no free point id left in {start}..{id_max}</source>
             <translation>{start}..{id_max} 范围内已没有空闲的点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="108" />
+            <location filename="../../ui/messages.py" line="166" />
             <source>there is no row {row}</source>
             <translation>不存在第 {row} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="109" />
+            <location filename="../../ui/messages.py" line="167" />
             <source>cannot move row {src} to {dst} in {rows} rows</source>
             <translation>无法在 {rows} 行中将第 {src} 行移到第 {dst} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="110" />
+            <location filename="../../ui/messages.py" line="168" />
             <source>row {row}: id {id} is already used on row {other}</source>
             <translation>第 {row} 行：编号 {id} 已被第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="111" />
+            <location filename="../../ui/messages.py" line="169" />
             <source>imported point {number}: id {id} appears twice</source>
             <translation>导入的第 {number} 个点：编号 {id} 出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="112" />
+            <location filename="../../ui/messages.py" line="170" />
             <source>id {id} is already used by {point}</source>
             <translation>编号 {id} 已被 {point} 使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="113" />
+            <location filename="../../ui/messages.py" line="171" />
             <source>the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)</source>
             <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
         </message>
@@ -1424,357 +1424,357 @@
             <translation>含有无效字符（孤立的代理项，不是 Unicode 文本）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="39" />
+            <location filename="../../ui/messages_files.py" line="41" />
             <source>must be one line</source>
             <translation>必须为单行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="40" />
+            <location filename="../../ui/messages_files.py" line="42" />
             <source>the value is missing</source>
             <translation>缺少该值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="42" />
+            <location filename="../../ui/messages_files.py" line="44" />
             <source>not UTF-8 text (bad byte at offset {offset}); save the file as UTF-8</source>
             <translation>不是 UTF-8 文本（偏移 {offset} 处有无效字节）；请将文件另存为 UTF-8</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="43" />
+            <location filename="../../ui/messages_files.py" line="47" />
             <source>the file is empty (expected a header row)</source>
             <translation>文件为空（应有表头行）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="44" />
+            <location filename="../../ui/messages_files.py" line="48" />
             <source>unknown column {name} (expected: {expected})</source>
             <translation>未知列 {name}（应为：{expected}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="45" />
+            <location filename="../../ui/messages_files.py" line="49" />
             <source>the column appears twice</source>
             <translation>该列出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="46" />
+            <location filename="../../ui/messages_files.py" line="50" />
             <source>the column is missing from the header</source>
             <translation>表头中缺少该列</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="47" />
+            <location filename="../../ui/messages_files.py" line="51" />
             <source>has {cells} cells, the header has {header} (truncated or extra cells?)</source>
             <translation>有 {cells} 个单元格，表头有 {header} 个（被截断或有多余单元格？）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="48" />
+            <location filename="../../ui/messages_files.py" line="54" />
             <source>id {id} is already used on row {other}</source>
             <translation>编号 {id} 已在第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="120" />
+            <location filename="../../ui/messages.py" line="181" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="121" />
+            <location filename="../../ui/messages.py" line="182" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="122" />
+            <location filename="../../ui/messages.py" line="183" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="123" />
+            <location filename="../../ui/messages.py" line="184" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="124" />
+            <location filename="../../ui/messages.py" line="185" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="125" />
+            <location filename="../../ui/messages.py" line="186" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="126" />
+            <location filename="../../ui/messages.py" line="187" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="127" />
+            <location filename="../../ui/messages.py" line="188" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="128" />
+            <location filename="../../ui/messages.py" line="189" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="129" />
+            <location filename="../../ui/messages.py" line="190" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="130" />
+            <location filename="../../ui/messages.py" line="191" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="131" />
+            <location filename="../../ui/messages.py" line="192" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="132" />
+            <location filename="../../ui/messages.py" line="193" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="133" />
+            <location filename="../../ui/messages.py" line="194" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="136" />
+            <location filename="../../ui/messages.py" line="199" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="137" />
+            <location filename="../../ui/messages.py" line="200" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="138" />
+            <location filename="../../ui/messages.py" line="201" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="139" />
+            <location filename="../../ui/messages.py" line="202" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="140" />
+            <location filename="../../ui/messages.py" line="203" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="143" />
+            <location filename="../../ui/messages.py" line="206" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="144" />
+            <location filename="../../ui/messages.py" line="207" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="145" />
+            <location filename="../../ui/messages.py" line="208" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="146" />
+            <location filename="../../ui/messages.py" line="209" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="147" />
+            <location filename="../../ui/messages.py" line="210" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="148" />
+            <location filename="../../ui/messages.py" line="211" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="149" />
+            <location filename="../../ui/messages.py" line="212" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="150" />
+            <location filename="../../ui/messages.py" line="213" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="151" />
+            <location filename="../../ui/messages.py" line="214" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="152" />
+            <location filename="../../ui/messages.py" line="215" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="153" />
+            <location filename="../../ui/messages.py" line="216" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="154" />
+            <location filename="../../ui/messages.py" line="217" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="155" />
+            <location filename="../../ui/messages.py" line="218" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="156" />
+            <location filename="../../ui/messages.py" line="219" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="157" />
+            <location filename="../../ui/messages.py" line="220" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="158" />
+            <location filename="../../ui/messages.py" line="221" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="159" />
+            <location filename="../../ui/messages.py" line="222" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="160" />
+            <location filename="../../ui/messages.py" line="223" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="161" />
+            <location filename="../../ui/messages.py" line="224" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="162" />
+            <location filename="../../ui/messages.py" line="225" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="164" />
+            <location filename="../../ui/messages.py" line="227" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="167" />
+            <location filename="../../ui/messages.py" line="230" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="168" />
+            <location filename="../../ui/messages.py" line="231" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="169" />
+            <location filename="../../ui/messages.py" line="232" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="170" />
+            <location filename="../../ui/messages.py" line="233" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="171" />
+            <location filename="../../ui/messages.py" line="234" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="172" />
+            <location filename="../../ui/messages.py" line="235" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="173" />
+            <location filename="../../ui/messages.py" line="236" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="174" />
+            <location filename="../../ui/messages.py" line="237" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="175" />
+            <location filename="../../ui/messages.py" line="238" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="176" />
+            <location filename="../../ui/messages.py" line="239" />
             <source>unit id</source>
             <translation>站号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="177" />
+            <location filename="../../ui/messages.py" line="240" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="181" />
+            <location filename="../../ui/messages.py" line="244" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="182" />
+            <location filename="../../ui/messages.py" line="245" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="183" />
+            <location filename="../../ui/messages.py" line="246" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="184" />
+            <location filename="../../ui/messages.py" line="247" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="185" />
+            <location filename="../../ui/messages.py" line="248" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="186" />
+            <location filename="../../ui/messages.py" line="249" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="187" />
+            <location filename="../../ui/messages.py" line="250" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="188" />
+            <location filename="../../ui/messages.py" line="251" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="189" />
+            <location filename="../../ui/messages.py" line="252" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="190" />
+            <location filename="../../ui/messages.py" line="253" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="192" />
+            <location filename="../../ui/messages.py" line="255" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
@@ -1784,418 +1784,418 @@
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="31" />
+            <location filename="../../ui/messages_plan.py" line="33" />
             <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
             <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="32" />
+            <location filename="../../ui/messages_plan.py" line="37" />
             <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
             <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="33" />
+            <location filename="../../ui/messages_plan.py" line="38" />
             <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
             <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="34" />
+            <location filename="../../ui/messages_plan.py" line="39" />
             <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
             <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="35" />
+            <location filename="../../ui/messages_plan.py" line="40" />
             <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
             <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="37" />
+            <location filename="../../ui/messages_plan.py" line="44" />
             <source>Refused by the safety envelope: {text}</source>
             <translation>安全边界拒绝：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="38" />
+            <location filename="../../ui/messages_plan.py" line="45" />
             <source>segment {n}: </source>
             <translation>第 {n} 段：</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="39" />
+            <location filename="../../ui/messages_plan.py" line="46" />
             <source> (reduced-speed mode)</source>
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="332" />
+            <location filename="../../ui/messages.py" line="405" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="333" />
+            <location filename="../../ui/messages.py" line="409" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="71" />
+            <location filename="../../ui/messages_plan.py" line="82" />
             <source>Plan “{plan}” has no segments.</source>
             <translation>规划“{plan}”没有任何段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="72" />
+            <location filename="../../ui/messages_plan.py" line="83" />
             <source>Cannot start at segment {start}: the plan has {segments} segments.</source>
             <translation>无法从第 {start} 段开始：该规划只有 {segments} 段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="73" />
+            <location filename="../../ui/messages_plan.py" line="86" />
             <source>speed {speed} mm/s is not in (0, {max}] mm/s.</source>
             <translation>速度 {speed} mm/s 不在 (0, {max}] mm/s 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="74" />
+            <location filename="../../ui/messages_plan.py" line="87" />
             <source>the arc has no middle point.</source>
             <translation>圆弧没有中间点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="75" />
+            <location filename="../../ui/messages_plan.py" line="88" />
             <source>middle point P{id} does not exist.</source>
             <translation>中间点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="76" />
+            <location filename="../../ui/messages_plan.py" line="89" />
             <source>end point P{id} does not exist.</source>
             <translation>终点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="77" />
+            <location filename="../../ui/messages_plan.py" line="90" />
             <source>{point} is not on the controller ({sync}); upload it.</source>
             <translation>{point} 不在控制器上（{sync}）；请上传。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="78" />
+            <location filename="../../ui/messages_plan.py" line="91" />
             <source>{point} was taught with {point_tool}, the segment moves with {segment_tool}.</source>
             <translation>{point} 示教时的工具为“{point_tool}”，该段运动的工具为“{segment_tool}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="79" />
+            <location filename="../../ui/messages_plan.py" line="94" />
             <source>the line goes nowhere (start and end {length} mm apart){where}.</source>
             <translation>直线没有移动（起点与终点相距 {length} mm）{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="80" />
+            <location filename="../../ui/messages_plan.py" line="97" />
             <source>the arc starts at the robot's current pose, which is not known: its shape is not checked.</source>
             <translation>圆弧从机器人的当前位姿开始，但当前位姿未知：未检查其形状。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="81" />
+            <location filename="../../ui/messages_plan.py" line="101" />
             <source>the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与中间点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="82" />
+            <location filename="../../ui/messages_plan.py" line="105" />
             <source>the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的中间点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="83" />
+            <location filename="../../ui/messages_plan.py" line="109" />
             <source>the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="84" />
+            <location filename="../../ui/messages_plan.py" line="113" />
             <source>the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}.</source>
             <translation>圆弧的三个点（几乎）在一条直线上：中间点距起点—终点连线仅 {offset} mm（至少需要 {tolerance} mm）；请改用直线{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="85" />
+            <location filename="../../ui/messages_plan.py" line="117" />
             <source>the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before.</source>
             <translation>机械臂停在圆弧中间点之后：从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；请用直线移动到终点，或从前一段开始运行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="86" />
+            <location filename="../../ui/messages_plan.py" line="121" />
             <source>sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here.</source>
             <translation>从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；从此处运行前请检查预览。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="87" />
+            <location filename="../../ui/messages_plan.py" line="125" />
             <source>{point} is out of the robot model's reach.</source>
             <translation>{point} 超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="88" />
+            <location filename="../../ui/messages_plan.py" line="126" />
             <source>the path is out of the robot model's reach.</source>
             <translation>路径超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="89" />
+            <location filename="../../ui/messages_plan.py" line="127" />
             <source>{point} passes a joint limit of the robot model.</source>
             <translation>{point} 会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="90" />
+            <location filename="../../ui/messages_plan.py" line="128" />
             <source>the path passes a joint limit of the robot model.</source>
             <translation>路径会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="92" />
+            <location filename="../../ui/messages_plan.py" line="130" />
             <source> (from the current pose)</source>
             <translation>（从当前位姿出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="93" />
+            <location filename="../../ui/messages_plan.py" line="131" />
             <source> (on loops after the first, starting at the end of segment {after})</source>
             <translation>（第一轮之后的循环中，从第 {after} 段的终点出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="110" />
+            <location filename="../../ui/messages_files.py" line="130" />
             <source>row {row}, column '{column}': {problem}</source>
             <translation>第 {row} 行，“{column}”列：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="112" />
+            <location filename="../../ui/messages_files.py" line="132" />
             <source>column '{column}': {problem}</source>
             <translation>“{column}”列：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="111" />
+            <location filename="../../ui/messages_files.py" line="131" />
             <source>row {row}: {problem}</source>
             <translation>第 {row} 行：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="49" />
+            <location filename="../../ui/messages_files.py" line="55" />
             <source>not valid CSV (a quote is not closed, or a stray character)</source>
             <translation>不是有效的 CSV 文件（引号未闭合，或有多余字符）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="51" />
+            <location filename="../../ui/messages_files.py" line="57" />
             <source>the file is too large ({size} bytes, at most {limit})</source>
             <translation>文件过大（{size} 字节，最多 {limit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="52" />
+            <location filename="../../ui/messages_files.py" line="58" />
             <source>the file does not exist</source>
             <translation>文件不存在</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="53" />
+            <location filename="../../ui/messages_files.py" line="59" />
             <source>is a folder, not a file</source>
             <translation>是文件夹，不是文件</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="54" />
+            <location filename="../../ui/messages_files.py" line="60" />
             <source>permission denied</source>
             <translation>没有访问权限</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="55" />
+            <location filename="../../ui/messages_files.py" line="61" />
             <source>the system refused the file (error {errno})</source>
             <translation>系统拒绝访问该文件（错误 {errno}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="57" />
+            <location filename="../../ui/messages_files.py" line="63" />
             <source>not valid JSON</source>
             <translation>不是有效的 JSON</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="58" />
+            <location filename="../../ui/messages_files.py" line="64" />
             <source>not valid JSON (nested too deeply)</source>
             <translation>不是有效的 JSON（嵌套层数过多）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="59" />
+            <location filename="../../ui/messages_files.py" line="65" />
             <source>not a project: expected a JSON object at the top level</source>
             <translation>不是工程文件：顶层应为 JSON 对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="60" />
+            <location filename="../../ui/messages_files.py" line="68" />
             <source>not a TeachPad project (format {got}, expected {expected})</source>
             <translation>不是 TeachPad 工程文件（格式为 {got}，应为 {expected}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="61" />
+            <location filename="../../ui/messages_files.py" line="71" />
             <source>version {version} is not supported (this TeachPad reads version {supported})</source>
             <translation>不支持版本 {version}（本 TeachPad 读取版本 {supported}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="62" />
+            <location filename="../../ui/messages_files.py" line="74" />
             <source>expected {expected}, got {got}</source>
             <translation>应为{expected}，实际为 {got}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="63" />
+            <location filename="../../ui/messages_files.py" line="75" />
             <source>id {id} is already used by point {other_number}</source>
             <translation>编号 {id} 已被第 {other_number} 个点使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="64" />
+            <location filename="../../ui/messages_files.py" line="76" />
             <source>another plan is named “{name}”</source>
             <translation>已有另一个名为“{name}”的轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="66" />
+            <location filename="../../ui/messages_files.py" line="78" />
             <source>{value} is not yes or no</source>
             <translation>{value} 不是“是”或“否”</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="67" />
+            <location filename="../../ui/messages_files.py" line="79" />
             <source>{value} is not a line or an arc</source>
             <translation>{value} 不是直线或圆弧</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="68" />
+            <location filename="../../ui/messages_files.py" line="80" />
             <source>{value} is not “changes” or “kept”</source>
             <translation>{value} 不是“变化”或“保持”</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="69" />
+            <location filename="../../ui/messages_files.py" line="83" />
             <source>point id {id} is negative</source>
             <translation>点编号 {id} 为负数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="70" />
+            <location filename="../../ui/messages_files.py" line="84" />
             <source>there is no field “{name}”</source>
             <translation>没有字段“{name}”</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="71" />
+            <location filename="../../ui/messages_files.py" line="85" />
             <source>a plan needs a name</source>
             <translation>轨迹需要一个名称</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="72" />
+            <location filename="../../ui/messages_files.py" line="86" />
             <source>the name must be one line of at most {max} characters</source>
             <translation>名称必须为单行，最多 {max} 个字符</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="73" />
+            <location filename="../../ui/messages_files.py" line="89" />
             <source>{value} loops: give 0 (endless) to {max}</source>
             <translation>循环次数 {value} 无效：请输入 0（无限）到 {max}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="74" />
+            <location filename="../../ui/messages_files.py" line="90" />
             <source>cannot move segment {src} to {dst} in {segments} segments</source>
             <translation>无法在 {segments} 段中把第 {src} 段移到第 {dst} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="75" />
+            <location filename="../../ui/messages_files.py" line="93" />
             <source>an arc needs its middle point</source>
             <translation>圆弧需要中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="76" />
+            <location filename="../../ui/messages_files.py" line="94" />
             <source>a line has no middle point</source>
             <translation>直线没有中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="77" />
+            <location filename="../../ui/messages_files.py" line="95" />
             <source>point P{id} does not exist: pick one of the list</source>
             <translation>点 P{id} 不存在：请从列表中选择</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="78" />
+            <location filename="../../ui/messages_files.py" line="98" />
             <source>{speed} mm/s: the speed must be above 0</source>
             <translation>{speed} mm/s：速度必须大于 0</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="79" />
+            <location filename="../../ui/messages_files.py" line="99" />
             <source>an arc's middle point must differ from its end point</source>
             <translation>圆弧的中间点必须与终点不同</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="84" />
+            <location filename="../../ui/messages_files.py" line="104" />
             <source>text</source>
             <translation>文本</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="85" />
+            <location filename="../../ui/messages_files.py" line="105" />
             <source>a list of points</source>
             <translation>点列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="86" />
+            <location filename="../../ui/messages_files.py" line="106" />
             <source>a list of plans</source>
             <translation>轨迹列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="87" />
+            <location filename="../../ui/messages_files.py" line="107" />
             <source>a list of segments</source>
             <translation>段列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="88" />
-            <location filename="../../ui/messages_files.py" line="93" />
+            <location filename="../../ui/messages_files.py" line="108" />
+            <location filename="../../ui/messages_files.py" line="113" />
             <source>an object</source>
             <translation>对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="89" />
+            <location filename="../../ui/messages_files.py" line="109" />
             <source>an object with time and endpoint</source>
             <translation>包含时间和端点的对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="92" />
+            <location filename="../../ui/messages_files.py" line="112" />
             <source>a list</source>
             <translation>列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="98" />
+            <location filename="../../ui/messages_files.py" line="118" />
             <source>the file</source>
             <translation>文件</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="99" />
+            <location filename="../../ui/messages_files.py" line="119" />
             <source>point {number}</source>
             <translation>第 {number} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="100" />
+            <location filename="../../ui/messages_files.py" line="120" />
             <source>point {number} (id {id})</source>
             <translation>第 {number} 个点（编号 {id}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="101" />
+            <location filename="../../ui/messages_files.py" line="121" />
             <source>point {number} (id {id}), upload history</source>
             <translation>第 {number} 个点（编号 {id}）的上传记录</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="102" />
+            <location filename="../../ui/messages_files.py" line="122" />
             <source>plan {number}</source>
             <translation>第 {number} 条轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="103" />
+            <location filename="../../ui/messages_files.py" line="123" />
             <source>plan {number} “{name}”</source>
             <translation>第 {number} 条轨迹“{name}”</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="104" />
+            <location filename="../../ui/messages_files.py" line="124" />
             <source>plan {number} “{name}”, segment {segment}</source>
             <translation>第 {number} 条轨迹“{name}”第 {segment} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="105" />
+            <location filename="../../ui/messages_files.py" line="125" />
             <source>line {line}, column {column}</source>
             <translation>第 {line} 行第 {column} 列</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="106" />
+            <location filename="../../ui/messages_files.py" line="126" />
             <source>at “{path}”</source>
             <translation>位于“{path}”</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="107" />
+            <location filename="../../ui/messages_files.py" line="127" />
             <source>a key at “{path}”</source>
             <translation>位于“{path}”的键</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="113" />
+            <location filename="../../ui/messages_files.py" line="133" />
             <source>{place}, field '{column}': {problem}</source>
             <translation>{place}，字段“{column}”：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="114" />
+            <location filename="../../ui/messages_files.py" line="134" />
             <source>{place}: {problem}</source>
             <translation>{place}：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="115" />
+            <location filename="../../ui/messages_files.py" line="135" />
             <source>{file}: {text}</source>
             <translation>{file}：{text}</translation>
         </message>
@@ -2291,17 +2291,17 @@
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="404" />
+            <location filename="../../ui/panels/monitor_panel.py" line="406" />
             <source>values stale (grey): no fresh data from the controller</source>
             <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="400" />
+            <location filename="../../ui/panels/monitor_panel.py" line="402" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="402" />
+            <location filename="../../ui/panels/monitor_panel.py" line="404" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -2412,42 +2412,42 @@
             <translation>未设置（无人能以此角色登录）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="156" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="157" />
             <source>The administrator password can be changed, not removed</source>
             <translation>管理员密码只能修改，不能清除</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="170" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="171" />
             <source>The two passwords differ</source>
             <translation>两次输入的密码不一致</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="178" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="179" />
             <source>Not set: {why}</source>
             <translation>未设置：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="183" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="184" />
             <source>Password set for the {role} role</source>
             <translation>已为{role}角色设置密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="196" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="197" />
             <source>Not cleared: {why}</source>
             <translation>未清除：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="198" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="199" />
             <source>Password cleared for the {role} role</source>
             <translation>已清除{role}角色的密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="210" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="211" />
             <source>The setting could not be saved: {why}</source>
             <translation>设置无法保存：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/password_dialog.py" line="212" />
+            <location filename="../../ui/dialogs/password_dialog.py" line="213" />
             <source>The window locks back to operator after {n} min without input</source>
             <translation>无操作 {n} 分钟后窗口退回操作员</translation>
         </message>
@@ -2469,43 +2469,43 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="268" />
+            <location filename="../../ui/panels/planner_widgets.py" line="294" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="269" />
+            <location filename="../../ui/panels/planner_widgets.py" line="295" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="288" />
+            <location filename="../../ui/panels/planner_widgets.py" line="314" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="291" />
+            <location filename="../../ui/panels/planner_widgets.py" line="317" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="293" />
+            <location filename="../../ui/panels/planner_widgets.py" line="319" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="295" />
+            <location filename="../../ui/panels/planner_widgets.py" line="321" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="298" />
+            <location filename="../../ui/panels/planner_widgets.py" line="324" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -2513,7 +2513,7 @@
     <context>
         <name>PlanEdits</name>
         <message>
-            <location filename="../../ui/panels/planner_edit.py" line="88" />
+            <location filename="../../ui/panels/planner_edit.py" line="94" />
             <source>Deleted plan {name} (Ctrl+Z to undo)</source>
             <translation>已删除轨迹 {name}（Ctrl+Z 撤销）</translation>
         </message>
@@ -2521,7 +2521,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="331" />
+            <location filename="../../ui/panels/planner_widgets.py" line="358" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -2529,62 +2529,62 @@
     <context>
         <name>PlanListModel</name>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="102" />
+            <location filename="../../ui/models/plan_model.py" line="104" />
             <source>Plan</source>
             <translation>轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="102" />
+            <location filename="../../ui/models/plan_model.py" line="104" />
             <source>Loops</source>
             <translation>循环次数</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="102" />
+            <location filename="../../ui/models/plan_model.py" line="104" />
             <source>Segments</source>
             <translation>段数</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="154" />
+            <location filename="../../ui/models/plan_model.py" line="157" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="158" />
+            <location filename="../../ui/models/plan_model.py" line="161" />
             <source>How many times the plan runs (0 = until stopped)</source>
             <translation>轨迹运行次数（0 = 直到停止）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="183" />
+            <location filename="../../ui/models/plan_model.py" line="186" />
             <source>Plan: refused, {reason}</source>
             <translation>轨迹：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="189" />
+            <location filename="../../ui/models/plan_model.py" line="192" />
             <source>plan</source>
             <translation>轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="193" />
+            <location filename="../../ui/models/plan_model.py" line="196" />
             <source>Add plan {name}</source>
             <translation>添加轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="201" />
+            <location filename="../../ui/models/plan_model.py" line="204" />
             <source>Duplicate plan {name}</source>
             <translation>复制轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="206" />
+            <location filename="../../ui/models/plan_model.py" line="210" />
             <source>Delete plan {name}</source>
             <translation>删除轨迹 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="216" />
+            <location filename="../../ui/models/plan_model.py" line="220" />
             <source>Rename plan {old} to {new}</source>
             <translation>将轨迹 {old} 重命名为 {new}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_model.py" line="225" />
+            <location filename="../../ui/models/plan_model.py" line="229" />
             <source>Set loops of {name} to {n}</source>
             <translation>将轨迹 {name} 的循环次数设为 {n}</translation>
         </message>
@@ -2592,68 +2592,68 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="265" />
+            <location filename="../../ui/panels/plan_preview.py" line="268" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="266" />
+            <location filename="../../ui/panels/plan_preview.py" line="269" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="267" />
+            <location filename="../../ui/panels/plan_preview.py" line="270" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="271" />
+            <location filename="../../ui/panels/plan_preview.py" line="274" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="272" />
+            <location filename="../../ui/panels/plan_preview.py" line="276" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="363" />
+            <location filename="../../ui/panels/plan_preview.py" line="372" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="365" />
+            <location filename="../../ui/panels/plan_preview.py" line="374" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="367" />
+            <location filename="../../ui/panels/plan_preview.py" line="377" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="368" />
+            <location filename="../../ui/panels/plan_preview.py" line="378" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="371" />
+            <location filename="../../ui/panels/plan_preview.py" line="382" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="375" />
+            <location filename="../../ui/panels/plan_preview.py" line="389" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="377" />
+            <location filename="../../ui/panels/plan_preview.py" line="392" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="378" />
+            <location filename="../../ui/panels/plan_preview.py" line="394" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -2661,23 +2661,23 @@
     <context>
         <name>PlanRunBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="221" />
+            <location filename="../../ui/panels/planner_widgets.py" line="238" />
             <source>Run</source>
             <extracomment>Colour of a summary line by level (the status line uses the darker warning text).</extracomment>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="224" />
+            <location filename="../../ui/panels/planner_widgets.py" line="241" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="225" />
+            <location filename="../../ui/panels/planner_widgets.py" line="243" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="239" />
+            <location filename="../../ui/panels/planner_widgets.py" line="264" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
@@ -2685,27 +2685,27 @@
     <context>
         <name>PlanRunController</name>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="227" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="239" />
             <source>Failed: {reason}</source>
             <translation>失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="227" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="239" />
             <source>Stopped: {reason}</source>
             <translation>已停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="229" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="242" />
             <source>Failed at segment {n}: {reason}</source>
             <translation>在第 {n} 段失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="230" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="244" />
             <source>Stopped at segment {n}: {reason}</source>
             <translation>在第 {n} 段停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="245" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="260" />
             <source>stopped by the operator</source>
             <translation>已由操作员停止</translation>
         </message>
@@ -2713,86 +2713,86 @@
     <context>
         <name>PlanRunFlow</name>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="70" />
+            <location filename="../../ui/panels/planner_run.py" line="76" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="73" />
+            <location filename="../../ui/panels/planner_run.py" line="79" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="85" />
+            <location filename="../../ui/panels/planner_run.py" line="91" />
             <source>Not connected to a controller</source>
             <translation>未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="94" />
+            <location filename="../../ui/panels/planner_run.py" line="102" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="100" />
+            <location filename="../../ui/panels/planner_run.py" line="111" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="102" />
+            <location filename="../../ui/panels/planner_run.py" line="113" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="104" />
+            <location filename="../../ui/panels/planner_run.py" line="115" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="105" />
+            <location filename="../../ui/panels/planner_run.py" line="116" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="117" />
+            <location filename="../../ui/panels/planner_run.py" line="128" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="119" />
+            <location filename="../../ui/panels/planner_run.py" line="130" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="121" />
+            <location filename="../../ui/panels/planner_run.py" line="132" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="123" />
+            <location filename="../../ui/panels/planner_run.py" line="134" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="124" />
+            <location filename="../../ui/panels/planner_run.py" line="135" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="127" />
+            <location filename="../../ui/panels/planner_run.py" line="138" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="131" />
+            <location filename="../../ui/panels/planner_run.py" line="142" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="186" />
+            <location filename="../../ui/panels/planner_run.py" line="197" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
@@ -2800,200 +2800,200 @@
     <context>
         <name>PlannerActions</name>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="65" />
+            <location filename="../../ui/panels/planner_actions.py" line="76" />
             <source>Add</source>
             <extracomment>The plan edits (engineer and up); the rest (run, step, pause, ...) is the operator's.</extracomment>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="65" />
+            <location filename="../../ui/panels/planner_actions.py" line="76" />
             <source>Add an empty plan</source>
             <translation>添加空轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="66" />
+            <location filename="../../ui/panels/planner_actions.py" line="77" />
             <source>Rename</source>
             <translation>重命名</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="66" />
+            <location filename="../../ui/panels/planner_actions.py" line="77" />
             <source>Rename the selected plan (F2)</source>
             <translation>重命名所选轨迹（F2）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="67" />
+            <location filename="../../ui/panels/planner_actions.py" line="78" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="67" />
+            <location filename="../../ui/panels/planner_actions.py" line="78" />
             <source>Copy the selected plan</source>
             <translation>复制所选轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="68" />
-            <location filename="../../ui/panels/planner_actions.py" line="71" />
+            <location filename="../../ui/panels/planner_actions.py" line="79" />
+            <location filename="../../ui/panels/planner_actions.py" line="82" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="68" />
+            <location filename="../../ui/panels/planner_actions.py" line="79" />
             <source>Delete the selected plan (Ctrl+Z to undo)</source>
             <translation>删除所选轨迹（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="69" />
+            <location filename="../../ui/panels/planner_actions.py" line="80" />
             <source>+ Line</source>
             <translation>+ 直线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="69" />
+            <location filename="../../ui/panels/planner_actions.py" line="80" />
             <source>Add a line segment after the selection (Ctrl+L)</source>
             <translation>在所选段之后添加直线段（Ctrl+L）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="70" />
+            <location filename="../../ui/panels/planner_actions.py" line="81" />
             <source>+ Arc</source>
             <translation>+ 圆弧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="70" />
+            <location filename="../../ui/panels/planner_actions.py" line="81" />
             <source>Add an arc segment after the selection</source>
             <translation>在所选段之后添加圆弧段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="71" />
+            <location filename="../../ui/panels/planner_actions.py" line="82" />
             <source>Delete the selected segments</source>
             <translation>删除所选段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="72" />
+            <location filename="../../ui/panels/planner_actions.py" line="83" />
             <source>Move the selected segments up (Alt+Up)</source>
             <translation>上移所选段（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="73" />
+            <location filename="../../ui/panels/planner_actions.py" line="84" />
             <source>Move the selected segments down (Alt+Down)</source>
             <translation>下移所选段（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="74" />
+            <location filename="../../ui/panels/planner_actions.py" line="85" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="74" />
+            <location filename="../../ui/panels/planner_actions.py" line="85" />
             <source>Check the plan from the robot's current pose</source>
             <translation>以机器人当前位姿检查轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="75" />
+            <location filename="../../ui/panels/planner_actions.py" line="86" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="75" />
+            <location filename="../../ui/panels/planner_actions.py" line="86" />
             <source>Upload the points the plan needs</source>
             <translation>上传轨迹所需的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="76" />
+            <location filename="../../ui/panels/planner_actions.py" line="87" />
             <source>Run</source>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="76" />
+            <location filename="../../ui/panels/planner_actions.py" line="87" />
             <source>Run the plan from the first segment (F5)</source>
             <translation>从第一段开始运行轨迹（F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="77" />
+            <location filename="../../ui/panels/planner_actions.py" line="88" />
             <source>Run from here</source>
             <translation>从此处运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="77" />
+            <location filename="../../ui/panels/planner_actions.py" line="88" />
             <source>Run from the selected segment (Shift+F5)</source>
             <translation>从所选段开始运行（Shift+F5）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="78" />
+            <location filename="../../ui/panels/planner_actions.py" line="89" />
             <source>Step</source>
             <translation>单步</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="78" />
+            <location filename="../../ui/panels/planner_actions.py" line="89" />
             <source>Run one segment, then stop (F10)</source>
             <translation>运行一段后停止（F10）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="79" />
+            <location filename="../../ui/panels/planner_actions.py" line="90" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="79" />
+            <location filename="../../ui/panels/planner_actions.py" line="90" />
             <source>Pause the motion</source>
             <translation>暂停运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="80" />
+            <location filename="../../ui/panels/planner_actions.py" line="91" />
             <source>Resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="80" />
+            <location filename="../../ui/panels/planner_actions.py" line="91" />
             <source>Resume the paused motion</source>
             <translation>继续已暂停的运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="81" />
+            <location filename="../../ui/panels/planner_actions.py" line="92" />
             <source>Stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="81" />
+            <location filename="../../ui/panels/planner_actions.py" line="92" />
             <source>Stop the robot and the run</source>
             <translation>停止机器人和轨迹运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="82" />
-            <location filename="../../ui/panels/planner_actions.py" line="94" />
+            <location filename="../../ui/panels/planner_actions.py" line="93" />
+            <location filename="../../ui/panels/planner_actions.py" line="107" />
             <source>Resume from segment</source>
             <translation>从该段继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="82" />
+            <location filename="../../ui/panels/planner_actions.py" line="93" />
             <source>Continue the stopped run</source>
             <translation>继续已停止的运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="93" />
+            <location filename="../../ui/panels/planner_actions.py" line="105" />
             <source>Resume from segment {k}</source>
             <translation>从第 {k} 段继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="117" />
+            <location filename="../../ui/panels/planner_actions.py" line="141" />
             <source>Run is disabled: the plan's checks found errors; fix them first</source>
             <translation>无法运行：计划检查发现错误，请先修正</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="121" />
+            <location filename="../../ui/panels/planner_actions.py" line="145" />
             <source>Run is disabled: not connected to the controller</source>
             <translation>无法运行：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="122" />
+            <location filename="../../ui/panels/planner_actions.py" line="146" />
             <source>Run is disabled: a run is going</source>
             <translation>无法运行：正在运行中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="123" />
+            <location filename="../../ui/panels/planner_actions.py" line="147" />
             <source>Run is disabled: the plan has no segments</source>
             <translation>无法运行：计划没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="124" />
+            <location filename="../../ui/panels/planner_actions.py" line="148" />
             <source>Run is disabled: wait for the points' upload to finish</source>
             <translation>无法运行：请等待点位上传完成</translation>
         </message>
@@ -3001,12 +3001,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="206" />
+            <location filename="../../ui/panels/planner_panel.py" line="258" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="379" />
+            <location filename="../../ui/panels/planner_panel.py" line="432" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -3014,12 +3014,12 @@
     <context>
         <name>PointPicker</name>
         <message>
-            <location filename="../../ui/widgets/point_picker.py" line="119" />
+            <location filename="../../ui/widgets/point_picker.py" line="121" />
             <source>Point P{id} does not exist</source>
             <translation>点 P{id} 不存在</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets/point_picker.py" line="120" />
+            <location filename="../../ui/widgets/point_picker.py" line="123" />
             <source>Pick an existing point (type its id or part of its name)</source>
             <translation>请选择已有的点（输入编号或名称的一部分）</translation>
         </message>
@@ -3027,157 +3027,157 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="161" />
+            <location filename="../../ui/controllers/point_sync.py" line="167" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="172" />
+            <location filename="../../ui/controllers/point_sync.py" line="178" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="182" />
+            <location filename="../../ui/controllers/point_sync.py" line="188" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="184" />
+            <location filename="../../ui/controllers/point_sync.py" line="190" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="191" />
+            <location filename="../../ui/controllers/point_sync.py" line="197" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="217" />
+            <location filename="../../ui/controllers/point_sync.py" line="223" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="223" />
+            <location filename="../../ui/controllers/point_sync.py" line="229" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="226" />
+            <location filename="../../ui/controllers/point_sync.py" line="233" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="230" />
+            <location filename="../../ui/controllers/point_sync.py" line="240" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="232" />
+            <location filename="../../ui/controllers/point_sync.py" line="242" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="237" />
+            <location filename="../../ui/controllers/point_sync.py" line="248" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="253" />
+            <location filename="../../ui/controllers/point_sync.py" line="275" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="273" />
+            <location filename="../../ui/controllers/point_sync.py" line="298" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="276" />
+            <location filename="../../ui/controllers/point_sync.py" line="301" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="301" />
+            <location filename="../../ui/controllers/point_sync.py" line="326" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="315" />
+            <location filename="../../ui/controllers/point_sync.py" line="342" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="339" />
+            <location filename="../../ui/controllers/point_sync.py" line="369" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="344" />
+            <location filename="../../ui/controllers/point_sync.py" line="374" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="355" />
+            <location filename="../../ui/controllers/point_sync.py" line="385" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="359" />
+            <location filename="../../ui/controllers/point_sync.py" line="390" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="365" />
+            <location filename="../../ui/controllers/point_sync.py" line="400" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="373" />
+            <location filename="../../ui/controllers/point_sync.py" line="409" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="377" />
+            <location filename="../../ui/controllers/point_sync.py" line="414" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="386" />
+            <location filename="../../ui/controllers/point_sync.py" line="426" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="390" />
+            <location filename="../../ui/controllers/point_sync.py" line="430" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="394" />
+            <location filename="../../ui/controllers/point_sync.py" line="435" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="437" />
+            <location filename="../../ui/controllers/point_sync.py" line="481" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="440" />
+            <location filename="../../ui/controllers/point_sync.py" line="484" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="456" />
+            <location filename="../../ui/controllers/point_sync.py" line="500" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="460" />
+            <location filename="../../ui/controllers/point_sync.py" line="505" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="464" />
+            <location filename="../../ui/controllers/point_sync.py" line="512" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -3185,28 +3185,28 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/point.py" line="156" />
+            <location filename="../../app/points/point.py" line="199" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="157" />
+            <location filename="../../app/points/point.py" line="200" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="158" />
+            <location filename="../../app/points/point.py" line="201" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="159" />
+            <location filename="../../app/points/point.py" line="202" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="160" />
+            <location filename="../../app/points/point.py" line="203" />
             <source>on controller, unconfirmed</source>
             <translation>已在控制器上（未确认）</translation>
         </message>
@@ -3214,160 +3214,160 @@
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/messages_plan.py" line="101" />
+            <location filename="../../ui/messages_plan.py" line="144" />
             <location filename="../../ui/models/point_columns.py" line="66" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="102" />
+            <location filename="../../ui/messages_plan.py" line="145" />
             <location filename="../../ui/models/point_columns.py" line="67" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="141" />
+            <location filename="../../ui/models/points_model.py" line="144" />
             <source>ID</source>
             <translation>编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="141" />
+            <location filename="../../ui/models/points_model.py" line="145" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="141" />
+            <location filename="../../ui/models/points_model.py" line="146" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="142" />
+            <location filename="../../ui/models/points_model.py" line="147" />
             <source>Sync</source>
             <translation>同步状态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="142" />
+            <location filename="../../ui/models/points_model.py" line="148" />
             <source>Note</source>
             <translation>备注</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="145" />
+            <location filename="../../ui/models/points_model.py" line="152" />
             <source>Temp point id on the controller</source>
             <translation>控制器上的临时点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="146" />
+            <location filename="../../ui/models/points_model.py" line="153" />
             <source>Tool frame (200 = none)</source>
             <translation>工具坐标系（200 = 无）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="147" />
+            <location filename="../../ui/models/points_model.py" line="154" />
             <source>Whether the controller holds this point</source>
             <translation>控制器上是否有此点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="148" />
+            <location filename="../../ui/models/points_model.py" line="155" />
             <source>mm, base frame</source>
             <translation>毫米，基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="149" />
+            <location filename="../../ui/models/points_model.py" line="156" />
             <source>degrees</source>
             <translation>度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="151" />
+            <location filename="../../ui/models/points_model.py" line="158" />
             <source>External axis (recorded only: the controller does not store it)</source>
             <translation>外部轴（仅记录：控制器不保存）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="230" />
+            <location filename="../../ui/models/points_model.py" line="239" />
             <source>no reason given</source>
             <translation>未给出原因</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="231" />
+            <location filename="../../ui/models/points_model.py" line="240" />
             <source>Upload failed: {reason}</source>
             <translation>上传失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="233" />
+            <location filename="../../ui/models/points_model.py" line="243" />
             <source>Not known whether the controller holds this point (it restarted or the link was lost): upload it before moving to it</source>
             <translation>不确定控制器上是否有此点（控制器已重启或通信曾中断）：运动到该点前请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="235" />
+            <location filename="../../ui/models/points_model.py" line="246" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="236" />
+            <location filename="../../ui/models/points_model.py" line="247" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="237" />
+            <location filename="../../ui/models/points_model.py" line="249" />
             <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
             <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="244" />
+            <location filename="../../ui/models/points_model.py" line="257" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="274" />
+            <location filename="../../ui/models/points_model.py" line="287" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="294" />
+            <location filename="../../ui/models/points_model.py" line="312" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="325" />
+            <location filename="../../ui/models/points_model.py" line="350" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="351" />
+            <location filename="../../ui/models/points_model.py" line="379" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="352" />
+            <location filename="../../ui/models/points_model.py" line="381" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="369" />
+            <location filename="../../ui/models/points_model.py" line="400" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="370" />
+            <location filename="../../ui/models/points_model.py" line="402" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="385" />
+            <location filename="../../ui/models/points_model.py" line="418" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="385" />
+            <location filename="../../ui/models/points_model.py" line="418" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="403" />
+            <location filename="../../ui/models/points_model.py" line="441" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="412" />
+            <location filename="../../ui/models/points_model.py" line="453" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -3375,194 +3375,194 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="148" />
+            <location filename="../../ui/panels/points_panel.py" line="178" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="148" />
+            <location filename="../../ui/panels/points_panel.py" line="180" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="150" />
+            <location filename="../../ui/panels/points_panel.py" line="183" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="150" />
+            <location filename="../../ui/panels/points_panel.py" line="183" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="151" />
+            <location filename="../../ui/panels/points_panel.py" line="184" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="151" />
+            <location filename="../../ui/panels/points_panel.py" line="184" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="152" />
+            <location filename="../../ui/panels/points_panel.py" line="186" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="153" />
+            <location filename="../../ui/panels/points_panel.py" line="187" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="154" />
+            <location filename="../../ui/panels/points_panel.py" line="189" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="155" />
+            <location filename="../../ui/panels/points_panel.py" line="190" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="156" />
+            <location filename="../../ui/panels/points_panel.py" line="192" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="157" />
+            <location filename="../../ui/panels/points_panel.py" line="193" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="158" />
+            <location filename="../../ui/panels/points_panel.py" line="196" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="159" />
+            <location filename="../../ui/panels/points_panel.py" line="197" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="160" />
+            <location filename="../../ui/panels/points_panel.py" line="199" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="160" />
+            <location filename="../../ui/panels/points_panel.py" line="199" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="161" />
-            <location filename="../../ui/panels/points_parts.py" line="151" />
+            <location filename="../../ui/panels/points_panel.py" line="201" />
+            <location filename="../../ui/panels/points_parts.py" line="166" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="162" />
+            <location filename="../../ui/panels/points_panel.py" line="202" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="163" />
+            <location filename="../../ui/panels/points_panel.py" line="204" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="164" />
-            <location filename="../../ui/panels/points_panel.py" line="328" />
+            <location filename="../../ui/panels/points_panel.py" line="206" />
+            <location filename="../../ui/panels/points_panel.py" line="394" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="165" />
+            <location filename="../../ui/panels/points_panel.py" line="207" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="166" />
+            <location filename="../../ui/panels/points_panel.py" line="209" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="166" />
+            <location filename="../../ui/panels/points_panel.py" line="209" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="167" />
+            <location filename="../../ui/panels/points_panel.py" line="210" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="120" />
+            <location filename="../../ui/panels/points_parts.py" line="129" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="121" />
+            <location filename="../../ui/panels/points_parts.py" line="130" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="122" />
+            <location filename="../../ui/panels/points_parts.py" line="131" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="148" />
+            <location filename="../../ui/panels/points_parts.py" line="160" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="172" />
+            <location filename="../../ui/panels/points_parts.py" line="187" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="173" />
+            <location filename="../../ui/panels/points_parts.py" line="188" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="260" />
+            <location filename="../../ui/panels/points_panel.py" line="304" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="263" />
+            <location filename="../../ui/panels/points_panel.py" line="308" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="264" />
+            <location filename="../../ui/panels/points_panel.py" line="310" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="265" />
+            <location filename="../../ui/panels/points_panel.py" line="313" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="285" />
+            <location filename="../../ui/panels/points_panel.py" line="340" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="288" />
+            <location filename="../../ui/panels/points_panel.py" line="343" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="313" />
+            <location filename="../../ui/panels/points_panel.py" line="369" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="321" />
+            <location filename="../../ui/panels/points_panel.py" line="378" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -3575,7 +3575,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="179" />
+            <location filename="../../ui/panels/points_parts.py" line="194" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -3599,8 +3599,8 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         </message>
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="67" />
-            <location filename="../../ui/panels/pose_strip.py" line="281" />
-            <location filename="../../ui/panels/pose_strip.py" line="282" />
+            <location filename="../../ui/panels/pose_strip.py" line="290" />
+            <location filename="../../ui/panels/pose_strip.py" line="291" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
@@ -3625,32 +3625,32 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="200" />
+            <location filename="../../ui/panels/pose_strip.py" line="208" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="201" />
+            <location filename="../../ui/panels/pose_strip.py" line="209" />
             <source>Mode</source>
             <translation>模式</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="202" />
+            <location filename="../../ui/panels/pose_strip.py" line="210" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="203" />
+            <location filename="../../ui/panels/pose_strip.py" line="211" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="204" />
+            <location filename="../../ui/panels/pose_strip.py" line="212" />
             <source>The controller's program state (register 561)</source>
             <translation>控制器程序状态（寄存器 561）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="205" />
+            <location filename="../../ui/panels/pose_strip.py" line="214" />
             <source>Whether the values shown were confirmed by the controller within the freshness limit</source>
             <translation>显示的数值是否在时效内得到控制器确认</translation>
         </message>
@@ -3658,78 +3658,78 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProgramPanel</name>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="103" />
+            <location filename="../../ui/panels/program_panel.py" line="107" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="104" />
+            <location filename="../../ui/panels/program_panel.py" line="108" />
             <source>Program no.:</source>
             <translation>程序号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="104" />
+            <location filename="../../ui/panels/program_panel.py" line="108" />
             <source>Run mode:</source>
             <translation>运行方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="104" />
+            <location filename="../../ui/panels/program_panel.py" line="108" />
             <source>Cycles:</source>
             <translation>循环次数：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="104" />
+            <location filename="../../ui/panels/program_panel.py" line="108" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="109" />
+            <location filename="../../ui/panels/program_panel.py" line="113" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="110" />
+            <location filename="../../ui/panels/program_panel.py" line="114" />
             <source>Number of cycles in cycle mode; 0 runs until stopped</source>
             <translation>循环模式下的循环次数；0 表示一直运行直到停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="111" />
+            <location filename="../../ui/panels/program_panel.py" line="115" />
             <source>Run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="112" />
-            <location filename="../../ui/panels/program_panel.py" line="114" />
+            <location filename="../../ui/panels/program_panel.py" line="116" />
+            <location filename="../../ui/panels/program_panel.py" line="118" />
             <source>Go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="113" />
+            <location filename="../../ui/panels/program_panel.py" line="117" />
             <source>All axes</source>
             <translation>所有轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="147" />
+            <location filename="../../ui/panels/program_panel.py" line="151" />
             <source>Run program {id} ({mode}) at {speed} %? The arm will move.</source>
             <translation>以 {speed} % 速度运行程序 {id}（{mode}）？机械臂将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="149" />
+            <location filename="../../ui/panels/program_panel.py" line="154" />
             <source>Confirm program run</source>
             <translation>确认运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="155" />
+            <location filename="../../ui/panels/program_panel.py" line="160" />
             <source>all axes</source>
             <translation>所有轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="156" />
+            <location filename="../../ui/panels/program_panel.py" line="161" />
             <source>Move {which} to zero? The arm will move.</source>
             <translation>将 {which} 回零？机械臂将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="157" />
+            <location filename="../../ui/panels/program_panel.py" line="162" />
             <source>Confirm go to zero</source>
             <translation>确认回零</translation>
         </message>
@@ -3737,158 +3737,158 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="129" />
+            <location filename="../../ui/controllers/project_controller.py" line="136" />
             <source>Undo</source>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="131" />
+            <location filename="../../ui/controllers/project_controller.py" line="138" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="135" />
+            <location filename="../../ui/controllers/project_controller.py" line="142" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="136" />
+            <location filename="../../ui/controllers/project_controller.py" line="143" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="137" />
+            <location filename="../../ui/controllers/project_controller.py" line="144" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="138" />
+            <location filename="../../ui/controllers/project_controller.py" line="145" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="139" />
+            <location filename="../../ui/controllers/project_controller.py" line="146" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="140" />
+            <location filename="../../ui/controllers/project_controller.py" line="147" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="163" />
+            <location filename="../../ui/controllers/project_controller.py" line="177" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="196" />
+            <location filename="../../ui/controllers/project_controller.py" line="210" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="204" />
-            <location filename="../../ui/controllers/project_controller.py" line="240" />
-            <location filename="../../ui/controllers/project_controller.py" line="352" />
+            <location filename="../../ui/controllers/project_controller.py" line="218" />
+            <location filename="../../ui/controllers/project_controller.py" line="254" />
+            <location filename="../../ui/controllers/project_controller.py" line="371" />
             <source>Project in use</source>
             <translation>工程正在使用中</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="209" />
-            <location filename="../../ui/controllers/project_controller.py" line="212" />
+            <location filename="../../ui/controllers/project_controller.py" line="223" />
+            <location filename="../../ui/controllers/project_controller.py" line="226" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="215" />
+            <location filename="../../ui/controllers/project_controller.py" line="229" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="227" />
+            <location filename="../../ui/controllers/project_controller.py" line="241" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="245" />
+            <location filename="../../ui/controllers/project_controller.py" line="259" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="257" />
+            <location filename="../../ui/controllers/project_controller.py" line="271" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="263" />
+            <location filename="../../ui/controllers/project_controller.py" line="277" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="270" />
-            <location filename="../../ui/controllers/project_controller.py" line="273" />
+            <location filename="../../ui/controllers/project_controller.py" line="284" />
             <location filename="../../ui/controllers/project_controller.py" line="287" />
+            <location filename="../../ui/controllers/project_controller.py" line="301" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="289" />
+            <location filename="../../ui/controllers/project_controller.py" line="303" />
             <source>{added} added, {updated} updated, {unchanged} unchanged, {removed} removed</source>
             <translation>新增 {added} 个，更新 {updated} 个，未变 {unchanged} 个，删除 {removed} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="291" />
+            <location filename="../../ui/controllers/project_controller.py" line="306" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="297" />
+            <location filename="../../ui/controllers/project_controller.py" line="312" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="304" />
+            <location filename="../../ui/controllers/project_controller.py" line="319" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="306" />
+            <location filename="../../ui/controllers/project_controller.py" line="322" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="332" />
+            <location filename="../../ui/controllers/project_controller.py" line="349" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="368" />
-            <location filename="../../ui/controllers/project_controller.py" line="371" />
+            <location filename="../../ui/controllers/project_controller.py" line="387" />
+            <location filename="../../ui/controllers/project_controller.py" line="390" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="374" />
+            <location filename="../../ui/controllers/project_controller.py" line="393" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="405" />
+            <location filename="../../ui/controllers/project_controller.py" line="425" />
             <source>Cannot lock {path}: {reason}</source>
             <translation>无法锁定 {path}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="414" />
+            <location filename="../../ui/controllers/project_controller.py" line="435" />
             <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
             <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="450" />
+            <location filename="../../ui/controllers/project_controller.py" line="471" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="453" />
+            <location filename="../../ui/controllers/project_controller.py" line="474" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>
@@ -3896,22 +3896,22 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectDialogs</name>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="39" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="41" />
             <source>Unsaved changes</source>
             <translation>未保存的更改</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="40" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="42" />
             <source>Save the changes to {name}?</source>
             <translation>保存对 {name} 的更改？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="51" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="56" />
             <source>an unsaved project</source>
             <translation>未保存的工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="52" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="58" />
             <source>TeachPad was not closed properly. An autosave of {what} is newer than the saved file:
 {autosave}
 
@@ -3922,12 +3922,12 @@ Recover it?</source>
 是否恢复？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="54" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="63" />
             <source>Recover autosave</source>
             <translation>恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="61" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="73" />
             <source>The file has no points. Importing it in replace mode removes all {n} points of the project.
 
 Remove them all?</source>
@@ -3936,23 +3936,23 @@ Remove them all?</source>
 确定全部删除吗？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="69" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="86" />
             <source>Replace all points</source>
             <translation>替换全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="70" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="87" />
             <source>Merge (update the same ids, append new ones)</source>
             <translation>合并（更新相同编号，追加新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="63" />
-            <location filename="../../ui/controllers/project_dialogs.py" line="71" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="78" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="90" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="71" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="91" />
             <source>Import mode:</source>
             <translation>导入方式：</translation>
         </message>
@@ -4185,174 +4185,174 @@ Remove them all?</source>
     <context>
         <name>RegisterProfileDialog</name>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="131" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="152" />
             <source>Register profile</source>
             <extracomment>apply(profile, reconnect) -&gt; None when saved, else the reason (already in the user's language)</extracomment>
             <translation>寄存器配置</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="132" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="154" />
             <source>Name:</source>
             <translation>名称：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="132" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="155" />
             <source>Float word order:</source>
             <translation>浮点字序：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="132" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="156" />
             <source>Unit id:</source>
             <translation>站号：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="133" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="157" />
             <source>Command completion:</source>
             <translation>指令完成判定：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="133" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="158" />
             <source>Unconfirmed after:</source>
             <translation>未确认判定时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="133" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="159" />
             <source>Poll timeout:</source>
             <translation>轮询超时：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="134" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="160" />
             <source>Date/time layout:</source>
             <translation>日期/时间格式：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="134" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="161" />
             <source>Lowest point id:</source>
             <translation>最小点号：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="134" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="162" />
             <source>Highest point id:</source>
             <translation>最大点号：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="137" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="166" />
             <source>Low word first (CDAB, default)</source>
             <translation>低字在前（CDAB，默认）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="138" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="167" />
             <source>High word first (ABCD)</source>
             <translation>高字在前（ABCD）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="139" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="170" />
             <source>automatic (probe GV291 once)</source>
             <translation>自动（试探一次 GV291）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="140" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="171" />
             <source>sentinel (GV291 keeps what the host writes)</source>
             <translation>哨兵值（GV291 保留上位机写入的值）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="141" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="172" />
             <source>observe (GV291 read-only or ignores writes)</source>
             <translation>观察（GV291 只读或忽略写入）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="143" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="176" />
             <source>split words (576 = year, 577 = month·256 + day)</source>
             <translation>分字（576 = 年，577 = 月·256 + 日）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="144" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="177" />
             <source>packed 32-bit (year in the high word)</source>
             <translation>32 位打包（年在高字）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="145" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="178" />
             <source>automatic</source>
             <translation>自动</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="146" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="179" />
             <source>automatic (by transport)</source>
             <translation>自动（按通信方式）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="147" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="180" />
             <source>Reconnect now to apply it</source>
             <translation>立即重新连接以应用</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="148" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="181" />
             <source>Otherwise it applies at the next connection</source>
             <translation>否则在下次连接时生效</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="149" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="182" />
             <source>Load…</source>
             <translation>载入…</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="150" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="183" />
             <source>Save as…</source>
             <translation>另存为…</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="151" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="184" />
             <source>Defaults</source>
             <translation>默认值</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="153" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="186" />
             <source>Save and apply</source>
             <translation>保存并应用</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="172" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="216" />
             <source>In force: “{name}”, revision {rev}, saved {saved}</source>
             <translation>当前生效：“{name}”，第 {rev} 版，保存于 {saved}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="175" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="220" />
             <source>In force: the remembered connection settings (no register profile saved yet)</source>
             <translation>当前生效：记住的连接设置（尚未保存寄存器配置）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="214" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="266" />
             <source>Not loaded: {why}</source>
             <translation>未载入：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="217" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="269" />
             <source>Loaded “{name}” from {file}; press Save and apply to use it</source>
             <translation>已从 {file} 载入“{name}”；按“保存并应用”后生效</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="232" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="285" />
             <source>Cannot write {file}: {why}</source>
             <translation>无法写入 {file}：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="235" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="288" />
             <source>Saved to {file}</source>
             <translation>已保存到 {file}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="251" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="305" />
             <source>Load a register profile</source>
             <translation>载入寄存器配置</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="252" />
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="257" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="305" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="311" />
             <source>Register profiles (*.json)</source>
             <translation>寄存器配置 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="256" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="311" />
             <source>Save the register profile as</source>
             <translation>寄存器配置另存为</translation>
         </message>
@@ -4360,7 +4360,7 @@ Remove them all?</source>
     <context>
         <name>RobotModelSource</name>
         <message>
-            <location filename="../../ui/panels/view3d_robot.py" line="97" />
+            <location filename="../../ui/panels/view3d_robot.py" line="99" />
             <source>The robot model remembered from the last session could not be loaded: %1. The default robot model (%2) is used.</source>
             <translation>上次使用的机器人模型无法加载：%1。现使用默认机器人模型（%2）。</translation>
         </message>
@@ -4398,28 +4398,28 @@ Remove them all?</source>
             <translation>密码：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="72" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="73" />
             <source>No administrator password is set yet: choose the administrator role, type a password and press “Set this role's password”.</source>
             <translation>尚未设置管理员密码：请选择管理员角色，输入密码，然后按“设置此角色的密码”。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="75" />
-            <location filename="../../ui/dialogs/role_dialog.py" line="85" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="77" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="88" />
             <source>No password is set for this role; an administrator sets it.</source>
             <translation>此角色尚未设置密码；请由管理员设置。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="83" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="86" />
             <source>Wrong password for the {role} role</source>
             <translation>{role}角色的密码错误</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="102" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="106" />
             <source>The password could not be saved: {why}</source>
             <translation>无法保存密码：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="105" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="109" />
             <source>Password set for the {role} role</source>
             <translation>已设置{role}角色的密码</translation>
         </message>
@@ -4455,77 +4455,77 @@ Remove them all?</source>
     <context>
         <name>SafetyController</name>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="159" />
+            <location filename="../../ui/controllers/safety.py" line="170" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="159" />
+            <location filename="../../ui/controllers/safety.py" line="171" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="160" />
+            <location filename="../../ui/controllers/safety.py" line="172" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="166" />
+            <location filename="../../ui/controllers/safety.py" line="179" />
             <source>Needs the {need} role (you are {role}); log in from the Safety menu</source>
             <translation>需要{need}角色（当前为{role}）；请从“安全”菜单登录</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="355" />
+            <location filename="../../ui/controllers/safety.py" line="373" />
             <source>{axis} = {value:.1f} is within stopping distance of the keep-out zone '{box}' (at {limit:.1f})</source>
             <translation>{axis} = {value:.1f}，已进入禁区“{box}”的停止距离内（边界 {limit:.1f}）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="358" />
+            <location filename="../../ui/controllers/safety.py" line="377" />
             <source>{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}</source>
             <translation>{axis} = {value:.1f}，已进入限位 {limit:.1f} 的停止距离内</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="360" />
+            <location filename="../../ui/controllers/safety.py" line="379" />
             <source>{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)</source>
             <translation>{axis} = {value:.1f} mm 超出允许的工作空间（限值 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="362" />
+            <location filename="../../ui/controllers/safety.py" line="382" />
             <source>The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, its face at {limit:.1f} mm)</source>
             <translation>路径进入禁区“{box}”（{axis} = {value:.1f} mm，边界在 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="365" />
+            <location filename="../../ui/controllers/safety.py" line="386" />
             <source>{axis} = {value:.1f}° is beyond its limit {limit:.1f}°</source>
             <translation>{axis} = {value:.1f}° 超出限位 {limit:.1f}°</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="367" />
+            <location filename="../../ui/controllers/safety.py" line="389" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode</source>
             <translation>速度 {value:g} mm/s 超过降速模式允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="368" />
+            <location filename="../../ui/controllers/safety.py" line="391" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed</source>
             <translation>速度 {value:g} mm/s 超过允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="370" />
+            <location filename="../../ui/controllers/safety.py" line="395" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode</source>
             <translation>点动速度 {value:g} % 超过降速模式允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="371" />
+            <location filename="../../ui/controllers/safety.py" line="397" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed</source>
             <translation>点动速度 {value:g} % 超过允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="375" />
+            <location filename="../../ui/controllers/safety.py" line="402" />
             <source>Segment {k}: {text}</source>
             <translation>第 {k} 段：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="380" />
+            <location filename="../../ui/controllers/safety.py" line="407" />
             <source>Jog stopped before the limit: {why}</source>
             <translation>点动已在到达边界前停止：{why}</translation>
         </message>
@@ -4533,112 +4533,112 @@ Remove them all?</source>
     <context>
         <name>SafetyMenu</name>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="101" />
+            <location filename="../../ui/controllers/safety_menu.py" line="111" />
             <source>&amp;Safety</source>
             <translation>安全(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="102" />
+            <location filename="../../ui/controllers/safety_menu.py" line="112" />
             <source>Log &amp;in…</source>
             <translation>登录(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="103" />
+            <location filename="../../ui/controllers/safety_menu.py" line="113" />
             <source>Log &amp;out (operator)</source>
             <translation>注销(&amp;O)（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="104" />
+            <location filename="../../ui/controllers/safety_menu.py" line="114" />
             <source>&amp;Reduced speed</source>
             <translation>降速模式(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="105" />
+            <location filename="../../ui/controllers/safety_menu.py" line="115" />
             <source>Safety &amp;envelope…</source>
             <translation>安全范围(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="106" />
+            <location filename="../../ui/controllers/safety_menu.py" line="116" />
             <source>Re&amp;gister profile…</source>
             <translation>寄存器配置(&amp;G)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="107" />
+            <location filename="../../ui/controllers/safety_menu.py" line="118" />
             <source>Word order, unit id, completion rule, poll timeout (administrator)</source>
             <translation>字序、站号、完成判定、轮询超时（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="109" />
+            <location filename="../../ui/controllers/safety_menu.py" line="120" />
             <source>&amp;Passwords and lock…</source>
             <translation>密码与锁定(&amp;P)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="110" />
+            <location filename="../../ui/controllers/safety_menu.py" line="122" />
             <source>Set, change or clear passwords; the idle lock time (administrator)</source>
             <translation>设置、修改或清除密码；空闲锁定时间（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="112" />
+            <location filename="../../ui/controllers/safety_menu.py" line="124" />
             <source>&amp;Audit trail…</source>
             <translation>审计记录(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="113" />
+            <location filename="../../ui/controllers/safety_menu.py" line="125" />
             <source>Write a &amp;support bundle…</source>
             <translation>生成支持包(&amp;S)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="126" />
+            <location filename="../../ui/controllers/safety_menu.py" line="138" />
             <source>Role: {role} · reduced speed</source>
             <translation>角色：{role} · 降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="126" />
+            <location filename="../../ui/controllers/safety_menu.py" line="138" />
             <source>Role: {role}</source>
             <translation>角色：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="134" />
+            <location filename="../../ui/controllers/safety_menu.py" line="148" />
             <source>Cap jog and move speeds (anyone may switch it on)</source>
             <translation>限制点动与移动速度（任何人都可开启）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="138" />
+            <location filename="../../ui/controllers/safety_menu.py" line="153" />
             <source>safety</source>
             <translation>安全</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="187" />
+            <location filename="../../ui/controllers/safety_menu.py" line="208" />
             <source>The register profile could not be saved: {why}</source>
             <translation>寄存器配置无法保存：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="192" />
+            <location filename="../../ui/controllers/safety_menu.py" line="213" />
             <source>Register profile “{name}” saved (revision {rev})</source>
             <translation>寄存器配置“{name}”已保存（第 {rev} 版）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="202" />
+            <location filename="../../ui/controllers/safety_menu.py" line="223" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="209" />
+            <location filename="../../ui/controllers/safety_menu.py" line="230" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="231" />
+            <location filename="../../ui/controllers/safety_menu.py" line="258" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="232" />
+            <location filename="../../ui/controllers/safety_menu.py" line="259" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="236" />
+            <location filename="../../ui/controllers/safety_menu.py" line="265" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
@@ -4646,7 +4646,7 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="384" />
+            <location filename="../../ui/panels/planner_widgets.py" line="427" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>
@@ -4654,52 +4654,52 @@ Remove them all?</source>
     <context>
         <name>SegmentTableModel</name>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="105" />
+            <location filename="../../ui/models/segment_model.py" line="106" />
             <source>Type</source>
             <translation>类型</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="105" />
+            <location filename="../../ui/models/segment_model.py" line="107" />
             <source>Middle point</source>
             <translation>中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="105" />
+            <location filename="../../ui/models/segment_model.py" line="108" />
             <source>End point</source>
             <translation>终点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="106" />
+            <location filename="../../ui/models/segment_model.py" line="110" />
             <source>Orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="106" />
+            <location filename="../../ui/models/segment_model.py" line="112" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_columns.py" line="60" />
+            <location filename="../../ui/models/plan_columns.py" line="69" />
             <source>changes</source>
             <translation>姿态变化</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_columns.py" line="61" />
+            <location filename="../../ui/models/plan_columns.py" line="70" />
             <source>kept</source>
             <translation>姿态保持</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_columns.py" line="85" />
+            <location filename="../../ui/models/plan_columns.py" line="94" />
             <source>error</source>
             <translation>错误</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_columns.py" line="86" />
+            <location filename="../../ui/models/plan_columns.py" line="95" />
             <source>needs upload</source>
             <translation>需要上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_columns.py" line="87" />
+            <location filename="../../ui/models/plan_columns.py" line="96" />
             <source>warning</source>
             <translation>警告</translation>
         </message>
@@ -4709,117 +4709,117 @@ Remove them all?</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="106" />
+            <location filename="../../ui/models/segment_model.py" line="109" />
             <source>Speed</source>
             <translation>速度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="106" />
+            <location filename="../../ui/models/segment_model.py" line="111" />
             <source>Ignore mid.</source>
             <translation>忽略中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="107" />
+            <location filename="../../ui/models/segment_model.py" line="113" />
             <source>Length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="107" />
+            <location filename="../../ui/models/segment_model.py" line="114" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="196" />
+            <location filename="../../ui/models/segment_model.py" line="205" />
             <source>Checks before running: hover the icon for details</source>
             <translation>运行前检查：鼠标悬停在图标上查看详情</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="197" />
+            <location filename="../../ui/models/segment_model.py" line="206" />
             <source>Speed in mm/s (GV225)</source>
             <translation>速度，单位 mm/s（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="198" />
+            <location filename="../../ui/models/segment_model.py" line="207" />
             <source>Middle point of an arc (GV200)</source>
             <translation>圆弧的中间点（GV200）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="199" />
+            <location filename="../../ui/models/segment_model.py" line="208" />
             <source>End point (GV201)</source>
             <translation>终点（GV201）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="200" />
+            <location filename="../../ui/models/segment_model.py" line="209" />
             <source>Orientation kept constant or changing along the move (GV202)</source>
             <translation>运动中姿态保持不变或变化（GV202）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="201" />
+            <location filename="../../ui/models/segment_model.py" line="210" />
             <source>Ignore the arc's middle point orientation (GV203)</source>
             <translation>忽略圆弧中间点的姿态（GV203）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="202" />
+            <location filename="../../ui/models/segment_model.py" line="211" />
             <source>Tool frame of the move (GV245)</source>
             <translation>运动使用的工具坐标系（GV245）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="203" />
+            <location filename="../../ui/models/segment_model.py" line="212" />
             <source>Estimated path length</source>
             <translation>估计路径长度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="204" />
+            <location filename="../../ui/models/segment_model.py" line="213" />
             <source>Estimated time: length / speed plus a fixed overhead per segment</source>
             <translation>估计时间：长度 / 速度，加上每段固定开销</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="304" />
+            <location filename="../../ui/models/segment_model.py" line="313" />
             <source>Segment {n}: no problems found</source>
             <translation>第 {n} 段：未发现问题</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="309" />
+            <location filename="../../ui/models/segment_model.py" line="318" />
             <source>Point P{id} does not exist</source>
             <translation>点 P{id} 不存在</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="343" />
+            <location filename="../../ui/models/segment_model.py" line="353" />
             <source>Segment {n}, {column}: refused, {reason}</source>
             <translation>第 {n} 段，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="370" />
+            <location filename="../../ui/models/segment_model.py" line="391" />
             <source>Edit segment {n} {column}</source>
             <translation>编辑第 {n} 段 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="381" />
+            <location filename="../../ui/models/segment_model.py" line="403" />
             <source>Add {kind} segment</source>
             <translation>添加{kind}段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="415" />
+            <location filename="../../ui/models/segment_model.py" line="442" />
             <source>Add {n} segments</source>
             <translation>添加 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="422" />
+            <location filename="../../ui/models/segment_model.py" line="451" />
             <source>Delete segment {n}</source>
             <translation>删除第 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="423" />
+            <location filename="../../ui/models/segment_model.py" line="453" />
             <source>Delete {n} segments</source>
             <translation>删除 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="439" />
+            <location filename="../../ui/models/segment_model.py" line="474" />
             <source>Move segment up</source>
             <translation>上移段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="439" />
+            <location filename="../../ui/models/segment_model.py" line="474" />
             <source>Move segment down</source>
             <translation>下移段</translation>
         </message>
@@ -4934,32 +4934,32 @@ Remove them all?</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="397" />
+            <location filename="../../ui/panels/status_panel.py" line="399" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="405" />
+            <location filename="../../ui/panels/status_panel.py" line="407" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="409" />
+            <location filename="../../ui/panels/status_panel.py" line="411" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="413" />
+            <location filename="../../ui/panels/status_panel.py" line="415" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="419" />
+            <location filename="../../ui/panels/status_panel.py" line="421" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="423" />
+            <location filename="../../ui/panels/status_panel.py" line="425" />
             <source>{value} (stale)</source>
             <translation>{value}（已过期）</translation>
         </message>
@@ -4967,97 +4967,97 @@ Remove them all?</source>
     <context>
         <name>StepPanel</name>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="156" />
+            <location filename="../../ui/panels/step_panel.py" line="157" />
             <source>Frame:</source>
             <translation>坐标系：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="157" />
+            <location filename="../../ui/panels/step_panel.py" line="158" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="158" />
+            <location filename="../../ui/panels/step_panel.py" line="159" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="159" />
+            <location filename="../../ui/panels/step_panel.py" line="160" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="160" />
+            <location filename="../../ui/panels/step_panel.py" line="161" />
             <source>Expected speed of the incremental move (GV225)</source>
             <translation>增量运动的期望速度（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="161" />
+            <location filename="../../ui/panels/step_panel.py" line="162" />
             <source>Increment per click (mm or °)</source>
             <translation>每次点击的增量（mm 或 °）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="162" />
+            <location filename="../../ui/panels/step_panel.py" line="163" />
             <source>Incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="163" />
+            <location filename="../../ui/panels/step_panel.py" line="164" />
             <source>Exact offset</source>
             <translation>精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="164" />
+            <location filename="../../ui/panels/step_panel.py" line="165" />
             <source>Move by values</source>
             <translation>按数值运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="165" />
+            <location filename="../../ui/panels/step_panel.py" line="166" />
             <source>Move every axis by its exact offset in one incremental move</source>
             <translation>以一次增量运动使各轴移动其精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="166" />
+            <location filename="../../ui/panels/step_panel.py" line="167" />
             <source>Clear values</source>
             <translation>清除数值</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="167" />
+            <location filename="../../ui/panels/step_panel.py" line="168" />
             <source>External axes J7–J11</source>
             <translation>外部轴 J7–J11</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="168" />
+            <location filename="../../ui/panels/step_panel.py" line="169" />
             <source>Show the external axes; while hidden their offsets are 0</source>
             <translation>显示外部轴；隐藏时其偏移量为 0</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="197" />
+            <location filename="../../ui/panels/step_panel.py" line="198" />
             <source>rpm</source>
             <translation>转/分</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="197" />
+            <location filename="../../ui/panels/step_panel.py" line="198" />
             <source>mm/s</source>
             <translation>mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="247" />
+            <location filename="../../ui/panels/step_panel.py" line="254" />
             <source>Move by {moves} at {speed} {unit}?</source>
             <translation>以 {speed} {unit} 运动 {moves}？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="249" />
+            <location filename="../../ui/panels/step_panel.py" line="257" />
             <source>Confirm incremental move</source>
             <translation>确认增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="273" />
+            <location filename="../../ui/panels/step_panel.py" line="281" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="273" />
+            <location filename="../../ui/panels/step_panel.py" line="281" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
@@ -5103,62 +5103,62 @@ Remove them all?</source>
     <context>
         <name>TrafficPanel</name>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="145" />
+            <location filename="../../ui/panels/traffic_panel.py" line="150" />
             <source>Filter: bytes or meaning</source>
             <translation>过滤：字节或含义</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="146" />
+            <location filename="../../ui/panels/traffic_panel.py" line="151" />
             <source>Hide polls</source>
             <translation>隐藏轮询</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="148" />
+            <location filename="../../ui/panels/traffic_panel.py" line="153" />
             <source>Hide the periodic reads of 412.. (pose) and 560.. (status)</source>
             <translation>隐藏对 412..（位姿）和 560..（状态）的周期读取</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="150" />
+            <location filename="../../ui/panels/traffic_panel.py" line="155" />
             <source>Pause capture</source>
             <translation>暂停抓包</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="151" />
+            <location filename="../../ui/panels/traffic_panel.py" line="156" />
             <source>Stop recording frames (the worker stops building them)</source>
             <translation>停止记录报文（后台不再生成报文记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="152" />
+            <location filename="../../ui/panels/traffic_panel.py" line="157" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="153" />
+            <location filename="../../ui/panels/traffic_panel.py" line="158" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="276" />
+            <location filename="../../ui/panels/traffic_panel.py" line="283" />
             <source>Export traffic</source>
             <translation>导出通信报文</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="277" />
+            <location filename="../../ui/panels/traffic_panel.py" line="285" />
             <source>CSV files (*.csv);;Text files (*.txt);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;文本文件 (*.txt);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="304" />
+            <location filename="../../ui/panels/traffic_panel.py" line="314" />
             <source>{n} frames</source>
             <translation>{n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="306" />
+            <location filename="../../ui/panels/traffic_panel.py" line="316" />
             <source>{shown} of {n} frames shown</source>
             <translation>显示 {shown} / {n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="308" />
+            <location filename="../../ui/panels/traffic_panel.py" line="318" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
         </message>
@@ -5166,7 +5166,7 @@ Remove them all?</source>
     <context>
         <name>View3DCanvas</name>
         <message>
-            <location filename="../../ui/panels/view3d_canvas.py" line="227" />
+            <location filename="../../ui/panels/view3d_canvas.py" line="239" />
             <source>grid %1 mm</source>
             <translation>网格 %1 mm</translation>
         </message>
@@ -5188,129 +5188,129 @@ Remove them all?</source>
     <context>
         <name>View3DPanel</name>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="190" />
+            <location filename="../../ui/panels/view3d_panel.py" line="203" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="190" />
+            <location filename="../../ui/panels/view3d_panel.py" line="204" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="190" />
+            <location filename="../../ui/panels/view3d_panel.py" line="205" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="191" />
+            <location filename="../../ui/panels/view3d_panel.py" line="206" />
             <source>Iso</source>
             <translation>轴测</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="194" />
+            <location filename="../../ui/panels/view3d_panel.py" line="210" />
             <source>Look at the scene from a preset direction</source>
             <translation>从预设方向观察场景</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="195" />
+            <location filename="../../ui/panels/view3d_panel.py" line="211" />
             <source>Fit all</source>
             <translation>全部显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="196" />
+            <location filename="../../ui/panels/view3d_panel.py" line="212" />
             <source>Show the arm, the points and the plan</source>
             <translation>显示机械臂、点位和轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="197" />
+            <location filename="../../ui/panels/view3d_panel.py" line="213" />
             <source>Orthographic</source>
             <translation>正交投影</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="198" />
+            <location filename="../../ui/panels/view3d_panel.py" line="214" />
             <source>Parallel projection (no perspective)</source>
             <translation>平行投影（无透视）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="199" />
+            <location filename="../../ui/panels/view3d_panel.py" line="215" />
             <source>Robot model…</source>
             <translation>机器人模型…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="200" />
+            <location filename="../../ui/panels/view3d_panel.py" line="217" />
             <source>Robot model: %1. Load another robot model profile (JSON)</source>
             <translation>机器人模型：%1。加载其他机器人模型配置文件（JSON）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="202" />
+            <location filename="../../ui/panels/view3d_panel.py" line="221" />
             <source>Beside the planner</source>
             <translation>在规划器旁显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="203" />
+            <location filename="../../ui/panels/view3d_panel.py" line="222" />
             <source>Show the 3D view next to the planner, not in its own tab</source>
             <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="204" />
+            <location filename="../../ui/panels/view3d_panel.py" line="224" />
             <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
             <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="237" />
+            <location filename="../../ui/panels/view3d_panel.py" line="257" />
             <source>Robot model not loaded: %1</source>
             <translation>未加载机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="249" />
+            <location filename="../../ui/panels/view3d_panel.py" line="270" />
             <source>Load a robot model profile</source>
             <translation>加载机器人模型配置文件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="250" />
+            <location filename="../../ui/panels/view3d_panel.py" line="270" />
             <source>Robot model profiles (*.json)</source>
             <translation>机器人模型配置文件 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="342" />
+            <location filename="../../ui/panels/view3d_panel.py" line="363" />
             <source>dry run: nothing is sent</source>
             <translation>空运行：不发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="344" />
+            <location filename="../../ui/panels/view3d_panel.py" line="365" />
             <source>no pose: home position shown</source>
             <translation>无位姿：显示原点姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="346" />
+            <location filename="../../ui/panels/view3d_panel.py" line="367" />
             <source>estimate (from the pose, no joint angles)</source>
             <translation>估算（由位姿求得，无关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="348" />
+            <location filename="../../ui/panels/view3d_panel.py" line="369" />
             <source>pose out of the model's reach</source>
             <translation>位姿超出模型可达范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="350" />
+            <location filename="../../ui/panels/view3d_panel.py" line="371" />
             <source>past a joint limit</source>
             <translation>超出关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="352" />
+            <location filename="../../ui/panels/view3d_panel.py" line="373" />
             <source>stale</source>
             <translation>数据过期</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="433" />
+            <location filename="../../ui/panels/view3d_panel.py" line="464" />
             <source>Out of the robot model's reach: %n point(s) (%1)</source>
             <translation>
                 <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="438" />
+            <location filename="../../ui/panels/view3d_panel.py" line="472" />
             <source>the path leaves the reach in %n segment(s) (%1)</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>
@@ -5320,118 +5320,118 @@ Remove them all?</source>
     <context>
         <name>WindowActions</name>
         <message>
-            <location filename="../../ui/window_actions.py" line="151" />
+            <location filename="../../ui/window_actions.py" line="176" />
             <source>Show &amp;monitor</source>
             <translation>显示监视(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="151" />
+            <location filename="../../ui/window_actions.py" line="176" />
             <source>Show &amp;points</source>
             <translation>显示点位(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="152" />
+            <location filename="../../ui/window_actions.py" line="176" />
             <source>Show p&amp;lanner</source>
             <translation>显示轨迹规划(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="154" />
+            <location filename="../../ui/window_actions.py" line="180" />
             <source>&amp;File</source>
             <translation>文件(&amp;F)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="155" />
+            <location filename="../../ui/window_actions.py" line="181" />
             <source>&amp;Edit</source>
             <translation>编辑(&amp;E)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="156" />
+            <location filename="../../ui/window_actions.py" line="182" />
             <source>&amp;Motion</source>
             <translation>运动(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="157" />
+            <location filename="../../ui/window_actions.py" line="183" />
             <source>&amp;View</source>
             <translation>视图(&amp;V)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="158" />
+            <location filename="../../ui/window_actions.py" line="184" />
             <source>&amp;Language</source>
             <translation>语言(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="159" />
+            <location filename="../../ui/window_actions.py" line="185" />
             <source>&amp;Help</source>
             <translation>帮助(&amp;H)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="160" />
-            <location filename="../../ui/window_actions.py" line="161" />
+            <location filename="../../ui/window_actions.py" line="186" />
+            <location filename="../../ui/window_actions.py" line="187" />
             <source>Toolbar</source>
             <translation>工具栏</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="162" />
+            <location filename="../../ui/window_actions.py" line="188" />
             <source>&amp;Connect…</source>
             <translation>连接(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="163" />
+            <location filename="../../ui/window_actions.py" line="189" />
             <source>Connect to a controller (Ctrl+K)</source>
             <translation>连接控制器（Ctrl+K）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="164" />
+            <location filename="../../ui/window_actions.py" line="190" />
             <source>&amp;Disconnect</source>
             <translation>断开(&amp;D)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="165" />
+            <location filename="../../ui/window_actions.py" line="191" />
             <source>&amp;Quit</source>
             <translation>退出(&amp;Q)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="166" />
+            <location filename="../../ui/window_actions.py" line="192" />
             <source>&amp;Stop</source>
             <translation>停止(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="167" />
+            <location filename="../../ui/window_actions.py" line="193" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="168" />
+            <location filename="../../ui/window_actions.py" line="194" />
             <source>&amp;Pause</source>
             <translation>暂停(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="169" />
+            <location filename="../../ui/window_actions.py" line="195" />
             <source>Pause the current move or program (F6)</source>
             <translation>暂停当前运动或程序（F6）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="170" />
+            <location filename="../../ui/window_actions.py" line="196" />
             <source>&amp;Resume</source>
             <translation>继续(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="171" />
+            <location filename="../../ui/window_actions.py" line="197" />
             <source>Resume the paused move or program (F7)</source>
             <translation>继续已暂停的运动或程序（F7）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="172" />
+            <location filename="../../ui/window_actions.py" line="198" />
             <source>&amp;About TeachPad</source>
             <translation>关于 TeachPad(&amp;A)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="173" />
+            <location filename="../../ui/window_actions.py" line="199" />
             <source>&amp;Touch mode</source>
             <translation>触摸模式(&amp;T)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="174" />
+            <location filename="../../ui/window_actions.py" line="200" />
             <source>Bigger motion buttons and an on-screen keypad for numbers</source>
             <translation>更大的运动按钮，数字输入使用屏幕小键盘</translation>
         </message>

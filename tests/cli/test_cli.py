@@ -69,9 +69,28 @@ def test_status_json_and_text(csim: Any, capsys: pytest.CaptureFixture[str]) -> 
 def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     """`jog` runs in another process; `status --json` here sees the pose change meanwhile."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli.main", "--port", str(csim.port), "jog", "--frame", "base",
-         "--axis", "Y", "--dir", "+", "--ratio", "40", "--for", "0.8"],
-        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "--port",
+            str(csim.port),
+            "jog",
+            "--frame",
+            "base",
+            "--axis",
+            "Y",
+            "--dir",
+            "+",
+            "--ratio",
+            "40",
+            "--for",
+            "0.8",
+        ],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     try:
         assert csim.wait_for(lambda s: s.jogging, CHILD_TIMEOUT)
@@ -95,8 +114,10 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
     assert not state.teach_enabled and state.teach_ratio == 0 and not state.jogging
 
 
-_WITH_CTRL_C = ("import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
-                "runpy.run_module('app.cli.main', run_name='__main__')")
+_WITH_CTRL_C = (
+    "import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
+    "runpy.run_module('app.cli.main', run_name='__main__')"
+)
 
 
 def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) -> tuple[int, str]:
@@ -107,7 +128,10 @@ def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) ->
     then leaves Ctrl-C ignored -- the CLI would never see it (right for a background job)."""
     proc = subprocess.Popen(
         [sys.executable, "-c", _WITH_CTRL_C, "--port", str(csim.port), *args],
-        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     try:
         assert csim.wait_for(started, CHILD_TIMEOUT)
@@ -121,8 +145,11 @@ def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) ->
 
 
 def test_jog_interrupted_still_stops_and_disables(csim: Any) -> None:
-    code, err = interrupt_cli(csim, ["jog", "--frame", "joint", "--axis", "J1", "--dir", "-", "--ratio", "20",
-                                     "--seconds", "30"], lambda s: s.jogging)
+    code, err = interrupt_cli(
+        csim,
+        ["jog", "--frame", "joint", "--axis", "J1", "--dir", "-", "--ratio", "20", "--seconds", "30"],
+        lambda s: s.jogging,
+    )
     assert code == ExitCode.INTERRUPTED
     assert one_line_error(err) == "teachpad-cli: error: interrupted"
     state = csim.state()
@@ -134,9 +161,28 @@ def test_jog_interrupted_still_stops_and_disables(csim: Any) -> None:
 def test_jog_killed_mid_jog_is_stopped_by_the_simulator_watchdog(csim: Any) -> None:
     """kill -9 leaves no chance to clean up: the simulator's watchdog sees the connection close."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli.main", "--port", str(csim.port), "jog", "--frame", "base",
-         "--axis", "X", "--dir", "-", "--ratio", "30", "--seconds", "30"],
-        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        [
+            sys.executable,
+            "-m",
+            "app.cli.main",
+            "--port",
+            str(csim.port),
+            "jog",
+            "--frame",
+            "base",
+            "--axis",
+            "X",
+            "--dir",
+            "-",
+            "--ratio",
+            "30",
+            "--seconds",
+            "30",
+        ],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     try:
         assert csim.wait_for(lambda s: s.jogging, CHILD_TIMEOUT)
@@ -188,8 +234,9 @@ def test_jog_errors(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = run(csim, capsys, "jog", "--axis", "X", "--dir", "+", "--ratio", "150", "--for", "1")
     assert code == ExitCode.USAGE and "ratio" in one_line_error(err)
     assert csim.writes == []
-    code, _, err = run(csim, capsys, "--monitor-only", "jog", "--axis", "X", "--dir", "+", "--ratio", "10",
-                       "--for", "1")
+    code, _, err = run(
+        csim, capsys, "--monitor-only", "jog", "--axis", "X", "--dir", "+", "--ratio", "10", "--for", "1"
+    )
     assert code == ExitCode.FAILED and "monitor-only" in one_line_error(err)
     assert csim.writes == []
 
@@ -203,8 +250,9 @@ def test_motion_commands(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     assert csim.state().pose[2] == pytest.approx(z0 - 5, abs=0.01)
     code, out, _ = run(csim, capsys, "step", "--frame", "joint", "J1=5", "J7=3")
     assert code == ExitCode.OK and csim.state().joints[6] == pytest.approx(3, abs=0.01)
-    code, out, _ = run(csim, capsys, "point", "create", "5", "--xyzabc", str(x0), str(y0 + 30), str(z0),
-                       "180", "0", "0")
+    code, out, _ = run(
+        csim, capsys, "point", "create", "5", "--xyzabc", str(x0), str(y0 + 30), str(z0), "180", "0", "0"
+    )
     assert code == ExitCode.OK and "point 5: create temp point: success" in out
     code, out, _ = run(csim, capsys, "point", "create", "6", "--from-pose")
     assert code == ExitCode.OK and out.strip().splitlines()[-1].startswith("pose X=")
@@ -213,18 +261,21 @@ def test_motion_commands(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     assert code == ExitCode.OK, err
     assert csim.state().pose[1] == pytest.approx(y0 + 30, abs=0.05)
     # the arm stands on point 5: the arc needs a middle point of its own
-    code, out, _ = run(csim, capsys, "point", "create", "7", "--xyzabc", str(x0 + 25), str(y0 + 20), str(z0),
-                       "180", "0", "0")
+    code, out, _ = run(
+        csim, capsys, "point", "create", "7", "--xyzabc", str(x0 + 25), str(y0 + 20), str(z0), "180", "0", "0"
+    )
     assert code == ExitCode.OK
-    code, out, err = run(csim, capsys, "move", "6", "--via", "7", "--ignore-middle", "--keep-orientation",
-                         "--speed", "400")
+    code, out, err = run(
+        csim, capsys, "move", "6", "--via", "7", "--ignore-middle", "--keep-orientation", "--speed", "400"
+    )
     assert code == ExitCode.OK, err
     code, out, err = run(csim, capsys, "move", "6", "--via", "6", "--speed", "400")
     assert code == ExitCode.USAGE and "middle point must differ" in one_line_error(err)
     code, _, err = run(csim, capsys, "move", "99")
     assert code == ExitCode.FAILED
-    assert one_line_error(err) == ("teachpad-cli: error: move to temp point refused: bad end point id "
-                                   "(status 13)")
+    assert one_line_error(err) == (
+        "teachpad-cli: error: move to temp point refused: bad end point id (status 13)"
+    )
 
 
 def test_plain_commands(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
@@ -271,25 +322,29 @@ def test_link_errors_exit_3(sim: Any, capsys: pytest.CaptureFixture[str]) -> Non
     code = main(["--port", str(free), "--timeout", "0.3", "status"])
     _, err = capsys.readouterr()
     assert code == ExitCode.LINK
-    assert one_line_error(err) == (f"teachpad-cli: error: cannot connect to the controller at "
-                                   f"127.0.0.1:{free}: connection refused")
+    assert one_line_error(err) == (
+        f"teachpad-cli: error: cannot connect to the controller at 127.0.0.1:{free}: connection refused"
+    )
     sim.set_silent(True)
     code, _, err = run(sim, capsys, "--poll-timeout", "0.2", "status", "--json")
     assert code == ExitCode.LINK
-    assert one_line_error(err) == (f"teachpad-cli: error: controller did not answer within 0.2 s "
-                                   f"(127.0.0.1:{sim.port})")
+    assert one_line_error(err) == (
+        f"teachpad-cli: error: controller did not answer within 0.2 s (127.0.0.1:{sim.port})"
+    )
 
 
 def test_failures_exit_1_and_usage_exit_2(sim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = run(sim, capsys, "--monitor-only", "mode", "auto")
     assert code == ExitCode.FAILED
-    assert one_line_error(err) == ("teachpad-cli: error: monitor-only mode: write to register 444 "
-                                   "(GV222_L) was not sent")
+    assert one_line_error(err) == (
+        "teachpad-cli: error: monitor-only mode: write to register 444 (GV222_L) was not sent"
+    )
     sim.set_exception(ExcCodes.ILLEGAL_ADDRESS, range(441, 442))
     code, _, err = run(sim, capsys, "stop")
     assert code == ExitCode.FAILED
-    assert one_line_error(err) == ("teachpad-cli: error: controller refused write to register 441 "
-                                   "(GV220_H): illegal data address")
+    assert one_line_error(err) == (
+        "teachpad-cli: error: controller refused write to register 441 (GV220_H): illegal data address"
+    )
     sim.set_exception(None)
     code, _, err = run(sim, capsys, "step", "--frame", "base", "X=abc")
     assert code == ExitCode.USAGE and "'abc' is not a number" in one_line_error(err)
@@ -313,15 +368,24 @@ def test_rtu_framing_option(sim_factory: Any, capsys: pytest.CaptureFixture[str]
 
 def test_entry_point_module_runs() -> None:
     env = dict(os.environ)
-    proc = subprocess.run([sys.executable, "-m", "app.cli.main", "--help"], cwd=ROOT, capture_output=True,
-                          text=True, env=env, timeout=30, check=False)
+    proc = subprocess.run(
+        [sys.executable, "-m", "app.cli.main", "--help"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=30,
+        check=False,
+    )
     assert proc.returncode == 0 and "teachpad-cli" in proc.stdout
 
 
 def test_interrupted_move_is_stopped(csim: Any) -> None:
     code, err = interrupt_cli(csim, ["step", "--frame", "base", "Y=100", "--speed", "20"], lambda s: s.moving)
     assert code == ExitCode.INTERRUPTED
-    assert err.splitlines() == ["teachpad-cli: warning: interrupted: stop sent",
-                                "teachpad-cli: error: interrupted"]
+    assert err.splitlines() == [
+        "teachpad-cli: warning: interrupted: stop sent",
+        "teachpad-cli: error: interrupted",
+    ]
     assert csim.wait_for(lambda s: not s.moving, 2.0)
     assert csim.writes[-1].address == 441

@@ -52,10 +52,12 @@ def write_register_profile(path: Path, profile: RegisterProfile, **edit: Any) ->
 
 
 def test_an_unreachable_point_refuses_the_run_before_anything_is_sent(
-        sim: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    sim: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     project = project_with_far_point(tmp_path)
-    code, _out, err = run_cli(capsys, "--port", str(sim.port), "run", str(project), "--plan",
-                              "pick and place")
+    code, _out, err = run_cli(
+        capsys, "--port", str(sim.port), "run", str(project), "--plan", "pick and place"
+    )
     assert code == ExitCode.FAILED
     assert "P2 '取料点 pick' is out of the robot model's reach" in err
     assert "not running it" in err
@@ -90,21 +92,25 @@ def test_the_robot_profile_decides_reach(tmp_path: Path, capsys: pytest.CaptureF
     shutil.copy(DEMO, demo)
     assert run_cli(capsys, "run", str(demo), "--plan", "circle", "--check")[0] == ExitCode.OK
     short = arm("short", 0.3)
-    code, _out, err = run_cli(capsys, "run", str(demo), "--plan", "circle", "--check",
-                              "--robot-profile", str(short))
+    code, _out, err = run_cli(
+        capsys, "run", str(demo), "--plan", "circle", "--check", "--robot-profile", str(short)
+    )
     assert code == ExitCode.FAILED and "out of the robot model's reach" in err
     long_arm = arm("long", 4.0)
-    code, _out, err = run_cli(capsys, "run", str(project), "--plan", "pick and place", "--check",
-                              "--robot-profile", str(long_arm))
+    code, _out, err = run_cli(
+        capsys, "run", str(project), "--plan", "pick and place", "--check", "--robot-profile", str(long_arm)
+    )
     assert "P2 '取料点 pick'" not in err
 
 
 def test_a_bad_robot_profile_is_a_usage_error_naming_the_file(
-        sim: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    sim: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     bad = tmp_path / "broken-arm.json"
     bad.write_text('{"format": "teachpad-robot-profile", "version": 1, "joints": "many"}', encoding="utf-8")
-    code, _out, err = run_cli(capsys, "--port", str(sim.port), "run", str(DEMO), "--plan", "circle",
-                              "--robot-profile", str(bad))
+    code, _out, err = run_cli(
+        capsys, "--port", str(sim.port), "run", str(DEMO), "--plan", "circle", "--robot-profile", str(bad)
+    )
     assert code == ExitCode.USAGE
     assert "broken-arm.json" in err and "joints" in err and len(err.strip().splitlines()) == 1
     assert sim.writes == []
@@ -112,73 +118,122 @@ def test_a_bad_robot_profile_is_a_usage_error_naming_the_file(
 
 def test_plan_errors_other_than_reach_stay_usage(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     project = project_with_far_point(tmp_path)
-    code, _out, err = run_cli(capsys, "run", str(project), "--plan", "pick and place", "--check",
-                              "--max-speed", "60")  # too slow for the plan's segments, and far
+    code, _out, err = run_cli(
+        capsys, "run", str(project), "--plan", "pick and place", "--check", "--max-speed", "60"
+    )  # too slow for the plan's segments, and far
     assert code == ExitCode.USAGE and "out of the robot model's reach" in err
 
 
 # --- the register profile ----------------------------------------------------------------------
 
 
-def test_a_register_profile_sets_word_order_and_unit(sim_factory: Any, tmp_path: Path,
-                                                     capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_register_profile_sets_word_order_and_unit(
+    sim_factory: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     sim = sim_factory(word_order=WordOrder.HIGH_FIRST, unit=7)
-    profile = write_register_profile(tmp_path / "cell.registers.json",
-                                     RegisterProfile("cell 7", word_order=WordOrder.HIGH_FIRST, unit=7))
-    code, out, err = run_cli(capsys, "--port", str(sim.port), "--register-profile", str(profile),
-                             "status", "--json")
+    profile = write_register_profile(
+        tmp_path / "cell.registers.json", RegisterProfile("cell 7", word_order=WordOrder.HIGH_FIRST, unit=7)
+    )
+    code, out, err = run_cli(
+        capsys, "--port", str(sim.port), "--register-profile", str(profile), "status", "--json"
+    )
     assert code == ExitCode.OK, err
     pose = json.loads(out)["pose"]
     expected = sim.state().pose
     assert [pose[k] for k in "xyz"] == pytest.approx(list(expected[:3]), abs=1e-3)
 
 
-def test_explicit_flags_override_the_profile(sim_factory: Any, tmp_path: Path,
-                                             capsys: pytest.CaptureFixture[str]) -> None:
+def test_explicit_flags_override_the_profile(
+    sim_factory: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     sim = sim_factory(word_order=WordOrder.HIGH_FIRST, unit=7)
-    wrong = write_register_profile(tmp_path / "other.registers.json",
-                                   RegisterProfile("other cell", word_order=WordOrder.LOW_FIRST, unit=3))
-    code, out, err = run_cli(capsys, "--port", str(sim.port), "--register-profile", str(wrong),
-                             "--unit", "7", "--word-order", "high-first", "status", "--json")
+    wrong = write_register_profile(
+        tmp_path / "other.registers.json",
+        RegisterProfile("other cell", word_order=WordOrder.LOW_FIRST, unit=3),
+    )
+    code, out, err = run_cli(
+        capsys,
+        "--port",
+        str(sim.port),
+        "--register-profile",
+        str(wrong),
+        "--unit",
+        "7",
+        "--word-order",
+        "high-first",
+        "status",
+        "--json",
+    )
     assert code == ExitCode.OK, err
     assert json.loads(out)["pose"]["x"] == pytest.approx(sim.state().pose[0], abs=1e-3)
     # the profile alone (low-first) reads the same registers as other numbers
-    code, out, err = run_cli(capsys, "--port", str(sim.port), "--register-profile", str(wrong),
-                             "--unit", "7", "status", "--json")
+    code, out, err = run_cli(
+        capsys, "--port", str(sim.port), "--register-profile", str(wrong), "--unit", "7", "status", "--json"
+    )
     assert code != ExitCode.OK or json.loads(out)["pose"]["x"] != pytest.approx(sim.state().pose[0], abs=1e-3)
 
 
 def test_settings_take_every_profile_field_and_the_flags_win(tmp_path: Path) -> None:
-    profile = RegisterProfile("cell 3", word_order=WordOrder.HIGH_FIRST, unit=5, completion="observe",
-                              unconfirmed_after=0.5, poll_timeout=0.3,
-                              datetime_layout=DateTimeLayout.PACKED32, point_id_min=10, point_id_max=99)
+    profile = RegisterProfile(
+        "cell 3",
+        word_order=WordOrder.HIGH_FIRST,
+        unit=5,
+        completion="observe",
+        unconfirmed_after=0.5,
+        poll_timeout=0.3,
+        datetime_layout=DateTimeLayout.PACKED32,
+        point_id_min=10,
+        point_id_max=99,
+    )
     path = write_register_profile(tmp_path / "cell.registers.json", profile)
     parser = build_parser()
-    args = parser.parse_args(["--host", "10.0.0.9", "--timeout", "0.7", "--register-profile", str(path),
-                              "status"])
+    args = parser.parse_args(
+        ["--host", "10.0.0.9", "--timeout", "0.7", "--register-profile", str(path), "status"]
+    )
     settings = settings_from_args(args)
     assert (settings.host, settings.timeout) == ("10.0.0.9", 0.7)  # where: the link options
     assert RegisterProfile.from_connection(settings, "cell 3") == profile  # how: the profile
-    args = parser.parse_args(["--register-profile", str(path), "--unit", "9", "--word-order", "low-first",
-                              "--completion", "sentinel", "--poll-timeout", "0.2", "status"])
+    args = parser.parse_args(
+        [
+            "--register-profile",
+            str(path),
+            "--unit",
+            "9",
+            "--word-order",
+            "low-first",
+            "--completion",
+            "sentinel",
+            "--poll-timeout",
+            "0.2",
+            "status",
+        ]
+    )
     settings = settings_from_args(args)
     assert (settings.unit, settings.word_order, settings.completion, settings.poll_timeout) == (
-        9, WordOrder.LOW_FIRST, "sentinel", 0.2)
+        9,
+        WordOrder.LOW_FIRST,
+        "sentinel",
+        0.2,
+    )
     assert settings.datetime_layout is DateTimeLayout.PACKED32 and settings.point_id_max == 99
     no_profile = settings_from_args(parser.parse_args(["status"]))
-    assert dataclasses.astuple(no_profile) == dataclasses.astuple(settings_from_args(
-        parser.parse_args(["--unit", "1", "--word-order", "low-first", "status"])))
+    assert dataclasses.astuple(no_profile) == dataclasses.astuple(
+        settings_from_args(parser.parse_args(["--unit", "1", "--word-order", "low-first", "status"]))
+    )
 
 
-@pytest.mark.parametrize(("edit", "field"), [
-    ({"unit": 300}, "unit"),
-    ({"word_order": "middle"}, "word_order"),
-    ({"completion": "guess"}, "completion"),
-    ({"poll_timeout": "soon"}, "poll_timeout"),
-])
+@pytest.mark.parametrize(
+    ("edit", "field"),
+    [
+        ({"unit": 300}, "unit"),
+        ({"word_order": "middle"}, "word_order"),
+        ({"completion": "guess"}, "completion"),
+        ({"poll_timeout": "soon"}, "poll_timeout"),
+    ],
+)
 def test_a_malformed_register_profile_is_usage_naming_file_and_field(
-        sim: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str], edit: dict[str, Any],
-        field: str) -> None:
+    sim: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str], edit: dict[str, Any], field: str
+) -> None:
     path = write_register_profile(tmp_path / "bad.registers.json", RegisterProfile(), **edit)
     code, out, err = run_cli(capsys, "--port", str(sim.port), "--register-profile", str(path), "zero", "all")
     assert code == ExitCode.USAGE and out == ""
@@ -193,11 +248,13 @@ def test_a_missing_register_profile_is_usage(tmp_path: Path, capsys: pytest.Capt
     assert code == ExitCode.USAGE and "nope.registers.json" in err and "does not exist" in err
 
 
-def test_the_profiles_point_ids_apply_to_project_files(tmp_path: Path,
-                                                       capsys: pytest.CaptureFixture[str]) -> None:
+def test_the_profiles_point_ids_apply_to_project_files(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """The demo uses ids 1..8; a controller that accepts 100..200 makes it unusable (USAGE)."""
-    path = write_register_profile(tmp_path / "ids.registers.json",
-                                  RegisterProfile("ids", point_id_min=100, point_id_max=200))
+    path = write_register_profile(
+        tmp_path / "ids.registers.json", RegisterProfile("ids", point_id_min=100, point_id_max=200)
+    )
     assert run_cli(capsys, "points", "list", str(DEMO))[0] == ExitCode.OK
     code, _out, err = run_cli(capsys, "--register-profile", str(path), "points", "list", str(DEMO))
     assert code == ExitCode.USAGE and "100" in err
@@ -232,14 +289,16 @@ def test_audit_counts_and_filters_unknown_writes(tmp_path: Path, capsys: pytest.
     assert code == ExitCode.OK and len(lines) == 1 and " unknown " in lines[0]
     assert "stopped before the answer" in lines[0] and err == ""
     csv_path = tmp_path / "unknown.csv"
-    code, out, _err = run_cli(capsys, "audit", "--audit-dir", str(trail), "--result", "unknown",
-                              "--csv", str(csv_path))
+    code, out, _err = run_cli(
+        capsys, "audit", "--audit-dir", str(trail), "--result", "unknown", "--csv", str(csv_path)
+    )
     assert code == ExitCode.OK and "wrote 1 records" in out and "(1 unknown)" in out
     assert Result.UNKNOWN in csv_path.read_text(encoding="utf-8")
 
 
-def test_audit_without_unknown_writes_says_nothing_about_them(tmp_path: Path,
-                                                              capsys: pytest.CaptureFixture[str]) -> None:
+def test_audit_without_unknown_writes_says_nothing_about_them(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     log = AuditLog(tmp_path, role="operator")
     with log.writing(441, [1], single=True):
         pass

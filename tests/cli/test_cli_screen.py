@@ -43,8 +43,12 @@ def test_a_command_help_shows_units_and_its_example(capsys: pytest.CaptureFixtur
 
 def test_status_into_a_closed_pipe_ends_quietly(sim: Any) -> None:
     """`teachpad-cli status | head -1`: the reader is gone before we write."""
-    proc = subprocess.Popen([sys.executable, "-m", "app.cli.main", "--port", str(sim.port), "status"],
-                            cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "app.cli.main", "--port", str(sim.port), "status"],
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
     assert proc.stdout is not None
     proc.stdout.close()  # like head after its first line
     _, err = proc.communicate(timeout=30)

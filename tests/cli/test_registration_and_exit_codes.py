@@ -30,8 +30,25 @@ ROOT = Path(__file__).resolve().parents[2]
 
 #: What each module's register() adds (top-level names), in the order of REGISTRARS.
 COMMANDS: list[tuple[Callable[[Any], None], set[str]]] = [
-    (controller.register, {"status", "watch", "mode", "step", "jog", "point", "move", "zero", "program",
-                           "stop", "pause", "resume", "read", "write"}),
+    (
+        controller.register,
+        {
+            "status",
+            "watch",
+            "mode",
+            "step",
+            "jog",
+            "point",
+            "move",
+            "zero",
+            "program",
+            "stop",
+            "pause",
+            "resume",
+            "read",
+            "write",
+        },
+    ),
     (points.register, {"points"}),
     (run_plan.register, {"run"}),
     (support.register, {"support-bundle", "audit", "roles"}),
@@ -53,8 +70,9 @@ def test_main_registers_every_command_module_explicitly() -> None:
     assert set(names) == set().union(*(commands for _, commands in COMMANDS))
 
 
-@pytest.mark.parametrize(("register", "commands"), COMMANDS,
-                         ids=[register.__module__ for register, _ in COMMANDS])
+@pytest.mark.parametrize(
+    ("register", "commands"), COMMANDS, ids=[register.__module__ for register, _ in COMMANDS]
+)
 def test_each_module_registers_its_own_commands(register: Callable[[Any], None], commands: set[str]) -> None:
     parser = argparse.ArgumentParser()
     register(parser.add_subparsers(dest="command"))
@@ -62,8 +80,11 @@ def test_each_module_registers_its_own_commands(register: Callable[[Any], None],
 
 
 def test_every_leaf_command_has_a_handler() -> None:
-    leaves = [(path, sub) for path, sub in walk(build_parser())
-              if path and not any(isinstance(a, argparse._SubParsersAction) for a in sub._actions)]
+    leaves = [
+        (path, sub)
+        for path, sub in walk(build_parser())
+        if path and not any(isinstance(a, argparse._SubParsersAction) for a in sub._actions)
+    ]
     assert len(leaves) == 24  # 14 controller (point create, program run) + 4 points + run + 5 offline
     missing = [path for path, sub in leaves if not callable(sub.get_default("handler"))]
     assert missing == []
@@ -78,8 +99,13 @@ def test_no_module_is_imported_by_name() -> None:
 
 
 def test_the_table_keeps_its_numbers() -> None:
-    assert {c.name: int(c) for c in ExitCode} == {"OK": 0, "FAILED": 1, "USAGE": 2, "LINK": 3,
-                                                  "INTERRUPTED": 130}
+    assert {c.name: int(c) for c in ExitCode} == {
+        "OK": 0,
+        "FAILED": 1,
+        "USAGE": 2,
+        "LINK": 3,
+        "INTERRUPTED": 130,
+    }
 
 
 def _error_classes() -> list[type[errors.TeachPadError]]:
@@ -94,7 +120,8 @@ def _error_classes() -> list[type[errors.TeachPadError]]:
 def test_every_typed_error_maps_to_one_code() -> None:
     expected = {
         errors.InvalidInput: ExitCode.USAGE,
-        errors.LinkError: ExitCode.LINK, errors.ResponseTimeout: ExitCode.LINK,
+        errors.LinkError: ExitCode.LINK,
+        errors.ResponseTimeout: ExitCode.LINK,
         errors.MalformedResponse: ExitCode.LINK,
     }
     classes = _error_classes()
@@ -107,8 +134,10 @@ def test_every_typed_error_maps_to_one_code() -> None:
 
 
 def _documented_codes(text: str) -> dict[int, str]:
-    return {int(code): meaning.strip() for code, meaning in re.findall(r"^\s*\|?\s*`?(\d+)`?\s*\|?\s+(.+)$",
-                                                                         text, re.M)}
+    return {
+        int(code): meaning.strip()
+        for code, meaning in re.findall(r"^\s*\|?\s*`?(\d+)`?\s*\|?\s+(.+)$", text, re.M)
+    }
 
 
 def test_the_table_is_in_help_and_in_the_readme(capsys: pytest.CaptureFixture[str]) -> None:
@@ -118,8 +147,8 @@ def test_the_table_is_in_help_and_in_the_readme(capsys: pytest.CaptureFixture[st
     for code in ExitCode:
         assert re.search(rf"^\s+{int(code)}  {re.escape(code.meaning)}$", out, re.M), code
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    section = readme[readme.index("### Exit codes"):]
-    section = section[:section.index("\n#")]
+    section = readme[readme.index("### Exit codes") :]
+    section = section[: section.index("\n#")]
     rows = dict(re.findall(r"^\| `(\d+)` \| (\w+) \|", section, re.M))
     assert {int(k): v for k, v in rows.items()} == {int(c): c.name for c in ExitCode}
 
@@ -167,8 +196,9 @@ def test_monitor_only_is_failed_and_sends_nothing(sim: Any, capsys: pytest.Captu
     assert sim.writes == []
 
 
-def test_a_file_that_cannot_be_written_is_failed_in_one_line(tmp_path: Path,
-                                                              capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_file_that_cannot_be_written_is_failed_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out_file = tmp_path / "no such folder" / "audit.csv"
     code = main(["audit", "--audit-dir", str(tmp_path), "--csv", str(out_file)])
     err = capsys.readouterr().err
@@ -176,11 +206,14 @@ def test_a_file_that_cannot_be_written_is_failed_in_one_line(tmp_path: Path,
     assert one_line_error(err) == f"teachpad-cli: error: {out_file}: No such file or directory"
 
 
-@pytest.mark.parametrize("argv", [
-    ["nonsense"],  # argparse
-    ["move", "5", "--via", "5"],  # a value the client refuses before sending
-    ["read", "10", "99"],  # more GVs than one request
-])
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["nonsense"],  # argparse
+        ["move", "5", "--via", "5"],  # a value the client refuses before sending
+        ["read", "10", "99"],  # more GVs than one request
+    ],
+)
 def test_usage_is_2_and_sends_nothing(sim: Any, capsys: pytest.CaptureFixture[str], argv: list[str]) -> None:
     code, _, err = _run(capsys, sim.port, *argv)
     assert code == ExitCode.USAGE and err
@@ -216,8 +249,9 @@ def test_a_malformed_answer_is_link(capsys: pytest.CaptureFixture[str]) -> None:
     assert "malformed answer" in one_line_error(err)
 
 
-def test_a_link_lost_in_a_points_upload_is_link_too(sim: Any, tmp_path: Path,
-                                                    capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_link_lost_in_a_points_upload_is_link_too(
+    sim: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """``points`` reports its own errors; the code comes from the same table."""
     demo = tmp_path / "demo.teachpad.json"
     demo.write_bytes((ROOT / "resources" / "samples" / "demo.teachpad.json").read_bytes())

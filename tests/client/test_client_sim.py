@@ -114,8 +114,9 @@ def test_command_status_uses_the_last_command_kind(scan_sim: Any, make_client: M
 
 @pytest.mark.parametrize("encoding", ["float", "int"])
 @pytest.mark.parametrize("order", [WordOrder.LOW_FIRST, WordOrder.HIGH_FIRST])
-def test_status_encodings_and_word_orders(sim_factory: Any, make_client: MakeClient, encoding: str,
-                                          order: WordOrder) -> None:
+def test_status_encodings_and_word_orders(
+    sim_factory: Any, make_client: MakeClient, encoding: str, order: WordOrder
+) -> None:
     sim = sim_factory(status_encoding=encoding, word_order=order, command_latency=SCAN)
     c = make_client(sim)
     assert close(c.read_pose().xyzabc, sim.state().pose, 1e-3)
@@ -316,8 +317,9 @@ def test_host_stop_and_pause_resume(sim: Any, make_client: MakeClient) -> None:
     assert sim.wait_for(lambda s: not s.moving, 2.0)
 
 
-def test_stop_by_someone_else_ends_the_wait(sim: Any, make_client: MakeClient,
-                                            monkeypatch: pytest.MonkeyPatch) -> None:
+def test_stop_by_someone_else_ends_the_wait(
+    sim: Any, make_client: MakeClient, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "STOP_SETTLE", 0.05)
     c = make_client(sim)
     other = make_client(sim)
@@ -353,8 +355,9 @@ def test_stale_done_is_not_taken_for_the_new_command(sim_factory: Any, make_clie
         c.move_to_point(77)
 
 
-def test_controller_that_never_acknowledges(sim_factory: Any, make_client: MakeClient,
-                                           monkeypatch: pytest.MonkeyPatch) -> None:
+def test_controller_that_never_acknowledges(
+    sim_factory: Any, make_client: MakeClient, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.2)
     sim = sim_factory(status_delay=5.0, command_latency=SCAN)
     c = make_client(sim)
@@ -469,7 +472,9 @@ def test_monitor_only_makes_no_writes(sim: Any, make_client: MakeClient) -> None
         lambda: c.teach_disable(),
         lambda: c.set_work_mode(WorkMode.AUTO),
         lambda: c.ensure_auto(),
-        c.stop, c.pause, c.resume,
+        c.stop,
+        c.pause,
+        c.resume,
         lambda: c.go_zero(None),
         lambda: c.run_program(1),
         lambda: c.write_gv(0, [1.0]),
@@ -494,8 +499,11 @@ def test_modbus_exception_is_readable(sim: Any, make_client: MakeClient) -> None
     assert str(info.value) == "controller refused write to register 440 (GV220_L): illegal data address"
     assert info.value.function_code == FC06 and info.value.exception_code == 2
     sim.set_exception(ExcCodes.DEVICE_BUSY, range(560, 584))
-    with pytest.raises(ModbusExceptionError, match=r"read of registers 560\.\.583 \(GV280\.\.GV291\): "
-                                                   "server device busy"):
+    with pytest.raises(
+        ModbusExceptionError,
+        match=r"read of registers 560\.\.583 \(GV280\.\.GV291\): "
+        "server device busy",
+    ):
         c.read_status()
     sim.set_exception(None)
     c.read_status()
@@ -522,8 +530,11 @@ def test_dead_server_then_reconnect(sim_factory: Any, make_client: MakeClient) -
     sim.stop()
     with pytest.raises(LinkError):
         c.read_status()
-    with pytest.raises(LinkError, match=rf"^cannot reconnect to the controller at 127\.0\.0\.1:{port} "
-                                        r"\(the link was lost\): connection refused$"):
+    with pytest.raises(
+        LinkError,
+        match=rf"^cannot reconnect to the controller at 127\.0\.0\.1:{port} "
+        r"\(the link was lost\): connection refused$",
+    ):
         c.read_status()
     assert not c.connected
     sim2 = sim_factory(port=port, command_latency=SCAN)
@@ -550,8 +561,11 @@ def test_connect_failure(make_client: MakeClient) -> None:
         config = type("C", (), {"framer": "socket", "word_order": WordOrder.LOW_FIRST})
 
     c = make_client(Dead(), connect=False, timeout=0.3)
-    with pytest.raises(LinkError, match=r"^cannot connect to the controller at 127\.0\.0\.1:1: "
-                                        r"connection refused$"):
+    with pytest.raises(
+        LinkError,
+        match=r"^cannot connect to the controller at 127\.0\.0\.1:1: "
+        r"connection refused$",
+    ):
         c.connect()
 
 
@@ -584,8 +598,9 @@ def test_observer_sees_the_seed_frames(sim: Any, make_client: MakeClient) -> Non
     assert records == []
 
 
-def test_broken_observer_does_not_break_the_link(sim: Any, make_client: MakeClient,
-                                                 caplog: pytest.LogCaptureFixture) -> None:
+def test_broken_observer_does_not_break_the_link(
+    sim: Any, make_client: MakeClient, caplog: pytest.LogCaptureFixture
+) -> None:
     c = make_client(sim)
 
     def bad(record: TrafficRecord) -> None:
@@ -667,7 +682,14 @@ def test_late_answer_is_not_taken_for_the_next_request(sim: Any, make_client: Ma
 def test_settings_are_checked() -> None:
     from app.link.client import ConnectionSettings
 
-    for bad in ({"port": 0}, {"unit": 300}, {"timeout": 0}, {"framer": "ascii"}, {"parity": "X"},
-                {"point_id_min": 5, "point_id_max": 1}, {"word_order": "low-first"}):
+    for bad in (
+        {"port": 0},
+        {"unit": 300},
+        {"timeout": 0},
+        {"framer": "ascii"},
+        {"parity": "X"},
+        {"point_id_min": 5, "point_id_max": 1},
+        {"word_order": "low-first"},
+    ):
         with pytest.raises(InvalidInput):
             RobotClient(ConnectionSettings(**bad))

@@ -29,8 +29,10 @@ def expected_rule(sim: Any) -> str:
 
 
 def points(n: int, first: int = 1) -> list[tuple[int, list[float]]]:
-    return [(i, [300.0 + i % 100, -50.0 + i % 40, 300.0 + i % 30, 180.0, 0.0, float(i % 90)])
-            for i in range(first, first + n)]
+    return [
+        (i, [300.0 + i % 100, -50.0 + i % 40, 300.0 + i % 30, 180.0, 0.0, float(i % 90)])
+        for i in range(first, first + n)
+    ]
 
 
 def test_create_point_and_teach_on_every_profile(profile_sim: Any, make_client: Any) -> None:
@@ -66,8 +68,9 @@ def test_moves_confirm_on_every_profile(profile_sim: Any, make_client: Any) -> N
     assert sim.state().pose[0] == pytest.approx(target[0], abs=0.01) and not sim.state().moving
 
 
-def test_error_injected_mid_upload_is_reported_for_that_point_only(profile_sim: Any,
-                                                                    make_client: Any) -> None:
+def test_error_injected_mid_upload_is_reported_for_that_point_only(
+    profile_sim: Any, make_client: Any
+) -> None:
     sim = profile_sim
     sim.refuse_point(17)
     c = make_client(sim)
@@ -93,8 +96,9 @@ def test_error_injected_mid_upload_is_reported_for_that_point_only(profile_sim: 
     assert results[17].ok
 
 
-def test_fast_read_only_says_unconfirmed_and_sentinel_confirms(sim_factory: Any, make_client: Any,
-                                                              quick_profiles: None) -> None:
+def test_fast_read_only_says_unconfirmed_and_sentinel_confirms(
+    sim_factory: Any, make_client: Any, quick_profiles: None
+) -> None:
     ro = make_client(sim_factory(timing="fast", gv291="read-only"))
     assert ro.create_point(1, pose=POSE).ok  # from 0 (initial) at power-on: a visible change
     second = ro.create_point(2, pose=POSE)
@@ -124,8 +128,9 @@ def test_forced_rules_and_monitor_only(sim_factory: Any, make_client: Any, quick
     assert monitor_sim.writes == [] and monitor.completion_rule is None
 
 
-def test_sentinel_is_what_the_status_shows_until_the_controller_answers(sim_factory: Any,
-                                                                       make_client: Any) -> None:
+def test_sentinel_is_what_the_status_shows_until_the_controller_answers(
+    sim_factory: Any, make_client: Any
+) -> None:
     sim = sim_factory(timing="classic", gv291="writable", status_delay=0.05)
     c = make_client(sim)
     assert c.probe_gv291()
@@ -139,15 +144,22 @@ def test_sentinel_is_what_the_status_shows_until_the_controller_answers(sim_fact
 
 
 def write_project(path: Path, n: int) -> None:
-    ledger = PointLedger([make_point(pid, f"p{pid}", pose, sync=SyncState.UNKNOWN)
-                          for pid, pose in points(n)])
+    ledger = PointLedger(
+        [make_point(pid, f"p{pid}", pose, sync=SyncState.UNKNOWN) for pid, pose in points(n)]
+    )
     save_project(Project("profiles", ledger), path)
 
 
 @pytest.mark.parametrize("timing_name", ["classic", "fast", "slow"])
 @pytest.mark.parametrize("gv291", ["writable", "read-only"])
-def test_cli_points_upload_on_every_profile(timing_name: str, gv291: str, sim_factory: Any, tmp_path: Path,
-                                            quick_profiles: None, capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_points_upload_on_every_profile(
+    timing_name: str,
+    gv291: str,
+    sim_factory: Any,
+    tmp_path: Path,
+    quick_profiles: None,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     sim = sim_factory(timing=timing_name, gv291=gv291)
     sim.refuse_point(123)
     path = tmp_path / "profiles.teachpad.json"

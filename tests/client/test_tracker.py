@@ -56,8 +56,9 @@ def feed_silent(tracker: CommandTracker, steps: Sequence[Step]) -> None:
 def test_stale_done_is_not_taken_for_the_new_create_point() -> None:
     tr = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0, unconfirmed_after=1.0)
     # The old 0xFF lingers (status delay), then 0 (received), then the new 0xFF.
-    i, result = feed(tr, [(0.01, st(DONE), None), (0.1, st(DONE), None), (0.2, st(0), None),
-                          (0.3, st(DONE), None)])
+    i, result = feed(
+        tr, [(0.01, st(DONE), None), (0.1, st(DONE), None), (0.2, st(0), None), (0.3, st(DONE), None)]
+    )
     assert i == 3
     assert result.ok and result.kind is CommandKind.CREATE_POINT
     assert result.status is not None and result.status.member is CreatePointStatus.DONE
@@ -89,8 +90,15 @@ def test_error_code_after_ack_is_a_refusal_with_the_decoded_status() -> None:
 def test_stale_error_code_is_ignored_until_the_code_changes() -> None:
     # The previous command failed with 13; the new one is a fine move.
     tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(13), HOME, 0.0)
-    i, result = feed(tr, [(0.01, st(13, RUNNING), moved(1)), (0.02, st(13, RUNNING), moved(2)),
-                          (0.03, st(6, RUNNING), moved(3)), (0.04, st(DONE), moved(4))])
+    i, result = feed(
+        tr,
+        [
+            (0.01, st(13, RUNNING), moved(1)),
+            (0.02, st(13, RUNNING), moved(2)),
+            (0.03, st(6, RUNNING), moved(3)),
+            (0.04, st(DONE), moved(4)),
+        ],
+    )
     assert i == 3 and result.ok
 
 
@@ -104,8 +112,12 @@ def test_first_error_when_pre_code_was_initial() -> None:
 def test_move_acknowledged_by_motion_still_waits_for_a_fresh_done() -> None:
     """Program state running and pose moving ack the move, but the stale 0xFF is not 'done'."""
     tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
-    steps = [(0.01, st(DONE, RUNNING), moved(1)), (0.05, st(DONE, RUNNING), moved(5)),
-             (0.10, st(DONE, STOPPED), moved(10)), (0.2, st(DONE, STOPPED), moved(10))]
+    steps = [
+        (0.01, st(DONE, RUNNING), moved(1)),
+        (0.05, st(DONE, RUNNING), moved(5)),
+        (0.10, st(DONE, STOPPED), moved(10)),
+        (0.2, st(DONE, STOPPED), moved(10)),
+    ]
     feed_silent(tr, steps)
     assert tr.acknowledged and tr.motion_seen
     i, result = feed(tr, [(0.25, st(0), moved(10)), (0.26, st(DONE), moved(10))])
@@ -123,8 +135,9 @@ def test_pose_change_alone_acknowledges_a_fast_move() -> None:
 
 def test_alarm_while_waiting_raises_alarm() -> None:
     tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
-    i, result = feed(tr, [(0.01, st(6, RUNNING), moved(1)),
-                          (0.02, st(0, STOPPED, Alarm.ESTOP | Alarm.SERVO), moved(1))])
+    i, result = feed(
+        tr, [(0.01, st(6, RUNNING), moved(1)), (0.02, st(0, STOPPED, Alarm.ESTOP | Alarm.SERVO), moved(1))]
+    )
     assert i == 1 and not result.ok
     assert isinstance(tr.error, AlarmRaised)
     assert tr.error.alarms == int(Alarm.ESTOP | Alarm.SERVO)
@@ -134,9 +147,13 @@ def test_alarm_while_waiting_raises_alarm() -> None:
 def test_program_state_back_to_stopped_with_initial_code_is_a_stop(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(timing, "STOP_SETTLE", 0.1)
     tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
-    steps = [(0.01, st(0, RUNNING), moved(1)), (0.02, st(6, RUNNING), moved(2)),
-             (0.03, st(0, STOPPED), moved(3)), (0.08, st(0, STOPPED), moved(3)),
-             (0.14, st(0, STOPPED), moved(3))]
+    steps = [
+        (0.01, st(0, RUNNING), moved(1)),
+        (0.02, st(6, RUNNING), moved(2)),
+        (0.03, st(0, STOPPED), moved(3)),
+        (0.08, st(0, STOPPED), moved(3)),
+        (0.14, st(0, STOPPED), moved(3)),
+    ]
     i, result = feed(tr, steps)
     assert i == 4 and not result.ok
     assert isinstance(tr.error, CommandStopped)
@@ -145,8 +162,12 @@ def test_program_state_back_to_stopped_with_initial_code_is_a_stop(monkeypatch: 
 def test_transient_initial_before_done_is_not_a_stop(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(timing, "STOP_SETTLE", 0.1)
     tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
-    steps = [(0.01, st(DONE, RUNNING), moved(1)), (0.05, st(DONE, STOPPED), moved(2)),
-             (0.06, st(0, STOPPED), moved(2)), (0.08, st(DONE, STOPPED), moved(2))]
+    steps = [
+        (0.01, st(DONE, RUNNING), moved(1)),
+        (0.05, st(DONE, STOPPED), moved(2)),
+        (0.06, st(0, STOPPED), moved(2)),
+        (0.08, st(DONE, STOPPED), moved(2)),
+    ]
     i, result = feed(tr, steps)
     assert i == 3 and result.ok
 
@@ -163,9 +184,14 @@ def test_host_sent_stop_ends_the_wait() -> None:
 
 def test_paused_move_keeps_waiting_and_resumes() -> None:
     tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
-    steps = [(0.01, st(6, RUNNING), moved(1)), (0.02, st(6, PAUSED), moved(1)),
-             (5.0, st(6, PAUSED), moved(1)), (9.0, st(6, PAUSED), moved(1)),
-             (15.0, st(6, RUNNING), moved(2)), (15.1, st(DONE), moved(3))]
+    steps = [
+        (0.01, st(6, RUNNING), moved(1)),
+        (0.02, st(6, PAUSED), moved(1)),
+        (5.0, st(6, PAUSED), moved(1)),
+        (9.0, st(6, PAUSED), moved(1)),
+        (15.0, st(6, RUNNING), moved(2)),
+        (15.1, st(DONE), moved(3)),
+    ]
     i, result = feed(tr, steps)
     assert i == 5 and result.ok
 
@@ -209,8 +235,12 @@ def test_move_that_ends_without_a_status_update_is_unknown(monkeypatch: pytest.M
     monkeypatch.setattr(timing, "ACK_TIMEOUT", 1.0)
     monkeypatch.setattr(timing, "STOP_SETTLE", 0.1)
     tr = CommandTracker(RunCommand.STEP_BASE, st(DONE), HOME, 0.0)
-    steps = [(0.01, st(DONE, RUNNING), moved(1)), (0.05, st(DONE, STOPPED), moved(2)),
-             (0.5, st(DONE, STOPPED), moved(2)), (0.99, st(DONE, STOPPED), moved(2))]
+    steps = [
+        (0.01, st(DONE, RUNNING), moved(1)),
+        (0.05, st(DONE, STOPPED), moved(2)),
+        (0.5, st(DONE, STOPPED), moved(2)),
+        (0.99, st(DONE, STOPPED), moved(2)),
+    ]
     feed_silent(tr, steps)
     result = tr.update(st(DONE, STOPPED), moved(2), 1.0)
     assert result is not None and isinstance(tr.error, CommandTimeout)
@@ -265,8 +295,11 @@ def test_sentinel_fast_error_is_reported() -> None:
 
 def test_sentinel_slow_waits_through_the_sentinel_and_the_zero() -> None:
     tr = sentinel(RunCommand.TEACH_DISABLE)
-    i, result = feed(tr, [(t / 1000, st(SENT), None) for t in range(1, 40, 5)]
-                     + [(0.045, st(0), None), (0.06, st(DONE), None)])
+    i, result = feed(
+        tr,
+        [(t / 1000, st(SENT), None) for t in range(1, 40, 5)]
+        + [(0.045, st(0), None), (0.06, st(DONE), None)],
+    )
     assert i == 9 and result.ok and not result.unconfirmed
     assert result.details["ack_after"] == pytest.approx(0.045)
 
@@ -308,8 +341,9 @@ def test_observe_stale_error_is_refused_never_a_success() -> None:
 
 def test_observe_slow_change_inside_the_window_is_confirmed() -> None:
     tr = CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, 0.0, unconfirmed_after=0.05)
-    i, result = feed(tr, [(0.001, st(DONE), None), (0.02, st(DONE), None), (0.03, st(0), None),
-                          (0.04, st(DONE), None)])
+    i, result = feed(
+        tr, [(0.001, st(DONE), None), (0.02, st(DONE), None), (0.03, st(0), None), (0.04, st(DONE), None)]
+    )
     assert i == 3 and result.ok and not result.unconfirmed
 
 
@@ -322,12 +356,16 @@ def test_observe_moves_are_never_unconfirmed(monkeypatch: pytest.MonkeyPatch) ->
     assert isinstance(tr.error, CommandTimeout)
 
 
-@pytest.mark.parametrize(("command", "before", "after"), [
-    (RunCommand.TEACH_ENABLE, ControllerMode.AUTO, ControllerMode.MODBUS_TEACH),
-    (RunCommand.TEACH_DISABLE, ControllerMode.MODBUS_TEACH, ControllerMode.AUTO),
-])
-def test_observe_teach_is_confirmed_by_the_controller_mode(command: RunCommand, before: ControllerMode,
-                                                          after: ControllerMode) -> None:
+@pytest.mark.parametrize(
+    ("command", "before", "after"),
+    [
+        (RunCommand.TEACH_ENABLE, ControllerMode.AUTO, ControllerMode.MODBUS_TEACH),
+        (RunCommand.TEACH_DISABLE, ControllerMode.MODBUS_TEACH, ControllerMode.AUTO),
+    ],
+)
+def test_observe_teach_is_confirmed_by_the_controller_mode(
+    command: RunCommand, before: ControllerMode, after: ControllerMode
+) -> None:
     pre = ControllerStatus(before, STOPPED, Alarm.NONE, DONE)
     tr = CommandTracker(command, pre, None, 0.0, unconfirmed_after=0.05)
     assert tr.update(pre, None, 0.001) is None
@@ -341,20 +379,30 @@ def test_a_move_whose_status_never_changed_is_done_when_it_stands_at_its_target(
     arm went and stopped. At the X Y Z the host sent for the end point, it ended there."""
     tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
     tr.target = (150.0, 0.0, 500.0)
-    steps = [(0.01, st(DONE), moved(20.0)), (0.05, st(DONE), moved(50.0)),
-             (0.1, st(DONE), moved(50.0)), (0.3, st(DONE), moved(50.0)), (0.41, st(DONE), moved(50.0))]
+    steps = [
+        (0.01, st(DONE), moved(20.0)),
+        (0.05, st(DONE), moved(50.0)),
+        (0.1, st(DONE), moved(50.0)),
+        (0.3, st(DONE), moved(50.0)),
+        (0.41, st(DONE), moved(50.0)),
+    ]
     i, result = feed(tr, steps)
     assert i == 4 and result.ok and not result.unconfirmed  # after stop_settle, long before ack_timeout
     assert "arrived at the point" in result.message
 
 
 def test_a_move_whose_status_never_changed_stopping_elsewhere_stays_unknown(
-        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
     tr = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0)
     tr.target = (150.0, 0.0, 500.0)  # the arm stops 10 mm short: not confirmed
-    steps = [(0.01, st(DONE), moved(20.0)), (0.05, st(DONE), moved(40.0)),
-             (0.4, st(DONE), moved(40.0)), (0.8, st(DONE), moved(40.0))]
+    steps = [
+        (0.01, st(DONE), moved(20.0)),
+        (0.05, st(DONE), moved(40.0)),
+        (0.4, st(DONE), moved(40.0)),
+        (0.8, st(DONE), moved(40.0)),
+    ]
     i, result = feed(tr, steps)
     assert i == 3 and not result.ok and "result is unknown" in result.message
 
@@ -368,9 +416,9 @@ def test_a_joint_step_whose_status_never_changed_is_done_at_its_target_joints() 
     assert i == 2 and result.ok
 
 
-
 def test_a_step_that_moves_external_axes_is_done_only_when_they_arrived_too(
-        monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
     """A joint step of J1 and E1 whose whole move a stalled host missed (0xFF before and after):
     done when J1..J6 and E1..E5 stand where the host sent them; E1 short of it stays unknown."""
     monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
@@ -385,8 +433,9 @@ def test_a_step_that_moves_external_axes_is_done_only_when_they_arrived_too(
     assert i == 2 and result.ok and "arrived at the point" in result.message
     tr = CommandTracker(RunCommand.STEP_JOINT, st(DONE), before, 0.0)
     tr.target_joints, tr.target_ext = joints_there, ext_target
-    i, result = feed(tr, [(0.01, st(DONE), short), (0.1, st(DONE), short), (0.41, st(DONE), short),
-                          (0.8, st(DONE), short)])
+    i, result = feed(
+        tr, [(0.01, st(DONE), short), (0.1, st(DONE), short), (0.41, st(DONE), short), (0.8, st(DONE), short)]
+    )
     assert i == 3 and not result.ok and "result is unknown" in result.message
 
 

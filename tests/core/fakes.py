@@ -44,23 +44,55 @@ class FakeClient:
     def read_pose(self) -> Pose:
         return self.pose
 
-    def create_point(self, point_id: int, *, pose: Sequence[float] | None = None, gv_start: int = 0,
-                     tool: int = 200, wait: bool = True, timeout: float | None = None) -> CommandResult:
+    def create_point(
+        self,
+        point_id: int,
+        *,
+        pose: Sequence[float] | None = None,
+        gv_start: int = 0,
+        tool: int = 200,
+        wait: bool = True,
+        timeout: float | None = None,
+    ) -> CommandResult:
         n = len(self.creates)
         self.creates.append({"id": point_id, "pose": tuple(pose) if pose else None, "tool": tool})
         if n not in self.create_script and pose is not None:
             self.stored[point_id] = tuple(pose)
-        return self._answer(self.create_script.get(n), CommandResult(
-            RunCommand.CREATE_POINT, CommandKind.CREATE_POINT,
-            CommandStatus(CommandKind.CREATE_POINT, 0xFF), True))
+        return self._answer(
+            self.create_script.get(n),
+            CommandResult(
+                RunCommand.CREATE_POINT,
+                CommandKind.CREATE_POINT,
+                CommandStatus(CommandKind.CREATE_POINT, 0xFF),
+                True,
+            ),
+        )
 
-    def move_to_point(self, end_id: int, *, via_id: int | None = None, orientation_changes: bool = True,
-                      ignore_middle: bool = False, speed: float = 50.0, tool: int = 200, wait: bool = True,
-                      timeout: float | None = None) -> CommandResult:
+    def move_to_point(
+        self,
+        end_id: int,
+        *,
+        via_id: int | None = None,
+        orientation_changes: bool = True,
+        ignore_middle: bool = False,
+        speed: float = 50.0,
+        tool: int = 200,
+        wait: bool = True,
+        timeout: float | None = None,
+    ) -> CommandResult:
         n = len(self.moves)
-        self.moves.append({"end": end_id, "via": via_id, "orientation_changes": orientation_changes,
-                           "ignore_middle": ignore_middle, "speed": speed, "tool": tool, "wait": wait,
-                           "timeout": timeout})
+        self.moves.append(
+            {
+                "end": end_id,
+                "via": via_id,
+                "orientation_changes": orientation_changes,
+                "ignore_middle": ignore_middle,
+                "speed": speed,
+                "tool": tool,
+                "wait": wait,
+                "timeout": timeout,
+            }
+        )
         result = self._answer(self.move_script.get(n), DONE)
         if result.ok and end_id in self.stored:
             x, y, z, a, b, c = self.stored[end_id][:6]

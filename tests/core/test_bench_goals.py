@@ -63,8 +63,11 @@ def test_a_figure_without_samples_is_null_with_a_reason() -> None:
     assert ratio(empty["p50_ms"], 1.0) is None and ratio(2.0, 0.0) is None and ratio(2.0, 1.0) == 2.0
     out = {"gui": {"sim_separate_process": {"stop_latency": {"gui_stop_button": empty}}}}
     result = goals(out)
-    entry = next(e for e in result["entries"]
-                 if e["key"] == "gui.sim_separate_process.stop_latency.gui_stop_button.p99_ms")
+    entry = next(
+        e
+        for e in result["entries"]
+        if e["key"] == "gui.sim_separate_process.stop_latency.gui_stop_button.p99_ms"
+    )
     assert entry["status"] == "not measured" and entry["met"] is None
     assert entry["reason"].startswith("the time budget")
     assert "not measured" in table(result) and result["all_met"] is False

@@ -88,8 +88,9 @@ def test_import_into_a_new_project(tmp_path: Path) -> None:
     assert project.name == "fresh" and len(project.ledger) == 8 and project.plans == []
 
 
-def test_import_of_a_bad_csv_leaves_the_project_as_it_was(demo: Path, tmp_path: Path,
-                                                          capsys: pytest.CaptureFixture[str]) -> None:
+def test_import_of_a_bad_csv_leaves_the_project_as_it_was(
+    demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     bad = tmp_path / "bad.csv"
     bad.write_text("id,name,x,y,z,a,b,c\n1,a,0,0,0,0,0,0\n2,b,0,abc,0,0,0,0\n", encoding="utf-8")
     before = demo.read_bytes()
@@ -98,8 +99,9 @@ def test_import_of_a_bad_csv_leaves_the_project_as_it_was(demo: Path, tmp_path: 
     assert demo.read_bytes() == before
 
 
-def test_import_warns_about_plans_losing_points(demo: Path, tmp_path: Path,
-                                                     capsys: pytest.CaptureFixture[str]) -> None:
+def test_import_warns_about_plans_losing_points(
+    demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     small = tmp_path / "small.csv"
     small.write_text("id,x,y,z,a,b,c\n1,400,0,450,180,0,0\n", encoding="utf-8")
     assert Cli()("points", "import", str(demo), "--csv", str(small)) == 0
@@ -147,7 +149,8 @@ def test_run_needs_a_plan_name_when_there_are_several(demo: Path, capsys: pytest
 
 
 def test_run_uploads_then_recreates_each_segments_points_before_its_move(
-        demo: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    demo: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     cli = Cli()
     assert cli("run", str(demo), "--plan", "circle") == 0
     # up front: every point the plan uses; then each segment's (via, end) right before its move
@@ -174,8 +177,9 @@ def test_run_no_upload_sends_no_point_and_warns(demo: Path, capsys: pytest.Captu
     assert demo.read_bytes() == before
 
 
-def test_run_no_upload_stops_when_the_arm_arrives_elsewhere(demo: Path,
-                                                           capsys: pytest.CaptureFixture[str]) -> None:
+def test_run_no_upload_stops_when_the_arm_arrives_elsewhere(
+    demo: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     """The controller holds a different P7 (another tool wrote it): the arrival check stops the run."""
     stored: dict[int, tuple[float, ...]] = {p.id: p.xyzabc for p in load_project(demo).ledger}
     stored[7] = (100.0, 100.0, 100.0, 180.0, 0.0, 0.0)
@@ -186,8 +190,9 @@ def test_run_no_upload_stops_when_the_arm_arrives_elsewhere(demo: Path,
     assert [m["end"] for m in client.moves] == [5, 7]  # nothing sent after the mismatch
 
 
-def test_run_stops_before_moving_when_a_point_is_refused(demo: Path,
-                                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_run_stops_before_moving_when_a_point_is_refused(
+    demo: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     from tests.core.fakes import failed
 
     client = FakeClient(create_script={1: failed(1, "bad point")})
@@ -195,8 +200,9 @@ def test_run_stops_before_moving_when_a_point_is_refused(demo: Path,
     assert "refused to create P6" in capsys.readouterr().err and client.moves == []
 
 
-def test_monitor_only_upload_refuses_before_touching_the_file(demo: Path,
-                                                             capsys: pytest.CaptureFixture[str]) -> None:
+def test_monitor_only_upload_refuses_before_touching_the_file(
+    demo: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     before = demo.read_bytes()
     mtime = demo.stat().st_mtime_ns
     cli = Cli()
@@ -211,8 +217,9 @@ def test_monitor_only_upload_refuses_before_touching_the_file(demo: Path,
     assert cli("--monitor-only", "run", str(demo), "--plan", "circle", "--check") == 0  # reads only
 
 
-def test_empty_csv_replace_import_needs_allow_empty(demo: Path, tmp_path: Path,
-                                                    capsys: pytest.CaptureFixture[str]) -> None:
+def test_empty_csv_replace_import_needs_allow_empty(
+    demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     empty = tmp_path / "empty.csv"
     empty.write_text("id,x,y,z,a,b,c\n", encoding="utf-8")
     before = demo.read_bytes()
@@ -299,8 +306,9 @@ def test_failed_segment_exit_code(demo: Path) -> None:
     assert Cli(FakeClient(move_script={0: refused}))("run", str(demo), "--plan", "circle") == 1
 
 
-def test_through_the_main_cli(demo: Path, capsys: pytest.CaptureFixture[str],
-                              monkeypatch: pytest.MonkeyPatch) -> None:
+def test_through_the_main_cli(
+    demo: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
     """app/cli/main.py registers this module and calls handler(ctx)."""
     from app.cli import main as main_cli
 

@@ -44,15 +44,31 @@ HEADER = "id,name,x,y,z,a,b,c,e1,e2,e3,e4,e5,tool,note"
 
 
 def sample_project() -> Project:
-    ledger = PointLedger([
-        make_point(1, "原点", (400, 0, 450, 180, 0, 0), sync=SyncState.ON_CONTROLLER),
-        make_point(2, "取料点, \"A\"", (450.125, -150, 250, 180, 0, 0), (1, 2, 3, 4, 5), tool=3,
-                   note="多行\n备注", sync=SyncState.FAILED, sync_error="bad point id"),
-        make_point(10000, "", (0.1, 1e-7, -3.5e5, -179.999, 90, 0), sync=SyncState.CHANGED),
-    ])
+    ledger = PointLedger(
+        [
+            make_point(1, "原点", (400, 0, 450, 180, 0, 0), sync=SyncState.ON_CONTROLLER),
+            make_point(
+                2,
+                '取料点, "A"',
+                (450.125, -150, 250, 180, 0, 0),
+                (1, 2, 3, 4, 5),
+                tool=3,
+                note="多行\n备注",
+                sync=SyncState.FAILED,
+                sync_error="bad point id",
+            ),
+            make_point(10000, "", (0.1, 1e-7, -3.5e5, -179.999, 90, 0), sync=SyncState.CHANGED),
+        ]
+    )
     plans = [
-        Plan("主程序", [Segment.line(2, 120.5), Segment.arc(1, 10000, 30, orientation_changes=False,
-                                                             ignore_middle=True, tool=3)], loops=3),
+        Plan(
+            "主程序",
+            [
+                Segment.line(2, 120.5),
+                Segment.arc(1, 10000, 30, orientation_changes=False, ignore_middle=True, tool=3),
+            ],
+            loops=3,
+        ),
         Plan("empty", [], loops=0),
     ]
     return Project(name="测试", ledger=ledger, plans=plans, description="d", created="2025-01-01T00:00:00Z")
@@ -81,16 +97,28 @@ def test_csv_minimal_columns_any_order_and_blank_lines() -> None:
     text = "\ufeffX, id ,y,z,a,b,c,Name\r\n\r\n1.5,3,2,3,180,0,0,点\r\n,,,,,,,\r\n2,4,0,0,0,0,0,\n"
     points = parse_points_csv(text)
     assert [(p.id, p.x, p.name, p.tool, p.ext) for p in points] == [
-        (3, 1.5, "点", 200, (0.0,) * 5), (4, 2.0, "", 200, (0.0,) * 5)]
+        (3, 1.5, "点", 200, (0.0,) * 5),
+        (4, 2.0, "", 200, (0.0,) * 5),
+    ]
     assert points[0].sync is SyncState.CHANGED
 
 
 BAD_CSV = [
-    ("bad number", f"{HEADER}\n1,a,0,0,0,0,0,0,0,0,0,0,0,200,\n2,b,abc,0,0,0,0,0,0,0,0,0,0,200,\n",
-     3, "x", "'abc' is not a number"),
+    (
+        "bad number",
+        f"{HEADER}\n1,a,0,0,0,0,0,0,0,0,0,0,0,200,\n2,b,abc,0,0,0,0,0,0,0,0,0,0,200,\n",
+        3,
+        "x",
+        "'abc' is not a number",
+    ),
     ("missing column", "id,name,x,y,z,a,b\n1,a,0,0,0,0,0\n", 1, "c", "missing"),
-    ("duplicate id", f"{HEADER}\n1,a,0,0,0,0,0,0,0,0,0,0,0,200,\n1,b,0,0,0,0,0,0,0,0,0,0,0,200,\n",
-     3, "id", "id 1 is already used on row 2"),
+    (
+        "duplicate id",
+        f"{HEADER}\n1,a,0,0,0,0,0,0,0,0,0,0,0,200,\n1,b,0,0,0,0,0,0,0,0,0,0,0,200,\n",
+        3,
+        "id",
+        "id 1 is already used on row 2",
+    ),
     ("id out of range", f"{HEADER}\n10001,a,0,0,0,0,0,0,0,0,0,0,0,200,\n", 2, "id", "outside 0..10000"),
     ("negative id", f"{HEADER}\n-1,a,0,0,0,0,0,0,0,0,0,0,0,200,\n", 2, "id", "outside"),
     ("NaN", f"{HEADER}\n1,a,0,0,NaN,0,0,0,0,0,0,0,0,200,\n", 2, "z", "not a finite number"),
@@ -102,7 +130,7 @@ BAD_CSV = [
     ("unknown column", "id,name,x,y,z,a,b,c,colour\n", 1, None, "unknown column 'colour'"),
     ("column twice", "id,x,y,z,a,b,c,x\n", 1, "x", "twice"),
     ("empty file", "\n\n", 1, None, "empty"),
-    ("unclosed quote", f"{HEADER}\n1,\"a,0,0,0,0,0,0,0,0,0,0,0,200,\n", 2, None, "not valid CSV"),
+    ("unclosed quote", f'{HEADER}\n1,"a,0,0,0,0,0,0,0,0,0,0,0,200,\n', 2, None, "not valid CSV"),
 ]
 
 
@@ -127,8 +155,11 @@ def test_bad_csv_is_refused_naming_row_and_column_and_ledger_unchanged(
 
 
 def test_csv_message_reads_like_the_issue() -> None:
-    text = f"{HEADER}\n" + "".join(f"{i},p,0,0,0,0,0,0,0,0,0,0,0,200,\n" for i in range(5)) + \
-        "5,p,abc,0,0,0,0,0,0,0,0,0,0,200,\n"
+    text = (
+        f"{HEADER}\n"
+        + "".join(f"{i},p,0,0,0,0,0,0,0,0,0,0,0,200,\n" for i in range(5))
+        + "5,p,abc,0,0,0,0,0,0,0,0,0,0,200,\n"
+    )
     with pytest.raises(FileFormatError, match=r"^row 7, column 'x': 'abc' is not a number$"):
         parse_points_csv(text)
 
@@ -166,10 +197,12 @@ def test_project_round_trip(tmp_path: Path) -> None:
     assert back.name == "测试" and back.description == "d" and back.created == project.created
     # a file cannot know what a controller holds: every loaded point is "unknown"
     assert back.ledger.snapshot() == tuple(
-        replace(p, sync=SyncState.UNKNOWN, sync_error="") for p in project.ledger.snapshot())
+        replace(p, sync=SyncState.UNKNOWN, sync_error="") for p in project.ledger.snapshot()
+    )
     assert '"sync"' not in path.read_text(encoding="utf-8")
     assert [(p.name, p.loops, p.segments) for p in back.plans] == [
-        (p.name, p.loops, p.segments) for p in project.plans]
+        (p.name, p.loops, p.segments) for p in project.plans
+    ]
     assert project_to_json(back) == project_to_json(project)
 
 
@@ -195,38 +228,81 @@ BAD_JSON = [
     ("not JSON", "hello", "line 1, column 1", "not valid JSON"),
     ("truncated", project_to_json(sample_project())[:300], "line ", "not valid JSON"),
     ("top-level list", "[]", "", "expected a JSON object"),
-    ("bad number", _with_points(_point(), _point(id=6, x="abc")), "points[1] (id 6), field 'x'",
-     "'abc' is not a number"),
+    (
+        "bad number",
+        _with_points(_point(), _point(id=6, x="abc")),
+        "points[1] (id 6), field 'x'",
+        "'abc' is not a number",
+    ),
     ("NaN", _with_points(_point(y=float("nan"))), "points[0] (id 5), field 'y'", "not a finite number"),
-    ("duplicate id", _with_points(_point(), _point()), "points[1] (id 5), field 'id'",
-     "already used by points[0]"),
+    (
+        "duplicate id",
+        _with_points(_point(), _point()),
+        "points[1] (id 5), field 'id'",
+        "already used by points[0]",
+    ),
     ("id out of range", _with_points(_point(id=20000)), "field 'id'", "outside 0..10000"),
-    ("missing column", _with_points({"id": 1, "x": 0, "y": 0, "z": 0, "a": 0, "b": 0}), "field 'c'",
-     "is missing"),
+    (
+        "missing column",
+        _with_points({"id": 1, "x": 0, "y": 0, "z": 0, "a": 0, "b": 0}),
+        "field 'c'",
+        "is missing",
+    ),
     ("bool as number", _with_points(_point(z=True)), "field 'z'", "not a number"),
     ("bad history", _with_points(_point(uploaded=[1])), "field 'uploaded'", "expected an object"),
     ("points not a list", json.dumps(_doc(points={})), "field 'points'", "expected a list"),
-    ("arc without via", json.dumps(_doc(plans=[{"name": "p", "segments": [{"type": "arc", "end": 1}]}])),
-     "plans[0] ('p') segment 1, field 'via'", "needs its middle point"),
-    ("line with via", json.dumps(_doc(plans=[{"name": "p", "segments": [
-        {"type": "line", "end": 1, "via": 2}]}])), "field 'via'", "no middle point"),
-    ("bad kind", json.dumps(_doc(plans=[{"name": "p", "segments": [{"type": "spline", "end": 1}]}])),
-     "field 'type'", "'line' or 'arc'"),
-    ("NaN speed", json.dumps(_doc(plans=[{"name": "p", "segments": [
-        {"type": "line", "end": 1, "speed": float("nan")}]}])), "field 'speed'", "finite"),
-    ("bad tool", json.dumps(_doc(plans=[{"name": "p", "segments": [
-        {"type": "line", "end": 1, "tool": 205}]}])), "field 'tool'", "tool 205"),
-    ("bad loops", json.dumps(_doc(plans=[{"name": "p", "loops": -1, "segments": []}])), "field 'loops'",
-     "is not 0"),
-    ("plan name twice", json.dumps(_doc(plans=[{"name": "p"}, {"name": "p"}])), "plans[1]",
-     "another plan is named"),
+    (
+        "arc without via",
+        json.dumps(_doc(plans=[{"name": "p", "segments": [{"type": "arc", "end": 1}]}])),
+        "plans[0] ('p') segment 1, field 'via'",
+        "needs its middle point",
+    ),
+    (
+        "line with via",
+        json.dumps(_doc(plans=[{"name": "p", "segments": [{"type": "line", "end": 1, "via": 2}]}])),
+        "field 'via'",
+        "no middle point",
+    ),
+    (
+        "bad kind",
+        json.dumps(_doc(plans=[{"name": "p", "segments": [{"type": "spline", "end": 1}]}])),
+        "field 'type'",
+        "'line' or 'arc'",
+    ),
+    (
+        "NaN speed",
+        json.dumps(
+            _doc(plans=[{"name": "p", "segments": [{"type": "line", "end": 1, "speed": float("nan")}]}])
+        ),
+        "field 'speed'",
+        "finite",
+    ),
+    (
+        "bad tool",
+        json.dumps(_doc(plans=[{"name": "p", "segments": [{"type": "line", "end": 1, "tool": 205}]}])),
+        "field 'tool'",
+        "tool 205",
+    ),
+    (
+        "bad loops",
+        json.dumps(_doc(plans=[{"name": "p", "loops": -1, "segments": []}])),
+        "field 'loops'",
+        "is not 0",
+    ),
+    (
+        "plan name twice",
+        json.dumps(_doc(plans=[{"name": "p"}, {"name": "p"}])),
+        "plans[1]",
+        "another plan is named",
+    ),
     ("plan without name", json.dumps(_doc(plans=[{"segments": []}])), "field 'name'", "needs a name"),
 ]
 
 
 @pytest.mark.parametrize(("case", "text", "where", "reason"), BAD_JSON, ids=[c[0] for c in BAD_JSON])
-def test_bad_project_is_refused_naming_where(tmp_path: Path, case: str, text: str, where: str,
-                                             reason: str) -> None:
+def test_bad_project_is_refused_naming_where(
+    tmp_path: Path, case: str, text: str, where: str, reason: str
+) -> None:
     path = tmp_path / "bad.teachpad.json"
     path.write_text(text, encoding="utf-8")
     with pytest.raises(FileFormatError) as info:
@@ -245,8 +321,9 @@ def test_missing_file_and_directory_are_refused(tmp_path: Path) -> None:
 
 def test_loaded_points_are_unknown_and_upload_history_round_trips(tmp_path: Path) -> None:
     """Old files' "sync": "on-controller" is ignored; the upload history is kept, never "synced"."""
-    text = _with_points(_point(sync="on-controller"), _point(id=6, sync="failed", sync_error="x"),
-                        _point(id=7, sync="bogus"))
+    text = _with_points(
+        _point(sync="on-controller"), _point(id=6, sync="failed", sync_error="x"), _point(id=7, sync="bogus")
+    )
     project = parse_project(text)
     assert [p.sync for p in project.ledger] == [SyncState.UNKNOWN] * 3
     assert project.upload_history == {}
@@ -260,9 +337,15 @@ def test_loaded_points_are_unknown_and_upload_history_round_trips(tmp_path: Path
 
 
 def test_unknown_keys_are_ignored_and_defaults_apply() -> None:
-    text = json.dumps({"format": "teachpad-project", "version": 1, "future": 1,
-                       "points": [{"id": 1, "x": 0, "y": 0, "z": 0, "a": 0, "b": 0, "c": 0, "colour": "red"}],
-                       "plans": [{"name": "p", "segments": [{"type": "line", "end": 1}]}]})
+    text = json.dumps(
+        {
+            "format": "teachpad-project",
+            "version": 1,
+            "future": 1,
+            "points": [{"id": 1, "x": 0, "y": 0, "z": 0, "a": 0, "b": 0, "c": 0, "colour": "red"}],
+            "plans": [{"name": "p", "segments": [{"type": "line", "end": 1}]}],
+        }
+    )
     project = parse_project(text)
     assert project.name == "untitled"
     assert project.ledger[0].sync is SyncState.UNKNOWN and project.ledger[0].tool == 200
@@ -320,8 +403,9 @@ def test_atomic_save_failure_mid_write_keeps_old_file(
 
 
 @pytest.mark.parametrize("fail", ["fsync", "replace"])
-def test_atomic_save_failure_before_rename_keeps_old_file(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                                                          fail: str) -> None:
+def test_atomic_save_failure_before_rename_keeps_old_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fail: str
+) -> None:
     path = tmp_path / "f.bin"
     path.write_bytes(b"old")
 
@@ -408,4 +492,5 @@ def test_sample_project_and_csv() -> None:
         assert not has_errors(issues), issues
     csv_points = read_points_csv(SAMPLES / "demo_points.csv")
     assert [(p.id, p.name, p.xyzabc) for p in csv_points] == [
-        (p.id, p.name, p.xyzabc) for p in project.ledger]
+        (p.id, p.name, p.xyzabc) for p in project.ledger
+    ]

@@ -35,19 +35,22 @@ HOME = (400.0, 0.0, 450.0)
 
 def ledger() -> PointLedger:
     """A horizontal circle of radius 100 around (400, 0, 300), plus odd points."""
-    return PointLedger([
-        make_point(1, "home", (*HOME, 180, 0, 0), sync=ON),
-        make_point(5, "W", (300, 0, 300, 180, 0, 0), sync=ON),
-        make_point(6, "N", (400, 100, 300, 180, 0, 0), sync=ON),
-        make_point(7, "E", (500, 0, 300, 180, 0, 0), sync=ON),
-        make_point(8, "S", (400, -100, 300, 180, 0, 0), sync=ON),
-        make_point(9, "mid W-E", (400, 0, 300, 180, 0, 0), sync=ON),
-        make_point(10, "W again", (300, 0, 300.05, 180, 0, 0), sync=ON),
-        make_point(11, "new", (350, 50, 300, 180, 0, 0), sync=SyncState.CHANGED),
-        make_point(12, "failed", (350, -50, 300, 180, 0, 0), sync=SyncState.FAILED,
-                   sync_error="bad point id"),
-        make_point(13, "tool 1", (450, 50, 300, 180, 0, 0), tool=0, sync=ON),
-    ])
+    return PointLedger(
+        [
+            make_point(1, "home", (*HOME, 180, 0, 0), sync=ON),
+            make_point(5, "W", (300, 0, 300, 180, 0, 0), sync=ON),
+            make_point(6, "N", (400, 100, 300, 180, 0, 0), sync=ON),
+            make_point(7, "E", (500, 0, 300, 180, 0, 0), sync=ON),
+            make_point(8, "S", (400, -100, 300, 180, 0, 0), sync=ON),
+            make_point(9, "mid W-E", (400, 0, 300, 180, 0, 0), sync=ON),
+            make_point(10, "W again", (300, 0, 300.05, 180, 0, 0), sync=ON),
+            make_point(11, "new", (350, 50, 300, 180, 0, 0), sync=SyncState.CHANGED),
+            make_point(
+                12, "failed", (350, -50, 300, 180, 0, 0), sync=SyncState.FAILED, sync_error="bad point id"
+            ),
+            make_point(13, "tool 1", (450, 50, 300, 180, 0, 0), tool=0, sync=ON),
+        ]
+    )
 
 
 def circle_plan(loops: int = 1) -> Plan:
@@ -124,7 +127,9 @@ def test_needs_upload_is_distinct_from_errors_and_reported_once_per_point() -> N
     issues = check_plan(plan, ledger(), current_pose=HOME)
     assert not has_errors(issues)
     assert [(i.segment, i.kind, i.point_id) for i in issues] == [
-        (0, IssueKind.NEEDS_UPLOAD, 11), (1, IssueKind.NEEDS_UPLOAD, 12)]
+        (0, IssueKind.NEEDS_UPLOAD, 11),
+        (1, IssueKind.NEEDS_UPLOAD, 12),
+    ]
     assert "changed on host" in issues[0].message
     assert "bad point id" in issues[1].message
     assert ids_needing_upload(issues) == [11, 12]
@@ -158,8 +163,11 @@ def test_speed_range() -> None:
     speeds = [0, -1, 1000, 1000.5]
     plan = Plan("p", [Segment.line(end, v) for end, v in zip((5, 6, 7, 8), speeds, strict=True)])
     issues = check_plan(plan, ledger(), current_pose=HOME)
-    assert [(i.segment, i.code) for i in issues] == [(0, IssueCode.BAD_SPEED), (1, IssueCode.BAD_SPEED),
-                                                     (3, IssueCode.BAD_SPEED)]
+    assert [(i.segment, i.code) for i in issues] == [
+        (0, IssueCode.BAD_SPEED),
+        (1, IssueCode.BAD_SPEED),
+        (3, IssueCode.BAD_SPEED),
+    ]
     assert "speed 1000.5 mm/s is not in (0, 1000] mm/s" in issues[2].message
     assert check_plan(plan, ledger(), PlanLimits(max_speed=2000), HOME)[-1].segment == 1
 
@@ -196,7 +204,9 @@ def test_empty_plan_zero_length_and_tool_mismatch() -> None:
     assert check_plan(Plan("e"), lg)[0].code is IssueCode.EMPTY_PLAN
     issues = check_plan(Plan("p", [Segment.line(1), Segment.line(13)]), lg, current_pose=HOME)
     assert [(i.segment, i.kind, i.code) for i in issues] == [
-        (0, IssueKind.WARNING, IssueCode.ZERO_LENGTH), (1, IssueKind.WARNING, IssueCode.TOOL_MISMATCH)]
+        (0, IssueKind.WARNING, IssueCode.ZERO_LENGTH),
+        (1, IssueKind.WARNING, IssueCode.TOOL_MISMATCH),
+    ]
     assert "taught with tool 1 (0)" in issues[1].message and not has_errors(issues)
 
 
@@ -314,8 +324,10 @@ def test_timeouts() -> None:
 
 def test_thousand_segments_are_fast() -> None:
     lg = ledger()
-    segments = [Segment.arc(6, 7) if i % 4 == 1 else Segment.arc(8, 5) if i % 4 == 2 else Segment.line(5)
-                for i in range(1000)]
+    segments = [
+        Segment.arc(6, 7) if i % 4 == 1 else Segment.arc(8, 5) if i % 4 == 2 else Segment.line(5)
+        for i in range(1000)
+    ]
     plan = Plan("big", segments)
     t0 = time.perf_counter()
     path = plan_path(plan, lg, HOME, samples=32)
@@ -346,7 +358,8 @@ def test_resuming_an_arc_before_its_middle_point_is_fine() -> None:
 def test_resuming_an_arc_past_its_middle_point_is_an_error() -> None:
     a = math.radians(45.0)  # between N (90 deg) and E (0 deg): past the middle point
     assert _resume_issues(400 + 100 * math.cos(a), 100 * math.sin(a)) == [
-        (IssueKind.ERROR, IssueCode.ARC_RESUME_PAST_MIDDLE)]
+        (IssueKind.ERROR, IssueCode.ARC_RESUME_PAST_MIDDLE)
+    ]
 
 
 def test_an_arc_from_elsewhere_with_a_larger_sweep_is_a_warning() -> None:

@@ -30,9 +30,20 @@ from app.plan.presenter import (
 from app.plan.segments import Plan, Segment
 from tests.core.test_plan import HOME, circle_plan, ledger
 
-IDLE = PanelState(connected=True, running=False, paused=False, can_resume=False, has_plan=True, segments=3,
-                  selected=True, can_move_up=True, can_move_down=False, has_sync=True, sync_busy=False,
-                  uploading=False)
+IDLE = PanelState(
+    connected=True,
+    running=False,
+    paused=False,
+    can_resume=False,
+    has_plan=True,
+    segments=3,
+    selected=True,
+    can_move_up=True,
+    can_move_down=False,
+    has_sync=True,
+    sync_busy=False,
+    uploading=False,
+)
 
 
 def test_a_plan_that_passes_reads_ok_and_runs() -> None:
@@ -98,10 +109,16 @@ def replace_loops(plan: Plan, loops: int) -> Plan:
     return Plan(plan.name, list(plan.segments), loops)
 
 
-@pytest.mark.parametrize(("start", "single", "resume", "kind"), [
-    (0, False, False, RunKind.WHOLE), (2, False, False, RunKind.FROM), (2, True, False, RunKind.STEP),
-    (0, True, False, RunKind.STEP), (2, True, True, RunKind.RESUME),
-])
+@pytest.mark.parametrize(
+    ("start", "single", "resume", "kind"),
+    [
+        (0, False, False, RunKind.WHOLE),
+        (2, False, False, RunKind.FROM),
+        (2, True, False, RunKind.STEP),
+        (0, True, False, RunKind.STEP),
+        (2, True, True, RunKind.RESUME),
+    ],
+)
 def test_run_kind(start: int, single: bool, resume: bool, kind: RunKind) -> None:
     assert run_kind(start, single, resume) is kind
 
@@ -123,8 +140,14 @@ def test_actions_idle_connected() -> None:
 def test_actions_while_running_and_paused() -> None:
     running = action_states(replace(IDLE, running=True))
     assert running.pause and running.stop and not running.resume
-    assert not (running.run or running.add_plan or running.edit_plan or running.delete_segment
-                or running.upload_now or running.resume_from)
+    assert not (
+        running.run
+        or running.add_plan
+        or running.edit_plan
+        or running.delete_segment
+        or running.upload_now
+        or running.resume_from
+    )
     paused = action_states(replace(IDLE, running=True, paused=True))
     assert paused.resume and not paused.pause and paused.stop
 

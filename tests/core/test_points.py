@@ -28,11 +28,13 @@ ON = SyncState.ON_CONTROLLER
 
 
 def ledger3() -> PointLedger:
-    return PointLedger([
-        make_point(1, "原点", (400, 0, 450, 180, 0, 0), sync=ON),
-        make_point(2, "Pick A", (450, -150, 250, 180, 0, 0), sync=ON),
-        make_point(5, "pick B", (450, 150, 250, 180, 0, 0), tool=0, sync=SyncState.CHANGED),
-    ])
+    return PointLedger(
+        [
+            make_point(1, "原点", (400, 0, 450, 180, 0, 0), sync=ON),
+            make_point(2, "Pick A", (450, -150, 250, 180, 0, 0), sync=ON),
+            make_point(5, "pick B", (450, 150, 250, 180, 0, 0), tool=0, sync=SyncState.CHANGED),
+        ]
+    )
 
 
 @pytest.mark.parametrize(
@@ -156,9 +158,15 @@ def test_editing_pose_marks_changed_but_name_does_not() -> None:
 
 @pytest.mark.parametrize(
     ("field", "value", "match"),
-    [("x", "abc", "'abc' is not a number"), ("x", "nan", "finite"), ("a", math.inf, "finite"),
-     ("id", 2, "already used"), ("id", 10001, "outside"), ("tool", 250, "tool 250"),
-     ("sync", "x", "no such field")],
+    [
+        ("x", "abc", "'abc' is not a number"),
+        ("x", "nan", "finite"),
+        ("a", math.inf, "finite"),
+        ("id", 2, "already used"),
+        ("id", 10001, "outside"),
+        ("tool", 250, "tool 250"),
+        ("sync", "x", "no such field"),
+    ],
 )
 def test_refused_edit_leaves_ledger_unchanged(field: str, value: object, match: str) -> None:
     ledger = ledger3()

@@ -15,12 +15,16 @@ from tests.core.fakes import DONE, FakeClient, failed
 
 
 def plan(loops: int = 1) -> Plan:
-    return Plan("p", [
-        Segment.line(1, 100),
-        Segment.arc(2, 3, 50, orientation_changes=False, ignore_middle=True, tool=4),
-        Segment.line(4, 25),
-        Segment.line(5, 10),
-    ], loops)
+    return Plan(
+        "p",
+        [
+            Segment.line(1, 100),
+            Segment.arc(2, 3, 50, orientation_changes=False, ignore_middle=True, tool=4),
+            Segment.line(4, 25),
+            Segment.line(5, 10),
+        ],
+        loops,
+    )
 
 
 def ends(client: FakeClient) -> list[int]:
@@ -35,8 +39,13 @@ class Recorder:
         self.events.append(p)
 
     def short(self) -> list[tuple[str, int, int]]:
-        names = {RunEvent.SEGMENT_STARTED: "start", RunEvent.SEGMENT_DONE: "done",
-                 RunEvent.FINISHED: "finished", RunEvent.STOPPED: "stopped", RunEvent.FAILED: "failed"}
+        names = {
+            RunEvent.SEGMENT_STARTED: "start",
+            RunEvent.SEGMENT_DONE: "done",
+            RunEvent.FINISHED: "finished",
+            RunEvent.STOPPED: "stopped",
+            RunEvent.FAILED: "failed",
+        }
         return [(names[e.event], e.index, e.loop) for e in self.events]
 
 
@@ -47,12 +56,28 @@ def test_runs_all_segments_in_order_with_their_parameters() -> None:
     assert outcome.ok and outcome.state is RunState.FINISHED and outcome.segments_done == 4
     assert outcome.resume_from is None and outcome.next_position is None
     assert ends(client) == [1, 3, 4, 5]
-    assert client.moves[1] == {"end": 3, "via": 2, "orientation_changes": False, "ignore_middle": True,
-                               "speed": 50.0, "tool": 4, "wait": True, "timeout": 20.0}
+    assert client.moves[1] == {
+        "end": 3,
+        "via": 2,
+        "orientation_changes": False,
+        "ignore_middle": True,
+        "speed": 50.0,
+        "tool": 4,
+        "wait": True,
+        "timeout": 20.0,
+    }
     assert client.moves[0]["via"] is None and client.moves[2]["timeout"] is None
-    assert rec.short() == [("start", 0, 1), ("done", 0, 1), ("start", 1, 1), ("done", 1, 1),
-                           ("start", 2, 1), ("done", 2, 1), ("start", 3, 1), ("done", 3, 1),
-                           ("finished", 3, 1)]
+    assert rec.short() == [
+        ("start", 0, 1),
+        ("done", 0, 1),
+        ("start", 1, 1),
+        ("done", 1, 1),
+        ("start", 2, 1),
+        ("done", 2, 1),
+        ("start", 3, 1),
+        ("done", 3, 1),
+        ("finished", 3, 1),
+    ]
     assert rec.events[2].text == "loop 1/1, segment 2/4" and rec.events[2].count == 4
     assert rec.events[2].message == "arc via P2 to P3, 50 mm/s"
     assert client.stops == 0
@@ -204,8 +229,14 @@ def test_step_by_step_driving_without_blocking() -> None:
     cmd = runner.next_command()
     assert cmd is not None and (cmd.index, cmd.loop, cmd.count, cmd.loops) == (0, 1, 4, 2)
     assert state_of(runner) is RunState.RUNNING and runner.current == cmd
-    assert cmd.move_kwargs() == {"via_id": None, "orientation_changes": True, "ignore_middle": False,
-                                 "speed": 100.0, "tool": 200, "timeout": None}
+    assert cmd.move_kwargs() == {
+        "via_id": None,
+        "orientation_changes": True,
+        "ignore_middle": False,
+        "speed": 100.0,
+        "tool": 200,
+        "timeout": None,
+    }
     with pytest.raises(RuntimeError, match="still running"):
         runner.next_command()
     runner.on_result(DONE)
@@ -297,8 +328,17 @@ def test_guard_recreates_each_segments_points_right_before_its_move() -> None:
     client.move_to_point = move  # type: ignore[method-assign]
     outcome = PlanRunner(plan()).run(client, guard)
     assert outcome.ok
-    assert calls == [("create", 1), ("move", 1), ("create", 2), ("create", 3), ("move", 3),
-                     ("create", 4), ("move", 4), ("create", 5), ("move", 5)]
+    assert calls == [
+        ("create", 1),
+        ("move", 1),
+        ("create", 2),
+        ("create", 3),
+        ("move", 3),
+        ("create", 4),
+        ("move", 4),
+        ("create", 5),
+        ("move", 5),
+    ]
 
 
 def test_guard_mismatch_fails_at_that_segment_and_sends_nothing_more() -> None:

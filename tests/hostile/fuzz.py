@@ -95,8 +95,9 @@ def run(framing: Framing, frames: int, seed: int) -> FuzzFigures:
     figures = FuzzFigures(framing)
     with HostileServer(framing) as server:
         server.default = lambda a: Reply(mutate(rng, a), close=True)
-        settings = ConnectionSettings(port=server.port, framer="rtu" if framing == "rtu" else "socket",
-                                      timeout=1.0)
+        settings = ConnectionSettings(
+            port=server.port, framer="rtu" if framing == "rtu" else "socket", timeout=1.0
+        )
         client = RobotClient(settings)
         t0 = time.monotonic()
         try:

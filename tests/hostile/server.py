@@ -49,8 +49,16 @@ class Answer:
     def function(self) -> int:
         return self.request[0]
 
-    def frame(self, pdu: bytes | None = None, *, tid: int | None = None, unit: int | None = None,
-              protocol: int = 0, length_delta: int = 0, bad_crc: bool = False) -> bytes:
+    def frame(
+        self,
+        pdu: bytes | None = None,
+        *,
+        tid: int | None = None,
+        unit: int | None = None,
+        protocol: int = 0,
+        length_delta: int = 0,
+        bad_crc: bool = False,
+    ) -> bytes:
         """A frame around ``pdu`` (default: the correct one), with the header fields given."""
         pdu = self.pdu if pdu is None else pdu
         unit = self.unit if unit is None else unit
@@ -202,5 +210,14 @@ def with_pdu(change: Callable[[Answer], bytes]) -> Mutation:
     return lambda a: Reply(a.frame(change(a)))
 
 
-__all__ = ["Answer", "HostileServer", "Mutation", "Reply", "bank_value", "correct", "crc16",
-           "silent", "with_pdu"]
+__all__ = [
+    "Answer",
+    "HostileServer",
+    "Mutation",
+    "Reply",
+    "bank_value",
+    "correct",
+    "crc16",
+    "silent",
+    "with_pdu",
+]

@@ -47,11 +47,13 @@ def test_cli_status_refuses_a_malformed_answer(framing: str, capsys: pytest.Capt
         assert err.count("\n") == 1 and err.startswith(
             "teachpad-cli: error: malformed answer to the read of registers 560..583 (GV280..GV291) "
             f"from 127.0.0.1:{server.port}: controller answered function 0x04 to a read of holding "
-            "registers (0x03)")
+            "registers (0x03)"
+        )
 
 
 def test_cli_status_reports_a_silent_controller_within_the_poll_timeout(
-        capsys: pytest.CaptureFixture[str]) -> None:
+    capsys: pytest.CaptureFixture[str],
+) -> None:
     with HostileServer("tcp") as server:
         server.default = silent
         t0 = time.monotonic()

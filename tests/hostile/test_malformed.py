@@ -36,8 +36,9 @@ def server(framing: str) -> Iterator[HostileServer]:
 
 @pytest.fixture
 def client(server: HostileServer, make_client: Callable[..., RobotClient]) -> RobotClient:
-    return make_client(port=server.port, framer="rtu" if server.framing == "rtu" else "socket",
-                       timeout=TIMEOUT)
+    return make_client(
+        port=server.port, framer="rtu" if server.framing == "rtu" else "socket", timeout=TIMEOUT
+    )
 
 
 def _shift_word(pdu: bytes, at: int, delta: int) -> bytes:
@@ -50,6 +51,7 @@ def _byte_count(delta: int) -> Mutation:
         data = a.pdu[2:]
         data = data + b"\x00" * delta if delta > 0 else data[: len(data) + delta]
         return bytes([0x03, a.pdu[1] + delta]) + data
+
     return with_pdu(change)
 
 
@@ -63,64 +65,160 @@ TCP_READ_LEN, RTU_READ_LEN = 7 + 2 + 48, 1 + 2 + 48 + 2
 
 # (case, operation, mutation, {framing: (field, message after "<endpoint>: ")})
 CASES: list[tuple[str, str, Mutation, dict[str, tuple[str, str]]]] = [
-    ("function 04", READ, with_pdu(lambda a: b"\x04" + a.pdu[1:]), dict.fromkeys(
-        ("tcp", "rtu"), ("function", "controller answered function 0x04 to a read of holding "
-                                     "registers \\(0x03\\)"))),
-    ("function 23", READ, with_pdu(lambda a: b"\x17" + a.pdu[1:]), dict.fromkeys(
-        ("tcp", "rtu"), ("function", "controller answered function 0x17 to a read of holding "
-                                     "registers \\(0x03\\)"))),
-    ("exception 0x83 with a bad length", READ, with_pdu(lambda a: b"\x83\x02\x00"), {
-        "tcp": ("length", "MBAP length field 4, expected 3"),
-        "rtu": ("CRC", "CRC 0x.{4}, expected 0x.{4}")}),
-    ("wrong unit", READ, lambda a: Reply(a.frame(unit=a.unit + 1)), dict.fromkeys(
-        ("tcp", "rtu"), ("unit id", "unit id 2, expected 1"))),
-    ("wrong transaction id", READ, lambda a: Reply(a.frame(tid=a.tid + 1)), {
-        "tcp": ("transaction id", r"transaction id 2, expected 1 \(an answer to another request\)")}),
-    ("protocol id not 0", READ, lambda a: Reply(a.frame(protocol=1)), {
-        "tcp": ("protocol id", "MBAP protocol id 1, expected 0")}),
-    ("MBAP length off by one", READ, lambda a: Reply(a.frame(length_delta=1)), {
-        "tcp": ("length", "MBAP length field 52, expected 51")}),
-    ("byte count too large", READ, _byte_count(2), dict.fromkeys(
-        ("tcp", "rtu"), ("byte count", "byte count 50, expected 48 for 24 registers"))),
-    ("byte count too small", READ, _byte_count(-2), dict.fromkeys(
-        ("tcp", "rtu"), ("byte count", "byte count 46, expected 48 for 24 registers"))),
-    ("odd byte count", READ, _byte_count(-1), dict.fromkeys(
-        ("tcp", "rtu"), ("byte count", "byte count 47, expected 48 for 24 registers"))),
-    ("extra trailing bytes", READ, lambda a: Reply(a.correct + b"\x00\x01\x02"), {
-        "tcp": ("length", f"3 bytes more than the {TCP_READ_LEN}-byte answer"),
-        "rtu": ("length", f"3 bytes more than the {RTU_READ_LEN}-byte answer")}),
-    ("short frame, then silence", READ, lambda a: Reply(a.correct[:-3]), {
-        "tcp": ("length", f"answer cut short: {TCP_READ_LEN - 3} of {TCP_READ_LEN} bytes within 0.3 s"),
-        "rtu": ("length", f"answer cut short: {RTU_READ_LEN - 3} of {RTU_READ_LEN} bytes within 0.3 s")}),
-    ("short frame, then hang-up", READ, lambda a: Reply(a.correct[:10], close=True), dict.fromkeys(
-        ("tcp", "rtu"),
-        ("length", r"answer cut short: the controller closed the link after 10 of \d+ bytes"))),
-    ("bad CRC", READ, lambda a: Reply(a.frame(bad_crc=True)), {
-        "rtu": ("CRC", "CRC 0x.{4}, expected 0x.{4}")}),
-    ("0x06 echoes another address", WRITE1, with_pdu(lambda a: _shift_word(a.pdu, 1, 1)), dict.fromkeys(
-        ("tcp", "rtu"), ("address", "the write's answer echoes address 101, expected 100"))),
-    ("0x06 echoes another value", WRITE1, with_pdu(lambda a: _shift_word(a.pdu, 3, 1)), dict.fromkeys(
-        ("tcp", "rtu"), ("value", "the write's answer echoes value 4661, expected 4660"))),
-    ("0x06 answered with 0x10", WRITE1, with_pdu(lambda a: b"\x10" + a.pdu[1:]), dict.fromkeys(
-        ("tcp", "rtu"),
-        ("function", r"controller answered function 0x10 to a write of one register \(0x06\)"))),
-    ("0x10 echoes another address", WRITEN, with_pdu(lambda a: _shift_word(a.pdu, 1, 2)), dict.fromkeys(
-        ("tcp", "rtu"), ("address", "the write's answer echoes address 2, expected 0"))),
-    ("0x10 echoes another quantity", WRITEN, with_pdu(lambda a: _shift_word(a.pdu, 3, -1)), dict.fromkeys(
-        ("tcp", "rtu"), ("quantity", "the write's answer echoes 3 registers, expected 4"))),
+    (
+        "function 04",
+        READ,
+        with_pdu(lambda a: b"\x04" + a.pdu[1:]),
+        dict.fromkeys(
+            ("tcp", "rtu"),
+            ("function", "controller answered function 0x04 to a read of holding registers \\(0x03\\)"),
+        ),
+    ),
+    (
+        "function 23",
+        READ,
+        with_pdu(lambda a: b"\x17" + a.pdu[1:]),
+        dict.fromkeys(
+            ("tcp", "rtu"),
+            ("function", "controller answered function 0x17 to a read of holding registers \\(0x03\\)"),
+        ),
+    ),
+    (
+        "exception 0x83 with a bad length",
+        READ,
+        with_pdu(lambda a: b"\x83\x02\x00"),
+        {"tcp": ("length", "MBAP length field 4, expected 3"), "rtu": ("CRC", "CRC 0x.{4}, expected 0x.{4}")},
+    ),
+    (
+        "wrong unit",
+        READ,
+        lambda a: Reply(a.frame(unit=a.unit + 1)),
+        dict.fromkeys(("tcp", "rtu"), ("unit id", "unit id 2, expected 1")),
+    ),
+    (
+        "wrong transaction id",
+        READ,
+        lambda a: Reply(a.frame(tid=a.tid + 1)),
+        {"tcp": ("transaction id", r"transaction id 2, expected 1 \(an answer to another request\)")},
+    ),
+    (
+        "protocol id not 0",
+        READ,
+        lambda a: Reply(a.frame(protocol=1)),
+        {"tcp": ("protocol id", "MBAP protocol id 1, expected 0")},
+    ),
+    (
+        "MBAP length off by one",
+        READ,
+        lambda a: Reply(a.frame(length_delta=1)),
+        {"tcp": ("length", "MBAP length field 52, expected 51")},
+    ),
+    (
+        "byte count too large",
+        READ,
+        _byte_count(2),
+        dict.fromkeys(("tcp", "rtu"), ("byte count", "byte count 50, expected 48 for 24 registers")),
+    ),
+    (
+        "byte count too small",
+        READ,
+        _byte_count(-2),
+        dict.fromkeys(("tcp", "rtu"), ("byte count", "byte count 46, expected 48 for 24 registers")),
+    ),
+    (
+        "odd byte count",
+        READ,
+        _byte_count(-1),
+        dict.fromkeys(("tcp", "rtu"), ("byte count", "byte count 47, expected 48 for 24 registers")),
+    ),
+    (
+        "extra trailing bytes",
+        READ,
+        lambda a: Reply(a.correct + b"\x00\x01\x02"),
+        {
+            "tcp": ("length", f"3 bytes more than the {TCP_READ_LEN}-byte answer"),
+            "rtu": ("length", f"3 bytes more than the {RTU_READ_LEN}-byte answer"),
+        },
+    ),
+    (
+        "short frame, then silence",
+        READ,
+        lambda a: Reply(a.correct[:-3]),
+        {
+            "tcp": ("length", f"answer cut short: {TCP_READ_LEN - 3} of {TCP_READ_LEN} bytes within 0.3 s"),
+            "rtu": ("length", f"answer cut short: {RTU_READ_LEN - 3} of {RTU_READ_LEN} bytes within 0.3 s"),
+        },
+    ),
+    (
+        "short frame, then hang-up",
+        READ,
+        lambda a: Reply(a.correct[:10], close=True),
+        dict.fromkeys(
+            ("tcp", "rtu"),
+            ("length", r"answer cut short: the controller closed the link after 10 of \d+ bytes"),
+        ),
+    ),
+    (
+        "bad CRC",
+        READ,
+        lambda a: Reply(a.frame(bad_crc=True)),
+        {"rtu": ("CRC", "CRC 0x.{4}, expected 0x.{4}")},
+    ),
+    (
+        "0x06 echoes another address",
+        WRITE1,
+        with_pdu(lambda a: _shift_word(a.pdu, 1, 1)),
+        dict.fromkeys(("tcp", "rtu"), ("address", "the write's answer echoes address 101, expected 100")),
+    ),
+    (
+        "0x06 echoes another value",
+        WRITE1,
+        with_pdu(lambda a: _shift_word(a.pdu, 3, 1)),
+        dict.fromkeys(("tcp", "rtu"), ("value", "the write's answer echoes value 4661, expected 4660")),
+    ),
+    (
+        "0x06 answered with 0x10",
+        WRITE1,
+        with_pdu(lambda a: b"\x10" + a.pdu[1:]),
+        dict.fromkeys(
+            ("tcp", "rtu"),
+            ("function", r"controller answered function 0x10 to a write of one register \(0x06\)"),
+        ),
+    ),
+    (
+        "0x10 echoes another address",
+        WRITEN,
+        with_pdu(lambda a: _shift_word(a.pdu, 1, 2)),
+        dict.fromkeys(("tcp", "rtu"), ("address", "the write's answer echoes address 2, expected 0")),
+    ),
+    (
+        "0x10 echoes another quantity",
+        WRITEN,
+        with_pdu(lambda a: _shift_word(a.pdu, 3, -1)),
+        dict.fromkeys(("tcp", "rtu"), ("quantity", "the write's answer echoes 3 registers, expected 4")),
+    ),
 ]
 
 
-PARAMS = [(framing, op, mutation, *expect[framing])
-          for _, op, mutation, expect in CASES for framing in ("tcp", "rtu") if framing in expect]
-IDS = [f"{framing}-{case}" for case, _, _, expect in CASES for framing in ("tcp", "rtu")
-       if framing in expect]
+PARAMS = [
+    (framing, op, mutation, *expect[framing])
+    for _, op, mutation, expect in CASES
+    for framing in ("tcp", "rtu")
+    if framing in expect
+]
+IDS = [f"{framing}-{case}" for case, _, _, expect in CASES for framing in ("tcp", "rtu") if framing in expect]
 
 
 @pytest.mark.parametrize(("framing", "op", "mutation", "field", "text"), PARAMS, ids=IDS)
 def test_malformed_answer_is_refused_then_the_link_resyncs(
-        framing: str, server: HostileServer, client: RobotClient, op: str, mutation: Mutation,
-        field: str, text: str) -> None:
+    framing: str,
+    server: HostileServer,
+    client: RobotClient,
+    op: str,
+    mutation: Mutation,
+    field: str,
+    text: str,
+) -> None:
     call, what = OPS[op]
     server.push(mutation)
     with pytest.raises(MalformedResponse) as info:
@@ -139,8 +237,11 @@ def test_malformed_answer_is_refused_then_the_link_resyncs(
 
 def test_a_well_formed_exception_is_a_modbus_exception(server: HostileServer, client: RobotClient) -> None:
     server.push(lambda a: Reply(a.frame(bytes([a.function | 0x80, 0x02]))))
-    with pytest.raises(ModbusExceptionError, match=r"^controller refused read of registers 560\.\.583 "
-                                                   r"\(GV280\.\.GV291\): illegal data address$"):
+    with pytest.raises(
+        ModbusExceptionError,
+        match=r"^controller refused read of registers 560\.\.583 "
+        r"\(GV280\.\.GV291\): illegal data address$",
+    ):
         client.read_status()
     assert (client.stats.exceptions, client.stats.malformed, client.stats.resyncs) == (1, 0, 0)
     assert client.read_registers(*STATUS) == [bank_value(a) for a in range(560, 584)]
@@ -163,16 +264,18 @@ def test_silence_is_a_timeout_within_the_poll_timeout(server: HostileServer, cli
     with pytest.raises(ResponseTimeout) as info:
         client.read_pose(timeout=poll_timeout)
     elapsed = time.monotonic() - t0
-    assert str(info.value) == (f"controller did not answer within {round(poll_timeout, 3)} s "
-                               f"(127.0.0.1:{server.port})")
+    assert str(info.value) == (
+        f"controller did not answer within {round(poll_timeout, 3)} s (127.0.0.1:{server.port})"
+    )
     assert poll_timeout <= elapsed < poll_timeout + 0.1
     stats = client.stats
     assert (stats.timeouts, stats.malformed, stats.resyncs) == (1, 0, 1)
     assert client.read_registers(*STATUS) == [bank_value(a) for a in range(560, 584)]
 
 
-def test_stray_bytes_after_a_good_answer_do_not_poison_the_next(server: HostileServer,
-                                                                 client: RobotClient) -> None:
+def test_stray_bytes_after_a_good_answer_do_not_poison_the_next(
+    server: HostileServer, client: RobotClient
+) -> None:
     assert client.read_registers(*STATUS) == [bank_value(a) for a in range(560, 584)]
     server.send_raw(b"\x00\x07\x00")
     sock: Any = client._transport._stream._sock  # type: ignore[union-attr]
@@ -187,24 +290,32 @@ def test_stray_bytes_after_a_good_answer_do_not_poison_the_next(server: HostileS
 
 def test_connection_errors_name_the_cause(make_client: Callable[..., RobotClient]) -> None:
     c = make_client(host="no-such-host.invalid", port=5020, connect=False)
-    with pytest.raises(LinkError, match=r"^cannot connect to the controller at no-such-host\.invalid:5020: "
-                                        r"the host name 'no-such-host\.invalid' cannot be resolved$"):
+    with pytest.raises(
+        LinkError,
+        match=r"^cannot connect to the controller at no-such-host\.invalid:5020: "
+        r"the host name 'no-such-host\.invalid' cannot be resolved$",
+    ):
         c.connect()
     assert c.stats.link_errors == 1
     c = make_client(port=502, connect=False)
     try:
         c.connect()
     except LinkError as exc:
-        assert str(exc) == ("cannot connect to the controller at 127.0.0.1:502: connection refused "
-                            "(nothing listens on port 502; the simulator's port is 5020)")
+        assert str(exc) == (
+            "cannot connect to the controller at 127.0.0.1:502: connection refused "
+            "(nothing listens on port 502; the simulator's port is 5020)"
+        )
     else:
         pytest.skip("something listens on 127.0.0.1:502 here")
 
 
 def test_lost_during_a_request(server: HostileServer, client: RobotClient) -> None:
     server.push(lambda a: Reply(None, close=True))
-    with pytest.raises(LinkError, match=r"^lost the connection to the controller at 127\.0\.0\.1:\d+ "
-                                        r"during the read of registers 560\.\.583"):
+    with pytest.raises(
+        LinkError,
+        match=r"^lost the connection to the controller at 127\.0\.0\.1:\d+ "
+        r"during the read of registers 560\.\.583",
+    ):
         client.read_registers(*STATUS)
     assert client.read_registers(*STATUS) == [bank_value(a) for a in range(560, 584)]
 

@@ -50,8 +50,9 @@ def assert_pose_at(pose: Sequence[float], target: Sequence[float], what: str = "
 
 def move_commands(sim: Any) -> int:
     """How many 'move to temp point' (440 <- 0x42) commands the simulator received."""
-    return sum(1 for w in sim.writes_to(registers.REG_RUN_COMMAND)
-               if w.values == (int(RunCommand.MOVE_TO_POINT),))
+    return sum(
+        1 for w in sim.writes_to(registers.REG_RUN_COMMAND) if w.values == (int(RunCommand.MOVE_TO_POINT),)
+    )
 
 
 def control_writes(sim: Any, register: int) -> list[Any]:

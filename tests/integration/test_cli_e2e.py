@@ -144,19 +144,31 @@ def csv_text(*bad_rows: tuple[int, str]) -> str:
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        (csv_text((4, "24,p24,abc,0,300,180,0,0,0,0,0,0,0,200,")),
-         "row 4, column 'x': 'abc' is not a number"),
+        (
+            csv_text((4, "24,p24,abc,0,300,180,0,0,0,0,0,0,0,200,")),
+            "row 4, column 'x': 'abc' is not a number",
+        ),
         (csv_text((3, "21,p21,400,0,300")), "row 3: has 5 cells, the header has 15"),
         (csv_text((5, GOOD_ROW.format(id=22, z=305))), "row 5, column 'id': id 22 is already used on row 2"),
         (csv_text((2, GOOD_ROW.format(id=20000, z=300))), "row 2, column 'id': id 20000 is outside 0..10000"),
-        (csv_text((6, "26,p26,400,0,nan,180,0,0,0,0,0,0,0,200,")),
-         "row 6, column 'z': 'nan' is not a finite"),
+        (
+            csv_text((6, "26,p26,400,0,nan,180,0,0,0,0,0,0,0,200,")),
+            "row 6, column 'z': 'nan' is not a finite",
+        ),
         (csv_text((6, "26,p26,400,0,300,180,0,0,0,0,0,0,0,7777,")), "row 6, column 'tool': tool 7777"),
         ("id,name,x,y,a,b,c\r\n1,p,1,2,3,4,5\r\n", "row 1, column 'z': the column is missing"),
         ("", "row 1: the file is empty"),
     ],
-    ids=["not-a-number", "truncated-row", "duplicate-id", "id-out-of-range", "nan", "bad-tool",
-         "missing-column", "empty"],
+    ids=[
+        "not-a-number",
+        "truncated-row",
+        "duplicate-id",
+        "id-out-of-range",
+        "nan",
+        "bad-tool",
+        "missing-column",
+        "empty",
+    ],
 )
 def test_malformed_csv_is_refused_and_the_project_is_unchanged(
     sim: Any, demo: Path, tmp_path: Path, capsys: Capsys, text: str, message: str
@@ -209,10 +221,15 @@ def test_plan_with_an_impossible_arc_is_refused_before_moving(sim: Any, demo: Pa
     doc = json.loads(demo.read_text(encoding="utf-8"))
     # P9 lies on the straight line from P1 (400, 0, 450) to P5 (300, 0, 300): no circle
     doc["points"].append({"id": 9, "x": 350.0, "y": 0.0, "z": 375.0, "a": 180.0, "b": 0.0, "c": 0.0})
-    doc["plans"].append({"name": "bad arc", "segments": [
-        {"type": "line", "end": 1, "speed": FAST},
-        {"type": "arc", "via": 9, "end": 5, "speed": FAST},
-    ]})
+    doc["plans"].append(
+        {
+            "name": "bad arc",
+            "segments": [
+                {"type": "line", "end": 1, "speed": FAST},
+                {"type": "arc", "via": 9, "end": 5, "speed": FAST},
+            ],
+        }
+    )
     demo.write_text(json.dumps(doc), encoding="utf-8")
     assert teachpad_cli(sim.port, "run", str(demo), "--plan", "bad arc", "--upload") == cli.EXIT_USAGE
     err = capsys.readouterr().err

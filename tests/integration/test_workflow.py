@@ -83,12 +83,15 @@ def test_teach_restart_restore_and_run_lines_and_arcs(sim: Any, make_client: Mak
     assert ledger.mark_all_unknown() == list(range(len(ledger)))
     assert {p.sync for p in ledger} == {SyncState.UNKNOWN}
 
-    plan = Plan("ring", [
-        Segment.line(1, speed=500.0),
-        Segment.arc(2, 3, speed=300.0),
-        Segment.arc(4, 1, speed=300.0),
-        Segment.line(5, speed=500.0),
-    ])
+    plan = Plan(
+        "ring",
+        [
+            Segment.line(1, speed=500.0),
+            Segment.arc(2, 3, speed=300.0),
+            Segment.arc(4, 1, speed=300.0),
+            Segment.line(5, speed=500.0),
+        ],
+    )
     issues = check_plan(plan, ledger, current_pose=client.read_pose())
     assert not has_errors(issues), issues
     assert ids_needing_upload(issues) == [1, 2, 3, 4, 5]
@@ -169,8 +172,9 @@ def test_arc_passes_through_the_middle_point_on_the_circle(sim: Any, make_client
 # pause / resume / stop
 # --------------------------------------------------------------------------------------------
 
-LINE_PLAN = Plan("lines", [Segment.line(1, speed=300.0), Segment.line(2, speed=150.0),
-                           Segment.line(3, speed=150.0)])
+LINE_PLAN = Plan(
+    "lines", [Segment.line(1, speed=300.0), Segment.line(2, speed=150.0), Segment.line(3, speed=150.0)]
+)
 
 
 def test_pause_resume_and_stop_a_blocking_run(sim: Any, make_client: MakeClient) -> None:
@@ -186,6 +190,7 @@ def test_pause_resume_and_stop_a_blocking_run(sim: Any, make_client: MakeClient)
         def mid_way(s: Any) -> bool:
             cmd = runner.current
             return cmd is not None and cmd.index == index and s.moving and 0.15 < along(s.pose, a, b) < 0.6
+
         return mid_way
 
     # pause mid-segment 2: the arm freezes, the run waits
@@ -217,8 +222,9 @@ def test_pause_resume_and_stop_a_blocking_run(sim: Any, make_client: MakeClient)
     assert sim.state().pose == stopped_at, "the arm moved after the stop"
 
     # the controller received exactly one pause, one resume, one stop (0x06 writes), in order
-    pauses, resumes, stops = (control_writes(sim, r) for r in
-                              (registers.REG_PAUSE, registers.REG_RESUME, registers.REG_STOP))
+    pauses, resumes, stops = (
+        control_writes(sim, r) for r in (registers.REG_PAUSE, registers.REG_RESUME, registers.REG_STOP)
+    )
     assert (len(pauses), len(resumes), len(stops)) == (1, 1, 1)
     assert pauses[0].t < resumes[0].t < stops[0].t
     assert move_commands(sim) == 3

@@ -77,8 +77,9 @@ class PartsHost:
         rid = self.request_id if request_id == -1 else request_id
         self.out.append(("commandFinished", dataclasses.replace(result, request_id=rid)))
 
-    def emit_error(self, operation: str, message: str, request_id: int | None = -1,
-                   reason: Reason | None = None) -> None:
+    def emit_error(
+        self, operation: str, message: str, request_id: int | None = -1, reason: Reason | None = None
+    ) -> None:
         rid = self.request_id if request_id == -1 else request_id
         self.out.append(("errorOccurred", WorkerError(operation, message, rid, reason)))
 

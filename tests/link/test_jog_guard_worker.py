@@ -112,5 +112,8 @@ def test_every_write_appears_once_in_the_audit(qtbot: Any, sim: Any, link: Robot
     sent = [(w.address, tuple(w.values)) for w in sim.writes]
     qtbot.waitUntil(lambda: len(audited()) == len(sent), timeout=SIGNAL_TIMEOUT_MS)
     assert audited() == sent
-    assert all(json.loads(line)["role"] == "engineer"
-               for f in tmp_path.glob("audit-*.jsonl") for line in f.read_text().splitlines())
+    assert all(
+        json.loads(line)["role"] == "engineer"
+        for f in tmp_path.glob("audit-*.jsonl")
+        for line in f.read_text().splitlines()
+    )

@@ -62,8 +62,9 @@ def test_silence_drops_the_jog_and_ratio_zero_goes_out_first_on_return(host: Par
     assert host.states()[-1] is LinkState.CONNECTED
 
 
-def test_idle_teach_is_disabled_after_the_idle_time(host: PartsHost, sim: Any,
-                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+def test_idle_teach_is_disabled_after_the_idle_time(
+    host: PartsHost, sim: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
     from app import timing
 
     monkeypatch.setattr(timing, "TEACH_IDLE_DISABLE", 0.0)

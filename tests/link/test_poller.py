@@ -41,8 +41,9 @@ def test_a_poll_publishes_pose_status_then_freshness_then_the_result(host: Parts
     host.out.clear()
     while host.motion.active is not None:
         host.poller.poll_once()
-    names = [n for n in host.names() if n in ("poseChanged", "statusChanged", "pollSucceeded",
-                                               "commandFinished")]
+    names = [
+        n for n in host.names() if n in ("poseChanged", "statusChanged", "pollSucceeded", "commandFinished")
+    ]
     done = names.index("commandFinished")
     assert names[done - 1] == "pollSucceeded"  # the result comes after that poll's data
     last_pose: Pose = host.of("poseChanged")[-1]
@@ -68,8 +69,9 @@ def test_one_silent_poll_is_not_answering_and_an_answer_is_connected_again(host:
     assert "pollSucceeded" in host.names()
 
 
-def test_silence_that_lasts_takes_the_link_down(host: PartsHost, sim: Any,
-                                                monkeypatch: pytest.MonkeyPatch) -> None:
+def test_silence_that_lasts_takes_the_link_down(
+    host: PartsHost, sim: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.1)
     host.connect(sim, poll_timeout=0.06)
     sim.set_silent(True)
@@ -90,8 +92,9 @@ def test_poll_uses_the_poll_timeout_not_the_command_timeout(host: PartsHost, sim
     sim.set_silent(False)
 
 
-def test_link_stats_reported_at_most_once_a_period(host: PartsHost, sim: Any,
-                                                   monkeypatch: pytest.MonkeyPatch) -> None:
+def test_link_stats_reported_at_most_once_a_period(
+    host: PartsHost, sim: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "RTT_REPORT_PERIOD", 3600.0)
     host.connect(sim)
     for _ in range(5):

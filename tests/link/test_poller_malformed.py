@@ -84,8 +84,11 @@ class GarblingProxy:
                 self.garble -= 1
                 self.garbled += 1
                 tid, proto, length, unit = struct.unpack_from(">HHHB", answer)
-                answer = (struct.pack(">HHHB", tid, proto, length - 4, unit) + bytes([0x03, answer[8] - 4])
-                          + answer[9:-4])
+                answer = (
+                    struct.pack(">HHHB", tid, proto, length - 4, unit)
+                    + bytes([0x03, answer[8] - 4])
+                    + answer[9:-4]
+                )
             try:
                 conn.sendall(answer)
             except OSError:
@@ -123,8 +126,9 @@ def test_a_malformed_poll_answer_is_a_failed_poll(host: PartsHost, sim: Any, pro
     assert "pollSucceeded" in host.names()
 
 
-def test_malformed_answers_in_a_row_take_the_link_down(host: PartsHost, sim: Any,
-                                                      proxy: GarblingProxy) -> None:
+def test_malformed_answers_in_a_row_take_the_link_down(
+    host: PartsHost, sim: Any, proxy: GarblingProxy
+) -> None:
     host.connect(sim, port=proxy.port)
     host.out.clear()
     proxy.garble = 100

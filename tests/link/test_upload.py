@@ -28,8 +28,9 @@ def test_every_item_is_checked_and_bad_values_are_quoted_short(sim: Any, make_cl
     assert len(str(info.value)) < 120
 
 
-def test_chunks_until_done_with_one_final_result(host: PartsHost, sim: Any,
-                                                 monkeypatch: pytest.MonkeyPatch) -> None:
+def test_chunks_until_done_with_one_final_result(
+    host: PartsHost, sim: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "UPLOAD_CHUNK_POINTS", 2)
     host.connect(sim)
     host.request_id = 9
@@ -45,8 +46,9 @@ def test_chunks_until_done_with_one_final_result(host: PartsHost, sim: Any,
     assert host.of("uploadProgress")[-1] == (5, 5)
 
 
-def test_cancel_between_chunks_ends_it_at_once(host: PartsHost, sim: Any,
-                                               monkeypatch: pytest.MonkeyPatch) -> None:
+def test_cancel_between_chunks_ends_it_at_once(
+    host: PartsHost, sim: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "UPLOAD_CHUNK_POINTS", 1)
     host.connect(sim)
     assert host.uploader.start([(100 + i, POSE, 200) for i in range(4)])

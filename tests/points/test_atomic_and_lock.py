@@ -47,7 +47,8 @@ def _temp_files(directory: Path) -> list[str]:
 
 
 def test_kill_9_during_saves_leaves_a_whole_file_and_the_next_save_cleans_up(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     old, new = (project_to_json(_project(n, k)).encode("utf-8") for n, k in (("old", 400), ("new", 600)))
     (tmp_path / "a.bin").write_bytes(old)
     (tmp_path / "b.bin").write_bytes(new)
@@ -59,8 +60,12 @@ def test_kill_9_during_saves_leaves_a_whole_file_and_the_next_save_cleans_up(
     leftovers_seen = 0
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     for _ in range(KILLS):
-        child = subprocess.Popen([sys.executable, "-c", _SAVER, str(target), str(tmp_path / "a.bin"),
-                                  str(tmp_path / "b.bin")], stdout=subprocess.PIPE, text=True, env=env)
+        child = subprocess.Popen(
+            [sys.executable, "-c", _SAVER, str(target), str(tmp_path / "a.bin"), str(tmp_path / "b.bin")],
+            stdout=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
         try:
             assert child.stdout is not None
             for _line in range(rng.randint(1, 6)):  # let it finish a few saves, then kill mid-way
@@ -106,10 +111,17 @@ def other_teachpad(tmp_path: Path) -> Iterator[tuple[subprocess.Popen[str], Path
     """Another process holding the lock of a project, until the test ends."""
     project = tmp_path / "shared.teachpad.json"
     save_project(_project("shared", 3), project)
-    code = ("import sys; from app.points.lock import ProjectLock; lock = ProjectLock.acquire(sys.argv[1]); "
-            "print('locked', flush=True); sys.stdin.read(); lock.release()")
-    child = subprocess.Popen([sys.executable, "-c", code, str(project)], stdin=subprocess.PIPE,
-                             stdout=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    code = (
+        "import sys; from app.points.lock import ProjectLock; lock = ProjectLock.acquire(sys.argv[1]); "
+        "print('locked', flush=True); sys.stdin.read(); lock.release()"
+    )
+    child = subprocess.Popen(
+        [sys.executable, "-c", code, str(project)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     assert child.stdout is not None and child.stdout.readline().strip() == "locked"
     try:
         yield child, project
@@ -123,7 +135,8 @@ def other_teachpad(tmp_path: Path) -> Iterator[tuple[subprocess.Popen[str], Path
 
 
 def test_a_live_lock_of_another_process_is_respected_and_released(
-        other_teachpad: tuple[subprocess.Popen[str], Path]) -> None:
+    other_teachpad: tuple[subprocess.Popen[str], Path],
+) -> None:
     child, project = other_teachpad
     owner = live_owner(project)
     assert owner is not None and owner.pid == child.pid and owner.host == socket.gethostname()
@@ -166,8 +179,8 @@ def test_lock_of_another_host_is_respected_and_a_corrupt_one_taken_over(tmp_path
 
 
 def test_the_cli_does_not_write_a_project_open_in_a_teachpad(
-        other_teachpad: tuple[subprocess.Popen[str], Path], tmp_path: Path,
-        capsys: pytest.CaptureFixture[str]) -> None:
+    other_teachpad: tuple[subprocess.Popen[str], Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     import argparse
 
     from app.cli import points as cli_points

@@ -49,41 +49,78 @@ def _point_text(field: str, raw: str) -> str:
 BAD_PROJECTS: list[tuple[str, str, str, str]] = [
     # case, file text, where (JSON path + field), reason
     ("10**400 as x", _project_text([_point_text("x", HUGE_INT)]), "points[0] (id 5), field 'x'", "too large"),
-    ("5000 digits as id", _project_text([_point_text("id", DIGITS_5000)]), "points[0], field 'id'",
-     "too large"),
-    ("5000 digits as loops", _project_text(plans='[{"name": "p", "loops": ' + DIGITS_5000 + "}]"),
-     "plans[0], field 'loops'", "too large"),
+    (
+        "5000 digits as id",
+        _project_text([_point_text("id", DIGITS_5000)]),
+        "points[0], field 'id'",
+        "too large",
+    ),
+    (
+        "5000 digits as loops",
+        _project_text(plans='[{"name": "p", "loops": ' + DIGITS_5000 + "}]"),
+        "plans[0], field 'loops'",
+        "too large",
+    ),
     ("1e400", _project_text([_point_text("z", "1e400")]), "field 'z'", "too large"),
     ("5000-digit float", _project_text([_point_text("z", DIGITS_5000 + ".5")]), "field 'z'", "too large"),
     ("NaN", _project_text([_point_text("y", "NaN")]), "points[0] (id 5), field 'y'", "not a finite number"),
     ("Infinity", _project_text([_point_text("a", "Infinity")]), "field 'a'", "not a finite number"),
-    ("-Infinity speed", _project_text(plans='[{"name": "p", "segments": [{"type": "line", "end": 5, '
-                                            '"speed": -Infinity}]}]'), "segment 1, field 'speed'", "finite"),
-    ("lone surrogate in a name", _project_text([_point_text("name", '"ab\\ud800cd"')]),
-     "points[0].name", "lone surrogate"),
-    ("lone surrogate in a plan name", _project_text(plans='[{"name": "\\udfff"}]'), "plans[0].name",
-     "lone surrogate"),
+    (
+        "-Infinity speed",
+        _project_text(plans='[{"name": "p", "segments": [{"type": "line", "end": 5, "speed": -Infinity}]}]'),
+        "segment 1, field 'speed'",
+        "finite",
+    ),
+    (
+        "lone surrogate in a name",
+        _project_text([_point_text("name", '"ab\\ud800cd"')]),
+        "points[0].name",
+        "lone surrogate",
+    ),
+    (
+        "lone surrogate in a plan name",
+        _project_text(plans='[{"name": "\\udfff"}]'),
+        "plans[0].name",
+        "lone surrogate",
+    ),
     ("lone surrogate in a key", _project_text(extra='{"\\ud800": 1}'), "extra (a key)", "lone surrogate"),
-    ("10 MB name", _project_text([_point_text("name", json.dumps("n" * BIG_LINE))]), "field 'name'",
-     "longer than 200"),
+    (
+        "10 MB name",
+        _project_text([_point_text("name", json.dumps("n" * BIG_LINE))]),
+        "field 'name'",
+        "longer than 200",
+    ),
     ("10 MB number", _project_text([_point_text("x", "9" * BIG_LINE)]), "field 'x'", "too large"),
-    ("10 MB format", _project_text(format=json.dumps("f" * BIG_LINE)), "field 'format'",
-     "not a TeachPad project"),
+    (
+        "10 MB format",
+        _project_text(format=json.dumps("f" * BIG_LINE)),
+        "field 'format'",
+        "not a TeachPad project",
+    ),
     ("list as x", _project_text([_point_text("x", "[1, 2]")]), "field 'x'", "not a number"),
     ("text as tool", _project_text([_point_text("tool", '"drill"')]), "field 'tool'", "not a number"),
     ("fractional id", _project_text([_point_text("id", "1.5")]), "field 'id'", "not an integer"),
     ("number as name", _project_text([_point_text("name", "12")]), "field 'name'", "is not text"),
-    ("object as points", _project_text(points=None).replace('"points": [', '"points": {"a": [') + "}",
-     "the file, field 'points'", "expected a list of points, got an object"),
+    (
+        "object as points",
+        _project_text(points=None).replace('"points": [', '"points": {"a": [') + "}",
+        "the file, field 'points'",
+        "expected a list of points, got an object",
+    ),
     ("string as plans", _project_text(plans='"' + "p" * 1000 + '"'), "field 'plans'", "expected a list"),
-    ("bad history", _project_text([_point_text("uploaded", '{"time": 5}')]), "uploaded, field 'time'",
-     "expected text"),
+    (
+        "bad history",
+        _project_text([_point_text("uploaded", '{"time": 5}')]),
+        "uploaded, field 'time'",
+        "expected text",
+    ),
 ]
 
 
 @pytest.mark.parametrize(("case", "text", "where", "reason"), BAD_PROJECTS, ids=[c[0] for c in BAD_PROJECTS])
 def test_bad_project_is_refused_briefly_naming_where_and_untouched(
-        tmp_path: Path, case: str, text: str, where: str, reason: str) -> None:
+    tmp_path: Path, case: str, text: str, where: str, reason: str
+) -> None:
     path = tmp_path / "bad.teachpad.json"
     path.write_text(text, encoding="utf-8", errors="surrogatepass")
     before, mtime = path.read_bytes(), path.stat().st_mtime_ns
@@ -98,8 +135,10 @@ def test_bad_project_is_refused_briefly_naming_where_and_untouched(
 
 def test_non_utf8_and_raw_surrogate_bytes_are_refused(tmp_path: Path) -> None:
     path = tmp_path / "gbk.teachpad.json"
-    for raw in (_project_text().replace('"p"', '"点"').encode("gbk"),
-                _project_text().encode("utf-8").replace(b'"p"', b'"\xed\xa0\x80"')):  # a surrogate in UTF-8
+    for raw in (
+        _project_text().replace('"p"', '"点"').encode("gbk"),
+        _project_text().encode("utf-8").replace(b'"p"', b'"\xed\xa0\x80"'),
+    ):  # a surrogate in UTF-8
         path.write_bytes(raw)
         with pytest.raises(FileFormatError, match=r"not UTF-8 text \(bad byte at offset"):
             load_project(path)
@@ -107,7 +146,8 @@ def test_non_utf8_and_raw_surrogate_bytes_are_refused(tmp_path: Path) -> None:
 
 
 def test_a_bad_project_through_the_cli_is_a_message_not_a_traceback(
-        tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     path = tmp_path / "bad.teachpad.json"
     path.write_text(_project_text([_point_text("x", DIGITS_5000)]), encoding="utf-8")
     parser_args = ["points", "list", str(path)]
@@ -151,7 +191,8 @@ BAD_CSV: list[tuple[str, str, str, str]] = [
 
 @pytest.mark.parametrize(("case", "text", "where", "reason"), BAD_CSV, ids=[c[0] for c in BAD_CSV])
 def test_bad_csv_is_refused_briefly_naming_row_and_column_and_untouched(
-        tmp_path: Path, case: str, text: str, where: str, reason: str) -> None:
+    tmp_path: Path, case: str, text: str, where: str, reason: str
+) -> None:
     path = tmp_path / "bad.csv"
     path.write_text(text, encoding="utf-8")
     before, mtime = path.read_bytes(), path.stat().st_mtime_ns
@@ -181,12 +222,56 @@ def test_quotes_are_short() -> None:
 # --- whatever loading accepts, saving writes -------------------------------------------------------
 
 
-NASTY_TEXT = ["", " ", "原点", "a,b", 'q"q', "line\nbreak", "\x00", "\ud800", "\udfff x", "e\u0301",
-              "\U0001f916", "\u202e", "\ufeff", "x" * 201, "y" * 2001, "\\", "\t"]
+NASTY_TEXT = [
+    "",
+    " ",
+    "原点",
+    "a,b",
+    'q"q',
+    "line\nbreak",
+    "\x00",
+    "\ud800",
+    "\udfff x",
+    "e\u0301",
+    "\U0001f916",
+    "\u202e",
+    "\ufeff",
+    "x" * 201,
+    "y" * 2001,
+    "\\",
+    "\t",
+]
 NASTY_NUMBERS: list[object] = [
-    0, -0.0, 1, -1, 0.1, 1e-320, 5e-324, 1.7976931348623157e308, 3.4e38, 1e300, 10**20, 10**400, 2**53 + 1,
-    0.5, 200, 199, 10000, 10001, -5, 12.0, float("nan"), float("inf"), True, None, "5", " 7 ", "1e3", "abc",
-    [], {},
+    0,
+    -0.0,
+    1,
+    -1,
+    0.1,
+    1e-320,
+    5e-324,
+    1.7976931348623157e308,
+    3.4e38,
+    1e300,
+    10**20,
+    10**400,
+    2**53 + 1,
+    0.5,
+    200,
+    199,
+    10000,
+    10001,
+    -5,
+    12.0,
+    float("nan"),
+    float("inf"),
+    True,
+    None,
+    "5",
+    " 7 ",
+    "1e3",
+    "abc",
+    [],
+    {},
 ]
 
 
@@ -210,13 +295,30 @@ def _random_doc(rng: random.Random) -> dict[str, object]:
         points.append(p)
     plans = []
     for j in range(rng.randint(0, 3)):
-        segs = [{"type": _pick(rng, ["arc", "spline", 1], "line"), "end": _pick(rng, NASTY_NUMBERS, 1),
-                 "speed": _pick(rng, NASTY_NUMBERS, rng.uniform(1, 900)),
-                 "tool": _pick(rng, NASTY_NUMBERS, 200)} for _ in range(rng.randint(0, 4))]
-        plans.append({"name": _pick(rng, NASTY_TEXT, f"plan {j}"), "loops": _pick(rng, NASTY_NUMBERS, 1),
-                      "segments": segs})
-    return {"format": "teachpad-project", "version": 1, "name": _pick(rng, NASTY_TEXT, "demo"),
-            "description": _pick(rng, NASTY_TEXT, ""), "points": points, "plans": plans}
+        segs = [
+            {
+                "type": _pick(rng, ["arc", "spline", 1], "line"),
+                "end": _pick(rng, NASTY_NUMBERS, 1),
+                "speed": _pick(rng, NASTY_NUMBERS, rng.uniform(1, 900)),
+                "tool": _pick(rng, NASTY_NUMBERS, 200),
+            }
+            for _ in range(rng.randint(0, 4))
+        ]
+        plans.append(
+            {
+                "name": _pick(rng, NASTY_TEXT, f"plan {j}"),
+                "loops": _pick(rng, NASTY_NUMBERS, 1),
+                "segments": segs,
+            }
+        )
+    return {
+        "format": "teachpad-project",
+        "version": 1,
+        "name": _pick(rng, NASTY_TEXT, "demo"),
+        "description": _pick(rng, NASTY_TEXT, ""),
+        "points": points,
+        "plans": plans,
+    }
 
 
 def test_saving_never_fails_on_what_loading_accepted(tmp_path: Path) -> None:
@@ -237,12 +339,15 @@ def test_saving_never_fails_on_what_loading_accepted(tmp_path: Path) -> None:
         back = load_project(path)
         assert back.ledger.snapshot() == project.ledger.snapshot()
         assert [(p.name, p.loops, p.segments) for p in back.plans] == [
-            (p.name, p.loops, p.segments) for p in project.plans]
+            (p.name, p.loops, p.segments) for p in project.plans
+        ]
         assert back.upload_history == project.upload_history
         assert project_to_json(back) == project_to_json(project)
         fields = [(p.id, p.name, p.xyzabc, p.ext, p.tool, p.note) for p in project.ledger]
-        assert [(p.id, p.name, p.xyzabc, p.ext, p.tool, p.note)
-                for p in parse_points_csv(points_to_csv(project.ledger))] == fields
+        assert [
+            (p.id, p.name, p.xyzabc, p.ext, p.tool, p.note)
+            for p in parse_points_csv(points_to_csv(project.ledger))
+        ] == fields
     assert accepted > 40 and refused > 40, (accepted, refused)
 
 
@@ -253,8 +358,9 @@ def test_csv_round_trip_of_random_rows() -> None:
         for i in range(rng.randint(0, 5)):
             name = rng.choice(NASTY_TEXT[:7]) if rng.random() < 0.9 else rng.choice(NASTY_TEXT)
             cells = [str(_pick(rng, NASTY_NUMBERS, i + 1, 0.9)), str(name)]
-            cells += [str(_pick(rng, NASTY_NUMBERS, round(rng.uniform(-999, 999), 3), 0.9))
-                      for _ in range(11)]
+            cells += [
+                str(_pick(rng, NASTY_NUMBERS, round(rng.uniform(-999, 999), 3), 0.9)) for _ in range(11)
+            ]
             cells += [str(_pick(rng, NASTY_NUMBERS, 200, 0.9)), "note"]
             rows.append(",".join(json.dumps(c) if ("," in c or '"' in c or "\n" in c) else c for c in cells))
         text = "\r\n".join(rows) + "\r\n"

@@ -20,13 +20,30 @@ from app.points.point import (
 )
 from app.points.project import FileFormatError, _parse_project_exact, parse_project
 
-GOOD = {"id": 7, "name": "原点", "x": 1.5, "y": -2.0, "z": 3.0, "a": 180.0, "b": 0.0, "c": 0.25,
-        "e1": 0.0, "e2": 1.0, "e3": 0.0, "e4": 0.0, "e5": 0.0, "tool": 3, "note": "two\nlines"}
+GOOD = {
+    "id": 7,
+    "name": "原点",
+    "x": 1.5,
+    "y": -2.0,
+    "z": 3.0,
+    "a": 180.0,
+    "b": 0.0,
+    "c": 0.25,
+    "e1": 0.0,
+    "e2": 1.0,
+    "e3": 0.0,
+    "e4": 0.0,
+    "e5": 0.0,
+    "tool": 3,
+    "note": "two\nlines",
+}
 
 
 def _doc(points: Sequence[object]) -> str:
-    return json.dumps({"format": "teachpad-project", "version": 1, "name": "t", "points": points,
-                       "plans": []}, ensure_ascii=False)
+    return json.dumps(
+        {"format": "teachpad-project", "version": 1, "name": "t", "points": points, "plans": []},
+        ensure_ascii=False,
+    )
 
 
 def test_fast_point_equals_careful_point() -> None:
@@ -36,12 +53,32 @@ def test_fast_point_equals_careful_point() -> None:
     assert fast == careful and hash(fast) == hash(careful) and repr(fast) == repr(careful)
 
 
-@pytest.mark.parametrize(("key", "value"), [
-    ("id", -1), ("id", 10**6), ("id", True), ("id", 7.0), ("id", "7"), ("x", float("nan")),
-    ("x", float("inf")), ("y", 1), ("z", "1.0"), ("e3", ""), ("e5", None), ("tool", 201),
-    ("tool", -1), ("tool", True), ("name", None), ("name", "a\nb"), ("name", "x" * 201),
-    ("note", "x" * 2001), ("note", "\ud800"), ("name", "\udfff"), ("c", 1e308),
-])
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [
+        ("id", -1),
+        ("id", 10**6),
+        ("id", True),
+        ("id", 7.0),
+        ("id", "7"),
+        ("x", float("nan")),
+        ("x", float("inf")),
+        ("y", 1),
+        ("z", "1.0"),
+        ("e3", ""),
+        ("e5", None),
+        ("tool", 201),
+        ("tool", -1),
+        ("tool", True),
+        ("name", None),
+        ("name", "a\nb"),
+        ("name", "x" * 201),
+        ("note", "x" * 2001),
+        ("note", "\ud800"),
+        ("name", "\udfff"),
+        ("c", 1e308),
+    ],
+)
 def test_fast_path_leaves_the_unusual_to_the_careful_path(key: str, value: object) -> None:
     fields = {**GOOD, key: value}
     fast = fast_point_from_fields(fields)
@@ -80,15 +117,19 @@ def test_loaded_project_matches_the_careful_decoder() -> None:
     assert all(p.sync is SyncState.UNKNOWN for p in fast.ledger)
 
 
-@pytest.mark.parametrize(("raw", "words"), [
-    ('"x": 1e400', "too large"),
-    ('"id": ' + "9" * 5000, "too large"),
-    ('"name": "\\ud800"', "lone surrogate"),
-    ('"x": "abc"', "is not a number"),
-])
+@pytest.mark.parametrize(
+    ("raw", "words"),
+    [
+        ('"x": 1e400', "too large"),
+        ('"id": ' + "9" * 5000, "too large"),
+        ('"name": "\\ud800"', "lone surrogate"),
+        ('"x": "abc"', "is not a number"),
+    ],
+)
 def test_bad_files_keep_their_messages(raw: str, words: str) -> None:
-    fields = ", ".join(f'"{k}": {json.dumps(v, ensure_ascii=False)}' for k, v in GOOD.items()
-                       if k != raw.split('"')[1])
+    fields = ", ".join(
+        f'"{k}": {json.dumps(v, ensure_ascii=False)}' for k, v in GOOD.items() if k != raw.split('"')[1]
+    )
     text = _doc([]).replace('"points": []', '"points": [{' + fields + ", " + raw + "}]")
     with pytest.raises(FileFormatError) as fast:
         parse_project(text, path="f.json")

@@ -23,11 +23,13 @@ TOLERANCE = 0.01  # mm: the simulator reaches a point exactly (float32 on the wi
 
 def _ledger(start: tuple[float, ...]) -> PointLedger:
     x, y, z, a, b, c = start
-    return PointLedger([
-        make_point(1, "a", (x + 30, y, z, a, b, c)),
-        make_point(2, "b", (x + 30, y + 30, z, a, b, c)),
-        make_point(3, "c", (x, y + 30, z, a, b, c)),
-    ])
+    return PointLedger(
+        [
+            make_point(1, "a", (x + 30, y, z, a, b, c)),
+            make_point(2, "b", (x + 30, y + 30, z, a, b, c)),
+            make_point(3, "c", (x, y + 30, z, a, b, c)),
+        ]
+    )
 
 
 PLAN = Plan("square", [Segment.line(1, SPEED), Segment.line(2, SPEED), Segment.line(3, SPEED)])
@@ -35,16 +37,21 @@ ELSEWHERE_OFFSET = (-40.0, -40.0, 25.0)
 
 
 def _elsewhere(point: tuple[float, ...]) -> tuple[float, ...]:
-    return (point[0] + ELSEWHERE_OFFSET[0], point[1] + ELSEWHERE_OFFSET[1], point[2] + ELSEWHERE_OFFSET[2],
-            *point[3:])
+    return (
+        point[0] + ELSEWHERE_OFFSET[0],
+        point[1] + ELSEWHERE_OFFSET[1],
+        point[2] + ELSEWHERE_OFFSET[2],
+        *point[3:],
+    )
 
 
 def _near(pose: tuple[float, ...], target: tuple[float, ...]) -> bool:
     return math.dist(pose[:3], target[:3]) <= TOLERANCE
 
 
-def test_an_overwrite_between_upload_and_run_is_undone_before_the_move(sim: Any,
-                                                                       make_client: MakeClient) -> None:
+def test_an_overwrite_between_upload_and_run_is_undone_before_the_move(
+    sim: Any, make_client: MakeClient
+) -> None:
     ours, other = make_client(sim), make_client(sim)
     ledger = _ledger(ours.read_pose().xyzabc)
     guard = PointGuard({p.id: p for p in ledger})
@@ -83,7 +90,8 @@ class _OverwriteBeforeMove:
 
 
 def test_an_overwrite_in_the_residual_window_stops_the_run_at_that_segment(
-        sim: Any, make_client: MakeClient) -> None:
+    sim: Any, make_client: MakeClient
+) -> None:
     ours, other = make_client(sim), make_client(sim)
     ledger = _ledger(ours.read_pose().xyzabc)
     wrong = _elsewhere(ledger.point(2).xyzabc)
@@ -118,8 +126,9 @@ def test_without_refresh_an_overwritten_point_stops_the_run(sim: Any, make_clien
     assert _near(sim.state().pose, wrong) and not _near(sim.state().pose, ledger.point(2).xyzabc)
 
 
-def test_a_restart_during_the_run_is_noticed_and_the_points_restored(sim: Any,
-                                                                     make_client: MakeClient) -> None:
+def test_a_restart_during_the_run_is_noticed_and_the_points_restored(
+    sim: Any, make_client: MakeClient
+) -> None:
     ours = make_client(sim)
     ledger = _ledger(ours.read_pose().xyzabc)
     guard = PointGuard({p.id: p for p in ledger})

@@ -50,8 +50,23 @@ def test_word_orders(value: float, low_first: list[int]) -> None:
 @pytest.mark.parametrize("order", list(WordOrder))
 @pytest.mark.parametrize(
     "value",
-    [0.0, 1.0, -1.0, 30.0, -30.0, 0.1, -123.456, 1e-3, 1e-40, -1e-45, 9999.75, -180.0, 1e30,
-     FLT_MAX, -FLT_MAX],
+    [
+        0.0,
+        1.0,
+        -1.0,
+        30.0,
+        -30.0,
+        0.1,
+        -123.456,
+        1e-3,
+        1e-40,
+        -1e-45,
+        9999.75,
+        -180.0,
+        1e30,
+        FLT_MAX,
+        -FLT_MAX,
+    ],
 )
 def test_round_trip(order: WordOrder, value: float) -> None:
     regs = float_to_registers(value, order)

@@ -34,8 +34,11 @@ def test_packed32_layout_puts_year_and_hour_in_the_high_words() -> None:
 @pytest.mark.parametrize("layout", list(DateTimeLayout))
 @pytest.mark.parametrize(
     "when",
-    [dt.datetime(2000, 1, 1, 0, 0, 0), dt.datetime(2024, 2, 29, 23, 59, 59),
-     dt.datetime(2099, 12, 31, 12, 30, 5)],
+    [
+        dt.datetime(2000, 1, 1, 0, 0, 0),
+        dt.datetime(2024, 2, 29, 23, 59, 59),
+        dt.datetime(2099, 12, 31, 12, 30, 5),
+    ],
 )
 def test_round_trip(layout: DateTimeLayout, when: dt.datetime) -> None:
     assert decode_clock(encode_clock(when, layout), layout).value == when

@@ -55,9 +55,13 @@ def test_enum_values_follow_the_tables() -> None:
 
 @pytest.mark.parametrize(
     ("table", "enum_type"),
-    [(RUN_COMMAND_TEXT, RunCommand), (CONTROLLER_MODE_TEXT, ControllerMode),
-     (PROGRAM_STATE_TEXT, ProgramState), (PROGRAM_MOTION_MODE_TEXT, ProgramMotionMode),
-     (TEACH_FRAME_TEXT, TeachFrame)],
+    [
+        (RUN_COMMAND_TEXT, RunCommand),
+        (CONTROLLER_MODE_TEXT, ControllerMode),
+        (PROGRAM_STATE_TEXT, ProgramState),
+        (PROGRAM_MOTION_MODE_TEXT, ProgramMotionMode),
+        (TEACH_FRAME_TEXT, TeachFrame),
+    ],
 )
 def test_every_member_has_a_text(table: dict[object, str], enum_type: type[enum.Enum]) -> None:
     assert set(table) == set(enum_type)
@@ -126,8 +130,13 @@ def test_the_same_code_reads_per_kind(kind: CommandKind | None, code: int, text:
 
 @pytest.mark.parametrize(
     ("kind", "code"),
-    [(CommandKind.MOVE, 14), (CommandKind.CREATE_POINT, 2), (CommandKind.TEACH, 8), (None, 99),
-     (CommandKind.MOVE, 0xFE)],
+    [
+        (CommandKind.MOVE, 14),
+        (CommandKind.CREATE_POINT, 2),
+        (CommandKind.TEACH, 8),
+        (None, 99),
+        (CommandKind.MOVE, 0xFE),
+    ],
 )
 def test_unknown_codes(kind: CommandKind | None, code: int) -> None:
     status = CommandStatus(kind, code)
@@ -150,8 +159,9 @@ def test_unknown_codes(kind: CommandKind | None, code: int) -> None:
         (CommandKind.CREATE_POINT, 0, False, True, False, False),
     ],
 )
-def test_status_predicates(kind: CommandKind, code: int, done: bool, initial: bool, moving: bool,
-                           error: bool) -> None:
+def test_status_predicates(
+    kind: CommandKind, code: int, done: bool, initial: bool, moving: bool, error: bool
+) -> None:
     status = CommandStatus(kind, code)
     flags = (status.is_done, status.is_initial, status.is_moving, status.is_error)
     assert flags == (done, initial, moving, error)
@@ -228,14 +238,16 @@ def test_alarm_names(bits: int, names: list[str]) -> None:
     assert alarm_names(bits) == names
 
 
-@pytest.mark.parametrize(("value", "text"), [(0, "manual"), (1, "auto"), (2, "Modbus teach"),
-                                             (3, "unknown status 3")])
+@pytest.mark.parametrize(
+    ("value", "text"), [(0, "manual"), (1, "auto"), (2, "Modbus teach"), (3, "unknown status 3")]
+)
 def test_controller_mode_text(value: int, text: str) -> None:
     assert controller_mode_text(value) == text
 
 
-@pytest.mark.parametrize(("value", "text"), [(0, "stopped"), (1, "running"), (2, "paused"),
-                                             (9, "unknown status 9")])
+@pytest.mark.parametrize(
+    ("value", "text"), [(0, "stopped"), (1, "running"), (2, "paused"), (9, "unknown status 9")]
+)
 def test_program_state_text(value: int, text: str) -> None:
     assert program_state_text(value) == text
 

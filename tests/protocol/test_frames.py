@@ -45,8 +45,15 @@ FC10 = FunctionCode.WRITE_MULTIPLE_REGISTERS
 CLOCK = dt.datetime(2025, 3, 14, 15, 9, 26)
 
 
-def status_registers(mode: int = 1, state: int = 0, alarms: int = 0, code: float = 255.0,
-                     *, int_status: bool = False, order: WordOrder = WordOrder.LOW_FIRST) -> list[int]:
+def status_registers(
+    mode: int = 1,
+    state: int = 0,
+    alarms: int = 0,
+    code: float = 255.0,
+    *,
+    int_status: bool = False,
+    order: WordOrder = WordOrder.LOW_FIRST,
+) -> list[int]:
     """Registers 560..583 as the controller would answer them."""
     regs = [0] * STATUS_BLOCK_COUNT
     regs[0:3] = [mode, state, alarms]
@@ -198,7 +205,8 @@ def test_one_exception_table_covers_every_standard_code() -> None:
 
 def test_exception_unknown_code_and_missing_code() -> None:
     assert decode_frame(encode_response(FC03, exception=0x77), transport="tcp").summary == (
-        "exception 77 unknown exception")
+        "exception 77 unknown exception"
+    )
     missing = decode_frame(bytes.fromhex("00 01 00 00 00 02 01 83"), transport="tcp")
     assert missing.summary == "exception (code missing)"
     assert missing.errors == ("truncated exception response: 0 of 1 data bytes",)
@@ -335,17 +343,22 @@ def test_responses_out_of_order_pair_by_transaction_id() -> None:
     status = decoder.decode(encode_request(FC03, 560, count=24, transaction_id=11))
     assert pose.summary == "read pose, ext axes, joints (412–511)"
     assert status.summary == "read status (560–583)"
-    answer = decoder.decode(encode_response(FC03, values=status_registers(alarms=Alarm.ESTOP | Alarm.BRAKE),
-                                            transaction_id=11))
+    answer = decoder.decode(
+        encode_response(FC03, values=status_registers(alarms=Alarm.ESTOP | Alarm.BRAKE), transaction_id=11)
+    )
     assert answer.request is status
-    assert answer.summary == ("status (560–583): mode=auto, program=stopped, "
-                              "alarms=emergency stop + brake alarm, "
-                              "clock=2025-03-14 15:09:26, GV291=done (0xFF)")
+    assert answer.summary == (
+        "status (560–583): mode=auto, program=stopped, "
+        "alarms=emergency stop + brake alarm, "
+        "clock=2025-03-14 15:09:26, GV291=done (0xFF)"
+    )
     values = encode_floats([float(i) for i in range(POSE_BLOCK_COUNT // 2)])
     answer = decoder.decode(encode_response(FC03, values=values, transaction_id=10))
     assert answer.request is pose
-    assert answer.summary == ("pose, ext axes, joints (412–511): X=0.0, Y=1.0, Z=2.0, A=3.0, B=4.0, C=5.0, "
-                              "EJ1=6.0, EJ2=7.0, … (+48)")
+    assert answer.summary == (
+        "pose, ext axes, joints (412–511): X=0.0, Y=1.0, Z=2.0, A=3.0, B=4.0, C=5.0, "
+        "EJ1=6.0, EJ2=7.0, … (+48)"
+    )
     # The block spans table 1 (440..453): those registers are integers, not GVs.
     assert len(answer.items) == 14 + 10 + 1 + 2 + 29
     roles = {item.role: item.value for item in answer.items}
@@ -363,14 +376,26 @@ def test_response_without_its_request_keeps_raw_values() -> None:
 @pytest.mark.parametrize(
     ("request_frame", "response", "error"),
     [
-        (encode_request(FC03, 560, count=24), encode_response(FC10, 560, count=24),
-         "function 0x10 answers a request of function 0x03"),
-        (encode_request(FC03, 560, count=3, unit=2), encode_response(FC03, values=[1, 0, 0]),
-         "unit 1 answers a request to unit 2"),
-        (encode_request(FC06, 444, [1]), encode_response(FC06, 444, [0]),
-         "the echo differs from the request"),
-        (encode_write_gv(200, 1.0), encode_response(FC10, 402, count=2),
-         "acknowledges 402+2, the request wrote 400+2"),
+        (
+            encode_request(FC03, 560, count=24),
+            encode_response(FC10, 560, count=24),
+            "function 0x10 answers a request of function 0x03",
+        ),
+        (
+            encode_request(FC03, 560, count=3, unit=2),
+            encode_response(FC03, values=[1, 0, 0]),
+            "unit 1 answers a request to unit 2",
+        ),
+        (
+            encode_request(FC06, 444, [1]),
+            encode_response(FC06, 444, [0]),
+            "the echo differs from the request",
+        ),
+        (
+            encode_write_gv(200, 1.0),
+            encode_response(FC10, 402, count=2),
+            "acknowledges 402+2, the request wrote 400+2",
+        ),
     ],
     ids=["function", "unit", "echo", "ack"],
 )
@@ -414,15 +439,17 @@ def test_pending_requests_are_bounded() -> None:
     ],
 )
 @pytest.mark.parametrize("int_status", [False, True], ids=["float", "int"])
-def test_gv291_is_decoded_for_the_last_command_sent(command: RunCommand, code: int, text: str,
-                                                     int_status: bool) -> None:
+def test_gv291_is_decoded_for_the_last_command_sent(
+    command: RunCommand, code: int, text: str, int_status: bool
+) -> None:
     decoder = FrameDecoder()
     decoder.decode(encode_request(FC06, REG_RUN_COMMAND, [command], transaction_id=1))
     decoder.decode(encode_request(FC06, REG_RUN_COMMAND, [RunCommand.RUN_PROGRAM], transaction_id=2))
     assert decoder.last_command is command  # running a program is not a GV291 command
     decoder.decode(encode_request(FC03, STATUS_BLOCK_START, count=STATUS_BLOCK_COUNT, transaction_id=3))
-    answer = decoder.decode(encode_response(FC03, values=status_registers(code=code, int_status=int_status),
-                                            transaction_id=3))
+    answer = decoder.decode(
+        encode_response(FC03, values=status_registers(code=code, int_status=int_status), transaction_id=3)
+    )
     assert answer.items[-1].kind is ItemKind.COMMAND_STATUS
     assert answer.items[-1].text == text
     assert answer.summary.endswith(f"GV291={text}")
@@ -437,8 +464,9 @@ def test_gv291_alone_with_high_word_first() -> None:
 
 
 def test_clock_layout_and_invalid_clock() -> None:
-    packed = describe_registers(576, encode_clock(CLOCK, DateTimeLayout.PACKED32),
-                                clock_layout=DateTimeLayout.PACKED32)
+    packed = describe_registers(
+        576, encode_clock(CLOCK, DateTimeLayout.PACKED32), clock_layout=DateTimeLayout.PACKED32
+    )
     assert [(item.role, item.value) for item in packed] == [("clock", CLOCK)]
     bad = describe_registers(576, [2025, 0x0D01, 0, 0])
     assert bad[0].text == "invalid (07E9 0D01 0000 0000)" and bad[0].value is None
@@ -496,7 +524,9 @@ def test_table1_read_mixes_integers_and_the_speed_float() -> None:
     values = [0x40, 0, 0, 0, 1, 0, 7, 1, 1, 50, *float_to_registers(25.5), 0, 0]
     items = describe_registers(440, values)
     assert [(item.address, item.kind, item.text) for item in items][:2] == [
-        (440, ItemKind.INTEGER, "incremental move (joint)"), (441, ItemKind.INTEGER, "0")]
+        (440, ItemKind.INTEGER, "incremental move (joint)"),
+        (441, ItemKind.INTEGER, "0"),
+    ]
     speed = [item for item in items if item.kind is ItemKind.FLOAT]
     assert [(s.name, s.role, s.value) for s in speed] == [("GV225", "speed", 25.5)]
     assert len(items) == 13
@@ -538,7 +568,9 @@ def test_odd_starts_and_half_gvs_stay_raw() -> None:
     assert [item.kind for item in describe_registers(401, [1, 2, 3])] == [ItemKind.RAW] * 3
     items = describe_registers(400, [*float_to_registers(1.0), 7])
     assert [(item.kind, item.name) for item in items] == [
-        (ItemKind.FLOAT, "GV200"), (ItemKind.RAW, "reg 402")]
+        (ItemKind.FLOAT, "GV200"),
+        (ItemKind.RAW, "reg 402"),
+    ]
     assert describe_registers(582, [0xFF])[0].kind is ItemKind.RAW  # half of GV291
     assert describe_registers(0, []) == ()
     with pytest.raises(ValueError):
@@ -571,17 +603,31 @@ def test_long_writes_are_cut_in_the_summary() -> None:
 
 
 def test_write_of_mixed_roles_lists_each() -> None:
-    frame = decode_frame(encode_write_gv(200, [-1.0, 2.0, 1.0, 0.0]), transport="tcp",
-                         params_for=RunCommand.MOVE_TO_POINT)
-    assert frame.summary == ("write motion=-1.0 (line), end point=2.0, orientation=1.0 (changes), "
-                             "ignore middle=0.0 (no)")
+    frame = decode_frame(
+        encode_write_gv(200, [-1.0, 2.0, 1.0, 0.0]), transport="tcp", params_for=RunCommand.MOVE_TO_POINT
+    )
+    assert frame.summary == (
+        "write motion=-1.0 (line), end point=2.0, orientation=1.0 (changes), ignore middle=0.0 (no)"
+    )
 
 
 @pytest.mark.parametrize(
     ("value", "text"),
-    [(30.0, "30.0"), (-1.0, "-1.0"), (0.1, "0.1"), (-0.0, "-0.0"), (100000.0, "100000.0"), (1e20, "1e+20"),
-     (123456789.0, "123456790.0"), (3.4028234663852886e38, "3.4028235e+38"), (1e-45, "1e-45"),
-     (float("nan"), "nan"), (float("inf"), "inf"), (float("-inf"), "-inf"), (1e39, "1e+39")],
+    [
+        (30.0, "30.0"),
+        (-1.0, "-1.0"),
+        (0.1, "0.1"),
+        (-0.0, "-0.0"),
+        (100000.0, "100000.0"),
+        (1e20, "1e+20"),
+        (123456789.0, "123456790.0"),
+        (3.4028234663852886e38, "3.4028235e+38"),
+        (1e-45, "1e-45"),
+        (float("nan"), "nan"),
+        (float("inf"), "inf"),
+        (float("-inf"), "-inf"),
+        (1e39, "1e+39"),
+    ],
 )
 def test_format_float32(value: float, text: str) -> None:
     assert format_float32(value) == text

@@ -40,8 +40,10 @@ def _patterns() -> list[int]:
         for sign in (0, 0x80000000):
             base = sign | exponent << 23
             patterns += [base, base + 1, base + 2, base - 1, base - 2]
-    patterns += [struct.unpack(">I", _F32.pack(round(rng.uniform(-2000, 2000), rng.randint(0, 5))))[0]
-                 for _ in range(2000)]
+    patterns += [
+        struct.unpack(">I", _F32.pack(round(rng.uniform(-2000, 2000), rng.randint(0, 5))))[0]
+        for _ in range(2000)
+    ]
     patterns += [struct.unpack(">I", _F32.pack(float(n)))[0] for n in range(-(1 << 25), 1 << 25, 99991)]
     return patterns
 
@@ -72,17 +74,24 @@ def test_the_pose_block_is_whole_gv_runs_around_table_1() -> None:
     integers = {*range(REG_RUN_COMMAND, REG_PROGRAM_SPEED + 1), REG_RESOURCE_TYPE, REG_RESOURCE_PARAM}
     assert [a for a, k in kinds.items() if k is ItemKind.INTEGER] == sorted(integers)
     floats = [a for a, k in kinds.items() if k is ItemKind.FLOAT]
-    assert floats == [a for a in range(POSE_BLOCK_START, POSE_BLOCK_START + POSE_BLOCK_COUNT, 2)
-                      if a not in integers and a + 1 not in integers]
+    assert floats == [
+        a
+        for a in range(POSE_BLOCK_START, POSE_BLOCK_START + POSE_BLOCK_COUNT, 2)
+        if a not in integers and a + 1 not in integers
+    ]
     assert sum(it.count for it in items) == POSE_BLOCK_COUNT
-    assert all(it.raw == tuple(words[it.address - POSE_BLOCK_START: it.last - POSE_BLOCK_START + 1])
-               for it in items)
+    assert all(
+        it.raw == tuple(words[it.address - POSE_BLOCK_START : it.last - POSE_BLOCK_START + 1]) for it in items
+    )
 
 
 def test_a_run_ending_in_half_a_gv_leaves_it_raw() -> None:
     items = describe_registers(400, [*encode_floats([1.0, 2.0]), 7])
     assert [(it.kind, it.text) for it in items] == [
-        (ItemKind.FLOAT, "1.0"), (ItemKind.FLOAT, "2.0"), (ItemKind.RAW, "0x0007")]
+        (ItemKind.FLOAT, "1.0"),
+        (ItemKind.FLOAT, "2.0"),
+        (ItemKind.RAW, "0x0007"),
+    ]
 
 
 def test_a_repeated_answer_reuses_its_items() -> None:
@@ -105,8 +114,12 @@ def test_cached_items_follow_the_word_order_and_the_command() -> None:
     assert describe_registers(gv_reg(GV_PARAM0), low)[0].label == "GV200 = 3.0"
     high = describe_registers(gv_reg(GV_PARAM0), low, WordOrder.HIGH_FIRST)[0]
     assert high.value != 3.0 and high.raw == tuple(low)
-    assert describe_registers(gv_reg(GV_PARAM0), float_to_registers(3.0, WordOrder.HIGH_FIRST),
-                              WordOrder.HIGH_FIRST)[0].text == "3.0"
+    assert (
+        describe_registers(
+            gv_reg(GV_PARAM0), float_to_registers(3.0, WordOrder.HIGH_FIRST), WordOrder.HIGH_FIRST
+        )[0].text
+        == "3.0"
+    )
 
 
 def test_a_full_cache_starts_again(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -128,5 +141,6 @@ def test_words_beyond_16_bits_are_masked() -> None:
 def test_a_summary_formats_only_what_it_shows() -> None:
     items = describe_registers(0, encode_floats([float(i) for i in range(20)]))
     assert summarize_registers(0, items) == (
-        "GV0–GV19 (0–39) = 0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, … (+12)")
+        "GV0–GV19 (0–39) = 0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, … (+12)"
+    )
     assert summarize_registers(0, items[:8]) == "GV0–GV7 (0–15) = 0.0, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0"

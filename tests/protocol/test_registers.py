@@ -9,8 +9,17 @@ from app.protocol import registers as r
 
 @pytest.mark.parametrize(
     ("n", "low", "high"),
-    [(0, 0, 1), (1, 2, 3), (200, 400, 401), (206, 412, 413), (220, 440, 441), (225, 450, 451),
-     (245, 490, 491), (280, 560, 561), (291, 582, 583)],
+    [
+        (0, 0, 1),
+        (1, 2, 3),
+        (200, 400, 401),
+        (206, 412, 413),
+        (220, 440, 441),
+        (225, 450, 451),
+        (245, 490, 491),
+        (280, 560, 561),
+        (291, 582, 583),
+    ],
 )
 def test_gv_registers(n: int, low: int, high: int) -> None:
     assert r.gv_reg(n) == r.gv_low(n) == low
@@ -19,8 +28,9 @@ def test_gv_registers(n: int, low: int, high: int) -> None:
     assert r.reg_to_gv(high) == (n, "H")
 
 
-@pytest.mark.parametrize("call", [lambda: r.gv_reg(-1), lambda: r.gv_low(-1), lambda: r.gv_high(-1),
-                                  lambda: r.reg_to_gv(-1)])
+@pytest.mark.parametrize(
+    "call", [lambda: r.gv_reg(-1), lambda: r.gv_low(-1), lambda: r.gv_high(-1), lambda: r.reg_to_gv(-1)]
+)
 def test_negative_indexes_are_refused(call: object) -> None:
     assert callable(call)
     with pytest.raises(ValueError):
@@ -61,7 +71,12 @@ def test_table1_addresses() -> None:
 
 def test_parameter_and_live_gvs() -> None:
     assert [r.gv_reg(n) for n in (r.GV_PARAM0, r.GV_PARAM1, r.GV_PARAM2, r.GV_PARAM3, r.GV_PARAM5)] == [
-        400, 402, 404, 406, 410]
+        400,
+        402,
+        404,
+        406,
+        410,
+    ]
     assert (r.gv_reg(r.GV_EXT_OFFSET0), r.gv_high(r.GV_EXT_OFFSET0 + 4)) == (472, 481)
     assert (r.gv_reg(r.GV_USER_FRAME), r.gv_reg(r.GV_TOOL_FRAME)) == (482, 490)
     assert r.TOOL_NONE == 200

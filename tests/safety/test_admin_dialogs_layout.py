@@ -37,8 +37,9 @@ def _problems(dialog: QDialog, language: str) -> list[str]:
 @pytest.mark.parametrize("role", [Role.OPERATOR, Role.ADMINISTRATOR])
 def test_admin_dialogs_layout(qtbot: Any, translator: Any, tmp_path: Path, language: str, role: Role) -> None:
     assert translator.set_language(language)
-    safety = SafetyController(None, QSettings(str(tmp_path / "t.ini"), QSettings.Format.IniFormat),
-                              scrypt_n=2**4)
+    safety = SafetyController(
+        None, QSettings(str(tmp_path / "t.ini"), QSettings.Format.IniFormat), scrypt_n=2**4
+    )
     safety.set_idle_polling(False)
     safety.session.set_password(Role.ADMINISTRATOR, "root-pw")
     if role is Role.ADMINISTRATOR:
@@ -46,10 +47,12 @@ def test_admin_dialogs_layout(qtbot: Any, translator: Any, tmp_path: Path, langu
     try:
         profile = RegisterProfile("cell 3", revision=2, saved="2026-11-24T05:40:00+00:00")
         dialogs: list[QDialog] = [
-            RegisterProfileDialog(profile, lambda _p, _r: None, reason=safety.reason(Action.REGISTER_PROFILE),
-                                  connected=True),
+            RegisterProfileDialog(
+                profile, lambda _p, _r: None, reason=safety.reason(Action.REGISTER_PROFILE), connected=True
+            ),
             PasswordDialog(safety),
-            ConnectionDialog(ConnectionSettings(), profile=profile)]  # with the profile's note
+            ConnectionDialog(ConnectionSettings(), profile=profile),
+        ]  # with the profile's note
         for dialog in dialogs:
             qtbot.addWidget(dialog)
             dialog.show()

@@ -54,8 +54,11 @@ def test_writes_and_refusals_are_recorded_with_role_result_and_both_clocks(tmp_p
     log.close()
     recs = list(read_records(tmp_path))
     assert [(r.kind, r.role, r.result) for r in recs] == [
-        ("write", "engineer", Result.OK), ("write", "engineer", Result.FAILED),
-        ("write", "operator", Result.BLOCKED), ("refused", "operator", Result.REFUSED)]
+        ("write", "engineer", Result.OK),
+        ("write", "engineer", Result.FAILED),
+        ("write", "operator", Result.BLOCKED),
+        ("refused", "operator", Result.REFUSED),
+    ]
     assert recs[0].command == "teach enable (440 ← 0x80)"
     assert recs[0].args == {"fc": 6, "address": 440, "values": [0x80]}
     assert recs[1].command.startswith("write GV200") and recs[1].detail == "no answer from 10.0.0.5:502"
@@ -65,8 +68,9 @@ def test_writes_and_refusals_are_recorded_with_role_result_and_both_clocks(tmp_p
 
 def test_one_file_per_day_rotation_and_size_cap(tmp_path: Path) -> None:
     clock = Clock(dt.datetime(2026, 3, 1, 12, 0, tzinfo=dt.UTC))
-    log = AuditLog(tmp_path, now=clock, max_file_bytes=2000, max_total_bytes=7000, keep_days=30,
-                   fsync=FsyncPolicy.NEVER)
+    log = AuditLog(
+        tmp_path, now=clock, max_file_bytes=2000, max_total_bytes=7000, keep_days=30, fsync=FsyncPolicy.NEVER
+    )
     for i in range(40):
         log.record("action", f"teach P{i}")
     clock.t += dt.timedelta(days=1)
@@ -115,8 +119,9 @@ def test_filters_and_csv_export(tmp_path: Path) -> None:
     assert [r.command for r in query(tmp_path, AuditFilter(role="administrator"))] == ["change connection"]
     assert [r.command for r in query(tmp_path, AuditFilter(result=Result.REFUSED))] == ["delete point"]
     assert [r.command for r in query(tmp_path, AuditFilter(command="STOP"))] == ["stop (441 ← 1)"]
-    window = AuditFilter(start=dt.datetime(2026, 5, 1, 9, 0).astimezone(),
-                         end=dt.datetime(2026, 5, 1, 23, 0).astimezone())
+    window = AuditFilter(
+        start=dt.datetime(2026, 5, 1, 9, 0).astimezone(), end=dt.datetime(2026, 5, 1, 23, 0).astimezone()
+    )
     assert [r.command for r in query(tmp_path, window)] == ["change connection"]
     out = io.StringIO()
     assert export_csv(query(tmp_path), out) == 3
@@ -168,8 +173,11 @@ def test_every_write_appears_once_also_after_kill_9(tmp_path: Path, sim: Any) ->
     key = {id(r): (r.args["values"][2], r.args["values"][0] | r.args["values"][1] << 16) for r in recs}
     audited = [key[id(r)] for r in recs]
     assert len(audited) == len(set(audited)), "a write was recorded twice"
-    received = {(w.values[2], w.values[0] | w.values[1] << 16) for w in sim.writes
-                if w.address == 0 and len(w.values) == 4}
+    received = {
+        (w.values[2], w.values[0] | w.values[1] << 16)
+        for w in sim.writes
+        if w.address == 0 and len(w.values) == 4
+    }
     assert received <= set(audited), "a write the controller received is not in the audit"  # write-ahead
     unknown = [key[id(r)] for r in recs if r.result == Result.UNKNOWN]
     assert all(r.result in (Result.OK, Result.UNKNOWN) for r in recs)
@@ -209,14 +217,20 @@ def test_a_write_is_one_record_also_when_its_outcome_line_is_in_the_next_file(tm
     stats = ReadStats()
     recs = list(read_records(tmp_path, stats=stats))
     assert [(r.kind, r.args.get("address"), r.result) for r in recs] == [
-        ("write", 441, Result.OK), ("action", None, Result.OK), ("write", 0, Result.FAILED),
-        ("write", 2, Result.OK), ("write", 4, Result.OK), ("write", 6, Result.UNKNOWN)]
+        ("write", 441, Result.OK),
+        ("action", None, Result.OK),
+        ("write", 0, Result.FAILED),
+        ("write", 2, Result.OK),
+        ("write", 4, Result.OK),
+        ("write", 6, Result.UNKNOWN),
+    ]
     assert recs[2].detail == "the link is down" and "stopped before the answer" in recs[5].detail
     assert stats.unknown == 1 and stats.records == 6 and stats.skipped == 0
 
 
-def test_an_unanswered_write_does_not_hold_back_what_follows(tmp_path: Path,
-                                                              monkeypatch: pytest.MonkeyPatch) -> None:
+def test_an_unanswered_write_does_not_hold_back_what_follows(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(audit_read, "MAX_OUTCOME_LAG", 5)
     log = AuditLog(tmp_path)
     log.record_write(6, [7], single=True, pending=True)  # never answered: its process died

@@ -78,15 +78,31 @@ def test_gui_writes_are_audited_once_also_after_kill_9(tmp_path: Path, sim_facto
     # (beside its settings file) says so -- applied at start-up, not overridden by --unit's default.
     sim = sim_factory(unit=7)
     save_register_profile(tmp_path / "safety" / PROFILE_NAME, RegisterProfile("unit 7", unit=7))
-    env = {**os.environ, "PYTHONPATH": str(ROOT), "QT_QPA_PLATFORM": "offscreen",
-           "XDG_CONFIG_HOME": str(tmp_path / "config"), "XDG_DATA_HOME": str(tmp_path / "data")}
-    argv = [sys.executable, "-c", CHILD, str(POINTS), "--host", "127.0.0.1", "--port", str(sim.port),
-            "--settings", str(tmp_path / "teachpad.ini")]
+    env = {
+        **os.environ,
+        "PYTHONPATH": str(ROOT),
+        "QT_QPA_PLATFORM": "offscreen",
+        "XDG_CONFIG_HOME": str(tmp_path / "config"),
+        "XDG_DATA_HOME": str(tmp_path / "data"),
+    }
+    argv = [
+        sys.executable,
+        "-c",
+        CHILD,
+        str(POINTS),
+        "--host",
+        "127.0.0.1",
+        "--port",
+        str(sim.port),
+        "--settings",
+        str(tmp_path / "teachpad.ini"),
+    ]
     child = subprocess.Popen(argv, env=env, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     assert child.stderr is not None
     try:
-        sent = sim.wait_for(lambda _s: len(sim.writes) >= KILL_AFTER_WRITES or child.poll() is not None,
-                            timeout=START_TIMEOUT)
+        sent = sim.wait_for(
+            lambda _s: len(sim.writes) >= KILL_AFTER_WRITES or child.poll() is not None, timeout=START_TIMEOUT
+        )
         assert child.poll() is None, f"the GUI exited by itself: {child.stderr.read()[-400:]!r}"
         assert sent, "the GUI did not write enough in time"
     finally:
@@ -99,7 +115,9 @@ def test_gui_writes_are_audited_once_also_after_kill_9(tmp_path: Path, sim_facto
     writes = [r for r in read_records(audit_dir, stats=stats) if r.kind == "write"]
     audited = [_write_key(r.args["fc"], r.args["address"], r.args["values"]) for r in writes]
     assert len(received) >= KILL_AFTER_WRITES and stats.skipped == 0
-    assert audited[:len(received)] == received, "a write the controller received is missing, doubled or moved"
+    assert audited[: len(received)] == received, (
+        "a write the controller received is missing, doubled or moved"
+    )
     assert len(audited) - len(received) in (0, 1)  # at most the one written ahead, then killed
     assert all(r.role == "operator" and r.result == Result.OK for r in writes[:-1])
     last = writes[-1]

@@ -37,25 +37,49 @@ def files(tmp_path: Path) -> dict[str, Path]:
     logs.mkdir()
     (logs / "teachpad.log").write_text("connected\n")
     (logs / "roles.json").write_bytes((tmp_path / "roles.json").read_bytes())  # a stray copy
-    return {"project": project, "profile": profile, "audit": audit_dir, "logs": logs,
-            "store": tmp_path / "roles.json"}
+    return {
+        "project": project,
+        "profile": profile,
+        "audit": audit_dir,
+        "logs": logs,
+        "store": tmp_path / "roles.json",
+    }
 
 
 def test_bundle_has_everything_but_secrets(tmp_path: Path, files: dict[str, Path]) -> None:
-    settings = {"connection": {"host": "10.0.0.5", "port": 502}, "admin_password": PASSWORD,
-                "roles": {"engineer": {"hash": "abcd", "salt": "ef"}}, "ui": {"language": "zh_CN"}}
+    settings = {
+        "connection": {"host": "10.0.0.5", "port": 502},
+        "admin_password": PASSWORD,
+        "roles": {"engineer": {"hash": "abcd", "salt": "ef"}},
+        "ui": {"language": "zh_CN"},
+    }
     out = tmp_path / "bundle.zip"
     manifest = write_support_bundle(
-        out, settings=settings, project=files["project"], profile=files["profile"], audit_dir=files["audit"],
-        events=["03:00 connected"], log_dir=files["logs"], traffic=["tx 00 01 00 00 00 06 01 03 01 9C 00 0C"],
-        days=3)
+        out,
+        settings=settings,
+        project=files["project"],
+        profile=files["profile"],
+        audit_dir=files["audit"],
+        events=["03:00 connected"],
+        log_dir=files["logs"],
+        traffic=["tx 00 01 00 00 00 06 01 03 01 9C 00 0C"],
+        days=3,
+    )
     with zipfile.ZipFile(out) as zf:
         names = set(zf.namelist())
         blob = b"".join(zf.read(n) for n in names)
         got_settings = json.loads(zf.read("settings.json"))
         versions = json.loads(zf.read("versions.json"))
-    assert {"versions.json", "settings.json", "project/demo.teachpad.json", "safety-profile.json",
-            "events.txt", "traffic.txt", "logs/teachpad.log", "manifest.json"} <= names
+    assert {
+        "versions.json",
+        "settings.json",
+        "project/demo.teachpad.json",
+        "safety-profile.json",
+        "events.txt",
+        "traffic.txt",
+        "logs/teachpad.log",
+        "manifest.json",
+    } <= names
     today = dt.date.today().isoformat()
     assert [n for n in names if n.startswith("audit/")] == [f"audit/audit-{today}.jsonl"]
     assert "pymodbus" in versions and "python" in versions and "teachpad" in versions
@@ -69,17 +93,36 @@ def test_bundle_has_everything_but_secrets(tmp_path: Path, files: dict[str, Path
 
 def test_redact_keeps_what_is_not_secret() -> None:
     assert redact({"a": [{"token": 1, "b": 2}], "Password": "x", "port": 5}) == {
-        "a": [{"token": REMOVED, "b": 2}], "Password": REMOVED, "port": 5}
+        "a": [{"token": REMOVED, "b": 2}],
+        "Password": REMOVED,
+        "port": 5,
+    }
 
 
-def test_cli_support_bundle_and_audit(tmp_path: Path, files: dict[str, Path],
-                                      capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_support_bundle_and_audit(
+    tmp_path: Path, files: dict[str, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
     settings = tmp_path / "settings.json"
     settings.write_text(json.dumps({"password": PASSWORD, "poll_hz": 50}))
     out = tmp_path / "out.zip"
-    code = main(["--host", "10.1.2.3", "support-bundle", str(out), "--project", str(files["project"]),
-                 "--profile", str(files["profile"]), "--settings", str(settings),
-                 "--audit-dir", str(files["audit"]), "--days", "2"])
+    code = main(
+        [
+            "--host",
+            "10.1.2.3",
+            "support-bundle",
+            str(out),
+            "--project",
+            str(files["project"]),
+            "--profile",
+            str(files["profile"]),
+            "--settings",
+            str(settings),
+            "--audit-dir",
+            str(files["audit"]),
+            "--days",
+            "2",
+        ]
+    )
     assert code == 0, capsys.readouterr().err
     assert f"wrote {out}" in capsys.readouterr().out
     with zipfile.ZipFile(out) as zf:
@@ -103,8 +146,9 @@ def test_cli_help_says_it_is_an_administrators_tool(capsys: pytest.CaptureFixtur
     assert "administrator's tool" in capsys.readouterr().out
 
 
-def test_cli_roles(tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
-                   capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_roles(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
     import io
 
     store = tmp_path / "roles.json"

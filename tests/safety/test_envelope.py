@@ -25,8 +25,15 @@ from app.safety.envelope import (
 
 CELL = Box("work space", (-800.0, -450.0, 0.0), (800.0, 450.0, 900.0))
 FIXTURE = Box("fixture A", (300.0, -100.0, 0.0), (400.0, 100.0, 200.0))
-ENV = Envelope(joint_limits=((-170, 170), (-90, 135)), keep_in=CELL, keep_out=(FIXTURE,),
-               max_jog_ratio=50, max_speed=500, reduced_jog_ratio=10, reduced_speed=250)
+ENV = Envelope(
+    joint_limits=((-170, 170), (-90, 135)),
+    keep_in=CELL,
+    keep_out=(FIXTURE,),
+    max_jog_ratio=50,
+    max_speed=500,
+    reduced_jog_ratio=10,
+    reduced_speed=250,
+)
 
 
 def pose(x: float, y: float, z: float) -> Pose:
@@ -72,8 +79,9 @@ def test_caps_and_reduced_mode() -> None:
 
 
 def _ledger(*poses: tuple[float, float, float]) -> PointLedger:
-    return PointLedger([make_point(i + 1, pose=(*p, 180, 0, 0), sync=SyncState.ON_CONTROLLER)
-                        for i, p in enumerate(poses)])
+    return PointLedger(
+        [make_point(i + 1, pose=(*p, 180, 0, 0), sync=SyncState.ON_CONTROLLER) for i, p in enumerate(poses)]
+    )
 
 
 def test_arc_bulging_into_a_zone_is_caught_though_its_points_are_clear() -> None:
@@ -101,12 +109,19 @@ def test_arc_leaving_keep_in_between_samples_of_its_points() -> None:
 
 def test_plan_through_a_keep_out_box_is_an_error_that_blocks_run() -> None:
     ledger = _ledger((200.0, 0.0, 100.0), (500.0, 0.0, 100.0), (500.0, 300.0, 100.0))
-    plan = Plan("weld", [Segment(SegmentKind.LINE, end_id=1, speed=100),
-                         Segment(SegmentKind.LINE, end_id=2, speed=100),  # crosses fixture A
-                         Segment(SegmentKind.LINE, end_id=3, speed=600)])  # too fast
+    plan = Plan(
+        "weld",
+        [
+            Segment(SegmentKind.LINE, end_id=1, speed=100),
+            Segment(SegmentKind.LINE, end_id=2, speed=100),  # crosses fixture A
+            Segment(SegmentKind.LINE, end_id=3, speed=600),
+        ],
+    )  # too fast
     violations = plan_violations(plan, ledger, ENV, pose(0, 0, 100))
-    assert [(v.segment, v.code) for v in violations] == [(1, ViolationCode.KEEP_OUT),
-                                                         (2, ViolationCode.SPEED)]
+    assert [(v.segment, v.code) for v in violations] == [
+        (1, ViolationCode.KEEP_OUT),
+        (2, ViolationCode.SPEED),
+    ]
     assert violations[0].message.startswith("segment 2: the path enters the keep-out zone 'fixture A'")
     issues = check_plan(plan, ledger, current_pose=pose(0, 0, 100), envelope=ENV)
     envelope_issues = [i for i in issues if i.code is IssueCode.OUTSIDE_ENVELOPE]
@@ -132,5 +147,5 @@ def test_scalar_and_vectorised_chord_tests_agree() -> None:
     scalar = [box.chord_hits(a[k], b[k]) for k in range(len(a))]
     assert any(scalar) and not all(scalar)
     for k in range(len(a)):
-        hit = box.segments_hit(np.repeat(a[k:k + 1], 5, axis=0), np.repeat(b[k:k + 1], 5, axis=0))
+        hit = box.segments_hit(np.repeat(a[k : k + 1], 5, axis=0), np.repeat(b[k : k + 1], 5, axis=0))
         assert (hit == 0) == scalar[k]

@@ -28,8 +28,7 @@ pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)
 PASSWORD = "cell-42"
 
 
-def test_views_draw_the_envelope_and_the_planner_checks_with_the_mode(qtbot: Any,
-                                                                       window: MainWindow) -> None:
+def test_views_draw_the_envelope_and_the_planner_checks_with_the_mode(qtbot: Any, window: MainWindow) -> None:
     safety = window.safety_menu.safety
     safety.session.store.scrypt_n = 2**4
     safety.session.store.set_password(Role.ENGINEER, PASSWORD, by=Role.ADMINISTRATOR)

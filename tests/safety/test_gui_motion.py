@@ -53,16 +53,18 @@ def test_the_jog_ratio_is_capped_by_the_envelope(qtbot: Any, sim: Any, menu: Saf
     assert max(ratio_writes(sim)) == 30.0 and ratio_writes(sim)[-1] == 0.0
 
 
-def test_a_step_out_of_the_work_space_is_refused_before_sending(qtbot: Any, sim: Any, menu: SafetyMenu,
-                                                                  window: Any) -> None:
+def test_a_step_out_of_the_work_space_is_refused_before_sending(
+    qtbot: Any, sim: Any, menu: SafetyMenu, window: Any
+) -> None:
     connect(qtbot, window.link, sim, poll_timeout=1.0)
     qtbot.waitUntil(lambda: window.link.state.pose is not None, timeout=SIGNAL_TIMEOUT_MS)
     y = window.link.state.pose.y
     _envelope(menu, Envelope(keep_in=Box("cell", (-5000.0, -5000.0, -5000.0), (5000.0, y + 50.0, 5000.0))))
     writes = len(sim.writes)
     with qtbot.waitSignal(menu.safety.message, timeout=SIGNAL_TIMEOUT_MS) as said:
-        window.step_panel.stepRequested.emit(StepRequest(StepFrame.BASE, (0.0, 100.0, 0.0, 0.0, 0.0, 0.0),
-                                                         (0.0,) * 5, 50.0))
+        window.step_panel.stepRequested.emit(
+            StepRequest(StepFrame.BASE, (0.0, 100.0, 0.0, 0.0, 0.0, 0.0), (0.0,) * 5, 50.0)
+        )
     assert "outside the allowed work space" in said.args[0]
     assert len(sim.writes) == writes  # nothing was sent
     assert query(menu.safety.audit_dir)[-1].command == "step"

@@ -84,8 +84,12 @@ def test_an_administrator_sets_changes_and_clears_passwords(qtbot: Any, safety: 
     dialog.idle.editingFinished.emit()
     assert safety.session.idle.timeout == 180.0 and '"idle_timeout": 180.0' in _roles_file(tmp_path)
     commands = [r.command for r in query(safety.audit_dir) if r.kind == "action"]
-    assert commands[-4:] == ["set the engineer password", "change the engineer password",
-                             "clear the engineer password", "set the idle lock time"]
+    assert commands[-4:] == [
+        "set the engineer password",
+        "change the engineer password",
+        "clear the engineer password",
+        "set the idle lock time",
+    ]
     assert not any("eng-" in str(r.args) + r.detail for r in query(safety.audit_dir))
 
 
@@ -104,8 +108,11 @@ def test_the_operator_cannot_use_it(qtbot: Any, safety: Any) -> None:
 
 
 def test_the_menu_entry_is_the_administrators(window: Any) -> None:
-    menu = install_safety(window, scrypt_n=2**4) if getattr(window, "safety_menu", None) is None \
+    menu = (
+        install_safety(window, scrypt_n=2**4)
+        if getattr(window, "safety_menu", None) is None
         else window.safety_menu
+    )
     menu.safety.session.store.scrypt_n = 2**4
     menu.safety.session.set_password(Role.ADMINISTRATOR, ADMIN_PW)
     action = menu.passwords_action

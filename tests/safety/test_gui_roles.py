@@ -166,7 +166,8 @@ def test_support_bundle_leaves_passwords_out(menu: SafetyMenu, window: Any, tmp_
 
 
 def test_a_move_to_a_point_outside_the_work_space_is_refused_before_sending(
-        qtbot: Any, sim: Any, menu: SafetyMenu, window: Any) -> None:
+    qtbot: Any, sim: Any, menu: SafetyMenu, window: Any
+) -> None:
     from tests.ui.pendant_support import connect
 
     assert window.project.open_file(SAMPLE)
@@ -175,8 +176,9 @@ def test_a_move_to_a_point_outside_the_work_space_is_refused_before_sending(
     ledger = window.project.points_model.ledger
     target = max(ledger, key=lambda p: p.xyz[1])  # the point furthest along +Y
     menu.safety.login(Role.ENGINEER, PASSWORD)
-    menu.safety.save_envelope(Envelope(keep_in=Box("cell", (-5000.0, -5000.0, -5000.0),
-                                                   (5000.0, target.xyz[1] - 10.0, 5000.0))))
+    menu.safety.save_envelope(
+        Envelope(keep_in=Box("cell", (-5000.0, -5000.0, -5000.0), (5000.0, target.xyz[1] - 10.0, 5000.0)))
+    )
     panel = window.points_panel
     panel.select_rows([window.project.points_model.row_of(target.id)])
     writes = len(sim.writes)

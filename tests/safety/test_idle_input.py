@@ -95,8 +95,9 @@ def _controller(tmp_path: Path, clock: Clock, monkeypatch: pytest.MonkeyPatch) -
 
 
 @pytest.fixture(name="safety")
-def safety_fixture(qapp: Any, tmp_path: Path, clock: Clock, monkeypatch: pytest.MonkeyPatch
-                   ) -> Iterator[SafetyController]:
+def safety_fixture(
+    qapp: Any, tmp_path: Path, clock: Clock, monkeypatch: pytest.MonkeyPatch
+) -> Iterator[SafetyController]:
     safety = _controller(tmp_path, clock, monkeypatch)
     safety.set_idle_polling(False)  # the test polls, on its own clock
     yield safety
@@ -137,8 +138,16 @@ def _wheel(qtbot: Any, window: QWindow, panel: Panel) -> None:
     # What the window system hands the window (QGuiApplication's processWheelEvent); the window
     # passes it on to the widget under the cursor.
     at = QPointF(_at(panel, panel.wheel))
-    event = QWheelEvent(at, window.mapToGlobal(at), QPoint(), QPoint(0, 120), Qt.MouseButton.NoButton,
-                        Qt.KeyboardModifier.NoModifier, Qt.ScrollPhase.NoScrollPhase, False)
+    event = QWheelEvent(
+        at,
+        window.mapToGlobal(at),
+        QPoint(),
+        QPoint(0, 120),
+        Qt.MouseButton.NoButton,
+        Qt.KeyboardModifier.NoModifier,
+        Qt.ScrollPhase.NoScrollPhase,
+        False,
+    )
     QApplication.sendEvent(window, event)
     assert panel.wheel.turns == 1
 
@@ -152,7 +161,11 @@ def _touch(qtbot: Any, window: QWindow, panel: Panel) -> None:
 
 
 INPUTS: dict[str, Callable[[Any, QWindow, Panel], None]] = {
-    "key": _key, "mouse": _mouse, "wheel": _wheel, "touch": _touch}
+    "key": _key,
+    "mouse": _mouse,
+    "wheel": _wheel,
+    "touch": _touch,
+}
 
 
 def _still_engineer_after(safety: SafetyController, clock: Clock, act: Callable[[], None]) -> bool:
@@ -169,16 +182,18 @@ def test_without_input_the_lock_falls(safety: SafetyController, clock: Clock) ->
 
 
 @pytest.mark.parametrize("kind", sorted(INPUTS))
-def test_input_in_a_child_widget_keeps_the_role(qtbot: Any, safety: SafetyController, clock: Clock,
-                                               kind: str) -> None:
+def test_input_in_a_child_widget_keeps_the_role(
+    qtbot: Any, safety: SafetyController, clock: Clock, kind: str
+) -> None:
     panel = Panel()
     window = _shown(qtbot, panel)
     assert _still_engineer_after(safety, clock, lambda: INPUTS[kind](qtbot, window, panel))
 
 
 @pytest.mark.parametrize("kind", sorted(INPUTS))
-def test_input_in_a_dialog_opened_later_keeps_the_role(qtbot: Any, safety: SafetyController, clock: Clock,
-                                                      kind: str) -> None:
+def test_input_in_a_dialog_opened_later_keeps_the_role(
+    qtbot: Any, safety: SafetyController, clock: Clock, kind: str
+) -> None:
     main = Panel()
     _shown(qtbot, main)
     dialog = Dialog(main)
@@ -200,8 +215,12 @@ def test_a_click_in_a_popup_menu_keeps_the_role(qtbot: Any, safety: SafetyContro
         assert QTest.qWaitForWindowExposed(menu)
         popup = menu.windowHandle()
         assert popup is not None
-        QTest.mouseClick(popup, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier,
-                         menu.actionGeometry(action).center())
+        QTest.mouseClick(
+            popup,
+            Qt.MouseButton.LeftButton,
+            Qt.KeyboardModifier.NoModifier,
+            menu.actionGeometry(action).center(),
+        )
         assert triggered
 
     assert _still_engineer_after(safety, clock, click)
@@ -209,7 +228,8 @@ def test_a_click_in_a_popup_menu_keeps_the_role(qtbot: Any, safety: SafetyContro
 
 @pytest.mark.qt_log_ignore(*OFFSCREEN_LIMITS)
 def test_a_window_that_never_takes_the_focus_is_watched_from_the_next_poll(
-        qtbot: Any, tmp_path: Path, clock: Clock, monkeypatch: pytest.MonkeyPatch) -> None:
+    qtbot: Any, tmp_path: Path, clock: Clock, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(safety_module, "IDLE_POLL_MS", 20)
     safety = _controller(tmp_path, clock, monkeypatch)  # polling (every 20 ms)
     main = Panel()
@@ -225,8 +245,9 @@ def test_a_window_that_never_takes_the_focus_is_watched_from_the_next_poll(
     clock.now = 100.0
 
     def click_is_noticed() -> bool:
-        QTest.mouseClick(window, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier,
-                         _at(tool, tool.button))
+        QTest.mouseClick(
+            window, Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier, _at(tool, tool.button)
+        )
         return safety.session.idle.remaining() == IDLE_TIMEOUT_DEFAULT  # touched at 100 s
 
     qtbot.waitUntil(click_is_noticed, timeout=5000)
@@ -249,10 +270,12 @@ class _Recording:
 
 
 def test_paints_timers_and_queued_calls_never_reach_the_filter(
-        qtbot: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    qtbot: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     seen = _Recording(monkeypatch)
-    safety = SafetyController(None, QSettings(str(tmp_path / "t.ini"), QSettings.Format.IniFormat),
-                              scrypt_n=2**4)
+    safety = SafetyController(
+        None, QSettings(str(tmp_path / "t.ini"), QSettings.Format.IniFormat), scrypt_n=2**4
+    )
     safety.set_idle_polling(False)
     panel = Panel()
     window = _shown(qtbot, panel)
@@ -277,8 +300,14 @@ def test_paints_timers_and_queued_calls_never_reach_the_filter(
     qtbot.waitUntil(lambda: len(ticks) >= 100, timeout=20000)
     timer.stop()
     panel.repaint()
-    busy = {QEvent.Type.Paint, QEvent.Type.Timer, QEvent.Type.MetaCall, QEvent.Type.User,
-            QEvent.Type.UpdateRequest, QEvent.Type.LayoutRequest}
+    busy = {
+        QEvent.Type.Paint,
+        QEvent.Type.Timer,
+        QEvent.Type.MetaCall,
+        QEvent.Type.User,
+        QEvent.Type.UpdateRequest,
+        QEvent.Type.LayoutRequest,
+    }
     assert not busy.intersection(seen.types), seen.types
     assert len(seen.types) < 10  # a few window events at most (against thousands app-wide)
 

@@ -14,9 +14,13 @@ from app.safety.envelope import Box, Envelope, ViolationCode
 from app.safety.jog_guard import JOG_GUARD_EXTRA_MM, ArmSpeeds, JogGuard, JogMotion
 
 CELL = Box("work space", (-800.0, -100.0, 0.0), (800.0, 450.0, 900.0))
-ENV = Envelope(joint_limits=((-170.0, 170.0), (-90.0, 135.0)), keep_in=CELL,
-               keep_out=(Box("fixture A", (300.0, 200.0, 0.0), (400.0, 300.0, 600.0)),),
-               max_jog_ratio=60, reduced_jog_ratio=10)
+ENV = Envelope(
+    joint_limits=((-170.0, 170.0), (-90.0, 135.0)),
+    keep_in=CELL,
+    keep_out=(Box("fixture A", (300.0, 200.0, 0.0), (400.0, 300.0, 600.0)),),
+    max_jog_ratio=60,
+    reduced_jog_ratio=10,
+)
 
 
 def at(x: float, y: float, z: float, joints: tuple[float, ...] | None = None) -> Pose:
@@ -97,8 +101,9 @@ POLL = 0.02  # s, the worker's 50 Hz
 LATENCY = 0.1  # s, generous: the machine running the tests is shared
 
 
-def _jog_until_guard_stops(client: Any, guard: JogGuard, motion: JogMotion,
-                           timeout: float) -> tuple[bool, Pose]:
+def _jog_until_guard_stops(
+    client: Any, guard: JogGuard, motion: JogMotion, timeout: float
+) -> tuple[bool, Pose]:
     """What the worker does while a jog button is held: poll the pose, ask the guard, write
     ratio 0 when it says stop. Returns (stopped by the guard, the pose it decided on)."""
     client.teach_set_ratio(motion.ratio)

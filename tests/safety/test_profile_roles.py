@@ -23,9 +23,13 @@ from app.safety.roles import (
 
 FAST_N = 2**8  # scrypt cost for tests
 
-ENV = Envelope(joint_limits=((-170.0, 170.0),), keep_in=Box("cell", (-800, -450, 0), (800, 450, 900)),
-               keep_out=(Box("fixture A", (300, -100, 0), (400, 100, 200)),), max_jog_ratio=50,
-               max_speed=500)
+ENV = Envelope(
+    joint_limits=((-170.0, 170.0),),
+    keep_in=Box("cell", (-800, -450, 0), (800, 450, 900)),
+    keep_out=(Box("fixture A", (300, -100, 0), (400, 100, 200)),),
+    max_jog_ratio=50,
+    max_speed=500,
+)
 
 
 def test_profile_round_trip_counts_revisions(tmp_path: Path) -> None:
@@ -38,15 +42,23 @@ def test_profile_round_trip_counts_revisions(tmp_path: Path) -> None:
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".teachpad-tmp.")]
 
 
-@pytest.mark.parametrize(("mutate", "message"), [
-    (lambda d: d.update(version=9), "written by a newer TeachPad"),
-    (lambda d: d["envelope"]["keep_in"].update(lo=[0, "a", 0]), r"envelope\.keep_in\.lo: expected a number"),
-    (lambda d: d["envelope"]["keep_out"][0].update(hi=[0, 0, 0]),
-     r"keep_out\[1\].*lower bound must be below"),
-    (lambda d: d["envelope"].update(max_jog_ratio=300), "at most 100"),
-    (lambda d: d["envelope"].update(colour="red"), "unknown field"),
-    (lambda d: d.update(format="x"), "not a TeachPad safety profile"),
-])
+@pytest.mark.parametrize(
+    ("mutate", "message"),
+    [
+        (lambda d: d.update(version=9), "written by a newer TeachPad"),
+        (
+            lambda d: d["envelope"]["keep_in"].update(lo=[0, "a", 0]),
+            r"envelope\.keep_in\.lo: expected a number",
+        ),
+        (
+            lambda d: d["envelope"]["keep_out"][0].update(hi=[0, 0, 0]),
+            r"keep_out\[1\].*lower bound must be below",
+        ),
+        (lambda d: d["envelope"].update(max_jog_ratio=300), "at most 100"),
+        (lambda d: d["envelope"].update(colour="red"), "unknown field"),
+        (lambda d: d.update(format="x"), "not a TeachPad safety profile"),
+    ],
+)
 def test_bad_profiles_are_refused_with_the_field(tmp_path: Path, mutate: object, message: str) -> None:
     path = tmp_path / "p.safety.json"
     save_profile(path, SafetyProfile("r", ENV))
@@ -71,7 +83,8 @@ def test_permission_table() -> None:
     assert allowed(Role.ENGINEER, Action.EDIT_ENVELOPE) and not allowed(Role.ENGINEER, Action.CONNECTION)
     assert all(allowed(Role.ADMINISTRATOR, a) for a in Action)
     assert permission_reason(Role.OPERATOR, Action.CONNECTION) == (
-        "change connection: needs the administrator role (logged in as operator)")
+        "change connection: needs the administrator role (logged in as operator)"
+    )
     assert permission_reason(Role.ADMINISTRATOR, Action.CONNECTION) is None
 
 
@@ -100,8 +113,11 @@ def test_passwords_are_salted_scrypt_hashes_never_plain_text(tmp_path: Path) -> 
 
 def test_damaged_role_store_is_an_error_not_an_open_door(tmp_path: Path) -> None:
     path = tmp_path / "roles.json"
-    path.write_text(json.dumps({"format": "teachpad-roles", "version": 1,
-                                "passwords": {"administrator": {"scheme": "md5"}}}))
+    path.write_text(
+        json.dumps(
+            {"format": "teachpad-roles", "version": 1, "passwords": {"administrator": {"scheme": "md5"}}}
+        )
+    )
     with pytest.raises(RoleStoreError, match="damaged"):
         RoleStore(path)
 

@@ -43,8 +43,15 @@ pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)
 
 PASSWORD = "cell-42"
 CHEAP_SCRYPT = 2**4
-HIGH = RegisterProfile("cell 3 (ABCD)", word_order=WordOrder.HIGH_FIRST, unit=1, completion="observe",
-                       poll_timeout=0.3, datetime_layout=DateTimeLayout.PACKED32, point_id_max=9999)
+HIGH = RegisterProfile(
+    "cell 3 (ABCD)",
+    word_order=WordOrder.HIGH_FIRST,
+    unit=1,
+    completion="observe",
+    poll_timeout=0.3,
+    datetime_layout=DateTimeLayout.PACKED32,
+    point_id_max=9999,
+)
 
 
 # --- the file -------------------------------------------------------------------------------------
@@ -71,18 +78,22 @@ def test_applied_to_the_connection_where_stays_where(tmp_path: Path) -> None:
     assert RegisterProfile.from_connection(applied, HIGH.name) == HIGH
 
 
-@pytest.mark.parametrize(("edit", "says"), [
-    ({"word_order": "middle"}, "word_order must be one of low-first, high-first"),
-    ({"unit": 300}, "unit must be a whole number 0..247"),
-    ({"completion": "guess"}, "completion must be one of auto, sentinel, observe"),
-    ({"poll_timeout": -1}, "poll_timeout must be empty (automatic)"),
-    ({"point_id_min": 50, "point_id_max": 10}, "above point_id_max"),
-    ({"version": 9}, "newer TeachPad"),
-    ({"bogus": 1}, "unknown field 'bogus'"),
-    ({"name": ""}, "name must be text"),
-])
-def test_a_bad_file_is_refused_naming_the_file_and_field(tmp_path: Path, edit: dict[str, Any],
-                                                         says: str) -> None:
+@pytest.mark.parametrize(
+    ("edit", "says"),
+    [
+        ({"word_order": "middle"}, "word_order must be one of low-first, high-first"),
+        ({"unit": 300}, "unit must be a whole number 0..247"),
+        ({"completion": "guess"}, "completion must be one of auto, sentinel, observe"),
+        ({"poll_timeout": -1}, "poll_timeout must be empty (automatic)"),
+        ({"point_id_min": 50, "point_id_max": 10}, "above point_id_max"),
+        ({"version": 9}, "newer TeachPad"),
+        ({"bogus": 1}, "unknown field 'bogus'"),
+        ({"name": ""}, "name must be text"),
+    ],
+)
+def test_a_bad_file_is_refused_naming_the_file_and_field(
+    tmp_path: Path, edit: dict[str, Any], says: str
+) -> None:
     doc = json.loads(profile_to_json(HIGH))
     doc.update(edit)
     path = tmp_path / "bad.registers.json"
@@ -146,8 +157,9 @@ def test_an_operator_cannot_change_the_register_profile(menu: SafetyMenu, window
     assert action.isEnabled() and action.toolTip().startswith("Word order")  # its own tooltip back
 
 
-def test_the_connection_dialog_shows_the_profiles_unit_and_word_order(menu: SafetyMenu, window: Any,
-                                                                      qtbot: Any) -> None:
+def test_the_connection_dialog_shows_the_profiles_unit_and_word_order(
+    menu: SafetyMenu, window: Any, qtbot: Any
+) -> None:
     menu.safety.login(Role.ADMINISTRATOR, PASSWORD)
     assert menu.apply_register_profile(HIGH) is None
     saved = window.settings.connection()
@@ -160,8 +172,9 @@ def test_the_connection_dialog_shows_the_profiles_unit_and_word_order(menu: Safe
     assert out.host == "10.1.1.1" and out.word_order is WordOrder.HIGH_FIRST and out.poll_timeout == 0.3
 
 
-def test_a_changed_word_order_changes_how_the_floats_are_read(menu: SafetyMenu, window: Any, qtbot: Any,
-                                                              sim_factory: Any) -> None:
+def test_a_changed_word_order_changes_how_the_floats_are_read(
+    menu: SafetyMenu, window: Any, qtbot: Any, sim_factory: Any
+) -> None:
     """The simulator speaks high word first; the default profile reads its pose as nonsense; an
     administrator saves a high-first profile in the dialog (reconnect now) and the pose is right."""
     sim = sim_factory(word_order=WordOrder.HIGH_FIRST)

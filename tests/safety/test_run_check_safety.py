@@ -26,8 +26,9 @@ def _profile(tmp_path: Path, envelope: Envelope) -> Path:
     return path
 
 
-def test_a_plan_outside_the_keep_in_box_is_refused(demo: Path, tmp_path: Path,
-                                                    capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_plan_outside_the_keep_in_box_is_refused(
+    demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     tiny = _profile(tmp_path, Envelope(keep_in=Box("cell", (9000.0,) * 3, (9001.0,) * 3)))
     cli = Cli()
     code = cli("run", str(demo), "--plan", "circle", "--check", "--safety", str(tiny))
@@ -43,8 +44,9 @@ def test_a_roomy_envelope_passes(demo: Path, tmp_path: Path) -> None:
     assert code == cli_points.EXIT_OK
 
 
-def test_a_bad_profile_is_a_usage_error(demo: Path, tmp_path: Path,
-                                        capsys: pytest.CaptureFixture[str]) -> None:
+def test_a_bad_profile_is_a_usage_error(
+    demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     bad = tmp_path / "bad.safety.json"
     bad.write_text("{", encoding="utf-8")
     code = Cli()("run", str(demo), "--plan", "circle", "--check", "--safety", str(bad))

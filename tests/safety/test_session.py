@@ -27,10 +27,12 @@ def session(tmp_path: Path) -> SafetySession:
     return s
 
 
-def test_an_operator_cannot_change_the_connection_and_the_refusal_is_audited(session: SafetySession,
-                                                                              tmp_path: Path) -> None:
+def test_an_operator_cannot_change_the_connection_and_the_refusal_is_audited(
+    session: SafetySession, tmp_path: Path
+) -> None:
     assert session.reason(Action.CONNECTION) == (
-        "change connection: needs the administrator role (logged in as operator)")
+        "change connection: needs the administrator role (logged in as operator)"
+    )
     with pytest.raises(PermissionRefused, match="needs the administrator role"):
         session.require(Action.CONNECTION, {"host": "10.0.0.9"})
     with pytest.raises(WrongPassword):
@@ -60,8 +62,9 @@ def test_reduced_mode_on_for_anyone_off_for_an_engineer(session: SafetySession) 
     assert session.jog_ratio(90) == 80
 
 
-def test_a_step_out_of_the_envelope_never_reaches_the_controller(session: SafetySession, sim: Any,
-                                                                  make_client: Any, tmp_path: Path) -> None:
+def test_a_step_out_of_the_envelope_never_reaches_the_controller(
+    session: SafetySession, sim: Any, make_client: Any, tmp_path: Path
+) -> None:
     client = make_client(sim)
     pose = client.read_pose()
     session.envelope = Envelope(keep_in=Box("cell", (-1000, pose.y - 50, -1000), (1000, 1000, 1000)))

@@ -67,7 +67,7 @@ def test_a_corrupted_crc_is_rejected_both_ways(line: tuple[PtyRelay, SimControll
 
 
 def test_line_noise_before_a_request_is_dropped_at_the_silent_gap(
-    line: tuple[PtyRelay, SimController, Any]
+    line: tuple[PtyRelay, SimController, Any],
 ) -> None:
     relay, sim, client = line
     relay.noise_before_next_request = b"\x01\x03\x07"  # looks like the start of a frame

@@ -28,8 +28,9 @@ def test_watchdog_and_serial_flags_parse() -> None:
     for bad in ("soon", "-1", "100"):
         with pytest.raises(SystemExit):
             parser.parse_args(["--watchdog", bad])
-    args = parser.parse_args(["--serial", "/dev/ttyUSB0", "--baud", "9600", "--parity", "E",
-                              "--stopbits", "2"])
+    args = parser.parse_args(
+        ["--serial", "/dev/ttyUSB0", "--baud", "9600", "--parity", "E", "--stopbits", "2"]
+    )
     assert (args.serial, args.baud, args.parity, args.stopbits) == ("/dev/ttyUSB0", 9600, "E", 2)
 
 
@@ -37,7 +38,10 @@ def test_teachpad_sim_serves_a_serial_line() -> None:
     relay = PtyRelay(57600)
     proc = subprocess.Popen(
         [sys.executable, "-m", "app.sim.cli", "--serial", relay.sim_port, "--baud", "57600", "--no-stdin"],
-        cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        cwd=ROOT,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     client = RobotClient(ConnectionSettings(serial_port=relay.host_port, baudrate=57600, timeout=0.5))
     try:

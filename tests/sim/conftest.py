@@ -18,12 +18,24 @@ from app.protocol.registers import GV_COMMAND_STATUS, GV_JOINTS, GV_POSE, gv_reg
 class Bus:
     """Raw register access plus the few helpers the tests need."""
 
-    def __init__(self, port: int, *, order: WordOrder = WordOrder.LOW_FIRST, rtu: bool = False,
-                 timeout: float = 1.0, unit: int = 1) -> None:
+    def __init__(
+        self,
+        port: int,
+        *,
+        order: WordOrder = WordOrder.LOW_FIRST,
+        rtu: bool = False,
+        timeout: float = 1.0,
+        unit: int = 1,
+    ) -> None:
         self.order = order
         self.unit = unit
-        self.client = ModbusTcpClient("127.0.0.1", port=port, timeout=timeout, retries=0,
-                                      framer=FramerType.RTU if rtu else FramerType.SOCKET)
+        self.client = ModbusTcpClient(
+            "127.0.0.1",
+            port=port,
+            timeout=timeout,
+            retries=0,
+            framer=FramerType.RTU if rtu else FramerType.SOCKET,
+        )
         assert self.client.connect()
 
     def close(self) -> None:

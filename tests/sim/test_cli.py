@@ -27,8 +27,18 @@ def test_help_lists_the_stdin_commands(capsys: pytest.CaptureFixture[str]) -> No
         main(["--help"])
     assert info.value.code == 0
     out = capsys.readouterr().out
-    for word in ("--word-order", "--status-encoding", "--status-delay", "--rtu-framing",
-                 "alarm NAME on|off", "delay SECONDS", "drop", "exception CODE", "silent on|off", "restart"):
+    for word in (
+        "--word-order",
+        "--status-encoding",
+        "--status-delay",
+        "--rtu-framing",
+        "alarm NAME on|off",
+        "delay SECONDS",
+        "drop",
+        "exception CODE",
+        "silent on|off",
+        "restart",
+    ):
         assert word in out
     args = build_parser().parse_args([])
     assert args.host == "127.0.0.1" and args.port == 5020 and args.unit == 1
@@ -63,9 +73,15 @@ def test_stdin_commands(sim: SimController, make_bus: Callable[..., Bus]) -> Non
 
 def test_process_runs_takes_commands_and_stops_on_sigterm(make_bus: Callable[..., Bus]) -> None:
     env = dict(os.environ, PYTHONPATH=str(ROOT), PYTHONUNBUFFERED="1")
-    with subprocess.Popen([sys.executable, "-m", "app.sim.cli", "--port", "0"], cwd=ROOT, env=env,
-                          stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                          text=True) as proc:
+    with subprocess.Popen(
+        [sys.executable, "-m", "app.sim.cli", "--port", "0"],
+        cwd=ROOT,
+        env=env,
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    ) as proc:
         try:
             assert proc.stdout is not None and proc.stdin is not None
             line = proc.stdout.readline()

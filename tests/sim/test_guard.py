@@ -77,17 +77,20 @@ def read_request(address: int, count: int) -> bytes:
 GOOD_READ = read_request(560, 3)
 
 
-@pytest.mark.parametrize("pdu", [
-    struct.pack(">BHH", 0x01, 0, 8),  # read coils
-    struct.pack(">BHH", 0x02, 0, 8),  # read discrete inputs
-    struct.pack(">BHH", 0x04, 0, 8),  # read input registers
-    struct.pack(">BHH", 0x05, 0, 0xFF00),  # write single coil
-    struct.pack(">BHHB", 0x0F, 0, 8, 1) + b"\x01",  # write multiple coils
-    struct.pack(">BHHHHB", 0x17, 0, 2, 0, 1, 2) + b"\0\0",  # read/write multiple registers
-    bytes([0x08, 0, 0, 0x12, 0x34]),  # diagnostics
-    bytes([0x2B, 0x0E, 1, 0]),  # device identification
-    bytes([0x55, 0, 0]),  # nothing at all
-])
+@pytest.mark.parametrize(
+    "pdu",
+    [
+        struct.pack(">BHH", 0x01, 0, 8),  # read coils
+        struct.pack(">BHH", 0x02, 0, 8),  # read discrete inputs
+        struct.pack(">BHH", 0x04, 0, 8),  # read input registers
+        struct.pack(">BHH", 0x05, 0, 0xFF00),  # write single coil
+        struct.pack(">BHHB", 0x0F, 0, 8, 1) + b"\x01",  # write multiple coils
+        struct.pack(">BHHHHB", 0x17, 0, 2, 0, 1, 2) + b"\0\0",  # read/write multiple registers
+        bytes([0x08, 0, 0, 0x12, 0x34]),  # diagnostics
+        bytes([0x2B, 0x0E, 1, 0]),  # device identification
+        bytes([0x55, 0, 0]),  # nothing at all
+    ],
+)
 def test_functions_the_controller_lacks_get_exception_1(sim: SimController, raw: RawLink, pdu: bytes) -> None:
     assert raw.ask(pdu) == bytes([pdu[0] | 0x80, 0x01])
     assert sim.bad_frame_counts() == {"illegal function": 1}
@@ -95,20 +98,23 @@ def test_functions_the_controller_lacks_get_exception_1(sim: SimController, raw:
     assert sim.writes == []
 
 
-@pytest.mark.parametrize("pdu", [
-    read_request(412, 0),
-    read_request(0, 126),
-    struct.pack(">BHHB", 0x10, 400, 0, 0),
-    struct.pack(">BHHB", 0x10, 0, 124, 248) + b"\0" * 248,
-    struct.pack(">BHHB", 0x10, 400, 2, 3) + b"\0" * 4,  # byte count is not 2 x count
-    struct.pack(">BHHB", 0x10, 400, 2, 4) + b"\0" * 2,  # fewer data bytes than the byte count
-    struct.pack(">BHH", 0x03, 412, 2) + b"\0",  # a byte too many
-])
+@pytest.mark.parametrize(
+    "pdu",
+    [
+        read_request(412, 0),
+        read_request(0, 126),
+        struct.pack(">BHHB", 0x10, 400, 0, 0),
+        struct.pack(">BHHB", 0x10, 0, 124, 248) + b"\0" * 248,
+        struct.pack(">BHHB", 0x10, 400, 2, 3) + b"\0" * 4,  # byte count is not 2 x count
+        struct.pack(">BHHB", 0x10, 400, 2, 4) + b"\0" * 2,  # fewer data bytes than the byte count
+        struct.pack(">BHH", 0x03, 412, 2) + b"\0",  # a byte too many
+    ],
+)
 def test_illegal_quantities_get_exception_3(sim: SimController, raw: RawLink, pdu: bytes) -> None:
     assert raw.ask(pdu) == bytes([pdu[0] | 0x80, 0x03])
     assert sum(sim.bad_frame_counts().values()) == 1
     assert sim.writes == []
-    assert raw.ask(read_request(0, 125))[:2] == b"\x03\xFA"  # the largest legal read
+    assert raw.ask(read_request(0, 125))[:2] == b"\x03\xfa"  # the largest legal read
 
 
 def test_a_bad_mbap_header_does_not_jam_the_connection(sim: SimController, raw: RawLink) -> None:
@@ -116,7 +122,7 @@ def test_a_bad_mbap_header_does_not_jam_the_connection(sim: SimController, raw: 
     raw.sock.sendall(raw.frame(GOOD_READ, pid=5))
     assert raw.silent_for(0.05)
     assert raw.ask(GOOD_READ, tid=2)[:2] == b"\x03\x06"
-    raw.sock.sendall(b"\x00\x07\x00\x00\xFF\xFF\x01\x03")  # impossible length: the buffer is dropped
+    raw.sock.sendall(b"\x00\x07\x00\x00\xff\xff\x01\x03")  # impossible length: the buffer is dropped
     assert raw.silent_for(0.05)
     assert raw.ask(GOOD_READ, tid=3)[:2] == b"\x03\x06"
     assert sim.bad_frame_counts() == {"bad protocol id": 1, "bad MBAP length": 1}
@@ -128,7 +134,7 @@ def test_another_unit_gets_gateway_exception_and_no_traceback(
     with caplog.at_level(logging.INFO):
         raw.sock.sendall(raw.frame(GOOD_READ, unit=7))
         _, unit, pdu = raw.answer()
-    assert (unit, pdu) == (7, b"\x83\x0B")
+    assert (unit, pdu) == (7, b"\x83\x0b")
     assert "Traceback" not in caplog.text
     assert sim.bad_frame_counts() == {"unit 7": 1}
 
@@ -149,8 +155,9 @@ def test_a_flood_of_bad_frames_logs_little_and_the_server_answers_right_after(
         (struct.pack(">BHHB", 0x10, 400, 2, 3) + b"\0" * 4, b"\x90\x03"),
         (GOOD_READ, None),  # sent with protocol id 9: skipped without an answer
     ]
-    flood = b"".join(raw.frame(kinds[i % 4][0], tid=i % 60000, pid=9 if i % 4 == 3 else 0)
-                     for i in range(10_000))
+    flood = b"".join(
+        raw.frame(kinds[i % 4][0], tid=i % 60000, pid=9 if i % 4 == 3 else 0) for i in range(10_000)
+    )
     with caplog.at_level(logging.DEBUG, logger="app.sim"), caplog.at_level(logging.INFO):
         raw.sock.sendall(flood + raw.frame(GOOD_READ, tid=60001))
         expected = [kinds[i % 4][1] for i in range(10_000) if i % 4 != 3]
@@ -158,8 +165,11 @@ def test_a_flood_of_bad_frames_logs_little_and_the_server_answers_right_after(
             assert raw.answer()[2] == want
         tid, _, pdu = raw.answer()
     assert tid == 60001 and pdu[:2] == b"\x03\x06"
-    assert sim.bad_frame_counts() == {"illegal function": 2500, "illegal quantity": 5000,
-                                      "bad protocol id": 2500}
+    assert sim.bad_frame_counts() == {
+        "illegal function": 2500,
+        "illegal quantity": 5000,
+        "bad protocol id": 2500,
+    }
     lines = [r for r in caplog.records if r.levelno >= logging.INFO]
     assert len(lines) <= 3, [r.getMessage() for r in lines]
     assert sum(len(r.getMessage()) for r in lines) < 1000

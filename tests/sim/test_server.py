@@ -58,8 +58,9 @@ def create_point(bus: Bus, point_id: float, pose: list[float] | None = None, fir
     return int(poll(bus.status, lambda s: s != 0, 2.0))
 
 
-def move_to_point(bus: Bus, end: float, via: float = -1, orient: int = 1, ignore: int = 0,
-                  speed: float = 400.0) -> None:
+def move_to_point(
+    bus: Bus, end: float, via: float = -1, orient: int = 1, ignore: int = 0, speed: float = 400.0
+) -> None:
     bus.set_gv(GV_PARAM0, [via, end, float(orient), float(ignore)])
     bus.set_gv(GV_EXPECTED_SPEED, [speed])
     bus.write(RUN, 0x42)
@@ -175,8 +176,9 @@ def test_restart_clears_the_general_purpose_gvs(sim: SimController, bus: Bus) ->
     assert bus.gv(99) == [3.0]
 
 
-def test_point_id_range_is_configurable(sim_factory: Callable[..., SimController],
-                                        make_bus: Callable[..., Bus]) -> None:
+def test_point_id_range_is_configurable(
+    sim_factory: Callable[..., SimController], make_bus: Callable[..., Bus]
+) -> None:
     sim = sim_factory(point_id_min=1, point_id_max=5)
     bus = make_bus(sim.port)
     assert create_point(bus, 0) == 1
@@ -407,8 +409,9 @@ def test_status_encodings(sim_factory: Callable[..., SimController], make_bus: C
     assert bus_i.read(582, 2) == [0x00FF, 0x0000]
 
 
-def test_word_order_high_first(sim_factory: Callable[..., SimController],
-                               make_bus: Callable[..., Bus]) -> None:
+def test_word_order_high_first(
+    sim_factory: Callable[..., SimController], make_bus: Callable[..., Bus]
+) -> None:
     sim = sim_factory(word_order=WordOrder.HIGH_FIRST)
     bus = make_bus(sim.port, order=WordOrder.HIGH_FIRST)
     assert bus.pose() == pytest.approx(sim.state().pose, abs=1e-3)
@@ -431,8 +434,9 @@ def test_status_delay_keeps_the_old_value(sim: SimController, bus: Bus) -> None:
     assert time.monotonic() - t0 >= 0.28
 
 
-def test_command_latency_shows_initial(sim_factory: Callable[..., SimController],
-                                       make_bus: Callable[..., Bus]) -> None:
+def test_command_latency_shows_initial(
+    sim_factory: Callable[..., SimController], make_bus: Callable[..., Bus]
+) -> None:
     sim = sim_factory(command_latency=0.2)
     bus = make_bus(sim.port)
     bus.set_gv(GV_PARAM0, [1.0, 0.0])
@@ -513,8 +517,9 @@ def test_unknown_run_command_is_an_illegal_value(sim: SimController, bus: Bus) -
 
 
 # --- framing, inspection, clock -----------------------------------------------------------
-def test_rtu_framing_over_tcp(sim_factory: Callable[..., SimController],
-                              make_bus: Callable[..., Bus]) -> None:
+def test_rtu_framing_over_tcp(
+    sim_factory: Callable[..., SimController], make_bus: Callable[..., Bus]
+) -> None:
     sim = sim_factory(framer="rtu")
     bus = make_bus(sim.port, rtu=True)
     assert bus.pose() == pytest.approx(sim.state().pose, abs=1e-3)

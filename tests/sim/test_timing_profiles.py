@@ -36,8 +36,9 @@ def codes_until_done(bus: Bus, timeout: float = 2.0) -> list[int]:
     return seen
 
 
-def test_fast_profile_shows_the_result_at_once_and_never_the_zero(sim_factory: Any,
-                                                                    make_bus: Callable[..., Bus]) -> None:
+def test_fast_profile_shows_the_result_at_once_and_never_the_zero(
+    sim_factory: Any, make_bus: Callable[..., Bus]
+) -> None:
     sim = sim_factory(timing="fast")
     bus = make_bus(sim.port)
     for pid in range(1, 6):
@@ -78,8 +79,9 @@ def test_slow_profile_keeps_the_old_code_then_zero_with_jitter() -> None:
     assert max(pickups) - min(pickups) > 0.002, pickups  # jitter
 
 
-def test_gv291_writable_keeps_the_host_value_until_the_next_result(sim_factory: Any,
-                                                                     make_bus: Callable[..., Bus]) -> None:
+def test_gv291_writable_keeps_the_host_value_until_the_next_result(
+    sim_factory: Any, make_bus: Callable[..., Bus]
+) -> None:
     sim = sim_factory(timing="fast", gv291="writable")
     bus = make_bus(sim.port)
     bus.write_regs(GV291, encode_floats([float(STATUS_SENTINEL)], bus.order))
@@ -112,6 +114,18 @@ def test_bad_profile_names_are_refused_and_the_cli_takes_them() -> None:
         SimConfig(timing="turbo")  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="gv291 must be one of"):
         SimConfig(gv291="maybe")  # type: ignore[arg-type]
-    args = build_parser().parse_args(["--timing", "fast", "--gv291", "read-only", "--seed", "3",
-                                      "--refuse-point", "5", "--refuse-point", "9"])
+    args = build_parser().parse_args(
+        [
+            "--timing",
+            "fast",
+            "--gv291",
+            "read-only",
+            "--seed",
+            "3",
+            "--refuse-point",
+            "5",
+            "--refuse-point",
+            "9",
+        ]
+    )
     assert (args.timing, args.gv291, args.seed, args.refuse_point) == ("fast", "read-only", 3, [5, 9])

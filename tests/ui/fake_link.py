@@ -77,8 +77,9 @@ class FakeLink(QObject):
     def resume(self) -> int:
         return self._record("resume")
 
-    def jog_press(self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0,
-                  tool: int = 0) -> int:
+    def jog_press(
+        self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0, tool: int = 0
+    ) -> int:
         return self._record("jog_press", frame, axis, direction, ratio, user, tool)
 
     def jog_release(self) -> int:
@@ -87,8 +88,13 @@ class FakeLink(QObject):
     def set_jog_ratio(self, ratio: float) -> int:
         return self._record("set_jog_ratio", ratio)
 
-    def step(self, frame: StepFrame, offsets: Sequence[float], ext_offsets: Sequence[float] = (),
-             speed: float = 10.0) -> int:
+    def step(
+        self,
+        frame: StepFrame,
+        offsets: Sequence[float],
+        ext_offsets: Sequence[float] = (),
+        speed: float = 10.0,
+    ) -> int:
         return self._record("step", frame, tuple(offsets), tuple(ext_offsets), speed)
 
     def set_mode(self, mode: WorkMode) -> int:
@@ -97,20 +103,43 @@ class FakeLink(QObject):
     def go_zero(self, axis: int | None) -> int:
         return self._record("go_zero", axis)
 
-    def run_program(self, program_id: int, mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
-                    cycles: int = 1, speed_ratio: int = 100) -> int:
+    def run_program(
+        self,
+        program_id: int,
+        mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
+        cycles: int = 1,
+        speed_ratio: int = 100,
+    ) -> int:
         return self._record("run_program", program_id, mode, cycles, speed_ratio)
 
     def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = 200) -> int:
         return self._record("create_point", point_id, pose, tool)
 
-    def move_to_point(self, end_id: int, via_id: int | None = None, *, orientation_changes: bool = True,
-                      ignore_middle: bool = False, speed: float = 50.0, tool: int = 200) -> int:
-        return self._record("move_to_point", end_id, via_id, orientation_changes=orientation_changes,
-                            ignore_middle=ignore_middle, speed=speed, tool=tool)
+    def move_to_point(
+        self,
+        end_id: int,
+        via_id: int | None = None,
+        *,
+        orientation_changes: bool = True,
+        ignore_middle: bool = False,
+        speed: float = 50.0,
+        tool: int = 200,
+    ) -> int:
+        return self._record(
+            "move_to_point",
+            end_id,
+            via_id,
+            orientation_changes=orientation_changes,
+            ignore_middle=ignore_middle,
+            speed=speed,
+            tool=tool,
+        )
 
-    def upload_points(self, points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
-                      tool: int = 200) -> int:
+    def upload_points(
+        self,
+        points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
+        tool: int = 200,
+    ) -> int:
         items = [(p[0], tuple(p[1]), p[2] if len(p) > 2 else tool) for p in points]
         return self._record("upload_points", items)
 
@@ -133,14 +162,28 @@ class FakeLink(QObject):
     def finish_create(self, ok: bool = True, pose: Sequence[float] | None = None, message: str = "") -> None:
         details = dict(zip("xyzabc", pose, strict=True)) if pose is not None else {}
         status = CommandStatus(CommandKind.CREATE_POINT, 0xFF if ok else 1)
-        self.commandFinished.emit(CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, status, ok,
-                                                message, {k: float(v) for k, v in details.items()},
-                                                request_id=self.last_id("create_point")))
+        self.commandFinished.emit(
+            CommandResult(
+                RunCommand.CREATE_POINT,
+                CommandKind.CREATE_POINT,
+                status,
+                ok,
+                message,
+                {k: float(v) for k, v in details.items()},
+                request_id=self.last_id("create_point"),
+            )
+        )
 
     def finish_move(self, ok: bool = True, code: int = 0xFF, message: str = "") -> None:
         status = CommandStatus(CommandKind.MOVE, code)
-        result = CommandResult(RunCommand.MOVE_TO_POINT, CommandKind.MOVE, status, ok, message,
-                               request_id=self.last_id("move_to_point"))
+        result = CommandResult(
+            RunCommand.MOVE_TO_POINT,
+            CommandKind.MOVE,
+            status,
+            ok,
+            message,
+            request_id=self.last_id("move_to_point"),
+        )
         self.commandFinished.emit(result)
 
     def point_ok(self, *point_ids: int) -> None:
@@ -152,9 +195,17 @@ class FakeLink(QObject):
 
     def upload_summary(self, uploaded: int, total: int, reason: str = "") -> None:
         text = f"uploaded {uploaded} of {total} points" + (f" ({reason})" if reason else "")
-        self.commandFinished.emit(CommandResult(RunCommand.CREATE_POINT, None, None, uploaded == total, text,
-                                                {"uploaded": float(uploaded)},
-                                                request_id=self.last_id("upload_points")))
+        self.commandFinished.emit(
+            CommandResult(
+                RunCommand.CREATE_POINT,
+                None,
+                None,
+                uploaded == total,
+                text,
+                {"uploaded": float(uploaded)},
+                request_id=self.last_id("upload_points"),
+            )
+        )
 
 
 def _fits(link: FakeLink) -> LinkPort:

@@ -59,7 +59,8 @@ def _plain(text: str) -> str:
 def _label_width(label: QLabel) -> int:
     text = label.text()
     if label.textFormat() == Qt.TextFormat.RichText or (
-            label.textFormat() == Qt.TextFormat.AutoText and GuiQt.mightBeRichText(text)):
+        label.textFormat() == Qt.TextFormat.AutoText and GuiQt.mightBeRichText(text)
+    ):
         doc = QTextDocument()
         doc.setDefaultFont(label.font())
         doc.setDocumentMargin(0)
@@ -100,15 +101,20 @@ def _button_needs(button: QAbstractButton) -> int:
     option = QStyleOptionButton()
     option.initFrom(button)
     if isinstance(button, QCheckBox | QRadioButton):
-        kind = (QStyle.ContentsType.CT_CheckBox if isinstance(button, QCheckBox)
-                else QStyle.ContentsType.CT_RadioButton)
+        kind = (
+            QStyle.ContentsType.CT_CheckBox
+            if isinstance(button, QCheckBox)
+            else QStyle.ContentsType.CT_RadioButton
+        )
         option.text = text  # the style adds the label spacing only when there is a text
         return style.sizeFromContents(kind, option, contents, button).width()
     if isinstance(button, QPushButton):
         option.text = ""  # no text: the style's minimum width for texts does not apply
         if button.menu() is not None:
-            contents.setWidth(contents.width()
-                              + style.pixelMetric(QStyle.PixelMetric.PM_MenuButtonIndicator, option, button))
+            contents.setWidth(
+                contents.width()
+                + style.pixelMetric(QStyle.PixelMetric.PM_MenuButtonIndicator, option, button)
+            )
         return style.sizeFromContents(QStyle.ContentsType.CT_PushButton, option, contents, button).width()
     return text_width + icon
 
@@ -157,30 +163,47 @@ def clipped_texts(root: QWidget) -> list[str]:
 def paints_nothing(widget: QWidget) -> bool:
     """An empty label without frame or style (a unit that is not shown, say) covers nothing."""
     style = widget.styleSheet()
-    return (isinstance(widget, QLabel) and not widget.text() and widget.frameShape() == QFrame.Shape.NoFrame
-            and "background" not in style and "border" not in style
-            and (widget.pixmap() is None or widget.pixmap().isNull()))
+    return (
+        isinstance(widget, QLabel)
+        and not widget.text()
+        and widget.frameShape() == QFrame.Shape.NoFrame
+        and "background" not in style
+        and "border" not in style
+        and (widget.pixmap() is None or widget.pixmap().isNull())
+    )
 
 
 def overlapping_siblings(root: QWidget) -> list[str]:
     problems: list[str] = []
     for parent in visible_widgets(root):
-        children = [c for c in parent.findChildren(QWidget, options=Qt.FindChildOption.FindDirectChildrenOnly)
-                    if c.isVisible() and not c.isWindow() and not c.objectName().startswith("qt_")
-                    and c.width() > 0 and c.height() > 0 and not paints_nothing(c)
-                    and c.geometry().intersects(parent.rect())]
+        children = [
+            c
+            for c in parent.findChildren(QWidget, options=Qt.FindChildOption.FindDirectChildrenOnly)
+            if c.isVisible()
+            and not c.isWindow()
+            and not c.objectName().startswith("qt_")
+            and c.width() > 0
+            and c.height() > 0
+            and not paints_nothing(c)
+            and c.geometry().intersects(parent.rect())
+        ]
         for i, first in enumerate(children):
-            for second in children[i + 1:]:
+            for second in children[i + 1 :]:
                 if first.geometry().intersects(second.geometry()):
                     shared = first.geometry().intersected(second.geometry())
-                    problems.append(f"{describe(first)} and {describe(second)} overlap by "
-                                    f"{shared.width()}×{shared.height()} px in {describe(parent)}")
+                    problems.append(
+                        f"{describe(first)} and {describe(second)} overlap by "
+                        f"{shared.width()}×{shared.height()} px in {describe(parent)}"
+                    )
     return problems
 
 
 def small_motion_buttons(root: QWidget, min_height: int) -> list[str]:
-    return [f"{describe(w)} is {w.height()} px high, motion buttons need {min_height}"
-            for w in visible_widgets(root) if w.property("motion") and w.height() < min_height]
+    return [
+        f"{describe(w)} is {w.height()} px high, motion buttons need {min_height}"
+        for w in visible_widgets(root)
+        if w.property("motion") and w.height() < min_height
+    ]
 
 
 def describe(widget: QWidget) -> str:

@@ -37,8 +37,9 @@ def link_fixture(qtbot: Any, fast_reconnect: None) -> Iterator[RobotLink]:
 
 
 @pytest.fixture(name="canary_link")
-def canary_link_fixture(qtbot: Any, fast_reconnect: None,
-                        monkeypatch: pytest.MonkeyPatch) -> Iterator[RobotLink]:
+def canary_link_fixture(
+    qtbot: Any, fast_reconnect: None, monkeypatch: pytest.MonkeyPatch
+) -> Iterator[RobotLink]:
     """A RobotLink with the restart canary on its default GV, checked every 0.1 s."""
     monkeypatch.setattr(timing, "CLOCK_POLL_PERIOD", 0.1)
     robot_link = RobotLink(poll_hz=timing.POLL_HZ_DEFAULT)
@@ -62,8 +63,9 @@ def connection_settings(sim: Any, **overrides: Any) -> ConnectionSettings:
 def connect(qtbot: Any, robot_link: RobotLink, sim: Any, **overrides: Any) -> ConnectionSettings:
     """Connect ``robot_link`` to ``sim`` and wait until the link is up."""
     settings = connection_settings(sim, **overrides)
-    with qtbot.waitSignal(robot_link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        robot_link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED), timeout=SIGNAL_TIMEOUT_MS
+    ):
         robot_link.connect_to(settings)
     return settings
 
@@ -75,7 +77,7 @@ def gv_writes(sim: Any, gv: int) -> list[tuple[int, float]]:
     for index, write in enumerate(list(sim.writes)):
         start = low - write.address
         if start >= 0 and start + 2 <= len(write.values):
-            regs = write.values[start:start + 2]
+            regs = write.values[start : start + 2]
             out.append((index, registers_to_float(regs, WordOrder.LOW_FIRST)))
     return out
 
@@ -158,14 +160,21 @@ def project_dialogs_fixture() -> FakeProjectDialogs:
 
 
 @pytest.fixture(name="window")
-def window_fixture(qtbot: Any, link: RobotLink, app_settings: Any, translator: Any,
-                   project_dialogs: FakeProjectDialogs, tmp_path: Any) -> Any:
+def window_fixture(
+    qtbot: Any,
+    link: RobotLink,
+    app_settings: Any,
+    translator: Any,
+    project_dialogs: FakeProjectDialogs,
+    tmp_path: Any,
+) -> Any:
     """The main window on ``link``, shown and active; confirmations answer yes, project
     questions go to ``project_dialogs``, autosaves to ``tmp_path``."""
     from ui.main_window import MainWindow
 
-    main_window = MainWindow(link, app_settings, translator, project_dialogs=project_dialogs,
-                             autosave_dir=tmp_path / "autosave")
+    main_window = MainWindow(
+        link, app_settings, translator, project_dialogs=project_dialogs, autosave_dir=tmp_path / "autosave"
+    )
     main_window.confirm = lambda _title, _text: True
     qtbot.addWidget(main_window)
     main_window.show()

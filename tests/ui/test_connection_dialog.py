@@ -74,13 +74,13 @@ def test_a_failing_port_list_is_not_an_error(qtbot: Any, monkeypatch: pytest.Mon
 # --- opening on the connection in use (issue 9) -------------------------------------------------
 
 
-def test_opens_on_the_link_connection_and_says_it_is_connected(qtbot: Any, link: RobotLink, sim_factory: Any,
-                                                               ports: list[FakePort]) -> None:
+def test_opens_on_the_link_connection_and_says_it_is_connected(
+    qtbot: Any, link: RobotLink, sim_factory: Any, ports: list[FakePort]
+) -> None:
     """A real link to the simulator: the dialog shows its settings (not the defaults), says
     it is connected, and the poll rate; OK without changes gives the same connection back."""
     sim = sim_factory(unit=7, word_order=WordOrder.HIGH_FIRST)
-    used = connect(qtbot, link, sim, unit=7, word_order=WordOrder.HIGH_FIRST, monitor_only=True,
-                   timeout=0.4)
+    used = connect(qtbot, link, sim, unit=7, word_order=WordOrder.HIGH_FIRST, monitor_only=True, timeout=0.4)
     # remembered, older: where is not shown; unit and word order are the register profile's (which
     # the remembered settings carry), shown read-only
     saved = ConnectionSettings(host="10.0.0.9", port=1502, unit=7, word_order=WordOrder.HIGH_FIRST)
@@ -96,8 +96,9 @@ def test_opens_on_the_link_connection_and_says_it_is_connected(qtbot: Any, link:
     assert "Polling at 40 Hz" in text and "Monitor only" in text
     assert dialog.settings() == used
     # disconnected: the dialog says so, still on the link's last settings
-    with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED), timeout=SIGNAL_TIMEOUT_MS
+    ):
         link.disconnect()
     later = ConnectionDialog.for_link(link, saved, poll_hz=40.0)
     qtbot.addWidget(later)

@@ -83,11 +83,13 @@ def test_mode_switch_shows_the_controllers_real_mode(qtbot: Any, sim: Any, windo
     qtbot.mouseClick(bar.manual_button, Qt.MouseButton.LeftButton)
     # The click alone does not change what is shown: the controller's next status does.
     qtbot.waitUntil(lambda: sim.state().work_mode is WorkMode.MANUAL, timeout=SIGNAL_TIMEOUT_MS)
-    qtbot.waitUntil(lambda: bar.mode_text() == "manual" and bar.manual_button.isChecked(),
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: bar.mode_text() == "manual" and bar.manual_button.isChecked(), timeout=SIGNAL_TIMEOUT_MS
+    )
     qtbot.mouseClick(bar.auto_button, Qt.MouseButton.LeftButton)
-    qtbot.waitUntil(lambda: bar.mode_text() == "auto" and bar.auto_button.isChecked(),
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: bar.mode_text() == "auto" and bar.auto_button.isChecked(), timeout=SIGNAL_TIMEOUT_MS
+    )
     assert sim.state().mode == ControllerMode.AUTO
 
 
@@ -143,8 +145,11 @@ def test_program_and_go_zero_ask_first(qtbot: Any, sim: Any, window: Any) -> Non
 
     window.confirm = lambda _title, _text: True
     panel.set_zero_axis(1)  # J2 (20 degrees at home) -> 0
-    with qtbot.waitSignal(window.link.commandFinished, check_params_cb=_ok(lambda r: "zero" in r.message),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        window.link.commandFinished,
+        check_params_cb=_ok(lambda r: "zero" in r.message),
+        timeout=SIGNAL_TIMEOUT_MS,
+    ):
         qtbot.mouseClick(panel.zero_button, Qt.MouseButton.LeftButton)
     assert sim.state().joints[1] == pytest.approx(0.0, abs=1e-6)
     assert [v for _, v in register_writes(sim, 445)] == [1]

@@ -126,15 +126,17 @@ def test_shown_panels_end_on_the_newest_pose_within_a_frame(qtbot: Any, link: Fa
     frames = clock.frames
     for i in range(1, 101):  # a second of polls at 100 Hz, faster than any frame
         _poll(link, float(i))
-    qtbot.waitUntil(lambda: monitor.readouts["X"].text() == "100.000" and strip.value_text("X") == "100.00",
-                    timeout=2000)
+    qtbot.waitUntil(
+        lambda: monitor.readouts["X"].text() == "100.000" and strip.value_text("X") == "100.00", timeout=2000
+    )
     assert clock.frames - frames <= 3  # a burst is drawn in a frame or two, not 100 times
     monitor.close()
     strip.close()
 
 
-def test_a_hidden_monitor_formats_and_plots_nothing(qtbot: Any, link: FakeLink,
-                                                    monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_hidden_monitor_formats_and_plots_nothing(
+    qtbot: Any, link: FakeLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
     formatted: list[float | None] = []
     original = NumericReadout.set_value
 
@@ -162,8 +164,9 @@ def test_a_hidden_monitor_formats_and_plots_nothing(qtbot: Any, link: FakeLink,
     assert monitor.sample_count == 200  # recorded all the same: the plots are whole when shown
 
 
-def test_a_hidden_traffic_panel_decodes_and_formats_nothing(qtbot: Any,
-                                                           monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_hidden_traffic_panel_decodes_and_formats_nothing(
+    qtbot: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
     from app.protocol.frames import decode_frame as original
     from benchmarks.traffic import Feed
 

@@ -189,7 +189,8 @@ class _Prefix(QTranslator):
 
 
 def test_language_change_retranslates_levels_and_payload_lines_not_written_texts(
-        qtbot: Any, panel: EventLogPanel) -> None:
+    qtbot: Any, panel: EventLogPanel
+) -> None:
     panel.add_event("warning", "s", "as logged", WHEN)
     panel.on_alarms(int(Alarm.SERVO))  # logged from a payload: rendered again after the switch
     translator = _Prefix()

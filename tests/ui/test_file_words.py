@@ -35,8 +35,9 @@ def controller(qtbot: Any, zh: None, tmp_path: Path) -> Iterator[tuple[ProjectCo
     target = tmp_path / "demo.teachpad.json"
     shutil.copy(SAMPLES / "demo.teachpad.json", target)
     dialogs = FakeDialogs()
-    ctl = ProjectController(load_project(target), target, dialogs=dialogs, autosave_interval=0,
-                            autosave_dir=tmp_path / "user")
+    ctl = ProjectController(
+        load_project(target), target, dialogs=dialogs, autosave_interval=0, autosave_dir=tmp_path / "user"
+    )
     yield ctl, dialogs
     ctl.close()
 
@@ -44,8 +45,9 @@ def controller(qtbot: Any, zh: None, tmp_path: Path) -> Iterator[tuple[ProjectCo
 Controller = tuple[ProjectController, FakeDialogs]
 
 
-def test_a_malformed_project_is_refused_in_chinese(qtbot: Any, controller: Controller,
-                                                   tmp_path: Path) -> None:
+def test_a_malformed_project_is_refused_in_chinese(
+    qtbot: Any, controller: Controller, tmp_path: Path
+) -> None:
     ctl, dialogs = controller
     before = ctl.project
     bad = tmp_path / "坏.teachpad.json"
@@ -54,10 +56,11 @@ def test_a_malformed_project_is_refused_in_chinese(qtbot: Any, controller: Contr
     assert not ctl.open_file(bad)
     title, shown = dialogs.errors[-1]
     assert title == "无法打开工程"
-    assert shown == ("坏.teachpad.json：第 1 条轨迹“pick and place”第 1 段，字段“type”："
-                     "'circle' 不是直线或圆弧"), shown
+    assert shown == (
+        "坏.teachpad.json：第 1 条轨迹“pick and place”第 1 段，字段“type”：'circle' 不是直线或圆弧"
+    ), shown
     assert ctl.project is before  # nothing half replaced
-    bad.write_text("{\"format\": ", encoding="utf-8")
+    bad.write_text('{"format": ', encoding="utf-8")
     assert not ctl.open_file(bad)
     assert dialogs.errors[-1][1] == "坏.teachpad.json：第 1 行第 12 列：不是有效的 JSON"
     assert not ctl.open_file(tmp_path / "没有.teachpad.json")
@@ -78,14 +81,18 @@ def test_an_import_reports_and_refuses_in_chinese(qtbot: Any, controller: Contro
     assert said.args[0] == f"已导入 {good}：新增 1 个，更新 0 个，未变 0 个，删除 0 个"
 
 
-@pytest.mark.parametrize(("column", "value", "reason"), [
-    (COL_KIND, "circle", "'circle' 不是直线或圆弧"),
-    (COL_SPEED, "0", "0 mm/s：速度必须大于 0"),
-    (COL_END, "99", "点 P99 不存在：请从列表中选择"),
-    (COL_VIA, "7", "圆弧的中间点必须与终点不同"),
-])
-def test_a_segment_edit_is_refused_in_chinese(qtbot: Any, zh: None, column: int, value: str,
-                                              reason: str) -> None:
+@pytest.mark.parametrize(
+    ("column", "value", "reason"),
+    [
+        (COL_KIND, "circle", "'circle' 不是直线或圆弧"),
+        (COL_SPEED, "0", "0 mm/s：速度必须大于 0"),
+        (COL_END, "99", "点 P99 不存在：请从列表中选择"),
+        (COL_VIA, "7", "圆弧的中间点必须与终点不同"),
+    ],
+)
+def test_a_segment_edit_is_refused_in_chinese(
+    qtbot: Any, zh: None, column: int, value: str, reason: str
+) -> None:
     project = load_project(SAMPLES / "demo.teachpad.json")
     model = SegmentTableModel(QUndoStack(), project.ledger)
     model.set_plan(project.plans[1])  # circle: line, arc, arc, line

@@ -36,8 +36,7 @@ pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)
 POLL_TIMEOUT = 1.0
 
 
-def _start_jog(qtbot: Any, window: Any, sim: Any, axis: int = 0, direction: int = 1,
-               **settings: Any) -> Any:
+def _start_jog(qtbot: Any, window: Any, sim: Any, axis: int = 0, direction: int = 1, **settings: Any) -> Any:
     """Press and hold a jog button until the simulator moves; returns the button."""
     settings.setdefault("poll_timeout", POLL_TIMEOUT)
     connect(qtbot, window.link, sim, **settings)
@@ -45,8 +44,9 @@ def _start_jog(qtbot: Any, window: Any, sim: Any, axis: int = 0, direction: int 
     button = window.jog_panel.button(axis, direction)
     x0 = sim.state().pose[axis]
     qtbot.mousePress(button, Qt.MouseButton.LeftButton)
-    qtbot.waitUntil(lambda: jogging(sim) and abs(sim.state().pose[axis] - x0) > 1.0,
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: jogging(sim) and abs(sim.state().pose[axis] - x0) > 1.0, timeout=SIGNAL_TIMEOUT_MS
+    )
     assert window.jog_panel.is_jogging
     assert max(ratio_writes(sim)) > 0
     return button
@@ -114,13 +114,15 @@ def test_closing_the_window_stops_the_jog_and_teach(qtbot: Any, sim: Any, window
     assert not window.link.is_running
 
 
-def test_link_loss_releases_and_reconnect_makes_safe(qtbot: Any, sim: Any, window: Any,
-                                                     monkeypatch: pytest.MonkeyPatch) -> None:
+def test_link_loss_releases_and_reconnect_makes_safe(
+    qtbot: Any, sim: Any, window: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.3)
     sim.set_watchdog(None)  # a controller without a communication watchdog
     _start_jog(qtbot, window, sim, poll_timeout=0.5)
-    with qtbot.waitSignal(window.link.connectionChanged, check_params_cb=is_state(LinkState.DOWN),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        window.link.connectionChanged, check_params_cb=is_state(LinkState.DOWN), timeout=SIGNAL_TIMEOUT_MS
+    ):
         sim.set_silent(True)
     assert not window.jog_panel.is_jogging
     assert not window.jog_panel.axes_box.isEnabled()

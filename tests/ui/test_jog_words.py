@@ -25,8 +25,9 @@ from ui.messages import error_text
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
 
-def test_a_jog_stopped_by_a_silent_controller_reads_in_chinese(qtbot: Any, sim: Any, link: Any,
-                                                               translator: Any) -> None:
+def test_a_jog_stopped_by_a_silent_controller_reads_in_chinese(
+    qtbot: Any, sim: Any, link: Any, translator: Any
+) -> None:
     assert translator.set_language("zh_CN")
     connect(qtbot, link, sim)
     link.jog_press(TeachFrame.BASE, 0, 1, 40.0)
@@ -35,8 +36,10 @@ def test_a_jog_stopped_by_a_silent_controller_reads_in_chinese(qtbot: Any, sim: 
     link.errorOccurred.connect(errors.append)
     sim.set_silent(True)
     try:
-        qtbot.waitUntil(lambda: any(e.reason is not None and e.reason.code == "jog_stopped_silent"
-                                    for e in errors), timeout=SIGNAL_TIMEOUT_MS)
+        qtbot.waitUntil(
+            lambda: any(e.reason is not None and e.reason.code == "jog_stopped_silent" for e in errors),
+            timeout=SIGNAL_TIMEOUT_MS,
+        )
     finally:
         sim.set_silent(False)
     note = next(e for e in errors if e.reason is not None and e.reason.code == "jog_stopped_silent")
@@ -44,5 +47,6 @@ def test_a_jog_stopped_by_a_silent_controller_reads_in_chinese(qtbot: Any, sim: 
     assert_chinese(error_text(note))
     # the dead-man on its return: speed 0 before anything else
     qtbot.waitUntil(lambda: link.state.connection.state is LinkState.CONNECTED, timeout=SIGNAL_TIMEOUT_MS)
-    qtbot.waitUntil(lambda: bool(ratio_writes(sim)) and ratio_writes(sim)[-1] == 0.0,
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: bool(ratio_writes(sim)) and ratio_writes(sim)[-1] == 0.0, timeout=SIGNAL_TIMEOUT_MS
+    )

@@ -65,8 +65,9 @@ def test_keypad_for_an_integer_field_has_no_point_or_sign(qtbot: Any) -> None:
     assert dialog.value() == 15
 
 
-def test_touch_mode_enlarges_motion_buttons_and_opens_the_keypad(qtbot: Any, window: MainWindow,
-                                                                app_settings: Any) -> None:
+def test_touch_mode_enlarges_motion_buttons_and_opens_the_keypad(
+    qtbot: Any, window: MainWindow, app_settings: Any
+) -> None:
     jog_button = window.jog_panel.button(0, 1)
     assert jog_button.height() >= MOTION_MIN_HEIGHT and jog_button.property("motion")
     assert window.control_bar.stop_button.property("motion")
@@ -95,11 +96,13 @@ def test_touch_mode_enlarges_motion_buttons_and_opens_the_keypad(qtbot: Any, win
         qtbot.mouseClick(field.lineEdit(), Qt.MouseButton.LeftButton)
 
 
-def test_touch_mode_is_remembered(qtbot: Any, link: Any, app_settings: Any, translator: Any,
-                                  project_dialogs: Any, tmp_path: Any) -> None:
+def test_touch_mode_is_remembered(
+    qtbot: Any, link: Any, app_settings: Any, translator: Any, project_dialogs: Any, tmp_path: Any
+) -> None:
     app_settings.touch_mode = True
-    window = MainWindow(link, app_settings, translator, project_dialogs=project_dialogs,
-                        autosave_dir=tmp_path / "autosave")
+    window = MainWindow(
+        link, app_settings, translator, project_dialogs=project_dialogs, autosave_dir=tmp_path / "autosave"
+    )
     qtbot.addWidget(window)
     assert window.menus.touch_action.isChecked()
     assert window.jog_panel.button(0, 0).minimumHeight() == TOUCH_MOTION_HEIGHT

@@ -74,14 +74,21 @@ def problems(root: QWidget, language: str, touch: bool) -> list[str]:
 
 
 @pytest.fixture(name="make_window")
-def make_window_fixture(qtbot: Any, link: Any, app_settings: Any, translator: Any, project_dialogs: Any,
-                        tmp_path: Any, sim: Any) -> Callable[..., MainWindow]:
-    def make(language: str, size: tuple[int, int], *, touch: bool = False,
-             connected: bool = True) -> MainWindow:
+def make_window_fixture(
+    qtbot: Any, link: Any, app_settings: Any, translator: Any, project_dialogs: Any, tmp_path: Any, sim: Any
+) -> Callable[..., MainWindow]:
+    def make(
+        language: str, size: tuple[int, int], *, touch: bool = False, connected: bool = True
+    ) -> MainWindow:
         assert translator.set_language(language)
         app_settings.touch_mode = touch
-        window = MainWindow(link, app_settings, translator, project_dialogs=project_dialogs,
-                            autosave_dir=tmp_path / "autosave")
+        window = MainWindow(
+            link,
+            app_settings,
+            translator,
+            project_dialogs=project_dialogs,
+            autosave_dir=tmp_path / "autosave",
+        )
         window.confirm = lambda _title, _text: True
         qtbot.addWidget(window)
         window.resize(*size)
@@ -100,8 +107,9 @@ def make_window_fixture(qtbot: Any, link: Any, app_settings: Any, translator: An
 
 def connect_window(qtbot: Any, window: MainWindow, sim: Any) -> None:
     connect(qtbot, window.link, sim)
-    qtbot.waitUntil(lambda: window.motion_enabled and window.link.state.status is not None,
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: window.motion_enabled and window.link.state.status is not None, timeout=SIGNAL_TIMEOUT_MS
+    )
     settle()
 
 
@@ -143,11 +151,15 @@ def squeezed(window: MainWindow) -> list[str]:
     found = []
     central = window.centralWidget()
     assert central is not None
-    for part, least in ((central, central.minimumSizeHint()),
-                        (window.status_dock, QSize(STATUS_DOCK_WIDTH, 0))):
+    for part, least in (
+        (central, central.minimumSizeHint()),
+        (window.status_dock, QSize(STATUS_DOCK_WIDTH, 0)),
+    ):
         if part.width() < least.width() or part.height() < least.height():
-            found.append(f"{part.objectName() or 'central area'} is {part.width()}×{part.height()}, "
-                         f"needs {least.width()}×{least.height()}")
+            found.append(
+                f"{part.objectName() or 'central area'} is {part.width()}×{part.height()}, "
+                f"needs {least.width()}×{least.height()}"
+            )
     return found
 
 
@@ -161,8 +173,10 @@ def check_window(window: MainWindow, language: str, touch: bool) -> list[str]:
         found += [f"[jog joint | {work}] {p}" for p in problems(window, language, touch) + squeezed(window)]
     for motion in motion_states(window):
         settle()
-        found += [f"[{motion} | planner after a stop] {p}"
-                  for p in problems(window, language, touch) + squeezed(window)]
+        found += [
+            f"[{motion} | planner after a stop] {p}"
+            for p in problems(window, language, touch) + squeezed(window)
+        ]
     return sorted(set(found))
 
 
@@ -177,8 +191,9 @@ def without_known(found: list[str], key: str) -> list[str]:
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 @pytest.mark.parametrize("language", LANGUAGES)
-def test_main_window_layout(qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str,
-                            size: tuple[int, int]) -> None:
+def test_main_window_layout(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str, size: tuple[int, int]
+) -> None:
     window = make_window(language, size, connected=False)
     found = check_window(window, language, touch=False)
     assert not found, "\n".join(found)
@@ -191,15 +206,18 @@ def test_main_window_layout(qtbot: Any, sim: Any, make_window: Callable[..., Mai
 def raise_estop(qtbot: Any, window: MainWindow, sim: Any) -> None:
     """An emergency stop at the simulator: the banner is up and the motion controls are held."""
     sim.set_alarm(Alarm.ESTOP, True)
-    qtbot.waitUntil(lambda: window.alarm_banner.isVisible() and not window.jog_panel.axes_box.isEnabled(),
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: window.alarm_banner.isVisible() and not window.jog_panel.axes_box.isEnabled(),
+        timeout=SIGNAL_TIMEOUT_MS,
+    )
     settle()
 
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 @pytest.mark.parametrize("language", LANGUAGES)
-def test_main_window_layout_with_an_alarm(qtbot: Any, sim: Any, make_window: Callable[..., MainWindow],
-                                          language: str, size: tuple[int, int]) -> None:
+def test_main_window_layout_with_an_alarm(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str, size: tuple[int, int]
+) -> None:
     window = make_window(language, size)
     raise_estop(qtbot, window, sim)
     found = check_window(window, language, touch=False)
@@ -210,8 +228,9 @@ def test_main_window_layout_with_an_alarm(qtbot: Any, sim: Any, make_window: Cal
     height = banner.height()
     for bit in (Alarm.SERVO, Alarm.ENCODER):
         sim.set_alarm(bit, True)
-    qtbot.waitUntil(lambda: banner.alarms == int(Alarm.ESTOP | Alarm.SERVO | Alarm.ENCODER),
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: banner.alarms == int(Alarm.ESTOP | Alarm.SERVO | Alarm.ENCODER), timeout=SIGNAL_TIMEOUT_MS
+    )
     settle()
     assert banner.height() == height and not squeezed(window)
     assert banner.label.toolTip().count("\n") == 3  # the whole text, one line per alarm
@@ -239,14 +258,19 @@ def test_touch_mode_layout_at_1280x800(make_window: Callable[..., MainWindow], l
 
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
-def test_points_primary_actions_and_docks_stay_visible(make_window: Callable[..., MainWindow],
-                                                       size: tuple[int, int]) -> None:
+def test_points_primary_actions_and_docks_stay_visible(
+    make_window: Callable[..., MainWindow], size: tuple[int, int]
+) -> None:
     window = make_window("en", size)
     window.show_tab(TAB_POINTS)
     settle()
     points = window.points_panel
-    for button in (points.teach_button, points.upload_button, points.restore_all_button,
-                   points.move_to_button):
+    for button in (
+        points.teach_button,
+        points.upload_button,
+        points.restore_all_button,
+        points.move_to_button,
+    ):
         assert button.isVisible() and button.width() >= button.sizeHint().width(), button.text()
     for dock, panel in ((window.event_dock, window.event_log), (window.traffic_dock, window.traffic_panel)):
         dock.raise_()
@@ -256,8 +280,9 @@ def test_points_primary_actions_and_docks_stay_visible(make_window: Callable[...
 
 
 @pytest.mark.parametrize("language", LANGUAGES)
-def test_joint_jog_fits_1280x800_without_scrolling(language: str,
-                                                   make_window: Callable[..., MainWindow]) -> None:
+def test_joint_jog_fits_1280x800_without_scrolling(
+    language: str, make_window: Callable[..., MainWindow]
+) -> None:
     window = make_window(language, SIZES[0])
     window.jog_panel.set_frame(TeachFrame.JOINT)
     settle()
@@ -281,9 +306,13 @@ def test_dialogs_layout(qtbot: Any, app_settings: Any, translator: Any, language
     field.setRange(-10_000.0, 10_000.0)
     field.setDecimals(3)
     keypad = KeypadDialog(field, parent)
-    question = QMessageBox(QMessageBox.Icon.Question, "Confirm program run",
-                           "Run program 1 (single run) at 50 %? The arm will move.",
-                           QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.Cancel, parent)
+    question = QMessageBox(
+        QMessageBox.Icon.Question,
+        "Confirm program run",
+        "Run program 1 (single run) at 50 %? The arm will move.",
+        QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.Cancel,
+        parent,
+    )
     for dialog in (connection, keypad, question):
         dialog.show()
         qtbot.waitExposed(dialog)

@@ -56,7 +56,14 @@ def test_building_the_window_does_not_import_the_3d_view_nor_pyqtgraph() -> None
         print("pyqtgraph" if "pyqtgraph" in sys.modules else "lazy")
         w.close(); link.shutdown()
     """)
-    out = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=60,
-                         env={**__import__("os").environ, "QT_QPA_PLATFORM": "offscreen"}, check=False)
+    out = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={**__import__("os").environ, "QT_QPA_PLATFORM": "offscreen"},
+        check=False,
+    )
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.strip().splitlines()[-2:] == ["lazy", "lazy"]  # neither the 3D view nor pyqtgraph

@@ -45,16 +45,29 @@ def _english(window: MainWindow) -> dict[str, str]:
     }
 
 
-def test_builds_and_switches_language_at_runtime(qtbot: Any, sim: Any, window: MainWindow,
-                                                 app_settings: AppSettings) -> None:
+def test_builds_and_switches_language_at_runtime(
+    qtbot: Any, sim: Any, window: MainWindow, app_settings: AppSettings
+) -> None:
     assert qm_path("zh_CN").is_file()
-    assert _english(window) == {"tab": "Jog", "stop": "STOP", "menu": "&Motion", "frame": "Base frame",
-                                "step": "Incremental move", "program": "Run program"}
+    assert _english(window) == {
+        "tab": "Jog",
+        "stop": "STOP",
+        "menu": "&Motion",
+        "frame": "Base frame",
+        "step": "Incremental move",
+        "program": "Run program",
+    }
     connect(qtbot, window.link, sim)
     qtbot.waitUntil(lambda: window.control_bar.mode_text() == "auto", timeout=SIGNAL_TIMEOUT_MS)
     window.menus.language_actions["zh_CN"].trigger()
-    assert _english(window) == {"tab": "点动", "stop": "停止", "menu": "运动(&M)", "frame": "基坐标系",
-                                "step": "增量运动", "program": "运行程序"}
+    assert _english(window) == {
+        "tab": "点动",
+        "stop": "停止",
+        "menu": "运动(&M)",
+        "frame": "基坐标系",
+        "step": "增量运动",
+        "program": "运行程序",
+    }
     assert window.control_bar.mode_text() == "自动"  # protocol texts too
     assert window.program_panel.mode_combo.itemText(2) == "循环"
     assert app_settings.language == "zh_CN"
@@ -63,8 +76,9 @@ def test_builds_and_switches_language_at_runtime(qtbot: Any, sim: Any, window: M
     assert app_settings.language == "en"
 
 
-def test_builds_in_chinese_from_the_start(qtbot: Any, link: Any, app_settings: AppSettings,
-                                          translator: Any) -> None:
+def test_builds_in_chinese_from_the_start(
+    qtbot: Any, link: Any, app_settings: AppSettings, translator: Any
+) -> None:
     assert translator.set_language("zh_CN")
     window = MainWindow(link, app_settings, translator)
     qtbot.addWidget(window)
@@ -92,24 +106,32 @@ def test_live_pose_reaches_the_monitor(qtbot: Any, sim: Any, window: MainWindow)
     connect(qtbot, window.link, sim)
     x = sim.state().pose[0]
     readout = window.monitor_panel.readouts["X"]
-    qtbot.waitUntil(lambda: readout.value is not None and abs(readout.value - x) < 1e-3,
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: readout.value is not None and abs(readout.value - x) < 1e-3, timeout=SIGNAL_TIMEOUT_MS
+    )
     window.link.jog_press(TeachFrame.BASE, 0, 1, 100.0)
     qtbot.waitUntil(lambda: readout.value is not None and readout.value > x + 5.0, timeout=SIGNAL_TIMEOUT_MS)
     window.link.jog_release()
 
 
-def test_connect_disconnect_from_the_window(qtbot: Any, sim: Any, window: MainWindow,
-                                            app_settings: AppSettings) -> None:
+def test_connect_disconnect_from_the_window(
+    qtbot: Any, sim: Any, window: MainWindow, app_settings: AppSettings
+) -> None:
     settings = connection_settings(sim, unit=1, word_order=WordOrder.LOW_FIRST)
-    with qtbot.waitSignal(window.link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        window.link.connectionChanged,
+        check_params_cb=is_state(LinkState.CONNECTED),
+        timeout=SIGNAL_TIMEOUT_MS,
+    ):
         window.connect_with(settings)
     assert window.status_link.text() == "connected"
     assert str(sim.port) in window.windowTitle()
     assert app_settings.connection() == settings  # remembered
-    with qtbot.waitSignal(window.link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        window.link.connectionChanged,
+        check_params_cb=is_state(LinkState.DISCONNECTED),
+        timeout=SIGNAL_TIMEOUT_MS,
+    ):
         window.menus.disconnect_action.trigger()
     assert not window.motion_enabled
 
@@ -119,11 +141,15 @@ def test_errors_reach_the_event_log(qtbot: Any, window: MainWindow) -> None:
         window.menus.stop_action.trigger()  # not connected
     last = list(window.event_log.model.events())[-1]
     assert (last.level, last.source, last.text) == (
-        "error", "stop", "Not connected to a controller: nothing was sent.")
+        "error",
+        "stop",
+        "Not connected to a controller: nothing was sent.",
+    )
 
 
-def test_window_state_is_remembered(qtbot: Any, link: Any, app_settings: AppSettings,
-                                    translator: Any) -> None:
+def test_window_state_is_remembered(
+    qtbot: Any, link: Any, app_settings: AppSettings, translator: Any
+) -> None:
     first = MainWindow(link, app_settings, translator, shutdown_link_on_close=False)
     qtbot.addWidget(first)
     first.show()
@@ -137,8 +163,9 @@ def test_window_state_is_remembered(qtbot: Any, link: Any, app_settings: AppSett
 
 
 def test_connection_dialog_round_trip(qtbot: Any) -> None:
-    settings = ConnectionSettings(host="10.0.0.7", port=1502, unit=3, word_order=WordOrder.HIGH_FIRST,
-                                  timeout=0.5, monitor_only=True)
+    settings = ConnectionSettings(
+        host="10.0.0.7", port=1502, unit=3, word_order=WordOrder.HIGH_FIRST, timeout=0.5, monitor_only=True
+    )
     dialog = ConnectionDialog(settings)
     qtbot.addWidget(dialog)
     assert dialog.settings() == settings
@@ -160,8 +187,19 @@ def test_settings_use_the_given_file(tmp_path: Any, qapp: Any) -> None:
 
 def test_teachpad_sim_screenshot(qtbot: Any, tmp_path: Any) -> None:
     png = tmp_path / "shot.png"
-    code = main(["--sim", "--screenshot", str(png), "--size", "1700x1000",
-                 "--settings", str(tmp_path / "teachpad.ini"), "--lang", "en"])
+    code = main(
+        [
+            "--sim",
+            "--screenshot",
+            str(png),
+            "--size",
+            "1700x1000",
+            "--settings",
+            str(tmp_path / "teachpad.ini"),
+            "--lang",
+            "en",
+        ]
+    )
     assert code == 0
     image = QImage(str(png))
     assert not image.isNull() and image.width() >= 1600
@@ -186,8 +224,9 @@ def test_traffic_inspector_shows_decoded_frames_from_the_simulator(
 
     qtbot.waitUntil(lambda: any("read pose" in t for t in texts(COL_MEANING)), timeout=SIGNAL_TIMEOUT_MS)
     window.link.set_mode(WorkMode.MANUAL)  # 444 <- 0, a 0x06 write
-    qtbot.waitUntil(lambda: any("work mode manual (444 ← 0)" in t for t in texts(COL_MEANING)),
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: any("work mode manual (444 ← 0)" in t for t in texts(COL_MEANING)), timeout=SIGNAL_TIMEOUT_MS
+    )
     # the hex column shows the bytes as the seed prints them: MBAP, then 01 06 01 BC 00 00
     assert any(t.endswith("01 06 01 BC 00 00") for t in texts(COL_BYTES))
     # hidden behind the event log, nothing is captured any more

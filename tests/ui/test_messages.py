@@ -50,8 +50,10 @@ QM = Path(__file__).resolve().parents[2] / "ui" / "i18n" / "teachpad_zh_CN.qm"
 ENDPOINT = "192.168.1.10:502"
 # what may stay ASCII in a Chinese sentence: units, register, protocol, format and product names, numbers,
 # addresses
-ALLOWED = re.compile(r"\d+(\.\d+)+:\d+|Modbus|TeachPad|TCP|RTU|CRC|UTF-8|Unicode|CSV|JSON|GV\d+|COM\d+|"
-                     r"mm/s|mm|\bs\b|\b[XYZABC]\b|\bJ\d+\b|\bP\d+\b|0x[0-9A-Fa-f]+")
+ALLOWED = re.compile(
+    r"\d+(\.\d+)+:\d+|Modbus|TeachPad|TCP|RTU|CRC|UTF-8|Unicode|CSV|JSON|GV\d+|COM\d+|"
+    r"mm/s|mm|\bs\b|\b[XYZABC]\b|\bJ\d+\b|\bP\d+\b|0x[0-9A-Fa-f]+"
+)
 
 
 @pytest.fixture
@@ -69,13 +71,15 @@ def assert_chinese(text: str) -> None:
     assert re.search(r"[\u4e00-\u9fff]", text), f"no Chinese in {text!r}"
 
 
-def _status(code: int, mode: int = ControllerMode.MODBUS_TEACH, state: int = ProgramState.STOPPED,
-            alarms: int = 0) -> ControllerStatus:
+def _status(
+    code: int, mode: int = ControllerMode.MODBUS_TEACH, state: int = ProgramState.STOPPED, alarms: int = 0
+) -> ControllerStatus:
     return ControllerStatus(mode, state, Alarm(alarms), code)
 
 
-def _tracked(command: RunCommand, *reads: ControllerStatus, pre: int = 0, stop: bool = False,
-             rule: str = "observe") -> CommandResult:
+def _tracked(
+    command: RunCommand, *reads: ControllerStatus, pre: int = 0, stop: bool = False, rule: str = "observe"
+) -> CommandResult:
     tracker = CommandTracker(command, _status(pre), None, 0.0, rule=rule)  # type: ignore[arg-type]
     now = 0.0
     for read in reads:
@@ -137,9 +141,18 @@ def test_every_result_kind_reads_in_chinese(zh: None) -> None:
     results = _results()
     codes = {name: r.reason.code for name, r in results.items() if r.reason is not None}
     assert len(codes) == len(results), "every tracked result carries a reason"
-    assert set(codes.values()) >= {"done", "done_by_mode", "command_refused", "alarm_while_waiting",
-                                   "not_acknowledged", "done_unconfirmed", "refused_unconfirmed",
-                                   "stopped_by_operator", "stopped_by_controller", "command_timeout"}
+    assert set(codes.values()) >= {
+        "done",
+        "done_by_mode",
+        "command_refused",
+        "alarm_while_waiting",
+        "not_acknowledged",
+        "done_unconfirmed",
+        "refused_unconfirmed",
+        "stopped_by_operator",
+        "stopped_by_controller",
+        "command_timeout",
+    }
     for result in results.values():
         assert_chinese(result_text(result))
     assert result_text(results["unconfirmed"]) == "创建临时点：已完成，控制器未确认。"
@@ -148,13 +161,17 @@ def test_every_result_kind_reads_in_chinese(zh: None) -> None:
 
 
 def test_refused_with_every_status_of_every_kind_reads_in_chinese(zh: None) -> None:
-    commands = {CommandKind.MOVE: RunCommand.MOVE_TO_POINT, CommandKind.CREATE_POINT: RunCommand.CREATE_POINT,
-                CommandKind.TEACH: RunCommand.TEACH_ENABLE}
+    commands = {
+        CommandKind.MOVE: RunCommand.MOVE_TO_POINT,
+        CommandKind.CREATE_POINT: RunCommand.CREATE_POINT,
+        CommandKind.TEACH: RunCommand.TEACH_ENABLE,
+    }
     for kind, table in _STATUS_TEXT.items():
         for code in [*table, 200, STATUS_SENTINEL]:
             error = CommandRefused(CommandStatus(kind, code), params={"command": int(commands[kind])})
-            result = CommandResult(commands[kind], kind, CommandStatus(kind, code), False, str(error),
-                                   reason=error.as_reason())
+            result = CommandResult(
+                commands[kind], kind, CommandStatus(kind, code), False, str(error), reason=error.as_reason()
+            )
             assert_chinese(result_text(result))
 
 
@@ -169,16 +186,22 @@ def test_the_operators_stop_is_neutral_and_an_unconfirmed_success_a_warning(zh: 
 
 
 def _errors() -> list[TeachPadError]:
-    reconnect = LinkError("cannot reconnect", code="connection_refused",
-                          params={"port": 502, "endpoint": ENDPOINT, "reconnect": True})
+    reconnect = LinkError(
+        "cannot reconnect",
+        code="connection_refused",
+        params={"port": 502, "endpoint": ENDPOINT, "reconnect": True},
+    )
     violation = EnvelopeViolation(ViolationCode.KEEP_IN, 1250.0, 1200.0, axis="X", segment=2)
     return [
         LinkError("lost", params={"endpoint": ENDPOINT}),
         LinkError("not connected"),
         LinkError("closed", code="link_closed", params={"endpoint": ENDPOINT}),
         LinkError("dns", code="host_unresolved", params={"host": "192.168.1.10"}),
-        LinkError("refused", code="connection_refused", params={"port": 502, "endpoint": ENDPOINT,
-                                                                 "reconnect": False}),
+        LinkError(
+            "refused",
+            code="connection_refused",
+            params={"port": 502, "endpoint": ENDPOINT, "reconnect": False},
+        ),
         reconnect,
         LinkError("timeout", code="connect_timeout", params={"seconds": 1.0}),
         LinkError("os", code="connect_failed", params={"errno": 113}),
@@ -210,8 +233,9 @@ def test_every_error_kind_reads_in_chinese(zh: None) -> None:
         assert worker_error.message == str(error)  # English beside the reason
         assert worker_error.request_id == 7
         assert error_text(worker_error) == error_text(error)
-    assert error_text(_errors()[5]) == ("无法重新连接控制器 192.168.1.10:502："
-                                        "连接被拒绝：端口 502 上没有服务在监听。")
+    assert error_text(_errors()[5]) == (
+        "无法重新连接控制器 192.168.1.10:502：连接被拒绝：端口 502 上没有服务在监听。"
+    )
 
 
 def test_an_error_without_a_reason_falls_back_to_its_message(zh: None) -> None:
@@ -238,8 +262,11 @@ def test_the_codes_the_worker_and_the_cli_use_read_in_chinese(zh: None) -> None:
         Reason("busy", {"operation": Operation.UPLOAD_POINTS}),
         Reason("link_shut_down"),
         Reason("not_connected"),
-        *(Reason("request_done", {"operation": op})
-          for name, op in vars(Operation).items() if name.isupper()),
+        *(
+            Reason("request_done", {"operation": op})
+            for name, op in vars(Operation).items()
+            if name.isupper()
+        ),
     ]
     for reason in reasons:
         assert_chinese(error_text(reason))
@@ -255,27 +282,42 @@ def test_the_link_states_and_cut_short_commands_read_in_chinese(zh: None) -> Non
     from ui.messages import connection_text
 
     states = [
-        ConnectionState(LinkState.NOT_ANSWERING, "no answer", ENDPOINT,
-                        reason=ResponseTimeout("no answer", params={"seconds": 0.2, "endpoint": ENDPOINT})
-                        .as_reason()),
-        ConnectionState(LinkState.DOWN, "link lost: x", ENDPOINT,
-                        reason=Reason("link_lost", {"endpoint": ENDPOINT})),
+        ConnectionState(
+            LinkState.NOT_ANSWERING,
+            "no answer",
+            ENDPOINT,
+            reason=ResponseTimeout("no answer", params={"seconds": 0.2, "endpoint": ENDPOINT}).as_reason(),
+        ),
+        ConnectionState(
+            LinkState.DOWN, "link lost: x", ENDPOINT, reason=Reason("link_lost", {"endpoint": ENDPOINT})
+        ),
         ConnectionState(LinkState.DOWN, "link lost: x", ENDPOINT, reason=Reason("link_lost")),
         ConnectionState(LinkState.DOWN, "cannot reconnect", ENDPOINT, reason=_errors()[5].as_reason()),
-        ConnectionState(LinkState.DISCONNECTED, "the link was shut down", ENDPOINT,
-                        reason=Reason("link_was_shut_down")),
+        ConnectionState(
+            LinkState.DISCONNECTED, "the link was shut down", ENDPOINT, reason=Reason("link_was_shut_down")
+        ),
     ]
     for state in states:
         assert_chinese(connection_text(state))
     assert connection_text(ConnectionState(LinkState.CONNECTED)) == ""
     assert connection_text(ConnectionState(LinkState.DOWN, "older producer")) == "older producer"
     for code in ("outcome_unknown_link_lost", "outcome_unknown_link_closed"):
-        result = CommandResult(None, None, None, False, "move to point: link lost",
-                               reason=Reason(code, {"operation": Operation.MOVE_TO_POINT}))
+        result = CommandResult(
+            None,
+            None,
+            None,
+            False,
+            "move to point: link lost",
+            reason=Reason(code, {"operation": Operation.MOVE_TO_POINT}),
+        )
         assert_chinese(result_text(result))
     for code in ("queued_link_down", "queued_link_closed"):  # requests the link never sent
-        error = WorkerError(Operation.MOVE_TO_POINT, "not sent", 7,
-                            reason=Reason(code, {"operation": Operation.MOVE_TO_POINT}))
+        error = WorkerError(
+            Operation.MOVE_TO_POINT,
+            "not sent",
+            7,
+            reason=Reason(code, {"operation": Operation.MOVE_TO_POINT}),
+        )
         assert_chinese(error_text(error))
 
 
@@ -289,25 +331,30 @@ def _plan_issues() -> list[Any]:
     from app.view3d.reach import _issue
 
     on = SyncState.ON_CONTROLLER
-    ledger = PointLedger([
-        make_point(1, "原点", (400, 0, 450, 180, 0, 0), sync=on),
-        make_point(5, "西", (300, 0, 300, 180, 0, 0), sync=on),
-        make_point(6, "北", (400, 100, 300, 180, 0, 0), sync=on),
-        make_point(7, "东", (500, 0, 300, 180, 0, 0), sync=on),
-        make_point(8, "南", (400, -100, 300, 180, 0, 0), sync=on),
-        make_point(9, "中", (400, 0, 300, 180, 0, 0), sync=on),
-        make_point(10, "又西", (300, 0, 300.05, 180, 0, 0), sync=on),
-        make_point(11, "新", (350, 50, 300, 180, 0, 0), sync=SyncState.CHANGED),
-        make_point(13, "工具点", (450, 50, 300, 180, 0, 0), tool=0, sync=on),
-    ])
+    ledger = PointLedger(
+        [
+            make_point(1, "原点", (400, 0, 450, 180, 0, 0), sync=on),
+            make_point(5, "西", (300, 0, 300, 180, 0, 0), sync=on),
+            make_point(6, "北", (400, 100, 300, 180, 0, 0), sync=on),
+            make_point(7, "东", (500, 0, 300, 180, 0, 0), sync=on),
+            make_point(8, "南", (400, -100, 300, 180, 0, 0), sync=on),
+            make_point(9, "中", (400, 0, 300, 180, 0, 0), sync=on),
+            make_point(10, "又西", (300, 0, 300.05, 180, 0, 0), sync=on),
+            make_point(11, "新", (350, 50, 300, 180, 0, 0), sync=SyncState.CHANGED),
+            make_point(13, "工具点", (450, 50, 300, 180, 0, 0), tool=0, sync=on),
+        ]
+    )
     home = (400.0, 0.0, 450.0)
     circle = Plan("圆", [Segment.line(5, 100), Segment.arc(6, 7, 50), Segment.arc(8, 5, 50)])
     wrap = Plan("环", [Segment.arc(9, 7), Segment.line(5)], loops=3)
     issues: list[PlanIssue] = [
         *check_plan(Plan("空"), ledger),
         *check_plan(wrap, ledger, current_pose=ledger.point(6), start_index=2),
-        *check_plan(Plan("p", [Segment.line(5, 0), Segment.arc(99, 7), Segment.line(42), Segment.line(11)]),
-                    ledger, current_pose=home),
+        *check_plan(
+            Plan("p", [Segment.line(5, 0), Segment.arc(99, 7), Segment.line(42), Segment.line(11)]),
+            ledger,
+            current_pose=home,
+        ),
         *check_plan(Plan("p", [Segment.line(1), Segment.line(13)]), ledger, current_pose=home),
         *check_plan(Plan("p", [Segment.arc(9, 7)]), ledger),
         *check_plan(Plan("p", [Segment.line(5), Segment.arc(9, 7)]), ledger, current_pose=home),
@@ -320,10 +367,17 @@ def _plan_issues() -> list[Any]:
     ]
     violation = EnvelopeViolation(ViolationCode.KEEP_OUT, 10.0, 0.0, axis="Z", box="夹具", segment=1)
     issues += [
-        PlanIssue(1, IssueKind.ERROR, IssueCode.OUTSIDE_ENVELOPE, violation.message,
-                  args=EnvelopeRefused(violation).as_reason().args),
-        _issue(0, Reach.UNREACHABLE, "P5 西", 5), _issue(1, Reach.UNREACHABLE, "the path", None),
-        _issue(0, Reach.JOINT_LIMIT, "P5 西", 5), _issue(1, Reach.JOINT_LIMIT, "the path", None),
+        PlanIssue(
+            1,
+            IssueKind.ERROR,
+            IssueCode.OUTSIDE_ENVELOPE,
+            violation.message,
+            args=EnvelopeRefused(violation).as_reason().args,
+        ),
+        _issue(0, Reach.UNREACHABLE, "P5 西", 5),
+        _issue(1, Reach.UNREACHABLE, "the path", None),
+        _issue(0, Reach.JOINT_LIMIT, "P5 西", 5),
+        _issue(1, Reach.JOINT_LIMIT, "the path", None),
     ]
     return issues
 
@@ -355,8 +409,10 @@ def test_the_plan_checks_stay_english_for_the_cli() -> None:
     assert summary.first_row_error == first.message and first.message.startswith("segment ")
     assert summary.details.split("\n")[0] == str(issues[0])
     warnings = run_gate(issues).warnings
-    assert warnings and warnings == tuple(i.message for i in issues
-                                          if i.kind is IssueKind.WARNING)[:len(warnings)]
+    assert (
+        warnings
+        and warnings == tuple(i.message for i in issues if i.kind is IssueKind.WARNING)[: len(warnings)]
+    )
 
 
 def test_the_ledgers_refusals_read_in_chinese(zh: None) -> None:
@@ -375,8 +431,9 @@ def test_the_ledgers_refusals_read_in_chinese(zh: None) -> None:
         lambda: ledger.import_points([point, point], ImportMode.MERGE),
         lambda: ledger.import_points([]),
         lambda: ledger.set_limits(PointLimits(id_min=5, id_max=10)),
-        lambda: PointLedger([make_point(1, "一", (0, 0, 0, 0, 0, 0))], PointLimits(id_min=1, id_max=1))
-        .next_free_id(),
+        lambda: PointLedger(
+            [make_point(1, "一", (0, 0, 0, 0, 0, 0))], PointLimits(id_min=1, id_max=1)
+        ).next_free_id(),
         lambda: ledger.replace(0, make_point(2, "一", (0, 0, 0, 0, 0, 0))),
     ]
     codes = set()
@@ -386,9 +443,17 @@ def test_the_ledgers_refusals_read_in_chinese(zh: None) -> None:
         codes.add(caught.value.code)
         assert_chinese(refusal_text(caught.value))
         assert re.search("[a-z]{3}", str(caught.value))  # English for logs and the CLI
-    assert codes == {"no_such_point", "no_such_row", "cannot_move_row", "duplicate_row_id",
-                     "import_duplicate_id", "empty_import", "points_outside_range", "no_free_point_id",
-                     "point_id_taken"}
+    assert codes == {
+        "no_such_point",
+        "no_such_row",
+        "cannot_move_row",
+        "duplicate_row_id",
+        "import_duplicate_id",
+        "empty_import",
+        "points_outside_range",
+        "no_free_point_id",
+        "point_id_taken",
+    }
     assert isinstance(EmptyImport(3), InvalidInput)
     assert refusal_text(InvalidInput("speed must be positive")) == "speed must be positive"  # no code: as is
 
@@ -421,8 +486,18 @@ def test_a_points_fields_and_files_refusals_read_in_chinese(zh: None) -> None:
             attempt()
         codes.add(caught.value.code)
         assert_chinese(_without_quoted(refusal_text(caught.value)))
-    assert codes >= {"not_a_number", "value_empty", "too_large", "not_finite", "not_integer",
-                     "id_out_of_range", "bad_tool", "not_text", "too_long", "not_one_line"}
+    assert codes >= {
+        "not_a_number",
+        "value_empty",
+        "too_large",
+        "not_finite",
+        "not_integer",
+        "id_out_of_range",
+        "bad_tool",
+        "not_text",
+        "too_long",
+        "not_one_line",
+    }
     header = "id,name,x,y,z,a,b,c"
     files = [
         "",
@@ -443,8 +518,15 @@ def test_a_points_fields_and_files_refusals_read_in_chinese(zh: None) -> None:
         assert shown.startswith("点位.csv：") and "/data" not in shown
         columns = "id,name,x,y,z,a,b,c,e1,e2,e3,e4,e5,tool,note"
         assert_chinese(_without_quoted(shown).replace(columns, "").replace("点位.csv", "点位"))
-    assert problems == {"empty_file", "unknown_column", "column_twice", "column_missing", "cell_count",
-                        "not_a_number", "row_id_taken"}
+    assert problems == {
+        "empty_file",
+        "unknown_column",
+        "column_twice",
+        "column_missing",
+        "cell_count",
+        "not_a_number",
+        "row_id_taken",
+    }
     with pytest.raises(FileFormatError) as bad_bytes:
         decode_text(b"\xff\xfe1", path="p.csv")
     assert_chinese(refusal_text(bad_bytes.value).replace("p.csv", ""))
@@ -458,8 +540,11 @@ def _project_texts() -> list[str]:
     """One malformed project per problem code (and per place) the loader names."""
     import json
 
-    sample = json.loads((Path(__file__).resolve().parents[2] / "resources" / "samples"
-                         / "demo.teachpad.json").read_text(encoding="utf-8"))
+    sample = json.loads(
+        (Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json").read_text(
+            encoding="utf-8"
+        )
+    )
 
     def changed(edit: Callable[[dict[str, Any]], None]) -> str:
         doc = json.loads(json.dumps(sample))
@@ -476,7 +561,7 @@ def _project_texts() -> list[str]:
         return lambda d: d["plans"][0]["segments"][0].pop(key)
 
     return [
-        "{\"format\": ",
+        '{"format": ',
         "[1, 2]",
         "[" * 100000,
         changed(lambda d: d.__setitem__("format", "other")),
@@ -522,13 +607,38 @@ def test_a_malformed_project_reads_in_chinese(zh: None) -> None:
         left = _without_quoted(shown).replace("工程.teachpad.json", "")
         assert_chinese(re.sub(r"\[[\d, ]*\]", "", left))
         assert str(error).startswith("/data/")  # the English whole for logs and the CLI
-    assert problems >= {"not_json", "not_json_object", "json_too_deep", "not_a_project",
-                        "version_unsupported", "expected_type", "not_a_number", "point_id_twice",
-                        "plan_name_taken", "plan_name_empty", "bad_loops", "value_missing",
-                        "not_segment_kind", "not_orientation", "not_yes_no",
-                        "negative_point_id", "line_has_no_middle", "bad_character"}
-    assert places >= {None, "place_file", "place_line", "place_point", "place_point_id", "place_point_upload",
-                      "place_plan", "place_plan_named", "place_segment", "place_json_path"}
+    assert problems >= {
+        "not_json",
+        "not_json_object",
+        "json_too_deep",
+        "not_a_project",
+        "version_unsupported",
+        "expected_type",
+        "not_a_number",
+        "point_id_twice",
+        "plan_name_taken",
+        "plan_name_empty",
+        "bad_loops",
+        "value_missing",
+        "not_segment_kind",
+        "not_orientation",
+        "not_yes_no",
+        "negative_point_id",
+        "line_has_no_middle",
+        "bad_character",
+    }
+    assert places >= {
+        None,
+        "place_file",
+        "place_line",
+        "place_point",
+        "place_point_id",
+        "place_point_upload",
+        "place_plan",
+        "place_plan_named",
+        "place_segment",
+        "place_json_path",
+    }
 
 
 def test_segment_jog_and_unreadable_file_codes_read_in_chinese(zh: None, tmp_path: Path) -> None:
@@ -552,16 +662,31 @@ def test_segment_jog_and_unreadable_file_codes_read_in_chinese(zh: None, tmp_pat
             attempt()
         error = caught.value
         codes.add(error.problem.code if isinstance(error, FileFormatError) and error.problem else error.code)
-        assert_chinese(_without_quoted(refusal_text(error)).replace(str(tmp_path), "")
-                       .replace("nothing.teachpad.json", "").replace(tmp_path.name, ""))
-    assert codes == {"cannot_move_segment", "no_such_field", "plan_name_format", "not_csv", "no_such_file",
-                     "is_a_directory"}
+        assert_chinese(
+            _without_quoted(refusal_text(error))
+            .replace(str(tmp_path), "")
+            .replace("nothing.teachpad.json", "")
+            .replace(tmp_path.name, "")
+        )
+    assert codes == {
+        "cannot_move_segment",
+        "no_such_field",
+        "plan_name_format",
+        "not_csv",
+        "no_such_file",
+        "is_a_directory",
+    }
     codes_args: list[tuple[str, dict[str, Any]]] = [
-        ("arc_needs_middle", {}), ("segment_point_missing", {"id": 7}),
+        ("arc_needs_middle", {}),
+        ("segment_point_missing", {"id": 7}),
         ("speed_not_positive", {"speed": "0"}),
-        ("arc_same_points", {}), ("file_too_large", {"size": 9, "limit": 8}), ("permission_denied", {}),
-        ("os_error", {"errno": 28}), ("jog_stopped_silent", {}),
-        ("left_teach_mode", {"mode": int(ControllerMode.MANUAL)}), ("jog_not_answering", {}),
+        ("arc_same_points", {}),
+        ("file_too_large", {"size": 9, "limit": 8}),
+        ("permission_denied", {}),
+        ("os_error", {"errno": 28}),
+        ("jog_stopped_silent", {}),
+        ("left_teach_mode", {"mode": int(ControllerMode.MANUAL)}),
+        ("jog_not_answering", {}),
         ("bad_jog_ratio", {"value": "120"}),
     ]
     for code, args in codes_args:

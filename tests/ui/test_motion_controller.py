@@ -36,8 +36,11 @@ class Rig:
         self.motion = MotionController(link, self.bar, self.jog, self.step, self.program, self.runs)
 
     def panels_enabled(self) -> bool:
-        return self.jog.axes_box.isEnabled() and self.step.move_button.isEnabled() \
+        return (
+            self.jog.axes_box.isEnabled()
+            and self.step.move_button.isEnabled()
             and self.program.run_button.isEnabled()
+        )
 
 
 @pytest.fixture

@@ -18,12 +18,14 @@ from ui.panels.plan_preview import PROJECTIONS, PlanPreview
 
 @pytest.fixture
 def ledger() -> PointLedger:
-    return PointLedger([
-        make_point(1, "home", (400, 0, 450, 180, 0, 0)),
-        make_point(5, "W", (300, 0, 300, 180, 0, 0)),
-        make_point(6, "N", (400, 100, 320, 180, 0, 0)),
-        make_point(7, "E", (500, 0, 300, 180, 0, 0)),
-    ])
+    return PointLedger(
+        [
+            make_point(1, "home", (400, 0, 450, 180, 0, 0)),
+            make_point(5, "W", (300, 0, 300, 180, 0, 0)),
+            make_point(6, "N", (400, 100, 320, 180, 0, 0)),
+            make_point(7, "E", (500, 0, 300, 180, 0, 0)),
+        ]
+    )
 
 
 @pytest.fixture
@@ -151,9 +153,16 @@ def wheel(qtbot: Any, preview: PlanPreview, key: str = "top") -> None:
 
     plot = preview.projections[key].plot
     centre = QPointF(plot.viewport().rect().center())
-    event = QWheelEvent(centre, QPointF(plot.viewport().mapToGlobal(centre.toPoint())), QPoint(0, 0),
-                        QPoint(0, 240), Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier,
-                        Qt.ScrollPhase.NoScrollPhase, False)
+    event = QWheelEvent(
+        centre,
+        QPointF(plot.viewport().mapToGlobal(centre.toPoint())),
+        QPoint(0, 0),
+        QPoint(0, 240),
+        Qt.MouseButton.NoButton,
+        Qt.KeyboardModifier.NoModifier,
+        Qt.ScrollPhase.NoScrollPhase,
+        False,
+    )
     QApplication.sendEvent(plot.viewport(), event)
 
 
@@ -164,8 +173,9 @@ def test_a_new_plan_shows_the_points_it_can_use(preview: PlanPreview, ledger: Po
     assert shows_all(preview, [p.xyz for p in ledger])  # not an empty view fitted to nothing
 
 
-def test_every_change_refits_until_the_operator_zooms(qtbot: Any, preview: PlanPreview,
-                                                      ledger: PointLedger) -> None:
+def test_every_change_refits_until_the_operator_zooms(
+    qtbot: Any, preview: PlanPreview, ledger: PointLedger
+) -> None:
     preview.show()
     qtbot.waitExposed(preview)
     ledger.append(make_point(8, "far", (2400, -1800, 1200, 180, 0, 0)))

@@ -59,13 +59,16 @@ class Bench:
 
     def __init__(self, qtbot: Any, link: RobotLink, sim: Any, start: tuple[float, ...]) -> None:
         x, y, z, a, b, c = start
-        self.project = Project(plans=[Plan("square", [Segment.line(1, SPEED), Segment.line(2, SPEED),
-                                                      Segment.line(3, SPEED)])])
-        self.project.ledger.replace_all([
-            make_point(1, "a", (x + 30, y, z, a, b, c)),
-            make_point(2, "b", (x + 30, y + 30, z, a, b, c)),
-            make_point(3, "c", (x, y + 30, z, a, b, c)),
-        ])
+        self.project = Project(
+            plans=[Plan("square", [Segment.line(1, SPEED), Segment.line(2, SPEED), Segment.line(3, SPEED)])]
+        )
+        self.project.ledger.replace_all(
+            [
+                make_point(1, "a", (x + 30, y, z, a, b, c)),
+                make_point(2, "b", (x + 30, y + 30, z, a, b, c)),
+                make_point(3, "c", (x, y + 30, z, a, b, c)),
+            ]
+        )
         self.model = PointsModel(self.project, QUndoStack())
         self.sync = PointSyncController(self.model, link)
         self.runs = PlanRunController(link, points=self.model)
@@ -115,7 +118,8 @@ def bench(qtbot: Any, sim: Any, link: RobotLink, make_client: MakeClient) -> Ben
 
 
 def test_a_point_overwritten_after_the_upload_is_re_created_before_its_move(
-        bench: Bench, sim: Any, make_client: MakeClient) -> None:
+    bench: Bench, sim: Any, make_client: MakeClient
+) -> None:
     bench.upload_all()
     other = make_client(sim)
     wrong = _elsewhere(bench.host(2))
@@ -141,7 +145,8 @@ def test_a_point_overwritten_after_the_upload_is_re_created_before_its_move(
 
 
 def test_an_overwrite_between_re_create_and_move_stops_the_run_and_tells_the_operator(
-        bench: Bench, sim: Any, make_client: MakeClient) -> None:
+    bench: Bench, sim: Any, make_client: MakeClient
+) -> None:
     """The residual window: another tool writes P2 after our create-point, before our move."""
     other = make_client(sim)
     wrong = _elsewhere(bench.host(2))
@@ -180,13 +185,16 @@ def test_an_overwrite_between_re_create_and_move_stops_the_run_and_tells_the_ope
 
 
 def test_a_point_the_controller_does_not_create_fails_the_segment_before_it_moves(
-        bench: Bench, sim: Any) -> None:
+    bench: Bench, sim: Any
+) -> None:
     sim.refuse_point(2)
     since = len(sim.writes)
     outcome = bench.run()
     assert outcome.state is RunState.FAILED and outcome.resume_from == 1
-    assert bench.runs.outcome_text(outcome) == ("Failed at segment 2: The controller did not create P2 'b' "
-                                                "again before the move: the arm was not moved.")
+    assert bench.runs.outcome_text(outcome) == (
+        "Failed at segment 2: The controller did not create P2 'b' "
+        "again before the move: the arm was not moved."
+    )
     assert bench.commands(since) == [CREATE, MOVE, CREATE]
     assert _near(sim.state().pose, bench.host(1))
     assert bench.project.ledger.point(2).sync is SyncState.FAILED
@@ -194,7 +202,8 @@ def test_a_point_the_controller_does_not_create_fails_the_segment_before_it_move
 
 
 def test_a_point_deleted_from_the_project_fails_the_segment_before_anything_is_sent(
-        bench: Bench, sim: Any) -> None:
+    bench: Bench, sim: Any
+) -> None:
     bench.project.ledger.remove(1)  # row 1: P2
     since = len(sim.writes)
     outcome = bench.run(start=1)
@@ -207,8 +216,9 @@ def test_a_pause_while_the_points_are_created_holds_the_move_until_resume(bench:
     since = len(sim.writes)
     bench.runs.step(bench.plan, 0)
     bench.runs.pause()  # before the worker has created P1: the move must wait
-    bench.qtbot.waitUntil(lambda: bench.project.ledger.point(1).sync is SyncState.ON_CONTROLLER,
-                          timeout=SIGNAL_TIMEOUT_MS)
+    bench.qtbot.waitUntil(
+        lambda: bench.project.ledger.point(1).sync is SyncState.ON_CONTROLLER, timeout=SIGNAL_TIMEOUT_MS
+    )
     assert bench.runs.running and bench.runs.paused
     assert MOVE not in bench.commands(since)
     with bench.qtbot.waitSignal(bench.runs.runFinished, timeout=RUN_TIMEOUT_MS) as finished:
@@ -234,16 +244,18 @@ def test_a_stop_while_a_move_is_held_by_a_pause_ends_the_run(bench: Bench, sim: 
     since = len(sim.writes)
     bench.runs.step(bench.plan, 0)
     bench.runs.pause()
-    bench.qtbot.waitUntil(lambda: bench.project.ledger.point(1).sync is SyncState.ON_CONTROLLER,
-                          timeout=SIGNAL_TIMEOUT_MS)
+    bench.qtbot.waitUntil(
+        lambda: bench.project.ledger.point(1).sync is SyncState.ON_CONTROLLER, timeout=SIGNAL_TIMEOUT_MS
+    )
     with bench.qtbot.waitSignal(bench.runs.runFinished, timeout=SIGNAL_TIMEOUT_MS) as finished:
         bench.runs.stop()
     assert finished.args[0].state is RunState.STOPPED and finished.args[0].resume_from == 0
     assert MOVE not in bench.commands(since)
 
 
-def test_a_controller_that_stops_answering_ends_the_run_as_not_answering(bench: Bench, sim: Any,
-                                                                         link: RobotLink) -> None:
+def test_a_controller_that_stops_answering_ends_the_run_as_not_answering(
+    bench: Bench, sim: Any, link: RobotLink
+) -> None:
     """The controller goes silent mid-move while the link stays open: the run ends at that
     segment, said as *not answering* (not as a lost link), and nothing further is sent."""
     slow = Plan("slow", [Segment.line(1, 5.0), Segment.line(2, SPEED)])  # 30 mm at 5 mm/s: 6 s
@@ -262,11 +274,14 @@ def test_a_controller_that_stops_answering_ends_the_run_as_not_answering(bench: 
     assert outcome.state is RunState.FAILED and outcome.resume_from == 0
     assert at_end == [LinkState.NOT_ANSWERING]  # the connection is still open
     text = bench.runs.outcome_text(outcome)
-    assert text.startswith(f"Failed at segment 1: The controller at 127.0.0.1:{sim.port} is not answering "
-                           "(the connection is still open): no further segment is sent."), text
+    assert text.startswith(
+        f"Failed at segment 1: The controller at 127.0.0.1:{sim.port} is not answering "
+        "(the connection is still open): no further segment is sent."
+    ), text
     assert "Lost the connection" not in text
-    with bench.qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED),
-                                timeout=SIGNAL_TIMEOUT_MS):
+    with bench.qtbot.waitSignal(
+        link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED), timeout=SIGNAL_TIMEOUT_MS
+    ):
         sim.set_silent(False)
     # at the simulator: segment 1's point and move, nothing after them
     assert bench.commands(since) == [CREATE, MOVE] and bench.runs.sent_segments == [0]

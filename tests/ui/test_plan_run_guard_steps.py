@@ -47,8 +47,9 @@ def _at(link: FakeLink, xyzabc: tuple[float, ...]) -> None:
     link.state.set_pose(Pose(x, y, z, a, b, c, ext=(0.0,) * 5))
 
 
-def test_points_first_then_the_move_then_the_arrival(qtbot: Any, runs: PlanRunController, link: FakeLink,
-                                                    project: Project) -> None:
+def test_points_first_then_the_move_then_the_arrival(
+    qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project
+) -> None:
     runs.run(project.plans[0])
     assert [c.name for c in link.calls] == ["upload_points"]
     assert link.named("upload_points")[0].args[0] == [(1, P1, 3)]  # the ledger's values and tool
@@ -69,7 +70,8 @@ def test_points_first_then_the_move_then_the_arrival(qtbot: Any, runs: PlanRunCo
 
 
 def test_an_arrival_elsewhere_fails_the_run_and_marks_the_point_unknown(
-        qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project) -> None:
+    qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project
+) -> None:
     runs.run(project.plans[0])
     link.point_ok(1)
     link.upload_summary(1, 1)
@@ -83,8 +85,9 @@ def test_an_arrival_elsewhere_fails_the_run_and_marks_the_point_unknown(
     assert len(link.named("upload_points")) == 1  # nothing more was sent
 
 
-def test_an_arrival_without_a_pose_is_not_taken_as_done(qtbot: Any, runs: PlanRunController,
-                                                       link: FakeLink, project: Project) -> None:
+def test_an_arrival_without_a_pose_is_not_taken_as_done(
+    qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project
+) -> None:
     runs.step(project.plans[0], 0)
     link.point_ok(1)
     link.upload_summary(1, 1)
@@ -94,8 +97,9 @@ def test_an_arrival_without_a_pose_is_not_taken_as_done(qtbot: Any, runs: PlanRu
     assert "position after the move to P1 is not known" in runs.outcome_text(finished.args[0])
 
 
-def test_link_lost_while_the_points_are_created(qtbot: Any, runs: PlanRunController, link: FakeLink,
-                                               project: Project) -> None:
+def test_link_lost_while_the_points_are_created(
+    qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project
+) -> None:
     runs.step(project.plans[0], 1)
     link.point_ok(2)  # P2 made it, P3 did not
     with qtbot.waitSignal(runs.runFinished) as finished:
@@ -107,18 +111,21 @@ def test_link_lost_while_the_points_are_created(qtbot: Any, runs: PlanRunControl
     assert not runs.running and link.named("move_to_point") == []
 
 
-def test_an_upload_the_worker_refuses_ends_the_run(qtbot: Any, runs: PlanRunController, link: FakeLink,
-                                                  project: Project) -> None:
+def test_an_upload_the_worker_refuses_ends_the_run(
+    qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project
+) -> None:
     runs.run(project.plans[0])
     with qtbot.waitSignal(runs.runFinished) as finished:
-        link.errorOccurred.emit(WorkerError("upload points", "jog is still under way",
-                                            link.last_id("upload_points")))
+        link.errorOccurred.emit(
+            WorkerError("upload points", "jog is still under way", link.last_id("upload_points"))
+        )
     assert finished.args[0].state is RunState.FAILED and link.named("move_to_point") == []
     assert "jog is still under way" in runs.outcome_text(finished.args[0])
 
 
-def test_a_stop_during_the_upload_ends_the_run_stopped(qtbot: Any, runs: PlanRunController, link: FakeLink,
-                                                      project: Project) -> None:
+def test_a_stop_during_the_upload_ends_the_run_stopped(
+    qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project
+) -> None:
     runs.run(project.plans[0])
     runs.stop()
     assert runs.running  # until the worker ends the upload
@@ -128,8 +135,9 @@ def test_a_stop_during_the_upload_ends_the_run_stopped(qtbot: Any, runs: PlanRun
     assert link.named("move_to_point") == []
 
 
-def test_a_stop_after_the_upload_ended_in_the_worker_sends_no_move(qtbot: Any, runs: PlanRunController,
-                                                                   link: FakeLink, project: Project) -> None:
+def test_a_stop_after_the_upload_ended_in_the_worker_sends_no_move(
+    qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project
+) -> None:
     runs.run(project.plans[0])
     link.point_ok(1)
     runs.stop()  # the upload's good summary is still on its way
@@ -147,8 +155,9 @@ def test_there_is_no_unguarded_run(link: FakeLink, project: Project) -> None:
     assert [c.name for c in link.calls] == ["upload_points"]  # the points first, never a bare move
 
 
-def test_the_guard_speaks_chinese(qtbot: Any, translator: Any, runs: PlanRunController, link: FakeLink,
-                                  project: Project) -> None:
+def test_the_guard_speaks_chinese(
+    qtbot: Any, translator: Any, runs: PlanRunController, link: FakeLink, project: Project
+) -> None:
     assert translator.set_language("zh_CN")
     runs.run(project.plans[0])
     link.point_ok(1)
@@ -161,9 +170,9 @@ def test_the_guard_speaks_chinese(qtbot: Any, translator: Any, runs: PlanRunCont
     assert "在第 1 段失败" in text
 
 
-
-def _link_leaves_connected(qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project,
-                           link_state: LinkState) -> str:
+def _link_leaves_connected(
+    qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project, link_state: LinkState
+) -> str:
     """Segment 1's move is out when the link leaves CONNECTED: how the run's end reads."""
     runs.run(project.plans[0])
     link.point_ok(1)
@@ -176,21 +185,33 @@ def _link_leaves_connected(qtbot: Any, runs: PlanRunController, link: FakeLink, 
     return runs.outcome_text(outcome)
 
 
-@pytest.mark.parametrize(("link_state", "sentence"), [
-    (LinkState.NOT_ANSWERING, "The controller at fake:502 is not answering (the connection is still open): "
-                              "no further segment is sent. The arm may still finish its current move; "
-                              "check the robot before resuming."),
-    (LinkState.DOWN, "Lost the connection to the controller at fake:502."),
-])
-def test_a_silent_controller_is_not_a_lost_link(qtbot: Any, runs: PlanRunController, link: FakeLink,
-                                               project: Project, link_state: LinkState,
-                                               sentence: str) -> None:
+@pytest.mark.parametrize(
+    ("link_state", "sentence"),
+    [
+        (
+            LinkState.NOT_ANSWERING,
+            "The controller at fake:502 is not answering (the connection is still open): "
+            "no further segment is sent. The arm may still finish its current move; "
+            "check the robot before resuming.",
+        ),
+        (LinkState.DOWN, "Lost the connection to the controller at fake:502."),
+    ],
+)
+def test_a_silent_controller_is_not_a_lost_link(
+    qtbot: Any,
+    runs: PlanRunController,
+    link: FakeLink,
+    project: Project,
+    link_state: LinkState,
+    sentence: str,
+) -> None:
     text = _link_leaves_connected(qtbot, runs, link, project, link_state)
     assert text == f"Failed at segment 1: {sentence}"
 
 
-def test_not_answering_speaks_chinese(qtbot: Any, translator: Any, runs: PlanRunController, link: FakeLink,
-                                      project: Project) -> None:
+def test_not_answering_speaks_chinese(
+    qtbot: Any, translator: Any, runs: PlanRunController, link: FakeLink, project: Project
+) -> None:
     assert translator.set_language("zh_CN")
     text = _link_leaves_connected(qtbot, runs, link, project, LinkState.NOT_ANSWERING)
     assert "在第 1 段失败" in text and "控制器 fake:502 无应答（连接仍然打开）：不再发送后续段。" in text

@@ -69,8 +69,9 @@ def all_uploaded(project: Project) -> None:
 # --- models ------------------------------------------------------------------------------------
 
 
-def test_models_pass_qt_model_tester(qtmodeltester: Any, project: Project, stack: QUndoStack,
-                                     segments: SegmentTableModel) -> None:
+def test_models_pass_qt_model_tester(
+    qtmodeltester: Any, project: Project, stack: QUndoStack, segments: SegmentTableModel
+) -> None:
     plans = PlanListModel(project, stack)
     qtmodeltester.check(plans, force_py=False)
     qtmodeltester.check(segments, force_py=False)
@@ -112,8 +113,9 @@ def test_segment_display(segments: SegmentTableModel) -> None:
         (COL_KIND, "circle", "is not a line or an arc"),
     ],
 )
-def test_bad_segment_input_is_refused(qtbot: Any, segments: SegmentTableModel, column: int, value: str,
-                                      reason: str) -> None:
+def test_bad_segment_input_is_refused(
+    qtbot: Any, segments: SegmentTableModel, column: int, value: str, reason: str
+) -> None:
     plan = segments.plan
     assert plan is not None
     before = list(plan.segments)
@@ -243,9 +245,9 @@ def moves(link: FakeLink) -> list[tuple[int, int | None]]:
     return [(c.args[0], c.args[1]) for c in link.named("move_to_point")]
 
 
-def test_segments_sent_in_order_each_after_the_previous_result(qtbot: Any, runner: PlanRunController,
-                                                               link: FakeLink, project: Project,
-                                                               worker: Worker) -> None:
+def test_segments_sent_in_order_each_after_the_previous_result(
+    qtbot: Any, runner: PlanRunController, link: FakeLink, project: Project, worker: Worker
+) -> None:
     plan = project.plans[0]  # line P2, arc P4 -> P3, line P1; 2 loops
     with qtbot.waitSignal(runner.runningChanged, check_params_cb=lambda running: running):
         runner.run(plan)
@@ -273,8 +275,9 @@ def _ack(text: str) -> Any:
     return CommandResult(None, None, None, True, text)
 
 
-def test_pause_resume_stop_are_forwarded(qtbot: Any, runner: PlanRunController, link: FakeLink,
-                                         project: Project, worker: Worker) -> None:
+def test_pause_resume_stop_are_forwarded(
+    qtbot: Any, runner: PlanRunController, link: FakeLink, project: Project, worker: Worker
+) -> None:
     runner.run(project.plans[1])
     worker.create_points()
     runner.pause()
@@ -290,9 +293,9 @@ def test_pause_resume_stop_are_forwarded(qtbot: Any, runner: PlanRunController, 
     assert moves(link) == [(5, None)]
 
 
-def test_error_at_segment_k_stops_and_resume_from_k_continues(qtbot: Any, runner: PlanRunController,
-                                                              link: FakeLink, project: Project,
-                                                              worker: Worker) -> None:
+def test_error_at_segment_k_stops_and_resume_from_k_continues(
+    qtbot: Any, runner: PlanRunController, link: FakeLink, project: Project, worker: Worker
+) -> None:
     runner.run(project.plans[1])  # circle: P5, arc P6->P7, arc P8->P5, P1
     worker.create_points()
     worker.finish_move()
@@ -312,8 +315,9 @@ def test_error_at_segment_k_stops_and_resume_from_k_continues(qtbot: Any, runner
     assert moves(link)[3:] == [(5, 8), (1, None)]
 
 
-def test_lost_link_and_refusal_end_the_run(qtbot: Any, runner: PlanRunController, link: FakeLink,
-                                           project: Project, worker: Worker) -> None:
+def test_lost_link_and_refusal_end_the_run(
+    qtbot: Any, runner: PlanRunController, link: FakeLink, project: Project, worker: Worker
+) -> None:
     runner.run(project.plans[1])
     worker.create_points()
     with qtbot.waitSignal(runner.runFinished) as finished:
@@ -326,13 +330,15 @@ def test_lost_link_and_refusal_end_the_run(qtbot: Any, runner: PlanRunController
     link.errorOccurred.emit(WorkerError("move to point", "another request's error", previous_move))
     assert runner.running  # not ours
     with qtbot.waitSignal(runner.runFinished) as finished:
-        link.errorOccurred.emit(WorkerError("move to point", "jog is still under way",
-                                          link.last_id("move_to_point")))
+        link.errorOccurred.emit(
+            WorkerError("move to point", "jog is still under way", link.last_id("move_to_point"))
+        )
     assert finished.args[0].resume_from == 0 and "jog is still under way" in finished.args[0].message
 
 
-def test_step_runs_one_segment(qtbot: Any, runner: PlanRunController, link: FakeLink,
-                               project: Project, worker: Worker) -> None:
+def test_step_runs_one_segment(
+    qtbot: Any, runner: PlanRunController, link: FakeLink, project: Project, worker: Worker
+) -> None:
     runner.step(project.plans[1], 2)
     worker.create_points()
     with qtbot.waitSignal(runner.runFinished) as finished:
@@ -374,8 +380,9 @@ def planner(qtbot: Any, project: Project, link: FakeLink) -> Iterator[PlannerPan
         questions.append(text)
         return answers.pop(0) if answers else False
 
-    panel = PlannerPanel(PlanListModel(project, stack), points, PlanRunController(link, points=points), sync,
-                         confirm=confirm)
+    panel = PlannerPanel(
+        PlanListModel(project, stack), points, PlanRunController(link, points=points), sync, confirm=confirm
+    )
     panel.answers = answers  # type: ignore[attr-defined]
     panel.questions = questions  # type: ignore[attr-defined]
     qtbot.addWidget(panel)
@@ -386,8 +393,9 @@ def planner(qtbot: Any, project: Project, link: FakeLink) -> Iterator[PlannerPan
         link.finish_move(False, code=0, message="stopped")
 
 
-def test_panel_summary_and_upload_now_then_run(qtbot: Any, planner: PlannerPanel, link: FakeLink,
-                                               project: Project, worker: Worker) -> None:
+def test_panel_summary_and_upload_now_then_run(
+    qtbot: Any, planner: PlannerPanel, link: FakeLink, project: Project, worker: Worker
+) -> None:
     planner.select_plan(1)
     assert planner.summary_text.startswith("5 point(s) need upload")
     assert planner.upload_button.isVisibleTo(planner)
@@ -439,8 +447,9 @@ def test_panel_refuses_a_plan_with_errors(planner: PlannerPanel, link: FakeLink,
     assert link.calls == []
 
 
-def test_panel_step_and_run_from_here(qtbot: Any, planner: PlannerPanel, link: FakeLink,
-                                      project: Project, worker: Worker) -> None:
+def test_panel_step_and_run_from_here(
+    qtbot: Any, planner: PlannerPanel, link: FakeLink, project: Project, worker: Worker
+) -> None:
     all_uploaded(project)
     planner.select_plan(1)
     planner.select_segments([2])
@@ -524,9 +533,9 @@ def test_many_segments_plan(planner: PlannerPanel, project: Project) -> None:
     assert planner.preview.path is not None and planner.preview.path.xyz.shape[0] >= 1000
 
 
-def test_bad_end_point_marks_points_unknown_and_offers_restore(qtbot: Any, planner: PlannerPanel,
-                                                              link: FakeLink, project: Project,
-                                                              worker: Worker) -> None:
+def test_bad_end_point_marks_points_unknown_and_offers_restore(
+    qtbot: Any, planner: PlannerPanel, link: FakeLink, project: Project, worker: Worker
+) -> None:
     all_uploaded(project)
     planner.select_plan(1)
     sync = planner.point_sync
@@ -541,8 +550,9 @@ def test_bad_end_point_marks_points_unknown_and_offers_restore(qtbot: Any, plann
     assert "Upload now?" in planner.summary_text
 
 
-def test_resume_after_an_edit_runs_the_edited_segments(qtbot: Any, planner: PlannerPanel, link: FakeLink,
-                                                       project: Project, worker: Worker) -> None:
+def test_resume_after_an_edit_runs_the_edited_segments(
+    qtbot: Any, planner: PlannerPanel, link: FakeLink, project: Project, worker: Worker
+) -> None:
     all_uploaded(project)
     planner.select_plan(1)
     planner.answers.append(True)  # type: ignore[attr-defined]

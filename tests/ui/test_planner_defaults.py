@@ -41,8 +41,13 @@ def link() -> FakeLink:
 def planner(qtbot: Any, project: Project, link: FakeLink) -> Iterator[PlannerPanel]:
     stack = QUndoStack()
     points = PointsModel(project, stack)
-    panel = PlannerPanel(PlanListModel(project, stack), points, PlanRunController(link, points=points),
-                         PointSyncController(points, link), confirm=lambda title, text: False)
+    panel = PlannerPanel(
+        PlanListModel(project, stack),
+        points,
+        PlanRunController(link, points=points),
+        PointSyncController(points, link),
+        confirm=lambda title, text: False,
+    )
     qtbot.addWidget(panel)
     panel.resize(1280, 700)
     yield panel
@@ -142,8 +147,12 @@ def test_no_segment_without_points(qtbot: Any, link: FakeLink) -> None:
     project = Project(ledger=PointLedger(), plans=[Plan("empty")])
     stack = QUndoStack()
     points = PointsModel(project, stack)
-    panel = PlannerPanel(PlanListModel(project, stack), points, PlanRunController(link, points=points),
-                         confirm=lambda title, text: False)
+    panel = PlannerPanel(
+        PlanListModel(project, stack),
+        points,
+        PlanRunController(link, points=points),
+        confirm=lambda title, text: False,
+    )
     qtbot.addWidget(panel)
     panel.action_add_line.trigger()
     assert len(project.plans[0]) == 0 and "no points yet" in panel.status.text()
@@ -175,8 +184,9 @@ def test_run_is_disabled_while_the_checks_fail_and_says_why(planner: PlannerPane
     assert planner.action_run.isEnabled() and "disabled" not in planner.action_run.toolTip()
 
 
-def test_a_new_plan_is_not_ready_and_its_preview_shows_the_points(planner: PlannerPanel,
-                                                                  project: Project) -> None:
+def test_a_new_plan_is_not_ready_and_its_preview_shows_the_points(
+    planner: PlannerPanel, project: Project
+) -> None:
     planner.action_add_plan.trigger()
     assert not planner.summary_text.startswith("Checks passed")
     assert not planner.action_run.isEnabled()

@@ -33,11 +33,13 @@ UPLOAD_TIMEOUT_MS = 20_000
 @pytest.fixture
 def project(qtbot: Any, tmp_path: Path) -> Any:
     source = Project()
-    source.ledger.replace_all([make_point(pid, f"p{pid}", (400.0 + pid, -50.0, 300.0, 180.0, 0.0, 0.0))
-                               for pid in range(1, 6)])
+    source.ledger.replace_all(
+        [make_point(pid, f"p{pid}", (400.0 + pid, -50.0, 300.0, 180.0, 0.0, 0.0)) for pid in range(1, 6)]
+    )
     path = tmp_path / "cell.teachpad.json"
-    ctl = ProjectController(source, path, dialogs=FakeDialogs(), autosave_interval=0,
-                            autosave_dir=tmp_path / "user")
+    ctl = ProjectController(
+        source, path, dialogs=FakeDialogs(), autosave_interval=0, autosave_dir=tmp_path / "user"
+    )
     assert ctl.save()
     yield ctl
     ctl.close()
@@ -50,8 +52,9 @@ def _upload(qtbot: Any, sync: PointSyncController, start: Any) -> UploadReport:
     return report
 
 
-def test_gui_uploads_record_the_history_in_the_project(qtbot: Any, sim: Any, link: RobotLink,
-                                                        project: ProjectController) -> None:
+def test_gui_uploads_record_the_history_in_the_project(
+    qtbot: Any, sim: Any, link: RobotLink, project: ProjectController
+) -> None:
     connect(qtbot, link, sim, poll_timeout=1.0)  # a loaded machine: see test_plan_run_guard.POLL_TIMEOUT
     sync = PointSyncController(project.points_model, link)
     data = project.points_model.project
@@ -93,8 +96,10 @@ def test_connected_is_the_link_states(qtbot: Any) -> None:
     runs = PlanRunController(link, points=points)
     sync = PointSyncController(points, link)
     assert not runs.connected and not sync.connected
-    with qtbot.waitSignal(runs.connectedChanged, check_params_cb=bool), \
-            qtbot.waitSignal(sync.connectedChanged, check_params_cb=bool):
+    with (
+        qtbot.waitSignal(runs.connectedChanged, check_params_cb=bool),
+        qtbot.waitSignal(sync.connectedChanged, check_params_cb=bool),
+    ):
         link.set_connected(True)
     assert runs.connected and sync.connected
     # whatever changes the link's state is seen at once: there is no copy to fall behind

@@ -21,8 +21,9 @@ COL_Y = COLUMNS.index("y")
 
 
 def on_controller(point: TempPoint) -> TempPoint:
-    return make_point(point.id, point.name, point.xyzabc, point.ext, point.tool, point.note,
-                      sync=SyncState.ON_CONTROLLER)
+    return make_point(
+        point.id, point.name, point.xyzabc, point.ext, point.tool, point.note, sync=SyncState.ON_CONTROLLER
+    )
 
 
 @pytest.fixture
@@ -81,8 +82,9 @@ def test_display_edit_and_decoration_roles(model: PointsModel) -> None:
         ("x", "", "empty"),
     ],
 )
-def test_bad_cell_input_is_refused_with_a_message(qtbot: Any, model: PointsModel, column: str, text: str,
-                                                  reason: str) -> None:
+def test_bad_cell_input_is_refused_with_a_message(
+    qtbot: Any, model: PointsModel, column: str, text: str, reason: str
+) -> None:
     before = model.ledger.snapshot()
     with qtbot.waitSignal(model.editRejected) as blocker:
         ok = model.setData(model.index(0, COLUMNS.index(column)), text)

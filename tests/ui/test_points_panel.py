@@ -60,8 +60,9 @@ def panel(qtbot: Any, model: PointsModel, link: FakeLink, answers: list[bool]) -
 # --- teach ----------------------------------------------------------------------------------
 
 
-def test_teach_creates_next_point_from_the_current_pose(qtbot: Any, panel: PointsPanel,
-                                                        link: FakeLink) -> None:
+def test_teach_creates_next_point_from_the_current_pose(
+    qtbot: Any, panel: PointsPanel, link: FakeLink
+) -> None:
     assert panel.action_teach.isEnabled()
     assert panel.action_teach.shortcut().toString() == "Ctrl+T"
     panel.action_teach.trigger()
@@ -84,8 +85,9 @@ def test_teach_creates_next_point_from_the_current_pose(qtbot: Any, panel: Point
     assert panel.model.ledger.point(9).sync is SyncState.ON_CONTROLLER
 
 
-def test_teach_without_pose_details_uses_the_latest_pose(qtbot: Any, panel: PointsPanel,
-                                                         link: FakeLink) -> None:
+def test_teach_without_pose_details_uses_the_latest_pose(
+    qtbot: Any, panel: PointsPanel, link: FakeLink
+) -> None:
     panel.teach()
     link.state.set_pose(Pose(1.0, 2.0, 3.0, 4.0, 5.0, 6.0))
     with qtbot.waitSignal(panel.controller.pointTaught):
@@ -102,13 +104,20 @@ def test_teach_refused_by_the_controller(qtbot: Any, panel: PointsPanel, link: F
     assert panel.action_teach.isEnabled()
 
 
-def test_teach_ignores_unrelated_results_and_ends_on_link_loss(qtbot: Any, panel: PointsPanel,
-                                                                link: FakeLink) -> None:
+def test_teach_ignores_unrelated_results_and_ends_on_link_loss(
+    qtbot: Any, panel: PointsPanel, link: FakeLink
+) -> None:
     panel.teach()
     link.commandFinished.emit(CommandResult(None, None, None, True, "pause: sent"))
     link.finish_move(True)
-    stale = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, None, True, "",
-                          request_id=link.last_id("create_point") - 1)  # an older create's result
+    stale = CommandResult(
+        RunCommand.CREATE_POINT,
+        CommandKind.CREATE_POINT,
+        None,
+        True,
+        "",
+        request_id=link.last_id("create_point") - 1,
+    )  # an older create's result
     link.commandFinished.emit(stale)
     assert panel.controller.busy
     link.set_connected(False, "connection refused")
@@ -128,8 +137,9 @@ def test_teach_needs_a_connection(panel: PointsPanel, link: FakeLink) -> None:
 # --- upload ----------------------------------------------------------------------------------
 
 
-def test_upload_selected_with_progress_and_a_refused_point(qtbot: Any, panel: PointsPanel,
-                                                           link: FakeLink) -> None:
+def test_upload_selected_with_progress_and_a_refused_point(
+    qtbot: Any, panel: PointsPanel, link: FakeLink
+) -> None:
     panel.select_rows([0, 2, 4])
     panel.action_upload_selected.trigger()
     (call,) = link.named("upload_points")
@@ -198,8 +208,15 @@ def test_upload_sends_each_points_tool_in_one_request(qtbot: Any, panel: PointsP
 
 def test_results_of_other_requests_are_ignored(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
     panel.controller.upload([1])
-    other = CommandResult(RunCommand.CREATE_POINT, None, None, True, "uploaded 1 of 1 points",
-                          {"uploaded": 1.0}, request_id=link.last_id("upload_points") - 1)
+    other = CommandResult(
+        RunCommand.CREATE_POINT,
+        None,
+        None,
+        True,
+        "uploaded 1 of 1 points",
+        {"uploaded": 1.0},
+        request_id=link.last_id("upload_points") - 1,
+    )
     link.commandFinished.emit(other)
     link.errorOccurred.emit(WorkerError("upload points", "someone else's", request_id=None))
     assert panel.controller.busy
@@ -208,14 +225,16 @@ def test_results_of_other_requests_are_ignored(qtbot: Any, panel: PointsPanel, l
 def test_upload_refused_by_the_worker(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
     panel.controller.upload([1])
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
-        link.errorOccurred.emit(WorkerError("upload points", "move to point is still under way",
-                                          link.last_id("upload_points")))
+        link.errorOccurred.emit(
+            WorkerError("upload points", "move to point is still under way", link.last_id("upload_points"))
+        )
     assert finished.args[0].aborted == "move to point is still under way"
     assert panel.model.ledger.point(1).sync is SyncState.UNKNOWN
 
 
-def test_link_loss_during_an_upload_keeps_the_late_reports(qtbot: Any, panel: PointsPanel,
-                                                          link: FakeLink) -> None:
+def test_link_loss_during_an_upload_keeps_the_late_reports(
+    qtbot: Any, panel: PointsPanel, link: FakeLink
+) -> None:
     panel.controller.upload([1, 2, 3])
     link.point_ok(1)
     link.set_connected(False, "link lost: timeout")
@@ -225,13 +244,17 @@ def test_link_loss_during_an_upload_keeps_the_late_reports(qtbot: Any, panel: Po
         link.upload_summary(2, 3, "link lost: timeout")
     assert finished.args[0].not_attempted == [3] and "link lost" in (finished.args[0].aborted or "")
     ledger = panel.model.ledger
-    assert [ledger.point(i).sync for i in (1, 2, 3)] == [SyncState.ON_CONTROLLER, SyncState.ON_CONTROLLER,
-                                                         SyncState.UNKNOWN]
+    assert [ledger.point(i).sync for i in (1, 2, 3)] == [
+        SyncState.ON_CONTROLLER,
+        SyncState.ON_CONTROLLER,
+        SyncState.UNKNOWN,
+    ]
 
 
 @pytest.mark.parametrize("signal", ["controllerReconnected", "controllerRestarted"])
-def test_reconnect_marks_unknown_and_offers_restore(qtbot: Any, panel: PointsPanel, link: FakeLink,
-                                                    signal: str) -> None:
+def test_reconnect_marks_unknown_and_offers_restore(
+    qtbot: Any, panel: PointsPanel, link: FakeLink, signal: str
+) -> None:
     model = panel.model
     model.apply_upload(_report_ok(model, [1, 2]))
     assert not panel.banner.isVisibleTo(panel)
@@ -257,8 +280,9 @@ def _report_ok(model: PointsModel, ids: list[int]) -> Any:
 # --- move to point ---------------------------------------------------------------------------
 
 
-def test_move_to_point_asks_first(qtbot: Any, panel: PointsPanel, link: FakeLink,
-                                  answers: list[bool]) -> None:
+def test_move_to_point_asks_first(
+    qtbot: Any, panel: PointsPanel, link: FakeLink, answers: list[bool]
+) -> None:
     model = panel.model
     model.apply_upload(_report_ok(model, [2]))
     panel.select_rows([1])
@@ -276,8 +300,9 @@ def test_move_to_point_asks_first(qtbot: Any, panel: PointsPanel, link: FakeLink
     assert done.args[0] is False and "bad end point id" in done.args[1]  # GV291 13, in words
 
 
-def test_move_to_a_point_not_on_the_controller_is_refused(panel: PointsPanel, link: FakeLink,
-                                                          answers: list[bool]) -> None:
+def test_move_to_a_point_not_on_the_controller_is_refused(
+    panel: PointsPanel, link: FakeLink, answers: list[bool]
+) -> None:
     panel.select_rows([0])
     answers.append(True)
     panel.move_to_selected()
@@ -359,8 +384,9 @@ def test_add_takes_the_current_pose_while_the_link_is_fresh(panel: PointsPanel, 
     assert panel.model.ledger.point(10).xyzabc == point.xyzabc and "no live pose" in panel.status.text()
 
 
-def test_add_without_a_live_pose_copies_a_point_and_says_so(qtbot: Any, panel: PointsPanel,
-                                                           link: FakeLink) -> None:
+def test_add_without_a_live_pose_copies_a_point_and_says_so(
+    qtbot: Any, panel: PointsPanel, link: FakeLink
+) -> None:
     import time
 
     link.state.set_freshness_limit(0.05)

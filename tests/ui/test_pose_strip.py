@@ -35,8 +35,9 @@ from ui.widgets_common import LEVEL_OFF
 POSE = Pose(512.25, -3.5, 400.0, 180.0, 0.0, -90.0)
 
 
-def status(mode: int = ControllerMode.AUTO, program: int = ProgramState.STOPPED,
-           alarms: int = 0) -> ControllerStatus:
+def status(
+    mode: int = ControllerMode.AUTO, program: int = ProgramState.STOPPED, alarms: int = 0
+) -> ControllerStatus:
     return ControllerStatus(mode, program, Alarm(alarms), 0xFF)
 
 
@@ -74,8 +75,9 @@ def test_the_strip_shows_pose_mode_and_program_live(strip: PoseStrip, link: Fake
     assert strip.values["X"].property("stale") is False
 
 
-def test_the_strip_goes_stale_after_silence_and_live_again(qtbot: Any, strip: PoseStrip,
-                                                           link: FakeLink) -> None:
+def test_the_strip_goes_stale_after_silence_and_live_again(
+    qtbot: Any, strip: PoseStrip, link: FakeLink
+) -> None:
     link.state.set_freshness_limit(0.05)
     poll(link)
     assert strip.is_live()
@@ -98,8 +100,14 @@ def test_the_strip_names_the_link_state(strip: PoseStrip, link: FakeLink) -> Non
 
 def _geometry(strip: PoseStrip, bar: ControlBar) -> list[Any]:
     QApplication.processEvents()  # let any relayout a text change asked for happen first
-    parts = [strip.mode_chip, strip.program_chip, strip.freshness, *strip.values.values(), bar.stop_button,
-             bar.mode_label]
+    parts = [
+        strip.mode_chip,
+        strip.program_chip,
+        strip.freshness,
+        *strip.values.values(),
+        bar.stop_button,
+        bar.mode_label,
+    ]
     return [(w.x(), w.width(), w.height()) for w in parts]
 
 
@@ -189,16 +197,18 @@ def test_the_time_axis_advances_while_the_pose_is_constant(qtbot: Any, link: Fak
     poll(link)  # one pose, then the arm stands still: no more poseChanged
     x_max = panel.xyz_plot.getPlotItem().getViewBox().viewRange()[0][1]
     samples = panel.sample_count
-    qtbot.waitUntil(lambda: panel.xyz_plot.getPlotItem().getViewBox().viewRange()[0][1] > x_max + 0.3,
-                    timeout=3000)
+    qtbot.waitUntil(
+        lambda: panel.xyz_plot.getPlotItem().getViewBox().viewRange()[0][1] > x_max + 0.3, timeout=3000
+    )
     assert panel.sample_count > samples  # the last value held at the display rate
     # stale: nothing is appended any more (a gap, not a flat line that looks live) ...
     link.set_connected(False)
     held = panel.sample_count
     x_now = panel.xyz_plot.getPlotItem().getViewBox().viewRange()[0][1]
     # ... but the axis keeps time
-    qtbot.waitUntil(lambda: panel.xyz_plot.getPlotItem().getViewBox().viewRange()[0][1] > x_now + 0.2,
-                    timeout=3000)
+    qtbot.waitUntil(
+        lambda: panel.xyz_plot.getPlotItem().getViewBox().viewRange()[0][1] > x_now + 0.2, timeout=3000
+    )
     assert panel.sample_count == held
     panel.hide()
     assert not panel.paint_timer_active  # hidden: idle
@@ -268,8 +278,9 @@ def test_an_estop_holds_motion_but_not_stop(qtbot: Any, link: FakeLink) -> None:
     host = QWidget()
     qtbot.addWidget(host)
     bar, jog, step, program = ControlBar(host), JogPanel(host), StepPanel(host), ProgramPanel(host)
-    motion = MotionController(link, bar, jog, step, program,
-                              PlanRunController(link, points=PointsModel(Project(), QUndoStack())))
+    motion = MotionController(
+        link, bar, jog, step, program, PlanRunController(link, points=PointsModel(Project(), QUndoStack()))
+    )
     holds: list[bool] = []
     motion.alarmHoldChanged.connect(holds.append)
     assert jog.axes_box.isEnabled()
@@ -293,8 +304,9 @@ def jog_request() -> Any:
     return JogRequest(TeachFrame.BASE, 0, 1, 20.0)
 
 
-def test_the_strip_redraws_at_the_paint_rate_and_ends_on_the_latest_pose(qtbot: Any, strip: PoseStrip,
-                                                                         link: FakeLink) -> None:
+def test_the_strip_redraws_at_the_paint_rate_and_ends_on_the_latest_pose(
+    qtbot: Any, strip: PoseStrip, link: FakeLink
+) -> None:
     poll(link, Pose(1.0, 0, 0, 0, 0, 0))
     assert strip.value_text("X") == "1.00"  # the first pose at once
     for i in range(2, 50):  # a burst at the poll rate: coalesced

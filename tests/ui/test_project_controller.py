@@ -73,10 +73,16 @@ def dialogs() -> FakeDialogs:
 
 
 @pytest.fixture
-def controller(qtbot: Any, project_file: Path, dialogs: FakeDialogs,
-               tmp_path: Path) -> Iterator[ProjectController]:
-    ctl = ProjectController(load_project(project_file), project_file, dialogs=dialogs, autosave_interval=0.05,
-                            autosave_dir=tmp_path / "user")
+def controller(
+    qtbot: Any, project_file: Path, dialogs: FakeDialogs, tmp_path: Path
+) -> Iterator[ProjectController]:
+    ctl = ProjectController(
+        load_project(project_file),
+        project_file,
+        dialogs=dialogs,
+        autosave_interval=0.05,
+        autosave_dir=tmp_path / "user",
+    )
     yield ctl
     ctl.close()
 
@@ -116,10 +122,12 @@ def test_autosave_written_when_dirty_only(qtbot: Any, controller: ProjectControl
     assert not controller.autosave_timer.isActive()
 
 
-def test_recovery_offered_when_the_autosave_is_newer(qtbot: Any, project_file: Path, dialogs: FakeDialogs,
-                                                     tmp_path: Path) -> None:
-    crashed = ProjectController(load_project(project_file), project_file, dialogs=dialogs,
-                                autosave_interval=0)
+def test_recovery_offered_when_the_autosave_is_newer(
+    qtbot: Any, project_file: Path, dialogs: FakeDialogs, tmp_path: Path
+) -> None:
+    crashed = ProjectController(
+        load_project(project_file), project_file, dialogs=dialogs, autosave_interval=0
+    )
     edit_something(crashed)
     auto = crashed.autosave_now()
     assert auto is not None
@@ -154,8 +162,9 @@ def test_recovery_declined_removes_the_autosave(qtbot: Any, project_file: Path, 
     assert fresh.check_recovery() is None
 
 
-def test_untitled_project_autosaves_in_the_user_directory(qtbot: Any, dialogs: FakeDialogs,
-                                                          tmp_path: Path) -> None:
+def test_untitled_project_autosaves_in_the_user_directory(
+    qtbot: Any, dialogs: FakeDialogs, tmp_path: Path
+) -> None:
     ctl = ProjectController(dialogs=dialogs, autosave_interval=0, autosave_dir=tmp_path / "user")
     ctl.points_model.add_point()
     auto = ctl.autosave_now()
@@ -165,8 +174,9 @@ def test_untitled_project_autosaves_in_the_user_directory(qtbot: Any, dialogs: F
     assert fresh.offer_recovery() and len(fresh.project.ledger) == 1
 
 
-def test_malformed_csv_leaves_the_table_as_it_was(qtbot: Any, controller: ProjectController,
-                                                  dialogs: FakeDialogs, tmp_path: Path) -> None:
+def test_malformed_csv_leaves_the_table_as_it_was(
+    qtbot: Any, controller: ProjectController, dialogs: FakeDialogs, tmp_path: Path
+) -> None:
     bad = tmp_path / "bad.csv"
     bad.write_text("id,name,x,y,z,a,b,c\n1,a,1,2,3,4,5,6\n2,b,1,abc,3,4,5,6\n", encoding="utf-8")
     before = controller.project.ledger.snapshot()
@@ -179,8 +189,9 @@ def test_malformed_csv_leaves_the_table_as_it_was(qtbot: Any, controller: Projec
     assert controller.undo_stack.count() == 0 and not controller.is_dirty
 
 
-def test_import_and_export_csv(qtbot: Any, controller: ProjectController, dialogs: FakeDialogs,
-                               tmp_path: Path) -> None:
+def test_import_and_export_csv(
+    qtbot: Any, controller: ProjectController, dialogs: FakeDialogs, tmp_path: Path
+) -> None:
     out = tmp_path / "out.csv"
     dialogs.paths.append(str(out))
     assert controller.export_csv()
@@ -193,8 +204,9 @@ def test_import_and_export_csv(qtbot: Any, controller: ProjectController, dialog
     assert controller.project.ledger.ids() == [3, 4, 5, 6, 7, 8]
 
 
-def test_malformed_project_is_refused(qtbot: Any, controller: ProjectController, dialogs: FakeDialogs,
-                                      tmp_path: Path) -> None:
+def test_malformed_project_is_refused(
+    qtbot: Any, controller: ProjectController, dialogs: FakeDialogs, tmp_path: Path
+) -> None:
     bad = tmp_path / "bad.teachpad.json"
     text = (SAMPLES / "demo.teachpad.json").read_text(encoding="utf-8").replace('"x": 450.0', '"x": "abc"', 1)
     bad.write_text(text, encoding="utf-8")
@@ -204,8 +216,9 @@ def test_malformed_project_is_refused(qtbot: Any, controller: ProjectController,
     assert controller.project is project
 
 
-def test_open_asks_to_save_changes(qtbot: Any, controller: ProjectController, dialogs: FakeDialogs,
-                                   tmp_path: Path) -> None:
+def test_open_asks_to_save_changes(
+    qtbot: Any, controller: ProjectController, dialogs: FakeDialogs, tmp_path: Path
+) -> None:
     other = tmp_path / "other.teachpad.json"
     shutil.copy(SAMPLES / "demo.teachpad.json", other)
     edit_something(controller)
@@ -219,14 +232,19 @@ def test_open_asks_to_save_changes(qtbot: Any, controller: ProjectController, di
     assert controller.points_model.rowCount() == 8 and controller.plans_model.rowCount() == 2
 
 
-def test_save_as_and_actions(qtbot: Any, controller: ProjectController, dialogs: FakeDialogs,
-                             tmp_path: Path) -> None:
+def test_save_as_and_actions(
+    qtbot: Any, controller: ProjectController, dialogs: FakeDialogs, tmp_path: Path
+) -> None:
     target = tmp_path / "copy"
     dialogs.paths.append(str(target))
     controller.action_save_as.trigger()
     assert controller.path == tmp_path / "copy.teachpad.json" and controller.path.exists()
     assert [a.text() if a else None for a in controller.file_actions()][:4] == [
-        "&New project", "&Open project…", "&Save project", "Save project &as…"]
+        "&New project",
+        "&Open project…",
+        "&Save project",
+        "Save project &as…",
+    ]
     edit_something(controller)
     assert controller.action_undo.isEnabled()
     controller.action_undo.trigger()
@@ -239,10 +257,17 @@ def test_save_as_and_actions(qtbot: Any, controller: ProjectController, dialogs:
 @pytest.fixture
 def other_teachpad(project_file: Path) -> Iterator[subprocess.Popen[str]]:
     """Another TeachPad process with ``project_file`` open (it holds the project's lock)."""
-    code = ("import sys; from app.points.lock import ProjectLock; lock = ProjectLock.acquire(sys.argv[1]); "
-            "print('locked', flush=True); sys.stdin.read(); lock.release()")
-    child = subprocess.Popen([sys.executable, "-c", code, str(project_file)], stdin=subprocess.PIPE,
-                             stdout=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    code = (
+        "import sys; from app.points.lock import ProjectLock; lock = ProjectLock.acquire(sys.argv[1]); "
+        "print('locked', flush=True); sys.stdin.read(); lock.release()"
+    )
+    child = subprocess.Popen(
+        [sys.executable, "-c", code, str(project_file)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     assert child.stdout is not None and child.stdout.readline().strip() == "locked"
     try:
         yield child
@@ -256,7 +281,8 @@ def other_teachpad(project_file: Path) -> Iterator[subprocess.Popen[str]]:
 
 
 def test_a_second_teachpad_says_the_project_is_open_instead_of_offering_its_autosave(
-        qtbot: Any, project_file: Path, dialogs: FakeDialogs, other_teachpad: subprocess.Popen[str]) -> None:
+    qtbot: Any, project_file: Path, dialogs: FakeDialogs, other_teachpad: subprocess.Popen[str]
+) -> None:
     # the other TeachPad has unsaved edits in its (live) autosave, newer than the project
     live = save_autosave(load_project(project_file), project_file)
     stamp = project_file.stat().st_mtime_ns
@@ -287,8 +313,9 @@ def test_a_second_teachpad_says_the_project_is_open_instead_of_offering_its_auto
     assert not lock_path(project_file).exists()
 
 
-def test_the_lock_follows_the_open_project(qtbot: Any, controller: ProjectController, project_file: Path,
-                                           tmp_path: Path) -> None:
+def test_the_lock_follows_the_open_project(
+    qtbot: Any, controller: ProjectController, project_file: Path, tmp_path: Path
+) -> None:
     assert lock_path(project_file).exists()
     other = tmp_path / "other.teachpad.json"
     assert controller.save_as(other)
@@ -301,8 +328,9 @@ def test_loaded_points_are_unknown(qtbot: Any, controller: ProjectController) ->
     assert all(p.sync is SyncState.UNKNOWN for p in controller.project.ledger)
 
 
-def test_an_empty_csv_replaces_the_points_only_when_confirmed(qtbot: Any, controller: ProjectController,
-                                                              dialogs: FakeDialogs, tmp_path: Path) -> None:
+def test_an_empty_csv_replaces_the_points_only_when_confirmed(
+    qtbot: Any, controller: ProjectController, dialogs: FakeDialogs, tmp_path: Path
+) -> None:
     empty = tmp_path / "empty.csv"
     empty.write_text("id,x,y,z,a,b,c\n", encoding="utf-8")
     count = len(controller.project.ledger)

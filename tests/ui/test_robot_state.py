@@ -25,8 +25,17 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     link_fixture,
 )
 
-SIGNALS = ("connectionChanged", "freshnessChanged", "poseChanged", "jointsChanged", "statusChanged",
-           "alarmsChanged", "lastResultChanged", "rttChanged", "statsChanged")
+SIGNALS = (
+    "connectionChanged",
+    "freshnessChanged",
+    "poseChanged",
+    "jointsChanged",
+    "statusChanged",
+    "alarmsChanged",
+    "lastResultChanged",
+    "rttChanged",
+    "statsChanged",
+)
 CONNECTED = ConnectionState(LinkState.CONNECTED, "", "10.0.0.5:502")
 
 
@@ -122,8 +131,9 @@ def test_polls_keep_it_fresh_with_one_timer(qtbot: Any, state: RobotState) -> No
     assert changes == [True] and state.fresh
 
 
-@pytest.mark.parametrize("link_state", [LinkState.NOT_ANSWERING, LinkState.DOWN, LinkState.DISCONNECTED,
-                                        LinkState.CONNECTING])
+@pytest.mark.parametrize(
+    "link_state", [LinkState.NOT_ANSWERING, LinkState.DOWN, LinkState.DISCONNECTED, LinkState.CONNECTING]
+)
 def test_anything_but_connected_is_stale_at_once(state: RobotState, link_state: LinkState) -> None:
     state.set_freshness_limit(60.0)
     state.set_connection(CONNECTED)
@@ -243,19 +253,22 @@ def test_the_state_follows_the_link(qtbot: Any, sim: Any, qapp: Any, fast_reconn
     link = RobotLink(canary_gv=None, freshness_limit=0.15)
     try:
         state = link.state
-        with qtbot.waitSignal(state.freshnessChanged, check_params_cb=lambda fresh: fresh,
-                              timeout=SIGNAL_TIMEOUT_MS):
+        with qtbot.waitSignal(
+            state.freshnessChanged, check_params_cb=lambda fresh: fresh, timeout=SIGNAL_TIMEOUT_MS
+        ):
             connect(qtbot, link, sim)
         assert state.connection is link.connection and state.connected
         assert state.pose is not None and state.status is not None and state.age() is not None
         qtbot.waitUntil(lambda: state.stats.answers > 0, timeout=SIGNAL_TIMEOUT_MS)
-        with qtbot.waitSignal(state.freshnessChanged, check_params_cb=lambda fresh: not fresh,
-                              timeout=SIGNAL_TIMEOUT_MS):
+        with qtbot.waitSignal(
+            state.freshnessChanged, check_params_cb=lambda fresh: not fresh, timeout=SIGNAL_TIMEOUT_MS
+        ):
             sim.set_silent(True)
         qtbot.waitUntil(lambda: not state.connected, timeout=SIGNAL_TIMEOUT_MS)
         assert not state.fresh
-        with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED),
-                              timeout=SIGNAL_TIMEOUT_MS):
+        with qtbot.waitSignal(
+            link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED), timeout=SIGNAL_TIMEOUT_MS
+        ):
             sim.set_silent(False)
         qtbot.waitUntil(lambda: state.fresh, timeout=SIGNAL_TIMEOUT_MS)
     finally:

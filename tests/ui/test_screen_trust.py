@@ -63,8 +63,9 @@ def _key(kind: QEvent.Type, key: Qt.Key) -> QKeyEvent:
     return QKeyEvent(kind, key, Qt.KeyboardModifier.NoModifier)
 
 
-def test_an_emergency_stop_shows_the_banner_and_holds_motion(qtbot: Any, sim: Any,
-                                                           window: MainWindow) -> None:
+def test_an_emergency_stop_shows_the_banner_and_holds_motion(
+    qtbot: Any, sim: Any, window: MainWindow
+) -> None:
     _live(qtbot, window, sim)
     banner, jog = window.alarm_banner, window.jog_panel
     assert not banner.isVisible() and jog.axes_box.isEnabled()

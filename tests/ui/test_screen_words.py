@@ -29,8 +29,9 @@ def _cell(panel: EventLogPanel, row: int, column: int) -> str:
     return str(panel.model.data(panel.model.index(row, column), Qt.ItemDataRole.DisplayRole))
 
 
-def test_a_silent_controller_is_explained_in_chinese(qtbot: Any, sim: Any, link: Any,
-                                                     translator: Any) -> None:
+def test_a_silent_controller_is_explained_in_chinese(
+    qtbot: Any, sim: Any, link: Any, translator: Any
+) -> None:
     assert translator.set_language("zh_CN")
     status, log = StatusPanel(), EventLogPanel()
     for panel in (status, log):
@@ -39,8 +40,9 @@ def test_a_silent_controller_is_explained_in_chinese(qtbot: Any, sim: Any, link:
     connect(qtbot, link, sim)
     sim.set_silent(True)
     try:
-        qtbot.waitUntil(lambda: link.state.connection.state is LinkState.NOT_ANSWERING,
-                        timeout=SIGNAL_TIMEOUT_MS)
+        qtbot.waitUntil(
+            lambda: link.state.connection.state is LinkState.NOT_ANSWERING, timeout=SIGNAL_TIMEOUT_MS
+        )
         connection: ConnectionState = link.state.connection
         assert connection.reason is not None and connection.reason.code == "no_answer"
         assert "did not answer" in connection.message  # the English stays for logs and the CLI
@@ -53,8 +55,9 @@ def test_a_silent_controller_is_explained_in_chinese(qtbot: Any, sim: Any, link:
     qtbot.waitUntil(lambda: link.state.connection.connected, timeout=SIGNAL_TIMEOUT_MS)
 
 
-def test_the_event_log_speaks_the_new_language_after_a_switch(qtbot: Any, sim: Any, link: Any,
-                                                              translator: Any) -> None:
+def test_the_event_log_speaks_the_new_language_after_a_switch(
+    qtbot: Any, sim: Any, link: Any, translator: Any
+) -> None:
     log = EventLogPanel()
     qtbot.addWidget(log)
     log.bind(link.state)
@@ -66,6 +69,7 @@ def test_the_event_log_speaks_the_new_language_after_a_switch(qtbot: Any, sim: A
     english = [_cell(log, row, COL_MESSAGE) for row in range(log.model.rowCount())]
     assert any("connected" in text for text in english) and "Alarm raised: emergency stop" in english
     assert translator.set_language("zh_CN")
+
     def messages() -> list[str]:
         return [_cell(log, r, COL_MESSAGE) for r in range(log.model.rowCount())]
 

@@ -53,14 +53,23 @@ def test_the_simulator_process_answers_and_stops_cleanly(make_client: Any) -> No
 @pytest.mark.skipif(sys.platform == "win32", reason="reads /proc")
 def test_the_simulator_stops_when_the_gui_process_dies() -> None:
     parent = subprocess.run(
-        [sys.executable, "-c", textwrap.dedent("""
+        [
+            sys.executable,
+            "-c",
+            textwrap.dedent("""
             import os
             from ui.main import SimProcess
             sim = SimProcess.start()
             print(sim.process.pid, flush=True)
             os._exit(3)  # a crash: no stop(), no cleanup
-        """)],
-        cwd=ROOT, capture_output=True, text=True, timeout=30, check=False)
+        """),
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=30,
+        check=False,
+    )
     assert parent.returncode == 3, parent.stderr
     child = int(parent.stdout.split()[0])
     assert _gone(child, 10.0)

@@ -115,14 +115,30 @@ def test_command_ok_is_green_and_decoded_by_kind(panel: StatusPanel) -> None:
 @pytest.mark.parametrize(
     ("command", "kind", "code", "text"),
     [
-        (RunCommand.STEP_JOINT, CommandKind.MOVE, 1,
-         "incremental move (joint) refused by the controller: work mode error."),
-        (RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, 1,
-         "create temp point refused by the controller: bad point id."),
-        (RunCommand.TEACH_DISABLE, CommandKind.TEACH, 7,
-         "teach disable refused by the controller: teach speed ratio not zero: enable/disable refused."),
-        (RunCommand.MOVE_TO_POINT, CommandKind.MOVE, 99,
-         "move to temp point refused by the controller: unknown status 99."),
+        (
+            RunCommand.STEP_JOINT,
+            CommandKind.MOVE,
+            1,
+            "incremental move (joint) refused by the controller: work mode error.",
+        ),
+        (
+            RunCommand.CREATE_POINT,
+            CommandKind.CREATE_POINT,
+            1,
+            "create temp point refused by the controller: bad point id.",
+        ),
+        (
+            RunCommand.TEACH_DISABLE,
+            CommandKind.TEACH,
+            7,
+            "teach disable refused by the controller: teach speed ratio not zero: enable/disable refused.",
+        ),
+        (
+            RunCommand.MOVE_TO_POINT,
+            CommandKind.MOVE,
+            99,
+            "move to temp point refused by the controller: unknown status 99.",
+        ),
     ],
 )
 def test_command_error_is_red_and_decoded_by_kind(
@@ -143,10 +159,16 @@ def test_command_without_status_uses_ok_and_message(panel: StatusPanel) -> None:
 def test_an_operators_stop_is_not_shown_as_a_failure(panel: StatusPanel) -> None:
     from app.errors import Reason
 
-    panel.on_command_result(CommandResult(
-        RunCommand.MOVE_TO_POINT, CommandKind.MOVE, CommandStatus(CommandKind.MOVE, 0), False,
-        "move to temp point stopped by the operator",
-        reason=Reason("stopped_by_operator", {"command": int(RunCommand.MOVE_TO_POINT)})))
+    panel.on_command_result(
+        CommandResult(
+            RunCommand.MOVE_TO_POINT,
+            CommandKind.MOVE,
+            CommandStatus(CommandKind.MOVE, 0),
+            False,
+            "move to temp point stopped by the operator",
+            reason=Reason("stopped_by_operator", {"command": int(RunCommand.MOVE_TO_POINT)}),
+        )
+    )
     assert "stopped by the operator" in panel.command_label.text()
     assert COLOR_ERROR not in panel.command_label.styleSheet()
 

@@ -46,8 +46,7 @@ def test_every_source_string_has_a_chinese_translation(tmp_path: Path) -> None:
     sources = sorted(str(p) for p in (ROOT / "app").rglob("*.py")) + sorted(
         str(p) for p in (ROOT / "ui").rglob("*.py")
     )
-    subprocess.run([_tool("pyside6-lupdate"), *sources, "-ts", str(fresh)], check=True,
-                   capture_output=True)
+    subprocess.run([_tool("pyside6-lupdate"), *sources, "-ts", str(fresh)], check=True, capture_output=True)
     wanted = set(_messages(fresh))
     shipped = _messages(TS)
     missing = sorted(key for key in wanted if not shipped.get(key))

@@ -29,11 +29,17 @@ pytestmark = pytest.mark.timeout(120)
 
 def _panel(qtbot: Any, link: RobotLink, count: int, tools: tuple[int, ...] = (200,)) -> PointsPanel:
     project = Project()
-    project.ledger.replace_all([
-        make_point(pid, f"p{pid}", (400.0 + pid * 0.01, -50.0, 300.0, 180.0, 0.0, 0.0),
-                   tool=tools[pid % len(tools)])
-        for pid in range(1, count + 1)
-    ])
+    project.ledger.replace_all(
+        [
+            make_point(
+                pid,
+                f"p{pid}",
+                (400.0 + pid * 0.01, -50.0, 300.0, 180.0, 0.0, 0.0),
+                tool=tools[pid % len(tools)],
+            )
+            for pid in range(1, count + 1)
+        ]
+    )
     model = PointsModel(project, QUndoStack())
     panel = PointsPanel(model, PointSyncController(model, link), confirm=lambda _title, _text: True)
     qtbot.addWidget(panel)
@@ -44,8 +50,9 @@ def _on_controller(panel: PointsPanel) -> list[int]:
     return [p.id for p in panel.model.ledger if p.sync is SyncState.ON_CONTROLLER]
 
 
-def test_cancel_half_way_leaves_the_ledger_exactly_as_the_controller(qtbot: Any, sim: Any,
-                                                                     link: RobotLink) -> None:
+def test_cancel_half_way_leaves_the_ledger_exactly_as_the_controller(
+    qtbot: Any, sim: Any, link: RobotLink
+) -> None:
     connect(qtbot, link, sim)
     panel = _panel(qtbot, link, 300, tools=(200, 2))
     controller = panel.controller
@@ -101,8 +108,9 @@ def test_link_loss_half_way_keeps_every_reported_point(qtbot: Any, sim: Any, lin
     sim.set_silent(False)
 
 
-def test_a_restart_seen_by_the_canary_offers_restore_all(qtbot: Any, sim: Any,
-                                                         canary_link: RobotLink) -> None:
+def test_a_restart_seen_by_the_canary_offers_restore_all(
+    qtbot: Any, sim: Any, canary_link: RobotLink
+) -> None:
     link = canary_link
     connect(qtbot, link, sim)
     panel = _panel(qtbot, link, 40, tools=(200, 1, 3))
@@ -126,4 +134,5 @@ def test_a_restart_seen_by_the_canary_offers_restore_all(qtbot: Any, sim: Any,
     assert len(_on_controller(panel)) == 40 and not panel.banner.isVisibleTo(panel)
     with sim.lock:
         assert {pid: p.tool for pid, p in sim.robot.points.items()} == {
-            p.id: p.tool for p in panel.model.ledger}
+            p.id: p.tool for p in panel.model.ledger
+        }

@@ -132,8 +132,9 @@ def test_unreachable_point_is_red_and_reported(qtbot: Any, window: MainWindow) -
 
 
 @pytest.mark.parametrize("plan_row", [0, 1])
-def test_dry_run_moves_the_arm_and_writes_nothing(qtbot: Any, sim: Any, link: Any, window: MainWindow,
-                                                  plan_row: int) -> None:
+def test_dry_run_moves_the_arm_and_writes_nothing(
+    qtbot: Any, sim: Any, link: Any, window: MainWindow, plan_row: int
+) -> None:
     assert window.project.open_file(DEMO)
     connect(qtbot, link, sim)
     panel = _panel(window, qtbot)
@@ -150,8 +151,9 @@ def test_dry_run_moves_the_arm_and_writes_nothing(qtbot: Any, sim: Any, link: An
         positions.append(panel.canvas.drawn["ghost_flange"][0].copy())
         state = bar.run.at(bar.time)
         assert state.pose is not None
-        assert np.allclose(panel.canvas.drawn["ghost_flange"], panel.canvas.project(np.array(state.pose[:3])),
-                           atol=0.5)
+        assert np.allclose(
+            panel.canvas.drawn["ghost_flange"], panel.canvas.project(np.array(state.pose[:3])), atol=0.5
+        )
     assert len({tuple(np.round(p, 1)) for p in positions}) >= 3
     assert panel.canvas.active_segment is not None
     bar.slider.setValue(0)
@@ -173,8 +175,6 @@ def test_beside_the_planner_and_back(qtbot: Any, window: MainWindow) -> None:
     assert window.work_tabs.currentWidget() is window.planner_panel
     panel.beside_button.setChecked(False)
     assert window.work_tabs.indexOf(panel) >= 0
-
-
 
 
 def test_another_robot_model_and_a_bad_profile_file(qtbot: Any, window: MainWindow, tmp_path: Path) -> None:
@@ -219,6 +219,7 @@ def test_drag_level_of_detail_keeps_selection_and_red_points(qtbot: Any) -> None
     canvas.set_selected({2, n})
     canvas.fit_all()
     full = canvas.project(xyz)
+
     def draw() -> None:
         image = QImage(600, 400, QImage.Format.Format_ARGB32_Premultiplied)
         painter = QPainter(image)

@@ -46,8 +46,9 @@ def _reach_issues(window: MainWindow) -> list[Any]:
     return [i for i in window.planner_panel.issues if i.code in reach]
 
 
-def test_unreachable_point_blocks_run_in_the_planner(qtbot: Any, sim: Any, link: Any,
-                                                     window: MainWindow) -> None:
+def test_unreachable_point_blocks_run_in_the_planner(
+    qtbot: Any, sim: Any, link: Any, window: MainWindow
+) -> None:
     assert window.project.open_file(DEMO)
     connect(qtbot, link, sim)
     planner = window.planner_panel
@@ -104,8 +105,9 @@ def test_loaded_profile_is_remembered_across_restarts(qtbot: Any, tmp_path: Path
 
 
 @pytest.mark.parametrize("damage", ["gone", "malformed"])
-def test_remembered_profile_gone_or_malformed_falls_back_to_the_default(qtbot: Any, tmp_path: Path,
-                                                                        damage: str) -> None:
+def test_remembered_profile_gone_or_malformed_falls_back_to_the_default(
+    qtbot: Any, tmp_path: Path, damage: str
+) -> None:
     settings = AppSettings.from_file(tmp_path / "teachpad.ini")
     path = _profile_file(tmp_path)
     assert RobotModelSource(settings).load_file(str(path)) is None
@@ -125,12 +127,13 @@ def test_remembered_profile_gone_or_malformed_falls_back_to_the_default(qtbot: A
     assert settings.robot_profile_path == ""  # forgotten: the next start is quiet
 
 
-def test_window_starts_with_the_remembered_profile_or_says_why_not(qtbot: Any, link: Any, app_settings: Any,
-                                                                   translator: Any, project_dialogs: Any,
-                                                                   tmp_path: Path) -> None:
+def test_window_starts_with_the_remembered_profile_or_says_why_not(
+    qtbot: Any, link: Any, app_settings: Any, translator: Any, project_dialogs: Any, tmp_path: Path
+) -> None:
     app_settings.robot_profile_path = str(tmp_path / "missing.json")
-    window = MainWindow(link, app_settings, translator, project_dialogs=project_dialogs,
-                        autosave_dir=tmp_path / "autosave")
+    window = MainWindow(
+        link, app_settings, translator, project_dialogs=project_dialogs, autosave_dir=tmp_path / "autosave"
+    )
     qtbot.addWidget(window)
     robot = window.view3d.robot
     assert robot.profile == default_profile()

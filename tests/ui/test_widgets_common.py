@@ -18,8 +18,9 @@ def parent(qtbot: Any) -> QWidget:
     return widget
 
 
-def test_export_writes_the_chosen_path(parent: QWidget, tmp_path: Path,
-                                       monkeypatch: pytest.MonkeyPatch) -> None:
+def test_export_writes_the_chosen_path(
+    parent: QWidget, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     target = tmp_path / "out.txt"
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a: (str(target), ""))
     export_with_dialog(parent, "Export", "x.txt", "*", lambda path: Path(path).write_text("ok"))
@@ -33,8 +34,9 @@ def test_a_cancelled_dialog_exports_nothing(parent: QWidget, monkeypatch: pytest
     assert calls == []
 
 
-def test_a_failed_write_is_shown_not_raised(parent: QWidget, tmp_path: Path,
-                                            monkeypatch: pytest.MonkeyPatch) -> None:
+def test_a_failed_write_is_shown_not_raised(
+    parent: QWidget, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     shown: list[tuple[str, str]] = []
     monkeypatch.setattr(QFileDialog, "getSaveFileName", lambda *a: (str(tmp_path / "no" / "x.txt"), ""))
     monkeypatch.setattr(QMessageBox, "warning", lambda _p, title, text: shown.append((title, text)))

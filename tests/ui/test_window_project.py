@@ -37,15 +37,49 @@ def _project_near(sim: Any, path: Path, speed: float = 400.0) -> Path:
     """A project with three points a few cm from the simulator's pose and a plan through them."""
     x, y, z, a, b, c = sim.state().pose
     offsets = [(30.0, 0.0, 0.0), (30.0, 30.0, 0.0), (0.0, 30.0, -20.0)]
-    points = [{"id": i, "name": f"p{i}", "x": x + dx, "y": y + dy, "z": z + dz, "a": a, "b": b, "c": c,
-               "e1": 0.0, "e2": 0.0, "e3": 0.0, "e4": 0.0, "e5": 0.0, "tool": 200, "note": "",
-               "sync": "unknown", "sync_error": ""}
-              for i, (dx, dy, dz) in enumerate(offsets, start=1)]
-    segments = [{"type": "line", "end": i, "speed": speed, "orientation": "changes", "ignore_middle": False,
-                 "tool": 200} for i in (1, 2, 3)]
-    data = {"format": "teachpad-project", "version": 1, "name": "near", "description": "",
-            "created": "2025-01-01T00:00:00Z", "modified": "2025-01-01T00:00:00Z",
-            "points": points, "plans": [{"name": "short", "loops": 1, "segments": segments}]}
+    points = [
+        {
+            "id": i,
+            "name": f"p{i}",
+            "x": x + dx,
+            "y": y + dy,
+            "z": z + dz,
+            "a": a,
+            "b": b,
+            "c": c,
+            "e1": 0.0,
+            "e2": 0.0,
+            "e3": 0.0,
+            "e4": 0.0,
+            "e5": 0.0,
+            "tool": 200,
+            "note": "",
+            "sync": "unknown",
+            "sync_error": "",
+        }
+        for i, (dx, dy, dz) in enumerate(offsets, start=1)
+    ]
+    segments = [
+        {
+            "type": "line",
+            "end": i,
+            "speed": speed,
+            "orientation": "changes",
+            "ignore_middle": False,
+            "tool": 200,
+        }
+        for i in (1, 2, 3)
+    ]
+    data = {
+        "format": "teachpad-project",
+        "version": 1,
+        "name": "near",
+        "description": "",
+        "created": "2025-01-01T00:00:00Z",
+        "modified": "2025-01-01T00:00:00Z",
+        "points": points,
+        "plans": [{"name": "short", "loops": 1, "segments": segments}],
+    }
     path.write_text(json.dumps(data), encoding="utf-8")
     return path
 
@@ -60,12 +94,24 @@ def test_window_fits_1280x800(window: MainWindow) -> None:
     assert window.control_bar.stop_button.isVisible()
 
 
-def test_tabs_and_menus_in_both_languages(qtbot: Any, link: Any, app_settings: AppSettings, translator: Any,
-                                          project_dialogs: FakeProjectDialogs, tmp_path: Path) -> None:
+def test_tabs_and_menus_in_both_languages(
+    qtbot: Any,
+    link: Any,
+    app_settings: AppSettings,
+    translator: Any,
+    project_dialogs: FakeProjectDialogs,
+    tmp_path: Path,
+) -> None:
     for language in ("en", "zh_CN"):
         assert translator.set_language(language)
-        window = MainWindow(link, app_settings, translator, project_dialogs=project_dialogs,
-                            autosave_dir=tmp_path, shutdown_link_on_close=False)
+        window = MainWindow(
+            link,
+            app_settings,
+            translator,
+            project_dialogs=project_dialogs,
+            autosave_dir=tmp_path,
+            shutdown_link_on_close=False,
+        )
         qtbot.addWidget(window)
         assert window.work_tabs.count() == 4  # Monitor, Points, Planner, 3D (the view3d branch)
         assert window.work_tabs.widget(TAB_POINTS) is window.points_panel
@@ -78,9 +124,13 @@ def test_tabs_and_menus_in_both_languages(qtbot: Any, link: Any, app_settings: A
         window.close()
 
 
-def test_start_project_opens_remembers_and_offers_recovery(qtbot: Any, window: MainWindow,
-                                                           project_dialogs: FakeProjectDialogs,
-                                                           app_settings: AppSettings, tmp_path: Path) -> None:
+def test_start_project_opens_remembers_and_offers_recovery(
+    qtbot: Any,
+    window: MainWindow,
+    project_dialogs: FakeProjectDialogs,
+    app_settings: AppSettings,
+    tmp_path: Path,
+) -> None:
     path = tmp_path / "demo.teachpad.json"
     path.write_bytes(SAMPLE.read_bytes())
     assert window.start_project(path)
@@ -93,16 +143,22 @@ def test_start_project_opens_remembers_and_offers_recovery(qtbot: Any, window: M
     assert window.project.is_dirty and window.project.autosave_now() is not None
     # the next start (a crash left the autosave): the last project, then the autosave
     project_dialogs.recover = True
-    second = MainWindow(window.link, app_settings, project_dialogs=project_dialogs,
-                        autosave_dir=tmp_path / "autosave", shutdown_link_on_close=False)
+    second = MainWindow(
+        window.link,
+        app_settings,
+        project_dialogs=project_dialogs,
+        autosave_dir=tmp_path / "autosave",
+        shutdown_link_on_close=False,
+    )
     qtbot.addWidget(second)
     assert second.start_project(None)
     assert project_dialogs.asked == ["recover"] and second.project.is_dirty
     assert second.project.points_model.ledger.point(1).name == "renamed"
 
 
-def test_close_asks_to_save_and_cancel_keeps_the_window(qtbot: Any, window: MainWindow,
-                                                        project_dialogs: FakeProjectDialogs) -> None:
+def test_close_asks_to_save_and_cancel_keeps_the_window(
+    qtbot: Any, window: MainWindow, project_dialogs: FakeProjectDialogs
+) -> None:
     window.project.open_file(SAMPLE)
     window.points_panel.add_point()
     assert window.project.is_dirty
@@ -139,8 +195,9 @@ def test_teach_a_point_from_the_window(qtbot: Any, sim: Any, window: MainWindow)
     assert panel.selected_rows() == [window.project.points_model.row_of(point_id)]
 
 
-def test_plan_runs_from_the_planner_tab_to_the_last_point(qtbot: Any, sim: Any, window: MainWindow,
-                                                         tmp_path: Path) -> None:
+def test_plan_runs_from_the_planner_tab_to_the_last_point(
+    qtbot: Any, sim: Any, window: MainWindow, tmp_path: Path
+) -> None:
     window.project.open_file(_project_near(sim, tmp_path / "near.teachpad.json"))
     connect(qtbot, window.link, sim)
     window.show_tab("planner")

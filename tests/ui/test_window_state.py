@@ -54,13 +54,16 @@ def _expected(window: MainWindow) -> dict[str, object]:
 
 def _copies(obj: object) -> list[str]:
     """Attributes of ``obj`` that hold a connection state (a copy kept in step by hand)."""
-    return [name for name, value in vars(obj).items()
-            if isinstance(value, ConnectionState | LinkState)
-            or ("connected" in name and isinstance(value, bool))]
+    return [
+        name
+        for name, value in vars(obj).items()
+        if isinstance(value, ConnectionState | LinkState) or ("connected" in name and isinstance(value, bool))
+    ]
 
 
-def test_connection_dependent_enabling_follows_the_robot_state(qtbot: Any, sim_factory: Any,
-                                                               window: MainWindow) -> None:
+def test_connection_dependent_enabling_follows_the_robot_state(
+    qtbot: Any, sim_factory: Any, window: MainWindow
+) -> None:
     state = window.link.state
     seen: list[LinkState] = []
     mismatches: list[tuple[LinkState, dict[str, object], dict[str, object]]] = []
@@ -91,8 +94,11 @@ def test_connection_dependent_enabling_follows_the_robot_state(qtbot: Any, sim_f
     qtbot.waitUntil(lambda: state.connected, timeout=SIGNAL_TIMEOUT_MS)
     assert _shown(window)["pause"] and not _shown(window)["banner"]
 
-    with qtbot.waitSignal(state.connectionChanged, timeout=SIGNAL_TIMEOUT_MS,
-                          check_params_cb=lambda c: c.state is LinkState.DISCONNECTED):
+    with qtbot.waitSignal(
+        state.connectionChanged,
+        timeout=SIGNAL_TIMEOUT_MS,
+        check_params_cb=lambda c: c.state is LinkState.DISCONNECTED,
+    ):
         window.menus.disconnect_action.trigger()
     assert not _shown(window)["disconnect"]
 

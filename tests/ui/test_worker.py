@@ -46,8 +46,9 @@ def test_connect_poll_disconnect(qtbot: Any, sim: Any, link: RobotLink) -> None:
         connect(qtbot, link, sim, timeout=2.0)  # roomy: the first attempt must succeed on a loaded box
     assert states[:2] == [LinkState.CONNECTING, LinkState.CONNECTED]
     assert link.connection.endpoint == f"127.0.0.1:{sim.port}"
-    with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED), timeout=SIGNAL_TIMEOUT_MS
+    ):
         link.disconnect()
     qtbot.waitUntil(lambda: sim.connections_count == 0, timeout=SIGNAL_TIMEOUT_MS)
     assert sim.writes == []  # connecting, polling and disconnecting never write
@@ -60,8 +61,9 @@ def test_signals_only_on_change(qtbot: Any, sim: Any, link: RobotLink) -> None:
     with qtbot.assertNotEmitted(link.poseChanged, wait=300):
         pass
     refs_before = sys.getrefcount(True)
-    with qtbot.waitSignal(link.alarmsChanged, check_params_cb=lambda a: a == int(Alarm.SERVO),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.alarmsChanged, check_params_cb=lambda a: a == int(Alarm.SERVO), timeout=SIGNAL_TIMEOUT_MS
+    ):
         sim.set_alarm(Alarm.SERVO, True)
     assert abs(sys.getrefcount(True) - refs_before) < 50  # the PySide6 6.12 bool refcount bug
 
@@ -73,12 +75,14 @@ def test_live_pose_while_the_simulator_moves(qtbot: Any, sim: Any, link: RobotLi
     link.poseChanged.connect(poses.append)
     connect(qtbot, link, sim)
     start = sim.state().joints[0]
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: r.ok),
-                          timeout=SIGNAL_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(
+        link.commandFinished, check_params_cb=_result(lambda r: r.ok), timeout=SIGNAL_TIMEOUT_MS
+    ) as blocker:
         link.step(StepFrame.JOINT, [6.0, 0, 0, 0, 0, 0], speed=1.0)  # 6 deg/s: about 1 s
         # Live poses while it moves: many polls fit in a second, even on a loaded machine.
-        qtbot.waitUntil(lambda: any(start + 0.1 < j < start + 5.9 for j in _j1(poses)),
-                        timeout=SIGNAL_TIMEOUT_MS)
+        qtbot.waitUntil(
+            lambda: any(start + 0.1 < j < start + 5.9 for j in _j1(poses)), timeout=SIGNAL_TIMEOUT_MS
+        )
     joints_at_result = _j1(poses)  # what the GUI had when the result arrived
     result = blocker.args[0]
     assert "done" in result.message
@@ -90,8 +94,9 @@ def _j1(poses: list[Pose]) -> list[float]:
     return [p.joints[0] for p in poses if p.joints]
 
 
-def test_jog_sequence_as_seen_by_the_simulator(qtbot: Any, sim: Any, link: RobotLink,
-                                               monkeypatch: pytest.MonkeyPatch) -> None:
+def test_jog_sequence_as_seen_by_the_simulator(
+    qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
     connect(qtbot, link, sim)
     link.jog_press(TeachFrame.BASE, 0, 1, 40.0)
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
@@ -122,8 +127,9 @@ def test_jog_sequence_as_seen_by_the_simulator(qtbot: Any, sim: Any, link: Robot
 
     # Another frame: disable (0x81) then enable again.
     link.jog_press(TeachFrame.JOINT, 0, 1, 50.0)
-    qtbot.waitUntil(lambda: jogging(sim) and sim.state().teach_frame == int(TeachFrame.JOINT),
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: jogging(sim) and sim.state().teach_frame == int(TeachFrame.JOINT), timeout=SIGNAL_TIMEOUT_MS
+    )
     commands = [v for _, v in register_writes(sim, 440)]
     assert commands[-2:] == [0x81, 0x80]
     link.jog_release()
@@ -174,12 +180,13 @@ def test_stop_goes_out_before_queued_commands_and_polls(qtbot: Any, sim: Any, li
     # nothing that was queued
     assert [w.address for w in writes] in ([441], [441, 441])
     # On the wire: the first request sent after the one in flight is the stop.
-    qtbot.waitUntil(lambda: any(f.frame[7] == 0x06 for f in frames if f.direction == "tx"),
-                    timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: any(f.frame[7] == 0x06 for f in frames if f.direction == "tx"), timeout=SIGNAL_TIMEOUT_MS
+    )
     tx = [f for f in frames if f.direction == "tx"]
     stop_index = next(i for i, f in enumerate(tx) if f.frame[7] == 0x06)
     assert int.from_bytes(tx[stop_index].frame[8:10], "big") == 441
-    in_flight_and_after = tx[stop_index - 1:]
+    in_flight_and_after = tx[stop_index - 1 :]
     assert all(f.frame[7] == 0x03 for f in in_flight_and_after[:1])
 
 
@@ -191,8 +198,11 @@ def test_pause_resume_reach_the_simulator(qtbot: Any, sim: Any, link: RobotLink)
     qtbot.waitUntil(lambda: sim.state().paused, timeout=SIGNAL_TIMEOUT_MS)
     link.resume()
     qtbot.waitUntil(lambda: sim.state().program_state == ProgramState.RUNNING, timeout=SIGNAL_TIMEOUT_MS)
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: "stopped" in r.message),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.commandFinished,
+        check_params_cb=_result(lambda r: "stopped" in r.message),
+        timeout=SIGNAL_TIMEOUT_MS,
+    ):
         link.stop()
     qtbot.waitUntil(lambda: sim.state().program_state == ProgramState.STOPPED, timeout=SIGNAL_TIMEOUT_MS)
 
@@ -215,15 +225,17 @@ def test_monitor_only_never_writes(qtbot: Any, sim: Any, link: RobotLink) -> Non
     assert sim.writes == []
 
 
-def test_link_loss_then_reconnect_stops_the_jog_first(qtbot: Any, sim: Any, link: RobotLink,
-                                                      monkeypatch: pytest.MonkeyPatch) -> None:
+def test_link_loss_then_reconnect_stops_the_jog_first(
+    qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.3)
     sim.set_watchdog(None)  # a controller without a communication watchdog
     connect(qtbot, link, sim, poll_timeout=0.5)
     link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
-    with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.DOWN),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.connectionChanged, check_params_cb=is_state(LinkState.DOWN), timeout=SIGNAL_TIMEOUT_MS
+    ):
         sim.set_silent(True)
     assert jogging(sim)  # like a real controller, the simulator keeps going without its master
     writes_before = len(sim.writes)
@@ -243,12 +255,14 @@ def test_dropped_connections_recover(qtbot: Any, sim: Any, link: RobotLink) -> N
     connect(qtbot, link, sim)
     states: list[LinkState] = []
     link.connectionChanged.connect(lambda s: states.append(s.state))
-    with qtbot.waitSignal(link.errorOccurred, check_params_cb=lambda e: e.operation == "poll",
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.errorOccurred, check_params_cb=lambda e: e.operation == "poll", timeout=SIGNAL_TIMEOUT_MS
+    ):
         assert sim.drop_connections() == 1
     qtbot.waitUntil(lambda: sim.connections_count == 1, timeout=SIGNAL_TIMEOUT_MS)
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: r.ok),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.commandFinished, check_params_cb=_result(lambda r: r.ok), timeout=SIGNAL_TIMEOUT_MS
+    ):
         link.step(StepFrame.JOINT, [0, 0, 0, 2.0, 0, 0], speed=10.0)
     assert states == []
 
@@ -256,20 +270,23 @@ def test_dropped_connections_recover(qtbot: Any, sim: Any, link: RobotLink) -> N
 def test_refusals_and_exceptions_are_results(qtbot: Any, sim: Any, link: RobotLink) -> None:
     connect(qtbot, link, sim)
     sim.set_alarm(Alarm.ESTOP, True)
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: not r.ok),
-                          timeout=SIGNAL_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(
+        link.commandFinished, check_params_cb=_result(lambda r: not r.ok), timeout=SIGNAL_TIMEOUT_MS
+    ) as blocker:
         link.jog_press(TeachFrame.BASE, 0, 1, 10.0)
     assert "emergency stop" in blocker.args[0].message
     sim.set_alarm(Alarm.ESTOP, False)
     sim.set_exception(ExcCodes.ILLEGAL_ADDRESS, range(445, 446))
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: not r.ok),
-                          timeout=SIGNAL_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(
+        link.commandFinished, check_params_cb=_result(lambda r: not r.ok), timeout=SIGNAL_TIMEOUT_MS
+    ) as blocker:
         link.go_zero(3)
     assert "illegal data address" in blocker.args[0].message
     sim.set_exception(None)
     # a poll that read 412..511 (it covers 445) while the exception was on may report late: skip it
-    with qtbot.waitSignal(link.errorOccurred, check_params_cb=lambda e: e.operation != "poll",
-                          timeout=SIGNAL_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(
+        link.errorOccurred, check_params_cb=lambda e: e.operation != "poll", timeout=SIGNAL_TIMEOUT_MS
+    ) as blocker:
         link.step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0])
     error = blocker.args[0]
     assert error.operation == "step" and "zero" in error.message and "Traceback" not in error.message
@@ -278,17 +295,20 @@ def test_refusals_and_exceptions_are_results(qtbot: Any, sim: Any, link: RobotLi
 def test_commands_while_disconnected_are_errors(qtbot: Any, link: RobotLink) -> None:
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as blocker:
         request_id = link.stop()
-    assert blocker.args[0] == WorkerError("stop", "not connected to a controller", request_id,
-                                          Reason("not_connected"))
+    assert blocker.args[0] == WorkerError(
+        "stop", "not connected to a controller", request_id, Reason("not_connected")
+    )
 
 
-def test_unreachable_controller_goes_down_and_shuts_down_cleanly(qtbot: Any, sim_factory: Any,
-                                                                 link: RobotLink) -> None:
+def test_unreachable_controller_goes_down_and_shuts_down_cleanly(
+    qtbot: Any, sim_factory: Any, link: RobotLink
+) -> None:
     sim = sim_factory()
     port = sim.port
     sim.stop()
-    with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.DOWN),
-                          timeout=SIGNAL_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(
+        link.connectionChanged, check_params_cb=is_state(LinkState.DOWN), timeout=SIGNAL_TIMEOUT_MS
+    ) as blocker:
         link.connect_to(connection_settings(sim, port=port))
     assert str(port) in blocker.args[0].message
     link.shutdown()  # while retrying: returns promptly, no thread left running
@@ -298,22 +318,27 @@ def test_unreachable_controller_goes_down_and_shuts_down_cleanly(qtbot: Any, sim
 def test_points_create_upload_and_move(qtbot: Any, sim: Any, link: RobotLink) -> None:
     connect(qtbot, link, sim)
     pose = sim.state().pose
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: r.ok),
-                          timeout=SIGNAL_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(
+        link.commandFinished, check_params_cb=_result(lambda r: r.ok), timeout=SIGNAL_TIMEOUT_MS
+    ) as blocker:
         link.create_point(7)
     details = blocker.args[0].details
     assert details["x"] == pytest.approx(pose[0], abs=1e-3) and 7 in sim.state().points
     target = (pose[0], pose[1] + 40.0, pose[2], pose[3], pose[4], pose[5])
     progress: list[tuple[int, int]] = []
     link.uploadProgress.connect(lambda done, total: progress.append((done, total)))
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: "uploaded" in r.message),
-                          timeout=SIGNAL_TIMEOUT_MS) as blocker:
+    with qtbot.waitSignal(
+        link.commandFinished,
+        check_params_cb=_result(lambda r: "uploaded" in r.message),
+        timeout=SIGNAL_TIMEOUT_MS,
+    ) as blocker:
         link.upload_points([(8, target), (9, pose)])
     assert blocker.args[0].ok and blocker.args[0].message == "uploaded 2 of 2 points"
     assert progress[0] == (0, 2) and progress[-1] == (2, 2)
     assert sim.state().points[8] == pytest.approx(target)
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: r.ok),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.commandFinished, check_params_cb=_result(lambda r: r.ok), timeout=SIGNAL_TIMEOUT_MS
+    ):
         link.move_to_point(8, speed=400.0)
     assert sim.state().pose[1] == pytest.approx(target[1], abs=1e-3)
 
@@ -389,8 +414,9 @@ def test_upload_reports_each_point_and_cancel_sends_no_stop(qtbot: Any, sim: Any
     link.pointUploaded.connect(on_point)
     items = _poses(sim, range(1, 301))
     upload_id = link.upload_points(items)
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_batch_result(upload_id),
-                          timeout=30_000) as done:
+    with qtbot.waitSignal(
+        link.commandFinished, check_params_cb=_batch_result(upload_id), timeout=30_000
+    ) as done:
         pass
     batch = done.args[0]
     assert "cancelled" in batch.message and not batch.ok
@@ -405,8 +431,9 @@ def test_upload_reports_each_point_and_cancel_sends_no_stop(qtbot: Any, sim: Any
     assert cancel_ids and cancel_ids[0] > upload_id
 
 
-def test_stop_during_a_large_upload_is_serviced_promptly(qtbot: Any, sim: Any, link: RobotLink,
-                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+def test_stop_during_a_large_upload_is_serviced_promptly(
+    qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "CLOCK_POLL_PERIOD", 0.05)
     connect(qtbot, link, sim)
     link.set_traffic_capture(True)  # one trafficObserved batch per poll: proof that polls go on
@@ -423,8 +450,9 @@ def test_stop_during_a_large_upload_is_serviced_promptly(qtbot: Any, sim: Any, l
     qtbot.waitUntil(lambda: len(polls) >= 10 and bool(statuses), timeout=SIGNAL_TIMEOUT_MS)
     assert len(sim.state().points) < total
     writes_before = len(sim.writes)
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_batch_result(upload_id),
-                          timeout=SIGNAL_TIMEOUT_MS) as done:
+    with qtbot.waitSignal(
+        link.commandFinished, check_params_cb=_batch_result(upload_id), timeout=SIGNAL_TIMEOUT_MS
+    ) as done:
         t0 = time.monotonic()
         link.stop()
         assert sim.wait_for(lambda _s: any(w.address == 441 for w in sim.writes[writes_before:]), 1.0)
@@ -454,8 +482,11 @@ def test_upload_tool_per_point_writes_gv245_once_per_tool(qtbot: Any, sim: Any, 
     items = [(pid, (x, y + pid, z, a, b, c), tool) for pid, tool in tools.items()]
     order: list[int] = []
     link.pointUploaded.connect(lambda pid, ok, _reason: order.append(pid) if ok else None)
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=_result(lambda r: "uploaded" in r.message),
-                          timeout=SIGNAL_TIMEOUT_MS) as done:
+    with qtbot.waitSignal(
+        link.commandFinished,
+        check_params_cb=_result(lambda r: "uploaded" in r.message),
+        timeout=SIGNAL_TIMEOUT_MS,
+    ) as done:
         link.upload_points(items)
     assert done.args[0].ok
     assert order == [1, 3, 6, 2, 4, 5]  # grouped by tool, first appearance first
@@ -479,8 +510,9 @@ def test_upload_checks_every_point_before_writing(qtbot: Any, sim: Any, link: Ro
 # --- the restart canary -------------------------------------------------------------------------
 
 
-def test_restart_canary_detects_a_restart_under_a_live_link(qtbot: Any, sim: Any,
-                                                            canary_link: RobotLink) -> None:
+def test_restart_canary_detects_a_restart_under_a_live_link(
+    qtbot: Any, sim: Any, canary_link: RobotLink
+) -> None:
     link = canary_link
     reconnected: list[bool] = []
     link.controllerReconnected.connect(lambda: reconnected.append(True))
@@ -500,8 +532,9 @@ def test_restart_canary_detects_a_restart_under_a_live_link(qtbot: Any, sim: Any
     assert reconnected == [] and link.connection.state is LinkState.CONNECTED
 
 
-def test_restart_canary_is_never_written_in_monitor_only(qtbot: Any, sim: Any,
-                                                         canary_link: RobotLink) -> None:
+def test_restart_canary_is_never_written_in_monitor_only(
+    qtbot: Any, sim: Any, canary_link: RobotLink
+) -> None:
     connect(qtbot, canary_link, sim, monitor_only=True)
     with qtbot.assertNotEmitted(canary_link.controllerRestarted, wait=400):
         sim.restart_controller()

@@ -53,16 +53,24 @@ class Rig(QObject):
         self.worker = RobotWorker(timing.POLL_HZ_DEFAULT, canary_gv=None)
         self.worker.moveToThread(self.worker_thread)
         self.worker_thread.started.connect(self.worker.start)
-        for name in ("poseChanged", "statusChanged", "pollSucceeded", "linkStatsChanged",
-                     "commandFinished", "connectionChanged", "stopped"):
+        for name in (
+            "poseChanged",
+            "statusChanged",
+            "pollSucceeded",
+            "linkStatsChanged",
+            "commandFinished",
+            "connectionChanged",
+            "stopped",
+        ):
             getattr(self.worker, name).connect(getattr(self, name))
         self.connectTo.connect(self.worker.connect_to)
         self.shutdown.connect(self.worker.shutdown)
         self.worker_thread.start()
 
     def connect_sim(self, qtbot: Any, sim: Any, **overrides: Any) -> None:
-        with qtbot.waitSignal(self.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED),
-                              timeout=SIGNAL_TIMEOUT_MS):
+        with qtbot.waitSignal(
+            self.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED), timeout=SIGNAL_TIMEOUT_MS
+        ):
             self.connectTo.emit(connection_settings(sim, **overrides))
 
 
@@ -112,34 +120,39 @@ def test_link_stats_are_reported(qtbot: Any, sim: Any, rig: Rig, monkeypatch: py
 
 
 @pytest.mark.parametrize("poll_hz", [20.0, 50.0])
-def test_a_silent_controller_is_not_answering_after_one_poll(qtbot: Any, sim: Any, link: RobotLink,
-                                                             poll_hz: float) -> None:
+def test_a_silent_controller_is_not_answering_after_one_poll(
+    qtbot: Any, sim: Any, link: RobotLink, poll_hz: float
+) -> None:
     link.set_poll_rate(poll_hz)
     connect(qtbot, link, sim)  # the product's poll timeout (0.15 s on TCP)
     states: list[ConnectionState] = []
     link.connectionChanged.connect(states.append)
-    with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.NOT_ANSWERING),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.connectionChanged, check_params_cb=is_state(LinkState.NOT_ANSWERING), timeout=SIGNAL_TIMEOUT_MS
+    ):
         silent_at = time.monotonic()
         sim.set_silent(True)
     elapsed = time.monotonic() - silent_at  # measured at the signal's arrival in the GUI thread
     print(f"not answering after {elapsed * 1000:.0f} ms at {poll_hz:g} Hz")
     assert states[-1].state is LinkState.NOT_ANSWERING  # not torn down on the first miss
     assert "did not answer" in states[-1].message
-    with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED), timeout=SIGNAL_TIMEOUT_MS
+    ):
         sim.set_silent(False)
     assert LinkState.DOWN not in [s.state for s in states]
 
 
-def test_not_answering_for_long_goes_down_and_reconnects(qtbot: Any, sim: Any, link: RobotLink,
-                                                         monkeypatch: pytest.MonkeyPatch) -> None:
+def test_not_answering_for_long_goes_down_and_reconnects(
+    qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.2)
     connect(qtbot, link, sim, poll_timeout=0.3)
     states: list[LinkState] = []
     link.connectionChanged.connect(lambda s: states.append(s.state))
-    with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.DOWN),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.connectionChanged, check_params_cb=is_state(LinkState.DOWN), timeout=SIGNAL_TIMEOUT_MS
+    ):
         sim.set_silent(True)
     with qtbot.waitSignal(link.controllerReconnected, timeout=SIGNAL_TIMEOUT_MS):
         sim.set_silent(False)
@@ -147,29 +160,33 @@ def test_not_answering_for_long_goes_down_and_reconnects(qtbot: Any, sim: Any, l
     assert states[-1] is LinkState.CONNECTED
 
 
-def test_jog_during_silence_gets_ratio_zero_first_when_it_answers(qtbot: Any, sim: Any,
-                                                                  link: RobotLink) -> None:
+def test_jog_during_silence_gets_ratio_zero_first_when_it_answers(
+    qtbot: Any, sim: Any, link: RobotLink
+) -> None:
     # a controller without a communication watchdog: the resync after the silent poll closes the
     # jog's connection, which would otherwise stop the jog at the simulator by itself
     sim.set_watchdog(None)
     connect(qtbot, link, sim, poll_timeout=0.3)
     link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
-    with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.NOT_ANSWERING),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.connectionChanged, check_params_cb=is_state(LinkState.NOT_ANSWERING), timeout=SIGNAL_TIMEOUT_MS
+    ):
         sim.set_silent(True)
     assert jogging(sim)  # the controller cannot hear us yet
     writes_before = len(sim.writes)
-    with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED),
-                          timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(
+        link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED), timeout=SIGNAL_TIMEOUT_MS
+    ):
         sim.set_silent(False)
     first = sim.writes[writes_before]
     assert first.address == 406 and first.values == (0, 0)  # GV203 = 0: the first write back
     assert not sim.state().jogging and ratio_writes(sim)[-1] == 0.0
 
 
-def test_shutdown_with_a_silent_controller_does_not_block_the_gui(qtbot: Any, sim: Any, link: RobotLink,
-                                                                  monkeypatch: pytest.MonkeyPatch) -> None:
+def test_shutdown_with_a_silent_controller_does_not_block_the_gui(
+    qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
     monkeypatch.setattr(timing, "SHUTDOWN_WAIT", 0.3)
     connect(qtbot, link, sim, timeout=2.0, poll_timeout=1.0)  # the safety writes wait 2 s for an answer
     link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
@@ -196,15 +213,17 @@ def test_shutdown_writes_ratio_zero_and_ends_the_thread(qtbot: Any, sim: Any, li
 
 
 def test_a_silent_controller_is_reported_with_a_reason_the_ui_can_translate(
-        qtbot: Any, sim: Any, link: RobotLink) -> None:
+    qtbot: Any, sim: Any, link: RobotLink
+) -> None:
     """The poll's error carries its cause as a code (no_answer) beside the English text, so the
     Chinese UI never shows "controller did not answer within ..."."""
     from app.link.types import WorkerError
     from ui.messages import error_text
 
     connect(qtbot, link, sim, poll_timeout=0.3)
-    with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS,
-                          check_params_cb=lambda e: e.operation == "poll") as blocker:
+    with qtbot.waitSignal(
+        link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS, check_params_cb=lambda e: e.operation == "poll"
+    ) as blocker:
         sim.set_silent(True)
     error: WorkerError = blocker.args[0]
     assert error.reason is not None and error.reason.code == "no_answer"

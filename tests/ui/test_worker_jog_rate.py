@@ -21,8 +21,9 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 pytestmark = pytest.mark.timeout(60)
 
 
-def test_a_slow_poll_setting_does_not_let_the_watchdog_stop_a_jog(qtbot: Any, sim: Any,
-                                                                   link: RobotLink) -> None:
+def test_a_slow_poll_setting_does_not_let_the_watchdog_stop_a_jog(
+    qtbot: Any, sim: Any, link: RobotLink
+) -> None:
     assert JOG_POLL_HZ_MIN >= 10.0
     link.set_poll_rate(1.0)  # one poll a second: far below the watchdog's 0.3 s
     connect(qtbot, link, sim)

@@ -24,16 +24,20 @@ POSES = {5: (400.0, 10.0, 300.0, 180.0, 0.0, 0.0), 6: (410.0, 10.0, 300.0, 180.0
 
 
 @pytest.mark.parametrize(("gv291", "unconfirmed"), [("read-only", True), ("writable", False)])
-def test_upload_carries_unconfirmed(qtbot: Any, sim_factory: Any, link: RobotLink, gv291: str,
-                                    unconfirmed: bool) -> None:
+def test_upload_carries_unconfirmed(
+    qtbot: Any, sim_factory: Any, link: RobotLink, gv291: str, unconfirmed: bool
+) -> None:
     # "fast": the controller finishes within one scan, GV291 shows 0xFF before and after. With a
     # read-only GV291 nothing tells this point's create from the last one: done, unconfirmed.
     sim = sim_factory(timing="fast", gv291=gv291)
     connect(qtbot, link, sim, unconfirmed_after=0.05)
     seen: list[tuple[int, bool, str, bool]] = []
     link.pointUploaded.connect(lambda *args: seen.append(args))
-    with qtbot.waitSignal(link.commandFinished, check_params_cb=lambda r: isinstance(r, CommandResult)
-                          and r.message.startswith("uploaded"), timeout=SIGNAL_TIMEOUT_MS) as done:
+    with qtbot.waitSignal(
+        link.commandFinished,
+        check_params_cb=lambda r: isinstance(r, CommandResult) and r.message.startswith("uploaded"),
+        timeout=SIGNAL_TIMEOUT_MS,
+    ) as done:
         link.upload_points([(pid, pose, 0) for pid, pose in POSES.items()])
     assert done.args[0].ok
     assert [(pid, ok) for pid, ok, _, _ in seen] == [(5, True), (6, True)]
@@ -42,11 +46,13 @@ def test_upload_carries_unconfirmed(qtbot: Any, sim_factory: Any, link: RobotLin
     assert sim.state().points[5] == pytest.approx(POSES[5])
 
     ledger = PointLedger([make_point(pid, pose=pose) for pid, pose in POSES.items()])
-    report = UploadReport([UploadOutcome(pid, ok, sent=ledger.point(pid), unconfirmed=unc)
-                           for pid, ok, _, unc in seen])
+    report = UploadReport(
+        [UploadOutcome(pid, ok, sent=ledger.point(pid), unconfirmed=unc) for pid, ok, _, unc in seen]
+    )
     apply_upload(ledger, report)
-    assert [p.sync for p in ledger] == [SyncState.UNCONFIRMED if unc else SyncState.ON_CONTROLLER
-                                        for *_, unc in seen]
+    assert [p.sync for p in ledger] == [
+        SyncState.UNCONFIRMED if unc else SyncState.ON_CONTROLLER for *_, unc in seen
+    ]
     assert ledger.point(6).needs_upload is unconfirmed  # not proven: upload again before relying on it
     ledger.mark_all_unknown()  # a reconnect: not known any more
     assert [p.sync for p in ledger] == [SyncState.UNKNOWN] * 2

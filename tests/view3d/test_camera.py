@@ -17,13 +17,17 @@ def test_target_projects_to_the_centre_and_behind_is_nan() -> None:
     assert np.isnan(screen[1]).all()
 
 
-@pytest.mark.parametrize(("preset", "right", "up"), [
-    (Preset.TOP, (1, 0, 0), (0, 1, 0)),
-    (Preset.FRONT, (1, 0, 0), (0, 0, 1)),
-    (Preset.SIDE, (0, 1, 0), (0, 0, 1)),
-])
-def test_presets_match_the_planner_projections(preset: Preset, right: tuple[int, ...],
-                                                up: tuple[int, ...]) -> None:
+@pytest.mark.parametrize(
+    ("preset", "right", "up"),
+    [
+        (Preset.TOP, (1, 0, 0), (0, 1, 0)),
+        (Preset.FRONT, (1, 0, 0), (0, 0, 1)),
+        (Preset.SIDE, (0, 1, 0), (0, 0, 1)),
+    ],
+)
+def test_presets_match_the_planner_projections(
+    preset: Preset, right: tuple[int, ...], up: tuple[int, ...]
+) -> None:
     cam = Camera(target=(0.0, 0.0, 0.0)).preset(preset)
     s, _ = cam.project(np.array([[0.0, 0.0, 0.0], right, up], dtype=float) * 100.0, 600, 600)
     assert s[1, 0] > s[0, 0] and s[1, 1] == pytest.approx(s[0, 1], abs=1e-6)  # right is right

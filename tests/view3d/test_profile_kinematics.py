@@ -65,19 +65,31 @@ def test_tracker_marks_estimates(model: ArmModel) -> None:
     assert np.allclose(model.forward(joints)[:3, 3], pose[:3], atol=0.05)
 
 
-@pytest.mark.parametrize(("text", "message"), [
-    ("{", "not valid JSON (line 1"),
-    ('{"format": "x", "version": 1}', "not a robot profile"),
-    ('{"format": "teachpad-robot-profile", "version": 9}', "version 9 is not supported"),
-    ('{"format": "teachpad-robot-profile", "version": 1, "joints": []}', "joints: expected a list"),
-    ('{"format": "teachpad-robot-profile", "version": 1, "joints": [{"d": 1}]}', "joint 1: missing a"),
-    ('{"format": "teachpad-robot-profile", "version": 1, "joints": [{"d": "abc", "a": 0, "alpha_deg": 0,'
-     ' "min_deg": -1, "max_deg": 1}]}', "joint 1 d: 'abc' is not a finite number"),
-    ('{"format": "teachpad-robot-profile", "version": 1, "joints": [{"d": 0, "a": 0, "alpha_deg": 0,'
-     ' "min_deg": 5, "max_deg": 1}]}', "min_deg 5 is not below max_deg 1"),
-    ('{"format": "teachpad-robot-profile", "version": 1, "joints": [{"d": 0, "a": 0, "alpha_deg": 0,'
-     ' "min_deg": -1, "max_deg": 1}], "base": [1, 2]}', "base: expected a list of six numbers"),
-])
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("{", "not valid JSON (line 1"),
+        ('{"format": "x", "version": 1}', "not a robot profile"),
+        ('{"format": "teachpad-robot-profile", "version": 9}', "version 9 is not supported"),
+        ('{"format": "teachpad-robot-profile", "version": 1, "joints": []}', "joints: expected a list"),
+        ('{"format": "teachpad-robot-profile", "version": 1, "joints": [{"d": 1}]}', "joint 1: missing a"),
+        (
+            '{"format": "teachpad-robot-profile", "version": 1, "joints": [{"d": "abc", "a": 0,'
+            ' "alpha_deg": 0, "min_deg": -1, "max_deg": 1}]}',
+            "joint 1 d: 'abc' is not a finite number",
+        ),
+        (
+            '{"format": "teachpad-robot-profile", "version": 1, "joints": [{"d": 0, "a": 0, "alpha_deg": 0,'
+            ' "min_deg": 5, "max_deg": 1}]}',
+            "min_deg 5 is not below max_deg 1",
+        ),
+        (
+            '{"format": "teachpad-robot-profile", "version": 1, "joints": [{"d": 0, "a": 0, "alpha_deg": 0,'
+            ' "min_deg": -1, "max_deg": 1}], "base": [1, 2]}',
+            "base: expected a list of six numbers",
+        ),
+    ],
+)
 def test_profile_file_errors_say_what_is_wrong(tmp_path: Path, text: str, message: str) -> None:
     path = tmp_path / "arm.json"
     path.write_text(text, encoding="utf-8")

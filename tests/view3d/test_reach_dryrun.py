@@ -19,12 +19,14 @@ DOWN = (180.0, 0.0, 180.0)  # tool pointing down
 
 
 def _ledger(far: bool = False) -> PointLedger:
-    return PointLedger([
-        make_point(1, "A", (450, -100, 350, *DOWN)),
-        make_point(2, "B", (500, 0, 420, *DOWN)),
-        make_point(3, "C", (450, 100, 350, *DOWN)),
-        make_point(9, "far", (1400 if far else 450, 0, 300, *DOWN)),
-    ])
+    return PointLedger(
+        [
+            make_point(1, "A", (450, -100, 350, *DOWN)),
+            make_point(2, "B", (500, 0, 420, *DOWN)),
+            make_point(3, "C", (450, 100, 350, *DOWN)),
+            make_point(9, "far", (1400 if far else 450, 0, 300, *DOWN)),
+        ]
+    )
 
 
 @pytest.fixture(name="checker")
@@ -52,8 +54,9 @@ def test_check_plan_reports_an_unreachable_point_only_when_asked(checker: ReachC
 
 def test_path_between_reachable_points_can_leave_the_reach(checker: ReachChecker) -> None:
     # two points on either side of the base, close to it: the straight line passes the J1 axis
-    ledger = PointLedger([make_point(1, "L", (-150, -300, 900, *DOWN)),
-                          make_point(2, "R", (-150, 300, 900, *DOWN))])
+    ledger = PointLedger(
+        [make_point(1, "L", (-150, -300, 900, *DOWN)), make_point(2, "R", (-150, 300, 900, *DOWN))]
+    )
     plan = Plan("through", [Segment.line(2)])
     start = Pose(-150, -300, 900, *DOWN)
     path = checker.path(plan, ledger, start)

@@ -42,9 +42,16 @@ class MotionController(QObject):
     motionEnabledChanged = Signal(bool)
     alarmHoldChanged = Signal(bool)
 
-    def __init__(self, link: LinkPort, control_bar: ControlBar, jog: JogPanel, step: StepPanel,
-                 program: ProgramPanel, run_controller: PlanRunController,
-                 parent: QObject | None = None) -> None:
+    def __init__(
+        self,
+        link: LinkPort,
+        control_bar: ControlBar,
+        jog: JogPanel,
+        step: StepPanel,
+        program: ProgramPanel,
+        run_controller: PlanRunController,
+        parent: QObject | None = None,
+    ) -> None:
         super().__init__(parent)
         self._link = link
         self._bar = control_bar
@@ -131,8 +138,9 @@ class MotionController(QObject):
             if refused:
                 safety.message.emit(refused)
                 return
-        self._link.jog_press(request.frame, request.axis, request.direction, request.ratio,
-                             request.user, request.tool)
+        self._link.jog_press(
+            request.frame, request.axis, request.direction, request.ratio, request.user, request.tool
+        )
 
     @Slot(float)
     def _on_ratio_changed(self, ratio: float) -> None:
@@ -144,8 +152,9 @@ class MotionController(QObject):
             return
         safety, pose = self.safety, self._link.state.pose
         if safety is not None and pose is not None:
-            refused = safety.check_step(pose, list(request.offsets), joint=request.frame is StepFrame.JOINT,
-                                        speed=request.speed)
+            refused = safety.check_step(
+                pose, list(request.offsets), joint=request.frame is StepFrame.JOINT, speed=request.speed
+            )
             if refused:
                 safety.message.emit(refused)
                 return
@@ -155,8 +164,9 @@ class MotionController(QObject):
     def _on_program_requested(self, request: ProgramRequest) -> None:
         if self._alarm_hold:
             return
-        self._link.run_program(request.program_id, ProgramMotionMode(request.mode), request.cycles,
-                               request.speed_ratio)
+        self._link.run_program(
+            request.program_id, ProgramMotionMode(request.mode), request.cycles, request.speed_ratio
+        )
 
     @Slot(object)
     def _on_go_zero(self, axis: int | None) -> None:

@@ -36,8 +36,9 @@ class NewPointPose:
         return self.source is PoseSource.LIVE
 
 
-def new_point_pose(fresh: bool, pose: Pose | None, ledger: PointLedger, near_row: int | None = None,
-                   tool: int = TOOL_NONE) -> NewPointPose:
+def new_point_pose(
+    fresh: bool, pose: Pose | None, ledger: PointLedger, near_row: int | None = None, tool: int = TOOL_NONE
+) -> NewPointPose:
     """The robot's pose (with ``tool``, the teach tool) when ``fresh`` and known; else the pose
     and tool of the point at ``near_row`` (the selection; default: the last point); else zeros."""
     if fresh and pose is not None:

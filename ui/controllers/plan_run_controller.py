@@ -72,8 +72,9 @@ class PlanRunController(QObject):
     segmentPrepared = Signal(int, object)
     pointMismatch = Signal(int)
 
-    def __init__(self, link: LinkPort | None = None, parent: QObject | None = None, *,
-                 points: PointsModel) -> None:
+    def __init__(
+        self, link: LinkPort | None = None, parent: QObject | None = None, *, points: PointsModel
+    ) -> None:
         super().__init__(parent)
         self._link: LinkPort | None = None
         self._runner: PlanRunner | None = None
@@ -149,8 +150,11 @@ class PlanRunController(QObject):
     def can_resume(self) -> bool:
         """A stopped or failed run can continue from :attr:`resume_from`."""
         runner = self._runner
-        return (runner is not None and runner.state in (RunState.STOPPED, RunState.FAILED)
-                and runner.resume_from is not None)
+        return (
+            runner is not None
+            and runner.state in (RunState.STOPPED, RunState.FAILED)
+            and runner.resume_from is not None
+        )
 
     @property
     def resume_from(self) -> int | None:
@@ -165,15 +169,23 @@ class PlanRunController(QObject):
         return list(self._sent)
 
     # --- commands
-    def start(self, plan: Plan | Sequence[Segment], *, start: int = 0, start_loop: int = 1,
-              single: bool = False, loops: int | None = None) -> None:
+    def start(
+        self,
+        plan: Plan | Sequence[Segment],
+        *,
+        start: int = 0,
+        start_loop: int = 1,
+        single: bool = False,
+        loops: int | None = None,
+    ) -> None:
         """Run ``plan`` from segment ``start`` (``single``: that segment only). Raises
         :class:`~app.errors.InvalidInput` for a bad start and :class:`LinkError` without a link."""
         if self.running:
             raise RuntimeError("a run is already under way")
         link = self._require_link()
-        self._runner = PlanRunner(plan, loops=loops, start=start, start_loop=start_loop, single=single,
-                                  progress=self._on_progress)
+        self._runner = PlanRunner(
+            plan, loops=loops, start=start, start_loop=start_loop, single=single, progress=self._on_progress
+        )
         self._plan = plan if isinstance(plan, Plan) else None
         self._outcome = None
         self.end_reason = ""
@@ -226,8 +238,11 @@ class PlanRunController(QObject):
         if outcome.resume_from is None:
             text = self.tr("Failed: {reason}") if failed else self.tr("Stopped: {reason}")
             return text.format(reason=reason)
-        text = (self.tr("Failed at segment {n}: {reason}") if failed
-                else self.tr("Stopped at segment {n}: {reason}"))
+        text = (
+            self.tr("Failed at segment {n}: {reason}")
+            if failed
+            else self.tr("Stopped at segment {n}: {reason}")
+        )
         return text.format(n=outcome.resume_from + 1, reason=reason)
 
     def stop(self) -> None:
@@ -244,8 +259,11 @@ class PlanRunController(QObject):
         runner.request_stop()
         self.end_reason = self.tr("stopped by the operator")
         self._set_paused(False)
-        if runner.state is not RunState.RUNNING or not self.connected \
-                or (self._move is None and self._upload is None):
+        if (
+            runner.state is not RunState.RUNNING
+            or not self.connected
+            or (self._move is None and self._upload is None)
+        ):
             # nothing out that could report the stop (e.g. a move held by a pause)
             self._clear_segment()
             runner.on_stopped()
@@ -292,8 +310,12 @@ class PlanRunController(QObject):
 
     def _on_upload(self, upload: Pending, result: CommandResult) -> None:
         runner, guard, link = self._runner, self._guard, self._link
-        if upload is not self._upload or runner is None or runner.state is not RunState.RUNNING \
-                or link is None:
+        if (
+            upload is not self._upload
+            or runner is None
+            or runner.state is not RunState.RUNNING
+            or link is None
+        ):
             return
         self._upload = None
         prepared = guard.finish_upload(link.state.connection.endpoint)
@@ -347,9 +369,16 @@ class PlanRunController(QObject):
         assert self._prepared is not None  # created by _prepare, or the move is not sent
         self.segmentPrepared.emit(command.index, list(self._prepared.points))
         self._sent.append(command.index)
-        move = link.track(link.move_to_point(
-            seg.end_id, seg.via_id, orientation_changes=seg.orientation_changes,
-            ignore_middle=seg.ignore_middle, speed=seg.speed, tool=seg.tool))
+        move = link.track(
+            link.move_to_point(
+                seg.end_id,
+                seg.via_id,
+                orientation_changes=seg.orientation_changes,
+                ignore_middle=seg.ignore_middle,
+                speed=seg.speed,
+                tool=seg.tool,
+            )
+        )
         self._move = move
         move.finished.connect(lambda result: self._on_result(move, result))
         move.failed.connect(lambda error: self._on_error(move, error))
@@ -383,8 +412,12 @@ class PlanRunController(QObject):
                 self._fail_segment(error)
                 return
         current = runner.current
-        missing = (not result.ok and result.status is not None
-                   and result.status.code == MoveStatus.BAD_END_POINT and current is not None)
+        missing = (
+            not result.ok
+            and result.status is not None
+            and result.status.code == MoveStatus.BAD_END_POINT
+            and current is not None
+        )
         if not result.ok:
             # the runner keeps the reason as text: give it the operator's language
             self.end_reason = result_text(result)
@@ -406,8 +439,12 @@ class PlanRunController(QObject):
 
     def _on_stop_failed(self, stop: Pending, error: WorkerError) -> None:
         runner = self._runner
-        if stop is self._stop and runner is not None and runner.state is RunState.RUNNING \
-                and runner.stop_requested:
+        if (
+            stop is self._stop
+            and runner is not None
+            and runner.state is RunState.RUNNING
+            and runner.stop_requested
+        ):
             self._clear_segment()
             self.end_reason = error_text(error)
             runner.on_stopped(self.end_reason)
@@ -433,8 +470,11 @@ def _connection_error(state: ConnectionState) -> TeachPadError:
     connection stays open (``NOT_ANSWERING``) is not a lost link, and is not said as one."""
     where = {"endpoint": state.endpoint} if state.endpoint else {}
     if state.state is LinkState.NOT_ANSWERING:
-        return ResponseTimeout(f"the controller is not answering: {state.message or 'no answer'}",
-                               code="run_not_answering", params=where)
+        return ResponseTimeout(
+            f"the controller is not answering: {state.message or 'no answer'}",
+            code="run_not_answering",
+            params=where,
+        )
     return LinkError(f"link lost: {state.message or 'link lost'}", params=where)
 
 

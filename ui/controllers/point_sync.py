@@ -91,8 +91,9 @@ class PointSyncController(QObject):
     restoreOffered = Signal(bool)
     moveFinished = Signal(bool, str)
 
-    def __init__(self, model: PointsModel, link: LinkPort | None = None,
-                 parent: QObject | None = None) -> None:
+    def __init__(
+        self, model: PointsModel, link: LinkPort | None = None, parent: QObject | None = None
+    ) -> None:
         super().__init__(parent)
         self._model = model
         self._link: LinkPort | None = None
@@ -137,8 +138,13 @@ class PointSyncController(QObject):
         """The pose for a point added by hand: the robot's while the link is fresh, else the
         point at ``near_row`` (default: the last one) or zeros (see :mod:`ui.controllers.new_point`)."""
         state = self._link.state if self._link is not None else None
-        return new_point_pose(state is not None and state.fresh, state.pose if state is not None else None,
-                              self._model.ledger, near_row, self.teach_tool)
+        return new_point_pose(
+            state is not None and state.fresh,
+            state.pose if state is not None else None,
+            self._model.ledger,
+            near_row,
+            self.teach_tool,
+        )
 
     @property
     def restore_offered(self) -> bool:
@@ -223,8 +229,12 @@ class PointSyncController(QObject):
             self._say(self.tr("There is no point P{id}").format(id=point_id), LEVEL_ERROR)
             return False
         if point.needs_upload:
-            self._say(self.tr("{point} is not on the controller ({state}): upload it first").format(
-                point=point.label, state=sync_text(point.sync)), LEVEL_ERROR)
+            self._say(
+                self.tr("{point} is not on the controller ({state}): upload it first").format(
+                    point=point.label, state=sync_text(point.sync)
+                ),
+                LEVEL_ERROR,
+            )
             return False
         if not 0 < speed <= MAX_MOVE_SPEED:
             self._say(self.tr("Speed {v} mm/s is out of range").format(v=speed), LEVEL_ERROR)
@@ -234,10 +244,20 @@ class PointSyncController(QObject):
             return False
         self._move_id = point_id
         self._set_operation("move")
-        self._say(self.tr("Moving to {point} at {v} mm/s…").format(point=point.label, v=f"{speed:g}"),
-                  LEVEL_INFO)
-        self._watch(link, link.move_to_point(point_id, None, orientation_changes=True, ignore_middle=False,
-                                             speed=float(speed), tool=point.tool))
+        self._say(
+            self.tr("Moving to {point} at {v} mm/s…").format(point=point.label, v=f"{speed:g}"), LEVEL_INFO
+        )
+        self._watch(
+            link,
+            link.move_to_point(
+                point_id,
+                None,
+                orientation_changes=True,
+                ignore_middle=False,
+                speed=float(speed),
+                tool=point.tool,
+            ),
+        )
         return True
 
     def points_missing(self, point_ids: Iterable[int]) -> None:
@@ -250,8 +270,13 @@ class PointSyncController(QObject):
                 self._model.set_sync(point_id, SyncState.UNKNOWN)
         if len(ledger):
             self._offer_restore(True)
-            self._say(self.tr("The controller does not hold the plan's points (did it restart?): "
-                              "Restore all to re-create them."), LEVEL_WARN)
+            self._say(
+                self.tr(
+                    "The controller does not hold the plan's points (did it restart?): "
+                    "Restore all to re-create them."
+                ),
+                LEVEL_WARN,
+            )
 
     def stop(self) -> None:
         """Stop whatever runs (a move, an upload)."""
@@ -312,8 +337,13 @@ class PointSyncController(QObject):
         self._model.mark_all_unknown()
         if len(self._model.ledger):
             self._offer_restore(True)
-            self._say(self.tr("The controller restarted or reconnected: {n} points may be gone from it. "
-                              "Restore all to re-create them.").format(n=len(self._model.ledger)), LEVEL_WARN)
+            self._say(
+                self.tr(
+                    "The controller restarted or reconnected: {n} points may be gone from it. "
+                    "Restore all to re-create them."
+                ).format(n=len(self._model.ledger)),
+                LEVEL_WARN,
+            )
 
     def _on_error(self, pending: Pending, error: WorkerError) -> None:
         if pending is self._pending:
@@ -356,14 +386,20 @@ class PointSyncController(QObject):
             return
         pose = _pose_from_details(result.details, self.last_pose)
         if pose is None:
-            self._say(self.tr("P{id} was created on the controller, but its pose is not known yet").format(
-                id=point_id), LEVEL_ERROR)
+            self._say(
+                self.tr("P{id} was created on the controller, but its pose is not known yet").format(
+                    id=point_id
+                ),
+                LEVEL_ERROR,
+            )
             return
         if self._model.ledger.get(point_id) is not None:
             # Someone added P{id} on the host meanwhile: the controller's copy is the taught pose.
             self._model.set_sync(point_id, SyncState.CHANGED)
-            text = self.tr("P{id} was added on the host while teaching; the controller now holds the "
-                           "taught pose: upload it to keep the host's values").format(id=point_id)
+            text = self.tr(
+                "P{id} was added on the host while teaching; the controller now holds the "
+                "taught pose: upload it to keep the host's values"
+            ).format(id=point_id)
             self._say(text, LEVEL_WARN)
             return
         try:
@@ -374,8 +410,12 @@ class PointSyncController(QObject):
             return
         if result.unconfirmed:  # created without an error, but not proven: not "on controller"
             self._model.set_sync(point_id, SyncState.UNCONFIRMED)
-        self._say(self.tr("Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}").format(
-            id=point_id, x=pose.x, y=pose.y, z=pose.z), LEVEL_INFO)
+        self._say(
+            self.tr("Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}").format(
+                id=point_id, x=pose.x, y=pose.y, z=pose.z
+            ),
+            LEVEL_INFO,
+        )
         self.pointTaught.emit(point_id)
 
     # move
@@ -391,8 +431,9 @@ class PointSyncController(QObject):
             self.moveFinished.emit(False, reason)
         else:
             reason = result_reason(result)
-            self._say(self.tr("Move to P{id} failed: {reason}").format(id=point_id, reason=reason),
-                      LEVEL_ERROR)
+            self._say(
+                self.tr("Move to P{id} failed: {reason}").format(id=point_id, reason=reason), LEVEL_ERROR
+            )
             self.moveFinished.emit(False, reason)
 
     # upload
@@ -402,8 +443,11 @@ class PointSyncController(QObject):
         if upload is None or point_id not in upload.points:
             return
         sent = upload.points[point_id]
-        outcome = (UploadOutcome(point_id, True, sent=sent, unconfirmed=unconfirmed) if ok
-                   else UploadOutcome(point_id, False, reason))
+        outcome = (
+            UploadOutcome(point_id, True, sent=sent, unconfirmed=unconfirmed)
+            if ok
+            else UploadOutcome(point_id, False, reason)
+        )
         upload.report.outcomes.append(outcome)
         upload.pending.append(outcome)
 
@@ -457,12 +501,17 @@ class PointSyncController(QObject):
             if upload.restore:
                 self._offer_restore(False)
         elif aborted is not None:
-            self._say(self.tr("Upload stopped after {ok} of {total} points: {reason}").format(
-                ok=ok, total=upload.total, reason=aborted), LEVEL_WARN)
+            self._say(
+                self.tr("Upload stopped after {ok} of {total} points: {reason}").format(
+                    ok=ok, total=upload.total, reason=aborted
+                ),
+                LEVEL_WARN,
+            )
         else:
             first = report.failed[0]
             text = self.tr("Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})").format(
-                ok=ok, total=upload.total, failed=failed, id=first.point_id, reason=first.reason)
+                ok=ok, total=upload.total, failed=failed, id=first.point_id, reason=first.reason
+            )
             self._say(text, LEVEL_ERROR)
         self.uploadFinished.emit(report)
 
@@ -471,4 +520,3 @@ def _batch_reason(message: str) -> str:
     """Why an upload ended early, from the link's "uploaded N of M points (reason)"."""
     _head, sep, tail = message.partition(" (")
     return tail[:-1] if sep and tail.endswith(")") else message
-

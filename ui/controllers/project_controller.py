@@ -81,9 +81,16 @@ class ProjectController(QObject):
     autosaved = Signal(str)
     statusMessage = Signal(str)
 
-    def __init__(self, project: Project | None = None, path: str | os.PathLike[str] | None = None, *,
-                 dialogs: Any = None, autosave_interval: float = AUTOSAVE_INTERVAL_S,
-                 autosave_dir: str | os.PathLike[str] | None = None, parent: QObject | None = None) -> None:
+    def __init__(
+        self,
+        project: Project | None = None,
+        path: str | os.PathLike[str] | None = None,
+        *,
+        dialogs: Any = None,
+        autosave_interval: float = AUTOSAVE_INTERVAL_S,
+        autosave_dir: str | os.PathLike[str] | None = None,
+        parent: QObject | None = None,
+    ) -> None:
         super().__init__(parent)
         self._project = project or Project()
         self._path: Path | None = Path(path) if path is not None else None
@@ -142,8 +149,15 @@ class ProjectController(QObject):
         self.plans_model.retranslate()
 
     def file_actions(self) -> list[QAction | None]:
-        return [self.action_new, self.action_open, self.action_save, self.action_save_as, None,
-                self.action_import_csv, self.action_export_csv]
+        return [
+            self.action_new,
+            self.action_open,
+            self.action_save,
+            self.action_save_as,
+            None,
+            self.action_import_csv,
+            self.action_export_csv,
+        ]
 
     # --- state
     @property
@@ -287,7 +301,8 @@ class ProjectController(QObject):
             self.dialogs.error(self.tr("Cannot import points"), refusal_text(exc))
             return False
         counts = self.tr("{added} added, {updated} updated, {unchanged} unchanged, {removed} removed").format(
-            added=report.added, updated=report.updated, unchanged=report.unchanged, removed=report.removed)
+            added=report.added, updated=report.updated, unchanged=report.unchanged, removed=report.removed
+        )
         self.statusMessage.emit(self.tr("Imported {path}: {report}").format(path=path, report=counts))
         return True
 
@@ -303,8 +318,9 @@ class ProjectController(QObject):
         except OSError as exc:
             self.dialogs.error(self.tr("Cannot export points"), os_error_text(path, exc))
             return False
-        self.statusMessage.emit(self.tr("Exported {n} points to {path}").format(
-            n=len(self._project.ledger), path=path))
+        self.statusMessage.emit(
+            self.tr("Exported {n} points to {path}").format(n=len(self._project.ledger), path=path)
+        )
         return True
 
     def maybe_save(self) -> bool:
@@ -329,8 +345,11 @@ class ProjectController(QObject):
         try:
             written = save_autosave(self._project, self._path, user_dir=self._autosave_dir)
         except OSError as exc:
-            self.statusMessage.emit(self.tr("Autosave failed: {reason}").format(
-                reason=os_error_text(self._path or self._project.name, exc)))
+            self.statusMessage.emit(
+                self.tr("Autosave failed: {reason}").format(
+                    reason=os_error_text(self._path or self._project.name, exc)
+                )
+            )
             return None
         self._autosaved_revision = revision
         self.autosaved.emit(str(written))
@@ -402,8 +421,9 @@ class ProjectController(QObject):
         except ProjectLocked as exc:
             self._foreign_lock = exc.owner
         except OSError as exc:  # e.g. a read-only directory: work without a lock, and say so
-            self.statusMessage.emit(self.tr("Cannot lock {path}: {reason}").format(
-                path=path, reason=os_error_text(path, exc)))
+            self.statusMessage.emit(
+                self.tr("Cannot lock {path}: {reason}").format(path=path, reason=os_error_text(path, exc))
+            )
 
     def _release_lock(self) -> None:
         if self._lock is not None:
@@ -411,10 +431,11 @@ class ProjectController(QObject):
             self._lock = None
 
     def _in_use_text(self, path: Path, owner: LockOwner) -> str:
-        return self.tr("{path} is open in another TeachPad (process {pid} on {host}, since {started}). "
-                       "Close it there first; its autosave belongs to that TeachPad and is not offered "
-                       "for recovery here.").format(path=path, pid=owner.pid, host=owner.host or "?",
-                                                    started=owner.started or "?")
+        return self.tr(
+            "{path} is open in another TeachPad (process {pid} on {host}, since {started}). "
+            "Close it there first; its autosave belongs to that TeachPad and is not offered "
+            "for recovery here."
+        ).format(path=path, pid=owner.pid, host=owner.host or "?", started=owner.started or "?")
 
     # --- internals
     def _replace(self, project: Project, path: Path | None, *, dirty: bool = False) -> None:

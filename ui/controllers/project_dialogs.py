@@ -35,11 +35,16 @@ class ProjectDialogs:
         QMessageBox.critical(self.parent, title, text)
 
     def ask_save_changes(self, name: str) -> str:
-        """"save", "discard" or "cancel"."""
-        box = QMessageBox(QMessageBox.Icon.Question, self.tr("Unsaved changes"),
-                          self.tr("Save the changes to {name}?").format(name=name),
-                          QMessageBox.StandardButton.Save | QMessageBox.StandardButton.Discard
-                          | QMessageBox.StandardButton.Cancel, self.parent)
+        """ "save", "discard" or "cancel"."""
+        box = QMessageBox(
+            QMessageBox.Icon.Question,
+            self.tr("Unsaved changes"),
+            self.tr("Save the changes to {name}?").format(name=name),
+            QMessageBox.StandardButton.Save
+            | QMessageBox.StandardButton.Discard
+            | QMessageBox.StandardButton.Cancel,
+            self.parent,
+        )
         answer = box.exec()
         if answer == QMessageBox.StandardButton.Save:
             return "save"
@@ -49,27 +54,45 @@ class ProjectDialogs:
 
     def ask_recover(self, autosave: Path, project_path: Path | None) -> bool:
         what = str(project_path) if project_path else self.tr("an unsaved project")
-        text = self.tr("TeachPad was not closed properly. An autosave of {what} is newer than the saved "
-                       "file:\n{autosave}\n\nRecover it?").format(what=what, autosave=autosave)
-        answer = QMessageBox.question(self.parent, self.tr("Recover autosave"), text,
-                                      QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
-                                      QMessageBox.StandardButton.Yes)
+        text = self.tr(
+            "TeachPad was not closed properly. An autosave of {what} is newer than the saved "
+            "file:\n{autosave}\n\nRecover it?"
+        ).format(what=what, autosave=autosave)
+        answer = QMessageBox.question(
+            self.parent,
+            self.tr("Recover autosave"),
+            text,
+            QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
+            QMessageBox.StandardButton.Yes,
+        )
         return answer == QMessageBox.StandardButton.Yes
 
     def ask_empty_import(self, existing: int) -> bool:
         """The CSV has no points: replace (delete) all ``existing`` points anyway?"""
-        text = self.tr("The file has no points. Importing it in replace mode removes all {n} points of "
-                       "the project.\n\nRemove them all?").format(n=existing)
-        answer = QMessageBox.warning(self.parent, self.tr("Import points"), text,
-                                     QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
-                                     QMessageBox.StandardButton.No)
+        text = self.tr(
+            "The file has no points. Importing it in replace mode removes all {n} points of "
+            "the project.\n\nRemove them all?"
+        ).format(n=existing)
+        answer = QMessageBox.warning(
+            self.parent,
+            self.tr("Import points"),
+            text,
+            QMessageBox.StandardButton.Yes | QMessageBox.StandardButton.No,
+            QMessageBox.StandardButton.No,
+        )
         return answer == QMessageBox.StandardButton.Yes
 
     def ask_import_mode(self) -> ImportMode | None:
         replace_text = self.tr("Replace all points")
         merge_text = self.tr("Merge (update the same ids, append new ones)")
-        choice, ok = QInputDialog.getItem(self.parent, self.tr("Import points"), self.tr("Import mode:"),
-                                          [replace_text, merge_text], 0, False)
+        choice, ok = QInputDialog.getItem(
+            self.parent,
+            self.tr("Import points"),
+            self.tr("Import mode:"),
+            [replace_text, merge_text],
+            0,
+            False,
+        )
         if not ok:
             return None
         return ImportMode.MERGE if choice == merge_text else ImportMode.REPLACE

@@ -84,8 +84,11 @@ class RunPoints:
         for point_id in segment.point_ids:
             point = ledger.get(point_id)
             if point is None:
-                raise PointNotCreated(f"the project has no point P{point_id}", code="point_missing",
-                                      params={"point": f"P{point_id}"})
+                raise PointNotCreated(
+                    f"the project has no point P{point_id}",
+                    code="point_missing",
+                    params={"point": f"P{point_id}"},
+                )
             points[point_id] = point
         self.segment = SegmentPoints(segment.end_id, points)
         return self.segment
@@ -96,8 +99,11 @@ class RunPoints:
         if seg is None or point_id not in seg.points:
             return
         sent = seg.points[point_id]
-        seg.outcomes.append(UploadOutcome(point_id, True, sent=sent, unconfirmed=unconfirmed) if ok
-                            else UploadOutcome(point_id, False, reason))
+        seg.outcomes.append(
+            UploadOutcome(point_id, True, sent=sent, unconfirmed=unconfirmed)
+            if ok
+            else UploadOutcome(point_id, False, reason)
+        )
 
     def finish_upload(self, endpoint: str) -> SegmentPoints | None:
         """The segment's upload ended: its outcomes go into the ledger and the created points
@@ -118,20 +124,27 @@ class RunPoints:
         point = seg.points[missing[0]] if missing else next(iter(seg.points.values()))
         failed = {o.point_id: o.reason for o in seg.failed}
         cause = failed.get(point.id, "not created")
-        return PointNotCreated(f"the controller did not create {point.label} before the move: {cause}",
-                               params={"point": point.label, "cause": cause})
+        return PointNotCreated(
+            f"the controller did not create {point.label} before the move: {cause}",
+            params={"point": point.label, "cause": cause},
+        )
 
     def check_arrival(self, seg: SegmentPoints, pose: Pose | None) -> TeachPadError | None:
         """None when ``pose`` is at the segment's end point as sent; else the error that ends
         the run (the end point is then marked *unknown* in the ledger)."""
         point = seg.points[seg.end_id]
         if pose is None:
-            return ArrivalUnknown(f"the arm's position after the move to {point.label} is not known",
-                                  params={"point": point.label})
+            return ArrivalUnknown(
+                f"the arm's position after the move to {point.label} is not known",
+                params={"point": point.label},
+            )
         mismatch = PointGuard(seg.points, canary_gv=None).check_arrival(pose, seg.end_id)
         if mismatch is not None and self._model.ledger.get(point.id) is not None:
-            self._model.set_sync(point.id, SyncState.UNKNOWN,
-                                 "the arm did not arrive at this point: the controller's copy differs")
+            self._model.set_sync(
+                point.id,
+                SyncState.UNKNOWN,
+                "the arm did not arrive at this point: the controller's copy differs",
+            )
         return mismatch
 
     def clear(self) -> None:

@@ -47,8 +47,12 @@ from app.safety.session import PermissionRefused, SafetySession
 
 IDLE_POLL_MS = 1000
 PROFILE_NAME = "envelope.safety.json"
-_TOUCH_EVENTS = (QEvent.Type.MouseButtonPress, QEvent.Type.KeyPress, QEvent.Type.TouchBegin,
-                 QEvent.Type.Wheel)
+_TOUCH_EVENTS = (
+    QEvent.Type.MouseButtonPress,
+    QEvent.Type.KeyPress,
+    QEvent.Type.TouchBegin,
+    QEvent.Type.Wheel,
+)
 
 
 class EnvelopeView(Protocol):
@@ -97,8 +101,14 @@ class SafetyController(QObject):
     reducedChanged = Signal(bool)
     message = Signal(str)  # a refusal or a problem, already translated, for the event log / status
 
-    def __init__(self, link: RobotLink | None, store: QSettings, parent: QObject | None = None, *,
-                 scrypt_n: int | None = None) -> None:
+    def __init__(
+        self,
+        link: RobotLink | None,
+        store: QSettings,
+        parent: QObject | None = None,
+        *,
+        scrypt_n: int | None = None,
+    ) -> None:
         super().__init__(parent)
         self.link = link
         roles_path, audit_dir, self.profile_path = safety_paths(store)
@@ -156,15 +166,19 @@ class SafetyController(QObject):
         return self.session.role
 
     def role_name(self, role: Role) -> str:
-        return {Role.OPERATOR: self.tr("operator"), Role.ENGINEER: self.tr("engineer"),
-                Role.ADMINISTRATOR: self.tr("administrator")}[role]
+        return {
+            Role.OPERATOR: self.tr("operator"),
+            Role.ENGINEER: self.tr("engineer"),
+            Role.ADMINISTRATOR: self.tr("administrator"),
+        }[role]
 
     def reason(self, action: Action) -> str | None:
         """Why the role in force may not do ``action``, translated (None: it may)."""
         if self.session.reason(action) is None:
             return None
         return self.tr("Needs the {need} role (you are {role}); log in from the Safety menu").format(
-            need=self.role_name(REQUIRED_ROLE[action]), role=self.role_name(self.role))
+            need=self.role_name(REQUIRED_ROLE[action]), role=self.role_name(self.role)
+        )
 
     def allowed(self, action: Action, *, say: bool = True) -> bool:
         """``require`` for a control that was used: audited, with a translated message."""
@@ -263,8 +277,9 @@ class SafetyController(QObject):
     def save_envelope(self, envelope: Envelope) -> SafetyProfile:
         """Set (role checked, audited) and save the profile atomically with its next revision."""
         self.session.set_envelope(envelope)
-        self.profile = save_profile(self.profile_path, SafetyProfile(self.profile.robot, envelope,
-                                                                     self.profile.revision))
+        self.profile = save_profile(
+            self.profile_path, SafetyProfile(self.profile.robot, envelope, self.profile.revision)
+        )
         self._envelope_changed()
         return self.profile
 
@@ -308,8 +323,9 @@ class SafetyController(QObject):
             return self.reason(exc.action) or str(exc)
         return str(exc)
 
-    def check_step(self, pose: Pose, offsets: list[float], *, joint: bool,
-                   speed: float | None = None) -> str | None:
+    def check_step(
+        self, pose: Pose, offsets: list[float], *, joint: bool, speed: float | None = None
+    ) -> str | None:
         """None when the step may go; else the translated reason (the refusal is audited)."""
         try:
             self.session.check_step(pose, offsets, joint=joint, speed=speed)
@@ -336,8 +352,9 @@ class SafetyController(QObject):
             return self.refusal(exc)
         return None
 
-    def check_move_to(self, pose: Pose | None, point_id: int, speed: float,
-                      ledger: PointLedger) -> str | None:
+    def check_move_to(
+        self, pose: Pose | None, point_id: int, speed: float, ledger: PointLedger
+    ) -> str | None:
         """Move to a point in a straight line (function 3) from ``pose`` (None: not known, the
         target and the speed are checked)."""
         start = pose if pose is not None else ledger.get(point_id)
@@ -352,23 +369,33 @@ class SafetyController(QObject):
         """:class:`EnvelopeViolation` in the operator's language."""
         if v.approaching:
             if v.box:
-                text = self.tr("{axis} = {value:.1f} is within stopping distance of the keep-out zone "
-                               "'{box}' (at {limit:.1f})")
+                text = self.tr(
+                    "{axis} = {value:.1f} is within stopping distance of the keep-out zone "
+                    "'{box}' (at {limit:.1f})"
+                )
             else:
                 text = self.tr("{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}")
         elif v.code is ViolationCode.KEEP_IN:
             text = self.tr("{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)")
         elif v.code is ViolationCode.KEEP_OUT:
-            text = self.tr("The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, "
-                           "its face at {limit:.1f} mm)")
+            text = self.tr(
+                "The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, "
+                "its face at {limit:.1f} mm)"
+            )
         elif v.code is ViolationCode.JOINT_LIMIT:
             text = self.tr("{axis} = {value:.1f}° is beyond its limit {limit:.1f}°")
         elif v.code is ViolationCode.SPEED:
-            text = (self.tr("Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode")
-                    if v.reduced else self.tr("Speed {value:g} mm/s is above the {limit:g} mm/s allowed"))
+            text = (
+                self.tr("Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode")
+                if v.reduced
+                else self.tr("Speed {value:g} mm/s is above the {limit:g} mm/s allowed")
+            )
         else:
-            text = (self.tr("Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode")
-                    if v.reduced else self.tr("Jog speed {value:g} % is above the {limit:g} % allowed"))
+            text = (
+                self.tr("Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode")
+                if v.reduced
+                else self.tr("Jog speed {value:g} % is above the {limit:g} % allowed")
+            )
         text = text.format(axis=v.axis, value=v.value, limit=v.limit, box=v.box)
         if v.segment is None:
             return text

@@ -70,9 +70,19 @@ class SafetyMenu(QObject):
         self.bundle_action = QAction(self)
         self.bundle_action.triggered.connect(self.write_bundle)
         self.menu = QMenu(window)
-        for action in (self.login_action, self.logout_action, None, self.reduced_action, self.envelope_action,
-                       None, self.register_profile_action, self.passwords_action, None, self.audit_action,
-                       self.bundle_action):
+        for action in (
+            self.login_action,
+            self.logout_action,
+            None,
+            self.reduced_action,
+            self.envelope_action,
+            None,
+            self.register_profile_action,
+            self.passwords_action,
+            None,
+            self.audit_action,
+            self.bundle_action,
+        ):
             if action is None:
                 self.menu.addSeparator()
             else:
@@ -104,11 +114,13 @@ class SafetyMenu(QObject):
         self.reduced_action.setText(self.tr("&Reduced speed"))
         self.envelope_action.setText(self.tr("Safety &envelope…"))
         self.register_profile_action.setText(self.tr("Re&gister profile…"))
-        self.register_profile_action.setToolTip(self.tr("Word order, unit id, completion rule, poll timeout "
-                                                        "(administrator)"))
+        self.register_profile_action.setToolTip(
+            self.tr("Word order, unit id, completion rule, poll timeout (administrator)")
+        )
         self.passwords_action.setText(self.tr("&Passwords and lock…"))
-        self.passwords_action.setToolTip(self.tr("Set, change or clear passwords; the idle lock time "
-                                                 "(administrator)"))
+        self.passwords_action.setToolTip(
+            self.tr("Set, change or clear passwords; the idle lock time (administrator)")
+        )
         self.audit_action.setText(self.tr("&Audit trail…"))
         self.bundle_action.setText(self.tr("Write a &support bundle…"))
         QTimer.singleShot(0, self._refresh)  # after the window's own retranslate (it sets tooltips)
@@ -130,8 +142,11 @@ class SafetyMenu(QObject):
         self.reduced_action.setChecked(safety.session.reduced)
         self.reduced_action.blockSignals(False)
         leave = safety.reason(Action.LEAVE_REDUCED_SPEED)
-        self.reduced_action.setToolTip(leave if safety.session.reduced and leave else
-                                       self.tr("Cap jog and move speeds (anyone may switch it on)"))
+        self.reduced_action.setToolTip(
+            leave
+            if safety.session.reduced and leave
+            else self.tr("Cap jog and move speeds (anyone may switch it on)")
+        )
 
     def source_name(self) -> str:
         """The event log's source column for safety messages."""
@@ -164,8 +179,13 @@ class SafetyMenu(QObject):
     def register_profile_dialog(self) -> RegisterProfileDialog:
         link = self.window.link
         connected = link.settings is not None and link.connection.state is not LinkState.DISCONNECTED
-        return RegisterProfileDialog(self.register_profile(), self.apply_register_profile, self.window,
-                                     reason=self.safety.reason(Action.REGISTER_PROFILE), connected=connected)
+        return RegisterProfileDialog(
+            self.register_profile(),
+            self.apply_register_profile,
+            self.window,
+            reason=self.safety.reason(Action.REGISTER_PROFILE),
+            connected=connected,
+        )
 
     @Slot()
     def open_register_profile_dialog(self) -> None:
@@ -177,8 +197,9 @@ class SafetyMenu(QObject):
         and, with ``reconnect``, connect the link again with it. None when done, else why not."""
         window = self.window
         try:
-            saved = self.safety.session.set_register_profile(window.settings.register_profile_path(), profile,
-                                                             self.register_profile())
+            saved = self.safety.session.set_register_profile(
+                window.settings.register_profile_path(), profile, self.register_profile()
+            )
         except PermissionRefused:
             why = self.safety.reason(Action.REGISTER_PROFILE) or ""
             self.safety.message.emit(why)
@@ -224,17 +245,28 @@ class SafetyMenu(QObject):
                 window.traffic_panel.export_to(Path(tmp) / "traffic.txt", visible_only=False)
                 traffic = (Path(tmp) / "traffic.txt").read_text(encoding="utf-8").splitlines()
                 manifest = write_support_bundle(
-                    path, settings=settings, project=project, profile=profile,
-                    register_profile=register_profile, audit_dir=self.safety.audit_dir, events=events,
-                    traffic=traffic)
+                    path,
+                    settings=settings,
+                    project=project,
+                    profile=profile,
+                    register_profile=register_profile,
+                    audit_dir=self.safety.audit_dir,
+                    events=events,
+                    traffic=traffic,
+                )
         except (OSError, TeachPadError) as exc:
             why = self.tr("The support bundle could not be written: {why}").format(why=str(exc)[:200])
             QMessageBox.warning(window, self.tr("Support bundle"), why)
             return None
-        self.safety.session.audit.record("action", "support bundle written",
-                                         args={"files": len(manifest.files)})
-        window.statusBar().showMessage(self.tr("Support bundle written: {file} ({n} files)").format(
-            file=Path(path).name, n=len(manifest.files)), 8000)
+        self.safety.session.audit.record(
+            "action", "support bundle written", args={"files": len(manifest.files)}
+        )
+        window.statusBar().showMessage(
+            self.tr("Support bundle written: {file} ({n} files)").format(
+                file=Path(path).name, n=len(manifest.files)
+            ),
+            8000,
+        )
         return Path(path)
 
 
@@ -249,7 +281,8 @@ def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> Safety
     safety.gate(menu.passwords_action, Action.MANAGE_ROLES)
     safety.gate_panel(window.points_panel, Action.EDIT_POINTS)
     window.points_panel.move_check = lambda point_id, speed: safety.check_move_to(
-        window.link.state.pose, point_id, speed, window.project.points_model.ledger)
+        window.link.state.pose, point_id, speed, window.project.points_model.ledger
+    )
     safety.gate_panel(window.planner_panel, Action.EDIT_PLANS)
     safety.attach_checker(window.planner_panel)  # its checks, and its 2D preview draws it
     # the 3D view is built on first show: its canvas is attached then

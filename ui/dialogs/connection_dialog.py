@@ -51,8 +51,10 @@ def available_serial_ports() -> list[SerialPortInfo]:
     """The machine's serial ports (pyserial's ``comports()``), sorted by device name."""
     from serial.tools import list_ports
 
-    ports = [SerialPortInfo(p.device, p.description if p.description not in (None, "n/a") else "")
-             for p in list_ports.comports()]
+    ports = [
+        SerialPortInfo(p.device, p.description if p.description not in (None, "n/a") else "")
+        for p in list_ports.comports()
+    ]
     return sorted(ports, key=lambda p: p.device)
 
 
@@ -70,9 +72,15 @@ class ConnectionDialog(QDialog):
     """Edits a :class:`ConnectionSettings`; ``settings()`` returns the result. ``connection``
     and ``poll_hz``: the link's state and poll rate, shown above the form."""
 
-    def __init__(self, settings: ConnectionSettings | None = None, parent: QWidget | None = None, *,
-                 connection: ConnectionState | None = None, poll_hz: float | None = None,
-                 profile: RegisterProfile | None = None) -> None:
+    def __init__(
+        self,
+        settings: ConnectionSettings | None = None,
+        parent: QWidget | None = None,
+        *,
+        connection: ConnectionState | None = None,
+        poll_hz: float | None = None,
+        profile: RegisterProfile | None = None,
+    ) -> None:
         super().__init__(parent)
         self.setObjectName("ConnectionDialog")
         self._base = settings or ConnectionSettings()
@@ -167,7 +175,8 @@ class ConnectionDialog(QDialog):
         form.addRow(self.monitor_check)
 
         self.buttons = QDialogButtonBox(
-            QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel, self)
+            QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel, self
+        )
         self.buttons.accepted.connect(self.accept)
         self.buttons.rejected.connect(self.reject)
         layout = QVBoxLayout(self)
@@ -203,30 +212,45 @@ class ConnectionDialog(QDialog):
         self.timeout_caption.setText(self.tr("Timeout:"))
         self.monitor_check.setText(self.tr("Monitor only (never write to the controller)"))
         if self.profile is not None:
-            note = self.tr("Unit id and word order come from the register profile (Safety → Register "
-                           "profile…, administrator).")
+            note = self.tr(
+                "Unit id and word order come from the register profile (Safety → Register "
+                "profile…, administrator)."
+            )
             self.profile_note.setText(note)
             for widget in (self.unit_spin, self.order_combo):
                 widget.setToolTip(note)
         self._show_current()
 
     @classmethod
-    def for_link(cls, link: LinkView, saved: ConnectionSettings, poll_hz: float | None = None,
-                 parent: QWidget | None = None) -> ConnectionDialog:
+    def for_link(
+        cls,
+        link: LinkView,
+        saved: ConnectionSettings,
+        poll_hz: float | None = None,
+        parent: QWidget | None = None,
+    ) -> ConnectionDialog:
         """The dialog on the connection in use: the link's settings (the remembered ones when
         the link has none yet), its state and the poll rate."""
-        return cls(link.settings or saved, parent, connection=link.connection, poll_hz=poll_hz,
-                   profile=RegisterProfile.from_connection(saved))
+        return cls(
+            link.settings or saved,
+            parent,
+            connection=link.connection,
+            poll_hz=poll_hz,
+            profile=RegisterProfile.from_connection(saved),
+        )
 
     def _show_current(self) -> None:
-        """"Connected to …" / "Not connected (…)", with the transport and the poll rate."""
+        """ "Connected to …" / "Not connected (…)", with the transport and the poll rate."""
         state = self._connection
         self.current_label.setVisible(state is not None)
         if state is None:
             return
         s = self._base
-        where = (f"{s.serial_port} {s.baudrate} {s.bytesize}{s.parity}{s.stopbits}" if s.serial_port
-                 else f"{s.host}:{s.port}")
+        where = (
+            f"{s.serial_port} {s.baudrate} {s.bytesize}{s.parity}{s.stopbits}"
+            if s.serial_port
+            else f"{s.host}:{s.port}"
+        )
         transport = self.tr("Modbus RTU (serial)") if s.transport == "rtu" else self.tr("Modbus TCP")
         words = {
             LinkState.CONNECTED: self.tr("Connected to {where}"),
@@ -235,8 +259,10 @@ class ConnectionDialog(QDialog):
             LinkState.DOWN: self.tr("Connection to {where} lost; retrying"),
             LinkState.DISCONNECTED: self.tr("Not connected (last: {where})"),
         }
-        lines = [words[state.state].format(where=state.endpoint or where),
-                 self.tr("{transport}, unit {unit}").format(transport=transport, unit=s.unit)]
+        lines = [
+            words[state.state].format(where=state.endpoint or where),
+            self.tr("{transport}, unit {unit}").format(transport=transport, unit=s.unit),
+        ]
         if self._poll_hz is not None:
             lines.append(self.tr("Polling at {hz:g} Hz").format(hz=self._poll_hz))
         if state.monitor_only or s.monitor_only:
@@ -269,7 +295,8 @@ class ConnectionDialog(QDialog):
     def _show_ports_note(self) -> None:
         if self._ports_error is not None:
             text = self.tr("Could not list the serial ports ({error}); type the device name").format(
-                error=self._ports_error)
+                error=self._ports_error
+            )
         elif self._ports:
             text = self.tr("Serial ports found: {n}").format(n=len(self._ports))
         else:

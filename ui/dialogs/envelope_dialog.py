@@ -69,8 +69,9 @@ class EnvelopeDialog(QDialog):
         self.keep_in_hi = [_spin(-LIMIT_MM, LIMIT_MM, v, " mm") for v in box.hi]
         # keep-out boxes
         self.keep_out = QTableWidget(0, _BOX_COLUMNS, self)
-        self.keep_out.setHorizontalHeaderLabels([self.tr("Name"), "X min", "Y min", "Z min", "X max", "Y max",
-                                                 "Z max"])
+        self.keep_out.setHorizontalHeaderLabels(
+            [self.tr("Name"), "X min", "Y min", "Z min", "X max", "Y max", "Z max"]
+        )
         self.keep_out.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Stretch)
         self.keep_out.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         for zone in env.keep_out:
@@ -138,8 +139,9 @@ class EnvelopeDialog(QDialog):
         layout.addLayout(bottom)
 
     def _add_row(self, zone: Box | None) -> None:
-        zone = zone or Box(self.tr("zone {n}").format(n=self.keep_out.rowCount() + 1), (0.0, 0.0, 0.0),
-                           (100.0, 100.0, 100.0))
+        zone = zone or Box(
+            self.tr("zone {n}").format(n=self.keep_out.rowCount() + 1), (0.0, 0.0, 0.0), (100.0, 100.0, 100.0)
+        )
         row = self.keep_out.rowCount()
         self.keep_out.insertRow(row)
         for col, text in enumerate([zone.name, *(f"{v:g}" for v in zone.lo), *(f"{v:g}" for v in zone.hi)]):
@@ -162,8 +164,13 @@ class EnvelopeDialog(QDialog):
         """The envelope as edited; ValueError / TeachPadError says what is wrong."""
         limits: tuple[tuple[float, float], ...] = ()
         if self.joints_on.isChecked():
-            limits = tuple((self._cell(self.joint_table, i, 0, f"J{i + 1}"),
-                            self._cell(self.joint_table, i, 1, f"J{i + 1}")) for i in range(JOINTS))
+            limits = tuple(
+                (
+                    self._cell(self.joint_table, i, 0, f"J{i + 1}"),
+                    self._cell(self.joint_table, i, 1, f"J{i + 1}"),
+                )
+                for i in range(JOINTS)
+            )
         keep_in = None
         if self.keep_in_on.isChecked():
             lo, hi = (s.value() for s in self.keep_in_lo), (s.value() for s in self.keep_in_hi)
@@ -174,8 +181,15 @@ class EnvelopeDialog(QDialog):
             name = (item.text().strip() if item is not None else "") or self.tr("zone {n}").format(n=row + 1)
             v = [self._cell(self.keep_out, row, col, name) for col in range(1, _BOX_COLUMNS)]
             zones.append(Box(name, (v[0], v[1], v[2]), (v[3], v[4], v[5])))
-        return Envelope(limits, keep_in, tuple(zones), self.max_jog.value(), self.max_speed.value(),
-                        self.reduced_jog.value(), self.reduced_speed.value())
+        return Envelope(
+            limits,
+            keep_in,
+            tuple(zones),
+            self.max_jog.value(),
+            self.max_speed.value(),
+            self.reduced_jog.value(),
+            self.reduced_speed.value(),
+        )
 
     def save(self) -> None:
         try:

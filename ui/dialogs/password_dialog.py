@@ -144,8 +144,9 @@ class PasswordDialog(QDialog):
         store = self._safety.session.store
         may = why is None
         self.set_button.setEnabled(may and role not in (None, Role.OPERATOR))
-        self.clear_button.setEnabled(may and role is not None and role is not Role.ADMINISTRATOR
-                                     and store.has_password(role))
+        self.clear_button.setEnabled(
+            may and role is not None and role is not Role.ADMINISTRATOR and store.has_password(role)
+        )
         inputs: tuple[QWidget, ...] = (self.password, self.repeat, self.idle, self.table)
         for widget in inputs:
             widget.setEnabled(may)

@@ -45,8 +45,15 @@ class RegisterProfileDialog(QDialog):
     """See the module docstring. ``reason``: why the role in force may not change it (None: it may).
     ``open_path`` / ``save_path`` ask for a file (tests replace them)."""
 
-    def __init__(self, profile: RegisterProfile, apply: ApplyProfile, parent: QWidget | None = None, *,
-                 reason: str | None = None, connected: bool = False) -> None:
+    def __init__(
+        self,
+        profile: RegisterProfile,
+        apply: ApplyProfile,
+        parent: QWidget | None = None,
+        *,
+        reason: str | None = None,
+        connected: bool = False,
+    ) -> None:
         super().__init__(parent)
         self.setObjectName("RegisterProfileDialog")
         self.profile = profile
@@ -85,14 +92,28 @@ class RegisterProfileDialog(QDialog):
         self.save_as_button = QPushButton(self)
         self.save_as_button.clicked.connect(self.save_as)
         self.defaults_button = QPushButton(self)
-        self.defaults_button.clicked.connect(lambda: self.set_profile(
-            dataclasses.replace(RegisterProfile(), name=self.name_edit.text().strip() or "default")))
+        self.defaults_button.clicked.connect(
+            lambda: self.set_profile(
+                dataclasses.replace(RegisterProfile(), name=self.name_edit.text().strip() or "default")
+            )
+        )
         self.captions = [QLabel(self) for _ in range(9)]
         form = QFormLayout()
-        for caption, field in zip(self.captions, (
-                self.name_edit, self.order_combo, self.unit_spin, self.completion_combo,
-                self.unconfirmed_spin, self.poll_timeout_spin, self.clock_combo, self.point_min_spin,
-                self.point_max_spin), strict=True):
+        for caption, field in zip(
+            self.captions,
+            (
+                self.name_edit,
+                self.order_combo,
+                self.unit_spin,
+                self.completion_combo,
+                self.unconfirmed_spin,
+                self.poll_timeout_spin,
+                self.clock_combo,
+                self.point_min_spin,
+                self.point_max_spin,
+            ),
+            strict=True,
+        ):
             form.addRow(caption, field)
         std = QDialogButtonBox.StandardButton
         self.buttons = QDialogButtonBox(std.Save | std.Cancel, self)
@@ -112,7 +133,7 @@ class RegisterProfileDialog(QDialog):
     def _seconds_spin(self, bounds: tuple[float, float], decimals: int) -> QDoubleSpinBox:
         """A seconds field whose lowest value means "automatic" (None in the profile)."""
         spin = QDoubleSpinBox(self)
-        step = 10.0 ** -decimals
+        step = 10.0**-decimals
         spin.setDecimals(decimals)
         spin.setRange(bounds[0] - step, bounds[1])
         spin.setSingleStep(step * 10)
@@ -129,16 +150,28 @@ class RegisterProfileDialog(QDialog):
 
     def retranslate(self) -> None:
         self.setWindowTitle(self.tr("Register profile"))
-        captions = (self.tr("Name:"), self.tr("Float word order:"), self.tr("Unit id:"),
-                    self.tr("Command completion:"), self.tr("Unconfirmed after:"), self.tr("Poll timeout:"),
-                    self.tr("Date/time layout:"), self.tr("Lowest point id:"), self.tr("Highest point id:"))
+        captions = (
+            self.tr("Name:"),
+            self.tr("Float word order:"),
+            self.tr("Unit id:"),
+            self.tr("Command completion:"),
+            self.tr("Unconfirmed after:"),
+            self.tr("Poll timeout:"),
+            self.tr("Date/time layout:"),
+            self.tr("Lowest point id:"),
+            self.tr("Highest point id:"),
+        )
         for label, text in zip(self.captions, captions, strict=True):
             label.setText(text)
         self.order_combo.setItemText(0, self.tr("Low word first (CDAB, default)"))
         self.order_combo.setItemText(1, self.tr("High word first (ABCD)"))
-        for i, text in enumerate((self.tr("automatic (probe GV291 once)"),
-                                  self.tr("sentinel (GV291 keeps what the host writes)"),
-                                  self.tr("observe (GV291 read-only or ignores writes)"))):
+        for i, text in enumerate(
+            (
+                self.tr("automatic (probe GV291 once)"),
+                self.tr("sentinel (GV291 keeps what the host writes)"),
+                self.tr("observe (GV291 read-only or ignores writes)"),
+            )
+        ):
             self.completion_combo.setItemText(i, text)
         self.clock_combo.setItemText(0, self.tr("split words (576 = year, 577 = month·256 + day)"))
         self.clock_combo.setItemText(1, self.tr("packed 32-bit (year in the high word)"))
@@ -162,15 +195,27 @@ class RegisterProfileDialog(QDialog):
             self.error.setText(tip)
 
     def _editors(self) -> list[QWidget]:
-        return [self.name_edit, self.order_combo, self.unit_spin, self.completion_combo,
-                self.unconfirmed_spin, self.poll_timeout_spin, self.clock_combo, self.point_min_spin,
-                self.point_max_spin, self.load_button, self.defaults_button, self.reconnect_check]
+        return [
+            self.name_edit,
+            self.order_combo,
+            self.unit_spin,
+            self.completion_combo,
+            self.unconfirmed_spin,
+            self.poll_timeout_spin,
+            self.clock_combo,
+            self.point_min_spin,
+            self.point_max_spin,
+            self.load_button,
+            self.defaults_button,
+            self.reconnect_check,
+        ]
 
     def _show_revision(self) -> None:
         p = self.profile
         if p.revision:
             text = self.tr("In force: \u201c{name}\u201d, revision {rev}, saved {saved}").format(
-                name=p.name, rev=p.revision, saved=p.saved.replace("T", " ")[:19])
+                name=p.name, rev=p.revision, saved=p.saved.replace("T", " ")[:19]
+            )
         else:
             text = self.tr("In force: the remembered connection settings (no register profile saved yet)")
         self.revision_label.setText(text)
@@ -186,8 +231,10 @@ class RegisterProfileDialog(QDialog):
         self.order_combo.setCurrentIndex(max(0, self.order_combo.findData(p.word_order.value)))
         self.unit_spin.setValue(p.unit)
         self.completion_combo.setCurrentIndex(max(0, self.completion_combo.findData(p.completion)))
-        for spin, value in ((self.unconfirmed_spin, p.unconfirmed_after),
-                            (self.poll_timeout_spin, p.poll_timeout)):
+        for spin, value in (
+            (self.unconfirmed_spin, p.unconfirmed_after),
+            (self.poll_timeout_spin, p.poll_timeout),
+        ):
             spin.setValue(spin.minimum() if value is None else value)
         self.clock_combo.setCurrentIndex(max(0, self.clock_combo.findData(p.datetime_layout.value)))
         self.point_min_spin.setValue(p.point_id_min)
@@ -196,13 +243,18 @@ class RegisterProfileDialog(QDialog):
     def edited(self) -> RegisterProfile:
         """The form as a profile (keeps the revision in force); raises RegisterProfileError."""
         return RegisterProfile(
-            name=self.name_edit.text().strip(), word_order=WordOrder(self.order_combo.currentData()),
-            unit=self.unit_spin.value(), completion=self.completion_combo.currentData(),
+            name=self.name_edit.text().strip(),
+            word_order=WordOrder(self.order_combo.currentData()),
+            unit=self.unit_spin.value(),
+            completion=self.completion_combo.currentData(),
             unconfirmed_after=self._seconds(self.unconfirmed_spin),
             poll_timeout=self._seconds(self.poll_timeout_spin),
             datetime_layout=DateTimeLayout(self.clock_combo.currentData()),
-            point_id_min=self.point_min_spin.value(), point_id_max=self.point_max_spin.value(),
-            revision=self.profile.revision, saved=self.profile.saved)
+            point_id_min=self.point_min_spin.value(),
+            point_id_max=self.point_max_spin.value(),
+            revision=self.profile.revision,
+            saved=self.profile.saved,
+        )
 
     def load(self) -> None:
         path = self.open_path()
@@ -229,8 +281,9 @@ class RegisterProfileDialog(QDialog):
         try:
             rp.export_register_profile(path, profile)
         except OSError as exc:
-            self.error.setText(self.tr("Cannot write {file}: {why}").format(file=Path(path).name,
-                                                                             why=exc.strerror or exc))
+            self.error.setText(
+                self.tr("Cannot write {file}: {why}").format(file=Path(path).name, why=exc.strerror or exc)
+            )
             return
         self.error.setText(self.tr("Saved to {file}").format(file=Path(path).name))
 
@@ -248,11 +301,13 @@ class RegisterProfileDialog(QDialog):
 
     # --- files --------------------------------------------------------------------------------
     def _ask_open(self) -> str | None:
-        path, _ = QFileDialog.getOpenFileName(self, self.tr("Load a register profile"), "",
-                                              self.tr("Register profiles (*.json)"))
+        path, _ = QFileDialog.getOpenFileName(
+            self, self.tr("Load a register profile"), "", self.tr("Register profiles (*.json)")
+        )
         return path or None
 
     def _ask_save(self, suggested: str) -> str | None:
-        path, _ = QFileDialog.getSaveFileName(self, self.tr("Save the register profile as"), suggested,
-                                              self.tr("Register profiles (*.json)"))
+        path, _ = QFileDialog.getSaveFileName(
+            self, self.tr("Save the register profile as"), suggested, self.tr("Register profiles (*.json)")
+        )
         return path or None

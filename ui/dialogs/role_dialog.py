@@ -69,8 +69,10 @@ class RoleDialog(QDialog):
         self.set_password_button.setEnabled(first and self._role() is Role.ADMINISTRATOR)
         hint = ""
         if first:
-            hint = self.tr("No administrator password is set yet: choose the administrator role, type a "
-                           "password and press \u201cSet this role's password\u201d.")
+            hint = self.tr(
+                "No administrator password is set yet: choose the administrator role, type a "
+                "password and press \u201cSet this role's password\u201d."
+            )
         elif self._role() is not Role.OPERATOR and not store.has_password(self._role()):
             hint = self.tr("No password is set for this role; an administrator sets it.")
         self.error.setText(hint)
@@ -80,9 +82,11 @@ class RoleDialog(QDialog):
         try:
             self._safety.login(role, self.password.text())
         except WrongPassword:
-            self.error.setText(self.tr("Wrong password for the {role} role").format(
-                role=self._safety.role_name(role)) if self._safety.session.store.has_password(role)
-                else self.tr("No password is set for this role; an administrator sets it."))
+            self.error.setText(
+                self.tr("Wrong password for the {role} role").format(role=self._safety.role_name(role))
+                if self._safety.session.store.has_password(role)
+                else self.tr("No password is set for this role; an administrator sets it.")
+            )
             self.password.selectAll()
             return
         self.accept()

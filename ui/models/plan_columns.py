@@ -21,7 +21,16 @@ from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_WARN, COLOR_WHITE
 ModelIndex = QModelIndex | QPersistentModelIndex
 
 SEG_COLUMNS: tuple[str, ...] = (
-    "index", "kind", "via", "end", "speed", "orientation", "ignore_middle", "tool", "length", "time",
+    "index",
+    "kind",
+    "via",
+    "end",
+    "speed",
+    "orientation",
+    "ignore_middle",
+    "tool",
+    "length",
+    "time",
 )
 COL_INDEX = 0
 COL_KIND = 1

@@ -43,8 +43,9 @@ class _PlanListCommand(QUndoCommand):
 
 
 class _InsertPlanCommand(_PlanListCommand):
-    def __init__(self, model: PlanListModel, row: int, plan: Plan, text: str, *,
-                 remove: bool = False) -> None:
+    def __init__(
+        self, model: PlanListModel, row: int, plan: Plan, text: str, *, remove: bool = False
+    ) -> None:
         super().__init__(model, text)
         self._row = row
         self._plan = plan
@@ -64,8 +65,9 @@ class _InsertPlanCommand(_PlanListCommand):
 
 
 class _PlanFieldCommand(_PlanListCommand):
-    def __init__(self, model: PlanListModel, plan: Plan, name: str, old: object, new: object,
-                 text: str) -> None:
+    def __init__(
+        self, model: PlanListModel, plan: Plan, name: str, old: object, new: object, text: str
+    ) -> None:
         super().__init__(model, text)
         self._plan = plan
         self._name = name
@@ -130,8 +132,9 @@ class PlanListModel(QAbstractTableModel):
     def columnCount(self, parent: ModelIndex = QModelIndex()) -> int:  # noqa: B008
         return 0 if parent.isValid() else len(PLAN_COLUMNS)
 
-    def headerData(self, section: int, orientation: Qt.Orientation,
-                   role: int = Qt.ItemDataRole.DisplayRole) -> Any:
+    def headerData(
+        self, section: int, orientation: Qt.Orientation, role: int = Qt.ItemDataRole.DisplayRole
+    ) -> Any:
         if role != Qt.ItemDataRole.DisplayRole:
             return None
         if orientation == Qt.Orientation.Horizontal and 0 <= section < len(PLAN_COLUMNS):
@@ -197,8 +200,9 @@ class PlanListModel(QAbstractTableModel):
     def duplicate_plan(self, row: int) -> int:
         source = self._project.plans[row]
         copy = source.copy(self._project.unique_plan_name(source.name))
-        self._stack.push(_InsertPlanCommand(self, row + 1, copy,
-                                            self.tr("Duplicate plan {name}").format(name=source.name)))
+        self._stack.push(
+            _InsertPlanCommand(self, row + 1, copy, self.tr("Duplicate plan {name}").format(name=source.name))
+        )
         return row + 1
 
     def remove_plan(self, row: int) -> None:

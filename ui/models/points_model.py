@@ -78,11 +78,13 @@ from ui.models.undo_list import (
 
 ModelIndex = QModelIndex | QPersistentModelIndex
 
+
 class _ReplaceAllCommand(QUndoCommand):
     """The whole list swapped (CSV import)."""
 
-    def __init__(self, model: PointsModel, before: Sequence[TempPoint], after: Sequence[TempPoint],
-                 text: str) -> None:
+    def __init__(
+        self, model: PointsModel, before: Sequence[TempPoint], after: Sequence[TempPoint], text: str
+    ) -> None:
         super().__init__(text)
         self._model = model
         self._before = tuple(before)
@@ -138,8 +140,13 @@ class PointsModel(UndoableListModel):
         self._on_controller = {p.id: p for p in self.ledger if p.sync is SyncState.ON_CONTROLLER}
 
     def retranslate(self) -> None:
-        names = {"id": self.tr("ID"), "name": self.tr("Name"), "tool": self.tr("Tool"),
-                 "sync": self.tr("Sync"), "note": self.tr("Note")}
+        names = {
+            "id": self.tr("ID"),
+            "name": self.tr("Name"),
+            "tool": self.tr("Tool"),
+            "sync": self.tr("Sync"),
+            "note": self.tr("Note"),
+        }
         self._headers = tuple(names.get(c, c.upper()) for c in COLUMNS)
         self._header_tips = {
             COL_ID: self.tr("Temp point id on the controller"),
@@ -147,8 +154,9 @@ class PointsModel(UndoableListModel):
             COL_SYNC: self.tr("Whether the controller holds this point"),
             **{c: self.tr("mm, base frame") for c in range(COL_X, COL_X + 3)},
             **{c: self.tr("degrees") for c in range(COL_X + 3, COL_C + 1)},
-            **dict.fromkeys(EXT_COLUMNS,
-                            self.tr("External axis (recorded only: the controller does not store it)")),
+            **dict.fromkeys(
+                EXT_COLUMNS, self.tr("External axis (recorded only: the controller does not store it)")
+            ),
         }
         self.headerDataChanged.emit(Qt.Orientation.Horizontal, 0, len(COLUMNS) - 1)
 
@@ -165,8 +173,9 @@ class PointsModel(UndoableListModel):
     def row_of(self, point_id: int) -> int | None:
         return self.ledger.row_of(point_id)
 
-    def headerData(self, section: int, orientation: Qt.Orientation,
-                   role: int = Qt.ItemDataRole.DisplayRole) -> Any:
+    def headerData(
+        self, section: int, orientation: Qt.Orientation, role: int = Qt.ItemDataRole.DisplayRole
+    ) -> Any:
         if orientation == Qt.Orientation.Horizontal and 0 <= section < len(COLUMNS):
             if role == Qt.ItemDataRole.DisplayRole:
                 return self._headers[section]
@@ -230,13 +239,17 @@ class PointsModel(UndoableListModel):
                 reason = point.sync_error or self.tr("no reason given")
                 return self.tr("Upload failed: {reason}").format(reason=reason)
             return {
-                SyncState.UNKNOWN: self.tr("Not known whether the controller holds this point (it "
-                                           "restarted or the link was lost): upload it before moving to it"),
+                SyncState.UNKNOWN: self.tr(
+                    "Not known whether the controller holds this point (it "
+                    "restarted or the link was lost): upload it before moving to it"
+                ),
                 SyncState.ON_CONTROLLER: self.tr("The controller holds this point with these values"),
                 SyncState.CHANGED: self.tr("Changed on the host (or new) since the last upload"),
-                SyncState.UNCONFIRMED: self.tr("Sent without an error, but the controller's status never "
-                                               "changed: most likely there, not proven; upload it again "
-                                               "before moving to it"),
+                SyncState.UNCONFIRMED: self.tr(
+                    "Sent without an error, but the controller's status never "
+                    "changed: most likely there, not proven; upload it again "
+                    "before moving to it"
+                ),
             }[point.sync]
         if name == "note" and point.note:
             return point.note
@@ -271,8 +284,9 @@ class PointsModel(UndoableListModel):
     def refusal_text(self, point: TempPoint, name: str, exc: InvalidInput) -> str:
         reason = refusal_text(exc)
         column = self._headers[COLUMNS.index(name)] if name in COLUMNS else name
-        return self.tr("{point}, {column}: refused, {reason}").format(point=point.label, column=column,
-                                                                  reason=reason)
+        return self.tr("{point}, {column}: refused, {reason}").format(
+            point=point.label, column=column, reason=reason
+        )
 
     # --- edits (each pushes one undo command; raise InvalidInput when refused)
     def edit_field(self, row: int, name: str, value: object) -> bool:
@@ -287,8 +301,12 @@ class PointsModel(UndoableListModel):
             other = self.ledger.row_of(new.id)
             if other is not None and other != row:
                 taken = self.ledger[other].label
-                raise FieldError("id", f"id {new.id} is already used by {taken}", code="point_id_taken",
-                                 params={"id": new.id, "point": taken})
+                raise FieldError(
+                    "id",
+                    f"id {new.id} is already used by {taken}",
+                    code="point_id_taken",
+                    params={"id": new.id, "point": taken},
+                )
         after = self._follow_id(old.id, new.id) if old.id != new.id else None
         column = self._headers[COLUMNS.index(name)] if name in COLUMNS else name
         text = self.tr("Edit {point} {column}").format(point=old.label, column=column)
@@ -316,13 +334,22 @@ class PointsModel(UndoableListModel):
 
         return apply
 
-    def add_point(self, row: int | None = None, *, name: str = "", pose: Sequence[float] | None = None,
-                  tool: int = TOOL_NONE) -> int:
+    def add_point(
+        self,
+        row: int | None = None,
+        *,
+        name: str = "",
+        pose: Sequence[float] | None = None,
+        tool: int = TOOL_NONE,
+    ) -> int:
         """A new point (next free id) at ``row`` (default: the end); returns its row."""
         point = make_point(self.next_id(), name, pose or (0.0,) * 6, tool=tool, limits=self.ledger.limits)
         row = len(self.ledger) if row is None else max(0, min(row, len(self.ledger)))
-        self._stack.push(InsertRowsCommand(self, self.ledger, [(row, point)],
-                                           self.tr("Add {point}").format(point=point.label)))
+        self._stack.push(
+            InsertRowsCommand(
+                self, self.ledger, [(row, point)], self.tr("Add {point}").format(point=point.label)
+            )
+        )
         return row
 
     def next_id(self) -> int:
@@ -348,8 +375,11 @@ class PointsModel(UndoableListModel):
             used.add(new_id)
             copy = replace(source, id=new_id, sync=SyncState.CHANGED, sync_error="")
             copies.append((row + 1 + offset, copy))
-        text = (self.tr("Duplicate {point}").format(point=self.ledger[chosen[0]].label) if len(chosen) == 1
-                else self.tr("Duplicate {n} points").format(n=len(chosen)))
+        text = (
+            self.tr("Duplicate {point}").format(point=self.ledger[chosen[0]].label)
+            if len(chosen) == 1
+            else self.tr("Duplicate {n} points").format(n=len(chosen))
+        )
         self._stack.push(InsertRowsCommand(self, self.ledger, copies, text))
         return [row for row, _ in copies]
 
@@ -366,8 +396,11 @@ class PointsModel(UndoableListModel):
         chosen = sorted({r for r in rows if 0 <= r < len(self.ledger)})
         if not chosen:
             return 0
-        text = (self.tr("Delete {point}").format(point=self.ledger[chosen[0]].label) if len(chosen) == 1
-                else self.tr("Delete {n} points").format(n=len(chosen)))
+        text = (
+            self.tr("Delete {point}").format(point=self.ledger[chosen[0]].label)
+            if len(chosen) == 1
+            else self.tr("Delete {n} points").format(n=len(chosen))
+        )
         self._stack.push(RemoveRowsCommand(self, self.ledger, chosen, text))
         return len(chosen)
 
@@ -395,16 +428,24 @@ class PointsModel(UndoableListModel):
         point = replace(point, sync=SyncState.ON_CONTROLLER)
         if self.ledger.row_of(point_id) is not None:
             taken = self.ledger.point(point_id).label
-            raise FieldError("id", f"id {point_id} is already used by {taken}", code="point_id_taken",
-                             params={"id": point_id, "point": taken})
+            raise FieldError(
+                "id",
+                f"id {point_id} is already used by {taken}",
+                code="point_id_taken",
+                params={"id": point_id, "point": taken},
+            )
         self._on_controller[point_id] = point
         row = len(self.ledger)
-        self._stack.push(InsertRowsCommand(self, self.ledger, [(row, point)],
-                                           self.tr("Teach {point}").format(point=point.label)))
+        self._stack.push(
+            InsertRowsCommand(
+                self, self.ledger, [(row, point)], self.tr("Teach {point}").format(point=point.label)
+            )
+        )
         return row
 
-    def import_points(self, points: Sequence[TempPoint],
-                      mode: ImportMode = ImportMode.REPLACE, *, allow_empty: bool = False) -> ImportReport:
+    def import_points(
+        self, points: Sequence[TempPoint], mode: ImportMode = ImportMode.REPLACE, *, allow_empty: bool = False
+    ) -> ImportReport:
         """Import parsed points (one undo step); the ledger is untouched when refused (an empty
         list in replace mode too, unless ``allow_empty``)."""
         scratch = PointLedger(self.ledger.snapshot(), self.ledger.limits)

@@ -102,9 +102,16 @@ class SegmentTableModel(UndoableListModel):
 
     def retranslate(self) -> None:
         self._headers = (
-            self.tr("Check"), self.tr("Type"), self.tr("Middle point"), self.tr("End point"),
-            self.tr("Speed"), self.tr("Orientation"), self.tr("Ignore mid."), self.tr("Tool"),
-            self.tr("Length"), self.tr("Time"),
+            self.tr("Check"),
+            self.tr("Type"),
+            self.tr("Middle point"),
+            self.tr("End point"),
+            self.tr("Speed"),
+            self.tr("Orientation"),
+            self.tr("Ignore mid."),
+            self.tr("Tool"),
+            self.tr("Length"),
+            self.tr("Time"),
         )
         self.headerDataChanged.emit(Qt.Orientation.Horizontal, 0, len(SEG_COLUMNS) - 1)
 
@@ -159,8 +166,9 @@ class SegmentTableModel(UndoableListModel):
     def issues_of(self, row: int) -> list[PlanIssue]:
         return list(self._issues.get(row, ()))
 
-    def set_estimate(self, lengths: Sequence[float] | np.ndarray,
-                     times: Sequence[float] | np.ndarray) -> None:
+    def set_estimate(
+        self, lengths: Sequence[float] | np.ndarray, times: Sequence[float] | np.ndarray
+    ) -> None:
         self._lengths = np.asarray(lengths, dtype=np.float64)
         self._times = np.asarray(times, dtype=np.float64)
         if self.rowCount():
@@ -184,8 +192,9 @@ class SegmentTableModel(UndoableListModel):
         assert self._plan is not None
         return self._plan[row]
 
-    def headerData(self, section: int, orientation: Qt.Orientation,
-                   role: int = Qt.ItemDataRole.DisplayRole) -> Any:
+    def headerData(
+        self, section: int, orientation: Qt.Orientation, role: int = Qt.ItemDataRole.DisplayRole
+    ) -> Any:
         if orientation == Qt.Orientation.Vertical:
             return section + 1 if role == Qt.ItemDataRole.DisplayRole else None
         if orientation == Qt.Orientation.Horizontal and 0 <= section < len(SEG_COLUMNS):
@@ -340,8 +349,11 @@ class SegmentTableModel(UndoableListModel):
             return self.edit_field(row, name, value)
         except InvalidInput as exc:
             reason = refusal_text(exc)
-            self.editRejected.emit(self.tr("Segment {n}, {column}: refused, {reason}").format(
-                n=row + 1, column=self._headers[column], reason=reason))
+            self.editRejected.emit(
+                self.tr("Segment {n}, {column}: refused, {reason}").format(
+                    n=row + 1, column=self._headers[column], reason=reason
+                )
+            )
             return False
 
     # --- edits (undoable; raise InvalidInput when refused)
@@ -353,17 +365,26 @@ class SegmentTableModel(UndoableListModel):
             if not (name == "via" and blank):
                 value = parse_point_id(_strip_p(value), self._ledger.limits, name)
                 if value not in self._ledger:  # a segment only picks points that exist
-                    raise FieldError(name, f"point P{value} does not exist: pick one of the list",
-                                     code="segment_point_missing", params={"id": value})
+                    raise FieldError(
+                        name,
+                        f"point P{value} does not exist: pick one of the list",
+                        code="segment_point_missing",
+                        params={"id": value},
+                    )
         if name == "tool" and isinstance(value, str) and value.strip().lower() in TOOL_NONE_WORDS:
             value = TOOL_NONE
         new = old.with_field(name, value)
         if new.speed <= 0:
-            raise FieldError("speed", f"{new.speed:g} mm/s: the speed must be > 0", code="speed_not_positive",
-                             params={"speed": f"{new.speed:g}"})
+            raise FieldError(
+                "speed",
+                f"{new.speed:g} mm/s: the speed must be > 0",
+                code="speed_not_positive",
+                params={"speed": f"{new.speed:g}"},
+            )
         if new.is_arc and new.via_id is not None and new.via_id == new.end_id:
-            raise FieldError(name, "an arc's middle point must differ from its end point",
-                             code="arc_same_points")
+            raise FieldError(
+                name, "an arc's middle point must differ from its end point", code="arc_same_points"
+            )
         if new == old:
             return False
         column = self._headers[SEG_COLUMNS.index(name)] if name in SEG_COLUMNS else name
@@ -377,8 +398,11 @@ class SegmentTableModel(UndoableListModel):
         plan = self._require_plan()
         at = len(plan) if row is None else max(0, min(row, len(plan)))
         segment = self.default_segment(at, kind)
-        self._stack.push(InsertRowsCommand(self, plan, [(at, segment)],
-                                           self.tr("Add {kind} segment").format(kind=kind_text(kind))))
+        self._stack.push(
+            InsertRowsCommand(
+                self, plan, [(at, segment)], self.tr("Add {kind} segment").format(kind=kind_text(kind))
+            )
+        )
         return at
 
     def default_segment(self, at: int, kind: SegmentKind) -> Segment:
@@ -389,8 +413,11 @@ class SegmentTableModel(UndoableListModel):
         ids = self._ledger.ids()
         previous = plan[at - 1] if 0 < at <= len(plan) else None
         if len(ids) < (2 if kind is SegmentKind.ARC else 1):
-            raise InvalidInput("an arc needs two points: add or teach points first" if ids
-                               else "there are no points yet: add or teach a point first")
+            raise InvalidInput(
+                "an arc needs two points: add or teach points first"
+                if ids
+                else "there are no points yet: add or teach a point first"
+            )
 
         def after(pid: int | None) -> int:
             if pid is None or pid not in ids:
@@ -411,16 +438,20 @@ class SegmentTableModel(UndoableListModel):
         at = max(0, min(at, len(plan)))
         items = [(at + k, seg) for k, seg in enumerate(segments)]
         if items:
-            self._stack.push(InsertRowsCommand(self, plan, items,
-                                               self.tr("Add {n} segments").format(n=len(items))))
+            self._stack.push(
+                InsertRowsCommand(self, plan, items, self.tr("Add {n} segments").format(n=len(items)))
+            )
 
     def remove_rows(self, rows: Iterable[int]) -> int:
         plan = self._require_plan()
         chosen = sorted({r for r in rows if 0 <= r < len(plan)})
         if not chosen:
             return 0
-        text = (self.tr("Delete segment {n}").format(n=chosen[0] + 1) if len(chosen) == 1
-                else self.tr("Delete {n} segments").format(n=len(chosen)))
+        text = (
+            self.tr("Delete segment {n}").format(n=chosen[0] + 1)
+            if len(chosen) == 1
+            else self.tr("Delete {n} segments").format(n=len(chosen))
+        )
         self._stack.push(RemoveRowsCommand(self, plan, chosen, text))
         return len(chosen)
 
@@ -435,8 +466,13 @@ class SegmentTableModel(UndoableListModel):
         chosen = sorted(set(rows))
         if not self.can_move(chosen, delta):
             return chosen
-        command = MoveRowsCommand(self, plan, chosen, delta,
-                                  self.tr("Move segment up") if delta < 0 else self.tr("Move segment down"))
+        command = MoveRowsCommand(
+            self,
+            plan,
+            chosen,
+            delta,
+            self.tr("Move segment up") if delta < 0 else self.tr("Move segment down"),
+        )
         self._stack.push(command)
         return list(command.new_rows)
 
@@ -471,5 +507,9 @@ def _is_checked(value: Any) -> bool:
         return value
     if isinstance(value, int):
         return value == Qt.CheckState.Checked.value
-    raise FieldError("ignore_middle", f"{value!r} is not a check state", code="not_yes_no",
-                     params={"value": repr(value)[:40]})
+    raise FieldError(
+        "ignore_middle",
+        f"{value!r} is not a check state",
+        code="not_yes_no",
+        params={"value": repr(value)[:40]},
+    )

@@ -112,8 +112,9 @@ class UndoableListModel(QAbstractTableModel):
 class InsertRowsCommand(QUndoCommand):
     """Insert items at rows (rows are where they end up, ascending)."""
 
-    def __init__(self, model: UndoableListModel, target: RowList[Any], items: Sequence[tuple[int, Any]],
-                 text: str) -> None:
+    def __init__(
+        self, model: UndoableListModel, target: RowList[Any], items: Sequence[tuple[int, Any]], text: str
+    ) -> None:
         super().__init__(text)
         self._model = model
         self._target = target
@@ -127,8 +128,9 @@ class InsertRowsCommand(QUndoCommand):
 
 
 class RemoveRowsCommand(QUndoCommand):
-    def __init__(self, model: UndoableListModel, target: RowList[Any], rows: Iterable[int],
-                 text: str) -> None:
+    def __init__(
+        self, model: UndoableListModel, target: RowList[Any], rows: Iterable[int], text: str
+    ) -> None:
         super().__init__(text)
         self._model = model
         self._target = target
@@ -145,8 +147,9 @@ class RemoveRowsCommand(QUndoCommand):
 class MoveRowsCommand(QUndoCommand):
     """Move a set of rows one place up (-1) or down (+1)."""
 
-    def __init__(self, model: UndoableListModel, target: RowList[Any], rows: Iterable[int], delta: int,
-                 text: str) -> None:
+    def __init__(
+        self, model: UndoableListModel, target: RowList[Any], rows: Iterable[int], delta: int, text: str
+    ) -> None:
         super().__init__(text)
         if delta not in (-1, 1):
             raise ValueError("delta must be -1 or +1")
@@ -166,8 +169,17 @@ class MoveRowsCommand(QUndoCommand):
 class ReplaceRowCommand(QUndoCommand):
     """One row replaced (a cell edit); ``extra`` commands run after it (redo) / before (undo)."""
 
-    def __init__(self, model: UndoableListModel, target: RowList[Any], row: int, old: Any, new: Any,
-                 text: str, *, after: Callable[[bool], None] | None = None) -> None:
+    def __init__(
+        self,
+        model: UndoableListModel,
+        target: RowList[Any],
+        row: int,
+        old: Any,
+        new: Any,
+        text: str,
+        *,
+        after: Callable[[bool], None] | None = None,
+    ) -> None:
         super().__init__(text)
         self._model = model
         self._target = target

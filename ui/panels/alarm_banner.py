@@ -101,9 +101,11 @@ class AlarmBanner(QToolBar):
         self.setFloatable(False)
         self.toggleViewAction().setVisible(False)  # not in the window's context menu: not closable
         self.setContextMenuPolicy(Qt.ContextMenuPolicy.PreventContextMenu)
-        self.setStyleSheet(f"QToolBar#AlarmBanner {{ background: {COLOR_ALARM_BANNER};"
-                           f" border: none; border-bottom: 2px solid {COLOR_ERROR_DARK};"
-                           f" padding: 0px; spacing: 0px; }}")
+        self.setStyleSheet(
+            f"QToolBar#AlarmBanner {{ background: {COLOR_ALARM_BANNER};"
+            f" border: none; border-bottom: 2px solid {COLOR_ERROR_DARK};"
+            f" padding: 0px; spacing: 0px; }}"
+        )
         layout = self.layout()
         if layout is not None:
             layout.setContentsMargins(0, 0, 0, 0)
@@ -173,4 +175,3 @@ class AlarmBanner(QToolBar):
         self.label.set_full_text("   ".join([head, *lines]))
         self.label.setToolTip(self._plain)
         self.setToolTip(self.tr("Register 562 = {word}").format(word=f"0x{self._alarms:04X}"))
-

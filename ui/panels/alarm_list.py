@@ -85,8 +85,15 @@ class AlarmListPanel(QWidget):
         return item.text() if item is not None else ""
 
     def retranslate(self) -> None:
-        self.table.setHorizontalHeaderLabels([self.tr("Alarm"), self.tr("Meaning"), self.tr("What to do"),
-                                              self.tr("Raised"), self.tr("Cleared")])
+        self.table.setHorizontalHeaderLabels(
+            [
+                self.tr("Alarm"),
+                self.tr("Meaning"),
+                self.tr("What to do"),
+                self.tr("Raised"),
+                self.tr("Cleared"),
+            ]
+        )
         self._render()
 
     def changeEvent(self, event: QEvent) -> None:
@@ -112,8 +119,10 @@ class AlarmListPanel(QWidget):
             tip = "\n".join(
                 self.tr("raised {raised}, cleared {cleared}").format(
                     raised=o.raised.strftime(TIME_FORMAT),
-                    cleared=o.cleared.strftime(TIME_FORMAT) if o.cleared else self.tr("active"))
-                for o in history[:20])
+                    cleared=o.cleared.strftime(TIME_FORMAT) if o.cleared else self.tr("active"),
+                )
+                for o in history[:20]
+            )
             for column, text in enumerate(texts):
                 item = table.item(row, column)
                 if item is None:

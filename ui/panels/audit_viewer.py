@@ -49,12 +49,19 @@ class AuditModel(QAbstractTableModel):
     def columnCount(self, parent: _Index = QModelIndex()) -> int:  # noqa: B008 - Qt's API
         return 0 if parent.isValid() else len(self.COLUMNS)
 
-    def headerData(self, section: int, orientation: Qt.Orientation,
-                   role: int = Qt.ItemDataRole.DisplayRole) -> Any:
+    def headerData(
+        self, section: int, orientation: Qt.Orientation, role: int = Qt.ItemDataRole.DisplayRole
+    ) -> Any:
         if role != Qt.ItemDataRole.DisplayRole or orientation != Qt.Orientation.Horizontal:
             return None
-        return (self.tr("Time"), self.tr("Role"), self.tr("Kind"), self.tr("Command"), self.tr("Result"),
-                self.tr("Detail"))[section]
+        return (
+            self.tr("Time"),
+            self.tr("Role"),
+            self.tr("Kind"),
+            self.tr("Command"),
+            self.tr("Result"),
+            self.tr("Detail"),
+        )[section]
 
     def data(self, index: _Index, role: int = Qt.ItemDataRole.DisplayRole) -> Any:
         if not index.isValid() or role not in (Qt.ItemDataRole.DisplayRole, Qt.ItemDataRole.ToolTipRole):
@@ -69,19 +76,32 @@ class AuditModel(QAbstractTableModel):
         return value
 
     def _words(self) -> dict[str, str]:
-        return {"operator": self.tr("operator"), "engineer": self.tr("engineer"),
-                "administrator": self.tr("administrator"),
-                "administrator (cli)": self.tr("administrator (CLI)"),
-                "write": self.tr("write"), "refused": self.tr("refused"), "login": self.tr("login"),
-                "action": self.tr("action"), "ok": self.tr("ok"), "failed": self.tr("failed"),
-                "blocked": self.tr("blocked"), "unknown": self.tr("unknown")}
+        return {
+            "operator": self.tr("operator"),
+            "engineer": self.tr("engineer"),
+            "administrator": self.tr("administrator"),
+            "administrator (cli)": self.tr("administrator (CLI)"),
+            "write": self.tr("write"),
+            "refused": self.tr("refused"),
+            "login": self.tr("login"),
+            "action": self.tr("action"),
+            "ok": self.tr("ok"),
+            "failed": self.tr("failed"),
+            "blocked": self.tr("blocked"),
+            "unknown": self.tr("unknown"),
+        }
 
 
 class AuditViewer(QDialog):
     """``save_path(suggested) -> path or None`` asks where to export (tests replace it)."""
 
-    def __init__(self, directory: Path, parent: QWidget | None = None, *,
-                 save_path: Callable[[str], str | None] | None = None) -> None:
+    def __init__(
+        self,
+        directory: Path,
+        parent: QWidget | None = None,
+        *,
+        save_path: Callable[[str], str | None] | None = None,
+    ) -> None:
         super().__init__(parent)
         self.setObjectName("AuditViewer")
         self.setWindowTitle(self.tr("Audit trail"))
@@ -95,17 +115,24 @@ class AuditViewer(QDialog):
             edit.setDisplayFormat("yyyy-MM-dd")
         self.role_box = QComboBox(self)
         self.role_box.addItem(self.tr("Any role"), None)
-        for name, text in (("operator", self.tr("operator")), ("engineer", self.tr("engineer")),
-                           ("administrator", self.tr("administrator")),
-                           ("administrator (cli)", self.tr("administrator (CLI)"))):
+        for name, text in (
+            ("operator", self.tr("operator")),
+            ("engineer", self.tr("engineer")),
+            ("administrator", self.tr("administrator")),
+            ("administrator (cli)", self.tr("administrator (CLI)")),
+        ):
             self.role_box.addItem(text, name)
         self.command = QLineEdit(self)
         self.command.setPlaceholderText(self.tr("Command contains…"))
         self.result_box = QComboBox(self)
         self.result_box.addItem(self.tr("Any result"), None)
-        for value, text in ((Result.OK, self.tr("ok")), (Result.FAILED, self.tr("failed")),
-                            (Result.BLOCKED, self.tr("blocked")), (Result.REFUSED, self.tr("refused")),
-                            (Result.UNKNOWN, self.tr("unknown"))):
+        for value, text in (
+            (Result.OK, self.tr("ok")),
+            (Result.FAILED, self.tr("failed")),
+            (Result.BLOCKED, self.tr("blocked")),
+            (Result.REFUSED, self.tr("refused")),
+            (Result.UNKNOWN, self.tr("unknown")),
+        ):
             self.result_box.addItem(text, value)
         self.refresh_button = QPushButton(self.tr("Show"), self)
         self.refresh_button.clicked.connect(self.refresh)
@@ -139,10 +166,13 @@ class AuditViewer(QDialog):
         end = self.end.date().toPython()
         assert isinstance(start, dt.date) and isinstance(end, dt.date)
         tz = dt.datetime.now().astimezone().tzinfo
-        return AuditFilter(start=dt.datetime.combine(start, dt.time.min, tz),
-                           end=dt.datetime.combine(end, dt.time.max, tz),
-                           role=self.role_box.currentData(), command=self.command.text().strip() or None,
-                           result=self.result_box.currentData())
+        return AuditFilter(
+            start=dt.datetime.combine(start, dt.time.min, tz),
+            end=dt.datetime.combine(end, dt.time.max, tz),
+            role=self.role_box.currentData(),
+            command=self.command.text().strip() or None,
+            result=self.result_box.currentData(),
+        )
 
     def refresh(self) -> None:
         stats = ReadStats()
@@ -158,8 +188,9 @@ class AuditViewer(QDialog):
         self.table.scrollToBottom()
 
     def _ask_path(self, suggested: str) -> str | None:
-        path, _ = QFileDialog.getSaveFileName(self, self.tr("Export the audit trail"), suggested,
-                                              self.tr("CSV files (*.csv)"))
+        path, _ = QFileDialog.getSaveFileName(
+            self, self.tr("Export the audit trail"), suggested, self.tr("CSV files (*.csv)")
+        )
         return path or None
 
     def export(self) -> None:
@@ -170,7 +201,8 @@ class AuditViewer(QDialog):
             with open(path, "w", encoding="utf-8", newline="") as out:
                 n = export_csv(self.model.records, out)
         except OSError as exc:
-            self.status.setText(self.tr("Cannot write {file}: {why}").format(file=Path(path).name,
-                                                                              why=exc.strerror or exc))
+            self.status.setText(
+                self.tr("Cannot write {file}: {why}").format(file=Path(path).name, why=exc.strerror or exc)
+            )
             return
         self.status.setText(self.tr("{n} records exported to {file}").format(n=n, file=Path(path).name))

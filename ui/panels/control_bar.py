@@ -72,7 +72,8 @@ class ControlBar(QWidget):
         self.stop_button.setFont(stop_font)
         self.stop_button.setFixedSize(
             max(STOP_MIN_WIDTH, fit_width(self.stop_button, both_languages("ControlBar", "STOP"), 28)),
-            2 * BUTTON_HEIGHT + 4)
+            2 * BUTTON_HEIGHT + 4,
+        )
         self.stop_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         self.stop_button.clicked.connect(self.stopRequested)
 
@@ -223,12 +224,14 @@ class ControlBar(QWidget):
         name = self.tr("unknown") if mode is None else protocol_text(controller_mode_text(int(mode)))
         full = self.tr("Mode:\n{mode}").format(mode=name)
         self.mode_label.setText(self.tr("Mode:\n{mode}").format(mode=self._fit_mode_name(name)))
-        self.mode_label.setToolTip(full.replace("\n", " ") + "\n"
-                                   + self.tr("The controller's work mode (register 560)"))
+        self.mode_label.setToolTip(
+            full.replace("\n", " ") + "\n" + self.tr("The controller's work mode (register 560)")
+        )
         background, color = MODE_COLORS.get(None if mode is None else int(mode), UNKNOWN_MODE_COLORS)
         self.mode_label.setStyleSheet(
             f"QLabel {{ background-color: {background}; color: {color}; border-radius: 5px;"
-            " padding: 3px 4px; }")
+            " padding: 3px 4px; }"
+        )
         self.manual_button.setChecked(mode == ControllerMode.MANUAL)
         self.auto_button.setChecked(mode in (ControllerMode.AUTO, ControllerMode.MODBUS_TEACH))
 

@@ -85,8 +85,10 @@ class LogEvent:
         if self.source_of is None and self.text_of is None:
             return self
         return dataclasses.replace(
-            self, source=self.source if self.source_of is None else self.source_of(),
-            text=self.text if self.text_of is None else self.text_of())
+            self,
+            source=self.source if self.source_of is None else self.source_of(),
+            text=self.text if self.text_of is None else self.text_of(),
+        )
 
 
 class EventLogModel(QAbstractTableModel):
@@ -127,8 +129,9 @@ class EventLogModel(QAbstractTableModel):
             self._events = [event.rendered() for event in self._events]
             last = len(self._events) - 1
             self.dataChanged.emit(
-                self.index(0, 0), self.index(last, _COLUMN_COUNT - 1),
-                [Qt.ItemDataRole.DisplayRole, Qt.ItemDataRole.ToolTipRole]
+                self.index(0, 0),
+                self.index(last, _COLUMN_COUNT - 1),
+                [Qt.ItemDataRole.DisplayRole, Qt.ItemDataRole.ToolTipRole],
             )
 
     @property
@@ -304,8 +307,14 @@ class EventLogPanel(QWidget):
             raise ValueError(f"level must be one of {LEVELS}, got {level!r}")
         source_of = source if callable(source) else None
         text_of = text if callable(text) else None
-        event = LogEvent(when or dt.datetime.now(), level, source if isinstance(source, str) else "",
-                         text if isinstance(text, str) else "", source_of, text_of).rendered()
+        event = LogEvent(
+            when or dt.datetime.now(),
+            level,
+            source if isinstance(source, str) else "",
+            text if isinstance(text, str) else "",
+            source_of,
+            text_of,
+        ).rendered()
         bar = self.view.verticalScrollBar()
         follow = bar.value() >= bar.maximum() - 2
         self.model.add(event)
@@ -372,8 +381,10 @@ class EventLogPanel(QWidget):
         _text, lamp = connection_display(connection)
 
         def text() -> str:
-            parts = [connection_display(connection)[0],
-                     *(p for p in (connection.endpoint, connection_text(connection)) if p)]
+            parts = [
+                connection_display(connection)[0],
+                *(p for p in (connection.endpoint, connection_text(connection)) if p),
+            ]
             return " — ".join(parts)
 
         if lamp == LEVEL_ERROR:
@@ -407,5 +418,10 @@ class EventLogPanel(QWidget):
 
     @Slot()
     def _export_dialog(self) -> None:
-        export_with_dialog(self, self.tr("Export event log"), "events.txt",
-                           self.tr("Text files (*.txt *.log);;All files (*)"), self.export_to)
+        export_with_dialog(
+            self,
+            self.tr("Export event log"),
+            "events.txt",
+            self.tr("Text files (*.txt *.log);;All files (*)"),
+            self.export_to,
+        )

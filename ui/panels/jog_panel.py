@@ -34,10 +34,22 @@ from ui.touch import MOTION_MIN_HEIGHT, RowsScrollArea, mark_motion
 
 DEFAULT_RATIO = 20
 # Keyboard jog: axis n (1..6) plus / minus. Letters on two rows of a QWERTY keyboard.
-PLUS_KEYS: tuple[Qt.Key, ...] = (Qt.Key.Key_Q, Qt.Key.Key_W, Qt.Key.Key_E, Qt.Key.Key_R, Qt.Key.Key_T,
-                                 Qt.Key.Key_Y)
-MINUS_KEYS: tuple[Qt.Key, ...] = (Qt.Key.Key_A, Qt.Key.Key_S, Qt.Key.Key_D, Qt.Key.Key_F, Qt.Key.Key_G,
-                                  Qt.Key.Key_H)
+PLUS_KEYS: tuple[Qt.Key, ...] = (
+    Qt.Key.Key_Q,
+    Qt.Key.Key_W,
+    Qt.Key.Key_E,
+    Qt.Key.Key_R,
+    Qt.Key.Key_T,
+    Qt.Key.Key_Y,
+)
+MINUS_KEYS: tuple[Qt.Key, ...] = (
+    Qt.Key.Key_A,
+    Qt.Key.Key_S,
+    Qt.Key.Key_D,
+    Qt.Key.Key_F,
+    Qt.Key.Key_G,
+    Qt.Key.Key_H,
+)
 _FRAMES: tuple[TeachFrame, ...] = (TeachFrame.BASE, TeachFrame.USER, TeachFrame.TOOL, TeachFrame.JOINT)
 BUTTON_WIDTH = 44  # px, the least width of a ± button (two columns of them fit the control column)
 EXTERNAL_COLUMN = 4  # grid column where the external axes start (joint frame: J7..J11 on the right)
@@ -358,8 +370,16 @@ class JogPanel(QWidget):
         self._held = held
         self._light(held, True)
         frame = self.frame
-        self.jogPressed.emit(JogRequest(frame, axis, direction, float(self.ratio),
-                                        user=self.user_spin.value(), tool=self.tool_spin.value()))
+        self.jogPressed.emit(
+            JogRequest(
+                frame,
+                axis,
+                direction,
+                float(self.ratio),
+                user=self.user_spin.value(),
+                tool=self.tool_spin.value(),
+            )
+        )
 
     def _release(self, source: str) -> None:
         held = self._held
@@ -388,10 +408,12 @@ class JogPanel(QWidget):
             if visible:
                 label.setText(names[axis])
                 unit = self.tr("°") if joint or axis >= 3 else self.tr("mm")
-                self.minus_buttons[axis].setToolTip(self.tr("Hold: {axis} − ({unit})").format(
-                    axis=names[axis], unit=unit))
-                self.plus_buttons[axis].setToolTip(self.tr("Hold: {axis} + ({unit})").format(
-                    axis=names[axis], unit=unit))
+                self.minus_buttons[axis].setToolTip(
+                    self.tr("Hold: {axis} − ({unit})").format(axis=names[axis], unit=unit)
+                )
+                self.plus_buttons[axis].setToolTip(
+                    self.tr("Hold: {axis} + ({unit})").format(axis=names[axis], unit=unit)
+                )
             for widget in (label, self.minus_buttons[axis], self.plus_buttons[axis]):
                 widget.setVisible(visible)
         self.external_caption.setVisible(joint)

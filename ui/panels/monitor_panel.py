@@ -252,8 +252,10 @@ class MonitorPanel(QWidget):
         if self._angle_raw is None:
             unwrapped = list(raw)
         else:
-            unwrapped = [unwrap_degrees(p, u, r)
-                         for p, u, r in zip(self._angle_raw, self._angle_unwrapped, raw, strict=True)]
+            unwrapped = [
+                unwrap_degrees(p, u, r)
+                for p, u, r in zip(self._angle_raw, self._angle_unwrapped, raw, strict=True)
+            ]
         self._angle_raw, self._angle_unwrapped = raw, unwrapped
         row = (rel, pose.x, pose.y, pose.z, *unwrapped)
         self._history.append(row)

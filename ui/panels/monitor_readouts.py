@@ -68,8 +68,9 @@ class ReadoutBoxes:
             axes_grid.setColumnStretch(column, 1)
 
     def _small(self, name: str) -> NumericReadout:
-        readout = NumericReadout(name, "", point_size=SMALL_POINTS, width_chars=8, unit_room="",
-                                 parent=self.axes_box)
+        readout = NumericReadout(
+            name, "", point_size=SMALL_POINTS, width_chars=8, unit_room="", parent=self.axes_box
+        )
         self.readouts[name] = readout
         return readout
 

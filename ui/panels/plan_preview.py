@@ -97,14 +97,17 @@ class _Projection:
         self.h = h
         self.v = v
         self.path = pg.PlotCurveItem(pen=pg.mkPen(COLOR_PATH, width=2), connect="finite", antialias=True)
-        self.selected = pg.PlotCurveItem(pen=pg.mkPen(COLOR_HIGHLIGHT, width=5), connect="finite",
-                                         antialias=True)
+        self.selected = pg.PlotCurveItem(
+            pen=pg.mkPen(COLOR_HIGHLIGHT, width=5), connect="finite", antialias=True
+        )
         self.points = pg.ScatterPlotItem(size=7, brush=pg.mkBrush(COLOR_AXIS), pen=pg.mkPen("w"))
-        self.start = pg.ScatterPlotItem(size=11, symbol="t1", brush=pg.mkBrush(COLOR_START),
-                                        pen=pg.mkPen("w"))
+        self.start = pg.ScatterPlotItem(
+            size=11, symbol="t1", brush=pg.mkBrush(COLOR_START), pen=pg.mkPen("w")
+        )
         self.trail = pg.PlotCurveItem(pen=pg.mkPen(COLOR_TRAIL, width=2))
-        self.tcp = pg.ScatterPlotItem(size=13, symbol="o", brush=pg.mkBrush(COLOR_TCP),
-                                      pen=pg.mkPen(COLOR_INK))
+        self.tcp = pg.ScatterPlotItem(
+            size=13, symbol="o", brush=pg.mkBrush(COLOR_TCP), pen=pg.mkPen(COLOR_INK)
+        )
         # the safety envelope (added at the first envelope): each box's 12 edges projected, dashed
         self.keep_in: pg.PlotCurveItem | None = None
         self.keep_out: pg.PlotCurveItem | None = None
@@ -269,8 +272,12 @@ class PlanPreview(QWidget):
         for key, title in self._titles.items():
             title.setText(names[key])
         self.fit_button.setText(QCoreApplication.translate("PlanPreview", "Fit"))
-        self.fit_button.setToolTip(QCoreApplication.translate(
-            "PlanPreview", "Fit the views to the plan; they follow every change again until you zoom or pan"))
+        self.fit_button.setToolTip(
+            QCoreApplication.translate(
+                "PlanPreview",
+                "Fit the views to the plan; they follow every change again until you zoom or pan",
+            )
+        )
 
     def changeEvent(self, event: QEvent) -> None:
         if event.type() == QEvent.Type.LanguageChange:
@@ -323,8 +330,9 @@ class PlanPreview(QWidget):
     def set_info(self, text: str) -> None:
         self.info.setText(text)
 
-    def show_plan(self, plan: Plan, ledger: PointLedger, start: Sequence[float] | None,
-                  selected: int | None) -> None:
+    def show_plan(
+        self, plan: Plan, ledger: PointLedger, start: Sequence[float] | None, selected: int | None
+    ) -> None:
         """Draw ``plan`` from ``start`` with the points it uses (all the points while it has no
         segments); the view fits another plan always, a change of the same plan unless the
         operator zoomed or panned since the last fit."""
@@ -336,8 +344,9 @@ class PlanPreview(QWidget):
             present = [p for p in used if p is not None]
         else:
             present = list(ledger)  # what a new plan can use
-        self.set_points(np.array([p.xyz for p in present], dtype=np.float64).reshape(-1, 3),
-                        [f"P{p.id}" for p in present])
+        self.set_points(
+            np.array([p.xyz for p in present], dtype=np.float64).reshape(-1, 3), [f"P{p.id}" for p in present]
+        )
         self.set_start(start)
         self.set_selected(selected)
         if another or not self._operator_view:
@@ -362,20 +371,28 @@ class PlanPreview(QWidget):
         """The plan's lengths and times (worked out by :func:`app.plan.presenter.plan_info`)."""
         loops = self.tr("endless") if info.loops == 0 else str(info.loops)
         lines = [
-            self.tr("<b>{name}</b>: {n} segments, loops: {loops}").format(name=info.name, n=info.segments,
-                                                                         loops=loops),
+            self.tr("<b>{name}</b>: {n} segments, loops: {loops}").format(
+                name=info.name, n=info.segments, loops=loops
+            ),
             self.tr("One loop: {length}, {time}").format(length=info.loop_length, time=info.loop_time),
             self.tr("Total: {length}, {time}").format(length=info.total_length, time=info.total_time),
         ]
         if info.unknown:
-            lines.append(self.tr("Not counted (unknown length): segments {list}").format(
-                list=", ".join(str(k) for k in info.unknown)))
+            lines.append(
+                self.tr("Not counted (unknown length): segments {list}").format(
+                    list=", ".join(str(k) for k in info.unknown)
+                )
+            )
         if info.selected is not None:
             k = info.selected
-            lines.append(self.tr("Segment {k}: {length}, {time}").format(k=k.number, length=k.length,
-                                                                        time=k.time))
-        lines.append(self.tr("Start: end of the last segment (robot pose unknown)") if info.assumed_start
-                     else self.tr("Start: the robot's current pose"))
+            lines.append(
+                self.tr("Segment {k}: {length}, {time}").format(k=k.number, length=k.length, time=k.time)
+            )
+        lines.append(
+            self.tr("Start: end of the last segment (robot pose unknown)")
+            if info.assumed_start
+            else self.tr("Start: the robot's current pose")
+        )
         self.set_info("<br>".join(lines))
 
     def set_envelope(self, envelope: Envelope | None) -> None:
@@ -401,7 +418,7 @@ class PlanPreview(QWidget):
         if path is not None and index is not None:
             hit = np.flatnonzero(path.segment == index)
             if hit.size:
-                rows = path.xyz[hit[0]:hit[-1] + 1]
+                rows = path.xyz[hit[0] : hit[-1] + 1]
         for proj in self._projections.values():
             if rows is None:
                 proj.selected.setData([], [])
@@ -468,7 +485,7 @@ class PlanPreview(QWidget):
         k = (self._trail_count - 1) % TRAIL_LENGTH
         n = min(self._trail_count, TRAIL_LENGTH)
         end = k + 1 + TRAIL_LENGTH if self._trail_count > TRAIL_LENGTH else k + 1
-        view = self._trail[end - n:end]
+        view = self._trail[end - n : end]
         for proj in self._projections.values():
             proj.trail.setData(view[:, proj.h], view[:, proj.v])
         if self._last_tcp is not None:

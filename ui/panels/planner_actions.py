@@ -35,8 +35,19 @@ SHORTCUTS: dict[str, str] = {
 }
 
 #: The plan edits (engineer and up); the rest (run, step, pause, ...) is the operator's.
-EDIT_ACTIONS = frozenset({"add_plan", "rename_plan", "duplicate_plan", "delete_plan", "add_line", "add_arc",
-                          "delete_segment", "segment_up", "segment_down"})
+EDIT_ACTIONS = frozenset(
+    {
+        "add_plan",
+        "rename_plan",
+        "duplicate_plan",
+        "delete_plan",
+        "add_line",
+        "add_arc",
+        "delete_segment",
+        "segment_up",
+        "segment_down",
+    }
+)
 
 
 class PlannerActions(QObject):
@@ -90,18 +101,31 @@ class PlannerActions(QObject):
 
     def set_resume_from(self, k: int | None) -> None:
         """``Resume from segment k`` (1-based), or the bare text when there is nothing to resume."""
-        self.all["resume_from"].setText(self.tr("Resume from segment {k}").format(k=k) if k is not None
-                                        else self.tr("Resume from segment"))
+        self.all["resume_from"].setText(
+            self.tr("Resume from segment {k}").format(k=k)
+            if k is not None
+            else self.tr("Resume from segment")
+        )
 
     def apply(self, states: ActionStates) -> None:
         enabled = {
-            "add_plan": states.add_plan, "rename_plan": states.edit_plan,
-            "duplicate_plan": states.edit_plan, "delete_plan": states.edit_plan,
-            "add_line": states.add_segment, "add_arc": states.add_segment,
-            "delete_segment": states.delete_segment, "segment_up": states.segment_up,
-            "segment_down": states.segment_down, "run": states.run, "run_from": states.run_from,
-            "step": states.run, "pause": states.pause, "resume": states.resume, "stop": states.stop,
-            "resume_from": states.resume_from, "upload_now": states.upload_now,
+            "add_plan": states.add_plan,
+            "rename_plan": states.edit_plan,
+            "duplicate_plan": states.edit_plan,
+            "delete_plan": states.edit_plan,
+            "add_line": states.add_segment,
+            "add_arc": states.add_segment,
+            "delete_segment": states.delete_segment,
+            "segment_up": states.segment_up,
+            "segment_down": states.segment_down,
+            "run": states.run,
+            "run_from": states.run_from,
+            "step": states.run,
+            "pause": states.pause,
+            "resume": states.resume,
+            "stop": states.stop,
+            "resume_from": states.resume_from,
+            "upload_now": states.upload_now,
         }
         for name, on in enabled.items():
             gated = self.edit_reason is not None and name in EDIT_ACTIONS

@@ -28,9 +28,16 @@ from ui.panels.planner_widgets import PlanChecksBar
 class PlannerChecks:
     """Checks, estimates and preview of the planner's plan (the panel says when)."""
 
-    def __init__(self, segments: SegmentTableModel, preview: PlanPreview, checks_bar: PlanChecksBar,
-                 ledger: Callable[[], PointLedger], pose: Callable[[], Pose | None], has_sync: bool,
-                 limits: PlanLimits | None = None) -> None:
+    def __init__(
+        self,
+        segments: SegmentTableModel,
+        preview: PlanPreview,
+        checks_bar: PlanChecksBar,
+        ledger: Callable[[], PointLedger],
+        pose: Callable[[], Pose | None],
+        has_sync: bool,
+        limits: PlanLimits | None = None,
+    ) -> None:
         self._segments = segments
         self._preview = preview
         self._bar = checks_bar
@@ -44,11 +51,20 @@ class PlannerChecks:
         self.issues: list[PlanIssue] = []
         self.summary_text = ""
 
-    def check(self, plan: Plan, pose: Pose | None, *, start_index: int = 0,
-              loops: int | None = None) -> list[PlanIssue]:
-        return check_plan(plan, self._ledger(), self.limits, pose, start_index=start_index,
-                          loops=plan.loops if loops is None else loops, envelope=self.envelope,
-                          reduced_speed=self.reduced_speed, reach=self.reach)
+    def check(
+        self, plan: Plan, pose: Pose | None, *, start_index: int = 0, loops: int | None = None
+    ) -> list[PlanIssue]:
+        return check_plan(
+            plan,
+            self._ledger(),
+            self.limits,
+            pose,
+            start_index=start_index,
+            loops=plan.loops if loops is None else loops,
+            envelope=self.envelope,
+            reduced_speed=self.reduced_speed,
+            reach=self.reach,
+        )
 
     def recheck(self, plan: Plan | None, selected: int | None) -> None:
         """Check ``plan`` from the robot's pose and show it all (``selected``: the segment row)."""

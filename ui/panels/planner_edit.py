@@ -21,8 +21,9 @@ from ui.models.segment_model import SegmentTableModel
 from ui.widgets.point_picker import PointPickerDelegate
 
 
-def install_point_pickers(view: QTableView, ledger: Callable[[], PointLedger]
-                          ) -> tuple[PointPickerDelegate, PointPickerDelegate]:
+def install_point_pickers(
+    view: QTableView, ledger: Callable[[], PointLedger]
+) -> tuple[PointPickerDelegate, PointPickerDelegate]:
     """Point pickers (existing points by id and name, no free number) for the middle point
     (may stay blank) and the end point columns of ``view``; returns (middle, end)."""
     via = PointPickerDelegate(ledger, view, allow_blank=True)
@@ -51,8 +52,13 @@ class PlanEditView(Protocol):
 class PlanEdits(QObject):
     """Plan and segment edits on behalf of the planner panel (its actions call these)."""
 
-    def __init__(self, view: PlanEditView, plans: PlanListModel, segments: SegmentTableModel,
-                 parent: QObject | None = None) -> None:
+    def __init__(
+        self,
+        view: PlanEditView,
+        plans: PlanListModel,
+        segments: SegmentTableModel,
+        parent: QObject | None = None,
+    ) -> None:
         super().__init__(parent)
         self._view = view
         self._plans = plans

@@ -75,10 +75,17 @@ class PlannerPanel(QWidget):
 
     statusMessage = Signal(str)
 
-    def __init__(self, plans: PlanListModel, points: PointsModel,
-                 run_controller: PlanRunController | None = None,
-                 point_sync: PointSyncController | None = None, parent: QWidget | None = None, *,
-                 confirm: ConfirmFn | None = None, limits: PlanLimits | None = None) -> None:
+    def __init__(
+        self,
+        plans: PlanListModel,
+        points: PointsModel,
+        run_controller: PlanRunController | None = None,
+        point_sync: PointSyncController | None = None,
+        parent: QWidget | None = None,
+        *,
+        confirm: ConfirmFn | None = None,
+        limits: PlanLimits | None = None,
+    ) -> None:
         super().__init__(parent)
         self.setObjectName("PlannerPanel")
         self._plans = plans
@@ -98,8 +105,15 @@ class PlannerPanel(QWidget):
         self.delete_segments, self.move_segments = e.delete_segments, e.move_segments
         self._make_actions()
         self._build()
-        self.checks = PlannerChecks(self.segments, self.preview, self.checks_bar, lambda: self._points.ledger,
-                                    self._pose, point_sync is not None, limits)
+        self.checks = PlannerChecks(
+            self.segments,
+            self.preview,
+            self.checks_bar,
+            lambda: self._points.ledger,
+            self._pose,
+            point_sync is not None,
+            limits,
+        )
         self.retranslate()
 
         plans.modelReset.connect(self._on_plans_reset)
@@ -111,8 +125,14 @@ class PlannerPanel(QWidget):
         self.segments.modelReset.connect(self.recheck)
         self.segments.planShown.connect(self._on_plan_shown)
         self.segments.editRejected.connect(lambda text: self.show_message(text, "error"))
-        for signal in (points.dataChanged, points.rowsInserted, points.rowsRemoved, points.rowsMoved,
-                       points.modelReset, points.planReferencesChanged):
+        for signal in (
+            points.dataChanged,
+            points.rowsInserted,
+            points.rowsRemoved,
+            points.rowsMoved,
+            points.modelReset,
+            points.planReferencesChanged,
+        ):
             signal.connect(self._on_points_changed)
         points.modelReset.connect(lambda: self.segments.set_ledger(points.ledger))
         self.plan_view.selectionModel().currentRowChanged.connect(self._on_plan_row)
@@ -138,15 +158,24 @@ class PlannerPanel(QWidget):
     # --- construction
     def _make_actions(self) -> None:
         slots: dict[str, Callable[[], Any]] = {
-            "add_plan": self.add_plan, "rename_plan": self.rename_plan,
-            "duplicate_plan": self.duplicate_plan, "delete_plan": self.delete_plan,
+            "add_plan": self.add_plan,
+            "rename_plan": self.rename_plan,
+            "duplicate_plan": self.duplicate_plan,
+            "delete_plan": self.delete_plan,
             "add_line": lambda: self.add_segment(SegmentKind.LINE),
             "add_arc": lambda: self.add_segment(SegmentKind.ARC),
             "delete_segment": self.delete_segments,
-            "segment_up": lambda: self.move_segments(-1), "segment_down": lambda: self.move_segments(1),
-            "check": self.recheck, "upload_now": self.upload_needed, "run": lambda: self.run(0),
-            "run_from": self.run_from_selected, "step": self.step, "pause": self._runner.pause,
-            "resume": self._runner.resume, "stop": self.stop, "resume_from": self.resume_from,
+            "segment_up": lambda: self.move_segments(-1),
+            "segment_down": lambda: self.move_segments(1),
+            "check": self.recheck,
+            "upload_now": self.upload_needed,
+            "run": lambda: self.run(0),
+            "run_from": self.run_from_selected,
+            "step": self.step,
+            "pause": self._runner.pause,
+            "resume": self._runner.resume,
+            "stop": self.stop,
+            "resume_from": self.resume_from,
         }
         self.planner_actions = PlannerActions(self, slots)
         a = self.planner_actions
@@ -162,11 +191,27 @@ class PlannerPanel(QWidget):
 
     def _build(self) -> None:
         # left: plans + run controls
-        self.plans_box = PlanListBox(self._plans, [self.action_add_plan, self.action_rename_plan,
-                                                   self.action_duplicate_plan, self.action_delete_plan], self)
+        self.plans_box = PlanListBox(
+            self._plans,
+            [
+                self.action_add_plan,
+                self.action_rename_plan,
+                self.action_duplicate_plan,
+                self.action_delete_plan,
+            ],
+            self,
+        )
         self.plan_view: QTableView = self.plans_box.plan_view
-        self.run_box = PlanRunBox(self.action_run, self.action_run_from, self.action_step, self.action_pause,
-                                  self.action_resume, self.action_stop, self.action_resume_from, self)
+        self.run_box = PlanRunBox(
+            self.action_run,
+            self.action_run_from,
+            self.action_step,
+            self.action_pause,
+            self.action_resume,
+            self.action_stop,
+            self.action_resume_from,
+            self,
+        )
         self.resume_from_button = self.run_box.resume_from_button
         self.run_label = self.run_box.run_label
         self.run_progress = self.run_box.run_progress
@@ -176,10 +221,16 @@ class PlannerPanel(QWidget):
         self.summary = self.checks_bar.summary
         self.upload_button = self.checks_bar.upload_button
         self.check_button = self.checks_bar.check_button
-        segment_actions = [self.action_add_line, self.action_add_arc, self.action_delete_segment,
-                           self.action_segment_up, self.action_segment_down]
-        self.segments_box = SegmentEditorBox(self.segments, self._points, segment_actions, self.checks_bar,
-                                             self)
+        segment_actions = [
+            self.action_add_line,
+            self.action_add_arc,
+            self.action_delete_segment,
+            self.action_segment_up,
+            self.action_segment_down,
+        ]
+        self.segments_box = SegmentEditorBox(
+            self.segments, self._points, segment_actions, self.checks_bar, self
+        )
         self.segment_view: QTableView = self.segments_box.segment_view
         self.point_pickers = install_point_pickers(self.segment_view, lambda: self._points.ledger)
 
@@ -189,8 +240,9 @@ class PlannerPanel(QWidget):
         preview_layout = QVBoxLayout(self.preview_box)
         preview_layout.addWidget(self.preview)
 
-        self.splitter, self.outer_splitter = planner_splitters(self, self.plans_box, self.run_box,
-                                                               self.segments_box, self.preview_box)
+        self.splitter, self.outer_splitter = planner_splitters(
+            self, self.plans_box, self.run_box, self.segments_box, self.preview_box
+        )
         self.status = QLabel(self)
         self.status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         layout = QVBoxLayout(self)
@@ -248,8 +300,9 @@ class PlannerPanel(QWidget):
         selection = self.segment_view.selectionModel()
         selection.clearSelection()
         for row in rows:
-            selection.select(self.segments.index(row, 0),
-                             selection.SelectionFlag.Select | selection.SelectionFlag.Rows)
+            selection.select(
+                self.segments.index(row, 0), selection.SelectionFlag.Select | selection.SelectionFlag.Rows
+            )
         if rows:
             selection.setCurrentIndex(self.segments.index(rows[0], 0), selection.SelectionFlag.NoUpdate)
             self.segment_view.scrollTo(self.segments.index(rows[0], 0))
@@ -330,7 +383,7 @@ class PlannerPanel(QWidget):
 
     @Slot()
     def resume_from(self) -> None:
-        """"Resume from k": re-check from segment k, then continue the stopped run."""
+        """ "Resume from k": re-check from segment k, then continue the stopped run."""
         k = self._runner.resume_from
         if k is None:
             return
@@ -473,13 +526,24 @@ class PlannerPanel(QWidget):
         rows = self.selected_segments()
         sync = self._sync
         errors = [issue_text(i) for i in self.checks.issues if i.is_error]
-        states = action_states(PanelState(
-            connected=r.connected, running=r.running, paused=r.paused, can_resume=r.can_resume,
-            has_plan=plan is not None, segments=len(plan) if plan is not None else 0, selected=bool(rows),
-            can_move_up=self.segments.can_move(rows, -1), can_move_down=self.segments.can_move(rows, 1),
-            has_sync=sync is not None, sync_busy=sync is not None and sync.busy,
-            uploading=sync is not None and sync.operation == "upload",
-            check_errors=len(errors), first_error=errors[0] if errors else ""))
+        states = action_states(
+            PanelState(
+                connected=r.connected,
+                running=r.running,
+                paused=r.paused,
+                can_resume=r.can_resume,
+                has_plan=plan is not None,
+                segments=len(plan) if plan is not None else 0,
+                selected=bool(rows),
+                can_move_up=self.segments.can_move(rows, -1),
+                can_move_down=self.segments.can_move(rows, 1),
+                has_sync=sync is not None,
+                sync_busy=sync is not None and sync.busy,
+                uploading=sync is not None and sync.operation == "upload",
+                check_errors=len(errors),
+                first_error=errors[0] if errors else "",
+            )
+        )
         self.planner_actions.apply(states)
         if self._alarm_hold:  # an e-stop / servo alarm: nothing that starts motion (Stop, Pause stay)
             for name in ("run", "run_from", "step", "resume", "resume_from"):

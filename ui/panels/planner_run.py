@@ -52,8 +52,14 @@ class PlannerView(Protocol):
 class PlanRunFlow(QObject):
     """Run, step, resume and stop, with the upload in between; remembers the run's plan."""
 
-    def __init__(self, view: PlannerView, runner: PlanRunController, sync: PointSyncController | None,
-                 points: PointsModel, parent: QObject | None = None) -> None:
+    def __init__(
+        self,
+        view: PlannerView,
+        runner: PlanRunController,
+        sync: PointSyncController | None,
+        points: PointsModel,
+        parent: QObject | None = None,
+    ) -> None:
         super().__init__(parent)
         self._view = view
         self._runner = runner
@@ -84,15 +90,20 @@ class PlanRunFlow(QObject):
         if not self._runner.connected:
             view.show_message(self.tr("Not connected to a controller"), "error")
             return False
-        issues = view.checks.check(plan, self._runner.last_pose, start_index=start,
-                                   loops=1 if single else plan.loops)
+        issues = view.checks.check(
+            plan, self._runner.last_pose, start_index=start, loops=1 if single else plan.loops
+        )
         summary = view.show_issues(issues, plan)
         gate = run_gate(issues, issue_text)
         if gate.block is RunBlock.ERRORS and (first := gate.first_error) is not None:
             if first.segment is not None:
                 view.select_segments([first.segment])
-            view.show_message(self.tr("Cannot run: {summary}. First: {message}").format(
-                summary=summary.split("\n")[0], message=issue_text(first)), "error")
+            view.show_message(
+                self.tr("Cannot run: {summary}. First: {message}").format(
+                    summary=summary.split("\n")[0], message=issue_text(first)
+                ),
+                "error",
+            )
             return False
         if gate.block is RunBlock.UPLOAD:
             needs = list(gate.uploads)

@@ -55,7 +55,10 @@ ModelIndex = QModelIndex | QPersistentModelIndex
 
 #: Colour of a summary line by level (the status line uses the darker warning text).
 SUMMARY_COLOURS: dict[Level, str] = {
-    Level.OK: COLOR_OK, Level.INFO: COLOR_INFO, Level.WARN: COLOR_WARN, Level.ERROR: COLOR_ERROR,
+    Level.OK: COLOR_OK,
+    Level.INFO: COLOR_INFO,
+    Level.WARN: COLOR_WARN,
+    Level.ERROR: COLOR_ERROR,
 }
 STATUS_COLOURS: dict[Level, str] = {**SUMMARY_COLOURS, Level.WARN: COLOR_WARN_TEXT, Level.INFO: COLOR_OK}
 
@@ -83,8 +86,9 @@ def action_button(action: QAction, *, bold: bool = False) -> QToolButton:
 class ChoiceDelegate(QStyledItemDelegate):
     """A combo box of fixed choices: ``choices()`` gives ``(value, text)`` pairs."""
 
-    def __init__(self, choices: Callable[[], Sequence[tuple[str, str]]],
-                 parent: QWidget | None = None) -> None:
+    def __init__(
+        self, choices: Callable[[], Sequence[tuple[str, str]]], parent: QWidget | None = None
+    ) -> None:
         super().__init__(parent)
         self._choices = choices
 
@@ -172,6 +176,7 @@ class LinesLabel(QLabel):
 
         def fits(candidate: str) -> bool:
             return metrics.boundingRect(room, flags, candidate).height() <= self.height()
+
         if not fits(text):
             low, high = 0, len(text)
             while low < high:  # the longest prefix that fits with the ellipsis
@@ -189,15 +194,27 @@ class PlanRunBox(QGroupBox):
 
     Two buttons a row: the box stays narrow enough to sit beside the plans and the segments."""
 
-    def __init__(self, run: QAction, run_from: QAction, step: QAction, pause: QAction, resume: QAction,
-                 stop: QAction, resume_from: QAction, parent: QWidget | None = None) -> None:
+    def __init__(
+        self,
+        run: QAction,
+        run_from: QAction,
+        step: QAction,
+        pause: QAction,
+        resume: QAction,
+        stop: QAction,
+        resume_from: QAction,
+        parent: QWidget | None = None,
+    ) -> None:
         super().__init__(parent)
         stop_button = action_button(stop, bold=True)
         stop_button.setStyleSheet(f"QToolButton:enabled {{ color: {COLOR_ERROR}; }}")
         buttons = QGridLayout()
         buttons.setSpacing(3)
-        rows = ((action_button(run, bold=True), action_button(run_from)), (action_button(step), stop_button),
-                (action_button(pause), action_button(resume)))
+        rows = (
+            (action_button(run, bold=True), action_button(run_from)),
+            (action_button(step), stop_button),
+            (action_button(pause), action_button(resume)),
+        )
         for row, pair in enumerate(rows):
             for column, button in enumerate(pair):
                 mark_motion(button)
@@ -222,10 +239,18 @@ class PlanRunBox(QGroupBox):
 
     def show_progress(self, progress: RunProgress) -> None:
         loops = self.tr("endless") if progress.loops == 0 else str(progress.loops)
-        self.run_label.setText(self.tr("Segment {k} of {n}, loop {i} of {m}").format(
-            k=progress.index + 1, n=progress.count, i=progress.loop, m=loops))
-        bar = progress_bar(progress.index, progress.count, progress.loop, progress.loops,
-                           progress.event is RunEvent.SEGMENT_DONE)
+        self.run_label.setText(
+            self.tr("Segment {k} of {n}, loop {i} of {m}").format(
+                k=progress.index + 1, n=progress.count, i=progress.loop, m=loops
+            )
+        )
+        bar = progress_bar(
+            progress.index,
+            progress.count,
+            progress.loop,
+            progress.loops,
+            progress.event is RunEvent.SEGMENT_DONE,
+        )
         if bar is None:
             self.run_progress.setRange(0, 0)  # endless: a busy bar
         else:
@@ -246,8 +271,9 @@ class PlanChecksBar(QWidget):
     """The checks under the segment table (wrapped to the room left), Upload now and Check on
     their right: one row, the table keeps the height."""
 
-    def __init__(self, upload: Callable[[], None], check: Callable[[], None],
-                 parent: QWidget | None = None) -> None:
+    def __init__(
+        self, upload: Callable[[], None], check: Callable[[], None], parent: QWidget | None = None
+    ) -> None:
         super().__init__(parent)
         self.summary = QLabel(self)
         self.summary.setWordWrap(True)
@@ -304,8 +330,9 @@ class PlanChecksBar(QWidget):
 class PlanListBox(QGroupBox):
     """The project's plans (name, loops, segments) and the plan buttons below them."""
 
-    def __init__(self, plans: PlanListModel, actions: Sequence[QAction],
-                 parent: QWidget | None = None) -> None:
+    def __init__(
+        self, plans: PlanListModel, actions: Sequence[QAction], parent: QWidget | None = None
+    ) -> None:
         super().__init__(parent)
         self.plan_view = QTableView(self)
         view = self.plan_view
@@ -332,8 +359,15 @@ class PlanListBox(QGroupBox):
 
 
 SEGMENT_COLUMN_WIDTHS: dict[int, int] = {
-    COL_INDEX: 50, COL_KIND: 50, COL_VIA: 104, COL_END: 104, COL_SPEED: 78, COL_ORIENTATION: 78,
-    COL_IGNORE: 84, COL_TOOL: 60, COL_LENGTH: 76,
+    COL_INDEX: 50,
+    COL_KIND: 50,
+    COL_VIA: 104,
+    COL_END: 104,
+    COL_SPEED: 78,
+    COL_ORIENTATION: 78,
+    COL_IGNORE: 84,
+    COL_TOOL: 60,
+    COL_LENGTH: 76,
 }
 
 
@@ -341,24 +375,33 @@ class SegmentEditorBox(QGroupBox):
     """The segment table (combo-box editors for kind, orientation and points), its buttons
     above and the checks bar below."""
 
-    def __init__(self, segments: SegmentTableModel, points: PointsModel, actions: Sequence[QAction],
-                 checks_bar: PlanChecksBar, parent: QWidget | None = None) -> None:
+    def __init__(
+        self,
+        segments: SegmentTableModel,
+        points: PointsModel,
+        actions: Sequence[QAction],
+        checks_bar: PlanChecksBar,
+        parent: QWidget | None = None,
+    ) -> None:
         super().__init__(parent)
         self.segment_view = QTableView(self)
         view = self.segment_view
         view.setModel(segments)
         view.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         view.setSelectionMode(QAbstractItemView.SelectionMode.ExtendedSelection)
-        view.setEditTriggers(QAbstractItemView.EditTrigger.DoubleClicked
-                             | QAbstractItemView.EditTrigger.EditKeyPressed
-                             | QAbstractItemView.EditTrigger.SelectedClicked)
+        view.setEditTriggers(
+            QAbstractItemView.EditTrigger.DoubleClicked
+            | QAbstractItemView.EditTrigger.EditKeyPressed
+            | QAbstractItemView.EditTrigger.SelectedClicked
+        )
         view.verticalHeader().setDefaultSectionSize(24)
         view.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Fixed)
         view.setWordWrap(False)
         view.setAlternatingRowColors(True)
         self._kind_delegate = ChoiceDelegate(lambda: [(k.value, kind_text(k)) for k in SegmentKind], view)
         self._orientation_delegate = ChoiceDelegate(
-            lambda: [("changes", orientation_text(True)), ("kept", orientation_text(False))], view)
+            lambda: [("changes", orientation_text(True)), ("kept", orientation_text(False))], view
+        )
         self._point_delegate = PointRefDelegate(points, view)
         view.setItemDelegateForColumn(COL_KIND, self._kind_delegate)
         view.setItemDelegateForColumn(COL_ORIENTATION, self._orientation_delegate)
@@ -384,8 +427,9 @@ class SegmentEditorBox(QGroupBox):
         self.setTitle(self.tr("Segments"))
 
 
-def planner_splitters(parent: QWidget, plans_box: QWidget, run_box: QWidget, segments_box: QWidget,
-                      preview_box: QWidget) -> tuple[QSplitter, QSplitter]:
+def planner_splitters(
+    parent: QWidget, plans_box: QWidget, run_box: QWidget, segments_box: QWidget, preview_box: QWidget
+) -> tuple[QSplitter, QSplitter]:
     """A narrow left column with the plans above the run box (the order of the work), and the
     work column: the segment table above the preview. At 1280×800 the work tab is only ~600 px
     wide: three boxes side by side left the segment table 180 px wide with one row showing; this

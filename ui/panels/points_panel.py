@@ -38,8 +38,14 @@ class PointsPanel(QWidget):
 
     statusMessage = Signal(str)
 
-    def __init__(self, model: PointsModel, controller: PointSyncController | None = None,
-                 parent: QWidget | None = None, *, confirm: ConfirmFn | None = None) -> None:
+    def __init__(
+        self,
+        model: PointsModel,
+        controller: PointSyncController | None = None,
+        parent: QWidget | None = None,
+        *,
+        confirm: ConfirmFn | None = None,
+    ) -> None:
         super().__init__(parent)
         self.setObjectName("PointsPanel")
         self._model = model
@@ -76,9 +82,11 @@ class PointsPanel(QWidget):
 
     # --- construction
     def _make_actions(self) -> None:
-        def act(shortcut: QKeySequence | QKeySequence.StandardKey | str | None = None,
-                slot: Callable[[], Any] | None = None,
-                checkable: bool = False) -> QAction:
+        def act(
+            shortcut: QKeySequence | QKeySequence.StandardKey | str | None = None,
+            slot: Callable[[], Any] | None = None,
+            checkable: bool = False,
+        ) -> QAction:
             action = QAction(self)
             if shortcut is not None:
                 action.setShortcut(QKeySequence(shortcut))
@@ -108,11 +116,22 @@ class PointsPanel(QWidget):
 
     def _build(self) -> None:
         bar = PointsActionBar(
-            self, teach=self.action_teach, upload_selected=self.action_upload_selected,
-            upload_needed=self.action_upload_needed, upload_all=self.action_upload_all,
-            restore_all=self.action_restore_all, move_to=self.action_move_to, show_ext=self.action_show_ext,
-            edits=(self.action_add, self.action_duplicate, self.action_delete, self.action_move_up,
-                   self.action_move_down))
+            self,
+            teach=self.action_teach,
+            upload_selected=self.action_upload_selected,
+            upload_needed=self.action_upload_needed,
+            upload_all=self.action_upload_all,
+            restore_all=self.action_restore_all,
+            move_to=self.action_move_to,
+            show_ext=self.action_show_ext,
+            edits=(
+                self.action_add,
+                self.action_duplicate,
+                self.action_delete,
+                self.action_move_up,
+                self.action_move_down,
+            ),
+        )
         self.action_bar = bar
         self.primary_row, self.toolbar = bar.primary_row, bar.toolbar
         self.teach_button, self.upload_button = bar.teach_button, bar.upload_button
@@ -125,8 +144,18 @@ class PointsPanel(QWidget):
         self.progress_row = UploadProgressRow(self._controller.cancel_upload, self)
         self.progress, self.cancel_button = self.progress_row.progress, self.progress_row.cancel_button
 
-        self.table = PointsTable((self.action_move_to, self.action_upload_selected, None, self.action_teach,
-                                  self.action_add, self.action_duplicate, self.action_delete), self)
+        self.table = PointsTable(
+            (
+                self.action_move_to,
+                self.action_upload_selected,
+                None,
+                self.action_teach,
+                self.action_add,
+                self.action_duplicate,
+                self.action_delete,
+            ),
+            self,
+        )
         self.table.setModel(self.proxy)
         self.table.size_columns()
         self._show_ext(False)
@@ -145,24 +174,38 @@ class PointsPanel(QWidget):
 
     def retranslate(self) -> None:
         texts = {
-            self.action_teach: (self.tr("Teach"), self.tr("Create the next temp point on the controller from "
-                                                          "the robot's current pose (Ctrl+T)")),
+            self.action_teach: (
+                self.tr("Teach"),
+                self.tr(
+                    "Create the next temp point on the controller from the robot's current pose (Ctrl+T)"
+                ),
+            ),
             self.action_add: (self.tr("Add"), self.tr("Add a point on the host (not on the controller yet)")),
             self.action_duplicate: (self.tr("Duplicate"), self.tr("Copy the selected points under new ids")),
-            self.action_delete: (self.tr("Delete"),
-                                 self.tr("Delete the selected points from the host's list")),
+            self.action_delete: (
+                self.tr("Delete"),
+                self.tr("Delete the selected points from the host's list"),
+            ),
             self.action_move_up: ("▲", self.tr("Move the selected points up (Alt+Up)")),
             self.action_move_down: ("▼", self.tr("Move the selected points down (Alt+Down)")),
-            self.action_upload_selected: (self.tr("Upload selected"),
-                                          self.tr("Create the selected points on the controller")),
-            self.action_upload_needed: (self.tr("Upload changed"),
-                                        self.tr("Upload every point not known to be on the controller")),
+            self.action_upload_selected: (
+                self.tr("Upload selected"),
+                self.tr("Create the selected points on the controller"),
+            ),
+            self.action_upload_needed: (
+                self.tr("Upload changed"),
+                self.tr("Upload every point not known to be on the controller"),
+            ),
             self.action_upload_all: (self.tr("Upload all"), self.tr("Create every point on the controller")),
-            self.action_restore_all: (self.tr("Restore all"),
-                                      self.tr("Re-create all points after a controller restart")),
+            self.action_restore_all: (
+                self.tr("Restore all"),
+                self.tr("Re-create all points after a controller restart"),
+            ),
             self.action_cancel_upload: (self.tr("Cancel upload"), ""),
-            self.action_move_to: (self.tr("Move to point"),
-                                  self.tr("Move the robot in a line to the selected point (asks first)")),
+            self.action_move_to: (
+                self.tr("Move to point"),
+                self.tr("Move the robot in a line to the selected point (asks first)"),
+            ),
             self.action_show_ext: (self.tr("E1–E5"), self.tr("Show the external axes columns")),
             self.action_find: (self.tr("Find"), ""),
         }
@@ -257,13 +300,21 @@ class PointsPanel(QWidget):
         self.select_rows([row])
         label = self._model.ledger[row].label
         if start.live:
-            self.show_message(self.tr("Added {point} at the robot's current pose").format(point=label),
-                              LEVEL_INFO)
+            self.show_message(
+                self.tr("Added {point} at the robot's current pose").format(point=label), LEVEL_INFO
+            )
             return
-        why = (self.tr("pose copied from P{id}").format(id=start.copied_from)
-               if start.copied_from is not None else self.tr("pose set to zeros"))
-        self.show_message(self.tr("Added {point}, not from the controller: no live pose ({why})").format(
-            point=label, why=why), LEVEL_WARN)
+        why = (
+            self.tr("pose copied from P{id}").format(id=start.copied_from)
+            if start.copied_from is not None
+            else self.tr("pose set to zeros")
+        )
+        self.show_message(
+            self.tr("Added {point}, not from the controller: no live pose ({why})").format(
+                point=label, why=why
+            ),
+            LEVEL_WARN,
+        )
 
     @Slot()
     def duplicate_selected(self) -> None:
@@ -279,14 +330,19 @@ class PointsPanel(QWidget):
         rows = self.selected_rows()
         if not rows:
             return
-        used = [(p.label, ref) for r in rows for p in [self._model.point_at(r)]
-                for ref in self._model.project.references(p.id)]
+        used = [
+            (p.label, ref)
+            for r in rows
+            for p in [self._model.point_at(r)]
+            for ref in self._model.project.references(p.id)
+        ]
         n = self._model.remove_rows(rows)
         text = self.tr("Deleted {n} points (Ctrl+Z to undo)").format(n=n)
         if used:
             label, (plan, segment) = used[0]
             text += " — " + self.tr("{point} is used by plan '{plan}' segment {k}").format(
-                point=label, plan=plan, k=segment + 1)
+                point=label, plan=plan, k=segment + 1
+            )
             self.show_message(text, LEVEL_WARN)
         else:
             self.show_message(text, LEVEL_INFO)
@@ -318,10 +374,20 @@ class PointsPanel(QWidget):
         if refused:
             self.show_message(refused, LEVEL_ERROR)
             return
-        question = self.tr("Move the robot in a straight line to {point}?\n\n"
-                           "X {x:.3f}  Y {y:.3f}  Z {z:.3f}\nA {a:.3f}  B {b:.3f}  C {c:.3f}\n"
-                           "Speed {v} mm/s").format(point=point.label, x=point.x, y=point.y, z=point.z,
-                                                    a=point.a, b=point.b, c=point.c, v=f"{speed:g}")
+        question = self.tr(
+            "Move the robot in a straight line to {point}?\n\n"
+            "X {x:.3f}  Y {y:.3f}  Z {z:.3f}\nA {a:.3f}  B {b:.3f}  C {c:.3f}\n"
+            "Speed {v} mm/s"
+        ).format(
+            point=point.label,
+            x=point.x,
+            y=point.y,
+            z=point.z,
+            a=point.a,
+            b=point.b,
+            c=point.c,
+            v=f"{speed:g}",
+        )
         if point.needs_upload:
             self._controller.move_to(point.id, speed)  # refuses with the reason
             return
@@ -383,8 +449,13 @@ class PointsPanel(QWidget):
         self.cancel_button.setEnabled(c.operation == "upload")
         self.action_move_to.setEnabled(link_ok and len(rows) == 1 and not self._alarm_hold)
         self.upload_button.setEnabled(link_ok and has_points)
-        edits = (self.action_add, self.action_duplicate, self.action_delete, self.action_move_up,
-                 self.action_move_down)
+        edits = (
+            self.action_add,
+            self.action_duplicate,
+            self.action_delete,
+            self.action_move_up,
+            self.action_move_down,
+        )
         self.action_add.setEnabled(True)
         for action in edits:
             action.setEnabled(action.isEnabled() and self._edit_reason is None)

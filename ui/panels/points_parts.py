@@ -46,7 +46,6 @@ ROW_HEIGHT = 24  # px, a table row
 FIND_MAX_WIDTH = 220  # px
 
 
-
 def _bold(widget: QWidget) -> None:
     font = widget.font()
     font.setBold(True)
@@ -58,9 +57,19 @@ class PointsActionBar:
     with its menu, ``restore_all_button``, ``move_to_button``, ``speed``) and ``edit_row``
     (``toolbar`` with the edit actions, ``find_label``, ``find_edit``, ``ext_button``)."""
 
-    def __init__(self, parent: QWidget, *, teach: QAction, upload_selected: QAction, upload_needed: QAction,
-                 upload_all: QAction, restore_all: QAction, move_to: QAction, show_ext: QAction,
-                 edits: Sequence[QAction]) -> None:
+    def __init__(
+        self,
+        parent: QWidget,
+        *,
+        teach: QAction,
+        upload_selected: QAction,
+        upload_needed: QAction,
+        upload_all: QAction,
+        restore_all: QAction,
+        move_to: QAction,
+        show_ext: QAction,
+        edits: Sequence[QAction],
+    ) -> None:
         self.primary_row = QWidget(parent)
         self.primary_row.setObjectName("PointsPrimary")
         primary = QHBoxLayout(self.primary_row)
@@ -132,8 +141,10 @@ class RestoreBanner(QFrame):
     def __init__(self, restore: Callable[[], object], parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("restoreBanner")
-        self.setStyleSheet(f"#restoreBanner {{ background: {COLOR_WARN_BG}; "
-                           f"border: 1px solid {COLOR_WARN}; border-radius: 4px; }}")
+        self.setStyleSheet(
+            f"#restoreBanner {{ background: {COLOR_WARN_BG}; "
+            f"border: 1px solid {COLOR_WARN}; border-radius: 4px; }}"
+        )
         row = QHBoxLayout(self)
         row.setContentsMargins(8, 4, 8, 4)
         self.label = QLabel(self)
@@ -145,9 +156,13 @@ class RestoreBanner(QFrame):
         row.addWidget(self.restore_button)
 
     def retranslate(self) -> None:
-        self.label.setText(QCoreApplication.translate(
-            "PointsPanel", "The controller restarted or the link was re-established: its temp "
-            "points may be gone. Re-create them before running a plan."))
+        self.label.setText(
+            QCoreApplication.translate(
+                "PointsPanel",
+                "The controller restarted or the link was re-established: its temp "
+                "points may be gone. Re-create them before running a plan.",
+            )
+        )
         self.restore_button.setText(QCoreApplication.translate("PointsPanel", "Restore all"))
 
 
@@ -188,9 +203,11 @@ class PointsTable(QTableView):
         self._menu_actions = list(menu_actions)
         self.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)
         self.setSelectionMode(QAbstractItemView.SelectionMode.ExtendedSelection)
-        self.setEditTriggers(QAbstractItemView.EditTrigger.DoubleClicked
-                             | QAbstractItemView.EditTrigger.EditKeyPressed
-                             | QAbstractItemView.EditTrigger.AnyKeyPressed)
+        self.setEditTriggers(
+            QAbstractItemView.EditTrigger.DoubleClicked
+            | QAbstractItemView.EditTrigger.EditKeyPressed
+            | QAbstractItemView.EditTrigger.AnyKeyPressed
+        )
         self.setAlternatingRowColors(True)
         self.setWordWrap(False)
         self.verticalHeader().setVisible(False)

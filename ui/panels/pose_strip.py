@@ -89,8 +89,10 @@ def _tr(text: str) -> str:
 
 
 def _chip_style(background: str, color: str) -> str:
-    return (f"QLabel {{ background-color: {background}; color: {color}; border: 1px solid {COLOR_BORDER};"
-            " border-radius: 5px; padding: 2px 8px; }")
+    return (
+        f"QLabel {{ background-color: {background}; color: {color}; border: 1px solid {COLOR_BORDER};"
+        " border-radius: 5px; padding: 2px 8px; }"
+    )
 
 
 class PoseStrip(QFrame):
@@ -150,8 +152,13 @@ class PoseStrip(QFrame):
         for caption_label in (self.mode_caption, self.program_caption):
             caption_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
         self._fix_widths()
-        for widget in (self.mode_caption, self.mode_chip, self.program_caption, self.program_chip,
-                       self.freshness):
+        for widget in (
+            self.mode_caption,
+            self.mode_chip,
+            self.program_caption,
+            self.program_chip,
+            self.freshness,
+        ):
             layout.addWidget(widget)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Fixed)
         self.retranslate()
@@ -188,8 +195,9 @@ class PoseStrip(QFrame):
         self.mode_chip.setFixedWidth(fit_width(self.mode_chip, [*proto, *unknown], pad))
         program = [t for text in PROGRAM_STATE_TEXT.values() for t in both_languages(TR_CONTEXT, text)]
         self.program_chip.setFixedWidth(fit_width(self.program_chip, [*program, *unknown], pad))
-        fresh = [t for text in (_LIVE, _STALE_NO_AGE, *_LINK_TEXT.values())
-                 for t in both_languages(CTX, text)]
+        fresh = [
+            t for text in (_LIVE, _STALE_NO_AGE, *_LINK_TEXT.values()) for t in both_languages(CTX, text)
+        ]
         fresh += [t.format(age=888) for t in both_languages(CTX, _STALE)]
         self.freshness.setFixedWidth(fit_width(self.freshness, fresh, pad))
         self.mode_caption.setFixedWidth(fit_width(self.mode_caption, both_languages(CTX, "Mode"), 4))
@@ -202,8 +210,9 @@ class PoseStrip(QFrame):
         self.program_caption.setText(self.tr("Program"))
         self.mode_chip.setToolTip(self.tr("The controller's work mode (register 560)"))
         self.program_chip.setToolTip(self.tr("The controller's program state (register 561)"))
-        self.freshness.setToolTip(self.tr("Whether the values shown were confirmed by the controller "
-                                          "within the freshness limit"))
+        self.freshness.setToolTip(
+            self.tr("Whether the values shown were confirmed by the controller within the freshness limit")
+        )
         self._refresh()
 
     def changeEvent(self, event: QEvent) -> None:
@@ -285,19 +294,34 @@ class PoseStrip(QFrame):
             mode: ControllerMode | None = ControllerMode(int(status.mode))
         except ValueError:
             mode = None
-        text = (QCoreApplication.translate(TR_CONTEXT, CONTROLLER_MODE_TEXT[mode]) if mode is not None else
-                QCoreApplication.translate(TR_CONTEXT, UNKNOWN_STATUS_TEXT).format(code=int(status.mode)))
-        self._set_chip(self.mode_chip, text, _MODE_COLORS.get(mode, (COLOR_ERROR, COLOR_WHITE))
-                       if mode is not None else (COLOR_ERROR, COLOR_WHITE))
+        text = (
+            QCoreApplication.translate(TR_CONTEXT, CONTROLLER_MODE_TEXT[mode])
+            if mode is not None
+            else QCoreApplication.translate(TR_CONTEXT, UNKNOWN_STATUS_TEXT).format(code=int(status.mode))
+        )
+        self._set_chip(
+            self.mode_chip,
+            text,
+            _MODE_COLORS.get(mode, (COLOR_ERROR, COLOR_WHITE))
+            if mode is not None
+            else (COLOR_ERROR, COLOR_WHITE),
+        )
         try:
             program: ProgramState | None = ProgramState(int(status.program_state))
         except ValueError:
             program = None
-        text = (QCoreApplication.translate(TR_CONTEXT, PROGRAM_STATE_TEXT[program]) if program is not None
-                else QCoreApplication.translate(TR_CONTEXT, UNKNOWN_STATUS_TEXT).format(
-                    code=int(status.program_state)))
-        self._set_chip(self.program_chip, text, _PROGRAM_COLORS[program] if program is not None
-                       else (COLOR_ERROR, COLOR_WHITE))
+        text = (
+            QCoreApplication.translate(TR_CONTEXT, PROGRAM_STATE_TEXT[program])
+            if program is not None
+            else QCoreApplication.translate(TR_CONTEXT, UNKNOWN_STATUS_TEXT).format(
+                code=int(status.program_state)
+            )
+        )
+        self._set_chip(
+            self.program_chip,
+            text,
+            _PROGRAM_COLORS[program] if program is not None else (COLOR_ERROR, COLOR_WHITE),
+        )
 
     def _set_chip(self, chip: QLabel, text: str, colors: tuple[str, str]) -> None:
         metrics = chip.fontMetrics()
@@ -318,8 +342,11 @@ class PoseStrip(QFrame):
         elif state.connection.state is not LinkState.CONNECTED:
             state_kind = state.connection.state
             text = _tr(_LINK_TEXT[state_kind])
-            colors = ((COLOR_ERROR, COLOR_WHITE) if state_kind in (LinkState.NOT_ANSWERING, LinkState.DOWN)
-                      else _UNKNOWN_COLORS)
+            colors = (
+                (COLOR_ERROR, COLOR_WHITE)
+                if state_kind in (LinkState.NOT_ANSWERING, LinkState.DOWN)
+                else _UNKNOWN_COLORS
+            )
         elif state.fresh:
             text, colors = _tr(_LIVE), (COLOR_OK, COLOR_WHITE)
         else:
@@ -330,8 +357,12 @@ class PoseStrip(QFrame):
         self._set_chip(self.freshness, text, colors)
 
     def _update_timer(self) -> None:
-        want = (self._state is not None and not self._state.fresh
-                and self._state.connection.state is LinkState.CONNECTED and self.isVisible())
+        want = (
+            self._state is not None
+            and not self._state.fresh
+            and self._state.connection.state is LinkState.CONNECTED
+            and self.isVisible()
+        )
         if want and not self._age_timer.isActive():
             self._age_timer.start()
         elif not want:

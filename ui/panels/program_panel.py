@@ -27,8 +27,11 @@ from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.i18n import protocol_text
 from ui.touch import mark_motion
 
-_MODES: tuple[ProgramMotionMode, ...] = (ProgramMotionMode.SINGLE_STEP, ProgramMotionMode.SINGLE_RUN,
-                                         ProgramMotionMode.CYCLE)
+_MODES: tuple[ProgramMotionMode, ...] = (
+    ProgramMotionMode.SINGLE_STEP,
+    ProgramMotionMode.SINGLE_RUN,
+    ProgramMotionMode.CYCLE,
+)
 
 
 @dataclass(frozen=True)
@@ -71,8 +74,9 @@ class ProgramPanel(QWidget):
         mark_motion(self.run_button)
         self.run_button.clicked.connect(self._run)
         self.captions = [QLabel(self.program_box) for _ in range(4)]
-        for caption, field in zip(self.captions, (self.id_spin, self.mode_combo, self.cycles_spin,
-                                                   self.speed_spin), strict=True):
+        for caption, field in zip(
+            self.captions, (self.id_spin, self.mode_combo, self.cycles_spin, self.speed_spin), strict=True
+        ):
             caption.setBuddy(field)
             form.addRow(caption, field)
         form.addRow(self.run_button)
@@ -145,7 +149,8 @@ class ProgramPanel(QWidget):
         request = self.request()
         mode = protocol_text(PROGRAM_MOTION_MODE_TEXT[request.mode])
         text = self.tr("Run program {id} ({mode}) at {speed} %? The arm will move.").format(
-            id=request.program_id, mode=mode, speed=request.speed_ratio)
+            id=request.program_id, mode=mode, speed=request.speed_ratio
+        )
         if self.confirm(self.tr("Confirm program run"), text):
             self.programRequested.emit(request)
 

@@ -389,8 +389,10 @@ class StatusPanel(QWidget):
         self.command_label.setText(result_text(result))  # one sentence, the operator's language
         self.command_label.setProperty("ok", bool(result.ok))
         level = result_level(result)  # the operator's own stop is not a failure
-        color = {messages.LEVEL_INFO: COLOR_OK if result.ok else COLOR_NEUTRAL,
-                 messages.LEVEL_WARNING: COLOR_WARN}.get(level, COLOR_ERROR)
+        color = {
+            messages.LEVEL_INFO: COLOR_OK if result.ok else COLOR_NEUTRAL,
+            messages.LEVEL_WARNING: COLOR_WARN,
+        }.get(level, COLOR_ERROR)
         self.command_label.setStyleSheet(f"color: {color}; font-weight: bold;")
         tip = []
         if result.status is not None:

@@ -38,6 +38,7 @@ CONFIRM_ABOVE = 10.0  # an exact-values move with any |offset| above this asks f
 SPEED_DEFAULT = {StepFrame.JOINT: 5.0, StepFrame.BASE: 50.0}  # rpm, mm/s
 SPEED_MAX = {StepFrame.JOINT: 100.0, StepFrame.BASE: 2000.0}
 
+
 @dataclass(frozen=True)
 class StepRequest:
     frame: StepFrame
@@ -213,12 +214,14 @@ class StepPanel(QWidget):
     def _request(self, offsets: list[float]) -> None:
         robot = offsets[:NUM_ROBOT_AXES]
         ext = offsets[NUM_ROBOT_AXES:NUM_AXES_TOTAL] if self.external_check.isChecked() else [0.0] * 5
-        self.stepRequested.emit(StepRequest(
-            self._frame,
-            (robot[0], robot[1], robot[2], robot[3], robot[4], robot[5]),
-            (ext[0], ext[1], ext[2], ext[3], ext[4]),
-            self.speed,
-        ))
+        self.stepRequested.emit(
+            StepRequest(
+                self._frame,
+                (robot[0], robot[1], robot[2], robot[3], robot[4], robot[5]),
+                (ext[0], ext[1], ext[2], ext[3], ext[4]),
+                self.speed,
+            )
+        )
 
     def _step_one(self, axis: int, sign: float) -> None:
         offsets = [0.0] * NUM_AXES_TOTAL
@@ -228,8 +231,12 @@ class StepPanel(QWidget):
     @Slot(bool)
     def _show_external(self, shown: bool) -> None:
         for axis in range(NUM_ROBOT_AXES, NUM_AXES_TOTAL):
-            for widget in (self.axis_labels[axis], self.minus_buttons[axis], self.plus_buttons[axis],
-                           self.value_spins[axis]):
+            for widget in (
+                self.axis_labels[axis],
+                self.minus_buttons[axis],
+                self.plus_buttons[axis],
+                self.value_spins[axis],
+            ):
                 widget.setVisible(shown)
         if shown:
             self.axes_scroll.ensureWidgetVisible(self.minus_buttons[NUM_ROBOT_AXES])
@@ -245,14 +252,15 @@ class StepPanel(QWidget):
             names = self._axis_names()
             moves = ", ".join(f"{names[i]} {v:+g}" for i, v in enumerate(offsets) if v)
             text = self.tr("Move by {moves} at {speed} {unit}?").format(
-                moves=moves, speed=f"{self.speed:g}", unit=self.speed_unit())
+                moves=moves, speed=f"{self.speed:g}", unit=self.speed_unit()
+            )
             if not self.confirm(self.tr("Confirm incremental move"), text):
                 return
         self._request(offsets)
 
     def _axis_names(self) -> tuple[str, ...]:
         robot = JOINT_AXIS_NAMES[:NUM_ROBOT_AXES] if self._frame is StepFrame.JOINT else CARTESIAN_AXIS_NAMES
-        return (*robot, *JOINT_AXIS_NAMES[NUM_ROBOT_AXES:NUM_ROBOT_AXES + NUM_EXTERNAL_AXES])
+        return (*robot, *JOINT_AXIS_NAMES[NUM_ROBOT_AXES : NUM_ROBOT_AXES + NUM_EXTERNAL_AXES])
 
     @Slot(int)
     def _on_frame_changed(self, index: int) -> None:

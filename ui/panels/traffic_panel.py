@@ -70,8 +70,13 @@ class TrafficPanel(QWidget):
 
     captureEnabledChanged = Signal(bool)
 
-    def __init__(self, parent: QWidget | None = None, *, max_rows: int = MAX_ROWS_DEFAULT,
-                 clock: DisplayClock | None = None) -> None:
+    def __init__(
+        self,
+        parent: QWidget | None = None,
+        *,
+        max_rows: int = MAX_ROWS_DEFAULT,
+        clock: DisplayClock | None = None,
+    ) -> None:
         super().__init__(parent)
         self._clock = clock if clock is not None else DisplayClock.shared()
         self.setObjectName("TrafficPanel")
@@ -273,8 +278,13 @@ class TrafficPanel(QWidget):
 
     @Slot()
     def _export_dialog(self) -> None:
-        export_with_dialog(self, self.tr("Export traffic"), "traffic.csv",
-                           self.tr("CSV files (*.csv);;Text files (*.txt);;All files (*)"), self.export_to)
+        export_with_dialog(
+            self,
+            self.tr("Export traffic"),
+            "traffic.csv",
+            self.tr("CSV files (*.csv);;Text files (*.txt);;All files (*)"),
+            self.export_to,
+        )
 
     # --- internals --------------------------------------------------------------------
     @Slot(str)

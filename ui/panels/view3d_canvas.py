@@ -123,8 +123,14 @@ class View3DCanvas(QWidget):
         self._static = None
         self.update()
 
-    def set_points(self, xyz: FloatArray, ids: Sequence[int], names: Sequence[str],
-                   colors: Sequence[str], bad: NDArray[np.bool_]) -> None:
+    def set_points(
+        self,
+        xyz: FloatArray,
+        ids: Sequence[int],
+        names: Sequence[str],
+        colors: Sequence[str],
+        bad: NDArray[np.bool_],
+    ) -> None:
         self.point_xyz = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
         self.point_ids = np.asarray(ids, dtype=np.intp)
         self.point_names = list(names)
@@ -147,8 +153,14 @@ class View3DCanvas(QWidget):
             self.selected_ids = set(ids)
             self.update()
 
-    def set_path(self, xyz: FloatArray, segment: NDArray[np.intp], bad: NDArray[np.bool_],
-                 mids: FloatArray, start: FloatArray | None) -> None:
+    def set_path(
+        self,
+        xyz: FloatArray,
+        segment: NDArray[np.intp],
+        bad: NDArray[np.bool_],
+        mids: FloatArray,
+        start: FloatArray | None,
+    ) -> None:
         self.path_xyz = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
         self.path_segment = np.asarray(segment, dtype=np.intp)
         self.path_bad = np.asarray(bad, dtype=bool)
@@ -299,19 +311,26 @@ class View3DCanvas(QWidget):
         left = tip - ARROW_PX * u + 0.5 * ARROW_PX * np.stack([-u[:, 1], u[:, 0]], axis=1)
         right = tip - ARROW_PX * u - 0.5 * ARROW_PX * np.stack([-u[:, 1], u[:, 0]], axis=1)
         painter.setPen(pen(COLOR_PATH, 2))
-        self._buf.draw_lines(painter, np.concatenate([np.concatenate([tip, left], axis=1),
-                                                      np.concatenate([tip, right], axis=1)]))
+        self._buf.draw_lines(
+            painter,
+            np.concatenate([np.concatenate([tip, left], axis=1), np.concatenate([tip, right], axis=1)]),
+        )
 
     def _draw_labels(self, painter: QPainter, pts: FloatArray) -> None:
         w, h = self.width(), self.height()
-        inside = np.flatnonzero(np.isfinite(pts).all(axis=1) & (pts[:, 0] >= 0) & (pts[:, 0] < w)
-                                & (pts[:, 1] >= 0) & (pts[:, 1] < h))
+        inside = np.flatnonzero(
+            np.isfinite(pts).all(axis=1)
+            & (pts[:, 0] >= 0)
+            & (pts[:, 0] < w)
+            & (pts[:, 1] >= 0)
+            & (pts[:, 1] < h)
+        )
         zoomed = self.camera.pixels_per_mm(h) >= LABEL_MIN_PX_PER_MM
         if len(inside) > MAX_LABELS and not zoomed:
             return
         painter.setPen(QColor(COLOR_INK_SOFT))
         painter.setFont(QFont(painter.font().family(), 8))
-        for row in inside[:MAX_LABELS * 2]:
+        for row in inside[: MAX_LABELS * 2]:
             painter.drawText(QPointF(pts[row, 0] + 6, pts[row, 1] - 6), self.point_names[row])
 
     def _draw_dynamic(self, painter: QPainter) -> None:
@@ -338,8 +357,9 @@ class View3DCanvas(QWidget):
         self._draw_arm(painter, self.ghost_arm, self.ghost_flange, COLOR_GHOST_ARM, "ghost_flange")
         self._draw_overlay(painter)
 
-    def _draw_arm(self, painter: QPainter, links: FloatArray | None, flange: FloatArray | None,
-                  color: str, key: str) -> None:
+    def _draw_arm(
+        self, painter: QPainter, links: FloatArray | None, flange: FloatArray | None, color: str, key: str
+    ) -> None:
         cam, w, h = self.camera, self.width(), self.height()
         if links is None or flange is None:
             self.drawn.pop(key, None)
@@ -405,8 +425,9 @@ class View3DCanvas(QWidget):
         self._moved = self._dragging = True
         dx, dy = pos.x() - self._last.x(), pos.y() - self._last.y()
         self._last = pos
-        pan = (self._button in (Qt.MouseButton.RightButton, Qt.MouseButton.MiddleButton)
-               or bool(event.modifiers() & Qt.KeyboardModifier.ShiftModifier))
+        pan = self._button in (Qt.MouseButton.RightButton, Qt.MouseButton.MiddleButton) or bool(
+            event.modifiers() & Qt.KeyboardModifier.ShiftModifier
+        )
         if pan:
             self.set_camera(self.camera.panned(dx, dy, self.height()))
         else:

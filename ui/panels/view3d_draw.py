@@ -58,8 +58,15 @@ class Buffers:
         self.fragments = PrimitiveArray(QPainter.PixmapFragment, 10)
         self.sprites: dict[tuple[str, int, bool, bool], QPixmap] = {}
 
-    def draw_sprites(self, painter: QPainter, xy: FloatArray, color: str, size: int,
-                     ring: bool = False, square: bool = False) -> None:
+    def draw_sprites(
+        self,
+        painter: QPainter,
+        xy: FloatArray,
+        color: str,
+        size: int,
+        ring: bool = False,
+        square: bool = False,
+    ) -> None:
         """One marker per row of ``xy`` (non-finite rows skipped), in one call."""
         finite = np.isfinite(xy).all(axis=1)
         if not finite.all():

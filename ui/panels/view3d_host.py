@@ -149,8 +149,12 @@ class View3DHost(QObject):
     @Slot(bool)
     def _on_dock_visible(self, visible: bool) -> None:
         # closing the dock (its X) puts the view back into its tab
-        if not visible and self._panel is not None and self.dock.widget() is self._panel \
-                and not self.dock.isVisible():
+        if (
+            not visible
+            and self._panel is not None
+            and self.dock.widget() is self._panel
+            and not self.dock.isVisible()
+        ):
             self.set_beside(False)
 
 

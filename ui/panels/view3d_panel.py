@@ -70,8 +70,9 @@ class View3DPanel(QWidget):
 
     besideToggled = Signal(bool)
 
-    def __init__(self, points: PointsModel, parent: QWidget | None = None, *,
-                 robot: RobotModelSource | None = None) -> None:
+    def __init__(
+        self, points: PointsModel, parent: QWidget | None = None, *, robot: RobotModelSource | None = None
+    ) -> None:
         super().__init__(parent)
         self.setObjectName("View3DPanel")
         self._points = points
@@ -148,8 +149,13 @@ class View3DPanel(QWidget):
         self._scene_timer.setSingleShot(True)
         self._scene_timer.setInterval(0)
         self._scene_timer.timeout.connect(self.refresh_scene)
-        for signal in (points.dataChanged, points.rowsInserted, points.rowsRemoved, points.rowsMoved,
-                       points.modelReset):
+        for signal in (
+            points.dataChanged,
+            points.rowsInserted,
+            points.rowsRemoved,
+            points.rowsMoved,
+            points.modelReset,
+        ):
             signal.connect(self._schedule_scene)
         self.retranslate()
         self.refresh_scene()
@@ -175,8 +181,14 @@ class View3DPanel(QWidget):
         """Show the planner's plan (``PlannerPanel.current_plan()``) and follow its edits."""
         self._planner = planner
         seg = planner.segments
-        for signal in (seg.modelReset, seg.dataChanged, seg.rowsInserted, seg.rowsRemoved, seg.rowsMoved,
-                       seg.listEdited):
+        for signal in (
+            seg.modelReset,
+            seg.dataChanged,
+            seg.rowsInserted,
+            seg.rowsRemoved,
+            seg.rowsMoved,
+            seg.listEdited,
+        ):
             signal.connect(self._schedule_scene)
         self._schedule_scene()
 
@@ -187,8 +199,12 @@ class View3DPanel(QWidget):
 
     # --- texts ---------------------------------------------------------------------------
     def retranslate(self) -> None:
-        names = {Preset.TOP: self.tr("Top"), Preset.FRONT: self.tr("Front"), Preset.SIDE: self.tr("Side"),
-                 Preset.ISO: self.tr("Iso")}
+        names = {
+            Preset.TOP: self.tr("Top"),
+            Preset.FRONT: self.tr("Front"),
+            Preset.SIDE: self.tr("Side"),
+            Preset.ISO: self.tr("Iso"),
+        }
         for preset, button in self.preset_buttons.items():
             button.setText(names[preset])
             button.setToolTip(self.tr("Look at the scene from a preset direction"))
@@ -197,12 +213,16 @@ class View3DPanel(QWidget):
         self.ortho_button.setText(self.tr("Orthographic"))
         self.ortho_button.setToolTip(self.tr("Parallel projection (no perspective)"))
         self.profile_button.setText(self.tr("Robot model…"))
-        self.profile_button.setToolTip(self.tr("Robot model: %1. Load another robot model profile (JSON)")
-                                       .replace("%1", self.model.profile.name))
+        self.profile_button.setToolTip(
+            self.tr("Robot model: %1. Load another robot model profile (JSON)").replace(
+                "%1", self.model.profile.name
+            )
+        )
         self.beside_button.setText(self.tr("Beside the planner"))
         self.beside_button.setToolTip(self.tr("Show the 3D view next to the planner, not in its own tab"))
-        self.canvas.setToolTip(self.tr("Drag: rotate · Shift or right drag: pan · Wheel: zoom · "
-                                       "Click a point: select it"))
+        self.canvas.setToolTip(
+            self.tr("Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it")
+        )
         self._show_reach()
         self._update_badges()
 
@@ -246,8 +266,9 @@ class View3DPanel(QWidget):
 
     @Slot()
     def choose_profile(self) -> None:
-        path, _filter = QFileDialog.getOpenFileName(self, self.tr("Load a robot model profile"), "",
-                                                    self.tr("Robot model profiles (*.json)"))
+        path, _filter = QFileDialog.getOpenFileName(
+            self, self.tr("Load a robot model profile"), "", self.tr("Robot model profiles (*.json)")
+        )
         if path:
             self.load_profile_file(path)
 
@@ -377,8 +398,9 @@ class View3DPanel(QWidget):
         self.point_reach = self.reach.points(checked)
         xyz = np.array([p.xyz for p in points], dtype=np.float64).reshape(-1, 3)
         bad = np.array([self.point_reach.get(p.id, Reach.OK) is not Reach.OK for p in points], dtype=bool)
-        self.canvas.set_points(xyz, [p.id for p in points], [p.label for p in points],
-                               [SYNC_COLORS[p.sync] for p in points], bad)
+        self.canvas.set_points(
+            xyz, [p.id for p in points], [p.label for p in points], [SYNC_COLORS[p.sync] for p in points], bad
+        )
         self._show_plan(plan, ledger)
         self._show_reach()
         self._on_table_selection()
@@ -389,8 +411,9 @@ class View3DPanel(QWidget):
     def _show_plan(self, plan: Plan | None, ledger: PointLedger) -> None:
         if plan is None or not len(plan):
             self.path_reach = None
-            self.canvas.set_path(np.zeros((0, 3)), np.zeros(0, dtype=np.intp), np.zeros(0, dtype=bool),
-                                 np.zeros((0, 3)), None)
+            self.canvas.set_path(
+                np.zeros((0, 3)), np.zeros(0, dtype=np.intp), np.zeros(0, dtype=bool), np.zeros((0, 3)), None
+            )
             self.dry_bar.set_run(None)
             return
         start, _rot = start_of(plan, ledger, self._pose)
@@ -401,9 +424,10 @@ class View3DPanel(QWidget):
         # samples are red from the first bad reach sample of their segment on (path samples are
         # denser than reach samples: mark the nearest ones)
         bad = self._bad_samples(path.xyz, path.segment, bad_seg)
-        mids = np.array([ledger.get(s.via_id).xyz if s.via_id is not None and ledger.get(s.via_id)  # type: ignore[union-attr]
-                         else (np.nan, np.nan, np.nan) for s in plan.segments if s.is_arc],
-                        dtype=np.float64).reshape(-1, 3)
+        vias = [ledger.get(s.via_id) if s.via_id is not None else None for s in plan.segments if s.is_arc]
+        mids = np.array(
+            [via.xyz if via is not None else (np.nan, np.nan, np.nan) for via in vias], dtype=np.float64
+        ).reshape(-1, 3)
         self.canvas.set_path(path.xyz, path.segment, bad, mids, start)
         self.dry_bar.set_run(DryRun(plan, ledger, self._pose))
 
@@ -430,13 +454,19 @@ class View3DPanel(QWidget):
         parts = []
         if bad_points:
             names = ", ".join(f"P{pid}" for pid in bad_points[:8]) + (" …" if len(bad_points) > 8 else "")
-            parts.append(self.tr("Out of the robot model's reach: %n point(s) (%1)", "",
-                                 len(bad_points)).replace("%1", names))
+            parts.append(
+                self.tr("Out of the robot model's reach: %n point(s) (%1)", "", len(bad_points)).replace(
+                    "%1", names
+                )
+            )
         if self.path_reach is not None:
             segs = [i + 1 for i, b in enumerate(self.path_reach.first_bad) if b is not None]
             if segs:
-                parts.append(self.tr("the path leaves the reach in %n segment(s) (%1)", "", len(segs))
-                             .replace("%1", ", ".join(str(s) for s in segs[:8])))
+                parts.append(
+                    self.tr("the path leaves the reach in %n segment(s) (%1)", "", len(segs)).replace(
+                        "%1", ", ".join(str(s) for s in segs[:8])
+                    )
+                )
         self.reach_label.setText("; ".join(parts))
         self.reach_label.setVisible(bool(parts))
 

@@ -94,14 +94,20 @@ class RobotModelSource(QObject):
         error = self.load_file(path)
         if error is None:
             return True
-        self.problem = self.tr("The robot model remembered from the last session could not be loaded: %1. "
-                               "The default robot model (%2) is used.").replace("%1", error) \
+        self.problem = (
+            self.tr(
+                "The robot model remembered from the last session could not be loaded: %1. "
+                "The default robot model (%2) is used."
+            )
+            .replace("%1", error)
             .replace("%2", self._default.name)
+        )
         self.set_profile(self._default)  # and forget the bad path
         self.problemRaised.emit(self.problem)
         return False
 
-    def plan_issues(self, plan: Plan, ledger: PointLedger,
-                    current_pose: PointLike | None) -> Sequence[PlanIssue]:
+    def plan_issues(
+        self, plan: Plan, ledger: PointLedger, current_pose: PointLike | None
+    ) -> Sequence[PlanIssue]:
         """The current profile's reach issues of a plan (``check_plan(..., reach=...)``)."""
         return self.reach.plan_issues(plan, ledger, current_pose)

@@ -47,8 +47,9 @@ def parse_choice(text: str) -> int | None:
 class PointPicker(QComboBox):
     """An editable, searchable combo box of the existing points (see the module docstring)."""
 
-    def __init__(self, ledger: PointLedger, parent: QWidget | None = None, *,
-                 allow_blank: bool = False) -> None:
+    def __init__(
+        self, ledger: PointLedger, parent: QWidget | None = None, *, allow_blank: bool = False
+    ) -> None:
         super().__init__(parent)
         self.setObjectName("PointPicker")
         self.setEditable(True)
@@ -116,16 +117,20 @@ class PointPicker(QComboBox):
         else:
             line.setStyleSheet(f"color: {COLOR_ERROR};")
             pid = parse_choice(self.currentText())
-            self.setToolTip(self.tr("Point P{id} does not exist").format(id=pid) if pid is not None
-                            else self.tr("Pick an existing point (type its id or part of its name)"))
+            self.setToolTip(
+                self.tr("Point P{id} does not exist").format(id=pid)
+                if pid is not None
+                else self.tr("Pick an existing point (type its id or part of its name)")
+            )
 
 
 class PointPickerDelegate(QStyledItemDelegate):
     """A :class:`PointPicker` in a segment table cell; ``ledger()`` gives the current points.
     ``allow_blank``: the middle point column (an arc's middle point may be left empty)."""
 
-    def __init__(self, ledger: Callable[[], PointLedger], parent: QWidget | None = None, *,
-                 allow_blank: bool = False) -> None:
+    def __init__(
+        self, ledger: Callable[[], PointLedger], parent: QWidget | None = None, *, allow_blank: bool = False
+    ) -> None:
         super().__init__(parent)
         self._ledger = ledger
         self._allow_blank = allow_blank
