@@ -1,8 +1,9 @@
 """RobotClient: one method per controller operation, typed results, typed errors.
 
-The commands and their completion, over :class:`~app.link.register_client.RegisterClient`
-(the link, the write guard, raw register access and the pose/status reads, which RobotClient
-inherits: ``connect``, ``read_pose``, ``read_status``, ``write_gv``, ``stats`` ...). Not
+The commands, over :class:`~app.link.command_client.CommandClient` (440 and the completion
+rule) and :class:`~app.link.register_client.RegisterClient` (the link, the write guard, raw
+register access and the pose/status reads), which RobotClient inherits: ``connect``,
+``read_pose``, ``read_status``, ``write_gv``, ``stats``, ``begin_command``, ``wait`` ... Not
 thread-safe: one thread owns it (the GUI worker, or the CLI).
 
 Decisions on the open questions of PROTOCOL.md section 7 that live here:
@@ -13,19 +14,14 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 * **Cached parameters**: GV245 (tool), GV241 (user frame) and the external-axis offsets
   GV236-240 are written only when they differ from what this client last wrote; the cache is
   dropped whenever the connection is (re)made or fails, and by :meth:`invalidate_cache`.
-* **Completion rule** (``ConnectionSettings.completion``, see app/link/tracker.py): "sentinel"
-  writes GV291 <- 0xA5 before each create/teach/move command (one extra 0x10) so the
-  controller's own write proves the result; "observe" never writes GV291 and may end an
-  instant command *done, unconfirmed*; "auto" (default) probes once, before the first such
-  command: write the sentinel, wait ``SENTINEL_PROBE_SETTLE``, read it back -- kept: sentinel;
-  Modbus exception or overwritten: observe. Never in monitor-only mode (no command is sent).
+* **Completion rule**: see :mod:`app.link.command_client` (CommandClient, the layer between
+  the registers and these operations: it writes 440 and follows the command to its end).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import enum
-import logging
 import math
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -36,27 +32,23 @@ from app.errors import (
     LinkError,
     MalformedResponse,
     ModbusExceptionError,
-    Reason,
     ResponseTimeout,
 )
 from app.link.checks import check_enum, check_float, check_floats, check_int, check_tool
+from app.link.command_client import CommandClient
 from app.link.register_client import RegisterClient
 from app.link.stats import LinkStats
-from app.link.tracker import CommandTracker, CompletionRule, ResultPacer, command_text
+from app.link.tracker import command_text
 from app.link.transport import ConnectionSettings, TrafficRecord
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import (
-    STATUS_SENTINEL,
     CommandKind,
-    CommandStatus,
     ControllerMode,
     ProgramMotionMode,
     RunCommand,
     TeachFrame,
     WorkMode,
-    decode_command_status,
-    decode_status_registers,
 )
 
 __all__ = [
@@ -67,8 +59,6 @@ __all__ = [
     "StepFrame",
     "TrafficRecord",
 ]
-
-_log = logging.getLogger(__name__)
 
 _GENERAL_POSE_LAST_START = registers.GV_GENERAL_LAST - 5  # six GVs must fit in GV0..GV99
 
@@ -87,7 +77,7 @@ class StepFrame(enum.Enum):
 ProgressCallback = Callable[[int, int], bool]
 
 
-class RobotClient(RegisterClient):
+class RobotClient(CommandClient):
     """One method per controller operation. Blocking; owned by one thread."""
 
     def __init__(self, settings: ConnectionSettings) -> None:
@@ -95,26 +85,16 @@ class RobotClient(RegisterClient):
         self._user_frame_cache: int | None = None
         self._ext_cache: tuple[float, ...] | None = None
         super().__init__(settings)
-        self._last_kind: CommandKind | None = None
         self._teach_frame: TeachFrame | None = None
-        self.last_tracker: CommandTracker | None = None
-        self._gv291_writable: bool | None = None  # completion "auto": None until probed
         # X Y Z of the points this client created from given poses (a move whose GV291 never
         # changed may be confirmed by arriving there, see CommandTracker's ``target``)
         self._sent_points: dict[int, tuple[float, float, float]] = {}
-        self._ack_latency = 0.0  # s, decaying maximum of the acknowledgement times seen
-        self._pacer = ResultPacer()  # when results show on this link (tracker.py)
 
     def invalidate_cache(self) -> None:
         """Forget which tool / user frame / external offsets were written last."""
         self._tool_cache = None
         self._user_frame_cache = None
         self._ext_cache = None
-
-    def command_status(self) -> CommandStatus:
-        """GV291 decoded with the table of the last command this client sent."""
-        regs = self._read(registers.gv_reg(registers.GV_COMMAND_STATUS), 2)
-        return decode_command_status(self._last_kind, decode_status_registers(regs, self.settings.word_order))
 
     # -- plain commands (no GV291) -------------------------------------------------------
     def set_work_mode(self, mode: WorkMode) -> None:
@@ -185,129 +165,6 @@ class RobotClient(RegisterClient):
         if self._user_frame_cache != user:
             self._write_floats(registers.GV_USER_FRAME, [float(user)])
             self._user_frame_cache = user
-
-    # -- completion rule (see app/link/tracker.py) ---------------------------------------
-    @property
-    def completion_rule(self) -> CompletionRule | None:
-        """The rule in force; None while "auto" has not probed GV291 yet."""
-        mode = self.settings.completion
-        if mode != "auto":
-            return mode
-        if self._gv291_writable is None:
-            return None
-        return "sentinel" if self._gv291_writable else "observe"
-
-    def probe_gv291(self) -> bool:
-        """Does the controller keep what the host writes into GV291? (Completion "auto".)
-
-        Writes the sentinel, waits ``timing.SENTINEL_PROBE_SETTLE`` (a controller that
-        re-publishes its status every scan has overwritten it by then) and reads it back. A
-        Modbus exception (a read-only GV291) means no. Safe: GV291 only reports the last
-        command's result, which the next command overwrites; the probe runs just before a
-        command, never in monitor-only mode. The answer is kept for this client's lifetime.
-        """
-        self._require_writable("GV291 probe")
-        try:
-            self._write_floats(registers.GV_COMMAND_STATUS, [float(STATUS_SENTINEL)])
-        except ModbusExceptionError as exc:
-            _log.info("GV291 is read-only (%s): completion rule observe", exc)
-            writable = False
-        else:
-            time.sleep(timing.SENTINEL_PROBE_SETTLE)
-            writable = self.read_status().command_status_code == STATUS_SENTINEL
-            _log.info(
-                "GV291 %s: completion rule %s",
-                "keeps the host's value" if writable else "ignores the host's writes",
-                "sentinel" if writable else "observe",
-            )
-        self._gv291_writable = writable
-        return writable
-
-    def _unconfirmed_window(self) -> float:
-        """How long an unchanged 0xFF waits before "done, unconfirmed" (observe rule)."""
-        base = self.settings.unconfirmed_after
-        base = timing.UNCONFIRMED_AFTER if base is None else base
-        learned = timing.UNCONFIRMED_LATENCY_FACTOR * self._ack_latency
-        return min(max(base, learned), timing.ACK_TIMEOUT / 2)
-
-    def _learn_latency(self) -> None:
-        """Decay the learned latency by 5 % a command; take in the previous command's
-        acknowledgement time (an instant command that was seen to change GV291)."""
-        self._ack_latency *= 0.95
-        last = self.last_tracker
-        if last is None or last.result is None or last.ack_time is None or last.is_move:
-            return
-        self._ack_latency = max(last.ack_time - last.started, self._ack_latency)
-
-    def begin_command(
-        self,
-        command: RunCommand,
-        before: ControllerStatus,
-        before_pose: Pose | None,
-        *,
-        timeout: float | None = None,
-    ) -> CommandTracker:
-        """Write 440 <- ``command`` (parameters already written) and return its tracker.
-
-        With the sentinel rule GV291 <- sentinel goes out first (completion "auto" probes
-        GV291 before the first command).
-        """
-        rule: CompletionRule = "observe"
-        pre_code: int | None = None
-        if CommandKind.of(command) is not None:
-            self._learn_latency()
-            probe = self.settings.completion == "auto" and self._gv291_writable is None
-            if probe and not self.probe_gv291() and self.last_status is not None:
-                pre_code = self.last_status.command_status_code  # the freshest read
-            rule = self.completion_rule or "observe"
-            if rule == "sentinel":
-                self._write_floats(registers.GV_COMMAND_STATUS, [float(STATUS_SENTINEL)])
-                pre_code = STATUS_SENTINEL
-        tracker = CommandTracker(
-            command,
-            before,
-            before_pose,
-            time.monotonic(),
-            timeout=timeout,
-            rule=rule,
-            pre_code=pre_code,
-            unconfirmed_after=self._unconfirmed_window(),
-            pacer=self._pacer,
-        )
-        self._last_kind = tracker.kind
-        self.last_tracker = tracker
-        self._write_control(registers.REG_RUN_COMMAND, int(command))
-        return tracker
-
-    def poll(self, tracker: CommandTracker) -> CommandResult | None:
-        """One status read (plus the pose for moves) fed to ``tracker``."""
-        status = self.read_status()
-        pose = self.read_pose() if tracker.is_move else None
-        return tracker.update(status, pose, time.monotonic())
-
-    def wait(self, tracker: CommandTracker, *, raise_errors: bool = True) -> CommandResult:
-        """Poll until ``tracker`` ends; raise its typed error when it failed (by default)."""
-        while True:
-            result = self.poll(tracker)  # the first poll is immediate: keep the ack window small
-            if result is not None:
-                if raise_errors and tracker.error is not None:
-                    raise tracker.error
-                return result
-            interval = tracker.poll_interval(time.monotonic())
-            if interval > 0:
-                time.sleep(interval)
-
-    def _finish(self, tracker: CommandTracker, wait: bool) -> CommandResult:
-        if wait:
-            return self.wait(tracker)
-        return CommandResult(
-            tracker.command,
-            tracker.kind,
-            None,
-            True,
-            f"{tracker.text}: sent",
-            reason=Reason("sent", {"command": int(tracker.command)}),
-        )
 
     def _check_point_id(self, point_id: int, name: str = "point id") -> int:
         return check_int(point_id, self.settings.point_id_min, self.settings.point_id_max, name)
