@@ -53,6 +53,8 @@ from app.errors import (
     Reason,
     TeachPadError,
 )
+from app.link.arrival import POSE_EPSILON, arrived, pose_moved
+from app.link.pacer import ResultPacer
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import (
     RUN_COMMAND_TEXT,
@@ -71,12 +73,6 @@ __all__ = ["POSE_EPSILON", "CommandTracker", "CompletionRule", "ResultPacer", "c
 
 CompletionRule = Literal["sentinel", "observe"]
 
-# A pose component that changed by more than this (mm or degrees) counts as motion.
-POSE_EPSILON = 1e-3
-# A move is at its end point when the TCP is this close (mm) to the X Y Z the host sent for it.
-ARRIVAL_TOLERANCE = 0.5
-ARRIVAL_TOLERANCE_DEG = 0.05  # the same for a joint step's joint angles (degrees)
-
 
 # --------------------------------------------------------------------------------------------
 # Completion detection
@@ -87,53 +83,8 @@ def command_text(command: RunCommand) -> str:
     return RUN_COMMAND_TEXT.get(command, f"command 0x{int(command):02X}")
 
 
-def _pose_values(pose: Pose) -> tuple[float, ...]:
-    return pose.xyzabc + tuple(pose.ext) + tuple(pose.joints or ())
-
-
-def pose_moved(a: Pose, b: Pose) -> bool:
-    va, vb = _pose_values(a), _pose_values(b)
-    return len(va) != len(vb) or any(abs(x - y) > POSE_EPSILON for x, y in zip(va, vb, strict=True))
-
-
 def _seconds(value: float) -> str:
     return str(round(value, 3))
-
-
-class ResultPacer:
-    """When, after an instant command (create point, teach), its result usually shows (per link).
-
-    ``estimate`` (s after the read that first showed the command *taken* -- GV291 left its old
-    code, e.g. the classic controller's 0, "received" -- with no result yet) times the next read.
-    Reads before that keep the plain backoff (a slow controller's short 0 phase must not be
-    skipped: the observe rule needs to see it). A fixed 1 ms backoff after the 0 overshot on a
-    loaded host and still read a 1 ms controller a third time now and then. Here the read after
-    it is due at ``estimate``, learned from each confirmed result: found in time -> it shrinks by
-    :data:`DECAY` (it probes a little earlier next time); missed -> it grows to :data:`GROW`
-    times the time of the read that missed (later reads back off as before). A steady
-    controller is read twice per command, with an extra read in about one command of ten (the
-    probe); a jittery one is read later rather than more often. Never a tight loop.
-    """
-
-    DECAY = 0.98
-    GROW = 1.25
-    MAX_ESTIMATE = 0.1  # s: a read at least every 0.1 s while a command is under way
-    FLOOR = 1e-4  # s: a miss raises the estimate to at least GROW x this
-
-    def __init__(self) -> None:
-        # Optimistic at first: the second read follows the first at once (an instant controller's
-        # result is there), and a slower controller's first misses raise it geometrically.
-        self.estimate = 0.0
-
-    def learn(self, missed: float | None, found: float) -> None:
-        """A confirmed result: ``found`` = when the read that saw it was sent, ``missed`` = when
-        the last read before it was sent (None: no read after the first missed), in s after the
-        first read."""
-        if missed is None:
-            value = min(self.estimate, found) * self.DECAY
-        else:
-            value = max(self.estimate, missed, self.FLOOR) * self.GROW
-        self.estimate = min(max(value, 0.0), self.MAX_ESTIMATE)
 
 
 class CommandTracker:
@@ -463,22 +414,8 @@ class CommandTracker:
         return settled and (at_target or now - self.started >= self.ack_timeout)
 
     def _at_target(self, pose: Pose | None) -> bool:
-        """The arm stands where this host sent it: the end point's X Y Z (within
-        ARRIVAL_TOLERANCE mm) or a joint step's J1..J6 (within ARRIVAL_TOLERANCE_DEG)."""
-        if pose is None:
-            return False
-        if self.target_ext is not None and not all(
-            abs(e - t) <= ARRIVAL_TOLERANCE for e, t in zip(pose.ext, self.target_ext, strict=False)
-        ):
-            return False
-        if self.target is not None:
-            return math.dist(pose.xyzabc[:3], self.target) <= ARRIVAL_TOLERANCE
-        if self.target_joints is not None and pose.joints:
-            return all(
-                abs(q - t) <= ARRIVAL_TOLERANCE_DEG
-                for q, t in zip(pose.joints, self.target_joints, strict=False)
-            )
-        return False
+        """The arm stands where this host sent it (see :func:`app.link.arrival.arrived`)."""
+        return pose is not None and arrived(pose, self.target, self.target_joints, self.target_ext)
 
     def _details(self, now: float) -> dict[str, float]:
         details = {"elapsed": now - self.started}

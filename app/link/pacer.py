@@ -1,0 +1,45 @@
+"""ResultPacer: when to read again after an instant command was seen taken (one per link).
+
+Used by :class:`~app.link.tracker.CommandTracker.poll_interval` (see "Polling while waiting"
+in app/link/tracker.py); :class:`~app.link.command_client.CommandClient` keeps one per connection.
+"""
+
+from __future__ import annotations
+
+__all__ = ["ResultPacer"]
+
+
+class ResultPacer:
+    """When, after an instant command (create point, teach), its result usually shows (per link).
+
+    ``estimate`` (s after the read that first showed the command *taken* -- GV291 left its old
+    code, e.g. the classic controller's 0, "received" -- with no result yet) times the next read.
+    Reads before that keep the plain backoff (a slow controller's short 0 phase must not be
+    skipped: the observe rule needs to see it). A fixed 1 ms backoff after the 0 overshot on a
+    loaded host and still read a 1 ms controller a third time now and then. Here the read after
+    it is due at ``estimate``, learned from each confirmed result: found in time -> it shrinks by
+    :data:`DECAY` (it probes a little earlier next time); missed -> it grows to :data:`GROW`
+    times the time of the read that missed (later reads back off as before). A steady
+    controller is read twice per command, with an extra read in about one command of ten (the
+    probe); a jittery one is read later rather than more often. Never a tight loop.
+    """
+
+    DECAY = 0.98
+    GROW = 1.25
+    MAX_ESTIMATE = 0.1  # s: a read at least every 0.1 s while a command is under way
+    FLOOR = 1e-4  # s: a miss raises the estimate to at least GROW x this
+
+    def __init__(self) -> None:
+        # Optimistic at first: the second read follows the first at once (an instant controller's
+        # result is there), and a slower controller's first misses raise it geometrically.
+        self.estimate = 0.0
+
+    def learn(self, missed: float | None, found: float) -> None:
+        """A confirmed result: ``found`` = when the read that saw it was sent, ``missed`` = when
+        the last read before it was sent (None: no read after the first missed), in s after the
+        first read."""
+        if missed is None:
+            value = min(self.estimate, found) * self.DECAY
+        else:
+            value = max(self.estimate, missed, self.FLOOR) * self.GROW
+        self.estimate = min(max(value, 0.0), self.MAX_ESTIMATE)
