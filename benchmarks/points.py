@@ -146,7 +146,8 @@ def bench_show(project: Project, repeats: int) -> dict[str, Any]:
         from PySide6.QtWidgets import QHeaderView, QTableView
 
         from ui.models.point_columns import COLUMNS
-        from ui.models.points_model import PointFilterProxy, PointsModel
+        from ui.models.point_filter import PointFilterProxy
+        from ui.models.points_model import PointsModel
     except ImportError as exc:
         return {"show_ms": None, "reason": f"ui/points_model.py is not usable: {exc}"}
     app = _qt_app()

@@ -10,16 +10,17 @@ The ledger is not thread-safe: one thread (the GUI's) owns it; workers get
 restart, a reconnect or a loaded file.
 
 The point itself lives in :mod:`app.points.point`, CSV in :mod:`app.points.csv_io`, uploads in
-:mod:`app.points.upload`; their names are re-exported here for older imports.
+:mod:`app.points.upload`, importing a file's list in :mod:`app.points.ledger_import`; their names
+are re-exported here for older imports.
 """
 
 from __future__ import annotations
 
-import enum
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 
 from app.errors import InvalidInput
+from app.points.ledger_import import EmptyImport, ImportMode, ImportReport, merge_import
 from app.points.point import (
     CONTROLLER_FIELDS,
     CSV_COLUMNS,
@@ -72,40 +73,6 @@ class PointEdit:
         if (self.old.sync, self.old.sync_error) != (self.new.sync, self.new.sync_error):
             names.append("sync")
         return tuple(names)
-
-
-class ImportMode(enum.Enum):
-    REPLACE = "replace"  # the ledger becomes the imported list
-    MERGE = "merge"  # imported ids replace the same ids in place; new ids are appended
-
-
-@dataclass(frozen=True)
-class ImportReport:
-    added: int
-    updated: int
-    unchanged: int
-    removed: int
-
-    @property
-    def text(self) -> str:
-        return (
-            f"{self.added} added, {self.updated} updated, {self.unchanged} unchanged, {self.removed} removed"
-        )
-
-
-class EmptyImport(InvalidInput):
-    """A replace-mode import without a single point: it would delete every point; refused
-    unless the caller asks for it explicitly (``allow_empty=True``)."""
-
-    code = "empty_import"
-
-    def __init__(self, existing: int) -> None:
-        self.existing = existing
-        super().__init__(
-            f"the file has no points: replacing with it would remove all {existing} point(s) "
-            "of the project (merge it, or ask explicitly for an empty import)",
-            params={"existing": existing},
-        )
 
 
 def _no_such_point(point_id: int) -> InvalidInput:
@@ -311,48 +278,13 @@ class PointLedger:
     def import_points(
         self, points: Sequence[TempPoint], mode: ImportMode = ImportMode.REPLACE, *, allow_empty: bool = False
     ) -> ImportReport:
-        """Import a parsed list. A point identical on the controller side to the one it
-        replaces keeps that one's sync state; others become ``CHANGED``. An empty list in
-        replace mode raises :class:`EmptyImport` unless ``allow_empty``."""
-        if not points and mode is ImportMode.REPLACE and not allow_empty:
-            raise EmptyImport(len(self._points))
-        old = {p.id: p for p in self._points}
-        seen: set[int] = set()
-        for number, point in enumerate(points, start=1):
-            if point.id in seen:
-                raise InvalidInput(
-                    f"imported point {number}: id {point.id} appears twice",
-                    code="import_duplicate_id",
-                    params={"number": number, "id": point.id},
-                )
-            seen.add(point.id)
-        incoming: list[TempPoint] = []
-        added = updated = unchanged = 0
-        for point in points:
-            previous = old.get(point.id)
-            if previous is None:
-                added += 1
-                incoming.append(replace(point, sync=SyncState.CHANGED, sync_error=""))
-            elif previous.same_on_controller(point):
-                if previous.name == point.name and previous.note == point.note and previous.ext == point.ext:
-                    unchanged += 1
-                else:
-                    updated += 1
-                incoming.append(replace(point, sync=previous.sync, sync_error=previous.sync_error))
-            else:
-                updated += 1
-                incoming.append(replace(point, sync=SyncState.CHANGED, sync_error=""))
-        if mode is ImportMode.REPLACE:
-            incoming_ids = {p.id for p in incoming}
-            removed = sum(1 for pid in old if pid not in incoming_ids)
-            self.replace_all(incoming)
-        else:
-            removed = 0
-            by_id = {p.id: p for p in incoming}
-            merged = [by_id.pop(p.id, p) for p in self._points]
-            merged.extend(p for p in incoming if p.id in by_id)
-            self.replace_all(merged)
-        return ImportReport(added=added, updated=updated, unchanged=unchanged, removed=removed)
+        """Import a parsed list (see :func:`~app.points.ledger_import.merge_import`): a point
+        identical on the controller side to the one it replaces keeps that one's sync state;
+        others become ``CHANGED``. An empty list in replace mode raises :class:`EmptyImport`
+        unless ``allow_empty``."""
+        merged, report = merge_import(self._points, points, mode, allow_empty=allow_empty)
+        self.replace_all(merged)
+        return report
 
     # --- edits of one row
     def replace(self, row: int, point: TempPoint) -> TempPoint:

@@ -14,7 +14,8 @@ from app.plan.segments import Plan, Segment
 from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport, make_point
 from app.points.project import Project, load_project
 from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COL_TOOL, COL_X, COLUMNS
-from ui.models.points_model import PointFilterProxy, PointsModel
+from ui.models.point_filter import PointFilterProxy
+from ui.models.points_model import PointsModel
 
 SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
 COL_Y = COLUMNS.index("y")

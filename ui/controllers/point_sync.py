@@ -16,13 +16,13 @@ created go into the project's upload history as they are applied (``project.reco
 with the link's endpoint, like the CLI's ``points upload``): history only, never proof that
 the controller still holds them. Teach reads the pose back from
 the ``x``..``c`` details that the link adds to a successful create-point result (the pose
-polled together with the completion); without them it uses the state's latest pose.
+polled together with the completion); without them it uses the state's latest pose. The
+bookkeeping of an upload in flight is :mod:`ui.controllers.point_sync_state`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass, field
 
 from PySide6.QtCore import QObject, Signal, Slot
 
@@ -30,46 +30,20 @@ from app.errors import InvalidInput
 from app.link.robot_link import LinkPort, Pending
 from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult, Pose
-from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport
+from app.points.ledger import SyncState, UploadReport
 from app.protocol.registers import TOOL_NONE
 from ui.controllers.new_point import NewPointPose, new_point_pose
+from ui.controllers.point_sync_state import UploadRun, batch_reason, pose_from_details, result_reason
 from ui.messages import connection_text, error_text, refusal_text, result_text
 from ui.models.point_columns import sync_text
 from ui.models.points_model import PointsModel
 
 DEFAULT_MOVE_SPEED = 50.0  # mm/s for "move to point"
 MAX_MOVE_SPEED = 1000.0
-POSE_DETAIL_KEYS: tuple[str, ...] = ("x", "y", "z", "a", "b", "c")
 
 LEVEL_INFO = "info"
 LEVEL_WARN = "warn"
 LEVEL_ERROR = "error"
-
-
-def result_reason(result: CommandResult) -> str:
-    """Why a result ended, one translated sentence (ui/messages.py)."""
-    return result_text(result)
-
-
-def _pose_from_details(details: dict[str, float], fallback: Pose | None) -> Pose | None:
-    if all(k in details for k in POSE_DETAIL_KEYS):
-        x, y, z, a, b, c = (float(details[k]) for k in POSE_DETAIL_KEYS)
-        return Pose(x, y, z, a, b, c, ext=fallback.ext if fallback else (0.0,) * 5)
-    return fallback
-
-
-@dataclass
-class _Upload:
-    points: dict[int, TempPoint]  # id -> the point as sent (ledger order)
-    restore: bool
-    report: UploadReport = field(default_factory=UploadReport)
-    pending: list[UploadOutcome] = field(default_factory=list)  # reported, not yet in the ledger
-    cancelled: bool = False
-    link_lost: str | None = None  # the link went down: waiting for the worker's final result
-
-    @property
-    def total(self) -> int:
-        return len(self.points)
 
 
 class PointSyncController(QObject):
@@ -102,7 +76,7 @@ class PointSyncController(QObject):
         self._teach_name = ""
         self._move_id: int | None = None
         self._pending: Pending | None = None  # the outcome of the running teach / move / upload
-        self._upload: _Upload | None = None
+        self._upload: UploadRun | None = None
         self._restore_offered = False
         self.teach_tool = TOOL_NONE
         if link is not None:
@@ -190,7 +164,7 @@ class PointSyncController(QObject):
         link = self._ready(self.tr("Upload"))
         if link is None:
             return False
-        upload = _Upload({p.id: p for p in points}, restore)
+        upload = UploadRun({p.id: p for p in points}, restore)
         self._upload = upload
         self._set_operation("upload")
         self.uploadProgress.emit(0, len(points))
@@ -384,7 +358,7 @@ class PointSyncController(QObject):
             reason = result_reason(result)
             self._say(self.tr("Teach P{id} failed: {reason}").format(id=point_id, reason=reason), LEVEL_ERROR)
             return
-        pose = _pose_from_details(result.details, self.last_pose)
+        pose = pose_from_details(result.details, self.last_pose)
         if pose is None:
             self._say(
                 self.tr("P{id} was created on the controller, but its pose is not known yet").format(
@@ -439,23 +413,14 @@ class PointSyncController(QObject):
     # upload
     @Slot(int, bool, str, bool)
     def _on_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
-        upload = self._upload
-        if upload is None or point_id not in upload.points:
-            return
-        sent = upload.points[point_id]
-        outcome = (
-            UploadOutcome(point_id, True, sent=sent, unconfirmed=unconfirmed)
-            if ok
-            else UploadOutcome(point_id, False, reason)
-        )
-        upload.report.outcomes.append(outcome)
-        upload.pending.append(outcome)
+        if self._upload is not None:
+            self._upload.record(point_id, ok, reason, unconfirmed)
 
     def _flush_upload(self) -> None:
         """Apply the outcomes reported since the last flush to the ledger (one model update)."""
         upload = self._upload
         if upload is not None and upload.pending:
-            batch, upload.pending = upload.pending, []
+            batch = upload.take_pending()
             created = [o.point_id for o in batch if o.ok]
             if created:  # before the sync states: the project's dirty check follows syncChanged
                 endpoint = self._link.state.connection.endpoint if self._link is not None else ""
@@ -473,14 +438,14 @@ class PointSyncController(QObject):
         upload = self._upload
         assert upload is not None
         self._flush_upload()
-        attempted = len(upload.report.outcomes)
+        attempted = upload.attempted
         self.uploadProgress.emit(attempted, upload.total)
         if attempted >= upload.total:
             self._finish_upload(aborted=None)
         elif upload.cancelled:
             self._finish_upload(aborted=self.tr("cancelled"))
         else:
-            batch = result_text(result) if result.reason else _batch_reason(result.message)
+            batch = result_text(result) if result.reason else batch_reason(result.message)
             reason = upload.link_lost or batch or self.tr("stopped")
             self._finish_upload(aborted=reason)
 
@@ -490,11 +455,7 @@ class PointSyncController(QObject):
         self._set_operation("")
         if upload is None:
             return
-        report = upload.report
-        done_ids = {o.point_id for o in report.outcomes}
-        if aborted is not None:
-            report.aborted = aborted
-            report.not_attempted = [pid for pid in upload.points if pid not in done_ids]
+        report = upload.close(aborted)
         ok, failed = report.ok_count, len(report.failed)
         if report.all_ok:
             self._say(self.tr("Uploaded {n} points").format(n=ok), LEVEL_INFO)
@@ -514,9 +475,3 @@ class PointSyncController(QObject):
             )
             self._say(text, LEVEL_ERROR)
         self.uploadFinished.emit(report)
-
-
-def _batch_reason(message: str) -> str:
-    """Why an upload ended early, from the link's "uploaded N of M points (reason)"."""
-    _head, sep, tail = message.partition(" (")
-    return tail[:-1] if sep and tail.endswith(")") else message

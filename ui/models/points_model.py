@@ -14,26 +14,26 @@ and teach, cleared by a reconnect) and derives the sync state of every point an 
 puts back from it, so undoing an edit after an upload never claims a point is on the
 controller when it is not.
 
-The generic undoable list model and its commands are in :mod:`ui.models.undo_list`.
+The generic undoable list model and its commands are in :mod:`ui.models.undo_list`, this
+model's own (import, id follow) in :mod:`ui.models.point_commands`; the filter proxy is
+:class:`ui.models.point_filter.PointFilterProxy`.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import replace
 from typing import Any
 
 from PySide6.QtCore import (
     QModelIndex,
     QPersistentModelIndex,
-    QSortFilterProxyModel,
     Qt,
     Signal,
 )
-from PySide6.QtGui import QBrush, QColor, QUndoCommand, QUndoStack
+from PySide6.QtGui import QBrush, QColor, QUndoStack
 
 from app.errors import InvalidInput
-from app.plan.segments import Plan, Segment
 from app.points.ledger import (
     FieldError,
     ImportMode,
@@ -68,6 +68,7 @@ from ui.models.point_columns import (
     sync_text,
     tool_display,
 )
+from ui.models.point_commands import ReplaceAllCommand, follow_id
 from ui.models.undo_list import (
     InsertRowsCommand,
     MoveRowsCommand,
@@ -77,24 +78,6 @@ from ui.models.undo_list import (
 )
 
 ModelIndex = QModelIndex | QPersistentModelIndex
-
-
-class _ReplaceAllCommand(QUndoCommand):
-    """The whole list swapped (CSV import)."""
-
-    def __init__(
-        self, model: PointsModel, before: Sequence[TempPoint], after: Sequence[TempPoint], text: str
-    ) -> None:
-        super().__init__(text)
-        self._model = model
-        self._before = tuple(before)
-        self._after = tuple(after)
-
-    def redo(self) -> None:
-        self._model._apply_replace_all(self._after)
-
-    def undo(self) -> None:
-        self._model._apply_replace_all(self._before)
 
 
 class PointsModel(UndoableListModel):
@@ -307,32 +290,15 @@ class PointsModel(UndoableListModel):
                     code="point_id_taken",
                     params={"id": new.id, "point": taken},
                 )
-        after = self._follow_id(old.id, new.id) if old.id != new.id else None
+        after = (
+            follow_id(lambda: self._project.plans, old.id, new.id, self.planReferencesChanged.emit)
+            if old.id != new.id
+            else None
+        )
         column = self._headers[COLUMNS.index(name)] if name in COLUMNS else name
         text = self.tr("Edit {point} {column}").format(point=old.label, column=column)
         self._stack.push(ReplaceRowCommand(self, self.ledger, row, old, new, text, after=after))
         return True
-
-    def _follow_id(self, old_id: int, new_id: int) -> Callable[[bool], None]:
-        """Renumber references in the plans (redo) and put them back exactly (undo)."""
-        saved: list[tuple[Plan, list[tuple[int, Segment]]]] = []
-
-        def apply(forward: bool) -> None:
-            if forward:
-                saved.clear()
-                for plan in self._project.plans:
-                    before = list(plan.segments)
-                    changed = plan.replace_point_id(old_id, new_id)
-                    if changed:
-                        saved.append((plan, [(r, before[r]) for r in changed]))
-            else:
-                for plan, originals in saved:
-                    for r, seg in originals:
-                        plan.replace(r, seg)
-            if saved:
-                self.planReferencesChanged.emit()
-
-        return apply
 
     def add_point(
         self,
@@ -451,7 +417,9 @@ class PointsModel(UndoableListModel):
         scratch = PointLedger(self.ledger.snapshot(), self.ledger.limits)
         report = scratch.import_points(points, mode, allow_empty=allow_empty)
         text = self.tr("Import {n} points").format(n=len(points))
-        self._stack.push(_ReplaceAllCommand(self, self.ledger.snapshot(), scratch.snapshot(), text))
+        self._stack.push(
+            ReplaceAllCommand(self._apply_replace_all, self.ledger.snapshot(), scratch.snapshot(), text)
+        )
         return report
 
     # --- sync state (not undoable)
@@ -510,31 +478,3 @@ class PointsModel(UndoableListModel):
         self.ledger.replace_all([self.settle(p) for p in points])
         self.endResetModel()
         self._after_change(self.ledger)
-
-
-class PointFilterProxy(QSortFilterProxyModel):
-    """Rows whose id equals the filter text or whose name contains it (case-insensitive)."""
-
-    def __init__(self, parent: Any = None) -> None:
-        super().__init__(parent)
-        self._needle = ""
-
-    @property
-    def filter_text(self) -> str:
-        return self._needle
-
-    def set_filter_text(self, text: str) -> None:
-        needle = text.strip().casefold()
-        if needle != self._needle:
-            self.beginFilterChange()
-            self._needle = needle
-            self.endFilterChange(QSortFilterProxyModel.Direction.Rows)
-
-    def filterAcceptsRow(self, source_row: int, source_parent: ModelIndex) -> bool:
-        if not self._needle:
-            return True
-        model = self.sourceModel()
-        if not isinstance(model, PointsModel) or source_row >= model.rowCount():
-            return True
-        point = model.point_at(source_row)
-        return self._needle == str(point.id) or self._needle in point.name.casefold()

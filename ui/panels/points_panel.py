@@ -22,7 +22,8 @@ from ui.controllers.point_sync import LEVEL_ERROR, LEVEL_INFO, LEVEL_WARN, Point
 from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.messages import refusal_text
-from ui.models.points_model import PointFilterProxy, PointsModel
+from ui.models.point_filter import PointFilterProxy
+from ui.models.points_model import PointsModel
 from ui.panels.points_parts import PointsActionBar, PointsTable, RestoreBanner, UploadProgressRow
 from ui.widgets_common import COLOR_ERROR, COLOR_OK
 
