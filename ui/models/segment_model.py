@@ -8,7 +8,8 @@ the list: the operator always sees what an undo changed.
 The results of the checks (:func:`app.plan.checks.check_plan`) and the estimates
 (:func:`app.plan.estimates.estimate_plan`) are given to the model by the panel
 (:meth:`SegmentTableModel.set_issues`, :meth:`SegmentTableModel.set_estimate`); each row shows
-its issues as an icon and a tooltip in the ``#`` column.
+its issues as an icon and a tooltip in the ``#`` column. What an edit accepts and the segment a
+new row starts with are :mod:`ui.models.segment_edits`.
 """
 
 from __future__ import annotations
@@ -29,13 +30,11 @@ from PySide6.QtGui import QBrush, QColor, QIcon, QUndoStack
 from app.errors import InvalidInput
 from app.plan.checks import IssueKind, PlanIssue
 from app.plan.segments import (
-    DEFAULT_SPEED,
     Plan,
     Segment,
     SegmentKind,
 )
-from app.points.ledger import FieldError, PointLedger, parse_point_id
-from app.protocol.registers import TOOL_NONE
+from app.points.ledger import PointLedger
 from ui.messages import issue_line, refusal_text
 from ui.models.plan_columns import (
     COL_END,
@@ -59,7 +58,8 @@ from ui.models.plan_columns import (
     kind_text,
     orientation_text,
 )
-from ui.models.point_columns import TOOL_NONE_WORDS, tool_display
+from ui.models.point_columns import tool_display
+from ui.models.segment_edits import default_segment, edited_segment, is_checked
 from ui.models.undo_list import (
     InsertRowsCommand,
     MoveRowsCommand,
@@ -341,7 +341,7 @@ class SegmentTableModel(UndoableListModel):
         if column == COL_IGNORE:
             if role != Qt.ItemDataRole.CheckStateRole:
                 return False
-            value = _is_checked(value)
+            value = is_checked(value)
         elif role != Qt.ItemDataRole.EditRole:
             return False
         name = SEG_COLUMNS[column]
@@ -360,31 +360,7 @@ class SegmentTableModel(UndoableListModel):
     def edit_field(self, row: int, name: str, value: object) -> bool:
         plan = self._require_plan()
         old = plan[row]
-        if name in ("via", "end"):
-            blank = value is None or (isinstance(value, str) and not value.strip())
-            if not (name == "via" and blank):
-                value = parse_point_id(_strip_p(value), self._ledger.limits, name)
-                if value not in self._ledger:  # a segment only picks points that exist
-                    raise FieldError(
-                        name,
-                        f"point P{value} does not exist: pick one of the list",
-                        code="segment_point_missing",
-                        params={"id": value},
-                    )
-        if name == "tool" and isinstance(value, str) and value.strip().lower() in TOOL_NONE_WORDS:
-            value = TOOL_NONE
-        new = old.with_field(name, value)
-        if new.speed <= 0:
-            raise FieldError(
-                "speed",
-                f"{new.speed:g} mm/s: the speed must be > 0",
-                code="speed_not_positive",
-                params={"speed": f"{new.speed:g}"},
-            )
-        if new.is_arc and new.via_id is not None and new.via_id == new.end_id:
-            raise FieldError(
-                name, "an arc's middle point must differ from its end point", code="arc_same_points"
-            )
+        new = edited_segment(old, name, value, self._ledger)
         if new == old:
             return False
         column = self._headers[SEG_COLUMNS.index(name)] if name in SEG_COLUMNS else name
@@ -409,29 +385,7 @@ class SegmentTableModel(UndoableListModel):
         """End = the point after the previous segment's end (the first point at the start);
         an arc's middle point is that point and its end the one after. Refused (InvalidInput)
         when there are not enough points: a segment never starts on an id that does not exist."""
-        plan = self._require_plan()
-        ids = self._ledger.ids()
-        previous = plan[at - 1] if 0 < at <= len(plan) else None
-        if len(ids) < (2 if kind is SegmentKind.ARC else 1):
-            raise InvalidInput(
-                "an arc needs two points: add or teach points first"
-                if ids
-                else "there are no points yet: add or teach a point first"
-            )
-
-        def after(pid: int | None) -> int:
-            if pid is None or pid not in ids:
-                return ids[0]
-            return ids[(ids.index(pid) + 1) % len(ids)]
-
-        speed = previous.speed if previous else DEFAULT_SPEED
-        tool = previous.tool if previous else TOOL_NONE
-        start = previous.end_id if previous else None
-        if kind is SegmentKind.ARC:
-            via = after(start)
-            end = after(via)
-            return Segment.arc(via, end, speed, tool=tool)
-        return Segment.line(after(start), speed, tool=tool)
+        return default_segment(self._require_plan(), self._ledger.ids(), at, kind)
 
     def insert_segments(self, at: int, segments: Sequence[Segment]) -> None:
         plan = self._require_plan()
@@ -488,28 +442,3 @@ class SegmentTableModel(UndoableListModel):
         if target is not self._plan:
             self.set_plan(target)
             self.planShown.emit(target)
-
-
-def _strip_p(value: object) -> object:
-    """Accept ``P5`` / ``p5`` / ``5 circle W`` (what the cell shows) for a point id."""
-    if isinstance(value, str):
-        text = value.strip()
-        if text[:1] in ("P", "p"):
-            text = text[1:]
-        return text.split()[0] if text.split() else text
-    return value
-
-
-def _is_checked(value: Any) -> bool:
-    if isinstance(value, Qt.CheckState):
-        return value == Qt.CheckState.Checked
-    if isinstance(value, bool):
-        return value
-    if isinstance(value, int):
-        return value == Qt.CheckState.Checked.value
-    raise FieldError(
-        "ignore_middle",
-        f"{value!r} is not a check state",
-        code="not_yes_no",
-        params={"value": repr(value)[:40]},
-    )

@@ -8,6 +8,7 @@ samples). On top: the selected segment (thick), the referenced points (one scatt
 labels for the first :data:`MAX_LABELS`), where the plan starts, and while a plan runs the
 live TCP (position and a short trail), repainted at most :data:`LIVE_FPS` times a second from
 the latest pose (poses arrive at the poll rate). Outside a run, poses are only remembered.
+The items of one projection are a :class:`ui.panels.plan_projection.Projection`.
 
 The view fits every change (another plan, a segment added, removed or edited, a point moved)
 until the operator zooms or pans a projection (pyqtgraph's ``sigRangeChangedManually``): from
@@ -22,10 +23,9 @@ only remember what to draw; the build draws it.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
 from PySide6.QtGui import QResizeEvent
 from PySide6.QtWidgets import QBoxLayout, QHBoxLayout, QLabel, QToolButton, QVBoxLayout, QWidget
@@ -36,115 +36,20 @@ from app.plan.presenter import PlanInfo
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger
 from app.safety.envelope import Envelope
-from ui.palette import (
-    COLOR_AXIS,
-    COLOR_HIGHLIGHT,
-    COLOR_INK,
-    COLOR_INK_SOFT,
-    COLOR_PATH,
-    COLOR_START,
-    COLOR_TCP,
-    COLOR_TRAIL,
-)
-from ui.palette import COLOR_ERROR as COLOR_KEEP_OUT
-from ui.palette import COLOR_OK as COLOR_KEEP_IN
+from ui.palette import COLOR_INK_SOFT
+from ui.panels.plan_projection import MAX_LABELS as MAX_LABELS
+from ui.panels.plan_projection import PLOT_MIN_HEIGHT as PLOT_MIN_HEIGHT
+from ui.panels.plan_projection import FloatArray, Projection, style_plot
 
-if TYPE_CHECKING:
-    import pyqtgraph as pg
-
-MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
 LIVE_FPS = 30
 TRAIL_LENGTH = 600  # live TCP positions kept for the trail
 INFO_WIDTH = 210  # px, the lengths / times column (at most)
 INFO_MIN_WIDTH = 140  # px, on a narrow window
-PLOT_MIN_HEIGHT = 80  # px: the planner's top row (segments, run box) needs the height at 1280×800
 INFO_BELOW_WIDTH = 620  # px: a narrower preview shows the lengths / times below the plots
 
 #: (key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.
 PROJECTIONS: tuple[tuple[str, int, int], ...] = (("top", 0, 1), ("front", 0, 2), ("side", 1, 2))
 AXIS_NAMES = ("X", "Y", "Z")
-
-FloatArray = NDArray[np.float64]
-
-
-def _style_plot(plot: pg.PlotWidget) -> None:
-    import pyqtgraph as pg  # deferred: see the module docstring
-
-    plot.setBackground("w")
-    item = plot.getPlotItem()
-    item.showGrid(x=True, y=True, alpha=0.25)
-    for name in ("left", "bottom"):
-        axis = item.getAxis(name)
-        axis.enableAutoSIPrefix(False)
-        axis.setPen(pg.mkPen(COLOR_AXIS))
-        axis.setTextPen(pg.mkPen(COLOR_INK))
-    # a fixed left axis: an auto-sized one changes the view's width with its tick labels, and an
-    # aspect-locked view then changes its range, hence its labels: an endless relayout when narrow
-    item.getAxis("left").setWidth(44)
-    plot.setMenuEnabled(False)
-    plot.setAspectLocked(True)
-    plot.getViewBox().setDefaultPadding(0.12)  # room for the point labels at the edges
-    plot.setMinimumSize(90, PLOT_MIN_HEIGHT)
-
-
-class _Projection:
-    """The items of one projection."""
-
-    def __init__(self, plot: pg.PlotWidget, h: int, v: int) -> None:
-        import pyqtgraph as pg  # deferred: see the module docstring
-
-        self.plot = plot
-        self.h = h
-        self.v = v
-        self.path = pg.PlotCurveItem(pen=pg.mkPen(COLOR_PATH, width=2), connect="finite", antialias=True)
-        self.selected = pg.PlotCurveItem(
-            pen=pg.mkPen(COLOR_HIGHLIGHT, width=5), connect="finite", antialias=True
-        )
-        self.points = pg.ScatterPlotItem(size=7, brush=pg.mkBrush(COLOR_AXIS), pen=pg.mkPen("w"))
-        self.start = pg.ScatterPlotItem(
-            size=11, symbol="t1", brush=pg.mkBrush(COLOR_START), pen=pg.mkPen("w")
-        )
-        self.trail = pg.PlotCurveItem(pen=pg.mkPen(COLOR_TRAIL, width=2))
-        self.tcp = pg.ScatterPlotItem(
-            size=13, symbol="o", brush=pg.mkBrush(COLOR_TCP), pen=pg.mkPen(COLOR_INK)
-        )
-        # the safety envelope (added at the first envelope): each box's 12 edges projected, dashed
-        self.keep_in: pg.PlotCurveItem | None = None
-        self.keep_out: pg.PlotCurveItem | None = None
-        self.labels: list[pg.TextItem] = []
-        for z, item in enumerate((self.path, self.selected, self.points, self.start, self.trail, self.tcp)):
-            item.setZValue(z)
-            plot.addItem(item)
-
-    def set_boxes(self, keep_in: FloatArray, keep_out: FloatArray) -> None:
-        """Outline rectangles of the envelope's boxes (point pairs of :meth:`Box.edges`)."""
-        if self.keep_in is None or self.keep_out is None:
-            if not len(keep_in) and not len(keep_out):
-                return
-            import pyqtgraph as pg  # deferred: see the module docstring
-
-            dash = Qt.PenStyle.DashLine
-            pairs = "pairs"
-            self.keep_in = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_IN, width=1, style=dash), connect=pairs)
-            self.keep_out = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_OUT, width=2, style=dash), connect=pairs)
-            for item in (self.keep_in, self.keep_out):
-                item.setZValue(-1)
-                self.plot.addItem(item)
-        self.keep_in.setData(keep_in[:, self.h], keep_in[:, self.v])
-        self.keep_out.setData(keep_out[:, self.h], keep_out[:, self.v])
-
-    def set_labels(self, xyz: FloatArray, texts: Sequence[str]) -> None:
-        import pyqtgraph as pg
-
-        for label in self.labels:
-            self.plot.removeItem(label)
-        self.labels = []
-        for row, text in zip(xyz[:MAX_LABELS], texts[:MAX_LABELS], strict=False):
-            label = pg.TextItem(text, color=COLOR_INK_SOFT, anchor=(0.0, 1.0))
-            label.setPos(float(row[self.h]), float(row[self.v]))
-            label.setZValue(10)
-            self.plot.addItem(label)
-            self.labels.append(label)
 
 
 class PlanPreview(QWidget):
@@ -175,7 +80,7 @@ class PlanPreview(QWidget):
         row.setContentsMargins(0, 0, 0, 0)
         row.setSpacing(6)
         self._row = row
-        self._projections: dict[str, _Projection] = {}  # empty until built (setters only remember)
+        self._projections: dict[str, Projection] = {}  # empty until built (setters only remember)
         self._titles: dict[str, QLabel] = {}
         self._points: tuple[FloatArray, list[str]] = (np.empty((0, 3)), [])
         self._start: tuple[float, float, float] | None = None
@@ -207,7 +112,7 @@ class PlanPreview(QWidget):
         self.retranslate()
 
     @property
-    def projections(self) -> dict[str, _Projection]:
+    def projections(self) -> dict[str, Projection]:
         """Key -> the projection's plot items (built now if they were not yet)."""
         self._build_plots()
         return self._projections
@@ -228,10 +133,10 @@ class PlanPreview(QWidget):
             self._slot = None
         for key, h, v in PROJECTIONS:
             plot = pg.PlotWidget(self)
-            _style_plot(plot)
+            style_plot(plot)
             plot.setLabel("bottom", f"{AXIS_NAMES[h]} (mm)")
             plot.setLabel("left", f"{AXIS_NAMES[v]} (mm)")
-            self._projections[key] = _Projection(plot, h, v)
+            self._projections[key] = Projection(plot, h, v)
             plot.getViewBox().sigRangeChangedManually.connect(self._on_operator_view)
             title = QLabel(self)
             title.setStyleSheet(f"font-weight: bold; color: {COLOR_INK_SOFT};")

@@ -19,7 +19,8 @@ injectable ``confirm(title, text) -> bool`` callable.
 What is shown is worked out without Qt by :mod:`app.plan.presenter`. The panel composes its
 parts: ``planner_actions`` (the QActions), ``planner_widgets`` (plan list, segment editor, run
 box, checks bar), ``planner_checks`` (the checks list, estimates, preview), ``planner_edit``
-(plan and segment edits), ``planner_run`` (the run flow).
+(plan and segment edits), ``planner_run`` (the run flow), ``planner_follow`` (the plan on
+display kept in step with the list, the undo stack and the points).
 """
 
 from __future__ import annotations
@@ -50,6 +51,7 @@ from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_actions import PlannerActions
 from ui.panels.planner_checks import PlannerChecks
 from ui.panels.planner_edit import PlanEdits, install_point_pickers
+from ui.panels.planner_follow import PlanFollower
 from ui.panels.planner_run import PlanRunFlow
 from ui.panels.planner_widgets import (
     STATUS_COLOURS,
@@ -116,27 +118,9 @@ class PlannerPanel(QWidget):
         )
         self.retranslate()
 
-        plans.modelReset.connect(self._on_plans_reset)
-        plans.rowsInserted.connect(self._on_plans_inserted)
-        plans.rowsRemoved.connect(self._on_plans_removed)
-        plans.planChanged.connect(self._on_plan_changed)
         plans.editRejected.connect(lambda text: self.show_message(text, "error"))
-        self.segments.listEdited.connect(self._on_segments_edited)
-        self.segments.modelReset.connect(self.recheck)
-        self.segments.planShown.connect(self._on_plan_shown)
         self.segments.editRejected.connect(lambda text: self.show_message(text, "error"))
-        for signal in (
-            points.dataChanged,
-            points.rowsInserted,
-            points.rowsRemoved,
-            points.rowsMoved,
-            points.modelReset,
-            points.planReferencesChanged,
-        ):
-            signal.connect(self._on_points_changed)
-        points.modelReset.connect(lambda: self.segments.set_ledger(points.ledger))
-        self.plan_view.selectionModel().currentRowChanged.connect(self._on_plan_row)
-        self.segment_view.selectionModel().selectionChanged.connect(self._on_segment_selection)
+        self.follower = PlanFollower(self, plans, points, self.segments, self._update_actions, self)
 
         r = self._runner
         r.runningChanged.connect(self._on_running)
@@ -448,57 +432,6 @@ class PlannerPanel(QWidget):
         k = self._runner.resume_from if self._runner.can_resume else None
         self.planner_actions.set_resume_from(k + 1 if k is not None else None)
 
-    @Slot()
-    def _on_plans_reset(self) -> None:
-        self.segments.set_ledger(self._points.ledger)
-        self.select_plan(0 if self._plans.rowCount() else -1)
-
-    @Slot(QModelIndex, int, int)
-    def _on_plans_inserted(self, parent: QModelIndex, first: int, last: int) -> None:
-        self.select_plan(first)
-
-    @Slot(QModelIndex, int, int)
-    def _on_plans_removed(self, parent: QModelIndex, first: int, last: int) -> None:
-        plan = self.current_plan()
-        if plan is not None and self._plans.row_of(plan) is None:
-            self.select_plan(min(first, self._plans.rowCount() - 1))
-
-    @Slot(object)
-    def _on_plan_changed(self, plan: object) -> None:
-        if plan is self.current_plan():
-            self.recheck()
-
-    @Slot(object)
-    def _on_plan_shown(self, plan: object) -> None:
-        row = self._plans.row_of(plan) if isinstance(plan, Plan) else None
-        if row is not None:
-            self.plan_view.blockSignals(True)
-            self.plan_view.selectRow(row)
-            self.plan_view.blockSignals(False)
-
-    @Slot(object)
-    def _on_segments_edited(self, plan: object) -> None:
-        self._plans.refresh_plan(plan)
-        self.recheck()
-
-    @Slot()
-    def _on_points_changed(self, *_args: Any) -> None:
-        self.segments.refresh()
-        self.recheck()
-
-    @Slot(QModelIndex, QModelIndex)
-    def _on_plan_row(self, current: QModelIndex, previous: QModelIndex) -> None:
-        row = current.row()
-        plan = self._plans.plan_at(row) if 0 <= row < self._plans.rowCount() else None
-        self.segments.set_plan(plan)
-        r = self._runner
-        if not r.running:
-            self.preview.clear_live()  # the last run's TCP trail belongs to its plan
-            if plan is not None and plan is self.run_flow.run_plan and r.can_resume and r.outcome is not None:
-                failed = r.resume_from if r.outcome.state is RunState.FAILED else None
-                self.segments.set_run_marker(None, failed)
-        self._update_actions()
-
     @Slot(object)
     def _on_pose(self, pose: Pose) -> None:
         if not self._pose_known:
@@ -506,13 +439,6 @@ class PlannerPanel(QWidget):
             self._pose_known = True
             if not self._runner.running:
                 self.recheck()
-
-    @Slot()
-    def _on_segment_selection(self, *_args: Any) -> None:
-        index = self._selected_index()
-        self.preview.set_selected(index)
-        self.checks.show_info(self.current_plan(), index)
-        self._update_actions()
 
     def set_alarm_hold(self, hold: bool) -> None:
         """An emergency stop or servo alarm is set (MotionController.alarmHoldChanged)."""

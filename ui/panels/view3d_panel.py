@@ -9,7 +9,8 @@ ways. The selected plan is a ghost path (lines and true arcs of :mod:`app.plan.g
 middle points as squares, the start as a green dot, one arrow per segment); during a run the
 segment being run is highlighted and the TCP leaves a trace. Points and path samples the
 profile cannot reach (or only past a joint limit) are red. The dry run bar plays the plan on
-the drawn arm without sending anything.
+the drawn arm without sending anything. What the scene shows of the points and the plan (colours,
+sampling, red samples) is worked out without widgets in :mod:`ui.panels.view3d_scene`.
 
 Live values arrive at the poll rate; the arm is redrawn at most :data:`LIVE_FPS` times a second
 from the latest one. The panel is connected to the window's parts with :meth:`bind`,
@@ -37,31 +38,25 @@ from app.link.state import RobotState
 from app.models import Pose
 from app.plan.geometry import plan_path
 from app.plan.segments import Plan
-from app.points.ledger import PointLedger, SyncState
+from app.points.ledger import PointLedger
 from app.view3d.camera import Preset
 from app.view3d.kinematics import ArmTracker, Reach
 from app.view3d.path import DryRun, DryRunState, start_of
 from app.view3d.profile import RobotProfile
 from app.view3d.reach import PathReach, ReachChecker
 from ui.models.points_model import PointsModel
-from ui.palette import COLOR_CURVE_PURPLE, COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, COLOR_OK, COLOR_WARN
+from ui.palette import COLOR_CURVE_PURPLE, COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, COLOR_WARN
 from ui.panels.view3d_canvas import View3DCanvas
 from ui.panels.view3d_dryrun import DryRunBar
 from ui.panels.view3d_robot import RobotModelSource
+from ui.panels.view3d_scene import MAX_PATH_ROWS as MAX_PATH_ROWS
+from ui.panels.view3d_scene import PATH_SAMPLES as PATH_SAMPLES
+from ui.panels.view3d_scene import REACH_MAX_POINTS as REACH_MAX_POINTS
+from ui.panels.view3d_scene import SYNC_COLORS as SYNC_COLORS
+from ui.panels.view3d_scene import arc_middles, bad_path_samples, path_samples, reach_checked
 
 LIVE_FPS: Final = 30
 TRACE_LENGTH: Final = 2000  # live TCP positions kept for the trace
-PATH_SAMPLES: Final = 24  # per segment for the ghost path
-MAX_PATH_ROWS: Final = 40_000  # fewer samples per segment for long plans
-REACH_MAX_POINTS: Final = 10_000  # points checked for reach (more: only those the plan uses)
-
-SYNC_COLORS: Final[dict[SyncState, str]] = {
-    SyncState.ON_CONTROLLER: COLOR_OK,
-    SyncState.CHANGED: COLOR_WARN,
-    SyncState.FAILED: COLOR_CURVE_PURPLE,
-    SyncState.UNCONFIRMED: COLOR_WARN,
-    SyncState.UNKNOWN: COLOR_NEUTRAL,
-}
 
 
 class View3DPanel(QWidget):
@@ -393,9 +388,7 @@ class View3DPanel(QWidget):
         points = list(ledger)
         plan = self._planner.current_plan() if self._planner is not None else None
         self.plan = plan
-        used = {pid for seg in plan.segments for pid in seg.point_ids} if plan is not None else set()
-        checked = points if len(points) <= REACH_MAX_POINTS else [p for p in points if p.id in used]
-        self.point_reach = self.reach.points(checked)
+        self.point_reach = self.reach.points(reach_checked(points, plan))
         xyz = np.array([p.xyz for p in points], dtype=np.float64).reshape(-1, 3)
         bad = np.array([self.point_reach.get(p.id, Reach.OK) is not Reach.OK for p in points], dtype=bool)
         self.canvas.set_points(
@@ -417,37 +410,11 @@ class View3DPanel(QWidget):
             self.dry_bar.set_run(None)
             return
         start, _rot = start_of(plan, ledger, self._pose)
-        samples = max(3, min(PATH_SAMPLES, MAX_PATH_ROWS // len(plan)))
-        path = plan_path(plan, ledger, start, samples)
+        path = plan_path(plan, ledger, start, path_samples(plan))
         self.path_reach = self.reach.path(plan, ledger, self._pose)
-        bad_seg = {i for i, b in enumerate(self.path_reach.first_bad) if b is not None}
-        # samples are red from the first bad reach sample of their segment on (path samples are
-        # denser than reach samples: mark the nearest ones)
-        bad = self._bad_samples(path.xyz, path.segment, bad_seg)
-        vias = [ledger.get(s.via_id) if s.via_id is not None else None for s in plan.segments if s.is_arc]
-        mids = np.array(
-            [via.xyz if via is not None else (np.nan, np.nan, np.nan) for via in vias], dtype=np.float64
-        ).reshape(-1, 3)
-        self.canvas.set_path(path.xyz, path.segment, bad, mids, start)
+        bad = bad_path_samples(path.xyz, path.segment, self.path_reach)
+        self.canvas.set_path(path.xyz, path.segment, bad, arc_middles(plan, ledger), start)
         self.dry_bar.set_run(DryRun(plan, ledger, self._pose))
-
-    def _bad_samples(self, xyz: np.ndarray, segment: np.ndarray, bad_seg: set[int]) -> np.ndarray:
-        reach = self.path_reach
-        bad = np.zeros(len(xyz), dtype=bool)
-        if reach is None or not bad_seg:
-            return bad
-        rmask = reach.bad_mask
-        bad_xyz = reach.xyz[rmask]
-        bad_of_seg = reach.segment[rmask]
-        for i in bad_seg:
-            rows = np.flatnonzero(segment == i)
-            targets = bad_xyz[bad_of_seg == i]
-            if not len(rows) or not len(targets):
-                continue
-            d = np.linalg.norm(xyz[rows][:, None, :] - targets[None, :, :], axis=2)
-            spacing = np.nanmax(np.linalg.norm(np.diff(reach.xyz[reach.segment == i], axis=0), axis=1))
-            bad[rows] = np.nanmin(d, axis=1) <= max(float(spacing) * 0.51, 1e-6)
-        return bad
 
     def _show_reach(self) -> None:
         bad_points = sorted(pid for pid, r in self.point_reach.items() if r is not Reach.OK)

@@ -1,0 +1,115 @@
+"""One projection of the plan preview (:mod:`ui.panels.plan_preview`): its plot styled for a
+preview (fixed axes, locked aspect) and the items drawn on it: the path, the selected segment,
+the points and their labels, the start, the live TCP and its trail, the safety envelope's boxes.
+pyqtgraph is imported when a projection is built (the planner is a hidden tab at start).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+from numpy.typing import NDArray
+from PySide6.QtCore import Qt
+
+from ui.palette import (
+    COLOR_AXIS,
+    COLOR_HIGHLIGHT,
+    COLOR_INK,
+    COLOR_INK_SOFT,
+    COLOR_PATH,
+    COLOR_START,
+    COLOR_TCP,
+    COLOR_TRAIL,
+)
+from ui.palette import COLOR_ERROR as COLOR_KEEP_OUT
+from ui.palette import COLOR_OK as COLOR_KEEP_IN
+
+if TYPE_CHECKING:
+    import pyqtgraph as pg
+
+MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
+PLOT_MIN_HEIGHT = 80  # px: the planner's top row (segments, run box) needs the height at 1280×800
+
+FloatArray = NDArray[np.float64]
+
+
+def style_plot(plot: pg.PlotWidget) -> None:
+    import pyqtgraph as pg  # deferred: see the module docstring
+
+    plot.setBackground("w")
+    item = plot.getPlotItem()
+    item.showGrid(x=True, y=True, alpha=0.25)
+    for name in ("left", "bottom"):
+        axis = item.getAxis(name)
+        axis.enableAutoSIPrefix(False)
+        axis.setPen(pg.mkPen(COLOR_AXIS))
+        axis.setTextPen(pg.mkPen(COLOR_INK))
+    # a fixed left axis: an auto-sized one changes the view's width with its tick labels, and an
+    # aspect-locked view then changes its range, hence its labels: an endless relayout when narrow
+    item.getAxis("left").setWidth(44)
+    plot.setMenuEnabled(False)
+    plot.setAspectLocked(True)
+    plot.getViewBox().setDefaultPadding(0.12)  # room for the point labels at the edges
+    plot.setMinimumSize(90, PLOT_MIN_HEIGHT)
+
+
+class Projection:
+    """The items of one projection."""
+
+    def __init__(self, plot: pg.PlotWidget, h: int, v: int) -> None:
+        import pyqtgraph as pg  # deferred: see the module docstring
+
+        self.plot = plot
+        self.h = h
+        self.v = v
+        self.path = pg.PlotCurveItem(pen=pg.mkPen(COLOR_PATH, width=2), connect="finite", antialias=True)
+        self.selected = pg.PlotCurveItem(
+            pen=pg.mkPen(COLOR_HIGHLIGHT, width=5), connect="finite", antialias=True
+        )
+        self.points = pg.ScatterPlotItem(size=7, brush=pg.mkBrush(COLOR_AXIS), pen=pg.mkPen("w"))
+        self.start = pg.ScatterPlotItem(
+            size=11, symbol="t1", brush=pg.mkBrush(COLOR_START), pen=pg.mkPen("w")
+        )
+        self.trail = pg.PlotCurveItem(pen=pg.mkPen(COLOR_TRAIL, width=2))
+        self.tcp = pg.ScatterPlotItem(
+            size=13, symbol="o", brush=pg.mkBrush(COLOR_TCP), pen=pg.mkPen(COLOR_INK)
+        )
+        # the safety envelope (added at the first envelope): each box's 12 edges projected, dashed
+        self.keep_in: pg.PlotCurveItem | None = None
+        self.keep_out: pg.PlotCurveItem | None = None
+        self.labels: list[pg.TextItem] = []
+        for z, item in enumerate((self.path, self.selected, self.points, self.start, self.trail, self.tcp)):
+            item.setZValue(z)
+            plot.addItem(item)
+
+    def set_boxes(self, keep_in: FloatArray, keep_out: FloatArray) -> None:
+        """Outline rectangles of the envelope's boxes (point pairs of :meth:`Box.edges`)."""
+        if self.keep_in is None or self.keep_out is None:
+            if not len(keep_in) and not len(keep_out):
+                return
+            import pyqtgraph as pg  # deferred: see the module docstring
+
+            dash = Qt.PenStyle.DashLine
+            pairs = "pairs"
+            self.keep_in = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_IN, width=1, style=dash), connect=pairs)
+            self.keep_out = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_OUT, width=2, style=dash), connect=pairs)
+            for item in (self.keep_in, self.keep_out):
+                item.setZValue(-1)
+                self.plot.addItem(item)
+        self.keep_in.setData(keep_in[:, self.h], keep_in[:, self.v])
+        self.keep_out.setData(keep_out[:, self.h], keep_out[:, self.v])
+
+    def set_labels(self, xyz: FloatArray, texts: Sequence[str]) -> None:
+        import pyqtgraph as pg
+
+        for label in self.labels:
+            self.plot.removeItem(label)
+        self.labels = []
+        for row, text in zip(xyz[:MAX_LABELS], texts[:MAX_LABELS], strict=False):
+            label = pg.TextItem(text, color=COLOR_INK_SOFT, anchor=(0.0, 1.0))
+            label.setPos(float(row[self.h]), float(row[self.v]))
+            label.setZValue(10)
+            self.plot.addItem(label)
+            self.labels.append(label)
