@@ -141,3 +141,16 @@ def read_limited(path: Path, limit: int = MAX_FILE_BYTES) -> bytes:
         raise FileFormatError(
             "cannot be read (permission denied)", path=str(path), problem=Reason("permission_denied")
         ) from None
+
+
+def read_settings_text(path: Path, limit: int, what: str, error: type[Exception]) -> str:
+    """A small settings file (a profile) as text: ``error`` naming ``what`` and the file when it is
+    missing, too large, unreadable or not UTF-8."""
+    try:
+        data = read_limited(path, limit)
+    except FileFormatError as exc:
+        raise error(f"{what}: {exc}") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise error(f"{what} {path.name} is not UTF-8 text") from None

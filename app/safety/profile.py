@@ -27,8 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from app.errors import InvalidInput, TeachPadError
-from app.points.atomic import atomic_write_bytes, read_limited
-from app.points.point import FileFormatError
+from app.points.atomic import atomic_write_bytes, read_settings_text
 from app.safety.envelope import Box, Envelope
 
 FORMAT = "teachpad-safety"
@@ -178,14 +177,7 @@ def profile_from_json(text: str, source: str = "the safety profile") -> SafetyPr
 def load_profile(path: str | os.PathLike[str]) -> SafetyProfile:
     """Read a profile; :class:`ProfileError` says what is wrong with it, in words."""
     p = Path(path)
-    try:
-        data = read_limited(p, _MAX_BYTES)
-    except FileFormatError as exc:
-        raise ProfileError(f"safety profile: {exc}") from None
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise ProfileError(f"safety profile {p.name} is not UTF-8 text") from None
+    text = read_settings_text(p, _MAX_BYTES, "safety profile", ProfileError)
     return profile_from_json(text, f"safety profile {p.name}")
 
 

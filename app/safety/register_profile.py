@@ -41,8 +41,7 @@ from typing import Any, Literal
 
 from app.errors import TeachPadError
 from app.link.transport import ConnectionSettings
-from app.points.atomic import atomic_write_bytes, read_limited
-from app.points.point import FileFormatError
+from app.points.atomic import atomic_write_bytes, read_settings_text
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 
@@ -230,14 +229,7 @@ def profile_from_json(text: str, source: str = "the register profile") -> Regist
 def load_register_profile(path: str | os.PathLike[str]) -> RegisterProfile:
     """Read a profile; :class:`RegisterProfileError` says what is wrong with it, in words."""
     p = Path(path)
-    try:
-        data = read_limited(p, _MAX_BYTES)
-    except FileFormatError as exc:
-        raise RegisterProfileError(f"register profile: {exc}") from None
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise RegisterProfileError(f"register profile {p.name} is not UTF-8 text") from None
+    text = read_settings_text(p, _MAX_BYTES, "register profile", RegisterProfileError)
     return profile_from_json(text, f"register profile {p.name}")
 
 
