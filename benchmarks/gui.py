@@ -104,12 +104,30 @@ __all__ = [
     "measure_stalls",
     "run",
     "run_memory",
+    "show_streaming_layout",
 ]
 
 
 # --------------------------------------------------------------------------------------------
 # The in-process part: one main window for stalls and stop latency
 # --------------------------------------------------------------------------------------------
+
+
+def show_streaming_layout(window: MainWindow) -> None:
+    """Show the window as the streaming figures measure it: desktop size, the Monitor tab and the
+    traffic inspector in front, painted once."""
+    # The offscreen screen is 800x800 and would clamp the window: use the desktop default.
+    window.resize(*DEFAULT_SIZE)
+    window.show_tab("monitor")
+    painted = _PaintCounter()
+    window.installEventFilter(painted)
+    window.show()
+    # Tabified with the event log, which is on top: bring the inspector to the front.
+    window.traffic_dock.raise_()
+    traffic = window.traffic_panel
+    if not _wait_until(lambda: painted.paints > 0 and not traffic.visibleRegion().isEmpty()):
+        raise RuntimeError("the main window was never painted with the traffic inspector shown")
+    window.removeEventFilter(painted)
 
 
 def bench_window(
@@ -152,19 +170,9 @@ def bench_window(
             AppSettings.from_file(Path(tmp.name) / "bench.ini"),
             autosave_dir=Path(tmp.name) / "autosave",
         )
-        # The offscreen screen is 800x800 and would clamp the window: use the desktop default.
-        window.resize(*DEFAULT_SIZE)
-        window.show_tab("monitor")
         counters = _Counters(link)
-        painted = _PaintCounter()
-        window.installEventFilter(painted)
-        window.show()
-        # Tabified with the event log, which is on top: bring the inspector to the front.
-        window.traffic_dock.raise_()
+        show_streaming_layout(window)
         traffic = window.traffic_panel
-        if not _wait_until(lambda: painted.paints > 0 and not traffic.visibleRegion().isEmpty()):
-            raise RuntimeError("the main window was never painted with the traffic inspector shown")
-        window.removeEventFilter(painted)
         lap("window_shown")
 
         # --- disconnected: stall baseline and the bare stop floor ----------------------

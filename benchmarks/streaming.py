@@ -55,14 +55,14 @@ from benchmarks.gui import (
     RemoteSim,
     _Counters,
     _motion_started,
-    _PaintCounter,
     _qapp,
     _run_for,
     _wait_until,
     measure_stalls,
+    show_streaming_layout,
 )
 from benchmarks.traffic import Feed
-from ui.main_window import DEFAULT_SIZE, MainWindow
+from ui.main_window import MainWindow
 from ui.settings import AppSettings
 
 _KEYS = (
@@ -91,17 +91,8 @@ def streaming_window(sim: RemoteSim) -> Iterator[tuple[MainWindow, _Counters]]:
             AppSettings.from_file(Path(tmp.name) / "bench.ini"),
             autosave_dir=Path(tmp.name) / "autosave",
         )
-        window.resize(*DEFAULT_SIZE)
-        window.show_tab("monitor")
         counters = _Counters(link)
-        painted = _PaintCounter()
-        window.installEventFilter(painted)
-        window.show()
-        window.traffic_dock.raise_()
-        traffic = window.traffic_panel
-        if not _wait_until(lambda: painted.paints > 0 and not traffic.visibleRegion().isEmpty()):
-            raise RuntimeError("the main window was never painted with the traffic inspector shown")
-        window.removeEventFilter(painted)
+        show_streaming_layout(window)
         link.connect_to(ConnectionSettings(host="127.0.0.1", port=sim.port, unit=sim.unit))
         if not _wait_until(lambda: counters.state.state is LinkState.CONNECTED):
             raise RuntimeError(f"could not connect to the simulator: {counters.state.message}")
@@ -184,16 +175,7 @@ def run_synthetic(seconds: float, profiler: cProfile.Profile | None) -> dict[str
             AppSettings.from_file(Path(tmp.name) / "bench.ini"),
             autosave_dir=Path(tmp.name) / "autosave",
         )
-        window.resize(*DEFAULT_SIZE)
-        window.show_tab("monitor")
-        painted = _PaintCounter()
-        window.installEventFilter(painted)
-        window.show()
-        window.traffic_dock.raise_()
-        traffic = window.traffic_panel
-        if not _wait_until(lambda: painted.paints > 0 and not traffic.visibleRegion().isEmpty()):
-            raise RuntimeError("the main window was never painted with the traffic inspector shown")
-        window.removeEventFilter(painted)
+        show_streaming_layout(window)
         state = link.state
         state.set_connection(ConnectionState(LinkState.CONNECTED, "", "bench:502"))
         feed = Feed()
