@@ -82,7 +82,9 @@ def test_cancel_half_way_leaves_the_ledger_exactly_as_the_controller(
 
 
 def test_link_loss_half_way_keeps_every_reported_point(qtbot: Any, sim: Any, link: RobotLink) -> None:
-    connect(qtbot, link, sim)
+    # the link must die where the test silences the simulator (after 100 points), not earlier
+    # because one poll of a loaded test process answered in more than the default 0.15 s
+    connect(qtbot, link, sim, poll_timeout=1.0)
     panel = _panel(qtbot, link, 300)
     controller = panel.controller
     reported: list[int] = []
