@@ -73,18 +73,17 @@ class JogMachine:
         self.teach = TeachState()
         self.ratio_zero_pending = False
 
-    def controller_silent(self) -> str | None:
+    def controller_silent(self) -> None:
         """The controller stopped answering: drop the held jog (ratio 0 goes out on its return).
         When a jog was under way the operator is told (an error with its reason, code
-        ``jog_stopped_silent``); returns None: nothing is left for the caller to say."""
+        ``jog_stopped_silent``)."""
         jogging = self.jog is not None or (self.teach.enabled and self.teach.ratio != 0.0)
         self.end_jog()
         if not jogging:
-            return None
+            return
         self.ratio_zero_pending = True
         note = "jog stopped: the controller is not answering (speed 0 is sent as soon as it answers)"
         self._host.emit_error(Operation.JOG, note, None, Reason("jog_stopped_silent"))
-        return None
 
     def controller_answers(self) -> None:
         """The dead-man after a silence: ratio 0 before anything else, if a jog was under way."""

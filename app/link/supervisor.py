@@ -196,9 +196,7 @@ class LinkSupervisor:
             self.answering = False
             self._silent_since = now
             self.set_state(LinkState.NOT_ANSWERING, str(cause), self._reason(cause))
-            note = self._host.jog.controller_silent()
-            if note is not None:
-                self._host.emit_error(Operation.JOG, note, None)
+            self._host.jog.controller_silent()  # tells the operator itself when a jog was under way
         elif now - self._silent_since >= timing.NOT_ANSWERING_DOWN_AFTER:
             self.link_lost(cause)
 
