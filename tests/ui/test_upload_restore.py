@@ -82,9 +82,10 @@ def test_cancel_half_way_leaves_the_ledger_exactly_as_the_controller(
 
 
 def test_link_loss_half_way_keeps_every_reported_point(qtbot: Any, sim: Any, link: RobotLink) -> None:
-    # the link must die where the test silences the simulator (after 100 points), not earlier
-    # because one poll of a loaded test process answered in more than the default 0.15 s
-    connect(qtbot, link, sim, poll_timeout=1.0)
+    # the upload must end where the test silences the simulator (after 100 points), not earlier
+    # because one create-point of a loaded test process took longer than the tests' short
+    # request timeout (an unanswered write ends the upload: its outcome is unknown)
+    connect(qtbot, link, sim, timeout=1.0)
     panel = _panel(qtbot, link, 300)
     controller = panel.controller
     reported: list[int] = []
