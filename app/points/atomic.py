@@ -12,6 +12,7 @@ process; the instance lock of :mod:`app.points.lock` keeps that rare).
 from __future__ import annotations
 
 import contextlib
+import json
 import os
 import re
 import stat
@@ -19,6 +20,7 @@ import sys
 import time
 import uuid
 from pathlib import Path
+from typing import Any
 
 from app.errors import Reason
 from app.points.point import FileFormatError
@@ -141,6 +143,27 @@ def read_limited(path: Path, limit: int = MAX_FILE_BYTES) -> bytes:
         raise FileFormatError(
             "cannot be read (permission denied)", path=str(path), problem=Reason("permission_denied")
         ) from None
+
+
+def versioned_document(
+    text: str, source: str, *, fmt: str, version: int, what: str, error: type[Exception]
+) -> dict[str, Any]:
+    """A settings file's JSON object, checked for its ``format`` name and a ``version`` this TeachPad
+    reads; ``error`` naming ``source`` otherwise (``what``: "safety profile", "register profile")."""
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise error(f"{source} is not valid JSON (line {exc.lineno}: {exc.msg})") from None
+    if not isinstance(doc, dict) or doc.get("format") != fmt:
+        raise error(f"{source} is not a TeachPad {what}")
+    found = doc.get("version")
+    if not isinstance(found, int) or isinstance(found, bool):
+        raise error(f"{source}: the format version is missing")
+    if found > version:
+        raise error(
+            f"{source} was written by a newer TeachPad (format {found}; this one reads up to {version})"
+        )
+    return doc
 
 
 def read_settings_text(path: Path, limit: int, what: str, error: type[Exception]) -> str:

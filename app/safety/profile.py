@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from app.errors import InvalidInput, TeachPadError
-from app.points.atomic import atomic_write_bytes, read_settings_text
+from app.points.atomic import atomic_write_bytes, read_settings_text, versioned_document
 from app.safety.envelope import Box, Envelope
 
 FORMAT = "teachpad-safety"
@@ -149,19 +149,9 @@ def profile_to_json(profile: SafetyProfile) -> str:
 
 
 def profile_from_json(text: str, source: str = "the safety profile") -> SafetyProfile:
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ProfileError(f"{source} is not valid JSON (line {exc.lineno}: {exc.msg})") from None
-    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
-        raise ProfileError(f"{source} is not a TeachPad safety profile")
-    version = doc.get("version")
-    if not isinstance(version, int) or isinstance(version, bool):
-        raise ProfileError(f"{source}: the format version is missing")
-    if version > VERSION:
-        raise ProfileError(
-            f"{source} was written by a newer TeachPad (format {version}; this one reads up to {VERSION})"
-        )
+    doc = versioned_document(
+        text, source, fmt=FORMAT, version=VERSION, what="safety profile", error=ProfileError
+    )
     robot, revision, saved = doc.get("robot", ""), doc.get("revision", 0), doc.get("saved", "")
     if not isinstance(robot, str) or not isinstance(saved, str):
         raise ProfileError(f"{source}: 'robot' and 'saved' must be text")

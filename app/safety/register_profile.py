@@ -41,7 +41,7 @@ from typing import Any, Literal
 
 from app.errors import TeachPadError
 from app.link.transport import ConnectionSettings
-from app.points.atomic import atomic_write_bytes, read_settings_text
+from app.points.atomic import atomic_write_bytes, read_settings_text, versioned_document
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 
@@ -185,19 +185,9 @@ def profile_to_json(profile: RegisterProfile) -> str:
 
 
 def profile_from_json(text: str, source: str = "the register profile") -> RegisterProfile:
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise RegisterProfileError(f"{source} is not valid JSON (line {exc.lineno}: {exc.msg})") from None
-    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
-        raise RegisterProfileError(f"{source} is not a TeachPad register profile")
-    version = doc.get("version")
-    if not isinstance(version, int) or isinstance(version, bool):
-        raise RegisterProfileError(f"{source}: the format version is missing")
-    if version > VERSION:
-        raise RegisterProfileError(
-            f"{source} was written by a newer TeachPad (format {version}; this one reads up to {VERSION})"
-        )
+    doc = versioned_document(
+        text, source, fmt=FORMAT, version=VERSION, what="register profile", error=RegisterProfileError
+    )
     unknown = sorted(set(doc) - {"format", "version", "name", "revision", "saved", *_FIELDS})
     if unknown:
         raise RegisterProfileError(f"{source}: unknown field {_short(unknown[0])}")
