@@ -3,9 +3,13 @@
 from __future__ import annotations
 
 import ctypes
+import faulthandler
 import os
+import shutil
 import sys
+import tempfile
 import threading
+import traceback
 import weakref
 from collections.abc import Iterator
 from typing import Any
@@ -15,10 +19,58 @@ import pytest
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 
-@pytest.fixture(autouse=True, scope="session")
-def _private_data_dir(tmp_path_factory: pytest.TempPathFactory) -> None:
-    """The audit trail (CLI clients write one) goes to a temporary data directory, not $HOME."""
-    os.environ["XDG_DATA_HOME"] = str(tmp_path_factory.mktemp("xdg-data"))
+# --- A hung test ends the run in minutes, saying which test and where. pytest-timeout (120 s,
+# pyproject) fails a test stuck in Python code and the run goes on; a test stuck where its
+# SIGALRM cannot end it (a Qt event loop or wait in C++: the exception raised in a slot is
+# swallowed) would otherwise hold the run until CI's limit. The watchdog below dumps every
+# thread's stack, names the test in the last lines printed, and exits the process.
+HUNG_AFTER = 180.0  # s for one test's setup, call and teardown together
+HUNG_EXIT_CODE = 70
+_stderr_copy = -1
+_PRIVATE_DIR = pytest.StashKey[str]()
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    global _stderr_copy
+    _stderr_copy = os.dup(2)  # the terminal's stderr, before tests capture fd 2
+    # The settings and data of the user running the tests are never read nor written: the audit
+    # trail, QSettings (XDG_CONFIG_HOME on Linux) and projects go to a fresh directory.
+    private = tempfile.mkdtemp(prefix="teachpad-tests-")
+    os.environ["XDG_DATA_HOME"] = os.path.join(private, "data")
+    os.environ["XDG_CONFIG_HOME"] = os.path.join(private, "config")
+    config.stash[_PRIVATE_DIR] = private
+
+
+def pytest_unconfigure(config: pytest.Config) -> None:
+    private = config.stash.get(_PRIVATE_DIR, "")
+    if private:
+        shutil.rmtree(private, ignore_errors=True)
+
+
+def _hung(nodeid: str) -> None:
+    fd = _stderr_copy if _stderr_copy >= 0 else 2
+    faulthandler.dump_traceback(file=fd, all_threads=True)
+    frame = sys._current_frames().get(threading.main_thread().ident or 0)
+    where = "".join(traceback.format_stack(frame)[-8:]) if frame is not None else "  (no main thread)\n"
+    os.write(
+        fd,
+        (
+            f"\nHUNG: {nodeid} did not end within {HUNG_AFTER:.0f} s; the main thread was at:\n"
+            f"{where}HUNG: {nodeid}\n"
+        ).encode(errors="replace"),
+    )
+    os._exit(HUNG_EXIT_CODE)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
+    watchdog = threading.Timer(HUNG_AFTER, _hung, args=(item.nodeid,))
+    watchdog.daemon = True
+    watchdog.start()
+    try:
+        yield
+    finally:
+        watchdog.cancel()
 
 
 @pytest.fixture
@@ -138,7 +190,40 @@ def _patch_qt() -> None:
     # patching Qt's methods: the stubs' overloads are not a replacement's concern
     QThread.start = tracked_thread_start  # type: ignore[method-assign,assignment]
     QTimer.start = tracked_timer_start  # type: ignore[method-assign]
+    _forbid_modal_dialogs()
     _patched = True
+
+
+# --- No modal dialog in a test. Offscreen, nobody answers one: its event loop would never end (and
+# no timeout can end a loop in C++). A test that expects a question answers it with its own fake
+# (``monkeypatch`` over these); any other opens nothing, gets "cancel" and fails, naming the dialog.
+_modals: list[str] = []
+
+
+def _forbid_modal_dialogs() -> None:
+    from PySide6.QtWidgets import QDialog, QFileDialog, QInputDialog, QMenu, QMessageBox
+
+    def refuse(what: str, answer: Any) -> Any:
+        def opened(*args: Any, **_kwargs: Any) -> Any:
+            texts = [a for a in args if isinstance(a, str)][:2]
+            name = type(args[0]).__name__ if args and isinstance(args[0], QDialog | QMenu) else what
+            _modals.append(f"{name}: {' / '.join(texts)}" if texts else name)
+            return answer
+
+        return opened
+
+    cancel = QMessageBox.StandardButton.Cancel
+    QDialog.exec = refuse("QDialog.exec", 0)  # type: ignore[method-assign]
+    QMenu.exec = refuse("QMenu.exec", None)  # type: ignore[method-assign]
+    for name in ("question", "warning", "critical", "information"):
+        setattr(QMessageBox, name, staticmethod(refuse(f"QMessageBox.{name}", cancel)))
+    QMessageBox.about = staticmethod(refuse("QMessageBox.about", None))  # type: ignore[method-assign]
+    for name in ("getOpenFileName", "getSaveFileName"):
+        setattr(QFileDialog, name, staticmethod(refuse(f"QFileDialog.{name}", ("", ""))))
+    QFileDialog.getOpenFileNames = staticmethod(refuse("QFileDialog.getOpenFileNames", ([], "")))  # type: ignore[method-assign]
+    QFileDialog.getExistingDirectory = staticmethod(refuse("QFileDialog.getExistingDirectory", ""))  # type: ignore[method-assign]
+    for name, answer in (("getItem", ""), ("getText", ""), ("getInt", 0), ("getDouble", 0.0)):
+        setattr(QInputDialog, name, staticmethod(refuse(f"QInputDialog.{name}", (answer, False))))
 
 
 @pytest.fixture(autouse=True)
@@ -149,6 +234,7 @@ def _qt_leak_check(request: pytest.FixtureRequest) -> Iterator[None]:
     _patch_qt()
     import shiboken6
 
+    _modals.clear()
     before_threads = set(map(id, _threads))
     before_timers = set(map(id, _timers))
     yield
@@ -160,6 +246,10 @@ def _qt_leak_check(request: pytest.FixtureRequest) -> Iterator[None]:
     ]
     _threads.clear()
     _timers.clear()
+    modals, _modals[:] = list(_modals), []
+    if modals:
+        opened = "; ".join(modals)
+        pytest.fail(f"a modal dialog opened in the test (nobody answers it): {opened}", pytrace=False)
     if leaked_threads or leaked_timers:
         pytest.fail(
             f"test leaked {len(leaked_threads)} running QThread(s) and {len(leaked_timers)} active QTimer(s)",
