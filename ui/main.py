@@ -348,16 +348,16 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         starter.started.connect(sim_started)
         starter.failed.connect(sim_failed)
-    # After the first paint; a screenshot run never stops on a question: it opens only what it was given.
-    _AfterFirstPaint(
-        window,
-        lambda: window.start_project(
-            args.project, reopen_last=not args.screenshot, offer_recovery=not args.screenshot
-        ),
-    )
+
+    def after_first_paint() -> None:
+        # The link's worker (pymodbus, the envelope) is made by the connection, after the paint.
+        if connection is not None:
+            link.connect_to(connection)
+        # A screenshot run never stops on a question: it opens only what it was given.
+        window.start_project(args.project, reopen_last=not args.screenshot, offer_recovery=not args.screenshot)
+
+    _AfterFirstPaint(window, after_first_paint)
     window.show()
-    if connection is not None:
-        link.connect_to(connection)
     try:
         code = app.exec()
     finally:

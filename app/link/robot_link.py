@@ -13,7 +13,7 @@ from __future__ import annotations
 import logging
 import sys
 from collections.abc import Iterable, Sequence
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from PySide6.QtCore import QCoreApplication, QObject, Qt, QThread, QTimer, Signal, SignalInstance, Slot
 
@@ -22,13 +22,16 @@ from app.errors import Reason
 from app.link.client import ConnectionSettings, StepFrame
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, RobotState
 from app.link.stats import LinkStats
+from app.link.supervisor import DEFAULT_CANARY_GV, check_canary_gv
 from app.link.types import ConnectionState, JogRequest, LinkState, WorkerError
-from app.link.worker import DEFAULT_CANARY_GV, RobotWorker
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
-from app.safety.audit import AuditLog
-from app.safety.jog_guard import JogGuard
+
+if TYPE_CHECKING:  # the worker (pymodbus, the envelope's numpy) is imported by the first request
+    from app.link.worker import RobotWorker
+    from app.safety.audit import AuditLog
+    from app.safety.jog_guard import JogGuard
 
 __all__ = ["LinkPort", "Pending", "RequestRouter", "RobotLink", "wait_for_detached_threads"]
 
@@ -191,6 +194,7 @@ class RobotLink(QObject):
     _captureRequested = Signal(bool)  # noqa: N815
     _guardRequested = Signal(object)  # noqa: N815
     _auditRequested = Signal(object)  # noqa: N815
+    _startRequested = Signal()  # noqa: N815
 
     def __init__(
         self,
@@ -206,18 +210,45 @@ class RobotLink(QObject):
         super().__init__(parent)
         if sys.getswitchinterval() > GIL_SWITCH_INTERVAL:
             sys.setswitchinterval(GIL_SWITCH_INTERVAL)  # see GIL_SWITCH_INTERVAL: a stop never waits 5 ms
+        check_canary_gv(canary_gv)  # a bad canary GV raises here, not at the first request
         self._settings: ConnectionSettings | None = None
         self._state = RobotState(self, freshness_limit=freshness_limit)
         self._router = RequestRouter()
         self._shut = False
         self._capture_users = 0
+        # What the worker gets when it is made (it is made by the first request: see _worker).
+        self._poll_hz = float(poll_hz)
+        self._canary_gv = canary_gv
+        self._use_stop_line = stop_line
+        self._guard: JogGuard | None = None
+        self._audit: AuditLog | None = None
+        self._made: RobotWorker | None = None
+        self._shutdownRequested.connect(self._on_shut_down)  # the GUI-side state: disconnected
         self._thread = QThread()
         self._thread.setObjectName("RobotWorker")
-        self._worker = RobotWorker(poll_hz, canary_gv=canary_gv)
-        self._worker.use_stop_line = stop_line
-        self._worker.moveToThread(self._thread)
-        self._thread.started.connect(self._worker.start)
-        w = self._worker
+        app = QCoreApplication.instance()
+        if app is not None:
+            app.aboutToQuit.connect(self.shutdown)
+        self._thread.start()
+
+    @property
+    def _worker(self) -> RobotWorker:
+        """The worker, made (and moved to its running thread) by the first request that needs it.
+
+        Building the window makes no worker: importing it means pymodbus and the envelope's
+        numpy (≈ 0.15 s), which the first paint does not need. Settings given before (poll rate,
+        audit, jog guard, capture) reach it first, in order, through the same queued signals."""
+        worker = self._made
+        if worker is None:
+            worker = self._made = self._make_worker()
+        return worker
+
+    def _make_worker(self) -> RobotWorker:
+        from app.link.worker import RobotWorker
+
+        w = RobotWorker(self._poll_hz, canary_gv=self._canary_gv)
+        w.use_stop_line = self._use_stop_line
+        w.moveToThread(self._thread)
         # the model first, so a view that reacts to the re-emitted signal reads the new value
         state = self._state
         w.poseChanged.connect(state.set_pose)
@@ -242,18 +273,24 @@ class RobotLink(QObject):
             (w.jogGuardStopped, self.jogGuardStopped),
         ):
             source.connect(target)
+        queued = Qt.ConnectionType.QueuedConnection
+        self._startRequested.connect(w.start, queued)  # the thread runs already: its timers, there
         self._connectRequested.connect(w.connect_to)
         self._disconnectRequested.connect(w.disconnect_link)
         self._pollRateRequested.connect(w.set_poll_rate)
         self._captureRequested.connect(w.set_traffic_capture)
         self._guardRequested.connect(w.set_jog_guard)
         self._auditRequested.connect(w.set_audit)
-        self._shutdownRequested.connect(w.shutdown, Qt.ConnectionType.QueuedConnection)
-        self._shutdownRequested.connect(self._on_shut_down)  # the GUI-side state: disconnected
-        app = QCoreApplication.instance()
-        if app is not None:
-            app.aboutToQuit.connect(self.shutdown)
-        self._thread.start()
+        self._shutdownRequested.connect(w.shutdown, queued)
+        self._startRequested.emit()
+        # queued, so in this order before the request that made the worker
+        if self._audit is not None:
+            self._auditRequested.emit(self._audit)
+        if self._guard is not None:
+            self._guardRequested.emit(self._guard)
+        if self._capture_users > 0:
+            self._captureRequested.emit(True)
+        return w
 
     # --- state --------------------------------------------------------------------------
     @property
@@ -316,32 +353,40 @@ class RobotLink(QObject):
         if self._shut:
             return
         self._settings = settings
+        _ = self._worker  # made now, at the latest
         self._connectRequested.emit(settings)
 
     def disconnect(self) -> None:  # type: ignore[override]  # QObject.disconnect is not used on links
-        if not self._shut:
+        if not self._shut and self._made is not None:  # no worker: no link to close
             self._disconnectRequested.emit()
 
     def set_poll_rate(self, hz: float) -> None:
         if not self._shut:
-            self._pollRateRequested.emit(float(hz))
+            self._poll_hz = float(hz)
+            if self._made is not None:
+                self._pollRateRequested.emit(float(hz))
 
     def set_jog_guard(self, guard: JogGuard | None) -> None:
         """The jog guard the worker applies on every poll during a jog (None: no envelope)."""
         if not self._shut:
-            self._guardRequested.emit(guard)
+            self._guard = guard
+            if self._made is not None:
+                self._guardRequested.emit(guard)
 
     def set_audit(self, audit: AuditLog | None) -> None:
         """The audit trail every write of this link goes to (call before :meth:`connect_to`)."""
         if not self._shut:
-            self._auditRequested.emit(audit)
+            self._audit = audit
+            if self._made is not None:
+                self._auditRequested.emit(audit)
 
     def set_traffic_capture(self, on: bool) -> None:
         """Reference-counted: capture runs while at least one user asked for it."""
         if self._shut:
             return
         self._capture_users = max(0, self._capture_users + (1 if on else -1))
-        self._captureRequested.emit(self._capture_users > 0)
+        if self._made is not None:
+            self._captureRequested.emit(self._capture_users > 0)
 
     # --- commands (queued; results come back as signals) -------------------------------
     # Each returns the request id that its CommandResult / WorkerError will carry (0 after shutdown:
@@ -449,15 +494,18 @@ class RobotLink(QObject):
         thread = self._thread
         if not thread.isRunning():
             return
+        worker = self._made
         self._shutdownRequested.emit()  # queued: runs once the transaction in flight is over
+        if worker is None:  # never made: nothing was sent, no link to close, only the thread
+            thread.quit()
         wait_ms = max(1, round(timing.SHUTDOWN_WAIT * 1000))
-        if not thread.wait(wait_ms):
+        if not thread.wait(wait_ms) and worker is not None:
             _log.warning(
                 "the robot worker is still inside a network call after %d ms; "
                 "it ends on its own in the background",
                 wait_ms,
             )
-            _keep_until_finished(thread, self._worker)
+            _keep_until_finished(thread, worker)
 
 
 # Threads still running after shutdown's wait, kept referenced until they end (GUI thread only).

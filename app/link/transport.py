@@ -29,7 +29,7 @@ import socket
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any, Literal
+from typing import TYPE_CHECKING, Any, Literal
 
 from app import timing
 from app.errors import (
@@ -38,13 +38,15 @@ from app.errors import (
     ModbusExceptionError,
     ResponseTimeout,
 )
-from app.link import frames
-from app.link.frames import Request
 from app.link.stats import LinkStats
 from app.protocol import registers
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 from app.protocol.exceptions import exception_text
+
+if TYPE_CHECKING:  # frames (pymodbus's framers) is imported when a Transport is made, not before:
+    # ConnectionSettings is read by the window at start-up, long before any link is opened
+    from app.link.frames import Framing, Request
 
 __all__ = ["ConnectionSettings", "TrafficObserver", "TrafficRecord", "Transport"]
 
@@ -274,8 +276,16 @@ class Transport:
     def __init__(
         self, settings: ConnectionSettings, on_link_change: Callable[[], None] | None = None
     ) -> None:
+        from app.link import frames  # pymodbus: only once a link is made (see the imports)
+
+        self._read_request = frames.read_request
+        self._write_single_request = frames.write_single_request
+        self._write_multiple_request = frames.write_multiple_request
+        self._encode_request = frames.encode_request
+        self._frame_need = frames.frame_need
+        self._decode_answer = frames.decode_answer
         self.settings = settings
-        self.framing: frames.Framing = settings.transport
+        self.framing: Framing = settings.transport
         self._stream: _TcpStream | _SerialStream = (
             _SerialStream(settings) if settings.serial_port is not None else _TcpStream(settings)
         )
@@ -360,16 +370,16 @@ class Transport:
     # -- requests -------------------------------------------------------------------------
     def read(self, what: str, address: int, count: int, timeout: float | None = None) -> list[int]:
         """0x03: exactly ``count`` registers."""
-        _, data = self.execute(what, frames.read_request(address, count), timeout)
+        _, data = self.execute(what, self._read_request(address, count), timeout)
         return [(data[i] << 8) | data[i + 1] for i in range(1, 1 + 2 * count, 2)]
 
     def write_single(self, what: str, address: int, value: int, timeout: float | None = None) -> None:
-        self.execute(what, frames.write_single_request(address, value), timeout)
+        self.execute(what, self._write_single_request(address, value), timeout)
 
     def write_multiple(
         self, what: str, address: int, values: Sequence[int], timeout: float | None = None
     ) -> None:
-        self.execute(what, frames.write_multiple_request(address, values), timeout)
+        self.execute(what, self._write_multiple_request(address, values), timeout)
 
     def execute(self, what: str, request: Request, timeout: float | None = None) -> tuple[int, bytes]:
         """Send ``request``; its checked answer as (function code, data)."""
@@ -421,7 +431,7 @@ class Transport:
         unit = self.settings.unit
         self._tid = self._tid % 65000 + 1 if self.framing == "tcp" else 0
         tid = self._tid
-        frame = frames.encode_request(self.framing, request, unit, tid)
+        frame = self._encode_request(self.framing, request, unit, tid)
         self._count("requests")
         try:
             self._stream.send(frame)
@@ -433,7 +443,7 @@ class Transport:
         deadline = time.monotonic() + timeout
         try:
             while True:
-                need = frames.frame_need(self.framing, request, unit, tid, buf)
+                need = self._frame_need(self.framing, request, unit, tid, buf)
                 if len(buf) >= need:
                     break
                 remaining = deadline - time.monotonic()
@@ -479,7 +489,7 @@ class Transport:
             raise error from None
         if self._observing:
             self._emit("rx", buf)
-        function, data = frames.decode_answer(self.framing, buf)
+        function, data = self._decode_answer(self.framing, buf)
         if function & 0x80:
             code = data[0]
             text = exception_text(code, f"exception code {code}")

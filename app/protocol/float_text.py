@@ -8,12 +8,23 @@ from __future__ import annotations
 
 import math
 import struct
+from collections.abc import Callable
 from typing import Final
-
-import numpy as np
 
 _FLOAT32: Final = struct.Struct(">f")
 _EXACT_INTEGERS: Final = float(1 << 24)  # every integer below this is a float32
+_numpy_float32: Callable[[float], object] | None = None  # numpy.float32, imported at first use
+
+
+def _dragon4_text(value: float) -> str:
+    """numpy's float32 text; numpy (0.1 s) is imported by the first value that needs it, not
+    when the window starts (this module is on the start-up path through the audit trail)."""
+    global _numpy_float32
+    if _numpy_float32 is None:
+        import numpy
+
+        _numpy_float32 = numpy.float32
+    return str(_numpy_float32(value))
 
 
 def format_float32(value: float) -> str:
@@ -36,7 +47,7 @@ def format_float32(value: float) -> str:
         if value.is_integer() and -_EXACT_INTEGERS < value < _EXACT_INTEGERS:
             return repr(value)
         if packed[1] & 0x7F or packed[2] or packed[3]:  # mantissa bits: not a power of two
-            return repr(float(str(np.float32(value))))
+            return repr(float(_dragon4_text(value)))
     return _search_float32_text(value, packed)
 
 
