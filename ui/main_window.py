@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
 from PySide6.QtGui import (
@@ -63,8 +63,6 @@ from ui.i18n import Translator
 from ui.messages import error_text
 from ui.panels.alarm_banner import AlarmBanner
 from ui.panels.monitor_panel import MonitorPanel
-from ui.panels.planner_panel import PlannerPanel
-from ui.panels.points_panel import PointsPanel
 from ui.panels.pose_strip import PoseStrip
 from ui.panels.view3d_host import install_view3d
 from ui.settings import AppSettings
@@ -73,6 +71,11 @@ from ui.window_actions import WindowActions
 from ui.window_column import ControlColumn
 from ui.window_docks import WindowDocks
 from ui.window_status import WindowStatusBar
+from ui.window_tabs import LazyTab
+
+if TYPE_CHECKING:  # built on first show (LazyTab): not imported before the window's first paint
+    from ui.panels.planner_panel import PlannerPanel
+    from ui.panels.points_panel import PointsPanel
 
 DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size
 MIN_SIZE = (1024, 700)  # the layout stays usable down to this
@@ -101,6 +104,7 @@ class MainWindow(QMainWindow):
         self.translator = translator
         self.shutdown_link_on_close = shutdown_link_on_close
         self._close_accepted = False
+        self._confirm: ConfirmFn | None = None  # given to the lazily built panels too
 
         # --- the project and its controllers (no widgets) ---------------------------------
         self.project = ProjectController(
@@ -115,17 +119,13 @@ class MainWindow(QMainWindow):
         self.tabs, self.jog_panel = column.tabs, column.jog_panel
         self.step_panel, self.program_panel = column.step_panel, column.program_panel
 
-        # --- right: the work tabs ---------------------------------------------------------
+        # --- right: the work tabs (Points and Planner are built when first shown or asked for) --
         self.monitor_panel = MonitorPanel(self)
-        self.points_panel = PointsPanel(self.project.points_model, self.point_sync, self)
-        self.planner_panel = PlannerPanel(
-            self.project.plans_model, self.project.points_model, self.run_controller, self.point_sync, self
-        )
         self.work_tabs = QTabWidget(self)
         self.work_tabs.setObjectName("WorkTabs")
         self.work_tabs.addTab(self.monitor_panel, "")
-        self.work_tabs.addTab(self.points_panel, "")
-        self.work_tabs.addTab(self.planner_panel, "")
+        self.points_tab: LazyTab[PointsPanel] = LazyTab(self.work_tabs, self._build_points_panel, "Points")
+        self.planner_tab: LazyTab[PlannerPanel] = LazyTab(self.work_tabs, self._build_planner_panel, "Planner")
 
         self.splitter = QSplitter(Qt.Orientation.Horizontal, self)
         self.splitter.setObjectName("MainSplitter")
@@ -249,14 +249,49 @@ class MainWindow(QMainWindow):
             self.run_controller,
             self,
         )
-        self.run_controller.runningChanged.connect(self.points_panel.set_run_active)
-        self.motion.alarmHoldChanged.connect(self.points_panel.set_alarm_hold)
-        self.motion.alarmHoldChanged.connect(self.planner_panel.set_alarm_hold)
         project = self.project
         project.titleChanged.connect(self._on_project_title)
         project.pathChanged.connect(self._on_project_path)
-        for source in (project, self.points_panel, self.planner_panel):
-            source.statusMessage.connect(self._show_message)
+        project.statusMessage.connect(self._show_message)
+
+    # --- the lazily built work tabs (LazyTab) -------------------------------------------------
+    @property
+    def points_panel(self) -> PointsPanel:
+        """The Points tab's panel (built now if it was not yet)."""
+        return self.points_tab.panel
+
+    @property
+    def planner_panel(self) -> PlannerPanel:
+        """The Planner tab's panel (built now if it was not yet)."""
+        return self.planner_tab.panel
+
+    def _build_points_panel(self) -> PointsPanel:
+        from ui.panels.points_panel import PointsPanel
+
+        panel = PointsPanel(self.project.points_model, self.point_sync, self)
+        panel.set_run_active(self.run_controller.running)
+        self.run_controller.runningChanged.connect(panel.set_run_active)
+        self._join_work_tab(panel)
+        return panel
+
+    def _build_planner_panel(self) -> PlannerPanel:
+        from ui.panels.planner_panel import PlannerPanel
+
+        project = self.project
+        panel = PlannerPanel(project.plans_model, project.points_model, self.run_controller, self.point_sync, self)
+        self._join_work_tab(panel)
+        return panel
+
+    def _join_work_tab(self, panel: PointsPanel | PlannerPanel) -> None:
+        """What every lazily built work panel gets from the window: the alarm hold, the status
+        bar, the operator's question, touch mode."""
+        panel.set_alarm_hold(self.motion.alarm_hold)
+        self.motion.alarmHoldChanged.connect(panel.set_alarm_hold)
+        panel.statusMessage.connect(self._show_message)
+        if self._confirm is not None:
+            panel.set_confirm(self._confirm)
+        if self.settings.touch_mode:
+            apply_touch_mode((panel,), True)
 
     # --- texts ------------------------------------------------------------------------
     def retranslate(self) -> None:
@@ -332,10 +367,12 @@ class MainWindow(QMainWindow):
 
     @confirm.setter
     def confirm(self, fn: ConfirmFn) -> None:
+        self._confirm = fn
         self.program_panel.confirm = fn
         self.step_panel.confirm = fn
-        self.points_panel.set_confirm(fn)
-        self.planner_panel.set_confirm(fn)
+        for tab in (self.points_tab, self.planner_tab):
+            if tab.built:
+                tab.panel.set_confirm(fn)
 
     # --- project -----------------------------------------------------------------------
     def show_tab(self, index: int | str) -> None:

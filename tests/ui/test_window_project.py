@@ -114,8 +114,10 @@ def test_tabs_and_menus_in_both_languages(
         )
         qtbot.addWidget(window)
         assert window.work_tabs.count() == 4  # Monitor, Points, Planner, 3D (the view3d branch)
-        assert window.work_tabs.widget(TAB_POINTS) is window.points_panel
-        assert window.work_tabs.widget(TAB_PLANNER) is window.planner_panel
+        assert all(window.work_tabs.tabText(i) for i in range(3))  # also before Points / Planner are built
+        points, planner = window.points_panel, window.planner_panel  # built on first use, in their tabs
+        assert window.work_tabs.widget(TAB_POINTS) is points
+        assert window.work_tabs.widget(TAB_PLANNER) is planner
         assert all(window.work_tabs.tabText(i) for i in range(3))
         assert window.project.action_undo in window.menus.edit_menu.actions()
         assert window.project.action_open in window.menus.file_menu.actions()

@@ -25,7 +25,6 @@ from PySide6.QtWidgets import QFileDialog, QLabel, QMenu, QMessageBox
 
 from app.errors import TeachPadError
 from app.link.types import LinkState
-from app.safety.bundle import write_support_bundle
 from app.safety.register_profile import RegisterProfile
 from app.safety.roles import Action, Role
 from app.safety.session import PermissionRefused
@@ -38,6 +37,8 @@ from ui.panels.audit_viewer import AuditViewer
 
 if TYPE_CHECKING:  # the window composes this menu; only its type is needed here
     from ui.main_window import MainWindow
+    from ui.panels.planner_panel import PlannerPanel
+    from ui.panels.points_panel import PointsPanel
 
 
 class SafetyMenu(QObject):
@@ -238,6 +239,8 @@ class SafetyMenu(QObject):
         register_profile: Path | None = window.settings.register_profile_path()
         if register_profile is not None and not register_profile.exists():
             register_profile = None
+        from app.safety.bundle import write_support_bundle  # importlib.metadata: not at start-up
+
         try:
             with tempfile.TemporaryDirectory() as tmp:
                 window.event_log.export_to(Path(tmp) / "events.txt")
@@ -270,6 +273,20 @@ class SafetyMenu(QObject):
         return Path(path)
 
 
+def gate_points(safety: SafetyController, window: MainWindow, panel: PointsPanel) -> None:
+    """The points table's edits by role; its move-to checked against the envelope."""
+    safety.gate_panel(panel, Action.EDIT_POINTS)
+    panel.move_check = lambda point_id, speed: safety.check_move_to(
+        window.link.state.pose, point_id, speed, window.project.points_model.ledger
+    )
+
+
+def gate_planner(safety: SafetyController, panel: PlannerPanel) -> None:
+    """The planner's edits by role; its checks (and its 2D preview) with the envelope."""
+    safety.gate_panel(panel, Action.EDIT_PLANS)
+    safety.attach_checker(panel)
+
+
 def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> SafetyMenu:
     """Compose the guard rails onto ``window`` (its 3D view already installed)."""
     safety = SafetyController(window.link, window.settings.store, window, scrypt_n=scrypt_n)
@@ -279,12 +296,10 @@ def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> Safety
     safety.gate(menu.envelope_action, Action.EDIT_ENVELOPE)
     safety.gate(menu.register_profile_action, Action.REGISTER_PROFILE)
     safety.gate(menu.passwords_action, Action.MANAGE_ROLES)
-    safety.gate_panel(window.points_panel, Action.EDIT_POINTS)
-    window.points_panel.move_check = lambda point_id, speed: safety.check_move_to(
-        window.link.state.pose, point_id, speed, window.project.points_model.ledger
-    )
-    safety.gate_panel(window.planner_panel, Action.EDIT_PLANS)
-    safety.attach_checker(window.planner_panel)  # its checks, and its 2D preview draws it
+    # Points and Planner are built on first show (ui/window_tabs.py): each is gated the moment
+    # it exists, before it is in its tab, with the role in force then and at every change after.
+    window.points_tab.on_built(lambda panel: gate_points(safety, window, panel))
+    window.planner_tab.on_built(lambda panel: gate_planner(safety, panel))
     # the 3D view is built on first show: its canvas is attached then
     window.view3d.on_built(lambda panel: safety.attach_view(panel.canvas))
     safety.message.connect(lambda text: window.event_log.add_event("warning", menu.source_name(), text))

@@ -34,9 +34,9 @@ class View3DHost(QObject):
         self.window = window
         self.robot = RobotModelSource(getattr(window, "settings", None), self)
         self.robot.problemRaised.connect(self._on_profile_problem)
-        self.robot.profileChanged.connect(lambda _p: window.planner_panel.recheck())
         self.robot.restore()
-        window.planner_panel.set_reach(self.robot.plan_issues)
+        # the planner is built on first show (ui/window_tabs.py): it gets the reach check then
+        window.planner_tab.on_built(self._attach_planner_reach)
         self._panel: View3DPanel | None = None
         self.tabs = window.work_tabs
         self._when_built: list[Callable[[View3DPanel], object]] = []
@@ -52,6 +52,10 @@ class View3DHost(QObject):
         self.dock.visibilityChanged.connect(self._on_dock_visible)
         self.tabs.currentChanged.connect(self._on_tab)
         self.retranslate()
+
+    def _attach_planner_reach(self, planner: Any) -> None:
+        planner.set_reach(self.robot.plan_issues)
+        self.robot.profileChanged.connect(lambda _p: planner.recheck())
 
     @property
     def panel(self) -> View3DPanel:
