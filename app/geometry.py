@@ -8,11 +8,18 @@ Lengths are millimetres.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
-import numpy as np
-from numpy.typing import NDArray
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
+    from app.lazy_numpy import np
 
-Matrix = NDArray[np.float64]
+if TYPE_CHECKING:
+    Matrix = NDArray[np.float64]
+else:  # the names, for importers: only annotations (strings) use them, so no numpy here
+    Matrix = object
 
 
 def rot_x(deg: float) -> Matrix:

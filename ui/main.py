@@ -354,7 +354,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         if connection is not None:
             link.connect_to(connection)
         # A screenshot run never stops on a question: it opens only what it was given.
-        window.start_project(args.project, reopen_last=not args.screenshot, offer_recovery=not args.screenshot)
+        shot_run = bool(args.screenshot)
+        window.start_project(args.project, reopen_last=not shot_run, offer_recovery=not shot_run)
 
     _AfterFirstPaint(window, after_first_paint)
     window.show()

@@ -124,8 +124,9 @@ class MainWindow(QMainWindow):
         self.work_tabs = QTabWidget(self)
         self.work_tabs.setObjectName("WorkTabs")
         self.work_tabs.addTab(self.monitor_panel, "")
-        self.points_tab: LazyTab[PointsPanel] = LazyTab(self.work_tabs, self._build_points_panel, "Points")
-        self.planner_tab: LazyTab[PlannerPanel] = LazyTab(self.work_tabs, self._build_planner_panel, "Planner")
+        tabs = self.work_tabs
+        self.points_tab: LazyTab[PointsPanel] = LazyTab(tabs, self._build_points_panel, "Points")
+        self.planner_tab: LazyTab[PlannerPanel] = LazyTab(tabs, self._build_planner_panel, "Planner")
 
         self.splitter = QSplitter(Qt.Orientation.Horizontal, self)
         self.splitter.setObjectName("MainSplitter")
@@ -278,7 +279,9 @@ class MainWindow(QMainWindow):
         from ui.panels.planner_panel import PlannerPanel
 
         project = self.project
-        panel = PlannerPanel(project.plans_model, project.points_model, self.run_controller, self.point_sync, self)
+        panel = PlannerPanel(
+            project.plans_model, project.points_model, self.run_controller, self.point_sync, self
+        )
         self._join_work_tab(panel)
         return panel
 

@@ -46,7 +46,8 @@ import threading
 import time
 from collections import deque
 
-from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot
+import numpy  # noqa: F401 - the jog guard's arithmetic (app/lazy_numpy.py): imported with the worker,
+from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot  # not by a check mid-jog
 
 from app import timing
 from app.errors import (

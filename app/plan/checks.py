@@ -13,9 +13,7 @@ import enum
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
-
-import numpy as np
+from typing import TYPE_CHECKING, Any
 
 from app.errors import InvalidInput
 from app.plan.geometry import PointLike, arc_geometry, xyz_of
@@ -26,6 +24,11 @@ from app.points.ledger import (
     tool_text,
 )
 from app.safety.envelope import Envelope, EnvelopeRefused, plan_violations
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
+    from app.lazy_numpy import np
 
 
 @dataclass(frozen=True)

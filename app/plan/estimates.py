@@ -6,8 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from app import timing
 from app.errors import InvalidInput
@@ -16,6 +15,11 @@ from app.plan.segments import FloatArray, Plan
 from app.points.ledger import (
     PointLedger,
 )
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
+    from app.lazy_numpy import np
 
 #: Time added per segment to length / speed: command round trip, acceleration, settling (s).
 SEGMENT_OVERHEAD_S = 0.3

@@ -10,9 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-
-import numpy as np
-from numpy.typing import NDArray
+from typing import TYPE_CHECKING
 
 from app.errors import InvalidInput
 from app.models import Pose
@@ -21,6 +19,12 @@ from app.points.ledger import (
     PointLedger,
     TempPoint,
 )
+
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
+    from app.lazy_numpy import np
 
 DEFAULT_SAMPLES = 32  # samples per segment for drawing
 

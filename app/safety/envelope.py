@@ -22,8 +22,7 @@ import enum
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from app.errors import InvalidInput, TeachPadError
 from app.models import Pose
@@ -31,6 +30,11 @@ from app.plan.geometry import PointLike, segment_length, segment_path, xyz_of
 from app.plan.segments import FloatArray, Plan, Segment
 from app.points.ledger import PointLedger
 from app.safety.box import Box
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
+    from app.lazy_numpy import np
 
 __all__ = [
     "ARC_SAMPLE_STEP_MM",

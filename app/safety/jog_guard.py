@@ -22,9 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Protocol
-
-import numpy as np
+from typing import TYPE_CHECKING, Protocol
 
 from app.geometry import abc_to_matrix
 from app.models import Pose
@@ -39,6 +37,11 @@ from app.safety.envelope import (
     check_path,
     check_point,
 )
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
+    from app.lazy_numpy import np
 
 #: Host-side delay (s) from a pose sample to a ratio-0 write landing: read + write round trips
 #: and the controller's reaction. The worker may pass its measured figure instead.

@@ -15,9 +15,7 @@ from __future__ import annotations
 import bisect
 import math
 from dataclasses import dataclass
-
-import numpy as np
-from numpy.typing import NDArray
+from typing import TYPE_CHECKING
 
 from app.geometry import abc_to_matrix, matrix_to_abc, slerp_matrix
 from app.models import Pose
@@ -26,8 +24,19 @@ from app.plan.geometry import plan_path
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger
 
-FloatArray = NDArray[np.float64]
-Matrix = NDArray[np.float64]
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
+    from app.lazy_numpy import np
+
+if TYPE_CHECKING:
+    FloatArray = NDArray[np.float64]
+    Matrix = NDArray[np.float64]
+else:  # the names, for importers: only annotations (strings) use them, so no numpy here
+    FloatArray = object
+    Matrix = object
+
 
 DRY_RUN_SAMPLES = 32  # per segment
 

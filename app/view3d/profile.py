@@ -17,13 +17,21 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from importlib import resources
-from typing import Any, Final
-
-import numpy as np
-from numpy.typing import NDArray
+from typing import TYPE_CHECKING, Any, Final
 
 from app.errors import InvalidInput
 from app.geometry import pose_to_transform
+
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
+    from app.lazy_numpy import np
+
+if TYPE_CHECKING:
+    Matrix = NDArray[np.float64]
+else:  # the names, for importers: only annotations (strings) use them, so no numpy here
+    Matrix = object
 
 PROFILE_FORMAT: Final = "teachpad-robot-profile"
 PROFILE_VERSION: Final = 1
@@ -31,8 +39,6 @@ DEFAULT_PROFILE_FILE: Final = "sim_arm.json"
 MAX_JOINTS: Final = 12
 MAX_FILE_BYTES: Final = 1_000_000
 _QUOTE_CHARS: Final = 40  # a bad value is quoted up to this many characters
-
-Matrix = NDArray[np.float64]
 
 
 class ProfileError(InvalidInput):

@@ -20,10 +20,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Final
-
-import numpy as np
-from numpy.typing import NDArray
+from typing import TYPE_CHECKING, Final
 
 from app.geometry import pose_to_transform
 from app.models import Pose
@@ -34,12 +31,22 @@ from app.points.ledger import PointLedger, TempPoint
 from app.view3d.kinematics import ArmModel, Reach
 from app.view3d.path import sample_poses, segment_rotations, start_of
 
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
+    from app.lazy_numpy import np
+
+if TYPE_CHECKING:
+    FloatArray = NDArray[np.float64]
+else:  # the names, for importers: only annotations (strings) use them, so no numpy here
+    FloatArray = object
+
 PATH_SAMPLES: Final = 9
 MIN_PATH_SAMPLES: Final = 3
 MAX_PATH_SAMPLES: Final = 3000
 CACHE_SIZE: Final = 50_000
 
-FloatArray = NDArray[np.float64]
 Pose6 = tuple[float, float, float, float, float, float]
 
 

@@ -112,10 +112,12 @@ def test_bad_arguments() -> None:
 
 def test_appending_allocates_nothing_that_stays() -> None:
     rb = RingBuffer(1000, 7)
-    storage = rb._buf
+    assert rb._buf is None  # allocated by the first sample, not when the monitor is built
     sample = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
     for _ in range(10):
         rb.append(sample)
+    storage = rb._buf
+    assert storage is not None
     tracemalloc.start()
     try:
         before, _ = tracemalloc.get_traced_memory()

@@ -10,27 +10,40 @@ C-contiguous, which is what ``PlotCurveItem.setData(..., skipFiniteCheck=True)``
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
-import numpy as np
-import numpy.typing as npt
+if TYPE_CHECKING:
+    import numpy as np
+    import numpy.typing as npt
+else:  # numpy: by the first sample, not when the monitor is built (app/lazy_numpy.py)
+    from app.lazy_numpy import np
 
 
 class RingBuffer:
     """Fixed-capacity FIFO of samples, each sample being one value per channel."""
 
-    __slots__ = ("_buf", "_capacity", "_channels", "_count", "_pos", "_total")
+    __slots__ = ("_buf", "_capacity", "_channels", "_count", "_dtype", "_pos", "_total")
 
-    def __init__(self, capacity: int, channels: int = 1, dtype: npt.DTypeLike = np.float64) -> None:
+    def __init__(self, capacity: int, channels: int = 1, dtype: npt.DTypeLike = "float64") -> None:
         if capacity < 1:
             raise ValueError(f"capacity must be >= 1, got {capacity}")
         if channels < 1:
             raise ValueError(f"channels must be >= 1, got {channels}")
         self._capacity = int(capacity)
         self._channels = int(channels)
-        self._buf: np.ndarray = np.zeros((self._channels, 2 * self._capacity), dtype=dtype)
+        self._dtype = dtype
+        self._buf: np.ndarray | None = None  # allocated by the first use (see _storage)
         self._pos = 0  # next write index in [0, capacity)
         self._count = 0  # valid samples, <= capacity
         self._total = 0  # samples ever appended; never reset, so it works as a change stamp
+
+    def _storage(self) -> np.ndarray:
+        """The storage, allocated the first time it is needed: building the monitor (before the
+        window's first paint) allocates nothing and imports no numpy."""
+        buf = self._buf
+        if buf is None:
+            buf = self._buf = np.zeros((self._channels, 2 * self._capacity), dtype=self._dtype)
+        return buf
 
     @property
     def capacity(self) -> int:
@@ -54,6 +67,8 @@ class RingBuffer:
             raise ValueError(f"expected {self._channels} values, got {len(values)}")
         pos = self._pos
         buf = self._buf
+        if buf is None:
+            buf = self._storage()
         buf[:, pos] = values
         buf[:, pos + self._capacity] = buf[:, pos]
         self._pos = pos + 1 if pos + 1 < self._capacity else 0
@@ -70,11 +85,12 @@ class RingBuffer:
         if n == 0:
             return
         cap = self._capacity
+        buf = self._storage()
         self._total += n
         if n >= cap:  # only the newest `cap` samples survive
             block = block[:, n - cap :]
-            self._buf[:, :cap] = block
-            self._buf[:, cap:] = block
+            buf[:, :cap] = block
+            buf[:, cap:] = block
             self._pos = 0
             self._count = cap
             return
@@ -82,8 +98,8 @@ class RingBuffer:
         for start, chunk in ((self._pos, block[:, :first]), (0, block[:, first:])):
             k = chunk.shape[1]
             if k:
-                self._buf[:, start : start + k] = chunk
-                self._buf[:, start + cap : start + cap + k] = chunk
+                buf[:, start : start + k] = chunk
+                buf[:, start + cap : start + cap + k] = chunk
         self._pos = (self._pos + n) % cap
         self._count = min(cap, self._count + n)
 
@@ -95,19 +111,19 @@ class RingBuffer:
         """
         n = self._count if last is None else max(0, min(int(last), self._count))
         end = self._pos + self._capacity
-        return self._buf[channel, end - n : end]
+        return self._storage()[channel, end - n : end]
 
     def views(self, last: int | None = None) -> np.ndarray:
         """All channels, shape ``(channels, n)``, as one view (each row contiguous)."""
         n = self._count if last is None else max(0, min(int(last), self._count))
         end = self._pos + self._capacity
-        return self._buf[:, end - n : end]
+        return self._storage()[:, end - n : end]
 
     def latest(self, channel: int) -> float:
         """Newest value of ``channel``; raises ``IndexError`` when empty."""
         if not self._count:
             raise IndexError("ring buffer is empty")
-        return float(self._buf[channel, self._pos + self._capacity - 1])
+        return float(self._storage()[channel, self._pos + self._capacity - 1])
 
     def clear(self) -> None:
         """Forget all samples (the storage is kept; ``total`` is not reset)."""

@@ -9,12 +9,16 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-import numpy as np
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QFont
 from PySide6.QtWidgets import QSizePolicy, QSplitter, QWidget
 
 from ui.models.ring_buffer import RingBuffer
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
+    from app.lazy_numpy import np
 
 if TYPE_CHECKING:  # imported when the first plot is built (the window's first paint goes first)
     import pyqtgraph as pg

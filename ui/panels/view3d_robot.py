@@ -46,7 +46,17 @@ class RobotModelSource(QObject):
         self._checkers: dict[RobotProfile, ReachChecker] = {}
         self.path = ""  # the profile's file ("" for the default profile)
         self.problem = ""  # the last profile file that could not be used, and why
-        self.reach = self._checker(self._default)
+        self._profile = self._default
+        self._reach: ReachChecker | None = None  # made by the first use: the arm model needs numpy,
+        # which the window's first paint does not (the planner's checks and the 3D view come later)
+
+    @property
+    def reach(self) -> ReachChecker:
+        """The current profile's reach checker (made now if it was not yet)."""
+        reach = self._reach
+        if reach is None:
+            reach = self._reach = self._checker(self._profile)
+        return reach
 
     @property
     def model(self) -> ArmModel:
@@ -54,7 +64,7 @@ class RobotModelSource(QObject):
 
     @property
     def profile(self) -> RobotProfile:
-        return self.reach.model.profile
+        return self._profile
 
     def _checker(self, profile: RobotProfile) -> ReachChecker:
         checker = self._checkers.pop(profile, None) or ReachChecker(ArmModel(profile))
@@ -65,7 +75,8 @@ class RobotModelSource(QObject):
 
     def set_profile(self, profile: RobotProfile, path: str = "") -> None:
         """Use ``profile`` (from the file ``path``; "" for one that has none) and remember it."""
-        self.reach = self._checker(profile)
+        self._profile = profile
+        self._reach = None if self._reach is None else self._checker(profile)
         self.path = path
         if self._settings is not None:
             self._settings.robot_profile_path = path
