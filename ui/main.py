@@ -23,8 +23,8 @@ from pathlib import Path
 from PySide6.QtCore import QEvent, QObject, QTimer, Signal
 from PySide6.QtWidgets import QApplication, QWidget
 
-from app.link.client import ConnectionSettings
 from app.link.robot_link import RobotLink, wait_for_detached_threads
+from app.link.transport import ConnectionSettings
 from app.link.types import ConnectionState
 from app.models import Pose
 from app.protocol.enums import ProgramMotionMode

@@ -48,8 +48,8 @@ from PySide6.QtWidgets import (
 )
 
 from app import __version__
-from app.link.client import ConnectionSettings
 from app.link.robot_link import RobotLink
+from app.link.transport import ConnectionSettings
 from app.link.types import WorkerError
 from app.safety.roles import Action
 from ui.controllers.motion import MotionController

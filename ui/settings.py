@@ -16,7 +16,7 @@ from typing import Any
 from PySide6.QtCore import QByteArray, QSettings
 
 from app import timing
-from app.link.client import ConnectionSettings
+from app.link.transport import ConnectionSettings
 from app.protocol.codec import WordOrder
 from app.safety import register_profile as regprofile
 from app.safety.roles import default_config_dir

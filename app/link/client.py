@@ -21,7 +21,6 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 from __future__ import annotations
 
 import dataclasses
-import enum
 import math
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -40,6 +39,7 @@ from app.link.register_client import RegisterClient
 from app.link.stats import LinkStats
 from app.link.tracker import command_text
 from app.link.transport import ConnectionSettings, TrafficRecord
+from app.link.types import StepFrame  # here for importers: the GUI imports it from types
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import (
@@ -61,17 +61,6 @@ __all__ = [
 ]
 
 _GENERAL_POSE_LAST_START = registers.GV_GENERAL_LAST - 5  # six GVs must fit in GV0..GV99
-
-
-class StepFrame(enum.Enum):
-    """Frame of an incremental move (function 1)."""
-
-    JOINT = "joint"
-    BASE = "base"
-
-    @property
-    def command(self) -> RunCommand:
-        return RunCommand.STEP_JOINT if self is StepFrame.JOINT else RunCommand.STEP_BASE
 
 
 ProgressCallback = Callable[[int, int], bool]

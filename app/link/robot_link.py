@@ -10,20 +10,20 @@ tests use a small fake that fits too).
 
 from __future__ import annotations
 
+import enum
 import logging
 import sys
 from collections.abc import Iterable, Sequence
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Literal, Protocol
 
 from PySide6.QtCore import QCoreApplication, QObject, Qt, QThread, QTimer, Signal, SignalInstance, Slot
 
 from app import timing
 from app.errors import Reason
-from app.link.client import ConnectionSettings, StepFrame
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, RobotState
 from app.link.stats import LinkStats
-from app.link.supervisor import DEFAULT_CANARY_GV, check_canary_gv
-from app.link.types import ConnectionState, JogRequest, LinkState, WorkerError
+from app.link.transport import ConnectionSettings
+from app.link.types import ConnectionState, JogRequest, LinkState, StepFrame, WorkerError
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
@@ -42,6 +42,12 @@ _log = logging.getLogger(__name__)
 #: slot): a Stop posted by the GUI then sat up to 5 ms before its write. 0.5 ms bounds that wait;
 #: the cost is more frequent GIL hand-offs, only when two threads want it at once.
 GIL_SWITCH_INTERVAL = 0.0005
+
+
+class _Default(enum.Enum):
+    """A parameter left to the worker's own default (its module is imported later)."""
+
+    CANARY_GV = "app.link.supervisor.DEFAULT_CANARY_GV"
 
 
 class Pending(QObject):
@@ -201,16 +207,20 @@ class RobotLink(QObject):
         parent: QObject | None = None,
         *,
         poll_hz: float = timing.POLL_HZ_DEFAULT,
-        canary_gv: int | None = DEFAULT_CANARY_GV,
+        canary_gv: int | Literal[_Default.CANARY_GV] | None = _Default.CANARY_GV,
         freshness_limit: float = DEFAULT_FRESHNESS_LIMIT,
         stop_line: bool = True,
     ) -> None:
-        """``stop_line`` False: never open the stop's own connection (app/link/stop_line.py);
-        every stop goes through the worker's queue on the main link."""
+        """``canary_gv``: the spare GV of the restart canary (default: the supervisor's, None: no
+        canary). ``stop_line`` False: never open the stop's own connection
+        (app/link/stop_line.py); every stop goes through the worker's queue on the main link."""
         super().__init__(parent)
         if sys.getswitchinterval() > GIL_SWITCH_INTERVAL:
             sys.setswitchinterval(GIL_SWITCH_INTERVAL)  # see GIL_SWITCH_INTERVAL: a stop never waits 5 ms
-        check_canary_gv(canary_gv)  # a bad canary GV raises here, not at the first request
+        if isinstance(canary_gv, int):  # a bad one raises here, not at the first request
+            from app.link.supervisor import check_canary_gv
+
+            check_canary_gv(canary_gv)
         self._settings: ConnectionSettings | None = None
         self._state = RobotState(self, freshness_limit=freshness_limit)
         self._router = RequestRouter()
@@ -246,7 +256,12 @@ class RobotLink(QObject):
     def _make_worker(self) -> RobotWorker:
         from app.link.worker import RobotWorker
 
-        w = RobotWorker(self._poll_hz, canary_gv=self._canary_gv)
+        canary = self._canary_gv
+        w = (
+            RobotWorker(self._poll_hz)
+            if canary is _Default.CANARY_GV
+            else RobotWorker(self._poll_hz, canary_gv=canary)
+        )
         w.use_stop_line = self._use_stop_line
         w.moveToThread(self._thread)
         # the model first, so a view that reacts to the re-emitted signal reads the new value

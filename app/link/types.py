@@ -6,9 +6,20 @@ import enum
 from dataclasses import dataclass
 
 from app.errors import Reason, TeachPadError
-from app.protocol.enums import TeachFrame
+from app.protocol.enums import RunCommand, TeachFrame
 
-__all__ = ["ConnectionState", "JogRequest", "LinkState", "Operation", "WorkerError"]
+__all__ = ["ConnectionState", "JogRequest", "LinkState", "Operation", "StepFrame", "WorkerError"]
+
+
+class StepFrame(enum.Enum):
+    """Frame of an incremental move (function 1)."""
+
+    JOINT = "joint"
+    BASE = "base"
+
+    @property
+    def command(self) -> RunCommand:
+        return RunCommand.STEP_JOINT if self is StepFrame.JOINT else RunCommand.STEP_BASE
 
 
 class Operation:

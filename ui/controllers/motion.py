@@ -21,9 +21,8 @@ import dataclasses
 from PySide6.QtCore import QObject, Signal, Slot
 
 from app.alarm_history import blocks_motion
-from app.link.client import StepFrame
 from app.link.robot_link import LinkPort
-from app.link.types import ConnectionState, JogRequest
+from app.link.types import ConnectionState, JogRequest, StepFrame
 from app.protocol.enums import ProgramMotionMode, WorkMode
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.safety import SafetyController

@@ -32,7 +32,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.link.client import ConnectionSettings
+from app.link.transport import ConnectionSettings
 from app.link.types import ConnectionState, LinkState
 from app.protocol.codec import WordOrder
 from app.safety.register_profile import RegisterProfile

@@ -25,7 +25,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.link.client import StepFrame
+from app.link.types import StepFrame
 from app.protocol.enums import CARTESIAN_AXIS_NAMES, JOINT_AXIS_NAMES
 from app.protocol.registers import NUM_AXES_TOTAL, NUM_EXTERNAL_AXES, NUM_ROBOT_AXES
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation

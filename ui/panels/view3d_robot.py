@@ -16,18 +16,20 @@ and keeps the default profile.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Final
+from typing import TYPE_CHECKING, Final
 
 from PySide6.QtCore import QObject, Signal
 
-from app.plan.checks import PlanIssue
-from app.plan.geometry import PointLike
-from app.plan.segments import Plan
-from app.points.ledger import PointLedger
-from app.view3d.kinematics import ArmModel
 from app.view3d.profile import ProfileError, RobotProfile, default_profile, load_profile
-from app.view3d.reach import ReachChecker
 from ui.settings import AppSettings
+
+if TYPE_CHECKING:  # the arm model and its reach checks: imported by the first reach question
+    from app.plan.checks import PlanIssue
+    from app.plan.geometry import PointLike
+    from app.plan.segments import Plan
+    from app.points.ledger import PointLedger
+    from app.view3d.kinematics import ArmModel
+    from app.view3d.reach import ReachChecker
 
 CHECKERS_KEPT: Final = 4  # profiles whose reach caches are kept (switching back is free)
 
@@ -67,6 +69,9 @@ class RobotModelSource(QObject):
         return self._profile
 
     def _checker(self, profile: RobotProfile) -> ReachChecker:
+        from app.view3d.kinematics import ArmModel
+        from app.view3d.reach import ReachChecker
+
         checker = self._checkers.pop(profile, None) or ReachChecker(ArmModel(profile))
         self._checkers[profile] = checker  # most recent last
         while len(self._checkers) > CHECKERS_KEPT:
