@@ -12,13 +12,12 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import os
-import queue
 import re
-import subprocess
 import sys
 import threading
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QEvent, QObject, QTimer, Signal
 from PySide6.QtWidgets import QApplication, QWidget
@@ -31,6 +30,9 @@ from app.protocol.enums import ProgramMotionMode
 from ui.i18n import LANGUAGE_NAMES, Translator
 from ui.main_window import TAB_NAMES, MainWindow
 from ui.settings import APPLICATION, ORGANIZATION, AppSettings
+
+if TYPE_CHECKING:  # subprocess and queue: imported when a simulator is started (--sim)
+    import subprocess
 
 SCREENSHOT_SETTLE_MS = 1500  # after the first pose: let the plots fill and the panels paint
 SCREENSHOT_TIMEOUT_MS = 20_000  # give up when no pose arrives
@@ -70,6 +72,9 @@ class SimProcess:
     @classmethod
     def start(cls, timeout: float = SIM_START_TIMEOUT) -> SimProcess:
         """Start ``teachpad-sim --port 0`` and wait until it says its port. Raises RuntimeError."""
+        import queue
+        import subprocess
+
         root = str(Path(__file__).resolve().parent.parent)  # where ``app`` is, installed or not
         env = dict(os.environ)
         env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH", "")) if p)
@@ -108,6 +113,8 @@ class SimProcess:
 
     def stop(self, timeout: float = SIM_STOP_TIMEOUT) -> int:
         """Close its stdin (it stops by itself), terminate it if it does not; its exit code."""
+        import subprocess
+
         process = self.process
         if process.stdin is not None and not process.stdin.closed:
             try:

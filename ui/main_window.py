@@ -58,7 +58,6 @@ from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController, ProjectDialogs
 from ui.controllers.safety_menu import install_safety
 from ui.dialogs.confirm import ConfirmFn
-from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import Translator
 from ui.messages import error_text
 from ui.panels.alarm_banner import AlarmBanner
@@ -409,6 +408,8 @@ class MainWindow(QMainWindow):
         self.jog_panel.release_all()
         if not self.safety_menu.safety.allowed(Action.CONNECTION):  # the administrator's (audited)
             return
+        from ui.dialogs.connection_dialog import ConnectionDialog  # not needed for the first paint
+
         dialog = ConnectionDialog.for_link(self.link, self.settings.connection(), self.settings.poll_hz, self)
         if dialog.exec() == ConnectionDialog.DialogCode.Accepted:
             self.connect_with(dialog.settings())

@@ -29,13 +29,10 @@ from app.safety.register_profile import RegisterProfile
 from app.safety.roles import Action, Role
 from app.safety.session import PermissionRefused
 from ui.controllers.safety import SafetyController
-from ui.dialogs.envelope_dialog import EnvelopeDialog
-from ui.dialogs.password_dialog import PasswordDialog
-from ui.dialogs.register_profile_dialog import RegisterProfileDialog
-from ui.dialogs.role_dialog import RoleDialog
-from ui.panels.audit_viewer import AuditViewer
 
-if TYPE_CHECKING:  # the window composes this menu; only its type is needed here
+if TYPE_CHECKING:  # the window composes this menu; only its type is needed here (the dialogs
+    # are imported when opened: the window's first paint does not wait for them)
+    from ui.dialogs.register_profile_dialog import RegisterProfileDialog
     from ui.main_window import MainWindow
     from ui.panels.planner_panel import PlannerPanel
     from ui.panels.points_panel import PointsPanel
@@ -161,16 +158,22 @@ class SafetyMenu(QObject):
     # --- dialogs -------------------------------------------------------------------------------
     @Slot()
     def open_role_dialog(self) -> None:
+        from ui.dialogs.role_dialog import RoleDialog
+
         RoleDialog(self.safety, self.window).exec()
 
     @Slot()
     def open_envelope_dialog(self) -> None:
         if self.safety.allowed(Action.EDIT_ENVELOPE):
+            from ui.dialogs.envelope_dialog import EnvelopeDialog
+
             EnvelopeDialog(self.safety, self.window).exec()
 
     @Slot()
     def open_password_dialog(self) -> None:
         if self.safety.allowed(Action.MANAGE_ROLES):
+            from ui.dialogs.password_dialog import PasswordDialog
+
             PasswordDialog(self.safety, self.window).exec()
 
     def register_profile(self) -> RegisterProfile:
@@ -178,6 +181,8 @@ class SafetyMenu(QObject):
         return self.window.settings.register_profile()[0]
 
     def register_profile_dialog(self) -> RegisterProfileDialog:
+        from ui.dialogs.register_profile_dialog import RegisterProfileDialog
+
         link = self.window.link
         connected = link.settings is not None and link.connection.state is not LinkState.DISCONNECTED
         return RegisterProfileDialog(
@@ -217,6 +222,8 @@ class SafetyMenu(QObject):
 
     @Slot()
     def open_audit_viewer(self) -> None:
+        from ui.panels.audit_viewer import AuditViewer
+
         viewer = AuditViewer(self.safety.audit_dir, self.window)
         viewer.exec()
 
