@@ -7,7 +7,8 @@ from pathlib import Path
 
 APP = Path(__file__).resolve().parent.parent / "app"
 QT_ALLOWED = {
-    APP / "link" / name: {"PySide6.QtCore", "PySide6"} for name in ("worker.py", "robot_link.py", "state.py")
+    APP / "link" / name: {"PySide6.QtCore", "PySide6"}
+    for name in ("worker.py", "robot_link.py", "link_port.py", "state.py")
 }
 
 

@@ -10,16 +10,25 @@ tests use a small fake that fits too).
 
 from __future__ import annotations
 
-import enum
 import logging
 import sys
 from collections.abc import Iterable, Sequence
-from typing import TYPE_CHECKING, Literal, Protocol
+from types import EllipsisType
+from typing import TYPE_CHECKING
 
-from PySide6.QtCore import QCoreApplication, QObject, Qt, QThread, QTimer, Signal, SignalInstance, Slot
+from PySide6.QtCore import (
+    QCoreApplication,
+    QMetaObject,
+    QObject,
+    Qt,
+    QThread,
+    Signal,
+    Slot,
+)
 
 from app import timing
 from app.errors import Reason
+from app.link.link_port import LinkPort, Pending, RequestRouter
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, RobotState
 from app.link.stats import LinkStats
 from app.link.transport import ConnectionSettings
@@ -42,138 +51,6 @@ _log = logging.getLogger(__name__)
 #: slot): a Stop posted by the GUI then sat up to 5 ms before its write. 0.5 ms bounds that wait;
 #: the cost is more frequent GIL hand-offs, only when two threads want it at once.
 GIL_SWITCH_INTERVAL = 0.0005
-
-
-class _Default(enum.Enum):
-    """A parameter left to the worker's own default (its module is imported later)."""
-
-    CANARY_GV = "app.link.supervisor.DEFAULT_CANARY_GV"
-
-
-class Pending(QObject):
-    """One request's outcome: exactly one of ``finished`` / ``failed`` fires, once."""
-
-    finished = Signal(CommandResult)
-    failed = Signal(WorkerError)
-
-    def __init__(self, request_id: int, parent: QObject | None = None) -> None:
-        super().__init__(parent)
-        self._request_id = request_id
-        self.result: CommandResult | None = None
-        self.error: WorkerError | None = None
-
-    @property
-    def request_id(self) -> int:
-        return self._request_id
-
-    @property
-    def done(self) -> bool:
-        return self.result is not None or self.error is not None
-
-    def _finish(self, result: CommandResult) -> None:
-        if not self.done:
-            self.result = result
-            self.finished.emit(result)
-
-    def _fail(self, error: WorkerError) -> None:
-        if not self.done:
-            self.error = error
-            self.failed.emit(error)
-
-
-class RequestRouter:
-    """Request id -> :class:`Pending`; the outcomes of untracked requests are ignored here."""
-
-    def __init__(self) -> None:
-        self._pending: dict[int, Pending] = {}
-
-    def track(self, request_id: int) -> Pending:
-        pending = self._pending.get(request_id)
-        if pending is not None:
-            return pending
-        pending = Pending(request_id)
-        if request_id <= 0:  # nothing was queued (the link is shut down): fail once connected to
-            error = WorkerError("request", "the link is shut down: nothing was sent", None)
-            QTimer.singleShot(0, pending, lambda: pending._fail(error))
-        else:
-            self._pending[request_id] = pending
-        return pending
-
-    def on_result(self, result: CommandResult) -> None:
-        if result.request_id is not None and (pending := self._pending.pop(result.request_id, None)):
-            pending._finish(result)
-
-    def on_error(self, error: WorkerError) -> None:
-        if error.request_id is not None and (pending := self._pending.pop(error.request_id, None)):
-            pending._fail(error)
-
-    def __len__(self) -> int:
-        return len(self._pending)
-
-
-class LinkPort(Protocol):
-    """What panels and controllers use of the link, with the real types (RobotLink fits)."""
-
-    controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
-    controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
-    uploadProgress: SignalInstance  # noqa: N815 - (int, int) points done, total of the running upload
-    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str, bool) point id, ok, reason, unconfirmed
-
-    @property
-    def state(self) -> RobotState: ...
-
-    def track(self, request_id: int) -> Pending: ...
-
-    def stop(self) -> int: ...
-
-    def pause(self) -> int: ...
-
-    def resume(self) -> int: ...
-
-    def jog_press(
-        self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0, tool: int = 0
-    ) -> int: ...
-
-    def jog_release(self) -> int: ...
-
-    def set_jog_ratio(self, ratio: float) -> int: ...
-
-    def step(
-        self,
-        frame: StepFrame,
-        offsets: Sequence[float],
-        ext_offsets: Sequence[float] = ...,
-        speed: float = ...,
-    ) -> int: ...
-
-    def set_mode(self, mode: WorkMode) -> int: ...
-
-    def go_zero(self, axis: int | None) -> int: ...
-
-    def run_program(
-        self, program_id: int, mode: ProgramMotionMode = ..., cycles: int = ..., speed_ratio: int = ...
-    ) -> int: ...
-
-    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = ...) -> int: ...
-
-    def move_to_point(
-        self,
-        end_id: int,
-        via_id: int | None = None,
-        *,
-        orientation_changes: bool = ...,
-        ignore_middle: bool = ...,
-        speed: float = ...,
-        tool: int = ...,
-    ) -> int: ...
-
-    def upload_points(
-        self,
-        points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
-        tool: int = ...,
-    ) -> int: ...
-
-    def cancel_upload(self) -> int: ...
 
 
 class RobotLink(QObject):
@@ -200,19 +77,18 @@ class RobotLink(QObject):
     _captureRequested = Signal(bool)  # noqa: N815
     _guardRequested = Signal(object)  # noqa: N815
     _auditRequested = Signal(object)  # noqa: N815
-    _startRequested = Signal()  # noqa: N815
 
     def __init__(
         self,
         parent: QObject | None = None,
         *,
         poll_hz: float = timing.POLL_HZ_DEFAULT,
-        canary_gv: int | Literal[_Default.CANARY_GV] | None = _Default.CANARY_GV,
+        canary_gv: int | EllipsisType | None = ...,
         freshness_limit: float = DEFAULT_FRESHNESS_LIMIT,
         stop_line: bool = True,
     ) -> None:
-        """``canary_gv``: the spare GV of the restart canary (default: the supervisor's, None: no
-        canary). ``stop_line`` False: never open the stop's own connection
+        """``canary_gv``: the restart canary's spare GV (``...``: the supervisor's default; None:
+        none). ``stop_line`` False: never open the stop's own connection
         (app/link/stop_line.py); every stop goes through the worker's queue on the main link."""
         super().__init__(parent)
         if sys.getswitchinterval() > GIL_SWITCH_INTERVAL:
@@ -257,25 +133,22 @@ class RobotLink(QObject):
         from app.link.worker import RobotWorker
 
         canary = self._canary_gv
-        w = (
-            RobotWorker(self._poll_hz)
-            if canary is _Default.CANARY_GV
-            else RobotWorker(self._poll_hz, canary_gv=canary)
-        )
+        w = RobotWorker(self._poll_hz) if canary is ... else RobotWorker(self._poll_hz, canary_gv=canary)
         w.use_stop_line = self._use_stop_line
         w.moveToThread(self._thread)
-        # the model first, so a view that reacts to the re-emitted signal reads the new value
+        # queued (in order, before the request that made it): the thread runs, its timers start there
+        QMetaObject.invokeMethod(w, "start", Qt.ConnectionType.QueuedConnection)
         state = self._state
-        w.poseChanged.connect(state.set_pose)
-        w.statusChanged.connect(state.set_status)
-        w.alarmsChanged.connect(state.set_alarms)
-        w.rttChanged.connect(state.set_rtt)
-        w.pollSucceeded.connect(state.note_good_poll)
-        w.linkStatsChanged.connect(self._on_stats)
-        w.commandFinished.connect(self._on_result)
-        w.errorOccurred.connect(self._on_error)
-        w.connectionChanged.connect(self._on_connection)
-        for source, target in (
+        for source, target in (  # the model first, so a view of the re-emitted signal reads the new value
+            (w.poseChanged, state.set_pose),
+            (w.statusChanged, state.set_status),
+            (w.alarmsChanged, state.set_alarms),
+            (w.rttChanged, state.set_rtt),
+            (w.pollSucceeded, state.note_good_poll),
+            (w.linkStatsChanged, self._on_stats),
+            (w.commandFinished, self._on_result),
+            (w.errorOccurred, self._on_error),
+            (w.connectionChanged, self._on_connection),
             (w.poseChanged, self.poseChanged),
             (w.statusChanged, self.statusChanged),
             (w.alarmsChanged, self.alarmsChanged),
@@ -286,18 +159,15 @@ class RobotLink(QObject):
             (w.uploadProgress, self.uploadProgress),
             (w.pointUploaded, self.pointUploaded),
             (w.jogGuardStopped, self.jogGuardStopped),
+            (self._connectRequested, w.connect_to),
+            (self._disconnectRequested, w.disconnect_link),
+            (self._pollRateRequested, w.set_poll_rate),
+            (self._captureRequested, w.set_traffic_capture),
+            (self._guardRequested, w.set_jog_guard),
+            (self._auditRequested, w.set_audit),
         ):
             source.connect(target)
-        queued = Qt.ConnectionType.QueuedConnection
-        self._startRequested.connect(w.start, queued)  # the thread runs already: its timers, there
-        self._connectRequested.connect(w.connect_to)
-        self._disconnectRequested.connect(w.disconnect_link)
-        self._pollRateRequested.connect(w.set_poll_rate)
-        self._captureRequested.connect(w.set_traffic_capture)
-        self._guardRequested.connect(w.set_jog_guard)
-        self._auditRequested.connect(w.set_audit)
-        self._shutdownRequested.connect(w.shutdown, queued)
-        self._startRequested.emit()
+        self._shutdownRequested.connect(w.shutdown, Qt.ConnectionType.QueuedConnection)
         # queued, so in this order before the request that made the worker
         if self._audit is not None:
             self._auditRequested.emit(self._audit)

@@ -1,0 +1,143 @@
+"""What panels and controllers hold of the link: :class:`LinkPort`, the typed port RobotLink
+fits (and the tests' small fake), :class:`Pending`, one request's outcome, and
+:class:`RequestRouter`, request id -> Pending. Re-exported by :mod:`app.link.robot_link`."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from typing import Protocol
+
+from PySide6.QtCore import QObject, QTimer, Signal, SignalInstance
+
+from app.link.state import RobotState
+from app.link.types import StepFrame, WorkerError
+from app.models import CommandResult
+from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
+
+__all__ = ["LinkPort", "Pending", "RequestRouter"]
+
+
+class Pending(QObject):
+    """One request's outcome: exactly one of ``finished`` / ``failed`` fires, once."""
+
+    finished = Signal(CommandResult)
+    failed = Signal(WorkerError)
+
+    def __init__(self, request_id: int, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self._request_id = request_id
+        self.result: CommandResult | None = None
+        self.error: WorkerError | None = None
+
+    @property
+    def request_id(self) -> int:
+        return self._request_id
+
+    @property
+    def done(self) -> bool:
+        return self.result is not None or self.error is not None
+
+    def _finish(self, result: CommandResult) -> None:
+        if not self.done:
+            self.result = result
+            self.finished.emit(result)
+
+    def _fail(self, error: WorkerError) -> None:
+        if not self.done:
+            self.error = error
+            self.failed.emit(error)
+
+
+class RequestRouter:
+    """Request id -> :class:`Pending`; the outcomes of untracked requests are ignored here."""
+
+    def __init__(self) -> None:
+        self._pending: dict[int, Pending] = {}
+
+    def track(self, request_id: int) -> Pending:
+        pending = self._pending.get(request_id)
+        if pending is not None:
+            return pending
+        pending = Pending(request_id)
+        if request_id <= 0:  # nothing was queued (the link is shut down): fail once connected to
+            error = WorkerError("request", "the link is shut down: nothing was sent", None)
+            QTimer.singleShot(0, pending, lambda: pending._fail(error))
+        else:
+            self._pending[request_id] = pending
+        return pending
+
+    def on_result(self, result: CommandResult) -> None:
+        if result.request_id is not None and (pending := self._pending.pop(result.request_id, None)):
+            pending._finish(result)
+
+    def on_error(self, error: WorkerError) -> None:
+        if error.request_id is not None and (pending := self._pending.pop(error.request_id, None)):
+            pending._fail(error)
+
+    def __len__(self) -> int:
+        return len(self._pending)
+
+
+class LinkPort(Protocol):
+    """What panels and controllers use of the link, with the real types (RobotLink fits)."""
+
+    controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
+    controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
+    uploadProgress: SignalInstance  # noqa: N815 - (int, int) points done, total of the running upload
+    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str, bool) point id, ok, reason, unconfirmed
+
+    @property
+    def state(self) -> RobotState: ...
+
+    def track(self, request_id: int) -> Pending: ...
+
+    def stop(self) -> int: ...
+
+    def pause(self) -> int: ...
+
+    def resume(self) -> int: ...
+
+    def jog_press(
+        self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0, tool: int = 0
+    ) -> int: ...
+
+    def jog_release(self) -> int: ...
+
+    def set_jog_ratio(self, ratio: float) -> int: ...
+
+    def step(
+        self,
+        frame: StepFrame,
+        offsets: Sequence[float],
+        ext_offsets: Sequence[float] = ...,
+        speed: float = ...,
+    ) -> int: ...
+
+    def set_mode(self, mode: WorkMode) -> int: ...
+
+    def go_zero(self, axis: int | None) -> int: ...
+
+    def run_program(
+        self, program_id: int, mode: ProgramMotionMode = ..., cycles: int = ..., speed_ratio: int = ...
+    ) -> int: ...
+
+    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = ...) -> int: ...
+
+    def move_to_point(
+        self,
+        end_id: int,
+        via_id: int | None = None,
+        *,
+        orientation_changes: bool = ...,
+        ignore_middle: bool = ...,
+        speed: float = ...,
+        tool: int = ...,
+    ) -> int: ...
+
+    def upload_points(
+        self,
+        points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
+        tool: int = ...,
+    ) -> int: ...
+
+    def cancel_upload(self) -> int: ...
