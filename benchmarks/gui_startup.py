@@ -70,15 +70,38 @@ if kind == "bare":
     app.exec()
     window.close()
 else:
+    # The simulator must not be imported here (pymodbus, numpy: it would be measured as start-up):
+    # SimController.start is wrapped only if the GUI process imports app.sim.server itself (an
+    # in-process simulator, which goals.py reports); the child process's start is timed too.
+    import importlib.abc, importlib.util
+    class SimWatch(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path, target=None):
+            if name != "app.sim.server":
+                return None
+            sys.meta_path.remove(self)
+            spec = importlib.util.find_spec(name)
+            run_module = spec.loader.exec_module
+            def exec_module(module):
+                run_module(module)
+                sim_start = module.SimController.start
+                def timed_start(self):
+                    mark("sim_start_begin")
+                    sim_start(self)
+                    mark("sim_started")
+                module.SimController.start = timed_start
+            spec.loader.exec_module = exec_module
+            return spec
+    sys.meta_path.insert(0, SimWatch())
     import ui.main as teachpad
-    from app.sim import SimController
     mark("ui_imported")
-    sim_start = SimController.start
-    def timed_start(self):
-        mark("sim_start_begin")
-        sim_start(self)
-        mark("sim_started")
-    SimController.start = timed_start
+    process_start = teachpad.SimProcess.start.__func__
+    def timed_process_start(cls, *args, **kwargs):
+        mark("sim_process_start_begin")
+        try:
+            return process_start(cls, *args, **kwargs)
+        finally:
+            mark("sim_process_started")
+    teachpad.SimProcess.start = classmethod(timed_process_start)
 
     class ReadoutPaint(QObject):
         def eventFilter(self, watched, event):
