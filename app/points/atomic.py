@@ -18,7 +18,6 @@ import re
 import stat
 import sys
 import time
-import uuid
 from pathlib import Path
 from typing import Any
 
@@ -36,7 +35,7 @@ _RANDOM = re.compile(r"[0-9a-f]{12}")
 
 def temp_name(target: Path) -> Path:
     """A fresh temp file name for a save of ``target``."""
-    return target.with_name(f"{TEMP_PREFIX}{target.name}.{uuid.uuid4().hex[:12]}{TEMP_SUFFIX}")
+    return target.with_name(f"{TEMP_PREFIX}{target.name}.{os.urandom(6).hex()}{TEMP_SUFFIX}")
 
 
 def stale_temp_files(target: str | os.PathLike[str], *, min_age: float | None = None) -> list[Path]:
