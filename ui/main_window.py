@@ -292,8 +292,7 @@ class MainWindow(QMainWindow):
         panel.statusMessage.connect(self._show_message)
         if self._confirm is not None:
             panel.set_confirm(self._confirm)
-        if self.settings.touch_mode:
-            apply_touch_mode((panel,), True)
+        apply_touch_mode((panel,), self.settings.touch_mode)  # as set_touch_mode did for the others
 
     # --- texts ------------------------------------------------------------------------
     def retranslate(self) -> None:
