@@ -75,6 +75,7 @@ from ui.window_tabs import LazyTab
 if TYPE_CHECKING:  # built on first show (LazyTab): not imported before the window's first paint
     from ui.panels.planner_panel import PlannerPanel
     from ui.panels.points_panel import PointsPanel
+    from ui.panels.traffic_panel import TrafficPanel
 
 DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size
 MIN_SIZE = (1024, 700)  # the layout stays usable down to this
@@ -145,7 +146,7 @@ class MainWindow(QMainWindow):
         # --- docks: the display panels --------------------------------------------------
         self.docks = docks = WindowDocks(self, link)
         self.status_panel, self.event_log = docks.status_panel, docks.event_log
-        self.traffic_panel, self.alarm_list = docks.traffic_panel, docks.alarm_list
+        self.alarm_list = docks.alarm_list  # traffic_panel: a property (built when first seen)
         self.status_dock, self.event_dock = docks.status_dock, docks.event_dock
         self.traffic_dock, self.alarm_dock = docks.traffic_dock, docks.alarm_dock
 
@@ -254,15 +255,17 @@ class MainWindow(QMainWindow):
         project.pathChanged.connect(self._on_project_path)
         project.statusMessage.connect(self._show_message)
 
+    @property
+    def traffic_panel(self) -> TrafficPanel:  # built when its dock is first seen (WindowDocks)
+        return self.docks.traffic_panel
+
     # --- the lazily built work tabs (LazyTab) -------------------------------------------------
     @property
-    def points_panel(self) -> PointsPanel:
-        """The Points tab's panel (built now if it was not yet)."""
+    def points_panel(self) -> PointsPanel:  # built on first use (LazyTab), like the next two
         return self.points_tab.panel
 
     @property
     def planner_panel(self) -> PlannerPanel:
-        """The Planner tab's panel (built now if it was not yet)."""
         return self.planner_tab.panel
 
     def _build_points_panel(self) -> PointsPanel:
@@ -285,8 +288,7 @@ class MainWindow(QMainWindow):
         return panel
 
     def _join_work_tab(self, panel: PointsPanel | PlannerPanel) -> None:
-        """What every lazily built work panel gets from the window: the alarm hold, the status
-        bar, the operator's question, touch mode."""
+        """A lazily built work panel gets the alarm hold, status bar, question and touch mode."""
         panel.set_alarm_hold(self.motion.alarm_hold)
         self.motion.alarmHoldChanged.connect(panel.set_alarm_hold)
         panel.statusMessage.connect(self._show_message)

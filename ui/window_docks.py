@@ -4,10 +4,14 @@ Status on the left (narrow, full height); Event log, Modbus traffic and Alarms t
 bottom, the event log in front. The docks are sized once, at the window's first show, when the
 layout has its real size (a remembered layout is restored instead). The worker builds traffic
 records only while someone can read them: while the traffic dock can be seen (not tabbed behind
-the log) and its capture switch is on.
+the log) and its capture switch is on. The traffic panel itself (its model and the frame
+decoder) is built the first time its dock can be seen or :attr:`WindowDocks.traffic_panel` is
+asked for: tabbed behind the log at start, the window's first paint does not wait for it.
 """
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QCoreApplication, QObject, Qt, Slot
 from PySide6.QtWidgets import QDockWidget, QMainWindow, QWidget
@@ -16,8 +20,10 @@ from app.link.robot_link import RobotLink
 from ui.panels.alarm_list import AlarmListPanel
 from ui.panels.event_log import EventLogPanel
 from ui.panels.status_panel import StatusPanel
-from ui.panels.traffic_panel import TrafficPanel
 from ui.touch import show_rows
+
+if TYPE_CHECKING:  # built when its dock can first be seen (see the module docstring)
+    from ui.panels.traffic_panel import TrafficPanel
 
 __all__ = ["WindowDocks"]
 
@@ -38,7 +44,7 @@ class WindowDocks(QObject):
         self._traffic_capture = False
         self._traffic_dock_shown = False
         self.status_panel = StatusPanel(window)
-        self.traffic_panel = TrafficPanel(window)
+        self._traffic_panel: TrafficPanel | None = None
         self.event_log = EventLogPanel(window)
         self.alarm_list = AlarmListPanel(window)
         area = Qt.DockWidgetArea
@@ -47,21 +53,37 @@ class WindowDocks(QObject):
         # column wider than this only steals room from the work tabs
         self.status_dock.setMaximumWidth(STATUS_DOCK_MAX_WIDTH)
         self.event_dock = self._dock("EventLogDock", self.event_log, area.BottomDockWidgetArea)
-        self.traffic_dock = self._dock("TrafficDock", self.traffic_panel, area.BottomDockWidgetArea)
+        placeholder = QWidget(window)
+        placeholder.setObjectName("TrafficPlaceholder")
+        self.traffic_dock = self._dock("TrafficDock", placeholder, area.BottomDockWidgetArea)
         window.tabifyDockWidget(self.event_dock, self.traffic_dock)
         self.alarm_dock = self._dock("AlarmDock", self.alarm_list, area.BottomDockWidgetArea)
         window.tabifyDockWidget(self.event_dock, self.alarm_dock)
         self.event_dock.raise_()
         window.setCorner(Qt.Corner.BottomLeftCorner, area.LeftDockWidgetArea)  # status runs full height
-        for panel in (self.event_log, self.traffic_panel):
-            show_rows(panel.view, DOCK_MIN_ROWS)
+        show_rows(self.event_log.view, DOCK_MIN_ROWS)
         # visibilityChanged(bool) says whether the dock can be seen: False while it is tabbed
         # behind the event log, when isVisible() still says True
         self.traffic_dock.visibilityChanged.connect(self._on_traffic_dock_visibility)
-        self.traffic_panel.captureEnabledChanged.connect(self._update_traffic_capture)
-        link.trafficObserved.connect(self.traffic_panel.on_traffic)
         link.errorOccurred.connect(self.event_log.on_error)
         self.retranslate()
+
+    @property
+    def traffic_panel(self) -> TrafficPanel:
+        """The Modbus traffic panel (built now, in its dock, if it was not yet)."""
+        panel = self._traffic_panel
+        if panel is None:
+            from ui.panels.traffic_panel import TrafficPanel
+
+            panel = self._traffic_panel = TrafficPanel(self._window)
+            show_rows(panel.view, DOCK_MIN_ROWS)
+            panel.captureEnabledChanged.connect(self._update_traffic_capture)
+            self._link.trafficObserved.connect(panel.on_traffic)
+            placeholder = self.traffic_dock.widget()
+            self.traffic_dock.setWidget(panel)
+            if placeholder is not None:
+                placeholder.deleteLater()
+        return panel
 
     @property
     def docks(self) -> list[QDockWidget]:
@@ -98,11 +120,14 @@ class WindowDocks(QObject):
     @Slot(bool)
     def _on_traffic_dock_visibility(self, shown: bool) -> None:
         self._traffic_dock_shown = shown
+        if shown:
+            self.traffic_panel  # noqa: B018 - builds it, in its dock, the first time it can be seen
         self._update_traffic_capture()
 
     @Slot()
     def _update_traffic_capture(self) -> None:
-        want = self._traffic_dock_shown and self.traffic_panel.capture_enabled()
+        panel = self._traffic_panel
+        want = self._traffic_dock_shown and panel is not None and panel.capture_enabled()
         if want != self._traffic_capture:
             self._traffic_capture = want
             self._link.set_traffic_capture(want)
