@@ -39,8 +39,6 @@ from typing import Any
 
 from app.errors import WriteBlocked
 from app.protocol.codec import WordOrder
-from app.protocol.naming import describe_registers
-from app.protocol.summaries import single_write_text, write_summary
 from app.safety.audit_read import (
     CSV_COLUMNS,
     FILE_RE,
@@ -241,6 +239,10 @@ class AuditLog:
         not known yet, an outcome line follows -- see :meth:`writing`)."""
         vals = [int(v) for v in values]
         try:
+            # the register tables: imported by the first write, not with the window (start-up)
+            from app.protocol.naming import describe_registers
+            from app.protocol.summaries import single_write_text, write_summary
+
             if single and len(vals) == 1:
                 command = single_write_text(address, vals[0])
             else:
