@@ -42,8 +42,8 @@ __all__ = [
     "PAINT_MARGIN",
     "PLOT_INTERVAL_MS",
     "MonitorPlots",
-    "fit_range",
     "add_legend",
+    "fit_range",
     "style_plot",
     "unwrap_degrees",
 ]
@@ -254,7 +254,8 @@ class MonitorPlots:
         for channel, name in enumerate(CARTESIAN, start=X):
             self.curves[name].setData(t_view, history.view(channel, n)[first::step], skipFiniteCheck=True)
         block = history.views(n)[:, first::step]
-        for key, plot, rows in (("xyz", self.xyz_plot, block[X : X + 3]), ("abc", self.abc_plot, block[X + 3 :])):
+        ranges = (("xyz", self.xyz_plot, block[X : X + 3]), ("abc", self.abc_plot, block[X + 3 :]))
+        for key, plot, rows in ranges:
             shown = self._y_ranges.get(key)
             wanted = fit_range(shown, float(rows.min()), float(rows.max()))
             if wanted != shown:
