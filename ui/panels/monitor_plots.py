@@ -13,6 +13,8 @@ the frame keeps the rest still:
 * The vertical ranges are set by the plots, not by pyqtgraph's auto-range (which scanned every
   curve in every frame): from the window's extremes, padded and snapped to round values, and
   only set again when a value leaves the range or the values use less than a third of it.
+* The curves are told their bounds (:class:`~ui.panels.monitor_curve.BoundedCurve`: the range
+  their plot shows) instead of scanning their data for them many times a frame.
 * The top view's marker is one ellipse moved with ``setPos`` (a scatter item rebuilt its spot
   table for one point in every frame).
 """
@@ -31,6 +33,8 @@ from ui.models.ring_buffer import RingBuffer
 
 if TYPE_CHECKING:  # imported when the first plot is built (the window's first paint goes first)
     import pyqtgraph as pg
+
+    from ui.panels.monitor_curve import BoundedCurve
 
 __all__ = [
     "AXIS_TICK_POINTS",
@@ -89,6 +93,7 @@ _PLOT_COLORS = {
     "C": "#1f77b4",
 }
 _TRACE_COLOR = "#6a1b9a"
+_PLOT_NAMES = {"xyz": CARTESIAN[:3], "abc": CARTESIAN[3:]}
 
 
 def unwrap_degrees(previous_raw: float, previous_unwrapped: float, raw: float) -> float:
@@ -172,6 +177,8 @@ class MonitorPlots:
     def __init__(self, parent: QWidget) -> None:
         import pyqtgraph as pg
 
+        from ui.panels.monitor_curve import BoundedCurve
+
         self.xyz_plot = pg.PlotWidget(parent)
         self.abc_plot = pg.PlotWidget(parent)
         self.trace_plot = pg.PlotWidget(parent)
@@ -182,14 +189,14 @@ class MonitorPlots:
         for plot in (self.xyz_plot, self.abc_plot):
             # the plots set their ranges (paint_history): no pan or zoom to fight them
             plot.setMouseEnabled(x=False, y=False)
-        self.curves: dict[str, pg.PlotCurveItem] = {}
+        self.curves: dict[str, BoundedCurve] = {}
         for name in CARTESIAN:
             plot = self.xyz_plot if name in "XYZ" else self.abc_plot
             if name in ("X", "A"):
                 add_legend(plot)
             # 1 px: the raster engine's fast path; a 2 px pen is stroked as polygons and cost
             # about half of the monitor's frame time (benchmarks/streaming.py, plots at 25 Hz)
-            curve = pg.PlotCurveItem(pen=pg.mkPen(_PLOT_COLORS[name], width=CURVE_WIDTH), name=name)
+            curve = BoundedCurve(pen=pg.mkPen(_PLOT_COLORS[name], width=CURVE_WIDTH), name=name)
             plot.addItem(curve)
             self.curves[name] = curve
 
@@ -198,7 +205,7 @@ class MonitorPlots:
         self.trace_plot.getPlotItem().layout.setContentsMargins(2, 2, 16, 2)
         # 1 px too: a 2 px trace was drawn as line segments, and a trace of a program running for
         # a minute (thousands of points) cost more than both time plots together
-        self.trace_curve = pg.PlotCurveItem(pen=pg.mkPen(_TRACE_COLOR, width=CURVE_WIDTH))
+        self.trace_curve = BoundedCurve(pen=pg.mkPen(_TRACE_COLOR, width=CURVE_WIDTH))
         self.trace_plot.addItem(self.trace_curve)
         # "now" on the top view: a fixed-size dot moved with setPos (no data, no bounds of its own)
         half = MARKER_SIZE / 2.0
@@ -261,6 +268,8 @@ class MonitorPlots:
             if wanted != shown:
                 self._y_ranges[key] = wanted
                 plot.setYRange(*wanted, padding=0)
+            for name in _PLOT_NAMES[key]:  # every point of the curve is in the range its plot shows
+                self.curves[name].set_bounds(-window_s, 0.0, *wanted)
 
     def _set_window(self, window_s: float) -> None:
         if window_s != self._window_s:
@@ -274,10 +283,15 @@ class MonitorPlots:
             self.trace_marker.setVisible(False)
             return
         xs, ys = trace.view(0, n), trace.view(1, n)
+        x0, x1, y0, y1 = float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max())
         self.trace_curve.setData(xs, ys, skipFiniteCheck=True)
+        # the view shows TRACE_PADDING of its span beyond the trace: half of that is a margin
+        # for the pen that stays inside the view
+        margin = max(x1 - x0, y1 - y0, TRACE_MIN_SPAN_MM) * TRACE_PADDING / 2.0
+        self.trace_curve.set_bounds(x0 - margin, x1 + margin, y0 - margin, y1 + margin)
         self.trace_marker.setPos(float(xs[-1]), float(ys[-1]))
         self.trace_marker.setVisible(True)
-        self._fit_trace(float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
+        self._fit_trace(x0, x1, y0, y1)
 
     def _fit_trace(self, x0: float, x1: float, y0: float, y1: float) -> None:
         """Show the whole trace, at least TRACE_MIN_SPAN_MM wide and tall, centred; the view is
