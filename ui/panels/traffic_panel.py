@@ -50,6 +50,7 @@ from ui.models.traffic_model import (
     TrafficModel,
 )
 from ui.palette import COLOR_NEUTRAL
+from ui.widgets.live_label import LiveLabel
 from ui.widgets_common import (
     atomic_write_text,
     export_with_dialog,
@@ -108,7 +109,9 @@ class TrafficPanel(QWidget):
         self.clear_button.clicked.connect(self.clear)
         self.export_button = QPushButton(self)
         self.export_button.clicked.connect(self._export_dialog)
-        self.count_label = QLabel(self)
+        # its text changes with every flush: a LiveLabel repaints itself only (no re-layout of the
+        # dock and the window above it)
+        self.count_label = LiveLabel(parent=self)
         self.count_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
 
         self.view = QTableView(self)
@@ -157,6 +160,7 @@ class TrafficPanel(QWidget):
         self.clear_button.setText(self.tr("Clear"))
         self.export_button.setText(self.tr("Export…"))
         self.model.retranslate()
+        self.count_label.fit_texts([self.tr("{n} frames").format(n=max(self.model.max_rows, 99_999))])
         self._update_count()
 
     def changeEvent(self, event: QEvent) -> None:
