@@ -33,7 +33,7 @@ class WindowStatusBar(QObject):
         self._project_title = ""
         self.project_label = QLabel(bar)
         self.link_label = QLabel(bar)
-        self.rtt_label = LiveLabel(parent=bar)  # twice a second: repaints itself, no re-layout
+        self.rtt_label = LiveLabel(parent=bar, opaque=True)  # twice a second: repaints itself only
         self.monitor_only_label = QLabel(bar)
         self.monitor_only_label.setStyleSheet("color: #c62828; font-weight: bold;")
         for label in (self.monitor_only_label, self.project_label, self.rtt_label, self.link_label):

@@ -8,7 +8,9 @@ each) and repaints what it covers. Qt stops that walk at a widget whose size is 
 (``samples``) or has shown since. A new text repaints the label only; a wider one than ever
 before grows it once (one re-layout), and it never shrinks, so nothing beside it moves back
 and forth. Its style sheet is set only when it changes (``set_style``): setting one re-polishes
-the widget even when the text is the same.
+the widget even when the text is the same. ``opaque``: the label fills its own background (the
+window colour), so its repaint does not repaint the widgets under it (a dock's title bar, the
+status bar); only where the parent's background is the plain window colour.
 """
 
 from __future__ import annotations
@@ -24,9 +26,17 @@ __all__ = ["LiveLabel"]
 class LiveLabel(QLabel):
     """A ``QLabel`` of fixed size that grows to fit a wider text and never shrinks."""
 
-    def __init__(self, text: str = "", parent: QWidget | None = None, *, samples: Iterable[str] = ()) -> None:
+    def __init__(
+        self,
+        text: str = "",
+        parent: QWidget | None = None,
+        *,
+        samples: Iterable[str] = (),
+        opaque: bool = False,
+    ) -> None:
         super().__init__(text, parent)
         self._style = ""
+        self.setAutoFillBackground(opaque)
         self.setFixedSize(self.sizeHint())
         self.fit_texts(samples)
 
