@@ -372,11 +372,13 @@ class MonitorPanel(QWidget):
     def _draw(self, *, plots: bool) -> None:
         if not self._plots_built:
             self._build_plots()
+        if plots and not self._paused:
+            self._draw_plots()
         if self._readouts_dirty:
             self._readouts_dirty = False
             self._paint_readouts()
-        if self._paused or not plots:
-            return
+
+    def _draw_plots(self) -> None:
         now = self._relative_now()
         painted = False
         if self._history.total != self._painted_history or now is not None:
