@@ -2,7 +2,7 @@
 
 Poll rate and paint rate are separate clocks: ``on_pose`` (called at the poll rate, 50–200 Hz)
 only stores the sample in preallocated ring buffers; the frames of the application's
-:class:`~ui.display_clock.DisplayClock` (≤ 25 Hz, shared with the pose strip and the traffic
+:class:`~ui.display_clock.DisplayClock` (≤ 20 Hz, shared with the pose strip and the traffic
 table so that they repaint together), taken only while the panel is visible, update the
 readouts, and every ``PLOT_INTERVAL_MS`` (every other frame) hand contiguous buffer views to
 the curves (:mod:`ui.panels.monitor_plots`).
@@ -64,7 +64,7 @@ __all__ = [
 #: Attributes that exist once the plots are built (asking for one builds them).
 _PLOT_ATTRIBUTES = frozenset({"xyz_plot", "abc_plot", "trace_plot", "curves", "trace_curve", "trace_marker"})
 
-PAINT_INTERVAL_MS = DISPLAY_INTERVAL_MS  # the display clock's frame period (<= 25 Hz): the readouts
+PAINT_INTERVAL_MS = DISPLAY_INTERVAL_MS  # the display clock's frame period (<= 20 Hz): the readouts
 # A plot frame is due this long after the last one: PLOT_INTERVAL_MS, less half a display frame
 # (frames come a millisecond early or late; every other one must do).
 _PLOT_DUE_S = (PLOT_INTERVAL_MS - DISPLAY_INTERVAL_MS / 2) / 1000.0

@@ -69,10 +69,10 @@ CURVE_WIDTH = 1  # px, the time curves and the top view's trace (see MonitorPlot
 PAINT_MARGIN = 512
 TRACE_MIN_SPAN_MM = 50.0  # the top view never zooms in closer than this (readable labels)
 TRACE_PADDING = 0.08  # fraction of the span around the trace
-# The plots' frame period: every other display frame (12.5 Hz). The readouts above them show the
-# newest pose at the display rate; a curve that moves 12 times a second still reads as live, and
+# The plots' frame period: every other display frame (10 Hz). The readouts above them show the
+# newest pose at the display rate; a curve that moves 10 times a second still reads as live, and
 # the plots were most of the monitor's painting (benchmarks/streaming.py).
-PLOT_INTERVAL_MS = 80
+PLOT_INTERVAL_MS = 100
 # Vertical ranges (see fit_range): padding around the values, the smallest span shown (a still
 # arm's flat line, not its noise magnified), and how little of the range the values may use
 # before it is narrowed again.
