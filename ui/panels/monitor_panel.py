@@ -101,7 +101,7 @@ class MonitorPanel(QWidget):
         self._readouts_dirty = False
         self._painted_history = -1  # RingBuffer.total at the last paint (-1: force)
         self._painted_trace = -1
-        self._plots_painted_at = -math.inf  # time.monotonic() of the last plot frame
+        self._plots_painted_at = -math.inf  # self._now() of the last plot frame
         self._window_s = float(DEFAULT_WINDOW_S)
         self._paused = False
         # A B C are plotted unwrapped (a turn through +-180 draws on continuously); the readouts
@@ -362,7 +362,7 @@ class MonitorPanel(QWidget):
                 self._readouts_dirty = False
                 self._paint_readouts()
             return
-        self._draw(plots=time.monotonic() - self._plots_painted_at >= _PLOT_DUE_S)
+        self._draw(plots=self._now() - self._plots_painted_at >= _PLOT_DUE_S)
 
     @Slot()
     def refresh(self) -> None:
@@ -390,7 +390,7 @@ class MonitorPanel(QWidget):
             self._plots.paint_trace(self._trace)
             painted = True
         if painted:
-            self._plots_painted_at = time.monotonic()
+            self._plots_painted_at = self._now()
 
     def _relative_now(self) -> float | None:
         """The display clock's "now" on the plots' time axis; None when the axis does not keep

@@ -240,6 +240,7 @@ class StatusPanel(QWidget):
         rows["clock"].setText(self.tr("Clock:"))
         rows["drift"].setText(self.tr("Drift:"))
         self.rtt_label.setToolTip(self.tr("Round-trip time of the last poll"))
+        self.rtt_label.fit_texts([self.tr("{ms} ms").format(ms="9999.9")])
         for bit in ALARM_BITS:
             lamp = self.alarm_lamps[int(bit)]
             lamp.setText(_protocol_tr(ALARM_TEXT[bit]))
