@@ -9,6 +9,12 @@ with the load average. ``--busy`` adds the busy-neighbour variant after each run
 thread is not profiled: cProfile follows the thread that enables it), and ``--variants``
 measures the stream again with the monitor hidden and with the traffic inspector hidden.
 
+``--warm SECONDS`` streams that long before measuring (default 1 s): with 31 s the monitor's
+30 s plots and its X–Y trace are full, as for an operator watching a program run (the first
+seconds draw short curves). ``--events`` counts the Qt events the GUI thread handles per
+second over the windows, by type, and the paints and re-layouts per widget class: the
+re-layouts of the main window and the paints of widgets no frame changed are what to look for.
+
 ``--synthetic`` feeds the same window from a 100 Hz timer in the GUI thread instead (the pose
 moving on the simulator's square, a status, a good poll and the four traffic frames per poll,
 the way the link delivers them), with no worker and no simulator: the GUI thread's CPU time per
@@ -16,12 +22,14 @@ poll, scaled to 100 polls a second, without the closed loop of a real link (on a
 machine a starved GUI gets fewer polls and the link flaps to "not answering").
 
 Usage: python -m benchmarks.streaming [--seconds 4] [--repeat 3] [--busy] [--variants]
-                                      [--synthetic] [--profile gui.prof] [--top 25]
+                                      [--warm 1] [--events] [--synthetic]
+                                      [--profile gui.prof] [--top 25]
 """
 
 from __future__ import annotations
 
 import argparse
+import collections
 import cProfile
 import gc
 import io
@@ -40,7 +48,7 @@ from typing import Any
 
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
-from PySide6.QtCore import QEvent, QEventLoop, Qt, QTimer
+from PySide6.QtCore import QEvent, QEventLoop, QObject, Qt, QTimer
 from PySide6.QtWidgets import QApplication
 
 from app.link.client import ConnectionSettings
@@ -78,8 +86,38 @@ _KEYS = (
 )
 
 
+class EventCounter(QObject):
+    """Counts the events the application delivers (an application-wide filter): per type, and
+    the paints and layout requests per receiving class. Installed only while counting."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.types: collections.Counter[str] = collections.Counter()
+        self.paints: collections.Counter[str] = collections.Counter()
+        self.layouts: collections.Counter[str] = collections.Counter()
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        kind = event.type()
+        self.types[kind.name] += 1
+        if kind == QEvent.Type.Paint:
+            self.paints[type(watched).__name__] += 1
+        elif kind == QEvent.Type.LayoutRequest:
+            self.layouts[type(watched).__name__] += 1
+        return False
+
+    def per_second(self, seconds: float, top: int = 12) -> dict[str, dict[str, float]]:
+        def rates(counter: collections.Counter[str]) -> dict[str, float]:
+            return {k: round(v / seconds, 1) for k, v in counter.most_common(top)}
+
+        return {
+            "events_per_s": rates(self.types),
+            "paints_per_s": rates(self.paints),
+            "layout_requests_per_s": rates(self.layouts),
+        }
+
+
 @contextmanager
-def streaming_window(sim: RemoteSim) -> Iterator[tuple[MainWindow, _Counters]]:
+def streaming_window(sim: RemoteSim, warm_s: float = 1.0) -> Iterator[tuple[MainWindow, _Counters]]:
     """The main window as :func:`benchmarks.gui.bench_window` shows it, connected, program running."""
     _qapp()
     tmp = tempfile.TemporaryDirectory(prefix="teachpad-bench-")
@@ -100,7 +138,7 @@ def streaming_window(sim: RemoteSim) -> Iterator[tuple[MainWindow, _Counters]]:
         link.run_program(STREAM_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
         if not _wait_until(lambda: _motion_started(sim, start)):
             raise RuntimeError("the simulator did not start the streaming program")
-        _run_for(1.0)  # the plots' first paints and the stream's start are not the steady state
+        _run_for(warm_s)  # the plots' first paints and the stream's start are not the steady state
         yield window, counters
         link.stop()
         _wait_until(lambda: not sim.busy())
@@ -120,13 +158,19 @@ def _stream(
     counters: _Counters,
     seconds: float,
     profiler: cProfile.Profile | None,
+    events: EventCounter | None = None,
 ) -> dict[str, Any]:
     poses0, requests0 = counters.poses, sim.requests()
+    app = QApplication.instance()
+    if events is not None and app is not None:
+        app.installEventFilter(events)
     if profiler is not None:
         profiler.enable()
     out = measure_stalls(seconds)
     if profiler is not None:
         profiler.disable()
+    if events is not None and app is not None:
+        app.removeEventFilter(events)
     out["polls_per_s"] = (sim.requests() - requests0) / 2 / out["seconds"]
     out["poses_per_s"] = (counters.poses - poses0) / out["seconds"]
     # A loaded machine delivers fewer polls (and so less work) than asked: the same CPU time per
@@ -136,13 +180,22 @@ def _stream(
 
 
 def run_once(
-    seconds: float, *, busy: bool, variants: bool, profiler: cProfile.Profile | None
+    seconds: float,
+    *,
+    busy: bool,
+    variants: bool,
+    profiler: cProfile.Profile | None,
+    warm_s: float = 1.0,
+    count_events: bool = False,
 ) -> dict[str, Any]:
     sim = RemoteSim()
     try:
-        with streaming_window(sim) as (window, counters):
+        with streaming_window(sim, warm_s) as (window, counters):
             out: dict[str, Any] = {"load_avg_1m": os.getloadavg()[0]}
-            out["streaming"] = _stream(sim, counters, seconds, profiler)
+            events = EventCounter() if count_events else None
+            out["streaming"] = _stream(sim, counters, seconds, profiler, events)
+            if events is not None:
+                out["events"] = events.per_second(seconds)
             out["streaming"]["monitor_shown"] = not window.monitor_panel.visibleRegion().isEmpty()
             out["streaming"]["traffic_shown"] = not window.traffic_panel.visibleRegion().isEmpty()
             if busy:
@@ -246,6 +299,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--busy", action="store_true", help="also with a busy neighbour on the other core")
     parser.add_argument("--variants", action="store_true", help="also with the monitor / the traffic hidden")
     parser.add_argument(
+        "--warm", type=float, default=1.0, help="seconds of streaming before measuring (31: full plots)"
+    )
+    parser.add_argument("--events", action="store_true", help="count Qt events per second (streaming window)")
+    parser.add_argument(
         "--synthetic",
         action="store_true",
         help="feed the window from a GUI-thread timer (no worker, no simulator)",
@@ -257,13 +314,22 @@ def main(argv: list[str] | None = None) -> int:
     runs = [
         run_synthetic(args.seconds, profiler)
         if args.synthetic
-        else run_once(args.seconds, busy=args.busy, variants=args.variants, profiler=profiler)
+        else run_once(
+            args.seconds,
+            busy=args.busy,
+            variants=args.variants,
+            profiler=profiler,
+            warm_s=args.warm,
+            count_events=args.events,
+        )
         for _ in range(args.repeat)
     ]
     medians: dict[str, Any] = {}
     for part in runs[0]:
         if part == "load_avg_1m":
             medians[part] = statistics.median(r[part] for r in runs)
+            continue
+        if part == "events":  # counts per run, not medians
             continue
         medians[part] = {
             k: round(statistics.median(r[part][k] for r in runs), 2)

@@ -14,6 +14,7 @@ from PySide6.QtWidgets import QLabel, QStatusBar
 from app.link.state import RobotState
 from app.link.types import ConnectionState
 from ui.messages import connection_text
+from ui.widgets.live_label import LiveLabel
 from ui.widgets_common import connection_display
 
 __all__ = ["MESSAGE_MS", "WindowStatusBar"]
@@ -32,7 +33,7 @@ class WindowStatusBar(QObject):
         self._project_title = ""
         self.project_label = QLabel(bar)
         self.link_label = QLabel(bar)
-        self.rtt_label = QLabel(bar)
+        self.rtt_label = LiveLabel(parent=bar, opaque=True)  # twice a second: repaints itself only
         self.monitor_only_label = QLabel(bar)
         self.monitor_only_label.setStyleSheet("color: #c62828; font-weight: bold;")
         for label in (self.monitor_only_label, self.project_label, self.rtt_label, self.link_label):
@@ -50,7 +51,7 @@ class WindowStatusBar(QObject):
     def retranslate(self) -> None:
         # room for the widest RTT from the start: the status bar does not shift when one arrives
         widest_rtt = QCoreApplication.translate("MainWindow", "RTT {ms} ms").format(ms="9999.9")
-        self.rtt_label.setMinimumWidth(self.rtt_label.fontMetrics().horizontalAdvance(widest_rtt) + 8)
+        self.rtt_label.fit_texts([widest_rtt + "  "])
         if self._state is not None and self._state.rtt is not None:
             self._show_rtt(self._state.rtt)
         self.show_project(self._project_title, self.project_label.toolTip())

@@ -96,7 +96,9 @@ def test_curves_get_data_after_the_paint_timer_fires(qtbot: Any, shown: MonitorP
     curve = shown.curves["Y"]
     qtbot.waitUntil(lambda: curve.xData is not None and len(curve.xData) == 50, timeout=2000)
     assert curve.yData[-1] == 98.0
-    assert curve.xData[0] == 0.0  # time since the first sample
+    # seconds before the newest sample: 0 at the right edge, the first one 49 x 20 ms earlier
+    assert curve.xData[-1] == 0.0
+    assert curve.xData[0] == pytest.approx(-0.98)
     # The curve holds a view of the ring buffer, not a copy.
     assert np.shares_memory(curve.yData, shown._history._buf)
     qtbot.waitUntil(
@@ -150,9 +152,10 @@ def test_window_limits_the_plotted_time_span(panel: MonitorPanel) -> None:
     assert panel.window_combo.currentData() == 10
     panel.refresh()
     xs = panel.curves["X"].xData
-    assert xs[-1] == pytest.approx(99.9)
-    assert xs[0] >= 99.9 - 10 - 1e-9
+    assert xs[-1] == 0.0  # the newest sample, at "now"
+    assert xs[0] >= -10 - 1e-9
     assert len(xs) == 101
+    assert panel.xyz_plot.getViewBox().viewRange()[0] == pytest.approx([-10.0, 0.0])
     panel.window_combo.setCurrentIndex(panel.window_combo.findData(60))
     assert panel.window_seconds() == 60
     panel.refresh()

@@ -2,14 +2,16 @@
 
 Poll rate and paint rate are separate clocks: ``on_pose`` (called at the poll rate, 50–200 Hz)
 only stores the sample in preallocated ring buffers; the frames of the application's
-:class:`~ui.display_clock.DisplayClock` (≤ 25 Hz, shared with the pose strip and the traffic
+:class:`~ui.display_clock.DisplayClock` (≤ 20 Hz, shared with the pose strip and the traffic
 table so that they repaint together), taken only while the panel is visible, update the
-readouts and hand contiguous buffer views to the curves (:mod:`ui.panels.monitor_plots`).
+readouts, and every ``PLOT_INTERVAL_MS`` (every other frame) hand contiguous buffer views to
+the curves (:mod:`ui.panels.monitor_plots`).
 
 Plots keep time: the pose only changes (and ``poseChanged`` only fires) while the arm moves, so
 each frame also appends the last pose at the current time while the values are fresh,
-and the time axis ends at "now": it scrolls at a steady rate when the arm is still, and a
-silent link leaves a visible gap instead of a flat line that looks live. Hidden, the panel takes
+and the time axis ends at "now" (it counts seconds before now): the curves move left at a
+steady rate when the arm is still, and a silent link leaves a visible gap at the right instead
+of a flat line that looks live. Hidden, the panel takes
 no frames: nothing is appended, formatted or painted. Stale values (``RobotState.fresh`` False)
 grey the readouts.
 The top view fits its trace (at least ``TRACE_MIN_SPAN_MM`` wide, so a standing arm's single
@@ -42,6 +44,7 @@ from ui.panels.monitor_plots import CARTESIAN as _CARTESIAN
 from ui.panels.monitor_plots import (
     MAX_PLOT_POINTS,
     PAINT_MARGIN,
+    PLOT_INTERVAL_MS,
     TRACE_MIN_SPAN_MM,
     MonitorPlots,
     unwrap_degrees,
@@ -49,12 +52,22 @@ from ui.panels.monitor_plots import (
 from ui.panels.monitor_readouts import BIG_POINTS_MAX, MIN_WIDTH, ReadoutBoxes, readout_scale
 from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
 
-__all__ = ["MAX_PLOT_POINTS", "PAINT_INTERVAL_MS", "PAINT_MARGIN", "TRACE_MIN_SPAN_MM", "MonitorPanel"]
+__all__ = [
+    "MAX_PLOT_POINTS",
+    "PAINT_INTERVAL_MS",
+    "PAINT_MARGIN",
+    "PLOT_INTERVAL_MS",
+    "TRACE_MIN_SPAN_MM",
+    "MonitorPanel",
+]
 
 #: Attributes that exist once the plots are built (asking for one builds them).
 _PLOT_ATTRIBUTES = frozenset({"xyz_plot", "abc_plot", "trace_plot", "curves", "trace_curve", "trace_marker"})
 
-PAINT_INTERVAL_MS = DISPLAY_INTERVAL_MS  # the display clock's frame period (<= 25 Hz)
+PAINT_INTERVAL_MS = DISPLAY_INTERVAL_MS  # the display clock's frame period (<= 20 Hz): the readouts
+# A plot frame is due this long after the last one: PLOT_INTERVAL_MS, less half a display frame
+# (frames come a millisecond early or late; every other one must do).
+_PLOT_DUE_S = (PLOT_INTERVAL_MS - DISPLAY_INTERVAL_MS / 2) / 1000.0
 WINDOW_CHOICES_S: tuple[int, ...] = (10, 30, 60)
 DEFAULT_WINDOW_S = 30
 HISTORY_CAPACITY = 16384  # samples: the longest window at up to ~270 Hz
@@ -88,6 +101,7 @@ class MonitorPanel(QWidget):
         self._readouts_dirty = False
         self._painted_history = -1  # RingBuffer.total at the last paint (-1: force)
         self._painted_trace = -1
+        self._plots_painted_at = -math.inf  # self._now() of the last plot frame
         self._window_s = float(DEFAULT_WINDOW_S)
         self._paused = False
         # A B C are plotted unwrapped (a turn through +-180 draws on continuously); the readouts
@@ -284,6 +298,8 @@ class MonitorPanel(QWidget):
         self._readouts_dirty = True
         self._painted_history = -1
         self._painted_trace = -1
+        if self._plots_built:
+            self._plots.forget_ranges()  # the next samples may be anywhere
 
     @Slot(bool)
     def set_paused(self, paused: bool) -> None:
@@ -332,8 +348,9 @@ class MonitorPanel(QWidget):
     # --- painting ---------------------------------------------------------------------
     @Slot()
     def _tick(self) -> None:
-        """A display frame: hold the last fresh pose at "now", paint, and ask for the next frame
-        while the time axis has to keep time."""
+        """A display frame: hold the last fresh pose at "now", draw the readouts that changed and,
+        every ``PLOT_INTERVAL_MS``, the plots; ask for the next frame while the time axis has to
+        keep time."""
         row, now = self._latest_row, self._relative_now()
         if row is not None and now is not None and self._fresh and now > row[0]:
             self._history.append((now, *row[1:]))
@@ -345,25 +362,35 @@ class MonitorPanel(QWidget):
                 self._readouts_dirty = False
                 self._paint_readouts()
             return
-        self.refresh()
+        self._draw(plots=self._now() - self._plots_painted_at >= _PLOT_DUE_S)
 
     @Slot()
     def refresh(self) -> None:
-        """One frame: readouts, then plots if new samples arrived (called by the display clock)."""
+        """Draw now: readouts, then the plots if new samples arrived (or the time axis moved)."""
+        self._draw(plots=True)
+
+    def _draw(self, *, plots: bool) -> None:
         if not self._plots_built:
             self._build_plots()
+        if plots and not self._paused:
+            self._draw_plots()
         if self._readouts_dirty:
             self._readouts_dirty = False
             self._paint_readouts()
-        if self._paused:
-            return
+
+    def _draw_plots(self) -> None:
         now = self._relative_now()
+        painted = False
         if self._history.total != self._painted_history or now is not None:
             self._painted_history = self._history.total
             self._plots.paint_history(self._history, self._window_s, now)
+            painted = True
         if self._trace.total != self._painted_trace:
             self._painted_trace = self._trace.total
             self._plots.paint_trace(self._trace)
+            painted = True
+        if painted:
+            self._plots_painted_at = self._now()
 
     def _relative_now(self) -> float | None:
         """The display clock's "now" on the plots' time axis; None when the axis does not keep

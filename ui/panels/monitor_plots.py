@@ -3,15 +3,30 @@
 :class:`MonitorPlots` builds the pyqtgraph widgets (pyqtgraph is imported only then, after the
 window's first paint) and draws from the monitor's ring buffers: contiguous views, no copies,
 a stride when a window holds more samples than the plot has pixels to show them.
+
+What a plot frame costs is mostly what changes in it (``python -m benchmarks.streaming``), so
+the frame keeps the rest still:
+
+* The time axis is "seconds ago" (``-window .. 0``): it is set once per window, and its tick
+  labels and grid do not move; only the curves do. A scrolling axis regenerated its labels,
+  re-laid out both plots and recomputed every curve's bounds in every frame.
+* The vertical ranges are set by the plots, not by pyqtgraph's auto-range (which scanned every
+  curve in every frame): from the window's extremes, padded and snapped to round values, and
+  only set again when a value leaves the range or the values use less than a third of it.
+* The curves are told their bounds (:class:`~ui.panels.monitor_curve.BoundedCurve`: the range
+  their plot shows) instead of scanning their data for them many times a frame.
+* The top view's marker is one ellipse moved with ``setPos`` (a scatter item rebuilt its spot
+  table for one point in every frame).
 """
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 from PySide6.QtCore import Qt
-from PySide6.QtGui import QFont
-from PySide6.QtWidgets import QSizePolicy, QSplitter, QWidget
+from PySide6.QtGui import QBrush, QColor, QFont, QPen
+from PySide6.QtWidgets import QGraphicsEllipseItem, QGraphicsItem, QSizePolicy, QSplitter, QWidget
 
 from ui.models.ring_buffer import RingBuffer
 
@@ -23,6 +38,8 @@ else:  # numpy is imported by its first use, not with this module (app/lazy_nump
 if TYPE_CHECKING:  # imported when the first plot is built (the window's first paint goes first)
     import pyqtgraph as pg
 
+    from ui.panels.monitor_curve import BoundedCurve
+
 __all__ = [
     "AXIS_TICK_POINTS",
     "CARTESIAN",
@@ -31,8 +48,10 @@ __all__ = [
     "MAX_PLOT_POINTS",
     "MIN_PLOT_POINTS",
     "PAINT_MARGIN",
+    "PLOT_INTERVAL_MS",
     "MonitorPlots",
     "add_legend",
+    "fit_range",
     "style_plot",
     "unwrap_degrees",
 ]
@@ -48,12 +67,23 @@ PLOT_MIN_HEIGHT = 80
 MAX_PLOT_POINTS = 2500
 MIN_PLOT_POINTS = 1000
 POINTS_PER_PIXEL = 2
-CURVE_WIDTH = 1  # px, the time curves (see MonitorPlots)
+CURVE_WIDTH = 1  # px, the time curves and the top view's trace (see MonitorPlots)
 # Curves keep a view of the ring buffer until the scene repaints; never hand them the whole
 # buffer, so samples arriving before that repaint cannot overwrite what they show.
 PAINT_MARGIN = 512
 TRACE_MIN_SPAN_MM = 50.0  # the top view never zooms in closer than this (readable labels)
 TRACE_PADDING = 0.08  # fraction of the span around the trace
+# The plots' frame period: every other display frame (10 Hz). The readouts above them show the
+# newest pose at the display rate; a curve that moves 10 times a second still reads as live, and
+# the plots were most of the monitor's painting (benchmarks/streaming.py).
+PLOT_INTERVAL_MS = 100
+# Vertical ranges (see fit_range): padding around the values, the smallest span shown (a still
+# arm's flat line, not its noise magnified), and how little of the range the values may use
+# before it is narrowed again.
+RANGE_PADDING = 0.1
+RANGE_MIN_SPAN = 2.0  # mm on the position plot, degrees on the orientation plot
+RANGE_MIN_USE = 1.0 / 3.0
+MARKER_SIZE = 11  # px, the top view's "now" marker
 
 # History channels: time, then X Y Z and the unwrapped A B C.
 T, X = 0, 1
@@ -67,6 +97,7 @@ _PLOT_COLORS = {
     "C": "#1f77b4",
 }
 _TRACE_COLOR = "#6a1b9a"
+_PLOT_NAMES = {"xyz": CARTESIAN[:3], "abc": CARTESIAN[3:]}
 
 
 def unwrap_degrees(previous_raw: float, previous_unwrapped: float, raw: float) -> float:
@@ -74,6 +105,32 @@ def unwrap_degrees(previous_raw: float, previous_unwrapped: float, raw: float) -
     round (so -179 -> +179 is a 2 degree step, not 358), added to ``previous_unwrapped``."""
     step = (raw - previous_raw + 180.0) % 360.0 - 180.0
     return previous_unwrapped + step
+
+
+def _nice_step(raw: float) -> float:
+    """The round step (1, 2 or 5 times a power of ten) at or above ``raw`` (> 0)."""
+    power = 10.0 ** math.floor(math.log10(raw))
+    for factor in (1.0, 2.0, 5.0, 10.0):
+        if raw <= factor * power:
+            return factor * power
+    return 10.0 * power
+
+
+def fit_range(
+    current: tuple[float, float] | None, lo: float, hi: float, min_span: float = RANGE_MIN_SPAN
+) -> tuple[float, float]:
+    """The vertical range to show values between ``lo`` and ``hi``: ``current`` while they stay
+    inside it and use at least ``RANGE_MIN_USE`` of it (the axis keeps still), else a new one,
+    padded by ``RANGE_PADDING`` and snapped outwards to round values."""
+    if current is not None:
+        c_lo, c_hi = current
+        if c_lo <= lo and hi <= c_hi and max(hi - lo, min_span) >= RANGE_MIN_USE * (c_hi - c_lo):
+            return current
+    middle, span = (lo + hi) / 2.0, max(hi - lo, min_span)
+    lo, hi = middle - span / 2.0, middle + span / 2.0
+    pad = span * RANGE_PADDING
+    step = _nice_step((span + 2 * pad) / 8.0)
+    return math.floor((lo - pad) / step) * step, math.ceil((hi + pad) / step) * step
 
 
 def add_legend(plot: pg.PlotWidget) -> None:
@@ -124,6 +181,8 @@ class MonitorPlots:
     def __init__(self, parent: QWidget) -> None:
         import pyqtgraph as pg
 
+        from ui.panels.monitor_curve import BoundedCurve
+
         self.xyz_plot = pg.PlotWidget(parent)
         self.abc_plot = pg.PlotWidget(parent)
         self.trace_plot = pg.PlotWidget(parent)
@@ -131,26 +190,39 @@ class MonitorPlots:
             style_plot(plot)
         self.abc_plot.setXLink(self.xyz_plot)
         self.xyz_plot.getPlotItem().hideAxis("bottom")
-        self.curves: dict[str, pg.PlotCurveItem] = {}
+        for plot in (self.xyz_plot, self.abc_plot):
+            # the plots set their ranges (paint_history): no pan or zoom to fight them
+            plot.setMouseEnabled(x=False, y=False)
+        self.curves: dict[str, BoundedCurve] = {}
         for name in CARTESIAN:
             plot = self.xyz_plot if name in "XYZ" else self.abc_plot
             if name in ("X", "A"):
                 add_legend(plot)
             # 1 px: the raster engine's fast path; a 2 px pen is stroked as polygons and cost
             # about half of the monitor's frame time (benchmarks/streaming.py, plots at 25 Hz)
-            curve = pg.PlotCurveItem(pen=pg.mkPen(_PLOT_COLORS[name], width=CURVE_WIDTH), name=name)
+            curve = BoundedCurve(pen=pg.mkPen(_PLOT_COLORS[name], width=CURVE_WIDTH), name=name)
             plot.addItem(curve)
             self.curves[name] = curve
 
         self.trace_plot.setAspectLocked(True)
         # room on the right for the last bottom tick label (else clipped at the plot's edge)
         self.trace_plot.getPlotItem().layout.setContentsMargins(2, 2, 16, 2)
-        self.trace_curve = pg.PlotCurveItem(pen=pg.mkPen(_TRACE_COLOR, width=2))
+        # 1 px too: a 2 px trace was drawn as line segments, and a trace of a program running for
+        # a minute (thousands of points) cost more than both time plots together
+        self.trace_curve = BoundedCurve(pen=pg.mkPen(_TRACE_COLOR, width=CURVE_WIDTH))
         self.trace_plot.addItem(self.trace_curve)
-        self.trace_marker = pg.ScatterPlotItem(size=11, brush=pg.mkBrush("#ff6f00"), pen=pg.mkPen("#263238"))
-        self.trace_plot.addItem(self.trace_marker)
+        # "now" on the top view: a fixed-size dot moved with setPos (no data, no bounds of its own)
+        half = MARKER_SIZE / 2.0
+        self.trace_marker = QGraphicsEllipseItem(-half, -half, MARKER_SIZE, MARKER_SIZE)
+        self.trace_marker.setBrush(QBrush(QColor("#ff6f00")))
+        self.trace_marker.setPen(QPen(QColor("#263238")))
+        self.trace_marker.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations)
+        self.trace_marker.setZValue(10)
+        self.trace_marker.setVisible(False)
+        self.trace_plot.getPlotItem().getViewBox().addItem(self.trace_marker, ignoreBounds=True)
         self._trace_range: tuple[float, float, float] | None = None  # centre x, y and half span set last
-        self._x_range: tuple[float, float] | None = None
+        self._window_s: float | None = None  # the time axis' span set last
+        self._y_ranges: dict[str, tuple[float, float]] = {}  # "xyz" / "abc" -> range set last
 
         time_plots = QSplitter(Qt.Orientation.Vertical, parent)
         time_plots.addWidget(self.xyz_plot)
@@ -171,8 +243,9 @@ class MonitorPlots:
         return min(MAX_PLOT_POINTS, max(MIN_PLOT_POINTS, POINTS_PER_PIXEL * width))
 
     def paint_history(self, history: RingBuffer, window_s: float, now: float | None) -> None:
-        """The time plots: the last ``window_s`` seconds, ending at ``now`` (relative time) or at
-        the newest sample, whichever is later."""
+        """The time plots: the last ``window_s`` seconds before ``now`` (relative time) or the
+        newest sample, whichever is later, on a time axis of seconds before that end."""
+        self._set_window(window_s)
         n = min(len(history), history.capacity - PAINT_MARGIN)
         if n <= 0:
             for curve in self.curves.values():
@@ -182,26 +255,47 @@ class MonitorPlots:
         t_end = float(t[-1]) if now is None else max(float(t[-1]), now)
         start = int(np.searchsorted(t, t_end - window_s, side="left"))
         count = n - start
+        if count <= 0:  # nothing within the window (a long silence): empty plots, ranges kept
+            for curve in self.curves.values():
+                curve.setData([], [])
+            return
         step = max(1, -(-count // self.max_points()))
         first = start + (count - 1) % step  # keep the newest sample on the stride
-        t_view = t[first::step]
+        t_view = t[first::step] - t_end  # seconds ago: <= 0, the newest at the right edge
         for channel, name in enumerate(CARTESIAN, start=X):
             self.curves[name].setData(t_view, history.view(channel, n)[first::step], skipFiniteCheck=True)
-        x_range = (max(0.0, t_end - window_s), max(t_end, window_s))
-        if x_range != self._x_range:
-            self._x_range = x_range
-            self.xyz_plot.setXRange(*x_range, padding=0)
+        block = history.views(n)[:, first::step]
+        ranges = (("xyz", self.xyz_plot, block[X : X + 3]), ("abc", self.abc_plot, block[X + 3 :]))
+        for key, plot, rows in ranges:
+            shown = self._y_ranges.get(key)
+            wanted = fit_range(shown, float(rows.min()), float(rows.max()))
+            if wanted != shown:
+                self._y_ranges[key] = wanted
+                plot.setYRange(*wanted, padding=0)
+            for name in _PLOT_NAMES[key]:  # every point of the curve is in the range its plot shows
+                self.curves[name].set_bounds(-window_s, 0.0, *wanted)
+
+    def _set_window(self, window_s: float) -> None:
+        if window_s != self._window_s:
+            self._window_s = window_s
+            self.xyz_plot.setXRange(-window_s, 0.0, padding=0)  # the ABC plot is linked to it
 
     def paint_trace(self, trace: RingBuffer) -> None:
         n = min(len(trace), trace.capacity - PAINT_MARGIN)
         if n <= 0:
             self.trace_curve.setData([], [])
-            self.trace_marker.setData([], [])
+            self.trace_marker.setVisible(False)
             return
         xs, ys = trace.view(0, n), trace.view(1, n)
+        x0, x1, y0, y1 = float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max())
         self.trace_curve.setData(xs, ys, skipFiniteCheck=True)
-        self.trace_marker.setData([float(xs[-1])], [float(ys[-1])])
-        self._fit_trace(float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max()))
+        # the view shows TRACE_PADDING of its span beyond the trace: half of that is a margin
+        # for the pen that stays inside the view
+        margin = max(x1 - x0, y1 - y0, TRACE_MIN_SPAN_MM) * TRACE_PADDING / 2.0
+        self.trace_curve.set_bounds(x0 - margin, x1 + margin, y0 - margin, y1 + margin)
+        self.trace_marker.setPos(float(xs[-1]), float(ys[-1]))
+        self.trace_marker.setVisible(True)
+        self._fit_trace(x0, x1, y0, y1)
 
     def _fit_trace(self, x0: float, x1: float, y0: float, y1: float) -> None:
         """Show the whole trace, at least TRACE_MIN_SPAN_MM wide and tall, centred; the view is
@@ -218,7 +312,12 @@ class MonitorPlots:
     def forget_ranges(self) -> None:
         """Set the view ranges again at the next paint (after the plots were cleared or resized)."""
         self._trace_range = None
-        self._x_range = None
+        self._window_s = None
+        self._y_ranges.clear()
+
+    def y_range(self, which: str) -> tuple[float, float] | None:
+        """The vertical range set last on the ``"xyz"`` or ``"abc"`` plot (None: none yet)."""
+        return self._y_ranges.get(which)
 
     def trace_view_range(self) -> tuple[tuple[float, float], tuple[float, float]]:
         (x0, x1), (y0, y1) = self.trace_plot.getPlotItem().getViewBox().viewRange()

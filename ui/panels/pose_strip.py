@@ -329,7 +329,8 @@ class PoseStrip(QFrame):
         shown = metrics.elidedText(text, Qt.TextElideMode.ElideRight, max(room, 10))
         if chip.text() != shown:
             chip.setText(shown)
-        chip.setToolTip(text if shown != text else chip.toolTip())
+        if shown != text and chip.toolTip() != text:  # each setToolTip sends the chip an event
+            chip.setToolTip(text)
         sheet = _chip_style(*colors)
         if chip.styleSheet() != sheet:
             chip.setStyleSheet(sheet)

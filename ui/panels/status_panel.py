@@ -48,6 +48,7 @@ from app.protocol.enums import (
 from app.protocol.registers import GV_DATE
 from ui import messages
 from ui.messages import connection_text, result_level, result_text
+from ui.widgets.live_label import LiveLabel
 from ui.widgets_common import (
     COLOR_ERROR,
     COLOR_NEUTRAL,
@@ -127,7 +128,9 @@ class StatusPanel(QWidget):
         self.link_message.setWordWrap(True)
         self.link_message.setStyleSheet(f"color: {COLOR_NEUTRAL};")
         self.link_message.setVisible(False)
-        self.rtt_label = QLabel("—", self._link_box)
+        # RTT, clock and drift change while streaming (twice and once a second): LiveLabels
+        # repaint themselves only, never re-lay out the dock and the window around them
+        self.rtt_label = LiveLabel("—", self._link_box)
         self.rtt_label.setFont(monospace_font(12))
         self._row_labels: dict[str, QLabel] = {}
         link_form.addRow(self._row_label("state"), self.link_lamp)
@@ -140,9 +143,10 @@ class StatusPanel(QWidget):
         ctrl_form.setFieldGrowthPolicy(QFormLayout.FieldGrowthPolicy.AllNonFixedFieldsGrow)
         self.mode_label = Lamp("—", self._ctrl_box, point_size=_LAMP_POINTS + 1)
         self.program_label = Lamp("—", self._ctrl_box, point_size=_LAMP_POINTS + 1)
-        self.clock_label = QLabel("—", self._ctrl_box)
+        self.clock_label = LiveLabel("—", self._ctrl_box)
         self.clock_label.setFont(monospace_font(10))  # "YYYY-MM-DD hh:mm:ss" fits the narrow status dock
-        self.drift_label = QLabel("", self._ctrl_box)
+        self.clock_label.fit_texts(["8888-88-88 88:88:88"])
+        self.drift_label = LiveLabel("", self._ctrl_box)
         self.drift_label.setFont(monospace_font(11))
         self.command_label = QLabel("", self._ctrl_box)
         self.command_label.setWordWrap(True)
@@ -236,6 +240,7 @@ class StatusPanel(QWidget):
         rows["clock"].setText(self.tr("Clock:"))
         rows["drift"].setText(self.tr("Drift:"))
         self.rtt_label.setToolTip(self.tr("Round-trip time of the last poll"))
+        self.rtt_label.fit_texts([self.tr("{ms} ms").format(ms="9999.9")])
         for bit in ALARM_BITS:
             lamp = self.alarm_lamps[int(bit)]
             lamp.setText(_protocol_tr(ALARM_TEXT[bit]))
@@ -407,31 +412,36 @@ class StatusPanel(QWidget):
         tip = self.tr("Raw words {first}..{last}: {words}").format(
             first=_CLOCK_FIRST_REGISTER, last=last, words=clock.raw_hex
         )
-        self.clock_label.setToolTip(tip)
-        self.drift_label.setToolTip(self.tr("Controller clock minus PC clock") + "\n" + tip)
+        _set_tip(self.clock_label, tip)
+        _set_tip(self.drift_label, self.tr("Controller clock minus PC clock") + "\n" + tip)
         drift = self._drift
         self.drift_label.setProperty("drift", drift)
         if clock.value is None or drift is None:
             self.clock_label.setText(self.tr("invalid date/time"))
-            self.clock_label.setStyleSheet(f"color: {COLOR_ERROR};")
+            self.clock_label.set_style(f"color: {COLOR_ERROR};")
             self.drift_label.setText("—")
-            self.drift_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+            self.drift_label.set_style(f"color: {COLOR_NEUTRAL};")
             return
         stamp = clock.value.strftime("%Y-%m-%d %H:%M:%S")
         drift_text = self.tr("{drift} s").format(drift=f"{drift:+.0f}")
-        self.drift_label.setText(drift_text)
         if not self._fresh:  # the last reading, no longer ticking: grey, italic, marked stale
             self.clock_label.setText(stamp)
             self.drift_label.setText(self.tr("{value} (stale)").format(value=drift_text))
-            self.clock_label.setStyleSheet(f"color: {COLOR_NEUTRAL}; font-style: italic;")
-            self.drift_label.setStyleSheet(f"color: {COLOR_NEUTRAL}; font-style: italic;")
+            self.clock_label.set_style(f"color: {COLOR_NEUTRAL}; font-style: italic;")
+            self.drift_label.set_style(f"color: {COLOR_NEUTRAL}; font-style: italic;")
             return
+        self.drift_label.setText(drift_text)
         self.clock_label.setText(stamp)
-        self.clock_label.setStyleSheet("")
+        self.clock_label.set_style("")
         if abs(drift) > CLOCK_DRIFT_ERROR_S:
             color = COLOR_ERROR
         elif abs(drift) > CLOCK_DRIFT_WARN_S:
             color = COLOR_WARN
         else:
             color = COLOR_OK
-        self.drift_label.setStyleSheet(f"color: {color};")
+        self.drift_label.set_style(f"color: {color};")
+
+
+def _set_tip(label: QLabel, tip: str) -> None:
+    if label.toolTip() != tip:  # each setToolTip sends the label an event
+        label.setToolTip(tip)

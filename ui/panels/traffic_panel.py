@@ -30,7 +30,6 @@ from PySide6.QtWidgets import (
     QCheckBox,
     QHBoxLayout,
     QHeaderView,
-    QLabel,
     QLineEdit,
     QPushButton,
     QTableView,
@@ -50,6 +49,7 @@ from ui.models.traffic_model import (
     TrafficModel,
 )
 from ui.palette import COLOR_NEUTRAL
+from ui.widgets.live_label import LiveLabel
 from ui.widgets_common import (
     atomic_write_text,
     export_with_dialog,
@@ -57,11 +57,12 @@ from ui.widgets_common import (
 )
 
 FILTER_DEBOUNCE_MS = 200  # typing in the filter box re-filters once the user pauses
-# At most 5 table updates a second while the panel is visible, each in a display-clock frame:
+# At most 2 table updates a second while the panel is visible, each in a display-clock frame:
 # every update scrolls a screenful of new rows whose meaning is decoded when painted (a pose
-# answer ~1.5 ms), so the cost follows this rate (20 Hz cost 1.5x 10 Hz, 10 Hz 1.6x 5 Hz:
-# python -m benchmarks.traffic); nobody reads 400 frames a second.
-FLUSH_INTERVAL_MS = 200
+# answer ~1.5 ms) and repaints the whole table, so the cost follows this rate (20 Hz cost 1.5x
+# 10 Hz, 10 Hz 1.6x 5 Hz: python -m benchmarks.traffic; at 5 Hz the table's paint was 12 % of the
+# GUI thread while streaming); nobody reads 400 frames a second.
+FLUSH_INTERVAL_MS = 500
 _BUSY_CURSOR_ROWS = 2000
 
 
@@ -108,7 +109,9 @@ class TrafficPanel(QWidget):
         self.clear_button.clicked.connect(self.clear)
         self.export_button = QPushButton(self)
         self.export_button.clicked.connect(self._export_dialog)
-        self.count_label = QLabel(self)
+        # its text changes with every flush: a LiveLabel repaints itself only (no re-layout of the
+        # dock and the window above it)
+        self.count_label = LiveLabel(parent=self, opaque=True)
         self.count_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
 
         self.view = QTableView(self)
@@ -157,6 +160,7 @@ class TrafficPanel(QWidget):
         self.clear_button.setText(self.tr("Clear"))
         self.export_button.setText(self.tr("Export…"))
         self.model.retranslate()
+        self.count_label.fit_texts([self.tr("{n} frames").format(n=max(self.model.max_rows, 99_999))])
         self._update_count()
 
     def changeEvent(self, event: QEvent) -> None:
