@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 
 import pytest
@@ -505,3 +506,52 @@ def test_reads_before_the_command_is_seen_taken_keep_the_backoff(monkeypatch: py
     assert tr.poll_interval(0.004) == pytest.approx(0.02)
     assert tr.update(st(DONE), None, 0.024) is not None
     assert pacer.estimate == pytest.approx(0.02 * ResultPacer.DECAY)
+
+
+def test_a_paced_read_that_was_early_is_followed_once_soon_then_the_backoff(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A miss costs a short wait, not a whole backoff step; never a tight loop after it."""
+    monkeypatch.setattr(timing, "ACK_BACKOFF_FIRST", 0.001)
+    monkeypatch.setattr(timing, "ACK_BACKOFF_CAP", 0.01)
+    pacer = ResultPacer()
+    pacer.estimate = 0.0008
+    tr = _paced(pacer, 0.0)
+    assert tr.update(st(0), None, 0.0001) is None  # taken
+    assert tr.poll_interval(0.0001) == pytest.approx(0.0008)
+    assert tr.update(st(0), None, 0.0009) is None  # the paced read: still no result
+    # once more after (GROW - 1) x the time since the taken read, at least RETRY_MIN
+    assert tr.poll_interval(0.0009) == pytest.approx(ResultPacer.RETRY_MIN)
+    reads = [0.0011]
+    now = 0.0011
+    while now < 0.05:  # the controller never answers: the reads back off from ACK_BACKOFF_FIRST
+        assert tr.update(st(0), None, now) is None
+        now += tr.poll_interval(now)
+        reads.append(now)
+    gaps = [b - a for a, b in itertools.pairwise(reads)]
+    assert gaps[:4] == pytest.approx([0.001, 0.002, 0.004, 0.008])
+    assert len(reads) <= 10  # 10 reads in 50 ms at most
+    # a later miss, long after the taken read: the retry is capped at ACK_BACKOFF_FIRST
+    assert pacer.retry_after(0.02, 0.001) == 0.001
+    assert pacer.retry_after(0.005, 0.001) == pytest.approx((ResultPacer.GROW - 1.0) * 0.005)
+
+
+def test_the_pacer_keeps_a_one_ms_controller_near_two_reads_per_command() -> None:
+    """With the retry a miss costs one read and a fraction of a millisecond."""
+    pacer = ResultPacer()
+    reads = 0
+    late = 0.0
+    t = 0.0
+    for _ in range(300):
+        tr = _paced(pacer, t)
+        first = t + 0.0002
+        assert tr.update(st(0), None, first) is None
+        read_at = first + tr.poll_interval(first)
+        while (result := tr.update(st(DONE) if read_at >= first + 0.001 else st(0), None, read_at)) is None:
+            read_at += tr.poll_interval(read_at)
+        assert result.ok and not result.unconfirmed
+        reads += tr.reads
+        late += read_at - (first + 0.001)
+        t = read_at + 0.001
+    assert reads / 300 <= 2.2
+    assert late / 300 <= 0.0002  # the result is read on average within 0.2 ms of showing
