@@ -33,6 +33,7 @@ from app.protocol.enums import (
     MoveStatus,
     ProgramMotionMode,
     ProgramState,
+    RunCommand,
     TeachFrame,
     WorkMode,
 )
@@ -268,6 +269,22 @@ def test_upload_points_goes_on_when_the_spare_gvs_are_refused(
     assert all(sim.robot.points[pid].tool == 3 for pid, _ in batch)
     assert c.stats.exceptions == 1  # one refused staging write, then the poses went one at a time
     assert [w.address for w in sim.writes if w.address < 400] == [0] * 6  # (a refused write is not stored)
+
+
+@pytest.mark.parametrize(("profile", "expected"), [("classic", [1]), ("fast", [])])
+def test_wait_runs_meanwhile_once_while_the_command_is_under_way(
+    sim_factory: Any, make_client: MakeClient, profile: str, expected: list[int]
+) -> None:
+    """After the first read, only when the command has not ended there (classic: 0 first)."""
+    sim = sim_factory(command_latency=SCAN, timing=profile, gv291="writable")
+    c = make_client(sim)
+    c.write_gv(0, [300.0, 0.0, 400.0, 180.0, 0.0, 0.0])
+    c.write_gv(200, [5.0, 1.0, 0.0])
+    tracker = c.begin_command(RunCommand.CREATE_POINT, c.read_status(), None)
+    calls: list[int] = []
+    result = c.wait(tracker, meanwhile=lambda: calls.append(tracker.reads))
+    assert result.ok and calls == expected
+    assert sim.state().points[5] == (300.0, 0.0, 400.0, 180.0, 0.0, 0.0)
 
 
 def test_upload_points_cancel_and_validation(scan_sim: Any, make_client: MakeClient) -> None:
