@@ -66,8 +66,7 @@ def test_the_second_pose_block_steps_aside_for_the_restart_canary(sim: Any) -> N
     host = PartsHost(canary_gv=8)
     try:
         host.connect(sim)
-        items = [(100 + i, (100.0 + i, 0.0, 300.0, 180.0, 0.0, 0.0), 200) for i in range(6)]
-        assert host.uploader.start(items)
+        assert host.uploader.start([(100 + i, (100.0 + i, 0.0, 300.0, 0.0, 0.0, 0.0), 200) for i in range(6)])
         while host.uploader.step():
             pass
         assert host.of("commandFinished")[-1].ok
@@ -75,4 +74,4 @@ def test_the_second_pose_block_steps_aside_for_the_restart_canary(sim: Any) -> N
         host.close()
     pose_blocks = {w.address for w in sim.writes if w.address < 400 and len(w.values) == 12}
     assert pose_blocks == {0, 24}  # GV0..GV5 and GV12..GV17
-    assert sim.state().points[105] == (105.0, 0.0, 300.0, 180.0, 0.0, 0.0)
+    assert sim.state().points[105] == (105.0, 0.0, 300.0, 0.0, 0.0, 0.0)
