@@ -253,19 +253,30 @@ class RobotClient(CommandClient):
         progress: ProgressCallback | None = None,
         *,
         gv_start: int = 0,
+        stage: bool = True,
+        stage_gv: int | None = None,
     ) -> list[CommandResult]:
-        """Batched case 2.2: per point GV0-5 (one 0x10), GV200-202 (one 0x10), 440 <- 0xE0, polls.
+        """Batched case 2.2: per point the pose GVs (one 0x10), GV200-202 (one 0x10), 440 <- 0xE0, polls.
 
         Every point is validated before the first write. Returns one result per point tried,
         in order (``details["point_id"]``); a refused point does not stop the others. A link
         error or timeout ends the batch after a failed result for that point; ``progress``
         (done, total) returning False cancels after the current point.
+
+        **Staging** (``stage``; ``stage_gv``: six more general-purpose GVs, by default the six
+        after ``gv_start``, or before it at the top of GV0..GV99): the poses alternate
+        between the two blocks, and while the controller works on point n (after the read that
+        shows it taken) point n+1's pose goes into the other block. The command in flight
+        reads only its own block and GV200-202, which are written after its result, so the
+        write only fills the controller's latency. A staged pose the upload then does not use
+        (cancelled, link lost) stays in its GVs, unused.
         """
         items = [
             (self._check_point_id(pid), check_floats(pose, 6, f"pose of point {pid}")) for pid, pose in points
         ]
         tool = check_tool(tool)
         gv_start = check_int(gv_start, registers.GV_GENERAL_FIRST, _GENERAL_POSE_LAST_START, "first pose GV")
+        spare = self._stage_block(gv_start, stage_gv) if stage else None
         results: list[CommandResult] = []
         if not items:
             return results
@@ -273,13 +284,33 @@ class RobotClient(CommandClient):
         self._write_tool(tool)
         kind = CommandKind.CREATE_POINT
         total = len(items)
-        for index, (point_id, values) in enumerate(items, start=1):
+        staged = -1  # the index of the item whose pose is already in its block
+
+        def block_of(index: int) -> int:
+            return spare if spare is not None and index % 2 else gv_start
+
+        for index, (point_id, values) in enumerate(items):
+            block = block_of(index)
+
+            def stage_next(nxt: int = index + 1) -> None:
+                nonlocal staged, spare
+                try:
+                    self._write_floats(block_of(nxt), items[nxt][1])
+                except ModbusExceptionError:
+                    # the spare GVs are refused: the point in flight goes on, and the next poses go
+                    # into the first block, each after the previous result (the unstaged way)
+                    spare = None
+                else:
+                    staged = nxt
+
+            meanwhile = stage_next if spare is not None and index + 1 < total else None
             try:
-                self._write_floats(gv_start, values)
-                self._write_floats(registers.GV_PARAM0, [float(point_id), 1.0, float(gv_start)])
+                if staged != index:
+                    self._write_floats(block, values)
+                self._write_floats(registers.GV_PARAM0, [float(point_id), 1.0, float(block)])
                 self._sent_points[point_id] = (values[0], values[1], values[2])
                 tracker = self.begin_command(RunCommand.CREATE_POINT, status, None)
-                result = self.wait(tracker, raise_errors=False)
+                result = self.wait(tracker, raise_errors=False, meanwhile=meanwhile)
                 status = tracker.last_status or status
             except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
                 results.append(
@@ -298,9 +329,20 @@ class RobotClient(CommandClient):
             results.append(
                 dataclasses.replace(result, message=f"point {point_id}: {result.message}", details=details)
             )
-            if progress is not None and progress(index, total) is False:
+            if progress is not None and progress(index + 1, total) is False:
                 break
         return results
+
+    @staticmethod
+    def _stage_block(gv_start: int, stage_gv: int | None) -> int:
+        """The second pose block of an upload (see :meth:`upload_points`), checked."""
+        if stage_gv is None:
+            after = gv_start + 6
+            return after if after <= _GENERAL_POSE_LAST_START else gv_start - 6
+        gv = check_int(stage_gv, registers.GV_GENERAL_FIRST, _GENERAL_POSE_LAST_START, "staging pose GV")
+        if abs(gv - gv_start) < 6:
+            raise InvalidInput(f"the staging pose GVs GV{gv}.. overlap the pose GVs GV{gv_start}..")
+        return gv
 
     # -- function 3: move to temp point --------------------------------------------------
     def move_to_point(

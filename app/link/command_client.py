@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable
 
 from app import timing
 from app.errors import ModbusExceptionError, Reason
@@ -157,14 +158,29 @@ class CommandClient(RegisterClient):
         pose = self.read_pose() if tracker.is_move else None
         return tracker.update(status, pose, time.monotonic())
 
-    def wait(self, tracker: CommandTracker, *, raise_errors: bool = True) -> CommandResult:
-        """Poll until ``tracker`` ends; raise its typed error when it failed (by default)."""
+    def wait(
+        self,
+        tracker: CommandTracker,
+        *,
+        raise_errors: bool = True,
+        meanwhile: Callable[[], None] | None = None,
+    ) -> CommandResult:
+        """Poll until ``tracker`` ends; raise its typed error when it failed (by default).
+
+        ``meanwhile`` runs once, after the first read when the command has not ended by then:
+        a transaction that fills the controller's latency (an upload writes the next point's
+        pose into the other pose GVs there). It must not touch what the command reads.
+        """
         while True:
             result = self.poll(tracker)  # the first poll is immediate: keep the ack window small
             if result is not None:
                 if raise_errors and tracker.error is not None:
                     raise tracker.error
                 return result
+            if meanwhile is not None:
+                work: Callable[[], None] = meanwhile
+                meanwhile = None
+                work()
             interval = tracker.poll_interval(time.monotonic())
             if interval > 0:
                 time.sleep(interval)

@@ -129,7 +129,8 @@ class RegisterClient:
                 self.write_count += 1
                 self._transport.write_single(f"write to {name}", address, int(values[0]), timeout)
             else:
-                _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
+                if _log.isEnabledFor(logging.DEBUG):  # the hex text costs more than the write's own Python
+                    _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
                 self.write_count += 1
                 self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values], timeout)
 

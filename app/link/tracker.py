@@ -33,7 +33,10 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
   commands a :class:`ResultPacer` (one per connection) times the second read: when this
   controller's results usually show, learned from the commands before, so a steady
   controller is read about twice per command (the first read, then the result) and a slow
-  or jittery one backs off as before.
+  or jittery one backs off as before. A paced read that came too early is followed by one
+  read a little later (``ResultPacer.retry_after``, at least ``RETRY_MIN``), then the backoff.
+  The caller may fill the wait with a transaction that does not touch what the command reads
+  (``CommandClient.wait(meanwhile=)``: an upload writes the next point's pose there).
 * **After a stop** the wait ends when the host sent the stop itself, or when a move that was
   seen under way shows program state *stopped* with GV291 at 0 (initial) for
   ``timing.STOP_SETTLE`` (a transient 0 just before 0xFF is not a stop).
@@ -182,8 +185,11 @@ class CommandTracker:
         if self.pacer is not None and ack and self.reads == ack:
             # taken, no result yet: the next read when this controller's results usually show
             interval = max(0.0, self._sent[ack - 1] + self.pacer.estimate - now)
+        elif self.pacer is not None and ack and self.reads == ack + 1:
+            # the paced read was early: once more a little later, then the backoff as before
+            interval = self.pacer.retry_after(now - self._sent[ack - 1], self.backoff_first)
         elif self.pacer is not None and ack:
-            interval = min(self.backoff_cap, self.backoff_first * 2.0 ** (self.reads - ack - 1))
+            interval = min(self.backoff_cap, self.backoff_first * 2.0 ** (self.reads - ack - 2))
         else:
             interval = min(self.backoff_cap, self.backoff_first * 2.0 ** max(0, self.reads - 1))
         if self.unconfirmed_after is not None and not self.acknowledged:

@@ -54,6 +54,7 @@ _log = logging.getLogger(__name__)
 
 SIMULATOR_PORT = 5020  # the simulator's default port, hinted when 502 refuses
 _RECV_SIZE = 4096
+_COUNTERS = tuple(f.name for f in dataclasses.fields(LinkStats) if f.name != "last_error")
 
 
 def _seconds(value: float) -> str:
@@ -294,18 +295,19 @@ class Transport:
         self._observing = False  # checked first on the hot path
         self._tid = 0
         self._ever_connected = False
-        self._stats = LinkStats()
+        # plain counters on the hot path; ``stats`` makes the LinkStats snapshot when asked
+        self._counts = dict.fromkeys(_COUNTERS, 0)
+        self._last_error = ""
 
     # -- statistics -----------------------------------------------------------------------
     @property
     def stats(self) -> LinkStats:
-        return self._stats
+        return LinkStats(**self._counts, last_error=self._last_error)
 
     def _count(self, field: str, error: str | None = None) -> None:
-        changes: dict[str, Any] = {field: getattr(self._stats, field) + 1}
+        self._counts[field] += 1
         if error is not None:
-            changes["last_error"] = error
-        self._stats = dataclasses.replace(self._stats, **changes)
+            self._last_error = error
 
     # -- connection -----------------------------------------------------------------------
     @property
@@ -394,7 +396,7 @@ class Transport:
                         f"controller did not answer within {_seconds(timeout * attempts)} s "
                         f"({self.settings.endpoint})"
                     )
-                    self._stats = dataclasses.replace(self._stats, last_error=message)
+                    self._last_error = message
                     raise ResponseTimeout(
                         message,
                         params={

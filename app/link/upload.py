@@ -1,9 +1,12 @@
 """An upload of many temp points (case 2.2), run in chunks on the worker thread.
 
 Items ``(id, pose6, tool)`` are checked before the first write and grouped by tool frame (GV245
-written once per group). Each chunk is at most :data:`app.timing.UPLOAD_CHUNK_POINTS` points of
-one tool or :data:`app.timing.UPLOAD_CHUNK_SECONDS`; the worker queues the next chunk behind
-whatever arrived meanwhile, so polls and queued calls keep flowing. Between two points the
+written once per group). The poses alternate between GV0..GV5 and GV6..GV11 (GV12..GV17 when the
+restart canary sits there): :meth:`~app.link.client.RobotClient.upload_points` writes the next
+pose while the controller creates the current point. Each chunk is at most
+:data:`app.timing.UPLOAD_CHUNK_POINTS` points of one tool or
+:data:`app.timing.UPLOAD_CHUNK_SECONDS`; the worker queues the next chunk behind whatever arrived
+meanwhile, so polls and queued calls keep flowing. Between two points the
 urgent jobs run (stop, cancel, jog release) and a poll goes out when one is due.
 """
 
@@ -23,9 +26,19 @@ from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import RunCommand
 
-__all__ = ["UPLOAD_POSE_GV", "UploadItem", "UploadRun", "Uploader", "check_upload_items", "group_by_tool"]
+__all__ = [
+    "UPLOAD_POSE_GV",
+    "UPLOAD_STAGE_GV",
+    "UploadItem",
+    "UploadRun",
+    "Uploader",
+    "check_upload_items",
+    "group_by_tool",
+    "stage_gv_for",
+]
 
-UPLOAD_POSE_GV = 0  # an upload passes each pose in GV0..GV5 (case 2.2)
+UPLOAD_POSE_GV = 0  # an upload passes each pose in GV0..GV5 (case 2.2) ...
+UPLOAD_STAGE_GV = 6  # ... and every other one in GV6..GV11, written while the previous one is created
 _FLOAT32_MAX = 3.4028234663852886e38
 
 UploadItem = tuple[int, tuple[float, ...], int]  # (point id, pose X Y Z A B C, tool frame)
@@ -43,6 +56,13 @@ class UploadRun:
     end: str | None = None  # why it ends early ("cancelled", "stopped", "link lost: ..."), once set
     progress_at: float = 0.0  # when uploadProgress was last emitted
     progress_done: int = -1  # the ``done`` it carried
+
+
+def stage_gv_for(canary_gv: int | None) -> int:
+    """The upload's second pose block: GV6..GV11, or GV12..GV17 when the restart canary is there."""
+    if canary_gv is not None and UPLOAD_STAGE_GV <= canary_gv < UPLOAD_STAGE_GV + 6:
+        return UPLOAD_STAGE_GV + 6
+    return UPLOAD_STAGE_GV
 
 
 def group_by_tool(items: Iterable[UploadItem]) -> list[UploadItem]:
@@ -153,7 +173,8 @@ class Uploader:
         outer_id, host.request_id = host.request_id, upload.request_id
         try:
             chunk = [(pid, pose) for pid, pose, _ in items[first:last]]
-            results = client.upload_points(chunk, tool, progress, gv_start=UPLOAD_POSE_GV)
+            stage_gv = stage_gv_for(host.supervisor.canary_gv)
+            results = client.upload_points(chunk, tool, progress, gv_start=UPLOAD_POSE_GV, stage_gv=stage_gv)
         except (LinkError, ResponseTimeout) as exc:  # before the first point (status read, mode)
             results, transport_error = [], str(exc)
         except TeachPadError as exc:

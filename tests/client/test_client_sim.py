@@ -24,7 +24,7 @@ from app.errors import (
     WriteBlocked,
 )
 from app.link.client import RobotClient, StepFrame, TrafficRecord
-from app.protocol.codec import WordOrder
+from app.protocol.codec import WordOrder, decode_floats
 from app.protocol.enums import (
     Alarm,
     CommandKind,
@@ -225,10 +225,19 @@ def test_upload_points_batched(sim_factory: Any, make_client: MakeClient) -> Non
     for pid, pose in points:
         if pid != 150:
             assert stored[pid] == tuple(pose)
-    # one GV245 write, then per point: GV0-5, GV200-202, 440
+    # one GV245 write, then per point: GV200-202, 440 and, while the controller works on it, the
+    # next point's pose into the other block (GV0-5 / GV6-11; the first pose goes before)
     w = wire(sim)
     assert w[0] == (FC10, 490, 2)
-    assert w[1:] == [(FC10, 0, 12), (FC10, 400, 6), (FC06, 440, 1)] * 31
+    expected = [(FC10, 0, 12)]
+    for i in range(31):
+        expected += [(FC10, 400, 6), (FC06, 440, 1)]
+        if i < 30:
+            expected.append((FC10, 12 * ((i + 1) % 2), 12))
+    assert w[1:] == expected
+    # each command named its own block in GV202, and its block held its pose then
+    params = [decode_floats(list(w.values), WordOrder.LOW_FIRST) for w in sim.writes if w.address == 400]
+    assert [(int(v[0]), v[2]) for v in params] == [(p[0], 6.0 * (i % 2)) for i, p in enumerate(points)]
 
 
 def test_upload_points_cancel_and_validation(scan_sim: Any, make_client: MakeClient) -> None:

@@ -8,7 +8,7 @@ import pytest
 
 from app import timing
 from app.errors import AlarmRaised, CommandRefused, CommandStopped, CommandTimeout
-from app.link.tracker import CommandTracker, ResultPacer
+from app.link.tracker import CommandTracker
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import (
     STATUS_SENTINEL,
@@ -437,71 +437,3 @@ def test_a_step_that_moves_external_axes_is_done_only_when_they_arrived_too(
         tr, [(0.01, st(DONE), short), (0.1, st(DONE), short), (0.41, st(DONE), short), (0.8, st(DONE), short)]
     )
     assert i == 3 and not result.ok and "result is unknown" in result.message
-
-
-# --- the result pacer: when the second status read of an instant command goes out
-
-
-def _paced(pacer: ResultPacer, t0: float) -> CommandTracker:
-    return CommandTracker(RunCommand.CREATE_POINT, st(DONE), None, t0, unconfirmed_after=1.0, pacer=pacer)
-
-
-def test_the_pacer_times_the_second_read_and_learns_a_steady_controller() -> None:
-    """A 1 ms controller: the first read shows 0 (received), the result shows 1 ms after it."""
-    pacer = ResultPacer()
-    misses = 0
-    t = 0.0
-    for _ in range(200):
-        tr = _paced(pacer, t)
-        first = t + 0.0002
-        assert tr.update(st(0), None, first) is None  # the first read: at once, sees the 0
-        read_at = first + tr.poll_interval(first)
-        while True:  # the host reads when it planned to; the result is there from first + 1 ms
-            result = tr.update(st(DONE) if read_at >= first + 0.001 else st(0), None, read_at)
-            if result is not None:
-                break
-            misses += 1
-            read_at += tr.poll_interval(read_at)
-        assert result.ok and not result.unconfirmed
-        t = read_at + 0.001
-    assert 0.0008 <= pacer.estimate <= 0.0016  # near the controller's latency, above it at most x1.6
-    assert misses <= 40  # about one probe in ten commands, plus the first few while it learns
-
-
-def test_the_pacer_reads_an_instant_controller_twice_per_command() -> None:
-    pacer = ResultPacer()
-    for k in range(50):
-        tr = _paced(pacer, float(k))
-        assert tr.update(st(0), None, k + 0.0002) is None
-        assert tr.poll_interval(k + 0.0002) == 0.0  # the result is usually there: read again now
-        result = tr.update(st(DONE), None, k + 0.0004)
-        assert result is not None and result.ok and tr.reads == 2
-    assert pacer.estimate == 0.0
-
-
-def test_unconfirmed_and_move_results_teach_the_pacer_nothing() -> None:
-    pacer = ResultPacer()
-    pacer.estimate = 0.002
-    tr = _paced(pacer, 0.0)
-    tr.unconfirmed_after = 0.05
-    for t in (0.001, 0.01, 0.06):  # the stale 0xFF never moves: done, unconfirmed
-        result = tr.update(st(DONE), None, t)
-    assert result is not None and result.unconfirmed and pacer.estimate == 0.002
-    move = CommandTracker(RunCommand.MOVE_TO_POINT, st(DONE), HOME, 0.0, pacer=pacer)
-    assert move.pacer is None  # moves keep their own poll
-
-
-def test_reads_before_the_command_is_seen_taken_keep_the_backoff(monkeypatch: pytest.MonkeyPatch) -> None:
-    """A slow controller's short 0 phase must not be skipped (the observe rule needs it)."""
-    monkeypatch.setattr(timing, "ACK_BACKOFF_FIRST", 0.001)
-    pacer = ResultPacer()
-    pacer.estimate = 0.02
-    tr = _paced(pacer, 0.0)
-    assert tr.update(st(DONE), None, 0.001) is None  # the old code: not taken yet
-    assert tr.poll_interval(0.001) == pytest.approx(0.001)
-    assert tr.update(st(DONE), None, 0.002) is None
-    assert tr.poll_interval(0.002) == pytest.approx(0.002)
-    assert tr.update(st(0), None, 0.004) is None  # taken: the next read when results usually show
-    assert tr.poll_interval(0.004) == pytest.approx(0.02)
-    assert tr.update(st(DONE), None, 0.024) is not None
-    assert pacer.estimate == pytest.approx(0.02 * ResultPacer.DECAY)

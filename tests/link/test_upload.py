@@ -8,7 +8,7 @@ import pytest
 
 from app import timing
 from app.errors import InvalidInput
-from app.link.upload import check_upload_items, group_by_tool
+from app.link.upload import UPLOAD_STAGE_GV, check_upload_items, group_by_tool, stage_gv_for
 from tests.link.harness import PartsHost
 
 POSE = (100.0, 0.0, 300.0, 180.0, 0.0, 0.0)
@@ -57,3 +57,21 @@ def test_cancel_between_chunks_ends_it_at_once(
     assert host.uploader.run is None
     result = host.of("commandFinished")[-1]
     assert not result.ok and result.message == "uploaded 1 of 4 points (cancelled)"
+
+
+def test_the_second_pose_block_steps_aside_for_the_restart_canary(sim: Any) -> None:
+    assert stage_gv_for(None) == UPLOAD_STAGE_GV == 6
+    assert stage_gv_for(99) == 6 and stage_gv_for(5) == 6
+    assert stage_gv_for(8) == 12  # the canary in GV6..GV11: the poses alternate with GV12..GV17
+    host = PartsHost(canary_gv=8)
+    try:
+        host.connect(sim)
+        assert host.uploader.start([(100 + i, (100.0 + i, 0.0, 300.0, 0.0, 0.0, 0.0), 200) for i in range(6)])
+        while host.uploader.step():
+            pass
+        assert host.of("commandFinished")[-1].ok
+    finally:
+        host.close()
+    pose_blocks = {w.address for w in sim.writes if w.address < 400 and len(w.values) == 12}
+    assert pose_blocks == {0, 24}  # GV0..GV5 and GV12..GV17
+    assert sim.state().points[105] == (105.0, 0.0, 300.0, 0.0, 0.0, 0.0)
