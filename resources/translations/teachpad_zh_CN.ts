@@ -993,27 +993,27 @@
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="84" />
+            <location filename="../../ui/window_docks.py" line="106" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="85" />
+            <location filename="../../ui/window_docks.py" line="107" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="86" />
+            <location filename="../../ui/window_docks.py" line="108" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/window_status.py" line="80" />
+            <location filename="../../ui/window_status.py" line="81" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="287" />
+            <location filename="../../ui/main_window.py" line="325" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1028,69 +1028,69 @@
             <translation>未连接：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/window_status.py" line="52" />
-            <location filename="../../ui/window_status.py" line="85" />
+            <location filename="../../ui/window_status.py" line="53" />
+            <location filename="../../ui/window_status.py" line="86" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/window_status.py" line="65" />
+            <location filename="../../ui/window_status.py" line="66" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="319" />
+            <location filename="../../ui/main_window.py" line="357" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="325" />
+            <location filename="../../ui/main_window.py" line="363" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="321" />
-            <location filename="../../ui/main_window.py" line="326" />
+            <location filename="../../ui/main_window.py" line="359" />
+            <location filename="../../ui/main_window.py" line="364" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="264" />
+            <location filename="../../ui/main_window.py" line="302" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="265" />
+            <location filename="../../ui/main_window.py" line="303" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="266" />
+            <location filename="../../ui/main_window.py" line="304" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="87" />
+            <location filename="../../ui/window_docks.py" line="109" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="386" />
+            <location filename="../../ui/main_window.py" line="428" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="388" />
+            <location filename="../../ui/main_window.py" line="430" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="408" />
+            <location filename="../../ui/main_window.py" line="450" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="408" />
+            <location filename="../../ui/main_window.py" line="450" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -2203,105 +2203,105 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="184" />
-            <location filename="../../ui/panels/monitor_panel.py" line="203" />
+            <location filename="../../ui/panels/monitor_panel.py" line="198" />
+            <location filename="../../ui/panels/monitor_panel.py" line="217" />
             <source>mm</source>
             <extracomment>Attributes that exist once the plots are built (asking for one builds them).</extracomment>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="184" />
-            <location filename="../../ui/panels/monitor_panel.py" line="203" />
+            <location filename="../../ui/panels/monitor_panel.py" line="198" />
+            <location filename="../../ui/panels/monitor_panel.py" line="217" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="185" />
+            <location filename="../../ui/panels/monitor_panel.py" line="199" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="187" />
+            <location filename="../../ui/panels/monitor_panel.py" line="201" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="191" />
+            <location filename="../../ui/panels/monitor_panel.py" line="205" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="192" />
+            <location filename="../../ui/panels/monitor_panel.py" line="206" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="193" />
+            <location filename="../../ui/panels/monitor_panel.py" line="207" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="194" />
+            <location filename="../../ui/panels/monitor_panel.py" line="208" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="195" />
+            <location filename="../../ui/panels/monitor_panel.py" line="209" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="196" />
+            <location filename="../../ui/panels/monitor_panel.py" line="210" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="197" />
+            <location filename="../../ui/panels/monitor_panel.py" line="211" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="204" />
+            <location filename="../../ui/panels/monitor_panel.py" line="218" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="205" />
+            <location filename="../../ui/panels/monitor_panel.py" line="219" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="206" />
+            <location filename="../../ui/panels/monitor_panel.py" line="220" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="206" />
+            <location filename="../../ui/panels/monitor_panel.py" line="220" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="207" />
+            <location filename="../../ui/panels/monitor_panel.py" line="221" />
             <source>Top view (X–Y)</source>
             <translation>俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="226" />
+            <location filename="../../ui/panels/monitor_panel.py" line="240" />
             <source>Stale: not confirmed by the controller within the freshness limit</source>
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="406" />
+            <location filename="../../ui/panels/monitor_panel.py" line="433" />
             <source>values stale (grey): no fresh data from the controller</source>
             <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="402" />
+            <location filename="../../ui/panels/monitor_panel.py" line="429" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="404" />
+            <location filename="../../ui/panels/monitor_panel.py" line="431" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -2455,13 +2455,13 @@
     <context>
         <name>Plan</name>
         <message>
-            <location filename="../../app/plan/segments.py" line="61" />
+            <location filename="../../app/plan/segments.py" line="69" />
             <source>line</source>
             <extracomment>Editable fields of a segment, in table column order.</extracomment>
             <translation>直线</translation>
         </message>
         <message>
-            <location filename="../../app/plan/segments.py" line="62" />
+            <location filename="../../app/plan/segments.py" line="70" />
             <source>arc</source>
             <translation>圆弧</translation>
         </message>
@@ -2592,68 +2592,68 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="268" />
+            <location filename="../../ui/panels/plan_preview.py" line="173" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="269" />
+            <location filename="../../ui/panels/plan_preview.py" line="174" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="270" />
+            <location filename="../../ui/panels/plan_preview.py" line="175" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="274" />
+            <location filename="../../ui/panels/plan_preview.py" line="179" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="276" />
+            <location filename="../../ui/panels/plan_preview.py" line="181" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="372" />
+            <location filename="../../ui/panels/plan_preview.py" line="277" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="374" />
+            <location filename="../../ui/panels/plan_preview.py" line="279" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="377" />
+            <location filename="../../ui/panels/plan_preview.py" line="282" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="378" />
+            <location filename="../../ui/panels/plan_preview.py" line="283" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="382" />
+            <location filename="../../ui/panels/plan_preview.py" line="287" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="389" />
+            <location filename="../../ui/panels/plan_preview.py" line="294" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="392" />
+            <location filename="../../ui/panels/plan_preview.py" line="297" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="394" />
+            <location filename="../../ui/panels/plan_preview.py" line="299" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -3001,12 +3001,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="258" />
+            <location filename="../../ui/panels/planner_panel.py" line="242" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="432" />
+            <location filename="../../ui/panels/planner_panel.py" line="416" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -3027,157 +3027,157 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="167" />
+            <location filename="../../ui/controllers/point_sync.py" line="141" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="178" />
+            <location filename="../../ui/controllers/point_sync.py" line="152" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="188" />
+            <location filename="../../ui/controllers/point_sync.py" line="162" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="190" />
+            <location filename="../../ui/controllers/point_sync.py" line="164" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="197" />
+            <location filename="../../ui/controllers/point_sync.py" line="171" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="223" />
+            <location filename="../../ui/controllers/point_sync.py" line="197" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="229" />
+            <location filename="../../ui/controllers/point_sync.py" line="203" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="233" />
+            <location filename="../../ui/controllers/point_sync.py" line="207" />
             <source>{point} is not on the controller ({state}): upload it first</source>
             <translation>{point} 不在控制器上（{state}）：请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="240" />
+            <location filename="../../ui/controllers/point_sync.py" line="214" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="242" />
+            <location filename="../../ui/controllers/point_sync.py" line="216" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="248" />
+            <location filename="../../ui/controllers/point_sync.py" line="222" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="275" />
+            <location filename="../../ui/controllers/point_sync.py" line="249" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="298" />
+            <location filename="../../ui/controllers/point_sync.py" line="272" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="301" />
+            <location filename="../../ui/controllers/point_sync.py" line="275" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="326" />
+            <location filename="../../ui/controllers/point_sync.py" line="300" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="342" />
+            <location filename="../../ui/controllers/point_sync.py" line="316" />
             <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="369" />
+            <location filename="../../ui/controllers/point_sync.py" line="343" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="374" />
+            <location filename="../../ui/controllers/point_sync.py" line="348" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="385" />
+            <location filename="../../ui/controllers/point_sync.py" line="359" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="390" />
+            <location filename="../../ui/controllers/point_sync.py" line="364" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="400" />
+            <location filename="../../ui/controllers/point_sync.py" line="374" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="409" />
+            <location filename="../../ui/controllers/point_sync.py" line="383" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="414" />
+            <location filename="../../ui/controllers/point_sync.py" line="388" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="426" />
+            <location filename="../../ui/controllers/point_sync.py" line="400" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="430" />
+            <location filename="../../ui/controllers/point_sync.py" line="404" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="435" />
+            <location filename="../../ui/controllers/point_sync.py" line="409" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="481" />
+            <location filename="../../ui/controllers/point_sync.py" line="446" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="484" />
+            <location filename="../../ui/controllers/point_sync.py" line="449" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="500" />
+            <location filename="../../ui/controllers/point_sync.py" line="461" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="505" />
+            <location filename="../../ui/controllers/point_sync.py" line="466" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="512" />
+            <location filename="../../ui/controllers/point_sync.py" line="473" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -3227,147 +3227,147 @@
             <translation>工具 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="144" />
+            <location filename="../../ui/models/points_model.py" line="127" />
             <source>ID</source>
             <translation>编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="145" />
+            <location filename="../../ui/models/points_model.py" line="128" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="146" />
+            <location filename="../../ui/models/points_model.py" line="129" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="147" />
+            <location filename="../../ui/models/points_model.py" line="130" />
             <source>Sync</source>
             <translation>同步状态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="148" />
+            <location filename="../../ui/models/points_model.py" line="131" />
             <source>Note</source>
             <translation>备注</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="152" />
+            <location filename="../../ui/models/points_model.py" line="135" />
             <source>Temp point id on the controller</source>
             <translation>控制器上的临时点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="153" />
+            <location filename="../../ui/models/points_model.py" line="136" />
             <source>Tool frame (200 = none)</source>
             <translation>工具坐标系（200 = 无）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="154" />
+            <location filename="../../ui/models/points_model.py" line="137" />
             <source>Whether the controller holds this point</source>
             <translation>控制器上是否有此点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="155" />
+            <location filename="../../ui/models/points_model.py" line="138" />
             <source>mm, base frame</source>
             <translation>毫米，基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="156" />
+            <location filename="../../ui/models/points_model.py" line="139" />
             <source>degrees</source>
             <translation>度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="158" />
+            <location filename="../../ui/models/points_model.py" line="141" />
             <source>External axis (recorded only: the controller does not store it)</source>
             <translation>外部轴（仅记录：控制器不保存）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="239" />
+            <location filename="../../ui/models/points_model.py" line="222" />
             <source>no reason given</source>
             <translation>未给出原因</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="240" />
+            <location filename="../../ui/models/points_model.py" line="223" />
             <source>Upload failed: {reason}</source>
             <translation>上传失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="243" />
+            <location filename="../../ui/models/points_model.py" line="226" />
             <source>Not known whether the controller holds this point (it restarted or the link was lost): upload it before moving to it</source>
             <translation>不确定控制器上是否有此点（控制器已重启或通信曾中断）：运动到该点前请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="246" />
+            <location filename="../../ui/models/points_model.py" line="229" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="247" />
+            <location filename="../../ui/models/points_model.py" line="230" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="249" />
+            <location filename="../../ui/models/points_model.py" line="232" />
             <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
             <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="257" />
+            <location filename="../../ui/models/points_model.py" line="240" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="287" />
+            <location filename="../../ui/models/points_model.py" line="270" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="312" />
+            <location filename="../../ui/models/points_model.py" line="299" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="350" />
+            <location filename="../../ui/models/points_model.py" line="316" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="379" />
+            <location filename="../../ui/models/points_model.py" line="345" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="381" />
+            <location filename="../../ui/models/points_model.py" line="347" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="400" />
+            <location filename="../../ui/models/points_model.py" line="366" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="402" />
+            <location filename="../../ui/models/points_model.py" line="368" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="418" />
+            <location filename="../../ui/models/points_model.py" line="384" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="418" />
+            <location filename="../../ui/models/points_model.py" line="384" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="441" />
+            <location filename="../../ui/models/points_model.py" line="407" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="453" />
+            <location filename="../../ui/models/points_model.py" line="419" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -3375,124 +3375,124 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="178" />
+            <location filename="../../ui/panels/points_panel.py" line="179" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="180" />
+            <location filename="../../ui/panels/points_panel.py" line="181" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="183" />
+            <location filename="../../ui/panels/points_panel.py" line="184" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="183" />
+            <location filename="../../ui/panels/points_panel.py" line="184" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="184" />
+            <location filename="../../ui/panels/points_panel.py" line="185" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="184" />
+            <location filename="../../ui/panels/points_panel.py" line="185" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="186" />
+            <location filename="../../ui/panels/points_panel.py" line="187" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="187" />
+            <location filename="../../ui/panels/points_panel.py" line="188" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="189" />
+            <location filename="../../ui/panels/points_panel.py" line="190" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="190" />
+            <location filename="../../ui/panels/points_panel.py" line="191" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="192" />
+            <location filename="../../ui/panels/points_panel.py" line="193" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="193" />
+            <location filename="../../ui/panels/points_panel.py" line="194" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="196" />
+            <location filename="../../ui/panels/points_panel.py" line="197" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="197" />
+            <location filename="../../ui/panels/points_panel.py" line="198" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="199" />
+            <location filename="../../ui/panels/points_panel.py" line="200" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="199" />
+            <location filename="../../ui/panels/points_panel.py" line="200" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="201" />
+            <location filename="../../ui/panels/points_panel.py" line="202" />
             <location filename="../../ui/panels/points_parts.py" line="166" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="202" />
+            <location filename="../../ui/panels/points_panel.py" line="203" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="204" />
+            <location filename="../../ui/panels/points_panel.py" line="205" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="206" />
-            <location filename="../../ui/panels/points_panel.py" line="394" />
+            <location filename="../../ui/panels/points_panel.py" line="207" />
+            <location filename="../../ui/panels/points_panel.py" line="395" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="207" />
+            <location filename="../../ui/panels/points_panel.py" line="208" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="209" />
+            <location filename="../../ui/panels/points_panel.py" line="210" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="209" />
+            <location filename="../../ui/panels/points_panel.py" line="210" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="210" />
+            <location filename="../../ui/panels/points_panel.py" line="211" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
@@ -3527,42 +3527,42 @@
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="304" />
+            <location filename="../../ui/panels/points_panel.py" line="305" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="308" />
+            <location filename="../../ui/panels/points_panel.py" line="309" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="310" />
+            <location filename="../../ui/panels/points_panel.py" line="311" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="313" />
+            <location filename="../../ui/panels/points_panel.py" line="314" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="340" />
+            <location filename="../../ui/panels/points_panel.py" line="341" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="343" />
+            <location filename="../../ui/panels/points_panel.py" line="344" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="369" />
+            <location filename="../../ui/panels/points_panel.py" line="370" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="378" />
+            <location filename="../../ui/panels/points_panel.py" line="379" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -4360,7 +4360,7 @@ Remove them all?</source>
     <context>
         <name>RobotModelSource</name>
         <message>
-            <location filename="../../ui/panels/view3d_robot.py" line="99" />
+            <location filename="../../ui/panels/view3d_robot.py" line="115" />
             <source>The robot model remembered from the last session could not be loaded: %1. The default robot model (%2) is used.</source>
             <translation>上次使用的机器人模型无法加载：%1。现使用默认机器人模型（%2）。</translation>
         </message>
@@ -4533,112 +4533,112 @@ Remove them all?</source>
     <context>
         <name>SafetyMenu</name>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="111" />
+            <location filename="../../ui/controllers/safety_menu.py" line="109" />
             <source>&amp;Safety</source>
             <translation>安全(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="112" />
+            <location filename="../../ui/controllers/safety_menu.py" line="110" />
             <source>Log &amp;in…</source>
             <translation>登录(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="113" />
+            <location filename="../../ui/controllers/safety_menu.py" line="111" />
             <source>Log &amp;out (operator)</source>
             <translation>注销(&amp;O)（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="114" />
+            <location filename="../../ui/controllers/safety_menu.py" line="112" />
             <source>&amp;Reduced speed</source>
             <translation>降速模式(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="115" />
+            <location filename="../../ui/controllers/safety_menu.py" line="113" />
             <source>Safety &amp;envelope…</source>
             <translation>安全范围(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="116" />
+            <location filename="../../ui/controllers/safety_menu.py" line="114" />
             <source>Re&amp;gister profile…</source>
             <translation>寄存器配置(&amp;G)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="118" />
+            <location filename="../../ui/controllers/safety_menu.py" line="116" />
             <source>Word order, unit id, completion rule, poll timeout (administrator)</source>
             <translation>字序、站号、完成判定、轮询超时（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="120" />
+            <location filename="../../ui/controllers/safety_menu.py" line="118" />
             <source>&amp;Passwords and lock…</source>
             <translation>密码与锁定(&amp;P)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="122" />
+            <location filename="../../ui/controllers/safety_menu.py" line="120" />
             <source>Set, change or clear passwords; the idle lock time (administrator)</source>
             <translation>设置、修改或清除密码；空闲锁定时间（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="124" />
+            <location filename="../../ui/controllers/safety_menu.py" line="122" />
             <source>&amp;Audit trail…</source>
             <translation>审计记录(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="125" />
+            <location filename="../../ui/controllers/safety_menu.py" line="123" />
             <source>Write a &amp;support bundle…</source>
             <translation>生成支持包(&amp;S)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="138" />
+            <location filename="../../ui/controllers/safety_menu.py" line="136" />
             <source>Role: {role} · reduced speed</source>
             <translation>角色：{role} · 降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="138" />
+            <location filename="../../ui/controllers/safety_menu.py" line="136" />
             <source>Role: {role}</source>
             <translation>角色：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="148" />
+            <location filename="../../ui/controllers/safety_menu.py" line="146" />
             <source>Cap jog and move speeds (anyone may switch it on)</source>
             <translation>限制点动与移动速度（任何人都可开启）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="153" />
+            <location filename="../../ui/controllers/safety_menu.py" line="151" />
             <source>safety</source>
             <translation>安全</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="208" />
+            <location filename="../../ui/controllers/safety_menu.py" line="214" />
             <source>The register profile could not be saved: {why}</source>
             <translation>寄存器配置无法保存：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="213" />
+            <location filename="../../ui/controllers/safety_menu.py" line="219" />
             <source>Register profile “{name}” saved (revision {rev})</source>
             <translation>寄存器配置“{name}”已保存（第 {rev} 版）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="223" />
+            <location filename="../../ui/controllers/safety_menu.py" line="231" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="230" />
+            <location filename="../../ui/controllers/safety_menu.py" line="238" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="258" />
+            <location filename="../../ui/controllers/safety_menu.py" line="268" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="259" />
+            <location filename="../../ui/controllers/safety_menu.py" line="269" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="265" />
+            <location filename="../../ui/controllers/safety_menu.py" line="275" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
@@ -4789,37 +4789,37 @@ Remove them all?</source>
             <translation>第 {n} 段，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="391" />
+            <location filename="../../ui/models/segment_model.py" line="367" />
             <source>Edit segment {n} {column}</source>
             <translation>编辑第 {n} 段 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="403" />
+            <location filename="../../ui/models/segment_model.py" line="379" />
             <source>Add {kind} segment</source>
             <translation>添加{kind}段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="442" />
+            <location filename="../../ui/models/segment_model.py" line="396" />
             <source>Add {n} segments</source>
             <translation>添加 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="451" />
+            <location filename="../../ui/models/segment_model.py" line="405" />
             <source>Delete segment {n}</source>
             <translation>删除第 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="453" />
+            <location filename="../../ui/models/segment_model.py" line="407" />
             <source>Delete {n} segments</source>
             <translation>删除 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="474" />
+            <location filename="../../ui/models/segment_model.py" line="428" />
             <source>Move segment up</source>
             <translation>上移段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="474" />
+            <location filename="../../ui/models/segment_model.py" line="428" />
             <source>Move segment down</source>
             <translation>下移段</translation>
         </message>
@@ -4827,139 +4827,140 @@ Remove them all?</source>
     <context>
         <name>StatusPanel</name>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="227" />
+            <location filename="../../ui/panels/status_panel.py" line="231" />
             <source>Link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="228" />
+            <location filename="../../ui/panels/status_panel.py" line="232" />
             <source>Controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="229" />
-            <location filename="../../ui/panels/status_panel.py" line="297" />
+            <location filename="../../ui/panels/status_panel.py" line="233" />
+            <location filename="../../ui/panels/status_panel.py" line="302" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="229" />
-            <location filename="../../ui/panels/status_panel.py" line="297" />
+            <location filename="../../ui/panels/status_panel.py" line="233" />
+            <location filename="../../ui/panels/status_panel.py" line="302" />
             <source>Alarms (last known)</source>
             <translation>报警（最后已知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="231" />
+            <location filename="../../ui/panels/status_panel.py" line="235" />
             <source>State:</source>
             <translation>状态：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="232" />
+            <location filename="../../ui/panels/status_panel.py" line="236" />
             <source>RTT:</source>
             <translation>往返时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="233" />
+            <location filename="../../ui/panels/status_panel.py" line="237" />
             <source>Mode:</source>
             <translation>模式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="234" />
+            <location filename="../../ui/panels/status_panel.py" line="238" />
             <source>Program:</source>
             <translation>程序：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="235" />
+            <location filename="../../ui/panels/status_panel.py" line="239" />
             <source>Last command:</source>
             <translation>上一条命令：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="236" />
+            <location filename="../../ui/panels/status_panel.py" line="240" />
             <source>Clock:</source>
             <translation>系统时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="237" />
+            <location filename="../../ui/panels/status_panel.py" line="241" />
             <source>Drift:</source>
             <translation>时差：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="238" />
+            <location filename="../../ui/panels/status_panel.py" line="242" />
             <source>Round-trip time of the last poll</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="242" />
+            <location filename="../../ui/panels/status_panel.py" line="247" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="243" />
+            <location filename="../../ui/panels/status_panel.py" line="248" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="246" />
+            <location filename="../../ui/panels/status_panel.py" line="251" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="253" />
+            <location filename="../../ui/panels/status_panel.py" line="258" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="346" />
+            <location filename="../../ui/panels/status_panel.py" line="351" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="364" />
+            <location filename="../../ui/panels/status_panel.py" line="369" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="366" />
+            <location filename="../../ui/panels/status_panel.py" line="371" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="376" />
+            <location filename="../../ui/panels/status_panel.py" line="381" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="382" />
+            <location filename="../../ui/panels/status_panel.py" line="243" />
+            <location filename="../../ui/panels/status_panel.py" line="387" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="399" />
+            <location filename="../../ui/panels/status_panel.py" line="404" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="407" />
+            <location filename="../../ui/panels/status_panel.py" line="412" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="411" />
+            <location filename="../../ui/panels/status_panel.py" line="416" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="415" />
+            <location filename="../../ui/panels/status_panel.py" line="420" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="421" />
+            <location filename="../../ui/panels/status_panel.py" line="426" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="425" />
+            <location filename="../../ui/panels/status_panel.py" line="429" />
             <source>{value} (stale)</source>
             <translation>{value}（已过期）</translation>
         </message>
@@ -5103,62 +5104,63 @@ Remove them all?</source>
     <context>
         <name>TrafficPanel</name>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="150" />
+            <location filename="../../ui/panels/traffic_panel.py" line="153" />
             <source>Filter: bytes or meaning</source>
             <translation>过滤：字节或含义</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="151" />
+            <location filename="../../ui/panels/traffic_panel.py" line="154" />
             <source>Hide polls</source>
             <translation>隐藏轮询</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="153" />
+            <location filename="../../ui/panels/traffic_panel.py" line="156" />
             <source>Hide the periodic reads of 412.. (pose) and 560.. (status)</source>
             <translation>隐藏对 412..（位姿）和 560..（状态）的周期读取</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="155" />
+            <location filename="../../ui/panels/traffic_panel.py" line="158" />
             <source>Pause capture</source>
             <translation>暂停抓包</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="156" />
+            <location filename="../../ui/panels/traffic_panel.py" line="159" />
             <source>Stop recording frames (the worker stops building them)</source>
             <translation>停止记录报文（后台不再生成报文记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="157" />
+            <location filename="../../ui/panels/traffic_panel.py" line="160" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="158" />
+            <location filename="../../ui/panels/traffic_panel.py" line="161" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="283" />
+            <location filename="../../ui/panels/traffic_panel.py" line="287" />
             <source>Export traffic</source>
             <translation>导出通信报文</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="285" />
+            <location filename="../../ui/panels/traffic_panel.py" line="289" />
             <source>CSV files (*.csv);;Text files (*.txt);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;文本文件 (*.txt);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="314" />
+            <location filename="../../ui/panels/traffic_panel.py" line="163" />
+            <location filename="../../ui/panels/traffic_panel.py" line="318" />
             <source>{n} frames</source>
             <translation>{n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="316" />
+            <location filename="../../ui/panels/traffic_panel.py" line="320" />
             <source>{shown} of {n} frames shown</source>
             <translation>显示 {shown} / {n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="318" />
+            <location filename="../../ui/panels/traffic_panel.py" line="322" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
         </message>
@@ -5174,13 +5176,13 @@ Remove them all?</source>
     <context>
         <name>View3DHost</name>
         <message>
-            <location filename="../../ui/panels/view3d_host.py" line="119" />
+            <location filename="../../ui/panels/view3d_host.py" line="123" />
             <source>3D</source>
             <translation>3D</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_host.py" line="120" />
-            <location filename="../../ui/panels/view3d_host.py" line="129" />
+            <location filename="../../ui/panels/view3d_host.py" line="124" />
+            <location filename="../../ui/panels/view3d_host.py" line="133" />
             <source>3D view</source>
             <translation>3D 视图</translation>
         </message>
@@ -5188,129 +5190,129 @@ Remove them all?</source>
     <context>
         <name>View3DPanel</name>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="203" />
+            <location filename="../../ui/panels/view3d_panel.py" line="198" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="204" />
+            <location filename="../../ui/panels/view3d_panel.py" line="199" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="205" />
+            <location filename="../../ui/panels/view3d_panel.py" line="200" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="206" />
+            <location filename="../../ui/panels/view3d_panel.py" line="201" />
             <source>Iso</source>
             <translation>轴测</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="210" />
+            <location filename="../../ui/panels/view3d_panel.py" line="205" />
             <source>Look at the scene from a preset direction</source>
             <translation>从预设方向观察场景</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="211" />
+            <location filename="../../ui/panels/view3d_panel.py" line="206" />
             <source>Fit all</source>
             <translation>全部显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="212" />
+            <location filename="../../ui/panels/view3d_panel.py" line="207" />
             <source>Show the arm, the points and the plan</source>
             <translation>显示机械臂、点位和轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="213" />
+            <location filename="../../ui/panels/view3d_panel.py" line="208" />
             <source>Orthographic</source>
             <translation>正交投影</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="214" />
+            <location filename="../../ui/panels/view3d_panel.py" line="209" />
             <source>Parallel projection (no perspective)</source>
             <translation>平行投影（无透视）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="215" />
+            <location filename="../../ui/panels/view3d_panel.py" line="210" />
             <source>Robot model…</source>
             <translation>机器人模型…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="217" />
+            <location filename="../../ui/panels/view3d_panel.py" line="212" />
             <source>Robot model: %1. Load another robot model profile (JSON)</source>
             <translation>机器人模型：%1。加载其他机器人模型配置文件（JSON）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="221" />
+            <location filename="../../ui/panels/view3d_panel.py" line="216" />
             <source>Beside the planner</source>
             <translation>在规划器旁显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="222" />
+            <location filename="../../ui/panels/view3d_panel.py" line="217" />
             <source>Show the 3D view next to the planner, not in its own tab</source>
             <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="224" />
+            <location filename="../../ui/panels/view3d_panel.py" line="219" />
             <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
             <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="257" />
+            <location filename="../../ui/panels/view3d_panel.py" line="252" />
             <source>Robot model not loaded: %1</source>
             <translation>未加载机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="270" />
+            <location filename="../../ui/panels/view3d_panel.py" line="265" />
             <source>Load a robot model profile</source>
             <translation>加载机器人模型配置文件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="270" />
+            <location filename="../../ui/panels/view3d_panel.py" line="265" />
             <source>Robot model profiles (*.json)</source>
             <translation>机器人模型配置文件 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="363" />
+            <location filename="../../ui/panels/view3d_panel.py" line="358" />
             <source>dry run: nothing is sent</source>
             <translation>空运行：不发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="365" />
+            <location filename="../../ui/panels/view3d_panel.py" line="360" />
             <source>no pose: home position shown</source>
             <translation>无位姿：显示原点姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="367" />
+            <location filename="../../ui/panels/view3d_panel.py" line="362" />
             <source>estimate (from the pose, no joint angles)</source>
             <translation>估算（由位姿求得，无关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="369" />
+            <location filename="../../ui/panels/view3d_panel.py" line="364" />
             <source>pose out of the model's reach</source>
             <translation>位姿超出模型可达范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="371" />
+            <location filename="../../ui/panels/view3d_panel.py" line="366" />
             <source>past a joint limit</source>
             <translation>超出关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="373" />
+            <location filename="../../ui/panels/view3d_panel.py" line="368" />
             <source>stale</source>
             <translation>数据过期</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="464" />
+            <location filename="../../ui/panels/view3d_panel.py" line="425" />
             <source>Out of the robot model's reach: %n point(s) (%1)</source>
             <translation>
                 <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="472" />
+            <location filename="../../ui/panels/view3d_panel.py" line="433" />
             <source>the path leaves the reach in %n segment(s) (%1)</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>
