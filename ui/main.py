@@ -302,7 +302,16 @@ class _LoopExit:
 class _Screenshot:
     """Saves the window once the link is up and a pose arrived, then quits the application."""
 
-    def __init__(self, window: MainWindow, link: RobotLink, path: str, exit_: Callable[[int], None]) -> None:
+    def __init__(
+        self,
+        window: MainWindow,
+        link: RobotLink,
+        path: str,
+        exit_: Callable[[int], None],
+        starting_ms: int = 0,
+    ) -> None:
+        """``starting_ms``: the first wait for a pose also covers a simulator starting that long
+        (:meth:`rearm` gives the full wait once it is up)."""
         self.window, self.link, self.path, self.exit = window, link, path, exit_
         self.connected = False
         self.scheduled = False
@@ -312,7 +321,7 @@ class _Screenshot:
         self.timeout = QTimer(window)
         self.timeout.setSingleShot(True)
         self.timeout.timeout.connect(self._give_up)
-        self.timeout.start(SCREENSHOT_TIMEOUT_MS)
+        self.timeout.start(SCREENSHOT_TIMEOUT_MS + starting_ms)
         self.settle = QTimer(window)
         self.settle.setSingleShot(True)
         self.settle.timeout.connect(self._save)
@@ -389,7 +398,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.tab:
         window.show_tab(args.tab)
     exit_loop = _LoopExit(app)
-    shot = _Screenshot(window, link, args.screenshot, exit_loop) if args.screenshot else None
+    starting_ms = round(SIM_START_TIMEOUT * 1000) if args.sim else 0
+    shot = _Screenshot(window, link, args.screenshot, exit_loop, starting_ms) if args.screenshot else None
     starter: _SimStarter | None = None
     failure: list[str] = []
     if args.sim:  # the simulator starts after the first paint (see _SimStarter)
