@@ -168,6 +168,7 @@ class _SimStarter(QObject):
 
     def start(self) -> None:
         if self._thread is None and not self._closed:
+            self._window.removeEventFilter(self)  # (started without a paint: not needed any more)
             self._thread = threading.Thread(target=self._run, name="sim-start", daemon=True)
             self._thread.start()
 
