@@ -9,10 +9,14 @@ from __future__ import annotations
 import queue
 import subprocess
 import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import IO, Any
 
 import pytest
 
+LOOP_DEADLINE = 40.0  # s for an in-process ``teachpad`` run (main()); a healthy one takes 1-5 s
+LOOP_DEADLINE_EXIT = 97  # what the loop returns when the deadline ended it
 CHILD_TIMEOUT = 30.0  # s for a child process to do its part (a loaded machine starts Python slowly)
 THREAD_TIMEOUT = 10.0  # s for a test's helper thread to end
 
@@ -64,3 +68,28 @@ def join(thread: threading.Thread, what: str = "", timeout: float = THREAD_TIMEO
     """Join ``thread``; fails when it still runs after ``timeout``."""
     thread.join(timeout)
     assert not thread.is_alive(), f"{what or thread.name} did not end within {timeout:g} s"
+
+
+@contextmanager
+def loop_deadline(what: str, seconds: float = LOOP_DEADLINE) -> Iterator[None]:
+    """Bound a block that runs the application's event loop (``app.exec()``, e.g. main()): after
+    ``seconds`` the loop is ended (``QApplication.exit``) and the test fails saying so. A SIGALRM
+    (pytest-timeout) cannot do that: its exception is raised inside a slot and swallowed."""
+    from PySide6.QtCore import QTimer
+    from PySide6.QtWidgets import QApplication
+
+    fired: list[bool] = []
+
+    def end_the_loop() -> None:
+        fired.append(True)
+        QApplication.exit(LOOP_DEADLINE_EXIT)
+
+    timer = QTimer()
+    timer.setSingleShot(True)
+    timer.timeout.connect(end_the_loop)
+    timer.start(round(seconds * 1000))
+    try:
+        yield
+    finally:
+        timer.stop()
+    assert not fired, f"{what} did not leave its event loop within {seconds:g} s: the test ended it"

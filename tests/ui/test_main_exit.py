@@ -4,13 +4,11 @@ the simulator is slow to start. An exit asked after the loop is never passed on 
 
 These tests run ``main()`` in this process. A SIGALRM (pytest-timeout) cannot end a Qt event loop
 (its exception is raised in a slot and swallowed), so each run is also bounded by
-:func:`loop_deadline`: a main() whose own exits were lost returns anyway, and the test says so."""
+:func:`tests.waits.loop_deadline`: a main() whose own exits were lost returns anyway, and the test says so."""
 
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -20,33 +18,11 @@ from PySide6.QtGui import QImage
 from PySide6.QtWidgets import QApplication
 
 from tests.ui.pendant_support import QT_LOG_IGNORE
+from tests.waits import loop_deadline
 from ui import main as teachpad
 from ui.main_window import MainWindow
 
 pytestmark = [pytest.mark.timeout(90), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
-
-DEADLINE = 40.0  # s for one main() run here; a healthy one takes 1-5 s
-DEADLINE_EXIT = 97  # the code main() returns when the test ended its loop
-
-
-@contextmanager
-def loop_deadline(seconds: float = DEADLINE) -> Iterator[None]:
-    """Fail (and end main()'s event loop) when the block has not returned after ``seconds``."""
-    fired: list[bool] = []
-
-    def end_the_loop() -> None:
-        fired.append(True)
-        QApplication.exit(DEADLINE_EXIT)
-
-    timer = QTimer()
-    timer.setSingleShot(True)
-    timer.timeout.connect(end_the_loop)
-    timer.start(round(seconds * 1000))
-    try:
-        yield
-    finally:
-        timer.stop()
-    assert not fired, f"main() did not leave its event loop within {seconds:g} s: the test ended it"
 
 
 def _args(tmp_path: Path, *extra: str) -> list[str]:
@@ -79,7 +55,7 @@ def test_main_returns_when_the_simulator_fails_to_start(
     # no --screenshot: nothing but the failure itself can end this run
     monkeypatch.setattr(teachpad.SimProcess, "start", _failing_start(exc))
     started = time.monotonic()
-    with loop_deadline():
+    with loop_deadline("main()"):
         code = main_run(tmp_path)
     assert code == 1
     assert "could not start the simulator" in capsys.readouterr().err
@@ -111,7 +87,7 @@ def test_an_exit_asked_before_the_loop_runs_still_ends_it(
             time.sleep(0.005)
 
     monkeypatch.setattr(MainWindow, "show", show_and_turn_the_loop)
-    with loop_deadline():
+    with loop_deadline("main()"):
         code = main_run(tmp_path)
     assert asked == [1] and code == 1
     assert "could not start the simulator: no port" in capsys.readouterr().err
@@ -120,7 +96,7 @@ def test_an_exit_asked_before_the_loop_runs_still_ends_it(
 def test_an_exit_asked_after_the_loop_does_not_end_the_next_loop(qtbot: Any, qapp: QApplication) -> None:
     loop_exit = teachpad._LoopExit(qapp)
     QTimer.singleShot(0, lambda: loop_exit(3))
-    with loop_deadline(10.0):
+    with loop_deadline("the loop", 10.0):
         assert loop_exit.exec() == 3
     assert loop_exit.ended
     loop_exit(5)  # late (a signal queued before the window closed): ignored
@@ -145,7 +121,7 @@ def test_a_screenshot_that_cannot_be_saved_still_ends_the_run(
         raise MemoryError("no memory for 1400x900")
 
     monkeypatch.setattr(MainWindow, "grab", broken_grab)
-    with loop_deadline(), qtbot.captureExceptions() as raised:
+    with loop_deadline("main()"), qtbot.captureExceptions() as raised:
         code = main_run(tmp_path, "--screenshot", str(tmp_path / "shot.png"))
     assert code == 1
     assert [type(e[1]) for e in raised] == [MemoryError]  # the failure is not hidden either
@@ -169,7 +145,7 @@ def test_a_slow_simulator_start_gets_the_full_wait_for_a_pose(
 
     monkeypatch.setattr(teachpad.SimProcess, "start", slow_start)
     png = tmp_path / "shot.png"
-    with loop_deadline():
+    with loop_deadline("main()"):
         code = main_run(tmp_path, "--screenshot", str(png), "--size", "800x600")
     assert code == 0
     assert not QImage(str(png)).isNull()
