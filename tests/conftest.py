@@ -23,9 +23,13 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 # pyproject) fails a test stuck in Python code and the run goes on; a test stuck where its
 # SIGALRM cannot end it (a Qt event loop or wait in C++: the exception raised in a slot is
 # swallowed) would otherwise hold the run until CI's limit. The watchdog below dumps every
-# thread's stack, names the test in the last lines printed, and exits the process.
-HUNG_AFTER = 180.0  # s for one test's setup, call and teardown together
+# thread's stack, names the test in the last lines printed, and exits the process. It is a
+# Python thread: a main thread stuck in C++ *holding the GIL* would keep it from running, so
+# faulthandler's own timer (a C thread, no GIL needed) dumps every stack and exits (code 1) a
+# little later as a last resort; the progress line above the dump names the test's file.
+HUNG_AFTER = float(os.environ.get("TEACHPAD_TEST_HUNG_AFTER", "180"))  # s for setup, call, teardown
 HUNG_EXIT_CODE = 70
+HUNG_BACKSTOP = float(os.environ.get("TEACHPAD_TEST_HUNG_BACKSTOP", "30"))  # s after HUNG_AFTER (see above)
 _stderr_copy = -1
 _PRIVATE_DIR = pytest.StashKey[str]()
 
@@ -67,9 +71,12 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> 
     watchdog = threading.Timer(HUNG_AFTER, _hung, args=(item.nodeid,))
     watchdog.daemon = True
     watchdog.start()
+    fd = _stderr_copy if _stderr_copy >= 0 else 2
+    faulthandler.dump_traceback_later(HUNG_AFTER + HUNG_BACKSTOP, exit=True, file=fd)
     try:
         yield
     finally:
+        faulthandler.cancel_dump_traceback_later()
         watchdog.cancel()
 
 

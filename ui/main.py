@@ -15,6 +15,7 @@ import os
 import re
 import sys
 import threading
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -38,6 +39,7 @@ SCREENSHOT_SETTLE_MS = 1500  # after the first pose: let the plots fill and the 
 SCREENSHOT_TIMEOUT_MS = 20_000  # give up when no pose arrives
 DEMO_PROGRAM = 1  # the simulator's "square 100 mm in XY"
 SIM_START_TIMEOUT = 20.0  # s for the simulator process to say which port it listens on
+SIM_START_LATEST_MS = 5000  # start the simulator then, even when the window has not painted yet
 SIM_STOP_TIMEOUT = 10.0  # s for it to stop after its stdin closed, before it is terminated (a loaded
 # machine needs seconds to wind an interpreter down; this waits after the window has closed)
 THREADS_EXIT_WAIT = 5.0  # s at exit for a worker thread still stuck in a network call
@@ -96,11 +98,16 @@ class SimProcess:
 
         reader = threading.Thread(target=read_stdout, name="sim-stdout", daemon=True)
         reader.start()
+        deadline = time.monotonic() + timeout  # one deadline: a child that only chatters ends too
         try:
             while True:
-                line = lines.get(timeout=timeout)
+                line = lines.get(timeout=max(0.0, deadline - time.monotonic()))
                 if not line:
-                    raise RuntimeError(f"the simulator exited at start (exit code {process.wait()})")
+                    try:
+                        code: int | str = process.wait(SIM_STOP_TIMEOUT)
+                    except subprocess.TimeoutExpired:
+                        code = "none yet"  # its output closed, it has not ended: stop() below
+                    raise RuntimeError(f"the simulator exited at start (exit code {code})")
                 found = _LISTENING.search(line)
                 if found:
                     return cls(process, found["host"], int(found["port"]), reader)
@@ -129,7 +136,7 @@ class SimProcess:
                 code = process.wait(timeout)
             except subprocess.TimeoutExpired:
                 process.kill()
-                code = process.wait()
+                code = process.wait(timeout)  # SIGKILL: it ends (an error after that long says so)
         if self._reader is not None:
             self._reader.join(timeout)  # it ends at the pipe's end of file
         if process.stdout is not None:
@@ -157,6 +164,8 @@ class _SimStarter(QObject):
         self._lock = threading.Lock()
         self._window = window
         window.installEventFilter(self)
+        # a window that is not painted (minimized, on another desktop) still gets its simulator
+        QTimer.singleShot(SIM_START_LATEST_MS, self, self.start)
 
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
         if watched is self._window and event.type() == QEvent.Type.Paint and self._thread is None:
@@ -165,15 +174,19 @@ class _SimStarter(QObject):
         return False
 
     def start(self) -> None:
-        if self._thread is None:
+        if self._thread is None and not self._closed:
+            self._window.removeEventFilter(self)  # (started without a paint: not needed any more)
             self._thread = threading.Thread(target=self._run, name="sim-start", daemon=True)
             self._thread.start()
 
     def _run(self) -> None:
         try:
             sim = SimProcess.start()
-        except (OSError, RuntimeError) as exc:
-            self.failed.emit(str(exc))
+        except Exception as exc:  # any failure ends the wait for it (a window waiting for a pose)
+            with self._lock:
+                closed = self._closed
+            if not closed:  # after close() nobody listens: a late exit would end someone else's loop
+                self.failed.emit(str(exc) or type(exc).__name__)
             return
         with self._lock:
             closed = self._closed
@@ -255,11 +268,59 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _LoopExit:
+    """``app.exit(code)`` for main()'s event loop, never lost and never stray. Qt drops an exit
+    asked before ``app.exec()`` runs (exec starts afresh, and nothing would end it); here it is
+    kept and ``exec`` returns it at once. One asked after exec returned (a signal queued late)
+    is ignored: passed on, it would end the next event loop of this process instead."""
+
+    def __init__(self, app: QApplication) -> None:
+        self._app = app
+        self._code: int | None = None
+        self._running = False
+        self._done = False
+
+    def __call__(self, code: int) -> None:
+        if self._done:
+            return
+        if self._code is None:
+            self._code = code
+        if self._running:
+            self._app.exit(code)
+
+    @property
+    def ended(self) -> bool:
+        """The loop has run and returned: what comes now is too late for it."""
+        return self._done
+
+    def exec(self) -> int:
+        """Run the application's loop until an exit (or return the one asked already)."""
+        if self._done:
+            raise RuntimeError("the loop already ran")
+        try:
+            if self._code is not None:
+                return self._code
+            self._running = True
+            return int(self._app.exec())
+        finally:
+            self._running = False
+            self._done = True
+
+
 class _Screenshot:
     """Saves the window once the link is up and a pose arrived, then quits the application."""
 
-    def __init__(self, window: MainWindow, link: RobotLink, path: str, app: QApplication) -> None:
-        self.window, self.link, self.path, self.app = window, link, path, app
+    def __init__(
+        self,
+        window: MainWindow,
+        link: RobotLink,
+        path: str,
+        exit_: Callable[[int], None],
+        starting_ms: int = 0,
+    ) -> None:
+        """``starting_ms``: the first wait for a pose also covers a simulator starting that long
+        (:meth:`rearm` gives the full wait once it is up)."""
+        self.window, self.link, self.path, self.exit = window, link, path, exit_
         self.connected = False
         self.scheduled = False
         self.ok = False
@@ -268,7 +329,7 @@ class _Screenshot:
         self.timeout = QTimer(window)
         self.timeout.setSingleShot(True)
         self.timeout.timeout.connect(self._give_up)
-        self.timeout.start(SCREENSHOT_TIMEOUT_MS)
+        self.timeout.start(SCREENSHOT_TIMEOUT_MS + starting_ms)
         self.settle = QTimer(window)
         self.settle.setSingleShot(True)
         self.settle.timeout.connect(self._save)
@@ -281,17 +342,26 @@ class _Screenshot:
             self.scheduled = True
             self.settle.start(SCREENSHOT_SETTLE_MS)
 
+    def rearm(self) -> None:
+        """The link was just asked to connect (the simulator is up): the full wait for a pose."""
+        if self.timeout.isActive():
+            self.timeout.start(SCREENSHOT_TIMEOUT_MS)
+
     def _save(self) -> None:
         self.timeout.stop()
-        self.ok = self.window.grab().save(self.path, "PNG")
-        if not self.ok:
-            print(f"teachpad: could not write {self.path}", file=sys.stderr)
-        self.app.exit(0 if self.ok else 1)
+        try:  # the loop ends whatever happens here: its timeout is stopped
+            self.ok = self.window.grab().save(self.path, "PNG")
+            if not self.ok:
+                print(f"teachpad: could not write {self.path}", file=sys.stderr)
+        finally:
+            self.exit(0 if self.ok else 1)
 
     def _give_up(self) -> None:
         self.settle.stop()
-        print("teachpad: no pose from the controller, no screenshot taken", file=sys.stderr)
-        self.app.exit(1)
+        try:
+            print("teachpad: no pose from the controller, no screenshot taken", file=sys.stderr)
+        finally:
+            self.exit(1)
 
     def cancel(self) -> None:
         self.timeout.stop()
@@ -335,13 +405,19 @@ def main(argv: Sequence[str] | None = None) -> int:
         window.resize(*args.size)
     if args.tab:
         window.show_tab(args.tab)
-    shot = _Screenshot(window, link, args.screenshot, app) if args.screenshot else None
+    exit_loop = _LoopExit(app)
+    starting_ms = round(SIM_START_TIMEOUT * 1000) if args.sim else 0
+    shot = _Screenshot(window, link, args.screenshot, exit_loop, starting_ms) if args.screenshot else None
     starter: _SimStarter | None = None
     failure: list[str] = []
     if args.sim:  # the simulator starts after the first paint (see _SimStarter)
         starter = _SimStarter(window)
 
         def sim_started(sim: SimProcess) -> None:
+            if exit_loop.ended:  # queued before the window closed: the starter stops that simulator
+                return
+            if shot is not None:
+                shot.rearm()
             link.connect_to(
                 ConnectionSettings(host=sim.host, port=sim.port, unit=1, monitor_only=args.monitor_only)
             )
@@ -351,7 +427,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         def sim_failed(reason: str) -> None:
             print(f"teachpad: could not start the simulator: {reason}", file=sys.stderr)
             failure.append(reason)
-            app.exit(1)
+            exit_loop(1)
 
         starter.started.connect(sim_started)
         starter.failed.connect(sim_failed)
@@ -367,7 +443,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     _AfterFirstPaint(window, after_first_paint)
     window.show()
     try:
-        code = app.exec()
+        code = exit_loop.exec()
     finally:
         if shot is not None:
             shot.cancel()

@@ -218,6 +218,14 @@ def close_loop(loop: asyncio.AbstractEventLoop) -> None:
     loop.close()
 
 
+def _stop_loop(loop: asyncio.AbstractEventLoop) -> None:
+    """Ask ``loop`` (another thread's) to stop; nothing when it has closed meanwhile."""
+    try:
+        loop.call_soon_threadsafe(loop.stop)
+    except RuntimeError:  # closed: its thread has ended
+        pass
+
+
 class ServerRunner:
     """A guarded server on its own asyncio loop in a daemon thread (``start``/``stop``)."""
 
@@ -254,9 +262,13 @@ class ServerRunner:
 
         self._thread = threading.Thread(target=run_loop, name="sim-modbus", daemon=True)
         self._thread.start()
-        if not ready.wait(self.START_TIMEOUT) or errors:
+        started = ready.wait(self.START_TIMEOUT)
+        if not started or errors:
+            if not started:  # still starting: stop its loop, or it would serve on, unowned, for good
+                _stop_loop(loop)
             self._thread.join(self.STOP_TIMEOUT)
-            raise OSError(f"simulator could not listen on {endpoint}: {errors[0] if errors else 'timeout'}")
+            why = errors[0] if started else f"timeout ({self.START_TIMEOUT:g} s)"
+            raise OSError(f"simulator could not listen on {endpoint}: {why}")
         sockets = getattr(self._server.transport, "sockets", None) if self._server is not None else None
         if sockets:
             self.port = int(sockets[0].getsockname()[1])
@@ -268,7 +280,7 @@ class ServerRunner:
                 asyncio.run_coroutine_threadsafe(shutdown_server(server), loop).result(self.STOP_TIMEOUT)
             except Exception as exc:  # the loop is going away anyway
                 log.warning("server shutdown: %s", exc)
-            loop.call_soon_threadsafe(loop.stop)
+            _stop_loop(loop)
         if self._thread is not None:
             self._thread.join(self.STOP_TIMEOUT)
 

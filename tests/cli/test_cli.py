@@ -107,7 +107,7 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
     finally:
         if proc.poll() is None:
             proc.kill()
-            proc.communicate()
+            proc.communicate(timeout=CHILD_TIMEOUT)
     assert proc.returncode == ExitCode.OK, err
     assert "teach enable: success" in out and out.strip().splitlines()[-1].startswith("pose ")
     state = csim.state()
@@ -140,7 +140,7 @@ def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) ->
     finally:
         if proc.poll() is None:
             proc.kill()
-            proc.communicate()
+            proc.communicate(timeout=CHILD_TIMEOUT)
     return proc.returncode, err
 
 
@@ -195,7 +195,7 @@ def test_jog_killed_mid_jog_is_stopped_by_the_simulator_watchdog(csim: Any) -> N
     finally:
         if proc.poll() is None:
             proc.kill()
-            proc.communicate()
+            proc.communicate(timeout=CHILD_TIMEOUT)
     (event,) = csim.watchdog_events()
     assert event.t - killed < 0.25, f"stopped {event.t - killed:.3f} s after the kill"
     assert csim.state().teach_ratio == 0

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import struct
 import threading
+import time
 from collections.abc import Callable
 from typing import Any
 
@@ -36,6 +37,7 @@ from app.protocol.enums import (
     TeachFrame,
     WorkMode,
 )
+from tests.waits import join
 
 FC06, FC10 = 0x06, 0x10
 # Create/teach commands publish 0 (received) for command_latency before the final code. The
@@ -662,9 +664,11 @@ def test_client_in_a_thread_while_another_reads(scan_sim: Any, make_client: Make
     thread = threading.Thread(target=move)
     thread.start()
     seen = set()
+    deadline = time.monotonic() + 30.0  # the step has its own (move) timeout, well under this
     while not done.is_set():
+        assert time.monotonic() < deadline, "the step did not end"
         seen.add(round(watcher.read_pose().y, 1))
-    thread.join()
+    join(thread, "the stepping thread")
     assert not errors
     assert len(seen) > 3 and max(seen) == pytest.approx(y0 + 30, abs=0.1)
 

@@ -61,4 +61,6 @@ def test_cli_status_reports_a_silent_controller_within_the_poll_timeout(
         elapsed = time.monotonic() - t0
     assert (code, out) == (EXIT_LINK, "")
     assert err == f"teachpad-cli: error: controller did not answer within 0.15 s (127.0.0.1:{server.port})\n"
-    assert elapsed < 0.15 + 0.2  # the poll timeout, not the 1 s command timeout
+    # the poll timeout, not the 1 s command timeout (0.35 s was once not enough for the whole CLI
+    # run, connect and error included, on a loaded machine)
+    assert elapsed < 0.15 + 0.6

@@ -5,6 +5,7 @@ from __future__ import annotations
 import threading
 
 from app.link.jobs import JOG_PRESS, JOG_RATIO, Job, JobKind, JobQueue
+from tests.waits import join
 
 
 def _job(name: str, kind: JobKind = JobKind.PLAIN, **kw: object) -> Job:
@@ -64,5 +65,5 @@ def test_ids_are_unique_across_threads() -> None:
     for t in threads:
         t.start()
     for t in threads:
-        t.join()
+        join(t, "a thread putting jobs")
     assert len(set(ids)) == 2000

@@ -23,6 +23,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     link_fixture,
     register_writes,
 )
+from tests.waits import join
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -49,7 +50,7 @@ def test_a_stop_sent_from_another_thread_reaches_the_simulator(sim: Any, line: S
     sent: list[Any] = []
     thread = threading.Thread(target=lambda: sent.append(line.send_stop()))
     thread.start()
-    thread.join()
+    join(thread, "the thread sending the stop")
     assert sent[0] is not None
     assert sim.wait_for(lambda _s: _stops(sim) == 1, 2.0)
     assert line.send_stop() is None  # the first one's answer is not read yet: no second one

@@ -19,6 +19,7 @@ from app.points import atomic
 from app.points.lock import LockOwner, ProjectLock, ProjectLocked, live_owner, lock_path
 from app.points.point import make_point
 from app.points.project import Project, load_project, project_to_json, save_project
+from tests.waits import kill_child, read_line, wait_child
 
 ROOT = Path(__file__).resolve().parents[2]
 KILLS = 8
@@ -69,12 +70,9 @@ def test_kill_9_during_saves_leaves_a_whole_file_and_the_next_save_cleans_up(
         try:
             assert child.stdout is not None
             for _line in range(rng.randint(1, 6)):  # let it finish a few saves, then kill mid-way
-                assert child.stdout.readline(), "the saving child died"
+                assert read_line(child.stdout, "the saving child"), "the saving child died"
         finally:
-            os.kill(child.pid, signal.SIGKILL)
-            child.wait()
-            if child.stdout is not None:
-                child.stdout.close()
+            kill_child(child)  # SIGKILL, mid-save
         assert target.read_bytes() in (old, new)  # never a mix, never empty
         load_project(target)
         leftovers_seen += bool(_temp_files(work))
@@ -122,16 +120,12 @@ def other_teachpad(tmp_path: Path) -> Iterator[tuple[subprocess.Popen[str], Path
         text=True,
         env={**os.environ, "PYTHONPATH": str(ROOT)},
     )
-    assert child.stdout is not None and child.stdout.readline().strip() == "locked"
     try:
+        assert child.stdout is not None
+        assert read_line(child.stdout, "the other process taking the lock").strip() == "locked"
         yield child, project
     finally:
-        if child.poll() is None:
-            child.kill()
-        child.wait()
-        for stream in (child.stdin, child.stdout):
-            if stream is not None:
-                stream.close()
+        kill_child(child)
 
 
 def test_a_live_lock_of_another_process_is_respected_and_released(
@@ -145,7 +139,7 @@ def test_a_live_lock_of_another_process_is_respected_and_released(
     assert info.value.owner.pid == child.pid
     assert child.stdin is not None
     child.stdin.close()  # the other TeachPad closes the project
-    child.wait()
+    assert wait_child(child, "the other process, its stdin closed") == 0
     assert not lock_path(project).exists() and live_owner(project) is None
     with ProjectLock.acquire(project) as lock:
         assert lock.held and json.loads(lock.path.read_text())["pid"] == os.getpid()
@@ -155,7 +149,7 @@ def test_a_live_lock_of_another_process_is_respected_and_released(
 def test_a_lock_of_a_killed_process_is_stale(other_teachpad: tuple[subprocess.Popen[str], Path]) -> None:
     child, project = other_teachpad
     os.kill(child.pid, signal.SIGKILL)
-    child.wait()
+    wait_child(child, "the killed process")
     assert lock_path(project).exists() and live_owner(project) is None
     lock = ProjectLock.acquire(project)
     assert json.loads(lock.path.read_text())["pid"] == os.getpid()

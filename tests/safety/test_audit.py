@@ -28,6 +28,7 @@ from app.safety.audit import (
     query,
     read_records,
 )
+from tests.waits import wait_child
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -166,7 +167,7 @@ def test_every_write_appears_once_also_after_kill_9(tmp_path: Path, sim: Any) ->
             assert child.poll() is None, "the child died by itself"
         finally:
             child.send_signal(signal.SIGKILL)
-            child.wait()
+            wait_child(child, "the writing child, killed")
     stats = ReadStats()
     recs = [r for r in read_records(tmp_path, stats=stats) if r.kind == "write"]
     assert stats.skipped <= kills  # at most a cut last line per kill (in practice none)

@@ -24,6 +24,7 @@ import pytest
 
 from app.safety.audit import ReadStats, Result, audit_files, read_records
 from app.safety.register_profile import PROFILE_NAME, RegisterProfile, save_register_profile
+from tests.waits import wait_child
 from ui.panels.audit_viewer import AuditViewer
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -107,7 +108,7 @@ def test_gui_writes_are_audited_once_also_after_kill_9(tmp_path: Path, sim_facto
         assert sent, "the GUI did not write enough in time"
     finally:
         child.send_signal(signal.SIGKILL)  # mid-upload: no chance to finish a line or close a file
-        child.wait()
+        wait_child(child, "the GUI, killed")
         child.stderr.close()
     received = [_write_key(w.function_code, w.address, w.values) for w in sim.writes]
     audit_dir = tmp_path / "safety" / "audit"  # beside the INI settings file

@@ -15,6 +15,7 @@ from app.link.client import ConnectionSettings, RobotClient
 from app.sim.cli import build_parser, execute
 from app.sim.guard import WATCHDOG_TIMEOUT
 from tests.serial.relay import PtyRelay
+from tests.waits import CHILD_TIMEOUT, kill_child, read_line
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -46,15 +47,18 @@ def test_teachpad_sim_serves_a_serial_line() -> None:
     client = RobotClient(ConnectionSettings(serial_port=relay.host_port, baudrate=57600, timeout=0.5))
     try:
         assert proc.stdout is not None
-        banner = proc.stdout.readline()
+        banner = read_line(proc.stdout, "teachpad-sim's banner")
         assert f"listening on {relay.sim_port} (57600 baud, 8N1)" in banner
         client.connect()
         assert client.read_status().mode == 1
     finally:
         client.close()
         proc.send_signal(signal.SIGTERM)
-        out, err = proc.communicate(timeout=10)
-        relay.close()
+        try:
+            out, err = proc.communicate(timeout=CHILD_TIMEOUT)
+        finally:
+            kill_child(proc)  # only when it did not stop by itself
+            relay.close()
     assert proc.returncode == 0, err
     assert "teachpad-sim stopped" in out
 

@@ -18,6 +18,7 @@ from app.protocol.enums import Alarm
 from app.sim import SimController
 from app.sim.cli import build_parser, execute, main
 from tests.sim.conftest import Bus, poll
+from tests.waits import CHILD_TIMEOUT, read_line
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -84,7 +85,7 @@ def test_process_runs_takes_commands_and_stops_on_sigterm(make_bus: Callable[...
     ) as proc:
         try:
             assert proc.stdout is not None and proc.stdin is not None
-            line = proc.stdout.readline()
+            line = read_line(proc.stdout, "teachpad-sim's banner")
             match = re.search(r"listening on 127\.0\.0\.1:(\d+)", line)
             assert match, line
             bus = make_bus(int(match.group(1)))
@@ -103,4 +104,4 @@ def test_process_runs_takes_commands_and_stops_on_sigterm(make_bus: Callable[...
         finally:
             if proc.poll() is None:
                 proc.kill()
-                proc.communicate()
+                proc.communicate(timeout=CHILD_TIMEOUT)

@@ -25,6 +25,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     translator_fixture,
     window_fixture,
 )
+from tests.waits import loop_deadline
 from ui.dialogs.connection_dialog import ConnectionDialog
 from ui.i18n import qm_path
 from ui.main import main
@@ -187,19 +188,9 @@ def test_settings_use_the_given_file(tmp_path: Any, qapp: Any) -> None:
 
 def test_teachpad_sim_screenshot(qtbot: Any, tmp_path: Any) -> None:
     png = tmp_path / "shot.png"
-    code = main(
-        [
-            "--sim",
-            "--screenshot",
-            str(png),
-            "--size",
-            "1700x1000",
-            "--settings",
-            str(tmp_path / "teachpad.ini"),
-            "--lang",
-            "en",
-        ]
-    )
+    args = ["--sim", "--screenshot", str(png), "--size", "1700x1000"]
+    with loop_deadline("teachpad --sim --screenshot"):  # main()'s app.exec() runs in this process
+        code = main([*args, "--settings", str(tmp_path / "teachpad.ini"), "--lang", "en"])
     assert code == 0
     image = QImage(str(png))
     assert not image.isNull() and image.width() >= 1600

@@ -125,6 +125,7 @@ def _stopped_by_controller() -> CommandResult:
     result = None
     while result is None:
         now += 0.1
+        assert now < 60.0, "a stop the controller reported never ended the command"
         result = tracker.update(_status(0, state=ProgramState.STOPPED), None, now)
     return result
 

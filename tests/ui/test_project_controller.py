@@ -16,6 +16,7 @@ import pytest
 from app.points.ledger import ImportMode, SyncState
 from app.points.lock import live_owner, lock_path
 from app.points.project import load_project, save_autosave
+from tests.waits import kill_child, read_line, wait_child
 from ui.controllers.project_controller import ProjectController
 from ui.models.point_columns import COL_X
 
@@ -268,16 +269,12 @@ def other_teachpad(project_file: Path) -> Iterator[subprocess.Popen[str]]:
         text=True,
         env={**os.environ, "PYTHONPATH": str(ROOT)},
     )
-    assert child.stdout is not None and child.stdout.readline().strip() == "locked"
     try:
+        assert child.stdout is not None
+        assert read_line(child.stdout, "the other TeachPad taking the lock").strip() == "locked"
         yield child
     finally:
-        if child.poll() is None:
-            child.kill()
-        child.wait()
-        for stream in (child.stdin, child.stdout):
-            if stream is not None:
-                stream.close()
+        kill_child(child)
 
 
 def test_a_second_teachpad_says_the_project_is_open_instead_of_offering_its_autosave(
@@ -306,7 +303,7 @@ def test_a_second_teachpad_says_the_project_is_open_instead_of_offering_its_auto
     # the other TeachPad closes: the project is ours, and its lock too
     assert other_teachpad.stdin is not None
     other_teachpad.stdin.close()
-    other_teachpad.wait()
+    assert wait_child(other_teachpad, "the other TeachPad, its stdin closed") == 0
     assert direct.lock_owner is None
     assert live_owner(project_file) is None and lock_path(project_file).exists()
     direct.close()

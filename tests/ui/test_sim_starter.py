@@ -49,3 +49,22 @@ def test_closing_while_it_starts_stops_it(qtbot: Any, monkeypatch: pytest.Monkey
     starter.close()  # the window closed at once: waits for the start, then stops the simulator
     assert len(made) == 1 and made[0].process.poll() is not None
     assert starter.sim is None
+
+
+def test_a_window_that_never_paints_still_gets_its_simulator(
+    qtbot: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Started minimized or on another desktop, the window does not paint: the simulator starts
+    anyway, a little later."""
+    monkeypatch.setattr(teachpad, "SIM_START_LATEST_MS", 100)
+    window = QWidget()  # never shown
+    qtbot.addWidget(window)
+    starter = _SimStarter(window)
+    try:
+        with qtbot.waitSignal(starter.started, timeout=30_000) as started:
+            pass
+        sim = started.args[0]
+        assert isinstance(sim, SimProcess) and starter.sim is sim
+    finally:
+        starter.close()
+    assert sim.process.poll() == 0

@@ -12,6 +12,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 TS = ROOT / "resources" / "translations" / "teachpad_zh_CN.ts"
+TOOL_TIMEOUT = 90.0  # s for lupdate over every source file (a loaded machine), or lrelease
 QM = ROOT / "ui" / "i18n" / "teachpad_zh_CN.qm"
 BIN = Path(sys.executable).parent
 
@@ -46,7 +47,12 @@ def test_every_source_string_has_a_chinese_translation(tmp_path: Path) -> None:
     sources = sorted(str(p) for p in (ROOT / "app").rglob("*.py")) + sorted(
         str(p) for p in (ROOT / "ui").rglob("*.py")
     )
-    subprocess.run([_tool("pyside6-lupdate"), *sources, "-ts", str(fresh)], check=True, capture_output=True)
+    subprocess.run(
+        [_tool("pyside6-lupdate"), *sources, "-ts", str(fresh)],
+        check=True,
+        capture_output=True,
+        timeout=TOOL_TIMEOUT,
+    )
     wanted = set(_messages(fresh))
     shipped = _messages(TS)
     missing = sorted(key for key in wanted if not shipped.get(key))
@@ -55,7 +61,12 @@ def test_every_source_string_has_a_chinese_translation(tmp_path: Path) -> None:
 
 def test_the_shipped_qm_is_the_compiled_ts(tmp_path: Path) -> None:
     out = tmp_path / "check.qm"
-    subprocess.run([_tool("pyside6-lrelease"), str(TS), "-qm", str(out)], check=True, capture_output=True)
+    subprocess.run(
+        [_tool("pyside6-lrelease"), str(TS), "-qm", str(out)],
+        check=True,
+        capture_output=True,
+        timeout=TOOL_TIMEOUT,
+    )
     assert out.read_bytes() == QM.read_bytes(), "run `make translations` to rebuild the .qm"
 
 

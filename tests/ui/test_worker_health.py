@@ -74,6 +74,9 @@ class Rig(QObject):
             self.connectTo.emit(connection_settings(sim, **overrides))
 
 
+_still_running: list[Rig] = []  # rigs whose thread did not end: kept, never destroyed while running
+
+
 @pytest.fixture
 def rig(qtbot: Any, fast_reconnect: None) -> Iterator[Rig]:
     """The shutdown is a queued call after which the worker quits its own thread."""
@@ -81,9 +84,13 @@ def rig(qtbot: Any, fast_reconnect: None) -> Iterator[Rig]:
     try:
         yield made
     finally:
-        with qtbot.waitSignal(made.stopped, timeout=SIGNAL_TIMEOUT_MS):
-            made.shutdown.emit()
-        assert made.worker_thread.wait(SIGNAL_TIMEOUT_MS)
+        try:
+            with qtbot.waitSignal(made.stopped, timeout=SIGNAL_TIMEOUT_MS):
+                made.shutdown.emit()
+        finally:
+            if not made.worker_thread.wait(SIGNAL_TIMEOUT_MS):
+                _still_running.append(made)  # destroying a running QThread would abort the whole run
+                pytest.fail(f"the worker's thread did not end within {SIGNAL_TIMEOUT_MS} ms", pytrace=False)
 
 
 def test_command_finished_comes_after_the_pose_and_status_of_its_poll(qtbot: Any, sim: Any, rig: Rig) -> None:
