@@ -2,8 +2,8 @@
 
 Order of a poll: **status first, then pose** -- so when the status says a motion ended, the pose
 read after it is the final one -- with the urgent jobs run between the two reads. Then, in this
-order: ``poseChanged`` / ``statusChanged`` / ``alarmsChanged`` (each only on change),
-``pollSucceeded``, the restart canary, ``commandFinished`` of the command the poll completed,
+order: one ``publish_polled`` of the pose / status / alarms (each only on change) and of the
+good poll, the restart canary, ``commandFinished`` of the command the poll completed,
 the RTT, the link statistics and the captured traffic. The clock (and the canary) are read
 every :data:`app.timing.CLOCK_POLL_PERIOD`. Polls use the poll timeout
 (``settings.effective_poll_timeout``), not the command timeout: a silent controller shows as
@@ -66,18 +66,21 @@ class Poller:
         self.rtt.forget()
         self.stats.forget()
 
-    def publish(self, pose: Pose, status: ControllerStatus) -> None:
-        host = self._host
+    def publish(self, pose: Pose, status: ControllerStatus, good_at: float | None = None) -> None:
+        """One delivery of what changed (pose, status, alarms; each None when unchanged) and of the
+        good poll at ``good_at`` (None: the connect read): one queued call to the GUI thread."""
+        new_pose: Pose | None = None
+        new_status: ControllerStatus | None = None
+        new_alarms: int | None = None
         if pose != self.last_pose:
-            self.last_pose = pose
-            host.publish_pose(pose)
+            self.last_pose = new_pose = pose
         if status != self.last_status:
-            self.last_status = status
-            host.publish_status(status)
+            self.last_status = new_status = status
         alarms = int(status.alarms)
         if alarms != self._last_alarms:
-            self._last_alarms = alarms
-            host.publish_alarms(alarms)
+            self._last_alarms = new_alarms = alarms
+        if new_pose is not None or new_status is not None or new_alarms is not None or good_at is not None:
+            self._host.publish_polled(new_pose, new_status, new_alarms, good_at)
 
     def poll_once(self) -> None:
         host = self._host
@@ -135,8 +138,7 @@ class Poller:
                 client.audit.note_controller_clock(status.clock.value, now)
         elif self.last_status is not None:
             status = dataclasses.replace(status, clock=self.last_status.clock)
-        self.publish(pose, status)
-        host.publish_poll(answered)
+        self.publish(pose, status, good_at=answered)
         if canary is not None:
             host.supervisor.canary_read(canary)
         done = host.motion.update(status, pose, answered)

@@ -29,7 +29,7 @@ from PySide6.QtCore import (
 from app import timing
 from app.errors import Reason
 from app.link.link_port import LinkPort, Pending, RequestRouter
-from app.link.state import DEFAULT_FRESHNESS_LIMIT, RobotState
+from app.link.state import DEFAULT_FRESHNESS_LIMIT, PollUpdate, RobotState
 from app.link.stats import LinkStats
 from app.link.transport import ConnectionSettings
 from app.link.types import ConnectionState, JogRequest, LinkState, StepFrame, WorkerError
@@ -140,18 +140,12 @@ class RobotLink(QObject):
         QMetaObject.invokeMethod(w, "start", Qt.ConnectionType.QueuedConnection)
         state = self._state
         for source, target in (  # the model first, so a view of the re-emitted signal reads the new value
-            (w.poseChanged, state.set_pose),
-            (w.statusChanged, state.set_status),
-            (w.alarmsChanged, state.set_alarms),
+            (w.polled, self._on_polled),  # pose, status, alarms, good poll: one queued call per poll
             (w.rttChanged, state.set_rtt),
-            (w.pollSucceeded, state.note_good_poll),
             (w.linkStatsChanged, self._on_stats),
             (w.commandFinished, self._on_result),
             (w.errorOccurred, self._on_error),
             (w.connectionChanged, self._on_connection),
-            (w.poseChanged, self.poseChanged),
-            (w.statusChanged, self.statusChanged),
-            (w.alarmsChanged, self.alarmsChanged),
             (w.rttChanged, self.rttChanged),
             (w.trafficObserved, self.trafficObserved),
             (w.controllerReconnected, self.controllerReconnected),
@@ -203,6 +197,25 @@ class RobotLink(QObject):
         """The :class:`Pending` of a request id this link returned (call it right away, in the
         GUI thread: outcomes arrive through queued signals, so none can be missed)."""
         return self._router.track(request_id)
+
+    @Slot(object)
+    def _on_polled(self, update: PollUpdate) -> None:
+        """One poll's delivery, in the order of the separate signals it replaces: each datum to
+        the model first, then the link's own signal (a view of that reads the new value), then
+        the good poll (freshness), all before the ``commandFinished`` that poll completed."""
+        state = self._state
+        pose, status, alarms = update.pose, update.status, update.alarms
+        if pose is not None:
+            state.set_pose(pose)
+            self.poseChanged.emit(pose)
+        if status is not None:
+            state.set_status(status)
+            self.statusChanged.emit(status)
+        if alarms is not None:
+            state.set_alarms(alarms)
+            self.alarmsChanged.emit(alarms)
+        if update.good_at is not None:
+            state.note_good_poll(update.good_at)
 
     @Slot(ConnectionState)
     def _on_connection(self, state: ConnectionState) -> None:

@@ -29,6 +29,7 @@ known contents when stale: a view shows them as stale, it does not blank them.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 from PySide6.QtCore import QObject, QTimer, Signal, Slot
 
@@ -36,9 +37,22 @@ from app.link.stats import LinkStats
 from app.link.types import ConnectionState, LinkState
 from app.models import CommandResult, ControllerStatus, Pose
 
-__all__ = ["DEFAULT_FRESHNESS_LIMIT", "RobotState"]
+__all__ = ["DEFAULT_FRESHNESS_LIMIT", "PollUpdate", "RobotState"]
 
 DEFAULT_FRESHNESS_LIMIT = 0.5  # s without a good poll before the values count as stale
+
+
+@dataclass(frozen=True, slots=True)
+class PollUpdate:
+    """What one poll (or the first read of a new link) changed, delivered to the GUI thread in one
+    queued call: the pose, the status and the alarm bits (None: unchanged), and ``good_at``, the
+    ``time.monotonic()`` of the good poll (None for the connect read, which is not a poll).
+    Applied in this order: pose, status, alarms, then the good poll."""
+
+    pose: Pose | None = None
+    status: ControllerStatus | None = None
+    alarms: int | None = None
+    good_at: float | None = None
 
 
 class RobotState(QObject):

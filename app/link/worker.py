@@ -68,6 +68,7 @@ from app.link.jog import JogMachine, PreemptedError
 from app.link.motion import MotionCommands, MotionTracker
 from app.link.poller import Poller
 from app.link.requests import STOP_HANDOFF_WAIT, WorkerRequests
+from app.link.state import PollUpdate
 from app.link.stats import LinkStats
 from app.link.stop_line import StopLine
 from app.link.supervisor import DEFAULT_CANARY_GV, LinkSupervisor
@@ -95,6 +96,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     connectionChanged = Signal(ConnectionState)  # noqa: N815
     rttChanged = Signal(float)  # noqa: N815 - ms, mean over RTT_REPORT_PERIOD
     pollSucceeded = Signal(float)  # noqa: N815 - time.monotonic() of a good poll, after its pose/status
+    polled = Signal(object)  # PollUpdate: the four above of one poll in one delivery (RobotLink's)
     linkStatsChanged = Signal(object)  # noqa: N815 - LinkStats, at most every RTT_REPORT_PERIOD, on change
     commandFinished = Signal(CommandResult)  # noqa: N815
     errorOccurred = Signal(WorkerError)  # noqa: N815
@@ -283,8 +285,20 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     def publish_rtt(self, ms: float) -> None:
         self.rttChanged.emit(ms)
 
-    def publish_poll(self, at: float) -> None:
-        self.pollSucceeded.emit(at)
+    def publish_polled(
+        self, pose: Pose | None, status: ControllerStatus | None, alarms: int | None, good_at: float | None
+    ) -> None:
+        """The separate signals (for whoever listens to the worker itself), then ``polled`` with all
+        of it: RobotLink listens to that one only (one queued call per poll into the GUI thread)."""
+        if pose is not None:
+            self.poseChanged.emit(pose)
+        if status is not None:
+            self.statusChanged.emit(status)
+        if alarms is not None:
+            self.alarmsChanged.emit(alarms)
+        if good_at is not None:
+            self.pollSucceeded.emit(good_at)
+        self.polled.emit(PollUpdate(pose, status, alarms, good_at))
 
     def publish_link_stats(self, stats: LinkStats) -> None:
         self.linkStatsChanged.emit(stats)

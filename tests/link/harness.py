@@ -114,8 +114,17 @@ class PartsHost:
     def publish_rtt(self, ms: float) -> None:
         self.out.append(("rttChanged", ms))
 
-    def publish_poll(self, at: float) -> None:
-        self.out.append(("pollSucceeded", at))
+    def publish_polled(
+        self, pose: Pose | None, status: ControllerStatus | None, alarms: int | None, good_at: float | None
+    ) -> None:  # recorded as the worker's separate signals, in their order
+        if pose is not None:
+            self.out.append(("poseChanged", pose))
+        if status is not None:
+            self.out.append(("statusChanged", status))
+        if alarms is not None:
+            self.out.append(("alarmsChanged", alarms))
+        if good_at is not None:
+            self.out.append(("pollSucceeded", good_at))
 
     def publish_link_stats(self, stats: LinkStats) -> None:
         self.out.append(("linkStatsChanged", stats))
