@@ -121,6 +121,11 @@ class TrafficPanel(QWidget):
         self.view.setTextElideMode(Qt.TextElideMode.ElideRight)
         self.view.setAlternatingRowColors(True)
         self.view.setHorizontalScrollMode(QAbstractItemView.ScrollMode.ScrollPerPixel)
+        # the scroll bars move with every flush: opaque, they repaint alone, not the dock (and its
+        # title bar's icons) and the window behind them
+        for scroll_bar in (self.view.verticalScrollBar(), self.view.horizontalScrollBar()):
+            scroll_bar.setAutoFillBackground(True)
+            scroll_bar.parentWidget().setAutoFillBackground(True)
         vheader = self.view.verticalHeader()
         vheader.setVisible(False)
         vheader.setSectionResizeMode(QHeaderView.ResizeMode.Fixed)
