@@ -1,0 +1,54 @@
+"""One poll reaches the GUI thread as one delivery (the worker's ``polled``), and RobotLink
+replays it in the order of the separate signals it replaced: each datum into RobotState first,
+then the link's own signal, the good poll after them, and the command a poll completed after
+that poll's pose (issue 8's race)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from app.link.client import StepFrame
+from app.link.robot_link import RobotLink
+from app.models import CommandResult
+from tests.ui.pendant_support import (  # noqa: F401 - fixtures
+    SIGNAL_TIMEOUT_MS,
+    connect,
+    fast_reconnect_fixture,
+    link_fixture,
+)
+
+
+def test_a_poll_is_replayed_in_the_old_order(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    connect(qtbot, link, sim)
+    state = link.state
+    seen: list[tuple[str, Any]] = []
+    model_first: list[bool] = []
+    state.poseChanged.connect(lambda p: seen.append(("state.pose", p)))
+    state.statusChanged.connect(lambda s: seen.append(("state.status", s)))
+    state.alarmsChanged.connect(lambda a: seen.append(("state.alarms", a)))
+    link.poseChanged.connect(lambda p: (seen.append(("link.pose", p)), model_first.append(state.pose == p)))
+    link.statusChanged.connect(
+        lambda s: (seen.append(("link.status", s)), model_first.append(state.status == s))
+    )
+    link.alarmsChanged.connect(lambda a: seen.append(("link.alarms", a)))
+    link.commandFinished.connect(lambda r: seen.append(("link.result", r)))
+
+    pending = link.track(link.step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], speed=20.0))
+    with qtbot.waitSignal(link.commandFinished, timeout=SIGNAL_TIMEOUT_MS * 3):
+        pass
+    qtbot.waitUntil(lambda: pending.result is not None, timeout=SIGNAL_TIMEOUT_MS)
+    assert pending.result is not None and pending.result.ok
+
+    assert model_first and all(model_first)  # a view of the link's signal reads the new value
+    names = [name for name, _ in seen]
+    for i, name in enumerate(names):
+        if name in ("state.pose", "state.status"):  # the link's own signal right after the model's
+            assert names[i + 1] == name.replace("state.", "link."), names[i : i + 3]
+    done = next(
+        i for i, (name, value) in enumerate(seen) if name == "link.result" and value is pending.result
+    )
+    assert isinstance(seen[done][1], CommandResult)
+    last_pose = next(value for name, value in reversed(seen[:done]) if name == "link.pose")
+    final = sim.state().joints[0]  # the step ended there: its pose was delivered before its result
+    assert last_pose.joints is not None and abs(last_pose.joints[0] - final) < 1e-3
+    assert state.fresh
