@@ -125,7 +125,9 @@ class TrafficPanel(QWidget):
         # title bar's icons) and the window behind them
         for scroll_bar in (self.view.verticalScrollBar(), self.view.horizontalScrollBar()):
             scroll_bar.setAutoFillBackground(True)
-            scroll_bar.parentWidget().setAutoFillBackground(True)
+            container = scroll_bar.parentWidget()
+            if container is not None:
+                container.setAutoFillBackground(True)
         vheader = self.view.verticalHeader()
         vheader.setVisible(False)
         vheader.setSectionResizeMode(QHeaderView.ResizeMode.Fixed)
