@@ -26,17 +26,18 @@ def test_a_poll_is_replayed_in_the_old_order(qtbot: Any, sim: Any, link: RobotLi
     state.poseChanged.connect(lambda p: seen.append(("state.pose", p)))
     state.statusChanged.connect(lambda s: seen.append(("state.status", s)))
     state.alarmsChanged.connect(lambda a: seen.append(("state.alarms", a)))
-    link.poseChanged.connect(lambda p: (seen.append(("link.pose", p)), model_first.append(state.pose == p)))
-    link.statusChanged.connect(
-        lambda s: (seen.append(("link.status", s)), model_first.append(state.status == s))
-    )
+
+    def on_link(name: str, value: Any, current: Any) -> None:
+        seen.append((name, value))
+        model_first.append(current == value)
+
+    link.poseChanged.connect(lambda p: on_link("link.pose", p, state.pose))
+    link.statusChanged.connect(lambda s: on_link("link.status", s, state.status))
     link.alarmsChanged.connect(lambda a: seen.append(("link.alarms", a)))
     link.commandFinished.connect(lambda r: seen.append(("link.result", r)))
 
     pending = link.track(link.step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], speed=20.0))
-    with qtbot.waitSignal(link.commandFinished, timeout=SIGNAL_TIMEOUT_MS * 3):
-        pass
-    qtbot.waitUntil(lambda: pending.result is not None, timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(lambda: pending.result is not None, timeout=SIGNAL_TIMEOUT_MS * 3)
     assert pending.result is not None and pending.result.ok
 
     assert model_first and all(model_first)  # a view of the link's signal reads the new value
