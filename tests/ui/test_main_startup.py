@@ -66,7 +66,7 @@ def test_nothing_heavy_is_imported_before_the_first_paint(tmp_path: Any) -> None
 
         HEAVY = ("numpy", "pymodbus", "pyqtgraph", "asyncio", "app.link.worker", "app.link.client",
                  "ui.panels.points_panel", "ui.panels.planner_panel", "ui.panels.view3d_panel",
-                 "ui.panels.traffic_panel")
+                 "ui.panels.traffic_panel", "app.plan.runner")
         teachpad.MainWindow = Probe
         sys.exit(teachpad.main(["--settings", sys.argv[1], "--host", "127.0.0.1", "--port", "9"]))
     """)
