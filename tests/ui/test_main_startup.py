@@ -48,8 +48,9 @@ def test_the_callback_runs_once_after_the_first_paint(qtbot: Any) -> None:
 
 def test_nothing_heavy_is_imported_before_the_first_paint(tmp_path: Any) -> None:
     """``teachpad`` (ui.main.main) up to the window's first paint imports neither pymodbus nor
-    numpy nor pyqtgraph, makes no link worker and builds neither Points nor Planner: the start-up
-    figure of issue 10 (first paint vs a bare QMainWindow) depends on it."""
+    numpy nor pyqtgraph (nor the plan runner or the project lock), makes no link worker and builds
+    neither Points nor Planner: the start-up figure of issue 10 (first paint vs a bare QMainWindow)
+    depends on it."""
     code = textwrap.dedent("""
         import json, sys
         from PySide6.QtWidgets import QApplication
@@ -66,7 +67,7 @@ def test_nothing_heavy_is_imported_before_the_first_paint(tmp_path: Any) -> None
 
         HEAVY = ("numpy", "pymodbus", "pyqtgraph", "asyncio", "app.link.worker", "app.link.client",
                  "ui.panels.points_panel", "ui.panels.planner_panel", "ui.panels.view3d_panel",
-                 "ui.panels.traffic_panel")
+                 "ui.panels.traffic_panel", "app.plan.runner", "app.points.lock")
         teachpad.MainWindow = Probe
         sys.exit(teachpad.main(["--settings", sys.argv[1], "--host", "127.0.0.1", "--port", "9"]))
     """)

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, Signal, Slot
 
@@ -37,12 +38,14 @@ from app.errors import LinkError, ResponseTimeout, TeachPadError
 from app.link.robot_link import LinkPort, Pending
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult, Pose
-from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState, SegmentCommand
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
 from ui.controllers.run_points import RunPoints, SegmentPoints
 from ui.messages import error_text, result_text
 from ui.models.points_model import PointsModel
+
+if TYPE_CHECKING:  # app.plan.runner is imported where a run starts, after the first paint
+    from app.plan.runner import PlanRunner, RunOutcome, RunProgress, SegmentCommand
 
 POSE_DETAIL_KEYS: tuple[str, ...] = ("x", "y", "z", "a", "b", "c")
 
@@ -149,6 +152,8 @@ class PlanRunController(QObject):
     @property
     def can_resume(self) -> bool:
         """A stopped or failed run can continue from :attr:`resume_from`."""
+        from app.plan.runner import RunState  # lazy: not before the first paint
+
         runner = self._runner
         return (
             runner is not None
@@ -180,6 +185,8 @@ class PlanRunController(QObject):
     ) -> None:
         """Run ``plan`` from segment ``start`` (``single``: that segment only). Raises
         :class:`~app.errors.InvalidInput` for a bad start and :class:`LinkError` without a link."""
+        from app.plan.runner import PlanRunner  # lazy: not before the first paint
+
         if self.running:
             raise RuntimeError("a run is already under way")
         link = self._require_link()
@@ -233,6 +240,8 @@ class PlanRunController(QObject):
 
     def outcome_text(self, outcome: RunOutcome) -> str:
         """How a stopped or failed run ended, in the operator's language (one sentence)."""
+        from app.plan.runner import RunState  # lazy: not before the first paint
+
         failed = outcome.state is RunState.FAILED
         reason = self.end_reason or outcome.message
         if outcome.resume_from is None:
@@ -248,6 +257,8 @@ class PlanRunController(QObject):
     def stop(self) -> None:
         """Stop the robot and the run. The run ends when the link reports the stopped move
         (at once when no move is out, or when the link is down)."""
+        from app.plan.runner import RunState  # lazy: not before the first paint
+
         runner = self._runner
         link = self._link
         if link is not None:
@@ -281,6 +292,8 @@ class PlanRunController(QObject):
             self.pausedChanged.emit(paused)
 
     def _on_progress(self, progress: RunProgress) -> None:
+        from app.plan.runner import RunEvent  # lazy: not before the first paint
+
         self._progress = progress
         if progress.event is RunEvent.SEGMENT_STARTED:
             self.segmentStarted.emit(progress.index, progress.loop)
@@ -309,6 +322,8 @@ class PlanRunController(QObject):
         upload.failed.connect(lambda error: self._on_upload_error(upload, error))
 
     def _on_upload(self, upload: Pending, result: CommandResult) -> None:
+        from app.plan.runner import RunState  # lazy: not before the first paint
+
         runner, guard, link = self._runner, self._guard, self._link
         if (
             upload is not self._upload
@@ -334,6 +349,8 @@ class PlanRunController(QObject):
             self._send_move(link, command)
 
     def _on_upload_error(self, upload: Pending, error: WorkerError) -> None:
+        from app.plan.runner import RunState  # lazy: not before the first paint
+
         runner = self._runner
         if upload is not self._upload or runner is None or runner.state is not RunState.RUNNING:
             return
@@ -400,6 +417,8 @@ class PlanRunController(QObject):
             self._send_next(self._link)
 
     def _on_result(self, move: Pending, result: CommandResult) -> None:
+        from app.plan.runner import RunState  # lazy: not before the first paint
+
         runner = self._runner
         if move is not self._move or runner is None or runner.state is not RunState.RUNNING:
             return
@@ -428,6 +447,8 @@ class PlanRunController(QObject):
         self._after_report()
 
     def _on_error(self, move: Pending, error: WorkerError) -> None:
+        from app.plan.runner import RunState  # lazy: not before the first paint
+
         runner = self._runner
         if move is not self._move or runner is None or runner.state is not RunState.RUNNING:
             return
@@ -438,6 +459,8 @@ class PlanRunController(QObject):
         self._after_report()
 
     def _on_stop_failed(self, stop: Pending, error: WorkerError) -> None:
+        from app.plan.runner import RunState  # lazy: not before the first paint
+
         runner = self._runner
         if (
             stop is self._stop
@@ -452,6 +475,8 @@ class PlanRunController(QObject):
 
     @Slot(ConnectionState)
     def _on_connection(self, state: ConnectionState) -> None:
+        from app.plan.runner import RunState  # lazy: not before the first paint
+
         self.connectedChanged.emit(state.connected)
         runner = self._runner
         if not state.connected and runner is not None and runner.state is RunState.RUNNING:

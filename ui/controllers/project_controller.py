@@ -30,14 +30,13 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QObject, QTimer, Signal, Slot
 from PySide6.QtGui import QAction, QKeySequence, QUndoStack
 
 from app.errors import InvalidInput
 from app.points.ledger import EmptyImport, ImportMode
-from app.points.lock import LockOwner, ProjectLock, ProjectLocked, live_owner
 from app.points.point import FileFormatError
 from app.points.project import (
     PROJECT_SUFFIX,
@@ -55,6 +54,9 @@ from ui.controllers.project_dialogs import ProjectDialogs
 from ui.messages import os_error_text, refusal_text
 from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
+
+if TYPE_CHECKING:  # app.points.lock is imported by the first open / save
+    from app.points.lock import LockOwner, ProjectLock
 
 AUTOSAVE_INTERVAL_S = 60.0  # seconds between autosaves while there are unsaved changes
 SAVE_CHOICES = ("save", "discard", "cancel")
@@ -206,6 +208,8 @@ class ProjectController(QObject):
     def open_file(self, path: str | os.PathLike[str] | None = None) -> bool:
         """Open a project (asks for the file when ``path`` is None). A bad file is refused
         with the core's message and the open project stays as it was."""
+        from app.points.lock import live_owner  # not before the first paint
+
         if path is None:
             chosen = self.dialogs.open_path(self.tr("Open project"), self._project_filter())
             if not chosen:
@@ -248,6 +252,8 @@ class ProjectController(QObject):
         return self._save_to(target)
 
     def _save_to(self, target: Path) -> bool:
+        from app.points.lock import live_owner  # not before the first paint
+
         old_autosave = self.autosave_file
         owner = live_owner(target)
         if owner is not None:
@@ -404,6 +410,8 @@ class ProjectController(QObject):
     def lock_owner(self) -> LockOwner | None:
         """Another running TeachPad that has this project open (None: the project is ours,
         or untitled). When that TeachPad has gone, this one takes the lock."""
+        from app.points.lock import live_owner  # not before the first paint
+
         if self._path is None or (self._lock is not None and self._lock.held):
             return None
         owner = live_owner(self._path)
@@ -414,6 +422,8 @@ class ProjectController(QObject):
 
     # --- the one-instance lock
     def _take_lock(self, path: Path) -> None:
+        from app.points.lock import ProjectLock, ProjectLocked  # not before the first paint
+
         self._release_lock()
         self._foreign_lock = None
         try:
