@@ -2685,27 +2685,27 @@
     <context>
         <name>PlanRunController</name>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="239" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="248" />
             <source>Failed: {reason}</source>
             <translation>失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="239" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="248" />
             <source>Stopped: {reason}</source>
             <translation>已停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="242" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="251" />
             <source>Failed at segment {n}: {reason}</source>
             <translation>在第 {n} 段失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="244" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="253" />
             <source>Stopped at segment {n}: {reason}</source>
             <translation>在第 {n} 段停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="260" />
+            <location filename="../../ui/controllers/plan_run_controller.py" line="271" />
             <source>stopped by the operator</source>
             <translation>已由操作员停止</translation>
         </message>
@@ -3737,158 +3737,158 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="136" />
+            <location filename="../../ui/controllers/project_controller.py" line="138" />
             <source>Undo</source>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="138" />
+            <location filename="../../ui/controllers/project_controller.py" line="140" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="142" />
+            <location filename="../../ui/controllers/project_controller.py" line="144" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="143" />
+            <location filename="../../ui/controllers/project_controller.py" line="145" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="144" />
+            <location filename="../../ui/controllers/project_controller.py" line="146" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="145" />
+            <location filename="../../ui/controllers/project_controller.py" line="147" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="146" />
+            <location filename="../../ui/controllers/project_controller.py" line="148" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="147" />
+            <location filename="../../ui/controllers/project_controller.py" line="149" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="177" />
+            <location filename="../../ui/controllers/project_controller.py" line="179" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="210" />
+            <location filename="../../ui/controllers/project_controller.py" line="214" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="218" />
-            <location filename="../../ui/controllers/project_controller.py" line="254" />
-            <location filename="../../ui/controllers/project_controller.py" line="371" />
+            <location filename="../../ui/controllers/project_controller.py" line="222" />
+            <location filename="../../ui/controllers/project_controller.py" line="260" />
+            <location filename="../../ui/controllers/project_controller.py" line="377" />
             <source>Project in use</source>
             <translation>工程正在使用中</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="223" />
-            <location filename="../../ui/controllers/project_controller.py" line="226" />
+            <location filename="../../ui/controllers/project_controller.py" line="227" />
+            <location filename="../../ui/controllers/project_controller.py" line="230" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="229" />
+            <location filename="../../ui/controllers/project_controller.py" line="233" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="241" />
+            <location filename="../../ui/controllers/project_controller.py" line="245" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="259" />
+            <location filename="../../ui/controllers/project_controller.py" line="265" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="271" />
+            <location filename="../../ui/controllers/project_controller.py" line="277" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="277" />
+            <location filename="../../ui/controllers/project_controller.py" line="283" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="284" />
-            <location filename="../../ui/controllers/project_controller.py" line="287" />
-            <location filename="../../ui/controllers/project_controller.py" line="301" />
+            <location filename="../../ui/controllers/project_controller.py" line="290" />
+            <location filename="../../ui/controllers/project_controller.py" line="293" />
+            <location filename="../../ui/controllers/project_controller.py" line="307" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="303" />
+            <location filename="../../ui/controllers/project_controller.py" line="309" />
             <source>{added} added, {updated} updated, {unchanged} unchanged, {removed} removed</source>
             <translation>新增 {added} 个，更新 {updated} 个，未变 {unchanged} 个，删除 {removed} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="306" />
+            <location filename="../../ui/controllers/project_controller.py" line="312" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="312" />
+            <location filename="../../ui/controllers/project_controller.py" line="318" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="319" />
+            <location filename="../../ui/controllers/project_controller.py" line="325" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="322" />
+            <location filename="../../ui/controllers/project_controller.py" line="328" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="349" />
+            <location filename="../../ui/controllers/project_controller.py" line="355" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="387" />
-            <location filename="../../ui/controllers/project_controller.py" line="390" />
+            <location filename="../../ui/controllers/project_controller.py" line="393" />
+            <location filename="../../ui/controllers/project_controller.py" line="396" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="393" />
+            <location filename="../../ui/controllers/project_controller.py" line="399" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="425" />
+            <location filename="../../ui/controllers/project_controller.py" line="435" />
             <source>Cannot lock {path}: {reason}</source>
             <translation>无法锁定 {path}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="435" />
+            <location filename="../../ui/controllers/project_controller.py" line="445" />
             <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
             <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="471" />
+            <location filename="../../ui/controllers/project_controller.py" line="481" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="474" />
+            <location filename="../../ui/controllers/project_controller.py" line="484" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>
@@ -5104,63 +5104,63 @@ Remove them all?</source>
     <context>
         <name>TrafficPanel</name>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="153" />
+            <location filename="../../ui/panels/traffic_panel.py" line="160" />
             <source>Filter: bytes or meaning</source>
             <translation>过滤：字节或含义</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="154" />
+            <location filename="../../ui/panels/traffic_panel.py" line="161" />
             <source>Hide polls</source>
             <translation>隐藏轮询</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="156" />
+            <location filename="../../ui/panels/traffic_panel.py" line="163" />
             <source>Hide the periodic reads of 412.. (pose) and 560.. (status)</source>
             <translation>隐藏对 412..（位姿）和 560..（状态）的周期读取</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="158" />
+            <location filename="../../ui/panels/traffic_panel.py" line="165" />
             <source>Pause capture</source>
             <translation>暂停抓包</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="159" />
+            <location filename="../../ui/panels/traffic_panel.py" line="166" />
             <source>Stop recording frames (the worker stops building them)</source>
             <translation>停止记录报文（后台不再生成报文记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="160" />
+            <location filename="../../ui/panels/traffic_panel.py" line="167" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="161" />
+            <location filename="../../ui/panels/traffic_panel.py" line="168" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="287" />
+            <location filename="../../ui/panels/traffic_panel.py" line="294" />
             <source>Export traffic</source>
             <translation>导出通信报文</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="289" />
+            <location filename="../../ui/panels/traffic_panel.py" line="296" />
             <source>CSV files (*.csv);;Text files (*.txt);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;文本文件 (*.txt);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="163" />
-            <location filename="../../ui/panels/traffic_panel.py" line="318" />
+            <location filename="../../ui/panels/traffic_panel.py" line="170" />
+            <location filename="../../ui/panels/traffic_panel.py" line="325" />
             <source>{n} frames</source>
             <translation>{n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="320" />
+            <location filename="../../ui/panels/traffic_panel.py" line="327" />
             <source>{shown} of {n} frames shown</source>
             <translation>显示 {shown} / {n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="322" />
+            <location filename="../../ui/panels/traffic_panel.py" line="329" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
         </message>
