@@ -12,14 +12,9 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     import numpy as np
-    from numpy.typing import NDArray
 else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
     from app.lazy_numpy import np
-
-if TYPE_CHECKING:
-    Matrix = NDArray[np.float64]
-else:  # the names, for importers: only annotations (strings) use them, so no numpy here
-    Matrix = object
+from app.lazy_numpy import Matrix
 
 
 def rot_x(deg: float) -> Matrix:

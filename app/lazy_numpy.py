@@ -9,6 +9,7 @@ modules write::
         import numpy as np
     else:
         from app.lazy_numpy import np
+    from app.lazy_numpy import FloatArray, Matrix  # float64 arrays, for annotations
 
 mypy sees numpy itself; at run time ``np`` is a stand-in that imports numpy the first time one
 of its names is read and keeps each name it hands out as its own attribute, so a later
@@ -19,7 +20,17 @@ numpy itself when it is made (a jog guard's first check must not wait for the im
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeAlias
+
+if TYPE_CHECKING:
+    from numpy import float64
+    from numpy.typing import NDArray
+
+    FloatArray: TypeAlias = NDArray[float64]
+    Matrix: TypeAlias = NDArray[float64]
+else:  # the names, for importers: only annotations (strings) use them, so no numpy here
+    FloatArray = object
+    Matrix = object
 
 
 class LazyModule:
@@ -40,4 +51,4 @@ class LazyModule:
 
 np: Any = LazyModule("numpy")
 
-__all__ = ["LazyModule", "np"]
+__all__ = ["FloatArray", "LazyModule", "Matrix", "np"]

@@ -27,24 +27,12 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING
 
 from app.errors import InvalidInput
+from app.lazy_numpy import FloatArray as FloatArray  # for the plan's importers
 from app.points.fields import FieldError, parse_float, parse_int, parse_tool, shown
 from app.protocol.enums import QT_TRANSLATE_NOOP
 from app.protocol.registers import TOOL_NONE
-
-if TYPE_CHECKING:
-    import numpy as np
-    from numpy.typing import NDArray
-else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
-    from app.lazy_numpy import np
-
-if TYPE_CHECKING:
-    FloatArray = NDArray[np.float64]
-else:  # the names, for importers: only annotations (strings) use them, so no numpy here
-    FloatArray = object
-
 
 TR_CONTEXT = "Plan"
 

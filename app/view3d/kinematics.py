@@ -18,17 +18,9 @@ from app.view3d.profile import RobotProfile, joints_array
 
 if TYPE_CHECKING:
     import numpy as np
-    from numpy.typing import NDArray
 else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
     from app.lazy_numpy import np
-
-if TYPE_CHECKING:
-    Matrix = NDArray[np.float64]
-    FloatArray = NDArray[np.float64]
-else:  # the names, for importers: only annotations (strings) use them, so no numpy here
-    Matrix = object
-    FloatArray = object
-
+from app.lazy_numpy import FloatArray, Matrix
 
 IK_POS_TOL_MM: Final = 0.01
 IK_ROT_TOL_RAD: Final = 1e-5

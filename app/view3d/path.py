@@ -26,17 +26,9 @@ from app.points.ledger import PointLedger
 
 if TYPE_CHECKING:
     import numpy as np
-    from numpy.typing import NDArray
 else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
     from app.lazy_numpy import np
-
-if TYPE_CHECKING:
-    FloatArray = NDArray[np.float64]
-    Matrix = NDArray[np.float64]
-else:  # the names, for importers: only annotations (strings) use them, so no numpy here
-    FloatArray = object
-    Matrix = object
-
+from app.lazy_numpy import FloatArray, Matrix
 
 DRY_RUN_SAMPLES = 32  # per segment
 

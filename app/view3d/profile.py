@@ -27,11 +27,7 @@ if TYPE_CHECKING:
     from numpy.typing import NDArray
 else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
     from app.lazy_numpy import np
-
-if TYPE_CHECKING:
-    Matrix = NDArray[np.float64]
-else:  # the names, for importers: only annotations (strings) use them, so no numpy here
-    Matrix = object
+from app.lazy_numpy import Matrix
 
 PROFILE_FORMAT: Final = "teachpad-robot-profile"
 PROFILE_VERSION: Final = 1

@@ -36,11 +36,7 @@ if TYPE_CHECKING:
     from numpy.typing import NDArray
 else:  # numpy is imported by its first use, not with this module (app/lazy_numpy.py)
     from app.lazy_numpy import np
-
-if TYPE_CHECKING:
-    FloatArray = NDArray[np.float64]
-else:  # the names, for importers: only annotations (strings) use them, so no numpy here
-    FloatArray = object
+from app.lazy_numpy import FloatArray
 
 PATH_SAMPLES: Final = 9
 MIN_PATH_SAMPLES: Final = 3
