@@ -114,7 +114,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     ) -> None:
         super().__init__()
         self._poll_hz = float(poll_hz)
-        self._jobs = JobQueue()
+        self._jobs = JobQueue(halting=(Operation.STOP, Operation.CANCEL_UPLOAD))
         self._wake.connect(self._on_wake, Qt.ConnectionType.QueuedConnection)
         self._uploadStep.connect(self._upload_step, Qt.ConnectionType.QueuedConnection)
         # Everything below is touched only in the worker thread.
@@ -134,10 +134,11 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         self.motion = MotionTracker()
         self.motions = MotionCommands(self)
         self.jog = JogMachine(self)
-        self.uploader = Uploader(self)
         self.poller = Poller(self)
         self.supervisor = LinkSupervisor(self, canary_gv)  # raises on a bad canary GV
         self.stop_line = StopLine()  # the stop's own connection; send_stop from any thread
+        # a stop counts on the stop line before its 441 goes out, then (and a cancel) in the queue
+        self.uploader = Uploader(self, lambda: self.stop_line.stops_requested + self._jobs.halts)
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
 
     # --- lifecycle (worker thread) ------------------------------------------------------
