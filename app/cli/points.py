@@ -35,12 +35,13 @@ from typing import Any, TextIO
 
 from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode, exit_code_for
+from app.cli.points_upload import by_tool, staged_upload
 from app.errors import InvalidInput, TeachPadError
 from app.points.ledger import EmptyImport, ImportMode, PointLedger
 from app.points.lock import live_owner
 from app.points.point import FileFormatError, PointLimits, TempPoint, tool_text
 from app.points.project import Project, load_project, read_points_csv, save_project, write_points_csv
-from app.points.upload import UploadReport, apply_upload, parse_id_list, upload_points
+from app.points.upload import UploadReport, apply_upload, parse_id_list
 
 # The table's members under the names callers imported before the table existed.
 EXIT_OK = ExitCode.OK
@@ -217,13 +218,14 @@ class _ProgressLine:
 
 def _upload(ctx: CliContext, project: Project, points: Sequence[TempPoint], client: Any) -> UploadReport:
     line = _ProgressLine(ctx.out)
+    ordered = by_tool(points)
 
     def progress(done: int, total: int) -> None:
         if done < total:
-            line.show(f"uploading {done + 1}/{total}: {points[done].label}")
+            line.show(f"uploading {done + 1}/{total}: {ordered[done].label}")
 
     try:
-        report = upload_points(client, points, progress=progress)
+        report = staged_upload(client, ordered, progress=progress)
     finally:
         line.done()
     apply_upload(project.ledger, report)

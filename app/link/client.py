@@ -255,6 +255,8 @@ class RobotClient(CommandClient):
         gv_start: int = 0,
         stage: bool = True,
         stage_gv: int | None = None,
+        halted: Callable[[], bool] | None = None,
+        results: list[CommandResult] | None = None,
     ) -> list[CommandResult]:
         """Batched case 2.2: per point the pose GVs (one 0x10), GV200-202 (one 0x10), 440 <- 0xE0, polls.
 
@@ -270,6 +272,12 @@ class RobotClient(CommandClient):
         reads only its own block and GV200-202, which are written after its result, so the
         write only fills the controller's latency. A staged pose the upload then does not use
         (cancelled, link lost) stays in its GVs, unused.
+
+        ``halted`` (any thread may make it True; read on this one): once True -- a stop or a
+        cancel is on its way -- no further write of the batch starts: no staging write, no next
+        point (the point whose writes went out is waited for). ``results``: the list the results
+        are appended to as they come (returned), so a caller interrupted mid-batch (Ctrl-C) keeps
+        what was done.
         """
         items = [
             (self._check_point_id(pid), check_floats(pose, 6, f"pose of point {pid}")) for pid, pose in points
@@ -277,8 +285,9 @@ class RobotClient(CommandClient):
         tool = check_tool(tool)
         gv_start = check_int(gv_start, registers.GV_GENERAL_FIRST, _GENERAL_POSE_LAST_START, "first pose GV")
         spare = self._stage_block(gv_start, stage_gv) if stage else None
-        results: list[CommandResult] = []
-        if not items:
+        if results is None:
+            results = []
+        if not items or (halted is not None and halted()):
             return results
         status, _ = self._prepare(RunCommand.CREATE_POINT)
         self._write_tool(tool)
@@ -290,10 +299,14 @@ class RobotClient(CommandClient):
             return spare if spare is not None and index % 2 else gv_start
 
         for index, (point_id, values) in enumerate(items):
+            if halted is not None and halted():
+                break  # nothing of this point has gone out: it is not attempted
             block = block_of(index)
 
             def stage_next(nxt: int = index + 1) -> None:
                 nonlocal staged, spare
+                if halted is not None and halted():
+                    return  # a stop or cancel is pending: the next point will not be created
                 try:
                     self._write_floats(block_of(nxt), items[nxt][1])
                 except ModbusExceptionError:

@@ -4,6 +4,8 @@ Requests from any thread become :class:`Job` s; the worker pops them on its own 
 jobs (stop, pause, resume, jog release, cancel upload) come out before every other job; a newer
 job with the same ``coalesce`` key takes the place of a queued one (the jog press and the jog
 speed), and an urgent job can drop queued jobs by key (a release drops a press not yet started).
+``halts`` counts the queued jobs that end a running upload (stop, cancel upload): an upload sees
+one queued after it began before that job runs, and writes nothing more that it would not need.
 """
 
 from __future__ import annotations
@@ -12,7 +14,7 @@ import enum
 import itertools
 import threading
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 
 __all__ = ["JOG_PRESS", "JOG_RATIO", "Job", "JobKind", "JobQueue"]
@@ -43,7 +45,9 @@ class Job:
 class JobQueue:
     """Two deques under one lock; urgent jobs first. Safe to call from any thread."""
 
-    def __init__(self) -> None:
+    def __init__(self, halting: Collection[str] = ()) -> None:
+        self._halting = frozenset(halting)  # operations that end a running upload (stop, cancel)
+        self.halts = 0  # how many of those were queued so far (read from any thread)
         self._lock = threading.Lock()
         self._urgent: deque[Job] = deque()
         self._normal: deque[Job] = deque()
@@ -56,6 +60,8 @@ class JobQueue:
         with self._lock:
             job.seq = next(self._seq)
             job.request_id = next(self._ids)
+            if job.operation in self._halting:
+                self.halts += 1
             if job.kind is JobKind.URGENT:
                 if job.cancels:  # e.g. a release drops a press still waiting: it must never start
                     self._normal = deque(q for q in self._normal if q.coalesce not in job.cancels)

@@ -79,6 +79,7 @@ class StopLine:
         self._retry_at = 0.0
         self._failures = 0
         self.stops_sent = 0
+        self.stops_requested = 0  # every send_stop call (any thread), whether the line took it or not
 
     @property
     def up(self) -> bool:
@@ -89,7 +90,10 @@ class StopLine:
         """Write 441 <- 1 now, from the calling thread; None when the line cannot take it (down,
         busy with a keepalive read, an answer not yet read). One system call: no check before it
         (each would release the GIL, and the worker could take it); a line the controller closed
-        since the last keepalive loses this stop, and the main link's copy of it goes out as before."""
+        since the last keepalive loses this stop, and the main link's copy of it goes out as before.
+        ``stops_requested`` counts the call first (no GIL release before it): from here on the
+        worker's upload writes nothing more it would not need (no staging write, no next point)."""
+        self.stops_requested += 1
         if not self._lock.acquire(blocking=False):
             return None
         try:

@@ -7,14 +7,17 @@ pose while the controller creates the current point. Each chunk is at most
 :data:`app.timing.UPLOAD_CHUNK_POINTS` points of one tool or
 :data:`app.timing.UPLOAD_CHUNK_SECONDS`; the worker queues the next chunk behind whatever arrived
 meanwhile, so polls and queued calls keep flowing. Between two points the
-urgent jobs run (stop, cancel, jog release) and a poll goes out when one is due.
+urgent jobs run (stop, cancel, jog release) and a poll goes out when one is due. From the moment
+a stop or a cancel is asked for (the worker's ``halt_count`` grows: the stop line counts the
+Stop before it writes 441) until that job runs, nothing more is written: no staging write of the
+next pose, no next point; only the point whose writes already went out is waited for.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 from app import timing
@@ -56,6 +59,7 @@ class UploadRun:
     end: str | None = None  # why it ends early ("cancelled", "stopped", "link lost: ..."), once set
     progress_at: float = 0.0  # when uploadProgress was last emitted
     progress_done: int = -1  # the ``done`` it carried
+    halts_at_start: int = 0  # the host's count of stops and cancels requested when it began
 
 
 def stage_gv_for(canary_gv: int | None) -> int:
@@ -103,8 +107,11 @@ def check_upload_items(client: RobotClient, raw: Sequence[RawItem]) -> list[Uplo
 class Uploader:
     """The running upload (one at a time)."""
 
-    def __init__(self, host: WorkerHost) -> None:
+    def __init__(self, host: WorkerHost, halt_count: Callable[[], int] = lambda: 0) -> None:
+        """``halt_count`` (any thread's stops and cancels so far, growing): once it has grown
+        since the upload began, a stop or cancel is on its way and nothing more is written."""
         self._host = host
+        self._halt_count = halt_count
         self.run: UploadRun | None = None
         self._busy = False  # inside a chunk (client.upload_points is running)
 
@@ -128,7 +135,7 @@ class Uploader:
             )
             return False
         host.jog.leave_teach(host.poller.last_status)
-        self.run = UploadRun(host.request_id, items)
+        self.run = UploadRun(host.request_id, items, halts_at_start=self._halt_count())
         self._note_progress(self.run, force=True)
         return True
 
@@ -141,6 +148,10 @@ class Uploader:
         if upload.end is None and upload.index < len(upload.items) and host.link_up:
             host.poll_if_due()  # keep the monitor live even if the event loop favours queued calls
             host.run_urgent()
+            if upload.end is None and self._halted(upload):
+                # a stop that did not end it (refused on the main link) or whose job is not queued
+                # yet: ended all the same, the operator asked for a stop
+                upload.end = "stopped"
             if upload.end is None and host.link_up and self.run is upload:
                 self._chunk(upload)
         if self.run is not upload:
@@ -168,13 +179,18 @@ class Uploader:
             host.poll_if_due()
             return host.link_up and time.monotonic() - start < timing.UPLOAD_CHUNK_SECONDS
 
+        def halted() -> bool:  # a stop or cancel on its way: no staging write, no next point
+            return self._halted(upload)
+
         transport_error: str | None = None
         self._busy = True
         outer_id, host.request_id = host.request_id, upload.request_id
         try:
             chunk = [(pid, pose) for pid, pose, _ in items[first:last]]
             stage_gv = stage_gv_for(host.supervisor.canary_gv)
-            results = client.upload_points(chunk, tool, progress, gv_start=UPLOAD_POSE_GV, stage_gv=stage_gv)
+            results = client.upload_points(
+                chunk, tool, progress, gv_start=UPLOAD_POSE_GV, stage_gv=stage_gv, halted=halted
+            )
         except (LinkError, ResponseTimeout) as exc:  # before the first point (status read, mode)
             results, transport_error = [], str(exc)
         except TeachPadError as exc:
@@ -196,6 +212,10 @@ class Uploader:
             upload.end = upload.end or transport_error
             host.supervisor.transport_failed(transport_error)
         self._note_progress(upload)
+
+    def _halted(self, upload: UploadRun) -> bool:
+        """Ending, or a stop or cancel asked for since it began (its job may not have run yet)."""
+        return upload.end is not None or self._halt_count() != upload.halts_at_start
 
     def _note_progress(self, upload: UploadRun, *, force: bool = False) -> None:
         now = time.monotonic()

@@ -8,8 +8,8 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
 
 * :class:`~app.link.supervisor.LinkSupervisor` -- connect, backoff, link loss, *not answering*,
   the restart canary.
-* :class:`~app.link.poller.Poller` -- status then pose per tick, one signal per changed datum,
-  then ``pollSucceeded``, then the ``commandFinished`` that poll completed.
+* :class:`~app.link.poller.Poller` -- status then pose per tick, one ``polled`` (PollUpdate: the
+  changed data and the poll's time), then the ``commandFinished`` that poll completed.
 * :class:`~app.link.jobs.JobQueue` -- urgent jobs (stop, pause, resume, jog release, cancel
   upload) first, also between any two transactions of a poll, a jog, a teach command or an
   upload. A stop cancels the motion jobs queued before it; a release drops a queued jog press.
@@ -90,13 +90,9 @@ SHUTDOWN_TIMEOUT_MS = round(timing.SHUTDOWN_WAIT * 1000)
 class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     """Owns the RobotClient in the worker thread and composes the parts; see the module docstring."""
 
-    poseChanged = Signal(Pose)  # noqa: N815
-    statusChanged = Signal(ControllerStatus)  # noqa: N815
-    alarmsChanged = Signal(int)  # noqa: N815
+    polled = Signal(object)  # PollUpdate: a poll's pose/status/alarms/freshness, its one delivery
     connectionChanged = Signal(ConnectionState)  # noqa: N815
     rttChanged = Signal(float)  # noqa: N815 - ms, mean over RTT_REPORT_PERIOD
-    pollSucceeded = Signal(float)  # noqa: N815 - time.monotonic() of a good poll, after its pose/status
-    polled = Signal(object)  # PollUpdate: the four above of one poll in one delivery (RobotLink's)
     linkStatsChanged = Signal(object)  # noqa: N815 - LinkStats, at most every RTT_REPORT_PERIOD, on change
     commandFinished = Signal(CommandResult)  # noqa: N815
     errorOccurred = Signal(WorkerError)  # noqa: N815
@@ -118,7 +114,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     ) -> None:
         super().__init__()
         self._poll_hz = float(poll_hz)
-        self._jobs = JobQueue()
+        self._jobs = JobQueue(halting=(Operation.STOP, Operation.CANCEL_UPLOAD))
         self._wake.connect(self._on_wake, Qt.ConnectionType.QueuedConnection)
         self._uploadStep.connect(self._upload_step, Qt.ConnectionType.QueuedConnection)
         # Everything below is touched only in the worker thread.
@@ -138,10 +134,11 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         self.motion = MotionTracker()
         self.motions = MotionCommands(self)
         self.jog = JogMachine(self)
-        self.uploader = Uploader(self)
         self.poller = Poller(self)
         self.supervisor = LinkSupervisor(self, canary_gv)  # raises on a bad canary GV
         self.stop_line = StopLine()  # the stop's own connection; send_stop from any thread
+        # a stop counts on the stop line before its 441 goes out, then (and a cancel) in the queue
+        self.uploader = Uploader(self, lambda: self.stop_line.stops_requested + self._jobs.halts)
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
 
     # --- lifecycle (worker thread) ------------------------------------------------------
@@ -270,15 +267,6 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         if batch is not None:
             self.trafficObserved.emit(batch)
 
-    def publish_pose(self, pose: Pose) -> None:
-        self.poseChanged.emit(pose)
-
-    def publish_status(self, status: ControllerStatus) -> None:
-        self.statusChanged.emit(status)
-
-    def publish_alarms(self, alarms: int) -> None:
-        self.alarmsChanged.emit(alarms)
-
     def publish_connection(self, state: ConnectionState) -> None:
         self.connectionChanged.emit(state)
 
@@ -288,16 +276,8 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     def publish_polled(
         self, pose: Pose | None, status: ControllerStatus | None, alarms: int | None, good_at: float | None
     ) -> None:
-        """The separate signals (for whoever listens to the worker itself), then ``polled`` with all
-        of it: RobotLink listens to that one only (one queued call per poll into the GUI thread)."""
-        if pose is not None:
-            self.poseChanged.emit(pose)
-        if status is not None:
-            self.statusChanged.emit(status)
-        if alarms is not None:
-            self.alarmsChanged.emit(alarms)
-        if good_at is not None:
-            self.pollSucceeded.emit(good_at)
+        """``polled``: the poll's one delivery (one queued call per poll into the GUI thread), nothing
+        beside it; RobotLink applies it to its RobotState and re-emits the link's own signals."""
         self.polled.emit(PollUpdate(pose, status, alarms, good_at))
 
     def publish_link_stats(self, stats: LinkStats) -> None:

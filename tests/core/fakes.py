@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from app.errors import CommandRefused, LinkError, MalformedResponse, ModbusExceptionError, ResponseTimeout
 from app.models import CommandResult, Pose
 from app.protocol.enums import CommandKind, CommandStatus, RunCommand
 
@@ -67,6 +69,32 @@ class FakeClient:
                 True,
             ),
         )
+
+    def upload_points(
+        self,
+        points: Sequence[tuple[int, Sequence[float]]],
+        tool: int = 200,
+        progress: Any = None,
+        *,
+        results: list[CommandResult] | None = None,
+        **_staging: Any,
+    ) -> list[CommandResult]:
+        """RobotClient.upload_points by :meth:`create_point` (so ``create_script`` counts points):
+        a link error or Modbus exception ends the batch with a failed result without a status."""
+        out: list[CommandResult] = [] if results is None else results
+        for i, (pid, pose) in enumerate(points):
+            try:
+                result = self.create_point(pid, pose=pose, tool=tool)
+            except CommandRefused as exc:
+                result = CommandResult(RunCommand.CREATE_POINT, exc.status.kind, exc.status, False, str(exc))
+            except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
+                kind, reason = CommandKind.CREATE_POINT, exc.as_reason()
+                out.append(CommandResult(RunCommand.CREATE_POINT, kind, None, False, str(exc), reason=reason))
+                break
+            out.append(dataclasses.replace(result, message=f"point {pid}: {result.message}"))
+            if progress is not None and progress(i + 1, len(points)) is False:
+                break
+        return out
 
     def move_to_point(
         self,

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import itertools
 from typing import Any
 
 import pytest
 
 from app import timing
 from app.errors import InvalidInput
-from app.link.upload import UPLOAD_STAGE_GV, check_upload_items, group_by_tool, stage_gv_for
+from app.link.jobs import Job, JobKind, JobQueue
+from app.link.upload import UPLOAD_STAGE_GV, Uploader, check_upload_items, group_by_tool, stage_gv_for
 from tests.link.harness import PartsHost
 
 POSE = (100.0, 0.0, 300.0, 180.0, 0.0, 0.0)
@@ -75,3 +77,51 @@ def test_the_second_pose_block_steps_aside_for_the_restart_canary(sim: Any) -> N
     pose_blocks = {w.address for w in sim.writes if w.address < 400 and len(w.values) == 12}
     assert pose_blocks == {0, 24}  # GV0..GV5 and GV12..GV17
     assert sim.state().points[105] == (105.0, 0.0, 300.0, 0.0, 0.0, 0.0)
+
+
+def test_a_stop_on_its_way_writes_nothing_more_than_the_point_in_flight(
+    host: PartsHost, sim_factory: Any
+) -> None:
+    """From the moment a stop (or cancel) is counted -- here: once the first point's 440 reached
+    the controller -- the upload writes no staged pose and starts no next point, and it ends
+    "stopped" even when no stop job comes to end it (a stop refused on the main link)."""
+    sim = sim_factory(command_latency=0.02)  # the controller works a while on each point: room to stage
+    host.uploader = Uploader(host, lambda: len(sim.writes_to(440)))
+    host.connect(sim)
+    assert host.uploader.start([(100 + i, (100.0 + i, 0.0, 300.0, 0.0, 0.0, 0.0), 200) for i in range(4)])
+    steps = 0
+    while host.uploader.step():
+        steps += 1
+        assert steps < 10  # no busy loop of empty chunks
+    result = host.of("commandFinished")[-1]
+    assert not result.ok and result.message == "uploaded 1 of 4 points (stopped)"
+    first = next(i for i, w in enumerate(sim.writes) if w.address == 440)
+    assert [w.address for w in sim.writes[first + 1 :] if w.address != 2 * 291] == []  # (GV291: completion)
+    assert set(sim.state().points) == {100}
+
+
+def test_without_a_stop_the_next_pose_is_staged(host: PartsHost, sim_factory: Any) -> None:
+    """The counterpart: the same upload, nothing asked, stages every next pose while the
+    controller works on the point before it."""
+    sim = sim_factory(command_latency=0.05)
+    host.uploader = Uploader(host, lambda: 0)
+    host.connect(sim)
+    assert host.uploader.start([(100 + i, (100.0 + i, 0.0, 300.0, 0.0, 0.0, 0.0), 200) for i in range(4)])
+    while host.uploader.step():
+        pass
+    assert host.of("commandFinished")[-1].message == "uploaded 4 of 4 points"
+    order = [w.address for w in sim.writes if w.address in (0, 12, 400, 440)]
+    # a pose right after a 440: the next point's, staged while the controller works (GV0.. / GV6..)
+    assert any(a == 440 and b in (0, 12) for a, b in itertools.pairwise(order)), order
+
+
+def test_the_queue_counts_the_jobs_that_end_an_upload() -> None:
+    jobs = JobQueue(halting=("stop", "cancel upload"))
+    jobs.put(Job("jog release", lambda: None, JobKind.URGENT))
+    jobs.put(Job("upload points", lambda: None, JobKind.MOTION))
+    assert jobs.halts == 0
+    jobs.put(Job("stop", lambda: None, JobKind.URGENT))
+    jobs.put(Job("cancel upload", lambda: None, JobKind.URGENT))
+    assert jobs.halts == 2
+    jobs.clear()
+    assert jobs.halts == 2  # a count of requests, never lowered: an upload compares it with its start

@@ -14,6 +14,7 @@ from app import timing
 from app.link import robot_link as robot_link_module
 from app.link.client import StepFrame
 from app.link.robot_link import RobotLink
+from app.link.state import PollUpdate
 from app.link.stats import LinkStats
 from app.link.types import ConnectionState, LinkState
 from app.link.worker import RobotWorker
@@ -37,9 +38,7 @@ class Rig(QObject):
     """A bare RobotWorker in its own QThread, seen from the GUI thread: every signal it has is
     relayed here (queued, in order), and calls go to it queued, as RobotLink makes them."""
 
-    poseChanged = Signal(object)  # noqa: N815
-    statusChanged = Signal(object)  # noqa: N815
-    pollSucceeded = Signal(float)  # noqa: N815
+    polled = Signal(object)  # PollUpdate: the worker's one delivery per poll
     linkStatsChanged = Signal(object)  # noqa: N815
     commandFinished = Signal(object)  # noqa: N815
     connectionChanged = Signal(object)  # noqa: N815
@@ -54,9 +53,7 @@ class Rig(QObject):
         self.worker.moveToThread(self.worker_thread)
         self.worker_thread.started.connect(self.worker.start)
         for name in (
-            "poseChanged",
-            "statusChanged",
-            "pollSucceeded",
+            "polled",
             "linkStatsChanged",
             "commandFinished",
             "connectionChanged",
@@ -95,9 +92,16 @@ def rig(qtbot: Any, fast_reconnect: None) -> Iterator[Rig]:
 
 def test_command_finished_comes_after_the_pose_and_status_of_its_poll(qtbot: Any, sim: Any, rig: Rig) -> None:
     events: list[tuple[str, Any]] = []
-    rig.poseChanged.connect(lambda p: events.append(("pose", p)))
-    rig.statusChanged.connect(lambda s: events.append(("status", s)))
-    rig.pollSucceeded.connect(lambda t: events.append(("poll", t)))
+
+    def on_polled(update: PollUpdate) -> None:  # one delivery: its parts in the order they happened
+        if update.pose is not None:
+            events.append(("pose", update.pose))
+        if update.status is not None:
+            events.append(("status", update.status))
+        if update.good_at is not None:
+            events.append(("poll", update.good_at))
+
+    rig.polled.connect(on_polled)
     rig.commandFinished.connect(lambda r: events.append(("result", r)))
     rig.connect_sim(qtbot, sim)
     with qtbot.waitSignal(rig.commandFinished, timeout=SIGNAL_TIMEOUT_MS) as blocker:

@@ -1,0 +1,87 @@
+"""``teachpad-cli points upload`` sends what the GUI's upload sends (RobotClient.upload_points,
+staged), against the real simulator: its writes, its request count, Ctrl-C mid-upload."""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from app.cli.exit_codes import ExitCode
+from app.link.upload import UPLOAD_POSE_GV, stage_gv_for
+from app.points.guard import CANARY_GV
+from app.points.project import load_project
+from app.protocol import registers
+from tests.cli.test_cli import SCAN, interrupt_cli, run
+
+N = 60  # points: enough for the per-point bound to tell the staged upload from the point-by-point one
+TOOLS = (200, 3)  # the first half without a tool, the second with tool 3: two batches, GV245 once each
+
+
+def _tool(point_id: int, n: int) -> int:
+    return TOOLS[0] if 2 * point_id <= n else TOOLS[1]
+
+
+def _project(sim: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path, n: int = N) -> Path:
+    csv = tmp_path / "points.csv"
+    header = "id,name,x,y,z,a,b,c,e1,e2,e3,e4,e5,tool,note"
+    rows = [f"{i},P{i},{300 + i},{-i},400,180,0,{i % 90},0,0,0,0,0,{_tool(i, n)}," for i in range(1, n + 1)]
+    csv.write_text("\n".join([header, *rows]) + "\n", encoding="utf-8")
+    project = tmp_path / "many.teachpad.json"
+    code, _, err = run(sim, capsys, "points", "import", str(project), "--csv", str(csv))
+    assert code == ExitCode.OK, err
+    return project
+
+
+def test_points_upload_is_staged_and_at_the_staged_request_bound(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    sim = sim_factory(command_latency=SCAN)  # the controller works a while on each point
+    project = _project(sim, capsys, tmp_path)
+    requests, writes = sim.requests_count, len(sim.writes)
+    code, out, err = run(sim, capsys, "points", "upload", str(project))
+    assert code == ExitCode.OK, err
+    assert f"uploaded {N} point(s)" in out
+    requests = sim.requests_count - requests
+    probe = 2 * registers.GV_COMMAND_STATUS  # the completion rule's probe of GV291 (once a connection)
+    wire = [w for w in sim.writes[writes:] if w.address != probe]
+    # writes: GV245 once per tool, then per point its pose, GV200-202 and 440 -- nothing more
+    params, command, tool = 2 * registers.GV_PARAM0, registers.REG_RUN_COMMAND, 2 * registers.GV_TOOL_FRAME
+    assert [w.address for w in wire].count(tool) == len(TOOLS)
+    assert [w.address for w in wire].count(params) == N and [w.address for w in wire].count(command) == N
+    poses = [w for w in wire if w.address < params]
+    assert len(poses) == N and len(wire) == len(TOOLS) + 3 * N
+    # the poses alternate between GV0.. and the canary-aware second block (GV6.. with the canary
+    # in GV99), each batch from GV0; most go out while the controller works on the point before
+    blocks = [2 * UPLOAD_POSE_GV, 2 * stage_gv_for(CANARY_GV)]
+    half = N // 2
+    assert [w.address for w in poses] == [blocks[i % 2] for i in range(half)] * 2
+    order = [w.address for w in wire]
+    staged = sum(a == command and b in blocks for a, b in itertools.pairwise(order))
+    assert staged >= N // 2, staged  # N - 2 when nothing stalls (each batch's first pose goes before)
+    # the staged bound: per point its 3 writes and at most 3 reads of its outcome (about 2.5 here),
+    # plus a fixed part (connect, the probe of the completion rule, each batch's status read). The
+    # point-by-point upload (a status read before every point) took about 6.4 requests a point.
+    assert requests <= 6 * N + 10, requests
+    print(f"points upload of {N}: {requests} requests ({requests / N:.2f} a point), {staged} poses staged")
+    held = sim.state().points
+    assert all(held[i] == (300.0 + i, -i, 400.0, 180.0, 0.0, float(i % 90)) for i in range(1, N + 1))
+    assert all(sim.robot.points[i].tool == _tool(i, N) for i in range(1, N + 1))
+    assert sorted(load_project(project).upload_history) == list(range(1, N + 1))
+
+
+def test_ctrl_c_in_a_staged_upload_keeps_what_was_done(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    sim = sim_factory(command_latency=0.05)
+    project = _project(sim, capsys, tmp_path)
+    code, err = interrupt_cli(sim, ["points", "upload", str(project)], lambda s: len(s.points) >= 6)
+    assert code == ExitCode.INTERRUPTED, err
+    assert "upload stopped (interrupted); not attempted:" in err
+    recorded = set(load_project(project).upload_history)
+    held = set(sim.state().points)
+    # every point recorded as uploaded is on the controller; at most the one under way is there
+    # without being recorded (its outcome was not known when Ctrl-C came)
+    assert len(recorded) >= 5 and recorded <= held and len(held - recorded) <= 1
