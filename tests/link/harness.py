@@ -99,15 +99,6 @@ class PartsHost:
     def stop_reconnect(self) -> None:
         pass
 
-    def publish_pose(self, pose: Pose) -> None:
-        self.out.append(("poseChanged", pose))
-
-    def publish_status(self, status: ControllerStatus) -> None:
-        self.out.append(("statusChanged", status))
-
-    def publish_alarms(self, alarms: int) -> None:
-        self.out.append(("alarmsChanged", alarms))
-
     def publish_connection(self, state: ConnectionState) -> None:
         self.out.append(("connectionChanged", state))
 
