@@ -10,7 +10,8 @@ The window only composes: the robot's state lives in one :class:`~app.link.state
 (``part.bind(state)``), the window keeps no copy; controllers turn the panels' intents into link
 requests. Its parts: :class:`~ui.window_column.ControlColumn` (the left column),
 :class:`~ui.window_docks.WindowDocks`, :class:`~ui.window_status.WindowStatusBar`,
-:class:`~ui.window_actions.WindowActions` (menus, toolbar); the window keeps their widgets under
+:class:`~ui.window_actions.WindowActions` (menus, toolbar), :mod:`~ui.window_rows` (the alarm
+banner and the pose strip above everything); the window keeps their widgets under
 its own names too (``window.control_bar``, ``window.event_log``, ``window.status_link``...).
 One :class:`ProjectController` owns the open project (File and Edit menus); the points panel
 and the planner share its models, a :class:`PointSyncController` and a
@@ -19,7 +20,8 @@ them only while the link is up and writable (not monitor-only). Any jog ends whe
 loses the focus, is hidden or closed, and when the link goes down.
 
 Close order: jog release first (before any question), then "save changes?" (Cancel keeps the
-window and the link), then the window state is saved and the link shut down.
+window and the link), then the window state is saved and the link shut down. A close that is not
+the operator's (:meth:`MainWindow.close_unattended`: ``teachpad --screenshot``) asks nothing.
 """
 
 from __future__ import annotations
@@ -42,7 +44,6 @@ from PySide6.QtWidgets import (
     QSizePolicy,
     QSplitter,
     QTabWidget,
-    QToolBar,
     QVBoxLayout,
     QWidget,
 )
@@ -60,15 +61,14 @@ from ui.controllers.safety_menu import install_safety
 from ui.dialogs.confirm import ConfirmFn
 from ui.i18n import Translator
 from ui.messages import error_text
-from ui.panels.alarm_banner import AlarmBanner
 from ui.panels.monitor_panel import MonitorPanel
-from ui.panels.pose_strip import PoseStrip
 from ui.panels.view3d_host import install_view3d
 from ui.settings import AppSettings
 from ui.touch import apply_touch_mode, mark_motion
 from ui.window_actions import WindowActions
 from ui.window_column import ControlColumn
 from ui.window_docks import WindowDocks
+from ui.window_rows import add_window_rows
 from ui.window_status import WindowStatusBar
 from ui.window_tabs import LazyTab
 
@@ -169,7 +169,8 @@ class MainWindow(QMainWindow):
             set_touch_mode=self.set_touch_mode,
             touch_mode=settings.touch_mode,
         )
-        self._compose_strip_and_banner()
+        rows = add_window_rows(self)  # above everything: the alarm banner, the pose strip
+        self.alarm_banner, self.pose_strip, self.pose_bar = rows.alarm_banner, rows.pose_strip, rows.pose_bar
         self.status_bar = WindowStatusBar(self.statusBar())
         labels = self.status_bar
         self.status_link, self.status_rtt = labels.link_label, labels.rtt_label
@@ -204,23 +205,6 @@ class MainWindow(QMainWindow):
         return max(width, MIN_SIZE[0]), max(height, MIN_SIZE[1])
 
     # --- construction -----------------------------------------------------------------
-    def _compose_strip_and_banner(self) -> None:
-        """Window-wide rows above everything (the main toolbar sits in the menu bar's corner):
-        the alarm banner (only while an alarm is set), then the pose strip (always). Neither can
-        be moved or hidden by hand."""
-        self.alarm_banner = AlarmBanner(self)
-        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.alarm_banner)
-        self.pose_strip = PoseStrip(self)
-        self.pose_bar = QToolBar(self)
-        self.pose_bar.setObjectName("PoseStripBar")
-        self.pose_bar.setMovable(False)
-        self.pose_bar.setFloatable(False)
-        self.pose_bar.toggleViewAction().setVisible(False)
-        self.pose_bar.setStyleSheet("QToolBar { padding: 0px; spacing: 0px; border: none; }")  # every px
-        self.pose_bar.addWidget(self.pose_strip)
-        self.addToolBarBreak(Qt.ToolBarArea.TopToolBarArea)
-        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.pose_bar)
-
     def _wire(self) -> None:
         """Every part follows the link's RobotState itself; the window keeps no copy of it."""
         link, state = self.link, self.link.state
@@ -472,6 +456,14 @@ class MainWindow(QMainWindow):
     def hideEvent(self, event: QHideEvent) -> None:
         self.jog_panel.release_all()
         super().hideEvent(event)
+
+    def close_unattended(self) -> bool:
+        """Close without any question (nobody is there to answer): unsaved changes are not
+        saved to the project file but kept in its autosave, which the next start offers."""
+        if not self._close_accepted and self.project.is_dirty:
+            self.project.autosave_now()
+        self._close_accepted = True
+        return self.close()
 
     def closeEvent(self, event: QCloseEvent) -> None:
         self.jog_panel.release_all()  # first, before any question
