@@ -65,7 +65,9 @@ def test_a_screenshot_run_closes_a_dirty_project_without_asking(
     png = tmp_path / "shot.png"
     args = ["--sim", "--settings", str(tmp_path / "teachpad.ini"), "--lang", "en"]
     with loop_deadline("main()"):
-        code = teachpad.main([*args, "--project", str(project), "--screenshot", str(png), "--size", "800x600"])
+        code = teachpad.main(
+            [*args, "--project", str(project), "--screenshot", str(png), "--size", "800x600"]
+        )
     assert code == 0 and not QImage(str(png)).isNull()
     assert asked == []  # no question
     assert project.read_bytes() == SAMPLE.read_bytes()  # the file is as the operator saved it
