@@ -50,9 +50,11 @@ class ControlColumn(QWidget):
         self.tabs = QTabWidget(self)
         self.tabs.setObjectName("MotionTabs")
         self.tabs.addTab(self.jog_panel, "")
+        # the dead-man first: connected before the lazy tabs, a held jog is let go before a tab
+        # being shown for the first time is built
+        self.tabs.currentChanged.connect(lambda _i: self.jog_panel.release_all())
         self.step_tab: LazyTab[StepPanel] = LazyTab(self.tabs, _build_step_panel, "Step")
         self.program_tab: LazyTab[ProgramPanel] = LazyTab(self.tabs, _build_program_panel, "Program")
-        self.tabs.currentChanged.connect(lambda _i: self.jog_panel.release_all())
         self.motion_banner = QLabel(self)
         self.motion_banner.setAlignment(Qt.AlignmentFlag.AlignCenter)
         self.motion_banner.setWordWrap(True)

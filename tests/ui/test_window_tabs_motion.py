@@ -108,7 +108,10 @@ def test_changing_to_a_tab_being_built_ends_a_held_jog_at_the_simulator(
     qtbot.mousePress(button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: jogging(sim) and abs(sim.state().pose[0] - x0) > 1.0, timeout=SIGNAL_TIMEOUT_MS)
     assert not window.step_tab.built
-    window.tabs.setCurrentIndex(TAB_STEP)  # first show: built, and the jog is let go
+    jogging_at_build: list[bool] = []
+    window.step_tab.on_built(lambda _panel: jogging_at_build.append(window.jog_panel.is_jogging))
+    window.tabs.setCurrentIndex(TAB_STEP)  # first show: the jog is let go, then the tab is built
+    assert jogging_at_build == [False]  # the release did not wait for the build
     assert window.step_tab.built and not window.jog_panel.is_jogging
     let_go = lambda: not sim.state().jogging and ratio_writes(sim)[-1] == 0.0  # noqa: E731
     qtbot.waitUntil(let_go, timeout=SIGNAL_TIMEOUT_MS)
