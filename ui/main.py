@@ -447,7 +447,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         if shot is not None:
             shot.cancel()
-        window.close()  # saves the window state and shuts the link down (stops any jog)
+        # saves the window state and shuts the link down (stops any jog); a screenshot run's
+        # close is not an operator's: no "Save changes?" may block it
+        if shot is not None:
+            window.close_unattended()
+        else:
+            window.close()
         link.shutdown()
         if starter is not None:
             starter.close()

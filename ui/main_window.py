@@ -10,7 +10,8 @@ The window only composes: the robot's state lives in one :class:`~app.link.state
 (``part.bind(state)``), the window keeps no copy; controllers turn the panels' intents into link
 requests. Its parts: :class:`~ui.window_column.ControlColumn` (the left column),
 :class:`~ui.window_docks.WindowDocks`, :class:`~ui.window_status.WindowStatusBar`,
-:class:`~ui.window_actions.WindowActions` (menus, toolbar); the window keeps their widgets under
+:class:`~ui.window_actions.WindowActions` (menus, toolbar), :mod:`~ui.window_rows` (the alarm
+banner and the pose strip above everything); the window keeps their widgets under
 its own names too (``window.control_bar``, ``window.event_log``, ``window.status_link``...).
 One :class:`ProjectController` owns the open project (File and Edit menus); the points panel
 and the planner share its models, a :class:`PointSyncController` and a
@@ -19,7 +20,8 @@ them only while the link is up and writable (not monitor-only). Any jog ends whe
 loses the focus, is hidden or closed, and when the link goes down.
 
 Close order: jog release first (before any question), then "save changes?" (Cancel keeps the
-window and the link), then the window state is saved and the link shut down.
+window and the link), then the window state is saved and the link shut down. A close that is not
+the operator's (:meth:`MainWindow.close_unattended`: ``teachpad --screenshot``) asks nothing.
 """
 
 from __future__ import annotations
@@ -29,12 +31,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
-from PySide6.QtGui import (
-    QCloseEvent,
-    QGuiApplication,
-    QHideEvent,
-    QShowEvent,
-)
+from PySide6.QtGui import QCloseEvent, QHideEvent, QShowEvent
 from PySide6.QtWidgets import (
     QApplication,
     QMainWindow,
@@ -42,7 +39,6 @@ from PySide6.QtWidgets import (
     QSizePolicy,
     QSplitter,
     QTabWidget,
-    QToolBar,
     QVBoxLayout,
     QWidget,
 )
@@ -60,25 +56,26 @@ from ui.controllers.safety_menu import install_safety
 from ui.dialogs.confirm import ConfirmFn
 from ui.i18n import Translator
 from ui.messages import error_text
-from ui.panels.alarm_banner import AlarmBanner
 from ui.panels.monitor_panel import MonitorPanel
-from ui.panels.pose_strip import PoseStrip
 from ui.panels.view3d_host import install_view3d
 from ui.settings import AppSettings
 from ui.touch import apply_touch_mode, mark_motion
 from ui.window_actions import WindowActions
 from ui.window_column import ControlColumn
 from ui.window_docks import WindowDocks
+from ui.window_geometry import DEFAULT_SIZE as DEFAULT_SIZE  # where the benchmarks import it from
+from ui.window_geometry import MIN_SIZE, default_size, restore_window
+from ui.window_rows import add_window_rows
 from ui.window_status import WindowStatusBar
 from ui.window_tabs import LazyTab
 
 if TYPE_CHECKING:  # built on first show (LazyTab): not imported before the window's first paint
     from ui.panels.planner_panel import PlannerPanel
     from ui.panels.points_panel import PointsPanel
+    from ui.panels.program_panel import ProgramPanel
+    from ui.panels.step_panel import StepPanel
     from ui.panels.traffic_panel import TrafficPanel
 
-DEFAULT_SIZE = (1600, 960)  # clamped to the screen's available size
-MIN_SIZE = (1024, 700)  # the layout stays usable down to this
 TAB_MONITOR, TAB_POINTS, TAB_PLANNER = range(3)
 TAB_NAMES = ("monitor", "points", "planner")
 
@@ -117,7 +114,7 @@ class MainWindow(QMainWindow):
         self.control_column = column = ControlColumn(self)
         self.control_bar, self.motion_banner = column.control_bar, column.motion_banner
         self.tabs, self.jog_panel = column.tabs, column.jog_panel
-        self.step_panel, self.program_panel = column.step_panel, column.program_panel
+        self.step_tab, self.program_tab = column.step_tab, column.program_tab  # built on first use
 
         # --- right: the work tabs (Points and Planner are built when first shown or asked for) --
         self.monitor_panel = MonitorPanel(self)
@@ -169,7 +166,8 @@ class MainWindow(QMainWindow):
             set_touch_mode=self.set_touch_mode,
             touch_mode=settings.touch_mode,
         )
-        self._compose_strip_and_banner()
+        rows = add_window_rows(self)  # above everything: the alarm banner, the pose strip
+        self.alarm_banner, self.pose_strip, self.pose_bar = rows.alarm_banner, rows.pose_strip, rows.pose_bar
         self.status_bar = WindowStatusBar(self.statusBar())
         labels = self.status_bar
         self.status_link, self.status_rtt = labels.link_label, labels.rtt_label
@@ -183,9 +181,9 @@ class MainWindow(QMainWindow):
         self.safety_menu = install_safety(self)  # roles, envelope, audit trail (the Safety menu)
         self.motion.safety = self.safety_menu.safety
         self.setMinimumSize(*MIN_SIZE)
-        self.resize(*self._default_size())
+        self.resize(*default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])
-        self._docks_sized = self._restore_window()  # else sized at the first show
+        self._docks_sized = restore_window(self, settings)  # else sized at the first show
         self.alarm_banner.sync()  # shown exactly while an alarm is set, whatever was saved
         self.pose_bar.setVisible(True)
         app = QApplication.instance()
@@ -194,33 +192,7 @@ class MainWindow(QMainWindow):
             app.applicationStateChanged.connect(self._on_application_state)
         self.retranslate()
 
-    @staticmethod
-    def _default_size() -> tuple[int, int]:
-        width, height = DEFAULT_SIZE
-        screen = QGuiApplication.primaryScreen()
-        if screen is not None:
-            available = screen.availableGeometry()
-            width, height = min(width, available.width()), min(height, available.height())
-        return max(width, MIN_SIZE[0]), max(height, MIN_SIZE[1])
-
     # --- construction -----------------------------------------------------------------
-    def _compose_strip_and_banner(self) -> None:
-        """Window-wide rows above everything (the main toolbar sits in the menu bar's corner):
-        the alarm banner (only while an alarm is set), then the pose strip (always). Neither can
-        be moved or hidden by hand."""
-        self.alarm_banner = AlarmBanner(self)
-        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.alarm_banner)
-        self.pose_strip = PoseStrip(self)
-        self.pose_bar = QToolBar(self)
-        self.pose_bar.setObjectName("PoseStripBar")
-        self.pose_bar.setMovable(False)
-        self.pose_bar.setFloatable(False)
-        self.pose_bar.toggleViewAction().setVisible(False)
-        self.pose_bar.setStyleSheet("QToolBar { padding: 0px; spacing: 0px; border: none; }")  # every px
-        self.pose_bar.addWidget(self.pose_strip)
-        self.addToolBarBreak(Qt.ToolBarArea.TopToolBarArea)
-        self.addToolBar(Qt.ToolBarArea.TopToolBarArea, self.pose_bar)
-
     def _wire(self) -> None:
         """Every part follows the link's RobotState itself; the window keeps no copy of it."""
         link, state = self.link, self.link.state
@@ -242,14 +214,13 @@ class MainWindow(QMainWindow):
         link.controllerReconnected.connect(self._on_reconnected)
         link.controllerRestarted.connect(self._on_restarted)
         self.motion = MotionController(
-            link,
-            self.control_bar,
-            self.jog_panel,
-            self.step_panel,
-            self.program_panel,
-            self.run_controller,
-            self,
+            link, self.control_bar, self.jog_panel, None, None, self.run_controller, self
         )
+        # Step and Program are built on first use: gated the moment they exist, before shown
+        self.step_tab.on_built(self.motion.add_step_panel)  # enabled or not at once, as the others
+        self.program_tab.on_built(self.motion.add_program_panel)
+        for tab in (self.step_tab, self.program_tab):
+            tab.on_built(self._join_motion_tab)  # then the question and the touch mode
         project = self.project
         project.titleChanged.connect(self._on_project_title)
         project.pathChanged.connect(self._on_project_path)
@@ -259,9 +230,24 @@ class MainWindow(QMainWindow):
     def traffic_panel(self) -> TrafficPanel:  # built when its dock is first seen (WindowDocks)
         return self.docks.traffic_panel
 
-    # --- the lazily built work tabs (LazyTab) -------------------------------------------------
+    # --- the lazily built motion and work tabs (LazyTab) -------------------------------------
     @property
-    def points_panel(self) -> PointsPanel:  # built on first use (LazyTab), like the next two
+    def step_panel(self) -> StepPanel:  # built on first use (LazyTab), like the next three
+        return self.step_tab.panel
+
+    @property
+    def program_panel(self) -> ProgramPanel:
+        return self.program_tab.panel
+
+    def _join_motion_tab(self, panel: StepPanel | ProgramPanel) -> None:
+        """A lazily built motion panel (already gated by the motion controller) gets the question
+        and the touch mode."""
+        if self._confirm is not None:
+            panel.confirm = self._confirm
+        apply_touch_mode((panel,), self.settings.touch_mode)
+
+    @property
+    def points_panel(self) -> PointsPanel:
         return self.points_tab.panel
 
     @property
@@ -366,13 +352,14 @@ class MainWindow(QMainWindow):
     # --- confirmation (one setter for every panel that asks) --------------------------
     @property
     def confirm(self) -> ConfirmFn:
-        return self.program_panel.confirm
+        return self._confirm if self._confirm is not None else self.program_panel.confirm
 
     @confirm.setter
     def confirm(self, fn: ConfirmFn) -> None:
         self._confirm = fn
-        self.program_panel.confirm = fn
-        self.step_panel.confirm = fn
+        for motion_tab in (self.step_tab, self.program_tab):
+            if motion_tab.built:
+                motion_tab.panel.confirm = fn
         for tab in (self.points_tab, self.planner_tab):
             if tab.built:
                 tab.panel.set_confirm(fn)
@@ -473,6 +460,14 @@ class MainWindow(QMainWindow):
         self.jog_panel.release_all()
         super().hideEvent(event)
 
+    def close_unattended(self) -> bool:
+        """Close without any question (nobody is there to answer): unsaved changes are not
+        saved to the project file but kept in its autosave, which the next start offers."""
+        if not self._close_accepted and self.project.is_dirty:
+            self.project.autosave_now()
+        self._close_accepted = True
+        return self.close()
+
     def closeEvent(self, event: QCloseEvent) -> None:
         self.jog_panel.release_all()  # first, before any question
         if not self._close_accepted:
@@ -491,11 +486,3 @@ class MainWindow(QMainWindow):
         if self.shutdown_link_on_close:
             self.link.shutdown()
         super().closeEvent(event)
-
-    def _restore_window(self) -> bool:
-        """The remembered geometry and dock layout; False when there was none."""
-        geometry = self.settings.window_geometry()
-        if geometry is not None:
-            self.restoreGeometry(geometry)
-        state = self.settings.window_state()
-        return state is not None and self.restoreState(state)

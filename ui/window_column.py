@@ -4,9 +4,15 @@ Jog / Step / Program tabs, on the window's left whatever work tab is shown.
 The banner says why the motion controls are off ("Not connected", "Monitor only"); it reads the
 link's :class:`~app.link.state.RobotState` when it changes and keeps no copy of it. Which
 controls are enabled is :class:`~ui.controllers.motion.MotionController`'s business.
+
+The Step and Program tabs are built the first time they are shown or asked for
+(:class:`~ui.window_tabs.LazyTab`, ``step_tab`` / ``program_tab``): the window's first paint does
+not wait for them; the window attaches their gating through ``on_built``.
 """
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QCoreApplication, Qt, Slot
 from PySide6.QtWidgets import QLabel, QSizePolicy, QTabWidget, QVBoxLayout, QWidget
@@ -15,8 +21,11 @@ from app.link.state import RobotState
 from app.link.types import ConnectionState
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
-from ui.panels.program_panel import ProgramPanel
-from ui.panels.step_panel import StepPanel
+from ui.window_tabs import LazyTab
+
+if TYPE_CHECKING:  # built when their tab is first shown (LazyTab)
+    from ui.panels.program_panel import ProgramPanel
+    from ui.panels.step_panel import StepPanel
 
 __all__ = ["ControlColumn"]
 
@@ -29,7 +38,8 @@ BANNER_STYLE = (
 
 class ControlColumn(QWidget):
     """``control_bar``, ``motion_banner``, ``tabs`` (``jog_panel``, ``step_panel``,
-    ``program_panel``). Changing the motion tab releases any held jog."""
+    ``program_panel``; the last two built on first use). Changing the motion tab releases any
+    held jog."""
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -37,14 +47,14 @@ class ControlColumn(QWidget):
         self._state: RobotState | None = None
         self.control_bar = ControlBar(self)
         self.jog_panel = JogPanel(self)
-        self.step_panel = StepPanel(self)
-        self.program_panel = ProgramPanel(self)
         self.tabs = QTabWidget(self)
         self.tabs.setObjectName("MotionTabs")
         self.tabs.addTab(self.jog_panel, "")
-        self.tabs.addTab(self.step_panel, "")
-        self.tabs.addTab(self.program_panel, "")
+        # the dead-man first: connected before the lazy tabs, a held jog is let go before a tab
+        # being shown for the first time is built
         self.tabs.currentChanged.connect(lambda _i: self.jog_panel.release_all())
+        self.step_tab: LazyTab[StepPanel] = LazyTab(self.tabs, _build_step_panel, "Step")
+        self.program_tab: LazyTab[ProgramPanel] = LazyTab(self.tabs, _build_program_panel, "Program")
         self.motion_banner = QLabel(self)
         self.motion_banner.setAlignment(Qt.AlignmentFlag.AlignCenter)
         self.motion_banner.setWordWrap(True)
@@ -56,6 +66,14 @@ class ControlColumn(QWidget):
         column.addWidget(self.tabs, 1)
         self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Expanding)
         self.retranslate()
+
+    @property
+    def step_panel(self) -> StepPanel:  # built now if it was not yet
+        return self.step_tab.panel
+
+    @property
+    def program_panel(self) -> ProgramPanel:
+        return self.program_tab.panel
 
     def bind(self, state: RobotState) -> None:
         """Follow ``state``: the banner shows while the link is not writable, and says why."""
@@ -86,3 +104,15 @@ class ControlColumn(QWidget):
                 QCoreApplication.translate("MainWindow", "Not connected: motion controls are disabled")
             )
         self.motion_banner.setVisible(not writable)
+
+
+def _build_step_panel() -> StepPanel:
+    from ui.panels.step_panel import StepPanel
+
+    return StepPanel()
+
+
+def _build_program_panel() -> ProgramPanel:
+    from ui.panels.program_panel import ProgramPanel
+
+    return ProgramPanel()

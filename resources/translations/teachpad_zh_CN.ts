@@ -2455,13 +2455,13 @@
     <context>
         <name>Plan</name>
         <message>
-            <location filename="../../app/plan/segments.py" line="69" />
+            <location filename="../../app/plan/segments.py" line="57" />
             <source>line</source>
             <extracomment>Editable fields of a segment, in table column order.</extracomment>
             <translation>直线</translation>
         </message>
         <message>
-            <location filename="../../app/plan/segments.py" line="70" />
+            <location filename="../../app/plan/segments.py" line="58" />
             <source>arc</source>
             <translation>圆弧</translation>
         </message>
@@ -2685,27 +2685,27 @@
     <context>
         <name>PlanRunController</name>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="248" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="41" />
             <source>Failed: {reason}</source>
             <translation>失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="248" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="43" />
             <source>Stopped: {reason}</source>
             <translation>已停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="251" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="47" />
             <source>Failed at segment {n}: {reason}</source>
             <translation>在第 {n} 段失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="253" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="49" />
             <source>Stopped at segment {n}: {reason}</source>
             <translation>在第 {n} 段停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_controller.py" line="271" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="29" />
             <source>stopped by the operator</source>
             <translation>已由操作员停止</translation>
         </message>

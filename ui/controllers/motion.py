@@ -12,11 +12,16 @@ Alarm hold: while the controller reports an emergency stop or a servo alarm
 disabled, any jog is released, and a jog / step / program intent that still arrives is dropped
 (never written). Stop stays enabled whatever happens. ``alarmHoldChanged(bool)`` tells the other
 panels that start motion (points' move-to, the planner's run).
+
+The step and program panels are built when their tab is first shown (``ui/window_tabs.py``):
+:meth:`MotionController.add_step_panel` / :meth:`~MotionController.add_program_panel` attach one
+when it exists, and it gets the gating in force before it can be shown.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, Signal, Slot
 
@@ -28,8 +33,10 @@ from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.safety import SafetyController
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
-from ui.panels.program_panel import ProgramPanel, ProgramRequest
-from ui.panels.step_panel import StepPanel, StepRequest
+
+if TYPE_CHECKING:  # built when their tab is first shown: not imported before the first paint
+    from ui.panels.program_panel import ProgramPanel, ProgramRequest
+    from ui.panels.step_panel import StepPanel, StepRequest
 
 __all__ = ["MotionController"]
 
@@ -46,8 +53,8 @@ class MotionController(QObject):
         link: LinkPort,
         control_bar: ControlBar,
         jog: JogPanel,
-        step: StepPanel,
-        program: ProgramPanel,
+        step: StepPanel | None,
+        program: ProgramPanel | None,
         run_controller: PlanRunController,
         parent: QObject | None = None,
     ) -> None:
@@ -55,8 +62,8 @@ class MotionController(QObject):
         self._link = link
         self._bar = control_bar
         self._jog = jog
-        self._step = step
-        self._program = program
+        self._step: StepPanel | None = None  # attached now or when built (add_step_panel)
+        self._program: ProgramPanel | None = None
         self._run_active = False
         self._enabled = link.state.writable
         self._alarm_hold = blocks_motion(link.state.alarms)
@@ -69,13 +76,31 @@ class MotionController(QObject):
         jog.jogPressed.connect(self._on_jog_pressed)
         jog.jogReleased.connect(link.jog_release)
         jog.ratioChanged.connect(self._on_ratio_changed)
-        step.stepRequested.connect(self._on_step_requested)
-        program.programRequested.connect(self._on_program_requested)
-        program.goZeroRequested.connect(self._on_go_zero)
         link.state.connectionChanged.connect(self._on_connection)
         link.state.alarmsChanged.connect(self._on_alarms)
         run_controller.runningChanged.connect(self._on_run_active)
         self._apply()
+        if step is not None:
+            self.add_step_panel(step)
+        if program is not None:
+            self.add_program_panel(program)
+
+    def add_step_panel(self, step: StepPanel) -> None:
+        """Drive and gate ``step`` from now on (enabled or not at once, as the others)."""
+        if self._step is not None:
+            raise RuntimeError("the step panel is already attached")
+        self._step = step
+        step.stepRequested.connect(self._on_step_requested)
+        step.set_motion_enabled(self._panels_enabled())
+
+    def add_program_panel(self, program: ProgramPanel) -> None:
+        """Drive and gate ``program`` from now on (enabled or not at once, as the others)."""
+        if self._program is not None:
+            raise RuntimeError("the program panel is already attached")
+        self._program = program
+        program.programRequested.connect(self._on_program_requested)
+        program.goZeroRequested.connect(self._on_go_zero)
+        program.set_motion_enabled(self._panels_enabled())
 
     @property
     def motion_enabled(self) -> bool:
@@ -114,12 +139,16 @@ class MotionController(QObject):
             self._jog.release_all()
         self._apply()
 
+    def _panels_enabled(self) -> bool:
+        """The jog, step and program panels: the link writable, no plan running, no alarm hold."""
+        return self._link.state.writable and not self._run_active and not self._alarm_hold
+
     def _apply(self) -> None:
         enabled = self._link.state.writable
-        panels_enabled = enabled and not self._run_active and not self._alarm_hold
-        self._jog.set_motion_enabled(panels_enabled)
-        self._step.set_motion_enabled(panels_enabled)
-        self._program.set_motion_enabled(panels_enabled)
+        panels_enabled = self._panels_enabled()
+        for panel in (self._jog, self._step, self._program):
+            if panel is not None:
+                panel.set_motion_enabled(panels_enabled)
         self._bar.set_motion_enabled(enabled)
         self._bar.set_alarm_hold(self._alarm_hold)
         if enabled != self._enabled:

@@ -24,6 +24,9 @@ ledger's end point. A point that is not created, or an arrival off by more than 
 was overwritten by another tool), ends the run in ``FAILED`` at that segment with a sentence
 from :mod:`ui.messages`; nothing further moves. ``segmentPrepared(int, object)`` (index, point
 ids) is emitted right before each move is sent. There is no unguarded run.
+
+How an ended run reads ("Failed at segment 2: ...") and what a link change means for it are
+:mod:`ui.controllers.plan_run_reasons`.
 """
 
 from __future__ import annotations
@@ -34,20 +37,20 @@ from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, Signal, Slot
 
-from app.errors import LinkError, ResponseTimeout, TeachPadError
+from app.errors import LinkError, TeachPadError
 from app.link.robot_link import LinkPort, Pending
-from app.link.types import ConnectionState, LinkState, WorkerError
+from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult, Pose
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
+from ui.controllers.plan_run_reasons import connection_error, outcome_text, stopped_by_operator
+from ui.controllers.point_sync_state import pose_from_details
 from ui.controllers.run_points import RunPoints, SegmentPoints
 from ui.messages import error_text, result_text
 from ui.models.points_model import PointsModel
 
 if TYPE_CHECKING:  # app.plan.runner is imported where a run starts, after the first paint
     from app.plan.runner import PlanRunner, RunOutcome, RunProgress, SegmentCommand
-
-POSE_DETAIL_KEYS: tuple[str, ...] = ("x", "y", "z", "a", "b", "c")
 
 
 class PlanRunController(QObject):
@@ -240,19 +243,7 @@ class PlanRunController(QObject):
 
     def outcome_text(self, outcome: RunOutcome) -> str:
         """How a stopped or failed run ended, in the operator's language (one sentence)."""
-        from app.plan.runner import RunState  # lazy: not before the first paint
-
-        failed = outcome.state is RunState.FAILED
-        reason = self.end_reason or outcome.message
-        if outcome.resume_from is None:
-            text = self.tr("Failed: {reason}") if failed else self.tr("Stopped: {reason}")
-            return text.format(reason=reason)
-        text = (
-            self.tr("Failed at segment {n}: {reason}")
-            if failed
-            else self.tr("Stopped at segment {n}: {reason}")
-        )
-        return text.format(n=outcome.resume_from + 1, reason=reason)
+        return outcome_text(outcome, self.end_reason)
 
     def stop(self) -> None:
         """Stop the robot and the run. The run ends when the link reports the stopped move
@@ -268,7 +259,7 @@ class PlanRunController(QObject):
         if runner is None or runner.state.is_over:
             return
         runner.request_stop()
-        self.end_reason = self.tr("stopped by the operator")
+        self.end_reason = stopped_by_operator()
         self._set_paused(False)
         if (
             runner.state is not RunState.RUNNING
@@ -425,7 +416,9 @@ class PlanRunController(QObject):
         self._move = None
         prepared, self._prepared = self._prepared, None
         if result.ok and prepared is not None:
-            error = self._guard.check_arrival(prepared, _pose_of(result, self.last_pose))
+            # the pose that came with the result, else the link's latest (the poll that
+            # completed the move publishes its pose before the result)
+            error = self._guard.check_arrival(prepared, pose_from_details(result.details, self.last_pose))
             if error is not None:
                 self.pointMismatch.emit(prepared.end_id)
                 self._fail_segment(error)
@@ -484,30 +477,7 @@ class PlanRunController(QObject):
             if self._upload is not None:
                 self._guard.finish_upload(state.endpoint)  # what the worker reported so far
             self._clear_segment()
-            error = _connection_error(state)
+            error = connection_error(state)
             self.end_reason = error_text(error)
             runner.on_error(error)
             self._finish()
-
-
-def _connection_error(state: ConnectionState) -> TeachPadError:
-    """Why a run ends when the link leaves CONNECTED: a controller that went silent while the
-    connection stays open (``NOT_ANSWERING``) is not a lost link, and is not said as one."""
-    where = {"endpoint": state.endpoint} if state.endpoint else {}
-    if state.state is LinkState.NOT_ANSWERING:
-        return ResponseTimeout(
-            f"the controller is not answering: {state.message or 'no answer'}",
-            code="run_not_answering",
-            params=where,
-        )
-    return LinkError(f"link lost: {state.message or 'link lost'}", params=where)
-
-
-def _pose_of(result: CommandResult, fallback: Pose | None) -> Pose | None:
-    """The pose that came with the result (``x``..``c`` details), else the link's latest pose:
-    the poll that completed the move publishes its pose before the result."""
-    details = result.details
-    if all(k in details for k in POSE_DETAIL_KEYS):
-        x, y, z, a, b, c = (float(details[k]) for k in POSE_DETAIL_KEYS)
-        return Pose(x, y, z, a, b, c, ext=fallback.ext if fallback else (0.0,) * 5)
-    return fallback
