@@ -38,10 +38,12 @@ def pytest_configure(config: pytest.Config) -> None:
     global _stderr_copy
     _stderr_copy = os.dup(2)  # the terminal's stderr, before tests capture fd 2
     # The settings and data of the user running the tests are never read nor written: the audit
-    # trail, QSettings (XDG_CONFIG_HOME on Linux) and projects go to a fresh directory.
+    # trail, QSettings (XDG_CONFIG_HOME on Linux), autosaves (XDG_STATE_HOME) and projects go to a
+    # fresh directory.
     private = tempfile.mkdtemp(prefix="teachpad-tests-")
     os.environ["XDG_DATA_HOME"] = os.path.join(private, "data")
     os.environ["XDG_CONFIG_HOME"] = os.path.join(private, "config")
+    os.environ["XDG_STATE_HOME"] = os.path.join(private, "state")
     config.stash[_PRIVATE_DIR] = private
 
 
