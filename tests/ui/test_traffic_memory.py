@@ -11,9 +11,7 @@ from PySide6.QtCore import QModelIndex
 import ui.models.traffic_model as traffic
 from tests.ui.test_traffic_panel import Rec, Wire, cell
 from ui.models.traffic_model import COL_MEANING, VIEW_CACHE_SIZE, TrafficModel
-from ui.models.traffic_store import FIXED_BYTES_PER_ROW, TrafficStore
-
-MAX_ADU_BYTES = 260  # the largest Modbus TCP frame
+from ui.models.traffic_store import FIXED_BYTES_PER_ROW, FRAME_BYTES_PER_ROW, MAX_FRAME_BYTES, TrafficStore
 
 
 def streaming(wire: Wire, n: int) -> list[Rec]:
@@ -44,9 +42,7 @@ def test_every_buffer_stays_bounded_when_filled_far_past_the_cap(qapp: Any) -> N
         assert model.view_count() <= VIEW_CACHE_SIZE
         assert len(model._summary_cache) <= traffic._SUMMARY_CACHE_SIZE
         assert len(model._pending) <= traffic._MAX_PENDING
-        frames = sum(len(model.row_at(r).frame) for r in range(model.rowCount()))
-        assert model.stored_bytes() == frames + FIXED_BYTES_PER_ROW * model.rowCount()
-        assert model.stored_bytes() <= 500 * (MAX_ADU_BYTES + FIXED_BYTES_PER_ROW)
+        assert model.stored_bytes() == 500 * (FRAME_BYTES_PER_ROW + FIXED_BYTES_PER_ROW)
 
 
 def test_unanswered_requests_do_not_pile_up(qapp: Any) -> None:
@@ -58,17 +54,34 @@ def test_unanswered_requests_do_not_pile_up(qapp: Any) -> None:
     assert model.rowCount() <= 100
 
 
-def test_a_stored_row_costs_its_frame_and_a_fixed_few_bytes() -> None:
-    store = TrafficStore()
-    for i in range(1000):
-        store.append(float(i), bytes(200), 0, -1, -1)
-    assert store.nbytes() == 1000 * (200 + FIXED_BYTES_PER_ROW)
-    store.drop_oldest(400)
-    assert len(store) == 600 and store.base == 400
-    assert store.nbytes() == 600 * (200 + FIXED_BYTES_PER_ROW)
-    assert store.time(0) == 400.0
-    store.clear()
-    assert len(store) == 0 and store.nbytes() == 0 and store.base == 1000
+def test_the_store_is_allocated_once_and_rolls_in_place() -> None:
+    store = TrafficStore(1000)
+    assert store.nbytes() == 0  # nothing before the first row
+    store.append(0.0, bytes(10), 0, -1, -1)
+    allocated = store.nbytes()
+    assert allocated == 1000 * (FRAME_BYTES_PER_ROW + FIXED_BYTES_PER_ROW)
+    buffers = [id(b) for b in (store._data, store._times, store._offsets, store._meanings)]
+    for i in range(1, 5000):
+        size = 1 + i % 120
+        store.append(float(i), bytes([i % 256]) * size, 0, -1, -1)
+        assert len(store) <= 1000 and store.frame_bytes() <= store.frame_capacity
+    assert store.nbytes() == allocated
+    assert [id(b) for b in (store._data, store._times, store._offsets, store._meanings)] == buffers
+    newest = len(store) - 1
+    assert store.time(newest) == 4999.0 and store.frame(newest) == bytes([4999 % 256]) * (1 + 4999 % 120)
+    assert store.base == 5000 - len(store)
+
+
+def test_big_frames_give_way_to_the_byte_ring_first() -> None:
+    store = TrafficStore(100)
+    for i in range(300):
+        store.append(float(i), bytes([i % 256]) * MAX_FRAME_BYTES, 0, -1, -1)
+    assert store.frame_bytes() <= store.frame_capacity
+    assert len(store) == store.frame_capacity // MAX_FRAME_BYTES  # fewer, longer rows
+    assert store.frame(len(store) - 1) == bytes([299 % 256]) * MAX_FRAME_BYTES
+    assert store.room_for([MAX_FRAME_BYTES]) >= 1
+    store.drop_oldest(len(store))
+    assert len(store) == 0 and store.room_for([12] * 100) == 0
 
 
 def test_rows_are_the_same_after_their_views_were_dropped(qapp: Any) -> None:
@@ -103,7 +116,26 @@ def test_clear_forgets_rows_views_and_pairing(qapp: Any) -> None:
     model.append_records([*streaming(wire, 20), wire.poll_status()[0]])
     show_all(model)
     model.clear()
-    assert (model.rowCount(), model.view_count(), model.stored_bytes(), len(model._pending)) == (0, 0, 0, 0)
+    assert (model.rowCount(), model.view_count(), len(model._pending)) == (0, 0, 0)
     with pytest.raises(IndexError):
         model.row_at(0)
     assert model.rowCount(QModelIndex()) == 0
+
+
+def test_records_gathered_while_shown_stay_within_the_table_bound(qtbot: Any) -> None:
+    from ui.display_clock import DisplayClock
+    from ui.panels.traffic_panel import TrafficPanel
+
+    clock = DisplayClock()  # never given a turn of the event loop here: nothing is flushed
+    panel = TrafficPanel(max_rows=50, clock=clock)
+    qtbot.addWidget(panel)
+    panel.show()
+    qtbot.waitExposed(panel)
+    wire = Wire()
+    for _ in range(100):
+        panel.on_traffic(streaming(wire, 5))
+        assert len(panel._pending) <= 50
+    newest = panel._pending[-1]
+    panel.flush()
+    assert panel.model.rowCount() == 50
+    assert panel.model.row_at(49).frame == newest.frame

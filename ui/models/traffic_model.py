@@ -33,12 +33,13 @@ from app.protocol.datetime_regs import DateTimeLayout
 from app.protocol.enums import CommandKind, RunCommand
 from app.protocol.frames import DecodedFrame, decode_frame
 from app.protocol.framing import EXCEPTION_FLAG, MBAP_SIZE, FunctionCode
-from ui.models.traffic_store import BAD, NO_COMMAND, NO_ROW, POLL, RTU, RX, TrafficStore
+from ui.models.traffic_store import BAD, MAX_FRAME_BYTES, NO_COMMAND, NO_ROW, POLL, RTU, RX, TrafficStore
 from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_INK_SOFT
 from ui.widgets_common import monospace_font
 
-# 20,000 rows: the last ~100 s at 100 Hz polling (a request and an answer per poll), ~2.9 MB
-# stored (~145 bytes a row while streaming: benchmarks.gui_memory, tests/ui/test_traffic_memory.py)
+# 20,000 rows: the last minute or so of 100 Hz polling (2 reads a poll, each a request and an
+# answer). The store takes 165 bytes a row, 3.3 MB, allocated by the first row and never more
+# (ui/models/traffic_store.py; before: ~390 bytes a row in Python objects, 7.7 MB).
 MAX_ROWS_DEFAULT = 20_000
 VIEW_CACHE_SIZE = 256  # row views (with their formatted texts) kept: a few screenfuls
 HEX_DISPLAY_BYTES = 40  # bytes shown in the table cell; a 412.. read answer has 209
@@ -177,7 +178,7 @@ class TrafficModel(QAbstractTableModel):
         super().__init__(parent)
         if max_rows < 1:
             raise ValueError("max_rows must be >= 1")
-        self._store = TrafficStore()
+        self._store = TrafficStore(max_rows)
         self._views: dict[int, TrafficRow] = {}  # absolute row index -> view, oldest first
         self._max_rows = max_rows
         # Dropping a chunk at a time keeps removals (and the proxy's remapping) rare.
@@ -226,12 +227,11 @@ class TrafficModel(QAbstractTableModel):
         """Add a batch (one insert notification); returns how many rows were added."""
         if not records:
             return 0
-        if len(records) > self._max_rows:
-            records = records[len(records) - self._max_rows :]
+        records = self._newest_that_fit(records)
         store = self._store
-        overflow = len(store) + len(records) - self._max_rows
-        if overflow > 0:
-            drop = min(len(store), max(overflow, self._drop_chunk))
+        need = store.room_for([len(r.frame) for r in records])
+        if need > 0:
+            drop = min(len(store), max(need, self._drop_chunk))
             if (
                 drop < len(store)
                 and store.request(drop) != NO_ROW
@@ -247,6 +247,19 @@ class TrafficModel(QAbstractTableModel):
             self._add(record)
         self.endInsertRows()
         return len(records)
+
+    def _newest_that_fit(self, records: Sequence[Any]) -> Sequence[Any]:
+        """The newest records the table can hold at once (rows and frame bytes)."""
+        if len(records) > self._max_rows:
+            records = records[len(records) - self._max_rows :]
+        budget = self._store.frame_capacity - MAX_FRAME_BYTES  # room for one wasted ring end
+        keep = 0
+        for record in reversed(records):
+            budget -= min(len(record.frame), MAX_FRAME_BYTES)
+            if budget < 0:
+                break
+            keep += 1
+        return records[len(records) - keep :] if keep < len(records) else records
 
     def _add(self, record: Any) -> None:
         store = self._store
@@ -336,7 +349,7 @@ class TrafficModel(QAbstractTableModel):
         view.bad = bool(flags & BAD)
         command = store.command(row)
         view.last_command = None if command == NO_COMMAND else RunCommand(command)
-        view._summary = store.meanings[row]
+        view._summary = store.meaning(row)
         views = self._views
         if len(views) >= VIEW_CACHE_SIZE:
             del views[next(iter(views))]
@@ -354,7 +367,7 @@ class TrafficModel(QAbstractTableModel):
         return bool(self._store.flags(row) & POLL)
 
     def stored_bytes(self) -> int:
-        """Bytes the rows take in the store (see :meth:`TrafficStore.nbytes`)."""
+        """Bytes allocated for the rows (see :meth:`TrafficStore.nbytes`): fixed once a row came."""
         return self._store.nbytes()
 
     def view_count(self) -> int:
@@ -383,7 +396,7 @@ class TrafficModel(QAbstractTableModel):
         """The meaning (and a malformed frame's red) goes with the stored row, for later views."""
         local = row.index - self._store.base
         if 0 <= local < len(self._store):
-            self._store.meanings[local] = text
+            self._store.set_meaning(local, text)
             if row.bad:
                 self._store.set_flag(local, BAD)
         return text
