@@ -5,14 +5,13 @@ Rows are added in batches; at insertion only a few bytes are peeked at (pairing 
 with its request, spotting polls and run commands) and the frame is stored compactly
 (:class:`ui.models.traffic_store.TrafficStore`: raw bytes and a few typed fields, no object
 per row). A :class:`TrafficRow` is a view made when a row is shown, filtered on or exported;
-the model keeps at most ``VIEW_CACHE_SIZE`` of them. The full decoding
-(:func:`app.protocol.frames.decode_frame`) runs the first time a row's meaning is needed and
-the text is kept with the row, so 100 Hz traffic does not stall the GUI.
+the model keeps at most ``VIEW_CACHE_SIZE`` of them (:mod:`ui.models.traffic_row`). The full
+decoding (:func:`app.protocol.frames.decode_frame`) runs the first time a row's meaning is
+needed and the text is kept with the stored row, so 100 Hz traffic does not stall the GUI.
 """
 
 from __future__ import annotations
 
-import time
 from collections import OrderedDict
 from collections.abc import Iterable, Sequence
 from typing import Any
@@ -31,18 +30,30 @@ from app.protocol import registers as regs
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 from app.protocol.enums import CommandKind, RunCommand
-from app.protocol.frames import DecodedFrame, decode_frame
 from app.protocol.framing import EXCEPTION_FLAG, MBAP_SIZE, FunctionCode
+from ui.models.traffic_row import TrafficRow, is_poll_read, wrap_hex
 from ui.models.traffic_store import BAD, MAX_FRAME_BYTES, NO_COMMAND, NO_ROW, POLL, RTU, RX, TrafficStore
 from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_INK_SOFT
 from ui.widgets_common import monospace_font
+
+__all__ = [
+    "COL_BYTES",
+    "COL_DIRECTION",
+    "COL_MEANING",
+    "COL_TIME",
+    "MAX_ROWS_DEFAULT",
+    "VIEW_CACHE_SIZE",
+    "TrafficFilter",
+    "TrafficModel",
+    "TrafficRow",
+    "is_poll_read",
+]
 
 # 20,000 rows: the last minute or so of 100 Hz polling (2 reads a poll, each a request and an
 # answer). The store takes 165 bytes a row, 3.3 MB, allocated by the first row and never more
 # (ui/models/traffic_store.py; before: ~390 bytes a row in Python objects, 7.7 MB).
 MAX_ROWS_DEFAULT = 20_000
 VIEW_CACHE_SIZE = 256  # row views (with their formatted texts) kept: a few screenfuls
-HEX_DISPLAY_BYTES = 40  # bytes shown in the table cell; a 412.. read answer has 209
 _MAX_PENDING = 256  # unanswered TCP requests remembered for pairing
 _SUMMARY_CACHE_SIZE = 2048  # distinct response contents remembered (emptied when full)
 
@@ -53,115 +64,6 @@ _FOREGROUND = Qt.ItemDataRole.ForegroundRole.value
 _FONT = Qt.ItemDataRole.FontRole.value
 _TOOLTIP = Qt.ItemDataRole.ToolTipRole.value
 _USED_ROLES = frozenset({_DISPLAY, _FOREGROUND, _FONT, _TOOLTIP})
-
-# Reads inside these register blocks are the monitor's polls ("hide polls").
-_POLL_BLOCKS: tuple[range, ...] = (
-    range(regs.POSE_BLOCK_START, regs.POSE_BLOCK_START + regs.POSE_BLOCK_COUNT),
-    range(regs.STATUS_BLOCK_START, regs.STATUS_BLOCK_START + regs.STATUS_BLOCK_COUNT),
-)
-
-
-def is_poll_read(address: int, count: int) -> bool:
-    """An FC03 read that lies wholly in the pose block (412..) or the status block (560..)."""
-    last = address + count - 1
-    return count > 0 and any(address in block and last in block for block in _POLL_BLOCKS)
-
-
-class TrafficRow:
-    """One captured frame plus what was learnt cheaply at insertion; decoding is cached.
-
-    Made by the model on demand (a view of a stored row, ``index`` its absolute row number)."""
-
-    __slots__ = (
-        "_decoded",
-        "_hex",
-        "_summary",
-        "_time",
-        "bad",
-        "direction",
-        "frame",
-        "index",
-        "last_command",
-        "poll",
-        "request",
-        "t",
-        "transport",
-    )
-
-    def __init__(self, t: float, direction: str, frame: bytes, transport: str, index: int = NO_ROW) -> None:
-        self.index = index
-        self.t = t
-        self.direction = direction
-        self.frame = frame
-        self.transport = transport
-        self.poll = False  # a read of the pose/status block, or its answer
-        self.bad = False  # exception response (or, once decoded, malformed)
-        self.request: TrafficRow | None = None  # for a response: the request it answers
-        self.last_command: RunCommand | None = None  # decides the GV291 table
-        self._hex: str | None = None
-        self._summary: str | None = None
-        self._time: str | None = None
-        self._decoded: DecodedFrame | None = None  # kept for requests only (they are small)
-
-    @property
-    def hex(self) -> str:
-        """All bytes, spaced uppercase hex as in the seed (not cached: cheap, and long)."""
-        return self.frame.hex(" ").upper()
-
-    @property
-    def hex_display(self) -> str:
-        """The hex cut after ``HEX_DISPLAY_BYTES`` (cached): eliding a 600-character string on
-        every repaint made the table slow. The tooltip and exports carry all bytes."""
-        if self._hex is None:
-            if len(self.frame) <= HEX_DISPLAY_BYTES:
-                self._hex = self.hex
-            else:
-                self._hex = self.frame[:HEX_DISPLAY_BYTES].hex(" ").upper() + " …"
-        return self._hex
-
-    def decode(self, word_order: WordOrder, clock_layout: DateTimeLayout) -> DecodedFrame:
-        """Full decoding (not cached for responses: use ``summary`` for the cached text)."""
-        if self._decoded is not None:
-            return self._decoded
-        request = self.request.decode(word_order, clock_layout) if self.request is not None else None
-        decoded = decode_frame(
-            self.frame,
-            transport="rtu" if self.transport == "rtu" else "tcp",
-            direction="rx" if self.direction == "rx" else "tx",
-            word_order=word_order,
-            last_command=self.last_command,
-            clock_layout=clock_layout,
-            request=request,
-        )
-        if self.direction == "tx":
-            self._decoded = decoded
-        return decoded
-
-    def summary(self, word_order: WordOrder, clock_layout: DateTimeLayout) -> str:
-        if self._summary is None:
-            decoded = self.decode(word_order, clock_layout)
-            text = decoded.summary
-            if decoded.errors:
-                text = f"{text} [{'; '.join(decoded.errors)}]"
-                self.bad = True
-            self._summary = text
-        return self._summary
-
-    @property
-    def time_display(self) -> str:
-        if self._time is None:
-            self._time = self.time_text()
-        return self._time
-
-    def time_text(self, with_date: bool = False) -> str:
-        stamp = time.localtime(self.t)
-        ms = int(self.t * 1000) % 1000
-        return time.strftime("%Y-%m-%d %H:%M:%S" if with_date else "%H:%M:%S", stamp) + f".{ms:03d}"
-
-
-def _wrap_hex(text: str, per_line: int = 16) -> str:
-    step = 3 * per_line
-    return "\n".join(text[i : i + step].rstrip() for i in range(0, len(text), step))
 
 
 class TrafficModel(QAbstractTableModel):
@@ -449,7 +351,7 @@ class TrafficModel(QAbstractTableModel):
         # Tooltip: rare, may decode again.
         if column == COL_BYTES:
             size = QCoreApplication.translate("TrafficModel", "{n} bytes").format(n=len(row.frame))
-            return f"{size}\n{_wrap_hex(row.hex)}"
+            return f"{size}\n{wrap_hex(row.hex)}"
         if column == COL_MEANING:
             decoded = row.decode(self.word_order, self.clock_layout)
             lines = [item.label for item in decoded.items[:40]]
