@@ -178,7 +178,7 @@ def test_a_hidden_traffic_panel_decodes_and_formats_nothing(
         decoded.append(bytes(data))
         return original(data, **kwargs)
 
-    monkeypatch.setattr("ui.models.traffic_model.decode_frame", counting)
+    monkeypatch.setattr("ui.models.traffic_row.decode_frame", counting)
     panel = TrafficPanel(clock=DisplayClock(interval_ms=5))
     qtbot.addWidget(panel)
     label = panel.count_label.text()

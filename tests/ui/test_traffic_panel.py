@@ -141,7 +141,7 @@ def test_rows_show_time_direction_seed_hex_and_meaning(panel: TrafficPanel) -> N
 
 def test_decoding_is_lazy_and_cached(panel: TrafficPanel, monkeypatch: pytest.MonkeyPatch) -> None:
     import app.protocol.frames as frames
-    import ui.models.traffic_model as traffic
+    import ui.models.traffic_row as traffic
 
     calls: list[bytes] = []
     real = frames.decode_frame  # the function the model module imported

@@ -2,14 +2,16 @@
 filter over it (:class:`TrafficFilter`).
 
 Rows are added in batches; at insertion only a few bytes are peeked at (pairing a response
-with its request, spotting polls and run commands); the full decoding
-(:func:`app.protocol.frames.decode_frame`) runs the first time a row's meaning is shown,
-filtered on or exported, and is cached, so 100 Hz traffic does not stall the GUI.
+with its request, spotting polls and run commands) and the frame is stored compactly
+(:class:`ui.models.traffic_store.TrafficStore`: raw bytes and a few typed fields, no object
+per row). A :class:`TrafficRow` is a view made when a row is shown, filtered on or exported;
+the model keeps at most ``VIEW_CACHE_SIZE`` of them (:mod:`ui.models.traffic_row`). The full
+decoding (:func:`app.protocol.frames.decode_frame`) runs the first time a row's meaning is
+needed and the text is kept with the stored row, so 100 Hz traffic does not stall the GUI.
 """
 
 from __future__ import annotations
 
-import time
 from collections import OrderedDict
 from collections.abc import Iterable, Sequence
 from typing import Any
@@ -28,15 +30,32 @@ from app.protocol import registers as regs
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 from app.protocol.enums import CommandKind, RunCommand
-from app.protocol.frames import DecodedFrame, decode_frame
 from app.protocol.framing import EXCEPTION_FLAG, MBAP_SIZE, FunctionCode
+from ui.models.traffic_row import TrafficRow, is_poll_read, wrap_hex
+from ui.models.traffic_store import BAD, MAX_FRAME_BYTES, NO_COMMAND, NO_ROW, POLL, RTU, RX, TrafficStore
 from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_INK_SOFT
 from ui.widgets_common import monospace_font
 
+__all__ = [
+    "COL_BYTES",
+    "COL_DIRECTION",
+    "COL_MEANING",
+    "COL_TIME",
+    "MAX_ROWS_DEFAULT",
+    "VIEW_CACHE_SIZE",
+    "TrafficFilter",
+    "TrafficModel",
+    "TrafficRow",
+    "is_poll_read",
+]
+
+# 20,000 rows: the last minute or so of 100 Hz polling (2 reads a poll, each a request and an
+# answer). The store takes 165 bytes a row, 3.3 MB, allocated by the first row and never more
+# (ui/models/traffic_store.py; before: ~390 bytes a row in Python objects, 7.7 MB).
 MAX_ROWS_DEFAULT = 20_000
-HEX_DISPLAY_BYTES = 40  # bytes shown in the table cell; a 412.. read answer has 209
+VIEW_CACHE_SIZE = 256  # row views (with their formatted texts) kept: a few screenfuls
 _MAX_PENDING = 256  # unanswered TCP requests remembered for pairing
-_SUMMARY_CACHE_SIZE = 4096  # distinct response contents remembered
+_SUMMARY_CACHE_SIZE = 2048  # distinct response contents remembered (emptied when full)
 
 COL_TIME, COL_DIRECTION, COL_BYTES, COL_MEANING = range(4)
 _COLUMN_COUNT = 4
@@ -45,111 +64,6 @@ _FOREGROUND = Qt.ItemDataRole.ForegroundRole.value
 _FONT = Qt.ItemDataRole.FontRole.value
 _TOOLTIP = Qt.ItemDataRole.ToolTipRole.value
 _USED_ROLES = frozenset({_DISPLAY, _FOREGROUND, _FONT, _TOOLTIP})
-
-# Reads inside these register blocks are the monitor's polls ("hide polls").
-_POLL_BLOCKS: tuple[range, ...] = (
-    range(regs.POSE_BLOCK_START, regs.POSE_BLOCK_START + regs.POSE_BLOCK_COUNT),
-    range(regs.STATUS_BLOCK_START, regs.STATUS_BLOCK_START + regs.STATUS_BLOCK_COUNT),
-)
-
-
-def is_poll_read(address: int, count: int) -> bool:
-    """An FC03 read that lies wholly in the pose block (412..) or the status block (560..)."""
-    last = address + count - 1
-    return count > 0 and any(address in block and last in block for block in _POLL_BLOCKS)
-
-
-class TrafficRow:
-    """One captured frame plus what was learnt cheaply at insertion; decoding is cached."""
-
-    __slots__ = (
-        "_decoded",
-        "_hex",
-        "_summary",
-        "_time",
-        "bad",
-        "direction",
-        "frame",
-        "last_command",
-        "poll",
-        "request",
-        "t",
-        "transport",
-    )
-
-    def __init__(self, t: float, direction: str, frame: bytes, transport: str) -> None:
-        self.t = t
-        self.direction = direction
-        self.frame = frame
-        self.transport = transport
-        self.poll = False  # a read of the pose/status block, or its answer
-        self.bad = False  # exception response (or, once decoded, malformed)
-        self.request: TrafficRow | None = None  # for a response: the request it answers
-        self.last_command: RunCommand | None = None  # decides the GV291 table
-        self._hex: str | None = None
-        self._summary: str | None = None
-        self._time: str | None = None
-        self._decoded: DecodedFrame | None = None  # kept for requests only (they are small)
-
-    @property
-    def hex(self) -> str:
-        """All bytes, spaced uppercase hex as in the seed (not cached: cheap, and long)."""
-        return self.frame.hex(" ").upper()
-
-    @property
-    def hex_display(self) -> str:
-        """The hex cut after ``HEX_DISPLAY_BYTES`` (cached): eliding a 600-character string on
-        every repaint made the table slow. The tooltip and exports carry all bytes."""
-        if self._hex is None:
-            if len(self.frame) <= HEX_DISPLAY_BYTES:
-                self._hex = self.hex
-            else:
-                self._hex = self.frame[:HEX_DISPLAY_BYTES].hex(" ").upper() + " …"
-        return self._hex
-
-    def decode(self, word_order: WordOrder, clock_layout: DateTimeLayout) -> DecodedFrame:
-        """Full decoding (not cached for responses: use ``summary`` for the cached text)."""
-        if self._decoded is not None:
-            return self._decoded
-        request = self.request.decode(word_order, clock_layout) if self.request is not None else None
-        decoded = decode_frame(
-            self.frame,
-            transport="rtu" if self.transport == "rtu" else "tcp",
-            direction="rx" if self.direction == "rx" else "tx",
-            word_order=word_order,
-            last_command=self.last_command,
-            clock_layout=clock_layout,
-            request=request,
-        )
-        if self.direction == "tx":
-            self._decoded = decoded
-        return decoded
-
-    def summary(self, word_order: WordOrder, clock_layout: DateTimeLayout) -> str:
-        if self._summary is None:
-            decoded = self.decode(word_order, clock_layout)
-            text = decoded.summary
-            if decoded.errors:
-                text = f"{text} [{'; '.join(decoded.errors)}]"
-                self.bad = True
-            self._summary = text
-        return self._summary
-
-    @property
-    def time_display(self) -> str:
-        if self._time is None:
-            self._time = self.time_text()
-        return self._time
-
-    def time_text(self, with_date: bool = False) -> str:
-        stamp = time.localtime(self.t)
-        ms = int(self.t * 1000) % 1000
-        return time.strftime("%Y-%m-%d %H:%M:%S" if with_date else "%H:%M:%S", stamp) + f".{ms:03d}"
-
-
-def _wrap_hex(text: str, per_line: int = 16) -> str:
-    step = 3 * per_line
-    return "\n".join(text[i : i + step].rstrip() for i in range(0, len(text), step))
 
 
 class TrafficModel(QAbstractTableModel):
@@ -166,15 +80,16 @@ class TrafficModel(QAbstractTableModel):
         super().__init__(parent)
         if max_rows < 1:
             raise ValueError("max_rows must be >= 1")
-        self._rows: list[TrafficRow] = []
+        self._store = TrafficStore(max_rows)
+        self._views: dict[int, TrafficRow] = {}  # absolute row index -> view, oldest first
         self._max_rows = max_rows
         # Dropping a chunk at a time keeps removals (and the proxy's remapping) rare.
         self._drop_chunk = max(1, max_rows // 20)
         self.word_order = word_order
         self.clock_layout = clock_layout
         self._summary_cache: dict[tuple[Any, ...], tuple[str, bool]] = {}
-        self._pending: OrderedDict[int, TrafficRow] = OrderedDict()  # TCP: transaction id -> request
-        self._last_request: TrafficRow | None = None  # RTU: half duplex, answers follow requests
+        self._pending: OrderedDict[int, int] = OrderedDict()  # TCP: transaction id -> request row
+        self._last_request = NO_ROW  # RTU: half duplex, answers follow requests
         self._last_command: RunCommand | None = None
         self._mono = monospace_font(9.5)
         self._tx_brush = QBrush(QColor(COLOR_INFO))
@@ -198,10 +113,10 @@ class TrafficModel(QAbstractTableModel):
         """Headers and direction texts in the current language (the decoded meaning stays English)."""
         self._set_texts()
         self.headerDataChanged.emit(Qt.Orientation.Horizontal, 0, _COLUMN_COUNT - 1)
-        if self._rows:
+        if len(self._store):
             self.dataChanged.emit(
                 self.index(0, COL_DIRECTION),
-                self.index(len(self._rows) - 1, COL_DIRECTION),
+                self.index(len(self._store) - 1, COL_DIRECTION),
                 [Qt.ItemDataRole.DisplayRole],
             )
 
@@ -214,61 +129,89 @@ class TrafficModel(QAbstractTableModel):
         """Add a batch (one insert notification); returns how many rows were added."""
         if not records:
             return 0
+        records = self._newest_that_fit(records)
+        store = self._store
+        need = store.room_for([len(r.frame) for r in records])
+        if need > 0:
+            drop = min(len(store), max(need, self._drop_chunk))
+            if (
+                drop < len(store)
+                and store.request(drop) != NO_ROW
+                and store.request(drop) < store.base + drop
+            ):
+                drop += 1  # an answer is not kept without the request it answers
+            self.beginRemoveRows(QModelIndex(), 0, drop - 1)
+            store.drop_oldest(drop)
+            self.endRemoveRows()
+        first = len(store)
+        self.beginInsertRows(QModelIndex(), first, first + len(records) - 1)
+        for record in records:
+            self._add(record)
+        self.endInsertRows()
+        return len(records)
+
+    def _newest_that_fit(self, records: Sequence[Any]) -> Sequence[Any]:
+        """The newest records the table can hold at once (rows and frame bytes)."""
         if len(records) > self._max_rows:
             records = records[len(records) - self._max_rows :]
-        new_rows = [self._make_row(r) for r in records]
-        overflow = len(self._rows) + len(new_rows) - self._max_rows
-        if overflow > 0:
-            drop = min(len(self._rows), max(overflow, self._drop_chunk))
-            self.beginRemoveRows(QModelIndex(), 0, drop - 1)
-            del self._rows[:drop]
-            self.endRemoveRows()
-        first = len(self._rows)
-        self.beginInsertRows(QModelIndex(), first, first + len(new_rows) - 1)
-        self._rows.extend(new_rows)
-        self.endInsertRows()
-        return len(new_rows)
+        budget = self._store.frame_capacity - MAX_FRAME_BYTES  # room for one wasted ring end
+        keep = 0
+        for record in reversed(records):
+            budget -= min(len(record.frame), MAX_FRAME_BYTES)
+            if budget < 0:
+                break
+            keep += 1
+        return records[len(records) - keep :] if keep < len(records) else records
 
-    def _make_row(self, record: Any) -> TrafficRow:
+    def _add(self, record: Any) -> None:
+        store = self._store
         frame = bytes(record.frame)
-        transport = "rtu" if record.transport == "rtu" else "tcp"
-        row = TrafficRow(float(record.t), "rx" if record.direction == "rx" else "tx", frame, transport)
-        offset = MBAP_SIZE if transport == "tcp" else 1  # where the PDU starts
+        rtu = record.transport == "rtu"
+        offset = 1 if rtu else MBAP_SIZE  # where the PDU starts
         fc = frame[offset] if len(frame) > offset else None
-        if row.direction == "tx":
+        flags = RTU if rtu else 0
+        if record.direction != "rx":
             if fc == FunctionCode.READ_HOLDING_REGISTERS and len(frame) >= offset + 5:
                 address = int.from_bytes(frame[offset + 1 : offset + 3], "big")
                 count = int.from_bytes(frame[offset + 3 : offset + 5], "big")
-                row.poll = is_poll_read(address, count)
+                if is_poll_read(address, count):
+                    flags |= POLL
             elif fc == FunctionCode.WRITE_SINGLE_REGISTER and len(frame) >= offset + 5:
                 address = int.from_bytes(frame[offset + 1 : offset + 3], "big")
                 if address == regs.REG_RUN_COMMAND:
                     self._note_command(int.from_bytes(frame[offset + 3 : offset + 5], "big"))
-            row.last_command = self._last_command
-            if transport == "tcp" and len(frame) >= 2:
+            index = store.append(float(record.t), frame, flags, NO_ROW, self._command_value())
+            if not rtu and len(frame) >= 2:
                 tid = int.from_bytes(frame[:2], "big")
                 self._pending.pop(tid, None)
-                self._pending[tid] = row
+                self._pending[tid] = index
                 while len(self._pending) > _MAX_PENDING:
                     self._pending.popitem(last=False)
             else:
-                self._last_request = row
-            return row
+                self._last_request = index
+            return
         # A response.
-        row.last_command = self._last_command
-        row.bad = fc is None or bool(fc & EXCEPTION_FLAG)
-        request: TrafficRow | None = None
-        if transport == "tcp":
+        flags |= RX
+        bad = fc is None or bool(fc & EXCEPTION_FLAG)
+        if bad:
+            flags |= BAD
+        request = NO_ROW
+        if not rtu:
             if len(frame) >= 2:
-                request = self._pending.pop(int.from_bytes(frame[:2], "big"), None)
+                request = self._pending.pop(int.from_bytes(frame[:2], "big"), NO_ROW)
         else:
-            request, self._last_request = self._last_request, None
-        if request is not None and len(request.frame) > offset:
-            req_fc = request.frame[offset]
-            if fc is not None and (fc & ~EXCEPTION_FLAG) == req_fc:
-                row.request = request
-                row.poll = request.poll and not row.bad
-        return row
+            request, self._last_request = self._last_request, NO_ROW
+        paired = NO_ROW
+        if request >= store.base and fc is not None:
+            local = request - store.base
+            if (fc & ~EXCEPTION_FLAG) == store.byte(local, offset):
+                paired = request
+                if store.flags(local) & POLL and not bad:
+                    flags |= POLL
+        store.append(float(record.t), frame, flags, paired, self._command_value())
+
+    def _command_value(self) -> int:
+        return NO_COMMAND if self._last_command is None else int(self._last_command)
 
     def _note_command(self, value: int) -> None:
         try:
@@ -280,16 +223,57 @@ class TrafficModel(QAbstractTableModel):
 
     def clear(self) -> None:
         self.beginResetModel()
-        self._rows.clear()
+        self._store.clear()
+        self._views.clear()
         self._pending.clear()
-        self._last_request = None
+        self._last_request = NO_ROW
         self.endResetModel()
 
     def row_at(self, row: int) -> TrafficRow:
-        return self._rows[row]
+        """A view of row ``row`` (0 = oldest); raises IndexError outside the table."""
+        if not 0 <= row < len(self._store):
+            raise IndexError(f"no traffic row {row}")
+        view = self._views.get(self._store.base + row)
+        return view if view is not None else self._make_view(row)
+
+    def _make_view(self, row: int) -> TrafficRow:
+        store = self._store
+        flags = store.flags(row)
+        index = store.base + row
+        view = TrafficRow(
+            store.time(row),
+            "rx" if flags & RX else "tx",
+            store.frame(row),
+            "rtu" if flags & RTU else "tcp",
+            index,
+        )
+        view.poll = bool(flags & POLL)
+        view.bad = bool(flags & BAD)
+        command = store.command(row)
+        view.last_command = None if command == NO_COMMAND else RunCommand(command)
+        view._summary = store.meaning(row)
+        views = self._views
+        if len(views) >= VIEW_CACHE_SIZE:
+            del views[next(iter(views))]
+        views[index] = view
+        request = store.request(row)
+        if request != NO_ROW:
+            view.request = self.row_at(request - store.base)
+        return view
 
     def rows(self) -> Iterable[TrafficRow]:
-        return iter(self._rows)
+        return (self.row_at(i) for i in range(len(self._store)))
+
+    def is_poll(self, row: int) -> bool:
+        """Row ``row`` is a poll or its answer (without making a view)."""
+        return bool(self._store.flags(row) & POLL)
+
+    def stored_bytes(self) -> int:
+        """Bytes allocated for the rows (see :meth:`TrafficStore.nbytes`): fixed once a row came."""
+        return self._store.nbytes()
+
+    def view_count(self) -> int:
+        return len(self._views)
 
     def summary(self, row: TrafficRow) -> str:
         """The decoded meaning (cached in the row). Identical answers (a robot standing still
@@ -298,7 +282,7 @@ class TrafficModel(QAbstractTableModel):
             return row._summary
         request = row.request
         if row.direction != "rx" or request is None:
-            return row.summary(self.word_order, self.clock_layout)
+            return self._keep(row, row.summary(self.word_order, self.clock_layout))
         skip = 2 if row.transport == "tcp" else 0  # the transaction id does not change the meaning
         key = (row.transport, row.frame[skip:], request.frame[skip:], row.last_command)
         cached = self._summary_cache.get(key)
@@ -308,7 +292,16 @@ class TrafficModel(QAbstractTableModel):
                 self._summary_cache.clear()
             self._summary_cache[key] = cached
         row._summary, row.bad = cached[0], row.bad or cached[1]
-        return row._summary
+        return self._keep(row, row._summary)
+
+    def _keep(self, row: TrafficRow, text: str) -> str:
+        """The meaning (and a malformed frame's red) goes with the stored row, for later views."""
+        local = row.index - self._store.base
+        if 0 <= local < len(self._store):
+            self._store.set_meaning(local, text)
+            if row.bad:
+                self._store.set_flag(local, BAD)
+        return text
 
     def set_word_order(self, order: WordOrder) -> None:
         """Word order of float32 values (applies to rows decoded from now on)."""
@@ -325,7 +318,7 @@ class TrafficModel(QAbstractTableModel):
 
     # --- QAbstractTableModel ----------------------------------------------------------
     def rowCount(self, parent: QModelIndex | QPersistentModelIndex = QModelIndex()) -> int:  # noqa: B008
-        return 0 if parent.isValid() else len(self._rows)
+        return 0 if parent.isValid() else len(self._store)
 
     def columnCount(self, parent: QModelIndex | QPersistentModelIndex = QModelIndex()) -> int:  # noqa: B008
         return 0 if parent.isValid() else _COLUMN_COUNT
@@ -335,9 +328,10 @@ class TrafficModel(QAbstractTableModel):
         if role not in _USED_ROLES or not index.isValid():
             return None
         r, column = index.row(), index.column()
-        if not (0 <= r < len(self._rows) and 0 <= column < _COLUMN_COUNT):
+        store = self._store
+        if not (0 <= r < len(store) and 0 <= column < _COLUMN_COUNT):
             return None
-        row = self._rows[r]
+        row = self._views.get(store.base + r) or self._make_view(r)
         if role == _DISPLAY:
             if column == COL_MEANING:
                 return row._summary if row._summary is not None else self.summary(row)
@@ -357,7 +351,7 @@ class TrafficModel(QAbstractTableModel):
         # Tooltip: rare, may decode again.
         if column == COL_BYTES:
             size = QCoreApplication.translate("TrafficModel", "{n} bytes").format(n=len(row.frame))
-            return f"{size}\n{_wrap_hex(row.hex)}"
+            return f"{size}\n{wrap_hex(row.hex)}"
         if column == COL_MEANING:
             decoded = row.decode(self.word_order, self.clock_layout)
             lines = [item.label for item in decoded.items[:40]]
@@ -423,4 +417,6 @@ class TrafficFilter(QSortFilterProxyModel):
 
     def filterAcceptsRow(self, source_row: int, source_parent: QModelIndex | QPersistentModelIndex) -> bool:
         model = self.traffic_model()
-        return self.accepts(model, model.row_at(source_row))
+        if self._hide_polls and model.is_poll(source_row):
+            return False
+        return not self._text or self.accepts(model, model.row_at(source_row))

@@ -190,6 +190,9 @@ class TrafficPanel(QWidget):
             self.model.append_records(records)  # no painting, no formatting: showEvent catches up
             return
         self._pending.extend(records)
+        excess = len(self._pending) - self.model.max_rows
+        if excess > 0:  # the table keeps no more than this of them anyway (a long-stalled clock)
+            del self._pending[:excess]
         if not self._flush_timer.isActive() and not self._clock.is_requested(self.flush):
             self._flush_timer.start()
 
