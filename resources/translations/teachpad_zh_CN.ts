@@ -5066,37 +5066,37 @@ Remove them all?</source>
     <context>
         <name>TrafficModel</name>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="189" />
+            <location filename="../../ui/models/traffic_model.py" line="104" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="190" />
+            <location filename="../../ui/models/traffic_model.py" line="105" />
             <source>Dir</source>
             <translation>方向</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="191" />
+            <location filename="../../ui/models/traffic_model.py" line="106" />
             <source>Bytes</source>
             <translation>字节</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="192" />
+            <location filename="../../ui/models/traffic_model.py" line="107" />
             <source>Meaning</source>
             <translation>含义</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="194" />
+            <location filename="../../ui/models/traffic_model.py" line="109" />
             <source>→ Tx</source>
             <translation>→ 发送</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="195" />
+            <location filename="../../ui/models/traffic_model.py" line="110" />
             <source>← Rx</source>
             <translation>← 接收</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="359" />
+            <location filename="../../ui/models/traffic_model.py" line="353" />
             <source>{n} bytes</source>
             <translation>{n} 字节</translation>
         </message>
@@ -5139,28 +5139,28 @@ Remove them all?</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="294" />
+            <location filename="../../ui/panels/traffic_panel.py" line="297" />
             <source>Export traffic</source>
             <translation>导出通信报文</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="296" />
+            <location filename="../../ui/panels/traffic_panel.py" line="299" />
             <source>CSV files (*.csv);;Text files (*.txt);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;文本文件 (*.txt);;所有文件 (*)</translation>
         </message>
         <message>
             <location filename="../../ui/panels/traffic_panel.py" line="170" />
-            <location filename="../../ui/panels/traffic_panel.py" line="325" />
+            <location filename="../../ui/panels/traffic_panel.py" line="328" />
             <source>{n} frames</source>
             <translation>{n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="327" />
+            <location filename="../../ui/panels/traffic_panel.py" line="330" />
             <source>{shown} of {n} frames shown</source>
             <translation>显示 {shown} / {n} 帧</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/traffic_panel.py" line="329" />
+            <location filename="../../ui/panels/traffic_panel.py" line="332" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
         </message>
