@@ -16,11 +16,20 @@ NOT_MEASURED = "not measured"
 
 # (dotted key, bound or None (report only), unit for the goal text, what it is)
 GOALS: tuple[tuple[str, float | None, str, str], ...] = (
+    # The GUI thread's own cost is measured without the 1 ms event-loop probe (the probe alone is
+    # 4-5 % of a core: benchmarks.gui_stalls.measure_cpu); the figure with the probe, the key of
+    # the first table, stays in the JSON and here, reported.
     (
-        "gui.sim_separate_process.event_loop_stall.streaming.gui_thread_cpu_pct",
+        "gui.sim_separate_process.event_loop_stall.streaming.gui_thread_cpu_pct_no_probe",
         15.0,
         " %",
         "GUI-thread CPU while streaming at 100 Hz, monitor + traffic shown",
+    ),
+    (
+        "gui.sim_separate_process.event_loop_stall.streaming.gui_thread_cpu_pct",
+        None,
+        " %",
+        "same, with the 1 ms probe timer running (report only)",
     ),
     (
         "gui.sim_separate_process.event_loop_stall.streaming.p99_ms",
@@ -35,10 +44,16 @@ GOALS: tuple[tuple[str, float | None, str, str], ...] = (
         "event-loop p99 while streaming, busy second core",
     ),
     (
-        "gui.sim_separate_process.event_loop_stall.streaming_busy.gui_thread_cpu_pct",
+        "gui.sim_separate_process.event_loop_stall.streaming_busy.gui_thread_cpu_pct_no_probe",
         15.0,
         " %",
         "GUI-thread CPU while streaming, busy second core",
+    ),
+    (
+        "gui.sim_separate_process.event_loop_stall.streaming_busy.gui_thread_cpu_pct",
+        None,
+        " %",
+        "same, with the 1 ms probe timer running (report only)",
     ),
     (
         "gui.startup.sim_in_gui_process",

@@ -80,7 +80,7 @@ from benchmarks.gui_common import (
     ratio,
 )
 from benchmarks.gui_memory import run_memory
-from benchmarks.gui_stalls import BusyNeighbour, _measure_streaming_busy, measure_stalls
+from benchmarks.gui_stalls import BusyNeighbour, _measure_streaming_busy, add_no_probe, measure_stalls
 from benchmarks.gui_startup import bench_startup
 from benchmarks.gui_stop import bench_stop_bare, bench_stop_gui
 from ui.main_window import DEFAULT_SIZE, MainWindow
@@ -199,6 +199,7 @@ def bench_window(
         streaming["poses_per_s"] = (counters.poses - poses0) / elapsed
         streaming["traffic_frames_per_s"] = (counters.traffic_frames - frames0) / elapsed
         _per_100hz(streaming)
+        add_no_probe(streaming, stall_s)
         streaming["traffic_shown"] = not traffic.visibleRegion().isEmpty()
         streaming["monitor_shown"] = not window.monitor_panel.visibleRegion().isEmpty()
         stalls["streaming"] = streaming
