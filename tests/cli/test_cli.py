@@ -127,7 +127,8 @@ def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) ->
     (``pytest ... &`` from a script) has SIGINT ignored, its children inherit that, and Python
     then leaves Ctrl-C ignored -- the CLI would never see it (right for a background job)."""
     proc = subprocess.Popen(
-        [sys.executable, "-c", _WITH_CTRL_C, "--port", str(csim.port), *args],
+        # -X faulthandler: a child that does not end after Ctrl-C dumps where it is (SIGABRT below)
+        [sys.executable, "-X", "faulthandler", "-c", _WITH_CTRL_C, "--port", str(csim.port), *args],
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -136,7 +137,12 @@ def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) ->
     try:
         assert csim.wait_for(started, CHILD_TIMEOUT)
         proc.send_signal(signal.SIGINT)
-        _, err = proc.communicate(timeout=CHILD_TIMEOUT)
+        try:
+            _, err = proc.communicate(timeout=CHILD_TIMEOUT)
+        except subprocess.TimeoutExpired:
+            proc.send_signal(signal.SIGABRT)  # every thread's stack to stderr, then it ends
+            _, err = proc.communicate(timeout=CHILD_TIMEOUT)
+            pytest.fail(f"teachpad-cli did not end {CHILD_TIMEOUT:g} s after Ctrl-C; where it was:\n{err}")
     finally:
         if proc.poll() is None:
             proc.kill()
