@@ -10,7 +10,7 @@ Each figure is measured in the same run as a baseline:
 * restoring all points to the simulator with ``RobotClient.upload_points`` — the product's
   "restore all" path (the GUI worker calls it) — vs the minimal-transactions bound
   (4 transactions x measured round trip + the simulator's command latency, per point); the
-  CLI's path (``app.points.ledger.upload_points``: one ``create_point`` per point) on a sample;
+  CLI's path (``app.cli.points_upload.staged_upload``: the same batches, per tool) on a sample;
 * plan geometry for 1,000 segments (``plan_path``, ``plan_geometry``, ``check_plan``,
   ``estimate_plan``) vs sampling the same segments one by one with ``segment_path``; and the
   preview widget's (``ui.panels.plan_preview.PlanPreview``) redraw of the 1,000 segments, vs the
@@ -36,12 +36,13 @@ from typing import Any
 import numpy as np
 from pymodbus.client import ModbusTcpClient
 
+from app.cli.points_upload import staged_upload
 from app.link.client import ConnectionSettings, RobotClient
 from app.plan.checks import check_plan
 from app.plan.estimates import estimate_plan
 from app.plan.geometry import plan_geometry, plan_path, segment_path
 from app.plan.segments import Plan, Segment
-from app.points.ledger import PointLedger, SyncState, TempPoint, make_point, upload_points
+from app.points.ledger import PointLedger, SyncState, TempPoint, make_point
 from app.points.project import Project, load_project, save_project
 from app.protocol import registers as R  # noqa: N812
 from app.sim import SimConfig, SimController
@@ -246,7 +247,7 @@ def bench_restore(n: int, cli_n: int) -> dict[str, Any]:
             sim.restart_controller()
             sample = points[:cli_n]
             t0 = time.perf_counter()
-            report = upload_points(client, sample)
+            report = staged_upload(client, sample)
             cli_s = time.perf_counter() - t0
         finally:
             client.close()
@@ -269,7 +270,7 @@ def bench_restore(n: int, cli_n: int) -> dict[str, Any]:
         "rtt_ms": round(rtt, 4),
         "controller_latency_ms": 1000.0 * latency,
         "cli_path": {
-            "path": "app.points.ledger.upload_points (teachpad-cli points upload: create_point per point)",
+            "path": "app.cli.points_upload.staged_upload (teachpad-cli points upload)",
             "points": cli_n,
             "failed": len(report.failed) + len(report.not_attempted),
             "ms_per_point": round(1000.0 * cli_s / cli_n, 3),
