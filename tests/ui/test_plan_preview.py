@@ -3,6 +3,7 @@ and a 1,000-segment plan drawn with one curve item per projection."""
 
 from __future__ import annotations
 
+import itertools
 from typing import Any
 
 import numpy as np
@@ -199,3 +200,47 @@ def test_every_change_refits_until_the_operator_zooms(
     assert preview.follows_changes and shows_all(preview, [(2400, -1800, 1200), (300, 0, 300)])
     preview.show_plan(Plan("other", [Segment.line(1)]), ledger, None, None)  # another plan: fitted
     assert not shows_all(preview, [(2400, -1800, 1200)])
+
+
+def label_gaps(axis: pg.AxisItem, span: tuple[float, float], width: int) -> list[float]:
+    """The gaps (px) between the X axis' tick labels as pyqtgraph lays them out at ``width``."""
+    from PySide6.QtGui import QImage, QPainter
+
+    axis.setRange(*span)
+    axis.resize(width, 40)
+    image = QImage(width + 20, 60, QImage.Format.Format_ARGB32)
+    painter = QPainter(image)
+    try:
+        specs = axis.generateDrawSpecs(painter)
+    finally:
+        painter.end()
+    assert specs is not None
+    rects = sorted((rect for rect, _flags, _text in specs[2]), key=lambda r: r.left())
+    assert rects
+    return [b.left() - a.right() for a, b in itertools.pairwise(rects)]
+
+
+SPANS = [(-1625.0, 925.0), (-234.0, 1134.0), (180.0, 620.0), (-12.0, 8.0), (-2500.0, 2500.0)]
+
+
+def test_x_axis_labels_never_touch_in_a_narrow_preview(preview: PlanPreview) -> None:
+    from ui.panels.plan_projection import MIN_LABEL_SPACING_PX
+
+    for proj in preview.projections.values():
+        axis = proj.plot.getPlotItem().getAxis("bottom")
+        for span in SPANS:
+            for width in range(50, 400, 10):
+                gaps = label_gaps(axis, span, width)
+                assert all(gap >= 6 for gap in gaps), (span, width, gaps)
+                if width >= 5 * MIN_LABEL_SPACING_PX:
+                    assert gaps, (span, width)  # a wide axis still has several labels
+
+
+def test_spaced_levels_widen_only_the_labelled_level() -> None:
+    from ui.panels.plan_projection import spaced_levels, wider_interval
+
+    wider = [wider_interval(v) for v in (1.0, 2.0, 5.0, 0.2, 50.0)]
+    assert wider == pytest.approx([2.0, 5.0, 10.0, 0.5, 100.0])
+    # 500 mm over 65 px: 200 mm is 26 px, too close; 500 mm (65 px) is not
+    assert spaced_levels([(200.0, 0.0), (100.0, 0.0)], 500.0, 65.0)[0] == (500.0, 0.0)
+    assert spaced_levels([(200.0, 0.0), (100.0, 0.0)], 500.0, 650.0) == [(200.0, 0.0), (100.0, 0.0)]

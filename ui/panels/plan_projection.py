@@ -6,6 +6,7 @@ pyqtgraph is imported when a projection is built (the planner is a hidden tab at
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -31,8 +32,59 @@ if TYPE_CHECKING:
 
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
 PLOT_MIN_HEIGHT = 80  # px: the planner's top row (segments, run box) needs the height at 1280×800
+MIN_LABEL_SPACING_PX = 44  # between two labelled ticks of the X axis: "-1200" and a gap
 
 FloatArray = NDArray[np.float64]
+
+
+def wider_interval(interval: float) -> float:
+    """The next round tick interval after ``interval`` (…, 1, 2, 5, 10, 20, …)."""
+    power = 10.0 ** math.floor(math.log10(interval))
+    leading = round(interval / power)
+    if leading < 2:
+        return 2.0 * power
+    if leading < 5:
+        return 5.0 * power
+    return 10.0 * power
+
+
+def spaced_levels(
+    levels: list[tuple[float, float]], span: float, size_px: float, min_px: float = MIN_LABEL_SPACING_PX
+) -> list[tuple[float, float]]:
+    """pyqtgraph's tick levels with the labelled (first) level at least ``min_px`` apart.
+
+    pyqtgraph always labels its first level, however narrow the axis: at 1280×800 a projection is
+    ~65 px wide and its labels ran into each other ("400600"). Finer levels stay as unlabelled ticks
+    (pyqtgraph labels them only where there is room).
+    """
+    if not levels or span <= 0 or size_px <= 0:
+        return levels
+    major = levels[0][0]
+    if major <= 0 or not math.isfinite(major):
+        return levels
+    while major * size_px / span < min_px and major < span:
+        major = wider_interval(major)
+    return [(major, 0.0)] + [level for level in levels[1:] if level[0] < major]
+
+
+_axis_class: type[pg.AxisItem] | None = None
+
+
+def spaced_axis(orientation: str) -> pg.AxisItem:
+    """An axis whose labels never touch (see :func:`spaced_levels`)."""
+    global _axis_class
+    if _axis_class is None:
+        import pyqtgraph as pg  # deferred: see the module docstring
+
+        class SpacedAxis(pg.AxisItem):  # type: ignore[misc]
+            def tickSpacing(self, minVal: float, maxVal: float, size: float) -> list[tuple[float, float]]:  # noqa: N803
+                levels = super().tickSpacing(minVal, maxVal, size)
+                if self._tickSpacing is not None:
+                    return list(levels)
+                return spaced_levels(list(levels), abs(maxVal - minVal), size)
+
+        _axis_class = SpacedAxis
+    return _axis_class(orientation=orientation)
 
 
 def style_plot(plot: pg.PlotWidget) -> None:
@@ -40,6 +92,7 @@ def style_plot(plot: pg.PlotWidget) -> None:
 
     plot.setBackground("w")
     item = plot.getPlotItem()
+    item.setAxisItems({"bottom": spaced_axis("bottom")})
     item.showGrid(x=True, y=True, alpha=0.25)
     for name in ("left", "bottom"):
         axis = item.getAxis(name)
