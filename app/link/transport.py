@@ -1,6 +1,6 @@
 """The link to the controller: connection, one request at a time, every answer checked.
 
-:class:`Transport` sends a request built with pymodbus's framers and reads its answer itself,
+:class:`Transport` sends a request framed as pymodbus frames it (:mod:`app.link.frames`) and reads its answer itself,
 checking each field as it arrives (:func:`app.link.frames.frame_need`): transaction and
 protocol id, unit id, function code (or its exception), byte count, exact length, the write's
 echo, the RTU CRC. Why not pymodbus's own sync transaction: it decodes the answer by the
@@ -175,6 +175,9 @@ class _TcpStream:
                 str(exc.strerror or exc).lower(), code="connect_failed", params={"errno": exc.errno}
             ) from None
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        # Non-blocking from here on, waits by select(): a request costs select + send + select +
+        # recv, not two more syscalls to switch the socket's timeout for sendall and for recv.
+        sock.setblocking(False)
         self._sock = sock
 
     def close(self) -> None:
@@ -185,17 +188,29 @@ class _TcpStream:
                 self._sock = None
 
     def send(self, data: bytes) -> None:
-        assert self._sock is not None
-        self._sock.settimeout(None)
-        self._sock.sendall(data)
+        """The whole frame (a frame is far smaller than the socket's buffer: one ``send``)."""
+        sock = self._sock
+        assert sock is not None
+        try:
+            sent = sock.send(data)
+        except BlockingIOError:
+            sent = 0
+        if sent < len(data):  # the buffer was full: the rest, blocking at most the request timeout
+            sock.settimeout(self._settings.timeout)
+            try:
+                sock.sendall(data[sent:])
+            finally:
+                sock.setblocking(False)
 
     def recv(self, timeout: float) -> bytes:
         """Whatever arrives within ``timeout`` (b"" for nothing); _PeerClosed at end of stream."""
-        assert self._sock is not None
-        self._sock.settimeout(max(timeout, 1e-4))
+        sock = self._sock
+        assert sock is not None
+        if not select.select((sock,), (), (), max(timeout, 1e-4))[0]:
+            return b""
         try:
-            data = self._sock.recv(_RECV_SIZE)
-        except TimeoutError:
+            data = sock.recv(_RECV_SIZE)
+        except BlockingIOError:  # a readiness that went away
             return b""
         if not data:
             raise _PeerClosed
@@ -203,10 +218,14 @@ class _TcpStream:
 
     def drain(self) -> int:
         """Drop the bytes already waiting; their count. _PeerClosed when the peer hung up."""
-        assert self._sock is not None
+        sock = self._sock
+        assert sock is not None
         dropped = 0
-        while select.select([self._sock], [], [], 0)[0]:
-            data = self._sock.recv(_RECV_SIZE)
+        while select.select((sock,), (), (), 0)[0]:
+            try:
+                data = sock.recv(_RECV_SIZE)
+            except BlockingIOError:
+                break
             if not data:
                 raise _PeerClosed
             dropped += len(data)
@@ -285,6 +304,7 @@ class Transport:
         self._encode_request = frames.encode_request
         self._frame_need = frames.frame_need
         self._decode_answer = frames.decode_answer
+        self._answer_registers = frames.answer_registers
         self.settings = settings
         self.framing: Framing = settings.transport
         self._stream: _TcpStream | _SerialStream = (
@@ -373,7 +393,7 @@ class Transport:
     def read(self, what: str, address: int, count: int, timeout: float | None = None) -> list[int]:
         """0x03: exactly ``count`` registers."""
         _, data = self.execute(what, self._read_request(address, count), timeout)
-        return [(data[i] << 8) | data[i + 1] for i in range(1, 1 + 2 * count, 2)]
+        return self._answer_registers(data, count)
 
     def write_single(self, what: str, address: int, value: int, timeout: float | None = None) -> None:
         self.execute(what, self._write_single_request(address, value), timeout)
@@ -428,26 +448,31 @@ class Transport:
         return LinkError(message, params={"endpoint": self.settings.endpoint})
 
     def _exchange(self, what: str, request: Request, timeout: float) -> tuple[int, bytes]:
-        self.open()
+        stream = self._stream
+        if not stream.is_open:
+            self.open()
         self._flush_stray()
         unit = self.settings.unit
-        self._tid = self._tid % 65000 + 1 if self.framing == "tcp" else 0
-        tid = self._tid
-        frame = self._encode_request(self.framing, request, unit, tid)
-        self._count("requests")
+        framing = self.framing
+        self._tid = tid = self._tid % 65000 + 1 if framing == "tcp" else 0
+        frame = self._encode_request(framing, request, unit, tid)
+        self._counts["requests"] += 1
         try:
-            self._stream.send(frame)
+            stream.send(frame)
         except OSError:
             raise self._lost(what) from None
         if self._observing:
             self._emit("tx", frame)
         buf = b""
+        need = 0  # nothing received yet: no field to check, receive first
+        frame_need = self._frame_need
         deadline = time.monotonic() + timeout
         try:
             while True:
-                need = self._frame_need(self.framing, request, unit, tid, buf)
-                if len(buf) >= need:
-                    break
+                if buf:
+                    need = frame_need(framing, request, unit, tid, buf)
+                    if len(buf) >= need:
+                        break
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     if not buf:
@@ -461,7 +486,7 @@ class Transport:
                         got=len(buf),
                     )
                 try:
-                    buf += self._stream.recv(remaining)
+                    buf += stream.recv(remaining)
                 except _PeerClosed:
                     if not buf:
                         raise self._lost(what) from None
@@ -491,12 +516,12 @@ class Transport:
             raise error from None
         if self._observing:
             self._emit("rx", buf)
-        function, data = self._decode_answer(self.framing, buf)
+        function, data = self._decode_answer(framing, buf)
         if function & 0x80:
             code = data[0]
             text = exception_text(code, f"exception code {code}")
             message = f"controller refused {what}: {text}"
             self._count("exceptions", message)
             raise ModbusExceptionError(function & 0x7F, code, message)
-        self._count("answers")
+        self._counts["answers"] += 1
         return function, data

@@ -8,6 +8,7 @@ stays Qt-free): ``pyside6-lupdate`` collects them and the GUI shows them through
 from __future__ import annotations
 
 import enum
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -316,6 +317,7 @@ class CommandStatus:
         return not (self.is_done or self.is_initial or self.is_moving or self.is_pending)
 
 
+@functools.lru_cache(maxsize=1024)  # immutable, and few (kind, code) pairs: every poll decodes one
 def decode_command_status(kind: CommandKind | None, code: int) -> CommandStatus:
     """Decode GV291's code for the command kind that was sent last."""
     return CommandStatus(kind, int(code))
