@@ -1,9 +1,9 @@
 """The link to the controller: connection, one request at a time, every answer checked.
 
-:class:`Transport` sends a request framed as pymodbus frames it (:mod:`app.link.frames`) and reads its answer itself,
-checking each field as it arrives (:func:`app.link.frames.frame_need`): transaction and
-protocol id, unit id, function code (or its exception), byte count, exact length, the write's
-echo, the RTU CRC. Why not pymodbus's own sync transaction: it decodes the answer by the
+:class:`Transport` sends a request framed as pymodbus frames it (:mod:`app.link.frames`) and
+reads its answer itself, checking each field as it arrives (:func:`app.link.frames.frame_need`):
+transaction and protocol id, unit id, function code (or its exception), byte count, exact
+length, the write's echo, the RTU CRC. Why not pymodbus's own sync transaction: it decodes the answer by the
 answer's function code (an 0x04 answer to an 0x03 read became registers), silently skips frames
 of another unit/transaction until the timeout (a wrong answer looked like silence), ignores
 byte counts and echoes, and leaves stray bytes in the socket for the next request.

@@ -317,9 +317,13 @@ class CommandStatus:
         return not (self.is_done or self.is_initial or self.is_moving or self.is_pending)
 
 
-@functools.lru_cache(maxsize=1024)  # immutable, and few (kind, code) pairs: every poll decodes one
 def decode_command_status(kind: CommandKind | None, code: int) -> CommandStatus:
     """Decode GV291's code for the command kind that was sent last."""
+    return _decoded(kind, code)
+
+
+@functools.lru_cache(maxsize=1024)  # immutable, and few (kind, code) pairs: every poll decodes one
+def _decoded(kind: CommandKind | None, code: int) -> CommandStatus:
     return CommandStatus(kind, int(code))
 
 
