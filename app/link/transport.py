@@ -24,12 +24,10 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import select
-import socket
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 from app import timing
 from app.errors import (
@@ -39,6 +37,7 @@ from app.errors import (
     ResponseTimeout,
 )
 from app.link.stats import LinkStats
+from app.link.streams import PeerClosed, SerialStream, TcpStream
 from app.protocol import registers
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
@@ -52,8 +51,6 @@ __all__ = ["ConnectionSettings", "TrafficObserver", "TrafficRecord", "Transport"
 
 _log = logging.getLogger(__name__)
 
-SIMULATOR_PORT = 5020  # the simulator's default port, hinted when 502 refuses
-_RECV_SIZE = 4096
 _COUNTERS = tuple(f.name for f in dataclasses.fields(LinkStats) if f.name != "last_error")
 
 
@@ -127,164 +124,6 @@ class TrafficRecord:
 TrafficObserver = Callable[[TrafficRecord], None]
 
 
-class _PeerClosed(Exception):
-    """The other end closed the byte stream."""
-
-
-# --------------------------------------------------------------------------------------------
-# Byte streams: a TCP socket or a serial line
-# --------------------------------------------------------------------------------------------
-
-
-class _TcpStream:
-    def __init__(self, settings: ConnectionSettings) -> None:
-        self._settings = settings
-        self._sock: socket.socket | None = None
-
-    @property
-    def is_open(self) -> bool:
-        return self._sock is not None
-
-    def open(self, timeout: float) -> None:
-        s = self._settings
-        try:
-            sock = socket.create_connection((s.host, s.port), timeout=timeout)
-        except socket.gaierror:
-            raise LinkError(
-                f"the host name {s.host[:60]!r} cannot be resolved",
-                code="host_unresolved",
-                params={"host": s.host[:60]},
-            ) from None
-        except ConnectionRefusedError:
-            hint = (
-                f" (nothing listens on port 502; the simulator's port is {SIMULATOR_PORT})"
-                if s.port == 502
-                else ""
-            )
-            raise LinkError(
-                f"connection refused{hint}", code="connection_refused", params={"port": s.port}
-            ) from None
-        except TimeoutError:
-            raise LinkError(
-                f"no answer to the connection request within {_seconds(timeout)} s",
-                code="connect_timeout",
-                params={"seconds": timeout},
-            ) from None
-        except OSError as exc:
-            raise LinkError(
-                str(exc.strerror or exc).lower(), code="connect_failed", params={"errno": exc.errno}
-            ) from None
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        # Non-blocking from here on, waits by select(): a request costs select + send + select +
-        # recv, not two more syscalls to switch the socket's timeout for sendall and for recv.
-        sock.setblocking(False)
-        self._sock = sock
-
-    def close(self) -> None:
-        if self._sock is not None:
-            try:
-                self._sock.close()
-            finally:
-                self._sock = None
-
-    def send(self, data: bytes) -> None:
-        """The whole frame (a frame is far smaller than the socket's buffer: one ``send``)."""
-        sock = self._sock
-        assert sock is not None
-        try:
-            sent = sock.send(data)
-        except BlockingIOError:
-            sent = 0
-        if sent < len(data):  # the buffer was full: the rest, blocking at most the request timeout
-            sock.settimeout(self._settings.timeout)
-            try:
-                sock.sendall(data[sent:])
-            finally:
-                sock.setblocking(False)
-
-    def recv(self, timeout: float) -> bytes:
-        """Whatever arrives within ``timeout`` (b"" for nothing); _PeerClosed at end of stream."""
-        sock = self._sock
-        assert sock is not None
-        if not select.select((sock,), (), (), max(timeout, 1e-4))[0]:
-            return b""
-        try:
-            data = sock.recv(_RECV_SIZE)
-        except BlockingIOError:  # a readiness that went away
-            return b""
-        if not data:
-            raise _PeerClosed
-        return data
-
-    def drain(self) -> int:
-        """Drop the bytes already waiting; their count. _PeerClosed when the peer hung up."""
-        sock = self._sock
-        assert sock is not None
-        dropped = 0
-        while select.select((sock,), (), (), 0)[0]:
-            try:
-                data = sock.recv(_RECV_SIZE)
-            except BlockingIOError:
-                break
-            if not data:
-                raise _PeerClosed
-            dropped += len(data)
-        return dropped
-
-
-class _SerialStream:
-    """RTU over a serial line (pyserial, which pymodbus[serial] brings)."""
-
-    def __init__(self, settings: ConnectionSettings) -> None:
-        self._settings = settings
-        self._port: Any = None
-
-    @property
-    def is_open(self) -> bool:
-        return self._port is not None
-
-    def open(self, timeout: float) -> None:
-        import serial
-
-        s = self._settings
-        try:
-            self._port = serial.Serial(
-                s.serial_port,
-                baudrate=s.baudrate,
-                parity=s.parity,
-                stopbits=s.stopbits,
-                bytesize=s.bytesize,
-                timeout=timeout,
-                exclusive=True,
-            )
-        except (serial.SerialException, OSError, ValueError) as exc:
-            raise LinkError(
-                f"cannot open the serial port: {exc}",
-                code="serial_open_failed",
-                params={"port": (s.serial_port or "")[:60]},
-            ) from None
-
-    def close(self) -> None:
-        if self._port is not None:
-            try:
-                self._port.close()
-            finally:
-                self._port = None
-
-    def send(self, data: bytes) -> None:
-        self._port.write(data)
-        self._port.flush()
-
-    def recv(self, timeout: float) -> bytes:
-        self._port.timeout = max(timeout, 1e-4)
-        return bytes(self._port.read(max(1, self._port.in_waiting)))
-
-    def drain(self) -> int:
-        waiting = int(self._port.in_waiting)
-        self._port.reset_input_buffer()
-        return waiting
-
-
 # --------------------------------------------------------------------------------------------
 # The transport
 # --------------------------------------------------------------------------------------------
@@ -307,8 +146,8 @@ class Transport:
         self._answer_registers = frames.answer_registers
         self.settings = settings
         self.framing: Framing = settings.transport
-        self._stream: _TcpStream | _SerialStream = (
-            _SerialStream(settings) if settings.serial_port is not None else _TcpStream(settings)
+        self._stream: TcpStream | SerialStream = (
+            SerialStream(settings) if settings.serial_port is not None else TcpStream(settings)
         )
         self._on_link_change = on_link_change or (lambda: None)
         self._observers: list[TrafficObserver] = []
@@ -366,7 +205,7 @@ class Transport:
         """Get back in step after a malformed answer or a timeout."""
         self._count("resyncs")
         _log.debug("resync after %s", why)
-        if isinstance(self._stream, _SerialStream) and self._stream.is_open:
+        if isinstance(self._stream, SerialStream) and self._stream.is_open:
             self._stream.drain()
         else:
             self.close()
@@ -429,7 +268,7 @@ class Transport:
     def _flush_stray(self) -> None:
         try:
             dropped = self._stream.drain()
-        except (_PeerClosed, OSError):
+        except (PeerClosed, OSError):
             # The controller closed the idle link (restart, its own timeout): say so once; the
             # next request opens a fresh link.
             self.close()
@@ -487,7 +326,7 @@ class Transport:
                     )
                 try:
                     buf += stream.recv(remaining)
-                except _PeerClosed:
+                except PeerClosed:
                     if not buf:
                         raise self._lost(what) from None
                     raise MalformedResponse(

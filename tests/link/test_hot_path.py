@@ -20,7 +20,8 @@ from app.link.frames import (
     write_multiple_request,
     write_single_request,
 )
-from app.link.transport import ConnectionSettings, _TcpStream
+from app.link.streams import TcpStream
+from app.link.transport import ConnectionSettings
 from app.protocol.codec import (
     WordOrder,
     check_float32,
@@ -95,7 +96,7 @@ def test_a_decoded_status_is_shared_and_equal_to_a_fresh_one() -> None:
 
 def test_a_send_into_a_full_socket_buffer_waits_for_room_and_sends_everything() -> None:
     ours, peer = socket.socketpair()
-    stream = _TcpStream(ConnectionSettings(timeout=5.0))
+    stream = TcpStream(ConnectionSettings(timeout=5.0))
     try:
         ours.setblocking(False)
         stream._sock = ours
@@ -128,7 +129,7 @@ def test_a_send_into_a_full_socket_buffer_waits_for_room_and_sends_everything() 
 
 def test_a_send_that_finds_no_room_gives_up_after_the_request_timeout() -> None:
     ours, peer = socket.socketpair()
-    stream = _TcpStream(ConnectionSettings(timeout=0.05))
+    stream = TcpStream(ConnectionSettings(timeout=0.05))
     try:
         ours.setblocking(False)
         stream._sock = ours
