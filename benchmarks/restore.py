@@ -50,6 +50,7 @@ _UNIT = 1
 class BareSample:
     """One stretch of the bare loop: per cycle (one point's work), seconds."""
 
+    cpu: float = 0.0  # s of this thread's CPU over the measured cycles (time.thread_time)
     cycle: list[float] = field(default_factory=list)  # the whole cycle, the wait included: the bound
     formula: list[float] = field(default_factory=list)  # its 3 round trips + max(latency, pose write)
     pose: list[float] = field(default_factory=list)  # the pose write (0x10, 12 registers)
@@ -60,6 +61,7 @@ class BareSample:
 class RestoreRound:
     points: int
     seconds: float
+    cpu: float = 0.0  # s of this thread's CPU in the round (the simulator runs in other threads)
 
 
 def bare_sample(bare: ModbusTcpClient, seconds: float, latency: float) -> BareSample:
@@ -78,6 +80,7 @@ def bare_sample(bare: ModbusTcpClient, seconds: float, latency: float) -> BareSa
     clock = time.perf_counter
     end = None
     n = 0
+    cpu0 = 0.0
     while end is None or clock() < end:
         t0 = clock()
         bare.write_registers(R.gv_reg(R.GV_PARAM0), params, device_id=_UNIT)
@@ -102,12 +105,15 @@ def bare_sample(bare: ModbusTcpClient, seconds: float, latency: float) -> BareSa
             sample.read.append(t6 - t5)
         elif n == WARM_CYCLES:
             end = clock() + seconds
+            cpu0 = time.thread_time()
+    sample.cpu = time.thread_time() - cpu0
     return sample
 
 
 def _pooled(samples: Sequence[BareSample]) -> BareSample:
     out = BareSample()
     for s in samples:
+        out.cpu += s.cpu
         out.cycle += s.cycle
         out.formula += s.formula
         out.pose += s.pose
@@ -163,6 +169,10 @@ def summarize(
             "status read (560..583); formula: its 3 round trips + max(latency, pose write)"
         ),
         "bare_cycles_per_sample": [len(s.cycle) for s in samples],
+        # the client's own CPU (its thread; the simulator's threads excluded): under CPU contention
+        # the side with more CPU per point is slowed more
+        "client_cpu_ms_per_point": round(1000.0 * sum(r.cpu for r in rounds) / n, 4),
+        "bare_cpu_ms_per_cycle": round(1000.0 * everything.cpu / max(1, len(everything.cycle)), 4),
     }
 
 
@@ -188,9 +198,9 @@ def bench_restore(
             requests = client.stats.requests
             for start in range(0, n, size):
                 chunk = [(p.id, p.xyzabc) for p in points[start : start + size]]
-                t0 = time.perf_counter()
+                t0, cpu0 = time.perf_counter(), time.thread_time()
                 results += client.upload_points(chunk)
-                done.append(RestoreRound(len(chunk), time.perf_counter() - t0))
+                done.append(RestoreRound(len(chunk), time.perf_counter() - t0, time.thread_time() - cpu0))
                 samples.append(bare_sample(bare, sample_s, latency))
             requests = client.stats.requests - requests
             failed = sum(1 for r in results if not r.ok) + n - len(results)
