@@ -179,6 +179,7 @@ def summarize(
         # the client's own CPU (its thread; the simulator's threads excluded): under CPU contention
         # the side with more CPU per point is slowed more
         "client_cpu_ms_per_point": round(1000.0 * sum(r.cpu for r in rounds) / n, 4),
+        # (a cycle's GV291 read for the old figure included: 5 transactions, as the product's point)
         "bare_cpu_ms_per_cycle": round(1000.0 * everything.cpu / max(1, len(everything.cycle)), 4),
     }
 
