@@ -8,9 +8,10 @@ Each figure is measured in the same run as a baseline:
   minimal table model of the same shape in the same view (offscreen Qt; null with a reason
   when the UI module is missing);
 * restoring all points to the simulator with ``RobotClient.upload_points`` — the product's
-  "restore all" path (the GUI worker calls it) — vs the minimal-transactions bound
-  (4 transactions x measured round trip + the simulator's command latency, per point); the
-  CLI's path (``app.cli.points_upload.staged_upload``: the same batches, per tool) on a sample;
+  "restore all" path (the GUI worker calls it) — in rounds, each vs a bare pymodbus loop of
+  the same per-point transactions sampled right before and after it (``benchmarks.restore``:
+  the median of the round ratios); the CLI's path (``app.cli.points_upload.staged_upload``: the
+  same batches, per tool) on a sample;
 * plan geometry for 1,000 segments (``plan_path``, ``plan_geometry``, ``check_plan``,
   ``estimate_plan``) vs sampling the same segments one by one with ``segment_path``; and the
   preview widget's (``ui.panels.plan_preview.PlanPreview``) redraw of the 1,000 segments, vs the
@@ -19,7 +20,7 @@ Each figure is measured in the same run as a baseline:
 Requests and time per created point on each simulator timing profile: see ``benchmarks.completion``
 (``completion_profiles``).
 
-Quick mode restores 500 points instead of 10,000 and repeats less.
+Quick mode restores 500 points (5 rounds, 0.1 s bare samples) instead of 10,000 and repeats less.
 """
 
 from __future__ import annotations
@@ -34,19 +35,15 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pymodbus.client import ModbusTcpClient
 
-from app.cli.points_upload import staged_upload
-from app.link.client import ConnectionSettings, RobotClient
 from app.plan.checks import check_plan
 from app.plan.estimates import estimate_plan
 from app.plan.geometry import plan_geometry, plan_path, segment_path
 from app.plan.segments import Plan, Segment
 from app.points.ledger import PointLedger, SyncState, TempPoint, make_point
 from app.points.project import Project, load_project, save_project
-from app.protocol import registers as R  # noqa: N812
-from app.sim import SimConfig, SimController
-from benchmarks import completion
+from benchmarks import completion, restore
+from benchmarks.restore import QUICK_SAMPLE_S, ROUNDS, SAMPLE_S
 
 PROJECT_POINTS = 10_000
 PLAN_SEGMENTS = 1_000
@@ -208,76 +205,13 @@ def bench_show(project: Project, repeats: int) -> dict[str, Any]:
     }
 
 
-# --- restore all -----------------------------------------------------------------------------------
+# --- restore all ---------------------------------------------------------------------------------
 
 
-def _rtt_samples(port: int, seconds: float) -> list[float]:
-    """Round trips (s) of one small read (GV291) with a bare pymodbus client."""
-    bare = ModbusTcpClient("127.0.0.1", port=port, timeout=1.0)
-    bare.connect()
-    try:
-        for _ in range(50):
-            bare.read_holding_registers(R.gv_reg(R.GV_COMMAND_STATUS), count=2, device_id=1)
-        lat: list[float] = []
-        end = time.perf_counter() + seconds
-        while time.perf_counter() < end:
-            t0 = time.perf_counter()
-            bare.read_holding_registers(R.gv_reg(R.GV_COMMAND_STATUS), count=2, device_id=1)
-            lat.append(time.perf_counter() - t0)
-    finally:
-        bare.close()
-    return lat
-
-
-def bench_restore(n: int, cli_n: int) -> dict[str, Any]:
-    sim = SimController(SimConfig(host="127.0.0.1", port=0))
-    sim.start()
-    try:
-        points = _points(n)
-        # the round trip, measured before and after the uploads (machine noise hits both alike)
-        rtt_s = _rtt_samples(sim.port, 0.3)
-        client = RobotClient(ConnectionSettings(host="127.0.0.1", port=sim.port))
-        client.connect()
-        try:
-            t0 = time.perf_counter()
-            results = client.upload_points([(p.id, p.xyzabc) for p in points])
-            restore_s = time.perf_counter() - t0
-            failed = sum(1 for r in results if not r.ok)
-            held = len(sim.state().points)
-            sim.restart_controller()
-            sample = points[:cli_n]
-            t0 = time.perf_counter()
-            report = staged_upload(client, sample)
-            cli_s = time.perf_counter() - t0
-        finally:
-            client.close()
-        rtt_s += _rtt_samples(sim.port, 0.3)
-        rtt = 1000.0 * statistics.median(rtt_s)
-        latency = sim.config.command_latency
-    finally:
-        sim.stop()
-    per_point_tx = 4  # pose GVs, id/source/index GVs, 440 <- 0xE0, one status read
-    bound_s = n * (per_point_tx * rtt / 1000.0 + latency)
-    return {
-        "points": n,
-        "path": "RobotClient.upload_points (the GUI's restore-all, via the worker)",
-        "restore_s": round(restore_s, 3),
-        "failed": failed,
-        "held_by_controller": held,
-        "points_per_s": round(n / restore_s, 1),
-        "min_transactions_bound_s": round(bound_s, 3),
-        "ratio_vs_bound": round(restore_s / bound_s, 2),
-        "rtt_ms": round(rtt, 4),
-        "controller_latency_ms": 1000.0 * latency,
-        "cli_path": {
-            "path": "app.cli.points_upload.staged_upload (teachpad-cli points upload)",
-            "points": cli_n,
-            "failed": len(report.failed) + len(report.not_attempted),
-            "ms_per_point": round(1000.0 * cli_s / cli_n, 3),
-            "restore_ms_per_point": round(1000.0 * restore_s / n, 3),
-            "ratio_cli_vs_restore": round((cli_s / cli_n) / (restore_s / n), 2),
-        },
-    }
+def bench_restore(n: int, cli_n: int, *, rounds: int = ROUNDS, sample_s: float = SAMPLE_S) -> dict[str, Any]:
+    """Restore-all of ``n`` points in ``rounds`` rounds, each beside a bare pymodbus sample
+    (see :mod:`benchmarks.restore`); the CLI's path on ``cli_n`` of them."""
+    return restore.bench_restore(_points(n), cli_n, rounds=rounds, sample_s=sample_s)
 
 
 # --- plan geometry and preview -------------------------------------------------------------------
@@ -394,7 +328,10 @@ def run(quick: bool) -> dict[str, Any]:
         out["project_load"] = bench_load(path, repeats)
         out["project_load"]["save_project_ms"] = _ms(save_s)
         out["points_table_show"] = bench_show(load_project(path), repeats)
-    out["restore_all"] = bench_restore(500 if quick else PROJECT_POINTS, 200 if quick else 1000)
+    if quick:
+        out["restore_all"] = bench_restore(500, 200, rounds=5, sample_s=QUICK_SAMPLE_S)
+    else:
+        out["restore_all"] = bench_restore(PROJECT_POINTS, 1000)
     out["completion_profiles"] = completion.bench_profiles(60 if quick else 300)
     out["plan_geometry"] = bench_plan(repeats)
     out["plan_preview"] = bench_preview(repeats)

@@ -12,6 +12,11 @@ from app.protocol.enums import Alarm, ControllerMode, ProgramState, decode_statu
 
 __all__ = ["decode_pose", "decode_status"]
 
+# looked up, not constructed, per status read (an Enum call is a few microseconds, every poll)
+_MODES = {int(m): m for m in ControllerMode}
+_STATES = {int(s): s for s in ProgramState}
+_NO_ALARM = Alarm(0)
+
 
 def decode_pose(regs: Sequence[int], order: WordOrder) -> Pose:
     """The pose block (GV206..GV255, registers 412..511): pose, external axes, joints."""
@@ -33,20 +38,13 @@ def decode_status(
     base = registers.STATUS_BLOCK_START
     mode_raw = regs[registers.REG_CONTROLLER_MODE - base]
     state_raw = regs[registers.REG_PROGRAM_STATE - base]
-    mode: ControllerMode | int
-    state: ProgramState | int
-    try:
-        mode = ControllerMode(mode_raw)
-    except ValueError:
-        mode = mode_raw
-    try:
-        state = ProgramState(state_raw)
-    except ValueError:
-        state = state_raw
+    mode: ControllerMode | int = _MODES.get(mode_raw, mode_raw)  # an unknown value stays an int
+    state: ProgramState | int = _STATES.get(state_raw, state_raw)
+    alarms_raw = regs[registers.REG_ALARMS - base]
     st = registers.gv_reg(registers.GV_COMMAND_STATUS) - base
     code = decode_status_registers(regs[st : st + 2], order)
     clock = None
     if clock_layout is not None:
         cs = registers.gv_reg(registers.GV_DATE) - base
         clock = decode_clock(regs[cs : cs + 4], clock_layout)
-    return ControllerStatus(mode, state, Alarm(regs[registers.REG_ALARMS - base]), code, clock)
+    return ControllerStatus(mode, state, _NO_ALARM if alarms_raw == 0 else Alarm(alarms_raw), code, clock)

@@ -1,10 +1,11 @@
 """Modbus request frames and the check of each answer against its request.
 
 Pure functions over bytes (no I/O), so the transport can check an answer as it arrives and the
-benchmarks can time the check alone. Frames are built with pymodbus's framers (MBAP for TCP,
-unit + CRC for RTU); the answers are checked here rather than by pymodbus, whose sync client
-decodes the answer by *its own* function code, skips frames of another unit or transaction and
-does not look at byte counts or echoes.
+benchmarks can time the check alone. Frames are the bytes pymodbus's framers make (TCP: the
+MBAP header packed here in one call, tests/link/test_hot_path.py compares it with
+``FramerSocket``; RTU: unit + CRC by ``FramerRTU``); the answers are checked here rather than
+by pymodbus, whose sync client decodes the answer by *its own* function code, skips frames of
+another unit or transaction and does not look at byte counts or echoes.
 
 :func:`frame_need` is called with the bytes received so far: it checks every field those bytes
 already show (raising :class:`MalformedResponse` at the first wrong one, so garbage is refused
@@ -13,12 +14,13 @@ without waiting for the rest) and returns the length the whole answer must have.
 
 from __future__ import annotations
 
+import functools
 import struct
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
-from pymodbus.framer import FramerRTU, FramerSocket
+from pymodbus.framer import FramerRTU
 from pymodbus.pdu import DecodePDU
 
 from app.errors import MalformedResponse
@@ -29,6 +31,7 @@ __all__ = [
     "FC_WRITE_SINGLE",
     "Framing",
     "Request",
+    "answer_registers",
     "crc16",
     "decode_answer",
     "encode_request",
@@ -50,7 +53,7 @@ _FUNCTION_TEXT = {
     FC_WRITE_MULTIPLE: "a write of several registers",
 }
 _MBAP = 7  # transaction id, protocol id, length, unit id
-_SOCKET_FRAMER = FramerSocket(DecodePDU(False))
+_MBAP_HEADER = struct.Struct(">HHHB")  # what FramerSocket.encode writes before the PDU
 _RTU_FRAMER = FramerRTU(DecodePDU(False))
 
 
@@ -65,19 +68,27 @@ class Request:
     pdu: bytes  # function code + data
 
 
+# Requests are immutable: the few reads and single writes a link repeats (the status block, the
+# pose block, 440 <- a command) are built once and reused.
+@functools.lru_cache(maxsize=256)
 def read_request(address: int, count: int) -> Request:
     return Request(FC_READ_HOLDING, address, count, 0, struct.pack(">BHH", FC_READ_HOLDING, address, count))
 
 
+@functools.lru_cache(maxsize=256)
 def write_single_request(address: int, value: int) -> Request:
     return Request(FC_WRITE_SINGLE, address, 1, value, struct.pack(">BHH", FC_WRITE_SINGLE, address, value))
 
 
+@functools.lru_cache(maxsize=128)
+def _write_multiple_struct(count: int) -> struct.Struct:
+    return struct.Struct(f">BHHB{count}H")
+
+
 def write_multiple_request(address: int, values: Sequence[int]) -> Request:
-    data = struct.pack(
-        f">BHHB{len(values)}H", FC_WRITE_MULTIPLE, address, len(values), 2 * len(values), *values
-    )
-    return Request(FC_WRITE_MULTIPLE, address, len(values), 0, data)
+    n = len(values)
+    data = _write_multiple_struct(n).pack(FC_WRITE_MULTIPLE, address, n, 2 * n, *values)
+    return Request(FC_WRITE_MULTIPLE, address, n, 0, data)
 
 
 def crc16(data: bytes) -> int:
@@ -86,8 +97,12 @@ def crc16(data: bytes) -> int:
 
 
 def encode_request(framing: Framing, request: Request, unit: int, tid: int) -> bytes:
-    framer = _SOCKET_FRAMER if framing == "tcp" else _RTU_FRAMER
-    return bytes(framer.encode(request.pdu, unit, tid))
+    """The request as sent: MBAP + PDU (TCP; the bytes ``FramerSocket.encode`` makes, packed in
+    one call) or unit + PDU + CRC (RTU, pymodbus's framer)."""
+    pdu = request.pdu
+    if framing == "tcp":
+        return _MBAP_HEADER.pack(tid, 0, len(pdu) + 1, unit) + pdu
+    return bytes(_RTU_FRAMER.encode(pdu, unit, tid))
 
 
 def _hex(value: int, width: int = 2) -> str:
@@ -204,6 +219,16 @@ def frame_need(framing: Framing, request: Request, unit: int, tid: int, buf: byt
             raise _bad("CRC", expected, crc, f"CRC {_hex(crc, 4)}, expected {_hex(expected, 4)}")
         _check_pdu(request, buf[1 : total - 2])
     return total
+
+
+@functools.lru_cache(maxsize=128)
+def _registers_struct(count: int) -> struct.Struct:
+    return struct.Struct(f">{count}H")
+
+
+def answer_registers(data: bytes, count: int) -> list[int]:
+    """The ``count`` registers of a checked 0x03 answer (``data``: after the function code)."""
+    return list(_registers_struct(count).unpack_from(data, 1))
 
 
 def decode_answer(framing: Framing, frame: bytes) -> tuple[int, bytes]:

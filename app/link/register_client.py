@@ -18,6 +18,7 @@ pose and status blocks are read and decoded here. Not thread-safe: one thread ow
 from __future__ import annotations
 
 import contextlib
+import functools
 import logging
 from collections.abc import Iterator, Sequence
 from typing import Self
@@ -39,6 +40,12 @@ _log = logging.getLogger(__name__)
 
 CONTROL_REGISTERS = range(registers.REG_RUN_COMMAND, registers.REG_GO_ZERO + 1)  # 440..445: 0x06 only
 MAX_REGISTER = 0xFFFF
+
+
+@functools.lru_cache(maxsize=512)
+def _what(verb: str, address: int, count: int) -> str:
+    """E.g. "read of registers 560..583 (...)": made once per block, not per request (hot path)."""
+    return f"{verb} {range_name(address, count)}"
 
 
 class RegisterClient:
@@ -93,7 +100,7 @@ class RegisterClient:
     # -- the transport: every answer is checked against its request ----------------------
     def _read(self, address: int, count: int, timeout: float | None = None) -> list[int]:
         timeout = self._io_timeout if timeout is None else timeout
-        return self._transport.read(f"read of {range_name(address, count)}", address, count, timeout)
+        return self._transport.read(_what("read of", address, count), address, count, timeout)
 
     @contextlib.contextmanager
     def io_timeout(self, seconds: float) -> Iterator[None]:
@@ -118,21 +125,21 @@ class RegisterClient:
         timeout = self._io_timeout if timeout is None else timeout
         ctx = self.audit.writing(address, values, single=single) if self.audit else contextlib.nullcontext()
         with ctx:
-            name = range_name(address, len(values))
-            self._require_writable(f"write to {name}")
+            what = _what("write to", address, len(values))
+            self._require_writable(what)
             if not values:
                 raise InvalidInput("nothing to write")
             if single:
                 if len(values) != 1:
                     raise InvalidInput("a single-register write takes one value")
-                _log.debug("write 0x06 %s <- %d", name, values[0])
+                _log.debug("%s: 0x06 <- %d", what, values[0])
                 self.write_count += 1
-                self._transport.write_single(f"write to {name}", address, int(values[0]), timeout)
+                self._transport.write_single(what, address, int(values[0]), timeout)
             else:
                 if _log.isEnabledFor(logging.DEBUG):  # the hex text costs more than the write's own Python
-                    _log.debug("write 0x10 %s <- %s", name, " ".join(f"{v:04X}" for v in values))
+                    _log.debug("%s: 0x10 <- %s", what, " ".join(f"{v:04X}" for v in values))
                 self.write_count += 1
-                self._transport.write_multiple(f"write to {name}", address, [int(v) for v in values], timeout)
+                self._transport.write_multiple(what, address, list(map(int, values)), timeout)
 
     def _write_floats(self, gv: int, values: Sequence[float], timeout: float | None = None) -> None:
         self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order), timeout=timeout)

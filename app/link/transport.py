@@ -1,9 +1,9 @@
 """The link to the controller: connection, one request at a time, every answer checked.
 
-:class:`Transport` sends a request built with pymodbus's framers and reads its answer itself,
-checking each field as it arrives (:func:`app.link.frames.frame_need`): transaction and
-protocol id, unit id, function code (or its exception), byte count, exact length, the write's
-echo, the RTU CRC. Why not pymodbus's own sync transaction: it decodes the answer by the
+:class:`Transport` sends a request framed as pymodbus frames it (:mod:`app.link.frames`) and
+reads its answer itself, checking each field as it arrives (:func:`app.link.frames.frame_need`):
+transaction and protocol id, unit id, function code (or its exception), byte count, exact
+length, the write's echo, the RTU CRC. Why not pymodbus's own sync transaction: it decodes the answer by the
 answer's function code (an 0x04 answer to an 0x03 read became registers), silently skips frames
 of another unit/transaction until the timeout (a wrong answer looked like silence), ignores
 byte counts and echoes, and leaves stray bytes in the socket for the next request.
@@ -24,12 +24,10 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import select
-import socket
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Literal
+from typing import TYPE_CHECKING, Literal
 
 from app import timing
 from app.errors import (
@@ -39,6 +37,7 @@ from app.errors import (
     ResponseTimeout,
 )
 from app.link.stats import LinkStats
+from app.link.streams import PeerClosed, SerialStream, TcpStream
 from app.protocol import registers
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
@@ -52,8 +51,6 @@ __all__ = ["ConnectionSettings", "TrafficObserver", "TrafficRecord", "Transport"
 
 _log = logging.getLogger(__name__)
 
-SIMULATOR_PORT = 5020  # the simulator's default port, hinted when 502 refuses
-_RECV_SIZE = 4096
 _COUNTERS = tuple(f.name for f in dataclasses.fields(LinkStats) if f.name != "last_error")
 
 
@@ -127,145 +124,6 @@ class TrafficRecord:
 TrafficObserver = Callable[[TrafficRecord], None]
 
 
-class _PeerClosed(Exception):
-    """The other end closed the byte stream."""
-
-
-# --------------------------------------------------------------------------------------------
-# Byte streams: a TCP socket or a serial line
-# --------------------------------------------------------------------------------------------
-
-
-class _TcpStream:
-    def __init__(self, settings: ConnectionSettings) -> None:
-        self._settings = settings
-        self._sock: socket.socket | None = None
-
-    @property
-    def is_open(self) -> bool:
-        return self._sock is not None
-
-    def open(self, timeout: float) -> None:
-        s = self._settings
-        try:
-            sock = socket.create_connection((s.host, s.port), timeout=timeout)
-        except socket.gaierror:
-            raise LinkError(
-                f"the host name {s.host[:60]!r} cannot be resolved",
-                code="host_unresolved",
-                params={"host": s.host[:60]},
-            ) from None
-        except ConnectionRefusedError:
-            hint = (
-                f" (nothing listens on port 502; the simulator's port is {SIMULATOR_PORT})"
-                if s.port == 502
-                else ""
-            )
-            raise LinkError(
-                f"connection refused{hint}", code="connection_refused", params={"port": s.port}
-            ) from None
-        except TimeoutError:
-            raise LinkError(
-                f"no answer to the connection request within {_seconds(timeout)} s",
-                code="connect_timeout",
-                params={"seconds": timeout},
-            ) from None
-        except OSError as exc:
-            raise LinkError(
-                str(exc.strerror or exc).lower(), code="connect_failed", params={"errno": exc.errno}
-            ) from None
-        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self._sock = sock
-
-    def close(self) -> None:
-        if self._sock is not None:
-            try:
-                self._sock.close()
-            finally:
-                self._sock = None
-
-    def send(self, data: bytes) -> None:
-        assert self._sock is not None
-        self._sock.settimeout(None)
-        self._sock.sendall(data)
-
-    def recv(self, timeout: float) -> bytes:
-        """Whatever arrives within ``timeout`` (b"" for nothing); _PeerClosed at end of stream."""
-        assert self._sock is not None
-        self._sock.settimeout(max(timeout, 1e-4))
-        try:
-            data = self._sock.recv(_RECV_SIZE)
-        except TimeoutError:
-            return b""
-        if not data:
-            raise _PeerClosed
-        return data
-
-    def drain(self) -> int:
-        """Drop the bytes already waiting; their count. _PeerClosed when the peer hung up."""
-        assert self._sock is not None
-        dropped = 0
-        while select.select([self._sock], [], [], 0)[0]:
-            data = self._sock.recv(_RECV_SIZE)
-            if not data:
-                raise _PeerClosed
-            dropped += len(data)
-        return dropped
-
-
-class _SerialStream:
-    """RTU over a serial line (pyserial, which pymodbus[serial] brings)."""
-
-    def __init__(self, settings: ConnectionSettings) -> None:
-        self._settings = settings
-        self._port: Any = None
-
-    @property
-    def is_open(self) -> bool:
-        return self._port is not None
-
-    def open(self, timeout: float) -> None:
-        import serial
-
-        s = self._settings
-        try:
-            self._port = serial.Serial(
-                s.serial_port,
-                baudrate=s.baudrate,
-                parity=s.parity,
-                stopbits=s.stopbits,
-                bytesize=s.bytesize,
-                timeout=timeout,
-                exclusive=True,
-            )
-        except (serial.SerialException, OSError, ValueError) as exc:
-            raise LinkError(
-                f"cannot open the serial port: {exc}",
-                code="serial_open_failed",
-                params={"port": (s.serial_port or "")[:60]},
-            ) from None
-
-    def close(self) -> None:
-        if self._port is not None:
-            try:
-                self._port.close()
-            finally:
-                self._port = None
-
-    def send(self, data: bytes) -> None:
-        self._port.write(data)
-        self._port.flush()
-
-    def recv(self, timeout: float) -> bytes:
-        self._port.timeout = max(timeout, 1e-4)
-        return bytes(self._port.read(max(1, self._port.in_waiting)))
-
-    def drain(self) -> int:
-        waiting = int(self._port.in_waiting)
-        self._port.reset_input_buffer()
-        return waiting
-
-
 # --------------------------------------------------------------------------------------------
 # The transport
 # --------------------------------------------------------------------------------------------
@@ -285,10 +143,11 @@ class Transport:
         self._encode_request = frames.encode_request
         self._frame_need = frames.frame_need
         self._decode_answer = frames.decode_answer
+        self._answer_registers = frames.answer_registers
         self.settings = settings
         self.framing: Framing = settings.transport
-        self._stream: _TcpStream | _SerialStream = (
-            _SerialStream(settings) if settings.serial_port is not None else _TcpStream(settings)
+        self._stream: TcpStream | SerialStream = (
+            SerialStream(settings) if settings.serial_port is not None else TcpStream(settings)
         )
         self._on_link_change = on_link_change or (lambda: None)
         self._observers: list[TrafficObserver] = []
@@ -346,7 +205,7 @@ class Transport:
         """Get back in step after a malformed answer or a timeout."""
         self._count("resyncs")
         _log.debug("resync after %s", why)
-        if isinstance(self._stream, _SerialStream) and self._stream.is_open:
+        if isinstance(self._stream, SerialStream) and self._stream.is_open:
             self._stream.drain()
         else:
             self.close()
@@ -373,7 +232,7 @@ class Transport:
     def read(self, what: str, address: int, count: int, timeout: float | None = None) -> list[int]:
         """0x03: exactly ``count`` registers."""
         _, data = self.execute(what, self._read_request(address, count), timeout)
-        return [(data[i] << 8) | data[i + 1] for i in range(1, 1 + 2 * count, 2)]
+        return self._answer_registers(data, count)
 
     def write_single(self, what: str, address: int, value: int, timeout: float | None = None) -> None:
         self.execute(what, self._write_single_request(address, value), timeout)
@@ -409,7 +268,7 @@ class Transport:
     def _flush_stray(self) -> None:
         try:
             dropped = self._stream.drain()
-        except (_PeerClosed, OSError):
+        except (PeerClosed, OSError):
             # The controller closed the idle link (restart, its own timeout): say so once; the
             # next request opens a fresh link.
             self.close()
@@ -428,26 +287,31 @@ class Transport:
         return LinkError(message, params={"endpoint": self.settings.endpoint})
 
     def _exchange(self, what: str, request: Request, timeout: float) -> tuple[int, bytes]:
-        self.open()
+        stream = self._stream
+        if not stream.is_open:
+            self.open()
         self._flush_stray()
         unit = self.settings.unit
-        self._tid = self._tid % 65000 + 1 if self.framing == "tcp" else 0
-        tid = self._tid
-        frame = self._encode_request(self.framing, request, unit, tid)
-        self._count("requests")
+        framing = self.framing
+        self._tid = tid = self._tid % 65000 + 1 if framing == "tcp" else 0
+        frame = self._encode_request(framing, request, unit, tid)
+        self._counts["requests"] += 1
         try:
-            self._stream.send(frame)
+            stream.send(frame)
         except OSError:
             raise self._lost(what) from None
         if self._observing:
             self._emit("tx", frame)
         buf = b""
+        need = 0  # nothing received yet: no field to check, receive first
+        frame_need = self._frame_need
         deadline = time.monotonic() + timeout
         try:
             while True:
-                need = self._frame_need(self.framing, request, unit, tid, buf)
-                if len(buf) >= need:
-                    break
+                if buf:
+                    need = frame_need(framing, request, unit, tid, buf)
+                    if len(buf) >= need:
+                        break
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:
                     if not buf:
@@ -461,8 +325,8 @@ class Transport:
                         got=len(buf),
                     )
                 try:
-                    buf += self._stream.recv(remaining)
-                except _PeerClosed:
+                    buf += stream.recv(remaining)
+                except PeerClosed:
                     if not buf:
                         raise self._lost(what) from None
                     raise MalformedResponse(
@@ -491,12 +355,12 @@ class Transport:
             raise error from None
         if self._observing:
             self._emit("rx", buf)
-        function, data = self._decode_answer(self.framing, buf)
+        function, data = self._decode_answer(framing, buf)
         if function & 0x80:
             code = data[0]
             text = exception_text(code, f"exception code {code}")
             message = f"controller refused {what}: {text}"
             self._count("exceptions", message)
             raise ModbusExceptionError(function & 0x7F, code, message)
-        self._count("answers")
+        self._counts["answers"] += 1
         return function, data

@@ -40,6 +40,24 @@ class WordOrder(enum.Enum):
         raise ValueError(f"unknown word order {text!r} (use low-first or high-first)")
 
 
+# The two word orders as byte orders: a float32 packed little-endian reads, as little-endian
+# 16-bit words, low word first (CDAB); packed and read big-endian, high word first (ABCD). One
+# struct call per block instead of two per float (the upload writes a pose for every point).
+# Compiled per block size, kept per word order (keyed by ``is``: an Enum hashes in Python).
+_LOW_FIRST: dict[int, tuple[struct.Struct, struct.Struct]] = {}  # n -> (n floats, 2n registers)
+_HIGH_FIRST: dict[int, tuple[struct.Struct, struct.Struct]] = {}
+
+
+def _structs(n: int, order: WordOrder) -> tuple[struct.Struct, struct.Struct]:
+    """(``n`` float32, ``2n`` registers) in ``order``, compiled once."""
+    cache = _LOW_FIRST if order is WordOrder.LOW_FIRST else _HIGH_FIRST
+    pair = cache.get(n)
+    if pair is None:
+        e = "<" if order is WordOrder.LOW_FIRST else ">"
+        pair = cache[n] = (struct.Struct(f"{e}{n}f"), struct.Struct(f"{e}{2 * n}H"))
+    return pair
+
+
 def float_to_registers(value: float, order: WordOrder = WordOrder.LOW_FIRST) -> list[int]:
     """Encode one float32 into two registers."""
     (raw,) = struct.unpack(">I", struct.pack(">f", value))
@@ -51,25 +69,29 @@ def registers_to_float(regs: Sequence[int], order: WordOrder = WordOrder.LOW_FIR
     """Decode two registers into one float32 (as a Python float)."""
     if len(regs) != 2:
         raise ValueError(f"a float32 needs 2 registers, got {len(regs)}")
-    first, second = (int(r) & 0xFFFF for r in regs)
-    high, low = (second, first) if order is WordOrder.LOW_FIRST else (first, second)
-    (value,) = struct.unpack(">f", struct.pack(">I", (high << 16) | low))
+    floats, words = _structs(1, order)
+    (value,) = floats.unpack(words.pack(int(regs[0]) & 0xFFFF, int(regs[1]) & 0xFFFF))
     return float(value)
 
 
 def encode_floats(values: Iterable[float], order: WordOrder = WordOrder.LOW_FIRST) -> list[int]:
-    """Encode consecutive float32 values into registers."""
-    out: list[int] = []
-    for v in values:
-        out.extend(float_to_registers(v, order))
-    return out
+    """Encode consecutive float32 values into registers (as :func:`float_to_registers` each)."""
+    items = values if isinstance(values, (list, tuple)) else list(values)
+    floats, words = _structs(len(items), order)
+    return list(words.unpack(floats.pack(*items)))
 
 
 def decode_floats(regs: Sequence[int], order: WordOrder = WordOrder.LOW_FIRST) -> list[float]:
-    """Decode an even number of registers into float32 values."""
-    if len(regs) % 2:
-        raise ValueError(f"odd register count {len(regs)} cannot hold float32 values")
-    return [registers_to_float(regs[i : i + 2], order) for i in range(0, len(regs), 2)]
+    """Decode an even number of registers into float32 values (as :func:`registers_to_float` each)."""
+    n = len(regs)
+    if n % 2:
+        raise ValueError(f"odd register count {n} cannot hold float32 values")
+    floats, words = _structs(n // 2, order)
+    try:
+        raw = words.pack(*regs)
+    except struct.error:  # not plain 16-bit values: each masked, one by one, as before
+        return [registers_to_float(regs[i : i + 2], order) for i in range(0, n, 2)]
+    return list(floats.unpack(raw))
 
 
 FLOAT32_MAX: float = struct.unpack(">f", b"\x7f\x7f\xff\xff")[0]
@@ -77,6 +99,8 @@ FLOAT32_MAX: float = struct.unpack(">f", b"\x7f\x7f\xff\xff")[0]
 
 def check_float32(value: float, name: str = "value") -> float:
     """Refuse NaN, infinities and values a float32 cannot hold (numpy scalars are fine)."""
+    if type(value) is float and -FLOAT32_MAX <= value <= FLOAT32_MAX:
+        return value  # the common case, checked without the ABC test (NaN fails the comparison)
     if not isinstance(value, numbers.Real) or isinstance(value, bool):
         raise ValueError(f"{name} must be a number, got {value!r}")
     try:

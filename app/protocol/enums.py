@@ -8,6 +8,7 @@ stays Qt-free): ``pyside6-lupdate`` collects them and the GUI shows them through
 from __future__ import annotations
 
 import enum
+import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -318,6 +319,11 @@ class CommandStatus:
 
 def decode_command_status(kind: CommandKind | None, code: int) -> CommandStatus:
     """Decode GV291's code for the command kind that was sent last."""
+    return _decoded(kind, code)
+
+
+@functools.lru_cache(maxsize=1024)  # immutable, and few (kind, code) pairs: every poll decodes one
+def _decoded(kind: CommandKind | None, code: int) -> CommandStatus:
     return CommandStatus(kind, int(code))
 
 
