@@ -322,7 +322,9 @@ class CommandTracker:
         unseen = "" if self.is_move else " before its result was seen (not confirmed)"
         return self._fail(
             CommandStopped(
-                f"{self.text} stopped by the operator{unseen}", code="stopped_by_operator", params=self._args()
+                f"{self.text} stopped by the operator{unseen}",
+                code="stopped_by_operator",
+                params=self._args(),
             ),
             code,
             now,
