@@ -1,5 +1,6 @@
-"""A Stop during an upload ends it at once: the point in flight is ended by the stop, not waited
-for (RobotLink + worker against the real simulator, no widgets)."""
+"""A Stop is serviced whatever the worker is doing (RobotLink + worker against the real simulator,
+no widgets): during an upload it ends the point in flight at once, and when its own write on the
+main link fails, nothing queued before it runs after it."""
 
 from __future__ import annotations
 
@@ -10,7 +11,9 @@ import pytest
 
 from app import timing
 from app.link.robot_link import RobotLink
+from app.link.types import WorkerError
 from app.models import CommandResult
+from app.protocol import registers
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,
@@ -62,3 +65,33 @@ def test_a_stop_ends_an_upload_at_once_even_when_the_point_in_flight_never_gets_
     writes = [w.address for w in list(sim.writes) if w.address != 2 * 291]  # (GV291: completion rule)
     assert writes.count(440) == 1 and writes.index(440) < writes.index(441)
     assert set(writes[writes.index(441) :]) == {441}
+
+
+def test_a_stop_whose_main_link_write_gets_no_answer_still_cancels_the_motions_queued_before_it(
+    qtbot: Any, sim: Any, link: RobotLink
+) -> None:
+    """The simulator answers after 0.4 s, beyond the link's 0.25 s request timeout: the main
+    link's 441 gets no answer in time (an error for the Stop). The motions queued before the Stop
+    are cancelled all the same -- the old code then sent them, after the operator's Stop."""
+    connect(qtbot, link, sim)
+    sim.set_response_delay(0.4)
+    seen = sim.requests_count
+    qtbot.waitUntil(lambda: sim.requests_count > seen, timeout=SIGNAL_TIMEOUT_MS)  # a read in flight
+    results: list[CommandResult] = []
+    errors: list[WorkerError] = []
+    link.commandFinished.connect(results.append)
+    link.errorOccurred.connect(errors.append)
+    writes_before = len(sim.writes)
+    queued = [link.go_zero(0), link.run_program(1)]
+    stop_id = link.stop()
+    qtbot.waitUntil(lambda: any(e.request_id == stop_id for e in errors), timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: {r.request_id for r in results if "cancelled by Stop" in r.message} == set(queued),
+        timeout=SIGNAL_TIMEOUT_MS,
+    )
+    sim.set_response_delay(0.0)
+    qtbot.waitUntil(lambda: bool(sim.writes_to(441)), timeout=SIGNAL_TIMEOUT_MS)  # stored after its delay
+    assert not any(e.request_id in queued for e in errors)  # never sent (no "did not answer" for them)
+    # at the simulator: the stop(s), never a go-to-zero (430) or a program run (440) after it
+    after = {w.address for w in list(sim.writes)[writes_before:]}
+    assert 441 in after and not after & {registers.REG_GO_ZERO, registers.REG_RUN_COMMAND}
