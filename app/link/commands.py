@@ -11,7 +11,7 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING, Protocol
 
-from app.errors import TeachPadError
+from app.errors import TeachPadError, WriteBlocked
 from app.link.jobs import JobKind
 from app.link.types import JogRequest, Operation
 from app.link.upload import RawItem
@@ -65,6 +65,8 @@ class WorkerCommands:
         client = self.client_or_raise()
         try:
             client.stop()  # first: nothing else goes out before the stop
+        except WriteBlocked:  # monitor-only: nothing is written, each queued job is refused in turn
+            raise
         except TeachPadError:  # no answer in time, refused, link lost: the operator still asked for it
             self._cancel_motions_before_stop()  # nothing queued before the Stop runs after it
             self.uploader.end("stopped")
