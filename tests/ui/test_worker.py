@@ -381,11 +381,16 @@ def test_a_stop_cancels_queued_motions_with_their_ids(qtbot: Any, sim: Any, link
     results: list[CommandResult] = []
     link.commandFinished.connect(results.append)
     queued = [link.go_zero(0), link.run_program(1)]
-    stop_id = link.stop()
-    qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
+    link.stop()
+
+    def cancelled() -> set[int | None]:
+        return {r.request_id for r in results if "cancelled by Stop" in r.message}
+
+    # (the Stop's own outcome is not awaited: on a loaded machine its main-link write may get no
+    # answer within the fixture's 0.25 s beside the 0.1 s delay -- an error, and the queued jobs
+    # are cancelled all the same, see test_worker_stop.py)
+    qtbot.waitUntil(lambda: cancelled() == set(queued), timeout=SIGNAL_TIMEOUT_MS)
     sim.set_response_delay(0.0)
-    cancelled = {r.request_id for r in results if "cancelled by Stop" in r.message}
-    assert cancelled == set(queued)
 
 
 # --- uploads ------------------------------------------------------------------------------------
