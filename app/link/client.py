@@ -256,6 +256,7 @@ class RobotClient(CommandClient):
         stage: bool = True,
         stage_gv: int | None = None,
         halted: Callable[[], bool] | None = None,
+        between: Callable[[], None] | None = None,
         results: list[CommandResult] | None = None,
     ) -> list[CommandResult]:
         """Batched case 2.2: per point the pose GVs (one 0x10), GV200-202 (one 0x10), 440 <- 0xE0, polls.
@@ -275,7 +276,10 @@ class RobotClient(CommandClient):
 
         ``halted`` (any thread may make it True; read on this one): once True -- a stop or a
         cancel is on its way -- no further write of the batch starts: no staging write, no next
-        point (the point whose writes went out is waited for). ``results``: the list the results
+        point (the point whose writes went out is waited for). ``between``: run between two status
+        reads of a point in flight (:meth:`CommandClient.wait`): the worker's urgent jobs; a stop
+        written there ends that point as stopped at once (never "created": its result was not
+        seen), and ``progress`` then ends the batch. ``results``: the list the results
         are appended to as they come (returned), so a caller interrupted mid-batch (Ctrl-C) keeps
         what was done.
         """
@@ -323,7 +327,7 @@ class RobotClient(CommandClient):
                 self._write_floats(registers.GV_PARAM0, [float(point_id), 1.0, float(block)])
                 self._sent_points[point_id] = (values[0], values[1], values[2])
                 tracker = self.begin_command(RunCommand.CREATE_POINT, status, None)
-                result = self.wait(tracker, raise_errors=False, meanwhile=meanwhile)
+                result = self.wait(tracker, raise_errors=False, meanwhile=meanwhile, between=between)
                 status = tracker.last_status or status
             except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
                 results.append(

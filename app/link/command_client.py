@@ -164,8 +164,16 @@ class CommandClient(RegisterClient):
         *,
         raise_errors: bool = True,
         meanwhile: Callable[[], None] | None = None,
+        between: Callable[[], None] | None = None,
     ) -> CommandResult:
         """Poll until ``tracker`` ends; raise its typed error when it failed (by default).
+
+        ``between`` runs after every read that did not end the command, before anything else:
+        the worker's urgent jobs (stop, pause, cancel, jog release), so none waits for a
+        command's result. A stop it writes on this client ends the command there
+        (:meth:`~app.link.tracker.CommandTracker.stopped`: the host sent the stop itself,
+        PROTOCOL.md section 7) and the wait returns that result without another read. It may
+        raise to abandon the wait (the link went down meanwhile).
 
         ``meanwhile`` runs once, after the first read when the command has not ended by then:
         a transaction that fills the controller's latency (an upload writes the next point's
@@ -173,6 +181,9 @@ class CommandClient(RegisterClient):
         """
         while True:
             result = self.poll(tracker)  # the first poll is immediate: keep the ack window small
+            if result is None and between is not None:
+                between()
+                result = tracker.result  # a stop the host sent meanwhile ended it
             if result is not None:
                 if raise_errors and tracker.error is not None:
                     raise tracker.error

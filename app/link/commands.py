@@ -11,6 +11,7 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING, Protocol
 
+from app.errors import TeachPadError, WriteBlocked
 from app.link.jobs import JobKind
 from app.link.types import JogRequest, Operation
 from app.link.upload import RawItem
@@ -64,6 +65,12 @@ class WorkerCommands:
         client = self.client_or_raise()
         try:
             client.stop()  # first: nothing else goes out before the stop
+        except WriteBlocked:  # monitor-only: nothing is written, each queued job is refused in turn
+            raise
+        except TeachPadError:  # no answer in time, refused, link lost: the operator still asked for it
+            self._cancel_motions_before_stop()  # nothing queued before the Stop runs after it
+            self.uploader.end("stopped")
+            raise
         finally:
             if on_line is not None:  # its answer: checked, audited, shown in the traffic
                 self.stop_line.report(self.capture, self.audit)
@@ -74,12 +81,15 @@ class WorkerCommands:
         self.uploader.end("stopped")
         self.jog.on_stop()
         active = self.motion.take()
-        stop_seq = self._current_seq
-        for job in self._jobs.cancel(lambda j: j.kind is JobKind.MOTION and j.seq < stop_seq):
-            self._failed(f"{job.operation}: cancelled by Stop", job.request_id)
+        self._cancel_motions_before_stop()
         if active is not None:
             self.emit_result(active.completion.stopped(now), active.request_id)
         self._done("stop: sent")
+
+    def _cancel_motions_before_stop(self) -> None:
+        stop_seq = self._current_seq
+        for job in self._jobs.cancel(lambda j: j.kind is JobKind.MOTION and j.seq < stop_seq):
+            self._failed(f"{job.operation}: cancelled by Stop", job.request_id)
 
     def _do_cancel_upload(self) -> None:
         """No controller stop: the upload ends after the point in progress; queued uploads are dropped."""

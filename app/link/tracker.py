@@ -37,7 +37,10 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
   read a little later (``ResultPacer.retry_after``, at least ``RETRY_MIN``), then the backoff.
   The caller may fill the wait with a transaction that does not touch what the command reads
   (``CommandClient.wait(meanwhile=)``: an upload writes the next point's pose there).
-* **After a stop** the wait ends when the host sent the stop itself, or when a move that was
+* **After a stop** the wait ends when the host sent the stop itself (:meth:`CommandTracker.stopped`,
+  at once, also for an instant command whose result has not shown yet: a controller that
+  resets GV291 to 0 on a stop never shows it, and waiting for it would hold the host for the
+  command's timeout; the command ends failed, *not confirmed*), or when a move that was
   seen under way shows program state *stopped* with GV291 at 0 (initial) for
   ``timing.STOP_SETTLE`` (a transient 0 just before 0xFF is not a stop).
 """
@@ -315,9 +318,13 @@ class CommandTracker:
         if self.result is not None:
             return self.result
         code = self.last_status.command_status_code if self.last_status else self.pre_code
+        # an instant command (create point) stopped before its result showed: not confirmed either way
+        unseen = "" if self.is_move else " before its result was seen (not confirmed)"
         return self._fail(
             CommandStopped(
-                f"{self.text} stopped by the operator", code="stopped_by_operator", params=self._args()
+                f"{self.text} stopped by the operator{unseen}",
+                code="stopped_by_operator",
+                params=self._args(),
             ),
             code,
             now,

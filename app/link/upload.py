@@ -7,7 +7,12 @@ pose while the controller creates the current point. Each chunk is at most
 :data:`app.timing.UPLOAD_CHUNK_POINTS` points of one tool or
 :data:`app.timing.UPLOAD_CHUNK_SECONDS`; the worker queues the next chunk behind whatever arrived
 meanwhile, so polls and queued calls keep flowing. Between two points the
-urgent jobs run (stop, cancel, jog release) and a poll goes out when one is due. From the moment
+urgent jobs run (stop, cancel, jog release) and a poll goes out when one is due; between two
+status reads of the point in flight they run too, so a Stop never waits for a point's result:
+its 441 on the main link ends the point in flight as stopped (the host sent the stop itself,
+PROTOCOL.md section 7; reported failed, never "created" -- the controller may hold it, as the
+point's result was not seen) and the upload ends with its final result at once. A cancel lets
+the point in flight finish (no controller stop). From the moment
 a stop or a cancel is asked for (the worker's ``halt_count`` grows: the stop line counts the
 Stop before it writes 441) until that job runs, nothing more is written: no staging write of the
 next pose, no next point; only the point whose writes already went out is waited for.
@@ -182,6 +187,11 @@ class Uploader:
         def halted() -> bool:  # a stop or cancel on its way: no staging write, no next point
             return self._halted(upload)
 
+        def between() -> None:  # between two reads of the point in flight (see the module docstring)
+            host.run_urgent()  # a stop's main-link 441 ends the point in flight as stopped
+            if not host.link_up or host.closed:  # lost or closed by an urgent job: no more reads
+                raise LinkError("the link went down while a point was in flight; its outcome is unknown")
+
         transport_error: str | None = None
         self._busy = True
         outer_id, host.request_id = host.request_id, upload.request_id
@@ -189,7 +199,13 @@ class Uploader:
             chunk = [(pid, pose) for pid, pose, _ in items[first:last]]
             stage_gv = stage_gv_for(host.supervisor.canary_gv)
             results = client.upload_points(
-                chunk, tool, progress, gv_start=UPLOAD_POSE_GV, stage_gv=stage_gv, halted=halted
+                chunk,
+                tool,
+                progress,
+                gv_start=UPLOAD_POSE_GV,
+                stage_gv=stage_gv,
+                halted=halted,
+                between=between,
             )
         except (LinkError, ResponseTimeout) as exc:  # before the first point (status read, mode)
             results, transport_error = [], str(exc)
@@ -210,7 +226,8 @@ class Uploader:
                     transport_error = result.message
         if transport_error is not None:
             upload.end = upload.end or transport_error
-            host.supervisor.transport_failed(transport_error)
+            if host.link_up:  # a link already lost or closed (an urgent job meanwhile) counts no more
+                host.supervisor.transport_failed(transport_error)
         self._note_progress(upload)
 
     def _halted(self, upload: UploadRun) -> bool:

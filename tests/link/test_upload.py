@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import itertools
+import threading
+import time
+from collections.abc import Callable
 from typing import Any
 
 import pytest
@@ -10,7 +13,14 @@ import pytest
 from app import timing
 from app.errors import InvalidInput
 from app.link.jobs import Job, JobKind, JobQueue
-from app.link.upload import UPLOAD_STAGE_GV, Uploader, check_upload_items, group_by_tool, stage_gv_for
+from app.link.upload import (
+    UPLOAD_STAGE_GV,
+    RawItem,
+    Uploader,
+    check_upload_items,
+    group_by_tool,
+    stage_gv_for,
+)
 from tests.link.harness import PartsHost
 
 POSE = (100.0, 0.0, 300.0, 180.0, 0.0, 0.0)
@@ -113,6 +123,102 @@ def test_without_a_stop_the_next_pose_is_staged(host: PartsHost, sim_factory: An
     order = [w.address for w in sim.writes if w.address in (0, 12, 400, 440)]
     # a pose right after a 440: the next point's, staged while the controller works (GV0.. / GV6..)
     assert any(a == 440 and b in (0, 12) for a, b in itertools.pairwise(order)), order
+
+
+def _queue_when_in_flight(
+    host: PartsHost, sim: Any, job: Callable[[], None], nth: int = 1
+) -> threading.Thread:
+    """From another thread (like the GUI's Stop): queue ``job`` as an urgent job once the
+    ``nth`` point's 440 reached the simulator, i.e. while that point is in flight."""
+
+    def post() -> None:
+        assert sim.wait_for(lambda _s: len(sim.writes_to(440)) >= nth, 10.0)
+        host.urgent.append(job)
+
+    thread = threading.Thread(target=post, daemon=True)
+    thread.start()
+    return thread
+
+
+def _long_point_timeouts(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A point in flight ends by its own timeouts only after 10 s (acknowledged or not)."""
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 10.0)
+    monkeypatch.setattr(timing, "CREATE_POINT_TIMEOUT", 10.0)
+
+
+def _run_upload(host: PartsHost, count: int) -> float:
+    """Start an upload of ``count`` points and step it to its end; the seconds the steps took."""
+    items: list[RawItem] = [(100 + i, (100.0 + i, 0.0, 300.0, 0.0, 0.0, 0.0), 200) for i in range(count)]
+    assert host.uploader.start(items)
+    start = time.monotonic()
+    steps = 0
+    while host.uploader.step():
+        steps += 1
+        assert steps < 20  # no busy loop of empty chunks
+    return time.monotonic() - start
+
+
+def test_a_stop_ends_the_point_in_flight_at_once_when_its_result_never_shows(
+    host: PartsHost, sim_factory: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The controller shows no create-point result for 60 s (and a stop resets GV291 to 0, so it
+    never will): the stop job, queued while the point is in flight, runs between two of the
+    point's status reads; its 441 on this link ends the point as stopped, and the upload returns
+    its results at once -- not after the point's timeout (here 10 s, as the old code did)."""
+    _long_point_timeouts(monkeypatch)
+    sim = sim_factory(command_latency=60.0)
+    host.connect(sim)
+
+    def stop() -> None:  # what the worker's stop job does first (app/link/commands.py)
+        host.client_or_raise().stop()
+        host.uploader.end("stopped")
+
+    poster = _queue_when_in_flight(host, sim, stop)
+    elapsed = _run_upload(host, 4)
+    poster.join(1.0)
+    assert elapsed < 2.0  # ms on an idle machine; the old code waited the point's 10 s timeout
+    result = host.of("commandFinished")[-1]
+    assert not result.ok and result.message == "uploaded 0 of 4 points (stopped)"
+    [(pid, ok, reason, unconfirmed)] = host.of("pointUploaded")
+    assert (pid, ok, unconfirmed) == (100, False, False)
+    assert "stopped by the operator" in reason and "not confirmed" in reason  # never "created"
+    # at the simulator: one point started, the stop after its 440, nothing of the batch after it
+    writes = [w.address for w in sim.writes if w.address != 2 * 291]  # (GV291: the completion rule)
+    assert writes.count(440) == 1 and writes.index(440) < writes.index(441)
+    assert set(writes[writes.index(441) :]) == {441}
+
+
+def test_a_cancel_lets_the_point_in_flight_finish(host: PartsHost, sim_factory: Any) -> None:
+    """A cancel is no controller stop: urgent jobs run between the reads of the point in
+    flight, but only a stop ends it; the point's own result (created) is waited for."""
+    sim = sim_factory(command_latency=0.2)
+    host.connect(sim)
+    poster = _queue_when_in_flight(host, sim, lambda: host.uploader.end("cancelled"))
+    _run_upload(host, 4)
+    poster.join(1.0)
+    assert host.of("commandFinished")[-1].message == "uploaded 1 of 4 points (cancelled)"
+    assert host.of("pointUploaded") == [(100, True, "", False)]
+    assert sim.writes_to(441) == [] and len(sim.writes_to(440)) == 1
+    assert set(sim.state().points) == {100}
+
+
+def test_a_link_lost_between_two_reads_ends_the_point_without_another_read(
+    host: PartsHost, sim_factory: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An urgent job that finds the link gone (here: declared lost) ends the wait: the point's
+    outcome is unknown, and no read goes out on the closed link (it would reconnect)."""
+    _long_point_timeouts(monkeypatch)
+    sim = sim_factory(command_latency=60.0)
+    host.connect(sim)
+    poster = _queue_when_in_flight(host, sim, lambda: host.supervisor.link_lost("the test cut it"))
+    elapsed = _run_upload(host, 3)
+    poster.join(1.0)
+    assert elapsed < 2.0
+    [(pid, ok, reason, _)] = host.of("pointUploaded")
+    assert (pid, ok) == (100, False) and "outcome is unknown" in reason
+    result = host.of("commandFinished")[-1]
+    assert not result.ok and "link lost" in result.message
+    assert not host.link_up and sim.wait_for(lambda _s: sim.connections_count == 0, 2.0)
 
 
 def test_the_queue_counts_the_jobs_that_end_an_upload() -> None:

@@ -381,11 +381,16 @@ def test_a_stop_cancels_queued_motions_with_their_ids(qtbot: Any, sim: Any, link
     results: list[CommandResult] = []
     link.commandFinished.connect(results.append)
     queued = [link.go_zero(0), link.run_program(1)]
-    stop_id = link.stop()
-    qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
+    link.stop()
+
+    def cancelled() -> set[int | None]:
+        return {r.request_id for r in results if "cancelled by Stop" in r.message}
+
+    # (the Stop's own outcome is not awaited: on a loaded machine its main-link write may get no
+    # answer within the fixture's 0.25 s beside the 0.1 s delay -- an error, and the queued jobs
+    # are cancelled all the same, see test_worker_stop.py)
+    qtbot.waitUntil(lambda: cancelled() == set(queued), timeout=SIGNAL_TIMEOUT_MS)
     sim.set_response_delay(0.0)
-    cancelled = {r.request_id for r in results if "cancelled by Stop" in r.message}
-    assert cancelled == set(queued)
 
 
 # --- uploads ------------------------------------------------------------------------------------
@@ -401,7 +406,10 @@ def _batch_result(request_id: int) -> Any:
 
 
 def test_upload_reports_each_point_and_cancel_sends_no_stop(qtbot: Any, sim: Any, link: RobotLink) -> None:
-    connect(qtbot, link, sim)
+    # a 1 s request timeout: this test is about cancel, and the fixture's 0.25 s ended the upload
+    # once ("controller did not answer within 0.25 s") when the loaded test process, which also
+    # runs the simulator, answered a status read late (as 9a5eede found for the link-loss test)
+    connect(qtbot, link, sim, timeout=1.0)
     points: list[tuple[int, bool, str]] = []
     progress: list[tuple[int, int]] = []
     link.uploadProgress.connect(lambda done, total: progress.append((done, total)))
