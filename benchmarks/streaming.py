@@ -4,10 +4,12 @@
 inside a long suite; this runs the same measurement (the main window at its desktop size, the
 Monitor tab and the traffic inspector shown, the simulator in its own process running the
 100 mm square, polling at 100 Hz) ``--repeat`` times and reports each run and the medians,
-with the load average. ``--busy`` adds the busy-neighbour variant after each run,
-``--profile FILE`` writes a cProfile of the GUI thread over the streaming windows without the
-probe timer (the worker thread is not profiled: cProfile follows the thread that enables it), and ``--variants``
-measures the stream again with the monitor hidden and with the traffic inspector hidden.
+with the load average: ``gui_thread_cpu_pct_no_probe`` (the goal's figure: the same stream
+measured again right after, without the 1 ms probe timer) and the probe's figures. ``--busy``
+adds the busy-neighbour variant after each run, ``--profile FILE`` writes a cProfile of the GUI
+thread over the probe-free windows (the worker thread is not profiled: cProfile follows the
+thread that enables it), and ``--variants`` measures the stream again with the monitor hidden
+and with the traffic inspector hidden.
 
 ``--warm SECONDS`` streams that long before measuring (default 1 s): with 31 s the monitor's
 30 s plots and its X–Y trace are full, as for an operator watching a program run (the first

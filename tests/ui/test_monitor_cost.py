@@ -72,7 +72,9 @@ def test_the_top_view_waits_for_the_marker_to_move_a_pixel(
     assert shown.trace_marker.pos().x() == pytest.approx(2 * step + pixel_x)
 
 
-def test_refresh_draws_the_top_view_for_any_move(shown: MonitorPanel, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_refresh_draws_the_top_view_for_any_move(
+    shown: MonitorPanel, monkeypatch: pytest.MonkeyPatch
+) -> None:
     shown.on_pose(pose(0.0, 0.0), t=0.0)
     shown.refresh()
     draws = _trace_draws(shown, monkeypatch)
@@ -96,7 +98,8 @@ def test_a_moving_arm_redraws_the_top_view_in_every_plot_frame(
 
 
 def _image(panel: MonitorPanel) -> QImage:
-    return panel.xyz_plot.grab().toImage()
+    image: QImage = panel.xyz_plot.grab().toImage()
+    return image
 
 
 def test_a_cached_axis_follows_its_range(qtbot: Any, shown: MonitorPanel) -> None:
@@ -112,7 +115,9 @@ def test_a_cached_axis_follows_its_range(qtbot: Any, shown: MonitorPanel) -> Non
     assert shown._plots.y_range("xyz") != low
     qtbot.waitUntil(lambda: _image(shown) != before, timeout=2000)
     axis = shown.xyz_plot.getPlotItem().getAxis("left")
-    values = [v for _spacing, ticks in axis.tickValues(*shown._plots.y_range("xyz"), 200) for v in ticks]
+    shown_range = shown._plots.y_range("xyz")
+    assert shown_range is not None
+    values = [v for _spacing, ticks in axis.tickValues(*shown_range, 200) for v in ticks]
     assert max(values) >= 1000.0  # the ticks are the new range's
 
 
@@ -132,8 +137,7 @@ def test_a_non_finite_value_in_any_field_stays_out_of_the_plots(qtbot: Any, bad:
     qtbot.addWidget(panel)
     panel.on_pose(pose(1.0), t=0.0)
     for field in range(6):
-        values = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
-        values[field] = bad
-        panel.on_pose(Pose(*values), t=0.1 + field)
+        x, y, z, a, b, c = (bad if i == field else float(i + 1) for i in range(6))
+        panel.on_pose(Pose(x, y, z, a, b, c), t=0.1 + field)
     assert panel.sample_count == 1
     assert panel.trace_count == 1

@@ -57,6 +57,7 @@ __all__ = [
     "PLOT_INTERVAL_MS",
     "MonitorPlots",
     "add_legend",
+    "cache_legend",
     "fit_range",
     "style_plot",
     "unwrap_degrees",
@@ -153,7 +154,17 @@ def add_legend(plot: pg.PlotWidget) -> None:
         verSpacing=-6,
         horSpacing=8,
     )
-    plot.getPlotItem().legend.setCacheMode(_CACHED)  # redrawn only when it changes
+
+
+def cache_legend(plot: pg.PlotWidget) -> None:
+    """Cache the legend and each of its parts (samples, labels, their text items) as pixmaps, once
+    its rows are in: a cached item does not cache its children, and the legend sits on the
+    curves, so without that each label's text was laid out and drawn again in every frame."""
+    pending: list[QGraphicsItem] = [plot.getPlotItem().legend]
+    while pending:
+        item = pending.pop()
+        item.setCacheMode(_CACHED)
+        pending.extend(item.childItems())
 
 
 def style_plot(plot: pg.PlotWidget) -> None:
@@ -214,6 +225,8 @@ class MonitorPlots:
             curve = BoundedCurve(pen=pg.mkPen(_PLOT_COLORS[name], width=CURVE_WIDTH), name=name)
             plot.addItem(curve)
             self.curves[name] = curve
+        for plot in (self.xyz_plot, self.abc_plot):
+            cache_legend(plot)
 
         self.trace_plot.setAspectLocked(True)
         # room on the right for the last bottom tick label (else clipped at the plot's edge)
