@@ -141,3 +141,20 @@ def test_a_non_finite_value_in_any_field_stays_out_of_the_plots(qtbot: Any, bad:
         panel.on_pose(Pose(x, y, z, a, b, c), t=0.1 + field)
     assert panel.sample_count == 1
     assert panel.trace_count == 1
+
+
+def test_a_cleared_trace_is_redrawn_in_the_next_frame_however_little_moved(
+    shown: MonitorPanel, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    clock = [1000.0]
+    monkeypatch.setattr(shown, "_now", lambda: clock[0])
+    for i in range(3):
+        shown.on_pose(pose(10.0 * i, 0.0))
+    shown.refresh()
+    assert len(shown.trace_curve.xData) == 3
+    shown.set_paused(True)
+    shown.clear_trace_button.click()
+    shown.on_pose(pose(20.06, 0.0))  # the marker's place, give or take a fraction of a pixel
+    shown.set_paused(False)
+    _frame(shown, clock)
+    assert shown.trace_curve.xData.tolist() == [pytest.approx(20.06)]  # not the old trace

@@ -390,8 +390,8 @@ class MonitorPanel(QWidget):
             self._plots.paint_history(self._history, self._window_s, now)
             painted = True
         if self._trace.total != self._painted_trace and (
-            every_trace_change or self._plots.trace_moved(self._trace)
-        ):
+            every_trace_change or self._painted_trace < 0 or self._plots.trace_moved(self._trace)
+        ):  # (-1: cleared, resumed or built since: drawn whatever moved)
             self._painted_trace = self._trace.total
             self._plots.paint_trace(self._trace)
             painted = True
