@@ -10,6 +10,7 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
+from PySide6.QtCore import QEvent, QObject
 from PySide6.QtGui import QUndoStack
 from PySide6.QtWidgets import QApplication, QMainWindow, QWidget
 
@@ -96,6 +97,42 @@ def test_the_strip_names_the_link_state(strip: PoseStrip, link: FakeLink) -> Non
     link.set_connected(False)
     assert strip.freshness_text() == "link down" and strip.mode_chip.text() == "unknown"
     assert strip.value_text("Z") == "400.00" and strip.values["Z"].property("stale") is True
+
+
+class _Paints(QObject):
+    """Counts the paint events a widget gets."""
+
+    def __init__(self, widget: QWidget) -> None:
+        super().__init__()
+        self.count = 0
+        widget.installEventFilter(self)
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() == QEvent.Type.Paint:
+            self.count += 1
+        return False
+
+
+def test_a_new_value_repaints_its_number_not_the_strip(qtbot: Any, strip: PoseStrip, link: FakeLink) -> None:
+    """The numbers are opaque (live: the strip's own colour; stale: the stale colour), so a new
+    value repaints the number alone: a see-through label repainted the strip under it too."""
+    poll(link)
+    qtbot.waitExposed(strip)
+    QApplication.processEvents()
+    under, number = _Paints(strip), _Paints(strip.values["X"])
+    for i in range(3):
+        poll(link, Pose(100.0 + i, -3.5, 400.0, 180.0, 0.0, -90.0))
+        strip._show_pose()  # the display frame
+        qtbot.waitUntil(lambda i=i: number.count > i, timeout=2000)
+    assert strip.value_text("X") == "102.00"
+    assert under.count == 0
+    for label in strip.values.values():
+        assert label.autoFillBackground()
+        assert label.palette().window().color().alpha() == 255
+    link.state.set_freshness_limit(0.01)
+    qtbot.waitUntil(lambda: not strip.is_live(), timeout=2000)
+    stale = strip.values["X"].palette().window().color()
+    assert stale.alpha() == 255 and stale != strip.palette().window().color()  # still looks stale
 
 
 def _geometry(strip: PoseStrip, bar: ControlBar) -> list[Any]:

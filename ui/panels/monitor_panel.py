@@ -47,7 +47,6 @@ from ui.panels.monitor_plots import (
     PLOT_INTERVAL_MS,
     TRACE_MIN_SPAN_MM,
     MonitorPlots,
-    unwrap_degrees,
 )
 from ui.panels.monitor_readouts import BIG_POINTS_MAX, MIN_WIDTH, ReadoutBoxes, readout_scale
 from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
@@ -106,8 +105,9 @@ class MonitorPanel(QWidget):
         self._paused = False
         # A B C are plotted unwrapped (a turn through +-180 draws on continuously); the readouts
         # show the controller's values. Last raw value and its unwrapped counterpart per angle.
-        self._angle_raw: list[float] | None = None
-        self._angle_unwrapped = [0.0, 0.0, 0.0]
+        self._angle_raw: tuple[float, float, float] | None = None
+        self._angle_unwrapped = (0.0, 0.0, 0.0)
+        self._trace_last: tuple[float, float] | None = None  # the trace's newest point
 
         self._clock = clock if clock is not None else DisplayClock.shared()
         self._shown = False  # between showEvent and hideEvent: frames are taken
@@ -249,41 +249,42 @@ class MonitorPanel(QWidget):
 
     @Slot(object)
     def on_pose(self, pose: Pose, t: float | None = None) -> None:
-        """Record one sample (``t``: monotonic seconds, default now). Cheap: no painting here."""
+        """Record one sample (``t``: monotonic seconds, default now). Cheap: no painting here
+        (it runs at the poll rate: plain float arithmetic, no per-sample lists)."""
         self._latest = pose
         self._readouts_dirty = True
         if self._shown:
             self._clock.request(self._tick)
-        if not all(map(math.isfinite, pose.xyzabc)):
+        x, y, z, a, b, c = pose.x, pose.y, pose.z, pose.a, pose.b, pose.c
+        # a NaN or an infinity in any of them (the sum of finite poses, < 1e39, is finite)
+        if not math.isfinite(x + y + z + a + b + c):
             return  # shown as "—"; kept out of the plots (skipFiniteCheck trusts the data)
         self._held_time = t is not None
         if t is None:
             t = self._now()
         if self._t0 is None:
             self._t0 = t
-        rel = t - self._t0
-        raw = [pose.a, pose.b, pose.c]
-        if self._angle_raw is None:
-            unwrapped = list(raw)
-        else:
-            unwrapped = [
-                unwrap_degrees(p, u, r)
-                for p, u, r in zip(self._angle_raw, self._angle_unwrapped, raw, strict=True)
-            ]
-        self._angle_raw, self._angle_unwrapped = raw, unwrapped
-        row = (rel, pose.x, pose.y, pose.z, *unwrapped)
+        raw = self._angle_raw
+        if raw is None:
+            ua, ub, uc = a, b, c
+        else:  # each angle's step taken the short way round (unwrap_degrees, inlined)
+            ua, ub, uc = self._angle_unwrapped
+            ua += (a - raw[0] + 180.0) % 360.0 - 180.0
+            ub += (b - raw[1] + 180.0) % 360.0 - 180.0
+            uc += (c - raw[2] + 180.0) % 360.0 - 180.0
+        self._angle_raw, self._angle_unwrapped = (a, b, c), (ua, ub, uc)
+        row = (t - self._t0, x, y, z, ua, ub, uc)
         self._history.append(row)
         self._latest_row = row
-        trace = self._trace
-        if (
-            not len(trace)
-            or math.hypot(pose.x - trace.latest(0), pose.y - trace.latest(1)) >= TRACE_MIN_STEP_MM
-        ):
-            trace.append((pose.x, pose.y))
+        last = self._trace_last
+        if last is None or math.hypot(x - last[0], y - last[1]) >= TRACE_MIN_STEP_MM:
+            self._trace.append((x, y))
+            self._trace_last = (x, y)
 
     @Slot()
     def clear_trace(self) -> None:
         self._trace.clear()
+        self._trace_last = None
         self._painted_trace = -1
 
     @Slot()
@@ -291,6 +292,7 @@ class MonitorPanel(QWidget):
         """Forget every sample (e.g. after connecting to another controller)."""
         self._history.clear()
         self._trace.clear()
+        self._trace_last = None
         self._angle_raw = None
         self._t0 = None
         self._latest = None
@@ -362,30 +364,34 @@ class MonitorPanel(QWidget):
                 self._readouts_dirty = False
                 self._paint_readouts()
             return
-        self._draw(plots=self._now() - self._plots_painted_at >= _PLOT_DUE_S)
+        self._draw(plots=self._now() - self._plots_painted_at >= _PLOT_DUE_S, frame=True)
 
     @Slot()
     def refresh(self) -> None:
         """Draw now: readouts, then the plots if new samples arrived (or the time axis moved)."""
         self._draw(plots=True)
 
-    def _draw(self, *, plots: bool) -> None:
+    def _draw(self, *, plots: bool, frame: bool = False) -> None:
         if not self._plots_built:
             self._build_plots()
         if plots and not self._paused:
-            self._draw_plots()
+            self._draw_plots(every_trace_change=not frame)
         if self._readouts_dirty:
             self._readouts_dirty = False
             self._paint_readouts()
 
-    def _draw_plots(self) -> None:
+    def _draw_plots(self, *, every_trace_change: bool = True) -> None:
+        """``every_trace_change`` False (the display frames): the top view only once its marker
+        moved a pixel (the time plots move with the clock in every plot frame)."""
         now = self._relative_now()
         painted = False
         if self._history.total != self._painted_history or now is not None:
             self._painted_history = self._history.total
             self._plots.paint_history(self._history, self._window_s, now)
             painted = True
-        if self._trace.total != self._painted_trace:
+        if self._trace.total != self._painted_trace and (
+            every_trace_change or self._painted_trace < 0 or self._plots.trace_moved(self._trace)
+        ):  # (-1: cleared, resumed or built since: drawn whatever moved)
             self._painted_trace = self._trace.total
             self._plots.paint_trace(self._trace)
             painted = True

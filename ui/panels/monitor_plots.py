@@ -16,7 +16,13 @@ the frame keeps the rest still:
 * The curves are told their bounds (:class:`~ui.panels.monitor_curve.BoundedCurve`: the range
   their plot shows) instead of scanning their data for them many times a frame.
 * The top view's marker is one ellipse moved with ``setPos`` (a scatter item rebuilt its spot
-  table for one point in every frame).
+  table for one point in every frame), and the top view is redrawn in a frame only when the
+  marker moved a pixel or more since it was drawn (:meth:`MonitorPlots.trace_moved`): a slow
+  arm's trace grows by less than a pixel per frame.
+* The axes (their tick labels and the grid they draw across the plot) and the legends are
+  cached as pixmaps (``DeviceCoordinateCache``): the curves move under them in every frame and
+  the scene repaints whatever they cover, but an axis is drawn again only when its ticks
+  change. Replaying their drawings was about a quarter of a plot frame.
 """
 
 from __future__ import annotations
@@ -51,6 +57,7 @@ __all__ = [
     "PLOT_INTERVAL_MS",
     "MonitorPlots",
     "add_legend",
+    "cache_legend",
     "fit_range",
     "style_plot",
     "unwrap_degrees",
@@ -84,6 +91,7 @@ RANGE_PADDING = 0.1
 RANGE_MIN_SPAN = 2.0  # mm on the position plot, degrees on the orientation plot
 RANGE_MIN_USE = 1.0 / 3.0
 MARKER_SIZE = 11  # px, the top view's "now" marker
+_CACHED = QGraphicsItem.CacheMode.DeviceCoordinateCache  # the axes' and legends' cache
 
 # History channels: time, then X Y Z and the unwrapped A B C.
 T, X = 0, 1
@@ -148,6 +156,17 @@ def add_legend(plot: pg.PlotWidget) -> None:
     )
 
 
+def cache_legend(plot: pg.PlotWidget) -> None:
+    """Cache the legend and each of its parts (samples, labels, their text items) as pixmaps, once
+    its rows are in: a cached item does not cache its children, and the legend sits on the
+    curves, so without that each label's text was laid out and drawn again in every frame."""
+    pending: list[QGraphicsItem] = [plot.getPlotItem().legend]
+    while pending:
+        item = pending.pop()
+        item.setCacheMode(_CACHED)
+        pending.extend(item.childItems())
+
+
 def style_plot(plot: pg.PlotWidget) -> None:
     import pyqtgraph as pg
 
@@ -167,6 +186,9 @@ def style_plot(plot: pg.PlotWidget) -> None:
         font = QFont()
         font.setPointSizeF(AXIS_TICK_POINTS)
         axis.setStyle(tickFont=font)
+        # a pixmap, drawn again only when its ticks change (AxisItem.update): the curves below
+        # it repaint in every frame, and with them the part of the grid they cover
+        axis.setCacheMode(_CACHED)
     for name in ("top", "right"):  # hidden, but linked to the view: no label update per new range
         item.getAxis(name).enableAutoSIPrefix(False)
     item.getAxis("left").setWidth(LEFT_AXIS_WIDTH)
@@ -203,6 +225,8 @@ class MonitorPlots:
             curve = BoundedCurve(pen=pg.mkPen(_PLOT_COLORS[name], width=CURVE_WIDTH), name=name)
             plot.addItem(curve)
             self.curves[name] = curve
+        for plot in (self.xyz_plot, self.abc_plot):
+            cache_legend(plot)
 
         self.trace_plot.setAspectLocked(True)
         # room on the right for the last bottom tick label (else clipped at the plot's edge)
@@ -221,6 +245,8 @@ class MonitorPlots:
         self.trace_marker.setVisible(False)
         self.trace_plot.getPlotItem().getViewBox().addItem(self.trace_marker, ignoreBounds=True)
         self._trace_range: tuple[float, float, float] | None = None  # centre x, y and half span set last
+        self._marker_at: tuple[float, float] | None = None  # the marker's position drawn last
+        self._trace_pixel = (0.0, 0.0)  # the top view's pixel in mm (x, y), at its last draw
         self._window_s: float | None = None  # the time axis' span set last
         self._y_ranges: dict[str, tuple[float, float]] = {}  # "xyz" / "abc" -> range set last
 
@@ -280,11 +306,22 @@ class MonitorPlots:
             self._window_s = window_s
             self.xyz_plot.setXRange(-window_s, 0.0, padding=0)  # the ABC plot is linked to it
 
+    def trace_moved(self, trace: RingBuffer) -> bool:
+        """Whether the trace's newest point is a pixel or more (in x or y) from where the marker
+        was drawn last, or the trace is new or empty: else redrawing the top view would show
+        nothing new (what the trace gained since is shorter than a pixel)."""
+        marker = self._marker_at
+        if marker is None or not len(trace):
+            return True
+        px, py = self._trace_pixel
+        return abs(trace.latest(0) - marker[0]) >= px or abs(trace.latest(1) - marker[1]) >= py
+
     def paint_trace(self, trace: RingBuffer) -> None:
         n = min(len(trace), trace.capacity - PAINT_MARGIN)
         if n <= 0:
             self.trace_curve.setData([], [])
             self.trace_marker.setVisible(False)
+            self._marker_at = None
             return
         xs, ys = trace.view(0, n), trace.view(1, n)
         x0, x1, y0, y1 = float(xs.min()), float(xs.max()), float(ys.min()), float(ys.max())
@@ -293,9 +330,12 @@ class MonitorPlots:
         # for the pen that stays inside the view
         margin = max(x1 - x0, y1 - y0, TRACE_MIN_SPAN_MM) * TRACE_PADDING / 2.0
         self.trace_curve.set_bounds(x0 - margin, x1 + margin, y0 - margin, y1 + margin)
-        self.trace_marker.setPos(float(xs[-1]), float(ys[-1]))
+        marker = (float(xs[-1]), float(ys[-1]))
+        self.trace_marker.setPos(*marker)
         self.trace_marker.setVisible(True)
         self._fit_trace(x0, x1, y0, y1)
+        self._marker_at = marker
+        self._measure_trace_pixel()  # each time: a resized view has other pixels
 
     def _fit_trace(self, x0: float, x1: float, y0: float, y1: float) -> None:
         """Show the whole trace, at least TRACE_MIN_SPAN_MM wide and tall, centred; the view is
@@ -309,9 +349,17 @@ class MonitorPlots:
         view = self.trace_plot.getPlotItem().getViewBox()
         view.setRange(xRange=(cx - half, cx + half), yRange=(cy - half, cy + half), padding=TRACE_PADDING)
 
+    def _measure_trace_pixel(self) -> None:
+        """The top view's pixel in mm now, for :meth:`trace_moved`."""
+        (x0, x1), (y0, y1) = self.trace_plot.getPlotItem().getViewBox().viewRange()
+        rect = self.trace_plot.getPlotItem().getViewBox().boundingRect()
+        width, height = max(1.0, rect.width()), max(1.0, rect.height())
+        self._trace_pixel = ((x1 - x0) / width, (y1 - y0) / height)
+
     def forget_ranges(self) -> None:
         """Set the view ranges again at the next paint (after the plots were cleared or resized)."""
         self._trace_range = None
+        self._marker_at = None
         self._window_s = None
         self._y_ranges.clear()
 

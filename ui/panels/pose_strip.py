@@ -129,8 +129,11 @@ class PoseStrip(QFrame):
             value.setObjectName(f"PoseStripValue{name}")
             value.setFont(monospace_font(VALUE_POINTS, bold=True))
             value.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
-            # a fixed size: a new value repaints the label only, never re-lays out the window
+            # a fixed size: a new value repaints the label only, never re-lays out the window;
+            # opaque (it fills its own background, the strip's colour while live): the strip
+            # under it is not repainted with it at every new value
             value.setFixedSize(fit_width(value, [VALUE_SAMPLE], padding=4), value.sizeHint().height())
+            value.setAutoFillBackground(True)
             unit = QLabel(self)
             unit.setStyleSheet(f"color: {COLOR_NEUTRAL};")
             unit.setFixedWidth(fit_width(unit, [*both_languages("PoseStrip", "mm"), "°"], padding=2))
@@ -270,8 +273,10 @@ class PoseStrip(QFrame):
             self._shown_style = live
             color = COLOR_INK if live else COLOR_STALE
             style = "normal" if live else "italic"
-            background = "transparent" if live else COLOR_STALE_BG
-            sheet = f"QLabel {{ color: {color}; font-style: {style}; background: {background}; }}"
+            # live: no background of its own, so the label fills with the strip's (an opaque
+            # label); a transparent one repainted the strip under it at every new value
+            background = "" if live else f" background: {COLOR_STALE_BG};"
+            sheet = f"QLabel {{ color: {color}; font-style: {style};{background} }}"
             for label in self.values.values():
                 label.setStyleSheet(sheet)
                 label.setProperty("stale", not live)
