@@ -1,0 +1,166 @@
+"""Ctrl-C in teachpad-cli: the stop after it (in-process, deterministic) and the Ctrl-C children.
+
+The children that get a real SIGINT (``interrupt_cli``, tests/cli/ctrl_c.py) run without
+coverage's tracer: a SIGINT handled inside the tracer's ``lock_data`` leaves coverage's lock held
+and the child hangs for ever (the CI timeout of ``test_ctrl_c_is_interrupted``). The code the
+children ran after Ctrl-C is measured here instead: ``wait_motion`` gets its KeyboardInterrupt
+from the motion it runs, against the real simulator over a real socket.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import signal
+import threading
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from app.cli.context import CliContext, sigint_deferred, wait_motion
+from app.cli.exit_codes import ExitCode
+from app.link.client import ConnectionSettings, StepFrame, TrafficRecord
+from app.models import CommandResult
+from app.protocol import registers
+from tests.cli.ctrl_c import COVERAGE_STARTUP_VARS, ROOT, interrupt_cli, untraced_env
+
+
+def _ctx(sim: Any, *, timeout: float = 1.0, monitor_only: bool = False) -> CliContext:
+    settings = ConnectionSettings(port=sim.port, timeout=timeout, monitor_only=monitor_only)
+    return CliContext(argparse.Namespace(), settings, out=io.StringIO(), err=io.StringIO())
+
+
+def _interrupted_step(ctx: CliContext, sim: Any) -> CommandResult:
+    """A slow joint step that is under way on the simulator, then Ctrl-C (as the poll loop gets it)."""
+    ctx.client.step(StepFrame.JOINT, [90.0, 0, 0, 0, 0, 0], speed=1.0, wait=False)
+    assert sim.wait_for(lambda s: s.moving, 5.0)
+    raise KeyboardInterrupt
+
+
+# --- the children that get SIGINT run untraced ---------------------------------------------------
+
+
+def test_a_ctrl_c_child_runs_without_coverage_tracing(
+    sim_factory: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """What would start coverage in a child (as ``make test`` sets it) does not reach it."""
+    monkeypatch.setenv("COVERAGE_PROCESS_START", str(ROOT / "pyproject.toml"))
+    monkeypatch.setenv("COVERAGE_FILE", str(tmp_path / ".coverage"))
+    assert not set(COVERAGE_STARTUP_VARS) & set(untraced_env())
+    sim = sim_factory(command_latency=0.02)
+    code, err = interrupt_cli(sim, ["step", "--frame", "joint", "J1=90", "--speed", "1"], lambda s: s.moving)
+    assert code == ExitCode.INTERRUPTED, err
+    assert list(tmp_path.iterdir()) == []  # a traced child writes its .coverage.* file at exit
+
+
+# --- wait_motion: the stop after Ctrl-C ----------------------------------------------------------
+
+
+def test_ctrl_c_in_a_motion_stops_it_on_a_fresh_link(sim_factory: Any) -> None:
+    sim = sim_factory(command_latency=0.02)
+    ctx = _ctx(sim)
+    seen: list[tuple[int, object]] = []  # (stop writes sent so far, the Ctrl-C handler) per request
+
+    def observe(record: TrafficRecord) -> None:
+        if record.direction == "tx":
+            seen.append((len(sim.writes_to(registers.REG_STOP)), signal.getsignal(signal.SIGINT)))
+
+    before = signal.getsignal(signal.SIGINT)
+    try:
+        ctx.client.add_observer(observe)
+        with pytest.raises(KeyboardInterrupt):
+            wait_motion(ctx, lambda: _interrupted_step(ctx, sim))
+        assert ctx.err.getvalue() == "teachpad-cli: warning: interrupted: stop sent\n"  # type: ignore[attr-defined]
+        assert sim.writes_to(registers.REG_STOP)[-1].values == (1,)
+        assert sim.wait_for(lambda s: not s.moving, 2.0)
+        # the half-done link was closed: the stop went out on a new connection, with Ctrl-C ignored
+        assert ctx.client.stats.reconnects == 1
+        assert seen[-1] == (0, signal.SIG_IGN)
+        assert signal.getsignal(signal.SIGINT) is before  # and Ctrl-C is back afterwards
+        tracker = ctx.client.last_tracker
+        assert tracker is not None and tracker.finished
+    finally:
+        ctx.close()
+
+
+def test_ctrl_c_with_a_silent_controller_says_the_stop_failed_within_the_timeout(sim_factory: Any) -> None:
+    sim = sim_factory(command_latency=0.02)
+    ctx = _ctx(sim, timeout=0.3)
+
+    def interrupted() -> CommandResult:
+        ctx.client.step(StepFrame.JOINT, [90.0, 0, 0, 0, 0, 0], speed=1.0, wait=False)
+        assert sim.wait_for(lambda s: s.moving, 5.0)
+        sim.set_silent(True)
+        raise KeyboardInterrupt
+
+    try:
+        started = time.monotonic()
+        with pytest.raises(KeyboardInterrupt):
+            wait_motion(ctx, interrupted)
+        took = time.monotonic() - started
+        warning = ctx.err.getvalue()  # type: ignore[attr-defined]
+        assert warning.startswith("teachpad-cli: warning: interrupted, and stop failed: ")
+        assert "did not answer within 0.3 s" in warning and warning.count("\n") == 1
+        assert took < 5.0, took  # one request's timeout (retries 0), not a wait on the motion
+    finally:
+        sim.set_silent(False)
+        ctx.close()
+
+
+def test_ctrl_c_before_a_command_went_out_sends_nothing(sim: Any) -> None:
+    ctx = _ctx(sim)
+
+    def interrupted() -> None:
+        ctx.client.read_status()
+        raise KeyboardInterrupt
+
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            wait_motion(ctx, interrupted)
+        assert ctx.err.getvalue() == ""  # type: ignore[attr-defined]
+        assert sim.writes == []
+    finally:
+        ctx.close()
+
+
+def test_ctrl_c_in_monitor_only_mode_sends_nothing(sim_factory: Any) -> None:
+    sim = sim_factory(command_latency=0.02)
+    ctx = _ctx(sim, monitor_only=True)
+
+    def interrupted() -> None:
+        ctx.client.read_pose()
+        raise KeyboardInterrupt
+
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            wait_motion(ctx, interrupted)
+        assert sim.writes == [] and ctx.err.getvalue() == ""  # type: ignore[attr-defined]
+    finally:
+        ctx.close()
+
+
+# --- sigint_deferred -----------------------------------------------------------------------------
+
+
+def test_sigint_deferred_ignores_ctrl_c_inside_and_restores_the_handler_after_an_error() -> None:
+    before = signal.getsignal(signal.SIGINT)
+    with pytest.raises(RuntimeError), sigint_deferred():
+        assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+        raise RuntimeError("cleanup failed")
+    assert signal.getsignal(signal.SIGINT) is before
+
+
+def test_sigint_deferred_off_the_main_thread_changes_nothing() -> None:
+    handlers: list[object] = []
+
+    def body() -> None:
+        with sigint_deferred():
+            handlers.append(signal.getsignal(signal.SIGINT))
+
+    before = signal.getsignal(signal.SIGINT)
+    thread = threading.Thread(target=body)
+    thread.start()
+    thread.join(5.0)
+    assert handlers == [before]
