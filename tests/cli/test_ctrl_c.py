@@ -19,9 +19,11 @@ from typing import Any
 
 import pytest
 
+from app.cli import run_plan
 from app.cli.context import CliContext, sigint_deferred, wait_motion
 from app.cli.exit_codes import ExitCode
-from app.link.client import ConnectionSettings, StepFrame, TrafficRecord
+from app.cli.main import build_parser
+from app.link.client import ConnectionSettings, RobotClient, StepFrame, TrafficRecord
 from app.models import CommandResult
 from app.protocol import registers
 from tests.cli.ctrl_c import COVERAGE_STARTUP_VARS, ROOT, interrupt_cli, untraced_env
@@ -164,3 +166,43 @@ def test_sigint_deferred_off_the_main_thread_changes_nothing() -> None:
     thread.start()
     thread.join(5.0)
     assert handlers == [before]
+
+
+# --- run: the runner's halt -----------------------------------------------------------------------
+
+
+def test_ctrl_c_in_a_run_stops_on_a_fresh_link_and_says_nothing_failed(
+    sim_factory: Any, tmp_path: Path
+) -> None:
+    """Ctrl-C while a status read of the move is on the wire (its answer comes 0.2 s later): on
+    the old link that late answer was read as the stop's ("the stop command failed too:
+    malformed answer ... an answer to another request") although the stop went out."""
+    sim = sim_factory(command_latency=0.02)
+    project = tmp_path / "demo.teachpad.json"
+    project.write_bytes((ROOT / "resources" / "samples" / "demo.teachpad.json").read_bytes())
+    args = build_parser().parse_args(
+        ["--port", str(sim.port), "run", str(project), "--plan", "pick and place"]
+    )
+    client = RobotClient(ConnectionSettings(port=sim.port))
+    cut: list[float] = []
+
+    def ctrl_c_on_the_wire(record: TrafficRecord) -> None:
+        if not cut and record.direction == "tx" and record.frame[7] == 0x03 and sim.state().moving:
+            cut.append(time.monotonic())
+            sim.set_response_delay(0.2)  # this read's answer, and every later one, comes late
+            raise KeyboardInterrupt  # the read is sent, its answer not read: cut in half
+
+    client.add_observer(ctrl_c_on_the_wire)
+    ctx = CliContext(args, client.settings, out=io.StringIO(), err=io.StringIO(), make_client=lambda: client)
+    try:
+        code = run_plan.cmd_run(ctx)
+    finally:
+        ctx.close()
+    err = ctx.err.getvalue()  # type: ignore[attr-defined]
+    assert code == ExitCode.INTERRUPTED, err
+    assert cut and err == "teachpad-cli: error: stopped: segment 1/3 (loop 1/2): interrupted (Ctrl-C)\n"
+    assert "to resume: teachpad-cli run" in ctx.out.getvalue()  # type: ignore[attr-defined]
+    stop = sim.writes_to(registers.REG_STOP)[-1]
+    assert stop.values == (1,) and stop.t > cut[0]
+    assert client.stats.reconnects == 1  # the stop's own link
+    assert sim.wait_for(lambda s: not s.moving, 2.0)
