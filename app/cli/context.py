@@ -22,7 +22,7 @@ from app.errors import TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
 from app.safety.audit import AuditLog
 
-__all__ = ["PROG", "CliContext", "Handler", "sigint_deferred", "wait_motion"]
+__all__ = ["PROG", "CliContext", "Handler", "sigint_deferred", "stop_after_ctrl_c", "wait_motion"]
 
 PROG = "teachpad-cli"
 
@@ -83,17 +83,26 @@ def wait_motion(ctx: CliContext, start: Callable[[], T]) -> T:
     try:
         return start()
     except KeyboardInterrupt:
-        client = ctx.client
-        tracker = client.last_tracker
+        tracker = ctx.client.last_tracker
         if tracker is not None and not tracker.finished and not ctx.settings.monitor_only:
-            client.close()  # a request may have been cut in half: stop on a fresh link
-            with sigint_deferred():
-                try:
-                    client.stop()
-                    ctx.warn("interrupted: stop sent")
-                except TeachPadError as exc:
-                    ctx.warn(f"interrupted, and stop failed: {exc}")
+            stop_after_ctrl_c(ctx)
         raise
+
+
+def stop_after_ctrl_c(ctx: CliContext) -> None:
+    """Send stop after Ctrl-C, and say how it went (one warning line).
+
+    The link is closed first: Ctrl-C may have cut a request in half, and its late answer would
+    be read as the stop's. Ctrl-C is ignored meanwhile; the stop is bounded by the link timeout
+    (connect, then one request)."""
+    client = ctx.client
+    client.close()
+    with sigint_deferred():
+        try:
+            client.stop()
+            ctx.warn("interrupted: stop sent")
+        except TeachPadError as exc:
+            ctx.warn(f"interrupted, and stop failed: {exc}")
 
 
 @contextlib.contextmanager

@@ -19,13 +19,14 @@ from typing import Any
 
 import pytest
 
-from app.cli import run_plan
+from app.cli import controller, run_plan
 from app.cli.context import CliContext, sigint_deferred, wait_motion
 from app.cli.exit_codes import ExitCode
 from app.cli.main import build_parser
 from app.link.client import ConnectionSettings, RobotClient, StepFrame, TrafficRecord
 from app.models import CommandResult
 from app.protocol import registers
+from app.protocol.enums import ProgramState
 from tests.cli.ctrl_c import COVERAGE_STARTUP_VARS, ROOT, interrupt_cli, untraced_env
 
 
@@ -206,3 +207,26 @@ def test_ctrl_c_in_a_run_stops_on_a_fresh_link_and_says_nothing_failed(
     assert stop.values == (1,) and stop.t > cut[0]
     assert client.stats.reconnects == 1  # the stop's own link
     assert sim.wait_for(lambda s: not s.moving, 2.0)
+
+
+def test_ctrl_c_while_a_program_starts_stops_it(sim_factory: Any) -> None:
+    sim = sim_factory(command_latency=0.02)
+    args = build_parser().parse_args(["--port", str(sim.port), "program", "run", "2", "--mode", "cycle"])
+    client = RobotClient(ConnectionSettings(port=sim.port))
+
+    def ctrl_c_after_the_run_command(record: TrafficRecord) -> None:
+        if record.direction == "tx" and record.frame[7] == 0x03 and sim.writes_to(registers.REG_RUN_COMMAND):
+            client.remove_observer(ctrl_c_after_the_run_command)
+            raise KeyboardInterrupt  # in the wait for the program to show running
+
+    client.add_observer(ctrl_c_after_the_run_command)
+    ctx = CliContext(args, client.settings, out=io.StringIO(), err=io.StringIO(), make_client=lambda: client)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            controller.cmd_program_run(ctx)
+    finally:
+        ctx.close()
+    assert ctx.err.getvalue() == "teachpad-cli: warning: interrupted: stop sent\n"  # type: ignore[attr-defined]
+    (run,) = sim.writes_to(registers.REG_RUN_COMMAND)
+    assert sim.writes_to(registers.REG_STOP)[-1].t > run.t
+    assert sim.wait_for(lambda s: s.program_state == ProgramState.STOPPED and not s.moving, 2.0)
