@@ -30,7 +30,8 @@ from app.protocol.enums import ProgramState
 from tests.cli.ctrl_c import COVERAGE_STARTUP_VARS, ROOT, interrupt_cli, untraced_env
 
 
-def _ctx(sim: Any, *, timeout: float = 1.0, monitor_only: bool = False) -> CliContext:
+def _ctx(sim: Any, *, timeout: float = 5.0, monitor_only: bool = False) -> CliContext:
+    """A context whose client talks to ``sim`` (a request timeout no loaded machine reaches)."""
     settings = ConnectionSettings(port=sim.port, timeout=timeout, monitor_only=monitor_only)
     return CliContext(argparse.Namespace(), settings, out=io.StringIO(), err=io.StringIO())
 
@@ -73,13 +74,14 @@ def test_ctrl_c_in_a_motion_stops_it_on_a_fresh_link(sim_factory: Any) -> None:
     before = signal.getsignal(signal.SIGINT)
     try:
         ctx.client.add_observer(observe)
+        links = ctx.client.stats.reconnects
         with pytest.raises(KeyboardInterrupt):
             wait_motion(ctx, lambda: _interrupted_step(ctx, sim))
         assert ctx.err.getvalue() == "teachpad-cli: warning: interrupted: stop sent\n"  # type: ignore[attr-defined]
         assert sim.writes_to(registers.REG_STOP)[-1].values == (1,)
         assert sim.wait_for(lambda s: not s.moving, 2.0)
         # the half-done link was closed: the stop went out on a new connection, with Ctrl-C ignored
-        assert ctx.client.stats.reconnects == 1
+        assert ctx.client.stats.reconnects == links + 1
         assert seen[-1] == (0, signal.SIG_IGN)
         assert signal.getsignal(signal.SIGINT) is before  # and Ctrl-C is back afterwards
         tracker = ctx.client.last_tracker
@@ -184,7 +186,7 @@ def test_ctrl_c_in_a_run_stops_on_a_fresh_link_and_says_nothing_failed(
     args = build_parser().parse_args(
         ["--port", str(sim.port), "run", str(project), "--plan", "pick and place"]
     )
-    client = RobotClient(ConnectionSettings(port=sim.port))
+    client = RobotClient(ConnectionSettings(port=sim.port, timeout=5.0))
     cut: list[float] = []
 
     def ctrl_c_on_the_wire(record: TrafficRecord) -> None:
@@ -205,14 +207,14 @@ def test_ctrl_c_in_a_run_stops_on_a_fresh_link_and_says_nothing_failed(
     assert "to resume: teachpad-cli run" in ctx.out.getvalue()  # type: ignore[attr-defined]
     stop = sim.writes_to(registers.REG_STOP)[-1]
     assert stop.values == (1,) and stop.t > cut[0]
-    assert client.stats.reconnects == 1  # the stop's own link
+    assert client.stats.reconnects == 1 and client.stats.timeouts == 0  # the stop's own link
     assert sim.wait_for(lambda s: not s.moving, 2.0)
 
 
 def test_ctrl_c_while_a_program_starts_stops_it(sim_factory: Any) -> None:
     sim = sim_factory(command_latency=0.02)
     args = build_parser().parse_args(["--port", str(sim.port), "program", "run", "2", "--mode", "cycle"])
-    client = RobotClient(ConnectionSettings(port=sim.port))
+    client = RobotClient(ConnectionSettings(port=sim.port, timeout=5.0))
 
     def ctrl_c_after_the_run_command(record: TrafficRecord) -> None:
         if record.direction == "tx" and record.frame[7] == 0x03 and sim.writes_to(registers.REG_RUN_COMMAND):
