@@ -13,16 +13,25 @@ import contextlib
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import TextIO, TypeVar
+from typing import Any, TextIO, TypeVar
 
 from app.cli.exit_codes import ExitCode
 from app.errors import TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
 from app.safety.audit import AuditLog
 
-__all__ = ["PROG", "CliContext", "Handler", "sigint_deferred", "stop_after_ctrl_c", "wait_motion"]
+__all__ = [
+    "PROG",
+    "CliContext",
+    "Handler",
+    "sigint_deferred",
+    "stop_after_ctrl_c",
+    "stop_on_a_fresh_link",
+    "wait_motion",
+]
 
 PROG = "teachpad-cli"
 
@@ -89,20 +98,35 @@ def wait_motion(ctx: CliContext, start: Callable[[], T]) -> T:
         raise
 
 
-def stop_after_ctrl_c(ctx: CliContext) -> None:
-    """Send stop after Ctrl-C, and say how it went (one warning line).
+def stop_after_ctrl_c(ctx: CliContext, *, command_sent: float | None = None) -> None:
+    """Send stop after Ctrl-C (:func:`stop_on_a_fresh_link`), and say how it went (one warning line)."""
+    try:
+        stop_on_a_fresh_link(ctx.client, command_sent=command_sent)
+        ctx.warn("interrupted: stop sent")
+    except TeachPadError as exc:
+        ctx.warn(f"interrupted, and stop failed: {exc}")
+
+
+def stop_on_a_fresh_link(client: Any, *, command_sent: float | None = None) -> None:
+    """Stop the robot after an interruption; raises the stop's :class:`TeachPadError`.
 
     The link is closed first: Ctrl-C may have cut a request in half, and its late answer would
-    be read as the stop's. Ctrl-C is ignored meanwhile; the stop is bounded by the link timeout
-    (connect, then one request)."""
-    client = ctx.client
+    be read as the stop's. But the command may still be on its way on the old link, and a
+    controller may take it after the stop that came on the new one: when its effect was not
+    seen yet (the client's last tracker, or ``command_sent``: ``time.monotonic()`` when a
+    command without a tracker went out), a second stop goes out once that command is older than
+    the link timeout (a controller takes a request within the timeout, or it counts as lost).
+    Ctrl-C is ignored meanwhile; it all takes at most the connect, two requests and the rest of
+    one timeout."""
+    tracker = getattr(client, "last_tracker", None)
+    if command_sent is None and tracker is not None and not tracker.finished and not tracker.acknowledged:
+        command_sent = tracker.started
     client.close()
     with sigint_deferred():
-        try:
+        client.stop()
+        if command_sent is not None:
+            time.sleep(max(0.0, command_sent + client.settings.timeout - time.monotonic()))
             client.stop()
-            ctx.warn("interrupted: stop sent")
-        except TeachPadError as exc:
-            ctx.warn(f"interrupted, and stop failed: {exc}")
 
 
 @contextlib.contextmanager

@@ -223,12 +223,13 @@ def cmd_program_run(ctx: CliContext) -> ExitCode:
     client = ctx.client
     before = client.read_pose()
     writes_before = client.write_count
+    sent = time.monotonic()
     try:
         return _start_program(ctx, client, before)
     except KeyboardInterrupt:
         # Ctrl-C while the program was being started: what it started is a motion under way
         if client.write_count != writes_before:
-            stop_after_ctrl_c(ctx)
+            stop_after_ctrl_c(ctx, command_sent=sent)
         raise
 
 

@@ -22,7 +22,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from app.cli.context import PROG, CliContext, sigint_deferred
+from app.cli.context import PROG, CliContext, stop_on_a_fresh_link
 from app.cli.exit_codes import ExitCode, exit_code_for
 from app.cli.points import (
     _PROJECT_HELP,
@@ -212,10 +212,10 @@ def reach_check(path: Path | str | None) -> ReachCheck:
 
 class _HaltOnFreshLink:
     """The client the plan runner drives. Its ``stop`` (the runner's halt after Ctrl-C, a
-    segment's timeout or an error) goes out on a fresh link with Ctrl-C deferred, as
-    :func:`~app.cli.context.wait_motion`'s: Ctrl-C may cut the request under way in half, and
-    its late answer, on the same link, would be read as the stop's ("malformed answer ...
-    an answer to another request": the stop said to have failed although it went out)."""
+    segment's timeout or an error) is :func:`~app.cli.context.stop_on_a_fresh_link`, as after
+    Ctrl-C in ``step`` / ``move``: Ctrl-C may cut the request under way in half, and its late
+    answer, on the same link, was read as the stop's ("malformed answer ... an answer to another
+    request": the stop said to have failed although it went out)."""
 
     def __init__(self, client: Any) -> None:
         self._client = client
@@ -228,9 +228,7 @@ class _HaltOnFreshLink:
         return result
 
     def stop(self) -> None:
-        self._client.close()
-        with sigint_deferred():
-            self._client.stop()
+        stop_on_a_fresh_link(self._client)
 
 
 def _refusal_code(errors: list[PlanIssue]) -> ExitCode:

@@ -37,9 +37,16 @@ def _ctx(sim: Any, *, timeout: float = 5.0, monitor_only: bool = False) -> CliCo
 
 
 def _interrupted_step(ctx: CliContext, sim: Any) -> CommandResult:
-    """A slow joint step that is under way on the simulator, then Ctrl-C (as the poll loop gets it)."""
-    ctx.client.step(StepFrame.JOINT, [90.0, 0, 0, 0, 0, 0], speed=1.0, wait=False)
-    assert sim.wait_for(lambda s: s.moving, 5.0)
+    """A slow joint step that is under way and seen so by the client, then Ctrl-C (as the poll
+    loop gets it)."""
+    client = ctx.client
+    client.step(StepFrame.JOINT, [90.0, 0, 0, 0, 0, 0], speed=1.0, wait=False)
+    tracker = client.last_tracker
+    assert tracker is not None and sim.wait_for(lambda s: s.moving, 5.0)
+    deadline = time.monotonic() + 5.0
+    while not tracker.acknowledged and time.monotonic() < deadline:
+        assert client.poll(tracker) is None
+    assert tracker.acknowledged  # the step was taken: one stop is enough (see the next test)
     raise KeyboardInterrupt
 
 
@@ -88,6 +95,43 @@ def test_ctrl_c_in_a_motion_stops_it_on_a_fresh_link(sim_factory: Any) -> None:
         assert tracker is not None and tracker.finished
     finally:
         ctx.close()
+
+
+def test_a_motion_command_the_controller_takes_after_the_stop_is_stopped_too(sim_factory: Any) -> None:
+    """Ctrl-C while the step's 440 write is on its way and the controller holds it (0.3 s): the
+    stop on the fresh link is taken first, the step after it. A second stop, once the step is
+    older than the link timeout, stops it."""
+    sim = sim_factory(command_latency=0.02)
+    settings = ConnectionSettings(port=sim.port, timeout=1.0, completion="observe")
+    ctx = CliContext(argparse.Namespace(), settings, out=io.StringIO(), err=io.StringIO())
+    speed_reg = registers.gv_reg(registers.GV_EXPECTED_SPEED)
+
+    def hold_the_command(record: TrafficRecord) -> None:
+        if record.direction != "tx":
+            return
+        address = int.from_bytes(record.frame[8:10], "big")
+        if address == speed_reg:
+            sim.set_response_delay(0.3)  # the next request, the step's 440, waits in the controller
+        elif address == registers.REG_RUN_COMMAND:
+            sent = ctx.client.stats.requests
+            deadline = time.monotonic() + 5.0
+            while sim.requests_count < sent and time.monotonic() < deadline:
+                time.sleep(0.001)  # until the controller holds the 440 (its delay is decided)
+            sim.set_response_delay(0.0)  # the stop will be taken at once
+            raise KeyboardInterrupt  # the 440 sent, its answer not read
+
+    try:
+        ctx.client.add_observer(hold_the_command)
+        with pytest.raises(KeyboardInterrupt):
+            wait_motion(ctx, lambda: ctx.client.step(StepFrame.JOINT, [90.0, 0, 0, 0, 0, 0], speed=1.0))
+    finally:
+        ctx.close()
+    assert ctx.err.getvalue() == "teachpad-cli: warning: interrupted: stop sent\n"  # type: ignore[attr-defined]
+    assert sim.wait_for(lambda _: bool(sim.writes_to(registers.REG_RUN_COMMAND)), 2.0)
+    (command,) = sim.writes_to(registers.REG_RUN_COMMAND)
+    first, second = sim.writes_to(registers.REG_STOP)
+    assert first.t < command.t < second.t  # the controller took the step after the first stop
+    assert sim.wait_for(lambda s: not s.moving, 2.0)
 
 
 def test_ctrl_c_with_a_silent_controller_says_the_stop_failed_within_the_timeout(sim_factory: Any) -> None:
@@ -186,7 +230,7 @@ def test_ctrl_c_in_a_run_stops_on_a_fresh_link_and_says_nothing_failed(
     args = build_parser().parse_args(
         ["--port", str(sim.port), "run", str(project), "--plan", "pick and place"]
     )
-    client = RobotClient(ConnectionSettings(port=sim.port, timeout=5.0))
+    client = RobotClient(ConnectionSettings(port=sim.port, timeout=2.0))  # 2nd stop: after 2 s
     cut: list[float] = []
 
     def ctrl_c_on_the_wire(record: TrafficRecord) -> None:
@@ -214,7 +258,7 @@ def test_ctrl_c_in_a_run_stops_on_a_fresh_link_and_says_nothing_failed(
 def test_ctrl_c_while_a_program_starts_stops_it(sim_factory: Any) -> None:
     sim = sim_factory(command_latency=0.02)
     args = build_parser().parse_args(["--port", str(sim.port), "program", "run", "2", "--mode", "cycle"])
-    client = RobotClient(ConnectionSettings(port=sim.port, timeout=5.0))
+    client = RobotClient(ConnectionSettings(port=sim.port, timeout=2.0))  # 2nd stop: after 2 s
 
     def ctrl_c_after_the_run_command(record: TrafficRecord) -> None:
         if record.direction == "tx" and record.frame[7] == 0x03 and sim.writes_to(registers.REG_RUN_COMMAND):
