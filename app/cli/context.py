@@ -27,6 +27,7 @@ __all__ = [
     "PROG",
     "CliContext",
     "Handler",
+    "ctrl_c_remembered",
     "sigint_deferred",
     "stop_after_ctrl_c",
     "stop_on_a_fresh_link",
@@ -54,6 +55,8 @@ class CliContext:
     @property
     def client(self) -> RobotClient:
         if self._client is None:
+            if _CtrlC.pressed:  # a Ctrl-C Python lost (see ctrl_c_remembered): nothing is sent
+                raise KeyboardInterrupt
             if self.make_client is not None:
                 self._client = self.make_client()
                 return self._client
@@ -127,6 +130,49 @@ def stop_on_a_fresh_link(client: Any, *, command_sent: float | None = None) -> N
         if command_sent is not None:
             time.sleep(max(0.0, command_sent + client.settings.timeout - time.monotonic()))
             client.stop()
+
+
+class _CtrlC:
+    """Whether Ctrl-C came while :func:`ctrl_c_remembered` was in force."""
+
+    pressed = False
+
+
+def _on_ctrl_c(signum: int, frame: object) -> None:
+    _CtrlC.pressed = True
+    raise KeyboardInterrupt
+
+
+def _quiet_lost_ctrl_c(unraisable: Any, default: Callable[[Any], None]) -> None:
+    if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+        default(unraisable)
+
+
+@contextlib.contextmanager
+def ctrl_c_remembered() -> Iterator[None]:
+    """Python's Ctrl-C (KeyboardInterrupt), and a memory of it for the Ctrl-C Python loses.
+
+    A KeyboardInterrupt raised where Python cannot raise (a finaliser, a weakref callback, as
+    during an import: "Exception ignored in ...") is printed and dropped, and the command went
+    on to move the robot. Here the Ctrl-C is remembered: the link is not opened after it
+    (:attr:`CliContext.client` raises KeyboardInterrupt), and the dropped one is not printed.
+    Nothing changes where Ctrl-C is ignored (a background job) or off the main thread."""
+    if (
+        threading.current_thread() is not threading.main_thread()
+        or signal.getsignal(signal.SIGINT) is not signal.default_int_handler
+    ):
+        yield
+        return
+    _CtrlC.pressed = False
+    default_hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: _quiet_lost_ctrl_c(unraisable, default_hook)
+    signal.signal(signal.SIGINT, _on_ctrl_c)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        sys.unraisablehook = default_hook
+        _CtrlC.pressed = False
 
 
 @contextlib.contextmanager

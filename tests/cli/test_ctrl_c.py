@@ -12,6 +12,8 @@ from __future__ import annotations
 import argparse
 import io
 import signal
+import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -27,7 +29,7 @@ from app.link.client import ConnectionSettings, RobotClient, StepFrame, TrafficR
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import ProgramState
-from tests.cli.ctrl_c import COVERAGE_STARTUP_VARS, ROOT, interrupt_cli, untraced_env
+from tests.cli.ctrl_c import CHILD_TIMEOUT, COVERAGE_STARTUP_VARS, ROOT, interrupt_cli, untraced_env
 
 
 def _ctx(sim: Any, *, timeout: float = 5.0, monitor_only: bool = False) -> CliContext:
@@ -276,3 +278,52 @@ def test_ctrl_c_while_a_program_starts_stops_it(sim_factory: Any) -> None:
     (run,) = sim.writes_to(registers.REG_RUN_COMMAND)
     assert sim.writes_to(registers.REG_STOP)[-1].t > run.t
     assert sim.wait_for(lambda s: s.program_state == ProgramState.STOPPED and not s.moving, 2.0)
+
+
+# --- a Ctrl-C Python drops -----------------------------------------------------------------------
+
+_CTRL_C_IN_A_FINALISER = """
+import signal, sys
+signal.signal(signal.SIGINT, signal.default_int_handler)
+from app.cli import main as cli
+
+class CtrlCInAFinaliser:
+    def __del__(self):
+        signal.raise_signal(signal.SIGINT)  # its KeyboardInterrupt: "Exception ignored in ..."
+
+real = cli.settings_from_args
+
+def settings_from_args(args):
+    CtrlCInAFinaliser()  # collected at once, before the link is opened
+    return real(args)
+
+cli.settings_from_args = settings_from_args
+sys.exit(cli.main(sys.argv[1:]))
+"""
+
+
+def test_a_ctrl_c_python_drops_still_ends_the_command_before_anything_is_sent(sim: Any) -> None:
+    """The hunt saw a Ctrl-C at start-up land in an import's weakref callback: Python printed
+    "Exception ignored ... KeyboardInterrupt", dropped it, and the step ran to its end (exit 0)."""
+    proc = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            _CTRL_C_IN_A_FINALISER,
+            "--port",
+            str(sim.port),
+            "step",
+            "--frame",
+            "joint",
+            "J1=5",
+        ],
+        cwd=ROOT,
+        env=untraced_env(),  # a signal in a traced child can hang it (tests/cli/ctrl_c.py)
+        capture_output=True,
+        text=True,
+        timeout=CHILD_TIMEOUT,
+        check=False,
+    )
+    assert (proc.returncode, proc.stdout) == (ExitCode.INTERRUPTED, "")
+    assert proc.stderr == "teachpad-cli: error: interrupted\n"
+    assert sim.writes == [] and not sim.state().moving
