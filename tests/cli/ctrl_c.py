@@ -7,11 +7,12 @@ the tracer in every Python child). Coverage's C tracer calls ``Collector.lock_da
 ``self.data_lock.acquire()``, a plain ``threading.Lock``) on function calls; a SIGINT handled
 right after that ``acquire()`` raises KeyboardInterrupt inside ``lock_data`` with the lock held,
 and the next traced call blocks on it for ever: the child never ends and prints nothing. That was
-``test_ctrl_c_is_interrupted``'s CI timeout (found by sending SIGINT to children under coverage:
-one hung within a few runs with the simulator's answers jittered, every time in
-``coverage/collector.py`` ``lock_data``; never one without coverage). Nothing of the CLI is
-involved, so these children run untraced: the Ctrl-C code paths are measured in-process
-(``tests/cli/test_ctrl_c.py``).
+``test_ctrl_c_is_interrupted``'s CI timeout. Found by force: SIGINT to CLI children right
+after motion, the simulator's answers jittered, two busy loops beside: under coverage 2 of 212
+children hung, both in ``coverage/collector.py`` ``lock_data``; without coverage none of several
+hundred. In a loop of calls into ``app/`` under coverage, 14 % of the KeyboardInterrupts a
+signal handler raised left that lock held. Nothing of the CLI is involved, so these children run
+untraced; what they ran after Ctrl-C is measured in-process (``tests/cli/test_ctrl_c.py``).
 """
 
 from __future__ import annotations
