@@ -13,16 +13,26 @@ import contextlib
 import signal
 import sys
 import threading
+import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import TextIO, TypeVar
+from typing import Any, TextIO, TypeVar
 
 from app.cli.exit_codes import ExitCode
 from app.errors import TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
 from app.safety.audit import AuditLog
 
-__all__ = ["PROG", "CliContext", "Handler", "sigint_deferred", "wait_motion"]
+__all__ = [
+    "PROG",
+    "CliContext",
+    "Handler",
+    "ctrl_c_remembered",
+    "sigint_deferred",
+    "stop_after_ctrl_c",
+    "stop_on_a_fresh_link",
+    "wait_motion",
+]
 
 PROG = "teachpad-cli"
 
@@ -45,6 +55,8 @@ class CliContext:
     @property
     def client(self) -> RobotClient:
         if self._client is None:
+            if _CtrlC.pressed:  # a Ctrl-C Python lost (see ctrl_c_remembered): nothing is sent
+                raise KeyboardInterrupt
             if self.make_client is not None:
                 self._client = self.make_client()
                 return self._client
@@ -83,17 +95,84 @@ def wait_motion(ctx: CliContext, start: Callable[[], T]) -> T:
     try:
         return start()
     except KeyboardInterrupt:
-        client = ctx.client
-        tracker = client.last_tracker
+        tracker = ctx.client.last_tracker
         if tracker is not None and not tracker.finished and not ctx.settings.monitor_only:
-            client.close()  # a request may have been cut in half: stop on a fresh link
-            with sigint_deferred():
-                try:
-                    client.stop()
-                    ctx.warn("interrupted: stop sent")
-                except TeachPadError as exc:
-                    ctx.warn(f"interrupted, and stop failed: {exc}")
+            stop_after_ctrl_c(ctx)
         raise
+
+
+def stop_after_ctrl_c(ctx: CliContext, *, command_sent: float | None = None) -> None:
+    """Send stop after Ctrl-C (:func:`stop_on_a_fresh_link`), and say how it went (one warning line)."""
+    try:
+        stop_on_a_fresh_link(ctx.client, command_sent=command_sent)
+        ctx.warn("interrupted: stop sent")
+    except TeachPadError as exc:
+        ctx.warn(f"interrupted, and stop failed: {exc}")
+
+
+def stop_on_a_fresh_link(client: Any, *, command_sent: float | None = None) -> None:
+    """Stop the robot after an interruption; raises the stop's :class:`TeachPadError`.
+
+    The link is closed first: Ctrl-C may have cut a request in half, and its late answer would
+    be read as the stop's. But the command may still be on its way on the old link, and a
+    controller may take it after the stop that came on the new one: when its effect was not
+    seen yet (the client's last tracker, or ``command_sent``: ``time.monotonic()`` when a
+    command without a tracker went out), a second stop goes out once that command is older than
+    the link timeout (a controller takes a request within the timeout, or it counts as lost).
+    Ctrl-C is ignored meanwhile; it all takes at most the connect, two requests and the rest of
+    one timeout."""
+    tracker = getattr(client, "last_tracker", None)
+    if command_sent is None and tracker is not None and not tracker.finished and not tracker.acknowledged:
+        command_sent = tracker.started
+    client.close()
+    with sigint_deferred():
+        client.stop()
+        if command_sent is not None:
+            time.sleep(max(0.0, command_sent + client.settings.timeout - time.monotonic()))
+            client.stop()
+
+
+class _CtrlC:
+    """Whether Ctrl-C came while :func:`ctrl_c_remembered` was in force."""
+
+    pressed = False
+
+
+def _on_ctrl_c(signum: int, frame: object) -> None:
+    _CtrlC.pressed = True
+    raise KeyboardInterrupt
+
+
+def _quiet_lost_ctrl_c(unraisable: Any, default: Callable[[Any], None]) -> None:
+    if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+        default(unraisable)
+
+
+@contextlib.contextmanager
+def ctrl_c_remembered() -> Iterator[None]:
+    """Python's Ctrl-C (KeyboardInterrupt), and a memory of it for the Ctrl-C Python loses.
+
+    A KeyboardInterrupt raised where Python cannot raise (a finaliser, a weakref callback, as
+    during an import: "Exception ignored in ...") is printed and dropped, and the command went
+    on to move the robot. Here the Ctrl-C is remembered: the link is not opened after it
+    (:attr:`CliContext.client` raises KeyboardInterrupt), and the dropped one is not printed.
+    Nothing changes where Ctrl-C is ignored (a background job) or off the main thread."""
+    if (
+        threading.current_thread() is not threading.main_thread()
+        or signal.getsignal(signal.SIGINT) is not signal.default_int_handler
+    ):
+        yield
+        return
+    _CtrlC.pressed = False
+    default_hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: _quiet_lost_ctrl_c(unraisable, default_hook)
+    signal.signal(signal.SIGINT, _on_ctrl_c)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        sys.unraisablehook = default_hook
+        _CtrlC.pressed = False
 
 
 @contextlib.contextmanager

@@ -13,7 +13,7 @@ import json
 import time
 from typing import Any
 
-from app.cli.context import CliContext, sigint_deferred, wait_motion
+from app.cli.context import CliContext, sigint_deferred, stop_after_ctrl_c, wait_motion
 from app.cli.exit_codes import ExitCode
 from app.cli.format import (
     JOG_SECONDS_MAX,
@@ -220,11 +220,24 @@ _PROGRAM_MODES = {
 
 
 def cmd_program_run(ctx: CliContext) -> ExitCode:
-    args = ctx.args
     client = ctx.client
     before = client.read_pose()
+    writes_before = client.write_count
+    sent = time.monotonic()
+    try:
+        return _start_program(ctx, client, before)
+    except KeyboardInterrupt:
+        # Ctrl-C while the program was being started: what it started is a motion under way
+        if client.write_count != writes_before:
+            stop_after_ctrl_c(ctx, command_sent=sent)
+        raise
+
+
+def _start_program(ctx: CliContext, client: RobotClient, before: Pose) -> ExitCode:
+    """Send the run command, then wait to see the program run (the controller answers a run
+    command only through its state)."""
+    args = ctx.args
     client.run_program(args.id, _PROGRAM_MODES[args.mode], cycles=args.cycles, speed_ratio=args.speed)
-    # The controller answers a run command only through its state: wait to see the program run.
     deadline = time.monotonic() + PROGRAM_START_TIMEOUT
     while True:
         status = client.read_status()

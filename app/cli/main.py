@@ -38,7 +38,7 @@ from pathlib import Path
 from typing import Any
 
 from app.cli import controller, points, run_plan, support
-from app.cli.context import PROG, CliContext, Handler
+from app.cli.context import PROG, CliContext, Handler, ctrl_c_remembered
 from app.cli.exit_codes import EPILOG, ExitCode, exit_code_for
 from app.cli.format import parse_positive_float, parse_word_order
 from app.cli.help import add_examples
@@ -234,7 +234,8 @@ def _quiet_broken_pipe() -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     try:
-        code = _main(argv)
+        with ctrl_c_remembered():  # a Ctrl-C Python drops (in a finaliser) still ends the command
+            code = _main(argv)
         sys.stdout.flush()
     except BrokenPipeError:
         _quiet_broken_pipe()

@@ -22,7 +22,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from app.cli.context import PROG, CliContext
+from app.cli.context import PROG, CliContext, stop_on_a_fresh_link
 from app.cli.exit_codes import ExitCode, exit_code_for
 from app.cli.points import (
     _PROJECT_HELP,
@@ -37,7 +37,7 @@ from app.cli.points import (
 )
 from app.errors import CommandRefused, InvalidInput, TeachPadError
 from app.link.client import RobotClient
-from app.models import Pose
+from app.models import CommandResult, Pose
 from app.plan.checks import IssueCode, IssueKind, PlanIssue, PlanLimits, ReachCheck, check_plan
 from app.plan.estimates import estimate_plan, segment_timeouts
 from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
@@ -210,6 +210,27 @@ def reach_check(path: Path | str | None) -> ReachCheck:
     return ReachChecker(ArmModel(profile)).plan_issues
 
 
+class _HaltOnFreshLink:
+    """The client the plan runner drives. Its ``stop`` (the runner's halt after Ctrl-C, a
+    segment's timeout or an error) is :func:`~app.cli.context.stop_on_a_fresh_link`, as after
+    Ctrl-C in ``step`` / ``move``: Ctrl-C may cut the request under way in half, and its late
+    answer, on the same link, was read as the stop's ("malformed answer ... an answer to another
+    request": the stop said to have failed although it went out)."""
+
+    def __init__(self, client: Any) -> None:
+        self._client = client
+
+    def __getattr__(self, name: str) -> Any:  # what the point guard uses: uploads, reads
+        return getattr(self._client, name)
+
+    def move_to_point(self, *args: Any, **kwargs: Any) -> CommandResult:
+        result: CommandResult = self._client.move_to_point(*args, **kwargs)
+        return result
+
+    def stop(self) -> None:
+        stop_on_a_fresh_link(self._client)
+
+
 def _refusal_code(errors: list[PlanIssue]) -> ExitCode:
     """Only reach errors: the robot cannot do a valid plan (FAILED); any other: USAGE."""
     return ExitCode.FAILED if all(i.code in REACH_CODES for i in errors) else ExitCode.USAGE
@@ -283,7 +304,7 @@ def _run(
         progress=progress,
     )
     try:
-        outcome = runner.run(client, guard)
+        outcome = runner.run(_HaltOnFreshLink(client), guard)
     finally:
         line.done()
     if outcome.state is RunState.FINISHED:

@@ -4,13 +4,10 @@ from __future__ import annotations
 
 import json
 import os
-import signal
 import socket
 import subprocess
 import sys
 import time
-from collections.abc import Callable
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -19,12 +16,9 @@ from pymodbus.constants import ExcCodes
 from app.cli.exit_codes import ExitCode
 from app.cli.main import main
 from app.protocol.enums import Alarm, WorkMode
+from tests.cli.ctrl_c import CHILD_TIMEOUT, ROOT, interrupt_cli
 
-ROOT = Path(__file__).resolve().parents[2]
 SCAN = 0.02  # see tests/client/test_client_sim.py
-# s for a teachpad-cli child to get going, or to wind down after Ctrl-C: generous, a loaded
-# machine (load 12 on 2 cores) took more than 10 s
-CHILD_TIMEOUT = 30.0
 
 
 def run(sim: Any, capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
@@ -112,42 +106,6 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
     assert "teach enable: success" in out and out.strip().splitlines()[-1].startswith("pose ")
     state = csim.state()
     assert not state.teach_enabled and state.teach_ratio == 0 and not state.jogging
-
-
-_WITH_CTRL_C = (
-    "import runpy, signal; signal.signal(signal.SIGINT, signal.default_int_handler); "
-    "runpy.run_module('app.cli.main', run_name='__main__')"
-)
-
-
-def interrupt_cli(csim: Any, args: list[str], started: Callable[[Any], bool]) -> tuple[int, str]:
-    """Run teachpad-cli in a subprocess, press Ctrl-C once ``started(state)``; (exit code, stderr).
-
-    The child gets Python's own Ctrl-C handler back: a test runner started in the background
-    (``pytest ... &`` from a script) has SIGINT ignored, its children inherit that, and Python
-    then leaves Ctrl-C ignored -- the CLI would never see it (right for a background job)."""
-    proc = subprocess.Popen(
-        # -X faulthandler: a child that does not end after Ctrl-C dumps where it is (SIGABRT below)
-        [sys.executable, "-X", "faulthandler", "-c", _WITH_CTRL_C, "--port", str(csim.port), *args],
-        cwd=ROOT,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    try:
-        assert csim.wait_for(started, CHILD_TIMEOUT)
-        proc.send_signal(signal.SIGINT)
-        try:
-            _, err = proc.communicate(timeout=CHILD_TIMEOUT)
-        except subprocess.TimeoutExpired:
-            proc.send_signal(signal.SIGABRT)  # every thread's stack to stderr, then it ends
-            _, err = proc.communicate(timeout=CHILD_TIMEOUT)
-            pytest.fail(f"teachpad-cli did not end {CHILD_TIMEOUT:g} s after Ctrl-C; where it was:\n{err}")
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.communicate(timeout=CHILD_TIMEOUT)
-    return proc.returncode, err
 
 
 def test_jog_interrupted_still_stops_and_disables(csim: Any) -> None:

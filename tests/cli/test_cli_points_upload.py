@@ -14,7 +14,8 @@ from app.link.upload import UPLOAD_POSE_GV, stage_gv_for
 from app.points.guard import CANARY_GV
 from app.points.project import load_project
 from app.protocol import registers
-from tests.cli.test_cli import SCAN, interrupt_cli, run
+from tests.cli.ctrl_c import interrupt_cli
+from tests.cli.test_cli import SCAN, run
 
 N = 60  # points: enough for the per-point bound to tell the staged upload from the point-by-point one
 TOOLS = (200, 3)  # the first half without a tool, the second with tool 3: two batches, GV245 once each

@@ -23,7 +23,8 @@ from app.cli.exit_codes import EPILOG, LINK_ERRORS, ExitCode, exit_code_for
 from app.cli.help import walk
 from app.cli.main import REGISTRARS, build_parser, main
 from app.protocol.enums import Alarm
-from tests.cli.test_cli import interrupt_cli, one_line_error
+from tests.cli.ctrl_c import interrupt_cli
+from tests.cli.test_cli import one_line_error
 from tests.hostile.server import HostileServer, with_pdu
 
 ROOT = Path(__file__).resolve().parents[2]
