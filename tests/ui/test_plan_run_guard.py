@@ -260,6 +260,8 @@ def test_a_controller_that_stops_answering_ends_the_run_as_not_answering(
     segment, said as *not answering* (not as a lost link), and nothing further is sent."""
     slow = Plan("slow", [Segment.line(1, 5.0), Segment.line(2, SPEED)])  # 30 mm at 5 mm/s: 6 s
     since = len(sim.writes)
+    # "connected" comes before the first poll's pose (the first poll was slow once under load)
+    bench.qtbot.waitUntil(lambda: link.state.pose is not None, timeout=SIGNAL_TIMEOUT_MS)
     start = link.state.pose
     assert start is not None
     bench.runs.run(slow)
