@@ -45,6 +45,30 @@ class ControllerStatus:
     clock: ControllerClock | None = None
 
 
+#: The reason codes of a failure that leaves the link's state unknown: the link is gone or could
+#: not be made (:class:`~app.errors.LinkError` and its codes), a request got no answer in time
+#: (:class:`~app.errors.ResponseTimeout`), or an answer did not match its request
+#: (:class:`~app.errors.MalformedResponse`: the byte stream may be out of step -- the next answer
+#: read may be this one's tail or a late answer to an earlier request -- so only a fresh connection
+#: can be trusted). Every other code is the controller's answer (a Modbus exception, a refused or
+#: failed command, a command timeout whose status reads were answered, a stop, an alarm) or the
+#: host's own refusal before the wire: the link is fine.
+LINK_FAILURE_CODES = frozenset(
+    {
+        "link_lost",
+        "link_closed",
+        "not_connected",
+        "connect_failed",
+        "connect_timeout",
+        "connection_refused",
+        "host_unresolved",
+        "serial_open_failed",
+        "no_answer",
+        "malformed_answer",
+    }
+)
+
+
 @dataclass(frozen=True)
 class CommandResult:
     """How a command sent by the host ended."""
@@ -63,6 +87,19 @@ class CommandResult:
     # why it ended, as a code and arguments beside the English ``message`` (see app/errors.py;
     # ui/messages.py renders it). None: an older producer; the GUI falls back to ``message``.
     reason: Reason | None = None
+
+    @property
+    def link_failed(self) -> bool:
+        """The link failed during it (its outcome is unknown, the connection is not to be trusted):
+        a reason in :data:`LINK_FAILURE_CODES`. False for a success and for any refusal, the
+        controller's own answer (a Modbus exception included). A failure without a reason (an
+        older producer) counts as a link failure only when it carries no controller status.
+        """
+        if self.ok:
+            return False
+        if self.reason is None:
+            return self.status is None
+        return self.reason.code in LINK_FAILURE_CODES
 
     @property
     def stopped_by_operator(self) -> bool:

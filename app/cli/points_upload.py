@@ -103,7 +103,7 @@ def _record(report: UploadReport, batch: Sequence[TempPoint], results: Sequence[
         reason = (result.message or "").removeprefix(f"point {point.id}: ")
         if result.ok:
             report.outcomes.append(UploadOutcome(point.id, True, sent=point, unconfirmed=result.unconfirmed))
-        elif result.status is None and (result.reason is None or result.reason.code != "modbus_exception"):
+        elif result.link_failed:  # the one rule (CommandResult.link_failed), as the GUI's upload
             return reason or "the link failed"
         else:
             report.outcomes.append(UploadOutcome(point.id, False, reason or "failed"))

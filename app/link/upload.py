@@ -65,6 +65,8 @@ class UploadRun:
     progress_at: float = 0.0  # when uploadProgress was last emitted
     progress_done: int = -1  # the ``done`` it carried
     halts_at_start: int = 0  # the host's count of stops and cancels requested when it began
+    refused: int = 0  # points the controller refused (a Modbus exception): reported failed, link kept
+    first_refusal: str = ""  # the first refused point's words, for the final result
 
 
 def stage_gv_for(canary_gv: int | None) -> int:
@@ -222,8 +224,14 @@ class Uploader:
                 host.publish_point_uploaded(point_id, True, "", result.unconfirmed)
             else:
                 host.publish_point_uploaded(point_id, False, result.message or "failed")
-                if result.status is None:  # the link failed during this point: its outcome is unknown
+                if result.link_failed:  # its outcome is unknown, the link not to be trusted
                     transport_error = result.message
+                elif not result.stopped_by_operator:
+                    # the controller said no (a failed status, or a Modbus exception, which ended the
+                    # batch there): the link is fine, the next chunk goes on with the next point in a
+                    # fresh call (its pose written anew, whatever was staged before the refusal)
+                    upload.refused += 1
+                    upload.first_refusal = upload.first_refusal or result.message
         if transport_error is not None:
             upload.end = upload.end or transport_error
             if host.link_up:  # a link already lost or closed (an urgent job meanwhile) counts no more
@@ -259,7 +267,17 @@ class Uploader:
             return
         total = len(upload.items)
         self._note_progress(upload, force=True)
-        text = f"uploaded {upload.good} of {total} points" + (f" ({upload.end})" if upload.end else "")
-        details = {"uploaded": float(upload.good), "attempted": float(upload.index), "total": float(total)}
+        text = f"uploaded {upload.good} of {total} points"
+        if upload.refused:
+            text += f", {upload.refused} refused"
+            if upload.end is None:  # "... (end)" stays last: the GUI reads why it ended from there
+                text += f": {upload.first_refusal}"
+        text += f" ({upload.end})" if upload.end else ""
+        details = {
+            "uploaded": float(upload.good),
+            "attempted": float(upload.index),
+            "refused": float(upload.refused),
+            "total": float(total),
+        }
         result = CommandResult(RunCommand.CREATE_POINT, None, None, upload.good == total, text, details)
         self._host.emit_result(result, upload.request_id)

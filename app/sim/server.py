@@ -42,6 +42,7 @@ from app.sim.config import SimConfig, SimEvent, SimSnapshot, WriteRecord
 from app.sim.execute import CommandExecutor
 from app.sim.guard import CURRENT_CONNECTION, BadFrames, CommWatchdog
 from app.sim.motion import Pose6, TraceSample
+from app.sim.refusals import PointWriteRefusals
 from app.sim.register_image import RegisterImage
 from app.sim.robot import SimRobot
 from app.sim.status import StatusPublisher
@@ -80,6 +81,7 @@ class SimController:
         self._silent = False
         self._exception: ExcCodes | None = None
         self._exception_range: range | None = None
+        self.point_write_refusals = PointWriteRefusals()
         # GV291 publication hold (app/sim/status.py), the register image, the command execution
         self.status = StatusPublisher(self.config.timing, self.config.command_latency, self.config.seed)
         self.image = RegisterImage(self.config)
@@ -256,6 +258,12 @@ class SimController:
         hit = exc_range is None or (address < exc_range.stop and exc_range.start < address + count)
         if exc is not None and hit:
             return exc
+        if set_values is not None:
+            values = [int(v) & 0xFFFF for v in set_values]
+            refused = self.point_write_refusals.check(address, values, self.config.word_order)
+            if refused is not None:
+                log.info("write fc=0x%02X address=%d refused with exception %d", function_code, address, refused)
+                return refused
         offset = address - start_address
         with self.lock:
             if self._wipe_general:  # a restarted controller starts with cleared general-purpose GVs
@@ -407,6 +415,14 @@ class SimController:
             else:
                 self.robot.refused_points.discard(int(point_id))
         log.info("create point %d: %s", point_id, "refused from now on" if refuse else "accepted again")
+
+    def refuse_point_write(
+        self, point_id: int, code: ExcCodes | int = ExcCodes.ILLEGAL_VALUE, times: int = 1
+    ) -> None:
+        """Answer the next ``times`` writes of GV200 naming ``point_id`` (a create point's
+        parameters) with Modbus exception ``code``; nothing of them is stored (0: accept again)."""
+        self.point_write_refusals.set(point_id, ExcCodes(code), times)
+        log.info("create point %d: its GV200 write refused %d time(s) with exception %d", point_id, times, code)
 
     def set_response_delay(self, seconds: float) -> None:
         self._response_delay = max(0.0, float(seconds))

@@ -3,15 +3,26 @@
 from __future__ import annotations
 
 import itertools
+import re
 import threading
 import time
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import pytest
 
+import app
 from app import timing
-from app.errors import InvalidInput
+from app.errors import (
+    InvalidInput,
+    LinkError,
+    MalformedResponse,
+    ModbusExceptionError,
+    Reason,
+    ResponseTimeout,
+    TeachPadError,
+)
 from app.link.jobs import Job, JobKind, JobQueue
 from app.link.upload import (
     UPLOAD_STAGE_GV,
@@ -21,6 +32,9 @@ from app.link.upload import (
     group_by_tool,
     stage_gv_for,
 )
+from app.link.types import LinkState
+from app.models import LINK_FAILURE_CODES, CommandResult
+from app.protocol.enums import CommandKind, CommandStatus, RunCommand
 from tests.link.harness import PartsHost
 
 POSE = (100.0, 0.0, 300.0, 180.0, 0.0, 0.0)
@@ -231,3 +245,138 @@ def test_the_queue_counts_the_jobs_that_end_an_upload() -> None:
     assert jobs.halts == 2
     jobs.clear()
     assert jobs.halts == 2  # a count of requests, never lowered: an upload compares it with its start
+
+
+# --- "the link failed" vs "the controller refused": one rule (CommandResult.link_failed) ------------
+
+#: Every reason code a failed command result may carry, and whether it means the link failed.
+_LINK_FAILED_BY_CODE = {
+    # the link is gone or could not be made (LinkError and the codes it is raised with)
+    "link_lost": True,
+    "link_closed": True,
+    "not_connected": True,
+    "connect_failed": True,
+    "connect_timeout": True,
+    "connection_refused": True,
+    "host_unresolved": True,
+    "serial_open_failed": True,
+    "no_answer": True,  # ResponseTimeout: no answer in time
+    "malformed_answer": True,  # the byte stream may be out of step: only a new connection is trusted
+    # the controller answered (or the host refused before the wire): the link is fine
+    "modbus_exception": False,
+    "command_refused": False,
+    "refused_unconfirmed": False,
+    "command_timeout": False,
+    "not_acknowledged": False,
+    "result_unknown": False,
+    "alarm_while_waiting": False,
+    "stopped_by_operator": False,
+    "stopped_by_controller": False,
+    "monitor_only": False,
+    "invalid_input": False,
+    "envelope_refused": False,
+    "point_mismatch": False,
+    "point_not_created": False,
+    "file_format": False,
+    "empty_import": False,
+    "jog_not_answering": False,  # the jog's own check before it starts: nothing was sent
+    "error": False,
+}
+
+
+def _error_classes(base: type[TeachPadError] = TeachPadError) -> list[type[TeachPadError]]:
+    found = [base]
+    for sub in base.__subclasses__():
+        found += _error_classes(sub)
+    return found
+
+
+def test_the_link_failed_rule_over_every_error_code() -> None:
+    """Every code of every typed error (app/errors.py, the LinkError variants raised in app/) is
+    classified: True only where the link's state is unknown; a result with a controller status
+    (the tracker's) never; a success never; no reason (an older producer): only without a status."""
+    class_codes = {cls.code for cls in _error_classes() if cls.__module__.startswith("app.")}
+    assert class_codes <= set(_LINK_FAILED_BY_CODE), class_codes - set(_LINK_FAILED_BY_CODE)
+    link_raises = set()
+    for path in Path(app.__file__).parent.rglob("*.py"):
+        text = path.read_text(encoding="utf-8")
+        for match in re.finditer(r"\b(LinkError|ResponseTimeout|MalformedResponse)\(", text):
+            call = re.split(r"\braise\b|\bdef\b|\n\s*\n", text[match.end() : match.end() + 300])[0]
+            code = re.search(r'code="(\w+)"', call)
+            if code is not None:
+                link_raises.add(code.group(1))
+    assert link_raises <= LINK_FAILURE_CODES, link_raises - LINK_FAILURE_CODES
+    assert LINK_FAILURE_CODES == {code for code, failed in _LINK_FAILED_BY_CODE.items() if failed}
+    status = CommandStatus(CommandKind.CREATE_POINT, 2)
+    for code, failed in _LINK_FAILED_BY_CODE.items():
+        reason = Reason(code, {})
+        upload_like = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, None, False, code, reason=reason)
+        assert upload_like.link_failed is failed, code
+        done = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, None, True, code, reason=reason)
+        assert not done.link_failed, code
+    # from the errors themselves, as RobotClient.upload_points builds a point's failed result
+    for error, failed in (
+        (LinkError("gone"), True),
+        (ResponseTimeout("late"), True),
+        (MalformedResponse("bad", field="CRC"), True),
+        (ModbusExceptionError(16, 3, "illegal data value"), False),
+    ):
+        result = CommandResult(RunCommand.CREATE_POINT, None, None, False, str(error), reason=error.as_reason())
+        assert result.link_failed is failed, error
+    answered = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, status, False, "refused")
+    assert not answered.link_failed  # no reason, but the controller's status: it answered
+    assert CommandResult(RunCommand.CREATE_POINT, None, None, False, "?").link_failed  # nothing known
+
+
+def _refusal_upload(host: PartsHost, sim: Any, count: int = 6) -> list[RawItem]:
+    items: list[RawItem] = [(100 + i, (100.0 + i, -float(i), 300.0, 0.0, 0.0, float(i)), 200) for i in range(count)]
+    assert host.uploader.start(items)
+    steps = 0
+    while host.uploader.step():
+        steps += 1
+        assert steps < 20  # no busy loop of empty chunks
+    return items
+
+
+def test_a_point_the_controller_refuses_with_a_modbus_exception_is_failed_and_the_upload_goes_on(
+    host: PartsHost, sim_factory: Any
+) -> None:
+    """Point 102's parameters (GV200-202) are answered with exception 3: that point is reported
+    failed in the controller's words, the link is not declared failed (no reconnect, one
+    connection all along), the points after it are created with their own poses -- the next
+    pose is written anew, whatever was staged before the refusal -- and the final result says
+    how many were refused."""
+    sim = sim_factory(command_latency=0.02)  # the controller works a while: the poses are staged
+    host.connect(sim)
+    connections = sim.connections_count
+    sim.refuse_point_write(102)
+    items = _refusal_upload(host, sim)
+    uploaded = host.of("pointUploaded")
+    assert [(pid, ok) for pid, ok, _, _ in uploaded] == [(100 + i, i != 2) for i in range(6)]
+    reason = uploaded[2][2]
+    assert reason.startswith("controller refused write") and "illegal data value" in reason, reason
+    result = host.of("commandFinished")[-1]
+    assert not result.ok
+    assert result.message.startswith("uploaded 5 of 6 points, 1 refused: "), result.message
+    assert result.details["refused"] == 1.0 and result.details["attempted"] == 6.0
+    # the link stayed up: never away from connected, no reconnect scheduled, the same connection
+    assert host.link_up and host.reconnect_delays == []
+    assert all(state is LinkState.CONNECTED for state in host.states()[1:]), host.states()
+    assert sim.connections_count == connections == 1
+    held = sim.state().points
+    assert set(held) == {100, 101, 103, 104, 105}
+    assert all(held[pid] == pose for pid, pose, _ in items if pid != 102)
+
+
+def test_a_refused_first_point_of_a_chunk_and_its_retry_next_time(host: PartsHost, sim_factory: Any) -> None:
+    """Chunks of one point: the refused point's chunk ends with it, the next chunk goes on; the
+    knob refuses only once, so a second upload of the same point is created."""
+    sim = sim_factory()
+    host.connect(sim)
+    sim.refuse_point_write(101)
+    _refusal_upload(host, sim, 3)
+    assert [(pid, ok) for pid, ok, _, _ in host.of("pointUploaded")] == [(100, True), (101, False), (102, True)]
+    assert host.link_up and set(sim.state().points) == {100, 102}
+    _refusal_upload(host, sim, 3)
+    assert host.of("commandFinished")[-1].message == "uploaded 3 of 3 points"
+    assert set(sim.state().points) == {100, 101, 102} and sim.connections_count == 1
