@@ -262,7 +262,7 @@ class SimController:
             values = [int(v) & 0xFFFF for v in set_values]
             refused = self.point_write_refusals.check(address, values, self.config.word_order)
             if refused is not None:
-                log.info("write fc=0x%02X address=%d refused with exception %d", function_code, address, refused)
+                log.info("write fc=0x%02X address=%d refused: exception %d", function_code, address, refused)
                 return refused
         offset = address - start_address
         with self.lock:
@@ -422,7 +422,7 @@ class SimController:
         """Answer the next ``times`` writes of GV200 naming ``point_id`` (a create point's
         parameters) with Modbus exception ``code``; nothing of them is stored (0: accept again)."""
         self.point_write_refusals.set(point_id, ExcCodes(code), times)
-        log.info("create point %d: its GV200 write refused %d time(s) with exception %d", point_id, times, code)
+        log.info("create point %d: GV200 write refused %d time(s), exception %d", point_id, times, code)
 
     def set_response_delay(self, seconds: float) -> None:
         self._response_delay = max(0.0, float(seconds))

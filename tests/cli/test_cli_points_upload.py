@@ -4,6 +4,7 @@ staged), against the real simulator: its writes, its request count, Ctrl-C mid-u
 from __future__ import annotations
 
 import itertools
+import threading
 from pathlib import Path
 from typing import Any
 
@@ -86,3 +87,55 @@ def test_ctrl_c_in_a_staged_upload_keeps_what_was_done(
     # every point recorded as uploaded is on the controller; at most the one under way is there
     # without being recorded (its outcome was not known when Ctrl-C came)
     assert len(recorded) >= 5 and recorded <= held and len(held - recorded) <= 1
+
+
+def test_a_point_refused_with_a_modbus_exception_is_failed_and_the_upload_goes_on(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """The rule the GUI's upload follows too (CommandResult.link_failed): a Modbus exception is the
+    controller's refusal of that point, not a lost link -- the point is reported failed in the
+    controller's words, the others are created, the exit code is "failed", not "link"."""
+    n = 10
+    sim = sim_factory(command_latency=0.02)  # the controller works a while: the poses are staged
+    project = _project(sim, capsys, tmp_path, n)
+    sim.refuse_point_write(3)  # in the first batch (tool 200) ...
+    sim.refuse_point_write(8)  # ... and in the second (tool 3)
+    code, out, err = run(sim, capsys, "points", "upload", str(project))
+    assert code == ExitCode.FAILED, err
+    assert f"uploaded {n - 2} point(s)" in out
+    assert "upload stopped" not in err and "not attempted" not in err
+    for pid in (3, 8):
+        assert (
+            f"P{pid}: controller refused write to registers 400..405 (GV200..GV202): illegal data value"
+            in err
+        )
+    held = sim.state().points
+    assert set(held) == set(range(1, n + 1)) - {3, 8}
+    assert all(held[i] == (300.0 + i, -i, 400.0, 180.0, 0.0, float(i % 90)) for i in held)
+    assert sorted(load_project(project).upload_history) == sorted(held)
+
+
+def test_a_link_lost_mid_upload_still_ends_it(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """The controller falls silent after a few points: no answer in time is a link failure -- the
+    upload ends there (exit code "link"), the rest not attempted, what was recorded is held."""
+    n = 20
+    sim = sim_factory(command_latency=0.02)
+    project = _project(sim, capsys, tmp_path, n)
+
+    def silence() -> None:
+        assert sim.wait_for(lambda s: len(s.points) >= 4, 20.0)
+        sim.set_silent(True)
+
+    thread = threading.Thread(target=silence, daemon=True)
+    thread.start()
+    try:
+        code, _, err = run(sim, capsys, "--timeout", "0.3", "points", "upload", str(project))
+    finally:
+        thread.join(5.0)
+        sim.set_silent(False)
+    assert code == ExitCode.LINK, err
+    assert "upload stopped (" in err and "not attempted:" in err and "did not answer" in err
+    recorded = set(load_project(project).upload_history)
+    assert len(recorded) >= 3 and recorded <= set(sim.state().points)

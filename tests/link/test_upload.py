@@ -24,6 +24,7 @@ from app.errors import (
     TeachPadError,
 )
 from app.link.jobs import Job, JobKind, JobQueue
+from app.link.types import LinkState
 from app.link.upload import (
     UPLOAD_STAGE_GV,
     RawItem,
@@ -32,7 +33,6 @@ from app.link.upload import (
     group_by_tool,
     stage_gv_for,
 )
-from app.link.types import LinkState
 from app.models import LINK_FAILURE_CODES, CommandResult
 from app.protocol.enums import CommandKind, CommandStatus, RunCommand
 from tests.link.harness import PartsHost
@@ -302,17 +302,21 @@ def test_the_link_failed_rule_over_every_error_code() -> None:
         text = path.read_text(encoding="utf-8")
         for match in re.finditer(r"\b(LinkError|ResponseTimeout|MalformedResponse)\(", text):
             call = re.split(r"\braise\b|\bdef\b|\n\s*\n", text[match.end() : match.end() + 300])[0]
-            code = re.search(r'code="(\w+)"', call)
-            if code is not None:
-                link_raises.add(code.group(1))
+            found = re.search(r'code="(\w+)"', call)
+            if found is not None:
+                link_raises.add(found.group(1))
     assert link_raises <= LINK_FAILURE_CODES, link_raises - LINK_FAILURE_CODES
-    assert LINK_FAILURE_CODES == {code for code, failed in _LINK_FAILED_BY_CODE.items() if failed}
+    assert {code for code, failed in _LINK_FAILED_BY_CODE.items() if failed} == LINK_FAILURE_CODES
     status = CommandStatus(CommandKind.CREATE_POINT, 2)
     for code, failed in _LINK_FAILED_BY_CODE.items():
         reason = Reason(code, {})
-        upload_like = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, None, False, code, reason=reason)
+        upload_like = CommandResult(
+            RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, None, False, code, reason=reason
+        )
         assert upload_like.link_failed is failed, code
-        done = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, None, True, code, reason=reason)
+        done = CommandResult(
+            RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, None, True, code, reason=reason
+        )
         assert not done.link_failed, code
     # from the errors themselves, as RobotClient.upload_points builds a point's failed result
     for error, failed in (
@@ -321,7 +325,9 @@ def test_the_link_failed_rule_over_every_error_code() -> None:
         (MalformedResponse("bad", field="CRC"), True),
         (ModbusExceptionError(16, 3, "illegal data value"), False),
     ):
-        result = CommandResult(RunCommand.CREATE_POINT, None, None, False, str(error), reason=error.as_reason())
+        result = CommandResult(
+            RunCommand.CREATE_POINT, None, None, False, str(error), reason=error.as_reason()
+        )
         assert result.link_failed is failed, error
     answered = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, status, False, "refused")
     assert not answered.link_failed  # no reason, but the controller's status: it answered
@@ -329,7 +335,9 @@ def test_the_link_failed_rule_over_every_error_code() -> None:
 
 
 def _refusal_upload(host: PartsHost, sim: Any, count: int = 6) -> list[RawItem]:
-    items: list[RawItem] = [(100 + i, (100.0 + i, -float(i), 300.0, 0.0, 0.0, float(i)), 200) for i in range(count)]
+    items: list[RawItem] = [
+        (100 + i, (100.0 + i, -float(i), 300.0, 0.0, 0.0, float(i)), 200) for i in range(count)
+    ]
     assert host.uploader.start(items)
     steps = 0
     while host.uploader.step():
@@ -375,7 +383,11 @@ def test_a_refused_first_point_of_a_chunk_and_its_retry_next_time(host: PartsHos
     host.connect(sim)
     sim.refuse_point_write(101)
     _refusal_upload(host, sim, 3)
-    assert [(pid, ok) for pid, ok, _, _ in host.of("pointUploaded")] == [(100, True), (101, False), (102, True)]
+    assert [(pid, ok) for pid, ok, _, _ in host.of("pointUploaded")] == [
+        (100, True),
+        (101, False),
+        (102, True),
+    ]
     assert host.link_up and set(sim.state().points) == {100, 102}
     _refusal_upload(host, sim, 3)
     assert host.of("commandFinished")[-1].message == "uploaded 3 of 3 points"
