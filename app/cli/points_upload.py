@@ -14,7 +14,8 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from app.cli.exit_codes import LINK_ERRORS
-from app.link.upload import UPLOAD_POSE_GV, stage_gv_for
+from app.errors import ModbusExceptionError
+from app.link.upload import UPLOAD_POSE_GV, refused_before_the_first, stage_gv_for
 from app.models import CommandResult
 from app.points.guard import CANARY_GV
 from app.points.point import TempPoint
@@ -41,8 +42,10 @@ def staged_upload(
 
     ``progress(done, total)`` (``done``: points tried, in that order) before each point and once
     at the end; False from it ends the upload there ("stopped on request"). A point the
-    controller refuses (a refusal or a Modbus exception) is recorded and the upload goes on; a
-    lost link or Ctrl-C ends it, the point under way and the rest ``not_attempted``.
+    controller refuses (a refusal or a Modbus exception; a batch whose tool frame or status read
+    is refused: each of its points) is recorded and the upload goes on; a lost link
+    (:attr:`CommandResult.link_failed`) or Ctrl-C ends it, the point under way and the rest
+    ``not_attempted``.
     """
     ordered = by_tool(points)
     report = UploadReport()
@@ -81,6 +84,8 @@ def staged_upload(
             )
         except LINK_ERRORS as exc:  # before its first point (the status read): nothing of it done
             return stop_here(str(exc) or type(exc).__name__)
+        except ModbusExceptionError as exc:  # refused before its first point (GV245, the status read)
+            results.extend(refused_before_the_first((p.id for p in batch[len(results) :]), exc))
         except KeyboardInterrupt:  # keep what was done: the caller records it, the ledger stays true
             _record(report, batch, results)
             done += len(results)
@@ -98,7 +103,9 @@ def staged_upload(
 
 def _record(report: UploadReport, batch: Sequence[TempPoint], results: Sequence[CommandResult]) -> str | None:
     """Each result as an outcome; the text of a link failure (the batch's last result, the point's
-    outcome unknown: not recorded) or None."""
+    outcome unknown: not recorded) or None. The rule is the GUI upload's
+    (:attr:`CommandResult.link_failed`): a Modbus exception or a refused command is that point's
+    failure, the link is fine and the upload goes on."""
     for point, result in zip(batch, results, strict=False):
         reason = (result.message or "").removeprefix(f"point {point.id}: ")
         if result.ok:

@@ -262,9 +262,14 @@ class RobotClient(CommandClient):
         """Batched case 2.2: per point the pose GVs (one 0x10), GV200-202 (one 0x10), 440 <- 0xE0, polls.
 
         Every point is validated before the first write. Returns one result per point tried,
-        in order (``details["point_id"]``); a refused point does not stop the others. A link
-        error or timeout ends the batch after a failed result for that point; ``progress``
-        (done, total) returning False cancels after the current point.
+        in order (``details["point_id"]``); a point whose command the controller refuses (a
+        failed status) does not stop the others. A link error, a timeout, a malformed answer or a
+        Modbus exception ends the batch after a failed result for that point (``status`` None,
+        ``reason`` the error's); :attr:`CommandResult.link_failed` tells the first three (the link
+        is not to be trusted) from the exception (the controller refused a write or read of that
+        point: the link is fine, and a caller goes on with the next point in a fresh call, which
+        writes its pose anew). ``progress`` (done, total) returning False cancels after the
+        current point.
 
         **Staging** (``stage``; ``stage_gv``: six more general-purpose GVs, by default the six
         after ``gv_start``, or before it at the top of GV0..GV99): the poses alternate

@@ -16,6 +16,13 @@ the point in flight finish (no controller stop). From the moment
 a stop or a cancel is asked for (the worker's ``halt_count`` grows: the stop line counts the
 Stop before it writes 441) until that job runs, nothing more is written: no staging write of the
 next pose, no next point; only the point whose writes already went out is waited for.
+
+A failed point ends the upload only when the link failed during it
+(:attr:`~app.models.CommandResult.link_failed`: link lost, no answer in time, a malformed
+answer -- its outcome is unknown and the link is declared failed). A point the controller
+refused (a failed status, or a Modbus exception, which ends that call of ``upload_points``) is
+reported failed in the controller's words and counted as refused; the next chunk goes on with
+the next point (the CLI's ``points upload`` follows the same rule).
 """
 
 from __future__ import annotations
@@ -26,13 +33,20 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 
 from app import timing
-from app.errors import InvalidInput, LinkError, ResponseTimeout, TeachPadError, WriteBlocked
+from app.errors import (
+    InvalidInput,
+    LinkError,
+    ModbusExceptionError,
+    ResponseTimeout,
+    TeachPadError,
+    WriteBlocked,
+)
 from app.link.client import RobotClient
 from app.link.host import WorkerHost
 from app.link.types import Operation
 from app.models import CommandResult
 from app.protocol import registers
-from app.protocol.enums import RunCommand
+from app.protocol.enums import CommandKind, RunCommand
 
 __all__ = [
     "UPLOAD_POSE_GV",
@@ -42,6 +56,7 @@ __all__ = [
     "Uploader",
     "check_upload_items",
     "group_by_tool",
+    "refused_before_the_first",
     "stage_gv_for",
 ]
 
@@ -82,6 +97,24 @@ def group_by_tool(items: Iterable[UploadItem]) -> list[UploadItem]:
     for item in items:
         groups.setdefault(item[2], []).append(item)
     return [item for group in groups.values() for item in group]
+
+
+def refused_before_the_first(point_ids: Iterable[int], exc: ModbusExceptionError) -> list[CommandResult]:
+    """A batch the controller refused before its first point (a Modbus exception on its tool frame
+    GV245 or its status read): every point of it refused in the controller's words -- not a link
+    failure (:attr:`CommandResult.link_failed` is False), the upload goes on with the next batch."""
+    return [
+        CommandResult(
+            RunCommand.CREATE_POINT,
+            CommandKind.CREATE_POINT,
+            None,
+            False,
+            str(exc),
+            {"point_id": float(pid)},
+            reason=exc.as_reason(),
+        )
+        for pid in point_ids
+    ]
 
 
 def check_upload_items(client: RobotClient, raw: Sequence[RawItem]) -> list[UploadItem]:
@@ -211,6 +244,8 @@ class Uploader:
             )
         except (LinkError, ResponseTimeout) as exc:  # before the first point (status read, mode)
             results, transport_error = [], str(exc)
+        except ModbusExceptionError as exc:  # refused before the first point (tool frame, status read)
+            results = refused_before_the_first((pid for pid, _ in chunk), exc)
         except TeachPadError as exc:
             results = []
             upload.end = upload.end or str(exc)

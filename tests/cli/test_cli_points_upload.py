@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from pymodbus.constants import ExcCodes
 
 from app.cli.exit_codes import ExitCode
 from app.link.upload import UPLOAD_POSE_GV, stage_gv_for
@@ -139,3 +140,22 @@ def test_a_link_lost_mid_upload_still_ends_it(
     assert "upload stopped (" in err and "not attempted:" in err and "did not answer" in err
     recorded = set(load_project(project).upload_history)
     assert len(recorded) >= 3 and recorded <= set(sim.state().points)
+
+
+def test_a_refused_tool_frame_refuses_the_points_of_that_tool_and_records_the_others(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """Every GV245 write answered with exception 3: each batch is refused before its first point
+    (the GUI's upload does the same): every point reported refused, none "not attempted", the exit
+    code "failed" (the link is fine), and nothing escapes as an error that would lose the record."""
+    n = 6
+    sim = sim_factory()
+    project = _project(sim, capsys, tmp_path, n)
+    tool = 2 * registers.GV_TOOL_FRAME
+    sim.set_exception(ExcCodes.ILLEGAL_VALUE, range(tool, tool + 2))
+    code, out, err = run(sim, capsys, "points", "upload", str(project))
+    assert code == ExitCode.FAILED, err
+    assert "uploaded 0 point(s)" in out and "upload stopped" not in err
+    for pid in range(1, n + 1):
+        assert f"P{pid}: controller refused write to register" in err and "illegal data value" in err
+    assert sim.state().points == {}

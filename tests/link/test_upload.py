@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from pymodbus.constants import ExcCodes
 
 import app
 from app import timing
@@ -34,6 +35,7 @@ from app.link.upload import (
     stage_gv_for,
 )
 from app.models import LINK_FAILURE_CODES, CommandResult
+from app.protocol import registers
 from app.protocol.enums import CommandKind, CommandStatus, RunCommand
 from tests.link.harness import PartsHost
 
@@ -392,3 +394,34 @@ def test_a_refused_first_point_of_a_chunk_and_its_retry_next_time(host: PartsHos
     _refusal_upload(host, sim, 3)
     assert host.of("commandFinished")[-1].message == "uploaded 3 of 3 points"
     assert set(sim.state().points) == {100, 101, 102} and sim.connections_count == 1
+
+
+def test_a_tool_frame_the_controller_refuses_refuses_its_points_and_the_upload_goes_on(
+    host: PartsHost, sim: Any
+) -> None:
+    """GV245 answered with exception 3 (the controller has no such tool): the batch of that tool
+    never gets to its first point -- each of its points is refused in the controller's words, the
+    link stays up, and the points of the next tool are created."""
+    host.connect(sim)
+    tool_regs = 2 * registers.GV_TOOL_FRAME
+    sim.set_exception(ExcCodes.ILLEGAL_VALUE, range(tool_regs, tool_regs + 2))
+    items: list[RawItem] = [
+        (100 + i, (100.0 + i, 0.0, 300.0, 0.0, 0.0, 0.0), 7 if i < 3 else 200) for i in range(5)
+    ]
+    # tool 200 (none) is the controller's default: the cached GV245 is written all the same, refused
+    # too -- so lift the refusal for the second tool once the first tool's points are reported
+    assert host.uploader.start(items)
+    while host.uploader.step():
+        if len(host.of("pointUploaded")) >= 3:
+            sim.set_exception(None)
+    uploaded = host.of("pointUploaded")
+    assert [(pid, ok) for pid, ok, _, _ in uploaded] == [
+        (100, False),
+        (101, False),
+        (102, False),
+        (103, True),
+        (104, True),
+    ]
+    assert all("illegal data value" in reason for _, _, reason, _ in uploaded[:3])
+    assert host.of("commandFinished")[-1].message.startswith("uploaded 2 of 5 points, 3 refused: ")
+    assert host.link_up and host.reconnect_delays == [] and set(sim.state().points) == {103, 104}
