@@ -305,7 +305,9 @@ class Uploader:
         text = f"uploaded {upload.good} of {total} points"
         if upload.refused:
             text += f", {upload.refused} refused"
-            if upload.end is None:  # "... (end)" stays last: the GUI reads why it ended from there
+            if upload.end is None and upload.index >= total:
+                # the first refusal's words only when every point was tried: one that ended early
+                # keeps its "(why)" last, where the GUI reads it (ui/controllers point_sync_state)
                 text += f": {upload.first_refusal}"
         text += f" ({upload.end})" if upload.end else ""
         details = {
