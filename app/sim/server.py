@@ -76,6 +76,7 @@ class SimController:
         self._stopped = False
         # fault injection
         self._response_delay = self.config.response_delay
+        self._delay_every = 1  # the delay holds every n-th request (1: all of them)
         self._status_delay = self.config.status_delay
         self._silent = False
         self._exception: ExcCodes | None = None
@@ -247,10 +248,11 @@ class SimController:
         connection = CURRENT_CONNECTION.get()
         with self.lock:
             self._requests += 1
+            serial = self._requests
             self._registers = registers
         if self._silent:
             return ExcCodes.DEVICE_FAILURE  # not executed; the answer is dropped by _trace_packet
-        if self._response_delay > 0:
+        if self._response_delay > 0 and serial % self._delay_every == 0:
             await asyncio.sleep(self._response_delay)
         exc, exc_range = self._exception, self._exception_range
         hit = exc_range is None or (address < exc_range.stop and exc_range.start < address + count)
@@ -408,9 +410,12 @@ class SimController:
                 self.robot.refused_points.discard(int(point_id))
         log.info("create point %d: %s", point_id, "refused from now on" if refuse else "accepted again")
 
-    def set_response_delay(self, seconds: float) -> None:
+    def set_response_delay(self, seconds: float, every: int = 1) -> None:
+        """Hold the answer of every ``every``-th request ``seconds`` (a slow controller; with
+        ``every`` > 1, a host whose polls come late now and then)."""
+        self._delay_every = max(1, int(every))
         self._response_delay = max(0.0, float(seconds))
-        log.info("response delay %.3f s", self._response_delay)
+        log.info("response delay %.3f s (every %d. request)", self._response_delay, self._delay_every)
 
     def set_status_delay(self, seconds: float) -> None:
         self._status_delay = max(0.0, float(seconds))
