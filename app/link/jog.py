@@ -280,7 +280,9 @@ class JogMachine:
         measured.note_decision(now, jogging=jog is not None)
         if jog is None or guard is None or client is None or jog.ratio <= 0:
             return None
-        decision = guard.decide(pose, jog, measured.horizon(guard, now, read_at))
+        horizon = measured.horizon(guard, now, read_at)
+        measured.note_horizon(now, horizon)
+        decision = guard.decide(pose, jog, horizon)
         if decision.allow or decision.violation is None:
             return None
         if self.teach.enabled and not client.settings.monitor_only:

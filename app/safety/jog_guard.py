@@ -70,13 +70,17 @@ class GuardTiming:
       late, and on a loaded PC it happens again;
     * the stop write's trip: the longest read seen in the window.
 
-    :meth:`horizon` never answers less than the guard's nominal ``poll period + latency``.
+    :meth:`horizon` never answers less than the guard's nominal ``poll period + latency``; for a
+    standing arm (a press) never less than the horizons its recent decisions used
+    (:meth:`note_horizon`), so a press toward a boundary right after a stop there is refused,
+    not started and stopped again.
     """
 
     def __init__(self, window: float = JOG_GUARD_WINDOW) -> None:
         self.window = window
         self._gaps: deque[tuple[float, float]] = deque()  # (when, gap s) between two decisions
         self._trips: deque[tuple[float, float]] = deque()  # (when, s) of one read
+        self._used: deque[tuple[float, float]] = deque()  # (when, s) horizons of decisions
         self._last_decision: float | None = None
 
     def note_read(self, read_at: float, answered_at: float) -> None:
@@ -91,6 +95,11 @@ class GuardTiming:
         self._last_decision = now if jogging else None
         self._forget(now)
 
+    def note_horizon(self, now: float, horizon: float) -> None:
+        """A decision on a moving arm used ``horizon``."""
+        self._used.append((now, horizon))
+        self._forget(now)
+
     def horizon(self, guard: JogGuard, now: float, read_at: float | None) -> float:
         """Seconds the arm may run, from the pose read at ``read_at`` (None: the arm stands still,
         its pose's age does not matter), before a stop decided at the next poll lands."""
@@ -99,10 +108,13 @@ class GuardTiming:
         gap = max((g for _, g in self._gaps), default=0.0)
         trip = max((t for _, t in self._trips), default=0.0)
         next_poll = guard.poll_period + 2 * trip  # the timer, then its status and pose reads
-        return max(guard.horizon, age + max(next_poll, gap) + trip)
+        seconds = max(guard.horizon, age + max(next_poll, gap) + trip)
+        if read_at is None:
+            seconds = max(seconds, max((h for _, h in self._used), default=0.0))
+        return seconds
 
     def _forget(self, now: float) -> None:
-        for items in (self._gaps, self._trips):
+        for items in (self._gaps, self._trips, self._used):
             while items and now - items[0][0] > self.window:
                 items.popleft()
 

@@ -88,7 +88,11 @@ def test_a_late_poll_during_a_jog_widens_the_horizon_for_a_while() -> None:
     near = at(0, 0, 400, (0.0, 132.0, 0, 0, 0, 0))
     assert guard.decide(near, jog(1, 1, frame=TeachFrame.JOINT)).allow
     assert not guard.decide(near, jog(1, 1, frame=TeachFrame.JOINT), 0.3).allow
-    # forgotten after the window
+    # a press right after: judged with at least the horizon the last decision used
+    measured.note_horizon(1.32, 0.5)
+    assert measured.horizon(guard, 1.4, None) == pytest.approx(0.5)
+    assert measured.horizon(guard, 1.4, 1.4) == pytest.approx(0.3)
+    # all forgotten after the window
     assert measured.horizon(guard, 1.33 + JOG_GUARD_WINDOW, None) == pytest.approx(0.07)
 
 
@@ -145,12 +149,11 @@ LATENCY = 0.1  # s, generous: the machine running the tests is shared
 
 
 def _jog_until_guard_stops(
-    client: Any, guard: JogGuard, motion: JogMotion, timeout: float
+    client: Any, guard: JogGuard, measured: GuardTiming, motion: JogMotion, timeout: float
 ) -> tuple[bool, Pose, float]:
     """What the worker does while a jog button is held: poll the pose, ask the guard, write
     ratio 0 when it says stop. Returns (stopped by the guard, the pose it decided on, the
     look-ahead it used in mm)."""
-    measured = GuardTiming()  # the worker's measured look-ahead (a late poll under load)
     client.teach_set_ratio(motion.ratio)
     deadline = time.monotonic() + timeout
     next_poll = time.monotonic()
@@ -160,7 +163,9 @@ def _jog_until_guard_stops(
         now = time.perf_counter()
         measured.note_read(read_at, now)
         measured.note_decision(now, jogging=True)
-        decision = guard.decide(pose, motion, measured.horizon(guard, now, read_at))
+        horizon = measured.horizon(guard, now, read_at)  # as the worker: measured, for a late poll
+        measured.note_horizon(now, horizon)
+        decision = guard.decide(pose, motion, horizon)
         if not decision.allow:
             client.teach_set_ratio(0.0)
             return True, pose, decision.margin
@@ -178,7 +183,8 @@ def test_a_jog_toward_a_boundary_stops_short_of_it_at_the_simulator(sim: Any, ma
     guard = JogGuard(env, poll_period=POLL, latency=LATENCY, speeds=ArmSpeeds(linear=250.0))
     assert client.teach_enable(TeachFrame.BASE, 1, 0).ok  # Y, negative
     toward = JogMotion(TeachFrame.BASE, 1, 0, 20.0)  # 50 mm/s
-    stopped, decided_at, margin = _jog_until_guard_stops(client, guard, toward, timeout=10.0)
+    measured = GuardTiming()
+    stopped, decided_at, margin = _jog_until_guard_stops(client, guard, measured, toward, timeout=10.0)
     assert stopped
     assert sim.wait_for(lambda s: not s.jogging, 2.0)
     final_y = sim.state().pose[1]
@@ -187,7 +193,8 @@ def test_a_jog_toward_a_boundary_stops_short_of_it_at_the_simulator(sim: Any, ma
     ratio_writes = sim.writes_to(registers.gv_reg(registers.GV_PARAM3) + 1)  # GV203's high word
     assert ratio_writes[-1].values == (0,) and len(ratio_writes) >= 2
     # at the boundary: further toward it is refused, back out is allowed and moves away
-    assert not guard.decide(client.read_pose(), toward).allow
+    standing = measured.horizon(guard, time.perf_counter(), None)  # a press: at least the stop's
+    assert not guard.decide(client.read_pose(), toward, standing).allow
     client.teach_set_axis(1, 1)
     away = JogMotion(TeachFrame.BASE, 1, 1, 20.0)
     assert guard.decide(client.read_pose(), away).allow
