@@ -94,13 +94,17 @@ def test_a_late_poll_does_not_carry_the_arm_over_the_face(
     y0 = sim.state().pose[1]
     y_limit = y0 + MARGIN_MM
     link.set_jog_guard(_guard(link, y_limit))
-    sim.set_response_delay(delay, every)
+    if every == 1:
+        sim.set_response_delay(delay)
+    else:
+        sim.set_slow_answers(delay, every)
     with qtbot.waitSignal(link.jogGuardStopped, timeout=SIGNAL_TIMEOUT_MS):
         _press(link, 1)
     qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     assert max(ratio_writes(sim)) == JOG_RATIO and ratio_writes(sim)[-1] == 0.0
     y_stop = sim.state().pose[1]
     sim.set_response_delay(0.0)
+    sim.set_slow_answers(0.0, 0)
     assert y0 < y_stop < y_limit  # at the simulator: short of the face
     link.jog_release()
 
