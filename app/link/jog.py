@@ -21,7 +21,7 @@ from app.link.types import JogRequest, Operation
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import ControllerMode, TeachFrame, controller_mode_text
 from app.safety.envelope import EnvelopeRefused, EnvelopeViolation
-from app.safety.jog_guard import JogGuard
+from app.safety.jog_guard import GuardTiming, JogGuard
 
 __all__ = ["JogMachine", "PreemptedError", "TeachState"]
 
@@ -51,6 +51,8 @@ class JogMachine:
         self.released_at = 0.0
         self.ratio_zero_pending = False  # the controller went silent while jogging: ratio 0 on return
         self.guard: JogGuard | None = None  # the safety envelope's jog guard (immutable; set by the GUI)
+        self.guard_timing = GuardTiming()  # the guard's look-ahead, measured (perf_counter clock)
+        self._pose_read_at: float | None = None  # when the read of the poller's last pose was sent
 
     # --- state ----------------------------------------------------------------------------
     def reset(self) -> None:
@@ -247,7 +249,11 @@ class JogMachine:
         guard, pose = self.guard, self._host.poller.last_pose
         if guard is None or pose is None:
             return
-        decision = guard.decide(pose, request)
+        # A standing arm's last pose is still where it is; a moving one's has aged since its read.
+        moving = self.teach.enabled and self.teach.ratio != 0.0
+        read_at = self._pose_read_at if moving else None
+        horizon = self.guard_timing.horizon(guard, time.perf_counter(), read_at)
+        decision = guard.decide(pose, request, horizon)
         if not decision.allow and decision.violation is not None:
             self.end_jog()
             if self.teach.enabled and self.teach.ratio != 0.0:  # a jog under way stops too
@@ -255,13 +261,28 @@ class JogMachine:
                 self.teach.ratio = 0.0
             raise EnvelopeRefused(decision.violation, "jog")
 
-    def guard_pose(self, pose: Pose) -> EnvelopeViolation | None:
-        """Per poll, right after the pose is read: stop a jog heading over a boundary (ratio 0
-        first, the jog ends; teach stays on, as after a release). Returns why it stopped."""
+    def guard_pose(
+        self, pose: Pose, read_at: float | None = None, answered_at: float | None = None
+    ) -> EnvelopeViolation | None:
+        """Per poll, right after the pose is read (its request sent at ``read_at``, answered at
+        ``answered_at``, ``time.perf_counter``; None: just now): stop a jog heading over a boundary
+        (ratio 0 first, the jog ends; teach stays on, as after a release). Returns why it stopped.
+
+        The look-ahead covers the measured time until the next poll's stop could land
+        (:class:`~app.safety.jog_guard.GuardTiming`), not the nominal poll period: a late poll
+        on a loaded PC must not carry the arm over the boundary."""
+        now = time.perf_counter()
+        read_at = now if read_at is None else read_at
+        self._pose_read_at = read_at
+        measured = self.guard_timing
+        measured.note_read(read_at, now if answered_at is None else answered_at)
         jog, guard, client = self.jog, self.guard, self._host.client
+        measured.note_decision(now, jogging=jog is not None)
         if jog is None or guard is None or client is None or jog.ratio <= 0:
             return None
-        decision = guard.decide(pose, jog)
+        horizon = measured.horizon(guard, now, read_at)
+        measured.note_horizon(now, horizon)
+        decision = guard.decide(pose, jog, horizon)
         if decision.allow or decision.violation is None:
             return None
         if self.teach.enabled and not client.settings.monitor_only:

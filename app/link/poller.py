@@ -102,7 +102,7 @@ class Poller:
             t2 = time.perf_counter()
             pose = client.read_pose(timeout=timeout)
             t3 = time.perf_counter()
-            guard_stop = host.jog.guard_pose(pose)  # ratio 0 before the TCP crosses a boundary
+            guard_stop = host.jog.guard_pose(pose, t2, t3)  # ratio 0 before the TCP crosses a boundary
             host.run_urgent()  # and before this poll's publishing: a stop waits one read at most
             if not host.link_up:
                 return

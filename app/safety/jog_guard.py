@@ -3,8 +3,11 @@
 The controller jogs until told otherwise, so the host decides on every pose poll:
 :meth:`JogGuard.decide` takes the pose just read and the jog under way and answers
 :class:`JogDecision` — ``allow`` or stop now (write ratio 0). The margin is the distance the arm
-can cover before the *next* decision takes effect: ``speed x (poll period + latency) +
-extra``, where ``speed`` is the arm's jog speed at 100 % times the ratio. A jog is stopped when
+can cover before the *next* decision takes effect: ``speed x horizon + extra``, where ``speed``
+is the arm's jog speed at 100 % times the ratio. The nominal horizon is ``poll period +
+latency``; the worker passes a measured one (:class:`GuardTiming`: the real age of the pose
+judged, the longest recent gap between two decisions, the longest recent answer) whenever that
+is longer -- a loaded PC polls late, and a keep-in face must hold then too. A jog is stopped when
 the point that far ahead along the jog direction (the chord to it, exactly) leaves the allowed
 space; a jog whose look-ahead point is *further inside* than the pose is always allowed, so
 the operator can jog back out of a boundary (or out of a zone entered some other way), and
@@ -21,6 +24,7 @@ the joint limits, with the same look-ahead in degrees.
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Protocol
 
@@ -48,6 +52,71 @@ else:  # numpy is imported by its first use, not with this module (app/lazy_nump
 JOG_GUARD_LATENCY = 0.05
 JOG_GUARD_EXTRA_MM = 1.0  # fixed extra margin (mm): deceleration, pose noise
 JOG_GUARD_EXTRA_DEG = 0.5  # the same for joint limits (degrees)
+#: How long (s) a late decision or a slow answer, once seen, keeps widening the look-ahead.
+JOG_GUARD_WINDOW = 5.0
+
+
+class GuardTiming:
+    """The look-ahead's time, measured on the worker (pure: the caller passes the clock readings,
+    all from one clock, ``time.perf_counter``).
+
+    A decision at ``now`` on a pose whose read was *sent* at ``read_at`` lets the arm run until
+    the next decision's stop lands, so the horizon is the sum of
+
+    * the pose's age, ``now - read_at`` (it may have been sampled as early as the request left);
+    * the time to the next decision: the longest gap between two decisions of a held jog seen in
+      the last :data:`JOG_GUARD_WINDOW` s, at least the nominal poll period plus two reads (the
+      next poll's status and pose) -- a worker descheduled or held up by a slow answer decides
+      late, and on a loaded PC it happens again;
+    * the stop write's trip: the longest read seen in the window.
+
+    :meth:`horizon` never answers less than the guard's nominal ``poll period + latency``; for a
+    standing arm (a press) never less than the horizons its recent decisions used
+    (:meth:`note_horizon`), so a press toward a boundary right after a stop there is refused,
+    not started and stopped again.
+    """
+
+    def __init__(self, window: float = JOG_GUARD_WINDOW) -> None:
+        self.window = window
+        self._gaps: deque[tuple[float, float]] = deque()  # (when, gap s) between two decisions
+        self._trips: deque[tuple[float, float]] = deque()  # (when, s) of one read
+        self._used: deque[tuple[float, float]] = deque()  # (when, s) horizons of decisions
+        self._last_decision: float | None = None
+
+    def note_read(self, read_at: float, answered_at: float) -> None:
+        """A pose read sent at ``read_at`` and answered at ``answered_at``."""
+        self._trips.append((answered_at, max(0.0, answered_at - read_at)))
+        self._forget(answered_at)
+
+    def note_decision(self, now: float, *, jogging: bool) -> None:
+        """A poll's decision point; the gap since the previous one counts while a jog is held."""
+        if jogging and self._last_decision is not None:
+            self._gaps.append((now, max(0.0, now - self._last_decision)))
+        self._last_decision = now if jogging else None
+        self._forget(now)
+
+    def note_horizon(self, now: float, horizon: float) -> None:
+        """A decision on a moving arm used ``horizon``."""
+        self._used.append((now, horizon))
+        self._forget(now)
+
+    def horizon(self, guard: JogGuard, now: float, read_at: float | None) -> float:
+        """Seconds the arm may run, from the pose read at ``read_at`` (None: the arm stands still,
+        its pose's age does not matter), before a stop decided at the next poll lands."""
+        self._forget(now)
+        age = 0.0 if read_at is None else max(0.0, now - read_at)
+        gap = max((g for _, g in self._gaps), default=0.0)
+        trip = max((t for _, t in self._trips), default=0.0)
+        next_poll = guard.poll_period + 2 * trip  # the timer, then its status and pose reads
+        seconds = max(guard.horizon, age + max(next_poll, gap) + trip)
+        if read_at is None:
+            seconds = max(seconds, max((h for _, h in self._used), default=0.0))
+        return seconds
+
+    def _forget(self, now: float) -> None:
+        for items in (self._gaps, self._trips, self._used):
+            while items and now - items[0][0] > self.window:
+                items.popleft()
 
 
 @dataclass(frozen=True)
@@ -153,15 +222,18 @@ class JogGuard:
         """Seconds until a stop decided at the next poll takes effect."""
         return self.poll_period + self.latency
 
-    def margin(self, motion: JogLike) -> float:
-        """Look-ahead (mm; degrees for a joint against its limit) for ``motion``."""
+    def margin(self, motion: JogLike, horizon: float | None = None) -> float:
+        """Look-ahead (mm) for ``motion`` over ``horizon`` s (None: the nominal :attr:`horizon`)."""
         frac = max(0.0, motion.ratio) / 100.0
+        seconds = self.horizon if horizon is None else max(self.horizon, horizon)
         if motion.frame is TeachFrame.JOINT:
-            return self.speeds.tcp_in_joint_jog * frac * self.horizon + JOG_GUARD_EXTRA_MM
-        return self.speeds.linear * frac * self.horizon + JOG_GUARD_EXTRA_MM
+            return self.speeds.tcp_in_joint_jog * frac * seconds + JOG_GUARD_EXTRA_MM
+        return self.speeds.linear * frac * seconds + JOG_GUARD_EXTRA_MM
 
-    def decide(self, pose: Pose, motion: JogLike) -> JogDecision:
-        """Allow the jog ``motion`` from ``pose``, or say why to stop it now."""
+    def decide(self, pose: Pose, motion: JogLike, horizon: float | None = None) -> JogDecision:
+        """Allow the jog ``motion`` from ``pose``, or say why to stop it now. ``horizon``: the
+        measured seconds until a stop decided next would land (:meth:`GuardTiming.horizon`);
+        never less than the nominal one."""
         env = self.envelope
         p = np.array((pose.x, pose.y, pose.z), dtype=np.float64)
         clearance = env.clearance(p)
@@ -171,10 +243,10 @@ class JogGuard:
         if motion.ratio <= 0:
             return JogDecision(True, clearance=clearance)
         if motion.frame is TeachFrame.JOINT:
-            joint = self._joint_decision(pose, motion)
+            joint = self._joint_decision(pose, motion, horizon)
             if joint is not None:
                 return joint
-        margin = self.margin(motion)
+        margin = self.margin(motion, horizon)
         direction = self._direction(pose, motion)
         if direction is None:  # the TCP does not move (rotation about it)
             return JogDecision(True, margin=margin, clearance=clearance)
@@ -203,14 +275,15 @@ class JogGuard:
         unit[motion.axis] = _sign(motion)
         return unit
 
-    def _joint_decision(self, pose: Pose, motion: JogLike) -> JogDecision | None:
+    def _joint_decision(self, pose: Pose, motion: JogLike, horizon: float | None) -> JogDecision | None:
         limits = self.envelope.joint_limits
         ax = motion.axis
         if pose.joints is None or ax >= len(limits) or ax >= len(pose.joints):
             return None
         lo, hi = limits[ax]
         q = pose.joints[ax]
-        step = self.speeds.joint * motion.ratio / 100.0 * self.horizon + JOG_GUARD_EXTRA_DEG
+        seconds = self.horizon if horizon is None else max(self.horizon, horizon)
+        step = self.speeds.joint * motion.ratio / 100.0 * seconds + JOG_GUARD_EXTRA_DEG
         ahead = q + _sign(motion) * step
         if lo <= ahead <= hi:
             return None

@@ -77,6 +77,7 @@ class SimController:
         self._stopped = False
         # fault injection
         self._response_delay = self.config.response_delay
+        self._slow_answers = (0.0, 0)  # (s, n): every n-th answer held this long (late polls)
         self._status_delay = self.config.status_delay
         self._silent = False
         self._exception: ExcCodes | None = None
@@ -249,11 +250,14 @@ class SimController:
         connection = CURRENT_CONNECTION.get()
         with self.lock:
             self._requests += 1
+            serial = self._requests
             self._registers = registers
         if self._silent:
             return ExcCodes.DEVICE_FAILURE  # not executed; the answer is dropped by _trace_packet
-        if self._response_delay > 0:
-            await asyncio.sleep(self._response_delay)
+        slow, every = self._slow_answers
+        delay = max(self._response_delay, slow if every and serial % every == 0 else 0.0)
+        if delay > 0:
+            await asyncio.sleep(delay)
         exc, exc_range = self._exception, self._exception_range
         hit = exc_range is None or (address < exc_range.stop and exc_range.start < address + count)
         if exc is not None and hit:
@@ -431,6 +435,12 @@ class SimController:
     def set_status_delay(self, seconds: float) -> None:
         self._status_delay = max(0.0, float(seconds))
         log.info("status delay %.3f s", self._status_delay)
+
+    def set_slow_answers(self, seconds: float, every: int) -> None:
+        """Hold the answer of every ``every``-th request ``seconds`` (beside the response delay):
+        a host whose polls come late now and then, as on a loaded PC. ``every`` 0: off."""
+        self._slow_answers = (max(0.0, float(seconds)), max(0, int(every)))
+        log.info("every %d. answer held %.3f s", every, seconds)
 
     def set_watchdog(self, seconds: float | None) -> None:
         """The communication watchdog's silence limit; None or 0 switches it off entirely."""

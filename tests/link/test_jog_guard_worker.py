@@ -76,6 +76,39 @@ def test_jog_toward_the_boundary_stops_short_of_it(qtbot: Any, sim: Any, link: R
     assert ratio_writes(sim)[-1] == 0.0
 
 
+@pytest.mark.parametrize(
+    ("delay", "every"),
+    [
+        (0.1, 1),  # a slow controller: every answer 0.1 s (a poll takes 0.2 s, the stop lands 0.1 s late)
+        (0.15, 4),  # polls late now and then, as on a loaded PC: every 4th answer held 0.15 s
+    ],
+    ids=["slow-answers", "late-polls"],
+)
+def test_a_late_poll_does_not_carry_the_arm_over_the_face(
+    qtbot: Any, sim: Any, link: RobotLink, delay: float, every: int
+) -> None:
+    """The guard's look-ahead is the measured time to the next stop (the pose's age, the longest
+    recent gap between two polls, the stop write's trip), not the nominal poll period: with the
+    nominal 0.07 s the arm ran up to 15 mm past the face here."""
+    connect(qtbot, link, sim, poll_timeout=1.0)
+    y0 = sim.state().pose[1]
+    y_limit = y0 + MARGIN_MM
+    link.set_jog_guard(_guard(link, y_limit))
+    if every == 1:
+        sim.set_response_delay(delay)
+    else:
+        sim.set_slow_answers(delay, every)
+    with qtbot.waitSignal(link.jogGuardStopped, timeout=SIGNAL_TIMEOUT_MS):
+        _press(link, 1)
+    qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
+    assert max(ratio_writes(sim)) == JOG_RATIO and ratio_writes(sim)[-1] == 0.0
+    y_stop = sim.state().pose[1]
+    sim.set_response_delay(0.0)
+    sim.set_slow_answers(0.0, 0)
+    assert y0 < y_stop < y_limit  # at the simulator: short of the face
+    link.jog_release()
+
+
 def test_without_a_guard_the_jog_runs(qtbot: Any, sim: Any, link: RobotLink) -> None:
     connect(qtbot, link, sim, poll_timeout=1.0)
     link.set_jog_guard(None)
