@@ -161,6 +161,8 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         self._reconnect_timer.timeout.connect(self._try_connect)
         self._traffic_timer = QTimer(self)
         self._traffic_timer.timeout.connect(self.flush_traffic)
+        if self.capture.on:
+            self._traffic_timer.start(max(1, round(timing.TRAFFIC_DELIVERY_PERIOD * 1000)))
 
     @Slot(object)
     def connect_to(self, settings: ConnectionSettings) -> None:
