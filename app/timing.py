@@ -40,6 +40,10 @@ RECONNECT_BACKOFF = (0.2, 0.5, 1.0, 2.0, 5.0)  # s, last one repeats
 LINK_LOSS_POLLS = 3  # consecutive failed transactions (refused, reset, command timeouts) -> link down
 NOT_ANSWERING_DOWN_AFTER = 3.0  # s of silence (polls timing out, link open) before the link is down
 RTT_REPORT_PERIOD = 0.5  # s between rttChanged / linkStatsChanged emissions
+# s between trafficObserved batches while capturing (the table refreshes ~2x/s): one queued call
+# into the GUI thread per period instead of one per poll; a command's result, a connection change,
+# capture off and shutdown deliver what is pending at once.
+TRAFFIC_DELIVERY_PERIOD = 0.1
 TEACH_IDLE_DISABLE = 30.0  # s after the last jog release before teach mode is disabled
 TEACH_MODE_GRACE = 0.3  # s after teach enable during which a status without mode 2 is not "teach lost"
 UPLOAD_CHUNK_POINTS = 20  # points per event-loop turn of an upload, at most ...

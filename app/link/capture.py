@@ -12,7 +12,8 @@ __all__ = ["LinkStatsReporter", "RttMeter", "TrafficCapture"]
 
 
 class TrafficCapture:
-    """Frames seen by the client while capturing, handed out as one batch per poll."""
+    """Frames seen by the client while capturing, handed out in batches (the worker's
+    ``flush_traffic``: every ``TRAFFIC_DELIVERY_PERIOD`` and before any outcome or state change)."""
 
     def __init__(self) -> None:
         self.on = False

@@ -4,7 +4,8 @@ Order of a poll: **status first, then pose** -- so when the status says a motion
 read after it is the final one -- with the urgent jobs run between the two reads. Then, in this
 order: one ``publish_polled`` of the pose / status / alarms (each only on change) and of the
 good poll, the restart canary, ``commandFinished`` of the command the poll completed,
-the RTT, the link statistics and the captured traffic. The clock (and the canary) are read
+the RTT and the link statistics (the captured traffic goes out on the worker's own period, not
+per poll: see :mod:`app.link.worker`). The clock (and the canary) are read
 every :data:`app.timing.CLOCK_POLL_PERIOD`. Polls use the poll timeout
 (``settings.effective_poll_timeout``), not the command timeout: a silent controller shows as
 ``NOT_ANSWERING`` after one poll.
@@ -149,7 +150,6 @@ class Poller:
         if rtt is not None:
             host.publish_rtt(rtt)
         self._report_stats()
-        host.flush_traffic()
 
     def _report_stats(self) -> None:
         client = self._host.client

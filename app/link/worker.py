@@ -20,7 +20,12 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
   ``_held`` until that one's outcome is known (GV291 tells one command at a time).
 * :class:`~app.link.upload.Uploader` -- chunked upload of many points, ``pointUploaded`` per
   point, ``uploadProgress``, one final ``commandFinished``; ``cancel_upload`` or a stop end it.
-* :class:`~app.link.capture.TrafficCapture`, RTT and link statistics.
+* :class:`~app.link.capture.TrafficCapture`, RTT and link statistics. The captured frames go
+  out in batches (``trafficObserved``) every :data:`app.timing.TRAFFIC_DELIVERY_PERIOD` from the
+  worker's own timer, not once per poll (one queued call into the GUI thread instead of ten at
+  100 Hz); whatever is pending goes out at once before a ``commandFinished`` / ``errorOccurred``
+  (a command's frames reach the GUI before its outcome), before a ``connectionChanged``, when
+  polling stops, when capture is switched off and at shutdown: no frame is left behind.
 
 The job bodies (``_do_stop`` ...) are in :mod:`app.link.commands`, the request API in
 :mod:`app.link.requests`.
@@ -96,7 +101,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     linkStatsChanged = Signal(object)  # noqa: N815 - LinkStats, at most every RTT_REPORT_PERIOD, on change
     commandFinished = Signal(CommandResult)  # noqa: N815
     errorOccurred = Signal(WorkerError)  # noqa: N815
-    trafficObserved = Signal(list)  # noqa: N815 - list[TrafficRecord], one batch per poll, only while capturing
+    trafficObserved = Signal(list)  # noqa: N815 - list[TrafficRecord], a batch every TRAFFIC_DELIVERY_PERIOD, only while capturing
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815 - the canary GV changed while the link stayed up
     uploadProgress = Signal(int, int)  # noqa: N815 - points done, total
@@ -130,6 +135,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         self._held: deque[Job] = deque()
         self._poll_timer: QTimer | None = None
         self._reconnect_timer: QTimer | None = None
+        self._traffic_timer: QTimer | None = None  # delivers the captured frames while capturing
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
         self.motions = MotionCommands(self)
@@ -153,6 +159,10 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         self._reconnect_timer = QTimer(self)
         self._reconnect_timer.setSingleShot(True)
         self._reconnect_timer.timeout.connect(self._try_connect)
+        self._traffic_timer = QTimer(self)
+        self._traffic_timer.timeout.connect(self.flush_traffic)
+        if self.capture.on:
+            self._traffic_timer.start(max(1, round(timing.TRAFFIC_DELIVERY_PERIOD * 1000)))
 
     @Slot(object)
     def connect_to(self, settings: ConnectionSettings) -> None:
@@ -173,9 +183,10 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         if self.closed:
             return
         self.supervisor.close_link(Operation.SHUTDOWN, LinkState.DISCONNECTED, "", short=True)
+        self.flush_traffic()  # the close's own frames (teach off) before the thread ends
         self.closed = True
         self._worker_ident = None
-        for timer in (self._poll_timer, self._reconnect_timer):
+        for timer in (self._poll_timer, self._reconnect_timer, self._traffic_timer):
             if timer is not None:
                 timer.stop()
         thread = self.thread()
@@ -211,8 +222,19 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
 
     @Slot(bool)
     def set_traffic_capture(self, on: bool) -> None:
-        if not self.closed:
-            self.capture.set(on, self.supervisor.client)
+        """Capture on: frames go out every :data:`app.timing.TRAFFIC_DELIVERY_PERIOD` (read now);
+        off: what was captured goes out first."""
+        if self.closed:
+            return
+        if not on:
+            self.flush_traffic()
+        self.capture.set(on, self.supervisor.client)
+        timer = self._traffic_timer
+        if timer is not None:
+            if on:
+                timer.start(max(1, round(timing.TRAFFIC_DELIVERY_PERIOD * 1000)))
+            else:
+                timer.stop()
 
     def _poll_interval_ms(self) -> int:
         return max(1, round(1000.0 / self.poller.rate(self._poll_hz)))
@@ -251,6 +273,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     def stop_polling(self) -> None:
         if self._poll_timer is not None:
             self._poll_timer.stop()
+        self.flush_traffic()  # the last poll's frames do not wait for the delivery timer
         # link_up is already False when the link was lost, still True when it is being closed
         self.stop_line.main_link_closed(time.monotonic(), lost=not self.supervisor.link_up)
 
@@ -262,12 +285,15 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         if self._reconnect_timer is not None:
             self._reconnect_timer.stop()
 
+    @Slot()
     def flush_traffic(self) -> None:
+        """``trafficObserved`` with the frames captured since the last batch (none: nothing)."""
         batch = self.capture.flush()
         if batch is not None:
             self.trafficObserved.emit(batch)
 
     def publish_connection(self, state: ConnectionState) -> None:
+        self.flush_traffic()  # the frames of the link that ended (or the connect) come first
         self.connectionChanged.emit(state)
 
     def publish_rtt(self, ms: float) -> None:
@@ -306,6 +332,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         rid = self.request_id if request_id == -1 else request_id
         if result.request_id is None and rid is not None:
             result = dataclasses.replace(result, request_id=rid)
+        self.flush_traffic()  # the command's frames reach the GUI before its outcome
         self.commandFinished.emit(result)
 
     def emit_error(
@@ -314,11 +341,13 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         """``errorOccurred`` with the request id (default: the job being executed) and, when the
         cause is known, its reason (code + arguments) for the operator's language."""
         rid = self.request_id if request_id == -1 else request_id
+        self.flush_traffic()
         self.errorOccurred.emit(WorkerError(operation, message, rid, reason))
 
     def emit_exception(self, operation: str, exc: BaseException, request_id: int | None = -1) -> None:
         """``errorOccurred`` for ``exc`` (its English text and, for a typed error, its reason)."""
         rid = self.request_id if request_id == -1 else request_id
+        self.flush_traffic()
         self.errorOccurred.emit(WorkerError.from_exception(operation, exc, rid))
 
     def fail_queued(self, message: str, code: str | None = None) -> None:

@@ -445,10 +445,19 @@ def test_stop_during_a_large_upload_is_serviced_promptly(
 ) -> None:
     monkeypatch.setattr(timing, "CLOCK_POLL_PERIOD", 0.05)
     connect(qtbot, link, sim)
-    link.set_traffic_capture(True)  # one trafficObserved batch per poll: proof that polls go on
+    link.set_traffic_capture(True)  # the polls' pose reads on the wire: proof that polls go on
     polls: list[int] = []
     statuses: list[Any] = []
-    link.trafficObserved.connect(lambda batch: polls.append(len(batch)))
+    pose_read = registers.POSE_BLOCK_START
+    link.trafficObserved.connect(
+        lambda batch: polls.extend(
+            1
+            for r in batch
+            if r.direction == "tx"
+            and r.frame[7] == 0x03
+            and int.from_bytes(r.frame[8:10], "big") == pose_read
+        )
+    )
     link.statusChanged.connect(statuses.append)
     total = 3000
     upload_id = link.upload_points(_poses(sim, range(1, total + 1)))
