@@ -2291,17 +2291,17 @@
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="433" />
+            <location filename="../../ui/panels/monitor_panel.py" line="439" />
             <source>values stale (grey): no fresh data from the controller</source>
             <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="429" />
+            <location filename="../../ui/panels/monitor_panel.py" line="435" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="431" />
+            <location filename="../../ui/panels/monitor_panel.py" line="437" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -3599,8 +3599,8 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
         </message>
         <message>
             <location filename="../../ui/panels/pose_strip.py" line="67" />
-            <location filename="../../ui/panels/pose_strip.py" line="290" />
-            <location filename="../../ui/panels/pose_strip.py" line="291" />
+            <location filename="../../ui/panels/pose_strip.py" line="295" />
+            <location filename="../../ui/panels/pose_strip.py" line="296" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
@@ -3625,32 +3625,32 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="208" />
+            <location filename="../../ui/panels/pose_strip.py" line="211" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="209" />
+            <location filename="../../ui/panels/pose_strip.py" line="212" />
             <source>Mode</source>
             <translation>模式</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="210" />
+            <location filename="../../ui/panels/pose_strip.py" line="213" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="211" />
+            <location filename="../../ui/panels/pose_strip.py" line="214" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="212" />
+            <location filename="../../ui/panels/pose_strip.py" line="215" />
             <source>The controller's program state (register 561)</source>
             <translation>控制器程序状态（寄存器 561）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="214" />
+            <location filename="../../ui/panels/pose_strip.py" line="217" />
             <source>Whether the values shown were confirmed by the controller within the freshness limit</source>
             <translation>显示的数值是否在时效内得到控制器确认</translation>
         </message>
@@ -3960,224 +3960,224 @@ Remove them all?</source>
     <context>
         <name>Protocol</name>
         <message>
-            <location filename="../../app/protocol/enums.py" line="39" />
+            <location filename="../../app/protocol/enums.py" line="40" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="40" />
+            <location filename="../../app/protocol/enums.py" line="41" />
             <source>incremental move (joint)</source>
             <translation>增量运动（关节）</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="41" />
+            <location filename="../../app/protocol/enums.py" line="42" />
             <source>incremental move (base)</source>
             <translation>增量运动（基坐标）</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="42" />
+            <location filename="../../app/protocol/enums.py" line="43" />
             <source>move to temp point</source>
             <translation>运动到临时点</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="43" />
+            <location filename="../../app/protocol/enums.py" line="44" />
             <source>teach enable</source>
             <translation>示教使能</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="44" />
+            <location filename="../../app/protocol/enums.py" line="45" />
             <source>teach disable</source>
             <translation>示教关闭</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="45" />
+            <location filename="../../app/protocol/enums.py" line="46" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="65" />
+            <location filename="../../app/protocol/enums.py" line="66" />
             <source>manual</source>
             <translation>手动</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="66" />
+            <location filename="../../app/protocol/enums.py" line="67" />
             <source>auto</source>
             <translation>自动</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="67" />
+            <location filename="../../app/protocol/enums.py" line="68" />
             <source>Modbus teach</source>
             <translation>Modbus 示教</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="80" />
+            <location filename="../../app/protocol/enums.py" line="81" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="81" />
+            <location filename="../../app/protocol/enums.py" line="82" />
             <source>running</source>
             <translation>运行中</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="82" />
+            <location filename="../../app/protocol/enums.py" line="83" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="95" />
+            <location filename="../../app/protocol/enums.py" line="96" />
             <source>single step</source>
             <translation>单步</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="96" />
+            <location filename="../../app/protocol/enums.py" line="97" />
             <source>single run</source>
             <translation>单次运行</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="97" />
+            <location filename="../../app/protocol/enums.py" line="98" />
             <source>cycle</source>
             <translation>循环</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="111" />
+            <location filename="../../app/protocol/enums.py" line="112" />
             <source>base</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="112" />
+            <location filename="../../app/protocol/enums.py" line="113" />
             <source>user</source>
             <translation>用户坐标系</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="113" />
+            <location filename="../../app/protocol/enums.py" line="114" />
             <source>tool</source>
             <translation>工具坐标系</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="114" />
+            <location filename="../../app/protocol/enums.py" line="115" />
             <source>joint</source>
             <translation>关节坐标系</translation>
-        </message>
-        <message>
-            <location filename="../../app/protocol/enums.py" line="133" />
-            <location filename="../../app/protocol/enums.py" line="224" />
-            <location filename="../../app/protocol/enums.py" line="246" />
-            <source>emergency stop</source>
-            <translation>急停</translation>
         </message>
         <message>
             <location filename="../../app/protocol/enums.py" line="134" />
             <location filename="../../app/protocol/enums.py" line="225" />
             <location filename="../../app/protocol/enums.py" line="247" />
-            <source>servo alarm</source>
-            <translation>伺服报警</translation>
+            <source>emergency stop</source>
+            <translation>急停</translation>
         </message>
         <message>
             <location filename="../../app/protocol/enums.py" line="135" />
             <location filename="../../app/protocol/enums.py" line="226" />
             <location filename="../../app/protocol/enums.py" line="248" />
+            <source>servo alarm</source>
+            <translation>伺服报警</translation>
+        </message>
+        <message>
+            <location filename="../../app/protocol/enums.py" line="136" />
+            <location filename="../../app/protocol/enums.py" line="227" />
+            <location filename="../../app/protocol/enums.py" line="249" />
             <source>brake alarm</source>
             <translation>抱闸报警</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="136" />
-            <location filename="../../app/protocol/enums.py" line="250" />
+            <location filename="../../app/protocol/enums.py" line="137" />
+            <location filename="../../app/protocol/enums.py" line="251" />
             <source>algorithm alarm</source>
             <translation>算法报警</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="137" />
+            <location filename="../../app/protocol/enums.py" line="138" />
             <source>encoder angle alarm</source>
             <translation>编码器角度报警</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="221" />
-            <location filename="../../app/protocol/enums.py" line="238" />
-            <location filename="../../app/protocol/enums.py" line="243" />
+            <location filename="../../app/protocol/enums.py" line="222" />
+            <location filename="../../app/protocol/enums.py" line="239" />
+            <location filename="../../app/protocol/enums.py" line="244" />
             <source>initial</source>
             <translation>初始</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="222" />
+            <location filename="../../app/protocol/enums.py" line="223" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="223" />
-            <location filename="../../app/protocol/enums.py" line="245" />
+            <location filename="../../app/protocol/enums.py" line="224" />
+            <location filename="../../app/protocol/enums.py" line="246" />
             <source>work mode error</source>
             <translation>工作模式错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="227" />
-            <location filename="../../app/protocol/enums.py" line="249" />
+            <location filename="../../app/protocol/enums.py" line="228" />
+            <location filename="../../app/protocol/enums.py" line="250" />
             <source>bus servo initialisation error</source>
             <translation>总线伺服初始化错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="228" />
+            <location filename="../../app/protocol/enums.py" line="229" />
             <source>moving</source>
             <translation>运动中</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="229" />
+            <location filename="../../app/protocol/enums.py" line="230" />
             <source>data length error</source>
             <translation>数据长度错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="230" />
+            <location filename="../../app/protocol/enums.py" line="231" />
             <source>encoder angle read error</source>
             <translation>编码器角度读取错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="231" />
+            <location filename="../../app/protocol/enums.py" line="232" />
             <source>encoder angle update error</source>
             <translation>编码器角度更新错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="232" />
+            <location filename="../../app/protocol/enums.py" line="233" />
             <source>calculation error</source>
             <translation>计算错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="233" />
+            <location filename="../../app/protocol/enums.py" line="234" />
             <source>algorithm error while moving</source>
             <translation>运动中算法错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="234" />
+            <location filename="../../app/protocol/enums.py" line="235" />
             <source>motion timeout</source>
             <translation>运动超时</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="235" />
+            <location filename="../../app/protocol/enums.py" line="236" />
             <source>bad end point id</source>
             <translation>终点编号错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="239" />
-            <location filename="../../app/protocol/enums.py" line="244" />
+            <location filename="../../app/protocol/enums.py" line="240" />
+            <location filename="../../app/protocol/enums.py" line="245" />
             <source>success</source>
             <translation>成功</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="240" />
+            <location filename="../../app/protocol/enums.py" line="241" />
             <source>bad point id</source>
             <translation>点编号错误</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="251" />
+            <location filename="../../app/protocol/enums.py" line="252" />
             <source>teach speed ratio not zero: enable/disable refused</source>
             <translation>示教速度比例不为零：拒绝使能/关闭</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="264" />
+            <location filename="../../app/protocol/enums.py" line="265" />
             <source>unknown status {code}</source>
             <translation>未知状态 {code}</translation>
         </message>
         <message>
-            <location filename="../../app/protocol/enums.py" line="265" />
+            <location filename="../../app/protocol/enums.py" line="266" />
             <source>sent, waiting for the controller</source>
             <translation>已发送，等待控制器结果</translation>
         </message>
