@@ -268,3 +268,35 @@ def test_ctrl_c_is_interrupted(sim_factory: Any) -> None:
     assert code == ExitCode.INTERRUPTED
     assert err.splitlines()[-1] == "teachpad-cli: error: interrupted"
     assert sim.wait_for(lambda s: not s.moving, 2.0)  # and the motion was stopped
+
+
+def test_the_console_script_ends_a_ctrl_c_during_its_imports_in_one_line(capsys: Any) -> None:
+    """Ctrl-C while ``teachpad-cli`` is still importing (a few hundred ms): exit 130, one line on
+    stderr, no traceback; otherwise the script is :func:`app.cli.main.main` itself."""
+    import tomllib
+
+    from app.cli import entry
+
+    def interrupted_import() -> Any:
+        raise KeyboardInterrupt
+
+    assert entry.main(interrupted_import) == ExitCode.INTERRUPTED == entry.INTERRUPTED
+    err = capsys.readouterr().err
+    assert err == "teachpad-cli: interrupted (before any request was sent)\n"
+    assert entry.main(lambda: lambda: 7) == 7
+    assert entry._load() is main
+    scripts = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["scripts"]
+    assert scripts["teachpad-cli"] == "app.cli.entry:main"
+
+
+def test_the_installed_console_script_runs() -> None:
+    """The ``teachpad-cli`` the install made (beside this Python) starts through :mod:`app.cli.entry`."""
+    import subprocess
+    import sys
+
+    script = Path(sys.executable).parent / "teachpad-cli"
+    if not script.exists():
+        pytest.skip("teachpad-cli is not installed beside this Python")
+    assert "app.cli.entry" in script.read_text()
+    proc = subprocess.run([str(script), "--help"], capture_output=True, text=True, timeout=60, check=False)
+    assert proc.returncode == 0 and "exit codes" in proc.stdout, proc.stderr
