@@ -121,11 +121,11 @@ def stop_on_a_fresh_link(client: Any, *, command_sent: float | None = None) -> N
     the link timeout (a controller takes a request within the timeout, or it counts as lost).
     Ctrl-C is ignored meanwhile; it all takes at most the connect, two requests and the rest of
     one timeout."""
-    tracker = getattr(client, "last_tracker", None)
-    if command_sent is None and tracker is not None and not tracker.finished and not tracker.acknowledged:
-        command_sent = tracker.started
-    client.close()
-    with sigint_deferred():
+    with sigint_deferred():  # from the start: a second Ctrl-C (operators press it again) cancels no stop
+        tracker = getattr(client, "last_tracker", None)
+        if command_sent is None and tracker is not None and not tracker.finished and not tracker.acknowledged:
+            command_sent = tracker.started
+        client.close()
         client.stop()
         if command_sent is not None:
             time.sleep(max(0.0, command_sent + client.settings.timeout - time.monotonic()))

@@ -70,6 +70,7 @@ class WorkerCommands:
         except TeachPadError:  # no answer in time, refused, link lost: the operator still asked for it
             self._cancel_motions_before_stop()  # nothing queued before the Stop runs after it
             self.uploader.end("stopped")
+            self._end_jog_after_a_failed_stop()
             raise
         finally:
             if on_line is not None:  # its answer: checked, audited, shown in the traffic
@@ -85,6 +86,15 @@ class WorkerCommands:
         if active is not None:
             self.emit_result(active.completion.stopped(now), active.request_id)
         self._done("stop: sent")
+
+    def _end_jog_after_a_failed_stop(self) -> None:
+        """The held jog ends (a jog sequence still starting gives way before its ratio goes out),
+        and speed 0 is tried; if that fails too it goes out as soon as the controller answers."""
+        jogging = self.jog.jog is not None or (self.jog.teach.enabled and self.jog.teach.ratio != 0.0)
+        try:
+            self.jog.on_stop()
+        except TeachPadError:
+            self.jog.ratio_zero_pending = self.jog.ratio_zero_pending or jogging
 
     def _cancel_motions_before_stop(self) -> None:
         stop_seq = self._current_seq

@@ -327,3 +327,41 @@ def test_a_ctrl_c_python_drops_still_ends_the_command_before_anything_is_sent(si
     assert (proc.returncode, proc.stdout) == (ExitCode.INTERRUPTED, "")
     assert proc.stderr == "teachpad-cli: error: interrupted\n"
     assert sim.writes == [] and not sim.state().moving
+
+
+def test_a_second_ctrl_c_while_the_old_link_closes_cancels_no_stop(
+    sim_factory: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Operators press Ctrl-C more than once: one landing while the half-used link is being closed
+    (before the stop) is ignored too, and the stop goes out. Before, the link was closed before
+    Ctrl-C was deferred: that second Ctrl-C ended the CLI with no stop sent."""
+    import os
+
+    from app.cli.context import stop_on_a_fresh_link
+
+    sim = sim_factory(command_latency=0.02)
+    ctx = _ctx(sim)
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)  # as in a shell's foreground
+    try:
+        client = ctx.client
+        client.step(StepFrame.JOINT, [90.0, 0, 0, 0, 0, 0], speed=1.0, wait=False)
+        assert sim.wait_for(lambda s: s.moving, 5.0)
+        close = client.close
+        pressed: list[bool] = []
+
+        def close_with_a_second_ctrl_c() -> None:
+            if not pressed:  # the stop's own close, not the test's at the end
+                pressed.append(True)
+                os.kill(os.getpid(), signal.SIGINT)
+            close()
+
+        monkeypatch.setattr(client, "close", close_with_a_second_ctrl_c)
+        try:
+            stop_on_a_fresh_link(client)
+        except KeyboardInterrupt:
+            pytest.fail("the second Ctrl-C ended the stop before it was sent")
+        assert sim.writes_to(registers.REG_STOP)[-1].values == (1,)
+        assert sim.wait_for(lambda s: not s.moving, 2.0)
+    finally:
+        signal.signal(signal.SIGINT, before)
+        ctx.close()

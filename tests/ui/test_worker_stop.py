@@ -95,3 +95,36 @@ def test_a_stop_whose_main_link_write_gets_no_answer_still_cancels_the_motions_q
     # at the simulator: the stop(s), never a go-to-zero (430) or a program run (440) after it
     after = {w.address for w in list(sim.writes)[writes_before:]}
     assert 441 in after and not after & {registers.REG_GO_ZERO, registers.REG_RUN_COMMAND}
+
+
+def test_a_stop_the_controller_refuses_still_ends_the_held_jog(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    """The operator holds a jog and presses Stop; the controller refuses the stop (a Modbus
+    exception on 441, on the stop line and the main link alike). The Stop fails, but the jog it was
+    pressed against ends all the same: speed 0 goes out and the arm stands. The old code ended the
+    jog only after a stop that succeeded: the arm went on jogging after the Stop."""
+    from pymodbus.constants import ExcCodes
+
+    from app.protocol.enums import TeachFrame
+    from tests.ui.pendant_support import jogging, ratio_writes
+
+    connect(qtbot, link, sim)
+    link.jog_press(TeachFrame.BASE, 1, 1, 20.0)
+    qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
+    ratios_before = len(ratio_writes(sim))
+    results: list[CommandResult] = []
+    link.commandFinished.connect(results.append)
+    sim.set_exception(ExcCodes.ILLEGAL_VALUE, range(registers.REG_STOP, registers.REG_STOP + 1))
+    stop_id = link.stop()
+    qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
+    stop = next(r for r in results if r.request_id == stop_id)
+    assert not stop.ok and "refused" in stop.message
+    assert sim.writes_to(441) == []  # the controller took no stop
+    # at the simulator: speed 0 after the refused stop, and the arm standing
+    qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
+    assert ratio_writes(sim)[ratios_before:] == [0.0]
+    sim.set_exception(None)
+    pose = sim.state().pose
+    seen = sim.requests_count  # a few polls later: the arm has not moved, no speed went out
+    qtbot.waitUntil(lambda: sim.requests_count > seen + 5, timeout=SIGNAL_TIMEOUT_MS)
+    assert sim.state().pose == pytest.approx(pose, abs=1e-6) and not jogging(sim)
+    assert ratio_writes(sim)[ratios_before:] == [0.0]
