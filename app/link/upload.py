@@ -20,9 +20,10 @@ next pose, no next point; only the point whose writes already went out is waited
 A failed point ends the upload only when the link failed during it
 (:attr:`~app.models.CommandResult.link_failed`: link lost, no answer in time, a malformed
 answer -- its outcome is unknown and the link is declared failed). A point the controller
-refused (a failed status, or a Modbus exception, which ends that call of ``upload_points``) is
-reported failed in the controller's words and counted as refused; the next chunk goes on with
-the next point (the CLI's ``points upload`` follows the same rule).
+refused (a refused status, or a Modbus exception, which ends that call of ``upload_points``), or
+whose result never showed (no acknowledgement, a timeout, an alarm), is reported failed in its own
+words and counted as refused or failed; the next chunk goes on with the next point (the CLI's
+``points upload`` follows the same rule).
 """
 
 from __future__ import annotations
@@ -80,8 +81,9 @@ class UploadRun:
     progress_at: float = 0.0  # when uploadProgress was last emitted
     progress_done: int = -1  # the ``done`` it carried
     halts_at_start: int = 0  # the host's count of stops and cancels requested when it began
-    refused: int = 0  # points the controller refused (a Modbus exception): reported failed, link kept
-    first_refusal: str = ""  # the first refused point's words, for the final result
+    refused: int = 0  # points the controller refused (a refused status, a Modbus exception): link kept
+    failed: int = 0  # points whose result never showed (no acknowledgement, timeout, alarm): link kept
+    first_failure: str = ""  # the first refused or failed point's words, for the final result
 
 
 def stage_gv_for(canary_gv: int | None) -> int:
@@ -97,6 +99,9 @@ def group_by_tool(items: Iterable[UploadItem]) -> list[UploadItem]:
     for item in items:
         groups.setdefault(item[2], []).append(item)
     return [item for group in groups.values() for item in group]
+
+
+REFUSAL_CODES = frozenset({"command_refused", "modbus_exception"})  # the controller answered no
 
 
 def refused_before_the_first(point_ids: Iterable[int], exc: ModbusExceptionError) -> list[CommandResult]:
@@ -262,11 +267,17 @@ class Uploader:
                 if result.link_failed:  # its outcome is unknown, the link not to be trusted
                     transport_error = result.message
                 elif not result.stopped_by_operator:
-                    # the controller said no (a failed status, or a Modbus exception, which ended the
-                    # batch there): the link is fine, the next chunk goes on with the next point in a
-                    # fresh call (its pose written anew, whatever was staged before the refusal)
-                    upload.refused += 1
-                    upload.first_refusal = upload.first_refusal or result.message
+                    # the link is fine: the next chunk goes on with the next point in a fresh call
+                    # (its pose written anew, whatever was staged before). Refused only when the
+                    # controller said no (a refused status, a Modbus exception, which ended the batch
+                    # there); a point whose result never showed (no acknowledgement, a timeout, an
+                    # alarm) failed, its words say how
+                    code = result.reason.code if result.reason is not None else ""
+                    if code in REFUSAL_CODES:
+                        upload.refused += 1
+                    else:
+                        upload.failed += 1
+                    upload.first_failure = upload.first_failure or result.message
         if transport_error is not None:
             upload.end = upload.end or transport_error
             if host.link_up:  # a link already lost or closed (an urgent job meanwhile) counts no more
@@ -305,15 +316,18 @@ class Uploader:
         text = f"uploaded {upload.good} of {total} points"
         if upload.refused:
             text += f", {upload.refused} refused"
-            if upload.end is None and upload.index >= total:
-                # the first refusal's words only when every point was tried: one that ended early
-                # keeps its "(why)" last, where the GUI reads it (ui/controllers point_sync_state)
-                text += f": {upload.first_refusal}"
+        if upload.failed:
+            text += f", {upload.failed} failed"
+        if upload.first_failure and upload.end is None and upload.index >= total:
+            # the first failure's words only when every point was tried: one that ended early
+            # keeps its "(why)" last, where the GUI reads it (ui/controllers point_sync_state)
+            text += f": {upload.first_failure}"
         text += f" ({upload.end})" if upload.end else ""
         details = {
             "uploaded": float(upload.good),
             "attempted": float(upload.index),
             "refused": float(upload.refused),
+            "failed": float(upload.failed),
             "total": float(total),
         }
         result = CommandResult(RunCommand.CREATE_POINT, None, None, upload.good == total, text, details)

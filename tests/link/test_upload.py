@@ -348,6 +348,25 @@ def _refusal_upload(host: PartsHost, sim: Any, count: int = 6) -> list[RawItem]:
     return items
 
 
+def test_a_point_whose_result_never_shows_is_counted_failed_not_refused(
+    host: PartsHost, sim_factory: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The controller keeps every create-point result back (60 s) past the point's timeout: nobody
+    said no, the points' outcome is not known -- the final result counts them *failed* with the
+    words of the first ("did not complete ..."), never "refused"; the link is kept."""
+    monkeypatch.setattr(timing, "CREATE_POINT_TIMEOUT", 0.3)
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.3)
+    sim = sim_factory(command_latency=60.0)
+    host.connect(sim)
+    _refusal_upload(host, sim, count=2)
+    assert [ok for _, ok, _, _ in host.of("pointUploaded")] == [False, False]
+    result = host.of("commandFinished")[-1]
+    assert re.match(r"uploaded 0 of 2 points, 2 failed: point 100: ", result.message), result.message
+    assert "refused" not in result.message
+    assert result.details["failed"] == 2.0 and result.details["refused"] == 0.0
+    assert host.link_up and host.reconnect_delays == []
+
+
 def test_a_point_the_controller_refuses_with_a_modbus_exception_is_failed_and_the_upload_goes_on(
     host: PartsHost, sim_factory: Any
 ) -> None:
