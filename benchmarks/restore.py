@@ -223,7 +223,10 @@ def bench_restore(
     figures = summarize(done, samples, latency)
     out: dict[str, Any] = {
         "points": n,
-        "path": "RobotClient.upload_points (the GUI's restore-all, via the worker)",
+        "path": (
+            "RobotClient.upload_points in rounds: the call the GUI's restore-all makes through the "
+            "worker (there per chunk of 20, with polls between chunks; here without the worker)"
+        ),
         "rounds": len(done),
         "points_per_round": size,
         "failed": failed,
