@@ -90,7 +90,7 @@ class WorkerCommands:
     def _end_jog_after_a_failed_stop(self) -> None:
         """The held jog ends (a jog sequence still starting gives way before its ratio goes out),
         and speed 0 is tried; if that fails too it goes out as soon as the controller answers."""
-        jogging = self.jog.jog is not None or (self.jog.teach.enabled and self.jog.teach.ratio != 0.0)
+        jogging = self.jog.jogging
         try:
             self.jog.on_stop()
         except TeachPadError:

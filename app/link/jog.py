@@ -34,6 +34,11 @@ class TeachState:
     ratio: float = 0.0  # last GV203 we wrote
     enabled_at: float = 0.0
 
+    @property
+    def moving(self) -> bool:
+        """Teach is on with a nonzero speed written: the arm may be jogging."""
+        return self.enabled and self.ratio != 0.0
+
 
 class PreemptedError(Exception):
     """A jog sequence gave way to an urgent job (release / stop) or to a link loss."""
@@ -55,6 +60,11 @@ class JogMachine:
         self._pose_read_at: float | None = None  # when the read of the poller's last pose was sent
 
     # --- state ----------------------------------------------------------------------------
+    @property
+    def jogging(self) -> bool:
+        """A jog is held, or a speed written for one is still in force."""
+        return self.jog is not None or self.teach.moving
+
     def reset(self) -> None:
         """A new connection (new settings): nothing is known about teach mode."""
         self.teach = TeachState()
@@ -79,7 +89,7 @@ class JogMachine:
         """The controller stopped answering: drop the held jog (ratio 0 goes out on its return).
         When a jog was under way the operator is told (an error with its reason, code
         ``jog_stopped_silent``)."""
-        jogging = self.jog is not None or (self.teach.enabled and self.teach.ratio != 0.0)
+        jogging = self.jogging
         self.end_jog()
         if not jogging:
             return
@@ -163,7 +173,7 @@ class JogMachine:
     def on_stop(self) -> None:
         """A stop went out: the jog ends, ratio 0 if teach is on and moving."""
         self.end_jog()
-        if self.teach.enabled and self.teach.ratio != 0.0:
+        if self.teach.moving:
             self._host.client_or_raise().teach_set_ratio(0.0)
             self.teach.ratio = 0.0
 
@@ -250,13 +260,13 @@ class JogMachine:
         if guard is None or pose is None:
             return
         # A standing arm's last pose is still where it is; a moving one's has aged since its read.
-        moving = self.teach.enabled and self.teach.ratio != 0.0
+        moving = self.teach.moving
         read_at = self._pose_read_at if moving else None
         horizon = self.guard_timing.horizon(guard, time.perf_counter(), read_at)
         decision = guard.decide(pose, request, horizon)
         if not decision.allow and decision.violation is not None:
             self.end_jog()
-            if self.teach.enabled and self.teach.ratio != 0.0:  # a jog under way stops too
+            if self.teach.moving:  # a jog under way stops too
                 self._host.client_or_raise().teach_set_ratio(0.0)
                 self.teach.ratio = 0.0
             raise EnvelopeRefused(decision.violation, "jog")
@@ -314,7 +324,7 @@ class JogMachine:
                 params={"value": f"{ratio:g}"},
             )
         self.jog = dataclasses.replace(jog, ratio=ratio)
-        if self.teach.enabled and self.teach.ratio != 0.0 and self.teach.ratio != ratio:
+        if self.teach.moving and self.teach.ratio != ratio:
             self._require_guard(self.jog)
             self._host.client_or_raise().teach_set_ratio(ratio)
             self.teach.ratio = ratio

@@ -48,7 +48,7 @@ class Poller:
     def rate(self, setting_hz: float) -> float:
         """The poll rate to use now: the GUI's setting, at least :data:`JOG_POLL_HZ_MIN` while jogging."""
         jog = self._host.jog
-        if jog.jog is not None or (jog.teach.enabled and jog.teach.ratio != 0.0):
+        if jog.jogging:
             return max(setting_hz, JOG_POLL_HZ_MIN)
         return setting_hz
 
