@@ -16,7 +16,13 @@ from app.protocol.codec import WordOrder, registers_to_float
 SIGNAL_TIMEOUT_MS = 5000
 # The offscreen platform warns when a top-level window gets size constraints; not our concern.
 QT_LOG_IGNORE = ("This plugin does not support propagateSizeHints",)
-REQUEST_TIMEOUT = 0.25  # s: a silent simulator is noticed quickly
+# Roomy timeouts (s), as tests/link/harness.py: the simulator runs in the test process, and a
+# loaded machine (coverage, a CI neighbour) can hold an answer past the product's 0.15 s poll
+# timeout; the product then rightly says "not answering" and a plan run or an upload ends -- a
+# test about something else fails (CI, stop 18: a plan run never started). Tests about silence
+# pass ``poll_timeout=None`` (the product's figure) or their own short timeouts.
+REQUEST_TIMEOUT = 1.0
+POLL_TIMEOUT = 1.0
 
 
 @pytest.fixture(name="fast_reconnect")
@@ -55,7 +61,12 @@ def is_state(state: LinkState) -> Callable[[ConnectionState], bool]:
 
 
 def connection_settings(sim: Any, **overrides: Any) -> ConnectionSettings:
-    values: dict[str, Any] = {"host": "127.0.0.1", "port": sim.port, "timeout": REQUEST_TIMEOUT}
+    values: dict[str, Any] = {
+        "host": "127.0.0.1",
+        "port": sim.port,
+        "timeout": REQUEST_TIMEOUT,
+        "poll_timeout": POLL_TIMEOUT,
+    }
     values.update(overrides)
     return ConnectionSettings(**values)
 

@@ -80,7 +80,8 @@ def test_opens_on_the_link_connection_and_says_it_is_connected(
     """A real link to the simulator: the dialog shows its settings (not the defaults), says
     it is connected, and the poll rate; OK without changes gives the same connection back."""
     sim = sim_factory(unit=7, word_order=WordOrder.HIGH_FIRST)
-    used = connect(qtbot, link, sim, unit=7, word_order=WordOrder.HIGH_FIRST, monitor_only=True, timeout=0.4)
+    options = {"unit": 7, "word_order": WordOrder.HIGH_FIRST, "monitor_only": True, "timeout": 0.4}
+    used = connect(qtbot, link, sim, **options, poll_timeout=None)  # the dialog has no poll timeout
     # remembered, older: where is not shown; unit and word order are the register profile's (which
     # the remembered settings carry), shown read-only
     saved = ConnectionSettings(host="10.0.0.9", port=1502, unit=7, word_order=WordOrder.HIGH_FIRST)

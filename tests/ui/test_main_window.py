@@ -118,7 +118,8 @@ def test_live_pose_reaches_the_monitor(qtbot: Any, sim: Any, window: MainWindow)
 def test_connect_disconnect_from_the_window(
     qtbot: Any, sim: Any, window: MainWindow, app_settings: AppSettings
 ) -> None:
-    settings = connection_settings(sim, unit=1, word_order=WordOrder.LOW_FIRST)
+    # poll_timeout None: the window remembers what the connection dialog offers, not a test knob
+    settings = connection_settings(sim, unit=1, word_order=WordOrder.LOW_FIRST, poll_timeout=None)
     with qtbot.waitSignal(
         window.link.connectionChanged,
         check_params_cb=is_state(LinkState.CONNECTED),

@@ -83,7 +83,7 @@ def test_a_link_lost_after_a_refused_point_still_ends_the_upload(
     link failure) ends the upload there, as before: the point under way failed, the rest not
     attempted, the link declared down; it comes back once the controller answers again."""
     sim = sim_factory(command_latency=0.02)
-    connect(qtbot, link, sim, timeout=1.0)
+    connect(qtbot, link, sim, timeout=1.0, poll_timeout=None)  # the product's poll timeout: silence is seen
     watch = _Watch(link)
     sim.refuse_point_write(3)
 
@@ -98,6 +98,9 @@ def test_a_link_lost_after_a_refused_point_still_ends_the_upload(
             link.commandFinished, check_params_cb=_finished(upload_id), timeout=30_000
         ) as done:
             pass
+        # the link is declared by the polls after the upload, which meet the silence (the old test
+        # un-silenced the simulator here at once: on a loaded machine before the next poll went out)
+        qtbot.waitUntil(lambda: bool(watch.states), timeout=SIGNAL_TIMEOUT_MS)
     finally:
         sim.set_silent(False)
     result = done.args[0]

@@ -206,8 +206,15 @@ def test_plan_runs_from_the_planner_tab_to_the_last_point(
     planner = window.planner_panel
     runs: list[bool] = []
     window.run_controller.runningChanged.connect(runs.append)
-    with qtbot.waitSignal(window.run_controller.runFinished, timeout=30_000) as finished:
-        assert planner.run()  # uploads the three points first (asked, answered yes), then runs
+    said: list[str] = []  # what the operator was told, quoted when the run never finishes
+    planner.statusMessage.connect(said.append)
+    window.point_sync.statusMessage.connect(lambda text, level: said.append(f"{level}: {text}"))
+    window.link.errorOccurred.connect(lambda error: said.append(f"link: {error}"))
+    try:
+        with qtbot.waitSignal(window.run_controller.runFinished, timeout=30_000) as finished:
+            assert planner.run()  # uploads the three points first (asked, answered yes), then runs
+    except qtbot.TimeoutError:
+        pytest.fail("the run never finished; the operator was told: " + " | ".join(said))
     assert finished.args[0].state is RunState.FINISHED
     assert runs == [True, False]
     assert sorted(sim.state().points) == [1, 2, 3]

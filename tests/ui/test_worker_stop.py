@@ -73,7 +73,7 @@ def test_a_stop_whose_main_link_write_gets_no_answer_still_cancels_the_motions_q
     """The simulator answers after 0.4 s, beyond the link's 0.25 s request timeout: the main
     link's 441 gets no answer in time (an error for the Stop). The motions queued before the Stop
     are cancelled all the same -- the old code then sent them, after the operator's Stop."""
-    connect(qtbot, link, sim)
+    connect(qtbot, link, sim, timeout=0.25, poll_timeout=None)
     sim.set_response_delay(0.4)
     seen = sim.requests_count
     qtbot.waitUntil(lambda: sim.requests_count > seen, timeout=SIGNAL_TIMEOUT_MS)  # a read in flight
