@@ -106,6 +106,9 @@ _TEMPLATES: dict[str, str] = {
     "jog_not_answering": QT_TRANSLATE_NOOP(
         "Messages", "The controller is not answering: the jog was not started."
     ),
+    "run_not_answering_start": QT_TRANSLATE_NOOP(
+        "Messages", "The controller is not answering: the plan was not started. Try again when it answers."
+    ),
     "bad_jog_ratio": QT_TRANSLATE_NOOP("Messages", "Jog speed {value}% is not within 1..100%."),
     # the link
     "link_lost": QT_TRANSLATE_NOOP("Messages", "Lost the connection to the controller at {endpoint}."),

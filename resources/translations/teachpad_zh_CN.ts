@@ -1214,162 +1214,167 @@
         </message>
         <message>
             <location filename="../../ui/messages.py" line="109" />
+            <source>The controller is not answering: the plan was not started. Try again when it answers.</source>
+            <translation>控制器无应答：计划未启动。待其恢复应答后再试。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="112" />
             <source>Jog speed {value}% is not within 1..100%.</source>
             <translation>点动速度 {value}% 不在 1..100% 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="111" />
+            <location filename="../../ui/messages.py" line="114" />
             <source>Lost the connection to the controller at {endpoint}.</source>
             <translation>与控制器 {endpoint} 的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="112" />
+            <location filename="../../ui/messages.py" line="115" />
             <source>The controller at {endpoint} closed the connection.</source>
             <translation>控制器 {endpoint} 关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="113" />
+            <location filename="../../ui/messages.py" line="116" />
             <source>The host name {host} cannot be resolved.</source>
             <translation>无法解析主机名 {host}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="114" />
+            <location filename="../../ui/messages.py" line="117" />
             <source>Connection refused: nothing listens on port {port}.</source>
             <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="117" />
+            <location filename="../../ui/messages.py" line="120" />
             <source>No answer to the connection request within {seconds} s.</source>
             <translation>连接请求在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="120" />
+            <location filename="../../ui/messages.py" line="123" />
             <source>The connection could not be opened.</source>
             <translation>无法建立连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="121" />
+            <location filename="../../ui/messages.py" line="124" />
             <source>Cannot open the serial port {port}.</source>
             <translation>无法打开串口 {port}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="122" />
+            <location filename="../../ui/messages.py" line="125" />
             <source>The controller at {endpoint} did not answer within {seconds} s.</source>
             <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="125" />
+            <location filename="../../ui/messages.py" line="128" />
             <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
             <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="129" />
+            <location filename="../../ui/messages.py" line="132" />
             <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="132" />
+            <location filename="../../ui/messages.py" line="135" />
             <source>Monitor-only mode: nothing was sent to the controller.</source>
             <translation>仅监视模式：未向控制器发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="133" />
+            <location filename="../../ui/messages.py" line="136" />
             <location filename="../../ui/messages_plan.py" line="26" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="134" />
+            <location filename="../../ui/messages.py" line="137" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="136" />
+            <location filename="../../ui/messages.py" line="139" />
             <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
             <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="140" />
+            <location filename="../../ui/messages.py" line="143" />
             <source>The controller did not create {point} again before the move: the arm was not moved.</source>
             <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="143" />
+            <location filename="../../ui/messages.py" line="146" />
             <source>The project has no point {point}: the arm was not moved.</source>
             <translation>项目中没有点 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="146" />
+            <location filename="../../ui/messages.py" line="149" />
             <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
             <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="150" />
+            <location filename="../../ui/messages.py" line="153" />
             <source>The link was shut down.</source>
             <translation>通信链路已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="151" />
+            <location filename="../../ui/messages.py" line="154" />
             <source>{operation}: the connection was lost while it was under way; its outcome is unknown.</source>
             <translation>{operation}：执行期间连接中断，结果未知。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="154" />
+            <location filename="../../ui/messages.py" line="157" />
             <source>{operation}: the connection was closed while it was under way.</source>
             <translation>{operation}：执行期间连接被关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="158" />
+            <location filename="../../ui/messages.py" line="161" />
             <source>{operation}: not sent, the connection to the controller is down.</source>
             <translation>{operation}：未发送，与控制器的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="161" />
+            <location filename="../../ui/messages.py" line="164" />
             <source>{operation}: not sent, the connection was closed.</source>
             <translation>{operation}：未发送，连接已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="163" />
+            <location filename="../../ui/messages.py" line="166" />
             <source>points outside {id_min}..{id_max}: {ids}</source>
             <translation>超出 {id_min}..{id_max} 范围的点：{ids}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="164" />
+            <location filename="../../ui/messages.py" line="167" />
             <source>there is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="165" />
+            <location filename="../../ui/messages.py" line="168" />
             <source>no free point id left in {start}..{id_max}</source>
             <translation>{start}..{id_max} 范围内已没有空闲的点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="166" />
+            <location filename="../../ui/messages.py" line="169" />
             <source>there is no row {row}</source>
             <translation>不存在第 {row} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="167" />
+            <location filename="../../ui/messages.py" line="170" />
             <source>cannot move row {src} to {dst} in {rows} rows</source>
             <translation>无法在 {rows} 行中将第 {src} 行移到第 {dst} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="168" />
+            <location filename="../../ui/messages.py" line="171" />
             <source>row {row}: id {id} is already used on row {other}</source>
             <translation>第 {row} 行：编号 {id} 已被第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="169" />
+            <location filename="../../ui/messages.py" line="172" />
             <source>imported point {number}: id {id} appears twice</source>
             <translation>导入的第 {number} 个点：编号 {id} 出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="170" />
+            <location filename="../../ui/messages.py" line="173" />
             <source>id {id} is already used by {point}</source>
             <translation>编号 {id} 已被 {point} 使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="171" />
+            <location filename="../../ui/messages.py" line="174" />
             <source>the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)</source>
             <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
         </message>
@@ -1469,312 +1474,312 @@
             <translation>编号 {id} 已在第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="181" />
+            <location filename="../../ui/messages.py" line="184" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="182" />
+            <location filename="../../ui/messages.py" line="185" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="183" />
+            <location filename="../../ui/messages.py" line="186" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="184" />
+            <location filename="../../ui/messages.py" line="187" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="185" />
+            <location filename="../../ui/messages.py" line="188" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="186" />
+            <location filename="../../ui/messages.py" line="189" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="187" />
+            <location filename="../../ui/messages.py" line="190" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="188" />
+            <location filename="../../ui/messages.py" line="191" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="189" />
+            <location filename="../../ui/messages.py" line="192" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="190" />
+            <location filename="../../ui/messages.py" line="193" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="191" />
+            <location filename="../../ui/messages.py" line="194" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="192" />
+            <location filename="../../ui/messages.py" line="195" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="193" />
+            <location filename="../../ui/messages.py" line="196" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="194" />
+            <location filename="../../ui/messages.py" line="197" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="199" />
+            <location filename="../../ui/messages.py" line="202" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="200" />
+            <location filename="../../ui/messages.py" line="203" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="201" />
+            <location filename="../../ui/messages.py" line="204" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="202" />
+            <location filename="../../ui/messages.py" line="205" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="203" />
+            <location filename="../../ui/messages.py" line="206" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="206" />
+            <location filename="../../ui/messages.py" line="209" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="207" />
+            <location filename="../../ui/messages.py" line="210" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="208" />
+            <location filename="../../ui/messages.py" line="211" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="209" />
+            <location filename="../../ui/messages.py" line="212" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="210" />
+            <location filename="../../ui/messages.py" line="213" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="211" />
+            <location filename="../../ui/messages.py" line="214" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="212" />
+            <location filename="../../ui/messages.py" line="215" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="213" />
+            <location filename="../../ui/messages.py" line="216" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="214" />
+            <location filename="../../ui/messages.py" line="217" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="215" />
+            <location filename="../../ui/messages.py" line="218" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="216" />
+            <location filename="../../ui/messages.py" line="219" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="217" />
+            <location filename="../../ui/messages.py" line="220" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="218" />
+            <location filename="../../ui/messages.py" line="221" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="219" />
+            <location filename="../../ui/messages.py" line="222" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="220" />
+            <location filename="../../ui/messages.py" line="223" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="221" />
+            <location filename="../../ui/messages.py" line="224" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="222" />
+            <location filename="../../ui/messages.py" line="225" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="223" />
+            <location filename="../../ui/messages.py" line="226" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="224" />
+            <location filename="../../ui/messages.py" line="227" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="225" />
+            <location filename="../../ui/messages.py" line="228" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="227" />
+            <location filename="../../ui/messages.py" line="230" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="230" />
+            <location filename="../../ui/messages.py" line="233" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="231" />
+            <location filename="../../ui/messages.py" line="234" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="232" />
+            <location filename="../../ui/messages.py" line="235" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="233" />
+            <location filename="../../ui/messages.py" line="236" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="234" />
+            <location filename="../../ui/messages.py" line="237" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="235" />
+            <location filename="../../ui/messages.py" line="238" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="236" />
+            <location filename="../../ui/messages.py" line="239" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="237" />
+            <location filename="../../ui/messages.py" line="240" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="238" />
+            <location filename="../../ui/messages.py" line="241" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="239" />
+            <location filename="../../ui/messages.py" line="242" />
             <source>unit id</source>
             <translation>站号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="240" />
+            <location filename="../../ui/messages.py" line="243" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="244" />
+            <location filename="../../ui/messages.py" line="247" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="245" />
+            <location filename="../../ui/messages.py" line="248" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="246" />
+            <location filename="../../ui/messages.py" line="249" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="247" />
+            <location filename="../../ui/messages.py" line="250" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="248" />
+            <location filename="../../ui/messages.py" line="251" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="249" />
+            <location filename="../../ui/messages.py" line="252" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="250" />
+            <location filename="../../ui/messages.py" line="253" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="251" />
+            <location filename="../../ui/messages.py" line="254" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="252" />
+            <location filename="../../ui/messages.py" line="255" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="253" />
+            <location filename="../../ui/messages.py" line="256" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="255" />
+            <location filename="../../ui/messages.py" line="258" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
@@ -1824,12 +1829,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="405" />
+            <location filename="../../ui/messages.py" line="408" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="409" />
+            <location filename="../../ui/messages.py" line="412" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -2723,76 +2728,71 @@
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="91" />
-            <source>Not connected to a controller</source>
-            <translation>未连接控制器</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_run.py" line="102" />
+            <location filename="../../ui/panels/planner_run.py" line="103" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="111" />
+            <location filename="../../ui/panels/planner_run.py" line="112" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="113" />
+            <location filename="../../ui/panels/planner_run.py" line="114" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="115" />
+            <location filename="../../ui/panels/planner_run.py" line="116" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="116" />
+            <location filename="../../ui/panels/planner_run.py" line="117" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="128" />
+            <location filename="../../ui/panels/planner_run.py" line="129" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="130" />
+            <location filename="../../ui/panels/planner_run.py" line="131" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="132" />
+            <location filename="../../ui/panels/planner_run.py" line="133" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="134" />
+            <location filename="../../ui/panels/planner_run.py" line="135" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="135" />
+            <location filename="../../ui/panels/planner_run.py" line="136" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="138" />
+            <location filename="../../ui/panels/planner_run.py" line="139" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="142" />
+            <location filename="../../ui/panels/planner_run.py" line="143" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="197" />
+            <location filename="../../ui/panels/planner_run.py" line="198" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>

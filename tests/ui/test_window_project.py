@@ -223,6 +223,48 @@ def test_plan_runs_from_the_planner_tab_to_the_last_point(
     assert abs(pose[0] - last.x) < 0.5 and abs(pose[1] - last.y) < 0.5 and abs(pose[2] - last.z) < 0.5
 
 
+def test_a_run_while_the_controller_is_not_answering_says_so_and_sends_nothing(
+    qtbot: Any, sim: Any, window: MainWindow, tmp_path: Path
+) -> None:
+    """The connection is open but the controller has stopped answering (one poll unanswered):
+    Run says the controller is not answering -- not "no connection" -- and nothing is written,
+    from the planner's button and from the start after an upload (the run controller itself)."""
+    from app.errors import LinkError
+    from app.link.types import LinkState
+    from ui.messages import error_text
+
+    window.project.open_file(_project_near(sim, tmp_path / "near.teachpad.json"))
+    connect(qtbot, window.link, sim, poll_timeout=0.2)  # the silence is seen quickly
+    window.show_tab("planner")
+    planner = window.planner_panel
+    said: list[str] = []
+    planner.statusMessage.connect(said.append)
+    writes = len(sim.writes)
+    sim.set_silent(True)
+    try:
+        qtbot.waitUntil(
+            lambda: window.link.state.connection.state is LinkState.NOT_ANSWERING, timeout=SIGNAL_TIMEOUT_MS
+        )
+        assert not planner.run()
+        expected = "The controller is not answering: the plan was not started. Try again when it answers."
+        assert said[-1] == expected
+        plan = planner.current_plan()
+        assert plan is not None
+        with pytest.raises(LinkError) as refused:
+            window.run_controller.start(plan)
+        assert refused.value.code == "run_not_answering_start"
+        assert error_text(refused.value) == said[-1]
+        assert len(sim.writes) == writes  # nothing was sent
+    finally:
+        sim.set_silent(False)
+    window.link.disconnect()
+    qtbot.waitUntil(
+        lambda: window.link.state.connection.state is LinkState.DISCONNECTED, timeout=SIGNAL_TIMEOUT_MS
+    )
+    assert not planner.run()
+    assert said[-1] == "Not connected to a controller: nothing was sent."
+
+
 def test_run_disables_the_motion_panels(qtbot: Any, window: MainWindow) -> None:
     window.run_controller.runningChanged.emit(True)
     assert not window.points_panel.action_teach.isEnabled()

@@ -39,7 +39,7 @@ from PySide6.QtCore import QObject, Signal, Slot
 
 from app.errors import LinkError, TeachPadError
 from app.link.robot_link import LinkPort, Pending
-from app.link.types import ConnectionState, WorkerError
+from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult, Pose
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
@@ -272,9 +272,21 @@ class PlanRunController(QObject):
             self._finish()
 
     # --- internals
-    def _require_link(self) -> LinkPort:
+    def link_refusal(self) -> LinkError | None:
+        """Why a run cannot start on the link now (None: it can): not connected, or connected but
+        the controller not answering (the last poll went unanswered) -- not "no connection"."""
+        if self._link is not None and self._link.state.connection.state is LinkState.NOT_ANSWERING:
+            return LinkError(
+                "the controller is not answering: the plan was not started", code="run_not_answering_start"
+            )
         if self._link is None or not self.connected:
-            raise LinkError("not connected to a controller")
+            return LinkError("not connected to a controller", code="not_connected")
+        return None
+
+    def _require_link(self) -> LinkPort:
+        refusal = self.link_refusal()
+        if refusal is not None or self._link is None:
+            raise refusal or LinkError("not connected to a controller", code="not_connected")
         return self._link
 
     def _set_paused(self, paused: bool) -> None:

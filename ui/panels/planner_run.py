@@ -87,8 +87,9 @@ class PlanRunFlow(QObject):
         plan = self._plan_for_run()
         if plan is None:
             return False
-        if not self._runner.connected:
-            view.show_message(self.tr("Not connected to a controller"), "error")
+        refusal = self._runner.link_refusal()  # not connected, or the controller not answering
+        if refusal is not None:
+            view.show_message(error_text(refusal), "error")
             return False
         issues = view.checks.check(
             plan, self._runner.last_pose, start_index=start, loops=1 if single else plan.loops
