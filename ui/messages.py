@@ -333,6 +333,11 @@ def reason_text(reason: Reason) -> str | None:
     args = reason.args
     if reason.code == "envelope_refused":
         return envelope_text(args)
+    if reason.code == "stop_sent_on_line":  # the main link's failure, in its own sentence
+        cause = reason_text(Reason(str(args.get("cause", "")), dict(args.get("cause_args") or {})))
+        if cause is None:
+            return _tr(_BARE["stop_sent_on_line"])
+        return _tr(_TEMPLATES["stop_sent_on_line"]).format(cause=cause)
     template = _TEMPLATES.get(reason.code)
     if template is None:
         return None
@@ -386,7 +391,8 @@ def result_text(result: CommandResult) -> str:
 def result_level(result: CommandResult) -> str:
     """info for success and the operator's own stop, warning for an unconfirmed success."""
     if result.ok:
-        return LEVEL_WARNING if result.unconfirmed else LEVEL_INFO
+        on_line_only = result.reason is not None and result.reason.code == "stop_sent_on_line"
+        return LEVEL_WARNING if result.unconfirmed or on_line_only else LEVEL_INFO
     return LEVEL_INFO if result.stopped_by_operator else LEVEL_ERROR
 
 
@@ -402,6 +408,15 @@ def error_text(error: WorkerError | TeachPadError | Reason) -> str:
             return text
     return error.message
 
+
+# The main link's stop failed but the controller took the stop line's (app/link/commands.py): the
+# arm was stopped; the main link's failure is said after it.
+_TEMPLATES["stop_sent_on_line"] = QT_TRANSLATE_NOOP(
+    "Messages", "Stop sent (on the separate stop connection); the main connection did not take it: {cause}"
+)
+_BARE["stop_sent_on_line"] = QT_TRANSLATE_NOOP(
+    "Messages", "Stop sent (on the separate stop connection); the main connection did not take it."
+)
 
 # A GUI plan run ended because the controller went silent while the connection stays open
 # (LinkState.NOT_ANSWERING, ui/controllers/plan_run_controller.py): not a lost link.

@@ -11,7 +11,7 @@ from __future__ import annotations
 import time
 from typing import TYPE_CHECKING, Protocol
 
-from app.errors import TeachPadError, WriteBlocked
+from app.errors import LinkError, MalformedResponse, Reason, ResponseTimeout, TeachPadError, WriteBlocked
 from app.link.jobs import JobKind
 from app.link.types import JogRequest, Operation
 from app.link.upload import RawItem
@@ -25,6 +25,7 @@ if TYPE_CHECKING:
     from app.link.jog import JogMachine
     from app.link.motion import MotionCommands, MotionTracker
     from app.link.stop_line import StopLine, StopSent
+    from app.link.supervisor import LinkSupervisor
     from app.link.upload import Uploader
     from app.safety.audit import AuditLog
 
@@ -45,6 +46,7 @@ class WorkerCommands:
         motion: MotionTracker
         motions: MotionCommands
         stop_line: StopLine
+        supervisor: LinkSupervisor
         uploader: Uploader
         _jobs: JobQueue
         _current_job: Job | None
@@ -66,26 +68,65 @@ class WorkerCommands:
         try:
             client.stop()  # first: nothing else goes out before the stop
         except WriteBlocked:  # monitor-only: nothing is written, each queued job is refused in turn
+            self._report_stop_line(on_line)
             raise
-        except TeachPadError:  # no answer in time, refused, link lost: the operator still asked for it
+        except TeachPadError as exc:  # no answer in time, refused, link lost: the operator still asked for it
+            if self._report_stop_line(on_line):  # ... and the controller took it on the stop line
+                self._stopped_on_the_line_only(client, exc)
+                return
             self._cancel_motions_before_stop()  # nothing queued before the Stop runs after it
             self.uploader.end("stopped")
             self._end_jog_after_a_failed_stop()
             raise
-        finally:
-            if on_line is not None:  # its answer: checked, audited, shown in the traffic
-                self.stop_line.report(self.capture, self.audit)
+        except BaseException:
+            self._report_stop_line(on_line)
+            raise
+        self._report_stop_line(on_line)
+        self._after_stop(time.monotonic(), "stop: sent")
+
+    def _report_stop_line(self, on_line: StopSent | None) -> bool:
+        """The stop line's answer: checked, audited, shown in the traffic. True when the
+        controller took the stop there."""
+        return on_line is not None and self.stop_line.report(self.capture, self.audit)
+
+    def _stopped_on_the_line_only(self, client: RobotClient, exc: TeachPadError) -> None:
+        """The main link's stop failed but the controller took the stop line's: the arm was
+        stopped. The command in flight ends as stopped at once (a point being created waits no
+        longer for a result the stop reset), the Stop is a success that says which line carried it,
+        and the main link's failure still counts against the main link (after: the motion in
+        flight ended as stopped, which it was, not as "link lost, outcome unknown")."""
         now = time.monotonic()
+        tracker = client.last_tracker
+        if tracker is not None and not tracker.finished:
+            tracker.stopped(now)
+        cause = exc.as_reason()
+        self._after_stop(
+            now,
+            f"stop: sent on the stop line (the main link's stop failed: {exc})",
+            Reason("stop_sent_on_line", {"cause": cause.code, "cause_args": dict(cause.args)}),
+            jog_may_fail=True,
+        )
+        if isinstance(exc, LinkError | ResponseTimeout | MalformedResponse):
+            self.supervisor.transport_failed(exc)
+
+    def _after_stop(
+        self, now: float, text: str, reason: Reason | None = None, *, jog_may_fail: bool = False
+    ) -> None:
+        """The controller took the stop: end the jog, the upload, the motion in flight and the
+        motions queued before the Stop; then the Stop's own result."""
         job = self._current_job
         if job is not None and job.sent is not None:
             job.sent.set()  # the poster (the GUI thread) may go on
         self.uploader.end("stopped")
-        self.jog.on_stop()
+        if jog_may_fail:  # the main link just failed: speed 0 goes out as soon as it answers
+            self._end_jog_after_a_failed_stop()
+        else:
+            self.jog.on_stop()
         active = self.motion.take()
         self._cancel_motions_before_stop()
         if active is not None:
             self.emit_result(active.completion.stopped(now), active.request_id)
-        self._done("stop: sent")
+        self.emit_result(CommandResult(None, None, None, True, text, reason=reason))
 
     def _end_jog_after_a_failed_stop(self) -> None:
         """The held jog ends (a jog sequence still starting gives way before its ratio goes out),

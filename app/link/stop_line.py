@@ -178,12 +178,13 @@ class StopLine:
                 return pending, b"", str(exc)
             return pending, answer, None
 
-    def report(self, capture: TrafficCapture, audit: AuditLog | None) -> None:
+    def report(self, capture: TrafficCapture, audit: AuditLog | None) -> bool:
         """:meth:`collect`, then the stop's frames to the traffic capture and its write to the
-        audit trail (worker thread); a bad answer is logged (the main link's stop went out too)."""
+        audit trail (worker thread); a bad answer is logged (the main link's stop went out too).
+        True when the controller took the stop on this line (its echo checked)."""
         sent, answer, problem = self.collect()
         if sent is None:
-            return
+            return False
         if capture.on:
             capture.observe(TrafficRecord(sent.at, "tx", sent.frame, "tcp"))
             if answer:
@@ -194,6 +195,7 @@ class StopLine:
             )
         if problem is not None:
             _log.warning("stop line: %s; the stop went out on the main link too", problem)
+        return problem is None
 
     def close(self) -> None:
         with self._lock:

@@ -82,6 +82,7 @@ class SimController:
         self._silent = False
         self._exception: ExcCodes | None = None
         self._exception_range: range | None = None
+        self._exception_connection: int | None = None
         self.point_write_refusals = PointWriteRefusals()
         # GV291 publication hold (app/sim/status.py), the register image, the command execution
         self.status = StatusPublisher(self.config.timing, self.config.command_latency, self.config.seed)
@@ -260,6 +261,7 @@ class SimController:
             await asyncio.sleep(delay)
         exc, exc_range = self._exception, self._exception_range
         hit = exc_range is None or (address < exc_range.stop and exc_range.start < address + count)
+        hit = hit and self._exception_connection in (None, connection)
         if exc is not None and hit:
             return exc
         if set_values is not None:
@@ -451,15 +453,24 @@ class SimController:
         self._silent = bool(silent)
         log.info("silent %s", "on" if silent else "off")
 
-    def set_exception(self, code: ExcCodes | int | None, addresses: range | None = None) -> None:
-        """Answer requests touching ``addresses`` (None: all) with Modbus exception ``code``."""
+    def set_exception(
+        self, code: ExcCodes | int | None, addresses: range | None = None, connection: int | None = None
+    ) -> None:
+        """Answer requests touching ``addresses`` (None: all) with Modbus exception ``code``; only
+        on one connection when ``connection`` (an id of :meth:`connection_ids`) is given."""
         self._exception_range = addresses
+        self._exception_connection = connection
         self._exception = None if code is None else ExcCodes(code)
         log.info(
-            "exception %s%s",
+            "exception %s%s%s",
             "off" if code is None else int(code),
             "" if addresses is None else f" on {addresses.start}..{addresses.stop - 1}",
+            "" if connection is None else f" on connection {connection}",
         )
+
+    def connection_ids(self) -> list[int]:
+        """The ids of the connections open now, oldest first."""
+        return self._runner.connection_ids()
 
     def drop_connections(self) -> int:
         """Close the sockets of the connected clients (the server keeps listening)."""

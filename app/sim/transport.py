@@ -289,6 +289,18 @@ class ServerRunner:
         server = self._server
         return 0 if server is None else len(server.active_connections)
 
+    def connection_ids(self) -> list[int]:
+        """The open connections' ids, oldest first (read in the server's loop)."""
+        loop, server = self._loop, self._server
+        if loop is None or server is None or loop.is_closed():
+            return []
+
+        async def ids() -> list[int]:
+            conns = server.active_connections.values()
+            return sorted(int(getattr(conn, "connection_id", -1)) for conn in conns)
+
+        return list(asyncio.run_coroutine_threadsafe(ids(), loop).result(self.STOP_TIMEOUT))
+
     def drop_connections(self) -> int:
         """Close the connected clients' sockets (the server keeps listening)."""
         loop, server = self._loop, self._server

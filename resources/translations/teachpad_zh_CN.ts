@@ -1784,6 +1784,16 @@
             <translation>未知异常</translation>
         </message>
         <message>
+            <location filename="../../ui/messages.py" line="413" />
+            <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
+            <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="416" />
+            <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
+            <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
+        </message>
+        <message>
             <location filename="../../ui/messages_plan.py" line="30" />
             <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
@@ -1829,12 +1839,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="408" />
+            <location filename="../../ui/messages.py" line="422" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="412" />
+            <location filename="../../ui/messages.py" line="426" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>

@@ -1,0 +1,101 @@
+"""A Stop the main connection does not take while the separate stop connection does
+(app/link/commands.py ``_stopped_on_the_line_only``), through RobotLink against the simulator.
+
+The simulator refuses ``441`` on the main link's connection only (``set_exception(...,
+connection=...)``): the controller took the stop on the stop line, so the arm was stopped. The
+operator is told the stop went out (and that the main connection did not take it), and the point
+being created -- whose result a stop resets, so it never shows -- ends at once as stopped. The
+old code reported the Stop as failed and left the point waiting for its own timeout.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+import pytest
+from pymodbus.constants import ExcCodes
+
+from app import timing
+from app.link import stop_line as stop_line_module
+from app.link.robot_link import RobotLink
+from app.models import CommandResult
+from app.protocol import registers
+from tests.ui.pendant_support import (  # noqa: F401 - fixtures
+    SIGNAL_TIMEOUT_MS,
+    connect,
+    fast_reconnect_fixture,
+    link_fixture,
+)
+
+pytestmark = pytest.mark.timeout(60)
+
+POINT_TIMEOUT = 10.0  # s: a point in flight ends by its own timeouts only after this
+
+
+def _line_open(qtbot: Any, link: RobotLink, sim: Any, monkeypatch: pytest.MonkeyPatch) -> int:
+    """Connect, wait for the stop line, and refuse 441 on the main link's connection; its id."""
+    monkeypatch.setattr(stop_line_module, "KEEPALIVE", 60.0)  # no keepalive read in the way of the stop
+    connect(qtbot, link, sim)
+    line = link._worker.stop_line  # the test waits for the line the product opens
+    qtbot.waitUntil(lambda: line.opened_at > 0, timeout=SIGNAL_TIMEOUT_MS)
+    ids: list[int] = sim.connection_ids()
+    main, _stop_connection = ids  # the main link first, the stop line after it
+    stop_register = range(registers.REG_STOP, registers.REG_STOP + 1)
+    sim.set_exception(ExcCodes.DEVICE_BUSY, stop_register, connection=main)
+    return main
+
+
+def test_a_stop_only_the_stop_connection_takes_ends_the_point_in_flight_and_is_sent(
+    qtbot: Any, sim_factory: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", POINT_TIMEOUT)
+    monkeypatch.setattr(timing, "CREATE_POINT_TIMEOUT", POINT_TIMEOUT)
+    sim = sim_factory(command_latency=60.0)  # a created point's result never shows
+    _line_open(qtbot, link, sim, monkeypatch)
+    results: list[CommandResult] = []
+    link.commandFinished.connect(results.append)
+    errors: list[Any] = []
+    link.errorOccurred.connect(errors.append)
+    items = [(100 + i, (300.0 + i, 0.0, 400.0, 180.0, 0.0, 0.0), 200) for i in range(5)]
+    upload_id = link.upload_points(items)
+    qtbot.waitUntil(lambda: bool(sim.writes_to(registers.REG_RUN_COMMAND)), timeout=SIGNAL_TIMEOUT_MS)
+    pressed = time.monotonic()
+    stop_id = link.stop()
+    qtbot.waitUntil(lambda: any(r.request_id == upload_id for r in results), timeout=2 * POINT_TIMEOUT * 1000)
+    elapsed = time.monotonic() - pressed
+    qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
+    stop = next(r for r in results if r.request_id == stop_id)
+    upload = next(r for r in results if r.request_id == upload_id)
+    # the Stop: sent, and says the main connection did not take it (in the controller's words)
+    assert stop.ok and stop.reason is not None and stop.reason.code == "stop_sent_on_line", stop
+    assert stop.reason.args["cause"] == "modbus_exception", stop.reason
+    assert not any(e.request_id == stop_id for e in errors), errors
+    # the point in flight ended as stopped at once (the old code: after its 10 s timeout)
+    assert elapsed < POINT_TIMEOUT / 2, elapsed
+    assert not upload.ok and upload.message == "uploaded 0 of 5 points (stopped)", upload.message
+    # at the simulator: the stop line's 441 was taken (stored), one point started, nothing after it
+    assert sim.writes_to(registers.REG_STOP), sim.writes
+    assert len(sim.writes_to(registers.REG_RUN_COMMAND)) == 1
+    assert link.connection.connected  # a refused write is no link failure
+
+
+def test_the_operator_reads_which_connection_carried_the_stop(
+    qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """No command in flight: the Stop's result says it went out on the stop connection, in the
+    operator's language, as a warning (the main connection's refusal is worth a look)."""
+    from ui.messages import LEVEL_WARNING, result_level, result_text
+
+    _line_open(qtbot, link, sim, monkeypatch)
+    with qtbot.waitSignal(
+        link.commandFinished, check_params_cb=lambda r: r.reason is not None, timeout=SIGNAL_TIMEOUT_MS
+    ) as done:
+        link.stop()
+    stop = done.args[0]
+    assert stop.ok and result_level(stop) == LEVEL_WARNING
+    assert result_text(stop) == (
+        "Stop sent (on the separate stop connection); the main connection did not take it: "
+        "The controller refused the request: Modbus exception 6 (server device busy)."
+    )
+    assert sim.writes_to(registers.REG_STOP)
