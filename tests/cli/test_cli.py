@@ -19,6 +19,11 @@ from app.protocol.enums import Alarm, WorkMode
 from tests.cli.ctrl_c import CHILD_TIMEOUT, ROOT, interrupt_cli
 
 SCAN = 0.02  # see tests/client/test_client_sim.py
+# `status` and `watch` read with the poll timeout (0.15 s on TCP). The simulator answers from this
+# test process, which a loaded machine (coverage, a CI neighbour) can hold that long: the CLI would
+# rightly say "did not answer" in a test about something else. Roomy here; the silence test keeps
+# its own short one.
+ROOMY_POLL = ("--poll-timeout", "1.0")
 
 
 def run(sim: Any, capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
@@ -41,7 +46,7 @@ def csim(sim_factory: Any) -> Any:
 
 
 def test_status_json_and_text(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
-    code, out, err = run(csim, capsys, "status", "--json")
+    code, out, err = run(csim, capsys, *ROOMY_POLL, "status", "--json")
     assert code == ExitCode.OK and err == ""
     data = json.loads(out)
     state = csim.state()
@@ -53,7 +58,7 @@ def test_status_json_and_text(csim: Any, capsys: pytest.CaptureFixture[str]) -> 
     assert data["command_status"] == {"code": 0, "text": "initial"}
     assert data["clock"]["iso"] and len(data["clock"]["raw"]) == 4
     csim.set_alarm(Alarm.ESTOP, True)
-    code, out, _ = run(csim, capsys, "status")
+    code, out, _ = run(csim, capsys, *ROOMY_POLL, "status")
     assert code == ExitCode.OK
     assert "mode      auto (1)" in out and "program   stopped (0)" in out
     assert "alarms    emergency stop (1)" in out and "command   0 initial" in out
@@ -91,7 +96,7 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
         ys = []
         deadline = time.monotonic() + 5.0
         while csim.state().jogging and time.monotonic() < deadline:
-            code, out, _ = run(csim, capsys, "status", "--json")
+            code, out, _ = run(csim, capsys, *ROOMY_POLL, "status", "--json")
             assert code == ExitCode.OK
             data = json.loads(out)
             if data["mode"]["name"] == "Modbus teach":  # the jog may end between two reads
@@ -273,7 +278,7 @@ def test_read_write_and_watch(csim: Any, capsys: pytest.CaptureFixture[str]) -> 
     assert out.splitlines() == ["GV200 = 30.0  (0000 41F0)", "GV201 = -1.5  (0000 BFC0)"]
     code, _, err = run(csim, capsys, "write", "220", "1")
     assert code == ExitCode.USAGE and "control registers" in one_line_error(err)
-    code, out, _ = run(csim, capsys, "watch", "--rate", "100", "--count", "3")
+    code, out, _ = run(csim, capsys, *ROOMY_POLL, "watch", "--rate", "100", "--count", "3")
     lines = out.splitlines()
     assert code == ExitCode.OK and len(lines) == 3
     assert all(line.startswith("t=") and "mode=auto" in line and "cmd=" in line for line in lines)
@@ -325,7 +330,7 @@ def test_failures_exit_1_and_usage_exit_2(sim: Any, capsys: pytest.CaptureFixtur
 
 def test_rtu_framing_option(sim_factory: Any, capsys: pytest.CaptureFixture[str]) -> None:
     sim = sim_factory(framer="rtu")
-    code, out, err = run(sim, capsys, "--framer", "rtu", "status", "--json")
+    code, out, err = run(sim, capsys, "--framer", "rtu", *ROOMY_POLL, "status", "--json")
     assert code == ExitCode.OK, err
     assert json.loads(out)["mode"]["name"] == "auto"
 

@@ -22,6 +22,8 @@ from app.view3d.profile import default_profile, profile_to_dict
 ROOT = Path(__file__).resolve().parents[2]
 DEMO = ROOT / "resources" / "samples" / "demo.teachpad.json"
 FAR_X = 3000.0  # mm: beyond the simulator arm's 900 mm reach
+# `status` reads with the poll timeout (0.15 s): roomy here, as tests/cli/test_cli.py says why
+ROOMY_POLL = ("--poll-timeout", "1.0")
 
 
 def run_cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
@@ -135,7 +137,7 @@ def test_a_register_profile_sets_word_order_and_unit(
         tmp_path / "cell.registers.json", RegisterProfile("cell 7", word_order=WordOrder.HIGH_FIRST, unit=7)
     )
     code, out, err = run_cli(
-        capsys, "--port", str(sim.port), "--register-profile", str(profile), "status", "--json"
+        capsys, "--port", str(sim.port), "--register-profile", str(profile), *ROOMY_POLL, "status", "--json"
     )
     assert code == ExitCode.OK, err
     pose = json.loads(out)["pose"]
@@ -161,6 +163,7 @@ def test_explicit_flags_override_the_profile(
         "7",
         "--word-order",
         "high-first",
+        *ROOMY_POLL,
         "status",
         "--json",
     )
@@ -168,7 +171,16 @@ def test_explicit_flags_override_the_profile(
     assert json.loads(out)["pose"]["x"] == pytest.approx(sim.state().pose[0], abs=1e-3)
     # the profile alone (low-first) reads the same registers as other numbers
     code, out, err = run_cli(
-        capsys, "--port", str(sim.port), "--register-profile", str(wrong), "--unit", "7", "status", "--json"
+        capsys,
+        "--port",
+        str(sim.port),
+        "--register-profile",
+        str(wrong),
+        "--unit",
+        "7",
+        *ROOMY_POLL,
+        "status",
+        "--json",
     )
     assert code != ExitCode.OK or json.loads(out)["pose"]["x"] != pytest.approx(sim.state().pose[0], abs=1e-3)
 

@@ -132,7 +132,9 @@ def test_a_link_lost_mid_upload_still_ends_it(
     thread = threading.Thread(target=silence, daemon=True)
     thread.start()
     try:
-        code, _, err = run(sim, capsys, "--timeout", "0.3", "points", "upload", str(project))
+        # 1 s, not 0.3: the points before the silence must be answered, and a loaded test process
+        # (the simulator answers from it) can hold an answer 0.3 s -- the upload then ended early
+        code, _, err = run(sim, capsys, "--timeout", "1.0", "points", "upload", str(project))
     finally:
         thread.join(5.0)
         sim.set_silent(False)

@@ -44,7 +44,8 @@ def test_a_command_help_shows_units_and_its_example(capsys: pytest.CaptureFixtur
 def test_status_into_a_closed_pipe_ends_quietly(sim: Any) -> None:
     """`teachpad-cli status | head -1`: the reader is gone before we write."""
     proc = subprocess.Popen(
-        [sys.executable, "-m", "app.cli.main", "--port", str(sim.port), "status"],
+        # a roomy poll timeout: the simulator answers from this (maybe loaded) test process
+        [sys.executable, "-m", "app.cli.main", "--port", str(sim.port), "--poll-timeout", "1.0", "status"],
         cwd=ROOT,
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -58,7 +59,9 @@ def test_status_into_a_closed_pipe_ends_quietly(sim: Any) -> None:
 
 @pytest.mark.skipif(shutil.which("head") is None or shutil.which("bash") is None, reason="needs a shell")
 def test_status_piped_into_head_prints_one_line_and_no_traceback(sim: Any) -> None:
-    cmd = f"set -o pipefail; {sys.executable} -m app.cli.main --port {sim.port} watch --rate 50 | head -1"
+    # a roomy poll timeout: the simulator answers from this (maybe loaded) test process
+    cli = f"{sys.executable} -m app.cli.main --port {sim.port} --poll-timeout 1.0"
+    cmd = f"set -o pipefail; {cli} watch --rate 50 | head -1"
     done = subprocess.run(["bash", "-c", cmd], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert done.stderr == ""
     assert len(done.stdout.splitlines()) == 1

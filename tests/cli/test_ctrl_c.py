@@ -141,7 +141,10 @@ def test_ctrl_c_with_a_silent_controller_says_the_stop_failed_within_the_timeout
     ctx = _ctx(sim, timeout=0.3)
 
     def interrupted() -> CommandResult:
-        ctx.client.step(StepFrame.JOINT, [90.0, 0, 0, 0, 0, 0], speed=1.0, wait=False)
+        # the step's writes must be answered: roomy (a loaded test process can hold an answer
+        # 0.3 s); the stop after the silence keeps the 0.3 s this test is about
+        with ctx.client.io_timeout(2.0):
+            ctx.client.step(StepFrame.JOINT, [90.0, 0, 0, 0, 0, 0], speed=1.0, wait=False)
         assert sim.wait_for(lambda s: s.moving, 5.0)
         sim.set_silent(True)
         raise KeyboardInterrupt

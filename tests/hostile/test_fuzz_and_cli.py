@@ -36,13 +36,15 @@ def _cli(server: HostileServer, capsys: pytest.CaptureFixture[str], *args: str) 
 @pytest.mark.parametrize("framing", ["tcp", "rtu"])
 def test_cli_status_refuses_a_malformed_answer(framing: str, capsys: pytest.CaptureFixture[str]) -> None:
     with HostileServer(framing) as server:  # type: ignore[arg-type]
-        code, out, err = _cli(server, capsys, "status", "--json")
+        # a roomy poll timeout: the server answers from this (maybe loaded) test process; this test
+        # is about a malformed answer, not a late one
+        code, out, err = _cli(server, capsys, "--poll-timeout", "1.0", "status", "--json")
         assert code == EXIT_OK, err
         link = json.loads(out)["link"]
         assert (link["requests"], link["answers"], link["malformed"]) == (2, 2, 0)
         # every read answered with function 0x04: no pose is printed, exit 3 with one line
         server.default = with_pdu(lambda a: b"\x04" + a.pdu[1:])
-        code, out, err = _cli(server, capsys, "status", "--json")
+        code, out, err = _cli(server, capsys, "--poll-timeout", "1.0", "status", "--json")
         assert (code, out) == (EXIT_LINK, "")
         assert err.count("\n") == 1 and err.startswith(
             "teachpad-cli: error: malformed answer to the read of registers 560..583 (GV280..GV291) "

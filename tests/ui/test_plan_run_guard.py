@@ -110,6 +110,16 @@ class Bench:
 POLL_TIMEOUT = 1.0
 
 
+@pytest.fixture(name="sim")
+def sentinel_sim_fixture(sim_factory: Any) -> Any:
+    """A simulator whose GV291 the host may write, so the link proves each point's creation with
+    a sentinel. With GV291 ignored (the default) the link only observes it: a create whose answer
+    or first status read a loaded test process holds past the simulator's 0.25 s read-hold of the
+    0 phase ends rightly *done, unconfirmed*, and the point reads "unconfirmed", not "on the
+    controller" (seen with every 4th answer held 0.3 s); these tests are about the run's guard."""
+    return sim_factory(gv291="writable")
+
+
 @pytest.fixture
 def bench(qtbot: Any, sim: Any, link: RobotLink, make_client: MakeClient) -> Bench:
     connect(qtbot, link, sim, poll_timeout=POLL_TIMEOUT)
