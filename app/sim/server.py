@@ -77,6 +77,7 @@ class SimController:
         self._stopped = False
         # fault injection
         self._response_delay = self.config.response_delay
+        self._response_delay_on: int | None = None  # the one connection delayed (None: all)
         self._slow_answers = (0.0, 0)  # (s, n): every n-th answer held this long (late polls)
         self._status_delay = self.config.status_delay
         self._silent = False
@@ -256,7 +257,8 @@ class SimController:
         if self._silent:
             return ExcCodes.DEVICE_FAILURE  # not executed; the answer is dropped by _trace_packet
         slow, every = self._slow_answers
-        delay = max(self._response_delay, slow if every and serial % every == 0 else 0.0)
+        held = self._response_delay if self._response_delay_on in (None, connection) else 0.0
+        delay = max(held, slow if every and serial % every == 0 else 0.0)
         if delay > 0:
             await asyncio.sleep(delay)
         exc, exc_range = self._exception, self._exception_range
@@ -430,9 +432,14 @@ class SimController:
         self.point_write_refusals.set(point_id, ExcCodes(code), times)
         log.info("create point %d: GV200 write refused %d time(s), exception %d", point_id, times, code)
 
-    def set_response_delay(self, seconds: float) -> None:
+    def set_response_delay(self, seconds: float, connection: int | None = None) -> None:
+        """Hold every answer ``seconds``; only on one connection (an id of :meth:`connection_ids`)
+        when ``connection`` is given (a wedged link beside a good one)."""
+        self._response_delay_on = connection
         self._response_delay = max(0.0, float(seconds))
-        log.info("response delay %.3f s", self._response_delay)
+        log.info(
+            "response delay %.3f s%s", self._response_delay, "" if connection is None else f" on {connection}"
+        )
 
     def set_status_delay(self, seconds: float) -> None:
         self._status_delay = max(0.0, float(seconds))

@@ -164,7 +164,9 @@ def test_cli_points_upload_on_every_profile(
     sim.refuse_point(123)
     path = tmp_path / "profiles.teachpad.json"
     write_project(path, 200)
-    code = cli.main(["--host", "127.0.0.1", "--port", str(sim.port), "points", "upload", str(path)])
+    # a roomy request timeout: the profiles are the subject, not a loaded test process's stalls
+    where = ["--host", "127.0.0.1", "--port", str(sim.port), "--timeout", "3"]
+    code = cli.main([*where, "points", "upload", str(path)])
     captured = capsys.readouterr()
     assert code == cli.EXIT_FAILED
     assert "uploaded 199 point(s)" in captured.out

@@ -271,7 +271,9 @@ def test_silence_is_a_timeout_within_the_poll_timeout(server: HostileServer, cli
     assert str(info.value) == (
         f"controller did not answer within {round(poll_timeout, 3)} s (127.0.0.1:{server.port})"
     )
-    assert poll_timeout <= elapsed < poll_timeout + 0.1
+    # seen after the poll timeout, and well before the 1 s request timeout (a loaded machine may
+    # wake the reader late: the upper bound is roomy)
+    assert poll_timeout <= elapsed < poll_timeout + 0.5
     stats = client.stats
     assert (stats.timeouts, stats.malformed, stats.resyncs) == (1, 0, 1)
     assert client.read_registers(*STATUS) == [bank_value(a) for a in range(560, 584)]

@@ -37,7 +37,9 @@ def demo(tmp_path: Path) -> Path:
 
 
 def teachpad_cli(port: int, *argv: str) -> int:
-    return cli.main(["--host", "127.0.0.1", "--port", str(port), *argv])
+    # a roomy request timeout: the simulator runs in this (maybe loaded) process, and no test here is
+    # about a timeout (a 1 s stall under a CI neighbour failed a run as "did not answer")
+    return cli.main(["--host", "127.0.0.1", "--port", str(port), "--timeout", "3", *argv])
 
 
 def sample_poses(path: Path) -> dict[int, tuple[float, ...]]:

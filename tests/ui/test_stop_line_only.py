@@ -99,3 +99,29 @@ def test_the_operator_reads_which_connection_carried_the_stop(
         "The controller refused the request: Modbus exception 6 (server device busy)."
     )
     assert sim.writes_to(registers.REG_STOP)
+
+
+def test_a_stop_the_wedged_main_link_never_answers_is_sent_on_the_line_and_the_link_goes_on_fresh(
+    qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The main link's connection is wedged (every answer on it held 3 s, past the 1 s request
+    timeout) while the stop connection answers: the arm is stopped (the line's 441 stored at once),
+    the Stop is reported sent with "did not answer" as the main connection's part, and the main
+    link goes on over a fresh connection (the wedged one is dropped)."""
+    main = _line_open(qtbot, link, sim, monkeypatch)
+    sim.set_exception(None)
+    results: list[CommandResult] = []
+    link.commandFinished.connect(results.append)
+    sim.set_response_delay(3.0, connection=main)
+    try:
+        stop_id = link.stop()
+        qtbot.waitUntil(lambda: bool(sim.writes_to(registers.REG_STOP)), timeout=SIGNAL_TIMEOUT_MS)
+        qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=3 * SIGNAL_TIMEOUT_MS)
+    finally:
+        sim.set_response_delay(0.0)
+    stop = next(r for r in results if r.request_id == stop_id)
+    assert stop.ok and stop.reason is not None and stop.reason.code == "stop_sent_on_line", stop
+    assert stop.reason.args["cause"] == "no_answer", stop.reason
+    # the wedged connection is replaced by a fresh one, and the link is up on it
+    qtbot.waitUntil(lambda: main not in sim.connection_ids(), timeout=3 * SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(lambda: link.connection.connected, timeout=3 * SIGNAL_TIMEOUT_MS)

@@ -182,7 +182,10 @@ def test_undo_from_the_edit_menu(window: MainWindow) -> None:
     assert len(model.ledger) == 8
 
 
-def test_teach_a_point_from_the_window(qtbot: Any, sim: Any, window: MainWindow) -> None:
+def test_teach_a_point_from_the_window(qtbot: Any, sim_factory: Any, window: MainWindow) -> None:
+    # a writable GV291 (sentinel rule): under the observed rule a create whose answer comes past the
+    # simulator's 0.25 s read-hold is rightly "done, unconfirmed" (a loaded machine), not ON_CONTROLLER
+    sim = sim_factory(gv291="writable")
     connect(qtbot, window.link, sim)
     window.show_tab("points")
     panel = window.points_panel
@@ -198,8 +201,9 @@ def test_teach_a_point_from_the_window(qtbot: Any, sim: Any, window: MainWindow)
 
 
 def test_plan_runs_from_the_planner_tab_to_the_last_point(
-    qtbot: Any, sim: Any, window: MainWindow, tmp_path: Path
+    qtbot: Any, sim_factory: Any, window: MainWindow, tmp_path: Path
 ) -> None:
+    sim = sim_factory(gv291="writable")  # results proved by the sentinel (see the teach test above)
     window.project.open_file(_project_near(sim, tmp_path / "near.teachpad.json"))
     connect(qtbot, window.link, sim)
     window.show_tab("planner")

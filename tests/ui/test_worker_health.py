@@ -135,7 +135,7 @@ def test_a_silent_controller_is_not_answering_after_one_poll(
     qtbot: Any, sim: Any, link: RobotLink, poll_hz: float
 ) -> None:
     link.set_poll_rate(poll_hz)
-    connect(qtbot, link, sim)  # the product's poll timeout (0.15 s on TCP)
+    connect(qtbot, link, sim, poll_timeout=None)  # the product's poll timeout (0.15 s on TCP)
     states: list[ConnectionState] = []
     link.connectionChanged.connect(states.append)
     with qtbot.waitSignal(

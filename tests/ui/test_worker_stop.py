@@ -5,6 +5,7 @@ main link fails, nothing queued before it runs after it."""
 from __future__ import annotations
 
 import time
+from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -22,6 +23,19 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 )
 
 pytestmark = pytest.mark.timeout(60)
+
+
+@pytest.fixture(name="main_only_link")
+def main_only_link_fixture(qtbot: Any, fast_reconnect: None) -> Iterator[RobotLink]:
+    """A RobotLink without the stop line: every stop goes on the main link alone. (With a line
+    that opened before a test slowed the simulator, the line's 441 may be answered in time: the
+    Stop then rightly succeeds -- tests/ui/test_stop_line_only.py -- whatever the main link did.)"""
+    robot_link = RobotLink(poll_hz=timing.POLL_HZ_DEFAULT, canary_gv=None, stop_line=False)
+    try:
+        yield robot_link
+    finally:
+        robot_link.shutdown()
+        assert not robot_link.is_running
 
 
 def _poses(sim: Any, ids: range) -> list[tuple[int, tuple[float, ...], int]]:
@@ -68,22 +82,22 @@ def test_a_stop_ends_an_upload_at_once_even_when_the_point_in_flight_never_gets_
 
 
 def test_a_stop_whose_main_link_write_gets_no_answer_still_cancels_the_motions_queued_before_it(
-    qtbot: Any, sim: Any, link: RobotLink
+    qtbot: Any, sim: Any, main_only_link: RobotLink
 ) -> None:
     """The simulator answers after 0.4 s, beyond the link's 0.25 s request timeout: the main
     link's 441 gets no answer in time (an error for the Stop). The motions queued before the Stop
     are cancelled all the same -- the old code then sent them, after the operator's Stop."""
-    connect(qtbot, link, sim, timeout=0.25, poll_timeout=None)
+    connect(qtbot, main_only_link, sim, timeout=0.25, poll_timeout=None)
     sim.set_response_delay(0.4)
     seen = sim.requests_count
     qtbot.waitUntil(lambda: sim.requests_count > seen, timeout=SIGNAL_TIMEOUT_MS)  # a read in flight
     results: list[CommandResult] = []
     errors: list[WorkerError] = []
-    link.commandFinished.connect(results.append)
-    link.errorOccurred.connect(errors.append)
+    main_only_link.commandFinished.connect(results.append)
+    main_only_link.errorOccurred.connect(errors.append)
     writes_before = len(sim.writes)
-    queued = [link.go_zero(0), link.run_program(1)]
-    stop_id = link.stop()
+    queued = [main_only_link.go_zero(0), main_only_link.run_program(1)]
+    stop_id = main_only_link.stop()
     qtbot.waitUntil(lambda: any(e.request_id == stop_id for e in errors), timeout=SIGNAL_TIMEOUT_MS)
     qtbot.waitUntil(
         lambda: {r.request_id for r in results if "cancelled by Stop" in r.message} == set(queued),
