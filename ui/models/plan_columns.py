@@ -11,7 +11,7 @@ from PySide6.QtCore import (
 )
 from PySide6.QtGui import QColor, QFont, QIcon, QPainter, QPixmap
 
-from app.plan.checks import IssueKind
+from app.plan.issue_kind import IssueKind
 from app.plan.segments import TR_CONTEXT as PLAN_CORE_CONTEXT
 from app.plan.segments import (
     SegmentKind,
