@@ -23,14 +23,17 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QEvent, QObject, QTimer, Signal
 from PySide6.QtWidgets import QApplication, QWidget
 
-from app.link.robot_link import RobotLink, wait_for_detached_threads
-from app.link.transport import ConnectionSettings
-from app.link.types import ConnectionState
-from app.models import Pose
-from app.protocol.enums import ProgramMotionMode
-from ui.i18n import LANGUAGE_NAMES, Translator
-from ui.main_window import TAB_NAMES, MainWindow
-from ui.settings import APPLICATION, ORGANIZATION, AppSettings
+from ui.startup_gc import StartupGcPause, gc_paused
+
+with gc_paused():  # the window's modules: many objects made, almost none freed (ui/startup_gc.py)
+    from app.link.robot_link import RobotLink, wait_for_detached_threads
+    from app.link.transport import ConnectionSettings
+    from app.link.types import ConnectionState
+    from app.models import Pose
+    from app.protocol.enums import ProgramMotionMode
+    from ui.i18n import LANGUAGE_NAMES, Translator
+    from ui.main_window import TAB_NAMES, MainWindow
+    from ui.settings import APPLICATION, ORGANIZATION, AppSettings
 
 if TYPE_CHECKING:  # subprocess and queue: imported when a simulator is started (--sim)
     import subprocess
@@ -369,6 +372,16 @@ class _Screenshot:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    # No automatic garbage collection until the window's first paint (ui/startup_gc.py): resumed
+    # by after_first_paint, or when main ends before that.
+    startup_gc = StartupGcPause()
+    try:
+        return _main(argv, startup_gc)
+    finally:
+        startup_gc.resume()
+
+
+def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
     args_in = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     args, qt_args = parser.parse_known_args(args_in)
@@ -433,6 +446,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         starter.failed.connect(sim_failed)
 
     def after_first_paint() -> None:
+        startup_gc.resume()
         # The link's worker (pymodbus, the envelope) is made by the connection, after the paint.
         if connection is not None:
             link.connect_to(connection)
