@@ -28,6 +28,7 @@ DEFERRED = (
     "ui.panels.monitor_plots",  # the monitor's plots: built after the first paint
     "app.plan.checks",  # the first plan checked (IssueKind: app/plan/issue_kind.py)
     "importlib.resources",  # the shipped robot profile: read by its first use
+    "ui.keypad",  # the on-screen keypad: touch mode on, or a field that has one
 )
 
 
