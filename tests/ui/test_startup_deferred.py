@@ -27,6 +27,7 @@ DEFERRED = (
     "app.link.streams",
     "ui.panels.monitor_plots",  # the monitor's plots: built after the first paint
     "app.plan.checks",  # the first plan checked (IssueKind: app/plan/issue_kind.py)
+    "app.view3d.profile",  # robot profiles: the first one read (3D view, planner checks)
     "importlib.resources",  # the shipped robot profile: read by its first use
     "ui.keypad",  # the on-screen keypad: touch mode on, or a field that has one
 )

@@ -20,15 +20,16 @@ from typing import TYPE_CHECKING, Final
 
 from PySide6.QtCore import QObject, Signal
 
-from app.view3d.profile import ProfileError, RobotProfile, default_profile, load_profile
 from ui.settings import AppSettings
 
-if TYPE_CHECKING:  # the arm model and its reach checks: imported by the first reach question
+if TYPE_CHECKING:  # the arm model and its reach checks: imported by the first reach question; the
+    # profiles' module by the first profile read (the default one, or one remembered or loaded)
     from app.plan.checks import PlanIssue
     from app.plan.geometry import PointLike
     from app.plan.segments import Plan
     from app.points.ledger import PointLedger
     from app.view3d.kinematics import ArmModel
+    from app.view3d.profile import RobotProfile
     from app.view3d.reach import ReachChecker
 
 CHECKERS_KEPT: Final = 4  # profiles whose reach caches are kept (switching back is free)
@@ -72,6 +73,8 @@ class RobotModelSource(QObject):
     def default(self) -> RobotProfile:
         """The shipped profile (the simulator's arm): read when first needed, not at start-up."""
         if self._default is None:
+            from app.view3d.profile import default_profile
+
             self._default = default_profile()
         return self._default
 
@@ -100,6 +103,8 @@ class RobotModelSource(QObject):
     def load_file(self, path: str) -> str | None:
         """Load a profile file and use it; the loader's message when it cannot be used (the
         current profile stays)."""
+        from app.view3d.profile import ProfileError, load_profile
+
         try:
             profile = load_profile(path)
         except ProfileError as exc:
