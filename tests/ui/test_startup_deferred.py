@@ -31,22 +31,27 @@ DEFERRED = (
     "importlib.resources",  # the shipped robot profile: read by its first use
     "ui.keypad",  # the on-screen keypad: touch mode on, or a field that has one
 )
+# Qt classes made ready (shiboken) by their first use: the dialogs, when one is shown
+# (PySide6 makes a class when it is first looked up: its module's namespace holds only those made)
+DEFERRED_QT = ("QDialog", "QMessageBox", "QFileDialog", "QInputDialog")
 
 
 def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint(tmp_path: Any) -> None:
     code = textwrap.dedent("""
         import gc, json, sys
+        import PySide6.QtWidgets
         from PySide6.QtCore import QTimer
         from PySide6.QtWidgets import QApplication
         import ui.main as teachpad
 
-        DEFERRED = json.loads(sys.argv[2])
+        DEFERRED, DEFERRED_QT = json.loads(sys.argv[2])
         after_import = gc.isenabled()  # the pause over the imports has ended with them
 
         class Probe(teachpad.MainWindow):
             def paintEvent(self, event):
                 if not hasattr(self, "seen"):
                     self.seen = sorted(m for m in DEFERRED if m in sys.modules)
+                    self.seen += sorted(c for c in DEFERRED_QT if c in vars(PySide6.QtWidgets))
                     self.gc_at_paint = gc.isenabled()
                     QTimer.singleShot(50, self._report)
                 super().paintEvent(event)
@@ -67,7 +72,7 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
         **{f"XDG_{d}_HOME": str(tmp_path / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
     }
     out = subprocess.run(
-        [sys.executable, "-c", code, str(tmp_path / "teachpad.ini"), json.dumps(DEFERRED)],
+        [sys.executable, "-c", code, str(tmp_path / "teachpad.ini"), json.dumps([DEFERRED, DEFERRED_QT])],
         cwd=ROOT,
         capture_output=True,
         text=True,
@@ -78,7 +83,7 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
     lines = {x.split(" ", 1)[0]: json.loads(x.split(" ", 1)[1]) for x in out.stdout.splitlines() if " " in x}
     assert out.returncode == 0 and "STARTUP" in lines, out.stderr[-2000:]
     seen, after_import, gc_at_paint, gc_after_paint = lines["STARTUP"]
-    assert seen == []  # none of DEFERRED before the first paint
+    assert seen == []  # none of DEFERRED (nor of DEFERRED_QT) before the first paint
     assert after_import is True  # importing ui.main leaves the collector as it found it
     assert gc_at_paint is False  # paused while the window was built and painted first
     assert gc_after_paint is True  # and on again on the loop's next turn
