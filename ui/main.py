@@ -43,6 +43,7 @@ SCREENSHOT_TIMEOUT_MS = 20_000  # give up when no pose arrives
 DEMO_PROGRAM = 1  # the simulator's "square 100 mm in XY"
 SIM_START_TIMEOUT = 20.0  # s for the simulator process to say which port it listens on
 SIM_START_LATEST_MS = 5000  # start the simulator then, even when the window has not painted yet
+STARTUP_GC_LATEST_MS = 5000  # garbage collection back on then, even when the window has not painted
 SIM_STOP_TIMEOUT = 10.0  # s for it to stop after its stdin closed, before it is terminated (a loaded
 # machine needs seconds to wind an interpreter down; this waits after the window has closed)
 THREADS_EXIT_WAIT = 5.0  # s at exit for a worker thread still stuck in a network call
@@ -455,6 +456,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
         window.start_project(args.project, reopen_last=not shot_run, offer_recovery=not shot_run)
 
     _AfterFirstPaint(window, after_first_paint)
+    QTimer.singleShot(STARTUP_GC_LATEST_MS, startup_gc.resume)  # a window never painted (minimized)
     window.show()
     try:
         code = exit_loop.exec()
