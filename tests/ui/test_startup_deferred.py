@@ -30,6 +30,7 @@ DEFERRED = (
     "app.view3d.profile",  # robot profiles: the first one read (3D view, planner checks)
     "importlib.resources",  # the shipped robot profile: read by its first use
     "ui.keypad",  # the on-screen keypad: touch mode on, or a field that has one
+    "hashlib",  # passwords (OpenSSL): the first one set or checked
 )
 # Qt classes made ready (shiboken) by their first use: the dialogs, when one is shown
 # (PySide6 makes a class when it is first looked up: its module's namespace holds only those made)
