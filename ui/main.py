@@ -23,14 +23,17 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QEvent, QObject, QTimer, Signal
 from PySide6.QtWidgets import QApplication, QWidget
 
-from app.link.robot_link import RobotLink, wait_for_detached_threads
-from app.link.transport import ConnectionSettings
-from app.link.types import ConnectionState
-from app.models import Pose
-from app.protocol.enums import ProgramMotionMode
-from ui.i18n import LANGUAGE_NAMES, Translator
-from ui.main_window import TAB_NAMES, MainWindow
-from ui.settings import APPLICATION, ORGANIZATION, AppSettings
+from ui.startup_gc import StartupGcPause, gc_paused
+
+with gc_paused():  # the window's modules: many objects made, almost none freed (ui/startup_gc.py)
+    from app.link.robot_link import RobotLink, wait_for_detached_threads
+    from app.link.transport import ConnectionSettings
+    from app.link.types import ConnectionState
+    from app.models import Pose
+    from app.protocol.enums import ProgramMotionMode
+    from ui.i18n import LANGUAGE_NAMES, Translator
+    from ui.main_window import TAB_NAMES, MainWindow
+    from ui.settings import APPLICATION, ORGANIZATION, AppSettings
 
 if TYPE_CHECKING:  # subprocess and queue: imported when a simulator is started (--sim)
     import subprocess
@@ -40,6 +43,7 @@ SCREENSHOT_TIMEOUT_MS = 20_000  # give up when no pose arrives
 DEMO_PROGRAM = 1  # the simulator's "square 100 mm in XY"
 SIM_START_TIMEOUT = 20.0  # s for the simulator process to say which port it listens on
 SIM_START_LATEST_MS = 5000  # start the simulator then, even when the window has not painted yet
+STARTUP_GC_LATEST_MS = 5000  # garbage collection back on then, even when the window has not painted
 SIM_STOP_TIMEOUT = 10.0  # s for it to stop after its stdin closed, before it is terminated (a loaded
 # machine needs seconds to wind an interpreter down; this waits after the window has closed)
 THREADS_EXIT_WAIT = 5.0  # s at exit for a worker thread still stuck in a network call
@@ -369,6 +373,16 @@ class _Screenshot:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    # No automatic garbage collection until the window's first paint (ui/startup_gc.py): resumed
+    # by after_first_paint, or when main ends before that.
+    startup_gc = StartupGcPause()
+    try:
+        return _main(argv, startup_gc)
+    finally:
+        startup_gc.resume()
+
+
+def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
     args_in = list(sys.argv[1:] if argv is None else argv)
     parser = build_parser()
     args, qt_args = parser.parse_known_args(args_in)
@@ -433,6 +447,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         starter.failed.connect(sim_failed)
 
     def after_first_paint() -> None:
+        startup_gc.resume()
         # The link's worker (pymodbus, the envelope) is made by the connection, after the paint.
         if connection is not None:
             link.connect_to(connection)
@@ -441,6 +456,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         window.start_project(args.project, reopen_last=not shot_run, offer_recovery=not shot_run)
 
     _AfterFirstPaint(window, after_first_paint)
+    QTimer.singleShot(STARTUP_GC_LATEST_MS, startup_gc.resume)  # a window never painted (minimized)
     window.show()
     try:
         code = exit_loop.exec()

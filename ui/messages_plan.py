@@ -8,13 +8,16 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QCoreApplication
 
-from app.plan.checks import IssueKind, PlanIssue
+from app.plan.issue_kind import IssueKind
 from app.points.point import SYNC_STATE_TEXT, SyncState
 from app.protocol.registers import TOOL_NONE
+
+if TYPE_CHECKING:  # the checks are imported by the first plan checked, after the first paint
+    from app.plan.checks import PlanIssue
 
 CONTEXT = "Messages"
 

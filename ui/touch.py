@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from PySide6.QtCore import QSize, Qt
+from PySide6.QtCore import QObject, QSize, Qt
 from PySide6.QtWidgets import (
     QAbstractButton,
     QDoubleSpinBox,
@@ -21,8 +21,6 @@ from PySide6.QtWidgets import (
     QTableView,
     QWidget,
 )
-
-from ui.keypad import install_keypad
 
 MOTION_MIN_HEIGHT = 40  # px, every motion button
 TOUCH_MOTION_HEIGHT = 56  # px, motion buttons in touch mode
@@ -86,4 +84,13 @@ def apply_touch_mode(roots: Iterable[QWidget], touch: bool) -> None:
             if button.property("motion"):
                 button.setMinimumHeight(height)
         for field in root.findChildren(QSpinBox) + root.findChildren(QDoubleSpinBox):
-            install_keypad(field, touch)
+            if touch or _has_keypad(field):  # else nothing to do (touch mode off, no keypad yet)
+                from ui.keypad import install_keypad  # the keypad: imported by the first one wanted
+
+                install_keypad(field, touch)
+
+
+def _has_keypad(field: QWidget) -> bool:
+    """``field`` has the keypad's opener (ui/keypad.py names it so), looked up without the keypad's module."""
+    opener = field.findChild(QObject, "KeypadOpener", Qt.FindChildOption.FindDirectChildrenOnly)
+    return opener is not None

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from PySide6.QtCore import QCoreApplication, QSize, Qt
 from PySide6.QtGui import QFont, QFontDatabase, QPainter, QPaintEvent, QPalette
-from PySide6.QtWidgets import QFileDialog, QFrame, QHBoxLayout, QLabel, QMessageBox, QSizePolicy, QWidget
+from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QSizePolicy, QWidget
 
 from app.link.types import ConnectionState, LinkState
 from app.models import CommandResult
@@ -303,6 +303,8 @@ def export_with_dialog(
     parent: QWidget, title: str, default_name: str, filters: str, export: Callable[[str], object]
 ) -> None:
     """Ask for a file name, run ``export(path)``; a failed write is shown, never raised."""
+    from PySide6.QtWidgets import QFileDialog, QMessageBox  # dialogs: imported when one is shown
+
     path, _ = QFileDialog.getSaveFileName(parent, title, default_name, filters)
     if not path:
         return

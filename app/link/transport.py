@@ -37,15 +37,16 @@ from app.errors import (
     ResponseTimeout,
 )
 from app.link.stats import LinkStats
-from app.link.streams import PeerClosed, SerialStream, TcpStream
 from app.protocol import registers
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 from app.protocol.exceptions import exception_text
 
-if TYPE_CHECKING:  # frames (pymodbus's framers) is imported when a Transport is made, not before:
-    # ConnectionSettings is read by the window at start-up, long before any link is opened
+if TYPE_CHECKING:  # frames (pymodbus's framers) and streams (sockets) are imported when a Transport
+    # is made, not before: ConnectionSettings is read by the window at start-up, long before any
+    # link is opened
     from app.link.frames import Framing, Request
+    from app.link.streams import SerialStream, TcpStream
 
 __all__ = ["ConnectionSettings", "TrafficObserver", "TrafficRecord", "Transport"]
 
@@ -135,7 +136,7 @@ class Transport:
     def __init__(
         self, settings: ConnectionSettings, on_link_change: Callable[[], None] | None = None
     ) -> None:
-        from app.link import frames  # pymodbus: only once a link is made (see the imports)
+        from app.link import frames, streams  # pymodbus, sockets: only once a link is made (see the imports)
 
         self._read_request = frames.read_request
         self._write_single_request = frames.write_single_request
@@ -146,9 +147,11 @@ class Transport:
         self._answer_registers = frames.answer_registers
         self.settings = settings
         self.framing: Framing = settings.transport
+        self._serial = settings.serial_port is not None
         self._stream: TcpStream | SerialStream = (
-            SerialStream(settings) if settings.serial_port is not None else TcpStream(settings)
+            streams.SerialStream(settings) if self._serial else streams.TcpStream(settings)
         )
+        self._peer_closed: type[Exception] = streams.PeerClosed  # the other end closed the stream
         self._on_link_change = on_link_change or (lambda: None)
         self._observers: list[TrafficObserver] = []
         self._observing = False  # checked first on the hot path
@@ -205,7 +208,7 @@ class Transport:
         """Get back in step after a malformed answer or a timeout."""
         self._count("resyncs")
         _log.debug("resync after %s", why)
-        if isinstance(self._stream, SerialStream) and self._stream.is_open:
+        if self._serial and self._stream.is_open:
             self._stream.drain()
         else:
             self.close()
@@ -268,7 +271,7 @@ class Transport:
     def _flush_stray(self) -> None:
         try:
             dropped = self._stream.drain()
-        except (PeerClosed, OSError):
+        except (self._peer_closed, OSError):
             # The controller closed the idle link (restart, its own timeout): say so once; the
             # next request opens a fresh link.
             self.close()
@@ -326,7 +329,7 @@ class Transport:
                     )
                 try:
                     buf += stream.recv(remaining)
-                except PeerClosed:
+                except self._peer_closed:
                     if not buf:
                         raise self._lost(what) from None
                     raise MalformedResponse(

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 from app.errors import InvalidInput
 from app.plan.geometry import PointLike, arc_geometry, xyz_of
+from app.plan.issue_kind import IssueKind as IssueKind  # re-exported: its home before issue_kind.py
 from app.plan.segments import FloatArray, Plan, Segment
 from app.points.ledger import (
     PointLedger,
@@ -47,12 +48,6 @@ class PlanLimits:
                 raise InvalidInput(f"{name} must be a finite number >= 0")
         if self.max_speed <= 0:
             raise InvalidInput("max_speed must be > 0")
-
-
-class IssueKind(enum.Enum):
-    ERROR = "error"  # the plan cannot run as it is
-    NEEDS_UPLOAD = "needs-upload"  # a point must be (re)created on the controller first
-    WARNING = "warning"  # it can run, but look
 
 
 # An arc resumed from a pose this far from its planned start is checked for a detour.

@@ -18,11 +18,8 @@ from __future__ import annotations
 
 import contextlib
 import enum
-import hashlib
-import hmac
 import json
 import os
-import secrets
 import sys
 import time
 from collections.abc import Callable
@@ -148,10 +145,14 @@ class PasswordHash:
 
     @classmethod
     def make(cls, password: str, *, n: int = SCRYPT_N) -> PasswordHash:
+        import secrets  # (hashlib, hmac, secrets: imported by the first password, not at start-up)
+
         salt = secrets.token_bytes(SALT_BYTES)
         return cls(salt, _scrypt(password, salt, n, SCRYPT_R, SCRYPT_P), n)
 
     def matches(self, password: str) -> bool:
+        import hmac
+
         return hmac.compare_digest(_scrypt(password, self.salt, self.n, self.r, self.p), self.digest)
 
     def to_dict(self) -> dict[str, object]:
@@ -176,6 +177,8 @@ class PasswordHash:
 
 
 def _scrypt(password: str, salt: bytes, n: int, r: int, p: int) -> bytes:
+    import hashlib
+
     return hashlib.scrypt(
         password.encode("utf-8"), salt=salt, n=n, r=r, p=p, dklen=HASH_BYTES, maxmem=256 * 1024 * 1024
     )

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QEvent, QObject, QTimer, Slot
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QFileDialog, QLabel, QMenu, QMessageBox
+from PySide6.QtWidgets import QLabel, QMenu
 
 from app.errors import TeachPadError
 from app.link.types import LinkState
@@ -228,6 +228,8 @@ class SafetyMenu(QObject):
         viewer.exec()
 
     def _ask_save_path(self, title: str, suggested: str) -> str | None:
+        from PySide6.QtWidgets import QFileDialog  # dialogs: imported when one is shown, not at start-up
+
         path, _ = QFileDialog.getSaveFileName(self.window, title, suggested, self.tr("Zip files (*.zip)"))
         return path or None
 
@@ -266,6 +268,8 @@ class SafetyMenu(QObject):
                 )
         except (OSError, TeachPadError) as exc:
             why = self.tr("The support bundle could not be written: {why}").format(why=str(exc)[:200])
+            from PySide6.QtWidgets import QMessageBox
+
             QMessageBox.warning(window, self.tr("Support bundle"), why)
             return None
         self.safety.session.audit.record(

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from PySide6.QtWidgets import QMessageBox, QWidget
+from PySide6.QtWidgets import QWidget
 
 ConfirmFn = Callable[[str, str], bool]  # (title, question) -> go ahead?
 
@@ -19,6 +19,8 @@ def ask_confirmation(parent: QWidget) -> ConfirmFn:
     """The default confirmation: a Yes/Cancel question box, Cancel being the default."""
 
     def confirm(title: str, text: str) -> bool:
+        from PySide6.QtWidgets import QMessageBox  # dialogs: imported when one is shown, not at start-up
+
         answer = QMessageBox.question(
             parent,
             title,

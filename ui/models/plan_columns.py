@@ -3,20 +3,25 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from PySide6.QtCore import (
     QCoreApplication,
     QModelIndex,
     QPersistentModelIndex,
     Qt,
 )
-from PySide6.QtGui import QColor, QFont, QIcon, QPainter, QPixmap
+from PySide6.QtGui import QColor, QFont
 
-from app.plan.checks import IssueKind
+from app.plan.issue_kind import IssueKind
 from app.plan.segments import TR_CONTEXT as PLAN_CORE_CONTEXT
 from app.plan.segments import (
     SegmentKind,
 )
 from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_WARN, COLOR_WHITE
+
+if TYPE_CHECKING:  # the icons are drawn by the planner (built after the window's first paint)
+    from PySide6.QtGui import QIcon
 
 ModelIndex = QModelIndex | QPersistentModelIndex
 
@@ -72,6 +77,8 @@ def orientation_text(changes: bool) -> str:
 
 def issue_icon(kind: IssueKind, size: int = 16) -> QIcon:
     """A filled circle with a glyph, in the issue's colour (no theme icons needed)."""
+    from PySide6.QtGui import QIcon, QPainter, QPixmap
+
     pixmap = QPixmap(size, size)
     pixmap.fill(Qt.GlobalColor.transparent)
     painter = QPainter(pixmap)

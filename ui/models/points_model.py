@@ -97,9 +97,7 @@ class PointsModel(UndoableListModel):
         self._on_controller: dict[int, TempPoint] = {}
         self._headers: tuple[str, ...] = ()
         self._header_tips: dict[int, str] = {}
-        self._brushes = {
-            state: (QBrush(QColor(fg)), QBrush(QColor(bg))) for state, (fg, bg) in SYNC_COLOURS.items()
-        }
+        self._brushes: dict[SyncState, tuple[QBrush, QBrush]] = {}  # made by the first row drawn
         self._seed_controller_copy()
         self.retranslate()
 
@@ -118,6 +116,16 @@ class PointsModel(UndoableListModel):
         self._project = project
         self._seed_controller_copy()
         self.endResetModel()
+
+    def _sync_brushes(self, state: SyncState) -> tuple[QBrush, QBrush]:
+        """(text, background) of a sync state's cell. Made by the first row drawn, not with the
+        model: PySide6 readies QGradient, QImage and QPixmap for the first QBrush(QColor), ~3 ms
+        that the window's first paint does not need (the points table is built after it)."""
+        if not self._brushes:
+            self._brushes = {
+                state: (QBrush(QColor(fg)), QBrush(QColor(bg))) for state, (fg, bg) in SYNC_COLOURS.items()
+            }
+        return self._brushes[state]
 
     def _seed_controller_copy(self) -> None:
         self._on_controller = {p.id: p for p in self.ledger if p.sync is SyncState.ON_CONTROLLER}
@@ -187,9 +195,9 @@ class PointsModel(UndoableListModel):
                 return int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
             return int(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
         if role == Qt.ItemDataRole.ForegroundRole and column == COL_SYNC:
-            return self._brushes[point.sync][0]
+            return self._sync_brushes(point.sync)[0]
         if role == Qt.ItemDataRole.BackgroundRole and column == COL_SYNC:
-            return self._brushes[point.sync][1]
+            return self._sync_brushes(point.sync)[1]
         if role == POINT_ID_ROLE:
             return point.id
         if role == SYNC_ROLE:

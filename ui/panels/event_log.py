@@ -101,11 +101,20 @@ class EventLogModel(QAbstractTableModel):
         self._events: list[LogEvent] = []
         self._max = max_events
         self._mono = monospace_font(9.5)
-        self._fg = {"warning": QBrush(QColor("#8a5300")), "error": QBrush(QColor(COLOR_ERROR))}
-        self._bg = {"warning": QBrush(QColor(COLOR_WARN_BG)), "error": QBrush(QColor(COLOR_ERROR_BG))}
+        self._fg: dict[str, QBrush] = {}  # made by the first warning or error shown (see _brushes)
+        self._bg: dict[str, QBrush] = {}
         self._headers: tuple[str, ...] = ()
         self._level_text: dict[str, str] = {}
         self._set_texts()
+
+    def _brushes(self) -> tuple[dict[str, QBrush], dict[str, QBrush]]:
+        """(text, background) brushes by level, made by the first row drawn: PySide6 readies
+        QGradient, QImage and QPixmap for the first QBrush(QColor), which the window's first paint
+        does not need."""
+        if not self._fg:
+            self._fg = {"warning": QBrush(QColor("#8a5300")), "error": QBrush(QColor(COLOR_ERROR))}
+            self._bg = {"warning": QBrush(QColor(COLOR_WARN_BG)), "error": QBrush(QColor(COLOR_ERROR_BG))}
+        return self._fg, self._bg
 
     def _set_texts(self) -> None:
         self._headers = (
@@ -187,9 +196,9 @@ class EventLogModel(QAbstractTableModel):
                 return event.source
             return event.text
         if role == Qt.ItemDataRole.ForegroundRole:
-            return self._fg.get(event.level)
+            return self._brushes()[0].get(event.level)
         if role == Qt.ItemDataRole.BackgroundRole:
-            return self._bg.get(event.level)
+            return self._brushes()[1].get(event.level)
         if role == Qt.ItemDataRole.FontRole and column == COL_TIME:
             return self._mono
         if role == Qt.ItemDataRole.ToolTipRole:

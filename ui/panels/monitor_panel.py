@@ -40,14 +40,8 @@ from app.link.state import RobotState
 from app.models import Pose
 from ui.display_clock import DISPLAY_INTERVAL_MS, DisplayClock
 from ui.models.ring_buffer import RingBuffer
-from ui.panels.monitor_plots import CARTESIAN as _CARTESIAN
-from ui.panels.monitor_plots import (
-    MAX_PLOT_POINTS,
-    PAINT_MARGIN,
-    PLOT_INTERVAL_MS,
-    TRACE_MIN_SPAN_MM,
-    MonitorPlots,
-)
+from ui.panels.monitor_figures import CARTESIAN as _CARTESIAN
+from ui.panels.monitor_figures import MAX_PLOT_POINTS, PAINT_MARGIN, PLOT_INTERVAL_MS, TRACE_MIN_SPAN_MM
 from ui.panels.monitor_readouts import BIG_POINTS_MAX, MIN_WIDTH, ReadoutBoxes, readout_scale
 from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
 
@@ -182,6 +176,8 @@ class MonitorPanel(QWidget):
         if self._plots_built:
             return
         self._plots_built = True
+        from ui.panels.monitor_plots import MonitorPlots  # not needed for the first paint
+
         plots = MonitorPlots(self)
         self._plots = plots
         self.xyz_plot, self.abc_plot, self.trace_plot = plots.xyz_plot, plots.abc_plot, plots.trace_plot

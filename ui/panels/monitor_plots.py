@@ -35,6 +35,13 @@ from PySide6.QtGui import QBrush, QColor, QFont, QPen
 from PySide6.QtWidgets import QGraphicsEllipseItem, QGraphicsItem, QSizePolicy, QSplitter, QWidget
 
 from ui.models.ring_buffer import RingBuffer
+from ui.panels.monitor_figures import (
+    CARTESIAN,
+    MAX_PLOT_POINTS,
+    PAINT_MARGIN,
+    PLOT_INTERVAL_MS,
+    TRACE_MIN_SPAN_MM,
+)
 
 if TYPE_CHECKING:
     import numpy as np
@@ -69,21 +76,13 @@ GRID_COLOR = "#dde3e6"
 # px: two stacked plots + the tiles above them set the Monitor tab's height, the tallest tab; with
 # the alarm banner up at 1280x800 (Chinese fonts are taller) 2 x 90 px did not fit
 PLOT_MIN_HEIGHT = 80
-# Points per curve: two per pixel of the plot's width, within these bounds; longer windows are
-# drawn with a stride (still a view). Drawing 2 px wide lines costs in proportion to the points.
-MAX_PLOT_POINTS = 2500
+# Points per curve: two per pixel of the plot's width, within MIN_PLOT_POINTS..MAX_PLOT_POINTS
+# (ui/panels/monitor_figures.py, with CARTESIAN, PAINT_MARGIN, TRACE_MIN_SPAN_MM and
+# PLOT_INTERVAL_MS: the panel needs them before the plots exist).
 MIN_PLOT_POINTS = 1000
 POINTS_PER_PIXEL = 2
 CURVE_WIDTH = 1  # px, the time curves and the top view's trace (see MonitorPlots)
-# Curves keep a view of the ring buffer until the scene repaints; never hand them the whole
-# buffer, so samples arriving before that repaint cannot overwrite what they show.
-PAINT_MARGIN = 512
-TRACE_MIN_SPAN_MM = 50.0  # the top view never zooms in closer than this (readable labels)
 TRACE_PADDING = 0.08  # fraction of the span around the trace
-# The plots' frame period: every other display frame (10 Hz). The readouts above them show the
-# newest pose at the display rate; a curve that moves 10 times a second still reads as live, and
-# the plots were most of the monitor's painting (benchmarks/streaming.py).
-PLOT_INTERVAL_MS = 100
 # Vertical ranges (see fit_range): padding around the values, the smallest span shown (a still
 # arm's flat line, not its noise magnified), and how little of the range the values may use
 # before it is narrowed again.
@@ -95,7 +94,6 @@ _CACHED = QGraphicsItem.CacheMode.DeviceCoordinateCache  # the axes' and legends
 
 # History channels: time, then X Y Z and the unwrapped A B C.
 T, X = 0, 1
-CARTESIAN = ("X", "Y", "Z", "A", "B", "C")
 _PLOT_COLORS = {
     "X": "#d62728",
     "Y": "#2ca02c",

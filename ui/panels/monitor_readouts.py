@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from PySide6.QtWidgets import QGridLayout, QGroupBox, QWidget
 
-from ui.panels.monitor_plots import CARTESIAN
+from ui.panels.monitor_figures import CARTESIAN
 from ui.widgets_common import NumericReadout
 
 __all__ = ["BIG_POINTS_MAX", "MIN_WIDTH", "ReadoutBoxes", "readout_point_sizes", "readout_scale"]

@@ -20,15 +20,16 @@ from typing import TYPE_CHECKING, Final
 
 from PySide6.QtCore import QObject, Signal
 
-from app.view3d.profile import ProfileError, RobotProfile, default_profile, load_profile
 from ui.settings import AppSettings
 
-if TYPE_CHECKING:  # the arm model and its reach checks: imported by the first reach question
+if TYPE_CHECKING:  # the arm model and its reach checks: imported by the first reach question; the
+    # profiles' module by the first profile read (the default one, or one remembered or loaded)
     from app.plan.checks import PlanIssue
     from app.plan.geometry import PointLike
     from app.plan.segments import Plan
     from app.points.ledger import PointLedger
     from app.view3d.kinematics import ArmModel
+    from app.view3d.profile import RobotProfile
     from app.view3d.reach import ReachChecker
 
 CHECKERS_KEPT: Final = 4  # profiles whose reach caches are kept (switching back is free)
@@ -44,11 +45,11 @@ class RobotModelSource(QObject):
     def __init__(self, settings: AppSettings | None = None, parent: QObject | None = None) -> None:
         super().__init__(parent)
         self._settings = settings
-        self._default = default_profile()
+        self._default: RobotProfile | None = None  # the shipped profile, read by its first use
         self._checkers: dict[RobotProfile, ReachChecker] = {}
         self.path = ""  # the profile's file ("" for the default profile)
         self.problem = ""  # the last profile file that could not be used, and why
-        self._profile = self._default
+        self._profile: RobotProfile | None = None  # None: the default profile (not read yet)
         self._reach: ReachChecker | None = None  # made by the first use: the arm model needs numpy,
         # which the window's first paint does not (the planner's checks and the 3D view come later)
 
@@ -57,7 +58,7 @@ class RobotModelSource(QObject):
         """The current profile's reach checker (made now if it was not yet)."""
         reach = self._reach
         if reach is None:
-            reach = self._reach = self._checker(self._profile)
+            reach = self._reach = self._checker(self.profile)
         return reach
 
     @property
@@ -66,7 +67,16 @@ class RobotModelSource(QObject):
 
     @property
     def profile(self) -> RobotProfile:
-        return self._profile
+        return self._profile if self._profile is not None else self.default
+
+    @property
+    def default(self) -> RobotProfile:
+        """The shipped profile (the simulator's arm): read when first needed, not at start-up."""
+        if self._default is None:
+            from app.view3d.profile import default_profile
+
+            self._default = default_profile()
+        return self._default
 
     def _checker(self, profile: RobotProfile) -> ReachChecker:
         from app.view3d.kinematics import ArmModel
@@ -88,11 +98,13 @@ class RobotModelSource(QObject):
         self.profileChanged.emit(profile)
 
     def use_default(self) -> None:
-        self.set_profile(self._default)
+        self.set_profile(self.default)
 
     def load_file(self, path: str) -> str | None:
         """Load a profile file and use it; the loader's message when it cannot be used (the
         current profile stays)."""
+        from app.view3d.profile import ProfileError, load_profile
+
         try:
             profile = load_profile(path)
         except ProfileError as exc:
@@ -116,9 +128,9 @@ class RobotModelSource(QObject):
                 "The default robot model (%2) is used."
             )
             .replace("%1", error)
-            .replace("%2", self._default.name)
+            .replace("%2", self.default.name)
         )
-        self.set_profile(self._default)  # and forget the bad path
+        self.set_profile(self.default)  # and forget the bad path
         self.problemRaised.emit(self.problem)
         return False
 

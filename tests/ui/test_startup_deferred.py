@@ -1,0 +1,132 @@
+"""Start-up margin (issue 10): what the first paint does not need waits for after it, and the
+garbage collector is paused until then (ui/startup_gc.py)."""
+
+from __future__ import annotations
+
+import gc
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from app.link.transport import ConnectionSettings, Transport
+from app.view3d.profile import default_profile
+from ui.panels.view3d_robot import RobotModelSource
+from ui.startup_gc import StartupGcPause, gc_paused
+
+ROOT = Path(__file__).resolve().parents[2]
+
+# Imported by their first use, after the window's first paint (not by the window's modules)
+DEFERRED = (
+    "socket",  # the transport's byte streams: when a Transport is made
+    "app.link.streams",
+    "ui.panels.monitor_plots",  # the monitor's plots: built after the first paint
+    "app.plan.checks",  # the first plan checked (IssueKind: app/plan/issue_kind.py)
+    "app.view3d.profile",  # robot profiles: the first one read (3D view, planner checks)
+    "importlib.resources",  # the shipped robot profile: read by its first use
+    "ui.keypad",  # the on-screen keypad: touch mode on, or a field that has one
+    "hashlib",  # passwords (OpenSSL): the first one set or checked
+)
+# Qt classes made ready (shiboken) by their first use: the dialogs, when one is shown
+# (PySide6 makes a class when it is first looked up: its module's namespace holds only those made)
+DEFERRED_QT = ("QDialog", "QMessageBox", "QFileDialog", "QInputDialog")
+
+
+def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint(tmp_path: Any) -> None:
+    code = textwrap.dedent("""
+        import gc, json, sys
+        import PySide6.QtWidgets
+        from PySide6.QtCore import QTimer
+        from PySide6.QtWidgets import QApplication
+        import ui.main as teachpad
+
+        DEFERRED, DEFERRED_QT = json.loads(sys.argv[2])
+        after_import = gc.isenabled()  # the pause over the imports has ended with them
+
+        class Probe(teachpad.MainWindow):
+            def paintEvent(self, event):
+                if not hasattr(self, "seen"):
+                    self.seen = sorted(m for m in DEFERRED if m in sys.modules)
+                    self.seen += sorted(c for c in DEFERRED_QT if c in vars(PySide6.QtWidgets))
+                    self.gc_at_paint = gc.isenabled()
+                    QTimer.singleShot(50, self._report)
+                super().paintEvent(event)
+
+            def _report(self):
+                print("STARTUP " + json.dumps([self.seen, after_import, self.gc_at_paint, gc.isenabled()]),
+                      flush=True)
+                QApplication.instance().exit(0)
+
+        teachpad.MainWindow = Probe
+        code = teachpad.main(["--settings", sys.argv[1]])
+        print("AFTER_MAIN " + json.dumps(gc.isenabled()), flush=True)
+        sys.exit(code)
+    """)
+    env = {
+        **os.environ,
+        "QT_QPA_PLATFORM": "offscreen",
+        **{f"XDG_{d}_HOME": str(tmp_path / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
+    }
+    out = subprocess.run(
+        [sys.executable, "-c", code, str(tmp_path / "teachpad.ini"), json.dumps([DEFERRED, DEFERRED_QT])],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=env,
+        check=False,
+    )
+    lines = {x.split(" ", 1)[0]: json.loads(x.split(" ", 1)[1]) for x in out.stdout.splitlines() if " " in x}
+    assert out.returncode == 0 and "STARTUP" in lines, out.stderr[-2000:]
+    seen, after_import, gc_at_paint, gc_after_paint = lines["STARTUP"]
+    assert seen == []  # none of DEFERRED (nor of DEFERRED_QT) before the first paint
+    assert after_import is True  # importing ui.main leaves the collector as it found it
+    assert gc_at_paint is False  # paused while the window was built and painted first
+    assert gc_after_paint is True  # and on again on the loop's next turn
+    assert lines["AFTER_MAIN"] is True
+
+
+def test_a_pause_resumes_once_and_only_a_collector_that_was_on() -> None:
+    assert gc.isenabled()
+    pause = StartupGcPause()
+    assert not gc.isenabled()
+    pause.resume()
+    assert gc.isenabled()
+    gc.disable()
+    try:
+        pause.resume()  # a second resume does nothing
+        assert not gc.isenabled()
+        StartupGcPause().resume()  # paused while off: stays off
+        assert not gc.isenabled()
+    finally:
+        gc.enable()
+
+
+def test_gc_paused_resumes_after_an_error() -> None:
+    with pytest.raises(RuntimeError), gc_paused():
+        assert not gc.isenabled()
+        raise RuntimeError("boom")
+    assert gc.isenabled()
+
+
+def test_the_default_robot_profile_is_read_by_its_first_use() -> None:
+    robot = RobotModelSource()
+    assert robot._default is None  # not read at construction (start-up)
+    assert robot.profile == default_profile()
+    assert robot.default is robot.profile
+    assert robot.restore()  # nothing remembered: the default stays
+    robot.use_default()
+    assert robot.profile == default_profile()
+
+
+def test_a_transport_picks_its_stream_when_made() -> None:
+    tcp = Transport(ConnectionSettings(host="127.0.0.1", port=9))
+    assert type(tcp._stream).__name__ == "TcpStream"
+    assert "app.link.streams" in sys.modules
+    serial = Transport(ConnectionSettings(serial_port="/dev/null-teachpad", framer="rtu"))
+    assert type(serial._stream).__name__ == "SerialStream"
