@@ -71,7 +71,11 @@ class WorkerCommands:
             self._report_stop_line(on_line)
             raise
         except TeachPadError as exc:  # no answer in time, refused, link lost: the operator still asked for it
-            if self._report_stop_line(on_line):  # ... and the controller took it on the stop line
+            took = self._report_stop_line(on_line)  # ... and the controller took it on the stop line
+            if took and on_line is not None and client.writes_settled_before(on_line.sent_mono):
+                # ... and nothing this link wrote can reach the controller after the line's stop:
+                # every write before it was answered before it went out, none began since (a
+                # motion write after it -- a job already under way -- would run after the stop)
                 self._stopped_on_the_line_only(client, exc)
                 return
             self._cancel_motions_before_stop()  # nothing queued before the Stop runs after it
@@ -87,7 +91,7 @@ class WorkerCommands:
     def _report_stop_line(self, on_line: StopSent | None) -> bool:
         """The stop line's answer: checked, audited, shown in the traffic. True when the
         controller took the stop there."""
-        return on_line is not None and self.stop_line.report(self.capture, self.audit)
+        return on_line is not None and self.stop_line.report(self.capture, self.audit, on_line)
 
     def _stopped_on_the_line_only(self, client: RobotClient, exc: TeachPadError) -> None:
         """The main link's stop failed but the controller took the stop line's: the arm was
@@ -104,24 +108,20 @@ class WorkerCommands:
             now,
             f"stop: sent on the stop line (the main link's stop failed: {exc})",
             Reason("stop_sent_on_line", {"cause": cause.code, "cause_args": dict(cause.args)}),
-            jog_may_fail=True,
         )
         if isinstance(exc, LinkError | ResponseTimeout | MalformedResponse):
             self.supervisor.transport_failed(exc)
 
-    def _after_stop(
-        self, now: float, text: str, reason: Reason | None = None, *, jog_may_fail: bool = False
-    ) -> None:
+    def _after_stop(self, now: float, text: str, reason: Reason | None = None) -> None:
         """The controller took the stop: end the jog, the upload, the motion in flight and the
         motions queued before the Stop; then the Stop's own result."""
         job = self._current_job
         if job is not None and job.sent is not None:
             job.sent.set()  # the poster (the GUI thread) may go on
         self.uploader.end("stopped")
-        if jog_may_fail:  # the main link just failed: speed 0 goes out as soon as it answers
-            self._end_jog_after_a_failed_stop()
-        else:
-            self.jog.on_stop()
+        # the jog's speed 0: when its write fails (the stop itself went out), it goes out as soon as
+        # the controller answers -- never an error that would skip the cancellations below
+        self._end_jog_after_a_failed_stop()
         active = self.motion.take()
         self._cancel_motions_before_stop()
         if active is not None:

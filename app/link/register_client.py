@@ -20,6 +20,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import logging
+import time
 from collections.abc import Iterator, Sequence
 from typing import Self
 
@@ -59,6 +60,9 @@ class RegisterClient:
         self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
         self._io_timeout: float | None = None  # see io_timeout()
         self.audit: AuditLog | None = None  # every write (and monitor-only block) is recorded here
+        # The writes other than Stop: all answered (writes_settled), the last one when (monotonic)
+        self.writes_settled = True
+        self.write_answered_at = 0.0
 
     # -- connection ----------------------------------------------------------------------
     def connect(self) -> None:
@@ -129,6 +133,9 @@ class RegisterClient:
             self._require_writable(what)
             if not values:
                 raise InvalidInput("nothing to write")
+            tracked = address != registers.REG_STOP
+            if tracked:  # settled again below, when the controller has answered it
+                self.writes_settled = False
             if single:
                 if len(values) != 1:
                     raise InvalidInput("a single-register write takes one value")
@@ -140,6 +147,15 @@ class RegisterClient:
                     _log.debug("%s: 0x10 <- %s", what, " ".join(f"{v:04X}" for v in values))
                 self.write_count += 1
                 self._transport.write_multiple(what, address, list(map(int, values)), timeout)
+            if tracked:
+                self.write_answered_at = time.monotonic()
+                self.writes_settled = True
+
+    def writes_settled_before(self, moment: float) -> bool:
+        """Every write but Stop's (441) this client began was answered before ``moment``
+        (``time.monotonic()``): the controller took each of them before anything sent later on
+        another connection. False after a write without its answer (failed, timed out)."""
+        return self.writes_settled and self.write_answered_at < moment
 
     def _write_floats(self, gv: int, values: Sequence[float], timeout: float | None = None) -> None:
         self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order), timeout=timeout)

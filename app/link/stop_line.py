@@ -60,6 +60,7 @@ class StopSent:
     tid: int
     frame: bytes
     at: float  # time.time() of the send, for the traffic record
+    sent_mono: float = 0.0  # time.monotonic() just before the send (what the main link wrote since)
 
 
 class StopLine:
@@ -103,6 +104,7 @@ class StopLine:
             self._tid = self._tid % 65000 + 1
             request = frames.write_single_request(registers.REG_STOP, 1)
             frame = frames.encode_request("tcp", request, settings.unit, self._tid)
+            sent_mono = time.monotonic()
             try:
                 sent = sock.send(frame)
             except OSError:
@@ -110,7 +112,7 @@ class StopLine:
             if sent != len(frame):  # never for 12 bytes on an idle socket; a torn frame is no stop
                 self._drop("a partial send")
                 return None
-            self._pending = StopSent(self._tid, frame, time.time())
+            self._pending = StopSent(self._tid, frame, time.time(), sent_mono)
             self.stops_sent += 1
             return self._pending
         finally:
@@ -156,8 +158,8 @@ class StopLine:
             return
         if now >= self._next_keepalive:
             with self._lock:
-                if self._sock is None:
-                    return
+                if self._sock is None or self._pending is not None:
+                    return  # a stop's answer waits for the stop job's report (it reads it there)
                 try:
                     self._collect_locked()
                     self._exchange(frames.read_request(registers.STATUS_BLOCK_START, 1))
@@ -178,10 +180,13 @@ class StopLine:
                 return pending, b"", str(exc)
             return pending, answer, None
 
-    def report(self, capture: TrafficCapture, audit: AuditLog | None) -> bool:
+    def report(
+        self, capture: TrafficCapture, audit: AuditLog | None, expected: StopSent | None = None
+    ) -> bool:
         """:meth:`collect`, then the stop's frames to the traffic capture and its write to the
         audit trail (worker thread); a bad answer is logged (the main link's stop went out too).
-        True when the controller took the stop on this line (its echo checked)."""
+        True when the controller took ``expected`` (the stop this job sent; None: whatever stop
+        was pending) on this line (its echo checked)."""
         sent, answer, problem = self.collect()
         if sent is None:
             return False
@@ -195,7 +200,7 @@ class StopLine:
             )
         if problem is not None:
             _log.warning("stop line: %s; the stop went out on the main link too", problem)
-        return problem is None
+        return problem is None and (expected is None or sent is expected)
 
     def close(self) -> None:
         with self._lock:

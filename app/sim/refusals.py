@@ -1,5 +1,6 @@
-"""A refusal knob of the simulator: one point's create-point parameters answered with a Modbus
-exception, a given number of times (:meth:`app.sim.server.SimController.refuse_point_write`).
+"""Fault knobs of the simulator. A refusal: one point's create-point parameters answered with a
+Modbus exception, a given number of times (:meth:`app.sim.server.SimController.refuse_point_write`);
+and which requests a delay or an exception touches (by register range and connection).
 
 A controller that does not take a point id refuses the write of GV200-202 (point id, pose
 source, first pose GV) with an exception (illegal data value, say) instead of accepting it and
@@ -16,7 +17,7 @@ from pymodbus.constants import ExcCodes
 from app.protocol.codec import WordOrder, registers_to_float
 from app.protocol.registers import GV_PARAM0, gv_reg
 
-__all__ = ["PointWriteRefusals"]
+__all__ = ["PointWriteRefusals", "at_text", "on_text", "touches"]
 
 _POINT_ID_REG = gv_reg(GV_PARAM0)  # GV200: the point id of a create point
 
@@ -52,3 +53,18 @@ class PointWriteRefusals:
             else:
                 del self._refusals[int(value)]
             return code
+
+
+def touches(addresses: range | None, address: int, count: int) -> bool:
+    """A request of ``count`` registers at ``address`` touches ``addresses`` (None: every request)."""
+    return addresses is None or (address < addresses.stop and addresses.start < address + count)
+
+
+def on_text(connection: int | None) -> str:
+    """For the log: on which connection a fault applies."""
+    return "" if connection is None else f" on connection {connection}"
+
+
+def at_text(addresses: range | None) -> str:
+    """For the log: which registers a fault touches."""
+    return "" if addresses is None else f" on {addresses.start}..{addresses.stop - 1}"

@@ -42,7 +42,7 @@ from app.sim.config import SimConfig, SimEvent, SimSnapshot, WriteRecord
 from app.sim.execute import CommandExecutor
 from app.sim.guard import CURRENT_CONNECTION, BadFrames, CommWatchdog
 from app.sim.motion import Pose6, TraceSample
-from app.sim.refusals import PointWriteRefusals
+from app.sim.refusals import PointWriteRefusals, at_text, on_text, touches
 from app.sim.register_image import RegisterImage
 from app.sim.robot import SimRobot
 from app.sim.status import StatusPublisher
@@ -76,14 +76,13 @@ class SimController:
         self._started = False
         self._stopped = False
         # fault injection
-        self._response_delay = self.config.response_delay
-        self._response_delay_on: int | None = None  # the one connection delayed (None: all)
+        # (seconds, connection or None: all, addresses or None: all), replaced whole (the loop reads it)
+        self._delay_rule: tuple[float, int | None, range | None] = (self.config.response_delay, None, None)
         self._slow_answers = (0.0, 0)  # (s, n): every n-th answer held this long (late polls)
         self._status_delay = self.config.status_delay
         self._silent = False
-        self._exception: ExcCodes | None = None
-        self._exception_range: range | None = None
-        self._exception_connection: int | None = None
+        # (code or None: off, addresses or None: all, connection or None: all), replaced whole
+        self._exception_rule: tuple[ExcCodes | None, range | None, int | None] = (None, None, None)
         self.point_write_refusals = PointWriteRefusals()
         # GV291 publication hold (app/sim/status.py), the register image, the command execution
         self.status = StatusPublisher(self.config.timing, self.config.command_latency, self.config.seed)
@@ -257,13 +256,14 @@ class SimController:
         if self._silent:
             return ExcCodes.DEVICE_FAILURE  # not executed; the answer is dropped by _trace_packet
         slow, every = self._slow_answers
-        held = self._response_delay if self._response_delay_on in (None, connection) else 0.0
+        held, delay_on, delay_range = self._delay_rule
+        if not (delay_on in (None, connection) and touches(delay_range, address, count)):
+            held = 0.0
         delay = max(held, slow if every and serial % every == 0 else 0.0)
         if delay > 0:
             await asyncio.sleep(delay)
-        exc, exc_range = self._exception, self._exception_range
-        hit = exc_range is None or (address < exc_range.stop and exc_range.start < address + count)
-        hit = hit and self._exception_connection in (None, connection)
+        exc, exc_range, exc_on = self._exception_rule
+        hit = touches(exc_range, address, count) and exc_on in (None, connection)
         if exc is not None and hit:
             return exc
         if set_values is not None:
@@ -432,14 +432,14 @@ class SimController:
         self.point_write_refusals.set(point_id, ExcCodes(code), times)
         log.info("create point %d: GV200 write refused %d time(s), exception %d", point_id, times, code)
 
-    def set_response_delay(self, seconds: float, connection: int | None = None) -> None:
-        """Hold every answer ``seconds``; only on one connection (an id of :meth:`connection_ids`)
-        when ``connection`` is given (a wedged link beside a good one)."""
-        self._response_delay_on = connection
-        self._response_delay = max(0.0, float(seconds))
-        log.info(
-            "response delay %.3f s%s", self._response_delay, "" if connection is None else f" on {connection}"
-        )
+    def set_response_delay(
+        self, seconds: float, connection: int | None = None, addresses: range | None = None
+    ) -> None:
+        """Hold answers ``seconds``: all of them, or only on one connection (an id of
+        :meth:`connection_ids`: a wedged link beside a good one) and/or only for requests touching
+        ``addresses``."""
+        self._delay_rule = (max(0.0, float(seconds)), connection, addresses)
+        log.info("response delay %.3f s%s%s", self._delay_rule[0], on_text(connection), at_text(addresses))
 
     def set_status_delay(self, seconds: float) -> None:
         self._status_delay = max(0.0, float(seconds))
@@ -465,14 +465,9 @@ class SimController:
     ) -> None:
         """Answer requests touching ``addresses`` (None: all) with Modbus exception ``code``; only
         on one connection when ``connection`` (an id of :meth:`connection_ids`) is given."""
-        self._exception_range = addresses
-        self._exception_connection = connection
-        self._exception = None if code is None else ExcCodes(code)
+        self._exception_rule = (None if code is None else ExcCodes(code), addresses, connection)
         log.info(
-            "exception %s%s%s",
-            "off" if code is None else int(code),
-            "" if addresses is None else f" on {addresses.start}..{addresses.stop - 1}",
-            "" if connection is None else f" on connection {connection}",
+            "exception %s%s%s", "off" if code is None else int(code), at_text(addresses), on_text(connection)
         )
 
     def connection_ids(self) -> list[int]:

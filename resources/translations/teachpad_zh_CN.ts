@@ -738,37 +738,37 @@
     <context>
         <name>EventLogModel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="112" />
+            <location filename="../../ui/panels/event_log.py" line="121" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="113" />
+            <location filename="../../ui/panels/event_log.py" line="122" />
             <source>Level</source>
             <translation>级别</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="114" />
+            <location filename="../../ui/panels/event_log.py" line="123" />
             <source>Source</source>
             <translation>来源</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="115" />
+            <location filename="../../ui/panels/event_log.py" line="124" />
             <source>Message</source>
             <translation>消息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="118" />
+            <location filename="../../ui/panels/event_log.py" line="127" />
             <source>Info</source>
             <translation>信息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="119" />
+            <location filename="../../ui/panels/event_log.py" line="128" />
             <source>Warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="120" />
+            <location filename="../../ui/panels/event_log.py" line="129" />
             <source>Error</source>
             <translation>错误</translation>
         </message>
@@ -776,72 +776,72 @@
     <context>
         <name>EventLogPanel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="287" />
+            <location filename="../../ui/panels/event_log.py" line="296" />
             <source>Show:</source>
             <translation>显示：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="288" />
+            <location filename="../../ui/panels/event_log.py" line="297" />
             <source>All events</source>
             <translation>全部事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="289" />
+            <location filename="../../ui/panels/event_log.py" line="298" />
             <source>Warnings and errors</source>
             <translation>警告和错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="290" />
+            <location filename="../../ui/panels/event_log.py" line="299" />
             <source>Errors only</source>
             <translation>仅错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="291" />
+            <location filename="../../ui/panels/event_log.py" line="300" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="292" />
+            <location filename="../../ui/panels/event_log.py" line="301" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="354" />
+            <location filename="../../ui/panels/event_log.py" line="363" />
             <source>alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="351" />
+            <location filename="../../ui/panels/event_log.py" line="360" />
             <source>Alarm raised: {name}</source>
             <translation>报警触发：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="351" />
+            <location filename="../../ui/panels/event_log.py" line="360" />
             <source>Alarm cleared: {name}</source>
             <translation>报警解除：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="360" />
+            <location filename="../../ui/panels/event_log.py" line="369" />
             <source>bit {n}</source>
             <translation>第 {n} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="364" />
+            <location filename="../../ui/panels/event_log.py" line="373" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="396" />
+            <location filename="../../ui/panels/event_log.py" line="405" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="423" />
+            <location filename="../../ui/panels/event_log.py" line="432" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="425" />
+            <location filename="../../ui/panels/event_log.py" line="434" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -849,7 +849,7 @@
     <context>
         <name>Export</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="315" />
+            <location filename="../../ui/widgets_common.py" line="317" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -1013,7 +1013,7 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="311" />
+            <location filename="../../ui/main_window.py" line="310" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1039,33 +1039,33 @@
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="343" />
+            <location filename="../../ui/main_window.py" line="342" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="349" />
+            <location filename="../../ui/main_window.py" line="348" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="345" />
-            <location filename="../../ui/main_window.py" line="350" />
+            <location filename="../../ui/main_window.py" line="344" />
+            <location filename="../../ui/main_window.py" line="349" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="288" />
+            <location filename="../../ui/main_window.py" line="287" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="289" />
+            <location filename="../../ui/main_window.py" line="288" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="290" />
+            <location filename="../../ui/main_window.py" line="289" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1075,22 +1075,22 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="415" />
+            <location filename="../../ui/main_window.py" line="416" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="417" />
+            <location filename="../../ui/main_window.py" line="418" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="437" />
+            <location filename="../../ui/main_window.py" line="438" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="437" />
+            <location filename="../../ui/main_window.py" line="438" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -1279,7 +1279,7 @@
         </message>
         <message>
             <location filename="../../ui/messages.py" line="136" />
-            <location filename="../../ui/messages_plan.py" line="26" />
+            <location filename="../../ui/messages_plan.py" line="29" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
@@ -1784,177 +1784,177 @@
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="413" />
+            <location filename="../../ui/messages.py" line="414" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="416" />
+            <location filename="../../ui/messages.py" line="417" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="30" />
+            <location filename="../../ui/messages_plan.py" line="33" />
             <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="33" />
+            <location filename="../../ui/messages_plan.py" line="36" />
             <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
             <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="37" />
+            <location filename="../../ui/messages_plan.py" line="40" />
             <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
             <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="38" />
+            <location filename="../../ui/messages_plan.py" line="41" />
             <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
             <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="39" />
+            <location filename="../../ui/messages_plan.py" line="42" />
             <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
             <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="40" />
+            <location filename="../../ui/messages_plan.py" line="43" />
             <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
             <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="44" />
+            <location filename="../../ui/messages_plan.py" line="47" />
             <source>Refused by the safety envelope: {text}</source>
             <translation>安全边界拒绝：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="45" />
+            <location filename="../../ui/messages_plan.py" line="48" />
             <source>segment {n}: </source>
             <translation>第 {n} 段：</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="46" />
+            <location filename="../../ui/messages_plan.py" line="49" />
             <source> (reduced-speed mode)</source>
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="422" />
+            <location filename="../../ui/messages.py" line="423" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="426" />
+            <location filename="../../ui/messages.py" line="427" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="82" />
+            <location filename="../../ui/messages_plan.py" line="85" />
             <source>Plan “{plan}” has no segments.</source>
             <translation>规划“{plan}”没有任何段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="83" />
+            <location filename="../../ui/messages_plan.py" line="86" />
             <source>Cannot start at segment {start}: the plan has {segments} segments.</source>
             <translation>无法从第 {start} 段开始：该规划只有 {segments} 段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="86" />
+            <location filename="../../ui/messages_plan.py" line="89" />
             <source>speed {speed} mm/s is not in (0, {max}] mm/s.</source>
             <translation>速度 {speed} mm/s 不在 (0, {max}] mm/s 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="87" />
+            <location filename="../../ui/messages_plan.py" line="90" />
             <source>the arc has no middle point.</source>
             <translation>圆弧没有中间点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="88" />
+            <location filename="../../ui/messages_plan.py" line="91" />
             <source>middle point P{id} does not exist.</source>
             <translation>中间点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="89" />
+            <location filename="../../ui/messages_plan.py" line="92" />
             <source>end point P{id} does not exist.</source>
             <translation>终点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="90" />
+            <location filename="../../ui/messages_plan.py" line="93" />
             <source>{point} is not on the controller ({sync}); upload it.</source>
             <translation>{point} 不在控制器上（{sync}）；请上传。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="91" />
+            <location filename="../../ui/messages_plan.py" line="94" />
             <source>{point} was taught with {point_tool}, the segment moves with {segment_tool}.</source>
             <translation>{point} 示教时的工具为“{point_tool}”，该段运动的工具为“{segment_tool}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="94" />
+            <location filename="../../ui/messages_plan.py" line="97" />
             <source>the line goes nowhere (start and end {length} mm apart){where}.</source>
             <translation>直线没有移动（起点与终点相距 {length} mm）{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="97" />
+            <location filename="../../ui/messages_plan.py" line="100" />
             <source>the arc starts at the robot's current pose, which is not known: its shape is not checked.</source>
             <translation>圆弧从机器人的当前位姿开始，但当前位姿未知：未检查其形状。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="101" />
+            <location filename="../../ui/messages_plan.py" line="104" />
             <source>the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与中间点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="105" />
+            <location filename="../../ui/messages_plan.py" line="108" />
             <source>the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的中间点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="109" />
+            <location filename="../../ui/messages_plan.py" line="112" />
             <source>the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="113" />
+            <location filename="../../ui/messages_plan.py" line="116" />
             <source>the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}.</source>
             <translation>圆弧的三个点（几乎）在一条直线上：中间点距起点—终点连线仅 {offset} mm（至少需要 {tolerance} mm）；请改用直线{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="117" />
+            <location filename="../../ui/messages_plan.py" line="120" />
             <source>the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before.</source>
             <translation>机械臂停在圆弧中间点之后：从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；请用直线移动到终点，或从前一段开始运行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="121" />
+            <location filename="../../ui/messages_plan.py" line="124" />
             <source>sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here.</source>
             <translation>从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；从此处运行前请检查预览。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="125" />
+            <location filename="../../ui/messages_plan.py" line="128" />
             <source>{point} is out of the robot model's reach.</source>
             <translation>{point} 超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="126" />
+            <location filename="../../ui/messages_plan.py" line="129" />
             <source>the path is out of the robot model's reach.</source>
             <translation>路径超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="127" />
+            <location filename="../../ui/messages_plan.py" line="130" />
             <source>{point} passes a joint limit of the robot model.</source>
             <translation>{point} 会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="128" />
+            <location filename="../../ui/messages_plan.py" line="131" />
             <source>the path passes a joint limit of the robot model.</source>
             <translation>路径会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="130" />
+            <location filename="../../ui/messages_plan.py" line="133" />
             <source> (from the current pose)</source>
             <translation>（从当前位姿出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="131" />
+            <location filename="../../ui/messages_plan.py" line="134" />
             <source> (on loops after the first, starting at the end of segment {after})</source>
             <translation>（第一轮之后的循环中，从第 {after} 段的终点出发）</translation>
         </message>
@@ -2218,105 +2218,105 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="198" />
-            <location filename="../../ui/panels/monitor_panel.py" line="217" />
+            <location filename="../../ui/panels/monitor_panel.py" line="194" />
+            <location filename="../../ui/panels/monitor_panel.py" line="213" />
             <source>mm</source>
             <extracomment>Attributes that exist once the plots are built (asking for one builds them).</extracomment>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="198" />
-            <location filename="../../ui/panels/monitor_panel.py" line="217" />
+            <location filename="../../ui/panels/monitor_panel.py" line="194" />
+            <location filename="../../ui/panels/monitor_panel.py" line="213" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="199" />
+            <location filename="../../ui/panels/monitor_panel.py" line="195" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="201" />
+            <location filename="../../ui/panels/monitor_panel.py" line="197" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="205" />
+            <location filename="../../ui/panels/monitor_panel.py" line="201" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="206" />
+            <location filename="../../ui/panels/monitor_panel.py" line="202" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="207" />
+            <location filename="../../ui/panels/monitor_panel.py" line="203" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="208" />
+            <location filename="../../ui/panels/monitor_panel.py" line="204" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="209" />
+            <location filename="../../ui/panels/monitor_panel.py" line="205" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="210" />
+            <location filename="../../ui/panels/monitor_panel.py" line="206" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="211" />
+            <location filename="../../ui/panels/monitor_panel.py" line="207" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="218" />
+            <location filename="../../ui/panels/monitor_panel.py" line="214" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="219" />
+            <location filename="../../ui/panels/monitor_panel.py" line="215" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="220" />
+            <location filename="../../ui/panels/monitor_panel.py" line="216" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="220" />
+            <location filename="../../ui/panels/monitor_panel.py" line="216" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="221" />
+            <location filename="../../ui/panels/monitor_panel.py" line="217" />
             <source>Top view (X–Y)</source>
             <translation>俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="240" />
+            <location filename="../../ui/panels/monitor_panel.py" line="236" />
             <source>Stale: not confirmed by the controller within the freshness limit</source>
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="439" />
+            <location filename="../../ui/panels/monitor_panel.py" line="435" />
             <source>values stale (grey): no fresh data from the controller</source>
             <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="435" />
+            <location filename="../../ui/panels/monitor_panel.py" line="431" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="437" />
+            <location filename="../../ui/panels/monitor_panel.py" line="433" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -3224,160 +3224,160 @@
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/messages_plan.py" line="144" />
+            <location filename="../../ui/messages_plan.py" line="147" />
             <location filename="../../ui/models/point_columns.py" line="66" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="145" />
+            <location filename="../../ui/messages_plan.py" line="148" />
             <location filename="../../ui/models/point_columns.py" line="67" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="127" />
+            <location filename="../../ui/models/points_model.py" line="135" />
             <source>ID</source>
             <translation>编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="128" />
+            <location filename="../../ui/models/points_model.py" line="136" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="129" />
+            <location filename="../../ui/models/points_model.py" line="137" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="130" />
+            <location filename="../../ui/models/points_model.py" line="138" />
             <source>Sync</source>
             <translation>同步状态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="131" />
+            <location filename="../../ui/models/points_model.py" line="139" />
             <source>Note</source>
             <translation>备注</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="135" />
+            <location filename="../../ui/models/points_model.py" line="143" />
             <source>Temp point id on the controller</source>
             <translation>控制器上的临时点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="136" />
+            <location filename="../../ui/models/points_model.py" line="144" />
             <source>Tool frame (200 = none)</source>
             <translation>工具坐标系（200 = 无）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="137" />
+            <location filename="../../ui/models/points_model.py" line="145" />
             <source>Whether the controller holds this point</source>
             <translation>控制器上是否有此点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="138" />
+            <location filename="../../ui/models/points_model.py" line="146" />
             <source>mm, base frame</source>
             <translation>毫米，基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="139" />
+            <location filename="../../ui/models/points_model.py" line="147" />
             <source>degrees</source>
             <translation>度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="141" />
+            <location filename="../../ui/models/points_model.py" line="149" />
             <source>External axis (recorded only: the controller does not store it)</source>
             <translation>外部轴（仅记录：控制器不保存）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="222" />
+            <location filename="../../ui/models/points_model.py" line="230" />
             <source>no reason given</source>
             <translation>未给出原因</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="223" />
+            <location filename="../../ui/models/points_model.py" line="231" />
             <source>Upload failed: {reason}</source>
             <translation>上传失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="226" />
+            <location filename="../../ui/models/points_model.py" line="234" />
             <source>Not known whether the controller holds this point (it restarted or the link was lost): upload it before moving to it</source>
             <translation>不确定控制器上是否有此点（控制器已重启或通信曾中断）：运动到该点前请先上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="229" />
+            <location filename="../../ui/models/points_model.py" line="237" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="230" />
+            <location filename="../../ui/models/points_model.py" line="238" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="232" />
+            <location filename="../../ui/models/points_model.py" line="240" />
             <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
             <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="240" />
+            <location filename="../../ui/models/points_model.py" line="248" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="270" />
+            <location filename="../../ui/models/points_model.py" line="278" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="299" />
+            <location filename="../../ui/models/points_model.py" line="307" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="316" />
+            <location filename="../../ui/models/points_model.py" line="324" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="345" />
+            <location filename="../../ui/models/points_model.py" line="353" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="347" />
+            <location filename="../../ui/models/points_model.py" line="355" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="366" />
+            <location filename="../../ui/models/points_model.py" line="374" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="368" />
+            <location filename="../../ui/models/points_model.py" line="376" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="384" />
+            <location filename="../../ui/models/points_model.py" line="392" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="384" />
+            <location filename="../../ui/models/points_model.py" line="392" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="407" />
+            <location filename="../../ui/models/points_model.py" line="415" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="419" />
+            <location filename="../../ui/models/points_model.py" line="427" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -3906,22 +3906,22 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectDialogs</name>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="41" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="54" />
             <source>Unsaved changes</source>
             <translation>未保存的更改</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="42" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="55" />
             <source>Save the changes to {name}?</source>
             <translation>保存对 {name} 的更改？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="56" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="71" />
             <source>an unsaved project</source>
             <translation>未保存的工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="58" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="73" />
             <source>TeachPad was not closed properly. An autosave of {what} is newer than the saved file:
 {autosave}
 
@@ -3932,12 +3932,12 @@ Recover it?</source>
 是否恢复？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="63" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="78" />
             <source>Recover autosave</source>
             <translation>恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="73" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="90" />
             <source>The file has no points. Importing it in replace mode removes all {n} points of the project.
 
 Remove them all?</source>
@@ -3946,23 +3946,23 @@ Remove them all?</source>
 确定全部删除吗？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="86" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="105" />
             <source>Replace all points</source>
             <translation>替换全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="87" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="106" />
             <source>Merge (update the same ids, append new ones)</source>
             <translation>合并（更新相同编号，追加新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="78" />
-            <location filename="../../ui/controllers/project_dialogs.py" line="90" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="95" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="109" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_dialogs.py" line="91" />
+            <location filename="../../ui/controllers/project_dialogs.py" line="110" />
             <source>Import mode:</source>
             <translation>导入方式：</translation>
         </message>
@@ -4370,7 +4370,7 @@ Remove them all?</source>
     <context>
         <name>RobotModelSource</name>
         <message>
-            <location filename="../../ui/panels/view3d_robot.py" line="115" />
+            <location filename="../../ui/panels/view3d_robot.py" line="127" />
             <source>The robot model remembered from the last session could not be loaded: %1. The default robot model (%2) is used.</source>
             <translation>上次使用的机器人模型无法加载：%1。现使用默认机器人模型（%2）。</translation>
         </message>
@@ -4628,27 +4628,27 @@ Remove them all?</source>
             <translation>寄存器配置“{name}”已保存（第 {rev} 版）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="231" />
+            <location filename="../../ui/controllers/safety_menu.py" line="233" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="238" />
+            <location filename="../../ui/controllers/safety_menu.py" line="240" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="268" />
+            <location filename="../../ui/controllers/safety_menu.py" line="270" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="269" />
+            <location filename="../../ui/controllers/safety_menu.py" line="273" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="275" />
+            <location filename="../../ui/controllers/safety_menu.py" line="279" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
@@ -4689,27 +4689,27 @@ Remove them all?</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_columns.py" line="69" />
+            <location filename="../../ui/models/plan_columns.py" line="74" />
             <source>changes</source>
             <translation>姿态变化</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_columns.py" line="70" />
+            <location filename="../../ui/models/plan_columns.py" line="75" />
             <source>kept</source>
             <translation>姿态保持</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_columns.py" line="94" />
+            <location filename="../../ui/models/plan_columns.py" line="101" />
             <source>error</source>
             <translation>错误</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_columns.py" line="95" />
+            <location filename="../../ui/models/plan_columns.py" line="102" />
             <source>needs upload</source>
             <translation>需要上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/plan_columns.py" line="96" />
+            <location filename="../../ui/models/plan_columns.py" line="103" />
             <source>warning</source>
             <translation>警告</translation>
         </message>

@@ -51,7 +51,7 @@ def test_stdin_commands(sim: SimController, make_bus: Callable[..., Bus]) -> Non
     assert sim.state().alarms == Alarm.ESTOP
     assert execute(sim, "alarm estop off", out)
     assert sim.state().alarms == Alarm.NONE
-    assert execute(sim, "delay 0.01", out) and sim._response_delay == 0.01
+    assert execute(sim, "delay 0.01", out) and sim._delay_rule == (0.01, None, None)
     assert execute(sim, "delay 0", out)
     assert execute(sim, "status-delay 0.2", out) and sim._status_delay == 0.2
     assert execute(sim, "exception 6", out)
