@@ -72,10 +72,16 @@ class WorkerCommands:
             raise
         except TeachPadError as exc:  # no answer in time, refused, link lost: the operator still asked for it
             took = self._report_stop_line(on_line)  # ... and the controller took it on the stop line
-            if took and on_line is not None and client.writes_settled_before(on_line.sent_mono):
+            if (
+                took
+                and on_line is not None
+                and client.writes_settled_before(on_line.sent_mono)
+                and not self.jog.jogging
+            ):
                 # ... and nothing this link wrote can reach the controller after the line's stop:
                 # every write before it was answered before it went out, none began since (a
-                # motion write after it -- a job already under way -- would run after the stop)
+                # motion write after it -- a job already under way -- would run after the stop);
+                # and no jog is held (its speed 0 needs the main link: the Stop stays a failure)
                 self._stopped_on_the_line_only(client, exc)
                 return
             self._cancel_motions_before_stop()  # nothing queued before the Stop runs after it
@@ -108,22 +114,27 @@ class WorkerCommands:
             now,
             f"stop: sent on the stop line (the main link's stop failed: {exc})",
             Reason("stop_sent_on_line", {"cause": cause.code, "cause_args": dict(cause.args)}),
+            main_link_failed=True,
         )
         if isinstance(exc, LinkError | ResponseTimeout | MalformedResponse):
             self.supervisor.transport_failed(exc)
 
-    def _after_stop(self, now: float, text: str, reason: Reason | None = None) -> None:
-        """The controller took the stop: end the jog, the upload, the motion in flight and the
-        motions queued before the Stop; then the Stop's own result."""
+    def _after_stop(
+        self, now: float, text: str, reason: Reason | None = None, *, main_link_failed: bool = False
+    ) -> None:
+        """The controller took the stop: end the upload, cancel the motions queued before the Stop
+        (first: whatever fails after, none of them runs after it), end the jog and the motion in
+        flight; then the Stop's own result."""
         job = self._current_job
         if job is not None and job.sent is not None:
             job.sent.set()  # the poster (the GUI thread) may go on
         self.uploader.end("stopped")
-        # the jog's speed 0: when its write fails (the stop itself went out), it goes out as soon as
-        # the controller answers -- never an error that would skip the cancellations below
-        self._end_jog_after_a_failed_stop()
-        active = self.motion.take()
         self._cancel_motions_before_stop()
+        if main_link_failed:  # no jog was held (the caller checked): nothing to say if this fails
+            self._end_jog_after_a_failed_stop()
+        else:
+            self.jog.on_stop()  # speed 0; a failure here is the Stop's error, as before
+        active = self.motion.take()
         if active is not None:
             self.emit_result(active.completion.stopped(now), active.request_id)
         self.emit_result(CommandResult(None, None, None, True, text, reason=reason))

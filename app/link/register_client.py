@@ -63,6 +63,7 @@ class RegisterClient:
         # The writes other than Stop: all answered (writes_settled), the last one when (monotonic)
         self.writes_settled = True
         self.write_answered_at = 0.0
+        self.write_lost_until = 0.0  # a write without its answer may be acted on until then
 
     # -- connection ----------------------------------------------------------------------
     def connect(self) -> None:
@@ -136,26 +137,39 @@ class RegisterClient:
             tracked = address != registers.REG_STOP
             if tracked:  # settled again below, when the controller has answered it
                 self.writes_settled = False
-            if single:
-                if len(values) != 1:
-                    raise InvalidInput("a single-register write takes one value")
-                _log.debug("%s: 0x06 <- %d", what, values[0])
-                self.write_count += 1
-                self._transport.write_single(what, address, int(values[0]), timeout)
-            else:
-                if _log.isEnabledFor(logging.DEBUG):  # the hex text costs more than the write's own Python
-                    _log.debug("%s: 0x10 <- %s", what, " ".join(f"{v:04X}" for v in values))
-                self.write_count += 1
-                self._transport.write_multiple(what, address, list(map(int, values)), timeout)
+            try:
+                self._send_write(what, address, values, single, timeout)
+            except BaseException:
+                if tracked:  # no answer (or a refusal): it may still be acted on, until the timeout ran out
+                    self.write_lost_until = time.monotonic() + self.settings.timeout
+                raise
             if tracked:
                 self.write_answered_at = time.monotonic()
                 self.writes_settled = True
 
+    def _send_write(
+        self, what: str, address: int, values: Sequence[int], single: bool, timeout: float | None
+    ) -> None:
+        """One 0x06 or 0x10 on the transport (checked, counted)."""
+        if single:
+            if len(values) != 1:
+                raise InvalidInput("a single-register write takes one value")
+            _log.debug("%s: 0x06 <- %d", what, values[0])
+            self.write_count += 1
+            self._transport.write_single(what, address, int(values[0]), timeout)
+        else:
+            if _log.isEnabledFor(logging.DEBUG):  # the hex text costs more than the write's own Python
+                _log.debug("%s: 0x10 <- %s", what, " ".join(f"{v:04X}" for v in values))
+            self.write_count += 1
+            self._transport.write_multiple(what, address, list(map(int, values)), timeout)
+
     def writes_settled_before(self, moment: float) -> bool:
         """Every write but Stop's (441) this client began was answered before ``moment``
         (``time.monotonic()``): the controller took each of them before anything sent later on
-        another connection. False after a write without its answer (failed, timed out)."""
-        return self.writes_settled and self.write_answered_at < moment
+        another connection. False while a write is without its answer, and until one timeout
+        after a write that failed (no answer, refused): a controller acts on a request within the
+        link timeout or not at all (the decision of ``app.cli.context.stop_on_a_fresh_link``)."""
+        return self.writes_settled and self.write_answered_at < moment and self.write_lost_until < moment
 
     def _write_floats(self, gv: int, values: Sequence[float], timeout: float | None = None) -> None:
         self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order), timeout=timeout)

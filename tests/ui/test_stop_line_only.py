@@ -62,6 +62,10 @@ def test_a_stop_only_the_stop_connection_takes_ends_the_point_in_flight_and_is_s
     items = [(100, (300.0, 0.0, 400.0, 180.0, 0.0, 0.0), 200)]
     upload_id = link.upload_points(items)
     qtbot.waitUntil(lambda: bool(sim.writes_to(registers.REG_RUN_COMMAND)), timeout=SIGNAL_TIMEOUT_MS)
+    # a request after the 440's: its answer has reached the worker (a Stop before that would rightly
+    # keep the cautious path: a write not yet answered when the line's stop went out)
+    after_440 = sim.requests_count
+    qtbot.waitUntil(lambda: sim.requests_count > after_440, timeout=SIGNAL_TIMEOUT_MS)
     pressed = time.monotonic()
     stop_id = link.stop()
     qtbot.waitUntil(lambda: any(r.request_id == upload_id for r in results), timeout=2 * POINT_TIMEOUT * 1000)
@@ -173,3 +177,28 @@ def test_a_motion_written_after_the_lines_stop_keeps_the_stop_a_failure(
             assert not any(r.request_id == zero_id and r.stopped_by_operator for r in results), results
             break
     assert seen_the_order, "the order (the line's 441, then the job's 445) never happened"
+
+
+def test_a_held_jog_keeps_a_stop_only_the_line_took_a_failure_and_still_ends(
+    qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A jog is held when Stop is pressed and only the stop connection takes the stop: the jog's
+    speed 0 needs the main link, so the Stop is not claimed sent (it stays the main link's
+    refusal, in words); the jog ends all the same (speed 0 stored) and the arm stands."""
+    from app.protocol.enums import TeachFrame
+    from tests.ui.pendant_support import jogging, ratio_writes
+
+    _line_open(qtbot, link, sim, monkeypatch)
+    link.jog_press(TeachFrame.BASE, 1, 1, 20.0)
+    qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
+    results: list[CommandResult] = []
+    link.commandFinished.connect(results.append)
+    stop_id = link.stop()
+    qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
+    stop = next(r for r in results if r.request_id == stop_id)
+    assert not stop.ok and stop.reason is not None and stop.reason.code == "modbus_exception", stop
+    assert sim.writes_to(registers.REG_STOP)  # the line's stop was taken
+    qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(
+        lambda: bool(ratio_writes(sim)) and ratio_writes(sim)[-1] == 0.0, timeout=SIGNAL_TIMEOUT_MS
+    )
