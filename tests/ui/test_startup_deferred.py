@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import gc
 import json
-import os
 import subprocess
 import sys
 import textwrap
@@ -16,6 +15,7 @@ import pytest
 
 from app.link.transport import ConnectionSettings, Transport
 from app.view3d.profile import default_profile
+from tests.cli.ctrl_c import untraced_env
 from ui.panels.view3d_robot import RobotModelSource
 from ui.startup_gc import StartupGcPause, gc_paused
 
@@ -68,7 +68,9 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
         sys.exit(code)
     """)
     env = {
-        **os.environ,
+        # untraced: coverage's tracer, started in every child by `make test`, imports socket and
+        # hashlib itself (this test failed under coverage: ['hashlib', 'socket'] before the paint)
+        **untraced_env(),
         "QT_QPA_PLATFORM": "offscreen",
         **{f"XDG_{d}_HOME": str(tmp_path / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
     }
