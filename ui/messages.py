@@ -389,7 +389,8 @@ def result_text(result: CommandResult) -> str:
 
 
 def result_level(result: CommandResult) -> str:
-    """info for success and the operator's own stop, warning for an unconfirmed success."""
+    """info for success and the operator's own stop, warning for an unconfirmed success and for a
+    Stop only the stop connection carried (the main connection did not take it)."""
     if result.ok:
         on_line_only = result.reason is not None and result.reason.code == "stop_sent_on_line"
         return LEVEL_WARNING if result.unconfirmed or on_line_only else LEVEL_INFO
