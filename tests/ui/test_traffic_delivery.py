@@ -77,6 +77,16 @@ def assert_whole_and_in_order(frames: list[TrafficRecord]) -> None:
     assert consecutive(requests), requests
 
 
+def _capturing(qtbot: Any, sim: Any, link: RobotLink, polls: int) -> Batches:
+    """Capture on, connected, and ``polls`` polls (status + pose) served: the batches delivered."""
+    link.set_traffic_capture(True)
+    got = Batches(link)
+    connect(qtbot, link, sim)
+    start = sim.requests_count
+    qtbot.waitUntil(lambda: sim.requests_count >= start + 2 * polls, timeout=SIGNAL_TIMEOUT_MS)
+    return got
+
+
 def test_frames_arrive_batched_every_one_in_order(qtbot: Any, sim: Any, link: RobotLink) -> None:
     link.set_traffic_capture(True)  # before the link exists: every request is captured
     got = Batches(link)
@@ -97,11 +107,7 @@ def test_capture_off_delivers_what_was_captured(
     qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(timing, "TRAFFIC_DELIVERY_PERIOD", NEVER)
-    link.set_traffic_capture(True)
-    got = Batches(link)
-    connect(qtbot, link, sim)
-    start = sim.requests_count
-    qtbot.waitUntil(lambda: sim.requests_count >= start + 20, timeout=SIGNAL_TIMEOUT_MS)
+    got = _capturing(qtbot, sim, link, polls=10)
     served_before_off = sim.requests_count
     with qtbot.waitSignal(link.trafficObserved, timeout=SIGNAL_TIMEOUT_MS):
         link.set_traffic_capture(False)
@@ -120,11 +126,7 @@ def test_disconnect_delivers_every_frame(
     qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(timing, "TRAFFIC_DELIVERY_PERIOD", NEVER)
-    link.set_traffic_capture(True)
-    got = Batches(link)
-    connect(qtbot, link, sim)
-    start = sim.requests_count
-    qtbot.waitUntil(lambda: sim.requests_count >= start + 20, timeout=SIGNAL_TIMEOUT_MS)
+    got = _capturing(qtbot, sim, link, polls=10)
     link.jog_press(TeachFrame.BASE, 0, 1, 20.0)  # the disconnect then writes ratio 0, teach off
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     at_end: list[tuple[int, int]] = []
@@ -145,11 +147,7 @@ def test_lost_link_delivers_its_frames_before_down(
 ) -> None:
     monkeypatch.setattr(timing, "TRAFFIC_DELIVERY_PERIOD", NEVER)
     monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.3)
-    link.set_traffic_capture(True)
-    got = Batches(link)
-    connect(qtbot, link, sim)
-    start = sim.requests_count
-    qtbot.waitUntil(lambda: sim.requests_count >= start + 20, timeout=SIGNAL_TIMEOUT_MS)
+    got = _capturing(qtbot, sim, link, polls=10)
     at_down: list[int] = []
     link.connectionChanged.connect(
         lambda s: at_down.append(len(got.tx())) if s.state is LinkState.DOWN else None
@@ -172,9 +170,7 @@ def test_a_commands_frames_come_before_its_result(
     qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(timing, "TRAFFIC_DELIVERY_PERIOD", NEVER)
-    link.set_traffic_capture(True)
-    got = Batches(link)
-    connect(qtbot, link, sim)
+    got = _capturing(qtbot, sim, link, polls=0)
     writes_at_result: list[int] = []
 
     def on_result(_result: CommandResult) -> None:  # what the GUI has when the result is shown
