@@ -180,13 +180,11 @@ class StopLine:
                 return pending, b"", str(exc)
             return pending, answer, None
 
-    def report(
-        self, capture: TrafficCapture, audit: AuditLog | None, expected: StopSent | None = None
-    ) -> bool:
+    def report(self, capture: TrafficCapture, audit: AuditLog | None, expected: StopSent) -> bool:
         """:meth:`collect`, then the stop's frames to the traffic capture and its write to the
         audit trail (worker thread); a bad answer is logged (the main link's stop went out too).
-        True when the controller took ``expected`` (the stop this job sent; None: whatever stop
-        was pending) on this line (its echo checked)."""
+        True when the controller took ``expected`` (the stop this job sent) on this line (its
+        echo checked)."""
         sent, answer, problem = self.collect()
         if sent is None:
             return False
@@ -200,7 +198,7 @@ class StopLine:
             )
         if problem is not None:
             _log.warning("stop line: %s; the stop went out on the main link too", problem)
-        return problem is None and (expected is None or sent is expected)
+        return problem is None and sent is expected
 
     def close(self) -> None:
         with self._lock:
