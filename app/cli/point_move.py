@@ -28,10 +28,10 @@ from pathlib import Path
 
 from app.cli.context import CliContext
 from app.cli.points import _limits
-from app.errors import InvalidInput
+from app.errors import CommandRefused, InvalidInput
 from app.link.client import RobotClient
 from app.models import Pose
-from app.points.guard import PointGuard, PointMismatch
+from app.points.guard import PointGuard, PointMismatch, PointNotCreated
 from app.points.project import load_project
 
 __all__ = ["UNCHECKED_WARNING", "check_arrival", "move_guard", "prepare_points"]
@@ -62,8 +62,18 @@ def point_ids(args: argparse.Namespace) -> list[int]:
 
 
 def prepare_points(guard: PointGuard, client: RobotClient, args: argparse.Namespace) -> None:
-    """Create the move's points again from the project's copy, right before the move."""
-    guard.before_segment(client, point_ids(args))
+    """Create the move's points again from the project's copy, right before the move; a point
+    the controller refuses is :class:`PointNotCreated` naming it (exit 1, nothing moved)."""
+    ids = point_ids(args)
+    sent = len(guard.created)
+    try:
+        guard.before_segment(client, ids)
+    except CommandRefused as exc:
+        point = guard.point(ids[len(guard.created) - sent])  # the first one not created
+        raise PointNotCreated(
+            f"the controller refused to create {point.label} before the move: {exc}; the arm was not moved",
+            params={"point": point.label, "cause": str(exc)},
+        ) from None
 
 
 def check_arrival(guard: PointGuard, pose: Pose, end_id: int) -> None:
