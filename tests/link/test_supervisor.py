@@ -80,7 +80,7 @@ def test_the_canary_must_be_a_spare_gv() -> None:
 
 def _controller(parts: PartsHost) -> ControllerIdentity:
     identity = parts.of("connectionChanged")[-1].controller
-    assert identity is not None
+    assert isinstance(identity, ControllerIdentity)
     return identity
 
 

@@ -96,7 +96,9 @@ def _teach_five(qtbot: Any, window: MainWindow, sim: Any, make_client: Any) -> N
 
 def _move_to_p1(qtbot: Any, window: MainWindow) -> tuple[bool, str]:
     panel = window.points_panel
-    panel.select_rows([window.project.points_model.row_of(1)])
+    row = window.project.points_model.row_of(1)
+    assert row is not None
+    panel.select_rows([row])
     panel.speed.setValue(SPEED)
     with qtbot.waitSignal(window.point_sync.moveFinished, timeout=MOVE_TIMEOUT_MS) as finished:
         panel.move_to_selected()  # the window's confirmation answers yes (window fixture)

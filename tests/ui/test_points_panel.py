@@ -11,7 +11,7 @@ from typing import Any
 import pytest
 from PySide6.QtGui import QUndoStack
 
-from app.link.types import ControllerIdentity, WorkerError
+from app.link.types import ConnectionState, ControllerIdentity, LinkState, WorkerError
 from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, make_point
 from app.points.project import load_project
@@ -290,6 +290,22 @@ def test_the_same_controller_boot_keeps_the_points(qtbot: Any, panel: PointsPane
     link.set_connected(True)  # the same endpoint, unit and canary token: the same boot
     assert [p.sync for p in model.ledger][:2] == [SyncState.ON_CONTROLLER] * 2
     assert not panel.banner.isVisibleTo(panel)
+
+
+def test_a_silence_on_the_same_connection_keeps_the_points(panel: PointsPanel, link: FakeLink) -> None:
+    """Not answering for a while and back, the link never down: the same connection, even with no
+    canary to prove the boot by (a new connection without one would make them unknown)."""
+    unprovable = dataclasses.replace(FAKE_CONTROLLER, boot=None)
+    link.set_connected(False)
+    link.set_connected(True, controller=unprovable)
+    model = panel.model
+    model.apply_upload(_report_ok(model, [1, 2]))
+    for state in (LinkState.NOT_ANSWERING, LinkState.CONNECTED):
+        link.state.set_connection(ConnectionState(state, "", "fake:502", controller=unprovable))
+    assert [p.sync for p in model.ledger][:2] == [SyncState.ON_CONTROLLER] * 2
+    link.set_connected(False)
+    link.set_connected(True, controller=unprovable)
+    assert [p.sync for p in model.ledger][:2] == [SyncState.UNKNOWN] * 2
 
 
 def _report_ok(model: PointsModel, ids: list[int]) -> Any:

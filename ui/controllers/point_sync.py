@@ -99,6 +99,7 @@ class PointSyncController(QObject):
         self._prepared: SegmentPoints | None = None  # the point of the move under way, as created
         # the controller (and boot) the ledger's sync states are true of (None: none met yet)
         self._controller: ControllerIdentity | None = None
+        self._live = False  # the link is up with self._controller (a new connection re-identifies)
         self._pending: Pending | None = None  # the outcome of the running teach / move / upload
         self._upload: UploadRun | None = None
         self._restore_offered = False
@@ -153,6 +154,7 @@ class PointSyncController(QObject):
             raise RuntimeError("the link is already set")
         self._link = link
         self._controller = link.state.connection.controller
+        self._live = self._controller is not None
         # Reconnects and restarts reach the points through the connection's controller identity
         # (_on_connection): a restart seen by the canary is a new identity, published before
         # controllerRestarted; a reconnect to the same boot keeps the states.
@@ -332,8 +334,12 @@ class PointSyncController(QObject):
     @Slot(ConnectionState)
     def _on_connection(self, state: ConnectionState) -> None:
         connected = state.connected
-        if connected:
-            self._identify(state.controller)  # the states first: views of connectedChanged read them
+        controller = state.controller  # set while the link is up (connected or not answering)
+        if controller is None:
+            self._live = False  # down, connecting, disconnected: the next identity is a new connection
+        elif not (self._live and controller == self._controller):  # not a blip of the same connection
+            self._live = True
+            self._identify(controller)  # the states first: views of connectedChanged read them
         self.connectedChanged.emit(connected)
         if not connected and self._operation:
             reason = connection_text(state) or self.tr("link lost")
@@ -343,11 +349,11 @@ class PointSyncController(QObject):
             else:
                 self._abort(reason)
 
-    def _identify(self, controller: ControllerIdentity | None) -> None:
+    def _identify(self, controller: ControllerIdentity) -> None:
         """The link is up to ``controller``: unless it is provably the controller and boot the
         sync states were made with, nothing is known to be on it any more."""
         previous, self._controller = self._controller, controller
-        if controller is not None and controller.same_boot(previous):
+        if controller.same_boot(previous):
             return
         self._flush_upload()  # what the controller confirmed before it changed
         changed = self._model.mark_all_unknown()
@@ -355,7 +361,7 @@ class PointSyncController(QObject):
         if not n or (previous is None and not changed):
             return  # the first controller these points meet, and none was believed on one
         self._offer_restore(True)
-        if controller is not None and previous is not None and not controller.same_place(previous):
+        if previous is not None and not controller.same_place(previous):
             text = self.tr(
                 "Connected to another controller ({endpoint}): {n} points are not known to be on it. "
                 "Restore all to create them there."
