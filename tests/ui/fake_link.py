@@ -21,7 +21,6 @@ from app.link.types import ConnectionState, ControllerIdentity, LinkState
 from app.models import CommandResult
 from app.protocol.enums import CommandKind, CommandStatus, ProgramMotionMode, RunCommand, TeachFrame, WorkMode
 
-
 #: The controller a FakeLink connects to unless told otherwise (one boot, its canary token 1).
 FAKE_CONTROLLER = ControllerIdentity("fake:502", 1, "low-first", 99, 1.0)
 
