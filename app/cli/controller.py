@@ -209,6 +209,8 @@ def cmd_move(ctx: CliContext) -> ExitCode:
     )
     if args.no_wait:
         ctx.print(result.message)
+        if guard is not None:
+            ctx.warn(f"P{args.id}: the arrival is not checked with --no-wait")
         return ExitCode.OK
     pose = client.read_pose()
     if guard is not None:

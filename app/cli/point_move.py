@@ -49,6 +49,8 @@ def move_guard(ctx: CliContext) -> PointGuard | None:
     path: Path | None = getattr(ctx.args, "project", None)
     if path is None:
         return None
+    if ctx.args.via == ctx.args.id:  # the client says so too, but only after the creates went out
+        raise InvalidInput("the arc's middle point must differ from its end point")
     project = load_project(path, _limits(ctx))
     missing = [f"P{pid}" for pid in point_ids(ctx.args) if project.ledger.get(pid) is None]
     if missing:  # refused before anything is sent

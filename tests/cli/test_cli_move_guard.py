@@ -106,6 +106,8 @@ def test_a_point_the_project_does_not_have_is_a_usage_error(
     assert code == ExitCode.USAGE and "the project has no point P2" in one_line_error(err)
     code, _, err = run(csim, capsys, "move", "1", "--via", "3", "--project", str(project))
     assert code == ExitCode.USAGE and "no point P3" in one_line_error(err)
+    code, _, err = run(csim, capsys, "move", "1", "--via", "1", "--project", str(project))
+    assert code == ExitCode.USAGE and "middle point must differ" in one_line_error(err)
     assert csim.writes == []
 
 
