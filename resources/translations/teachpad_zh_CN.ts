@@ -3037,158 +3037,159 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="167" />
+            <location filename="../../ui/controllers/point_sync.py" line="169" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="178" />
+            <location filename="../../ui/controllers/point_sync.py" line="180" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="188" />
+            <location filename="../../ui/controllers/point_sync.py" line="190" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="190" />
+            <location filename="../../ui/controllers/point_sync.py" line="192" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="197" />
+            <location filename="../../ui/controllers/point_sync.py" line="199" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="223" />
+            <location filename="../../ui/controllers/point_sync.py" line="225" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="231" />
+            <location filename="../../ui/controllers/point_sync.py" line="233" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="234" />
+            <location filename="../../ui/controllers/point_sync.py" line="236" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="236" />
+            <location filename="../../ui/controllers/point_sync.py" line="238" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="244" />
+            <location filename="../../ui/controllers/point_sync.py" line="246" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="286" />
+            <location filename="../../ui/controllers/point_sync.py" line="296" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="309" />
+            <location filename="../../ui/controllers/point_sync.py" line="319" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="312" />
+            <location filename="../../ui/controllers/point_sync.py" line="322" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="339" />
+            <location filename="../../ui/controllers/point_sync.py" line="353" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="360" />
+            <location filename="../../ui/controllers/point_sync.py" line="374" />
             <source>Connected to another controller ({endpoint}): {n} points are not known to be on it. Restore all to create them there.</source>
             <translation>已连接到另一台控制器（{endpoint}）：不知道它是否保存着这 {n} 个点。点击“恢复全部”在其上创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="365" />
+            <location filename="../../ui/controllers/point_sync.py" line="379" />
             <source>The controller restarted, or it is not the one the points were uploaded to: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启，或不是上传这些点的那台控制器：其上可能已没有这 {n} 个点。点击“恢复全部”重新创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="393" />
+            <location filename="../../ui/controllers/point_sync.py" line="407" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="402" />
+            <location filename="../../ui/controllers/point_sync.py" line="416" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="413" />
+            <location filename="../../ui/controllers/point_sync.py" line="427" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="418" />
+            <location filename="../../ui/controllers/point_sync.py" line="432" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="428" />
+            <location filename="../../ui/controllers/point_sync.py" line="442" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="437" />
+            <location filename="../../ui/controllers/point_sync.py" line="451" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="442" />
+            <location filename="../../ui/controllers/point_sync.py" line="456" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="462" />
+            <location filename="../../ui/controllers/point_sync.py" line="476" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="466" />
+            <location filename="../../ui/controllers/point_sync.py" line="263" />
+            <location filename="../../ui/controllers/point_sync.py" line="480" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="474" />
-            <location filename="../../ui/controllers/point_sync.py" line="483" />
+            <location filename="../../ui/controllers/point_sync.py" line="488" />
+            <location filename="../../ui/controllers/point_sync.py" line="497" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="529" />
+            <location filename="../../ui/controllers/point_sync.py" line="543" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="532" />
+            <location filename="../../ui/controllers/point_sync.py" line="546" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="544" />
+            <location filename="../../ui/controllers/point_sync.py" line="558" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="549" />
+            <location filename="../../ui/controllers/point_sync.py" line="563" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="556" />
+            <location filename="../../ui/controllers/point_sync.py" line="570" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>

@@ -365,6 +365,20 @@ def test_move_to_a_point_not_on_the_controller_creates_it_first(
     assert f"Move to P{point.id} failed" in panel.status.text() and "not moved" in panel.status.text()
 
 
+def test_a_stop_while_the_point_is_created_sends_no_move(
+    qtbot: Any, panel: PointsPanel, link: FakeLink, answers: list[bool]
+) -> None:
+    panel.select_rows([1])
+    answers.append(True)
+    panel.move_to_selected()
+    panel.controller.stop()
+    assert link.named("stop")
+    with qtbot.waitSignal(panel.controller.moveFinished) as done:
+        link.upload_summary(0, 1, "stopped")  # the worker's upload ends at the stop
+    assert done.args[0] is False and link.named("move_to_point") == []
+    assert "stopped by the operator" in panel.status.text()
+
+
 def test_an_arm_that_stops_elsewhere_is_a_failed_move(
     qtbot: Any, panel: PointsPanel, link: FakeLink, answers: list[bool]
 ) -> None:

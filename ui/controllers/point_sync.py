@@ -256,7 +256,15 @@ class PointSyncController(QObject):
         guard.clear()
         assert prepared is not None
         if not (result.ok and prepared.all_created):
-            self._fail_move(prepared.end_id, error_text(guard.not_created(prepared)))
+            if batch_reason(result.message) == "stopped":  # the operator's Stop ended the create
+                self._move_id = None
+                self._set_operation("")
+                self._say(
+                    self.tr("Move to P{id} stopped by the operator").format(id=prepared.end_id), LEVEL_INFO
+                )
+                self.moveFinished.emit(False, batch_reason(result.message))
+            else:
+                self._fail_move(prepared.end_id, error_text(guard.not_created(prepared)))
             return
         point = prepared.points[prepared.end_id]
         self._prepared = prepared
