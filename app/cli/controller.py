@@ -11,8 +11,10 @@ from __future__ import annotations
 
 import json
 import time
+from pathlib import Path
 from typing import Any
 
+from app.cli import point_move
 from app.cli.context import CliContext, sigint_deferred, stop_after_ctrl_c, wait_motion
 from app.cli.exit_codes import ExitCode
 from app.cli.format import (
@@ -184,8 +186,14 @@ def cmd_point_create(ctx: CliContext) -> ExitCode:
 
 
 def cmd_move(ctx: CliContext) -> ExitCode:
+    """Guarded by the project's copy of the points with ``--project`` (app/cli/point_move.py)."""
     args = ctx.args
+    guard = point_move.move_guard(ctx)  # before connecting: a bad project sends nothing
     client = ctx.client
+    tool = args.tool
+    if guard is not None:
+        point_move.prepare_points(guard, client, args)
+        tool = guard.point(args.id).tool if tool is None else tool
     result = wait_motion(
         ctx,
         lambda: client.move_to_point(
@@ -194,14 +202,23 @@ def cmd_move(ctx: CliContext) -> ExitCode:
             orientation_changes=not args.keep_orientation,
             ignore_middle=args.ignore_middle,
             speed=args.speed,
-            tool=args.tool,
+            tool=registers.TOOL_NONE if tool is None else tool,
             wait=not args.no_wait,
             timeout=args.wait_timeout,
         ),
     )
+    if args.no_wait:
+        ctx.print(result.message)
+        if guard is not None:
+            ctx.warn(f"P{args.id}: the arrival is not checked with --no-wait")
+        return ExitCode.OK
+    pose = client.read_pose()
+    if guard is not None:
+        point_move.check_arrival(guard, pose, args.id)  # elsewhere: exit 1, in words
     ctx.print(result.message)
-    if not args.no_wait:
-        ctx.print(_pose_line(client.read_pose()))
+    ctx.print(_pose_line(pose))
+    if guard is None:
+        ctx.warn(point_move.UNCHECKED_WARNING.format(id=args.id))
     return ExitCode.OK
 
 
@@ -403,9 +420,17 @@ def register(sub: Any) -> None:
     p.add_argument(
         "--tool",
         type=int,
-        default=registers.TOOL_NONE,
+        default=None,
         metavar="N",
-        help=f"tool frame id ({registers.TOOL_NONE}: none, the default)",
+        help=f"tool frame id (default: the point's in --project, else {registers.TOOL_NONE}: none)",
+    )
+    p.add_argument(
+        "--project",
+        type=Path,
+        metavar="FILE",
+        help="the project holding the points (the host's copy): they are created again from it right "
+        "before the move and the arrival is checked against it (1 mm). Without it the arm goes to "
+        "whatever the controller holds under the id, unchecked",
     )
     p.add_argument("--no-wait", action="store_true", help="return once the command is sent")
     p.add_argument(

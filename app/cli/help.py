@@ -21,7 +21,7 @@ EXAMPLES: dict[str, str] = {
     "step": "teachpad-cli step --frame base X=10 Z=-5 --speed 20",
     "jog": "teachpad-cli jog --axis Z --dir + --ratio 10 --seconds 1.5",
     "point create": "teachpad-cli point create 12 --xyzabc 400 0 300 180 0 0 --tool 1",
-    "move": "teachpad-cli move 12 --via 11 --speed 80",
+    "move": "teachpad-cli move 12 --via 11 --speed 80 --project cell.teachpad.json",
     "zero": "teachpad-cli zero J3",
     "program run": "teachpad-cli program run 1 --mode cycle --cycles 3 --speed 50",
     "stop": "teachpad-cli stop",

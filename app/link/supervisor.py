@@ -11,10 +11,18 @@
   :data:`app.timing.RECONNECT_BACKOFF` by itself and ends with ``controllerReconnected``.
 * **Restart canary**: a random token in a spare GV, read back on the clock poll; a change means
   the controller restarted under a live link (``controllerRestarted``).
+* **Which controller**: every connect decides the :class:`~app.link.types.ControllerIdentity`
+  (endpoint, unit, word order, the canary's token) and publishes it in the
+  ``ConnectionState`` (``controller``) before the link goes live. The canary is *read* first
+  (write-free): when the last connection was to the same endpoint and unit and the canary still
+  holds the token written then, it is the same boot and the token is kept; otherwise a fresh one
+  is written, a new identity. A restart under a live link gives a new identity too, published
+  before ``controllerRestarted``. The GUI's points follow it (``ui/controllers/point_sync.py``).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import random
 import time
@@ -23,7 +31,7 @@ from app import timing
 from app.errors import LinkError, Reason, ResponseTimeout, TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
 from app.link.host import WorkerHost
-from app.link.types import ConnectionState, LinkState, Operation
+from app.link.types import ConnectionState, ControllerIdentity, LinkState, Operation
 from app.link.upload import UPLOAD_POSE_GV
 from app.models import CommandResult
 from app.protocol import registers
@@ -66,6 +74,8 @@ class LinkSupervisor:
         self._failures = 0
         self._backoff_index = 0
         self.canary_token: float | None = None  # what we wrote to the canary GV (None: not checking)
+        # the controller of the live connection, kept after it ends: the next connect compares
+        self.identity: ControllerIdentity | None = None
         self._random = random.Random()
 
     # --- state ----------------------------------------------------------------------------
@@ -77,6 +87,7 @@ class LinkSupervisor:
             settings.endpoint if settings else "",
             bool(settings and settings.monitor_only),
             reason,
+            self.identity if self.link_up else None,
         )
         if new != self.state:
             self.state = new
@@ -120,7 +131,7 @@ class LinkSupervisor:
         reconnected = self._ever_connected
         self._ever_connected = True
         host.poller.reset(time.monotonic())
-        self.arm_canary()  # before the GUI hears of the link: a restart from now on is noticed
+        self.identify(client)  # before the GUI hears of the link: a restart from now on is noticed
         self.set_state(LinkState.CONNECTED, "")
         host.poller.publish(pose, status)
         if reconnected:
@@ -136,7 +147,53 @@ class LinkSupervisor:
         if not self._host.closed:
             self._host.start_reconnect(delay)
 
-    # --- the restart canary ----------------------------------------------------------------
+    # --- which controller, the restart canary ------------------------------------------------
+    def identify(self, client: RobotClient) -> None:
+        """Decide the identity of the connection just opened (see the module docstring): keep
+        the canary's token when it proves the same boot as the last connection, else arm a new one."""
+        kept = self._surviving_token(client)
+        if kept is not None:
+            self.canary_token = kept
+        else:
+            self.arm_canary()
+        self._set_identity()
+
+    def _place(self) -> ControllerIdentity | None:
+        """The identity of the current settings with the current token (None: no settings)."""
+        settings = self.settings
+        if settings is None:
+            return None
+        return ControllerIdentity(
+            settings.endpoint, settings.unit, settings.word_order.value, self.canary_gv, self.canary_token
+        )
+
+    def _set_identity(self) -> None:
+        self.identity = self._place()
+
+    def _surviving_token(self, client: RobotClient) -> float | None:
+        """The last connection's token when the canary here still reads it (one read, no write),
+        else None: another endpoint or unit, a restart, another master's write, no canary."""
+        last, here = self.identity, self._place()
+        gv = self.canary_gv
+        if last is None or last.boot is None or here is None or gv is None or client.settings.monitor_only:
+            return None
+        if dataclasses.replace(here, boot=last.boot) != last:  # another endpoint, unit, word order
+            return None
+        try:
+            value = client.read_gv(gv)[0]
+        except TeachPadError as exc:
+            _log.warning("could not read the restart canary GV%s: %s", gv, exc)
+            return None
+        if value != last.boot:
+            _log.info(
+                "restart canary GV%s reads %g, not %g: another controller or another boot",
+                gv,
+                value,
+                last.boot,
+            )
+            return None
+        return last.boot
+
     def arm_canary(self) -> None:
         """Write a fresh random token to the canary GV (not in monitor-only mode, not when disabled)."""
         self.canary_token = None
@@ -168,8 +225,11 @@ class LinkSupervisor:
         )
         if self.client is not None:
             self.client.invalidate_cache()  # GV245 and friends may have been reset too
-        self._host.publish_restarted()
         self.arm_canary()
+        self._set_identity()  # another boot: published before the restart itself, so the GUI's
+        if self.link_up:  # points are unknown by the time it hears of the restart
+            self.set_state(self.state.state, self.state.message, self.state.reason)
+        self._host.publish_restarted()
 
     # --- failures ----------------------------------------------------------------------
     def poll_answered(self) -> None:

@@ -8,7 +8,15 @@ from dataclasses import dataclass
 from app.errors import Reason, TeachPadError
 from app.protocol.enums import RunCommand, TeachFrame
 
-__all__ = ["ConnectionState", "JogRequest", "LinkState", "Operation", "StepFrame", "WorkerError"]
+__all__ = [
+    "ConnectionState",
+    "ControllerIdentity",
+    "JogRequest",
+    "LinkState",
+    "Operation",
+    "StepFrame",
+    "WorkerError",
+]
 
 
 class StepFrame(enum.Enum):
@@ -56,6 +64,47 @@ class LinkState(enum.Enum):
 
 
 @dataclass(frozen=True)
+class ControllerIdentity:
+    """Which controller, and which boot of it, a connection talks to; decided at every connect
+    (start-up, *Connect…*, a reconnect after a loss, a changed register profile) and again when
+    the restart canary changes under a live link (:mod:`app.link.supervisor`).
+
+    * ``endpoint`` (``host:port`` or the serial device) and ``unit`` (the Modbus unit id): where
+      the controller answers.
+    * ``word_order``: how its floats are written; a point written in another word order is
+      another point.
+    * ``canary_gv`` and ``boot``: the random token this TeachPad wrote into the restart canary (a
+      spare GV, GV99 by default) of this boot of the controller; None when there is none
+      (monitor-only mode, the canary switched off, its write refused). A controller clears its
+      temp points *and* GV0..GV99 when its system logs in again, so a canary that still reads
+      our token on a reconnect proves the same boot: its temp points are the ones we left.
+
+    Two connections reach the same controller boot (:meth:`same_boot`) only when every field
+    agrees and the token is known; anything else (another endpoint or unit, a restart, a canary
+    another master overwrote, no canary at all) is "another controller" and every point's sync
+    state becomes unknown. Deliberately not part of it: the controller's clock (it changes every
+    second and any master may set it), GV291 and the parameter GVs (every master writes them);
+    the protocol has no serial number or model register to read. So nothing here changes in
+    another master's normal work, except the canary itself (issue 19: the canary must tell a
+    restart from another TeachPad's write; this identity follows whatever the canary decides).
+    """
+
+    endpoint: str
+    unit: int
+    word_order: str
+    canary_gv: int | None
+    boot: float | None
+
+    def same_boot(self, other: ControllerIdentity | None) -> bool:
+        """True when ``other`` is provably this controller in this boot (see the class)."""
+        return other is not None and self.boot is not None and self == other
+
+    def same_place(self, other: ControllerIdentity | None) -> bool:
+        """True when ``other`` answers at the same endpoint and unit (maybe in another boot)."""
+        return other is not None and (self.endpoint, self.unit) == (other.endpoint, other.unit)
+
+
+@dataclass(frozen=True)
 class ConnectionState:
     """Link state for the GUI: ``message`` says why in plain English (logs, CLI); ``reason`` is
     the same as a code and its arguments, which the GUI turns into the operator's language
@@ -66,6 +115,8 @@ class ConnectionState:
     endpoint: str = ""
     monitor_only: bool = False
     reason: Reason | None = None
+    #: the controller (and boot) this link reaches while it is up; None when it is not
+    controller: ControllerIdentity | None = None
 
     @property
     def connected(self) -> bool:

@@ -51,7 +51,10 @@ class PointMismatch(TeachPadError):
 
     code = "point_mismatch"
 
-    def __init__(self, point: TempPoint, pose: Pose, distance: float) -> None:
+    #: what the English message says happens next (a single move says its own)
+    RUN_STOPPED = "The run is stopped; check the point and the robot before resuming"
+
+    def __init__(self, point: TempPoint, pose: Pose, distance: float, then: str = RUN_STOPPED) -> None:
         self.point = point
         self.pose = pose
         self.distance = distance
@@ -60,7 +63,7 @@ class PointMismatch(TeachPadError):
         super().__init__(
             f"the arm stopped at ({got}), {distance:.2f} mm away from {point.label} at ({want}): the "
             "controller's copy of the point differs from this project's (overwritten by another tool?). "
-            "The run is stopped; check the point and the robot before resuming",
+            f"{then}",
             params={"point": point.label, "got": got, "want": want, "distance": f"{distance:.2f}"},
         )
 

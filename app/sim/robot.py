@@ -175,6 +175,9 @@ class SimRobot(ControllerCommands):
         self.last_kind: CommandKind | None = None
         self.points: dict[int, StoredPoint] = {}
         self.refused_points: set[int] = set()  # fault injection: create point answers 1 for these
+        # fault injection: another master writes its own copy of these points right after each of
+        # our creates of them (the window between a host's create point and its move)
+        self.foreign_points: dict[int, StoredPoint] = {}
         self.time = 0.0
         # motion
         self.motion: Motion | None = None

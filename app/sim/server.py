@@ -409,6 +409,11 @@ class SimController:
         with self.lock:
             self.robot.points[point_id] = StoredPoint(pose, tool)
 
+    def remove_point(self, point_id: int) -> None:
+        """Forget one temp point (test setup: the controller lost it, a move to it answers 13)."""
+        with self.lock:
+            self.robot.points.pop(point_id, None)
+
     # --- fault injection ------------------------------------------------------------------
     def set_alarm(self, bit: Alarm | int, on: bool) -> None:
         with self.lock:
@@ -423,6 +428,17 @@ class SimController:
             else:
                 self.robot.refused_points.discard(int(point_id))
         log.info("create point %d: %s", point_id, "refused from now on" if refuse else "accepted again")
+
+    def overwrite_after_create(self, point_id: int, pose: Pose6 | None, tool: int = 200) -> None:
+        """Another master that writes its own ``point_id`` at ``pose`` right after every create of
+        it (a host's create reports success, then the controller holds the other pose): the
+        window between a host's create point and its move. None: no more."""
+        with self.lock:
+            if pose is None:
+                self.robot.foreign_points.pop(int(point_id), None)
+            else:
+                self.robot.foreign_points[int(point_id)] = StoredPoint(pose, tool)
+        log.info("create point %d: %s", point_id, "overwritten by another master" if pose else "kept again")
 
     def refuse_point_write(
         self, point_id: int, code: ExcCodes | int = ExcCodes.ILLEGAL_VALUE, times: int = 1

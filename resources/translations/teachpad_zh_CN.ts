@@ -1784,12 +1784,12 @@
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="414" />
+            <location filename="../../ui/messages.py" line="415" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="417" />
+            <location filename="../../ui/messages.py" line="418" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
@@ -1839,12 +1839,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="423" />
+            <location filename="../../ui/messages.py" line="424" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="427" />
+            <location filename="../../ui/messages.py" line="428" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -3037,157 +3037,159 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="141" />
+            <location filename="../../ui/controllers/point_sync.py" line="169" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="152" />
+            <location filename="../../ui/controllers/point_sync.py" line="180" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="162" />
+            <location filename="../../ui/controllers/point_sync.py" line="190" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="164" />
+            <location filename="../../ui/controllers/point_sync.py" line="192" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="171" />
+            <location filename="../../ui/controllers/point_sync.py" line="199" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="197" />
+            <location filename="../../ui/controllers/point_sync.py" line="225" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="203" />
+            <location filename="../../ui/controllers/point_sync.py" line="233" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="207" />
-            <source>{point} is not on the controller ({state}): upload it first</source>
-            <translation>{point} 不在控制器上（{state}）：请先上传</translation>
-        </message>
-        <message>
-            <location filename="../../ui/controllers/point_sync.py" line="214" />
+            <location filename="../../ui/controllers/point_sync.py" line="236" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="216" />
+            <location filename="../../ui/controllers/point_sync.py" line="238" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="222" />
+            <location filename="../../ui/controllers/point_sync.py" line="246" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="249" />
+            <location filename="../../ui/controllers/point_sync.py" line="296" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="272" />
+            <location filename="../../ui/controllers/point_sync.py" line="319" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="275" />
+            <location filename="../../ui/controllers/point_sync.py" line="322" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="300" />
+            <location filename="../../ui/controllers/point_sync.py" line="353" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="316" />
-            <source>The controller restarted or reconnected: {n} points may be gone from it. Restore all to re-create them.</source>
-            <translation>控制器已重启或重新连接：其上的 {n} 个点可能已丢失。请点击“恢复全部”重新创建。</translation>
+            <location filename="../../ui/controllers/point_sync.py" line="374" />
+            <source>Connected to another controller ({endpoint}): {n} points are not known to be on it. Restore all to create them there.</source>
+            <translation>已连接到另一台控制器（{endpoint}）：不知道它是否保存着这 {n} 个点。点击“恢复全部”在其上创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="343" />
+            <location filename="../../ui/controllers/point_sync.py" line="379" />
+            <source>The controller restarted, or it is not the one the points were uploaded to: {n} points may be gone from it. Restore all to re-create them.</source>
+            <translation>控制器已重启，或不是上传这些点的那台控制器：其上可能已没有这 {n} 个点。点击“恢复全部”重新创建它们。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/point_sync.py" line="407" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="348" />
+            <location filename="../../ui/controllers/point_sync.py" line="416" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="359" />
+            <location filename="../../ui/controllers/point_sync.py" line="427" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="364" />
+            <location filename="../../ui/controllers/point_sync.py" line="432" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="374" />
+            <location filename="../../ui/controllers/point_sync.py" line="442" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="383" />
+            <location filename="../../ui/controllers/point_sync.py" line="451" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="388" />
+            <location filename="../../ui/controllers/point_sync.py" line="456" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="400" />
+            <location filename="../../ui/controllers/point_sync.py" line="476" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="404" />
+            <location filename="../../ui/controllers/point_sync.py" line="263" />
+            <location filename="../../ui/controllers/point_sync.py" line="480" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="409" />
+            <location filename="../../ui/controllers/point_sync.py" line="488" />
+            <location filename="../../ui/controllers/point_sync.py" line="497" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="446" />
+            <location filename="../../ui/controllers/point_sync.py" line="543" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="449" />
+            <location filename="../../ui/controllers/point_sync.py" line="546" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="461" />
+            <location filename="../../ui/controllers/point_sync.py" line="558" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="466" />
+            <location filename="../../ui/controllers/point_sync.py" line="563" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="473" />
+            <location filename="../../ui/controllers/point_sync.py" line="570" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -3303,81 +3305,81 @@
         </message>
         <message>
             <location filename="../../ui/models/points_model.py" line="234" />
-            <source>Not known whether the controller holds this point (it restarted or the link was lost): upload it before moving to it</source>
-            <translation>不确定控制器上是否有此点（控制器已重启或通信曾中断）：运动到该点前请先上传</translation>
+            <source>Not known whether the controller holds this point (it restarted, it is another controller, or the arm did not arrive there): a move to it creates it again first</source>
+            <translation>不知道控制器是否保存着此点（控制器已重启、是另一台控制器，或机械臂未到达该点）：移动到此点时会先重新创建它</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="237" />
+            <location filename="../../ui/models/points_model.py" line="238" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="238" />
+            <location filename="../../ui/models/points_model.py" line="239" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="240" />
+            <location filename="../../ui/models/points_model.py" line="241" />
             <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
             <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="248" />
+            <location filename="../../ui/models/points_model.py" line="249" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="278" />
+            <location filename="../../ui/models/points_model.py" line="279" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="307" />
+            <location filename="../../ui/models/points_model.py" line="308" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="324" />
+            <location filename="../../ui/models/points_model.py" line="325" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="353" />
+            <location filename="../../ui/models/points_model.py" line="354" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="355" />
+            <location filename="../../ui/models/points_model.py" line="356" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="374" />
+            <location filename="../../ui/models/points_model.py" line="375" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="376" />
+            <location filename="../../ui/models/points_model.py" line="377" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="392" />
+            <location filename="../../ui/models/points_model.py" line="393" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="392" />
+            <location filename="../../ui/models/points_model.py" line="393" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="415" />
+            <location filename="../../ui/models/points_model.py" line="416" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="427" />
+            <location filename="../../ui/models/points_model.py" line="428" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -3482,7 +3484,7 @@
         </message>
         <message>
             <location filename="../../ui/panels/points_panel.py" line="207" />
-            <location filename="../../ui/panels/points_panel.py" line="395" />
+            <location filename="../../ui/panels/points_panel.py" line="393" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
@@ -3523,8 +3525,8 @@
         </message>
         <message>
             <location filename="../../ui/panels/points_parts.py" line="160" />
-            <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
-            <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
+            <source>The controller restarted, or it is another controller: it may not hold these points. Re-create them before running a plan.</source>
+            <translation>控制器已重启，或是另一台控制器：它可能没有保存这些点。运行轨迹前请重新创建它们。</translation>
         </message>
         <message>
             <location filename="../../ui/panels/points_parts.py" line="187" />

@@ -8,7 +8,7 @@ import pytest
 
 from app import timing
 from app.link.supervisor import LinkSupervisor, check_canary_gv
-from app.link.types import LinkState
+from app.link.types import ControllerIdentity, LinkState
 from tests.link.harness import PartsHost
 
 
@@ -73,3 +73,62 @@ def test_the_canary_must_be_a_spare_gv() -> None:
         check_canary_gv(3)
     with pytest.raises(ValueError):
         LinkSupervisor(PartsHost(), 2)
+
+
+# --- which controller, which boot (issue 18) -----------------------------------------------------
+
+
+def _controller(parts: PartsHost) -> ControllerIdentity:
+    identity = parts.of("connectionChanged")[-1].controller
+    assert isinstance(identity, ControllerIdentity)
+    return identity
+
+
+def test_every_connect_says_which_controller_and_which_boot(sim_factory: Any) -> None:
+    first, second = sim_factory(), sim_factory()
+    parts = PartsHost(canary_gv=99)
+    try:
+        parts.connect(first)
+        one = _controller(parts)
+        assert (one.endpoint, one.unit, one.canary_gv) == (f"127.0.0.1:{first.port}", 1, 99)
+        assert one.boot == parts.supervisor.canary_token and one.boot is not None
+        # lost and back, the same boot: the canary still holds our token (read, never written again)
+        canary_writes = len(first.writes_to(198))
+        parts.supervisor.link_lost("test")
+        assert parts.of("connectionChanged")[-1].controller is None  # not connected: no controller
+        parts.supervisor.try_connect()
+        assert _controller(parts).same_boot(one) and len(first.writes_to(198)) == canary_writes
+        # restarted while the link was down: the same place, another boot (a new token written)
+        parts.supervisor.link_lost("test")
+        first.restart_controller()
+        parts.supervisor.try_connect()
+        restarted = _controller(parts)
+        assert restarted.same_place(one) and not restarted.same_boot(one)
+        assert len(first.writes_to(198)) == canary_writes + 1
+        # Connect… to another controller: another place
+        parts.connect(second)
+        other = _controller(parts)
+        assert not other.same_place(restarted) and not other.same_boot(restarted)
+    finally:
+        parts.close()
+
+
+def test_a_restart_under_a_live_link_is_a_new_identity_published_before_the_restart(sim: Any) -> None:
+    parts = PartsHost(canary_gv=99)
+    try:
+        parts.connect(sim)
+        one = _controller(parts)
+        parts.supervisor.canary_read(0.0)  # the canary reads wiped: the controller restarted
+        names = parts.names()
+        last_state = len(names) - 1 - names[::-1].index("connectionChanged")
+        assert last_state < names.index("controllerRestarted")
+        assert not _controller(parts).same_boot(one) and _controller(parts).same_place(one)
+    finally:
+        parts.close()
+
+
+def test_without_a_canary_no_two_connections_are_the_same_boot(host: PartsHost, sim: Any) -> None:
+    host.connect(sim)
+    identity = _controller(host)
+    assert identity.boot is None and not identity.same_boot(identity)
+    assert sim.writes == []  # and nothing is written to tell

@@ -17,9 +17,12 @@ from PySide6.QtCore import QObject, Signal
 from app.link.client import StepFrame
 from app.link.robot_link import LinkPort, Pending, RequestRouter
 from app.link.state import RobotState
-from app.link.types import ConnectionState, LinkState
+from app.link.types import ConnectionState, ControllerIdentity, LinkState
 from app.models import CommandResult
 from app.protocol.enums import CommandKind, CommandStatus, ProgramMotionMode, RunCommand, TeachFrame, WorkMode
+
+#: The controller a FakeLink connects to unless told otherwise (one boot, its canary token 1).
+FAKE_CONTROLLER = ControllerIdentity("fake:502", 1, "low-first", 99, 1.0)
 
 
 @dataclass
@@ -155,9 +158,22 @@ class FakeLink(QObject):
         calls = self.named(name)
         return calls[-1].request_id if calls else 0
 
-    def set_connected(self, connected: bool, message: str = "", *, monitor_only: bool = False) -> None:
+    def set_connected(
+        self,
+        connected: bool,
+        message: str = "",
+        *,
+        monitor_only: bool = False,
+        controller: ControllerIdentity = FAKE_CONTROLLER,
+    ) -> None:
+        """Connected (to ``controller``: by default the same controller in the same boot every
+        time) or down."""
         state = LinkState.CONNECTED if connected else LinkState.DOWN
-        self._state.set_connection(ConnectionState(state, message, "fake:502", monitor_only))
+        self._state.set_connection(
+            ConnectionState(
+                state, message, "fake:502", monitor_only, controller=controller if connected else None
+            )
+        )
 
     def finish_create(self, ok: bool = True, pose: Sequence[float] | None = None, message: str = "") -> None:
         details = dict(zip("xyzabc", pose, strict=True)) if pose is not None else {}

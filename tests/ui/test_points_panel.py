@@ -3,6 +3,7 @@ move to point (confirmation injected), validation messages, filter, undo of teac
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -10,12 +11,12 @@ from typing import Any
 import pytest
 from PySide6.QtGui import QUndoStack
 
-from app.link.types import WorkerError
+from app.link.types import ConnectionState, ControllerIdentity, LinkState, WorkerError
 from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, make_point
 from app.points.project import load_project
 from app.protocol.enums import CommandKind, RunCommand
-from tests.ui.fake_link import FakeLink
+from tests.ui.fake_link import FAKE_CONTROLLER, FakeLink
 from ui.controllers.point_sync import PointSyncController
 from ui.models.point_columns import COL_E1, COL_TOOL, COL_X
 from ui.models.points_model import PointsModel
@@ -251,14 +252,24 @@ def test_link_loss_during_an_upload_keeps_the_late_reports(
     ]
 
 
-@pytest.mark.parametrize("signal", ["controllerReconnected", "controllerRestarted"])
-def test_reconnect_marks_unknown_and_offers_restore(
-    qtbot: Any, panel: PointsPanel, link: FakeLink, signal: str
+@pytest.mark.parametrize(
+    "controller",
+    [
+        dataclasses.replace(FAKE_CONTROLLER, endpoint="other:502"),  # Connect… to another controller
+        dataclasses.replace(FAKE_CONTROLLER, unit=2),  # another unit behind the same gateway
+        dataclasses.replace(FAKE_CONTROLLER, boot=2.0),  # a restart: the canary holds another token
+        dataclasses.replace(FAKE_CONTROLLER, boot=None),  # no canary: the boot cannot be told
+    ],
+    ids=["endpoint", "unit", "restart", "no canary"],
+)
+def test_another_controller_marks_unknown_and_offers_restore(
+    qtbot: Any, panel: PointsPanel, link: FakeLink, controller: ControllerIdentity
 ) -> None:
     model = panel.model
     model.apply_upload(_report_ok(model, [1, 2]))
     assert not panel.banner.isVisibleTo(panel)
-    getattr(link, signal).emit()
+    link.set_connected(False, "link lost")
+    link.set_connected(True, controller=controller)
     assert [p.sync for p in model.ledger][:2] == [SyncState.UNKNOWN] * 2
     assert panel.banner.isVisibleTo(panel) and panel.restore_button.isEnabled()
     panel.restore_button.click()
@@ -269,6 +280,32 @@ def test_reconnect_marks_unknown_and_offers_restore(
         link.upload_summary(8, 8)
     assert all(p.sync is SyncState.ON_CONTROLLER for p in model.ledger)
     assert not panel.banner.isVisibleTo(panel)
+
+
+def test_the_same_controller_boot_keeps_the_points(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
+    model = panel.model
+    model.apply_upload(_report_ok(model, [1, 2]))
+    link.set_connected(False, "link lost")
+    link.controllerReconnected.emit()  # a reconnect alone says nothing about the points
+    link.set_connected(True)  # the same endpoint, unit and canary token: the same boot
+    assert [p.sync for p in model.ledger][:2] == [SyncState.ON_CONTROLLER] * 2
+    assert not panel.banner.isVisibleTo(panel)
+
+
+def test_a_silence_on_the_same_connection_keeps_the_points(panel: PointsPanel, link: FakeLink) -> None:
+    """Not answering for a while and back, the link never down: the same connection, even with no
+    canary to prove the boot by (a new connection without one would make them unknown)."""
+    unprovable = dataclasses.replace(FAKE_CONTROLLER, boot=None)
+    link.set_connected(False)
+    link.set_connected(True, controller=unprovable)
+    model = panel.model
+    model.apply_upload(_report_ok(model, [1, 2]))
+    for state in (LinkState.NOT_ANSWERING, LinkState.CONNECTED):
+        link.state.set_connection(ConnectionState(state, "", "fake:502", controller=unprovable))
+    assert [p.sync for p in model.ledger][:2] == [SyncState.ON_CONTROLLER] * 2
+    link.set_connected(False)
+    link.set_connected(True, controller=unprovable)
+    assert [p.sync for p in model.ledger][:2] == [SyncState.UNKNOWN] * 2
 
 
 def _report_ok(model: PointsModel, ids: list[int]) -> Any:
@@ -290,24 +327,75 @@ def test_move_to_point_asks_first(
     answers.append(False)
     panel.action_move_to.trigger()
     assert "P2" in panel.questions[-1] and "120" in panel.questions[-1]  # type: ignore[attr-defined]
-    assert link.named("move_to_point") == []
+    assert link.named("move_to_point") == [] and link.named("upload_points") == []
     answers.append(True)
     panel.move_to_selected()
+    # the point guard: P2 is created again from the ledger first, the move waits for it
+    (create,) = link.named("upload_points")
+    assert create.args[0] == [(2, model.ledger.point(2).xyzabc, 200)]
+    assert link.named("move_to_point") == []
+    with qtbot.waitSignal(panel.controller.movePrepared) as prepared:
+        link.point_ok(2)
+        link.upload_summary(1, 1)
+    assert prepared.args == [2]
     (call,) = link.named("move_to_point")
     assert call.args == (2, None) and call.kwargs["speed"] == 120.0 and call.kwargs["tool"] == 200
     with qtbot.waitSignal(panel.controller.moveFinished) as done:
         link.finish_move(False, code=13, message="bad end-point id")
     assert done.args[0] is False and "bad end point id" in done.args[1]  # GV291 13, in words
+    # the controller does not hold P2: not known to be on it, Restore all offered
+    assert model.ledger.point(2).sync is SyncState.UNKNOWN
+    assert panel.banner.isVisibleTo(panel) and "Move to P2 failed" in panel.status.text()
 
 
-def test_move_to_a_point_not_on_the_controller_is_refused(
-    panel: PointsPanel, link: FakeLink, answers: list[bool]
+def test_move_to_a_point_not_on_the_controller_creates_it_first(
+    qtbot: Any, panel: PointsPanel, link: FakeLink, answers: list[bool]
 ) -> None:
+    point = panel.model.ledger[0]
+    assert point.needs_upload
     panel.select_rows([0])
     answers.append(True)
     panel.move_to_selected()
-    assert link.named("move_to_point") == []
-    assert "upload it first" in panel.status.text()
+    assert panel.questions  # type: ignore[attr-defined]  # asked, like any move
+    assert [c.args[0][0][0] for c in link.named("upload_points")] == [point.id]
+    link.point_failed(point.id, "bad point id")
+    with qtbot.waitSignal(panel.controller.moveFinished) as done:
+        link.upload_summary(0, 1)
+    assert done.args[0] is False and link.named("move_to_point") == []  # never sent
+    assert f"Move to P{point.id} failed" in panel.status.text() and "not moved" in panel.status.text()
+
+
+def test_a_stop_while_the_point_is_created_sends_no_move(
+    qtbot: Any, panel: PointsPanel, link: FakeLink, answers: list[bool]
+) -> None:
+    panel.select_rows([1])
+    answers.append(True)
+    panel.move_to_selected()
+    panel.controller.stop()
+    assert link.named("stop")
+    with qtbot.waitSignal(panel.controller.moveFinished) as done:
+        link.upload_summary(0, 1, "stopped")  # the worker's upload ends at the stop
+    assert done.args[0] is False and link.named("move_to_point") == []
+    assert "stopped by the operator" in panel.status.text()
+
+
+def test_an_arm_that_stops_elsewhere_is_a_failed_move(
+    qtbot: Any, panel: PointsPanel, link: FakeLink, answers: list[bool]
+) -> None:
+    model = panel.model
+    point = model.ledger[1]
+    panel.select_rows([1])
+    answers.append(True)
+    panel.move_to_selected()
+    link.point_ok(point.id)
+    link.upload_summary(1, 1)
+    assert model.ledger.point(point.id).sync is SyncState.ON_CONTROLLER
+    link.state.set_pose(Pose(point.x + 3.0, point.y, point.z, point.a, point.b, point.c))  # 3 mm off
+    with qtbot.waitSignal(panel.controller.moveFinished) as done:
+        link.finish_move(True)
+    assert done.args[0] is False and "3.00 mm from" in done.args[1]
+    assert "Reached" not in panel.status.text() and f"Move to P{point.id} failed" in panel.status.text()
+    assert model.ledger.point(point.id).sync is SyncState.UNKNOWN
 
 
 def test_run_active_disables_motion(panel: PointsPanel) -> None:

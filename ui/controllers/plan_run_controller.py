@@ -314,7 +314,7 @@ class PlanRunController(QObject):
     def _prepare(self, link: LinkPort, guard: RunPoints, command: SegmentCommand) -> None:
         """Create the segment's points from the ledger (worker thread); the move follows."""
         try:
-            prepared = guard.begin(command.segment)
+            prepared = guard.begin(command.segment.end_id, command.segment.point_ids)
         except TeachPadError as exc:
             self._fail_segment(exc)
             return

@@ -18,6 +18,22 @@ the controller still holds them. Teach reads the pose back from
 the ``x``..``c`` details that the link adds to a successful create-point result (the pose
 polled together with the completion); without them it uses the state's latest pose. The
 bookkeeping of an upload in flight is :mod:`ui.controllers.point_sync_state`.
+
+**Which controller the states refer to.** The sync states are true of one controller in one
+boot: the :class:`~app.link.types.ControllerIdentity` the link publishes with each connection
+(``link.state.connection.controller``). Whenever the link comes up with an identity that is not
+provably the same boot as the one the states were made with (another endpoint or unit after
+*Connect…*, a changed register profile, a restart seen by the canary, a reconnect whose canary
+no longer holds our token), every point becomes *unknown* and "Restore all" is offered; a
+reconnect to the same boot keeps them. A move that the controller answers with "bad end point
+id" (it does not hold the point) makes that point *unknown* too.
+
+**Move to point** goes through the point guard of the plan runs
+(:class:`~ui.controllers.run_points.RunPoints`): the point is created again from the ledger
+(one ``link.upload_points``), ``movePrepared(int)`` is emitted and the move goes out only when
+the controller has created it; after the move the pose polled with its completion is compared
+with the ledger's point (1 mm): an arm that stopped elsewhere is a failed move, said in words,
+and the point becomes *unknown*.
 """
 
 from __future__ import annotations
@@ -28,14 +44,15 @@ from PySide6.QtCore import QObject, Signal, Slot
 
 from app.errors import InvalidInput
 from app.link.robot_link import LinkPort, Pending
-from app.link.types import ConnectionState, WorkerError
+from app.link.types import ConnectionState, ControllerIdentity, WorkerError
 from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, UploadReport
+from app.protocol.enums import MoveStatus
 from app.protocol.registers import TOOL_NONE
 from ui.controllers.new_point import NewPointPose, new_point_pose
 from ui.controllers.point_sync_state import UploadRun, batch_reason, pose_from_details, result_reason
+from ui.controllers.run_points import RunPoints, SegmentPoints
 from ui.messages import connection_text, error_text, refusal_text, result_text
-from ui.models.point_columns import sync_text
 from ui.models.points_model import PointsModel
 
 DEFAULT_MOVE_SPEED = 50.0  # mm/s for "move to point"
@@ -53,7 +70,8 @@ class PointSyncController(QObject):
     connection change of the state), ``statusMessage(str, str)``
     (text, level "info" / "warn" / "error"), ``pointTaught(int)`` (id), ``uploadProgress(int,
     int)`` (points done, total), ``uploadFinished(object)`` (:class:`UploadReport` of the whole
-    request), ``restoreOffered(bool)`` (show / hide "Restore all"), ``moveFinished(bool, str)``.
+    request), ``restoreOffered(bool)`` (show / hide "Restore all"), ``movePrepared(int)`` (the
+    point was created again from the ledger: its move goes out next), ``moveFinished(bool, str)``.
     """
 
     busyChanged = Signal(bool)
@@ -63,6 +81,7 @@ class PointSyncController(QObject):
     uploadProgress = Signal(int, int)
     uploadFinished = Signal(object)
     restoreOffered = Signal(bool)
+    movePrepared = Signal(int)
     moveFinished = Signal(bool, str)
 
     def __init__(
@@ -75,6 +94,12 @@ class PointSyncController(QObject):
         self._teach_id: int | None = None
         self._teach_name = ""
         self._move_id: int | None = None
+        self._move_speed = DEFAULT_MOVE_SPEED
+        self._guard = RunPoints(model)  # a move's point re-created and its arrival checked
+        self._prepared: SegmentPoints | None = None  # the point of the move under way, as created
+        # the controller (and boot) the ledger's sync states are true of (None: none met yet)
+        self._controller: ControllerIdentity | None = None
+        self._live = False  # the link is up with self._controller (a new connection re-identifies)
         self._pending: Pending | None = None  # the outcome of the running teach / move / upload
         self._upload: UploadRun | None = None
         self._restore_offered = False
@@ -128,9 +153,12 @@ class PointSyncController(QObject):
         if self._link is not None:
             raise RuntimeError("the link is already set")
         self._link = link
+        self._controller = link.state.connection.controller
+        self._live = self._controller is not None
+        # Reconnects and restarts reach the points through the connection's controller identity
+        # (_on_connection): a restart seen by the canary is a new identity, published before
+        # controllerRestarted; a reconnect to the same boot keeps the states.
         link.state.connectionChanged.connect(self._on_connection)
-        link.controllerReconnected.connect(self._on_reconnected)
-        link.controllerRestarted.connect(self._on_reconnected)  # the same path: the points may be gone
         link.uploadProgress.connect(self._on_upload_progress)
         link.pointUploaded.connect(self._on_point_uploaded)
 
@@ -197,18 +225,12 @@ class PointSyncController(QObject):
         self._say(self.tr("Cancelling the upload…"), LEVEL_WARN)
 
     def move_to(self, point_id: int, speed: float = DEFAULT_MOVE_SPEED) -> bool:
-        """Line move to a point (function 3). The caller asks the operator first."""
+        """Line move to a point (function 3), guarded: the point is created again from the
+        ledger first, the arrival is checked after (see the module docstring). The caller asks
+        the operator first."""
         point = self._model.ledger.get(point_id)
         if point is None:
             self._say(self.tr("There is no point P{id}").format(id=point_id), LEVEL_ERROR)
-            return False
-        if point.needs_upload:
-            self._say(
-                self.tr("{point} is not on the controller ({state}): upload it first").format(
-                    point=point.label, state=sync_text(point.sync)
-                ),
-                LEVEL_ERROR,
-            )
             return False
         if not 0 < speed <= MAX_MOVE_SPEED:
             self._say(self.tr("Speed {v} mm/s is out of range").format(v=speed), LEVEL_ERROR)
@@ -216,23 +238,48 @@ class PointSyncController(QObject):
         link = self._ready(self.tr("Move"))
         if link is None:
             return False
+        prepared = self._guard.begin(point_id, (point_id,))
         self._move_id = point_id
+        self._move_speed = float(speed)
         self._set_operation("move")
         self._say(
             self.tr("Moving to {point} at {v} mm/s…").format(point=point.label, v=f"{speed:g}"), LEVEL_INFO
         )
+        self._watch(link, link.upload_points(prepared.items()))  # the move follows once it is created
+        return True
+
+    def _move_point_created(self, result: CommandResult) -> None:
+        """The move's point was created again (or not): send the move, or fail it unsent."""
+        link, guard = self._link, self._guard
+        assert link is not None
+        prepared = guard.finish_upload(link.state.connection.endpoint)
+        guard.clear()
+        assert prepared is not None
+        if not (result.ok and prepared.all_created):
+            if batch_reason(result.message) == "stopped":  # the operator's Stop ended the create
+                self._move_id = None
+                self._set_operation("")
+                self._say(
+                    self.tr("Move to P{id} stopped by the operator").format(id=prepared.end_id), LEVEL_INFO
+                )
+                self.moveFinished.emit(False, batch_reason(result.message))
+            else:
+                self._fail_move(prepared.end_id, error_text(guard.not_created(prepared)))
+            return
+        point = prepared.points[prepared.end_id]
+        self._prepared = prepared
+        self.movePrepared.emit(point.id)
         self._watch(
             link,
             link.move_to_point(
-                point_id,
+                point.id,
                 None,
                 orientation_changes=True,
                 ignore_middle=False,
-                speed=float(speed),
+                speed=self._move_speed,
                 tool=point.tool,
             ),
         )
-        return True
 
     def points_missing(self, point_ids: Iterable[int]) -> None:
         """The controller said it does not hold these points (e.g. "bad end point id"):
@@ -295,6 +342,12 @@ class PointSyncController(QObject):
     @Slot(ConnectionState)
     def _on_connection(self, state: ConnectionState) -> None:
         connected = state.connected
+        controller = state.controller  # set while the link is up (connected or not answering)
+        if controller is None:
+            self._live = False  # down, connecting, disconnected: the next identity is a new connection
+        elif not (self._live and controller == self._controller):  # not a blip of the same connection
+            self._live = True
+            self._identify(controller)  # the states first: views of connectedChanged read them
         self.connectedChanged.emit(connected)
         if not connected and self._operation:
             reason = connection_text(state) or self.tr("link lost")
@@ -304,20 +357,29 @@ class PointSyncController(QObject):
             else:
                 self._abort(reason)
 
-    @Slot()
-    def _on_reconnected(self) -> None:
-        """The controller restarted (canary) or the link came back: its points may be gone."""
-        self._flush_upload()
-        self._model.mark_all_unknown()
-        if len(self._model.ledger):
-            self._offer_restore(True)
-            self._say(
-                self.tr(
-                    "The controller restarted or reconnected: {n} points may be gone from it. "
-                    "Restore all to re-create them."
-                ).format(n=len(self._model.ledger)),
-                LEVEL_WARN,
-            )
+    def _identify(self, controller: ControllerIdentity) -> None:
+        """The link is up to ``controller``: unless it is provably the controller and boot the
+        sync states were made with, nothing is known to be on it any more."""
+        previous, self._controller = self._controller, controller
+        if controller.same_boot(previous):
+            return
+        self._flush_upload()  # what the controller confirmed before it changed
+        changed = self._model.mark_all_unknown()
+        n = len(self._model.ledger)
+        if not n or (previous is None and not changed):
+            return  # the first controller these points meet, and none was believed on one
+        self._offer_restore(True)
+        if previous is not None and not controller.same_place(previous):
+            text = self.tr(
+                "Connected to another controller ({endpoint}): {n} points are not known to be on it. "
+                "Restore all to create them there."
+            ).format(endpoint=controller.endpoint, n=n)
+        else:
+            text = self.tr(
+                "The controller restarted, or it is not the one the points were uploaded to: {n} "
+                "points may be gone from it. Restore all to re-create them."
+            ).format(n=n)
+        self._say(text, LEVEL_WARN)
 
     def _on_error(self, pending: Pending, error: WorkerError) -> None:
         if pending is self._pending:
@@ -330,6 +392,8 @@ class PointSyncController(QObject):
         self._pending = None
         if self._operation == "teach":
             self._finish_teach(result)
+        elif self._operation == "move" and self._guard.segment is not None:
+            self._move_point_created(result)
         elif self._operation == "move":
             self._finish_move(result)
         elif self._operation == "upload":
@@ -342,7 +406,11 @@ class PointSyncController(QObject):
             self._set_operation("")
             self._say(self.tr("Teach failed: {reason}").format(reason=reason), LEVEL_ERROR)
         elif operation == "move":
+            if self._guard.segment is not None:  # while its point was being created
+                self._guard.finish_upload(self._link.state.connection.endpoint if self._link else "")
+                self._guard.clear()
             self._move_id = None
+            self._prepared = None
             self._set_operation("")
             self.moveFinished.emit(False, reason)
             self._say(self.tr("Move failed: {reason}").format(reason=reason), LEVEL_ERROR)
@@ -395,6 +463,14 @@ class PointSyncController(QObject):
     # move
     def _finish_move(self, result: CommandResult) -> None:
         point_id, self._move_id = self._move_id, None
+        prepared, self._prepared = self._prepared, None
+        if result.ok and prepared is not None:
+            # the pose that came with the result, else the link's latest (the poll that completed
+            # the move publishes its pose before the result): the 1 mm rule of the plan runs
+            error = self._guard.check_arrival(prepared, pose_from_details(result.details, self.last_pose))
+            if error is not None:
+                self._fail_move(point_id, error_text(error))
+                return
         self._set_operation("")
         if result.ok:
             self._say(self.tr("Reached P{id}").format(id=point_id), LEVEL_INFO)
@@ -405,16 +481,37 @@ class PointSyncController(QObject):
             self.moveFinished.emit(False, reason)
         else:
             reason = result_reason(result)
+            missing = result.status is not None and result.status.code == MoveStatus.BAD_END_POINT
+            if missing and point_id is not None:
+                self._point_gone(point_id)
             self._say(
                 self.tr("Move to P{id} failed: {reason}").format(id=point_id, reason=reason), LEVEL_ERROR
             )
             self.moveFinished.emit(False, reason)
+
+    def _fail_move(self, point_id: int | None, reason: str) -> None:
+        """The guarded move failed for ``reason`` (its point not created, or the arm elsewhere)."""
+        self._move_id = None
+        self._prepared = None
+        self._set_operation("")
+        self._say(self.tr("Move to P{id} failed: {reason}").format(id=point_id, reason=reason), LEVEL_ERROR)
+        self.moveFinished.emit(False, reason)
+
+    def _point_gone(self, point_id: int) -> None:
+        """The controller does not hold ``point_id`` ("bad end point id"): not known to be on it."""
+        if self._model.ledger.get(point_id) is not None:
+            self._model.set_sync(
+                point_id, SyncState.UNKNOWN, "the controller answered that it does not hold this point"
+            )
+            self._offer_restore(True)
 
     # upload
     @Slot(int, bool, str, bool)
     def _on_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
         if self._upload is not None:
             self._upload.record(point_id, ok, reason, unconfirmed)
+        elif self._operation == "move":  # the move's own point (others are ignored there)
+            self._guard.on_point_uploaded(point_id, ok, reason, unconfirmed)
 
     def _flush_upload(self) -> None:
         """Apply the outcomes reported since the last flush to the ledger (one model update)."""

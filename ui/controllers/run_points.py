@@ -1,4 +1,8 @@
-"""The point guard of a GUI plan run: each segment's points re-created, its arrival checked.
+"""The point guard of the GUI: a move's points re-created, its arrival checked.
+
+Every move of the GUI to a stored point goes through it: each segment of a plan run
+(:mod:`ui.controllers.plan_run_controller`) and the points table's *Move to point*
+(:mod:`ui.controllers.point_sync`).
 
 The GUI's side of :class:`app.points.guard.PointGuard` (the rule the CLI's ``run`` follows): a
 temp point cannot be read back, the controller forgets them when it restarts and any other
@@ -29,7 +33,6 @@ from dataclasses import dataclass, field
 
 from app.errors import TeachPadError
 from app.models import Pose
-from app.plan.segments import Segment
 from app.points.guard import PointGuard, PointNotCreated
 from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport
 from ui.models.points_model import PointsModel
@@ -76,12 +79,13 @@ class RunPoints:
     def model(self) -> PointsModel:
         return self._model
 
-    def begin(self, segment: Segment) -> SegmentPoints:
-        """The segment's points from the ledger now; :class:`PointNotCreated` (``point_missing``)
-        when the project has no such point."""
+    def begin(self, end_id: int, point_ids: Sequence[int]) -> SegmentPoints:
+        """The points of a move to ``end_id`` (a segment's ``point_ids``, or the end point alone
+        for the points table's *Move to point*) from the ledger now; :class:`PointNotCreated`
+        (``point_missing``) when the project has no such point."""
         ledger = self._model.ledger
         points: dict[int, TempPoint] = {}
-        for point_id in segment.point_ids:
+        for point_id in point_ids:
             point = ledger.get(point_id)
             if point is None:
                 raise PointNotCreated(
@@ -90,7 +94,7 @@ class RunPoints:
                     params={"point": f"P{point_id}"},
                 )
             points[point_id] = point
-        self.segment = SegmentPoints(segment.end_id, points)
+        self.segment = SegmentPoints(end_id, points)
         return self.segment
 
     def on_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool) -> None:

@@ -231,8 +231,9 @@ class PointsModel(UndoableListModel):
                 return self.tr("Upload failed: {reason}").format(reason=reason)
             return {
                 SyncState.UNKNOWN: self.tr(
-                    "Not known whether the controller holds this point (it "
-                    "restarted or the link was lost): upload it before moving to it"
+                    "Not known whether the controller holds this point (it restarted, it is "
+                    "another controller, or the arm did not arrive there): a move to it creates "
+                    "it again first"
                 ),
                 SyncState.ON_CONTROLLER: self.tr("The controller holds this point with these values"),
                 SyncState.CHANGED: self.tr("Changed on the host (or new) since the last upload"),

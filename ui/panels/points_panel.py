@@ -389,9 +389,7 @@ class PointsPanel(QWidget):
             c=point.c,
             v=f"{speed:g}",
         )
-        if point.needs_upload:
-            self._controller.move_to(point.id, speed)  # refuses with the reason
-            return
+        # whatever its sync state: the move creates the point again from this pose first
         if self._confirm(self.tr("Move to point"), question):
             self._controller.move_to(point.id, speed)
 

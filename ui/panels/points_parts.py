@@ -159,8 +159,8 @@ class RestoreBanner(QFrame):
         self.label.setText(
             QCoreApplication.translate(
                 "PointsPanel",
-                "The controller restarted or the link was re-established: its temp "
-                "points may be gone. Re-create them before running a plan.",
+                "The controller restarted, or it is another controller: it may not hold "
+                "these points. Re-create them before running a plan.",
             )
         )
         self.restore_button.setText(QCoreApplication.translate("PointsPanel", "Restore all"))
