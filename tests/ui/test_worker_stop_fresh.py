@@ -155,8 +155,8 @@ def test_motions_in_flight_until_their_outcome(qtbot: Any, sim: Any, link: Robot
     from app.link.client import StepFrame
 
     connect(qtbot, link, sim)
-    assert link.motions_in_flight == ()
+    assert not link.motions_in_flight
     with qtbot.waitSignal(link.commandFinished, timeout=SIGNAL_TIMEOUT_MS):
-        link.step(StepFrame.BASE, (0.0, 0.0, -5.0, 0.0, 0.0, 0.0), speed=50.0)
-        assert link.motions_in_flight == ("step",)
-    assert link.motions_in_flight == ()
+        request_id = link.step(StepFrame.BASE, (0.0, 0.0, -5.0, 0.0, 0.0, 0.0), speed=50.0)
+        assert request_id and link.motions_in_flight == ("step",)
+    assert not link.motions_in_flight
