@@ -327,7 +327,8 @@ def stop_on_a_fresh_connection(
     client.audit = audit
     capture.attach(client)
     try:
-        client.connect()
+        if not settings.monitor_only:  # (monitor-only: the write guard refuses it, audited, nothing opened)
+            client.connect()
         sent = time.monotonic()
         client.stop()
         if ratio_zero:

@@ -978,52 +978,52 @@
     <context>
         <name>LinkGuard</name>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="133" />
+            <location filename="../../ui/controllers/link_guard.py" line="135" />
             <source>Disconnect</source>
             <translation>断开连接</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="137" />
+            <location filename="../../ui/controllers/link_guard.py" line="139" />
             <source>Disconnecting does not stop the robot, and TeachPad no longer shows what it does. Stop all motion first?</source>
             <translation>断开连接不会停止机器人，且 TeachPad 将不再显示它的动作。要先停止所有运动吗？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="141" />
+            <location filename="../../ui/controllers/link_guard.py" line="143" />
             <source>Stop, then disconnect</source>
             <translation>先停止，再断开</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="142" />
+            <location filename="../../ui/controllers/link_guard.py" line="144" />
             <source>Disconnect without stopping</source>
             <translation>不停止，直接断开</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="159" />
+            <location filename="../../ui/controllers/link_guard.py" line="161" />
             <source>Close TeachPad</source>
             <translation>关闭 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="160" />
+            <location filename="../../ui/controllers/link_guard.py" line="162" />
             <source>Closing TeachPad does not stop the robot. Stop all motion first?</source>
             <translation>关闭 TeachPad 不会停止机器人。要先停止所有运动吗？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="161" />
+            <location filename="../../ui/controllers/link_guard.py" line="163" />
             <source>Stop, then close</source>
             <translation>先停止，再关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="162" />
+            <location filename="../../ui/controllers/link_guard.py" line="164" />
             <source>Close without stopping</source>
             <translation>不停止，直接关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="182" />
+            <location filename="../../ui/controllers/link_guard.py" line="184" />
             <source>the controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="184" />
+            <location filename="../../ui/controllers/link_guard.py" line="186" />
             <source>Under way on {endpoint}:
 {items}
 
@@ -1843,37 +1843,37 @@
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="417" />
+            <location filename="../../ui/messages.py" line="420" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="420" />
+            <location filename="../../ui/messages.py" line="423" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="465" />
+            <location filename="../../ui/messages.py" line="469" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="468" />
+            <location filename="../../ui/messages.py" line="472" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="472" />
+            <location filename="../../ui/messages.py" line="476" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="475" />
+            <location filename="../../ui/messages.py" line="479" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="478" />
+            <location filename="../../ui/messages.py" line="482" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
@@ -1923,12 +1923,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="426" />
+            <location filename="../../ui/messages.py" line="429" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="430" />
+            <location filename="../../ui/messages.py" line="433" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -5278,22 +5278,22 @@ Remove them all?</source>
             <translation>点动按住中</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="94" />
+            <location filename="../../ui/controllers/link_guard.py" line="96" />
             <source>{operation}: under way</source>
             <translation>{operation}：正在进行</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="96" />
+            <location filename="../../ui/controllers/link_guard.py" line="98" />
             <source>a plan run is under way</source>
             <translation>规划正在运行</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="99" />
+            <location filename="../../ui/controllers/link_guard.py" line="101" />
             <source>the arm is moving</source>
             <translation>机械臂正在运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="101" />
+            <location filename="../../ui/controllers/link_guard.py" line="103" />
             <source>the arm was moving when last seen</source>
             <translation>最后一次看到时机械臂正在运动</translation>
         </message>

@@ -151,6 +151,17 @@ def test_a_stop_without_any_controller_known_sends_nothing(qtbot: Any, link: Rob
     assert error_text(failed.args[0]) == "Not connected to a controller: nothing was sent."
 
 
+def test_a_monitor_only_stop_after_a_disconnect_sends_nothing(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    connect(qtbot, link, sim, monitor_only=True)
+    with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED)):
+        link.disconnect()
+    requests = sim.requests_count
+    with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as failed:
+        link.stop()
+    assert error_text(failed.args[0]) == "Monitor-only mode: nothing was sent to the controller."
+    assert sim.requests_count == requests and sim.connections_count == 0
+
+
 def test_motions_in_flight_until_their_outcome(qtbot: Any, sim: Any, link: RobotLink) -> None:
     from app.link.client import StepFrame
 

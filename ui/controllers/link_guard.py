@@ -24,7 +24,7 @@ from PySide6.QtWidgets import QWidget
 
 from app.link.robot_link import RobotLink
 from app.link.transport import ConnectionSettings
-from app.link.types import LinkState
+from app.link.types import LinkState, Operation
 from app.models import Pose
 from app.protocol.enums import ProgramState
 from ui.dialogs.stop_first import AskStopFirst, StopFirst, StopFirstQuestion, ask_stop_first
@@ -91,6 +91,8 @@ class UnderWay(QObject):
         if self._jog.is_jogging:
             out.append(self.tr("a jog is held"))
         for operation in dict.fromkeys(self._link.motions_in_flight):
+            if operation == Operation.RUN_PROGRAM and program in (ProgramState.RUNNING, ProgramState.PAUSED):
+                continue  # said above, from the program's own state
             out.append(self.tr("{operation}: under way").format(operation=operation_text(operation)))
         if self._runs.running:
             out.append(self.tr("a plan run is under way"))
