@@ -65,6 +65,7 @@ LINK_FAILURE_CODES = frozenset(
         "serial_open_failed",
         "no_answer",
         "malformed_answer",
+        "stop_unreachable",  # a Stop's fresh connection to the controller failed too
     }
 )
 

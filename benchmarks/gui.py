@@ -252,7 +252,7 @@ def bench_window(
         out["traffic_rows_at_end"] = traffic.model.rowCount()
     finally:
         if window is not None:
-            window.close()  # saves state and shuts the link down (blocking queued call)
+            window.close_unattended()  # no question: stops what runs, shuts the link down
         link.shutdown()
         if window is not None:
             window.deleteLater()

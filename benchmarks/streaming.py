@@ -148,7 +148,7 @@ def streaming_window(sim: RemoteSim, warm_s: float = 1.0) -> Iterator[tuple[Main
         _wait_until(lambda: not sim.busy())
     finally:
         if window is not None:
-            window.close()
+            window.close_unattended()  # no question (nobody answers): stops what runs
         link.shutdown()
         if window is not None:
             window.deleteLater()
@@ -288,7 +288,7 @@ def run_synthetic(seconds: float, profiler: cProfile.Profile | None) -> dict[str
         }
     finally:
         if window is not None:
-            window.close()
+            window.close_unattended()  # no question (nobody answers): stops what runs
         link.shutdown()
         if window is not None:
             window.deleteLater()

@@ -20,8 +20,11 @@ them only while the link is up and writable (not monitor-only). Any jog ends whe
 loses the focus, is hidden or closed, and when the link goes down.
 
 Close order: jog release first (before any question), then "save changes?" (Cancel keeps the
-window and the link), then the window state is saved and the link shut down. A close that is not
-the operator's (:meth:`MainWindow.close_unattended`: ``teachpad --screenshot``) asks nothing.
+window and the link), then, when motion or a program may be under way, "stop first?"
+(:class:`~ui.controllers.link_guard.LinkGuard`; Cancel keeps both too), then the window state is
+saved and the link shut down (a Stop chosen goes out before). A close that is not the operator's
+(:meth:`MainWindow.close_unattended`: ``teachpad --screenshot``) asks nothing and stops what is
+under way.
 """
 
 from __future__ import annotations
@@ -47,6 +50,7 @@ from app.link.robot_link import RobotLink
 from app.link.transport import ConnectionSettings
 from app.link.types import WorkerError
 from app.safety.roles import Action
+from ui.controllers.link_guard import LinkGuard
 from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
@@ -147,10 +151,14 @@ class MainWindow(QMainWindow):
         self.traffic_dock, self.alarm_dock = docks.traffic_dock, docks.alarm_dock
 
         # --- actions, menus, toolbar, status bar ---------------------------------------
+        # Disconnect and the close ask first when the robot may be moving; Reconnect (any role)
+        self.link_guard = LinkGuard(link, self.jog_panel, self.run_controller, settings, self)
         self.menus = WindowActions(
             self,
             connect=self.open_connection_dialog,
-            disconnect=link.disconnect,
+            disconnect=self.link_guard.disconnect_link,
+            reconnect=self.reconnect,
+            can_reconnect=lambda: self.link_guard.last_connection() is not None,
             stop=link.stop,
             pause=link.pause,
             resume=link.resume,
@@ -402,6 +410,13 @@ class MainWindow(QMainWindow):
             self.connect_with(dialog.settings())
             self.safety_menu.safety.set_poll_rate(self.settings.poll_hz)
 
+    @Slot()
+    def reconnect(self) -> None:
+        """Connect again to the last controller, its settings unchanged: any role's (audited
+        like every role check); another controller is :meth:`open_connection_dialog`'s."""
+        if self.safety_menu.safety.allowed(Action.RECONNECT):
+            self.link_guard.reconnect()
+
     def connect_with(self, settings: ConnectionSettings) -> None:
         """Remember ``settings`` and connect (the link retries by itself until it succeeds)."""
         self.settings.save_connection(settings)
@@ -463,9 +478,12 @@ class MainWindow(QMainWindow):
 
     def close_unattended(self) -> bool:
         """Close without any question (nobody is there to answer): unsaved changes are not
-        saved to the project file but kept in its autosave, which the next start offers."""
-        if not self._close_accepted and self.project.is_dirty:
-            self.project.autosave_now()
+        saved to the project file but kept in its autosave, which the next start offers; motion
+        under way is stopped (nobody is left to stop it)."""
+        if not self._close_accepted:
+            if self.project.is_dirty:
+                self.project.autosave_now()
+            self.link_guard.stop_if_under_way()
         self._close_accepted = True
         return self.close()
 
@@ -474,6 +492,9 @@ class MainWindow(QMainWindow):
         if not self._close_accepted:
             if not self.project.maybe_save():
                 event.ignore()  # the operator cancelled: the window and the link stay
+                return
+            if not self.link_guard.allow_close():  # motion under way: stop first? (or cancel)
+                event.ignore()
                 return
             self._close_accepted = True
         self.project.close()

@@ -338,6 +338,8 @@ def reason_text(reason: Reason) -> str | None:
         if cause is None:
             return _tr(_BARE["stop_sent_on_line"])
         return _tr(_TEMPLATES["stop_sent_on_line"]).format(cause=cause)
+    if reason.code in _FRESH_STOP:
+        return _fresh_stop_text(reason)
     template = _TEMPLATES.get(reason.code)
     if template is None:
         return None
@@ -390,10 +392,13 @@ def result_text(result: CommandResult) -> str:
 
 def result_level(result: CommandResult) -> str:
     """info for success and the operator's own stop, warning for an unconfirmed success and for a
-    Stop only the stop connection carried (the main connection did not take it)."""
+    Stop the main connection did not carry (the stop connection or a fresh one did)."""
     if result.ok:
-        on_line_only = result.reason is not None and result.reason.code == "stop_sent_on_line"
-        return LEVEL_WARNING if result.unconfirmed or on_line_only else LEVEL_INFO
+        another_way = result.reason is not None and result.reason.code in (
+            "stop_sent_on_line",
+            "stop_sent_fresh",
+        )
+        return LEVEL_WARNING if result.unconfirmed or another_way else LEVEL_INFO
     return LEVEL_INFO if result.stopped_by_operator else LEVEL_ERROR
 
 
@@ -457,3 +462,46 @@ def os_error_text(path: object, exc: OSError) -> str:
     """A file the system would not open or write, in the operator's language ("a.csv: ...")."""
     code, args = os_problem(exc)
     return refusal_text(FileFormatError(exc.strerror or str(exc), path=str(path), problem=Reason(code, args)))
+
+
+# A Stop the main link could not carry went over a fresh connection to the last controller
+# (app/link/commands.py: disconnected, lost, or its own stop failed), or could not reach it.
+_TEMPLATES["stop_sent_fresh"] = QT_TRANSLATE_NOOP(
+    "Messages", "Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it)."
+)
+_TEMPLATES["stop_sent_fresh_after"] = QT_TRANSLATE_NOOP(
+    "Messages",
+    "Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}",
+)
+_BARE["stop_sent_fresh_after"] = QT_TRANSLATE_NOOP(
+    "Messages", "Stop sent to {endpoint} over a fresh connection; the main connection did not take it."
+)
+_TEMPLATES["stop_unreachable"] = QT_TRANSLATE_NOOP(
+    "Messages", "Stop could not reach the controller at {endpoint}: {cause} Check the robot."
+)
+_BARE["stop_unreachable"] = QT_TRANSLATE_NOOP(
+    "Messages", "Stop could not reach the controller at {endpoint}. Check the robot."
+)
+_FRESH_STOP = ("stop_sent_fresh", "stop_unreachable")
+
+
+def _fresh_stop_text(reason: Reason) -> str:
+    """A Stop over a fresh connection: sent (after the main link's failure, when it had one) or
+    not (why: the fresh connection's failure), naming the controller."""
+    args = reason.args
+    endpoint = str(args.get("endpoint", ""))
+    cause = None
+    if args.get("cause"):
+        cause_args = dict(args.get("cause_args") or {})
+        for named_here in ("endpoint", "reconnect"):  # the controller is named once, by this sentence
+            cause_args.pop(named_here, None)
+        cause = reason_text(Reason(str(args["cause"]), cause_args))
+    if reason.code == "stop_sent_fresh":
+        if "cause" not in args:
+            return _tr(_TEMPLATES["stop_sent_fresh"]).format(endpoint=endpoint)
+        if cause is None:
+            return _tr(_BARE["stop_sent_fresh_after"]).format(endpoint=endpoint)
+        return _tr(_TEMPLATES["stop_sent_fresh_after"]).format(endpoint=endpoint, cause=cause)
+    if cause is None:
+        return _tr(_BARE["stop_unreachable"]).format(endpoint=endpoint)
+    return _tr(_TEMPLATES["stop_unreachable"]).format(endpoint=endpoint, cause=cause)

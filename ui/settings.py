@@ -125,6 +125,10 @@ class AppSettings:
                 pass
         return dataclasses.replace(defaults, **values)
 
+    def has_saved_connection(self) -> bool:
+        """A connection was saved (``connection()`` is then the last one, not the defaults)."""
+        return self._store.contains("connection/host") or self._store.contains("connection/serial_port")
+
     def save_connection(self, settings: ConnectionSettings) -> None:
         for key in _CONNECTION_KEYS:
             value = getattr(settings, key)

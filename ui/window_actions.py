@@ -5,8 +5,9 @@
 wide (also from floating docks); every other shortcut works in the window.
 
 Once bound to the link's :class:`~app.link.state.RobotState` (:meth:`WindowActions.bind`),
-Disconnect is enabled unless the link is disconnected, Pause and Resume only while it is
-writable (connected, not monitor-only); Stop always. They read the state when it changes and
+Disconnect is enabled unless the link is disconnected, Reconnect only while it is (and a last
+connection is known), Pause and Resume only while it is writable (connected, not monitor-only);
+Stop always. They read the state when it changes and
 keep no copy of it.
 """
 
@@ -38,6 +39,8 @@ class WindowActions(QObject):
         *,
         connect: Command,
         disconnect: Command,
+        reconnect: Command,
+        can_reconnect: Callable[[], bool],
         stop: Command,
         pause: Command,
         resume: Command,
@@ -58,6 +61,9 @@ class WindowActions(QObject):
         app_wide = Qt.ShortcutContext.ApplicationShortcut
         self.connect_action = self._action(connect, "Ctrl+K")
         self.disconnect_action = self._action(disconnect, "Ctrl+Shift+K")
+        self.reconnect_action = self._action(reconnect)
+        self.reconnect_action.setObjectName("ReconnectAction")
+        self._can_reconnect = can_reconnect
         self.quit_action = self._action(window.close, QKeySequence.StandardKey.Quit)
         self.stop_action = self._action(stop, Qt.Key.Key_Escape, context=app_wide)
         self.stop_action.setObjectName("StopAction")
@@ -110,7 +116,9 @@ class WindowActions(QObject):
     @Slot(ConnectionState)
     def _on_connection(self, connection: ConnectionState) -> None:
         writable = self._state is not None and self._state.writable
-        self.disconnect_action.setEnabled(connection.state is not LinkState.DISCONNECTED)
+        disconnected = connection.state is LinkState.DISCONNECTED
+        self.disconnect_action.setEnabled(not disconnected)
+        self.reconnect_action.setEnabled(disconnected and self._can_reconnect())
         self.pause_action.setEnabled(writable)
         self.resume_action.setEnabled(writable)
 
@@ -131,6 +139,7 @@ class WindowActions(QObject):
                 window.addAction(file_action)  # shortcuts work from every panel
         self.file_menu.addSeparator()
         self.file_menu.addAction(self.connect_action)
+        self.file_menu.addAction(self.reconnect_action)
         self.file_menu.addAction(self.disconnect_action)
         self.file_menu.addSeparator()
         self.file_menu.addAction(self.quit_action)
@@ -158,7 +167,7 @@ class WindowActions(QObject):
         self.toolbar = QToolBar(window)
         self.toolbar.setObjectName("MainToolBar")
         self.toolbar.setMovable(False)
-        for action in (self.connect_action, self.disconnect_action):
+        for action in (self.connect_action, self.reconnect_action, self.disconnect_action):
             self.toolbar.addAction(action)
         self.toolbar.addSeparator()
         for action in (self.stop_action, self.pause_action, self.resume_action):
@@ -188,6 +197,10 @@ class WindowActions(QObject):
         self.connect_action.setText(self.tr("&Connect…"))
         self.connect_action.setToolTip(self.tr("Connect to a controller (Ctrl+K)"))
         self.disconnect_action.setText(self.tr("&Disconnect"))
+        self.reconnect_action.setText(self.tr("&Reconnect"))
+        self.reconnect_action.setToolTip(
+            self.tr("Connect again to the last controller, with the same settings")
+        )
         self.quit_action.setText(self.tr("&Quit"))
         self.stop_action.setText(self.tr("&Stop"))
         self.stop_action.setToolTip(self.tr("Stop all motion (Esc)"))

@@ -8,11 +8,13 @@ the body of one job, reports through ``emit_result`` and raises typed errors tha
 
 from __future__ import annotations
 
+import logging
 import time
 from typing import TYPE_CHECKING, Protocol
 
 from app.errors import LinkError, MalformedResponse, Reason, ResponseTimeout, TeachPadError, WriteBlocked
 from app.link.jobs import JobKind
+from app.link.stop_line import stop_on_a_fresh_connection
 from app.link.types import JogRequest, Operation
 from app.link.upload import RawItem
 from app.models import CommandResult
@@ -30,6 +32,11 @@ if TYPE_CHECKING:
     from app.safety.audit import AuditLog
 
 __all__ = ["WorkerCommands"]
+
+_log = logging.getLogger(__name__)
+
+#: The main link's stop failed because the link did (not the controller's refusal).
+_LINK_FAILURES = (LinkError, ResponseTimeout, MalformedResponse)
 
 
 class _Step(Protocol):
@@ -64,7 +71,13 @@ class WorkerCommands:
 
     # --- plain and urgent commands ------------------------------------------------------
     def _do_stop(self, on_line: StopSent | None = None) -> None:  # on_line: sent on the stop line
-        client = self.client_or_raise()
+        client = self.supervisor.client
+        if client is None or not self.supervisor.link_up:
+            # disconnected by the operator, lost and reconnecting, still connecting: the last
+            # controller may be moving all the same (a program runs on without its host)
+            self._report_stop_line(on_line)
+            self._stop_on_a_fresh_connection(None)
+            return
         try:
             client.stop()  # first: nothing else goes out before the stop
         except WriteBlocked:  # monitor-only: nothing is written, each queued job is refused in turn
@@ -84,6 +97,11 @@ class WorkerCommands:
                 # and no jog is held (its speed 0 needs the main link: the Stop stays a failure)
                 self._stopped_on_the_line_only(client, exc)
                 return
+            if isinstance(exc, _LINK_FAILURES) and client.settings.serial_port is None:
+                # the main link did not carry it (silent, dropped, out of step): a new TCP
+                # connection beside it may (a serial line has one port: the link's own)
+                self._stop_on_a_fresh_connection(exc)
+                return
             self._cancel_motions_before_stop()  # nothing queued before the Stop runs after it
             self.uploader.end("stopped")
             self._end_jog_after_a_failed_stop()
@@ -93,6 +111,56 @@ class WorkerCommands:
             raise
         self._report_stop_line(on_line)
         self._after_stop(time.monotonic(), "stop: sent")
+
+    def _stop_on_a_fresh_connection(self, main_failure: TeachPadError | None) -> None:
+        """The Stop over a new connection to the last controller (app/link/stop_line.py): the
+        link is not up (``main_failure`` None) or its own stop failed (``main_failure``). Sent:
+        the Stop's result says so, naming the controller (a warning); the command in flight ends
+        as stopped. Not sent: a :class:`LinkError` (code ``stop_unreachable``) naming the
+        controller and why, and everything queued before the Stop is cancelled all the same."""
+        supervisor = self.supervisor
+        settings = supervisor.settings
+        if settings is None:  # TeachPad knows no controller: nothing to stop
+            raise LinkError("not connected to a controller", code="not_connected")
+        prior = supervisor.client  # the link that went (None after a disconnect): its unanswered writes
+        jog = self.jog
+        try:
+            sent = stop_on_a_fresh_connection(
+                settings,
+                audit=self.audit,
+                capture=self.capture,
+                ratio_zero=jog.jogging or jog.teach_dirty or jog.ratio_zero_pending,
+                again_after=prior.write_lost_until if prior is not None else 0.0,
+            )
+        except WriteBlocked:
+            raise
+        except TeachPadError as exc:
+            self._cancel_motions_before_stop()
+            self.uploader.end("stopped")
+            self._end_jog_after_a_failed_stop()
+            cause = exc.as_reason()
+            raise LinkError(
+                f"stop: could not reach the controller at {settings.endpoint} ({exc}): check the robot",
+                code="stop_unreachable",
+                params={"endpoint": settings.endpoint, "cause": cause.code, "cause_args": dict(cause.args)},
+            ) from None
+        job = self._current_job
+        if job is not None and job.sent is not None:
+            job.sent.set()
+        now = time.monotonic()
+        args: dict[str, object] = {"endpoint": settings.endpoint}
+        text = f"stop: sent to {settings.endpoint} over a fresh connection"
+        if main_failure is not None:
+            tracker = prior.last_tracker if prior is not None else None
+            if tracker is not None and not tracker.finished:
+                tracker.stopped(now)
+            cause = main_failure.as_reason()
+            args.update(cause=cause.code, cause_args=dict(cause.args))
+            text += f" (the main link's stop failed: {main_failure})"
+        _log.warning("%s (sent %.3f s ago)", text, now - sent)
+        self._after_stop(now, text, Reason("stop_sent_fresh", args), main_link_failed=True)
+        if main_failure is not None:  # it still counts against the main link
+            self.supervisor.transport_failed(main_failure)
 
     def _report_stop_line(self, on_line: StopSent | None) -> bool:
         """The stop line's answer: checked, audited, shown in the traffic. True when the
@@ -130,7 +198,8 @@ class WorkerCommands:
             job.sent.set()  # the poster (the GUI thread) may go on
         self.uploader.end("stopped")
         self._cancel_motions_before_stop()
-        if main_link_failed:  # no jog was held (the caller checked): nothing to say if this fails
+        # no jog held, or its speed 0 went on the other connection: nothing to say if this fails
+        if main_link_failed:
             self._end_jog_after_a_failed_stop()
         else:
             self.jog.on_stop()  # speed 0; a failure here is the Stop's error, as before

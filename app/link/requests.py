@@ -75,10 +75,15 @@ class WorkerRequests:
         """Write the stop now on the stop line when there is one (app/link/stop_line.py), then queue
         the stop job first in line (the main link's stop, the line's answer, the bookkeeping).
         Without a stop line, from another thread, wait (GIL released) until the worker has written
-        it, at most :data:`STOP_HANDOFF_WAIT`, so nothing of the caller's runs first."""
+        it, at most :data:`STOP_HANDOFF_WAIT`, so nothing of the caller's runs first. The job runs
+        whatever the link's state: without a link it goes over a fresh connection to the last
+        controller (:meth:`~app.link.commands.WorkerCommands._do_stop`)."""
         on_line = self.stop_line.send_stop()
         sent = threading.Event()
-        request_id = self.post(Operation.STOP, lambda: self._do_stop(on_line), JobKind.URGENT, sent=sent)
+        # needs no link: without one the job stops the last controller over a fresh connection
+        request_id = self.post(
+            Operation.STOP, lambda: self._do_stop(on_line), JobKind.URGENT, needs_link=False, sent=sent
+        )
         worker = self._worker_ident
         if on_line is None and worker is not None and worker != threading.get_ident():
             sent.wait(STOP_HANDOFF_WAIT)

@@ -32,7 +32,7 @@ from app.link.link_port import LinkPort, Pending, RequestRouter
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, PollUpdate, RobotState
 from app.link.stats import LinkStats
 from app.link.transport import ConnectionSettings
-from app.link.types import ConnectionState, JogRequest, LinkState, StepFrame, WorkerError
+from app.link.types import ConnectionState, JogRequest, LinkState, Operation, StepFrame, WorkerError
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
@@ -100,6 +100,7 @@ class RobotLink(QObject):
         self._settings: ConnectionSettings | None = None
         self._state = RobotState(self, freshness_limit=freshness_limit)
         self._router = RequestRouter()
+        self._motions: dict[int, str] = {}  # request id -> operation: motions sent, outcome not known yet
         self._shut = False
         self._capture_users = 0
         # What the worker gets when it is made (it is made by the first request: see _worker).
@@ -193,6 +194,17 @@ class RobotLink(QObject):
     def is_running(self) -> bool:
         return self._thread.isRunning()
 
+    @property
+    def motions_in_flight(self) -> tuple[str, ...]:
+        """The operations (:class:`~app.link.types.Operation` values) of the motion requests
+        (step, go to zero, run program, move to point) whose outcome has not come back yet."""
+        return tuple(self._motions.values())
+
+    def _motion(self, operation: str, request_id: int) -> int:
+        if request_id:
+            self._motions[request_id] = operation
+        return request_id
+
     def track(self, request_id: int) -> Pending:
         """The :class:`Pending` of a request id this link returned (call it right away, in the
         GUI thread: outcomes arrive through queued signals, so none can be missed)."""
@@ -233,12 +245,16 @@ class RobotLink(QObject):
 
     @Slot(CommandResult)
     def _on_result(self, result: CommandResult) -> None:
+        if result.request_id is not None:
+            self._motions.pop(result.request_id, None)
         self._state.set_last_result(result)
         self._router.on_result(result)
         self.commandFinished.emit(result)
 
     @Slot(WorkerError)
     def _on_error(self, error: WorkerError) -> None:
+        if error.request_id is not None:
+            self._motions.pop(error.request_id, None)
         self._router.on_error(error)
         self.errorOccurred.emit(error)
 
@@ -319,13 +335,15 @@ class RobotLink(QObject):
         ext_offsets: Sequence[float] = (0.0,) * registers.NUM_EXTERNAL_AXES,
         speed: float = 10.0,
     ) -> int:
-        return 0 if self._shut else self._worker.request_step(frame, offsets, ext_offsets, speed)
+        if self._shut:
+            return 0
+        return self._motion(Operation.STEP, self._worker.request_step(frame, offsets, ext_offsets, speed))
 
     def set_mode(self, mode: WorkMode) -> int:
         return 0 if self._shut else self._worker.request_set_mode(mode)
 
     def go_zero(self, axis: int | None) -> int:
-        return 0 if self._shut else self._worker.request_go_zero(axis)
+        return 0 if self._shut else self._motion(Operation.GO_ZERO, self._worker.request_go_zero(axis))
 
     def run_program(
         self,
@@ -334,7 +352,10 @@ class RobotLink(QObject):
         cycles: int = 1,
         speed_ratio: int = 100,
     ) -> int:
-        return 0 if self._shut else self._worker.request_run_program(program_id, mode, cycles, speed_ratio)
+        if self._shut:
+            return 0
+        request_id = self._worker.request_run_program(program_id, mode, cycles, speed_ratio)
+        return self._motion(Operation.RUN_PROGRAM, request_id)
 
     def create_point(
         self, point_id: int, pose: Sequence[float] | None = None, tool: int = registers.TOOL_NONE
@@ -353,9 +374,10 @@ class RobotLink(QObject):
     ) -> int:
         if self._shut:
             return 0
-        return self._worker.request_move_to_point(
+        request_id = self._worker.request_move_to_point(
             end_id, via_id, orientation_changes, ignore_middle, speed, tool
         )
+        return self._motion(Operation.MOVE_TO_POINT, request_id)
 
     def upload_points(
         self,
@@ -389,6 +411,7 @@ class RobotLink(QObject):
         if self._shut:
             return
         self._shut = True
+        self._motions.clear()
         thread = self._thread
         if not thread.isRunning():
             return

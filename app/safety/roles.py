@@ -1,8 +1,10 @@
 """Operator roles: who may do what, passwords as salted scrypt hashes, idle lock-back.
 
 Three roles, each with everything of the one before: the **operator** jogs, steps, teaches,
-runs plans and programs; the **engineer** also edits points, plans and the envelope; the
-**administrator** also changes the connection, the register profile, roles and passwords.
+runs plans and programs and reconnects to the controller of the last connection (its settings
+unchanged); the **engineer** also edits points, plans and the envelope; the **administrator**
+also changes the connection (another controller, other settings), the register profile, roles
+and passwords.
 :func:`permission_reason` answers the GUI's question "why is this control disabled?".
 
 Passwords never touch the disk: :class:`RoleStore` keeps ``hashlib.scrypt`` hashes with a
@@ -74,6 +76,7 @@ class Action(enum.Enum):
     EDIT_PLANS = "edit plans"
     EDIT_ENVELOPE = "edit envelope"
     LEAVE_REDUCED_SPEED = "leave reduced speed"
+    RECONNECT = "reconnect to the same controller"  # its last settings, unchanged
     CONNECTION = "change connection"
     REGISTER_PROFILE = "change register profile"
     MANAGE_ROLES = "manage roles and passwords"
@@ -90,6 +93,7 @@ REQUIRED_ROLE: dict[Action, Role] = {
     Action.STOP: Role.OPERATOR,
     Action.REDUCED_SPEED: Role.OPERATOR,
     Action.SUPPORT_BUNDLE: Role.OPERATOR,
+    Action.RECONNECT: Role.OPERATOR,
     Action.EDIT_POINTS: Role.ENGINEER,
     Action.EDIT_PLANS: Role.ENGINEER,
     Action.EDIT_ENVELOPE: Role.ENGINEER,

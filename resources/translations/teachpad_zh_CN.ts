@@ -976,6 +976,65 @@
         </message>
     </context>
     <context>
+        <name>LinkGuard</name>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="135" />
+            <source>Disconnect</source>
+            <translation>断开连接</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="139" />
+            <source>Disconnecting does not stop the robot, and TeachPad no longer shows what it does. Stop all motion first?</source>
+            <translation>断开连接不会停止机器人，且 TeachPad 将不再显示它的动作。要先停止所有运动吗？</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="143" />
+            <source>Stop, then disconnect</source>
+            <translation>先停止，再断开</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="144" />
+            <source>Disconnect without stopping</source>
+            <translation>不停止，直接断开</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="161" />
+            <source>Close TeachPad</source>
+            <translation>关闭 TeachPad</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="162" />
+            <source>Closing TeachPad does not stop the robot. Stop all motion first?</source>
+            <translation>关闭 TeachPad 不会停止机器人。要先停止所有运动吗？</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="163" />
+            <source>Stop, then close</source>
+            <translation>先停止，再关闭</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="164" />
+            <source>Close without stopping</source>
+            <translation>不停止，直接关闭</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="184" />
+            <source>the controller</source>
+            <translation>控制器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="186" />
+            <source>Under way on {endpoint}:
+{items}
+
+{ending}</source>
+            <translation>{endpoint} 上正在进行：
+{items}
+
+{ending}</translation>
+        </message>
+    </context>
+    <context>
         <name>MainWindow</name>
         <message>
             <location filename="../../ui/window_column.py" line="85" />
@@ -1013,7 +1072,7 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="310" />
+            <location filename="../../ui/main_window.py" line="318" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1039,33 +1098,33 @@
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="342" />
+            <location filename="../../ui/main_window.py" line="350" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="348" />
+            <location filename="../../ui/main_window.py" line="356" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="344" />
-            <location filename="../../ui/main_window.py" line="349" />
+            <location filename="../../ui/main_window.py" line="352" />
+            <location filename="../../ui/main_window.py" line="357" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="287" />
+            <location filename="../../ui/main_window.py" line="295" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="288" />
+            <location filename="../../ui/main_window.py" line="296" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="289" />
+            <location filename="../../ui/main_window.py" line="297" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1075,22 +1134,22 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="416" />
+            <location filename="../../ui/main_window.py" line="431" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="418" />
+            <location filename="../../ui/main_window.py" line="433" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="438" />
+            <location filename="../../ui/main_window.py" line="453" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="438" />
+            <location filename="../../ui/main_window.py" line="453" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -1784,14 +1843,39 @@
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="415" />
+            <location filename="../../ui/messages.py" line="420" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="418" />
+            <location filename="../../ui/messages.py" line="423" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="469" />
+            <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
+            <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="472" />
+            <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
+            <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="476" />
+            <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
+            <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="479" />
+            <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
+            <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="482" />
+            <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
+            <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
         <message>
             <location filename="../../ui/messages_plan.py" line="33" />
@@ -1839,12 +1923,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="424" />
+            <location filename="../../ui/messages.py" line="429" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="428" />
+            <location filename="../../ui/messages.py" line="433" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -5178,6 +5262,45 @@ Remove them all?</source>
         </message>
     </context>
     <context>
+        <name>UnderWay</name>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="88" />
+            <source>a program is running</source>
+            <extracomment>mm or degrees: a smaller change between two polled poses is noise, not motion s: the arm counts as moving while the last good poll came within this of its last movement (a stale pose that was still changing when the link went counts as moving)</extracomment>
+            <translation>程序正在运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="90" />
+            <source>a program is paused</source>
+            <translation>程序已暂停</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="92" />
+            <source>a jog is held</source>
+            <translation>点动按住中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="96" />
+            <source>{operation}: under way</source>
+            <translation>{operation}：正在进行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="98" />
+            <source>a plan run is under way</source>
+            <translation>规划正在运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="101" />
+            <source>the arm is moving</source>
+            <translation>机械臂正在运动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/link_guard.py" line="103" />
+            <source>the arm was moving when last seen</source>
+            <translation>最后一次看到时机械臂正在运动</translation>
+        </message>
+    </context>
+    <context>
         <name>View3DCanvas</name>
         <message>
             <location filename="../../ui/panels/view3d_canvas.py" line="239" />
@@ -5334,118 +5457,128 @@ Remove them all?</source>
     <context>
         <name>WindowActions</name>
         <message>
-            <location filename="../../ui/window_actions.py" line="176" />
+            <location filename="../../ui/window_actions.py" line="185" />
             <source>Show &amp;monitor</source>
             <translation>显示监视(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="176" />
+            <location filename="../../ui/window_actions.py" line="185" />
             <source>Show &amp;points</source>
             <translation>显示点位(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="176" />
+            <location filename="../../ui/window_actions.py" line="185" />
             <source>Show p&amp;lanner</source>
             <translation>显示轨迹规划(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="180" />
+            <location filename="../../ui/window_actions.py" line="189" />
             <source>&amp;File</source>
             <translation>文件(&amp;F)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="181" />
+            <location filename="../../ui/window_actions.py" line="190" />
             <source>&amp;Edit</source>
             <translation>编辑(&amp;E)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="182" />
+            <location filename="../../ui/window_actions.py" line="191" />
             <source>&amp;Motion</source>
             <translation>运动(&amp;M)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="183" />
+            <location filename="../../ui/window_actions.py" line="192" />
             <source>&amp;View</source>
             <translation>视图(&amp;V)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="184" />
+            <location filename="../../ui/window_actions.py" line="193" />
             <source>&amp;Language</source>
             <translation>语言(&amp;L)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="185" />
+            <location filename="../../ui/window_actions.py" line="194" />
             <source>&amp;Help</source>
             <translation>帮助(&amp;H)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="186" />
-            <location filename="../../ui/window_actions.py" line="187" />
+            <location filename="../../ui/window_actions.py" line="195" />
+            <location filename="../../ui/window_actions.py" line="196" />
             <source>Toolbar</source>
             <translation>工具栏</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="188" />
+            <location filename="../../ui/window_actions.py" line="197" />
             <source>&amp;Connect…</source>
             <translation>连接(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="189" />
+            <location filename="../../ui/window_actions.py" line="198" />
             <source>Connect to a controller (Ctrl+K)</source>
             <translation>连接控制器（Ctrl+K）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="190" />
+            <location filename="../../ui/window_actions.py" line="199" />
             <source>&amp;Disconnect</source>
             <translation>断开(&amp;D)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="191" />
+            <location filename="../../ui/window_actions.py" line="200" />
+            <source>&amp;Reconnect</source>
+            <translation>重新连接(&amp;R)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="202" />
+            <source>Connect again to the last controller, with the same settings</source>
+            <translation>以相同设置重新连接到上次的控制器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_actions.py" line="204" />
             <source>&amp;Quit</source>
             <translation>退出(&amp;Q)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="192" />
+            <location filename="../../ui/window_actions.py" line="205" />
             <source>&amp;Stop</source>
             <translation>停止(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="193" />
+            <location filename="../../ui/window_actions.py" line="206" />
             <source>Stop all motion (Esc)</source>
             <translation>停止所有运动（Esc）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="194" />
+            <location filename="../../ui/window_actions.py" line="207" />
             <source>&amp;Pause</source>
             <translation>暂停(&amp;P)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="195" />
+            <location filename="../../ui/window_actions.py" line="208" />
             <source>Pause the current move or program (F6)</source>
             <translation>暂停当前运动或程序（F6）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="196" />
+            <location filename="../../ui/window_actions.py" line="209" />
             <source>&amp;Resume</source>
             <translation>继续(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="197" />
+            <location filename="../../ui/window_actions.py" line="210" />
             <source>Resume the paused move or program (F7)</source>
             <translation>继续已暂停的运动或程序（F7）</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="198" />
+            <location filename="../../ui/window_actions.py" line="211" />
             <source>&amp;About TeachPad</source>
             <translation>关于 TeachPad(&amp;A)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="199" />
+            <location filename="../../ui/window_actions.py" line="212" />
             <source>&amp;Touch mode</source>
             <translation>触摸模式(&amp;T)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_actions.py" line="200" />
+            <location filename="../../ui/window_actions.py" line="213" />
             <source>Bigger motion buttons and an on-screen keypad for numbers</source>
             <translation>更大的运动按钮，数字输入使用屏幕小键盘</translation>
         </message>

@@ -264,6 +264,7 @@ _LINK_FAILED_BY_CODE = {
     "serial_open_failed": True,
     "no_answer": True,  # ResponseTimeout: no answer in time
     "malformed_answer": True,  # the byte stream may be out of step: only a new connection is trusted
+    "stop_unreachable": True,  # a Stop's fresh connection failed too: the controller's state is unknown
     # the controller answered (or the host refused before the wire): the link is fine
     "modbus_exception": False,
     "command_refused": False,

@@ -179,14 +179,17 @@ def window_fixture(
     project_dialogs: FakeProjectDialogs,
     tmp_path: Any,
 ) -> Any:
-    """The main window on ``link``, shown and active; confirmations answer yes, project
-    questions go to ``project_dialogs``, autosaves to ``tmp_path``."""
+    """The main window on ``link``, shown and active; confirmations answer yes (and "stop
+    first?" stop), project questions go to ``project_dialogs``, autosaves to ``tmp_path``."""
+    from ui.dialogs.stop_first import StopFirst
     from ui.main_window import MainWindow
 
     main_window = MainWindow(
         link, app_settings, translator, project_dialogs=project_dialogs, autosave_dir=tmp_path / "autosave"
     )
     main_window.confirm = lambda _title, _text: True
+    # "stop first?" (Disconnect, the close, with motion under way): stop, as the dialog's default
+    main_window.link_guard.ask = lambda _question: StopFirst.STOP
     qtbot.addWidget(main_window)
     main_window.show()
     qtbot.waitExposed(main_window)
