@@ -102,6 +102,7 @@ class RobotLink(QObject):
         self._router = RequestRouter()
         self._motions: dict[int, str] = {}  # request id -> operation: motions sent, outcome not known yet
         self._shut = False
+        self._stops = 0  # Stops asked on the GUI thread (see stops_requested)
         self._capture_users = 0
         # What the worker gets when it is made (it is made by the first request: see _worker).
         self._poll_hz = float(poll_hz)
@@ -306,7 +307,18 @@ class RobotLink(QObject):
     # Each returns the request id that its CommandResult / WorkerError will carry (0 after shutdown:
     # nothing was queued).
     def stop(self) -> int:
+        self._stops += 1
         return 0 if self._shut else self._worker.request_stop()
+
+    @property
+    def stops_requested(self) -> int:
+        """How many Stops were asked of this link so far (counted on the GUI thread, when asked).
+
+        A controller that chains a move after another request (the point guard: create the
+        points, then move) notes it when the chain begins and sends nothing more once it changed:
+        a Stop asked between the create's answer and the move's request must not be followed by
+        the move (the worker cancels only the motions queued *before* the Stop)."""
+        return self._stops
 
     def pause(self) -> int:
         return 0 if self._shut else self._worker.request_pause()

@@ -74,6 +74,10 @@ class FakeLink(QObject):
     def stop(self) -> int:
         return self._record("stop")
 
+    @property
+    def stops_requested(self) -> int:
+        return sum(1 for call in self.calls if call.name == "stop")
+
     def pause(self) -> int:
         return self._record("pause")
 

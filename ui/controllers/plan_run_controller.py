@@ -96,6 +96,7 @@ class PlanRunController(QObject):
         self._sent: list[int] = []  # segment indices sent, in order (for tests and the log)
         self._move: Pending | None = None  # the outcome of the segment under way
         self._stop: Pending | None = None  # the outcome of our last stop
+        self._stops = 0  # link.stops_requested when the run began or resumed
         if link is not None:
             self.set_link(link)
 
@@ -197,6 +198,7 @@ class PlanRunController(QObject):
             plan, loops=loops, start=start, start_loop=start_loop, single=single, progress=self._on_progress
         )
         self._plan = plan if isinstance(plan, Plan) else None
+        self._stops = link.stops_requested  # a Stop asked after this (any button): no further move
         self._outcome = None
         self.end_reason = ""
         self._sent = []
@@ -220,6 +222,7 @@ class PlanRunController(QObject):
             raise RuntimeError("there is no stopped or failed run to resume")
         link = self._require_link()
         runner.resume()
+        self._stops = link.stops_requested
         self._outcome = None
         self.end_reason = ""
         self._set_paused(False)
@@ -238,7 +241,9 @@ class PlanRunController(QObject):
             self._link.resume()
             self._set_paused(False)
             held, self._held = self._held, None
-            if held is not None:
+            if held is not None and self._stop_asked_since_start():
+                self._end_stopped()
+            elif held is not None:
                 self._send_move(self._link, held)
 
     def outcome_text(self, outcome: RunOutcome) -> str:
@@ -302,9 +307,28 @@ class PlanRunController(QObject):
             self.segmentStarted.emit(progress.index, progress.loop)
         self.progressChanged.emit(progress)
 
+    def _stop_asked_since_start(self) -> bool:
+        """A Stop was asked of the link (any button: the window's STOP too) since the run began
+        or resumed: nothing more is sent for this run."""
+        return self._link is not None and self._link.stops_requested != self._stops
+
+    def _end_stopped(self) -> None:
+        """End the run as stopped by the operator before its next move went out."""
+        runner = self._runner
+        assert runner is not None
+        if not runner.stop_requested:
+            runner.request_stop()
+            self.end_reason = stopped_by_operator()
+        self._clear_segment()
+        runner.on_stopped(self.end_reason or "stopped by the operator")
+        self._finish()
+
     def _send_next(self, link: LinkPort) -> None:
         runner = self._runner
         assert runner is not None
+        if self._stop_asked_since_start() and not runner.stop_requested:
+            runner.request_stop()  # the runner ends the run before this segment
+            self.end_reason = stopped_by_operator()
         command = runner.next_command()
         if command is None:
             self._finish()
@@ -340,10 +364,8 @@ class PlanRunController(QObject):
         guard.clear()
         command = runner.current
         assert command is not None and prepared is not None
-        if runner.stop_requested:
-            self._clear_segment()
-            runner.on_stopped(self.end_reason or "stopped by the operator")
-            self._finish()
+        if runner.stop_requested or self._stop_asked_since_start():
+            self._end_stopped()
         elif not (result.ok and prepared.all_created):
             self._fail_segment(guard.not_created(prepared))
         elif self._paused:
