@@ -11,14 +11,17 @@ never wider than the room the widget has.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QCoreApplication
-from PySide6.QtWidgets import QApplication, QLabel
+from PySide6.QtCore import QCoreApplication, QEvent, QObject
+from PySide6.QtWidgets import QApplication, QLabel, QMainWindow
 
+from app.models import Pose
 from app.protocol.codec import WordOrder, float_to_registers, registers_to_float
+from tests.ui.fake_link import FakeLink
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,
@@ -30,6 +33,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     translator_fixture,
 )
 from ui.main_window import TAB_MONITOR, MainWindow
+from ui.panels.monitor_panel import MonitorPanel
+from ui.panels.pose_strip import PoseStrip
 from ui.widgets.number_text import OVERFLOW
 from ui.widgets_common import NumericReadout
 
@@ -147,3 +152,60 @@ def test_readouts_show_a_number_whole_or_not_at_all(
     j2 = readouts["J2"]
     assert j2.shown_text() == OVERFLOW
     assert f"{garbled:.3f}" in j2._number.toolTip()
+
+
+class _LayoutRequests(QObject):
+    def __init__(self, watched: QObject) -> None:
+        super().__init__()
+        self.count = 0
+        watched.installEventFilter(self)
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() == QEvent.Type.LayoutRequest:
+            self.count += 1
+        return False
+
+
+@pytest.fixture(name="fake_link")
+def fake_link_fixture(qtbot: Any) -> Iterator[FakeLink]:
+    fake = FakeLink(connected=True)
+    yield fake
+    fake.set_connected(False)  # stops the state's freshness timer
+
+
+def test_values_that_come_and_go_past_their_room_do_not_relayout_the_window(
+    qtbot: Any, fake_link: FakeLink
+) -> None:
+    """While values stream, a value that does not fit (and its tooltip) repaints the readout only."""
+    window = QMainWindow()
+    qtbot.addWidget(window)
+    monitor = MonitorPanel()
+    window.setCentralWidget(monitor)
+    strip = PoseStrip(window)
+    window.setMenuWidget(strip)
+    state = fake_link.state
+    monitor.bind(state)
+    strip.bind(state)
+    window.resize(1280, 800)
+    window.show()
+    qtbot.waitExposed(window)
+    joints = (0.0, 20.0, 20.0, 0.0, 50.0, 0.0)
+
+    def stream(i: int, *, past: bool = True) -> None:
+        x = _float32(GARBLED) if past and i % 3 == 2 else 500.0 + i
+        y = -12345.678 if past and i % 3 == 1 else 1.0
+        state.set_pose(Pose(x, y, 300.0, 180.0, 0.0, 90.0, (FAR_EXTERNAL,) * 5, joints))
+        state.note_good_poll(time.monotonic())
+        monitor.refresh()
+        QApplication.processEvents()
+
+    for i in range(3):  # the first values, the plots built after the first paint
+        stream(i, past=False)
+        qtbot.wait(50)  # a re-layout climbs one level per turn of the event loop: let it settle
+    relayouts = _LayoutRequests(window)
+    for i in range(3, 33):
+        stream(i)
+    assert relayouts.count == 0
+    assert monitor.readouts["X"].shown_text() == OVERFLOW and strip.values["X"].text() == OVERFLOW
+    assert strip.values["Y"].toolTip() == ""  # fits again: its tooltip went with the overflow
+    assert monitor.readouts["EJ1"].shown_text() == "-1000.000"
