@@ -1,7 +1,8 @@
 """Operator roles: who may do what, passwords as salted scrypt hashes, idle lock-back.
 
 Three roles, each with everything of the one before: the **operator** jogs, steps, teaches,
-runs plans and programs; the **engineer** also edits points, plans and the envelope; the
+runs plans and programs; the **engineer** also edits points, plans and the envelope and changes
+the robot model (it feeds the reach checks that block or allow a run); the
 **administrator** also changes the connection, the register profile, roles and passwords.
 :func:`permission_reason` answers the GUI's question "why is this control disabled?".
 
@@ -73,6 +74,7 @@ class Action(enum.Enum):
     EDIT_POINTS = "edit points"
     EDIT_PLANS = "edit plans"
     EDIT_ENVELOPE = "edit envelope"
+    ROBOT_MODEL = "change robot model"  # the 3D view's robot model profile (reach checks)
     LEAVE_REDUCED_SPEED = "leave reduced speed"
     CONNECTION = "change connection"
     REGISTER_PROFILE = "change register profile"
@@ -93,6 +95,7 @@ REQUIRED_ROLE: dict[Action, Role] = {
     Action.EDIT_POINTS: Role.ENGINEER,
     Action.EDIT_PLANS: Role.ENGINEER,
     Action.EDIT_ENVELOPE: Role.ENGINEER,
+    Action.ROBOT_MODEL: Role.ENGINEER,
     Action.LEAVE_REDUCED_SPEED: Role.ENGINEER,
     Action.CONNECTION: Role.ADMINISTRATOR,
     Action.REGISTER_PROFILE: Role.ADMINISTRATOR,

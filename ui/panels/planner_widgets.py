@@ -48,7 +48,7 @@ from ui.models.plan_columns import (
 from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
-from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_OK, COLOR_WARN, COLOR_WARN_TEXT
+from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, COLOR_OK, COLOR_WARN, COLOR_WARN_TEXT
 from ui.touch import RowsScrollArea, mark_motion
 
 ModelIndex = QModelIndex | QPersistentModelIndex
@@ -268,8 +268,9 @@ class PlanRunBox(QGroupBox):
 
 
 class PlanChecksBar(QWidget):
-    """The checks under the segment table (wrapped to the room left), Upload now and Check on
-    their right: one row, the table keeps the height."""
+    """The checks under the segment table (wrapped to the room left) and, under them, the robot
+    model whose reach they checked; Upload now and Check on their right: the table keeps the
+    height."""
 
     def __init__(
         self, upload: Callable[[], None], check: Callable[[], None], parent: QWidget | None = None
@@ -278,21 +279,40 @@ class PlanChecksBar(QWidget):
         self.summary = QLabel(self)
         self.summary.setWordWrap(True)
         self.summary.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        self.model_label = LinesLabel(1, self)  # the robot model of the reach checks (elided)
+        self.model_label.setObjectName("ReachModelLabel")
+        self.model_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+        self.model_label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
+        self.model_label.hide()  # until the window gives the reach check
+        self._model = ""
         self.upload_button = QPushButton(self)
         self.upload_button.clicked.connect(upload)
         self.check_button = QPushButton(self)
         self.check_button.clicked.connect(check)
         self.summary.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         self.summary.setMinimumWidth(SUMMARY_MIN_WIDTH)
+        texts = QVBoxLayout()
+        texts.setContentsMargins(0, 0, 0, 0)
+        texts.setSpacing(0)
+        texts.addWidget(self.summary, 1)
+        texts.addWidget(self.model_label)
         layout = QHBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.addWidget(self.summary, 1)
+        layout.addLayout(texts, 1)
         layout.addWidget(self.upload_button, 0, Qt.AlignmentFlag.AlignTop)
         layout.addWidget(self.check_button, 0, Qt.AlignmentFlag.AlignTop)
 
     def retranslate(self) -> None:
         self.upload_button.setText(self.tr("Upload now"))
         self.check_button.setText(self.tr("Check"))
+        self.set_model(self._model)
+
+    def set_model(self, name: str) -> None:
+        """Name the robot model whose reach the checks use ("": none, the line is hidden)."""
+        self._model = name
+        if name:
+            self.model_label.setText(self.tr("Reach: robot model \u201c%1\u201d").replace("%1", name))
+        self.model_label.setVisible(bool(name))
 
     def show_checks(self, checks: CheckSummary | None, can_upload: bool) -> str:
         """Show the summary (None: no plan); returns the text shown."""
