@@ -174,7 +174,8 @@ def test_the_shipped_model_agrees_with_the_simulator_wherever_the_arm_is(
         qtbot.waitUntil(lambda: robot.agreement is not None, timeout=SIGNAL_TIMEOUT_MS)
         agreement = robot.agreement
         assert agreement is not None and agreement.agrees
-        assert agreement.distance_mm < MODEL_TOLERANCE_MM / 50 and agreement.angle_deg < MODEL_TOLERANCE_DEG / 50
+        assert agreement.distance_mm < MODEL_TOLERANCE_MM / 50  # float32 rounding, nothing more
+        assert agreement.angle_deg < MODEL_TOLERANCE_DEG / 50
     panel = view3d(window, qtbot)
     assert not panel.agreement_label.isVisible()
     assert "Agrees with the controller" in panel.model_label.toolTip()
