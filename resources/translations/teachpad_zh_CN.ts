@@ -2499,48 +2499,43 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="306" />
+            <location filename="../../ui/panels/planner_widgets.py" line="245" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="307" />
+            <location filename="../../ui/panels/planner_widgets.py" line="246" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="314" />
-            <source>Reach: robot model “%1”</source>
-            <translation>可达性：机器人模型“%1”</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="334" />
+            <location filename="../../ui/panels/planner_widgets.py" line="265" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="337" />
+            <location filename="../../ui/panels/planner_widgets.py" line="268" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="339" />
+            <location filename="../../ui/panels/planner_widgets.py" line="270" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="341" />
+            <location filename="../../ui/panels/planner_widgets.py" line="272" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="344" />
+            <location filename="../../ui/panels/planner_widgets.py" line="275" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -2556,7 +2551,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="378" />
+            <location filename="../../ui/panels/planner_widgets.py" line="309" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -2627,68 +2622,73 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="173" />
+            <location filename="../../ui/panels/plan_preview.py" line="185" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="174" />
+            <location filename="../../ui/panels/plan_preview.py" line="186" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="175" />
+            <location filename="../../ui/panels/plan_preview.py" line="187" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="179" />
+            <location filename="../../ui/panels/plan_preview.py" line="191" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="181" />
+            <location filename="../../ui/panels/plan_preview.py" line="194" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="277" />
+            <location filename="../../ui/panels/plan_preview.py" line="252" />
+            <source>Reach: robot model “%1”</source>
+            <translation>可达性：机器人模型“%1”</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/plan_preview.py" line="298" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="279" />
+            <location filename="../../ui/panels/plan_preview.py" line="300" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="282" />
+            <location filename="../../ui/panels/plan_preview.py" line="303" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="283" />
+            <location filename="../../ui/panels/plan_preview.py" line="304" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="287" />
+            <location filename="../../ui/panels/plan_preview.py" line="308" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="294" />
+            <location filename="../../ui/panels/plan_preview.py" line="315" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="297" />
+            <location filename="../../ui/panels/plan_preview.py" line="318" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="299" />
+            <location filename="../../ui/panels/plan_preview.py" line="320" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -2696,23 +2696,23 @@
     <context>
         <name>PlanRunBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="238" />
+            <location filename="../../ui/panels/planner_widgets.py" line="189" />
             <source>Run</source>
             <extracomment>Colour of a summary line by level (the status line uses the darker warning text).</extracomment>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="241" />
+            <location filename="../../ui/panels/planner_widgets.py" line="192" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="243" />
+            <location filename="../../ui/panels/planner_widgets.py" line="194" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="264" />
+            <location filename="../../ui/panels/planner_widgets.py" line="215" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
@@ -4676,7 +4676,7 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="447" />
+            <location filename="../../ui/panels/planner_widgets.py" line="378" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>

@@ -103,9 +103,9 @@ def test_an_engineer_loads_a_robot_model_audited_and_named(
     assert loaded.args == {"file": str(path), "name": "longer forearm"}
     assert "longer forearm" in panel.model_label.text()
     assert str(path) in panel.model_label.toolTip()
-    planner = window.planner_panel  # where the reach checks are listed
-    assert "longer forearm" in planner.checks_bar.model_label.text()
-    assert planner.checks_bar.model_label.isVisibleTo(planner)
+    planner = window.planner_panel  # where the reach checks are listed: beside the preview's Fit
+    assert "longer forearm" in planner.preview.reach_label.text()
+    assert planner.preview.reach_label.isVisibleTo(planner)
 
 
 def test_a_longer_link_model_disagrees_with_the_simulator_and_blocks_run(

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 
-from PySide6.QtCore import QAbstractItemModel, QModelIndex, QPersistentModelIndex, QRect, Qt
-from PySide6.QtGui import QAction, QResizeEvent
+from PySide6.QtCore import QAbstractItemModel, QModelIndex, QPersistentModelIndex, Qt
+from PySide6.QtGui import QAction
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QComboBox,
@@ -48,8 +48,9 @@ from ui.models.plan_columns import (
 from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
-from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, COLOR_OK, COLOR_WARN, COLOR_WARN_TEXT
+from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_OK, COLOR_WARN, COLOR_WARN_TEXT
 from ui.touch import RowsScrollArea, mark_motion
+from ui.widgets.lines_label import LinesLabel
 
 ModelIndex = QModelIndex | QPersistentModelIndex
 
@@ -139,56 +140,6 @@ class PointRefDelegate(QStyledItemDelegate):
         model.setData(index, editor.itemData(found) if found >= 0 else text, Qt.ItemDataRole.EditRole)
 
 
-class LinesLabel(QLabel):
-    """Wrapped text in at most ``lines`` lines: a longer text ends in "…" and the whole of it
-    is in the tooltip. Its height never changes, so the box around it does not move."""
-
-    def __init__(self, lines: int, parent: QWidget | None = None) -> None:
-        super().__init__(parent)
-        self._lines = lines
-        self._full = ""
-        self.setProperty("elide", True)
-        self.setWordWrap(True)
-        self.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
-        self.setFixedHeight(lines * self.fontMetrics().lineSpacing() + 2)
-
-    def text(self) -> str:
-        """The whole text, also when the label shows it cut short."""
-        return self._full
-
-    def shown_text(self) -> str:
-        return super().text()
-
-    def setText(self, text: str) -> None:
-        self._full = text
-        self.setToolTip(text)
-        self._fit()
-
-    def resizeEvent(self, event: QResizeEvent) -> None:
-        super().resizeEvent(event)
-        self._fit()
-
-    def _fit(self) -> None:
-        text = self._full
-        metrics = self.fontMetrics()
-        room = QRect(0, 0, max(1, self.width()), 10_000)
-        flags = int(Qt.TextFlag.TextWordWrap)
-
-        def fits(candidate: str) -> bool:
-            return metrics.boundingRect(room, flags, candidate).height() <= self.height()
-
-        if not fits(text):
-            low, high = 0, len(text)
-            while low < high:  # the longest prefix that fits with the ellipsis
-                middle = (low + high + 1) // 2
-                if fits(text[:middle].rstrip() + "…"):
-                    low = middle
-                else:
-                    high = middle - 1
-            text = text[:low].rstrip() + "…"
-        super().setText(text)
-
-
 class PlanRunBox(QGroupBox):
     """Run, Run from here / Step, Stop / Pause, Resume / Resume from k, and the run's progress.
 
@@ -268,9 +219,8 @@ class PlanRunBox(QGroupBox):
 
 
 class PlanChecksBar(QWidget):
-    """The checks under the segment table (wrapped to the room left) and, under them, the robot
-    model whose reach they checked; Upload now and Check on their right: the table keeps the
-    height."""
+    """The checks under the segment table (wrapped to the room left), Upload now and Check on
+    their right: one row, the table keeps the height."""
 
     def __init__(
         self, upload: Callable[[], None], check: Callable[[], None], parent: QWidget | None = None
@@ -279,40 +229,21 @@ class PlanChecksBar(QWidget):
         self.summary = QLabel(self)
         self.summary.setWordWrap(True)
         self.summary.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
-        self.model_label = LinesLabel(1, self)  # the robot model of the reach checks (elided)
-        self.model_label.setObjectName("ReachModelLabel")
-        self.model_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
-        self.model_label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
-        self.model_label.hide()  # until the window gives the reach check
-        self._model = ""
         self.upload_button = QPushButton(self)
         self.upload_button.clicked.connect(upload)
         self.check_button = QPushButton(self)
         self.check_button.clicked.connect(check)
         self.summary.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         self.summary.setMinimumWidth(SUMMARY_MIN_WIDTH)
-        texts = QVBoxLayout()
-        texts.setContentsMargins(0, 0, 0, 0)
-        texts.setSpacing(0)
-        texts.addWidget(self.summary, 1)
-        texts.addWidget(self.model_label)
         layout = QHBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
-        layout.addLayout(texts, 1)
+        layout.addWidget(self.summary, 1)
         layout.addWidget(self.upload_button, 0, Qt.AlignmentFlag.AlignTop)
         layout.addWidget(self.check_button, 0, Qt.AlignmentFlag.AlignTop)
 
     def retranslate(self) -> None:
         self.upload_button.setText(self.tr("Upload now"))
         self.check_button.setText(self.tr("Check"))
-        self.set_model(self._model)
-
-    def set_model(self, name: str) -> None:
-        """Name the robot model whose reach the checks use ("": none, the line is hidden)."""
-        self._model = name
-        if name:
-            self.model_label.setText(self.tr("Reach: robot model \u201c%1\u201d").replace("%1", name))
-        self.model_label.setVisible(bool(name))
 
     def show_checks(self, checks: CheckSummary | None, can_upload: bool) -> str:
         """Show the summary (None: no plan); returns the text shown."""

@@ -30,7 +30,7 @@ from collections.abc import Sequence
 from typing import Any, Final
 
 import numpy as np
-from PySide6.QtCore import QEvent, QItemSelection, Qt, QTimer, Signal, Slot
+from PySide6.QtCore import QEvent, QItemSelection, QTimer, Signal, Slot
 from PySide6.QtGui import QHideEvent, QShowEvent
 from PySide6.QtWidgets import (
     QFileDialog,
@@ -56,7 +56,6 @@ from app.view3d.reach import PathReach, ReachChecker
 from ui.messages import issue_text
 from ui.models.points_model import PointsModel
 from ui.palette import COLOR_CURVE_PURPLE, COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, COLOR_WARN
-from ui.panels.planner_widgets import LinesLabel
 from ui.panels.view3d_canvas import View3DCanvas
 from ui.panels.view3d_dryrun import DryRunBar
 from ui.panels.view3d_robot import RobotModelSource
@@ -65,9 +64,9 @@ from ui.panels.view3d_scene import PATH_SAMPLES as PATH_SAMPLES
 from ui.panels.view3d_scene import REACH_MAX_POINTS as REACH_MAX_POINTS
 from ui.panels.view3d_scene import SYNC_COLORS as SYNC_COLORS
 from ui.panels.view3d_scene import arc_middles, bad_path_samples, path_samples, reach_checked
+from ui.widgets.lines_label import LinesLabel
 
 LIVE_FPS: Final = 30
-MODEL_LABEL_MIN_WIDTH: Final = 80  # px: the model's name elides down to this
 TRACE_LENGTH: Final = 2000  # live TCP positions kept for the trace
 
 
@@ -125,12 +124,7 @@ class View3DPanel(QWidget):
         self.beside_button.toggled.connect(self.besideToggled)
         for w in (self.fit_button, self.ortho_button):
             bar.addWidget(w)
-        self.model_label = LinesLabel(1, self)  # the model in use: elided, whole in the tooltip
-        self.model_label.setObjectName("View3DModelLabel")
-        self.model_label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
-        self.model_label.setMinimumWidth(MODEL_LABEL_MIN_WIDTH)
-        self.model_label.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
-        bar.addWidget(self.model_label, 1)
+        bar.addStretch(1)
         self.profile_button = QToolButton(self)
         self.profile_button.setObjectName("RobotModelButton")
         self.profile_button.clicked.connect(self.choose_profile)
@@ -144,6 +138,11 @@ class View3DPanel(QWidget):
         self.robot.profileChanged.connect(self._on_profile)
         self.robot.problemRaised.connect(self._show_problem)
         self.robot.agreementChanged.connect(self._show_agreement)
+        # the model in use, on its own line under the buttons (elided, whole in the tooltip)
+        self.model_label = LinesLabel(1, self)
+        self.model_label.setObjectName("View3DModelLabel")
+        self.model_label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
+        self.model_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
         self.agreement_label = QLabel(self)  # the model disagrees with the controller: in words
         self.agreement_label.setObjectName("View3DAgreementLabel")
         self.agreement_label.setWordWrap(True)
@@ -155,6 +154,7 @@ class View3DPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(bar)
+        layout.addWidget(self.model_label)
         layout.addWidget(self.agreement_label)
         layout.addWidget(self.canvas, 1)
         layout.addWidget(self.message_label)
