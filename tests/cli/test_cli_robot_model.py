@@ -4,6 +4,7 @@ verdicts are used, as in the GUI (issue 18). Against the simulator over TCP."""
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 from typing import Any
 
@@ -33,7 +34,9 @@ def longer_model(tmp_path: Path) -> Path:
 def test_a_model_that_disagrees_with_the_controller_refuses_the_run(
     sim: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    argv = ["--port", str(sim.port), "run", str(DEMO), "--plan", "circle"]
+    demo = tmp_path / "demo.teachpad.json"  # a run that went ahead would record its uploads in it
+    shutil.copy(DEMO, demo)
+    argv = ["--port", str(sim.port), "run", str(demo), "--plan", "circle"]
     code = main([*argv, "--robot-profile", str(longer_model(tmp_path))])
     err = capsys.readouterr().err
     assert code == ExitCode.FAILED and "Traceback" not in err
