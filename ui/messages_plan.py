@@ -129,6 +129,18 @@ _ISSUES: dict[str, str] = {
     "unreachable/path": QT_TRANSLATE_NOOP("Messages", "the path is out of the robot model's reach."),
     "joint-limit/point": QT_TRANSLATE_NOOP("Messages", "{point} passes a joint limit of the robot model."),
     "joint-limit/path": QT_TRANSLATE_NOOP("Messages", "the path passes a joint limit of the robot model."),
+    "model-disagrees/position": QT_TRANSLATE_NOOP(
+        "Messages",
+        "The robot model \u201c{model}\u201d disagrees with the controller's pose by {distance} mm: reach checks may be wrong.",
+    ),
+    "model-disagrees/orientation": QT_TRANSLATE_NOOP(
+        "Messages",
+        "The robot model \u201c{model}\u201d disagrees with the controller's pose by {angle}°: reach checks may be wrong.",
+    ),
+    "model-disagrees/both": QT_TRANSLATE_NOOP(
+        "Messages",
+        "The robot model \u201c{model}\u201d disagrees with the controller's pose by {distance} mm and {angle}°: reach checks may be wrong.",
+    ),
 }
 _FROM_CURRENT_POSE = QT_TRANSLATE_NOOP("Messages", " (from the current pose)")
 _FROM_LATER_LOOPS = QT_TRANSLATE_NOOP(
@@ -158,6 +170,9 @@ def _issue_key(issue: PlanIssue) -> str:
         return f"{code}/{'past' if args.get('past_middle') else 'larger'}"
     if code in ("unreachable", "joint-limit"):
         return f"{code}/{'point' if args.get('point') else 'path'}"
+    if code == "model-disagrees":
+        position, orientation = bool(args.get("position_off")), bool(args.get("orientation_off"))
+        return f"{code}/{'both' if position and orientation else 'position' if position else 'orientation'}"
     return code
 
 

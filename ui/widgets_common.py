@@ -12,8 +12,8 @@ import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
-from PySide6.QtCore import QCoreApplication, QSize, Qt
-from PySide6.QtGui import QFont, QFontDatabase, QPainter, QPaintEvent, QPalette
+from PySide6.QtCore import QCoreApplication, QEvent, QSize, Qt
+from PySide6.QtGui import QFont, QFontDatabase, QFontMetrics, QPainter, QPaintEvent, QPalette, QResizeEvent
 from PySide6.QtWidgets import QFrame, QHBoxLayout, QLabel, QSizePolicy, QWidget
 
 from app.link.types import ConnectionState, LinkState
@@ -37,8 +37,14 @@ from ui.palette import (  # re-exported: panels import the state colours from he
     COLOR_WARN_BG,  # noqa: F401
     COLOR_WHITE,
 )
+from ui.widgets.number_text import fit_number, number_room, number_text
 
 TR = "Panels"
+READOUT_MARGINS = (6, 2, 6, 2)  # a numeric readout's left, top, right, bottom margins (px)
+READOUT_SPACING = 6  # px between its caption, number and unit
+COMPACT_MARGINS = (3, 1, 3, 1)  # the same for a compact readout (no unit: six share a row)
+COMPACT_SPACING = 4
+CAPTION_MIN_POINTS = 8.0  # its caption and unit are not smaller (unless the number is)
 
 # Lamp levels: the ``level`` dynamic property holds one of these.
 LEVEL_OFF = "off"
@@ -118,20 +124,32 @@ class _Digits(QWidget):
     """A readout's number, painted on its own opaque background with a size hint that does not
     follow the text. A new value repaints this rectangle only; a QLabel's ``setText`` re-lays
     out every parent up to the window and repaints the backgrounds under it, which at the
-    monitor's frame rate was a good part of the GUI thread's time (benchmarks/streaming.py)."""
+    monitor's frame rate was a good part of the GUI thread's time (benchmarks/streaming.py).
+
+    The number is drawn whole or not at all: when it does not fit the width the layout gave
+    (a value wider than the room kept for it, a narrow window), ``######`` is drawn and the
+    tooltip has the whole value (:func:`ui.widgets.number_text.fit_number`)."""
 
     def __init__(self, text: str, parent: QWidget) -> None:
         super().__init__(parent)
         self._text = text
+        self._shown = text  # what paintEvent draws: ``_text`` or the overflow marks
+        self.tip_prefix = ""  # the tooltip of an overflow: "<prefix><whole value><suffix>"
+        self.tip_suffix = ""
         self.setAttribute(Qt.WidgetAttribute.WA_OpaquePaintEvent)
         self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Preferred)
 
     def text(self) -> str:
         return self._text
 
+    def shown_text(self) -> str:
+        """The text drawn now: the number, or ``######`` when it does not fit."""
+        return self._shown
+
     def setText(self, text: str) -> None:  # QLabel's name: the readout's API
         if text != self._text:
             self._text = text
+            self.fit()
             self.update()
 
     def sizeHint(self) -> QSize:
@@ -140,12 +158,29 @@ class _Digits(QWidget):
     def minimumSizeHint(self) -> QSize:
         return self.sizeHint()
 
+    def fit(self) -> None:
+        """Decide what is drawn (the number or the overflow marks) and the tooltip that goes with it."""
+        self._shown = fit_number(self._text, self.fontMetrics(), self.width())
+        tip = "" if self._shown == self._text else self.tip_prefix + self._text + self.tip_suffix
+        if tip != self.toolTip():
+            self.setToolTip(tip)
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        super().resizeEvent(event)
+        self.fit()
+
+    def changeEvent(self, event: QEvent) -> None:
+        super().changeEvent(event)
+        if event.type() == QEvent.Type.FontChange:
+            self.fit()
+
     def paintEvent(self, event: QPaintEvent) -> None:
         painter = QPainter(self)
         palette = self.palette()  # the disabled (stale) colours while disabled
         painter.fillRect(event.rect(), palette.window())
         painter.setPen(palette.color(QPalette.ColorRole.WindowText))
-        painter.drawText(self.rect(), Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter, self._text)
+        right = Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter
+        painter.drawText(self.rect(), right, self._shown)
 
 
 class NumericReadout(QFrame):
@@ -153,6 +188,10 @@ class NumericReadout(QFrame):
 
     ``set_value`` only touches the number when the shown text changes, so calling it at the
     paint rate with an unchanged value costs nothing; a change repaints the number alone.
+    The number keeps room for ``integer_digits`` digits, a sign, the point and the decimals in
+    its font (the widest digit of the font in use: :func:`~ui.widgets.number_text.number_room`);
+    a value that does not fit the room it gets shows ``######``, the whole value in the tooltip
+    (``text()`` is the value's text, ``shown_text()`` what is drawn).
     """
 
     PLACEHOLDER = "—"
@@ -164,8 +203,9 @@ class NumericReadout(QFrame):
         *,
         decimals: int = 3,
         point_size: float = 22.0,
-        width_chars: int = 9,
+        integer_digits: int = 4,
         unit_room: str = "mm ",
+        compact: bool = False,
         parent: QWidget | None = None,
     ) -> None:
         super().__init__(parent)
@@ -175,8 +215,10 @@ class NumericReadout(QFrame):
         self._decimals = decimals
         self._value: float | None = None
 
-        self._width_chars = width_chars
+        self._integer_digits = integer_digits
         self._unit_room = unit_room  # the unit column is this wide, so numbers line up
+        self._margins = COMPACT_MARGINS if compact else READOUT_MARGINS
+        self._spacing = COMPACT_SPACING if compact else READOUT_SPACING
         self._point_size = 0.0
 
         self._caption = QLabel(caption, self)
@@ -184,11 +226,13 @@ class NumericReadout(QFrame):
         self._number = _Digits(self.PLACEHOLDER, self)
         self._unit = QLabel(unit, self)
         self._unit.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+        self._unit.setVisible(not compact)  # compact: the unit is in the box's title
+        self._tip()
         self.set_point_size(point_size)
 
         layout = QHBoxLayout(self)
-        layout.setContentsMargins(6, 2, 6, 2)
-        layout.setSpacing(6)
+        layout.setContentsMargins(*self._margins)
+        layout.setSpacing(self._spacing)
         layout.addWidget(self._caption)
         layout.addWidget(self._number, 1)
         layout.addWidget(self._unit)
@@ -197,30 +241,60 @@ class NumericReadout(QFrame):
     def point_size(self) -> float:
         return self._point_size
 
+    @staticmethod
+    def _caption_font(base: QFont, point_size: float) -> QFont:
+        font = QFont(base)
+        font.setPointSizeF(max(min(CAPTION_MIN_POINTS, point_size), point_size * 0.6))
+        font.setBold(True)
+        return font
+
+    @staticmethod
+    def _unit_font(base: QFont, point_size: float) -> QFont:
+        font = QFont(base)
+        font.setPointSizeF(max(min(CAPTION_MIN_POINTS, point_size), point_size * 0.55))
+        return font
+
+    def _number_room(self, font: QFont) -> int:
+        return number_room(QFontMetrics(font), self._integer_digits, self._decimals)
+
+    def width_for(self, point_size: float) -> int:
+        """The least width (px) this readout needs at ``point_size`` to show its widest number
+        whole, with its caption and unit: the panel picks the largest size that fits."""
+        caption = QFontMetrics(self._caption_font(self.font(), point_size)).horizontalAdvance(self.caption())
+        number = self._number_room(monospace_font(point_size, bold=True))
+        left, _top, right, _bottom = self._margins
+        width = caption + number + left + right + self._spacing + 2 * self.frameWidth()
+        if self._unit.isVisibleTo(self):
+            metrics = QFontMetrics(self._unit_font(self.font(), point_size))
+            unit = max(metrics.horizontalAdvance(self._unit_room), metrics.horizontalAdvance(self.unit()))
+            width += unit + self._spacing
+        return width
+
     def set_point_size(self, point_size: float) -> None:
-        """Size of the number; caption and unit follow. Keeps room for ``width_chars`` digits."""
+        """Size of the number; caption and unit follow. Keeps room for the widest expected value
+        (measured in the font in use) so the layout does not jump while the robot moves."""
         if point_size == self._point_size:
             return
         self._point_size = point_size
-        caption_font = self.font()
-        caption_font.setPointSizeF(max(9.0, point_size * 0.6))
-        caption_font.setBold(True)
-        self._caption.setFont(caption_font)
-        self._number.setFont(monospace_font(point_size, bold=True))
-        # Room for the widest expected value so the layout does not jump while the robot moves.
-        self._number.setMinimumWidth(self._number.fontMetrics().horizontalAdvance("8" * self._width_chars))
-        unit_font = self.font()
-        unit_font.setPointSizeF(max(9.0, point_size * 0.55))
+        self._caption.setFont(self._caption_font(self.font(), point_size))
+        number_font = monospace_font(point_size, bold=True)
+        self._number.setFont(number_font)
+        self._number.setMinimumWidth(self._number_room(number_font))
+        unit_font = self._unit_font(self.font(), point_size)
         self._unit.setFont(unit_font)
-        self._unit.setMinimumWidth(self._unit.fontMetrics().horizontalAdvance(self._unit_room))
+        self._unit.setMinimumWidth(QFontMetrics(unit_font).horizontalAdvance(self._unit_room))
 
     @property
     def value(self) -> float | None:
         return self._value
 
     def text(self) -> str:
-        """The number as shown (without caption and unit)."""
+        """The value's text, whole (without caption and unit)."""
         return self._number.text()
+
+    def shown_text(self) -> str:
+        """What the readout draws now: the value's text, or ``######`` when it does not fit."""
+        return self._number.shown_text()
 
     def caption(self) -> str:
         return self._caption.text()
@@ -230,15 +304,17 @@ class NumericReadout(QFrame):
 
     def set_unit(self, unit: str) -> None:
         self._unit.setText(unit)
+        self._tip()
+
+    def _tip(self) -> None:
+        self._number.tip_prefix = f"{self.caption()} = "
+        self._number.tip_suffix = f" {self.unit()}" if self.unit() else ""
+        self._number.fit()
 
     def set_value(self, value: float | None) -> None:
         self._value = value
-        if value is None or value != value:  # None or NaN
-            text = self.PLACEHOLDER
-        else:
-            text = f"{value:.{self._decimals}f}"
-            if text.startswith("-") and float(text) == 0.0:
-                text = text[1:]  # no "-0.000" flicker around zero
+        nan = value != value
+        text = self.PLACEHOLDER if value is None or nan else number_text(value, self._decimals)
         if text != self._number.text():
             self._number.setText(text)
 

@@ -3,8 +3,9 @@
 :func:`register` adds ``run`` to the main parser; the helpers are :mod:`app.cli.points`'s, the
 exit codes :class:`app.cli.exit_codes.ExitCode`. Segment numbers on the command line and in
 messages count from 1. ``run`` checks the plan first (the GUI's checks, reach by the robot model
-of ``--robot-profile`` included): errors refuse to run (USAGE; FAILED when the only errors are
-points or path samples the robot model cannot reach). A project file cannot know what the
+of ``--robot-profile`` included, and that model against the controller's joints and pose, as in
+the GUI): errors refuse to run (USAGE; FAILED when the only errors are points or path samples the
+robot model cannot reach, or a model the controller contradicts). A project file cannot know what the
 controller holds, so ``run`` creates every point its plan uses before the first move and guards
 each segment with :class:`app.points.guard.PointGuard` (restart canary, points re-created right
 before the move, arrival verified after it). ``--no-upload`` skips the uploads: the operator
@@ -40,22 +41,26 @@ from app.link.client import RobotClient
 from app.models import CommandResult, Pose
 from app.plan.checks import IssueCode, IssueKind, PlanIssue, PlanLimits, ReachCheck, check_plan
 from app.plan.estimates import estimate_plan, segment_timeouts
+from app.plan.geometry import PointLike
 from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
 from app.plan.segments import Plan
 from app.points.guard import PointGuard, PointMismatch, PointNotCreated
+from app.points.ledger import PointLedger
 from app.points.lock import live_owner
 from app.points.project import Project
 from app.protocol.enums import MoveStatus
 from app.safety.envelope import Envelope
 from app.safety.profile import load_profile
+from app.view3d.agreement import compare_model, model_issue
 from app.view3d.kinematics import ArmModel
 from app.view3d.profile import DEFAULT_PROFILE_FILE, default_profile
 from app.view3d.profile import load_profile as load_robot_profile
 from app.view3d.reach import ReachChecker
 
 #: The checks that say the robot (its model) cannot do the plan: a refusal (FAILED), where the
-#: other errors say the plan or the command line is wrong (USAGE).
-REACH_CODES = frozenset({IssueCode.UNREACHABLE, IssueCode.JOINT_LIMIT})
+#: other errors say the plan or the command line is wrong (USAGE). A model the controller
+#: contradicts (app/view3d/agreement.py) is one of them: the plan may be fine, the model is not.
+REACH_CODES = frozenset({IssueCode.UNREACHABLE, IssueCode.JOINT_LIMIT, IssueCode.MODEL_DISAGREES})
 
 
 def register(subparsers: Any) -> None:
@@ -94,7 +99,8 @@ def register(subparsers: Any) -> None:
         metavar="FILE",
         help="the robot model (.json, as the GUI's 3D view loads it) whose reach every point "
         "and the sampled path must stay in (default: the simulator's arm, "
-        f"{DEFAULT_PROFILE_FILE})",
+        f"{DEFAULT_PROFILE_FILE}); a model whose kinematics disagree with the controller's "
+        "joints and pose refuses the run",
     )
     r.add_argument(
         "--max-speed",
@@ -187,7 +193,7 @@ def cmd_run(ctx: CliContext) -> ExitCode:
     try:
         if getattr(args, "safety", None):
             envelope = load_profile(args.safety).envelope
-        reach = reach_check(getattr(args, "robot_profile", None))
+        model = robot_model(getattr(args, "robot_profile", None))
     except TeachPadError as exc:
         ctx.error(str(exc))
         return ExitCode.USAGE
@@ -199,15 +205,31 @@ def cmd_run(ctx: CliContext) -> ExitCode:
             pose = client.read_pose()
         except TeachPadError as exc:
             return _link_code(ctx, exc, "cannot read the robot's pose")
+    reach = reach_check(model, pose)
     return _run(ctx, args, project, plan, client, pose, limits, loops, start, envelope, reach)
 
 
-def reach_check(path: Path | str | None) -> ReachCheck:
-    """The planner's reach check (``check_plan(..., reach=...)``) of the robot model in ``path``
-    (the default profile when None), as the GUI's 3D view builds it. A file that cannot be used
+def robot_model(path: Path | str | None) -> ArmModel:
+    """The robot model in ``path`` (the default profile when None). A file that cannot be used
     raises :class:`~app.view3d.profile.ProfileError` (InvalidInput), naming the file."""
-    profile = default_profile() if path is None else load_robot_profile(path)
-    return ReachChecker(ArmModel(profile)).plan_issues
+    return ArmModel(default_profile() if path is None else load_robot_profile(path))
+
+
+def reach_check(model: ArmModel, pose: Pose | None = None) -> ReachCheck:
+    """The planner's reach check (``check_plan(..., reach=...)``) of ``model``, as the GUI's 3D
+    view builds it; with the controller's ``pose`` (and its joints), the model is compared with
+    it first, as in the GUI: a model that disagrees is an error of the whole plan."""
+    checker = ReachChecker(model)
+    joints = pose.joints if pose is not None else None
+    agreement = None if pose is None or joints is None else compare_model(model, joints, pose.xyzabc)
+    if agreement is None or agreement.agrees:
+        return checker.plan_issues
+    disagrees = model_issue(agreement)
+
+    def checks(plan: Plan, ledger: PointLedger, current_pose: PointLike | None) -> list[PlanIssue]:
+        return [disagrees, *checker.plan_issues(plan, ledger, current_pose)]
+
+    return checks
 
 
 class _HaltOnFreshLink:
@@ -236,6 +258,14 @@ def _refusal_code(errors: list[PlanIssue]) -> ExitCode:
     return ExitCode.FAILED if all(i.code in REACH_CODES for i in errors) else ExitCode.USAGE
 
 
+def _refusal_why(errors: list[PlanIssue], code: ExitCode) -> str:
+    if code is not ExitCode.FAILED:
+        return ""
+    if any(i.code is IssueCode.MODEL_DISAGREES for i in errors):
+        return " (the robot model disagrees with the controller)"
+    return " (out of the robot model's reach)"
+
+
 def _run(
     ctx: CliContext,
     args: argparse.Namespace,
@@ -261,8 +291,9 @@ def _run(
         for issue in errors:
             ctx.error(issue.message)
         code = _refusal_code(errors)
-        what = " (out of the robot model's reach)" if code is ExitCode.FAILED else ""
-        ctx.error(f"plan {plan.name!r} has {len(errors)} error(s){what}: not running it")
+        ctx.error(
+            f"plan {plan.name!r} has {len(errors)} error(s){_refusal_why(errors, code)}: not running it"
+        )
         return code
     est = estimate_plan(plan, ledger, pose, loops=loops)
     ctx.print(

@@ -71,6 +71,7 @@ class IssueCode(enum.Enum):
     OUTSIDE_ENVELOPE = "outside-envelope"  # an error: the segment leaves the safety envelope
     UNREACHABLE = "unreachable"  # the robot model's IK finds no solution (app.view3d.reach)
     JOINT_LIMIT = "joint-limit"  # reachable only past a joint limit of the robot model
+    MODEL_DISAGREES = "model-disagrees"  # the model's FK is not the controller's pose (view3d.agreement)
 
 
 @dataclass(frozen=True)

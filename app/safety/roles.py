@@ -2,9 +2,9 @@
 
 Three roles, each with everything of the one before: the **operator** jogs, steps, teaches,
 runs plans and programs and reconnects to the controller of the last connection (its settings
-unchanged); the **engineer** also edits points, plans and the envelope; the **administrator**
-also changes the connection (another controller, other settings), the register profile, roles
-and passwords.
+unchanged); the **engineer** also edits points, plans and the envelope and changes the robot
+model (it feeds the reach checks that block or allow a run); the **administrator** also changes
+the connection (another controller, other settings), the register profile, roles and passwords.
 :func:`permission_reason` answers the GUI's question "why is this control disabled?".
 
 Passwords never touch the disk: :class:`RoleStore` keeps ``hashlib.scrypt`` hashes with a
@@ -75,6 +75,7 @@ class Action(enum.Enum):
     EDIT_POINTS = "edit points"
     EDIT_PLANS = "edit plans"
     EDIT_ENVELOPE = "edit envelope"
+    ROBOT_MODEL = "change robot model"  # the 3D view's robot model profile (reach checks)
     LEAVE_REDUCED_SPEED = "leave reduced speed"
     RECONNECT = "reconnect to the same controller"  # its last settings, unchanged
     CONNECTION = "change connection"
@@ -97,6 +98,7 @@ REQUIRED_ROLE: dict[Action, Role] = {
     Action.EDIT_POINTS: Role.ENGINEER,
     Action.EDIT_PLANS: Role.ENGINEER,
     Action.EDIT_ENVELOPE: Role.ENGINEER,
+    Action.ROBOT_MODEL: Role.ENGINEER,
     Action.LEAVE_REDUCED_SPEED: Role.ENGINEER,
     Action.CONNECTION: Role.ADMINISTRATOR,
     Action.REGISTER_PROFILE: Role.ADMINISTRATOR,

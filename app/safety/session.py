@@ -166,6 +166,16 @@ class SafetySession:
         self.store.save()
         self.audit.record("action", "set the idle lock time", args={"seconds": float(seconds)})
 
+    # --- the robot model ---------------------------------------------------------------------
+    def require_robot_model(self, file: str) -> None:
+        """Raise :class:`PermissionRefused` (audited with the file) unless the role may change
+        the robot model (an engineer's: it feeds the reach checks that block or allow a run)."""
+        self.require(Action.ROBOT_MODEL, {"file": file} if file else None)
+
+    def robot_model_loaded(self, file: str, name: str) -> None:
+        """Audit the robot model now in use: its file and its name."""
+        self.audit.record("action", "change robot model", args={"file": file, "name": name})
+
     # --- envelope ---------------------------------------------------------------------------
     def set_envelope(self, envelope: Envelope) -> None:
         self.require(Action.EDIT_ENVELOPE)

@@ -414,6 +414,15 @@ class SimController:
         with self.lock:
             self.robot.points.pop(point_id, None)
 
+    def set_joint(self, axis: int, value: float) -> None:
+        """Put joint ``axis`` (1..11: J1..J6, then the external axes J7..J11) at ``value`` at once,
+        not checked against its limits (test setup: a far external axis, a value that reads as
+        garbage with the other word order)."""
+        with self.lock:
+            joints = self.robot.joints.copy()
+            joints[axis - 1] = value
+            self.robot.set_joints(joints)
+
     # --- fault injection ------------------------------------------------------------------
     def set_alarm(self, bit: Alarm | int, on: bool) -> None:
         with self.lock:

@@ -849,7 +849,7 @@
     <context>
         <name>Export</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="317" />
+            <location filename="../../ui/widgets_common.py" line="393" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -2033,12 +2033,27 @@
             <translation>路径会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="133" />
+            <location filename="../../ui/messages_plan.py" line="132" />
+            <source>The robot model “{model}” disagrees with the controller's pose by {distance} mm: reach checks may be wrong.</source>
+            <translation>机器人模型“{model}”与控制器的位姿相差 {distance} mm：可达性检查可能有误。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_plan.py" line="136" />
+            <source>The robot model “{model}” disagrees with the controller's pose by {angle}°: reach checks may be wrong.</source>
+            <translation>机器人模型“{model}”与控制器的位姿相差 {angle}°：可达性检查可能有误。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_plan.py" line="140" />
+            <source>The robot model “{model}” disagrees with the controller's pose by {distance} mm and {angle}°: reach checks may be wrong.</source>
+            <translation>机器人模型“{model}”与控制器的位姿相差 {distance} mm 和 {angle}°：可达性检查可能有误。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_plan.py" line="145" />
             <source> (from the current pose)</source>
             <translation>（从当前位姿出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="134" />
+            <location filename="../../ui/messages_plan.py" line="146" />
             <source> (on loops after the first, starting at the end of segment {after})</source>
             <translation>（第一轮之后的循环中，从第 {after} 段的终点出发）</translation>
         </message>
@@ -2408,42 +2423,42 @@
     <context>
         <name>Panels</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="268" />
+            <location filename="../../ui/widgets_common.py" line="344" />
             <source>connected</source>
             <translation>已连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="269" />
+            <location filename="../../ui/widgets_common.py" line="345" />
             <source>connecting</source>
             <translation>正在连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="272" />
+            <location filename="../../ui/widgets_common.py" line="348" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="271" />
+            <location filename="../../ui/widgets_common.py" line="347" />
             <source>link down</source>
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="296" />
+            <location filename="../../ui/widgets_common.py" line="372" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="287" />
+            <location filename="../../ui/widgets_common.py" line="363" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="270" />
+            <location filename="../../ui/widgets_common.py" line="346" />
             <source>not answering</source>
             <translation>无应答</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="295" />
+            <location filename="../../ui/widgets_common.py" line="371" />
             <source>done</source>
             <translation>完成</translation>
         </message>
@@ -2568,43 +2583,43 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="294" />
+            <location filename="../../ui/panels/planner_widgets.py" line="245" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="295" />
+            <location filename="../../ui/panels/planner_widgets.py" line="246" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="314" />
+            <location filename="../../ui/panels/planner_widgets.py" line="265" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="317" />
+            <location filename="../../ui/panels/planner_widgets.py" line="268" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="319" />
+            <location filename="../../ui/panels/planner_widgets.py" line="270" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="321" />
+            <location filename="../../ui/panels/planner_widgets.py" line="272" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="324" />
+            <location filename="../../ui/panels/planner_widgets.py" line="275" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -2620,7 +2635,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="358" />
+            <location filename="../../ui/panels/planner_widgets.py" line="309" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -2691,68 +2706,73 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="173" />
+            <location filename="../../ui/panels/plan_preview.py" line="185" />
             <source>Top (XY)</source>
             <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="174" />
+            <location filename="../../ui/panels/plan_preview.py" line="186" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="175" />
+            <location filename="../../ui/panels/plan_preview.py" line="187" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="179" />
+            <location filename="../../ui/panels/plan_preview.py" line="191" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="181" />
+            <location filename="../../ui/panels/plan_preview.py" line="194" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="277" />
+            <location filename="../../ui/panels/plan_preview.py" line="252" />
+            <source>Reach: robot model “%1”</source>
+            <translation>可达性：机器人模型“%1”</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/plan_preview.py" line="298" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="279" />
+            <location filename="../../ui/panels/plan_preview.py" line="300" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="282" />
+            <location filename="../../ui/panels/plan_preview.py" line="303" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="283" />
+            <location filename="../../ui/panels/plan_preview.py" line="304" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="287" />
+            <location filename="../../ui/panels/plan_preview.py" line="308" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="294" />
+            <location filename="../../ui/panels/plan_preview.py" line="315" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="297" />
+            <location filename="../../ui/panels/plan_preview.py" line="318" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="299" />
+            <location filename="../../ui/panels/plan_preview.py" line="320" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -2760,23 +2780,23 @@
     <context>
         <name>PlanRunBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="238" />
+            <location filename="../../ui/panels/planner_widgets.py" line="189" />
             <source>Run</source>
             <extracomment>Colour of a summary line by level (the status line uses the darker warning text).</extracomment>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="241" />
+            <location filename="../../ui/panels/planner_widgets.py" line="192" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="243" />
+            <location filename="../../ui/panels/planner_widgets.py" line="194" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="264" />
+            <location filename="../../ui/panels/planner_widgets.py" line="215" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
@@ -3100,7 +3120,7 @@
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="416" />
+            <location filename="../../ui/panels/planner_panel.py" line="422" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -3121,159 +3141,159 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="169" />
+            <location filename="../../ui/controllers/point_sync.py" line="170" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="180" />
+            <location filename="../../ui/controllers/point_sync.py" line="181" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="190" />
+            <location filename="../../ui/controllers/point_sync.py" line="191" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="192" />
+            <location filename="../../ui/controllers/point_sync.py" line="193" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="199" />
+            <location filename="../../ui/controllers/point_sync.py" line="200" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="225" />
+            <location filename="../../ui/controllers/point_sync.py" line="226" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="233" />
+            <location filename="../../ui/controllers/point_sync.py" line="234" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="236" />
+            <location filename="../../ui/controllers/point_sync.py" line="237" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="238" />
+            <location filename="../../ui/controllers/point_sync.py" line="239" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="246" />
+            <location filename="../../ui/controllers/point_sync.py" line="248" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="296" />
+            <location filename="../../ui/controllers/point_sync.py" line="299" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="319" />
+            <location filename="../../ui/controllers/point_sync.py" line="322" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="322" />
+            <location filename="../../ui/controllers/point_sync.py" line="325" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="353" />
+            <location filename="../../ui/controllers/point_sync.py" line="356" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="374" />
+            <location filename="../../ui/controllers/point_sync.py" line="377" />
             <source>Connected to another controller ({endpoint}): {n} points are not known to be on it. Restore all to create them there.</source>
             <translation>已连接到另一台控制器（{endpoint}）：不知道它是否保存着这 {n} 个点。点击“恢复全部”在其上创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="379" />
+            <location filename="../../ui/controllers/point_sync.py" line="382" />
             <source>The controller restarted, or it is not the one the points were uploaded to: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启，或不是上传这些点的那台控制器：其上可能已没有这 {n} 个点。点击“恢复全部”重新创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="407" />
+            <location filename="../../ui/controllers/point_sync.py" line="410" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="416" />
+            <location filename="../../ui/controllers/point_sync.py" line="419" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="427" />
+            <location filename="../../ui/controllers/point_sync.py" line="430" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="432" />
+            <location filename="../../ui/controllers/point_sync.py" line="435" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="442" />
+            <location filename="../../ui/controllers/point_sync.py" line="445" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="451" />
+            <location filename="../../ui/controllers/point_sync.py" line="454" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="456" />
+            <location filename="../../ui/controllers/point_sync.py" line="459" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="476" />
+            <location filename="../../ui/controllers/point_sync.py" line="479" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="263" />
-            <location filename="../../ui/controllers/point_sync.py" line="480" />
+            <location filename="../../ui/controllers/point_sync.py" line="266" />
+            <location filename="../../ui/controllers/point_sync.py" line="483" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="488" />
-            <location filename="../../ui/controllers/point_sync.py" line="497" />
+            <location filename="../../ui/controllers/point_sync.py" line="491" />
+            <location filename="../../ui/controllers/point_sync.py" line="500" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="543" />
+            <location filename="../../ui/controllers/point_sync.py" line="546" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="546" />
+            <location filename="../../ui/controllers/point_sync.py" line="549" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="558" />
+            <location filename="../../ui/controllers/point_sync.py" line="561" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="563" />
+            <location filename="../../ui/controllers/point_sync.py" line="566" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="570" />
+            <location filename="../../ui/controllers/point_sync.py" line="573" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -3310,14 +3330,14 @@
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/messages_plan.py" line="147" />
+            <location filename="../../ui/messages_plan.py" line="159" />
             <location filename="../../ui/models/point_columns.py" line="66" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="148" />
+            <location filename="../../ui/messages_plan.py" line="160" />
             <location filename="../../ui/models/point_columns.py" line="67" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
@@ -3679,74 +3699,74 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>PoseStrip</name>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="64" />
+            <location filename="../../ui/panels/pose_strip.py" line="69" />
             <source>live</source>
             <translation>实时</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="65" />
+            <location filename="../../ui/panels/pose_strip.py" line="70" />
             <source>stale {age} s</source>
             <translation>过期 {age} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="66" />
+            <location filename="../../ui/panels/pose_strip.py" line="71" />
             <source>stale</source>
             <translation>过期</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="67" />
-            <location filename="../../ui/panels/pose_strip.py" line="295" />
-            <location filename="../../ui/panels/pose_strip.py" line="296" />
+            <location filename="../../ui/panels/pose_strip.py" line="72" />
+            <location filename="../../ui/panels/pose_strip.py" line="306" />
+            <location filename="../../ui/panels/pose_strip.py" line="307" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="69" />
+            <location filename="../../ui/panels/pose_strip.py" line="74" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="70" />
+            <location filename="../../ui/panels/pose_strip.py" line="75" />
             <source>connecting</source>
             <translation>正在连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="71" />
+            <location filename="../../ui/panels/pose_strip.py" line="76" />
             <source>not answering</source>
             <translation>无应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="72" />
+            <location filename="../../ui/panels/pose_strip.py" line="77" />
             <source>link down</source>
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="211" />
+            <location filename="../../ui/panels/pose_strip.py" line="217" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="212" />
+            <location filename="../../ui/panels/pose_strip.py" line="218" />
             <source>Mode</source>
             <translation>模式</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="213" />
+            <location filename="../../ui/panels/pose_strip.py" line="219" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="214" />
+            <location filename="../../ui/panels/pose_strip.py" line="220" />
             <source>The controller's work mode (register 560)</source>
             <translation>控制器工作模式（寄存器 560）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="215" />
+            <location filename="../../ui/panels/pose_strip.py" line="221" />
             <source>The controller's program state (register 561)</source>
             <translation>控制器程序状态（寄存器 561）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/pose_strip.py" line="217" />
+            <location filename="../../ui/panels/pose_strip.py" line="223" />
             <source>Whether the values shown were confirmed by the controller within the freshness limit</source>
             <translation>显示的数值是否在时效内得到控制器确认</translation>
         </message>
@@ -4456,7 +4476,7 @@ Remove them all?</source>
     <context>
         <name>RobotModelSource</name>
         <message>
-            <location filename="../../ui/panels/view3d_robot.py" line="127" />
+            <location filename="../../ui/panels/view3d_robot.py" line="182" />
             <source>The robot model remembered from the last session could not be loaded: %1. The default robot model (%2) is used.</source>
             <translation>上次使用的机器人模型无法加载：%1。现使用默认机器人模型（%2）。</translation>
         </message>
@@ -4571,57 +4591,57 @@ Remove them all?</source>
             <translation>需要{need}角色（当前为{role}）；请从“安全”菜单登录</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="373" />
+            <location filename="../../ui/controllers/safety.py" line="387" />
             <source>{axis} = {value:.1f} is within stopping distance of the keep-out zone '{box}' (at {limit:.1f})</source>
             <translation>{axis} = {value:.1f}，已进入禁区“{box}”的停止距离内（边界 {limit:.1f}）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="377" />
+            <location filename="../../ui/controllers/safety.py" line="391" />
             <source>{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}</source>
             <translation>{axis} = {value:.1f}，已进入限位 {limit:.1f} 的停止距离内</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="379" />
+            <location filename="../../ui/controllers/safety.py" line="393" />
             <source>{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)</source>
             <translation>{axis} = {value:.1f} mm 超出允许的工作空间（限值 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="382" />
+            <location filename="../../ui/controllers/safety.py" line="396" />
             <source>The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, its face at {limit:.1f} mm)</source>
             <translation>路径进入禁区“{box}”（{axis} = {value:.1f} mm，边界在 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="386" />
+            <location filename="../../ui/controllers/safety.py" line="400" />
             <source>{axis} = {value:.1f}° is beyond its limit {limit:.1f}°</source>
             <translation>{axis} = {value:.1f}° 超出限位 {limit:.1f}°</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="389" />
+            <location filename="../../ui/controllers/safety.py" line="403" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode</source>
             <translation>速度 {value:g} mm/s 超过降速模式允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="391" />
+            <location filename="../../ui/controllers/safety.py" line="405" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed</source>
             <translation>速度 {value:g} mm/s 超过允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="395" />
+            <location filename="../../ui/controllers/safety.py" line="409" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode</source>
             <translation>点动速度 {value:g} % 超过降速模式允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="397" />
+            <location filename="../../ui/controllers/safety.py" line="411" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed</source>
             <translation>点动速度 {value:g} % 超过允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="402" />
+            <location filename="../../ui/controllers/safety.py" line="416" />
             <source>Segment {k}: {text}</source>
             <translation>第 {k} 段：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="407" />
+            <location filename="../../ui/controllers/safety.py" line="421" />
             <source>Jog stopped before the limit: {why}</source>
             <translation>点动已在到达边界前停止：{why}</translation>
         </message>
@@ -4629,112 +4649,112 @@ Remove them all?</source>
     <context>
         <name>SafetyMenu</name>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="109" />
+            <location filename="../../ui/controllers/safety_menu.py" line="110" />
             <source>&amp;Safety</source>
             <translation>安全(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="110" />
+            <location filename="../../ui/controllers/safety_menu.py" line="111" />
             <source>Log &amp;in…</source>
             <translation>登录(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="111" />
+            <location filename="../../ui/controllers/safety_menu.py" line="112" />
             <source>Log &amp;out (operator)</source>
             <translation>注销(&amp;O)（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="112" />
+            <location filename="../../ui/controllers/safety_menu.py" line="113" />
             <source>&amp;Reduced speed</source>
             <translation>降速模式(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="113" />
+            <location filename="../../ui/controllers/safety_menu.py" line="114" />
             <source>Safety &amp;envelope…</source>
             <translation>安全范围(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="114" />
+            <location filename="../../ui/controllers/safety_menu.py" line="115" />
             <source>Re&amp;gister profile…</source>
             <translation>寄存器配置(&amp;G)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="116" />
+            <location filename="../../ui/controllers/safety_menu.py" line="117" />
             <source>Word order, unit id, completion rule, poll timeout (administrator)</source>
             <translation>字序、站号、完成判定、轮询超时（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="118" />
+            <location filename="../../ui/controllers/safety_menu.py" line="119" />
             <source>&amp;Passwords and lock…</source>
             <translation>密码与锁定(&amp;P)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="120" />
+            <location filename="../../ui/controllers/safety_menu.py" line="121" />
             <source>Set, change or clear passwords; the idle lock time (administrator)</source>
             <translation>设置、修改或清除密码；空闲锁定时间（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="122" />
+            <location filename="../../ui/controllers/safety_menu.py" line="123" />
             <source>&amp;Audit trail…</source>
             <translation>审计记录(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="123" />
+            <location filename="../../ui/controllers/safety_menu.py" line="124" />
             <source>Write a &amp;support bundle…</source>
             <translation>生成支持包(&amp;S)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="136" />
+            <location filename="../../ui/controllers/safety_menu.py" line="137" />
             <source>Role: {role} · reduced speed</source>
             <translation>角色：{role} · 降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="136" />
+            <location filename="../../ui/controllers/safety_menu.py" line="137" />
             <source>Role: {role}</source>
             <translation>角色：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="146" />
+            <location filename="../../ui/controllers/safety_menu.py" line="147" />
             <source>Cap jog and move speeds (anyone may switch it on)</source>
             <translation>限制点动与移动速度（任何人都可开启）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="151" />
+            <location filename="../../ui/controllers/safety_menu.py" line="152" />
             <source>safety</source>
             <translation>安全</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="214" />
+            <location filename="../../ui/controllers/safety_menu.py" line="215" />
             <source>The register profile could not be saved: {why}</source>
             <translation>寄存器配置无法保存：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="219" />
+            <location filename="../../ui/controllers/safety_menu.py" line="220" />
             <source>Register profile “{name}” saved (revision {rev})</source>
             <translation>寄存器配置“{name}”已保存（第 {rev} 版）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="233" />
+            <location filename="../../ui/controllers/safety_menu.py" line="234" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="240" />
+            <location filename="../../ui/controllers/safety_menu.py" line="241" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="270" />
+            <location filename="../../ui/controllers/safety_menu.py" line="271" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="273" />
+            <location filename="../../ui/controllers/safety_menu.py" line="274" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="279" />
+            <location filename="../../ui/controllers/safety_menu.py" line="280" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
@@ -4742,7 +4762,7 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="427" />
+            <location filename="../../ui/panels/planner_widgets.py" line="378" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>
@@ -5311,13 +5331,14 @@ Remove them all?</source>
     <context>
         <name>View3DHost</name>
         <message>
-            <location filename="../../ui/panels/view3d_host.py" line="123" />
+            <location filename="../../ui/panels/view3d_host.py" line="137" />
             <source>3D</source>
             <translation>3D</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_host.py" line="124" />
-            <location filename="../../ui/panels/view3d_host.py" line="133" />
+            <location filename="../../ui/panels/view3d_host.py" line="138" />
+            <location filename="../../ui/panels/view3d_host.py" line="147" />
+            <location filename="../../ui/panels/view3d_host.py" line="159" />
             <source>3D view</source>
             <translation>3D 视图</translation>
         </message>
@@ -5325,129 +5346,161 @@ Remove them all?</source>
     <context>
         <name>View3DPanel</name>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="198" />
+            <location filename="../../ui/panels/view3d_panel.py" line="223" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="199" />
+            <location filename="../../ui/panels/view3d_panel.py" line="224" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="200" />
+            <location filename="../../ui/panels/view3d_panel.py" line="225" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="201" />
+            <location filename="../../ui/panels/view3d_panel.py" line="226" />
             <source>Iso</source>
             <translation>轴测</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="205" />
+            <location filename="../../ui/panels/view3d_panel.py" line="230" />
             <source>Look at the scene from a preset direction</source>
             <translation>从预设方向观察场景</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="206" />
+            <location filename="../../ui/panels/view3d_panel.py" line="231" />
             <source>Fit all</source>
             <translation>全部显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="207" />
+            <location filename="../../ui/panels/view3d_panel.py" line="232" />
             <source>Show the arm, the points and the plan</source>
             <translation>显示机械臂、点位和轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="208" />
+            <location filename="../../ui/panels/view3d_panel.py" line="233" />
             <source>Orthographic</source>
             <translation>正交投影</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="209" />
+            <location filename="../../ui/panels/view3d_panel.py" line="234" />
             <source>Parallel projection (no perspective)</source>
             <translation>平行投影（无透视）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="210" />
+            <location filename="../../ui/panels/view3d_panel.py" line="235" />
             <source>Robot model…</source>
             <translation>机器人模型…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="212" />
-            <source>Robot model: %1. Load another robot model profile (JSON)</source>
-            <translation>机器人模型：%1。加载其他机器人模型配置文件（JSON）</translation>
+            <location filename="../../ui/panels/view3d_panel.py" line="236" />
+            <source>Load another robot model profile (JSON; engineer)</source>
+            <translation>加载其他机器人模型配置文件（JSON；需工程师）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="216" />
+            <location filename="../../ui/panels/view3d_panel.py" line="238" />
             <source>Beside the planner</source>
             <translation>在规划器旁显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="217" />
+            <location filename="../../ui/panels/view3d_panel.py" line="239" />
             <source>Show the 3D view next to the planner, not in its own tab</source>
             <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="219" />
+            <location filename="../../ui/panels/view3d_panel.py" line="241" />
             <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
             <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="252" />
+            <location filename="../../ui/panels/view3d_panel.py" line="275" />
+            <location filename="../../ui/panels/view3d_panel.py" line="324" />
             <source>Robot model not loaded: %1</source>
             <translation>未加载机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="265" />
+            <location filename="../../ui/panels/view3d_panel.py" line="284" />
+            <location filename="../../ui/panels/view3d_panel.py" line="286" />
+            <source>Robot model: %1</source>
+            <translation>机器人模型：%1</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="287" />
+            <source>File: %1</source>
+            <translation>文件：%1</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="289" />
+            <source>Shipped with TeachPad</source>
+            <translation>TeachPad 自带</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="293" />
+            <source>Not compared with the controller (no joint angles from it)</source>
+            <translation>未与控制器比对（控制器未提供关节角）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="296" />
+            <source>Agrees with the controller's pose (within %1 mm, %2°)</source>
+            <translation>与控制器的位姿一致（误差在 %1 mm、%2° 以内）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="330" />
             <source>Load a robot model profile</source>
             <translation>加载机器人模型配置文件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="265" />
+            <location filename="../../ui/panels/view3d_panel.py" line="330" />
             <source>Robot model profiles (*.json)</source>
             <translation>机器人模型配置文件 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="358" />
+            <location filename="../../ui/panels/view3d_panel.py" line="423" />
             <source>dry run: nothing is sent</source>
             <translation>空运行：不发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="360" />
+            <location filename="../../ui/panels/view3d_panel.py" line="425" />
             <source>no pose: home position shown</source>
             <translation>无位姿：显示原点姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="362" />
+            <location filename="../../ui/panels/view3d_panel.py" line="427" />
             <source>estimate (from the pose, no joint angles)</source>
             <translation>估算（由位姿求得，无关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="364" />
+            <location filename="../../ui/panels/view3d_panel.py" line="429" />
             <source>pose out of the model's reach</source>
             <translation>位姿超出模型可达范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="366" />
+            <location filename="../../ui/panels/view3d_panel.py" line="431" />
             <source>past a joint limit</source>
             <translation>超出关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="368" />
+            <location filename="../../ui/panels/view3d_panel.py" line="433" />
             <source>stale</source>
             <translation>数据过期</translation>
         </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="436" />
+            <source>the robot model disagrees with the controller</source>
+            <translation>机器人模型与控制器不一致</translation>
+        </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="425" />
+            <location filename="../../ui/panels/view3d_panel.py" line="493" />
             <source>Out of the robot model's reach: %n point(s) (%1)</source>
             <translation>
                 <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="433" />
+            <location filename="../../ui/panels/view3d_panel.py" line="501" />
             <source>the path leaves the reach in %n segment(s) (%1)</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>

@@ -196,3 +196,18 @@ def window_fixture(
     main_window.activateWindow()
     qtbot.waitActive(main_window)
     return main_window
+
+
+TEST_PASSWORD = "cell-42"
+CHEAP_SCRYPT = 2**4  # tests only: the real cost is 2**14
+
+
+def log_in(window: Any, role: Any) -> None:
+    """Log ``window`` in as ``role`` (an :class:`app.safety.roles.Role`), its password set first."""
+    from app.safety.roles import Role
+
+    safety = window.safety_menu.safety
+    store = safety.session.store
+    store.scrypt_n = CHEAP_SCRYPT
+    store.set_password(role, TEST_PASSWORD, by=Role.ADMINISTRATOR)
+    safety.login(role, TEST_PASSWORD)

@@ -328,6 +328,7 @@ def _plan_issues() -> list[Any]:
     from app.plan.segments import Plan, Segment, SegmentKind
     from app.points.ledger import PointLedger, SyncState, make_point
     from app.safety.envelope import EnvelopeRefused
+    from app.view3d.agreement import ModelAgreement, model_issue
     from app.view3d.kinematics import Reach
     from app.view3d.reach import _issue
 
@@ -379,6 +380,10 @@ def _plan_issues() -> list[Any]:
         _issue(1, Reach.UNREACHABLE, "the path", None),
         _issue(0, Reach.JOINT_LIMIT, "P5 西", 5),
         _issue(1, Reach.JOINT_LIMIT, "the path", None),
+        # the robot model against the controller: off in position, in orientation, in both
+        model_issue(ModelAgreement("长前臂", 200.0, 0.2)),
+        model_issue(ModelAgreement("长前臂", 1.0, 3.5)),
+        model_issue(ModelAgreement("长前臂", 12.0, 2.0)),
     ]
     return issues
 
@@ -694,3 +699,13 @@ def test_segment_jog_and_unreadable_file_codes_read_in_chinese(zh: None, tmp_pat
         assert_chinese(error_text(Reason(code, args)))
     assert_chinese(os_error_text("a", PermissionError(13, "Permission denied")).replace("a：", "："))
     assert_chinese(os_error_text("a", OSError(28, "No space left on device")).replace("a：", "："))
+
+
+def test_a_robot_model_that_disagrees_reads_in_words(zh: None) -> None:
+    from app.view3d.agreement import ModelAgreement, model_issue
+    from ui.messages import issue_text
+
+    assert issue_text(model_issue(ModelAgreement("arm B", 312.4, 0.1))) == (
+        "机器人模型\u201carm B\u201d与控制器的位姿相差 312 mm：可达性检查可能有误。"
+    )
+    assert "相差 3.5°" in issue_text(model_issue(ModelAgreement("arm B", 0.5, 3.5)))

@@ -12,6 +12,7 @@ from PySide6.QtCore import QPoint, Qt
 from PySide6.QtGui import QImage, QPainter
 
 from app.plan.checks import IssueCode
+from app.safety.roles import Role
 from app.sim import kinematics as sim_kin
 from app.view3d.camera import Preset
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -19,6 +20,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     connect,
     fast_reconnect_fixture,
     link_fixture,
+    log_in,
     project_dialogs_fixture,
     translator_fixture,
     window_fixture,
@@ -183,6 +185,7 @@ def test_another_robot_model_and_a_bad_profile_file(qtbot: Any, window: MainWind
     from app.view3d.profile import default_profile, profile_to_dict
 
     panel = _panel(window, qtbot)
+    log_in(window, Role.ENGINEER)  # the robot model is an engineer's
     bad = tmp_path / "bad.json"
     bad.write_text('{"format": "teachpad-robot-profile", "version": 2}', encoding="utf-8")
     assert not panel.load_profile_file(str(bad))

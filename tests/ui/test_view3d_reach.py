@@ -10,12 +10,14 @@ from typing import Any
 import pytest
 
 from app.plan.checks import IssueCode, IssueKind
+from app.safety.roles import Role
 from app.view3d.profile import default_profile, profile_to_dict
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     app_settings_fixture,
     connect,
     fast_reconnect_fixture,
     link_fixture,
+    log_in,
     project_dialogs_fixture,
     translator_fixture,
     window_fixture,
@@ -143,6 +145,7 @@ def test_window_starts_with_the_remembered_profile_or_says_why_not(
     assert "could not be loaded" in panel.message_label.text()
 
     path = _profile_file(tmp_path, "arm B")
+    log_in(window, Role.ENGINEER)  # the robot model is an engineer's
     assert panel.load_profile_file(str(path))
     assert app_settings.robot_profile_path == str(path)
     assert window.planner_panel.checks.reach == robot.plan_issues

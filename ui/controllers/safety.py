@@ -258,6 +258,20 @@ class SafetyController(QObject):
     def set_idle_timeout(self, seconds: float) -> None:
         self.session.idle.timeout = seconds
 
+    # --- the robot model (ui.panels.view3d_robot.ModelGuard) ------------------------------------
+    def robot_model_refusal(self, path: str) -> str | None:
+        """None when the role may change the robot model; else why not (audited, said)."""
+        try:
+            self.session.require_robot_model(path)
+        except PermissionRefused:
+            why = self.reason(Action.ROBOT_MODEL) or ""
+            self.message.emit(why)
+            return why
+        return None
+
+    def robot_model_loaded(self, path: str, name: str) -> None:
+        self.session.robot_model_loaded(path, name)
+
     # --- envelope and reduced speed ------------------------------------------------------------
     @property
     def envelope(self) -> Envelope:

@@ -1,10 +1,10 @@
 """The Safety menu and the window's role gating, composed onto the main window in one call.
 
 :func:`install_safety` creates the :class:`SafetyController`, gates the window's controls by
-role (connection, register profile, passwords: administrator; point and plan edits, the envelope:
-engineer), feeds the envelope to the planner, the 3D view and the worker, and adds the menu: log
-in / out, reduced speed, envelope, register profile, passwords and lock, audit trail, support
-bundle; a status-bar label shows the role.
+role (connection, register profile, passwords: administrator; point and plan edits, the envelope,
+the robot model: engineer), feeds the envelope to the planner, the 3D view and the worker, and
+adds the menu: log in / out, reduced speed, envelope, register profile, passwords and lock, audit
+trail, support bundle; a status-bar label shows the role.
 
 The register profile in force is a file beside the settings (``AppSettings.register_profile_path``);
 ``AppSettings.connection()`` applies it, so every connection made from the remembered settings
@@ -36,6 +36,7 @@ if TYPE_CHECKING:  # the window composes this menu; only its type is needed here
     from ui.main_window import MainWindow
     from ui.panels.planner_panel import PlannerPanel
     from ui.panels.points_panel import PointsPanel
+    from ui.panels.view3d_panel import View3DPanel
 
 
 class SafetyMenu(QObject):
@@ -298,6 +299,12 @@ def gate_planner(safety: SafetyController, panel: PlannerPanel) -> None:
     safety.attach_checker(panel)
 
 
+def attach_view3d(safety: SafetyController, panel: View3DPanel) -> None:
+    """The 3D view draws the envelope; its Robot model… button is an engineer's."""
+    safety.attach_view(panel.canvas)
+    safety.gate(panel.profile_button, Action.ROBOT_MODEL)
+
+
 def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> SafetyMenu:
     """Compose the guard rails onto ``window`` (its 3D view already installed)."""
     safety = SafetyController(window.link, window.settings.store, window, scrypt_n=scrypt_n)
@@ -311,8 +318,10 @@ def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> Safety
     # it exists, before it is in its tab, with the role in force then and at every change after.
     window.points_tab.on_built(lambda panel: gate_points(safety, window, panel))
     window.planner_tab.on_built(lambda panel: gate_planner(safety, panel))
-    # the 3D view is built on first show: its canvas is attached then
-    window.view3d.on_built(lambda panel: safety.attach_view(panel.canvas))
+    # the robot model is an engineer's: its loads pass the guard (refused and audited otherwise);
+    # the 3D view is built on first show: its canvas and its Robot model… button are attached then
+    window.view3d.robot.guard = safety
+    window.view3d.on_built(lambda panel: attach_view3d(safety, panel))
     safety.message.connect(lambda text: window.event_log.add_event("warning", menu.source_name(), text))
     safety.message.connect(lambda text: window.statusBar().showMessage(text, 8000))
     if safety.problem:

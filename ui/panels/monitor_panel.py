@@ -42,7 +42,7 @@ from ui.display_clock import DISPLAY_INTERVAL_MS, DisplayClock
 from ui.models.ring_buffer import RingBuffer
 from ui.panels.monitor_figures import CARTESIAN as _CARTESIAN
 from ui.panels.monitor_figures import MAX_PLOT_POINTS, PAINT_MARGIN, PLOT_INTERVAL_MS, TRACE_MIN_SPAN_MM
-from ui.panels.monitor_readouts import BIG_POINTS_MAX, MIN_WIDTH, ReadoutBoxes, readout_scale
+from ui.panels.monitor_readouts import BIG_POINTS_MAX, MIN_WIDTH, PANEL_MARGIN, ReadoutBoxes, readout_scale
 from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
 
 __all__ = [
@@ -148,7 +148,7 @@ class MonitorPanel(QWidget):
         self._status.setStyleSheet(f"color: {COLOR_NEUTRAL};")
 
         layout = QVBoxLayout(self)
-        layout.setContentsMargins(6, 6, 6, 6)
+        layout.setContentsMargins(PANEL_MARGIN, PANEL_MARGIN, PANEL_MARGIN, PANEL_MARGIN)
         layout.setSpacing(6)
         layout.addWidget(boxes.cart_box)
         layout.addWidget(boxes.axes_box)

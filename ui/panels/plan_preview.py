@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
 from PySide6.QtGui import QResizeEvent
-from PySide6.QtWidgets import QBoxLayout, QHBoxLayout, QLabel, QToolButton, QVBoxLayout, QWidget
+from PySide6.QtWidgets import QBoxLayout, QHBoxLayout, QLabel, QSizePolicy, QToolButton, QVBoxLayout, QWidget
 
 from app.models import Pose
 from app.plan.geometry import PlanPath, plan_path
@@ -40,6 +40,7 @@ from ui.palette import COLOR_INK_SOFT
 from ui.panels.plan_projection import MAX_LABELS as MAX_LABELS
 from ui.panels.plan_projection import PLOT_MIN_HEIGHT as PLOT_MIN_HEIGHT
 from ui.panels.plan_projection import FloatArray, Projection, style_plot
+from ui.widgets.lines_label import LinesLabel
 
 LIVE_FPS = 30
 TRAIL_LENGTH = 600  # live TCP positions kept for the trail
@@ -99,10 +100,21 @@ class PlanPreview(QWidget):
         self.fit_button = QToolButton(self)
         self.fit_button.setObjectName("PlanPreviewFit")
         self.fit_button.clicked.connect(self.fit)
+        # the robot model whose reach the checks use, beside Fit (elided, whole in the tooltip)
+        self.reach_label = LinesLabel(1, self)
+        self.reach_label.setObjectName("PlanPreviewReachModel")
+        self.reach_label.setStyleSheet(f"color: {COLOR_INK_SOFT};")
+        self.reach_label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
+        self.reach_label.hide()  # until the window gives the reach check
+        self._reach_model = ""
+        fit_row = QHBoxLayout()
+        fit_row.setContentsMargins(0, 0, 0, 0)
+        fit_row.addWidget(self.fit_button)
+        fit_row.addWidget(self.reach_label, 1, Qt.AlignmentFlag.AlignVCenter)
         side = QVBoxLayout()
         side.setContentsMargins(0, 0, 0, 0)
         side.addWidget(self.info, 1)
-        side.addWidget(self.fit_button, 0, Qt.AlignmentFlag.AlignLeft)
+        side.addLayout(fit_row)
         # The lengths / times sit right of the plots, or below them on a narrow panel.
         layout = QBoxLayout(QBoxLayout.Direction.LeftToRight, self)
         layout.setContentsMargins(0, 0, 0, 0)
@@ -177,6 +189,7 @@ class PlanPreview(QWidget):
         for key, title in self._titles.items():
             title.setText(names[key])
         self.fit_button.setText(QCoreApplication.translate("PlanPreview", "Fit"))
+        self.set_reach_model(self._reach_model)
         self.fit_button.setToolTip(
             QCoreApplication.translate(
                 "PlanPreview",
@@ -231,6 +244,14 @@ class PlanPreview(QWidget):
     @property
     def selected(self) -> int | None:
         return self._selected
+
+    def set_reach_model(self, name: str) -> None:
+        """Name the robot model whose reach the plan's checks use ("": none, hidden)."""
+        self._reach_model = name
+        if name:
+            text = QCoreApplication.translate("PlanPreview", "Reach: robot model \u201c%1\u201d")
+            self.reach_label.setText(text.replace("%1", name))
+        self.reach_label.setVisible(bool(name))
 
     def set_info(self, text: str) -> None:
         self.info.setText(text)

@@ -323,10 +323,16 @@ class PlannerPanel(QWidget):
         self.preview.set_envelope(envelope)
         self.recheck()
 
-    def set_reach(self, reach: ReachCheck | None) -> None:
-        """The robot model's reach check (the 3D view's): its errors block Run like the others."""
+    def set_reach(self, reach: ReachCheck | None, model: str = "") -> None:
+        """The robot model's reach check (the 3D view's): its errors block Run like the others;
+        ``model`` names the robot model (beside the preview's Fit)."""
         self.checks.reach = reach
+        self.preview.set_reach_model(model if reach is not None else "")
         self.recheck()
+
+    def set_reach_model(self, model: str) -> None:
+        """Another robot model checks the reach now: name it."""
+        self.preview.set_reach_model(model)
 
     def recheck(self) -> None:
         """Checks, estimates and preview of the plan on display."""

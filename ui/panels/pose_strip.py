@@ -3,7 +3,9 @@
 One row above the work tabs: X Y Z (mm) A B C (°), the controller's mode and program state, and
 the link's freshness ("live", "stale 3 s", "not answering", "disconnected"). Bound to a
 :class:`~app.link.state.RobotState` only. Every part has a fixed width computed from the widest
-value or text in every shipped language, so nothing moves when a text changes.
+value (the widest digit of the font in use) or text in every shipped language, so nothing moves
+when a text changes; a value wider than its room (-12345.67, a garbled float) reads ``######``,
+the whole value in its tooltip, never a cut number.
 
 When the values are not fresh (no good poll within the state's freshness limit, or the link
 not CONNECTED) the numbers keep their last known value but turn grey and italic, the chips say
@@ -50,13 +52,16 @@ from ui.palette import (
     COLOR_WHITE,
 )
 from ui.text_fit import both_languages, fit_width
+from ui.widgets.number_text import fit_number, number_room, number_text
 from ui.widgets_common import monospace_font
 
 __all__ = ["AGE_TICK_MS", "PoseStrip"]
 
 CTX = "PoseStrip"
 AGE_TICK_MS = 1000  # the stale age counts up at this period (only while stale and shown)
-VALUE_SAMPLE = "-8888.88"  # the widest value the strip keeps room for
+VALUE_INTEGER_DIGITS = 4  # the strip keeps room for -8888.88 in the widest digit of its font
+VALUE_DECIMALS = 2
+VALUE_PADDING = 4  # px
 VALUE_POINTS = 12.0
 CHIP_PADDING = 20  # px: the chips' left + right padding and border
 CHIP_SLACK = 4  # px more than the widest text: elision measures a pixel or two wider
@@ -132,7 +137,8 @@ class PoseStrip(QFrame):
             # a fixed size: a new value repaints the label only, never re-lays out the window;
             # opaque (it fills its own background, the strip's colour while live): the strip
             # under it is not repainted with it at every new value
-            value.setFixedSize(fit_width(value, [VALUE_SAMPLE], padding=4), value.sizeHint().height())
+            room = number_room(value.fontMetrics(), VALUE_INTEGER_DIGITS, VALUE_DECIMALS)
+            value.setFixedSize(room + VALUE_PADDING, value.sizeHint().height())
             value.setAutoFillBackground(True)
             unit = QLabel(self)
             unit.setStyleSheet(f"color: {COLOR_NEUTRAL};")
@@ -282,12 +288,17 @@ class PoseStrip(QFrame):
                 label.setProperty("stale", not live)
         values = pose.xyzabc if pose is not None else (math.nan,) * len(CARTESIAN_AXIS_NAMES)
         for name, value in zip(CARTESIAN_AXIS_NAMES, values, strict=True):
-            label = self.values[name]
-            text = f"{value:.2f}" if math.isfinite(value) else "—"
-            if text.startswith("-") and text.strip("-0.") == "":
-                text = text[1:]  # no "-0.00" flicker
-            if label.text() != text:
-                label.setText(text)
+            self._show_value(name, number_text(value, VALUE_DECIMALS) if math.isfinite(value) else "—")
+
+    def _show_value(self, name: str, text: str) -> None:
+        """``text`` whole, or ``######`` with the whole value in the tooltip: never a cut number."""
+        label = self.values[name]
+        shown = fit_number(text, label.fontMetrics(), label.contentsRect().width())
+        if label.text() != shown:
+            label.setText(shown)
+        tip = "" if shown == text else f"{name} = {text} {self.units[name].text()}"
+        if label.toolTip() != tip:
+            label.setToolTip(tip)
 
     def _show_status(self) -> None:
         status = self._state.status if self._state is not None else None

@@ -5,11 +5,13 @@ planner when the panel's "Beside the planner" button is on (the planner tab come
 model (:class:`~ui.panels.view3d_robot.RobotModelSource`: the profile remembered in the settings,
 or the default one, saying in the event log why a remembered one could not be loaded) and gives
 its reach check to the planner, whose checks list then shows what the 3D view marks red and
-follows a change of profile. The panel is built the first time
-it is needed (its tab comes to the front, or someone asks for :attr:`View3DHost.panel`): until
-then the tab holds an empty placeholder, so the window's first paint does not wait for the 3D
-view's module (and the pyqtgraph it imports). Once built it is connected to the robot's state,
-the points table, the planner and the run controller, and its tab title is kept translated.
+follows a change of profile and the model's agreement with the controller (compared live from
+the robot's state; a model that starts to disagree is also a warning in the event log). The
+panel is built the first time it is needed (its tab comes to the front, or someone asks for
+:attr:`View3DHost.panel`): until then the tab holds an empty placeholder, so the window's first
+paint does not wait for the 3D view's module (and the pyqtgraph it imports). Once built it is
+connected to the robot's state, the points table, the planner and the run controller, and its
+tab title is kept translated.
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ from PySide6.QtWidgets import QDockWidget, QWidget
 from ui.panels.view3d_robot import RobotModelSource
 
 if TYPE_CHECKING:
+    from app.view3d.agreement import ModelAgreement
+    from app.view3d.profile import RobotProfile
     from ui.panels.view3d_panel import View3DPanel
 
 
@@ -35,6 +39,10 @@ class View3DHost(QObject):
         self.robot = RobotModelSource(getattr(window, "settings", None), self)
         self.robot.problemRaised.connect(self._on_profile_problem)
         self.robot.restore()
+        self.robot.bind(window.link.state)
+        self.robot.agreementChanged.connect(self._on_agreement)
+        self._disagreeing = False
+        self._planner: Any = None  # the planner, once built (its checks follow the agreement)
         # the planner is built on first show (ui/window_tabs.py): it gets the reach check then
         window.planner_tab.on_built(self._attach_planner_reach)
         self._panel: View3DPanel | None = None
@@ -54,8 +62,14 @@ class View3DHost(QObject):
         self.retranslate()
 
     def _attach_planner_reach(self, planner: Any) -> None:
-        planner.set_reach(self.robot.plan_issues)
-        self.robot.profileChanged.connect(lambda _p: planner.recheck())
+        planner.set_reach(self.robot.plan_issues, self.robot.profile.name)
+
+        def follow(profile: RobotProfile) -> None:
+            planner.set_reach_model(profile.name)
+            planner.recheck()
+
+        self.robot.profileChanged.connect(follow)
+        self._planner = planner
 
     @property
     def panel(self) -> View3DPanel:
@@ -131,6 +145,21 @@ class View3DHost(QObject):
     @Slot(str)
     def _on_profile_problem(self, text: str) -> None:
         self.window.event_log.add_event("warning", self.tr("3D view"), text)
+
+    @Slot(object)
+    def _on_agreement(self, agreement: ModelAgreement | None) -> None:
+        """A model that starts to disagree with the controller: a warning in the event log (once
+        per disagreement, not at every drift of its size) and the planner's checks again (only
+        a disagreement is a check: a model found to agree changes none)."""
+        disagreeing = agreement is not None and not agreement.agrees
+        if disagreeing and not self._disagreeing and agreement is not None:
+            from app.view3d.agreement import model_issue
+            from ui.messages import issue_text
+
+            self.window.event_log.add_event("warning", self.tr("3D view"), issue_text(model_issue(agreement)))
+        if (disagreeing or self._disagreeing) and self._planner is not None:
+            self._planner.recheck()
+        self._disagreeing = disagreeing
 
     @Slot(bool)
     def set_beside(self, beside: bool) -> None:

@@ -12,6 +12,12 @@ profile cannot reach (or only past a joint limit) are red. The dry run bar plays
 the drawn arm without sending anything. What the scene shows of the points and the plan (colours,
 sampling, red samples) is worked out without widgets in :mod:`ui.panels.view3d_scene`.
 
+The header names the robot model in use (its file and whether it agrees with the controller in
+the tooltip); a model whose forward kinematics disagree with the controller's pose is said in
+words under it and as a badge (:mod:`app.view3d.agreement`). *Robot model…* is an engineer's:
+disabled with the role it needs for the others (the window's safety gate), and refused in words
+if reached another way (:class:`~ui.panels.view3d_robot.ModelGuard`).
+
 Live values arrive at the poll rate; the arm is redrawn at most :data:`LIVE_FPS` times a second
 from the latest one. The panel is connected to the window's parts with :meth:`bind`,
 :meth:`attach_points`, :meth:`attach_planner` and :meth:`attach_runner`.
@@ -19,6 +25,7 @@ from the latest one. The panel is connected to the window's parts with :meth:`bi
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from typing import Any, Final
 
@@ -29,6 +36,7 @@ from PySide6.QtWidgets import (
     QFileDialog,
     QHBoxLayout,
     QLabel,
+    QSizePolicy,
     QToolButton,
     QVBoxLayout,
     QWidget,
@@ -39,11 +47,13 @@ from app.models import Pose
 from app.plan.geometry import plan_path
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger
+from app.view3d.agreement import MODEL_TOLERANCE_DEG, MODEL_TOLERANCE_MM, ModelAgreement
 from app.view3d.camera import Preset
 from app.view3d.kinematics import ArmTracker, Reach
 from app.view3d.path import DryRun, DryRunState, start_of
 from app.view3d.profile import RobotProfile
 from app.view3d.reach import PathReach, ReachChecker
+from ui.messages import issue_text
 from ui.models.points_model import PointsModel
 from ui.palette import COLOR_CURVE_PURPLE, COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, COLOR_WARN
 from ui.panels.view3d_canvas import View3DCanvas
@@ -54,6 +64,7 @@ from ui.panels.view3d_scene import PATH_SAMPLES as PATH_SAMPLES
 from ui.panels.view3d_scene import REACH_MAX_POINTS as REACH_MAX_POINTS
 from ui.panels.view3d_scene import SYNC_COLORS as SYNC_COLORS
 from ui.panels.view3d_scene import arc_middles, bad_path_samples, path_samples, reach_checked
+from ui.widgets.lines_label import LinesLabel
 
 LIVE_FPS: Final = 30
 TRACE_LENGTH: Final = 2000  # live TCP positions kept for the trace
@@ -115,6 +126,7 @@ class View3DPanel(QWidget):
             bar.addWidget(w)
         bar.addStretch(1)
         self.profile_button = QToolButton(self)
+        self.profile_button.setObjectName("RobotModelButton")
         self.profile_button.clicked.connect(self.choose_profile)
         bar.addWidget(self.profile_button)
         bar.addWidget(self.beside_button)
@@ -125,12 +137,25 @@ class View3DPanel(QWidget):
         self.message_label.setText(self.robot.problem)
         self.robot.profileChanged.connect(self._on_profile)
         self.robot.problemRaised.connect(self._show_problem)
+        self.robot.agreementChanged.connect(self._show_agreement)
+        # the model in use, on its own line under the buttons (elided, whole in the tooltip)
+        self.model_label = LinesLabel(1, self)
+        self.model_label.setObjectName("View3DModelLabel")
+        self.model_label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
+        self.model_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+        self.agreement_label = QLabel(self)  # the model disagrees with the controller: in words
+        self.agreement_label.setObjectName("View3DAgreementLabel")
+        self.agreement_label.setWordWrap(True)
+        self.agreement_label.setStyleSheet(f"color: {COLOR_ERROR}; font-weight: bold;")
+        self.agreement_label.hide()
         self.reach_label = QLabel(self)
         self.reach_label.setWordWrap(True)
         self.reach_label.setStyleSheet(f"color: {COLOR_ERROR};")
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(bar)
+        layout.addWidget(self.model_label)
+        layout.addWidget(self.agreement_label)
         layout.addWidget(self.canvas, 1)
         layout.addWidget(self.message_label)
         layout.addWidget(self.reach_label)
@@ -208,11 +233,8 @@ class View3DPanel(QWidget):
         self.ortho_button.setText(self.tr("Orthographic"))
         self.ortho_button.setToolTip(self.tr("Parallel projection (no perspective)"))
         self.profile_button.setText(self.tr("Robot model…"))
-        self.profile_button.setToolTip(
-            self.tr("Robot model: %1. Load another robot model profile (JSON)").replace(
-                "%1", self.model.profile.name
-            )
-        )
+        self.profile_button.setToolTip(self.tr("Load another robot model profile (JSON; engineer)"))
+        self._show_agreement(self.robot.agreement)
         self.beside_button.setText(self.tr("Beside the planner"))
         self.beside_button.setToolTip(self.tr("Show the 3D view next to the planner, not in its own tab"))
         self.canvas.setToolTip(
@@ -246,13 +268,49 @@ class View3DPanel(QWidget):
         self._update_arm()
 
     def load_profile_file(self, path: str) -> bool:
-        """Load a profile file; a bad one is refused with the loader's message (kept model)."""
+        """Load a profile file (an engineer's); a bad one, or a role that may not, is refused in
+        words (the model in use stays)."""
         error = self.robot.load_file(path)
         if error is not None:
             self._show_problem(self.tr("Robot model not loaded: %1").replace("%1", error))
             return False
         self.message_label.hide()
         return True
+
+    def _show_model(self) -> None:
+        """The model's name in the header; its file and its agreement with the controller in
+        the tooltip."""
+        name = self.robot.profile.name
+        self.model_label.setText(self.tr("Robot model: %1").replace("%1", name))
+        lines = [
+            self.tr("Robot model: %1").replace("%1", name),
+            self.tr("File: %1").replace("%1", self.robot.path)
+            if self.robot.path
+            else self.tr("Shipped with TeachPad"),
+        ]
+        agreement = self.robot.agreement
+        if agreement is None:
+            lines.append(self.tr("Not compared with the controller (no joint angles from it)"))
+        elif agreement.agrees:
+            lines.append(
+                self.tr("Agrees with the controller's pose (within %1 mm, %2°)")
+                .replace("%1", f"{MODEL_TOLERANCE_MM:g}")
+                .replace("%2", f"{MODEL_TOLERANCE_DEG:g}")
+            )
+        else:
+            lines.append(self.agreement_label.text())
+        self.model_label.setToolTip("\n".join(lines))
+
+    @Slot(object)
+    def _show_agreement(self, agreement: ModelAgreement | None) -> None:
+        off = agreement is not None and not agreement.agrees
+        if agreement is not None and off:
+            from app.view3d.agreement import model_issue
+
+            self.agreement_label.setText(issue_text(model_issue(agreement)))
+        self.agreement_label.setVisible(off)
+        self._show_model()
+        self._update_badges()
 
     @Slot(str)
     def _show_problem(self, text: str) -> None:
@@ -261,8 +319,15 @@ class View3DPanel(QWidget):
 
     @Slot()
     def choose_profile(self) -> None:
+        refused = self.robot.refusal()  # before the file dialog: an operator gets no dialog
+        if refused is not None:
+            self._show_problem(self.tr("Robot model not loaded: %1").replace("%1", refused))
+            return
+        from importlib import resources
+
+        folder = os.path.dirname(self.robot.path) or str(resources.files("app.view3d").joinpath("profiles"))
         path, _filter = QFileDialog.getOpenFileName(
-            self, self.tr("Load a robot model profile"), "", self.tr("Robot model profiles (*.json)")
+            self, self.tr("Load a robot model profile"), folder, self.tr("Robot model profiles (*.json)")
         )
         if path:
             self.load_profile_file(path)
@@ -366,6 +431,9 @@ class View3DPanel(QWidget):
             badges.append((self.tr("past a joint limit"), COLOR_ERROR))
         if self._state is not None and not self._fresh:
             badges.append((self.tr("stale"), COLOR_WARN))
+        agreement = self.robot.agreement
+        if agreement is not None and not agreement.agrees:
+            badges.append((self.tr("the robot model disagrees with the controller"), COLOR_ERROR))
         self.canvas.set_badges(badges)
 
     # --- scene ---------------------------------------------------------------------------

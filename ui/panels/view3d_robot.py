@@ -11,15 +11,30 @@ The path of a loaded profile is remembered in the settings
 (:attr:`ui.settings.AppSettings.robot_profile_path`); :meth:`restore` loads it at start-up and,
 when the file is gone or malformed, says so (:attr:`problem`, ``problemRaised``), forgets it
 and keeps the default profile.
+
+Changing the model is an engineer's (it feeds the reach checks that block or allow a run): the
+window gives the source a :class:`ModelGuard` (the safety controller), which refuses the
+operator (audited, with the file) and audits every model loaded with its file and name
+(:meth:`load_file`; the start-up :meth:`restore` of the model an engineer chose is not a change).
+
+Once bound to the robot's state (:meth:`bind`), the source compares the model with the
+controller at most every :data:`AGREEMENT_CHECK_MS`: the model's forward kinematics of the
+joints the controller reports against the pose it reports (:mod:`app.view3d.agreement`).
+:attr:`agreement` is the last verdict (None: not compared -- no link, or no joint angles);
+``agreementChanged`` says when it changed enough to be said again. A model that disagrees adds
+an error to the plan's reach checks (:meth:`plan_issues`), which blocks Run.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Final
+from typing import TYPE_CHECKING, Final, Protocol
 
-from PySide6.QtCore import QObject, Signal
+from PySide6.QtCore import QObject, QTimer, Signal, Slot
 
+from app.link.state import RobotState
+from app.link.types import ConnectionState, LinkState
+from app.models import Pose
 from ui.settings import AppSettings
 
 if TYPE_CHECKING:  # the arm model and its reach checks: imported by the first reach question; the
@@ -28,22 +43,47 @@ if TYPE_CHECKING:  # the arm model and its reach checks: imported by the first r
     from app.plan.geometry import PointLike
     from app.plan.segments import Plan
     from app.points.ledger import PointLedger
+    from app.view3d.agreement import ModelAgreement
     from app.view3d.kinematics import ArmModel
     from app.view3d.profile import RobotProfile
     from app.view3d.reach import ReachChecker
 
 CHECKERS_KEPT: Final = 4  # profiles whose reach caches are kept (switching back is free)
+AGREEMENT_CHECK_MS: Final = 250  # the model is compared with the controller's pose at most this often
+
+
+class ModelGuard(Protocol):
+    """Who may change the robot model (the safety controller)."""
+
+    def robot_model_refusal(self, path: str) -> str | None:
+        """None when the role in force may load the model ``path`` ("": not chosen yet); else
+        why not, in words (the refusal is audited)."""
+        ...
+
+    def robot_model_loaded(self, path: str, name: str) -> None:
+        """Audit the model now in use."""
+        ...
 
 
 class RobotModelSource(QObject):
     """The active robot model. Signals: ``profileChanged(object)`` (the new
-    :class:`RobotProfile`), ``problemRaised(str)`` (a profile file could not be used)."""
+    :class:`RobotProfile`), ``problemRaised(str)`` (a profile file could not be used),
+    ``agreementChanged(object)`` (the new :class:`~app.view3d.agreement.ModelAgreement`, or
+    None: not compared)."""
 
     profileChanged = Signal(object)
     problemRaised = Signal(str)
+    agreementChanged = Signal(object)
 
     def __init__(self, settings: AppSettings | None = None, parent: QObject | None = None) -> None:
         super().__init__(parent)
+        self.guard: ModelGuard | None = None  # None: anyone (a source without a window)
+        self.agreement: ModelAgreement | None = None
+        self._state: RobotState | None = None
+        self._compare_timer = QTimer(self)
+        self._compare_timer.setSingleShot(True)
+        self._compare_timer.setInterval(AGREEMENT_CHECK_MS)
+        self._compare_timer.timeout.connect(self.compare)
         self._settings = settings
         self._default: RobotProfile | None = None  # the shipped profile, read by its first use
         self._checkers: dict[RobotProfile, ReachChecker] = {}
@@ -96,13 +136,28 @@ class RobotModelSource(QObject):
         if self._settings is not None:
             self._settings.robot_profile_path = path
         self.profileChanged.emit(profile)
+        if self._state is not None:
+            self.compare()  # the new model against the controller, now
 
     def use_default(self) -> None:
         self.set_profile(self.default)
 
+    def refusal(self, path: str = "") -> str | None:
+        """Why the role in force may not change the model (None: it may); audited."""
+        return self.guard.robot_model_refusal(path) if self.guard is not None else None
+
     def load_file(self, path: str) -> str | None:
-        """Load a profile file and use it; the loader's message when it cannot be used (the
-        current profile stays)."""
+        """Load a profile file and use it (an engineer's: see :class:`ModelGuard`); why not, in
+        words, when it cannot be used or the role may not (the current profile stays)."""
+        refused = self.refusal(path)
+        if refused is not None:
+            return refused
+        error = self._load(path)
+        if error is None and self.guard is not None:
+            self.guard.robot_model_loaded(path, self.profile.name)
+        return error
+
+    def _load(self, path: str) -> str | None:
         from app.view3d.profile import ProfileError, load_profile
 
         try:
@@ -119,7 +174,7 @@ class RobotModelSource(QObject):
         path = self._settings.robot_profile_path if self._settings is not None else ""
         if not path:
             return True
-        error = self.load_file(path)
+        error = self._load(path)  # the model an engineer chose: no change, nothing to allow
         if error is None:
             return True
         self.problem = (
@@ -137,5 +192,49 @@ class RobotModelSource(QObject):
     def plan_issues(
         self, plan: Plan, ledger: PointLedger, current_pose: PointLike | None
     ) -> Sequence[PlanIssue]:
-        """The current profile's reach issues of a plan (``check_plan(..., reach=...)``)."""
-        return self.reach.plan_issues(plan, ledger, current_pose)
+        """The current profile's reach issues of a plan (``check_plan(..., reach=...)``), after
+        the model's disagreement with the controller when it disagrees (an error: blocks Run)."""
+        issues = self.reach.plan_issues(plan, ledger, current_pose)
+        agreement = self.agreement
+        if agreement is None or agreement.agrees:
+            return issues
+        from app.view3d.agreement import model_issue
+
+        return [model_issue(agreement), *issues]
+
+    # --- the model against the controller ------------------------------------------------
+    def bind(self, state: RobotState) -> None:
+        """Compare the model with the controller's joints and pose from now on."""
+        self._state = state
+        state.poseChanged.connect(self._on_pose)
+        state.connectionChanged.connect(self._on_connection)
+
+    @Slot(Pose)
+    def _on_pose(self, _pose: Pose) -> None:
+        if not self._compare_timer.isActive():
+            self._compare_timer.start()
+
+    @Slot(ConnectionState)
+    def _on_connection(self, connection: ConnectionState) -> None:
+        if connection.state is not LinkState.CONNECTED:
+            self._compare_timer.stop()
+            self._set_agreement(None)  # another controller may come: compare it afresh
+
+    @Slot()
+    def compare(self) -> None:
+        """Compare the model with the controller's latest joints and pose now."""
+        state = self._state
+        pose = state.pose if state is not None else None
+        connected = state is not None and state.connection.state is LinkState.CONNECTED
+        if pose is None or pose.joints is None or not connected:
+            self._set_agreement(None)
+            return
+        from app.view3d.agreement import compare_model
+
+        self._set_agreement(compare_model(self.model, pose.joints, pose.xyzabc))
+
+    def _set_agreement(self, agreement: ModelAgreement | None) -> None:
+        previous, self.agreement = self.agreement, agreement
+        news = previous is not None if agreement is None else agreement.differs_from(previous)
+        if news:
+            self.agreementChanged.emit(agreement)

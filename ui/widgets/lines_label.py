@@ -1,0 +1,60 @@
+"""A label of at most a few lines whose height never changes: a longer text ends in "…", the
+whole of it in the tooltip (``elide=True`` for the layout check)."""
+
+from __future__ import annotations
+
+from PySide6.QtCore import QRect, Qt
+from PySide6.QtGui import QResizeEvent
+from PySide6.QtWidgets import QLabel, QWidget
+
+__all__ = ["LinesLabel"]
+
+
+class LinesLabel(QLabel):
+    """Wrapped text in at most ``lines`` lines: a longer text ends in "…" and the whole of it
+    is in the tooltip. Its height never changes, so the box around it does not move."""
+
+    def __init__(self, lines: int, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self._lines = lines
+        self._full = ""
+        self.setProperty("elide", True)
+        self.setWordWrap(True)
+        self.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
+        self.setFixedHeight(lines * self.fontMetrics().lineSpacing() + 2)
+
+    def text(self) -> str:
+        """The whole text, also when the label shows it cut short."""
+        return self._full
+
+    def shown_text(self) -> str:
+        return super().text()
+
+    def setText(self, text: str) -> None:
+        self._full = text
+        self.setToolTip(text)
+        self._fit()
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        super().resizeEvent(event)
+        self._fit()
+
+    def _fit(self) -> None:
+        text = self._full
+        metrics = self.fontMetrics()
+        room = QRect(0, 0, max(1, self.width()), 10_000)
+        flags = int(Qt.TextFlag.TextWordWrap)
+
+        def fits(candidate: str) -> bool:
+            return metrics.boundingRect(room, flags, candidate).height() <= self.height()
+
+        if not fits(text):
+            low, high = 0, len(text)
+            while low < high:  # the longest prefix that fits with the ellipsis
+                middle = (low + high + 1) // 2
+                if fits(text[:middle].rstrip() + "…"):
+                    low = middle
+                else:
+                    high = middle - 1
+            text = text[:low].rstrip() + "…"
+        super().setText(text)
