@@ -5,8 +5,10 @@ from __future__ import annotations
 import pytest
 
 from app import timing
-from app.link.motion import MotionTracker, MotionWatch
+from app.errors import Reason
+from app.link.motion import MotionTracker
 from app.link.types import Operation
+from app.link.watch import MotionWatch
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import Alarm, ControllerMode, ProgramState, RunCommand
 
@@ -48,6 +50,11 @@ class _Done:
 
     def stopped(self, now: float) -> CommandResult:
         return CommandResult(None, None, None, False, "stopped")
+
+    def unknown(
+        self, now: float, cause: object = None, *, message: str | None = None, reason: Reason | None = None
+    ) -> CommandResult:
+        return CommandResult(None, None, None, False, message or "unknown", reason=reason)
 
 
 def test_tracker_hands_out_the_result_once_with_its_request_id() -> None:
