@@ -349,10 +349,11 @@ class CommandTracker:
 
     # -- internals -----------------------------------------------------------------------
     def _alarm(self, status: ControllerStatus, code: int, now: float) -> CommandResult:
-        """An alarm ends the wait. When GV291 already shows this command's refusal, the controller's
-        own code says why (e.g. 2, emergency stop, for a step sent during one)."""
+        """An alarm ends the wait. For a command sent during the alarm, GV291's refusal is the
+        controller's own word for it (e.g. 2, emergency stop, for a step sent during one); an
+        alarm raised after the command ended it (alarm while waiting)."""
         decoded = self.decode(code)
-        if code != self.pre_code and decoded.is_error:
+        if self.before.alarms and code != self.pre_code and decoded.is_error:
             err: TeachPadError = CommandRefused(
                 decoded, f"{self.text} refused: {decoded.text} (status {code})", params=self._args()
             )
