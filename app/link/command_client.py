@@ -214,7 +214,8 @@ class CommandClient(RegisterClient):
 
         Once the command was answered, a status read that fails does not fail the command: reads
         are retried every ``timing.OUTCOME_READ_RETRY`` for ``timing.OUTCOME_READ_BUDGET`` after the
-        first failure (or while the command's own time runs, if longer); then the command ends
+        first failure (or, unless the link is gone, while the command's own time runs, if longer);
+        then the command ends
         *unknown* (:class:`~app.errors.OutcomeUnknown`: "sent; the outcome is unknown -- check the
         robot before sending it again"), recorded so in the audit trail."""
         failed_since: float | None = None
@@ -227,10 +228,13 @@ class CommandClient(RegisterClient):
                 now = time.monotonic()
                 if failed_since is None or self._read_since(failed_since):
                     failed_since = now
-                if now >= max(failed_since + timing.OUTCOME_READ_BUDGET, completion.deadline):
+                limit = failed_since + timing.OUTCOME_READ_BUDGET
+                if not isinstance(exc, LinkError):  # a controller gone for good is not waited for
+                    limit = max(limit, completion.deadline)
+                if now >= limit:
                     completion.unknown(now, exc)
                     assert completion.error is not None
-                    raise completion.error from None
+                    raise completion.error from exc
                 time.sleep(timing.OUTCOME_READ_RETRY)
 
     def _read_since(self, moment: float) -> bool:
