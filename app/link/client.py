@@ -110,9 +110,10 @@ class RobotClient(CommandClient):
     def resume(self) -> None:
         self._write_control(registers.REG_RESUME, 1)
 
-    def go_zero(self, axis: int | None) -> MotionWatch:
+    def go_zero(self, axis: int | None, *, before: Pose | None = None) -> MotionWatch:
         """Send one axis (0..10 = J1..J11) or all axes (None) to zero; returns the watch that tells
-        how it ends (by motion: go to zero has no GV291 result; :meth:`follow` it, or feed it)."""
+        how it ends (by motion: go to zero has no GV291 result; :meth:`follow` it, or feed it).
+        ``before``: the pose just read (the GUI's last poll), else it is read here."""
         last_axis = registers.NUM_AXES_TOTAL - 1
         value = registers.GO_ZERO_ALL if axis is None else check_int(axis, 0, last_axis, "axis")
         which = "all axes" if axis is None else JOINT_AXIS_NAMES[axis]
@@ -120,7 +121,7 @@ class RobotClient(CommandClient):
         status = self.read_status()
         self._refuse_while_busy("go to zero", f"go to zero ({which})", status)
         self._ensure_auto(status)
-        before = self.read_pose()
+        before = before or self.read_pose()
         with self.judged_writes() as judged:
             self._write_control(registers.REG_GO_ZERO, value)
         axes = tuple(range(registers.NUM_AXES_TOTAL)) if axis is None else (value,)
@@ -135,8 +136,11 @@ class RobotClient(CommandClient):
         mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
         cycles: int = 1,
         speed_ratio: int = 100,
+        *,
+        before: Pose | None = None,
     ) -> MotionWatch:
-        """446..449 in one 0x10, then 440 <- 0x01; returns the watch that tells how it ends."""
+        """446..449 in one 0x10, then 440 <- 0x01; returns the watch that tells how it ends
+        (``before``: as for :meth:`go_zero`)."""
         program_id = check_int(program_id, 0, 0xFFFF, "program id")
         motion = check_enum(mode, ProgramMotionMode, "program motion mode")
         cycles = check_int(cycles, 0, 0xFFFF, "cycle count")
@@ -145,7 +149,7 @@ class RobotClient(CommandClient):
         status = self.read_status()
         self._refuse_while_busy("run program", f"run program {program_id}", status)
         self._ensure_auto(status)
-        before = self.read_pose()
+        before = before or self.read_pose()
         self._write(registers.REG_PROGRAM_ID, [program_id, int(motion), cycles, speed_ratio])
         with self.judged_writes() as judged:
             self._write_control(registers.REG_RUN_COMMAND, int(RunCommand.RUN_PROGRAM))

@@ -165,13 +165,14 @@ class MotionCommands:
 
     def go_zero(self, axis: int | None) -> None:
         client = self._begin(Operation.GO_ZERO)
-        self._track(Operation.GO_ZERO, client.go_zero(axis), motion=True)
+        before = self._host.poller.last_pose  # (the client reads it when there was no poll yet)
+        self._track(Operation.GO_ZERO, client.go_zero(axis, before=before), motion=True)
 
     def run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int, speed_ratio: int) -> None:
         client = self._begin(Operation.RUN_PROGRAM)
-        self._track(
-            Operation.RUN_PROGRAM, client.run_program(program_id, mode, cycles, speed_ratio), motion=True
-        )
+        before = self._host.poller.last_pose
+        watch = client.run_program(program_id, mode, cycles, speed_ratio, before=before)
+        self._track(Operation.RUN_PROGRAM, watch, motion=True)
 
     def create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> None:
         self.require_none(Operation.CREATE_POINT)

@@ -91,7 +91,7 @@ class AuditModel(QAbstractTableModel):
             "refused": self.tr("refused"),
             "login": self.tr("login"),
             "action": self.tr("action"),
-            "ok": self.tr("ok"),
+            "ok": self.tr("answered"),  # a plain write: answered (a command reads its outcome)
             "failed": self.tr("failed"),
             "blocked": self.tr("blocked"),
             "unknown": self.tr("unknown"),
@@ -139,7 +139,7 @@ class AuditViewer(QDialog):
             (Result.REFUSED, self.tr("refused")),
             (Result.STOPPED, self.tr("stopped")),
             (Result.UNKNOWN, self.tr("unknown")),
-            (Result.OK, self.tr("ok")),
+            (Result.OK, self.tr("answered")),
             (Result.FAILED, self.tr("failed")),
             (Result.BLOCKED, self.tr("blocked")),
         ):
