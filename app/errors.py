@@ -120,6 +120,21 @@ class CommandTimeout(TeachPadError):
     code = "command_timeout"
 
 
+class OutcomeUnknown(CommandTimeout):
+    """A command the controller took (its write was answered) whose outcome could not be told: its
+    status reads kept failing, the link went down, or the host stopped following it. The robot
+    may have acted on it: check it before sending the command again (code: outcome_unknown)."""
+
+    code = "outcome_unknown"
+
+
+class ControllerBusy(TeachPadError):
+    """Not sent: the controller shows a program or motion under way, and a command whose outcome
+    is told only by motion (run program, go to zero) could not be told from it."""
+
+    code = "controller_busy"
+
+
 class AlarmRaised(TeachPadError):
     """An alarm appeared while waiting for a command to complete."""
 

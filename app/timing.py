@@ -32,6 +32,11 @@ ACK_TIMEOUT = 2.0  # s for the controller to show it has taken a command (leave 
 CREATE_POINT_TIMEOUT = 3.0  # s for create-point / teach enable to finish
 MOVE_TIMEOUT_MIN = 10.0  # s; a move's timeout is max(this, 3 x its estimated duration)
 STOP_SETTLE = 0.3  # s a moved command must read 'stopped' with GV291 = 0 before it counts as stopped
+# A command the controller took whose status reads then fail: they are retried every
+# OUTCOME_READ_RETRY for at least OUTCOME_READ_BUDGET after the first failure (longer while the
+# command's own time runs), then its outcome is "unknown" (app/link/command_client.py follow).
+OUTCOME_READ_BUDGET = 2.0
+OUTCOME_READ_RETRY = 0.05
 
 # Worker (GUI side).
 POLL_HZ_DEFAULT = 50

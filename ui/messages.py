@@ -86,6 +86,22 @@ _TEMPLATES: dict[str, str] = {
     "no_motion": QT_TRANSLATE_NOOP(
         "Messages", "{command}: no motion within {seconds} s (refused by the controller, or already there)."
     ),
+    # the controller's outcome (app/link/outcome.py): refused, unknown, and the motion-told commands
+    "refused_alarm": QT_TRANSLATE_NOOP("Messages", "{command} refused by the controller: {alarms}."),
+    "outcome_unknown": QT_TRANSLATE_NOOP(
+        "Messages", "{command}: sent; the outcome is unknown — check the robot before sending it again."
+    ),
+    "zero_already": QT_TRANSLATE_NOOP("Messages", "{command}: done (the axes were already at zero)."),
+    "zero_stopped_short": QT_TRANSLATE_NOOP(
+        "Messages", "{command}: the arm stopped before zero ({axis} at {value})."
+    ),
+    "controller_busy": QT_TRANSLATE_NOOP(
+        "Messages",
+        "{command} not sent: a program or motion is under way on the controller; wait for it to end, or press Stop.",
+    ),
+    "state_not_reached": QT_TRANSLATE_NOOP(
+        "Messages", "{command}: the controller did not show it within {seconds} s."
+    ),
     "program_not_started": QT_TRANSLATE_NOOP(
         "Messages", "Program {program} did not start: no such program, or the controller refused it."
     ),
@@ -152,10 +168,12 @@ _TEMPLATES: dict[str, str] = {
     # the link's own state and the commands it cut short (app/link/supervisor.py)
     "link_was_shut_down": QT_TRANSLATE_NOOP("Messages", "The link was shut down."),
     "outcome_unknown_link_lost": QT_TRANSLATE_NOOP(
-        "Messages", "{operation}: the connection was lost while it was under way; its outcome is unknown."
+        "Messages",
+        "{operation}: the connection was lost while it was under way; the outcome is unknown — check the robot before sending it again.",
     ),
     "outcome_unknown_link_closed": QT_TRANSLATE_NOOP(
-        "Messages", "{operation}: the connection was closed while it was under way."
+        "Messages",
+        "{operation}: the connection was closed while it was under way; the outcome is unknown — check the robot before sending it again.",
     ),
     # queued requests the link never sent (app/link/worker.py fail_queued)
     "queued_link_down": QT_TRANSLATE_NOOP(
@@ -299,8 +317,12 @@ def _alarms(mask: int) -> str:
 
 
 def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
-    """The placeholders of ``code``'s sentence, formatted and translated from its arguments."""
-    out: dict[str, str] = {"command": _command_name(args.get("command"))}
+    """The placeholders of ``code``'s sentence, formatted and translated from its arguments. A
+    command without a 440 code (go to zero, the plain commands) is named by its operation."""
+    if args.get("command") is None and "operation" in args:
+        out: dict[str, str] = {"command": operation_text(str(args["operation"]))}
+    else:
+        out = {"command": _command_name(args.get("command"))}
     for key, value in args.items():
         if key in ("command", "kind") or value is None:
             continue

@@ -84,10 +84,23 @@ class CliContext:
 
     def close(self) -> None:
         if self._client is not None:
+            _not_followed(self._client)
             self._client.close()
 
 
 Handler = Callable[[CliContext], int]
+
+
+def _not_followed(client: RobotClient) -> None:
+    """A command still under way when the CLI is done with it (``--no-wait``, or an error before
+    its end): its outcome is unknown, and the audit trail says so in these words."""
+    now = time.monotonic()
+    for command in (client.last_tracker, client.last_watch):
+        if command is not None and not command.finished:
+            command.unknown(
+                now,
+                message=f"{command.text}: not followed to its end by teachpad-cli; its outcome is unknown",
+            )
 
 
 def wait_motion(ctx: CliContext, start: Callable[[], T]) -> T:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -30,21 +31,23 @@ from app.cli.format import (
     parse_zero_axis,
     status_to_dict,
 )
-from app.errors import AlarmRaised, CommandRefused, InvalidInput, TeachPadError
+from app.errors import AlarmRaised, InvalidInput, OutcomeUnknown, Reason, TeachPadError
 from app.link.client import RobotClient, StepFrame
-from app.link.tracker import pose_moved
-from app.models import Pose
+from app.link.outcome import UNKNOWN_ADVICE, outcome_note
+from app.link.watch import MotionWatch, StateCheck
+from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.codec import decode_floats, encode_floats
 from app.protocol.enums import (
     CARTESIAN_AXIS_NAMES,
-    JOINT_AXIS_NAMES,
-    CommandStatus,
+    ControllerMode,
     ProgramMotionMode,
     ProgramState,
     TeachFrame,
     WorkMode,
     alarm_names,
+    controller_mode_text,
+    program_state_text,
 )
 
 __all__ = ["JOG_SECONDS_DEFAULT", "register"]
@@ -52,10 +55,6 @@ __all__ = ["JOG_SECONDS_DEFAULT", "register"]
 JOG_POLL_INTERVAL = 0.05  # s between status checks while a jog runs (keeps a watchdog fed)
 JOG_SECONDS_DEFAULT = 2.0  # s a jog runs when --seconds is not given
 WATCH_RATE_DEFAULT = 10.0  # Hz
-# A program the controller accepted shows program state running (or has moved the arm) within
-# this time; one that stays stopped was not started (unknown id, or refused).
-PROGRAM_START_TIMEOUT = 1.0  # s
-PROGRAM_START_POLL = 0.02  # s between status reads while waiting for the start
 
 
 # --------------------------------------------------------------------------------------------
@@ -106,8 +105,17 @@ def cmd_watch(ctx: CliContext) -> ExitCode:
 
 def cmd_mode(ctx: CliContext) -> ExitCode:
     mode = WorkMode.AUTO if ctx.args.mode == "auto" else WorkMode.MANUAL
-    ctx.client.set_work_mode(mode)
-    return ctx.report(f"work mode set to {ctx.args.mode}")
+    client = ctx.client
+    wanted = _MODES_READ[mode]
+    check = StateCheck(f"work mode {ctx.args.mode}", lambda s: s.mode in wanted, _mode_words, 0.0)
+    return _judged(ctx, check, lambda: client.set_work_mode(mode))
+
+
+# What the controller's mode (560) reads once a work mode (444) is taken: Modbus teach is an auto mode.
+_MODES_READ = {
+    WorkMode.AUTO: (ControllerMode.AUTO, ControllerMode.MODBUS_TEACH),
+    WorkMode.MANUAL: (ControllerMode.MANUAL,),
+}
 
 
 def cmd_step(ctx: CliContext) -> ExitCode:
@@ -224,9 +232,8 @@ def cmd_move(ctx: CliContext) -> ExitCode:
 
 def cmd_zero(ctx: CliContext) -> ExitCode:
     axis = parse_zero_axis(ctx.args.axis)
-    ctx.client.go_zero(axis)
-    target = "all axes" if axis is None else JOINT_AXIS_NAMES[axis]
-    return ctx.report(f"go to zero sent ({target})")
+    client = ctx.client
+    return _follow_watch(ctx, lambda: client.go_zero(axis))
 
 
 _PROGRAM_MODES = {
@@ -237,58 +244,73 @@ _PROGRAM_MODES = {
 
 
 def cmd_program_run(ctx: CliContext) -> ExitCode:
+    args = ctx.args
     client = ctx.client
-    before = client.read_pose()
+    mode = _PROGRAM_MODES[args.mode]
+    return _follow_watch(
+        ctx,
+        lambda: client.run_program(args.id, mode, cycles=args.cycles, speed_ratio=args.speed),
+        until_started=args.no_wait,
+    )
+
+
+def _follow_watch(
+    ctx: CliContext, start: Callable[[], MotionWatch], *, until_started: bool = False
+) -> ExitCode:
+    """Send a command told by motion (go to zero, run program) and follow it to its outcome (or,
+    ``until_started``, until it is seen under way); Ctrl-C meanwhile sends stop."""
+    client = ctx.client
     writes_before = client.write_count
     sent = time.monotonic()
     try:
-        return _start_program(ctx, client, before)
+        watch = start()
+        result = client.follow(watch, until_started=until_started)
     except KeyboardInterrupt:
-        # Ctrl-C while the program was being started: what it started is a motion under way
+        # Ctrl-C while the command was being sent or followed: what it started is a motion under way
         if client.write_count != writes_before:
             stop_after_ctrl_c(ctx, command_sent=sent)
         raise
-
-
-def _start_program(ctx: CliContext, client: RobotClient, before: Pose) -> ExitCode:
-    """Send the run command, then wait to see the program run (the controller answers a run
-    command only through its state)."""
-    args = ctx.args
-    client.run_program(args.id, _PROGRAM_MODES[args.mode], cycles=args.cycles, speed_ratio=args.speed)
-    deadline = time.monotonic() + PROGRAM_START_TIMEOUT
-    while True:
-        status = client.read_status()
-        if status.alarms:
-            names = ", ".join(alarm_names(int(status.alarms)))
-            raise AlarmRaised(int(status.alarms), f"program {args.id} not started: alarm {names}")
-        if status.program_state in (ProgramState.RUNNING, ProgramState.PAUSED):
-            return ctx.report(f"program {args.id} running ({args.mode})")
-        if pose_moved(client.read_pose(), before):
-            return ctx.report(f"program {args.id} ran and ended ({args.mode})")
-        if time.monotonic() >= deadline:
-            raise CommandRefused(
-                CommandStatus(None, status.command_status_code),
-                f"the controller did not start program {args.id}: its program state stayed stopped for "
-                f"{PROGRAM_START_TIMEOUT:g} s (no such program, or the controller refused it)",
-                code="program_not_started",
-                params={"program": args.id},
-            )
-        time.sleep(PROGRAM_START_POLL)
+    if result is None:
+        return ctx.report(f"{watch.text}: started (under way; its end is not waited for)")
+    return ctx.report(result.message)
 
 
 def cmd_stop(ctx: CliContext) -> ExitCode:
-    ctx.client.stop()
-    return ctx.report("stop sent")
+    check = StateCheck("stop", lambda s: s.program_state == ProgramState.STOPPED, _state_words, 0.0)
+    return _judged(ctx, check, ctx.client.stop)
 
 
 def cmd_pause(ctx: CliContext) -> ExitCode:
-    ctx.client.pause()
-    return ctx.report("pause sent")
+    # nothing under way (stopped) is what a pause wants too: the arm stands still
+    paused = (ProgramState.PAUSED, ProgramState.STOPPED)
+    check = StateCheck("pause", lambda s: s.program_state in paused, _state_words, 0.0)
+    return _judged(ctx, check, ctx.client.pause)
 
 
 def cmd_resume(ctx: CliContext) -> ExitCode:
-    ctx.client.resume()
-    return ctx.report("resume sent")
+    check = StateCheck("resume", lambda s: s.program_state == ProgramState.RUNNING, _state_words, 0.0)
+    return _judged(ctx, check, ctx.client.resume)
+
+
+def _mode_words(status: ControllerStatus) -> str:
+    return f"the controller's mode reads {controller_mode_text(int(status.mode))}"
+
+
+def _state_words(status: ControllerStatus) -> str:
+    return f"the program state reads {program_state_text(int(status.program_state))}"
+
+
+def _judged(ctx: CliContext, check: StateCheck, send: Callable[[], object]) -> ExitCode:
+    """Send a plain command (its writes judged in the audit trail) and follow ``check`` to the
+    controller's outcome: done (exit 0), not taken (1) or unknown (4)."""
+    client = ctx.client
+    with client.judged_writes() as judged:
+        send()
+    check.started = time.monotonic()
+    check.note = outcome_note(client.audit, judged)
+    result = client.follow(check)
+    assert result is not None
+    return ctx.report(result.message)
 
 
 def cmd_read(ctx: CliContext) -> ExitCode:
@@ -305,10 +327,33 @@ def cmd_read(ctx: CliContext) -> ExitCode:
 
 
 def cmd_write(ctx: CliContext) -> ExitCode:
+    """Write GVs, then read them back: the controller kept them (done), overwrote or did not keep
+    them (refused, exit 1), or the read-back failed (unknown, exit 4)."""
     gv, values = ctx.args.gv, ctx.args.values
-    ctx.client.write_gv(gv, values)
-    raw = " ".join(f"{r:04X}" for r in encode_floats(values, ctx.settings.word_order))
-    return ctx.report(f"GV{gv}..GV{gv + len(values) - 1} written ({raw})")
+    client = ctx.client
+    order = ctx.settings.word_order
+    regs = encode_floats(values, order)
+    what = f"GV{gv}" if len(values) == 1 else f"GV{gv}..GV{gv + len(values) - 1}"
+    with client.judged_writes() as judged:
+        client.write_gv(gv, values)
+    note = outcome_note(client.audit, judged) or (lambda result: None)
+    raw = " ".join(f"{r:04X}" for r in regs)
+    try:
+        back = client.read_registers(registers.gv_reg(gv), len(regs))
+    except TeachPadError as exc:
+        unknown = OutcomeUnknown(f"{what} write: {UNKNOWN_ADVICE} (the read-back failed: {exc})")
+        note(CommandResult(None, None, None, False, str(unknown), reason=unknown.as_reason()))
+        raise unknown from None
+    if list(back) != list(regs):
+        got = ", ".join(repr(v) for v in decode_floats(back, order))
+        refused = TeachPadError(
+            f"{what} written ({raw}), but they read back {got}: the controller did not keep them"
+        )
+        note(CommandResult(None, None, None, False, str(refused), reason=Reason("not_kept")))
+        raise refused
+    text = f"{what} written ({raw}), read back the same"
+    note(CommandResult(None, None, None, True, text, reason=Reason("done")))
+    return ctx.report(text)
 
 
 # --------------------------------------------------------------------------------------------
@@ -442,7 +487,9 @@ def register(sub: Any) -> None:
     )
     p.set_defaults(handler=cmd_move)
 
-    p = sub.add_parser("zero", help="go to zero: one axis (J1..J11) or all")
+    p = sub.add_parser(
+        "zero", help="go to zero: one axis (J1..J11) or all; waits until the arm stands at zero"
+    )
     p.add_argument("axis", metavar="AXIS|all", help="J1..J11, or all")
     p.set_defaults(handler=cmd_zero)
 
@@ -459,6 +506,11 @@ def register(sub: Any) -> None:
     pr.add_argument("--cycles", type=int, default=1, help="cycle count (0: endless)")
     pr.add_argument(
         "--speed", type=int, default=100, help="speed ratio in percent, 1..100 (default %(default)s)"
+    )
+    pr.add_argument(
+        "--no-wait",
+        action="store_true",
+        help="return once the program is seen running (a refusal is still told); its end is not waited for",
     )
     pr.set_defaults(handler=cmd_program_run)
 

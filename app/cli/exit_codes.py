@@ -10,7 +10,14 @@ from __future__ import annotations
 
 import enum
 
-from app.errors import InvalidInput, LinkError, MalformedResponse, ResponseTimeout, TeachPadError
+from app.errors import (
+    CommandTimeout,
+    InvalidInput,
+    LinkError,
+    MalformedResponse,
+    ResponseTimeout,
+    TeachPadError,
+)
 from app.safety.register_profile import RegisterProfileError
 
 __all__ = ["EPILOG", "LINK_ERRORS", "ExitCode", "exit_code_for"]
@@ -20,15 +27,19 @@ class ExitCode(enum.IntEnum):
     """What a ``teachpad-cli`` run ended with (the process's exit status)."""
 
     OK = 0
-    #: the command ran and failed: refused by the controller, Modbus exception, command
-    #: timeout, alarm, stopped, blocked by --monitor-only, a plan the robot model cannot reach,
-    #: a file that cannot be written
+    #: the command ran and failed: refused by the controller (its status code in words), busy,
+    #: Modbus exception, alarm, stopped, blocked by --monitor-only, a plan the robot model cannot
+    #: reach, a file that cannot be written
     FAILED = 1
     #: bad arguments or values, an unreadable or malformed input file, a plan with errors:
     #: nothing was sent
     USAGE = 2
     #: the link: cannot connect, no answer in time, a malformed answer
     LINK = 3
+    #: the controller took the command (its write was answered) but what it did is not known:
+    #: its status could not be read, it did not finish within its time, it was never
+    #: acknowledged. The robot may have acted on it: check it before sending it again
+    UNKNOWN = 4
     #: Ctrl-C (a motion that was under way is stopped first)
     INTERRUPTED = 130
 
@@ -40,11 +51,14 @@ class ExitCode(enum.IntEnum):
 _MEANING = {
     ExitCode.OK: "ok",
     ExitCode.FAILED: (
-        "command failed or refused (controller, alarm, timeout of the command, monitor-only, "
-        "out of the robot's reach)"
+        "command failed or refused (controller, busy, alarm, stopped, monitor-only, out of the robot's reach)"
     ),
     ExitCode.USAGE: "usage: bad arguments, values or input files (nothing sent)",
     ExitCode.LINK: "link: cannot connect, no answer in time, malformed answer",
+    ExitCode.UNKNOWN: (
+        "sent; the outcome is unknown (status unreadable, not finished in time, not acknowledged): "
+        "check the robot before sending it again"
+    ),
     ExitCode.INTERRUPTED: "interrupted (Ctrl-C; a motion under way is stopped first)",
 }
 
@@ -64,4 +78,6 @@ def exit_code_for(error: BaseException) -> ExitCode:
         return ExitCode.USAGE
     if isinstance(error, LINK_ERRORS):
         return ExitCode.LINK
+    if isinstance(error, CommandTimeout):  # OutcomeUnknown too: taken, what it did is not known
+        return ExitCode.UNKNOWN
     return ExitCode.FAILED  # a TeachPadError of the command, or a file that cannot be written

@@ -44,6 +44,7 @@ from app.cli.format import parse_positive_float, parse_word_order
 from app.cli.help import add_examples
 from app.errors import InvalidInput, TeachPadError
 from app.link.client import ConnectionSettings
+from app.link.outcome import UNKNOWN_ADVICE
 from app.safety.register_profile import (
     COMPLETION_MODES,
     PROFILE_NAME,
@@ -57,6 +58,7 @@ __all__ = [
     "EXIT_INTERRUPTED",
     "EXIT_LINK",
     "EXIT_OK",
+    "EXIT_UNKNOWN",
     "EXIT_USAGE",
     "PROG",
     "REGISTRARS",
@@ -82,6 +84,7 @@ EXIT_FAILED = ExitCode.FAILED
 EXIT_USAGE = ExitCode.USAGE
 EXIT_LINK = ExitCode.LINK
 EXIT_INTERRUPTED = ExitCode.INTERRUPTED
+EXIT_UNKNOWN = ExitCode.UNKNOWN
 
 _PATH_SHOWN = 100  # characters of a path in an error message
 
@@ -263,9 +266,12 @@ def _main(argv: Sequence[str] | None = None) -> int:
         _quiet_broken_pipe()
         return ExitCode.OK
     except (TeachPadError, OSError, KeyboardInterrupt) as exc:
+        code = exit_code_for(exc)
         message = "interrupted" if isinstance(exc, KeyboardInterrupt) else _error_text(exc)
+        if code is ExitCode.UNKNOWN and UNKNOWN_ADVICE not in message:
+            message = f"{message}: {UNKNOWN_ADVICE}"  # a command that did not finish in time
         print(f"{PROG}: error: {message}", file=sys.stderr, flush=True)
-        return exit_code_for(exc)
+        return code
     finally:
         ctx.close()
 

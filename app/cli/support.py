@@ -6,7 +6,8 @@ so they stay out of the shell history) and see which are set. ``support-bundle``
 :mod:`app.safety.bundle` (versions, the CLI's connection settings plus an optional settings
 file with secrets removed, the project, the safety profile, the audit trail of the last days,
 log files, recorded traffic). ``audit`` prints or exports the audit trail, filtered, and says how
-many of the records shown are writes whose answer was never recorded (result ``unknown``).
+many of the records shown are writes whose outcome is unknown (result ``unknown``: the answer or
+the controller's outcome was never recorded, or the controller's outcome could not be told).
 
 teachpad-cli is an administrator's tool: whoever has a shell on the pendant PC can read and
 write every file TeachPad keeps, so a ``--role`` switch would protect nothing. Roles guard the
@@ -25,12 +26,30 @@ from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode
 from app.cli.format import parse_moment, parse_positive_int
 from app.errors import InvalidInput
-from app.safety.audit import AuditFilter, AuditRecord, ReadStats, Result, default_audit_dir, export_csv, query
+from app.safety.audit import (
+    AuditFilter,
+    AuditRecord,
+    ReadStats,
+    Result,
+    default_audit_dir,
+    export_csv,
+    query,
+    result_label,
+)
 from app.safety.bundle import DEFAULT_DAYS, write_support_bundle
 from app.safety.roles import Role, RoleStore, default_store_path
 
-#: What ``audit --result`` filters by (a write's outcome; ``pending`` exists only inside the file).
-AUDIT_RESULTS = (Result.OK, Result.FAILED, Result.BLOCKED, Result.REFUSED, Result.UNKNOWN)
+#: What ``audit --result`` filters by: a command's outcome (done, refused, stopped, unknown), a
+#: plain write's answer (ok, failed), blocked (``pending`` exists only inside the file).
+AUDIT_RESULTS = (
+    Result.DONE,
+    Result.REFUSED,
+    Result.STOPPED,
+    Result.UNKNOWN,
+    Result.OK,
+    Result.FAILED,
+    Result.BLOCKED,
+)
 
 ADMIN_NOTE = (
     "teachpad-cli is an administrator's tool: it is not limited by TeachPad's roles "
@@ -84,8 +103,9 @@ def register(subparsers: Any) -> None:
     p.add_argument(
         "--result",
         choices=AUDIT_RESULTS,
-        help="only records with this result (unknown: writes sent whose answer was never "
-        "recorded, TeachPad stopped first)",
+        help="only records with this result: a command's outcome as the controller told it (done, "
+        "refused -- shown refused:CODE with its status code --, stopped, unknown: sent, and what the "
+        "controller did is not known), or a plain write's answer (ok, failed), or blocked",
     )
     p.add_argument("--csv", type=Path, metavar="OUT", help="write CSV instead of printing")
     p.set_defaults(handler=cmd_audit)
@@ -168,11 +188,11 @@ def cmd_audit(ctx: CliContext) -> ExitCode:
     else:
         for r in records:
             extra = f" - {r.detail}" if r.detail else ""
-            ctx.print(f"{r.host_time}  {r.role:<13} {r.result:<8} {r.command}{extra}")
+            ctx.print(f"{r.host_time}  {r.role:<13} {result_label(r):<11} {r.command}{extra}")
     if unknown and args.result != Result.UNKNOWN:
         ctx.warn(
-            f"{unknown} write(s) with result unknown: sent, but TeachPad stopped before the answer "
-            "was recorded (check the robot); list them with --result unknown"
+            f"{unknown} write(s) with result unknown: sent, and what the controller did is not known "
+            "(check the robot); list them with --result unknown"
         )
     if stats.skipped:
         ctx.warn(f"{stats.skipped} damaged line(s) skipped")

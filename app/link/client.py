@@ -27,6 +27,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 from app import timing
 from app.errors import (
+    ControllerBusy,
     InvalidInput,
     LinkError,
     MalformedResponse,
@@ -35,21 +36,27 @@ from app.errors import (
 )
 from app.link.checks import check_enum, check_float, check_floats, check_int, check_tool
 from app.link.command_client import CommandClient
+from app.link.outcome import outcome_note
 from app.link.register_client import RegisterClient
 from app.link.stats import LinkStats
-from app.link.tracker import command_text
+from app.link.tracker import CommandTracker, command_text
 from app.link.transport import ConnectionSettings, TrafficRecord
 from app.link.types import StepFrame  # here for importers: the GUI imports it from types
+from app.link.watch import MotionWatch
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import (
+    JOINT_AXIS_NAMES,
     CommandKind,
     ControllerMode,
     ProgramMotionMode,
+    ProgramState,
     RunCommand,
     TeachFrame,
     WorkMode,
+    program_state_text,
 )
+from app.safety.audit import AuditRecord
 
 __all__ = [
     "ConnectionSettings",
@@ -75,6 +82,7 @@ class RobotClient(CommandClient):
         self._ext_cache: tuple[float, ...] | None = None
         super().__init__(settings)
         self._teach_frame: TeachFrame | None = None
+        self.last_watch: MotionWatch | None = None  # the last go to zero / run program (stop ends it)
         # X Y Z of the points this client created from given poses (a move whose GV291 never
         # changed may be confirmed by arriving there, see CommandTracker's ``target``)
         self._sent_points: dict[int, tuple[float, float, float]] = {}
@@ -92,9 +100,9 @@ class RobotClient(CommandClient):
 
     def stop(self) -> None:
         self._write_control(registers.REG_STOP, 1)
-        tracker = self.last_tracker
-        if tracker is not None and not tracker.finished:
-            tracker.stopped(time.monotonic())
+        for command in (self.last_tracker, self.last_watch):
+            if command is not None and not command.finished:
+                command.stopped(time.monotonic())
 
     def pause(self) -> None:
         self._write_control(registers.REG_PAUSE, 1)
@@ -102,13 +110,25 @@ class RobotClient(CommandClient):
     def resume(self) -> None:
         self._write_control(registers.REG_RESUME, 1)
 
-    def go_zero(self, axis: int | None) -> None:
-        """Send one axis (0..10 = J1..J11) or all axes (None) to zero."""
+    def go_zero(self, axis: int | None, *, before: Pose | None = None) -> MotionWatch:
+        """Send one axis (0..10 = J1..J11) or all axes (None) to zero; returns the watch that tells
+        how it ends (by motion: go to zero has no GV291 result; :meth:`follow` it, or feed it).
+        ``before``: the pose just read (the GUI's last poll), else it is read here."""
         last_axis = registers.NUM_AXES_TOTAL - 1
         value = registers.GO_ZERO_ALL if axis is None else check_int(axis, 0, last_axis, "axis")
+        which = "all axes" if axis is None else JOINT_AXIS_NAMES[axis]
         self._require_writable("go to zero")
-        self._ensure_auto(self.read_status())
-        self._write_control(registers.REG_GO_ZERO, value)
+        status = self.read_status()
+        self._refuse_while_busy("go to zero", f"go to zero ({which})", status)
+        self._ensure_auto(status)
+        before = before or self.read_pose()
+        with self.judged_writes() as judged:
+            self._write_control(registers.REG_GO_ZERO, value)
+        axes = tuple(range(registers.NUM_AXES_TOTAL)) if axis is None else (value,)
+        watch = MotionWatch(
+            None, f"go to zero ({which})", before, time.monotonic(), operation="go to zero", zero_axes=axes
+        )
+        return self._watching(watch, judged)
 
     def run_program(
         self,
@@ -116,16 +136,50 @@ class RobotClient(CommandClient):
         mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
         cycles: int = 1,
         speed_ratio: int = 100,
-    ) -> None:
-        """446..449 in one 0x10, then 440 <- 0x01."""
+        *,
+        before: Pose | None = None,
+    ) -> MotionWatch:
+        """446..449 in one 0x10, then 440 <- 0x01; returns the watch that tells how it ends
+        (``before``: as for :meth:`go_zero`)."""
         program_id = check_int(program_id, 0, 0xFFFF, "program id")
         motion = check_enum(mode, ProgramMotionMode, "program motion mode")
         cycles = check_int(cycles, 0, 0xFFFF, "cycle count")
         speed_ratio = check_int(speed_ratio, 1, 100, "program speed ratio")
         self._require_writable("run program")
-        self._ensure_auto(self.read_status())
+        status = self.read_status()
+        self._refuse_while_busy("run program", f"run program {program_id}", status)
+        self._ensure_auto(status)
+        before = before or self.read_pose()
         self._write(registers.REG_PROGRAM_ID, [program_id, int(motion), cycles, speed_ratio])
-        self._write_control(registers.REG_RUN_COMMAND, int(RunCommand.RUN_PROGRAM))
+        with self.judged_writes() as judged:
+            self._write_control(registers.REG_RUN_COMMAND, int(RunCommand.RUN_PROGRAM))
+        watch = MotionWatch(
+            RunCommand.RUN_PROGRAM,
+            f"run program {program_id}",
+            before,
+            time.monotonic(),
+            operation="run program",
+            program=program_id,
+        )
+        return self._watching(watch, judged)
+
+    def _refuse_while_busy(self, operation: str, what: str, status: ControllerStatus) -> None:
+        """Run program and go to zero are told by motion: not while a program or motion runs
+        (nothing would tell this command's start from what is under way). Audited, not sent."""
+        if status.program_state not in (ProgramState.RUNNING, ProgramState.PAUSED):
+            return
+        state = program_state_text(int(status.program_state))
+        text = (
+            f"{what} not sent: the controller is busy (program state {state}); wait for it to end, or stop it"
+        )
+        if self.audit is not None:
+            self.audit.record_refused(what, text, {"program_state": int(status.program_state)})
+        raise ControllerBusy(text, params={"operation": operation})
+
+    def _watching(self, watch: MotionWatch, judged: list[AuditRecord]) -> MotionWatch:
+        watch.note = outcome_note(self.audit, judged)
+        self.last_watch = watch
+        return watch
 
     # -- helpers of the four functions ---------------------------------------------------
     def _ensure_auto(self, status: ControllerStatus) -> None:
@@ -326,6 +380,7 @@ class RobotClient(CommandClient):
                     staged = nxt
 
             meanwhile = stage_next if spare is not None and index + 1 < total else None
+            tracker: CommandTracker | None = None
             try:
                 if staged != index:
                     self._write_floats(block, values)
@@ -335,6 +390,8 @@ class RobotClient(CommandClient):
                 result = self.wait(tracker, raise_errors=False, meanwhile=meanwhile, between=between)
                 status = tracker.last_status or status
             except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
+                if tracker is not None:  # its command was answered: what it did is not known
+                    tracker.unknown(time.monotonic(), exc)
                 results.append(
                     CommandResult(
                         RunCommand.CREATE_POINT,

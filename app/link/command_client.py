@@ -23,10 +23,12 @@ import time
 from collections.abc import Callable
 
 from app import timing
-from app.errors import ModbusExceptionError, Reason
+from app.errors import LinkError, MalformedResponse, ModbusExceptionError, Reason, ResponseTimeout
+from app.link.outcome import outcome_note
 from app.link.register_client import RegisterClient
 from app.link.tracker import CommandTracker, CompletionRule, ResultPacer
 from app.link.transport import ConnectionSettings
+from app.link.watch import MotionWatch, StateCheck
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.enums import (
@@ -38,9 +40,15 @@ from app.protocol.enums import (
     decode_status_registers,
 )
 
-__all__ = ["CommandClient"]
+__all__ = ["CommandClient", "Completion"]
 
 _log = logging.getLogger(__name__)
+
+#: How a command under way is followed: by GV291, by motion (run program, go to zero), or by the
+#: state it asks for (the CLI's plain commands).
+Completion = CommandTracker | MotionWatch | StateCheck
+#: A status or pose read that failed: the command's outcome is not told by it (follow retries).
+_READ_ERRORS = (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError)
 
 
 class CommandClient(RegisterClient):
@@ -149,7 +157,9 @@ class CommandClient(RegisterClient):
         )
         self._last_kind = tracker.kind
         self.last_tracker = tracker
-        self._write_control(registers.REG_RUN_COMMAND, int(command))
+        with self.judged_writes() as judged:
+            self._write_control(registers.REG_RUN_COMMAND, int(command))
+        tracker.note = outcome_note(self.audit, judged)  # its outcome goes to the audit trail
         return tracker
 
     def poll(self, tracker: CommandTracker) -> CommandResult | None:
@@ -196,9 +206,61 @@ class CommandClient(RegisterClient):
             if interval > 0:
                 time.sleep(interval)
 
+    def follow(self, completion: Completion, *, until_started: bool = False) -> CommandResult | None:
+        """Poll a command the controller took to its end and return its result; raise its typed
+        error when it did not end done. ``completion``: a :class:`CommandTracker` (polled by
+        :meth:`wait`) or a :class:`~app.link.watch.MotionWatch` (status and pose every
+        ``MOVE_POLL_INTERVAL``); ``until_started`` (a watch): return None once it is seen under way.
+
+        Once the command was answered, a status read that fails does not fail the command: reads
+        are retried every ``timing.OUTCOME_READ_RETRY`` for ``timing.OUTCOME_READ_BUDGET`` after the
+        first failure (or, unless the link is gone, while the command's own time runs, if longer);
+        then the command ends
+        *unknown* (:class:`~app.errors.OutcomeUnknown`: "sent; the outcome is unknown -- check the
+        robot before sending it again"), recorded so in the audit trail."""
+        failed_since: float | None = None
+        while True:
+            try:
+                return self._poll_to_end(completion, until_started)
+            except _READ_ERRORS as exc:
+                if completion.finished:  # (not a read of this command's: its end is its own)
+                    raise
+                now = time.monotonic()
+                if failed_since is None or self._read_since(failed_since):
+                    failed_since = now
+                limit = failed_since + timing.OUTCOME_READ_BUDGET
+                if not isinstance(exc, LinkError):  # a controller gone for good is not waited for
+                    limit = max(limit, completion.deadline)
+                if now >= limit:
+                    completion.unknown(now, exc)
+                    assert completion.error is not None
+                    raise completion.error from exc
+                time.sleep(timing.OUTCOME_READ_RETRY)
+
+    def _read_since(self, moment: float) -> bool:
+        """A status read was answered after ``moment`` (monotonic)."""
+        return self.status_read_at > moment
+
+    def _poll_to_end(self, completion: Completion, until_started: bool) -> CommandResult | None:
+        if isinstance(completion, CommandTracker):
+            return self.wait(completion)
+        while True:
+            status = self.read_status()
+            pose = self.read_pose()
+            result = completion.update(status, pose, time.monotonic())
+            if result is not None:
+                if completion.error is not None:
+                    raise completion.error
+                return result
+            if until_started and completion.seen:
+                return None
+            time.sleep(timing.MOVE_POLL_INTERVAL)
+
     def _finish(self, tracker: CommandTracker, wait: bool) -> CommandResult:
         if wait:
-            return self.wait(tracker)
+            result = self.follow(tracker)
+            assert result is not None
+            return result
         return CommandResult(
             tracker.command,
             tracker.kind,

@@ -3,9 +3,10 @@ and the completion tracking of the one under way.
 
 :class:`MotionCommands` starts them without waiting (teach mode is left first); the regular
 polls then feed the active command through :class:`MotionTracker`: a :class:`CommandTracker`
-(commands with GV291) or a :class:`MotionWatch` (run program and go to zero, which do not use
-GV291) until a :class:`CommandResult` comes out. Only one motion at a time: a motion requested
-while another one or an upload is under way is refused.
+(commands with GV291) or a :class:`~app.link.watch.MotionWatch` (run program and go to zero,
+which do not use GV291; the client makes it, as for the CLI) until a :class:`CommandResult`
+comes out. Only one motion at a time: a motion requested while another one or an upload is
+under way is refused.
 """
 
 from __future__ import annotations
@@ -17,15 +18,15 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from app import timing
-from app.errors import InvalidInput
+from app.errors import InvalidInput, Reason
 from app.link.client import RobotClient, StepFrame
 from app.link.host import WorkerHost
-from app.link.tracker import CommandTracker, pose_moved
+from app.link.tracker import CommandTracker
 from app.link.types import Operation
 from app.models import CommandResult, ControllerStatus, Pose
-from app.protocol.enums import ProgramMotionMode, ProgramState, RunCommand, alarm_names
+from app.protocol.enums import ProgramMotionMode
 
-__all__ = ["ActiveCommand", "Completion", "MotionCommands", "MotionTracker", "MotionWatch"]
+__all__ = ["ActiveCommand", "Completion", "MotionCommands", "MotionTracker"]
 
 
 class Completion(Protocol):
@@ -33,51 +34,9 @@ class Completion(Protocol):
 
     def stopped(self, now: float) -> CommandResult: ...
 
-
-class MotionWatch:
-    """Program state and pose decide how a program run / go to zero ended (GV291 is not used).
-
-    Started once the program state shows running/paused or the pose moves; done once it reads
-    stopped with the pose standing still. No sign of motion within ``timing.ACK_TIMEOUT``
-    means the controller did not start it (refused, or already there).
-    """
-
-    def __init__(self, command: RunCommand | None, text: str, before_pose: Pose | None, now: float) -> None:
-        self.command = command
-        self.text = text
-        self.started = now
-        self.ack_timeout = timing.ACK_TIMEOUT
-        self._last_pose = before_pose
-        self._seen = False
-
-    def _result(self, ok: bool, message: str, now: float) -> CommandResult:
-        return CommandResult(self.command, None, None, ok, message, {"elapsed": now - self.started})
-
-    def update(self, status: ControllerStatus, pose: Pose | None, now: float) -> CommandResult | None:
-        if status.alarms:
-            names = ", ".join(alarm_names(int(status.alarms)))
-            return self._result(False, f"{self.text}: alarm: {names}", now)
-        running = status.program_state in (ProgramState.RUNNING, ProgramState.PAUSED)
-        moved = pose is not None and self._last_pose is not None and pose_moved(pose, self._last_pose)
-        if pose is not None:
-            self._last_pose = pose
-        if not self._seen:
-            if running or moved:
-                self._seen = True
-            elif now - self.started >= self.ack_timeout:
-                return self._result(
-                    False,
-                    f"{self.text}: no motion within {self.ack_timeout:g} s "
-                    "(refused by the controller, or already there)",
-                    now,
-                )
-            return None
-        if not running and not moved:
-            return self._result(True, f"{self.text}: done", now)
-        return None
-
-    def stopped(self, now: float) -> CommandResult:
-        return self._result(False, f"{self.text} stopped by the host", now)
+    def unknown(
+        self, now: float, cause: object = None, *, message: str | None = None, reason: Reason | None = None
+    ) -> CommandResult: ...
 
 
 @dataclass
@@ -206,20 +165,13 @@ class MotionCommands:
 
     def go_zero(self, axis: int | None) -> None:
         client = self._begin(Operation.GO_ZERO)
-        before = self._host.poller.last_pose
-        client.go_zero(axis)
-        which = "all axes" if axis is None else f"J{axis + 1}"
-        self._track(
-            Operation.GO_ZERO,
-            MotionWatch(None, f"go to zero ({which})", before, time.monotonic()),
-            motion=True,
-        )
+        before = self._host.poller.last_pose  # (the client reads it when there was no poll yet)
+        self._track(Operation.GO_ZERO, client.go_zero(axis, before=before), motion=True)
 
     def run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int, speed_ratio: int) -> None:
         client = self._begin(Operation.RUN_PROGRAM)
         before = self._host.poller.last_pose
-        client.run_program(program_id, mode, cycles, speed_ratio)
-        watch = MotionWatch(RunCommand.RUN_PROGRAM, f"run program {program_id}", before, time.monotonic())
+        watch = client.run_program(program_id, mode, cycles, speed_ratio, before=before)
         self._track(Operation.RUN_PROGRAM, watch, motion=True)
 
     def create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> None:

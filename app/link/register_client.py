@@ -33,7 +33,7 @@ from app.models import ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.codec import decode_floats, encode_floats
 from app.protocol.datetime_regs import ControllerClock, decode_clock
-from app.safety.audit import AuditLog
+from app.safety.audit import AuditLog, AuditRecord
 
 __all__ = ["RegisterClient"]
 
@@ -57,6 +57,7 @@ class RegisterClient:
         self.settings = settings
         self._transport = Transport(settings, on_link_change=self.invalidate_cache)
         self.last_status: ControllerStatus | None = None
+        self.status_read_at = 0.0  # when the last status read was answered (monotonic)
         self.write_count = 0  # writes handed to the link (the CLI uses it to know what to undo)
         self._io_timeout: float | None = None  # see io_timeout()
         self.audit: AuditLog | None = None  # every write (and monitor-only block) is recorded here
@@ -64,6 +65,7 @@ class RegisterClient:
         self.writes_settled = True
         self.write_answered_at = 0.0
         self.write_lost_until = 0.0  # a write without its answer may be acted on until then
+        self._judged: list[AuditRecord] | None = None  # see judged_writes()
 
     # -- connection ----------------------------------------------------------------------
     def connect(self) -> None:
@@ -117,6 +119,18 @@ class RegisterClient:
         finally:
             self._io_timeout = outer
 
+    @contextlib.contextmanager
+    def judged_writes(self) -> Iterator[list[AuditRecord]]:
+        """The writes inside await the controller's outcome in the audit trail: each is recorded
+        as judged (its record reads *unknown* until an outcome is recorded against it, see
+        :meth:`AuditLog.record_result`), and the list yielded collects their records (empty without
+        a trail). :func:`app.link.outcome.outcome_note` records the outcome against them."""
+        outer, self._judged = self._judged, []
+        try:
+            yield self._judged
+        finally:
+            self._judged = outer
+
     def _require_writable(self, what: str) -> None:
         if self.settings.monitor_only:
             raise WriteBlocked(f"monitor-only mode: {what} was not sent")
@@ -128,8 +142,16 @@ class RegisterClient:
         is recorded there once, blocked ones too). ``timeout`` (s per attempt) overrides the
         request timeout (default: :meth:`io_timeout`'s, else the settings')."""
         timeout = self._io_timeout if timeout is None else timeout
-        ctx = self.audit.writing(address, values, single=single) if self.audit else contextlib.nullcontext()
-        with ctx:
+        judged = self._judged
+        audit = self.audit
+        ctx = (
+            audit.writing(address, values, single=single, judged=judged is not None)
+            if audit
+            else contextlib.nullcontext()
+        )
+        with ctx as intent:
+            if judged is not None and intent is not None:
+                judged.append(intent)
             what = _what("write to", address, len(values))
             self._require_writable(what)
             if not values:
@@ -238,6 +260,7 @@ class RegisterClient:
             regs, self.settings.word_order, self.settings.datetime_layout if with_clock else None
         )
         self.last_status = status
+        self.status_read_at = time.monotonic()
         return status
 
     def read_clock(self) -> ControllerClock:

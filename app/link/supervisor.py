@@ -33,7 +33,6 @@ from app.link.client import ConnectionSettings, RobotClient
 from app.link.host import WorkerHost
 from app.link.types import ConnectionState, ControllerIdentity, LinkState, Operation
 from app.link.upload import UPLOAD_POSE_GV
-from app.models import CommandResult
 from app.protocol import registers
 
 __all__ = ["DEFAULT_CANARY_GV", "Cause", "LinkSupervisor", "check_canary_gv"]
@@ -341,12 +340,10 @@ class LinkSupervisor:
     def _fail_active(self, message: str, code: str) -> None:
         active = self._host.motion.take()
         if active is not None:
-            result = CommandResult(
-                None,
-                None,
-                None,
-                False,
-                f"{active.operation}: {message}",
+            # its outcome is unknown: said so, and recorded so against its command in the audit
+            result = active.completion.unknown(
+                time.monotonic(),
+                message=f"{active.operation}: {message}",
                 reason=Reason(code, {"operation": active.operation}),
             )
             self._host.emit_result(result, active.request_id)

@@ -56,10 +56,12 @@ from app.errors import (
     CommandRefused,
     CommandStopped,
     CommandTimeout,
+    OutcomeUnknown,
     Reason,
     TeachPadError,
 )
 from app.link.arrival import POSE_EPSILON, arrived, pose_moved
+from app.link.outcome import UNKNOWN_ADVICE, OutcomeHook
 from app.link.pacer import ResultPacer
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import (
@@ -165,6 +167,7 @@ class CommandTracker:
         self.last_status: ControllerStatus | None = None
         self.result: CommandResult | None = None
         self.error: TeachPadError | None = None
+        self.note: OutcomeHook | None = None  # the audit's hook, called with the result (outcome.py)
 
     # -- public --------------------------------------------------------------------------
     @property
@@ -174,6 +177,11 @@ class CommandTracker:
     @property
     def text(self) -> str:
         return command_text(self.command)
+
+    @property
+    def deadline(self) -> float:
+        """When the command's own time runs out (monotonic; a move making progress moves it on)."""
+        return self._deadline
 
     def decode(self, code: int) -> CommandStatus:
         return decode_command_status(self.kind, code)
@@ -212,14 +220,9 @@ class CommandTracker:
         self.last_status = status
         code = status.command_status_code
         if status.alarms:
-            names = ", ".join(alarm_names(int(status.alarms))) or str(int(status.alarms))
-            return self._fail(
-                AlarmRaised(
-                    int(status.alarms), f"{self.text}: alarm while waiting: {names}", params=self._args()
-                ),
-                code,
-                now,
-            )
+            if self.before.alarms and code == self.pre_code and now - self.started < self.ack_timeout:
+                return None  # sent during the alarm: the controller's own refusal code is on its way
+            return self._alarm(status, code, now)
         if code != self.pre_code:
             if not self.code_left_pre:
                 self._ack_read = self.reads
@@ -313,6 +316,20 @@ class CommandTracker:
             )
         return None
 
+    def unknown(
+        self, now: float, cause: object = None, *, message: str | None = None, reason: Reason | None = None
+    ) -> CommandResult:
+        """The host cannot tell how it ended (its status reads failed, the link went down, it is
+        no longer followed): ends *unknown* (unless it already ended). ``message``/``reason``
+        replace the default words ("sent; the outcome is unknown -- check the robot ...")."""
+        if self.result is not None:
+            return self.result
+        code = self.last_status.command_status_code if self.last_status else self.pre_code
+        text = message or f"{self.text}: {UNKNOWN_ADVICE}" + (f" ({cause})" if cause else "")
+        error = OutcomeUnknown(text, params=self._args())
+        self.error = error
+        return self._finish(False, self.decode(code), text, now, reason=reason or error.as_reason())
+
     def stopped(self, now: float) -> CommandResult:
         """The host sent stop itself: the command ends as stopped (unless it already ended)."""
         if self.result is not None:
@@ -331,6 +348,22 @@ class CommandTracker:
         )
 
     # -- internals -----------------------------------------------------------------------
+    def _alarm(self, status: ControllerStatus, code: int, now: float) -> CommandResult:
+        """An alarm ends the wait. For a command sent during the alarm, GV291's refusal is the
+        controller's own word for it (e.g. 2, emergency stop, for a step sent during one); an
+        alarm raised after the command ended it (alarm while waiting)."""
+        decoded = self.decode(code)
+        if self.before.alarms and code != self.pre_code and decoded.is_error:
+            err: TeachPadError = CommandRefused(
+                decoded, f"{self.text} refused: {decoded.text} (status {code})", params=self._args()
+            )
+        else:
+            names = ", ".join(alarm_names(int(status.alarms))) or str(int(status.alarms))
+            err = AlarmRaised(
+                int(status.alarms), f"{self.text}: alarm while waiting: {names}", params=self._args()
+            )
+        return self._fail(err, code, now)
+
     def _teach_mode_changed(self, status: ControllerStatus) -> bool:
         """Teach enable/disable proven by the controller mode (560) entering / leaving 2."""
         teach = ControllerMode.MODBUS_TEACH
@@ -461,6 +494,8 @@ class CommandTracker:
         self.result = CommandResult(
             self.command, self.kind, status, ok, message, details, unconfirmed=unconfirmed, reason=reason
         )
+        if self.note is not None:
+            self.note(self.result)
         return self.result
 
     def _fail(self, error: TeachPadError, code: int, now: float) -> CommandResult:

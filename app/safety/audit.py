@@ -19,6 +19,13 @@ the write's ``seq``) once it is answered. The reader merges the two into one rec
 the controller may have received is in the file exactly once, also after a ``kill -9``: a write
 whose outcome line never came reads as ``unknown`` ("sent; TeachPad stopped before the answer").
 
+A command's write (440, 445, and the CLI's plain commands) is *judged*: an answer says only that
+it arrived, so a third line, ``result`` (:meth:`AuditLog.record_result`), records what the
+controller made of the command once that is known -- ``done``, ``refused`` (with the GV291 code
+in ``args.status`` when there is one), ``stopped`` or ``unknown`` (see
+:mod:`app.link.outcome`) -- and the reader merges it into the write too. A judged write answered
+but without its result line reads ``unknown``.
+
 The record format and the reader (:func:`read_records`, :func:`query`, :func:`export_csv`,
 :class:`AuditFilter`, :class:`ReadStats`) live in :mod:`app.safety.audit_read`; they are
 re-exported here.
@@ -44,7 +51,9 @@ from app.safety.audit_read import (
     FILE_RE,
     MAX_OUTCOME_LAG,
     OUTCOME,
+    RESULT,
     UNKNOWN_DETAIL,
+    UNKNOWN_OUTCOME_DETAIL,
     AuditFilter,
     AuditRecord,
     ReadStats,
@@ -55,6 +64,7 @@ from app.safety.audit_read import (
     export_csv,
     query,
     read_records,
+    result_label,
 )
 
 __all__ = [  # the reader's names stay importable from here (app.safety.audit_read)
@@ -68,7 +78,9 @@ __all__ = [  # the reader's names stay importable from here (app.safety.audit_re
     "MAX_TOTAL_BYTES",
     "MAX_VALUES_KEPT",
     "OUTCOME",
+    "RESULT",
     "UNKNOWN_DETAIL",
+    "UNKNOWN_OUTCOME_DETAIL",
     "AuditFilter",
     "AuditLog",
     "AuditRecord",
@@ -81,6 +93,7 @@ __all__ = [  # the reader's names stay importable from here (app.safety.audit_re
     "export_csv",
     "query",
     "read_records",
+    "result_label",
 ]
 
 MAX_FILE_BYTES = 8 * 1024 * 1024
@@ -234,9 +247,11 @@ class AuditLog:
         single: bool = False,
         error: BaseException | None = None,
         pending: bool = False,
+        judged: bool = False,
     ) -> AuditRecord:
         """One write to the controller and how it ended (``error`` None: it succeeded; ``pending``:
-        not known yet, an outcome line follows -- see :meth:`writing`)."""
+        not known yet, an outcome line follows -- see :meth:`writing`; ``judged``: a command's
+        write, whose outcome the controller tells later, see :meth:`record_result`)."""
         vals = [int(v) for v in values]
         try:
             # the register tables: imported by the first write, not with the window (start-up)
@@ -253,15 +268,20 @@ class AuditLog:
         args = {"fc": 6 if single else 16, "address": address, "values": vals[:MAX_VALUES_KEPT]}
         if len(vals) > MAX_VALUES_KEPT:
             args["count"] = len(vals)
+        if judged:
+            args["judged"] = True
         return self.record("write", command, result=result, args=args, detail=detail)
 
     @contextlib.contextmanager
-    def writing(self, address: int, values: Sequence[int], *, single: bool = False) -> Iterator[None]:
+    def writing(
+        self, address: int, values: Sequence[int], *, single: bool = False, judged: bool = False
+    ) -> Iterator[AuditRecord]:
         """Wrap one write, write-ahead: its line (``pending``) before the request goes out, its
-        outcome line after; the reader merges them. Errors pass through unchanged."""
-        intent = self.record_write(address, values, single=single, pending=True)
+        outcome line after; the reader merges them. Errors pass through unchanged. Yields the
+        write's record (``judged``: the command's outcome is recorded against it later)."""
+        intent = self.record_write(address, values, single=single, pending=True, judged=judged)
         try:
-            yield
+            yield intent
         except Exception as exc:
             self._record_outcome(intent, exc)
             raise
@@ -271,6 +291,20 @@ class AuditLog:
         result, detail = _write_result(error)
         self.record(
             OUTCOME, intent.command, result=result, args={"ref": intent.seq}, detail=detail, role=intent.role
+        )
+
+    def record_result(
+        self, write: AuditRecord, result: str, detail: str, args: dict[str, Any] | None = None
+    ) -> AuditRecord:
+        """What the controller made of the command ``write`` sent (``done``, ``refused``,
+        ``stopped``, ``unknown``; ``detail``: in words); the reader merges it into the write."""
+        return self.record(
+            RESULT,
+            write.command,
+            result=result,
+            args={"ref": write.seq, **(args or {})},
+            detail=detail,
+            role=write.role,
         )
 
     def record_refused(self, action: str, reason: str, args: dict[str, Any] | None = None) -> AuditRecord:

@@ -3,11 +3,14 @@
 A file is ``audit-YYYY-MM-DD.jsonl`` (part 0) or ``audit-YYYY-MM-DD.N.jsonl``, one JSON object
 per line (:class:`AuditRecord`). A write is two lines: the write itself with result ``pending``
 (before the request goes out) and an ``outcome`` line (``args.ref`` = the write's ``seq``) once
-it is answered. :func:`read_records` merges them into one record, so every write the controller
-may have received is read exactly once; a write whose outcome line never came (the process
-died) reads as ``unknown``. Lines that do not parse (a line cut short by a power cut, damage)
-are skipped and counted in :class:`ReadStats`. :func:`query` filters (:class:`AuditFilter`),
-:func:`export_csv` writes what the viewer shows.
+it is answered. A command's write (``args.judged``) has a third, ``result``: what the controller
+made of the command (done / refused / stopped / unknown, see :mod:`app.link.outcome`).
+:func:`read_records` merges them into one record, so every write the controller may have
+received is read exactly once; a write whose outcome line never came (the process died) reads
+as ``unknown``, and so does a judged write answered but without its result line. Lines that do
+not parse (a line cut short by a power cut, damage) are skipped and counted in
+:class:`ReadStats`. :func:`query` filters (:class:`AuditFilter`), :func:`export_csv` writes what
+the viewer shows.
 
 Everything here is re-exported by :mod:`app.safety.audit`, so ``from app.safety.audit import
 query`` keeps working.
@@ -32,7 +35,9 @@ __all__ = [
     "FILE_RE",
     "MAX_OUTCOME_LAG",
     "OUTCOME",
+    "RESULT",
     "UNKNOWN_DETAIL",
+    "UNKNOWN_OUTCOME_DETAIL",
     "AuditFilter",
     "AuditRecord",
     "ReadStats",
@@ -43,22 +48,32 @@ __all__ = [
     "export_csv",
     "query",
     "read_records",
+    "result_label",
 ]
 
 FILE_RE = re.compile(r"audit-(\d{4}-\d{2}-\d{2})(?:\.(\d+))?\.jsonl")
 
 
 class Result:
-    OK = "ok"
-    FAILED = "failed"  # sent, and the controller or the link failed it
+    OK = "ok"  # sent and answered (a write that is not a command: nothing more to tell)
+    FAILED = "failed"  # sent, and the controller or the link failed the write
     BLOCKED = "blocked"  # not sent: monitor-only
-    REFUSED = "refused"  # not sent: the host refused (envelope, role, bad value)
+    # kind "refused": not sent, the host refused (envelope, role, bad value, controller busy);
+    # kind "write": the controller refused the command (args.status: its GV291 code, if any)
+    REFUSED = "refused"
     PENDING = "pending"  # in the file only: sent, its outcome line follows (merged by the reader)
-    UNKNOWN = "unknown"  # sent, no outcome recorded (TeachPad stopped before the answer)
+    UNKNOWN = "unknown"  # sent, and what the controller did is not known
+    DONE = "done"  # a command the controller reported (or was seen) done
+    STOPPED = "stopped"  # a command a stop ended
 
 
 OUTCOME = "outcome"  # the kind of a write's second line (merged into the write by the reader)
+RESULT = "result"  # the kind of a command write's third line: the controller's outcome (merged)
 UNKNOWN_DETAIL = "sent; TeachPad stopped before the answer was recorded"
+UNKNOWN_OUTCOME_DETAIL = (
+    "sent and answered; the controller's outcome was not recorded (still under way when read, "
+    "or TeachPad stopped first)"
+)
 MAX_OUTCOME_LAG = 4096  # records read after a pending write before the reader stops waiting
 
 
@@ -137,13 +152,33 @@ def audit_files(directory: Path, start: dt.date | None = None, end: dt.date | No
     return [p for _, _, p in sorted(out)]
 
 
-class _Slot:
-    """A record waiting in file order; a pending write waits for its outcome line."""
+def result_label(record: AuditRecord) -> str:
+    """The result as the CLI prints it: ``refused:13`` for a command the controller refused with
+    GV291 code 13, else the result word."""
+    status = record.args.get("status")
+    if record.result == Result.REFUSED and record.kind == "write" and isinstance(status, int):
+        return f"{record.result}:{status}"
+    return record.result
 
-    __slots__ = ("pending", "record")
+
+class _Slot:
+    """A record waiting in file order; a pending write waits for its outcome line, a judged one
+    (a command) also for its result line."""
+
+    __slots__ = ("judged", "pending", "record")
 
     def __init__(self, record: AuditRecord) -> None:
         self.record, self.pending = record, record.result == Result.PENDING
+        self.judged = self.pending and record.args.get("judged") is True
+
+    def take(self, line: AuditRecord) -> None:
+        """Merge an ``outcome`` or ``result`` line into the write."""
+        extra = {k: v for k, v in line.args.items() if k != "ref"}
+        self.record = replace(
+            self.record, result=line.result, detail=line.detail, args={**self.record.args, **extra}
+        )
+        # an answered command still waits for the controller's outcome; anything else is final
+        self.pending = line.kind == OUTCOME and self.judged and line.result == Result.OK
 
 
 def read_records(
@@ -170,12 +205,13 @@ def read_records(
             except (ValueError, TypeError, UnicodeDecodeError):
                 stats.skipped += 1
                 continue
-            if rec.kind == OUTCOME:
+            if rec.kind in (OUTCOME, RESULT):
                 ref = rec.args.get("ref")
                 slot = waiting.pop((rec.session, ref), None) if isinstance(ref, int) else None
                 if slot is not None:
-                    slot.pending = False
-                    slot.record = replace(slot.record, result=rec.result, detail=rec.detail)
+                    slot.take(rec)
+                    if slot.pending:  # (ref is the slot's seq)
+                        waiting[(rec.session, slot.record.seq)] = slot
             else:  # (an outcome whose write is outside the range read shows nothing)
                 held.append(_Slot(rec))
                 if held[-1].pending:
@@ -194,8 +230,11 @@ def read_records(
 
 
 def _give_up(slot: _Slot, stats: ReadStats) -> None:
+    answered = slot.record.result == Result.OK  # a command answered, its outcome not recorded
     slot.pending = False
-    slot.record = replace(slot.record, result=Result.UNKNOWN, detail=UNKNOWN_DETAIL)
+    slot.record = replace(
+        slot.record, result=Result.UNKNOWN, detail=UNKNOWN_OUTCOME_DETAIL if answered else UNKNOWN_DETAIL
+    )
     stats.unknown += 1
 
 

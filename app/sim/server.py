@@ -83,6 +83,8 @@ class SimController:
         self._silent = False
         # (code or None: off, addresses or None: all, connection or None: all), replaced whole
         self._exception_rule: tuple[ExcCodes | None, range | None, int | None] = (None, None, None)
+        # set_exception(after_write=REG): the rule waits for a stored write covering REG (None: armed)
+        self._exception_after: int | None = None
         self.point_write_refusals = PointWriteRefusals()
         # GV291 publication hold (app/sim/status.py), the register image, the command execution
         self.status = StatusPublisher(self.config.timing, self.config.command_latency, self.config.seed)
@@ -263,7 +265,11 @@ class SimController:
         if delay > 0:
             await asyncio.sleep(delay)
         exc, exc_range, exc_on = self._exception_rule
-        hit = touches(exc_range, address, count) and exc_on in (None, connection)
+        hit = (
+            touches(exc_range, address, count)
+            and exc_on in (None, connection)
+            and self._exception_after is None
+        )
         if exc is not None and hit:
             return exc
         if set_values is not None:
@@ -296,6 +302,10 @@ class SimController:
                 ratio = gv_reg(GV_PARAM3)
                 if self.robot.jogging and address <= ratio + 1 and ratio < address + len(values):
                     self.watchdog.jog_written(connection)
+                armer = self._exception_after
+                if armer is not None and address <= armer < address + len(values):
+                    self._exception_after = None  # the exception rule applies from the next request on
+                    log.info("exception rule armed by the write to %d", armer)
             self._refresh(registers, start_address)
             status_reg = gv_reg(GV_COMMAND_STATUS)
             if set_values is None and address <= status_reg < address + count:
@@ -486,13 +496,27 @@ class SimController:
         log.info("silent %s", "on" if silent else "off")
 
     def set_exception(
-        self, code: ExcCodes | int | None, addresses: range | None = None, connection: int | None = None
+        self,
+        code: ExcCodes | int | None,
+        addresses: range | None = None,
+        connection: int | None = None,
+        *,
+        after_write: int | None = None,
     ) -> None:
         """Answer requests touching ``addresses`` (None: all) with Modbus exception ``code``; only
-        on one connection when ``connection`` (an id of :meth:`connection_ids`) is given."""
-        self._exception_rule = (None if code is None else ExcCodes(code), addresses, connection)
+        on one connection when ``connection`` (an id of :meth:`connection_ids`) is given; only
+        from the first request after a stored write covering register ``after_write`` on (e.g.
+        440: the status becomes unreadable once a command was taken)."""
+        with self.lock:
+            self._exception_after = None if code is None else after_write
+            self._exception_rule = (None if code is None else ExcCodes(code), addresses, connection)
+        after = "" if after_write is None else f" after a write to {after_write}"
         log.info(
-            "exception %s%s%s", "off" if code is None else int(code), at_text(addresses), on_text(connection)
+            "exception %s%s%s%s",
+            "off" if code is None else int(code),
+            at_text(addresses),
+            on_text(connection),
+            after,
         )
 
     def connection_ids(self) -> list[int]:

@@ -251,22 +251,20 @@ def test_plain_commands(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     assert run(csim, capsys, "mode", "manual")[0] == ExitCode.OK
     assert csim.state().work_mode is WorkMode.MANUAL
     assert run(csim, capsys, "mode", "auto")[0] == ExitCode.OK
-    code, out, _ = run(csim, capsys, "program", "run", "2", "--mode", "single", "--speed", "50")
-    assert code == ExitCode.OK and "program 2 running" in out
-    assert csim.wait_for(lambda s: s.moving, 2.0)
-    assert run(csim, capsys, "pause")[0] == ExitCode.OK
-    assert csim.wait_for(lambda s: s.paused, 2.0)
+    code, out, _ = run(csim, capsys, "program", "run", "2", "--mode", "single", "--speed", "50", "--no-wait")
+    assert code == ExitCode.OK and out == "run program 2: started (under way; its end is not waited for)\n"
+    assert csim.state().moving
+    code, out, _ = run(csim, capsys, "pause")
+    assert code == ExitCode.OK and out == "pause: done (the program state reads paused)\n"
+    assert csim.state().paused
     assert run(csim, capsys, "resume")[0] == ExitCode.OK
-    assert csim.wait_for(lambda s: not s.paused, 2.0)
-    assert run(csim, capsys, "stop")[1] == "stop sent\n"
-    assert csim.wait_for(lambda s: not s.moving, 2.0)
-    code, out, _ = run(csim, capsys, "zero", "J2")
-    assert code == ExitCode.OK and out == "go to zero sent (J2)\n"
-    assert csim.writes[-1].address == 445 and csim.writes[-1].values == (1,)
-    assert csim.wait_for(lambda s: not s.moving, 5.0)
-    run(csim, capsys, "zero", "all")
-    assert csim.writes[-1].values == (0x0B,)
-    run(csim, capsys, "stop")
+    assert not csim.state().paused
+    assert run(csim, capsys, "stop")[1] == "stop: done (the program state reads stopped)\n"
+    assert not csim.state().moving
+    code, out, _ = run(csim, capsys, "zero", "J2")  # waits until the arm stands at zero
+    assert code == ExitCode.OK and out == "go to zero (J2): done\n"
+    assert csim.writes_to(445)[-1].values == (1,)
+    assert not csim.state().moving and csim.state().joints[1] == pytest.approx(0.0, abs=0.01)
     code, _, err = run(csim, capsys, "zero", "J12")
     assert code == ExitCode.USAGE and "J1..J11" in one_line_error(err)
 

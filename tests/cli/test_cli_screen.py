@@ -72,7 +72,7 @@ def test_program_run_of_an_unknown_program_is_an_error(sim: Any, capsys: pytest.
     code = main(["--port", str(sim.port), "program", "run", "99"])
     out, err = capsys.readouterr()
     assert code == ExitCode.FAILED and out == ""
-    assert err.startswith("teachpad-cli: error: the controller did not start program 99")
+    assert err.startswith("teachpad-cli: error: run program 99 refused: the program did not start")
     assert len(err.strip().splitlines()) == 1
     assert not sim.state().moving
 

@@ -105,6 +105,7 @@ def test_the_table_keeps_its_numbers() -> None:
         "FAILED": 1,
         "USAGE": 2,
         "LINK": 3,
+        "UNKNOWN": 4,
         "INTERRUPTED": 130,
     }
 
@@ -124,6 +125,8 @@ def test_every_typed_error_maps_to_one_code() -> None:
         errors.LinkError: ExitCode.LINK,
         errors.ResponseTimeout: ExitCode.LINK,
         errors.MalformedResponse: ExitCode.LINK,
+        errors.CommandTimeout: ExitCode.UNKNOWN,  # taken, not finished in time: what it did is unknown
+        errors.OutcomeUnknown: ExitCode.UNKNOWN,
     }
     classes = _error_classes()
     assert set(LINK_ERRORS) <= set(classes) and len(classes) >= 10

@@ -35,6 +35,9 @@ class FakeClient:
     #: the points the fake controller holds (id -> pose), from create_point; a move to one of
     #: them puts ``pose`` there, like the simulator does (a move elsewhere leaves it)
     stored: dict[int, tuple[float, ...]] = field(default_factory=dict)
+    # the commands a CLI context ends as unknown when it closes with one still under way (none here)
+    last_tracker: Any = None
+    last_watch: Any = None
 
     def read_gv(self, n: int, count: int = 1) -> list[float]:
         return [self.gvs.get(n + i, 0.0) for i in range(count)]

@@ -5,8 +5,11 @@ from __future__ import annotations
 import pytest
 
 from app import timing
-from app.link.motion import MotionTracker, MotionWatch
+from app.errors import Reason
+from app.link.motion import MotionTracker
+from app.link.outcome import Outcome, outcome_of
 from app.link.types import Operation
+from app.link.watch import MotionWatch
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import Alarm, ControllerMode, ProgramState, RunCommand
 
@@ -29,17 +32,61 @@ def test_watch_needs_motion_then_standing_still() -> None:
 
 def test_watch_without_motion_is_refused_after_the_ack_timeout(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
-    watch = MotionWatch(None, "go to zero (all axes)", _pose(0), 0.0)
+    watch = MotionWatch(None, "go to zero (all axes)", _pose(0), 0.0, operation=Operation.GO_ZERO)
     assert watch.update(IDLE, _pose(0), 0.4) is None
     result = watch.update(IDLE, _pose(0), 0.6)
-    assert result is not None and not result.ok and "no motion within 0.5 s" in result.message
+    assert result is not None and not result.ok and "nothing moved within 0.5 s" in result.message
+    assert outcome_of(result) is Outcome.REFUSED and result.reason == Reason(
+        "no_motion", {"operation": "go to zero", "seconds": 0.5}
+    )
 
 
 def test_watch_ends_on_an_alarm() -> None:
-    watch = MotionWatch(None, "go to zero (J1)", _pose(0), 0.0)
+    watch = MotionWatch(None, "go to zero (J1)", _pose(0), 0.0, operation=Operation.GO_ZERO)
     alarm = ControllerStatus(ControllerMode.AUTO, ProgramState.STOPPED, Alarm.ESTOP, 0)
     result = watch.update(alarm, _pose(0), 0.1)
-    assert result is not None and not result.ok and "alarm" in result.message
+    assert result is not None and not result.ok
+    assert result.message == "go to zero (J1) refused by the controller: emergency stop"
+    assert outcome_of(result) is Outcome.REFUSED and result.reason is not None
+    assert result.reason.code == "refused_alarm" and result.reason.args["alarms"] == int(Alarm.ESTOP)
+    # an alarm after the motion was seen ended it
+    watch = MotionWatch(None, "go to zero (J1)", _pose(0), 0.0, operation=Operation.GO_ZERO)
+    assert watch.update(RUNNING, _pose(3), 0.1) is None
+    result = watch.update(alarm, _pose(4), 0.2)
+    assert result is not None and result.message == "go to zero (J1): ended by an alarm: emergency stop"
+    assert outcome_of(result) is Outcome.REFUSED
+
+
+def test_go_to_zero_is_done_only_at_zero_when_joints_are_reported(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
+
+    def joints(j2: float) -> Pose:
+        return Pose(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, joints=(0.0, j2, 0.0, 0.0, 0.0, 0.0))
+
+    watch = MotionWatch(None, "go to zero (J2)", joints(30.0), 0.0, operation="go to zero", zero_axes=(1,))
+    assert watch.update(RUNNING, joints(20.0), 0.1) is None
+    result = watch.update(IDLE, joints(20.0), 0.2)  # stood still short of zero (stopped by someone)
+    assert result is not None and outcome_of(result) is Outcome.STOPPED
+    assert result.message == "go to zero (J2): the arm stopped before zero (J2 at 20.000)"
+    watch = MotionWatch(None, "go to zero (J2)", joints(0.0), 0.0, operation="go to zero", zero_axes=(1,))
+    result = watch.update(IDLE, joints(0.0), 0.6)  # nothing moved: it was already there
+    assert result is not None and result.ok and result.message == "go to zero (J2): done (already at zero)"
+
+
+def test_watch_outcome_unknown_and_stopped_reach_its_hook() -> None:
+    seen: list[CommandResult] = []
+    watch = MotionWatch(RunCommand.RUN_PROGRAM, "run program 1", _pose(0), 0.0, program=1)
+    watch.note = seen.append
+    result = watch.unknown(1.0, "status unreadable")
+    assert outcome_of(result) is Outcome.UNKNOWN and seen == [result]
+    assert result.message == (
+        "run program 1: sent; the outcome is unknown \u2014 check the robot before sending it again "
+        "(status unreadable)"
+    )
+    assert watch.stopped(2.0) is result and seen == [result]  # ended once
+    watch = MotionWatch(RunCommand.RUN_PROGRAM, "run program 1", _pose(0), 0.0, program=1)
+    watch.note = seen.append
+    assert outcome_of(watch.stopped(1.0)) is Outcome.STOPPED and len(seen) == 2
 
 
 class _Done:
@@ -48,6 +95,11 @@ class _Done:
 
     def stopped(self, now: float) -> CommandResult:
         return CommandResult(None, None, None, False, "stopped")
+
+    def unknown(
+        self, now: float, cause: object = None, *, message: str | None = None, reason: Reason | None = None
+    ) -> CommandResult:
+        return CommandResult(None, None, None, False, message or "unknown", reason=reason)
 
 
 def test_tracker_hands_out_the_result_once_with_its_request_id() -> None:

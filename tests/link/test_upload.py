@@ -283,6 +283,8 @@ _LINK_FAILED_BY_CODE = {
     "file_format": False,
     "empty_import": False,
     "jog_not_answering": False,  # the jog's own check before it starts: nothing was sent
+    "outcome_unknown": False,  # taken, then its status could not be read: counted by the reads that failed
+    "controller_busy": False,  # not sent: the controller runs a program
     "error": False,
 }
 

@@ -1,4 +1,8 @@
-"""The audit trail viewer: filter by date, role, command and result; export the rows shown as CSV."""
+"""The audit trail viewer: filter by date, role, command and result; export the rows shown as CSV.
+
+A command's result is the controller's outcome (done, refused -- with its status code, as
+"refused:13" --, stopped, unknown; see app/link/outcome.py); other writes read ok when answered.
+"""
 
 from __future__ import annotations
 
@@ -23,7 +27,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.safety.audit import AuditFilter, AuditRecord, ReadStats, Result, export_csv, query
+from app.safety.audit import AuditFilter, AuditRecord, ReadStats, Result, export_csv, query, result_label
 
 DEFAULT_DAYS = 7  # the range shown when the viewer opens
 MAX_ROWS = 20000  # newest rows kept in the table (the CSV export takes the same rows)
@@ -72,7 +76,9 @@ class AuditModel(QAbstractTableModel):
             return r.host_time.replace("T", " ")[:23]
         value = str(getattr(r, col))
         if col in ("role", "kind", "result"):  # the file keeps English keys; the table shows words
-            return self._words().get(value, value)
+            words = self._words().get(value, value)
+            label = result_label(r) if col == "result" else value
+            return words + label[len(value) :]  # "refused:13": the controller's code after the word
         return value
 
     def _words(self) -> dict[str, str]:
@@ -85,10 +91,12 @@ class AuditModel(QAbstractTableModel):
             "refused": self.tr("refused"),
             "login": self.tr("login"),
             "action": self.tr("action"),
-            "ok": self.tr("ok"),
+            "ok": self.tr("answered"),  # a plain write: answered (a command reads its outcome)
             "failed": self.tr("failed"),
             "blocked": self.tr("blocked"),
             "unknown": self.tr("unknown"),
+            "done": self.tr("done"),
+            "stopped": self.tr("stopped"),
         }
 
 
@@ -127,11 +135,13 @@ class AuditViewer(QDialog):
         self.result_box = QComboBox(self)
         self.result_box.addItem(self.tr("Any result"), None)
         for value, text in (
-            (Result.OK, self.tr("ok")),
+            (Result.DONE, self.tr("done")),
+            (Result.REFUSED, self.tr("refused")),
+            (Result.STOPPED, self.tr("stopped")),
+            (Result.UNKNOWN, self.tr("unknown")),
+            (Result.OK, self.tr("answered")),
             (Result.FAILED, self.tr("failed")),
             (Result.BLOCKED, self.tr("blocked")),
-            (Result.REFUSED, self.tr("refused")),
-            (Result.UNKNOWN, self.tr("unknown")),
         ):
             self.result_box.addItem(text, value)
         self.refresh_button = QPushButton(self.tr("Show"), self)
@@ -182,8 +192,8 @@ class AuditViewer(QDialog):
         text = self.tr("{n} records")
         if stats.skipped:
             text = self.tr("{n} records ({skipped} damaged lines skipped)")
-        if stats.unknown:  # sent when TeachPad stopped: what the controller did is not recorded
-            text += " " + self.tr("{unknown} writes without a recorded answer (TeachPad stopped)")
+        if stats.unknown:  # sent, and its answer or the controller's outcome was never recorded
+            text += " " + self.tr("{unknown} writes whose answer or outcome was not recorded")
         self.status.setText(text.format(n=n, skipped=stats.skipped, unknown=stats.unknown))
         self.table.scrollToBottom()
 
