@@ -437,3 +437,54 @@ def test_a_step_that_moves_external_axes_is_done_only_when_they_arrived_too(
         tr, [(0.01, st(DONE), short), (0.1, st(DONE), short), (0.41, st(DONE), short), (0.8, st(DONE), short)]
     )
     assert i == 3 and not result.ok and "result is unknown" in result.message
+
+
+# --- a long wait (issue 18: "a long move crashes the client") ----------------------------------
+
+
+def _long_move_tracker() -> CommandTracker:
+    return CommandTracker(
+        RunCommand.STEP_BASE, st(DONE), HOME, 0.0, rule="sentinel", pre_code=STATUS_SENTINEL
+    )
+
+
+def test_a_ten_minute_move_is_read_at_the_cap_to_the_end_without_overflow_or_growth() -> None:
+    """Ten minutes of a move's wait, as CommandClient.wait paces it (the clock injected: each read
+    at the time the tracker planned). It used to raise OverflowError at the 1025th read (about
+    11 s into a move at the 10 ms cap); the tracker's memory must not grow with the reads either."""
+    import tracemalloc
+
+    tr = _long_move_tracker()
+    ten_minutes = 600.0
+    now, x = 0.0, 0.0
+    intervals: set[float] = set()
+    tracemalloc.start()
+    try:
+        sizes: dict[int, int] = {}
+        while now < ten_minutes:
+            x += 0.001  # 0.1 mm/s at 100 reads a second: progress on every read
+            assert tr.update(st(int(MoveStatus.MOVING), RUNNING), moved(x), now) is None
+            interval = tr.poll_interval(now)
+            intervals.add(round(interval, 9))
+            now += interval
+            minute = int(now // 60)
+            if minute not in sizes:
+                sizes[minute] = tracemalloc.get_traced_memory()[0]
+        result = tr.update(st(DONE), moved(x), now)
+    finally:
+        tracemalloc.stop()
+    assert result is not None and result.ok
+    assert tr.reads > 60_000  # a read every MOVE_POLL_INTERVAL all along
+    assert max(intervals) == pytest.approx(timing.MOVE_POLL_INTERVAL)
+    # what was allocated between minute 1 and minute 10 of the wait: a few small objects, not per read
+    assert sizes[10] - sizes[1] < 4096
+
+
+def test_backoff_of_any_read_count_is_the_cap() -> None:
+    from app.link.tracker import backoff
+
+    assert backoff(0.001, 0.01, 0) == 0.001
+    assert backoff(0.001, 0.01, -3) == 0.001
+    assert backoff(0.001, 0.01, 3) == 0.008
+    for doublings in (1023, 1024, 1025, 10**6, 10**12):
+        assert backoff(0.001, 0.01, doublings) == 0.01
