@@ -30,7 +30,9 @@ from app.cli.format import (
 )
 from app.errors import AlarmRaised, CommandRefused, InvalidInput, TeachPadError
 from app.link.client import RobotClient, StepFrame
+from app.link.halt import HaltWatch, HaltWrite, confirm_halt
 from app.link.tracker import pose_moved
+from app.link.types import HaltKind
 from app.models import Pose
 from app.protocol import registers
 from app.protocol.codec import decode_floats, encode_floats
@@ -136,6 +138,7 @@ def cmd_jog(ctx: CliContext) -> ExitCode:
         raise InvalidInput(f"jog ratio must be in (0, 100], got {args.ratio}")
     client = ctx.client
     writes_before = client.write_count
+    halt: HaltWatch | None = None
     try:
         result = client.teach_enable(frame, axis, direction, user_frame=args.user, tool_frame=args.tool)
         ctx.print(result.message)
@@ -155,20 +158,53 @@ def cmd_jog(ctx: CliContext) -> ExitCode:
         # (but not when nothing was written, e.g. monitor-only or no link at all).
         if client.write_count != writes_before:
             with sigint_deferred():
-                _jog_cleanup(ctx, client)
+                halt = _jog_cleanup(ctx, client)
+    if halt is not None and not halt.over:
+        raise TeachPadError(_halt_failed("jog", halt), code="halt_unconfirmed")
     ctx.print(_pose_line(client.read_pose()))
     return ExitCode.OK
 
 
-def _jog_cleanup(ctx: CliContext, client: RobotClient) -> None:
-    try:
-        client.teach_set_ratio(0.0)
-    except TeachPadError as exc:
-        ctx.warn(f"could not set the jog ratio to 0: {exc}")
+def _jog_cleanup(ctx: CliContext, client: RobotClient) -> HaltWatch:
+    """The jog is over only when the controller has answered speed 0 (or a Stop) and the pose is
+    seen still: speed 0 again every ``JOG_POLL_INTERVAL``, a Stop too after
+    ``timing.HALT_ESCALATE_AFTER``, for ``timing.HALT_CONFIRM_BUDGET`` at most (app/link/halt.py).
+    Then teach mode off. What went wrong is said in a warning (the arm stopped or not)."""
+    halt = HaltWatch(HaltKind.RELEASE, None, time.monotonic())
+    _confirm(client, halt)
+    if not halt.over:
+        ctx.warn(_halt_failed("jog", halt) + "; teach mode was left on")
+        return halt
+    if halt.refusals:
+        ctx.warn(_halt_confirmed("jog", halt))
     try:
         client.teach_disable()
     except TeachPadError as exc:
         ctx.warn(f"could not disable teach mode: {exc}")
+    return halt
+
+
+def _confirm(client: RobotClient, halt: HaltWatch) -> None:
+    def write(what: HaltWrite) -> None:
+        if what is HaltWrite.SPEED_ZERO:
+            client.teach_set_ratio(0.0)
+        else:
+            client.stop()
+
+    confirm_halt(write, client.read_pose, halt, interval=JOG_POLL_INTERVAL)
+
+
+def _halt_failed(what: str, halt: HaltWatch) -> str:
+    return f"{what}: {halt.words(time.monotonic())}: the arm may still be moving -- stop it at the controller"
+
+
+def _halt_confirmed(what: str, halt: HaltWatch) -> str:
+    seconds = (halt.answered_at or time.monotonic()) - halt.since
+    answered = "stop (441)" if halt.answered_by is HaltWrite.STOP else "speed 0"
+    return (
+        f"{what}: the controller refused or did not answer {halt.refusals} time(s) "
+        f"({halt.last_error}); it took the {answered} after {seconds:.1f} s and the arm stands still"
+    )
 
 
 def cmd_point_create(ctx: CliContext) -> ExitCode:
@@ -260,7 +296,13 @@ def _start_program(ctx: CliContext, client: RobotClient, before: Pose) -> ExitCo
 
 
 def cmd_stop(ctx: CliContext) -> ExitCode:
-    ctx.client.stop()
+    """441 until the controller takes it and the pose is seen still (app/link/halt.py)."""
+    halt = HaltWatch(HaltKind.STOP, None, time.monotonic())
+    _confirm(ctx.client, halt)
+    if not halt.over:
+        raise TeachPadError(_halt_failed("stop", halt), code="halt_unconfirmed")
+    if halt.refusals:
+        ctx.warn(_halt_confirmed("stop", halt))
     return ctx.report("stop sent")
 
 
