@@ -299,6 +299,8 @@ def cmd_stop(ctx: CliContext) -> ExitCode:
     """441 until the controller takes it and the pose is seen still (app/link/halt.py)."""
     halt = HaltWatch(HaltKind.STOP, None, time.monotonic())
     _confirm(ctx.client, halt)
+    if halt.given_up and halt.refusals == 1 and halt.last_error is not None:
+        raise halt.last_error  # refused for good (not busy): the controller's own words, at once
     if not halt.over:
         raise TeachPadError(_halt_failed("stop", halt), code="halt_unconfirmed")
     if halt.refusals:

@@ -33,7 +33,7 @@ from app.link.arrival import pose_moved
 from app.link.types import HaltKind, JogRequest, UnconfirmedHalt
 from app.models import Pose
 
-__all__ = ["HaltWatch", "HaltWrite", "confirm_halt", "halt_refusal"]
+__all__ = ["RETRY_EXCEPTIONS", "HaltWatch", "HaltWrite", "confirm_halt", "halt_refusal"]
 
 
 class HaltWrite(enum.Enum):
@@ -43,11 +43,23 @@ class HaltWrite(enum.Enum):
     STOP = "stop"  # 441 <- 1: everything stops
 
 
+#: Modbus exceptions that mean "not now" (PROTOCOL.md section 7): 4 server device failure,
+#: 5 acknowledge (still working on an earlier request), 6 server device busy. Any other exception
+#: (illegal function, address, value ...) refuses that write for good: it is not sent again (a
+#: release then goes on with Stop at once).
+RETRY_EXCEPTIONS = frozenset({4, 5, 6})
+
+
 def halt_refusal(exc: TeachPadError) -> bool:
-    """The controller refused the write (a Modbus exception: busy...) or did not answer it in time:
-    worth sending again at the next poll. Anything else (the link is gone, a bad answer) is the
-    link's failure and goes its own way (the write is tried again once the link is back)."""
+    """The controller refused the write (a Modbus exception) or did not answer it in time: the
+    halt goes on. Anything else (the link is gone, a bad answer) is the link's failure and goes
+    its own way (the write is tried again once the link is back)."""
     return isinstance(exc, ModbusExceptionError | ResponseTimeout)
+
+
+def _for_good(exc: TeachPadError) -> bool:
+    """A refusal that sending the same write again cannot change."""
+    return isinstance(exc, ModbusExceptionError) and exc.exception_code not in RETRY_EXCEPTIONS
 
 
 class HaltWatch:
@@ -77,6 +89,7 @@ class HaltWatch:
         self.refusals = 0  # halting writes refused or unanswered
         self.silent = False  # the controller stopped answering while this jog ran
         self.last_error: TeachPadError | None = None
+        self.refused_for_good: set[HaltWrite] = set()  # not sent again (see RETRY_EXCEPTIONS)
         self.over = False
         self._still_from: Pose | None = None  # the pose of the last poll after the answer
         self._moving_after_answer = False  # answered, and the pose still changed after that
@@ -100,10 +113,21 @@ class HaltWatch:
         if now - self.since >= self.escalate_after:
             self.escalated = True
         if self.kind is HaltKind.STOP and self.request is None:
-            return (HaltWrite.STOP,)
-        if self.escalated:
-            return (HaltWrite.STOP, HaltWrite.SPEED_ZERO)
-        return (HaltWrite.SPEED_ZERO,)
+            writes: tuple[HaltWrite, ...] = (HaltWrite.STOP,)
+        elif self.escalated:
+            writes = (HaltWrite.STOP, HaltWrite.SPEED_ZERO)
+        else:
+            writes = (HaltWrite.SPEED_ZERO,)
+        return tuple(w for w in writes if w not in self.refused_for_good)
+
+    @property
+    def given_up(self) -> bool:
+        """Every write that could stop the arm was refused for good and none was answered: there
+        is nothing left to send (the arm may still move)."""
+        if self.over or self.answered_at is not None:
+            return False
+        needed = {HaltWrite.STOP} if self.kind is HaltKind.STOP and self.request is None else set(HaltWrite)
+        return needed <= self.refused_for_good
 
     def escalate(self) -> bool:
         """The envelope guard sees the arm heading over a boundary: a Stop at once -- unless the
@@ -126,9 +150,14 @@ class HaltWatch:
             self._moving_after_answer = False
         self.silent = False
 
-    def refused(self, exc: TeachPadError) -> None:
+    def refused(self, write: HaltWrite, exc: TeachPadError) -> None:
+        """The controller did not take ``write``: refused (``exc``, a Modbus exception) or no
+        answer. Refused for good: not sent again, and a Stop goes out at once instead."""
         self.refusals += 1
         self.last_error = exc
+        if _for_good(exc):
+            self.refused_for_good.add(write)
+            self.escalated = True
 
     def pose_seen(self, pose: Pose) -> bool:
         """A poll's pose; True once the halt is over (answered, then the pose unchanged from one
@@ -175,8 +204,9 @@ def confirm_halt(
     sleep: Callable[[float], None] = time.sleep,
 ) -> bool:
     """Blocking (teachpad-cli): send what ``watch`` asks for, read the pose, every ``interval``
-    s, until the halt is over (True) or ``budget`` s (default
-    :data:`app.timing.HALT_CONFIRM_BUDGET`) have passed since the watch began (False).
+    s, until the halt is over (True), or ``budget`` s (default
+    :data:`app.timing.HALT_CONFIRM_BUDGET`) have passed since the watch began, or every write
+    was refused for good (False).
 
     ``write`` raises a :class:`TeachPadError` when the controller did not take it: refused or
     unanswered (:func:`halt_refusal`) counts and is tried again; anything else is raised. A pose
@@ -190,7 +220,7 @@ def confirm_halt(
             except TeachPadError as exc:
                 if not halt_refusal(exc):
                     raise
-                watch.refused(exc)
+                watch.refused(item, exc)
             else:
                 watch.took(item, clock())
         if watch.answered_at is not None:
@@ -202,6 +232,6 @@ def confirm_halt(
             else:
                 if watch.pose_seen(pose):
                     return True
-        if clock() - watch.since >= budget:
+        if watch.given_up or clock() - watch.since >= budget:
             return False
         sleep(interval)

@@ -217,7 +217,7 @@ class JogMachine:
         if halt is None or halt.kind is not HaltKind.STOP:
             request = jog if jog is not None else (halt.request if halt is not None else None)
             halt = self.halt = HaltWatch(HaltKind.STOP, request, time.monotonic())
-        halt.refused(exc)
+        halt.refused(HaltWrite.STOP, exc)
         self._publish_halt()
 
     # --- jobs ----------------------------------------------------------------------------
@@ -393,7 +393,7 @@ class JogMachine:
                 try:
                     self._send(write)
                 except TeachPadError as exc:
-                    halt.refused(exc)
+                    halt.refused(write, exc)
                     if not halt_refusal(exc):
                         failure = exc
                         break
@@ -418,7 +418,7 @@ class JogMachine:
                 None,
                 True,
                 f"{what}: confirmed by the controller after {seconds:.1f} s (the arm stands still)",
-                reason=Reason("halt_confirmed", {"seconds": round(seconds, 1), "kind": halt.kind.value}),
+                reason=Reason(f"{halt.kind.value}_confirmed", {"seconds": round(seconds, 1)}),
             ),
             None,
         )
@@ -482,11 +482,13 @@ class JogMachine:
         if state is None or halt is None or quiet:
             return
         now = time.monotonic()
-        if before is None or (state.escalated and not before.escalated):
-            code = "halt_escalated" if state.escalated else "halt_unconfirmed"
-            operation = Operation.JOG_RELEASE if halt.kind is HaltKind.RELEASE else Operation.STOP
-            args = {"seconds": round(now - halt.since, 1), "kind": halt.kind.value}
-            self._host.emit_error(operation, halt.words(now), None, Reason(code, args))
+        release = halt.kind is HaltKind.RELEASE
+        if before is None or (release and state.escalated and not before.escalated):
+            # release_unconfirmed, release_escalated (Stop sent too), stop_unconfirmed
+            step = "escalated" if release and state.escalated else "unconfirmed"
+            operation = Operation.JOG_RELEASE if release else Operation.STOP
+            reason = Reason(f"{halt.kind.value}_{step}", {"seconds": round(now - halt.since, 1)})
+            self._host.emit_error(operation, halt.words(now), None, reason)
 
     def set_ratio(self, ratio: float) -> None:
         """Speed slider moved while jogging: GV203 changes the speed live."""

@@ -24,6 +24,7 @@ from app.protocol import registers
 from app.protocol.enums import TeachFrame
 from app.safety.envelope import Box, Envelope
 from app.safety.jog_guard import JogGuard
+from app.sim.config import WriteRecord
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,
@@ -73,7 +74,7 @@ def _refused_for_a_while(qtbot: Any, sim: Any) -> None:
     qtbot.waitUntil(lambda: sim.requests_count >= before + REFUSED_REQUESTS, timeout=SIGNAL_TIMEOUT_MS)
 
 
-def _halting(write: Any) -> bool:
+def _halting(write: WriteRecord) -> bool:
     """A write that stops motion: speed 0 (GV203 <- 0.0) or Stop (441 <- 1)."""
     speed_zero = write.address == RATIO_REGISTERS.start and write.values == (0, 0)
     return speed_zero or (write.address == registers.REG_STOP and write.values == (1,))
@@ -149,7 +150,7 @@ def test_a_release_refused_beyond_the_budget_escalates_to_stop(
     assert [w.values for w in stops] == [(1,)]
     assert stops[0].t - released >= timing.HALT_ESCALATE_AFTER  # speed 0 was tried alone first
     qtbot.waitUntil(lambda: link.state.halt is None, timeout=SIGNAL_TIMEOUT_MS)
-    confirmed = [r for r in results if r.reason is not None and r.reason.code == "halt_confirmed"]
+    confirmed = [r for r in results if r.reason is not None and r.reason.code == "release_confirmed"]
     assert len(confirmed) == 1 and confirmed[0].ok
     sim.set_exception(None)
 
