@@ -177,3 +177,31 @@ def test_stop_refused_as_busy_goes_out_again_until_taken(
     stops = sim.writes_to(registers.REG_STOP)
     assert len(stops) == 1 and stops[0].t - answers_again < STOPS_WITHIN
     assert "took the stop (441)" in err
+
+
+def test_the_stop_after_ctrl_c_goes_out_again_while_the_controller_is_busy(
+    busy_sim: Any, make_client: Any
+) -> None:
+    from app.cli.context import stop_on_a_fresh_link
+
+    sim = busy_sim
+    client = make_client(sim)
+    client.step(StepFrame.BASE, [0.0, 0.0, -30.0, 0.0, 0.0, 0.0], speed=5.0, wait=False)  # 6 s
+    assert sim.wait_for(lambda s: s.moving, timeout=WAIT)
+    sim.set_exception(BUSY, STOP_REGISTER)
+
+    def answer_again() -> None:
+        before = sim.requests_count
+        deadline = time.monotonic() + WAIT
+        while sim.requests_count < before + REFUSED_REQUESTS // 3 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        sim.set_exception(None)
+
+    helper = threading.Thread(target=answer_again, name="test-busy-off", daemon=True)
+    helper.start()
+    stop_on_a_fresh_link(client)  # the old code: the busy answer raised, the move went on
+    join(helper)
+    assert sim.wait_for(lambda s: not s.moving, timeout=2.0)
+    # taken once busy ended (a second one follows: the step was never seen taken, see the function)
+    stops = sim.writes_to(registers.REG_STOP)
+    assert stops and all(w.values == (1,) for w in stops)
