@@ -81,6 +81,7 @@ class HaltWatch:
         self.kind = kind
         self.request = request
         self.since = now
+        self._clock_from = now  # the escalation's clock: from the release, or the controller's return
         self.escalate_after = timing.HALT_ESCALATE_AFTER if escalate_after is None else escalate_after
         self.escalated = kind is HaltKind.STOP  # a refused Stop: 441 is the write to repeat
         self.answered_at: float | None = None  # the controller answered a halting write
@@ -110,7 +111,7 @@ class HaltWatch:
                 return ()
             self.answered_at = None  # answered, yet the arm still moves: a Stop
             self.escalated = True
-        if now - self.since >= self.escalate_after:
+        if now - self._clock_from >= self.escalate_after:
             self.escalated = True
         if self.kind is HaltKind.STOP and self.request is None:
             writes: tuple[HaltWrite, ...] = (HaltWrite.STOP,)
@@ -128,6 +129,12 @@ class HaltWatch:
             return False
         needed = {HaltWrite.STOP} if self.kind is HaltKind.STOP and self.request is None else set(HaltWrite)
         return needed <= self.refused_for_good
+
+    def answering_again(self, now: float) -> None:
+        """The controller answers again after a silence: it gets the speed 0 first, and
+        ``escalate_after`` from now to take it (nothing could reach it while it was silent)."""
+        if self.silent and not self.escalated:
+            self._clock_from = now
 
     def escalate(self) -> bool:
         """The envelope guard sees the arm heading over a boundary: a Stop at once -- unless the

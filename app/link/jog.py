@@ -74,12 +74,6 @@ class JogMachine:
         return self.jog is not None or self.teach.moving
 
     @property
-    def ratio_zero_pending(self) -> bool:
-        """A jog's stop the controller has not answered yet (it goes out again at every poll)."""
-        halt = self.halt
-        return halt is not None and halt.answered_at is None
-
-    @property
     def halting(self) -> bool:
         """A jog or a Stop is being stopped and the controller has not confirmed it yet."""
         return self.halt is not None
@@ -124,7 +118,9 @@ class JogMachine:
 
     def controller_answers(self) -> None:
         """The dead-man after a silence: ratio 0 before anything else, if a jog was under way."""
-        if self.ratio_zero_pending:
+        halt = self.halt
+        if halt is not None and halt.answered_at is None:
+            halt.answering_again(time.monotonic())
             self.settle_halt()
 
     # --- sequences without urgent jobs in between (connect, close, idle) -------------------
