@@ -403,6 +403,11 @@ class JogMachine:
         if halt is None or not halt.pose_seen(pose):
             return
         self.halt = None
+        if not halt.speed_zero_answered and self.teach.moving:
+            # stopped by a Stop while GV203 still holds the jog's speed: teach mode counts as
+            # unknown, so the next jog writes speed 0 and switches teach off and on first
+            self.teach = TeachState()
+            self.teach_dirty = True
         if self._shown is None:
             return  # answered at once and seen still: nothing to say
         seconds = time.monotonic() - halt.since

@@ -193,3 +193,20 @@ def test_a_stop_refused_as_busy_goes_out_again_until_the_controller_takes_it(
     qtbot.waitUntil(lambda: link.state.halt is None, timeout=SIGNAL_TIMEOUT_MS)
     assert halts[0] is not None and halts[0].kind is HaltKind.STOP  # the screen was told
     assert halts[-1] is None
+
+
+def test_after_a_jog_stopped_by_stop_alone_the_next_jog_moves_again(
+    qtbot: Any, busy_sim: Any, link: RobotLink
+) -> None:
+    """Speed 0 never got through (GV203 still holds 10 %), a Stop did: the next press of the same
+    jog must still start the arm (teach mode is switched off and on, the speed written again)."""
+    sim = busy_sim
+    connect(qtbot, link, sim)
+    _jog_up(qtbot, link, sim)
+    sim.set_exception(BUSY, RATIO_REGISTERS)
+    link.jog_release()
+    qtbot.waitUntil(lambda: not jogging(sim) and link.state.halt is None, timeout=SIGNAL_TIMEOUT_MS)
+    sim.set_exception(None)
+    _jog_up(qtbot, link, sim)  # the same axis, direction and speed
+    link.jog_release()
+    qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
