@@ -49,6 +49,13 @@ RTT_REPORT_PERIOD = 0.5  # s between rttChanged / linkStatsChanged emissions
 # into the GUI thread per period instead of one per poll; a command's result, a connection change,
 # capture off and shutdown deliver what is pending at once.
 TRAFFIC_DELIVERY_PERIOD = 0.1
+# A write that stops motion (a jog's speed 0, a Stop) the controller refused or did not answer is
+# sent again at every poll (app/link/halt.py). Not confirmed this long after the release -- or
+# answered while the arm kept moving -- a Stop (441) goes out too, at every poll: 0.5 s is
+# 12.5 mm at the 10 % jog of the field report (5 to 10 polls), short of a second refusal's worth.
+HALT_ESCALATE_AFTER = 0.5
+# teachpad-cli keeps trying that long (s) before it gives up, says the arm may still move, exits 1.
+HALT_CONFIRM_BUDGET = 10.0
 TEACH_IDLE_DISABLE = 30.0  # s after the last jog release before teach mode is disabled
 TEACH_MODE_GRACE = 0.3  # s after teach enable during which a status without mode 2 is not "teach lost"
 UPLOAD_CHUNK_POINTS = 20  # points per event-loop turn of an upload, at most ...

@@ -122,6 +122,33 @@ _TEMPLATES: dict[str, str] = {
     "jog_not_answering": QT_TRANSLATE_NOOP(
         "Messages", "The controller is not answering: the jog was not started."
     ),
+    # a write that stops motion, until the controller confirms it (app/link/halt.py)
+    "release_unconfirmed": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Releasing — the controller has not confirmed: it refused or did not answer speed 0. "
+        "Speed 0 is sent again at every poll until the controller answers and the arm stands still.",
+    ),
+    "release_escalated": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Releasing — the controller has not confirmed speed 0 after {seconds} s: Stop is sent as well, "
+        "at every poll, until the controller takes it.",
+    ),
+    "release_confirmed": QT_TRANSLATE_NOOP(
+        "Messages", "Jog stopped: the controller confirmed after {seconds} s and the arm stands still."
+    ),
+    "stop_unconfirmed": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Stopping — the controller has not confirmed: it refused or did not answer the Stop. "
+        "Stop is sent again at every poll until the controller takes it and the arm stands still.",
+    ),
+    "stop_confirmed": QT_TRANSLATE_NOOP(
+        "Messages", "Stop confirmed by the controller after {seconds} s; the arm stands still."
+    ),
+    "halt_unconfirmed": QT_TRANSLATE_NOOP(
+        "Messages",
+        "{operation} refused: the controller has not confirmed that the arm stopped (the stop is "
+        "sent again at every poll). Press Stop, or wait until the arm stands still.",
+    ),
     "run_not_answering_start": QT_TRANSLATE_NOOP(
         "Messages", "The controller is not answering: the plan was not started. Try again when it answers."
     ),

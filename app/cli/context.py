@@ -18,9 +18,11 @@ from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any, TextIO, TypeVar
 
+from app import timing
 from app.cli.exit_codes import ExitCode
-from app.errors import TeachPadError
+from app.errors import ModbusExceptionError, TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
+from app.link.halt import RETRY_EXCEPTIONS
 from app.safety.audit import AuditLog
 
 __all__ = [
@@ -31,6 +33,7 @@ __all__ = [
     "sigint_deferred",
     "stop_after_ctrl_c",
     "stop_on_a_fresh_link",
+    "stop_while_busy",
     "wait_motion",
 ]
 
@@ -133,16 +136,36 @@ def stop_on_a_fresh_link(client: Any, *, command_sent: float | None = None) -> N
     command without a tracker went out), a second stop goes out once that command is older than
     the link timeout (a controller takes a request within the timeout, or it counts as lost).
     Ctrl-C is ignored meanwhile; it all takes at most the connect, two requests and the rest of
-    one timeout."""
+    one timeout -- unless the controller answers *busy*: then the stop goes out again
+    (:func:`stop_while_busy`)."""
     with sigint_deferred():  # from the start: a second Ctrl-C (operators press it again) cancels no stop
         tracker = getattr(client, "last_tracker", None)
         if command_sent is None and tracker is not None and not tracker.finished and not tracker.acknowledged:
             command_sent = tracker.started
         client.close()
-        client.stop()
+        stop_while_busy(client)
         if command_sent is not None:
             time.sleep(max(0.0, command_sent + client.settings.timeout - time.monotonic()))
+            stop_while_busy(client)
+
+
+#: s between two stops while the controller answers *busy* (:func:`stop_while_busy`)
+STOP_RETRY_INTERVAL = 0.05
+
+
+def stop_while_busy(client: Any) -> None:
+    """441 <- 1, again every :data:`STOP_RETRY_INTERVAL` while the controller answers "not now"
+    (Modbus exception 4, 5 or 6: app/link/halt.py), for ``timing.HALT_CONFIRM_BUDGET`` at most;
+    then (or on any other failure) the last error is raised."""
+    deadline = time.monotonic() + timing.HALT_CONFIRM_BUDGET
+    while True:
+        try:
             client.stop()
+            return
+        except ModbusExceptionError as exc:
+            if exc.exception_code not in RETRY_EXCEPTIONS or time.monotonic() >= deadline:
+                raise
+        time.sleep(STOP_RETRY_INTERVAL)
 
 
 class _CtrlC:

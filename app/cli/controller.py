@@ -33,7 +33,9 @@ from app.cli.format import (
 )
 from app.errors import AlarmRaised, InvalidInput, OutcomeUnknown, Reason, TeachPadError
 from app.link.client import RobotClient, StepFrame
+from app.link.halt import HaltWatch, HaltWrite, confirm_halt
 from app.link.outcome import UNKNOWN_ADVICE, outcome_note
+from app.link.types import HaltKind
 from app.link.watch import MotionWatch, StateCheck
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
@@ -146,6 +148,7 @@ def cmd_jog(ctx: CliContext) -> ExitCode:
         raise InvalidInput(f"jog ratio must be in (0, 100], got {args.ratio}")
     client = ctx.client
     writes_before = client.write_count
+    halt: HaltWatch | None = None
     try:
         result = client.teach_enable(frame, axis, direction, user_frame=args.user, tool_frame=args.tool)
         ctx.print(result.message)
@@ -165,20 +168,53 @@ def cmd_jog(ctx: CliContext) -> ExitCode:
         # (but not when nothing was written, e.g. monitor-only or no link at all).
         if client.write_count != writes_before:
             with sigint_deferred():
-                _jog_cleanup(ctx, client)
+                halt = _jog_cleanup(ctx, client)
+    if halt is not None and not halt.over:
+        raise TeachPadError(_halt_failed("jog", halt), code="halt_unconfirmed")
     ctx.print(_pose_line(client.read_pose()))
     return ExitCode.OK
 
 
-def _jog_cleanup(ctx: CliContext, client: RobotClient) -> None:
-    try:
-        client.teach_set_ratio(0.0)
-    except TeachPadError as exc:
-        ctx.warn(f"could not set the jog ratio to 0: {exc}")
+def _jog_cleanup(ctx: CliContext, client: RobotClient) -> HaltWatch:
+    """The jog is over only when the controller has answered speed 0 (or a Stop) and the pose is
+    seen still: speed 0 again every ``JOG_POLL_INTERVAL``, a Stop too after
+    ``timing.HALT_ESCALATE_AFTER``, for ``timing.HALT_CONFIRM_BUDGET`` at most (app/link/halt.py).
+    Then teach mode off. What went wrong is said in a warning (the arm stopped or not)."""
+    halt = HaltWatch(HaltKind.RELEASE, None, time.monotonic())
+    _confirm(client, halt)
+    if not halt.over:
+        ctx.warn(_halt_failed("jog", halt) + "; teach mode was left on")
+        return halt
+    if halt.refusals:
+        ctx.warn(_halt_confirmed("jog", halt))
     try:
         client.teach_disable()
     except TeachPadError as exc:
         ctx.warn(f"could not disable teach mode: {exc}")
+    return halt
+
+
+def _confirm(client: RobotClient, halt: HaltWatch) -> None:
+    def write(what: HaltWrite) -> None:
+        if what is HaltWrite.SPEED_ZERO:
+            client.teach_set_ratio(0.0)
+        else:
+            client.stop()
+
+    confirm_halt(write, client.read_pose, halt, interval=JOG_POLL_INTERVAL)
+
+
+def _halt_failed(what: str, halt: HaltWatch) -> str:
+    return f"{what}: {halt.words(time.monotonic())}: the arm may still be moving -- stop it at the controller"
+
+
+def _halt_confirmed(what: str, halt: HaltWatch) -> str:
+    seconds = (halt.answered_at or time.monotonic()) - halt.since
+    answered = "stop (441)" if halt.answered_by is HaltWrite.STOP else "speed 0"
+    return (
+        f"{what}: the controller refused or did not answer {halt.refusals} time(s) "
+        f"({halt.last_error}); it took the {answered} after {seconds:.1f} s and the arm stands still"
+    )
 
 
 def cmd_point_create(ctx: CliContext) -> ExitCode:
@@ -276,8 +312,28 @@ def _follow_watch(
 
 
 def cmd_stop(ctx: CliContext) -> ExitCode:
-    check = StateCheck("stop", lambda s: s.program_state == ProgramState.STOPPED, _state_words, 0.0)
-    return _judged(ctx, check, ctx.client.stop)
+    """441 until the controller takes it and the pose is seen still (app/link/halt.py); the audit
+    records the outcome against every 441 sent (done, refused, unknown)."""
+    client = ctx.client
+    halt = HaltWatch(HaltKind.STOP, None, time.monotonic())
+    with client.judged_writes() as judged:
+        _confirm(client, halt)
+    note = outcome_note(client.audit, judged) or (lambda _result: None)
+    if halt.given_up and halt.refusals == 1 and halt.last_error is not None:
+        note(_stop_result(False, str(halt.last_error), "refused"))
+        raise halt.last_error  # refused for good (not busy): the controller's own words, at once
+    if not halt.over:
+        note(_stop_result(False, _halt_failed("stop", halt), "outcome_unknown"))
+        raise TeachPadError(_halt_failed("stop", halt), code="halt_unconfirmed")
+    if halt.refusals:
+        ctx.warn(_halt_confirmed("stop", halt))
+    note(_stop_result(True, "stop: done (the arm stands still)", "done"))
+    return ctx.report("stop: done (the arm stands still)")
+
+
+def _stop_result(ok: bool, message: str, code: str) -> CommandResult:
+    """The outcome of the CLI's stop as the audit records it (no GV291 result: told by motion)."""
+    return CommandResult(None, None, None, ok, message, reason=Reason(code))
 
 
 def cmd_pause(ctx: CliContext) -> ExitCode:

@@ -104,7 +104,7 @@ class WorkerCommands:
                 return
             self._cancel_motions_before_stop()  # nothing queued before the Stop runs after it
             self.uploader.end("stopped")
-            self._end_jog_after_a_failed_stop()
+            self.jog.stop_refused(exc)  # sent again at every poll until the controller takes it
             raise
         except BaseException:
             self._report_stop_line(on_line)
@@ -129,7 +129,7 @@ class WorkerCommands:
                 settings,
                 audit=self.audit,
                 capture=self.capture,
-                ratio_zero=jog.jogging or jog.teach_dirty or jog.ratio_zero_pending,
+                ratio_zero=jog.jogging or jog.teach_dirty or jog.halting,
                 again_after=prior.write_lost_until if prior is not None else 0.0,
             )
         except WriteBlocked:
@@ -209,13 +209,13 @@ class WorkerCommands:
         self.emit_result(CommandResult(None, None, None, True, text, reason=reason))
 
     def _end_jog_after_a_failed_stop(self) -> None:
-        """The held jog ends (a jog sequence still starting gives way before its ratio goes out),
-        and speed 0 is tried; if that fails too it goes out as soon as the controller answers."""
-        jogging = self.jog.jogging
+        """The stop line's stop was taken, the main link failed: the held jog ends (a jog sequence
+        still starting gives way before its ratio goes out), and speed 0 is tried; if that fails
+        too, teach mode counts as unknown (speed 0 and teach off before anything else)."""
         try:
             self.jog.on_stop()
         except TeachPadError:
-            self.jog.ratio_zero_pending = self.jog.ratio_zero_pending or jogging
+            self.jog.teach_dirty = True
 
     def _cancel_motions_before_stop(self) -> None:
         stop_seq = self._current_seq

@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Protocol
 
 from app.errors import Reason
-from app.link.types import ConnectionState
+from app.link.types import ConnectionState, UnconfirmedHalt
 from app.models import CommandResult, ControllerStatus, Pose
 
 if TYPE_CHECKING:
@@ -47,6 +47,8 @@ class WorkerOutputs(Protocol):
         """``unconfirmed``: ok, but the controller's status never changed (observe rule)."""
 
     def publish_guard_stop(self, violation: EnvelopeViolation) -> None: ...
+    def publish_halt(self, halt: UnconfirmedHalt | None) -> None:
+        """A write that stops motion is not confirmed by the controller (None: nothing is)."""
 
 
 class WorkerHost(WorkerOutputs, Protocol):

@@ -5,6 +5,12 @@ Release writes ratio 0 and keeps teach enabled; teach is disabled after
 on shutdown. When the link comes back after a loss, ratio 0 and teach disable go out before
 anything else (a real controller keeps jogging when its master goes away); when a silent
 controller answers again, ratio 0 goes out at once if a jog was under way.
+
+A jog is over only when the controller has answered its speed 0 (or a Stop) and the pose is
+seen still (:class:`~app.link.halt.HaltWatch`, app/link/halt.py): a refused or unanswered speed 0
+is sent again at every poll (:meth:`JogMachine.settle_halt`), escalates to Stop, the envelope
+guard keeps deciding on the jog being released, and the GUI is told (``publish_halt``). A Stop
+the controller refused is followed the same way. No new jog or motion starts meanwhile.
 """
 
 from __future__ import annotations
@@ -14,10 +20,11 @@ import time
 from dataclasses import dataclass
 
 from app import timing
-from app.errors import CommandRefused, InvalidInput, LinkError, Reason, TeachPadError
+from app.errors import CommandRefused, InvalidInput, LinkError, ModbusExceptionError, Reason, TeachPadError
+from app.link.halt import HaltWatch, HaltWrite, halt_refusal
 from app.link.host import WorkerHost
 from app.link.tracker import CommandTracker
-from app.link.types import JogRequest, Operation
+from app.link.types import HaltKind, JogRequest, Operation, UnconfirmedHalt
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import ControllerMode, TeachFrame, controller_mode_text
 from app.safety.envelope import EnvelopeRefused, EnvelopeViolation
@@ -54,7 +61,8 @@ class JogMachine:
         self.jog: JogRequest | None = None
         self._serial = 0
         self.released_at = 0.0
-        self.ratio_zero_pending = False  # the controller went silent while jogging: ratio 0 on return
+        self.halt: HaltWatch | None = None  # a jog / Stop being stopped, until the controller confirms
+        self._shown: UnconfirmedHalt | None = None  # what the GUI was last told of it
         self.guard: JogGuard | None = None  # the safety envelope's jog guard (immutable; set by the GUI)
         self.guard_timing = GuardTiming()  # the guard's look-ahead, measured (perf_counter clock)
         self._pose_read_at: float | None = None  # when the read of the poller's last pose was sent
@@ -65,11 +73,16 @@ class JogMachine:
         """A jog is held, or a speed written for one is still in force."""
         return self.jog is not None or self.teach.moving
 
+    @property
+    def halting(self) -> bool:
+        """A jog or a Stop is being stopped and the controller has not confirmed it yet."""
+        return self.halt is not None
+
     def reset(self) -> None:
         """A new connection (new settings): nothing is known about teach mode."""
         self.teach = TeachState()
         self.teach_dirty = False
-        self.ratio_zero_pending = False
+        self._drop_halt()
 
     def end_jog(self) -> None:
         """Forget the held jog; a jog sequence still running for it gives way."""
@@ -79,41 +92,42 @@ class JogMachine:
         self._serial += 1
 
     def link_lost(self) -> None:
+        """The link is down. A jog being stopped stays watched (and shown): the reconnection's
+        speed 0 and the polls after it confirm it."""
         if self.teach.enabled or self.jog is not None:
             self.teach_dirty = True  # a real controller keeps jogging: switch it off on return
+        jog = self.jog
+        if jog is not None:
+            self._begin_halt(HaltKind.RELEASE, jog).silent = True
+            self._publish_halt(quiet=True)  # the link's state says why
         self.end_jog()
         self.teach = TeachState()
-        self.ratio_zero_pending = False
 
     def controller_silent(self) -> None:
         """The controller stopped answering: drop the held jog (ratio 0 goes out on its return).
         When a jog was under way the operator is told (an error with its reason, code
         ``jog_stopped_silent``)."""
-        jogging = self.jogging
+        jog, jogging = self.jog, self.jogging
         self.end_jog()
         if not jogging:
             return
-        self.ratio_zero_pending = True
+        self._begin_halt(HaltKind.RELEASE, jog).silent = True
+        self._publish_halt(quiet=True)  # the sentence below says it
         note = "jog stopped: the controller is not answering (speed 0 is sent as soon as it answers)"
         self._host.emit_error(Operation.JOG, note, None, Reason("jog_stopped_silent"))
 
     def controller_answers(self) -> None:
         """The dead-man after a silence: ratio 0 before anything else, if a jog was under way."""
-        if not self.ratio_zero_pending:
-            return
-        self.ratio_zero_pending = False
-        client = self._host.client
-        if client is None or client.settings.monitor_only:
-            return
-        client.teach_set_ratio(0.0)
-        self.teach.ratio = 0.0
+        halt = self.halt
+        if halt is not None and halt.answered_at is None:
+            halt.answering_again(time.monotonic())
+            self.settle_halt()
 
     # --- sequences without urgent jobs in between (connect, close, idle) -------------------
     def make_teach_safe(self, status: ControllerStatus, ever_connected: bool) -> None:
         """On (re)connection: a jog left running by a lost link is stopped before anything else."""
         client = self._host.client
         assert client is not None
-        self.ratio_zero_pending = False
         if not (ever_connected or status.mode == ControllerMode.MODBUS_TEACH):
             return
         maybe_on = self.teach.enabled or self.teach_dirty or status.mode == ControllerMode.MODBUS_TEACH
@@ -131,8 +145,7 @@ class JogMachine:
         client = self._host.client  # also while connecting, before the link is declared up
         if client is None:
             raise LinkError("not connected to a controller", code="not_connected")
-        client.teach_set_ratio(0.0)
-        self.teach.ratio = 0.0
+        self._speed_zero()
         client.teach_disable(wait=False)
         self.teach = TeachState()
         self.teach_dirty = False
@@ -162,6 +175,7 @@ class JogMachine:
         elif (
             (teach.enabled or self.teach_dirty)
             and self.jog is None
+            and not (self.halt is not None and self.halt.unconfirmed)  # its own writes go on first
             and idle
             and now - self.released_at >= timing.TEACH_IDLE_DISABLE
         ):
@@ -171,11 +185,36 @@ class JogMachine:
                 self._host.emit_exception(Operation.TEACH_DISABLE, exc)
 
     def on_stop(self) -> None:
-        """A stop went out: the jog ends, ratio 0 if teach is on and moving."""
+        """The controller took a Stop: the jog ends, and a jog or Stop being stopped is answered
+        (it is over once the pose is seen still). Ratio 0 if teach is on and moving; if the
+        controller refuses that, the Stop stopped the arm: teach mode counts as unknown (switched
+        off before the next jog)."""
         self.end_jog()
+        halt = self.halt
+        if halt is not None:
+            halt.took(HaltWrite.STOP, time.monotonic())
         if self.teach.moving:
-            self._host.client_or_raise().teach_set_ratio(0.0)
-            self.teach.ratio = 0.0
+            try:
+                self._speed_zero()
+            except ModbusExceptionError:
+                self.teach = TeachState()
+                self.teach_dirty = True
+
+    def stop_refused(self, exc: TeachPadError) -> None:
+        """The operator's Stop was refused or not answered: it goes out again at every poll (with
+        speed 0 if a jog was under way) until the controller takes it."""
+        jog = self.jog
+        self.end_jog()
+        if not halt_refusal(exc):
+            if jog is not None or self.teach.moving:
+                self.teach_dirty = True  # the link failed: speed 0 and teach off on its return
+            return
+        halt = self.halt
+        if halt is None or halt.kind is not HaltKind.STOP:
+            request = jog if jog is not None else (halt.request if halt is not None else None)
+            halt = self.halt = HaltWatch(HaltKind.STOP, request, time.monotonic())
+        halt.refused(HaltWrite.STOP, exc)
+        self._publish_halt()
 
     # --- jobs ----------------------------------------------------------------------------
     def _check(self, serial: int) -> None:
@@ -204,7 +243,9 @@ class JogMachine:
                 code="bad_jog_ratio",
                 params={"value": f"{request.ratio:g}"},
             )
+        self.require_no_halt(Operation.JOG)
         self._require_guard(request)  # refused before teach mode is even switched on
+        self._drop_halt()  # a release answered, not seen still yet: this jog supersedes it
         self.jog = request
         self._serial += 1
         serial = self._serial
@@ -265,10 +306,10 @@ class JogMachine:
         horizon = self.guard_timing.horizon(guard, time.perf_counter(), read_at)
         decision = guard.decide(pose, request, horizon)
         if not decision.allow and decision.violation is not None:
+            jog = self.jog
             self.end_jog()
-            if self.teach.moving:  # a jog under way stops too
-                self._host.client_or_raise().teach_set_ratio(0.0)
-                self.teach.ratio = 0.0
+            if self.teach.moving:  # a jog under way stops too, until the controller confirms it
+                self._halt_now(HaltKind.RELEASE, jog)
             raise EnvelopeRefused(decision.violation, "jog")
 
     def guard_pose(
@@ -286,31 +327,169 @@ class JogMachine:
         self._pose_read_at = read_at
         measured = self.guard_timing
         measured.note_read(read_at, now if answered_at is None else answered_at)
-        jog, guard, client = self.jog, self.guard, self._host.client
-        measured.note_decision(now, jogging=jog is not None)
-        if jog is None or guard is None or client is None or jog.ratio <= 0:
+        jog, guard, client, halt = self.jog, self.guard, self._host.client, self.halt
+        releasing = halt.request if jog is None and halt is not None and halt.unconfirmed else None
+        watched = jog if jog is not None else releasing  # the guard keeps watching a jog being stopped
+        measured.note_decision(now, jogging=watched is not None)
+        if watched is None or guard is None or client is None or watched.ratio <= 0:
             return None
         horizon = measured.horizon(guard, now, read_at)
         measured.note_horizon(now, horizon)
-        decision = guard.decide(pose, jog, horizon)
+        decision = guard.decide(pose, watched, horizon)
         if decision.allow or decision.violation is None:
             return None
-        if self.teach.enabled and not client.settings.monitor_only:
-            client.teach_set_ratio(0.0)
-            self.teach.ratio = 0.0
+        if halt is not None and jog is None:
+            if not halt.escalate():  # speed 0 not confirmed, the arm heads over a boundary: Stop now
+                return None
+            self.settle_halt()
+            return decision.violation
         self.end_jog()
+        if self.teach.enabled and not client.settings.monitor_only:
+            self._halt_now(HaltKind.RELEASE, jog)
         return decision.violation
 
     def release(self) -> None:
-        """The dead-man: ratio 0, teach stays enabled (disabled later when idle)."""
+        """The dead-man: ratio 0, teach stays enabled (disabled later when idle). The jog is over
+        once the controller has answered and the pose is seen still (see the module docstring)."""
+        jog = self.jog
         self.end_jog()
         self.released_at = time.monotonic()
         client = self._host.client
         if not self._host.link_up or client is None:
             return
         if self.teach.enabled:
-            client.teach_set_ratio(0.0)
-            self.teach.ratio = 0.0
+            self._halt_now(HaltKind.RELEASE, jog)
+
+    # --- a halt until the controller confirms it (app/link/halt.py) ------------------------
+    def require_no_halt(self, operation: str) -> None:
+        """Refuse ``operation`` while a jog's stop or a Stop is not confirmed by the controller."""
+        halt = self.halt
+        if halt is not None and halt.unconfirmed:
+            what = "the last jog's stop" if halt.kind is HaltKind.RELEASE else "the Stop"
+            raise TeachPadError(
+                f"{operation} refused: the controller has not confirmed {what} yet (it is sent again "
+                "at every poll; press Stop, or wait until the arm is seen still)",
+                code="halt_unconfirmed",
+                params={"operation": operation},
+            )
+
+    def settle_halt(self) -> None:
+        """Per poll (before its reads) while a halt is watched: send what it asks for now. A
+        refusal or no answer is counted (and tried again at the next poll); a link failure is
+        raised after that (the poll fails as it would have)."""
+        halt = self.halt
+        client = self._host.client
+        if halt is None or client is None or client.settings.monitor_only:
+            return
+        failure: TeachPadError | None = None
+        # each write waits the poll timeout at most: a controller that does not answer it gets it
+        # again at the next poll, it does not hold the worker for the request timeout
+        with client.io_timeout(client.settings.effective_poll_timeout):
+            for write in halt.due(time.monotonic()):
+                try:
+                    self._send(write)
+                except TeachPadError as exc:
+                    halt.refused(write, exc)
+                    if not halt_refusal(exc):
+                        failure = exc
+                        break
+        self._publish_halt()
+        if failure is not None:
+            raise failure
+
+    def halt_pose(self, pose: Pose) -> None:
+        """Per poll, after the pose: the halt is over once answered and the pose is still."""
+        halt = self.halt
+        if halt is None or not halt.pose_seen(pose):
+            return
+        self.halt = None
+        if not halt.speed_zero_answered and self.teach.moving:
+            # stopped by a Stop while GV203 still holds the jog's speed: teach mode counts as
+            # unknown, so the next jog writes speed 0 and switches teach off and on first
+            self.teach = TeachState()
+            self.teach_dirty = True
+        if self._shown is None:
+            return  # answered at once and seen still: nothing to say
+        seconds = time.monotonic() - halt.since
+        what = "jog stopped" if halt.kind is HaltKind.RELEASE else "stop"
+        self._host.emit_result(
+            CommandResult(
+                None,
+                None,
+                None,
+                True,
+                f"{what}: confirmed by the controller after {seconds:.1f} s (the arm stands still)",
+                reason=Reason(f"{halt.kind.value}_confirmed", {"seconds": round(seconds, 1)}),
+            ),
+            None,
+        )
+        self._publish_halt()
+
+    def _begin_halt(self, kind: HaltKind, request: JogRequest | None) -> HaltWatch:
+        halt = self.halt
+        if halt is None or halt.over:
+            halt = self.halt = HaltWatch(kind, request, time.monotonic())
+        elif halt.request is None:
+            halt.request = request
+        return halt
+
+    def _halt_now(self, kind: HaltKind, request: JogRequest | None) -> None:
+        """Begin (or go on with) a halt and send its writes at once."""
+        self._begin_halt(kind, request)
+        self.settle_halt()
+
+    def _drop_halt(self) -> None:
+        self.halt = None
+        self._publish_halt()
+
+    def _speed_zero(self) -> None:
+        """GV203 <- 0 (also while connecting, before the link is declared up); a halt being
+        watched counts it as answered."""
+        client = self._host.client
+        if client is None:
+            raise LinkError("not connected to a controller", code="not_connected")
+        client.teach_set_ratio(0.0)
+        self.teach.ratio = 0.0
+        if self.halt is not None:
+            self.halt.took(HaltWrite.SPEED_ZERO, time.monotonic())
+
+    def _send(self, write: HaltWrite) -> None:
+        if write is HaltWrite.SPEED_ZERO:
+            self._speed_zero()
+            return
+        client = self._host.client
+        if client is None:
+            raise LinkError("not connected to a controller", code="not_connected")
+        client.stop()
+        self._stop_taken()
+
+    def _stop_taken(self) -> None:
+        """A Stop this machine sent was answered: the motion in flight ends as stopped."""
+        halt = self.halt
+        if halt is not None:
+            halt.took(HaltWrite.STOP, time.monotonic())
+        active = self._host.motion.take()
+        if active is not None:
+            self._host.emit_result(active.completion.stopped(time.monotonic()), active.request_id)
+
+    def _publish_halt(self, *, quiet: bool = False) -> None:
+        """Tell the GUI what changed (and, the first time it goes wrong, why, unless ``quiet``)."""
+        halt = self.halt
+        state = None if halt is None else halt.state()
+        if state == self._shown:
+            return
+        before, self._shown = self._shown, state
+        self._host.publish_halt(state)
+        if state is None or halt is None or quiet:
+            return
+        now = time.monotonic()
+        release = halt.kind is HaltKind.RELEASE
+        if before is None or (release and state.escalated and not before.escalated):
+            # release_unconfirmed, release_escalated (Stop sent too), stop_unconfirmed
+            step = "escalated" if release and state.escalated else "unconfirmed"
+            operation = Operation.JOG_RELEASE if release else Operation.STOP
+            reason = Reason(f"{halt.kind.value}_{step}", {"seconds": round(now - halt.since, 1)})
+            self._host.emit_error(operation, halt.words(now), None, reason)
 
     def set_ratio(self, ratio: float) -> None:
         """Speed slider moved while jogging: GV203 changes the speed live."""
@@ -351,8 +530,9 @@ class JogMachine:
             or (last_status is not None and last_status.mode == ControllerMode.MODBUS_TEACH)
         ):
             return
+        self._drop_halt()  # the motion's own commands take over (a halt not confirmed refused it before)
         self.end_jog()
-        self._host.client_or_raise().teach_set_ratio(0.0)
+        self._speed_zero()
         self.disable_teach()
 
     def await_short(self, tracker: CommandTracker, *, urgent: bool) -> CommandResult:

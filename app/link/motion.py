@@ -94,6 +94,7 @@ class MotionCommands:
     def require_none(self, operation: str) -> None:
         """Refuse ``operation`` while a motion or an upload is under way."""
         host = self._host
+        host.jog.require_no_halt(operation)
         busy = host.motion.motion_under_way
         if busy is not None:
             raise InvalidInput(f"{busy} is still under way: wait for it or press Stop")

@@ -1,12 +1,13 @@
 """The poller: one read of status and pose per tick, published as signals (worker thread).
 
-Order of a poll: **status first, then pose** -- so when the status says a motion ended, the pose
-read after it is the final one -- with the urgent jobs run between the two reads. Then, in this
-order: one ``publish_polled`` of the pose / status / alarms (each only on change) and of the
-good poll, the restart canary, ``commandFinished`` of the command the poll completed,
-the RTT and the link statistics (the captured traffic goes out on the worker's own period, not
-per poll: see :mod:`app.link.worker`). The clock (and the canary) are read
-every :data:`app.timing.CLOCK_POLL_PERIOD`. Polls use the poll timeout
+Order of a poll: a stop the controller has not confirmed goes out again first
+(:meth:`~app.link.jog.JogMachine.settle_halt`); then **status first, then pose** -- so when the
+status says a motion ended, the pose read after it is the final one -- with the urgent jobs run
+between the two reads. Then, in this order: one ``publish_polled`` of the pose / status /
+alarms (each only on change) and of the good poll, the restart canary, ``commandFinished`` of
+the command the poll completed, the RTT and the link statistics (the captured traffic goes out
+on the worker's own period, not per poll: see :mod:`app.link.worker`). The clock (and the
+canary) are read every :data:`app.timing.CLOCK_POLL_PERIOD`. Polls use the poll timeout
 (``settings.effective_poll_timeout``), not the command timeout: a silent controller shows as
 ``NOT_ANSWERING`` after one poll.
 """
@@ -48,7 +49,7 @@ class Poller:
     def rate(self, setting_hz: float) -> float:
         """The poll rate to use now: the GUI's setting, at least :data:`JOG_POLL_HZ_MIN` while jogging."""
         jog = self._host.jog
-        if jog.jogging:
+        if jog.jogging or jog.halting:  # a jog's stop is confirmed by polls too (app/link/halt.py)
             return max(setting_hz, JOG_POLL_HZ_MIN)
         return setting_hz
 
@@ -94,6 +95,8 @@ class Poller:
         timeout = client.settings.effective_poll_timeout
         canary: float | None = None
         try:
+            if host.supervisor.answering:
+                host.jog.settle_halt()  # a stop the controller has not confirmed: again, first
             t0 = time.perf_counter()
             status = client.read_status(with_clock=with_clock, timeout=timeout)
             t1 = time.perf_counter()
@@ -104,6 +107,7 @@ class Poller:
             pose = client.read_pose(timeout=timeout)
             t3 = time.perf_counter()
             guard_stop = host.jog.guard_pose(pose, t2, t3)  # ratio 0 before the TCP crosses a boundary
+            host.jog.halt_pose(pose)  # a jog's stop is over once answered and the pose is still
             host.run_urgent()  # and before this poll's publishing: a stop waits one read at most
             if not host.link_up:
                 return

@@ -155,6 +155,7 @@ class RobotLink(QObject):
             (w.uploadProgress, self.uploadProgress),
             (w.pointUploaded, self.pointUploaded),
             (w.jogGuardStopped, self.jogGuardStopped),
+            (w.haltChanged, state.set_halt),
             (self._connectRequested, w.connect_to),
             (self._disconnectRequested, w.disconnect_link),
             (self._pollRateRequested, w.set_poll_rate),

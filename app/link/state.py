@@ -17,6 +17,8 @@ field (property)       signal                      what
 ``last_result``        ``lastResultChanged``       the latest :class:`CommandResult` of any request
 ``rtt``                ``rttChanged(float)``       mean poll round trip, ms
 ``stats``              ``statsChanged``            :class:`LinkStats` snapshot of the client
+``halt``               ``haltChanged(object)``     :class:`UnconfirmedHalt`: a jog's stop or a
+                                                   Stop the controller has not confirmed (None)
 =====================  ==========================  ===========================================
 
 Freshness: ``fresh`` is True only while the link is CONNECTED and the last good poll is
@@ -34,7 +36,7 @@ from dataclasses import dataclass
 from PySide6.QtCore import QObject, QTimer, Signal, Slot
 
 from app.link.stats import LinkStats
-from app.link.types import ConnectionState, LinkState
+from app.link.types import ConnectionState, LinkState, UnconfirmedHalt
 from app.models import CommandResult, ControllerStatus, Pose
 
 __all__ = ["DEFAULT_FRESHNESS_LIMIT", "PollUpdate", "RobotState"]
@@ -67,6 +69,7 @@ class RobotState(QObject):
     lastResultChanged = Signal(CommandResult)  # noqa: N815
     rttChanged = Signal(float)  # noqa: N815
     statsChanged = Signal(LinkStats)  # noqa: N815
+    haltChanged = Signal(object)  # noqa: N815 - UnconfirmedHalt | None
 
     def __init__(
         self, parent: QObject | None = None, *, freshness_limit: float = DEFAULT_FRESHNESS_LIMIT
@@ -85,6 +88,7 @@ class RobotState(QObject):
         self._last_result: CommandResult | None = None
         self._rtt: float | None = None
         self._stats = LinkStats()
+        self._halt: UnconfirmedHalt | None = None
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.timeout.connect(self._check_freshness)
@@ -214,6 +218,17 @@ class RobotState(QObject):
         if stats != self._stats:
             self._stats = stats
             self.statsChanged.emit(stats)
+
+    @property
+    def halt(self) -> UnconfirmedHalt | None:
+        """A write that stops motion the controller has not confirmed yet (retried every poll)."""
+        return self._halt
+
+    @Slot(object)
+    def set_halt(self, halt: UnconfirmedHalt | None) -> None:
+        if halt != self._halt:
+            self._halt = halt
+            self.haltChanged.emit(halt)
 
     # --- freshness ------------------------------------------------------------------------
     def _remaining(self) -> float:

@@ -48,6 +48,7 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 from __future__ import annotations
 
 import math
+from collections import deque
 from typing import Literal
 
 from app import timing
@@ -77,7 +78,16 @@ from app.protocol.enums import (
     decode_command_status,
 )
 
-__all__ = ["POSE_EPSILON", "CommandTracker", "CompletionRule", "ResultPacer", "command_text", "pose_moved"]
+__all__ = [
+    "BACKOFF_DOUBLINGS_MAX",
+    "POSE_EPSILON",
+    "CommandTracker",
+    "CompletionRule",
+    "ResultPacer",
+    "backoff",
+    "command_text",
+    "pose_moved",
+]
 
 CompletionRule = Literal["sentinel", "observe"]
 
@@ -89,6 +99,16 @@ CompletionRule = Literal["sentinel", "observe"]
 
 def command_text(command: RunCommand) -> str:
     return RUN_COMMAND_TEXT.get(command, f"command 0x{int(command):02X}")
+
+
+#: Doublings after which a backoff is at its cap whatever its first pause (2**60 x 1 ns > 30 years):
+#: the exponent stops there, so a wait of any length (a move read for minutes) never overflows.
+BACKOFF_DOUBLINGS_MAX = 60
+
+
+def backoff(first: float, cap: float, doublings: int) -> float:
+    """``first`` doubled ``doublings`` times (none when negative), capped at ``cap``."""
+    return min(cap, first * 2.0 ** min(max(0, doublings), BACKOFF_DOUBLINGS_MAX))
 
 
 def _seconds(value: float) -> str:
@@ -159,7 +179,10 @@ class CommandTracker:
         # instant commands: the second read is timed by the pacer (see ResultPacer)
         self.pacer = None if self.is_move else pacer
         self._read_at = math.inf  # when the next read goes out (monotonic), planned by poll_interval
-        self._sent: list[float] = []  # when each read went out (monotonic)
+        # when the last two reads went out (monotonic), and the read that showed the command taken:
+        # what the pacer needs, and no more (a move may be read for as long as it runs)
+        self._sent: deque[float] = deque(maxlen=2)
+        self._ack_sent = 0.0
         self._ack_read = 0  # how many reads it took to see the command taken (GV291 left the old code)
         self._stopped_since: float | None = None
         self._idle_since: float | None = None
@@ -195,14 +218,14 @@ class CommandTracker:
         ack = self._ack_read  # reads up to the one that showed the command taken (0: not yet)
         if self.pacer is not None and ack and self.reads == ack:
             # taken, no result yet: the next read when this controller's results usually show
-            interval = max(0.0, self._sent[ack - 1] + self.pacer.estimate - now)
+            interval = max(0.0, self._ack_sent + self.pacer.estimate - now)
         elif self.pacer is not None and ack and self.reads == ack + 1:
             # the paced read was early: once more a little later, then the backoff as before
-            interval = self.pacer.retry_after(now - self._sent[ack - 1], self.backoff_first)
+            interval = self.pacer.retry_after(now - self._ack_sent, self.backoff_first)
         elif self.pacer is not None and ack:
-            interval = min(self.backoff_cap, self.backoff_first * 2.0 ** (self.reads - ack - 2))
+            interval = backoff(self.backoff_first, self.backoff_cap, self.reads - ack - 2)
         else:
-            interval = min(self.backoff_cap, self.backoff_first * 2.0 ** max(0, self.reads - 1))
+            interval = backoff(self.backoff_first, self.backoff_cap, self.reads - 1)
         if self.unconfirmed_after is not None and not self.acknowledged:
             left = self.started + self.unconfirmed_after - now
             if left > 0:
@@ -226,6 +249,7 @@ class CommandTracker:
         if code != self.pre_code:
             if not self.code_left_pre:
                 self._ack_read = self.reads
+                self._ack_sent = self._sent[-1]
             self.code_left_pre = True
         progressed = self._note_motion(status, pose)
         if not self.acknowledged and (self.code_left_pre or self.motion_seen):
@@ -488,7 +512,7 @@ class CommandTracker:
         ack = self._ack_read
         if self.pacer is not None and not unconfirmed and 0 < ack < self.reads:
             # a result seen after the read that showed the command taken: how long after it
-            taken = self._sent[ack - 1]
+            taken = self._ack_sent
             missed = self._sent[-2] - taken if self.reads > ack + 1 else None
             self.pacer.learn(missed, self._sent[-1] - taken)
         self.result = CommandResult(

@@ -11,10 +11,12 @@ from app.protocol.enums import RunCommand, TeachFrame
 __all__ = [
     "ConnectionState",
     "ControllerIdentity",
+    "HaltKind",
     "JogRequest",
     "LinkState",
     "Operation",
     "StepFrame",
+    "UnconfirmedHalt",
     "WorkerError",
 ]
 
@@ -163,3 +165,21 @@ class JogRequest:
             self.user if self.frame is TeachFrame.USER else 0,
             self.tool if self.frame is TeachFrame.TOOL else 0,
         )
+
+
+class HaltKind(enum.Enum):
+    """What is being stopped (app/link/halt.py)."""
+
+    RELEASE = "release"  # a jog the operator let go of: speed 0
+    STOP = "stop"  # the operator's Stop (441)
+
+
+@dataclass(frozen=True)
+class UnconfirmedHalt:
+    """A write that stops motion the controller has not confirmed yet (refused, unanswered, or
+    answered while the arm kept moving): the worker sends it again at every poll. ``since``:
+    ``time.monotonic()`` of the release / Stop; ``escalated``: a Stop (441) goes out too."""
+
+    kind: HaltKind
+    since: float
+    escalated: bool

@@ -77,7 +77,7 @@ from app.link.state import PollUpdate
 from app.link.stats import LinkStats
 from app.link.stop_line import StopLine
 from app.link.supervisor import DEFAULT_CANARY_GV, LinkSupervisor
-from app.link.types import ConnectionState, LinkState, Operation, WorkerError
+from app.link.types import ConnectionState, LinkState, Operation, UnconfirmedHalt, WorkerError
 from app.link.upload import Uploader
 from app.models import CommandResult, ControllerStatus, Pose
 from app.safety.audit import AuditLog
@@ -107,6 +107,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     uploadProgress = Signal(int, int)  # noqa: N815 - points done, total
     pointUploaded = Signal(int, bool, str, bool)  # noqa: N815 - point id, ok, reason ("" when ok), unconfirmed
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard wrote ratio 0
+    haltChanged = Signal(object)  # noqa: N815 - UnconfirmedHalt | None: a stop the controller has not confirmed
     stopped = Signal()  # the worker has closed the link and is quitting its thread (shutdown)
 
     # Wakes the worker from any thread (a queued call, since the worker lives in its thread).
@@ -326,6 +327,9 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
 
     def publish_guard_stop(self, violation: EnvelopeViolation) -> None:
         self.jogGuardStopped.emit(violation)
+
+    def publish_halt(self, halt: UnconfirmedHalt | None) -> None:
+        self.haltChanged.emit(halt)
 
     def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None:
         """``commandFinished`` with the request id (default: the job being executed)."""

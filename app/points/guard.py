@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import random
+from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Protocol
 
@@ -41,6 +42,9 @@ from app.points.point import TempPoint
 CANARY_GV = 99
 #: Largest distance (mm) between the pose after a segment and the host's end point.
 ARRIVAL_TOLERANCE_MM = 1.0
+#: How many of the create-points sent a guard remembers (PointGuard.created): a run with endless
+#: loops re-creates its points before every segment, for as long as it runs.
+CREATED_KEPT = 1000
 
 
 class PointMismatch(TeachPadError):
@@ -111,7 +115,14 @@ class PointGuard:
         self._token: float | None = None
         self._uploaded: set[int] = set()  # created by this process since the last restart check
         self.restarts = 0  # restarts noticed
-        self.created: list[int] = []  # every create-point sent, in order (for reports and tests)
+        # the create-points sent, in order (for reports and tests): the last CREATED_KEPT of them,
+        # an endless run re-creates points before every segment
+        self._created: deque[int] = deque(maxlen=CREATED_KEPT)
+
+    @property
+    def created(self) -> list[int]:
+        """The last :data:`CREATED_KEPT` create-points sent, oldest first."""
+        return list(self._created)
 
     @property
     def uploaded(self) -> frozenset[int]:
@@ -152,7 +163,7 @@ class PointGuard:
     def _create(self, client: GuardClient, point_id: int) -> None:
         point = self.point(point_id)
         result = client.create_point(point.id, pose=point.xyzabc, tool=point.tool, wait=True)
-        self.created.append(point.id)
+        self._created.append(point.id)
         if not result.ok:
             reason = result.message or (result.status.text if result.status is not None else "failed")
             raise PointNotCreated(

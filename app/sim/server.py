@@ -54,6 +54,9 @@ _FC_WRITE_SINGLE = 6
 _GENERAL_REGISTERS = 200  # GV0..GV99 (registers 0..199): cleared by a controller restart
 _STOP_TIMEOUT = 2.0
 _ANSWER_HOLD_MAX = 0.5  # s a move waits at most for its command's answer to go out
+#: Writes the simulator keeps in :attr:`SimController.writes` (tests read the log from the start;
+#: none comes near this): beyond it the oldest tenth is dropped, so a long session does not grow.
+WRITE_LOG_LIMIT = 200_000
 
 
 class SimController:
@@ -67,7 +70,10 @@ class SimController:
             point_id_max=self.config.point_id_max,
             work_mode=self.config.work_mode,
         )
+        # every write received, oldest first: the last WRITE_LOG_LIMIT (writes_dropped: how many
+        # older ones were forgotten -- a simulator child of the GUI may run for days)
         self.writes: list[WriteRecord] = []
+        self.writes_dropped = 0
         self._requests = 0
         self._port: int | None = None
         self._runner = ServerRunner()
@@ -286,7 +292,7 @@ class SimController:
                 registers[first:last] = [0] * (last - first)
             if set_values is not None:
                 values = [int(v) & 0xFFFF for v in set_values]
-                self.writes.append(WriteRecord(time.monotonic(), function_code, address, tuple(values)))
+                self._log_write(WriteRecord(time.monotonic(), function_code, address, tuple(values)))
                 log.info(
                     "write fc=0x%02X address=%d values=%s",
                     function_code,
@@ -343,6 +349,15 @@ class SimController:
     def watchdog_events(self) -> list[SimEvent]:
         with self.lock:
             return [e for e in self.events if e.kind == "watchdog"]
+
+    def _log_write(self, record: WriteRecord) -> None:
+        """Keep ``record``; past :data:`WRITE_LOG_LIMIT` the oldest tenth goes (under the lock)."""
+        writes = self.writes
+        writes.append(record)
+        if len(writes) > WRITE_LOG_LIMIT:
+            drop = len(writes) - WRITE_LOG_LIMIT + WRITE_LOG_LIMIT // 10
+            del writes[:drop]
+            self.writes_dropped += drop
 
     def _watchdog_stop(self, reason: str) -> bool:
         """The watchdog fired: ratio 0 (GV203 reads 0 too), teach stays enabled."""

@@ -150,7 +150,7 @@ def test_a_program_run_while_one_runs_is_refused_as_busy(
     first = command_record(audit_dir, registers.REG_RUN_COMMAND, 0x01)
     assert first.result == Result.UNKNOWN and "not followed to its end" in first.detail
     code, out, _ = run(csim, capsys, "stop")
-    assert code == ExitCode.OK and out == "stop: done (the program state reads stopped)\n"
+    assert code == ExitCode.OK and out == "stop: done (the arm stands still)\n"
 
 
 # --- unknown: taken, and what it did cannot be told -------------------------------------------

@@ -437,3 +437,55 @@ def test_a_step_that_moves_external_axes_is_done_only_when_they_arrived_too(
         tr, [(0.01, st(DONE), short), (0.1, st(DONE), short), (0.41, st(DONE), short), (0.8, st(DONE), short)]
     )
     assert i == 3 and not result.ok and "result is unknown" in result.message
+
+
+# --- a long wait (issue 18: "a long move crashes the client") ----------------------------------
+
+
+def _long_move_tracker() -> CommandTracker:
+    return CommandTracker(
+        RunCommand.STEP_BASE, st(DONE), HOME, 0.0, rule="sentinel", pre_code=STATUS_SENTINEL
+    )
+
+
+def test_a_ten_minute_move_is_read_at_the_cap_to_the_end_without_overflow_or_growth() -> None:
+    """Ten minutes of a move's wait, as CommandClient.wait paces it (the clock injected: each read
+    at the time the tracker planned). It used to raise OverflowError at the 1025th read (about
+    11 s into a move at the 10 ms cap); the tracker's memory must not grow with the reads either:
+    what the tenth minute's 6,000 reads leave allocated is measured (the old list of read times
+    kept ~200 kB of it)."""
+    import tracemalloc
+
+    tr = _long_move_tracker()
+    moving = st(int(MoveStatus.MOVING), RUNNING)
+    poses = (moved(0.0), moved(0.002))  # the arm moves between every two reads (made once)
+    now, reads, longest = 0.0, 0, 0.0
+    kept_before = kept_after = 0
+    try:
+        while now < 600.0:
+            if now >= 540.0 and not tracemalloc.is_tracing():  # the tenth minute, measured
+                tracemalloc.start()
+                kept_before = tracemalloc.get_traced_memory()[0]
+            assert tr.update(moving, poses[reads & 1], now) is None
+            reads += 1
+            interval = tr.poll_interval(now)
+            longest = max(longest, interval)
+            now += interval
+        kept_after = tracemalloc.get_traced_memory()[0]
+    finally:
+        tracemalloc.stop()
+    result = tr.update(st(DONE), poses[reads & 1], now)
+    assert result is not None and result.ok
+    assert tr.reads > 60_000  # a read every MOVE_POLL_INTERVAL all along
+    assert longest == pytest.approx(timing.MOVE_POLL_INTERVAL)
+    assert kept_after - kept_before < 4096  # a few small objects, not one per read
+
+
+def test_backoff_of_any_read_count_is_the_cap() -> None:
+    from app.link.tracker import backoff
+
+    assert backoff(0.001, 0.01, 0) == 0.001
+    assert backoff(0.001, 0.01, -3) == 0.001
+    assert backoff(0.001, 0.01, 3) == 0.008
+    for doublings in (1023, 1024, 1025, 10**6, 10**12):
+        assert backoff(0.001, 0.01, doublings) == 0.01

@@ -14,7 +14,7 @@ from app.link.motion import MotionTracker
 from app.link.poller import Poller
 from app.link.stats import LinkStats
 from app.link.supervisor import LinkSupervisor
-from app.link.types import ConnectionState, LinkState, WorkerError
+from app.link.types import ConnectionState, LinkState, UnconfirmedHalt, WorkerError
 from app.link.upload import Uploader
 from app.models import CommandResult, ControllerStatus, Pose
 from app.safety.audit import AuditLog
@@ -125,6 +125,9 @@ class PartsHost:
 
     def publish_guard_stop(self, violation: EnvelopeViolation) -> None:
         self.out.append(("jogGuardStopped", violation))
+
+    def publish_halt(self, halt: UnconfirmedHalt | None) -> None:
+        self.out.append(("haltChanged", halt))
 
     def publish_reconnected(self) -> None:
         self.out.append(("controllerReconnected", None))

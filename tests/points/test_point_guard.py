@@ -155,3 +155,19 @@ def test_a_restart_during_the_run_is_noticed_and_the_points_restored(
     assert guard.restarts == 1
     assert _near(sim.state().pose, ledger.point(3).xyzabc)
     assert set(sim.state().points) == {2, 3}  # what was re-created after the restart
+
+
+def test_the_guard_keeps_only_the_last_create_points_it_sent(
+    sim: Any, make_client: MakeClient, monkeypatch: Any
+) -> None:
+    """A run with endless loops re-creates its points before every segment: the guard's record of
+    them keeps the last CREATED_KEPT, it does not grow for as long as the run goes (issue 18)."""
+    from app.points import guard as guard_module
+
+    monkeypatch.setattr(guard_module, "CREATED_KEPT", 4)
+    ours = make_client(sim)
+    ledger = _ledger(ours.read_pose().xyzabc)
+    guard = PointGuard({p.id: p for p in ledger})
+    for _ in range(3):
+        guard.before_segment(ours, [1, 2, 3])
+    assert guard.created == [3, 1, 2, 3]  # the last four of the nine sent

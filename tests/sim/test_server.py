@@ -555,3 +555,16 @@ def test_monitor_block_reads(sim: SimController, bus: Bus) -> None:
     assert len(bus.read(412, 100)) == 100
     regs = bus.read(560, 24)
     assert regs[0] == ControllerMode.AUTO and regs[1] == ProgramState.STOPPED
+
+
+def test_the_write_log_keeps_the_last_writes_only(sim: Any, make_client: Any, monkeypatch: Any) -> None:
+    """A simulator the GUI runs for days must not grow with every write (issue 18): past
+    WRITE_LOG_LIMIT the oldest tenth is dropped, and counted."""
+    from app.sim import server
+
+    monkeypatch.setattr(server, "WRITE_LOG_LIMIT", 10)
+    client = make_client(sim)
+    for value in range(15):
+        client.write_register(100, value)
+    assert len(sim.writes) <= 10 and sim.writes_dropped == 15 - len(sim.writes)
+    assert [w.values for w in sim.writes][-3:] == [(12,), (13,), (14,)]

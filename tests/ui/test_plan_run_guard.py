@@ -302,3 +302,18 @@ def test_a_controller_that_stops_answering_ends_the_run_as_not_answering(
 def _moved(link: RobotLink, start: Pose) -> bool:
     pose = link.state.pose
     return pose is not None and math.dist(pose.xyzabc[:3], start.xyzabc[:3]) > 0.5
+
+
+def test_a_run_of_many_loops_remembers_only_its_last_segments(
+    bench: Bench, link: RobotLink, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """An endless run sends segments for as long as it goes: the record of them keeps the last
+    SENT_KEPT (issue 18: nothing grows with the run's length)."""
+    from ui.controllers import plan_run_controller
+
+    monkeypatch.setattr(plan_run_controller, "SENT_KEPT", 4)
+    runs = PlanRunController(link, points=bench.model)  # made with the small record
+    with bench.qtbot.waitSignal(runs.runFinished, timeout=RUN_TIMEOUT_MS) as finished:
+        runs.start(bench.plan, loops=2)
+    assert finished.args[0].state is RunState.FINISHED
+    assert runs.sent_segments == [2, 0, 1, 2]  # the last four of the six sent

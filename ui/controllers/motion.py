@@ -76,6 +76,8 @@ class MotionController(QObject):
         jog.jogPressed.connect(self._on_jog_pressed)
         jog.jogReleased.connect(link.jog_release)
         jog.ratioChanged.connect(self._on_ratio_changed)
+        link.state.haltChanged.connect(jog.show_halt)  # "releasing -- the controller has not confirmed"
+        jog.show_halt(link.state.halt)
         link.state.connectionChanged.connect(self._on_connection)
         link.state.alarmsChanged.connect(self._on_alarms)
         run_controller.runningChanged.connect(self._on_run_active)

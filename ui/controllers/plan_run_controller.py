@@ -32,6 +32,7 @@ How an ended run reads ("Failed at segment 2: ...") and what a link change means
 from __future__ import annotations
 
 import dataclasses
+from collections import deque
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -51,6 +52,10 @@ from ui.models.points_model import PointsModel
 
 if TYPE_CHECKING:  # app.plan.runner is imported where a run starts, after the first paint
     from app.plan.runner import PlanRunner, RunOutcome, RunProgress, SegmentCommand
+
+#: How many of the segments sent a run remembers (``sent_segments``): a run with endless loops
+#: sends segments for as long as it runs.
+SENT_KEPT = 1000
 
 
 class PlanRunController(QObject):
@@ -93,7 +98,8 @@ class PlanRunController(QObject):
         self._outcome: RunOutcome | None = None
         self.end_reason = ""  # why the last run stopped or failed, translated (outcome_text)
         self._progress: RunProgress | None = None
-        self._sent: list[int] = []  # segment indices sent, in order (for tests and the log)
+        # segment indices sent, in order (for tests and the log): the last SENT_KEPT (endless loops)
+        self._sent: deque[int] = deque(maxlen=SENT_KEPT)
         self._move: Pending | None = None  # the outcome of the segment under way
         self._stop: Pending | None = None  # the outcome of our last stop
         self._stops = 0  # link.stops_requested when the run began or resumed
@@ -201,7 +207,7 @@ class PlanRunController(QObject):
         self._stops = link.stops_requested  # a Stop asked after this (any button): no further move
         self._outcome = None
         self.end_reason = ""
-        self._sent = []
+        self._sent.clear()
         self._set_paused(False)
         self.runningChanged.emit(True)
         self._send_next(link)

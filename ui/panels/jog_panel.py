@@ -27,7 +27,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.link.types import JogRequest
+from app.link.types import HaltKind, JogRequest, UnconfirmedHalt
 from app.protocol.enums import CARTESIAN_AXIS_NAMES, JOINT_AXIS_NAMES, TeachFrame
 from app.protocol.registers import NUM_AXES_TOTAL, NUM_ROBOT_AXES, TOOL_NONE
 from ui.touch import MOTION_MIN_HEIGHT, RowsScrollArea, mark_motion
@@ -53,6 +53,10 @@ MINUS_KEYS: tuple[Qt.Key, ...] = (
 _FRAMES: tuple[TeachFrame, ...] = (TeachFrame.BASE, TeachFrame.USER, TeachFrame.TOOL, TeachFrame.JOINT)
 BUTTON_WIDTH = 44  # px, the least width of a ± button (two columns of them fit the control column)
 EXTERNAL_COLUMN = 4  # grid column where the external axes start (joint frame: J7..J11 on the right)
+
+
+_HOLD_STYLE = "QLabel { color: #ef8f00; font-weight: bold; font-size: 15px; }"
+_HALT_STYLE = "QLabel { color: #ffffff; background: #c62828; font-weight: bold; font-size: 15px; }"
 
 
 @dataclass(frozen=True)
@@ -134,6 +138,7 @@ class JogPanel(QWidget):
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self._held: _Held | None = None
         self._motion_enabled = False
+        self._halt: UnconfirmedHalt | None = None  # a stop the controller has not confirmed
 
         # compact rows: 6 rows of 40 px buttons fit a 1280×800 screen under the docks
         self.frame_box = QWidget(self)
@@ -210,7 +215,8 @@ class JogPanel(QWidget):
 
         self.hold_label = QLabel(self)
         self.hold_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
-        self.hold_label.setStyleSheet("QLabel { color: #ef8f00; font-weight: bold; font-size: 15px; }")
+        self.hold_label.setWordWrap(True)
+        self.hold_label.setStyleSheet(_HOLD_STYLE)
 
         self.speed_caption = QLabel(self)
         self.speed_slider = QSlider(Qt.Orientation.Horizontal, self)
@@ -258,7 +264,7 @@ class JogPanel(QWidget):
         self.user_label.setText(self.tr("User no.:"))
         self.tool_label.setText(self.tr("Tool no.:"))
         self.external_caption.setText(self.tr("External axes"))
-        self.hold_label.setText(self.tr("HOLD TO MOVE — release to stop"))
+        self._show_halt()
         self.speed_caption.setText(self.tr("Speed:"))
         self._show_speed()
         plus = " ".join(k.name[-1] for k in PLUS_KEYS)
@@ -310,6 +316,38 @@ class JogPanel(QWidget):
             self.release_all()
         self.axes_box.setEnabled(self._motion_enabled)
         self.hold_label.setEnabled(self._motion_enabled)
+
+    @property
+    def halt(self) -> UnconfirmedHalt | None:
+        return self._halt
+
+    @Slot(object)
+    def show_halt(self, halt: UnconfirmedHalt | None) -> None:
+        """A jog's stop (or a Stop) the controller has not confirmed: said where the jog is held,
+        until the controller has answered and the arm is seen still (app/link/halt.py)."""
+        self._halt = halt
+        self._show_halt()
+
+    def _show_halt(self) -> None:
+        halt = self._halt
+        if halt is None:
+            self.hold_label.setStyleSheet(_HOLD_STYLE)
+            self.hold_label.setText(self.tr("HOLD TO MOVE — release to stop"))
+            self.hold_label.setToolTip("")
+            return
+        self.hold_label.setStyleSheet(_HALT_STYLE)
+        if halt.kind is HaltKind.RELEASE:
+            text = self.tr("Releasing — the controller has not confirmed")
+        else:
+            text = self.tr("Stopping — the controller has not confirmed")
+        tip = self.tr(
+            "The controller refused or did not answer the write that stops the arm. TeachPad sends "
+            "it again at every poll until the controller answers and the arm is seen still."
+        )
+        if halt.escalated:
+            tip += "\n" + self.tr("Stop was sent too.")
+        self.hold_label.setText(text)
+        self.hold_label.setToolTip(tip)
 
     @Slot()
     def release_all(self) -> None:
