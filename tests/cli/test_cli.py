@@ -259,7 +259,7 @@ def test_plain_commands(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     assert csim.state().paused
     assert run(csim, capsys, "resume")[0] == ExitCode.OK
     assert not csim.state().paused
-    assert run(csim, capsys, "stop")[1] == "stop: done (the program state reads stopped)\n"
+    assert run(csim, capsys, "stop")[1] == "stop: done (the arm stands still)\n"
     assert not csim.state().moving
     code, out, _ = run(csim, capsys, "zero", "J2")  # waits until the arm stands at zero
     assert code == ExitCode.OK and out == "go to zero (J2): done\n"
