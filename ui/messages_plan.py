@@ -129,6 +129,9 @@ _ISSUES: dict[str, str] = {
     "unreachable/path": QT_TRANSLATE_NOOP("Messages", "the path is out of the robot model's reach."),
     "joint-limit/point": QT_TRANSLATE_NOOP("Messages", "{point} passes a joint limit of the robot model."),
     "joint-limit/path": QT_TRANSLATE_NOOP("Messages", "the path passes a joint limit of the robot model."),
+    "speed-capped": QT_TRANSLATE_NOOP(
+        "Messages", "runs at {cap} mm/s, the reduced-speed cap (planned {speed} mm/s)."
+    ),
 }
 _FROM_CURRENT_POSE = QT_TRANSLATE_NOOP("Messages", " (from the current pose)")
 _FROM_LATER_LOOPS = QT_TRANSLATE_NOOP(

@@ -207,7 +207,7 @@ def cmd_move(ctx: CliContext) -> ExitCode:
 
 def cmd_zero(ctx: CliContext) -> ExitCode:
     axis = parse_zero_axis(ctx.args.axis)
-    ctx.client.go_zero(axis)
+    ctx.client.go_zero(axis, switch_to_auto=ctx.args.auto)
     target = "all axes" if axis is None else JOINT_AXIS_NAMES[axis]
     return ctx.report(f"go to zero sent ({target})")
 
@@ -237,7 +237,13 @@ def _start_program(ctx: CliContext, client: RobotClient, before: Pose) -> ExitCo
     """Send the run command, then wait to see the program run (the controller answers a run
     command only through its state)."""
     args = ctx.args
-    client.run_program(args.id, _PROGRAM_MODES[args.mode], cycles=args.cycles, speed_ratio=args.speed)
+    client.run_program(
+        args.id,
+        _PROGRAM_MODES[args.mode],
+        cycles=args.cycles,
+        speed_ratio=args.speed,
+        switch_to_auto=args.auto,
+    )
     deadline = time.monotonic() + PROGRAM_START_TIMEOUT
     while True:
         status = client.read_status()
@@ -297,6 +303,21 @@ def cmd_write(ctx: CliContext) -> ExitCode:
 # --------------------------------------------------------------------------------------------
 # Parsers
 # --------------------------------------------------------------------------------------------
+
+_MANUAL_TEXT = (
+    "A controller in manual mode is refused (exit 1, nothing written): switching the work mode is "
+    "the operator's decision; --auto switches it to auto first (444 <- 1, its own audited write), "
+    "then sends {what}."
+)
+
+
+def _add_auto(parser: Any) -> None:
+    parser.add_argument(
+        "--auto",
+        action="store_true",
+        help="in manual mode, switch the controller to auto (444 <- 1) first; without it manual mode "
+        "is refused (exit 1, nothing written)",
+    )
 
 
 def register(sub: Any) -> None:
@@ -417,13 +438,26 @@ def register(sub: Any) -> None:
     )
     p.set_defaults(handler=cmd_move)
 
-    p = sub.add_parser("zero", help="go to zero: one axis (J1..J11) or all")
+    p = sub.add_parser(
+        "zero",
+        help="go to zero: one axis (J1..J11) or all",
+        description="Send one axis or all axes to zero (register 445). "
+        + _MANUAL_TEXT.format(what="go to zero")
+        + " Refused with --reduced-speed: go to zero runs at the controller's own speed.",
+    )
     p.add_argument("axis", metavar="AXIS|all", help="J1..J11, or all")
+    _add_auto(p)
     p.set_defaults(handler=cmd_zero)
 
     p = sub.add_parser("program", help="controller programs")
     psub = p.add_subparsers(dest="program_command", metavar="ACTION", required=True)
-    pr = psub.add_parser("run", help="run a program")
+    pr = psub.add_parser(
+        "run",
+        help="run a program",
+        description="Run a controller program (446..449, then 440 <- 0x01). "
+        + _MANUAL_TEXT.format(what="the program")
+        + " With --reduced-speed the speed ratio is capped.",
+    )
     pr.add_argument("id", type=int, help="program id on the controller (register 446)")
     pr.add_argument(
         "--mode",
@@ -435,6 +469,7 @@ def register(sub: Any) -> None:
     pr.add_argument(
         "--speed", type=int, default=100, help="speed ratio in percent, 1..100 (default %(default)s)"
     )
+    _add_auto(pr)
     pr.set_defaults(handler=cmd_program_run)
 
     for name, handler, text in (

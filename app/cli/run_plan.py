@@ -19,6 +19,7 @@ the ``--from`` / ``--from-loop`` that resumes it.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -199,6 +200,8 @@ def cmd_run(ctx: CliContext) -> ExitCode:
             pose = client.read_pose()
         except TeachPadError as exc:
             return _link_code(ctx, exc, "cannot read the robot's pose")
+    if ctx.caps is not None:
+        plan = _capped(ctx, plan, ctx.caps.speed)
     return _run(ctx, args, project, plan, client, pose, limits, loops, start, envelope, reach)
 
 
@@ -234,6 +237,20 @@ class _HaltOnFreshLink:
 def _refusal_code(errors: list[PlanIssue]) -> ExitCode:
     """Only reach errors: the robot cannot do a valid plan (FAILED); any other: USAGE."""
     return ExitCode.FAILED if all(i.code in REACH_CODES for i in errors) else ExitCode.USAGE
+
+
+def _capped(ctx: CliContext, plan: Plan, cap: float) -> Plan:
+    """``--reduced-speed``: the plan with every segment at most ``cap`` mm/s (said per segment),
+    so that its estimates and wait timeouts are the capped run's (the client caps the writes too)."""
+    segments = []
+    for i, seg in enumerate(plan.segments):
+        if seg.speed > cap:
+            ctx.warn(
+                f"segment {i + 1}: runs at {cap:g} mm/s, the reduced-speed cap (planned {seg.speed:g} mm/s)"
+            )
+            seg = dataclasses.replace(seg, speed=cap)
+        segments.append(seg)
+    return dataclasses.replace(plan, segments=segments)
 
 
 def _run(

@@ -204,10 +204,10 @@ class MotionCommands:
         )
         self._track_last(client, Operation.MOVE_TO_POINT, motion=True)
 
-    def go_zero(self, axis: int | None) -> None:
+    def go_zero(self, axis: int | None, switch_to_auto: bool = False) -> None:
         client = self._begin(Operation.GO_ZERO)
         before = self._host.poller.last_pose
-        client.go_zero(axis)
+        client.go_zero(axis, switch_to_auto=switch_to_auto)
         which = "all axes" if axis is None else f"J{axis + 1}"
         self._track(
             Operation.GO_ZERO,
@@ -215,10 +215,17 @@ class MotionCommands:
             motion=True,
         )
 
-    def run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int, speed_ratio: int) -> None:
+    def run_program(
+        self,
+        program_id: int,
+        mode: ProgramMotionMode,
+        cycles: int,
+        speed_ratio: int,
+        switch_to_auto: bool = False,
+    ) -> None:
         client = self._begin(Operation.RUN_PROGRAM)
         before = self._host.poller.last_pose
-        client.run_program(program_id, mode, cycles, speed_ratio)
+        client.run_program(program_id, mode, cycles, speed_ratio, switch_to_auto=switch_to_auto)
         watch = MotionWatch(RunCommand.RUN_PROGRAM, f"run program {program_id}", before, time.monotonic())
         self._track(Operation.RUN_PROGRAM, watch, motion=True)
 

@@ -282,6 +282,8 @@ _LINK_FAILED_BY_CODE = {
     "file_format": False,
     "empty_import": False,
     "jog_not_answering": False,  # the jog's own check before it starts: nothing was sent
+    "manual_mode": False,  # go to zero / run program in manual mode, no switch allowed: nothing sent
+    "reduced_speed_refused": False,  # go to zero in reduced-speed mode: nothing sent
     "error": False,
 }
 
