@@ -138,17 +138,19 @@ class CommandStopped(TeachPadError):
 
 
 class ManualModeRefused(TeachPadError):
-    """A command that needs Auto mode found the controller in Manual (or an unknown mode) and
-    was not allowed to switch it: nothing was written. Switching the work mode is the operator's
-    decision (the GUI asks, naming the switch; the CLI needs ``--auto``)."""
+    """A command that needs auto mode found the controller in manual (or a mode it does not know)
+    and was not allowed to switch it: nothing was written. Switching the work mode is the
+    operator's decision (the GUI asks, naming the switch; the CLI needs ``--auto``). ``mode`` is
+    register 560 as read; the reason carries it only when it is manual (0), a mode the GUI names."""
 
     code = "manual_mode"
 
     def __init__(self, operation: str, mode: int | None) -> None:
+        where = "is in manual mode" if mode == 0 else "is not in auto mode"
         super().__init__(
-            f"{operation} refused: the controller is in manual mode (560 = {mode}); nothing was sent. "
-            "Switch it to auto first (or allow the switch: --auto in teachpad-cli)",
-            params={"operation": operation} if mode is None else {"operation": operation, "mode": mode},
+            f"{operation} refused: the controller {where} (register 560 reads {mode}); nothing was "
+            "sent. Switch it to auto first (or allow the switch: --auto in teachpad-cli)",
+            params={"operation": operation} if mode != 0 else {"operation": operation, "mode": mode},
         )
 
 

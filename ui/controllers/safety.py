@@ -176,6 +176,7 @@ class SafetyController(QObject):
         """A fresh install's envelope (the robot model's defaults) is saved at once, audited: it is
         the envelope in force, revision 1, read by every later start."""
         try:
+            self.profile_path.parent.mkdir(parents=True, exist_ok=True)
             self.profile = save_profile(self.profile_path, self.profile)
         except (OSError, TeachPadError) as exc:  # it applies all the same; say that it is not saved
             self._problem = f"the default safety envelope could not be saved in {self.profile_path}: {exc}"

@@ -2,7 +2,7 @@
 
 The speed slider shows the ratio the jog goes out at: when the envelope caps it (reduced-speed
 mode, or the envelope's maximum jog speed; :meth:`JogPanel.set_ratio_cap`) the value reads
-"50 % → 10 %", highlighted, with the reason in its tooltip.
+"50 % → 10 % (reduced speed)" (or "50 % → 40 %"), highlighted, with the reason in its tooltip.
 
 Dead-man everywhere: a jog lasts exactly as long as the button or key is held. It also ends
 when the panel loses the keyboard focus, when the window is deactivated or closed, and when
@@ -449,7 +449,12 @@ class JogPanel(QWidget):
             self.speed_value.setStyleSheet("")
             self.speed_value.setToolTip("")
             return
-        self.speed_value.setText(self.tr("{ratio} % → {cap} %").format(ratio=self.ratio, cap=f"{sent:g}"))
+        shown = (
+            self.tr("{ratio} % → {cap} % (reduced speed)")
+            if self._reduced
+            else self.tr("{ratio} % → {cap} %")
+        )
+        self.speed_value.setText(shown.format(ratio=self.ratio, cap=f"{sent:g}"))
         self.speed_value.setStyleSheet("QLabel { color: #ef8f00; font-weight: bold; }")
         why = (
             self.tr("Capped at {cap} % (reduced speed): the jog goes out at {cap} %, not {ratio} %")

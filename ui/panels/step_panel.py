@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from PySide6.QtCore import QEvent, Signal, Slot
+from PySide6.QtCore import QEvent, Qt, Signal, Slot
 from PySide6.QtWidgets import (
     QButtonGroup,
     QCheckBox,
@@ -115,7 +115,7 @@ class StepPanel(QWidget):
         top.addSpacing(12)
         top.addWidget(self.speed_caption)
         top.addWidget(self.speed_spin)
-        top.addWidget(self.speed_cap)
+        self.speed_cap.setAlignment(Qt.AlignmentFlag.AlignRight)  # its own line: the top row is full
 
         self.preset_box = QGroupBox(self)
         preset_row = QHBoxLayout(self.preset_box)
@@ -185,6 +185,7 @@ class StepPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
         layout.addLayout(top)
+        layout.addWidget(self.speed_cap)
         layout.addWidget(self.preset_box)
         layout.addWidget(self.axes_box, 1)
         layout.addLayout(actions)
