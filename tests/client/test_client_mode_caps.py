@@ -37,11 +37,12 @@ def test_manual_mode_is_refused_audited_and_nothing_written(
     sim = sim_factory(work_mode=WorkMode.MANUAL)
     client: RobotClient = make_client(sim)
     client.audit = AuditLog(tmp_path)
-    call = (lambda: client.go_zero(None)) if operation == "go to zero" else (lambda: client.run_program(2))
-    with pytest.raises(
-        ManualModeRefused, match=f"^{operation} refused: the controller is in manual mode"
-    ) as info:
-        call()
+    refused = f"^{operation} refused: the controller is in manual mode"
+    with pytest.raises(ManualModeRefused, match=refused) as info:
+        if operation == "go to zero":
+            client.go_zero(None)
+        else:
+            client.run_program(2)
     assert info.value.params == {"operation": operation, "mode": 0}
     assert sim.writes == [] and sim.state().work_mode is WorkMode.MANUAL
     client.audit.close()
