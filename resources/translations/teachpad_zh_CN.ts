@@ -3425,194 +3425,199 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="179" />
+            <location filename="../../ui/panels/points_panel.py" line="183" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="181" />
+            <location filename="../../ui/panels/points_panel.py" line="185" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="184" />
+            <location filename="../../ui/panels/points_panel.py" line="188" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="184" />
+            <location filename="../../ui/panels/points_panel.py" line="188" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="185" />
+            <location filename="../../ui/panels/points_panel.py" line="189" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="185" />
+            <location filename="../../ui/panels/points_panel.py" line="189" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="187" />
+            <location filename="../../ui/panels/points_panel.py" line="191" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="188" />
+            <location filename="../../ui/panels/points_panel.py" line="192" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="190" />
+            <location filename="../../ui/panels/points_panel.py" line="194" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="191" />
+            <location filename="../../ui/panels/points_panel.py" line="195" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="193" />
+            <location filename="../../ui/panels/points_panel.py" line="197" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="194" />
+            <location filename="../../ui/panels/points_panel.py" line="198" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="197" />
+            <location filename="../../ui/panels/points_panel.py" line="201" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="198" />
+            <location filename="../../ui/panels/points_panel.py" line="202" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="200" />
+            <location filename="../../ui/panels/points_panel.py" line="204" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="200" />
+            <location filename="../../ui/panels/points_panel.py" line="204" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="202" />
-            <location filename="../../ui/panels/points_parts.py" line="166" />
+            <location filename="../../ui/panels/points_panel.py" line="206" />
+            <location filename="../../ui/panels/points_parts.py" line="171" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="203" />
+            <location filename="../../ui/panels/points_panel.py" line="207" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="205" />
+            <location filename="../../ui/panels/points_panel.py" line="209" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="207" />
-            <location filename="../../ui/panels/points_panel.py" line="395" />
+            <location filename="../../ui/panels/points_panel.py" line="211" />
+            <location filename="../../ui/panels/points_panel.py" line="399" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="208" />
+            <location filename="../../ui/panels/points_panel.py" line="212" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="210" />
+            <location filename="../../ui/panels/points_panel.py" line="214" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="210" />
+            <location filename="../../ui/panels/points_panel.py" line="214" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="211" />
+            <location filename="../../ui/panels/points_panel.py" line="215" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="129" />
+            <location filename="../../ui/panels/points_panel.py" line="420" />
+            <source>→ {cap} mm/s (reduced speed)</source>
+            <translation>→ {cap} mm/s（降速模式）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/points_parts.py" line="134" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="130" />
+            <location filename="../../ui/panels/points_parts.py" line="135" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="131" />
+            <location filename="../../ui/panels/points_parts.py" line="136" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="160" />
+            <location filename="../../ui/panels/points_parts.py" line="165" />
             <source>The controller restarted or the link was re-established: its temp points may be gone. Re-create them before running a plan.</source>
             <translation>控制器已重启或通信已重新建立：其上的临时点可能已丢失。运行轨迹前请重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="187" />
+            <location filename="../../ui/panels/points_parts.py" line="192" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="188" />
+            <location filename="../../ui/panels/points_parts.py" line="193" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="305" />
+            <location filename="../../ui/panels/points_panel.py" line="309" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="309" />
+            <location filename="../../ui/panels/points_panel.py" line="313" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="311" />
+            <location filename="../../ui/panels/points_panel.py" line="315" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="314" />
+            <location filename="../../ui/panels/points_panel.py" line="318" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="341" />
+            <location filename="../../ui/panels/points_panel.py" line="345" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="344" />
+            <location filename="../../ui/panels/points_panel.py" line="348" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="370" />
+            <location filename="../../ui/panels/points_panel.py" line="374" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="379" />
+            <location filename="../../ui/panels/points_panel.py" line="383" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -3625,7 +3630,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="194" />
+            <location filename="../../ui/panels/points_parts.py" line="199" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>

@@ -80,8 +80,11 @@ def test_reduced_speed_caps_every_speed_written(sim: Any, make_client: MakeClien
     client.step(StepFrame.BASE, [0, 0, -5, 0, 0, 0], speed=800)
     client.step(StepFrame.JOINT, [2, 0, 0, 0, 0, 0], speed=5)
     client.step(StepFrame.JOINT, [2, -2, 1, 0, 0, 0], speed=5)
+    x, y, z, a, b, c = client.read_pose().xyzabc
+    client.create_point(3, pose=[x, y, z - 20, a, b, c])
+    client.move_to_point(3, speed=800)  # a plan's segment, the points table's Move to point, the CLI's move
     assert gv_values(sim, registers.GV_EXPECTED_SPEED) == pytest.approx(
-        [250.0, CAPS.joint_rpm_cap, CAPS.joint_rpm_cap / 2.5], rel=1e-6
+        [250.0, CAPS.joint_rpm_cap, CAPS.joint_rpm_cap / 2.5, 250.0], rel=1e-6
     )
     client.teach_enable(TeachFrame.BASE, 2, 0)
     client.teach_set_ratio(60)

@@ -148,6 +148,26 @@ def test_plan_through_a_keep_out_box_is_an_error_that_blocks_run() -> None:
     assert not has_errors(check_plan(plan, ledger, current_pose=pose(0, 0, 100)))
 
 
+def test_reduced_speed_caps_a_plans_segments_instead_of_refusing_them() -> None:
+    ledger = _ledger((200.0, 0.0, 100.0), (200.0, 200.0, 100.0), (0.0, 200.0, 100.0))
+    plan = Plan(
+        "slow",
+        [
+            Segment(SegmentKind.LINE, end_id=1, speed=100),  # under the reduced cap (250)
+            Segment(SegmentKind.LINE, end_id=2, speed=400),  # runs at 250
+            Segment(SegmentKind.LINE, end_id=3, speed=600),  # above the envelope's maximum (500)
+        ],
+    )
+    issues = check_plan(plan, ledger, current_pose=pose(0, 0, 100), envelope=ENV, reduced_speed=True)
+    assert [(i.segment, i.kind, i.code) for i in issues] == [
+        (1, IssueKind.WARNING, IssueCode.SPEED_CAPPED),
+        (2, IssueKind.ERROR, IssueCode.OUTSIDE_ENVELOPE),  # refused in every mode
+    ]
+    assert issues[0].message == "segment 2: runs at 250 mm/s, the reduced-speed cap (planned 400 mm/s)"
+    normal = check_plan(plan, ledger, current_pose=pose(0, 0, 100), envelope=ENV)
+    assert [(i.segment, i.code) for i in normal] == [(2, IssueCode.OUTSIDE_ENVELOPE)]
+
+
 def test_plan_without_a_start_pose_checks_the_first_end_point_only() -> None:
     ledger = _ledger((350.0, 0.0, 100.0), (0.0, 0.0, 100.0))
     plan = Plan("p", [Segment(SegmentKind.LINE, end_id=1, speed=100), Segment(SegmentKind.LINE, end_id=2)])

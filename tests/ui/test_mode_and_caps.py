@@ -148,6 +148,12 @@ def test_reduced_speed_caps_every_motion_and_shows_the_cap(qtbot: Any, sim: Any,
         window.link.stop()
     assert sim.wait_for(lambda s: not s.moving, 5.0)
 
+    # a move to a point: the cap beside its speed, and the speed it goes out at
+    points = window.points_panel
+    points.speed.setValue(500.0)
+    assert points.speed_cap.isVisibleTo(points) and points.speed_cap.text() == "→ 250 mm/s (reduced speed)"
+    assert points.sent_speed() == REDUCED_SPEED_DEFAULT
+
     # go to zero cannot be capped: held
     assert not program.zero_button.isEnabled() and "reduced-speed" in program.zero_button.toolTip()
 
