@@ -152,6 +152,37 @@ class CommandStopped(TeachPadError):
     code = "stopped_by_controller"
 
 
+class ManualModeRefused(TeachPadError):
+    """A command that needs auto mode found the controller in manual (or a mode it does not know)
+    and was not allowed to switch it: nothing was written. Switching the work mode is the
+    operator's decision (the GUI asks, naming the switch; the CLI needs ``--auto``). ``mode`` is
+    register 560 as read; the reason carries it only when it is manual (0), a mode the GUI names."""
+
+    code = "manual_mode"
+
+    def __init__(self, operation: str, mode: int | None) -> None:
+        where = "is in manual mode" if mode == 0 else "is not in auto mode"
+        super().__init__(
+            f"{operation} refused: the controller {where} (register 560 reads {mode}); nothing was "
+            "sent. Switch it to auto first (or allow the switch: --auto in teachpad-cli)",
+            params={"operation": operation} if mode != 0 else {"operation": operation, "mode": mode},
+        )
+
+
+class ReducedSpeedRefused(TeachPadError):
+    """A motion reduced-speed mode cannot cap (it has no speed the host sets, e.g. go to zero):
+    refused before the wire."""
+
+    code = "reduced_speed_refused"
+
+    def __init__(self, operation: str) -> None:
+        super().__init__(
+            f"{operation} refused in reduced-speed mode: it runs at the controller's own speed, "
+            "which TeachPad cannot cap; nothing was sent",
+            params={"operation": operation},
+        )
+
+
 class InvalidInput(TeachPadError, ValueError):
     """A value the host refuses before sending (range, NaN, unknown enum)."""
 

@@ -1,7 +1,9 @@
 """The on-screen numeric keypad of touch mode: tap a number field, type, OK.
 
 :class:`KeypadDialog` has digits, sign, decimal point, backspace, clear, OK / Cancel, and
-respects the field's range and decimals (OK is off while the value is outside the range).
+respects the field's range and decimals (OK is off while the value is outside the range). A
+field with ``keypad_range()`` (:class:`~ui.keypad_range.RangedField`: an axis's offset) narrows
+the range to what it allows now, and its note says why (the axis's limits, where it stands).
 :func:`install_keypad` puts an opener on a QSpinBox / QDoubleSpinBox; ``ui.touch`` switches
 the openers with touch mode.
 """
@@ -23,6 +25,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from ui.keypad_range import RangedField
+
 KEYPAD_KEY_SIZE = 56  # px, a key of the on-screen keypad
 MINUS = "−"  # shown; "-" is what the value parser reads
 
@@ -39,6 +43,12 @@ class KeypadDialog(QDialog):
         self.setModal(True)
         self._minimum = float(field.minimum())
         self._maximum = float(field.maximum())
+        offered = field.keypad_range() if isinstance(field, RangedField) else None
+        self._note = ""
+        if offered is not None:  # what the field allows now, within its own range
+            self._minimum = max(self._minimum, offered.low)
+            self._maximum = min(self._maximum, offered.high)
+            self._note = offered.note
         self._decimals = field.decimals() if isinstance(field, QDoubleSpinBox) else 0
         self.display = QLineEdit(self)
         self.display.setObjectName("KeypadDisplay")
@@ -95,7 +105,8 @@ class KeypadDialog(QDialog):
         self.keys["back"].setToolTip(self.tr("Delete the last digit"))
         self.keys["clear"].setToolTip(self.tr("Clear"))
         low, high = (f"{v:.{self._decimals}f}" for v in (self._minimum, self._maximum))
-        self.range_label.setText(self.tr("From {low} to {high}").format(low=low, high=high))
+        text = self.tr("From {low} to {high}").format(low=low, high=high)
+        self.range_label.setText(f"{text}\n{self._note}" if self._note else text)
 
     def changeEvent(self, event: QEvent) -> None:
         if event.type() == QEvent.Type.LanguageChange:

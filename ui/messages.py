@@ -176,6 +176,16 @@ _TEMPLATES: dict[str, str] = {
         "Messages", "The controller refused the request: Modbus exception {exception} ({name})."
     ),
     "monitor_only": QT_TRANSLATE_NOOP("Messages", "Monitor-only mode: nothing was sent to the controller."),
+    "manual_mode": QT_TRANSLATE_NOOP(
+        "Messages",
+        "{operation}: not sent, the controller is in {mode} mode. Switching it to auto is the operator's "
+        "decision: say yes when the confirmation asks, or switch it to auto first.",
+    ),
+    "reduced_speed_refused": QT_TRANSLATE_NOOP(
+        "Messages",
+        "{operation}: not sent in reduced-speed mode: it runs at the controller's own speed, which "
+        "TeachPad cannot cap.",
+    ),
     "invalid_input": QT_TRANSLATE_NOOP("Messages", "Invalid value: nothing was sent."),
     "unexpected": QT_TRANSLATE_NOOP("Messages", "Unexpected internal error; the log has the details."),
     # a plan run's point guard (app/points/guard.py, ui/controllers/run_points.py)
@@ -241,6 +251,9 @@ _BARE: dict[str, str] = {
     "done": QT_TRANSLATE_NOOP("Messages", "{command}: done."),
     "modbus_exception": QT_TRANSLATE_NOOP(
         "Messages", "The controller refused the request (Modbus exception)."
+    ),
+    "manual_mode": QT_TRANSLATE_NOOP(
+        "Messages", "{operation}: not sent, the controller is not in auto mode."
     ),
 }
 

@@ -141,6 +141,9 @@ _ISSUES: dict[str, str] = {
         "Messages",
         "The robot model \u201c{model}\u201d disagrees with the controller's pose by {distance} mm and {angle}°: reach checks may be wrong.",
     ),
+    "speed-capped": QT_TRANSLATE_NOOP(
+        "Messages", "runs at {cap} mm/s, the reduced-speed cap (planned {speed} mm/s)."
+    ),
 }
 _FROM_CURRENT_POSE = QT_TRANSLATE_NOOP("Messages", " (from the current pose)")
 _FROM_LATER_LOOPS = QT_TRANSLATE_NOOP(

@@ -24,6 +24,7 @@ from app.errors import ModbusExceptionError, TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
 from app.link.halt import RETRY_EXCEPTIONS
 from app.safety.audit import AuditLog
+from app.safety.caps import MotionCaps
 
 __all__ = [
     "PROG",
@@ -53,6 +54,8 @@ class CliContext:
     #: where the client comes from (default: a RobotClient from ``settings``, with the audit
     #: trail); the context closes it either way
     make_client: Callable[[], RobotClient] | None = None
+    #: reduced-speed mode's caps (``--reduced-speed``), given to the client (None: not reduced)
+    caps: MotionCaps | None = None
     _client: RobotClient | None = None
 
     @property
@@ -60,15 +63,25 @@ class CliContext:
         if self._client is None:
             if _CtrlC.pressed:  # a Ctrl-C Python lost (see ctrl_c_remembered): nothing is sent
                 raise KeyboardInterrupt
+            if self.caps is not None:
+                self._say_caps(self.caps)
             if self.make_client is not None:
                 self._client = self.make_client()
+                self._client.caps = self.caps
                 return self._client
             client = RobotClient(self.settings)
+            client.caps = self.caps
             # The CLI is an administrator's tool; its writes go to the same audit trail as the GUI's.
             client.audit = AuditLog(role="administrator (cli)", word_order=self.settings.word_order)
             self._client = client
             client.connect()
         return self._client
+
+    def _say_caps(self, caps: MotionCaps) -> None:
+        self.warn(
+            f"reduced speed: motions capped at {caps.ratio:g} % (jog, programs), {caps.speed:g} mm/s "
+            f"(moves, base steps), {caps.joint_rpm_cap:.2g} rpm (one joint); go to zero refused"
+        )
 
     def print(self, *parts: object) -> None:
         print(*parts, file=self.out, flush=True)

@@ -269,7 +269,7 @@ def cmd_move(ctx: CliContext) -> ExitCode:
 def cmd_zero(ctx: CliContext) -> ExitCode:
     axis = parse_zero_axis(ctx.args.axis)
     client = ctx.client
-    return _follow_watch(ctx, lambda: client.go_zero(axis))
+    return _follow_watch(ctx, lambda: client.go_zero(axis, switch_to_auto=ctx.args.auto))
 
 
 _PROGRAM_MODES = {
@@ -285,7 +285,9 @@ def cmd_program_run(ctx: CliContext) -> ExitCode:
     mode = _PROGRAM_MODES[args.mode]
     return _follow_watch(
         ctx,
-        lambda: client.run_program(args.id, mode, cycles=args.cycles, speed_ratio=args.speed),
+        lambda: client.run_program(
+            args.id, mode, cycles=args.cycles, speed_ratio=args.speed, switch_to_auto=args.auto
+        ),
         until_started=args.no_wait,
     )
 
@@ -416,6 +418,21 @@ def cmd_write(ctx: CliContext) -> ExitCode:
 # Parsers
 # --------------------------------------------------------------------------------------------
 
+_MANUAL_TEXT = (
+    "A controller in manual mode is refused (exit 1, nothing written): switching the work mode is "
+    "the operator's decision; --auto switches it to auto first (444 <- 1, its own audited write), "
+    "then sends {what}."
+)
+
+
+def _add_auto(parser: Any) -> None:
+    parser.add_argument(
+        "--auto",
+        action="store_true",
+        help="in manual mode, switch the controller to auto (444 <- 1) first; without it manual mode "
+        "is refused (exit 1, nothing written)",
+    )
+
 
 def register(sub: Any) -> None:
     """Add the controller commands to the main parser's subcommands (``sub``)."""
@@ -544,14 +561,25 @@ def register(sub: Any) -> None:
     p.set_defaults(handler=cmd_move)
 
     p = sub.add_parser(
-        "zero", help="go to zero: one axis (J1..J11) or all; waits until the arm stands at zero"
+        "zero",
+        help="go to zero: one axis (J1..J11) or all; waits until the arm stands at zero",
+        description="Send one axis or all axes to zero (register 445) and wait until the arm stands at zero. "
+        + _MANUAL_TEXT.format(what="go to zero")
+        + " Refused with --reduced-speed: go to zero runs at the controller's own speed.",
     )
     p.add_argument("axis", metavar="AXIS|all", help="J1..J11, or all")
+    _add_auto(p)
     p.set_defaults(handler=cmd_zero)
 
     p = sub.add_parser("program", help="controller programs")
     psub = p.add_subparsers(dest="program_command", metavar="ACTION", required=True)
-    pr = psub.add_parser("run", help="run a program")
+    pr = psub.add_parser(
+        "run",
+        help="run a program",
+        description="Run a controller program (446..449, then 440 <- 0x01). "
+        + _MANUAL_TEXT.format(what="the program")
+        + " With --reduced-speed the speed ratio is capped.",
+    )
     pr.add_argument("id", type=int, help="program id on the controller (register 446)")
     pr.add_argument(
         "--mode",
@@ -568,6 +596,7 @@ def register(sub: Any) -> None:
         action="store_true",
         help="return once the program is seen running (a refusal is still told); its end is not waited for",
     )
+    _add_auto(pr)
     pr.set_defaults(handler=cmd_program_run)
 
     for name, handler, text in (

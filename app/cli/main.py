@@ -2,11 +2,12 @@
 
     teachpad-cli [--host H --port P | --rtu DEV --baud B --parity N] [--timeout S]
                  [--register-profile FILE] [--unit U] [--word-order W] [--completion C]
-                 [--poll-timeout S] [--monitor-only] COMMAND ...
+                 [--poll-timeout S] [--monitor-only] [--reduced-speed] COMMAND ...
 
 The connection options say where the controller is; ``--register-profile`` how its registers
 read (:mod:`app.safety.register_profile`, as the GUI applies it); ``--unit``, ``--word-order``,
 ``--completion`` and ``--poll-timeout`` override the profile's field (:func:`settings_from_args`).
+``--reduced-speed`` caps every motion the command sends (:func:`caps_from_args`).
 
 Every command, by the module whose ``register`` adds it (:data:`REGISTRARS`, in this order):
 
@@ -45,6 +46,9 @@ from app.cli.help import add_examples
 from app.errors import InvalidInput, TeachPadError
 from app.link.client import ConnectionSettings
 from app.link.outcome import UNKNOWN_ADVICE
+from app.safety.caps import MotionCaps
+from app.safety.envelope import Envelope
+from app.safety.profile import load_profile as load_safety_profile
 from app.safety.register_profile import (
     COMPLETION_MODES,
     PROFILE_NAME,
@@ -172,6 +176,14 @@ def build_parser() -> argparse.ArgumentParser:
         "profile's, else 0.15 over TCP, by baud rate over RTU)",
     )
     link.add_argument("--monitor-only", action="store_true", help="refuse every write")
+    parser.add_argument(
+        "--reduced-speed",
+        action="store_true",
+        help="reduced-speed mode: cap every motion at the envelope's reduced caps (run --safety FILE's, "
+        "else the defaults: 10 %% for jog and program speed ratios, 250 mm/s for steps, moves and "
+        "plan segments; joint steps at the rpm that keeps the arm under that speed at the robot "
+        "model's reach); go to zero is refused (it runs at the controller's own speed)",
+    )
     parser.add_argument("-v", "--verbose", action="store_true", help="log every write and the link")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for register in REGISTRARS:
@@ -207,6 +219,23 @@ def settings_from_args(args: argparse.Namespace) -> ConnectionSettings:
     if "unit" in overrides and not UNIT_RANGE[0] <= overrides["unit"] <= UNIT_RANGE[1]:
         raise InvalidInput(f"--unit must be {UNIT_RANGE[0]}..{UNIT_RANGE[1]}, got {overrides['unit']}")
     return dataclasses.replace(settings, **overrides)
+
+
+def caps_from_args(args: argparse.Namespace) -> MotionCaps | None:
+    """Reduced-speed mode's caps (None without ``--reduced-speed``): the envelope of ``--safety``
+    when the command has one (``run``), else the default envelope's; the reach of its
+    ``--robot-profile``, else the default robot model's. A file that cannot be used raises a
+    :class:`TeachPadError` naming it (a usage error: nothing sent)."""
+    if not args.reduced_speed:
+        return None
+    from app.view3d.profile import default_profile
+    from app.view3d.profile import load_profile as load_robot_profile
+
+    safety = getattr(args, "safety", None)
+    envelope = Envelope() if not safety else load_safety_profile(safety).envelope
+    robot = getattr(args, "robot_profile", None)
+    model = default_profile() if robot is None else load_robot_profile(robot)
+    return envelope.motion_caps(model.reach)
 
 
 def _shown_path(path: Path) -> str:
@@ -258,7 +287,12 @@ def _main(argv: Sequence[str] | None = None) -> int:
     except TeachPadError as exc:  # a register profile that cannot be used, a bad --unit
         print(f"{PROG}: error: {exc}", file=sys.stderr, flush=True)
         return exit_code_for(exc)
-    ctx = CliContext(args, settings)
+    try:
+        caps = caps_from_args(args)
+    except TeachPadError as exc:  # a safety or robot profile that cannot be used: nothing sent
+        print(f"{PROG}: error: {exc}", file=sys.stderr, flush=True)
+        return ExitCode.USAGE
+    ctx = CliContext(args, settings, caps=caps)
     handler: Handler = args.handler
     try:
         return handler(ctx)

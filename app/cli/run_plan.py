@@ -20,6 +20,7 @@ the ``--from`` / ``--from-loop`` that resumes it.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 from pathlib import Path
 from typing import Any
 
@@ -206,6 +207,8 @@ def cmd_run(ctx: CliContext) -> ExitCode:
         except TeachPadError as exc:
             return _link_code(ctx, exc, "cannot read the robot's pose")
     reach = reach_check(model, pose)
+    if ctx.caps is not None:
+        plan = _capped(ctx, plan, ctx.caps.speed)
     return _run(ctx, args, project, plan, client, pose, limits, loops, start, envelope, reach)
 
 
@@ -264,6 +267,20 @@ def _refusal_why(errors: list[PlanIssue], code: ExitCode) -> str:
     if any(i.code is IssueCode.MODEL_DISAGREES for i in errors):
         return " (the robot model disagrees with the controller)"
     return " (out of the robot model's reach)"
+
+
+def _capped(ctx: CliContext, plan: Plan, cap: float) -> Plan:
+    """``--reduced-speed``: the plan with every segment at most ``cap`` mm/s (said per segment),
+    so that its estimates and wait timeouts are the capped run's (the client caps the writes too)."""
+    segments = []
+    for i, seg in enumerate(plan.segments):
+        if seg.speed > cap:
+            ctx.warn(
+                f"segment {i + 1}: runs at {cap:g} mm/s, the reduced-speed cap (planned {seg.speed:g} mm/s)"
+            )
+            seg = dataclasses.replace(seg, speed=cap)
+        segments.append(seg)
+    return dataclasses.replace(plan, segments=segments)
 
 
 def _run(

@@ -8,9 +8,18 @@ thread-safe: one thread owns it (the GUI worker, or the CLI).
 
 Decisions on the open questions of PROTOCOL.md section 7 that live here:
 
-* **Work mode**: before a motion/create/teach command the client reads the status (it needs
-  it as the tracker's "before" anyway) and writes 444 <- auto only when the mode reads manual
-  (or an unknown value); Modbus-teach (2) counts as auto.
+* **Work mode**: before a step, move, create-point or teach command the client reads the status
+  (it needs it as the tracker's "before" anyway) and writes 444 <- auto only when the mode reads
+  manual (or an unknown value), as the vendor's recipe of the four functions says; Modbus-teach
+  (2) counts as auto. Go to zero and run program are not in those recipes: in manual mode they
+  are refused (:class:`~app.errors.ManualModeRefused`, audited, nothing written) unless the
+  caller passes ``switch_to_auto=True`` -- the operator confirmed the switch (the GUI names it in
+  its confirmation, the CLI needs ``--auto``); 444 <- auto then goes out as its own write (its
+  own audit record) before the command.
+* **Reduced-speed caps** (``caps``, :class:`~app.safety.caps.MotionCaps`, None: not reduced):
+  every speed this client writes is capped here -- the jog ratio, the program speed ratio, the
+  GV225 of steps and moves -- whoever asked for it; go to zero, which has no speed to cap, is
+  refused (:class:`~app.errors.ReducedSpeedRefused`).
 * **Cached parameters**: GV245 (tool), GV241 (user frame) and the external-axis offsets
   GV236-240 are written only when they differ from what this client last wrote; the cache is
   dropped whenever the connection is (re)made or fails, and by :meth:`invalidate_cache`.
@@ -31,8 +40,11 @@ from app.errors import (
     InvalidInput,
     LinkError,
     MalformedResponse,
+    ManualModeRefused,
     ModbusExceptionError,
+    ReducedSpeedRefused,
     ResponseTimeout,
+    TeachPadError,
 )
 from app.link.checks import check_enum, check_float, check_floats, check_int, check_tool
 from app.link.command_client import CommandClient
@@ -57,6 +69,7 @@ from app.protocol.enums import (
     program_state_text,
 )
 from app.safety.audit import AuditRecord
+from app.safety.caps import MotionCaps
 
 __all__ = [
     "ConnectionSettings",
@@ -86,6 +99,8 @@ class RobotClient(CommandClient):
         # X Y Z of the points this client created from given poses (a move whose GV291 never
         # changed may be confirmed by arriving there, see CommandTracker's ``target``)
         self._sent_points: dict[int, tuple[float, float, float]] = {}
+        #: reduced-speed mode's caps, applied to every speed written (None: not reduced)
+        self.caps: MotionCaps | None = None
 
     def invalidate_cache(self) -> None:
         """Forget which tool / user frame / external offsets were written last."""
@@ -110,17 +125,22 @@ class RobotClient(CommandClient):
     def resume(self) -> None:
         self._write_control(registers.REG_RESUME, 1)
 
-    def go_zero(self, axis: int | None, *, before: Pose | None = None) -> MotionWatch:
+    def go_zero(
+        self, axis: int | None, *, before: Pose | None = None, switch_to_auto: bool = False
+    ) -> MotionWatch:
         """Send one axis (0..10 = J1..J11) or all axes (None) to zero; returns the watch that tells
         how it ends (by motion: go to zero has no GV291 result; :meth:`follow` it, or feed it).
-        ``before``: the pose just read (the GUI's last poll), else it is read here."""
+        ``before``: the pose just read (the GUI's last poll), else it is read here. In manual mode:
+        refused, unless ``switch_to_auto`` (444 <- auto first); in reduced-speed mode: refused."""
         last_axis = registers.NUM_AXES_TOTAL - 1
         value = registers.GO_ZERO_ALL if axis is None else check_int(axis, 0, last_axis, "axis")
         which = "all axes" if axis is None else JOINT_AXIS_NAMES[axis]
         self._require_writable("go to zero")
+        if self.caps is not None:
+            self._refuse("go to zero", ReducedSpeedRefused("go to zero"))
         status = self.read_status()
         self._refuse_while_busy("go to zero", f"go to zero ({which})", status)
-        self._ensure_auto(status)
+        self._auto_for("go to zero", status, switch_to_auto)
         before = before or self.read_pose()
         with self.judged_writes() as judged:
             self._write_control(registers.REG_GO_ZERO, value)
@@ -138,17 +158,21 @@ class RobotClient(CommandClient):
         speed_ratio: int = 100,
         *,
         before: Pose | None = None,
+        switch_to_auto: bool = False,
     ) -> MotionWatch:
         """446..449 in one 0x10, then 440 <- 0x01; returns the watch that tells how it ends
-        (``before``: as for :meth:`go_zero`)."""
+        (``before``: as for :meth:`go_zero`). In manual mode: refused, unless ``switch_to_auto``
+        (444 <- auto first); the speed ratio is capped in reduced-speed mode."""
         program_id = check_int(program_id, 0, 0xFFFF, "program id")
         motion = check_enum(mode, ProgramMotionMode, "program motion mode")
         cycles = check_int(cycles, 0, 0xFFFF, "cycle count")
         speed_ratio = check_int(speed_ratio, 1, 100, "program speed ratio")
+        if self.caps is not None:
+            speed_ratio = self.caps.program_ratio(speed_ratio)
         self._require_writable("run program")
         status = self.read_status()
         self._refuse_while_busy("run program", f"run program {program_id}", status)
-        self._ensure_auto(status)
+        self._auto_for("run program", status, switch_to_auto)
         before = before or self.read_pose()
         self._write(registers.REG_PROGRAM_ID, [program_id, int(motion), cycles, speed_ratio])
         with self.judged_writes() as judged:
@@ -186,6 +210,21 @@ class RobotClient(CommandClient):
         """444 <- auto unless the (fresh) status already says auto or Modbus teach."""
         if status.mode not in (ControllerMode.AUTO, ControllerMode.MODBUS_TEACH):
             self.set_work_mode(WorkMode.AUTO)
+
+    def _auto_for(self, operation: str, status: ControllerStatus, switch: bool) -> None:
+        """Auto (or Modbus teach) already: nothing; manual or unknown: 444 <- auto when the caller
+        may ``switch``, else refused (audited) before anything is written."""
+        if status.mode in (ControllerMode.AUTO, ControllerMode.MODBUS_TEACH):
+            return
+        if not switch:
+            self._refuse(operation, ManualModeRefused(operation, int(status.mode)))
+        self.set_work_mode(WorkMode.AUTO)
+
+    def _refuse(self, operation: str, error: TeachPadError) -> None:
+        """Record ``error`` as a refused action in the audit trail and raise it (nothing sent)."""
+        if self.audit is not None:
+            self.audit.record_refused(operation, str(error), dict(error.params))
+        raise error
 
     def ensure_auto(self) -> None:
         self._require_writable("set work mode")
@@ -237,6 +276,12 @@ class RobotClient(CommandClient):
             timeout = check_float(timeout, "timeout", 0.0, lo_open=True)
         if not any(offs) and not any(ext):
             raise InvalidInput("step: every offset is zero, nothing to move")
+        if self.caps is not None:
+            speed = (
+                self.caps.joint_speed(speed, offs)
+                if frame is StepFrame.JOINT
+                else self.caps.linear_speed(speed)
+            )
         if timeout is None:
             timeout = self._step_timeout(frame, offs, ext, speed)
         command = frame.command
@@ -445,6 +490,8 @@ class RobotClient(CommandClient):
                 raise InvalidInput("the arc's middle point must differ from its end point")
             motion = float(via_id)
         speed = check_float(speed, "speed", 0.0, lo_open=True)
+        if self.caps is not None:
+            speed = self.caps.linear_speed(speed)
         tool = check_tool(tool)
         if timeout is not None:
             timeout = check_float(timeout, "timeout", 0.0, lo_open=True)
@@ -499,6 +546,8 @@ class RobotClient(CommandClient):
     def teach_set_ratio(self, ratio: float, *, timeout: float | None = None) -> None:
         """GV203 <- ratio: > 0 moves, 0 stops the jog (teach stays enabled). ``timeout``: s per attempt."""
         ratio = check_float(ratio, "speed ratio", 0.0, 100.0)
+        if self.caps is not None:
+            ratio = self.caps.jog_ratio(ratio)
         self._write_floats(registers.GV_PARAM3, [ratio], timeout)
 
     def teach_set_axis(self, axis: int, direction: int) -> None:

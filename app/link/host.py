@@ -23,6 +23,7 @@ if TYPE_CHECKING:
     from app.link.supervisor import LinkSupervisor
     from app.link.upload import Uploader
     from app.safety.audit import AuditLog
+    from app.safety.caps import MotionCaps
     from app.safety.envelope import EnvelopeViolation
 
 __all__ = ["WorkerHost", "WorkerOutputs"]
@@ -62,6 +63,7 @@ class WorkerHost(WorkerOutputs, Protocol):
     capture: TrafficCapture
     closed: bool
     audit: AuditLog | None  # given to each new client (thread-safe)
+    caps: MotionCaps | None  # reduced-speed mode's caps, given to each new client
     request_id: int | None  # of the job being executed (results and errors carry it)
 
     @property

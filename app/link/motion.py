@@ -164,15 +164,26 @@ class MotionCommands:
         )
         self._track_last(client, Operation.MOVE_TO_POINT, motion=True)
 
-    def go_zero(self, axis: int | None) -> None:
+    def go_zero(self, axis: int | None, switch_to_auto: bool = False) -> None:
         client = self._begin(Operation.GO_ZERO)
         before = self._host.poller.last_pose  # (the client reads it when there was no poll yet)
-        self._track(Operation.GO_ZERO, client.go_zero(axis, before=before), motion=True)
+        self._track(
+            Operation.GO_ZERO, client.go_zero(axis, before=before, switch_to_auto=switch_to_auto), motion=True
+        )
 
-    def run_program(self, program_id: int, mode: ProgramMotionMode, cycles: int, speed_ratio: int) -> None:
+    def run_program(
+        self,
+        program_id: int,
+        mode: ProgramMotionMode,
+        cycles: int,
+        speed_ratio: int,
+        switch_to_auto: bool = False,
+    ) -> None:
         client = self._begin(Operation.RUN_PROGRAM)
         before = self._host.poller.last_pose
-        watch = client.run_program(program_id, mode, cycles, speed_ratio, before=before)
+        watch = client.run_program(
+            program_id, mode, cycles, speed_ratio, before=before, switch_to_auto=switch_to_auto
+        )
         self._track(Operation.RUN_PROGRAM, watch, motion=True)
 
     def create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> None:

@@ -123,15 +123,22 @@ class WorkerRequests:
     def request_set_mode(self, mode: WorkMode) -> int:
         return self.post(Operation.SET_MODE, lambda: self._do_set_mode(mode))
 
-    def request_go_zero(self, axis: int | None) -> int:
-        return self.post(Operation.GO_ZERO, lambda: self.motions.go_zero(axis), JobKind.MOTION)
+    def request_go_zero(self, axis: int | None, switch_to_auto: bool = False) -> int:
+        return self.post(
+            Operation.GO_ZERO, lambda: self.motions.go_zero(axis, switch_to_auto), JobKind.MOTION
+        )
 
     def request_run_program(
-        self, program_id: int, mode: ProgramMotionMode, cycles: int, speed_ratio: int
+        self,
+        program_id: int,
+        mode: ProgramMotionMode,
+        cycles: int,
+        speed_ratio: int,
+        switch_to_auto: bool = False,
     ) -> int:
         return self.post(
             Operation.RUN_PROGRAM,
-            lambda: self.motions.run_program(program_id, mode, cycles, speed_ratio),
+            lambda: self.motions.run_program(program_id, mode, cycles, speed_ratio, switch_to_auto),
             JobKind.MOTION,
         )
 

@@ -40,6 +40,7 @@ from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
 if TYPE_CHECKING:  # the worker (pymodbus, the envelope's numpy) is imported by the first request
     from app.link.worker import RobotWorker
     from app.safety.audit import AuditLog
+    from app.safety.caps import MotionCaps
     from app.safety.jog_guard import JogGuard
 
 __all__ = ["LinkPort", "Pending", "RequestRouter", "RobotLink", "wait_for_detached_threads"]
@@ -77,6 +78,7 @@ class RobotLink(QObject):
     _captureRequested = Signal(bool)  # noqa: N815
     _guardRequested = Signal(object)  # noqa: N815
     _auditRequested = Signal(object)  # noqa: N815
+    _capsRequested = Signal(object)  # noqa: N815
 
     def __init__(
         self,
@@ -109,6 +111,7 @@ class RobotLink(QObject):
         self._canary_gv = canary_gv
         self._use_stop_line = stop_line
         self._guard: JogGuard | None = None
+        self._caps: MotionCaps | None = None
         self._audit: AuditLog | None = None
         self._made: RobotWorker | None = None
         self._shutdownRequested.connect(self._on_shut_down)  # the GUI-side state: disconnected
@@ -162,6 +165,7 @@ class RobotLink(QObject):
             (self._captureRequested, w.set_traffic_capture),
             (self._guardRequested, w.set_jog_guard),
             (self._auditRequested, w.set_audit),
+            (self._capsRequested, w.set_motion_caps),
         ):
             source.connect(target)
         self._shutdownRequested.connect(w.shutdown, Qt.ConnectionType.QueuedConnection)
@@ -170,6 +174,8 @@ class RobotLink(QObject):
             self._auditRequested.emit(self._audit)
         if self._guard is not None:
             self._guardRequested.emit(self._guard)
+        if self._caps is not None:
+            self._capsRequested.emit(self._caps)
         if self._capture_users > 0:
             self._captureRequested.emit(True)
         return w
@@ -289,6 +295,14 @@ class RobotLink(QObject):
             if self._made is not None:
                 self._guardRequested.emit(guard)
 
+    def set_motion_caps(self, caps: MotionCaps | None) -> None:
+        """Reduced-speed mode's caps, applied by the worker's client to every speed it writes
+        (None: not reduced). Queued: a request made after this call is capped."""
+        if not self._shut:
+            self._caps = caps
+            if self._made is not None:
+                self._capsRequested.emit(caps)
+
     def set_audit(self, audit: AuditLog | None) -> None:
         """The audit trail every write of this link goes to (call before :meth:`connect_to`)."""
         if not self._shut:
@@ -355,8 +369,10 @@ class RobotLink(QObject):
     def set_mode(self, mode: WorkMode) -> int:
         return 0 if self._shut else self._worker.request_set_mode(mode)
 
-    def go_zero(self, axis: int | None) -> int:
-        return 0 if self._shut else self._motion(Operation.GO_ZERO, self._worker.request_go_zero(axis))
+    def go_zero(self, axis: int | None, *, switch_to_auto: bool = False) -> int:
+        if self._shut:
+            return 0
+        return self._motion(Operation.GO_ZERO, self._worker.request_go_zero(axis, switch_to_auto))
 
     def run_program(
         self,
@@ -364,10 +380,12 @@ class RobotLink(QObject):
         mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
         cycles: int = 1,
         speed_ratio: int = 100,
+        *,
+        switch_to_auto: bool = False,
     ) -> int:
         if self._shut:
             return 0
-        request_id = self._worker.request_run_program(program_id, mode, cycles, speed_ratio)
+        request_id = self._worker.request_run_program(program_id, mode, cycles, speed_ratio, switch_to_auto)
         return self._motion(Operation.RUN_PROGRAM, request_id)
 
     def create_point(

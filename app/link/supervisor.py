@@ -101,6 +101,7 @@ class LinkSupervisor:
         self.settings = settings
         self.client = RobotClient(settings)
         self.client.audit = getattr(host, "audit", None)  # the audit trail records every write
+        self.client.caps = host.caps  # reduced-speed mode's caps
         host.capture.attach(self.client)
         self._ever_connected = False
         self._backoff_index = 0

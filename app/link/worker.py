@@ -81,6 +81,7 @@ from app.link.types import ConnectionState, LinkState, Operation, UnconfirmedHal
 from app.link.upload import Uploader
 from app.models import CommandResult, ControllerStatus, Pose
 from app.safety.audit import AuditLog
+from app.safety.caps import MotionCaps
 from app.safety.envelope import EnvelopeViolation
 from app.safety.jog_guard import JogGuard
 
@@ -126,6 +127,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         # Everything below is touched only in the worker thread.
         self.closed = False
         self.audit: AuditLog | None = None  # set before connecting (set_audit); thread-safe
+        self.caps: MotionCaps | None = None  # reduced-speed mode's caps (set_motion_caps)
         self.request_id: int | None = None  # request id of the job being executed
         self._current_seq = 0  # sequence number of the job being executed
         self._current_job: Job | None = None
@@ -212,6 +214,14 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     def set_jog_guard(self, guard: JogGuard | None) -> None:
         """The safety envelope's jog guard (immutable, so safe to pass between threads); None: off."""
         self.jog.guard = guard
+
+    @Slot(object)
+    def set_motion_caps(self, caps: MotionCaps | None) -> None:
+        """Reduced-speed mode's caps (immutable) for this connection's client and the next ones."""
+        self.caps = caps
+        client = self.supervisor.client
+        if client is not None:
+            client.caps = caps
 
     @Slot(object)
     def set_audit(self, audit: AuditLog | None) -> None:

@@ -72,6 +72,7 @@ class IssueCode(enum.Enum):
     UNREACHABLE = "unreachable"  # the robot model's IK finds no solution (app.view3d.reach)
     JOINT_LIMIT = "joint-limit"  # reachable only past a joint limit of the robot model
     MODEL_DISAGREES = "model-disagrees"  # the model's FK is not the controller's pose (view3d.agreement)
+    SPEED_CAPPED = "speed-capped"  # a warning: reduced-speed mode sends the segment at its cap
 
 
 @dataclass(frozen=True)
@@ -156,8 +157,10 @@ def check_plan(
     Without it, an arc starting there is reported as unchecked (warning). With ``loops``
     other than 1, the first segment is also checked from the end of the last one.
     Issues come sorted by segment; "needs upload" is reported once per point. With an
-    ``envelope``, a segment that leaves it (sampled, arcs too) or runs faster than it allows
-    is an error (:data:`IssueCode.OUTSIDE_ENVELOPE`), which blocks Run.
+    ``envelope``, a segment that leaves it (sampled, arcs too) or runs faster than its maximum
+    speed is an error (:data:`IssueCode.OUTSIDE_ENVELOPE`), which blocks Run; with
+    ``reduced_speed`` a segment faster than the reduced-speed cap is a warning
+    (:data:`IssueCode.SPEED_CAPPED`): it runs at the cap (the client caps every speed it writes).
     ``reach`` (e.g. :meth:`app.view3d.reach.ReachChecker.plan_issues`) adds the robot model's
     reachability issues (:data:`IssueCode.UNREACHABLE`, :data:`IssueCode.JOINT_LIMIT`).
     """
@@ -207,9 +210,9 @@ def check_plan(
                 )
             )
     if envelope is not None:
-        for v in plan_violations(
-            plan, ledger, envelope, current_pose, start_index=start_index, loops=loops, reduced=reduced_speed
-        ):
+        if reduced_speed:
+            issues.extend(_capped_speeds(plan, envelope))
+        for v in plan_violations(plan, ledger, envelope, current_pose, start_index=start_index, loops=loops):
             issues.append(
                 PlanIssue(
                     v.segment,
@@ -224,6 +227,22 @@ def check_plan(
     order = {IssueKind.ERROR: 0, IssueKind.NEEDS_UPLOAD: 1, IssueKind.WARNING: 2}
     issues.sort(key=lambda it: (-1 if it.segment is None else it.segment, order[it.kind]))
     return issues
+
+
+def _capped_speeds(plan: Plan, envelope: Envelope) -> list[PlanIssue]:
+    """Reduced-speed mode: the segments that will run at the cap, not at their own speed."""
+    cap = envelope.speed_cap(reduced=True)
+    return [
+        PlanIssue(
+            i,
+            IssueKind.WARNING,
+            IssueCode.SPEED_CAPPED,
+            f"{_seg_name(i)}: runs at {cap:g} mm/s, the reduced-speed cap (planned {seg.speed:g} mm/s)",
+            args={"speed": seg.speed, "cap": cap},
+        )
+        for i, seg in enumerate(plan.segments)
+        if cap < seg.speed <= envelope.max_speed
+    ]
 
 
 def _point_issues(plan: Plan, ledger: PointLedger, limits: PlanLimits) -> list[PlanIssue]:

@@ -12,6 +12,10 @@ GUI can translate it, and a plain English ``message``) or None.
   (slab test), so a thin keep-out box between two samples is not missed;
 * :func:`plan_violations` — every segment of a plan, for :func:`app.plan.checks.check_plan`.
 
+Speeds: a step, move or segment faster than ``max_speed`` is a violation in every mode. Reduced-
+speed mode does not refuse a faster one: it caps it (:meth:`Envelope.motion_caps`, applied by the
+client to every speed it writes), so the speed checks here do not depend on the mode.
+
 The jog guard lives in :mod:`app.safety.jog_guard`; the boxes (:class:`Box`, their slab test)
 in :mod:`app.safety.box`.
 """
@@ -30,6 +34,7 @@ from app.plan.geometry import PointLike, segment_length, segment_path, xyz_of
 from app.plan.segments import FloatArray, Plan, Segment
 from app.points.ledger import PointLedger
 from app.safety.box import Box
+from app.safety.caps import MotionCaps
 
 if TYPE_CHECKING:
     import numpy as np
@@ -206,6 +211,11 @@ class Envelope:
         """The ratio to send: ``ratio`` capped (reduced mode caps silently, as a mode should)."""
         return min(ratio, self.jog_ratio_cap(reduced))
 
+    def motion_caps(self, reach: float) -> MotionCaps:
+        """Reduced-speed mode's caps for the client: the ratio cap (jog, programs), the TCP speed
+        cap (steps, moves), and ``reach`` (mm, the robot model's reach bound: joint steps)."""
+        return MotionCaps(self.jog_ratio_cap(True), self.speed_cap(True), reach)
+
     def clearance(self, p: FloatArray) -> float:
         """Signed distance (mm) to the Cartesian boundary: > 0 inside the allowed space."""
         best = math.inf
@@ -250,10 +260,10 @@ def check_joints(envelope: Envelope, joints: Sequence[float]) -> EnvelopeViolati
     return None
 
 
-def check_speed(envelope: Envelope, speed: float, reduced: bool = False) -> EnvelopeViolation | None:
-    cap = envelope.speed_cap(reduced)
-    if speed > cap:
-        return EnvelopeViolation(ViolationCode.SPEED, float(speed), cap, reduced=reduced)
+def check_speed(envelope: Envelope, speed: float) -> EnvelopeViolation | None:
+    """Above ``max_speed``: refused in every mode (reduced-speed mode caps, it does not refuse)."""
+    if speed > envelope.max_speed:
+        return EnvelopeViolation(ViolationCode.SPEED, float(speed), envelope.max_speed)
     return None
 
 
@@ -270,13 +280,12 @@ def check_target(
     joints: Sequence[float] | None = None,
     *,
     speed: float | None = None,
-    reduced: bool = False,
 ) -> EnvelopeViolation | None:
     """A step or move target (and its joints, its speed, when known): the first violation."""
     return (
         check_point(envelope, xyz_of(pose))
         or (check_joints(envelope, joints) if joints is not None else None)
-        or (check_speed(envelope, speed, reduced) if speed is not None else None)
+        or (check_speed(envelope, speed) if speed is not None else None)
     )
 
 
@@ -286,11 +295,10 @@ def require_target(
     joints: Sequence[float] | None = None,
     *,
     speed: float | None = None,
-    reduced: bool = False,
     action: str = "",
 ) -> None:
     """:func:`check_target`, raising :class:`EnvelopeRefused` for a violation."""
-    violation = check_target(envelope, pose, joints, speed=speed, reduced=reduced)
+    violation = check_target(envelope, pose, joints, speed=speed)
     if violation is not None:
         raise EnvelopeRefused(violation, action)
 
@@ -302,7 +310,6 @@ def check_step(
     *,
     joint: bool,
     speed: float | None = None,
-    reduced: bool = False,
 ) -> EnvelopeViolation | None:
     """An incremental move (function 1) from ``pose``: base frame (``joint`` False) X Y Z
     offsets in mm, a straight line checked whole, and its speed (mm/s); joint frame J1..J6
@@ -313,7 +320,7 @@ def check_step(
             return None
         target = [q + d for q, d in zip(pose.joints, offsets, strict=False)]
         return check_joints(envelope, target)
-    if speed is not None and (too_fast := check_speed(envelope, speed, reduced)) is not None:
+    if speed is not None and (too_fast := check_speed(envelope, speed)) is not None:
         return too_fast
     start = np.array((pose.x, pose.y, pose.z), dtype=np.float64)
     end = start + np.asarray(list(offsets)[:3], dtype=np.float64)
@@ -355,13 +362,13 @@ def _samples_for(start: PointLike, segment: Segment, ledger: PointLedger) -> int
 
 
 def check_segment(
-    envelope: Envelope, start: PointLike, segment: Segment, ledger: PointLedger, *, reduced: bool = False
+    envelope: Envelope, start: PointLike, segment: Segment, ledger: PointLedger
 ) -> EnvelopeViolation | None:
     """One plan segment from ``start``: its speed, then its path (arcs sampled finely).
 
     Raises :class:`InvalidInput` for a missing point or an arc that defines no circle (the
     plan checks report those themselves)."""
-    speed = check_speed(envelope, segment.speed, reduced)
+    speed = check_speed(envelope, segment.speed)
     if speed is not None:
         return speed
     path = segment_path(start, segment, ledger, samples=_samples_for(start, segment, ledger))
@@ -376,7 +383,6 @@ def plan_violations(
     *,
     start_index: int = 0,
     loops: int | None = None,
-    reduced: bool = False,
 ) -> list[EnvelopeViolation]:
     """The first violation of each segment that leaves the envelope (``segment`` set).
 
@@ -404,7 +410,7 @@ def plan_violations(
         found: EnvelopeViolation | None = None
         for start in starts:
             try:
-                found = check_segment(envelope, start, seg, ledger, reduced=reduced)
+                found = check_segment(envelope, start, seg, ledger)
             except InvalidInput:
                 found = None
             if found is not None:
@@ -413,7 +419,7 @@ def plan_violations(
             end = ledger.get(seg.end_id)
             via = ledger.get(seg.via_id) if seg.via_id is not None else None
             found = (
-                check_speed(envelope, seg.speed, reduced)
+                check_speed(envelope, seg.speed)
                 or (check_point(envelope, xyz_of(end)) if end is not None else None)
                 or (check_point(envelope, xyz_of(via)) if via is not None else None)
             )

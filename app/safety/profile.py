@@ -14,6 +14,12 @@
 saves, so an audit record or a support bundle can say which envelope was in force. The
 envelope alone (:func:`envelope_to_dict` / :func:`envelope_from_dict`) can be embedded in a
 larger robot profile.
+
+A fresh install has no file yet: :func:`fresh_profile` derives its envelope from the robot model
+(:func:`default_envelope`): the model's joint limits, and a keep-in box from its reach -- X and Y
+within the reach around the base, Z from the plane the robot stands on (the base's own height)
+up to the reach above it: the TCP never goes below the surface the arm is mounted on. Both on,
+so a new user starts with the limits checked; an engineer tightens them to the cell.
 """
 
 from __future__ import annotations
@@ -24,11 +30,14 @@ import math
 import os
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from app.errors import InvalidInput, TeachPadError
 from app.points.atomic import atomic_write_bytes, read_settings_text, versioned_document
 from app.safety.envelope import Box, Envelope
+
+if TYPE_CHECKING:  # the robot model is read only for a fresh install
+    from app.view3d.profile import RobotProfile
 
 FORMAT = "teachpad-safety"
 VERSION = 1
@@ -46,6 +55,30 @@ class SafetyProfile:
     envelope: Envelope = field(default_factory=Envelope)
     revision: int = 0
     saved: str = ""  # ISO time of the last save
+
+
+#: The keep-in box of a fresh install, rounded out to this many mm.
+FRESH_BOX_ROUNDING = 10.0
+#: The name of a fresh install's keep-in box.
+FRESH_BOX_NAME = "robot reach"
+
+
+def default_envelope(robot: RobotProfile) -> Envelope:
+    """A fresh install's envelope from the robot model ``robot`` (see the module docstring); the
+    speed caps are the :class:`Envelope` defaults. A base mounted tilted (A or B not 0) gets the
+    reach all round in Z too: there is no floor below it to keep to."""
+    limits = tuple((j.min_deg, j.max_deg) for j in robot.joints[:6])
+    reach = math.ceil(robot.reach / FRESH_BOX_ROUNDING) * FRESH_BOX_ROUNDING
+    x, y, z, a, b, _c = robot.base
+    upright = abs(a) < 1e-9 and abs(b) < 1e-9
+    lo = (x - reach, y - reach, z if upright else z - reach)
+    hi = (x + reach, y + reach, z + reach)
+    return Envelope(joint_limits=limits, keep_in=Box(FRESH_BOX_NAME, lo, hi))
+
+
+def fresh_profile(robot: RobotProfile) -> SafetyProfile:
+    """The safety profile of a fresh install (no file yet): :func:`default_envelope`, revision 0."""
+    return SafetyProfile(robot.name, default_envelope(robot))
 
 
 def _box_to_dict(box: Box) -> dict[str, Any]:

@@ -199,14 +199,12 @@ class SafetySession:
     ) -> None:
         """Before a step (function 1): refused (audited) when it would leave the envelope."""
         self.require(Action.STEP)
-        violation = check_step(
-            self.envelope, pose, offsets, joint=joint, speed=None if joint else speed, reduced=self.reduced
-        )
+        violation = check_step(self.envelope, pose, offsets, joint=joint, speed=None if joint else speed)
         self._refuse("step", violation, {"offsets": list(offsets), "joint": joint})
 
     def check_move(self, start: PointLike, segment: Segment, ledger: PointLedger) -> None:
         """Before a move to a point (function 3) from ``start``."""
-        violation = check_segment(self.envelope, start, segment, ledger, reduced=self.reduced)
+        violation = check_segment(self.envelope, start, segment, ledger)
         self._refuse(
             "move to point", violation, {"end": segment.end_id, "via": segment.via_id, "speed": segment.speed}
         )

@@ -877,140 +877,160 @@
     <context>
         <name>JogPanel</name>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="257" />
+            <location filename="../../ui/panels/jog_panel.py" line="264" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="258" />
+            <location filename="../../ui/panels/jog_panel.py" line="265" />
             <source>User frame</source>
             <translation>用户坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="259" />
+            <location filename="../../ui/panels/jog_panel.py" line="266" />
             <source>Tool frame</source>
             <translation>工具坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="260" />
+            <location filename="../../ui/panels/jog_panel.py" line="267" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="264" />
+            <location filename="../../ui/panels/jog_panel.py" line="271" />
             <source>User no.:</source>
             <translation>用户坐标号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="265" />
+            <location filename="../../ui/panels/jog_panel.py" line="272" />
             <source>Tool no.:</source>
             <translation>工具号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="255" />
+            <location filename="../../ui/panels/jog_panel.py" line="262" />
             <source>Frame:</source>
             <translation>坐标系：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="266" />
+            <location filename="../../ui/panels/jog_panel.py" line="273" />
             <source>External axes</source>
             <translation>外部轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="335" />
+            <location filename="../../ui/panels/jog_panel.py" line="355" />
             <source>HOLD TO MOVE — release to stop</source>
             <translation>按住运动 — 松开即停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="268" />
+            <location filename="../../ui/panels/jog_panel.py" line="275" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="273" />
+            <location filename="../../ui/panels/jog_panel.py" line="280" />
             <source>Keyboard: click this panel, then hold {plus} (+) or {minus} (−) for axes 1–6; releasing the key stops.</source>
             <translation>键盘：先单击本面板，再按住 {plus}（+）或 {minus}（−）点动第 1–6 轴；松开按键即停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="276" />
+            <location filename="../../ui/panels/jog_panel.py" line="283" />
             <source>Keys: hold {plus} (+) or {minus} (−)</source>
             <translation>按键：按住 {plus} (+) 或 {minus} (−)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="340" />
+            <location filename="../../ui/panels/jog_panel.py" line="360" />
             <source>Releasing — the controller has not confirmed</source>
             <translation>正在松开 — 控制器尚未确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="342" />
+            <location filename="../../ui/panels/jog_panel.py" line="362" />
             <source>Stopping — the controller has not confirmed</source>
             <translation>正在停止 — 控制器尚未确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="344" />
+            <location filename="../../ui/panels/jog_panel.py" line="364" />
             <source>The controller refused or did not answer the write that stops the arm. TeachPad sends it again at every poll until the controller answers and the arm is seen still.</source>
             <translation>控制器拒绝或未应答使机械臂停止的写入。TeachPad 每次轮询都会重新发送，直到控制器应答且确认机械臂已静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="348" />
+            <location filename="../../ui/panels/jog_panel.py" line="368" />
             <source>Stop was sent too.</source>
             <translation>也已发送停止命令。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="448" />
+            <location filename="../../ui/panels/jog_panel.py" line="468" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="448" />
+            <location filename="../../ui/panels/jog_panel.py" line="468" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="450" />
+            <location filename="../../ui/panels/jog_panel.py" line="470" />
             <source>Hold: {axis} − ({unit})</source>
             <translation>按住：{axis} −（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="453" />
+            <location filename="../../ui/panels/jog_panel.py" line="473" />
             <source>Hold: {axis} + ({unit})</source>
             <translation>按住：{axis} +（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="464" />
+            <location filename="../../ui/panels/jog_panel.py" line="486" />
             <source>{ratio} %</source>
             <translation>{ratio} %</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/jog_panel.py" line="491" />
+            <source>{ratio} % → {cap} % (reduced speed)</source>
+            <translation>{ratio} % → {cap} %（降速模式）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/jog_panel.py" line="493" />
+            <source>{ratio} % → {cap} %</source>
+            <translation>{ratio} % → {cap} %</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/jog_panel.py" line="498" />
+            <source>Capped at {cap} % (reduced speed): the jog goes out at {cap} %, not {ratio} %</source>
+            <translation>限制为 {cap} %（降速模式）：点动以 {cap} % 而不是 {ratio} % 发出</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/jog_panel.py" line="501" />
+            <source>Capped at {cap} % (the safety envelope's maximum): the jog goes out at {cap} %, not {ratio} %</source>
+            <translation>限制为 {cap} %（安全范围的最大值）：点动以 {cap} % 而不是 {ratio} % 发出</translation>
         </message>
     </context>
     <context>
         <name>KeypadDialog</name>
         <message>
-            <location filename="../../ui/keypad.py" line="92" />
+            <location filename="../../ui/keypad.py" line="102" />
             <source>Enter a value</source>
             <translation>输入数值</translation>
         </message>
         <message>
-            <location filename="../../ui/keypad.py" line="93" />
+            <location filename="../../ui/keypad.py" line="103" />
             <source>OK</source>
             <translation>确定</translation>
         </message>
         <message>
-            <location filename="../../ui/keypad.py" line="94" />
+            <location filename="../../ui/keypad.py" line="104" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/keypad.py" line="95" />
+            <location filename="../../ui/keypad.py" line="105" />
             <source>Delete the last digit</source>
             <translation>删除最后一位</translation>
         </message>
         <message>
-            <location filename="../../ui/keypad.py" line="96" />
+            <location filename="../../ui/keypad.py" line="106" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/keypad.py" line="98" />
+            <location filename="../../ui/keypad.py" line="108" />
             <source>From {low} to {high}</source>
             <translation>范围：{low} 至 {high}</translation>
         </message>
@@ -1438,92 +1458,102 @@
         </message>
         <message>
             <location filename="../../ui/messages.py" line="179" />
+            <source>{operation}: not sent, the controller is in {mode} mode. Switching it to auto is the operator's decision: say yes when the confirmation asks, or switch it to auto first.</source>
+            <translation>{operation}：未发送，控制器处于{mode}模式。切换到自动模式须由操作员决定：在确认框询问时选择“是”，或先将其切换到自动模式。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="184" />
+            <source>{operation}: not sent in reduced-speed mode: it runs at the controller's own speed, which TeachPad cannot cap.</source>
+            <translation>{operation}：降速模式下未发送：它以控制器自身的速度运行，TeachPad 无法限制该速度。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="189" />
             <location filename="../../ui/messages_plan.py" line="29" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="180" />
+            <location filename="../../ui/messages.py" line="190" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="182" />
+            <location filename="../../ui/messages.py" line="192" />
             <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
             <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="186" />
+            <location filename="../../ui/messages.py" line="196" />
             <source>The controller did not create {point} again before the move: the arm was not moved.</source>
             <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="189" />
+            <location filename="../../ui/messages.py" line="199" />
             <source>The project has no point {point}: the arm was not moved.</source>
             <translation>项目中没有点 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="192" />
+            <location filename="../../ui/messages.py" line="202" />
             <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
             <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="196" />
+            <location filename="../../ui/messages.py" line="206" />
             <source>The link was shut down.</source>
             <translation>通信链路已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="206" />
+            <location filename="../../ui/messages.py" line="216" />
             <source>{operation}: not sent, the connection to the controller is down.</source>
             <translation>{operation}：未发送，与控制器的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="209" />
+            <location filename="../../ui/messages.py" line="219" />
             <source>{operation}: not sent, the connection was closed.</source>
             <translation>{operation}：未发送，连接已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="211" />
+            <location filename="../../ui/messages.py" line="221" />
             <source>points outside {id_min}..{id_max}: {ids}</source>
             <translation>超出 {id_min}..{id_max} 范围的点：{ids}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="212" />
+            <location filename="../../ui/messages.py" line="222" />
             <source>there is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="213" />
+            <location filename="../../ui/messages.py" line="223" />
             <source>no free point id left in {start}..{id_max}</source>
             <translation>{start}..{id_max} 范围内已没有空闲的点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="214" />
+            <location filename="../../ui/messages.py" line="224" />
             <source>there is no row {row}</source>
             <translation>不存在第 {row} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="215" />
+            <location filename="../../ui/messages.py" line="225" />
             <source>cannot move row {src} to {dst} in {rows} rows</source>
             <translation>无法在 {rows} 行中将第 {src} 行移到第 {dst} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="216" />
+            <location filename="../../ui/messages.py" line="226" />
             <source>row {row}: id {id} is already used on row {other}</source>
             <translation>第 {row} 行：编号 {id} 已被第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="217" />
+            <location filename="../../ui/messages.py" line="227" />
             <source>imported point {number}: id {id} appears twice</source>
             <translation>导入的第 {number} 个点：编号 {id} 出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="218" />
+            <location filename="../../ui/messages.py" line="228" />
             <source>id {id} is already used by {point}</source>
             <translation>编号 {id} 已被 {point} 使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="219" />
+            <location filename="../../ui/messages.py" line="229" />
             <source>the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)</source>
             <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
         </message>
@@ -1623,357 +1653,362 @@
             <translation>编号 {id} 已在第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="197" />
+            <location filename="../../ui/messages.py" line="207" />
             <source>{operation}: the connection was lost while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接中断，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="201" />
+            <location filename="../../ui/messages.py" line="211" />
             <source>{operation}: the connection was closed while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接被关闭，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="229" />
+            <location filename="../../ui/messages.py" line="239" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="230" />
+            <location filename="../../ui/messages.py" line="240" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="231" />
+            <location filename="../../ui/messages.py" line="241" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="232" />
+            <location filename="../../ui/messages.py" line="242" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="233" />
+            <location filename="../../ui/messages.py" line="243" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="234" />
+            <location filename="../../ui/messages.py" line="244" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="235" />
+            <location filename="../../ui/messages.py" line="245" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="236" />
+            <location filename="../../ui/messages.py" line="246" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="237" />
+            <location filename="../../ui/messages.py" line="247" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="238" />
+            <location filename="../../ui/messages.py" line="248" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="239" />
+            <location filename="../../ui/messages.py" line="249" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="240" />
+            <location filename="../../ui/messages.py" line="250" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="241" />
+            <location filename="../../ui/messages.py" line="251" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="242" />
+            <location filename="../../ui/messages.py" line="252" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="247" />
+            <location filename="../../ui/messages.py" line="255" />
+            <source>{operation}: not sent, the controller is not in auto mode.</source>
+            <translation>{operation}：未发送，控制器不处于自动模式。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="260" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="248" />
+            <location filename="../../ui/messages.py" line="261" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="249" />
+            <location filename="../../ui/messages.py" line="262" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="250" />
+            <location filename="../../ui/messages.py" line="263" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="251" />
+            <location filename="../../ui/messages.py" line="264" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="254" />
+            <location filename="../../ui/messages.py" line="267" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="255" />
+            <location filename="../../ui/messages.py" line="268" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="256" />
+            <location filename="../../ui/messages.py" line="269" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="257" />
+            <location filename="../../ui/messages.py" line="270" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="258" />
+            <location filename="../../ui/messages.py" line="271" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="259" />
+            <location filename="../../ui/messages.py" line="272" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="260" />
+            <location filename="../../ui/messages.py" line="273" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="261" />
+            <location filename="../../ui/messages.py" line="274" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="262" />
+            <location filename="../../ui/messages.py" line="275" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="263" />
+            <location filename="../../ui/messages.py" line="276" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="264" />
+            <location filename="../../ui/messages.py" line="277" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="265" />
+            <location filename="../../ui/messages.py" line="278" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="266" />
+            <location filename="../../ui/messages.py" line="279" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="267" />
+            <location filename="../../ui/messages.py" line="280" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="268" />
+            <location filename="../../ui/messages.py" line="281" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="269" />
+            <location filename="../../ui/messages.py" line="282" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="270" />
+            <location filename="../../ui/messages.py" line="283" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="271" />
+            <location filename="../../ui/messages.py" line="284" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="272" />
+            <location filename="../../ui/messages.py" line="285" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="273" />
+            <location filename="../../ui/messages.py" line="286" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="275" />
+            <location filename="../../ui/messages.py" line="288" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="278" />
+            <location filename="../../ui/messages.py" line="291" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="279" />
+            <location filename="../../ui/messages.py" line="292" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="280" />
+            <location filename="../../ui/messages.py" line="293" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="281" />
+            <location filename="../../ui/messages.py" line="294" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="282" />
+            <location filename="../../ui/messages.py" line="295" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="283" />
+            <location filename="../../ui/messages.py" line="296" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="284" />
+            <location filename="../../ui/messages.py" line="297" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="285" />
+            <location filename="../../ui/messages.py" line="298" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="286" />
+            <location filename="../../ui/messages.py" line="299" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="287" />
+            <location filename="../../ui/messages.py" line="300" />
             <source>unit id</source>
             <translation>站号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="288" />
+            <location filename="../../ui/messages.py" line="301" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="292" />
+            <location filename="../../ui/messages.py" line="305" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="293" />
+            <location filename="../../ui/messages.py" line="306" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="294" />
+            <location filename="../../ui/messages.py" line="307" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="295" />
+            <location filename="../../ui/messages.py" line="308" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="296" />
+            <location filename="../../ui/messages.py" line="309" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="297" />
+            <location filename="../../ui/messages.py" line="310" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="298" />
+            <location filename="../../ui/messages.py" line="311" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="299" />
+            <location filename="../../ui/messages.py" line="312" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="300" />
+            <location filename="../../ui/messages.py" line="313" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="301" />
+            <location filename="../../ui/messages.py" line="314" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="303" />
+            <location filename="../../ui/messages.py" line="316" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="469" />
+            <location filename="../../ui/messages.py" line="482" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="472" />
+            <location filename="../../ui/messages.py" line="485" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="518" />
+            <location filename="../../ui/messages.py" line="531" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="521" />
+            <location filename="../../ui/messages.py" line="534" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="525" />
+            <location filename="../../ui/messages.py" line="538" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="528" />
+            <location filename="../../ui/messages.py" line="541" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="531" />
+            <location filename="../../ui/messages.py" line="544" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
@@ -2023,12 +2058,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="478" />
+            <location filename="../../ui/messages.py" line="491" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="482" />
+            <location filename="../../ui/messages.py" line="495" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -2148,12 +2183,17 @@
             <translation>机器人模型“{model}”与控制器的位姿相差 {distance} mm 和 {angle}°：可达性检查可能有误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="145" />
+            <location filename="../../ui/messages_plan.py" line="144" />
+            <source>runs at {cap} mm/s, the reduced-speed cap (planned {speed} mm/s).</source>
+            <translation>以降速模式上限 {cap} mm/s 运行（计划 {speed} mm/s）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_plan.py" line="148" />
             <source> (from the current pose)</source>
             <translation>（从当前位姿出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="146" />
+            <location filename="../../ui/messages_plan.py" line="149" />
             <source> (on loops after the first, starting at the end of segment {after})</source>
             <translation>（第一轮之后的循环中，从第 {after} 段的终点出发）</translation>
         </message>
@@ -3430,14 +3470,14 @@
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/messages_plan.py" line="159" />
+            <location filename="../../ui/messages_plan.py" line="162" />
             <location filename="../../ui/models/point_columns.py" line="66" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="160" />
+            <location filename="../../ui/messages_plan.py" line="163" />
             <location filename="../../ui/models/point_columns.py" line="67" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
@@ -3591,194 +3631,199 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="179" />
+            <location filename="../../ui/panels/points_panel.py" line="183" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="181" />
+            <location filename="../../ui/panels/points_panel.py" line="185" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="184" />
+            <location filename="../../ui/panels/points_panel.py" line="188" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="184" />
+            <location filename="../../ui/panels/points_panel.py" line="188" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="185" />
+            <location filename="../../ui/panels/points_panel.py" line="189" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="185" />
+            <location filename="../../ui/panels/points_panel.py" line="189" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="187" />
+            <location filename="../../ui/panels/points_panel.py" line="191" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="188" />
+            <location filename="../../ui/panels/points_panel.py" line="192" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="190" />
+            <location filename="../../ui/panels/points_panel.py" line="194" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="191" />
+            <location filename="../../ui/panels/points_panel.py" line="195" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="193" />
+            <location filename="../../ui/panels/points_panel.py" line="197" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="194" />
+            <location filename="../../ui/panels/points_panel.py" line="198" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="197" />
+            <location filename="../../ui/panels/points_panel.py" line="201" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="198" />
+            <location filename="../../ui/panels/points_panel.py" line="202" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="200" />
+            <location filename="../../ui/panels/points_panel.py" line="204" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="200" />
+            <location filename="../../ui/panels/points_panel.py" line="204" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="202" />
-            <location filename="../../ui/panels/points_parts.py" line="166" />
+            <location filename="../../ui/panels/points_panel.py" line="206" />
+            <location filename="../../ui/panels/points_parts.py" line="171" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="203" />
+            <location filename="../../ui/panels/points_panel.py" line="207" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="205" />
+            <location filename="../../ui/panels/points_panel.py" line="209" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="207" />
-            <location filename="../../ui/panels/points_panel.py" line="393" />
+            <location filename="../../ui/panels/points_panel.py" line="211" />
+            <location filename="../../ui/panels/points_panel.py" line="397" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="208" />
+            <location filename="../../ui/panels/points_panel.py" line="212" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="210" />
+            <location filename="../../ui/panels/points_panel.py" line="214" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="210" />
+            <location filename="../../ui/panels/points_panel.py" line="214" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="211" />
+            <location filename="../../ui/panels/points_panel.py" line="215" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="129" />
+            <location filename="../../ui/panels/points_panel.py" line="418" />
+            <source>→ {cap} mm/s (reduced speed)</source>
+            <translation>→ {cap} mm/s（降速模式）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/points_parts.py" line="134" />
             <source>Speed of Move to point</source>
             <translation>运动到点的速度</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="130" />
+            <location filename="../../ui/panels/points_parts.py" line="135" />
             <source>Find:</source>
             <translation>查找：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="131" />
+            <location filename="../../ui/panels/points_parts.py" line="136" />
             <source>id or name</source>
             <translation>编号或名称</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="160" />
+            <location filename="../../ui/panels/points_parts.py" line="165" />
             <source>The controller restarted, or it is another controller: it may not hold these points. Re-create them before running a plan.</source>
             <translation>控制器已重启，或是另一台控制器：它可能没有保存这些点。运行轨迹前请重新创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="187" />
+            <location filename="../../ui/panels/points_parts.py" line="192" />
             <source>Cancel</source>
             <translation>取消</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="188" />
+            <location filename="../../ui/panels/points_parts.py" line="193" />
             <source>Uploading</source>
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="305" />
+            <location filename="../../ui/panels/points_panel.py" line="309" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="309" />
+            <location filename="../../ui/panels/points_panel.py" line="313" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="311" />
+            <location filename="../../ui/panels/points_panel.py" line="315" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="314" />
+            <location filename="../../ui/panels/points_panel.py" line="318" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="341" />
+            <location filename="../../ui/panels/points_panel.py" line="345" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="344" />
+            <location filename="../../ui/panels/points_panel.py" line="348" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="370" />
+            <location filename="../../ui/panels/points_panel.py" line="374" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="379" />
+            <location filename="../../ui/panels/points_panel.py" line="383" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -3791,7 +3836,7 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
 速度 {v} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_parts.py" line="194" />
+            <location filename="../../ui/panels/points_parts.py" line="199" />
             <source>%v of %m points</source>
             <translation>%v / %m 个点</translation>
         </message>
@@ -3874,78 +3919,113 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProgramPanel</name>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="107" />
+            <location filename="../../ui/panels/program_panel.py" line="136" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="108" />
+            <location filename="../../ui/panels/program_panel.py" line="137" />
             <source>Program no.:</source>
             <translation>程序号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="108" />
+            <location filename="../../ui/panels/program_panel.py" line="137" />
             <source>Run mode:</source>
             <translation>运行方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="108" />
+            <location filename="../../ui/panels/program_panel.py" line="137" />
             <source>Cycles:</source>
             <translation>循环次数：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="108" />
+            <location filename="../../ui/panels/program_panel.py" line="137" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="113" />
+            <location filename="../../ui/panels/program_panel.py" line="142" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="114" />
+            <location filename="../../ui/panels/program_panel.py" line="143" />
             <source>Number of cycles in cycle mode; 0 runs until stopped</source>
             <translation>循环模式下的循环次数；0 表示一直运行直到停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="115" />
+            <location filename="../../ui/panels/program_panel.py" line="144" />
             <source>Run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="116" />
-            <location filename="../../ui/panels/program_panel.py" line="118" />
+            <location filename="../../ui/panels/program_panel.py" line="145" />
+            <location filename="../../ui/panels/program_panel.py" line="147" />
             <source>Go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="117" />
+            <location filename="../../ui/panels/program_panel.py" line="146" />
             <source>All axes</source>
             <translation>所有轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="151" />
-            <source>Run program {id} ({mode}) at {speed} %? The arm will move.</source>
-            <translation>以 {speed} % 速度运行程序 {id}（{mode}）？机械臂将会运动。</translation>
+            <location filename="../../ui/panels/program_panel.py" line="201" />
+            <source>{speed} %</source>
+            <translation>{speed} %</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="154" />
+            <location filename="../../ui/panels/program_panel.py" line="202" />
+            <source>{speed} % (capped by reduced speed; {asked} % set)</source>
+            <translation>{speed} %（受降速模式限制；设定为 {asked} %）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/program_panel.py" line="212" />
+            <source>The controller is in Manual mode. Switch it to Auto and run program {id} ({mode}) at {speed}? The arm will move.</source>
+            <translation>控制器处于手动模式。切换到自动模式，并以 {speed} 运行程序 {id}（{mode}）？机械臂将会运动。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/program_panel.py" line="216" />
+            <source>Run program {id} ({mode}) at {speed}? The arm will move.</source>
+            <translation>以 {speed} 速度运行程序 {id}（{mode}）？机械臂将会运动。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/program_panel.py" line="244" />
+            <source>→ {cap} % (reduced speed)</source>
+            <translation>→ {cap} %（降速模式）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/program_panel.py" line="246" />
+            <source>Reduced-speed mode: the program runs at {cap} % at most</source>
+            <translation>降速模式：程序最多以 {cap} % 运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/program_panel.py" line="256" />
+            <source>Not in reduced-speed mode: go to zero runs at the controller's own speed, which TeachPad cannot cap</source>
+            <translation>降速模式下不可用：回零以控制器自身的速度运行，TeachPad 无法限制该速度</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/program_panel.py" line="218" />
             <source>Confirm program run</source>
             <translation>确认运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="160" />
+            <location filename="../../ui/panels/program_panel.py" line="226" />
             <source>all axes</source>
             <translation>所有轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="161" />
+            <location filename="../../ui/panels/program_panel.py" line="230" />
+            <source>The controller is in Manual mode. Switch it to Auto and move {which} to zero? The arm will move.</source>
+            <translation>控制器处于手动模式。切换到自动模式，并将 {which} 回零？机械臂将会运动。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/program_panel.py" line="234" />
             <source>Move {which} to zero? The arm will move.</source>
             <translation>将 {which} 回零？机械臂将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/program_panel.py" line="162" />
+            <location filename="../../ui/panels/program_panel.py" line="235" />
             <source>Confirm go to zero</source>
             <translation>确认回零</translation>
         </message>
@@ -4671,77 +4751,77 @@ Remove them all?</source>
     <context>
         <name>SafetyController</name>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="170" />
+            <location filename="../../ui/controllers/safety.py" line="202" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="171" />
+            <location filename="../../ui/controllers/safety.py" line="203" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="172" />
+            <location filename="../../ui/controllers/safety.py" line="204" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="179" />
+            <location filename="../../ui/controllers/safety.py" line="211" />
             <source>Needs the {need} role (you are {role}); log in from the Safety menu</source>
             <translation>需要{need}角色（当前为{role}）；请从“安全”菜单登录</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="387" />
+            <location filename="../../ui/controllers/safety.py" line="441" />
             <source>{axis} = {value:.1f} is within stopping distance of the keep-out zone '{box}' (at {limit:.1f})</source>
             <translation>{axis} = {value:.1f}，已进入禁区“{box}”的停止距离内（边界 {limit:.1f}）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="391" />
+            <location filename="../../ui/controllers/safety.py" line="445" />
             <source>{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}</source>
             <translation>{axis} = {value:.1f}，已进入限位 {limit:.1f} 的停止距离内</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="393" />
+            <location filename="../../ui/controllers/safety.py" line="447" />
             <source>{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)</source>
             <translation>{axis} = {value:.1f} mm 超出允许的工作空间（限值 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="396" />
+            <location filename="../../ui/controllers/safety.py" line="450" />
             <source>The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, its face at {limit:.1f} mm)</source>
             <translation>路径进入禁区“{box}”（{axis} = {value:.1f} mm，边界在 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="400" />
+            <location filename="../../ui/controllers/safety.py" line="454" />
             <source>{axis} = {value:.1f}° is beyond its limit {limit:.1f}°</source>
             <translation>{axis} = {value:.1f}° 超出限位 {limit:.1f}°</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="403" />
+            <location filename="../../ui/controllers/safety.py" line="457" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode</source>
             <translation>速度 {value:g} mm/s 超过降速模式允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="405" />
+            <location filename="../../ui/controllers/safety.py" line="459" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed</source>
             <translation>速度 {value:g} mm/s 超过允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="409" />
+            <location filename="../../ui/controllers/safety.py" line="463" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode</source>
             <translation>点动速度 {value:g} % 超过降速模式允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="411" />
+            <location filename="../../ui/controllers/safety.py" line="465" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed</source>
             <translation>点动速度 {value:g} % 超过允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="416" />
+            <location filename="../../ui/controllers/safety.py" line="470" />
             <source>Segment {k}: {text}</source>
             <translation>第 {k} 段：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="421" />
+            <location filename="../../ui/controllers/safety.py" line="475" />
             <source>Jog stopped before the limit: {why}</source>
             <translation>点动已在到达边界前停止：{why}</translation>
         </message>
@@ -5184,97 +5264,129 @@ Remove them all?</source>
     <context>
         <name>StepPanel</name>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="157" />
+            <location filename="../../ui/panels/step_panel.py" line="199" />
             <source>Frame:</source>
             <translation>坐标系：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="158" />
+            <location filename="../../ui/panels/step_panel.py" line="200" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="159" />
+            <location filename="../../ui/panels/step_panel.py" line="201" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="160" />
+            <location filename="../../ui/panels/step_panel.py" line="202" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="161" />
+            <location filename="../../ui/panels/step_panel.py" line="203" />
             <source>Expected speed of the incremental move (GV225)</source>
             <translation>增量运动的期望速度（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="162" />
+            <location filename="../../ui/panels/step_panel.py" line="204" />
             <source>Increment per click (mm or °)</source>
             <translation>每次点击的增量（mm 或 °）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="163" />
+            <location filename="../../ui/panels/step_panel.py" line="205" />
             <source>Incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="164" />
+            <location filename="../../ui/panels/step_panel.py" line="206" />
             <source>Exact offset</source>
             <translation>精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="165" />
+            <location filename="../../ui/panels/step_panel.py" line="207" />
             <source>Move by values</source>
             <translation>按数值运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="166" />
+            <location filename="../../ui/panels/step_panel.py" line="208" />
             <source>Move every axis by its exact offset in one incremental move</source>
             <translation>以一次增量运动使各轴移动其精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="167" />
+            <location filename="../../ui/panels/step_panel.py" line="209" />
             <source>Clear values</source>
             <translation>清除数值</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="168" />
+            <location filename="../../ui/panels/step_panel.py" line="210" />
             <source>External axes J7–J11</source>
             <translation>外部轴 J7–J11</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="169" />
+            <location filename="../../ui/panels/step_panel.py" line="211" />
             <source>Show the external axes; while hidden their offsets are 0</source>
             <translation>显示外部轴；隐藏时其偏移量为 0</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="198" />
+            <location filename="../../ui/panels/step_panel.py" line="240" />
             <source>rpm</source>
             <translation>转/分</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="198" />
+            <location filename="../../ui/panels/step_panel.py" line="240" />
             <source>mm/s</source>
             <translation>mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="254" />
+            <location filename="../../ui/panels/step_panel.py" line="302" />
+            <source>{axis} limits {lo} … {hi} {unit} (its position is not known)</source>
+            <translation>{axis} 限位 {lo} … {hi} {unit}（当前位置未知）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/step_panel.py" line="306" />
+            <source>{axis} limits {lo} … {hi} {unit}, now at {at} {unit}</source>
+            <translation>{axis} 限位 {lo} … {hi} {unit}，当前位于 {at} {unit}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/step_panel.py" line="373" />
             <source>Move by {moves} at {speed} {unit}?</source>
             <translation>以 {speed} {unit} 运动 {moves}？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="257" />
+            <location filename="../../ui/panels/step_panel.py" line="377" />
+            <source>(capped by reduced speed; {asked} {unit} set)</source>
+            <translation>（受降速模式限制；设定为 {asked} {unit}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/step_panel.py" line="380" />
             <source>Confirm incremental move</source>
             <translation>确认增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="281" />
+            <location filename="../../ui/panels/step_panel.py" line="424" />
+            <source>→ {cap} {unit}</source>
+            <translation>→ {cap} {unit}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/step_panel.py" line="427" />
+            <source>Reduced speed: a step goes out at {cap} {unit} at most (one joint; less when several joints move together)</source>
+            <translation>降速模式：增量运动最多以 {cap} {unit} 发出（单个关节；多个关节同时运动时更低）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/step_panel.py" line="431" />
+            <source>Reduced speed: a step goes out at {cap} {unit} at most</source>
+            <translation>降速模式：增量运动最多以 {cap} {unit} 发出</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/step_panel.py" line="299" />
+            <location filename="../../ui/panels/step_panel.py" line="406" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="281" />
+            <location filename="../../ui/panels/step_panel.py" line="299" />
+            <location filename="../../ui/panels/step_panel.py" line="406" />
             <source>mm</source>
             <translation>mm</translation>
         </message>

@@ -18,6 +18,7 @@ from app.link.types import ConnectionState, LinkState, UnconfirmedHalt, WorkerEr
 from app.link.upload import Uploader
 from app.models import CommandResult, ControllerStatus, Pose
 from app.safety.audit import AuditLog
+from app.safety.caps import MotionCaps
 from app.safety.envelope import EnvelopeViolation
 
 
@@ -32,6 +33,7 @@ class PartsHost:
         self.reconnect_delays: list[float] = []
         self.urgent: list[Any] = []  # callables run by run_urgent (like urgent jobs)
         self.audit: AuditLog | None = None
+        self.caps: MotionCaps | None = None
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
         self.jog = JogMachine(self)

@@ -54,9 +54,14 @@ def test_target_inside_keep_out_and_joint_and_speed() -> None:
     assert (v.code, v.box, v.axis, v.limit) == (ViolationCode.KEEP_OUT, "fixture A", "Y", 100.0)
     v = check_target(ENV, pose(0, 0, 400), joints=(0, 140, 0))
     assert v is not None and (v.code, v.axis, v.limit) == (ViolationCode.JOINT_LIMIT, "J2", 135.0)
-    v = check_target(ENV, pose(0, 0, 400), speed=300, reduced=True)
-    assert v is not None and v.code is ViolationCode.SPEED and v.limit == 250 and "reduced-speed" in v.message
-    assert check_target(ENV, pose(0, 0, 400), speed=300) is None
+    v = check_target(ENV, pose(0, 0, 400), speed=600)
+    assert (
+        v is not None
+        and v.code is ViolationCode.SPEED
+        and v.limit == 500
+        and "reduced-speed" not in v.message
+    )
+    assert check_target(ENV, pose(0, 0, 400), speed=300) is None  # reduced-speed mode caps it, not refuses
     with pytest.raises(EnvelopeRefused, match=r"^step refused: .*keep-out zone 'fixture A'") as info:
         require_target(ENV, pose(350, 0, 100), action="step")
     assert info.value.violation.code is ViolationCode.KEEP_OUT
@@ -72,6 +77,18 @@ def test_a_line_through_a_thin_zone_between_its_ends_is_caught() -> None:
 def test_caps_and_reduced_mode() -> None:
     assert ENV.cap_jog_ratio(80) == 50 and ENV.cap_jog_ratio(80, reduced=True) == 10
     assert ENV.speed_cap(True) == 250 and ENV.speed_cap() == 500
+    caps = ENV.motion_caps(reach=1000.0)  # what the client applies in reduced-speed mode
+    assert (caps.jog_ratio(80), caps.jog_ratio(0), caps.program_ratio(100), caps.linear_speed(300)) == (
+        10,
+        0,
+        10,
+        250,
+    )
+    one_joint = 250 / 1000 * 60 / (2 * np.pi)  # rpm: a point 1000 mm from the axis at 250 mm/s
+    assert caps.joint_speed(5.0, [10, 0, 0, 0, 0, 0]) == pytest.approx(one_joint)
+    assert caps.joint_speed(5.0, [10, -10, 5, 0, 0, 0]) == pytest.approx(one_joint / 2.5)  # they add up
+    assert caps.joint_speed(5.0, [0] * 6 + [100]) == pytest.approx(one_joint)  # external axes alone
+    assert caps.joint_speed(0.5, [10, 0, 0, 0, 0, 0]) == 0.5
     with pytest.raises(InvalidInput, match="lower bound must be below"):
         Box("bad", (0, 0, 0), (0, 1, 1))
     with pytest.raises(InvalidInput, match="at most 100"):
@@ -129,6 +146,26 @@ def test_plan_through_a_keep_out_box_is_an_error_that_blocks_run() -> None:
     assert has_errors(issues)
     # without an envelope the plan checks are what they were
     assert not has_errors(check_plan(plan, ledger, current_pose=pose(0, 0, 100)))
+
+
+def test_reduced_speed_caps_a_plans_segments_instead_of_refusing_them() -> None:
+    ledger = _ledger((200.0, 0.0, 100.0), (200.0, 200.0, 100.0), (0.0, 200.0, 100.0))
+    plan = Plan(
+        "slow",
+        [
+            Segment(SegmentKind.LINE, end_id=1, speed=100),  # under the reduced cap (250)
+            Segment(SegmentKind.LINE, end_id=2, speed=400),  # runs at 250
+            Segment(SegmentKind.LINE, end_id=3, speed=600),  # above the envelope's maximum (500)
+        ],
+    )
+    issues = check_plan(plan, ledger, current_pose=pose(0, 0, 100), envelope=ENV, reduced_speed=True)
+    assert [(i.segment, i.kind, i.code) for i in issues] == [
+        (1, IssueKind.WARNING, IssueCode.SPEED_CAPPED),
+        (2, IssueKind.ERROR, IssueCode.OUTSIDE_ENVELOPE),  # refused in every mode
+    ]
+    assert issues[0].message == "segment 2: runs at 250 mm/s, the reduced-speed cap (planned 400 mm/s)"
+    normal = check_plan(plan, ledger, current_pose=pose(0, 0, 100), envelope=ENV)
+    assert [(i.segment, i.code) for i in normal] == [(2, IssueCode.OUTSIDE_ENVELOPE)]
 
 
 def test_plan_without_a_start_pose_checks_the_first_end_point_only() -> None:

@@ -110,7 +110,8 @@ def test_envelope_dialog_saves_and_draws_the_boxes(qtbot: Any, menu: SafetyMenu,
     with qtbot.waitSignal(menu.safety.envelopeChanged, timeout=2000):
         dialog.save()
     saved = load_profile(menu.safety.profile_path)
-    assert saved.revision == 1 and [b.name for b in saved.envelope.keep_out] == ["fixture"]
+    # revision 1 is the fresh install's (the robot model's defaults), saved at start
+    assert saved.revision == 2 and [b.name for b in saved.envelope.keep_out] == ["fixture"]
     top = window.planner_panel.preview.projections["top"]
     assert len(top.keep_out.xData) == 24 and len(top.keep_in.xData) == 24
     view3d = getattr(window, "view3d", None)

@@ -107,8 +107,8 @@ class FakeLink(QObject):
     def set_mode(self, mode: WorkMode) -> int:
         return self._record("set_mode", mode)
 
-    def go_zero(self, axis: int | None) -> int:
-        return self._record("go_zero", axis)
+    def go_zero(self, axis: int | None, *, switch_to_auto: bool = False) -> int:
+        return self._record("go_zero", axis, switch_to_auto=switch_to_auto)
 
     def run_program(
         self,
@@ -116,8 +116,12 @@ class FakeLink(QObject):
         mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
         cycles: int = 1,
         speed_ratio: int = 100,
+        *,
+        switch_to_auto: bool = False,
     ) -> int:
-        return self._record("run_program", program_id, mode, cycles, speed_ratio)
+        return self._record(
+            "run_program", program_id, mode, cycles, speed_ratio, switch_to_auto=switch_to_auto
+        )
 
     def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = 200) -> int:
         return self._record("create_point", point_id, pose, tool)

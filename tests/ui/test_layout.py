@@ -257,6 +257,24 @@ def test_touch_mode_layout_at_1280x800(make_window: Callable[..., MainWindow], l
     assert scroll.verticalScrollBar().maximum() + scroll.viewport().height() >= rows.height()
 
 
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_reduced_speed_caps_fit_at_1280x800(make_window: Callable[..., MainWindow], language: str) -> None:
+    """Reduced-speed mode shows its caps beside the jog slider, the program speed and the step speed
+    (issue 18): they fit the control column without clipping, in both languages."""
+    window = make_window(language, SIZES[0])
+    assert window.safety_menu.safety.set_reduced(True)
+    window.jog_panel.set_ratio(100)
+    window.program_panel.speed_spin.setValue(100)
+    window.step_panel.speed_spin.setValue(50.0)  # rpm: above the joint cap
+    assert window.jog_panel.speed_value.text() == (
+        "100 % → 10 %" + ("（降速模式）" if language != "en" else " (reduced speed)")
+    )
+    assert window.program_panel.speed_cap.isVisibleTo(window.program_panel)
+    assert window.step_panel.speed_cap.isVisibleTo(window.step_panel)
+    found = without_known(check_window(window, language, touch=False), f"{language}-1280x800-connected")
+    assert not found, "\n".join(found)
+
+
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 def test_points_primary_actions_and_docks_stay_visible(
     make_window: Callable[..., MainWindow], size: tuple[int, int]

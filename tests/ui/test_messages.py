@@ -22,8 +22,10 @@ from app.errors import (
     InvalidInput,
     LinkError,
     MalformedResponse,
+    ManualModeRefused,
     ModbusExceptionError,
     Reason,
+    ReducedSpeedRefused,
     ResponseTimeout,
     TeachPadError,
     WriteBlocked,
@@ -224,6 +226,9 @@ def _errors() -> list[TeachPadError]:
         EnvelopeRefused(EnvelopeViolation(ViolationCode.SPEED, 500.0, 250.0, reduced=True)),
         EnvelopeRefused(EnvelopeViolation(ViolationCode.JOG_RATIO, 80.0, 30.0)),
         EnvelopeRefused(EnvelopeViolation(ViolationCode.KEEP_IN, 1190.0, 1200.0, axis="Y", approaching=True)),
+        ManualModeRefused("go to zero", 0),
+        ManualModeRefused("run program", 7),  # a mode the table does not know: not named
+        ReducedSpeedRefused("go to zero"),
     ]
 
 
@@ -327,7 +332,7 @@ def _plan_issues() -> list[Any]:
     from app.plan.checks import PlanIssue, check_plan
     from app.plan.segments import Plan, Segment, SegmentKind
     from app.points.ledger import PointLedger, SyncState, make_point
-    from app.safety.envelope import EnvelopeRefused
+    from app.safety.envelope import Envelope, EnvelopeRefused
     from app.view3d.agreement import ModelAgreement, model_issue
     from app.view3d.kinematics import Reach
     from app.view3d.reach import _issue
@@ -366,6 +371,13 @@ def _plan_issues() -> list[Any]:
         *check_plan(Plan("p", [Segment.line(7), Segment(SegmentKind.ARC, 6)]), ledger, current_pose=home),
         *check_plan(circle, ledger, current_pose=(470.7, 70.7, 300, 180, 0, 0), start_index=1),
         *check_plan(circle, ledger, current_pose=(520.0, -40.0, 300, 180, 0, 0), start_index=1),
+        *check_plan(  # reduced-speed mode: a segment faster than its cap runs at the cap (a warning)
+            Plan("p", [Segment.line(5, 400)]),
+            ledger,
+            current_pose=home,
+            envelope=Envelope(),
+            reduced_speed=True,
+        ),
     ]
     violation = EnvelopeViolation(ViolationCode.KEEP_OUT, 10.0, 0.0, axis="Z", box="夹具", segment=1)
     issues += [

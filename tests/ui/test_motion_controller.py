@@ -19,7 +19,7 @@ from ui.controllers.plan_run_controller import PlanRunController
 from ui.models.points_model import PointsModel
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
-from ui.panels.program_panel import ProgramPanel
+from ui.panels.program_panel import ProgramPanel, ZeroRequest
 from ui.panels.step_panel import StepPanel
 
 
@@ -87,8 +87,12 @@ def test_intents_become_requests(rig: Rig) -> None:
     rig.bar.pauseRequested.emit()
     rig.bar.resumeRequested.emit()
     rig.bar.modeRequested.emit(WorkMode.MANUAL)
-    rig.program.goZeroRequested.emit(2)
+    rig.program.goZeroRequested.emit(ZeroRequest(2))
+    rig.program.goZeroRequested.emit(ZeroRequest(None, switch_to_auto=True))  # the operator said yes to it
     names = [c.name for c in rig.link.calls]
-    assert names == ["stop", "pause", "resume", "set_mode", "go_zero"]
+    assert names == ["stop", "pause", "resume", "set_mode", "go_zero", "go_zero"]
     assert rig.link.named("set_mode")[0].args == (WorkMode.MANUAL,)
-    assert rig.link.named("go_zero")[0].args == (2,)
+    assert [(c.args, c.kwargs) for c in rig.link.named("go_zero")] == [
+        ((2,), {"switch_to_auto": False}),
+        ((None,), {"switch_to_auto": True}),
+    ]

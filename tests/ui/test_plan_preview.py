@@ -202,6 +202,24 @@ def test_every_change_refits_until_the_operator_zooms(
     assert not shows_all(preview, [(2400, -1800, 1200)])
 
 
+def test_the_envelopes_boxes_are_drawn_but_the_view_fits_the_plan(
+    qtbot: Any, preview: PlanPreview, ledger: PointLedger
+) -> None:
+    """A fresh install's keep-in box is the robot's whole reach (2.8 m wide): drawn, but a 200 mm
+    plan still fills the view (issue 18's defaults)."""
+    from app.safety.profile import default_envelope
+    from app.view3d.profile import default_profile
+
+    preview.show()
+    qtbot.waitExposed(preview)
+    preview.set_envelope(default_envelope(default_profile()))
+    preview.show_plan(Plan("p", [Segment.line(5), Segment.line(7)]), ledger, (400, 0, 450), None)
+    top = preview.projections["top"]
+    assert top.keep_in is not None and len(top.keep_in.getData()[0]) > 0  # the box is drawn
+    (x0, x1), _ = top.plot.getViewBox().viewRange()
+    assert shows_all(preview, [(300, 0, 300), (500, 0, 300)]) and x1 - x0 < 1000  # fitted to the plan
+
+
 def label_gaps(axis: pg.AxisItem, span: tuple[float, float], width: int) -> list[float]:
     """The gaps (px) between the X axis' tick labels as pyqtgraph lays them out at ``width``."""
     from PySide6.QtGui import QImage, QPainter

@@ -13,6 +13,11 @@ disabled, any jog is released, and a jog / step / program intent that still arri
 (never written). Stop stays enabled whatever happens. ``alarmHoldChanged(bool)`` tells the other
 panels that start motion (points' move-to, the planner's run).
 
+Work mode and reduced speed: the program panel is told the controller's mode (its confirmations
+name a switch from manual to auto, and only a yes to that lets the request switch it); with the
+guard rails installed (:attr:`MotionController.safety`) the jog, step and program panels are told
+the caps in force, shown where each speed is set (the link's client applies them to the writes).
+
 The step and program panels are built when their tab is first shown (``ui/window_tabs.py``):
 :meth:`MotionController.add_step_panel` / :meth:`~MotionController.add_program_panel` attach one
 when it exists, and it gets the gating in force before it can be shown.
@@ -28,14 +33,16 @@ from PySide6.QtCore import QObject, Signal, Slot
 from app.alarm_history import blocks_motion
 from app.link.robot_link import LinkPort
 from app.link.types import ConnectionState, JogRequest, StepFrame
+from app.models import ControllerStatus
 from app.protocol.enums import ProgramMotionMode, WorkMode
+from app.safety.caps import MotionCaps
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.safety import SafetyController
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
 
 if TYPE_CHECKING:  # built when their tab is first shown: not imported before the first paint
-    from ui.panels.program_panel import ProgramPanel, ProgramRequest
+    from ui.panels.program_panel import ProgramPanel, ProgramRequest, ZeroRequest
     from ui.panels.step_panel import StepPanel, StepRequest
 
 __all__ = ["MotionController"]
@@ -67,7 +74,7 @@ class MotionController(QObject):
         self._run_active = False
         self._enabled = link.state.writable
         self._alarm_hold = blocks_motion(link.state.alarms)
-        self.safety: SafetyController | None = None  # the guard rails (set by install_safety)
+        self._safety: SafetyController | None = None  # the guard rails (set by install_safety)
 
         control_bar.stopRequested.connect(link.stop)
         control_bar.pauseRequested.connect(link.pause)
@@ -80,6 +87,8 @@ class MotionController(QObject):
         jog.show_halt(link.state.halt)
         link.state.connectionChanged.connect(self._on_connection)
         link.state.alarmsChanged.connect(self._on_alarms)
+        link.state.statusChanged.connect(self._on_status)
+        link.state.connectionChanged.connect(self._on_status)
         run_controller.runningChanged.connect(self._on_run_active)
         self._apply()
         if step is not None:
@@ -94,6 +103,9 @@ class MotionController(QObject):
         self._step = step
         step.stepRequested.connect(self._on_step_requested)
         step.set_motion_enabled(self._panels_enabled())
+        step.set_pose(self._link.state.pose)
+        self._link.state.poseChanged.connect(step.set_pose)
+        self._on_caps()
 
     def add_program_panel(self, program: ProgramPanel) -> None:
         """Drive and gate ``program`` from now on (enabled or not at once, as the others)."""
@@ -103,6 +115,48 @@ class MotionController(QObject):
         program.programRequested.connect(self._on_program_requested)
         program.goZeroRequested.connect(self._on_go_zero)
         program.set_motion_enabled(self._panels_enabled())
+        program.set_caps(self._caps())
+        self._on_status()
+
+    @property
+    def safety(self) -> SafetyController | None:
+        """The guard rails (set once by ``install_safety``): the envelope's checks and caps."""
+        return self._safety
+
+    @safety.setter
+    def safety(self, safety: SafetyController | None) -> None:
+        if self._safety is not None:
+            self._safety.capsChanged.disconnect(self._on_caps)
+        self._safety = safety
+        if safety is not None:
+            safety.capsChanged.connect(self._on_caps)
+        self._on_caps()
+
+    def _caps(self) -> MotionCaps | None:
+        return self._safety.caps if self._safety is not None else None
+
+    @Slot()
+    def _on_caps(self) -> None:
+        """Show the caps in force where each speed is set (reduced speed, the envelope's jog cap)."""
+        safety = self._safety
+        caps = self._caps()
+        self._jog.set_ratio_cap(
+            safety.jog_ratio_cap() if safety is not None else None, reduced=caps is not None
+        )
+        if self._step is not None:
+            self._step.set_caps(caps)
+            if safety is not None:  # the offset fields and the keypad follow the envelope's limits
+                self._step.set_limits(safety.envelope.joint_limits, safety.envelope.keep_in)
+        if self._program is not None:
+            self._program.set_caps(caps)
+
+    @Slot()
+    def _on_status(self) -> None:
+        """The program panel's confirmations name a switch from manual (the mode as last read)."""
+        state = self._link.state
+        status: ControllerStatus | None = state.status if state.connected else None
+        if self._program is not None:
+            self._program.set_controller_mode(status.mode if status is not None else None)
 
     @property
     def motion_enabled(self) -> bool:
@@ -195,13 +249,17 @@ class MotionController(QObject):
         if self._alarm_hold:
             return
         self._link.run_program(
-            request.program_id, ProgramMotionMode(request.mode), request.cycles, request.speed_ratio
+            request.program_id,
+            ProgramMotionMode(request.mode),
+            request.cycles,
+            request.speed_ratio,
+            switch_to_auto=request.switch_to_auto,
         )
 
     @Slot(object)
-    def _on_go_zero(self, axis: int | None) -> None:
+    def _on_go_zero(self, request: ZeroRequest) -> None:
         if not self._alarm_hold:
-            self._link.go_zero(axis)
+            self._link.go_zero(request.axis, switch_to_auto=request.switch_to_auto)
 
     @Slot(object)
     def _on_mode_requested(self, mode: WorkMode) -> None:

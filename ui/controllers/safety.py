@@ -16,6 +16,12 @@
   (:class:`EnvelopeView`: the 3D view's canvas; the planner hands it to its 2D preview), to the
   checks that use it with the speed caps (:class:`EnvelopeChecker`: the planner) and to the
   worker's jog guard (with reduced-speed mode). The seams are Protocols checked by mypy.
+* **Reduced-speed caps**: while reduced-speed mode is on, :attr:`SafetyController.caps` (the
+  envelope's reduced caps, the joint steps' from the robot model's reach) go to the link, whose
+  client caps every speed it writes (jog, program, steps, moves, plan segments) and refuses go to
+  zero; ``capsChanged`` tells the panels that show the cap where the speed is set.
+* **A fresh install** (no envelope file yet) starts with :func:`~app.safety.profile.
+  fresh_profile`: the robot model's joint limits and a keep-in box from its reach, on.
 * **Audit**: the link's :class:`~app.safety.audit.AuditLog` follows the role in force.
 
 Files: next to an INI settings file (tests, portable installs) or in the user's directories.
@@ -24,7 +30,7 @@ Files: next to an INI settings file (tests, portable installs) or in the user's 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from PySide6.QtCore import QEvent, QObject, QSettings, QTimer, Signal, Slot
 from PySide6.QtGui import QAction, QGuiApplication
@@ -39,11 +45,15 @@ from app.plan.geometry import PointLike
 from app.plan.segments import Segment
 from app.points.ledger import PointLedger
 from app.safety.audit import AuditLog, default_audit_dir
+from app.safety.caps import MotionCaps
 from app.safety.envelope import Envelope, EnvelopeRefused, EnvelopeViolation, ViolationCode
 from app.safety.jog_guard import JogMotion
-from app.safety.profile import SafetyProfile, load_profile, save_profile
+from app.safety.profile import SafetyProfile, fresh_profile, load_profile, save_profile
 from app.safety.roles import REQUIRED_ROLE, Action, Role, RoleStore, default_config_dir, default_store_path
 from app.safety.session import PermissionRefused, SafetySession
+
+if TYPE_CHECKING:  # the robot model is read by its first use (a fresh install, reduced speed)
+    from app.view3d.profile import RobotProfile
 
 IDLE_POLL_MS = 1000
 PROFILE_NAME = "envelope.safety.json"
@@ -99,6 +109,7 @@ class SafetyController(QObject):
     roleChanged = Signal(object)
     envelopeChanged = Signal(object)
     reducedChanged = Signal(bool)
+    capsChanged = Signal(object)  # MotionCaps | None: after every change of the envelope or the mode
     message = Signal(str)  # a refusal or a problem, already translated, for the event log / status
 
     def __init__(
@@ -121,13 +132,19 @@ class SafetyController(QObject):
         else:
             self._problem = ""
         audit = AuditLog(audit_dir, on_error=lambda text: self.message.emit(text))
+        self._reach: float | None = None  # the robot model's reach bound (mm), read when first needed
         self.profile = SafetyProfile()
-        if self.profile_path.exists():
+        fresh = not self.profile_path.exists()
+        if fresh:
+            self.profile = fresh_profile(self.robot_model())
+        else:
             try:
                 self.profile = load_profile(self.profile_path)
             except TeachPadError as exc:
                 self._problem = str(exc)
         self.session = SafetySession(roles, audit, self.profile.envelope, on_role_changed=self._role_changed)
+        if fresh:
+            self._save_fresh()
         self._gated: list[tuple[QAction | QWidget, Action]] = []
         self._panels: list[tuple[EditGated, Action]] = []
         self._views: list[EnvelopeView] = []
@@ -154,6 +171,21 @@ class SafetyController(QObject):
             self._app.focusObjectChanged.connect(self._focus_moved)
         self._watch_windows()
         self._push_guard()
+
+    def _save_fresh(self) -> None:
+        """A fresh install's envelope (the robot model's defaults) is saved at once, audited: it is
+        the envelope in force, revision 1, read by every later start."""
+        try:
+            self.profile_path.parent.mkdir(parents=True, exist_ok=True)
+            self.profile = save_profile(self.profile_path, self.profile)
+        except (OSError, TeachPadError) as exc:  # it applies all the same; say that it is not saved
+            self._problem = f"the default safety envelope could not be saved in {self.profile_path}: {exc}"
+            return
+        self.session.audit.record(
+            "action",
+            "create the default envelope",
+            args={"robot": self.profile.robot, "revision": self.profile.revision},
+        )
 
     @property
     def problem(self) -> str:
@@ -315,6 +347,7 @@ class SafetyController(QObject):
             checker.set_envelope(self.envelope, self.session.reduced)
         self._push_guard()
         self.envelopeChanged.emit(self.envelope)
+        self.capsChanged.emit(self.caps)
 
     def set_poll_rate(self, hz: float) -> None:
         if hz > 0:
@@ -324,9 +357,30 @@ class SafetyController(QObject):
     def _push_guard(self) -> None:
         if self.link is not None:
             self.link.set_jog_guard(self.session.jog_guard(self.poll_period))
+            self.link.set_motion_caps(self.caps)
 
     def jog_ratio(self, ratio: float) -> float:
         return self.session.jog_ratio(ratio)
+
+    @staticmethod
+    def robot_model() -> RobotProfile:
+        """The robot model the defaults and the joint steps' cap come from: the default one."""
+        from app.view3d.profile import default_profile  # a JSON file: read when first needed
+
+        return default_profile()
+
+    @property
+    def caps(self) -> MotionCaps | None:
+        """Reduced-speed mode's caps (None while it is off)."""
+        if not self.session.reduced:
+            return None
+        if self._reach is None:
+            self._reach = self.robot_model().reach
+        return self.envelope.motion_caps(self._reach)
+
+    def jog_ratio_cap(self) -> float:
+        """The jog ratio the envelope allows in the mode in force (%)."""
+        return self.envelope.jog_ratio_cap(self.session.reduced)
 
     # --- checks before sending ------------------------------------------------------------------
     def refusal(self, exc: TeachPadError) -> str:

@@ -291,6 +291,8 @@ def gate_points(safety: SafetyController, window: MainWindow, panel: PointsPanel
     panel.move_check = lambda point_id, speed: safety.check_move_to(
         window.link.state.pose, point_id, speed, window.project.points_model.ledger
     )
+    panel.set_caps(safety.caps)
+    safety.capsChanged.connect(panel.set_caps)
 
 
 def gate_planner(safety: SafetyController, panel: PlannerPanel) -> None:

@@ -1,5 +1,9 @@
 """Jog (teach, function 4): hold a ± button or a key to move, let go to stop.
 
+The speed slider shows the ratio the jog goes out at: when the envelope caps it (reduced-speed
+mode, or the envelope's maximum jog speed; :meth:`JogPanel.set_ratio_cap`) the value reads
+"50 % → 10 % (reduced speed)" (or "50 % → 40 %"), highlighted, with the reason in its tooltip.
+
 Dead-man everywhere: a jog lasts exactly as long as the button or key is held. It also ends
 when the panel loses the keyboard focus, when the window is deactivated or closed, and when
 the link goes down (the main window calls :meth:`JogPanel.release_all`). A button that was
@@ -139,6 +143,8 @@ class JogPanel(QWidget):
         self._held: _Held | None = None
         self._motion_enabled = False
         self._halt: UnconfirmedHalt | None = None  # a stop the controller has not confirmed
+        self._ratio_cap: float | None = None  # the envelope's cap in force (None: no envelope)
+        self._reduced = False  # the cap is reduced-speed mode's
 
         # compact rows: 6 rows of 40 px buttons fit a 1280×800 screen under the docks
         self.frame_box = QWidget(self)
@@ -225,6 +231,7 @@ class JogPanel(QWidget):
         self.speed_slider.setPageStep(10)
         self.speed_slider.installEventFilter(self)
         self.speed_value = QLabel(self)
+        self.speed_value.setObjectName("JogSpeedValue")
         self.speed_value.setMinimumWidth(self.speed_value.fontMetrics().horizontalAdvance("100 %") + 8)
         self.speed_slider.valueChanged.connect(self._on_speed_changed)
         speed_row = QHBoxLayout()
@@ -298,6 +305,19 @@ class JogPanel(QWidget):
 
     def set_ratio(self, ratio: int) -> None:
         self.speed_slider.setValue(int(ratio))
+
+    def set_ratio_cap(self, cap: float | None, *, reduced: bool = False) -> None:
+        """The jog ratio the envelope allows now (None: no envelope); ``reduced``: it is reduced-
+        speed mode's cap. Shown at the slider whenever the slider is above it."""
+        self._ratio_cap = cap
+        self._reduced = reduced
+        self._show_speed()
+
+    @property
+    def sent_ratio(self) -> float:
+        """The ratio a jog goes out at: the slider's, capped by the envelope."""
+        cap = self._ratio_cap
+        return float(self.ratio) if cap is None else min(float(self.ratio), cap)
 
     @property
     def is_jogging(self) -> bool:
@@ -461,7 +481,28 @@ class JogPanel(QWidget):
         self.tool_spin.setVisible(frame is TeachFrame.TOOL)
 
     def _show_speed(self) -> None:
-        self.speed_value.setText(self.tr("{ratio} %").format(ratio=self.ratio))
+        sent = self.sent_ratio
+        if sent >= self.ratio:
+            self.speed_value.setText(self.tr("{ratio} %").format(ratio=self.ratio))
+            self.speed_value.setStyleSheet("")
+            self.speed_value.setToolTip("")
+            return
+        shown = (
+            self.tr("{ratio} % → {cap} % (reduced speed)")
+            if self._reduced
+            else self.tr("{ratio} % → {cap} %")
+        )
+        self.speed_value.setText(shown.format(ratio=self.ratio, cap=f"{sent:g}"))
+        self.speed_value.setStyleSheet("QLabel { color: #ef8f00; font-weight: bold; }")
+        why = (
+            self.tr("Capped at {cap} % (reduced speed): the jog goes out at {cap} %, not {ratio} %")
+            if self._reduced
+            else self.tr(
+                "Capped at {cap} % (the safety envelope's maximum): "
+                "the jog goes out at {cap} %, not {ratio} %"
+            )
+        )
+        self.speed_value.setToolTip(why.format(cap=f"{sent:g}", ratio=self.ratio))
 
     @Slot(int)
     def _on_speed_changed(self, value: int) -> None:

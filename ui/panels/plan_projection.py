@@ -150,7 +150,8 @@ class Projection:
             self.keep_out = pg.PlotCurveItem(pen=pg.mkPen(COLOR_KEEP_OUT, width=2, style=dash), connect=pairs)
             for item in (self.keep_in, self.keep_out):
                 item.setZValue(-1)
-                self.plot.addItem(item)
+                # drawn, but the view fits the plan: a keep-in box is often the arm's whole reach
+                self.plot.addItem(item, ignoreBounds=True)
         self.keep_in.setData(keep_in[:, self.h], keep_in[:, self.v])
         self.keep_out.setData(keep_out[:, self.h], keep_out[:, self.v])
 

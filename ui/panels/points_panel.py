@@ -18,6 +18,7 @@ from PySide6.QtWidgets import QLabel, QSizePolicy, QVBoxLayout, QWidget
 
 from app.errors import InvalidInput
 from app.points.ledger import UploadReport
+from app.safety.caps import MotionCaps
 from ui.controllers.point_sync import LEVEL_ERROR, LEVEL_INFO, LEVEL_WARN, PointSyncController
 from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
@@ -138,6 +139,9 @@ class PointsPanel(QWidget):
         self.teach_button, self.upload_button = bar.teach_button, bar.upload_button
         self.restore_all_button, self.move_to_button = bar.restore_all_button, bar.move_to_button
         self.speed, self.find_edit = bar.speed, bar.find_edit
+        self.speed_cap = bar.speed_cap
+        self._caps: MotionCaps | None = None  # reduced-speed mode's caps, None: off
+        self.speed.valueChanged.connect(self._show_move_cap)
         self.find_edit.textChanged.connect(self.proxy.set_filter_text)
 
         self.banner = RestoreBanner(self._controller.restore_all, self)
@@ -370,7 +374,7 @@ class PointsPanel(QWidget):
             self.show_message(self.tr("Select one point to move to"), LEVEL_WARN)
             return
         point = self._model.point_at(rows[0])
-        speed = self.speed.value()
+        speed = self.sent_speed()
         refused = self.move_check(point.id, speed) if self.move_check is not None else None
         if refused:
             self.show_message(refused, LEVEL_ERROR)
@@ -392,6 +396,26 @@ class PointsPanel(QWidget):
         # whatever its sync state: the move creates the point again from this pose first
         if self._confirm(self.tr("Move to point"), question):
             self._controller.move_to(point.id, speed)
+
+    @Slot(object)
+    def set_caps(self, caps: MotionCaps | None) -> None:
+        """Reduced-speed mode's caps (None: off): the TCP cap is shown beside the speed, and is the
+        speed a move to a point goes out at (the link's client caps it too)."""
+        self._caps = caps
+        self._show_move_cap()
+
+    def sent_speed(self) -> float:
+        """The speed of Move to point as it goes out: the field's, capped in reduced-speed mode."""
+        speed = float(self.speed.value())
+        return speed if self._caps is None else self._caps.linear_speed(speed)
+
+    @Slot()
+    def _show_move_cap(self) -> None:
+        sent = self.sent_speed()
+        capped = sent < self.speed.value()
+        self.speed_cap.setVisible(capped)
+        if capped:
+            self.speed_cap.setText(self.tr("→ {cap} mm/s (reduced speed)").format(cap=f"{sent:g}"))
 
     # --- internals
     def _clear_filter_for(self, row: int) -> None:

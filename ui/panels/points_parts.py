@@ -54,7 +54,7 @@ def _bold(widget: QWidget) -> None:
 
 class PointsActionBar:
     """Two rows for the panel's layout: ``primary_row`` (``teach_button``, ``upload_button``
-    with its menu, ``restore_all_button``, ``move_to_button``, ``speed``) and ``edit_row``
+    with its menu, ``restore_all_button``, ``move_to_button``, ``speed``, ``speed_cap``) and ``edit_row``
     (``toolbar`` with the edit actions, ``find_label``, ``find_edit``, ``ext_button``)."""
 
     def __init__(
@@ -97,6 +97,11 @@ class PointsActionBar:
         primary.addSpacing(12)
         primary.addWidget(self.move_to_button)
         primary.addWidget(self.speed)
+        self.speed_cap = QLabel(self.primary_row)  # reduced speed's cap, when below the speed
+        self.speed_cap.setObjectName("PointsSpeedCap")
+        self.speed_cap.setStyleSheet("QLabel { color: #ef8f00; font-weight: bold; }")
+        self.speed_cap.hide()
+        primary.addWidget(self.speed_cap)
         primary.addStretch(1)
 
         self.edit_row = QWidget(parent)

@@ -3,14 +3,24 @@
 A ± button moves one axis by the selected preset (0.1 / 1 / 10 mm or °). "Move by values"
 sends every exact value at once; a move longer than :data:`CONFIRM_ABOVE` asks first (the
 ``confirm`` attribute, replaceable in tests). Speed is rpm in the joint frame and mm/s in the
-base frame (the controller's unit for GV225 depends on the frame).
+base frame (the controller's unit for GV225 depends on the frame). In reduced-speed mode
+(:meth:`StepPanel.set_caps`) the speed field shows the cap the step goes out at: the TCP cap in the
+base frame, in the joint frame the rpm at which one joint keeps the arm under it (less when
+several joints move together: :class:`~app.safety.caps.MotionCaps`).
+
+The exact-offset fields follow the axes' own limits (:meth:`StepPanel.set_limits`, the safety
+envelope's): a joint's offset lies within its limits' span, X Y Z within the keep-in box's, a
+rotation within a turn; the on-screen keypad offers what keeps the axis inside its limits from
+where it stands (:meth:`StepPanel.set_pose`), and says so. External axes (no limits known) keep
+:data:`OFFSET_LIMIT`.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from PySide6.QtCore import QEvent, Signal, Slot
+from PySide6.QtCore import QEvent, Qt, Signal, Slot
 from PySide6.QtWidgets import (
     QButtonGroup,
     QCheckBox,
@@ -26,17 +36,39 @@ from PySide6.QtWidgets import (
 )
 
 from app.link.types import StepFrame
+from app.models import Pose
 from app.protocol.enums import CARTESIAN_AXIS_NAMES, JOINT_AXIS_NAMES
 from app.protocol.registers import NUM_AXES_TOTAL, NUM_EXTERNAL_AXES, NUM_ROBOT_AXES
+from app.safety.box import Box
+from app.safety.caps import MotionCaps
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
+from ui.keypad_range import KeypadRange
 from ui.touch import RowsScrollArea, mark_motion
 
 PRESETS: tuple[float, ...] = (0.1, 1.0, 10.0)
 DEFAULT_PRESET = 1.0
-OFFSET_LIMIT = 10_000.0  # mm or degrees, per axis and move
+OFFSET_LIMIT = 10_000.0  # mm or degrees, per axis and move, where no limit of the axis is known
+ROTATION_LIMIT = 360.0  # degrees: a step rotates A, B or C by at most a turn
 CONFIRM_ABOVE = 10.0  # an exact-values move with any |offset| above this asks first
 SPEED_DEFAULT = {StepFrame.JOINT: 5.0, StepFrame.BASE: 50.0}  # rpm, mm/s
 SPEED_MAX = {StepFrame.JOINT: 100.0, StepFrame.BASE: 2000.0}
+
+
+def _figure(speed: float) -> str:
+    """A capped speed as shown: whole from 10 up, else two decimals at most (1.72 rpm)."""
+    return f"{speed:.0f}" if speed >= 10 else f"{speed:.2f}".rstrip("0").rstrip(".")
+
+
+class OffsetSpin(QDoubleSpinBox):
+    """An axis's exact offset: the keypad asks ``reach`` what it may offer now (see
+    :class:`~ui.keypad_range.RangedField`); the panel sets it."""
+
+    def __init__(self, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.reach: Callable[[], KeypadRange | None] | None = None
+
+    def keypad_range(self) -> KeypadRange | None:
+        return self.reach() if self.reach is not None else None
 
 
 @dataclass(frozen=True)
@@ -58,6 +90,10 @@ class StepPanel(QWidget):
         self.confirm: ConfirmFn = ask_confirmation(self)
         self._speeds = dict(SPEED_DEFAULT)
         self._frame = StepFrame.JOINT
+        self._caps: MotionCaps | None = None
+        self._joint_limits: tuple[tuple[float, float], ...] = ()  # J1.. (the envelope's; () none)
+        self._keep_in: Box | None = None
+        self._pose: Pose | None = None
 
         self.frame_caption = QLabel(self)
         self.frame_combo = QComboBox(self)
@@ -69,12 +105,17 @@ class StepPanel(QWidget):
         self.speed_spin.setDecimals(1)
         self.speed_spin.setMinimum(0.1)
         self.speed_spin.valueChanged.connect(self._on_speed_changed)
+        self.speed_cap = QLabel(self)  # the cap in force (reduced speed), else hidden
+        self.speed_cap.setObjectName("StepSpeedCap")
+        self.speed_cap.setStyleSheet("QLabel { color: #ef8f00; font-weight: bold; }")
+        self.speed_cap.hide()
         top = QHBoxLayout()
         top.addWidget(self.frame_caption)
         top.addWidget(self.frame_combo, 1)
         top.addSpacing(12)
         top.addWidget(self.speed_caption)
         top.addWidget(self.speed_spin)
+        self.speed_cap.setAlignment(Qt.AlignmentFlag.AlignRight)  # its own line: the top row is full
 
         self.preset_box = QGroupBox(self)
         preset_row = QHBoxLayout(self.preset_box)
@@ -102,7 +143,7 @@ class StepPanel(QWidget):
         self.axis_labels: list[QLabel] = []
         self.minus_buttons: list[QPushButton] = []
         self.plus_buttons: list[QPushButton] = []
-        self.value_spins: list[QDoubleSpinBox] = []
+        self.value_spins: list[OffsetSpin] = []
         self.value_caption = QLabel(self.axes_rows)
         grid.addWidget(self.value_caption, 0, 3)
         for axis in range(NUM_AXES_TOTAL):
@@ -114,8 +155,8 @@ class StepPanel(QWidget):
             plus.setObjectName(f"step_plus_{axis}")
             minus.clicked.connect(lambda _=False, a=axis: self._step_one(a, -1.0))
             plus.clicked.connect(lambda _=False, a=axis: self._step_one(a, 1.0))
-            spin = QDoubleSpinBox(self.axes_rows)
-            spin.setRange(-OFFSET_LIMIT, OFFSET_LIMIT)
+            spin = OffsetSpin(self.axes_rows)
+            spin.reach = lambda a=axis: self._offset_reach(a)
             spin.setDecimals(3)
             spin.setSingleStep(DEFAULT_PRESET)
             row = axis + 1 if axis < NUM_ROBOT_AXES else axis + 2  # external axes below their switch
@@ -144,6 +185,7 @@ class StepPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
         layout.addLayout(top)
+        layout.addWidget(self.speed_cap)
         layout.addWidget(self.preset_box)
         layout.addWidget(self.axes_box, 1)
         layout.addLayout(actions)
@@ -210,6 +252,81 @@ class StepPanel(QWidget):
         self.axes_box.setEnabled(enabled)
         self.move_button.setEnabled(enabled)
 
+    def set_limits(self, joint_limits: Sequence[tuple[float, float]], keep_in: Box | None) -> None:
+        """The axes' limits (the safety envelope's joint limits and keep-in box; empty / None: not
+        checked): the offset fields' ranges and what the keypad offers follow them."""
+        self._joint_limits = tuple((float(lo), float(hi)) for lo, hi in joint_limits)
+        self._keep_in = keep_in
+        self._apply_ranges()
+
+    def set_pose(self, pose: Pose | None) -> None:
+        """Where the arm is (the keypad offers each axis's offsets from there to its limits)."""
+        self._pose = pose
+
+    def axis_limits(self, axis: int) -> tuple[float, float] | None:
+        """Axis ``axis``'s limits in the frame in force (degrees or mm), None when not known."""
+        if self._frame is StepFrame.JOINT:
+            return self._joint_limits[axis] if axis < len(self._joint_limits) else None
+        if axis < 3 and self._keep_in is not None:
+            return (self._keep_in.lo[axis], self._keep_in.hi[axis])
+        return None
+
+    def _position(self, axis: int) -> float | None:
+        pose = self._pose
+        if pose is None:
+            return None
+        if self._frame is StepFrame.JOINT:
+            return pose.joints[axis] if pose.joints is not None and axis < len(pose.joints) else None
+        return pose.xyzabc[axis] if axis < 3 else None
+
+    def _offset_range(self, axis: int) -> tuple[float, float]:
+        """The offset field's fixed range: the span of the axis's limits, a turn for a rotation."""
+        limits = self.axis_limits(axis)
+        if limits is not None:
+            span = limits[1] - limits[0]
+            return (-span, span)
+        if self._frame is StepFrame.BASE and 3 <= axis < NUM_ROBOT_AXES:
+            return (-ROTATION_LIMIT, ROTATION_LIMIT)
+        return (-OFFSET_LIMIT, OFFSET_LIMIT)
+
+    def _offset_reach(self, axis: int) -> KeypadRange | None:
+        """What the keypad offers for ``axis`` now: from where it stands to each of its limits."""
+        limits = self.axis_limits(axis)
+        if limits is None:
+            return None
+        lo, hi = limits
+        name = self._axis_names()[axis]
+        unit = self.tr("°") if self._frame is StepFrame.JOINT else self.tr("mm")
+        at = self._position(axis)
+        if at is None:
+            note = self.tr("{axis} limits {lo} … {hi} {unit} (its position is not known)")
+            return KeypadRange(
+                lo - hi, hi - lo, note.format(axis=name, lo=f"{lo:g}", hi=f"{hi:g}", unit=unit)
+            )
+        note = self.tr("{axis} limits {lo} … {hi} {unit}, now at {at} {unit}")
+        text = note.format(axis=name, lo=f"{lo:g}", hi=f"{hi:g}", at=f"{at:.1f}", unit=unit)
+        return KeypadRange(lo - at, hi - at, text)
+
+    def _apply_ranges(self) -> None:
+        for axis, spin in enumerate(self.value_spins):
+            low, high = self._offset_range(axis)
+            spin.setRange(low, high)
+
+    def set_caps(self, caps: MotionCaps | None) -> None:
+        """Reduced-speed mode's caps (None: off), shown beside the speed field."""
+        self._caps = caps
+        self._show_cap()
+
+    def sent_speed(self, offsets: list[float] | None = None) -> float:
+        """The speed a step by ``offsets`` goes out at (a one-axis step when None): the field's,
+        capped in reduced-speed mode."""
+        caps = self._caps
+        if caps is None:
+            return self.speed
+        if self._frame is StepFrame.BASE:
+            return caps.linear_speed(self.speed)
+        return caps.joint_speed(self.speed, offsets if offsets is not None else [1.0])
+
     # --- internals --------------------------------------------------------------------
     def _request(self, offsets: list[float]) -> None:
         robot = offsets[:NUM_ROBOT_AXES]
@@ -251,9 +368,15 @@ class StepPanel(QWidget):
         if max(abs(v) for v in offsets) > CONFIRM_ABOVE:
             names = self._axis_names()
             moves = ", ".join(f"{names[i]} {v:+g}" for i, v in enumerate(offsets) if v)
+            sent = self.sent_speed(offsets)
+            speed = _figure(sent) if sent < self.speed else f"{self.speed:g}"
             text = self.tr("Move by {moves} at {speed} {unit}?").format(
-                moves=moves, speed=f"{self.speed:g}", unit=self.speed_unit()
+                moves=moves, speed=speed, unit=self.speed_unit()
             )
+            if sent < self.speed:
+                text += " " + self.tr("(capped by reduced speed; {asked} {unit} set)").format(
+                    asked=f"{self.speed:g}", unit=self.speed_unit()
+                )
             if not self.confirm(self.tr("Confirm incremental move"), text):
                 return
         self._request(offsets)
@@ -274,6 +397,8 @@ class StepPanel(QWidget):
         self.speed_spin.setValue(self._speeds[frame])
         self.speed_spin.blockSignals(False)
         self._apply_units()
+        self._apply_ranges()
+        self._show_cap()
 
     def _apply_units(self) -> None:
         self.speed_spin.setSuffix(" " + self.speed_unit())
@@ -288,6 +413,24 @@ class StepPanel(QWidget):
     @Slot(float)
     def _on_speed_changed(self, value: float) -> None:
         self._speeds[self._frame] = float(value)
+        self._show_cap()
+
+    def _show_cap(self) -> None:
+        sent = self.sent_speed()
+        capped = sent < self.speed
+        self.speed_cap.setVisible(capped)
+        if not capped:
+            return
+        self.speed_cap.setText(self.tr("→ {cap} {unit}").format(cap=_figure(sent), unit=self.speed_unit()))
+        tip = (
+            self.tr(
+                "Reduced speed: a step goes out at {cap} {unit} at most (one joint; less when several "
+                "joints move together)"
+            )
+            if self._frame is StepFrame.JOINT
+            else self.tr("Reduced speed: a step goes out at {cap} {unit} at most")
+        )
+        self.speed_cap.setToolTip(tip.format(cap=_figure(sent), unit=self.speed_unit()))
 
     @Slot(int)
     def _on_preset(self, index: int) -> None:
