@@ -61,7 +61,8 @@ def test_an_allowed_switch_is_its_own_write_before_the_command(
     client.audit.close()
     writes = [r for r in query(tmp_path) if r.kind == "write"]
     assert [r.args["address"] for r in writes] == [444, 445]  # two records: the mode change is audited
-    assert "work mode" in writes[0].command and all(r.result == "ok" for r in writes)
+    # the mode change is a plain write (answered: ok); the go to zero awaits its outcome (not followed here)
+    assert "work mode" in writes[0].command and writes[0].result == "ok"
 
 
 def test_auto_mode_needs_no_switch(sim: Any, make_client: MakeClient) -> None:
