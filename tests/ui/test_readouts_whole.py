@@ -33,6 +33,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     project_dialogs_fixture,
     translator_fixture,
 )
+from ui.dialogs.stop_first import StopFirst
 from ui.main_window import TAB_MONITOR, MainWindow
 from ui.panels.monitor_panel import MonitorPanel
 from ui.panels.pose_strip import PoseStrip
@@ -77,6 +78,7 @@ def make_window_fixture(
             autosave_dir=tmp_path / "autosave",
         )
         qtbot.addWidget(window)
+        window.link_guard.ask = lambda _question: StopFirst.STOP  # the close asks when the arm moved
         window.resize(*size)
         window.show()
         qtbot.waitExposed(window)
