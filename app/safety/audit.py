@@ -2,8 +2,16 @@
 
 Files: ``<data dir>/audit/audit-YYYY-MM-DD.jsonl`` per (host, local) day; when a day's file
 reaches :data:`MAX_FILE_BYTES` the next part is ``audit-YYYY-MM-DD.1.jsonl``, ``.2`` ...
-(new files, never renames). After each new file, old ones go: older than ``keep_days``, then
-the oldest until the total is under ``max_total_bytes``.
+(new files, never renames). After each new file, old ones go: the files of all but the newest
+``keep_days`` days *on which something was recorded*, then the oldest until the total is under
+``max_total_bytes``.
+
+The PC's clock is not trusted to age files: a clock one year ahead must not delete a year of
+records, so nothing is deleted because of what the clock says (only by the count of days on disk
+and the size cap: a clock jump deletes at most what an ordinary new day would). A clock stepped
+back does not make the writer go back to an older day's file either: within a process the day of
+the file only moves forward, so a session's records are in file order, and the reader pairs a
+write with its outcome by ``(session, seq)``, whatever the times say.
 
 Crash safety: the file is opened with ``O_APPEND`` and each record is one ``os.write`` of a
 whole line, so a ``kill -9`` loses at most the record being written, and a partly written last
@@ -332,7 +340,8 @@ class AuditLog:
             self._unsynced = False
 
     def _append(self, line: bytes, now: dt.datetime) -> None:
-        day = now.date().isoformat()
+        # a clock stepped back keeps writing to the day's file it was at (never back to an older one)
+        day = max(now.date().isoformat(), self._day)
         if self._fd is None or day != self._day or self._size + len(line) > self.max_file_bytes:
             self._open_for(day, len(line))
         assert self._fd is not None
@@ -372,15 +381,18 @@ class AuditLog:
         self._prune(keep=path)
 
     def _prune(self, keep: Path) -> None:
+        """Delete the files of all but the newest ``keep_days`` days on disk, then the oldest until
+        the total fits ``max_total_bytes``; never by the clock (see the module docstring)."""
         files = sorted(
             ((d, part, p) for p, d, part in audit_file_parts(self.directory)), key=lambda t: (t[0], t[1])
         )
-        cutoff = (self._now().date() - dt.timedelta(days=self.keep_days)).isoformat()
+        days = sorted({d for d, _, _ in files})
+        kept_days = set(days[-self.keep_days :]) if self.keep_days > 0 else set(days)
         remaining: list[tuple[Path, int]] = []
         for d, _, p in files:
             if p == keep:
                 continue
-            if d < cutoff:
+            if d not in kept_days:
                 with contextlib.suppress(OSError):
                     p.unlink()
                 continue

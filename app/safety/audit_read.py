@@ -191,6 +191,7 @@ def read_records(
     stats = stats if stats is not None else ReadStats()
     held: deque[_Slot] = deque()
     waiting: dict[tuple[str, int], _Slot] = {}
+    early: _Early = {}
     for path in audit_files(directory, start, end):
         stats.files += 1
         try:
@@ -206,16 +207,13 @@ def read_records(
                 stats.skipped += 1
                 continue
             if rec.kind in (OUTCOME, RESULT):
-                ref = rec.args.get("ref")
-                slot = waiting.pop((rec.session, ref), None) if isinstance(ref, int) else None
-                if slot is not None:
-                    slot.take(rec)
-                    if slot.pending:  # (ref is the slot's seq)
-                        waiting[(rec.session, slot.record.seq)] = slot
+                _pair(rec, waiting, early)
             else:  # (an outcome whose write is outside the range read shows nothing)
                 held.append(_Slot(rec))
                 if held[-1].pending:
                     waiting[(rec.session, rec.seq)] = held[-1]
+                    for line in early.pop((rec.session, rec.seq), []):  # read before it (a clock set back)
+                        _pair(line, waiting, early)
             if len(held) > MAX_OUTCOME_LAG:  # the oldest waits in vain: its process died
                 _give_up(held[0], stats)
                 waiting.pop((held[0].record.session, held[0].record.seq), None)
@@ -227,6 +225,28 @@ def read_records(
             _give_up(slot, stats)
         stats.records += 1
         yield slot.record
+
+
+_Early = dict[tuple[str, int], list[AuditRecord]]
+
+
+def _pair(line: AuditRecord, waiting: dict[tuple[str, int], _Slot], early: _Early) -> None:
+    """Merge an outcome or result line into its write, paired by ``(session, seq)``, never by time:
+    a line read before its write (files written by a clock stepped back across midnight) waits in
+    ``early`` (at most :data:`MAX_OUTCOME_LAG` of them) for the write."""
+    ref = line.args.get("ref")
+    if not isinstance(ref, int):
+        return
+    slot = waiting.pop((line.session, ref), None)
+    if slot is None:
+        if len(early) < MAX_OUTCOME_LAG:
+            early.setdefault((line.session, ref), []).append(line)
+        return
+    slot.take(line)
+    if slot.pending:  # (ref is the slot's seq)
+        waiting[(line.session, slot.record.seq)] = slot
+    for later in early.pop((line.session, ref), []):
+        _pair(later, waiting, early)
 
 
 def _give_up(slot: _Slot, stats: ReadStats) -> None:

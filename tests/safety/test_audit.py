@@ -84,10 +84,42 @@ def test_one_file_per_day_rotation_and_size_cap(tmp_path: Path) -> None:
     # the oldest parts went first: what is left is the most recent of day one, in order
     day1 = [r.command for r in read_records(tmp_path, dt.date(2026, 3, 1), dt.date(2026, 3, 1))]
     assert day1 == [f"teach P{i}" for i in range(40 - len(day1), 40)]
-    # older than keep_days: removed when a new file is opened
+    # the files of all but the newest keep_days days on disk go when a new file is opened (by the
+    # count of days written, never by the clock: see the next test)
     clock.t += dt.timedelta(days=40)
-    AuditLog(tmp_path, now=clock, keep_days=30).record("action", "much later")
-    assert [p.name for p in audit_files(tmp_path)] == ["audit-2026-04-11.jsonl"]
+    AuditLog(tmp_path, now=clock, keep_days=2).record("action", "much later")
+    assert [p.name for p in audit_files(tmp_path)] == ["audit-2026-03-02.jsonl", "audit-2026-04-11.jsonl"]
+
+
+def test_a_clock_a_year_ahead_deletes_no_record(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Issue 19 s5: a PC clock one year ahead deleted every older file (5 records -> 0)."""
+    clock = Clock(dt.datetime(2026, 3, 1, 12, 0, tzinfo=dt.UTC))
+    for day in range(5):
+        with AuditLog(tmp_path, now=clock, keep_days=90) as log:
+            log.record("action", f"teach P{day}")
+        clock.t += dt.timedelta(days=1)
+    clock.t += dt.timedelta(days=365)  # the clock jumps a year ahead
+    with AuditLog(tmp_path, now=clock, keep_days=90) as log:
+        log.record("action", "after the jump")
+    commands = [r.command for r in read_records(tmp_path)]
+    assert commands == [f"teach P{d}" for d in range(5)] + ["after the jump"]
+
+
+def test_a_clock_stepped_back_across_midnight_keeps_a_write_paired(tmp_path: Path) -> None:
+    """Issue 19 s5: a clock stepped back across midnight between a write and its answer turned the
+    successful write "unknown" (its outcome line went to the older day's file, read first)."""
+    clock = Clock(dt.datetime(2026, 3, 2, 0, 0, 1, tzinfo=dt.UTC))
+    with AuditLog(tmp_path, now=clock) as log, log.writing(441, [1], single=True):
+        clock.t -= dt.timedelta(seconds=5)  # 23:59:56 the day before
+    stats = ReadStats()
+    assert [r.result for r in read_records(tmp_path, stats=stats)] == [Result.OK]
+    assert stats.unknown == 0
+    # files an older TeachPad wrote that way (the outcome line in the older day's file) pair too
+    (tmp_path / "old").mkdir()
+    lines = (tmp_path / "audit-2026-03-02.jsonl").read_bytes().splitlines(keepends=True)
+    (tmp_path / "old" / "audit-2026-03-02.jsonl").write_bytes(lines[0])
+    (tmp_path / "old" / "audit-2026-03-01.jsonl").write_bytes(lines[1])
+    assert [r.result for r in read_records(tmp_path / "old")] == [Result.OK]
 
 
 def test_a_line_cut_short_is_skipped_and_the_next_writer_starts_a_fresh_line(tmp_path: Path) -> None:
