@@ -176,6 +176,11 @@ _TEMPLATES: dict[str, str] = {
         "Messages", "The controller refused the request: Modbus exception {exception} ({name})."
     ),
     "monitor_only": QT_TRANSLATE_NOOP("Messages", "Monitor-only mode: nothing was sent to the controller."),
+    "audit_unavailable": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Not sent: the audit trail in {folder} cannot be written ({cause}). No write goes out without "
+        "its record (Stop still does): free disk space or fix the audit folder.",
+    ),
     "manual_mode": QT_TRANSLATE_NOOP(
         "Messages",
         "{operation}: not sent, the controller is in {mode} mode. Switching it to auto is the operator's "

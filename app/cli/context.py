@@ -72,7 +72,11 @@ class CliContext:
             client = RobotClient(self.settings)
             client.caps = self.caps
             # The CLI is an administrator's tool; its writes go to the same audit trail as the GUI's.
-            client.audit = AuditLog(role="administrator (cli)", word_order=self.settings.word_order)
+            # No write goes out without its record (a full disk refuses it, Stop excepted, see
+            # AuditLog.writing); a record that cannot be written is said, once per problem.
+            client.audit = AuditLog(
+                role="administrator (cli)", word_order=self.settings.word_order, on_error=self.warn
+            )
             self._client = client
             client.connect()
         return self._client

@@ -53,6 +53,7 @@ from pathlib import Path
 from typing import Any
 
 from app.errors import WriteBlocked
+from app.protocol import registers
 from app.protocol.codec import WordOrder
 from app.safety.audit_read import (
     CSV_COLUMNS,
@@ -92,10 +93,12 @@ __all__ = [  # the reader's names stay importable from here (app.safety.audit_re
     "AuditFilter",
     "AuditLog",
     "AuditRecord",
+    "AuditUnavailable",
     "FsyncPolicy",
     "ReadStats",
     "Result",
     "audit_files",
+    "brings_to_rest",
     "default_audit_dir",
     "default_data_dir",
     "export_csv",
@@ -131,6 +134,26 @@ def default_data_dir() -> Path:
 
 def default_audit_dir() -> Path:
     return default_data_dir() / "audit"
+
+
+class AuditUnavailable(WriteBlocked):
+    """A write refused before the wire because its audit record could not be written first."""
+
+    code = "audit_unavailable"
+
+
+_REST_WRITES = (
+    (registers.REG_STOP, (1,)),
+    (registers.REG_PAUSE, (1,)),
+    (registers.gv_reg(registers.GV_PARAM3), (0, 0)),  # the jog ratio 0 (float 0.0: both words 0)
+)
+
+
+def brings_to_rest(address: int, values: Sequence[int]) -> bool:
+    """A write that only stops the arm (Stop, Pause, the jog ratio 0): it goes out also when its
+    audit record cannot be written (the failure is reported, see ``AuditLog.on_error``)."""
+    vals = tuple(int(v) for v in values)
+    return any(address == a and vals == v for a, v in _REST_WRITES)
 
 
 def _write_result(error: BaseException | None) -> tuple[str, str]:
@@ -183,6 +206,7 @@ class AuditLog:
         # written are counted, and on_error hears of each new problem once.
         self.on_error = on_error
         self.last_error: str | None = None
+        self.last_cause = ""  # the OS's words of the last failure ("No space left on device")
         self.dropped = 0
 
     # --- context ---------------------------------------------------------------------------
@@ -241,7 +265,8 @@ class AuditLog:
     def _failed(self, exc: OSError) -> None:
         self.dropped += 1
         self._close_fd()
-        message = f"the audit trail cannot be written in {self.directory} ({exc.strerror or exc})"
+        self.last_cause = exc.strerror or str(exc)
+        message = f"the audit trail cannot be written in {self.directory} ({self.last_cause})"
         if message != self.last_error:
             self.last_error = message
             if self.on_error is not None:
@@ -286,8 +311,20 @@ class AuditLog:
     ) -> Iterator[AuditRecord]:
         """Wrap one write, write-ahead: its line (``pending``) before the request goes out, its
         outcome line after; the reader merges them. Errors pass through unchanged. Yields the
-        write's record (``judged``: the command's outcome is recorded against it later)."""
+        write's record (``judged``: the command's outcome is recorded against it later).
+
+        No write without its record: when the write's line cannot be written (a full disk, the
+        folder gone) this raises :class:`AuditUnavailable` and the write is not sent -- except a
+        write that only brings the arm to rest (:func:`brings_to_rest`: Stop, Pause, jog ratio
+        0), which must go out whatever the disk says."""
+        dropped = self.dropped
         intent = self.record_write(address, values, single=single, pending=True, judged=judged)
+        if self.dropped != dropped and not brings_to_rest(address, values):
+            raise AuditUnavailable(
+                f"not sent: {intent.command} could not be recorded first ({self.last_error}); "
+                "no write goes out without its audit record (Stop still does)",
+                params={"folder": str(self.directory), "cause": self.last_cause},
+            )
         try:
             yield intent
         except Exception as exc:
