@@ -36,6 +36,7 @@ from app.safety.audit import (
     query,
     result_label,
 )
+from app.safety.audit_chain import verify_chain
 from app.safety.bundle import DEFAULT_DAYS, write_support_bundle
 from app.safety.roles import Role, RoleStore, default_store_path
 
@@ -108,6 +109,12 @@ def register(subparsers: Any) -> None:
         "controller did is not known), or a plain write's answer (ok, failed), or blocked",
     )
     p.add_argument("--csv", type=Path, metavar="OUT", help="write CSV instead of printing")
+    p.add_argument(
+        "--verify",
+        action="store_true",
+        help="check the chain of hashes that links each record to the one before it, across files, "
+        "and say where it breaks (a record changed or removed); exit code 1 if it does",
+    )
     p.set_defaults(handler=cmd_audit)
 
     p = subparsers.add_parser(
@@ -175,6 +182,8 @@ def cmd_audit(ctx: CliContext) -> ExitCode:
     """Print (or write as CSV) the records that match, then say how many of them are writes whose
     answer was never recorded (``unknown``: the controller may or may not have acted on them)."""
     args = ctx.args
+    if args.verify:
+        return _verify(ctx, args.audit_dir or default_audit_dir())
     flt = AuditFilter(
         start=args.start, end=args.end, role=args.role, command=args.command_text, result=args.result
     )
@@ -197,6 +206,15 @@ def cmd_audit(ctx: CliContext) -> ExitCode:
     if stats.skipped:
         ctx.warn(f"{stats.skipped} damaged line(s) skipped")
     return ExitCode.OK
+
+
+def _verify(ctx: CliContext, directory: Path) -> ExitCode:
+    """``audit --verify``: where the chain of hashes breaks (every file, whatever the filters)."""
+    report = verify_chain(directory)
+    for chain_break in report.breaks:
+        ctx.print(f"chain broken at {chain_break}")
+    ctx.print(f"{directory}: {report.summary()}")
+    return ExitCode.OK if report.intact else ExitCode.FAILED
 
 
 def unknown_count(records: list[AuditRecord]) -> int:

@@ -49,12 +49,14 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from app.errors import WriteBlocked
 from app.protocol import registers
 from app.protocol.codec import WordOrder
+from app.safety.audit_chain import last_line_hash, line_hash
 from app.safety.audit_read import (
     CSV_COLUMNS,
     FILE_RE,
@@ -200,6 +202,7 @@ class AuditLog:
         self._last_sync = 0.0
         self._unsynced = False
         self._clock: tuple[dt.datetime, float] | None = None
+        self._prev: str | None = None  # the hash of the last record written (the chain)
         self.session = os.urandom(6).hex()  # 12 hex digits (not uuid4: its import costs 7 ms at start-up)
         self._seq = 0
         # A full disk must not stop a write (least of all a stop): records that cannot be
@@ -255,7 +258,7 @@ class AuditLog:
             )
             self._seq += 1
             try:
-                self._append(rec.to_line(), now)
+                rec = self._append(rec, now)
             except OSError as exc:
                 self._failed(exc)
             else:
@@ -376,17 +379,28 @@ class AuditLog:
             self._fd = None
             self._unsynced = False
 
-    def _append(self, line: bytes, now: dt.datetime) -> None:
+    def _append(self, rec: AuditRecord, now: dt.datetime) -> AuditRecord:
+        """Append ``rec`` chained to the record before it (returned with its ``prev``)."""
         # a clock stepped back keeps writing to the day's file it was at (never back to an older one)
         day = max(now.date().isoformat(), self._day)
-        if self._fd is None or day != self._day or self._size + len(line) > self.max_file_bytes:
-            self._open_for(day, len(line))
-        assert self._fd is not None
-        view = memoryview(line)
-        while view:
-            view = view[os.write(self._fd, view) :]
+        need = len(rec.to_line()) + _PREV_CHARS
+        if self._fd is None or day != self._day or self._size + need > self.max_file_bytes:
+            self._open_for(day, need)
+        assert self._fd is not None and self._path is not None
+        with _locked(self._fd):  # another TeachPad (the GUI and the CLI) may append to the same file
+            size = os.fstat(self._fd).st_size
+            if size != self._size:  # it did: chain to its last record
+                self._prev = last_line_hash(self._path) or self._prev
+                self._size = size
+            rec = replace(rec, prev=self._prev or "")
+            line = rec.to_line()
+            view = memoryview(line)
+            while view:
+                view = view[os.write(self._fd, view) :]
+        self._prev = line_hash(line)
         self._size += len(line)
         self._sync()
+        return rec
 
     def _sync(self) -> None:
         assert self._fd is not None
@@ -402,6 +416,9 @@ class AuditLog:
     def _open_for(self, day: str, need: int) -> None:
         self._close_fd()
         self.directory.mkdir(parents=True, exist_ok=True)
+        on_disk = sorted((d, part, p) for p, d, part in audit_file_parts(self.directory))
+        if on_disk and on_disk[-1][0] > day:  # a clock set back since: keep to the newest day's file
+            day = on_disk[-1][0]
         parts = sorted((part, p) for p, d, part in audit_file_parts(self.directory) if d == day)
         part = parts[-1][0] if parts else 0
         while True:
@@ -414,6 +431,9 @@ class AuditLog:
         if size and not _ends_with_newline(path):
             os.write(fd, b"\n")  # close a line cut short by a crash; the reader skips it
             size += 1
+        # the chain: from this file's last record, else from the newest file before it
+        before = [p for _, _, p in on_disk if p != path]
+        self._prev = last_line_hash(path) if size else (last_line_hash(before[-1]) if before else None)
         self._fd, self._path, self._size, self._day = fd, path, size, day
         self._prune(keep=path)
 
@@ -435,13 +455,32 @@ class AuditLog:
                 continue
             with contextlib.suppress(OSError):
                 remaining.append((p, p.stat().st_size))
-        total = sum(s for _, s in remaining) + self._size
+        total = sum(s for _, s in remaining) + self.max_file_bytes  # room for the new file to fill
         for p, s in remaining:  # oldest first
             if total <= self.max_total_bytes:
                 break
             with contextlib.suppress(OSError):
                 p.unlink()
                 total -= s
+
+
+_PREV_CHARS = len(',"prev":""') + 64  # what the chain adds to a line
+
+
+@contextlib.contextmanager
+def _locked(fd: int) -> Iterator[None]:
+    """An exclusive lock on the open file while one record is appended (POSIX; elsewhere none:
+    two writers at once may then break the chain, which the verifier shows)."""
+    try:
+        import fcntl
+    except ImportError:
+        yield
+        return
+    fcntl.flock(fd, fcntl.LOCK_EX)
+    try:
+        yield
+    finally:
+        fcntl.flock(fd, fcntl.LOCK_UN)
 
 
 def _ends_with_newline(path: Path) -> bool:

@@ -89,6 +89,7 @@ class AuditRecord:
     controller_time: str | None = None  # the controller's clock, estimated from its last read
     session: str = ""  # one id per AuditLog: with seq, identifies a record
     seq: int = 0
+    prev: str | None = None  # the hash of the record before it (app.safety.audit_chain); None: older
 
     @property
     def time(self) -> dt.datetime:
@@ -107,6 +108,8 @@ class AuditRecord:
             "session": self.session,
             "seq": self.seq,
         }
+        if self.prev is not None:
+            doc["prev"] = self.prev
         return (json.dumps(doc, ensure_ascii=False, separators=(",", ":")) + "\n").encode("utf-8")
 
     @classmethod

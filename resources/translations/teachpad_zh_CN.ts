@@ -134,102 +134,102 @@
     <context>
         <name>AuditModel</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="62" />
+            <location filename="../../ui/panels/audit_viewer.py" line="63" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="63" />
+            <location filename="../../ui/panels/audit_viewer.py" line="64" />
             <source>Role</source>
             <translation>角色</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="64" />
+            <location filename="../../ui/panels/audit_viewer.py" line="65" />
             <source>Kind</source>
             <translation>类型</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="65" />
+            <location filename="../../ui/panels/audit_viewer.py" line="66" />
             <source>Command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="66" />
+            <location filename="../../ui/panels/audit_viewer.py" line="67" />
             <source>Result</source>
             <translation>结果</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="67" />
+            <location filename="../../ui/panels/audit_viewer.py" line="68" />
             <source>Detail</source>
             <translation>详情</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="86" />
+            <location filename="../../ui/panels/audit_viewer.py" line="87" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="87" />
+            <location filename="../../ui/panels/audit_viewer.py" line="88" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="88" />
+            <location filename="../../ui/panels/audit_viewer.py" line="89" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="89" />
+            <location filename="../../ui/panels/audit_viewer.py" line="90" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="90" />
+            <location filename="../../ui/panels/audit_viewer.py" line="91" />
             <source>write</source>
             <translation>写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="91" />
+            <location filename="../../ui/panels/audit_viewer.py" line="92" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="92" />
+            <location filename="../../ui/panels/audit_viewer.py" line="93" />
             <source>login</source>
             <translation>登录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="93" />
+            <location filename="../../ui/panels/audit_viewer.py" line="94" />
             <source>action</source>
             <translation>操作</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="94" />
+            <location filename="../../ui/panels/audit_viewer.py" line="95" />
             <source>answered</source>
             <translation>已应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <location filename="../../ui/panels/audit_viewer.py" line="99" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="99" />
+            <location filename="../../ui/panels/audit_viewer.py" line="100" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="95" />
+            <location filename="../../ui/panels/audit_viewer.py" line="96" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="96" />
+            <location filename="../../ui/panels/audit_viewer.py" line="97" />
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="97" />
+            <location filename="../../ui/panels/audit_viewer.py" line="98" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
@@ -237,132 +237,152 @@
     <context>
         <name>AuditViewer</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="115" />
+            <location filename="../../ui/panels/audit_viewer.py" line="116" />
             <source>Audit trail</source>
             <translation>审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="125" />
+            <location filename="../../ui/panels/audit_viewer.py" line="126" />
             <source>Any role</source>
             <translation>任意角色</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="127" />
+            <location filename="../../ui/panels/audit_viewer.py" line="128" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="128" />
+            <location filename="../../ui/panels/audit_viewer.py" line="129" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="129" />
+            <location filename="../../ui/panels/audit_viewer.py" line="130" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="130" />
+            <location filename="../../ui/panels/audit_viewer.py" line="131" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="134" />
+            <location filename="../../ui/panels/audit_viewer.py" line="135" />
             <source>Command contains…</source>
             <translation>命令包含…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="136" />
+            <location filename="../../ui/panels/audit_viewer.py" line="137" />
             <source>Any result</source>
             <translation>任意结果</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="143" />
+            <location filename="../../ui/panels/audit_viewer.py" line="144" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="144" />
+            <location filename="../../ui/panels/audit_viewer.py" line="145" />
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="139" />
+            <location filename="../../ui/panels/audit_viewer.py" line="140" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="138" />
+            <location filename="../../ui/panels/audit_viewer.py" line="139" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="140" />
+            <location filename="../../ui/panels/audit_viewer.py" line="141" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="141" />
+            <location filename="../../ui/panels/audit_viewer.py" line="142" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="142" />
+            <location filename="../../ui/panels/audit_viewer.py" line="143" />
             <source>answered</source>
             <translation>已应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="147" />
+            <location filename="../../ui/panels/audit_viewer.py" line="148" />
             <source>Show</source>
             <translation>显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="149" />
+            <location filename="../../ui/panels/audit_viewer.py" line="150" />
             <source>Export CSV…</source>
             <translation>导出 CSV…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="159" />
+            <location filename="../../ui/panels/audit_viewer.py" line="160" />
             <source>From</source>
             <translation>从</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="159" />
+            <location filename="../../ui/panels/audit_viewer.py" line="160" />
             <source>to</source>
             <translation>到</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="192" />
+            <location filename="../../ui/panels/audit_viewer.py" line="193" />
             <source>{n} records</source>
             <translation>{n} 条记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="194" />
+            <location filename="../../ui/panels/audit_viewer.py" line="195" />
             <source>{n} records ({skipped} damaged lines skipped)</source>
             <translation>{n} 条记录（跳过 {skipped} 行损坏的记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="196" />
+            <location filename="../../ui/panels/audit_viewer.py" line="197" />
             <source>{unknown} writes whose answer or outcome was not recorded</source>
             <translation>{unknown} 条写入的应答或结果未记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="202" />
+            <location filename="../../ui/panels/audit_viewer.py" line="209" />
+            <source>The chain of hashes breaks at {file} line {line}: records before it were removed.</source>
+            <translation>哈希链在 {file} 第 {line} 行断开：此前的记录已被删除。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="213" />
+            <source>The chain of hashes breaks at {file} line {line}: the record before it was changed, or records were removed.</source>
+            <translation>哈希链在 {file} 第 {line} 行断开：此前的记录被修改，或有记录被删除。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="218" />
+            <source>{n} breaks in all.</source>
+            <translation>共 {n} 处断开。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="221" />
+            <source>(No chain of hashes: records of an older TeachPad.)</source>
+            <translation>（无哈希链：旧版 TeachPad 的记录。）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/audit_viewer.py" line="226" />
             <source>Export the audit trail</source>
             <translation>导出审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="202" />
+            <location filename="../../ui/panels/audit_viewer.py" line="226" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="215" />
+            <location filename="../../ui/panels/audit_viewer.py" line="239" />
             <source>Cannot write {file}: {why}</source>
             <translation>无法写入 {file}：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="218" />
+            <location filename="../../ui/panels/audit_viewer.py" line="242" />
             <source>{n} records exported to {file}</source>
             <translation>已将 {n} 条记录导出到 {file}</translation>
         </message>

@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.safety.audit import AuditFilter, AuditRecord, ReadStats, Result, export_csv, query, result_label
+from app.safety.audit_chain import verify_chain
 
 DEFAULT_DAYS = 7  # the range shown when the viewer opens
 MAX_ROWS = 20000  # newest rows kept in the table (the CSV export takes the same rows)
@@ -194,8 +195,31 @@ class AuditViewer(QDialog):
             text = self.tr("{n} records ({skipped} damaged lines skipped)")
         if stats.unknown:  # sent, and its answer or the controller's outcome was never recorded
             text += " " + self.tr("{unknown} writes whose answer or outcome was not recorded")
-        self.status.setText(text.format(n=n, skipped=stats.skipped, unknown=stats.unknown))
+        text = text.format(n=n, skipped=stats.skipped, unknown=stats.unknown)
+        self.status.setText(" ".join(filter(None, (text, self._chain_text()))))
         self.table.scrollToBottom()
+
+    def _chain_text(self) -> str:
+        """Where the chain of hashes breaks in the days shown (a record changed or removed)."""
+        report = verify_chain(self.directory, *self.current_filter().days())
+        if report.breaks:
+            first = report.breaks[0]
+            if first.missing:
+                where = self.tr(
+                    "The chain of hashes breaks at {file} line {line}: records before it were removed."
+                )
+            else:
+                where = self.tr(
+                    "The chain of hashes breaks at {file} line {line}: the record before it was changed, or "
+                    "records were removed."
+                )
+            text = where.format(file=first.file, line=first.line)
+            if len(report.breaks) > 1:
+                text += " " + self.tr("{n} breaks in all.").format(n=len(report.breaks))
+            return text
+        if report.records and not report.chained:
+            return self.tr("(No chain of hashes: records of an older TeachPad.)")
+        return ""
 
     def _ask_path(self, suggested: str) -> str | None:
         path, _ = QFileDialog.getSaveFileName(
