@@ -74,21 +74,26 @@ def clean_stale_temp_files(target: str | os.PathLike[str], *, min_age: float | N
     return removed
 
 
-def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
+def atomic_write_bytes(path: str | os.PathLike[str], data: bytes, *, mode: int | None = None) -> None:
     """Replace ``path`` with ``data`` so that a crash leaves the old file or the new, never a mix.
 
     Temp file in the same directory (same filesystem), written in full, fsynced, then
     ``os.replace``; the directory is fsynced afterwards where the OS allows it. On any error
-    the temp file is removed and the old file is untouched. Keeps an existing file's mode.
+    the temp file is removed and the old file is untouched. Keeps an existing file's mode, unless
+    ``mode`` is given (e.g. ``0o600`` for a file with secrets): then the file has that mode from
+    its creation on, before a byte is written (never readable by others, not even for a moment).
     Removes stale temp files of earlier, killed saves of the same target first.
     """
     target = Path(path)
     directory = target.parent
     clean_stale_temp_files(target)
     tmp = temp_name(target)
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
+    fd = os.open(tmp, flags, 0o666 if mode is None else mode)
     try:
         try:
+            if mode is not None and hasattr(os, "fchmod"):
+                os.fchmod(fd, mode)  # exactly this mode, whatever the umask
             view = memoryview(data)
             while view:
                 written = os.write(fd, view)
@@ -96,8 +101,9 @@ def atomic_write_bytes(path: str | os.PathLike[str], data: bytes) -> None:
             os.fsync(fd)
         finally:
             os.close(fd)
-        with contextlib.suppress(FileNotFoundError):
-            os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode))
+        if mode is None:
+            with contextlib.suppress(FileNotFoundError):
+                os.chmod(tmp, stat.S_IMODE(os.stat(target).st_mode))
         os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(OSError):

@@ -2,14 +2,17 @@
 
 Contents (each only when given): ``versions.json`` (Python, the platform, TeachPad, pymodbus,
 PySide6 and pyqtgraph when installed, numpy), ``settings.json`` (passwords, hashes, salts,
-secrets and tokens removed: see :func:`redact`), ``project/<file>``, ``safety-profile.json``,
+secrets and tokens removed by key name and by value: see :func:`redact`), ``project/<file>``,
+``safety-profile.json``,
 ``register-profile.json`` (word order, unit id, completion rule... in force), ``audit/`` (the
 audit files of the last ``days`` days), ``events.txt`` (the event log's lines),
 ``logs/`` (files of a log directory changed in the last ``days`` days), ``traffic.txt`` (recent
 Modbus traffic), and ``manifest.json`` listing what is inside and what was left out, and why.
 
-The role store (password hashes) is never included, whatever is passed. The zip is written
-atomically (:func:`app.points.atomic.atomic_write_bytes`).
+The role store (password hashes) is never included, whatever is passed. Logs, events and traffic
+are redacted by value too (:func:`redact_text`); the audit files and the project go as they are
+(the audit's chain of hashes must stay checkable). The zip is written atomically
+(:func:`app.points.atomic.atomic_write_bytes`), owner-only (0600) from its creation on.
 """
 
 from __future__ import annotations
@@ -36,8 +39,34 @@ from app.safety.roles import STORE_FORMAT
 
 DEFAULT_DAYS = 7
 MAX_FILE_BYTES = 64 * 1024 * 1024  # a single file larger than this is left out (and said so)
-_SECRET_KEY = re.compile(r"pass(word)?|pwd|hash|salt|secret|token|credential|api[_-]?key", re.IGNORECASE)
+_SECRET_WORDS = (
+    r"pass(?:word|wd|phrase)?|pwd|hash|salt|secret|token|credential|api[_-]?key|private[_-]?key"
+    r"|auth(?!ors?(?![a-z]))|cookie|licen[cs]e|session[_-]?id|(?<![a-z])pin(?:code)?(?![a-z])"
+)
+_SECRET_KEY = re.compile(_SECRET_WORDS, re.IGNORECASE)
 REMOVED = "<removed>"
+# Secrets found by their value, wherever they are (settings values, log lines, events, traffic):
+_VALUE_PATTERNS = (
+    # user:password@ of a URL (http://user:pw@host, mqtt://token@host ...)
+    (re.compile(r"\b([a-z][a-z0-9+.-]*://)[^/\s@\"']+@", re.IGNORECASE), rf"\1{REMOVED}@"),
+    # a PEM private key, whole
+    (
+        re.compile(r"-----BEGIN [A-Z ]*PRIVATE KEY-----.*?(?:-----END [A-Z ]*PRIVATE KEY-----|$)", re.DOTALL),
+        REMOVED,
+    ),
+    # the credentials of an HTTP Authorization header
+    (re.compile(r"\b(Bearer|Basic|Digest|Token)\s+[A-Za-z0-9._~+/=-]{6,}", re.IGNORECASE), rf"\1 {REMOVED}"),
+    # a Cookie / Set-Cookie header: all of its line
+    (re.compile(r"\b((?:set-)?cookie\s*:\s*)[^\r\n]+", re.IGNORECASE), rf"\1{REMOVED}"),
+    # key=value, key: value, "key": "value" with a key named like a secret
+    (
+        re.compile(
+            rf"""(?P<key>[\w.-]*(?:{_SECRET_WORDS})[\w.-]*["']?\s*[:=]\s*["']?)(?P<value>[^\s"',;&]+)""",
+            re.IGNORECASE,
+        ),
+        rf"\g<key>{REMOVED}",
+    ),
+)
 _DISTRIBUTIONS = ("pymodbus", "PySide6-Essentials", "PySide6", "pyqtgraph", "numpy", "pyserial")
 
 
@@ -65,12 +94,23 @@ def versions() -> dict[str, str]:
 
 
 def redact(value: Any) -> Any:
-    """A copy of a settings tree without anything that may be a secret (by key name)."""
+    """A copy of a settings tree without anything that may be a secret: by key name (passwords,
+    tokens, keys, auth, PINs, licences, cookies ...) and by value (:func:`redact_text`)."""
     if isinstance(value, Mapping):
         return {str(k): (REMOVED if _SECRET_KEY.search(str(k)) else redact(v)) for k, v in value.items()}
     if isinstance(value, list | tuple):
         return [redact(v) for v in value]
+    if isinstance(value, str):
+        return redact_text(value)
     return value
+
+
+def redact_text(text: str) -> str:
+    """``text`` without the secrets found by their value: a URL's credentials, a private key, an
+    Authorization header's credentials, ``key=value`` where the key is named like a secret."""
+    for pattern, replacement in _VALUE_PATTERNS:
+        text = pattern.sub(replacement, text)
+    return text
 
 
 def _is_role_store(data: bytes) -> bool:
@@ -83,10 +123,11 @@ class _Writer:
         self.manifest = manifest
 
     def text(self, name: str, text: str) -> None:
-        self.zf.writestr(name, text.encode("utf-8"))
+        self.zf.writestr(name, redact_text(text).encode("utf-8"))
         self.manifest.files.append(name)
 
-    def file(self, name: str, path: Path) -> None:
+    def file(self, name: str, path: Path, *, redacted: bool = False) -> None:
+        """``path`` as it is (``redacted``: a text file, secrets removed by value: logs)."""
         try:
             size = path.stat().st_size
             if size > MAX_FILE_BYTES:
@@ -99,6 +140,8 @@ class _Writer:
         if _is_role_store(data):
             self.manifest.left_out.append(f"{path.name}: the role store (password hashes) is never included")
             return
+        if redacted:
+            data = redact_text(data.decode("utf-8", errors="replace")).encode("utf-8")
         self.zf.writestr(name, data)
         self.manifest.files.append(name)
 
@@ -147,7 +190,7 @@ def build_support_bundle(
             cutoff = (now - dt.timedelta(days=days)).timestamp()
             for path in sorted(p for p in log_dir.iterdir() if p.is_file()) if log_dir.is_dir() else []:
                 if path.stat().st_mtime >= cutoff:
-                    w.file(f"logs/{path.name}", path)
+                    w.file(f"logs/{path.name}", path, redacted=True)
         if traffic is not None:
             w.text("traffic.txt", "".join(line.rstrip("\n") + "\n" for line in traffic))
         manifest.files.append("manifest.json")
@@ -174,5 +217,5 @@ def write_support_bundle(out: str | os.PathLike[str], **kwargs: Any) -> BundleMa
     target = Path(out)
     if target.parent and not target.parent.is_dir():
         raise InvalidInput(f"the folder {str(target.parent)[:60]} does not exist")
-    atomic_write_bytes(target, data)
+    atomic_write_bytes(target, data, mode=0o600)  # owner-only: it holds the site's settings and logs
     return manifest

@@ -18,7 +18,6 @@ activity, the session falls back to operator.
 
 from __future__ import annotations
 
-import contextlib
 import enum
 import json
 import os
@@ -237,9 +236,8 @@ class RoleStore:
             "passwords": {role.text: h.to_dict() for role, h in sorted(self._hashes.items())},
         }
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        atomic_write_bytes(self.path, (json.dumps(doc, indent=2) + "\n").encode("utf-8"))
-        with contextlib.suppress(OSError):
-            os.chmod(self.path, 0o600)
+        # owner-only from its creation on (not chmod-ed after: readable by others meanwhile)
+        atomic_write_bytes(self.path, (json.dumps(doc, indent=2) + "\n").encode("utf-8"), mode=0o600)
 
     def has_password(self, role: Role) -> bool:
         return role in self._hashes

@@ -47,10 +47,10 @@ def test_a_full_disk_refuses_the_write_too(
 ) -> None:
     monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path))
 
-    def full(fd: int, data: Any) -> int:
+    def full(self: audit.AuditLog, rec: Any, now: Any) -> Any:
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(audit.os, "write", full)
+    monkeypatch.setattr(audit.AuditLog, "_append", full)
     code, _, err = run(sim, capsys, "write", "10", "1.5")
     assert code == ExitCode.FAILED and "No space left on device" in err
     assert not [w for w in sim.writes if w.address == registers.gv_reg(10)]

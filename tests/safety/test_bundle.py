@@ -28,11 +28,12 @@ def files(tmp_path: Path) -> dict[str, Path]:
     store = RoleStore(tmp_path / "roles.json", scrypt_n=2**8)
     store.set_password(Role.ADMINISTRATOR, PASSWORD, by=Role.ADMINISTRATOR)
     audit_dir = tmp_path / "audit"
-    with AuditLog(audit_dir, role="engineer") as log:
-        log.record_write(440, [0x80], single=True)
-    # (written second: a log opening a file prunes days older than keep_days before its "now")
+    # (written first: a writer never goes back to an older day's file than the newest on disk, and
+    # files are pruned by the count of days on disk, not by the clock)
     with AuditLog(audit_dir, now=lambda: dt.datetime(2020, 1, 1, 12, 0).astimezone()) as old:
         old.record("action", "long ago")
+    with AuditLog(audit_dir, role="engineer") as log:
+        log.record_write(440, [0x80], single=True)
     logs = tmp_path / "logs"
     logs.mkdir()
     (logs / "teachpad.log").write_text("connected\n")
