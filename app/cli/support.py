@@ -2,7 +2,9 @@
 
 None talks to the controller. ``roles`` lets an administrator set or clear the engineer's and
 administrator's passwords (read from the terminal, or one line of stdin; never an argument,
-so they stay out of the shell history) and see which are set. ``support-bundle`` writes the zip of
+so they stay out of the shell history) and see which are set; once the administrator has a
+password, a change needs it (asked for, or ``TEACHPAD_ADMIN_PASSWORD``) and every change and
+refusal is audited, as in the GUI. ``support-bundle`` writes the zip of
 :mod:`app.safety.bundle` (versions, the CLI's connection settings plus an optional settings
 file with secrets removed, the project, the safety profile, the audit trail of the last days,
 log files, recorded traffic). ``audit`` prints or exports the audit trail, filtered, and says how
@@ -11,13 +13,14 @@ the controller's outcome was never recorded, or the controller's outcome could n
 
 teachpad-cli is an administrator's tool: whoever has a shell on the pendant PC can read and
 write every file TeachPad keeps, so a ``--role`` switch would protect nothing. Roles guard the
-GUI.
+GUI; the role store itself is guarded by the administrator's password here too.
 """
 
 from __future__ import annotations
 
 import getpass
 import json
+import os
 import sys
 from pathlib import Path
 from typing import Any
@@ -28,7 +31,9 @@ from app.cli.format import parse_moment, parse_positive_int
 from app.errors import InvalidInput
 from app.safety.audit import (
     AuditFilter,
+    AuditLog,
     AuditRecord,
+    FsyncPolicy,
     ReadStats,
     Result,
     default_audit_dir,
@@ -38,7 +43,7 @@ from app.safety.audit import (
 )
 from app.safety.audit_chain import verify_chain
 from app.safety.bundle import DEFAULT_DAYS, write_support_bundle
-from app.safety.roles import Role, RoleStore, default_store_path
+from app.safety.roles import Role, RoleStore, WrongPassword, default_store_path
 
 #: What ``audit --result`` filters by: a command's outcome (done, refused, stopped, unknown), a
 #: plain write's answer (ok, failed), blocked (``pending`` exists only inside the file).
@@ -55,6 +60,14 @@ AUDIT_RESULTS = (
 ADMIN_NOTE = (
     "teachpad-cli is an administrator's tool: it is not limited by TeachPad's roles "
     "(anyone with a shell can read and write TeachPad's files)."
+)
+
+ADMIN_PASSWORD_ENV = "TEACHPAD_ADMIN_PASSWORD"
+ROLES_NOTE = (
+    "Once the administrator has a password, changing the role store needs it: asked for in a "
+    f"terminal, or taken from the environment variable {ADMIN_PASSWORD_ENV} (scripts). Every "
+    "change, and every refusal, is recorded in the audit trail (never a password). The "
+    "administrator's own password can be changed, not removed (anyone could then set a new one)."
 )
 
 
@@ -120,9 +133,15 @@ def register(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "roles",
         help="set or clear the GUI's role passwords (offline)",
-        description="Passwords of TeachPad's roles. " + ADMIN_NOTE,
+        description="Passwords of TeachPad's roles. " + ADMIN_NOTE + " " + ROLES_NOTE,
     )
     p.add_argument("--store", type=Path, help=f"the role store (default {default_store_path()})")
+    p.add_argument(
+        "--audit-dir",
+        type=Path,
+        help=f"where the change is audited (default {default_audit_dir()}; with --store: the audit "
+        "folder beside it)",
+    )
     rsub = p.add_subparsers(dest="roles_command", metavar="ACTION", required=True)
     r = rsub.add_parser("show", help="which roles have a password, and the idle time")
     r.set_defaults(handler=cmd_roles)
@@ -232,6 +251,48 @@ def _read_password() -> str:
     return sys.stdin.readline().rstrip("\r\n")
 
 
+def _admin_password() -> str | None:
+    """The administrator's password for a change: the environment variable, else asked for in a
+    terminal; None: neither (a script without the variable)."""
+    given = os.environ.get(ADMIN_PASSWORD_ENV)
+    if given is not None:
+        return given
+    if sys.stdin.isatty():
+        return getpass.getpass("administrator password: ")
+    return None
+
+
+def _roles_audit(args: Any) -> AuditLog:
+    directory = args.audit_dir or (default_audit_dir() if args.store is None else args.store.parent / "audit")
+    return AuditLog(directory, role="administrator (cli)", fsync=FsyncPolicy.ALWAYS)
+
+
+def _change_roles(store: RoleStore, role: Role, action: str, audit: AuditLog) -> None:
+    """Change the role store as :class:`app.safety.session.SafetySession` does in the GUI: the
+    administrator's password first (when one is set), audited either way."""
+    what = f"{'clear' if action == 'clear-password' else 'set'} the {role.text} password"
+    if store.has_password(Role.ADMINISTRATOR):
+        password = _admin_password()
+        if password is None:
+            why = f"the administrator password is needed: run it in a terminal, or set {ADMIN_PASSWORD_ENV}"
+            audit.record_refused(what, why)
+            raise WrongPassword(f"{what}: not done; {why}")
+        if not store.verify(Role.ADMINISTRATOR, password):
+            audit.record_refused(what, "wrong administrator password")
+            raise WrongPassword(f"{what}: not done; wrong administrator password")
+    if action == "clear-password":
+        if role is Role.ADMINISTRATOR:
+            why = "the administrator password can be changed, not removed (anyone could then set it)"
+            audit.record_refused(what, why)
+            raise InvalidInput(f"{what}: not done; {why}")
+        store.clear_password(role, by=Role.ADMINISTRATOR)
+        audit.record("action", what)
+        return
+    changed = store.has_password(role)
+    store.set_password(role, _read_password(), by=Role.ADMINISTRATOR)
+    audit.record("action", f"{'change' if changed else 'set'} the {role.text} password")
+
+
 def cmd_roles(ctx: CliContext) -> ExitCode:
     args = ctx.args
     store = RoleStore(args.store or default_store_path())
@@ -241,10 +302,10 @@ def cmd_roles(ctx: CliContext) -> ExitCode:
         ctx.print(f"idle lock     {store.idle_timeout:g} s")
         return ExitCode.OK
     role = Role.parse(args.role)
-    if args.roles_command == "clear-password":
-        store.clear_password(role, by=Role.ADMINISTRATOR)
-        ctx.print(f"password of the {role.text} role removed")
-        return ExitCode.OK
-    store.set_password(role, _read_password(), by=Role.ADMINISTRATOR)
-    ctx.print(f"password of the {role.text} role set")
+    with _roles_audit(args) as audit:
+        _change_roles(store, role, args.roles_command, audit)
+        if audit.last_error is not None:
+            ctx.warn(f"the change is not in the audit trail: {audit.last_error}")
+    done = "removed" if args.roles_command == "clear-password" else "set"
+    ctx.print(f"password of the {role.text} role {done}")
     return ExitCode.OK
