@@ -49,7 +49,6 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -258,7 +257,7 @@ class AuditLog:
             )
             self._seq += 1
             try:
-                rec = self._append(rec, now)
+                self._append(rec, now)
             except OSError as exc:
                 self._failed(exc)
             else:
@@ -379,11 +378,13 @@ class AuditLog:
             self._fd = None
             self._unsynced = False
 
-    def _append(self, rec: AuditRecord, now: dt.datetime) -> AuditRecord:
-        """Append ``rec`` chained to the record before it (returned with its ``prev``)."""
+    def _append(self, rec: AuditRecord, now: dt.datetime) -> None:
+        """Append ``rec``'s line chained to the record before it: the line ends with ``prev`` (the
+        record object stays without it; one JSON encoding per record, spliced: this is the hot path)."""
         # a clock stepped back keeps writing to the day's file it was at (never back to an older one)
         day = max(now.date().isoformat(), self._day)
-        need = len(rec.to_line()) + _PREV_CHARS
+        body = rec.to_line()  # ends with b"}\n"; AuditRecord.to_line puts "prev" last, the same way
+        need = len(body) + _PREV_CHARS
         if self._fd is None or day != self._day or self._size + need > self.max_file_bytes:
             self._open_for(day, need)
         assert self._fd is not None and self._path is not None
@@ -392,15 +393,13 @@ class AuditLog:
             if size != self._size:  # it did: chain to its last record
                 self._prev = last_line_hash(self._path) or self._prev
                 self._size = size
-            rec = replace(rec, prev=self._prev or "")
-            line = rec.to_line()
+            line = b'%s,"prev":"%s"}\n' % (body[:-2], (self._prev or "").encode("ascii"))
             view = memoryview(line)
             while view:
                 view = view[os.write(self._fd, view) :]
         self._prev = line_hash(line)
         self._size += len(line)
         self._sync()
-        return rec
 
     def _sync(self) -> None:
         assert self._fd is not None

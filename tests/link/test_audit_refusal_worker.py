@@ -35,7 +35,7 @@ def test_the_gui_link_refuses_a_write_it_cannot_record(
     link.set_audit(audit)  # (before connecting: the worker has it for every write that follows)
     connect(qtbot, link, sim, poll_timeout=1.0)
 
-    def full(rec: AuditRecord, now: dt.datetime) -> AuditRecord:
+    def full(rec: AuditRecord, now: dt.datetime) -> None:
         raise OSError(errno.ENOSPC, "No space left on device")
 
     audit._append = full  # type: ignore[method-assign]  # the disk is full from now on
