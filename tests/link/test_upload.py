@@ -261,6 +261,7 @@ _LINK_FAILED_BY_CODE = {
     "connect_timeout": True,
     "connection_refused": True,
     "host_unresolved": True,
+    "host_invalid": True,
     "serial_open_failed": True,
     "no_answer": True,  # ResponseTimeout: no answer in time
     "malformed_answer": True,  # the byte stream may be out of step: only a new connection is trusted
