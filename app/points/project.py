@@ -77,7 +77,14 @@ from app.points.point import (
     shown,
 )
 from app.points.project_model import HISTORY_TEXT_MAX, Project, UploadRecord, now_iso
-from app.points.project_write import FORMAT_NAME, FORMAT_VERSION, project_to_dict, project_to_json
+from app.points.project_write import (
+    FORMAT_NAME,
+    FORMAT_VERSION,
+    ProjectTooLarge,
+    project_bytes,
+    project_to_dict,
+    project_to_json,
+)
 
 PROJECT_SUFFIX = ".teachpad.json"
 
@@ -89,6 +96,7 @@ __all__ = [
     "PROJECT_SUFFIX",
     "FileFormatError",
     "Project",
+    "ProjectTooLarge",
     "UploadRecord",
     "atomic_write_bytes",
     "autosave_path",
@@ -97,6 +105,7 @@ __all__ = [
     "find_autosave",
     "load_project",
     "parse_project",
+    "project_bytes",
     "project_from_dict",
     "project_to_dict",
     "project_to_json",
@@ -409,10 +418,11 @@ def load_project(path: str | os.PathLike[str], limits: PointLimits = DEFAULT_LIM
 
 
 def save_project(project: Project, path: str | os.PathLike[str], *, touch: bool = True) -> None:
-    """Write the project atomically; sets ``modified`` (unless ``touch`` is False)."""
+    """Write the project atomically; sets ``modified`` (unless ``touch`` is False).
+    :class:`ProjectTooLarge` (nothing written) when TeachPad could not open the file again."""
     if touch:
         project.modified = now_iso()
-    atomic_write_bytes(path, project_to_json(project).encode("utf-8"))
+    atomic_write_bytes(path, project_bytes(project))
 
 
 # --- CSV files ----------------------------------------------------------------------------------
