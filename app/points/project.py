@@ -285,6 +285,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
 
     raw_plans = _expect(doc.get("plans", []), list, top, "plans", "plans")
     plans: list[Plan] = []
+    plan_names: set[str] = set()  # the names so far: a linear check, not pairwise
     for i, raw in enumerate(raw_plans):
         where = (f"plans[{i}]", Reason("place_plan", {"index": i}))
         obj = _expect(raw, dict, where, "", "object")
@@ -294,7 +295,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
         except FieldError as exc:
             raise _refuse(exc.reason, _field_problem(exc), where, exc.field) from None
         where = (f"plans[{i}] ({plan_name!r})", Reason("place_plan_named", {"index": i, "name": plan_name}))
-        if plan_name in (p.name for p in plans):
+        if plan_name in plan_names:
             raise _refuse(
                 f"another plan is named {plan_name!r}",
                 Reason("plan_name_taken", {"name": plan_name}),
@@ -311,6 +312,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
             seg = _expect(raw_seg, dict, seg_where, "", "object")
             segments.append(_segment_from_dict(seg, seg_where))
         plans.append(Plan(plan_name, segments, loops))
+        plan_names.add(plan_name)
 
     return Project(
         name=name,
