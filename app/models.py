@@ -62,6 +62,7 @@ LINK_FAILURE_CODES = frozenset(
         "connect_timeout",
         "connection_refused",
         "host_unresolved",
+        "host_invalid",
         "serial_open_failed",
         "no_answer",
         "malformed_answer",

@@ -37,6 +37,15 @@ STOP_SETTLE = 0.3  # s a moved command must read 'stopped' with GV291 = 0 before
 # command's own time runs), then its outcome is "unknown" (app/link/command_client.py follow).
 OUTCOME_READ_BUDGET = 2.0
 OUTCOME_READ_RETRY = 0.05
+# Modbus exception 6 (server device busy) means "try again later". A write that is safe to repeat
+# (an upload's point: re-creating the same point at the same pose is idempotent; never a move) is
+# tried again after BUSY_BACKOFF_FIRST, doubling up to BUSY_BACKOFF_CAP, for at most
+# BUSY_RETRY_BUDGET s from the first busy answer of that point (app/link/busy.py); then it fails
+# as refused "busy". The wait is cut in BUSY_BACKOFF_SLICE pieces so a Stop never waits for it.
+BUSY_BACKOFF_FIRST = 0.05
+BUSY_BACKOFF_CAP = 0.5
+BUSY_RETRY_BUDGET = 5.0
+BUSY_BACKOFF_SLICE = 0.02
 
 # Worker (GUI side).
 POLL_HZ_DEFAULT = 50

@@ -157,6 +157,7 @@ _TEMPLATES: dict[str, str] = {
     "link_lost": QT_TRANSLATE_NOOP("Messages", "Lost the connection to the controller at {endpoint}."),
     "link_closed": QT_TRANSLATE_NOOP("Messages", "The controller at {endpoint} closed the connection."),
     "host_unresolved": QT_TRANSLATE_NOOP("Messages", "The host name {host} cannot be resolved."),
+    "host_invalid": QT_TRANSLATE_NOOP("Messages", "The host name {host} is not valid: check it in Connect…"),
     "connection_refused": QT_TRANSLATE_NOOP(
         "Messages", "Connection refused: nothing listens on port {port}."
     ),
@@ -248,6 +249,7 @@ _BARE: dict[str, str] = {
     "malformed_answer": QT_TRANSLATE_NOOP("Messages", "Malformed answer from the controller."),
     "serial_open_failed": QT_TRANSLATE_NOOP("Messages", "Cannot open the serial port."),
     "host_unresolved": QT_TRANSLATE_NOOP("Messages", "The host name cannot be resolved."),
+    "host_invalid": QT_TRANSLATE_NOOP("Messages", "The host name is not valid."),
     "connect_timeout": QT_TRANSLATE_NOOP("Messages", "No answer to the connection request."),
     "command_timeout": QT_TRANSLATE_NOOP("Messages", "{command} did not finish in time."),
     "not_acknowledged": QT_TRANSLATE_NOOP("Messages", "{command}: the controller did not acknowledge it."),

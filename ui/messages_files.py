@@ -55,6 +55,10 @@ FILE_TEMPLATES: dict[str, str] = {
     "not_csv": QT_TRANSLATE_NOOP("Messages", "not valid CSV (a quote is not closed, or a stray character)"),
     # a file that cannot be read at all (app/points/atomic.py read_limited), or an OSError's errno
     "file_too_large": QT_TRANSLATE_NOOP("Messages", "the file is too large ({size} bytes, at most {limit})"),
+    "project_too_large": QT_TRANSLATE_NOOP(
+        "Messages",
+        "The project would be {size} bytes, more than TeachPad opens ({limit} bytes): nothing was changed or written.",
+    ),
     "no_such_file": QT_TRANSLATE_NOOP("Messages", "the file does not exist"),
     "is_a_directory": QT_TRANSLATE_NOOP("Messages", "is a folder, not a file"),
     "permission_denied": QT_TRANSLATE_NOOP("Messages", "permission denied"),

@@ -40,7 +40,14 @@ from app.errors import InvalidInput, TeachPadError
 from app.points.ledger import EmptyImport, ImportMode, PointLedger
 from app.points.lock import live_owner
 from app.points.point import FileFormatError, PointLimits, TempPoint, tool_text
-from app.points.project import Project, load_project, read_points_csv, save_project, write_points_csv
+from app.points.project import (
+    Project,
+    ProjectTooLarge,
+    load_project,
+    read_points_csv,
+    save_project,
+    write_points_csv,
+)
 from app.points.upload import UploadReport, apply_upload, parse_id_list
 
 # The table's members under the names callers imported before the table existed.
@@ -173,6 +180,9 @@ def _save(ctx: CliContext, project: Project, path: Path) -> bool:
         return False
     try:
         save_project(project, path)
+    except ProjectTooLarge as exc:  # refused before the write: never a file TeachPad cannot open
+        ctx.error(f"{path}: not saved: {exc}")
+        return False
     except OSError as exc:
         ctx.error(f"{path}: could not save: {exc}")
         return False

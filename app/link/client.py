@@ -46,6 +46,7 @@ from app.errors import (
     ResponseTimeout,
     TeachPadError,
 )
+from app.link.busy import BusyBackoff, is_busy, retry_busy
 from app.link.checks import check_enum, check_float, check_floats, check_int, check_tool
 from app.link.command_client import CommandClient
 from app.link.outcome import outcome_note
@@ -397,8 +398,9 @@ class RobotClient(CommandClient):
             results = []
         if not items or (halted is not None and halted()):
             return results
-        status, _ = self._prepare(RunCommand.CREATE_POINT)
-        self._write_tool(tool)
+        backoff = BusyBackoff(halted, between)  # busy before the first point: the status read, GV245
+        status, _ = retry_busy(lambda: self._prepare(RunCommand.CREATE_POINT), backoff)
+        retry_busy(lambda: self._write_tool(tool), backoff)
         kind = CommandKind.CREATE_POINT
         total = len(items)
         staged = -1  # the index of the item whose pose is already in its block
@@ -413,30 +415,32 @@ class RobotClient(CommandClient):
 
             def stage_next(nxt: int = index + 1) -> None:
                 nonlocal staged, spare
-                if halted is not None and halted():
-                    return  # a stop or cancel is pending: the next point will not be created
+                if staged == nxt or (halted is not None and halted()):
+                    return  # staged already (a busy retry); a stop or cancel is pending
                 try:
                     self._write_floats(block_of(nxt), items[nxt][1])
-                except ModbusExceptionError:
-                    # the spare GVs are refused: the point in flight goes on, and the next poses go
-                    # into the first block, each after the previous result (the unstaged way)
-                    spare = None
+                except ModbusExceptionError as exc:
+                    # busy: staged after the result instead. Refused: the point in flight goes on,
+                    # and the next poses go into the first block, each after the previous result
+                    # (the unstaged way)
+                    if not is_busy(exc):
+                        spare = None
                 else:
                     staged = nxt
 
             meanwhile = stage_next if spare is not None and index + 1 < total else None
-            tracker: CommandTracker | None = None
             try:
-                if staged != index:
-                    self._write_floats(block, values)
-                self._write_floats(registers.GV_PARAM0, [float(point_id), 1.0, float(block)])
-                self._sent_points[point_id] = (values[0], values[1], values[2])
-                tracker = self.begin_command(RunCommand.CREATE_POINT, status, None)
-                result = self.wait(tracker, raise_errors=False, meanwhile=meanwhile, between=between)
-                status = tracker.last_status or status
+                result, status = self._create_one(
+                    point_id,
+                    values,
+                    block,
+                    status,
+                    write_pose=staged != index,
+                    meanwhile=meanwhile,
+                    between=between,
+                    backoff=BusyBackoff(halted, between),
+                )
             except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
-                if tracker is not None:  # its command was answered: what it did is not known
-                    tracker.unknown(time.monotonic(), exc)
                 results.append(
                     CommandResult(
                         RunCommand.CREATE_POINT,
@@ -456,6 +460,42 @@ class RobotClient(CommandClient):
             if progress is not None and progress(index + 1, total) is False:
                 break
         return results
+
+    def _create_one(
+        self,
+        point_id: int,
+        values: Sequence[float],
+        block: int,
+        status: ControllerStatus,
+        *,
+        write_pose: bool,
+        meanwhile: Callable[[], None] | None,
+        between: Callable[[], None] | None,
+        backoff: BusyBackoff,
+    ) -> tuple[CommandResult, ControllerStatus]:
+        """One point of :meth:`upload_points`: its pose (unless staged), GV200-202, 440 and the status
+        reads to its result; the result and the last status read. A *busy* answer to any of them
+        (Modbus exception 6) sends the whole point again after ``backoff``'s pause, within its
+        budget (the same point at the same pose: idempotent); any other error is raised."""
+        while True:
+            tracker: CommandTracker | None = None
+            try:
+                if write_pose:
+                    self._write_floats(block, values)
+                self._write_floats(registers.GV_PARAM0, [float(point_id), 1.0, float(block)])
+                self._sent_points[point_id] = (values[0], values[1], values[2])
+                tracker = self.begin_command(RunCommand.CREATE_POINT, status, None)
+                result = self.wait(tracker, raise_errors=False, meanwhile=meanwhile, between=between)
+                return result, tracker.last_status or status
+            except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
+                if tracker is not None:  # its command was answered: what it did is not known
+                    tracker.unknown(time.monotonic(), exc)
+                if not backoff.may_retry(exc):
+                    raise
+                busy = exc
+            if not backoff.pause():  # a stop or cancel came meanwhile: no retry
+                raise busy
+            write_pose = True  # the pose again too: the point is sent whole
 
     @staticmethod
     def _stage_block(gv_start: int, stage_gv: int | None) -> int:

@@ -11,6 +11,7 @@ import socket
 from typing import TYPE_CHECKING, Any
 
 from app.errors import LinkError
+from app.link.hostname import host_problem_text
 
 if TYPE_CHECKING:
     from app.link.transport import ConnectionSettings
@@ -45,9 +46,16 @@ class TcpStream:
 
     def open(self, timeout: float) -> None:
         s = self._settings
+        problem = host_problem_text(s.host)
+        if problem is not None:  # a typo: said as such, never handed to the resolver
+            raise LinkError(
+                f"the host name {s.host[:60]!r} is not valid: {problem}",
+                code="host_invalid",
+                params={"host": s.host[:60]},
+            )
         try:
             sock = socket.create_connection((s.host, s.port), timeout=timeout)
-        except socket.gaierror:
+        except (socket.gaierror, UnicodeError):  # UnicodeError: the IDNA codec refused the name
             raise LinkError(
                 f"the host name {s.host[:60]!r} cannot be resolved",
                 code="host_unresolved",

@@ -125,8 +125,10 @@ def _fsync_dir(directory: Path) -> None:
             os.close(dfd)
 
 
-def read_limited(path: Path, limit: int = MAX_FILE_BYTES) -> bytes:
-    """The file's bytes; :class:`FileFormatError` for a missing, too large or unreadable file."""
+def read_limited(path: Path, limit: int | None = None) -> bytes:
+    """The file's bytes; :class:`FileFormatError` for a missing, too large or unreadable file
+    (``limit``: :data:`MAX_FILE_BYTES` as it is now)."""
+    limit = MAX_FILE_BYTES if limit is None else limit
     try:
         size = path.stat().st_size
         if size > limit:

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from app.points.atomic import atomic_write_bytes
-from app.points.project import Project, project_to_json
+from app.points.project import Project, project_bytes
 
 AUTOSAVE_SUFFIX = ".autosave.json"
 
@@ -43,10 +43,12 @@ def autosave_path(project_path: str | os.PathLike[str] | None, *, user_dir: Path
 def save_autosave(
     project: Project, project_path: str | os.PathLike[str] | None, *, user_dir: Path | None = None
 ) -> Path:
-    """Write the autosave (atomically; ``modified`` untouched); returns its path."""
+    """Write the autosave (atomically; ``modified`` untouched); returns its path.
+    :class:`~app.points.project.ProjectTooLarge` (nothing written) when it could not be read back."""
+    data = project_bytes(project)
     target = autosave_path(project_path, user_dir=user_dir)
     target.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(target, project_to_json(project).encode("utf-8"))
+    atomic_write_bytes(target, data)
     return target
 
 

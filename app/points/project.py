@@ -77,7 +77,14 @@ from app.points.point import (
     shown,
 )
 from app.points.project_model import HISTORY_TEXT_MAX, Project, UploadRecord, now_iso
-from app.points.project_write import FORMAT_NAME, FORMAT_VERSION, project_to_dict, project_to_json
+from app.points.project_write import (
+    FORMAT_NAME,
+    FORMAT_VERSION,
+    ProjectTooLarge,
+    project_bytes,
+    project_to_dict,
+    project_to_json,
+)
 
 PROJECT_SUFFIX = ".teachpad.json"
 
@@ -89,6 +96,7 @@ __all__ = [
     "PROJECT_SUFFIX",
     "FileFormatError",
     "Project",
+    "ProjectTooLarge",
     "UploadRecord",
     "atomic_write_bytes",
     "autosave_path",
@@ -97,6 +105,7 @@ __all__ = [
     "find_autosave",
     "load_project",
     "parse_project",
+    "project_bytes",
     "project_from_dict",
     "project_to_dict",
     "project_to_json",
@@ -276,6 +285,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
 
     raw_plans = _expect(doc.get("plans", []), list, top, "plans", "plans")
     plans: list[Plan] = []
+    plan_names: set[str] = set()  # the names so far: a linear check, not pairwise
     for i, raw in enumerate(raw_plans):
         where = (f"plans[{i}]", Reason("place_plan", {"index": i}))
         obj = _expect(raw, dict, where, "", "object")
@@ -285,7 +295,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
         except FieldError as exc:
             raise _refuse(exc.reason, _field_problem(exc), where, exc.field) from None
         where = (f"plans[{i}] ({plan_name!r})", Reason("place_plan_named", {"index": i, "name": plan_name}))
-        if plan_name in (p.name for p in plans):
+        if plan_name in plan_names:
             raise _refuse(
                 f"another plan is named {plan_name!r}",
                 Reason("plan_name_taken", {"name": plan_name}),
@@ -302,6 +312,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
             seg = _expect(raw_seg, dict, seg_where, "", "object")
             segments.append(_segment_from_dict(seg, seg_where))
         plans.append(Plan(plan_name, segments, loops))
+        plan_names.add(plan_name)
 
     return Project(
         name=name,
@@ -409,10 +420,11 @@ def load_project(path: str | os.PathLike[str], limits: PointLimits = DEFAULT_LIM
 
 
 def save_project(project: Project, path: str | os.PathLike[str], *, touch: bool = True) -> None:
-    """Write the project atomically; sets ``modified`` (unless ``touch`` is False)."""
+    """Write the project atomically; sets ``modified`` (unless ``touch`` is False).
+    :class:`ProjectTooLarge` (nothing written) when TeachPad could not open the file again."""
     if touch:
         project.modified = now_iso()
-    atomic_write_bytes(path, project_to_json(project).encode("utf-8"))
+    atomic_write_bytes(path, project_bytes(project))
 
 
 # --- CSV files ----------------------------------------------------------------------------------

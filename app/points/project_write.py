@@ -9,7 +9,9 @@ from __future__ import annotations
 import json
 from typing import Any
 
+from app.errors import InvalidInput
 from app.plan.segments import Segment
+from app.points import atomic
 from app.points.point import EXT_FIELDS, POSE_FIELDS, TempPoint
 from app.points.project_model import Project, UploadRecord
 
@@ -82,3 +84,29 @@ def project_to_json(project: Project) -> str:
         plans.append(f'{{{head}, "segments": {segments}}}')
     lines.append(f'  "plans": {_json_list(plans, "  ")}')
     return "{\n" + ",\n".join(lines) + "\n}\n"
+
+
+class ProjectTooLarge(InvalidInput):
+    """The project's file would exceed what TeachPad reads back (:data:`app.points.atomic.MAX_FILE_BYTES`):
+    it is not written -- never a file TeachPad then refuses to open."""
+
+    code = "project_too_large"
+
+    def __init__(self, size: int, limit: int) -> None:
+        super().__init__(
+            f"the project would be {size} bytes, more than TeachPad opens ({limit} bytes); "
+            "nothing was written",
+            params={"size": size, "limit": limit},
+        )
+        self.size, self.limit = size, limit
+
+
+def project_bytes(project: Project) -> bytes:
+    """The project's file as it would be written; :class:`ProjectTooLarge` when TeachPad could not
+    read it back (checked before any write: :func:`~app.points.project.save_project`, the autosave,
+    an import's check)."""
+    data = project_to_json(project).encode("utf-8")
+    limit = atomic.MAX_FILE_BYTES
+    if len(data) > limit:
+        raise ProjectTooLarge(len(data), limit)
+    return data

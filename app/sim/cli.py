@@ -36,6 +36,7 @@ commands typed on stdin while running (one per line):
   drop                close the connections of the connected clients
   watchdog SECONDS|off  stop a jog whose host went away (see --watchdog)
   exception CODE      answer every request with Modbus exception CODE (1-11)
+  exception CODE S    the same for S seconds (e.g. "exception 6 2": busy for 2 s)
   exception off       answer normally again
   silent on|off       receive requests but never answer
   restart             the controller logs in again: temp points wiped, motion stopped
@@ -153,6 +154,8 @@ def execute(sim: SimController, line: str, out: TextIO) -> bool:
                 raise ValueError(str(exc)) from None
         elif cmd == "exception" and len(args) == 1:
             sim.set_exception(None if args[0] == "off" else ExcCodes(int(args[0], 0)))
+        elif cmd == "exception" and len(args) == 2 and args[0] != "off":
+            sim.set_exception(ExcCodes(int(args[0], 0)), seconds=float(args[1]))
         elif cmd == "silent" and len(args) == 1 and args[0] in ("on", "off"):
             sim.set_silent(args[0] == "on")
         elif cmd == "restart" and not args:

@@ -14,8 +14,11 @@
   would wait on it for ever and the connection would never answer again) and drops the buffer
   when the MBAP length is impossible; :class:`ScreenedRtuFramer` counts CRC failures.
 * :class:`CommWatchdog`: during a teach jog (ratio > 0), stop the jog when the connection that
-  last wrote the ratio closes, or when no request from any connection has arrived for
-  ``timeout`` seconds. See the README's protocol decision "communication watchdog".
+  last wrote the ratio closes, or when no request from that connection has arrived for
+  ``timeout`` seconds -- another master polling meanwhile does not keep a silent host's jog
+  going (the strictest plausible controller). A jog no connection is known to own (started
+  before any ratio write was seen) counts requests from any connection. See the README's
+  protocol decision "communication watchdog".
 """
 
 from __future__ import annotations
@@ -227,7 +230,8 @@ class CommWatchdog:
         self.timeout = timeout if timeout and timeout > 0 else None
         self._stop_jog = stop_jog
         self._clock = clock
-        self._last_request = clock()
+        self._last_request = clock()  # from any connection
+        self._last_by_connection: dict[int, float] = {}
         self._owner: int | None = None
         # added to the timeout on a slow serial line: the longest answer's time on the wire,
         # during which the host cannot send its next request
@@ -242,15 +246,21 @@ class CommWatchdog:
         self.timeout = timeout if timeout and timeout > 0 else None
         self._last_request = self._clock()
 
-    def request(self) -> None:
-        """A request arrived (any connection)."""
-        self._last_request = self._clock()
+    def request(self, connection: int | None = None) -> None:
+        """A request arrived from ``connection`` (None: not known)."""
+        now = self._clock()
+        self._last_request = now
+        if connection is not None:
+            self._last_by_connection[connection] = now
 
     def jog_written(self, connection: int | None) -> None:
         """``connection`` wrote the ratio and the arm is jogging: it now owns the jog."""
         self._owner = connection
+        if connection is not None:
+            self._last_by_connection[connection] = self._clock()
 
     def closed(self, connection: int) -> None:
+        self._last_by_connection.pop(connection, None)
         if self.timeout is None or connection != self._owner:
             return
         self._owner = None
@@ -260,8 +270,11 @@ class CommWatchdog:
         """The silence check (the ticker calls this every tick)."""
         if self.timeout is None or not jogging:
             return
-        silent = self._clock() - self._last_request
+        owner = self._owner
+        last = self._last_by_connection.get(owner) if owner is not None else None
+        silent = self._clock() - (self._last_request if last is None else last)
+        source = "" if last is None else f" from connection {owner}, which jogs,"
         if silent > self.timeout + self.allowance and self._stop_jog(
-            f"no request for {silent:.3f} s (watchdog {self.timeout:g} s)"
+            f"no request{source} for {silent:.3f} s (watchdog {self.timeout:g} s)"
         ):
             self._owner = None

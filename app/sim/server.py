@@ -91,6 +91,10 @@ class SimController:
         self._exception_rule: tuple[ExcCodes | None, range | None, int | None] = (None, None, None)
         # set_exception(after_write=REG): the rule waits for a stored write covering REG (None: armed)
         self._exception_after: int | None = None
+        # set_exception(seconds=S): the rule lifts itself S s after it is armed (None: until lifted)
+        self._exception_seconds: float | None = None
+        self._exception_until: float | None = None
+        self._exceptions_answered = 0  # requests answered by the exception rule
         self.point_write_refusals = PointWriteRefusals()
         # GV291 publication hold (app/sim/status.py), the register image, the command execution
         self.status = StatusPublisher(self.config.timing, self.config.command_latency, self.config.seed)
@@ -276,7 +280,9 @@ class SimController:
             and exc_on in (None, connection)
             and self._exception_after is None
         )
-        if exc is not None and hit:
+        if exc is not None and hit and self._exception_window_open():
+            with self.lock:
+                self._exceptions_answered += 1
             return exc
         if set_values is not None:
             values = [int(v) & 0xFFFF for v in set_values]
@@ -311,6 +317,7 @@ class SimController:
                 armer = self._exception_after
                 if armer is not None and address <= armer < address + len(values):
                     self._exception_after = None  # the exception rule applies from the next request on
+                    self._arm_exception_window()
                     log.info("exception rule armed by the write to %d", armer)
             self._refresh(registers, start_address)
             status_reg = gv_reg(GV_COMMAND_STATUS)
@@ -331,7 +338,22 @@ class SimController:
     def _move_accepted(self) -> None:
         self._move_unanswered = time.monotonic()
 
+    def _arm_exception_window(self) -> None:
+        """The exception rule applies from now on: its window (``seconds``) starts (lock held)."""
+        if self._exception_seconds is not None:
+            self._exception_until = time.monotonic() + self._exception_seconds
+
+    def _exception_window_open(self) -> bool:
+        until = self._exception_until
+        return until is None or time.monotonic() < until
+
     # --- inspection -----------------------------------------------------------------------
+    @property
+    def exceptions_answered(self) -> int:
+        """Requests answered with the exception of :meth:`set_exception` so far."""
+        with self.lock:
+            return self._exceptions_answered
+
     @property
     def requests_count(self) -> int:
         with self.lock:
@@ -517,14 +539,20 @@ class SimController:
         connection: int | None = None,
         *,
         after_write: int | None = None,
+        seconds: float | None = None,
     ) -> None:
         """Answer requests touching ``addresses`` (None: all) with Modbus exception ``code``; only
         on one connection when ``connection`` (an id of :meth:`connection_ids`) is given; only
         from the first request after a stored write covering register ``after_write`` on (e.g.
-        440: the status becomes unreadable once a command was taken)."""
+        440: the status becomes unreadable once a command was taken); for ``seconds`` from then
+        on (a controller *busy* for 2 s), else until lifted."""
         with self.lock:
             self._exception_after = None if code is None else after_write
             self._exception_rule = (None if code is None else ExcCodes(code), addresses, connection)
+            self._exception_seconds = None if code is None else seconds
+            self._exception_until = None
+            if self._exception_after is None:
+                self._arm_exception_window()
         after = "" if after_write is None else f" after a write to {after_write}"
         log.info(
             "exception %s%s%s%s",

@@ -129,7 +129,7 @@ class GuardedHandler(ServerRequestHandler):  # type: ignore[misc]  # pymodbus is
             while self._pending:
                 pdu, addr = self._pending.popleft()
                 if not isinstance(pdu, RejectedRequest):
-                    self.guard.watchdog.request()
+                    self.guard.watchdog.request(self.connection_id)
                 self.last_pdu, self.last_addr = pdu, addr
                 await self.handle_request()
         finally:

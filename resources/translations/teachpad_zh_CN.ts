@@ -390,176 +390,216 @@
     <context>
         <name>ConnectionDialog</name>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="193" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="200" />
             <source>Connect to controller</source>
             <translation>连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="194" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="201" />
             <source>Transport:</source>
             <translation>通信方式：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="195" />
-            <location filename="../../ui/dialogs/connection_dialog.py" line="254" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="202" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="261" />
             <source>Modbus TCP</source>
             <translation>Modbus TCP</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="196" />
-            <location filename="../../ui/dialogs/connection_dialog.py" line="254" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="203" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="261" />
             <source>Modbus RTU (serial)</source>
             <translation>Modbus RTU（串口）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="197" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="204" />
             <source>Host:</source>
             <translation>主机：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="198" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="205" />
             <source>Port:</source>
             <translation>端口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="199" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="206" />
             <source>Serial port:</source>
             <translation>串口：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="200" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="207" />
             <source>Refresh</source>
             <translation>刷新</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="201" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="208" />
             <source>List the serial ports of this computer again</source>
             <translation>重新列出本机的串口</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="203" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="210" />
             <source>Baud rate:</source>
             <translation>波特率：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="204" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="211" />
             <source>Parity:</source>
             <translation>校验位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="205" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="212" />
             <source>none</source>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="205" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="212" />
             <source>even</source>
             <translation>偶校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="205" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="212" />
             <source>odd</source>
             <translation>奇校验</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="207" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="214" />
             <source>Stop bits:</source>
             <translation>停止位：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="208" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="215" />
             <source>Unit id:</source>
             <translation>从站地址：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="209" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="216" />
             <source>Float word order:</source>
             <translation>浮点数字序：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="210" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="217" />
             <source>Low word first (CDAB, default)</source>
             <translation>低字在前（CDAB，默认）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="211" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="218" />
             <source>High word first (ABCD)</source>
             <translation>高字在前（ABCD）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="212" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="219" />
             <source>Timeout:</source>
             <translation>超时：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="213" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="220" />
             <source>Monitor only (never write to the controller)</source>
             <translation>仅监视（从不写入控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="216" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="223" />
             <source>Unit id and word order come from the register profile (Safety → Register profile…, administrator).</source>
             <translation>站号和字序取自寄存器配置（安全 → 寄存器配置…，管理员）。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="256" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="263" />
             <source>Connected to {where}</source>
             <translation>已连接到 {where}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="257" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="264" />
             <source>Connecting to {where}</source>
             <translation>正在连接 {where}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="258" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="265" />
             <source>Connected to {where}, but the controller does not answer</source>
             <translation>已连接到 {where}，但控制器没有应答</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="259" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="266" />
             <source>Connection to {where} lost; retrying</source>
             <translation>与 {where} 的连接已断开，正在重试</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="260" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="267" />
             <source>Not connected (last: {where})</source>
             <translation>未连接（上次：{where}）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="264" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="271" />
             <source>{transport}, unit {unit}</source>
             <translation>{transport}，站号 {unit}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="267" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="274" />
             <source>Polling at {hz:g} Hz</source>
             <translation>轮询频率 {hz:g} Hz</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="269" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="276" />
             <source>Monitor only: nothing is written to the controller</source>
             <translation>仅监视：不向控制器写入任何内容</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="297" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="304" />
             <source>Could not list the serial ports ({error}); type the device name</source>
             <translation>无法列出串口（{error}），请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="301" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="308" />
             <source>Serial ports found: {n}</source>
             <translation>找到的串口：{n} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="303" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="310" />
             <source>No serial port found; type the device name</source>
             <translation>未找到串口，请直接输入设备名</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/connection_dialog.py" line="356" />
+            <location filename="../../ui/dialogs/connection_dialog.py" line="363" />
             <source>a serial port is needed for RTU</source>
             <translation>RTU 方式需要指定串口</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="376" />
+            <source>it contains a space</source>
+            <translation>其中含有空格</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="377" />
+            <source>it is longer than 253 characters</source>
+            <translation>长度超过 253 个字符</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="378" />
+            <source>it has an empty part (two dots in a row, or a dot at the start)</source>
+            <translation>其中有空的部分（两个点相连，或以点开头）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="379" />
+            <source>a part between two dots is longer than 63 characters</source>
+            <translation>两个点之间的某一部分超过 63 个字符</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="380" />
+            <source>it contains a character a host name cannot have</source>
+            <translation>其中含有主机名不允许的字符</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="381" />
+            <source>a part between two dots starts or ends with a hyphen</source>
+            <translation>两个点之间的某一部分以连字符开头或结尾</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="382" />
+            <source>it looks like an IP address but is not one</source>
+            <translation>看起来像 IP 地址，但不是有效的 IP 地址</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/connection_dialog.py" line="384" />
+            <source>Not a valid host name or IP address: {why}.</source>
+            <translation>不是有效的主机名或 IP 地址：{why}。</translation>
         </message>
     </context>
     <context>
@@ -1438,147 +1478,152 @@
         </message>
         <message>
             <location filename="../../ui/messages.py" line="160" />
+            <source>The host name {host} is not valid: check it in Connect…</source>
+            <translation>主机名 {host} 无效：请在“连接…”中检查。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="161" />
             <source>Connection refused: nothing listens on port {port}.</source>
             <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="163" />
+            <location filename="../../ui/messages.py" line="164" />
             <source>No answer to the connection request within {seconds} s.</source>
             <translation>连接请求在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="166" />
+            <location filename="../../ui/messages.py" line="167" />
             <source>The connection could not be opened.</source>
             <translation>无法建立连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="167" />
+            <location filename="../../ui/messages.py" line="168" />
             <source>Cannot open the serial port {port}.</source>
             <translation>无法打开串口 {port}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="168" />
+            <location filename="../../ui/messages.py" line="169" />
             <source>The controller at {endpoint} did not answer within {seconds} s.</source>
             <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="171" />
+            <location filename="../../ui/messages.py" line="172" />
             <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
             <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="175" />
+            <location filename="../../ui/messages.py" line="176" />
             <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="178" />
+            <location filename="../../ui/messages.py" line="179" />
             <source>Monitor-only mode: nothing was sent to the controller.</source>
             <translation>仅监视模式：未向控制器发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="179" />
+            <location filename="../../ui/messages.py" line="180" />
             <source>Not sent: the audit trail in {folder} cannot be written ({cause}). No write goes out without its record (Stop still does): free disk space or fix the audit folder.</source>
             <translation>未发送：审计记录目录 {folder} 无法写入（{cause}）。没有审计记录的写入一律不发送（停止除外）：请释放磁盘空间或修复审计目录。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="184" />
+            <location filename="../../ui/messages.py" line="185" />
             <source>{operation}: not sent, the controller is in {mode} mode. Switching it to auto is the operator's decision: say yes when the confirmation asks, or switch it to auto first.</source>
             <translation>{operation}：未发送，控制器处于{mode}模式。切换到自动模式须由操作员决定：在确认框询问时选择“是”，或先将其切换到自动模式。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="189" />
+            <location filename="../../ui/messages.py" line="190" />
             <source>{operation}: not sent in reduced-speed mode: it runs at the controller's own speed, which TeachPad cannot cap.</source>
             <translation>{operation}：降速模式下未发送：它以控制器自身的速度运行，TeachPad 无法限制该速度。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="194" />
+            <location filename="../../ui/messages.py" line="195" />
             <location filename="../../ui/messages_plan.py" line="29" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="195" />
+            <location filename="../../ui/messages.py" line="196" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="197" />
+            <location filename="../../ui/messages.py" line="198" />
             <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
             <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="201" />
+            <location filename="../../ui/messages.py" line="202" />
             <source>The controller did not create {point} again before the move: the arm was not moved.</source>
             <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="204" />
+            <location filename="../../ui/messages.py" line="205" />
             <source>The project has no point {point}: the arm was not moved.</source>
             <translation>项目中没有点 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="207" />
+            <location filename="../../ui/messages.py" line="208" />
             <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
             <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="211" />
+            <location filename="../../ui/messages.py" line="212" />
             <source>The link was shut down.</source>
             <translation>通信链路已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="221" />
+            <location filename="../../ui/messages.py" line="222" />
             <source>{operation}: not sent, the connection to the controller is down.</source>
             <translation>{operation}：未发送，与控制器的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="224" />
+            <location filename="../../ui/messages.py" line="225" />
             <source>{operation}: not sent, the connection was closed.</source>
             <translation>{operation}：未发送，连接已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="226" />
+            <location filename="../../ui/messages.py" line="227" />
             <source>points outside {id_min}..{id_max}: {ids}</source>
             <translation>超出 {id_min}..{id_max} 范围的点：{ids}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="227" />
+            <location filename="../../ui/messages.py" line="228" />
             <source>there is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="228" />
+            <location filename="../../ui/messages.py" line="229" />
             <source>no free point id left in {start}..{id_max}</source>
             <translation>{start}..{id_max} 范围内已没有空闲的点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="229" />
+            <location filename="../../ui/messages.py" line="230" />
             <source>there is no row {row}</source>
             <translation>不存在第 {row} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="230" />
+            <location filename="../../ui/messages.py" line="231" />
             <source>cannot move row {src} to {dst} in {rows} rows</source>
             <translation>无法在 {rows} 行中将第 {src} 行移到第 {dst} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="231" />
+            <location filename="../../ui/messages.py" line="232" />
             <source>row {row}: id {id} is already used on row {other}</source>
             <translation>第 {row} 行：编号 {id} 已被第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="232" />
+            <location filename="../../ui/messages.py" line="233" />
             <source>imported point {number}: id {id} appears twice</source>
             <translation>导入的第 {number} 个点：编号 {id} 出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="233" />
+            <location filename="../../ui/messages.py" line="234" />
             <source>id {id} is already used by {point}</source>
             <translation>编号 {id} 已被 {point} 使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="234" />
+            <location filename="../../ui/messages.py" line="235" />
             <source>the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)</source>
             <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
         </message>
@@ -1678,362 +1723,367 @@
             <translation>编号 {id} 已在第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="212" />
+            <location filename="../../ui/messages.py" line="213" />
             <source>{operation}: the connection was lost while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接中断，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="216" />
+            <location filename="../../ui/messages.py" line="217" />
             <source>{operation}: the connection was closed while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接被关闭，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="244" />
+            <location filename="../../ui/messages.py" line="245" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="245" />
+            <location filename="../../ui/messages.py" line="246" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="246" />
+            <location filename="../../ui/messages.py" line="247" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="247" />
+            <location filename="../../ui/messages.py" line="248" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="248" />
+            <location filename="../../ui/messages.py" line="249" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="249" />
+            <location filename="../../ui/messages.py" line="250" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="250" />
+            <location filename="../../ui/messages.py" line="251" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="251" />
+            <location filename="../../ui/messages.py" line="252" />
+            <source>The host name is not valid.</source>
+            <translation>主机名无效。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="253" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="252" />
+            <location filename="../../ui/messages.py" line="254" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="253" />
+            <location filename="../../ui/messages.py" line="255" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="254" />
+            <location filename="../../ui/messages.py" line="256" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="255" />
+            <location filename="../../ui/messages.py" line="257" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="256" />
+            <location filename="../../ui/messages.py" line="258" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="257" />
+            <location filename="../../ui/messages.py" line="259" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="260" />
+            <location filename="../../ui/messages.py" line="262" />
             <source>{operation}: not sent, the controller is not in auto mode.</source>
             <translation>{operation}：未发送，控制器不处于自动模式。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="265" />
+            <location filename="../../ui/messages.py" line="267" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="266" />
+            <location filename="../../ui/messages.py" line="268" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="267" />
+            <location filename="../../ui/messages.py" line="269" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="268" />
+            <location filename="../../ui/messages.py" line="270" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="269" />
+            <location filename="../../ui/messages.py" line="271" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="272" />
+            <location filename="../../ui/messages.py" line="274" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="273" />
+            <location filename="../../ui/messages.py" line="275" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="274" />
+            <location filename="../../ui/messages.py" line="276" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="275" />
+            <location filename="../../ui/messages.py" line="277" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="276" />
+            <location filename="../../ui/messages.py" line="278" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="277" />
+            <location filename="../../ui/messages.py" line="279" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="278" />
+            <location filename="../../ui/messages.py" line="280" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="279" />
+            <location filename="../../ui/messages.py" line="281" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="280" />
+            <location filename="../../ui/messages.py" line="282" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="281" />
+            <location filename="../../ui/messages.py" line="283" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="282" />
+            <location filename="../../ui/messages.py" line="284" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="283" />
+            <location filename="../../ui/messages.py" line="285" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="284" />
+            <location filename="../../ui/messages.py" line="286" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="285" />
+            <location filename="../../ui/messages.py" line="287" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="286" />
+            <location filename="../../ui/messages.py" line="288" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="287" />
+            <location filename="../../ui/messages.py" line="289" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="288" />
+            <location filename="../../ui/messages.py" line="290" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="289" />
+            <location filename="../../ui/messages.py" line="291" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="290" />
+            <location filename="../../ui/messages.py" line="292" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="291" />
+            <location filename="../../ui/messages.py" line="293" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="293" />
+            <location filename="../../ui/messages.py" line="295" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="296" />
+            <location filename="../../ui/messages.py" line="298" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="297" />
+            <location filename="../../ui/messages.py" line="299" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="298" />
+            <location filename="../../ui/messages.py" line="300" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="299" />
+            <location filename="../../ui/messages.py" line="301" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="300" />
+            <location filename="../../ui/messages.py" line="302" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="301" />
+            <location filename="../../ui/messages.py" line="303" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="302" />
+            <location filename="../../ui/messages.py" line="304" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="303" />
+            <location filename="../../ui/messages.py" line="305" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="304" />
+            <location filename="../../ui/messages.py" line="306" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="305" />
+            <location filename="../../ui/messages.py" line="307" />
             <source>unit id</source>
             <translation>站号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="306" />
+            <location filename="../../ui/messages.py" line="308" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="310" />
+            <location filename="../../ui/messages.py" line="312" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="311" />
+            <location filename="../../ui/messages.py" line="313" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="312" />
+            <location filename="../../ui/messages.py" line="314" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="313" />
+            <location filename="../../ui/messages.py" line="315" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="314" />
+            <location filename="../../ui/messages.py" line="316" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="315" />
+            <location filename="../../ui/messages.py" line="317" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="316" />
+            <location filename="../../ui/messages.py" line="318" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="317" />
+            <location filename="../../ui/messages.py" line="319" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="318" />
+            <location filename="../../ui/messages.py" line="320" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="319" />
+            <location filename="../../ui/messages.py" line="321" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="321" />
+            <location filename="../../ui/messages.py" line="323" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="487" />
+            <location filename="../../ui/messages.py" line="489" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="490" />
+            <location filename="../../ui/messages.py" line="492" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="536" />
+            <location filename="../../ui/messages.py" line="538" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="539" />
+            <location filename="../../ui/messages.py" line="541" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="543" />
+            <location filename="../../ui/messages.py" line="545" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="546" />
+            <location filename="../../ui/messages.py" line="548" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="549" />
+            <location filename="../../ui/messages.py" line="551" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
@@ -2083,12 +2133,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="496" />
+            <location filename="../../ui/messages.py" line="498" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="500" />
+            <location filename="../../ui/messages.py" line="502" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -2223,17 +2273,17 @@
             <translation>（第一轮之后的循环中，从第 {after} 段的终点出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="130" />
+            <location filename="../../ui/messages_files.py" line="134" />
             <source>row {row}, column '{column}': {problem}</source>
             <translation>第 {row} 行，“{column}”列：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="132" />
+            <location filename="../../ui/messages_files.py" line="136" />
             <source>column '{column}': {problem}</source>
             <translation>“{column}”列：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="131" />
+            <location filename="../../ui/messages_files.py" line="135" />
             <source>row {row}: {problem}</source>
             <translation>第 {row} 行：{problem}</translation>
         </message>
@@ -2249,232 +2299,237 @@
         </message>
         <message>
             <location filename="../../ui/messages_files.py" line="58" />
+            <source>The project would be {size} bytes, more than TeachPad opens ({limit} bytes): nothing was changed or written.</source>
+            <translation>项目将有 {size} 字节，超过 TeachPad 能打开的大小（{limit} 字节）：未做任何更改，也未写入文件。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_files.py" line="62" />
             <source>the file does not exist</source>
             <translation>文件不存在</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="59" />
+            <location filename="../../ui/messages_files.py" line="63" />
             <source>is a folder, not a file</source>
             <translation>是文件夹，不是文件</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="60" />
+            <location filename="../../ui/messages_files.py" line="64" />
             <source>permission denied</source>
             <translation>没有访问权限</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="61" />
+            <location filename="../../ui/messages_files.py" line="65" />
             <source>the system refused the file (error {errno})</source>
             <translation>系统拒绝访问该文件（错误 {errno}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="63" />
+            <location filename="../../ui/messages_files.py" line="67" />
             <source>not valid JSON</source>
             <translation>不是有效的 JSON</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="64" />
+            <location filename="../../ui/messages_files.py" line="68" />
             <source>not valid JSON (nested too deeply)</source>
             <translation>不是有效的 JSON（嵌套层数过多）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="65" />
+            <location filename="../../ui/messages_files.py" line="69" />
             <source>not a project: expected a JSON object at the top level</source>
             <translation>不是工程文件：顶层应为 JSON 对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="68" />
+            <location filename="../../ui/messages_files.py" line="72" />
             <source>not a TeachPad project (format {got}, expected {expected})</source>
             <translation>不是 TeachPad 工程文件（格式为 {got}，应为 {expected}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="71" />
+            <location filename="../../ui/messages_files.py" line="75" />
             <source>version {version} is not supported (this TeachPad reads version {supported})</source>
             <translation>不支持版本 {version}（本 TeachPad 读取版本 {supported}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="74" />
+            <location filename="../../ui/messages_files.py" line="78" />
             <source>expected {expected}, got {got}</source>
             <translation>应为{expected}，实际为 {got}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="75" />
+            <location filename="../../ui/messages_files.py" line="79" />
             <source>id {id} is already used by point {other_number}</source>
             <translation>编号 {id} 已被第 {other_number} 个点使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="76" />
+            <location filename="../../ui/messages_files.py" line="80" />
             <source>another plan is named “{name}”</source>
             <translation>已有另一个名为“{name}”的轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="78" />
+            <location filename="../../ui/messages_files.py" line="82" />
             <source>{value} is not yes or no</source>
             <translation>{value} 不是“是”或“否”</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="79" />
+            <location filename="../../ui/messages_files.py" line="83" />
             <source>{value} is not a line or an arc</source>
             <translation>{value} 不是直线或圆弧</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="80" />
+            <location filename="../../ui/messages_files.py" line="84" />
             <source>{value} is not “changes” or “kept”</source>
             <translation>{value} 不是“变化”或“保持”</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="83" />
+            <location filename="../../ui/messages_files.py" line="87" />
             <source>point id {id} is negative</source>
             <translation>点编号 {id} 为负数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="84" />
+            <location filename="../../ui/messages_files.py" line="88" />
             <source>there is no field “{name}”</source>
             <translation>没有字段“{name}”</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="85" />
+            <location filename="../../ui/messages_files.py" line="89" />
             <source>a plan needs a name</source>
             <translation>轨迹需要一个名称</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="86" />
+            <location filename="../../ui/messages_files.py" line="90" />
             <source>the name must be one line of at most {max} characters</source>
             <translation>名称必须为单行，最多 {max} 个字符</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="89" />
+            <location filename="../../ui/messages_files.py" line="93" />
             <source>{value} loops: give 0 (endless) to {max}</source>
             <translation>循环次数 {value} 无效：请输入 0（无限）到 {max}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="90" />
+            <location filename="../../ui/messages_files.py" line="94" />
             <source>cannot move segment {src} to {dst} in {segments} segments</source>
             <translation>无法在 {segments} 段中把第 {src} 段移到第 {dst} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="93" />
+            <location filename="../../ui/messages_files.py" line="97" />
             <source>an arc needs its middle point</source>
             <translation>圆弧需要中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="94" />
+            <location filename="../../ui/messages_files.py" line="98" />
             <source>a line has no middle point</source>
             <translation>直线没有中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="95" />
+            <location filename="../../ui/messages_files.py" line="99" />
             <source>point P{id} does not exist: pick one of the list</source>
             <translation>点 P{id} 不存在：请从列表中选择</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="98" />
+            <location filename="../../ui/messages_files.py" line="102" />
             <source>{speed} mm/s: the speed must be above 0</source>
             <translation>{speed} mm/s：速度必须大于 0</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="99" />
+            <location filename="../../ui/messages_files.py" line="103" />
             <source>an arc's middle point must differ from its end point</source>
             <translation>圆弧的中间点必须与终点不同</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="104" />
+            <location filename="../../ui/messages_files.py" line="108" />
             <source>text</source>
             <translation>文本</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="105" />
+            <location filename="../../ui/messages_files.py" line="109" />
             <source>a list of points</source>
             <translation>点列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="106" />
+            <location filename="../../ui/messages_files.py" line="110" />
             <source>a list of plans</source>
             <translation>轨迹列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="107" />
+            <location filename="../../ui/messages_files.py" line="111" />
             <source>a list of segments</source>
             <translation>段列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="108" />
-            <location filename="../../ui/messages_files.py" line="113" />
+            <location filename="../../ui/messages_files.py" line="112" />
+            <location filename="../../ui/messages_files.py" line="117" />
             <source>an object</source>
             <translation>对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="109" />
+            <location filename="../../ui/messages_files.py" line="113" />
             <source>an object with time and endpoint</source>
             <translation>包含时间和端点的对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="112" />
+            <location filename="../../ui/messages_files.py" line="116" />
             <source>a list</source>
             <translation>列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="118" />
+            <location filename="../../ui/messages_files.py" line="122" />
             <source>the file</source>
             <translation>文件</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="119" />
+            <location filename="../../ui/messages_files.py" line="123" />
             <source>point {number}</source>
             <translation>第 {number} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="120" />
+            <location filename="../../ui/messages_files.py" line="124" />
             <source>point {number} (id {id})</source>
             <translation>第 {number} 个点（编号 {id}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="121" />
+            <location filename="../../ui/messages_files.py" line="125" />
             <source>point {number} (id {id}), upload history</source>
             <translation>第 {number} 个点（编号 {id}）的上传记录</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="122" />
+            <location filename="../../ui/messages_files.py" line="126" />
             <source>plan {number}</source>
             <translation>第 {number} 条轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="123" />
+            <location filename="../../ui/messages_files.py" line="127" />
             <source>plan {number} “{name}”</source>
             <translation>第 {number} 条轨迹“{name}”</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="124" />
+            <location filename="../../ui/messages_files.py" line="128" />
             <source>plan {number} “{name}”, segment {segment}</source>
             <translation>第 {number} 条轨迹“{name}”第 {segment} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="125" />
+            <location filename="../../ui/messages_files.py" line="129" />
             <source>line {line}, column {column}</source>
             <translation>第 {line} 行第 {column} 列</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="126" />
+            <location filename="../../ui/messages_files.py" line="130" />
             <source>at “{path}”</source>
             <translation>位于“{path}”</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="127" />
+            <location filename="../../ui/messages_files.py" line="131" />
             <source>a key at “{path}”</source>
             <translation>位于“{path}”的键</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="133" />
+            <location filename="../../ui/messages_files.py" line="137" />
             <source>{place}, field '{column}': {problem}</source>
             <translation>{place}，字段“{column}”：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="134" />
+            <location filename="../../ui/messages_files.py" line="138" />
             <source>{place}: {problem}</source>
             <translation>{place}：{problem}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_files.py" line="135" />
+            <location filename="../../ui/messages_files.py" line="139" />
             <source>{file}: {text}</source>
             <translation>{file}：{text}</translation>
         </message>
@@ -3648,7 +3703,7 @@
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="428" />
+            <location filename="../../ui/models/points_model.py" line="436" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -4058,158 +4113,160 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="138" />
+            <location filename="../../ui/controllers/project_controller.py" line="141" />
             <source>Undo</source>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="140" />
+            <location filename="../../ui/controllers/project_controller.py" line="143" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="144" />
+            <location filename="../../ui/controllers/project_controller.py" line="147" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="145" />
+            <location filename="../../ui/controllers/project_controller.py" line="148" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="146" />
+            <location filename="../../ui/controllers/project_controller.py" line="149" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="147" />
+            <location filename="../../ui/controllers/project_controller.py" line="150" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="148" />
+            <location filename="../../ui/controllers/project_controller.py" line="151" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="149" />
+            <location filename="../../ui/controllers/project_controller.py" line="152" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="179" />
+            <location filename="../../ui/controllers/project_controller.py" line="182" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="214" />
+            <location filename="../../ui/controllers/project_controller.py" line="217" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="222" />
-            <location filename="../../ui/controllers/project_controller.py" line="260" />
-            <location filename="../../ui/controllers/project_controller.py" line="377" />
+            <location filename="../../ui/controllers/project_controller.py" line="225" />
+            <location filename="../../ui/controllers/project_controller.py" line="263" />
+            <location filename="../../ui/controllers/project_controller.py" line="394" />
             <source>Project in use</source>
             <translation>工程正在使用中</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="227" />
             <location filename="../../ui/controllers/project_controller.py" line="230" />
+            <location filename="../../ui/controllers/project_controller.py" line="233" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="233" />
+            <location filename="../../ui/controllers/project_controller.py" line="236" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="245" />
+            <location filename="../../ui/controllers/project_controller.py" line="248" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="265" />
+            <location filename="../../ui/controllers/project_controller.py" line="268" />
+            <location filename="../../ui/controllers/project_controller.py" line="271" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="277" />
+            <location filename="../../ui/controllers/project_controller.py" line="283" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="283" />
+            <location filename="../../ui/controllers/project_controller.py" line="289" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="290" />
-            <location filename="../../ui/controllers/project_controller.py" line="293" />
-            <location filename="../../ui/controllers/project_controller.py" line="307" />
+            <location filename="../../ui/controllers/project_controller.py" line="296" />
+            <location filename="../../ui/controllers/project_controller.py" line="299" />
+            <location filename="../../ui/controllers/project_controller.py" line="314" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="309" />
+            <location filename="../../ui/controllers/project_controller.py" line="316" />
             <source>{added} added, {updated} updated, {unchanged} unchanged, {removed} removed</source>
             <translation>新增 {added} 个，更新 {updated} 个，未变 {unchanged} 个，删除 {removed} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="312" />
+            <location filename="../../ui/controllers/project_controller.py" line="319" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="318" />
+            <location filename="../../ui/controllers/project_controller.py" line="332" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="325" />
+            <location filename="../../ui/controllers/project_controller.py" line="339" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="328" />
+            <location filename="../../ui/controllers/project_controller.py" line="342" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="355" />
+            <location filename="../../ui/controllers/project_controller.py" line="368" />
+            <location filename="../../ui/controllers/project_controller.py" line="372" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="393" />
-            <location filename="../../ui/controllers/project_controller.py" line="396" />
+            <location filename="../../ui/controllers/project_controller.py" line="410" />
+            <location filename="../../ui/controllers/project_controller.py" line="413" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="399" />
+            <location filename="../../ui/controllers/project_controller.py" line="416" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="435" />
+            <location filename="../../ui/controllers/project_controller.py" line="452" />
             <source>Cannot lock {path}: {reason}</source>
             <translation>无法锁定 {path}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="445" />
+            <location filename="../../ui/controllers/project_controller.py" line="462" />
             <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
             <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="481" />
+            <location filename="../../ui/controllers/project_controller.py" line="498" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="484" />
+            <location filename="../../ui/controllers/project_controller.py" line="501" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>

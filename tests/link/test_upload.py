@@ -261,6 +261,7 @@ _LINK_FAILED_BY_CODE = {
     "connect_timeout": True,
     "connection_refused": True,
     "host_unresolved": True,
+    "host_invalid": True,
     "serial_open_failed": True,
     "no_answer": True,  # ResponseTimeout: no answer in time
     "malformed_answer": True,  # the byte stream may be out of step: only a new connection is trusted
@@ -282,6 +283,7 @@ _LINK_FAILED_BY_CODE = {
     "point_not_created": False,
     "file_format": False,
     "empty_import": False,
+    "project_too_large": False,  # a project TeachPad could not read back: not written
     "jog_not_answering": False,  # the jog's own check before it starts: nothing was sent
     "outcome_unknown": False,  # taken, then its status could not be read: counted by the reads that failed
     "controller_busy": False,  # not sent: the controller runs a program

@@ -60,6 +60,10 @@ def test_stdin_commands(sim: SimController, make_bus: Callable[..., Bus]) -> Non
     assert rr.isError() and rr.exception_code == 6
     assert execute(sim, "exception off", out)
     assert bus.mode() == 1
+    assert execute(sim, "exception 6 0.05", out)  # busy for a window that lifts itself
+    assert sim._exception_until is not None
+    assert sim.wait_for(lambda _: not sim._exception_window_open(), 2)
+    assert bus.mode() == 1
     assert execute(sim, "silent on", out) and sim._silent
     assert execute(sim, "silent off", out) and not sim._silent
     assert execute(sim, "drop", out)

@@ -268,3 +268,27 @@ def test_watchdog_off_keeps_jogging_like_a_controller_without_one(
     t0 = sim.state().t
     assert sim.wait_for(lambda s: s.t > t0 + 0.3, 5.0)
     assert sim.state().jogging and sim.watchdog_events() == []
+
+
+def test_another_master_polling_does_not_keep_a_silent_hosts_jog(
+    sim_factory: Callable[..., SimController], make_bus: Callable[..., Bus]
+) -> None:
+    """The watchdog belongs to the connection that jogs (issue 19 section 6): the jogging host goes
+    silent (its connection open) while a second master polls at 50 Hz -- the arm stops at the
+    watchdog all the same."""
+    sim = sim_factory(watchdog=0.2)
+    jogger = make_bus(sim.port)
+    poller = make_bus(sim.port)
+    start_jog(jogger, sim)
+    silent_since = sim.writes[-1].t  # the jogger's last request: the ratio write
+    deadline = time.monotonic() + 3.0  # well past the watchdog: a jog still going then is a failure
+    while sim.state().jogging and time.monotonic() < deadline:
+        poller.mode()
+        time.sleep(0.02)  # the other master's 50 Hz poll
+    state = sim.state()
+    assert not state.jogging and state.teach_ratio == 0
+    (event,) = sim.watchdog_events()
+    assert (
+        event.t - silent_since < 0.2 + 0.5 and "connection" in event.detail and "no request" in event.detail
+    )
+    assert jogger.mode() == 2  # its connection is fine: only silent

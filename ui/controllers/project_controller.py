@@ -28,6 +28,7 @@ A CSV without points does not replace all points unless the operator confirms it
 
 from __future__ import annotations
 
+import copy
 import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -36,15 +37,17 @@ from PySide6.QtCore import QObject, QTimer, Signal, Slot
 from PySide6.QtGui import QAction, QKeySequence, QUndoStack
 
 from app.errors import InvalidInput
-from app.points.ledger import EmptyImport, ImportMode
+from app.points.ledger import EmptyImport, ImportMode, PointLedger
 from app.points.point import FileFormatError
 from app.points.project import (
     PROJECT_SUFFIX,
     Project,
+    ProjectTooLarge,
     autosave_path,
     discard_autosave,
     find_autosave,
     load_project,
+    project_bytes,
     read_points_csv,
     save_autosave,
     save_project,
@@ -261,6 +264,9 @@ class ProjectController(QObject):
             return False
         try:
             save_project(self._project, target)
+        except ProjectTooLarge as exc:
+            self.dialogs.error(self.tr("Cannot save project"), refusal_text(exc))
+            return False
         except OSError as exc:
             self.dialogs.error(self.tr("Cannot save project"), os_error_text(target, exc))
             return False
@@ -296,13 +302,14 @@ class ProjectController(QObject):
             mode = self.dialogs.ask_import_mode()
             if mode is None:
                 return False
+        check = self._fits_when_saved
         try:
             try:
-                report = self.points_model.import_points(points, mode)
+                report = self.points_model.import_points(points, mode, check=check)
             except EmptyImport as exc:
                 if not self.dialogs.ask_empty_import(exc.existing):
                     return False
-                report = self.points_model.import_points(points, mode, allow_empty=True)
+                report = self.points_model.import_points(points, mode, allow_empty=True, check=check)
         except InvalidInput as exc:
             self.dialogs.error(self.tr("Cannot import points"), refusal_text(exc))
             return False
@@ -311,6 +318,13 @@ class ProjectController(QObject):
         )
         self.statusMessage.emit(self.tr("Imported {path}: {report}").format(path=path, report=counts))
         return True
+
+    def _fits_when_saved(self, ledger: PointLedger) -> None:
+        """:class:`ProjectTooLarge` when the project holding ``ledger`` could not be saved and
+        opened again (an import is refused first: never a file TeachPad then refuses to open)."""
+        project = copy.copy(self._project)
+        project.ledger = ledger
+        project_bytes(project)
 
     def export_csv(self, path: str | os.PathLike[str] | None = None) -> bool:
         if path is None:
@@ -350,6 +364,9 @@ class ProjectController(QObject):
             return None
         try:
             written = save_autosave(self._project, self._path, user_dir=self._autosave_dir)
+        except ProjectTooLarge as exc:
+            self.statusMessage.emit(self.tr("Autosave failed: {reason}").format(reason=refusal_text(exc)))
+            return None
         except OSError as exc:
             self.statusMessage.emit(
                 self.tr("Autosave failed: {reason}").format(

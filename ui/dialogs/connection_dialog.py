@@ -32,6 +32,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.link.hostname import host_problem
 from app.link.transport import ConnectionSettings
 from app.link.types import ConnectionState, LinkState
 from app.protocol.codec import WordOrder
@@ -103,7 +104,13 @@ class ConnectionDialog(QDialog):
         self.port_spin.setRange(1, 65535)
         self.host_caption = QLabel(self.tcp_page)
         self.port_caption = QLabel(self.tcp_page)
+        self.host_note = QLabel(self.tcp_page)  # why the host typed is refused (hidden: none)
+        self.host_note.setObjectName("hostNote")
+        self.host_note.setWordWrap(True)
+        self.host_note.hide()
+        self.host_edit.textEdited.connect(lambda _text: self.host_note.hide())
         tcp_form.addRow(self.host_caption, self.host_edit)
+        tcp_form.addRow(self.host_note)
         tcp_form.addRow(self.port_caption, self.port_spin)
 
         self.rtu_page = QWidget(self)
@@ -355,4 +362,27 @@ class ConnectionDialog(QDialog):
             self.serial_edit.setFocus()
             self.serial_edit.setPlaceholderText(self.tr("a serial port is needed for RTU"))
             return
+        if self.transport_combo.currentData() == "tcp" and not self._host_ok():
+            return
         super().accept()
+
+    def _host_ok(self) -> bool:
+        """The host typed is an IP address or a valid host name; else say why, beside it."""
+        problem = host_problem(self.host_edit.text().strip() or "127.0.0.1")
+        if problem is None:
+            self.host_note.hide()
+            return True
+        why = {
+            "space": self.tr("it contains a space"),
+            "too_long": self.tr("it is longer than 253 characters"),
+            "empty_label": self.tr("it has an empty part (two dots in a row, or a dot at the start)"),
+            "long_label": self.tr("a part between two dots is longer than 63 characters"),
+            "bad_character": self.tr("it contains a character a host name cannot have"),
+            "bad_hyphen": self.tr("a part between two dots starts or ends with a hyphen"),
+            "bad_ip": self.tr("it looks like an IP address but is not one"),
+        }.get(problem, problem)
+        self.host_note.setText(self.tr("Not a valid host name or IP address: {why}.").format(why=why))
+        self.host_note.show()
+        self.host_edit.setFocus()
+        self.host_edit.selectAll()
+        return False

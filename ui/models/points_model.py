@@ -21,7 +21,7 @@ model's own (import, id follow) in :mod:`ui.models.point_commands`; the filter p
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -419,12 +419,20 @@ class PointsModel(UndoableListModel):
         return row
 
     def import_points(
-        self, points: Sequence[TempPoint], mode: ImportMode = ImportMode.REPLACE, *, allow_empty: bool = False
+        self,
+        points: Sequence[TempPoint],
+        mode: ImportMode = ImportMode.REPLACE,
+        *,
+        allow_empty: bool = False,
+        check: Callable[[PointLedger], None] | None = None,
     ) -> ImportReport:
         """Import parsed points (one undo step); the ledger is untouched when refused (an empty
-        list in replace mode too, unless ``allow_empty``)."""
+        list in replace mode too, unless ``allow_empty``; ``check`` raising on the ledger the
+        import would give -- a project too large to be read back)."""
         scratch = PointLedger(self.ledger.snapshot(), self.ledger.limits)
         report = scratch.import_points(points, mode, allow_empty=allow_empty)
+        if check is not None:
+            check(scratch)
         text = self.tr("Import {n} points").format(n=len(points))
         self._stack.push(
             ReplaceAllCommand(self._apply_replace_all, self.ledger.snapshot(), scratch.snapshot(), text)
