@@ -14,7 +14,6 @@ signature).
 from __future__ import annotations
 
 import datetime as dt
-import hashlib
 import json
 import os
 from dataclasses import dataclass, field
@@ -29,6 +28,8 @@ TAIL_BYTES = 64 * 1024  # what is read of a file's end to find its last record
 
 def line_hash(line: bytes) -> str:
     """The hash a record's successor carries: SHA-256 of its line (without the newline), hex."""
+    import hashlib  # (OpenSSL: loaded by the first record hashed, not with the window's modules)
+
     return hashlib.sha256(line.rstrip(b"\r\n")).hexdigest()
 
 

@@ -289,6 +289,7 @@ _LINK_FAILED_BY_CODE = {
     "controller_busy": False,  # not sent: the controller runs a program
     "manual_mode": False,  # go to zero / run program in manual mode, no switch allowed: nothing sent
     "reduced_speed_refused": False,  # go to zero in reduced-speed mode: nothing sent
+    "audit_unavailable": False,  # its audit record could not be written: refused, nothing sent
     "error": False,
 }
 

@@ -144,8 +144,13 @@ def test_reduced_speed_caps_every_motion_and_shows_the_cap(qtbot: Any, sim: Any,
     )
     assert [v for _, v in register_writes(sim, registers.REG_PROGRAM_SPEED)] == [10]
     assert "at 10 % (capped by reduced speed; 50 % set)" in questions[-1]
-    with qtbot.waitSignal(window.link.commandFinished, timeout=SIGNAL_TIMEOUT_MS):
-        window.link.stop()
+    stop_ids: list[int] = []  # the Stop's own result (the stopped program's comes first)
+    with qtbot.waitSignal(
+        window.link.commandFinished,
+        check_params_cb=lambda r: r.request_id in stop_ids,
+        timeout=SIGNAL_TIMEOUT_MS,
+    ):
+        stop_ids.append(window.link.stop())
     assert sim.wait_for(lambda s: not s.moving, 5.0)
 
     # a move to a point: the cap beside its speed, and the speed it goes out at
@@ -167,6 +172,7 @@ def test_reduced_speed_caps_every_motion_and_shows_the_cap(qtbot: Any, sim: Any,
     assert step.speed_cap.text() == "→ 250 mm/s"
     with qtbot.waitSignal(window.link.commandFinished, check_params_cb=_ok(), timeout=SIGNAL_TIMEOUT_MS):
         qtbot.mouseClick(step.minus_buttons[2], Qt.MouseButton.LeftButton)  # Z-
+    qtbot.waitUntil(lambda: len(gv_writes(sim, registers.GV_EXPECTED_SPEED)) >= 2, timeout=SIGNAL_TIMEOUT_MS)
     speeds = [v for _, v in gv_writes(sim, registers.GV_EXPECTED_SPEED)]
     assert speeds == pytest.approx([caps.joint_rpm_cap, REDUCED_SPEED_DEFAULT], rel=1e-6)
 
