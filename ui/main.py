@@ -75,23 +75,23 @@ class SimProcess:
         self.port = port
         self._reader = reader
 
+    @staticmethod
+    def command() -> tuple[list[str], dict[str, str]]:
+        """The child's command line and environment (its stdin and stdout are pipes from us)."""
+        root = str(Path(__file__).resolve().parent.parent)  # where ``app`` is, installed or not
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH", "")) if p)
+        env["PYTHONUNBUFFERED"] = "1"
+        return [sys.executable, "-c", _SIM_CHILD, "--host", "127.0.0.1", "--port", "0", "--no-stdin"], env
+
     @classmethod
     def start(cls, timeout: float = SIM_START_TIMEOUT) -> SimProcess:
         """Start ``teachpad-sim --port 0`` and wait until it says its port. Raises RuntimeError."""
         import queue
         import subprocess
 
-        root = str(Path(__file__).resolve().parent.parent)  # where ``app`` is, installed or not
-        env = dict(os.environ)
-        env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH", "")) if p)
-        env["PYTHONUNBUFFERED"] = "1"
-        process = subprocess.Popen(
-            [sys.executable, "-c", _SIM_CHILD, "--host", "127.0.0.1", "--port", "0", "--no-stdin"],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-            env=env,
-        )
+        command, env = cls.command()
+        process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env)
         lines: queue.Queue[str] = queue.Queue()
 
         def read_stdout() -> None:
