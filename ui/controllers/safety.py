@@ -100,6 +100,8 @@ class SafetyController(QObject):
     envelopeChanged = Signal(object)
     reducedChanged = Signal(bool)
     message = Signal(str)  # a refusal or a problem, already translated, for the event log / status
+    # (emitted in the GUI thread only: its receivers touch widgets)
+    _auditFailed = Signal(str)  # noqa: N815 - from the audit's own thread (the worker records writes)
 
     def __init__(
         self,
@@ -120,7 +122,11 @@ class SafetyController(QObject):
             self._problem = str(exc)
         else:
             self._problem = ""
-        audit = AuditLog(audit_dir, on_error=lambda text: self.message.emit(text))
+        # The audit hears of a problem in the thread that wrote: mostly the link's worker. Its
+        # callback only emits _auditFailed, whose receiver (a slot of this object, GUI thread) is
+        # reached by a queued call; ``message`` is then emitted in the GUI thread.
+        self._auditFailed.connect(self._on_audit_failed)
+        audit = AuditLog(audit_dir, on_error=self._auditFailed.emit)
         self.profile = SafetyProfile()
         if self.profile_path.exists():
             try:
@@ -154,6 +160,10 @@ class SafetyController(QObject):
             self._app.focusObjectChanged.connect(self._focus_moved)
         self._watch_windows()
         self._push_guard()
+
+    @Slot(str)
+    def _on_audit_failed(self, text: str) -> None:
+        self.message.emit(text)
 
     @property
     def problem(self) -> str:
