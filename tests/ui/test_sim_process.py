@@ -95,3 +95,26 @@ def test_the_simulator_exits_quietly_when_the_window_goes_away() -> None:
     assert "Traceback" not in errors and "BrokenPipeError" not in errors, errors
     assert "Exception ignored" not in errors, errors
     assert code == 0, errors
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_the_simulator_stops_cleanly_on_ctrl_c_with_the_window_still_there() -> None:
+    """Ctrl-C in the terminal of ``teachpad --sim`` reaches the child too, while its stdin watch
+    still waits: it stops with exit code 0 (it aborted at exit: "Fatal Python error:
+    _enter_buffered_busy", the watch held sys.stdin's lock)."""
+    import signal
+
+    command, env = SimProcess.command()
+    child = subprocess.Popen(
+        command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
+    )
+    try:
+        assert child.stdout is not None and child.stderr is not None
+        assert "listening on" in read_line(child.stdout, "the simulator's port")
+        child.send_signal(signal.SIGINT)
+        code = wait_child(child, "the simulator after Ctrl-C")
+        errors = child.stderr.read()
+    finally:
+        kill_child(child)
+    assert "Fatal Python error" not in errors and "Traceback" not in errors, errors
+    assert code == 0, errors

@@ -101,7 +101,7 @@ class SafetyController(QObject):
     reducedChanged = Signal(bool)
     message = Signal(str)  # a refusal or a problem, already translated, for the event log / status
     # (emitted in the GUI thread only: its receivers touch widgets)
-    _auditFailed = Signal(str)  # noqa: N815 - from the audit's own thread (the worker records writes)
+    _auditFailed = Signal(str)  # from the audit's own thread (the worker records writes)
 
     def __init__(
         self,
