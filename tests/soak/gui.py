@@ -25,7 +25,7 @@ import threading
 import time
 import traceback
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from types import TracebackType
 from typing import Any
@@ -38,6 +38,7 @@ from PySide6.QtCore import (
     Signal,
     Slot,
     qInstallMessageHandler,
+    qWarning,
 )
 from PySide6.QtWidgets import QApplication
 
@@ -141,8 +142,9 @@ class Session(QObject):
 
     failed = Signal()  # from any thread: end now
 
-    def __init__(self, rng: random.Random, seconds: float, folder: Path) -> None:
+    def __init__(self, rng: random.Random, seconds: float, folder: Path, inject: str = "") -> None:
         super().__init__()
+        self.inject = inject
         self.rng = rng
         self.seconds = seconds
         self.folder = folder
@@ -195,10 +197,23 @@ class Session(QObject):
             say(f"connected to the simulator at {settings.host}:{settings.port}; simulator pid {_children()}")
             self.operator = Operator(window, self.rng, say, settings)
             self.operator.start()
+            if self.inject:
+                QTimer.singleShot(1000, self, self._inject)
             self._deadline = time.monotonic() + self.seconds
             QTimer.singleShot(round(self.seconds * 1000), self, self.end)
         elif time.monotonic() > self._deadline:
             fail(f"the link did not come up within {CONNECT_WAIT:g} s")
+
+    @Slot()
+    def _inject(self) -> None:
+        """The soak's self-test (tests/soak/test_soak_smoke.py): the failure asked for, from a
+        thread of its own: the hooks must catch it wherever it happens."""
+        say(f"injecting: {self.inject}")
+        if self.inject == "qt-warning":
+            target: Callable[[], object] = lambda: qWarning("soak self-test: a Qt warning")  # noqa: E731
+        else:
+            target = lambda: 1 / 0  # noqa: E731
+        threading.Thread(target=target, name="soak-inject").start()
 
     def _status(self) -> None:
         if time.monotonic() < self.status_at or self.window is None or self.operator is None:
@@ -269,6 +284,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--seed", type=int, required=True)
     parser.add_argument("--seconds", type=float, required=True)
     parser.add_argument("--home", type=Path, required=True, help="settings, project, outputs")
+    parser.add_argument("--inject", choices=["qt-warning", "exception"], default="", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     install_hooks()
     home: Path = args.home
@@ -277,7 +293,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     shutil.copyfile(SAMPLE, project)
     say(f"soak session: seed {args.seed}, {args.seconds:g} s, home {home}")
     app = QApplication.instance() or QApplication([sys.argv[0]])
-    _session = session = Session(random.Random(args.seed), args.seconds, home)
+    _session = session = Session(random.Random(args.seed), args.seconds, home, args.inject)
     import ui.main as teachpad
 
     code = teachpad.main(["--sim", "--settings", str(home / "teachpad.ini"), "--project", str(project)])

@@ -51,6 +51,7 @@ MARKERS = (
     "Segmentation fault",
     "BrokenPipeError",
 )
+_SIM_PID = re.compile(r"simulator pid (\d+)")
 _ACTION = re.compile(r" s  #\d{5} ")  # an action's line in the log (tests/soak/gui.py: say)
 
 
@@ -80,8 +81,11 @@ def _pump(stream: IO[str], sink: IO[str], echo: bool, lines: list[str]) -> None:
     sink.flush()
 
 
-def run_session(number: int, seed: int, seconds: float, out: Path, *, echo: bool = True) -> SessionResult:
-    """One GUI process for ``seconds`` of actions, judged (see the module docstring)."""
+def run_session(
+    number: int, seed: int, seconds: float, out: Path, *, echo: bool = True, inject: str = ""
+) -> SessionResult:
+    """One GUI process for ``seconds`` of actions, judged (see the module docstring). ``inject``:
+    the self-test's failure (tests/soak/test_soak_smoke.py)."""
     result = SessionResult(number, seed, seconds)
     home = out / f"session-{number}"
     env = dict(os.environ)
@@ -93,6 +97,7 @@ def run_session(number: int, seed: int, seconds: float, out: Path, *, echo: bool
     )
     command = [sys.executable, "-X", "faulthandler", "-m", "tests.soak.gui"]
     command += ["--seed", str(seed), "--seconds", f"{seconds:g}", "--home", str(home / "home")]
+    command += ["--inject", inject] if inject else []
     start = time.monotonic()
     out_lines: list[str] = []
     err_lines: list[str] = []
@@ -121,9 +126,25 @@ def run_session(number: int, seed: int, seconds: float, out: Path, *, echo: bool
             pump.join(SIM_EXIT_WAIT)
         if any(pump.is_alive() for pump in pumps):
             result.problems.append(f"the simulator child still runs {SIM_EXIT_WAIT:g} s after its window")
+            _kill_simulator(out_lines)
+            for pump in pumps:
+                pump.join(SIM_EXIT_WAIT)
+        child.stdout.close()
+        child.stderr.close()
     result.wall = time.monotonic() - start
     _judge(result, out_lines, err_lines, out)
     return result
+
+
+def _kill_simulator(out_lines: list[str]) -> None:
+    """Kill the simulator child the session named (``simulator pid N``), so its pipe closes."""
+    for line in out_lines:
+        found = _SIM_PID.search(line)
+        if found:
+            try:
+                os.kill(int(found[1]), signal.SIGKILL)
+            except OSError:
+                pass
 
 
 def _wait(child: subprocess.Popen[str], timeout: float, result: SessionResult) -> int:
