@@ -9,10 +9,12 @@ import json
 import subprocess
 import sys
 import textwrap
+import threading
+import time
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QObject
+from PySide6.QtCore import QObject, Qt, QThread, QTimer, Slot
 
 from tests.cli.ctrl_c import untraced_env
 from ui.gui_gc import GuiThreadCollector, due_generation
@@ -129,3 +131,72 @@ def test_a_process_without_automatic_collection_gets_none(qapp: Any) -> None:
         assert not gc.isenabled()
     finally:
         gc.enable()
+
+
+class _Churn(QObject):
+    """Allocates in its own thread (as the link's worker does at every poll), cycles included,
+    until ``stop`` is set."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.stop = threading.Event()
+        self.rounds = 0
+
+    @Slot()
+    def run(self) -> None:
+        while not self.stop.is_set():
+            junk: list[Any] = [[i] for i in range(50)]
+            junk.append(junk)
+            self.rounds += 1
+
+
+def _let_allocate(churn: _Churn, rounds: int) -> None:
+    """Hand the GIL to the allocating thread until it made ``rounds`` more rounds (bounded)."""
+    churn.rounds = 0
+    deadline = time.monotonic() + 10.0
+    while churn.rounds < rounds:
+        assert time.monotonic() < deadline, "the allocating thread does not run"
+        time.sleep(0)  # a GIL hand-off, not a wait for time to pass
+
+
+def test_a_parentless_qt_object_in_a_cycle_dies_on_the_gui_thread_while_a_worker_allocates(
+    qtbot: Any,
+) -> None:
+    """The crash's mechanism: under automatic collection, a pass started by the worker's
+    allocations destroyed the GUI thread's garbage there (measured with started QTimers in
+    cycles: 293 of 2000 destroyed on the worker, Qt: "Timers cannot be stopped from another
+    thread"; a widget dies harder). With the GUI-thread collector, every one dies here."""
+    was = gc.get_threshold()
+    pause = StartupGcPause()
+    collector = GuiThreadCollector(pause, check_ms=5)
+    thread = QThread()
+    churn = _Churn()
+    churn.moveToThread(thread)
+    thread.started.connect(churn.run)
+    died: list[bool] = []  # destroyed in the GUI thread?
+    gui_thread = QThread.currentThread()
+    try:
+        collector.start()
+        gc.set_threshold(50, 10, 10)
+        thread.start()
+        qtbot.waitUntil(lambda: churn.rounds > 100, timeout=10_000)
+        for _ in range(100):
+            timer = QTimer()  # no parent, started: its timer is registered in this thread
+            timer.start(60_000)
+            timer.destroyed.connect(
+                lambda *_a: died.append(QThread.currentThread() is gui_thread),
+                Qt.ConnectionType.DirectConnection,
+            )
+            cycle: list[Any] = [timer]
+            cycle.append(cycle)
+            del timer, cycle
+            _let_allocate(churn, 5)
+        qtbot.waitUntil(lambda: len(died) == 100, timeout=10_000)  # the collector's ticks free them
+    finally:
+        churn.stop.set()
+        thread.quit()
+        thread.wait()
+        gc.set_threshold(*was)
+        collector.stop()
+        pause.resume()
+    assert all(died) and collector.passes > 0
