@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
 export QT_QPA_PLATFORM ?= offscreen
 
-.PHONY: run test lint bench bench-quick sim translations clean
+.PHONY: run test lint bench bench-quick sim soak translations clean
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -42,6 +42,14 @@ bench: $(STAMP)
 
 bench-quick: $(STAMP)
 	$(BIN)/python -m benchmarks.run --quick
+
+# The real window against the simulator for SOAK_MINUTES of random operator actions (seeded:
+# SOAK_SEED repeats a run), under faulthandler, Qt warnings fatal, core dumps on; fails on any
+# crash, warning or traceback (tests/soak/run.py). Not part of `make test`.
+SOAK_MINUTES ?= 30
+SOAK_SEED ?=
+soak: $(STAMP)
+	$(BIN)/python -m tests.soak.run --minutes $(SOAK_MINUTES) $(if $(SOAK_SEED),--seed $(SOAK_SEED))
 
 # Collect every tr() string, fill Chinese from resources/translations/*_zh_CN.txt, compile the .qm.
 translations: $(STAMP)

@@ -298,7 +298,7 @@ class _Counters(QObject):
     def _on_pose(self, _pose: Pose) -> None:
         self.poses += 1
 
-    def _on_traffic(self, batch: list[Any]) -> None:
+    def _on_traffic(self, batch: tuple[Any, ...]) -> None:
         self.traffic_frames += len(batch)
 
     def _on_result(self, result: CommandResult) -> None:

@@ -258,7 +258,7 @@ def run_synthetic(seconds: float, profiler: cProfile.Profile | None) -> dict[str
             )
             state.set_status(status)
             state.note_good_poll(time.monotonic())
-            link.trafficObserved.emit(feed.batch())
+            link.trafficObserved.emit(tuple(feed.batch()))
 
         timer = QTimer()
         timer.setTimerType(Qt.TimerType.PreciseTimer)

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QEvent, QObject, QTimer, Signal
 from PySide6.QtWidgets import QApplication, QWidget
 
+from ui.gui_gc import GuiThreadCollector
 from ui.startup_gc import StartupGcPause, gc_paused
 
 with gc_paused():  # the window's modules: many objects made, almost none freed (ui/startup_gc.py)
@@ -43,7 +44,7 @@ SCREENSHOT_TIMEOUT_MS = 20_000  # give up when no pose arrives
 DEMO_PROGRAM = 1  # the simulator's "square 100 mm in XY"
 SIM_START_TIMEOUT = 20.0  # s for the simulator process to say which port it listens on
 SIM_START_LATEST_MS = 5000  # start the simulator then, even when the window has not painted yet
-STARTUP_GC_LATEST_MS = 5000  # garbage collection back on then, even when the window has not painted
+STARTUP_GC_LATEST_MS = 5000  # the GUI thread's garbage collection starts then, even with no paint yet
 SIM_STOP_TIMEOUT = 10.0  # s for it to stop after its stdin closed, before it is terminated (a loaded
 # machine needs seconds to wind an interpreter down; this waits after the window has closed)
 THREADS_EXIT_WAIT = 5.0  # s at exit for a worker thread still stuck in a network call
@@ -51,11 +52,15 @@ THREADS_EXIT_WAIT = 5.0  # s at exit for a worker thread still stuck in a networ
 # The simulator's process: ``teachpad-sim`` on a free port, plus a watch on its stdin -- a pipe
 # from this process. The pipe closes when the window closes (SimProcess.stop) and also when this
 # process dies, however it dies: the simulator then stops by itself (SIGTERM to itself, which
-# teachpad-sim handles like Ctrl-C).
+# teachpad-sim handles like Ctrl-C). The watch reads the file descriptor itself, not sys.stdin:
+# a child stopped another way (Ctrl-C in the terminal reaches it too) ends its interpreter while
+# the watch still waits, and a wait inside sys.stdin's buffer holds that buffer's lock, which the
+# interpreter's exit then cannot take ("Fatal Python error: _enter_buffered_busy", SIGABRT).
 _SIM_CHILD = """\
 import os, signal, sys, threading
 def _watch_parent():
-    sys.stdin.buffer.read()
+    while os.read(0, 4096):
+        pass
     os.kill(os.getpid(), signal.SIGTERM)
 threading.Thread(target=_watch_parent, name="parent-watch", daemon=True).start()
 from app.sim.cli import main
@@ -75,23 +80,23 @@ class SimProcess:
         self.port = port
         self._reader = reader
 
+    @staticmethod
+    def command() -> tuple[list[str], dict[str, str]]:
+        """The child's command line and environment (its stdin and stdout are pipes from us)."""
+        root = str(Path(__file__).resolve().parent.parent)  # where ``app`` is, installed or not
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH", "")) if p)
+        env["PYTHONUNBUFFERED"] = "1"
+        return [sys.executable, "-c", _SIM_CHILD, "--host", "127.0.0.1", "--port", "0", "--no-stdin"], env
+
     @classmethod
     def start(cls, timeout: float = SIM_START_TIMEOUT) -> SimProcess:
         """Start ``teachpad-sim --port 0`` and wait until it says its port. Raises RuntimeError."""
         import queue
         import subprocess
 
-        root = str(Path(__file__).resolve().parent.parent)  # where ``app`` is, installed or not
-        env = dict(os.environ)
-        env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH", "")) if p)
-        env["PYTHONUNBUFFERED"] = "1"
-        process = subprocess.Popen(
-            [sys.executable, "-c", _SIM_CHILD, "--host", "127.0.0.1", "--port", "0", "--no-stdin"],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-            env=env,
-        )
+        command, env = cls.command()
+        process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env)
         lines: queue.Queue[str] = queue.Queue()
 
         def read_stdout() -> None:
@@ -373,8 +378,9 @@ class _Screenshot:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    # No automatic garbage collection until the window's first paint (ui/startup_gc.py): resumed
-    # by after_first_paint, or when main ends before that.
+    # No automatic garbage collection in this process while the window lives: from here until the
+    # first paint none at all (ui/startup_gc.py), then only on the GUI thread (ui/gui_gc.py).
+    # Automatic collection is back when main ends.
     startup_gc = StartupGcPause()
     try:
         return _main(argv, startup_gc)
@@ -446,8 +452,10 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
         starter.started.connect(sim_started)
         starter.failed.connect(sim_failed)
 
+    collector = GuiThreadCollector(startup_gc, window)
+
     def after_first_paint() -> None:
-        startup_gc.resume()
+        collector.start()
         # The link's worker (pymodbus, the envelope) is made by the connection, after the paint.
         if connection is not None:
             link.connect_to(connection)
@@ -456,7 +464,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
         window.start_project(args.project, reopen_last=not shot_run, offer_recovery=not shot_run)
 
     _AfterFirstPaint(window, after_first_paint)
-    QTimer.singleShot(STARTUP_GC_LATEST_MS, startup_gc.resume)  # a window never painted (minimized)
+    QTimer.singleShot(STARTUP_GC_LATEST_MS, collector, collector.start)  # a window never painted
     window.show()
     try:
         code = exit_loop.exec()
@@ -475,6 +483,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
         if not wait_for_detached_threads(THREADS_EXIT_WAIT):
             print("teachpad: the link to the controller did not close in time", file=sys.stderr)
         translator.uninstall()
+        collector.stop()  # automatic collection is back when main() ends
         window.deleteLater()
     return int(code)
 

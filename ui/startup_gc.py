@@ -27,6 +27,11 @@ class StartupGcPause:
         self._resume = gc.isenabled()
         gc.disable()
 
+    @property
+    def pausing(self) -> bool:
+        """The pause is on and will turn collection back on (it was on before)."""
+        return self._resume
+
     def resume(self) -> None:
         """Collection back on (if it was on before the pause); later calls do nothing."""
         if self._resume:

@@ -44,11 +44,13 @@ class TrafficCapture:
         if self.on:
             self._records.append(record)
 
-    def flush(self) -> list[TrafficRecord] | None:
-        """The frames since the last flush (None when not capturing or nothing new)."""
+    def flush(self) -> tuple[TrafficRecord, ...] | None:
+        """The frames since the last flush (None when not capturing or nothing new): a tuple of
+        frozen records, so the batch that crosses into the GUI thread can change in neither."""
         if not (self.on and self._records):
             return None
-        batch, self._records = self._records, []
+        batch = tuple(self._records)
+        self._records.clear()
         return batch
 
 

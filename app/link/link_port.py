@@ -7,7 +7,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from typing import Protocol
 
-from PySide6.QtCore import QObject, QTimer, Signal, SignalInstance
+from PySide6.QtCore import QMetaMethod, QObject, QTimer, Signal, SignalInstance
 
 from app.link.state import RobotState
 from app.link.types import StepFrame, WorkerError
@@ -18,7 +18,13 @@ __all__ = ["LinkPort", "Pending", "RequestRouter"]
 
 
 class Pending(QObject):
-    """One request's outcome: exactly one of ``finished`` / ``failed`` fires, once."""
+    """One request's outcome: exactly one of ``finished`` / ``failed`` fires, once; then every
+    receiver is disconnected (connect before the outcome: call ``track`` right away).
+
+    Why the disconnect: a receiver that captures its Pending (``pending.finished.connect(lambda r:
+    self._on_result(pending, r))``, the controllers' way) makes a cycle that runs through Qt's
+    connection, which the garbage collector cannot see: every such Pending (and what its lambdas
+    captured) lived as long as the process, a leak per request (issue 18)."""
 
     finished = Signal(CommandResult)
     failed = Signal(WorkerError)
@@ -41,11 +47,24 @@ class Pending(QObject):
         if not self.done:
             self.result = result
             self.finished.emit(result)
+            self._release()
 
     def _fail(self, error: WorkerError) -> None:
         if not self.done:
             self.error = error
             self.failed.emit(error)
+            self._release()
+
+    def _release(self) -> None:
+        """Drop the receivers of both signals: nothing more will be emitted (see the class)."""
+        # Looked up in the meta-object: QMetaMethod.fromSignal(self.finished) keeps a reference
+        # to self (PySide 6.11), the very leak this ends; disconnecting a signal without
+        # receivers warns.
+        meta = self.metaObject()
+        for index in range(meta.methodOffset(), meta.methodCount()):
+            method = meta.method(index)
+            if method.methodType() == QMetaMethod.MethodType.Signal and self.isSignalConnected(method):
+                getattr(self, bytes(method.name().data()).decode()).disconnect()
 
 
 class RequestRouter:

@@ -64,7 +64,7 @@ class RobotLink(QObject):
     rttChanged = Signal(float)  # noqa: N815
     commandFinished = Signal(CommandResult)  # noqa: N815
     errorOccurred = Signal(WorkerError)  # noqa: N815
-    trafficObserved = Signal(list)  # noqa: N815
+    trafficObserved = Signal(tuple)  # noqa: N815 - tuple[TrafficRecord, ...]: see RobotWorker
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815
     uploadProgress = Signal(int, int)  # noqa: N815

@@ -102,7 +102,9 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     linkStatsChanged = Signal(object)  # noqa: N815 - LinkStats, at most every RTT_REPORT_PERIOD, on change
     commandFinished = Signal(CommandResult)  # noqa: N815
     errorOccurred = Signal(WorkerError)  # noqa: N815
-    trafficObserved = Signal(list)  # noqa: N815 - list[TrafficRecord], a batch every TRAFFIC_DELIVERY_PERIOD, only while capturing
+    # tuple[TrafficRecord, ...] (immutable, handed over as it is; Signal(list) was a QVariantList,
+    # converted record by record in both threads), a batch every TRAFFIC_DELIVERY_PERIOD, only while capturing
+    trafficObserved = Signal(tuple)  # noqa: N815
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815 - the canary GV changed while the link stayed up
     uploadProgress = Signal(int, int)  # noqa: N815 - points done, total
@@ -320,7 +322,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     def publish_link_stats(self, stats: LinkStats) -> None:
         self.linkStatsChanged.emit(stats)
 
-    def publish_traffic(self, records: list[TrafficRecord]) -> None:
+    def publish_traffic(self, records: tuple[TrafficRecord, ...]) -> None:
         self.trafficObserved.emit(records)
 
     def publish_reconnected(self) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import signal
 import sys
 import threading
@@ -235,15 +236,18 @@ def main(argv: Sequence[str] | None = None) -> int:
             previous[sig] = signal.signal(sig, on_signal)
     # Announced only now: whoever waits for this line may stop us at once (SIGTERM), and before
     # the handler exists that would kill the process instead of stopping it cleanly.
-    print(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop", flush=True)
+    _say(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop")
 
     if not args.no_stdin:
 
         def read_stdin() -> None:
-            for line in sys.stdin:
-                if not execute(sim, line, sys.stdout):
-                    done.set()
-                    return
+            try:
+                for line in sys.stdin:
+                    if not execute(sim, line, sys.stdout):
+                        break
+            except BrokenPipeError:  # nobody reads our answers any more: stop, quietly
+                pass
+            done.set()
 
         threading.Thread(target=read_stdin, name="sim-stdin", daemon=True).start()
 
@@ -256,8 +260,26 @@ def main(argv: Sequence[str] | None = None) -> int:
         sim.stop()
         for sig, handler in previous.items():
             signal.signal(sig, handler)  # type: ignore[arg-type]
-    print("teachpad-sim stopped", flush=True)
+    _say("teachpad-sim stopped")
     return 0
+
+
+def _say(line: str) -> None:
+    """One line on stdout, flushed; nobody reading any more is not an error.
+
+    ``teachpad --sim`` reads this process's stdout through a pipe; when the GUI goes away (closed,
+    killed, crashed) the pipe's reader is gone, and the simulator stops by itself (its stdin
+    closed): the last line then meets a closed pipe. The line is dropped and stdout points to
+    the null device from then on, so neither this print nor the interpreter's flush at exit
+    raises BrokenPipeError."""
+    try:
+        print(line, flush=True)
+    except BrokenPipeError:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        try:
+            os.dup2(devnull, sys.stdout.fileno())
+        finally:
+            os.close(devnull)
 
 
 if __name__ == "__main__":

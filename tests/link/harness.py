@@ -122,7 +122,7 @@ class PartsHost:
     def publish_link_stats(self, stats: LinkStats) -> None:
         self.out.append(("linkStatsChanged", stats))
 
-    def publish_traffic(self, records: list[TrafficRecord]) -> None:
+    def publish_traffic(self, records: tuple[TrafficRecord, ...]) -> None:
         self.out.append(("trafficObserved", records))
 
     def publish_guard_stop(self, violation: EnvelopeViolation) -> None:

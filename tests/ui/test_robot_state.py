@@ -3,7 +3,9 @@ a real RobotLink talking to the simulator."""
 
 from __future__ import annotations
 
+import gc
 import time
+import weakref
 from collections.abc import Iterator
 from typing import Any
 
@@ -247,6 +249,33 @@ def test_two_creates_in_a_row_each_get_their_own_result(qtbot: Any, sim: Any, li
         assert pending.result.request_id == pending.request_id
     assert sim.state().points[22] == pytest.approx(target) and 21 in sim.state().points
     assert sim.state().points[23] == pytest.approx(target)
+
+
+def _watch(link: RobotLink, request_id: int, outcomes: list[object]) -> weakref.ref[Pending]:
+    """Track a request as the controllers do: lambdas that capture their Pending (a cycle through
+    Qt's connection, which the garbage collector cannot see)."""
+    pending = link.track(request_id)
+    pending.finished.connect(lambda result: outcomes.append((pending.request_id, result)))
+    pending.failed.connect(lambda error: outcomes.append((pending.request_id, error)))
+    return weakref.ref(pending)
+
+
+def test_a_pending_is_freed_once_its_request_ended(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    """Issue 18: every Pending whose lambdas captured it was kept for the life of the process
+    (a leak per request). Once its one outcome was delivered, nothing keeps it."""
+    connect(qtbot, link, sim)
+    outcomes: list[object] = []
+    target = (400.0, 10.0, 300.0, 180.0, 0.0, 0.0)
+    refs = [_watch(link, link.create_point(30 + i, target), outcomes) for i in range(8)]
+    refs += [_watch(link, link.pause(), outcomes) for _ in range(4)]
+    refs.append(_watch(link, link.step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0]), outcomes))  # fails in the worker
+    refs.append(_watch(link, 0, outcomes))  # never queued: fails on the next turn of the loop
+    qtbot.waitUntil(lambda: len(outcomes) == len(refs), timeout=SIGNAL_TIMEOUT_MS)
+    assert len(link._router) == 0
+    gc.collect()
+    alive = [ref() for ref in refs if ref() is not None]
+    assert alive == [], f"{len(alive)} of {len(refs)} Pendings still alive after their outcome"
+    assert len(outcomes) == len(refs)  # and each delivered its outcome once
 
 
 def test_the_state_follows_the_link(qtbot: Any, sim: Any, qapp: Any, fast_reconnect: None) -> None:

@@ -12,6 +12,7 @@ from typing import Any
 
 import pytest
 
+from tests.waits import kill_child, read_line, wait_child
 from ui.main import SimProcess
 
 pytestmark = pytest.mark.timeout(60)
@@ -73,3 +74,47 @@ def test_the_simulator_stops_when_the_gui_process_dies() -> None:
     assert parent.returncode == 3, parent.stderr
     child = int(parent.stdout.split()[0])
     assert _gone(child, 10.0)
+
+
+def test_the_simulator_exits_quietly_when_the_window_goes_away() -> None:
+    """The GUI gone (closed, killed, crashed) closes both pipes: the child stops by itself and
+    its last line meets a pipe nobody reads -- no BrokenPipeError traceback, exit code 0."""
+    command, env = SimProcess.command()  # started as the GUI starts it
+    child = subprocess.Popen(
+        command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
+    )
+    try:
+        assert child.stdout is not None and child.stdin is not None and child.stderr is not None
+        assert "listening on" in read_line(child.stdout, "the simulator's port")
+        child.stdout.close()  # the GUI's reader is gone ...
+        child.stdin.close()  # ... and so is its end of the stdin pipe: the child stops itself
+        code = wait_child(child, "the simulator after its parent went away")
+        errors = child.stderr.read()
+    finally:
+        kill_child(child)
+    assert "Traceback" not in errors and "BrokenPipeError" not in errors, errors
+    assert "Exception ignored" not in errors, errors
+    assert code == 0, errors
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_the_simulator_stops_cleanly_on_ctrl_c_with_the_window_still_there() -> None:
+    """Ctrl-C in the terminal of ``teachpad --sim`` reaches the child too, while its stdin watch
+    still waits: it stops with exit code 0 (it aborted at exit: "Fatal Python error:
+    _enter_buffered_busy", the watch held sys.stdin's lock)."""
+    import signal
+
+    command, env = SimProcess.command()
+    child = subprocess.Popen(
+        command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env
+    )
+    try:
+        assert child.stdout is not None and child.stderr is not None
+        assert "listening on" in read_line(child.stdout, "the simulator's port")
+        child.send_signal(signal.SIGINT)
+        code = wait_child(child, "the simulator after Ctrl-C")
+        errors = child.stderr.read()
+    finally:
+        kill_child(child)
+    assert "Fatal Python error" not in errors and "Traceback" not in errors, errors
+    assert code == 0, errors

@@ -6,12 +6,13 @@ request on the main link, consecutive)."""
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QCoreApplication
+from PySide6.QtCore import QCoreApplication, Qt
 
 from app import timing
 from app.link.client import TrafficRecord
@@ -43,7 +44,7 @@ class Batches:
     """The trafficObserved batches the GUI thread received, in order."""
 
     def __init__(self, link: RobotLink) -> None:
-        self.batches: list[list[TrafficRecord]] = []
+        self.batches: list[tuple[TrafficRecord, ...]] = []
         link.trafficObserved.connect(self.batches.append)
 
     @property
@@ -184,3 +185,22 @@ def test_a_commands_frames_come_before_its_result(
     assert writes_at_result == [len(sim.writes)]  # all of its writes were already in the table
     writes = [r for r in got.tx() if r.frame[7] in (0x06, 0x10)]
     assert int.from_bytes(writes[-1].frame[8:10], "big") == registers.REG_RUN_COMMAND  # the command last
+
+
+def test_a_batch_crosses_threads_as_one_immutable_object(qtbot: Any, sim: Any, link: RobotLink) -> None:
+    """Issue 18: a batch was a list (``Signal(list)``: copied into a QVariantList in the worker,
+    one QVariant per record, and back into a new list in the GUI thread). It is one tuple of
+    frozen records now, handed over as it is: the GUI thread gets the object the worker made."""
+    made: list[object] = []  # what the worker emitted (recorded in the worker thread)
+    link.set_traffic_capture(True)
+    _ = link._worker  # made now, so its own signal can be watched from the start
+    assert link._made is not None
+    link._made.trafficObserved.connect(made.append, Qt.ConnectionType.DirectConnection)
+    got = _capturing(qtbot, sim, link, polls=10)
+    qtbot.waitUntil(lambda: len(got.batches) >= 2, timeout=SIGNAL_TIMEOUT_MS)
+    batch = got.batches[0]
+    assert isinstance(batch, tuple) and batch
+    assert all(isinstance(record, TrafficRecord) for record in batch)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        batch[0].frame = b""  # type: ignore[misc]
+    assert batch is made[0]  # not a copy made on the way

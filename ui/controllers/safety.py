@@ -111,6 +111,8 @@ class SafetyController(QObject):
     reducedChanged = Signal(bool)
     capsChanged = Signal(object)  # MotionCaps | None: after every change of the envelope or the mode
     message = Signal(str)  # a refusal or a problem, already translated, for the event log / status
+    # (emitted in the GUI thread only: its receivers touch widgets)
+    _auditFailed = Signal(str)  # from the audit's own thread (the worker records writes)
 
     def __init__(
         self,
@@ -131,7 +133,11 @@ class SafetyController(QObject):
             self._problem = str(exc)
         else:
             self._problem = ""
-        audit = AuditLog(audit_dir, on_error=lambda text: self.message.emit(text))
+        # The audit hears of a problem in the thread that wrote: mostly the link's worker. Its
+        # callback only emits _auditFailed, whose receiver (a slot of this object, GUI thread) is
+        # reached by a queued call; ``message`` is then emitted in the GUI thread.
+        self._auditFailed.connect(self._on_audit_failed)
+        audit = AuditLog(audit_dir, on_error=self._auditFailed.emit)
         self._reach: float | None = None  # the robot model's reach bound (mm), read when first needed
         self.profile = SafetyProfile()
         fresh = not self.profile_path.exists()
@@ -186,6 +192,10 @@ class SafetyController(QObject):
             "create the default envelope",
             args={"robot": self.profile.robot, "revision": self.profile.revision},
         )
+
+    @Slot(str)
+    def _on_audit_failed(self, text: str) -> None:
+        self.message.emit(text)
 
     @property
     def problem(self) -> str:

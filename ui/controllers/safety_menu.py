@@ -147,6 +147,12 @@ class SafetyMenu(QObject):
             else self.tr("Cap jog and move speeds (anyone may switch it on)")
         )
 
+    @Slot(str)
+    def show_message(self, text: str) -> None:
+        """A refusal or a problem of the guard rails: in the event log and the status bar."""
+        self.window.event_log.add_event("warning", self.source_name(), text)
+        self.window.statusBar().showMessage(text, 8000)
+
     def source_name(self) -> str:
         """The event log's source column for safety messages."""
         return self.tr("safety")
@@ -324,8 +330,7 @@ def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> Safety
     # the 3D view is built on first show: its canvas and its Robot model… button are attached then
     window.view3d.robot.guard = safety
     window.view3d.on_built(lambda panel: attach_view3d(safety, panel))
-    safety.message.connect(lambda text: window.event_log.add_event("warning", menu.source_name(), text))
-    safety.message.connect(lambda text: window.statusBar().showMessage(text, 8000))
+    safety.message.connect(menu.show_message)  # a slot of the menu: a receiver in the GUI thread
     if safety.problem:
         safety.message.emit(safety.problem)
     register_problem = window.settings.register_profile()[1]

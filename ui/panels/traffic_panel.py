@@ -14,6 +14,7 @@ from __future__ import annotations
 import csv
 import io
 import os
+from collections.abc import Sequence
 from typing import Any
 
 from PySide6.QtCore import (
@@ -177,7 +178,7 @@ class TrafficPanel(QWidget):
 
     # --- slots ------------------------------------------------------------------------
     @Slot(object)
-    def on_traffic(self, records: list[Any]) -> None:
+    def on_traffic(self, records: Sequence[Any]) -> None:
         """Append a batch of TrafficRecords (ignored while capture is paused).
 
         While the panel is visible, batches are gathered and inserted at most every
