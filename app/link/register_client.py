@@ -27,6 +27,7 @@ from typing import Self
 from app.errors import InvalidInput, WriteBlocked
 from app.link.checks import check_float, check_int, check_settings, range_name
 from app.link.decode import decode_pose, decode_status
+from app.link.foreign import ForeignMasterWatch
 from app.link.stats import LinkStats
 from app.link.transport import ConnectionSettings, TrafficObserver, Transport
 from app.models import ControllerStatus, Pose
@@ -66,6 +67,7 @@ class RegisterClient:
         self.write_answered_at = 0.0
         self.write_lost_until = 0.0  # a write without its answer may be acted on until then
         self._judged: list[AuditRecord] | None = None  # see judged_writes()
+        self.foreign = ForeignMasterWatch()  # another master's GV291 results (app/link/foreign.py)
 
     # -- connection ----------------------------------------------------------------------
     def connect(self) -> None:
@@ -159,12 +161,14 @@ class RegisterClient:
             tracked = address != registers.REG_STOP
             if tracked:  # settled again below, when the controller has answered it
                 self.writes_settled = False
+            self.foreign.note_write(time.monotonic())
             try:
                 self._send_write(what, address, values, single, timeout)
             except BaseException:
                 if tracked:  # no answer (or a refusal): it may still be acted on, until the timeout ran out
                     self.write_lost_until = time.monotonic() + self.settings.timeout
                 raise
+            self.foreign.note_write(time.monotonic())  # its answer may come from now on
             if tracked:
                 self.write_answered_at = time.monotonic()
                 self.writes_settled = True
@@ -261,6 +265,7 @@ class RegisterClient:
         )
         self.last_status = status
         self.status_read_at = time.monotonic()
+        self.foreign.note_status(status.command_status_code, self.status_read_at)
         return status
 
     def read_clock(self) -> ControllerClock:

@@ -30,6 +30,7 @@ import time
 from app import timing
 from app.errors import LinkError, Reason, ResponseTimeout, TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
+from app.link.foreign import ForeignSighting
 from app.link.host import WorkerHost
 from app.link.types import ConnectionState, ControllerIdentity, LinkState, Operation
 from app.link.upload import UPLOAD_POSE_GV
@@ -73,6 +74,7 @@ class LinkSupervisor:
         self._failures = 0
         self._backoff_index = 0
         self.canary_token: float | None = None  # what we wrote to the canary GV (None: not checking)
+        self._canary_foreign: float | None = None  # another master's value last seen there
         # the controller of the live connection, kept after it ends: the next connect compares
         self.identity: ControllerIdentity | None = None
         self._random = random.Random()
@@ -184,6 +186,8 @@ class LinkSupervisor:
         except TeachPadError as exc:
             _log.warning("could not read the restart canary GV%s: %s", gv, exc)
             return None
+        if value == self._canary_foreign and value != 0.0:
+            return last.boot  # another master's token we saw under the live link: the same boot
         if value != last.boot:
             _log.info(
                 "restart canary GV%s reads %g, not %g: another controller or another boot",
@@ -197,6 +201,7 @@ class LinkSupervisor:
     def arm_canary(self) -> None:
         """Write a fresh random token to the canary GV (not in monitor-only mode, not when disabled)."""
         self.canary_token = None
+        self._canary_foreign = None
         client = self.client
         gv = self.canary_gv
         if gv is None or client is None or client.settings.monitor_only:
@@ -214,13 +219,29 @@ class LinkSupervisor:
         self.canary_token = token
 
     def canary_read(self, value: float) -> None:
-        """The canary GV as read on the clock poll; a foreign value means the controller restarted."""
-        if self.canary_token is None or value == self.canary_token:
+        """The canary GV as read on the clock poll (issue 19). A restart clears GV0..GV99, so
+        only 0 reads as "the controller restarted" (new identity, armed again). Any other value
+        than ours was written by another master: not a restart (the identity and the points stay),
+        a sighting of another master (:mod:`app.link.foreign`) once per value, and our token is
+        not written back (two TeachPads would fight over it). A reconnect accepts the value last
+        seen as well as ours (:meth:`_surviving_token`)."""
+        if self.canary_token is None or value in (self.canary_token, self._canary_foreign):
+            return
+        if value != 0.0:
+            _log.warning(
+                "restart canary GV%s reads %g instead of %g: another master wrote it (not a restart)",
+                self.canary_gv,
+                value,
+                self.canary_token,
+            )
+            self._canary_foreign = value
+            client = self.client
+            if client is not None:
+                client.foreign.add(ForeignSighting("canary", value, time.monotonic()))
             return
         _log.warning(
-            "restart canary GV%s reads %g instead of %g: the controller restarted",
+            "restart canary GV%s reads 0 instead of %g: the controller restarted",
             self.canary_gv,
-            value,
             self.canary_token,
         )
         if self.client is not None:

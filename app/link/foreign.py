@@ -1,0 +1,115 @@
+"""Another Modbus master on the same controller: what one client can see of it (issue 19).
+
+The controller has one set of parameter GVs, one command block and one GV291 for every master,
+and Modbus has no lock (PROTOCOL.md, "More than one master"). A host cannot prevent another
+master's writes; it can notice them. Two signs are watched here and in the supervisor:
+
+* **GV291 results we did not cause** (:class:`ForeignMasterWatch`, fed by the client itself):
+  GV291 changes to a non-initial value while none of our writes is pending -- a pending write is
+  one made less than :data:`app.timing.FOREIGN_RESULT_WINDOW` ago, or the command it started is
+  still running (GV291 *moving*). A change to 0 (initial) is not counted: a controller restart
+  and a stop also show 0, and another master's command shows its result after it anyway.
+* **The restart canary holding another host's token** (:mod:`app.link.supervisor`): a restart
+  clears GV0..GV99, so the canary reads 0; any other value than ours was written by another
+  master -- not a restart.
+
+Each sighting is a :class:`ForeignSighting` (``what``: ``"gv291"`` or ``"canary"``, and the value
+seen); the worker publishes it (screen and audit), the CLI prints a warning line.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from app import timing
+from app.protocol.enums import STATUS_INITIAL, STATUS_SENTINEL, MoveStatus
+
+__all__ = ["ForeignMasterWatch", "ForeignSighting"]
+
+#: GV291 values that do not end a command of ours (the sentinel is ours, 0 shows before a result)
+_NOT_FINAL = frozenset({STATUS_INITIAL, STATUS_SENTINEL, int(MoveStatus.MOVING)})
+
+
+@dataclass(frozen=True)
+class ForeignSighting:
+    """One sign of another master: ``what`` (``"gv291"``, ``"canary"``) and the value seen."""
+
+    what: str
+    value: float
+    at: float  # monotonic time it was seen
+
+    @property
+    def message(self) -> str:
+        """English, for the log and the CLI."""
+        if self.what == "canary":
+            return (
+                f"another Modbus master is on this controller: the restart canary holds another "
+                f"host's token ({self.value:g})"
+            )
+        return (
+            f"another Modbus master is on this controller: GV291 changed to {self.value:g} "
+            f"without a command of ours"
+        )
+
+
+class ForeignMasterWatch:
+    """GV291 watched across one client's writes and status reads (any thread; one lock)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._last_code: int | None = None
+        self._last_write = -1e9
+        self._ours_open = False  # a write of ours may still be answered in GV291
+        self._sightings: list[ForeignSighting] = []
+        self.last_seen: float | None = None  # monotonic time of the last sighting (any kind)
+        #: called with each sighting as it is made (the CLI's warning line); from the reading thread
+        self.on_sighting: Callable[[ForeignSighting], None] | None = None
+
+    def note_write(self, now: float) -> None:
+        """A write of ours is about to go out: GV291 changes from now on may be its answer."""
+        with self._lock:
+            self._last_write = now
+            self._ours_open = True
+
+    def note_status(self, code: int, now: float) -> ForeignSighting | None:
+        """GV291 as just read; a sighting when it changed without a write of ours pending."""
+        with self._lock:
+            last, self._last_code = self._last_code, code
+            sighting = None
+            if last is not None and code != last:
+                if self._ours_open:
+                    if code not in _NOT_FINAL:
+                        self._ours_open = False  # our command's result: later changes are not ours
+                elif code != STATUS_INITIAL:
+                    sighting = ForeignSighting("gv291", float(code), now)
+            if (
+                self._ours_open
+                and code != MoveStatus.MOVING
+                and now - self._last_write > timing.FOREIGN_RESULT_WINDOW
+            ):
+                self._ours_open = False  # nothing of ours is running any more (a stop reads 0)
+        if sighting is not None:
+            self.add(sighting)
+        return sighting
+
+    def add(self, sighting: ForeignSighting) -> None:
+        """Record a sighting (the supervisor adds the canary's) and tell ``on_sighting``."""
+        with self._lock:
+            self._sightings.append(sighting)
+            self.last_seen = sighting.at
+        callback = self.on_sighting
+        if callback is not None:
+            callback(sighting)
+
+    def take(self) -> list[ForeignSighting]:
+        """The sightings not taken yet, oldest first."""
+        with self._lock:
+            taken, self._sightings = self._sightings, []
+        return taken
+
+    def seen_within(self, now: float, window: float) -> bool:
+        """True when another master was seen less than ``window`` seconds before ``now``."""
+        seen = self.last_seen
+        return seen is not None and now - seen < window

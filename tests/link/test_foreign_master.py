@@ -1,0 +1,132 @@
+"""Another master on the same controller (issue 19 section 2): the restart canary tells a restart
+(GV99 reads 0: the controller cleared GV0..GV99) from another host's token, and another master is
+seen -- its canary token, GV291 results we did not cause -- within a second (no Qt)."""
+
+from __future__ import annotations
+
+import itertools
+import time
+from typing import Any
+
+import pytest
+
+from app import timing
+from app.link.client import ConnectionSettings, RobotClient
+from app.link.types import ControllerIdentity
+from app.safety.audit import AuditLog
+from tests.link.harness import PartsHost
+
+CANARY_GV = 99
+CANARY_REG = 2 * CANARY_GV
+
+
+@pytest.fixture
+def fast_canary(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The canary is read on every poll (the clock period is not the subject here)."""
+    monkeypatch.setattr(timing, "CLOCK_POLL_PERIOD", 0.0)
+
+
+def _other_master(sim: Any) -> RobotClient:
+    client = RobotClient(ConnectionSettings(host="127.0.0.1", port=sim.port, timeout=2.0))
+    client.connect()
+    return client
+
+
+def _identity(parts: PartsHost) -> ControllerIdentity:
+    identity = parts.of("connectionChanged")[-1].controller
+    assert isinstance(identity, ControllerIdentity)
+    return identity
+
+
+def test_another_teachpads_canary_token_is_not_a_restart(sim: Any, fast_canary: None) -> None:
+    """A second TeachPad (old rule: it rewrites its own token every time it sees ours gone) writes
+    its token over and over: we never read it as a restart, never write ours back, keep the same
+    controller identity (the points stay on the controller); a real restart is still seen."""
+    parts = PartsHost(canary_gv=CANARY_GV)
+    other = _other_master(sim)
+    try:
+        parts.connect(sim)
+        one = _identity(parts)
+        our_writes = len(sim.writes_to(CANARY_REG))
+        tokens = itertools.count(1001)
+        canary_reads = 0
+        while canary_reads < 40:  # 40 fights of the old rule, each read back by our canary poll
+            other.write_gv(CANARY_GV, [float(next(tokens))])
+            parts.poller.poll_once()
+            canary_reads += 1
+        assert "controllerRestarted" not in parts.names()
+        assert len(sim.writes_to(CANARY_REG)) - our_writes == 40  # the other master's only: no fight
+        assert _identity(parts).same_boot(one)
+        seen = parts.of("foreignMaster")
+        assert seen and seen[0] == ("canary", 1001.0)
+        # the controller restarts: GV0..GV99 read 0, the canary says so
+        sim.restart_controller()
+        deadline = time.monotonic() + 10.0
+        while "controllerRestarted" not in parts.names() and time.monotonic() < deadline:
+            parts.poller.poll_once()
+        assert parts.names().count("controllerRestarted") == 1
+        assert not _identity(parts).same_boot(one)
+    finally:
+        other.close()
+        parts.close()
+
+
+def test_a_reconnect_keeps_the_boot_when_the_canary_holds_the_token_another_master_left(
+    sim: Any, fast_canary: None
+) -> None:
+    parts = PartsHost(canary_gv=CANARY_GV)
+    other = _other_master(sim)
+    try:
+        parts.connect(sim)
+        one = _identity(parts)
+        other.write_gv(CANARY_GV, [4242.0])
+        parts.poller.poll_once()
+        parts.supervisor.link_lost("test")
+        parts.supervisor.try_connect()
+        assert _identity(parts).same_boot(one)
+    finally:
+        other.close()
+        parts.close()
+
+
+def test_another_masters_command_result_is_seen_within_a_second_and_audited(
+    sim: Any, tmp_path: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(timing, "FOREIGN_RESULT_WINDOW", 0.2)
+    parts = PartsHost()
+    parts.audit = AuditLog(tmp_path)
+    other = _other_master(sim)
+    try:
+        parts.connect(sim)
+        deadline = time.monotonic() + 0.5
+        while time.monotonic() < deadline:  # our own connect writes are long settled
+            parts.poller.poll_once()
+        assert "foreignMaster" not in parts.names()
+        started = time.monotonic()
+        other.create_point(7, pose=[400.0, 0.0, 300.0, 180.0, 0.0, 0.0])  # another master's command
+        while "foreignMaster" not in parts.names() and time.monotonic() - started < 5.0:
+            parts.poller.poll_once()
+        assert time.monotonic() - started < 1.0 + 2.0  # seen at the next poll (slack for a loaded box)
+        assert parts.of("foreignMaster")[0] == ("gv291", 255.0)
+        records = [r for r in _audit_lines(tmp_path) if "another Modbus master" in r]
+        assert records
+    finally:
+        other.close()
+        parts.close()
+
+
+def test_our_own_commands_are_not_another_master(sim: Any, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(timing, "FOREIGN_RESULT_WINDOW", 0.2)
+    client = _other_master(sim)
+    try:
+        client.read_status()
+        for point_id in range(3):
+            client.create_point(point_id, pose=[400.0, 0.0, 300.0 + point_id, 180.0, 0.0, 0.0])
+            client.read_status()
+        assert client.foreign.take() == []
+    finally:
+        client.close()
+
+
+def _audit_lines(folder: Any) -> list[str]:
+    return [line for path in sorted(folder.rglob("*")) if path.is_file() for line in path.read_text().splitlines()]
