@@ -40,7 +40,7 @@ OUTCOME_READ_RETRY = 0.05
 
 # Worker (GUI side).
 POLL_HZ_DEFAULT = 50
-CLOCK_POLL_PERIOD = 1.0  # s between date/time reads (and restart-canary reads: another master seen within 1 s)
+CLOCK_POLL_PERIOD = 1.0  # s between date/time and restart-canary reads (another master seen in 1 s)
 # s after a write of ours during which a GV291 change may be its answer (app/link/foreign.py)
 FOREIGN_RESULT_WINDOW = 2.0
 RECONNECT_BACKOFF = (0.2, 0.5, 1.0, 2.0, 5.0)  # s, last one repeats

@@ -129,4 +129,6 @@ def test_our_own_commands_are_not_another_master(sim: Any, monkeypatch: pytest.M
 
 
 def _audit_lines(folder: Any) -> list[str]:
-    return [line for path in sorted(folder.rglob("*")) if path.is_file() for line in path.read_text().splitlines()]
+    return [
+        line for path in sorted(folder.rglob("*")) if path.is_file() for line in path.read_text().splitlines()
+    ]
