@@ -9,18 +9,24 @@ master's writes; it can notice them. Two signs are watched here and in the super
   one made less than :data:`app.timing.FOREIGN_RESULT_WINDOW` ago, or the command it started is
   still running (GV291 *moving*). A change to 0 (initial) is not counted: a controller restart
   and a stop also show 0, and another master's command shows its result after it anyway.
+* **Parameter and command registers changing without a write of ours**: GV200..GV227
+  (registers 400..455: the motion parameters and the command register 440) are read on the
+  clock poll (:meth:`~app.link.register_client.RegisterClient.watch_shared_registers`); a change
+  between two reads with no write of ours in between is another master's (the controller only
+  reads these registers: PROTOCOL.md, the host writes them).
 * **The restart canary holding another host's token** (:mod:`app.link.supervisor`): a restart
   clears GV0..GV99, so the canary reads 0; any other value than ours was written by another
   master -- not a restart.
 
-Each sighting is a :class:`ForeignSighting` (``what``: ``"gv291"`` or ``"canary"``, and the value
-seen); the worker publishes it (screen and audit), the CLI prints a warning line.
+Each sighting is a :class:`ForeignSighting` (``what``: ``"gv291"``, ``"registers"`` or
+``"canary"``, and the value seen: the GV291 code, the first changed register, the token); the
+worker publishes it (screen and audit), the CLI prints a warning line.
 """
 
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from app import timing
@@ -43,6 +49,11 @@ class ForeignSighting:
     @property
     def message(self) -> str:
         """English, for the log and the CLI."""
+        if self.what == "registers":
+            return (
+                f"another Modbus master is on this controller: register {self.value:g} changed "
+                f"without a write of ours"
+            )
         if self.what == "canary":
             return (
                 f"another Modbus master is on this controller: the restart canary holds another "
@@ -62,6 +73,10 @@ class ForeignMasterWatch:
         self._last_code: int | None = None
         self._last_write = -1e9
         self._ours_open = False  # a write of ours may still be answered in GV291
+        self._write_seq = 0  # writes of ours so far
+        self._shared: tuple[tuple[int, ...], int] | None = (
+            None  # the shared registers last read, at which write
+        )
         self._sightings: list[ForeignSighting] = []
         self.last_seen: float | None = None  # monotonic time of the last sighting (any kind)
         #: called with each sighting as it is made (the CLI's warning line); from the reading thread
@@ -72,6 +87,7 @@ class ForeignMasterWatch:
         with self._lock:
             self._last_write = now
             self._ours_open = True
+            self._write_seq += 1
 
     def note_status(self, code: int, now: float) -> ForeignSighting | None:
         """GV291 as just read; a sighting when it changed without a write of ours pending."""
@@ -92,6 +108,21 @@ class ForeignMasterWatch:
                 self._ours_open = False  # nothing of ours is running any more (a stop reads 0)
         if sighting is not None:
             self.add(sighting)
+        return sighting
+
+    def note_shared(self, start: int, values: Sequence[int], now: float) -> ForeignSighting | None:
+        """The shared parameter / command registers as just read (from register ``start``); a
+        sighting when they changed since the last read with no write of ours in between."""
+        snapshot = tuple(values)
+        with self._lock:
+            last, self._shared = self._shared, (snapshot, self._write_seq)
+            if last is None or last[0] == snapshot or len(last[0]) != len(snapshot):
+                return None
+            if last[1] != self._write_seq:  # ours (the controller itself never writes them)
+                return None
+            first = next(i for i, (a, b) in enumerate(zip(last[0], snapshot, strict=True)) if a != b)
+        sighting = ForeignSighting("registers", float(start + first), now)
+        self.add(sighting)
         return sighting
 
     def add(self, sighting: ForeignSighting) -> None:

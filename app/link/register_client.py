@@ -50,6 +50,11 @@ def _what(verb: str, address: int, count: int) -> str:
     return f"{verb} {range_name(address, count)}"
 
 
+#: The parameter and command registers every master shares: GV200..GV227 (registers 400..455)
+SHARED_START = registers.gv_reg(200)
+SHARED_COUNT = registers.gv_reg(228) - SHARED_START
+
+
 class RegisterClient:
     """Registers, GVs and the pose/status blocks of one controller. Blocking; owned by one thread."""
 
@@ -267,6 +272,14 @@ class RegisterClient:
         self.status_read_at = time.monotonic()
         self.foreign.note_status(status.command_status_code, self.status_read_at)
         return status
+
+    def watch_shared_registers(self, *, timeout: float | None = None) -> None:
+        """One read of the registers every master shares (GV200..GV227: the motion parameters and
+        the command register) for the foreign-master watch (:mod:`app.link.foreign`)."""
+        regs = self._read(SHARED_START, SHARED_COUNT, timeout)
+        # the stop register is not watched: our own Stop may go on the stop line (app/link/stop_line.py)
+        regs[registers.REG_STOP - SHARED_START] = 0
+        self.foreign.note_shared(SHARED_START, regs, time.monotonic())
 
     def read_clock(self) -> ControllerClock:
         return decode_clock(self._read(registers.gv_reg(registers.GV_DATE), 4), self.settings.datetime_layout)
