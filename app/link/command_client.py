@@ -65,7 +65,11 @@ class CommandClient(RegisterClient):
     def command_status(self) -> CommandStatus:
         """GV291 decoded with the table of the last command this client sent."""
         regs = self._read(registers.gv_reg(registers.GV_COMMAND_STATUS), 2)
-        return decode_command_status(self._last_kind, decode_status_registers(regs, self.settings.word_order))
+        code = decode_status_registers(regs, self.settings.word_order)
+        now = time.monotonic()
+        self.foreign.note_status(code, now)
+        self.watch_shared_if_due(now)
+        return decode_command_status(self._last_kind, code)
 
     # -- completion rule (see app/link/tracker.py) ---------------------------------------
     @property

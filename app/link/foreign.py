@@ -9,11 +9,12 @@ master's writes; it can notice them. Two signs are watched here and in the super
   one made less than :data:`app.timing.FOREIGN_RESULT_WINDOW` ago, or the command it started is
   still running (GV291 *moving*). A change to 0 (initial) is not counted: a controller restart
   and a stop also show 0, and another master's command shows its result after it anyway.
-* **Parameter and command registers changing without a write of ours**: GV200..GV227
-  (registers 400..455: the motion parameters and the command register 440) are read on the
-  clock poll (:meth:`~app.link.register_client.RegisterClient.watch_shared_registers`); a change
-  between two reads with no write of ours in between is another master's (the controller only
-  reads these registers: PROTOCOL.md, the host writes them).
+* **Parameter and command registers changing without a write of ours**: GV200..GV205 and
+  GV220..GV227 (the motion parameters and the command register 440; see
+  :data:`~app.link.register_client.SHARED_WATCHED`) are read on the
+  clock poll (:meth:`~app.link.register_client.RegisterClient.watch_shared_registers`); a value
+  other than the last read and our own answered writes since then left there is another
+  master's (the controller only reads these registers: PROTOCOL.md, the host writes them).
 * **The restart canary holding another host's token** (:mod:`app.link.supervisor`): a restart
   clears GV0..GV99, so the canary reads 0; any other value than ours was written by another
   master -- not a restart.
@@ -31,8 +32,9 @@ from dataclasses import dataclass
 
 from app import timing
 from app.protocol.enums import STATUS_INITIAL, STATUS_SENTINEL, MoveStatus
+from app.safety.audit import AuditLog
 
-__all__ = ["ForeignMasterWatch", "ForeignSighting"]
+__all__ = ["ForeignMasterWatch", "ForeignSighting", "audit_sighting"]
 
 #: GV291 values that do not end a command of ours (the sentinel is ours, 0 shows before a result)
 _NOT_FINAL = frozenset({STATUS_INITIAL, STATUS_SENTINEL, int(MoveStatus.MOVING)})
@@ -73,10 +75,8 @@ class ForeignMasterWatch:
         self._last_code: int | None = None
         self._last_write = -1e9
         self._ours_open = False  # a write of ours may still be answered in GV291
-        self._write_seq = 0  # writes of ours so far
-        self._shared: tuple[tuple[int, ...], int] | None = (
-            None  # the shared registers last read, at which write
-        )
+        # the shared registers as the last read and our writes since then left them (None: not read yet)
+        self._expected: dict[int, int] | None = None
         self._sightings: list[ForeignSighting] = []
         self.last_seen: float | None = None  # monotonic time of the last sighting (any kind)
         #: called with each sighting as it is made (the CLI's warning line); from the reading thread
@@ -87,7 +87,6 @@ class ForeignMasterWatch:
         with self._lock:
             self._last_write = now
             self._ours_open = True
-            self._write_seq += 1
 
     def note_status(self, code: int, now: float) -> ForeignSighting | None:
         """GV291 as just read; a sighting when it changed without a write of ours pending."""
@@ -110,18 +109,31 @@ class ForeignMasterWatch:
             self.add(sighting)
         return sighting
 
-    def note_shared(self, start: int, values: Sequence[int], now: float) -> ForeignSighting | None:
-        """The shared parameter / command registers as just read (from register ``start``); a
-        sighting when they changed since the last read with no write of ours in between."""
-        snapshot = tuple(values)
+    def note_registers(self, address: int, values: Sequence[int], *, stored: bool) -> None:
+        """A write of ours to ``address`` (``values``): what the shared registers hold now when the
+        controller answered it (``stored``), else those registers are unknown until the next read."""
         with self._lock:
-            last, self._shared = self._shared, (snapshot, self._write_seq)
-            if last is None or last[0] == snapshot or len(last[0]) != len(snapshot):
+            expected = self._expected
+            if expected is None:
+                return
+            for offset, value in enumerate(values):
+                if address + offset in expected:
+                    if stored:
+                        expected[address + offset] = int(value) & 0xFFFF
+                    else:
+                        del expected[address + offset]
+
+    def note_shared(self, watched: Sequence[tuple[int, int]], now: float) -> ForeignSighting | None:
+        """The shared parameter / command registers as just read ((address, value) pairs); a
+        sighting when one differs from what the last read and our writes since then left there."""
+        with self._lock:
+            expected, self._expected = self._expected, dict(watched)
+            if expected is None:
                 return None
-            if last[1] != self._write_seq:  # ours (the controller itself never writes them)
-                return None
-            first = next(i for i, (a, b) in enumerate(zip(last[0], snapshot, strict=True)) if a != b)
-        sighting = ForeignSighting("registers", float(start + first), now)
+            changed = [address for address, value in watched if expected.get(address, value) != value]
+        if not changed:
+            return None
+        sighting = ForeignSighting("registers", float(changed[0]), now)
         self.add(sighting)
         return sighting
 
@@ -144,3 +156,10 @@ class ForeignMasterWatch:
         """True when another master was seen less than ``window`` seconds before ``now``."""
         seen = self.last_seen
         return seen is not None and now - seen < window
+
+
+def audit_sighting(audit: AuditLog | None, sighting: ForeignSighting) -> None:
+    """The audit trail's record of a sighting (GUI and CLI alike)."""
+    if audit is not None:
+        args = {"what": sighting.what, "value": sighting.value}
+        audit.record("link", "another Modbus master seen", args=args, detail=sighting.message)

@@ -22,6 +22,7 @@ from app import timing
 from app.errors import LinkError, MalformedResponse, ResponseTimeout, TeachPadError
 from app.link.capture import LinkStatsReporter, RttMeter
 from app.link.client import RobotClient
+from app.link.foreign import audit_sighting
 from app.link.host import WorkerHost
 from app.link.types import Operation
 from app.models import ControllerStatus, Pose
@@ -166,9 +167,7 @@ class Poller:
         """Another master's signs seen by this poll (app/link/foreign.py): logged, audited, published."""
         for sighting in client.foreign.take():
             _log.warning("%s", sighting.message)
-            if client.audit is not None:
-                args = {"what": sighting.what, "value": sighting.value}
-                client.audit.record("link", "another Modbus master seen", args=args, detail=sighting.message)
+            audit_sighting(client.audit, sighting)
             self._host.publish_foreign_master(sighting.what, sighting.value)
 
     def _report_stats(self) -> None:

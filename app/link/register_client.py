@@ -50,9 +50,21 @@ def _what(verb: str, address: int, count: int) -> str:
     return f"{verb} {range_name(address, count)}"
 
 
-#: The parameter and command registers every master shares: GV200..GV227 (registers 400..455)
-SHARED_START = registers.gv_reg(200)
+#: The parameter and command registers every master shares, read in one block (registers
+#: 400..455, GV200..GV227) of which these are compared: GV200..GV205 and GV220..GV227 (GV206..
+#: GV216 are the live pose); not GV203, the jog ratio a controller's watchdog may zero itself,
+#: nor the stop register (our own Stop may go on the stop line, app/link/stop_line.py)
+SHARED_START = registers.gv_reg(registers.GV_PARAM0)
 SHARED_COUNT = registers.gv_reg(228) - SHARED_START
+SHARED_WATCHED = tuple(
+    address
+    for address in (
+        *range(SHARED_START, registers.gv_reg(206)),
+        *range(registers.gv_reg(220), registers.gv_reg(228)),
+    )
+    if address not in (registers.gv_reg(registers.GV_PARAM3), registers.gv_reg(registers.GV_PARAM3) + 1)
+    and address != registers.REG_STOP
+)
 
 
 class RegisterClient:
@@ -73,6 +85,10 @@ class RegisterClient:
         self.write_lost_until = 0.0  # a write without its answer may be acted on until then
         self._judged: list[AuditRecord] | None = None  # see judged_writes()
         self.foreign = ForeignMasterWatch()  # another master's GV291 results (app/link/foreign.py)
+        # read the shared registers with a status read at most this often (s; None: never -- the
+        # GUI's poller reads them on its clock poll; the CLI sets it)
+        self.watch_shared_every: float | None = None
+        self._shared_read_at = -1e9
 
     # -- connection ----------------------------------------------------------------------
     def connect(self) -> None:
@@ -170,10 +186,12 @@ class RegisterClient:
             try:
                 self._send_write(what, address, values, single, timeout)
             except BaseException:
+                self.foreign.note_registers(address, values, stored=False)
                 if tracked:  # no answer (or a refusal): it may still be acted on, until the timeout ran out
                     self.write_lost_until = time.monotonic() + self.settings.timeout
                 raise
             self.foreign.note_write(time.monotonic())  # its answer may come from now on
+            self.foreign.note_registers(address, values, stored=True)
             if tracked:
                 self.write_answered_at = time.monotonic()
                 self.writes_settled = True
@@ -271,15 +289,22 @@ class RegisterClient:
         self.last_status = status
         self.status_read_at = time.monotonic()
         self.foreign.note_status(status.command_status_code, self.status_read_at)
+        self.watch_shared_if_due(self.status_read_at, timeout)
         return status
+
+    def watch_shared_if_due(self, now: float, timeout: float | None = None) -> None:
+        """Read the shared registers when ``watch_shared_every`` says so (a status read calls it)."""
+        every = self.watch_shared_every
+        if every is not None and now - self._shared_read_at >= every:
+            self._shared_read_at = now
+            self.watch_shared_registers(timeout=timeout)
 
     def watch_shared_registers(self, *, timeout: float | None = None) -> None:
         """One read of the registers every master shares (GV200..GV227: the motion parameters and
         the command register) for the foreign-master watch (:mod:`app.link.foreign`)."""
         regs = self._read(SHARED_START, SHARED_COUNT, timeout)
-        # the stop register is not watched: our own Stop may go on the stop line (app/link/stop_line.py)
-        regs[registers.REG_STOP - SHARED_START] = 0
-        self.foreign.note_shared(SHARED_START, regs, time.monotonic())
+        watched = [(address, regs[address - SHARED_START]) for address in SHARED_WATCHED]
+        self.foreign.note_shared(watched, time.monotonic())
 
     def read_clock(self) -> ControllerClock:
         return decode_clock(self._read(registers.gv_reg(registers.GV_DATE), 4), self.settings.datetime_layout)
