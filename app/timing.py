@@ -43,6 +43,8 @@ POLL_HZ_DEFAULT = 50
 CLOCK_POLL_PERIOD = 1.0  # s between date/time and restart-canary reads (another master seen in 1 s)
 # s after a write of ours during which a GV291 change may be its answer (app/link/foreign.py)
 FOREIGN_RESULT_WINDOW = 2.0
+# s after a sign of another master during which no move is sent (app/link/foreign.py)
+FOREIGN_MOVE_HOLD = 5.0
 RECONNECT_BACKOFF = (0.2, 0.5, 1.0, 2.0, 5.0)  # s, last one repeats
 LINK_LOSS_POLLS = 3  # consecutive failed transactions (refused, reset, command timeouts) -> link down
 NOT_ANSWERING_DOWN_AFTER = 3.0  # s of silence (polls timing out, link open) before the link is down

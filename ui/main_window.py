@@ -366,7 +366,8 @@ class MainWindow(QMainWindow):
             )
         text = self.tr(
             "Another Modbus master is on this controller: {sign}. It shares the parameter and "
-            "command registers with TeachPad: its writes can change what ours do. Check who else is connected."
+            "command registers with TeachPad: its writes can change what ours do. "
+            "Check who else is connected."
         ).format(sign=sign)
         if self.control_column.show_foreign_master(text):
             self.event_log.add_event("warning", self.tr("link"), text)

@@ -142,6 +142,7 @@ class RobotClient(CommandClient):
         self._refuse_while_busy("go to zero", f"go to zero ({which})", status)
         self._auto_for("go to zero", status, switch_to_auto)
         before = before or self.read_pose()
+        self.check_no_foreign_master("go to zero")
         with self.judged_writes() as judged:
             self._write_control(registers.REG_GO_ZERO, value)
         axes = tuple(range(registers.NUM_AXES_TOTAL)) if axis is None else (value,)
@@ -175,6 +176,7 @@ class RobotClient(CommandClient):
         self._auto_for("run program", status, switch_to_auto)
         before = before or self.read_pose()
         self._write(registers.REG_PROGRAM_ID, [program_id, int(motion), cycles, speed_ratio])
+        self.check_no_foreign_master("run program")
         with self.judged_writes() as judged:
             self._write_control(registers.REG_RUN_COMMAND, int(RunCommand.RUN_PROGRAM))
         watch = MotionWatch(

@@ -79,6 +79,7 @@ class ForeignMasterWatch:
         self._expected: dict[int, int] | None = None
         self._sightings: list[ForeignSighting] = []
         self.last_seen: float | None = None  # monotonic time of the last sighting (any kind)
+        self.last_sighting: ForeignSighting | None = None
         #: called with each sighting as it is made (the CLI's warning line); from the reading thread
         self.on_sighting: Callable[[ForeignSighting], None] | None = None
 
@@ -142,6 +143,7 @@ class ForeignMasterWatch:
         with self._lock:
             self._sightings.append(sighting)
             self.last_seen = sighting.at
+            self.last_sighting = sighting
         callback = self.on_sighting
         if callback is not None:
             callback(sighting)

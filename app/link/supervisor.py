@@ -9,8 +9,10 @@
 * **Link loss**: :data:`app.timing.LINK_LOSS_POLLS` failed transactions in a row (refused, reset,
   command timeouts) declare the link ``DOWN`` at once; reconnection follows
   :data:`app.timing.RECONNECT_BACKOFF` by itself and ends with ``controllerReconnected``.
-* **Restart canary**: a random token in a spare GV, read back on the clock poll; a change means
-  the controller restarted under a live link (``controllerRestarted``).
+* **Restart canary**: a random token in a spare GV, read back on the clock poll; 0 means the
+  controller restarted under a live link (``controllerRestarted``: a restart clears GV0..GV99);
+  another nonzero value is another master's token (a sign of another master, not a restart;
+  see :meth:`LinkSupervisor.canary_read`).
 * **Which controller**: every connect decides the :class:`~app.link.types.ControllerIdentity`
   (endpoint, unit, word order, the canary's token) and publishes it in the
   ``ConnectionState`` (``controller``) before the link goes live. The canary is *read* first

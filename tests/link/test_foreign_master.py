@@ -5,12 +5,15 @@ seen -- its canary token, GV291 results we did not cause -- within a second (no 
 from __future__ import annotations
 
 import itertools
+import tempfile
 import time
+from pathlib import Path
 from typing import Any
 
 import pytest
 
 from app import timing
+from app.errors import ForeignMasterRefused
 from app.link.client import ConnectionSettings, RobotClient
 from app.link.types import ControllerIdentity
 from app.safety.audit import AuditLog
@@ -132,3 +135,28 @@ def _audit_lines(folder: Any) -> list[str]:
     return [
         line for path in sorted(folder.rglob("*")) if path.is_file() for line in path.read_text().splitlines()
     ]
+
+
+def test_a_move_is_not_sent_over_another_masters_parameter_write(sim: Any) -> None:
+    """Another master writes the step offsets GV204/GV205 (its own step being prepared) while we
+    prepare a move to a point (which writes GV200..GV203): the read-back just before our trigger
+    sees them, the move is refused before 440 (the arm does not move), in words and audited."""
+    start = sim.state().pose
+    target = (start[0] + 20.0, start[1], start[2], start[3], start[4], start[5])
+    sim.add_point(1, target)
+    client = _other_master(sim)
+    other = _other_master(sim)
+    audit_dir = Path(tempfile.mkdtemp())
+    client.audit = AuditLog(audit_dir)
+    try:
+        client.read_status()
+        client.watch_shared_registers()  # what the shared registers hold now
+        other.write_gv(204, [15.0, 5.0])  # another master's step offsets
+        with pytest.raises(ForeignMasterRefused, match="another Modbus master"):
+            client.move_to_point(1, speed=50.0)
+        assert [w for w in sim.writes_to(440) if w.values == (0x42,)] == []
+        assert sim.state().pose == start
+        assert any("not sent" in line and "another Modbus master" in line for line in _audit_lines(audit_dir))
+    finally:
+        other.close()
+        client.close()
