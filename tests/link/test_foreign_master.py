@@ -137,10 +137,13 @@ def _audit_lines(folder: Any) -> list[str]:
     ]
 
 
-def test_a_move_is_not_sent_over_another_masters_parameter_write(sim: Any) -> None:
+def test_a_move_is_not_sent_over_another_masters_parameter_write(
+    sim: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """Another master writes the step offsets GV204/GV205 (its own step being prepared) while we
     prepare a move to a point (which writes GV200..GV203): the read-back just before our trigger
     sees them, the move is refused before 440 (the arm does not move), in words and audited."""
+    monkeypatch.setattr(timing, "FOREIGN_MOVE_HOLD", 5.0)  # the product's (tests/conftest.py sets 0)
     start = sim.state().pose
     target = (start[0] + 20.0, start[1], start[2], start[3], start[4], start[5])
     sim.add_point(1, target)
