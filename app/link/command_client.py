@@ -168,6 +168,7 @@ class CommandClient(RegisterClient):
             unconfirmed_after=self._unconfirmed_window(),
             pacer=self._pacer,
         )
+        tracker.foreign = self.foreign
         self._last_kind = tracker.kind
         self.last_tracker = tracker
         with self.judged_writes() as judged:

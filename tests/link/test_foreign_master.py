@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import itertools
 import tempfile
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -13,11 +14,12 @@ from typing import Any
 import pytest
 
 from app import timing
-from app.errors import ForeignMasterRefused
-from app.link.client import ConnectionSettings, RobotClient
+from app.errors import ForeignMasterRefused, OutcomeUnknown
+from app.link.client import ConnectionSettings, RobotClient, StepFrame
 from app.link.types import ControllerIdentity
 from app.safety.audit import AuditLog
 from tests.link.harness import PartsHost
+from tests.waits import join
 
 CANARY_GV = 99
 CANARY_REG = 2 * CANARY_GV
@@ -163,3 +165,33 @@ def test_a_move_is_not_sent_over_another_masters_parameter_write(
     finally:
         other.close()
         client.close()
+
+
+def test_a_move_that_ends_while_another_master_writes_is_outcome_unknown(sim: Any) -> None:
+    """Another master rewrites the step's own offsets while our step runs: the "done" GV291 then
+    shows cannot be told from the other master's, so our step ends *outcome unknown* (audited)."""
+    client = _other_master(sim)
+    other = _other_master(sim)
+    audit_dir = Path(tempfile.mkdtemp())
+    client.audit = AuditLog(audit_dir)
+    client.watch_shared_every = 0.1
+    start_z = sim.state().pose[2]
+    stop = threading.Event()
+
+    def another_master() -> None:  # writes the offsets once our move is seen under way
+        while not stop.wait(0.01):
+            if abs(sim.state().pose[2] - start_z) > 0.5:
+                other.write_gv(202, [33.0])
+                return
+
+    thread = threading.Thread(target=another_master, daemon=True)
+    thread.start()
+    try:
+        with pytest.raises(OutcomeUnknown, match="another Modbus master was seen while it ran"):
+            client.step(StepFrame.BASE, (0.0, 0.0, -8.0, 0.0, 0.0, 0.0), speed=8.0)
+    finally:
+        stop.set()
+        join(thread, "another master")
+        other.close()
+        client.close()
+    assert any('"unknown"' in line for line in _audit_lines(audit_dir))
