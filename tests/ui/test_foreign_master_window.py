@@ -11,9 +11,11 @@ from typing import Any
 
 import pytest
 
+from app.errors import ForeignMasterRefused
 from app.link.robot_link import RobotLink
 from app.points.guard import CANARY_GV
 from app.points.ledger import SyncState
+from app.protocol.enums import RunCommand
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,
@@ -26,6 +28,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     window_fixture,
 )
 from ui.main_window import TAB_POINTS, MainWindow
+from ui.messages import reason_text
 
 pytestmark = [pytest.mark.timeout(120), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
@@ -88,3 +91,12 @@ def test_another_masters_command_is_said_on_screen(
         assert other.create_point(9, pose=[400.0, 0.0, 300.0, 180.0, 0.0, 0.0]).ok
     assert seen.args is not None and seen.args[0] in ("registers", "gv291")
     assert "Another Modbus master" in window.control_column.foreign_banner.text()
+
+
+def test_the_move_refusal_reads_in_both_languages(translator: Any) -> None:
+    error = ForeignMasterRefused("incremental move (base)", 5.0, "another master", int(RunCommand.STEP_BASE))
+    english = reason_text(error.as_reason())
+    assert english is not None and "another Modbus master" in english and "5 s" in english
+    assert translator.set_language("zh_CN")
+    chinese = reason_text(error.as_reason())
+    assert chinese is not None and "另一个 Modbus 主站" in chinese
