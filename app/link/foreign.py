@@ -11,8 +11,9 @@ master's writes; it can notice them. Two signs are watched here and in the super
   and a stop also show 0, and another master's command shows its result after it anyway.
 * **Parameter and command registers changing without a write of ours**: GV200..GV205 and
   GV220..GV227 (the motion parameters and the command register 440; see
-  :data:`~app.link.register_client.SHARED_WATCHED`) are read on the
-  clock poll (:meth:`~app.link.register_client.RegisterClient.watch_shared_registers`); a value
+  :data:`~app.link.register_client.SHARED_WATCHED`) are read with a status read once a clock
+  period (``watch_shared_every``: the GUI's polls, an upload's or a command's waits, the CLI's
+  reads) and just before a move's trigger; a value
   other than the last read and our own answered writes since then left there is another
   master's (the controller only reads these registers: PROTOCOL.md, the host writes them).
 * **The restart canary holding another host's token** (:mod:`app.link.supervisor`): a restart

@@ -119,8 +119,6 @@ class Poller:
             gv = host.supervisor.canary_gv
             if with_clock and host.supervisor.canary_token is not None and gv is not None:
                 canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock
-            if with_clock:
-                client.watch_shared_registers(timeout=timeout)  # another master's parameters, commands
         except ResponseTimeout as exc:
             self._report_error(exc)
             host.supervisor.poll_silent(exc, time.monotonic())

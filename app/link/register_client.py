@@ -85,8 +85,8 @@ class RegisterClient:
         self.write_lost_until = 0.0  # a write without its answer may be acted on until then
         self._judged: list[AuditRecord] | None = None  # see judged_writes()
         self.foreign = ForeignMasterWatch()  # another master's GV291 results (app/link/foreign.py)
-        # read the shared registers with a status read at most this often (s; None: never -- the
-        # GUI's poller reads them on its clock poll; the CLI sets it)
+        # read the shared registers with a status read at most this often (s; None: never; the
+        # GUI's link and the CLI set it, app/link/foreign.py)
         self.watch_shared_every: float | None = None
         self._shared_read_at = -1e9
 

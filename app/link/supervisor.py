@@ -106,6 +106,9 @@ class LinkSupervisor:
         self.client = RobotClient(settings)
         self.client.audit = getattr(host, "audit", None)  # the audit trail records every write
         self.client.caps = host.caps  # reduced-speed mode's caps
+        # another master's parameter / command writes: the shared registers read with a status
+        # read once a clock period (polls, and the reads of uploads and command waits alike)
+        self.client.watch_shared_every = timing.CLOCK_POLL_PERIOD
         host.capture.attach(self.client)
         self._ever_connected = False
         self._backoff_index = 0
