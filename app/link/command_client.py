@@ -180,7 +180,8 @@ class CommandClient(RegisterClient):
         """Just before a motion's trigger: read the shared registers back (our parameters still
         there?) and refuse (audited, :class:`ForeignMasterRefused`) when another master was seen
         within :data:`app.timing.FOREIGN_MOVE_HOLD`: a move is never sent over a foreign write."""
-        self.watch_shared_registers()
+        if self.watch_shared_every is not None:  # (a client that does not watch them: GV291 only)
+            self.watch_shared_registers()
         foreign = self.foreign
         hold = timing.FOREIGN_MOVE_HOLD
         if not foreign.seen_within(time.monotonic(), hold):

@@ -111,6 +111,11 @@ class ForeignMasterWatch:
             self.add(sighting)
         return sighting
 
+    @property
+    def has_baseline(self) -> bool:
+        """The shared registers were read once (what they should hold is known)."""
+        return self._expected is not None
+
     def note_registers(self, address: int, values: Sequence[int], *, stored: bool) -> None:
         """A write of ours to ``address`` (``values``): what the shared registers hold now when the
         controller answered it (``stored``), else those registers are unknown until the next read."""

@@ -293,11 +293,20 @@ class RegisterClient:
         return status
 
     def watch_shared_if_due(self, now: float, timeout: float | None = None) -> None:
-        """Read the shared registers when ``watch_shared_every`` says so (a status read calls it)."""
+        """Read the shared registers when ``watch_shared_every`` says so (a status read calls it);
+        not before this client's first command or write (a read-only session has nothing to guard)."""
         every = self.watch_shared_every
-        if every is not None and now - self._shared_read_at >= every:
+        if every is None or (self.write_count == 0 and not self.foreign.has_baseline):
+            return
+        if now - self._shared_read_at >= every:
             self._shared_read_at = now
             self.watch_shared_registers(timeout=timeout)
+
+    def watch_shared_baseline(self) -> None:
+        """Before a command's first write: what the shared registers hold (once per connection)."""
+        if self.watch_shared_every is not None and not self.foreign.has_baseline:
+            self._shared_read_at = time.monotonic()
+            self.watch_shared_registers()
 
     def watch_shared_registers(self, *, timeout: float | None = None) -> None:
         """One read of the registers every master shares (GV200..GV227: the motion parameters and

@@ -153,6 +153,7 @@ def test_a_move_is_not_sent_over_another_masters_parameter_write(
     other = _other_master(sim)
     audit_dir = Path(tempfile.mkdtemp())
     client.audit = AuditLog(audit_dir)
+    client.watch_shared_every = 1.0  # as the GUI's link and the CLI do
     try:
         client.read_status()
         client.watch_shared_registers()  # what the shared registers hold now
