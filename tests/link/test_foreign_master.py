@@ -196,3 +196,39 @@ def test_a_move_that_ends_while_another_master_writes_is_outcome_unknown(sim: An
         other.close()
         client.close()
     assert any('"unknown"' in line for line in _audit_lines(audit_dir))
+
+
+def test_both_teachpads_see_a_restart_before_either_writes_a_fresh_token(
+    sim_factory: Any, fast_canary: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Two TeachPads on one controller; it restarts. The first to read the canary sees 0 and says
+    "restarted", but writes its fresh token only CANARY_REARM_DELAY later: the second, reading
+    within that time, sees the 0 (the restart) too, not the first one's token. The first's token
+    then stands for the boot: no fight, no second restart."""
+    monkeypatch.setattr(timing, "CANARY_REARM_DELAY", 0.3)
+    sim = sim_factory()
+    first, second = PartsHost(canary_gv=CANARY_GV), PartsHost(canary_gv=CANARY_GV)
+    try:
+        first.connect(sim)
+        second.connect(sim)
+        first.poller.poll_once()  # the second's token: another master, not a restart
+        sim.restart_controller()
+        first.poller.poll_once()
+        first.poller.poll_once()
+        assert first.names().count("controllerRestarted") == 1
+        second.poller.poll_once()
+        assert second.names().count("controllerRestarted") == 1  # it saw the 0 as well
+        deadline = time.monotonic() + 10.0
+        while first.supervisor.rearm_pending or second.supervisor.rearm_pending:
+            assert time.monotonic() < deadline, "the canary was never armed again"
+            first.poller.poll_once()
+            second.poller.poll_once()
+        for _ in range(5):
+            first.poller.poll_once()
+            second.poller.poll_once()
+        assert first.names().count("controllerRestarted") == 1
+        assert second.names().count("controllerRestarted") == 1
+        assert len(sim.writes_to(CANARY_REG)) <= 4  # each wrote at most once after the restart
+    finally:
+        first.close()
+        second.close()
