@@ -2,7 +2,7 @@
 
 The controller has one set of parameter GVs, one command block and one GV291 for every master,
 and Modbus has no lock (PROTOCOL.md, "More than one master"). A host cannot prevent another
-master's writes; it can notice them. Two signs are watched here and in the supervisor:
+master's writes; it can notice them. Three signs are watched, here and in the supervisor:
 
 * **GV291 results we did not cause** (:class:`ForeignMasterWatch`, fed by the client itself):
   GV291 changes to a non-initial value while none of our writes is pending -- a pending write is
@@ -43,7 +43,8 @@ _NOT_FINAL = frozenset({STATUS_INITIAL, STATUS_SENTINEL, int(MoveStatus.MOVING)}
 
 @dataclass(frozen=True)
 class ForeignSighting:
-    """One sign of another master: ``what`` (``"gv291"``, ``"canary"``) and the value seen."""
+    """One sign of another master: ``what`` (``"gv291"``, ``"registers"``, ``"canary"``) and the
+    value seen."""
 
     what: str
     value: float
@@ -69,7 +70,9 @@ class ForeignSighting:
 
 
 class ForeignMasterWatch:
-    """GV291 watched across one client's writes and status reads (any thread; one lock)."""
+    """GV291 and the shared registers watched across one client's writes and reads, and the
+    sightings of every kind (any thread; one lock). A move is refused while one is recent
+    (:meth:`seen_within`), a command's "done" after one is *outcome unknown* (the tracker)."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
