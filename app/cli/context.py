@@ -69,7 +69,6 @@ class CliContext:
             if self.make_client is not None:
                 self._client = self.make_client()
                 self._client.caps = self.caps
-                self._watch_foreign(self._client)
                 return self._client
             client = RobotClient(self.settings)
             client.caps = self.caps
