@@ -9,9 +9,9 @@ master's writes; it can notice them. Three signs are watched, here and in the su
   one made less than :data:`app.timing.FOREIGN_RESULT_WINDOW` ago, or the command it started is
   still running (GV291 *moving*). A change to 0 (initial) is not counted: a controller restart
   and a stop also show 0, and another master's command shows its result after it anyway.
-* **Parameter and command registers changing without a write of ours**: GV200..GV205 and
-  GV220..GV227 (the motion parameters and the command register 440; see
-  :data:`~app.link.register_client.SHARED_WATCHED`) are read with a status read once a clock
+* **Parameter registers changing without a write of ours**: GV200..GV205 and GV221..GV227
+  (the motion parameters, the program and mode registers; see
+  :data:`~app.link.register_client.SHARED_BLOCKS`) are read with a status read once a clock
   period (``watch_shared_every``: the GUI's polls, an upload's or a command's waits, the CLI's
   reads) and just before a move's trigger; a value
   other than the last read and our own answered writes since then left there is another

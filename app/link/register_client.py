@@ -50,21 +50,16 @@ def _what(verb: str, address: int, count: int) -> str:
     return f"{verb} {range_name(address, count)}"
 
 
-#: The parameter and command registers every master shares, read in one block (registers
-#: 400..455, GV200..GV227) of which these are compared: GV200..GV205 and GV220..GV227 (GV206..
-#: GV216 are the live pose); not GV203, the jog ratio a controller's watchdog may zero itself,
-#: nor the stop register (our own Stop may go on the stop line, app/link/stop_line.py)
-SHARED_START = registers.gv_reg(registers.GV_PARAM0)
-SHARED_COUNT = registers.gv_reg(228) - SHARED_START
-SHARED_WATCHED = tuple(
-    address
-    for address in (
-        *range(SHARED_START, registers.gv_reg(206)),
-        *range(registers.gv_reg(220), registers.gv_reg(228)),
-    )
-    if address not in (registers.gv_reg(registers.GV_PARAM3), registers.gv_reg(registers.GV_PARAM3) + 1)
-    and address != registers.REG_STOP
+#: The parameter and command registers every master shares, read in two blocks and compared:
+#: GV200..GV205 (registers 400..411; GV206.. are the live pose) but not GV203, the jog ratio a
+#: controller's watchdog may zero itself; and GV221..GV227 (442..455). Not the command and stop
+#: registers 440/441: our own Stop may go on the stop line (app/link/stop_line.py), and a read
+#: touching the stop register must not stand between a Stop and the controller.
+SHARED_BLOCKS = (
+    (registers.gv_reg(registers.GV_PARAM0), registers.gv_reg(206) - registers.gv_reg(registers.GV_PARAM0)),
+    (registers.REG_PAUSE, registers.gv_reg(228) - registers.REG_PAUSE),
 )
+_RATIO = (registers.gv_reg(registers.GV_PARAM3), registers.gv_reg(registers.GV_PARAM3) + 1)
 
 
 class RegisterClient:
@@ -311,8 +306,10 @@ class RegisterClient:
     def watch_shared_registers(self, *, timeout: float | None = None) -> None:
         """One read of the registers every master shares (GV200..GV227: the motion parameters and
         the command register) for the foreign-master watch (:mod:`app.link.foreign`)."""
-        regs = self._read(SHARED_START, SHARED_COUNT, timeout)
-        watched = [(address, regs[address - SHARED_START]) for address in SHARED_WATCHED]
+        watched: list[tuple[int, int]] = []
+        for start, count in SHARED_BLOCKS:
+            regs = self._read(start, count, timeout)
+            watched += [(start + i, v) for i, v in enumerate(regs) if start + i not in _RATIO]
         self.foreign.note_shared(watched, time.monotonic())
 
     def read_clock(self) -> ControllerClock:
