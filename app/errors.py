@@ -183,6 +183,23 @@ class ReducedSpeedRefused(TeachPadError):
         )
 
 
+class ForeignMasterRefused(TeachPadError):
+    """Not sent: another Modbus master wrote to the controller moments ago (app/link/foreign.py),
+    so a move's parameters may be its own; nothing was started."""
+
+    code = "foreign_master"
+
+    def __init__(self, operation: str, seconds: float, sign: str, command: int | None = None) -> None:
+        params: dict[str, Any] = {"operation": operation, "seconds": round(seconds)}
+        if command is not None:
+            params["command"] = command
+        super().__init__(
+            f"{operation} not sent: {sign} less than {seconds:g} s ago; its writes could change this "
+            "move. Make sure no other master is commanding the robot, then send it again",
+            params=params,
+        )
+
+
 class InvalidInput(TeachPadError, ValueError):
     """A value the host refuses before sending (range, NaN, unknown enum)."""
 

@@ -49,7 +49,14 @@ BUSY_BACKOFF_SLICE = 0.02
 
 # Worker (GUI side).
 POLL_HZ_DEFAULT = 50
-CLOCK_POLL_PERIOD = 1.0  # s between date/time reads
+CLOCK_POLL_PERIOD = 1.0  # s between date/time and restart-canary reads (another master seen in 1 s)
+# s after a write of ours during which a GV291 change may be its answer (app/link/foreign.py)
+FOREIGN_RESULT_WINDOW = 2.0
+# s after a sign of another master during which no move is sent (app/link/foreign.py)
+FOREIGN_MOVE_HOLD = 5.0
+# s after a restart the canary reads 0 before our fresh token is written: other TeachPads
+# (reading it once a CLOCK_POLL_PERIOD) see the restart too (app/link/supervisor.py)
+CANARY_REARM_DELAY = 3.0
 RECONNECT_BACKOFF = (0.2, 0.5, 1.0, 2.0, 5.0)  # s, last one repeats
 LINK_LOSS_POLLS = 3  # consecutive failed transactions (refused, reset, command timeouts) -> link down
 NOT_ANSWERING_DOWN_AFTER = 3.0  # s of silence (polls timing out, link open) before the link is down

@@ -264,3 +264,14 @@ def _qt_leak_check(request: pytest.FixtureRequest) -> Iterator[None]:
             f"test leaked {len(leaked_threads)} running QThread(s) and {len(leaked_timers)} active QTimer(s)",
             pytrace=False,
         )
+
+
+@pytest.fixture(autouse=True)
+def _no_foreign_move_hold(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Many tests move the simulated arm with a helper client (``make_client``) between the
+    product's own moves: for the product that is another master, and it holds every move for
+    ``timing.FOREIGN_MOVE_HOLD`` after one (issue 19). The hold is not those tests' subject: it is
+    off here; the tests about it (tests/link/test_foreign_master.py) set it themselves."""
+    from app import timing
+
+    monkeypatch.setattr(timing, "FOREIGN_MOVE_HOLD", 0.0)

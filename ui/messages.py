@@ -95,6 +95,11 @@ _TEMPLATES: dict[str, str] = {
     "zero_stopped_short": QT_TRANSLATE_NOOP(
         "Messages", "{command}: the arm stopped before zero ({axis} at {value})."
     ),
+    "foreign_master": QT_TRANSLATE_NOOP(
+        "Messages",
+        "{command} not sent: another Modbus master wrote to the controller less than {seconds} s ago and "
+        "its writes could change this move. Make sure no other master is commanding the robot, then send it again.",
+    ),
     "controller_busy": QT_TRANSLATE_NOOP(
         "Messages",
         "{command} not sent: a program or motion is under way on the controller; wait for it to end, or press Stop.",

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from PySide6.QtCore import QCoreApplication, Qt, Slot
+from PySide6.QtCore import QCoreApplication, Qt, QTimer, Slot
 from PySide6.QtWidgets import QLabel, QSizePolicy, QTabWidget, QVBoxLayout, QWidget
 
 from app.link.state import RobotState
@@ -27,7 +27,10 @@ if TYPE_CHECKING:  # built when their tab is first shown (LazyTab)
     from ui.panels.program_panel import ProgramPanel
     from ui.panels.step_panel import StepPanel
 
-__all__ = ["ControlColumn"]
+__all__ = ["FOREIGN_BANNER_MS", "ControlColumn"]
+
+#: How long the "another master" banner stays after the last sign of one (ms)
+FOREIGN_BANNER_MS = 15_000
 
 # The column was part of the window: its texts keep the "MainWindow" translation context.
 BANNER_STYLE = (
@@ -59,10 +62,20 @@ class ControlColumn(QWidget):
         self.motion_banner.setAlignment(Qt.AlignmentFlag.AlignCenter)
         self.motion_banner.setWordWrap(True)
         self.motion_banner.setStyleSheet(BANNER_STYLE)
+        # another Modbus master on the controller (issue 19): shown while its signs keep coming
+        self.foreign_banner = QLabel(self)
+        self.foreign_banner.setObjectName("ForeignMasterBanner")
+        self.foreign_banner.setWordWrap(True)
+        self.foreign_banner.setStyleSheet(BANNER_STYLE)
+        self.foreign_banner.setVisible(False)
+        self._foreign_timer = QTimer(self)
+        self._foreign_timer.setSingleShot(True)
+        self._foreign_timer.timeout.connect(self.hide_foreign_master)
         column = QVBoxLayout(self)
         column.setContentsMargins(0, 0, 0, 0)
         column.addWidget(self.control_bar)
         column.addWidget(self.motion_banner)
+        column.addWidget(self.foreign_banner)
         column.addWidget(self.tabs, 1)
         self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Expanding)
         self.retranslate()
@@ -88,8 +101,24 @@ class ControlColumn(QWidget):
         self._show_banner()
 
     @Slot(ConnectionState)
-    def _on_connection(self, _connection: ConnectionState) -> None:
+    def _on_connection(self, connection: ConnectionState) -> None:
+        if not connection.connected:
+            self.hide_foreign_master()  # another controller may come next
         self._show_banner()
+
+    def show_foreign_master(self, text: str) -> bool:
+        """Say that another master is on the controller (for :data:`FOREIGN_BANNER_MS` after the
+        last sign); True when the banner was not showing (a new episode)."""
+        new = self.foreign_banner.isHidden()
+        self.foreign_banner.setText(text)
+        self.foreign_banner.setVisible(True)
+        self._foreign_timer.start(FOREIGN_BANNER_MS)
+        return new
+
+    @Slot()
+    def hide_foreign_master(self) -> None:
+        self._foreign_timer.stop()
+        self.foreign_banner.setVisible(False)
 
     def _show_banner(self) -> None:
         state = self._state

@@ -22,6 +22,7 @@ from app import timing
 from app.cli.exit_codes import ExitCode
 from app.errors import ModbusExceptionError, TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
+from app.link.foreign import ForeignSighting, audit_sighting
 from app.link.halt import RETRY_EXCEPTIONS
 from app.safety.audit import AuditLog
 from app.safety.caps import MotionCaps
@@ -77,9 +78,24 @@ class CliContext:
             client.audit = AuditLog(
                 role="administrator (cli)", word_order=self.settings.word_order, on_error=self.warn
             )
+            self._watch_foreign(client)
             self._client = client
             client.connect()
         return self._client
+
+    def _watch_foreign(self, client: RobotClient) -> None:
+        """Another Modbus master seen while this command reads the controller (app/link/foreign.py):
+        one warning line per kind of sign, every sighting audited."""
+        said: set[str] = set()
+
+        def seen(sighting: ForeignSighting) -> None:
+            audit_sighting(client.audit, sighting)
+            if sighting.what not in said:
+                said.add(sighting.what)
+                self.warn(f"{sighting.message}; its writes can change what ours do")
+
+        client.foreign.on_sighting = seen
+        client.watch_shared_every = timing.CLOCK_POLL_PERIOD
 
     def _say_caps(self, caps: MotionCaps) -> None:
         self.warn(

@@ -137,12 +137,14 @@ class RobotClient(CommandClient):
         value = registers.GO_ZERO_ALL if axis is None else check_int(axis, 0, last_axis, "axis")
         which = "all axes" if axis is None else JOINT_AXIS_NAMES[axis]
         self._require_writable("go to zero")
+        self.watch_shared_baseline()
         if self.caps is not None:
             self._refuse("go to zero", ReducedSpeedRefused("go to zero"))
         status = self.read_status()
         self._refuse_while_busy("go to zero", f"go to zero ({which})", status)
         self._auto_for("go to zero", status, switch_to_auto)
         before = before or self.read_pose()
+        self.check_no_foreign_master("go to zero")
         with self.judged_writes() as judged:
             self._write_control(registers.REG_GO_ZERO, value)
         axes = tuple(range(registers.NUM_AXES_TOTAL)) if axis is None else (value,)
@@ -171,11 +173,13 @@ class RobotClient(CommandClient):
         if self.caps is not None:
             speed_ratio = self.caps.program_ratio(speed_ratio)
         self._require_writable("run program")
+        self.watch_shared_baseline()
         status = self.read_status()
         self._refuse_while_busy("run program", f"run program {program_id}", status)
         self._auto_for("run program", status, switch_to_auto)
         before = before or self.read_pose()
         self._write(registers.REG_PROGRAM_ID, [program_id, int(motion), cycles, speed_ratio])
+        self.check_no_foreign_master("run program")
         with self.judged_writes() as judged:
             self._write_control(registers.REG_RUN_COMMAND, int(RunCommand.RUN_PROGRAM))
         watch = MotionWatch(
@@ -233,6 +237,7 @@ class RobotClient(CommandClient):
 
     def _prepare(self, command: RunCommand, *, auto: bool = True) -> tuple[ControllerStatus, Pose | None]:
         self._require_writable(command_text(command))
+        self.watch_shared_baseline()  # another master's writes from here on are told from ours
         before = self.read_status()
         before_pose = self.read_pose() if CommandKind.of(command) is CommandKind.MOVE else None
         if auto:

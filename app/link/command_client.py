@@ -23,10 +23,17 @@ import time
 from collections.abc import Callable
 
 from app import timing
-from app.errors import LinkError, MalformedResponse, ModbusExceptionError, Reason, ResponseTimeout
+from app.errors import (
+    ForeignMasterRefused,
+    LinkError,
+    MalformedResponse,
+    ModbusExceptionError,
+    Reason,
+    ResponseTimeout,
+)
 from app.link.outcome import outcome_note
 from app.link.register_client import RegisterClient
-from app.link.tracker import CommandTracker, CompletionRule, ResultPacer
+from app.link.tracker import CommandTracker, CompletionRule, ResultPacer, command_text
 from app.link.transport import ConnectionSettings
 from app.link.watch import MotionWatch, StateCheck
 from app.models import CommandResult, ControllerStatus, Pose
@@ -65,7 +72,11 @@ class CommandClient(RegisterClient):
     def command_status(self) -> CommandStatus:
         """GV291 decoded with the table of the last command this client sent."""
         regs = self._read(registers.gv_reg(registers.GV_COMMAND_STATUS), 2)
-        return decode_command_status(self._last_kind, decode_status_registers(regs, self.settings.word_order))
+        code = decode_status_registers(regs, self.settings.word_order)
+        now = time.monotonic()
+        self.foreign.note_status(code, now)
+        self.watch_shared_if_due(now)
+        return decode_command_status(self._last_kind, code)
 
     # -- completion rule (see app/link/tracker.py) ---------------------------------------
     @property
@@ -133,6 +144,8 @@ class CommandClient(RegisterClient):
         With the sentinel rule GV291 <- sentinel goes out first (completion "auto" probes
         GV291 before the first command).
         """
+        if CommandKind.of(command) is CommandKind.MOVE:  # (the parameters are written by now)
+            self.check_no_foreign_master(command_text(command), int(command))
         rule: CompletionRule = "observe"
         pre_code: int | None = None
         if CommandKind.of(command) is not None:
@@ -155,12 +168,30 @@ class CommandClient(RegisterClient):
             unconfirmed_after=self._unconfirmed_window(),
             pacer=self._pacer,
         )
+        tracker.foreign = self.foreign
         self._last_kind = tracker.kind
         self.last_tracker = tracker
         with self.judged_writes() as judged:
             self._write_control(registers.REG_RUN_COMMAND, int(command))
         tracker.note = outcome_note(self.audit, judged)  # its outcome goes to the audit trail
         return tracker
+
+    def check_no_foreign_master(self, operation: str, command: int | None = None) -> None:
+        """Just before a motion's trigger: read the shared registers back (our parameters still
+        there?) and refuse (audited, :class:`ForeignMasterRefused`) when another master was seen
+        within :data:`app.timing.FOREIGN_MOVE_HOLD`: a move is never sent over a foreign write."""
+        if self.watch_shared_every is not None:  # (a client that does not watch them: GV291 only)
+            self.watch_shared_registers()
+        foreign = self.foreign
+        hold = timing.FOREIGN_MOVE_HOLD
+        if not foreign.seen_within(time.monotonic(), hold):
+            return
+        sighting = foreign.last_sighting
+        sign = sighting.message if sighting is not None else "another Modbus master was seen"
+        error = ForeignMasterRefused(operation, hold, sign, command)
+        if self.audit is not None:
+            self.audit.record_refused(operation, str(error), dict(error.params))
+        raise error
 
     def poll(self, tracker: CommandTracker) -> CommandResult | None:
         """One status read (plus the pose for moves) fed to ``tracker``."""

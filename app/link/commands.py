@@ -144,6 +144,8 @@ class WorkerCommands:
                 code="stop_unreachable",
                 params={"endpoint": settings.endpoint, "cause": cause.code, "cause_args": dict(cause.args)},
             ) from None
+        if prior is not None:  # its writes (stop, ratio 0) are ours, not another master's
+            prior.foreign.note_write(time.monotonic())
         job = self._current_job
         if job is not None and job.sent is not None:
             job.sent.set()

@@ -102,6 +102,7 @@ class LinkPort(Protocol):
 
     controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
     controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
+    foreignMaster: SignalInstance  # noqa: N815 - (str, float) another master seen: what, the value (app/link/foreign.py)
     uploadProgress: SignalInstance  # noqa: N815 - (int, int) points done, total of the running upload
     pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str, bool) point id, ok, reason, unconfirmed
 

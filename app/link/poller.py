@@ -15,11 +15,14 @@ canary) are read every :data:`app.timing.CLOCK_POLL_PERIOD`. Polls use the poll 
 from __future__ import annotations
 
 import dataclasses
+import logging
 import time
 
 from app import timing
 from app.errors import LinkError, MalformedResponse, ResponseTimeout, TeachPadError
 from app.link.capture import LinkStatsReporter, RttMeter
+from app.link.client import RobotClient
+from app.link.foreign import audit_sighting
 from app.link.host import WorkerHost
 from app.link.types import Operation
 from app.models import ControllerStatus, Pose
@@ -30,6 +33,8 @@ __all__ = ["JOG_POLL_HZ_MIN", "Poller"]
 #: rate whatever the GUI's setting: the controller's watchdog (0.3 s on the simulator) stops a jog
 #: that sees no traffic, so a slow poll setting (below ~3.4 Hz) would stop the operator's own jog.
 JOG_POLL_HZ_MIN = 10.0
+
+_log = logging.getLogger(__name__)
 
 
 class Poller:
@@ -146,6 +151,7 @@ class Poller:
         self.publish(pose, status, good_at=answered)
         if canary is not None:
             host.supervisor.canary_read(canary)
+        self._report_foreign(client)
         done = host.motion.update(status, pose, answered)
         if done is not None:
             host.emit_result(*done)
@@ -154,6 +160,13 @@ class Poller:
         if rtt is not None:
             host.publish_rtt(rtt)
         self._report_stats()
+
+    def _report_foreign(self, client: RobotClient) -> None:
+        """Another master's signs seen by this poll (app/link/foreign.py): logged, audited, published."""
+        for sighting in client.foreign.take():
+            _log.warning("%s", sighting.message)
+            audit_sighting(client.audit, sighting)
+            self._host.publish_foreign_master(sighting.what, sighting.value)
 
     def _report_stats(self) -> None:
         client = self._host.client

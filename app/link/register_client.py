@@ -27,6 +27,7 @@ from typing import Self
 from app.errors import InvalidInput, WriteBlocked
 from app.link.checks import check_float, check_int, check_settings, range_name
 from app.link.decode import decode_pose, decode_status
+from app.link.foreign import ForeignMasterWatch
 from app.link.stats import LinkStats
 from app.link.transport import ConnectionSettings, TrafficObserver, Transport
 from app.models import ControllerStatus, Pose
@@ -49,6 +50,18 @@ def _what(verb: str, address: int, count: int) -> str:
     return f"{verb} {range_name(address, count)}"
 
 
+#: The parameter and command registers every master shares, read in two blocks and compared:
+#: GV200..GV205 (registers 400..411; GV206.. are the live pose) but not GV203, the jog ratio a
+#: controller's watchdog may zero itself; and GV221..GV227 (442..455). Not the command and stop
+#: registers 440/441: our own Stop may go on the stop line (app/link/stop_line.py), and a read
+#: touching the stop register must not stand between a Stop and the controller.
+SHARED_BLOCKS = (
+    (registers.gv_reg(registers.GV_PARAM0), registers.gv_reg(206) - registers.gv_reg(registers.GV_PARAM0)),
+    (registers.REG_PAUSE, registers.gv_reg(228) - registers.REG_PAUSE),
+)
+_RATIO = (registers.gv_reg(registers.GV_PARAM3), registers.gv_reg(registers.GV_PARAM3) + 1)
+
+
 class RegisterClient:
     """Registers, GVs and the pose/status blocks of one controller. Blocking; owned by one thread."""
 
@@ -66,6 +79,11 @@ class RegisterClient:
         self.write_answered_at = 0.0
         self.write_lost_until = 0.0  # a write without its answer may be acted on until then
         self._judged: list[AuditRecord] | None = None  # see judged_writes()
+        self.foreign = ForeignMasterWatch()  # another master's GV291 results (app/link/foreign.py)
+        # read the shared registers with a status read at most this often (s; None: never; the
+        # GUI's link and the CLI set it, app/link/foreign.py)
+        self.watch_shared_every: float | None = None
+        self._shared_read_at = -1e9
 
     # -- connection ----------------------------------------------------------------------
     def connect(self) -> None:
@@ -159,12 +177,16 @@ class RegisterClient:
             tracked = address != registers.REG_STOP
             if tracked:  # settled again below, when the controller has answered it
                 self.writes_settled = False
+            self.foreign.note_write(time.monotonic())
             try:
                 self._send_write(what, address, values, single, timeout)
             except BaseException:
+                self.foreign.note_registers(address, values, stored=False)
                 if tracked:  # no answer (or a refusal): it may still be acted on, until the timeout ran out
                     self.write_lost_until = time.monotonic() + self.settings.timeout
                 raise
+            self.foreign.note_write(time.monotonic())  # its answer may come from now on
+            self.foreign.note_registers(address, values, stored=True)
             if tracked:
                 self.write_answered_at = time.monotonic()
                 self.writes_settled = True
@@ -261,7 +283,34 @@ class RegisterClient:
         )
         self.last_status = status
         self.status_read_at = time.monotonic()
+        self.foreign.note_status(status.command_status_code, self.status_read_at)
+        self.watch_shared_if_due(self.status_read_at, timeout)
         return status
+
+    def watch_shared_if_due(self, now: float, timeout: float | None = None) -> None:
+        """Read the shared registers when ``watch_shared_every`` says so (a status read calls it);
+        not before this client's first command or write (a read-only session has nothing to guard)."""
+        every = self.watch_shared_every
+        if every is None or (self.write_count == 0 and not self.foreign.has_baseline):
+            return
+        if now - self._shared_read_at >= every:
+            self._shared_read_at = now
+            self.watch_shared_registers(timeout=timeout)
+
+    def watch_shared_baseline(self) -> None:
+        """Before a command's first write: what the shared registers hold (once per connection)."""
+        if self.watch_shared_every is not None and not self.foreign.has_baseline:
+            self._shared_read_at = time.monotonic()
+            self.watch_shared_registers()
+
+    def watch_shared_registers(self, *, timeout: float | None = None) -> None:
+        """One read of the registers every master shares (GV200..GV227: the motion parameters and
+        the command register) for the foreign-master watch (:mod:`app.link.foreign`)."""
+        watched: list[tuple[int, int]] = []
+        for start, count in SHARED_BLOCKS:
+            regs = self._read(start, count, timeout)
+            watched += [(start + i, v) for i, v in enumerate(regs) if start + i not in _RATIO]
+        self.foreign.note_shared(watched, time.monotonic())
 
     def read_clock(self) -> ControllerClock:
         return decode_clock(self._read(registers.gv_reg(registers.GV_DATE), 4), self.settings.datetime_layout)

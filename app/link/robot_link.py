@@ -67,6 +67,7 @@ class RobotLink(QObject):
     trafficObserved = Signal(tuple)  # noqa: N815 - tuple[TrafficRecord, ...]: see RobotWorker
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815
+    foreignMaster = Signal(str, float)  # noqa: N815
     uploadProgress = Signal(int, int)  # noqa: N815
     pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard stopped a jog
@@ -155,6 +156,7 @@ class RobotLink(QObject):
             (w.trafficObserved, self.trafficObserved),
             (w.controllerReconnected, self.controllerReconnected),
             (w.controllerRestarted, self.controllerRestarted),
+            (w.foreignMaster, self.foreignMaster),
             (w.uploadProgress, self.uploadProgress),
             (w.pointUploaded, self.pointUploaded),
             (w.jogGuardStopped, self.jogGuardStopped),

@@ -9,8 +9,10 @@
 * **Link loss**: :data:`app.timing.LINK_LOSS_POLLS` failed transactions in a row (refused, reset,
   command timeouts) declare the link ``DOWN`` at once; reconnection follows
   :data:`app.timing.RECONNECT_BACKOFF` by itself and ends with ``controllerReconnected``.
-* **Restart canary**: a random token in a spare GV, read back on the clock poll; a change means
-  the controller restarted under a live link (``controllerRestarted``).
+* **Restart canary**: a random token in a spare GV, read back on the clock poll; 0 means the
+  controller restarted under a live link (``controllerRestarted``: a restart clears GV0..GV99);
+  another nonzero value is another master's token (a sign of another master, not a restart;
+  see :meth:`LinkSupervisor.canary_read`).
 * **Which controller**: every connect decides the :class:`~app.link.types.ControllerIdentity`
   (endpoint, unit, word order, the canary's token) and publishes it in the
   ``ConnectionState`` (``controller``) before the link goes live. The canary is *read* first
@@ -30,6 +32,7 @@ import time
 from app import timing
 from app.errors import LinkError, Reason, ResponseTimeout, TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
+from app.link.foreign import ForeignSighting
 from app.link.host import WorkerHost
 from app.link.types import ConnectionState, ControllerIdentity, LinkState, Operation
 from app.link.upload import UPLOAD_POSE_GV
@@ -73,6 +76,8 @@ class LinkSupervisor:
         self._failures = 0
         self._backoff_index = 0
         self.canary_token: float | None = None  # what we wrote to the canary GV (None: not checking)
+        self._canary_foreign: float | None = None  # another master's value last seen there
+        self._rearm_at: float | None = None  # after a restart: when our token is written (monotonic)
         # the controller of the live connection, kept after it ends: the next connect compares
         self.identity: ControllerIdentity | None = None
         self._random = random.Random()
@@ -102,6 +107,9 @@ class LinkSupervisor:
         self.client = RobotClient(settings)
         self.client.audit = getattr(host, "audit", None)  # the audit trail records every write
         self.client.caps = host.caps  # reduced-speed mode's caps
+        # another master's parameter / command writes: the shared registers read with a status
+        # read once a clock period (polls, and the reads of uploads and command waits alike)
+        self.client.watch_shared_every = timing.CLOCK_POLL_PERIOD
         host.capture.attach(self.client)
         self._ever_connected = False
         self._backoff_index = 0
@@ -184,6 +192,8 @@ class LinkSupervisor:
         except TeachPadError as exc:
             _log.warning("could not read the restart canary GV%s: %s", gv, exc)
             return None
+        if value == self._canary_foreign and value != 0.0:
+            return last.boot  # another master's token we saw under the live link: the same boot
         if value != last.boot:
             _log.info(
                 "restart canary GV%s reads %g, not %g: another controller or another boot",
@@ -194,14 +204,18 @@ class LinkSupervisor:
             return None
         return last.boot
 
-    def arm_canary(self) -> None:
-        """Write a fresh random token to the canary GV (not in monitor-only mode, not when disabled)."""
+    def arm_canary(self, token: float | None = None) -> None:
+        """Write a fresh random token (or ``token``) to the canary GV (not in monitor-only mode,
+        not when disabled)."""
         self.canary_token = None
+        self._canary_foreign = None
+        self._rearm_at = None
         client = self.client
         gv = self.canary_gv
         if gv is None or client is None or client.settings.monitor_only:
             return
-        token = float(self._random.randint(1, 1 << 23))  # nonzero, exact in float32
+        if token is None:
+            token = self.new_token()
         try:
             client.write_gv(gv, [token])
         except TeachPadError as exc:
@@ -213,23 +227,73 @@ class LinkSupervisor:
             return
         self.canary_token = token
 
+    @property
+    def rearm_pending(self) -> bool:
+        """A restart was seen and our fresh token is not written yet (see :meth:`canary_read`)."""
+        return self._rearm_at is not None
+
+    def new_token(self) -> float:
+        return float(self._random.randint(1, 1 << 23))  # nonzero, exact in float32
+
     def canary_read(self, value: float) -> None:
-        """The canary GV as read on the clock poll; a foreign value means the controller restarted."""
-        if self.canary_token is None or value == self.canary_token:
+        """The canary GV as read on the clock poll (issue 19). A restart clears GV0..GV99, so
+        only 0 reads as "the controller restarted" (new identity, armed again). Any other value
+        than ours was written by another master: not a restart (the identity and the points stay),
+        a sighting of another master (:mod:`app.link.foreign`) once per value, and our token is
+        not written back (two TeachPads would fight over it). A reconnect accepts the value last
+        seen as well as ours (:meth:`_surviving_token`).
+
+        After a restart our fresh token is written only :data:`app.timing.CANARY_REARM_DELAY`
+        later, while the canary still reads 0: another TeachPad reading once a second sees the 0
+        (the restart) too, instead of our token. When another host's token shows first, it
+        stands for this boot and nothing is written."""
+        if self.canary_token is None:
+            return
+        if self._rearm_at is not None and self._pending_rearm(value):
+            return
+        if value in (self.canary_token, self._canary_foreign):
+            return
+        if value != 0.0:
+            _log.warning(
+                "restart canary GV%s reads %g instead of %g: another master wrote it (not a restart)",
+                self.canary_gv,
+                value,
+                self.canary_token,
+            )
+            self._canary_foreign = value
+            client = self.client
+            if client is not None:
+                client.foreign.add(ForeignSighting("canary", value, time.monotonic()))
             return
         _log.warning(
-            "restart canary GV%s reads %g instead of %g: the controller restarted",
+            "restart canary GV%s reads 0 instead of %g: the controller restarted",
             self.canary_gv,
-            value,
             self.canary_token,
         )
         if self.client is not None:
             self.client.invalidate_cache()  # GV245 and friends may have been reset too
-        self.arm_canary()
+        self.canary_token, self._canary_foreign = self.new_token(), None  # written after the delay
+        self._rearm_at = time.monotonic() + timing.CANARY_REARM_DELAY
         self._set_identity()  # another boot: published before the restart itself, so the GUI's
         if self.link_up:  # points are unknown by the time it hears of the restart
             self.set_state(self.state.state, self.state.message, self.state.reason)
         self._host.publish_restarted()
+
+    def _pending_rearm(self, value: float) -> bool:
+        """After a restart, before our token is written: True when ``value`` is dealt with here."""
+        if value == 0.0:
+            rearm_at = self._rearm_at
+            if rearm_at is not None and time.monotonic() >= rearm_at:
+                token = self.canary_token
+                self.arm_canary(token)
+                self._set_identity()  # the same token: the identity does not change
+            return True
+        self._rearm_at = None  # another host wrote its token first: it stands for this boot
+        self._canary_foreign = value
+        client = self.client
+        if client is not None:  # (another master is there)
+            client.foreign.add(ForeignSighting("canary", value, time.monotonic()))
+        return True
 
     # --- failures ----------------------------------------------------------------------
     def poll_answered(self) -> None:

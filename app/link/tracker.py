@@ -62,6 +62,7 @@ from app.errors import (
     TeachPadError,
 )
 from app.link.arrival import POSE_EPSILON, arrived, pose_moved
+from app.link.foreign import ForeignMasterWatch
 from app.link.outcome import UNKNOWN_ADVICE, OutcomeHook
 from app.link.pacer import ResultPacer
 from app.models import CommandResult, ControllerStatus, Pose
@@ -191,6 +192,9 @@ class CommandTracker:
         self.result: CommandResult | None = None
         self.error: TeachPadError | None = None
         self.note: OutcomeHook | None = None  # the audit's hook, called with the result (outcome.py)
+        # the sending client's watch for another master (app/link/foreign.py): a "done" seen
+        # while another master was seen cannot be told from its command's, it ends unknown
+        self.foreign: ForeignMasterWatch | None = None
 
     # -- public --------------------------------------------------------------------------
     @property
@@ -507,6 +511,14 @@ class CommandTracker:
         unconfirmed: bool = False,
         reason: Reason | None = None,
     ) -> CommandResult:
+        foreign = self.foreign
+        if ok and foreign is not None and foreign.last_seen is not None and foreign.last_seen >= self.started:
+            message = (
+                f"{self.text}: another Modbus master was seen while it ran, so its result may be the "
+                f"other master's: {UNKNOWN_ADVICE}"
+            )
+            self.error = OutcomeUnknown(message, params=self._args(foreign=True))
+            ok, reason = False, self.error.as_reason()
         details = self._details(now)
         details["reads"] = float(self.reads)
         ack = self._ack_read

@@ -82,13 +82,15 @@ class ControllerIdentity:
       our token on a reconnect proves the same boot: its temp points are the ones we left.
 
     Two connections reach the same controller boot (:meth:`same_boot`) only when every field
-    agrees and the token is known; anything else (another endpoint or unit, a restart, a canary
-    another master overwrote, no canary at all) is "another controller" and every point's sync
-    state becomes unknown. Deliberately not part of it: the controller's clock (it changes every
-    second and any master may set it), GV291 and the parameter GVs (every master writes them);
-    the protocol has no serial number or model register to read. So nothing here changes in
-    another master's normal work, except the canary itself (issue 19: the canary must tell a
-    restart from another TeachPad's write; this identity follows whatever the canary decides).
+    agrees and the token is known; anything else (another endpoint or unit, a restart, a token
+    we never saw -- another master may have written it after a restart while we were away --,
+    no canary at all) is "another controller" and every point's sync state becomes unknown.
+    Deliberately not part of it: the controller's clock (it changes every second and any master
+    may set it), GV291 and the parameter GVs (every master writes them); the protocol has no
+    serial number or model register to read. So nothing here changes in another master's normal
+    work: under a live link the canary reads a restart only as 0 (a restart clears GV0..GV99);
+    another TeachPad's token is another master, not a restart, and keeps this identity
+    (``LinkSupervisor.canary_read`` in :mod:`app.link.supervisor`).
     """
 
     endpoint: str

@@ -107,6 +107,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     trafficObserved = Signal(tuple)  # noqa: N815
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815 - the canary GV changed while the link stayed up
+    foreignMaster = Signal(str, float)  # noqa: N815 - another master seen: what ("gv291", "canary"), the value
     uploadProgress = Signal(int, int)  # noqa: N815 - points done, total
     pointUploaded = Signal(int, bool, str, bool)  # noqa: N815 - point id, ok, reason ("" when ok), unconfirmed
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard wrote ratio 0
@@ -330,6 +331,9 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
 
     def publish_restarted(self) -> None:
         self.controllerRestarted.emit()
+
+    def publish_foreign_master(self, what: str, value: float) -> None:
+        self.foreignMaster.emit(what, value)
 
     def publish_upload_progress(self, done: int, total: int) -> None:
         self.uploadProgress.emit(done, total)

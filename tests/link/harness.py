@@ -137,6 +137,9 @@ class PartsHost:
     def publish_restarted(self) -> None:
         self.out.append(("controllerRestarted", None))
 
+    def publish_foreign_master(self, what: str, value: float) -> None:
+        self.out.append(("foreignMaster", (what, value)))
+
     def publish_upload_progress(self, done: int, total: int) -> None:
         self.out.append(("uploadProgress", (done, total)))
 

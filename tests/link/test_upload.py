@@ -287,6 +287,7 @@ _LINK_FAILED_BY_CODE = {
     "jog_not_answering": False,  # the jog's own check before it starts: nothing was sent
     "outcome_unknown": False,  # taken, then its status could not be read: counted by the reads that failed
     "controller_busy": False,  # not sent: the controller runs a program
+    "foreign_master": False,  # not sent: another master wrote moments ago (the link is fine)
     "manual_mode": False,  # go to zero / run program in manual mode, no switch allowed: nothing sent
     "reduced_speed_refused": False,  # go to zero in reduced-speed mode: nothing sent
     "audit_unavailable": False,  # its audit record could not be written: refused, nothing sent

@@ -41,6 +41,7 @@ class FakeLink(QObject):
     errorOccurred = Signal(object)  # noqa: N815 - WorkerError, routed likewise
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815
+    foreignMaster = Signal(str, float)  # noqa: N815
     uploadProgress = Signal(int, int)  # noqa: N815
     pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
     called = Signal(str)
