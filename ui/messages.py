@@ -386,6 +386,16 @@ def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
         out["status"] = status
     if "alarms" in args:
         out["alarms"] = _alarms(int(args["alarms"]))
+    _named_fields(args, out)
+    file_fields(code, args, out)
+    if code == "modbus_exception" and "exception" in args:
+        out["name"] = _tr(_MODBUS_EXCEPTIONS.get(int(args["exception"]), _UNKNOWN_EXCEPTION))
+    return out
+
+
+def _named_fields(args: Mapping[str, Any], out: dict[str, str]) -> None:
+    """The arguments that are names in the protocol's or the operator's words: an operation, a
+    controller mode, a settings field (a field with no name of its own is left out)."""
     if "operation" in args:
         out["operation"] = operation_text(str(args["operation"]))
     if "mode" in args:
@@ -396,10 +406,6 @@ def _fields(code: str, args: Mapping[str, Any]) -> dict[str, str]:
             out["field"] = _tr(_FIELDS[field])
         else:
             out.pop("field", None)
-    file_fields(code, args, out)
-    if code == "modbus_exception" and "exception" in args:
-        out["name"] = _tr(_MODBUS_EXCEPTIONS.get(int(args["exception"]), _UNKNOWN_EXCEPTION))
-    return out
 
 
 def reason_text(reason: Reason) -> str | None:

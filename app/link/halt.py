@@ -220,25 +220,33 @@ def confirm_halt(
     read that fails the same way is tried again at the next turn."""
     budget = timing.HALT_CONFIRM_BUDGET if budget is None else budget
     while True:
-        now = clock()
-        for item in watch.due(now):
-            try:
-                write(item)
-            except TeachPadError as exc:
-                if not halt_refusal(exc):
-                    raise
-                watch.refused(item, exc)
-            else:
-                watch.took(item, clock())
-        if watch.answered_at is not None:
-            try:
-                pose = read_pose()
-            except TeachPadError as exc:
-                if not halt_refusal(exc):
-                    raise
-            else:
-                if watch.pose_seen(pose):
-                    return True
+        _send_due(write, watch, clock)
+        if watch.answered_at is not None and _seen_still(read_pose, watch):
+            return True
         if watch.given_up or clock() - watch.since >= budget:
             return False
         sleep(interval)
+
+
+def _send_due(write: Callable[[HaltWrite], None], watch: HaltWatch, clock: Callable[[], float]) -> None:
+    """Send what ``watch`` asks for now; a refusal or no answer (:func:`halt_refusal`) is counted."""
+    for item in watch.due(clock()):
+        try:
+            write(item)
+        except TeachPadError as exc:
+            if not halt_refusal(exc):
+                raise
+            watch.refused(item, exc)
+        else:
+            watch.took(item, clock())
+
+
+def _seen_still(read_pose: Callable[[], Pose], watch: HaltWatch) -> bool:
+    """The pose read now is the one read before (a read refused or unanswered: not yet)."""
+    try:
+        pose = read_pose()
+    except TeachPadError as exc:
+        if not halt_refusal(exc):
+            raise
+        return False
+    return watch.pose_seen(pose)
