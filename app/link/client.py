@@ -42,6 +42,7 @@ from app.errors import (
     MalformedResponse,
     ManualModeRefused,
     ModbusExceptionError,
+    OutcomeUnknown,
     ReducedSpeedRefused,
     ResponseTimeout,
     TeachPadError,
@@ -49,7 +50,6 @@ from app.errors import (
 from app.link.busy import BusyBackoff, is_busy, retry_busy
 from app.link.checks import check_enum, check_float, check_floats, check_int, check_tool
 from app.link.command_client import CommandClient
-from app.link.outcome import outcome_note
 from app.link.register_client import RegisterClient
 from app.link.stats import LinkStats
 from app.link.tracker import CommandTracker, command_text
@@ -69,7 +69,6 @@ from app.protocol.enums import (
     WorkMode,
     program_state_text,
 )
-from app.safety.audit import AuditRecord
 from app.safety.caps import MotionCaps
 
 __all__ = [
@@ -145,13 +144,11 @@ class RobotClient(CommandClient):
         self._auto_for("go to zero", status, switch_to_auto)
         before = before or self.read_pose()
         self.check_no_foreign_master("go to zero")
-        with self.judged_writes() as judged:
-            self._write_control(registers.REG_GO_ZERO, value)
         axes = tuple(range(registers.NUM_AXES_TOTAL)) if axis is None else (value,)
         watch = MotionWatch(
             None, f"go to zero ({which})", before, time.monotonic(), operation="go to zero", zero_axes=axes
         )
-        return self._watching(watch, judged)
+        return self._watching(watch, registers.REG_GO_ZERO, value)
 
     def run_program(
         self,
@@ -180,8 +177,6 @@ class RobotClient(CommandClient):
         before = before or self.read_pose()
         self._write(registers.REG_PROGRAM_ID, [program_id, int(motion), cycles, speed_ratio])
         self.check_no_foreign_master("run program")
-        with self.judged_writes() as judged:
-            self._write_control(registers.REG_RUN_COMMAND, int(RunCommand.RUN_PROGRAM))
         watch = MotionWatch(
             RunCommand.RUN_PROGRAM,
             f"run program {program_id}",
@@ -190,7 +185,7 @@ class RobotClient(CommandClient):
             operation="run program",
             program=program_id,
         )
-        return self._watching(watch, judged)
+        return self._watching(watch, registers.REG_RUN_COMMAND, int(RunCommand.RUN_PROGRAM))
 
     def _refuse_while_busy(self, operation: str, what: str, status: ControllerStatus) -> None:
         """Run program and go to zero are told by motion: not while a program or motion runs
@@ -205,8 +200,9 @@ class RobotClient(CommandClient):
             self.audit.record_refused(what, text, {"program_state": int(status.program_state)})
         raise ControllerBusy(text, params={"operation": operation})
 
-    def _watching(self, watch: MotionWatch, judged: list[AuditRecord]) -> MotionWatch:
-        watch.note = outcome_note(self.audit, judged)
+    def _watching(self, watch: MotionWatch, register: int, value: int) -> MotionWatch:
+        """Send the trigger ``register`` <- ``value`` of the command ``watch`` tells the end of."""
+        self.send_trigger(register, value, watch)
         self.last_watch = watch
         return watch
 
@@ -445,7 +441,13 @@ class RobotClient(CommandClient):
                     between=between,
                     backoff=BusyBackoff(halted, between),
                 )
-            except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
+            except (
+                LinkError,
+                ResponseTimeout,
+                MalformedResponse,
+                ModbusExceptionError,
+                OutcomeUnknown,
+            ) as exc:
                 results.append(
                     CommandResult(
                         RunCommand.CREATE_POINT,

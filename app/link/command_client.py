@@ -46,6 +46,7 @@ from app.protocol.enums import (
     decode_command_status,
     decode_status_registers,
 )
+from app.protocol.exceptions import exception_text, not_carried_out
 
 __all__ = ["CommandClient", "Completion"]
 
@@ -56,6 +57,9 @@ _log = logging.getLogger(__name__)
 Completion = CommandTracker | MotionWatch | StateCheck
 #: A status or pose read that failed: the command's outcome is not told by it (follow retries).
 _READ_ERRORS = (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError)
+#: Modbus exceptions to the GV291 probe's write that say GV291 cannot be written (illegal
+#: function, address, value); any other code says nothing about it.
+_READ_ONLY_CODES = frozenset({0x01, 0x02, 0x03})
 
 
 class CommandClient(RegisterClient):
@@ -94,14 +98,19 @@ class CommandClient(RegisterClient):
 
         Writes the sentinel, waits ``timing.SENTINEL_PROBE_SETTLE`` (a controller that
         re-publishes its status every scan has overwritten it by then) and reads it back. A
-        Modbus exception (a read-only GV291) means no. Safe: GV291 only reports the last
-        command's result, which the next command overwrites; the probe runs just before a
-        command, never in monitor-only mode. The answer is kept for this client's lifetime.
+        Modbus exception that refuses the write itself (illegal function, address or value: a
+        read-only GV291) means no; any other exception (busy, device failure, acknowledge, a
+        gateway's, a code the standard does not define) says nothing about GV291: it is raised
+        (the command is not sent) and the next command probes again. Safe: GV291 only reports
+        the last command's result, which the next command overwrites; the probe runs just before
+        a command, never in monitor-only mode. The answer is kept for this client's lifetime.
         """
         self._require_writable("GV291 probe")
         try:
             self._write_floats(registers.GV_COMMAND_STATUS, [float(STATUS_SENTINEL)])
         except ModbusExceptionError as exc:
+            if exc.exception_code not in _READ_ONLY_CODES:
+                raise
             _log.info("GV291 is read-only (%s): completion rule observe", exc)
             writable = False
         else:
@@ -171,10 +180,36 @@ class CommandClient(RegisterClient):
         tracker.foreign = self.foreign
         self._last_kind = tracker.kind
         self.last_tracker = tracker
-        with self.judged_writes() as judged:
-            self._write_control(registers.REG_RUN_COMMAND, int(command))
-        tracker.note = outcome_note(self.audit, judged)  # its outcome goes to the audit trail
+        self.send_trigger(registers.REG_RUN_COMMAND, int(command), tracker)
         return tracker
+
+    def send_trigger(self, register: int, value: int, completion: Completion) -> None:
+        """The write that sets a command going (440 <- command, 445 <- axes), judged: its outcome
+        goes to the audit trail through ``completion.note`` (:func:`outcome_note`).
+
+        A Modbus exception answer is a refusal only when its code says the request was not
+        carried out (:data:`app.protocol.exceptions.NOT_CARRIED_OUT`: raised as it is); any other
+        code (device failure, acknowledge, a gateway's target that did not respond, an unknown
+        code) leaves open what the controller did: ``completion`` ends *unknown* and its
+        :class:`~app.errors.OutcomeUnknown` is raised ("sent; the outcome is unknown -- check the
+        robot before sending it again"), recorded so in the audit trail."""
+        with self.judged_writes() as judged:
+            try:
+                self._write_control(register, value)
+            except ModbusExceptionError as exc:
+                if not_carried_out(exc.exception_code):
+                    raise
+                completion.note = outcome_note(self.audit, judged)
+                code = exc.exception_code
+                completion.unknown(
+                    time.monotonic(),
+                    f"the controller answered Modbus exception {code} "
+                    f"({exception_text(code, 'a code the standard does not define')}), "
+                    "which does not say it was not carried out",
+                )
+                assert completion.error is not None
+                raise completion.error from exc
+        completion.note = outcome_note(self.audit, judged)  # its outcome goes to the audit trail
 
     def check_no_foreign_master(self, operation: str, command: int | None = None) -> None:
         """Just before a motion's trigger: read the shared registers back (our parameters still

@@ -23,9 +23,23 @@ MODBUS_EXCEPTION_TEXT: Final[dict[int, str]] = {
 }
 
 
+#: The codes that say the request was *not carried out*: refused before acting on it (illegal
+#: function, address or value), busy ("retransmit later"), or not forwarded by a gateway. Any other
+#: code -- server device failure (4, it may have acted part-way), acknowledge (5: taken, still
+#: working), negative acknowledge, memory parity error, a gateway's target that did not respond
+#: (0x0B: it may have acted), a code the standard does not define -- leaves open what the
+#: controller did with the request.
+NOT_CARRIED_OUT: Final[frozenset[int]] = frozenset({0x01, 0x02, 0x03, 0x06, 0x0A})
+
+
+def not_carried_out(code: int) -> bool:
+    """Exception ``code`` says the request was not carried out (see :data:`NOT_CARRIED_OUT`)."""
+    return code in NOT_CARRIED_OUT
+
+
 def exception_text(code: int, unknown: str = "unknown exception") -> str:
     """The standard's name of exception ``code``; ``unknown`` for a code it does not define."""
     return MODBUS_EXCEPTION_TEXT.get(code, unknown)
 
 
-__all__ = ["MODBUS_EXCEPTION_TEXT", "exception_text"]
+__all__ = ["MODBUS_EXCEPTION_TEXT", "NOT_CARRIED_OUT", "exception_text", "not_carried_out"]
