@@ -192,14 +192,14 @@ class CommandClient(RegisterClient):
         code (device failure, acknowledge, a gateway's target that did not respond, an unknown
         code) leaves open what the controller did: ``completion`` ends *unknown* and its
         :class:`~app.errors.OutcomeUnknown` is raised ("sent; the outcome is unknown -- check the
-        robot before sending it again"), recorded so in the audit trail."""
+        robot before sending it again"), and its write reads so in the audit trail."""
         with self.judged_writes() as judged:
             try:
                 self._write_control(register, value)
             except ModbusExceptionError as exc:
                 if not_carried_out(exc.exception_code):
                     raise
-                completion.note = outcome_note(self.audit, judged)
+                # (no result line: the write's own outcome line reads unknown, app/safety/audit.py)
                 code = exc.exception_code
                 completion.unknown(
                     time.monotonic(),

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import functools
 import struct
-from collections.abc import Sequence
+from collections.abc import Container, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -37,6 +37,7 @@ __all__ = [
     "encode_request",
     "frame_need",
     "read_request",
+    "stale_answer_length",
     "write_multiple_request",
     "write_single_request",
 ]
@@ -54,6 +55,7 @@ _FUNCTION_TEXT = {
 }
 _MBAP = 7  # transaction id, protocol id, length, unit id
 _MBAP_HEADER = struct.Struct(">HHHB")  # what FramerSocket.encode writes before the PDU
+_MBAP_START = struct.Struct(">HHH")  # transaction id, protocol id, length
 _RTU_FRAMER = FramerRTU(DecodePDU(False))
 
 
@@ -219,6 +221,20 @@ def frame_need(framing: Framing, request: Request, unit: int, tid: int, buf: byt
             raise _bad("CRC", expected, crc, f"CRC {_hex(crc, 4)}, expected {_hex(expected, 4)}")
         _check_pdu(request, buf[1 : total - 2])
     return total
+
+
+def stale_answer_length(buf: bytes, earlier: Container[int]) -> int:
+    """TCP: the length of the answer to an *earlier* request of this link that ``buf`` starts
+    with (its transaction id in ``earlier``, protocol id 0, a plausible MBAP length); 0 when it
+    does not start with one (the caller checks it as this request's answer). The length may
+    exceed ``len(buf)``: the rest has not arrived yet. Such an answer came late (a duplicate, a
+    slow gateway): dropped whole, it cannot be taken for this request's, whose own answer follows."""
+    if len(buf) < 6:
+        return 0
+    got_tid, protocol, length = _MBAP_START.unpack_from(buf)
+    if got_tid not in earlier or protocol != 0 or not 2 <= length <= 254:
+        return 0
+    return 6 + int(length)
 
 
 @functools.lru_cache(maxsize=128)

@@ -14,7 +14,11 @@ or with bytes too many); :class:`ResponseTimeout` (silence); :class:`LinkError` 
 After a malformed answer or a timeout the link resynchronises: a TCP link is dropped (the next
 request reopens it, so a late or garbled tail is never read as the next answer); a serial line
 has its input flushed. Before every request, bytes that arrived unasked (stray bytes after a
-good answer) are flushed, so they cannot poison the next answer.
+good answer) are flushed, so they cannot poison the next answer. Modbus TCP: a whole answer that
+arrives first carrying the transaction id of one of the connection's last requests (a duplicate,
+a gateway's late answer) is dropped and counted as a resync; the request's own answer is read
+after it, and no answer is ever taken but by its own transaction id. (RTU has no transaction id:
+a late answer of the same shape cannot be told from the own one there.)
 
 Not thread-safe: one thread owns a transport. Traffic observers are called synchronously in
 that thread, inside the request: keep them short.
@@ -25,6 +29,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import time
+from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Literal
@@ -52,6 +57,7 @@ __all__ = ["ConnectionSettings", "TrafficObserver", "TrafficRecord", "Transport"
 
 _log = logging.getLogger(__name__)
 
+_EARLIER_TIDS = 16  # earlier requests whose late answers are recognised (and dropped)
 _COUNTERS = tuple(f.name for f in dataclasses.fields(LinkStats) if f.name != "last_error")
 
 
@@ -144,6 +150,7 @@ class Transport:
         self._encode_request = frames.encode_request
         self._frame_need = frames.frame_need
         self._decode_answer = frames.decode_answer
+        self._stale_answer_length = frames.stale_answer_length
         self._answer_registers = frames.answer_registers
         self.settings = settings
         self.framing: Framing = settings.transport
@@ -156,6 +163,10 @@ class Transport:
         self._observers: list[TrafficObserver] = []
         self._observing = False  # checked first on the hot path
         self._tid = 0
+        # the transaction ids of the last requests on this connection (not the one in flight,
+        # ``_tid_sent``): a late answer to one of them is dropped, never taken (``_stale``)
+        self._earlier_tids: deque[int] = deque(maxlen=_EARLIER_TIDS)
+        self._tid_sent = 0
         self._ever_connected = False
         # plain counters on the hot path; ``stats`` makes the LinkStats snapshot when asked
         self._counts = dict.fromkeys(_COUNTERS, 0)
@@ -202,6 +213,8 @@ class Transport:
 
     def close(self) -> None:
         self._stream.close()
+        self._earlier_tids.clear()  # a new connection carries no answer to these
+        self._tid_sent = 0
         self._on_link_change()
 
     def _resync(self, why: str) -> None:
@@ -283,6 +296,31 @@ class Transport:
         if dropped:
             self._count("resyncs", f"dropped {dropped} stray bytes from {self.settings.endpoint}")
 
+    def _need(self, request: Request, tid: int, own: bytes, buf: bytes) -> tuple[bytes, int]:
+        """What is left of ``buf`` once late answers are dropped (TCP: ``own``, the request's
+        transaction id, does not start it), and the length the answer must have (checked so far,
+        :func:`app.link.frames.frame_need`; a late answer's while it is not whole)."""
+        if own and buf[:2] != own:
+            buf, awaited = self._drop_stale(buf)
+            if awaited or not buf:
+                return buf, awaited
+        return buf, self._frame_need(self.framing, request, self.settings.unit, tid, buf)
+
+    def _drop_stale(self, buf: bytes) -> tuple[bytes, int]:
+        """Drop the whole late answers to earlier requests of this connection at the start of
+        ``buf`` (:func:`app.link.frames.stale_answer_length`), each counted as a resync: an answer
+        is taken only by its own transaction id, never a late one in its place, and the own answer
+        is read after them. Returns what is left and the length still awaited of a late answer
+        not yet whole (0: none; what is left is checked as the request's own answer)."""
+        while buf:
+            length = self._stale_answer_length(buf, self._earlier_tids)
+            if not length or len(buf) < length:
+                return buf, length
+            got = int.from_bytes(buf[:2], "big")
+            self._count("resyncs", f"dropped a late answer to an earlier request (transaction id {got})")
+            buf = buf[length:]
+        return buf, 0
+
     def _lost(self, what: str) -> LinkError:
         self.close()
         message = f"lost the connection to the controller at {self.settings.endpoint} during the {what}"
@@ -297,6 +335,9 @@ class Transport:
         unit = self.settings.unit
         framing = self.framing
         self._tid = tid = self._tid % 65000 + 1 if framing == "tcp" else 0
+        if self._tid_sent:  # (TCP) the transaction ids of this connection's earlier requests
+            self._earlier_tids.append(self._tid_sent)
+        self._tid_sent = tid
         frame = self._encode_request(framing, request, unit, tid)
         self._counts["requests"] += 1
         try:
@@ -307,13 +348,13 @@ class Transport:
             self._emit("tx", frame)
         buf = b""
         need = 0  # nothing received yet: no field to check, receive first
-        frame_need = self._frame_need
+        own = tid.to_bytes(2, "big") if framing == "tcp" else b""
         deadline = time.monotonic() + timeout
         try:
             while True:
                 if buf:
-                    need = frame_need(framing, request, unit, tid, buf)
-                    if len(buf) >= need:
+                    buf, need = self._need(request, tid, own, buf)
+                    if len(buf) >= need > 0:
                         break
                 remaining = deadline - time.monotonic()
                 if remaining <= 0:

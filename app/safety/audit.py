@@ -52,9 +52,10 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
-from app.errors import WriteBlocked
+from app.errors import ModbusExceptionError, WriteBlocked
 from app.protocol import registers
 from app.protocol.codec import WordOrder
+from app.protocol.exceptions import not_carried_out
 from app.safety.audit_chain import last_line_hash, line_hash
 from app.safety.audit_read import (
     CSV_COLUMNS,
@@ -157,11 +158,16 @@ def brings_to_rest(address: int, values: Sequence[int]) -> bool:
     return any(address == a and vals == v for a, v in _REST_WRITES)
 
 
-def _write_result(error: BaseException | None) -> tuple[str, str]:
+def _write_result(error: BaseException | None, judged: bool = False) -> tuple[str, str]:
     if error is None:
         return Result.OK, ""
     if isinstance(error, WriteBlocked):
         return Result.BLOCKED, str(error)
+    if judged and isinstance(error, ModbusExceptionError) and not not_carried_out(error.exception_code):
+        # a command's write answered with an exception that does not say it was not carried out
+        # (device failure, acknowledge, an undefined code): what it did is not known
+        # (app/link/command_client.py send_trigger)
+        return Result.UNKNOWN, str(error)
     return Result.FAILED, str(error) or type(error).__name__
 
 
@@ -335,7 +341,7 @@ class AuditLog:
         self._record_outcome(intent, None)
 
     def _record_outcome(self, intent: AuditRecord, error: BaseException | None) -> None:
-        result, detail = _write_result(error)
+        result, detail = _write_result(error, intent.args.get("judged") is True)
         self.record(
             OUTCOME, intent.command, result=result, args={"ref": intent.seq}, detail=detail, role=intent.role
         )

@@ -67,7 +67,8 @@ def _wrong_size(a: Answer) -> bytes:
     return _word(a.pdu, 3, 1)
 
 
-def _exception(code: int) -> Misbehaviour:
+def exception_answer(code: int) -> Misbehaviour:
+    """A well-formed exception answer with ``code``."""
     return _framed(lambda a: bytes([a.function | 0x80, code]))
 
 
@@ -95,13 +96,13 @@ MISBEHAVIOURS: dict[str, Misbehaviour] = {
     "stale answer only": _stale_only,
     "answered twice": lambda a, _p: Reply(a.correct + a.correct),
     "bytes after it": lambda a, _p: Reply(a.correct + b"\x00\x01\x02"),
-    "exception 2 (illegal address)": _exception(2),
-    "exception 4 (device failure)": _exception(4),
-    "exception 5 (acknowledge)": _exception(5),
-    "exception 6 (busy)": _exception(6),
-    "exception 0x0B (gateway target)": _exception(0x0B),
-    "exception 0x37 (unknown code)": _exception(0x37),
-    "exception 0 (no code)": _exception(0),
+    "exception 2 (illegal address)": exception_answer(2),
+    "exception 4 (device failure)": exception_answer(4),
+    "exception 5 (acknowledge)": exception_answer(5),
+    "exception 6 (busy)": exception_answer(6),
+    "exception 0x0B (gateway target)": exception_answer(0x0B),
+    "exception 0x37 (unknown code)": exception_answer(0x37),
+    "exception 0 (no code)": exception_answer(0),
     "exception of another function": _framed(lambda a: bytes([(a.function ^ 0x13) | 0x80, 2])),
     "hang-up, no answer": lambda a, _p: Reply(None, close=True),
     "half an answer, hang-up": _cut_then_close,
@@ -302,7 +303,6 @@ def _outcome(run: Run) -> Outcome | None:
 def judge(command: Command, run: Run, budget: float, sim: Any) -> list[str]:
     """What is wrong with ``run`` (empty: right). See the module docstring."""
     wrong: list[str] = []
-    aimed = [ex for ex in run.exchanges if ex.aimed]
     if run.seconds > 2 * budget:
         wrong.append(f"took {run.seconds:.2f} s, more than twice its budget {budget:.2f} s")
     relayed_as_is = sum(1 for ex in run.exchanges if ex.sent is not None and ex.correct in ex.sent)
@@ -321,15 +321,16 @@ def judge(command: Command, run: Run, budget: float, sim: Any) -> list[str]:
         return wrong
     if run.error is not None and not str(run.error).strip():
         wrong.append(f"an error without words: {type(run.error).__name__}")
-    trigger = [ex for ex in aimed if ex.function == 0x06 and ex.address in TRIGGERS]
-    if command.motion and trigger:
-        code = _exception_code(trigger[0])
+    # the last trigger the command sent (an upload's busy retry sends one again) ended it when
+    # its answer was not its confirmation
+    triggers = [ex for ex in run.exchanges if ex.function == 0x06 and ex.address in TRIGGERS]
+    last = triggers[-1] if triggers else None
+    if command.motion and last is not None and last.aimed:
+        code = _exception_code(last)
         refusal = code is not None and code in NOT_CARRIED_OUT
         outcome = _outcome(run)
         if refusal and outcome is not Outcome.REFUSED:
             wrong.append(f"the trigger was refused (exception {code}) but the outcome reads {outcome}")
         elif not refusal and outcome is not Outcome.UNKNOWN:
-            wrong.append(
-                f"the trigger went out unconfirmed ({trigger[0].aimed}) but the outcome reads {outcome}"
-            )
+            wrong.append(f"the trigger went out unconfirmed ({last.aimed}) but the outcome reads {outcome}")
     return wrong

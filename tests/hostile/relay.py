@@ -49,7 +49,11 @@ class Exchange:
 
     @property
     def answered_correctly(self) -> bool:
-        return self.sent == self.correct and not self.aimed.startswith("late")
+        """Its own answer came whole: as it was, or (Modbus TCP) after a late answer to an
+        earlier request, which a transaction id tells apart (over RTU nothing does)."""
+        if self.sent is None or not self.sent.endswith(self.correct):
+            return False
+        return self.sent == self.correct or (self.framing == "tcp" and self.aimed.startswith("late"))
 
 
 @dataclass

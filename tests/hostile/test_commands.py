@@ -11,13 +11,31 @@ first request and the trigger only. A test lists every wrong case at once.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
 
 from app import timing
-from tests.hostile.commands import COMMANDS, MISBEHAVIOURS, SLOW, TRIGGERS, Command, judge, run_case
+from app.cli.exit_codes import ExitCode, exit_code_for
+from app.errors import ModbusExceptionError, OutcomeUnknown, ResponseTimeout
+from app.link.client import ConnectionSettings, RobotClient
+from app.link.types import StepFrame
+from app.protocol import registers
+from app.safety.audit import AuditLog, Result, read_records
+from tests.hostile.commands import (
+    COMMANDS,
+    MISBEHAVIOURS,
+    POSE,
+    SLOW,
+    TRIGGERS,
+    Command,
+    exception_answer,
+    judge,
+    run_case,
+)
 from tests.hostile.relay import HostileRelay
+from tests.hostile.server import HostileServer, Reply, bank_value
 
 # The client's request timeout: silence waits it out. The simulator answers from this process:
 # under load a good answer may come late, which fails a command (allowed), never makes one wrong.
@@ -88,3 +106,80 @@ def test_each_misbehaviour_at_each_request_tcp(name: str, relay: tuple[Any, Host
 def test_each_misbehaviour_at_each_request_rtu(name: str, relay: tuple[Any, HostileRelay]) -> None:
     sim, r = relay
     _sweep(COMMANDS[name], sim, r, RTU_SKIP)
+
+
+# -- the paths the sweep found, one by one ------------------------------------------------------
+
+
+@pytest.mark.parametrize("relay", ["tcp"], indirect=True, ids=["tcp"])
+@pytest.mark.parametrize("code", [4, 5, 0x0B, 0x37])
+def test_a_trigger_answered_with_an_open_exception_ends_unknown_in_the_audit(
+    code: int, relay: tuple[Any, HostileRelay], tmp_path: Path
+) -> None:
+    """440 <- step answered with an exception that does not say "not carried out": the step ends
+    *unknown* (exit 4 in the CLI's table), and so does its write in the audit trail; the arm
+    moves (the controller took it), which is why "refused" (before) was wrong."""
+    sim, r = relay
+    clean = run_case(sim, r, COMMANDS["step"], {}, TIMEOUT)
+    trigger = next(ex.index for ex in clean.exchanges if ex.address == registers.REG_RUN_COMMAND)
+    sim.restart_controller()
+    before = sim.state().pose
+    r.arm({trigger: (f"exception {code}", exception_answer(code))})
+    audit = AuditLog(tmp_path)
+    client = RobotClient(ConnectionSettings(port=r.port, timeout=TIMEOUT))
+    client.audit = audit
+    with client, pytest.raises(OutcomeUnknown, match=r"sent; the outcome is unknown .* Modbus exception"):
+        client.step(StepFrame.BASE, [1.0, 0, 0, 0, 0, 0], speed=200.0)
+    assert r.delivered
+    assert sim.wait_for(lambda s: abs(s.pose[0] - before[0] - 1.0) < 1e-3 and not s.moving, 5.0)
+    audit.close()
+    commands = [rec for rec in read_records(tmp_path) if rec.kind == "write" and rec.args.get("judged")]
+    assert [rec.result for rec in commands] == [Result.UNKNOWN]
+    assert exit_code_for(OutcomeUnknown("sent")) is ExitCode.UNKNOWN
+
+
+@pytest.mark.parametrize("relay", ["tcp"], indirect=True, ids=["tcp"])
+@pytest.mark.parametrize("code", [4, 5, 6, 0x0B, 0x37])
+def test_the_completion_probe_takes_only_a_refusal_for_read_only(
+    code: int, relay: tuple[Any, HostileRelay]
+) -> None:
+    """The GV291 probe's write answered busy, device failure, acknowledge...: not "GV291 is
+    read-only" (before: the command went on under the observe rule and succeeded): the command
+    fails before its trigger, and the next command probes again."""
+    sim, r = relay
+    gv291 = registers.gv_reg(registers.GV_COMMAND_STATUS)
+    clean = run_case(sim, r, COMMANDS["create_point"], {}, TIMEOUT)
+    probe = next(ex.index for ex in clean.exchanges if ex.address == gv291)
+    sim.restart_controller()
+    triggers = len(sim.writes_to(registers.REG_RUN_COMMAND))
+    r.arm({probe: (f"exception {code}", exception_answer(code))})
+    with RobotClient(ConnectionSettings(port=r.port, timeout=TIMEOUT)) as client:
+        with pytest.raises(ModbusExceptionError) as info:
+            client.create_point(7, pose=POSE)
+        assert info.value.exception_code == code
+        assert client.completion_rule is None  # not decided: probed again next time
+        assert len(sim.writes_to(registers.REG_RUN_COMMAND)) == triggers
+        assert client.create_point(7, pose=POSE).ok
+        assert client.completion_rule == "sentinel"
+
+
+def test_a_late_answer_to_an_earlier_request_is_dropped_not_taken() -> None:
+    """Modbus TCP: an answer carrying the transaction id of an earlier request of the connection
+    (a duplicate, a slow gateway's) arrives before the request's own: dropped whole, counted, and
+    the own answer is read after it (before: a malformed answer, the link dropped); alone, it is
+    silence, never taken. Over RTU there is no transaction id to tell them apart."""
+    with HostileServer("tcp") as server:
+        client = RobotClient(ConnectionSettings(port=server.port, timeout=TIMEOUT))
+        with client:
+            assert client.read_registers(100, 4) == [bank_value(a) for a in range(100, 104)]
+            assert server.last is not None
+            late = server.last[0]  # the answer to transaction 1
+            server.push(lambda a: Reply(late + a.correct))
+            assert client.read_registers(560, 24) == [bank_value(a) for a in range(560, 584)]
+            stats = client.stats
+            assert (stats.answers, stats.malformed, stats.timeouts, stats.resyncs) == (2, 0, 0, 1)
+            assert stats.last_error == "dropped a late answer to an earlier request (transaction id 1)"
+            server.push(lambda a: Reply(late))
+            with pytest.raises(ResponseTimeout):
+                client.read_registers(100, 4)
+            assert (client.stats.answers, client.stats.malformed) == (2, 0)
