@@ -52,7 +52,7 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
-from app.errors import ModbusExceptionError, WriteBlocked
+from app.errors import LinkError, MalformedResponse, ModbusExceptionError, ResponseTimeout, WriteBlocked
 from app.protocol import registers
 from app.protocol.codec import WordOrder
 from app.protocol.exceptions import not_carried_out
@@ -163,12 +163,21 @@ def _write_result(error: BaseException | None, judged: bool = False) -> tuple[st
         return Result.OK, ""
     if isinstance(error, WriteBlocked):
         return Result.BLOCKED, str(error)
-    if judged and isinstance(error, ModbusExceptionError) and not not_carried_out(error.exception_code):
-        # a command's write answered with an exception that does not say it was not carried out
-        # (device failure, acknowledge, an undefined code): what it did is not known
-        # (app/link/command_client.py send_trigger)
+    if judged and _went_out_unconfirmed(error):
         return Result.UNKNOWN, str(error)
     return Result.FAILED, str(error) or type(error).__name__
+
+
+def _went_out_unconfirmed(error: BaseException) -> bool:
+    """A command's write went out and what it did is not known: answered with an exception that
+    does not say it was not carried out (device failure, acknowledge, an undefined code; see
+    app/link/command_client.py send_trigger), no answer in time, a malformed answer, or the link
+    lost during the request (``link_lost``; ``link_closed`` is seen before the request goes out)."""
+    if isinstance(error, ModbusExceptionError):
+        return not not_carried_out(error.exception_code)
+    if isinstance(error, ResponseTimeout | MalformedResponse):
+        return True
+    return isinstance(error, LinkError) and error.code == "link_lost"
 
 
 def _short(text: str, limit: int = MAX_DETAIL_CHARS) -> str:

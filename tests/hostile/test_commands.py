@@ -18,9 +18,18 @@ import pytest
 
 from app import timing
 from app.cli.exit_codes import ExitCode, exit_code_for
-from app.errors import ModbusExceptionError, OutcomeUnknown, ResponseTimeout
+from app.errors import (
+    LinkError,
+    MalformedResponse,
+    ModbusExceptionError,
+    OutcomeUnknown,
+    ResponseTimeout,
+    TeachPadError,
+)
 from app.link.client import ConnectionSettings, RobotClient
+from app.link.outcome import Outcome, outcome_of
 from app.link.types import StepFrame
+from app.models import CommandResult
 from app.protocol import registers
 from app.safety.audit import AuditLog, Result, read_records
 from tests.hostile.commands import (
@@ -111,31 +120,55 @@ def test_each_misbehaviour_at_each_request_rtu(name: str, relay: tuple[Any, Host
 # -- the paths the sweep found, one by one ------------------------------------------------------
 
 
+OPEN_EXCEPTIONS = [
+    "exception 4 (device failure)",
+    "exception 5 (acknowledge)",
+    "exception 0x0B (gateway target)",
+    "exception 0x37 (unknown code)",
+]
+UNCONFIRMED = [*OPEN_EXCEPTIONS, "hang-up, no answer", "function code", "half an answer, hang-up", "silence"]
+
+
 @pytest.mark.parametrize("relay", ["tcp"], indirect=True, ids=["tcp"])
-@pytest.mark.parametrize("code", [4, 5, 0x0B, 0x37])
-def test_a_trigger_answered_with_an_open_exception_ends_unknown_in_the_audit(
-    code: int, relay: tuple[Any, HostileRelay], tmp_path: Path
+@pytest.mark.parametrize("name", UNCONFIRMED)
+def test_a_trigger_that_went_out_unconfirmed_is_unknown_in_the_audit(
+    name: str, relay: tuple[Any, HostileRelay], tmp_path: Path
 ) -> None:
-    """440 <- step answered with an exception that does not say "not carried out": the step ends
-    *unknown* (exit 4 in the CLI's table), and so does its write in the audit trail; the arm
-    moves (the controller took it), which is why "refused" (before) was wrong."""
+    """440 <- step went out and its answer was not its confirmation: the arm moves (the simulator
+    took it). An exception that does not say "not carried out" ends the step *unknown*
+    (OutcomeUnknown, exit 4; before: "refused"); a link failure stays a link error (its reason
+    reads unknown in app/link/outcome.py's table); either way its write reads *unknown* in the
+    audit trail (before: "failed")."""
     sim, r = relay
     clean = run_case(sim, r, COMMANDS["step"], {}, TIMEOUT)
     trigger = next(ex.index for ex in clean.exchanges if ex.address == registers.REG_RUN_COMMAND)
     sim.restart_controller()
     before = sim.state().pose
-    r.arm({trigger: (f"exception {code}", exception_answer(code))})
+    r.arm({trigger: (name, MISBEHAVIOURS[name])})
     audit = AuditLog(tmp_path)
     client = RobotClient(ConnectionSettings(port=r.port, timeout=TIMEOUT))
     client.audit = audit
-    with client, pytest.raises(OutcomeUnknown, match=r"sent; the outcome is unknown .* Modbus exception"):
+    with client, pytest.raises(TeachPadError) as info:
         client.step(StepFrame.BASE, [1.0, 0, 0, 0, 0, 0], speed=200.0)
     assert r.delivered
+    if name in OPEN_EXCEPTIONS:
+        assert isinstance(info.value, OutcomeUnknown)
+        assert str(info.value) == (
+            "incremental move (base): sent; the outcome is unknown \u2014 check the robot before sending "
+            f"it again (the controller answered Modbus exception {int(name.split()[1], 0)} "
+            f"{name.split(' ', 2)[2]}, which does not say it was not carried out)"
+        ).replace("(unknown code)", "(a code the standard does not define)").replace(
+            "(gateway target)", "(gateway target device failed to respond)"
+        ).replace("(device failure)", "(server device failure)")
+        assert exit_code_for(info.value) is ExitCode.UNKNOWN
+    else:
+        assert isinstance(info.value, LinkError | MalformedResponse | ResponseTimeout)
+    reason = CommandResult(None, None, None, False, str(info.value), reason=info.value.as_reason())
+    assert outcome_of(reason) is Outcome.UNKNOWN
     assert sim.wait_for(lambda s: abs(s.pose[0] - before[0] - 1.0) < 1e-3 and not s.moving, 5.0)
     audit.close()
     commands = [rec for rec in read_records(tmp_path) if rec.kind == "write" and rec.args.get("judged")]
     assert [rec.result for rec in commands] == [Result.UNKNOWN]
-    assert exit_code_for(OutcomeUnknown("sent")) is ExitCode.UNKNOWN
 
 
 @pytest.mark.parametrize("relay", ["tcp"], indirect=True, ids=["tcp"])
