@@ -164,7 +164,7 @@ class Transport:
         self._observing = False  # checked first on the hot path
         self._tid = 0
         # the transaction ids of the last requests on this connection (not the one in flight,
-        # ``_tid_sent``): a late answer to one of them is dropped, never taken (``_stale``)
+        # ``_tid_sent``): a late answer to one of them is dropped, never taken (``_drop_stale``)
         self._earlier_tids: deque[int] = deque(maxlen=_EARLIER_TIDS)
         self._tid_sent = 0
         self._ever_connected = False
