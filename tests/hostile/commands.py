@@ -39,7 +39,7 @@ from app.link.types import StepFrame
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
-from tests.hostile.relay import Exchange, HostileRelay, Misbehaviour, Reply
+from tests.hostile.relay import Exchange, HostileRelay, Later, Misbehaviour, Reply
 from tests.hostile.server import Answer
 
 # -- misbehaviours -----------------------------------------------------------------------------
@@ -77,6 +77,11 @@ def _late(a: Answer, previous: bytes) -> Reply:
     return Reply(previous + a.correct)
 
 
+def _late_apart(a: Answer, previous: bytes) -> Reply:
+    """The answer to the request before, alone, and this one's a moment later."""
+    return Later(previous, then=a.correct)
+
+
 def _stale_only(a: Answer, previous: bytes) -> Reply:
     """Only the answer to the request before (this one's never comes)."""
     return Reply(previous or a.correct[:3])
@@ -93,6 +98,7 @@ MISBEHAVIOURS: dict[str, Misbehaviour] = {
     "echo address": _framed(lambda a: _word(a.pdu, 1, 1) if a.function != 0x03 else a.pdu[:1] + b"\x00"),
     "transaction id +1": lambda a, _p: Reply(a.frame(tid=a.tid + 1)),
     "late answer first": _late,
+    "late answer, then the own": _late_apart,
     "stale answer only": _stale_only,
     "answered twice": lambda a, _p: Reply(a.correct + a.correct),
     "bytes after it": lambda a, _p: Reply(a.correct + b"\x00\x01\x02"),

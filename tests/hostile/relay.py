@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 from tests.hostile.server import Answer, Framing, Reply, crc16
 
-__all__ = ["Exchange", "HostileRelay", "Misbehaviour", "Reply"]
+__all__ = ["Exchange", "HostileRelay", "Later", "Misbehaviour", "Reply"]
 
 #: What the client gets for one request: from the correct answer and the answer sent before it
 #: on this relay (b"" before the first).
@@ -54,6 +54,14 @@ class Exchange:
         if self.sent is None or not self.sent.endswith(self.correct):
             return False
         return self.sent == self.correct or (self.framing == "tcp" and self.aimed.startswith("late"))
+
+
+@dataclass(frozen=True)
+class Later(Reply):
+    """``data`` first, then after ``gap`` seconds ``then`` (a late answer, then the own one)."""
+
+    then: bytes = b""
+    gap: float = 0.02
 
 
 @dataclass
@@ -123,6 +131,7 @@ class HostileRelay:
                 conn.close()
                 continue
             upstream.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+            self._previous = b""  # a late answer comes on the connection of its request
             try:
                 self._relay(conn, upstream)
             except (ConnectionError, OSError):
@@ -200,7 +209,9 @@ class HostileRelay:
                 address,
                 second,
                 answer.correct,
-                reply.data,
+                reply.data + reply.then
+                if isinstance(reply, Later) and reply.data is not None
+                else reply.data,
                 reply.close,
                 aim.name if aim else "",
                 self.framing,
@@ -209,6 +220,9 @@ class HostileRelay:
                 self.log.append(exchange)
             if reply.data:
                 conn.sendall(reply.data)
+            if isinstance(reply, Later):
+                time.sleep(reply.gap)
+                conn.sendall(reply.then)
             self._previous = answer.correct
             if reply.close:
                 return

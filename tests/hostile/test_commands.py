@@ -49,9 +49,21 @@ from tests.hostile.server import HostileServer, Reply, bank_value
 # The client's request timeout: silence waits it out. The simulator answers from this process:
 # under load a good answer may come late, which fails a command (allowed), never makes one wrong.
 TIMEOUT = 0.4
-# Over RTU framing there is no transaction id; the exception codes are the same words as over TCP
-RTU_SKIP = frozenset({"transaction id +1", "exception 0x0B (gateway target)", "exception 4 (device failure)"})
-RTU_COMMANDS = ("read_registers", "write_gv", "stop", "step", "go_zero")
+# Over RTU framing there is no transaction id: a late answer of the same shape, alone, cannot be
+# told from the own one (a known limit of RTU, not checked); the exception codes are the same
+# words as over TCP
+RTU_SKIP = frozenset(
+    {
+        "transaction id +1",
+        "late answer, then the own",
+        "exception 0x0B (gateway target)",
+        "exception 4 (device failure)",
+    }
+)
+RTU_COMMANDS = ("read_registers", "write_gv", "stop", "go_zero")
+# Frame-level faults the single-request tests (test_malformed.py) cover field by field, left to
+# the random run (command_fuzz.py) here: the sweep stays under a minute
+FRAME_ONLY = frozenset({"exception 0 (no code)", "bytes after it", "answered twice"})
 
 
 @pytest.fixture(autouse=True)
@@ -86,7 +98,7 @@ def _sweep(command: Command, sim: Any, relay: HostileRelay, skip: frozenset[str]
     cases = 0
     for index in indices:
         for name, misbehaviour in MISBEHAVIOURS.items():
-            if name in skip or (name in SLOW and index not in (0, *triggers)):
+            if name in skip or name in FRAME_ONLY or (name in SLOW and index not in (0, *triggers)):
                 continue
             run = run_case(sim, relay, command, {index: (name, misbehaviour)}, TIMEOUT)
             cases += 1
