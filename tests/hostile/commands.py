@@ -328,10 +328,10 @@ def judge(command: Command, run: Run, budget: float, sim: Any) -> list[str]:
     if run.error is not None and not str(run.error).strip():
         wrong.append(f"an error without words: {type(run.error).__name__}")
     # the last trigger the command sent (an upload's busy retry sends one again) ended it when
-    # its answer was not its confirmation
+    # its answer was not its confirmation (a late answer before its own, over TCP, is dropped)
     triggers = [ex for ex in run.exchanges if ex.function == 0x06 and ex.address in TRIGGERS]
     last = triggers[-1] if triggers else None
-    if command.motion and last is not None and last.aimed:
+    if command.motion and last is not None and last.aimed and not last.answered_correctly:
         code = _exception_code(last)
         refusal = code is not None and code in NOT_CARRIED_OUT
         outcome = _outcome(run)
