@@ -335,7 +335,9 @@ def judge(command: Command, run: Run, budget: float, sim: Any) -> list[str]:
         code = _exception_code(last)
         refusal = code is not None and code in NOT_CARRIED_OUT
         outcome = _outcome(run)
-        if refusal and outcome is not Outcome.REFUSED:
+        later = any(ex.aimed and ex.index > last.index for ex in run.exchanges)
+        if refusal and outcome is not Outcome.REFUSED and not (later and outcome is Outcome.UNKNOWN):
+            # (a refusal, then the retry's write got no answer of its own: unknown is the safe word)
             wrong.append(f"the trigger was refused (exception {code}) but the outcome reads {outcome}")
         elif not refusal and outcome is not Outcome.UNKNOWN:
             wrong.append(f"the trigger went out unconfirmed ({last.aimed}) but the outcome reads {outcome}")
