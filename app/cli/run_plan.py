@@ -92,7 +92,8 @@ def register(subparsers: Any) -> None:
     r.add_argument(
         "--safety",
         metavar="PROFILE",
-        help="a safety profile (.safety.json): the plan must stay in its envelope",
+        help="a safety profile (.safety.json): the plan must stay in its envelope (default: the "
+        "envelope in force, the GUI's)",
     )
     r.add_argument(
         "--robot-profile",
@@ -194,6 +195,8 @@ def cmd_run(ctx: CliContext) -> ExitCode:
     try:
         if getattr(args, "safety", None):
             envelope = load_profile(args.safety).envelope
+        elif ctx.safety is not None:  # the envelope in force, the GUI's (app/cli/guard.py)
+            envelope = ctx.safety.envelope
         model = robot_model(getattr(args, "robot_profile", None))
     except TeachPadError as exc:
         ctx.error(str(exc))

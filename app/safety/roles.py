@@ -81,6 +81,7 @@ class Action(enum.Enum):
     REGISTER_PROFILE = "change register profile"
     MANAGE_ROLES = "manage roles and passwords"
     SUPPORT_BUNDLE = "write a support bundle"
+    WRITE_REGISTERS = "write controller registers directly"  # teachpad-cli write: any GV, unchecked
 
 
 #: The least role that may do each action.
@@ -102,6 +103,7 @@ REQUIRED_ROLE: dict[Action, Role] = {
     Action.CONNECTION: Role.ADMINISTRATOR,
     Action.REGISTER_PROFILE: Role.ADMINISTRATOR,
     Action.MANAGE_ROLES: Role.ADMINISTRATOR,
+    Action.WRITE_REGISTERS: Role.ADMINISTRATOR,
 }
 
 
