@@ -291,6 +291,8 @@ def cmd_point_create(ctx: CliContext) -> ExitCode:
 def cmd_move(ctx: CliContext) -> ExitCode:
     """Guarded by the project's copy of the points with ``--project`` (app/cli/point_move.py)."""
     args = ctx.args
+    if args.via is not None and args.via == args.id:  # a usage error before any other check
+        raise InvalidInput("the arc's middle point must differ from its end point")
     guard = point_move.move_guard(ctx)  # before connecting: a bad project sends nothing
     client = ctx.client
     tool = args.tool
