@@ -208,9 +208,9 @@ class CliSafety:
     def check_jog_start(self, pose: Pose, motion: JogMotion, poll_period: float) -> None:
         self.session.check_jog_start(pose, motion, poll_period)
 
-    def guard_stopped(self, violation: EnvelopeViolation, motion: JogMotion) -> EnvelopeRefused:
-        """The jog guard stopped a jog (audited); the error the command ends with."""
-        error = EnvelopeRefused(violation, "jog stopped before the limit")
+    def guard_stopped(self, violation: EnvelopeViolation, motion: JogMotion) -> TeachPadError:
+        """The jog guard stopped a jog (audited); the error the command ends with (exit 1)."""
+        text = f"jog stopped before the limit: {violation.message}"
         self.session.audit.record(
             "action",
             "jog stopped before the limit",
@@ -218,7 +218,7 @@ class CliSafety:
             args={"axis": motion.axis, "direction": motion.direction, "ratio": motion.ratio},
             detail=violation.message,
         )
-        return error
+        return TeachPadError(text, code="jog_guard_stopped")
 
 
 class EnvelopeUnchecked(TeachPadError):

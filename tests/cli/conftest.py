@@ -7,7 +7,6 @@ from pathlib import Path
 
 import pytest
 
-from app.cli.guard import ENVELOPE_FILE
 from app.safety.envelope import Envelope
 from app.safety.profile import SafetyProfile, save_profile
 from app.safety.roles import default_config_dir
@@ -23,7 +22,7 @@ def own_config_dir(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 
 def save_envelope(envelope: Envelope) -> Path:
     """Save ``envelope`` where the GUI keeps the one in force (the CLI reads it from there)."""
-    path = default_config_dir() / ENVELOPE_FILE
+    path = default_config_dir() / "envelope.safety.json"  # the GUI's (app/cli/guard.py ENVELOPE_FILE)
     path.parent.mkdir(parents=True, exist_ok=True)
     save_profile(path, SafetyProfile("test", envelope))
     return path
