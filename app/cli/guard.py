@@ -130,8 +130,10 @@ class CliSafety:
         store = RoleStore(default_store_path())
         session = SafetySession(store, audit, envelope_in_force(getattr(args, "safety", None)))
         session.reduced = bool(getattr(args, "reduced_speed", False))
-        session.idle.login(Role.ADMINISTRATOR)  # as the CLI always was, until log_in says otherwise
-        audit.set_role(_cli_role(Role.ADMINISTRATOR))
+        # until log_in: operator where roles apply, else administrator (as the CLI always was)
+        start = Role.OPERATOR if store.has_password(Role.ADMINISTRATOR) else Role.ADMINISTRATOR
+        session.idle.login(start)
+        audit.set_role(_cli_role(start))
         tty = (stdin or sys.stdin).isatty()
         return cls(session, getpass.getpass if tty else None, os.environ if environ is None else environ)
 
