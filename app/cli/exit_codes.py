@@ -51,7 +51,8 @@ class ExitCode(enum.IntEnum):
 _MEANING = {
     ExitCode.OK: "ok",
     ExitCode.FAILED: (
-        "command failed or refused (controller, busy, alarm, stopped, monitor-only, out of the robot's reach)"
+        "command failed or refused (controller, busy, alarm, stopped, monitor-only, out of the robot's "
+        "reach, safety envelope, role)"
     ),
     ExitCode.USAGE: "usage: bad arguments, values or input files (nothing sent)",
     ExitCode.LINK: "link: cannot connect, no answer in time, malformed answer",
