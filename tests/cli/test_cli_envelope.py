@@ -99,7 +99,9 @@ def test_a_jog_towards_the_box_wall_stops_before_it(csim: Any, capsys: pytest.Ca
     assert z0 + 5.0 < z <= box.hi[2], (z0, z, box.hi[2])
     assert not csim.state().jogging and not csim.state().teach_enabled
     assert out.strip().splitlines()[-1].startswith("pose X=")
-    # a jog that would have to stop at once is refused: nothing is written
+    # a jog that would have to stop at once (the wall 3 mm above, within its look-ahead) is
+    # refused: nothing is written
+    save_envelope(Envelope(keep_in=box_around(csim, 400.0, z_above=3.0)))
     writes = len(csim.writes)
     code, _, err = run(csim, capsys, "jog", "--axis", "Z", "--dir", "+", "--ratio", "20", "--seconds", "5")
     assert code == ExitCode.FAILED and "jog refused: " in one_line(err)
@@ -108,6 +110,7 @@ def test_a_jog_towards_the_box_wall_stops_before_it(csim: Any, capsys: pytest.Ca
     code, _, err = run(csim, capsys, "jog", "--axis", "Z", "--dir", "-", "--ratio", "20", "--seconds", "0.3")
     assert code == ExitCode.OK, err
     assert csim.state().pose[2] < z
+    assert csim.state().pose[2] <= box.hi[2]
 
 
 def test_a_move_the_host_cannot_check_is_refused(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
