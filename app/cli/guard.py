@@ -133,7 +133,7 @@ class CliSafety:
         # until log_in: operator where roles apply, else administrator (as the CLI always was)
         start = Role.OPERATOR if store.has_password(Role.ADMINISTRATOR) else Role.ADMINISTRATOR
         session.idle.login(start)
-        audit.set_role(_cli_role(start))
+        audit.set_role(lambda: _cli_role(session.role))  # the role in force, as in the GUI
         tty = (stdin or sys.stdin).isatty()
         return cls(session, getpass.getpass if tty else None, os.environ if environ is None else environ)
 
@@ -167,7 +167,6 @@ class CliSafety:
                 self.session.idle.logout()  # the operator needs no password
             else:
                 self.session.login(role, self._password(role))
-        self.session.audit.set_role(_cli_role(role))
         self.session.require(action, {"command": command_path(args)})
 
     def _password(self, role: Role) -> str:

@@ -4,6 +4,8 @@ Asserted at the simulator: its pose and its write log."""
 
 from __future__ import annotations
 
+import shutil
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -13,6 +15,7 @@ from app.cli.main import main
 from app.safety.audit import Result, default_audit_dir, query
 from app.safety.envelope import Box, Envelope
 from tests.cli.conftest import save_envelope
+from tests.core.test_cli_points import SAMPLES
 
 SCAN = 0.02
 GV203_HIGH = 407  # the jog ratio's high word: 20.0 = 0x41A0 0000, 100.0 = 0x42C8 0000
@@ -126,3 +129,17 @@ def test_a_move_the_host_cannot_check_is_refused(csim: Any, capsys: pytest.Captu
     assert code == ExitCode.FAILED
     assert "move to point refused: P5 cannot be checked against the safety envelope" in one_line(err)
     assert len(csim.writes) == writes and csim.state().pose[:3] == pytest.approx((x, y, z))
+
+
+def test_run_checks_its_plan_against_the_envelope_in_force(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without --safety, `run` checks the plan against the GUI's envelope (it checked none)."""
+    demo = tmp_path / "demo.teachpad.json"
+    shutil.copy(SAMPLES / "demo.teachpad.json", demo)
+    assert main(["run", str(demo), "--plan", "circle", "--check"]) == ExitCode.OK
+    capsys.readouterr()
+    save_envelope(Envelope(keep_in=Box("cell", (9000.0,) * 3, (9001.0,) * 3)))
+    assert main(["run", str(demo), "--plan", "circle", "--check"]) == ExitCode.FAILED
+    err = capsys.readouterr().err
+    assert "outside the allowed work space" in err and "(outside the safety envelope): not running it" in err

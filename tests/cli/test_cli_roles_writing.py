@@ -97,3 +97,27 @@ def test_without_passwords_the_cli_acts_as_administrator_as_before(
     assert code == ExitCode.OK, text
     writes = [r for r in query(default_audit_dir()) if r.kind == "write"]
     assert writes and all(r.role == "administrator (cli)" for r in writes)
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_in_a_terminal_the_password_is_asked_for(
+    sim: Any, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch, passwords: None
+) -> None:
+    asked: list[str] = []
+
+    def ask(prompt: str = "") -> str:
+        asked.append(prompt)
+        return ENGINEER
+
+    monkeypatch.setattr("sys.stdin", _Terminal(""))
+    monkeypatch.setattr("getpass.getpass", ask)
+    code, text = run(sim, capsys, "--role", "engineer", "step", "--frame", "base", "X=5")
+    assert code == ExitCode.OK, text
+    assert asked == ["engineer password: "]
+    records = query(default_audit_dir())
+    assert ("log in as engineer", "engineer (cli)") in [(r.command, r.role) for r in records]
+    assert next(r for r in records if r.kind == "write").role == "engineer (cli)"
