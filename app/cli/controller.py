@@ -551,7 +551,9 @@ def register(sub: Any) -> None:
         help="teach-mode jog for a bounded time (function 4); always stops and disables",
         description="Jog one axis in teach mode, then write ratio 0 and disable teach mode. The jog is "
         f"bounded: it stops after --seconds (default {JOG_SECONDS_DEFAULT:g} s, at most "
-        f"{JOG_SECONDS_MAX:g} s), on Ctrl-C and on any error. Example: "
+        f"{JOG_SECONDS_MAX:g} s), on Ctrl-C and on any error. The safety envelope binds it as in the "
+        "GUI: the ratio is capped at the envelope's jog cap, a jog that would have to stop at once "
+        "is refused, and the jog guard stops it before a boundary (exit 1). Example: "
         "teachpad-cli --host 192.168.1.10 jog --axis Z --dir + --ratio 10 --seconds 1.5",
     )
     p.add_argument(
@@ -624,8 +626,9 @@ def register(sub: Any) -> None:
         type=Path,
         metavar="FILE",
         help="the project holding the points (the host's copy): they are created again from it right "
-        "before the move and the arrival is checked against it (1 mm). Without it the arm goes to "
-        "whatever the controller holds under the id, unchecked",
+        "before the move and the arrival is checked against it (1 mm), and the path is checked "
+        "against the safety envelope. Without it the point cannot be checked: refused when the "
+        "envelope has a keep-in box or keep-out zones (a fresh install's has one)",
     )
     p.add_argument("--no-wait", action="store_true", help="return once the command is sent")
     p.add_argument(

@@ -42,7 +42,15 @@ from app.cli import controller, points, run_plan, support
 from app.cli.context import PROG, CliContext, Handler, ctrl_c_remembered
 from app.cli.exit_codes import EPILOG, ExitCode, exit_code_for
 from app.cli.format import parse_positive_float, parse_word_order
-from app.cli.guard import COMMAND_ACTIONS, PASSWORD_ENV, ROLE_ENV, ROLES_TEXT, CliSafety, command_path
+from app.cli.guard import (
+    COMMAND_ACTIONS,
+    ENVELOPE_FILE,
+    PASSWORD_ENV,
+    ROLE_ENV,
+    ROLES_TEXT,
+    CliSafety,
+    command_path,
+)
 from app.cli.help import add_examples
 from app.errors import InvalidInput, TeachPadError
 from app.link.client import ConnectionSettings
@@ -98,7 +106,10 @@ _DESCRIPTION = "Talk to a Bochuang robot controller over Modbus. " + ROLES_TEXT
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG,
-        description=textwrap.fill(_DESCRIPTION, 90),
+        description=textwrap.fill(
+            f"{_DESCRIPTION} The GUI's envelope file: {_shown_path(default_config_dir() / ENVELOPE_FILE)}.",
+            90,
+        ),
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,  # keeps the exit code table's lines
     )
