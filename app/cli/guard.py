@@ -125,8 +125,8 @@ class CliSafety:
         environ: Mapping[str, str] | None = None,
     ) -> CliSafety:
         """The role store and the envelope in force (:class:`TeachPadError` for a file that
-        cannot be used), reduced-speed mode as ``--reduced-speed`` says; acting as administrator
-        until :meth:`log_in`."""
+        cannot be used), reduced-speed mode as ``--reduced-speed`` says; until :meth:`log_in`
+        acting as operator where roles apply, else as administrator."""
         store = RoleStore(default_store_path())
         session = SafetySession(store, audit, envelope_in_force(getattr(args, "safety", None)))
         session.reduced = bool(getattr(args, "reduced_speed", False))
