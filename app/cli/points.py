@@ -288,18 +288,18 @@ def boot_lost_text(lost: BootLost, report: UploadReport, total: int) -> str:
         gone = "what was uploaded before cannot be proven on the controller"
     where = f" (after P{lost.after})" if lost.after is not None else ""
     text = f"{what}{where}: {gone}, the {len(report.confirmed)} point(s) uploaded before it among them"
-    if lost.suspects:
-        text += f"; {_id_text(lost.suspects)}, created as it came, "
+    if lost.suspects:  # sent around it: one may have been created at a wiped (zero) pose
+        text += f"; {_id_text(lost.suspects)}, sent around it, "
         if lost.repaired and not lost.repair_error:
-            text += "created again at their poses after it"
+            text += "were created again at their poses after it"
         else:
             text += (
-                f"created again after it: {_id_text(lost.repaired) or 'none'} "
+                f"were created again after it: {_id_text(lost.repaired) or 'none'} "
                 f"({lost.repair_error}; the others may be at wrong poses on the controller)"
             )
     left = report.not_attempted
     text += f"; not sent after it: {_id_text(left)}" if left else "; nothing else was left to send"
-    return text + f". Upload all {total} again (the upload record of the old boot is void)"
+    return text + f". Upload the {total} again: the upload record of the old boot is void, --needed sends all"
 
 
 def _upload_code(report: UploadReport) -> ExitCode:
@@ -432,7 +432,7 @@ def _save_record(where: Path, record: UploadRecord) -> str | None:
     try:
         save_record(where, record)
     except OSError as exc:
-        return str(exc)
+        return exc.strerror or str(exc)
     return None
 
 
