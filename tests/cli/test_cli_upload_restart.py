@@ -17,8 +17,8 @@ import pytest
 from app.cli.exit_codes import ExitCode
 from app.link.upload import stage_gv_for
 from app.points import atomic
-from app.points.guard import CANARY_GV
 from app.points import project as project_module
+from app.points.guard import CANARY_GV
 from app.points.project import load_project
 from app.points.upload_record import load_record, record_path
 from app.protocol import registers
