@@ -37,7 +37,7 @@ from typing import Any, TextIO
 from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode, exit_code_for
 from app.cli.points_upload import BootWatch, by_tool, open_boot, staged_upload
-from app.errors import InvalidInput, TeachPadError
+from app.errors import InvalidInput, ModbusExceptionError, TeachPadError
 from app.points.guard import CANARY_GV
 from app.points.ledger import EmptyImport, ImportMode, PointLedger
 from app.points.lock import live_owner
@@ -234,7 +234,9 @@ class _ProgressLine:
         self.width = 0
 
 
-def _upload(ctx: CliContext, points: Sequence[TempPoint], client: Any, watch: BootWatch) -> UploadReport:
+def _upload(
+    ctx: CliContext, points: Sequence[TempPoint], client: Any, watch: BootWatch | None
+) -> UploadReport:
     line = _ProgressLine(ctx.out)
     ordered = by_tool(points)
 
@@ -353,7 +355,7 @@ def cmd_points_upload(ctx: CliContext) -> ExitCode:
     old = _load_record(ctx, where)
     try:
         client = ctx.client
-        watch, record, resumed = open_boot(client, ctx.settings, old)
+        watch, record, resumed = _open_boot(ctx, client, old)
         if args.needed:
             points = _needed(ctx, project.ledger, record if resumed else None)
         if not points:
@@ -364,8 +366,7 @@ def cmd_points_upload(ctx: CliContext) -> ExitCode:
     except TeachPadError as exc:
         return _link_code(ctx, exc, "cannot upload")
     apply_upload(project.ledger, report)
-    _follow(record, points, report)
-    record_problem = _save_record(where, record)
+    record_problem = _keep_record(where, record, points, report)
     project_problem = _save_problem(project, args.project)
     _say_upload(ctx, report, len(points))
     return _say_kept(ctx, report, args.project, project_problem, record_problem) or _upload_code(report)
@@ -428,7 +429,28 @@ def _follow(record: UploadRecord, points: Sequence[TempPoint], report: UploadRep
     record.confirm([point for i in report.confirmed if (point := sent.get(i)) is not None])
 
 
-def _save_record(where: Path, record: UploadRecord) -> str | None:
+def _open_boot(
+    ctx: CliContext, client: Any, old: UploadRecord | None
+) -> tuple[BootWatch | None, UploadRecord | None, bool]:
+    """:func:`~app.cli.points_upload.open_boot`; a controller that refuses the restart canary's GV
+    (a Modbus exception) gets the upload without it, said: no restart seen, no record kept."""
+    try:
+        return open_boot(client, ctx.settings, old)
+    except ModbusExceptionError as exc:
+        ctx.warn(
+            f"the restart canary GV{CANARY_GV} cannot be used ({exc}): a controller restart during the "
+            "upload would go unseen"
+        )
+        return None, None, False
+
+
+def _keep_record(
+    where: Path, record: UploadRecord | None, points: Sequence[TempPoint], report: UploadReport
+) -> str | None:
+    """The record after ``report``, written; why it was not (None: it was)."""
+    if record is None:
+        return f"without the restart canary GV{CANARY_GV} nothing proves what the controller holds"
+    _follow(record, points, report)
     try:
         save_record(where, record)
     except OSError as exc:
@@ -456,7 +478,7 @@ def _say_kept(
         return ExitCode.FAILED
     if record_problem is not None:
         ctx.warn(
-            f"{record_path(path)}: the upload record could not be written ({record_problem}): {held} "
+            f"{record_path(path)}: no upload record was kept ({record_problem}): {held} "
             "and the project was saved, but a later --needed will send them again"
         )
     return None
