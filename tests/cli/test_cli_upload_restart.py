@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from pymodbus.constants import ExcCodes
 
 from app.cli.exit_codes import ExitCode
 from app.link.upload import stage_gv_for
@@ -185,3 +186,18 @@ def test_a_full_disk_is_said_after_what_was_uploaded_and_what_it_means(
     assert "the project file is as it was before this upload" in said
     assert "the upload record could not be kept either" in said and "--needed will send them again" in said
     assert project.read_bytes() == before and load_project(project).upload_history == {}
+
+
+def test_a_controller_that_refuses_the_canary_gets_the_upload_without_a_record(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """GV99 refused (a Modbus exception): the points are uploaded all the same, the CLI says a
+    restart would go unseen, and no upload record is kept (nothing proves what the controller holds)."""
+    sim = sim_factory(command_latency=0.0)
+    project = _project(sim, capsys, tmp_path, 5)
+    sim.set_exception(ExcCodes.ILLEGAL_ADDRESS, range(2 * CANARY_GV, 2 * CANARY_GV + 2))
+    code, out, err = run(sim, capsys, "points", "upload", str(project))
+    assert code == ExitCode.OK, err
+    assert "uploaded 5 point(s)" in out and len(_held_right(sim)) == 5
+    assert "the restart canary GV99 cannot be used" in err and "no upload record was kept" in err
+    assert not record_path(project).exists()
