@@ -98,7 +98,11 @@ def register(subparsers: Any) -> None:
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
     group = p.add_mutually_exclusive_group()
     group.add_argument("--ids", help="ids to upload, e.g. 1,2,5-9 (default: all)")
-    group.add_argument("--needed", action="store_true", help="only points not known to be on the controller")
+    group.add_argument(
+        "--needed",
+        action="store_true",
+        help="only points the upload record of this controller boot does not hold (resume)",
+    )
     p.set_defaults(handler=cmd_points_upload)
 
     p = psub.add_parser("export", help="write the project's points to a CSV file")
@@ -419,11 +423,9 @@ def _follow(record: UploadRecord, points: Sequence[TempPoint], report: UploadRep
         record.points.clear()
         record.identity = dataclasses.replace(record.identity, boot=None)
         return
-    unsent = set(
-        report.not_attempted[1:] if report.aborted and not report.interrupted else report.not_attempted
-    )
+    unsent = set(report.not_attempted[1:])  # the first (under way at Ctrl-C, a lost link) may have gone out
     for p in points:
-        if p.id not in unsent:  # the first not attempted after a lost link may have gone out
+        if p.id not in unsent:
             record.points.pop(p.id, None)
     sent = {o.point_id: o.sent for o in report.outcomes if o.sent is not None}
     record.confirm([point for i in report.confirmed if (point := sent.get(i)) is not None])
