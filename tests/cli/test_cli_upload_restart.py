@@ -201,3 +201,18 @@ def test_a_controller_that_refuses_the_canary_gets_the_upload_without_a_record(
     assert "uploaded 5 point(s)" in out and len(_held_right(sim)) == 5
     assert "the restart canary GV99 cannot be used" in err and "no upload record was kept" in err
     assert not record_path(project).exists()
+
+
+def test_a_malformed_record_is_not_trusted(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    sim = sim_factory(command_latency=0.0)
+    project = _project(sim, capsys, tmp_path, 4)
+    record_path(project).write_text('{"format": "teachpad-upload-record", "version": 1}', encoding="utf-8")
+    since = len(sim.writes)
+    code, _, err = run(sim, capsys, "points", "upload", str(project), "--needed")
+    assert code == ExitCode.OK, err
+    assert "not a TeachPad upload record" in err and "it is not used (every point is sent)" in err
+    assert "Traceback" not in err and sorted(_creates(sim, since)) == [1, 2, 3, 4]
+    record = load_record(record_path(project))  # replaced by a good one
+    assert record is not None and sorted(record.points) == [1, 2, 3, 4]
