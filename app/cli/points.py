@@ -27,13 +27,16 @@ file.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import math
+import time
 import unicodedata
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
+from app import timing
 from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode, exit_code_for
 from app.cli.points_upload import BootWatch, by_tool, open_boot, staged_upload
@@ -239,7 +242,11 @@ class _ProgressLine:
 
 
 def _upload(
-    ctx: CliContext, points: Sequence[TempPoint], client: Any, watch: BootWatch | None
+    ctx: CliContext,
+    points: Sequence[TempPoint],
+    client: Any,
+    watch: BootWatch | None,
+    proven: Callable[[list[TempPoint]], object] | None,
 ) -> UploadReport:
     line = _ProgressLine(ctx.out)
     ordered = by_tool(points)
@@ -249,7 +256,7 @@ def _upload(
             line.show(f"uploading {done + 1}/{total}: {ordered[done].label}")
 
     try:
-        return staged_upload(client, ordered, progress=progress, watch=watch)
+        return staged_upload(client, ordered, progress=progress, watch=watch, proven=proven)
     finally:
         line.done()
 
@@ -365,12 +372,13 @@ def cmd_points_upload(ctx: CliContext) -> ExitCode:
         if not points:
             ctx.print("nothing to upload")
             return ExitCode.OK
-        report = _upload(ctx, points, client, watch)
+        keeper = None if record is None else _RecordKeeper(where, record, points)
+        report = _upload(ctx, points, client, watch, None if keeper is None else keeper.proven)
         project.record_upload([o.point_id for o in report.outcomes if o.ok], _endpoint(client))
     except TeachPadError as exc:
         return _link_code(ctx, exc, "cannot upload")
     apply_upload(project.ledger, report)
-    record_problem = _keep_record(where, record, points, report)
+    record_problem = _keep_record(where, keeper, report)
     project_problem = _save_problem(project, args.project)
     _say_upload(ctx, report, len(points))
     return _say_kept(ctx, report, args.project, project_problem, record_problem) or _upload_code(report)
@@ -416,19 +424,40 @@ def _load_record(ctx: CliContext, where: Path) -> UploadRecord | None:
         return None
 
 
-def _follow(record: UploadRecord, points: Sequence[TempPoint], report: UploadReport) -> None:
-    """The record after ``report``: the points sent (or maybe sent) forgotten, the confirmed ones
-    kept with what was sent; after a restart nothing of it holds any more (no token: void)."""
-    if report.boot_lost is not None:
-        record.points.clear()
-        record.identity = dataclasses.replace(record.identity, boot=None)
-        return
-    unsent = set(report.not_attempted[1:])  # the first (under way at Ctrl-C, a lost link) may have gone out
-    for p in points:
-        if p.id not in unsent:
-            record.points.pop(p.id, None)
-    sent = {o.point_id: o.sent for o in report.outcomes if o.sent is not None}
-    record.confirm([point for i in report.confirmed if (point := sent.get(i)) is not None])
+class _RecordKeeper:
+    """The upload record while the upload runs: the points about to be sent leave it first (the
+    controller's copy of them is about to change), each good read of the canary adds what it
+    proved, written every :data:`app.timing.UPLOAD_RECORD_PERIOD` at most -- so even a killed
+    upload resumes from what the controller confirmed."""
+
+    def __init__(self, where: Path, record: UploadRecord, points: Sequence[TempPoint]) -> None:
+        self.where, self.record = where, record
+        self.before = {p.id: held for p in points if (held := record.points.pop(p.id, None)) is not None}
+        self.saved_at = time.monotonic()
+
+    def proven(self, confirmed: list[TempPoint]) -> None:
+        self.record.confirm(confirmed)
+        now = time.monotonic()
+        if now - self.saved_at >= timing.UPLOAD_RECORD_PERIOD:
+            self.saved_at = now
+            with contextlib.suppress(OSError):  # said at the end, when the last write fails too
+                save_record(self.where, self.record)
+
+    def finish(self, report: UploadReport) -> None:
+        """The record after ``report``: the confirmed points as sent, the points not sent as they
+        were; after a restart nothing of it holds any more (no token: void)."""
+        record = self.record
+        if report.boot_lost is not None:
+            record.points.clear()
+            record.identity = dataclasses.replace(record.identity, boot=None)
+            return
+        sent = {o.point_id: o.sent for o in report.outcomes if o.sent is not None}
+        record.confirm([point for i in report.confirmed if (point := sent.get(i)) is not None])
+        # the first one not attempted (under way at Ctrl-C or a lost link) may have gone out
+        for point_id in report.not_attempted[1:]:
+            held = self.before.get(point_id)
+            if held is not None:
+                record.points[point_id] = held
 
 
 def _open_boot(
@@ -446,15 +475,13 @@ def _open_boot(
         return None, None, False
 
 
-def _keep_record(
-    where: Path, record: UploadRecord | None, points: Sequence[TempPoint], report: UploadReport
-) -> str | None:
+def _keep_record(where: Path, keeper: _RecordKeeper | None, report: UploadReport) -> str | None:
     """The record after ``report``, written; why it was not (None: it was)."""
-    if record is None:
+    if keeper is None:
         return f"without the restart canary GV{CANARY_GV} nothing proves what the controller holds"
-    _follow(record, points, report)
+    keeper.finish(report)
     try:
-        save_record(where, record)
+        save_record(where, keeper.record)
     except OSError as exc:
         return exc.strerror or str(exc)
     return None

@@ -98,6 +98,7 @@ def staged_upload(
     points: Sequence[TempPoint],
     progress: Callable[[int, int], object] | None = None,
     watch: BootWatch | None = None,
+    proven: Callable[[list[TempPoint]], object] | None = None,
 ) -> UploadReport:
     """Create ``points`` with ``RobotClient.upload_points``, as the GUI's upload does: in
     :func:`by_tool` order (GV245 once per tool), the next point's pose staged in the spare pose
@@ -110,9 +111,11 @@ def staged_upload(
     is refused: each of its points) is recorded and the upload goes on; a lost link
     (:attr:`CommandResult.link_failed`) or Ctrl-C ends it, the point under way and the rest
     ``not_attempted``. ``watch``: the restart canary of the boot it began on (see the module
-    docstring); without it nothing is ``confirmed`` and a restart goes unseen.
+    docstring); without it nothing is ``confirmed`` and a restart goes unseen. ``proven(points)``:
+    after each good read of the canary, every point confirmed so far (as sent), for a record kept
+    while the upload runs.
     """
-    return _StagedUpload(client, by_tool(points), progress, watch).run()
+    return _StagedUpload(client, by_tool(points), progress, watch, proven).run()
 
 
 class _StagedUpload:
@@ -124,8 +127,12 @@ class _StagedUpload:
         ordered: list[TempPoint],
         progress: Callable[[int, int], object] | None,
         watch: BootWatch | None,
+        proven: Callable[[list[TempPoint]], object] | None = None,
     ) -> None:
         self.client, self.ordered, self.progress, self.watch = client, ordered, progress, watch
+        self.on_proven = proven
+        self.results: list[CommandResult] = []  # the batch under way's results so far ...
+        self.batch_first = 0  # ... and the index of its first point
         self.report = UploadReport()
         self.total, self.done = len(ordered), 0
         self.told, self.go_on = -1, True
@@ -156,7 +163,17 @@ class _StagedUpload:
             self.changed = value
             return False
         self.proven = n
+        if self.on_proven is not None:
+            self.on_proven(self.confirmed())
         return True
+
+    def confirmed(self) -> list[TempPoint]:
+        """The points created ("done", not unconfirmed) before the canary's last good read."""
+        report, ordered = self.report, self.ordered
+        ok = {o.point_id for o in report.outcomes if o.ok and not o.unconfirmed}
+        first = self.batch_first
+        ok.update(ordered[first + i].id for i, r in enumerate(self.results) if r.ok and not r.unconfirmed)
+        return [p for p in ordered[: self.proven] if p.id in ok]
 
     def stop_here(self, why: str, *, interrupted: bool = False) -> UploadReport:
         report = self.report
@@ -167,10 +184,7 @@ class _StagedUpload:
     def finish(self) -> UploadReport:
         """The report, with what the canary proved and (when it changed) the restart."""
         report = self.report
-        proven = {p.id for p in self.ordered[: self.proven]}
-        report.confirmed = [
-            o.point_id for o in report.outcomes if o.ok and not o.unconfirmed and o.point_id in proven
-        ]
+        report.confirmed = [p.id for p in self.confirmed()]
         if self.changed is not None and self.watch is not None:
             report.aborted = report.aborted or self.why_stopped()
             suspects = self.ordered[self.proven : self.done]
@@ -206,6 +220,7 @@ class _StagedUpload:
         """One tool frame's points; the final report when the upload ends here, else None."""
         first = self.done
         results: list[CommandResult] = []
+        self.results, self.batch_first = results, first
         report = self.report
         try:
             self.client.upload_points(

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import errno
 import os
+import subprocess
 import sys
 from pathlib import Path
 from typing import Any
@@ -24,8 +25,9 @@ from app.points.project import load_project
 from app.points.upload_record import load_record, record_path
 from app.protocol import registers
 from app.protocol.codec import registers_to_float
-from tests.cli.ctrl_c import interrupt_cli
+from tests.cli.ctrl_c import ROOT, ctrl_c_child, interrupt_cli, untraced_env
 from tests.cli.test_cli import run
+from tests.waits import CHILD_TIMEOUT, kill_child
 
 N = 30
 ZERO = (0.0,) * 6
@@ -216,3 +218,37 @@ def test_a_malformed_record_is_not_trusted(
     assert "Traceback" not in err and sorted(_creates(sim, since)) == [1, 2, 3, 4]
     record = load_record(record_path(project))  # replaced by a good one
     assert record is not None and sorted(record.points) == [1, 2, 3, 4]
+
+
+def test_a_killed_upload_resumes_from_the_record_written_while_it_ran(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """kill -9 mid-upload: the record written while it ran (every UPLOAD_RECORD_PERIOD) holds
+    only points the controller holds at their poses, and ``--needed`` sends the rest."""
+    n = 80
+    sim = sim_factory(command_latency=0.05)
+    project = _project(sim, capsys, tmp_path, n)
+    where = record_path(project)
+    proc = subprocess.Popen(
+        ctrl_c_child(sim.port, ["points", "upload", str(project)]),
+        cwd=ROOT,
+        env=untraced_env(),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        assert sim.wait_for(lambda s: where.exists() and len(s.points) >= 24, CHILD_TIMEOUT)
+        proc.kill()
+    finally:
+        kill_child(proc)
+    record = load_record(where)
+    assert record is not None and record.identity.boot
+    kept = set(record.points)
+    held = _held_right(sim)
+    assert len(kept) >= 8 and kept <= set(held) and len(held) < n, (sorted(kept), len(held))
+    since = len(sim.writes)
+    code, out, err = run(sim, capsys, "points", "upload", str(project), "--needed")
+    assert code == ExitCode.OK, err
+    assert sorted(_creates(sim, since)) == sorted(set(range(1, n + 1)) - kept)
+    assert f"{len(kept)} point(s) already on the controller" in out
+    assert sorted(_held_right(sim)) == list(range(1, n + 1))
