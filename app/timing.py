@@ -77,6 +77,7 @@ TEACH_MODE_GRACE = 0.3  # s after teach enable during which a status without mod
 UPLOAD_CHUNK_POINTS = 20  # points per event-loop turn of an upload, at most ...
 UPLOAD_CHUNK_SECONDS = 0.03  # ... or this long (s), whichever comes first
 UPLOAD_PROGRESS_PERIOD = 0.05  # s between uploadProgress emissions (the last one always goes out)
+UPLOAD_RECORD_PERIOD = 1.0  # s between two writes of teachpad-cli's upload record during an upload
 SHUTDOWN_WAIT = 1.5  # s the GUI waits for the worker thread on shutdown before detaching it
 
 # Simulator.
