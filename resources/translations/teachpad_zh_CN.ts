@@ -4150,160 +4150,166 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="141" />
+            <location filename="../../ui/controllers/project_controller.py" line="150" />
             <source>Undo</source>
+            <extracomment>The longest a close, a save or a discard waits for the autosave being written (s): a 58 MB project is written in about a second; a stuck disk must not hold the window for ever.</extracomment>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="143" />
+            <location filename="../../ui/controllers/project_controller.py" line="152" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="147" />
+            <location filename="../../ui/controllers/project_controller.py" line="156" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="148" />
+            <location filename="../../ui/controllers/project_controller.py" line="157" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="149" />
+            <location filename="../../ui/controllers/project_controller.py" line="158" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="150" />
+            <location filename="../../ui/controllers/project_controller.py" line="159" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="151" />
+            <location filename="../../ui/controllers/project_controller.py" line="160" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="152" />
+            <location filename="../../ui/controllers/project_controller.py" line="161" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="182" />
+            <location filename="../../ui/controllers/project_controller.py" line="191" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="217" />
+            <location filename="../../ui/controllers/project_controller.py" line="226" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="225" />
-            <location filename="../../ui/controllers/project_controller.py" line="263" />
-            <location filename="../../ui/controllers/project_controller.py" line="394" />
+            <location filename="../../ui/controllers/project_controller.py" line="234" />
+            <location filename="../../ui/controllers/project_controller.py" line="272" />
+            <location filename="../../ui/controllers/project_controller.py" line="426" />
             <source>Project in use</source>
             <translation>工程正在使用中</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="230" />
-            <location filename="../../ui/controllers/project_controller.py" line="233" />
+            <location filename="../../ui/controllers/project_controller.py" line="239" />
+            <location filename="../../ui/controllers/project_controller.py" line="242" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="236" />
+            <location filename="../../ui/controllers/project_controller.py" line="245" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="248" />
+            <location filename="../../ui/controllers/project_controller.py" line="257" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="268" />
-            <location filename="../../ui/controllers/project_controller.py" line="271" />
+            <location filename="../../ui/controllers/project_controller.py" line="278" />
+            <location filename="../../ui/controllers/project_controller.py" line="281" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="283" />
+            <location filename="../../ui/controllers/project_controller.py" line="293" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="289" />
+            <location filename="../../ui/controllers/project_controller.py" line="299" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="296" />
-            <location filename="../../ui/controllers/project_controller.py" line="299" />
-            <location filename="../../ui/controllers/project_controller.py" line="314" />
+            <location filename="../../ui/controllers/project_controller.py" line="306" />
+            <location filename="../../ui/controllers/project_controller.py" line="309" />
+            <location filename="../../ui/controllers/project_controller.py" line="324" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="316" />
+            <location filename="../../ui/controllers/project_controller.py" line="326" />
             <source>{added} added, {updated} updated, {unchanged} unchanged, {removed} removed</source>
             <translation>新增 {added} 个，更新 {updated} 个，未变 {unchanged} 个，删除 {removed} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="319" />
+            <location filename="../../ui/controllers/project_controller.py" line="329" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="332" />
+            <location filename="../../ui/controllers/project_controller.py" line="342" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="339" />
+            <location filename="../../ui/controllers/project_controller.py" line="349" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="342" />
+            <location filename="../../ui/controllers/project_controller.py" line="352" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="368" />
-            <location filename="../../ui/controllers/project_controller.py" line="372" />
+            <location filename="../../ui/controllers/project_controller.py" line="400" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="410" />
-            <location filename="../../ui/controllers/project_controller.py" line="413" />
+            <location filename="../../ui/controllers/project_controller.py" line="408" />
+            <location filename="../../ui/controllers/project_controller.py" line="461" />
+            <source>The autosave {path} is still being written after {seconds} s.</source>
+            <translation>自动保存 {path} 在 {seconds} 秒后仍在写入。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_controller.py" line="442" />
+            <location filename="../../ui/controllers/project_controller.py" line="445" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="416" />
+            <location filename="../../ui/controllers/project_controller.py" line="448" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="452" />
+            <location filename="../../ui/controllers/project_controller.py" line="495" />
             <source>Cannot lock {path}: {reason}</source>
             <translation>无法锁定 {path}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="462" />
+            <location filename="../../ui/controllers/project_controller.py" line="505" />
             <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
             <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="498" />
+            <location filename="../../ui/controllers/project_controller.py" line="542" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="501" />
+            <location filename="../../ui/controllers/project_controller.py" line="545" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>
