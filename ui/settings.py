@@ -3,7 +3,8 @@
 
 ``AppSettings()`` uses the user's settings store (organisation ``Bochuang``, application
 ``TeachPad``); tests and portable installs pass an explicit INI file
-(``AppSettings.from_file(path)``) so they never touch the user's.
+(``AppSettings.from_file(path)``) so they never touch the user's. The safety state (roles,
+envelope, register profile, audit trail) is never kept here: :mod:`app.safety.location`.
 """
 
 from __future__ import annotations

@@ -6,7 +6,8 @@ the robot model: engineer), feeds the envelope to the planner, the 3D view and t
 adds the menu: log in / out, reduced speed, envelope, register profile, passwords and lock, audit
 trail, support bundle; a status-bar label shows the role.
 
-The register profile in force is a file beside the settings (``AppSettings.register_profile_path``);
+The register profile in force is a file beside the role store (``AppSettings.register_profile_path``,
+:mod:`app.safety.location`; never beside the settings file);
 ``AppSettings.connection()`` applies it, so every connection made from the remembered settings
 uses it. :meth:`SafetyMenu.apply_register_profile` saves a new one (administrator, audited) and can
 reconnect the link at once with it.
