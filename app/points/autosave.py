@@ -211,7 +211,10 @@ class AutosaveWriter:
             done = self._write_job(job)
             with self._report_lock:  # reported before flush() returns; never after close()
                 if not self._muted:
-                    self.on_done(done)
+                    try:
+                        self.on_done(done)
+                    except RuntimeError:  # its receiver is gone (a deleted Qt object): nobody to tell
+                        self._muted = True
             with self._cond:
                 self._busy = False
                 self._cond.notify_all()

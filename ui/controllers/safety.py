@@ -109,10 +109,11 @@ class SafetyController(QObject):
     def __init__(
         self,
         link: RobotLink | None,
-        parent: QObject | None = None,
         *,
+        parent: QObject | None = None,
         scrypt_n: int | None = None,
     ) -> None:
+        # (no settings store: the safety state does not follow it; an old call passing one fails)
         super().__init__(parent)
         self.link = link
         self.location: SafetyLocation = safety_location()  # not beside the settings file (see above)

@@ -316,7 +316,7 @@ def attach_view3d(safety: SafetyController, panel: View3DPanel) -> None:
 
 def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> SafetyMenu:
     """Compose the guard rails onto ``window`` (its 3D view already installed)."""
-    safety = SafetyController(window.link, window, scrypt_n=scrypt_n)
+    safety = SafetyController(window.link, parent=window, scrypt_n=scrypt_n)
     safety.set_poll_rate(window.settings.poll_hz)  # the jog guard's margin follows the poll period
     menu = SafetyMenu(window, safety)
     safety.gate(window.menus.connect_action, Action.CONNECTION)
