@@ -5,6 +5,8 @@ for the GUI and the CLI alike, whatever settings file the GUI was started with."
 
 from __future__ import annotations
 
+import json
+import zipfile
 from pathlib import Path
 from typing import Any
 
@@ -112,3 +114,14 @@ def test_a_machine_wide_folder_is_used_when_an_administrator_made_one(
     saved = save_register_profile(where.register_profile, RegisterProfile("unit 7", unit=7))
     assert saved.revision == 1 and where.register_profile.parent == machine
     assert str(machine) in where.describe() and "machine-wide" in where.describe()
+
+
+def test_the_support_bundle_says_where_the_safety_state_lives(window: Any, tmp_path: Path) -> None:
+    menu = window.safety_menu
+    out = tmp_path / "bundle.zip"
+    menu.save_path = lambda _title, _suggested: str(out)
+    assert menu.write_bundle() == out
+    with zipfile.ZipFile(out) as zf:
+        settings = json.loads(zf.read("settings.json"))
+    where = safety_location()
+    assert settings["safety_state"] == where.describe() and str(where.audit_dir) in settings["safety_state"]

@@ -251,6 +251,7 @@ class SafetyMenu(QObject):
         window = self.window
         store = window.settings.store
         settings = {key: store.value(key) for key in store.allKeys()}
+        settings["safety_state"] = self.safety.location.describe()  # where roles, envelope, audit live
         project = window.project.path
         profile = self.safety.profile_path if self.safety.profile_path.exists() else None
         register_profile: Path | None = window.settings.register_profile_path()
