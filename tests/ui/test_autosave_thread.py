@@ -21,6 +21,7 @@ import pytest
 from app.points import autosave
 from app.points.atomic import atomic_write_bytes
 from app.points.project import load_project
+from tests.ui.pendant_support import FakeProjectDialogs
 from ui.controllers.project_controller import ProjectController
 from ui.models.point_columns import COL_X
 
@@ -60,7 +61,7 @@ def held(monkeypatch: pytest.MonkeyPatch) -> HeldWrites:
 def controller(qtbot: Any, tmp_path: Path, held: HeldWrites) -> Iterator[ProjectController]:
     path = tmp_path / "demo.teachpad.json"
     shutil.copy(ROOT / "resources" / "samples" / "demo.teachpad.json", path)
-    ctl = ProjectController(load_project(path), path, autosave_interval=0)
+    ctl = ProjectController(load_project(path), path, dialogs=FakeProjectDialogs(), autosave_interval=0)
     yield ctl
     held.gate.set()
     ctl.close()
@@ -113,6 +114,34 @@ def test_a_close_waits_for_the_autosave_being_written(
     assert controller.close()
     assert held.gate.is_set() and controller.autosaver.idle
     assert x_on_disk(controller) == 404.5
+
+
+def test_a_save_or_a_discard_leaves_no_autosave_landing_after_it(
+    qtbot: Any, controller: ProjectController, held: HeldWrites, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    flush = controller.autosaver.flush
+
+    def let_go_then_flush(timeout: float) -> bool:
+        held.gate.set()
+        return flush(timeout)
+
+    monkeypatch.setattr(controller.autosaver, "flush", let_go_then_flush)
+    set_x(controller, 406.5)
+    controller.autosave_now()
+    qtbot.waitUntil(held.entered.is_set, timeout=5000)
+    set_x(controller, 407.5)
+    controller.autosave_now()  # waiting behind the held one: dropped by the save
+    assert controller.save()
+    assert controller.autosaver.idle and not controller.autosave_file.exists()
+    assert load_project(controller.path).ledger[0].x == 407.5  # type: ignore[arg-type]
+    held.gate.clear()
+    held.entered.clear()
+    set_x(controller, 408.5)
+    controller.autosave_now()
+    qtbot.waitUntil(held.entered.is_set, timeout=5000)
+    controller.dialogs.save_choice = "discard"
+    assert controller.maybe_save()
+    assert controller.autosaver.idle and not controller.autosave_file.exists()
 
 
 def test_a_failed_autosave_is_said_in_words_and_tried_again(
