@@ -139,7 +139,9 @@ def test_a_save_or_a_discard_leaves_no_autosave_landing_after_it(
     set_x(controller, 408.5)
     controller.autosave_now()
     qtbot.waitUntil(held.entered.is_set, timeout=5000)
-    controller.dialogs.save_choice = "discard"
+    dialogs = controller.dialogs
+    assert isinstance(dialogs, FakeProjectDialogs)
+    dialogs.save_choice = "discard"
     assert controller.maybe_save()
     assert controller.autosaver.idle and not controller.autosave_file.exists()
 
