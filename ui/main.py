@@ -262,7 +262,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--monitor-only", action="store_true", help="never write to the controller")
     parser.add_argument("--lang", choices=sorted(LANGUAGE_NAMES), help="user interface language")
     parser.add_argument("--poll-hz", type=float, help="pose/status poll rate (default 50)")
-    parser.add_argument("--settings", metavar="FILE", help="keep settings in this INI file")
+    parser.add_argument(
+        "--settings",
+        metavar="FILE",
+        help="keep settings in this INI file (not the roles, the envelope nor the audit trail: "
+        "they stay where Help > About says)",
+    )
     parser.add_argument("--size", type=_size, metavar="WxH", help="window size, e.g. 1400x900")
     parser.add_argument(
         "--screenshot", metavar="PNG", help="save the window once connected with a pose, then exit"

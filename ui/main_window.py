@@ -49,6 +49,7 @@ from app import __version__
 from app.link.robot_link import RobotLink
 from app.link.transport import ConnectionSettings
 from app.link.types import WorkerError
+from app.safety.location import Scope
 from app.safety.roles import Action
 from ui.controllers.link_guard import LinkGuard
 from ui.controllers.motion import MotionController
@@ -454,8 +455,21 @@ class MainWindow(QMainWindow):
             self.tr(
                 "<b>TeachPad {version}</b><br>Desktop teach pendant for Bochuang robot controllers "
                 "(Modbus TCP / RTU).<br><br>Esc stops all motion. Jog buttons and keys move only while held."
-            ).format(version=__version__),
+            ).format(version=__version__)
+            + "<br><br>"
+            + self._safety_state_text(),
         )
+
+    def _safety_state_text(self) -> str:
+        """Where the roles, the envelope and the audit trail live (never beside the settings file)."""
+        from html import escape
+
+        where = self.safety_menu.safety.location
+        if where.scope is Scope.MACHINE:
+            text = self.tr("Safety state (roles, envelope, audit trail), machine-wide: {folder}")
+            return escape(text.format(folder=where.config_dir))
+        text = self.tr("Safety state (roles, envelope), this user's: {folder}<br>Audit trail: {audit}")
+        return text.format(folder=escape(str(where.config_dir)), audit=escape(str(where.audit_dir)))
 
     @property
     def touch_mode(self) -> bool:

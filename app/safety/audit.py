@@ -45,7 +45,6 @@ import contextlib
 import datetime as dt
 import enum
 import os
-import sys
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
@@ -76,6 +75,7 @@ from app.safety.audit_read import (
     read_records,
     result_label,
 )
+from app.safety.location import safety_location, user_data_dir
 
 __all__ = [  # the reader's names stay importable from here (app.safety.audit_read)
     "CSV_COLUMNS",
@@ -124,17 +124,13 @@ class FsyncPolicy(enum.Enum):
 
 def default_data_dir() -> Path:
     """Per-user data directory of TeachPad."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
-    return base / "teachpad"
+    return user_data_dir()
 
 
 def default_audit_dir() -> Path:
-    return default_data_dir() / "audit"
+    """The audit trail's folder: machine-wide when an administrator made one, else the user's
+    (:mod:`app.safety.location`; never beside a settings file)."""
+    return safety_location().audit_dir
 
 
 class AuditUnavailable(WriteBlocked):
