@@ -39,6 +39,7 @@ from app.points.ledger import PointLedger
 from app.safety.audit import AuditLog, Result
 from app.safety.envelope import Envelope, EnvelopeRefused, EnvelopeViolation, check_speed
 from app.safety.jog_guard import JogMotion
+from app.safety.location import ENVELOPE_NAME
 from app.safety.profile import fresh_profile, load_profile
 from app.safety.roles import Action, Role, RoleStore, WrongPassword, default_config_dir, default_store_path
 from app.safety.session import SafetySession
@@ -56,8 +57,8 @@ __all__ = [
 
 ROLE_ENV = "TEACHPAD_ROLE"
 PASSWORD_ENV = "TEACHPAD_PASSWORD"
-#: The GUI's envelope file in the user's config directory (ui/controllers/safety.py's PROFILE_NAME)
-ENVELOPE_FILE = "envelope.safety.json"
+#: The GUI's envelope file, in the safety state's folder (:mod:`app.safety.location`)
+ENVELOPE_FILE = ENVELOPE_NAME
 
 #: What each command that writes does, in the GUI's permission table's words; a command not
 #: listed only reads (status, watch, read, audit, points list / export, roles: its own check).
