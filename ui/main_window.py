@@ -354,22 +354,11 @@ class MainWindow(QMainWindow):
 
     @Slot(str, float)
     def _on_foreign_master(self, what: str, value: float) -> None:
-        """Another Modbus master is on the controller (app/link/foreign.py): banner, status bar,
-        and the event log once per episode (the worker audited it)."""
-        if what == "canary":
-            sign = self.tr("it wrote its own restart token ({value})").format(value=f"{value:g}")
-        elif what == "registers":
-            sign = self.tr("register {value} changed without a write of TeachPad").format(value=f"{value:g}")
-        else:
-            sign = self.tr("a command result TeachPad did not cause (GV291 = {value})").format(
-                value=f"{value:g}"
-            )
-        text = self.tr(
-            "Another Modbus master is on this controller: {sign}. It shares the parameter and "
-            "command registers with TeachPad: its writes can change what ours do. "
-            "Check who else is connected."
-        ).format(sign=sign)
-        if self.control_column.show_foreign_master(text):
+        """Another Modbus master is on the controller (app/link/foreign.py): banner (it follows the
+        language), status bar, and the event log once per episode (the worker audited it)."""
+        new = self.control_column.show_foreign_master(what, value)
+        text = self.control_column.foreign_banner.text()
+        if new:
             self.event_log.add_event("warning", self.tr("link"), text)
         self._show_message(text)
 

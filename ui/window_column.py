@@ -27,7 +27,7 @@ if TYPE_CHECKING:  # built when their tab is first shown (LazyTab)
     from ui.panels.program_panel import ProgramPanel
     from ui.panels.step_panel import StepPanel
 
-__all__ = ["FOREIGN_BANNER_MS", "ControlColumn"]
+__all__ = ["FOREIGN_BANNER_MS", "ControlColumn", "foreign_master_text"]
 
 #: How long the "another master" banner stays after the last sign of one (ms)
 FOREIGN_BANNER_MS = 15_000
@@ -68,6 +68,7 @@ class ControlColumn(QWidget):
         self.foreign_banner.setWordWrap(True)
         self.foreign_banner.setStyleSheet(BANNER_STYLE)
         self.foreign_banner.setVisible(False)
+        self._foreign_sign: tuple[str, float] | None = None  # the sign the banner says (what, value)
         self._foreign_timer = QTimer(self)
         self._foreign_timer.setSingleShot(True)
         self._foreign_timer.timeout.connect(self.hide_foreign_master)
@@ -99,6 +100,8 @@ class ControlColumn(QWidget):
         self.tabs.setTabText(1, QCoreApplication.translate("MainWindow", "Step"))
         self.tabs.setTabText(2, QCoreApplication.translate("MainWindow", "Program"))
         self._show_banner()
+        if self._foreign_sign is not None:
+            self.foreign_banner.setText(foreign_master_text(*self._foreign_sign))
 
     @Slot(ConnectionState)
     def _on_connection(self, connection: ConnectionState) -> None:
@@ -106,11 +109,14 @@ class ControlColumn(QWidget):
             self.hide_foreign_master()  # another controller may come next
         self._show_banner()
 
-    def show_foreign_master(self, text: str) -> bool:
+    def show_foreign_master(self, what: str, value: float) -> bool:
         """Say that another master is on the controller (for :data:`FOREIGN_BANNER_MS` after the
-        last sign); True when the banner was not showing (a new episode)."""
+        last sign): ``what`` and ``value`` as the link reports the sign (app/link/foreign.py); the
+        banner says it again in the new language when it changes. True when the banner was not
+        showing (a new episode)."""
         new = self.foreign_banner.isHidden()
-        self.foreign_banner.setText(text)
+        self._foreign_sign = (what, value)
+        self.foreign_banner.setText(foreign_master_text(what, value))
         self.foreign_banner.setVisible(True)
         self._foreign_timer.start(FOREIGN_BANNER_MS)
         return new
@@ -118,6 +124,7 @@ class ControlColumn(QWidget):
     @Slot()
     def hide_foreign_master(self) -> None:
         self._foreign_timer.stop()
+        self._foreign_sign = None
         self.foreign_banner.setVisible(False)
 
     def _show_banner(self) -> None:
@@ -133,6 +140,27 @@ class ControlColumn(QWidget):
                 QCoreApplication.translate("MainWindow", "Not connected: motion controls are disabled")
             )
         self.motion_banner.setVisible(not writable)
+
+
+def foreign_master_text(what: str, value: float) -> str:
+    """The banner's sentence for a sign of another master (``what``: "canary", "registers",
+    "gv291"), in the language in force."""
+    if what == "canary":
+        sign = QCoreApplication.translate("MainWindow", "it wrote its own restart token ({value})")
+    elif what == "registers":
+        sign = QCoreApplication.translate(
+            "MainWindow", "register {value} changed without a write of TeachPad"
+        )
+    else:
+        sign = QCoreApplication.translate(
+            "MainWindow", "a command result TeachPad did not cause (GV291 = {value})"
+        )
+    return QCoreApplication.translate(
+        "MainWindow",
+        "Another Modbus master is on this controller: {sign}. It shares the parameter and "
+        "command registers with TeachPad: its writes can change what ours do. "
+        "Check who else is connected.",
+    ).format(sign=sign.format(value=f"{value:g}"))
 
 
 def _build_step_panel() -> StepPanel:
