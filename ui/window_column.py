@@ -19,6 +19,7 @@ from PySide6.QtWidgets import QLabel, QSizePolicy, QTabWidget, QVBoxLayout, QWid
 
 from app.link.state import RobotState
 from app.link.types import ConnectionState
+from ui.foreign_words import foreign_master_text
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
 from ui.window_tabs import LazyTab
@@ -27,7 +28,7 @@ if TYPE_CHECKING:  # built when their tab is first shown (LazyTab)
     from ui.panels.program_panel import ProgramPanel
     from ui.panels.step_panel import StepPanel
 
-__all__ = ["FOREIGN_BANNER_MS", "ControlColumn", "foreign_master_text"]
+__all__ = ["FOREIGN_BANNER_MS", "ControlColumn"]
 
 #: How long the "another master" banner stays after the last sign of one (ms)
 FOREIGN_BANNER_MS = 15_000
@@ -140,27 +141,6 @@ class ControlColumn(QWidget):
                 QCoreApplication.translate("MainWindow", "Not connected: motion controls are disabled")
             )
         self.motion_banner.setVisible(not writable)
-
-
-def foreign_master_text(what: str, value: float) -> str:
-    """The banner's sentence for a sign of another master (``what``: "canary", "registers",
-    "gv291"), in the language in force."""
-    if what == "canary":
-        sign = QCoreApplication.translate("MainWindow", "it wrote its own restart token ({value})")
-    elif what == "registers":
-        sign = QCoreApplication.translate(
-            "MainWindow", "register {value} changed without a write of TeachPad"
-        )
-    else:
-        sign = QCoreApplication.translate(
-            "MainWindow", "a command result TeachPad did not cause (GV291 = {value})"
-        )
-    return QCoreApplication.translate(
-        "MainWindow",
-        "Another Modbus master is on this controller: {sign}. It shares the parameter and "
-        "command registers with TeachPad: its writes can change what ours do. "
-        "Check who else is connected.",
-    ).format(sign=sign.format(value=f"{value:g}"))
 
 
 def _build_step_panel() -> StepPanel:
