@@ -53,6 +53,7 @@ from app.safety.roles import Action
 from ui.controllers.link_guard import LinkGuard
 from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.plan_run_reasons import foreign_pause_text
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController, ProjectDialogs
 from ui.controllers.safety_menu import install_safety
@@ -221,6 +222,7 @@ class MainWindow(QMainWindow):
         link.controllerReconnected.connect(self._on_reconnected)
         link.controllerRestarted.connect(self._on_restarted)
         link.foreignMaster.connect(self._on_foreign_master)
+        self.run_controller.pausedByForeign.connect(self._on_run_paused_by_foreign)
         self.motion = MotionController(
             link, self.control_bar, self.jog_panel, None, None, self.run_controller, self
         )
@@ -361,6 +363,13 @@ class MainWindow(QMainWindow):
         if new:
             self.event_log.add_event("warning", self.tr("link"), text)
         self._show_message(text)
+
+    @Slot(str, float)
+    def _on_run_paused_by_foreign(self, what: str, value: float) -> None:
+        """The plan run paused itself at a sign of another master: the event log says why."""
+        self.event_log.add_event(
+            "warning", lambda: self.tr("plan run"), lambda: foreign_pause_text(what, value)
+        )
 
     @Slot()
     def _on_reconnected(self) -> None:

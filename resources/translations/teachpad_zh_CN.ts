@@ -1157,18 +1157,18 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/window_column.py" line="98" />
+            <location filename="../../ui/window_column.py" line="100" />
             <source>Jog</source>
             <extracomment>How long the "another master" banner stays after the last sign of one (ms)</extracomment>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="99" />
+            <location filename="../../ui/window_column.py" line="101" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="100" />
+            <location filename="../../ui/window_column.py" line="102" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
@@ -1193,17 +1193,17 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="319" />
+            <location filename="../../ui/main_window.py" line="321" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="129" />
+            <location filename="../../ui/window_column.py" line="137" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="133" />
+            <location filename="../../ui/window_column.py" line="141" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
@@ -1219,56 +1219,61 @@
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="351" />
+            <location filename="../../ui/main_window.py" line="353" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="360" />
+            <location filename="../../ui/foreign_words.py" line="16" />
             <source>it wrote its own restart token ({value})</source>
             <translation>它写入了自己的重启标记（{value}）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="362" />
+            <location filename="../../ui/foreign_words.py" line="18" />
             <source>register {value} changed without a write of TeachPad</source>
             <translation>寄存器 {value} 在 TeachPad 未写入的情况下发生了变化</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="364" />
+            <location filename="../../ui/foreign_words.py" line="22" />
             <source>a command result TeachPad did not cause (GV291 = {value})</source>
             <translation>出现了并非 TeachPad 引起的指令结果（GV291 = {value}）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="368" />
+            <location filename="../../ui/foreign_words.py" line="30" />
             <source>Another Modbus master is on this controller: {sign}. It shares the parameter and command registers with TeachPad: its writes can change what ours do. Check who else is connected.</source>
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="378" />
+            <location filename="../../ui/main_window.py" line="376" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="353" />
-            <location filename="../../ui/main_window.py" line="373" />
-            <location filename="../../ui/main_window.py" line="379" />
+            <location filename="../../ui/main_window.py" line="355" />
+            <location filename="../../ui/main_window.py" line="364" />
+            <location filename="../../ui/main_window.py" line="377" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="296" />
+            <location filename="../../ui/main_window.py" line="298" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="297" />
+            <location filename="../../ui/main_window.py" line="299" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="298" />
+            <location filename="../../ui/main_window.py" line="300" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="371" />
+            <source>plan run</source>
+            <translation>计划运行</translation>
         </message>
         <message>
             <location filename="../../ui/window_docks.py" line="109" />
@@ -1276,22 +1281,22 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="453" />
+            <location filename="../../ui/main_window.py" line="451" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="455" />
+            <location filename="../../ui/main_window.py" line="453" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="475" />
+            <location filename="../../ui/main_window.py" line="473" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="475" />
+            <location filename="../../ui/main_window.py" line="473" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -2080,37 +2085,37 @@
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="494" />
+            <location filename="../../ui/messages.py" line="500" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="497" />
+            <location filename="../../ui/messages.py" line="503" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="543" />
+            <location filename="../../ui/messages.py" line="549" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="546" />
+            <location filename="../../ui/messages.py" line="552" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="550" />
+            <location filename="../../ui/messages.py" line="556" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="553" />
+            <location filename="../../ui/messages.py" line="559" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="556" />
+            <location filename="../../ui/messages.py" line="562" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
@@ -2160,12 +2165,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="503" />
+            <location filename="../../ui/messages.py" line="509" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="507" />
+            <location filename="../../ui/messages.py" line="513" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -2830,43 +2835,43 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="245" />
+            <location filename="../../ui/panels/planner_widgets.py" line="249" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="246" />
+            <location filename="../../ui/panels/planner_widgets.py" line="250" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="265" />
+            <location filename="../../ui/panels/planner_widgets.py" line="269" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="268" />
+            <location filename="../../ui/panels/planner_widgets.py" line="272" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="270" />
+            <location filename="../../ui/panels/planner_widgets.py" line="274" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="272" />
+            <location filename="../../ui/panels/planner_widgets.py" line="276" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="275" />
+            <location filename="../../ui/panels/planner_widgets.py" line="279" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -2882,7 +2887,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="309" />
+            <location filename="../../ui/panels/planner_widgets.py" line="313" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -3051,27 +3056,37 @@
     <context>
         <name>PlanRunController</name>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="41" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="48" />
             <source>Failed: {reason}</source>
             <translation>失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="43" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="50" />
             <source>Stopped: {reason}</source>
             <translation>已停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="47" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="54" />
             <source>Failed at segment {n}: {reason}</source>
             <translation>在第 {n} 段失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="49" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="56" />
             <source>Stopped at segment {n}: {reason}</source>
             <translation>在第 {n} 段停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="29" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="76" />
+            <source>Paused: another master wrote to the controller ({sign})</source>
+            <translation>已暂停：另一个主站写入了控制器（{sign}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="83" />
+            <source>Not resumed: another master wrote to the controller less than {hold} s ago. Make sure no other master is commanding the robot; Resume is possible in {left} s.</source>
+            <translation>未继续：另一个主站在不到 {hold} 秒前写入了控制器。请确认没有其他主站在控制机器人；{left} 秒后才能继续。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="36" />
             <source>stopped by the operator</source>
             <translation>已由操作员停止</translation>
         </message>
@@ -3362,12 +3377,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="242" />
+            <location filename="../../ui/panels/planner_panel.py" line="245" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="422" />
+            <location filename="../../ui/panels/planner_panel.py" line="425" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -5051,7 +5066,7 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="378" />
+            <location filename="../../ui/panels/planner_widgets.py" line="382" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>

@@ -37,6 +37,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 )
 from tests.waits import join
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.plan_run_reasons import foreign_pause_text
 from ui.models.points_model import PointsModel
 
 pytestmark = pytest.mark.timeout(120)
@@ -126,7 +127,7 @@ def test_a_run_pauses_at_another_masters_write_and_continues_after_the_hold(
     project, runs = _bench(link, make_client(sim).read_pose().xyzabc)
     runs.audit = AuditLog(tmp_path)
     said: list[str] = []
-    runs.pausedFor.connect(said.append)
+    runs.pausedByForeign.connect(lambda what, value: said.append(foreign_pause_text(what, value)))
     refused: list[str] = []
     runs.resumeRefused.connect(refused.append)
     since = len(sim.writes)

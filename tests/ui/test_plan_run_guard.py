@@ -179,7 +179,7 @@ def test_an_overwrite_between_re_create_and_move_stops_the_run_and_tells_the_ope
     bench.runs.segmentPrepared.connect(overwrite)
     # the other tool's writes are a sign of another master: the run pauses itself when it sees them
     # (tests/ui/test_plan_run_foreign.py); the operator resumes at once (the move hold is 0 here)
-    bench.runs.pausedFor.connect(lambda _text: QTimer.singleShot(0, bench.runs.resume))
+    bench.runs.pausedByForeign.connect(lambda _what, _value: QTimer.singleShot(0, bench.runs.resume))
     mismatches: list[int] = []
     bench.runs.pointMismatch.connect(mismatches.append)
     since = len(sim.writes)

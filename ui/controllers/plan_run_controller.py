@@ -27,11 +27,12 @@ ids) is emitted right before each move is sent. There is no unguarded run.
 
 **Another master** (issue 19 section 2, app/link/foreign.py): at the link's ``foreignMaster``
 sign the run pauses itself as the operator's Pause would (442, the arm held, resumable) and says
-why (``pausedFor(str)``: "Paused: another master wrote to the controller (...)"; the window puts it
-in the run box and the event log; audited when ``audit`` is given). Nothing further is sent while
-it is paused so: no move, and not even the next segment's points (a create overlapping the other
-master's writes would be *unknown*). :meth:`resume` checks again: refused while the link's move
-hold (:data:`app.timing.FOREIGN_MOVE_HOLD`) lasts after the last sign (``resumeRefused(str)``).
+why (``pausedByForeign``: "Paused: another master wrote to the controller (...)"; the planner
+puts it in the run box, the window in the event log; audited when ``audit`` is given). Nothing
+further is sent while it is paused so: no move, and not even the next segment's points (a create
+overlapping the other master's writes would be *unknown*). :meth:`resume` checks again: refused
+while the link's move hold (:data:`app.timing.FOREIGN_MOVE_HOLD`) lasts after the last sign
+(``resumeRefused(str)``).
 The segment that was under way at the sign ends *outcome unknown* (its "done" cannot be told from
 the other master's): the run tells it by arrival instead -- the arm stands at the ledger's end
 point (the point guard's check): done; elsewhere: the run fails at that segment (the arm stopped
@@ -60,7 +61,6 @@ from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
 from ui.controllers.plan_run_reasons import (
     connection_error,
-    foreign_pause_text,
     foreign_resume_refused_text,
     outcome_text,
     stopped_by_operator,
@@ -91,8 +91,9 @@ class PlanRunController(QObject):
     segment's points — e.g. it restarted without the link noticing), ``segmentPrepared(int,
     object)`` (index, list of point ids re-created: the guarded move goes out next),
     ``pointMismatch(int)`` (end point id: the arm did not arrive at the ledger's copy),
-    ``pausedFor(str)`` (the run paused itself: why, translated), ``resumeRefused(str)`` (Resume
-    did nothing: why, translated).
+    ``pausedByForeign(str, float)`` (the run paused itself at a sign of another master: what and
+    the value, as ``link.foreignMaster``; :func:`~ui.controllers.plan_run_reasons.foreign_pause_text`
+    says it), ``resumeRefused(str)`` (Resume did nothing: why, translated).
     """
 
     runningChanged = Signal(bool)
@@ -105,7 +106,7 @@ class PlanRunController(QObject):
     pointsMissing = Signal(object)
     segmentPrepared = Signal(int, object)
     pointMismatch = Signal(int)
-    pausedFor = Signal(str)
+    pausedByForeign = Signal(str, float)
     resumeRefused = Signal(str)
 
     def __init__(
@@ -320,7 +321,6 @@ class PlanRunController(QObject):
         if not self._paused:
             self.pause()
         self._foreign_paused = True
-        text = foreign_pause_text(what, value)
         if self.audit is not None:
             current = runner.current
             args: dict[str, object] = {"what": what, "value": value}
@@ -332,7 +332,7 @@ class PlanRunController(QObject):
                 args=args,
                 detail="Paused: another master wrote to the controller",
             )
-        self.pausedFor.emit(text)
+        self.pausedByForeign.emit(what, value)
 
     def outcome_text(self, outcome: RunOutcome) -> str:
         """How a stopped or failed run ended, in the operator's language (one sentence)."""
