@@ -57,8 +57,8 @@ _MEANING = {
     ExitCode.USAGE: "usage: bad arguments, values or input files (nothing sent)",
     ExitCode.LINK: "link: cannot connect, no answer in time, malformed answer",
     ExitCode.UNKNOWN: (
-        "sent; the outcome is unknown (status unreadable, not finished in time, not acknowledged): "
-        "check the robot before sending it again"
+        "sent; the outcome is unknown (status unreadable, not finished in time, not acknowledged, "
+        "another master seen before its end): check the robot before sending it again"
     ),
     ExitCode.INTERRUPTED: "interrupted (Ctrl-C; a motion under way is stopped first)",
 }

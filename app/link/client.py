@@ -145,11 +145,12 @@ class RobotClient(CommandClient):
         self._auto_for("go to zero", status, switch_to_auto)
         before = before or self.read_pose()
         self.check_no_foreign_master("go to zero")
+        sent = time.monotonic()  # a sign of another master from here on overlaps it
         with self.judged_writes() as judged:
             self._write_control(registers.REG_GO_ZERO, value)
         axes = tuple(range(registers.NUM_AXES_TOTAL)) if axis is None else (value,)
         watch = MotionWatch(
-            None, f"go to zero ({which})", before, time.monotonic(), operation="go to zero", zero_axes=axes
+            None, f"go to zero ({which})", before, sent, operation="go to zero", zero_axes=axes
         )
         return self._watching(watch, judged)
 
@@ -180,13 +181,14 @@ class RobotClient(CommandClient):
         before = before or self.read_pose()
         self._write(registers.REG_PROGRAM_ID, [program_id, int(motion), cycles, speed_ratio])
         self.check_no_foreign_master("run program")
+        sent = time.monotonic()  # a sign of another master from here on overlaps it
         with self.judged_writes() as judged:
             self._write_control(registers.REG_RUN_COMMAND, int(RunCommand.RUN_PROGRAM))
         watch = MotionWatch(
             RunCommand.RUN_PROGRAM,
             f"run program {program_id}",
             before,
-            time.monotonic(),
+            sent,
             operation="run program",
             program=program_id,
         )
@@ -207,6 +209,7 @@ class RobotClient(CommandClient):
 
     def _watching(self, watch: MotionWatch, judged: list[AuditRecord]) -> MotionWatch:
         watch.note = outcome_note(self.audit, judged)
+        watch.foreign = self.foreign
         self.last_watch = watch
         return watch
 

@@ -1157,18 +1157,18 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/window_column.py" line="98" />
+            <location filename="../../ui/window_column.py" line="100" />
             <source>Jog</source>
             <extracomment>How long the "another master" banner stays after the last sign of one (ms)</extracomment>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="99" />
+            <location filename="../../ui/window_column.py" line="101" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="100" />
+            <location filename="../../ui/window_column.py" line="102" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
@@ -1193,17 +1193,17 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="320" />
+            <location filename="../../ui/main_window.py" line="322" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="129" />
+            <location filename="../../ui/window_column.py" line="137" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="133" />
+            <location filename="../../ui/window_column.py" line="141" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
@@ -1219,54 +1219,54 @@
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="352" />
+            <location filename="../../ui/main_window.py" line="354" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="361" />
+            <location filename="../../ui/foreign_words.py" line="16" />
             <source>it wrote its own restart token ({value})</source>
             <translation>它写入了自己的重启标记（{value}）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="363" />
+            <location filename="../../ui/foreign_words.py" line="18" />
             <source>register {value} changed without a write of TeachPad</source>
             <translation>寄存器 {value} 在 TeachPad 未写入的情况下发生了变化</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="365" />
+            <location filename="../../ui/foreign_words.py" line="22" />
             <source>a command result TeachPad did not cause (GV291 = {value})</source>
             <translation>出现了并非 TeachPad 引起的指令结果（GV291 = {value}）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="369" />
+            <location filename="../../ui/foreign_words.py" line="30" />
             <source>Another Modbus master is on this controller: {sign}. It shares the parameter and command registers with TeachPad: its writes can change what ours do. Check who else is connected.</source>
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="379" />
+            <location filename="../../ui/main_window.py" line="377" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="354" />
-            <location filename="../../ui/main_window.py" line="374" />
-            <location filename="../../ui/main_window.py" line="380" />
+            <location filename="../../ui/main_window.py" line="356" />
+            <location filename="../../ui/main_window.py" line="365" />
+            <location filename="../../ui/main_window.py" line="378" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="297" />
+            <location filename="../../ui/main_window.py" line="299" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="298" />
+            <location filename="../../ui/main_window.py" line="300" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="299" />
+            <location filename="../../ui/main_window.py" line="301" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1276,32 +1276,37 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="454" />
+            <location filename="../../ui/main_window.py" line="372" />
+            <source>plan run</source>
+            <translation>计划运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="452" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="456" />
+            <location filename="../../ui/main_window.py" line="454" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="469" />
+            <location filename="../../ui/main_window.py" line="467" />
             <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
             <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="471" />
+            <location filename="../../ui/main_window.py" line="469" />
             <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="489" />
+            <location filename="../../ui/main_window.py" line="487" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="489" />
+            <location filename="../../ui/main_window.py" line="487" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -2840,43 +2845,43 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="245" />
+            <location filename="../../ui/panels/planner_widgets.py" line="249" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="246" />
+            <location filename="../../ui/panels/planner_widgets.py" line="250" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="265" />
+            <location filename="../../ui/panels/planner_widgets.py" line="269" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="268" />
+            <location filename="../../ui/panels/planner_widgets.py" line="272" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="270" />
+            <location filename="../../ui/panels/planner_widgets.py" line="274" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="272" />
+            <location filename="../../ui/panels/planner_widgets.py" line="276" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="275" />
+            <location filename="../../ui/panels/planner_widgets.py" line="279" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -2892,7 +2897,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="309" />
+            <location filename="../../ui/panels/planner_widgets.py" line="313" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -3061,27 +3066,37 @@
     <context>
         <name>PlanRunController</name>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="41" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="48" />
             <source>Failed: {reason}</source>
             <translation>失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="43" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="50" />
             <source>Stopped: {reason}</source>
             <translation>已停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="47" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="54" />
             <source>Failed at segment {n}: {reason}</source>
             <translation>在第 {n} 段失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="49" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="56" />
             <source>Stopped at segment {n}: {reason}</source>
             <translation>在第 {n} 段停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="29" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="76" />
+            <source>Paused: another master wrote to the controller ({sign})</source>
+            <translation>已暂停：另一个主站写入了控制器（{sign}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="83" />
+            <source>Not resumed: another master wrote to the controller less than {hold} s ago. Make sure no other master is commanding the robot; Resume is possible in {left} s.</source>
+            <translation>未继续：另一个主站在不到 {hold} 秒前写入了控制器。请确认没有其他主站在控制机器人；{left} 秒后才能继续。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="36" />
             <source>stopped by the operator</source>
             <translation>已由操作员停止</translation>
         </message>
@@ -3372,12 +3387,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="242" />
+            <location filename="../../ui/panels/planner_panel.py" line="245" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="422" />
+            <location filename="../../ui/panels/planner_panel.py" line="425" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -5067,7 +5082,7 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="378" />
+            <location filename="../../ui/panels/planner_widgets.py" line="382" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>

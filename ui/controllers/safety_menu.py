@@ -319,6 +319,7 @@ def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> Safety
     """Compose the guard rails onto ``window`` (its 3D view already installed)."""
     safety = SafetyController(window.link, parent=window, scrypt_n=scrypt_n)
     safety.set_poll_rate(window.settings.poll_hz)  # the jog guard's margin follows the poll period
+    window.run_controller.audit = safety.session.audit  # a run's own pause is audited (issue 19)
     menu = SafetyMenu(window, safety)
     safety.gate(window.menus.connect_action, Action.CONNECTION)
     safety.gate(menu.envelope_action, Action.EDIT_ENVELOPE)
