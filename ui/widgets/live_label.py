@@ -7,7 +7,8 @@ each) and repaints what it covers. Qt stops that walk at a widget whose size is 
 :class:`LiveLabel` keeps a fixed size: as wide as the widest text it was given up front
 (``samples``) or has shown since; the digits of a sample stand for any digit (room is made for
 the widest digit of the font in use), and the samples are measured again when the font or the
-style changes (an italic "stale" style may fall back to another font, with other widths). A new text repaints the label only; a wider one than ever
+style changes (an italic "stale" style may fall back to another font, with other widths). A new
+text repaints the label only; a wider one than ever
 before grows it once (one re-layout), and it never shrinks, so nothing beside it moves back
 and forth. Its style sheet is set only when it changes (``set_style``): setting one re-polishes
 the widget even when the text is the same. ``opaque``: the label fills its own background (the
