@@ -25,7 +25,7 @@ from pathlib import Path
 
 from tests.fonts.fontsets import FONT_SETS, describe_fonts, fontset_roots, write_config
 
-SCREENS = "1024x768,1280x800,1920x1080"
+SCREENS = "1024x768,1280x800,1920x1080,1920x1200"
 SCALES = ("1", "1.25", "1.5")
 FULL = ["tests/ui/test_layout.py", "tests/ui/test_live_views_cost.py", "tests/ui/test_readouts_whole.py"]
 SCALED = [

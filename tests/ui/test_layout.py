@@ -45,7 +45,6 @@ from ui.main_window import (
 )
 from ui.touch import SCROLL_MIN_ROWS_HEIGHT, motion_height
 from ui.window_docks import DOCK_MIN_ROWS, STATUS_DOCK_WIDTH
-from ui.window_geometry import MIN_SIZE
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
@@ -53,6 +52,12 @@ pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)
 # rest. Remove an entry when its panel is fixed (an entry that no longer matches fails the test).
 KNOWN_ISSUES: dict[str, str] = {}
 SCREENS = ((1280, 800), (1920, 1080))
+# Decided (issue 20): the README promises the layout from 1280×800 device-independent pixels up,
+# the size that holds under every font set (tests/fonts). Under it (1024×768, or 1920×1080 at
+# 150 % = 1280×720) the window still opens down to MIN_SIZE but squeezes or scrolls parts: the
+# control column, the planner and the status dock need ~850 + 320 px across, and the work tabs
+# ~480 px of height under Noto's taller lines.
+PROMISED_MIN = (1280, 800)
 
 
 def screens() -> tuple[tuple[int, int], ...]:
@@ -66,11 +71,11 @@ def screens() -> tuple[tuple[int, int], ...]:
 
 def window_sizes() -> tuple[tuple[int, int], ...]:
     """The window filling each screen, in Qt's device-independent pixels: a screen's pixels over
-    ``QT_SCALE_FACTOR`` (1920×1080 at 150 % is a 1280×720 window). Windows under the minimum
-    the README promises (:data:`MIN_SIZE`) are not checked."""
+    ``QT_SCALE_FACTOR`` (1920×1080 at 150 % is a 1280×720 window). Windows under the size the
+    README promises the layout at (:data:`PROMISED_MIN`) are not checked."""
     scale = float(os.environ.get("QT_SCALE_FACTOR", "") or 1.0)
     sizes = ((int(w / scale), int(h / scale)) for w, h in screens())
-    return tuple(s for s in sizes if s[0] >= MIN_SIZE[0] and s[1] >= MIN_SIZE[1])
+    return tuple(s for s in sizes if s[0] >= PROMISED_MIN[0] and s[1] >= PROMISED_MIN[1])
 
 
 SIZES = window_sizes()
