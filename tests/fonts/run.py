@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -105,7 +106,7 @@ def main(argv: list[str]) -> int:
             runs.append(Run(fonts.name, scale, config, work / f"{fonts.name}-{scale}.log"))
     for name in missing:
         print(f"font set missing: {name}", flush=True)
-    print(f"{len(runs)} runs, {args.jobs} at a time; logs in {work}", flush=True)
+    print(f"{len(runs)} runs, {args.jobs} at a time; logs in {work} (removed when all pass)", flush=True)
     with ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         for run in pool.map(_execute, runs):
             verdict = "ok" if run.code == 0 else f"FAILED (exit {run.code})"
@@ -125,6 +126,7 @@ def main(argv: list[str]) -> int:
     print(f"font sets: {len(runs) - len(failed)} passed, {len(failed)} failed")
     if failed or (missing and args.require_all) or not runs:
         return 1
+    shutil.rmtree(work, ignore_errors=True)  # kept only when something failed (its logs)
     return 0
 
 
