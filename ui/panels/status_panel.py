@@ -426,7 +426,7 @@ class StatusPanel(QWidget):
             self.drift_label.set_style(f"color: {COLOR_NEUTRAL};")
             return
         stamp = clock.value.strftime("%Y-%m-%d %H:%M:%S")
-        drift_text = self.tr("{drift} s").format(drift=f"{drift:+.0f}")
+        drift_text = self.tr("{drift} s").format(drift=f"{round(drift):+d}")  # never "-0"
         if not self._fresh:  # the last reading, no longer ticking: grey, italic, marked stale
             self.clock_label.setText(stamp)
             self.drift_label.setText(self.tr("{value} (stale)").format(value=drift_text))
