@@ -4,9 +4,11 @@ On every tab (and the states that change a layout: jog frames, the step panel's 
 axes, the points banner and upload progress, the planner after a stop) no visible text is
 clipped, no two visible siblings overlap, motion buttons are tall enough (``layout_audit``);
 connected, again with the alarm banner up (an emergency stop raised at the simulator).
+``make test-fonts`` (``tests/fonts/run.py``) runs it again under three font sets, on more
+screens (``TEACHPAD_LAYOUT_SCREENS``) and at 125 % and 150 % (``QT_SCALE_FACTOR``).
 
-Chinese text is measured with the font Qt really uses. Where no CJK font is installed (CI
-installs only the Python packages), Qt measures missing glyphs as narrow boxes, so a clipped
+Chinese text is measured with the font Qt really uses. Where no CJK font is installed (the
+DejaVu-only font set, a machine without one), Qt measures missing glyphs as narrow boxes, so a clipped
 Chinese text cannot be told from a fitting one: the text check is skipped for zh_CN there,
 and only overlap and sizes are checked (they do not depend on glyph widths being right).
 """
