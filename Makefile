@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
 export QT_QPA_PLATFORM ?= offscreen
 
-.PHONY: run test lint bench bench-quick sim soak translations clean
+.PHONY: run test lint bench bench-quick sim soak translations clean test-fonts
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -36,6 +36,17 @@ COV_QTHREADS ?= 0
 test: lint
 	TEACHPAD_COV_QTHREADS=$(COV_QTHREADS) $(BIN)/python -m pytest --cov=app --cov=ui --cov-report=term-missing:skip-covered \
 		--cov-fail-under=$(COV_FLOOR)
+
+# --- Font sets (issue 20) ---------------------------------------------------------------------
+# The layout and relayout tests under fontconfig setups made for the run (tests/fonts): DejaVu
+# only; URW base35 + Droid Sans Fallback; Noto Sans, Sans Mono, Sans CJK -- each at 100, 125 and
+# 150 %, both languages, two processes at a time. A set whose fonts are missing is named with its
+# Debian packages (`.ci/run` installs them; FONTSET_ROOT=/:DIR also looks in a `dpkg -x` tree).
+# FONTSETS_ARGS, e.g. "--sets noto --scales 1.5" or "--require-all" (CI).
+FONTSETS_ARGS ?=
+test-fonts: $(STAMP)
+	$(BIN)/python -m tests.fonts.run $(FONTSETS_ARGS)
+# --- end of font sets ----------------------------------------------------------------------------
 
 bench: $(STAMP)
 	$(BIN)/python -m benchmarks.run

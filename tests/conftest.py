@@ -34,6 +34,16 @@ _stderr_copy = -1
 _PRIVATE_DIR = pytest.StashKey[str]()
 
 
+def pytest_report_header(config: pytest.Config) -> str:
+    """Which fonts this run lays the window out with (the layout checks depend on them): a font
+    set of ``tests/fonts`` (``make test-fonts``) or what this machine's fontconfig finds."""
+    from tests.fonts.fontsets import describe_fonts
+
+    config_file = os.environ.get("FONTCONFIG_FILE", "")
+    which = os.environ.get("TEACHPAD_FONTSET") or (config_file and f"FONTCONFIG_FILE={config_file}")
+    return f"fonts ({which or 'this machine'}): {describe_fonts()}"
+
+
 def pytest_configure(config: pytest.Config) -> None:
     global _stderr_copy
     _stderr_copy = os.dup(2)  # the terminal's stderr, before tests capture fd 2
