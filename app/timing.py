@@ -52,7 +52,7 @@ BUSY_BACKOFF_SLICE = 0.02
 # GV245) read back and, unless it took, written again up to LINE_WRITE_RETRIES times; an upload's
 # point (the same point at the same pose: idempotent) sent whole again up to LINE_POINT_RETRIES
 # times. Never a motion command. Only on a serial line (on TCP a bad answer is not line noise).
-LINE_READ_RETRIES = 2
+LINE_READ_RETRIES = 4
 LINE_WRITE_RETRIES = 3
 LINE_POINT_RETRIES = 5
 # After a bad frame on a serial line the input is dropped until the line has been silent this long

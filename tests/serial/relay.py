@@ -18,6 +18,7 @@ import select
 import threading
 import time
 import tty
+from collections.abc import Callable
 
 
 class PtyRelay:
@@ -35,6 +36,10 @@ class PtyRelay:
         self.corrupt_next_request = False
         self.corrupt_next_answer = False
         self.noise_before_next_request = b""
+        # a request it returns True for has its answer's CRC corrupted (once each time it matches)
+        self.corrupt_answer_to: Callable[[bytes], bool] | None = None
+        # a request it returns True for has its answer's CRC corrupted (once each time it matches)
+        self.corrupt_answer_to: Callable[[bytes], bool] | None = None
         self.noise_gap = 0.06  # s of silence between the noise and the request
         self.requests = 0
         self._stop = threading.Event()
@@ -67,6 +72,8 @@ class PtyRelay:
 
     def _forward_request(self, data: bytes) -> None:
         self.requests += 1
+        if self.corrupt_answer_to is not None and self.corrupt_answer_to(data):
+            self.corrupt_next_answer = True
         if self.noise_before_next_request:
             self._forward(self._sim_master, self.noise_before_next_request)
             self.noise_before_next_request = b""
