@@ -40,10 +40,15 @@ def project_points(n: int, seed: int = 19) -> list[TempPoint]:
     rng = random.Random(seed)
     points = []
     for i in range(n):
-        xyz = [round(rng.uniform(-600.0, 600.0), 3) for _ in range(3)]
-        abc = [round(rng.uniform(-180.0, 180.0), 3) for _ in range(3)]
-        points.append(TempPoint(i + 1, f"P{i + 1}", *xyz, *abc, tool=(i // 50) % 2))
+        x, y, z = (round(rng.uniform(-600.0, 600.0), 3) for _ in range(3))
+        a, b, c = (round(rng.uniform(-180.0, 180.0), 3) for _ in range(3))
+        points.append(TempPoint(i + 1, f"P{i + 1}", x, y, z, a, b, c, tool=(i // 50) % 2))
     return points
+
+
+def _same_pose(held: tuple[float, ...], sent: tuple[float, ...]) -> bool:
+    """``held`` (the controller's float32 values) is ``sent`` as float32."""
+    return all(abs(h - _f32(s)) <= 1e-6 * max(1.0, abs(s)) for h, s in zip(held, sent, strict=True))
 
 
 def wrong_points(sim: SimController, points: list[TempPoint]) -> int:
@@ -53,9 +58,7 @@ def wrong_points(sim: SimController, points: list[TempPoint]) -> int:
     wrong = 0
     for p in points:
         got = stored.get(p.id)
-        if got is None or got.tool != p.tool:
-            wrong += 1
-        elif any(abs(a - _f32(b)) > 1e-6 * max(1.0, abs(b)) for a, b in zip(got.pose, p.xyzabc, strict=True)):
+        if got is None or got.tool != p.tool or not _same_pose(got.pose, p.xyzabc):
             wrong += 1
     return wrong
 

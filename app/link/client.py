@@ -407,7 +407,9 @@ class RobotClient(CommandClient):
         backoff = BusyBackoff(halted, between)  # busy before the first point: the status read, GV245
         # a damaged frame there: prepared again (its status read tells whether a 444 <- auto took)
         line = LineRetry(self.settings, timing.LINE_POINT_RETRIES, halted)
-        status, _ = retry_busy(lambda: retry_line(lambda: self._prepare(RunCommand.CREATE_POINT), line), backoff)
+        status, _ = retry_busy(
+            lambda: retry_line(lambda: self._prepare(RunCommand.CREATE_POINT), line), backoff
+        )
         retry_busy(lambda: self._write_tool(tool), backoff)
         kind = CommandKind.CREATE_POINT
         total = len(items)
@@ -501,7 +503,10 @@ class RobotClient(CommandClient):
                 if write_pose:
                     self._write_floats(block, values, repeatable=True, halted=line.halted)
                 self._write_floats(
-                    registers.GV_PARAM0, [float(point_id), 1.0, float(block)], repeatable=True, halted=line.halted
+                    registers.GV_PARAM0,
+                    [float(point_id), 1.0, float(block)],
+                    repeatable=True,
+                    halted=line.halted,
                 )
                 self._sent_points[point_id] = (values[0], values[1], values[2])
                 tracker = self.begin_command(RunCommand.CREATE_POINT, status, None)

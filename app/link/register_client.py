@@ -261,8 +261,9 @@ class RegisterClient:
         self, address: int, regs: Sequence[int], timeout: float | None, halted: Callable[[], bool] | None
     ) -> None:
         """A write of value registers over a noisy serial line: after a damaged frame (its answer
-        or its request) they are read back -- the values there: it took; else written again at once, up to :data:`app.timing.LINE_WRITE_RETRIES` times
-        (not once ``halted``). Nothing else is written in between: never after a newer write."""
+        or its request) they are read back -- the values there: it took; else written again at
+        once, up to :data:`app.timing.LINE_WRITE_RETRIES` times (not once ``halted``). Nothing else
+        is written in between: a repeated write never lands after a newer one."""
         retry = LineRetry(self.settings, timing.LINE_WRITE_RETRIES, halted)
         while True:
             try:

@@ -14,8 +14,9 @@ or with bytes too many); :class:`ResponseTimeout` (silence); :class:`LinkError` 
 After a malformed answer or a timeout the link resynchronises: a TCP link is dropped (the next
 request reopens it, so a late or garbled tail is never read as the next answer); a serial line
 has its input dropped until the line has been quiet for :data:`app.timing.RTU_RESYNC_QUIET` (or
-twice 3.5 characters), so the rest of a damaged answer still on the wire is dropped too. Before every request, bytes that arrived unasked (stray bytes after a
-good answer) are flushed, so they cannot poison the next answer.
+twice 3.5 characters), so the rest of a damaged answer still on the wire is dropped too. Before
+every request, bytes that arrived unasked (stray bytes after a good answer) are flushed, so they
+cannot poison the next answer.
 
 Not thread-safe: one thread owns a transport. Traffic observers are called synchronously in
 that thread, inside the request: keep them short.

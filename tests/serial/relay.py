@@ -38,8 +38,6 @@ class PtyRelay:
         self.noise_before_next_request = b""
         # a request it returns True for has its answer's CRC corrupted (once each time it matches)
         self.corrupt_answer_to: Callable[[bytes], bool] | None = None
-        # a request it returns True for has its answer's CRC corrupted (once each time it matches)
-        self.corrupt_answer_to: Callable[[bytes], bool] | None = None
         self.noise_gap = 0.06  # s of silence between the noise and the request
         self.requests = 0
         self._stop = threading.Event()

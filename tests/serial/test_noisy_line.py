@@ -83,10 +83,10 @@ def test_cli_points_upload_over_a_noisy_line_completes_with_no_wrong_point(
     relay, sim = noisy
     points = project_points(N)
     csv = tmp_path / "points.csv"
-    rows = [
-        f"{p.id},{p.name},{p.x},{p.y},{p.z},{p.a},{p.b},{p.c},0,0,0,0,0,{p.tool}," for p in points
-    ]
-    csv.write_text("id,name,x,y,z,a,b,c,e1,e2,e3,e4,e5,tool,note\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    rows = [f"{p.id},{p.name},{p.x},{p.y},{p.z},{p.a},{p.b},{p.c},0,0,0,0,0,{p.tool}," for p in points]
+    csv.write_text(
+        "id,name,x,y,z,a,b,c,e1,e2,e3,e4,e5,tool,note\n" + "\n".join(rows) + "\n", encoding="utf-8"
+    )
     project = tmp_path / "noisy.teachpad.json"
     assert main(["points", "import", str(project), "--csv", str(csv)]) == ExitCode.OK, capsys.readouterr()
     capsys.readouterr()
