@@ -55,6 +55,11 @@ BUSY_BACKOFF_SLICE = 0.02
 LINE_READ_RETRIES = 4
 LINE_WRITE_RETRIES = 3
 LINE_POINT_RETRIES = 5
+# ... of which at most this many after no answer at all (a damaged request: rare twice in a row;
+# a controller that went silent is told about soon, not after every budget ran out); an upload's
+# point, LINE_POINT_TIMEOUT_RETRIES.
+LINE_TIMEOUT_RETRIES = 1
+LINE_POINT_TIMEOUT_RETRIES = 2
 # After a bad frame on a serial line the input is dropped until the line has been silent this long
 # (s; at least 3.5 characters at the baud rate, twice), at most one request timeout: the rest of a
 # damaged answer is never read as the start of the next one.

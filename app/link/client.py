@@ -406,7 +406,9 @@ class RobotClient(CommandClient):
             return results
         backoff = BusyBackoff(halted, between)  # busy before the first point: the status read, GV245
         # a damaged frame there: prepared again (its status read tells whether a 444 <- auto took)
-        line = LineRetry(self.settings, timing.LINE_POINT_RETRIES, halted)
+        line = LineRetry(
+            self.settings, timing.LINE_POINT_RETRIES, halted, timeouts=timing.LINE_POINT_TIMEOUT_RETRIES
+        )
         status, _ = retry_busy(
             lambda: retry_line(lambda: self._prepare(RunCommand.CREATE_POINT), line), backoff
         )
@@ -451,7 +453,12 @@ class RobotClient(CommandClient):
                     meanwhile=meanwhile,
                     between=between,
                     backoff=BusyBackoff(halted, between),
-                    line=LineRetry(self.settings, timing.LINE_POINT_RETRIES, halted),
+                    line=LineRetry(
+                        self.settings,
+                        timing.LINE_POINT_RETRIES,
+                        halted,
+                        timeouts=timing.LINE_POINT_TIMEOUT_RETRIES,
+                    ),
                 )
             except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
                 results.append(

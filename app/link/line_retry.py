@@ -4,7 +4,8 @@ On an RTU serial line a byte in a few hundred may be damaged: an answer fails it
 length, or arrives garbled (:class:`~app.errors.MalformedResponse`), or a damaged request is not
 answered at all (:class:`~app.errors.ResponseTimeout`). The transport has resynchronised by then
 (its input dropped until the line was quiet, :meth:`~app.link.transport.Transport._resync`). What
-is sent again, within a bounded budget (:mod:`app.timing` ``LINE_*``):
+is sent again, within a bounded budget (:mod:`app.timing` ``LINE_*``; no answer at all is retried fewer times,
+``LINE_TIMEOUT_RETRIES``, so a silent controller is still seen soon):
 
 * every read (status polls, pose reads, GV291, the shared registers): it changes nothing;
 * a write of registers that only hold values (an upload's pose GVs, GV200-202 of a create point,
@@ -26,6 +27,7 @@ import logging
 from collections.abc import Callable
 from typing import TypeVar
 
+from app import timing
 from app.errors import MalformedResponse, ResponseTimeout
 from app.link.transport import ConnectionSettings
 
@@ -47,10 +49,19 @@ class LineRetry:
     """One request's (or one upload point's) budget of retries after damaged frames."""
 
     def __init__(
-        self, settings: ConnectionSettings, budget: int, halted: Callable[[], bool] | None = None
+        self,
+        settings: ConnectionSettings,
+        budget: int,
+        halted: Callable[[], bool] | None = None,
+        *,
+        timeouts: int | None = None,
     ) -> None:
-        """``halted``: True once a stop or a cancel is on its way (then nothing is sent again)."""
+        """``budget`` retries, of which at most ``timeouts`` (default
+        :data:`app.timing.LINE_TIMEOUT_RETRIES`) after no answer at all: a damaged request is rare
+        twice in a row, a silent controller is not to be waited for much longer than before.
+        ``halted``: True once a stop or a cancel is on its way (then nothing is sent again)."""
         self._left = budget if on_noisy_line(settings) else 0
+        self._timeouts_left = timing.LINE_TIMEOUT_RETRIES if timeouts is None else timeouts
         self._halted = halted
         self.retries = 0
 
@@ -65,6 +76,10 @@ class LineRetry:
             return False
         if self.halted():
             return False
+        if isinstance(exc, ResponseTimeout):
+            if self._timeouts_left <= 0:
+                return False
+            self._timeouts_left -= 1
         self._left -= 1
         self.retries += 1
         _log.info("damaged frame on the serial line (%s): sending it again (retry %d)", exc, self.retries)

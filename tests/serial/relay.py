@@ -38,6 +38,7 @@ class PtyRelay:
         self.noise_before_next_request = b""
         # a request it returns True for has its answer's CRC corrupted (once each time it matches)
         self.corrupt_answer_to: Callable[[bytes], bool] | None = None
+        self.drop_requests = False  # a controller gone silent: requests go nowhere
         self.noise_gap = 0.06  # s of silence between the noise and the request
         self.requests = 0
         self._stop = threading.Event()
@@ -70,6 +71,8 @@ class PtyRelay:
 
     def _forward_request(self, data: bytes) -> None:
         self.requests += 1
+        if self.drop_requests:
+            return
         if self.corrupt_answer_to is not None and self.corrupt_answer_to(data):
             self.corrupt_next_answer = True
         if self.noise_before_next_request:

@@ -17,7 +17,7 @@ import pytest
 from app import timing
 from app.cli.exit_codes import ExitCode
 from app.cli.main import main
-from app.errors import TeachPadError
+from app.errors import ResponseTimeout, TeachPadError
 from app.link.client import ConnectionSettings, RobotClient, StepFrame
 from app.link.robot_link import RobotLink
 from app.link.types import LinkState
@@ -142,6 +142,18 @@ def test_a_damaged_read_is_sent_again(clean: tuple[PtyRelay, SimController, Robo
     assert client.read_status().mode == 1
     assert sim.bad_frame_counts() == {"bad CRC": 1}
     assert (client.stats.malformed, client.stats.timeouts) == (1, 1)
+
+
+def test_a_silent_controller_is_not_waited_for_through_every_retry(
+    clean: tuple[PtyRelay, SimController, RobotClient],
+) -> None:
+    relay, _, client = clean
+    relay.drop_requests = True
+    with pytest.raises(ResponseTimeout):
+        client.read_status()
+    assert client.stats.timeouts == 1 + timing.LINE_TIMEOUT_RETRIES  # once more, not the whole budget
+    relay.drop_requests = False
+    assert client.read_status().mode == 1
 
 
 def test_a_pose_write_whose_answer_was_damaged_is_read_back_not_written_twice(
