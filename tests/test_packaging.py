@@ -123,3 +123,15 @@ def test_the_spec_collects_the_files_the_code_reads_at_their_package_paths() -> 
     assert (ROOT / "app" / "view3d" / "profiles" / DEFAULT_PROFILE_FILE).is_file()
     launchers = sorted(p.stem for p in (ROOT / "packaging" / "launchers").glob("*.py"))
     assert launchers == ["teachpad", "teachpad-cli", "teachpad-sim"]
+
+
+def test_the_bench_says_why_when_the_bundle_is_not_built(tmp_path: Path) -> None:
+    """`make bench` without `make dist`: the bundle's keys are there, null, with the reason."""
+    from benchmarks import bundle
+    from benchmarks.goals import goals
+
+    out = bundle.run(True, tmp_path / "dist" / "teachpad")
+    assert out["built"] is False and "make dist" in out["reason"]
+    assert out["size_mb"] is None and out["cli_status_s"] is None and out["cli_help_s"] is None
+    entry = next(e for e in goals({"bundle": out})["entries"] if e["key"] == "bundle.size_mb")
+    assert entry["value"] is None and "make dist" in entry["reason"]  # the table says why too
