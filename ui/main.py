@@ -89,7 +89,17 @@ class SimProcess:
         import subprocess
 
         command, env = cls.command()
-        process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env)
+        # Windows: the bundle's teachpad has no console (a GUI executable), teachpad-sim has one;
+        # without this flag its start would open a console window beside the pendant
+        no_window = getattr(subprocess, "CREATE_NO_WINDOW", 0) if sys.platform == "win32" else 0
+        process = subprocess.Popen(
+            command,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+            env=env,
+            creationflags=no_window,
+        )
         lines: queue.Queue[str] = queue.Queue()
 
         def read_stdout() -> None:

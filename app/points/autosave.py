@@ -10,24 +10,18 @@ checks the lock before it offers recovery.
 from __future__ import annotations
 
 import os
-import sys
 from pathlib import Path
 
 from app.points.atomic import atomic_write_bytes
 from app.points.project import Project, project_bytes
+from app.user_dirs import state_dir
 
 AUTOSAVE_SUFFIX = ".autosave.json"
 
 
 def default_autosave_dir() -> Path:
-    """Per-user directory for autosaves of projects that were never saved."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_STATE_HOME") or Path.home() / ".local" / "state")
-    return base / "teachpad" / "autosave"
+    """Per-user directory for autosaves of projects that were never saved (app.user_dirs)."""
+    return state_dir() / "autosave"
 
 
 def autosave_path(project_path: str | os.PathLike[str] | None, *, user_dir: Path | None = None) -> Path:
