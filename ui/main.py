@@ -89,8 +89,8 @@ class SimProcess:
         import subprocess
 
         command, env = cls.command()
-        # Windows: the bundle's teachpad has no console (a GUI executable), teachpad-sim has one;
-        # without this flag its start would open a console window beside the pendant
+        # Windows: teachpad-sim is a console program; started from a pendant whose console is
+        # hidden (the bundle's teachpad from Explorer) it would open a console window of its own
         no_window = getattr(subprocess, "CREATE_NO_WINDOW", 0) if sys.platform == "win32" else 0
         process = subprocess.Popen(
             command,
