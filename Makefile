@@ -22,8 +22,8 @@ sim: $(STAMP)
 	$(BIN)/teachpad-sim
 
 lint: $(STAMP)
-	$(BIN)/ruff check app ui tests benchmarks
-	$(BIN)/ruff format --check app ui tests benchmarks
+	$(BIN)/ruff check app ui tests benchmarks tools
+	$(BIN)/ruff format --check app ui tests benchmarks tools
 	$(BIN)/mypy
 	$(BIN)/lint-imports
 
