@@ -3,7 +3,8 @@
 Start-up is the wall time of a whole process, median of ``runs`` alternating bundle and venv runs
 (the same machine state for both), in an environment with a temporary HOME:
 
-* ``cli_help_s``: ``teachpad-cli --help`` -- the CLI's imports and argparse, no network;
+* ``cli_version_s``: ``teachpad-cli --version`` -- the CLI's imports, no network;
+* ``cli_help_s``: ``teachpad-cli --help`` -- the same plus every command's help text;
 * ``cli_status_s``: ``teachpad-cli status`` against a simulator in this process (connect, read
   the status, print, exit);
 * ``gui_help_s``: ``teachpad --help`` -- the GUI's module imports (PySide6, the window's
@@ -29,7 +30,7 @@ BUNDLE = REPO / "dist" / "teachpad"
 EXE_SUFFIX = ".exe" if sys.platform == "win32" else ""
 NAMES = ("teachpad", "teachpad-cli", "teachpad-sim")
 RUN_TIMEOUT_S = 60.0
-FIGURES = ("cli_help_s", "cli_status_s", "gui_help_s")
+FIGURES = ("cli_version_s", "cli_help_s", "cli_status_s", "gui_help_s")
 
 
 def folder_mb(folder: Path) -> float:
@@ -106,6 +107,8 @@ def run(quick: bool, bundle: Path = BUNDLE) -> dict[str, Any]:
         home = Path(tmp_name)
         env = {**os.environ, "HOME": str(home), "QT_QPA_PLATFORM": "offscreen"}
         env.pop("PYTHONPATH", None)
+        cli = (str(exes["teachpad-cli"]), str(venv["teachpad-cli"]))
+        out["cli_version_s"] = _compare([cli[0], "--version"], [cli[1], "--version"], runs, env, home)
         out["cli_help_s"] = _compare(
             [str(exes["teachpad-cli"]), "--help"], [str(venv["teachpad-cli"]), "--help"], runs, env, home
         )

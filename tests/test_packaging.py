@@ -135,3 +135,30 @@ def test_the_bench_says_why_when_the_bundle_is_not_built(tmp_path: Path) -> None
     assert out["size_mb"] is None and out["cli_status_s"] is None and out["cli_help_s"] is None
     entry = next(e for e in goals({"bundle": out})["entries"] if e["key"] == "bundle.size_mb")
     assert entry["value"] is None and "make dist" in entry["reason"]  # the table says why too
+
+
+@pytest.mark.parametrize(
+    ("module", "prog"),
+    [("ui.main", "teachpad"), ("app.cli.main", "teachpad-cli"), ("app.sim.cli", "teachpad-sim")],
+)
+def test_every_executable_says_its_version(module: str, prog: str) -> None:
+    """`--version` (a bundle on a factory PC: which TeachPad is this?) prints the installed
+    distribution's version, pyproject.toml's."""
+    import tomllib
+
+    from app.version import version
+
+    with open(ROOT / "pyproject.toml", "rb") as f:
+        expected = tomllib.load(f)["project"]["version"]
+    assert version() == expected
+    done = subprocess.run(
+        [sys.executable, "-m", module, "--version"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=False,
+        env={**os.environ, "QT_QPA_PLATFORM": "offscreen"},
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip() == f"{prog} {expected}"

@@ -7,7 +7,8 @@ PYTHONHOME, a temporary HOME (and on Windows temporary APPDATA/LOCALAPPDATA) and
 directory outside the repository, so nothing but the bundle can be imported:
 
 1. the bundled simulator, ``teachpad-sim --port 0`` (a free loopback port, said on its stdout);
-2. ``teachpad-cli status`` against it (exit 0);
+2. ``teachpad-cli --version`` (pyproject.toml's version: the metadata is in the bundle) and
+   ``teachpad-cli status`` against the simulator (exit 0);
 3. ``teachpad-cli run demo.teachpad.json --plan circle --check`` (exit 0: the plan is checked
    against the robot profile, which must be found inside the bundle);
 4. ``teachpad --screenshot`` offscreen in zh_CN against it (exit 0, no traceback, the zh_CN
@@ -47,6 +48,13 @@ SIZE = ("--size", "1280x800")
 
 class SmokeFailure(Exception):
     pass
+
+
+def project_version() -> str:
+    import tomllib
+
+    with open(ROOT / "pyproject.toml", "rb") as f:
+        return str(tomllib.load(f)["project"]["version"])
 
 
 def clean_env(home: Path) -> dict[str, str]:
@@ -202,6 +210,10 @@ def smoke(bundle: Path, keep: Path | None) -> dict[str, Any]:
             print(f"dist-smoke: teachpad-sim listening on 127.0.0.1:{port} (pid {sim.process.pid})")
             link = ["--host", "127.0.0.1", "--port", str(port)]
             cli = str(exes["teachpad-cli"])
+            said = run("teachpad-cli --version", [cli, "--version"], env, work, steps).stdout.strip()
+            expected = f"teachpad-cli {project_version()}"
+            if said != expected:
+                raise SmokeFailure(f"teachpad-cli --version says {said!r}, not {expected!r}")
             status = run("teachpad-cli status", [cli, *link, "status"], env, work, steps)
             print(status.stdout.rstrip())
             run(

@@ -32,6 +32,7 @@ with gc_paused():  # the window's modules: many objects made, almost none freed 
     from app.link.types import ConnectionState
     from app.models import Pose
     from app.protocol.enums import ProgramMotionMode
+    from app.version import VersionAction
     from ui.i18n import LANGUAGE_NAMES, Translator
     from ui.main_window import TAB_NAMES, MainWindow
     from ui.settings import APPLICATION, ORGANIZATION, AppSettings
@@ -257,6 +258,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="teachpad", description="Teach pendant for Bochuang robot controllers"
     )
+    parser.add_argument("--version", action=VersionAction)
     target = parser.add_mutually_exclusive_group()
     target.add_argument("--sim", action="store_true", help="start the built-in simulator and connect to it")
     target.add_argument("--host", help="controller address (Modbus TCP)")

@@ -18,6 +18,7 @@ from app.protocol.enums import Alarm
 from app.sim.config import GV291_MODES, TIMING_PROFILES, SimConfig
 from app.sim.guard import WATCHDOG_TIMEOUT
 from app.sim.server import SimController
+from app.version import VersionAction
 
 log = logging.getLogger(__name__)
 
@@ -55,6 +56,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=COMMANDS_HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    parser.add_argument("--version", action=VersionAction)
     parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     parser.add_argument("--port", type=int, default=5020, help="TCP port (default 5020, 0 = any free port)")
     parser.add_argument("--unit", type=int, default=1, help="Modbus unit id (default 1)")
