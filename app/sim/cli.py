@@ -233,15 +233,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"teachpad-sim: {exc}", file=sys.stderr)
         return 1
     done = threading.Event()
-    previous: dict[signal.Signals, object] = {}
-    if threading.current_thread() is threading.main_thread():
-
-        def on_signal(signum: int, _frame: object) -> None:
-            log.info("signal %d: stopping", signum)
-            done.set()
-
-        for sig in _stop_signals():
-            previous[sig] = signal.signal(sig, on_signal)
+    previous = _stop_on_signals(done)
     # Announced only now: whoever waits for this line may stop us at once (SIGTERM), and before
     # the handler exists that would kill the process instead of stopping it cleanly.
     _say(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop")
@@ -273,6 +265,21 @@ def main(argv: Sequence[str] | None = None) -> int:
             signal.signal(sig, handler)  # type: ignore[arg-type]
     _say("teachpad-sim stopped")
     return 0
+
+
+def _stop_on_signals(done: threading.Event) -> dict[signal.Signals, object]:
+    """Handlers that set ``done`` on the stop signals (main thread only: elsewhere Python cannot
+    install them); the handlers they replace, to put back at the end."""
+    previous: dict[signal.Signals, object] = {}
+    if threading.current_thread() is threading.main_thread():
+
+        def on_signal(signum: int, _frame: object) -> None:
+            log.info("signal %d: stopping", signum)
+            done.set()
+
+        for sig in _stop_signals():
+            previous[sig] = signal.signal(sig, on_signal)
+    return previous
 
 
 def _stop_signals() -> tuple[signal.Signals, ...]:
