@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
 export QT_QPA_PLATFORM ?= offscreen
 
-.PHONY: run test lint bench bench-quick sim soak translations clean test-fonts
+.PHONY: run test lint bench bench-quick sim soak translations clean test-fonts dist dist-smoke
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,8 +22,8 @@ sim: $(STAMP)
 	$(BIN)/teachpad-sim
 
 lint: $(STAMP)
-	$(BIN)/ruff check app ui tests benchmarks
-	$(BIN)/ruff format --check app ui tests benchmarks
+	$(BIN)/ruff check app ui tests benchmarks tools
+	$(BIN)/ruff format --check app ui tests benchmarks tools
 	$(BIN)/mypy
 	$(BIN)/lint-imports
 
@@ -68,5 +68,21 @@ translations: $(STAMP)
 	$(BIN)/python resources/translations/merge.py resources/translations/teachpad_zh_CN.ts resources/translations/*_zh_CN.txt
 	$(BIN)/pyside6-lrelease resources/translations/teachpad_zh_CN.ts -qm ui/i18n/teachpad_zh_CN.qm
 
+# The bundle that needs no Python (README, "Bundle"): dist/teachpad/ holds the executables
+# teachpad, teachpad-cli and teachpad-sim over one _internal/ folder (Qt, numpy, Python, the
+# translations, the robot profiles). PyInstaller is pinned in pyproject.toml's `dist` extra.
+# `make dist-smoke` runs the bundle from a clean environment (tools/dist_smoke.py).
+DIST_STAMP := $(VENV)/.dist-stamp
+$(DIST_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[test,dist]'
+	touch $(DIST_STAMP)
+
+dist: $(DIST_STAMP)
+	$(BIN)/pyinstaller --noconfirm --log-level WARN --distpath dist --workpath build/pyinstaller \
+		packaging/teachpad.spec
+
+dist-smoke: dist
+	$(BIN)/python tools/dist_smoke.py dist/teachpad
+
 clean:
-	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache .coverage .coverage.* htmlcov
+	rm -rf build dist $(VENV) .pytest_cache .mypy_cache .ruff_cache .coverage .coverage.* htmlcov

@@ -64,6 +64,7 @@ from app.safety.register_profile import (
     load_register_profile,
 )
 from app.safety.roles import default_config_dir
+from app.version import VersionAction
 
 __all__ = [
     "EXIT_FAILED",
@@ -113,6 +114,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,  # keeps the exit code table's lines
     )
+    parser.add_argument("--version", action=VersionAction)
     link = parser.add_argument_group("link")
     link.add_argument(
         "--host", default="127.0.0.1", help="controller's IP address or host name (default %(default)s)"

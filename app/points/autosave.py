@@ -17,7 +17,6 @@ waits (bounded) for what is pending: a close, a save or a discard first lets it 
 from __future__ import annotations
 
 import os
-import sys
 import threading
 import time
 from collections.abc import Callable
@@ -27,19 +26,14 @@ from pathlib import Path
 from app.points.atomic import atomic_write_bytes
 from app.points.project_model import Project
 from app.points.project_write import ProjectSnapshot, project_bytes
+from app.user_dirs import state_dir
 
 AUTOSAVE_SUFFIX = ".autosave.json"
 
 
 def default_autosave_dir() -> Path:
-    """Per-user directory for autosaves of projects that were never saved."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_STATE_HOME") or Path.home() / ".local" / "state")
-    return base / "teachpad" / "autosave"
+    """Per-user directory for autosaves of projects that were never saved (app.user_dirs)."""
+    return state_dir() / "autosave"
 
 
 def autosave_path(project_path: str | os.PathLike[str] | None, *, user_dir: Path | None = None) -> Path:

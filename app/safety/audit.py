@@ -464,13 +464,24 @@ _PREV_CHARS = len(',"prev":""') + 64  # what the chain adds to a line
 
 @contextlib.contextmanager
 def _locked(fd: int) -> Iterator[None]:
-    """An exclusive lock on the open file while one record is appended (POSIX; elsewhere none:
-    two writers at once may then break the chain, which the verifier shows)."""
-    try:
-        import fcntl
-    except ImportError:
-        yield
+    """An exclusive lock on the open file while one record is appended: ``flock`` on POSIX; on
+    Windows (no fcntl) a lock of the file's first byte with ``msvcrt.locking``, the same byte for
+    every writer whatever the file's length (the file is opened O_APPEND: each write goes to
+    the end wherever the position is). ``LK_LOCK`` retries for 10 s, then raises OSError: the
+    record is then not written, like any other failed append."""
+    if sys.platform == "win32":
+        import msvcrt
+
+        os.lseek(fd, 0, os.SEEK_SET)
+        msvcrt.locking(fd, msvcrt.LK_LOCK, 1)
+        try:
+            yield
+        finally:
+            os.lseek(fd, 0, os.SEEK_SET)
+            msvcrt.locking(fd, msvcrt.LK_UNLCK, 1)
         return
+    import fcntl
+
     fcntl.flock(fd, fcntl.LOCK_EX)
     try:
         yield

@@ -30,6 +30,8 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+from app import user_dirs
+
 __all__ = [
     "AUDIT_FOLDER",
     "ENVELOPE_NAME",
@@ -65,24 +67,12 @@ def machine_dir() -> Path:
 
 def user_config_dir() -> Path:
     """The user's config folder of TeachPad (the per-user role store, envelope, register profile)."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("APPDATA") or Path.home() / "AppData" / "Roaming")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_CONFIG_HOME") or Path.home() / ".config")
-    return base / "teachpad"
+    return user_dirs.config_dir()
 
 
 def user_data_dir() -> Path:
     """The user's data folder of TeachPad (the per-user audit trail)."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
-    return base / "teachpad"
+    return user_dirs.data_dir()
 
 
 @dataclass(frozen=True)
