@@ -45,6 +45,7 @@ import contextlib
 import datetime as dt
 import enum
 import os
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator, Sequence

@@ -9,7 +9,7 @@ import pytest
 from PySide6.QtCore import QStandardPaths
 
 from app import user_dirs
-from app.points.project import default_autosave_dir  # (app.points.autosave alone: a circle)
+from app.points.autosave import default_autosave_dir
 
 Location = QStandardPaths.StandardLocation
 LINUX_ONLY = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="the XDG folders")
