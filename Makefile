@@ -6,7 +6,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed-stamp
 export QT_QPA_PLATFORM ?= offscreen
 
-.PHONY: run test lint bench bench-quick sim soak translations clean
+.PHONY: run test lint bench bench-quick sim soak translations clean test-fonts dist dist-smoke
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
@@ -22,8 +22,8 @@ sim: $(STAMP)
 	$(BIN)/teachpad-sim
 
 lint: $(STAMP)
-	$(BIN)/ruff check app ui tests benchmarks
-	$(BIN)/ruff format --check app ui tests benchmarks
+	$(BIN)/ruff check app ui tests benchmarks tools
+	$(BIN)/ruff format --check app ui tests benchmarks tools
 	$(BIN)/mypy
 	$(BIN)/lint-imports
 
@@ -36,6 +36,17 @@ COV_QTHREADS ?= 0
 test: lint
 	TEACHPAD_COV_QTHREADS=$(COV_QTHREADS) $(BIN)/python -m pytest --cov=app --cov=ui --cov-report=term-missing:skip-covered \
 		--cov-fail-under=$(COV_FLOOR)
+
+# --- Font sets (issue 20) ---------------------------------------------------------------------
+# The layout and relayout tests under fontconfig setups made for the run (tests/fonts): DejaVu
+# only; URW base35 + Droid Sans Fallback; Noto Sans, Sans Mono, Sans CJK -- each at 100, 125 and
+# 150 %, both languages, two processes at a time. A set whose fonts are missing is named with its
+# Debian packages (`.ci/run` installs them; FONTSET_ROOT=/:DIR also looks in a `dpkg -x` tree).
+# FONTSETS_ARGS, e.g. "--sets noto --scales 1.5" or "--require-all" (CI).
+FONTSETS_ARGS ?=
+test-fonts: $(STAMP)
+	$(BIN)/python -m tests.fonts.run $(FONTSETS_ARGS)
+# --- end of font sets ----------------------------------------------------------------------------
 
 bench: $(STAMP)
 	$(BIN)/python -m benchmarks.run
@@ -57,5 +68,21 @@ translations: $(STAMP)
 	$(BIN)/python resources/translations/merge.py resources/translations/teachpad_zh_CN.ts resources/translations/*_zh_CN.txt
 	$(BIN)/pyside6-lrelease resources/translations/teachpad_zh_CN.ts -qm ui/i18n/teachpad_zh_CN.qm
 
+# The bundle that needs no Python (README, "Bundle"): dist/teachpad/ holds the executables
+# teachpad, teachpad-cli and teachpad-sim over one _internal/ folder (Qt, numpy, Python, the
+# translations, the robot profiles). PyInstaller is pinned in pyproject.toml's `dist` extra.
+# `make dist-smoke` runs the bundle from a clean environment (tools/dist_smoke.py).
+DIST_STAMP := $(VENV)/.dist-stamp
+$(DIST_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet -e '.[test,dist]'
+	touch $(DIST_STAMP)
+
+dist: $(DIST_STAMP)
+	$(BIN)/pyinstaller --noconfirm --log-level WARN --distpath dist --workpath build/pyinstaller \
+		packaging/teachpad.spec
+
+dist-smoke: dist
+	$(BIN)/python tools/dist_smoke.py dist/teachpad
+
 clean:
-	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache .coverage .coverage.* htmlcov
+	rm -rf build dist $(VENV) .pytest_cache .mypy_cache .ruff_cache .coverage .coverage.* htmlcov

@@ -46,6 +46,24 @@ BUSY_BACKOFF_FIRST = 0.05
 BUSY_BACKOFF_CAP = 0.5
 BUSY_RETRY_BUDGET = 5.0
 BUSY_BACKOFF_SLICE = 0.02
+# A noisy serial line (RTU): a frame damaged on the wire (a CRC or length error, a garbled answer,
+# no answer to a damaged request) is sent again where that is safe (app/link/line_retry.py): a read
+# up to LINE_READ_RETRIES more times; a write of value registers (an upload's pose GVs, GV200-202,
+# GV245) read back and, unless it took, written again up to LINE_WRITE_RETRIES times; an upload's
+# point (the same point at the same pose: idempotent) sent whole again up to LINE_POINT_RETRIES
+# times. Never a motion command. Only on a serial line (on TCP a bad answer is not line noise).
+LINE_READ_RETRIES = 4
+LINE_WRITE_RETRIES = 3
+LINE_POINT_RETRIES = 5
+# ... of which at most this many after no answer at all (a damaged request: rare twice in a row;
+# a controller that went silent is told about soon, not after every budget ran out); an upload's
+# point, LINE_POINT_TIMEOUT_RETRIES.
+LINE_TIMEOUT_RETRIES = 1
+LINE_POINT_TIMEOUT_RETRIES = 2
+# After a bad frame on a serial line the input is dropped until the line has been silent this long
+# (s; at least 3.5 characters at the baud rate, twice), at most one request timeout: the rest of a
+# damaged answer is never read as the start of the next one.
+RTU_RESYNC_QUIET = 0.03
 
 # Worker (GUI side).
 POLL_HZ_DEFAULT = 50
@@ -77,6 +95,7 @@ TEACH_MODE_GRACE = 0.3  # s after teach enable during which a status without mod
 UPLOAD_CHUNK_POINTS = 20  # points per event-loop turn of an upload, at most ...
 UPLOAD_CHUNK_SECONDS = 0.03  # ... or this long (s), whichever comes first
 UPLOAD_PROGRESS_PERIOD = 0.05  # s between uploadProgress emissions (the last one always goes out)
+UPLOAD_RECORD_PERIOD = 1.0  # s between two writes of teachpad-cli's upload record during an upload
 SHUTDOWN_WAIT = 1.5  # s the GUI waits for the worker thread on shutdown before detaching it
 
 # Simulator.

@@ -90,6 +90,8 @@ GOALS: tuple[tuple[str, float | None, str, str], ...] = (
     ("gui.memory.soak.growth_mb", 10.0, " MB", "RSS growth over the soak (10 minutes with --long)"),
     ("gui.memory.idle_rss_mb", None, " MB", "idle RSS of the GUI process after start-up (report only)"),
     ("core.monitor_cycle.ratio_robot_vs_bare", None, "x", "monitor cycle vs bare pymodbus (report only)"),
+    ("bundle.size_mb", None, " MB", "the bundle (make dist) on disk (report only)"),
+    ("bundle.cli_status_s.ratio_bundle_vs_venv", None, "x", "CLI status run: bundle vs venv (report only)"),
 )
 
 

@@ -8,6 +8,7 @@ import os
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -40,10 +41,24 @@ STARTUP_TIMEOUT_S = 60.0
 REPO = Path(__file__).resolve().parents[1]
 
 _app: QApplication | None = None  # kept alive for the process: Qt wants one QApplication
+_user_dirs: tempfile.TemporaryDirectory[str] | None = None  # removed when the process ends
+
+
+def private_user_dirs() -> None:
+    """Point this process's per-user folders (XDG_*) at a temporary folder, once: the windows the
+    benchmarks make keep their safety state (roles, envelope, audit trail) in the user's folders,
+    never beside their settings file (app/safety/location.py), and must not touch the real ones."""
+    global _user_dirs
+    if _user_dirs is not None:
+        return
+    _user_dirs = tempfile.TemporaryDirectory(prefix="teachpad-bench-user-")
+    for kind in ("CONFIG", "DATA", "STATE", "CACHE"):
+        os.environ[f"XDG_{kind}_HOME"] = str(Path(_user_dirs.name) / kind.lower())
 
 
 def _qapp() -> QApplication:
     global _app
+    private_user_dirs()  # every benchmark window is made after this
     existing = QApplication.instance()
     _app = existing if isinstance(existing, QApplication) else QApplication(["teachpad-bench"])
     return _app

@@ -12,6 +12,12 @@ Each figure is measured in the same run as a baseline:
   the same per-point transactions sampled right before and after it (``benchmarks.restore``:
   the median of the round ratios); the CLI's path (``app.cli.points_upload.staged_upload``: the
   same batches, per tool) on a sample;
+* the autosave of a large project (58 MB, as in issue 19: 10,000 points with long notes and
+  400 plans of 1,000 segments): the time the GUI thread spends on it -- before (issue 19 s6) the
+  whole save (``save_autosave`` on the GUI thread), now ``ProjectController.autosave_now`` (the
+  snapshot; the writer's thread serializes and writes) -- and the longest the GUI thread could
+  not run while the writer works, vs the same spin with nothing else running (quick mode: a tenth
+  of the size);
 * plan geometry for 1,000 segments (``plan_path``, ``plan_geometry``, ``check_plan``,
   ``estimate_plan``) vs sampling the same segments one by one with ``segment_path``; and the
   preview widget's (``ui.panels.plan_preview.PlanPreview``) redraw of the 1,000 segments, vs the
@@ -25,6 +31,7 @@ Quick mode restores 500 points (5 rounds, 0.1 s bare samples) instead of 10,000 
 
 from __future__ import annotations
 
+import gc
 import json
 import math
 import statistics
@@ -214,6 +221,97 @@ def bench_restore(n: int, cli_n: int, *, rounds: int = ROUNDS, sample_s: float =
     return restore.bench_restore(_points(n), cli_n, rounds=rounds, sample_s=sample_s)
 
 
+# --- the autosave of a large project ---------------------------------------------------------------
+
+AUTOSAVE_NOTE_CHARS = 1_000
+AUTOSAVE_PLANS = 400
+AUTOSAVE_SEGMENTS = 1_000
+
+
+def _large_project(scale: int) -> Project:
+    """About 58 MB on disk at ``scale`` 1 (a tenth of it at 10)."""
+    note = "n" * AUTOSAVE_NOTE_CHARS
+    points = [
+        make_point(i, f"p{i}", (300.0 + i % 100, -100.0 + i % 50, 300.0, 180.0, 0.0, 0.0), note=note)
+        for i in range(1, 10_000 // scale + 1)
+    ]
+    plans = [
+        Plan(
+            f"plan {k}",
+            [Segment.line(1 + (j % 9_000) // scale, speed=200.0 + j % 7) for j in range(AUTOSAVE_SEGMENTS)],
+        )
+        for k in range(AUTOSAVE_PLANS // scale)
+    ]
+    return Project("bench", PointLedger(points), plans)
+
+
+def _longest_gap_ms(done: Callable[[], bool]) -> float:
+    """Spin in this (the GUI) thread until ``done``; the longest gap between two turns is the
+    longest this thread could not run (the writer's thread holding the interpreter lock, or the
+    OS running something else: see the baseline)."""
+    longest, last = 0.0, time.perf_counter()
+    while not done():
+        now = time.perf_counter()
+        longest, last = max(longest, now - last), now
+    return _ms(longest)
+
+
+def bench_autosave(quick: bool) -> dict[str, Any]:
+    from app.points.autosave import save_autosave
+    from ui.controllers.project_controller import ProjectController
+
+    _qt_app()
+    project = _large_project(10 if quick else 1)
+    was_enabled = gc.isenabled()
+    gc.disable()  # as in the GUI process (ui/gui_gc.py): no collection in the writer's thread
+    try:
+        return _autosave_figures(project, ProjectController, save_autosave)
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def _autosave_figures(project: Project, controller: Any, save_autosave: Callable[..., Any]) -> dict[str, Any]:
+    with tempfile.TemporaryDirectory(prefix="teachpad-bench-") as tmp:
+        path = Path(tmp) / "large.teachpad.json"
+        save_project(project, path)
+        size = path.stat().st_size
+        t0 = time.perf_counter()
+        save_autosave(project, path)  # issue 19's path: all of it on the GUI thread
+        before = time.perf_counter() - t0
+        path.with_name("large.teachpad.autosave.json").unlink()
+        ctl = controller(project, path, autosave_interval=0)
+        try:
+            project.touch()  # an edit: the project is dirty
+            t0 = time.perf_counter()
+            ctl.autosave_now()
+            gui = time.perf_counter() - t0
+            ctl.wait_autosave(600.0)  # the GUI thread idle, as in its event loop
+            written = time.perf_counter() - t0
+            project.touch()
+            t0 = time.perf_counter()
+            ctl.autosave_now()
+            gap = _longest_gap_ms(lambda: ctl.autosaver.idle)
+            spun = time.perf_counter() - t0
+            t0 = time.perf_counter()
+            baseline = _longest_gap_ms(lambda: time.perf_counter() - t0 >= spun)
+        finally:
+            ctl.close()
+    return {
+        "project_mb": round(size / 1e6, 1),
+        "points": len(project.ledger),
+        "segments": sum(len(p) for p in project.plans),
+        "before_gui_thread_ms": _ms(before),
+        "after_gui_thread_ms": _ms(gui),
+        "after_written_ms": _ms(written),
+        "after_gui_thread_longest_gap_ms": gap,
+        "baseline_longest_gap_ms": baseline,
+        "note": "before: save_autosave on the GUI thread (issue 19 s6); after: autosave_now (the "
+        "snapshot) on the GUI thread, the writer's thread serializes and writes; longest gap: the "
+        "GUI thread spinning while the writer works, vs spinning as long with nothing else running",
+    }
+
+
 # --- plan geometry and preview -------------------------------------------------------------------
 
 
@@ -335,4 +433,5 @@ def run(quick: bool) -> dict[str, Any]:
     out["completion_profiles"] = completion.bench_profiles(60 if quick else 300)
     out["plan_geometry"] = bench_plan(repeats)
     out["plan_preview"] = bench_preview(repeats)
+    out["autosave_large"] = bench_autosave(quick)
     return out

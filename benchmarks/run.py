@@ -1,9 +1,11 @@
 """`make bench`: run every benchmark and print one JSON object.
 
-Usage: python -m benchmarks.run [--quick] [--long] [--only core,gui,points]
+Usage: python -m benchmarks.run [--quick] [--long] [--only core,gui,points,noisy_line,bundle]
 
 ``goals`` (:mod:`benchmarks.goals`) prints each of the issue's figures beside its goal.
 ``--long`` adds the 10-minute memory soak (``gui.memory.soak``).
+``bundle`` (:mod:`benchmarks.bundle`): the size and start-up of ``make dist``'s bundle beside the
+venv's; null figures with the reason when it is not built.
 
 Bytecode: ``app/`` and ``ui/`` are compiled first (``compileall``), so the start-up figures
 measure what an installed TeachPad does (a wheel install compiles them; a normal interpreter
@@ -31,7 +33,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="small N and short windows")
     parser.add_argument("--long", action="store_true", help="memory soak of 10 minutes (RSS every 30 s)")
-    parser.add_argument("--only", default="core,gui,points", help="comma-separated suites")
+    parser.add_argument("--only", default="core,gui,points,noisy_line,bundle", help="comma-separated suites")
     parser.add_argument(
         "--no-compile",
         action="store_true",
@@ -76,6 +78,13 @@ def main(argv: list[str] | None = None) -> int:
             out["points"] = {"skipped": str(exc)}
         else:
             out["points"] = guarded("points", lambda: points.run(args.quick))
+    if "noisy_line" in suites:  # a 200-point RTU upload through a line damaging 1 byte in 500
+        noisy_line = __import__("benchmarks.noisy_line", fromlist=["run"])
+        out["noisy_line"] = guarded("noisy_line", lambda: noisy_line.run(args.quick))
+    if "bundle" in suites:  # report only: the bundle beside the venv (null + reason when not built)
+        from benchmarks import bundle
+
+        out["bundle"] = guarded("bundle", lambda: bundle.run(args.quick))
     if "safety" in suites:  # not in the default set: --only safety (or core,gui,points,safety)
         safety = __import__("benchmarks.safety", fromlist=["run"])
         out["safety"] = guarded("safety", lambda: safety.run(args.quick))

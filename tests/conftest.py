@@ -34,6 +34,16 @@ _stderr_copy = -1
 _PRIVATE_DIR = pytest.StashKey[str]()
 
 
+def pytest_report_header(config: pytest.Config) -> str:
+    """Which fonts this run lays the window out with (the layout checks depend on them): a font
+    set of ``tests/fonts`` (``make test-fonts``) or what this machine's fontconfig finds."""
+    from tests.fonts.fontsets import describe_fonts
+
+    config_file = os.environ.get("FONTCONFIG_FILE", "")
+    which = os.environ.get("TEACHPAD_FONTSET") or (config_file and f"FONTCONFIG_FILE={config_file}")
+    return f"fonts ({which or 'this machine'}): {describe_fonts()}"
+
+
 def pytest_configure(config: pytest.Config) -> None:
     global _stderr_copy
     _stderr_copy = os.dup(2)  # the terminal's stderr, before tests capture fd 2
@@ -45,6 +55,14 @@ def pytest_configure(config: pytest.Config) -> None:
     os.environ["XDG_CONFIG_HOME"] = os.path.join(private, "config")
     os.environ["XDG_STATE_HOME"] = os.path.join(private, "state")
     config.stash[_PRIVATE_DIR] = private
+    from app.safety.location import machine_dir
+
+    if machine_dir().is_dir():  # the tests (and the programs they start) would write there
+        pytest.exit(
+            f"{machine_dir()} exists: on this PC TeachPad keeps its safety state (roles, envelope, "
+            "audit) there for every account, and the tests would change it. Run them elsewhere.",
+            returncode=4,
+        )
 
 
 def pytest_unconfigure(config: pytest.Config) -> None:
@@ -264,6 +282,16 @@ def _qt_leak_check(request: pytest.FixtureRequest) -> Iterator[None]:
             f"test leaked {len(leaked_threads)} running QThread(s) and {len(leaked_timers)} active QTimer(s)",
             pytrace=False,
         )
+
+
+@pytest.fixture(autouse=True)
+def _private_safety_state(monkeypatch: pytest.MonkeyPatch, tmp_path_factory: pytest.TempPathFactory) -> None:
+    """Each test its own per-user folders (``app.safety.location``): the role store, the envelope,
+    the register profile and the audit trail of one test are never another's (they do not follow
+    a settings file, so a test's INI file does not separate them)."""
+    home = tmp_path_factory.mktemp("xdg")
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(home / "config"))
+    monkeypatch.setenv("XDG_DATA_HOME", str(home / "data"))
 
 
 @pytest.fixture(autouse=True)

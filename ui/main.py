@@ -32,6 +32,7 @@ with gc_paused():  # the window's modules: many objects made, almost none freed 
     from app.link.types import ConnectionState
     from app.models import Pose
     from app.protocol.enums import ProgramMotionMode
+    from app.version import VersionAction
     from ui.i18n import LANGUAGE_NAMES, Translator
     from ui.main_window import TAB_NAMES, MainWindow
     from ui.settings import APPLICATION, ORGANIZATION, AppSettings
@@ -49,23 +50,13 @@ SIM_STOP_TIMEOUT = 10.0  # s for it to stop after its stdin closed, before it is
 # machine needs seconds to wind an interpreter down; this waits after the window has closed)
 THREADS_EXIT_WAIT = 5.0  # s at exit for a worker thread still stuck in a network call
 
-# The simulator's process: ``teachpad-sim`` on a free port, plus a watch on its stdin -- a pipe
-# from this process. The pipe closes when the window closes (SimProcess.stop) and also when this
-# process dies, however it dies: the simulator then stops by itself (SIGTERM to itself, which
-# teachpad-sim handles like Ctrl-C). The watch reads the file descriptor itself, not sys.stdin:
-# a child stopped another way (Ctrl-C in the terminal reaches it too) ends its interpreter while
-# the watch still waits, and a wait inside sys.stdin's buffer holds that buffer's lock, which the
-# interpreter's exit then cannot take ("Fatal Python error: _enter_buffered_busy", SIGABRT).
-_SIM_CHILD = """\
-import os, signal, sys, threading
-def _watch_parent():
-    while os.read(0, 4096):
-        pass
-    os.kill(os.getpid(), signal.SIGTERM)
-threading.Thread(target=_watch_parent, name="parent-watch", daemon=True).start()
-from app.sim.cli import main
-raise SystemExit(main(sys.argv[1:]))
-"""
+# The simulator's process: ``teachpad-sim`` on a free port, told to stop when its stdin -- a
+# pipe from this process -- ends (``--stop-with-stdin``). The pipe closes when the window closes
+# (SimProcess.stop) and also when this process dies, however it dies: the simulator then stops
+# by itself, the same way on every platform (no signal). In the venv it is this interpreter
+# running ``app.sim.cli``; in the bundle (frozen: sys.executable is the bundle's ``teachpad``,
+# which runs nothing but the GUI) it is the bundle's own ``teachpad-sim`` beside it.
+SIM_ARGS = ("--host", "127.0.0.1", "--port", "0", "--no-stdin", "--stop-with-stdin")
 _LISTENING = re.compile(r"listening on (?P<host>[^\s:]+):(?P<port>\d+)")
 
 
@@ -83,11 +74,14 @@ class SimProcess:
     @staticmethod
     def command() -> tuple[list[str], dict[str, str]]:
         """The child's command line and environment (its stdin and stdout are pipes from us)."""
-        root = str(Path(__file__).resolve().parent.parent)  # where ``app`` is, installed or not
         env = dict(os.environ)
-        env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH", "")) if p)
         env["PYTHONUNBUFFERED"] = "1"
-        return [sys.executable, "-c", _SIM_CHILD, "--host", "127.0.0.1", "--port", "0", "--no-stdin"], env
+        if getattr(sys, "frozen", False):  # the bundle (PyInstaller): its executables side by side
+            suffix = ".exe" if sys.platform == "win32" else ""
+            return [str(Path(sys.executable).with_name(f"teachpad-sim{suffix}")), *SIM_ARGS], env
+        root = str(Path(__file__).resolve().parent.parent)  # where ``app`` is, installed or not
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH", "")) if p)
+        return [sys.executable, "-m", "app.sim.cli", *SIM_ARGS], env
 
     @classmethod
     def start(cls, timeout: float = SIM_START_TIMEOUT) -> SimProcess:
@@ -96,7 +90,17 @@ class SimProcess:
         import subprocess
 
         command, env = cls.command()
-        process = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env)
+        # Windows: teachpad-sim is a console program; started from a pendant whose console is
+        # hidden (the bundle's teachpad from Explorer) it would open a console window of its own
+        no_window = getattr(subprocess, "CREATE_NO_WINDOW", 0) if sys.platform == "win32" else 0
+        process = subprocess.Popen(
+            command,
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+            env=env,
+            creationflags=no_window,
+        )
         lines: queue.Queue[str] = queue.Queue()
 
         def read_stdout() -> None:
@@ -254,6 +258,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="teachpad", description="Teach pendant for Bochuang robot controllers"
     )
+    parser.add_argument("--version", action=VersionAction)
     target = parser.add_mutually_exclusive_group()
     target.add_argument("--sim", action="store_true", help="start the built-in simulator and connect to it")
     target.add_argument("--host", help="controller address (Modbus TCP)")
@@ -262,7 +267,12 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--monitor-only", action="store_true", help="never write to the controller")
     parser.add_argument("--lang", choices=sorted(LANGUAGE_NAMES), help="user interface language")
     parser.add_argument("--poll-hz", type=float, help="pose/status poll rate (default 50)")
-    parser.add_argument("--settings", metavar="FILE", help="keep settings in this INI file")
+    parser.add_argument(
+        "--settings",
+        metavar="FILE",
+        help="keep settings in this INI file (not the roles, the envelope nor the audit trail: "
+        "they stay where Help > About says)",
+    )
     parser.add_argument("--size", type=_size, metavar="WxH", help="window size, e.g. 1400x900")
     parser.add_argument(
         "--screenshot", metavar="PNG", help="save the window once connected with a pose, then exit"

@@ -49,10 +49,12 @@ from app import __version__
 from app.link.robot_link import RobotLink
 from app.link.transport import ConnectionSettings
 from app.link.types import WorkerError
+from app.safety.location import Scope
 from app.safety.roles import Action
 from ui.controllers.link_guard import LinkGuard
 from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.plan_run_reasons import foreign_pause_text
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController, ProjectDialogs
 from ui.controllers.safety_menu import install_safety
@@ -221,6 +223,7 @@ class MainWindow(QMainWindow):
         link.controllerReconnected.connect(self._on_reconnected)
         link.controllerRestarted.connect(self._on_restarted)
         link.foreignMaster.connect(self._on_foreign_master)
+        self.run_controller.pausedByForeign.connect(self._on_run_paused_by_foreign)
         self.motion = MotionController(
             link, self.control_bar, self.jog_panel, None, None, self.run_controller, self
         )
@@ -354,24 +357,20 @@ class MainWindow(QMainWindow):
 
     @Slot(str, float)
     def _on_foreign_master(self, what: str, value: float) -> None:
-        """Another Modbus master is on the controller (app/link/foreign.py): banner, status bar,
-        and the event log once per episode (the worker audited it)."""
-        if what == "canary":
-            sign = self.tr("it wrote its own restart token ({value})").format(value=f"{value:g}")
-        elif what == "registers":
-            sign = self.tr("register {value} changed without a write of TeachPad").format(value=f"{value:g}")
-        else:
-            sign = self.tr("a command result TeachPad did not cause (GV291 = {value})").format(
-                value=f"{value:g}"
-            )
-        text = self.tr(
-            "Another Modbus master is on this controller: {sign}. It shares the parameter and "
-            "command registers with TeachPad: its writes can change what ours do. "
-            "Check who else is connected."
-        ).format(sign=sign)
-        if self.control_column.show_foreign_master(text):
+        """Another Modbus master is on the controller (app/link/foreign.py): banner (it follows the
+        language), status bar, and the event log once per episode (the worker audited it)."""
+        new = self.control_column.show_foreign_master(what, value)
+        text = self.control_column.foreign_banner.text()
+        if new:
             self.event_log.add_event("warning", self.tr("link"), text)
         self._show_message(text)
+
+    @Slot(str, float)
+    def _on_run_paused_by_foreign(self, what: str, value: float) -> None:
+        """The plan run paused itself at a sign of another master: the event log says why."""
+        self.event_log.add_event(
+            "warning", lambda: self.tr("plan run"), lambda: foreign_pause_text(what, value)
+        )
 
     @Slot()
     def _on_reconnected(self) -> None:
@@ -454,8 +453,21 @@ class MainWindow(QMainWindow):
             self.tr(
                 "<b>TeachPad {version}</b><br>Desktop teach pendant for Bochuang robot controllers "
                 "(Modbus TCP / RTU).<br><br>Esc stops all motion. Jog buttons and keys move only while held."
-            ).format(version=__version__),
+            ).format(version=__version__)
+            + "<br><br>"
+            + self._safety_state_text(),
         )
+
+    def _safety_state_text(self) -> str:
+        """Where the roles, the envelope and the audit trail live (never beside the settings file)."""
+        from html import escape
+
+        where = self.safety_menu.safety.location
+        if where.scope is Scope.MACHINE:
+            text = self.tr("Safety state (roles, envelope, audit trail), machine-wide: {folder}")
+            return escape(text.format(folder=where.config_dir))
+        text = self.tr("Safety state (roles, envelope), this user's: {folder}<br>Audit trail: {audit}")
+        return text.format(folder=escape(str(where.config_dir)), audit=escape(str(where.audit_dir)))
 
     @property
     def touch_mode(self) -> bool:

@@ -3,7 +3,8 @@
 
 ``AppSettings()`` uses the user's settings store (organisation ``Bochuang``, application
 ``TeachPad``); tests and portable installs pass an explicit INI file
-(``AppSettings.from_file(path)``) so they never touch the user's.
+(``AppSettings.from_file(path)``) so they never touch the user's. The safety state (roles,
+envelope, register profile, audit trail) is never kept here: :mod:`app.safety.location`.
 """
 
 from __future__ import annotations
@@ -19,7 +20,7 @@ from app import timing
 from app.link.transport import ConnectionSettings
 from app.protocol.codec import WordOrder
 from app.safety import register_profile as regprofile
-from app.safety.roles import default_config_dir
+from app.safety.location import safety_location
 
 ORGANIZATION = "Bochuang"
 APPLICATION = "TeachPad"
@@ -141,12 +142,9 @@ class AppSettings:
     # keys: only an administrator changes it (Safety -> Register profile...). ``connection()``
     # returns the remembered connection with the profile in force applied.
     def register_profile_path(self) -> Path:
-        """The profile in force: beside an INI settings file (tests, portable installs), else in
-        the user's config folder (next to the role store and the envelope)."""
-        store = self._store
-        if store.format() == QSettings.Format.IniFormat and store.fileName():
-            return Path(store.fileName()).parent / "safety" / regprofile.PROFILE_NAME
-        return default_config_dir() / regprofile.PROFILE_NAME
+        """The profile in force: with the role store and the envelope
+        (:func:`~app.safety.location.safety_location`), never beside the settings file."""
+        return safety_location().register_profile
 
     def register_profile(self) -> tuple[regprofile.RegisterProfile, str]:
         """(the profile in force, a problem reading it or ""). No file yet: the profile the

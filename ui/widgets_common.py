@@ -183,6 +183,12 @@ class _Digits(QWidget):
         painter.drawText(self.rect(), right, self._shown)
 
 
+# What width_for adds to the sum of its measured parts: each is an advance rounded down (a label
+# lays its text out with fractional advances and may need a pixel more), and a font whose
+# metrics differ from the developers' must not tip a readout into overlapping its unit.
+READOUT_SLACK_PX = 4
+
+
 class NumericReadout(QFrame):
     """A large fixed-decimal number with its caption and unit, e.g. ``X  -123.456 mm``.
 
@@ -268,7 +274,7 @@ class NumericReadout(QFrame):
             metrics = QFontMetrics(self._unit_font(self.font(), point_size))
             unit = max(metrics.horizontalAdvance(self._unit_room), metrics.horizontalAdvance(self.unit()))
             width += unit + self._spacing
-        return width
+        return width + READOUT_SLACK_PX
 
     def set_point_size(self, point_size: float) -> None:
         """Size of the number; caption and unit follow. Keeps room for the widest expected value

@@ -19,6 +19,7 @@ from PySide6.QtWidgets import QLabel, QSizePolicy, QTabWidget, QVBoxLayout, QWid
 
 from app.link.state import RobotState
 from app.link.types import ConnectionState
+from ui.foreign_words import foreign_master_text
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
 from ui.window_tabs import LazyTab
@@ -68,6 +69,7 @@ class ControlColumn(QWidget):
         self.foreign_banner.setWordWrap(True)
         self.foreign_banner.setStyleSheet(BANNER_STYLE)
         self.foreign_banner.setVisible(False)
+        self._foreign_sign: tuple[str, float] | None = None  # the sign the banner says (what, value)
         self._foreign_timer = QTimer(self)
         self._foreign_timer.setSingleShot(True)
         self._foreign_timer.timeout.connect(self.hide_foreign_master)
@@ -99,6 +101,8 @@ class ControlColumn(QWidget):
         self.tabs.setTabText(1, QCoreApplication.translate("MainWindow", "Step"))
         self.tabs.setTabText(2, QCoreApplication.translate("MainWindow", "Program"))
         self._show_banner()
+        if self._foreign_sign is not None:
+            self.foreign_banner.setText(foreign_master_text(*self._foreign_sign))
 
     @Slot(ConnectionState)
     def _on_connection(self, connection: ConnectionState) -> None:
@@ -106,11 +110,14 @@ class ControlColumn(QWidget):
             self.hide_foreign_master()  # another controller may come next
         self._show_banner()
 
-    def show_foreign_master(self, text: str) -> bool:
+    def show_foreign_master(self, what: str, value: float) -> bool:
         """Say that another master is on the controller (for :data:`FOREIGN_BANNER_MS` after the
-        last sign); True when the banner was not showing (a new episode)."""
+        last sign): ``what`` and ``value`` as the link reports the sign (app/link/foreign.py); the
+        banner says it again in the new language when it changes. True when the banner was not
+        showing (a new episode)."""
         new = self.foreign_banner.isHidden()
-        self.foreign_banner.setText(text)
+        self._foreign_sign = (what, value)
+        self.foreign_banner.setText(foreign_master_text(what, value))
         self.foreign_banner.setVisible(True)
         self._foreign_timer.start(FOREIGN_BANNER_MS)
         return new
@@ -118,6 +125,7 @@ class ControlColumn(QWidget):
     @Slot()
     def hide_foreign_master(self) -> None:
         self._foreign_timer.stop()
+        self._foreign_sign = None
         self.foreign_banner.setVisible(False)
 
     def _show_banner(self) -> None:

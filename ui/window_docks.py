@@ -30,7 +30,7 @@ __all__ = ["WindowDocks"]
 # The docks were the window's: their titles keep the "MainWindow" translation context.
 STATUS_DOCK_WIDTH = 265
 STATUS_DOCK_MAX_WIDTH = 320  # the status column never needs more; the work tabs get the rest
-DOCK_MIN_ROWS = 5  # the bottom docks (event log, traffic) show at least this many rows
+DOCK_MIN_ROWS = 4  # the bottom docks (event log, traffic) show at least this many rows
 
 
 class WindowDocks(QObject):

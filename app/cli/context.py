@@ -16,7 +16,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
-from typing import Any, TextIO, TypeVar
+from typing import TYPE_CHECKING, Any, TextIO, TypeVar
 
 from app import timing
 from app.cli.exit_codes import ExitCode
@@ -26,6 +26,9 @@ from app.link.foreign import ForeignSighting, audit_sighting
 from app.link.halt import RETRY_EXCEPTIONS
 from app.safety.audit import AuditLog
 from app.safety.caps import MotionCaps
+
+if TYPE_CHECKING:
+    from app.cli.guard import CliSafety
 
 __all__ = [
     "PROG",
@@ -57,7 +60,20 @@ class CliContext:
     make_client: Callable[[], RobotClient] | None = None
     #: reduced-speed mode's caps (``--reduced-speed``), given to the client (None: not reduced)
     caps: MotionCaps | None = None
+    #: the GUI's envelope and roles for this command (app/cli/guard.py); None: a command that
+    #: only reads
+    safety: CliSafety | None = None
     _client: RobotClient | None = None
+    _audit: AuditLog | None = None
+
+    @property
+    def audit(self) -> AuditLog:
+        """The audit trail the GUI writes too; its records carry the role the command acts as."""
+        if self._audit is None:
+            self._audit = AuditLog(
+                role="administrator (cli)", word_order=self.settings.word_order, on_error=self.warn
+            )
+        return self._audit
 
     @property
     def client(self) -> RobotClient:
@@ -72,12 +88,10 @@ class CliContext:
                 return self._client
             client = RobotClient(self.settings)
             client.caps = self.caps
-            # The CLI is an administrator's tool; its writes go to the same audit trail as the GUI's.
+            # The CLI's writes go to the same audit trail as the GUI's, with the role it acts as.
             # No write goes out without its record (a full disk refuses it, Stop excepted, see
             # AuditLog.writing); a record that cannot be written is said, once per problem.
-            client.audit = AuditLog(
-                role="administrator (cli)", word_order=self.settings.word_order, on_error=self.warn
-            )
+            client.audit = self.audit
             self._watch_foreign(client)
             self._client = client
             client.connect()

@@ -9,6 +9,7 @@ once, by ``app/cli/main.py``.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from collections.abc import Callable
@@ -38,6 +39,9 @@ from app.link.outcome import UNKNOWN_ADVICE, outcome_note
 from app.link.types import HaltKind
 from app.link.watch import MotionWatch, StateCheck
 from app.models import CommandResult, ControllerStatus, Pose
+from app.plan.segments import Segment
+from app.points.guard import PointGuard
+from app.points.ledger import PointLedger
 from app.protocol import registers
 from app.protocol.codec import decode_floats, encode_floats
 from app.protocol.enums import (
@@ -51,6 +55,7 @@ from app.protocol.enums import (
     controller_mode_text,
     program_state_text,
 )
+from app.safety.jog_guard import GuardTiming, JogMotion
 
 __all__ = ["JOG_SECONDS_DEFAULT", "register"]
 
@@ -124,6 +129,9 @@ def cmd_step(ctx: CliContext) -> ExitCode:
     frame = StepFrame(ctx.args.frame)
     offsets, ext = parse_step_offsets(frame, ctx.args.offsets)
     client = ctx.client
+    if ctx.safety is not None:  # the envelope, from the pose now (refused: nothing is sent)
+        joint = frame is StepFrame.JOINT
+        ctx.safety.check_step(client.read_pose(), offsets, joint=joint, speed=ctx.args.speed)
     result = wait_motion(
         ctx, lambda: client.step(frame, offsets, ext, speed=ctx.args.speed, wait=not ctx.args.no_wait)
     )
@@ -139,6 +147,8 @@ def _pose_line(pose: Pose) -> str:
 
 
 def cmd_jog(ctx: CliContext) -> ExitCode:
+    """A bounded jog in the envelope: its ratio capped, refused when it would have to stop at
+    once, stopped before a boundary by the GUI's jog guard watching the pose (app/cli/guard.py)."""
     args = ctx.args
     frame = TeachFrame[args.frame.upper()]
     axis = parse_axis(args.axis, frame is TeachFrame.JOINT)
@@ -147,18 +157,23 @@ def cmd_jog(ctx: CliContext) -> ExitCode:
     if not 0 < ratio <= 100:
         raise InvalidInput(f"jog ratio must be in (0, 100], got {args.ratio}")
     client = ctx.client
+    watch = _JogWatch.start(ctx, JogMotion(frame, axis, direction, ratio))
     writes_before = client.write_count
     halt: HaltWatch | None = None
+    stopped: TeachPadError | None = None
     try:
         result = client.teach_enable(frame, axis, direction, user_frame=args.user, tool_frame=args.tool)
         ctx.print(result.message)
-        client.teach_set_ratio(ratio)
+        client.teach_set_ratio(watch.motion.ratio)
         deadline = time.monotonic() + args.duration
         while (remaining := deadline - time.monotonic()) > 0:
             status = client.read_status()
             if status.alarms:
                 names = ", ".join(alarm_names(int(status.alarms)))
                 raise AlarmRaised(int(status.alarms), f"jog: alarm while jogging: {names}")
+            stopped = watch.poll(client)
+            if stopped is not None:
+                break
             time.sleep(min(remaining, JOG_POLL_INTERVAL))
     except KeyboardInterrupt:
         client.close()  # a request may have been cut in half: clean up on a fresh link
@@ -172,7 +187,51 @@ def cmd_jog(ctx: CliContext) -> ExitCode:
     if halt is not None and not halt.over:
         raise TeachPadError(_halt_failed("jog", halt), code="halt_unconfirmed")
     ctx.print(_pose_line(client.read_pose()))
+    if stopped is not None:
+        raise stopped
     return ExitCode.OK
+
+
+class _JogWatch:
+    """The envelope around a CLI jog: the GUI's jog guard deciding on every poll's pose, with
+    the look-ahead timed as the worker times it (:class:`GuardTiming`)."""
+
+    def __init__(self, ctx: CliContext, motion: JogMotion) -> None:
+        self.safety = ctx.safety
+        self.motion = motion
+        self.guard = None if ctx.safety is None else ctx.safety.session.jog_guard(JOG_POLL_INTERVAL)
+        self.timing = GuardTiming()
+
+    @classmethod
+    def start(cls, ctx: CliContext, motion: JogMotion) -> _JogWatch:
+        """The ratio capped (said when it is), and the jog refused (nothing sent) when it would
+        have to stop at once."""
+        safety = ctx.safety
+        if safety is None:
+            return cls(ctx, motion)
+        capped = safety.jog_ratio(motion.ratio)
+        if capped < motion.ratio:
+            mode = " in reduced-speed mode" if safety.session.reduced else ""
+            ctx.warn(f"jog: ratio {motion.ratio:g} % capped at {capped:g} %, the envelope's limit{mode}")
+            motion = dataclasses.replace(motion, ratio=capped)
+        safety.check_jog_start(ctx.client.read_pose(), motion, JOG_POLL_INTERVAL)
+        return cls(ctx, motion)
+
+    def poll(self, client: RobotClient) -> TeachPadError | None:
+        """Read the pose and decide; the error the jog ends with when the guard stops it."""
+        if self.guard is None or self.safety is None:
+            return None
+        read_at = time.perf_counter()
+        pose = client.read_pose()
+        now = time.perf_counter()
+        self.timing.note_read(read_at, now)
+        self.timing.note_decision(now, jogging=True)
+        horizon = self.timing.horizon(self.guard, now, read_at)
+        self.timing.note_horizon(now, horizon)
+        decision = self.guard.decide(pose, self.motion, horizon)
+        if decision.allow or decision.violation is None:
+            return None
+        return self.safety.guard_stopped(decision.violation, self.motion)
 
 
 def _jog_cleanup(ctx: CliContext, client: RobotClient) -> HaltWatch:
@@ -232,9 +291,13 @@ def cmd_point_create(ctx: CliContext) -> ExitCode:
 def cmd_move(ctx: CliContext) -> ExitCode:
     """Guarded by the project's copy of the points with ``--project`` (app/cli/point_move.py)."""
     args = ctx.args
+    if args.via is not None and args.via == args.id:  # a usage error before any other check
+        raise InvalidInput("the arc's middle point must differ from its end point")
     guard = point_move.move_guard(ctx)  # before connecting: a bad project sends nothing
     client = ctx.client
     tool = args.tool
+    if ctx.safety is not None:  # the envelope, from the pose now (refused: nothing is sent)
+        _check_move(ctx, client, guard)
     if guard is not None:
         point_move.prepare_points(guard, client, args)
         tool = guard.point(args.id).tool if tool is None else tool
@@ -264,6 +327,20 @@ def cmd_move(ctx: CliContext) -> ExitCode:
     if guard is None:
         ctx.warn(point_move.UNCHECKED_WARNING.format(id=args.id))
     return ExitCode.OK
+
+
+def _check_move(ctx: CliContext, client: RobotClient, guard: PointGuard | None) -> None:
+    """The move's path from the pose now against the envelope (with the project's copy of its
+    points; without one only what can be checked, app/cli/guard.py)."""
+    assert ctx.safety is not None
+    args = ctx.args
+    if args.via is None:
+        segment = Segment.line(args.id, args.speed)
+    else:
+        segment = Segment.arc(args.via, args.id, args.speed)
+    points = point_move.point_ids(args)
+    ledger = None if guard is None else PointLedger.from_checked([guard.point(i) for i in points])
+    ctx.safety.check_move(client.read_pose(), segment, ledger)
 
 
 def cmd_zero(ctx: CliContext) -> ExitCode:
@@ -474,7 +551,9 @@ def register(sub: Any) -> None:
         help="teach-mode jog for a bounded time (function 4); always stops and disables",
         description="Jog one axis in teach mode, then write ratio 0 and disable teach mode. The jog is "
         f"bounded: it stops after --seconds (default {JOG_SECONDS_DEFAULT:g} s, at most "
-        f"{JOG_SECONDS_MAX:g} s), on Ctrl-C and on any error. Example: "
+        f"{JOG_SECONDS_MAX:g} s), on Ctrl-C and on any error. The safety envelope binds it as in the "
+        "GUI: the ratio is capped at the envelope's jog cap, a jog that would have to stop at once "
+        "is refused, and the jog guard stops it before a boundary (exit 1). Example: "
         "teachpad-cli --host 192.168.1.10 jog --axis Z --dir + --ratio 10 --seconds 1.5",
     )
     p.add_argument(
@@ -547,8 +626,9 @@ def register(sub: Any) -> None:
         type=Path,
         metavar="FILE",
         help="the project holding the points (the host's copy): they are created again from it right "
-        "before the move and the arrival is checked against it (1 mm). Without it the arm goes to "
-        "whatever the controller holds under the id, unchecked",
+        "before the move and the arrival is checked against it (1 mm), and the path is checked "
+        "against the safety envelope. Without it the point cannot be checked: refused when the "
+        "envelope has a keep-in box or keep-out zones (a fresh install's has one)",
     )
     p.add_argument("--no-wait", action="store_true", help="return once the command is sent")
     p.add_argument(

@@ -51,13 +51,14 @@ class ExitCode(enum.IntEnum):
 _MEANING = {
     ExitCode.OK: "ok",
     ExitCode.FAILED: (
-        "command failed or refused (controller, busy, alarm, stopped, monitor-only, out of the robot's reach)"
+        "command failed or refused (controller, busy, alarm, stopped, monitor-only, out of the robot's "
+        "reach, safety envelope, role)"
     ),
     ExitCode.USAGE: "usage: bad arguments, values or input files (nothing sent)",
     ExitCode.LINK: "link: cannot connect, no answer in time, malformed answer",
     ExitCode.UNKNOWN: (
-        "sent; the outcome is unknown (status unreadable, not finished in time, not acknowledged): "
-        "check the robot before sending it again"
+        "sent; the outcome is unknown (status unreadable, not finished in time, not acknowledged, "
+        "another master seen before its end): check the robot before sending it again"
     ),
     ExitCode.INTERRUPTED: "interrupted (Ctrl-C; a motion under way is stopped first)",
 }

@@ -42,13 +42,21 @@ from app.cli import controller, points, run_plan, support
 from app.cli.context import PROG, CliContext, Handler, ctrl_c_remembered
 from app.cli.exit_codes import EPILOG, ExitCode, exit_code_for
 from app.cli.format import parse_positive_float, parse_word_order
+from app.cli.guard import (
+    COMMAND_ACTIONS,
+    ENVELOPE_FILE,
+    PASSWORD_ENV,
+    ROLE_ENV,
+    ROLES_TEXT,
+    CliSafety,
+    command_path,
+)
 from app.cli.help import add_examples
 from app.errors import InvalidInput, TeachPadError
 from app.link.client import ConnectionSettings
 from app.link.outcome import UNKNOWN_ADVICE
 from app.safety.caps import MotionCaps
 from app.safety.envelope import Envelope
-from app.safety.profile import load_profile as load_safety_profile
 from app.safety.register_profile import (
     COMPLETION_MODES,
     PROFILE_NAME,
@@ -56,6 +64,7 @@ from app.safety.register_profile import (
     load_register_profile,
 )
 from app.safety.roles import default_config_dir
+from app.version import VersionAction
 
 __all__ = [
     "EXIT_FAILED",
@@ -92,19 +101,20 @@ EXIT_UNKNOWN = ExitCode.UNKNOWN
 
 _PATH_SHOWN = 100  # characters of a path in an error message
 
-_DESCRIPTION = (
-    "Talk to a Bochuang robot controller over Modbus. An administrator's tool: "
-    "TeachPad's operator roles apply to the GUI, not here."
-)
+_DESCRIPTION = "Talk to a Bochuang robot controller over Modbus. " + ROLES_TEXT
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG,
-        description=textwrap.fill(_DESCRIPTION, 90),
+        description=textwrap.fill(
+            f"{_DESCRIPTION} The GUI's envelope file: {_shown_path(default_config_dir() / ENVELOPE_FILE)}.",
+            90,
+        ),
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,  # keeps the exit code table's lines
     )
+    parser.add_argument("--version", action=VersionAction)
     link = parser.add_argument_group("link")
     link.add_argument(
         "--host", default="127.0.0.1", help="controller's IP address or host name (default %(default)s)"
@@ -180,9 +190,18 @@ def build_parser() -> argparse.ArgumentParser:
         "--reduced-speed",
         action="store_true",
         help="reduced-speed mode: cap every motion at the envelope's reduced caps (run --safety FILE's, "
-        "else the defaults: 10 %% for jog and program speed ratios, 250 mm/s for steps, moves and "
-        "plan segments; joint steps at the rpm that keeps the arm under that speed at the robot "
+        "else the envelope in force, the GUI's; its defaults: 10 %% for jog and program speed "
+        "ratios, 250 mm/s for steps, moves and plan segments; joint steps at the rpm that keeps "
+        "the arm under that speed at the robot "
         "model's reach); go to zero is refused (it runs at the controller's own speed)",
+    )
+    parser.add_argument(
+        "--role",
+        choices=("operator", "engineer", "administrator"),
+        default=None,
+        help=f"the role a writing command acts as once the administrator has a password (default: "
+        f"${ROLE_ENV}, else operator); its password is asked for in a terminal or taken from "
+        f"${PASSWORD_ENV}",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log every write and the link")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
@@ -221,18 +240,19 @@ def settings_from_args(args: argparse.Namespace) -> ConnectionSettings:
     return dataclasses.replace(settings, **overrides)
 
 
-def caps_from_args(args: argparse.Namespace) -> MotionCaps | None:
-    """Reduced-speed mode's caps (None without ``--reduced-speed``): the envelope of ``--safety``
-    when the command has one (``run``), else the default envelope's; the reach of its
-    ``--robot-profile``, else the default robot model's. A file that cannot be used raises a
-    :class:`TeachPadError` naming it (a usage error: nothing sent)."""
+def caps_from_args(args: argparse.Namespace, envelope: Envelope | None = None) -> MotionCaps | None:
+    """Reduced-speed mode's caps (None without ``--reduced-speed``): those of ``envelope`` (the
+    one in force: ``--safety`` when the command has one, else the GUI's, app/cli/guard.py); the
+    reach of its ``--robot-profile``, else the default robot model's. A file that cannot be used
+    raises a :class:`TeachPadError` naming it (a usage error: nothing sent)."""
     if not args.reduced_speed:
         return None
+    from app.cli.guard import envelope_in_force
     from app.view3d.profile import default_profile
     from app.view3d.profile import load_profile as load_robot_profile
 
-    safety = getattr(args, "safety", None)
-    envelope = Envelope() if not safety else load_safety_profile(safety).envelope
+    if envelope is None:
+        envelope = envelope_in_force(getattr(args, "safety", None))
     robot = getattr(args, "robot_profile", None)
     model = default_profile() if robot is None else load_robot_profile(robot)
     return envelope.motion_caps(model.reach)
@@ -287,14 +307,18 @@ def _main(argv: Sequence[str] | None = None) -> int:
     except TeachPadError as exc:  # a register profile that cannot be used, a bad --unit
         print(f"{PROG}: error: {exc}", file=sys.stderr, flush=True)
         return exit_code_for(exc)
-    try:
-        caps = caps_from_args(args)
+    ctx = CliContext(args, settings)
+    try:  # the envelope and the role store the GUI uses (a command that writes): nothing sent yet
+        if command_path(args) in COMMAND_ACTIONS:
+            ctx.safety = CliSafety.load(args, ctx.audit)
+        ctx.caps = caps_from_args(args, ctx.safety.envelope if ctx.safety is not None else None)
     except TeachPadError as exc:  # a safety or robot profile that cannot be used: nothing sent
         print(f"{PROG}: error: {exc}", file=sys.stderr, flush=True)
         return ExitCode.USAGE
-    ctx = CliContext(args, settings, caps=caps)
     handler: Handler = args.handler
     try:
+        if ctx.safety is not None:
+            ctx.safety.log_in(args)  # the role a writing command acts as, and its permission
         return handler(ctx)
     except BrokenPipeError:
         _quiet_broken_pipe()

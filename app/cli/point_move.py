@@ -16,8 +16,10 @@ move goes through :class:`app.points.guard.PointGuard`, the guard of the plan ru
 The restart canary is not written: a single move has nothing to guard across moves, and a token
 written here would read as a controller restart to a TeachPad on the same controller.
 
-Without ``--project`` the CLI holds no copy of the point, so there is nothing to check the
-arrival against: the arm goes to the controller's copy, the command prints where it stopped and
+Without ``--project`` the CLI holds no copy of the point, so neither its path (the safety
+envelope, app/cli/guard.py) nor its arrival can be checked: with a keep-in box or keep-out zones
+in the envelope (a fresh install's has a keep-in box) the move is refused before anything is
+sent; with none, the arm goes to the controller's copy, the command prints where it stopped and
 says on stderr that the point was not checked (a warning; the exit code stays the move's).
 """
 

@@ -27,19 +27,24 @@ file.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import dataclasses
 import math
+import time
 import unicodedata
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
+from app import timing
 from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode, exit_code_for
-from app.cli.points_upload import by_tool, staged_upload
-from app.errors import InvalidInput, TeachPadError
+from app.cli.points_upload import BootWatch, by_tool, open_boot, staged_upload
+from app.errors import InvalidInput, ModbusExceptionError, TeachPadError
+from app.points.guard import CANARY_GV
 from app.points.ledger import EmptyImport, ImportMode, PointLedger
 from app.points.lock import live_owner
-from app.points.point import FileFormatError, PointLimits, TempPoint, tool_text
+from app.points.point import FileFormatError, PointLimits, SyncState, TempPoint, tool_text
 from app.points.project import (
     Project,
     ProjectTooLarge,
@@ -48,7 +53,8 @@ from app.points.project import (
     save_project,
     write_points_csv,
 )
-from app.points.upload import UploadReport, apply_upload, parse_id_list
+from app.points.upload import BootLost, UploadReport, apply_upload, parse_id_list
+from app.points.upload_record import UploadRecord, load_record, record_path, save_record
 
 # The table's members under the names callers imported before the table existed.
 EXIT_OK = ExitCode.OK
@@ -95,7 +101,11 @@ def register(subparsers: Any) -> None:
     p.add_argument("project", type=Path, help=_PROJECT_HELP)
     group = p.add_mutually_exclusive_group()
     group.add_argument("--ids", help="ids to upload, e.g. 1,2,5-9 (default: all)")
-    group.add_argument("--needed", action="store_true", help="only points not known to be on the controller")
+    group.add_argument(
+        "--needed",
+        action="store_true",
+        help="only points the upload record of this controller boot does not hold (resume)",
+    )
     p.set_defaults(handler=cmd_points_upload)
 
     p = psub.add_parser("export", help="write the project's points to a CSV file")
@@ -171,22 +181,27 @@ def _monitor_only(ctx: CliContext, args: argparse.Namespace, what: str) -> bool:
 
 
 def _save(ctx: CliContext, project: Project, path: Path) -> bool:
+    problem = _save_problem(project, path)
+    if problem is not None:
+        ctx.error(f"{path}: {problem}")
+    return problem is None
+
+
+def _save_problem(project: Project, path: Path) -> str | None:
+    """Save ``project`` to ``path``; None when it was saved, else why not ("not saved: ...")."""
     owner = live_owner(path)
     if owner is not None:
-        ctx.error(
-            f"{path}: not saved: the project is open in a TeachPad ({owner.text}); "
+        return (
+            f"not saved: the project is open in a TeachPad ({owner.text}); "
             "close it there or make the change there"
         )
-        return False
     try:
         save_project(project, path)
     except ProjectTooLarge as exc:  # refused before the write: never a file TeachPad cannot open
-        ctx.error(f"{path}: not saved: {exc}")
-        return False
+        return f"not saved: {exc}"
     except OSError as exc:
-        ctx.error(f"{path}: could not save: {exc}")
-        return False
-    return True
+        return f"could not save: {exc}"
+    return None
 
 
 def _link_code(ctx: CliContext, exc: TeachPadError, what: str) -> ExitCode:
@@ -226,7 +241,13 @@ class _ProgressLine:
         self.width = 0
 
 
-def _upload(ctx: CliContext, project: Project, points: Sequence[TempPoint], client: Any) -> UploadReport:
+def _upload(
+    ctx: CliContext,
+    points: Sequence[TempPoint],
+    client: Any,
+    watch: BootWatch | None,
+    proven: Callable[[list[TempPoint]], object] | None,
+) -> UploadReport:
     line = _ProgressLine(ctx.out)
     ordered = by_tool(points)
 
@@ -235,11 +256,18 @@ def _upload(ctx: CliContext, project: Project, points: Sequence[TempPoint], clie
             line.show(f"uploading {done + 1}/{total}: {ordered[done].label}")
 
     try:
-        report = staged_upload(client, ordered, progress=progress)
+        return staged_upload(client, ordered, progress=progress, watch=watch, proven=proven)
     finally:
         line.done()
-    apply_upload(project.ledger, report)
-    ctx.print(f"uploaded {report.ok_count} point(s)")
+
+
+def _say_upload(ctx: CliContext, report: UploadReport, total: int) -> None:
+    """What happened on the controller, in the order it happened (what was kept comes after)."""
+    lost = report.boot_lost
+    if lost is None:
+        ctx.print(
+            f"uploaded {report.ok_count} point(s)" + (f" of {total}" if report.ok_count != total else "")
+        )
     unconfirmed = [o.point_id for o in report.outcomes if o.ok and o.unconfirmed]
     if unconfirmed:
         shown = ",".join(map(str, unconfirmed[:20])) + (",..." if len(unconfirmed) > 20 else "")
@@ -249,15 +277,49 @@ def _upload(ctx: CliContext, project: Project, points: Sequence[TempPoint], clie
         )
     for outcome in report.failed:
         ctx.error(f"P{outcome.point_id}: {outcome.reason}")
-    if report.aborted:
+    if lost is not None:
+        ctx.error(boot_lost_text(lost, report, total))
+    elif report.aborted:
         left = ",".join(str(i) for i in report.not_attempted)
         ctx.error(f"upload stopped ({report.aborted}); not attempted: {left}")
-    return report
+
+
+def _id_text(ids: Sequence[int]) -> str:
+    return ",".join(f"P{i}" for i in ids[:20]) + (",..." if len(ids) > 20 else "")
+
+
+def boot_lost_text(lost: BootLost, report: UploadReport, total: int) -> str:
+    """The words for an upload the controller restarted under (or whose canary changed)."""
+    if lost.restarted:
+        what = "the controller restarted during the upload"
+        gone = "it forgot every temp point"
+    else:
+        what = (
+            f"the restart canary GV{CANARY_GV} changed during the upload (another host wrote it: "
+            "another master, or a restart it armed again)"
+        )
+        gone = "what was uploaded before cannot be proven on the controller"
+    where = f" (after P{lost.after})" if lost.after is not None else ""
+    text = f"{what}{where}: {gone}, the {len(report.confirmed)} point(s) uploaded before it among them"
+    if lost.suspects:  # sent around it: one may have been created at a wiped (zero) pose
+        text += f"; {_id_text(lost.suspects)}, sent around it, "
+        if lost.repaired and not lost.repair_error:
+            text += "were created again at their poses after it"
+        else:
+            text += (
+                f"were created again after it: {_id_text(lost.repaired) or 'none'} "
+                f"({lost.repair_error}; the others may be at wrong poses on the controller)"
+            )
+    left = report.not_attempted
+    text += f"; not sent after it: {_id_text(left)}" if left else "; nothing else was left to send"
+    return text + f". Upload the {total} again: the upload record of the old boot is void, --needed sends all"
 
 
 def _upload_code(report: UploadReport) -> ExitCode:
     if report.interrupted:
         return ExitCode.INTERRUPTED
+    if report.boot_lost is not None:
+        return ExitCode.FAILED
     if report.aborted:
         return ExitCode.LINK
     return ExitCode.OK if report.all_ok else ExitCode.FAILED
@@ -286,41 +348,169 @@ def cmd_points_list(ctx: CliContext) -> ExitCode:
 
 
 def cmd_points_upload(ctx: CliContext) -> ExitCode:
-    """``points upload PROJECT [--ids ... | --needed]``; saves the upload history."""
+    """``points upload PROJECT [--ids ... | --needed]``; saves the upload history and the upload
+    record (:mod:`app.points.upload_record`) the next ``--needed`` resumes from."""
     args = ctx.args
     if _monitor_only(ctx, args, "points upload"):
         return ExitCode.FAILED
     project = _load(ctx, args.project, _limits(ctx))
     if project is None:
         return ExitCode.USAGE
-    ledger = project.ledger
-    if args.ids:
-        try:
-            ids = parse_id_list(args.ids)
-        except InvalidInput as exc:
-            ctx.error(str(exc))
-            return ExitCode.USAGE
-        missing = [i for i in ids if i not in ledger]
-        if missing:
-            ctx.error(f"no point with id {', '.join(map(str, missing))} in {args.project}")
-            return ExitCode.USAGE
-        points = [ledger.point(i) for i in ids]
-    elif args.needed:
-        points = ledger.needing_upload()
-    else:
-        points = list(ledger)
-    if not points:
+    points = _chosen(ctx, project.ledger, args)
+    if isinstance(points, ExitCode):
+        return points
+    if not points and not args.needed:
         ctx.print("nothing to upload")
         return ExitCode.OK
+    where = record_path(args.project)
+    old = _load_record(ctx, where)
     try:
         client = ctx.client
-        report = _upload(ctx, project, points, client)
+        watch, record, resumed = _open_boot(ctx, client, old)
+        if args.needed:
+            points = _needed(ctx, project.ledger, record if resumed else None)
+        if not points:
+            ctx.print("nothing to upload")
+            return ExitCode.OK
+        keeper = None if record is None else _RecordKeeper(where, record, points)
+        report = _upload(ctx, points, client, watch, None if keeper is None else keeper.proven)
         project.record_upload([o.point_id for o in report.outcomes if o.ok], _endpoint(client))
     except TeachPadError as exc:
         return _link_code(ctx, exc, "cannot upload")
-    if not _save(ctx, project, args.project):
+    apply_upload(project.ledger, report)
+    record_problem = _keep_record(where, keeper, report)
+    project_problem = _save_problem(project, args.project)
+    _say_upload(ctx, report, len(points))
+    return _say_kept(ctx, report, args.project, project_problem, record_problem) or _upload_code(report)
+
+
+def _chosen(ctx: CliContext, ledger: PointLedger, args: argparse.Namespace) -> list[TempPoint] | ExitCode:
+    """The points ``--ids`` names (USAGE after saying why when it is bad), else all of them (also
+    for ``--needed``: which of them are needed is known once the controller's boot is)."""
+    if not args.ids:
+        return list(ledger)
+    try:
+        ids = parse_id_list(args.ids)
+    except InvalidInput as exc:
+        ctx.error(str(exc))
+        return ExitCode.USAGE
+    missing = [i for i in ids if i not in ledger]
+    if missing:
+        ctx.error(f"no point with id {', '.join(map(str, missing))} in {args.project}")
+        return ExitCode.USAGE
+    return [ledger.point(i) for i in ids]
+
+
+def _needed(ctx: CliContext, ledger: PointLedger, record: UploadRecord | None) -> list[TempPoint]:
+    """``--needed``: the points the upload record of this very boot does not hold at their present
+    pose and tool frame (those it holds are "on controller"); all of them without such a record."""
+    if record is not None:
+        held = [p.id for p in ledger if record.holds(p)]
+        for point_id in held:
+            ledger.set_sync(point_id, SyncState.ON_CONTROLLER)
+        if held:
+            ctx.print(
+                f"{len(held)} point(s) already on the controller (the upload record of this boot of it): "
+                "not sent again"
+            )
+    return ledger.needing_upload()
+
+
+def _load_record(ctx: CliContext, where: Path) -> UploadRecord | None:
+    try:
+        return load_record(where)
+    except FileFormatError as exc:
+        ctx.warn(f"{exc}; it is not used (every point is sent)")
+        return None
+
+
+class _RecordKeeper:
+    """The upload record while the upload runs: the points about to be sent leave it first (the
+    controller's copy of them is about to change), each good read of the canary adds what it
+    proved, written every :data:`app.timing.UPLOAD_RECORD_PERIOD` at most -- so even a killed
+    upload resumes from what the controller confirmed."""
+
+    def __init__(self, where: Path, record: UploadRecord, points: Sequence[TempPoint]) -> None:
+        self.where, self.record = where, record
+        self.before = {p.id: held for p in points if (held := record.points.pop(p.id, None)) is not None}
+        self.saved_at = time.monotonic()
+
+    def proven(self, confirmed: list[TempPoint]) -> None:
+        self.record.confirm(confirmed)
+        now = time.monotonic()
+        if now - self.saved_at >= timing.UPLOAD_RECORD_PERIOD:
+            self.saved_at = now
+            with contextlib.suppress(OSError):  # said at the end, when the last write fails too
+                save_record(self.where, self.record)
+
+    def finish(self, report: UploadReport) -> None:
+        """The record after ``report``: the confirmed points as sent, the points not sent as they
+        were; after a restart nothing of it holds any more (no token: void)."""
+        record = self.record
+        if report.boot_lost is not None:
+            record.points.clear()
+            record.identity = dataclasses.replace(record.identity, boot=None)
+            return
+        sent = {o.point_id: o.sent for o in report.outcomes if o.sent is not None}
+        record.confirm([point for i in report.confirmed if (point := sent.get(i)) is not None])
+        # the first one not attempted (under way at Ctrl-C or a lost link) may have gone out
+        for point_id in report.not_attempted[1:]:
+            held = self.before.get(point_id)
+            if held is not None:
+                record.points[point_id] = held
+
+
+def _open_boot(
+    ctx: CliContext, client: Any, old: UploadRecord | None
+) -> tuple[BootWatch | None, UploadRecord | None, bool]:
+    """:func:`~app.cli.points_upload.open_boot`; a controller that refuses the restart canary's GV
+    (a Modbus exception) gets the upload without it, said: no restart seen, no record kept."""
+    try:
+        return open_boot(client, ctx.settings, old)
+    except ModbusExceptionError as exc:
+        ctx.warn(
+            f"the restart canary GV{CANARY_GV} cannot be used ({exc}): a controller restart during the "
+            "upload would go unseen"
+        )
+        return None, None, False
+
+
+def _keep_record(where: Path, keeper: _RecordKeeper | None, report: UploadReport) -> str | None:
+    """The record after ``report``, written; why it was not (None: it was)."""
+    if keeper is None:
+        return f"without the restart canary GV{CANARY_GV} nothing proves what the controller holds"
+    keeper.finish(report)
+    try:
+        save_record(where, keeper.record)
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    return None
+
+
+def _say_kept(
+    ctx: CliContext, report: UploadReport, path: Path, project_problem: str | None, record_problem: str | None
+) -> ExitCode | None:
+    """What was kept of the upload on this computer, after what happened on the controller; FAILED
+    when the project could not be saved (None: the upload's own code stands)."""
+    held = f"the {report.ok_count} point(s) uploaded are on the controller"
+    if record_problem is None:
+        record = "the upload record beside it was kept (--needed will not send them again)"
+    else:
+        record = (
+            f"the upload record could not be kept either ({record_problem}): --needed will send them again"
+        )
+    if project_problem is not None:
+        ctx.error(
+            f"{path}: {project_problem}. {held.capitalize()}, but the project file is as it was "
+            f"before this upload (its upload history does not show it); {record}"
+        )
         return ExitCode.FAILED
-    return _upload_code(report)
+    if record_problem is not None:
+        ctx.warn(
+            f"{record_path(path)}: no upload record was kept ({record_problem}): {held} "
+            "and the project was saved, but a later --needed will send them again"
+        )
+    return None
 
 
 def cmd_points_export(ctx: CliContext) -> ExitCode:

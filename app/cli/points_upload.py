@@ -6,22 +6,83 @@ controller creates it the next point's pose goes into the other pose block -- GV
 GV12..GV17 when the restart canary (:data:`app.points.guard.CANARY_GV`) sits there
 (:func:`app.link.upload.stage_gv_for`) -- so the write fills the controller's latency. The
 outcome is an :class:`app.points.upload.UploadReport`, as the point-by-point upload gave.
+
+**Restarts** (issue 19): the upload watches the restart canary (:class:`BootWatch`, GV99) the way
+the GUI's link does -- it is read every :data:`CANARY_EVERY` points and after the last. A point
+counts as *confirmed* (``UploadReport.confirmed``, what the upload record of
+:mod:`app.points.upload_record` keeps) only when a read after its result still showed the token. A
+changed canary ends the upload as a restart (``UploadReport.boot_lost``), never as "uploaded": a
+restart clears GV0..GV99, so a point whose staged pose it wiped was created at (0,0,0,0,0,0); the
+points tried since the last good read are created again at their poses on the new boot (the same
+point at the same pose: safe to repeat) and proven by a fresh token, and the rest is not sent.
 """
 
 from __future__ import annotations
 
+import itertools
+import random
 from collections.abc import Callable, Sequence
-from typing import Any
+from dataclasses import dataclass, replace
+from typing import Any, Protocol
 
 from app.cli.exit_codes import LINK_ERRORS
-from app.errors import ModbusExceptionError
+from app.errors import ModbusExceptionError, TeachPadError
+from app.link.transport import ConnectionSettings
+from app.link.types import ControllerIdentity
 from app.link.upload import UPLOAD_POSE_GV, refused_before_the_first, stage_gv_for
 from app.models import CommandResult
 from app.points.guard import CANARY_GV
 from app.points.point import TempPoint
-from app.points.upload import UploadOutcome, UploadReport
+from app.points.upload import BootLost, UploadOutcome, UploadReport
+from app.points.upload_record import UploadRecord
 
-__all__ = ["by_tool", "staged_upload"]
+__all__ = ["CANARY_EVERY", "BootWatch", "by_tool", "open_boot", "staged_upload"]
+
+#: points created between two reads of the restart canary during an upload (and one after the last)
+CANARY_EVERY = 8
+
+
+class CanaryClient(Protocol):
+    """The part of ``RobotClient`` the restart canary needs."""
+
+    def read_gv(self, n: int, count: int = 1) -> list[float]: ...
+
+    def write_gv(self, n: int, values: Sequence[float]) -> None: ...
+
+
+@dataclass
+class BootWatch:
+    """The restart canary of the boot an upload runs on: ``token`` in GV ``gv``."""
+
+    gv: int
+    token: float
+    every: int = CANARY_EVERY
+
+    def read(self, client: CanaryClient) -> float:
+        """The canary's value now (the link's errors as they come)."""
+        return client.read_gv(self.gv)[0]
+
+
+def new_token() -> float:
+    return float(random.SystemRandom().randint(1, 1 << 23))  # nonzero, exact in float32
+
+
+def open_boot(
+    client: CanaryClient, settings: ConnectionSettings, record: UploadRecord | None, gv: int = CANARY_GV
+) -> tuple[BootWatch, UploadRecord, bool]:
+    """The boot an upload begins on: ``(watch, record, resumed)``. ``record`` (the one kept beside the
+    project) is resumed only when it is provably this boot: the same endpoint, unit, word order and
+    canary GV, and the canary reads its token now (:meth:`UploadRecord.same_boot`). Otherwise a
+    fresh, empty record: the canary's token is adopted when one is armed (nonzero: any TeachPad
+    writes a fresh random one after a restart, a restart clears it), else a fresh one is written."""
+    value = client.read_gv(gv)[0]
+    place = ControllerIdentity(settings.endpoint, settings.unit, settings.word_order.value, gv, value)
+    if record is not None and value != 0.0 and record.same_boot(place):
+        return BootWatch(gv, value), record, True
+    if value == 0.0:
+        value = new_token()
+        client.write_gv(gv, [value])
+    return BootWatch(gv, value), UploadRecord(replace(place, boot=value)), False
 
 
 def by_tool(points: Sequence[TempPoint]) -> list[TempPoint]:
@@ -33,7 +94,11 @@ def by_tool(points: Sequence[TempPoint]) -> list[TempPoint]:
 
 
 def staged_upload(
-    client: Any, points: Sequence[TempPoint], progress: Callable[[int, int], object] | None = None
+    client: Any,
+    points: Sequence[TempPoint],
+    progress: Callable[[int, int], object] | None = None,
+    watch: BootWatch | None = None,
+    proven: Callable[[list[TempPoint]], object] | None = None,
 ) -> UploadReport:
     """Create ``points`` with ``RobotClient.upload_points``, as the GUI's upload does: in
     :func:`by_tool` order (GV245 once per tool), the next point's pose staged in the spare pose
@@ -45,60 +110,172 @@ def staged_upload(
     controller refuses (a refusal or a Modbus exception; a batch whose tool frame or status read
     is refused: each of its points) is recorded and the upload goes on; a lost link
     (:attr:`CommandResult.link_failed`) or Ctrl-C ends it, the point under way and the rest
-    ``not_attempted``.
+    ``not_attempted``. ``watch``: the restart canary of the boot it began on (see the module
+    docstring); without it nothing is ``confirmed`` and a restart goes unseen. ``proven(points)``:
+    after each good read of the canary, every point confirmed so far (as sent), for a record kept
+    while the upload runs.
     """
-    ordered = by_tool(points)
-    report = UploadReport()
-    total, done = len(ordered), 0
-    stage_gv = stage_gv_for(CANARY_GV)
-    told, go_on = -1, True
+    return _StagedUpload(client, by_tool(points), progress, watch, proven).run()
 
-    def tell(n: int) -> bool:  # once per point; False (from ``progress``): end after this one
-        nonlocal told, go_on
-        if progress is not None and n != told and go_on:
-            told = n
-            go_on = progress(n, total) is not False
-        return go_on
 
-    def stop_here(why: str, *, interrupted: bool = False) -> UploadReport:
+class _StagedUpload:
+    """One :func:`staged_upload`: the batches, the progress and the canary reads between points."""
+
+    def __init__(
+        self,
+        client: Any,
+        ordered: list[TempPoint],
+        progress: Callable[[int, int], object] | None,
+        watch: BootWatch | None,
+        proven: Callable[[list[TempPoint]], object] | None = None,
+    ) -> None:
+        self.client, self.ordered, self.progress, self.watch = client, ordered, progress, watch
+        self.on_proven = proven
+        self.results: list[CommandResult] = []  # the batch under way's results so far ...
+        self.batch_first = 0  # ... and the index of its first point
+        self.report = UploadReport()
+        self.total, self.done = len(ordered), 0
+        self.told, self.go_on = -1, True
+        self.proven = 0  # the points before this index were tried before the canary's last good read
+        self.changed: float | None = None  # the canary's value when it was not the token any more
+        self.canary_error: str | None = None  # the read of the canary failed
+
+    def tell(self, n: int) -> bool:
+        """Once per point; False (from ``progress``, a changed canary): end after this one."""
+        if n != self.told and self.go_on:
+            self.told = n
+            if self.progress is not None:
+                self.go_on = self.progress(n, self.total) is not False
+            watch = self.watch
+            if watch is not None and (n - self.proven >= watch.every or (n == self.total > self.proven)):
+                self.go_on = self.canary_holds(n) and self.go_on
+        return self.go_on
+
+    def canary_holds(self, n: int) -> bool:
+        """Read the canary: True (the points tried so far proven) while it holds the token."""
+        assert self.watch is not None
+        try:
+            value = self.watch.read(self.client)
+        except TeachPadError as exc:  # the link, a refusal: the boot cannot be proven any more
+            self.canary_error = f"the restart canary GV{self.watch.gv} could not be read: {exc}"
+            return False
+        if value != self.watch.token:
+            self.changed = value
+            return False
+        self.proven = n
+        if self.on_proven is not None:
+            self.on_proven(self.confirmed())
+        return True
+
+    def confirmed(self) -> list[TempPoint]:
+        """The points created ("done", not unconfirmed) before the canary's last good read."""
+        report, ordered = self.report, self.ordered
+        ok = {o.point_id for o in report.outcomes if o.ok and not o.unconfirmed}
+        first = self.batch_first
+        ok.update(ordered[first + i].id for i, r in enumerate(self.results) if r.ok and not r.unconfirmed)
+        return [p for p in ordered[: self.proven] if p.id in ok]
+
+    def stop_here(self, why: str, *, interrupted: bool = False) -> UploadReport:
+        report = self.report
         report.aborted, report.interrupted = why, interrupted
-        report.not_attempted = [p.id for p in ordered[done:]]
+        report.not_attempted = [p.id for p in self.ordered[self.done :]]
+        return self.finish()
+
+    def finish(self) -> UploadReport:
+        """The report, with what the canary proved and (when it changed) the restart."""
+        report = self.report
+        report.confirmed = [p.id for p in self.confirmed()]
+        if self.changed is not None and self.watch is not None:
+            report.aborted = report.aborted or self.why_stopped()
+            suspects = self.ordered[self.proven : self.done]
+            after = self.ordered[self.proven - 1].id if self.proven else None
+            report.boot_lost = _repair(self.client, self.watch, BootLost(self.changed, after), suspects)
         return report
 
-    while done < total:
-        end = done
-        while end < total and ordered[end].tool == ordered[done].tool:
-            end += 1
-        batch, first = ordered[done:end], done
+    def run(self) -> UploadReport:
+        ordered, total = self.ordered, self.total
+        while self.done < total:
+            done = self.done
+            end = done
+            while end < total and ordered[end].tool == ordered[done].tool:
+                end += 1
+            if not self.tell(done):
+                return self.stop_here(self.why_stopped())
+            stopped = self.batch(ordered[done:end])
+            if stopped is not None:
+                return stopped
+            if not self.go_on and self.done < total:
+                return self.stop_here(self.why_stopped())
+        self.tell(total)
+        if self.changed is not None or self.canary_error is not None:
+            return self.stop_here(self.why_stopped())
+        return self.finish()
+
+    def why_stopped(self) -> str:
+        if self.changed is not None:
+            return "the controller restarted" if self.changed == 0.0 else "the restart canary changed"
+        return self.canary_error or "stopped on request"
+
+    def batch(self, batch: list[TempPoint]) -> UploadReport | None:
+        """One tool frame's points; the final report when the upload ends here, else None."""
+        first = self.done
         results: list[CommandResult] = []
-        if not tell(done):
-            return stop_here("stopped on request")
+        self.results, self.batch_first = results, first
+        report = self.report
         try:
-            client.upload_points(
+            self.client.upload_points(
                 [(p.id, p.xyzabc) for p in batch],
                 batch[0].tool,
-                lambda n, _total, first=first: tell(first + n),
+                lambda n, _total, first=first: self.tell(first + n),
                 gv_start=UPLOAD_POSE_GV,
-                stage_gv=stage_gv,
+                stage_gv=stage_gv_for(CANARY_GV),
                 results=results,
             )
         except LINK_ERRORS as exc:  # before its first point (the status read): nothing of it done
-            return stop_here(str(exc) or type(exc).__name__)
+            return self.stop_here(str(exc) or type(exc).__name__)
         except ModbusExceptionError as exc:  # refused before its first point (GV245, the status read)
             results.extend(refused_before_the_first((p.id for p in batch[len(results) :]), exc))
         except KeyboardInterrupt:  # keep what was done: the caller records it, the ledger stays true
             _record(report, batch, results)
-            done += len(results)
-            return stop_here("interrupted", interrupted=True)
+            self.done += len(results)
+            return self.stop_here("interrupted", interrupted=True)
         link_lost = _record(report, batch, results)
         if link_lost is not None:
-            done += len(results) - 1  # that point's outcome is unknown: not attempted
-            return stop_here(link_lost)
-        done += len(results)
-        if not go_on and done < total:
-            return stop_here("stopped on request")
-    tell(total)
-    return report
+            self.done += len(results) - 1  # that point's outcome is unknown: not attempted
+            return self.stop_here(link_lost)
+        self.done += len(results)
+        return None
+
+
+def _repair(client: Any, watch: BootWatch, lost: BootLost, suspects: Sequence[TempPoint]) -> BootLost:
+    """After the canary changed: create the points tried since its last good read again, at their
+    poses, on the new boot (a restart may have wiped a staged pose: that point is at zeros), and
+    prove them with a token of this boot (a fresh one after a restart, else the value now there)."""
+    lost = replace(lost, suspects=tuple(p.id for p in suspects))
+    if not suspects:
+        return lost
+    token = lost.value
+    repaired: list[int] = []
+    client.invalidate_cache()  # GV245 (the tool frame) was cleared with the rest: written anew
+    try:
+        if token == 0.0:
+            token = new_token()
+            client.write_gv(watch.gv, [token])
+        for group in _tool_groups(suspects):
+            results = client.upload_points(
+                [(p.id, p.xyzabc) for p in group], group[0].tool, gv_start=UPLOAD_POSE_GV
+            )
+            repaired += [p.id for p, r in zip(group, results, strict=False) if r.ok and not r.unconfirmed]
+        if watch.read(client) != token:
+            return replace(lost, repair_error="the restart canary changed again while they were created")
+    except TeachPadError as exc:
+        return replace(lost, repaired=tuple(repaired), repair_error=str(exc))
+    missing = len(suspects) - len(repaired)
+    return replace(lost, repaired=tuple(repaired), repair_error=f"{missing} refused" if missing else "")
+
+
+def _tool_groups(points: Sequence[TempPoint]) -> list[list[TempPoint]]:
+    return [list(group) for _, group in itertools.groupby(by_tool(points), key=lambda p: p.tool)]
 
 
 def _record(report: UploadReport, batch: Sequence[TempPoint], results: Sequence[CommandResult]) -> str | None:

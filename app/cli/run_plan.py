@@ -92,7 +92,8 @@ def register(subparsers: Any) -> None:
     r.add_argument(
         "--safety",
         metavar="PROFILE",
-        help="a safety profile (.safety.json): the plan must stay in its envelope",
+        help="a safety profile (.safety.json): the plan must stay in its envelope (default: the "
+        "envelope in force, the GUI's)",
     )
     r.add_argument(
         "--robot-profile",
@@ -194,6 +195,8 @@ def cmd_run(ctx: CliContext) -> ExitCode:
     try:
         if getattr(args, "safety", None):
             envelope = load_profile(args.safety).envelope
+        elif ctx.safety is not None:  # the envelope in force, the GUI's (app/cli/guard.py)
+            envelope = ctx.safety.envelope
         model = robot_model(getattr(args, "robot_profile", None))
     except TeachPadError as exc:
         ctx.error(str(exc))
@@ -256,9 +259,15 @@ class _HaltOnFreshLink:
         stop_on_a_fresh_link(self._client)
 
 
+#: The checks that refuse a valid plan (FAILED): the robot's reach, and the safety envelope (a
+#: step or a move out of it is refused with the same code).
+REFUSAL_CODES = REACH_CODES | {IssueCode.OUTSIDE_ENVELOPE}
+
+
 def _refusal_code(errors: list[PlanIssue]) -> ExitCode:
-    """Only reach errors: the robot cannot do a valid plan (FAILED); any other: USAGE."""
-    return ExitCode.FAILED if all(i.code in REACH_CODES for i in errors) else ExitCode.USAGE
+    """Only reach and envelope errors: the robot or the envelope refuses a valid plan (FAILED);
+    any other: USAGE."""
+    return ExitCode.FAILED if all(i.code in REFUSAL_CODES for i in errors) else ExitCode.USAGE
 
 
 def _refusal_why(errors: list[PlanIssue], code: ExitCode) -> str:
@@ -266,6 +275,8 @@ def _refusal_why(errors: list[PlanIssue], code: ExitCode) -> str:
         return ""
     if any(i.code is IssueCode.MODEL_DISAGREES for i in errors):
         return " (the robot model disagrees with the controller)"
+    if all(i.code is IssueCode.OUTSIDE_ENVELOPE for i in errors):
+        return " (outside the safety envelope)"
     return " (out of the robot model's reach)"
 
 

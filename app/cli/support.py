@@ -11,9 +11,8 @@ log files, recorded traffic). ``audit`` prints or exports the audit trail, filte
 many of the records shown are writes whose outcome is unknown (result ``unknown``: the answer or
 the controller's outcome was never recorded, or the controller's outcome could not be told).
 
-teachpad-cli is an administrator's tool: whoever has a shell on the pendant PC can read and
-write every file TeachPad keeps, so a ``--role`` switch would protect nothing. Roles guard the
-GUI; the role store itself is guarded by the administrator's password here too.
+Once the administrator has a password, the CLI's writing commands act as a role
+(app/cli/guard.py); the role store itself is guarded by the administrator's password here.
 """
 
 from __future__ import annotations
@@ -58,8 +57,9 @@ AUDIT_RESULTS = (
 )
 
 ADMIN_NOTE = (
-    "teachpad-cli is an administrator's tool: it is not limited by TeachPad's roles "
-    "(anyone with a shell can read and write TeachPad's files)."
+    "Once the administrator has a password, teachpad-cli's writing commands act as a role "
+    "(--role, TEACHPAD_ROLE, TEACHPAD_PASSWORD; see teachpad-cli --help); without one it acts as "
+    "administrator."
 )
 
 ADMIN_PASSWORD_ENV = "TEACHPAD_ADMIN_PASSWORD"

@@ -50,6 +50,7 @@ from app.errors import (
 from app.link.busy import BusyBackoff, is_busy, retry_busy
 from app.link.checks import check_enum, check_float, check_floats, check_int, check_tool
 from app.link.command_client import CommandClient
+from app.link.line_retry import LINE_ERRORS, LineRetry, retry_line
 from app.link.register_client import RegisterClient
 from app.link.stats import LinkStats
 from app.link.tracker import CommandTracker, command_text
@@ -144,9 +145,10 @@ class RobotClient(CommandClient):
         self._auto_for("go to zero", status, switch_to_auto)
         before = before or self.read_pose()
         self.check_no_foreign_master("go to zero")
+        sent = time.monotonic()  # a sign of another master from here on overlaps it
         axes = tuple(range(registers.NUM_AXES_TOTAL)) if axis is None else (value,)
         watch = MotionWatch(
-            None, f"go to zero ({which})", before, time.monotonic(), operation="go to zero", zero_axes=axes
+            None, f"go to zero ({which})", before, sent, operation="go to zero", zero_axes=axes
         )
         return self._watching(watch, registers.REG_GO_ZERO, value)
 
@@ -177,11 +179,12 @@ class RobotClient(CommandClient):
         before = before or self.read_pose()
         self._write(registers.REG_PROGRAM_ID, [program_id, int(motion), cycles, speed_ratio])
         self.check_no_foreign_master("run program")
+        sent = time.monotonic()  # a sign of another master from here on overlaps it
         watch = MotionWatch(
             RunCommand.RUN_PROGRAM,
             f"run program {program_id}",
             before,
-            time.monotonic(),
+            sent,
             operation="run program",
             program=program_id,
         )
@@ -201,8 +204,12 @@ class RobotClient(CommandClient):
         raise ControllerBusy(text, params={"operation": operation})
 
     def _watching(self, watch: MotionWatch, register: int, value: int) -> MotionWatch:
-        """Send the trigger ``register`` <- ``value`` of the command ``watch`` tells the end of."""
+        """Send the trigger ``register`` <- ``value`` of the command ``watch`` tells the end of
+        (a sign of another master before its end makes it unknown: ``watch.foreign``)."""
+        watch.foreign = self.foreign
         self.send_trigger(register, value, watch)
+        self.last_watch = watch
+        return watch
         self.last_watch = watch
         return watch
 
@@ -241,8 +248,8 @@ class RobotClient(CommandClient):
         return before, before_pose
 
     def _write_tool(self, tool: int) -> None:
-        if self._tool_cache != tool:
-            self._write_floats(registers.GV_TOOL_FRAME, [float(tool)])
+        if self._tool_cache != tool:  # a value register: written again on a noisy line (read back first)
+            self._write_floats(registers.GV_TOOL_FRAME, [float(tool)], repeatable=True)
             self._tool_cache = tool
 
     def _write_user_frame(self, user: int) -> None:
@@ -400,7 +407,13 @@ class RobotClient(CommandClient):
         if not items or (halted is not None and halted()):
             return results
         backoff = BusyBackoff(halted, between)  # busy before the first point: the status read, GV245
-        status, _ = retry_busy(lambda: self._prepare(RunCommand.CREATE_POINT), backoff)
+        # a damaged frame there: prepared again (its status read tells whether a 444 <- auto took)
+        line = LineRetry(
+            self.settings, timing.LINE_POINT_RETRIES, halted, timeouts=timing.LINE_POINT_TIMEOUT_RETRIES
+        )
+        status, _ = retry_busy(
+            lambda: retry_line(lambda: self._prepare(RunCommand.CREATE_POINT), line), backoff
+        )
         retry_busy(lambda: self._write_tool(tool), backoff)
         kind = CommandKind.CREATE_POINT
         total = len(items)
@@ -419,7 +432,9 @@ class RobotClient(CommandClient):
                 if staged == nxt or (halted is not None and halted()):
                     return  # staged already (a busy retry); a stop or cancel is pending
                 try:
-                    self._write_floats(block_of(nxt), items[nxt][1])
+                    self._write_floats(block_of(nxt), items[nxt][1], repeatable=True, halted=halted)
+                except LINE_ERRORS:
+                    return  # not known to be there: written again before its point is created
                 except ModbusExceptionError as exc:
                     # busy: staged after the result instead. Refused: the point in flight goes on,
                     # and the next poses go into the first block, each after the previous result
@@ -440,6 +455,12 @@ class RobotClient(CommandClient):
                     meanwhile=meanwhile,
                     between=between,
                     backoff=BusyBackoff(halted, between),
+                    line=LineRetry(
+                        self.settings,
+                        timing.LINE_POINT_RETRIES,
+                        halted,
+                        timeouts=timing.LINE_POINT_TIMEOUT_RETRIES,
+                    ),
                 )
             except (
                 LinkError,
@@ -479,17 +500,29 @@ class RobotClient(CommandClient):
         meanwhile: Callable[[], None] | None,
         between: Callable[[], None] | None,
         backoff: BusyBackoff,
+        line: LineRetry,
     ) -> tuple[CommandResult, ControllerStatus]:
         """One point of :meth:`upload_points`: its pose (unless staged), GV200-202, 440 and the status
         reads to its result; the result and the last status read. A *busy* answer to any of them
         (Modbus exception 6) sends the whole point again after ``backoff``'s pause, within its
-        budget (the same point at the same pose: idempotent); any other error is raised."""
+        budget (the same point at the same pose: idempotent); so does a frame damaged on a serial
+        line (:mod:`app.link.line_retry`), at once, within ``line``'s budget, after a fresh status
+        read (the "before" of its new command); any other error is raised. Its value registers
+        (the pose, GV200-202) are read back after a damaged answer before they are written again."""
+        fresh = False  # a status read before the command: the point is sent again after a damaged frame
         while True:
             tracker: CommandTracker | None = None
             try:
+                if fresh:
+                    status = self.read_status()
                 if write_pose:
-                    self._write_floats(block, values)
-                self._write_floats(registers.GV_PARAM0, [float(point_id), 1.0, float(block)])
+                    self._write_floats(block, values, repeatable=True, halted=line.halted)
+                self._write_floats(
+                    registers.GV_PARAM0,
+                    [float(point_id), 1.0, float(block)],
+                    repeatable=True,
+                    halted=line.halted,
+                )
                 self._sent_points[point_id] = (values[0], values[1], values[2])
                 tracker = self.begin_command(RunCommand.CREATE_POINT, status, None)
                 result = self.wait(tracker, raise_errors=False, meanwhile=meanwhile, between=between)
@@ -497,6 +530,9 @@ class RobotClient(CommandClient):
             except (LinkError, ResponseTimeout, MalformedResponse, ModbusExceptionError) as exc:
                 if tracker is not None:  # its command was answered: what it did is not known
                     tracker.unknown(time.monotonic(), exc)
+                if line.may_retry(exc):  # the same point at the same pose, at once: idempotent
+                    write_pose = fresh = True
+                    continue
                 if not backoff.may_retry(exc):
                     raise
                 busy = exc

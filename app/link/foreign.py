@@ -32,10 +32,11 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from app import timing
+from app.link.outcome import UNKNOWN_ADVICE
 from app.protocol.enums import STATUS_INITIAL, STATUS_SENTINEL, MoveStatus
 from app.safety.audit import AuditLog
 
-__all__ = ["ForeignMasterWatch", "ForeignSighting", "audit_sighting"]
+__all__ = ["ForeignMasterWatch", "ForeignSighting", "audit_sighting", "overlapped_text"]
 
 #: GV291 values that do not end a command of ours (the sentinel is ours, 0 shows before a result)
 _NOT_FINAL = frozenset({STATUS_INITIAL, STATUS_SENTINEL, int(MoveStatus.MOVING)})
@@ -163,10 +164,24 @@ class ForeignMasterWatch:
             taken, self._sightings = self._sightings, []
         return taken
 
+    def seen_since(self, moment: float) -> bool:
+        """True when another master was seen at or after ``moment`` (monotonic): a command sent
+        then cannot tell its own end from the other master's."""
+        seen = self.last_seen
+        return seen is not None and seen >= moment
+
     def seen_within(self, now: float, window: float) -> bool:
         """True when another master was seen less than ``window`` seconds before ``now``."""
         seen = self.last_seen
         return seen is not None and now - seen < window
+
+
+def overlapped_text(command: str) -> str:
+    """What a command whose end came while another master was seen says (its outcome is unknown)."""
+    return (
+        f"{command}: another Modbus master was seen while it ran, so its result may be the other "
+        f"master's: {UNKNOWN_ADVICE}"
+    )
 
 
 def audit_sighting(audit: AuditLog | None, sighting: ForeignSighting) -> None:

@@ -12,13 +12,14 @@ under way is refused.
 from __future__ import annotations
 
 import dataclasses
+import logging
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
 from app import timing
-from app.errors import InvalidInput, Reason
+from app.errors import InvalidInput, MalformedResponse, ModbusExceptionError, Reason, ResponseTimeout
 from app.link.client import RobotClient, StepFrame
 from app.link.host import WorkerHost
 from app.link.tracker import CommandTracker
@@ -28,8 +29,16 @@ from app.protocol.enums import ProgramMotionMode
 
 __all__ = ["ActiveCommand", "Completion", "MotionCommands", "MotionTracker"]
 
+_log = logging.getLogger(__name__)
+
+#: A status read that failed without the link going down (busy, no answer in time, a bad answer)
+_READ_ERRORS = (ModbusExceptionError, ResponseTimeout, MalformedResponse)
+
 
 class Completion(Protocol):
+    @property
+    def deadline(self) -> float: ...
+
     def update(self, status: ControllerStatus, pose: Pose | None, now: float) -> CommandResult | None: ...
 
     def stopped(self, now: float) -> CommandResult: ...
@@ -128,7 +137,16 @@ class MotionCommands:
         host = self._host
         deadline = time.monotonic() + timing.ACK_SPIN
         while True:
-            status = client.read_status(timeout=client.settings.effective_poll_timeout)
+            try:
+                status = client.read_status(timeout=client.settings.effective_poll_timeout)
+            except _READ_ERRORS as exc:
+                # the command was taken (its write answered): a status read that fails does not
+                # make it failed; the polls follow it (retried, and the link's own rules for a
+                # controller that stays silent or busy: unknown when the link goes down)
+                _log.info(
+                    "%s: status read after the command failed (%s); the polls follow it", tracker.text, exc
+                )
+                return
             now = time.monotonic()
             if tracker.update(status, None, now) is not None or tracker.code_left_pre or now >= deadline:
                 return

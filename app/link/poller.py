@@ -47,6 +47,7 @@ class Poller:
         self._last_alarms: int | None = None
         self._next_clock = 0.0
         self._error: str | None = None  # the last poll error reported (once per distinct error)
+        self._unread_since: float | None = None  # polls failing since (monotonic) under a command
         self.last_poll = 0.0  # monotonic time of the last poll attempt
         self.rtt = RttMeter(timing.RTT_REPORT_PERIOD)
         self.stats = LinkStatsReporter(timing.RTT_REPORT_PERIOD)
@@ -61,6 +62,7 @@ class Poller:
     def reset(self, now: float) -> None:
         """A link just came up."""
         self._error = None
+        self._unread_since = None
         self._next_clock = now + timing.CLOCK_POLL_PERIOD
         self.rtt.period = self.stats.period = timing.RTT_REPORT_PERIOD
         self.rtt.reset(now)
@@ -121,6 +123,7 @@ class Poller:
                 canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock
         except ResponseTimeout as exc:
             self._report_error(exc)
+            self._command_unread(exc)
             host.supervisor.poll_silent(exc, time.monotonic())
             self._report_stats()
             return
@@ -129,14 +132,17 @@ class Poller:
             # (a TCP link is reopened by the next request); none of its values are published;
             # LINK_LOSS_POLLS of them in a row take the link down like any failed transaction.
             self._report_error(exc)
+            self._command_unread(exc)
             host.supervisor.transport_failed(exc)
             self._report_stats()
             return
         except TeachPadError as exc:
             self._report_error(exc)
+            self._command_unread(exc)
             return
         answered = time.monotonic()
         self._error = None
+        self._unread_since = None
         host.supervisor.poll_answered()
         if not host.link_up:
             return
@@ -160,6 +166,26 @@ class Poller:
         if rtt is not None:
             host.publish_rtt(rtt)
         self._report_stats()
+
+    def _command_unread(self, exc: TeachPadError) -> None:
+        """A poll failed while a command is followed: its outcome is not told by it. The polls go
+        on reading; once they failed for ``timing.OUTCOME_READ_BUDGET`` and the command's own time
+        ran out, it ends *unknown* ("sent; the outcome is unknown -- check the robot ..."), never
+        failed (issue 19 section 3; the CLI's ``CommandClient.follow`` keeps the same rule)."""
+        host = self._host
+        active = host.motion.active
+        if active is None:
+            self._unread_since = None
+            return
+        now = time.monotonic()
+        if self._unread_since is None:
+            self._unread_since = now
+        completion = active.completion
+        if now < max(self._unread_since + timing.OUTCOME_READ_BUDGET, completion.deadline):
+            return
+        host.motion.take()
+        self._unread_since = None
+        host.emit_result(completion.unknown(now, exc), active.request_id)
 
     def _report_foreign(self, client: RobotClient) -> None:
         """Another master's signs seen by this poll (app/link/foreign.py): logged, audited, published."""

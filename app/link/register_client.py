@@ -10,7 +10,9 @@ pose and status blocks are read and decoded here. Not thread-safe: one thread ow
 * Control registers 440-445 are written with 0x06 only; raw multi-register writes that touch
   them are refused (:class:`InvalidInput`).
 * A request that timed out or got a malformed answer closes the link (the next request
-  reconnects), so a late answer is never read as the next request's.
+  reconnects), so a late answer is never read as the next request's; on a serial line the input
+  is dropped until the line is quiet, and what is safe to repeat is sent again
+  (:mod:`app.link.line_retry`: every read; a write of value registers when asked, read back first).
 * Traffic observers are called synchronously in the client's thread, inside the request:
   keep them short (the GUI should only queue the record).
 """
@@ -21,13 +23,15 @@ import contextlib
 import functools
 import logging
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Self
 
+from app import timing
 from app.errors import InvalidInput, WriteBlocked
 from app.link.checks import check_float, check_int, check_settings, range_name
 from app.link.decode import decode_pose, decode_status
 from app.link.foreign import ForeignMasterWatch
+from app.link.line_retry import LINE_ERRORS, LineRetry, on_noisy_line
 from app.link.stats import LinkStats
 from app.link.transport import ConnectionSettings, TrafficObserver, Transport
 from app.models import ControllerStatus, Pose
@@ -84,6 +88,7 @@ class RegisterClient:
         # GUI's link and the CLI set it, app/link/foreign.py)
         self.watch_shared_every: float | None = None
         self._shared_read_at = -1e9
+        self._noisy_line = on_noisy_line(settings)  # damaged frames are sent again (line_retry.py)
 
     # -- connection ----------------------------------------------------------------------
     def connect(self) -> None:
@@ -124,8 +129,28 @@ class RegisterClient:
 
     # -- the transport: every answer is checked against its request ----------------------
     def _read(self, address: int, count: int, timeout: float | None = None) -> list[int]:
+        """0x03; on a serial line a read whose frame was damaged is sent again (a read changes
+        nothing), up to :data:`app.timing.LINE_READ_RETRIES` times."""
         timeout = self._io_timeout if timeout is None else timeout
-        return self._transport.read(_what("read of", address, count), address, count, timeout)
+        what = _what("read of", address, count)
+        try:
+            return self._transport.read(what, address, count, timeout)
+        except LINE_ERRORS as exc:
+            if not self._noisy_line:
+                raise
+            return self._read_again(what, address, count, timeout, exc)
+
+    def _read_again(
+        self, what: str, address: int, count: int, timeout: float | None, error: BaseException
+    ) -> list[int]:
+        """A read whose frame was damaged on the serial line, sent again within its budget."""
+        retry = LineRetry(self.settings, timing.LINE_READ_RETRIES)
+        while retry.may_retry(error):
+            try:
+                return self._transport.read(what, address, count, timeout)
+            except LINE_ERRORS as exc:
+                error = exc
+        raise error
 
     @contextlib.contextmanager
     def io_timeout(self, seconds: float) -> Iterator[None]:
@@ -215,8 +240,56 @@ class RegisterClient:
         link timeout or not at all (the decision of ``app.cli.context.stop_on_a_fresh_link``)."""
         return self.writes_settled and self.write_answered_at < moment and self.write_lost_until < moment
 
-    def _write_floats(self, gv: int, values: Sequence[float], timeout: float | None = None) -> None:
-        self._write(registers.gv_reg(gv), encode_floats(values, self.settings.word_order), timeout=timeout)
+    def _write_floats(
+        self,
+        gv: int,
+        values: Sequence[float],
+        timeout: float | None = None,
+        *,
+        repeatable: bool = False,
+        halted: Callable[[], bool] | None = None,
+    ) -> None:
+        """GVs from ``gv`` on (one 0x10). ``repeatable``: they only hold values (no motion, no
+        mode) and may be written again on a noisy line (:meth:`_write_repeatable`)."""
+        regs = encode_floats(values, self.settings.word_order)
+        if repeatable and self._noisy_line:
+            self._write_repeatable(registers.gv_reg(gv), regs, timeout, halted)
+        else:
+            self._write(registers.gv_reg(gv), regs, timeout=timeout)
+
+    def _write_repeatable(
+        self, address: int, regs: Sequence[int], timeout: float | None, halted: Callable[[], bool] | None
+    ) -> None:
+        """A write of value registers over a noisy serial line: after a damaged frame (its answer
+        or its request) they are read back -- the values there: it took; else written again at
+        once, up to :data:`app.timing.LINE_WRITE_RETRIES` times (not once ``halted``). Nothing else
+        is written in between: a repeated write never lands after a newer one."""
+        retry = LineRetry(self.settings, timing.LINE_WRITE_RETRIES, halted)
+        while True:
+            try:
+                self._write(address, regs, timeout=timeout)
+                return
+            except LINE_ERRORS as exc:
+                if not retry.may_retry(exc):
+                    raise
+            if self._read_back_holds(address, regs):
+                return
+
+    def _read_back_holds(self, address: int, regs: Sequence[int]) -> bool:
+        """After a write whose frame was damaged: do the registers hold what it wrote? Yes: the
+        write took (its answer was damaged), noted as answered for the foreign-master watch. (Its
+        audit record keeps the error its answer met: what the wire did.)"""
+        try:
+            held = self._read(address, len(regs))
+        except LINE_ERRORS:
+            return False  # not known: written again
+        if held != [int(v) & 0xFFFF for v in regs]:
+            return False
+        _log.info("%s: its answer was damaged; read back, it took", _what("write to", address, len(regs)))
+        self.foreign.note_registers(address, regs, stored=True)
+        self.write_answered_at = time.monotonic()
+        self.writes_settled = True
+        return True
 
     def _write_control(self, register: int, value: int) -> None:
         self._write(register, [value], single=True)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import select
 import socket
+import time
 from typing import TYPE_CHECKING, Any
 
 from app.errors import LinkError
@@ -189,3 +190,17 @@ class SerialStream:
         waiting = int(self._port.in_waiting)
         self._port.reset_input_buffer()
         return waiting
+
+    def settle(self, quiet: float, limit: float) -> int:
+        """Drop what arrives until nothing has for ``quiet`` s (at most ``limit`` s in all: a
+        babbling line); the bytes dropped. After a bad frame: the rest of it is on the wire still."""
+        port = self._port
+        end = time.monotonic() + limit
+        dropped = self.drain()
+        port.timeout = quiet
+        while time.monotonic() < end:
+            data = port.read(max(1, int(port.in_waiting)))
+            if not data:
+                break
+            dropped += len(data)
+        return dropped

@@ -62,7 +62,7 @@ from app.errors import (
     TeachPadError,
 )
 from app.link.arrival import POSE_EPSILON, arrived, pose_moved
-from app.link.foreign import ForeignMasterWatch
+from app.link.foreign import ForeignMasterWatch, overlapped_text
 from app.link.outcome import UNKNOWN_ADVICE, OutcomeHook
 from app.link.pacer import ResultPacer
 from app.models import CommandResult, ControllerStatus, Pose
@@ -512,11 +512,8 @@ class CommandTracker:
         reason: Reason | None = None,
     ) -> CommandResult:
         foreign = self.foreign
-        if ok and foreign is not None and foreign.last_seen is not None and foreign.last_seen >= self.started:
-            message = (
-                f"{self.text}: another Modbus master was seen while it ran, so its result may be the "
-                f"other master's: {UNKNOWN_ADVICE}"
-            )
+        if ok and foreign is not None and foreign.seen_since(self.started):
+            message = overlapped_text(self.text)
             self.error = OutcomeUnknown(message, params=self._args(foreign=True))
             ok, reason = False, self.error.as_reason()
         details = self._details(now)

@@ -13,12 +13,14 @@ answer); :class:`MalformedResponse` (anything else that arrived, including an an
 or with bytes too many); :class:`ResponseTimeout` (silence); :class:`LinkError` (no link).
 After a malformed answer or a timeout the link resynchronises: a TCP link is dropped (the next
 request reopens it, so a late or garbled tail is never read as the next answer); a serial line
-has its input flushed. Before every request, bytes that arrived unasked (stray bytes after a
-good answer) are flushed, so they cannot poison the next answer. Modbus TCP: a whole answer that
-arrives first carrying the transaction id of one of the connection's last requests (a duplicate,
-a gateway's late answer) is dropped and counted as a resync; the request's own answer is read
-after it, and no answer is ever taken but by its own transaction id. (RTU has no transaction id:
-a late answer of the same shape cannot be told from the own one there.)
+has its input dropped until the line has been quiet for :data:`app.timing.RTU_RESYNC_QUIET` (or
+twice 3.5 characters), so the rest of a damaged answer still on the wire is dropped too. Before
+every request, bytes that arrived unasked (stray bytes after a good answer) are flushed, so they
+cannot poison the next answer. Modbus TCP: a whole answer that arrives first carrying the
+transaction id of one of the connection's last requests (a duplicate, a gateway's late answer) is
+dropped and counted as a resync; the request's own answer is read after it, and no answer is ever
+taken but by its own transaction id. (RTU has no transaction id: a late answer of the same shape
+cannot be told from the own one there.)
 
 Not thread-safe: one thread owns a transport. Traffic observers are called synchronously in
 that thread, inside the request: keep them short.
@@ -159,6 +161,7 @@ class Transport:
             streams.SerialStream(settings) if self._serial else streams.TcpStream(settings)
         )
         self._peer_closed: type[Exception] = streams.PeerClosed  # the other end closed the stream
+        self._serial_stream = streams.SerialStream
         self._on_link_change = on_link_change or (lambda: None)
         self._observers: list[TrafficObserver] = []
         self._observing = False  # checked first on the hot path
@@ -221,8 +224,12 @@ class Transport:
         """Get back in step after a malformed answer or a timeout."""
         self._count("resyncs")
         _log.debug("resync after %s", why)
-        if self._serial and self._stream.is_open:
-            self._stream.drain()
+        if isinstance(self._stream, self._serial_stream) and self._stream.is_open:
+            # the rest of a damaged answer may still be on the wire: drop what arrives until the
+            # line is quiet, so it is never read as the start of the next answer (line_retry.py)
+            baud = max(self.settings.baudrate, 1)
+            quiet = max(timing.RTU_RESYNC_QUIET, 2 * 3.5 * 11 / baud)
+            self._stream.settle(quiet, self.settings.timeout)
         else:
             self.close()
 

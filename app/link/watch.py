@@ -10,7 +10,9 @@ alike. Its results sort into the outcomes of :mod:`app.link.outcome`:
   the joints already read zero: then done, "already at zero");
 * moved, then program state stopped with the pose standing still: done -- for go to zero only
   when the joints asked for read zero (when the controller reports joints), else stopped short;
-* the host's own stop: stopped; reads that fail or a link that goes down: unknown.
+* the host's own stop: stopped; reads that fail or a link that goes down: unknown;
+* seen done while another Modbus master was seen since it was sent (:mod:`app.link.foreign`): unknown
+  -- the motion and the stop seen may be the other master's doing (issue 19).
 
 A command sent while the controller already runs a program cannot be told by motion: the client
 does not send it (:class:`~app.errors.ControllerBusy`, in :mod:`app.link.client`).
@@ -23,6 +25,7 @@ from collections.abc import Callable
 from app import timing
 from app.errors import AlarmRaised, CommandStopped, OutcomeUnknown, Reason, TeachPadError
 from app.link.arrival import pose_moved
+from app.link.foreign import ForeignMasterWatch, overlapped_text
 from app.link.outcome import UNKNOWN_ADVICE, OutcomeHook
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import JOINT_AXIS_NAMES, ProgramState, RunCommand, alarm_names
@@ -77,6 +80,9 @@ class MotionWatch:
         self.result: CommandResult | None = None
         self.error: TeachPadError | None = None
         self.note: OutcomeHook | None = None  # the audit's hook (app/link/outcome.py)
+        # the sending client's watch for another master (app/link/foreign.py): what was seen done
+        # while another master was seen cannot be told from its doing, it ends unknown
+        self.foreign: ForeignMasterWatch | None = None
 
     @property
     def finished(self) -> bool:
@@ -98,6 +104,12 @@ class MotionWatch:
     def _end(
         self, ok: bool, message: str, now: float, reason: Reason, error: TeachPadError | None = None
     ) -> CommandResult:
+        foreign = self.foreign
+        if ok and foreign is not None and foreign.seen_since(self.started):
+            # what it was seen to do (moved and stood still, at zero) may be the other master's
+            message = overlapped_text(self.text)
+            error = OutcomeUnknown(message, params=self._args(foreign=True))
+            ok, reason = False, error.as_reason()
         self.error = error
         self.result = CommandResult(
             self.command, None, None, ok, message, {"elapsed": now - self.started}, reason=reason

@@ -36,8 +36,8 @@ surrogates, no numbers beyond float range).
 
 The project in memory (:class:`Project`) lives in :mod:`app.points.project_model`; this module
 is the file format and reads it, :mod:`app.points.project_write` writes it. Saving is atomic
-(:mod:`app.points.atomic`); autosave and recovery live in :mod:`app.points.autosave`, the
-one-instance lock in :mod:`app.points.lock`.
+(:mod:`app.points.atomic`); autosave and recovery live in :mod:`app.points.autosave` (import
+them from there), the one-instance lock in :mod:`app.points.lock`.
 """
 
 from __future__ import annotations
@@ -89,7 +89,6 @@ from app.points.project_write import (
 PROJECT_SUFFIX = ".teachpad.json"
 
 __all__ = [
-    "AUTOSAVE_SUFFIX",
     "FORMAT_NAME",
     "FORMAT_VERSION",
     "MAX_FILE_BYTES",
@@ -99,10 +98,6 @@ __all__ = [
     "ProjectTooLarge",
     "UploadRecord",
     "atomic_write_bytes",
-    "autosave_path",
-    "default_autosave_dir",
-    "discard_autosave",
-    "find_autosave",
     "load_project",
     "parse_project",
     "project_bytes",
@@ -110,7 +105,6 @@ __all__ = [
     "project_to_dict",
     "project_to_json",
     "read_points_csv",
-    "save_autosave",
     "save_project",
     "write_points_csv",
 ]
@@ -440,15 +434,3 @@ def write_points_csv(path: str | os.PathLike[str], points: Iterable[TempPoint], 
     Chinese names as UTF-8."""
     text = points_to_csv(points)
     atomic_write_bytes(path, (("\ufeff" + text) if bom else text).encode("utf-8"))
-
-
-# Older imports (``from app.points.project import find_autosave``) keep working. Imported last:
-# app.points.autosave refers back to this module.
-from app.points.autosave import (  # noqa: E402
-    AUTOSAVE_SUFFIX,
-    autosave_path,
-    default_autosave_dir,
-    discard_autosave,
-    find_autosave,
-    save_autosave,
-)

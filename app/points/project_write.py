@@ -2,11 +2,19 @@
 
 The format is described in :mod:`app.points.project` (which reads it and re-exports these
 names); whatever loading accepts, this writes back.
+
+Every writer works from a :class:`ProjectSnapshot`: an immutable copy taken in the thread that
+owns the project (the points, segments and upload records are frozen already, so the copy is a
+few tuples of references: milliseconds for a 58 MB project), which another thread may then turn
+into the file's text while the project changes (the autosave, :mod:`app.points.autosave`).
 """
 
 from __future__ import annotations
 
 import json
+import types
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 from app.errors import InvalidInput
@@ -45,18 +53,58 @@ def _segment_to_dict(s: Segment) -> dict[str, Any]:
     return d
 
 
-def project_to_dict(project: Project) -> dict[str, Any]:
+@dataclass(frozen=True)
+class PlanSnapshot:
+    name: str
+    loops: int
+    segments: tuple[Segment, ...]
+
+
+@dataclass(frozen=True)
+class ProjectSnapshot:
+    """What the project file holds, at one revision, safe to read from any thread."""
+
+    name: str
+    description: str
+    created: str
+    modified: str
+    points: tuple[TempPoint, ...]
+    upload_history: Mapping[int, UploadRecord]  # a read-only copy
+    plans: tuple[PlanSnapshot, ...]
+    revision: int
+
+
+def take_snapshot(project: Project) -> ProjectSnapshot:
+    """An immutable copy of ``project`` (call it in the thread that changes the project)."""
+    return ProjectSnapshot(
+        name=project.name,
+        description=project.description,
+        created=project.created,
+        modified=project.modified,
+        points=project.ledger.snapshot(),
+        upload_history=types.MappingProxyType(dict(project.upload_history)),
+        plans=tuple(PlanSnapshot(p.name, p.loops, tuple(p.segments)) for p in project.plans),
+        revision=project.revision,
+    )
+
+
+def _snapshot_of(project: Project | ProjectSnapshot) -> ProjectSnapshot:
+    return project if isinstance(project, ProjectSnapshot) else take_snapshot(project)
+
+
+def project_to_dict(project: Project | ProjectSnapshot) -> dict[str, Any]:
+    snap = _snapshot_of(project)
     return {
         "format": FORMAT_NAME,
         "version": FORMAT_VERSION,
-        "name": project.name,
-        "description": project.description,
-        "created": project.created,
-        "modified": project.modified,
-        "points": [_point_to_dict(p, project.upload_history.get(p.id)) for p in project.ledger],
+        "name": snap.name,
+        "description": snap.description,
+        "created": snap.created,
+        "modified": snap.modified,
+        "points": [_point_to_dict(p, snap.upload_history.get(p.id)) for p in snap.points],
         "plans": [
             {"name": p.name, "loops": p.loops, "segments": [_segment_to_dict(s) for s in p.segments]}
-            for p in project.plans
+            for p in snap.plans
         ],
     }
 
@@ -65,25 +113,46 @@ def _dumps(value: object) -> str:
     return json.dumps(value, ensure_ascii=False, allow_nan=False)
 
 
-def _json_list(items: list[str], indent: str) -> str:
-    if not items:
-        return "[]"
-    return "[\n" + ",\n".join(indent + "  " + item for item in items) + "\n" + indent + "]"
+def _json_list(items: Iterable[str], indent: str) -> Iterator[str]:
+    """A JSON list laid out one item a line, in pieces (the items' text as they come)."""
+    first = True
+    for item in items:
+        yield ("[\n" if first else ",\n") + indent + "  " + item
+        first = False
+    yield "[]" if first else "\n" + indent + "]"
 
 
-def project_to_json(project: Project) -> str:
+def _project_pieces(snap: ProjectSnapshot) -> Iterator[str]:
+    """The file's text in pieces: one per point and per segment (each piece's dict is freed at
+    once, and no single step works on the whole text: a writer thread lets the GUI thread run)."""
+    head = {
+        "format": FORMAT_NAME,
+        "version": FORMAT_VERSION,
+        "name": snap.name,
+        "description": snap.description,
+        "created": snap.created,
+        "modified": snap.modified,
+    }
+    yield "{\n" + ",\n".join(f"  {_dumps(k)}: {_dumps(v)}" for k, v in head.items())
+    yield ',\n  "points": '
+    history = snap.upload_history
+    yield from _json_list((_dumps(_point_to_dict(p, history.get(p.id))) for p in snap.points), "  ")
+    yield ',\n  "plans": '
+    first = True
+    for plan in snap.plans:
+        opening = "[\n" if first else ",\n"
+        yield f'{opening}    {{"name": {_dumps(plan.name)}, "loops": {_dumps(plan.loops)}, "segments": '
+        yield from _json_list((_dumps(_segment_to_dict(s)) for s in plan.segments), "    ")
+        yield "}"
+        first = False
+    yield "[]" if first else "\n  ]"
+    yield "\n}\n"
+
+
+def project_to_json(project: Project | ProjectSnapshot) -> str:
     """The file's text: plain JSON laid out one point and one segment per line (readable,
     and a changed point is a one-line diff)."""
-    doc = project_to_dict(project)
-    lines = [f"  {_dumps(k)}: {_dumps(v)}" for k, v in doc.items() if k not in ("points", "plans")]
-    lines.append(f'  "points": {_json_list([_dumps(p) for p in doc["points"]], "  ")}')
-    plans = []
-    for plan in doc["plans"]:
-        head = ", ".join(f"{_dumps(k)}: {_dumps(v)}" for k, v in plan.items() if k != "segments")
-        segments = _json_list([_dumps(s) for s in plan["segments"]], "    ")
-        plans.append(f'{{{head}, "segments": {segments}}}')
-    lines.append(f'  "plans": {_json_list(plans, "  ")}')
-    return "{\n" + ",\n".join(lines) + "\n}\n"
+    return "".join(_project_pieces(_snapshot_of(project)))
 
 
 class ProjectTooLarge(InvalidInput):
@@ -101,11 +170,11 @@ class ProjectTooLarge(InvalidInput):
         self.size, self.limit = size, limit
 
 
-def project_bytes(project: Project) -> bytes:
+def project_bytes(project: Project | ProjectSnapshot) -> bytes:
     """The project's file as it would be written; :class:`ProjectTooLarge` when TeachPad could not
     read it back (checked before any write: :func:`~app.points.project.save_project`, the autosave,
     an import's check)."""
-    data = project_to_json(project).encode("utf-8")
+    data = b"".join(piece.encode("utf-8") for piece in _project_pieces(_snapshot_of(project)))
     limit = atomic.MAX_FILE_BYTES
     if len(data) > limit:
         raise ProjectTooLarge(len(data), limit)

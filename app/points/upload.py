@@ -31,12 +31,38 @@ class UploadOutcome:
     unconfirmed: bool = False  # ok, but the controller's status never changed (CommandResult.unconfirmed)
 
 
+@dataclass(frozen=True)
+class BootLost:
+    """The restart canary changed during an upload (``teachpad-cli points upload``): the controller
+    is not the boot the upload began on. ``value``: what the canary read (0: it restarted, a
+    restart clears GV0..GV99; another value: another host wrote it -- another master, or a restart
+    it armed again; either way nothing before it is proven). ``after``: the last point proven
+    created before it (None: none). ``suspects``: the points created or tried since the last good
+    read of the canary (one may have been created at a wiped, zero pose); ``repaired``: those of
+    them created again at their poses on the new boot and proven there; ``repair_error``: why the
+    rest were not (empty: all were)."""
+
+    value: float
+    after: int | None
+    suspects: tuple[int, ...] = ()
+    repaired: tuple[int, ...] = ()
+    repair_error: str = ""
+
+    @property
+    def restarted(self) -> bool:
+        return self.value == 0.0
+
+
 @dataclass
 class UploadReport:
     outcomes: list[UploadOutcome] = field(default_factory=list)
     aborted: str | None = None  # why the upload stopped early (link lost, stop requested)
     not_attempted: list[int] = field(default_factory=list)
     interrupted: bool = False  # ended by Ctrl-C
+    #: ids created and proven held by the boot the upload began on (a read of the restart canary
+    #: after their result still showed its token): what an upload record may keep
+    confirmed: list[int] = field(default_factory=list)
+    boot_lost: BootLost | None = None  # the controller restarted (or the canary changed) meanwhile
 
     @property
     def ok_count(self) -> int:

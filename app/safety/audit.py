@@ -77,6 +77,7 @@ from app.safety.audit_read import (
     read_records,
     result_label,
 )
+from app.safety.location import safety_location, user_data_dir
 
 __all__ = [  # the reader's names stay importable from here (app.safety.audit_read)
     "CSV_COLUMNS",
@@ -125,17 +126,13 @@ class FsyncPolicy(enum.Enum):
 
 def default_data_dir() -> Path:
     """Per-user data directory of TeachPad."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("LOCALAPPDATA") or Path.home() / "AppData" / "Local")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share")
-    return base / "teachpad"
+    return user_data_dir()
 
 
 def default_audit_dir() -> Path:
-    return default_data_dir() / "audit"
+    """The audit trail's folder: machine-wide when an administrator made one, else the user's
+    (:mod:`app.safety.location`; never beside a settings file)."""
+    return safety_location().audit_dir
 
 
 class AuditUnavailable(WriteBlocked):
@@ -483,13 +480,24 @@ _PREV_CHARS = len(',"prev":""') + 64  # what the chain adds to a line
 
 @contextlib.contextmanager
 def _locked(fd: int) -> Iterator[None]:
-    """An exclusive lock on the open file while one record is appended (POSIX; elsewhere none:
-    two writers at once may then break the chain, which the verifier shows)."""
-    try:
-        import fcntl
-    except ImportError:
-        yield
+    """An exclusive lock on the open file while one record is appended: ``flock`` on POSIX; on
+    Windows (no fcntl) a lock of the file's first byte with ``msvcrt.locking``, the same byte for
+    every writer whatever the file's length (the file is opened O_APPEND: each write goes to
+    the end wherever the position is). ``LK_LOCK`` retries for 10 s, then raises OSError: the
+    record is then not written, like any other failed append."""
+    if sys.platform == "win32":
+        import msvcrt
+
+        os.lseek(fd, 0, os.SEEK_SET)
+        msvcrt.locking(fd, msvcrt.LK_LOCK, 1)
+        try:
+            yield
+        finally:
+            os.lseek(fd, 0, os.SEEK_SET)
+            msvcrt.locking(fd, msvcrt.LK_UNLCK, 1)
         return
+    import fcntl
+
     fcntl.flock(fd, fcntl.LOCK_EX)
     try:
         yield

@@ -44,10 +44,11 @@ from app.link.transport import ConnectionSettings
 from app.points.atomic import atomic_write_bytes, read_settings_text, versioned_document
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
+from app.safety.location import REGISTER_PROFILE_NAME
 
 FORMAT = "teachpad-registers"
 VERSION = 1
-PROFILE_NAME = "register.profile.json"  # the profile in force, in the safety folder
+PROFILE_NAME = REGISTER_PROFILE_NAME  # the profile in force, in the safety folder (app.safety.location)
 PROFILE_SUFFIX = ".registers.json"  # profiles kept elsewhere (Save as / Load)
 _MAX_BYTES = 256 * 1024
 COMPLETION_MODES: tuple[str, ...] = ("auto", "sentinel", "observe")

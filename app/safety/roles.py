@@ -20,8 +20,6 @@ from __future__ import annotations
 
 import enum
 import json
-import os
-import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -30,6 +28,7 @@ from pathlib import Path
 from app.errors import InvalidInput, TeachPadError
 from app.points.atomic import atomic_write_bytes, read_limited
 from app.points.point import FileFormatError
+from app.safety.location import safety_location
 
 STORE_FORMAT = "teachpad-roles"
 STORE_VERSION = 1
@@ -81,6 +80,7 @@ class Action(enum.Enum):
     REGISTER_PROFILE = "change register profile"
     MANAGE_ROLES = "manage roles and passwords"
     SUPPORT_BUNDLE = "write a support bundle"
+    WRITE_REGISTERS = "write controller registers directly"  # teachpad-cli write: any GV, unchecked
 
 
 #: The least role that may do each action.
@@ -102,6 +102,7 @@ REQUIRED_ROLE: dict[Action, Role] = {
     Action.CONNECTION: Role.ADMINISTRATOR,
     Action.REGISTER_PROFILE: Role.ADMINISTRATOR,
     Action.MANAGE_ROLES: Role.ADMINISTRATOR,
+    Action.WRITE_REGISTERS: Role.ADMINISTRATOR,
 }
 
 
@@ -126,18 +127,13 @@ class WrongPassword(TeachPadError):
 
 
 def default_config_dir() -> Path:
-    """Per-user config directory of TeachPad."""
-    if sys.platform == "win32":
-        base = Path(os.environ.get("APPDATA") or Path.home() / "AppData" / "Roaming")
-    elif sys.platform == "darwin":
-        base = Path.home() / "Library" / "Application Support"
-    else:
-        base = Path(os.environ.get("XDG_CONFIG_HOME") or Path.home() / ".config")
-    return base / "teachpad"
+    """The folder of the role store, the envelope and the register profile: machine-wide when an
+    administrator made one, else the user's config folder (:mod:`app.safety.location`)."""
+    return safety_location().config_dir
 
 
 def default_store_path() -> Path:
-    return default_config_dir() / "roles.json"
+    return safety_location().roles
 
 
 @dataclass(frozen=True)

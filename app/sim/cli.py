@@ -18,6 +18,7 @@ from app.protocol.enums import Alarm
 from app.sim.config import GV291_MODES, TIMING_PROFILES, SimConfig
 from app.sim.guard import WATCHDOG_TIMEOUT
 from app.sim.server import SimController
+from app.version import VersionAction
 
 log = logging.getLogger(__name__)
 
@@ -55,6 +56,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=COMMANDS_HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    parser.add_argument("--version", action=VersionAction)
     parser.add_argument("--host", default="127.0.0.1", help="address to bind (default 127.0.0.1)")
     parser.add_argument("--port", type=int, default=5020, help="TCP port (default 5020, 0 = any free port)")
     parser.add_argument("--unit", type=int, default=1, help="Modbus unit id (default 1)")
@@ -117,6 +119,12 @@ def build_parser() -> argparse.ArgumentParser:
     serial.add_argument("--parity", choices=["N", "E", "O"], default="N", help="parity (default N)")
     serial.add_argument("--stopbits", type=int, choices=[1, 2], default=1, help="stop bits (default 1)")
     parser.add_argument("--no-stdin", action="store_true", help="do not read commands from stdin")
+    parser.add_argument(
+        "--stop-with-stdin",
+        action="store_true",
+        help="stop when stdin reaches its end (a parent's pipe closed: it went away); "
+        "with --no-stdin, for `teachpad --sim`",
+    )
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
     return parser
 
@@ -225,19 +233,14 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"teachpad-sim: {exc}", file=sys.stderr)
         return 1
     done = threading.Event()
-    previous: dict[signal.Signals, object] = {}
-    if threading.current_thread() is threading.main_thread():
-
-        def on_signal(signum: int, _frame: object) -> None:
-            log.info("signal %d: stopping", signum)
-            done.set()
-
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            previous[sig] = signal.signal(sig, on_signal)
+    previous = _stop_on_signals(done)
     # Announced only now: whoever waits for this line may stop us at once (SIGTERM), and before
     # the handler exists that would kill the process instead of stopping it cleanly.
     _say(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop")
 
+    if args.stop_with_stdin:
+        watch = threading.Thread(target=_wait_for_end_of_stdin, args=(done,), daemon=True)
+        watch.start()
     if not args.no_stdin:
 
         def read_stdin() -> None:
@@ -262,6 +265,43 @@ def main(argv: Sequence[str] | None = None) -> int:
             signal.signal(sig, handler)  # type: ignore[arg-type]
     _say("teachpad-sim stopped")
     return 0
+
+
+def _stop_on_signals(done: threading.Event) -> dict[signal.Signals, object]:
+    """Handlers that set ``done`` on the stop signals (main thread only: elsewhere Python cannot
+    install them); the handlers they replace, to put back at the end."""
+    previous: dict[signal.Signals, object] = {}
+    if threading.current_thread() is threading.main_thread():
+
+        def on_signal(signum: int, _frame: object) -> None:
+            log.info("signal %d: stopping", signum)
+            done.set()
+
+        for sig in _stop_signals():
+            previous[sig] = signal.signal(sig, on_signal)
+    return previous
+
+
+def _stop_signals() -> tuple[signal.Signals, ...]:
+    """The signals that stop the simulator cleanly: Ctrl-C and SIGTERM (``terminate()`` on POSIX;
+    on Windows ``terminate()`` is TerminateProcess, which no handler sees), plus Ctrl-Break on
+    Windows (SIGBREAK, the console's other stop key)."""
+    ctrl_break: signal.Signals | None = getattr(signal, "SIGBREAK", None)
+    return (signal.SIGINT, signal.SIGTERM) + ((ctrl_break,) if ctrl_break is not None else ())
+
+
+def _wait_for_end_of_stdin(done: threading.Event) -> None:
+    """``--stop-with-stdin``: the parent (``teachpad --sim``) holds the other end of our stdin;
+    when it goes away, however it goes (closed, killed, crashed), the pipe ends and so do we. The
+    file descriptor is read, not ``sys.stdin``: a wait inside sys.stdin's buffer holds its lock,
+    which the interpreter's exit after a Ctrl-C then cannot take ("Fatal Python error:
+    _enter_buffered_busy"). Portable: no signal to ourselves."""
+    try:
+        while os.read(0, 4096):
+            pass
+    except OSError:  # stdin closed or not readable: no parent to watch
+        pass
+    done.set()
 
 
 def _say(line: str) -> None:

@@ -104,6 +104,8 @@ class SimController:
         )
         self._move_unanswered: float | None = None  # when a move command not answered yet came
         self._wipe_general = False  # set by restart_controller(): clear GV0..GV99 on the next request
+        # restart_after_write(): (register, writes to go) -- the controller restarts after that write
+        self._restart_after: tuple[int, int] | None = None
         # bad input and the communication watchdog (app/sim/guard.py)
         self.events: list[SimEvent] = []
         self.bad_frames = BadFrames()
@@ -319,6 +321,7 @@ class SimController:
                     self._exception_after = None  # the exception rule applies from the next request on
                     self._arm_exception_window()
                     log.info("exception rule armed by the write to %d", armer)
+                self._restart_if_due(address, len(values))
             self._refresh(registers, start_address)
             status_reg = gv_reg(GV_COMMAND_STATUS)
             if set_values is None and address <= status_reg < address + count:
@@ -450,6 +453,23 @@ class SimController:
             self.status.release()
             self._wipe_general = True  # GV0..GV99 read 0 from the next request on
         log.info("controller restarted: temp points and GV0-GV99 wiped")
+
+    def restart_after_write(self, register: int, nth: int = 1) -> None:
+        """Restart the controller (:meth:`restart_controller`) right after the ``nth`` stored write
+        covering ``register`` from now on -- its answer still goes out, the next request finds the
+        controller restarted: e.g. between an upload's staged pose and its create point."""
+        with self.lock:
+            self._restart_after = (int(register), int(nth))
+
+    def _restart_if_due(self, address: int, count: int) -> None:
+        rule = self._restart_after  # (under the lock)
+        if rule is None or not address <= rule[0] < address + count:
+            return
+        if rule[1] > 1:
+            self._restart_after = (rule[0], rule[1] - 1)
+            return
+        self._restart_after = None
+        self.restart_controller()
 
     def add_point(self, point_id: int, pose: Pose6, tool: int = 200) -> None:
         """Store a temp point directly (test setup)."""

@@ -1157,18 +1157,18 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/window_column.py" line="98" />
+            <location filename="../../ui/window_column.py" line="100" />
             <source>Jog</source>
             <extracomment>How long the "another master" banner stays after the last sign of one (ms)</extracomment>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="99" />
+            <location filename="../../ui/window_column.py" line="101" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="100" />
+            <location filename="../../ui/window_column.py" line="102" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
@@ -1193,17 +1193,17 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="319" />
+            <location filename="../../ui/main_window.py" line="322" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="129" />
+            <location filename="../../ui/window_column.py" line="137" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="133" />
+            <location filename="../../ui/window_column.py" line="141" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
@@ -1219,54 +1219,54 @@
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="351" />
+            <location filename="../../ui/main_window.py" line="354" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="360" />
+            <location filename="../../ui/foreign_words.py" line="16" />
             <source>it wrote its own restart token ({value})</source>
             <translation>它写入了自己的重启标记（{value}）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="362" />
+            <location filename="../../ui/foreign_words.py" line="18" />
             <source>register {value} changed without a write of TeachPad</source>
             <translation>寄存器 {value} 在 TeachPad 未写入的情况下发生了变化</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="364" />
+            <location filename="../../ui/foreign_words.py" line="22" />
             <source>a command result TeachPad did not cause (GV291 = {value})</source>
             <translation>出现了并非 TeachPad 引起的指令结果（GV291 = {value}）</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="368" />
+            <location filename="../../ui/foreign_words.py" line="30" />
             <source>Another Modbus master is on this controller: {sign}. It shares the parameter and command registers with TeachPad: its writes can change what ours do. Check who else is connected.</source>
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="378" />
+            <location filename="../../ui/main_window.py" line="377" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="353" />
-            <location filename="../../ui/main_window.py" line="373" />
-            <location filename="../../ui/main_window.py" line="379" />
+            <location filename="../../ui/main_window.py" line="356" />
+            <location filename="../../ui/main_window.py" line="365" />
+            <location filename="../../ui/main_window.py" line="378" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="296" />
+            <location filename="../../ui/main_window.py" line="299" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="297" />
+            <location filename="../../ui/main_window.py" line="300" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="298" />
+            <location filename="../../ui/main_window.py" line="301" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1276,22 +1276,37 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="453" />
+            <location filename="../../ui/main_window.py" line="372" />
+            <source>plan run</source>
+            <translation>计划运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="452" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="455" />
+            <location filename="../../ui/main_window.py" line="454" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="475" />
+            <location filename="../../ui/main_window.py" line="467" />
+            <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
+            <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="469" />
+            <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
+            <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="487" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="475" />
+            <location filename="../../ui/main_window.py" line="487" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -2080,37 +2095,37 @@
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="494" />
+            <location filename="../../ui/messages.py" line="500" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="497" />
+            <location filename="../../ui/messages.py" line="503" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="543" />
+            <location filename="../../ui/messages.py" line="549" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="546" />
+            <location filename="../../ui/messages.py" line="552" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="550" />
+            <location filename="../../ui/messages.py" line="556" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="553" />
+            <location filename="../../ui/messages.py" line="559" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="556" />
+            <location filename="../../ui/messages.py" line="562" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
@@ -2160,12 +2175,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="503" />
+            <location filename="../../ui/messages.py" line="509" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="507" />
+            <location filename="../../ui/messages.py" line="513" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -2830,43 +2845,43 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="245" />
+            <location filename="../../ui/panels/planner_widgets.py" line="249" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="246" />
+            <location filename="../../ui/panels/planner_widgets.py" line="250" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="265" />
+            <location filename="../../ui/panels/planner_widgets.py" line="269" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="268" />
+            <location filename="../../ui/panels/planner_widgets.py" line="272" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="270" />
+            <location filename="../../ui/panels/planner_widgets.py" line="274" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="272" />
+            <location filename="../../ui/panels/planner_widgets.py" line="276" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="275" />
+            <location filename="../../ui/panels/planner_widgets.py" line="279" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -2882,7 +2897,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="309" />
+            <location filename="../../ui/panels/planner_widgets.py" line="313" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -3051,27 +3066,37 @@
     <context>
         <name>PlanRunController</name>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="41" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="48" />
             <source>Failed: {reason}</source>
             <translation>失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="43" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="50" />
             <source>Stopped: {reason}</source>
             <translation>已停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="47" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="54" />
             <source>Failed at segment {n}: {reason}</source>
             <translation>在第 {n} 段失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="49" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="56" />
             <source>Stopped at segment {n}: {reason}</source>
             <translation>在第 {n} 段停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="29" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="76" />
+            <source>Paused: another master wrote to the controller ({sign})</source>
+            <translation>已暂停：另一个主站写入了控制器（{sign}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="83" />
+            <source>Not resumed: another master wrote to the controller less than {hold} s ago. Make sure no other master is commanding the robot; Resume is possible in {left} s.</source>
+            <translation>未继续：另一个主站在不到 {hold} 秒前写入了控制器。请确认没有其他主站在控制机器人；{left} 秒后才能继续。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="36" />
             <source>stopped by the operator</source>
             <translation>已由操作员停止</translation>
         </message>
@@ -3362,12 +3387,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="242" />
+            <location filename="../../ui/panels/planner_panel.py" line="245" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="422" />
+            <location filename="../../ui/panels/planner_panel.py" line="425" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -4140,160 +4165,166 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="141" />
+            <location filename="../../ui/controllers/project_controller.py" line="150" />
             <source>Undo</source>
+            <extracomment>The longest a close, a save or a discard waits for the autosave being written (s): a 58 MB project is written in about a second; a stuck disk must not hold the window for ever.</extracomment>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="143" />
+            <location filename="../../ui/controllers/project_controller.py" line="152" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="147" />
+            <location filename="../../ui/controllers/project_controller.py" line="156" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="148" />
+            <location filename="../../ui/controllers/project_controller.py" line="157" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="149" />
+            <location filename="../../ui/controllers/project_controller.py" line="158" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="150" />
+            <location filename="../../ui/controllers/project_controller.py" line="159" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="151" />
+            <location filename="../../ui/controllers/project_controller.py" line="160" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="152" />
+            <location filename="../../ui/controllers/project_controller.py" line="161" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="182" />
+            <location filename="../../ui/controllers/project_controller.py" line="191" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="217" />
+            <location filename="../../ui/controllers/project_controller.py" line="226" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="225" />
-            <location filename="../../ui/controllers/project_controller.py" line="263" />
-            <location filename="../../ui/controllers/project_controller.py" line="394" />
+            <location filename="../../ui/controllers/project_controller.py" line="234" />
+            <location filename="../../ui/controllers/project_controller.py" line="272" />
+            <location filename="../../ui/controllers/project_controller.py" line="426" />
             <source>Project in use</source>
             <translation>工程正在使用中</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="230" />
-            <location filename="../../ui/controllers/project_controller.py" line="233" />
+            <location filename="../../ui/controllers/project_controller.py" line="239" />
+            <location filename="../../ui/controllers/project_controller.py" line="242" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="236" />
+            <location filename="../../ui/controllers/project_controller.py" line="245" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="248" />
+            <location filename="../../ui/controllers/project_controller.py" line="257" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="268" />
-            <location filename="../../ui/controllers/project_controller.py" line="271" />
+            <location filename="../../ui/controllers/project_controller.py" line="278" />
+            <location filename="../../ui/controllers/project_controller.py" line="281" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="283" />
+            <location filename="../../ui/controllers/project_controller.py" line="293" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="289" />
+            <location filename="../../ui/controllers/project_controller.py" line="299" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="296" />
-            <location filename="../../ui/controllers/project_controller.py" line="299" />
-            <location filename="../../ui/controllers/project_controller.py" line="314" />
+            <location filename="../../ui/controllers/project_controller.py" line="306" />
+            <location filename="../../ui/controllers/project_controller.py" line="309" />
+            <location filename="../../ui/controllers/project_controller.py" line="324" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="316" />
+            <location filename="../../ui/controllers/project_controller.py" line="326" />
             <source>{added} added, {updated} updated, {unchanged} unchanged, {removed} removed</source>
             <translation>新增 {added} 个，更新 {updated} 个，未变 {unchanged} 个，删除 {removed} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="319" />
+            <location filename="../../ui/controllers/project_controller.py" line="329" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="332" />
+            <location filename="../../ui/controllers/project_controller.py" line="342" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="339" />
+            <location filename="../../ui/controllers/project_controller.py" line="349" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="342" />
+            <location filename="../../ui/controllers/project_controller.py" line="352" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="368" />
-            <location filename="../../ui/controllers/project_controller.py" line="372" />
+            <location filename="../../ui/controllers/project_controller.py" line="400" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="410" />
-            <location filename="../../ui/controllers/project_controller.py" line="413" />
+            <location filename="../../ui/controllers/project_controller.py" line="408" />
+            <location filename="../../ui/controllers/project_controller.py" line="461" />
+            <source>The autosave {path} is still being written after {seconds} s.</source>
+            <translation>自动保存 {path} 在 {seconds} 秒后仍在写入。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/project_controller.py" line="442" />
+            <location filename="../../ui/controllers/project_controller.py" line="445" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="416" />
+            <location filename="../../ui/controllers/project_controller.py" line="448" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="452" />
+            <location filename="../../ui/controllers/project_controller.py" line="495" />
             <source>Cannot lock {path}: {reason}</source>
             <translation>无法锁定 {path}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="462" />
+            <location filename="../../ui/controllers/project_controller.py" line="505" />
             <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
             <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="498" />
+            <location filename="../../ui/controllers/project_controller.py" line="542" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="501" />
+            <location filename="../../ui/controllers/project_controller.py" line="545" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>
@@ -4860,77 +4891,77 @@ Remove them all?</source>
     <context>
         <name>SafetyController</name>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="212" />
+            <location filename="../../ui/controllers/safety.py" line="206" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="213" />
+            <location filename="../../ui/controllers/safety.py" line="207" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="214" />
+            <location filename="../../ui/controllers/safety.py" line="208" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="221" />
+            <location filename="../../ui/controllers/safety.py" line="215" />
             <source>Needs the {need} role (you are {role}); log in from the Safety menu</source>
             <translation>需要{need}角色（当前为{role}）；请从“安全”菜单登录</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="451" />
+            <location filename="../../ui/controllers/safety.py" line="445" />
             <source>{axis} = {value:.1f} is within stopping distance of the keep-out zone '{box}' (at {limit:.1f})</source>
             <translation>{axis} = {value:.1f}，已进入禁区“{box}”的停止距离内（边界 {limit:.1f}）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="455" />
+            <location filename="../../ui/controllers/safety.py" line="449" />
             <source>{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}</source>
             <translation>{axis} = {value:.1f}，已进入限位 {limit:.1f} 的停止距离内</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="457" />
+            <location filename="../../ui/controllers/safety.py" line="451" />
             <source>{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)</source>
             <translation>{axis} = {value:.1f} mm 超出允许的工作空间（限值 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="460" />
+            <location filename="../../ui/controllers/safety.py" line="454" />
             <source>The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, its face at {limit:.1f} mm)</source>
             <translation>路径进入禁区“{box}”（{axis} = {value:.1f} mm，边界在 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="464" />
+            <location filename="../../ui/controllers/safety.py" line="458" />
             <source>{axis} = {value:.1f}° is beyond its limit {limit:.1f}°</source>
             <translation>{axis} = {value:.1f}° 超出限位 {limit:.1f}°</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="467" />
+            <location filename="../../ui/controllers/safety.py" line="461" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode</source>
             <translation>速度 {value:g} mm/s 超过降速模式允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="469" />
+            <location filename="../../ui/controllers/safety.py" line="463" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed</source>
             <translation>速度 {value:g} mm/s 超过允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="473" />
+            <location filename="../../ui/controllers/safety.py" line="467" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode</source>
             <translation>点动速度 {value:g} % 超过降速模式允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="475" />
+            <location filename="../../ui/controllers/safety.py" line="469" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed</source>
             <translation>点动速度 {value:g} % 超过允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="480" />
+            <location filename="../../ui/controllers/safety.py" line="474" />
             <source>Segment {k}: {text}</source>
             <translation>第 {k} 段：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="485" />
+            <location filename="../../ui/controllers/safety.py" line="479" />
             <source>Jog stopped before the limit: {why}</source>
             <translation>点动已在到达边界前停止：{why}</translation>
         </message>
@@ -4938,112 +4969,112 @@ Remove them all?</source>
     <context>
         <name>SafetyMenu</name>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="110" />
+            <location filename="../../ui/controllers/safety_menu.py" line="111" />
             <source>&amp;Safety</source>
             <translation>安全(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="111" />
+            <location filename="../../ui/controllers/safety_menu.py" line="112" />
             <source>Log &amp;in…</source>
             <translation>登录(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="112" />
+            <location filename="../../ui/controllers/safety_menu.py" line="113" />
             <source>Log &amp;out (operator)</source>
             <translation>注销(&amp;O)（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="113" />
+            <location filename="../../ui/controllers/safety_menu.py" line="114" />
             <source>&amp;Reduced speed</source>
             <translation>降速模式(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="114" />
+            <location filename="../../ui/controllers/safety_menu.py" line="115" />
             <source>Safety &amp;envelope…</source>
             <translation>安全范围(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="115" />
+            <location filename="../../ui/controllers/safety_menu.py" line="116" />
             <source>Re&amp;gister profile…</source>
             <translation>寄存器配置(&amp;G)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="117" />
+            <location filename="../../ui/controllers/safety_menu.py" line="118" />
             <source>Word order, unit id, completion rule, poll timeout (administrator)</source>
             <translation>字序、站号、完成判定、轮询超时（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="119" />
+            <location filename="../../ui/controllers/safety_menu.py" line="120" />
             <source>&amp;Passwords and lock…</source>
             <translation>密码与锁定(&amp;P)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="121" />
+            <location filename="../../ui/controllers/safety_menu.py" line="122" />
             <source>Set, change or clear passwords; the idle lock time (administrator)</source>
             <translation>设置、修改或清除密码；空闲锁定时间（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="123" />
+            <location filename="../../ui/controllers/safety_menu.py" line="124" />
             <source>&amp;Audit trail…</source>
             <translation>审计记录(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="124" />
+            <location filename="../../ui/controllers/safety_menu.py" line="125" />
             <source>Write a &amp;support bundle…</source>
             <translation>生成支持包(&amp;S)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="137" />
+            <location filename="../../ui/controllers/safety_menu.py" line="138" />
             <source>Role: {role} · reduced speed</source>
             <translation>角色：{role} · 降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="137" />
+            <location filename="../../ui/controllers/safety_menu.py" line="138" />
             <source>Role: {role}</source>
             <translation>角色：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="147" />
+            <location filename="../../ui/controllers/safety_menu.py" line="148" />
             <source>Cap jog and move speeds (anyone may switch it on)</source>
             <translation>限制点动与移动速度（任何人都可开启）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="158" />
+            <location filename="../../ui/controllers/safety_menu.py" line="159" />
             <source>safety</source>
             <translation>安全</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="221" />
+            <location filename="../../ui/controllers/safety_menu.py" line="222" />
             <source>The register profile could not be saved: {why}</source>
             <translation>寄存器配置无法保存：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="226" />
+            <location filename="../../ui/controllers/safety_menu.py" line="227" />
             <source>Register profile “{name}” saved (revision {rev})</source>
             <translation>寄存器配置“{name}”已保存（第 {rev} 版）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="240" />
+            <location filename="../../ui/controllers/safety_menu.py" line="241" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="247" />
+            <location filename="../../ui/controllers/safety_menu.py" line="248" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="277" />
+            <location filename="../../ui/controllers/safety_menu.py" line="279" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="280" />
+            <location filename="../../ui/controllers/safety_menu.py" line="282" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="286" />
+            <location filename="../../ui/controllers/safety_menu.py" line="288" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
@@ -5051,7 +5082,7 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="378" />
+            <location filename="../../ui/panels/planner_widgets.py" line="382" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>

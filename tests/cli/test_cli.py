@@ -210,6 +210,7 @@ def test_jog_errors(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     assert csim.writes == []
 
 
+@pytest.mark.usefixtures("open_envelope")  # a move without --project: no keep-in box
 def test_motion_commands(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     x0, y0, z0 = csim.state().pose[:3]
     code, out, err = run(csim, capsys, "step", "--frame", "base", "X=10", "z=-5", "--speed", "200")

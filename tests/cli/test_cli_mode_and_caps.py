@@ -87,6 +87,7 @@ def test_help_says_what_manual_mode_does(capsys: pytest.CaptureFixture[str]) -> 
     assert "--reduced-speed" in capsys.readouterr().out
 
 
+@pytest.mark.usefixtures("open_envelope")  # a move without --project: no keep-in box
 def test_reduced_speed_caps_the_program_run_step_move_and_jog(
     csim: Any, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -111,6 +111,7 @@ def test_a_point_the_project_does_not_have_is_a_usage_error(
     assert csim.writes == []
 
 
+@pytest.mark.usefixtures("open_envelope")  # a move without --project: no keep-in box
 def test_without_a_project_the_move_says_the_point_was_not_checked(
     csim: Any, capsys: pytest.CaptureFixture[str]
 ) -> None:

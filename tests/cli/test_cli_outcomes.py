@@ -100,6 +100,7 @@ def test_a_step_during_an_emergency_stop_reads_the_controllers_code(
     assert record.args["status"] == 2 and "emergency stop" in record.detail
 
 
+@pytest.mark.usefixtures("open_envelope")  # a move without --project: no keep-in box
 def test_move_to_a_missing_point_is_refused_with_status_13_in_words(
     csim: Any, capsys: pytest.CaptureFixture[str], audit_dir: Path
 ) -> None:

@@ -49,7 +49,9 @@ def test_points_upload_is_staged_and_at_the_staged_request_bound(
     assert f"uploaded {N} point(s)" in out
     requests = sim.requests_count - requests
     probe = 2 * registers.GV_COMMAND_STATUS  # the completion rule's probe of GV291 (once a connection)
-    wire = [w for w in sim.writes[writes:] if w.address != probe]
+    canary = 2 * CANARY_GV  # the restart canary's token, written once (it read 0: none armed)
+    assert [w.address for w in sim.writes[writes:]].count(canary) == 1
+    wire = [w for w in sim.writes[writes:] if w.address not in (probe, canary)]
     # writes: GV245 once per tool, then per point its pose, GV200-202 and 440 -- nothing more
     params, command, tool = 2 * registers.GV_PARAM0, registers.REG_RUN_COMMAND, 2 * registers.GV_TOOL_FRAME
     assert [w.address for w in wire].count(tool) == len(TOOLS)

@@ -173,6 +173,7 @@ def test_ok(sim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     assert (code, err) == (ExitCode.OK, "") and "mode      auto" in out
 
 
+@pytest.mark.usefixtures("open_envelope")  # a move without --project: no keep-in box
 def test_refused_by_the_controller_is_failed(sim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     code, _, err = _run(capsys, sim.port, "move", "77")  # no temp point 77 on the controller
     assert code == ExitCode.FAILED

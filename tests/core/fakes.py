@@ -49,6 +49,9 @@ class FakeClient:
     def read_pose(self) -> Pose:
         return self.pose
 
+    def invalidate_cache(self) -> None:
+        """RobotClient forgets the tool frame it wrote last (nothing cached here)."""
+
     def create_point(
         self,
         point_id: int,

@@ -13,6 +13,7 @@ import pytest
 from app.errors import InvalidInput
 from app.plan.checks import check_plan, has_errors
 from app.plan.segments import Plan, Segment
+from app.points.autosave import autosave_path, discard_autosave, find_autosave, save_autosave
 from app.points.ledger import (
     FileFormatError,
     ImportMode,
@@ -27,14 +28,10 @@ from app.points.project import (
     Project,
     UploadRecord,
     atomic_write_bytes,
-    autosave_path,
-    discard_autosave,
-    find_autosave,
     load_project,
     parse_project,
     project_to_json,
     read_points_csv,
-    save_autosave,
     save_project,
     write_points_csv,
 )

@@ -90,6 +90,8 @@ def test_watch_outcome_unknown_and_stopped_reach_its_hook() -> None:
 
 
 class _Done:
+    deadline = 0.0
+
     def update(self, status: ControllerStatus, pose: Pose | None, now: float) -> CommandResult | None:
         return CommandResult(RunCommand.CREATE_POINT, None, None, True, "created")
 

@@ -291,6 +291,7 @@ _LINK_FAILED_BY_CODE = {
     "manual_mode": False,  # go to zero / run program in manual mode, no switch allowed: nothing sent
     "reduced_speed_refused": False,  # go to zero in reduced-speed mode: nothing sent
     "audit_unavailable": False,  # its audit record could not be written: refused, nothing sent
+    "envelope_unchecked": False,  # the CLI's move with no host copy under a box: refused, nothing sent
     "error": False,
 }
 

@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QCoreApplication, QSettings
+from PySide6.QtCore import QCoreApplication
 from PySide6.QtGui import QFontDatabase
 from PySide6.QtWidgets import QApplication, QDialog
 
@@ -37,9 +37,7 @@ def _problems(dialog: QDialog, language: str) -> list[str]:
 @pytest.mark.parametrize("role", [Role.OPERATOR, Role.ADMINISTRATOR])
 def test_admin_dialogs_layout(qtbot: Any, translator: Any, tmp_path: Path, language: str, role: Role) -> None:
     assert translator.set_language(language)
-    safety = SafetyController(
-        None, QSettings(str(tmp_path / "t.ini"), QSettings.Format.IniFormat), scrypt_n=2**4
-    )
+    safety = SafetyController(None, scrypt_n=2**4)
     safety.set_idle_polling(False)
     safety.session.set_password(Role.ADMINISTRATOR, "root-pw")
     if role is Role.ADMINISTRATOR:

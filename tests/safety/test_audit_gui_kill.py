@@ -77,9 +77,10 @@ def _write_key(fc: int, address: int, values: Any) -> tuple[int, int, tuple[int,
 @pytest.mark.timeout(120)
 def test_gui_writes_are_audited_once_also_after_kill_9(tmp_path: Path, sim_factory: Any, qtbot: Any) -> None:
     # The controller answers unit 7 only: the GUI gets there because the register profile in force
-    # (beside its settings file) says so -- applied at start-up, not overridden by --unit's default.
+    # (in the child's config folder, XDG_CONFIG_HOME below) says so -- applied at start-up, not
+    # overridden by --unit's default.
     sim = sim_factory(unit=7)
-    save_register_profile(tmp_path / "safety" / PROFILE_NAME, RegisterProfile("unit 7", unit=7))
+    save_register_profile(tmp_path / "config" / "teachpad" / PROFILE_NAME, RegisterProfile("unit 7", unit=7))
     env = {
         **os.environ,
         "PYTHONPATH": str(ROOT),
@@ -112,7 +113,7 @@ def test_gui_writes_are_audited_once_also_after_kill_9(tmp_path: Path, sim_facto
         wait_child(child, "the GUI, killed")
         child.stderr.close()
     received = [_write_key(w.function_code, w.address, w.values) for w in sim.writes]
-    audit_dir = tmp_path / "safety" / "audit"  # beside the INI settings file
+    audit_dir = tmp_path / "data" / "teachpad" / "audit"  # the child's XDG_DATA_HOME, not beside its INI file
     stats = ReadStats()
     writes = [r for r in read_records(audit_dir, stats=stats) if r.kind == "write"]
     audited = [_write_key(r.args["fc"], r.args["address"], r.args["values"]) for r in writes]

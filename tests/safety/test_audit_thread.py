@@ -14,6 +14,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 from app.protocol.enums import WorkMode
+from app.safety.location import safety_location
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,
@@ -31,8 +32,9 @@ pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)
 
 @pytest.fixture(name="blocked_audit")
 def blocked_audit_fixture(tmp_path: Path) -> Path:
-    """A file where the window's audit folder goes (beside its INI settings): nothing can be recorded."""
-    folder = tmp_path / "safety" / "audit"
+    """A file where the window's audit folder goes (the test's own per-user folder): nothing can be
+    recorded."""
+    folder = safety_location().audit_dir
     folder.parent.mkdir(parents=True, exist_ok=True)
     folder.write_text("a file where the folder should be", encoding="utf-8")
     return folder

@@ -142,9 +142,10 @@ def test_cli_support_bundle_and_audit(
     assert "long ago" in capsys.readouterr().out
 
 
-def test_cli_help_says_it_is_an_administrators_tool(capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_help_says_how_roles_apply(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["--help"]) == 0
-    assert "administrator's tool" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "TEACHPAD_ROLE" in out and "TEACHPAD_PASSWORD" in out and "--role" in out
 
 
 def test_cli_roles(

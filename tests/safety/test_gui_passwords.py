@@ -7,10 +7,10 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QSettings
 
 from app.errors import InvalidInput
 from app.safety.audit import Result, query
+from app.safety.location import safety_location
 from app.safety.roles import Role
 from app.safety.session import PermissionRefused
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -33,8 +33,7 @@ ADMIN_PW = "root-pw"
 
 @pytest.fixture(name="safety")
 def safety_fixture(qtbot: Any, tmp_path: Path) -> Any:
-    store = QSettings(str(tmp_path / "t.ini"), QSettings.Format.IniFormat)
-    controller = SafetyController(None, store, scrypt_n=2**4)
+    controller = SafetyController(None, scrypt_n=2**4)
     controller.set_idle_polling(False)
     controller.session.set_password(Role.ADMINISTRATOR, ADMIN_PW)  # the first one: anyone
     yield controller
@@ -48,7 +47,7 @@ def _cell(dialog: PasswordDialog, role: Role) -> str:
 
 
 def _roles_file(tmp_path: Path) -> str:
-    return (tmp_path / "safety" / "roles.json").read_text(encoding="utf-8")
+    return safety_location().roles.read_text(encoding="utf-8")
 
 
 def test_an_administrator_sets_changes_and_clears_passwords(qtbot: Any, safety: Any, tmp_path: Path) -> None:

@@ -5,23 +5,21 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QSettings
-
+from app.safety.location import safety_location
 from app.safety.roles import Role
 from ui.controllers.safety import SafetyController
 from ui.dialogs.role_dialog import RoleDialog
 
 
 def _safety(qtbot: Any, tmp_path: Path) -> SafetyController:
-    store = QSettings(str(tmp_path / "t.ini"), QSettings.Format.IniFormat)
-    safety = SafetyController(None, store, scrypt_n=2**4)
+    safety = SafetyController(None, scrypt_n=2**4)
     safety.set_idle_polling(False)
     return safety
 
 
 def test_first_admin_password_then_log_in_and_out(qtbot: Any, tmp_path: Path) -> None:
     safety = _safety(qtbot, tmp_path)
-    assert safety.audit_dir == tmp_path / "safety" / "audit"  # beside the INI file, not in $HOME
+    assert safety.audit_dir == safety_location().audit_dir  # the test's own folder (tests/conftest.py)
     dialog = RoleDialog(safety)
     qtbot.addWidget(dialog)
     assert "No administrator password" in dialog.error.text()
@@ -44,6 +42,6 @@ def test_first_admin_password_then_log_in_and_out(qtbot: Any, tmp_path: Path) ->
     assert again.set_password_button.isHidden()  # passwords are now the Passwords screen's
     again.log_out()
     assert safety.role is Role.OPERATOR
-    stored = (tmp_path / "safety" / "roles.json").read_text(encoding="utf-8")
+    stored = safety_location().roles.read_text(encoding="utf-8")
     assert "root-pw" not in stored and "scrypt" in stored.lower()
     safety.close()

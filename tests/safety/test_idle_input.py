@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QEvent, QObject, QPoint, QPointF, QSettings, Qt, QTimer
+from PySide6.QtCore import QEvent, QObject, QPoint, QPointF, Qt, QTimer
 from PySide6.QtGui import QGuiApplication, QWheelEvent, QWindow
 from PySide6.QtTest import QTest
 from PySide6.QtWidgets import (
@@ -84,8 +84,7 @@ def clock_fixture() -> Clock:
 
 def _controller(tmp_path: Path, clock: Clock, monkeypatch: pytest.MonkeyPatch) -> SafetyController:
     """A controller with an engineer logged in, its idle lock on ``clock``."""
-    store = QSettings(str(tmp_path / "t.ini"), QSettings.Format.IniFormat)
-    safety = SafetyController(None, store, scrypt_n=2**4)
+    safety = SafetyController(None, scrypt_n=2**4)
     monkeypatch.setattr(safety.session.idle, "_clock", clock)
     roles = safety.session.store
     roles.set_password(Role.ADMINISTRATOR, PASSWORD, by=Role.ADMINISTRATOR)
@@ -273,9 +272,7 @@ def test_paints_timers_and_queued_calls_never_reach_the_filter(
     qtbot: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     seen = _Recording(monkeypatch)
-    safety = SafetyController(
-        None, QSettings(str(tmp_path / "t.ini"), QSettings.Format.IniFormat), scrypt_n=2**4
-    )
+    safety = SafetyController(None, scrypt_n=2**4)
     safety.set_idle_polling(False)
     panel = Panel()
     window = _shown(qtbot, panel)

@@ -32,9 +32,10 @@ def test_a_plan_outside_the_keep_in_box_is_refused(
     tiny = _profile(tmp_path, Envelope(keep_in=Box("cell", (9000.0,) * 3, (9001.0,) * 3)))
     cli = Cli()
     code = cli("run", str(demo), "--plan", "circle", "--check", "--safety", str(tiny))
-    assert code == cli_points.EXIT_USAGE
+    assert code == cli_points.EXIT_FAILED  # refused by the envelope, as a step out of it is (issue 19 §5)
     err = capsys.readouterr().err
     assert "outside the allowed work space" in err and "not running it" in err
+    assert "(outside the safety envelope)" in err
     assert cli.clients_made == 0
 
 

@@ -54,16 +54,22 @@ def test_status_pose_and_a_write_over_the_serial_line(line: tuple[PtyRelay, SimC
 
 
 def test_a_corrupted_crc_is_rejected_both_ways(line: tuple[PtyRelay, SimController, Any]) -> None:
+    """A damaged frame is never data; a read is sent again (app/link/line_retry.py), a mode write
+    is not (its damaged answer is an error)."""
     relay, sim, client = line
     relay.corrupt_next_request = True
-    with pytest.raises(TeachPadError):
-        client.read_status()
+    assert client.read_status().mode == 1  # not answered (bad CRC at the controller): read again
     assert sim.bad_frame_counts() == {"bad CRC": 1}
-    assert client.read_status().mode == 1  # the line recovers
+    assert client.stats.timeouts == 1
+    relay.corrupt_next_answer = True
+    assert client.read_pose().xyzabc == pytest.approx(sim.state().pose, abs=1e-3)
+    assert client.stats.malformed == 1  # the damaged answer was rejected, the read sent again
     relay.corrupt_next_answer = True
     with pytest.raises(TeachPadError):
-        client.read_pose()  # a damaged answer is an error, never data
-    assert client.read_pose().xyzabc == pytest.approx(sim.state().pose, abs=1e-3)
+        client.set_work_mode(WorkMode.MANUAL)  # a damaged answer to a mode change: an error
+    assert len(sim.writes_to(REG_WORK_MODE)) == 1  # never sent again
+    assert sim.state().work_mode is WorkMode.MANUAL  # it took: only its answer was damaged
+    assert client.read_status().mode == 0  # the line recovers
 
 
 def test_line_noise_before_a_request_is_dropped_at_the_silent_gap(

@@ -4,15 +4,18 @@ On every tab (and the states that change a layout: jog frames, the step panel's 
 axes, the points banner and upload progress, the planner after a stop) no visible text is
 clipped, no two visible siblings overlap, motion buttons are tall enough (``layout_audit``);
 connected, again with the alarm banner up (an emergency stop raised at the simulator).
+``make test-fonts`` (``tests/fonts/run.py``) runs it again under three font sets, on more
+screens (``TEACHPAD_LAYOUT_SCREENS``) and at 125 % and 150 % (``QT_SCALE_FACTOR``).
 
-Chinese text is measured with the font Qt really uses. Where no CJK font is installed (CI
-installs only the Python packages), Qt measures missing glyphs as narrow boxes, so a clipped
+Chinese text is measured with the font Qt really uses. Where no CJK font is installed (the
+DejaVu-only font set, a machine without one), Qt measures missing glyphs as narrow boxes, so a clipped
 Chinese text cannot be told from a fitting one: the text check is skipped for zh_CN there,
 and only overlap and sizes are checked (they do not depend on glyph widths being right).
 """
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Callable, Iterator
 from typing import Any
@@ -50,7 +53,35 @@ pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)
 # Known problems in panels owned elsewhere, each with its reason; the check stays strict for the
 # rest. Remove an entry when its panel is fixed (an entry that no longer matches fails the test).
 KNOWN_ISSUES: dict[str, str] = {}
-SIZES = ((1280, 800), (1920, 1080))
+SCREENS = ((1280, 800), (1920, 1080))
+# Decided (issue 20): the README promises the layout from 1280×800 device-independent pixels up,
+# the size that holds under every font set (tests/fonts). Under it (1024×768, or 1920×1080 at
+# 150 % = 1280×720) the window still opens down to MIN_SIZE but squeezes or scrolls parts: the
+# control column, the planner and the status dock need ~850 + 320 px across, and the work tabs
+# ~480 px of height under Noto's taller lines.
+PROMISED_MIN = (1280, 800)
+
+
+def screens() -> tuple[tuple[int, int], ...]:
+    """The screen sizes to check: ``TEACHPAD_LAYOUT_SCREENS`` ("1024x768,1280x800", set by the
+    font-set run, ``tests/fonts/run.py``) or :data:`SCREENS`."""
+    listed = os.environ.get("TEACHPAD_LAYOUT_SCREENS", "")
+    if not listed:
+        return SCREENS
+    return tuple((int(w), int(h)) for w, h in (size.split("x") for size in listed.split(",")))
+
+
+def window_sizes() -> tuple[tuple[int, int], ...]:
+    """The window filling each screen, in Qt's device-independent pixels: a screen's pixels over
+    ``QT_SCALE_FACTOR`` (1920×1080 at 150 % is a 1280×720 window). Windows under the size the
+    README promises the layout at (:data:`PROMISED_MIN`) are not checked."""
+    scale = float(os.environ.get("QT_SCALE_FACTOR", "") or 1.0)
+    sizes = ((int(w / scale), int(h / scale)) for w, h in screens())
+    return tuple(s for s in sizes if s[0] >= PROMISED_MIN[0] and s[1] >= PROMISED_MIN[1])
+
+
+SIZES = window_sizes()
+LAPTOP = (1280, 800)  # the touch, reduced-speed and joint jog checks
 LANGUAGES = ("en", "zh_CN")
 STOP_MESSAGE = "Stopped: the operator pressed STOP during segment 3 of 12 (the controller reported ESTOP)"
 
@@ -238,7 +269,7 @@ def test_main_window_layout_with_an_alarm(
 
 @pytest.mark.parametrize("language", LANGUAGES)
 def test_touch_mode_layout_at_1280x800(make_window: Callable[..., MainWindow], language: str) -> None:
-    window = make_window(language, SIZES[0], touch=True)
+    window = make_window(language, LAPTOP, touch=True)
     assert window.menus.touch_action.isChecked()
     found = without_known(check_window(window, language, touch=True), f"{language}-1280x800-connected")
     assert not found, "\n".join(found)
@@ -261,7 +292,7 @@ def test_touch_mode_layout_at_1280x800(make_window: Callable[..., MainWindow], l
 def test_reduced_speed_caps_fit_at_1280x800(make_window: Callable[..., MainWindow], language: str) -> None:
     """Reduced-speed mode shows its caps beside the jog slider, the program speed and the step speed
     (issue 18): they fit the control column without clipping, in both languages."""
-    window = make_window(language, SIZES[0])
+    window = make_window(language, LAPTOP)
     assert window.safety_menu.safety.set_reduced(True)
     window.jog_panel.set_ratio(100)
     window.program_panel.speed_spin.setValue(100)
@@ -301,7 +332,7 @@ def test_points_primary_actions_and_docks_stay_visible(
 def test_joint_jog_fits_1280x800_without_scrolling(
     language: str, make_window: Callable[..., MainWindow]
 ) -> None:
-    window = make_window(language, SIZES[0])
+    window = make_window(language, LAPTOP)
     window.jog_panel.set_frame(TeachFrame.JOINT)
     settle()
     jog = window.jog_panel

@@ -193,6 +193,26 @@ def test_a_live_label_repaints_itself_without_a_relayout_and_only_grows(qtbot: A
     assert label.width() == wide and relayouts.count == 1
 
 
+def test_a_live_label_keeps_room_for_its_samples_in_a_new_style(qtbot: Any) -> None:
+    """The samples are measured again in the font a style brings (the status panel's stale clock
+    is italic, which may fall back to another font): a sample-shaped text then needs no re-layout."""
+    window = QWidget()
+    qtbot.addWidget(window)
+    layout = QVBoxLayout(window)
+    label = LiveLabel("1", parent=window, samples=["12:34 s"])
+    layout.addWidget(label)
+    window.show()
+    qtbot.waitExposed(window)
+    label.set_style("font-size: 40px; font-style: italic;")
+    QApplication.processEvents()
+    relayouts = _Count(window, QEvent.Type.LayoutRequest)
+    width = label.width()
+    for text in ("00:00 s", "88:88 s", "47:59 s", "12:34 s"):  # any digits, the sample's shape
+        label.setText(text)
+        QApplication.processEvents()
+    assert relayouts.count == 0 and label.width() == width
+
+
 def test_streaming_status_and_traffic_do_not_relayout_the_main_window(qtbot: Any) -> None:
     link = FakeLink(connected=True)
     window = QMainWindow()

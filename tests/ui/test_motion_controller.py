@@ -96,3 +96,36 @@ def test_intents_become_requests(rig: Rig) -> None:
         ((2,), {"switch_to_auto": False}),
         ((None,), {"switch_to_auto": True}),
     ]
+
+
+def test_the_windows_resume_goes_through_a_run_paused_by_another_master(
+    rig: Rig, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A run that paused itself at a sign of another master is not resumed past the move hold by
+    the window's Resume (issue 19): the control bar's Resume goes through the run, which refuses it
+    while the hold lasts; its Pause pauses the run (which then holds its next move)."""
+    from app import timing
+    from app.plan.segments import Plan, Segment
+    from app.points.point import make_point
+
+    monkeypatch.setattr(timing, "FOREIGN_MOVE_HOLD", 60.0)
+    rig.link.set_connected(True)
+    project = Project(plans=[Plan("one", [Segment.line(1, 50.0)])])
+    project.ledger.replace_all([make_point(1, "a", (400.0, 0.0, 300.0, 180.0, 0.0, 0.0))])
+    runs = PlanRunController(rig.link, points=PointsModel(project, QUndoStack()))
+    bar = ControlBar(rig.host)
+    motion = MotionController(rig.link, bar, rig.jog, None, None, runs)
+    assert not motion.run_active  # (made before the run)
+    runs.start(project.plans[0])
+    assert runs.running and not runs.paused and motion.run_active
+    refused: list[str] = []
+    runs.resumeRefused.connect(refused.append)
+    rig.link.foreignMaster.emit("registers", 409.0)
+    assert runs.paused and len(rig.link.named("pause")) == 1
+    bar.resumeRequested.emit()
+    assert rig.link.named("resume") == [] and runs.paused and len(refused) == 1
+    monkeypatch.setattr(timing, "FOREIGN_MOVE_HOLD", 0.0)
+    bar.resumeRequested.emit()
+    assert len(rig.link.named("resume")) == 1 and not runs.paused
+    bar.pauseRequested.emit()
+    assert runs.paused and len(rig.link.named("pause")) == 2

@@ -12,6 +12,7 @@ from collections.abc import Callable
 from typing import Any
 
 import pytest
+from PySide6.QtCore import QTimer
 from PySide6.QtGui import QUndoStack
 
 from app.link.robot_link import RobotLink
@@ -128,12 +129,19 @@ def bench(qtbot: Any, sim: Any, link: RobotLink, make_client: MakeClient) -> Ben
 
 
 def test_a_point_overwritten_after_the_upload_is_re_created_before_its_move(
-    bench: Bench, sim: Any, make_client: MakeClient
+    bench: Bench, sim: Any, link: RobotLink, make_client: MakeClient
 ) -> None:
     bench.upload_all()
     other = make_client(sim)
     wrong = _elsewhere(bench.host(2))
-    assert other.create_point(2, pose=wrong, wait=True).ok  # another tool, after our upload
+    # another tool, after our upload; the link sees it (its parameter writes) before the run starts
+    # -- a sign seen during a run pauses it (tests/ui/test_plan_run_foreign.py)
+    with bench.qtbot.waitSignal(
+        link.foreignMaster,
+        check_params_cb=lambda what, _v: what == "registers",
+        timeout=RUN_TIMEOUT_MS,
+    ):
+        assert other.create_point(2, pose=wrong, wait=True).ok
     assert _near(sim.state().points[2], wrong)
     since = len(sim.writes)
     prepared: list[tuple[int, list[int]]] = []
@@ -169,6 +177,9 @@ def test_an_overwrite_between_re_create_and_move_stops_the_run_and_tells_the_ope
             assert other.create_point(2, pose=wrong, wait=True).ok
 
     bench.runs.segmentPrepared.connect(overwrite)
+    # the other tool's writes are a sign of another master: the run pauses itself when it sees them
+    # (tests/ui/test_plan_run_foreign.py); the operator resumes at once (the move hold is 0 here)
+    bench.runs.pausedByForeign.connect(lambda _what, _value: QTimer.singleShot(0, bench.runs.resume))
     mismatches: list[int] = []
     bench.runs.pointMismatch.connect(mismatches.append)
     since = len(sim.writes)

@@ -13,9 +13,10 @@ from typing import Any
 
 import pytest
 
+from app.points.autosave import save_autosave
 from app.points.ledger import ImportMode, SyncState
 from app.points.lock import live_owner, lock_path
-from app.points.project import load_project, save_autosave
+from app.points.project import load_project
 from tests.waits import kill_child, read_line, wait_child
 from ui.controllers.project_controller import ProjectController
 from ui.models.point_columns import COL_X
@@ -131,7 +132,7 @@ def test_recovery_offered_when_the_autosave_is_newer(
     )
     edit_something(crashed)
     auto = crashed.autosave_now()
-    assert auto is not None
+    assert auto is not None and crashed.wait_autosave()  # written by the autosave's own thread
     stamp = project_file.stat().st_mtime_ns
     os.utime(auto, ns=(stamp + 10**9, stamp + 10**9))
     # next start
@@ -149,7 +150,7 @@ def test_recovery_declined_removes_the_autosave(qtbot: Any, project_file: Path, 
     ctl = ProjectController(load_project(project_file), project_file, dialogs=dialogs, autosave_interval=0)
     edit_something(ctl)
     auto = ctl.autosave_now()
-    assert auto is not None
+    assert auto is not None and ctl.wait_autosave()
     stamp = project_file.stat().st_mtime_ns
     os.utime(auto, ns=(stamp + 10**9, stamp + 10**9))
     dialogs.recover = False
@@ -158,7 +159,7 @@ def test_recovery_declined_removes_the_autosave(qtbot: Any, project_file: Path, 
     assert not auto.exists() and fresh.project.ledger[0].x == 400.0
     # an autosave older than the project is not offered
     edit_something(fresh)
-    assert fresh.autosave_now() == auto
+    assert fresh.autosave_now() == auto and fresh.wait_autosave()
     os.utime(auto, ns=(stamp - 10**9, stamp - 10**9))
     assert fresh.check_recovery() is None
 
@@ -169,7 +170,7 @@ def test_untitled_project_autosaves_in_the_user_directory(
     ctl = ProjectController(dialogs=dialogs, autosave_interval=0, autosave_dir=tmp_path / "user")
     ctl.points_model.add_point()
     auto = ctl.autosave_now()
-    assert auto == tmp_path / "user" / "untitled.autosave.json"
+    assert auto == tmp_path / "user" / "untitled.autosave.json" and ctl.wait_autosave()
     fresh = ProjectController(dialogs=dialogs, autosave_interval=0, autosave_dir=tmp_path / "user")
     assert fresh.check_recovery() == auto
     assert fresh.offer_recovery() and len(fresh.project.ledger) == 1

@@ -222,3 +222,25 @@ def test_values_that_come_and_go_past_their_room_do_not_relayout_the_window(
     assert monitor.readouts["X"].shown_text() == OVERFLOW
     assert strip.values["Y"].toolTip() == ""  # fits again: its tooltip went with the overflow
     assert monitor.readouts["EJ1"].shown_text() == "-1000.000"
+
+
+@pytest.mark.parametrize(("caption", "unit"), [("X", "mm"), ("C", "°"), ("J4", "°"), ("E1", "mm")])
+def test_a_readout_needs_no_more_than_the_width_the_monitor_is_told(
+    qtbot: Any, caption: str, unit: str
+) -> None:
+    """The monitor picks the largest point size whose ``width_for`` fits a column (issue 20): a
+    readout that really needs more than that is squeezed by its layout and its digits run into
+    the unit ("_Digits and QLabel 'mm' overlap by 1×32 px" under Noto Sans Mono). At every size,
+    in the font in use, the width told covers the width the layout gives it at least."""
+    readout = NumericReadout(caption, unit)
+    qtbot.addWidget(readout)
+    readout.show()
+    short = []
+    for tenths in range(80, 320, 5):
+        points = tenths / 10
+        readout.set_point_size(points)
+        if readout.minimumSizeHint().width() > readout.width_for(points):
+            short.append(
+                f"{points} pt: needs {readout.minimumSizeHint().width()}, told {readout.width_for(points)}"
+            )
+    assert not short, "\n".join(short)

@@ -15,10 +15,10 @@ from typing import Any
 import pytest
 
 from app.link.transport import ConnectionSettings, Transport
+from app.safety.location import ENVELOPE_NAME
 from app.safety.profile import SafetyProfile, save_profile
 from app.view3d.profile import default_profile
 from tests.cli.ctrl_c import untraced_env
-from ui.controllers.safety import PROFILE_NAME
 from ui.panels.view3d_robot import RobotModelSource
 from ui.startup_gc import StartupGcPause, gc_paused
 
@@ -44,8 +44,8 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
     # Every start but an install's first: that one reads the robot model (app.view3d.profile, the
     # shipped file) once before its first paint, to make and save its safety envelope (~10 ms;
     # tests/ui/test_mode_and_caps.py), which the later starts read instead.
-    (tmp_path / "safety").mkdir()
-    save_profile(tmp_path / "safety" / PROFILE_NAME, SafetyProfile())
+    (tmp_path / "config" / "teachpad").mkdir(parents=True)  # the child's XDG_CONFIG_HOME (below)
+    save_profile(tmp_path / "config" / "teachpad" / ENVELOPE_NAME, SafetyProfile())
     code = textwrap.dedent("""
         import gc, json, sys
         import PySide6.QtWidgets

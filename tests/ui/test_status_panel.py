@@ -189,6 +189,8 @@ def test_clock_and_drift(panel: StatusPanel) -> None:
     assert COLOR_WARN in panel.drift_label.styleSheet()
     panel.on_clock(clock, now=controller + dt.timedelta(hours=1))
     assert COLOR_ERROR in panel.drift_label.styleSheet()
+    panel.on_clock(clock, now=controller + dt.timedelta(seconds=0.4))
+    assert panel.drift_label.text() == "+0 s"  # not "-0 s"
 
 
 def test_clock_arrives_with_the_status(panel: StatusPanel) -> None:

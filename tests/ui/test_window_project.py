@@ -143,6 +143,7 @@ def test_start_project_opens_remembers_and_offers_recovery(
     assert project_dialogs.asked == []  # no autosave: no question
     assert window.project.points_model.setData(window.project.points_model.index(0, 1), "renamed")
     assert window.project.is_dirty and window.project.autosave_now() is not None
+    assert window.project.wait_autosave()
     # the next start (a crash left the autosave): the last project, then the autosave
     project_dialogs.recover = True
     second = MainWindow(

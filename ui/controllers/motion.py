@@ -77,8 +77,9 @@ class MotionController(QObject):
         self._safety: SafetyController | None = None  # the guard rails (set by install_safety)
 
         control_bar.stopRequested.connect(link.stop)
-        control_bar.pauseRequested.connect(link.pause)
-        control_bar.resumeRequested.connect(link.resume)
+        self._runs = run_controller
+        control_bar.pauseRequested.connect(self._on_pause_requested)
+        control_bar.resumeRequested.connect(self._on_resume_requested)
         control_bar.modeRequested.connect(self._on_mode_requested)
         jog.jogPressed.connect(self._on_jog_pressed)
         jog.jogReleased.connect(link.jog_release)
@@ -95,6 +96,24 @@ class MotionController(QObject):
             self.add_step_panel(step)
         if program is not None:
             self.add_program_panel(program)
+
+    @Slot()
+    def _on_pause_requested(self) -> None:
+        """The window's Pause: a plan run under way is paused as its own Pause would (it then
+        holds its next move), anything else at the link."""
+        if self._runs.running and not self._runs.paused:
+            self._runs.pause()
+        else:
+            self._link.pause()
+
+    @Slot()
+    def _on_resume_requested(self) -> None:
+        """The window's Resume: a paused plan run resumes through the run (which refuses while
+        the another-master hold lasts, and sends what its pause held back), anything else at the link."""
+        if self._runs.running and self._runs.paused:
+            self._runs.resume()
+        else:
+            self._link.resume()
 
     def add_step_panel(self, step: StepPanel) -> None:
         """Drive and gate ``step`` from now on (enabled or not at once, as the others)."""

@@ -25,6 +25,19 @@ was overwritten by another tool), ends the run in ``FAILED`` at that segment wit
 from :mod:`ui.messages`; nothing further moves. ``segmentPrepared(int, object)`` (index, point
 ids) is emitted right before each move is sent. There is no unguarded run.
 
+**Another master** (issue 19 section 2, app/link/foreign.py): at the link's ``foreignMaster``
+sign the run pauses itself as the operator's Pause would (442, the arm held, resumable) and says
+why (``pausedByForeign``: "Paused: another master wrote to the controller (...)"; the planner
+puts it in the run box, the window in the event log; audited when ``audit`` is given). Nothing
+further is sent while it is paused so: no move, and not even the next segment's points (a create
+overlapping the other master's writes would be *unknown*). :meth:`resume` checks again: refused
+while the link's move hold (:data:`app.timing.FOREIGN_MOVE_HOLD`) lasts after the last sign
+(``resumeRefused(str)``).
+The segment that was under way at the sign ends *outcome unknown* (its "done" cannot be told from
+the other master's): the run tells it by arrival instead -- the arm stands at the ledger's end
+point (the point guard's check): done; elsewhere: the run fails at that segment (the arm stopped
+if our pause holds it), "Resume from k" sends it again.
+
 How an ended run reads ("Failed at segment 2: ...") and what a link change means for it are
 :mod:`ui.controllers.plan_run_reasons`.
 """
@@ -32,19 +45,26 @@ How an ended run reads ("Failed at segment 2: ...") and what a link change means
 from __future__ import annotations
 
 import dataclasses
+import time
 from collections import deque
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, Signal, Slot
 
+from app import timing
 from app.errors import LinkError, TeachPadError
 from app.link.robot_link import LinkPort, Pending
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult, Pose
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
-from ui.controllers.plan_run_reasons import connection_error, outcome_text, stopped_by_operator
+from ui.controllers.plan_run_reasons import (
+    connection_error,
+    foreign_resume_refused_text,
+    outcome_text,
+    stopped_by_operator,
+)
 from ui.controllers.point_sync_state import pose_from_details
 from ui.controllers.run_points import RunPoints, SegmentPoints
 from ui.messages import error_text, result_text
@@ -52,6 +72,7 @@ from ui.models.points_model import PointsModel
 
 if TYPE_CHECKING:  # app.plan.runner is imported where a run starts, after the first paint
     from app.plan.runner import PlanRunner, RunOutcome, RunProgress, SegmentCommand
+    from app.safety.audit import AuditLog
 
 #: How many of the segments sent a run remembers (``sent_segments``): a run with endless loops
 #: sends segments for as long as it runs.
@@ -69,7 +90,10 @@ class PlanRunController(QObject):
     (list of point ids: the controller answered "bad end point id", so it does not hold the
     segment's points — e.g. it restarted without the link noticing), ``segmentPrepared(int,
     object)`` (index, list of point ids re-created: the guarded move goes out next),
-    ``pointMismatch(int)`` (end point id: the arm did not arrive at the ledger's copy).
+    ``pointMismatch(int)`` (end point id: the arm did not arrive at the ledger's copy),
+    ``pausedByForeign(str, float)`` (the run paused itself at a sign of another master: what and
+    the value, as ``link.foreignMaster``; :func:`~ui.controllers.plan_run_reasons.foreign_pause_text`
+    says it), ``resumeRefused(str)`` (Resume did nothing: why, translated).
     """
 
     runningChanged = Signal(bool)
@@ -82,6 +106,8 @@ class PlanRunController(QObject):
     pointsMissing = Signal(object)
     segmentPrepared = Signal(int, object)
     pointMismatch = Signal(int)
+    pausedByForeign = Signal(str, float)
+    resumeRefused = Signal(str)
 
     def __init__(
         self, link: LinkPort | None = None, parent: QObject | None = None, *, points: PointsModel
@@ -103,6 +129,11 @@ class PlanRunController(QObject):
         self._move: Pending | None = None  # the outcome of the segment under way
         self._stop: Pending | None = None  # the outcome of our last stop
         self._stops = 0  # link.stops_requested when the run began or resumed
+        self.audit: AuditLog | None = None  # the trail a pause of the run's own is recorded in
+        self._foreign_at: float | None = None  # monotonic time of the last sign of another master
+        self._foreign_paused = False  # paused by the run itself at such a sign (not the operator)
+        self._deferred = False  # the next segment waits for Resume (paused at a sign between segments)
+        self._redo: SegmentCommand | None = None  # its points are created again on Resume
         if link is not None:
             self.set_link(link)
 
@@ -113,6 +144,7 @@ class PlanRunController(QObject):
         link.state.connectionChanged.connect(self._on_connection)
         link.state.poseChanged.connect(self.poseChanged)
         link.pointUploaded.connect(self._on_point_uploaded)
+        link.foreignMaster.connect(self._on_foreign_master)
 
     @property
     def points(self) -> PointsModel:
@@ -242,15 +274,65 @@ class PlanRunController(QObject):
 
     def resume(self) -> None:
         """Resume a paused move (not to be confused with :meth:`resume_run`); a move held
-        because the operator paused while its points were being created goes out now."""
-        if self.running and self._paused and self._link is not None:
-            self._link.resume()
-            self._set_paused(False)
-            held, self._held = self._held, None
-            if held is not None and self._stop_asked_since_start():
-                self._end_stopped()
-            elif held is not None:
-                self._send_move(self._link, held)
+        because the operator paused while its points were being created goes out now, and what a
+        pause at a sign of another master held back (the next segment, its points). Refused
+        (``resumeRefused``) while another master was seen less than the move hold ago."""
+        link = self._link
+        if not (self.running and self._paused and link is not None) or self._foreign_hold_lasts():
+            return
+        link.resume()
+        self._set_paused(False)
+        held, self._held = self._held, None
+        redo, self._redo = self._redo, None
+        deferred, self._deferred = self._deferred, False
+        if (held or redo or deferred) and self._stop_asked_since_start():
+            self._end_stopped()
+        elif held is not None:
+            self._send_move(link, held)
+        elif redo is not None:
+            self._prepare(link, self._guard, redo)
+        elif deferred:
+            self._send_next(link)
+
+    def _foreign_hold_lasts(self) -> bool:
+        """Another master was seen less than ``timing.FOREIGN_MOVE_HOLD`` ago: said, and True."""
+        seen, hold = self._foreign_at, timing.FOREIGN_MOVE_HOLD
+        left = hold - (time.monotonic() - seen) if seen is not None else 0.0
+        if left <= 0:
+            return False
+        text = foreign_resume_refused_text(hold, left)
+        if self.audit is not None:
+            self.audit.record_refused(
+                "resume the plan run",
+                f"another master wrote to the controller less than {hold:g} s ago",
+                {"hold": hold},
+            )
+        self.resumeRefused.emit(text)
+        return True
+
+    @Slot(str, float)
+    def _on_foreign_master(self, what: str, value: float) -> None:
+        """A sign of another master (app/link/foreign.py): a run under way pauses itself and says
+        why (once per pause); the sign's time starts the hold :meth:`resume` checks."""
+        self._foreign_at = time.monotonic()
+        runner = self._runner
+        if not self.running or runner is None or runner.stop_requested or self._foreign_paused:
+            return
+        if not self._paused:
+            self.pause()
+        self._foreign_paused = True
+        if self.audit is not None:
+            current = runner.current
+            args: dict[str, object] = {"what": what, "value": value}
+            if current is not None:
+                args["segment"] = current.index + 1
+            self.audit.record(
+                "action",
+                "plan run paused",
+                args=args,
+                detail="Paused: another master wrote to the controller",
+            )
+        self.pausedByForeign.emit(what, value)
 
     def outcome_text(self, outcome: RunOutcome) -> str:
         """How a stopped or failed run ended, in the operator's language (one sentence)."""
@@ -301,6 +383,8 @@ class PlanRunController(QObject):
         return self._link
 
     def _set_paused(self, paused: bool) -> None:
+        if not paused:
+            self._foreign_paused = False
         if paused != self._paused:
             self._paused = paused
             self.pausedChanged.emit(paused)
@@ -372,6 +456,8 @@ class PlanRunController(QObject):
         assert command is not None and prepared is not None
         if runner.stop_requested or self._stop_asked_since_start():
             self._end_stopped()
+        elif not (result.ok and prepared.all_created) and self._foreign_paused:
+            self._redo = command  # another master wrote meanwhile: created again on Resume
         elif not (result.ok and prepared.all_created):
             self._fail_segment(guard.not_created(prepared))
         elif self._paused:
@@ -406,6 +492,8 @@ class PlanRunController(QObject):
         self._upload = None
         self._prepared = None
         self._held = None
+        self._redo = None
+        self._deferred = False
         self._guard.clear()
 
     def _on_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
@@ -444,6 +532,8 @@ class PlanRunController(QObject):
         assert runner is not None
         if runner.state.is_over:
             self._finish()
+        elif self._foreign_paused:
+            self._deferred = True  # paused at a sign of another master: Resume sends it
         elif self._link is not None:
             self._send_next(self._link)
 
@@ -455,6 +545,8 @@ class PlanRunController(QObject):
             return
         self._move = None
         prepared, self._prepared = self._prepared, None
+        if _overlapped(result) and prepared is not None:
+            result = self._told_by_arrival(result, prepared)
         if result.ok and prepared is not None:
             # the pose that came with the result, else the link's latest (the poll that
             # completed the move publishes its pose before the result)
@@ -478,6 +570,19 @@ class PlanRunController(QObject):
         if missing and current is not None:
             self.pointsMissing.emit(list(current.segment.point_ids))
         self._after_report()
+
+    def _told_by_arrival(self, result: CommandResult, prepared: SegmentPoints) -> CommandResult:
+        """A segment whose end came while another master was seen: done when the arm stands at
+        the ledger's end point (what the segment was for; the other master's command would have
+        left it elsewhere), else it stays *unknown* and the arm held by our pause is stopped (the
+        run fails at it; "Resume from k" sends it again)."""
+        pose = pose_from_details(result.details, self.last_pose)
+        if self._guard.check_arrival(prepared, pose) is None:
+            message = "arrived at the end point (its result could not be told from another master's)"
+            return dataclasses.replace(result, ok=True, message=message, reason=None)
+        if self._paused and self._link is not None:
+            self._link.stop()
+        return result
 
     def _on_error(self, move: Pending, error: WorkerError) -> None:
         from app.plan.runner import RunState  # lazy: not before the first paint
@@ -521,3 +626,14 @@ class PlanRunController(QObject):
             self.end_reason = error_text(error)
             runner.on_error(error)
             self._finish()
+
+
+def _overlapped(result: CommandResult) -> bool:
+    """The command's end came while another master was seen (app/link/foreign.py): unknown."""
+    reason = result.reason
+    return (
+        not result.ok
+        and reason is not None
+        and reason.code == "outcome_unknown"
+        and bool(reason.args.get("foreign"))
+    )

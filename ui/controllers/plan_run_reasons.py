@@ -17,11 +17,18 @@ from PySide6.QtCore import QCoreApplication
 
 from app.errors import LinkError, ResponseTimeout, TeachPadError
 from app.link.types import ConnectionState, LinkState
+from ui.foreign_words import foreign_sign_text
 
 if TYPE_CHECKING:  # app.plan.runner is imported where a run starts, after the first paint
     from app.plan.runner import RunOutcome
 
-__all__ = ["connection_error", "outcome_text", "stopped_by_operator"]
+__all__ = [
+    "connection_error",
+    "foreign_pause_text",
+    "foreign_resume_refused_text",
+    "outcome_text",
+    "stopped_by_operator",
+]
 
 
 def stopped_by_operator() -> str:
@@ -62,3 +69,19 @@ def connection_error(state: ConnectionState) -> TeachPadError:
             params=where,
         )
     return LinkError(f"link lost: {state.message or 'link lost'}", params=where)
+
+
+def foreign_pause_text(what: str, value: float) -> str:
+    """Why a run paused itself: a sign of another master (``what``, ``value``: app/link/foreign.py)."""
+    return QCoreApplication.translate(
+        "PlanRunController", "Paused: another master wrote to the controller ({sign})"
+    ).format(sign=foreign_sign_text(what, value))
+
+
+def foreign_resume_refused_text(hold: float, left: float) -> str:
+    """Why Resume did nothing: another master was seen less than ``hold`` s ago (``left`` s to go)."""
+    return QCoreApplication.translate(
+        "PlanRunController",
+        "Not resumed: another master wrote to the controller less than {hold} s ago. "
+        "Make sure no other master is commanding the robot; Resume is possible in {left} s.",
+    ).format(hold=f"{hold:g}", left=f"{max(left, 0.1):.1f}")

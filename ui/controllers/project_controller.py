@@ -13,9 +13,13 @@ by a fake in tests.
 
 Autosave: every :data:`AUTOSAVE_INTERVAL_S` seconds while the project has unsaved changes, to
 ``<name>.autosave.json`` next to the project (or the per-user directory for an untitled
-project). A save removes it. At startup :meth:`ProjectController.check_recovery` returns an
-autosave newer than its project (a crash left it); :meth:`ProjectController.offer_recovery`
-asks and loads it. :meth:`ProjectController.close` stops the timer.
+project). Off the GUI thread: the GUI thread takes an immutable snapshot (milliseconds) and the
+:class:`~app.points.autosave.AutosaveWriter`'s thread turns it into the file and writes it, newest
+last; ``autosaved`` (or "Autosave failed: ..." on ``statusMessage``) follows in the GUI thread. A
+save removes it (after the write under way, if any, has landed). At startup
+:meth:`ProjectController.check_recovery` returns an autosave newer than its project (a crash left
+it); :meth:`ProjectController.offer_recovery` asks and loads it. :meth:`ProjectController.close`
+stops the timer and waits (at most :data:`AUTOSAVE_FLUSH_S`) for the autosave under way.
 
 One instance per project: the open project's lock file (:mod:`app.points.lock`) is taken when
 it is opened or saved under a new name and released when another project replaces it or the
@@ -37,22 +41,20 @@ from PySide6.QtCore import QObject, QTimer, Signal, Slot
 from PySide6.QtGui import QAction, QKeySequence, QUndoStack
 
 from app.errors import InvalidInput
+from app.points.autosave import AutosaveDone, AutosaveWriter, autosave_path, discard_autosave, find_autosave
 from app.points.ledger import EmptyImport, ImportMode, PointLedger
 from app.points.point import FileFormatError
 from app.points.project import (
     PROJECT_SUFFIX,
     Project,
     ProjectTooLarge,
-    autosave_path,
-    discard_autosave,
-    find_autosave,
     load_project,
     project_bytes,
     read_points_csv,
-    save_autosave,
     save_project,
     write_points_csv,
 )
+from app.points.project_write import take_snapshot
 from ui.controllers.project_dialogs import ProjectDialogs
 from ui.messages import os_error_text, refusal_text
 from ui.models.plan_model import PlanListModel
@@ -62,9 +64,12 @@ if TYPE_CHECKING:  # app.points.lock is imported by the first open / save
     from app.points.lock import LockOwner, ProjectLock
 
 AUTOSAVE_INTERVAL_S = 60.0  # seconds between autosaves while there are unsaved changes
+#: The longest a close, a save or a discard waits for the autosave being written (s): a 58 MB
+#: project is written in about a second; a stuck disk must not hold the window for ever.
+AUTOSAVE_FLUSH_S = 10.0
 SAVE_CHOICES = ("save", "discard", "cancel")
 
-__all__ = ["AUTOSAVE_INTERVAL_S", "SAVE_CHOICES", "ProjectController", "ProjectDialogs"]
+__all__ = ["AUTOSAVE_FLUSH_S", "AUTOSAVE_INTERVAL_S", "SAVE_CHOICES", "ProjectController", "ProjectDialogs"]
 
 
 class ProjectController(QObject):
@@ -85,6 +90,7 @@ class ProjectController(QObject):
     titleChanged = Signal(str)
     autosaved = Signal(str)
     statusMessage = Signal(str)
+    _autosaveDone = Signal(object)  # AutosaveDone, from the writer's thread (queued to the GUI thread)
 
     def __init__(
         self,
@@ -115,6 +121,9 @@ class ProjectController(QObject):
         self.undo_stack.indexChanged.connect(self._check_dirty)
         self.points_model.syncChanged.connect(self._check_dirty)
 
+        self._closed = False
+        self._autosaveDone.connect(self._on_autosave_done)
+        self.autosaver = AutosaveWriter(self._autosaveDone.emit)
         self._timer = QTimer(self)
         self._timer.timeout.connect(self.autosave_now)
         self.set_autosave_interval(autosave_interval)
@@ -262,6 +271,7 @@ class ProjectController(QObject):
         if owner is not None:
             self.dialogs.error(self.tr("Project in use"), self._in_use_text(target, owner))
             return False
+        self._drain_autosave()  # none lands after the save has removed it
         try:
             save_project(self._project, target)
         except ProjectTooLarge as exc:
@@ -351,6 +361,7 @@ class ProjectController(QObject):
         if choice == "save":
             return self.save()
         if choice == "discard":
+            self._drain_autosave()
             discard_autosave(self._path, user_dir=self._autosave_dir)
             return True
         return False
@@ -358,25 +369,46 @@ class ProjectController(QObject):
     # --- autosave and recovery
     @Slot()
     def autosave_now(self) -> Path | None:
-        """Write the autosave if there are changes since the last save / autosave."""
+        """Autosave if there are changes since the last save / autosave: the snapshot is taken
+        here, the file written by the writer's thread (``autosaved`` when it is on disk). Returns
+        the autosave's path, or None when there was nothing to save."""
         revision = self._project.revision
-        if not self.is_dirty or revision == self._autosaved_revision:
+        if self._closed or not self.is_dirty or revision == self._autosaved_revision:
             return None
-        try:
-            written = save_autosave(self._project, self._path, user_dir=self._autosave_dir)
-        except ProjectTooLarge as exc:
-            self.statusMessage.emit(self.tr("Autosave failed: {reason}").format(reason=refusal_text(exc)))
-            return None
-        except OSError as exc:
+        target = self.autosave_file
+        self.autosaver.submit(take_snapshot(self._project), target)
+        self._autosaved_revision = revision
+        return target
+
+    def wait_autosave(self, timeout: float = AUTOSAVE_FLUSH_S) -> bool:
+        """Wait until the autosave submitted last is written (or failed); False after ``timeout``."""
+        return self.autosaver.flush(timeout)
+
+    @Slot(object)
+    def _on_autosave_done(self, done: AutosaveDone) -> None:
+        if done.error is None:
+            self.autosaved.emit(str(done.target))
+            return
+        if done.revision == self._autosaved_revision:
+            self._autosaved_revision = -1  # not on disk: the next tick tries again
+        if isinstance(done.error, ProjectTooLarge):
+            reason = refusal_text(done.error)
+        elif isinstance(done.error, OSError):
+            reason = os_error_text(done.target, done.error)
+        else:
+            reason = str(done.error) or type(done.error).__name__
+        self.statusMessage.emit(self.tr("Autosave failed: {reason}").format(reason=reason))
+
+    def _drain_autosave(self) -> None:
+        """Before a save, a discard or another project: the autosave waiting is dropped and the
+        one being written lands (bounded), so none appears after it was removed."""
+        self.autosaver.cancel()
+        if not self.autosaver.flush(AUTOSAVE_FLUSH_S):
             self.statusMessage.emit(
-                self.tr("Autosave failed: {reason}").format(
-                    reason=os_error_text(self._path or self._project.name, exc)
+                self.tr("The autosave {path} is still being written after {seconds} s.").format(
+                    path=self.autosave_file, seconds=f"{AUTOSAVE_FLUSH_S:g}"
                 )
             )
-            return None
-        self._autosaved_revision = revision
-        self.autosaved.emit(str(written))
-        return written
 
     def check_recovery(self) -> Path | None:
         """The autosave to offer at startup (newer than the project, or of an untitled one);
@@ -417,11 +449,22 @@ class ProjectController(QObject):
         return True
 
     @Slot()
-    def close(self) -> None:
-        """Stop autosaving and release the project's lock (the window is closing; call
-        :meth:`maybe_save` first)."""
+    def close(self) -> bool:
+        """Stop autosaving, let the autosave under way land (at most :data:`AUTOSAVE_FLUSH_S`) and
+        release the project's lock (the window is closing; call :meth:`maybe_save` first). False
+        when the autosave was still being written (then said on ``statusMessage``)."""
         self._timer.stop()
+        self._closed = True
+        landed = self.autosaver.flush(AUTOSAVE_FLUSH_S)
+        if not landed:
+            self.statusMessage.emit(
+                self.tr("The autosave {path} is still being written after {seconds} s.").format(
+                    path=self.autosave_file, seconds=f"{AUTOSAVE_FLUSH_S:g}"
+                )
+            )
+        self.autosaver.close(0.0 if not landed else AUTOSAVE_FLUSH_S)
         self._release_lock()
+        return landed
 
     @property
     def lock_owner(self) -> LockOwner | None:
@@ -466,6 +509,7 @@ class ProjectController(QObject):
 
     # --- internals
     def _replace(self, project: Project, path: Path | None, *, dirty: bool = False) -> None:
+        self._drain_autosave()  # the old project's autosave lands before anything changes
         old_path = self._path
         self.undo_stack.clear()
         self._project = project

@@ -24,15 +24,16 @@
   fresh_profile`: the robot model's joint limits and a keep-in box from its reach, on.
 * **Audit**: the link's :class:`~app.safety.audit.AuditLog` follows the role in force.
 
-Files: next to an INI settings file (tests, portable installs) or in the user's directories.
+Files: where :func:`~app.safety.location.safety_location` says (machine-wide when an administrator
+made the folder, else the user's), the same for the CLI; never beside a settings file, which
+``teachpad --settings`` can point anywhere.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import TYPE_CHECKING, Protocol
 
-from PySide6.QtCore import QEvent, QObject, QSettings, QTimer, Signal, Slot
+from PySide6.QtCore import QEvent, QObject, QTimer, Signal, Slot
 from PySide6.QtGui import QAction, QGuiApplication
 from PySide6.QtWidgets import QAbstractItemView, QWidget
 
@@ -44,19 +45,19 @@ from app.models import Pose
 from app.plan.geometry import PointLike
 from app.plan.segments import Segment
 from app.points.ledger import PointLedger
-from app.safety.audit import AuditLog, default_audit_dir
+from app.safety.audit import AuditLog
 from app.safety.caps import MotionCaps
 from app.safety.envelope import Envelope, EnvelopeRefused, EnvelopeViolation, ViolationCode
 from app.safety.jog_guard import JogMotion
+from app.safety.location import SafetyLocation, safety_location
 from app.safety.profile import SafetyProfile, fresh_profile, load_profile, save_profile
-from app.safety.roles import REQUIRED_ROLE, Action, Role, RoleStore, default_config_dir, default_store_path
+from app.safety.roles import REQUIRED_ROLE, Action, Role, RoleStore
 from app.safety.session import PermissionRefused, SafetySession
 
 if TYPE_CHECKING:  # the robot model is read by its first use (a fresh install, reduced speed)
     from app.view3d.profile import RobotProfile
 
 IDLE_POLL_MS = 1000
-PROFILE_NAME = "envelope.safety.json"
 _TOUCH_EVENTS = (
     QEvent.Type.MouseButtonPress,
     QEvent.Type.KeyPress,
@@ -84,15 +85,6 @@ class EditGated(Protocol):
     def set_edit_permission(self, reason: str | None) -> None: ...
 
 
-def safety_paths(store: QSettings) -> tuple[Path, Path, Path]:
-    """(role store, audit directory, envelope profile) for a settings store: beside an INI file
-    (tests and portable installs keep everything together), else the user's directories."""
-    if store.format() == QSettings.Format.IniFormat and store.fileName():
-        base = Path(store.fileName()).parent / "safety"
-        return base / "roles.json", base / "audit", base / PROFILE_NAME
-    return default_store_path(), default_audit_dir(), default_config_dir() / PROFILE_NAME
-
-
 def lock_editing(view: QAbstractItemView, locked: bool) -> None:
     """Role gating of a table's cell edits: off while ``locked``, its own triggers back after."""
     if locked:
@@ -117,15 +109,17 @@ class SafetyController(QObject):
     def __init__(
         self,
         link: RobotLink | None,
-        store: QSettings,
-        parent: QObject | None = None,
         *,
+        parent: QObject | None = None,
         scrypt_n: int | None = None,
     ) -> None:
+        # (no settings store: the safety state does not follow it; an old call passing one fails)
         super().__init__(parent)
         self.link = link
-        roles_path, audit_dir, self.profile_path = safety_paths(store)
+        self.location: SafetyLocation = safety_location()  # not beside the settings file (see above)
+        roles_path, audit_dir = self.location.roles, self.location.audit_dir
         self.audit_dir = audit_dir
+        self.profile_path = self.location.envelope
         try:
             roles = RoleStore(roles_path) if scrypt_n is None else RoleStore(roles_path, scrypt_n=scrypt_n)
         except TeachPadError as exc:  # a damaged store: operator only, and say so

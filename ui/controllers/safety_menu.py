@@ -6,7 +6,8 @@ the robot model: engineer), feeds the envelope to the planner, the 3D view and t
 adds the menu: log in / out, reduced speed, envelope, register profile, passwords and lock, audit
 trail, support bundle; a status-bar label shows the role.
 
-The register profile in force is a file beside the settings (``AppSettings.register_profile_path``);
+The register profile in force is a file beside the role store (``AppSettings.register_profile_path``,
+:mod:`app.safety.location`; never beside the settings file);
 ``AppSettings.connection()`` applies it, so every connection made from the remembered settings
 uses it. :meth:`SafetyMenu.apply_register_profile` saves a new one (administrator, audited) and can
 reconnect the link at once with it.
@@ -250,6 +251,7 @@ class SafetyMenu(QObject):
         window = self.window
         store = window.settings.store
         settings = {key: store.value(key) for key in store.allKeys()}
+        settings["safety_state"] = self.safety.location.describe()  # where roles, envelope, audit live
         project = window.project.path
         profile = self.safety.profile_path if self.safety.profile_path.exists() else None
         register_profile: Path | None = window.settings.register_profile_path()
@@ -315,8 +317,9 @@ def attach_view3d(safety: SafetyController, panel: View3DPanel) -> None:
 
 def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> SafetyMenu:
     """Compose the guard rails onto ``window`` (its 3D view already installed)."""
-    safety = SafetyController(window.link, window.settings.store, window, scrypt_n=scrypt_n)
+    safety = SafetyController(window.link, parent=window, scrypt_n=scrypt_n)
     safety.set_poll_rate(window.settings.poll_hz)  # the jog guard's margin follows the poll period
+    window.run_controller.audit = safety.session.audit  # a run's own pause is audited (issue 19)
     menu = SafetyMenu(window, safety)
     safety.gate(window.menus.connect_action, Action.CONNECTION)
     safety.gate(menu.envelope_action, Action.EDIT_ENVELOPE)

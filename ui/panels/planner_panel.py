@@ -39,6 +39,7 @@ from app.plan.segments import Plan, SegmentKind
 from app.points.ledger import UploadReport
 from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.plan_run_reasons import foreign_pause_text
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
@@ -128,6 +129,8 @@ class PlannerPanel(QWidget):
         r.connectedChanged.connect(self._update_actions)
         r.progressChanged.connect(self._on_progress)
         r.runFinished.connect(self._on_run_finished)
+        r.pausedByForeign.connect(self._on_paused_by_foreign)
+        r.resumeRefused.connect(self._on_resume_refused)
         r.poseChanged.connect(self.preview.on_pose)
         r.poseChanged.connect(self._on_pose)
         if point_sync is not None:
@@ -433,6 +436,18 @@ class PlannerPanel(QWidget):
             self.show_message(text, level)
         self._update_resume_text()
         self._update_actions()
+
+    @Slot(str, float)
+    def _on_paused_by_foreign(self, what: str, value: float) -> None:
+        """The run paused itself at a sign of another master: the run box says why."""
+        text = foreign_pause_text(what, value)
+        self.run_box.show_paused(text)
+        self.show_message(text, "warn")
+
+    @Slot(str)
+    def _on_resume_refused(self, text: str) -> None:
+        self.run_box.show_paused(text)
+        self.show_message(text, "warn")
 
     def _update_resume_text(self) -> None:
         k = self._runner.resume_from if self._runner.can_resume else None

@@ -217,6 +217,10 @@ class PlanRunBox(QGroupBox):
     def show_ended(self, text: str) -> None:
         self.run_label.setText(text)
 
+    def show_paused(self, text: str) -> None:
+        """Why the run is paused or not resumed (a run that paused itself; issue 19)."""
+        self.run_label.setText(text)
+
 
 class PlanChecksBar(QWidget):
     """The checks under the segment table (wrapped to the room left), Upload now and Check on

@@ -241,6 +241,9 @@ class StatusPanel(QWidget):
         rows["drift"].setText(self.tr("Drift:"))
         self.rtt_label.setToolTip(self.tr("Round-trip time of the last poll"))
         self.rtt_label.fit_texts([self.tr("{ms} ms").format(ms="9999.9")])
+        # a drift of up to ~3 years keeps the label's width (a wider one grows it once)
+        drift = self.tr("{drift} s").format(drift="-99999999")
+        self.drift_label.fit_texts([drift, self.tr("{value} (stale)").format(value=drift)])
         for bit in ALARM_BITS:
             lamp = self.alarm_lamps[int(bit)]
             lamp.setText(_protocol_tr(ALARM_TEXT[bit]))
@@ -423,7 +426,7 @@ class StatusPanel(QWidget):
             self.drift_label.set_style(f"color: {COLOR_NEUTRAL};")
             return
         stamp = clock.value.strftime("%Y-%m-%d %H:%M:%S")
-        drift_text = self.tr("{drift} s").format(drift=f"{drift:+.0f}")
+        drift_text = self.tr("{drift} s").format(drift=f"{round(drift):+d}")  # never "-0"
         if not self._fresh:  # the last reading, no longer ticking: grey, italic, marked stale
             self.clock_label.setText(stamp)
             self.drift_label.setText(self.tr("{value} (stale)").format(value=drift_text))

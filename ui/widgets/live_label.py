@@ -5,7 +5,10 @@ asks its own parent's (``QLayout::activate`` ends in ``updateGeometry``) -- up t
 window, whose layout then re-places every dock and toolbar (creating a geometry animation for
 each) and repaints what it covers. Qt stops that walk at a widget whose size is fixed. A
 :class:`LiveLabel` keeps a fixed size: as wide as the widest text it was given up front
-(``samples``) or has shown since. A new text repaints the label only; a wider one than ever
+(``samples``) or has shown since; the digits of a sample stand for any digit (room is made for
+the widest digit of the font in use), and the samples are measured again when the font or the
+style changes (an italic "stale" style may fall back to another font, with other widths). A new
+text repaints the label only; a wider one than ever
 before grows it once (one re-layout), and it never shrinks, so nothing beside it moves back
 and forth. Its style sheet is set only when it changes (``set_style``): setting one re-polishes
 the widget even when the text is the same. ``opaque``: the label fills its own background (the
@@ -20,7 +23,13 @@ from collections.abc import Iterable
 from PySide6.QtCore import QEvent
 from PySide6.QtWidgets import QLabel, QWidget
 
+from ui.widgets.number_text import widest_digits
+
 __all__ = ["LiveLabel"]
+
+# Room beyond a sample's measured width: a text of the same shape can round a pixel wider
+# (fractional advances, kerning between other digits).
+SAMPLE_SLACK_PX = 2
 
 
 class LiveLabel(QLabel):
@@ -36,16 +45,24 @@ class LiveLabel(QLabel):
     ) -> None:
         super().__init__(text, parent)
         self._style = ""
+        self._samples: dict[str, None] = {}  # ordered, no repeats (retranslate adds them again)
         self.setAutoFillBackground(opaque)
         self.setFixedSize(self.sizeHint())
         self.fit_texts(samples)
 
     def fit_texts(self, texts: Iterable[str]) -> None:
-        """Make room for each of ``texts`` (e.g. the widest value, in every language) now."""
+        """Make room for each of ``texts`` (e.g. the widest value, in every language) now, and
+        again whenever the font or the style changes; their digits stand for any digit."""
+        self._samples.update(dict.fromkeys(texts))
+        self._fit_samples()
+
+    def _fit_samples(self) -> None:
         shown = self.text()
-        for text in texts:
-            super().setText(text)
-            self._grow()
+        metrics = self.fontMetrics()
+        for text in self._samples:
+            for sample in (text, widest_digits(text, metrics)):
+                super().setText(sample)
+                self._grow(SAMPLE_SLACK_PX)
         super().setText(shown)
 
     def setText(self, text: str) -> None:  # QLabel's name: the label's API
@@ -66,11 +83,12 @@ class LiveLabel(QLabel):
     def changeEvent(self, event: QEvent) -> None:
         super().changeEvent(event)
         if event.type() in (QEvent.Type.FontChange, QEvent.Type.StyleChange):
-            self._grow()  # a font or a style (padding) may need more room
+            self._fit_samples()  # a font or a style (padding, italic) may need more room
+            self._grow()
 
-    def _grow(self) -> None:
+    def _grow(self, slack: int = 0) -> None:
         hint = self.sizeHint()
-        width = max(self.maximumWidth(), hint.width())
+        width = max(self.maximumWidth(), hint.width() + slack)
         height = max(self.maximumHeight(), hint.height(), self.minimumHeight())
         if (width, height) != (self.maximumWidth(), self.maximumHeight()):
             self.setFixedSize(width, height)

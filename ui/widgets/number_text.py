@@ -17,7 +17,7 @@ from typing import Final
 
 from PySide6.QtGui import QFontMetrics
 
-__all__ = ["DIGITS", "OVERFLOW", "fit_number", "number_room", "number_text"]
+__all__ = ["DIGITS", "OVERFLOW", "fit_number", "number_room", "number_text", "widest_digits"]
 
 OVERFLOW: Final = "######"
 DIGITS: Final = "0123456789"
@@ -27,6 +27,13 @@ _OVERFLOW_MARK: Final = "#"
 def widest_digit(metrics: QFontMetrics) -> str:
     """The digit with the largest advance in this font (the first of equals)."""
     return max(DIGITS, key=metrics.horizontalAdvance)
+
+
+def widest_digits(text: str, metrics: QFontMetrics) -> str:
+    """``text`` with every digit written as the font's widest one: the room any number of that
+    shape needs (a proportional font, or an italic that falls back to one, has unequal digits)."""
+    digit = widest_digit(metrics)
+    return "".join(digit if c in DIGITS else c for c in text)
 
 
 def number_room(metrics: QFontMetrics, integer_digits: int, decimals: int, *, sign: bool = True) -> int:
