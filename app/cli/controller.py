@@ -57,6 +57,12 @@ __all__ = ["JOG_SECONDS_DEFAULT", "register"]
 JOG_POLL_INTERVAL = 0.05  # s between status checks while a jog runs (keeps a watchdog fed)
 JOG_SECONDS_DEFAULT = 2.0  # s a jog runs when --seconds is not given
 WATCH_RATE_DEFAULT = 10.0  # Hz
+# What the link accepts (RobotClient checks settings.point_id_min..max, the register profile's;
+# PROTOCOL.md: 0 <= id <= 10000 by default).
+_POINT_ID_RANGE = (
+    f"{registers.TEMP_POINT_ID_MIN}..{registers.TEMP_POINT_ID_MAX} "
+    "(the register profile's point_id_min..point_id_max)"
+)
 
 
 # --------------------------------------------------------------------------------------------
@@ -503,7 +509,7 @@ def register(sub: Any) -> None:
     p = sub.add_parser("point", help="temp points (function 2)")
     psub = p.add_subparsers(dest="point_command", metavar="ACTION", required=True)
     pc = psub.add_parser("create", help="create or overwrite a temp point")
-    pc.add_argument("id", type=int, help="temp point id, 1..10000")
+    pc.add_argument("id", type=int, help=f"temp point id, {_POINT_ID_RANGE}")
     src = pc.add_mutually_exclusive_group()
     src.add_argument("--from-pose", action="store_true", help="from the current pose (default)")
     src.add_argument(
@@ -524,7 +530,7 @@ def register(sub: Any) -> None:
     pc.set_defaults(handler=cmd_point_create)
 
     p = sub.add_parser("move", help="move to a temp point: line, or arc with --via (function 3)")
-    p.add_argument("id", type=int, help="temp point id of the end point, 1..10000")
+    p.add_argument("id", type=int, help=f"temp point id of the end point, {_POINT_ID_RANGE}")
     p.add_argument("--via", type=int, metavar="MID", help="temp point id of an arc's middle point")
     p.add_argument("--speed", type=parse_positive_float, default=50.0, help="mm/s (default %(default)g)")
     p.add_argument(

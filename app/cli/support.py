@@ -19,6 +19,7 @@ GUI; the role store itself is guarded by the administrator's password here too.
 from __future__ import annotations
 
 import getpass
+import io
 import json
 import os
 import sys
@@ -29,6 +30,7 @@ from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode
 from app.cli.format import parse_moment, parse_positive_int
 from app.errors import InvalidInput
+from app.points.atomic import atomic_write_bytes
 from app.safety.audit import (
     AuditFilter,
     AuditLog,
@@ -210,13 +212,13 @@ def cmd_audit(ctx: CliContext) -> ExitCode:
     records = query(args.audit_dir or default_audit_dir(), flt, stats)
     unknown = unknown_count(records)
     if args.csv is not None:
-        with open(args.csv, "w", encoding="utf-8", newline="") as f:
-            n = export_csv(records, f)
+        buffer = io.StringIO(newline="")
+        n = export_csv(records, buffer)
+        # UTF-8 with a BOM: Excel on a Chinese Windows reads it as UTF-8 (without, as GBK)
+        atomic_write_bytes(args.csv, buffer.getvalue().encode("utf-8-sig"))
         ctx.print(f"wrote {n} records to {args.csv} ({unknown} unknown)")
     else:
-        for r in records:
-            extra = f" - {r.detail}" if r.detail else ""
-            ctx.print(f"{r.host_time}  {r.role:<13} {result_label(r):<11} {r.command}{extra}")
+        _print_table(ctx, records)
     if unknown and args.result != Result.UNKNOWN:
         ctx.warn(
             f"{unknown} write(s) with result unknown: sent, and what the controller did is not known "
@@ -225,6 +227,17 @@ def cmd_audit(ctx: CliContext) -> ExitCode:
     if stats.skipped:
         ctx.warn(f"{stats.skipped} damaged line(s) skipped")
     return ExitCode.OK
+
+
+def _print_table(ctx: CliContext, records: list[AuditRecord]) -> None:
+    """One line per record, the role and result columns as wide as their widest entry (the
+    CLI's own role, "administrator (cli)", is wider than the GUI's)."""
+    labels = [result_label(r) for r in records]
+    role_width = max((len(r.role) for r in records), default=0)
+    result_width = max((len(label) for label in labels), default=0)
+    for r, label in zip(records, labels, strict=True):
+        extra = f" - {r.detail}" if r.detail else ""
+        ctx.print(f"{r.host_time}  {r.role:<{role_width}}  {label:<{result_width}}  {r.command}{extra}")
 
 
 def _verify(ctx: CliContext, directory: Path) -> ExitCode:
