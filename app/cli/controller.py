@@ -22,7 +22,6 @@ from app.cli.format import (
     JOG_SECONDS_MAX,
     format_number,
     format_status,
-    format_watch_line,
     parse_axis,
     parse_direction,
     parse_jog_seconds,
@@ -31,6 +30,7 @@ from app.cli.format import (
     parse_zero_axis,
     status_to_dict,
 )
+from app.cli.watching import add_watch_parser
 from app.errors import AlarmRaised, InvalidInput, OutcomeUnknown, Reason, TeachPadError
 from app.link.client import RobotClient, StepFrame
 from app.link.halt import HaltWatch, HaltWrite, confirm_halt
@@ -56,7 +56,6 @@ __all__ = ["JOG_SECONDS_DEFAULT", "register"]
 
 JOG_POLL_INTERVAL = 0.05  # s between status checks while a jog runs (keeps a watchdog fed)
 JOG_SECONDS_DEFAULT = 2.0  # s a jog runs when --seconds is not given
-WATCH_RATE_DEFAULT = 10.0  # Hz
 # What the link accepts (RobotClient checks settings.point_id_min..max, the register profile's;
 # PROTOCOL.md: 0 <= id <= 10000 by default).
 _POINT_ID_RANGE = (
@@ -81,33 +80,6 @@ def cmd_status(ctx: CliContext) -> ExitCode:
         ctx.print(json.dumps({**status_to_dict(pose, status), "link": client.stats.as_dict()}))
     else:
         ctx.print(format_status(pose, status))
-    return ExitCode.OK
-
-
-def cmd_watch(ctx: CliContext) -> ExitCode:
-    client = ctx.client
-    period = 1.0 / ctx.args.rate
-    count = ctx.args.count
-    start = time.monotonic()
-    next_t = start
-    n = 0
-    try:
-        timeout = ctx.settings.effective_poll_timeout
-        while count <= 0 or n < count:
-            status = client.read_status(timeout=timeout)
-            pose = client.read_pose(timeout=timeout)
-            ctx.print(format_watch_line(time.monotonic() - start, pose, status))
-            n += 1
-            if count > 0 and n >= count:
-                break
-            next_t += period
-            delay = next_t - time.monotonic()
-            if delay > 0:
-                time.sleep(delay)
-            else:
-                next_t = time.monotonic()  # fell behind: do not burst
-    except KeyboardInterrupt:
-        return ExitCode.OK  # Ctrl-C is how a watch normally ends
     return ExitCode.OK
 
 
@@ -446,16 +418,7 @@ def register(sub: Any) -> None:
     p.add_argument("--json", action="store_true", help="one JSON object")
     p.set_defaults(handler=cmd_status)
 
-    p = sub.add_parser("watch", help="stream one status line per sample")
-    p.add_argument(
-        "--rate",
-        type=parse_positive_float,
-        default=WATCH_RATE_DEFAULT,
-        metavar="HZ",
-        help="samples per second, Hz (default %(default)g)",
-    )
-    p.add_argument("--count", type=int, default=0, metavar="N", help="stop after N lines (0: until Ctrl-C)")
-    p.set_defaults(handler=cmd_watch)
+    add_watch_parser(sub)  # app/cli/watching.py
 
     p = sub.add_parser("mode", help="set the work mode")
     p.add_argument("mode", choices=("auto", "manual"), help="auto or manual (register 444)")

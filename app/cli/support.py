@@ -215,7 +215,10 @@ def cmd_audit(ctx: CliContext) -> ExitCode:
         buffer = io.StringIO(newline="")
         n = export_csv(records, buffer)
         # UTF-8 with a BOM: Excel on a Chinese Windows reads it as UTF-8 (without, as GBK)
-        atomic_write_bytes(args.csv, buffer.getvalue().encode("utf-8-sig"))
+        try:
+            atomic_write_bytes(args.csv, buffer.getvalue().encode("utf-8-sig"))
+        except OSError as exc:  # name the file asked for, not the temp file beside it
+            raise OSError(exc.errno, exc.strerror, str(args.csv)) from None
         ctx.print(f"wrote {n} records to {args.csv} ({unknown} unknown)")
     else:
         _print_table(ctx, records)

@@ -5,6 +5,7 @@ length, the audit CSV opens right in Excel (UTF-8 with a BOM)."""
 from __future__ import annotations
 
 import csv
+import json
 from pathlib import Path
 from typing import Any
 
@@ -110,3 +111,56 @@ def test_audit_csv_has_a_bom(tmp_path: Path, capsys: pytest.CaptureFixture[str])
     assert data.startswith(b"\xef\xbb\xbf")
     rows = list(csv.reader(data.decode("utf-8-sig").splitlines()))
     assert rows[0][0] == "host_time" and len(rows) == 4
+
+
+def test_watch_json_lines(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
+    code = main(
+        [
+            "--port",
+            str(csim.port),
+            "--poll-timeout",
+            "1.0",
+            "watch",
+            "--json",
+            "--rate",
+            "100",
+            "--count",
+            "3",
+        ]
+    )
+    out, err = capsys.readouterr()
+    assert code == ExitCode.OK and err == ""
+    samples = [json.loads(line) for line in out.splitlines()]
+    assert len(samples) == 3
+    assert all(s["stale"] is False and s["mode"]["name"] == "auto" for s in samples)
+    assert samples[0]["pose"]["x"] == pytest.approx(csim.state().pose[0], abs=1e-3)
+    assert samples[0]["t"] <= samples[1]["t"] <= samples[2]["t"]
+
+
+def test_watch_goes_on_after_a_missed_poll(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
+    """Every third answer comes after the poll timeout: those samples read "stale", the watch
+    goes on and ends normally."""
+    csim.set_slow_answers(0.8, every=3)
+    argv = ["--port", str(csim.port), "--poll-timeout", "0.4"]
+    code = main([*argv, "watch", "--json", "--rate", "50", "--count", "8", "--down-after", "30"])
+    out, err = capsys.readouterr()
+    assert code == ExitCode.OK, err
+    samples = [json.loads(line) for line in out.splitlines()]
+    assert len(samples) == 8
+    stale = [i for i, s in enumerate(samples) if s["stale"]]
+    assert stale and "did not answer" in samples[stale[0]]["error"]
+    assert any(not s["stale"] for s in samples[stale[0] + 1 :])  # answered again after a miss
+    code = main([*argv, "watch", "--rate", "50", "--count", "8", "--down-after", "30"])
+    out, err = capsys.readouterr()
+    assert code == ExitCode.OK, err
+    assert any(" stale: " in line for line in out.splitlines())
+
+
+def test_watch_exits_3_when_the_link_is_down(csim: Any, capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["--port", str(csim.port), "--poll-timeout", "0.2"]
+    csim.set_silent(True)
+    code = main([*argv, "watch", "--rate", "20", "--down-after", "0.6"])
+    out, err = capsys.readouterr()
+    assert code == ExitCode.LINK
+    assert out and all(" stale: " in line for line in out.splitlines())
+    assert "link is down" in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
