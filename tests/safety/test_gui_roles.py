@@ -148,7 +148,8 @@ def test_audit_viewer_filters_and_exports(qtbot: Any, menu: SafetyMenu, tmp_path
     viewer.refresh()
     assert viewer.model.rowCount() == 1 and viewer.model.records[0].command == "change connection"
     viewer.export()
-    rows = list(csv.reader((tmp_path / "out.csv").read_text(encoding="utf-8").splitlines()))
+    assert (tmp_path / "out.csv").read_bytes().startswith(b"\xef\xbb\xbf")  # UTF-8 with a BOM, for Excel
+    rows = list(csv.reader((tmp_path / "out.csv").read_text(encoding="utf-8-sig").splitlines()))
     assert rows[0][0] == "host_time" and len(rows) == 2
 
 
