@@ -29,7 +29,7 @@ from typing import Final
 
 from app.safety.audit import default_data_dir
 
-__all__ = ["KEEP_DAYS", "MAX_BYTES", "EventStore", "StoredEvent", "default_events_dir"]
+__all__ = ["KEEP_DAYS", "MAX_BYTES", "EventStore", "StoredEvent", "default_events_dir", "export_line"]
 
 KEEP_DAYS: Final = 7  # days of events shown again at start (and so in the support bundle)
 MAX_BYTES: Final = 2 * 1024 * 1024  # one file; with the previous one at most twice this on disk
@@ -49,6 +49,19 @@ class StoredEvent:
     level: str
     source: str
     text: str
+
+
+def export_line(event: StoredEvent) -> str:
+    """The event as the log's export and the support bundle write it: time, LEVEL, source and
+    text, tab-separated, on one line."""
+    return "\t".join(
+        (
+            event.when.isoformat(sep=" ", timespec="milliseconds"),
+            event.level.upper(),
+            event.source,
+            " ".join(event.text.split()),
+        )
+    )
 
 
 class EventStore:

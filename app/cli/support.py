@@ -30,6 +30,7 @@ from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode
 from app.cli.format import parse_moment, parse_positive_int
 from app.errors import InvalidInput
+from app.event_store import EventStore, default_events_dir, export_line
 from app.points.atomic import atomic_write_bytes
 from app.safety.audit import (
     AuditFilter,
@@ -85,6 +86,9 @@ def register(subparsers: Any) -> None:
     p.add_argument("--settings", type=Path, help="a JSON settings file (secrets are removed)")
     p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
     p.add_argument("--log-dir", type=Path, help="a folder of log files to include")
+    p.add_argument(
+        "--events-dir", type=Path, help=f"the GUI's saved event log (default {default_events_dir()})"
+    )
     p.add_argument("--traffic", type=Path, help="a text file of recorded Modbus traffic")
     p.add_argument(
         "--days",
@@ -184,6 +188,7 @@ def cmd_support_bundle(ctx: CliContext) -> ExitCode:
         project=args.project,
         profile=args.profile,
         audit_dir=args.audit_dir or default_audit_dir(),
+        events=[export_line(e) for e in EventStore(args.events_dir, keep_days=args.days).recent()],
         log_dir=args.log_dir,
         traffic=traffic,
         days=args.days,

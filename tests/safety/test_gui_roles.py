@@ -162,8 +162,10 @@ def test_support_bundle_leaves_passwords_out(menu: SafetyMenu, window: Any, tmp_
     with zipfile.ZipFile(out) as zf:
         names = zf.namelist()
         settings = json.loads(zf.read("settings.json"))
+        left_out = json.loads(zf.read("manifest.json"))["left_out"]
     assert "versions.json" in names and any(n.startswith("audit/") for n in names)
-    assert "events.txt" in names and "traffic.txt" in names
+    # never connected: no traffic, and the manifest says so (issue 21)
+    assert "traffic.txt" not in names and any(n.startswith("Modbus traffic: no frames") for n in left_out)
     assert "secret" not in json.dumps(settings)
 
 

@@ -42,7 +42,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.event_store import EventStore, StoredEvent
+from app.event_store import EventStore, StoredEvent, export_line
 from app.link.state import RobotState
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult
@@ -463,17 +463,7 @@ class EventLogPanel(QWidget):
                 self.model.event_at(self.proxy.mapToSource(self.proxy.index(row, 0)).row())
                 for row in range(self.proxy.rowCount())
             )
-        lines = [
-            "\t".join(
-                (
-                    e.when.isoformat(sep=" ", timespec="milliseconds"),
-                    e.level.upper(),
-                    e.source,
-                    " ".join(e.text.split()),
-                )
-            )  # one line per event
-            for e in events
-        ]
+        lines = [export_line(_stored(e)) for e in events]  # one line per event
         atomic_write_text(path, "".join(line + "\n" for line in lines), encoding="utf-8-sig")
         return len(lines)
 
