@@ -487,7 +487,7 @@ def register(sub: Any) -> None:
         type=int,
         default=registers.TOOL_NONE,
         metavar="N",
-        help="GV245: 200 none (default), N = tool N+1",
+        help="tool frame 0..199 as GV245, the CSV and the GUI number it; 200 none (default)",
     )
     pc.add_argument("--gv-start", type=int, default=0, metavar="N", help="first of the six pose GVs")
     pc.set_defaults(handler=cmd_point_create)

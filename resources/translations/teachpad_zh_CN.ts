@@ -134,102 +134,102 @@
     <context>
         <name>AuditModel</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="63" />
+            <location filename="../../ui/panels/audit_viewer.py" line="65" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="64" />
+            <location filename="../../ui/panels/audit_viewer.py" line="66" />
             <source>Role</source>
             <translation>角色</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="65" />
+            <location filename="../../ui/panels/audit_viewer.py" line="67" />
             <source>Kind</source>
             <translation>类型</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="66" />
+            <location filename="../../ui/panels/audit_viewer.py" line="68" />
             <source>Command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="67" />
+            <location filename="../../ui/panels/audit_viewer.py" line="69" />
             <source>Result</source>
             <translation>结果</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="68" />
+            <location filename="../../ui/panels/audit_viewer.py" line="70" />
             <source>Detail</source>
             <translation>详情</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="87" />
+            <location filename="../../ui/panels/audit_viewer.py" line="89" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="88" />
+            <location filename="../../ui/panels/audit_viewer.py" line="90" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="89" />
+            <location filename="../../ui/panels/audit_viewer.py" line="91" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="90" />
+            <location filename="../../ui/panels/audit_viewer.py" line="92" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="91" />
+            <location filename="../../ui/panels/audit_viewer.py" line="93" />
             <source>write</source>
             <translation>写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="92" />
+            <location filename="../../ui/panels/audit_viewer.py" line="94" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="93" />
+            <location filename="../../ui/panels/audit_viewer.py" line="95" />
             <source>login</source>
             <translation>登录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="94" />
+            <location filename="../../ui/panels/audit_viewer.py" line="96" />
             <source>action</source>
             <translation>操作</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="95" />
+            <location filename="../../ui/panels/audit_viewer.py" line="97" />
             <source>answered</source>
             <translation>已应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="99" />
+            <location filename="../../ui/panels/audit_viewer.py" line="101" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="100" />
+            <location filename="../../ui/panels/audit_viewer.py" line="102" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="96" />
+            <location filename="../../ui/panels/audit_viewer.py" line="98" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="97" />
+            <location filename="../../ui/panels/audit_viewer.py" line="99" />
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <location filename="../../ui/panels/audit_viewer.py" line="100" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
@@ -237,152 +237,152 @@
     <context>
         <name>AuditViewer</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="116" />
+            <location filename="../../ui/panels/audit_viewer.py" line="118" />
             <source>Audit trail</source>
             <translation>审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="126" />
+            <location filename="../../ui/panels/audit_viewer.py" line="128" />
             <source>Any role</source>
             <translation>任意角色</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="128" />
+            <location filename="../../ui/panels/audit_viewer.py" line="130" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="129" />
+            <location filename="../../ui/panels/audit_viewer.py" line="131" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="130" />
+            <location filename="../../ui/panels/audit_viewer.py" line="132" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="131" />
+            <location filename="../../ui/panels/audit_viewer.py" line="133" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="135" />
+            <location filename="../../ui/panels/audit_viewer.py" line="137" />
             <source>Command contains…</source>
             <translation>命令包含…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="137" />
+            <location filename="../../ui/panels/audit_viewer.py" line="139" />
             <source>Any result</source>
             <translation>任意结果</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="144" />
+            <location filename="../../ui/panels/audit_viewer.py" line="146" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="145" />
+            <location filename="../../ui/panels/audit_viewer.py" line="147" />
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="140" />
+            <location filename="../../ui/panels/audit_viewer.py" line="142" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="139" />
+            <location filename="../../ui/panels/audit_viewer.py" line="141" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="141" />
+            <location filename="../../ui/panels/audit_viewer.py" line="143" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="142" />
+            <location filename="../../ui/panels/audit_viewer.py" line="144" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="143" />
+            <location filename="../../ui/panels/audit_viewer.py" line="145" />
             <source>answered</source>
             <translation>已应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="148" />
+            <location filename="../../ui/panels/audit_viewer.py" line="150" />
             <source>Show</source>
             <translation>显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="150" />
+            <location filename="../../ui/panels/audit_viewer.py" line="152" />
             <source>Export CSV…</source>
             <translation>导出 CSV…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="160" />
+            <location filename="../../ui/panels/audit_viewer.py" line="162" />
             <source>From</source>
             <translation>从</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="160" />
+            <location filename="../../ui/panels/audit_viewer.py" line="162" />
             <source>to</source>
             <translation>到</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="193" />
+            <location filename="../../ui/panels/audit_viewer.py" line="195" />
             <source>{n} records</source>
             <translation>{n} 条记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="195" />
+            <location filename="../../ui/panels/audit_viewer.py" line="197" />
             <source>{n} records ({skipped} damaged lines skipped)</source>
             <translation>{n} 条记录（跳过 {skipped} 行损坏的记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="197" />
+            <location filename="../../ui/panels/audit_viewer.py" line="199" />
             <source>{unknown} writes whose answer or outcome was not recorded</source>
             <translation>{unknown} 条写入的应答或结果未记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="209" />
+            <location filename="../../ui/panels/audit_viewer.py" line="211" />
             <source>The chain of hashes breaks at {file} line {line}: records before it were removed.</source>
             <translation>哈希链在 {file} 第 {line} 行断开：此前的记录已被删除。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="213" />
+            <location filename="../../ui/panels/audit_viewer.py" line="215" />
             <source>The chain of hashes breaks at {file} line {line}: the record before it was changed, or records were removed.</source>
             <translation>哈希链在 {file} 第 {line} 行断开：此前的记录被修改，或有记录被删除。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="218" />
+            <location filename="../../ui/panels/audit_viewer.py" line="220" />
             <source>{n} breaks in all.</source>
             <translation>共 {n} 处断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="221" />
+            <location filename="../../ui/panels/audit_viewer.py" line="223" />
             <source>(No chain of hashes: records of an older TeachPad.)</source>
             <translation>（无哈希链：旧版 TeachPad 的记录。）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="226" />
+            <location filename="../../ui/panels/audit_viewer.py" line="228" />
             <source>Export the audit trail</source>
             <translation>导出审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="226" />
+            <location filename="../../ui/panels/audit_viewer.py" line="228" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="239" />
+            <location filename="../../ui/panels/audit_viewer.py" line="242" />
             <source>Cannot write {file}: {why}</source>
             <translation>无法写入 {file}：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="242" />
+            <location filename="../../ui/panels/audit_viewer.py" line="245" />
             <source>{n} records exported to {file}</source>
             <translation>已将 {n} 条记录导出到 {file}</translation>
         </message>
@@ -818,37 +818,37 @@
     <context>
         <name>EventLogModel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="121" />
+            <location filename="../../ui/panels/event_log.py" line="123" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="122" />
+            <location filename="../../ui/panels/event_log.py" line="124" />
             <source>Level</source>
             <translation>级别</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="123" />
+            <location filename="../../ui/panels/event_log.py" line="125" />
             <source>Source</source>
             <translation>来源</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="124" />
+            <location filename="../../ui/panels/event_log.py" line="126" />
             <source>Message</source>
             <translation>消息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="127" />
+            <location filename="../../ui/panels/event_log.py" line="129" />
             <source>Info</source>
             <translation>信息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="128" />
+            <location filename="../../ui/panels/event_log.py" line="130" />
             <source>Warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="129" />
+            <location filename="../../ui/panels/event_log.py" line="131" />
             <source>Error</source>
             <translation>错误</translation>
         </message>
@@ -856,72 +856,82 @@
     <context>
         <name>EventLogPanel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="296" />
+            <location filename="../../ui/panels/event_log.py" line="308" />
             <source>Show:</source>
             <translation>显示：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="297" />
+            <location filename="../../ui/panels/event_log.py" line="309" />
             <source>All events</source>
             <translation>全部事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="298" />
+            <location filename="../../ui/panels/event_log.py" line="310" />
             <source>Warnings and errors</source>
             <translation>警告和错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="299" />
+            <location filename="../../ui/panels/event_log.py" line="311" />
             <source>Errors only</source>
             <translation>仅错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="300" />
+            <location filename="../../ui/panels/event_log.py" line="312" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="301" />
+            <location filename="../../ui/panels/event_log.py" line="313" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="363" />
+            <location filename="../../ui/panels/event_log.py" line="356" />
+            <source>event log</source>
+            <translation>事件日志</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="357" />
+            <source>The event log is not saved for the next start: {why}</source>
+            <translation>事件日志无法保存到下次启动：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="407" />
             <source>alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="360" />
+            <location filename="../../ui/panels/event_log.py" line="404" />
             <source>Alarm raised: {name}</source>
             <translation>报警触发：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="360" />
+            <location filename="../../ui/panels/event_log.py" line="404" />
             <source>Alarm cleared: {name}</source>
             <translation>报警解除：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="369" />
+            <location filename="../../ui/panels/event_log.py" line="413" />
             <source>bit {n}</source>
             <translation>第 {n} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="373" />
+            <location filename="../../ui/panels/event_log.py" line="417" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="405" />
+            <location filename="../../ui/panels/event_log.py" line="449" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="432" />
+            <location filename="../../ui/panels/event_log.py" line="474" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="434" />
+            <location filename="../../ui/panels/event_log.py" line="476" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -1173,17 +1183,17 @@
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="106" />
+            <location filename="../../ui/window_docks.py" line="117" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="107" />
+            <location filename="../../ui/window_docks.py" line="118" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="108" />
+            <location filename="../../ui/window_docks.py" line="119" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
@@ -1271,7 +1281,7 @@
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="109" />
+            <location filename="../../ui/window_docks.py" line="120" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
@@ -2080,37 +2090,37 @@
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="494" />
+            <location filename="../../ui/messages.py" line="500" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="497" />
+            <location filename="../../ui/messages.py" line="503" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="543" />
+            <location filename="../../ui/messages.py" line="549" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="546" />
+            <location filename="../../ui/messages.py" line="552" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="550" />
+            <location filename="../../ui/messages.py" line="556" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="553" />
+            <location filename="../../ui/messages.py" line="559" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="556" />
+            <location filename="../../ui/messages.py" line="562" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
@@ -2160,12 +2170,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="503" />
+            <location filename="../../ui/messages.py" line="509" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="507" />
+            <location filename="../../ui/messages.py" line="513" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -3548,28 +3558,28 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/point.py" line="199" />
+            <location filename="../../app/points/point.py" line="202" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="200" />
+            <location filename="../../app/points/point.py" line="203" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="201" />
+            <location filename="../../app/points/point.py" line="204" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="202" />
+            <location filename="../../app/points/point.py" line="205" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="203" />
+            <location filename="../../app/points/point.py" line="206" />
             <source>on controller, unconfirmed</source>
             <translation>已在控制器上（未确认）</translation>
         </message>
@@ -3578,14 +3588,14 @@
         <name>PointsModel</name>
         <message>
             <location filename="../../ui/messages_plan.py" line="162" />
-            <location filename="../../ui/models/point_columns.py" line="66" />
+            <location filename="../../ui/models/point_columns.py" line="67" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
             <location filename="../../ui/messages_plan.py" line="163" />
-            <location filename="../../ui/models/point_columns.py" line="67" />
+            <location filename="../../ui/models/point_columns.py" line="68" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
         </message>

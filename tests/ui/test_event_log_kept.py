@@ -10,6 +10,7 @@ from typing import Any
 
 from app.event_store import CURRENT, PREVIOUS, EventStore, StoredEvent, default_events_dir
 from app.safety.audit import default_data_dir
+from tests.ui.pendant_support import translator_fixture  # noqa: F401 - fixture
 from ui.panels.event_log import EventLogPanel
 
 
@@ -94,3 +95,14 @@ def test_export_honours_errors_only(qtbot: Any, tmp_path: Path) -> None:
     panel.level_combo.setCurrentIndex(1)  # warnings and errors
     assert panel.export_to(target, shown_only=True) == 2
     assert panel.export_to(target) == 3  # the support bundle's: every event
+
+
+def test_the_warning_reads_in_chinese(qtbot: Any, tmp_path: Path, translator: Any) -> None:
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    assert translator.set_language("zh_CN")
+    panel = new_panel(qtbot)
+    panel.keep_across_restarts(blocker / "events")
+    panel.add_event("info", "user", "one")
+    (warning,) = [e for e in panel.model.events() if e.level == "warning"]
+    assert warning.source == "事件日志" and warning.text.startswith("事件日志无法保存到下次启动：")

@@ -65,7 +65,7 @@ def sync_text(state: SyncState) -> str:
 def tool_display(tool: int) -> str:
     if tool == TOOL_NONE:
         return QCoreApplication.translate("PointsModel", "none")
-    return QCoreApplication.translate("PointsModel", "tool {n}").format(n=tool + 1)
+    return QCoreApplication.translate("PointsModel", "tool {n}").format(n=tool)  # as in the CSV and GV245
 
 
 def format_number(value: float, field: str = "") -> str:
