@@ -4783,58 +4783,68 @@ Remove them all?</source>
     <context>
         <name>RoleDialog</name>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="29" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="30" />
             <source>Log in</source>
             <translation>登录</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="36" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="39" />
             <source>Now: {role}</source>
             <translation>当前：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="41" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="43" />
             <source>Set this role's password</source>
             <translation>设置此角色的密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="43" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="45" />
             <source>Log out (operator)</source>
             <translation>注销（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="46" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="48" />
             <source>Role:</source>
             <translation>角色：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="47" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="49" />
             <source>Password:</source>
             <translation>密码：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="73" />
-            <source>No administrator password is set yet: choose the administrator role, type a password and press “Set this role's password”.</source>
-            <translation>尚未设置管理员密码：请选择管理员角色，输入密码，然后按“设置此角色的密码”。</translation>
+            <location filename="../../ui/dialogs/role_dialog.py" line="50" />
+            <source>Repeat:</source>
+            <translation>再次输入：</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/role_dialog.py" line="77" />
-            <location filename="../../ui/dialogs/role_dialog.py" line="88" />
+            <source>No administrator password is set yet: choose the administrator role, type a password twice and press “Set this role's password”.</source>
+            <translation>尚未设置管理员密码：请选择管理员角色，输入两次密码，然后按“设置此角色的密码”。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="81" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="97" />
             <source>No password is set for this role; an administrator sets it.</source>
             <translation>此角色尚未设置密码；请由管理员设置。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="86" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="95" />
             <source>Wrong password for the {role} role</source>
             <translation>{role}角色的密码错误</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="106" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="115" />
+            <source>The two passwords differ: nothing was set. Type the same password twice.</source>
+            <translation>两次输入的密码不一致：未作任何设置。请两次输入相同的密码。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="126" />
             <source>The password could not be saved: {why}</source>
             <translation>无法保存密码：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="109" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="130" />
             <source>Password set for the {role} role</source>
             <translation>已设置{role}角色的密码</translation>
         </message>
