@@ -3372,12 +3372,17 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="242" />
+            <location filename="../../ui/panels/planner_panel.py" line="244" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="422" />
+            <location filename="../../ui/panels/planner_panel.py" line="327" />
+            <source>This cell cannot be edited: {why}</source>
+            <translation>无法编辑此单元格：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_panel.py" line="431" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -3748,129 +3753,134 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="183" />
+            <location filename="../../ui/panels/points_panel.py" line="184" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="185" />
+            <location filename="../../ui/panels/points_panel.py" line="186" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="188" />
+            <location filename="../../ui/panels/points_panel.py" line="189" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="188" />
+            <location filename="../../ui/panels/points_panel.py" line="189" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="189" />
+            <location filename="../../ui/panels/points_panel.py" line="190" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="189" />
+            <location filename="../../ui/panels/points_panel.py" line="190" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="191" />
+            <location filename="../../ui/panels/points_panel.py" line="192" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="192" />
+            <location filename="../../ui/panels/points_panel.py" line="193" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="194" />
+            <location filename="../../ui/panels/points_panel.py" line="195" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="195" />
+            <location filename="../../ui/panels/points_panel.py" line="196" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="197" />
+            <location filename="../../ui/panels/points_panel.py" line="198" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="198" />
+            <location filename="../../ui/panels/points_panel.py" line="199" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="201" />
+            <location filename="../../ui/panels/points_panel.py" line="202" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="202" />
+            <location filename="../../ui/panels/points_panel.py" line="203" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="204" />
+            <location filename="../../ui/panels/points_panel.py" line="205" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="204" />
+            <location filename="../../ui/panels/points_panel.py" line="205" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="206" />
+            <location filename="../../ui/panels/points_panel.py" line="207" />
             <location filename="../../ui/panels/points_parts.py" line="171" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="207" />
+            <location filename="../../ui/panels/points_panel.py" line="208" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="209" />
+            <location filename="../../ui/panels/points_panel.py" line="210" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="211" />
-            <location filename="../../ui/panels/points_panel.py" line="397" />
+            <location filename="../../ui/panels/points_panel.py" line="212" />
+            <location filename="../../ui/panels/points_panel.py" line="405" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="212" />
+            <location filename="../../ui/panels/points_panel.py" line="213" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="214" />
+            <location filename="../../ui/panels/points_panel.py" line="215" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="214" />
+            <location filename="../../ui/panels/points_panel.py" line="215" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="215" />
+            <location filename="../../ui/panels/points_panel.py" line="216" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="418" />
+            <location filename="../../ui/panels/points_panel.py" line="274" />
+            <source>This cell cannot be edited: {why}</source>
+            <translation>无法编辑此单元格：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/points_panel.py" line="426" />
             <source>→ {cap} mm/s (reduced speed)</source>
             <translation>→ {cap} mm/s（降速模式）</translation>
         </message>
@@ -3905,42 +3915,42 @@
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="309" />
+            <location filename="../../ui/panels/points_panel.py" line="317" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="313" />
+            <location filename="../../ui/panels/points_panel.py" line="321" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="315" />
+            <location filename="../../ui/panels/points_panel.py" line="323" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="318" />
+            <location filename="../../ui/panels/points_panel.py" line="326" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="345" />
+            <location filename="../../ui/panels/points_panel.py" line="353" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="348" />
+            <location filename="../../ui/panels/points_panel.py" line="356" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="374" />
+            <location filename="../../ui/panels/points_panel.py" line="382" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="383" />
+            <location filename="../../ui/panels/points_panel.py" line="391" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
