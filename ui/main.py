@@ -387,6 +387,14 @@ class _Screenshot:
         self.settle.stop()
 
 
+def _start_session(window: MainWindow, project: str | None, *, shot_run: bool) -> None:
+    """After the first paint: the event log of earlier sessions (kept from now on), the project.
+    A screenshot run shows its own events only and never stops on a question."""
+    if not shot_run:
+        window.event_log.keep_across_restarts()
+    window.start_project(project, reopen_last=not shot_run, offer_recovery=not shot_run)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     # No automatic garbage collection in this process while the window lives: from here until the
     # first paint none at all (ui/startup_gc.py), then only on the GUI thread (ui/gui_gc.py).
@@ -470,8 +478,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
         if connection is not None:
             link.connect_to(connection)
         # A screenshot run never stops on a question: it opens only what it was given.
-        shot_run = bool(args.screenshot)
-        window.start_project(args.project, reopen_last=not shot_run, offer_recovery=not shot_run)
+        _start_session(window, args.project, shot_run=bool(args.screenshot))
 
     _AfterFirstPaint(window, after_first_paint)
     QTimer.singleShot(STARTUP_GC_LATEST_MS, collector, collector.start)  # a window never painted

@@ -160,7 +160,7 @@ def _tool(tool: Any) -> str:
     """A tool frame as the points table shows it (translations of "PointsModel")."""
     if int(tool) == TOOL_NONE:
         return QCoreApplication.translate("PointsModel", "none")
-    return QCoreApplication.translate("PointsModel", "tool {n}").format(n=int(tool) + 1)
+    return QCoreApplication.translate("PointsModel", "tool {n}").format(n=int(tool))  # as in the CSV
 
 
 def _issue_key(issue: PlanIssue) -> str:

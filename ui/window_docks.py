@@ -2,16 +2,21 @@
 
 Status on the left (narrow, full height); Event log, Modbus traffic and Alarms tabified at the
 bottom, the event log in front. The docks are sized once, at the window's first show, when the
-layout has its real size (a remembered layout is restored instead). The worker builds traffic
-records only while someone can read them: while the traffic dock can be seen (not tabbed behind
-the log) and its capture switch is on. The traffic panel itself (its model and the frame
-decoder) is built the first time its dock can be seen or :attr:`WindowDocks.traffic_panel` is
-asked for: tabbed behind the log at start, the window's first paint does not wait for it.
+layout has its real size (a remembered layout is restored instead). The traffic panel itself
+(its model and the frame decoder) is built the first time its dock can be seen or
+:attr:`WindowDocks.traffic_panel` is asked for: tabbed behind the log at start, the window's
+first paint does not wait for it.
+
+The worker captures the frames all the time: the last :data:`RECENT_TRAFFIC` of them are kept
+here (raw records in a ring, no decoding, no painting), so the support bundle always carries
+the recent Modbus traffic and the panel, built late, starts with them. :attr:`traffic_capture`
+says whether the panel wants them too (its dock can be seen and its capture switch is on).
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from collections import deque
+from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QCoreApplication, QObject, Qt, Slot
 from PySide6.QtWidgets import QDockWidget, QMainWindow, QWidget
@@ -31,6 +36,7 @@ __all__ = ["WindowDocks"]
 STATUS_DOCK_WIDTH = 265
 STATUS_DOCK_MAX_WIDTH = 320  # the status column never needs more; the work tabs get the rest
 DOCK_MIN_ROWS = 4  # the bottom docks (event log, traffic) show at least this many rows
+RECENT_TRAFFIC = 6000  # frames kept for the support bundle (about a minute of 10 Hz polls)
 
 
 class WindowDocks(QObject):
@@ -66,6 +72,10 @@ class WindowDocks(QObject):
         # behind the event log, when isVisible() still says True
         self.traffic_dock.visibilityChanged.connect(self._on_traffic_dock_visibility)
         link.errorOccurred.connect(self.event_log.on_error)
+        # the recent traffic, whether or not the panel was ever shown (a capture user for good)
+        self._recent_traffic: deque[Any] = deque(maxlen=RECENT_TRAFFIC)
+        link.trafficObserved.connect(self._keep_traffic)
+        link.set_traffic_capture(True)
         self.retranslate()
 
     @property
@@ -78,6 +88,7 @@ class WindowDocks(QObject):
             panel = self._traffic_panel = TrafficPanel(self._window)
             show_rows(panel.view, DOCK_MIN_ROWS)
             panel.captureEnabledChanged.connect(self._update_traffic_capture)
+            panel.on_traffic(tuple(self._recent_traffic))  # what came before it was built
             self._link.trafficObserved.connect(panel.on_traffic)
             placeholder = self.traffic_dock.widget()
             self.traffic_dock.setWidget(panel)
@@ -116,6 +127,10 @@ class WindowDocks(QObject):
         window.resizeDocks(
             [self.event_dock], [self.event_dock.minimumSizeHint().height()], Qt.Orientation.Vertical
         )
+
+    @Slot(tuple)
+    def _keep_traffic(self, records: tuple[Any, ...]) -> None:
+        self._recent_traffic.extend(records)
 
     @Slot(bool)
     def _on_traffic_dock_visibility(self, shown: bool) -> None:

@@ -23,7 +23,6 @@ from app.cli.format import (
     JOG_SECONDS_MAX,
     format_number,
     format_status,
-    format_watch_line,
     parse_axis,
     parse_direction,
     parse_jog_seconds,
@@ -32,6 +31,7 @@ from app.cli.format import (
     parse_zero_axis,
     status_to_dict,
 )
+from app.cli.watching import add_watch_parser
 from app.errors import AlarmRaised, InvalidInput, OutcomeUnknown, Reason, TeachPadError
 from app.link.client import RobotClient, StepFrame
 from app.link.halt import HaltWatch, HaltWrite, confirm_halt
@@ -61,7 +61,12 @@ __all__ = ["JOG_SECONDS_DEFAULT", "register"]
 
 JOG_POLL_INTERVAL = 0.05  # s between status checks while a jog runs (keeps a watchdog fed)
 JOG_SECONDS_DEFAULT = 2.0  # s a jog runs when --seconds is not given
-WATCH_RATE_DEFAULT = 10.0  # Hz
+# What the link accepts (RobotClient checks settings.point_id_min..max, the register profile's;
+# PROTOCOL.md: 0 <= id <= 10000 by default).
+_POINT_ID_RANGE = (
+    f"{registers.TEMP_POINT_ID_MIN}..{registers.TEMP_POINT_ID_MAX} "
+    "(the register profile's point_id_min..point_id_max)"
+)
 
 
 # --------------------------------------------------------------------------------------------
@@ -80,33 +85,6 @@ def cmd_status(ctx: CliContext) -> ExitCode:
         ctx.print(json.dumps({**status_to_dict(pose, status), "link": client.stats.as_dict()}))
     else:
         ctx.print(format_status(pose, status))
-    return ExitCode.OK
-
-
-def cmd_watch(ctx: CliContext) -> ExitCode:
-    client = ctx.client
-    period = 1.0 / ctx.args.rate
-    count = ctx.args.count
-    start = time.monotonic()
-    next_t = start
-    n = 0
-    try:
-        timeout = ctx.settings.effective_poll_timeout
-        while count <= 0 or n < count:
-            status = client.read_status(timeout=timeout)
-            pose = client.read_pose(timeout=timeout)
-            ctx.print(format_watch_line(time.monotonic() - start, pose, status))
-            n += 1
-            if count > 0 and n >= count:
-                break
-            next_t += period
-            delay = next_t - time.monotonic()
-            if delay > 0:
-                time.sleep(delay)
-            else:
-                next_t = time.monotonic()  # fell behind: do not burst
-    except KeyboardInterrupt:
-        return ExitCode.OK  # Ctrl-C is how a watch normally ends
     return ExitCode.OK
 
 
@@ -517,16 +495,7 @@ def register(sub: Any) -> None:
     p.add_argument("--json", action="store_true", help="one JSON object")
     p.set_defaults(handler=cmd_status)
 
-    p = sub.add_parser("watch", help="stream one status line per sample")
-    p.add_argument(
-        "--rate",
-        type=parse_positive_float,
-        default=WATCH_RATE_DEFAULT,
-        metavar="HZ",
-        help="samples per second, Hz (default %(default)g)",
-    )
-    p.add_argument("--count", type=int, default=0, metavar="N", help="stop after N lines (0: until Ctrl-C)")
-    p.set_defaults(handler=cmd_watch)
+    add_watch_parser(sub)  # app/cli/watching.py
 
     p = sub.add_parser("mode", help="set the work mode")
     p.add_argument("mode", choices=("auto", "manual"), help="auto or manual (register 444)")
@@ -582,7 +551,7 @@ def register(sub: Any) -> None:
     p = sub.add_parser("point", help="temp points (function 2)")
     psub = p.add_subparsers(dest="point_command", metavar="ACTION", required=True)
     pc = psub.add_parser("create", help="create or overwrite a temp point")
-    pc.add_argument("id", type=int, help="temp point id, 1..10000")
+    pc.add_argument("id", type=int, help=f"temp point id, {_POINT_ID_RANGE}")
     src = pc.add_mutually_exclusive_group()
     src.add_argument("--from-pose", action="store_true", help="from the current pose (default)")
     src.add_argument(
@@ -597,13 +566,13 @@ def register(sub: Any) -> None:
         type=int,
         default=registers.TOOL_NONE,
         metavar="N",
-        help="GV245: 200 none (default), N = tool N+1",
+        help="tool frame 0..199 as GV245, the CSV and the GUI number it; 200 none (default)",
     )
     pc.add_argument("--gv-start", type=int, default=0, metavar="N", help="first of the six pose GVs")
     pc.set_defaults(handler=cmd_point_create)
 
     p = sub.add_parser("move", help="move to a temp point: line, or arc with --via (function 3)")
-    p.add_argument("id", type=int, help="temp point id of the end point, 1..10000")
+    p.add_argument("id", type=int, help=f"temp point id of the end point, {_POINT_ID_RANGE}")
     p.add_argument("--via", type=int, metavar="MID", help="temp point id of an arc's middle point")
     p.add_argument("--speed", type=parse_positive_float, default=50.0, help="mm/s (default %(default)g)")
     p.add_argument(

@@ -84,7 +84,7 @@ def format_status(pose: Pose, status: ControllerStatus) -> str:
     cart = "  ".join(
         f"{n} {format_number(v)}" for n, v in zip(CARTESIAN_AXIS_NAMES, pose.xyzabc, strict=True)
     )
-    ext = "  ".join(f"EJ{i} {format_number(v)}" for i, v in enumerate(pose.ext, start=1))
+    ext = "  ".join(f"J{i} {format_number(v)}" for i, v in enumerate(pose.ext, start=7))
     joints = (
         "  ".join(f"J{i} {format_number(v)}" for i, v in enumerate(pose.joints, start=1))
         if pose.joints is not None

@@ -46,6 +46,7 @@ from app.points.ledger import EmptyImport, ImportMode, PointLedger
 from app.points.lock import live_owner
 from app.points.point import FileFormatError, PointLimits, SyncState, TempPoint, tool_text
 from app.points.project import (
+    PROJECT_SUFFIX,
     Project,
     ProjectTooLarge,
     load_project,
@@ -64,7 +65,7 @@ EXIT_LINK = ExitCode.LINK
 EXIT_INTERRUPTED = ExitCode.INTERRUPTED
 
 
-_PROJECT_HELP = "the project file (.tpproj)"
+_PROJECT_HELP = f"the project file ({PROJECT_SUFFIX}, as TeachPad saves it)"
 NAME_WIDTH = 20  # terminal columns of the name in ``points list``
 
 

@@ -18,6 +18,7 @@ Once the administrator has a password, the CLI's writing commands act as a role
 from __future__ import annotations
 
 import getpass
+import io
 import json
 import os
 import sys
@@ -28,6 +29,8 @@ from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode
 from app.cli.format import parse_moment, parse_positive_int
 from app.errors import InvalidInput
+from app.event_store import EventStore, default_events_dir, export_line
+from app.points.atomic import atomic_write_bytes
 from app.safety.audit import (
     AuditFilter,
     AuditLog,
@@ -83,6 +86,9 @@ def register(subparsers: Any) -> None:
     p.add_argument("--settings", type=Path, help="a JSON settings file (secrets are removed)")
     p.add_argument("--audit-dir", type=Path, help=f"audit trail folder (default {default_audit_dir()})")
     p.add_argument("--log-dir", type=Path, help="a folder of log files to include")
+    p.add_argument(
+        "--events-dir", type=Path, help=f"the GUI's saved event log (default {default_events_dir()})"
+    )
     p.add_argument("--traffic", type=Path, help="a text file of recorded Modbus traffic")
     p.add_argument(
         "--days",
@@ -182,6 +188,7 @@ def cmd_support_bundle(ctx: CliContext) -> ExitCode:
         project=args.project,
         profile=args.profile,
         audit_dir=args.audit_dir or default_audit_dir(),
+        events=[export_line(e) for e in EventStore(args.events_dir, keep_days=args.days).recent()],
         log_dir=args.log_dir,
         traffic=traffic,
         days=args.days,
@@ -210,13 +217,16 @@ def cmd_audit(ctx: CliContext) -> ExitCode:
     records = query(args.audit_dir or default_audit_dir(), flt, stats)
     unknown = unknown_count(records)
     if args.csv is not None:
-        with open(args.csv, "w", encoding="utf-8", newline="") as f:
-            n = export_csv(records, f)
+        buffer = io.StringIO(newline="")
+        n = export_csv(records, buffer)
+        # UTF-8 with a BOM: Excel on a Chinese Windows reads it as UTF-8 (without, as GBK)
+        try:
+            atomic_write_bytes(args.csv, buffer.getvalue().encode("utf-8-sig"))
+        except OSError as exc:  # name the file asked for, not the temp file beside it
+            raise OSError(exc.errno, exc.strerror, str(args.csv)) from None
         ctx.print(f"wrote {n} records to {args.csv} ({unknown} unknown)")
     else:
-        for r in records:
-            extra = f" - {r.detail}" if r.detail else ""
-            ctx.print(f"{r.host_time}  {r.role:<13} {result_label(r):<11} {r.command}{extra}")
+        _print_table(ctx, records)
     if unknown and args.result != Result.UNKNOWN:
         ctx.warn(
             f"{unknown} write(s) with result unknown: sent, and what the controller did is not known "
@@ -225,6 +235,17 @@ def cmd_audit(ctx: CliContext) -> ExitCode:
     if stats.skipped:
         ctx.warn(f"{stats.skipped} damaged line(s) skipped")
     return ExitCode.OK
+
+
+def _print_table(ctx: CliContext, records: list[AuditRecord]) -> None:
+    """One line per record, the role and result columns as wide as their widest entry (the
+    CLI's own role, "administrator (cli)", is wider than the GUI's)."""
+    labels = [result_label(r) for r in records]
+    role_width = max((len(r.role) for r in records), default=0)
+    result_width = max((len(label) for label in labels), default=0)
+    for r, label in zip(records, labels, strict=True):
+        extra = f" - {r.detail}" if r.detail else ""
+        ctx.print(f"{r.host_time}  {r.role:<{role_width}}  {label:<{result_width}}  {r.command}{extra}")
 
 
 def _verify(ctx: CliContext, directory: Path) -> ExitCode:

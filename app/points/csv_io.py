@@ -14,6 +14,7 @@ import io
 from collections.abc import Iterable
 
 from app.errors import Reason
+from app.points.number_text import value_text
 from app.points.point import (
     CSV_COLUMNS,
     CSV_REQUIRED,
@@ -26,13 +27,12 @@ from app.points.point import (
     shown,
 )
 
-
-def _format_float(value: float) -> str:
-    return repr(float(value))
+_POSE_FIELDS = ("x", "y", "z", "a", "b", "c")
 
 
 def points_to_csv(points: Iterable[TempPoint]) -> str:
-    """The CSV text (no BOM) of ``points``, header first."""
+    """The CSV text (no BOM) of ``points``, header first; numbers as :mod:`app.points.number_text`
+    writes them (shortest float32 text, 0 near 0, +180 for A/C at ±180)."""
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\r\n")
     writer.writerow(CSV_COLUMNS)
@@ -41,8 +41,8 @@ def points_to_csv(points: Iterable[TempPoint]) -> str:
             [
                 str(p.id),
                 p.name,
-                *(_format_float(v) for v in p.xyzabc),
-                *(_format_float(v) for v in p.ext),
+                *(value_text(v, field) for v, field in zip(p.xyzabc, _POSE_FIELDS, strict=True)),
+                *(value_text(v) for v in p.ext),
                 str(p.tool),
                 p.note,
             ]

@@ -16,7 +16,7 @@ from typing import Any
 from app.errors import InvalidInput
 from app.protocol.registers import TEMP_POINT_ID_MAX, TEMP_POINT_ID_MIN, TOOL_NONE
 
-TOOL_MAX = 199  # tool frames 0..199 are "tool N+1"; TOOL_NONE (200) is "no tool frame"
+TOOL_MAX = 199  # tool frames 0..199, shown as "tool N" (GV245's N); TOOL_NONE (200) is "no tool frame"
 NAME_MAX_CHARS = 200
 NOTE_MAX_CHARS = 2000
 
@@ -195,7 +195,7 @@ def parse_point_id(value: object, limits: PointLimits = DEFAULT_LIMITS, field_na
 
 
 def parse_tool(value: object, field_name: str = "tool") -> int:
-    """Tool frame: 0..199 (tool N+1) or 200 (none)."""
+    """Tool frame: 0..199 (GV245's number, as shown everywhere) or 200 (none)."""
     tool = parse_int(field_name, value)
     if not (0 <= tool <= TOOL_MAX or tool == TOOL_NONE):
         raise FieldError(
@@ -228,5 +228,6 @@ def parse_text(field_name: str, value: object, max_chars: int) -> str:
 
 
 def tool_text(tool: int) -> str:
-    """How the GUI and CLI show a tool frame."""
-    return "none" if tool == TOOL_NONE else f"tool {tool + 1} ({tool})"
+    """How the GUI and CLI show a tool frame: the one number the CSV, the project file, the cell
+    editor, ``--tool`` and GV245 hold (0..199; the controller's own pendant may count from 1)."""
+    return "none" if tool == TOOL_NONE else f"tool {tool}"

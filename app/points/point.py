@@ -21,6 +21,7 @@ from __future__ import annotations
 import enum
 import math
 import os
+import struct
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
@@ -47,6 +48,8 @@ from app.points.fields import (
 )
 from app.protocol.enums import QT_TRANSLATE_NOOP
 from app.protocol.registers import TOOL_NONE
+
+_POSE32 = struct.Struct("<6f")
 
 __all__ = [  # the field parsing lives in app.points.fields; re-exported for older imports
     "CONTROLLER_FIELDS",
@@ -252,8 +255,22 @@ class TempPoint:
         raise FieldError(field_name, "no such field")
 
     def same_on_controller(self, other: TempPoint) -> bool:
-        """True when the controller would hold the same data for both (id, pose, tool)."""
-        return self.id == other.id and self.xyzabc == other.xyzabc and self.tool == other.tool
+        """True when the controller would hold the same data for both (id, pose, tool): the pose
+        as the float32 values it holds (a CSV's shortest text of a float32 reads back as the
+        same float32, not the same float64)."""
+        return (
+            self.id == other.id
+            and _float32s(self.xyzabc) == _float32s(other.xyzabc)
+            and self.tool == other.tool
+        )
+
+
+def _float32s(values: Sequence[float]) -> tuple[float, ...] | Sequence[float]:
+    """``values`` rounded to float32 as the controller holds them (as they are if one does not fit)."""
+    try:
+        return _POSE32.unpack(_POSE32.pack(*values))
+    except (OverflowError, struct.error):
+        return values
 
 
 def make_point(

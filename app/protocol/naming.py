@@ -107,7 +107,7 @@ def _tool_meaning(value: float) -> str | None:
     n = _integral(value)
     if n == regs.TOOL_NONE:
         return "no tool"
-    return f"tool {n + 1}" if n is not None and n >= 0 else None
+    return f"tool {n}" if n is not None and n >= 0 else None  # GV245's number, as the GUI and CSV show it
 
 
 def _motion_meaning(value: float) -> str | None:
@@ -129,7 +129,7 @@ _GvRole = tuple[str, Meaning | None]
 
 _FIXED_GV_ROLES: dict[int, _GvRole] = {
     **{regs.GV_POSE + i: (axis, None) for i, axis in enumerate(CARTESIAN_AXIS_NAMES)},
-    **{regs.GV_EXT_AXES + i: (f"EJ{i + 1}", None) for i in range(regs.NUM_EXTERNAL_AXES)},
+    **{regs.GV_EXT_AXES + i: (f"J{i + 7}", None) for i in range(regs.NUM_EXTERNAL_AXES)},  # external axes
     **{regs.GV_JOINTS + i: (f"J{i + 1}", None) for i in range(regs.NUM_ROBOT_AXES)},
     **{regs.GV_EXT_OFFSET0 + i: (f"J{i + 7} offset", None) for i in range(regs.NUM_EXTERNAL_AXES)},
     regs.GV_EXPECTED_SPEED: ("speed", None),
@@ -272,7 +272,7 @@ _STATUS_SPARE: Final = frozenset(
 _KNOWN_BLOCKS: dict[tuple[int, int], str] = {
     (regs.POSE_BLOCK_START, 12): "pose X..C (GV206–GV211)",
     (regs.POSE_BLOCK_START, regs.POSE_BLOCK_COUNT): "pose, ext axes, joints (412–511)",
-    (regs.gv_reg(regs.GV_EXT_AXES), 10): "ext axes EJ1..EJ5 (GV212–GV216)",
+    (regs.gv_reg(regs.GV_EXT_AXES), 10): "ext axes J7..J11 (GV212–GV216)",
     (regs.gv_reg(regs.GV_JOINTS), 12): "joints J1..J6 (GV250–GV255)",
     (regs.STATUS_BLOCK_START, regs.STATUS_BLOCK_COUNT): "status (560–583)",
     (regs.STATUS_BLOCK_START, 3): "status (560–562)",

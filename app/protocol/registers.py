@@ -58,11 +58,11 @@ GV_PARAM5: Final = 205
 GV_EXT_OFFSET0: Final = 236  # GV236..GV240: J7..J11 incremental offsets
 GV_USER_FRAME: Final = 241
 GV_TOOL_FRAME: Final = 245
-TOOL_NONE: Final = 200  # GV245 = 200: no tool frame; N: tool N+1
+TOOL_NONE: Final = 200  # GV245 = 200: no tool frame; N: tool frame N (PROTOCOL.md: the controller's tool N+1)
 
 # --- Live values (read with 0x03) -------------------------------------------------------
 GV_POSE: Final = 206  # GV206..GV211: X Y Z A B C, base frame
-GV_EXT_AXES: Final = 212  # GV212..GV216: EJ1..EJ5
+GV_EXT_AXES: Final = 212  # GV212..GV216: the external axes J7..J11 (PROTOCOL.md: EJ1..EJ5)
 # Project extension (not in the seed): joint angles J1..J6 published in spare GVs.
 GV_JOINTS: Final = 250  # GV250..GV255 (registers 500-511)
 

@@ -38,6 +38,9 @@ from app.safety.audit import audit_files
 from app.safety.roles import STORE_FORMAT
 
 DEFAULT_DAYS = 7
+_NO_EVENTS = "event log: none given"
+_NO_TRAFFIC = "Modbus traffic: none given (TeachPad records it; teachpad-cli takes a file with --traffic)"
+_TRAFFIC_EMPTY = "Modbus traffic: no frames recorded (no connection to a controller since TeachPad started)"
 MAX_FILE_BYTES = 64 * 1024 * 1024  # a single file larger than this is left out (and said so)
 _SECRET_WORDS = (
     r"pass(?:word|wd|phrase)?|pwd|hash|salt|secret|token|credential|api[_-]?key|private[_-]?key"
@@ -184,15 +187,23 @@ def build_support_bundle(
                 w.file(f"audit/{path.name}", path)
             if not found:
                 manifest.left_out.append(f"audit trail: no records in the last {days} days")
-        if events is not None:
-            w.text("events.txt", "".join(line.rstrip("\n") + "\n" for line in events))
+        event_lines = None if events is None else list(events)
+        if event_lines:
+            w.text("events.txt", "".join(line.rstrip("\n") + "\n" for line in event_lines))
+        else:
+            manifest.left_out.append(
+                _NO_EVENTS if event_lines is None else f"event log: no events in the last {days} days"
+            )
         if log_dir is not None:
             cutoff = (now - dt.timedelta(days=days)).timestamp()
             for path in sorted(p for p in log_dir.iterdir() if p.is_file()) if log_dir.is_dir() else []:
                 if path.stat().st_mtime >= cutoff:
                     w.file(f"logs/{path.name}", path, redacted=True)
-        if traffic is not None:
-            w.text("traffic.txt", "".join(line.rstrip("\n") + "\n" for line in traffic))
+        traffic_lines = None if traffic is None else list(traffic)
+        if traffic_lines:
+            w.text("traffic.txt", "".join(line.rstrip("\n") + "\n" for line in traffic_lines))
+        else:
+            manifest.left_out.append(_NO_TRAFFIC if traffic_lines is None else _TRAFFIC_EMPTY)
         manifest.files.append("manifest.json")
         zf.writestr(
             "manifest.json",

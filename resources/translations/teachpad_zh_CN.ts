@@ -134,102 +134,102 @@
     <context>
         <name>AuditModel</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="63" />
+            <location filename="../../ui/panels/audit_viewer.py" line="65" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="64" />
+            <location filename="../../ui/panels/audit_viewer.py" line="66" />
             <source>Role</source>
             <translation>角色</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="65" />
+            <location filename="../../ui/panels/audit_viewer.py" line="67" />
             <source>Kind</source>
             <translation>类型</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="66" />
+            <location filename="../../ui/panels/audit_viewer.py" line="68" />
             <source>Command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="67" />
+            <location filename="../../ui/panels/audit_viewer.py" line="69" />
             <source>Result</source>
             <translation>结果</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="68" />
+            <location filename="../../ui/panels/audit_viewer.py" line="70" />
             <source>Detail</source>
             <translation>详情</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="87" />
+            <location filename="../../ui/panels/audit_viewer.py" line="89" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="88" />
+            <location filename="../../ui/panels/audit_viewer.py" line="90" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="89" />
+            <location filename="../../ui/panels/audit_viewer.py" line="91" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="90" />
+            <location filename="../../ui/panels/audit_viewer.py" line="92" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="91" />
+            <location filename="../../ui/panels/audit_viewer.py" line="93" />
             <source>write</source>
             <translation>写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="92" />
+            <location filename="../../ui/panels/audit_viewer.py" line="94" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="93" />
+            <location filename="../../ui/panels/audit_viewer.py" line="95" />
             <source>login</source>
             <translation>登录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="94" />
+            <location filename="../../ui/panels/audit_viewer.py" line="96" />
             <source>action</source>
             <translation>操作</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="95" />
+            <location filename="../../ui/panels/audit_viewer.py" line="97" />
             <source>answered</source>
             <translation>已应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="99" />
+            <location filename="../../ui/panels/audit_viewer.py" line="101" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="100" />
+            <location filename="../../ui/panels/audit_viewer.py" line="102" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="96" />
+            <location filename="../../ui/panels/audit_viewer.py" line="98" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="97" />
+            <location filename="../../ui/panels/audit_viewer.py" line="99" />
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <location filename="../../ui/panels/audit_viewer.py" line="100" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
@@ -237,152 +237,152 @@
     <context>
         <name>AuditViewer</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="116" />
+            <location filename="../../ui/panels/audit_viewer.py" line="118" />
             <source>Audit trail</source>
             <translation>审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="126" />
+            <location filename="../../ui/panels/audit_viewer.py" line="128" />
             <source>Any role</source>
             <translation>任意角色</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="128" />
+            <location filename="../../ui/panels/audit_viewer.py" line="130" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="129" />
+            <location filename="../../ui/panels/audit_viewer.py" line="131" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="130" />
+            <location filename="../../ui/panels/audit_viewer.py" line="132" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="131" />
+            <location filename="../../ui/panels/audit_viewer.py" line="133" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="135" />
+            <location filename="../../ui/panels/audit_viewer.py" line="137" />
             <source>Command contains…</source>
             <translation>命令包含…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="137" />
+            <location filename="../../ui/panels/audit_viewer.py" line="139" />
             <source>Any result</source>
             <translation>任意结果</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="144" />
+            <location filename="../../ui/panels/audit_viewer.py" line="146" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="145" />
+            <location filename="../../ui/panels/audit_viewer.py" line="147" />
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="140" />
+            <location filename="../../ui/panels/audit_viewer.py" line="142" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="139" />
+            <location filename="../../ui/panels/audit_viewer.py" line="141" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="141" />
+            <location filename="../../ui/panels/audit_viewer.py" line="143" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="142" />
+            <location filename="../../ui/panels/audit_viewer.py" line="144" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="143" />
+            <location filename="../../ui/panels/audit_viewer.py" line="145" />
             <source>answered</source>
             <translation>已应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="148" />
+            <location filename="../../ui/panels/audit_viewer.py" line="150" />
             <source>Show</source>
             <translation>显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="150" />
+            <location filename="../../ui/panels/audit_viewer.py" line="152" />
             <source>Export CSV…</source>
             <translation>导出 CSV…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="160" />
+            <location filename="../../ui/panels/audit_viewer.py" line="162" />
             <source>From</source>
             <translation>从</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="160" />
+            <location filename="../../ui/panels/audit_viewer.py" line="162" />
             <source>to</source>
             <translation>到</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="193" />
+            <location filename="../../ui/panels/audit_viewer.py" line="195" />
             <source>{n} records</source>
             <translation>{n} 条记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="195" />
+            <location filename="../../ui/panels/audit_viewer.py" line="197" />
             <source>{n} records ({skipped} damaged lines skipped)</source>
             <translation>{n} 条记录（跳过 {skipped} 行损坏的记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="197" />
+            <location filename="../../ui/panels/audit_viewer.py" line="199" />
             <source>{unknown} writes whose answer or outcome was not recorded</source>
             <translation>{unknown} 条写入的应答或结果未记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="209" />
+            <location filename="../../ui/panels/audit_viewer.py" line="211" />
             <source>The chain of hashes breaks at {file} line {line}: records before it were removed.</source>
             <translation>哈希链在 {file} 第 {line} 行断开：此前的记录已被删除。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="213" />
+            <location filename="../../ui/panels/audit_viewer.py" line="215" />
             <source>The chain of hashes breaks at {file} line {line}: the record before it was changed, or records were removed.</source>
             <translation>哈希链在 {file} 第 {line} 行断开：此前的记录被修改，或有记录被删除。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="218" />
+            <location filename="../../ui/panels/audit_viewer.py" line="220" />
             <source>{n} breaks in all.</source>
             <translation>共 {n} 处断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="221" />
+            <location filename="../../ui/panels/audit_viewer.py" line="223" />
             <source>(No chain of hashes: records of an older TeachPad.)</source>
             <translation>（无哈希链：旧版 TeachPad 的记录。）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="226" />
+            <location filename="../../ui/panels/audit_viewer.py" line="228" />
             <source>Export the audit trail</source>
             <translation>导出审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="226" />
+            <location filename="../../ui/panels/audit_viewer.py" line="228" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="239" />
+            <location filename="../../ui/panels/audit_viewer.py" line="242" />
             <source>Cannot write {file}: {why}</source>
             <translation>无法写入 {file}：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="242" />
+            <location filename="../../ui/panels/audit_viewer.py" line="245" />
             <source>{n} records exported to {file}</source>
             <translation>已将 {n} 条记录导出到 {file}</translation>
         </message>
@@ -818,37 +818,37 @@
     <context>
         <name>EventLogModel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="121" />
+            <location filename="../../ui/panels/event_log.py" line="123" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="122" />
+            <location filename="../../ui/panels/event_log.py" line="124" />
             <source>Level</source>
             <translation>级别</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="123" />
+            <location filename="../../ui/panels/event_log.py" line="125" />
             <source>Source</source>
             <translation>来源</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="124" />
+            <location filename="../../ui/panels/event_log.py" line="126" />
             <source>Message</source>
             <translation>消息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="127" />
+            <location filename="../../ui/panels/event_log.py" line="129" />
             <source>Info</source>
             <translation>信息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="128" />
+            <location filename="../../ui/panels/event_log.py" line="130" />
             <source>Warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="129" />
+            <location filename="../../ui/panels/event_log.py" line="131" />
             <source>Error</source>
             <translation>错误</translation>
         </message>
@@ -856,72 +856,82 @@
     <context>
         <name>EventLogPanel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="296" />
+            <location filename="../../ui/panels/event_log.py" line="308" />
             <source>Show:</source>
             <translation>显示：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="297" />
+            <location filename="../../ui/panels/event_log.py" line="309" />
             <source>All events</source>
             <translation>全部事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="298" />
+            <location filename="../../ui/panels/event_log.py" line="310" />
             <source>Warnings and errors</source>
             <translation>警告和错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="299" />
+            <location filename="../../ui/panels/event_log.py" line="311" />
             <source>Errors only</source>
             <translation>仅错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="300" />
+            <location filename="../../ui/panels/event_log.py" line="312" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="301" />
+            <location filename="../../ui/panels/event_log.py" line="313" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="363" />
+            <location filename="../../ui/panels/event_log.py" line="356" />
+            <source>event log</source>
+            <translation>事件日志</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="357" />
+            <source>The event log is not saved for the next start: {why}</source>
+            <translation>事件日志无法保存到下次启动：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/event_log.py" line="407" />
             <source>alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="360" />
+            <location filename="../../ui/panels/event_log.py" line="404" />
             <source>Alarm raised: {name}</source>
             <translation>报警触发：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="360" />
+            <location filename="../../ui/panels/event_log.py" line="404" />
             <source>Alarm cleared: {name}</source>
             <translation>报警解除：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="369" />
+            <location filename="../../ui/panels/event_log.py" line="413" />
             <source>bit {n}</source>
             <translation>第 {n} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="373" />
+            <location filename="../../ui/panels/event_log.py" line="417" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="405" />
+            <location filename="../../ui/panels/event_log.py" line="449" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="432" />
+            <location filename="../../ui/panels/event_log.py" line="474" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="434" />
+            <location filename="../../ui/panels/event_log.py" line="476" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -929,7 +939,7 @@
     <context>
         <name>Export</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="393" />
+            <location filename="../../ui/widgets_common.py" line="399" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -1173,17 +1183,17 @@
             <translation>程序</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="106" />
+            <location filename="../../ui/window_docks.py" line="117" />
             <source>Status</source>
             <translation>状态</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="107" />
+            <location filename="../../ui/window_docks.py" line="118" />
             <source>Event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="108" />
+            <location filename="../../ui/window_docks.py" line="119" />
             <source>Modbus traffic</source>
             <translation>Modbus 报文</translation>
         </message>
@@ -1271,7 +1281,7 @@
             <translation>轨迹规划</translation>
         </message>
         <message>
-            <location filename="../../ui/window_docks.py" line="109" />
+            <location filename="../../ui/window_docks.py" line="120" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
@@ -2685,42 +2695,42 @@
     <context>
         <name>Panels</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="344" />
+            <location filename="../../ui/widgets_common.py" line="350" />
             <source>connected</source>
             <translation>已连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="345" />
+            <location filename="../../ui/widgets_common.py" line="351" />
             <source>connecting</source>
             <translation>正在连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="348" />
+            <location filename="../../ui/widgets_common.py" line="354" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="347" />
+            <location filename="../../ui/widgets_common.py" line="353" />
             <source>link down</source>
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="372" />
+            <location filename="../../ui/widgets_common.py" line="378" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="363" />
+            <location filename="../../ui/widgets_common.py" line="369" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="346" />
+            <location filename="../../ui/widgets_common.py" line="352" />
             <source>not answering</source>
             <translation>无应答</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="371" />
+            <location filename="../../ui/widgets_common.py" line="377" />
             <source>done</source>
             <translation>完成</translation>
         </message>
@@ -3387,12 +3397,17 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="245" />
+            <location filename="../../ui/panels/planner_panel.py" line="247" />
             <source>Preview</source>
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="425" />
+            <location filename="../../ui/panels/planner_panel.py" line="330" />
+            <source>This cell cannot be edited: {why}</source>
+            <translation>无法编辑此单元格：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_panel.py" line="434" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -3573,28 +3588,28 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/point.py" line="199" />
+            <location filename="../../app/points/point.py" line="202" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="200" />
+            <location filename="../../app/points/point.py" line="203" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="201" />
+            <location filename="../../app/points/point.py" line="204" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="202" />
+            <location filename="../../app/points/point.py" line="205" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="203" />
+            <location filename="../../app/points/point.py" line="206" />
             <source>on controller, unconfirmed</source>
             <translation>已在控制器上（未确认）</translation>
         </message>
@@ -3603,14 +3618,14 @@
         <name>PointsModel</name>
         <message>
             <location filename="../../ui/messages_plan.py" line="162" />
-            <location filename="../../ui/models/point_columns.py" line="66" />
+            <location filename="../../ui/models/point_columns.py" line="67" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
             <location filename="../../ui/messages_plan.py" line="163" />
-            <location filename="../../ui/models/point_columns.py" line="67" />
+            <location filename="../../ui/models/point_columns.py" line="68" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
         </message>
@@ -3763,129 +3778,134 @@
     <context>
         <name>PointsPanel</name>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="183" />
+            <location filename="../../ui/panels/points_panel.py" line="184" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="185" />
+            <location filename="../../ui/panels/points_panel.py" line="186" />
             <source>Create the next temp point on the controller from the robot's current pose (Ctrl+T)</source>
             <translation>以机器人当前位姿在控制器上创建下一个临时点（Ctrl+T）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="188" />
+            <location filename="../../ui/panels/points_panel.py" line="189" />
             <source>Add</source>
             <translation>添加</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="188" />
+            <location filename="../../ui/panels/points_panel.py" line="189" />
             <source>Add a point on the host (not on the controller yet)</source>
             <translation>在上位机添加一个点（尚未上传到控制器）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="189" />
+            <location filename="../../ui/panels/points_panel.py" line="190" />
             <source>Duplicate</source>
             <translation>复制</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="189" />
+            <location filename="../../ui/panels/points_panel.py" line="190" />
             <source>Copy the selected points under new ids</source>
             <translation>以新编号复制所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="191" />
+            <location filename="../../ui/panels/points_panel.py" line="192" />
             <source>Delete</source>
             <translation>删除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="192" />
+            <location filename="../../ui/panels/points_panel.py" line="193" />
             <source>Delete the selected points from the host's list</source>
             <translation>从上位机列表中删除所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="194" />
+            <location filename="../../ui/panels/points_panel.py" line="195" />
             <source>Move the selected points up (Alt+Up)</source>
             <translation>上移所选点（Alt+↑）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="195" />
+            <location filename="../../ui/panels/points_panel.py" line="196" />
             <source>Move the selected points down (Alt+Down)</source>
             <translation>下移所选点（Alt+↓）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="197" />
+            <location filename="../../ui/panels/points_panel.py" line="198" />
             <source>Upload selected</source>
             <translation>上传所选</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="198" />
+            <location filename="../../ui/panels/points_panel.py" line="199" />
             <source>Create the selected points on the controller</source>
             <translation>在控制器上创建所选点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="201" />
+            <location filename="../../ui/panels/points_panel.py" line="202" />
             <source>Upload changed</source>
             <translation>上传已修改</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="202" />
+            <location filename="../../ui/panels/points_panel.py" line="203" />
             <source>Upload every point not known to be on the controller</source>
             <translation>上传所有不确定在控制器上的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="204" />
+            <location filename="../../ui/panels/points_panel.py" line="205" />
             <source>Upload all</source>
             <translation>全部上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="204" />
+            <location filename="../../ui/panels/points_panel.py" line="205" />
             <source>Create every point on the controller</source>
             <translation>在控制器上创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="206" />
+            <location filename="../../ui/panels/points_panel.py" line="207" />
             <location filename="../../ui/panels/points_parts.py" line="171" />
             <source>Restore all</source>
             <translation>恢复全部</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="207" />
+            <location filename="../../ui/panels/points_panel.py" line="208" />
             <source>Re-create all points after a controller restart</source>
             <translation>控制器重启后重新创建所有点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="209" />
+            <location filename="../../ui/panels/points_panel.py" line="210" />
             <source>Cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="211" />
-            <location filename="../../ui/panels/points_panel.py" line="397" />
+            <location filename="../../ui/panels/points_panel.py" line="212" />
+            <location filename="../../ui/panels/points_panel.py" line="405" />
             <source>Move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="212" />
+            <location filename="../../ui/panels/points_panel.py" line="213" />
             <source>Move the robot in a line to the selected point (asks first)</source>
             <translation>机器人以直线运动到所选点（会先确认）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="214" />
+            <location filename="../../ui/panels/points_panel.py" line="215" />
             <source>E1–E5</source>
             <translation>E1–E5</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="214" />
+            <location filename="../../ui/panels/points_panel.py" line="215" />
             <source>Show the external axes columns</source>
             <translation>显示外部轴列</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="215" />
+            <location filename="../../ui/panels/points_panel.py" line="216" />
             <source>Find</source>
             <translation>查找</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="418" />
+            <location filename="../../ui/panels/points_panel.py" line="274" />
+            <source>This cell cannot be edited: {why}</source>
+            <translation>无法编辑此单元格：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/points_panel.py" line="426" />
             <source>→ {cap} mm/s (reduced speed)</source>
             <translation>→ {cap} mm/s（降速模式）</translation>
         </message>
@@ -3920,42 +3940,42 @@
             <translation>正在上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="309" />
+            <location filename="../../ui/panels/points_panel.py" line="317" />
             <source>Added {point} at the robot's current pose</source>
             <translation>已在机器人当前位姿添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="313" />
+            <location filename="../../ui/panels/points_panel.py" line="321" />
             <source>pose copied from P{id}</source>
             <translation>位姿复制自 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="315" />
+            <location filename="../../ui/panels/points_panel.py" line="323" />
             <source>pose set to zeros</source>
             <translation>位姿设为零</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="318" />
+            <location filename="../../ui/panels/points_panel.py" line="326" />
             <source>Added {point}, not from the controller: no live pose ({why})</source>
             <translation>已添加 {point}，位姿并非来自控制器：没有实时位姿（{why}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="345" />
+            <location filename="../../ui/panels/points_panel.py" line="353" />
             <source>Deleted {n} points (Ctrl+Z to undo)</source>
             <translation>已删除 {n} 个点（Ctrl+Z 撤销）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="348" />
+            <location filename="../../ui/panels/points_panel.py" line="356" />
             <source>{point} is used by plan '{plan}' segment {k}</source>
             <translation>{point} 被轨迹“{plan}”的第 {k} 段使用</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="374" />
+            <location filename="../../ui/panels/points_panel.py" line="382" />
             <source>Select one point to move to</source>
             <translation>请选择一个要运动到的点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/points_panel.py" line="383" />
+            <location filename="../../ui/panels/points_panel.py" line="391" />
             <source>Move the robot in a straight line to {point}?
 
 X {x:.3f}  Y {y:.3f}  Z {z:.3f}
@@ -4804,58 +4824,68 @@ Remove them all?</source>
     <context>
         <name>RoleDialog</name>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="29" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="30" />
             <source>Log in</source>
             <translation>登录</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="36" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="39" />
             <source>Now: {role}</source>
             <translation>当前：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="41" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="43" />
             <source>Set this role's password</source>
             <translation>设置此角色的密码</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="43" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="45" />
             <source>Log out (operator)</source>
             <translation>注销（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="46" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="48" />
             <source>Role:</source>
             <translation>角色：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="47" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="49" />
             <source>Password:</source>
             <translation>密码：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="73" />
-            <source>No administrator password is set yet: choose the administrator role, type a password and press “Set this role's password”.</source>
-            <translation>尚未设置管理员密码：请选择管理员角色，输入密码，然后按“设置此角色的密码”。</translation>
+            <location filename="../../ui/dialogs/role_dialog.py" line="50" />
+            <source>Repeat:</source>
+            <translation>再次输入：</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/role_dialog.py" line="77" />
-            <location filename="../../ui/dialogs/role_dialog.py" line="88" />
+            <source>No administrator password is set yet: choose the administrator role, type a password twice and press “Set this role's password”.</source>
+            <translation>尚未设置管理员密码：请选择管理员角色，输入两次密码，然后按“设置此角色的密码”。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="81" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="97" />
             <source>No password is set for this role; an administrator sets it.</source>
             <translation>此角色尚未设置密码；请由管理员设置。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="86" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="95" />
             <source>Wrong password for the {role} role</source>
             <translation>{role}角色的密码错误</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="106" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="115" />
+            <source>The two passwords differ: nothing was set. Type the same password twice.</source>
+            <translation>两次输入的密码不一致：未作任何设置。请两次输入相同的密码。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/role_dialog.py" line="126" />
             <source>The password could not be saved: {why}</source>
             <translation>无法保存密码：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="109" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="130" />
             <source>Password set for the {role} role</source>
             <translation>已设置{role}角色的密码</translation>
         </message>
@@ -5274,13 +5304,13 @@ Remove them all?</source>
         </message>
         <message>
             <location filename="../../ui/panels/status_panel.py" line="233" />
-            <location filename="../../ui/panels/status_panel.py" line="302" />
+            <location filename="../../ui/panels/status_panel.py" line="305" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
             <location filename="../../ui/panels/status_panel.py" line="233" />
-            <location filename="../../ui/panels/status_panel.py" line="302" />
+            <location filename="../../ui/panels/status_panel.py" line="305" />
             <source>Alarms (last known)</source>
             <translation>报警（最后已知）</translation>
         </message>
@@ -5325,78 +5355,80 @@ Remove them all?</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="247" />
+            <location filename="../../ui/panels/status_panel.py" line="250" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="248" />
+            <location filename="../../ui/panels/status_panel.py" line="251" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="251" />
+            <location filename="../../ui/panels/status_panel.py" line="254" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="258" />
+            <location filename="../../ui/panels/status_panel.py" line="261" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="351" />
+            <location filename="../../ui/panels/status_panel.py" line="354" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="369" />
+            <location filename="../../ui/panels/status_panel.py" line="372" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="371" />
+            <location filename="../../ui/panels/status_panel.py" line="374" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="381" />
+            <location filename="../../ui/panels/status_panel.py" line="384" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
             <location filename="../../ui/panels/status_panel.py" line="243" />
-            <location filename="../../ui/panels/status_panel.py" line="387" />
+            <location filename="../../ui/panels/status_panel.py" line="390" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="404" />
+            <location filename="../../ui/panels/status_panel.py" line="407" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="412" />
+            <location filename="../../ui/panels/status_panel.py" line="415" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="416" />
+            <location filename="../../ui/panels/status_panel.py" line="419" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="420" />
+            <location filename="../../ui/panels/status_panel.py" line="423" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="426" />
+            <location filename="../../ui/panels/status_panel.py" line="245" />
+            <location filename="../../ui/panels/status_panel.py" line="429" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="429" />
+            <location filename="../../ui/panels/status_panel.py" line="246" />
+            <location filename="../../ui/panels/status_panel.py" line="432" />
             <source>{value} (stale)</source>
             <translation>{value}（已过期）</translation>
         </message>

@@ -54,7 +54,7 @@ def sample_project() -> Project:
                 sync=SyncState.FAILED,
                 sync_error="bad point id",
             ),
-            make_point(10000, "", (0.1, 1e-7, -3.5e5, -179.999, 90, 0), sync=SyncState.CHANGED),
+            make_point(10000, "", (0.1, 1e-3, -3.5e5, -179.999, 90, 0), sync=SyncState.CHANGED),
         ]
     )
     plans = [
@@ -174,9 +174,13 @@ def test_csv_respects_id_limits_setting() -> None:
 
 
 def test_points_to_csv_floats_round_trip_exactly() -> None:
-    p = make_point(1, pose=(0.1, 1 / 3, -1e-300, 179.99999999999997, 0, 1e15))
+    """A value that is no float32 (typed, computed) is written as its exact repr; one nearer 0
+    than the table's 0.0005 reads 0 (app/points/number_text.py; float32 values: tests/points)."""
+    p = make_point(1, pose=(0.1, 1 / 3, -0.001, 179.99999999999997, 0, 1e15))
     (back,) = parse_points_csv(points_to_csv([p]))
     assert back.xyzabc == p.xyzabc
+    (back,) = parse_points_csv(points_to_csv([make_point(1, pose=(0.1, 1 / 3, -1e-300, 1e-7, 0, 1e15))]))
+    assert back.xyzabc == (0.1, 1 / 3, 0.0, 0.0, 0.0, 1e15)
 
 
 # --- JSON ------------------------------------------------------------------------------------

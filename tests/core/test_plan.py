@@ -207,7 +207,7 @@ def test_empty_plan_zero_length_and_tool_mismatch() -> None:
         (0, IssueKind.WARNING, IssueCode.ZERO_LENGTH),
         (1, IssueKind.WARNING, IssueCode.TOOL_MISMATCH),
     ]
-    assert "taught with tool 1 (0)" in issues[1].message and not has_errors(issues)
+    assert "taught with tool 0" in issues[1].message and not has_errors(issues)
 
 
 # --- geometry ------------------------------------------------------------------------------------

@@ -356,8 +356,7 @@ def test_responses_out_of_order_pair_by_transaction_id() -> None:
     answer = decoder.decode(encode_response(FC03, values=values, transaction_id=10))
     assert answer.request is pose
     assert answer.summary == (
-        "pose, ext axes, joints (412–511): X=0.0, Y=1.0, Z=2.0, A=3.0, B=4.0, C=5.0, "
-        "EJ1=6.0, EJ2=7.0, … (+48)"
+        "pose, ext axes, joints (412–511): X=0.0, Y=1.0, Z=2.0, A=3.0, B=4.0, C=5.0, J7=6.0, J8=7.0, … (+48)"
     )
     # The block spans table 1 (440..453): those registers are integers, not GVs.
     assert len(answer.items) == 14 + 10 + 1 + 2 + 29
@@ -552,10 +551,10 @@ def test_table1_read_mixes_integers_and_the_speed_float() -> None:
         (GV_PARAM2, 0.0, RunCommand.TEACH_DISABLE, "GV202 direction = 0.0 (negative)"),
         (GV_PARAM2, 0.0, RunCommand.RUN_PROGRAM, "GV202 = 0.0"),
         (GV_TOOL_FRAME, 200.0, None, "GV245 tool = 200.0 (no tool)"),
-        (GV_TOOL_FRAME, 3.0, None, "GV245 tool = 3.0 (tool 4)"),
+        (GV_TOOL_FRAME, 3.0, None, "GV245 tool = 3.0 (tool 3)"),
         (GV_USER_FRAME, 2.0, None, "GV241 user frame = 2.0"),
         (GV_EXPECTED_SPEED, 0.1, None, "GV225 speed = 0.1"),
-        (212, 0.0, None, "GV212 EJ1 = 0.0"),
+        (212, 0.0, None, "GV212 J7 = 0.0"),
         (99, 1e20, None, "GV99 = 1e+20"),
     ],
 )
@@ -581,7 +580,7 @@ def test_odd_starts_and_half_gvs_stay_raw() -> None:
     ("address", "count", "label"),
     [
         (412, 12, "pose X..C (GV206–GV211)"),
-        (424, 10, "ext axes EJ1..EJ5 (GV212–GV216)"),
+        (424, 10, "ext axes J7..J11 (GV212–GV216)"),
         (500, 12, "joints J1..J6 (GV250–GV255)"),
         (560, 3, "status (560–562)"),
         (576, 4, "clock (576–579)"),

@@ -7,6 +7,7 @@ from typing import Any
 
 from app.safety.location import safety_location
 from app.safety.roles import Role
+from tests.ui.pendant_support import translator_fixture  # noqa: F401 - fixture
 from ui.controllers.safety import SafetyController
 from ui.dialogs.role_dialog import RoleDialog
 
@@ -26,6 +27,7 @@ def test_first_admin_password_then_log_in_and_out(qtbot: Any, tmp_path: Path) ->
     dialog.role_box.setCurrentIndex(dialog.role_box.findData(Role.ADMINISTRATOR))
     assert dialog.set_password_button.isEnabled()  # the first one: anyone
     dialog.password.setText("root-pw")
+    dialog.repeat.setText("root-pw")
     dialog.set_password()
     assert safety.session.store.has_password(Role.ADMINISTRATOR)
     assert not dialog.set_password_button.isEnabled()  # now only an administrator
@@ -44,4 +46,47 @@ def test_first_admin_password_then_log_in_and_out(qtbot: Any, tmp_path: Path) ->
     assert safety.role is Role.OPERATOR
     stored = safety_location().roles.read_text(encoding="utf-8")
     assert "root-pw" not in stored and "scrypt" in stored.lower()
+    safety.close()
+
+
+def _first_admin(qtbot: Any, tmp_path: Path) -> tuple[SafetyController, RoleDialog]:
+    safety = _safety(qtbot, tmp_path)
+    dialog = RoleDialog(safety)
+    qtbot.addWidget(dialog)
+    dialog.role_box.setCurrentIndex(dialog.role_box.findData(Role.ADMINISTRATOR))
+    return safety, dialog
+
+
+def test_the_first_administrator_password_is_typed_twice_and_confirmed(qtbot: Any, tmp_path: Path) -> None:
+    """Issue 21: one typo in the first administrator password locked the administrator out."""
+    safety, dialog = _first_admin(qtbot, tmp_path)
+    assert not dialog.repeat.isHidden()
+    dialog.password.setText("root-pw")
+    dialog.repeat.setText("root-pq")
+    dialog.set_password()
+    assert not safety.session.store.has_password(Role.ADMINISTRATOR)
+    assert "differ" in dialog.error.text() and "nothing was set" in dialog.error.text()
+    assert dialog.password.text() == dialog.repeat.text() == ""
+    dialog.password.setText("root-pw")
+    dialog.repeat.setText("root-pw")
+    dialog.set_password()
+    assert safety.session.store.verify(Role.ADMINISTRATOR, "root-pw")
+    assert dialog.error.text() == "Password set for the administrator role"  # stays, not a red hint
+    assert "c62828" not in dialog.error.styleSheet()
+    assert dialog.repeat.isHidden()  # the Passwords screen's from now on
+    safety.close()
+
+
+def test_the_first_password_reads_in_chinese(qtbot: Any, tmp_path: Path, translator: Any) -> None:
+    assert translator.set_language("zh_CN")
+    safety, dialog = _first_admin(qtbot, tmp_path)
+    assert "两次" in dialog.error.text()  # the hint: type it twice
+    dialog.password.setText("a-Pa55")
+    dialog.repeat.setText("b-Pa55")
+    dialog.set_password()
+    assert dialog.error.text().startswith("两次输入的密码不一致")
+    dialog.password.setText("a-Pa55")
+    dialog.repeat.setText("a-Pa55")
+    dialog.set_password()
+    assert dialog.error.text().startswith("已设置") and not any("a" <= c <= "z" for c in dialog.error.text())
     safety.close()

@@ -148,7 +148,8 @@ def test_audit_viewer_filters_and_exports(qtbot: Any, menu: SafetyMenu, tmp_path
     viewer.refresh()
     assert viewer.model.rowCount() == 1 and viewer.model.records[0].command == "change connection"
     viewer.export()
-    rows = list(csv.reader((tmp_path / "out.csv").read_text(encoding="utf-8").splitlines()))
+    assert (tmp_path / "out.csv").read_bytes().startswith(b"\xef\xbb\xbf")  # UTF-8 with a BOM, for Excel
+    rows = list(csv.reader((tmp_path / "out.csv").read_text(encoding="utf-8-sig").splitlines()))
     assert rows[0][0] == "host_time" and len(rows) == 2
 
 
@@ -161,8 +162,10 @@ def test_support_bundle_leaves_passwords_out(menu: SafetyMenu, window: Any, tmp_
     with zipfile.ZipFile(out) as zf:
         names = zf.namelist()
         settings = json.loads(zf.read("settings.json"))
+        left_out = json.loads(zf.read("manifest.json"))["left_out"]
     assert "versions.json" in names and any(n.startswith("audit/") for n in names)
-    assert "events.txt" in names and "traffic.txt" in names
+    # never connected: no traffic, and the manifest says so (issue 21)
+    assert "traffic.txt" not in names and any(n.startswith("Modbus traffic: no frames") for n in left_out)
     assert "secret" not in json.dumps(settings)
 
 

@@ -157,7 +157,8 @@ def test_export_is_atomic(tmp_path: Path, panel: EventLogPanel) -> None:
     target.write_text("previous")
     assert panel.export_to(target) == 2
     assert [p.name for p in tmp_path.iterdir()] == ["events.txt"]
-    assert target.read_text(encoding="utf-8").splitlines() == [
+    assert target.read_bytes().startswith(b"\xef\xbb\xbf")  # UTF-8 with a BOM, for Excel
+    assert target.read_text(encoding="utf-8-sig").splitlines() == [
         "2025-06-01 08:30:15.250\tINFO\tlink\tconnected",
         "2025-06-01 08:30:16.250\tERROR\tcommand\ttwo lines",
     ]

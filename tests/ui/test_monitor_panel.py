@@ -62,9 +62,9 @@ def test_readouts_show_fixed_decimals_and_units(panel: MonitorPanel) -> None:
     assert r["Z"].text() == "1500.000"
     assert r["A"].text() == "180.000"
     assert r["B"].text() == "-0.500"
-    assert r["EJ2"].text() == "2.250"
-    assert r["EJ5"].text() == "-7.000"
-    assert (r["X"].unit(), r["A"].unit(), r["EJ1"].unit()) == ("mm", "°", "")
+    assert r["J8"].text() == "2.250"
+    assert r["J11"].text() == "-7.000"
+    assert (r["X"].unit(), r["A"].unit(), r["J7"].unit()) == ("mm", "°", "")
     assert panel._axes_box.title().endswith("(°)")  # the small readouts' unit is in the title
     assert r["X"].caption() == "X"
 

@@ -1,7 +1,7 @@
 """A number is shown whole or visibly not at all (issue 18): the monitor's readouts and the pose
 strip, against the simulator, at every size the README names and in both languages.
 
-Two values from the issue: an external axis at -1000 (the CLI prints ``EJ1 -1000.000``; the
+Two values from the issue: an external axis at -1000 (the CLI prints ``J7 -1000.000``; the
 small readouts used to cut it to "1000.000") and a joint that reads as -6.1e29 when the host
 reads the other word order (it used to read "1200.000"). Asserted on the text the readouts draw
 (``shown_text()``, the text their paint event draws; a pose strip value is a QLabel, whose text
@@ -44,7 +44,7 @@ pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)
 
 SIZES = ((1024, 768), (1280, 800), (1920, 1080))
 LANGUAGES = ("en", "zh_CN")
-FAR_EXTERNAL = -1000.0  # J7 (EJ1) at the end of the simulator's external-axis range
+FAR_EXTERNAL = -1000.0  # J7 (GV212) at the end of the simulator's external-axis range
 GARBLED = -6.1e29  # what J2 reads as with the other word order
 
 
@@ -148,11 +148,11 @@ def test_readouts_show_a_number_whole_or_not_at_all(
     window = make_window(language, size)
     readouts = window.monitor_panel.readouts
     connect(qtbot, window.link, sim)
-    qtbot.waitUntil(lambda: readouts["EJ1"].value == FAR_EXTERNAL, timeout=SIGNAL_TIMEOUT_MS)
+    qtbot.waitUntil(lambda: readouts["J7"].value == FAR_EXTERNAL, timeout=SIGNAL_TIMEOUT_MS)
     settle()
     assert_whole_or_hidden(qtbot, window)
     if size != SIZES[0]:  # room is kept for it where the README promises the layout
-        assert readouts["EJ1"].shown_text() == "-1000.000"
+        assert readouts["J7"].shown_text() == "-1000.000"
 
     # the host reads the other word order: J2 reads -6.1e29, the pose is garbage too
     connect(qtbot, window.link, sim, word_order=WordOrder.HIGH_FIRST)
@@ -221,7 +221,7 @@ def test_values_that_come_and_go_past_their_room_do_not_relayout_the_window(
     assert relayouts.count == 0
     assert monitor.readouts["X"].shown_text() == OVERFLOW
     assert strip.values["Y"].toolTip() == ""  # fits again: its tooltip went with the overflow
-    assert monitor.readouts["EJ1"].shown_text() == "-1000.000"
+    assert monitor.readouts["J7"].shown_text() == "-1000.000"
 
 
 @pytest.mark.parametrize(("caption", "unit"), [("X", "mm"), ("C", "°"), ("J4", "°"), ("E1", "mm")])

@@ -299,7 +299,8 @@ def test_export_csv_is_atomic_and_follows_the_filter(tmp_path: Path, panel: Traf
     panel.set_hide_polls(True)
     assert panel.export_to(target) == 2
     assert [p.name for p in tmp_path.iterdir()] == ["traffic.csv"]  # no temp file left
-    rows = list(csv.reader(io.StringIO(target.read_text(encoding="utf-8"))))
+    assert target.read_bytes().startswith(b"\xef\xbb\xbf")  # UTF-8 with a BOM, for Excel
+    rows = list(csv.reader(io.StringIO(target.read_text(encoding="utf-8-sig"))))
     assert rows[0] == ["time", "direction", "bytes", "meaning"]
     assert rows[1][1:] == ["Tx", SEED_TX, "write GV200 = 30.0"]
     assert rows[2][1:] == ["Rx", SEED_RX, "ack write GV200 (400–401)"]
@@ -311,7 +312,7 @@ def test_export_text_is_tab_separated(tmp_path: Path, panel: TrafficPanel) -> No
     panel.on_traffic(seed_pair())
     target = tmp_path / "traffic.txt"
     panel.export_to(target)
-    lines = target.read_text(encoding="utf-8").splitlines()
+    lines = target.read_text(encoding="utf-8-sig").splitlines()
     assert len(lines) == 2
     assert lines[0].split("\t")[1:] == ["Tx", SEED_TX, "write GV200 = 30.0"]
 
@@ -420,7 +421,7 @@ def test_long_frames_are_cut_in_the_cell_but_complete_in_tooltip_and_export(
     tip = cell(panel.model, 1, COL_BYTES, Qt.ItemDataRole.ToolTipRole)
     assert tip.startswith("209 bytes") and tip.replace("\n", " ").endswith(full[-20:])
     panel.export_to(tmp_path / "t.txt")
-    assert full in (tmp_path / "t.txt").read_text(encoding="utf-8")
+    assert full in (tmp_path / "t.txt").read_text(encoding="utf-8-sig")
 
 
 def test_a_100hz_stream_updates_the_visible_table_at_most_at_the_flush_rate(

@@ -262,9 +262,9 @@ class SafetyMenu(QObject):
         try:
             with tempfile.TemporaryDirectory() as tmp:
                 window.event_log.export_to(Path(tmp) / "events.txt")
-                events = (Path(tmp) / "events.txt").read_text(encoding="utf-8").splitlines()
+                events = (Path(tmp) / "events.txt").read_text(encoding="utf-8-sig").splitlines()
                 window.traffic_panel.export_to(Path(tmp) / "traffic.txt", visible_only=False)
-                traffic = (Path(tmp) / "traffic.txt").read_text(encoding="utf-8").splitlines()
+                traffic = (Path(tmp) / "traffic.txt").read_text(encoding="utf-8-sig").splitlines()
                 manifest = write_support_bundle(
                     path,
                     settings=settings,

@@ -13,6 +13,7 @@ from app.points.ledger import (
     SyncState,
 )
 from app.points.ledger import TR_CONTEXT as POINTS_CORE_CONTEXT
+from app.points.number_text import display_text, value_text
 from app.protocol.registers import TOOL_NONE
 from ui.palette import (
     COLOR_ERROR,
@@ -64,16 +65,18 @@ def sync_text(state: SyncState) -> str:
 def tool_display(tool: int) -> str:
     if tool == TOOL_NONE:
         return QCoreApplication.translate("PointsModel", "none")
-    return QCoreApplication.translate("PointsModel", "tool {n}").format(n=tool + 1)
+    return QCoreApplication.translate("PointsModel", "tool {n}").format(n=tool)  # as in the CSV and GV245
 
 
-def format_number(value: float) -> str:
-    return f"{value:.3f}"
+def format_number(value: float, field: str = "") -> str:
+    """The table's text of a number (3 decimals, no -0.000, +180 for A/C: app/points/number_text.py)."""
+    return display_text(value, field)
 
 
-def edit_text(value: float) -> str:
-    """Editor text of a float that round-trips exactly (``400.0``, ``0.1``)."""
-    return repr(float(value))
+def edit_text(value: float, field: str = "") -> str:
+    """Editor text of a number: its shortest float32 text, as the CSV writes it (``596.903``,
+    ``400.0``, ``0.0`` for -9.2e-06; app/points/number_text.py)."""
+    return value_text(value, field)
 
 
 # --------------------------------------------------------------------------------------------

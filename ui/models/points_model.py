@@ -214,14 +214,14 @@ class PointsModel(UndoableListModel):
         if name == "sync":
             return sync_text(point.sync)
         value = point.get(name)
-        return format_number(float(value)) if isinstance(value, float | int) else str(value)
+        return format_number(float(value), name) if isinstance(value, float | int) else str(value)
 
     def _edit_value(self, point: TempPoint, name: str) -> str:
         if name == "sync":
             return point.sync.value
         value = point.get(name)
         if isinstance(value, float):
-            return edit_text(value)
+            return edit_text(value, name)
         return str(value)
 
     def _tooltip(self, point: TempPoint, name: str) -> str | None:

@@ -7,6 +7,7 @@ A command's result is the controller's outcome (done, refused -- with its status
 from __future__ import annotations
 
 import datetime as dt
+import io
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -29,6 +30,7 @@ from PySide6.QtWidgets import (
 
 from app.safety.audit import AuditFilter, AuditRecord, ReadStats, Result, export_csv, query, result_label
 from app.safety.audit_chain import verify_chain
+from ui.widgets_common import atomic_write_text
 
 DEFAULT_DAYS = 7  # the range shown when the viewer opens
 MAX_ROWS = 20000  # newest rows kept in the table (the CSV export takes the same rows)
@@ -231,9 +233,10 @@ class AuditViewer(QDialog):
         path = self._save_path(f"audit-{dt.date.today().isoformat()}.csv")
         if not path:
             return
-        try:
-            with open(path, "w", encoding="utf-8", newline="") as out:
-                n = export_csv(self.model.records, out)
+        buffer = io.StringIO(newline="")
+        n = export_csv(self.model.records, buffer)
+        try:  # atomically, UTF-8 with a BOM: Excel on a Chinese Windows reads it as UTF-8
+            atomic_write_text(path, buffer.getvalue(), encoding="utf-8-sig")
         except OSError as exc:
             self.status.setText(
                 self.tr("Cannot write {file}: {why}").format(file=Path(path).name, why=exc.strerror or exc)

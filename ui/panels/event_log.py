@@ -15,6 +15,7 @@ import datetime as dt
 import os
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 from PySide6.QtCore import (
@@ -41,6 +42,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.event_store import EventStore, StoredEvent, export_line
 from app.link.state import RobotState
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult
@@ -158,6 +160,15 @@ class EventLogModel(QAbstractTableModel):
         self._events.append(event)
         self.endInsertRows()
 
+    def prepend(self, events: list[LogEvent]) -> None:
+        """Put ``events`` (older than every row, oldest first) before the rows, as many as fit."""
+        events = events[max(0, len(events) - (self._max - len(self._events))) :]
+        if not events:
+            return
+        self.beginInsertRows(QModelIndex(), 0, len(events) - 1)
+        self._events[:0] = events
+        self.endInsertRows()
+
     def clear(self) -> None:
         self.beginResetModel()
         self._events.clear()
@@ -244,6 +255,7 @@ class EventLogPanel(QWidget):
         self.setObjectName("EventLogPanel")
         self._alarms: int | None = None
         self._last_connection: tuple[LinkState, str] | None = None
+        self._store: EventStore | None = None  # kept across restarts once attach_store is called
         self.model = EventLogModel(self, max_events=max_events)
         self.proxy = _LevelFilter(self)
         self.proxy.setSourceModel(self.model)
@@ -329,8 +341,40 @@ class EventLogPanel(QWidget):
         self.model.add(event)
         if follow:
             self.view.scrollToBottom()
+        if self._store is not None:
+            self._store.append(_stored(event))
         self.eventAdded.emit(event)
         return event
+
+    def keep_across_restarts(self, directory: Path | None = None) -> int:
+        """Keep the log in ``directory`` (default: the events folder in TeachPad's data folder):
+        :meth:`attach_store` with a store that says in the log when it cannot write."""
+
+        def failed(why: str) -> None:
+            self.add_event(
+                "warning",
+                lambda: self.tr("event log"),
+                lambda: self.tr("The event log is not saved for the next start: {why}").format(why=why),
+            )
+
+        return self.attach_store(EventStore(directory, on_error=failed))
+
+    def attach_store(self, store: EventStore) -> int:
+        """Keep the log across restarts: show ``store``'s recent events (of earlier sessions,
+        as they were written) before this session's, and save every event from now on (this
+        session's so far too). Returns how many events were restored."""
+        self._store = store
+        session = list(self.model.events())
+        restored = [
+            LogEvent(e.when, e.level, e.source, e.text)
+            for e in store.recent(limit=self.model.max_events)
+            if not session or e.when <= session[0].when
+        ]
+        for event in session:
+            store.append(_stored(event))
+        self.model.prepend(restored)
+        self.view.scrollToBottom()
+        return len(restored)
 
     def bind(self, state: RobotState) -> None:
         """Log ``state``'s link changes, alarm edges and command results from now on."""
@@ -409,20 +453,18 @@ class EventLogPanel(QWidget):
         self.model.clear()
 
     # --- export -----------------------------------------------------------------------
-    def export_to(self, path: str | os.PathLike[str]) -> int:
-        """Write every event as tab-separated text, atomically; returns the number of events."""
-        lines = [
-            "\t".join(
-                (
-                    e.when.isoformat(sep=" ", timespec="milliseconds"),
-                    e.level.upper(),
-                    e.source,
-                    " ".join(e.text.split()),
-                )
-            )  # one line per event
-            for e in self.model.events()
-        ]
-        atomic_write_text(path, "".join(line + "\n" for line in lines))
+    def export_to(self, path: str | os.PathLike[str], *, shown_only: bool = False) -> int:
+        """Write the events as tab-separated text, atomically, UTF-8 with a BOM (Excel on a
+        Chinese Windows reads it as UTF-8); every event, or with ``shown_only`` those the level
+        filter shows ("Errors only": the errors). Returns the number of events written."""
+        events = self.model.events()
+        if shown_only:
+            events = (
+                self.model.event_at(self.proxy.mapToSource(self.proxy.index(row, 0)).row())
+                for row in range(self.proxy.rowCount())
+            )
+        lines = [export_line(_stored(e)) for e in events]  # one line per event
+        atomic_write_text(path, "".join(line + "\n" for line in lines), encoding="utf-8-sig")
         return len(lines)
 
     @Slot()
@@ -432,5 +474,9 @@ class EventLogPanel(QWidget):
             self.tr("Export event log"),
             "events.txt",
             self.tr("Text files (*.txt *.log);;All files (*)"),
-            self.export_to,
+            lambda path: self.export_to(path, shown_only=True),
         )
+
+
+def _stored(event: LogEvent) -> StoredEvent:
+    return StoredEvent(event.when, event.level, event.source, event.text)

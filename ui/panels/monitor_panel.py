@@ -410,8 +410,8 @@ class MonitorPanel(QWidget):
             return
         for name, value in zip(_CARTESIAN, pose.xyzabc, strict=True):
             readouts[name].set_value(value)
-        for i, value in enumerate(pose.ext[:5], start=1):
-            readouts[f"EJ{i}"].set_value(value)
+        for i, value in enumerate(pose.ext[:5], start=7):  # the external axes, J7..J11
+            readouts[f"J{i}"].set_value(value)
         joints = pose.joints
         if joints and not self.joints_shown:
             for readout in self._joint_readouts:

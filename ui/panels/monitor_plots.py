@@ -74,8 +74,9 @@ AXIS_TICK_POINTS = 9.0
 LEFT_AXIS_WIDTH = 52  # px: room for "-8888" labels, so the plots do not shift as values change
 GRID_COLOR = "#dde3e6"
 # px: two stacked plots + the tiles above them set the Monitor tab's height, the tallest tab; with
-# the alarm banner up at 1280x800 (Chinese fonts are taller) 2 x 90 px did not fit
-PLOT_MIN_HEIGHT = 80
+# the alarm banner up at 1280x800 (Chinese fonts are taller) 2 x 90 px did not fit; 80 left no
+# room once the external axes read J7..J11 (their narrower captions take a half point larger font)
+PLOT_MIN_HEIGHT = 76
 # Points per curve: two per pixel of the plot's width, within MIN_PLOT_POINTS..MAX_PLOT_POINTS
 # (ui/panels/monitor_figures.py, with CARTESIAN, PAINT_MARGIN, TRACE_MIN_SPAN_MM and
 # PLOT_INTERVAL_MS: the panel needs them before the plots exist).

@@ -47,7 +47,7 @@ def readout_point_sizes(width: int) -> tuple[float, float]:
 
 
 class ReadoutBoxes:
-    """The two boxes of readouts; ``readouts`` by name (X.. C, J1..J6, EJ1..EJ5)."""
+    """The two boxes of readouts; ``readouts`` by name (X.. C, J1..J6, J7..J11 the external axes)."""
 
     def __init__(self, parent: QWidget) -> None:
         self.readouts: dict[str, NumericReadout] = {}
@@ -78,7 +78,8 @@ class ReadoutBoxes:
             readout = self._small(f"J{i}")
             readout.setVisible(False)  # shown once a pose carries joint angles
             self.joint_readouts.append(readout)
-        self.external_readouts = [self._small(f"EJ{i}") for i in range(1, 6)]
+        # J7..J11 as the jog panel, go to zero and the joint frame number them (GV212..GV216)
+        self.external_readouts = [self._small(f"J{i}") for i in range(7, 12)]
         self.small_columns = 0
         self._place_small(SMALL_COLUMNS[0])
         self._widths: dict[tuple[str, str, float], int] = {}  # (caption, unit, points) -> px

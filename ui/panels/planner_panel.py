@@ -121,6 +121,8 @@ class PlannerPanel(QWidget):
 
         plans.editRejected.connect(lambda text: self.show_message(text, "error"))
         self.segments.editRejected.connect(lambda text: self.show_message(text, "error"))
+        for view in (self.plan_view, self.segment_view):
+            view.doubleClicked.connect(self._say_why_not_editable)
         self.follower = PlanFollower(self, plans, points, self.segments, self._update_actions, self)
 
         r = self._runner
@@ -319,6 +321,13 @@ class PlannerPanel(QWidget):
         for view in (self.plan_view, self.segment_view):
             lock_editing(view, reason is not None)
         self._update_actions()
+
+    @Slot()
+    def _say_why_not_editable(self) -> None:
+        """A double click on a cell the role may not edit says why (it opened nothing)."""
+        reason = self.planner_actions.edit_reason
+        if reason is not None:
+            self.show_message(self.tr("This cell cannot be edited: {why}").format(why=reason), "warn")
 
     def set_envelope(self, envelope: Envelope | None, reduced_speed: bool = False) -> None:
         """The safety envelope the checks (and Run) use; its boxes are drawn in the preview."""

@@ -163,6 +163,7 @@ class PointsPanel(QWidget):
         )
         self.table.setModel(self.proxy)
         self.table.size_columns()
+        self.table.doubleClicked.connect(self._say_why_not_editable)
         self._show_ext(False)
 
         self.status = QLabel(self)
@@ -265,6 +266,13 @@ class PointsPanel(QWidget):
         lock_editing(self.table, reason is not None)
         self.retranslate()  # the usual tooltips back; _update_actions puts the reason on top
         self._update_actions()
+
+    @Slot()
+    def _say_why_not_editable(self) -> None:
+        """A double click on a cell the role may not edit says why (it opened nothing)."""
+        if self._edit_reason is not None:
+            text = self.tr("This cell cannot be edited: {why}").format(why=self._edit_reason)
+            self.show_message(text, LEVEL_WARN)
 
     def set_run_active(self, active: bool) -> None:
         """A plan is running: no teach / upload / move from here."""

@@ -288,7 +288,7 @@ class TrafficPanel(QWidget):
             text = buffer.getvalue()
         else:
             text = "".join("\t".join(f) + "\n" for f in fields)
-        atomic_write_text(path, text)
+        atomic_write_text(path, text, encoding="utf-8-sig")  # with a BOM: Excel reads it as UTF-8
         return len(rows)
 
     @Slot()
