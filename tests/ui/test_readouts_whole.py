@@ -224,7 +224,7 @@ def test_values_that_come_and_go_past_their_room_do_not_relayout_the_window(
     assert monitor.readouts["J7"].shown_text() == "-1000.000"
 
 
-@pytest.mark.parametrize(("caption", "unit"), [("X", "mm"), ("C", "°"), ("J4", "°"), ("E1", "mm")])
+@pytest.mark.parametrize(("caption", "unit"), [("X", "mm"), ("C", "°"), ("J4", "°"), ("J7", "mm")])
 def test_a_readout_needs_no_more_than_the_width_the_monitor_is_told(
     qtbot: Any, caption: str, unit: str
 ) -> None:
