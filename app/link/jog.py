@@ -20,13 +20,23 @@ import time
 from dataclasses import dataclass
 
 from app import timing
-from app.errors import CommandRefused, InvalidInput, LinkError, ModbusExceptionError, Reason, TeachPadError
+from app.errors import (
+    CommandRefused,
+    InvalidInput,
+    LinkError,
+    ModbusExceptionError,
+    OutcomeUnknown,
+    Reason,
+    TeachPadError,
+)
 from app.link.halt import HaltWatch, HaltWrite, halt_refusal
 from app.link.host import WorkerHost
+from app.link.outcome import UNKNOWN_ADVICE
 from app.link.tracker import CommandTracker
 from app.link.types import HaltKind, JogRequest, Operation, UnconfirmedHalt
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import ControllerMode, TeachFrame, controller_mode_text
+from app.protocol.exceptions import exception_text, not_carried_out
 from app.safety.envelope import EnvelopeRefused, EnvelopeViolation
 from app.safety.jog_guard import GuardTiming, JogGuard
 
@@ -258,8 +268,7 @@ class JogMachine:
                 self._check(serial)
             if teach.ratio != request.ratio:
                 self._require_guard(request)
-                client.teach_set_ratio(request.ratio)
-                teach.ratio = request.ratio
+                self._start(request.ratio)
             return
         if teach.enabled or self.teach_dirty:
             client.teach_set_ratio(0.0)
@@ -290,8 +299,28 @@ class JogMachine:
             return
         self._check(serial)
         self._require_guard(request)  # the pose may have moved on while teach mode came up
-        client.teach_set_ratio(request.ratio)
-        self.teach.ratio = request.ratio
+        self._start(request.ratio)
+
+    def _start(self, ratio: float) -> None:
+        """GV203 <- ``ratio`` (> 0: the arm moves). An answer that does not say the write was not
+        carried out (a Modbus exception other than :data:`~app.protocol.exceptions.NOT_CARRIED_OUT`)
+        leaves the arm maybe jogging: the jog counts as under way (the envelope guard watches it,
+        a release or Stop halts it) and the operator reads "outcome unknown", never "refused"."""
+        client = self._host.client_or_raise()
+        try:
+            client.teach_set_ratio(ratio)
+        except ModbusExceptionError as exc:
+            if not_carried_out(exc.exception_code):
+                raise
+            self.teach.ratio = ratio
+            code = exc.exception_code
+            answer = exception_text(code, "a code the standard does not define")
+            raise OutcomeUnknown(
+                f"jog at {ratio:g} %: {UNKNOWN_ADVICE} (the speed write was answered Modbus exception "
+                f"{code}, {answer}, which does not say it was not carried out: the arm may be jogging)",
+                params={"operation": Operation.JOG},
+            ) from exc
+        self.teach.ratio = ratio
 
     # --- the jog guard (the safety envelope) ---------------------------------------------
     def _require_guard(self, request: JogRequest) -> None:

@@ -91,6 +91,9 @@ class SimController:
         self._exception_rule: tuple[ExcCodes | None, range | None, int | None] = (None, None, None)
         # set_exception(after_write=REG): the rule waits for a stored write covering REG (None: armed)
         self._exception_after: int | None = None
+        # answer_after_applying(code, register): the next write starting at register is carried
+        # out, then answered with this exception (a controller that acted and said it failed)
+        self._applied_then: tuple[ExcCodes, int] | None = None
         # set_exception(seconds=S): the rule lifts itself S s after it is armed (None: until lifted)
         self._exception_seconds: float | None = None
         self._exception_until: float | None = None
@@ -293,6 +296,7 @@ class SimController:
                 log.info("write fc=0x%02X address=%d refused: exception %d", function_code, address, refused)
                 return refused
         offset = address - start_address
+        answer: ExcCodes | None = None
         with self.lock:
             if self._wipe_general:  # a restarted controller starts with cleared general-purpose GVs
                 self._wipe_general = False
@@ -322,11 +326,16 @@ class SimController:
                     self._arm_exception_window()
                     log.info("exception rule armed by the write to %d", armer)
                 self._restart_if_due(address, len(values))
+                applied = self._applied_then
+                if applied is not None and address == applied[1]:
+                    self._applied_then = None  # once
+                    answer = applied[0]
+                    log.info("write to %d carried out, answered exception %d", address, int(answer))
             self._refresh(registers, start_address)
             status_reg = gv_reg(GV_COMMAND_STATUS)
             if set_values is None and address <= status_reg < address + count:
                 self.status.seen(time.monotonic())  # a host has now seen the 0 (if it shows)
-        return None
+        return answer
 
     # --- registers ------------------------------------------------------------------------
     def published_status(self, now: float | None = None) -> int:
@@ -581,6 +590,14 @@ class SimController:
             on_text(connection),
             after,
         )
+
+    def answer_after_applying(self, code: ExcCodes | int, register: int) -> None:
+        """The next write starting at ``register`` is carried out, then answered with Modbus
+        exception ``code``: a controller (or a gateway) that acted and reported a failure, the
+        answer after which the host cannot know what the write did (once)."""
+        with self.lock:
+            self._applied_then = (ExcCodes(code), register)
+        log.info("the next write to %d: carried out, answered exception %d", register, int(code))
 
     def connection_ids(self) -> list[int]:
         """The ids of the connections open now, oldest first."""
