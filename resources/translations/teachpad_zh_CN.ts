@@ -3655,122 +3655,122 @@
             <translation>备注</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="143" />
+            <location filename="../../ui/models/points_model.py" line="146" />
             <source>Temp point id on the controller</source>
             <translation>控制器上的临时点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="144" />
+            <location filename="../../ui/models/points_model.py" line="147" />
             <source>Tool frame (200 = none)</source>
             <translation>工具坐标系（200 = 无）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="145" />
+            <location filename="../../ui/models/points_model.py" line="148" />
             <source>Whether the controller holds this point</source>
             <translation>控制器上是否有此点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="146" />
+            <location filename="../../ui/models/points_model.py" line="149" />
             <source>mm, base frame</source>
             <translation>毫米，基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="147" />
+            <location filename="../../ui/models/points_model.py" line="150" />
             <source>degrees</source>
             <translation>度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="149" />
-            <source>External axis (recorded only: the controller does not store it)</source>
-            <translation>外部轴（仅记录：控制器不保存）</translation>
+            <location filename="../../ui/models/points_model.py" line="153" />
+            <source>External axis (recorded only: the controller does not store it); CSV column {column}</source>
+            <translation>外部轴（仅记录：控制器不保存）；CSV 列 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="230" />
+            <location filename="../../ui/models/points_model.py" line="236" />
             <source>no reason given</source>
             <translation>未给出原因</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="231" />
+            <location filename="../../ui/models/points_model.py" line="237" />
             <source>Upload failed: {reason}</source>
             <translation>上传失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="234" />
+            <location filename="../../ui/models/points_model.py" line="240" />
             <source>Not known whether the controller holds this point (it restarted, it is another controller, or the arm did not arrive there): a move to it creates it again first</source>
             <translation>不知道控制器是否保存着此点（控制器已重启、是另一台控制器，或机械臂未到达该点）：移动到此点时会先重新创建它</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="238" />
+            <location filename="../../ui/models/points_model.py" line="244" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="239" />
+            <location filename="../../ui/models/points_model.py" line="245" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="241" />
+            <location filename="../../ui/models/points_model.py" line="247" />
             <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
             <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="249" />
+            <location filename="../../ui/models/points_model.py" line="255" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="279" />
+            <location filename="../../ui/models/points_model.py" line="285" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="308" />
+            <location filename="../../ui/models/points_model.py" line="314" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="325" />
+            <location filename="../../ui/models/points_model.py" line="331" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="354" />
+            <location filename="../../ui/models/points_model.py" line="360" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="356" />
+            <location filename="../../ui/models/points_model.py" line="362" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="375" />
+            <location filename="../../ui/models/points_model.py" line="381" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="377" />
+            <location filename="../../ui/models/points_model.py" line="383" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="393" />
+            <location filename="../../ui/models/points_model.py" line="399" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="393" />
+            <location filename="../../ui/models/points_model.py" line="399" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="416" />
+            <location filename="../../ui/models/points_model.py" line="422" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="436" />
+            <location filename="../../ui/models/points_model.py" line="442" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -3886,13 +3886,13 @@
         </message>
         <message>
             <location filename="../../ui/panels/points_panel.py" line="215" />
-            <source>E1–E5</source>
-            <translation>E1–E5</translation>
+            <source>J7–J11</source>
+            <translation>J7–J11</translation>
         </message>
         <message>
             <location filename="../../ui/panels/points_panel.py" line="215" />
-            <source>Show the external axes columns</source>
-            <translation>显示外部轴列</translation>
+            <source>Show the external axes columns (J7–J11)</source>
+            <translation>显示外部轴列（J7–J11）</translation>
         </message>
         <message>
             <location filename="../../ui/panels/points_panel.py" line="216" />

@@ -59,6 +59,26 @@ def test_external_axes_are_j7_to_j11_in_the_monitor(qtbot: Any) -> None:
     assert captions == list(JOINT_AXIS_NAMES[6:])
 
 
+def test_the_points_table_names_external_axes_j7_to_j11(qtbot: Any, translator: Any) -> None:
+    """The table's external-axis columns read as the jog panel names the axes; the tip says the
+    CSV column (e1..e5, kept for existing files); the switch that shows them too."""
+    from ui.models.point_columns import EXT_COLUMNS
+    from ui.panels.points_panel import PointsPanel
+
+    model = PointsModel(Project(name="ext"), QUndoStack())
+    horizontal = Qt.Orientation.Horizontal
+    headers = [model.headerData(c, horizontal, Qt.ItemDataRole.DisplayRole) for c in EXT_COLUMNS]
+    assert headers == list(JOINT_AXIS_NAMES[6:])
+    assert "e1" in model.headerData(EXT_COLUMNS[0], horizontal, Qt.ItemDataRole.ToolTipRole)
+    panel = PointsPanel(model)
+    qtbot.addWidget(panel)
+    assert panel.action_show_ext.text() == "J7–J11"
+    assert translator.set_language("zh_CN")
+    model.retranslate()
+    tip = model.headerData(EXT_COLUMNS[4], horizontal, Qt.ItemDataRole.ToolTipRole)
+    assert "外部轴" in tip and "e5" in tip
+
+
 def test_the_cli_status_names_external_axes_as_jog_and_zero_do(
     sim: Any, capsys: pytest.CaptureFixture[str]
 ) -> None:

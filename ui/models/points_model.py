@@ -137,6 +137,9 @@ class PointsModel(UndoableListModel):
             "tool": self.tr("Tool"),
             "sync": self.tr("Sync"),
             "note": self.tr("Note"),
+            # external axes: J7..J11 as the jog panel, go to zero and the monitor name them (the
+            # CSV's columns keep their names e1..e5, the header tip says which)
+            **{f"e{n}": f"J{n + 6}" for n in range(1, 6)},
         }
         self._headers = tuple(names.get(c, c.upper()) for c in COLUMNS)
         self._header_tips = {
@@ -145,9 +148,12 @@ class PointsModel(UndoableListModel):
             COL_SYNC: self.tr("Whether the controller holds this point"),
             **{c: self.tr("mm, base frame") for c in range(COL_X, COL_X + 3)},
             **{c: self.tr("degrees") for c in range(COL_X + 3, COL_C + 1)},
-            **dict.fromkeys(
-                EXT_COLUMNS, self.tr("External axis (recorded only: the controller does not store it)")
-            ),
+            **{
+                c: self.tr(
+                    "External axis (recorded only: the controller does not store it); CSV column {column}"
+                ).format(column=f"e{n}")
+                for n, c in enumerate(EXT_COLUMNS, start=1)
+            },
         }
         self.headerDataChanged.emit(Qt.Orientation.Horizontal, 0, len(COLUMNS) - 1)
 

@@ -212,7 +212,7 @@ class PointsPanel(QWidget):
                 self.tr("Move to point"),
                 self.tr("Move the robot in a line to the selected point (asks first)"),
             ),
-            self.action_show_ext: (self.tr("E1–E5"), self.tr("Show the external axes columns")),
+            self.action_show_ext: (self.tr("J7–J11"), self.tr("Show the external axes columns (J7–J11)")),
             self.action_find: (self.tr("Find"), ""),
         }
         for action, (text, tip) in texts.items():

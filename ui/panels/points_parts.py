@@ -2,7 +2,7 @@
 
 * :class:`PointsActionBar`: the primary row (Teach, Upload ▾, Restore all, Move to point and its
   speed: plain buttons, a toolbar would hide them behind » on a narrow screen), then the edit
-  toolbar, the filter (id or name) and the E1–E5 switch;
+  toolbar, the filter (id or name) and the J7–J11 switch;
 * :class:`RestoreBanner`: "the controller may have lost its points", with Restore all;
 * :class:`UploadProgressRow`: the running upload, with Cancel;
 * :class:`PointsTable`: the ledger table (rows selected whole, E1..E5 hideable, widths that fit
