@@ -60,6 +60,7 @@ from ui.controllers.project_controller import ProjectController, ProjectDialogs
 from ui.controllers.safety_menu import install_safety
 from ui.dialogs.confirm import ConfirmFn
 from ui.i18n import Translator
+from ui.joins import labelled
 from ui.messages import error_text
 from ui.panels.monitor_panel import MonitorPanel
 from ui.panels.view3d_host import install_view3d
@@ -332,7 +333,7 @@ class MainWindow(QMainWindow):
     @Slot(WorkerError)
     def _on_error(self, error: WorkerError) -> None:
         operation = self.event_log.operation_text(error.operation)
-        self.status_bar.show_message(f"{operation}: {error_text(error)}")
+        self.status_bar.show_message(labelled(operation, error_text(error)))
 
     @Slot(str)
     def _show_message(self, text: str) -> None:

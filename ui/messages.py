@@ -29,6 +29,7 @@ from app.protocol.enums import (
     alarm_names,
     controller_mode_text,
 )
+from ui.joins import join_names
 from ui.messages_files import FILE_TEMPLATES, file_fields, file_text, os_problem
 from ui.messages_plan import _number, _tr, envelope_text, issue_line, issue_text
 
@@ -363,7 +364,7 @@ def _status(args: Mapping[str, Any]) -> str | None:
 
 
 def _alarms(mask: int) -> str:
-    return "、".join(
+    return join_names(
         _tr(name, "Protocol") if not name.startswith("bit ") else name[4:] for name in alarm_names(mask)
     )
 

@@ -15,6 +15,7 @@ from PySide6.QtCore import QCoreApplication
 from app.plan.issue_kind import IssueKind
 from app.points.point import SYNC_STATE_TEXT, SyncState
 from app.protocol.registers import TOOL_NONE
+from ui.joins import labelled
 
 if TYPE_CHECKING:  # the checks are imported by the first plan checked, after the first paint
     from app.plan.checks import PlanIssue
@@ -220,4 +221,4 @@ def issue_text(issue: PlanIssue) -> str:
 def issue_line(issue: PlanIssue) -> str:
     """An issue with its kind ("error: segment 2: ..."), for lists and tooltips."""
     kind = QCoreApplication.translate("SegmentTableModel", _ISSUE_KINDS[issue.kind])
-    return f"{kind}: {issue_text(issue)}"
+    return labelled(kind, issue_text(issue))

@@ -4,27 +4,27 @@
     <context>
         <name>AlarmBanner</name>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="44" />
+            <location filename="../../ui/panels/alarm_banner.py" line="45" />
             <source>alarm bit {bit}</source>
             <translation>报警位 {bit}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="166" />
+            <location filename="../../ui/panels/alarm_banner.py" line="167" />
             <source>ALARM: {names}</source>
             <translation>报警：{names}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="168" />
+            <location filename="../../ui/panels/alarm_banner.py" line="169" />
             <source>(last known: the link is not live)</source>
             <translation>（最后已知：通信未实时）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="171" />
+            <location filename="../../ui/panels/alarm_banner.py" line="172" />
             <source>Motion controls are held until the alarm is reset. STOP stays available.</source>
             <translation>报警复位前运动控制已锁定。停止按钮始终可用。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="177" />
+            <location filename="../../ui/panels/alarm_banner.py" line="178" />
             <source>Register 562 = {word}</source>
             <translation>寄存器 562 = {word}</translation>
         </message>
@@ -499,7 +499,7 @@
         <message>
             <location filename="../../ui/dialogs/connection_dialog.py" line="223" />
             <source>Unit id and word order come from the register profile (Safety → Register profile…, administrator).</source>
-            <translation>站号和字序取自寄存器配置（安全 → 寄存器配置…，管理员）。</translation>
+            <translation>从站地址和字序取自寄存器配置（安全 → 寄存器配置…，管理员）。</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/connection_dialog.py" line="263" />
@@ -529,7 +529,7 @@
         <message>
             <location filename="../../ui/dialogs/connection_dialog.py" line="271" />
             <source>{transport}, unit {unit}</source>
-            <translation>{transport}，站号 {unit}</translation>
+            <translation>{transport}，从站地址 {unit}</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/connection_dialog.py" line="274" />
@@ -744,73 +744,83 @@
             <translation>TCP 必须留在此长方体内</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="73" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="74" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="79" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="75" />
+            <source>{axis} min</source>
+            <translation>{axis} 最小</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="76" />
+            <source>{axis} max</source>
+            <translation>{axis} 最大</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="83" />
             <source>Add zone</source>
             <translation>添加禁区</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="81" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="85" />
             <source>Remove zone</source>
             <translation>删除禁区</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="91" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="95" />
             <source>Revision {n}</source>
             <translation>版本 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="95" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="99" />
             <source>Joint limits</source>
             <translation>关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="99" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="103" />
             <source>Work space (keep-in box)</source>
             <translation>工作空间（允许区域）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="108" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="112" />
             <source>Keep-out zones</source>
             <translation>禁入区域</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="116" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="120" />
             <source>Speeds</source>
             <translation>速度</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="118" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="122" />
             <source>Max jog speed:</source>
             <translation>最大点动速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="119" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="123" />
             <source>Max TCP speed (moves, plans):</source>
             <translation>最大 TCP 速度（移动、计划）：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="120" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="124" />
             <source>Reduced mode jog speed:</source>
             <translation>降速模式点动速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="121" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="125" />
             <source>Reduced mode TCP speed:</source>
             <translation>降速模式 TCP 速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="143" />
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="181" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="147" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="185" />
             <source>zone {n}</source>
             <translation>禁区 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="160" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="164" />
             <source>{what}: '{text}' is not a number</source>
             <translation>{what}：“{text}”不是数字</translation>
         </message>
@@ -1073,6 +1083,32 @@
         </message>
     </context>
     <context>
+        <name>JoinNames</name>
+        <message>
+            <location filename="../../ui/joins.py" line="20" />
+            <source>, </source>
+            <translation>、</translation>
+        </message>
+    </context>
+    <context>
+        <name>Joins</name>
+        <message>
+            <location filename="../../ui/joins.py" line="25" />
+            <source>, </source>
+            <translation>，</translation>
+        </message>
+        <message>
+            <location filename="../../ui/joins.py" line="30" />
+            <source>; </source>
+            <translation>；</translation>
+        </message>
+        <message>
+            <location filename="../../ui/joins.py" line="35" />
+            <source>{label}: {text}</source>
+            <translation>{label}：{text}</translation>
+        </message>
+    </context>
+    <context>
         <name>KeypadDialog</name>
         <message>
             <location filename="../../ui/keypad.py" line="102" />
@@ -1203,7 +1239,7 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="322" />
+            <location filename="../../ui/main_window.py" line="323" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1229,7 +1265,7 @@
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="354" />
+            <location filename="../../ui/main_window.py" line="355" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
@@ -1254,29 +1290,29 @@
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="377" />
+            <location filename="../../ui/main_window.py" line="378" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="356" />
-            <location filename="../../ui/main_window.py" line="365" />
-            <location filename="../../ui/main_window.py" line="378" />
+            <location filename="../../ui/main_window.py" line="357" />
+            <location filename="../../ui/main_window.py" line="366" />
+            <location filename="../../ui/main_window.py" line="379" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="299" />
+            <location filename="../../ui/main_window.py" line="300" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="300" />
+            <location filename="../../ui/main_window.py" line="301" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="301" />
+            <location filename="../../ui/main_window.py" line="302" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1286,37 +1322,37 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="372" />
+            <location filename="../../ui/main_window.py" line="373" />
             <source>plan run</source>
             <translation>计划运行</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="452" />
+            <location filename="../../ui/main_window.py" line="453" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="454" />
+            <location filename="../../ui/main_window.py" line="455" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="467" />
+            <location filename="../../ui/main_window.py" line="468" />
             <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
             <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="469" />
+            <location filename="../../ui/main_window.py" line="470" />
             <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="487" />
+            <location filename="../../ui/main_window.py" line="488" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="487" />
+            <location filename="../../ui/main_window.py" line="488" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -1324,358 +1360,358 @@
     <context>
         <name>Messages</name>
         <message>
-            <location filename="../../ui/messages.py" line="65" />
+            <location filename="../../ui/messages.py" line="66" />
             <source>{command}: {status}.</source>
             <translation>{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="66" />
+            <location filename="../../ui/messages.py" line="67" />
             <source>{command}: done, not confirmed by the controller.</source>
             <translation>{command}：已完成，控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="67" />
+            <location filename="../../ui/messages.py" line="68" />
             <source>{command}: done (the controller is now in {mode} mode).</source>
             <translation>{command}：已完成（控制器现处于{mode}模式）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="68" />
+            <location filename="../../ui/messages.py" line="69" />
             <source>{command} refused by the controller: {status}.</source>
             <translation>控制器拒绝了{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="69" />
+            <location filename="../../ui/messages.py" line="70" />
             <source>{command} not taken: the controller still shows “{status}” from the previous command.</source>
             <translation>{command}未被执行：控制器仍显示上一条命令的“{status}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="73" />
+            <location filename="../../ui/messages.py" line="74" />
             <source>{command} ended by an alarm: {alarms}.</source>
             <translation>{command}因报警而中止：{alarms}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="74" />
+            <location filename="../../ui/messages.py" line="75" />
             <source>{command}: the controller did not acknowledge it within {seconds} s.</source>
             <translation>{command}：控制器在 {seconds} s 内未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="77" />
+            <location filename="../../ui/messages.py" line="78" />
             <source>{command} did not finish within {seconds} s (last status: {status}).</source>
             <translation>{command}未在 {seconds} s 内完成（最后状态：{status}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="80" />
+            <location filename="../../ui/messages.py" line="81" />
             <source>{command}: the arm moved and stopped, but the controller did not report the result.</source>
             <translation>{command}：机械臂已运动并停止，但控制器未报告结果。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="83" />
+            <location filename="../../ui/messages.py" line="84" />
             <source>{command}: stopped by the operator.</source>
             <translation>{command}：已由操作员停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="84" />
+            <location filename="../../ui/messages.py" line="85" />
             <source>{command}: stopped by the controller.</source>
             <translation>{command}：已被控制器停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="85" />
+            <location filename="../../ui/messages.py" line="86" />
             <source>{command}: sent (not waited for).</source>
             <translation>{command}：已发送（未等待结果）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="86" />
+            <location filename="../../ui/messages.py" line="87" />
             <source>{command}: no motion within {seconds} s (refused by the controller, or already there).</source>
             <translation>{command}：{seconds} s 内没有运动（被控制器拒绝，或已在目标位置）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="90" />
+            <location filename="../../ui/messages.py" line="91" />
             <source>{command} refused by the controller: {alarms}.</source>
             <translation>{command} 被控制器拒绝：{alarms}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="91" />
+            <location filename="../../ui/messages.py" line="92" />
             <source>{command}: sent; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{command}：已发送，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="94" />
+            <location filename="../../ui/messages.py" line="95" />
             <source>{command}: done (the axes were already at zero).</source>
             <translation>{command}：完成（各轴已在零位）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="95" />
+            <location filename="../../ui/messages.py" line="96" />
             <source>{command}: the arm stopped before zero ({axis} at {value}).</source>
             <translation>{command}：机械臂在到达零位前停止（{axis} 位于 {value}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="98" />
+            <location filename="../../ui/messages.py" line="99" />
             <source>{command} not sent: another Modbus master wrote to the controller less than {seconds} s ago and its writes could change this move. Make sure no other master is commanding the robot, then send it again.</source>
             <translation>{command} 未发送：另一个 Modbus 主站在不到 {seconds} 秒前写入了控制器，它的写入可能改变这次运动。请确认没有其他主站在指挥机器人，然后再发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="103" />
+            <location filename="../../ui/messages.py" line="104" />
             <source>{command} not sent: a program or motion is under way on the controller; wait for it to end, or press Stop.</source>
             <translation>{command} 未发送：控制器上有程序或运动正在进行；请等待其结束，或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="107" />
+            <location filename="../../ui/messages.py" line="108" />
             <source>{command}: the controller did not show it within {seconds} s.</source>
             <translation>{command}：控制器在 {seconds} s 内未显示该状态。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="110" />
+            <location filename="../../ui/messages.py" line="111" />
             <source>Program {program} did not start: no such program, or the controller refused it.</source>
             <translation>程序 {program} 未启动：没有该程序，或控制器拒绝执行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="113" />
+            <location filename="../../ui/messages.py" line="114" />
             <source>Uploaded {uploaded} of {total} points.</source>
             <translation>已上传 {uploaded}/{total} 个点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="115" />
+            <location filename="../../ui/messages.py" line="116" />
             <source>{operation}: sent.</source>
             <translation>{operation}：已发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="116" />
+            <location filename="../../ui/messages.py" line="117" />
             <source>{operation}: failed.</source>
             <translation>{operation}：失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="117" />
+            <location filename="../../ui/messages.py" line="118" />
             <source>{operation} is still under way: wait for it or press Stop.</source>
             <translation>{operation}仍在进行：请等待其结束或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="118" />
+            <location filename="../../ui/messages.py" line="119" />
             <source>The link is shut down: nothing was sent.</source>
             <translation>通信链路已关闭：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="119" />
+            <location filename="../../ui/messages.py" line="120" />
             <source>Not connected to a controller: nothing was sent.</source>
             <translation>未连接控制器：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="121" />
+            <location filename="../../ui/messages.py" line="122" />
             <source>Jog stopped: the controller is not answering (speed 0 is sent as soon as it answers).</source>
             <translation>点动已停止：控制器无应答（一旦应答即发送速度 0）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="124" />
+            <location filename="../../ui/messages.py" line="125" />
             <source>Jog stopped: the controller left teach mode (now in {mode} mode).</source>
             <translation>点动已停止：控制器已退出示教模式（当前为{mode}模式）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="127" />
+            <location filename="../../ui/messages.py" line="128" />
             <source>The controller is not answering: the jog was not started.</source>
             <translation>控制器无应答：点动未启动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="131" />
+            <location filename="../../ui/messages.py" line="132" />
             <source>Releasing — the controller has not confirmed: it refused or did not answer speed 0. Speed 0 is sent again at every poll until the controller answers and the arm stands still.</source>
             <translation>正在松开 — 控制器尚未确认：它拒绝或未应答速度 0。每次轮询都会重新发送速度 0，直到控制器应答且机械臂静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="136" />
+            <location filename="../../ui/messages.py" line="137" />
             <source>Releasing — the controller has not confirmed speed 0 after {seconds} s: Stop is sent as well, at every poll, until the controller takes it.</source>
             <translation>正在松开 — {seconds} 秒后控制器仍未确认速度 0：每次轮询同时发送停止命令，直到控制器接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="141" />
+            <location filename="../../ui/messages.py" line="142" />
             <source>Jog stopped: the controller confirmed after {seconds} s and the arm stands still.</source>
             <translation>点动已停止：控制器在 {seconds} 秒后确认，机械臂已静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="144" />
+            <location filename="../../ui/messages.py" line="145" />
             <source>Stopping — the controller has not confirmed: it refused or did not answer the Stop. Stop is sent again at every poll until the controller takes it and the arm stands still.</source>
             <translation>正在停止 — 控制器尚未确认：它拒绝或未应答停止命令。每次轮询都会重新发送停止命令，直到控制器接受且机械臂静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="149" />
+            <location filename="../../ui/messages.py" line="150" />
             <source>Stop confirmed by the controller after {seconds} s; the arm stands still.</source>
             <translation>控制器在 {seconds} 秒后确认停止；机械臂已静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="152" />
+            <location filename="../../ui/messages.py" line="153" />
             <source>{operation} refused: the controller has not confirmed that the arm stopped (the stop is sent again at every poll). Press Stop, or wait until the arm stands still.</source>
             <translation>{operation}被拒绝：控制器尚未确认机械臂已停止（每次轮询都会重新发送停止）。请按停止，或等待机械臂静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="157" />
+            <location filename="../../ui/messages.py" line="158" />
             <source>The controller is not answering: the plan was not started. Try again when it answers.</source>
             <translation>控制器无应答：计划未启动。待其恢复应答后再试。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="160" />
+            <location filename="../../ui/messages.py" line="161" />
             <source>Jog speed {value}% is not within 1..100%.</source>
             <translation>点动速度 {value}% 不在 1..100% 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="162" />
+            <location filename="../../ui/messages.py" line="163" />
             <source>Lost the connection to the controller at {endpoint}.</source>
             <translation>与控制器 {endpoint} 的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="163" />
+            <location filename="../../ui/messages.py" line="164" />
             <source>The controller at {endpoint} closed the connection.</source>
             <translation>控制器 {endpoint} 关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="164" />
+            <location filename="../../ui/messages.py" line="165" />
             <source>The host name {host} cannot be resolved.</source>
             <translation>无法解析主机名 {host}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="165" />
+            <location filename="../../ui/messages.py" line="166" />
             <source>The host name {host} is not valid: check it in Connect…</source>
             <translation>主机名 {host} 无效：请在“连接…”中检查。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="166" />
+            <location filename="../../ui/messages.py" line="167" />
             <source>Connection refused: nothing listens on port {port}.</source>
             <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="169" />
+            <location filename="../../ui/messages.py" line="170" />
             <source>No answer to the connection request within {seconds} s.</source>
             <translation>连接请求在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="172" />
+            <location filename="../../ui/messages.py" line="173" />
             <source>The connection could not be opened.</source>
             <translation>无法建立连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="173" />
+            <location filename="../../ui/messages.py" line="174" />
             <source>Cannot open the serial port {port}.</source>
             <translation>无法打开串口 {port}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="174" />
+            <location filename="../../ui/messages.py" line="175" />
             <source>The controller at {endpoint} did not answer within {seconds} s.</source>
             <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="177" />
+            <location filename="../../ui/messages.py" line="178" />
             <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
             <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="181" />
+            <location filename="../../ui/messages.py" line="182" />
             <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="184" />
+            <location filename="../../ui/messages.py" line="185" />
             <source>Monitor-only mode: nothing was sent to the controller.</source>
             <translation>仅监视模式：未向控制器发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="185" />
+            <location filename="../../ui/messages.py" line="186" />
             <source>Not sent: the audit trail in {folder} cannot be written ({cause}). No write goes out without its record (Stop still does): free disk space or fix the audit folder.</source>
             <translation>未发送：审计记录目录 {folder} 无法写入（{cause}）。没有审计记录的写入一律不发送（停止除外）：请释放磁盘空间或修复审计目录。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="190" />
+            <location filename="../../ui/messages.py" line="191" />
             <source>{operation}: not sent, the controller is in {mode} mode. Switching it to auto is the operator's decision: say yes when the confirmation asks, or switch it to auto first.</source>
             <translation>{operation}：未发送，控制器处于{mode}模式。切换到自动模式须由操作员决定：在确认框询问时选择“是”，或先将其切换到自动模式。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="195" />
+            <location filename="../../ui/messages.py" line="196" />
             <source>{operation}: not sent in reduced-speed mode: it runs at the controller's own speed, which TeachPad cannot cap.</source>
             <translation>{operation}：降速模式下未发送：它以控制器自身的速度运行，TeachPad 无法限制该速度。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="200" />
-            <location filename="../../ui/messages_plan.py" line="29" />
+            <location filename="../../ui/messages.py" line="201" />
+            <location filename="../../ui/messages_plan.py" line="30" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="201" />
+            <location filename="../../ui/messages.py" line="202" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="203" />
+            <location filename="../../ui/messages.py" line="204" />
             <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
             <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="207" />
+            <location filename="../../ui/messages.py" line="208" />
             <source>The controller did not create {point} again before the move: the arm was not moved.</source>
             <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="210" />
+            <location filename="../../ui/messages.py" line="211" />
             <source>The project has no point {point}: the arm was not moved.</source>
             <translation>项目中没有点 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="213" />
+            <location filename="../../ui/messages.py" line="214" />
             <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
             <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="217" />
+            <location filename="../../ui/messages.py" line="218" />
             <source>The link was shut down.</source>
             <translation>通信链路已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="227" />
+            <location filename="../../ui/messages.py" line="228" />
             <source>{operation}: not sent, the connection to the controller is down.</source>
             <translation>{operation}：未发送，与控制器的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="230" />
+            <location filename="../../ui/messages.py" line="231" />
             <source>{operation}: not sent, the connection was closed.</source>
             <translation>{operation}：未发送，连接已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="232" />
+            <location filename="../../ui/messages.py" line="233" />
             <source>points outside {id_min}..{id_max}: {ids}</source>
             <translation>超出 {id_min}..{id_max} 范围的点：{ids}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="233" />
+            <location filename="../../ui/messages.py" line="234" />
             <source>there is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="234" />
+            <location filename="../../ui/messages.py" line="235" />
             <source>no free point id left in {start}..{id_max}</source>
             <translation>{start}..{id_max} 范围内已没有空闲的点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="235" />
+            <location filename="../../ui/messages.py" line="236" />
             <source>there is no row {row}</source>
             <translation>不存在第 {row} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="236" />
+            <location filename="../../ui/messages.py" line="237" />
             <source>cannot move row {src} to {dst} in {rows} rows</source>
             <translation>无法在 {rows} 行中将第 {src} 行移到第 {dst} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="237" />
+            <location filename="../../ui/messages.py" line="238" />
             <source>row {row}: id {id} is already used on row {other}</source>
             <translation>第 {row} 行：编号 {id} 已被第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="238" />
+            <location filename="../../ui/messages.py" line="239" />
             <source>imported point {number}: id {id} appears twice</source>
             <translation>导入的第 {number} 个点：编号 {id} 出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="239" />
+            <location filename="../../ui/messages.py" line="240" />
             <source>id {id} is already used by {point}</source>
             <translation>编号 {id} 已被 {point} 使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="240" />
+            <location filename="../../ui/messages.py" line="241" />
             <source>the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)</source>
             <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
         </message>
@@ -1775,552 +1811,552 @@
             <translation>编号 {id} 已在第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="218" />
+            <location filename="../../ui/messages.py" line="219" />
             <source>{operation}: the connection was lost while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接中断，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="222" />
+            <location filename="../../ui/messages.py" line="223" />
             <source>{operation}: the connection was closed while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接被关闭，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="250" />
+            <location filename="../../ui/messages.py" line="251" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="251" />
+            <location filename="../../ui/messages.py" line="252" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="252" />
+            <location filename="../../ui/messages.py" line="253" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="253" />
+            <location filename="../../ui/messages.py" line="254" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="254" />
+            <location filename="../../ui/messages.py" line="255" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="255" />
+            <location filename="../../ui/messages.py" line="256" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="256" />
+            <location filename="../../ui/messages.py" line="257" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="257" />
+            <location filename="../../ui/messages.py" line="258" />
             <source>The host name is not valid.</source>
             <translation>主机名无效。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="258" />
+            <location filename="../../ui/messages.py" line="259" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="259" />
+            <location filename="../../ui/messages.py" line="260" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="260" />
+            <location filename="../../ui/messages.py" line="261" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="261" />
+            <location filename="../../ui/messages.py" line="262" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="262" />
+            <location filename="../../ui/messages.py" line="263" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="263" />
+            <location filename="../../ui/messages.py" line="264" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="264" />
+            <location filename="../../ui/messages.py" line="265" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="267" />
+            <location filename="../../ui/messages.py" line="268" />
             <source>{operation}: not sent, the controller is not in auto mode.</source>
             <translation>{operation}：未发送，控制器不处于自动模式。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="272" />
+            <location filename="../../ui/messages.py" line="273" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="273" />
+            <location filename="../../ui/messages.py" line="274" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="274" />
+            <location filename="../../ui/messages.py" line="275" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="275" />
+            <location filename="../../ui/messages.py" line="276" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="276" />
+            <location filename="../../ui/messages.py" line="277" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="279" />
+            <location filename="../../ui/messages.py" line="280" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="280" />
+            <location filename="../../ui/messages.py" line="281" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="281" />
+            <location filename="../../ui/messages.py" line="282" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="282" />
+            <location filename="../../ui/messages.py" line="283" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="283" />
+            <location filename="../../ui/messages.py" line="284" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="284" />
+            <location filename="../../ui/messages.py" line="285" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="285" />
+            <location filename="../../ui/messages.py" line="286" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="286" />
+            <location filename="../../ui/messages.py" line="287" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="287" />
+            <location filename="../../ui/messages.py" line="288" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="288" />
+            <location filename="../../ui/messages.py" line="289" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="289" />
+            <location filename="../../ui/messages.py" line="290" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="290" />
+            <location filename="../../ui/messages.py" line="291" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="291" />
+            <location filename="../../ui/messages.py" line="292" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="292" />
+            <location filename="../../ui/messages.py" line="293" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="293" />
+            <location filename="../../ui/messages.py" line="294" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="294" />
+            <location filename="../../ui/messages.py" line="295" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="295" />
+            <location filename="../../ui/messages.py" line="296" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="296" />
+            <location filename="../../ui/messages.py" line="297" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="297" />
+            <location filename="../../ui/messages.py" line="298" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="298" />
+            <location filename="../../ui/messages.py" line="299" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="300" />
+            <location filename="../../ui/messages.py" line="301" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="303" />
+            <location filename="../../ui/messages.py" line="304" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="304" />
+            <location filename="../../ui/messages.py" line="305" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="305" />
+            <location filename="../../ui/messages.py" line="306" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="306" />
+            <location filename="../../ui/messages.py" line="307" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="307" />
+            <location filename="../../ui/messages.py" line="308" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="308" />
+            <location filename="../../ui/messages.py" line="309" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="309" />
+            <location filename="../../ui/messages.py" line="310" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="310" />
+            <location filename="../../ui/messages.py" line="311" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="311" />
+            <location filename="../../ui/messages.py" line="312" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="312" />
+            <location filename="../../ui/messages.py" line="313" />
             <source>unit id</source>
-            <translation>站号</translation>
+            <translation>从站地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="313" />
+            <location filename="../../ui/messages.py" line="314" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="317" />
+            <location filename="../../ui/messages.py" line="318" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="318" />
+            <location filename="../../ui/messages.py" line="319" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="319" />
+            <location filename="../../ui/messages.py" line="320" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="320" />
+            <location filename="../../ui/messages.py" line="321" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="321" />
+            <location filename="../../ui/messages.py" line="322" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="322" />
+            <location filename="../../ui/messages.py" line="323" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="323" />
+            <location filename="../../ui/messages.py" line="324" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="324" />
+            <location filename="../../ui/messages.py" line="325" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="325" />
+            <location filename="../../ui/messages.py" line="326" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="326" />
+            <location filename="../../ui/messages.py" line="327" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="328" />
+            <location filename="../../ui/messages.py" line="329" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="500" />
+            <location filename="../../ui/messages.py" line="501" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="503" />
+            <location filename="../../ui/messages.py" line="504" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="549" />
+            <location filename="../../ui/messages.py" line="550" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="552" />
+            <location filename="../../ui/messages.py" line="553" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="556" />
+            <location filename="../../ui/messages.py" line="557" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="559" />
+            <location filename="../../ui/messages.py" line="560" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="562" />
+            <location filename="../../ui/messages.py" line="563" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="33" />
+            <location filename="../../ui/messages_plan.py" line="34" />
             <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="36" />
+            <location filename="../../ui/messages_plan.py" line="37" />
             <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
             <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="40" />
+            <location filename="../../ui/messages_plan.py" line="41" />
             <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
             <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="41" />
+            <location filename="../../ui/messages_plan.py" line="42" />
             <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
             <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="42" />
+            <location filename="../../ui/messages_plan.py" line="43" />
             <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
             <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="43" />
+            <location filename="../../ui/messages_plan.py" line="44" />
             <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
             <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="47" />
+            <location filename="../../ui/messages_plan.py" line="48" />
             <source>Refused by the safety envelope: {text}</source>
             <translation>安全边界拒绝：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="48" />
+            <location filename="../../ui/messages_plan.py" line="49" />
             <source>segment {n}: </source>
             <translation>第 {n} 段：</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="49" />
+            <location filename="../../ui/messages_plan.py" line="50" />
             <source> (reduced-speed mode)</source>
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="509" />
+            <location filename="../../ui/messages.py" line="510" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="513" />
+            <location filename="../../ui/messages.py" line="514" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="85" />
+            <location filename="../../ui/messages_plan.py" line="86" />
             <source>Plan “{plan}” has no segments.</source>
             <translation>规划“{plan}”没有任何段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="86" />
+            <location filename="../../ui/messages_plan.py" line="87" />
             <source>Cannot start at segment {start}: the plan has {segments} segments.</source>
             <translation>无法从第 {start} 段开始：该规划只有 {segments} 段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="89" />
+            <location filename="../../ui/messages_plan.py" line="90" />
             <source>speed {speed} mm/s is not in (0, {max}] mm/s.</source>
             <translation>速度 {speed} mm/s 不在 (0, {max}] mm/s 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="90" />
+            <location filename="../../ui/messages_plan.py" line="91" />
             <source>the arc has no middle point.</source>
             <translation>圆弧没有中间点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="91" />
+            <location filename="../../ui/messages_plan.py" line="92" />
             <source>middle point P{id} does not exist.</source>
             <translation>中间点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="92" />
+            <location filename="../../ui/messages_plan.py" line="93" />
             <source>end point P{id} does not exist.</source>
             <translation>终点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="93" />
+            <location filename="../../ui/messages_plan.py" line="94" />
             <source>{point} is not on the controller ({sync}); upload it.</source>
             <translation>{point} 不在控制器上（{sync}）；请上传。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="94" />
+            <location filename="../../ui/messages_plan.py" line="95" />
             <source>{point} was taught with {point_tool}, the segment moves with {segment_tool}.</source>
             <translation>{point} 示教时的工具为“{point_tool}”，该段运动的工具为“{segment_tool}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="97" />
+            <location filename="../../ui/messages_plan.py" line="98" />
             <source>the line goes nowhere (start and end {length} mm apart){where}.</source>
             <translation>直线没有移动（起点与终点相距 {length} mm）{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="100" />
+            <location filename="../../ui/messages_plan.py" line="101" />
             <source>the arc starts at the robot's current pose, which is not known: its shape is not checked.</source>
             <translation>圆弧从机器人的当前位姿开始，但当前位姿未知：未检查其形状。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="104" />
+            <location filename="../../ui/messages_plan.py" line="105" />
             <source>the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与中间点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="108" />
+            <location filename="../../ui/messages_plan.py" line="109" />
             <source>the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的中间点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="112" />
+            <location filename="../../ui/messages_plan.py" line="113" />
             <source>the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="116" />
+            <location filename="../../ui/messages_plan.py" line="117" />
             <source>the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}.</source>
             <translation>圆弧的三个点（几乎）在一条直线上：中间点距起点—终点连线仅 {offset} mm（至少需要 {tolerance} mm）；请改用直线{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="120" />
+            <location filename="../../ui/messages_plan.py" line="121" />
             <source>the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before.</source>
             <translation>机械臂停在圆弧中间点之后：从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；请用直线移动到终点，或从前一段开始运行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="124" />
+            <location filename="../../ui/messages_plan.py" line="125" />
             <source>sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here.</source>
             <translation>从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；从此处运行前请检查预览。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="128" />
+            <location filename="../../ui/messages_plan.py" line="129" />
             <source>{point} is out of the robot model's reach.</source>
             <translation>{point} 超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="129" />
+            <location filename="../../ui/messages_plan.py" line="130" />
             <source>the path is out of the robot model's reach.</source>
             <translation>路径超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="130" />
+            <location filename="../../ui/messages_plan.py" line="131" />
             <source>{point} passes a joint limit of the robot model.</source>
             <translation>{point} 会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="131" />
+            <location filename="../../ui/messages_plan.py" line="132" />
             <source>the path passes a joint limit of the robot model.</source>
             <translation>路径会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="132" />
+            <location filename="../../ui/messages_plan.py" line="133" />
             <source>The robot model “{model}” disagrees with the controller's pose by {distance} mm: reach checks may be wrong.</source>
             <translation>机器人模型“{model}”与控制器的位姿相差 {distance} mm：可达性检查可能有误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="136" />
+            <location filename="../../ui/messages_plan.py" line="137" />
             <source>The robot model “{model}” disagrees with the controller's pose by {angle}°: reach checks may be wrong.</source>
             <translation>机器人模型“{model}”与控制器的位姿相差 {angle}°：可达性检查可能有误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="140" />
+            <location filename="../../ui/messages_plan.py" line="141" />
             <source>The robot model “{model}” disagrees with the controller's pose by {distance} mm and {angle}°: reach checks may be wrong.</source>
             <translation>机器人模型“{model}”与控制器的位姿相差 {distance} mm 和 {angle}°：可达性检查可能有误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="144" />
+            <location filename="../../ui/messages_plan.py" line="145" />
             <source>runs at {cap} mm/s, the reduced-speed cap (planned {speed} mm/s).</source>
             <translation>以降速模式上限 {cap} mm/s 运行（计划 {speed} mm/s）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="148" />
+            <location filename="../../ui/messages_plan.py" line="149" />
             <source> (from the current pose)</source>
             <translation>（从当前位姿出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="149" />
+            <location filename="../../ui/messages_plan.py" line="150" />
             <source> (on loops after the first, starting at the end of segment {after})</source>
             <translation>（第一轮之后的循环中，从第 {after} 段的终点出发）</translation>
         </message>
@@ -2855,43 +2891,43 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="249" />
+            <location filename="../../ui/panels/planner_widgets.py" line="250" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="250" />
+            <location filename="../../ui/panels/planner_widgets.py" line="251" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="269" />
+            <location filename="../../ui/panels/planner_widgets.py" line="270" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="272" />
+            <location filename="../../ui/panels/planner_widgets.py" line="273" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="274" />
+            <location filename="../../ui/panels/planner_widgets.py" line="275" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="276" />
+            <location filename="../../ui/panels/planner_widgets.py" line="277" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="279" />
+            <location filename="../../ui/panels/planner_widgets.py" line="280" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -2907,7 +2943,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="313" />
+            <location filename="../../ui/panels/planner_widgets.py" line="314" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -3052,23 +3088,23 @@
     <context>
         <name>PlanRunBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="189" />
+            <location filename="../../ui/panels/planner_widgets.py" line="190" />
             <source>Run</source>
             <extracomment>Colour of a summary line by level (the status line uses the darker warning text).</extracomment>
             <translation>运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="192" />
+            <location filename="../../ui/panels/planner_widgets.py" line="193" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="194" />
+            <location filename="../../ui/panels/planner_widgets.py" line="195" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="215" />
+            <location filename="../../ui/panels/planner_widgets.py" line="216" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
@@ -3114,81 +3150,81 @@
     <context>
         <name>PlanRunFlow</name>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="76" />
+            <location filename="../../ui/panels/planner_run.py" line="77" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="79" />
+            <location filename="../../ui/panels/planner_run.py" line="80" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="103" />
+            <location filename="../../ui/panels/planner_run.py" line="104" />
             <source>Cannot run: {summary}. First: {message}</source>
             <translation>无法运行：{summary}。第一个问题：{message}</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="112" />
+            <location filename="../../ui/panels/planner_run.py" line="113" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="114" />
+            <location filename="../../ui/panels/planner_run.py" line="115" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="116" />
+            <location filename="../../ui/panels/planner_run.py" line="117" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="117" />
+            <location filename="../../ui/panels/planner_run.py" line="118" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="129" />
+            <location filename="../../ui/panels/planner_run.py" line="130" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="131" />
+            <location filename="../../ui/panels/planner_run.py" line="132" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="133" />
+            <location filename="../../ui/panels/planner_run.py" line="134" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="135" />
+            <location filename="../../ui/panels/planner_run.py" line="136" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="136" />
+            <location filename="../../ui/panels/planner_run.py" line="137" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="139" />
+            <location filename="../../ui/panels/planner_run.py" line="140" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="143" />
+            <location filename="../../ui/panels/planner_run.py" line="144" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="198" />
+            <location filename="../../ui/panels/planner_run.py" line="199" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
@@ -3617,14 +3653,14 @@
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/messages_plan.py" line="162" />
+            <location filename="../../ui/messages_plan.py" line="163" />
             <location filename="../../ui/models/point_columns.py" line="67" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="163" />
+            <location filename="../../ui/messages_plan.py" line="164" />
             <location filename="../../ui/models/point_columns.py" line="68" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
@@ -4639,6 +4675,19 @@ Remove them all?</source>
         </message>
     </context>
     <context>
+        <name>QFileDialog</name>
+        <message>
+            <location filename="../../ui/qt_words.py" line="16" />
+            <source>&amp;Look in:</source>
+            <translation>查找范围(&amp;L)：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/qt_words.py" line="17" />
+            <source>Files of &amp;type:</source>
+            <translation>文件类型(&amp;T)：</translation>
+        </message>
+    </context>
+    <context>
         <name>RegisterProfileDialog</name>
         <message>
             <location filename="../../ui/dialogs/register_profile_dialog.py" line="152" />
@@ -4659,7 +4708,7 @@ Remove them all?</source>
         <message>
             <location filename="../../ui/dialogs/register_profile_dialog.py" line="156" />
             <source>Unit id:</source>
-            <translation>站号：</translation>
+            <translation>从站地址：</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/register_profile_dialog.py" line="157" />
@@ -4719,7 +4768,7 @@ Remove them all?</source>
         <message>
             <location filename="../../ui/dialogs/register_profile_dialog.py" line="176" />
             <source>split words (576 = year, 577 = month·256 + day)</source>
-            <translation>分字（576 = 年，577 = 月·256 + 日）</translation>
+            <translation>分两个寄存器（576 = 年，577 = 月·256 + 日）</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/register_profile_dialog.py" line="177" />
@@ -5031,7 +5080,7 @@ Remove them all?</source>
         <message>
             <location filename="../../ui/controllers/safety_menu.py" line="118" />
             <source>Word order, unit id, completion rule, poll timeout (administrator)</source>
-            <translation>字序、站号、完成判定、轮询超时（管理员）</translation>
+            <translation>字序、从站地址、完成判定、轮询超时（管理员）</translation>
         </message>
         <message>
             <location filename="../../ui/controllers/safety_menu.py" line="120" />
@@ -5112,7 +5161,7 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="382" />
+            <location filename="../../ui/panels/planner_widgets.py" line="383" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>
@@ -5730,161 +5779,161 @@ Remove them all?</source>
     <context>
         <name>View3DPanel</name>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="223" />
+            <location filename="../../ui/panels/view3d_panel.py" line="224" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="224" />
+            <location filename="../../ui/panels/view3d_panel.py" line="225" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="225" />
+            <location filename="../../ui/panels/view3d_panel.py" line="226" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="226" />
+            <location filename="../../ui/panels/view3d_panel.py" line="227" />
             <source>Iso</source>
             <translation>轴测</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="230" />
+            <location filename="../../ui/panels/view3d_panel.py" line="231" />
             <source>Look at the scene from a preset direction</source>
             <translation>从预设方向观察场景</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="231" />
+            <location filename="../../ui/panels/view3d_panel.py" line="232" />
             <source>Fit all</source>
             <translation>全部显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="232" />
+            <location filename="../../ui/panels/view3d_panel.py" line="233" />
             <source>Show the arm, the points and the plan</source>
             <translation>显示机械臂、点位和轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="233" />
+            <location filename="../../ui/panels/view3d_panel.py" line="234" />
             <source>Orthographic</source>
             <translation>正交投影</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="234" />
+            <location filename="../../ui/panels/view3d_panel.py" line="235" />
             <source>Parallel projection (no perspective)</source>
             <translation>平行投影（无透视）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="235" />
+            <location filename="../../ui/panels/view3d_panel.py" line="236" />
             <source>Robot model…</source>
             <translation>机器人模型…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="236" />
+            <location filename="../../ui/panels/view3d_panel.py" line="237" />
             <source>Load another robot model profile (JSON; engineer)</source>
             <translation>加载其他机器人模型配置文件（JSON；需工程师）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="238" />
+            <location filename="../../ui/panels/view3d_panel.py" line="239" />
             <source>Beside the planner</source>
             <translation>在规划器旁显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="239" />
+            <location filename="../../ui/panels/view3d_panel.py" line="240" />
             <source>Show the 3D view next to the planner, not in its own tab</source>
             <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="241" />
+            <location filename="../../ui/panels/view3d_panel.py" line="242" />
             <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
             <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="275" />
-            <location filename="../../ui/panels/view3d_panel.py" line="324" />
+            <location filename="../../ui/panels/view3d_panel.py" line="276" />
+            <location filename="../../ui/panels/view3d_panel.py" line="325" />
             <source>Robot model not loaded: %1</source>
             <translation>未加载机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="284" />
-            <location filename="../../ui/panels/view3d_panel.py" line="286" />
+            <location filename="../../ui/panels/view3d_panel.py" line="285" />
+            <location filename="../../ui/panels/view3d_panel.py" line="287" />
             <source>Robot model: %1</source>
             <translation>机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="287" />
+            <location filename="../../ui/panels/view3d_panel.py" line="288" />
             <source>File: %1</source>
             <translation>文件：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="289" />
+            <location filename="../../ui/panels/view3d_panel.py" line="290" />
             <source>Shipped with TeachPad</source>
             <translation>TeachPad 自带</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="293" />
+            <location filename="../../ui/panels/view3d_panel.py" line="294" />
             <source>Not compared with the controller (no joint angles from it)</source>
             <translation>未与控制器比对（控制器未提供关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="296" />
+            <location filename="../../ui/panels/view3d_panel.py" line="297" />
             <source>Agrees with the controller's pose (within %1 mm, %2°)</source>
             <translation>与控制器的位姿一致（误差在 %1 mm、%2° 以内）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="330" />
+            <location filename="../../ui/panels/view3d_panel.py" line="331" />
             <source>Load a robot model profile</source>
             <translation>加载机器人模型配置文件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="330" />
+            <location filename="../../ui/panels/view3d_panel.py" line="331" />
             <source>Robot model profiles (*.json)</source>
             <translation>机器人模型配置文件 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="423" />
+            <location filename="../../ui/panels/view3d_panel.py" line="424" />
             <source>dry run: nothing is sent</source>
             <translation>空运行：不发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="425" />
+            <location filename="../../ui/panels/view3d_panel.py" line="426" />
             <source>no pose: home position shown</source>
             <translation>无位姿：显示原点姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="427" />
+            <location filename="../../ui/panels/view3d_panel.py" line="428" />
             <source>estimate (from the pose, no joint angles)</source>
             <translation>估算（由位姿求得，无关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="429" />
+            <location filename="../../ui/panels/view3d_panel.py" line="430" />
             <source>pose out of the model's reach</source>
             <translation>位姿超出模型可达范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="431" />
+            <location filename="../../ui/panels/view3d_panel.py" line="432" />
             <source>past a joint limit</source>
             <translation>超出关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="433" />
+            <location filename="../../ui/panels/view3d_panel.py" line="434" />
             <source>stale</source>
             <translation>数据过期</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="436" />
+            <location filename="../../ui/panels/view3d_panel.py" line="437" />
             <source>the robot model disagrees with the controller</source>
             <translation>机器人模型与控制器不一致</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="493" />
+            <location filename="../../ui/panels/view3d_panel.py" line="494" />
             <source>Out of the robot model's reach: %n point(s) (%1)</source>
             <translation>
                 <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="501" />
+            <location filename="../../ui/panels/view3d_panel.py" line="502" />
             <source>the path leaves the reach in %n segment(s) (%1)</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>

@@ -70,7 +70,11 @@ class EnvelopeDialog(QDialog):
         # keep-out boxes
         self.keep_out = QTableWidget(0, _BOX_COLUMNS, self)
         self.keep_out.setHorizontalHeaderLabels(
-            [self.tr("Name"), "X min", "Y min", "Z min", "X max", "Y max", "Z max"]
+            [
+                self.tr("Name"),
+                *(self.tr("{axis} min").format(axis=axis) for axis in "XYZ"),
+                *(self.tr("{axis} max").format(axis=axis) for axis in "XYZ"),
+            ]
         )
         self.keep_out.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeMode.Stretch)
         self.keep_out.setSelectionBehavior(QAbstractItemView.SelectionBehavior.SelectRows)

@@ -25,6 +25,7 @@ from app.alarm_history import (
 )
 from app.link.state import RobotState
 from app.protocol.enums import ALARM_TEXT, TR_CONTEXT
+from ui.joins import join_names, labelled
 from ui.palette import COLOR_ALARM_BANNER, COLOR_ALARM_BANNER_TEXT, COLOR_ERROR_DARK
 
 __all__ = ["AlarmBanner", "alarm_name"]
@@ -162,14 +163,14 @@ class AlarmBanner(QToolBar):
             self.label.setToolTip("")
             return
         bits = alarm_bits(self._alarms)
-        names = ", ".join(alarm_name(b) for b in bits)
+        names = join_names(alarm_name(b) for b in bits)
         title = self.tr("ALARM: {names}").format(names=names)
         if self._state is not None and not self._state.fresh:
             title += " " + self.tr("(last known: the link is not live)")
         held = ""
         if blocks_motion(self._alarms):
             held = self.tr("Motion controls are held until the alarm is reset. STOP stays available.")
-        lines = [f"{alarm_name(b)}: {alarm_advice(b)}" for b in bits]
+        lines = [labelled(alarm_name(b), alarm_advice(b)) for b in bits]
         head = f"{title} — {held}" if held else title
         self._plain = "\n".join([head, *lines])
         self.label.set_full_text("   ".join([head, *lines]))

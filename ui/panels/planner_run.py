@@ -21,6 +21,7 @@ from app.plan.segments import Plan
 from app.points.ledger import UploadReport
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
+from ui.joins import join_names
 from ui.messages import error_text, issue_text, refusal_text
 from ui.models.points_model import PointsModel
 from ui.panels.planner_checks import PlannerChecks
@@ -112,7 +113,7 @@ class PlanRunFlow(QObject):
                 view.show_message(self.tr("Cannot run: %n point(s) need upload", "", len(needs)), "error")
                 return False
             question = self.tr("%n point(s) of the plan are not on the controller: ", "", len(needs))
-            question += ", ".join(f"P{pid}" for pid in needs[:MAX_POINTS_LISTED])
+            question += join_names(f"P{pid}" for pid in needs[:MAX_POINTS_LISTED])
             question += "\n\n" + self.tr("Upload now, then run?")
             if not view.confirm(self.tr("Upload points"), question):
                 return False

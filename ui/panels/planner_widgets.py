@@ -31,6 +31,7 @@ from PySide6.QtWidgets import (
 from app.plan.presenter import CheckSummary, Level, progress_bar
 from app.plan.runner import RunEvent, RunProgress
 from app.plan.segments import SegmentKind
+from ui.joins import join_clauses
 from ui.models.plan_columns import (
     COL_END,
     COL_IGNORE,
@@ -274,7 +275,7 @@ class PlanChecksBar(QWidget):
             parts.append(self.tr("%n point(s) need upload", "", len(checks.uploads)))
         if checks.warnings:
             parts.append(self.tr("%n warning(s)", "", checks.warnings))
-        text = ", ".join(parts)
+        text = join_clauses(parts)
         if checks.uploads and can_upload:
             text += " — " + self.tr("Upload now?")
         if checks.first_row_error:

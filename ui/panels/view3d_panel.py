@@ -53,6 +53,7 @@ from app.view3d.kinematics import ArmTracker, Reach
 from app.view3d.path import DryRun, DryRunState, start_of
 from app.view3d.profile import RobotProfile
 from app.view3d.reach import PathReach, ReachChecker
+from ui.joins import join_names, join_sentences
 from ui.messages import issue_text
 from ui.models.points_model import PointsModel
 from ui.palette import COLOR_CURVE_PURPLE, COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, COLOR_WARN
@@ -488,7 +489,7 @@ class View3DPanel(QWidget):
         bad_points = sorted(pid for pid, r in self.point_reach.items() if r is not Reach.OK)
         parts = []
         if bad_points:
-            names = ", ".join(f"P{pid}" for pid in bad_points[:8]) + (" …" if len(bad_points) > 8 else "")
+            names = join_names(f"P{pid}" for pid in bad_points[:8]) + (" …" if len(bad_points) > 8 else "")
             parts.append(
                 self.tr("Out of the robot model's reach: %n point(s) (%1)", "", len(bad_points)).replace(
                     "%1", names
@@ -499,10 +500,10 @@ class View3DPanel(QWidget):
             if segs:
                 parts.append(
                     self.tr("the path leaves the reach in %n segment(s) (%1)", "", len(segs)).replace(
-                        "%1", ", ".join(str(s) for s in segs[:8])
+                        "%1", join_names(str(s) for s in segs[:8])
                     )
                 )
-        self.reach_label.setText("; ".join(parts))
+        self.reach_label.setText(join_sentences(parts))
         self.reach_label.setVisible(bool(parts))
 
     # --- selection -----------------------------------------------------------------------
