@@ -119,6 +119,16 @@ class AlarmLamp(Lamp):
         self.setProperty("active", bool(active))
         self.set_level(LEVEL_ERROR if active else LEVEL_OFF)
 
+    def width_needed(self) -> int:
+        """The width its text needs lit or not: an active lamp is bold, which is wider in most
+        fonts, so a layout that keeps this much never cuts it when it lights up."""
+        hint = self.sizeHint().width()
+        bold = QFont(self.font())
+        bold.setBold(True)
+        text = self.text()
+        extra = QFontMetrics(bold).horizontalAdvance(text) - self.fontMetrics().horizontalAdvance(text)
+        return hint + max(0, extra)
+
 
 class _Digits(QWidget):
     """A readout's number, painted on its own opaque background with a size hint that does not

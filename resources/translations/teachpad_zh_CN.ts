@@ -949,7 +949,7 @@
     <context>
         <name>Export</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="399" />
+            <location filename="../../ui/widgets_common.py" line="409" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -2731,42 +2731,42 @@
     <context>
         <name>Panels</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="350" />
+            <location filename="../../ui/widgets_common.py" line="360" />
             <source>connected</source>
             <translation>已连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="351" />
+            <location filename="../../ui/widgets_common.py" line="361" />
             <source>connecting</source>
             <translation>正在连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="354" />
+            <location filename="../../ui/widgets_common.py" line="364" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="353" />
+            <location filename="../../ui/widgets_common.py" line="363" />
             <source>link down</source>
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="378" />
+            <location filename="../../ui/widgets_common.py" line="388" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="369" />
+            <location filename="../../ui/widgets_common.py" line="379" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="352" />
+            <location filename="../../ui/widgets_common.py" line="362" />
             <source>not answering</source>
             <translation>无应答</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="377" />
+            <location filename="../../ui/widgets_common.py" line="387" />
             <source>done</source>
             <translation>完成</translation>
         </message>
@@ -5342,142 +5342,142 @@ Remove them all?</source>
     <context>
         <name>StatusPanel</name>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="231" />
+            <location filename="../../ui/panels/status_panel.py" line="245" />
             <source>Link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="232" />
+            <location filename="../../ui/panels/status_panel.py" line="246" />
             <source>Controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="233" />
-            <location filename="../../ui/panels/status_panel.py" line="305" />
+            <location filename="../../ui/panels/status_panel.py" line="247" />
+            <location filename="../../ui/panels/status_panel.py" line="321" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="233" />
-            <location filename="../../ui/panels/status_panel.py" line="305" />
+            <location filename="../../ui/panels/status_panel.py" line="247" />
+            <location filename="../../ui/panels/status_panel.py" line="321" />
             <source>Alarms (last known)</source>
             <translation>报警（最后已知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="235" />
+            <location filename="../../ui/panels/status_panel.py" line="249" />
             <source>State:</source>
             <translation>状态：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="236" />
+            <location filename="../../ui/panels/status_panel.py" line="250" />
             <source>RTT:</source>
             <translation>往返时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="237" />
+            <location filename="../../ui/panels/status_panel.py" line="251" />
             <source>Mode:</source>
             <translation>模式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="238" />
+            <location filename="../../ui/panels/status_panel.py" line="252" />
             <source>Program:</source>
             <translation>程序：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="239" />
+            <location filename="../../ui/panels/status_panel.py" line="253" />
             <source>Last command:</source>
             <translation>上一条命令：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="240" />
+            <location filename="../../ui/panels/status_panel.py" line="254" />
             <source>Clock:</source>
             <translation>系统时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="241" />
+            <location filename="../../ui/panels/status_panel.py" line="255" />
             <source>Drift:</source>
             <translation>时差：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="242" />
+            <location filename="../../ui/panels/status_panel.py" line="256" />
             <source>Round-trip time of the last poll</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="250" />
+            <location filename="../../ui/panels/status_panel.py" line="264" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="251" />
+            <location filename="../../ui/panels/status_panel.py" line="265" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="254" />
+            <location filename="../../ui/panels/status_panel.py" line="270" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="261" />
+            <location filename="../../ui/panels/status_panel.py" line="277" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="354" />
+            <location filename="../../ui/panels/status_panel.py" line="370" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="372" />
+            <location filename="../../ui/panels/status_panel.py" line="388" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="374" />
+            <location filename="../../ui/panels/status_panel.py" line="390" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="384" />
+            <location filename="../../ui/panels/status_panel.py" line="402" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="243" />
-            <location filename="../../ui/panels/status_panel.py" line="390" />
+            <location filename="../../ui/panels/status_panel.py" line="257" />
+            <location filename="../../ui/panels/status_panel.py" line="408" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="407" />
+            <location filename="../../ui/panels/status_panel.py" line="425" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="415" />
+            <location filename="../../ui/panels/status_panel.py" line="433" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="419" />
+            <location filename="../../ui/panels/status_panel.py" line="437" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="423" />
+            <location filename="../../ui/panels/status_panel.py" line="441" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="245" />
-            <location filename="../../ui/panels/status_panel.py" line="429" />
+            <location filename="../../ui/panels/status_panel.py" line="259" />
+            <location filename="../../ui/panels/status_panel.py" line="447" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="246" />
-            <location filename="../../ui/panels/status_panel.py" line="432" />
+            <location filename="../../ui/panels/status_panel.py" line="260" />
+            <location filename="../../ui/panels/status_panel.py" line="450" />
             <source>{value} (stale)</source>
             <translation>{value}（已过期）</translation>
         </message>

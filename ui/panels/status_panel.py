@@ -47,6 +47,7 @@ from app.protocol.enums import (
 )
 from app.protocol.registers import GV_DATE
 from ui import messages
+from ui.joins import join_names
 from ui.messages import connection_text, result_level, result_text
 from ui.widgets.live_label import LiveLabel
 from ui.widgets_common import (
@@ -213,10 +214,23 @@ class StatusPanel(QWidget):
         return self._alarm_columns
 
     def resizeEvent(self, event: QResizeEvent) -> None:
-        widest = max(lamp.sizeHint().width() for lamp in self._all_alarm_lamps())
-        margins = self._alarm_box.contentsMargins().left() + self._alarm_box.contentsMargins().right() + 24
-        self._layout_alarms(2 if event.size().width() >= 2 * widest + margins else 1)
+        self._reflow_alarms(event.size().width())
         super().resizeEvent(event)
+
+    def _reflow_alarms(self, width: int) -> None:
+        """Two columns of lamps only when two of the widest fit side by side in ``width`` (what
+        the panel's, the box's and the grid's margins and the grid's spacing leave), lit or not;
+        the box keeps one column's width. Measured, not guessed: a guessed margin cut
+        "编码器角度报警" by 2-6 px in a dock of 284-292 px."""
+        widest = max(lamp.width_needed() for lamp in self._all_alarm_lamps())
+        box = self._alarm_box.contentsMargins()
+        grid = self._alarm_grid.contentsMargins()
+        outer = self.layout().contentsMargins()
+        around = box.left() + box.right() + grid.left() + grid.right()
+        self._alarm_box.setMinimumWidth(widest + around)
+        spacing = max(0, self._alarm_grid.horizontalSpacing())
+        two = 2 * widest + spacing + around + outer.left() + outer.right()
+        self._layout_alarms(2 if width >= two else 1)
 
     def _row_label(self, key: str) -> QLabel:
         # As tall as a lamp and centred, so the caption lines up with the lamp's text.
@@ -249,6 +263,8 @@ class StatusPanel(QWidget):
             lamp.setText(_protocol_tr(ALARM_TEXT[bit]))
             lamp.setToolTip(self.tr("Register 562 bit {bit}").format(bit=int(bit).bit_length() - 1))
         self.other_alarm_lamp.setToolTip(self.tr("Register 562 bits with no documented meaning"))
+        if self.layout() is not None:  # (built once the texts are set; a new language reflows)
+            self._reflow_alarms(self.width())
         # Redraw what the slots showed, in the new language.
         if self._connection is None:
             self.link_lamp.setText(self.tr("disconnected"))
@@ -368,10 +384,12 @@ class StatusPanel(QWidget):
         unknown = alarms & ~ALARM_MASK
         self.other_alarm_lamp.set_active(bool(unknown))
         if unknown:
-            bits = ", ".join(str(b) for b in range(16) if unknown & (1 << b))
+            bits = join_names(str(b) for b in range(16) if unknown & (1 << b))
             self.other_alarm_lamp.setText(self.tr("other bits: {bits}").format(bits=bits))
         else:
             self.other_alarm_lamp.setText(self.tr("other bits"))
+        if self.layout() is not None:
+            self._reflow_alarms(self.width())  # the undocumented bits' lamp names them
 
     def _render_connection(self) -> None:
         connection = self._connection
