@@ -18,7 +18,7 @@ import datetime as dt
 import math
 from typing import Any
 
-from PySide6.QtCore import QCoreApplication, QEvent, QSize, Qt, Slot
+from PySide6.QtCore import QCoreApplication, QEvent, QMargins, QSize, Qt, Slot
 from PySide6.QtGui import QResizeEvent
 from PySide6.QtWidgets import (
     QFormLayout,
@@ -225,7 +225,8 @@ class StatusPanel(QWidget):
         widest = max(lamp.width_needed() for lamp in self._all_alarm_lamps())
         box = self._alarm_box.contentsMargins()
         grid = self._alarm_grid.contentsMargins()
-        outer = self.layout().contentsMargins()
+        layout = self.layout()
+        outer = layout.contentsMargins() if layout is not None else QMargins()
         around = box.left() + box.right() + grid.left() + grid.right()
         self._alarm_box.setMinimumWidth(widest + around)
         spacing = max(0, self._alarm_grid.horizontalSpacing())
