@@ -586,3 +586,11 @@ def _fresh_stop_text(reason: Reason) -> str:
     if cause is None:
         return _tr(_BARE["stop_unreachable"]).format(endpoint=endpoint)
     return _tr(_TEMPLATES["stop_unreachable"]).format(endpoint=endpoint, cause=cause)
+
+
+# A queued request the worker dropped before sending it (app/link/commands.py): a motion queued
+# behind a Stop, an upload queued when the operator cancelled uploads. Nothing was sent.
+_TEMPLATES["cancelled_by_stop"] = QT_TRANSLATE_NOOP("Messages", "{operation}: not sent, cancelled by Stop.")
+_TEMPLATES["upload_cancelled"] = QT_TRANSLATE_NOOP(
+    "Messages", "{operation}: not sent, the upload was cancelled."
+)

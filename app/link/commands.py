@@ -66,8 +66,8 @@ class WorkerCommands:
     def _done(self, text: str) -> None:
         self.emit_result(CommandResult(None, None, None, True, text))
 
-    def _failed(self, text: str, request_id: int | None = -1) -> None:
-        self.emit_result(CommandResult(None, None, None, False, text), request_id)
+    def _failed(self, text: str, request_id: int | None = -1, reason: Reason | None = None) -> None:
+        self.emit_result(CommandResult(None, None, None, False, text, reason=reason), request_id)
 
     # --- plain and urgent commands ------------------------------------------------------
     def _do_stop(self, on_line: StopSent | None = None) -> None:  # on_line: sent on the stop line
@@ -222,12 +222,20 @@ class WorkerCommands:
     def _cancel_motions_before_stop(self) -> None:
         stop_seq = self._current_seq
         for job in self._jobs.cancel(lambda j: j.kind is JobKind.MOTION and j.seq < stop_seq):
-            self._failed(f"{job.operation}: cancelled by Stop", job.request_id)
+            self._failed(
+                f"{job.operation}: cancelled by Stop",
+                job.request_id,
+                Reason("cancelled_by_stop", {"operation": str(job.operation)}),
+            )
 
     def _do_cancel_upload(self) -> None:
         """No controller stop: the upload ends after the point in progress; queued uploads are dropped."""
         for job in self._jobs.cancel(lambda j: j.operation == Operation.UPLOAD_POINTS):
-            self._failed(f"{job.operation}: cancelled", job.request_id)
+            self._failed(
+                f"{job.operation}: cancelled",
+                job.request_id,
+                Reason("upload_cancelled", {"operation": str(job.operation)}),
+            )
         if self.uploader.run is None:
             self._done(f"{Operation.CANCEL_UPLOAD}: no upload under way")
             return

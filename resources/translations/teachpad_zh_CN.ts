@@ -2176,6 +2176,16 @@
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
         <message>
+            <location filename="../../ui/messages.py" line="593" />
+            <source>{operation}: not sent, cancelled by Stop.</source>
+            <translation>{operation}：未发送，已被停止取消。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="594" />
+            <source>{operation}: not sent, the upload was cancelled.</source>
+            <translation>{operation}：未发送，上传已取消。</translation>
+        </message>
+        <message>
             <location filename="../../ui/messages_plan.py" line="34" />
             <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
@@ -5342,142 +5352,142 @@ Remove them all?</source>
     <context>
         <name>StatusPanel</name>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="245" />
+            <location filename="../../ui/panels/status_panel.py" line="246" />
             <source>Link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="246" />
+            <location filename="../../ui/panels/status_panel.py" line="247" />
             <source>Controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="247" />
-            <location filename="../../ui/panels/status_panel.py" line="321" />
+            <location filename="../../ui/panels/status_panel.py" line="248" />
+            <location filename="../../ui/panels/status_panel.py" line="322" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="247" />
-            <location filename="../../ui/panels/status_panel.py" line="321" />
+            <location filename="../../ui/panels/status_panel.py" line="248" />
+            <location filename="../../ui/panels/status_panel.py" line="322" />
             <source>Alarms (last known)</source>
             <translation>报警（最后已知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="249" />
+            <location filename="../../ui/panels/status_panel.py" line="250" />
             <source>State:</source>
             <translation>状态：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="250" />
+            <location filename="../../ui/panels/status_panel.py" line="251" />
             <source>RTT:</source>
             <translation>往返时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="251" />
+            <location filename="../../ui/panels/status_panel.py" line="252" />
             <source>Mode:</source>
             <translation>模式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="252" />
+            <location filename="../../ui/panels/status_panel.py" line="253" />
             <source>Program:</source>
             <translation>程序：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="253" />
+            <location filename="../../ui/panels/status_panel.py" line="254" />
             <source>Last command:</source>
             <translation>上一条命令：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="254" />
+            <location filename="../../ui/panels/status_panel.py" line="255" />
             <source>Clock:</source>
             <translation>系统时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="255" />
+            <location filename="../../ui/panels/status_panel.py" line="256" />
             <source>Drift:</source>
             <translation>时差：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="256" />
+            <location filename="../../ui/panels/status_panel.py" line="257" />
             <source>Round-trip time of the last poll</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="264" />
+            <location filename="../../ui/panels/status_panel.py" line="265" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="265" />
+            <location filename="../../ui/panels/status_panel.py" line="266" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="270" />
+            <location filename="../../ui/panels/status_panel.py" line="271" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="277" />
+            <location filename="../../ui/panels/status_panel.py" line="278" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="370" />
+            <location filename="../../ui/panels/status_panel.py" line="371" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="388" />
+            <location filename="../../ui/panels/status_panel.py" line="389" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="390" />
+            <location filename="../../ui/panels/status_panel.py" line="391" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="402" />
+            <location filename="../../ui/panels/status_panel.py" line="403" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="257" />
-            <location filename="../../ui/panels/status_panel.py" line="408" />
+            <location filename="../../ui/panels/status_panel.py" line="258" />
+            <location filename="../../ui/panels/status_panel.py" line="409" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="425" />
+            <location filename="../../ui/panels/status_panel.py" line="426" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="433" />
+            <location filename="../../ui/panels/status_panel.py" line="434" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="437" />
+            <location filename="../../ui/panels/status_panel.py" line="438" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="441" />
+            <location filename="../../ui/panels/status_panel.py" line="442" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="259" />
-            <location filename="../../ui/panels/status_panel.py" line="447" />
+            <location filename="../../ui/panels/status_panel.py" line="260" />
+            <location filename="../../ui/panels/status_panel.py" line="448" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="260" />
-            <location filename="../../ui/panels/status_panel.py" line="450" />
+            <location filename="../../ui/panels/status_panel.py" line="261" />
+            <location filename="../../ui/panels/status_panel.py" line="451" />
             <source>{value} (stale)</source>
             <translation>{value}（已过期）</translation>
         </message>

@@ -721,3 +721,58 @@ def test_a_robot_model_that_disagrees_reads_in_words(zh: None) -> None:
         "机器人模型\u201carm B\u201d与控制器的位姿相差 312 mm：可达性检查可能有误。"
     )
     assert "相差 3.5°" in issue_text(model_issue(ModelAgreement("arm B", 0.5, 3.5)))
+
+
+# Codes rendered elsewhere (a file's place: ui/messages_files.py, the CLI's own) or generic.
+_NOT_A_SENTENCE = re.compile(r"place_\w+|file_format|error|envelope_unchecked|jog_guard_stopped|not_kept")
+_SAMPLE_ARGS: dict[str, Any] = {
+    "command": int(RunCommand.MOVE_TO_POINT),
+    "operation": "jog",
+    "program": 7,
+    "seconds": 2.0,
+    "status": 13,
+    "alarms": int(Alarm.ESTOP | Alarm.SERVO),
+    "axis": "J1",
+    "value": 1.5,
+    "endpoint": ENDPOINT,
+    "exception": 11,
+    "mode": int(ControllerMode.MANUAL),
+    "field": "unit id",
+}
+
+
+def _codes_the_core_uses() -> set[str]:
+    """Every reason code app/ (the CLI's own folder aside) gives an error or a result."""
+    found: set[str] = set()
+    app = Path(__file__).resolve().parents[2] / "app"
+    pattern = re.compile(r'\bcode\s*=\s*"([a-z_0-9]+)"|Reason\(\s*"([a-z_0-9]+)"')
+    for path in app.rglob("*.py"):
+        if path.parent.name == "cli":
+            continue
+        for match in pattern.finditer(path.read_text(encoding="utf-8")):
+            found.add(next(group for group in match.groups() if group))
+    return {code for code in found if not _NOT_A_SENTENCE.fullmatch(code)}
+
+
+def test_every_code_the_core_uses_reads_in_chinese(zh: None) -> None:
+    """A scan, not a list: a code added to the core without its Chinese sentence fails here (no
+    English word of three letters or more inside the Chinese, units and names aside)."""
+    import string
+
+    from ui import messages
+    from ui.messages import reason_text
+
+    codes = _codes_the_core_uses() | {"refused_alarm", "alarm_while_waiting"}  # (app/link/watch.py's pair)
+    assert {"no_motion", "program_not_started", "zero_already", "cancelled_by_stop"} <= codes
+    wrong = []
+    for code in sorted(codes):
+        args = dict(_SAMPLE_ARGS)
+        template = messages._TEMPLATES.get(code) or messages._BARE.get(code) or ""
+        for _literal, name, _spec, _conv in string.Formatter().parse(template):
+            if name and name not in args:
+                args[name] = "1"
+        text = reason_text(Reason(code, args))
+        left = ALLOWED.sub("", text or "")
+        if text is None or re.search(r"[A-Za-z]{3,}", left) or not re.search(r"[\u4e00-\u9fff]", text):
+            wrong.append(f"{code}: {text!r}")
+    assert wrong == [], "\n".join(wrong)

@@ -31,7 +31,9 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     link_fixture,
     ratio_writes,
     register_writes,
+    translator_fixture,
 )
+from ui.messages import result_text
 
 pytestmark = pytest.mark.timeout(60)
 
@@ -378,7 +380,9 @@ def test_request_ids_round_trip(qtbot: Any, sim: Any, link: RobotLink) -> None:
     assert all(r.request_id is not None for r in results)
 
 
-def test_a_stop_cancels_queued_motions_with_their_ids(qtbot: Any, sim: Any, link: RobotLink) -> None:
+def test_a_stop_cancels_queued_motions_with_their_ids(
+    qtbot: Any, sim: Any, link: RobotLink, translator: Any
+) -> None:
     connect(qtbot, link, sim)
     sim.set_response_delay(0.1)
     seen = sim.requests_count
@@ -396,6 +400,14 @@ def test_a_stop_cancels_queued_motions_with_their_ids(qtbot: Any, sim: Any, link
     # are cancelled all the same, see test_worker_stop.py)
     qtbot.waitUntil(lambda: cancelled() == set(queued), timeout=SIGNAL_TIMEOUT_MS)
     sim.set_response_delay(0.0)
+    # in the operator's words, in either language (was: "Failed: go to zero: cancelled by Stop")
+    words = [result_text(r) for r in results if r.request_id in queued]
+    assert words == ["go to zero: not sent, cancelled by Stop.", "run program: not sent, cancelled by Stop."]
+    assert translator.set_language("zh_CN")
+    assert [result_text(r) for r in results if r.request_id in queued] == [
+        "回零：未发送，已被停止取消。",
+        "运行程序：未发送，已被停止取消。",
+    ]
 
 
 # --- uploads ------------------------------------------------------------------------------------
