@@ -32,6 +32,7 @@ from app.protocol.enums import (
 from ui.joins import join_names
 from ui.messages_files import FILE_TEMPLATES, file_fields, file_text, os_problem
 from ui.messages_plan import _number, _tr, envelope_text, issue_line, issue_text
+from ui.messages_profile import is_profile_code, profile_text
 
 __all__ = [
     "LEVEL_ERROR",
@@ -421,6 +422,8 @@ def reason_text(reason: Reason) -> str | None:
         return _tr(_TEMPLATES["stop_sent_on_line"]).format(cause=cause)
     if reason.code in _FRESH_STOP:
         return _fresh_stop_text(reason)
+    if is_profile_code(reason.code):
+        return profile_text(reason.code, args)
     template = _TEMPLATES.get(reason.code)
     if template is None:
         return None

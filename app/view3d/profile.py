@@ -37,7 +37,11 @@ _QUOTE_CHARS: Final = 40  # a bad value is quoted up to this many characters
 
 
 class ProfileError(InvalidInput):
-    """A robot profile file that cannot be used; the message says where and why."""
+    """A robot profile file that cannot be used; the message says where and why. Its code
+    (``profile_*``) and params say the same for the GUI's words (ui/messages_files.py): ``where``
+    the field (``joint``, 1-based, and ``key``), ``file`` the file when it came from one."""
+
+    code = "profile_invalid"
 
 
 @dataclass(frozen=True)
@@ -92,36 +96,64 @@ def _quote(value: object) -> str:
     return text if len(text) <= _QUOTE_CHARS else text[: _QUOTE_CHARS - 1] + "…"
 
 
-def _number(where: str, value: object) -> float:
+def _place(where: str, joint: int | None = None) -> dict[str, object]:
+    """The params naming a field: its key (``d``, ``home_deg[2]``) and its joint (1-based)."""
+    return {"key": where} if joint is None else {"joint": joint, "key": where}
+
+
+def _number(where: str, value: object, joint: int | None = None) -> float:
     if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(float(value)):
-        raise ProfileError(f"{where}: {_quote(value)} is not a finite number")
+        label = where if joint is None else f"joint {joint} {where}"
+        raise ProfileError(
+            f"{label}: {_quote(value)} is not a finite number",
+            code="profile_not_number",
+            params={**_place(where, joint), "value": _quote(value)},
+        )
     return float(value)
 
 
 def _six(where: str, value: object) -> tuple[float, float, float, float, float, float]:
     if not isinstance(value, list) or len(value) != 6:
-        raise ProfileError(f"{where}: expected a list of six numbers X Y Z A B C, got {_quote(value)}")
+        raise ProfileError(
+            f"{where}: expected a list of six numbers X Y Z A B C, got {_quote(value)}",
+            code="profile_not_six",
+            params={**_place(where), "value": _quote(value)},
+        )
     x, y, z, a, b, c = (_number(f"{where}[{i}]", v) for i, v in enumerate(value))
     return (x, y, z, a, b, c)
 
 
 def _joint(index: int, raw: object) -> JointSpec:
-    where = f"joint {index + 1}"
+    joint = index + 1
+    where = f"joint {joint}"
+    keys = ("offset_deg", "d", "a", "alpha_deg", "min_deg", "max_deg")
     if not isinstance(raw, dict):
-        raise ProfileError(f"{where}: expected an object with offset_deg, d, a, alpha_deg, min_deg, max_deg")
-    missing = [k for k in ("d", "a", "alpha_deg", "min_deg", "max_deg") if k not in raw]
-    if missing:
-        raise ProfileError(f"{where}: missing {', '.join(missing)}")
-    name = raw.get("name", f"J{index + 1}")
-    if not isinstance(name, str):
-        raise ProfileError(f"{where}: name {_quote(name)} is not text")
-    values = {
-        k: _number(f"{where} {k}", raw.get(k, 0.0))
-        for k in ("offset_deg", "d", "a", "alpha_deg", "min_deg", "max_deg")
-    }
-    if values["min_deg"] >= values["max_deg"]:
         raise ProfileError(
-            f"{where}: min_deg {values['min_deg']:g} is not below max_deg {values['max_deg']:g}"
+            f"{where}: expected an object with {', '.join(keys)}",
+            code="profile_joint_not_object",
+            params={"joint": joint, "keys": ", ".join(keys)},
+        )
+    missing = [k for k in keys[1:] if k not in raw]
+    if missing:
+        raise ProfileError(
+            f"{where}: missing {', '.join(missing)}",
+            code="profile_missing",
+            params={"joint": joint, "keys": ", ".join(missing)},
+        )
+    name = raw.get("name", f"J{joint}")
+    if not isinstance(name, str):
+        raise ProfileError(
+            f"{where}: name {_quote(name)} is not text",
+            code="profile_name_not_text",
+            params={"joint": joint, "value": _quote(name)},
+        )
+    values = {k: _number(k, raw.get(k, 0.0), joint) for k in keys}
+    if values["min_deg"] >= values["max_deg"]:
+        low, high = f"{values['min_deg']:g}", f"{values['max_deg']:g}"
+        raise ProfileError(
+            f"{where}: min_deg {low} is not below max_deg {high}",
+            code="profile_limits",
+            params={"joint": joint, "low": low, "high": high},
         )
     return JointSpec(name=name[:20], **values)
 
@@ -129,28 +161,42 @@ def _joint(index: int, raw: object) -> JointSpec:
 def profile_from_dict(data: object) -> RobotProfile:
     """A profile from parsed JSON; :class:`ProfileError` says what is wrong."""
     if not isinstance(data, dict):
-        raise ProfileError("a robot profile is a JSON object")
+        raise ProfileError("a robot profile is a JSON object", code="profile_not_object")
     if data.get("format") != PROFILE_FORMAT:
         raise ProfileError(
-            f"not a robot profile: format is {_quote(data.get('format'))}, expected '{PROFILE_FORMAT}'"
+            f"not a robot profile: format is {_quote(data.get('format'))}, expected '{PROFILE_FORMAT}'",
+            code="profile_format",
+            params={"value": _quote(data.get("format")), "expected": PROFILE_FORMAT},
         )
     version = data.get("version")
     if version != PROFILE_VERSION:
         raise ProfileError(
             f"profile version {_quote(version)} is not supported (this TeachPad reads "
-            f"version {PROFILE_VERSION})"
+            f"version {PROFILE_VERSION})",
+            code="profile_version",
+            params={"value": _quote(version), "expected": PROFILE_VERSION},
         )
     joints_raw = data.get("joints")
     if not isinstance(joints_raw, list) or not 1 <= len(joints_raw) <= MAX_JOINTS:
-        raise ProfileError(f"joints: expected a list of 1 to {MAX_JOINTS} joints")
+        raise ProfileError(
+            f"joints: expected a list of 1 to {MAX_JOINTS} joints",
+            code="profile_joints",
+            params={"most": MAX_JOINTS},
+        )
     joints = tuple(_joint(i, raw) for i, raw in enumerate(joints_raw))
     home_raw: Any = data.get("home_deg", [0.0] * len(joints))
     if not isinstance(home_raw, list) or len(home_raw) != len(joints):
-        raise ProfileError(f"home_deg: expected {len(joints)} numbers, one per joint")
+        raise ProfileError(
+            f"home_deg: expected {len(joints)} numbers, one per joint",
+            code="profile_home",
+            params={"count": len(joints)},
+        )
     home = tuple(_number(f"home_deg[{i}]", v) for i, v in enumerate(home_raw))
     name = data.get("name", "robot")
     if not isinstance(name, str):
-        raise ProfileError(f"name {_quote(name)} is not text")
+        raise ProfileError(
+            f"name {_quote(name)} is not text", code="profile_name_not_text", params={"value": _quote(name)}
+        )
     base = _six("base", data.get("base", [0.0] * 6))
     flange = _six("flange", data.get("flange", [0.0] * 6))
     return RobotProfile(name=name[:100], joints=joints, home_deg=home, base=base, flange=flange)
@@ -161,13 +207,23 @@ def load_profile(path: str | os.PathLike[str]) -> RobotProfile:
     label = os.fspath(path)
     try:
         if os.path.getsize(path) > MAX_FILE_BYTES:
-            raise ProfileError(f"{label}: too large for a robot profile (over {MAX_FILE_BYTES // 1000} kB)")
+            raise ProfileError(
+                f"{label}: too large for a robot profile (over {MAX_FILE_BYTES // 1000} kB)",
+                code="profile_too_large",
+                params={"file": label, "kb": MAX_FILE_BYTES // 1000},
+            )
         with open(path, encoding="utf-8") as handle:
             text = handle.read()
     except OSError as exc:
-        raise ProfileError(f"{label}: cannot read the robot profile ({exc.strerror or exc})") from exc
+        raise ProfileError(
+            f"{label}: cannot read the robot profile ({exc.strerror or exc})",
+            code="profile_unreadable",
+            params={"file": label, "cause": exc.strerror or str(exc)},
+        ) from exc
     except UnicodeDecodeError as exc:
-        raise ProfileError(f"{label}: the robot profile is not UTF-8 text") from exc
+        raise ProfileError(
+            f"{label}: the robot profile is not UTF-8 text", code="profile_not_utf8", params={"file": label}
+        ) from exc
     return parse_profile(text, label)
 
 
@@ -176,11 +232,15 @@ def parse_profile(text: str, label: str = "profile") -> RobotProfile:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
         where = f"line {exc.lineno}, column {exc.colno}"
-        raise ProfileError(f"{label}: not valid JSON ({where}: {exc.msg})") from exc
+        raise ProfileError(
+            f"{label}: not valid JSON ({where}: {exc.msg})",
+            code="profile_not_json",
+            params={"file": label, "line": exc.lineno, "column": exc.colno},
+        ) from exc
     try:
         return profile_from_dict(data)
     except ProfileError as exc:
-        raise ProfileError(f"{label}: {exc}") from exc
+        raise ProfileError(f"{label}: {exc}", code=exc.code, params={**exc.params, "file": label}) from exc
 
 
 def profile_to_dict(profile: RobotProfile) -> dict[str, Any]:

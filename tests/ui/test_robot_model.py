@@ -180,3 +180,42 @@ def test_the_shipped_model_agrees_with_the_simulator_wherever_the_arm_is(
     assert not panel.agreement_label.isVisible()
     assert "Agrees with the controller" in panel.model_label.toolTip()
     assert not any("disagrees" in e.text for e in window.event_log.model.events())
+
+
+def test_a_robot_model_file_that_cannot_be_used_is_refused_in_chinese(
+    qtbot: Any, translator: Any, tmp_path: Path
+) -> None:
+    """(issue 21) The refusal names the file, the field and why in the operator's language: the
+    core's English ("joint 2: min_deg 10 is not below max_deg 5") was shown inside Chinese."""
+    import re
+
+    from app.view3d.profile import PROFILE_FORMAT
+    from ui.panels.view3d_robot import RobotModelSource
+
+    cases = {
+        "limits.json": json.dumps(
+            {
+                "format": PROFILE_FORMAT,
+                "version": 1,
+                "joints": [{"d": 1, "a": 0, "alpha_deg": 0, "min_deg": 10, "max_deg": 5}],
+            }
+        ),
+        "missing.json": json.dumps({"format": PROFILE_FORMAT, "version": 1, "joints": [{"d": 1}]}),
+        "format.json": '{"format": "cad", "version": 1}',
+        "broken.json": '{"format": ',
+    }
+    source = RobotModelSource()
+    assert translator.set_language("zh_CN")
+    words: dict[str, str | None] = {}
+    for name, text in cases.items():
+        path = tmp_path / name
+        path.write_text(text, encoding="utf-8")
+        words[name] = source.load_file(str(path))
+    # what stays as written: the file, JSON and its keys, the format's id, a quoted value
+    keys = re.compile(PROFILE_FORMAT + r"|[a-z]+_deg|\bformat\b|'cad'|JSON|TeachPad|[\w/.-]+\.json")
+    for name, said in words.items():
+        assert said is not None and name in said, said
+        assert re.search(r"[\u4e00-\u9fff]", said), said
+        assert not re.search(r"[A-Za-z]{3,}", keys.sub("", said)), f"English left in {said!r}"
+    assert "关节 1：min_deg 10 不小于 max_deg 5" in (words["limits.json"] or "")
+    assert "第 1 行" in (words["broken.json"] or "")

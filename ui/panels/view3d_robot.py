@@ -163,7 +163,9 @@ class RobotModelSource(QObject):
         try:
             profile = load_profile(path)
         except ProfileError as exc:
-            return str(exc)
+            from ui.messages import error_text
+
+            return error_text(exc)  # in the operator's language (ui/messages_profile.py)
         self.problem = ""
         self.set_profile(profile, path)
         return None

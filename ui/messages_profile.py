@@ -1,0 +1,82 @@
+"""A robot profile file that cannot be used (:class:`app.view3d.profile.ProfileError`, codes
+``profile_*``), in the operator's language: the file, the field (a joint, a JSON key), then
+why. The JSON keys (``min_deg``, ``home_deg``) stay as written in the file."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+from PySide6.QtCore import QCoreApplication
+
+from ui.joins import labelled
+
+__all__ = ["is_profile_code", "profile_text"]
+
+_CONTEXT = "ProfileWords"
+
+
+def QT_TRANSLATE_NOOP(context: str, text: str) -> str:
+    return text
+
+
+_SENTENCES: dict[str, str] = {
+    "profile_invalid": QT_TRANSLATE_NOOP("ProfileWords", "the robot profile cannot be used"),
+    "profile_not_number": QT_TRANSLATE_NOOP("ProfileWords", "{value} is not a finite number"),
+    "profile_not_six": QT_TRANSLATE_NOOP(
+        "ProfileWords", "expected a list of six numbers X Y Z A B C, got {value}"
+    ),
+    "profile_joint_not_object": QT_TRANSLATE_NOOP("ProfileWords", "expected an object with {keys}"),
+    "profile_missing": QT_TRANSLATE_NOOP("ProfileWords", "missing {keys}"),
+    "profile_name_not_text": QT_TRANSLATE_NOOP("ProfileWords", "the name {value} is not text"),
+    "profile_limits": QT_TRANSLATE_NOOP("ProfileWords", "min_deg {low} is not below max_deg {high}"),
+    "profile_not_object": QT_TRANSLATE_NOOP("ProfileWords", "a robot profile is a JSON object"),
+    "profile_format": QT_TRANSLATE_NOOP(
+        "ProfileWords", "not a robot profile: its format is {value}, expected {expected}"
+    ),
+    "profile_version": QT_TRANSLATE_NOOP(
+        "ProfileWords", "profile version {value} is not supported (this TeachPad reads version {expected})"
+    ),
+    "profile_joints": QT_TRANSLATE_NOOP("ProfileWords", "joints: expected a list of 1 to {most} joints"),
+    "profile_home": QT_TRANSLATE_NOOP("ProfileWords", "home_deg: expected {count} numbers, one per joint"),
+    "profile_too_large": QT_TRANSLATE_NOOP("ProfileWords", "too large for a robot profile (over {kb} kB)"),
+    "profile_unreadable": QT_TRANSLATE_NOOP("ProfileWords", "cannot read the robot profile ({cause})"),
+    "profile_not_utf8": QT_TRANSLATE_NOOP("ProfileWords", "the robot profile is not UTF-8 text"),
+    "profile_not_json": QT_TRANSLATE_NOOP("ProfileWords", "not valid JSON (line {line}, column {column})"),
+}
+_JOINT = QT_TRANSLATE_NOOP("ProfileWords", "joint {n}")
+_JOINT_KEY = QT_TRANSLATE_NOOP("ProfileWords", "joint {n} {key}")
+
+
+def _tr(text: str) -> str:
+    return QCoreApplication.translate(_CONTEXT, text)
+
+
+def is_profile_code(code: str) -> bool:
+    return code in _SENTENCES
+
+
+def _place(args: Mapping[str, Any]) -> str:
+    joint, key = args.get("joint"), args.get("key")
+    if joint is not None and key:
+        return _tr(_JOINT_KEY).format(n=joint, key=key)
+    if joint is not None:
+        return _tr(_JOINT).format(n=joint)
+    return str(key or "")
+
+
+def profile_text(code: str, args: Mapping[str, Any]) -> str | None:
+    """The sentence for a ``profile_*`` code and its params; None for another code."""
+    sentence = _SENTENCES.get(code)
+    if sentence is None:
+        return None
+    fields = {k: str(v) for k, v in args.items()}
+    try:
+        text = _tr(sentence).format(**fields)
+    except KeyError:
+        text = _tr(_SENTENCES["profile_invalid"])
+    place = _place(args)
+    if place and code not in ("profile_joints", "profile_home"):  # (these name their key)
+        text = labelled(place, text)
+    file = args.get("file")
+    return labelled(str(file), text) if file else text
