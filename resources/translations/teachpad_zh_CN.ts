@@ -1427,7 +1427,7 @@
         <message>
             <location filename="../../ui/messages.py" line="92" />
             <source>{command} refused by the controller: {alarms}.</source>
-            <translation>{command} 被控制器拒绝：{alarms}。</translation>
+            <translation>{command}被控制器拒绝：{alarms}。</translation>
         </message>
         <message>
             <location filename="../../ui/messages.py" line="93" />
@@ -1447,12 +1447,12 @@
         <message>
             <location filename="../../ui/messages.py" line="100" />
             <source>{command} not sent: another Modbus master wrote to the controller less than {seconds} s ago and its writes could change this move. Make sure no other master is commanding the robot, then send it again.</source>
-            <translation>{command} 未发送：另一个 Modbus 主站在不到 {seconds} 秒前写入了控制器，它的写入可能改变这次运动。请确认没有其他主站在指挥机器人，然后再发送。</translation>
+            <translation>{command}未发送：另一个 Modbus 主站在不到 {seconds} 秒前写入了控制器，它的写入可能改变这次运动。请确认没有其他主站在指挥机器人，然后再发送。</translation>
         </message>
         <message>
             <location filename="../../ui/messages.py" line="105" />
             <source>{command} not sent: a program or motion is under way on the controller; wait for it to end, or press Stop.</source>
-            <translation>{command} 未发送：控制器上有程序或运动正在进行；请等待其结束，或按停止。</translation>
+            <translation>{command}未发送：控制器上有程序或运动正在进行；请等待其结束，或按停止。</translation>
         </message>
         <message>
             <location filename="../../ui/messages.py" line="109" />

@@ -94,3 +94,9 @@ def test_one_word_for_the_unit_id_and_no_split_words() -> None:
     assert [t for _c, _s, t in found if "站号" in t or "分字" in t] == []
     unit = [t for _c, s, t in found if re.search(r"\bunit( id)?\b", re.sub(r"{\w+}", "", s), re.IGNORECASE)]
     assert unit and all("从站地址" in t for t in unit), unit
+
+
+def test_a_named_command_runs_into_the_chinese_that_follows() -> None:
+    """ "{command} 被控制器拒绝" read "运行程序 被控制器拒绝": Chinese puts no space after a word."""
+    spaced = re.compile(r"\{(command|operation)\} [\u4e00-\u9fff]")
+    assert [t for _c, _s, t in _translations() if spaced.search(t)] == []
