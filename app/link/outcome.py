@@ -83,6 +83,15 @@ def outcome_args(result: CommandResult) -> dict[str, Any]:
     args: dict[str, Any] = {}
     if result.reason is not None:
         args["reason"] = result.reason.code
+        # its arguments, for the viewer's words (ui/audit_words.py): plain values only (the
+        # record is JSON), nested causes left out
+        kept = {
+            k: v
+            for k, v in result.reason.args.items()
+            if v is None or isinstance(v, str | int | float | bool)
+        }
+        if kept:
+            args["reason_args"] = kept
     if result.status is not None and result.status.is_error:  # the controller's refusal code
         args["status"] = result.status.code
     if result.ok and result.unconfirmed:

@@ -134,102 +134,102 @@
     <context>
         <name>AuditModel</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="65" />
+            <location filename="../../ui/panels/audit_viewer.py" line="66" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="66" />
+            <location filename="../../ui/panels/audit_viewer.py" line="67" />
             <source>Role</source>
             <translation>角色</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="67" />
+            <location filename="../../ui/panels/audit_viewer.py" line="68" />
             <source>Kind</source>
             <translation>类型</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="68" />
+            <location filename="../../ui/panels/audit_viewer.py" line="69" />
             <source>Command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="69" />
+            <location filename="../../ui/panels/audit_viewer.py" line="70" />
             <source>Result</source>
             <translation>结果</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="70" />
+            <location filename="../../ui/panels/audit_viewer.py" line="71" />
             <source>Detail</source>
             <translation>详情</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="89" />
+            <location filename="../../ui/panels/audit_viewer.py" line="94" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="90" />
+            <location filename="../../ui/panels/audit_viewer.py" line="95" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="91" />
+            <location filename="../../ui/panels/audit_viewer.py" line="96" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="92" />
+            <location filename="../../ui/panels/audit_viewer.py" line="97" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="93" />
+            <location filename="../../ui/panels/audit_viewer.py" line="98" />
             <source>write</source>
             <translation>写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="94" />
+            <location filename="../../ui/panels/audit_viewer.py" line="99" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="95" />
+            <location filename="../../ui/panels/audit_viewer.py" line="100" />
             <source>login</source>
             <translation>登录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="96" />
+            <location filename="../../ui/panels/audit_viewer.py" line="101" />
             <source>action</source>
             <translation>操作</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="97" />
+            <location filename="../../ui/panels/audit_viewer.py" line="102" />
             <source>answered</source>
             <translation>已应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="101" />
+            <location filename="../../ui/panels/audit_viewer.py" line="106" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="102" />
+            <location filename="../../ui/panels/audit_viewer.py" line="107" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="98" />
+            <location filename="../../ui/panels/audit_viewer.py" line="103" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="99" />
+            <location filename="../../ui/panels/audit_viewer.py" line="104" />
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="100" />
+            <location filename="../../ui/panels/audit_viewer.py" line="105" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
@@ -237,154 +237,337 @@
     <context>
         <name>AuditViewer</name>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="118" />
+            <location filename="../../ui/panels/audit_viewer.py" line="123" />
             <source>Audit trail</source>
             <translation>审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="128" />
+            <location filename="../../ui/panels/audit_viewer.py" line="133" />
             <source>Any role</source>
             <translation>任意角色</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="130" />
+            <location filename="../../ui/panels/audit_viewer.py" line="135" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="131" />
+            <location filename="../../ui/panels/audit_viewer.py" line="136" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="132" />
+            <location filename="../../ui/panels/audit_viewer.py" line="137" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="133" />
+            <location filename="../../ui/panels/audit_viewer.py" line="138" />
             <source>administrator (CLI)</source>
             <translation>管理员（命令行）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="137" />
+            <location filename="../../ui/panels/audit_viewer.py" line="142" />
             <source>Command contains…</source>
             <translation>命令包含…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="139" />
+            <location filename="../../ui/panels/audit_viewer.py" line="144" />
             <source>Any result</source>
             <translation>任意结果</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="146" />
+            <location filename="../../ui/panels/audit_viewer.py" line="151" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="147" />
+            <location filename="../../ui/panels/audit_viewer.py" line="152" />
             <source>blocked</source>
             <translation>已阻止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="142" />
+            <location filename="../../ui/panels/audit_viewer.py" line="147" />
             <source>refused</source>
             <translation>已拒绝</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="141" />
+            <location filename="../../ui/panels/audit_viewer.py" line="146" />
             <source>done</source>
             <translation>完成</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="143" />
+            <location filename="../../ui/panels/audit_viewer.py" line="148" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="144" />
+            <location filename="../../ui/panels/audit_viewer.py" line="149" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="145" />
+            <location filename="../../ui/panels/audit_viewer.py" line="150" />
             <source>answered</source>
             <translation>已应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="150" />
+            <location filename="../../ui/panels/audit_viewer.py" line="155" />
             <source>Show</source>
             <translation>显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="152" />
+            <location filename="../../ui/panels/audit_viewer.py" line="157" />
             <source>Export CSV…</source>
             <translation>导出 CSV…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="162" />
+            <location filename="../../ui/panels/audit_viewer.py" line="167" />
             <source>From</source>
             <translation>从</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="162" />
+            <location filename="../../ui/panels/audit_viewer.py" line="167" />
             <source>to</source>
             <translation>到</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="195" />
+            <location filename="../../ui/panels/audit_viewer.py" line="200" />
             <source>{n} records</source>
             <translation>{n} 条记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="197" />
+            <location filename="../../ui/panels/audit_viewer.py" line="202" />
             <source>{n} records ({skipped} damaged lines skipped)</source>
             <translation>{n} 条记录（跳过 {skipped} 行损坏的记录）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="199" />
+            <location filename="../../ui/panels/audit_viewer.py" line="204" />
             <source>{unknown} writes whose answer or outcome was not recorded</source>
             <translation>{unknown} 条写入的应答或结果未记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="211" />
+            <location filename="../../ui/panels/audit_viewer.py" line="216" />
             <source>The chain of hashes breaks at {file} line {line}: records before it were removed.</source>
             <translation>哈希链在 {file} 第 {line} 行断开：此前的记录已被删除。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="215" />
+            <location filename="../../ui/panels/audit_viewer.py" line="220" />
             <source>The chain of hashes breaks at {file} line {line}: the record before it was changed, or records were removed.</source>
             <translation>哈希链在 {file} 第 {line} 行断开：此前的记录被修改，或有记录被删除。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="220" />
+            <location filename="../../ui/panels/audit_viewer.py" line="225" />
             <source>{n} breaks in all.</source>
             <translation>共 {n} 处断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="223" />
+            <location filename="../../ui/panels/audit_viewer.py" line="228" />
             <source>(No chain of hashes: records of an older TeachPad.)</source>
             <translation>（无哈希链：旧版 TeachPad 的记录。）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="228" />
+            <location filename="../../ui/panels/audit_viewer.py" line="233" />
             <source>Export the audit trail</source>
             <translation>导出审计记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="228" />
+            <location filename="../../ui/panels/audit_viewer.py" line="233" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="242" />
+            <location filename="../../ui/panels/audit_viewer.py" line="247" />
             <source>Cannot write {file}: {why}</source>
             <translation>无法写入 {file}：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/audit_viewer.py" line="245" />
+            <location filename="../../ui/panels/audit_viewer.py" line="250" />
             <source>{n} records exported to {file}</source>
             <translation>已将 {n} 条记录导出到 {file}</translation>
+        </message>
+    </context>
+    <context>
+        <name>AuditWords</name>
+        <message>
+            <location filename="../../ui/audit_words.py" line="34" />
+            <source>jog</source>
+            <translation>点动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="35" />
+            <source>step</source>
+            <translation>增量运动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="36" />
+            <source>teach</source>
+            <translation>示教点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="37" />
+            <source>run plan</source>
+            <translation>运行轨迹</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="38" />
+            <source>run program</source>
+            <translation>运行程序</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="39" />
+            <source>stop</source>
+            <translation>停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="40" />
+            <source>reduced speed</source>
+            <translation>降速模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="41" />
+            <source>edit points</source>
+            <translation>编辑点位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="42" />
+            <source>edit plans</source>
+            <translation>编辑轨迹</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="43" />
+            <source>edit envelope</source>
+            <translation>编辑安全范围</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="44" />
+            <source>change robot model</source>
+            <translation>更换机器人模型</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="45" />
+            <source>leave reduced speed</source>
+            <translation>退出降速模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="46" />
+            <source>reconnect to the same controller</source>
+            <translation>重新连接同一控制器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="47" />
+            <source>change connection</source>
+            <translation>更改连接</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="48" />
+            <source>change register profile</source>
+            <translation>更改寄存器配置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="49" />
+            <source>manage roles and passwords</source>
+            <translation>管理角色与密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="50" />
+            <source>write a support bundle</source>
+            <translation>生成支持包</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="51" />
+            <source>write controller registers directly</source>
+            <translation>直接写控制器寄存器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="52" />
+            <source>move to point</source>
+            <translation>运动到点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="53" />
+            <source>set the idle lock time</source>
+            <translation>设置空闲锁定时间</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="54" />
+            <source>reduced speed on</source>
+            <translation>开启降速模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="55" />
+            <source>reduced speed off</source>
+            <translation>关闭降速模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="56" />
+            <source>clear the administrator password</source>
+            <translation>清除管理员密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="61" />
+            <source>operator</source>
+            <translation>操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="62" />
+            <source>engineer</source>
+            <translation>工程师</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="63" />
+            <source>administrator</source>
+            <translation>管理员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="68" />
+            <source>log in as {role}</source>
+            <translation>以{role}身份登录</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="69" />
+            <source>log out ({role})</source>
+            <translation>注销（{role}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="72" />
+            <source>set the {role} password</source>
+            <translation>设置{role}密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="76" />
+            <source>change the {role} password</source>
+            <translation>更改{role}密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="80" />
+            <source>clear the {role} password</source>
+            <translation>清除{role}密码</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="84" />
+            <source>locked back to operator after {seconds} s idle</source>
+            <translation>空闲 {seconds} s 后锁回操作员</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="89" />
+            <source>{action} ({register})</source>
+            <translation>{action}（{register}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="91" />
+            <source>write {what}</source>
+            <translation>写入 {what}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="94" />
+            <source>sent; TeachPad stopped before the answer was recorded</source>
+            <translation>已发送；记录应答之前 TeachPad 已停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="95" />
+            <source>sent and answered; the controller's outcome was not recorded (still under way when read, or TeachPad stopped first)</source>
+            <translation>已发送并已应答；未记录控制器的结果（读取时仍在进行，或 TeachPad 先停止了）</translation>
         </message>
     </context>
     <context>

@@ -30,6 +30,7 @@ from PySide6.QtWidgets import (
 
 from app.safety.audit import AuditFilter, AuditRecord, ReadStats, Result, export_csv, query, result_label
 from app.safety.audit_chain import verify_chain
+from ui.audit_words import command_words, detail_words
 from ui.widgets_common import atomic_write_text
 
 DEFAULT_DAYS = 7  # the range shown when the viewer opens
@@ -77,6 +78,10 @@ class AuditModel(QAbstractTableModel):
         col = self.COLUMNS[index.column()]
         if col == "time":
             return r.host_time.replace("T", " ")[:23]
+        if col == "command":
+            return command_words(r)
+        if col == "detail":
+            return detail_words(r)
         value = str(getattr(r, col))
         if col in ("role", "kind", "result"):  # the file keeps English keys; the table shows words
             words = self._words().get(value, value)
