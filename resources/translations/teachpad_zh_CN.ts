@@ -5901,37 +5901,37 @@ Remove them all?</source>
     <context>
         <name>TrafficModel</name>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="104" />
+            <location filename="../../ui/models/traffic_model.py" line="106" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="105" />
+            <location filename="../../ui/models/traffic_model.py" line="107" />
             <source>Dir</source>
             <translation>方向</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="106" />
+            <location filename="../../ui/models/traffic_model.py" line="108" />
             <source>Bytes</source>
             <translation>字节</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="107" />
+            <location filename="../../ui/models/traffic_model.py" line="109" />
             <source>Meaning</source>
             <translation>含义</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="109" />
+            <location filename="../../ui/models/traffic_model.py" line="111" />
             <source>→ Tx</source>
             <translation>→ 发送</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="110" />
+            <location filename="../../ui/models/traffic_model.py" line="112" />
             <source>← Rx</source>
             <translation>← 接收</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="353" />
+            <location filename="../../ui/models/traffic_model.py" line="357" />
             <source>{n} bytes</source>
             <translation>{n} 字节</translation>
         </message>
@@ -5998,6 +5998,115 @@ Remove them all?</source>
             <location filename="../../ui/panels/traffic_panel.py" line="333" />
             <source>capture paused</source>
             <translation>抓包已暂停</translation>
+        </message>
+    </context>
+    <context>
+        <name>TrafficWords</name>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="30" />
+            <source>read {what}</source>
+            <translation>读取 {what}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="31" />
+            <source>write acknowledged: {what}</source>
+            <translation>写入已应答：{what}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="32" />
+            <source>acknowledged: {what}</source>
+            <translation>已应答：{what}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="33" />
+            <source>malformed: {what}</source>
+            <translation>格式错误：{what}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="34" />
+            <source>write {what}</source>
+            <translation>写入 {what}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="37" />
+            <source>exception {code}: {name}</source>
+            <translation>异常 {code}：{name}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="41" />
+            <source>truncated frame</source>
+            <translation>帧不完整</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="42" />
+            <source>exception (code missing)</source>
+            <translation>异常（缺少异常码）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="46" />
+            <source>pose X..C</source>
+            <translation>位姿 X..C</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="47" />
+            <source>pose, ext axes, joints</source>
+            <translation>位姿、外部轴、关节</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="48" />
+            <source>ext axes J7..J11</source>
+            <translation>外部轴 J7..J11</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="49" />
+            <source>joints J1..J6</source>
+            <translation>关节 J1..J6</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="50" />
+            <source>status</source>
+            <translation>状态</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="51" />
+            <location filename="../../ui/traffic_words.py" line="58" />
+            <source>clock</source>
+            <translation>时钟</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="52" />
+            <source>command status</source>
+            <translation>命令状态</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="55" />
+            <source>mode</source>
+            <translation>模式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="56" />
+            <source>program</source>
+            <translation>程序</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="57" />
+            <source>alarms</source>
+            <translation>报警</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="64" />
+            <source>invalid</source>
+            <translation>无效</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="65" />
+            <source>none</source>
+            <translation>无</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="88" />
+            <source>: </source>
+            <translation>：</translation>
         </message>
     </context>
     <context>

@@ -457,3 +457,32 @@ def test_a_100hz_stream_updates_the_visible_table_at_most_at_the_flush_rate(
     assert len(inserts) < fed[0]  # batched, not one insert per poll
     panel.flush()
     assert panel.model.rowCount() == 4 * fed[0]  # nothing lost
+
+
+def test_the_meaning_column_reads_in_chinese(qtbot: Any, panel: TrafficPanel) -> None:
+    """(issue 21) 含义 was the English decoding inside the Chinese table; the stored meaning, the
+    filter and the export keep the English."""
+    import re
+
+    from tests.ui.pendant_support import translator_fixture  # noqa: F401 - (the fixture's module)
+    from ui.i18n import Translator
+
+    wire = Wire()
+    panel.on_traffic(seed_pair() + wire.poll_status() + wire.write(440, 0x80) + wire.bad_read())
+    english = [cell(panel.model, row, COL_MEANING) for row in range(panel.model.rowCount())]
+    translator = Translator()
+    assert translator.set_language("zh_CN")
+    try:
+        qtbot.waitUntil(lambda: cell(panel.model, 0, COL_MEANING) != english[0], timeout=2000)
+        words = [cell(panel.model, row, COL_MEANING) for row in range(panel.model.rowCount())]
+    finally:
+        translator.uninstall()
+    assert words[0] == "写入 GV200 = 30.0" and words[1] == "写入已应答：GV200 (400–401)"
+    assert words[2].startswith("读取 状态 (560–583)") and words[3].startswith("状态 (560–583)：模式=")
+    assert words[5].startswith("已应答：示教使能 (440 ← 0x80)"), words[5]
+    assert "异常 02：非法数据地址" in words[7], words[7]
+    kept = re.compile(r"Modbus|GV\d+|0x[0-9A-Fa-f]+|\bX\b|\d+")
+    for text in words:
+        assert not re.search(r"[A-Za-z]{3,}", kept.sub("", text)), f"English left in {text!r}"
+    qtbot.waitUntil(lambda: cell(panel.model, 0, COL_MEANING) == english[0], timeout=2000)
+    assert panel.model.summary(panel.model._make_view(0)) == english[0]  # the stored meaning

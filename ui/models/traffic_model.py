@@ -34,6 +34,7 @@ from app.protocol.framing import EXCEPTION_FLAG, MBAP_SIZE, FunctionCode
 from ui.models.traffic_row import TrafficRow, is_poll_read, wrap_hex
 from ui.models.traffic_store import BAD, MAX_FRAME_BYTES, NO_COMMAND, NO_ROW, POLL, RTU, RX, TrafficStore
 from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_INK_SOFT
+from ui.traffic_words import MeaningWords
 from ui.widgets_common import monospace_font
 
 __all__ = [
@@ -97,6 +98,7 @@ class TrafficModel(QAbstractTableModel):
         self._bad_brush = QBrush(QColor(COLOR_ERROR))
         self._headers: tuple[str, ...] = ()
         self._tx_text = self._rx_text = ""
+        self._meaning_words = MeaningWords()  # the meaning column in the current language
         self._set_texts()
 
     def _set_texts(self) -> None:
@@ -108,15 +110,17 @@ class TrafficModel(QAbstractTableModel):
         )
         self._tx_text = QCoreApplication.translate("TrafficModel", "→ Tx")
         self._rx_text = QCoreApplication.translate("TrafficModel", "← Rx")
+        self._meaning_words.retranslate()
 
     def retranslate(self) -> None:
-        """Headers and direction texts in the current language (the decoded meaning stays English)."""
+        """Headers, direction texts and the shown meanings in the current language (the stored
+        meaning, the filter and the export keep the English decoding)."""
         self._set_texts()
         self.headerDataChanged.emit(Qt.Orientation.Horizontal, 0, _COLUMN_COUNT - 1)
         if len(self._store):
             self.dataChanged.emit(
                 self.index(0, COL_DIRECTION),
-                self.index(len(self._store) - 1, COL_DIRECTION),
+                self.index(len(self._store) - 1, COL_MEANING),
                 [Qt.ItemDataRole.DisplayRole],
             )
 
@@ -334,7 +338,7 @@ class TrafficModel(QAbstractTableModel):
         row = self._views.get(store.base + r) or self._make_view(r)
         if role == _DISPLAY:
             if column == COL_MEANING:
-                return row._summary if row._summary is not None else self.summary(row)
+                return self._meaning_words(row._summary if row._summary is not None else self.summary(row))
             if column == COL_BYTES:
                 return row.hex_display
             if column == COL_TIME:
