@@ -59,6 +59,10 @@ _FIELDS = {
 }
 _BLOCK = re.compile(r"(?P<name>[A-Za-z][A-Za-z .,0-9]*?)(?P<rest> (?:GV\d+ )?\([^)]*\))")
 _ACTION = re.compile(r"(?P<action>[a-z][a-z ]*[a-z]) (?P<register>\(\d+ ← [^)]+\))")
+# raw registers: "regs 107–109", "reg 1", an answer's "3 regs = 0x0001, ..." (its count first)
+_REGISTERS = re.compile(r"(?:(?P<count>\d+) )?regs? (?P<rest>(?:=|\d).*)")
+_REGS_COUNTED = QT_TRANSLATE_NOOP("TrafficWords", "{n} registers {rest}")
+_REGS = QT_TRANSLATE_NOOP("TrafficWords", "registers {rest}")
 _FIELD = re.compile(r"(?P<key>[A-Za-z0-9]+)=(?P<value>.*)")
 _WORDS = re.compile(r"(?P<words>[A-Za-z][A-Za-z ]*[a-z])(?P<rest> \(.*\))?")
 _INVALID = QT_TRANSLATE_NOOP("TrafficWords", "invalid")
@@ -79,7 +83,12 @@ def _subject(text: str) -> str:
     head, sep, fields = text.partition(": ")
     block = _BLOCK.fullmatch(head)
     action = _ACTION.fullmatch(head)
-    if block is not None and block["name"] in _BLOCKS:
+    registers = _REGISTERS.fullmatch(head)
+    if registers is not None:
+        count = registers["count"]
+        rest = registers["rest"]
+        head = _tr(_REGS_COUNTED).format(n=count, rest=rest) if count else _tr(_REGS).format(rest=rest)
+    elif block is not None and block["name"] in _BLOCKS:
         head = _tr(_BLOCKS[block["name"]]) + block["rest"]
     elif action is not None:
         head = f"{_protocol(action['action'])} {action['register']}"

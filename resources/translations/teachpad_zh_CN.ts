@@ -6095,16 +6095,26 @@ Remove them all?</source>
         </message>
         <message>
             <location filename="../../ui/traffic_words.py" line="64" />
+            <source>{n} registers {rest}</source>
+            <translation>{n} 个寄存器 {rest}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="65" />
+            <source>registers {rest}</source>
+            <translation>寄存器 {rest}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/traffic_words.py" line="68" />
             <source>invalid</source>
             <translation>无效</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_words.py" line="65" />
+            <location filename="../../ui/traffic_words.py" line="69" />
             <source>none</source>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/traffic_words.py" line="88" />
+            <location filename="../../ui/traffic_words.py" line="97" />
             <source>: </source>
             <translation>：</translation>
         </message>

@@ -466,6 +466,7 @@ def test_the_meaning_column_reads_in_chinese(qtbot: Any, panel: TrafficPanel) ->
 
     from tests.ui.pendant_support import translator_fixture  # noqa: F401 - (the fixture's module)
     from ui.i18n import Translator
+    from ui.traffic_words import meaning_words
 
     wire = Wire()
     panel.on_traffic(seed_pair() + wire.poll_status() + wire.write(440, 0x80) + wire.bad_read())
@@ -475,12 +476,14 @@ def test_the_meaning_column_reads_in_chinese(qtbot: Any, panel: TrafficPanel) ->
     try:
         qtbot.waitUntil(lambda: cell(panel.model, 0, COL_MEANING) != english[0], timeout=2000)
         words = [cell(panel.model, row, COL_MEANING) for row in range(panel.model.rowCount())]
+        raw = [meaning_words("read regs 107–109"), meaning_words("3 regs = 0x0001, 0x0002, 0x0003")]
     finally:
         translator.uninstall()
     assert words[0] == "写入 GV200 = 30.0" and words[1] == "写入已应答：GV200 (400–401)"
     assert words[2].startswith("读取 状态 (560–583)") and words[3].startswith("状态 (560–583)：模式=")
     assert words[5].startswith("已应答：示教使能 (440 ← 0x80)"), words[5]
     assert "异常 02：非法数据地址" in words[7], words[7]
+    assert raw == ["读取 寄存器 107–109", "3 个寄存器 = 0x0001, 0x0002, 0x0003"]
     kept = re.compile(r"Modbus|GV\d+|0x[0-9A-Fa-f]+|\bX\b|\d+")
     for text in words:
         assert not re.search(r"[A-Za-z]{3,}", kept.sub("", text)), f"English left in {text!r}"
