@@ -133,9 +133,21 @@ def detail_words(record: AuditRecord) -> str:
     code = args.get("reason")
     if isinstance(code, str) and code:
         reason_args = args.get("reason_args")
-        text = reason_text(Reason(code, dict(reason_args) if isinstance(reason_args, dict) else {}))
+        plain = dict(reason_args) if isinstance(reason_args, dict) else {}
+        text = _role_refused(plain) if code == "role_refused" else reason_text(Reason(code, plain))
         if text:
             return text
     if record.detail in _DETAILS:
         return _tr(_DETAILS[record.detail])
     return record.detail
+
+
+def _role_refused(args: Mapping[str, Any]) -> str | None:
+    """A control the role in force may not use (app.safety.session.require)."""
+    need, role = str(args.get("need", "")), str(args.get("role", ""))
+    if need not in _ROLES or role not in _ROLES:
+        return None
+    return _tr(_ROLE_REFUSED).format(need=_tr(need), role=_tr(role))
+
+
+_ROLE_REFUSED = QT_TRANSLATE_NOOP("AuditWords", "needs the {need} role ({role} was logged in)")

@@ -38,7 +38,15 @@ from app.safety.envelope import (
 )
 from app.safety.jog_guard import JOG_GUARD_LATENCY, ArmSpeeds, JogGuard, JogMotion
 from app.safety.register_profile import RegisterProfile, save_register_profile
-from app.safety.roles import Action, IdleLock, Role, RoleStore, WrongPassword, permission_reason
+from app.safety.roles import (
+    REQUIRED_ROLE,
+    Action,
+    IdleLock,
+    Role,
+    RoleStore,
+    WrongPassword,
+    permission_reason,
+)
 
 
 class PermissionRefused(TeachPadError):
@@ -84,7 +92,11 @@ class SafetySession:
         """Raise :class:`PermissionRefused` (audited) unless the role may do ``action``."""
         why = self.reason(action)
         if why is not None:
-            self.audit.record_refused(action.value, why, args)
+            # the reason's code and arguments beside the English, for the viewer's words
+            words = {"need": REQUIRED_ROLE[action].text, "role": self.role.text}
+            self.audit.record_refused(
+                action.value, why, {**(args or {}), "reason": "role_refused", "reason_args": words}
+            )
             raise PermissionRefused(self.role, action)
 
     def login(self, role: Role, password: str) -> Role:
@@ -191,8 +203,16 @@ class SafetySession:
 
     def _refuse(self, action: str, violation: EnvelopeViolation | None, args: dict[str, Any]) -> None:
         if violation is not None:
-            self.audit.record_refused(action, violation.message, args)
-            raise EnvelopeRefused(violation, action)
+            refused = EnvelopeRefused(violation, action)
+            plain = {
+                k: v
+                for k, v in refused.params.items()
+                if v is None or isinstance(v, str | int | float | bool)
+            }
+            self.audit.record_refused(
+                action, violation.message, {**args, "reason": refused.code, "reason_args": plain}
+            )
+            raise refused
 
     def check_step(
         self, pose: Pose, offsets: list[float], *, joint: bool, speed: float | None = None

@@ -569,6 +569,11 @@
             <source>sent and answered; the controller's outcome was not recorded (still under way when read, or TeachPad stopped first)</source>
             <translation>已发送并已应答；未记录控制器的结果（读取时仍在进行，或 TeachPad 先停止了）</translation>
         </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="153" />
+            <source>needs the {need} role ({role} was logged in)</source>
+            <translation>需要{need}角色（当时登录的是{role}）</translation>
+        </message>
     </context>
     <context>
         <name>ConnectionDialog</name>

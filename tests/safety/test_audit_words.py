@@ -62,3 +62,32 @@ def test_the_audit_viewer_words_commands_and_outcomes_in_chinese(
         assert not re.search(r"[A-Za-z]{3,}", KEPT.sub("", text)), f"English left in {text!r}"
     # the record keeps English
     assert [r.command for r in query(tmp_path)][:2] == ["log in as engineer", "edit envelope"]
+
+
+def test_the_refusals_details_read_in_chinese(qapp: Any, translator: Any, tmp_path: Path) -> None:
+    """A role refusal and an envelope refusal keep their reason's code beside the English; the
+    viewer words them (was the English "change connection: needs the administrator role ...")."""
+    import pytest
+
+    from app.models import Pose
+    from app.safety.envelope import Box, Envelope, EnvelopeRefused
+    from app.safety.roles import Action, RoleStore
+    from app.safety.session import PermissionRefused, SafetySession
+
+    session = SafetySession(RoleStore(tmp_path / "roles.json", scrypt_n=2**8), AuditLog(tmp_path / "audit"))
+    session.envelope = Envelope(keep_in=Box("cell", (-1000, -100, -1000), (1000, 1000, 1000)))
+    with pytest.raises(PermissionRefused):
+        session.require(Action.CONNECTION, {"host": "10.0.0.9"})
+    with pytest.raises(EnvelopeRefused):
+        session.check_step(Pose(0.0, 0.0, 500.0, 180.0, 0.0, 90.0), [0, -200, 0, 0, 0, 0], joint=False)
+    session.audit.close()
+    records = [r for r in query(tmp_path / "audit") if r.kind == "refused"]
+    assert records[0].detail.startswith("change connection: needs the administrator role")  # kept
+    model = AuditModel()
+    model.set_records(records)
+    assert translator.set_language("zh_CN")
+    details = _column(model, "detail")
+    assert details[0] == "需要管理员角色（当时登录的是操作员）", details
+    assert "Y = " in details[1] and "工作空间" in details[1], details
+    for text in details:
+        assert not re.search(r"[A-Za-z]{3,}", KEPT.sub("", text)), f"English left in {text!r}"
