@@ -100,3 +100,17 @@ def test_a_named_command_runs_into_the_chinese_that_follows() -> None:
     """ "{command} 被控制器拒绝" read "运行程序 被控制器拒绝": Chinese puts no space after a word."""
     spaced = re.compile(r"\{(command|operation)\} [\u4e00-\u9fff]")
     assert [t for _c, _s, t in _translations() if spaced.search(t)] == []
+
+
+def test_every_list_in_the_gui_is_joined_with_a_translatable_separator() -> None:
+    """No ", ".join / "; ".join in the GUI's code: ui/joins.py says it in the operator's language."""
+    ui = Path(__file__).resolve().parents[2] / "ui"
+    english = re.compile(r'"[,;] "\.join\(')
+    found = [
+        f"{path.relative_to(ui)}:{number}"
+        for path in sorted(ui.rglob("*.py"))
+        if path.name != "joins.py"
+        for number, line in enumerate(path.read_text(encoding="utf-8").splitlines(), start=1)
+        if english.search(line)
+    ]
+    assert found == []

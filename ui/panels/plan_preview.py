@@ -36,6 +36,7 @@ from app.plan.presenter import PlanInfo
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger
 from app.safety.envelope import Envelope
+from ui.joins import join_names
 from ui.palette import COLOR_INK_SOFT
 from ui.panels.plan_projection import MAX_LABELS as MAX_LABELS
 from ui.panels.plan_projection import PLOT_MIN_HEIGHT as PLOT_MIN_HEIGHT
@@ -306,7 +307,7 @@ class PlanPreview(QWidget):
         if info.unknown:
             lines.append(
                 self.tr("Not counted (unknown length): segments {list}").format(
-                    list=", ".join(str(k) for k in info.unknown)
+                    list=join_names(str(k) for k in info.unknown)
                 )
             )
         if info.selected is not None:

@@ -42,6 +42,7 @@ from app.protocol.registers import NUM_AXES_TOTAL, NUM_EXTERNAL_AXES, NUM_ROBOT_
 from app.safety.box import Box
 from app.safety.caps import MotionCaps
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
+from ui.joins import join_names
 from ui.keypad_range import KeypadRange
 from ui.touch import RowsScrollArea, mark_motion
 
@@ -367,7 +368,7 @@ class StepPanel(QWidget):
             return
         if max(abs(v) for v in offsets) > CONFIRM_ABOVE:
             names = self._axis_names()
-            moves = ", ".join(f"{names[i]} {v:+g}" for i, v in enumerate(offsets) if v)
+            moves = join_names(f"{names[i]} {v:+g}" for i, v in enumerate(offsets) if v)
             sent = self.sent_speed(offsets)
             speed = _figure(sent) if sent < self.speed else f"{self.speed:g}"
             text = self.tr("Move by {moves} at {speed} {unit}?").format(
