@@ -3076,32 +3076,47 @@
     <context>
         <name>PlanRunController</name>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="48" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="51" />
             <source>Failed: {reason}</source>
             <translation>失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="50" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="53" />
             <source>Stopped: {reason}</source>
             <translation>已停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="54" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="57" />
             <source>Failed at segment {n}: {reason}</source>
             <translation>在第 {n} 段失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="56" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="59" />
             <source>Stopped at segment {n}: {reason}</source>
             <translation>在第 {n} 段停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="76" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="70" />
+            <source>Stopped by the operator at segment {n}</source>
+            <translation>已由操作员在第 {n} 段停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="74" />
+            <source>Stopped by the operator at segment {n}, loop {loop} (endless)</source>
+            <translation>已由操作员在第 {n} 段、第 {loop} 轮（无限循环）停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="77" />
+            <source>Stopped by the operator at segment {n}, loop {loop} of {loops}</source>
+            <translation>已由操作员在第 {n} 段、第 {loop} 轮（共 {loops} 轮）停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="97" />
             <source>Paused: another master wrote to the controller ({sign})</source>
             <translation>已暂停：另一个主站写入了控制器（{sign}）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/plan_run_reasons.py" line="83" />
+            <location filename="../../ui/controllers/plan_run_reasons.py" line="104" />
             <source>Not resumed: another master wrote to the controller less than {hold} s ago. Make sure no other master is commanding the robot; Resume is possible in {left} s.</source>
             <translation>未继续：另一个主站在不到 {hold} 秒前写入了控制器。请确认没有其他主站在控制机器人；{left} 秒后才能继续。</translation>
         </message>
@@ -3354,7 +3369,7 @@
         </message>
         <message>
             <location filename="../../ui/panels/planner_actions.py" line="93" />
-            <location filename="../../ui/panels/planner_actions.py" line="107" />
+            <location filename="../../ui/panels/planner_actions.py" line="106" />
             <source>Resume from segment</source>
             <translation>从该段继续</translation>
         </message>
@@ -3364,32 +3379,37 @@
             <translation>继续已停止的运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="105" />
+            <location filename="../../ui/panels/planner_actions.py" line="108" />
             <source>Resume from segment {k}</source>
             <translation>从第 {k} 段继续</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="141" />
+            <location filename="../../ui/panels/planner_actions.py" line="110" />
+            <source>Resume from segment {k}, loop {loop}</source>
+            <translation>从第 {k} 段、第 {loop} 轮继续</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_actions.py" line="144" />
             <source>Run is disabled: the plan's checks found errors; fix them first</source>
             <translation>无法运行：计划检查发现错误，请先修正</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="145" />
+            <location filename="../../ui/panels/planner_actions.py" line="148" />
             <source>Run is disabled: not connected to the controller</source>
             <translation>无法运行：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="146" />
+            <location filename="../../ui/panels/planner_actions.py" line="149" />
             <source>Run is disabled: a run is going</source>
             <translation>无法运行：正在运行中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="147" />
+            <location filename="../../ui/panels/planner_actions.py" line="150" />
             <source>Run is disabled: the plan has no segments</source>
             <translation>无法运行：计划没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_actions.py" line="148" />
+            <location filename="../../ui/panels/planner_actions.py" line="151" />
             <source>Run is disabled: wait for the points' upload to finish</source>
             <translation>无法运行：请等待点位上传完成</translation>
         </message>

@@ -459,8 +459,13 @@ class PlannerPanel(QWidget):
         self.show_message(text, "warn")
 
     def _update_resume_text(self) -> None:
-        k = self._runner.resume_from if self._runner.can_resume else None
-        self.planner_actions.set_resume_from(k + 1 if k is not None else None)
+        runs = self._runner
+        k = runs.resume_from if runs.can_resume else None
+        runner = runs.runner
+        many = runner is not None and runner.loops != 1  # the loop is named: "…, loop 2"
+        self.planner_actions.set_resume_from(
+            k + 1 if k is not None else None, runs.resume_loop if many else None
+        )
 
     @Slot(object)
     def _on_pose(self, pose: Pose) -> None:
