@@ -115,6 +115,9 @@ _TEMPLATES: dict[str, str] = {
     "request_done": QT_TRANSLATE_NOOP("Messages", "{operation}: sent."),
     "request_failed": QT_TRANSLATE_NOOP("Messages", "{operation}: failed."),
     "busy": QT_TRANSLATE_NOOP("Messages", "{operation} is still under way: wait for it or press Stop."),
+    "busy_upload": QT_TRANSLATE_NOOP(
+        "Messages", "{operation} is still under way: wait for it, cancel it or press Stop."
+    ),
     "link_shut_down": QT_TRANSLATE_NOOP("Messages", "The link is shut down: nothing was sent."),
     "not_connected": QT_TRANSLATE_NOOP("Messages", "Not connected to a controller: nothing was sent."),
     # the jog (app/link/jog.py)
