@@ -2870,33 +2870,38 @@
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="269" />
+            <location filename="../../ui/panels/planner_widgets.py" line="259" />
+            <source>Checks passed; the plan cannot run until the emergency stop or servo alarm is cleared</source>
+            <translation>检查通过；急停或伺服报警解除之前，计划不能运行</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="275" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="272" />
+            <location filename="../../ui/panels/planner_widgets.py" line="278" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="274" />
+            <location filename="../../ui/panels/planner_widgets.py" line="280" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="276" />
+            <location filename="../../ui/panels/planner_widgets.py" line="282" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="279" />
+            <location filename="../../ui/panels/planner_widgets.py" line="285" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -2912,7 +2917,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="313" />
+            <location filename="../../ui/panels/planner_widgets.py" line="319" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -3143,72 +3148,74 @@
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
-        <message>
-            <location filename="../../ui/panels/planner_run.py" line="103" />
-            <source>Cannot run: {summary}. First: {message}</source>
-            <translation>无法运行：{summary}。第一个问题：{message}</translation>
+        <message numerus="yes">
+            <location filename="../../ui/panels/planner_run.py" line="104" />
+            <source>Cannot run: the plan has %n error(s); the first: {message}</source>
+            <translation>
+                <numerusform>无法运行：计划有 %n 个错误，第一个：{message}</numerusform>
+            </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="112" />
+            <location filename="../../ui/panels/planner_run.py" line="113" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="114" />
+            <location filename="../../ui/panels/planner_run.py" line="115" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="116" />
+            <location filename="../../ui/panels/planner_run.py" line="117" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="117" />
+            <location filename="../../ui/panels/planner_run.py" line="118" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="129" />
+            <location filename="../../ui/panels/planner_run.py" line="130" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="131" />
+            <location filename="../../ui/panels/planner_run.py" line="132" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="133" />
+            <location filename="../../ui/panels/planner_run.py" line="134" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="135" />
+            <location filename="../../ui/panels/planner_run.py" line="136" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="136" />
+            <location filename="../../ui/panels/planner_run.py" line="137" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="139" />
+            <location filename="../../ui/panels/planner_run.py" line="140" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="143" />
+            <location filename="../../ui/panels/planner_run.py" line="144" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="198" />
+            <location filename="../../ui/panels/planner_run.py" line="199" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
@@ -3427,12 +3434,12 @@
             <translation>预览</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="330" />
+            <location filename="../../ui/panels/planner_panel.py" line="335" />
             <source>This cell cannot be edited: {why}</source>
             <translation>无法编辑此单元格：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="434" />
+            <location filename="../../ui/panels/planner_panel.py" line="440" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -5137,7 +5144,7 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="382" />
+            <location filename="../../ui/panels/planner_widgets.py" line="388" />
             <source>Segments</source>
             <translation>轨迹段</translation>
         </message>

@@ -309,6 +309,11 @@ class PlannerPanel(QWidget):
         self.status.setToolTip(text)
         self.statusMessage.emit(text)
 
+    def _clear_message(self) -> None:
+        self.status.setStyleSheet("")
+        self.status.clear()
+        self.status.setToolTip("")
+
     # --- checks, estimates, preview
     def _pose(self) -> Pose | None:
         return self._runner.last_pose
@@ -411,6 +416,7 @@ class PlannerPanel(QWidget):
         self.segments.set_locked(running)
         self.plan_view.setEnabled(not running)
         if running:
+            self._clear_message()  # the last run's "Plan finished" / how it ended is history now
             self.recheck()  # from the pose the run starts at
             self.preview.start_live()
             self.segments.set_run_marker(None, None)
@@ -477,7 +483,11 @@ class PlannerPanel(QWidget):
 
     def set_alarm_hold(self, hold: bool) -> None:
         """An emergency stop or servo alarm is set (MotionController.alarmHoldChanged)."""
+        changed = bool(hold) != self._alarm_hold
         self._alarm_hold = bool(hold)
+        if changed:
+            self.checks.held = self._alarm_hold
+            self.checks.show(self.checks.issues, self.current_plan())  # not "ready to run" under one
         self._update_actions()
 
     @Slot()
