@@ -1198,12 +1198,12 @@
             <translation>Modbus 报文</translation>
         </message>
         <message>
-            <location filename="../../ui/window_status.py" line="81" />
+            <location filename="../../ui/window_status.py" line="89" />
             <source>MONITOR ONLY</source>
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="322" />
+            <location filename="../../ui/main_window.py" line="323" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1219,17 +1219,22 @@
         </message>
         <message>
             <location filename="../../ui/window_status.py" line="53" />
-            <location filename="../../ui/window_status.py" line="86" />
+            <location filename="../../ui/window_status.py" line="103" />
             <source>RTT {ms} ms</source>
             <translation>往返 {ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/window_status.py" line="66" />
+            <location filename="../../ui/window_status.py" line="68" />
             <source>Project: {name}</source>
             <translation>工程：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="354" />
+            <location filename="../../ui/window_status.py" line="101" />
+            <source>RTT —</source>
+            <translation>往返 —</translation>
+        </message>
+        <message>
+            <location filename="../../ui/main_window.py" line="356" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
@@ -1254,29 +1259,29 @@
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="377" />
+            <location filename="../../ui/main_window.py" line="379" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="356" />
-            <location filename="../../ui/main_window.py" line="365" />
-            <location filename="../../ui/main_window.py" line="378" />
+            <location filename="../../ui/main_window.py" line="358" />
+            <location filename="../../ui/main_window.py" line="367" />
+            <location filename="../../ui/main_window.py" line="380" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="299" />
+            <location filename="../../ui/main_window.py" line="300" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="300" />
+            <location filename="../../ui/main_window.py" line="301" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="301" />
+            <location filename="../../ui/main_window.py" line="302" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1286,37 +1291,37 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="372" />
+            <location filename="../../ui/main_window.py" line="374" />
             <source>plan run</source>
             <translation>计划运行</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="452" />
+            <location filename="../../ui/main_window.py" line="454" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="454" />
+            <location filename="../../ui/main_window.py" line="456" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="467" />
+            <location filename="../../ui/main_window.py" line="469" />
             <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
             <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="469" />
+            <location filename="../../ui/main_window.py" line="471" />
             <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="487" />
+            <location filename="../../ui/main_window.py" line="489" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="487" />
+            <location filename="../../ui/main_window.py" line="489" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -5407,60 +5412,60 @@ Remove them all?</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="354" />
+            <location filename="../../ui/panels/status_panel.py" line="355" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="372" />
+            <location filename="../../ui/panels/status_panel.py" line="373" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="374" />
+            <location filename="../../ui/panels/status_panel.py" line="375" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="384" />
+            <location filename="../../ui/panels/status_panel.py" line="385" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
             <location filename="../../ui/panels/status_panel.py" line="243" />
-            <location filename="../../ui/panels/status_panel.py" line="390" />
+            <location filename="../../ui/panels/status_panel.py" line="393" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="407" />
+            <location filename="../../ui/panels/status_panel.py" line="410" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="415" />
+            <location filename="../../ui/panels/status_panel.py" line="418" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="419" />
+            <location filename="../../ui/panels/status_panel.py" line="422" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="423" />
+            <location filename="../../ui/panels/status_panel.py" line="426" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
             <location filename="../../ui/panels/status_panel.py" line="245" />
-            <location filename="../../ui/panels/status_panel.py" line="429" />
+            <location filename="../../ui/panels/status_panel.py" line="432" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>
         <message>
             <location filename="../../ui/panels/status_panel.py" line="246" />
-            <location filename="../../ui/panels/status_panel.py" line="432" />
+            <location filename="../../ui/panels/status_panel.py" line="435" />
             <source>{value} (stale)</source>
             <translation>{value}（已过期）</translation>
         </message>

@@ -31,7 +31,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.link.state import RobotState
-from app.link.types import ConnectionState
+from app.link.types import ConnectionState, LinkState
 from app.models import CommandResult, ControllerStatus
 from app.protocol.datetime_regs import ControllerClock
 from app.protocol.enums import (
@@ -322,6 +322,7 @@ class StatusPanel(QWidget):
     def on_connection(self, connection: ConnectionState) -> None:
         self._connection = connection
         self._render_connection()
+        self._render_rtt()
 
     @Slot(float)
     def on_rtt(self, ms: float) -> None:
@@ -386,8 +387,10 @@ class StatusPanel(QWidget):
         self.link_message.setVisible(bool(parts))
 
     def _render_rtt(self) -> None:
-        ms = self._rtt
-        text = "—" if ms is None or not math.isfinite(ms) else self.tr("{ms} ms").format(ms=f"{ms:.1f}")
+        ms, connection = self._rtt, self._connection
+        answering = connection is None or connection.state is LinkState.CONNECTED
+        stale = ms is None or not math.isfinite(ms) or not answering  # down or silent: no round trip
+        text = "—" if stale else self.tr("{ms} ms").format(ms=f"{ms:.1f}")
         if text != self.rtt_label.text():
             self.rtt_label.setText(text)
 
