@@ -110,6 +110,7 @@ class StatusPanel(QWidget):
         self._alarms: int | None = None
         self._status: ControllerStatus | None = None
         self._connection: ConnectionState | None = None
+        self._refusal: str | None = None  # the guard rails' last refusal, newer than the last result
         self._rtt: float | None = None
         self._result: CommandResult | None = None
         self._clock: ControllerClock | None = None
@@ -257,7 +258,9 @@ class StatusPanel(QWidget):
         self._render_rtt()
         self._render_status()
         self._render_alarms()
-        if self._result is None:
+        if self._refusal is not None:
+            self._render_refusal()
+        elif self._result is None:
             self.command_label.setText(self.tr("none yet"))
         else:
             self._render_result()
@@ -332,7 +335,23 @@ class StatusPanel(QWidget):
     @Slot(object)
     def on_command_result(self, result: CommandResult) -> None:
         self._result = result
+        self._refusal = None
         self._render_result()
+
+    @Slot(str)
+    def show_refusal(self, text: str) -> None:
+        """A command the guard rails refused before it went out, or a jog they stopped ("X =
+        560.2 mm is outside the allowed work space ..."): the operator's last command, in amber
+        (until the next command's result)."""
+        self._refusal = text
+        self._render_refusal()
+
+    def _render_refusal(self) -> None:
+        text = self._refusal or ""
+        self.command_label.setText(text)
+        self.command_label.setProperty("ok", False)
+        self.command_label.setStyleSheet(f"color: {COLOR_WARN}; font-weight: bold;")
+        self.command_label.setToolTip(text)
 
     @Slot(object)
     def on_clock(self, clock: ControllerClock, now: dt.datetime | None = None) -> None:
