@@ -29,6 +29,7 @@ from app.protocol.enums import (
     alarm_names,
     controller_mode_text,
 )
+from app.protocol.exceptions import GATEWAY_EXCEPTIONS
 from ui.messages_files import FILE_TEMPLATES, file_fields, file_text, os_problem
 from ui.messages_plan import _number, _tr, envelope_text, issue_line, issue_text
 
@@ -183,6 +184,11 @@ _TEMPLATES: dict[str, str] = {
     ),
     "modbus_exception": QT_TRANSLATE_NOOP(
         "Messages", "The controller refused the request: Modbus exception {exception} ({name})."
+    ),
+    # a gateway's 10 / 11 (app/protocol/exceptions.py GATEWAY_EXCEPTIONS): nothing at the unit id
+    "modbus_gateway": QT_TRANSLATE_NOOP(
+        "Messages",
+        "No device answered at unit id {unit} (Modbus exception {exception}, {name}): check the unit id in Connect…",
     ),
     "monitor_only": QT_TRANSLATE_NOOP("Messages", "Monitor-only mode: nothing was sent to the controller."),
     "audit_unavailable": QT_TRANSLATE_NOOP(
@@ -423,7 +429,10 @@ def reason_text(reason: Reason) -> str | None:
         return _tr(_TEMPLATES["stop_sent_on_line"]).format(cause=cause)
     if reason.code in _FRESH_STOP:
         return _fresh_stop_text(reason)
-    template = _TEMPLATES.get(reason.code)
+    code = reason.code
+    if code == "modbus_exception" and "unit" in args and args.get("exception") in GATEWAY_EXCEPTIONS:
+        code = "modbus_gateway"  # a wrong unit id, most often: said as such
+    template = _TEMPLATES.get(code)
     if template is None:
         return None
     fields = _fields(reason.code, args)
