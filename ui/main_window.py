@@ -49,6 +49,7 @@ from app import __version__
 from app.link.robot_link import RobotLink
 from app.link.transport import ConnectionSettings
 from app.link.types import WorkerError
+from app.models import LINK_FAILURE_CODES
 from app.safety.location import Scope
 from app.safety.roles import Action
 from ui.controllers.link_guard import LinkGuard
@@ -333,7 +334,8 @@ class MainWindow(QMainWindow):
     @Slot(WorkerError)
     def _on_error(self, error: WorkerError) -> None:
         operation = self.event_log.operation_text(error.operation)
-        self.status_bar.show_message(labelled(operation, error_text(error)))
+        silence = error.reason is not None and error.reason.code in LINK_FAILURE_CODES
+        self.status_bar.show_message(labelled(operation, error_text(error)), until_answering=silence)
 
     @Slot(str)
     def _show_message(self, text: str) -> None:

@@ -29,6 +29,7 @@ from app.protocol.enums import (
     alarm_names,
     controller_mode_text,
 )
+from app.protocol.exceptions import GATEWAY_EXCEPTIONS
 from ui.joins import join_names
 from ui.messages_files import FILE_TEMPLATES, file_fields, file_text, os_problem
 from ui.messages_plan import _number, _tr, envelope_text, issue_line, issue_text
@@ -117,6 +118,9 @@ _TEMPLATES: dict[str, str] = {
     "request_done": QT_TRANSLATE_NOOP("Messages", "{operation}: sent."),
     "request_failed": QT_TRANSLATE_NOOP("Messages", "{operation}: failed."),
     "busy": QT_TRANSLATE_NOOP("Messages", "{operation} is still under way: wait for it or press Stop."),
+    "busy_upload": QT_TRANSLATE_NOOP(
+        "Messages", "{operation} is still under way: wait for it, cancel it or press Stop."
+    ),
     "link_shut_down": QT_TRANSLATE_NOOP("Messages", "The link is shut down: nothing was sent."),
     "not_connected": QT_TRANSLATE_NOOP("Messages", "Not connected to a controller: nothing was sent."),
     # the jog (app/link/jog.py)
@@ -182,6 +186,11 @@ _TEMPLATES: dict[str, str] = {
     ),
     "modbus_exception": QT_TRANSLATE_NOOP(
         "Messages", "The controller refused the request: Modbus exception {exception} ({name})."
+    ),
+    # a gateway's 10 / 11 (app/protocol/exceptions.py GATEWAY_EXCEPTIONS): nothing at the unit id
+    "modbus_gateway": QT_TRANSLATE_NOOP(
+        "Messages",
+        "No device answered at unit id {unit} (Modbus exception {exception}, {name}): check the unit id in Connect…",
     ),
     "monitor_only": QT_TRANSLATE_NOOP("Messages", "Monitor-only mode: nothing was sent to the controller."),
     "audit_unavailable": QT_TRANSLATE_NOOP(
@@ -424,7 +433,10 @@ def reason_text(reason: Reason) -> str | None:
         return _fresh_stop_text(reason)
     if is_profile_code(reason.code):
         return profile_text(reason.code, args)
-    template = _TEMPLATES.get(reason.code)
+    code = reason.code
+    if code == "modbus_exception" and "unit" in args and args.get("exception") in GATEWAY_EXCEPTIONS:
+        code = "modbus_gateway"  # a wrong unit id, most often: said as such
+    template = _TEMPLATES.get(code)
     if template is None:
         return None
     fields = _fields(reason.code, args)

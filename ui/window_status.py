@@ -12,7 +12,7 @@ from PySide6.QtCore import QCoreApplication, QObject, Slot
 from PySide6.QtWidgets import QLabel, QStatusBar
 
 from app.link.state import RobotState
-from app.link.types import ConnectionState
+from app.link.types import ConnectionState, LinkState
 from ui.messages import connection_text
 from ui.widgets.live_label import LiveLabel
 from ui.widgets_common import connection_display
@@ -31,6 +31,7 @@ class WindowStatusBar(QObject):
         self.bar = bar
         self._state: RobotState | None = None
         self._project_title = ""
+        self._silence_note: str | None = None  # the message shown about the controller's silence
         self.project_label = QLabel(bar)
         self.link_label = QLabel(bar)
         self.rtt_label = LiveLabel(parent=bar, opaque=True)  # twice a second: repaints itself only
@@ -43,22 +44,23 @@ class WindowStatusBar(QObject):
     def bind(self, state: RobotState) -> None:
         self._state = state
         state.connectionChanged.connect(self._on_connection)
-        state.rttChanged.connect(self._show_rtt)
+        state.rttChanged.connect(lambda _ms: self._show_rtt())
         self._show_connection()
-        if state.rtt is not None:
-            self._show_rtt(state.rtt)
+        self._show_rtt()
 
     def retranslate(self) -> None:
         # room for the widest RTT from the start: the status bar does not shift when one arrives
         widest_rtt = QCoreApplication.translate("MainWindow", "RTT {ms} ms").format(ms="9999.9")
         self.rtt_label.fit_texts([widest_rtt + "  "])
-        if self._state is not None and self._state.rtt is not None:
-            self._show_rtt(self._state.rtt)
+        self._show_rtt()
         self.show_project(self._project_title, self.project_label.toolTip())
         self._show_connection()
 
-    def show_message(self, text: str) -> None:
+    def show_message(self, text: str, *, until_answering: bool = False) -> None:
+        """A transient message; ``until_answering``: it says the controller did not answer or
+        the link failed, and goes as soon as the controller answers again (not after 8 s)."""
         self.bar.showMessage(text, MESSAGE_MS)
+        self._silence_note = text if until_answering else None
 
     def show_project(self, title: str, path: str) -> None:
         self._project_title = title
@@ -68,8 +70,14 @@ class WindowStatusBar(QObject):
         self.project_label.setToolTip(path)
 
     @Slot(ConnectionState)
-    def _on_connection(self, _connection: ConnectionState) -> None:
+    def _on_connection(self, connection: ConnectionState) -> None:
+        note = self._silence_note
+        if connection.state is LinkState.CONNECTED and note is not None:
+            self._silence_note = None
+            if self.bar.currentMessage() == note:
+                self.bar.clearMessage()  # the controller answers again: the silence is over
         self._show_connection()
+        self._show_rtt()
 
     def _show_connection(self) -> None:
         if self._state is None:
@@ -81,6 +89,16 @@ class WindowStatusBar(QObject):
         monitor_only = QCoreApplication.translate("MainWindow", "MONITOR ONLY")
         self.monitor_only_label.setText(monitor_only if connection.monitor_only else "")
 
-    @Slot(float)
-    def _show_rtt(self, ms: float) -> None:
-        self.rtt_label.setText(QCoreApplication.translate("MainWindow", "RTT {ms} ms").format(ms=f"{ms:.1f}"))
+    @Slot()
+    def _show_rtt(self) -> None:
+        """The mean round trip of the polls, "—" while the controller is not answering or the
+        link is down (the last figure is not today's)."""
+        state = self._state
+        if state is None:
+            return
+        ms = state.rtt
+        if ms is None or state.connection.state is not LinkState.CONNECTED:
+            text = QCoreApplication.translate("MainWindow", "RTT —")
+        else:
+            text = QCoreApplication.translate("MainWindow", "RTT {ms} ms").format(ms=f"{ms:.1f}")
+        self.rtt_label.setText(text)

@@ -15,9 +15,11 @@ from app.errors import (
     InvalidInput,
     LinkError,
     MalformedResponse,
+    ModbusExceptionError,
     ResponseTimeout,
     TeachPadError,
 )
+from app.protocol.exceptions import GATEWAY_EXCEPTIONS
 from app.safety.register_profile import RegisterProfileError
 
 __all__ = ["EPILOG", "LINK_ERRORS", "ExitCode", "exit_code_for"]
@@ -34,7 +36,8 @@ class ExitCode(enum.IntEnum):
     #: bad arguments or values, an unreadable or malformed input file, a plan with errors:
     #: nothing was sent
     USAGE = 2
-    #: the link: cannot connect, no answer in time, a malformed answer
+    #: the link: cannot connect, no answer in time, a malformed answer, nothing answers at the
+    #: unit id (a gateway's Modbus exception 10 / 11: check the unit id)
     LINK = 3
     #: the controller took the command (its write was answered) but what it did is not known:
     #: its status could not be read, it did not finish within its time, it was never
@@ -55,7 +58,7 @@ _MEANING = {
         "reach, safety envelope, role)"
     ),
     ExitCode.USAGE: "usage: bad arguments, values or input files (nothing sent)",
-    ExitCode.LINK: "link: cannot connect, no answer in time, malformed answer",
+    ExitCode.LINK: "link: cannot connect, no answer in time, malformed answer, no device at the unit id",
     ExitCode.UNKNOWN: (
         "sent; the outcome is unknown (status unreadable, not finished in time, not acknowledged, "
         "another master seen before its end): check the robot before sending it again"
@@ -79,6 +82,9 @@ def exit_code_for(error: BaseException) -> ExitCode:
         return ExitCode.USAGE
     if isinstance(error, LINK_ERRORS):
         return ExitCode.LINK
+    gateway = getattr(error, "exception_code", None) in GATEWAY_EXCEPTIONS
+    if isinstance(error, ModbusExceptionError) and gateway:
+        return ExitCode.LINK  # nothing answers at this unit id: the link, not the command
     if isinstance(error, CommandTimeout):  # OutcomeUnknown too: taken, what it did is not known
         return ExitCode.UNKNOWN
     return ExitCode.FAILED  # a TeachPadError of the command, or a file that cannot be written

@@ -63,8 +63,11 @@ class WorkerCommands:
         def client_or_raise(self) -> RobotClient: ...
         def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None: ...
 
-    def _done(self, text: str) -> None:
-        self.emit_result(CommandResult(None, None, None, True, text))
+    def _done(self, text: str, operation: str) -> None:
+        """A request the controller answered (its outcome is not watched): *sent*, named by its
+        operation (the GUI says "pause: sent.", never a nameless "The command: done.")."""
+        reason = Reason("request_done", {"operation": operation})
+        self.emit_result(CommandResult(None, None, None, True, text, reason=reason))
 
     def _failed(self, text: str, request_id: int | None = -1, reason: Reason | None = None) -> None:
         self.emit_result(CommandResult(None, None, None, False, text, reason=reason), request_id)
@@ -237,18 +240,19 @@ class WorkerCommands:
                 Reason("upload_cancelled", {"operation": str(job.operation)}),
             )
         if self.uploader.run is None:
-            self._done(f"{Operation.CANCEL_UPLOAD}: no upload under way")
+            self._done(f"{Operation.CANCEL_UPLOAD}: no upload under way", Operation.CANCEL_UPLOAD)
             return
         self.uploader.end("cancelled")
-        self._done(f"{Operation.CANCEL_UPLOAD}: the upload ends after the current point")
+        ends = f"{Operation.CANCEL_UPLOAD}: the upload ends after the current point"
+        self._done(ends, Operation.CANCEL_UPLOAD)
 
     def _do_pause(self) -> None:
         self.client_or_raise().pause()
-        self._done("pause: sent")
+        self._done("pause: sent", Operation.PAUSE)
 
     def _do_resume(self) -> None:
         self.client_or_raise().resume()
-        self._done("resume: sent")
+        self._done("resume: sent", Operation.RESUME)
 
     def _do_set_mode(self, mode: WorkMode) -> None:
         mode = WorkMode(mode)
@@ -256,7 +260,7 @@ class WorkerCommands:
         if mode is WorkMode.MANUAL:
             self.jog.stop_jog_and_teach()
         client.set_work_mode(mode)
-        self._done(f"work mode: {mode.name.lower()}")
+        self._done(f"work mode: {mode.name.lower()}", Operation.SET_MODE)
 
     def _do_jog_press(self, request: JogRequest) -> None:
         self.motions.require_none(Operation.JOG)

@@ -106,10 +106,13 @@ class MotionCommands:
         host.jog.require_no_halt(operation)
         busy = host.motion.motion_under_way
         if busy is not None:
-            raise InvalidInput(f"{busy} is still under way: wait for it or press Stop")
+            text = f"{busy} is still under way: wait for it or press Stop"
+            raise InvalidInput(text, code="busy", params={"operation": busy})
         if host.uploader.run is not None:
             raise InvalidInput(
-                f"{Operation.UPLOAD_POINTS} is still under way: wait for it, cancel it or press Stop"
+                f"{Operation.UPLOAD_POINTS} is still under way: wait for it, cancel it or press Stop",
+                code="busy_upload",
+                params={"operation": Operation.UPLOAD_POINTS},
             )
 
     def _begin(self, operation: str) -> RobotClient:

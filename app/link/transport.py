@@ -47,7 +47,7 @@ from app.link.stats import LinkStats
 from app.protocol import registers
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
-from app.protocol.exceptions import exception_text
+from app.protocol.exceptions import GATEWAY_EXCEPTIONS, exception_text
 
 if TYPE_CHECKING:  # frames (pymodbus's framers) and streams (sockets) are imported when a Transport
     # is made, not before: ConnectionSettings is read by the window at start-up, long before any
@@ -408,10 +408,23 @@ class Transport:
             self._emit("rx", buf)
         function, data = self._decode_answer(framing, buf)
         if function & 0x80:
-            code = data[0]
-            text = exception_text(code, f"exception code {code}")
-            message = f"controller refused {what}: {text}"
-            self._count("exceptions", message)
-            raise ModbusExceptionError(function & 0x7F, code, message)
+            refused = self._exception(what, function & 0x7F, data[0])
+            self._count("exceptions", str(refused))
+            raise refused
         self._counts["answers"] += 1
         return function, data
+
+    def _exception(self, what: str, function: int, code: int) -> ModbusExceptionError:
+        """The answer's Modbus exception; a gateway's 10 / 11 names the unit id (most often the
+        wrong one: nothing answers at it) and says to check it."""
+        text = exception_text(code, f"exception code {code}")
+        if code not in GATEWAY_EXCEPTIONS:
+            return ModbusExceptionError(function, code, f"controller refused {what}: {text}")
+        unit, endpoint = self.settings.unit, self.settings.endpoint
+        message = (
+            f"no device answered {what} at unit id {unit} on {endpoint} "
+            f"(Modbus exception {code}, {text}): check the unit id"
+        )
+        error = ModbusExceptionError(function, code, message)
+        error.params.update(unit=unit, endpoint=endpoint)
+        return error

@@ -173,6 +173,7 @@ class RunOutcome:
     error: BaseException | None = None
     next_position: tuple[int, int] | None = None  # (index, loop) a further step would run
     interrupted: bool = False  # ended by Ctrl-C in run()
+    loops: int = 1  # the run's number of loops (0 = endless): "loop 2 of 20"
 
     @property
     def ok(self) -> bool:
@@ -279,6 +280,7 @@ class PlanRunner:
             self._error,
             self._position,
             self._interrupted,
+            self._loops,
         )
 
     # --- driving

@@ -332,12 +332,19 @@ def decode_status_registers(regs: Sequence[int], order: WordOrder = WordOrder.LO
 
     A finite integral float32 in 0..255 wins; otherwise register 582 as uint16. (An integer
     0xFF in 582 with 0 in 583 is a float denormal, never integral, so the two can't clash.)
+
+    A float32 status written in the *other* word order than ``order`` (the register profile's
+    word order does not match the controller's, e.g. just after switching the profile) is read
+    as that float too: its high word alone in 582 read as an integer was "unknown status 17279"
+    (0x437F, the high word of 255.0), a refusal the controller never said. (An integer status
+    0..255 in 582 read in the other order is a float below 1e-37, never integral either.)
     """
     if len(regs) != 2:
         raise ValueError("GV291 needs its two registers")
-    value = registers_to_float(regs, order)
-    if math.isfinite(value) and value.is_integer() and 0 <= value <= 255:
-        return int(value)
+    for words in (regs, (regs[1], regs[0])):
+        value = registers_to_float(words, order)
+        if math.isfinite(value) and value.is_integer() and 0 <= value <= 255:
+            return int(value)
     return int(regs[0]) & 0xFFFF
 
 

@@ -32,6 +32,12 @@ MODBUS_EXCEPTION_TEXT: Final[dict[int, str]] = {
 NOT_CARRIED_OUT: Final[frozenset[int]] = frozenset({0x01, 0x02, 0x03, 0x06, 0x0A})
 
 
+#: The codes a gateway answers when nothing answers at the request's unit id (path unavailable,
+#: target device failed to respond): most often a wrong unit id -- a link problem, not the
+#: controller's refusal of the command (the CLI's exit 3; the GUI says to check the unit id).
+GATEWAY_EXCEPTIONS: Final[frozenset[int]] = frozenset({0x0A, 0x0B})
+
+
 def not_carried_out(code: int) -> bool:
     """Exception ``code`` says the request was not carried out (see :data:`NOT_CARRIED_OUT`)."""
     return code in NOT_CARRIED_OUT
@@ -42,4 +48,10 @@ def exception_text(code: int, unknown: str = "unknown exception") -> str:
     return MODBUS_EXCEPTION_TEXT.get(code, unknown)
 
 
-__all__ = ["MODBUS_EXCEPTION_TEXT", "NOT_CARRIED_OUT", "exception_text", "not_carried_out"]
+__all__ = [
+    "GATEWAY_EXCEPTIONS",
+    "MODBUS_EXCEPTION_TEXT",
+    "NOT_CARRIED_OUT",
+    "exception_text",
+    "not_carried_out",
+]

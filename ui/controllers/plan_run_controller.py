@@ -123,6 +123,7 @@ class PlanRunController(QObject):
         self._held: SegmentCommand | None = None  # created while paused: the move waits for Resume
         self._outcome: RunOutcome | None = None
         self.end_reason = ""  # why the last run stopped or failed, translated (outcome_text)
+        self._by_operator = False  # the last run ended by an operator's Stop (said in its own words)
         self._progress: RunProgress | None = None
         # segment indices sent, in order (for tests and the log): the last SENT_KEPT (endless loops)
         self._sent: deque[int] = deque(maxlen=SENT_KEPT)
@@ -239,6 +240,7 @@ class PlanRunController(QObject):
         self._stops = link.stops_requested  # a Stop asked after this (any button): no further move
         self._outcome = None
         self.end_reason = ""
+        self._by_operator = False
         self._sent.clear()
         self._set_paused(False)
         self.runningChanged.emit(True)
@@ -263,6 +265,7 @@ class PlanRunController(QObject):
         self._stops = link.stops_requested
         self._outcome = None
         self.end_reason = ""
+        self._by_operator = False
         self._set_paused(False)
         self.runningChanged.emit(True)
         self._send_next(link)
@@ -336,7 +339,11 @@ class PlanRunController(QObject):
 
     def outcome_text(self, outcome: RunOutcome) -> str:
         """How a stopped or failed run ended, in the operator's language (one sentence)."""
-        return outcome_text(outcome, self.end_reason)
+        return outcome_text(outcome, self.end_reason, by_operator=self._by_operator)
+
+    def _mark_operator_stop(self) -> None:
+        self.end_reason = stopped_by_operator()
+        self._by_operator = True
 
     def stop(self) -> None:
         """Stop the robot and the run. The run ends when the link reports the stopped move
@@ -352,7 +359,7 @@ class PlanRunController(QObject):
         if runner is None or runner.state.is_over:
             return
         runner.request_stop()
-        self.end_reason = stopped_by_operator()
+        self._mark_operator_stop()
         self._set_paused(False)
         if (
             runner.state is not RunState.RUNNING
@@ -408,7 +415,7 @@ class PlanRunController(QObject):
         assert runner is not None
         if not runner.stop_requested:
             runner.request_stop()
-            self.end_reason = stopped_by_operator()
+            self._mark_operator_stop()
         self._clear_segment()
         runner.on_stopped(self.end_reason or "stopped by the operator")
         self._finish()
@@ -418,7 +425,7 @@ class PlanRunController(QObject):
         assert runner is not None
         if self._stop_asked_since_start() and not runner.stop_requested:
             runner.request_stop()  # the runner ends the run before this segment
-            self.end_reason = stopped_by_operator()
+            self._mark_operator_stop()
         command = runner.next_command()
         if command is None:
             self._finish()
@@ -562,7 +569,9 @@ class PlanRunController(QObject):
             and result.status.code == MoveStatus.BAD_END_POINT
             and current is not None
         )
-        if not result.ok:
+        if not result.ok and (result.stopped_by_operator or self._stop_asked_since_start()):
+            self._stopped_by_operator(runner)  # a Stop (any button) ended it: not a failure
+        elif not result.ok:
             # the runner keeps the reason as text: give it the operator's language
             self.end_reason = result_text(result)
             result = dataclasses.replace(result, message=self.end_reason)
@@ -592,9 +601,20 @@ class PlanRunController(QObject):
             return
         self._move = None
         self._prepared = None
-        self.end_reason = error_text(error)
-        runner.on_error(TeachPadError(self.end_reason))
+        if error.reason is not None and error.reason.code == "stopped_by_operator":
+            self._stopped_by_operator(runner)
+            runner.on_stopped(self.end_reason)
+        else:
+            self.end_reason = error_text(error)
+            runner.on_error(TeachPadError(self.end_reason))
         self._after_report()
+
+    def _stopped_by_operator(self, runner: PlanRunner) -> None:
+        """The segment under way ended by a Stop (ours, the window's STOP, the keyboard's): the
+        run ends *stopped by the operator* at it, never as a failure."""
+        if not runner.stop_requested:
+            runner.request_stop()
+        self._mark_operator_stop()
 
     def _on_stop_failed(self, stop: Pending, error: WorkerError) -> None:
         from app.plan.runner import RunState  # lazy: not before the first paint
@@ -608,6 +628,7 @@ class PlanRunController(QObject):
         ):
             self._clear_segment()
             self.end_reason = error_text(error)
+            self._by_operator = False
             runner.on_stopped(self.end_reason)
             self._finish()
 

@@ -36,12 +36,15 @@ def stopped_by_operator() -> str:
     return QCoreApplication.translate("PlanRunController", "stopped by the operator")
 
 
-def outcome_text(outcome: RunOutcome, end_reason: str = "") -> str:
+def outcome_text(outcome: RunOutcome, end_reason: str = "", *, by_operator: bool = False) -> str:
     """How a stopped or failed run ended, one sentence: ``end_reason`` (the controller's
-    translated reason) if there is one, else the runner's own message."""
+    translated reason) if there is one, else the runner's own message; a run the operator
+    stopped (``by_operator``) reads where it stood, in the language shown now."""
     from app.plan.runner import RunState  # lazy: not before the first paint
 
     failed = outcome.state is RunState.FAILED
+    if not failed and by_operator and outcome.resume_from is not None:
+        return _stopped_at(outcome)
     reason = end_reason or outcome.message
     if outcome.resume_from is None:
         text = (
@@ -56,6 +59,24 @@ def outcome_text(outcome: RunOutcome, end_reason: str = "") -> str:
         else QCoreApplication.translate("PlanRunController", "Stopped at segment {n}: {reason}")
     )
     return text.format(n=outcome.resume_from + 1, reason=reason)
+
+
+def _stopped_at(outcome: RunOutcome) -> str:
+    """The operator's Stop, where the run stood: not a failure, and the loop is named when the
+    plan has more than one ("Stopped by the operator at segment 2, loop 2 of 20")."""
+    assert outcome.resume_from is not None
+    n, loop, loops = outcome.resume_from + 1, outcome.resume_loop or 1, outcome.loops
+    if loops == 1:
+        return QCoreApplication.translate(
+            "PlanRunController", "Stopped by the operator at segment {n}"
+        ).format(n=n)
+    if loops == 0:
+        return QCoreApplication.translate(
+            "PlanRunController", "Stopped by the operator at segment {n}, loop {loop} (endless)"
+        ).format(n=n, loop=loop)
+    return QCoreApplication.translate(
+        "PlanRunController", "Stopped by the operator at segment {n}, loop {loop} of {loops}"
+    ).format(n=n, loop=loop, loops=loops)
 
 
 def connection_error(state: ConnectionState) -> TeachPadError:

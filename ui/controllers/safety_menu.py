@@ -150,8 +150,10 @@ class SafetyMenu(QObject):
 
     @Slot(str)
     def show_message(self, text: str) -> None:
-        """A refusal or a problem of the guard rails: in the event log and the status bar."""
+        """A refusal or a problem of the guard rails: where the operator looks for what became of
+        the command (the status dock's *Last command*), the event log and the status bar."""
         self.window.event_log.add_event("warning", self.source_name(), text)
+        self.window.status_panel.show_refusal(text)
         self.window.statusBar().showMessage(text, 8000)
 
     def source_name(self) -> str:

@@ -99,13 +99,16 @@ class PlannerActions(QObject):
         if self._states is not None:
             self._show_run_blocker(self._states)
 
-    def set_resume_from(self, k: int | None) -> None:
-        """``Resume from segment k`` (1-based), or the bare text when there is nothing to resume."""
-        self.all["resume_from"].setText(
-            self.tr("Resume from segment {k}").format(k=k)
-            if k is not None
-            else self.tr("Resume from segment")
-        )
+    def set_resume_from(self, k: int | None, loop: int | None = None) -> None:
+        """``Resume from segment k`` (1-based), ``…, loop i`` when the run has more than one
+        loop (``loop``; None: it has one), or the bare text when there is nothing to resume."""
+        if k is None:
+            text = self.tr("Resume from segment")
+        elif loop is None:
+            text = self.tr("Resume from segment {k}").format(k=k)
+        else:
+            text = self.tr("Resume from segment {k}, loop {loop}").format(k=k, loop=loop)
+        self.all["resume_from"].setText(text)
 
     def apply(self, states: ActionStates) -> None:
         enabled = {

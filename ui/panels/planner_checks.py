@@ -50,6 +50,7 @@ class PlannerChecks:
         self.reach: ReachCheck | None = None  # the robot model's reach
         self.issues: list[PlanIssue] = []
         self.summary_text = ""
+        self.held = False  # an emergency stop or servo alarm is set: nothing is "ready to run"
 
     def check(
         self, plan: Plan, pose: Pose | None, *, start_index: int = 0, loops: int | None = None
@@ -88,7 +89,7 @@ class PlannerChecks:
         self.issues = list(issues)
         self._segments.set_issues(self.issues)
         checks = summarize_checks(issues, issue_text, issue_line) if plan is not None else None
-        self.summary_text = self._bar.show_checks(checks, self._has_sync)
+        self.summary_text = self._bar.show_checks(checks, self._has_sync, self.held)
         return self.summary_text
 
     def show_info(self, plan: Plan | None, selected: int | None) -> None:

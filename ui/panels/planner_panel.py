@@ -309,6 +309,11 @@ class PlannerPanel(QWidget):
         self.status.setToolTip(text)
         self.statusMessage.emit(text)
 
+    def _clear_message(self) -> None:
+        self.status.setStyleSheet("")
+        self.status.clear()
+        self.status.setToolTip("")
+
     # --- checks, estimates, preview
     def _pose(self) -> Pose | None:
         return self._runner.last_pose
@@ -411,6 +416,7 @@ class PlannerPanel(QWidget):
         self.segments.set_locked(running)
         self.plan_view.setEnabled(not running)
         if running:
+            self._clear_message()  # the last run's "Plan finished" / how it ended is history now
             self.recheck()  # from the pose the run starts at
             self.preview.start_live()
             self.segments.set_run_marker(None, None)
@@ -459,8 +465,13 @@ class PlannerPanel(QWidget):
         self.show_message(text, "warn")
 
     def _update_resume_text(self) -> None:
-        k = self._runner.resume_from if self._runner.can_resume else None
-        self.planner_actions.set_resume_from(k + 1 if k is not None else None)
+        runs = self._runner
+        k = runs.resume_from if runs.can_resume else None
+        runner = runs.runner
+        many = runner is not None and runner.loops != 1  # the loop is named: "…, loop 2"
+        self.planner_actions.set_resume_from(
+            k + 1 if k is not None else None, runs.resume_loop if many else None
+        )
 
     @Slot(object)
     def _on_pose(self, pose: Pose) -> None:
@@ -472,7 +483,11 @@ class PlannerPanel(QWidget):
 
     def set_alarm_hold(self, hold: bool) -> None:
         """An emergency stop or servo alarm is set (MotionController.alarmHoldChanged)."""
+        changed = bool(hold) != self._alarm_hold
         self._alarm_hold = bool(hold)
+        if changed:
+            self.checks.held = self._alarm_hold
+            self.checks.show(self.checks.issues, self.current_plan())  # not "ready to run" under one
         self._update_actions()
 
     @Slot()

@@ -14,7 +14,7 @@ from typing import Protocol
 from PySide6.QtCore import QObject
 
 from app.errors import InvalidInput, TeachPadError
-from app.plan.checks import PlanIssue, ids_needing_upload
+from app.plan.checks import IssueKind, PlanIssue, ids_needing_upload
 from app.plan.presenter import RunBlock, RunKind, run_gate, run_kind
 from app.plan.runner import RunOutcome, RunState
 from app.plan.segments import Plan
@@ -95,14 +95,15 @@ class PlanRunFlow(QObject):
         issues = view.checks.check(
             plan, self._runner.last_pose, start_index=start, loops=1 if single else plan.loops
         )
-        summary = view.show_issues(issues, plan)
+        view.show_issues(issues, plan)
         gate = run_gate(issues, issue_text)
         if gate.block is RunBlock.ERRORS and (first := gate.first_error) is not None:
             if first.segment is not None:
                 view.select_segments([first.segment])
-            view.show_message(
-                self.tr("Cannot run: {summary}. First: {message}").format(
-                    summary=summary.split("\n")[0], message=issue_text(first)
+            errors = sum(1 for issue in issues if issue.kind is IssueKind.ERROR)
+            view.show_message(  # one sentence: how many errors and the first one
+                self.tr("Cannot run: the plan has %n error(s); the first: {message}", "", errors).format(
+                    message=issue_text(first)
                 ),
                 "error",
             )

@@ -250,10 +250,16 @@ class PlanChecksBar(QWidget):
         self.upload_button.setText(self.tr("Upload now"))
         self.check_button.setText(self.tr("Check"))
 
-    def show_checks(self, checks: CheckSummary | None, can_upload: bool) -> str:
-        """Show the summary (None: no plan); returns the text shown."""
+    def show_checks(self, checks: CheckSummary | None, can_upload: bool, held: bool = False) -> str:
+        """Show the summary (None: no plan); returns the text shown. ``held``: an emergency stop
+        or servo alarm is set, so a plan that passed is not "ready to run" (said, in amber)."""
         if checks is None:
             text, colour = "", ""
+        elif checks.passed and held:
+            text = self.tr(
+                "Checks passed; the plan cannot run until the emergency stop or servo alarm is cleared"
+            )
+            colour = SUMMARY_COLOURS[Level.WARN]
         else:
             text = self._words(checks, can_upload)
             colour = SUMMARY_COLOURS[checks.level]

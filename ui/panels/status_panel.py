@@ -31,7 +31,7 @@ from PySide6.QtWidgets import (
 )
 
 from app.link.state import RobotState
-from app.link.types import ConnectionState
+from app.link.types import ConnectionState, LinkState
 from app.models import CommandResult, ControllerStatus
 from app.protocol.datetime_regs import ControllerClock
 from app.protocol.enums import (
@@ -111,6 +111,7 @@ class StatusPanel(QWidget):
         self._alarms: int | None = None
         self._status: ControllerStatus | None = None
         self._connection: ConnectionState | None = None
+        self._refusal: str | None = None  # the guard rails' last refusal, newer than the last result
         self._rtt: float | None = None
         self._result: CommandResult | None = None
         self._clock: ControllerClock | None = None
@@ -274,7 +275,9 @@ class StatusPanel(QWidget):
         self._render_rtt()
         self._render_status()
         self._render_alarms()
-        if self._result is None:
+        if self._refusal is not None:
+            self._render_refusal()
+        elif self._result is None:
             self.command_label.setText(self.tr("none yet"))
         else:
             self._render_result()
@@ -339,6 +342,7 @@ class StatusPanel(QWidget):
     def on_connection(self, connection: ConnectionState) -> None:
         self._connection = connection
         self._render_connection()
+        self._render_rtt()
 
     @Slot(float)
     def on_rtt(self, ms: float) -> None:
@@ -348,7 +352,23 @@ class StatusPanel(QWidget):
     @Slot(object)
     def on_command_result(self, result: CommandResult) -> None:
         self._result = result
+        self._refusal = None
         self._render_result()
+
+    @Slot(str)
+    def show_refusal(self, text: str) -> None:
+        """A command the guard rails refused before it went out, or a jog they stopped ("X =
+        560.2 mm is outside the allowed work space ..."): the operator's last command, in amber
+        (until the next command's result)."""
+        self._refusal = text
+        self._render_refusal()
+
+    def _render_refusal(self) -> None:
+        text = self._refusal or ""
+        self.command_label.setText(text)
+        self.command_label.setProperty("ok", False)
+        self.command_label.setStyleSheet(f"color: {COLOR_WARN}; font-weight: bold;")
+        self.command_label.setToolTip(text)
 
     @Slot(object)
     def on_clock(self, clock: ControllerClock, now: dt.datetime | None = None) -> None:
@@ -405,8 +425,10 @@ class StatusPanel(QWidget):
         self.link_message.setVisible(bool(parts))
 
     def _render_rtt(self) -> None:
-        ms = self._rtt
-        text = "—" if ms is None or not math.isfinite(ms) else self.tr("{ms} ms").format(ms=f"{ms:.1f}")
+        ms, connection = self._rtt, self._connection
+        answering = connection is None or connection.state is LinkState.CONNECTED
+        stale = ms is None or not math.isfinite(ms) or not answering  # down or silent: no round trip
+        text = "—" if stale else self.tr("{ms} ms").format(ms=f"{ms:.1f}")
         if text != self.rtt_label.text():
             self.rtt_label.setText(text)
 
