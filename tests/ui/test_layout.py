@@ -23,7 +23,7 @@ from typing import Any
 import pytest
 from PySide6.QtCore import QCoreApplication, QSize, Qt
 from PySide6.QtGui import QFontDatabase
-from PySide6.QtWidgets import QApplication, QMessageBox, QWidget
+from PySide6.QtWidgets import QApplication, QLabel, QMessageBox, QWidget
 
 from app.protocol.enums import Alarm, TeachFrame
 from tests.ui.layout_audit import clipped_texts, overlapping_siblings, small_motion_buttons
@@ -254,17 +254,16 @@ def test_main_window_layout_with_an_alarm(
     found = check_window(window, language, touch=False)
     assert window.alarm_banner.isVisible()
     assert not found, "\n".join(found)
-    # more alarms do not make the banner taller (the window below it does not move)
+    # more alarms add their lines to the banner (laid over the bottom docks): nothing is squeezed
     banner = window.alarm_banner
-    height = banner.height()
     for bit in (Alarm.SERVO, Alarm.ENCODER):
         sim.set_alarm(bit, True)
     qtbot.waitUntil(
         lambda: banner.alarms == int(Alarm.ESTOP | Alarm.SERVO | Alarm.ENCODER), timeout=SIGNAL_TIMEOUT_MS
     )
     settle()
-    assert banner.height() == height and not squeezed(window)
-    assert banner.label.toolTip().count("\n") == 3  # the whole text, one line per alarm
+    assert not squeezed(window) and not clipped_texts(banner)
+    assert banner.label.text().count("\n") == 3  # the whole text, one line per alarm
 
 
 @pytest.mark.parametrize("language", LANGUAGES)
@@ -368,3 +367,73 @@ def test_dialogs_layout(qtbot: Any, app_settings: Any, translator: Any, language
         settle()
         assert problems(dialog, language, touch=False) == [], type(dialog).__name__
         dialog.close()
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_the_alarm_banner_moves_nothing(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str, size: tuple[int, int]
+) -> None:
+    """Issue 21: the banner appeared above everything and pushed the window 24 px down, STOP with it,
+    at the worst moment. It is laid over the window now: STOP, the pose strip and the work tabs
+    keep their place on the screen while alarms come and go."""
+    window = make_window(language, size)
+    stop = window.control_bar.stop_button
+    watched = (stop, window.pose_strip, window.tabs, window.work_tabs)
+
+    def places() -> list[tuple[int, int, int, int]]:
+        return [(w.mapToGlobal(w.rect().topLeft()).toTuple() + w.size().toTuple()) for w in watched]
+
+    before = places()
+    raise_estop(qtbot, window, sim)
+    assert places() == before
+    sim.set_alarm(Alarm.ENCODER, True)
+    qtbot.waitUntil(
+        lambda: window.alarm_banner.alarms == int(Alarm.ESTOP | Alarm.ENCODER), timeout=SIGNAL_TIMEOUT_MS
+    )
+    settle()
+    assert places() == before
+    for bit in (Alarm.ESTOP, Alarm.ENCODER):
+        sim.set_alarm(bit, False)
+    qtbot.waitUntil(lambda: not window.alarm_banner.isVisible(), timeout=SIGNAL_TIMEOUT_MS)
+    settle()
+    assert places() == before
+
+
+def shown_whole(label: QLabel, sentence: str) -> bool:
+    """``sentence`` is in what ``label`` paints (not elided), every line of it inside the label,
+    and no sibling covers the label."""
+    text = label.text().replace("\n", " ")
+    if sentence not in " ".join(text.split()):
+        return False
+    needs = label.heightForWidth(label.width()) if label.wordWrap() else label.sizeHint().height()
+    return label.height() >= needs and label.visibleRegion().boundingRect() == label.rect()
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_the_emergency_stop_instruction_reads_whole_at_1280x800(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str
+) -> None:
+    """Issue 21: "Make the cell safe, release the emergency stop, …" was elided in the banner and the
+    Alarms dock. The banner shows the whole sentence; more alarms add their lines (it lies over the
+    bottom docks, the window below does not move)."""
+    from app.alarm_history import ALARM_ADVICE, TR_ALARMS
+
+    window = make_window(language, LAPTOP)
+    raise_estop(qtbot, window, sim)
+    advice = QCoreApplication.translate(TR_ALARMS, ALARM_ADVICE[Alarm.ESTOP])
+    assert advice != ALARM_ADVICE[Alarm.ESTOP] or language == "en"
+    label = window.alarm_banner.label
+    assert shown_whole(label, advice), label.text()
+    assert window.rect().contains(window.alarm_banner.geometry())
+    for bit in (Alarm.SERVO, Alarm.ENCODER):
+        sim.set_alarm(bit, True)
+    qtbot.waitUntil(
+        lambda: window.alarm_banner.alarms == int(Alarm.ESTOP | Alarm.SERVO | Alarm.ENCODER),
+        timeout=SIGNAL_TIMEOUT_MS,
+    )
+    settle()
+    for bit in (Alarm.ESTOP, Alarm.SERVO, Alarm.ENCODER):
+        sentence = QCoreApplication.translate(TR_ALARMS, ALARM_ADVICE[bit])
+        assert shown_whole(label, sentence), label.text()
+    assert window.rect().contains(window.alarm_banner.geometry())
