@@ -17,11 +17,11 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QCoreApplication, QSize, Qt
+from PySide6.QtCore import QCoreApplication, QPoint, QSize, Qt
 from PySide6.QtGui import QFontDatabase
 from PySide6.QtWidgets import QApplication, QLabel, QMessageBox, QWidget
 
@@ -45,7 +45,7 @@ from ui.main_window import (
     TAB_POINTS,
     MainWindow,
 )
-from ui.touch import SCROLL_MIN_ROWS_HEIGHT, motion_height
+from ui.touch import MOTION_MIN_HEIGHT, TOUCH_MOTION_HEIGHT, motion_height
 from ui.window_docks import DOCK_MIN_ROWS, STATUS_DOCK_WIDTH
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
@@ -272,19 +272,83 @@ def test_touch_mode_layout_at_1280x800(make_window: Callable[..., MainWindow], l
     assert window.menus.touch_action.isChecked()
     found = without_known(check_window(window, language, touch=True), f"{language}-1280x800-connected")
     assert not found, "\n".join(found)
-    # Decided: in touch mode the joint jog scrolls at 1280×800. Six rows of 56 px buttons (J1..J6
-    # beside J7..J11) need ~350 px under the control bar, frame and speed rows; the only ways to
-    # win that height would shrink the touch targets or drop the bottom docks. The scroll area
-    # keeps every button full size and reachable, and shows at least three rows at once.
-    window.jog_panel.set_frame(TeachFrame.JOINT)
-    window.tabs.setCurrentWidget(window.jog_panel)
+    # Issue 21 (was: the rows scrolled): touch mode lays the rows in three lines of two, X Y Z
+    # beside A B C, J1 J2 J3 beside J4 J5 J6, and J7..J11 the same way behind the "J7–J11" switch
+    jog = window.jog_panel
+    window.tabs.setCurrentWidget(jog)
+    for frame, external, axes in (
+        (TeachFrame.BASE, False, range(6)),
+        (TeachFrame.JOINT, False, range(6)),
+        (TeachFrame.JOINT, True, range(6, 11)),
+    ):
+        jog.set_frame(frame)
+        jog.external_check.setChecked(external)
+        settle()
+        assert not jog.axes_scroll.verticalScrollBar().isVisible(), (frame, external)
+        assert jog.external_check.isVisible() == (frame is TeachFrame.JOINT)
+        assert_rows_whole(jog, axes, TOUCH_MOTION_HEIGHT)
+        hidden = set(range(11)) - set(axes)
+        assert not any(jog.button(a, d).isVisible() for a in hidden for d in (0, 1))
+    jog.external_check.setChecked(False)
+    # the step increments at touch size
+    window.tabs.setCurrentWidget(window.step_panel)
     settle()
-    scroll = window.jog_panel.axes_scroll
-    assert scroll.verticalScrollBar().isVisible(), "touch joint jog fits now: drop the scroll decision"
-    assert scroll.viewport().height() >= SCROLL_MIN_ROWS_HEIGHT
-    rows = scroll.widget()
-    assert rows is not None
-    assert scroll.verticalScrollBar().maximum() + scroll.viewport().height() >= rows.height()
+    assert all(b.height() >= TOUCH_MOTION_HEIGHT for b in window.step_panel.preset_buttons)
+    window.set_touch_mode(False)
+    settle()
+    assert all(b.height() < TOUCH_MOTION_HEIGHT for b in window.step_panel.preset_buttons)
+    window.tabs.setCurrentWidget(jog)
+    jog.set_frame(TeachFrame.JOINT)
+    settle()
+    assert not jog.external_check.isVisible()
+    assert_rows_whole(jog, range(11), MOTION_MIN_HEIGHT)  # compact: J1..J6 beside J7..J11
+
+
+def assert_rows_whole(jog: Any, axes: Iterable[int], height: int) -> None:
+    """Each of ``axes`` shows both its buttons whole (nothing scrolled or cut away), ``height`` px high."""
+    for axis in axes:
+        for direction in (0, 1):
+            button = jog.button(axis, direction)
+            assert button.isVisible() and button.height() >= height, (axis, direction)
+            assert button.visibleRegion().boundingRect() == button.rect(), (axis, direction)
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_step_offsets_show_whole_at_1280x800(make_window: Callable[..., MainWindow], language: str) -> None:
+    """Issue 21: in the base frame the exact offsets' arrows were cut off at the right ("X (mm)"
+    took their room; the unit is in the field)."""
+    from app.link.types import StepFrame
+
+    window = make_window(language, LAPTOP)
+    step = window.step_panel
+    window.tabs.setCurrentWidget(step)
+    for touch in (False, True):
+        window.set_touch_mode(touch)
+        for frame in (StepFrame.JOINT, StepFrame.BASE):
+            step.set_frame(frame)
+            settle()
+            viewport = step.axes_scroll.viewport()
+            for axis in range(6):
+                spin = step.value_spins[axis]
+                right = spin.mapTo(viewport, QPoint(spin.width(), 0)).x()
+                assert right <= viewport.width(), (touch, frame, axis, right, viewport.width())
+
+
+def test_a_jog_permitted_alarm_clips_no_jog_row_at_1280x800(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow]
+) -> None:
+    """Issue 21: zh_CN with an alarm that lets the arm jog (the encoder alarm) cut the last jog rows."""
+    window = make_window("zh_CN", LAPTOP)
+    sim.set_alarm(Alarm.ENCODER, True)
+    qtbot.waitUntil(window.alarm_banner.isVisible, timeout=SIGNAL_TIMEOUT_MS)
+    jog = window.jog_panel
+    qtbot.waitUntil(jog.axes_box.isEnabled, timeout=SIGNAL_TIMEOUT_MS)
+    window.tabs.setCurrentWidget(jog)
+    for frame, axes in ((TeachFrame.BASE, range(6)), (TeachFrame.JOINT, range(11))):
+        jog.set_frame(frame)
+        settle()
+        assert not jog.axes_scroll.verticalScrollBar().isVisible(), frame
+        assert_rows_whole(jog, axes, MOTION_MIN_HEIGHT)
 
 
 @pytest.mark.parametrize("language", LANGUAGES)
@@ -437,3 +501,39 @@ def test_the_emergency_stop_instruction_reads_whole_at_1280x800(
         sentence = QCoreApplication.translate(TR_ALARMS, ALARM_ADVICE[bit])
         assert shown_whole(label, sentence), label.text()
     assert window.rect().contains(window.alarm_banner.geometry())
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_the_login_dialog_keeps_its_fields_when_it_says_wrong_password(
+    qtbot: Any, translator: Any, language: str
+) -> None:
+    """Issue 21: "Wrong password" squeezed the dialog's fields (it did not grow for the line)."""
+    from app.safety.roles import Role
+    from ui.controllers.safety import SafetyController
+    from ui.dialogs.role_dialog import RoleDialog
+
+    assert translator.set_language(language)
+    safety = SafetyController(None, scrypt_n=2**4)
+    safety.set_idle_polling(False)
+    safety.session.set_password(Role.ADMINISTRATOR, "root-pw")  # the first one: anyone
+    dialog = RoleDialog(safety)
+    qtbot.addWidget(dialog)
+    dialog.role_box.setCurrentIndex(dialog.role_box.findData(Role.ADMINISTRATOR))
+    assert not dialog.error.text()  # no hint: the administrator has a password
+    dialog.show()
+    qtbot.waitExposed(dialog)
+    settle()
+    assert not problems(dialog, language, touch=False)
+    fields = (dialog.role_box, dialog.password)
+    heights = [f.height() for f in fields]
+    dialog.password.setText("wrong")
+    dialog.log_in()
+    settle()
+    assert dialog.error.text() and dialog.error.isVisible()
+    assert [f.height() for f in fields] == heights
+    assert all(f.height() >= f.sizeHint().height() for f in fields)
+    found = problems(dialog, language, touch=False)
+    error = dialog.error
+    assert error.height() >= error.heightForWidth(error.width()), "the refusal is cut"
+    assert not found, "\n".join(found)
+    safety.close()
