@@ -451,6 +451,9 @@ def test_the_alarm_banner_moves_nothing(
     before = places()
     raise_estop(qtbot, window, sim)
     assert places() == before
+    window.alarm_dock.raise_()  # the Alarms dock in view under the banner: nothing moves either
+    settle()
+    assert places() == before
     sim.set_alarm(Alarm.ENCODER, True)
     qtbot.waitUntil(
         lambda: window.alarm_banner.alarms == int(Alarm.ESTOP | Alarm.ENCODER), timeout=SIGNAL_TIMEOUT_MS
@@ -537,3 +540,32 @@ def test_the_login_dialog_keeps_its_fields_when_it_says_wrong_password(
     assert error.height() >= error.heightForWidth(error.width()), "the refusal is cut"
     assert not found, "\n".join(found)
     safety.close()
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_the_alarms_dock_reads_what_to_do_whole_at_1280x800(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str
+) -> None:
+    """Issue 21: the Alarms dock elided "Make the cell safe, release the emergency stop button, …":
+    its rows wrap and are as tall as their text."""
+    from PySide6.QtCore import QRect
+
+    from ui.panels.alarm_list import COL_ADVICE, COL_MEANING
+
+    window = make_window(language, LAPTOP)
+    raise_estop(qtbot, window, sim)
+    window.alarm_dock.raise_()
+    settle()
+    alarms = window.alarm_list
+    # the banner stays above the dock raised under it (it says the same, whole)
+    label = window.alarm_banner.label
+    assert window.alarm_banner.isVisible() and shown_whole(label, label.text().split("\n")[-1])
+    table = alarms.table
+    metrics = table.fontMetrics()
+    for bit in (int(b) for b in Alarm):
+        for column in (COL_MEANING, COL_ADVICE):
+            text = alarms.cell(bit, column)
+            cell = table.visualRect(table.model().index(alarms.row_of(bit), column))
+            room = cell.adjusted(3, 0, -3, 0)  # the item's text margins
+            needs = metrics.boundingRect(QRect(0, 0, room.width(), 10_000), Qt.TextFlag.TextWordWrap, text)
+            assert needs.height() <= cell.height() and needs.width() <= room.width(), (bit, column, text)

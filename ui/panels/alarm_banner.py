@@ -36,7 +36,13 @@ __all__ = ["AlarmBanner", "alarm_name"]
 BANNER_FONT_SCALE = 1.15  # a little larger than the window's text: it must not be missed
 BANNER_PADDING_PX = 2  # px above and below the line (the toolbar adds no chrome of its own)
 # the window's layout changed: the banner follows the bottom docks
-_RELAYOUT_EVENTS = (QEvent.Type.Resize, QEvent.Type.Move, QEvent.Type.LayoutRequest, QEvent.Type.Show)
+_RELAYOUT_EVENTS = (
+    QEvent.Type.Resize,
+    QEvent.Type.Move,
+    QEvent.Type.LayoutRequest,
+    QEvent.Type.Show,
+    QEvent.Type.ZOrderChange,  # a dock raised (a tab of the bottom docks chosen) covered the banner
+)
 
 
 def _anchor(window: QMainWindow) -> tuple[QRect, bool]:
@@ -100,7 +106,7 @@ class AlarmBanner(QFrame):
         self._state: RobotState | None = None
         self._alarms = 0
         self._plain = ""
-        self._watched: QWidget | None = None
+        self._watched: list[QWidget] = []  # the parts whose moves and raises the banner follows
         self.setVisible(False)
         if parent is not None:
             parent.installEventFilter(self)
@@ -109,8 +115,12 @@ class AlarmBanner(QFrame):
         """Follow the window's layout (a resize, a dock moved or shown): the banner keeps its place
         over the top of the bottom docks."""
         if event.type() in _RELAYOUT_EVENTS and self.isVisible():
-            QTimer.singleShot(0, self.place)
+            self._later()
         return False
+
+    @Slot()
+    def _later(self) -> None:
+        QTimer.singleShot(0, self.place)
 
     def place(self) -> None:
         """Lay the banner over the top of the bottom docks (without one, over the bottom of the
@@ -119,9 +129,13 @@ class AlarmBanner(QFrame):
         if not isinstance(window, QMainWindow) or self.isHidden():
             return
         central = window.centralWidget()
-        if central is not None and central is not self._watched:  # it moves when a dock does
-            central.installEventFilter(self)
-            self._watched = central
+        docks = window.findChildren(QDockWidget, options=Qt.FindChildOption.FindDirectChildrenOnly)
+        for part in (central, *docks):  # the central area moves when a dock does; a dock raised
+            if part is not None and part not in self._watched:
+                part.installEventFilter(self)
+                self._watched.append(part)
+                if isinstance(part, QDockWidget):  # a tab of the bottom docks chosen
+                    part.visibilityChanged.connect(self._later)
         area, over_docks = _anchor(window)
         need = self._height_for(area.width())
         top = area.top() if over_docks else area.bottom() + 1 - need
