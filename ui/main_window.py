@@ -480,6 +480,7 @@ class MainWindow(QMainWindow):
         """Bigger motion buttons and a keypad for number fields (remembered)."""
         self.settings.touch_mode = on
         apply_touch_mode((self.control_column, self.work_tabs), on)
+        self.jog_panel.set_touch(on)  # its rows in three lines of two (issue 21)
         self.menus.touch_action.setChecked(on)
 
     def set_language(self, code: str) -> None:

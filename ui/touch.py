@@ -34,6 +34,13 @@ def mark_motion(*buttons: QAbstractButton) -> None:
         button.setMinimumHeight(max(button.minimumHeight(), MOTION_MIN_HEIGHT))
 
 
+def mark_touch_target(*buttons: QAbstractButton) -> None:
+    """Mark buttons a finger picks often that move nothing (the step increments 0.1/1/10): touch
+    mode gives them the motion buttons' height."""
+    for button in buttons:
+        button.setProperty("touch_target", True)
+
+
 def motion_height(touch: bool) -> int:
     return TOUCH_MOTION_HEIGHT if touch else MOTION_MIN_HEIGHT
 
@@ -83,6 +90,8 @@ def apply_touch_mode(roots: Iterable[QWidget], touch: bool) -> None:
         for button in root.findChildren(QAbstractButton):
             if button.property("motion"):
                 button.setMinimumHeight(height)
+            elif button.property("touch_target"):
+                button.setMinimumHeight(TOUCH_MOTION_HEIGHT if touch else 0)
         for field in root.findChildren(QSpinBox) + root.findChildren(QDoubleSpinBox):
             if touch or _has_keypad(field):  # else nothing to do (touch mode off, no keypad yet)
                 from ui.keypad import install_keypad  # the keypad: imported by the first one wanted

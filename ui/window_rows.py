@@ -1,6 +1,7 @@
-"""The main window's window-wide rows above everything (its main toolbar sits in the menu bar's
-corner): the alarm banner (only while an alarm is set), then the pose strip (always). Neither can
-be moved or hidden by hand; the window binds both to the link's state like its other parts."""
+"""The main window's window-wide parts (its main toolbar sits in the menu bar's corner): the pose
+strip, a row above everything (always), and the alarm banner, laid over the window while an alarm
+is set (it moves nothing: ui/panels/alarm_banner.py). Neither can be moved or hidden by hand; the
+window binds both to the link's state like its other parts."""
 
 from __future__ import annotations
 
@@ -19,15 +20,14 @@ POSE_BAR_STYLE = "QToolBar { padding: 0px; spacing: 0px; border: none; }"  # eve
 
 @dataclass(frozen=True)
 class WindowRows:
-    alarm_banner: AlarmBanner  # a tool bar of its own
+    alarm_banner: AlarmBanner  # laid over the window, a child of it
     pose_strip: PoseStrip
     pose_bar: QToolBar  # holds the pose strip
 
 
 def add_window_rows(window: QMainWindow) -> WindowRows:
-    """Add the two rows to ``window``'s top tool bar area, the banner first, each on its own line."""
+    """Add the pose strip to ``window``'s top tool bar area and the alarm banner over the window."""
     banner = AlarmBanner(window)
-    window.addToolBar(Qt.ToolBarArea.TopToolBarArea, banner)
     strip = PoseStrip(window)
     bar = QToolBar(window)
     bar.setObjectName("PoseStripBar")
@@ -36,6 +36,5 @@ def add_window_rows(window: QMainWindow) -> WindowRows:
     bar.toggleViewAction().setVisible(False)
     bar.setStyleSheet(POSE_BAR_STYLE)
     bar.addWidget(strip)
-    window.addToolBarBreak(Qt.ToolBarArea.TopToolBarArea)
     window.addToolBar(Qt.ToolBarArea.TopToolBarArea, bar)
     return WindowRows(banner, strip, bar)

@@ -4,27 +4,27 @@
     <context>
         <name>AlarmBanner</name>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="45" />
+            <location filename="../../ui/panels/alarm_banner.py" line="73" />
             <source>alarm bit {bit}</source>
             <translation>报警位 {bit}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="167" />
+            <location filename="../../ui/panels/alarm_banner.py" line="198" />
             <source>ALARM: {names}</source>
             <translation>报警：{names}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="169" />
+            <location filename="../../ui/panels/alarm_banner.py" line="200" />
             <source>(last known: the link is not live)</source>
             <translation>（最后已知：通信未实时）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="172" />
+            <location filename="../../ui/panels/alarm_banner.py" line="203" />
             <source>Motion controls are held until the alarm is reset. STOP stays available.</source>
             <translation>报警复位前运动控制已锁定。停止按钮始终可用。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_banner.py" line="178" />
+            <location filename="../../ui/panels/alarm_banner.py" line="210" />
             <source>Register 562 = {word}</source>
             <translation>寄存器 562 = {word}</translation>
         </message>
@@ -32,38 +32,38 @@
     <context>
         <name>AlarmListPanel</name>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="90" />
+            <location filename="../../ui/panels/alarm_list.py" line="93" />
             <source>Alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="91" />
+            <location filename="../../ui/panels/alarm_list.py" line="94" />
             <source>Meaning</source>
             <translation>含义</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="92" />
+            <location filename="../../ui/panels/alarm_list.py" line="95" />
             <source>What to do</source>
             <translation>处理方法</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="93" />
+            <location filename="../../ui/panels/alarm_list.py" line="96" />
             <source>Raised</source>
             <translation>触发时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="94" />
+            <location filename="../../ui/panels/alarm_list.py" line="97" />
             <source>Cleared</source>
             <translation>清除时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="114" />
-            <location filename="../../ui/panels/alarm_list.py" line="122" />
+            <location filename="../../ui/panels/alarm_list.py" line="117" />
+            <location filename="../../ui/panels/alarm_list.py" line="125" />
             <source>active</source>
             <translation>未清除</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/alarm_list.py" line="120" />
+            <location filename="../../ui/panels/alarm_list.py" line="123" />
             <source>raised {raised}, cleared {cleared}</source>
             <translation>触发 {raised}，清除 {cleared}</translation>
         </message>
@@ -1185,87 +1185,97 @@
             <translation>外部轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="355" />
+            <location filename="../../ui/panels/jog_panel.py" line="357" />
             <source>HOLD TO MOVE — release to stop</source>
             <translation>按住运动 — 松开即停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="275" />
+            <location filename="../../ui/panels/jog_panel.py" line="277" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="280" />
+            <location filename="../../ui/panels/jog_panel.py" line="274" />
+            <source>J7–J11</source>
+            <translation>J7–J11</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/jog_panel.py" line="275" />
+            <source>Touch mode: the rows show the external axes J7–J11</source>
+            <translation>触屏模式：各行显示外部轴 J7–J11</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/jog_panel.py" line="282" />
             <source>Keyboard: click this panel, then hold {plus} (+) or {minus} (−) for axes 1–6; releasing the key stops.</source>
             <translation>键盘：先单击本面板，再按住 {plus}（+）或 {minus}（−）点动第 1–6 轴；松开按键即停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="283" />
+            <location filename="../../ui/panels/jog_panel.py" line="285" />
             <source>Keys: hold {plus} (+) or {minus} (−)</source>
             <translation>按键：按住 {plus} (+) 或 {minus} (−)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="360" />
+            <location filename="../../ui/panels/jog_panel.py" line="362" />
             <source>Releasing — the controller has not confirmed</source>
             <translation>正在松开 — 控制器尚未确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="362" />
+            <location filename="../../ui/panels/jog_panel.py" line="364" />
             <source>Stopping — the controller has not confirmed</source>
             <translation>正在停止 — 控制器尚未确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="364" />
+            <location filename="../../ui/panels/jog_panel.py" line="366" />
             <source>The controller refused or did not answer the write that stops the arm. TeachPad sends it again at every poll until the controller answers and the arm is seen still.</source>
             <translation>控制器拒绝或未应答使机械臂停止的写入。TeachPad 每次轮询都会重新发送，直到控制器应答且确认机械臂已静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="368" />
+            <location filename="../../ui/panels/jog_panel.py" line="370" />
             <source>Stop was sent too.</source>
             <translation>也已发送停止命令。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="468" />
+            <location filename="../../ui/panels/jog_panel.py" line="510" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="468" />
+            <location filename="../../ui/panels/jog_panel.py" line="510" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="470" />
+            <location filename="../../ui/panels/jog_panel.py" line="512" />
             <source>Hold: {axis} − ({unit})</source>
             <translation>按住：{axis} −（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="473" />
+            <location filename="../../ui/panels/jog_panel.py" line="515" />
             <source>Hold: {axis} + ({unit})</source>
             <translation>按住：{axis} +（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="486" />
+            <location filename="../../ui/panels/jog_panel.py" line="529" />
             <source>{ratio} %</source>
             <translation>{ratio} %</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="491" />
+            <location filename="../../ui/panels/jog_panel.py" line="534" />
             <source>{ratio} % → {cap} % (reduced speed)</source>
             <translation>{ratio} % → {cap} %（降速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="493" />
+            <location filename="../../ui/panels/jog_panel.py" line="536" />
             <source>{ratio} % → {cap} %</source>
             <translation>{ratio} % → {cap} %</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="498" />
+            <location filename="../../ui/panels/jog_panel.py" line="541" />
             <source>Capped at {cap} % (reduced speed): the jog goes out at {cap} %, not {ratio} %</source>
             <translation>限制为 {cap} %（降速模式）：点动以 {cap} % 而不是 {ratio} % 发出</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="501" />
+            <location filename="../../ui/panels/jog_panel.py" line="544" />
             <source>Capped at {cap} % (the safety envelope's maximum): the jog goes out at {cap} %, not {ratio} %</source>
             <translation>限制为 {cap} %（安全范围的最大值）：点动以 {cap} % 而不是 {ratio} % 发出</translation>
         </message>
@@ -1540,12 +1550,12 @@
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="490" />
+            <location filename="../../ui/main_window.py" line="491" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="490" />
+            <location filename="../../ui/main_window.py" line="491" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -5247,27 +5257,27 @@ Remove them all?</source>
         </message>
         <message>
             <location filename="../../ui/dialogs/role_dialog.py" line="81" />
-            <location filename="../../ui/dialogs/role_dialog.py" line="97" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="110" />
             <source>No password is set for this role; an administrator sets it.</source>
             <translation>此角色尚未设置密码；请由管理员设置。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="95" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="108" />
             <source>Wrong password for the {role} role</source>
             <translation>{role}角色的密码错误</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="115" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="128" />
             <source>The two passwords differ: nothing was set. Type the same password twice.</source>
             <translation>两次输入的密码不一致：未作任何设置。请两次输入相同的密码。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="126" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="139" />
             <source>The password could not be saved: {why}</source>
             <translation>无法保存密码：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/role_dialog.py" line="130" />
+            <location filename="../../ui/dialogs/role_dialog.py" line="143" />
             <source>Password set for the {role} role</source>
             <translation>已设置{role}角色的密码</translation>
         </message>
@@ -5818,129 +5828,129 @@ Remove them all?</source>
     <context>
         <name>StepPanel</name>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="200" />
+            <location filename="../../ui/panels/step_panel.py" line="202" />
             <source>Frame:</source>
             <translation>坐标系：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="201" />
+            <location filename="../../ui/panels/step_panel.py" line="203" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="202" />
+            <location filename="../../ui/panels/step_panel.py" line="204" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="203" />
+            <location filename="../../ui/panels/step_panel.py" line="205" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="204" />
+            <location filename="../../ui/panels/step_panel.py" line="206" />
             <source>Expected speed of the incremental move (GV225)</source>
             <translation>增量运动的期望速度（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="205" />
+            <location filename="../../ui/panels/step_panel.py" line="207" />
             <source>Increment per click (mm or °)</source>
             <translation>每次点击的增量（mm 或 °）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="206" />
+            <location filename="../../ui/panels/step_panel.py" line="208" />
             <source>Incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="207" />
+            <location filename="../../ui/panels/step_panel.py" line="209" />
             <source>Exact offset</source>
             <translation>精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="208" />
+            <location filename="../../ui/panels/step_panel.py" line="210" />
             <source>Move by values</source>
             <translation>按数值运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="209" />
+            <location filename="../../ui/panels/step_panel.py" line="211" />
             <source>Move every axis by its exact offset in one incremental move</source>
             <translation>以一次增量运动使各轴移动其精确偏移量</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="210" />
+            <location filename="../../ui/panels/step_panel.py" line="212" />
             <source>Clear values</source>
             <translation>清除数值</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="211" />
+            <location filename="../../ui/panels/step_panel.py" line="213" />
             <source>External axes J7–J11</source>
             <translation>外部轴 J7–J11</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="212" />
+            <location filename="../../ui/panels/step_panel.py" line="214" />
             <source>Show the external axes; while hidden their offsets are 0</source>
             <translation>显示外部轴；隐藏时其偏移量为 0</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="241" />
+            <location filename="../../ui/panels/step_panel.py" line="243" />
             <source>rpm</source>
             <translation>转/分</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="241" />
+            <location filename="../../ui/panels/step_panel.py" line="243" />
             <source>mm/s</source>
             <translation>mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="303" />
+            <location filename="../../ui/panels/step_panel.py" line="305" />
             <source>{axis} limits {lo} … {hi} {unit} (its position is not known)</source>
             <translation>{axis} 限位 {lo} … {hi} {unit}（当前位置未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="307" />
+            <location filename="../../ui/panels/step_panel.py" line="309" />
             <source>{axis} limits {lo} … {hi} {unit}, now at {at} {unit}</source>
             <translation>{axis} 限位 {lo} … {hi} {unit}，当前位于 {at} {unit}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="374" />
+            <location filename="../../ui/panels/step_panel.py" line="376" />
             <source>Move by {moves} at {speed} {unit}?</source>
             <translation>以 {speed} {unit} 运动 {moves}？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="378" />
+            <location filename="../../ui/panels/step_panel.py" line="380" />
             <source>(capped by reduced speed; {asked} {unit} set)</source>
             <translation>（受降速模式限制；设定为 {asked} {unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="381" />
+            <location filename="../../ui/panels/step_panel.py" line="383" />
             <source>Confirm incremental move</source>
             <translation>确认增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="425" />
+            <location filename="../../ui/panels/step_panel.py" line="430" />
             <source>→ {cap} {unit}</source>
             <translation>→ {cap} {unit}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="428" />
+            <location filename="../../ui/panels/step_panel.py" line="433" />
             <source>Reduced speed: a step goes out at {cap} {unit} at most (one joint; less when several joints move together)</source>
             <translation>降速模式：增量运动最多以 {cap} {unit} 发出（单个关节；多个关节同时运动时更低）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="432" />
+            <location filename="../../ui/panels/step_panel.py" line="437" />
             <source>Reduced speed: a step goes out at {cap} {unit} at most</source>
             <translation>降速模式：增量运动最多以 {cap} {unit} 发出</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="300" />
-            <location filename="../../ui/panels/step_panel.py" line="407" />
+            <location filename="../../ui/panels/step_panel.py" line="302" />
+            <location filename="../../ui/panels/step_panel.py" line="409" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/step_panel.py" line="300" />
-            <location filename="../../ui/panels/step_panel.py" line="407" />
+            <location filename="../../ui/panels/step_panel.py" line="302" />
+            <location filename="../../ui/panels/step_panel.py" line="409" />
             <source>mm</source>
             <translation>mm</translation>
         </message>

@@ -182,6 +182,7 @@ def overlapping_siblings(root: QWidget) -> list[str]:
             if c.isVisible()
             and not c.isWindow()
             and not c.objectName().startswith("qt_")
+            and not c.property("overlay")  # laid over the others on purpose (the alarm banner)
             and c.width() > 0
             and c.height() > 0
             and not paints_nothing(c)

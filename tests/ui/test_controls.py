@@ -106,7 +106,8 @@ def test_step_preset_and_exact_values(qtbot: Any, sim: Any, window: Any) -> None
 
     panel.set_frame(StepFrame.BASE)
     assert panel.speed_spin.suffix().strip() == "mm/s"
-    assert panel.axis_labels[0].text() == "X (mm)" and panel.axis_labels[3].text() == "A (°)"
+    assert panel.axis_labels[0].text() == "X" and panel.axis_labels[3].text() == "A"  # the unit: in the field
+    assert panel.value_spins[0].suffix() == " mm" and panel.value_spins[3].suffix() == " °"
     z = sim.state().pose[2]
     panel.set_values([0.0, 0.0, -25.0])
     asked: list[str] = []

@@ -17,13 +17,13 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QCoreApplication, QSize, Qt
+from PySide6.QtCore import QCoreApplication, QPoint, QSize, Qt
 from PySide6.QtGui import QFontDatabase
-from PySide6.QtWidgets import QApplication, QMessageBox, QWidget
+from PySide6.QtWidgets import QApplication, QLabel, QMessageBox, QWidget
 
 from app.protocol.enums import Alarm, TeachFrame
 from tests.ui.layout_audit import clipped_texts, overlapping_siblings, small_motion_buttons
@@ -45,7 +45,7 @@ from ui.main_window import (
     TAB_POINTS,
     MainWindow,
 )
-from ui.touch import SCROLL_MIN_ROWS_HEIGHT, motion_height
+from ui.touch import MOTION_MIN_HEIGHT, TOUCH_MOTION_HEIGHT, motion_height
 from ui.window_docks import DOCK_MIN_ROWS, STATUS_DOCK_WIDTH
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
@@ -254,17 +254,16 @@ def test_main_window_layout_with_an_alarm(
     found = check_window(window, language, touch=False)
     assert window.alarm_banner.isVisible()
     assert not found, "\n".join(found)
-    # more alarms do not make the banner taller (the window below it does not move)
+    # more alarms add their lines to the banner (laid over the bottom docks): nothing is squeezed
     banner = window.alarm_banner
-    height = banner.height()
     for bit in (Alarm.SERVO, Alarm.ENCODER):
         sim.set_alarm(bit, True)
     qtbot.waitUntil(
         lambda: banner.alarms == int(Alarm.ESTOP | Alarm.SERVO | Alarm.ENCODER), timeout=SIGNAL_TIMEOUT_MS
     )
     settle()
-    assert banner.height() == height and not squeezed(window)
-    assert banner.label.toolTip().count("\n") == 3  # the whole text, one line per alarm
+    assert not squeezed(window) and not clipped_texts(banner)
+    assert banner.label.text().count("\n") == 3  # the whole text, one line per alarm
 
 
 @pytest.mark.parametrize("language", LANGUAGES)
@@ -273,19 +272,83 @@ def test_touch_mode_layout_at_1280x800(make_window: Callable[..., MainWindow], l
     assert window.menus.touch_action.isChecked()
     found = without_known(check_window(window, language, touch=True), f"{language}-1280x800-connected")
     assert not found, "\n".join(found)
-    # Decided: in touch mode the joint jog scrolls at 1280×800. Six rows of 56 px buttons (J1..J6
-    # beside J7..J11) need ~350 px under the control bar, frame and speed rows; the only ways to
-    # win that height would shrink the touch targets or drop the bottom docks. The scroll area
-    # keeps every button full size and reachable, and shows at least three rows at once.
-    window.jog_panel.set_frame(TeachFrame.JOINT)
-    window.tabs.setCurrentWidget(window.jog_panel)
+    # Issue 21 (was: the rows scrolled): touch mode lays the rows in three lines of two, X Y Z
+    # beside A B C, J1 J2 J3 beside J4 J5 J6, and J7..J11 the same way behind the "J7–J11" switch
+    jog = window.jog_panel
+    window.tabs.setCurrentWidget(jog)
+    for frame, external, axes in (
+        (TeachFrame.BASE, False, range(6)),
+        (TeachFrame.JOINT, False, range(6)),
+        (TeachFrame.JOINT, True, range(6, 11)),
+    ):
+        jog.set_frame(frame)
+        jog.external_check.setChecked(external)
+        settle()
+        assert not jog.axes_scroll.verticalScrollBar().isVisible(), (frame, external)
+        assert jog.external_check.isVisible() == (frame is TeachFrame.JOINT)
+        assert_rows_whole(jog, axes, TOUCH_MOTION_HEIGHT)
+        hidden = set(range(11)) - set(axes)
+        assert not any(jog.button(a, d).isVisible() for a in hidden for d in (0, 1))
+    jog.external_check.setChecked(False)
+    # the step increments at touch size
+    window.tabs.setCurrentWidget(window.step_panel)
     settle()
-    scroll = window.jog_panel.axes_scroll
-    assert scroll.verticalScrollBar().isVisible(), "touch joint jog fits now: drop the scroll decision"
-    assert scroll.viewport().height() >= SCROLL_MIN_ROWS_HEIGHT
-    rows = scroll.widget()
-    assert rows is not None
-    assert scroll.verticalScrollBar().maximum() + scroll.viewport().height() >= rows.height()
+    assert all(b.height() >= TOUCH_MOTION_HEIGHT for b in window.step_panel.preset_buttons)
+    window.set_touch_mode(False)
+    settle()
+    assert all(b.height() < TOUCH_MOTION_HEIGHT for b in window.step_panel.preset_buttons)
+    window.tabs.setCurrentWidget(jog)
+    jog.set_frame(TeachFrame.JOINT)
+    settle()
+    assert not jog.external_check.isVisible()
+    assert_rows_whole(jog, range(11), MOTION_MIN_HEIGHT)  # compact: J1..J6 beside J7..J11
+
+
+def assert_rows_whole(jog: Any, axes: Iterable[int], height: int) -> None:
+    """Each of ``axes`` shows both its buttons whole (nothing scrolled or cut away), ``height`` px high."""
+    for axis in axes:
+        for direction in (0, 1):
+            button = jog.button(axis, direction)
+            assert button.isVisible() and button.height() >= height, (axis, direction)
+            assert button.visibleRegion().boundingRect() == button.rect(), (axis, direction)
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_step_offsets_show_whole_at_1280x800(make_window: Callable[..., MainWindow], language: str) -> None:
+    """Issue 21: in the base frame the exact offsets' arrows were cut off at the right ("X (mm)"
+    took their room; the unit is in the field)."""
+    from app.link.types import StepFrame
+
+    window = make_window(language, LAPTOP)
+    step = window.step_panel
+    window.tabs.setCurrentWidget(step)
+    for touch in (False, True):
+        window.set_touch_mode(touch)
+        for frame in (StepFrame.JOINT, StepFrame.BASE):
+            step.set_frame(frame)
+            settle()
+            viewport = step.axes_scroll.viewport()
+            for axis in range(6):
+                spin = step.value_spins[axis]
+                right = spin.mapTo(viewport, QPoint(spin.width(), 0)).x()
+                assert right <= viewport.width(), (touch, frame, axis, right, viewport.width())
+
+
+def test_a_jog_permitted_alarm_clips_no_jog_row_at_1280x800(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow]
+) -> None:
+    """Issue 21: zh_CN with an alarm that lets the arm jog (the encoder alarm) cut the last jog rows."""
+    window = make_window("zh_CN", LAPTOP)
+    sim.set_alarm(Alarm.ENCODER, True)
+    qtbot.waitUntil(window.alarm_banner.isVisible, timeout=SIGNAL_TIMEOUT_MS)
+    jog = window.jog_panel
+    qtbot.waitUntil(jog.axes_box.isEnabled, timeout=SIGNAL_TIMEOUT_MS)
+    window.tabs.setCurrentWidget(jog)
+    for frame, axes in ((TeachFrame.BASE, range(6)), (TeachFrame.JOINT, range(11))):
+        jog.set_frame(frame)
+        settle()
+        assert not jog.axes_scroll.verticalScrollBar().isVisible(), frame
+        assert_rows_whole(jog, axes, MOTION_MIN_HEIGHT)
 
 
 @pytest.mark.parametrize("language", LANGUAGES)
@@ -368,3 +431,141 @@ def test_dialogs_layout(qtbot: Any, app_settings: Any, translator: Any, language
         settle()
         assert problems(dialog, language, touch=False) == [], type(dialog).__name__
         dialog.close()
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_the_alarm_banner_moves_nothing(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str, size: tuple[int, int]
+) -> None:
+    """Issue 21: the banner appeared above everything and pushed the window 24 px down, STOP with it,
+    at the worst moment. It is laid over the window now: STOP, the pose strip and the work tabs
+    keep their place on the screen while alarms come and go."""
+    window = make_window(language, size)
+    stop = window.control_bar.stop_button
+    watched = (stop, window.pose_strip, window.tabs, window.work_tabs)
+
+    def places() -> list[tuple[int, int, int, int]]:
+        return [(w.mapToGlobal(w.rect().topLeft()).toTuple() + w.size().toTuple()) for w in watched]
+
+    before = places()
+    raise_estop(qtbot, window, sim)
+    assert places() == before
+    window.alarm_dock.raise_()  # the Alarms dock in view under the banner: nothing moves either
+    settle()
+    assert places() == before
+    sim.set_alarm(Alarm.ENCODER, True)
+    qtbot.waitUntil(
+        lambda: window.alarm_banner.alarms == int(Alarm.ESTOP | Alarm.ENCODER), timeout=SIGNAL_TIMEOUT_MS
+    )
+    settle()
+    assert places() == before
+    for bit in (Alarm.ESTOP, Alarm.ENCODER):
+        sim.set_alarm(bit, False)
+    qtbot.waitUntil(lambda: not window.alarm_banner.isVisible(), timeout=SIGNAL_TIMEOUT_MS)
+    settle()
+    assert places() == before
+
+
+def shown_whole(label: QLabel, sentence: str) -> bool:
+    """``sentence`` is in what ``label`` paints (not elided), every line of it inside the label,
+    and no sibling covers the label."""
+    text = label.text().replace("\n", " ")
+    if sentence not in " ".join(text.split()):
+        return False
+    needs = label.heightForWidth(label.width()) if label.wordWrap() else label.sizeHint().height()
+    return label.height() >= needs and label.visibleRegion().boundingRect() == label.rect()
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_the_emergency_stop_instruction_reads_whole_at_1280x800(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str
+) -> None:
+    """Issue 21: "Make the cell safe, release the emergency stop, …" was elided in the banner and the
+    Alarms dock. The banner shows the whole sentence; more alarms add their lines (it lies over the
+    bottom docks, the window below does not move)."""
+    from app.alarm_history import ALARM_ADVICE, TR_ALARMS
+
+    window = make_window(language, LAPTOP)
+    raise_estop(qtbot, window, sim)
+    advice = QCoreApplication.translate(TR_ALARMS, ALARM_ADVICE[Alarm.ESTOP])
+    assert advice != ALARM_ADVICE[Alarm.ESTOP] or language == "en"
+    label = window.alarm_banner.label
+    assert shown_whole(label, advice), label.text()
+    assert window.rect().contains(window.alarm_banner.geometry())
+    for bit in (Alarm.SERVO, Alarm.ENCODER):
+        sim.set_alarm(bit, True)
+    qtbot.waitUntil(
+        lambda: window.alarm_banner.alarms == int(Alarm.ESTOP | Alarm.SERVO | Alarm.ENCODER),
+        timeout=SIGNAL_TIMEOUT_MS,
+    )
+    settle()
+    for bit in (Alarm.ESTOP, Alarm.SERVO, Alarm.ENCODER):
+        sentence = QCoreApplication.translate(TR_ALARMS, ALARM_ADVICE[bit])
+        assert shown_whole(label, sentence), label.text()
+    assert window.rect().contains(window.alarm_banner.geometry())
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_the_login_dialog_keeps_its_fields_when_it_says_wrong_password(
+    qtbot: Any, translator: Any, language: str
+) -> None:
+    """Issue 21: "Wrong password" squeezed the dialog's fields (it did not grow for the line)."""
+    from app.safety.roles import Role
+    from ui.controllers.safety import SafetyController
+    from ui.dialogs.role_dialog import RoleDialog
+
+    assert translator.set_language(language)
+    safety = SafetyController(None, scrypt_n=2**4)
+    safety.set_idle_polling(False)
+    safety.session.set_password(Role.ADMINISTRATOR, "root-pw")  # the first one: anyone
+    dialog = RoleDialog(safety)
+    qtbot.addWidget(dialog)
+    dialog.role_box.setCurrentIndex(dialog.role_box.findData(Role.ADMINISTRATOR))
+    assert not dialog.error.text()  # no hint: the administrator has a password
+    dialog.show()
+    qtbot.waitExposed(dialog)
+    settle()
+    assert not problems(dialog, language, touch=False)
+    fields = (dialog.role_box, dialog.password)
+    heights = [f.height() for f in fields]
+    dialog.password.setText("wrong")
+    dialog.log_in()
+    settle()
+    assert dialog.error.text() and dialog.error.isVisible()
+    assert [f.height() for f in fields] == heights
+    assert all(f.height() >= f.sizeHint().height() for f in fields)
+    found = problems(dialog, language, touch=False)
+    error = dialog.error
+    assert error.height() >= error.heightForWidth(error.width()), "the refusal is cut"
+    assert not found, "\n".join(found)
+    safety.close()
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_the_alarms_dock_reads_what_to_do_whole_at_1280x800(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str
+) -> None:
+    """Issue 21: the Alarms dock elided "Make the cell safe, release the emergency stop button, …":
+    its rows wrap and are as tall as their text."""
+    from PySide6.QtCore import QRect
+
+    from ui.panels.alarm_list import COL_ADVICE, COL_MEANING
+
+    window = make_window(language, LAPTOP)
+    raise_estop(qtbot, window, sim)
+    window.alarm_dock.raise_()
+    settle()
+    alarms = window.alarm_list
+    # the banner stays above the dock raised under it (it says the same, whole)
+    label = window.alarm_banner.label
+    assert window.alarm_banner.isVisible() and shown_whole(label, label.text().split("\n")[-1])
+    table = alarms.table
+    metrics = table.fontMetrics()
+    for bit in (int(b) for b in Alarm):
+        for column in (COL_MEANING, COL_ADVICE):
+            text = alarms.cell(bit, column)
+            cell = table.visualRect(table.model().index(alarms.row_of(bit), column))
+            room = cell.adjusted(3, 0, -3, 0)  # the item's text margins
+            needs = metrics.boundingRect(QRect(0, 0, room.width(), 10_000), Qt.TextFlag.TextWordWrap, text)
+            assert needs.height() <= cell.height() and needs.width() <= room.width(), (bit, column, text)

@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 import pytest
-from PySide6.QtCore import QEvent, Qt
+from PySide6.QtCore import QEvent, QPoint, QRect, Qt
 from PySide6.QtGui import QKeyEvent
 from PySide6.QtWidgets import QApplication
 
@@ -72,7 +72,10 @@ def test_an_emergency_stop_shows_the_banner_and_holds_motion(
     sim.set_alarm(Alarm.ESTOP, True)
     qtbot.waitUntil(banner.isVisible, timeout=SIGNAL_TIMEOUT_MS)
     assert "emergency stop" in banner.text()
-    assert banner.geometry().top() < window.pose_bar.geometry().top()  # above everything
+    # laid over the window (issue 21): raised above the docks it lies on, STOP not covered
+    assert banner.visibleRegion().boundingRect() == banner.rect()
+    stop = window.control_bar.stop_button
+    assert not banner.geometry().intersects(QRect(stop.mapTo(window, QPoint(0, 0)), stop.size()))
     assert not jog.axes_box.isEnabled() and not window.step_panel.move_button.isEnabled()
     assert not window.program_panel.run_button.isEnabled()
     assert window.control_bar.stop_button.isEnabled()

@@ -85,6 +85,19 @@ class RoleDialog(QDialog):
         """A hint or refusal in red; a confirmation in the normal colour."""
         self.error.setStyleSheet("color: #c62828;" if error else "")
         self.error.setText(text)
+        self._fit()
+
+    def _fit(self) -> None:
+        """Grow for a new line of text: a dialog already shown keeps its size, and the fields
+        were squeezed under "Wrong password …" (issue 21)."""
+        layout = self.layout()
+        if layout is None or not self.isVisible():
+            return  # not shown yet: the dialog is sized when it opens
+        layout.activate()
+        needed = layout.totalHeightForWidth(self.width()) if layout.hasHeightForWidth() else 0
+        needed = max(needed, layout.totalMinimumSize().height())
+        if self.height() < needed:
+            self.resize(self.width(), needed)
 
     def log_in(self) -> None:
         role = self._role()

@@ -52,7 +52,10 @@ class AlarmListPanel(QWidget):
         self.table.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)
         self.table.setSelectionMode(QAbstractItemView.SelectionMode.NoSelection)
         self.table.verticalHeader().setVisible(False)
-        self.table.setWordWrap(False)
+        # the meaning and what to do read whole: rows as tall as their wrapped text (issue 21:
+        # "Make the cell safe, release the emergency stop button, …" was elided at 1280×800)
+        self.table.setWordWrap(True)
+        self.table.verticalHeader().setSectionResizeMode(QHeaderView.ResizeMode.ResizeToContents)
         header = self.table.horizontalHeader()
         for column in (COL_NAME, COL_RAISED, COL_CLEARED):
             header.setSectionResizeMode(column, QHeaderView.ResizeMode.ResizeToContents)

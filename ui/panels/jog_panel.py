@@ -18,6 +18,7 @@ from PySide6.QtCore import QEvent, QObject, Qt, Signal, Slot
 from PySide6.QtGui import QKeyEvent, QMouseEvent
 from PySide6.QtWidgets import (
     QApplication,
+    QCheckBox,
     QComboBox,
     QGridLayout,
     QGroupBox,
@@ -168,6 +169,12 @@ class JogPanel(QWidget):
         frame_row.addWidget(self.user_spin)
         frame_row.addWidget(self.tool_label)
         frame_row.addWidget(self.tool_spin)
+        # touch mode, joint frame: the rows show J1..J6 or, checked, J7..J11 (see _arrange)
+        self.external_check = QCheckBox(self.frame_box)
+        self.external_check.setObjectName("JogExternalAxes")
+        self.external_check.toggled.connect(self._on_external_toggled)
+        frame_row.addWidget(self.external_check)
+        self._touch = False
 
         # the rows scroll only where they cannot fit (touch mode on a 800 px screen)
         self.axes_box = QGroupBox(self)
@@ -200,14 +207,6 @@ class JogPanel(QWidget):
             plus.held.connect(lambda a=axis: self._press("mouse", a, 1))
             minus.letGo.connect(lambda: self._release("mouse"))
             plus.letGo.connect(lambda: self._release("mouse"))
-            # joint frame: J1..J6 on the left, the caption and J7..J11 on the right (11 rows
-            # of 40 px buttons would not fit a 800 px screen)
-            external = axis >= NUM_ROBOT_AXES
-            row = axis - NUM_ROBOT_AXES + 1 if external else axis
-            column = EXTERNAL_COLUMN if external else 0
-            grid.addWidget(minus, row, column)
-            grid.addWidget(label, row, column + 1)
-            grid.addWidget(plus, row, column + 2)
             self.axis_labels.append(label)
             self.minus_buttons.append(minus)
             self.plus_buttons.append(plus)
@@ -218,6 +217,7 @@ class JogPanel(QWidget):
         grid.setColumnMinimumWidth(EXTERNAL_COLUMN - 1, 8)
         grid.setRowStretch(NUM_ROBOT_AXES, 1)  # spare height below the rows, not between them
         self._grid = grid
+        self._arrange()
 
         self.hold_label = QLabel(self)
         self.hold_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
@@ -271,6 +271,8 @@ class JogPanel(QWidget):
         self.user_label.setText(self.tr("User no.:"))
         self.tool_label.setText(self.tr("Tool no.:"))
         self.external_caption.setText(self.tr("External axes"))
+        self.external_check.setText(self.tr("J7–J11"))
+        self.external_check.setToolTip(self.tr("Touch mode: the rows show the external axes J7–J11"))
         self._show_halt()
         self.speed_caption.setText(self.tr("Speed:"))
         self._show_speed()
@@ -457,12 +459,52 @@ class JogPanel(QWidget):
         self.release_all()
         self._update_axes()
 
+    def set_touch(self, touch: bool) -> None:
+        """Touch mode: the rows in three lines of two (see :meth:`_arrange`)."""
+        if touch != self._touch:
+            self.release_all()
+            self._touch = touch
+            self._arrange()
+            self._update_axes()
+
+    @Slot(bool)
+    def _on_external_toggled(self, _checked: bool) -> None:
+        self.release_all()  # a held button may be hidden
+        self._update_axes()
+
+    def _arrange(self) -> None:
+        """Place the rows. Compact: X..C (J1..J6) one under the other, in the joint frame J7..J11
+        beside them under their caption (11 rows of 40 px would not fit a 800 px screen).
+        Touch mode (56 px buttons; six rows do not fit under the control bar at 1280×800, issue 21):
+        three lines of two, X Y Z beside A B C (J1 J2 J3 beside J4 J5 J6), and in the joint frame
+        J7..J11 the same way in place of J1..J6 while *External axes* is checked."""
+        grid = self._grid
+        for axis in range(NUM_AXES_TOTAL):
+            external = axis >= NUM_ROBOT_AXES
+            if self._touch:
+                index = axis - NUM_ROBOT_AXES if external else axis
+                row, column = index % 3, (0 if index < 3 else EXTERNAL_COLUMN)
+            else:
+                row = axis - NUM_ROBOT_AXES + 1 if external else axis
+                column = EXTERNAL_COLUMN if external else 0
+            widgets = (self.minus_buttons[axis], self.axis_labels[axis], self.plus_buttons[axis])
+            for offset, widget in enumerate(widgets):
+                grid.removeWidget(widget)
+                grid.addWidget(widget, row, column + offset)
+
+    def _axis_shown(self, axis: int, joint: bool) -> bool:
+        if not joint:
+            return axis < NUM_ROBOT_AXES
+        if not self._touch:
+            return True
+        return (axis >= NUM_ROBOT_AXES) == self.external_check.isChecked()
+
     def _update_axes(self) -> None:
         frame = self.frame
         joint = frame is TeachFrame.JOINT
         names = JOINT_AXIS_NAMES if joint else CARTESIAN_AXIS_NAMES
         for axis, label in enumerate(self.axis_labels):
-            visible = axis < (NUM_AXES_TOTAL if joint else NUM_ROBOT_AXES)
+            visible = self._axis_shown(axis, joint)
             if visible:
                 label.setText(names[axis])
                 unit = self.tr("°") if joint or axis >= 3 else self.tr("mm")
@@ -474,7 +516,8 @@ class JogPanel(QWidget):
                 )
             for widget in (label, self.minus_buttons[axis], self.plus_buttons[axis]):
                 widget.setVisible(visible)
-        self.external_caption.setVisible(joint)
+        self.external_caption.setVisible(joint and not self._touch)
+        self.external_check.setVisible(joint and self._touch)
         self.user_label.setVisible(frame is TeachFrame.USER)
         self.user_spin.setVisible(frame is TeachFrame.USER)
         self.tool_label.setVisible(frame is TeachFrame.TOOL)

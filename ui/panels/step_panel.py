@@ -44,7 +44,7 @@ from app.safety.caps import MotionCaps
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.joins import join_names
 from ui.keypad_range import KeypadRange
-from ui.touch import RowsScrollArea, mark_motion
+from ui.touch import RowsScrollArea, mark_motion, mark_touch_target
 
 PRESETS: tuple[float, ...] = (0.1, 1.0, 10.0)
 DEFAULT_PRESET = 1.0
@@ -120,6 +120,7 @@ class StepPanel(QWidget):
 
         self.preset_box = QGroupBox(self)
         preset_row = QHBoxLayout(self.preset_box)
+        preset_row.setContentsMargins(6, 2, 6, 4)  # touch mode: 56 px buttons fit 1280×800 (issue 21)
         self.preset_group = QButtonGroup(self)
         self.preset_buttons: list[QPushButton] = []
         for i, value in enumerate(PRESETS):
@@ -128,6 +129,7 @@ class StepPanel(QWidget):
             button.setChecked(value == DEFAULT_PRESET)
             self.preset_group.addButton(button, i)
             preset_row.addWidget(button)
+            mark_touch_target(button)  # touch mode: finger size (issue 21)
             self.preset_buttons.append(button)
 
         # 11 rows of 40 px buttons do not fit a 800 px screen: the rows scroll (the robot axes
@@ -408,7 +410,10 @@ class StepPanel(QWidget):
         for axis, label in enumerate(self.axis_labels):
             linear = self._frame is StepFrame.BASE and axis < 3
             unit = mm if linear else deg
-            label.setText(f"{names[axis]} ({unit})")
+            # the unit is in the field ("0.000 mm"): "X (mm)" left the field's arrows clipped at
+            # 1280×800 in the base frame (issue 21)
+            label.setText(names[axis])
+            label.setToolTip(f"{names[axis]} ({unit})")
             self.value_spins[axis].setSuffix(f" {unit}")
 
     @Slot(float)
