@@ -292,6 +292,7 @@ _LINK_FAILED_BY_CODE = {
     "reduced_speed_refused": False,  # go to zero in reduced-speed mode: nothing sent
     "audit_unavailable": False,  # its audit record could not be written: refused, nothing sent
     "envelope_unchecked": False,  # the CLI's move with no host copy under a box: refused, nothing sent
+    "profile_invalid": False,  # a robot model file that cannot be used: a file problem, not the link
     "error": False,
 }
 

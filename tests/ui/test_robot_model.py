@@ -78,7 +78,17 @@ def test_an_operator_cannot_load_a_robot_model(qtbot: Any, window: MainWindow, t
     assert "engineer" in panel.message_label.text() and panel.message_label.isVisible()
     refused = audit(window, "change robot model")
     assert [(r.kind, r.result, r.role, r.args) for r in refused] == [
-        ("refused", "refused", "operator", {"file": str(path)})
+        (
+            "refused",
+            "refused",
+            "operator",
+            # the refusal's reason is kept for the audit viewer's words (issue 21)
+            {
+                "file": str(path),
+                "reason": "role_refused",
+                "reason_args": {"need": "engineer", "role": "operator"},
+            },
+        )
     ]
     panel.choose_profile()  # the button's slot: refused before any file dialog opens
     assert len(audit(window, "change robot model")) == 2
