@@ -12,11 +12,11 @@ import pytest
 from tests.cli.ctrl_c import COVERAGE_STARTUP_VARS
 from tests.soak.run import SessionResult, _judge, run_session
 
-# A session is a GUI process and its simulator child: start-up, 20 s of actions and the close
+# A session is a GUI process and its simulator child: start-up, 12 s of actions and the close
 # take ~30 s, far more on a loaded machine (the session's own hang limit is minutes).
 pytestmark = pytest.mark.timeout(600)
 
-SMOKE_SECONDS = 20.0
+SMOKE_SECONDS = 12.0
 SMOKE_SEED = 18  # fixed: the same actions every run (their timing follows the machine)
 
 
