@@ -210,8 +210,6 @@ class RobotClient(CommandClient):
         self.send_trigger(register, value, watch)
         self.last_watch = watch
         return watch
-        self.last_watch = watch
-        return watch
 
     # -- helpers of the four functions ---------------------------------------------------
     def _ensure_auto(self, status: ControllerStatus) -> None:
