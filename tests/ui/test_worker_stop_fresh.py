@@ -170,6 +170,8 @@ def test_a_monitor_only_stop_after_a_disconnect_sends_nothing(qtbot: Any, sim: A
     connect(qtbot, link, sim, monitor_only=True)
     with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED)):
         link.disconnect()
+    # the simulator sees the close a moment after the client made it
+    qtbot.waitUntil(lambda: sim.connections_count == 0, timeout=SIGNAL_TIMEOUT_MS)
     requests = sim.requests_count
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as failed:
         link.stop()
