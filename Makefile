@@ -33,12 +33,16 @@ lint: $(STAMP)
 COV_FLOOR ?= 91
 COV_QTHREADS ?= 0
 
-# The lint (one core: mypy, mostly) runs beside the suite (one process): on a 2-core machine both at
+# The suite runs in TEST_WORKERS processes (pytest-xdist; each its own simulator ports, temporary
+# folders and Qt application), one per core by default; TEST_WORKERS=0 runs it in this process.
+TEST_WORKERS ?= $(shell nproc 2>/dev/null || echo 2)
+# The lint (one core: mypy, mostly) runs beside the suite: it takes about a core for 2-3 min, so both at
 # once take the suite's time, not the sum. Its output is printed when it ends; either failing fails.
 LINT_LOG := $(VENV)/lint.log
 test: $(STAMP)
 	@$(MAKE) --no-print-directory lint > $(LINT_LOG) 2>&1 & lint=$$!; \
-	TEACHPAD_COV_QTHREADS=$(COV_QTHREADS) $(BIN)/python -m pytest --cov=app --cov=ui \
+	TEACHPAD_COV_QTHREADS=$(COV_QTHREADS) $(BIN)/python -m pytest -n $(TEST_WORKERS) --dist worksteal \
+		--cov=app --cov=ui \
 		--cov-report=term-missing:skip-covered --cov-fail-under=$(COV_FLOOR); tests=$$?; \
 	wait $$lint; linted=$$?; echo "--- make lint (beside the suite) ---"; cat $(LINT_LOG); \
 	if [ $$linted -ne 0 ]; then echo "make test: the lint FAILED (above)"; fi; \

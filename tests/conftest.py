@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ctypes
 import faulthandler
+import gc
 import os
 import shutil
 import sys
@@ -282,6 +283,34 @@ def _qt_leak_check(request: pytest.FixtureRequest) -> Iterator[None]:
             f"test leaked {len(leaked_threads)} running QThread(s) and {len(leaked_timers)} active QTimer(s)",
             pytrace=False,
         )
+
+
+@pytest.fixture(autouse=True)
+def _gc_on_the_gui_thread(request: pytest.FixtureRequest) -> Iterator[None]:
+    """A Qt test collects garbage on the GUI (main) thread only, as the GUI process does
+    (``ui/gui_gc.py``): automatic collection is off while it runs, and what CPython would have
+    collected is collected at its end, here. With automatic collection on, a pass started by an
+    allocation in the link's worker or the simulator's threads freed the cycles of pyqtgraph items
+    a plot had dropped (labels, curves) on that thread while the GUI thread painted: a segfault in
+    ``GraphicsView.paintEvent`` (seen once in ~2,400 tests run on two cores). Tests of the
+    collection itself (marker ``automatic_gc``) keep CPython's automatic collection."""
+    if "automatic_gc" in request.keywords or (
+        "qtbot" not in request.fixturenames and "qapp" not in request.fixturenames
+    ):
+        yield
+        return
+    from ui.gui_gc import due_generation
+
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        generation = due_generation(gc.get_count(), gc.get_threshold())
+        if generation is not None:
+            gc.collect(generation)
+        if was_enabled:
+            gc.enable()
 
 
 @pytest.fixture(autouse=True)

@@ -14,6 +14,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import pytest
 from PySide6.QtCore import QObject, Qt, QThread, QTimer, Slot
 
 from tests.cli.ctrl_c import untraced_env
@@ -21,6 +22,9 @@ from ui.gui_gc import GuiThreadCollector, due_generation
 from ui.startup_gc import StartupGcPause
 
 ROOT = Path(__file__).resolve().parents[2]
+
+# these tests switch collection off and on themselves, and count passes in other threads
+pytestmark = pytest.mark.automatic_gc
 
 # ``teachpad --sim`` in a child, collections made due often (a pass would run in any thread that
 # allocates past the threshold: the worker allocates at every poll). Every pass is counted by the
