@@ -13,9 +13,20 @@ import time
 from typing import TYPE_CHECKING, Protocol
 
 from app.errors import LinkError, MalformedResponse, Reason, ResponseTimeout, TeachPadError, WriteBlocked
-from app.link.jobs import JobKind
+from app.link.ops import (
+    CancelUpload,
+    JobKind,
+    JogPress,
+    JogRelease,
+    Pause,
+    Resume,
+    SetJogRatio,
+    SetMode,
+    Stop,
+    UploadPoints,
+)
 from app.link.stop_line import stop_on_a_fresh_connection
-from app.link.types import JogRequest, Operation
+from app.link.types import Operation
 from app.link.upload import RawItem
 from app.models import CommandResult
 from app.protocol.enums import WorkMode
@@ -73,7 +84,9 @@ class WorkerCommands:
         self.emit_result(CommandResult(None, None, None, False, text, reason=reason), request_id)
 
     # --- plain and urgent commands ------------------------------------------------------
-    def _do_stop(self, on_line: StopSent | None = None) -> None:  # on_line: sent on the stop line
+    def _do_stop(self, _op: Stop) -> None:
+        job = self._current_job
+        on_line = job.on_line if job is not None else None  # already written on the stop line
         client = self.supervisor.client
         if client is None or not self.supervisor.link_up:
             # disconnected by the operator, lost and reconnecting, still connecting: the last
@@ -231,7 +244,7 @@ class WorkerCommands:
                 Reason("cancelled_by_stop", {"operation": str(job.operation)}),
             )
 
-    def _do_cancel_upload(self) -> None:
+    def _do_cancel_upload(self, _op: CancelUpload) -> None:
         """No controller stop: the upload ends after the point in progress; queued uploads are dropped."""
         for job in self._jobs.cancel(lambda j: j.operation == Operation.UPLOAD_POINTS):
             self._failed(
@@ -246,29 +259,36 @@ class WorkerCommands:
         ends = f"{Operation.CANCEL_UPLOAD}: the upload ends after the current point"
         self._done(ends, Operation.CANCEL_UPLOAD)
 
-    def _do_pause(self) -> None:
+    def _do_pause(self, _op: Pause) -> None:
         self.client_or_raise().pause()
         self._done("pause: sent", Operation.PAUSE)
 
-    def _do_resume(self) -> None:
+    def _do_resume(self, _op: Resume) -> None:
         self.client_or_raise().resume()
         self._done("resume: sent", Operation.RESUME)
 
-    def _do_set_mode(self, mode: WorkMode) -> None:
-        mode = WorkMode(mode)
+    def _do_set_mode(self, op: SetMode) -> None:
+        mode = WorkMode(op.mode)
         client = self.client_or_raise()
         if mode is WorkMode.MANUAL:
             self.jog.stop_jog_and_teach()
         client.set_work_mode(mode)
         self._done(f"work mode: {mode.name.lower()}", Operation.SET_MODE)
 
-    def _do_jog_press(self, request: JogRequest) -> None:
+    def _do_jog_press(self, op: JogPress) -> None:
         self.motions.require_none(Operation.JOG)
-        self.jog.press(request)
+        self.jog.press(op.request)
+
+    def _do_jog_release(self, _op: JogRelease) -> None:
+        self.jog.release()
+
+    def _do_jog_ratio(self, op: SetJogRatio) -> None:
+        self.jog.set_ratio(op.ratio)
 
     # --- long commands ------------------------------------------------------------------
-    def _do_upload_points(self, raw: list[RawItem]) -> None:
+    def _do_upload_points(self, op: UploadPoints) -> None:
         """Case 2.2 for many points, tool by tool; runs in chunks, see :class:`Uploader`."""
         self.motions.require_none(Operation.UPLOAD_POINTS)
+        raw: list[RawItem] = list(op.items)
         if self.uploader.start(raw):
             self._uploadStep.emit()
