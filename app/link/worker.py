@@ -29,8 +29,9 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
 
 Requests are operations as data (:mod:`app.link.ops`): :meth:`RobotWorker.submit` queues one
 and returns its ticket (request id); the worker runs each through one table, operation type ->
-handler (``handlers``). The handlers of the short commands (``_do_stop`` ...) are in
-:mod:`app.link.commands`, those of the long ones in :class:`~app.link.motion.MotionCommands`.
+handler (``handlers``). The handlers of the short commands (``stop`` ...) are in
+:class:`~app.link.commands.WorkerCommands`, those of the long ones in
+:class:`~app.link.motion.MotionCommands`: parts the worker composes, like the others.
 
 Stop latency: :meth:`RobotWorker.submit` of a :class:`~app.link.ops.Stop` writes the stop from
 the calling thread on the stop line (:mod:`app.link.stop_line`) when there is one; the stop job
@@ -53,6 +54,7 @@ import logging
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 
 import numpy  # noqa: F401 - the jog guard's arithmetic (app/lazy_numpy.py): imported with the worker,
 from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot  # not by a check mid-jog
@@ -119,7 +121,7 @@ SHUTDOWN_TIMEOUT_MS = round(timing.SHUTDOWN_WAIT * 1000)
 STOP_HANDOFF_WAIT = 0.005
 
 
-class RobotWorker(WorkerCommands, QObject):
+class RobotWorker(QObject):
     """Owns the RobotClient in the worker thread and composes the parts; see the module docstring."""
 
     polled = Signal(object)  # PollUpdate: a poll's pose/status/alarms/freshness, its one delivery
@@ -158,7 +160,6 @@ class RobotWorker(WorkerCommands, QObject):
         self.audit: AuditLog | None = None  # set before connecting (set_audit); thread-safe
         self.caps: MotionCaps | None = None  # reduced-speed mode's caps (set_motion_caps)
         self.request_id: int | None = None  # request id of the job being executed
-        self._current_seq = 0  # sequence number of the job being executed
         self._current_job: Job | None = None
         self._in_urgent = False
         self._worker_ident: int | None = None  # the worker thread, once started (request_stop)
@@ -178,25 +179,26 @@ class RobotWorker(WorkerCommands, QObject):
         # a stop counts on the stop line before its 441 goes out, then (and a cancel) in the queue
         self.uploader = Uploader(self, lambda: self.stop_line.stops_requested + self._jobs.halts)
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
+        self.commands = WorkerCommands(self)  # the short commands' handlers
         self.handlers = self._make_handlers()
 
     def _make_handlers(self) -> Handlers:
         """The one table: operation type -> what runs it (worker thread)."""
-        handlers = Handlers()
-        handlers.add(Stop, self._do_stop)
-        handlers.add(Pause, self._do_pause)
-        handlers.add(Resume, self._do_resume)
-        handlers.add(SetMode, self._do_set_mode)
-        handlers.add(CancelUpload, self._do_cancel_upload)
-        handlers.add(JogPress, self._do_jog_press)
-        handlers.add(JogRelease, self._do_jog_release)
-        handlers.add(SetJogRatio, self._do_jog_ratio)
+        handlers, commands = Handlers(), self.commands
+        handlers.add(Stop, commands.stop)
+        handlers.add(Pause, commands.pause)
+        handlers.add(Resume, commands.resume)
+        handlers.add(SetMode, commands.set_mode)
+        handlers.add(CancelUpload, commands.cancel_upload)
+        handlers.add(JogPress, commands.jog_press)
+        handlers.add(JogRelease, commands.jog_release)
+        handlers.add(SetJogRatio, commands.jog_ratio)
         handlers.add(Step, self.motions.step)
         handlers.add(GoZero, self.motions.go_zero)
         handlers.add(RunProgram, self.motions.run_program)
         handlers.add(MoveToPoint, self.motions.move_to_point)
         handlers.add(CreatePoint, self.motions.create_point)
-        handlers.add(UploadPoints, self._do_upload_points)
+        handlers.add(UploadPoints, commands.upload_points)
         return handlers
 
     # --- requests (any thread) ----------------------------------------------------------
@@ -208,7 +210,7 @@ class RobotWorker(WorkerCommands, QObject):
         answer, the bookkeeping). Without a stop line, from another thread, this waits (GIL
         released) until the worker has written it, at most :data:`STOP_HANDOFF_WAIT`, so nothing
         of the caller's runs first. The stop runs whatever the link's state: without a link it
-        goes over a fresh connection to the last controller (``_do_stop``)."""
+        goes over a fresh connection to the last controller (``WorkerCommands.stop``)."""
         if not isinstance(op, Stop):
             request_id = self._jobs.put(Job(op))
             self._wake.emit()
@@ -331,6 +333,17 @@ class RobotWorker(WorkerCommands, QObject):
                 timer.setInterval(interval)
 
     # --- the host of the parts (worker thread) ------------------------------------------
+    @property
+    def current_job(self) -> Job | None:
+        """The job being executed (None between jobs)."""
+        return self._current_job
+
+    def cancel_queued(self, predicate: Callable[[Job], bool]) -> list[Job]:
+        return self._jobs.cancel(predicate)
+
+    def next_upload_step(self) -> None:
+        self._uploadStep.emit()
+
     @property
     def client(self) -> RobotClient | None:
         return self.supervisor.client
@@ -525,8 +538,8 @@ class RobotWorker(WorkerCommands, QObject):
         if not held and self._must_wait(job):
             self._held.append(job)
             return
-        outer = (self._current_seq, self.request_id, self._current_job)
-        self._current_seq, self.request_id, self._current_job = job.seq, job.request_id, job
+        outer = (self.request_id, self._current_job)
+        self.request_id, self._current_job = job.request_id, job
         try:
             self.handlers.run(job.op)
         except PreemptedError:
@@ -536,7 +549,7 @@ class RobotWorker(WorkerCommands, QObject):
         finally:
             if job.sent is not None:
                 job.sent.set()  # also when it failed: the poster waits no longer
-            self._current_seq, self.request_id, self._current_job = outer
+            self.request_id, self._current_job = outer
 
     def _report_failure(self, operation: str, exc: Exception) -> None:
         """A job's failure as its signal: the controller's refusal (a Modbus exception, a refused
