@@ -21,6 +21,7 @@ from app.link.jog import JogMachine
 from app.link.motion import MotionCommands, MotionTracker
 from app.link.ops import (
     CancelUpload,
+    Handlers,
     JobKind,
     JogPress,
     JogRelease,
@@ -82,6 +83,18 @@ class WorkerCommands:
 
     def __init__(self, host: CommandsHost) -> None:
         self._host = host
+
+    def register(self, handlers: Handlers) -> None:
+        """The operations these handlers run, in the worker's one table."""
+        handlers.add(Stop, self.stop)
+        handlers.add(Pause, self.pause)
+        handlers.add(Resume, self.resume)
+        handlers.add(SetMode, self.set_mode)
+        handlers.add(CancelUpload, self.cancel_upload)
+        handlers.add(JogPress, self.jog_press)
+        handlers.add(JogRelease, self.jog_release)
+        handlers.add(SetJogRatio, self.jog_ratio)
+        handlers.add(UploadPoints, self.upload_points)
 
     def _done(self, text: str, operation: str) -> None:
         """A request the controller answered (its outcome is not watched): *sent*, named by its

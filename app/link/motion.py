@@ -21,7 +21,7 @@ from app import timing
 from app.errors import InvalidInput, MalformedResponse, ModbusExceptionError, Reason, ResponseTimeout
 from app.link.client import RobotClient
 from app.link.host import WorkerHost
-from app.link.ops import CreatePoint, GoZero, MoveToPoint, RunProgram, Step
+from app.link.ops import CreatePoint, GoZero, Handlers, MoveToPoint, RunProgram, Step
 from app.link.tracker import CommandTracker
 from app.link.types import Operation
 from app.models import CommandResult, ControllerStatus, Pose
@@ -99,6 +99,14 @@ class MotionCommands:
 
     def __init__(self, host: WorkerHost) -> None:
         self._host = host
+
+    def register(self, handlers: Handlers) -> None:
+        """The operations these handlers run, in the worker's one table."""
+        handlers.add(Step, self.step)
+        handlers.add(GoZero, self.go_zero)
+        handlers.add(RunProgram, self.run_program)
+        handlers.add(MoveToPoint, self.move_to_point)
+        handlers.add(CreatePoint, self.create_point)
 
     def require_none(self, operation: str) -> None:
         """Refuse ``operation`` while a motion or an upload is under way."""

@@ -3,7 +3,7 @@
 ``RobotLink.submit(op)`` queues one of these and returns its ticket (the request id every
 ``CommandResult`` / ``WorkerError`` it causes carries; ``link.track(ticket)`` gives its
 :class:`~app.link.link_port.Pending`). The worker runs it through one table, operation type ->
-handler (:class:`Handlers`, filled by :class:`~app.link.worker.RobotWorker`).
+handler (:class:`Handlers`, the worker's, filled by its parts).
 
 Each class says what the queue needs of it (class attributes, not fields):
 
@@ -18,7 +18,10 @@ Each class says what the queue needs of it (class attributes, not fields):
   over a fresh connection; a release and a cancel need nothing of the link);
 * ``tracks_motion`` -- a motion whose outcome RobotLink keeps in ``motions_in_flight``.
 
-Adding an operation: a class here, a handler registered in the worker (the part that does it).
+Adding an operation: its class here, and its handler in the worker's part that runs it, added to
+the table by that part's ``register`` (:class:`~app.link.commands.WorkerCommands`,
+:class:`~app.link.motion.MotionCommands`); the caller submits it. Nothing else restates it:
+not RobotLink, not the port panels use, not the tests' fake link.
 """
 
 from __future__ import annotations

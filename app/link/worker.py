@@ -76,24 +76,7 @@ from app.link.commands import WorkerCommands
 from app.link.jobs import Job, JobQueue
 from app.link.jog import JogMachine, PreemptedError
 from app.link.motion import MotionCommands, MotionTracker
-from app.link.ops import (
-    CancelUpload,
-    CreatePoint,
-    GoZero,
-    Handlers,
-    JogPress,
-    JogRelease,
-    LinkOp,
-    MoveToPoint,
-    Pause,
-    Resume,
-    RunProgram,
-    SetJogRatio,
-    SetMode,
-    Step,
-    Stop,
-    UploadPoints,
-)
+from app.link.ops import CancelUpload, Handlers, LinkOp, Stop
 from app.link.poller import Poller
 from app.link.state import PollUpdate
 from app.link.stats import LinkStats
@@ -183,22 +166,11 @@ class RobotWorker(QObject):
         self.handlers = self._make_handlers()
 
     def _make_handlers(self) -> Handlers:
-        """The one table: operation type -> what runs it (worker thread)."""
-        handlers, commands = Handlers(), self.commands
-        handlers.add(Stop, commands.stop)
-        handlers.add(Pause, commands.pause)
-        handlers.add(Resume, commands.resume)
-        handlers.add(SetMode, commands.set_mode)
-        handlers.add(CancelUpload, commands.cancel_upload)
-        handlers.add(JogPress, commands.jog_press)
-        handlers.add(JogRelease, commands.jog_release)
-        handlers.add(SetJogRatio, commands.jog_ratio)
-        handlers.add(Step, self.motions.step)
-        handlers.add(GoZero, self.motions.go_zero)
-        handlers.add(RunProgram, self.motions.run_program)
-        handlers.add(MoveToPoint, self.motions.move_to_point)
-        handlers.add(CreatePoint, self.motions.create_point)
-        handlers.add(UploadPoints, commands.upload_points)
+        """The one table: operation type -> what runs it (worker thread); each part registers
+        the operations it runs."""
+        handlers = Handlers()
+        self.commands.register(handlers)  # the short ones (stop, pause, the jog ...)
+        self.motions.register(handlers)  # the long ones (step, move to point ...)
         return handlers
 
     # --- requests (any thread) ----------------------------------------------------------
