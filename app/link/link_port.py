@@ -98,10 +98,10 @@ class RequestRouter:
 
 class LinkPort(Protocol):
     """What panels and controllers use of the link (RobotLink fits; the tests' FakeLink too):
-    its state, ``submit(op)`` of one operation of :mod:`app.link.ops` (its ticket back: the
-    request id) and ``track(ticket)``; besides, the stops asked so far and the signals that are
-    not one request's outcome (the link came back, the controller restarted, another master, an
-    upload's points and progress)."""
+    its state (``state.stops_requested`` included), ``submit(op)`` of one operation of
+    :mod:`app.link.ops` (its ticket back: the request id) and ``track(ticket)``; besides, the
+    signals that are not one request's outcome (the link came back, the controller restarted,
+    another master, an upload's points and progress)."""
 
     controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
     controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
@@ -115,6 +115,3 @@ class LinkPort(Protocol):
     def submit(self, op: LinkOp) -> int: ...
 
     def track(self, request_id: int) -> Pending: ...
-
-    @property
-    def stops_requested(self) -> int: ...

@@ -103,7 +103,6 @@ class RobotLink(QObject):
         self._router = RequestRouter()
         self._motions: dict[int, str] = {}  # request id -> operation: motions sent, outcome not known yet
         self._shut = False
-        self._stops = 0  # Stops asked on the GUI thread (see stops_requested)
         self._capture_users = 0
         # What the worker gets when it is made (it is made by the first request: see _worker).
         self._poll_hz = float(poll_hz)
@@ -320,23 +319,13 @@ class RobotLink(QObject):
         nothing was queued. A :class:`~app.link.ops.Stop` is written at once on the stop line
         when there is one and goes before every queued job."""
         if isinstance(op, Stop):
-            self._stops += 1
+            self._state.note_stop()  # counted even after shutdown: state.stops_requested
         if self._shut:
             return 0
         request_id = self._worker.submit(op)
         if op.tracks_motion and request_id:
             self._motions[request_id] = op.operation
         return request_id
-
-    @property
-    def stops_requested(self) -> int:
-        """How many Stops were asked of this link so far (counted on the GUI thread, when asked).
-
-        A controller that chains a move after another request (the point guard: create the
-        points, then move) notes it when the chain begins and sends nothing more once it changed:
-        a Stop asked between the create's answer and the move's request must not be followed by
-        the move (the worker cancels only the motions queued *before* the Stop)."""
-        return self._stops
 
     # --- shutdown -----------------------------------------------------------------------
     @Slot()

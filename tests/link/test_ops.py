@@ -133,7 +133,7 @@ def test_the_link_is_one_port_submit_and_track() -> None:
     tickets = [fake.submit(op) for op in EVERY_OP]
     assert fake.kinds() == [type(op) for op in EVERY_OP] and len(set(tickets)) == len(tickets)
     assert fake.named(MoveToPoint) == [MoveToPoint(7)] and fake.last_id(MoveToPoint) == tickets[11]
-    assert fake.stops_requested == 1
+    assert fake.state.stops_requested == 1
 
 
 @dataclass(frozen=True)

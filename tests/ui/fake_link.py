@@ -70,13 +70,11 @@ class FakeLink(QObject):
         return self._router.track(request_id)
 
     def submit(self, op: LinkOp) -> int:
+        if isinstance(op, Stop):
+            self._state.note_stop()
         self._next_id += 1
         self.submitted.append(Submitted(op, self._next_id))
         return self._next_id
-
-    @property
-    def stops_requested(self) -> int:
-        return len(self.named(Stop))
 
     # --- for the tests
     def named(self, op_type: type[_Op]) -> list[_Op]:

@@ -130,7 +130,7 @@ class PlanRunController(QObject):
         self._sent: deque[int] = deque(maxlen=SENT_KEPT)
         self._move: Pending | None = None  # the outcome of the segment under way
         self._stop: Pending | None = None  # the outcome of our last stop
-        self._stops = 0  # link.stops_requested when the run began or resumed
+        self._stops = 0  # link.state.stops_requested when the run began or resumed
         self.audit: AuditLog | None = None  # the trail a pause of the run's own is recorded in
         self._foreign_at: float | None = None  # monotonic time of the last sign of another master
         self._foreign_paused = False  # paused by the run itself at such a sign (not the operator)
@@ -238,7 +238,7 @@ class PlanRunController(QObject):
             plan, loops=loops, start=start, start_loop=start_loop, single=single, progress=self._on_progress
         )
         self._plan = plan if isinstance(plan, Plan) else None
-        self._stops = link.stops_requested  # a Stop asked after this (any button): no further move
+        self._stops = link.state.stops_requested  # a Stop asked after this (any button): no further move
         self._outcome = None
         self.end_reason = ""
         self._by_operator = False
@@ -263,7 +263,7 @@ class PlanRunController(QObject):
             raise RuntimeError("there is no stopped or failed run to resume")
         link = self._require_link()
         runner.resume()
-        self._stops = link.stops_requested
+        self._stops = link.state.stops_requested
         self._outcome = None
         self.end_reason = ""
         self._by_operator = False
@@ -408,7 +408,7 @@ class PlanRunController(QObject):
     def _stop_asked_since_start(self) -> bool:
         """A Stop was asked of the link (any button: the window's STOP too) since the run began
         or resumed: nothing more is sent for this run."""
-        return self._link is not None and self._link.stops_requested != self._stops
+        return self._link is not None and self._link.state.stops_requested != self._stops
 
     def _end_stopped(self) -> None:
         """End the run as stopped by the operator before its next move went out."""

@@ -96,7 +96,7 @@ class PointSyncController(QObject):
         self._teach_name = ""
         self._move_id: int | None = None
         self._move_speed = DEFAULT_MOVE_SPEED
-        self._move_stops = 0  # link.stops_requested when the move began (a Stop since: no move)
+        self._move_stops = 0  # link.state.stops_requested when the move began (a Stop since: no move)
         self._guard = RunPoints(model)  # a move's point re-created and its arrival checked
         self._prepared: SegmentPoints | None = None  # the point of the move under way, as created
         # the controller (and boot) the ledger's sync states are true of (None: none met yet)
@@ -243,7 +243,7 @@ class PointSyncController(QObject):
         prepared = self._guard.begin(point_id, (point_id,))
         self._move_id = point_id
         self._move_speed = float(speed)
-        self._move_stops = link.stops_requested
+        self._move_stops = link.state.stops_requested
         self._set_operation("move")
         self._say(
             self.tr("Moving to {point} at {v} mm/s…").format(point=point.label, v=f"{speed:g}"), LEVEL_INFO
@@ -260,7 +260,7 @@ class PointSyncController(QObject):
         prepared = guard.finish_upload(link.state.connection.endpoint)
         guard.clear()
         assert prepared is not None
-        stopped_since = link.stops_requested != self._move_stops  # a Stop after the create's answer
+        stopped_since = link.state.stops_requested != self._move_stops  # a Stop after the create's answer
         if stopped_since or not (result.ok and prepared.all_created):
             if stopped_since or batch_reason(result.message) == "stopped":  # the operator's Stop
                 self._move_id = None
