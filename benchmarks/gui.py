@@ -58,6 +58,7 @@ from PySide6.QtCore import QEvent
 from PySide6.QtWidgets import QApplication
 
 from app.link.client import ConnectionSettings
+from app.link.ops import RunProgram, Stop
 from app.link.robot_link import RobotLink
 from app.link.types import LinkState
 from app.protocol.enums import ProgramMotionMode
@@ -187,7 +188,7 @@ def bench_window(
         if not _wait_until(lambda: counters.state.state is LinkState.CONNECTED):
             raise RuntimeError(f"could not connect to the simulator: {counters.state.message}")
         start = sim.write_count()
-        link.run_program(STREAM_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
+        link.submit(RunProgram(STREAM_PROGRAM, ProgramMotionMode.CYCLE, 0, 100))
         if not _wait_until(lambda: _motion_started(sim, start)):
             raise RuntimeError("the simulator did not start the streaming program")
         poses0, frames0, requests0 = counters.poses, counters.traffic_frames, sim.requests()
@@ -228,7 +229,7 @@ def bench_window(
             window.show_tab("monitor")
         out["event_loop_stall"] = stalls
         # End the streaming program the ordinary way before the stop-latency runs.
-        link.stop()
+        link.submit(Stop())
         if not _wait_until(lambda: not sim.busy()):
             raise RuntimeError("the streaming program did not stop")
         lap("streaming")

@@ -35,6 +35,7 @@ from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication
 import ui.main as teachpad
 from app.protocol.enums import ProgramMotionMode
+from app.link.ops import RunProgram, Stop
 settings_path, size, soak_s, every_s, settle_s, program = sys.argv[1:7]
 soak_s, every_s, settle_s, program = float(soak_s), float(every_s), float(settle_s), int(program)
 
@@ -148,7 +149,7 @@ class Probe(teachpad.MainWindow):
         gc.collect()
         report("idle")
         self.traffic_dock.raise_()  # the inspector shown too: its capture is part of the soak
-        self.link.run_program(program, ProgramMotionMode.CYCLE, 0, 100)
+        self.link.submit(RunProgram(program, ProgramMotionMode.CYCLE, 0, 100))
         self._bench_t0 = time.monotonic()
         self._bench_timer = QTimer(self)
         self._bench_timer.timeout.connect(self._bench_sample)
@@ -161,7 +162,7 @@ class Probe(teachpad.MainWindow):
                          or elapsed >= soak_s - 1e-3):
             trace(f"{elapsed:.0f} s")
         if time.monotonic() - self._bench_t0 >= soak_s - 1e-3:
-            self.link.stop()
+            self.link.submit(Stop())
             QApplication.instance().quit()
 teachpad.MainWindow = Probe
 teachpad.main(["--sim", "--settings", settings_path, "--size", size])

@@ -16,6 +16,7 @@ from pymodbus.client import ModbusTcpClient
 from PySide6.QtCore import QCoreApplication, QEvent, QPointF, Qt, QTimer
 from PySide6.QtGui import QMouseEvent
 
+from app.link.ops import RunProgram
 from app.protocol import registers as R  # noqa: N812
 from app.protocol.enums import ProgramMotionMode
 from app.sim import WriteRecord
@@ -96,7 +97,7 @@ def bench_stop_gui(
             break
         # (Re)start the motion and wait until the simulator runs it and a poll has seen it.
         start = sim.write_count()
-        link.run_program(STOP_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
+        link.submit(RunProgram(STOP_PROGRAM, ProgramMotionMode.CYCLE, 0, 100))
         if not _wait_until(functools.partial(_motion_started, sim, start)):
             failures += 1
             continue

@@ -54,6 +54,7 @@ from PySide6.QtCore import QEvent, QEventLoop, QObject, Qt, QTimer
 from PySide6.QtWidgets import QApplication
 
 from app.link.client import ConnectionSettings
+from app.link.ops import RunProgram, Stop
 from app.link.robot_link import RobotLink
 from app.link.types import ConnectionState, LinkState
 from app.models import ControllerStatus, Pose
@@ -139,12 +140,12 @@ def streaming_window(sim: RemoteSim, warm_s: float = 1.0) -> Iterator[tuple[Main
         if not _wait_until(lambda: counters.state.state is LinkState.CONNECTED):
             raise RuntimeError(f"could not connect to the simulator: {counters.state.message}")
         start = sim.write_count()
-        link.run_program(STREAM_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
+        link.submit(RunProgram(STREAM_PROGRAM, ProgramMotionMode.CYCLE, 0, 100))
         if not _wait_until(lambda: _motion_started(sim, start)):
             raise RuntimeError("the simulator did not start the streaming program")
         _run_for(warm_s)  # the plots' first paints and the stream's start are not the steady state
         yield window, counters
-        link.stop()
+        link.submit(Stop())
         _wait_until(lambda: not sim.busy())
     finally:
         if window is not None:

@@ -27,6 +27,7 @@ from ui.gui_gc import GuiThreadCollector
 from ui.startup_gc import StartupGcPause, gc_paused
 
 with gc_paused():  # the window's modules: many objects made, almost none freed (ui/startup_gc.py)
+    from app.link.ops import RunProgram
     from app.link.robot_link import RobotLink, wait_for_detached_threads
     from app.link.transport import ConnectionSettings
     from app.link.types import ConnectionState
@@ -460,7 +461,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
                 ConnectionSettings(host=sim.host, port=sim.port, unit=1, monitor_only=args.monitor_only)
             )
             if args.demo:
-                link.run_program(DEMO_PROGRAM, ProgramMotionMode.CYCLE, 0, 100)
+                link.submit(RunProgram(DEMO_PROGRAM, ProgramMotionMode.CYCLE, 0, 100))
 
         def sim_failed(reason: str) -> None:
             print(f"teachpad: could not start the simulator: {reason}", file=sys.stderr)

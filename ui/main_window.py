@@ -46,6 +46,7 @@ from PySide6.QtWidgets import (
 )
 
 from app import __version__
+from app.link.ops import Pause, Resume, Stop
 from app.link.robot_link import RobotLink
 from app.link.transport import ConnectionSettings
 from app.link.types import WorkerError
@@ -163,9 +164,9 @@ class MainWindow(QMainWindow):
             disconnect=self.link_guard.disconnect_link,
             reconnect=self.reconnect,
             can_reconnect=lambda: self.link_guard.last_connection() is not None,
-            stop=link.stop,
-            pause=link.pause,
-            resume=link.resume,
+            stop=lambda: link.submit(Stop()),
+            pause=lambda: link.submit(Pause()),
+            resume=lambda: link.submit(Resume()),
             about=self.show_about,
             show_tab=self.show_tab,
             tab_count=len(TAB_NAMES),

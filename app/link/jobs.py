@@ -1,45 +1,62 @@
 """The worker's job queue: the only state shared between the GUI thread and the worker thread.
 
-Requests from any thread become :class:`Job` s; the worker pops them on its own thread. Urgent
-jobs (stop, pause, resume, jog release, cancel upload) come out before every other job; a newer
-job with the same ``coalesce`` key takes the place of a queued one (the jog press and the jog
-speed), and an urgent job can drop queued jobs by key (a release drops a press not yet started).
+Operations submitted from any thread (:mod:`app.link.ops`) become :class:`Job` s; the worker
+pops them on its own thread. Urgent jobs (stop, pause, resume, jog release, cancel upload) come
+out before every other job; a newer job with the same ``coalesce`` key takes the place of a
+queued one (the jog press and the jog speed), and an urgent job can drop queued jobs by key (a
+release drops a press not yet started). Each op's class says which it is.
 ``halts`` counts the queued jobs that end a running upload (stop, cancel upload): an upload sees
 one queued after it began before that job runs, and writes nothing more that it would not need.
 """
 
 from __future__ import annotations
 
-import enum
 import itertools
 import threading
 from collections import deque
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
-__all__ = ["JOG_PRESS", "JOG_RATIO", "Job", "JobKind", "JobQueue"]
+from app.link.ops import JobKind, LinkOp
 
-JOG_PRESS = "jog press"  # coalesce key of the jog press
-JOG_RATIO = "jog ratio"  # coalesce key of the live jog speed
+if TYPE_CHECKING:  # the stop line needs pymodbus; the queue is imported by the GUI before any worker
+    from app.link.stop_line import StopSent
 
-
-class JobKind(enum.Enum):
-    URGENT = "urgent"  # stop / pause / resume / jog release: ahead of everything
-    MOTION = "motion"  # cancelled by a stop queued after it
-    PLAIN = "plain"
+__all__ = ["Job", "JobQueue"]
 
 
 @dataclass
 class Job:
-    operation: str
-    run: Callable[[], None]
-    kind: JobKind
+    """One submitted operation in the queue; what the queue needs comes from the op's class."""
+
+    op: LinkOp
     seq: int = 0
     request_id: int = 0
-    coalesce: str | None = None  # a newer job with the same key replaces a queued one
-    needs_link: bool = True
-    cancels: tuple[str, ...] = ()  # an urgent job drops the queued jobs with these coalesce keys
     sent: threading.Event | None = None  # set by the worker once the job's first write is out (stop)
+    on_line: StopSent | None = None  # a Stop already written on the stop line (its answer to read)
+
+    @property
+    def operation(self) -> str:
+        return self.op.operation
+
+    @property
+    def kind(self) -> JobKind:
+        return self.op.kind
+
+    @property
+    def coalesce(self) -> str | None:
+        """A newer job with the same key replaces a queued one."""
+        return self.op.coalesce
+
+    @property
+    def cancels(self) -> tuple[str, ...]:
+        """An urgent job drops the queued jobs with these coalesce keys."""
+        return self.op.cancels
+
+    @property
+    def needs_link(self) -> bool:
+        return self.op.needs_link
 
 
 class JobQueue:

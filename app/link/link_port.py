@@ -4,15 +4,14 @@ fits (and the tests' small fake), :class:`Pending`, one request's outcome, and
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
 from typing import Protocol
 
 from PySide6.QtCore import QMetaMethod, QObject, QTimer, Signal, SignalInstance
 
+from app.link.ops import LinkOp
 from app.link.state import RobotState
-from app.link.types import StepFrame, WorkerError
+from app.link.types import WorkerError
 from app.models import CommandResult
-from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
 
 __all__ = ["LinkPort", "Pending", "RequestRouter"]
 
@@ -98,7 +97,11 @@ class RequestRouter:
 
 
 class LinkPort(Protocol):
-    """What panels and controllers use of the link, with the real types (RobotLink fits)."""
+    """What panels and controllers use of the link (RobotLink fits; the tests' FakeLink too):
+    its state (``state.stops_requested`` included), ``submit(op)`` of one operation of
+    :mod:`app.link.ops` (its ticket back: the request id) and ``track(ticket)``; besides, the
+    signals that are not one request's outcome (the link came back, the controller restarted,
+    another master, an upload's points and progress)."""
 
     controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
     controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
@@ -109,64 +112,6 @@ class LinkPort(Protocol):
     @property
     def state(self) -> RobotState: ...
 
+    def submit(self, op: LinkOp) -> int: ...
+
     def track(self, request_id: int) -> Pending: ...
-
-    def stop(self) -> int: ...
-
-    @property
-    def stops_requested(self) -> int: ...
-
-    def pause(self) -> int: ...
-
-    def resume(self) -> int: ...
-
-    def jog_press(
-        self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0, tool: int = 0
-    ) -> int: ...
-
-    def jog_release(self) -> int: ...
-
-    def set_jog_ratio(self, ratio: float) -> int: ...
-
-    def step(
-        self,
-        frame: StepFrame,
-        offsets: Sequence[float],
-        ext_offsets: Sequence[float] = ...,
-        speed: float = ...,
-    ) -> int: ...
-
-    def set_mode(self, mode: WorkMode) -> int: ...
-
-    def go_zero(self, axis: int | None, *, switch_to_auto: bool = ...) -> int: ...
-
-    def run_program(
-        self,
-        program_id: int,
-        mode: ProgramMotionMode = ...,
-        cycles: int = ...,
-        speed_ratio: int = ...,
-        *,
-        switch_to_auto: bool = ...,
-    ) -> int: ...
-
-    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = ...) -> int: ...
-
-    def move_to_point(
-        self,
-        end_id: int,
-        via_id: int | None = None,
-        *,
-        orientation_changes: bool = ...,
-        ignore_middle: bool = ...,
-        speed: float = ...,
-        tool: int = ...,
-    ) -> int: ...
-
-    def upload_points(
-        self,
-        points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
-        tool: int = ...,
-    ) -> int: ...
-
-    def cancel_upload(self) -> int: ...

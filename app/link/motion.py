@@ -14,18 +14,17 @@ from __future__ import annotations
 import dataclasses
 import logging
 import time
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
 from app import timing
 from app.errors import InvalidInput, MalformedResponse, ModbusExceptionError, Reason, ResponseTimeout
-from app.link.client import RobotClient, StepFrame
+from app.link.client import RobotClient
 from app.link.host import WorkerHost
+from app.link.ops import CreatePoint, GoZero, Handlers, MoveToPoint, RunProgram, Step
 from app.link.tracker import CommandTracker
 from app.link.types import Operation
 from app.models import CommandResult, ControllerStatus, Pose
-from app.protocol.enums import ProgramMotionMode
 
 __all__ = ["ActiveCommand", "Completion", "MotionCommands", "MotionTracker"]
 
@@ -95,10 +94,19 @@ class MotionTracker:
 
 
 class MotionCommands:
-    """The job bodies of the long commands (worker thread; errors propagate to the executor)."""
+    """The handlers of the long commands' operations (:mod:`app.link.ops`; worker thread;
+    errors propagate to the executor)."""
 
     def __init__(self, host: WorkerHost) -> None:
         self._host = host
+
+    def register(self, handlers: Handlers) -> None:
+        """The operations these handlers run, in the worker's one table."""
+        handlers.add(Step, self.step)
+        handlers.add(GoZero, self.go_zero)
+        handlers.add(RunProgram, self.run_program)
+        handlers.add(MoveToPoint, self.move_to_point)
+        handlers.add(CreatePoint, self.create_point)
 
     def require_none(self, operation: str) -> None:
         """Refuse ``operation`` while a motion or an upload is under way."""
@@ -159,56 +167,40 @@ class MotionCommands:
                 return
             time.sleep(tracker.poll_interval(now))
 
-    def step(self, frame: StepFrame, offsets: Sequence[float], ext: Sequence[float], speed: float) -> None:
+    def step(self, op: Step) -> None:
         client = self._begin(Operation.STEP)
-        client.step(frame, offsets, ext, speed, wait=False)
+        client.step(op.frame, op.offsets, op.ext_offsets, op.speed, wait=False)
         self._track_last(client, Operation.STEP, motion=True)
 
-    def move_to_point(
-        self,
-        end_id: int,
-        via_id: int | None,
-        orientation_changes: bool,
-        ignore_middle: bool,
-        speed: float,
-        tool: int,
-    ) -> None:
+    def move_to_point(self, op: MoveToPoint) -> None:
         client = self._begin(Operation.MOVE_TO_POINT)
         client.move_to_point(
-            end_id,
-            via_id=via_id,
-            orientation_changes=orientation_changes,
-            ignore_middle=ignore_middle,
-            speed=speed,
-            tool=tool,
+            op.end_id,
+            via_id=op.via_id,
+            orientation_changes=op.orientation_changes,
+            ignore_middle=op.ignore_middle,
+            speed=op.speed,
+            tool=op.tool,
             wait=False,
         )
         self._track_last(client, Operation.MOVE_TO_POINT, motion=True)
 
-    def go_zero(self, axis: int | None, switch_to_auto: bool = False) -> None:
+    def go_zero(self, op: GoZero) -> None:
         client = self._begin(Operation.GO_ZERO)
         before = self._host.poller.last_pose  # (the client reads it when there was no poll yet)
-        self._track(
-            Operation.GO_ZERO, client.go_zero(axis, before=before, switch_to_auto=switch_to_auto), motion=True
-        )
+        completion = client.go_zero(op.axis, before=before, switch_to_auto=op.switch_to_auto)
+        self._track(Operation.GO_ZERO, completion, motion=True)
 
-    def run_program(
-        self,
-        program_id: int,
-        mode: ProgramMotionMode,
-        cycles: int,
-        speed_ratio: int,
-        switch_to_auto: bool = False,
-    ) -> None:
+    def run_program(self, op: RunProgram) -> None:
         client = self._begin(Operation.RUN_PROGRAM)
         before = self._host.poller.last_pose
         watch = client.run_program(
-            program_id, mode, cycles, speed_ratio, before=before, switch_to_auto=switch_to_auto
+            op.program_id, op.mode, op.cycles, op.speed_ratio, before=before, switch_to_auto=op.switch_to_auto
         )
         self._track(Operation.RUN_PROGRAM, watch, motion=True)
 
-    def create_point(self, point_id: int, pose: Sequence[float] | None, tool: int) -> None:
+    def create_point(self, op: CreatePoint) -> None:
         self.require_none(Operation.CREATE_POINT)
         client = self._host.client_or_raise()
-        client.create_point(point_id, pose=pose, tool=tool, wait=False)
+        client.create_point(op.point_id, pose=op.pose, tool=op.tool, wait=False)
         self._track_last(client, Operation.CREATE_POINT, motion=False)

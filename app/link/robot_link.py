@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import logging
 import sys
-from collections.abc import Iterable, Sequence
 from types import EllipsisType
 from typing import TYPE_CHECKING
 
@@ -29,13 +28,12 @@ from PySide6.QtCore import (
 from app import timing
 from app.errors import Reason
 from app.link.link_port import LinkPort, Pending, RequestRouter
+from app.link.ops import LinkOp, Stop
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, PollUpdate, RobotState
 from app.link.stats import LinkStats
 from app.link.transport import ConnectionSettings
-from app.link.types import ConnectionState, JogRequest, LinkState, Operation, StepFrame, WorkerError
+from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult, ControllerStatus, Pose
-from app.protocol import registers
-from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
 
 if TYPE_CHECKING:  # the worker (pymodbus, the envelope's numpy) is imported by the first request
     from app.link.worker import RobotWorker
@@ -105,7 +103,6 @@ class RobotLink(QObject):
         self._router = RequestRouter()
         self._motions: dict[int, str] = {}  # request id -> operation: motions sent, outcome not known yet
         self._shut = False
-        self._stops = 0  # Stops asked on the GUI thread (see stops_requested)
         self._capture_users = 0
         # What the worker gets when it is made (it is made by the first request: see _worker).
         self._poll_hz = float(poll_hz)
@@ -209,11 +206,6 @@ class RobotLink(QObject):
         """The operations (:class:`~app.link.types.Operation` values) of the motion requests
         (step, go to zero, run program, move to point) whose outcome has not come back yet."""
         return tuple(self._motions.values())
-
-    def _motion(self, operation: str, request_id: int) -> int:
-        if request_id:
-            self._motions[request_id] = operation
-        return request_id
 
     def track(self, request_id: int) -> Pending:
         """The :class:`Pending` of a request id this link returned (call it right away, in the
@@ -320,117 +312,20 @@ class RobotLink(QObject):
         if self._made is not None:
             self._captureRequested.emit(self._capture_users > 0)
 
-    # --- commands (queued; results come back as signals) -------------------------------
-    # Each returns the request id that its CommandResult / WorkerError will carry (0 after shutdown:
-    # nothing was queued).
-    def stop(self) -> int:
-        self._stops += 1
-        return 0 if self._shut else self._worker.request_stop()
-
-    @property
-    def stops_requested(self) -> int:
-        """How many Stops were asked of this link so far (counted on the GUI thread, when asked).
-
-        A controller that chains a move after another request (the point guard: create the
-        points, then move) notes it when the chain begins and sends nothing more once it changed:
-        a Stop asked between the create's answer and the move's request must not be followed by
-        the move (the worker cancels only the motions queued *before* the Stop)."""
-        return self._stops
-
-    def pause(self) -> int:
-        return 0 if self._shut else self._worker.request_pause()
-
-    def resume(self) -> int:
-        return 0 if self._shut else self._worker.request_resume()
-
-    def jog_press(
-        self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0, tool: int = 0
-    ) -> int:
+    # --- requests (queued; results come back as signals) -------------------------------
+    def submit(self, op: LinkOp) -> int:
+        """Queue the operation ``op`` (:mod:`app.link.ops`); returns its ticket, the request id
+        its ``CommandResult`` / ``WorkerError`` will carry (:meth:`track` it). 0 after shutdown:
+        nothing was queued. A :class:`~app.link.ops.Stop` is written at once on the stop line
+        when there is one and goes before every queued job."""
+        if isinstance(op, Stop):
+            self._state.note_stop()  # counted even after shutdown: state.stops_requested
         if self._shut:
             return 0
-        request = JogRequest(TeachFrame(frame), axis, direction, ratio, user, tool)
-        return self._worker.request_jog_press(request)
-
-    def jog_release(self) -> int:
-        return 0 if self._shut else self._worker.request_jog_release()
-
-    def set_jog_ratio(self, ratio: float) -> int:
-        return 0 if self._shut else self._worker.request_jog_ratio(ratio)
-
-    def step(
-        self,
-        frame: StepFrame,
-        offsets: Sequence[float],
-        ext_offsets: Sequence[float] = (0.0,) * registers.NUM_EXTERNAL_AXES,
-        speed: float = 10.0,
-    ) -> int:
-        if self._shut:
-            return 0
-        return self._motion(Operation.STEP, self._worker.request_step(frame, offsets, ext_offsets, speed))
-
-    def set_mode(self, mode: WorkMode) -> int:
-        return 0 if self._shut else self._worker.request_set_mode(mode)
-
-    def go_zero(self, axis: int | None, *, switch_to_auto: bool = False) -> int:
-        if self._shut:
-            return 0
-        return self._motion(Operation.GO_ZERO, self._worker.request_go_zero(axis, switch_to_auto))
-
-    def run_program(
-        self,
-        program_id: int,
-        mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
-        cycles: int = 1,
-        speed_ratio: int = 100,
-        *,
-        switch_to_auto: bool = False,
-    ) -> int:
-        if self._shut:
-            return 0
-        request_id = self._worker.request_run_program(program_id, mode, cycles, speed_ratio, switch_to_auto)
-        return self._motion(Operation.RUN_PROGRAM, request_id)
-
-    def create_point(
-        self, point_id: int, pose: Sequence[float] | None = None, tool: int = registers.TOOL_NONE
-    ) -> int:
-        return 0 if self._shut else self._worker.request_create_point(point_id, pose, tool)
-
-    def move_to_point(
-        self,
-        end_id: int,
-        via_id: int | None = None,
-        *,
-        orientation_changes: bool = True,
-        ignore_middle: bool = False,
-        speed: float = 50.0,
-        tool: int = registers.TOOL_NONE,
-    ) -> int:
-        if self._shut:
-            return 0
-        request_id = self._worker.request_move_to_point(
-            end_id, via_id, orientation_changes, ignore_middle, speed, tool
-        )
-        return self._motion(Operation.MOVE_TO_POINT, request_id)
-
-    def upload_points(
-        self,
-        points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
-        tool: int = registers.TOOL_NONE,
-    ) -> int:
-        """Create temp points from (id, pose6, tool) items ((id, pose6) items take ``tool``).
-
-        The worker groups them by tool frame (GV245 written once per group) and reports each
-        point with ``pointUploaded``, progress with ``uploadProgress`` and the batch with one
-        ``commandFinished`` carrying the returned id. Stop or :meth:`cancel_upload` end it
-        between two points."""
-        if self._shut:
-            return 0
-        items = [(item[0], item[1], item[2] if len(item) > 2 else tool) for item in points]
-        return self._worker.request_upload_points(items)
-
-    def cancel_upload(self) -> int:
-        """End the running upload after the current point; sends no stop to the controller."""
-        return 0 if self._shut else self._worker.request_cancel_upload()
+        request_id = self._worker.submit(op)
+        if op.tracks_motion and request_id:
+            self._motions[request_id] = op.operation
+        return request_id
 
     # --- shutdown -----------------------------------------------------------------------
     @Slot()

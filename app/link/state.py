@@ -89,6 +89,7 @@ class RobotState(QObject):
         self._rtt: float | None = None
         self._stats = LinkStats()
         self._halt: UnconfirmedHalt | None = None
+        self._stops = 0
         self._timer = QTimer(self)
         self._timer.setSingleShot(True)
         self._timer.timeout.connect(self._check_freshness)
@@ -229,6 +230,21 @@ class RobotState(QObject):
         if halt != self._halt:
             self._halt = halt
             self.haltChanged.emit(halt)
+
+    @property
+    def stops_requested(self) -> int:
+        """How many Stops were asked of the link so far (counted on the GUI thread, when asked,
+        by the link's ``submit``).
+
+        A controller that chains a move after another request (the point guard: create the
+        points, then move) notes it when the chain begins and sends nothing more once it changed:
+        a Stop asked between the create's answer and the move's request must not be followed by
+        the move (the worker cancels only the motions queued *before* the Stop)."""
+        return self._stops
+
+    def note_stop(self) -> None:
+        """A Stop was asked (the link's ``submit``, before anything else)."""
+        self._stops += 1
 
     # --- freshness ------------------------------------------------------------------------
     def _remaining(self) -> float:

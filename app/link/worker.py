@@ -27,15 +27,19 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
   (a command's frames reach the GUI before its outcome), before a ``connectionChanged``, when
   polling stops, when capture is switched off and at shutdown: no frame is left behind.
 
-The job bodies (``_do_stop`` ...) are in :mod:`app.link.commands`, the request API in
-:mod:`app.link.requests`.
+Requests are operations as data (:mod:`app.link.ops`): :meth:`RobotWorker.submit` queues one
+and returns its ticket (request id); the worker runs each through one table, operation type ->
+handler (``handlers``). The handlers of the short commands (``stop`` ...) are in
+:class:`~app.link.commands.WorkerCommands`, those of the long ones in
+:class:`~app.link.motion.MotionCommands`: parts the worker composes, like the others.
 
-Stop latency: :meth:`RobotWorker.request_stop` writes the stop from the calling thread on the stop
-line (:mod:`app.link.stop_line`) when there is one; the stop job then writes it on the main link
-too, after the transaction in flight (ordering), and reads the line's answer. Without a line the
-GUI thread waits (GIL released, at most :data:`STOP_HANDOFF_WAIT`) for the worker to write it.
+Stop latency: :meth:`RobotWorker.submit` of a :class:`~app.link.ops.Stop` writes the stop from
+the calling thread on the stop line (:mod:`app.link.stop_line`) when there is one; the stop job
+then writes it on the main link too, after the transaction in flight (ordering), and reads the
+line's answer. Without a line the GUI thread waits (GIL released, at most
+:data:`STOP_HANDOFF_WAIT`) for the worker to write it.
 
-Every :class:`RobotLink` command returns an ``int`` request id; each :class:`CommandResult` /
+Every submitted operation gets an ``int`` request id; each :class:`CommandResult` /
 :class:`WorkerError` it causes carries it. Every failure becomes a signal (``commandFinished``:
 the outcome of every command that reached the controller; ``errorOccurred``: everything else).
 
@@ -50,6 +54,7 @@ import logging
 import threading
 import time
 from collections import deque
+from collections.abc import Callable
 
 import numpy  # noqa: F401 - the jog guard's arithmetic (app/lazy_numpy.py): imported with the worker,
 from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot  # not by a check mid-jog
@@ -71,8 +76,8 @@ from app.link.commands import WorkerCommands
 from app.link.jobs import Job, JobQueue
 from app.link.jog import JogMachine, PreemptedError
 from app.link.motion import MotionCommands, MotionTracker
+from app.link.ops import CancelUpload, Handlers, LinkOp, Stop
 from app.link.poller import Poller
-from app.link.requests import STOP_HANDOFF_WAIT, WorkerRequests
 from app.link.state import PollUpdate
 from app.link.stats import LinkStats
 from app.link.stop_line import StopLine
@@ -92,8 +97,14 @@ _log = logging.getLogger(__name__)
 #: Kept for importers; the GUI's shutdown waits :data:`app.timing.SHUTDOWN_WAIT` (read at use time).
 SHUTDOWN_TIMEOUT_MS = round(timing.SHUTDOWN_WAIT * 1000)
 
+#: How long a thread that submits a Stop waits (GIL released) for the worker to send it (s). While
+#: it waits, the poster (the GUI thread) cannot hold the GIL the worker needs to write the stop:
+#: measured, that wait was most of a Stop's latency (the worker waiting for a busy GUI thread's
+#: GIL, the in-flight poll finishing in slow motion). A rare event: a short freeze is the price.
+STOP_HANDOFF_WAIT = 0.005
 
-class RobotWorker(WorkerCommands, WorkerRequests, QObject):
+
+class RobotWorker(QObject):
     """Owns the RobotClient in the worker thread and composes the parts; see the module docstring."""
 
     polled = Signal(object)  # PollUpdate: a poll's pose/status/alarms/freshness, its one delivery
@@ -124,7 +135,7 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
     ) -> None:
         super().__init__()
         self._poll_hz = float(poll_hz)
-        self._jobs = JobQueue(halting=(Operation.STOP, Operation.CANCEL_UPLOAD))
+        self._jobs = JobQueue(halting=(Stop.operation, CancelUpload.operation))
         self._wake.connect(self._on_wake, Qt.ConnectionType.QueuedConnection)
         self._uploadStep.connect(self._upload_step, Qt.ConnectionType.QueuedConnection)
         # Everything below is touched only in the worker thread.
@@ -132,7 +143,6 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         self.audit: AuditLog | None = None  # set before connecting (set_audit); thread-safe
         self.caps: MotionCaps | None = None  # reduced-speed mode's caps (set_motion_caps)
         self.request_id: int | None = None  # request id of the job being executed
-        self._current_seq = 0  # sequence number of the job being executed
         self._current_job: Job | None = None
         self._in_urgent = False
         self._worker_ident: int | None = None  # the worker thread, once started (request_stop)
@@ -152,6 +162,39 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         # a stop counts on the stop line before its 441 goes out, then (and a cancel) in the queue
         self.uploader = Uploader(self, lambda: self.stop_line.stops_requested + self._jobs.halts)
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
+        self.commands = WorkerCommands(self)  # the short commands' handlers
+        self.handlers = self._make_handlers()
+
+    def _make_handlers(self) -> Handlers:
+        """The one table: operation type -> what runs it (worker thread); each part registers
+        the operations it runs."""
+        handlers = Handlers()
+        self.commands.register(handlers)  # the short ones (stop, pause, the jog ...)
+        self.motions.register(handlers)  # the long ones (step, move to point ...)
+        return handlers
+
+    # --- requests (any thread) ----------------------------------------------------------
+    def submit(self, op: LinkOp) -> int:
+        """Queue ``op`` and wake the worker; returns the request id its results will carry.
+
+        A :class:`~app.link.ops.Stop` is written now on the stop line when there is one
+        (app/link/stop_line.py), then queued first in line (the main link's stop, the line's
+        answer, the bookkeeping). Without a stop line, from another thread, this waits (GIL
+        released) until the worker has written it, at most :data:`STOP_HANDOFF_WAIT`, so nothing
+        of the caller's runs first. The stop runs whatever the link's state: without a link it
+        goes over a fresh connection to the last controller (``WorkerCommands.stop``)."""
+        if not isinstance(op, Stop):
+            request_id = self._jobs.put(Job(op))
+            self._wake.emit()
+            return request_id
+        on_line = self.stop_line.send_stop()
+        sent = threading.Event()
+        request_id = self._jobs.put(Job(op, sent=sent, on_line=on_line))
+        self._wake.emit()
+        worker = self._worker_ident
+        if on_line is None and worker is not None and worker != threading.get_ident():
+            sent.wait(STOP_HANDOFF_WAIT)
+        return request_id
 
     # --- lifecycle (worker thread) ------------------------------------------------------
     @Slot()
@@ -262,6 +305,17 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
                 timer.setInterval(interval)
 
     # --- the host of the parts (worker thread) ------------------------------------------
+    @property
+    def current_job(self) -> Job | None:
+        """The job being executed (None between jobs)."""
+        return self._current_job
+
+    def cancel_queued(self, predicate: Callable[[Job], bool]) -> list[Job]:
+        return self._jobs.cancel(predicate)
+
+    def next_upload_step(self) -> None:
+        self._uploadStep.emit()
+
     @property
     def client(self) -> RobotClient | None:
         return self.supervisor.client
@@ -456,35 +510,38 @@ class RobotWorker(WorkerCommands, WorkerRequests, QObject):
         if not held and self._must_wait(job):
             self._held.append(job)
             return
-        outer_seq, self._current_seq = self._current_seq, job.seq
-        outer_id, self.request_id = self.request_id, job.request_id
-        outer_job, self._current_job = self._current_job, job
+        outer = (self.request_id, self._current_job)
+        self.request_id, self._current_job = job.request_id, job
         try:
-            job.run()
+            self.handlers.run(job.op)
         except PreemptedError:
             pass
-        except WriteBlocked as exc:
-            self.emit_exception(job.operation, exc)
-        except (LinkError, ResponseTimeout, MalformedResponse) as exc:
-            # Malformed: the transport already resynchronised; the command's outcome is unknown.
-            self.emit_exception(job.operation, exc)
-            self.supervisor.transport_failed(exc)
-        except ModbusExceptionError as exc:
-            self.emit_result(
-                CommandResult(None, None, None, False, f"{job.operation}: {exc}", reason=exc.as_reason())
-            )
-        except CommandRefused as exc:
-            self.emit_result(
-                CommandResult(None, exc.status.kind, exc.status, False, str(exc), reason=exc.as_reason())
-            )
-        except TeachPadError as exc:  # InvalidInput and the rest
-            self.emit_exception(job.operation, exc)
-        except Exception as exc:  # a bug: report it plainly, keep the worker alive
-            _log.exception("%s failed", job.operation)
-            self.emit_exception(job.operation, exc)
+        except Exception as exc:  # every failure becomes a signal; the worker stays alive
+            self._report_failure(job.operation, exc)
         finally:
             if job.sent is not None:
                 job.sent.set()  # also when it failed: the poster waits no longer
-            self._current_seq = outer_seq
-            self.request_id = outer_id
-            self._current_job = outer_job
+            self.request_id, self._current_job = outer
+
+    def _report_failure(self, operation: str, exc: Exception) -> None:
+        """A job's failure as its signal: the controller's refusal (a Modbus exception, a refused
+        status) is the request's failed result; anything else an error, and a link failure (or a
+        malformed answer: the transport resynchronised, the outcome is unknown) also counts
+        against the link. Monitor-only's refusal before the wire is only an error."""
+        if isinstance(exc, ModbusExceptionError):
+            text = f"{operation}: {exc}"
+            self.emit_result(CommandResult(None, None, None, False, text, reason=exc.as_reason()))
+            return
+        if isinstance(exc, CommandRefused):
+            status = exc.status
+            self.emit_result(
+                CommandResult(None, status.kind, status, False, str(exc), reason=exc.as_reason())
+            )
+            return
+        if not isinstance(exc, TeachPadError):  # a bug: report it plainly
+            _log.error("%s failed", operation, exc_info=exc)
+        self.emit_exception(operation, exc)
+        if isinstance(exc, LinkError | ResponseTimeout | MalformedResponse) and not isinstance(
+            exc, WriteBlocked
+        ):
+            self.supervisor.transport_failed(exc)

@@ -25,7 +25,9 @@ sys.path.insert(0, str(REPO))
 
 from app import timing  # noqa: E402
 from app.link.client import ConnectionSettings  # noqa: E402
+from app.link.ops import JogPress, JogRelease  # noqa: E402
 from app.link.robot_link import RobotLink  # noqa: E402
+from app.link.types import JogRequest  # noqa: E402
 from app.protocol.enums import TeachFrame  # noqa: E402
 from app.safety.envelope import Box, Envelope  # noqa: E402
 from app.safety.roles import Action, Role  # noqa: E402
@@ -76,9 +78,9 @@ def main() -> None:
         keep_in=Box("cell", (xs[0] - 300, ys[0] - 300, 0.0), (xs[-1] + 300, ys[-1] + 300, zs[-1] + 400)),
         keep_out=(Box("fixture", (mid[0] - 60, mid[1] - 60, zs[0] - 200), (mid[0] + 60, mid[1] + 60, mid[2])),),
         max_jog_ratio=50.0, max_speed=500.0))
-    link.jog_press(TeachFrame.BASE, 0, 1, 10.0)
+    link.submit(JogPress(JogRequest(TeachFrame.BASE, 0, 1, 10.0)))
     _spin(0.6)
-    link.jog_release()
+    link.submit(JogRelease())
     _spin(0.5)
     safety.logout()
     safety.allowed(Action.CONNECTION)  # an operator tries: refused, audited

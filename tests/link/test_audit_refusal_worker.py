@@ -12,6 +12,7 @@ from typing import Any
 
 import pytest
 
+from app.link.ops import CreatePoint, Stop
 from app.link.robot_link import RobotLink
 from app.link.types import WorkerError
 from app.protocol import registers
@@ -41,7 +42,7 @@ def test_the_gui_link_refuses_a_write_it_cannot_record(
     audit._append = full  # type: ignore[method-assign]  # the disk is full from now on
     before = len(sim.writes)
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as refused:
-        link.create_point(3001, None)
+        link.submit(CreatePoint(3001, None))
     error: WorkerError = refused.args[0]
     assert error.reason is not None and error.reason.code == "audit_unavailable"
     assert "not sent" in error.message and "No space left on device" in error.message
@@ -50,7 +51,7 @@ def test_the_gui_link_refuses_a_write_it_cannot_record(
     assert sim.writes[before:] == []  # at the simulator: nothing went out
     assert heard and "cannot be written" in heard[0]
     # Stop goes out whatever the disk says
-    link.stop()
+    link.submit(Stop())
     qtbot.waitUntil(
         lambda: any(w.address == registers.REG_STOP for w in sim.writes[before:]), timeout=SIGNAL_TIMEOUT_MS
     )

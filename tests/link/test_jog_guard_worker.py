@@ -10,8 +10,9 @@ from typing import Any
 
 import pytest
 
+from app.link.ops import CreatePoint, JogPress, JogRelease
 from app.link.robot_link import RobotLink
-from app.link.types import WorkerError
+from app.link.types import JogRequest, WorkerError
 from app.protocol.enums import TeachFrame
 from app.safety.audit import AuditLog, FsyncPolicy
 from app.safety.envelope import Box, Envelope, ViolationCode
@@ -39,7 +40,7 @@ def _guard(link: RobotLink, y_limit: float) -> JogGuard:
 
 
 def _press(link: RobotLink, direction: int) -> int:
-    return link.jog_press(TeachFrame.BASE, 1, direction, JOG_RATIO)
+    return link.submit(JogPress(JogRequest(TeachFrame.BASE, 1, direction, JOG_RATIO)))
 
 
 def test_jog_toward_the_boundary_stops_short_of_it(qtbot: Any, sim: Any, link: RobotLink) -> None:
@@ -57,7 +58,7 @@ def test_jog_toward_the_boundary_stops_short_of_it(qtbot: Any, sim: Any, link: R
     assert max(ratios) == JOG_RATIO and ratios[-1] == 0.0
     y_stop = sim.state().pose[1]
     assert y0 < y_stop < y_limit
-    link.jog_release()
+    link.submit(JogRelease())
 
     # Further in: refused before any ratio is written.
     count = len(ratio_writes(sim))
@@ -71,7 +72,7 @@ def test_jog_toward_the_boundary_stops_short_of_it(qtbot: Any, sim: Any, link: R
     # Back out: allowed, the arm moves away from the face.
     _press(link, 0)
     qtbot.waitUntil(lambda: jogging(sim) and sim.state().pose[1] < y_stop - 1.0, timeout=SIGNAL_TIMEOUT_MS)
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     assert ratio_writes(sim)[-1] == 0.0
 
@@ -106,7 +107,7 @@ def test_a_late_poll_does_not_carry_the_arm_over_the_face(
     sim.set_response_delay(0.0)
     sim.set_slow_answers(0.0, 0)
     assert y0 < y_stop < y_limit  # at the simulator: short of the face
-    link.jog_release()
+    link.submit(JogRelease())
 
 
 def test_without_a_guard_the_jog_runs(qtbot: Any, sim: Any, link: RobotLink) -> None:
@@ -115,7 +116,7 @@ def test_without_a_guard_the_jog_runs(qtbot: Any, sim: Any, link: RobotLink) -> 
     y0 = sim.state().pose[1]
     _press(link, 1)
     qtbot.waitUntil(lambda: jogging(sim) and sim.state().pose[1] > y0 + MARGIN_MM, timeout=SIGNAL_TIMEOUT_MS)
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
 
 
@@ -125,10 +126,10 @@ def test_every_write_appears_once_in_the_audit(qtbot: Any, sim: Any, link: Robot
     connect(qtbot, link, sim, poll_timeout=1.0)
     _press(link, 1)
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not jogging(sim) and ratio_writes(sim)[-1] == 0.0, timeout=SIGNAL_TIMEOUT_MS)
     with qtbot.waitSignal(link.commandFinished, timeout=SIGNAL_TIMEOUT_MS):
-        link.create_point(3001, None)
+        link.submit(CreatePoint(3001, None))
     qtbot.waitUntil(lambda: 3001 in sim.state().points, timeout=SIGNAL_TIMEOUT_MS)
     link.disconnect()  # ratio 0 / teach disable go out too
     qtbot.waitUntil(lambda: not sim.state().teach_enabled, timeout=SIGNAL_TIMEOUT_MS)

@@ -17,8 +17,9 @@ from pymodbus.constants import ExcCodes
 
 from app import timing
 from app.link.client import StepFrame
+from app.link.ops import JogPress, JogRelease, Step, Stop
 from app.link.robot_link import RobotLink
-from app.link.types import HaltKind, UnconfirmedHalt
+from app.link.types import HaltKind, JogRequest, UnconfirmedHalt
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import TeachFrame
@@ -62,7 +63,7 @@ def _keep_in_below(z_face: float) -> JogGuard:
 def _jog_up(qtbot: Any, link: RobotLink, sim: Any) -> float:
     """Jog Z+ at 10 % until the arm is seen moving; returns the Z it started from."""
     z0 = float(sim.state().pose[2])
-    link.jog_press(TeachFrame.BASE, Z_AXIS, PLUS, JOG_RATIO)
+    link.submit(JogPress(JogRequest(TeachFrame.BASE, Z_AXIS, PLUS, JOG_RATIO)))
     qtbot.waitUntil(lambda: jogging(sim) and sim.state().pose[2] > z0 + 1.0, timeout=SIGNAL_TIMEOUT_MS)
     return z0
 
@@ -93,7 +94,7 @@ def test_a_release_refused_as_busy_goes_out_again_and_the_arm_stops_once_answere
         link.set_jog_guard(_keep_in_below(z_face))
     z0 = _jog_up(qtbot, link, sim)
     sim.set_exception(BUSY)  # every request: reads and writes
-    link.jog_release()
+    link.submit(JogRelease())
     _refused_for_a_while(qtbot, sim)
     assert jogging(sim)  # nothing got through: the controller still jogs
     writes_before = len(sim.writes)
@@ -124,7 +125,7 @@ def test_the_envelope_guard_keeps_watching_a_jog_whose_release_was_refused(
     link.set_jog_guard(_keep_in_below(z_face))
     z0 = _jog_up(qtbot, link, sim)
     sim.set_exception(BUSY, RATIO_REGISTERS)
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)  # the old code: through the face
     assert [v for _, v in register_writes(sim, registers.REG_STOP)] == [1]
     z_stop = float(sim.state().pose[2])
@@ -144,7 +145,7 @@ def test_a_release_refused_beyond_the_budget_escalates_to_stop(
     _jog_up(qtbot, link, sim)
     sim.set_exception(BUSY, RATIO_REGISTERS)  # speed 0 refused for good; 441 and the reads answer
     released = time.monotonic()
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     stops = sim.writes_to(registers.REG_STOP)
     assert [w.values for w in stops] == [(1,)]
@@ -162,7 +163,7 @@ def test_a_release_answered_at_once_stays_one_write(qtbot: Any, busy_sim: Any, l
     link.state.haltChanged.connect(halts.append)
     _jog_up(qtbot, link, sim)
     writes_before = len(sim.writes)
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     polls = sim.requests_count
     qtbot.waitUntil(lambda: sim.requests_count >= polls + 20, timeout=SIGNAL_TIMEOUT_MS)  # ten polls on
@@ -179,10 +180,10 @@ def test_a_stop_refused_as_busy_goes_out_again_until_the_controller_takes_it(
     connect(qtbot, link, sim)
     halts: list[UnconfirmedHalt | None] = []
     link.state.haltChanged.connect(halts.append)
-    link.step(StepFrame.BASE, [0.0, 0.0, -30.0, 0.0, 0.0, 0.0], speed=5.0)  # 6 s
+    link.submit(Step(StepFrame.BASE, [0.0, 0.0, -30.0, 0.0, 0.0, 0.0], speed=5.0))  # 6 s
     qtbot.waitUntil(lambda: sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
     sim.set_exception(BUSY, STOP_REGISTER)
-    link.stop()
+    link.submit(Stop())
     _refused_for_a_while(qtbot, sim)
     assert sim.state().moving and sim.writes_to(registers.REG_STOP) == []
     sim.set_exception(None)
@@ -204,9 +205,9 @@ def test_after_a_jog_stopped_by_stop_alone_the_next_jog_moves_again(
     connect(qtbot, link, sim)
     _jog_up(qtbot, link, sim)
     sim.set_exception(BUSY, RATIO_REGISTERS)
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not jogging(sim) and link.state.halt is None, timeout=SIGNAL_TIMEOUT_MS)
     sim.set_exception(None)
     _jog_up(qtbot, link, sim)  # the same axis, direction and speed
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)

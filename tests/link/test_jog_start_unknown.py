@@ -14,8 +14,9 @@ import pytest
 from pymodbus.constants import ExcCodes
 
 from app import timing
+from app.link.ops import JogPress, JogRelease
 from app.link.robot_link import RobotLink
-from app.link.types import WorkerError
+from app.link.types import JogRequest, WorkerError
 from app.protocol import registers
 from app.protocol.enums import TeachFrame
 from app.safety.envelope import Box, Envelope
@@ -45,7 +46,7 @@ def _press_answered(qtbot: Any, link: RobotLink, sim: Any, code: int) -> list[Wo
     errors: list[WorkerError] = []
     link.errorOccurred.connect(errors.append)
     sim.answer_after_applying(code, RATIO_REGISTER)
-    link.jog_press(TeachFrame.BASE, Z_AXIS, PLUS, 10.0)
+    link.submit(JogPress(JogRequest(TeachFrame.BASE, Z_AXIS, PLUS, 10.0)))
     qtbot.waitUntil(lambda: bool(errors) and jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     return errors
 
@@ -62,7 +63,7 @@ def test_a_jog_whose_speed_write_met_an_odd_exception_is_unknown_and_released(
     errors = _press_answered(qtbot, link, sim, code)
     text = errors[0].message
     assert "unknown" in text and "refused" not in text, text  # the arm may move: said so
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     assert ratio_writes(sim)[-1] == 0.0
 

@@ -128,6 +128,7 @@ def test_motion_commands_start_without_waiting_and_refuse_a_second_motion(sim: o
     from app.errors import InvalidInput as Refused
     from app.link.client import StepFrame
     from app.link.motion import MotionCommands
+    from app.link.ops import CreatePoint, GoZero, Step
     from tests.link.harness import PartsHost
 
     host = PartsHost()
@@ -135,12 +136,12 @@ def test_motion_commands_start_without_waiting_and_refuse_a_second_motion(sim: o
         host.connect(sim)
         commands = MotionCommands(host)
         host.request_id = 4
-        commands.step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], (0.0,) * 5, 1.0)  # about 0.33 s
+        commands.step(Step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], (0.0,) * 5, 1.0))  # about 0.33 s
         assert host.motion.active is not None and host.motion.active.request_id == 4
         with pytest.raises(Refused, match="still under way"):
-            commands.go_zero(None)
+            commands.go_zero(GoZero(None))
         with pytest.raises(Refused):  # nor a create point while it moves
-            commands.create_point(5, None, 200)
+            commands.create_point(CreatePoint(5, None, 200))
         assert host.motion.motion_under_way == "step"
     finally:
         host.close()

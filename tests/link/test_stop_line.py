@@ -4,14 +4,15 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Iterator
-from typing import Any
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import pytest
 
 from app.link import stop_line as stop_line_module
 from app.link.client import ConnectionSettings
-from app.link.jobs import JobKind
+from app.link.ops import LinkOp, Stop
 from app.link.robot_link import RobotLink
 from app.link.stop_line import StopLine
 from app.models import CommandResult
@@ -115,6 +116,14 @@ def test_the_keepalive_notices_a_closed_line(sim: Any, line: StopLine) -> None:
     assert not line.up and "keepalive" in line.why_not
 
 
+@dataclass(frozen=True)
+class _Hold(LinkOp):
+    """A test's own operation: runs ``run`` in the worker thread (needs no link)."""
+
+    needs_link: ClassVar[bool] = False
+    run: Callable[[], None]
+
+
 def _hold_worker(link: RobotLink) -> threading.Event:
     """Keep the worker thread busy inside a job until the returned event is set."""
     gate = threading.Event()
@@ -124,7 +133,10 @@ def _hold_worker(link: RobotLink) -> threading.Event:
         entered.set()
         gate.wait(10.0)
 
-    link._worker.post("test hold", hold, JobKind.PLAIN, needs_link=False)
+    worker = link._worker
+    if _Hold not in worker.handlers:
+        worker.handlers.add(_Hold, lambda op: op.run())
+    worker.submit(_Hold(hold))
     assert entered.wait(5.0)
     return gate
 
@@ -140,7 +152,7 @@ def test_a_gui_stop_does_not_wait_for_a_busy_worker(qtbot: Any, sim: Any, link: 
     link.commandFinished.connect(results.append)
     gate = _hold_worker(link)
     try:
-        stop_id = link.stop()
+        stop_id = link.submit(Stop())
         # written while the worker thread is still inside its job
         assert sim.wait_for(lambda _s: _stops(sim) == 1, 2.0)
         assert not any(r.request_id == stop_id for r in results)
@@ -158,7 +170,7 @@ def test_without_the_line_a_stop_waits_for_the_worker(qtbot: Any, sim: Any) -> N
         connect(qtbot, link, sim)
         gate = _hold_worker(link)
         try:
-            link.stop()
+            link.submit(Stop())
             assert not sim.wait_for(lambda _s: _stops(sim) > 0, 0.2)
         finally:
             gate.set()

@@ -24,7 +24,8 @@ from app.errors import (
     ResponseTimeout,
     TeachPadError,
 )
-from app.link.jobs import Job, JobKind, JobQueue
+from app.link.jobs import Job, JobQueue
+from app.link.ops import CancelUpload, JogRelease, Stop, UploadPoints
 from app.link.types import LinkState
 from app.link.upload import (
     UPLOAD_STAGE_GV,
@@ -239,11 +240,11 @@ def test_a_link_lost_between_two_reads_ends_the_point_without_another_read(
 
 def test_the_queue_counts_the_jobs_that_end_an_upload() -> None:
     jobs = JobQueue(halting=("stop", "cancel upload"))
-    jobs.put(Job("jog release", lambda: None, JobKind.URGENT))
-    jobs.put(Job("upload points", lambda: None, JobKind.MOTION))
+    jobs.put(Job(JogRelease()))
+    jobs.put(Job(UploadPoints(())))
     assert jobs.halts == 0
-    jobs.put(Job("stop", lambda: None, JobKind.URGENT))
-    jobs.put(Job("cancel upload", lambda: None, JobKind.URGENT))
+    jobs.put(Job(Stop()))
+    jobs.put(Job(CancelUpload()))
     assert jobs.halts == 2
     jobs.clear()
     assert jobs.halts == 2  # a count of requests, never lowered: an upload compares it with its start

@@ -41,6 +41,7 @@ from PySide6.QtCore import QTimer
 from PySide6.QtWidgets import QApplication
 
 app = QApplication([sys.argv[0]])  # ui.main.main uses this one
+from app.link.ops import UploadPoints
 from app.link.types import LinkState
 from ui import main as teachpad
 from ui.main_window import MainWindow
@@ -58,8 +59,8 @@ def hook():
 
     def on_connection(state):
         if state.state is LinkState.CONNECTED and not started:
-            started.append(link.upload_points(
-                [(i, (300.0 + i % 100, -50.0, 400.0, 180.0, 0.0, 0.0)) for i in range(1, points + 1)]))
+            started.append(link.submit(UploadPoints.of(
+                [(i, (300.0 + i % 100, -50.0, 400.0, 180.0, 0.0, 0.0)) for i in range(1, points + 1)])))
             print("uploading", flush=True)
 
     link.connectionChanged.connect(on_connection)

@@ -13,6 +13,7 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
+from app.link.ops import SetMode
 from app.protocol.enums import WorkMode
 from app.safety.location import safety_location
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -63,7 +64,7 @@ def test_an_audit_failure_in_the_worker_reaches_the_window_from_the_gui_thread(
     safety.session.audit.last_error = None
     connect(qtbot, window.link, sim)
     writes = len(sim.writes)
-    window.link.set_mode(WorkMode.MANUAL)  # a write: recorded by the worker, before it goes out
+    window.link.submit(SetMode(WorkMode.MANUAL))  # a write: recorded by the worker, before it goes out
     qtbot.waitUntil(lambda: any("cannot be written" in text for _, text in heard), timeout=SIGNAL_TIMEOUT_MS)
     assert len(sim.writes) == writes  # no write without its record (issue 19): refused, not sent
     assert wrote and wrote[0] != threading.main_thread().name  # met in the worker thread

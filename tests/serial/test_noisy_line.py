@@ -19,6 +19,7 @@ from app.cli.exit_codes import ExitCode
 from app.cli.main import main
 from app.errors import ResponseTimeout, TeachPadError
 from app.link.client import ConnectionSettings, RobotClient, StepFrame
+from app.link.ops import UploadPoints
 from app.link.robot_link import RobotLink
 from app.link.types import LinkState
 from app.models import CommandResult
@@ -119,7 +120,7 @@ def test_the_gui_upload_over_a_noisy_line_completes_with_no_wrong_point(
         link.pointUploaded.connect(lambda pid, ok, why: uploaded.append((pid, ok, why)))
         finished: list[CommandResult] = []
         link.commandFinished.connect(finished.append)
-        request = link.upload_points([(p.id, p.xyzabc, p.tool) for p in points])
+        request = link.submit(UploadPoints.of([(p.id, p.xyzabc, p.tool) for p in points]))
         qtbot.waitUntil(lambda: any(r.request_id == request for r in finished), timeout=150_000)
         result = next(r for r in finished if r.request_id == request)
         assert result.ok, result.message

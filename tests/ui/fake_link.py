@@ -1,41 +1,45 @@
 """A small typed fake of the link port (:class:`app.link.robot_link.LinkPort`) for unit tests.
 
 It holds a real :class:`RobotState` and a real :class:`RequestRouter`, so the code under test
-sees the real types and the real request-id routing; commands are recorded, not sent. Tests
+sees the real types and the real request-id routing; the submitted operations
+(:mod:`app.link.ops`) are recorded, not sent: a test reads them as data (``link.named(MoveToPoint)``). Tests
 play the worker: ``commandFinished.emit(result)`` / ``errorOccurred.emit(error)`` go through the
 router exactly like the link's, ``set_connected`` changes ``state.connection``.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
-from dataclasses import dataclass, field
-from typing import Any
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TypeVar
 
 from PySide6.QtCore import QObject, Signal
 
-from app.link.client import StepFrame
-from app.link.robot_link import LinkPort, Pending, RequestRouter
+from app.link.link_port import LinkPort, Pending, RequestRouter
+from app.link.ops import CreatePoint, LinkOp, MoveToPoint, Stop, UploadPoints
 from app.link.state import RobotState
 from app.link.types import ConnectionState, ControllerIdentity, LinkState
 from app.models import CommandResult
-from app.protocol.enums import CommandKind, CommandStatus, ProgramMotionMode, RunCommand, TeachFrame, WorkMode
+from app.protocol.enums import CommandKind, CommandStatus, RunCommand
 
 #: The controller a FakeLink connects to unless told otherwise (one boot, its canary token 1).
 FAKE_CONTROLLER = ControllerIdentity("fake:502", 1, "low-first", 99, 1.0)
 
 
-@dataclass
-class Call:
-    name: str
-    args: tuple[Any, ...]
-    kwargs: dict[str, Any] = field(default_factory=dict)
-    request_id: int = 0
+@dataclass(frozen=True)
+class Submitted:
+    """One operation the code under test submitted, and the ticket it got."""
+
+    op: LinkOp
+    request_id: int
+
+
+_Op = TypeVar("_Op", bound=LinkOp)
 
 
 class FakeLink(QObject):
-    """Records the calls; every command returns a request id; the ``finish_*`` helpers answer
-    the latest request of their kind."""
+    """Records the submitted operations (each gets a ticket, a request id); the ``finish_*``
+    helpers answer the latest request of their kind."""
 
     commandFinished = Signal(CommandResult)  # noqa: N815 - the worker's side: routed like RobotLink's
     errorOccurred = Signal(object)  # noqa: N815 - WorkerError, routed likewise
@@ -44,7 +48,6 @@ class FakeLink(QObject):
     foreignMaster = Signal(str, float)  # noqa: N815
     uploadProgress = Signal(int, int)  # noqa: N815
     pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
-    called = Signal(str)
 
     def __init__(self, connected: bool = True) -> None:
         super().__init__()
@@ -53,7 +56,7 @@ class FakeLink(QObject):
         self.commandFinished.connect(self._state.set_last_result)
         self.commandFinished.connect(self._router.on_result)
         self.errorOccurred.connect(self._router.on_error)
-        self.calls: list[Call] = []
+        self.submitted: list[Submitted] = []
         self._next_id = 100
         if connected:
             self.set_connected(True)
@@ -66,106 +69,30 @@ class FakeLink(QObject):
     def track(self, request_id: int) -> Pending:
         return self._router.track(request_id)
 
-    def _record(self, name: str, *args: Any, **kwargs: Any) -> int:
+    def submit(self, op: LinkOp) -> int:
+        if isinstance(op, Stop):
+            self._state.note_stop()
         self._next_id += 1
-        self.calls.append(Call(name, args, kwargs, self._next_id))
-        self.called.emit(name)
+        self.submitted.append(Submitted(op, self._next_id))
         return self._next_id
 
-    def stop(self) -> int:
-        return self._record("stop")
-
-    @property
-    def stops_requested(self) -> int:
-        return sum(1 for call in self.calls if call.name == "stop")
-
-    def pause(self) -> int:
-        return self._record("pause")
-
-    def resume(self) -> int:
-        return self._record("resume")
-
-    def jog_press(
-        self, frame: TeachFrame, axis: int, direction: int, ratio: float, user: int = 0, tool: int = 0
-    ) -> int:
-        return self._record("jog_press", frame, axis, direction, ratio, user, tool)
-
-    def jog_release(self) -> int:
-        return self._record("jog_release")
-
-    def set_jog_ratio(self, ratio: float) -> int:
-        return self._record("set_jog_ratio", ratio)
-
-    def step(
-        self,
-        frame: StepFrame,
-        offsets: Sequence[float],
-        ext_offsets: Sequence[float] = (),
-        speed: float = 10.0,
-    ) -> int:
-        return self._record("step", frame, tuple(offsets), tuple(ext_offsets), speed)
-
-    def set_mode(self, mode: WorkMode) -> int:
-        return self._record("set_mode", mode)
-
-    def go_zero(self, axis: int | None, *, switch_to_auto: bool = False) -> int:
-        return self._record("go_zero", axis, switch_to_auto=switch_to_auto)
-
-    def run_program(
-        self,
-        program_id: int,
-        mode: ProgramMotionMode = ProgramMotionMode.SINGLE_RUN,
-        cycles: int = 1,
-        speed_ratio: int = 100,
-        *,
-        switch_to_auto: bool = False,
-    ) -> int:
-        return self._record(
-            "run_program", program_id, mode, cycles, speed_ratio, switch_to_auto=switch_to_auto
-        )
-
-    def create_point(self, point_id: int, pose: Sequence[float] | None = None, tool: int = 200) -> int:
-        return self._record("create_point", point_id, pose, tool)
-
-    def move_to_point(
-        self,
-        end_id: int,
-        via_id: int | None = None,
-        *,
-        orientation_changes: bool = True,
-        ignore_middle: bool = False,
-        speed: float = 50.0,
-        tool: int = 200,
-    ) -> int:
-        return self._record(
-            "move_to_point",
-            end_id,
-            via_id,
-            orientation_changes=orientation_changes,
-            ignore_middle=ignore_middle,
-            speed=speed,
-            tool=tool,
-        )
-
-    def upload_points(
-        self,
-        points: Iterable[tuple[int, Sequence[float], int] | tuple[int, Sequence[float]]],
-        tool: int = 200,
-    ) -> int:
-        items = [(p[0], tuple(p[1]), p[2] if len(p) > 2 else tool) for p in points]
-        return self._record("upload_points", items)
-
-    def cancel_upload(self) -> int:
-        return self._record("cancel_upload")
-
     # --- for the tests
-    def named(self, name: str) -> list[Call]:
-        return [c for c in self.calls if c.name == name]
+    def named(self, op_type: type[_Op]) -> list[_Op]:
+        """The submitted operations of this type, in order."""
+        return [s.op for s in self.submitted if isinstance(s.op, op_type)]
 
-    def last_id(self, name: str) -> int:
-        """The id of the latest ``name`` call (0, an id never given out, if there was none)."""
-        calls = self.named(name)
-        return calls[-1].request_id if calls else 0
+    def kinds(self) -> list[type[LinkOp]]:
+        """The types of the submitted operations, in order."""
+        return [type(s.op) for s in self.submitted]
+
+    def ids(self, op_type: type[LinkOp]) -> list[int]:
+        """The tickets of the submitted operations of this type, in order."""
+        return [s.request_id for s in self.submitted if isinstance(s.op, op_type)]
+
+    def last_id(self, op_type: type[LinkOp]) -> int:
+        """The ticket of the latest op of this type (0, an id never given out, if there was none)."""
+        ids = self.ids(op_type)
+        return ids[-1] if ids else 0
 
     def set_connected(
         self,
@@ -195,7 +122,7 @@ class FakeLink(QObject):
                 ok,
                 message,
                 {k: float(v) for k, v in details.items()},
-                request_id=self.last_id("create_point"),
+                request_id=self.last_id(CreatePoint),
             )
         )
 
@@ -207,7 +134,7 @@ class FakeLink(QObject):
             status,
             ok,
             message,
-            request_id=self.last_id("move_to_point"),
+            request_id=self.last_id(MoveToPoint),
         )
         self.commandFinished.emit(result)
 
@@ -228,7 +155,7 @@ class FakeLink(QObject):
                 uploaded == total,
                 text,
                 {"uploaded": float(uploaded)},
-                request_id=self.last_id("upload_points"),
+                request_id=self.last_id(UploadPoints),
             )
         )
 

@@ -8,6 +8,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 from app.link.client import StepFrame
+from app.link.ops import RunProgram, Step, Stop
 from app.link.types import WorkerError
 from app.models import CommandResult
 from app.protocol.enums import ControllerMode, ProgramMotionMode, ProgramState, WorkMode
@@ -65,14 +66,14 @@ def _stop_sent(result: Any) -> bool:
 
 def test_pause_and_resume_buttons(qtbot: Any, sim: Any, window: Any) -> None:
     _connected(qtbot, window, sim)
-    window.link.run_program(1, ProgramMotionMode.CYCLE, 0, 20)
+    window.link.submit(RunProgram(1, ProgramMotionMode.CYCLE, 0, 20))
     qtbot.waitUntil(lambda: sim.state().program_state == ProgramState.RUNNING, timeout=SIGNAL_TIMEOUT_MS)
     qtbot.mouseClick(window.control_bar.pause_button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: sim.state().paused, timeout=SIGNAL_TIMEOUT_MS)
     qtbot.waitUntil(lambda: window.status_panel.program_label.text() == "paused", timeout=SIGNAL_TIMEOUT_MS)
     qtbot.mouseClick(window.control_bar.resume_button, Qt.MouseButton.LeftButton)
     qtbot.waitUntil(lambda: not sim.state().paused and sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
-    window.link.stop()
+    window.link.submit(Stop())
     qtbot.waitUntil(lambda: not sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
 
 
@@ -170,7 +171,7 @@ def test_monitor_only_disables_motion_and_writes_nothing(qtbot: Any, sim: Any, w
     assert window.status_monitor_only.text() == "MONITOR ONLY"
     qtbot.mousePress(window.jog_panel.button(0, 1), Qt.MouseButton.LeftButton)  # disabled: nothing
     qtbot.mouseRelease(window.jog_panel.button(0, 1), Qt.MouseButton.LeftButton)
-    window.link.step(StepFrame.JOINT, [1.0, 0, 0, 0, 0, 0])  # behind the GUI's back
+    window.link.submit(Step(StepFrame.JOINT, [1.0, 0, 0, 0, 0, 0]))  # behind the GUI's back
     qtbot.mouseClick(window.control_bar.stop_button, Qt.MouseButton.LeftButton)
     # the step's and the Stop's refusals (a poll that times out under load may add its own error)
     qtbot.waitUntil(lambda: {e.operation for e in errors} >= {"step", "stop"}, timeout=SIGNAL_TIMEOUT_MS)

@@ -7,7 +7,8 @@ from typing import Any
 
 import pytest
 
-from app.link.types import LinkState, WorkerError
+from app.link.ops import JogPress
+from app.link.types import JogRequest, LinkState, WorkerError
 from app.protocol.enums import TeachFrame
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
@@ -30,7 +31,7 @@ def test_a_jog_stopped_by_a_silent_controller_reads_in_chinese(
 ) -> None:
     assert translator.set_language("zh_CN")
     connect(qtbot, link, sim)
-    link.jog_press(TeachFrame.BASE, 0, 1, 40.0)
+    link.submit(JogPress(JogRequest(TeachFrame.BASE, 0, 1, 40.0)))
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     errors: list[WorkerError] = []
     link.errorOccurred.connect(errors.append)

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from app.link.ops import Stop
 from app.link.robot_link import RobotLink
 from app.protocol import registers
 from app.safety.audit import AuditLog, query
@@ -30,7 +31,7 @@ def test_no_worker_until_the_first_request_then_it_has_what_was_set_before(
     worker = link._made
     assert worker is not None and worker._poll_hz == 25.0
     with qtbot.waitSignal(link.commandFinished, timeout=SIGNAL_TIMEOUT_MS):
-        link.stop()
+        link.submit(Stop())
     qtbot.waitUntil(lambda: bool(sim.writes_to(registers.REG_STOP)), timeout=SIGNAL_TIMEOUT_MS)
     records = query(tmp_path)  # audited: the log given before the worker existed reached it
     assert ("stop (441 ← 1)", "write") in [(r.command, r.kind) for r in records]
@@ -41,5 +42,5 @@ def test_a_link_shut_down_before_any_request_stops_its_thread(qtbot: Any) -> Non
     assert link.is_running and link._made is None
     link.shutdown()
     assert not link.is_running and link._made is None
-    assert link.stop() == 0  # nothing is made after a shutdown
+    assert link.submit(Stop()) == 0  # nothing is made after a shutdown
     assert link._made is None

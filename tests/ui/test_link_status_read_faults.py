@@ -16,6 +16,7 @@ from pymodbus.constants import ExcCodes
 
 from app import timing
 from app.link.client import StepFrame
+from app.link.ops import GoZero, RunProgram, Step
 from app.link.outcome import Outcome, outcome_of
 from app.link.robot_link import RobotLink
 from app.models import CommandResult
@@ -54,7 +55,7 @@ def results(link: RobotLink) -> Results:
 
 
 def _step_40(link: RobotLink) -> int:
-    return link.step(StepFrame.BASE, [40.0, 0, 0, 0, 0, 0], speed=80.0)
+    return link.submit(Step(StepFrame.BASE, [40.0, 0, 0, 0, 0, 0], speed=80.0))
 
 
 def test_busy_status_reads_right_after_a_step_do_not_fail_it(
@@ -153,7 +154,7 @@ def test_zero_and_program_another_master_wrote_under_are_unknown(
     monkeypatch.setattr(timing, "CLOCK_POLL_PERIOD", 0.05)  # the shared registers read often
     connect(qtbot, link, sim, poll_timeout=1.0)
     another_master.set()
-    request = link.go_zero(None) if command == "zero" else link.run_program(3, speed_ratio=100)
+    request = link.submit(GoZero(None)) if command == "zero" else link.submit(RunProgram(3, speed_ratio=100))
     (result,) = results.of(qtbot, request)
     assert outcome_of(result) is Outcome.UNKNOWN
     assert "another Modbus master" in result.message

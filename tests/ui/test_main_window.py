@@ -9,7 +9,8 @@ from PySide6.QtCore import QSettings
 from PySide6.QtGui import QImage
 
 from app.link.client import ConnectionSettings
-from app.link.types import LinkState
+from app.link.ops import JogPress, JogRelease, SetMode
+from app.link.types import JogRequest, LinkState
 from app.protocol.codec import WordOrder
 from app.protocol.enums import Alarm, TeachFrame, WorkMode
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -110,9 +111,9 @@ def test_live_pose_reaches_the_monitor(qtbot: Any, sim: Any, window: MainWindow)
     qtbot.waitUntil(
         lambda: readout.value is not None and abs(readout.value - x) < 1e-3, timeout=SIGNAL_TIMEOUT_MS
     )
-    window.link.jog_press(TeachFrame.BASE, 0, 1, 100.0)
+    window.link.submit(JogPress(JogRequest(TeachFrame.BASE, 0, 1, 100.0)))
     qtbot.waitUntil(lambda: readout.value is not None and readout.value > x + 5.0, timeout=SIGNAL_TIMEOUT_MS)
-    window.link.jog_release()
+    window.link.submit(JogRelease())
 
 
 def test_connect_disconnect_from_the_window(
@@ -215,7 +216,7 @@ def test_traffic_inspector_shows_decoded_frames_from_the_simulator(
         return [str(model.data(model.index(r, column))) for r in range(model.rowCount())]
 
     qtbot.waitUntil(lambda: any("read pose" in t for t in texts(COL_MEANING)), timeout=SIGNAL_TIMEOUT_MS)
-    window.link.set_mode(WorkMode.MANUAL)  # 444 <- 0, a 0x06 write
+    window.link.submit(SetMode(WorkMode.MANUAL))  # 444 <- 0, a 0x06 write
     qtbot.waitUntil(
         lambda: any("work mode manual (444 ← 0)" in t for t in texts(COL_MEANING)), timeout=SIGNAL_TIMEOUT_MS
     )

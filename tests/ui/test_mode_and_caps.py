@@ -10,6 +10,7 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
+from app.link.ops import GoZero, Stop
 from app.link.types import WorkerError
 from app.models import CommandResult
 from app.protocol import registers
@@ -98,7 +99,7 @@ def test_a_controller_found_in_manual_is_not_switched_behind_the_confirmation(
     _connected(qtbot, window, sim)
     errors: list[WorkerError] = []
     window.link.errorOccurred.connect(errors.append)
-    window.link.go_zero(None)  # as a request confirmed in auto would arrive: no switch allowed
+    window.link.submit(GoZero(None))  # as a request confirmed in auto would arrive: no switch allowed
     qtbot.waitUntil(lambda: any(e.operation == "go to zero" for e in errors), timeout=SIGNAL_TIMEOUT_MS)
     error = next(e for e in errors if e.operation == "go to zero")
     assert error.reason is not None and error.reason.code == "manual_mode"
@@ -150,7 +151,7 @@ def test_reduced_speed_caps_every_motion_and_shows_the_cap(qtbot: Any, sim: Any,
         check_params_cb=lambda r: r.request_id in stop_ids,
         timeout=SIGNAL_TIMEOUT_MS,
     ):
-        stop_ids.append(window.link.stop())
+        stop_ids.append(window.link.submit(Stop()))
     assert sim.wait_for(lambda s: not s.moving, 5.0)
 
     # a move to a point: the cap beside its speed, and the speed it goes out at

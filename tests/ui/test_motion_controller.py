@@ -10,6 +10,7 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 from PySide6.QtWidgets import QWidget
 
+from app.link.ops import GoZero, JogPress, JogRelease, Pause, Resume, SetMode, Stop
 from app.link.types import ConnectionState, LinkState
 from app.points.project import Project
 from app.protocol.enums import TeachFrame, WorkMode
@@ -74,11 +75,12 @@ def test_a_held_jog_ends_when_the_link_stops_answering(qtbot: Any, rig: Rig) -> 
     rig.link.set_connected(True)
     rig.host.show()
     qtbot.mousePress(rig.jog.button(0, 1), Qt.MouseButton.LeftButton)
-    assert [c.args[:3] for c in rig.link.named("jog_press")] == [(TeachFrame(rig.jog.frame), 0, 1)]
+    presses = [op.request for op in rig.link.named(JogPress)]
+    assert [(r.frame, r.axis, r.direction) for r in presses] == [(TeachFrame(rig.jog.frame), 0, 1)]
     rig.link.state.set_connection(ConnectionState(LinkState.NOT_ANSWERING, "silent"))
-    assert len(rig.link.named("jog_release")) == 1  # the dead-man, before anything else
+    assert len(rig.link.named(JogRelease)) == 1  # the dead-man, before anything else
     qtbot.mouseRelease(rig.jog.button(0, 1), Qt.MouseButton.LeftButton)
-    assert len(rig.link.named("jog_release")) == 1
+    assert len(rig.link.named(JogRelease)) == 1
 
 
 def test_intents_become_requests(rig: Rig) -> None:
@@ -89,13 +91,9 @@ def test_intents_become_requests(rig: Rig) -> None:
     rig.bar.modeRequested.emit(WorkMode.MANUAL)
     rig.program.goZeroRequested.emit(ZeroRequest(2))
     rig.program.goZeroRequested.emit(ZeroRequest(None, switch_to_auto=True))  # the operator said yes to it
-    names = [c.name for c in rig.link.calls]
-    assert names == ["stop", "pause", "resume", "set_mode", "go_zero", "go_zero"]
-    assert rig.link.named("set_mode")[0].args == (WorkMode.MANUAL,)
-    assert [(c.args, c.kwargs) for c in rig.link.named("go_zero")] == [
-        ((2,), {"switch_to_auto": False}),
-        ((None,), {"switch_to_auto": True}),
-    ]
+    assert rig.link.kinds() == [Stop, Pause, Resume, SetMode, GoZero, GoZero]
+    assert rig.link.named(SetMode) == [SetMode(WorkMode.MANUAL)]
+    assert rig.link.named(GoZero) == [GoZero(2, switch_to_auto=False), GoZero(None, switch_to_auto=True)]
 
 
 def test_the_windows_resume_goes_through_a_run_paused_by_another_master(
@@ -121,11 +119,11 @@ def test_the_windows_resume_goes_through_a_run_paused_by_another_master(
     refused: list[str] = []
     runs.resumeRefused.connect(refused.append)
     rig.link.foreignMaster.emit("registers", 409.0)
-    assert runs.paused and len(rig.link.named("pause")) == 1
+    assert runs.paused and len(rig.link.named(Pause)) == 1
     bar.resumeRequested.emit()
-    assert rig.link.named("resume") == [] and runs.paused and len(refused) == 1
+    assert rig.link.named(Resume) == [] and runs.paused and len(refused) == 1
     monkeypatch.setattr(timing, "FOREIGN_MOVE_HOLD", 0.0)
     bar.resumeRequested.emit()
-    assert len(rig.link.named("resume")) == 1 and not runs.paused
+    assert len(rig.link.named(Resume)) == 1 and not runs.paused
     bar.pauseRequested.emit()
-    assert runs.paused and len(rig.link.named("pause")) == 2
+    assert runs.paused and len(rig.link.named(Pause)) == 2

@@ -15,6 +15,7 @@ from PySide6.QtCore import QCoreApplication, QTranslator
 from app import timing
 from app.errors import Reason
 from app.link.client import StepFrame
+from app.link.ops import GoZero, RunProgram, Step
 from app.link.outcome import Outcome, outcome_of
 from app.link.robot_link import RobotLink
 from app.link.types import LinkState, Operation
@@ -80,7 +81,7 @@ def test_go_to_zero_during_an_emergency_stop_reads_refused(
     connect(qtbot, link, sim)
     sim.set_alarm(Alarm.ESTOP, True)
     joints = sim.state().joints
-    result = results.of(qtbot, link.go_zero(None))
+    result = results.of(qtbot, link.submit(GoZero(None)))
     assert not result.ok and outcome_of(result) is Outcome.REFUSED
     assert result_text(result) == "go to zero refused by the controller: emergency stop."
     assert sim.writes_to(registers.REG_GO_ZERO) and sim.state().joints == joints
@@ -92,7 +93,7 @@ def test_a_step_during_an_emergency_stop_reads_the_controllers_code(
 ) -> None:
     connect(qtbot, link, sim)
     sim.set_alarm(Alarm.ESTOP, True)
-    result = results.of(qtbot, link.step(StepFrame.BASE, [10, 0, 0, 0, 0, 0], speed=50.0))
+    result = results.of(qtbot, link.submit(Step(StepFrame.BASE, [10, 0, 0, 0, 0, 0], speed=50.0)))
     assert outcome_of(result) is Outcome.REFUSED
     assert result_text(result) == "incremental move (base) refused by the controller: emergency stop."
     qtbot.waitUntil(lambda: result_label(_command_record(audited, registers.REG_RUN_COMMAND)) == "refused:2")
@@ -103,10 +104,10 @@ def test_a_program_that_does_not_start_reads_refused_and_one_that_runs_reads_don
 ) -> None:
     monkeypatch.setattr(timing, "ACK_TIMEOUT", 0.5)
     connect(qtbot, link, sim)
-    result = results.of(qtbot, link.run_program(7))
+    result = results.of(qtbot, link.submit(RunProgram(7)))
     assert outcome_of(result) is Outcome.REFUSED
     assert result_text(result) == "Program 7 did not start: no such program, or the controller refused it."
-    result = results.of(qtbot, link.go_zero(1), timeout=10 * SIGNAL_TIMEOUT_MS)
+    result = results.of(qtbot, link.submit(GoZero(1)), timeout=10 * SIGNAL_TIMEOUT_MS)
     assert result.ok and result_text(result) == "go to zero: done."
     assert sim.state().joints[1] == pytest.approx(0.0, abs=0.01)
     outcomes = [r.result for r in query(audited) if r.kind == "write" and r.args.get("judged")]
@@ -118,7 +119,7 @@ def test_a_link_lost_under_a_go_to_zero_reads_unknown(
 ) -> None:
     monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.3)
     connect(qtbot, link, sim, poll_timeout=0.5)
-    zero = link.go_zero(None)
+    zero = link.submit(GoZero(None))
     qtbot.waitUntil(lambda: sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
     with qtbot.waitSignal(
         link.connectionChanged, check_params_cb=is_state(LinkState.DOWN), timeout=SIGNAL_TIMEOUT_MS

@@ -8,6 +8,7 @@ from typing import Any
 import pytest
 from PySide6.QtGui import QUndoStack
 
+from app.link.ops import MoveToPoint, UploadPoints
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import Pose
 from app.plan.runner import RunState
@@ -51,18 +52,18 @@ def test_points_first_then_the_move_then_the_arrival(
     qtbot: Any, runs: PlanRunController, link: FakeLink, project: Project
 ) -> None:
     runs.run(project.plans[0])
-    assert [c.name for c in link.calls] == ["upload_points"]
-    assert link.named("upload_points")[0].args[0] == [(1, P1, 3)]  # the ledger's values and tool
+    assert link.kinds() == [UploadPoints]
+    assert link.named(UploadPoints)[0].items == ((1, P1, 3),)  # the ledger's values and tool
     link.point_ok(1)
     link.upload_summary(1, 1)
-    assert [c.name for c in link.calls] == ["upload_points", "move_to_point"]
+    assert link.kinds() == [UploadPoints, MoveToPoint]
     _at(link, P1)
     link.finish_move()
     # the arc: its middle and end points, then the move through them
-    assert link.named("upload_points")[1].args[0] == [(2, P2, 200), (3, P3, 200)]
+    assert link.named(UploadPoints)[1].items == ((2, P2, 200), (3, P3, 200))
     link.point_ok(2, 3)
     link.upload_summary(2, 2)
-    assert link.named("move_to_point")[1].args[:2] == (3, 2)
+    assert (link.named(MoveToPoint)[1].end_id, link.named(MoveToPoint)[1].via_id) == (3, 2)
     _at(link, P3)
     with qtbot.waitSignal(runs.runFinished) as finished:
         link.finish_move()
@@ -82,7 +83,7 @@ def test_an_arrival_elsewhere_fails_the_run_and_marks_the_point_unknown(
     assert outcome.state is RunState.FAILED and outcome.resume_from == 0 and mismatch.args == [1]
     assert "30.00 mm from P1" in runs.outcome_text(outcome)
     assert project.ledger.point(1).sync is SyncState.UNKNOWN
-    assert len(link.named("upload_points")) == 1  # nothing more was sent
+    assert len(link.named(UploadPoints)) == 1  # nothing more was sent
 
 
 def test_an_arrival_without_a_pose_is_not_taken_as_done(
@@ -105,10 +106,10 @@ def test_link_lost_while_the_points_are_created(
     with qtbot.waitSignal(runs.runFinished) as finished:
         link.set_connected(False, "connection reset")
     assert finished.args[0].state is RunState.FAILED and finished.args[0].resume_from == 1
-    assert link.named("move_to_point") == []
+    assert link.named(MoveToPoint) == []
     assert project.ledger.point(2).sync is SyncState.ON_CONTROLLER and set(project.upload_history) == {2}
     link.upload_summary(1, 2, "link lost")  # the worker's late summary: not the run's any more
-    assert not runs.running and link.named("move_to_point") == []
+    assert not runs.running and link.named(MoveToPoint) == []
 
 
 def test_an_upload_the_worker_refuses_ends_the_run(
@@ -117,9 +118,9 @@ def test_an_upload_the_worker_refuses_ends_the_run(
     runs.run(project.plans[0])
     with qtbot.waitSignal(runs.runFinished) as finished:
         link.errorOccurred.emit(
-            WorkerError("upload points", "jog is still under way", link.last_id("upload_points"))
+            WorkerError("upload points", "jog is still under way", link.last_id(UploadPoints))
         )
-    assert finished.args[0].state is RunState.FAILED and link.named("move_to_point") == []
+    assert finished.args[0].state is RunState.FAILED and link.named(MoveToPoint) == []
     assert "jog is still under way" in runs.outcome_text(finished.args[0])
 
 
@@ -132,7 +133,7 @@ def test_a_stop_during_the_upload_ends_the_run_stopped(
     with qtbot.waitSignal(runs.runFinished) as finished:
         link.upload_summary(0, 1, "stopped")
     assert finished.args[0].state is RunState.STOPPED and finished.args[0].resume_from == 0
-    assert link.named("move_to_point") == []
+    assert link.named(MoveToPoint) == []
 
 
 def test_a_stop_after_the_upload_ended_in_the_worker_sends_no_move(
@@ -143,7 +144,7 @@ def test_a_stop_after_the_upload_ended_in_the_worker_sends_no_move(
     runs.stop()  # the upload's good summary is still on its way
     with qtbot.waitSignal(runs.runFinished) as finished:
         link.upload_summary(1, 1)
-    assert finished.args[0].state is RunState.STOPPED and link.named("move_to_point") == []
+    assert finished.args[0].state is RunState.STOPPED and link.named(MoveToPoint) == []
 
 
 def test_there_is_no_unguarded_run(link: FakeLink, project: Project) -> None:
@@ -152,7 +153,7 @@ def test_there_is_no_unguarded_run(link: FakeLink, project: Project) -> None:
     runs.set_link(link)
     assert runs.points is model
     runs.run(project.plans[0])
-    assert [c.name for c in link.calls] == ["upload_points"]  # the points first, never a bare move
+    assert link.kinds() == [UploadPoints]  # the points first, never a bare move
 
 
 def test_the_guard_speaks_chinese(
@@ -177,7 +178,7 @@ def _link_leaves_connected(
     runs.run(project.plans[0])
     link.point_ok(1)
     link.upload_summary(1, 1)
-    assert link.named("move_to_point")
+    assert link.named(MoveToPoint)
     with qtbot.waitSignal(runs.runFinished) as finished:
         link.state.set_connection(ConnectionState(link_state, "no answer", "fake:502"))
     outcome = finished.args[0]

@@ -10,6 +10,7 @@ from typing import Any
 
 import pytest
 
+from app.link.ops import Stop
 from app.link.robot_link import RobotLink
 from app.models import Pose
 from app.plan.runner import RunOutcome, RunState
@@ -68,7 +69,7 @@ def _stop_in_segment_2(bench: Bench, link: RobotLink, stop: Any) -> RunOutcome:
 def test_an_operator_stop_is_not_a_failure_in_both_languages(
     bench: Bench, link: RobotLink, translator: Any, which: str
 ) -> None:
-    stop = link.stop if which == "window" else bench.runs.stop
+    stop = (lambda: link.submit(Stop())) if which == "window" else bench.runs.stop
     outcome = _stop_in_segment_2(bench, link, stop)
     assert outcome.state is RunState.STOPPED, outcome.message
     assert (outcome.resume_from, outcome.resume_loop, outcome.loops) == (1, 1, 20)

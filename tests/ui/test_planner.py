@@ -14,6 +14,7 @@ import pytest
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 
+from app.link.ops import MoveToPoint, Pause, Resume, Stop, UploadPoints
 from app.link.types import WorkerError
 from app.models import Pose
 from app.plan.checks import IssueKind
@@ -217,11 +218,11 @@ class Worker:
 
     def create_points(self) -> None:
         """Answer the latest upload (if not yet answered): every point created."""
-        uploads = self.link.named("upload_points")
-        if not uploads or uploads[-1].request_id in self._answered:
+        uploads, tickets = self.link.named(UploadPoints), self.link.ids(UploadPoints)
+        if not uploads or tickets[-1] in self._answered:
             return
-        self._answered.add(uploads[-1].request_id)
-        ids = [point_id for point_id, _, _ in uploads[-1].args[0]]
+        self._answered.add(tickets[-1])
+        ids = [point_id for point_id, _, _ in uploads[-1].items]
         self.link.point_ok(*ids)
         self.link.upload_summary(len(ids), len(ids))
 
@@ -229,7 +230,7 @@ class Worker:
         """The latest move ends (see :meth:`FakeLink.finish_move`); the next segment's points are
         then created at once."""
         if ok:
-            end = self.link.named("move_to_point")[-1].args[0]
+            end = self.link.named(MoveToPoint)[-1].end_id
             x, y, z, a, b, c = self.project.ledger.point(end).xyzabc
             self.link.state.set_pose(Pose(x, y, z, a, b, c, ext=(0.0,) * 5))
         self.link.finish_move(ok, code, message)
@@ -242,7 +243,7 @@ def worker(link: FakeLink, project: Project) -> Worker:
 
 
 def moves(link: FakeLink) -> list[tuple[int, int | None]]:
-    return [(c.args[0], c.args[1]) for c in link.named("move_to_point")]
+    return [(c.end_id, c.via_id) for c in link.named(MoveToPoint)]
 
 
 def test_segments_sent_in_order_each_after_the_previous_result(
@@ -254,11 +255,11 @@ def test_segments_sent_in_order_each_after_the_previous_result(
     assert moves(link) == []  # the segment's points are created first
     worker.create_points()
     assert moves(link) == [(2, None)]
-    call = link.named("move_to_point")[0]
-    assert call.kwargs == {"orientation_changes": True, "ignore_middle": False, "speed": 100.0, "tool": 200}
+    call = link.named(MoveToPoint)[0]
+    assert call == MoveToPoint(2, None, orientation_changes=True, ignore_middle=False, speed=100.0, tool=200)
     worker.finish_move()
     assert moves(link) == [(2, None), (3, 4)]
-    assert link.named("move_to_point")[1].kwargs["orientation_changes"] is False  # "kept"
+    assert link.named(MoveToPoint)[1].orientation_changes is False  # "kept"
     link.commandFinished.emit(_ack("pause: sent"))  # not a move result: ignored
     assert len(moves(link)) == 2
     assert runner.progress is not None and runner.progress.text == "loop 1/2, segment 2/3"
@@ -281,11 +282,11 @@ def test_pause_resume_stop_are_forwarded(
     runner.run(project.plans[1])
     worker.create_points()
     runner.pause()
-    assert runner.paused and link.named("pause")
+    assert runner.paused and link.named(Pause)
     runner.resume()
-    assert not runner.paused and link.named("resume")
+    assert not runner.paused and link.named(Resume)
     runner.stop()
-    assert link.named("stop") and runner.running  # until the link reports the stopped move
+    assert link.named(Stop) and runner.running  # until the link reports the stopped move
     with qtbot.waitSignal(runner.runFinished) as finished:
         link.finish_move(False, code=0, message="stopped")
     outcome = finished.args[0]
@@ -326,12 +327,12 @@ def test_lost_link_and_refusal_end_the_run(
     link.set_connected(True)
     runner.resume_run()
     worker.create_points()
-    previous_move = link.named("move_to_point")[-2].request_id  # the one the lost link ended
+    previous_move = link.ids(MoveToPoint)[-2]  # the one the lost link ended
     link.errorOccurred.emit(WorkerError("move to point", "another request's error", previous_move))
     assert runner.running  # not ours
     with qtbot.waitSignal(runner.runFinished) as finished:
         link.errorOccurred.emit(
-            WorkerError("move to point", "jog is still under way", link.last_id("move_to_point"))
+            WorkerError("move to point", "jog is still under way", link.last_id(MoveToPoint))
         )
     assert finished.args[0].resume_from == 0 and "jog is still under way" in finished.args[0].message
 
@@ -353,7 +354,7 @@ def test_start_needs_a_connection(runner: PlanRunController, link: FakeLink, pro
     link.set_connected(False)
     with pytest.raises(LinkError):
         runner.run(project.plans[0])
-    assert link.calls == []
+    assert link.submitted == []
 
 
 # --- the panel -------------------------------------------------------------------------------------
@@ -402,8 +403,8 @@ def test_panel_summary_and_upload_now_then_run(
     planner.answers.extend([True, True])  # type: ignore[attr-defined]
     assert planner.run(0)
     assert "not on the controller" in planner.questions[0]  # type: ignore[attr-defined]
-    (upload,) = link.named("upload_points")
-    assert sorted(pid for pid, _, _ in upload.args[0]) == [1, 5, 6, 7, 8]
+    (upload,) = link.named(UploadPoints)
+    assert sorted(pid for pid, _, _ in upload.items) == [1, 5, 6, 7, 8]
     assert moves(link) == []
     link.point_ok(1, 5, 6, 7, 8)
     with qtbot.waitSignal(planner.run_controller.runningChanged):
@@ -444,7 +445,7 @@ def test_panel_refuses_a_plan_with_errors(planner: PlannerPanel, link: FakeLink,
     assert not planner.run(0)
     assert "Cannot run" in planner.status.text() and "P42 does not exist" in planner.status.text()
     assert planner.selected_segments() == [2]
-    assert link.calls == []
+    assert link.submitted == []
 
 
 def test_panel_step_and_run_from_here(
@@ -565,8 +566,8 @@ def test_resume_after_an_edit_runs_the_edited_segments(
     planner.answers.append(True)  # type: ignore[attr-defined]
     planner.action_resume_from.trigger()
     worker.create_points()
-    last = link.named("move_to_point")[-1]
-    assert (last.args, last.kwargs["speed"]) == ((7, 6), 20.0)
+    last = link.named(MoveToPoint)[-1]
+    assert (last.end_id, last.via_id, last.speed) == (7, 6, 20.0)
     with qtbot.waitSignal(planner.run_controller.runFinished) as finished:
         for _ in range(3):
             worker.finish_move()

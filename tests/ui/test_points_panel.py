@@ -11,6 +11,7 @@ from typing import Any
 import pytest
 from PySide6.QtGui import QUndoStack
 
+from app.link.ops import CancelUpload, CreatePoint, MoveToPoint, Stop, UploadPoints
 from app.link.types import ConnectionState, ControllerIdentity, LinkState, WorkerError
 from app.models import CommandResult, Pose
 from app.points.ledger import SyncState, make_point
@@ -67,7 +68,7 @@ def test_teach_creates_next_point_from_the_current_pose(
     assert panel.action_teach.isEnabled()
     assert panel.action_teach.shortcut().toString() == "Ctrl+T"
     panel.action_teach.trigger()
-    assert [(c.args) for c in link.named("create_point")] == [(9, None, 200)]
+    assert link.named(CreatePoint) == [CreatePoint(9, None, 200)]
     assert not panel.action_teach.isEnabled()  # one operation at a time
     assert 9 not in panel.model.ledger  # nothing until the controller confirms
     link.state.set_pose(Pose(0, 0, 0, 0, 0, 0, ext=(1, 2, 3, 4, 5)))
@@ -117,7 +118,7 @@ def test_teach_ignores_unrelated_results_and_ends_on_link_loss(
         None,
         True,
         "",
-        request_id=link.last_id("create_point") - 1,
+        request_id=link.last_id(CreatePoint) - 1,
     )  # an older create's result
     link.commandFinished.emit(stale)
     assert panel.controller.busy
@@ -131,7 +132,7 @@ def test_teach_needs_a_connection(panel: PointsPanel, link: FakeLink) -> None:
     link.set_connected(False)
     assert not panel.action_teach.isEnabled()
     panel.controller.teach()
-    assert link.calls == []
+    assert link.submitted == []
     assert "not connected" in panel.status.text()
 
 
@@ -143,9 +144,9 @@ def test_upload_selected_with_progress_and_a_refused_point(
 ) -> None:
     panel.select_rows([0, 2, 4])
     panel.action_upload_selected.trigger()
-    (call,) = link.named("upload_points")
-    assert [(pid, tool) for pid, _, tool in call.args[0]] == [(1, 200), (3, 200), (5, 200)]
-    assert call.args[0][0][1] == (400.0, 0.0, 450.0, 180.0, 0.0, 0.0)
+    (call,) = link.named(UploadPoints)
+    assert [(pid, tool) for pid, _, tool in call.items] == [(1, 200), (3, 200), (5, 200)]
+    assert call.items[0][1] == (400.0, 0.0, 450.0, 180.0, 0.0, 0.0)
     assert panel.progress_row.isVisibleTo(panel)
     ledger = panel.model.ledger
     link.point_ok(1)
@@ -173,7 +174,7 @@ def test_cancel_half_way_keeps_what_was_uploaded(qtbot: Any, panel: PointsPanel,
     link.point_ok(1, 2)
     link.uploadProgress.emit(2, 8)
     panel.action_cancel_upload.trigger()
-    assert link.named("cancel_upload") and not link.named("stop")  # no controller stop
+    assert link.named(CancelUpload) and not link.named(Stop)  # no controller stop
     assert panel.controller.busy  # until the link says the batch ended
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
         link.upload_summary(2, 8, "cancelled")
@@ -197,8 +198,8 @@ def test_a_stopped_upload_says_why(qtbot: Any, panel: PointsPanel, link: FakeLin
 def test_upload_sends_each_points_tool_in_one_request(qtbot: Any, panel: PointsPanel, link: FakeLink) -> None:
     panel.model.setData(panel.model.index(1, COL_TOOL), "4")  # P2 tool 4
     panel.controller.upload([1, 2, 3])
-    (call,) = link.named("upload_points")
-    assert [(pid, tool) for pid, _, tool in call.args[0]] == [(1, 200), (2, 4), (3, 200)]
+    (call,) = link.named(UploadPoints)
+    assert [(pid, tool) for pid, _, tool in call.items] == [(1, 200), (2, 4), (3, 200)]
     link.point_ok(1, 3, 2)
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
         link.uploadProgress.emit(3, 3)
@@ -216,7 +217,7 @@ def test_results_of_other_requests_are_ignored(qtbot: Any, panel: PointsPanel, l
         True,
         "uploaded 1 of 1 points",
         {"uploaded": 1.0},
-        request_id=link.last_id("upload_points") - 1,
+        request_id=link.last_id(UploadPoints) - 1,
     )
     link.commandFinished.emit(other)
     link.errorOccurred.emit(WorkerError("upload points", "someone else's", request_id=None))
@@ -227,7 +228,7 @@ def test_upload_refused_by_the_worker(qtbot: Any, panel: PointsPanel, link: Fake
     panel.controller.upload([1])
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
         link.errorOccurred.emit(
-            WorkerError("upload points", "move to point is still under way", link.last_id("upload_points"))
+            WorkerError("upload points", "move to point is still under way", link.last_id(UploadPoints))
         )
     assert finished.args[0].aborted == "move to point is still under way"
     assert panel.model.ledger.point(1).sync is SyncState.UNKNOWN
@@ -273,8 +274,8 @@ def test_another_controller_marks_unknown_and_offers_restore(
     assert [p.sync for p in model.ledger][:2] == [SyncState.UNKNOWN] * 2
     assert panel.banner.isVisibleTo(panel) and panel.restore_button.isEnabled()
     panel.restore_button.click()
-    (call,) = link.named("upload_points")
-    assert [pid for pid, _, _ in call.args[0]] == model.ledger.ids()
+    (call,) = link.named(UploadPoints)
+    assert [pid for pid, _, _ in call.items] == model.ledger.ids()
     link.point_ok(*model.ledger.ids())
     with qtbot.waitSignal(panel.controller.uploadFinished):
         link.upload_summary(8, 8)
@@ -327,19 +328,19 @@ def test_move_to_point_asks_first(
     answers.append(False)
     panel.action_move_to.trigger()
     assert "P2" in panel.questions[-1] and "120" in panel.questions[-1]  # type: ignore[attr-defined]
-    assert link.named("move_to_point") == [] and link.named("upload_points") == []
+    assert link.named(MoveToPoint) == [] and link.named(UploadPoints) == []
     answers.append(True)
     panel.move_to_selected()
     # the point guard: P2 is created again from the ledger first, the move waits for it
-    (create,) = link.named("upload_points")
-    assert create.args[0] == [(2, model.ledger.point(2).xyzabc, 200)]
-    assert link.named("move_to_point") == []
+    (create,) = link.named(UploadPoints)
+    assert create.items == ((2, model.ledger.point(2).xyzabc, 200),)
+    assert link.named(MoveToPoint) == []
     with qtbot.waitSignal(panel.controller.movePrepared) as prepared:
         link.point_ok(2)
         link.upload_summary(1, 1)
     assert prepared.args == [2]
-    (call,) = link.named("move_to_point")
-    assert call.args == (2, None) and call.kwargs["speed"] == 120.0 and call.kwargs["tool"] == 200
+    (call,) = link.named(MoveToPoint)
+    assert (call.end_id, call.via_id, call.speed, call.tool) == (2, None, 120.0, 200)
     with qtbot.waitSignal(panel.controller.moveFinished) as done:
         link.finish_move(False, code=13, message="bad end-point id")
     assert done.args[0] is False and "bad end point id" in done.args[1]  # GV291 13, in words
@@ -357,11 +358,11 @@ def test_move_to_a_point_not_on_the_controller_creates_it_first(
     answers.append(True)
     panel.move_to_selected()
     assert panel.questions  # type: ignore[attr-defined]  # asked, like any move
-    assert [c.args[0][0][0] for c in link.named("upload_points")] == [point.id]
+    assert [c.items[0][0] for c in link.named(UploadPoints)] == [point.id]
     link.point_failed(point.id, "bad point id")
     with qtbot.waitSignal(panel.controller.moveFinished) as done:
         link.upload_summary(0, 1)
-    assert done.args[0] is False and link.named("move_to_point") == []  # never sent
+    assert done.args[0] is False and link.named(MoveToPoint) == []  # never sent
     assert f"Move to P{point.id} failed" in panel.status.text() and "not moved" in panel.status.text()
 
 
@@ -372,10 +373,10 @@ def test_a_stop_while_the_point_is_created_sends_no_move(
     answers.append(True)
     panel.move_to_selected()
     panel.controller.stop()
-    assert link.named("stop")
+    assert link.named(Stop)
     with qtbot.waitSignal(panel.controller.moveFinished) as done:
         link.upload_summary(0, 1, "stopped")  # the worker's upload ends at the stop
-    assert done.args[0] is False and link.named("move_to_point") == []
+    assert done.args[0] is False and link.named(MoveToPoint) == []
     assert "stopped by the operator" in panel.status.text()
 
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 from typing import Any
 
 from app.link.client import StepFrame
+from app.link.ops import Step
 from app.link.robot_link import RobotLink
 from app.models import CommandResult
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -36,7 +37,7 @@ def test_a_poll_is_replayed_in_the_old_order(qtbot: Any, sim: Any, link: RobotLi
     link.commandFinished.connect(lambda r: seen.append(("link.result", r)))
     connect(qtbot, link, sim)  # after the wiring: the first poll (alarms None -> 0) is always seen
 
-    pending = link.track(link.step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], speed=20.0))
+    pending = link.track(link.submit(Step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], speed=20.0)))
     qtbot.waitUntil(lambda: pending.result is not None, timeout=SIGNAL_TIMEOUT_MS * 3)
     assert pending.result is not None and pending.result.ok
 

@@ -14,6 +14,7 @@ from PySide6.QtCore import QEvent, QObject
 from PySide6.QtGui import QUndoStack
 from PySide6.QtWidgets import QApplication, QMainWindow, QWidget
 
+from app.link.ops import GoZero, JogPress, Stop
 from app.models import ControllerStatus, Pose
 from app.points.project import Project
 from app.protocol.enums import Alarm, ControllerMode, ProgramState, TeachFrame
@@ -325,9 +326,9 @@ def test_an_estop_holds_motion_but_not_stop(qtbot: Any, link: FakeLink) -> None:
     assert bar.stop_button.isEnabled() and bar.pause_button.isEnabled()
     jog.jogPressed.emit(jog_request())  # an intent already on its way is dropped
     program.goZeroRequested.emit(None)
-    assert link.named("jog_press") == [] and link.named("go_zero") == []
+    assert link.named(JogPress) == [] and link.named(GoZero) == []
     bar.stopRequested.emit()
-    assert [c.name for c in link.calls] == ["stop"]
+    assert link.kinds() == [Stop]
     poll(link, st=status(alarms=int(Alarm.BRAKE)))  # a brake alarm alone does not hold
     assert not motion.alarm_hold and jog.axes_box.isEnabled() and bar.resume_button.isEnabled()
 

@@ -10,6 +10,7 @@ from typing import Any
 
 import pytest
 
+from app.link.ops import Pause, Resume, RunProgram, Stop
 from app.link.robot_link import RobotLink
 from app.link.types import WorkerError
 from app.protocol import registers
@@ -34,8 +35,8 @@ def test_pause_and_resume_read_sent_and_named_in_both_languages(
     connect(qtbot, link, sim)
     results = Results(link)
     since = len(sim.writes)
-    pause = results.of(qtbot, link.pause())
-    resume = results.of(qtbot, link.resume())
+    pause = results.of(qtbot, link.submit(Pause()))
+    resume = results.of(qtbot, link.submit(Resume()))
     addresses = [write.address for write in sim.writes[since:]]
     assert registers.REG_PAUSE in addresses and registers.REG_RESUME in addresses
     assert (result_text(pause), result_text(resume)) == ("pause: sent.", "resume: sent.")
@@ -52,14 +53,14 @@ def test_a_program_while_one_runs_keeps_the_cores_sentence_in_both_languages(
     connect(qtbot, link, sim)
     errors: list[WorkerError] = []
     link.errorOccurred.connect(errors.append)
-    link.run_program(1)
+    link.submit(RunProgram(1))
     qtbot.waitUntil(lambda: sim.state().program_state == ProgramState.RUNNING, timeout=SIGNAL_TIMEOUT_MS)
     since = len(sim.writes)
-    second = link.run_program(2)
+    second = link.submit(RunProgram(2))
     qtbot.waitUntil(lambda: any(e.request_id == second for e in errors), timeout=SIGNAL_TIMEOUT_MS)
     error = next(e for e in errors if e.request_id == second)
     assert error_text(error) == "run program is still under way: wait for it or press Stop."
     assert registers.REG_RUN_COMMAND not in [write.address for write in sim.writes[since:]]
     assert translator.set_language("zh_CN")
     assert_chinese(error_text(error))
-    link.stop()
+    link.submit(Stop())

@@ -12,6 +12,7 @@ from typing import Any
 import pytest
 
 from app.link.client import StepFrame
+from app.link.ops import CreatePoint, MoveToPoint, Pause, Step
 from app.link.robot_link import Pending, RequestRouter, RobotLink
 from app.link.state import RobotState
 from app.link.stats import LinkStats
@@ -195,8 +196,8 @@ def test_a_request_that_was_never_queued_fails(qtbot: Any) -> None:
 
 def test_the_fake_link_routes_like_the_link(qapp: Any) -> None:
     link = FakeLink()
-    a = link.track(link.move_to_point(1))
-    b = link.track(link.move_to_point(2))
+    a = link.track(link.submit(MoveToPoint(1)))
+    b = link.track(link.submit(MoveToPoint(2)))
     seen: list[tuple[Pending, str]] = []
     a.finished.connect(lambda r: seen.append((a, r.message)))
     b.finished.connect(lambda r: seen.append((b, r.message)))
@@ -221,9 +222,11 @@ def _outcomes(qtbot: Any, *pendings: Pending, timeout: int = SIGNAL_TIMEOUT_MS) 
 def test_concurrent_requests_each_get_their_own_result(qtbot: Any, sim: Any, link: RobotLink) -> None:
     connect(qtbot, link, sim)
     target = (400.0, 10.0, 300.0, 180.0, 0.0, 0.0)
-    create = link.track(link.create_point(22, target))
-    pause = link.track(link.pause())  # urgent: may overtake the create
-    refused = link.track(link.step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0]))  # invalid: fails in the worker
+    create = link.track(link.submit(CreatePoint(22, target)))
+    pause = link.track(link.submit(Pause()))  # urgent: may overtake the create
+    refused = link.track(
+        link.submit(Step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0]))
+    )  # invalid: fails in the worker
     outcomes = _outcomes(qtbot, create, pause, refused)
     assert all(len(v) == 1 for v in outcomes.values())  # one outcome each, never another's
     for request_id, (outcome,) in outcomes.items():
@@ -239,9 +242,9 @@ def test_two_creates_in_a_row_each_get_their_own_result(qtbot: Any, sim: Any, li
     one command at a time), then goes out: each request ends once, with its own result."""
     connect(qtbot, link, sim)
     target = (400.0, 10.0, 300.0, 180.0, 0.0, 0.0)
-    first = link.track(link.create_point(21))
-    second = link.track(link.create_point(22, target))
-    third = link.track(link.create_point(23, target))
+    first = link.track(link.submit(CreatePoint(21)))
+    second = link.track(link.submit(CreatePoint(22, target)))
+    third = link.track(link.submit(CreatePoint(23, target)))
     outcomes = _outcomes(qtbot, first, second, third)
     assert all(len(v) == 1 for v in outcomes.values())
     for pending in (first, second, third):
@@ -266,9 +269,11 @@ def test_a_pending_is_freed_once_its_request_ended(qtbot: Any, sim: Any, link: R
     connect(qtbot, link, sim)
     outcomes: list[object] = []
     target = (400.0, 10.0, 300.0, 180.0, 0.0, 0.0)
-    refs = [_watch(link, link.create_point(30 + i, target), outcomes) for i in range(8)]
-    refs += [_watch(link, link.pause(), outcomes) for _ in range(4)]
-    refs.append(_watch(link, link.step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0]), outcomes))  # fails in the worker
+    refs = [_watch(link, link.submit(CreatePoint(30 + i, target)), outcomes) for i in range(8)]
+    refs += [_watch(link, link.submit(Pause()), outcomes) for _ in range(4)]
+    refs.append(
+        _watch(link, link.submit(Step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0])), outcomes)
+    )  # fails in the worker
     refs.append(_watch(link, 0, outcomes))  # never queued: fails on the next turn of the loop
     qtbot.waitUntil(lambda: len(outcomes) == len(refs), timeout=SIGNAL_TIMEOUT_MS)
     assert len(link._router) == 0

@@ -11,6 +11,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 from app.link.client import StepFrame
+from app.link.ops import RunProgram, Step, Stop
 from app.link.types import LinkState
 from app.models import CommandResult
 from app.protocol import registers
@@ -57,7 +58,7 @@ def _connected(qtbot: Any, window: Any, sim: Any) -> Any:
 
 def _program_running(qtbot: Any, window: Any, sim: Any) -> None:
     """Program 1 cycling until stopped, at 20 %, seen running by the window too."""
-    window.link.run_program(1, ProgramMotionMode.CYCLE, 0, 20)
+    window.link.submit(RunProgram(1, ProgramMotionMode.CYCLE, 0, 20))
     qtbot.waitUntil(lambda: sim.state().program_state == ProgramState.RUNNING, timeout=SIGNAL_TIMEOUT_MS)
     status = window.link.state
     qtbot.waitUntil(
@@ -143,14 +144,14 @@ def test_disconnect_asks_only_while_something_is_under_way_and_cancel_keeps_the_
 def test_disconnect_names_a_move_in_flight(qtbot: Any, sim: Any, window: Any) -> None:
     _connected(qtbot, window, sim)
     answers = window.link_guard.ask = Answers(StopFirst.CANCEL)
-    window.link.step(StepFrame.BASE, (0.0, 0.0, -60.0, 0.0, 0.0, 0.0), speed=20.0)  # 3 s
+    window.link.submit(Step(StepFrame.BASE, (0.0, 0.0, -60.0, 0.0, 0.0, 0.0), speed=20.0))  # 3 s
     assert window.link.motions_in_flight == ("step",)
     window.menus.disconnect_action.trigger()
     [question] = answers.asked
     assert "incremental move: under way" in question.text
     qtbot.waitUntil(lambda: sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
     qtbot.waitUntil(lambda: window.link_guard.under_way.pose_moving(), timeout=SIGNAL_TIMEOUT_MS)
-    window.link.stop()
+    window.link.submit(Stop())
     qtbot.waitUntil(lambda: window.link.motions_in_flight == (), timeout=SIGNAL_TIMEOUT_MS)
     assert sim.wait_for(lambda s: not s.moving, 2.0)
     _idle(qtbot, window)  # (the close at the teardown asks nothing: Cancel would keep the window)

@@ -18,7 +18,9 @@ from pymodbus.constants import ExcCodes
 
 from app import timing
 from app.link import stop_line as stop_line_module
+from app.link.ops import GoZero, JogPress, Stop, UploadPoints
 from app.link.robot_link import RobotLink
+from app.link.types import JogRequest
 from app.models import CommandResult
 from app.protocol import registers
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -60,14 +62,14 @@ def test_a_stop_only_the_stop_connection_takes_ends_the_point_in_flight_and_is_s
     # one point: no staging write of a next pose can be on its way when Stop is pressed (a write
     # answered after the line's stop keeps the old, cautious path: test_a_write_after_the_line_...)
     items = [(100, (300.0, 0.0, 400.0, 180.0, 0.0, 0.0), 200)]
-    upload_id = link.upload_points(items)
+    upload_id = link.submit(UploadPoints.of(items))
     qtbot.waitUntil(lambda: bool(sim.writes_to(registers.REG_RUN_COMMAND)), timeout=SIGNAL_TIMEOUT_MS)
     # a request after the 440's: its answer has reached the worker (a Stop before that would rightly
     # keep the cautious path: a write not yet answered when the line's stop went out)
     after_440 = sim.requests_count
     qtbot.waitUntil(lambda: sim.requests_count > after_440, timeout=SIGNAL_TIMEOUT_MS)
     pressed = time.monotonic()
-    stop_id = link.stop()
+    stop_id = link.submit(Stop())
     qtbot.waitUntil(lambda: any(r.request_id == upload_id for r in results), timeout=2 * POINT_TIMEOUT * 1000)
     elapsed = time.monotonic() - pressed
     qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
@@ -97,7 +99,7 @@ def test_the_operator_reads_which_connection_carried_the_stop(
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=lambda r: r.reason is not None, timeout=SIGNAL_TIMEOUT_MS
     ) as done:
-        link.stop()
+        link.submit(Stop())
     stop = done.args[0]
     assert stop.ok and result_level(stop) == LEVEL_WARNING
     assert result_text(stop) == (
@@ -120,7 +122,7 @@ def test_a_stop_the_wedged_main_link_never_answers_is_sent_on_the_line_and_the_l
     link.commandFinished.connect(results.append)
     sim.set_response_delay(3.0, connection=main, addresses=range(registers.REG_STOP, registers.REG_STOP + 1))
     try:
-        stop_id = link.stop()
+        stop_id = link.submit(Stop())
         qtbot.waitUntil(lambda: bool(sim.writes_to(registers.REG_STOP)), timeout=SIGNAL_TIMEOUT_MS)
         qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=3 * SIGNAL_TIMEOUT_MS)
     finally:
@@ -152,10 +154,10 @@ def test_a_motion_written_after_the_lines_stop_keeps_the_stop_a_failure(
         sim.set_response_delay(0.3, connection=main)  # slow, under the 1 s request timeout
         try:
             stops_before = len(sim.writes_to(registers.REG_STOP))
-            zero_id = link.go_zero(None)
+            zero_id = link.submit(GoZero(None))
             reads = sim.requests_count
             qtbot.waitUntil(lambda r=reads: sim.requests_count > r + 1, timeout=SIGNAL_TIMEOUT_MS)
-            stop_id = link.stop()
+            stop_id = link.submit(Stop())
             qtbot.waitUntil(
                 lambda s=stop_id: (
                     any(e.request_id == s for e in errors) or any(r.request_id == s for r in results)
@@ -189,11 +191,11 @@ def test_a_held_jog_keeps_a_stop_only_the_line_took_a_failure_and_still_ends(
     from tests.ui.pendant_support import jogging, ratio_writes
 
     _line_open(qtbot, link, sim, monkeypatch)
-    link.jog_press(TeachFrame.BASE, 1, 1, 20.0)
+    link.submit(JogPress(JogRequest(TeachFrame.BASE, 1, 1, 20.0)))
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     results: list[CommandResult] = []
     link.commandFinished.connect(results.append)
-    stop_id = link.stop()
+    stop_id = link.submit(Stop())
     qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
     stop = next(r for r in results if r.request_id == stop_id)
     assert not stop.ok and stop.reason is not None and stop.reason.code == "modbus_exception", stop

@@ -16,8 +16,9 @@ from PySide6.QtCore import QCoreApplication, Qt
 
 from app import timing
 from app.link.client import TrafficRecord
+from app.link.ops import CreatePoint, JogPress
 from app.link.robot_link import RobotLink
-from app.link.types import LinkState
+from app.link.types import JogRequest, LinkState
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import TeachFrame
@@ -128,7 +129,9 @@ def test_disconnect_delivers_every_frame(
 ) -> None:
     monkeypatch.setattr(timing, "TRAFFIC_DELIVERY_PERIOD", NEVER)
     got = _capturing(qtbot, sim, link, polls=10)
-    link.jog_press(TeachFrame.BASE, 0, 1, 20.0)  # the disconnect then writes ratio 0, teach off
+    link.submit(
+        JogPress(JogRequest(TeachFrame.BASE, 0, 1, 20.0))
+    )  # the disconnect then writes ratio 0, teach off
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     at_end: list[tuple[int, int]] = []
     link.connectionChanged.connect(lambda _s: at_end.append((len(got.tx()), _writes(got))))
@@ -179,7 +182,7 @@ def test_a_commands_frames_come_before_its_result(
 
     link.commandFinished.connect(on_result)
     with qtbot.waitSignal(link.commandFinished, timeout=SIGNAL_TIMEOUT_MS) as done:
-        link.create_point(7, [100.0, 0.0, 300.0, 0.0, 0.0, 0.0], 0)
+        link.submit(CreatePoint(7, [100.0, 0.0, 300.0, 0.0, 0.0, 0.0], 0))
     assert done.args[0].ok, done.args[0].message
     assert len(sim.writes) >= 2  # the pose, the command
     assert writes_at_result == [len(sim.writes)]  # all of its writes were already in the table

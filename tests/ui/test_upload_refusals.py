@@ -9,6 +9,7 @@ from typing import Any
 
 import pytest
 
+from app.link.ops import UploadPoints
 from app.link.robot_link import RobotLink
 from app.link.types import LinkState
 from app.models import CommandResult
@@ -56,7 +57,7 @@ def test_a_refused_point_is_failed_the_link_stays_up_and_the_upload_goes_on(
     watch = _Watch(link)
     sim.refuse_point_write(5)  # its GV200-202 answered with exception 3 (illegal data value), once
     items = _items(10)
-    upload_id = link.upload_points(items)
+    upload_id = link.submit(UploadPoints.of(items))
     with qtbot.waitSignal(link.commandFinished, check_params_cb=_finished(upload_id), timeout=30_000) as done:
         pass
     result = done.args[0]
@@ -92,7 +93,7 @@ def test_a_link_lost_after_a_refused_point_still_ends_the_upload(
             sim.set_silent(True)
 
     link.pointUploaded.connect(silence_at_six)
-    upload_id = link.upload_points(_items(200))
+    upload_id = link.submit(UploadPoints.of(_items(200)))
     try:
         with qtbot.waitSignal(
             link.commandFinished, check_params_cb=_finished(upload_id), timeout=30_000

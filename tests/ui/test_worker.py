@@ -13,8 +13,24 @@ from app import timing
 from app.errors import Reason
 from app.link import worker as worker_module
 from app.link.client import StepFrame
+from app.link.ops import (
+    CancelUpload,
+    CreatePoint,
+    GoZero,
+    JogPress,
+    JogRelease,
+    MoveToPoint,
+    Pause,
+    Resume,
+    RunProgram,
+    SetJogRatio,
+    SetMode,
+    Step,
+    Stop,
+    UploadPoints,
+)
 from app.link.robot_link import RobotLink
-from app.link.types import LinkState, Operation, WorkerError
+from app.link.types import JogRequest, LinkState, Operation, WorkerError
 from app.link.worker import RobotWorker
 from app.models import CommandResult, Pose
 from app.protocol import registers
@@ -81,7 +97,7 @@ def test_live_pose_while_the_simulator_moves(qtbot: Any, sim: Any, link: RobotLi
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_result(lambda r: r.ok), timeout=SIGNAL_TIMEOUT_MS
     ) as blocker:
-        link.step(StepFrame.JOINT, [6.0, 0, 0, 0, 0, 0], speed=1.0)  # 6 deg/s: about 1 s
+        link.submit(Step(StepFrame.JOINT, [6.0, 0, 0, 0, 0, 0], speed=1.0))  # 6 deg/s: about 1 s
         # Live poses while it moves: many polls fit in a second, even on a loaded machine.
         qtbot.waitUntil(
             lambda: any(start + 0.1 < j < start + 5.9 for j in _j1(poses)), timeout=SIGNAL_TIMEOUT_MS
@@ -101,7 +117,7 @@ def test_jog_sequence_as_seen_by_the_simulator(
     qtbot: Any, sim: Any, link: RobotLink, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     connect(qtbot, link, sim)
-    link.jog_press(TeachFrame.BASE, 0, 1, 40.0)
+    link.submit(JogPress(JogRequest(TeachFrame.BASE, 0, 1, 40.0)))
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     state = sim.state()
     assert state.mode == ControllerMode.MODBUS_TEACH and state.teach_ratio == 40.0
@@ -112,30 +128,30 @@ def test_jog_sequence_as_seen_by_the_simulator(
     assert params and enables and params[0] < enables[0] < ratios[-1][0]
     assert ratios[-1][1] == 40.0
 
-    link.set_jog_ratio(75.0)  # speed changes live while moving
+    link.submit(SetJogRatio(75.0))  # speed changes live while moving
     qtbot.waitUntil(lambda: sim.state().teach_ratio == 75.0, timeout=SIGNAL_TIMEOUT_MS)
 
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not sim.state().jogging, timeout=SIGNAL_TIMEOUT_MS)
     assert ratio_writes(sim)[-1] == 0.0
     assert sim.state().teach_enabled  # release keeps teach enabled
 
     # Another axis in the same frame: ratio 0, GV201-202, ratio -- no new enable.
     enables_before = len([v for _, v in register_writes(sim, 440) if v == 0x80])
-    link.jog_press(TeachFrame.BASE, 2, 0, 30.0)
+    link.submit(JogPress(JogRequest(TeachFrame.BASE, 2, 0, 30.0)))
     qtbot.waitUntil(lambda: jogging(sim) and sim.state().teach_ratio == 30.0, timeout=SIGNAL_TIMEOUT_MS)
     assert len([v for _, v in register_writes(sim, 440) if v == 0x80]) == enables_before
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not sim.state().jogging, timeout=SIGNAL_TIMEOUT_MS)
 
     # Another frame: disable (0x81) then enable again.
-    link.jog_press(TeachFrame.JOINT, 0, 1, 50.0)
+    link.submit(JogPress(JogRequest(TeachFrame.JOINT, 0, 1, 50.0)))
     qtbot.waitUntil(
         lambda: jogging(sim) and sim.state().teach_frame == int(TeachFrame.JOINT), timeout=SIGNAL_TIMEOUT_MS
     )
     commands = [v for _, v in register_writes(sim, 440)]
     assert commands[-2:] == [0x81, 0x80]
-    link.jog_release()
+    link.submit(JogRelease())
     qtbot.waitUntil(lambda: not sim.state().jogging, timeout=SIGNAL_TIMEOUT_MS)
 
     # Idle: teach mode is switched off by itself.
@@ -150,8 +166,8 @@ def test_release_cancels_a_press_still_queued(qtbot: Any, sim: Any, link: RobotL
     sim.set_response_delay(0.15)
     seen = sim.requests_count
     qtbot.waitUntil(lambda: sim.requests_count > seen, timeout=SIGNAL_TIMEOUT_MS)  # one in flight
-    link.jog_press(TeachFrame.BASE, 0, 1, 50.0)
-    link.jog_release()
+    link.submit(JogPress(JogRequest(TeachFrame.BASE, 0, 1, 50.0)))
+    link.submit(JogRelease())
     sim.set_response_delay(0.0)
     seen = sim.requests_count
     qtbot.waitUntil(lambda: sim.requests_count > seen + 6, timeout=SIGNAL_TIMEOUT_MS)  # polls go on
@@ -171,11 +187,11 @@ def test_stop_goes_out_before_queued_commands_and_polls(qtbot: Any, sim: Any, li
     writes_before = len(sim.writes)
     cancelled: list[CommandResult] = []
     link.commandFinished.connect(lambda r: cancelled.append(r) if "cancelled" in r.message else None)
-    link.go_zero(0)
-    link.go_zero(1)
-    link.run_program(1)
-    link.step(StepFrame.JOINT, [1.0, 0, 0, 0, 0, 0])
-    link.stop()
+    link.submit(GoZero(0))
+    link.submit(GoZero(1))
+    link.submit(RunProgram(1))
+    link.submit(Step(StepFrame.JOINT, [1.0, 0, 0, 0, 0, 0]))
+    link.submit(Stop())
     qtbot.waitUntil(lambda: len(cancelled) == 4, timeout=SIGNAL_TIMEOUT_MS)
     sim.set_response_delay(0.0)
     writes = sim.writes[writes_before:]
@@ -195,18 +211,18 @@ def test_stop_goes_out_before_queued_commands_and_polls(qtbot: Any, sim: Any, li
 
 def test_pause_resume_reach_the_simulator(qtbot: Any, sim: Any, link: RobotLink) -> None:
     connect(qtbot, link, sim)
-    link.run_program(2)  # the joint wiggle
+    link.submit(RunProgram(2))  # the joint wiggle
     qtbot.waitUntil(lambda: sim.state().program_state == ProgramState.RUNNING, timeout=SIGNAL_TIMEOUT_MS)
-    link.pause()
+    link.submit(Pause())
     qtbot.waitUntil(lambda: sim.state().paused, timeout=SIGNAL_TIMEOUT_MS)
-    link.resume()
+    link.submit(Resume())
     qtbot.waitUntil(lambda: sim.state().program_state == ProgramState.RUNNING, timeout=SIGNAL_TIMEOUT_MS)
     with qtbot.waitSignal(
         link.commandFinished,
         check_params_cb=_result(lambda r: "stopped" in r.message),
         timeout=SIGNAL_TIMEOUT_MS,
     ):
-        link.stop()
+        link.submit(Stop())
     qtbot.waitUntil(lambda: sim.state().program_state == ProgramState.STOPPED, timeout=SIGNAL_TIMEOUT_MS)
 
 
@@ -216,12 +232,12 @@ def test_monitor_only_never_writes(qtbot: Any, sim: Any, link: RobotLink) -> Non
     connect(qtbot, link, sim, monitor_only=True)
     assert link.connection.monitor_only
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS):
-        link.jog_press(TeachFrame.BASE, 0, 1, 50.0)
-    link.jog_release()  # (a release right after a press would drop the press unsent)
-    link.step(StepFrame.BASE, [1.0, 0, 0, 0, 0, 0])
-    link.go_zero(None)
-    link.set_mode(WorkMode.MANUAL)
-    link.stop()
+        link.submit(JogPress(JogRequest(TeachFrame.BASE, 0, 1, 50.0)))
+    link.submit(JogRelease())  # (a release right after a press would drop the press unsent)
+    link.submit(Step(StepFrame.BASE, [1.0, 0, 0, 0, 0, 0]))
+    link.submit(GoZero(None))
+    link.submit(SetMode(WorkMode.MANUAL))
+    link.submit(Stop())
     # every request refused (a poll that times out at 0.25 s under load may add its own error)
 
     def refused() -> list[WorkerError]:
@@ -239,7 +255,7 @@ def test_link_loss_then_reconnect_stops_the_jog_first(
     monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.3)
     sim.set_watchdog(None)  # a controller without a communication watchdog
     connect(qtbot, link, sim, poll_timeout=0.5)
-    link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
+    link.submit(JogPress(JogRequest(TeachFrame.JOINT, 0, 1, 20.0)))
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     with qtbot.waitSignal(
         link.connectionChanged, check_params_cb=is_state(LinkState.DOWN), timeout=SIGNAL_TIMEOUT_MS
@@ -271,7 +287,7 @@ def test_dropped_connections_recover(qtbot: Any, sim: Any, link: RobotLink) -> N
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_result(lambda r: r.ok), timeout=SIGNAL_TIMEOUT_MS
     ):
-        link.step(StepFrame.JOINT, [0, 0, 0, 2.0, 0, 0], speed=10.0)
+        link.submit(Step(StepFrame.JOINT, [0, 0, 0, 2.0, 0, 0], speed=10.0))
     assert states == []
 
 
@@ -281,28 +297,28 @@ def test_refusals_and_exceptions_are_results(qtbot: Any, sim: Any, link: RobotLi
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_result(lambda r: not r.ok), timeout=SIGNAL_TIMEOUT_MS
     ) as blocker:
-        link.jog_press(TeachFrame.BASE, 0, 1, 10.0)
+        link.submit(JogPress(JogRequest(TeachFrame.BASE, 0, 1, 10.0)))
     assert "emergency stop" in blocker.args[0].message
     sim.set_alarm(Alarm.ESTOP, False)
     sim.set_exception(ExcCodes.ILLEGAL_ADDRESS, range(445, 446))
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_result(lambda r: not r.ok), timeout=SIGNAL_TIMEOUT_MS
     ) as blocker:
-        link.go_zero(3)
+        link.submit(GoZero(3))
     assert "illegal data address" in blocker.args[0].message
     sim.set_exception(None)
     # a poll that read 412..511 (it covers 445) while the exception was on may report late: skip it
     with qtbot.waitSignal(
         link.errorOccurred, check_params_cb=lambda e: e.operation != "poll", timeout=SIGNAL_TIMEOUT_MS
     ) as blocker:
-        link.step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0])
+        link.submit(Step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0]))
     error = blocker.args[0]
     assert error.operation == "step" and "zero" in error.message and "Traceback" not in error.message
 
 
 def test_commands_while_disconnected_are_errors(qtbot: Any, link: RobotLink) -> None:
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as blocker:
-        request_id = link.stop()
+        request_id = link.submit(Stop())
     assert blocker.args[0] == WorkerError(
         "stop", "not connected to a controller", request_id, Reason("not_connected")
     )
@@ -329,7 +345,7 @@ def test_points_create_upload_and_move(qtbot: Any, sim: Any, link: RobotLink) ->
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_result(lambda r: r.ok), timeout=SIGNAL_TIMEOUT_MS
     ) as blocker:
-        link.create_point(7)
+        link.submit(CreatePoint(7))
     details = blocker.args[0].details
     assert details["x"] == pytest.approx(pose[0], abs=1e-3) and 7 in sim.state().points
     target = (pose[0], pose[1] + 40.0, pose[2], pose[3], pose[4], pose[5])
@@ -340,14 +356,14 @@ def test_points_create_upload_and_move(qtbot: Any, sim: Any, link: RobotLink) ->
         check_params_cb=_result(lambda r: "uploaded" in r.message),
         timeout=SIGNAL_TIMEOUT_MS,
     ) as blocker:
-        link.upload_points([(8, target), (9, pose)])
+        link.submit(UploadPoints.of([(8, target), (9, pose)]))
     assert blocker.args[0].ok and blocker.args[0].message == "uploaded 2 of 2 points"
     assert progress[0] == (0, 2) and progress[-1] == (2, 2)
     assert sim.state().points[8] == pytest.approx(target)
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_result(lambda r: r.ok), timeout=SIGNAL_TIMEOUT_MS
     ):
-        link.move_to_point(8, speed=400.0)
+        link.submit(MoveToPoint(8, speed=400.0))
     assert sim.state().pose[1] == pytest.approx(target[1], abs=1e-3)
 
 
@@ -360,13 +376,13 @@ def test_request_ids_round_trip(qtbot: Any, sim: Any, link: RobotLink) -> None:
     errors: list[WorkerError] = []
     link.commandFinished.connect(results.append)
     link.errorOccurred.connect(errors.append)
-    step_id = link.step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], speed=10.0)
-    refused_id = link.go_zero(0)  # a motion is under way: refused by the worker
+    step_id = link.submit(Step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], speed=10.0))
+    refused_id = link.submit(GoZero(0))  # a motion is under way: refused by the worker
     qtbot.waitUntil(lambda: any(r.request_id == step_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
-    bad_id = link.step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0])  # invalid input
-    create_id = link.create_point(11)
+    bad_id = link.submit(Step(StepFrame.JOINT, [0, 0, 0, 0, 0, 0]))  # invalid input
+    create_id = link.submit(CreatePoint(11))
     qtbot.waitUntil(lambda: any(r.request_id == create_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
-    stop_id = link.stop()
+    stop_id = link.submit(Stop())
     qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
     ids = [step_id, refused_id, bad_id, create_id, stop_id]
     assert ids == sorted(ids) and len(set(ids)) == 5 and min(ids) > 0
@@ -389,8 +405,8 @@ def test_a_stop_cancels_queued_motions_with_their_ids(
     qtbot.waitUntil(lambda: sim.requests_count > seen, timeout=SIGNAL_TIMEOUT_MS)
     results: list[CommandResult] = []
     link.commandFinished.connect(results.append)
-    queued = [link.go_zero(0), link.run_program(1)]
-    link.stop()
+    queued = [link.submit(GoZero(0)), link.submit(RunProgram(1))]
+    link.submit(Stop())
 
     def cancelled() -> set[int | None]:
         return {r.request_id for r in results if "cancelled by Stop" in r.message}
@@ -435,11 +451,11 @@ def test_upload_reports_each_point_and_cancel_sends_no_stop(qtbot: Any, sim: Any
     def on_point(point_id: int, ok: bool, reason: str) -> None:
         points.append((point_id, ok, reason))
         if len(points) == 150:
-            cancel_ids.append(link.cancel_upload())
+            cancel_ids.append(link.submit(CancelUpload()))
 
     link.pointUploaded.connect(on_point)
     items = _poses(sim, range(1, 301))
-    upload_id = link.upload_points(items)
+    upload_id = link.submit(UploadPoints.of(items))
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_batch_result(upload_id), timeout=30_000
     ) as done:
@@ -477,7 +493,7 @@ def test_stop_during_a_large_upload_is_serviced_promptly(
     )
     link.statusChanged.connect(statuses.append)
     total = 3000
-    upload_id = link.upload_points(_poses(sim, range(1, total + 1)))
+    upload_id = link.submit(UploadPoints.of(_poses(sim, range(1, total + 1))))
     qtbot.waitUntil(lambda: len(sim.state().points) >= 100, timeout=30_000)
     polls.clear()
     statuses.clear()
@@ -489,7 +505,7 @@ def test_stop_during_a_large_upload_is_serviced_promptly(
         link.commandFinished, check_params_cb=_batch_result(upload_id), timeout=SIGNAL_TIMEOUT_MS
     ) as done:
         t0 = time.monotonic()
-        link.stop()
+        link.submit(Stop())
         assert sim.wait_for(lambda _s: any(w.address == 441 for w in sim.writes[writes_before:]), 1.0)
         latency = time.monotonic() - t0
         created_at_stop = len(sim.state().points)
@@ -529,7 +545,7 @@ def test_upload_tool_per_point_writes_gv245_once_per_tool(qtbot: Any, sim: Any, 
         check_params_cb=_result(lambda r: "uploaded" in r.message),
         timeout=SIGNAL_TIMEOUT_MS,
     ) as done:
-        link.upload_points(items)
+        link.submit(UploadPoints.of(items))
     assert done.args[0].ok
     assert order == [1, 3, 6, 2, 4, 5]  # grouped by tool, first appearance first
     with sim.lock:
@@ -541,10 +557,12 @@ def test_upload_tool_per_point_writes_gv245_once_per_tool(qtbot: Any, sim: Any, 
 def test_upload_checks_every_point_before_writing(qtbot: Any, sim: Any, link: RobotLink) -> None:
     connect(qtbot, link, sim)
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as blocker:
-        upload_id = link.upload_points([(1, (0.0,) * 6, 200), (2, (0.0, float("nan"), 0, 0, 0, 0), 200)])
+        upload_id = link.submit(
+            UploadPoints.of([(1, (0.0,) * 6, 200), (2, (0.0, float("nan"), 0, 0, 0, 0), 200)])
+        )
     assert blocker.args[0].request_id == upload_id and "point 2" in blocker.args[0].message
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as blocker:
-        link.upload_points([(1, (0.0,) * 6, 201)])
+        link.submit(UploadPoints.of([(1, (0.0,) * 6, 201)]))
     assert "tool frame" in blocker.args[0].message
     assert sim.writes == []
 

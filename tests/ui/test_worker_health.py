@@ -13,10 +13,11 @@ from PySide6.QtCore import QObject, QThread, Signal
 from app import timing
 from app.link import robot_link as robot_link_module
 from app.link.client import StepFrame
+from app.link.ops import JogPress, Step
 from app.link.robot_link import RobotLink
 from app.link.state import PollUpdate
 from app.link.stats import LinkStats
-from app.link.types import ConnectionState, LinkState
+from app.link.types import ConnectionState, JogRequest, LinkState
 from app.link.worker import RobotWorker
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import TeachFrame
@@ -105,7 +106,7 @@ def test_command_finished_comes_after_the_pose_and_status_of_its_poll(qtbot: Any
     rig.commandFinished.connect(lambda r: events.append(("result", r)))
     rig.connect_sim(qtbot, sim)
     with qtbot.waitSignal(rig.commandFinished, timeout=SIGNAL_TIMEOUT_MS) as blocker:
-        rig.worker.request_step(StepFrame.JOINT, [3.0, 0, 0, 0, 0, 0], (0.0,) * 5, 10.0)
+        rig.worker.submit(Step(StepFrame.JOINT, [3.0, 0, 0, 0, 0, 0], (0.0,) * 5, 10.0))
     result: CommandResult = blocker.args[0]
     assert result.ok, result.message
     done = next(i for i, (kind, value) in enumerate(events) if kind == "result" and value is result)
@@ -178,7 +179,7 @@ def test_jog_during_silence_gets_ratio_zero_first_when_it_answers(
     # jog's connection, which would otherwise stop the jog at the simulator by itself
     sim.set_watchdog(None)
     connect(qtbot, link, sim, poll_timeout=0.3)
-    link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
+    link.submit(JogPress(JogRequest(TeachFrame.JOINT, 0, 1, 20.0)))
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     with qtbot.waitSignal(
         link.connectionChanged, check_params_cb=is_state(LinkState.NOT_ANSWERING), timeout=SIGNAL_TIMEOUT_MS
@@ -200,7 +201,7 @@ def test_shutdown_with_a_silent_controller_does_not_block_the_gui(
 ) -> None:
     monkeypatch.setattr(timing, "SHUTDOWN_WAIT", 0.3)
     connect(qtbot, link, sim, timeout=2.0, poll_timeout=1.0)  # the safety writes wait 2 s for an answer
-    link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
+    link.submit(JogPress(JogRequest(TeachFrame.JOINT, 0, 1, 20.0)))
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     sim.set_silent(True)
     t0 = time.monotonic()
@@ -216,7 +217,7 @@ def test_shutdown_with_a_silent_controller_does_not_block_the_gui(
 
 def test_shutdown_writes_ratio_zero_and_ends_the_thread(qtbot: Any, sim: Any, link: RobotLink) -> None:
     connect(qtbot, link, sim)
-    link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
+    link.submit(JogPress(JogRequest(TeachFrame.JOINT, 0, 1, 20.0)))
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     link.shutdown()
     assert not link.is_running

@@ -8,7 +8,9 @@ from typing import Any
 
 import pytest
 
+from app.link.ops import JogPress
 from app.link.robot_link import RobotLink
+from app.link.types import JogRequest
 from app.protocol.enums import TeachFrame
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
@@ -26,7 +28,7 @@ def test_shutdown_safety_writes_use_the_short_timeout(qtbot: Any, sim: Any, link
     # a command would wait 3 s for an answer; the polls 0.5 s (0.1 s was met by a loaded test
     # process: "not answering" dropped the jog before it started)
     connect(qtbot, link, sim, timeout=3.0, poll_timeout=0.5)
-    link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
+    link.submit(JogPress(JogRequest(TeachFrame.JOINT, 0, 1, 20.0)))
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     sim.set_silent(True)
     t0 = time.monotonic()
@@ -39,7 +41,7 @@ def test_shutdown_safety_writes_use_the_short_timeout(qtbot: Any, sim: Any, link
 
 def test_shutdown_with_a_live_controller_still_stops_the_jog(qtbot: Any, sim: Any, link: RobotLink) -> None:
     connect(qtbot, link, sim, timeout=3.0, poll_timeout=0.5)
-    link.jog_press(TeachFrame.JOINT, 0, 1, 20.0)
+    link.submit(JogPress(JogRequest(TeachFrame.JOINT, 0, 1, 20.0)))
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     link.shutdown()
     assert not link.is_running

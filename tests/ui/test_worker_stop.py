@@ -11,8 +11,9 @@ from typing import Any
 import pytest
 
 from app import timing
+from app.link.ops import GoZero, JogPress, RunProgram, Stop, UploadPoints
 from app.link.robot_link import RobotLink
-from app.link.types import WorkerError
+from app.link.types import JogRequest, WorkerError
 from app.models import CommandResult
 from app.protocol import registers
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -59,7 +60,7 @@ def test_a_stop_ends_an_upload_at_once_even_when_the_point_in_flight_never_gets_
     link.pointUploaded.connect(lambda pid, ok, reason: points.append((pid, ok, reason)))
     results: list[CommandResult] = []
     link.commandFinished.connect(results.append)
-    upload_id = link.upload_points(_poses(sim, range(1, 6)))
+    upload_id = link.submit(UploadPoints.of(_poses(sim, range(1, 6))))
     assert sim.wait_for(lambda _s: len(sim.writes_to(440)) == 1, 5.0)  # point 1 is in flight
     with qtbot.waitSignal(
         link.commandFinished,
@@ -67,7 +68,7 @@ def test_a_stop_ends_an_upload_at_once_even_when_the_point_in_flight_never_gets_
         timeout=SIGNAL_TIMEOUT_MS,
     ) as done:
         t0 = time.monotonic()
-        stop_id = link.stop()
+        stop_id = link.submit(Stop())
     elapsed = time.monotonic() - t0
     assert elapsed < 1.0  # ms on an idle machine
     assert done.args[0].message == "uploaded 0 of 5 points (stopped)" and not done.args[0].ok
@@ -96,8 +97,8 @@ def test_a_stop_whose_main_link_write_gets_no_answer_still_cancels_the_motions_q
     main_only_link.commandFinished.connect(results.append)
     main_only_link.errorOccurred.connect(errors.append)
     writes_before = len(sim.writes)
-    queued = [main_only_link.go_zero(0), main_only_link.run_program(1)]
-    stop_id = main_only_link.stop()
+    queued = [main_only_link.submit(GoZero(0)), main_only_link.submit(RunProgram(1))]
+    stop_id = main_only_link.submit(Stop())
     qtbot.waitUntil(lambda: any(e.request_id == stop_id for e in errors), timeout=SIGNAL_TIMEOUT_MS)
     qtbot.waitUntil(
         lambda: {r.request_id for r in results if "cancelled by Stop" in r.message} == set(queued),
@@ -122,13 +123,13 @@ def test_a_stop_the_controller_refuses_still_ends_the_held_jog(qtbot: Any, sim: 
     from tests.ui.pendant_support import jogging, ratio_writes
 
     connect(qtbot, link, sim)
-    link.jog_press(TeachFrame.BASE, 1, 1, 20.0)
+    link.submit(JogPress(JogRequest(TeachFrame.BASE, 1, 1, 20.0)))
     qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
     ratios_before = len(ratio_writes(sim))
     results: list[CommandResult] = []
     link.commandFinished.connect(results.append)
     sim.set_exception(ExcCodes.ILLEGAL_VALUE, range(registers.REG_STOP, registers.REG_STOP + 1))
-    stop_id = link.stop()
+    stop_id = link.submit(Stop())
     qtbot.waitUntil(lambda: any(r.request_id == stop_id for r in results), timeout=SIGNAL_TIMEOUT_MS)
     stop = next(r for r in results if r.request_id == stop_id)
     assert not stop.ok and "refused" in stop.message

@@ -12,6 +12,7 @@ from typing import Any
 import pytest
 
 from app import timing
+from app.link.ops import RunProgram, Step, Stop
 from app.link.robot_link import RobotLink
 from app.link.types import LinkState, WorkerError
 from app.models import CommandResult
@@ -32,7 +33,7 @@ pytestmark = pytest.mark.timeout(60)
 
 def _run_endless_program(qtbot: Any, link: RobotLink, sim: Any) -> None:
     """Program 1 (the 100 mm square), cycling until stopped, at 20 %."""
-    link.run_program(1, ProgramMotionMode.CYCLE, 0, 20)
+    link.submit(RunProgram(1, ProgramMotionMode.CYCLE, 0, 20))
     qtbot.waitUntil(lambda: sim.state().program_state == ProgramState.RUNNING, timeout=SIGNAL_TIMEOUT_MS)
 
 
@@ -68,7 +69,7 @@ def test_a_stop_after_a_disconnect_reaches_the_controller_over_a_fresh_connectio
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_fresh_stop, timeout=SIGNAL_TIMEOUT_MS
     ) as done:
-        link.stop()
+        link.submit(Stop())
     result = done.args[0]
     assert result.ok and result.reason.args == {"endpoint": settings.endpoint}
     assert sim.wait_for(lambda s: s.program_state == ProgramState.STOPPED and not s.moving, 2.0)
@@ -102,7 +103,7 @@ def test_a_stop_after_the_link_was_lost_reaches_the_controller_answering_again(
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_fresh_stop, timeout=SIGNAL_TIMEOUT_MS
     ) as done:
-        link.stop()
+        link.submit(Stop())
     assert done.args[0].ok and done.args[0].reason.args["endpoint"] == settings.endpoint
     assert sim.wait_for(lambda s: s.program_state == ProgramState.STOPPED and not s.moving, 2.0)
     assert link.connection.state is LinkState.DOWN  # still waiting for its own reconnect
@@ -127,7 +128,7 @@ def test_a_stop_with_the_stop_line_closed_and_the_main_link_wedged_goes_over_a_f
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_a_stop, timeout=3 * SIGNAL_TIMEOUT_MS
     ) as done:
-        link.stop()
+        link.submit(Stop())
     result = done.args[0]
     assert result.ok and time.monotonic() - sent < 10.0  # long before the held answer (30 s)
     assert sim.wait_for(lambda s: s.program_state == ProgramState.STOPPED, 1.0)
@@ -150,7 +151,7 @@ def test_a_stop_that_cannot_reach_the_controller_says_so(qtbot: Any, sim: Any, l
         link.disconnect()
     sim.set_silent(True)  # it takes the connection, never answers
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as failed:
-        link.stop()
+        link.submit(Stop())
     error = failed.args[0]
     assert isinstance(error, WorkerError) and error.operation == "stop"
     assert error.reason is not None and error.reason.code == "stop_unreachable"
@@ -162,7 +163,7 @@ def test_a_stop_that_cannot_reach_the_controller_says_so(qtbot: Any, sim: Any, l
 
 def test_a_stop_without_any_controller_known_sends_nothing(qtbot: Any, link: RobotLink) -> None:
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as failed:
-        link.stop()
+        link.submit(Stop())
     assert error_text(failed.args[0]) == "Not connected to a controller: nothing was sent."
 
 
@@ -174,7 +175,7 @@ def test_a_monitor_only_stop_after_a_disconnect_sends_nothing(qtbot: Any, sim: A
     qtbot.waitUntil(lambda: sim.connections_count == 0, timeout=SIGNAL_TIMEOUT_MS)
     requests = sim.requests_count
     with qtbot.waitSignal(link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS) as failed:
-        link.stop()
+        link.submit(Stop())
     assert error_text(failed.args[0]) == "Monitor-only mode: nothing was sent to the controller."
     assert sim.requests_count == requests and sim.connections_count == 0
 
@@ -185,6 +186,6 @@ def test_motions_in_flight_until_their_outcome(qtbot: Any, sim: Any, link: Robot
     connect(qtbot, link, sim)
     assert not link.motions_in_flight
     with qtbot.waitSignal(link.commandFinished, timeout=SIGNAL_TIMEOUT_MS):
-        request_id = link.step(StepFrame.BASE, (0.0, 0.0, -5.0, 0.0, 0.0, 0.0), speed=50.0)
+        request_id = link.submit(Step(StepFrame.BASE, (0.0, 0.0, -5.0, 0.0, 0.0, 0.0), speed=50.0))
         assert request_id and link.motions_in_flight == ("step",)
     assert not link.motions_in_flight

@@ -7,6 +7,7 @@ from typing import Any
 
 import pytest
 
+from app.link.ops import UploadPoints
 from app.link.robot_link import RobotLink
 from app.models import CommandResult
 from app.points.ledger import PointLedger, SyncState, make_point
@@ -38,7 +39,7 @@ def test_upload_carries_unconfirmed(
         check_params_cb=lambda r: isinstance(r, CommandResult) and r.message.startswith("uploaded"),
         timeout=SIGNAL_TIMEOUT_MS,
     ) as done:
-        link.upload_points([(pid, pose, 0) for pid, pose in POSES.items()])
+        link.submit(UploadPoints.of([(pid, pose, 0) for pid, pose in POSES.items()]))
     assert done.args[0].ok
     assert [(pid, ok) for pid, ok, _, _ in seen] == [(5, True), (6, True)]
     # The first create may still see GV291 change from its power-on value; the second cannot.

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QObject, Slot
 from PySide6.QtWidgets import QWidget
 
+from app.link.ops import Stop
 from app.link.robot_link import RobotLink
 from app.link.transport import ConnectionSettings
 from app.link.types import LinkState, Operation
@@ -147,7 +148,7 @@ class LinkGuard(QObject):
             if answer is StopFirst.CANCEL:
                 return
             if answer is StopFirst.STOP:
-                self._link.stop()  # queued before the disconnect: it goes out first
+                self._link.submit(Stop())  # queued before the disconnect: it goes out first
         self._link.disconnect()
 
     # --- closing the window ---------------------------------------------------------------
@@ -165,14 +166,14 @@ class LinkGuard(QObject):
         )
         answer = self.ask(question)
         if answer is StopFirst.STOP:
-            self._link.stop()  # queued before the link's shutdown
+            self._link.submit(Stop())  # queued before the link's shutdown
         return answer is not StopFirst.CANCEL
 
     def stop_if_under_way(self) -> bool:
         """A close nobody attends: stop when something is under way (no question). True if sent."""
         if not self._items_while_linked():
             return False
-        self._link.stop()
+        self._link.submit(Stop())
         return True
 
     def _items_while_linked(self) -> list[str]:

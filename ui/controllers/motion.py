@@ -31,6 +31,18 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QObject, Signal, Slot
 
 from app.alarm_history import blocks_motion
+from app.link.ops import (
+    GoZero,
+    JogPress,
+    JogRelease,
+    Pause,
+    Resume,
+    RunProgram,
+    SetJogRatio,
+    SetMode,
+    Step,
+    Stop,
+)
 from app.link.robot_link import LinkPort
 from app.link.types import ConnectionState, JogRequest, StepFrame
 from app.models import ControllerStatus
@@ -76,13 +88,13 @@ class MotionController(QObject):
         self._alarm_hold = blocks_motion(link.state.alarms)
         self._safety: SafetyController | None = None  # the guard rails (set by install_safety)
 
-        control_bar.stopRequested.connect(link.stop)
+        control_bar.stopRequested.connect(self._on_stop_requested)
         self._runs = run_controller
         control_bar.pauseRequested.connect(self._on_pause_requested)
         control_bar.resumeRequested.connect(self._on_resume_requested)
         control_bar.modeRequested.connect(self._on_mode_requested)
         jog.jogPressed.connect(self._on_jog_pressed)
-        jog.jogReleased.connect(link.jog_release)
+        jog.jogReleased.connect(self._on_jog_released)
         jog.ratioChanged.connect(self._on_ratio_changed)
         link.state.haltChanged.connect(jog.show_halt)  # "releasing -- the controller has not confirmed"
         jog.show_halt(link.state.halt)
@@ -98,13 +110,21 @@ class MotionController(QObject):
             self.add_program_panel(program)
 
     @Slot()
+    def _on_stop_requested(self) -> None:
+        self._link.submit(Stop())
+
+    @Slot()
+    def _on_jog_released(self) -> None:
+        self._link.submit(JogRelease())
+
+    @Slot()
     def _on_pause_requested(self) -> None:
         """The window's Pause: a plan run under way is paused as its own Pause would (it then
         holds its next move), anything else at the link."""
         if self._runs.running and not self._runs.paused:
             self._runs.pause()
         else:
-            self._link.pause()
+            self._link.submit(Pause())
 
     @Slot()
     def _on_resume_requested(self) -> None:
@@ -113,7 +133,7 @@ class MotionController(QObject):
         if self._runs.running and self._runs.paused:
             self._runs.resume()
         else:
-            self._link.resume()
+            self._link.submit(Resume())
 
     def add_step_panel(self, step: StepPanel) -> None:
         """Drive and gate ``step`` from now on (enabled or not at once, as the others)."""
@@ -241,13 +261,11 @@ class MotionController(QObject):
             if refused:
                 safety.message.emit(refused)
                 return
-        self._link.jog_press(
-            request.frame, request.axis, request.direction, request.ratio, request.user, request.tool
-        )
+        self._link.submit(JogPress(request))
 
     @Slot(float)
     def _on_ratio_changed(self, ratio: float) -> None:
-        self._link.set_jog_ratio(self.safety.jog_ratio(ratio) if self.safety is not None else ratio)
+        self._link.submit(SetJogRatio(self.safety.jog_ratio(ratio) if self.safety is not None else ratio))
 
     @Slot(object)
     def _on_step_requested(self, request: StepRequest) -> None:
@@ -261,26 +279,28 @@ class MotionController(QObject):
             if refused:
                 safety.message.emit(refused)
                 return
-        self._link.step(request.frame, request.offsets, request.ext_offsets, request.speed)
+        self._link.submit(Step(request.frame, request.offsets, request.ext_offsets, request.speed))
 
     @Slot(object)
     def _on_program_requested(self, request: ProgramRequest) -> None:
         if self._alarm_hold:
             return
-        self._link.run_program(
-            request.program_id,
-            ProgramMotionMode(request.mode),
-            request.cycles,
-            request.speed_ratio,
-            switch_to_auto=request.switch_to_auto,
+        self._link.submit(
+            RunProgram(
+                request.program_id,
+                ProgramMotionMode(request.mode),
+                request.cycles,
+                request.speed_ratio,
+                switch_to_auto=request.switch_to_auto,
+            )
         )
 
     @Slot(object)
     def _on_go_zero(self, request: ZeroRequest) -> None:
         if not self._alarm_hold:
-            self._link.go_zero(request.axis, switch_to_auto=request.switch_to_auto)
+            self._link.submit(GoZero(request.axis, switch_to_auto=request.switch_to_auto))
 
     @Slot(object)
     def _on_mode_requested(self, mode: WorkMode) -> None:
         self._jog.release_all()
-        self._link.set_mode(mode)
+        self._link.submit(SetMode(mode))

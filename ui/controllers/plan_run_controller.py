@@ -2,14 +2,14 @@
 
 :class:`PlanRunController` wraps :class:`app.plan.runner.PlanRunner` (the sequencing, resume
 points and messages live there) around the non-blocking robot link: it sends segment k with
-``link.move_to_point(...)`` and sends segment k+1 only after the link's ``commandFinished``
+``link.submit(MoveToPoint(...))`` and sends segment k+1 only after the link's ``commandFinished``
 for segment k. Pause / resume / stop are forwarded to the link. A failed segment, a refused
 command, a lost link or a controller that is not answering (each said as such, through
 :mod:`ui.messages`) ends the run in ``FAILED`` at that segment; :meth:`resume_run`
 continues from it ("Resume from k").
 
 Each segment's outcome comes back on its own :class:`~app.link.robot_link.Pending`
-(``link.track(link.move_to_point(...))``: the link matches request ids, including "cancelled by
+(``link.track(link.submit(MoveToPoint(...)))``: the link matches request ids, including "cancelled by
 Stop" and refusals); everything else (acknowledgements, other panels' commands) never reaches
 the run. A failed stop request of ours ends a run that is stopping. Connection and pose come
 from ``link.state`` (:class:`~app.link.state.RobotState`), never a copy kept here.
@@ -17,7 +17,7 @@ from ``link.state`` (:class:`~app.link.state.RobotState`), never a copy kept her
 **The point guard** (every run; the :class:`~ui.models.points_model.PointsModel` given as
 ``points=`` is mandatory): the controller's temp points are never assumed
 (:mod:`ui.controllers.run_points`). Before each segment's move its
-points are created again from the ledger, in the worker thread (one ``link.upload_points``
+points are created again from the ledger, in the worker thread (one ``UploadPoints``
 request; the move goes out when it has succeeded, or on Resume when the operator paused
 meanwhile), and after the move the pose polled with its completion is compared with the
 ledger's end point. A point that is not created, or an arrival off by more than 1 mm (the point
@@ -54,6 +54,7 @@ from PySide6.QtCore import QObject, Signal, Slot
 
 from app import timing
 from app.errors import LinkError, TeachPadError
+from app.link.ops import MoveToPoint, Pause, Resume, Stop, UploadPoints
 from app.link.robot_link import LinkPort, Pending
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult, Pose
@@ -129,7 +130,7 @@ class PlanRunController(QObject):
         self._sent: deque[int] = deque(maxlen=SENT_KEPT)
         self._move: Pending | None = None  # the outcome of the segment under way
         self._stop: Pending | None = None  # the outcome of our last stop
-        self._stops = 0  # link.stops_requested when the run began or resumed
+        self._stops = 0  # link.state.stops_requested when the run began or resumed
         self.audit: AuditLog | None = None  # the trail a pause of the run's own is recorded in
         self._foreign_at: float | None = None  # monotonic time of the last sign of another master
         self._foreign_paused = False  # paused by the run itself at such a sign (not the operator)
@@ -237,7 +238,7 @@ class PlanRunController(QObject):
             plan, loops=loops, start=start, start_loop=start_loop, single=single, progress=self._on_progress
         )
         self._plan = plan if isinstance(plan, Plan) else None
-        self._stops = link.stops_requested  # a Stop asked after this (any button): no further move
+        self._stops = link.state.stops_requested  # a Stop asked after this (any button): no further move
         self._outcome = None
         self.end_reason = ""
         self._by_operator = False
@@ -262,7 +263,7 @@ class PlanRunController(QObject):
             raise RuntimeError("there is no stopped or failed run to resume")
         link = self._require_link()
         runner.resume()
-        self._stops = link.stops_requested
+        self._stops = link.state.stops_requested
         self._outcome = None
         self.end_reason = ""
         self._by_operator = False
@@ -272,7 +273,7 @@ class PlanRunController(QObject):
 
     def pause(self) -> None:
         if self.running and not self._paused and self._link is not None:
-            self._link.pause()
+            self._link.submit(Pause())
             self._set_paused(True)
 
     def resume(self) -> None:
@@ -283,7 +284,7 @@ class PlanRunController(QObject):
         link = self._link
         if not (self.running and self._paused and link is not None) or self._foreign_hold_lasts():
             return
-        link.resume()
+        link.submit(Resume())
         self._set_paused(False)
         held, self._held = self._held, None
         redo, self._redo = self._redo, None
@@ -353,7 +354,7 @@ class PlanRunController(QObject):
         runner = self._runner
         link = self._link
         if link is not None:
-            stop = link.track(link.stop())
+            stop = link.track(link.submit(Stop()))
             self._stop = stop
             stop.failed.connect(lambda error: self._on_stop_failed(stop, error))
         if runner is None or runner.state.is_over:
@@ -407,7 +408,7 @@ class PlanRunController(QObject):
     def _stop_asked_since_start(self) -> bool:
         """A Stop was asked of the link (any button: the window's STOP too) since the run began
         or resumed: nothing more is sent for this run."""
-        return self._link is not None and self._link.stops_requested != self._stops
+        return self._link is not None and self._link.state.stops_requested != self._stops
 
     def _end_stopped(self) -> None:
         """End the run as stopped by the operator before its next move went out."""
@@ -440,7 +441,7 @@ class PlanRunController(QObject):
             self._fail_segment(exc)
             return
         self._prepared = prepared
-        upload = link.track(link.upload_points(prepared.items()))
+        upload = link.track(link.submit(UploadPoints.of(prepared.items())))
         self._upload = upload
         upload.finished.connect(lambda result: self._on_upload(upload, result))
         upload.failed.connect(lambda error: self._on_upload_error(upload, error))
@@ -513,13 +514,15 @@ class PlanRunController(QObject):
         self.segmentPrepared.emit(command.index, list(self._prepared.points))
         self._sent.append(command.index)
         move = link.track(
-            link.move_to_point(
-                seg.end_id,
-                seg.via_id,
-                orientation_changes=seg.orientation_changes,
-                ignore_middle=seg.ignore_middle,
-                speed=seg.speed,
-                tool=seg.tool,
+            link.submit(
+                MoveToPoint(
+                    seg.end_id,
+                    seg.via_id,
+                    orientation_changes=seg.orientation_changes,
+                    ignore_middle=seg.ignore_middle,
+                    speed=seg.speed,
+                    tool=seg.tool,
+                )
             )
         )
         self._move = move
@@ -590,7 +593,7 @@ class PlanRunController(QObject):
             message = "arrived at the end point (its result could not be told from another master's)"
             return dataclasses.replace(result, ok=True, message=message, reason=None)
         if self._paused and self._link is not None:
-            self._link.stop()
+            self._link.submit(Stop())
         return result
 
     def _on_error(self, move: Pending, error: WorkerError) -> None:

@@ -30,7 +30,7 @@ id" (it does not hold the point) makes that point *unknown* too.
 
 **Move to point** goes through the point guard of the plan runs
 (:class:`~ui.controllers.run_points.RunPoints`): the point is created again from the ledger
-(one ``link.upload_points``), ``movePrepared(int)`` is emitted and the move goes out only when
+(one ``UploadPoints``), ``movePrepared(int)`` is emitted and the move goes out only when
 the controller has created it; after the move the pose polled with its completion is compared
 with the ledger's point (1 mm): an arm that stopped elsewhere is a failed move, said in words,
 and the point becomes *unknown*.
@@ -43,6 +43,7 @@ from collections.abc import Iterable
 from PySide6.QtCore import QObject, Signal, Slot
 
 from app.errors import InvalidInput
+from app.link.ops import CancelUpload, CreatePoint, MoveToPoint, Stop, UploadPoints
 from app.link.robot_link import LinkPort, Pending
 from app.link.types import ConnectionState, ControllerIdentity, WorkerError
 from app.models import CommandResult, Pose
@@ -95,7 +96,7 @@ class PointSyncController(QObject):
         self._teach_name = ""
         self._move_id: int | None = None
         self._move_speed = DEFAULT_MOVE_SPEED
-        self._move_stops = 0  # link.stops_requested when the move began (a Stop since: no move)
+        self._move_stops = 0  # link.state.stops_requested when the move began (a Stop since: no move)
         self._guard = RunPoints(model)  # a move's point re-created and its arrival checked
         self._prepared: SegmentPoints | None = None  # the point of the move under way, as created
         # the controller (and boot) the ledger's sync states are true of (None: none met yet)
@@ -179,7 +180,7 @@ class PointSyncController(QObject):
         self._teach_name = name
         self._set_operation("teach")
         self._say(self.tr("Teaching P{id} at the current pose…").format(id=point_id), LEVEL_INFO)
-        self._watch(link, link.create_point(point_id, None, self.teach_tool))
+        self._watch(link, link.submit(CreatePoint(point_id, None, self.teach_tool)))
         return point_id
 
     def upload(self, point_ids: Iterable[int], *, restore: bool = False) -> bool:
@@ -198,7 +199,7 @@ class PointSyncController(QObject):
         self._set_operation("upload")
         self.uploadProgress.emit(0, len(points))
         self._say(self.tr("Uploading {n} points…").format(n=len(points)), LEVEL_INFO)
-        self._watch(link, link.upload_points([(p.id, p.xyzabc, p.tool) for p in points]))
+        self._watch(link, link.submit(UploadPoints.of((p.id, p.xyzabc, p.tool) for p in points)))
         return True
 
     def upload_needed(self) -> bool:
@@ -222,7 +223,7 @@ class PointSyncController(QObject):
             return
         upload.cancelled = True
         if self._link is not None:
-            self._link.cancel_upload()
+            self._link.submit(CancelUpload())
         self._say(self.tr("Cancelling the upload…"), LEVEL_WARN)
 
     def move_to(self, point_id: int, speed: float = DEFAULT_MOVE_SPEED) -> bool:
@@ -242,12 +243,14 @@ class PointSyncController(QObject):
         prepared = self._guard.begin(point_id, (point_id,))
         self._move_id = point_id
         self._move_speed = float(speed)
-        self._move_stops = link.stops_requested
+        self._move_stops = link.state.stops_requested
         self._set_operation("move")
         self._say(
             self.tr("Moving to {point} at {v} mm/s…").format(point=point.label, v=f"{speed:g}"), LEVEL_INFO
         )
-        self._watch(link, link.upload_points(prepared.items()))  # the move follows once it is created
+        self._watch(
+            link, link.submit(UploadPoints.of(prepared.items()))
+        )  # the move follows once it is created
         return True
 
     def _move_point_created(self, result: CommandResult) -> None:
@@ -257,7 +260,7 @@ class PointSyncController(QObject):
         prepared = guard.finish_upload(link.state.connection.endpoint)
         guard.clear()
         assert prepared is not None
-        stopped_since = link.stops_requested != self._move_stops  # a Stop after the create's answer
+        stopped_since = link.state.stops_requested != self._move_stops  # a Stop after the create's answer
         if stopped_since or not (result.ok and prepared.all_created):
             if stopped_since or batch_reason(result.message) == "stopped":  # the operator's Stop
                 self._move_id = None
@@ -274,13 +277,15 @@ class PointSyncController(QObject):
         self.movePrepared.emit(point.id)
         self._watch(
             link,
-            link.move_to_point(
-                point.id,
-                None,
-                orientation_changes=True,
-                ignore_middle=False,
-                speed=self._move_speed,
-                tool=point.tool,
+            link.submit(
+                MoveToPoint(
+                    point.id,
+                    None,
+                    orientation_changes=True,
+                    ignore_middle=False,
+                    speed=self._move_speed,
+                    tool=point.tool,
+                )
             ),
         )
 
@@ -307,7 +312,7 @@ class PointSyncController(QObject):
         if self._upload is not None:
             self.cancel_upload()
         elif self._link is not None:
-            self._link.stop()
+            self._link.submit(Stop())
 
     # --- internals
     def _watch(self, link: LinkPort, request_id: int) -> None:

@@ -11,7 +11,7 @@ Modbus client may overwrite one, so "uploaded earlier" proves nothing. For every
 
 1. takes the segment's points from the ledger as it is now (:meth:`RunPoints.begin`; a point
    the project no longer has fails the segment before anything is sent),
-2. gives the items of one ``link.upload_points`` request (the worker creates them from the
+2. gives the items of one ``UploadPoints`` request (the worker creates them from the
    host's values, stop and cancel between two points), which the run controller sends right
    before the segment's move; :meth:`RunPoints.on_point_uploaded` collects what the worker
    reports and :meth:`RunPoints.finish_upload` writes it into the ledger (sync state) and the
@@ -55,7 +55,7 @@ class SegmentPoints:
     outcomes: list[UploadOutcome] = field(default_factory=list)
 
     def items(self) -> list[tuple[int, Sequence[float], int]]:
-        """``link.upload_points`` items: (id, X Y Z A B C, tool frame)."""
+        """:class:`~app.link.ops.UploadPoints` items: (id, X Y Z A B C, tool frame)."""
         return [(p.id, p.xyzabc, p.tool) for p in self.points.values()]
 
     @property
