@@ -17,7 +17,7 @@ from app.link.client import ConnectionSettings
 from app.points.ledger import SyncState
 from app.points.project import load_project
 from app.protocol.enums import CommandKind, CommandStatus
-from tests.core.fakes import FakeClient
+from tests.fakes import FakeClient
 
 SAMPLES = Path(__file__).resolve().parents[2] / "resources" / "samples"
 
@@ -193,7 +193,7 @@ def test_run_no_upload_stops_when_the_arm_arrives_elsewhere(
 def test_run_stops_before_moving_when_a_point_is_refused(
     demo: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from tests.core.fakes import failed
+    from tests.fakes import failed
 
     client = FakeClient(create_script={1: failed(1, "bad point")})
     assert Cli(client)("run", str(demo), "--plan", "circle") == cli_points.EXIT_FAILED

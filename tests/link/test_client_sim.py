@@ -50,7 +50,7 @@ MakeClient = Callable[..., RobotClient]  # the make_client fixture (tests/confte
 
 def wire(sim: Any, since: int = 0) -> list[tuple[int, int, int]]:
     """(function code, first register, register count) of each write the simulator received,
-    but the completion rule's writes to GV291 (582; tests/client/test_completion_profiles.py)."""
+    but the completion rule's writes to GV291 (582; tests/link/test_completion_profiles.py)."""
     return [(w.function_code, w.address, len(w.values)) for w in sim.writes[since:] if w.address != 582]
 
 

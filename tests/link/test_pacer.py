@@ -12,7 +12,7 @@ import pytest
 from app import timing
 from app.link.tracker import CommandTracker, ResultPacer
 from app.protocol.enums import RunCommand
-from tests.client.test_tracker import DONE, HOME, st
+from tests.link.test_tracker import DONE, HOME, st
 
 
 def _paced(pacer: ResultPacer, t0: float) -> CommandTracker:

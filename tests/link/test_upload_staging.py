@@ -13,7 +13,7 @@ from pymodbus.constants import ExcCodes
 
 from app.errors import InvalidInput
 from app.protocol.enums import RunCommand
-from tests.client.test_client_sim import FC06, FC10, SCAN, MakeClient, wire
+from tests.link.test_client_sim import FC06, FC10, SCAN, MakeClient, wire
 
 
 @pytest.fixture

@@ -29,7 +29,7 @@ pytestmark = pytest.mark.timeout(60)
 def main_only_link_fixture(qtbot: Any, fast_reconnect: None) -> Iterator[RobotLink]:
     """A RobotLink without the stop line: every stop goes on the main link alone. (With a line
     that opened before a test slowed the simulator, the line's 441 may be answered in time: the
-    Stop then rightly succeeds -- tests/ui/test_stop_line_only.py -- whatever the main link did.)"""
+    Stop then rightly succeeds -- tests/link/test_stop_line_only.py -- whatever the main link did.)"""
     robot_link = RobotLink(poll_hz=timing.POLL_HZ_DEFAULT, canary_gv=None, stop_line=False)
     try:
         yield robot_link

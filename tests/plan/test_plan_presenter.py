@@ -28,7 +28,7 @@ from app.plan.presenter import (
     summarize_checks,
 )
 from app.plan.segments import Plan, Segment
-from tests.core.test_plan import HOME, circle_plan, ledger
+from tests.plan.test_plan import HOME, circle_plan, ledger
 
 IDLE = PanelState(
     connected=True,

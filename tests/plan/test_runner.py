@@ -11,7 +11,7 @@ from app.plan.segments import Plan, Segment
 from app.points.guard import PointGuard, PointMismatch, PointNotCreated
 from app.points.point import TempPoint, make_point
 from app.protocol.enums import CommandKind, CommandStatus
-from tests.core.fakes import DONE, FakeClient, failed
+from tests.fakes import DONE, FakeClient, failed
 
 
 def plan(loops: int = 1) -> Plan:

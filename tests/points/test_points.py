@@ -22,7 +22,7 @@ from app.points.ledger import (
 )
 from app.protocol.enums import CommandKind, CommandStatus
 from app.protocol.registers import TOOL_NONE
-from tests.core.fakes import FakeClient
+from tests.fakes import FakeClient
 
 ON = SyncState.ON_CONTROLLER
 

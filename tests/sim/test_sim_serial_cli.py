@@ -14,7 +14,7 @@ import pytest
 from app.link.client import ConnectionSettings, RobotClient
 from app.sim.cli import build_parser, execute
 from app.sim.guard import WATCHDOG_TIMEOUT
-from tests.serial.relay import PtyRelay
+from tests.link.serial.relay import PtyRelay
 from tests.waits import CHILD_TIMEOUT, kill_child, read_line
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -12,8 +12,8 @@ from PySide6.QtCore import Qt
 
 from app.link.client import StepFrame
 from app.safety.envelope import Box, Envelope
-from tests.safety.test_gui_motion import _envelope
-from tests.safety.test_gui_roles import menu_fixture  # noqa: F401 - fixture
+from tests.ui.controllers.test_gui_motion import _envelope
+from tests.ui.controllers.test_gui_roles import menu_fixture  # noqa: F401 - fixture
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,

@@ -1,9 +1,9 @@
 """A long random run of every command against the hostile relay: false successes, wrong
 outcomes and hangs counted (a report, not a test).
 
-``python -m tests.hostile.command_fuzz [calls] [seed] [tcp|rtu]`` prints one JSON line.
+``python -m tests.link.hostile.command_fuzz [calls] [seed] [tcp|rtu]`` prints one JSON line.
 
-Each call picks a command (tests/hostile/commands.py :data:`COMMANDS`), aims one to three
+Each call picks a command (tests/link/hostile/commands.py :data:`COMMANDS`), aims one to three
 misbehaviours (:data:`MISBEHAVIOURS`, silence and "stale answer only" less often: each costs a
 request timeout) at random requests among its first ones, runs it on a fresh client and judges it
 (:func:`judge`): ``false_successes`` (a success although a write got no answer of its own, a
@@ -23,9 +23,9 @@ from typing import Any
 
 from app import timing
 from app.sim import SimConfig, SimController
-from tests.hostile.commands import COMMANDS, MISBEHAVIOURS, SLOW, judge, run_case
-from tests.hostile.relay import HostileRelay
-from tests.hostile.server import Framing
+from tests.link.hostile.commands import COMMANDS, MISBEHAVIOURS, SLOW, judge, run_case
+from tests.link.hostile.relay import HostileRelay
+from tests.link.hostile.server import Framing
 
 TIMEOUT = 0.3  # s, the client's request timeout
 FAST = [name for name in MISBEHAVIOURS if name not in SLOW]

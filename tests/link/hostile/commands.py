@@ -20,8 +20,8 @@ client, and :func:`judge` says whether what it returned is right:
 * and never past **twice its budget** (its clean run's time plus one request timeout plus
   ``timing.OUTCOME_READ_BUDGET``).
 
-The deterministic tests (tests/hostile/test_commands.py) run every (command, request,
-misbehaviour); ``python -m tests.hostile.command_fuzz`` runs random ones for a long time.
+The deterministic tests (tests/link/hostile/test_commands.py) run every (command, request,
+misbehaviour); ``python -m tests.link.hostile.command_fuzz`` runs random ones for a long time.
 """
 
 from __future__ import annotations
@@ -39,8 +39,8 @@ from app.link.types import StepFrame
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
-from tests.hostile.relay import Exchange, HostileRelay, Later, Misbehaviour, Reply
-from tests.hostile.server import Answer
+from tests.link.hostile.relay import Exchange, HostileRelay, Later, Misbehaviour, Reply
+from tests.link.hostile.server import Answer
 
 # -- misbehaviours -----------------------------------------------------------------------------
 

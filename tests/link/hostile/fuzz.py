@@ -1,6 +1,6 @@
 """Seeded random mutations of correct answers, sent by the HostileServer to a RobotClient.
 
-``python -m tests.hostile.fuzz [frames] [seed]`` prints the figures for both framings.
+``python -m tests.link.hostile.fuzz [frames] [seed]`` prints the figures for both framings.
 
 Each request (a read of 1..125 registers, a 0x06 or a 0x10 write) is answered with its correct
 frame mutated once: a bit flipped or a byte replaced in a checked field, the frame cut short,
@@ -22,7 +22,7 @@ from typing import Any
 
 from app.errors import MalformedResponse, TeachPadError
 from app.link.client import ConnectionSettings, RobotClient
-from tests.hostile.server import Answer, Framing, HostileServer, Reply
+from tests.link.hostile.server import Answer, Framing, HostileServer, Reply
 
 _CONTROL = range(440, 446)
 

@@ -20,7 +20,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from tests.hostile.server import Answer, Framing, Reply, crc16
+from tests.link.hostile.server import Answer, Framing, Reply, crc16
 
 __all__ = ["Exchange", "HostileRelay", "Later", "Misbehaviour", "Reply"]
 

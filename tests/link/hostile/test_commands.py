@@ -1,8 +1,8 @@
 """Every command, each misbehaviour aimed at each of its requests: success only when every write
 was answered as itself, a clear error (unknown for an unconfirmed motion) otherwise, never a hang.
 
-The relay (tests/hostile/relay.py) forwards each request to the simulator and misbehaves on the
-one chosen; the judge (tests/hostile/commands.py) says what is wrong. Each test runs one command
+The relay (tests/link/hostile/relay.py) forwards each request to the simulator and misbehaves on the
+one chosen; the judge (tests/link/hostile/commands.py) says what is wrong. Each test runs one command
 over every request up to its trigger and the two reads after it (the reads that follow are the
 same reads again), with every misbehaviour; silence (a whole request timeout) is aimed at the
 first request and the trigger only. A test lists every wrong case at once.
@@ -32,7 +32,7 @@ from app.link.types import StepFrame
 from app.models import CommandResult
 from app.protocol import registers
 from app.safety.audit import AuditLog, Result, read_records
-from tests.hostile.commands import (
+from tests.link.hostile.commands import (
     COMMANDS,
     MISBEHAVIOURS,
     POSE,
@@ -43,8 +43,8 @@ from tests.hostile.commands import (
     judge,
     run_case,
 )
-from tests.hostile.relay import HostileRelay
-from tests.hostile.server import HostileServer, Reply, bank_value
+from tests.link.hostile.relay import HostileRelay
+from tests.link.hostile.server import HostileServer, Reply, bank_value
 
 # The client's request timeout: silence waits it out. The simulator answers from this process:
 # under load a good answer may come late, which fails a command (allowed), never makes one wrong.

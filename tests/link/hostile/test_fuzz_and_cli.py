@@ -8,8 +8,8 @@ import time
 import pytest
 
 from app.cli.main import EXIT_LINK, EXIT_OK, main
-from tests.hostile.fuzz import run
-from tests.hostile.server import HostileServer, silent, with_pdu
+from tests.link.hostile.fuzz import run
+from tests.link.hostile.server import HostileServer, silent, with_pdu
 
 FRAMES = 2000  # per framing; about a second each
 

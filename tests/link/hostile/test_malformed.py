@@ -1,7 +1,7 @@
 """Every malformed answer is refused with words that name the field, then the link resyncs.
 
 Each case runs over Modbus TCP (MBAP) and RTU framing over TCP, against the raw-socket
-HostileServer (tests/hostile/server.py), through RobotClient's public API.
+HostileServer (tests/link/hostile/server.py), through RobotClient's public API.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ import pytest
 
 from app.errors import LinkError, MalformedResponse, ModbusExceptionError, ResponseTimeout
 from app.link.client import RobotClient
-from tests.hostile.server import Answer, HostileServer, Mutation, Reply, bank_value, silent, with_pdu
+from tests.link.hostile.server import Answer, HostileServer, Mutation, Reply, bank_value, silent, with_pdu
 
 # The client's request timeout in these tests (only the cut-short case waits it). After a resync
 # the good answer comes from the server's thread in this process, once it has seen the old

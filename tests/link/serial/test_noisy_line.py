@@ -25,7 +25,7 @@ from app.models import CommandResult
 from app.protocol import registers
 from app.sim import SimConfig, SimController
 from benchmarks.noisy_line import project_points, wrong_points
-from tests.serial.relay import PtyRelay
+from tests.link.serial.relay import PtyRelay
 from tests.ui.pendant_support import SIGNAL_TIMEOUT_MS, is_state
 
 pytestmark = [

@@ -13,7 +13,7 @@ from app.link.client import ConnectionSettings, RobotClient
 from app.protocol.enums import TeachFrame, WorkMode
 from app.protocol.registers import REG_WORK_MODE
 from app.sim import SimConfig, SimController
-from tests.serial.relay import PtyRelay
+from tests.link.serial.relay import PtyRelay
 
 pytestmark = pytest.mark.skipif(not hasattr(__import__("os"), "openpty"), reason="needs POSIX ptys")
 

@@ -25,7 +25,7 @@ from tests.ui.pendant_support import FakeProjectDialogs
 from ui.controllers.project_controller import ProjectController
 from ui.models.point_columns import COL_X
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 HOLD_LIMIT = 30.0  # s: a held write goes on by itself after this (a failing test must not hang)
 
 

@@ -14,8 +14,8 @@ from PySide6.QtGui import QUndoStack
 
 from app.points.ledger import ImportMode
 from app.points.project import load_project
+from tests.ui.controllers.test_project_controller import SAMPLES, FakeDialogs
 from tests.ui.test_messages import QM, assert_chinese
-from tests.ui.test_project_controller import SAMPLES, FakeDialogs
 from ui.controllers.project_controller import ProjectController
 from ui.models.plan_columns import COL_END, COL_KIND, COL_SPEED, COL_VIA
 from ui.models.segment_model import SegmentTableModel

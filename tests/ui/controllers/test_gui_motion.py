@@ -13,7 +13,7 @@ from app.link.client import StepFrame
 from app.safety.audit import query
 from app.safety.envelope import Box, Envelope
 from app.safety.roles import Role
-from tests.safety.test_gui_roles import PASSWORD, menu_fixture  # noqa: F401 - fixture
+from tests.ui.controllers.test_gui_roles import PASSWORD, menu_fixture  # noqa: F401 - fixture
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,

@@ -26,7 +26,7 @@ from ui.models.point_columns import COL_NAME
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
-SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
+SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "samples" / "demo.teachpad.json"
 PASSWORD = "cell-42"
 
 

@@ -30,7 +30,7 @@ from ui.panels.audit_viewer import AuditViewer
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
 PASSWORD = "cell-42"
-SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
+SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "samples" / "demo.teachpad.json"
 CHEAP_SCRYPT = 2**4  # tests only: the real cost is 2**14
 
 

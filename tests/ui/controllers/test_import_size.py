@@ -12,7 +12,7 @@ import pytest
 from app.points import atomic
 from app.points.ledger import ImportMode
 from app.points.project import Project, load_project
-from tests.ui.test_project_controller import FakeDialogs
+from tests.ui.controllers.test_project_controller import FakeDialogs
 from ui.controllers.project_controller import ProjectController
 
 LIMIT = 20_000

@@ -20,7 +20,7 @@ from ui.controllers.point_sync import PointSyncController
 from ui.models.points_model import PointsModel
 from ui.panels.points_panel import PointsPanel
 
-SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
+SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "samples" / "demo.teachpad.json"
 
 
 def test_add_follows_the_freshness_of_a_real_link(qtbot: Any, link: RobotLink, sim: Any) -> None:

@@ -50,7 +50,7 @@ CREATE, MOVE = int(RunCommand.CREATE_POINT), int(RunCommand.MOVE_TO_POINT)
 
 @pytest.fixture(name="sim")
 def sentinel_sim_fixture(sim_factory: Any) -> Any:
-    return sim_factory(gv291="writable")  # each point's creation proven (tests/ui/test_plan_run_guard.py)
+    return sim_factory(gv291="writable")  # each point's creation proven (./test_plan_run_guard.py)
 
 
 @pytest.fixture

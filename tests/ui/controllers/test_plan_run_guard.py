@@ -135,7 +135,7 @@ def test_a_point_overwritten_after_the_upload_is_re_created_before_its_move(
     other = make_client(sim)
     wrong = _elsewhere(bench.host(2))
     # another tool, after our upload; the link sees it (its parameter writes) before the run starts
-    # -- a sign seen during a run pauses it (tests/ui/test_plan_run_foreign.py)
+    # -- a sign seen during a run pauses it (tests/ui/controllers/test_plan_run_foreign.py)
     with bench.qtbot.waitSignal(
         link.foreignMaster,
         check_params_cb=lambda what, _v: what == "registers",
@@ -178,7 +178,7 @@ def test_an_overwrite_between_re_create_and_move_stops_the_run_and_tells_the_ope
 
     bench.runs.segmentPrepared.connect(overwrite)
     # the other tool's writes are a sign of another master: the run pauses itself when it sees them
-    # (tests/ui/test_plan_run_foreign.py); the operator resumes at once (the move hold is 0 here)
+    # (tests/ui/controllers/test_plan_run_foreign.py); the operator resumes at once (the move hold is 0 here)
     bench.runs.pausedByForeign.connect(lambda _what, _value: QTimer.singleShot(0, bench.runs.resume))
     mismatches: list[int] = []
     bench.runs.pointMismatch.connect(mismatches.append)

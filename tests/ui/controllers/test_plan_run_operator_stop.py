@@ -14,6 +14,13 @@ from app.link.robot_link import RobotLink
 from app.models import Pose
 from app.plan.runner import RunOutcome, RunState
 from app.plan.segments import Plan, Segment
+from tests.ui.controllers.test_plan_run_guard import (  # noqa: F401 - fixtures
+    POLL_TIMEOUT,
+    RUN_TIMEOUT_MS,
+    SPEED,
+    Bench,
+    sentinel_sim_fixture,
+)
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,
@@ -22,13 +29,6 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     translator_fixture,
 )
 from tests.ui.test_messages import assert_chinese
-from tests.ui.test_plan_run_guard import (  # noqa: F401 - fixtures
-    POLL_TIMEOUT,
-    RUN_TIMEOUT_MS,
-    SPEED,
-    Bench,
-    sentinel_sim_fixture,
-)
 from ui.controllers.plan_run_reasons import outcome_text
 from ui.panels.planner_actions import PlannerActions
 

@@ -15,13 +15,13 @@ from app.link.types import ConnectionState, LinkState
 from app.points.ledger import UploadReport
 from app.points.point import make_point
 from app.points.project import Project, load_project
+from tests.ui.controllers.test_project_controller import FakeDialogs
 from tests.ui.fake_link import FakeLink
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     connect,
     fast_reconnect_fixture,
     link_fixture,
 )
-from tests.ui.test_project_controller import FakeDialogs
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController

@@ -21,7 +21,7 @@ from tests.waits import kill_child, read_line, wait_child
 from ui.controllers.project_controller import ProjectController
 from ui.models.point_columns import COL_X
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 SAMPLES = ROOT / "resources" / "samples"
 
 

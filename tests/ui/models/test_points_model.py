@@ -17,7 +17,7 @@ from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COL_TOOL, COL_X,
 from ui.models.point_filter import PointFilterProxy
 from ui.models.points_model import PointsModel
 
-SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
+SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "samples" / "demo.teachpad.json"
 COL_Y = COLUMNS.index("y")
 
 

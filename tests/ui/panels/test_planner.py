@@ -41,7 +41,7 @@ from ui.models.segment_model import SegmentTableModel
 from ui.palette import COLOR_ERROR, COLOR_WARN_TEXT
 from ui.panels.planner_panel import PlannerPanel
 
-SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
+SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "samples" / "demo.teachpad.json"
 
 
 @pytest.fixture

@@ -24,7 +24,7 @@ from ui.models.points_model import PointsModel
 from ui.panels.planner_panel import PlannerPanel
 from ui.widgets.point_picker import PointPicker, parse_choice, point_choice_text
 
-SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
+SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "samples" / "demo.teachpad.json"
 
 
 @pytest.fixture

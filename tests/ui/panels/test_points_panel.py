@@ -22,7 +22,7 @@ from ui.models.point_columns import COL_E1, COL_TOOL, COL_X
 from ui.models.points_model import PointsModel
 from ui.panels.points_panel import PointsPanel
 
-SAMPLE = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
+SAMPLE = Path(__file__).resolve().parents[3] / "resources" / "samples" / "demo.teachpad.json"
 
 
 # --- fixtures -------------------------------------------------------------------------------

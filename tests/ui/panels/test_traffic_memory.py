@@ -9,7 +9,7 @@ import pytest
 from PySide6.QtCore import QModelIndex
 
 import ui.models.traffic_model as traffic
-from tests.ui.test_traffic_panel import Rec, Wire, cell
+from tests.ui.panels.test_traffic_panel import Rec, Wire, cell
 from ui.models.traffic_model import COL_MEANING, VIEW_CACHE_SIZE, TrafficModel
 from ui.models.traffic_store import FIXED_BYTES_PER_ROW, FRAME_BYTES_PER_ROW, MAX_FRAME_BYTES, TrafficStore
 

@@ -28,7 +28,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 from ui.main_window import MainWindow
 from ui.panels.view3d_panel import View3DPanel
 
-DEMO = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
+DEMO = Path(__file__).resolve().parents[3] / "resources" / "samples" / "demo.teachpad.json"
 
 
 def _panel(window: MainWindow, qtbot: Any) -> View3DPanel:

@@ -27,7 +27,7 @@ from ui.models.point_columns import COL_X
 from ui.panels.view3d_robot import RobotModelSource
 from ui.settings import AppSettings
 
-DEMO = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
+DEMO = Path(__file__).resolve().parents[3] / "resources" / "samples" / "demo.teachpad.json"
 FAR_X = 1500.0  # mm: past the simulator arm's 900 mm reach
 
 
