@@ -12,39 +12,6 @@ QT_ALLOWED = {
 }
 
 
-def _imports(path: Path) -> set[str]:
-    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
-    names: set[str] = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            names.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            names.add(node.module)
-            if node.module == "PySide6":
-                names.update(f"PySide6.{alias.name}" for alias in node.names)
-    return names
-
-
-def test_app_imports_no_widgets_and_qt_only_in_the_worker() -> None:
-    offenders: list[str] = []
-    files = sorted(APP.rglob("*.py"))
-    assert files, "app/ has no modules?"
-    for path in files:
-        for name in _imports(path):
-            root = name.split(".")[0]
-            gui = root in {"ui", "pyqtgraph"}
-            qt = root in {"PySide6", "shiboken6"} and name not in QT_ALLOWED.get(path, set())
-            if gui or qt:
-                offenders.append(f"{path.relative_to(APP.parent)} imports {name}")
-    assert offenders == []
-
-
-def test_the_checker_sees_a_widget_import(tmp_path: Path) -> None:
-    bad = tmp_path / "bad.py"
-    bad.write_text("from PySide6 import QtWidgets\nimport ui.main_window\n", encoding="utf-8")
-    assert {"PySide6.QtWidgets", "ui.main_window"} <= _imports(bad)
-
-
 # --- The tests mirror the code (issue 22) ---------------------------------------------------------
 # tests/<area>/ holds the tests of app/<area>/, tests/ui/<area>/ those of ui/<area>/ (tests/ui/ the
 # window's and ui/'s own modules), tests/benchmarks/ those of benchmarks/; tests/test_*.py those of
@@ -101,3 +68,36 @@ def test_the_mirror_check_sees_a_folder_of_no_package(tmp_path: Path) -> None:
         "tests/ui/widgets has no __init__.py",
         "tests/ui/widgets mirrors no package (ui/widgets)",
     ]
+
+
+def _imports(path: Path) -> set[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+    names: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.add(node.module)
+            if node.module == "PySide6":
+                names.update(f"PySide6.{alias.name}" for alias in node.names)
+    return names
+
+
+def test_app_imports_no_widgets_and_qt_only_in_the_worker() -> None:
+    offenders: list[str] = []
+    files = sorted(APP.rglob("*.py"))
+    assert files, "app/ has no modules?"
+    for path in files:
+        for name in _imports(path):
+            root = name.split(".")[0]
+            gui = root in {"ui", "pyqtgraph"}
+            qt = root in {"PySide6", "shiboken6"} and name not in QT_ALLOWED.get(path, set())
+            if gui or qt:
+                offenders.append(f"{path.relative_to(APP.parent)} imports {name}")
+    assert offenders == []
+
+
+def test_the_checker_sees_a_widget_import(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.py"
+    bad.write_text("from PySide6 import QtWidgets\nimport ui.main_window\n", encoding="utf-8")
+    assert {"PySide6.QtWidgets", "ui.main_window"} <= _imports(bad)
