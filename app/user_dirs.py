@@ -10,7 +10,7 @@
 
 each with ``teachpad`` under it. On Linux these are ``QStandardPaths.writableLocation`` of
 ``GenericConfigLocation``, ``GenericDataLocation`` and ``GenericStateLocation``
-(tests/core/test_user_dirs.py compares them); a relative ``XDG_*`` value is ignored, as the XDG
+(tests/test_user_dirs.py compares them); a relative ``XDG_*`` value is ignored, as the XDG
 specification and Qt do. On Windows data and state are Qt's ``GenericDataLocation``
 (``%LOCALAPPDATA%``, this computer only); config is the roaming profile (``%APPDATA%``, Qt's
 ``AppDataLocation`` without the application's folder) so that a user's settings follow them

@@ -2,7 +2,7 @@
 
 The simulator serves one pty, ``teachpad-cli points upload``'s own upload
 (:func:`app.cli.points_upload.staged_upload`) drives a :class:`~app.link.client.RobotClient` on the
-other, and the relay between them (:class:`tests.serial.relay.PtyRelay`) damages one byte in
+other, and the relay between them (:class:`tests.link.serial.relay.PtyRelay`) damages one byte in
 ``damage_one_in`` in both directions (seeded: run ``i`` uses seed ``i``). Per run: did the upload
 finish (every point reported uploaded, nothing aborted), and how many of the project's points the
 controller holds wrong (missing, another pose, another tool) -- counted at the simulator.
@@ -24,7 +24,7 @@ from app.cli.points_upload import staged_upload
 from app.link.client import ConnectionSettings, RobotClient
 from app.points.point import TempPoint
 from app.sim import SimConfig, SimController
-from tests.serial.relay import PtyRelay
+from tests.link.serial.relay import PtyRelay
 
 BAUD = 115200
 # s per request: the longest answer (125 registers, 255 bytes) is 22 ms on the wire at 115200 baud;

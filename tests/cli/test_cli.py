@@ -18,7 +18,7 @@ from app.cli.main import main
 from app.protocol.enums import Alarm, WorkMode
 from tests.cli.ctrl_c import CHILD_TIMEOUT, ROOT, interrupt_cli
 
-SCAN = 0.02  # see tests/client/test_client_sim.py
+SCAN = 0.02  # see tests/link/test_client_sim.py
 # `status` and `watch` read with the poll timeout (0.15 s on TCP). The simulator answers from this
 # test process, which a loaded machine (coverage, a CI neighbour) can hold that long: the CLI would
 # rightly say "did not answer" in a test about something else. Roomy here; the silence test keeps

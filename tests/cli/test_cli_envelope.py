@@ -15,7 +15,7 @@ from app.cli.main import main
 from app.safety.audit import Result, default_audit_dir, query
 from app.safety.envelope import Box, Envelope
 from tests.cli.conftest import save_envelope
-from tests.core.test_cli_points import SAMPLES
+from tests.cli.test_cli_points import SAMPLES
 
 SCAN = 0.02
 GV203_HIGH = 407  # the jog ratio's high word: 20.0 = 0x41A0 0000, 100.0 = 0x42C8 0000

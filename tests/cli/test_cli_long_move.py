@@ -4,7 +4,7 @@ old overflow came at about 11 s).
 The status backoff used to raise ``OverflowError`` about 11 s into any move (``2.0 ** reads`` at
 the 1025th read). 15 mm at 1 mm/s keeps the simulator moving for 15 s of its own time: slow,
 not far. (Ten minutes of the same wait are covered without the wall clock in
-tests/client/test_tracker.py.)
+tests/link/test_tracker.py.)
 """
 
 from __future__ import annotations

@@ -16,7 +16,7 @@ from app.protocol.enums import WorkMode
 from app.safety.envelope import REDUCED_SPEED_DEFAULT, Envelope
 from app.view3d.profile import default_profile
 
-SCAN = 0.02  # see tests/client/test_client_sim.py
+SCAN = 0.02  # see tests/link/test_client_sim.py
 
 
 def run(sim: Any, capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

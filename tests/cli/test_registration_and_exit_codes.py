@@ -25,7 +25,7 @@ from app.cli.main import REGISTRARS, build_parser, main
 from app.protocol.enums import Alarm
 from tests.cli.ctrl_c import interrupt_cli
 from tests.cli.test_cli import one_line_error
-from tests.hostile.server import HostileServer, with_pdu
+from tests.link.hostile.server import HostileServer, with_pdu
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -28,11 +28,15 @@ from tests.fonts.fontsets import FONT_SETS, describe_fonts, fontset_roots, write
 
 SCREENS = "1024x768,1280x800,1920x1080,1920x1200"
 SCALES = ("1", "1.25", "1.5")
-FULL = ["tests/ui/test_layout.py", "tests/ui/test_live_views_cost.py", "tests/ui/test_readouts_whole.py"]
+FULL = [
+    "tests/ui/test_layout.py",
+    "tests/ui/panels/test_live_views_cost.py",
+    "tests/ui/test_readouts_whole.py",
+]
 SCALED = [
     "tests/ui/test_layout.py::test_main_window_layout",
     "tests/ui/test_layout.py::test_main_window_layout_with_an_alarm",
-    "tests/ui/test_live_views_cost.py::test_streaming_status_and_traffic_do_not_relayout_the_main_window",
+    "tests/ui/panels/test_live_views_cost.py::test_streaming_status_and_traffic_do_not_relayout_the_main_window",
 ]
 RUN_TIMEOUT_S = 900
 

@@ -10,7 +10,7 @@ import pytest
 from app.cli import points as cli_points
 from app.safety.envelope import Box, Envelope
 from app.safety.profile import SafetyProfile, save_profile
-from tests.core.test_cli_points import SAMPLES, Cli
+from tests.cli.test_cli_points import SAMPLES, Cli
 
 
 @pytest.fixture

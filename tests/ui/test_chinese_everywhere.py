@@ -53,7 +53,7 @@ def test_sentences_from_parts_use_full_width_separators(qapp: Any, translator: A
 
 def test_the_alarm_banner_joins_in_chinese(qtbot: Any, translator: Any) -> None:
     from tests.ui.fake_link import FakeLink
-    from tests.ui.test_pose_strip import poll, status
+    from tests.ui.panels.test_pose_strip import poll, status
     from ui.panels.alarm_banner import AlarmBanner
 
     assert translator.set_language("zh_CN")

@@ -62,7 +62,7 @@ def test_a_run_paused_by_another_master_says_so_in_the_run_box_and_the_event_log
     qtbot: Any, window: MainWindow
 ) -> None:
     """The window's parts listen to the run's own pause (its behaviour at the simulator:
-    tests/ui/test_plan_run_foreign.py): the run box and the event log say why, in the language in
+    tests/ui/controllers/test_plan_run_foreign.py): the run box and the event log say why, in the language in
     force; the pause is recorded in the window's audit trail."""
     runs = window.run_controller
     assert runs.audit is window.safety_menu.safety.session.audit
