@@ -43,4 +43,3 @@ def test_a_qthread_runs_under_the_coverage_tracer(qtbot: Any) -> None:
     [tracer] = probe.tracers
     # the thread's trace function is the one coverage installs in Python threads (its collector's)
     assert tracer is not None and type(tracer) is type(sys.gettrace())
-

@@ -93,7 +93,7 @@ def test_status_json_shows_a_live_pose_during_a_jog(csim: Any, capsys: pytest.Ca
     )
     try:
         assert csim.wait_for(lambda s: s.jogging, CHILD_TIMEOUT)
-        ys = []
+        ys: list[float] = []
         deadline = time.monotonic() + 4.0
         # three reads while it moves, however long a read takes on a loaded machine (0.8 s of jog
         # gave two reads with the suite on both cores beside other test runs)
