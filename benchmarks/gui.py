@@ -173,7 +173,6 @@ def bench_window(
         )
         counters = _Counters(link)
         show_streaming_layout(window)
-        traffic = window.traffic_panel
         lap("window_shown")
 
         # --- disconnected: stall baseline and the bare stop floor ----------------------
@@ -184,49 +183,12 @@ def bench_window(
         lap("disconnected")
 
         # --- connected at 100 Hz, program running: streaming stalls -------------------
-        link.connect_to(ConnectionSettings(host="127.0.0.1", port=sim.port, unit=sim.unit))
-        if not _wait_until(lambda: counters.state.state is LinkState.CONNECTED):
-            raise RuntimeError(f"could not connect to the simulator: {counters.state.message}")
-        start = sim.write_count()
-        link.submit(RunProgram(STREAM_PROGRAM, ProgramMotionMode.CYCLE, 0, 100))
-        if not _wait_until(lambda: _motion_started(sim, start)):
-            raise RuntimeError("the simulator did not start the streaming program")
-        poses0, frames0, requests0 = counters.poses, counters.traffic_frames, sim.requests()
-        t0 = time.perf_counter()
-        streaming = measure_stalls(stall_s)
-        elapsed = time.perf_counter() - t0
-        # a poll is two reads (pose block, status block): the rate the worker really reached
-        streaming["polls_per_s"] = (sim.requests() - requests0) / 2 / elapsed
-        streaming["poses_per_s"] = (counters.poses - poses0) / elapsed
-        streaming["traffic_frames_per_s"] = (counters.traffic_frames - frames0) / elapsed
-        _per_100hz(streaming)
-        add_no_probe(streaming, stall_s)
-        streaming["traffic_shown"] = not traffic.visibleRegion().isEmpty()
-        streaming["monitor_shown"] = not window.monitor_panel.visibleRegion().isEmpty()
-        stalls["streaming"] = streaming
+        _start_streaming(link, sim, counters)
+        stalls["streaming"] = _measure_streaming(window, sim, counters, stall_s)
         if busy_s > 0:
             stalls["streaming_busy"] = _measure_streaming_busy(window, sim, counters, busy_s)
         if complete:
-            idle_max = stalls["disconnected"].get("max_ms")
-            stalls["ratio_max_streaming_vs_disconnected"] = ratio(streaming.get("max_ms"), idle_max)
-            # Attribution: the same stream with the Points tab in front (the monitor's plots and
-            # readouts hidden, its paint timer stopped); the traffic inspector stays shown.
-            window.show_tab("points")
-            requests0, t0 = sim.requests(), time.perf_counter()
-            hidden = measure_stalls(stall_s / 2)
-            hidden["polls_per_s"] = (sim.requests() - requests0) / 2 / (time.perf_counter() - t0)
-            hidden["monitor_shown"] = not window.monitor_panel.visibleRegion().isEmpty()
-            stalls["streaming_monitor_hidden"] = hidden
-            # The same stream with the 3D view in front: the arm redrawn from every pose.
-            view3d = window.view3d.panel
-            window.work_tabs.setCurrentWidget(view3d)
-            _run_for(VIEW3D_SETTLE_S)  # its first paint and scene build are not the steady state
-            requests0, t0 = sim.requests(), time.perf_counter()
-            shown3d = measure_stalls(stall_s / 2)
-            shown3d["polls_per_s"] = (sim.requests() - requests0) / 2 / (time.perf_counter() - t0)
-            shown3d["view3d_shown"] = not view3d.canvas.visibleRegion().isEmpty()
-            stalls["streaming_view3d_shown"] = shown3d
-            window.show_tab("monitor")
+            _measure_attribution(window, sim, stalls, stall_s)
         out["event_loop_stall"] = stalls
         # End the streaming program the ordinary way before the stop-latency runs.
         link.submit(Stop())
@@ -235,36 +197,126 @@ def bench_window(
         lap("streaming")
 
         # --- stop latency from the GUI, then the bare floor under the same polling -----
-        gui = bench_stop_gui(window, sim, counters, n_stop, rng, budget_s=stop_budget_s)
-        stops: dict[str, Any] = {
-            "gui_stop_button": gui,
-            "bare_pymodbus_idle": floor,
-            "ratio_p50_gui_vs_bare_idle": ratio(gui.get("p50_ms"), floor.get("p50_ms")),
-            "ratio_p99_gui_vs_bare_idle": ratio(gui.get("p99_ms"), floor.get("p99_ms")),
-        }
-        lap("stop_clicks")
-        if complete:
-            stops["gui_posted_mouse_click"] = bench_stop_gui(
-                window, sim, counters, n_posted, rng, posted=True, budget_s=posted_budget_s
-            )
-            lap("stop_posted_input")
-            stops["bare_pymodbus_while_polling"] = bench_stop_bare(sim, n_stop, rng)
-        out["stop_latency"] = stops
-        out["traffic_rows_at_end"] = traffic.model.rowCount()
+        out["stop_latency"] = _measure_stops(
+            window,
+            sim,
+            counters,
+            n_stop,
+            rng,
+            floor,
+            lap,
+            posted=(n_posted, posted_budget_s) if complete else None,
+            stop_budget_s=stop_budget_s,
+        )
+        out["traffic_rows_at_end"] = window.traffic_panel.model.rowCount()
     finally:
-        if window is not None:
-            window.close_unattended()  # no question: stops what runs, shuts the link down
-        link.shutdown()
-        if window is not None:
-            window.deleteLater()
-        QApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete)
-        gc.collect()  # pyqtgraph's reference cycles keep ~40 menus alive until collected
-        tmp.cleanup()
+        _close_window(window, link, tmp)
     if link.is_running:
         raise RuntimeError("the robot worker thread is still running after shutdown")
     lap("rest_and_shutdown")
     out["phase_s"] = phases
     return out
+
+
+def _start_streaming(link: RobotLink, sim: SimHandle, counters: _Counters) -> None:
+    """Connect the window's link and start the streaming program on the simulator."""
+    link.connect_to(ConnectionSettings(host="127.0.0.1", port=sim.port, unit=sim.unit))
+    if not _wait_until(lambda: counters.state.state is LinkState.CONNECTED):
+        raise RuntimeError(f"could not connect to the simulator: {counters.state.message}")
+    start = sim.write_count()
+    link.submit(RunProgram(STREAM_PROGRAM, ProgramMotionMode.CYCLE, 0, 100))
+    if not _wait_until(lambda: _motion_started(sim, start)):
+        raise RuntimeError("the simulator did not start the streaming program")
+
+
+def _measure_streaming(
+    window: MainWindow, sim: SimHandle, counters: _Counters, stall_s: float
+) -> dict[str, Any]:
+    """The streaming stalls with the rates the worker and the views really reached."""
+    poses0, frames0, requests0 = counters.poses, counters.traffic_frames, sim.requests()
+    t0 = time.perf_counter()
+    streaming = measure_stalls(stall_s)
+    elapsed = time.perf_counter() - t0
+    # a poll is two reads (pose block, status block): the rate the worker really reached
+    streaming["polls_per_s"] = (sim.requests() - requests0) / 2 / elapsed
+    streaming["poses_per_s"] = (counters.poses - poses0) / elapsed
+    streaming["traffic_frames_per_s"] = (counters.traffic_frames - frames0) / elapsed
+    _per_100hz(streaming)
+    add_no_probe(streaming, stall_s)
+    streaming["traffic_shown"] = not window.traffic_panel.visibleRegion().isEmpty()
+    streaming["monitor_shown"] = not window.monitor_panel.visibleRegion().isEmpty()
+    return streaming
+
+
+def _stalls_and_polls(sim: SimHandle, seconds: float) -> dict[str, Any]:
+    """The stalls over ``seconds`` and the poll rate meanwhile (a poll is two reads)."""
+    requests0, t0 = sim.requests(), time.perf_counter()
+    stalls = measure_stalls(seconds)
+    stalls["polls_per_s"] = (sim.requests() - requests0) / 2 / (time.perf_counter() - t0)
+    return stalls
+
+
+def _measure_attribution(window: MainWindow, sim: SimHandle, stalls: dict[str, Any], stall_s: float) -> None:
+    """Into ``stalls``: streaming against disconnected, then the same stream with the Points tab
+    in front (the monitor's plots and readouts hidden, its paint timer stopped; the traffic
+    inspector stays shown) and with the 3D view in front (the arm redrawn from every pose)."""
+    idle_max = stalls["disconnected"].get("max_ms")
+    stalls["ratio_max_streaming_vs_disconnected"] = ratio(stalls["streaming"].get("max_ms"), idle_max)
+    window.show_tab("points")
+    hidden = _stalls_and_polls(sim, stall_s / 2)
+    hidden["monitor_shown"] = not window.monitor_panel.visibleRegion().isEmpty()
+    stalls["streaming_monitor_hidden"] = hidden
+    view3d = window.view3d.panel
+    window.work_tabs.setCurrentWidget(view3d)
+    _run_for(VIEW3D_SETTLE_S)  # its first paint and scene build are not the steady state
+    shown3d = _stalls_and_polls(sim, stall_s / 2)
+    shown3d["view3d_shown"] = not view3d.canvas.visibleRegion().isEmpty()
+    stalls["streaming_view3d_shown"] = shown3d
+    window.show_tab("monitor")
+
+
+def _measure_stops(
+    window: MainWindow,
+    sim: SimHandle,
+    counters: _Counters,
+    n_stop: int,
+    rng: random.Random,
+    floor: dict[str, Any],
+    lap: Callable[[str], None],
+    *,
+    posted: tuple[int, float] | None,
+    stop_budget_s: float,
+) -> dict[str, Any]:
+    """Stop latency from the GUI's button against the bare floor; with ``posted`` (samples,
+    budget) also the posted mouse clicks and the bare stops under the same polling."""
+    gui = bench_stop_gui(window, sim, counters, n_stop, rng, budget_s=stop_budget_s)
+    stops: dict[str, Any] = {
+        "gui_stop_button": gui,
+        "bare_pymodbus_idle": floor,
+        "ratio_p50_gui_vs_bare_idle": ratio(gui.get("p50_ms"), floor.get("p50_ms")),
+        "ratio_p99_gui_vs_bare_idle": ratio(gui.get("p99_ms"), floor.get("p99_ms")),
+    }
+    lap("stop_clicks")
+    if posted is not None:
+        n_posted, posted_budget_s = posted
+        stops["gui_posted_mouse_click"] = bench_stop_gui(
+            window, sim, counters, n_posted, rng, posted=True, budget_s=posted_budget_s
+        )
+        lap("stop_posted_input")
+        stops["bare_pymodbus_while_polling"] = bench_stop_bare(sim, n_stop, rng)
+    return stops
+
+
+def _close_window(window: MainWindow | None, link: RobotLink, tmp: tempfile.TemporaryDirectory[str]) -> None:
+    """Close the window unattended (it stops what runs), shut the link down, free what they held."""
+    if window is not None:
+        window.close_unattended()  # no question: stops what runs, shuts the link down
+    link.shutdown()
+    if window is not None:
+        window.deleteLater()
+    QApplication.sendPostedEvents(None, QEvent.Type.DeferredDelete)
+    gc.collect()  # pyqtgraph's reference cycles keep ~40 menus alive until collected
+    tmp.cleanup()
 
 
 def _with_sim(make: Callable[[], SimHandle], body: Callable[[SimHandle], dict[str, Any]]) -> dict[str, Any]:

@@ -41,6 +41,79 @@ from ui.main_window import MainWindow
 # --------------------------------------------------------------------------------------------
 
 
+class _GuiStopper:
+    """One stop sample after another with the window's Stop button: the motion (re)started and
+    seen by a poll, the Stop pressed after a delay, the simulator's 441 <- 1 write found."""
+
+    def __init__(self, window: MainWindow, sim: SimHandle, counters: _Counters, *, posted: bool) -> None:
+        self.link = window.link
+        self.button = window.control_bar.stop_button
+        self.sim = sim
+        self.counters = counters
+        self.posted = posted
+        self.pending: dict[str, float | int] = {}
+        self.found: list[WriteRecord] = []
+        self.clicker = QTimer()
+        self.clicker.setSingleShot(True)
+        self.clicker.setTimerType(Qt.TimerType.PreciseTimer)
+        self.clicker.timeout.connect(self._click)
+
+    def _click(self) -> None:
+        self.pending["t0"] = time.monotonic()
+        self.button.click()
+
+    def _post_click(self, local: QPointF, screen: QPointF) -> None:  # runs in a timer thread
+        left, none, plain = Qt.MouseButton.LeftButton, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier
+        press = QMouseEvent(QEvent.Type.MouseButtonPress, local, screen, left, left, plain)
+        release = QMouseEvent(QEvent.Type.MouseButtonRelease, local, screen, left, none, plain)
+        self.pending["t0"] = time.monotonic()
+        QCoreApplication.postEvent(self.button, press)
+        QCoreApplication.postEvent(self.button, release)
+
+    def _stop_seen(self) -> bool:
+        record = _stop_write_after(self.sim, int(self.pending["index"]))
+        if record is not None:
+            self.found.append(record)
+        return record is not None
+
+    def motion_running(self) -> bool:
+        """(Re)start the motion; True once the simulator runs it and a poll has seen it."""
+        start = self.sim.write_count()
+        self.link.submit(RunProgram(STOP_PROGRAM, ProgramMotionMode.CYCLE, 0, 100))
+        if not _wait_until(functools.partial(_motion_started, self.sim, start)):
+            return False
+        poses = self.counters.poses
+        return _wait_until(functools.partial(_more_poses, self.counters, poses))
+
+    def press_stop(self, delay: float) -> bool:
+        """Press Stop ``delay`` s from now (a GUI-thread timer's ``click()``, or a mouse press and
+        release posted from another thread); True once the simulator logged the stop write."""
+        self.found.clear()
+        self.pending.clear()
+        self.pending["index"] = self.sim.write_count()
+        self.pending["results"] = len(self.counters.results)
+        poster: threading.Timer | None = None
+        if self.posted:
+            local = QPointF(self.button.rect().center())
+            poster = threading.Timer(delay, self._post_click, (local, self.button.mapToGlobal(local)))
+            poster.start()
+        else:
+            self.clicker.start(int(1000.0 * delay))
+        seen = _wait_until(lambda: "t0" in self.pending) and _wait_until(self._stop_seen)
+        if poster is not None:
+            poster.join()
+        return seen
+
+    def stop_sent(self) -> bool:
+        """Wait for the worker to finish the stop job ("stop: sent")."""
+        done = int(self.pending["results"])
+        return _wait_until(functools.partial(_stop_sent, self.counters, done))
+
+    def latency(self) -> float:
+        """The last stop's: the simulator's write time minus the time just before the press."""
+        return self.found[0].t - float(self.pending["t0"])
+
+
 def bench_stop_gui(
     window: MainWindow,
     sim: SimHandle,
@@ -59,78 +132,29 @@ def bench_stop_gui(
     (what an operator's click meets: the event loop has to get to it first).
     Ends early, with fewer samples, after ``budget_s`` (a saturated GUI makes each sample slow).
     """
-    link = window.link
-    button = window.control_bar.stop_button
+    stopper = _GuiStopper(window, sim, counters, posted=posted)
     spread = INPUT_PHASE_SPREAD_S if posted else 1.0 / POLL_HZ
     latencies: list[float] = []
     failures = 0
-    pending: dict[str, float | int] = {}
-    found: list[WriteRecord] = []
-    clicker = QTimer()
-    clicker.setSingleShot(True)
-    clicker.setTimerType(Qt.TimerType.PreciseTimer)
-
-    def click() -> None:
-        pending["t0"] = time.monotonic()
-        button.click()
-
-    def post_click(local: QPointF, screen: QPointF) -> None:  # runs in a timer thread
-        left, none, plain = Qt.MouseButton.LeftButton, Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier
-        press = QMouseEvent(QEvent.Type.MouseButtonPress, local, screen, left, left, plain)
-        release = QMouseEvent(QEvent.Type.MouseButtonRelease, local, screen, left, none, plain)
-        pending["t0"] = time.monotonic()
-        QCoreApplication.postEvent(button, press)
-        QCoreApplication.postEvent(button, release)
-
-    def stop_seen() -> bool:
-        record = _stop_write_after(sim, int(pending["index"]))
-        if record is not None:
-            found.append(record)
-        return record is not None
-
-    clicker.timeout.connect(click)
     deadline = time.monotonic() + budget_s
     out: dict[str, Any] = {"budget_exhausted": False}
     for i in range(n + WARMUP_SAMPLES):
         if time.monotonic() > deadline:
             out["budget_exhausted"] = True
             break
-        # (Re)start the motion and wait until the simulator runs it and a poll has seen it.
-        start = sim.write_count()
-        link.submit(RunProgram(STOP_PROGRAM, ProgramMotionMode.CYCLE, 0, 100))
-        if not _wait_until(functools.partial(_motion_started, sim, start)):
-            failures += 1
-            continue
-        poses = counters.poses
-        if not _wait_until(functools.partial(_more_poses, counters, poses)):
+        if not stopper.motion_running():
             failures += 1
             continue
         # Just after a poll: a uniform delay over one poll period (posted input: over one paint
         # period of the monitor, several polls) spreads the stop over the cycle.
-        found.clear()
-        pending.clear()
-        pending["index"] = sim.write_count()
-        pending["results"] = len(counters.results)
-        delay = rng.uniform(0.0, spread)
-        poster: threading.Timer | None = None
-        if posted:
-            local = QPointF(button.rect().center())
-            poster = threading.Timer(delay, post_click, (local, button.mapToGlobal(local)))
-            poster.start()
-        else:
-            clicker.start(int(1000.0 * delay))
-        seen = _wait_until(lambda: "t0" in pending) and _wait_until(stop_seen)
-        if poster is not None:
-            poster.join()
-        if not seen:
+        if not stopper.press_stop(rng.uniform(0.0, spread)):
             failures += 1
             continue
         # Let the worker finish the stop job ("stop: sent") before the next run request.
-        done = int(pending["results"])
-        if not _wait_until(functools.partial(_stop_sent, counters, done)):
+        if not stopper.stop_sent():
             failures += 1
         if i >= WARMUP_SAMPLES:
-            latencies.append(found[0].t - float(pending["t0"]))
+            latencies.append(stopper.latency())
     reason = (
         "the time budget ran out before a stop was measured"
         if out["budget_exhausted"]

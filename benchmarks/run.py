@@ -23,13 +23,68 @@ import os
 import platform
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from benchmarks.goals import goals, guarded, table
 
 
-def main(argv: list[str] | None = None) -> int:
+def _core(args: argparse.Namespace) -> dict[str, Any]:
+    from benchmarks import core
+
+    return guarded("core", lambda: core.run(args.quick))
+
+
+def _gui(args: argparse.Namespace) -> dict[str, Any]:
+    try:
+        from benchmarks import gui
+    except ImportError as exc:  # suite not written yet
+        return {"skipped": str(exc)}
+    out = guarded("gui", lambda: gui.run(args.quick))
+    out["memory"] = guarded("gui.memory", lambda: gui.run_memory(args.quick, args.long))
+    return out
+
+
+def _points(args: argparse.Namespace) -> dict[str, Any]:
+    try:
+        from benchmarks import points
+    except ImportError as exc:
+        return {"skipped": str(exc)}
+    return guarded("points", lambda: points.run(args.quick))
+
+
+def _noisy_line(args: argparse.Namespace) -> dict[str, Any]:
+    """A 200-point RTU upload through a line damaging 1 byte in 500."""
+    noisy_line = __import__("benchmarks.noisy_line", fromlist=["run"])
+    return guarded("noisy_line", lambda: noisy_line.run(args.quick))
+
+
+def _bundle(args: argparse.Namespace) -> dict[str, Any]:
+    """Report only: the bundle beside the venv (null + reason when not built)."""
+    from benchmarks import bundle
+
+    return guarded("bundle", lambda: bundle.run(args.quick))
+
+
+def _safety(args: argparse.Namespace) -> dict[str, Any]:
+    """Not in the default set: --only safety (or core,gui,points,safety)."""
+    safety = __import__("benchmarks.safety", fromlist=["run"])
+    return guarded("safety", lambda: safety.run(args.quick))
+
+
+#: The suites in the order they run; each imported only when it runs.
+SUITES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
+    "core": _core,
+    "gui": _gui,
+    "points": _points,
+    "noisy_line": _noisy_line,
+    "bundle": _bundle,
+    "safety": _safety,
+}
+
+
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="small N and short windows")
     parser.add_argument("--long", action="store_true", help="memory soak of 10 minutes (RSS every 30 s)")
@@ -39,7 +94,11 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="do not compile app/ and ui/ first (start-up then includes compiling)",
     )
-    args = parser.parse_args(argv)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
     suites = {s.strip() for s in args.only.split(",") if s.strip()}
     os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
@@ -59,35 +118,9 @@ def main(argv: list[str] | None = None) -> int:
         for package in ("app", "ui"):
             compileall.compile_dir(root / package, quiet=1)
     t0 = time.perf_counter()
-    if "core" in suites:
-        from benchmarks import core
-
-        out["core"] = guarded("core", lambda: core.run(args.quick))
-    if "gui" in suites:
-        try:
-            from benchmarks import gui
-        except ImportError as exc:  # suite not written yet
-            out["gui"] = {"skipped": str(exc)}
-        else:
-            out["gui"] = guarded("gui", lambda: gui.run(args.quick))
-            out["gui"]["memory"] = guarded("gui.memory", lambda: gui.run_memory(args.quick, args.long))
-    if "points" in suites:
-        try:
-            from benchmarks import points
-        except ImportError as exc:
-            out["points"] = {"skipped": str(exc)}
-        else:
-            out["points"] = guarded("points", lambda: points.run(args.quick))
-    if "noisy_line" in suites:  # a 200-point RTU upload through a line damaging 1 byte in 500
-        noisy_line = __import__("benchmarks.noisy_line", fromlist=["run"])
-        out["noisy_line"] = guarded("noisy_line", lambda: noisy_line.run(args.quick))
-    if "bundle" in suites:  # report only: the bundle beside the venv (null + reason when not built)
-        from benchmarks import bundle
-
-        out["bundle"] = guarded("bundle", lambda: bundle.run(args.quick))
-    if "safety" in suites:  # not in the default set: --only safety (or core,gui,points,safety)
-        safety = __import__("benchmarks.safety", fromlist=["run"])
-        out["safety"] = guarded("safety", lambda: safety.run(args.quick))
+    for name, run_suite in SUITES.items():
+        if name in suites:
+            out[name] = run_suite(args)
     out["total_s"] = time.perf_counter() - t0
     out["goals"] = goals(out)
     json.dump(out, sys.stdout, indent=2, sort_keys=True)

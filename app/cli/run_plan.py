@@ -43,7 +43,7 @@ from app.models import CommandResult, Pose
 from app.plan.checks import IssueCode, IssueKind, PlanIssue, PlanLimits, ReachCheck, check_plan
 from app.plan.estimates import estimate_plan, segment_timeouts
 from app.plan.geometry import PointLike
-from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
+from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan
 from app.points.guard import PointGuard, PointMismatch, PointNotCreated
 from app.points.ledger import PointLedger
@@ -166,6 +166,40 @@ def _points_lost(error: BaseException | None) -> bool:
     return isinstance(error, CommandRefused) and error.status.code == MoveStatus.BAD_END_POINT
 
 
+def _run_numbers(args: argparse.Namespace, plan: Plan) -> tuple[PlanLimits, int, int]:
+    """The run's limits, loop count and 0-based start segment from the command line; numbers
+    the plan cannot take raise :class:`InvalidInput`."""
+    loops = plan.loops if args.loops is None else args.loops
+    start = args.from_segment - 1
+    limits = PlanLimits(max_speed=args.max_speed)
+    if loops < 0:
+        raise InvalidInput("--loops must be >= 0 (0 = until stopped)")
+    if not 0 <= start < len(plan):
+        raise InvalidInput(f"--from {args.from_segment}: the plan has segments 1..{len(plan)}")
+    if args.from_loop < 1 or (loops and args.from_loop > loops):
+        raise InvalidInput(f"--from-loop {args.from_loop}: the run has loops 1..{loops}")
+    return limits, loops, start
+
+
+def _envelope(ctx: CliContext, args: argparse.Namespace) -> Envelope | None:
+    """``--safety``'s envelope, else the envelope in force (the GUI's, app/cli/guard.py), else none."""
+    if getattr(args, "safety", None):
+        return load_profile(args.safety).envelope
+    if ctx.safety is not None:
+        return ctx.safety.envelope
+    return None
+
+
+def _connect_for_run(ctx: CliContext) -> tuple[RobotClient, Pose] | ExitCode:
+    """The controller's client and its pose (the plan's checks start from it), or the exit code
+    of a link that failed."""
+    try:
+        client = ctx.client
+        return client, client.read_pose()
+    except TeachPadError as exc:
+        return _link_code(ctx, exc, "cannot read the robot's pose")
+
+
 def cmd_run(ctx: CliContext) -> ExitCode:
     """``run PROJECT [--plan NAME] ...``: check, upload, run guarded with a progress line."""
     args = ctx.args
@@ -177,26 +211,13 @@ def cmd_run(ctx: CliContext) -> ExitCode:
     plan = _pick_plan(ctx, project, args.plan)
     if plan is None:
         return ExitCode.USAGE
-    loops = plan.loops if args.loops is None else args.loops
-    start = args.from_segment - 1
     try:
-        limits = PlanLimits(max_speed=args.max_speed)
-        if loops < 0:
-            raise InvalidInput("--loops must be >= 0 (0 = until stopped)")
-        if not 0 <= start < len(plan):
-            raise InvalidInput(f"--from {args.from_segment}: the plan has segments 1..{len(plan)}")
-        if args.from_loop < 1 or (loops and args.from_loop > loops):
-            raise InvalidInput(f"--from-loop {args.from_loop}: the run has loops 1..{loops}")
+        limits, loops, start = _run_numbers(args, plan)
     except InvalidInput as exc:
         ctx.error(str(exc))
         return ExitCode.USAGE
-
-    envelope: Envelope | None = None
     try:
-        if getattr(args, "safety", None):
-            envelope = load_profile(args.safety).envelope
-        elif ctx.safety is not None:  # the envelope in force, the GUI's (app/cli/guard.py)
-            envelope = ctx.safety.envelope
+        envelope = _envelope(ctx, args)
         model = robot_model(getattr(args, "robot_profile", None))
     except TeachPadError as exc:
         ctx.error(str(exc))
@@ -204,11 +225,10 @@ def cmd_run(ctx: CliContext) -> ExitCode:
     client: RobotClient | None = None
     pose: Pose | None = None
     if not args.check:
-        try:
-            client = ctx.client
-            pose = client.read_pose()
-        except TeachPadError as exc:
-            return _link_code(ctx, exc, "cannot read the robot's pose")
+        connected = _connect_for_run(ctx)
+        if isinstance(connected, ExitCode):
+            return connected
+        client, pose = connected
     reach = reach_check(model, pose)
     if ctx.caps is not None:
         plan = _capped(ctx, plan, ctx.caps.speed)
@@ -294,20 +314,19 @@ def _capped(ctx: CliContext, plan: Plan, cap: float) -> Plan:
     return dataclasses.replace(plan, segments=segments)
 
 
-def _run(
+def _refused(
     ctx: CliContext,
-    args: argparse.Namespace,
-    project: Project,
     plan: Plan,
-    client: Any,
-    pose: Pose | None,
+    ledger: PointLedger,
     limits: PlanLimits,
-    loops: int,
+    pose: Pose | None,
     start: int,
-    envelope: Envelope | None = None,
-    reach: ReachCheck | None = None,
-) -> ExitCode:
-    ledger = project.ledger
+    loops: int,
+    envelope: Envelope | None,
+    reach: ReachCheck | None,
+) -> ExitCode | None:
+    """Check the plan as the GUI does: warnings are said; errors are said and refuse the run
+    (the exit code returned), None when the plan may run."""
     issues = check_plan(
         plan, ledger, limits, pose, start_index=start, loops=loops, envelope=envelope, reach=reach
     )
@@ -315,38 +334,56 @@ def _run(
         if issue.kind is IssueKind.WARNING:
             ctx.warn(issue.message)
     errors = [i for i in issues if i.kind is IssueKind.ERROR]
-    if errors:
-        for issue in errors:
-            ctx.error(issue.message)
-        code = _refusal_code(errors)
-        ctx.error(
-            f"plan {plan.name!r} has {len(errors)} error(s){_refusal_why(errors, code)}: not running it"
-        )
-        return code
-    est = estimate_plan(plan, ledger, pose, loops=loops)
-    ctx.print(
-        f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
-        f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}"
-    )
-    plan_ids = list(dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids))
-    if args.check:
-        if args.no_upload:
-            ctx.print("--no-upload: the controller must already hold the plan's points")
-        else:
-            ctx.print(f"would upload: {', '.join(map(str, plan_ids))}")
-        ctx.print("check only: not running")
-        return ExitCode.OK
-    guard = PointGuard({p.id: p for p in ledger}, refresh=not args.no_upload)
-    if args.no_upload:
-        ctx.warn(
-            f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
-            f"{', '.join(map(str, plan_ids))} (the operator's responsibility)"
-        )
-    else:
-        code = _upload_plan_points(ctx, args, project, guard, plan_ids, client)
-        if code != ExitCode.OK:
-            return code
+    if not errors:
+        return None
+    for issue in errors:
+        ctx.error(issue.message)
+    code = _refusal_code(errors)
+    ctx.error(f"plan {plan.name!r} has {len(errors)} error(s){_refusal_why(errors, code)}: not running it")
+    return code
 
+
+def _say_check_only(ctx: CliContext, args: argparse.Namespace, plan_ids: list[int]) -> ExitCode:
+    """``--check``: what a run would upload, and that nothing runs."""
+    if args.no_upload:
+        ctx.print("--no-upload: the controller must already hold the plan's points")
+    else:
+        ctx.print(f"would upload: {', '.join(map(str, plan_ids))}")
+    ctx.print("check only: not running")
+    return ExitCode.OK
+
+
+def _prepare_points(
+    ctx: CliContext,
+    args: argparse.Namespace,
+    project: Project,
+    guard: PointGuard,
+    plan_ids: list[int],
+    client: Any,
+) -> ExitCode:
+    """Create the plan's points before the first move, or (``--no-upload``) say whose
+    responsibility they are."""
+    if not args.no_upload:
+        return _upload_plan_points(ctx, args, project, guard, plan_ids, client)
+    ctx.warn(
+        f"--no-upload: nothing is uploaded; the controller must hold exactly this project's points "
+        f"{', '.join(map(str, plan_ids))} (the operator's responsibility)"
+    )
+    return ExitCode.OK
+
+
+def _drive(
+    ctx: CliContext,
+    args: argparse.Namespace,
+    plan: Plan,
+    ledger: PointLedger,
+    client: Any,
+    pose: Pose | None,
+    loops: int,
+    start: int,
+    guard: PointGuard,
+) -> RunOutcome:
+    """Run the plan through the guard with a progress line of the segment under way."""
     line = _ProgressLine(ctx.out)
 
     def progress(p: RunProgress) -> None:
@@ -363,12 +400,27 @@ def _run(
         progress=progress,
     )
     try:
-        outcome = runner.run(_HaltOnFreshLink(client), guard)
+        return runner.run(_HaltOnFreshLink(client), guard)
     finally:
         line.done()
-    if outcome.state is RunState.FINISHED:
-        ctx.print(f"done: {outcome.segments_done} segment(s)")
-        return ExitCode.OK
+
+
+def _resume_command(
+    args: argparse.Namespace, project: Project, plan: Plan, loops: int, outcome: RunOutcome
+) -> str | None:
+    """The command line that resumes a run that ended early, None when it cannot be resumed."""
+    if outcome.resume_from is None:
+        return None
+    resume = f"--from {outcome.resume_from + 1}"
+    if outcome.resume_loop and outcome.resume_loop > 1:
+        resume += f" --from-loop {outcome.resume_loop}"
+    plan_arg = f" --plan {plan.name!r}" if len(project.plans) > 1 else ""
+    loops_arg = f" --loops {loops}" if args.loops is not None else ""
+    return f"{PROG} run {args.project}{plan_arg} {resume}{loops_arg}"
+
+
+def _say_why_stopped(ctx: CliContext, outcome: RunOutcome) -> None:
+    """A run that did not finish: its state and message, and what the error means for the points."""
     ctx.error(f"{outcome.state.value}: {outcome.message}")
     if _points_lost(outcome.error):
         # "bad end point id": the controller does not hold the segment's points (restarted?)
@@ -378,15 +430,51 @@ def _run(
         )
     if isinstance(outcome.error, PointMismatch | PointNotCreated):
         ctx.error("nothing further was sent; the robot is where the message above says")
-    if outcome.resume_from is not None:
-        resume = f"--from {outcome.resume_from + 1}"
-        if outcome.resume_loop and outcome.resume_loop > 1:
-            resume += f" --from-loop {outcome.resume_loop}"
-        plan_arg = f" --plan {plan.name!r}" if len(project.plans) > 1 else ""
-        loops_arg = f" --loops {loops}" if args.loops is not None else ""
-        ctx.print(f"to resume: {PROG} run {args.project}{plan_arg} {resume}{loops_arg}")
+
+
+def _unfinished_code(outcome: RunOutcome) -> ExitCode:
     if outcome.interrupted:
         return ExitCode.INTERRUPTED
     if isinstance(outcome.error, TeachPadError):
         return exit_code_for(outcome.error)
     return ExitCode.FAILED
+
+
+def _run(
+    ctx: CliContext,
+    args: argparse.Namespace,
+    project: Project,
+    plan: Plan,
+    client: Any,
+    pose: Pose | None,
+    limits: PlanLimits,
+    loops: int,
+    start: int,
+    envelope: Envelope | None = None,
+    reach: ReachCheck | None = None,
+) -> ExitCode:
+    ledger = project.ledger
+    refused = _refused(ctx, plan, ledger, limits, pose, start, loops, envelope, reach)
+    if refused is not None:
+        return refused
+    est = estimate_plan(plan, ledger, pose, loops=loops)
+    ctx.print(
+        f"plan {plan.name!r}: {len(plan)} segment(s), {est.loop_length:.1f} mm per loop, "
+        f"loops {loops or 'until stopped'}, about {_fmt_time(est.total_time)}"
+    )
+    plan_ids = list(dict.fromkeys(pid for seg in plan.segments for pid in seg.point_ids))
+    if args.check:
+        return _say_check_only(ctx, args, plan_ids)
+    guard = PointGuard({p.id: p for p in ledger}, refresh=not args.no_upload)
+    code = _prepare_points(ctx, args, project, guard, plan_ids, client)
+    if code != ExitCode.OK:
+        return code
+    outcome = _drive(ctx, args, plan, ledger, client, pose, loops, start, guard)
+    if outcome.state is RunState.FINISHED:
+        ctx.print(f"done: {outcome.segments_done} segment(s)")
+        return ExitCode.OK
+    _say_why_stopped(ctx, outcome)
+    resume = _resume_command(args, project, plan, loops, outcome)
+    if resume is not None:
+        ctx.print(f"to resume: {resume}")
+    return _unfinished_code(outcome)

@@ -62,10 +62,8 @@ def decode_text(data: bytes, path: str | None = None) -> str:
         ) from None
 
 
-def parse_points_csv(
-    text: str, limits: PointLimits = DEFAULT_LIMITS, *, path: str | None = None
-) -> list[TempPoint]:
-    """Parse CSV text fully; raises :class:`FileFormatError` naming the row and column."""
+def _read_rows(text: str, path: str | None) -> list[list[str]]:
+    """The CSV's rows as cells (a leading BOM dropped); text the csv module refuses is not CSV."""
     if text.startswith("\ufeff"):
         text = text[1:]
     reader = csv.reader(io.StringIO(text, newline=""), strict=True)
@@ -78,21 +76,29 @@ def parse_points_csv(
         raise FileFormatError(
             f"not valid CSV ({reason})", path=path, row=len(rows) + 1, problem=Reason("not_csv")
         ) from None
+    return rows
+
+
+def _header_index(rows: list[list[str]], path: str | None) -> int:
+    """The index of the header: the first row with a cell that is not blank."""
     header_at = next((i for i, r in enumerate(rows) if any(cell.strip() for cell in r)), None)
     if header_at is None:
         raise FileFormatError(
             "the file is empty (expected a header row)", path=path, row=1, problem=Reason("empty_file")
         )
-    header = [cell.strip().lower() for cell in rows[header_at]]
-    header_row = header_at + 1
+    return header_at
+
+
+def _check_header(cells: list[str], header: list[str], header_row: int, path: str | None) -> None:
+    """Every column known and named once, every required column present."""
     for col, name in enumerate(header):
         if name not in CSV_COLUMNS:
             raise FileFormatError(
-                f"unknown column {shown(rows[header_at][col])} (expected: {','.join(CSV_COLUMNS)})",
+                f"unknown column {shown(cells[col])} (expected: {','.join(CSV_COLUMNS)})",
                 path=path,
                 row=header_row,
                 problem=Reason(
-                    "unknown_column", {"name": shown(rows[header_at][col]), "expected": ",".join(CSV_COLUMNS)}
+                    "unknown_column", {"name": shown(cells[col]), "expected": ",".join(CSV_COLUMNS)}
                 ),
             )
         if header.index(name) != col:
@@ -112,25 +118,43 @@ def parse_points_csv(
                 column=name,
                 problem=Reason("column_missing"),
             )
+
+
+def _parse_row(
+    cells: list[str], header: list[str], number: int, limits: PointLimits, path: str | None
+) -> TempPoint:
+    """The point of one data row (spreadsheet row ``number``)."""
+    if len(cells) != len(header):
+        raise FileFormatError(
+            f"has {len(cells)} cells, the header has {len(header)} (truncated or extra cells?)",
+            path=path,
+            row=number,
+            problem=Reason("cell_count", {"cells": len(cells), "header": len(header)}),
+        )
+    fields = dict(zip(header, cells, strict=True))
+    try:
+        return point_from_fields(fields, limits)
+    except FieldError as exc:
+        raise FileFormatError(
+            exc.reason, path=path, row=number, column=exc.field, problem=exc.as_reason()
+        ) from None
+
+
+def parse_points_csv(
+    text: str, limits: PointLimits = DEFAULT_LIMITS, *, path: str | None = None
+) -> list[TempPoint]:
+    """Parse CSV text fully; raises :class:`FileFormatError` naming the row and column."""
+    rows = _read_rows(text, path)
+    header_at = _header_index(rows, path)
+    header = [cell.strip().lower() for cell in rows[header_at]]
+    header_row = header_at + 1
+    _check_header(rows[header_at], header, header_row, path)
     points: list[TempPoint] = []
     seen: dict[int, int] = {}
     for number, cells in enumerate(rows[header_at + 1 :], start=header_row + 1):
         if not any(cell.strip() for cell in cells):
             continue  # blank line
-        if len(cells) != len(header):
-            raise FileFormatError(
-                f"has {len(cells)} cells, the header has {len(header)} (truncated or extra cells?)",
-                path=path,
-                row=number,
-                problem=Reason("cell_count", {"cells": len(cells), "header": len(header)}),
-            )
-        fields = dict(zip(header, cells, strict=True))
-        try:
-            point = point_from_fields(fields, limits)
-        except FieldError as exc:
-            raise FileFormatError(
-                exc.reason, path=path, row=number, column=exc.field, problem=exc.as_reason()
-            ) from None
+        point = _parse_row(cells, header, number, limits, path)
         if point.id in seen:
             raise FileFormatError(
                 f"id {point.id} is already used on row {seen[point.id]}",

@@ -203,6 +203,27 @@ def project_from_dict(
 
 def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = True) -> Project:
     top = _TOP
+    doc = _checked_document(data, scan_text=scan_text)
+    name = _text_field(doc, "name", top) or "untitled"
+    description = _text_field(doc, "description", top)
+    created = _text_field(doc, "created", top)
+    modified = _text_field(doc, "modified", top)
+    points, history = _points_from(_expect(doc.get("points", []), list, top, "points", "points"), limits)
+    plans = _plans_from(_expect(doc.get("plans", []), list, top, "plans", "plans"))
+    return Project(
+        name=name,
+        ledger=PointLedger.from_checked(points, limits),
+        plans=plans,
+        description=description,
+        created=created,
+        modified=modified,
+        upload_history=history,
+    )
+
+
+def _checked_document(data: object, *, scan_text: bool) -> dict[str, Any]:
+    """The top-level object of a TeachPad project of the version this reads, all of its text
+    Unicode (``scan_text=False``: the caller knows it is)."""
     if not isinstance(data, dict):
         raise FileFormatError("expected a JSON object at the top level", problem=Reason("not_json_object"))
     doc: dict[str, Any] = data
@@ -218,7 +239,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
         raise _refuse(
             f"expected {FORMAT_NAME!r}, got {got}: not a TeachPad project",
             Reason("not_a_project", {"expected": repr(FORMAT_NAME), "got": got}),
-            top,
+            _TOP,
             "format",
         )
     version = doc.get("version")
@@ -227,96 +248,99 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
         raise _refuse(
             f"version {got} is not supported (this TeachPad reads version {FORMAT_VERSION})",
             Reason("version_unsupported", {"version": got, "supported": FORMAT_VERSION}),
-            top,
+            _TOP,
             "version",
         )
-    name = _text_field(doc, "name", top) or "untitled"
-    description = _text_field(doc, "description", top)
-    created = _text_field(doc, "created", top)
-    modified = _text_field(doc, "modified", top)
+    return doc
 
-    raw_points = _expect(doc.get("points", []), list, top, "points", "points")
+
+def _points_from(
+    raw_points: list[Any], limits: PointLimits
+) -> tuple[list[TempPoint], dict[int, UploadRecord]]:
+    """The file's points and their upload history. The fast path takes a well-formed point
+    whole; anything else goes the careful way, whose refusal says where and what."""
     points: list[TempPoint] = []
     history: dict[int, UploadRecord] = {}
     seen: dict[int, int] = {}
     unknown = SyncState.UNKNOWN
     for i, raw in enumerate(raw_points):
-        if type(raw) is dict:
-            fast = fast_point_from_fields(raw, limits, sync=unknown)
-            if fast is not None and fast.id not in seen:
-                seen[fast.id] = i
-                points.append(fast)
-                uploaded = raw.get("uploaded")
-                if uploaded is not None:
-                    record = _history_from(uploaded, i, fast.id)
-                    if record is not None:
-                        history[fast.id] = record
-                continue
-        where = _point_place(i)
-        obj = _expect(raw, dict, where, "", "object")
-        raw_id = obj.get("id")
-        if isinstance(raw_id, int) and not isinstance(raw_id, bool) and abs(raw_id) < 10**9:
-            where = _point_place(i, raw_id)
-        try:
-            # A file cannot know what a controller holds: every loaded point is "unknown"
-            # (older files' "sync" / "sync_error" keys are ignored).
-            point = point_from_fields(obj, limits, sync=SyncState.UNKNOWN)
-        except FieldError as exc:
-            raise _refuse(exc.reason, _field_problem(exc), where, exc.field) from None
-        where = _point_place(i, point.id)
-        if point.id in seen:
-            raise _refuse(
-                f"id {point.id} is already used by points[{seen[point.id]}]",
-                Reason("point_id_twice", {"id": point.id, "other": seen[point.id]}),
-                where,
-                "id",
-            )
+        point = fast_point_from_fields(raw, limits, sync=unknown) if type(raw) is dict else None
+        if point is None or point.id in seen:
+            point = _careful_point(raw, i, limits, seen)
         seen[point.id] = i
         points.append(point)
-        record = _history_from(obj.get("uploaded"), i, point.id)
-        if record is not None:
-            history[point.id] = record
+        uploaded = raw.get("uploaded")
+        if uploaded is not None:
+            record = _history_from(uploaded, i, point.id)
+            if record is not None:
+                history[point.id] = record
+    return points, history
 
-    raw_plans = _expect(doc.get("plans", []), list, top, "plans", "plans")
+
+def _careful_point(raw: object, index: int, limits: PointLimits, seen: Mapping[int, int]) -> TempPoint:
+    """The point at ``points[index]`` validated field by field; refuses an id used before."""
+    where = _point_place(index)
+    obj = _expect(raw, dict, where, "", "object")
+    raw_id = obj.get("id")
+    if isinstance(raw_id, int) and not isinstance(raw_id, bool) and abs(raw_id) < 10**9:
+        where = _point_place(index, raw_id)
+    try:
+        # A file cannot know what a controller holds: every loaded point is "unknown"
+        # (older files' "sync" / "sync_error" keys are ignored).
+        point = point_from_fields(obj, limits, sync=SyncState.UNKNOWN)
+    except FieldError as exc:
+        raise _refuse(exc.reason, _field_problem(exc), where, exc.field) from None
+    if point.id in seen:
+        raise _refuse(
+            f"id {point.id} is already used by points[{seen[point.id]}]",
+            Reason("point_id_twice", {"id": point.id, "other": seen[point.id]}),
+            _point_place(index, point.id),
+            "id",
+        )
+    return point
+
+
+def _plans_from(raw_plans: list[Any]) -> list[Plan]:
+    """The file's plans, each name used once."""
     plans: list[Plan] = []
     plan_names: set[str] = set()  # the names so far: a linear check, not pairwise
     for i, raw in enumerate(raw_plans):
-        where = (f"plans[{i}]", Reason("place_plan", {"index": i}))
-        obj = _expect(raw, dict, where, "", "object")
-        try:
-            plan_name = validate_plan_name(obj.get("name"))
-            loops = validate_loops(obj.get("loops", 1))
-        except FieldError as exc:
-            raise _refuse(exc.reason, _field_problem(exc), where, exc.field) from None
-        where = (f"plans[{i}] ({plan_name!r})", Reason("place_plan_named", {"index": i, "name": plan_name}))
-        if plan_name in plan_names:
-            raise _refuse(
-                f"another plan is named {plan_name!r}",
-                Reason("plan_name_taken", {"name": plan_name}),
-                where,
-                "name",
-            )
-        segments: list[Segment] = []
-        raw_segments = _expect(obj.get("segments", []), list, where, "segments", "segments")
-        for j, raw_seg in enumerate(raw_segments):
-            seg_where = (
-                f"{where[0]} segment {j + 1}",
-                Reason("place_segment", {"index": i, "name": plan_name, "segment": j + 1}),
-            )
-            seg = _expect(raw_seg, dict, seg_where, "", "object")
-            segments.append(_segment_from_dict(seg, seg_where))
-        plans.append(Plan(plan_name, segments, loops))
-        plan_names.add(plan_name)
+        plan = _plan_from(raw, i, plan_names)
+        plans.append(plan)
+        plan_names.add(plan.name)
+    return plans
 
-    return Project(
-        name=name,
-        ledger=PointLedger.from_checked(points, limits),
-        plans=plans,
-        description=description,
-        created=created,
-        modified=modified,
-        upload_history=history,
+
+def _plan_from(raw: object, index: int, taken: set[str]) -> Plan:
+    """The plan at ``plans[index]``; refuses a name in ``taken``."""
+    where = (f"plans[{index}]", Reason("place_plan", {"index": index}))
+    obj = _expect(raw, dict, where, "", "object")
+    try:
+        plan_name = validate_plan_name(obj.get("name"))
+        loops = validate_loops(obj.get("loops", 1))
+    except FieldError as exc:
+        raise _refuse(exc.reason, _field_problem(exc), where, exc.field) from None
+    where = (
+        f"plans[{index}] ({plan_name!r})",
+        Reason("place_plan_named", {"index": index, "name": plan_name}),
     )
+    if plan_name in taken:
+        raise _refuse(
+            f"another plan is named {plan_name!r}",
+            Reason("plan_name_taken", {"name": plan_name}),
+            where,
+            "name",
+        )
+    segments: list[Segment] = []
+    raw_segments = _expect(obj.get("segments", []), list, where, "segments", "segments")
+    for j, raw_seg in enumerate(raw_segments):
+        seg_where = (
+            f"{where[0]} segment {j + 1}",
+            Reason("place_segment", {"index": index, "name": plan_name, "segment": j + 1}),
+        )
+        seg = _expect(raw_seg, dict, seg_where, "", "object")
+        segments.append(_segment_from_dict(seg, seg_where))
+    return Plan(plan_name, segments, loops)
 
 
 def _history_from(raw: object, index: int, point_id: int) -> UploadRecord | None:

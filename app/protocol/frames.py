@@ -335,22 +335,41 @@ def _frame_summary(header_ok: bool, pdu: _Pdu, address: int | None, items: Seque
     if not header_ok or fc is None:
         return "truncated frame"
     if pdu.is_exception:
-        if pdu.exception_code is None:
-            return "exception (code missing)"
-        text = exception_text(pdu.exception_code)
-        return f"exception {pdu.exception_code:02X} {text}"
+        return _exception_summary(pdu)
     if fc not in FUNCTION_VERB:
         return f"function 0x{fc:02X} (unsupported)"
     if fc == FunctionCode.WRITE_SINGLE_REGISTER:
-        if not pdu.complete or address is None:
-            return "malformed write register"
-        text = single_write_text(address, pdu.values[0])
-        return f"ack {text}" if pdu.is_response else text
+        return _single_write_summary(pdu, address)
     if fc == FunctionCode.READ_HOLDING_REGISTERS and pdu.is_response:
-        if items and address is not None:
-            return summarize_registers(address, items)
-        n = len(pdu.values)
-        return f"{n} reg{'s' if n != 1 else ''} = {limited_list([f'0x{v:04X}' for v in pdu.values])}"
+        return _read_answer_summary(pdu, address, items)
+    return _range_summary(fc, pdu, address, items)
+
+
+def _exception_summary(pdu: _Pdu) -> str:
+    if pdu.exception_code is None:
+        return "exception (code missing)"
+    text = exception_text(pdu.exception_code)
+    return f"exception {pdu.exception_code:02X} {text}"
+
+
+def _single_write_summary(pdu: _Pdu, address: int | None) -> str:
+    """A write of one register, or its echo (the ack)."""
+    if not pdu.complete or address is None:
+        return "malformed write register"
+    text = single_write_text(address, pdu.values[0])
+    return f"ack {text}" if pdu.is_response else text
+
+
+def _read_answer_summary(pdu: _Pdu, address: int | None, items: Sequence[RegisterItem]) -> str:
+    """The answer to a read: the registers by name when the request is known, else raw words."""
+    if items and address is not None:
+        return summarize_registers(address, items)
+    n = len(pdu.values)
+    return f"{n} reg{'s' if n != 1 else ''} = {limited_list([f'0x{v:04X}' for v in pdu.values])}"
+
+
+def _range_summary(fc: int, pdu: _Pdu, address: int | None, items: Sequence[RegisterItem]) -> str:
+    """A frame about a range of registers: a read request, a multiple write or its ack."""
     if address is None or pdu.count is None:
         return f"malformed {FUNCTION_VERB[fc]}"
     label = range_label(address, pdu.count)

@@ -195,6 +195,26 @@ def read_records(
     held: deque[_Slot] = deque()
     waiting: dict[tuple[str, int], _Slot] = {}
     early: _Early = {}
+    for rec in _parsed_lines(directory, start, end, stats):
+        _hold(rec, held, waiting, early)
+        if len(held) > MAX_OUTCOME_LAG:  # the oldest waits in vain: its process died
+            _give_up(held[0], stats)
+            waiting.pop((held[0].record.session, held[0].record.seq), None)
+        while held and not held[0].pending:
+            stats.records += 1
+            yield held.popleft().record
+    for slot in held:
+        if slot.pending:
+            _give_up(slot, stats)
+        stats.records += 1
+        yield slot.record
+
+
+def _parsed_lines(
+    directory: Path, start: dt.date | None, end: dt.date | None, stats: ReadStats
+) -> Iterator[AuditRecord]:
+    """Every line of the day files that parses, in file order (files counted; a file that cannot
+    be read is passed over, a line that does not parse is counted as skipped)."""
     for path in audit_files(directory, start, end):
         stats.files += 1
         try:
@@ -204,30 +224,33 @@ def read_records(
         for raw in data.split(b"\n"):
             if not raw.strip():
                 continue
-            try:
-                rec = AuditRecord.from_json(json.loads(raw.decode("utf-8")))
-            except (ValueError, TypeError, UnicodeDecodeError):
+            rec = _parse_line(raw)
+            if rec is None:
                 stats.skipped += 1
-                continue
-            if rec.kind in (OUTCOME, RESULT):
-                _pair(rec, waiting, early)
-            else:  # (an outcome whose write is outside the range read shows nothing)
-                held.append(_Slot(rec))
-                if held[-1].pending:
-                    waiting[(rec.session, rec.seq)] = held[-1]
-                    for line in early.pop((rec.session, rec.seq), []):  # read before it (a clock set back)
-                        _pair(line, waiting, early)
-            if len(held) > MAX_OUTCOME_LAG:  # the oldest waits in vain: its process died
-                _give_up(held[0], stats)
-                waiting.pop((held[0].record.session, held[0].record.seq), None)
-            while held and not held[0].pending:
-                stats.records += 1
-                yield held.popleft().record
-    for slot in held:
-        if slot.pending:
-            _give_up(slot, stats)
-        stats.records += 1
-        yield slot.record
+            else:
+                yield rec
+
+
+def _parse_line(raw: bytes) -> AuditRecord | None:
+    try:
+        return AuditRecord.from_json(json.loads(raw.decode("utf-8")))
+    except (ValueError, TypeError, UnicodeDecodeError):
+        return None
+
+
+def _hold(rec: AuditRecord, held: deque[_Slot], waiting: dict[tuple[str, int], _Slot], early: _Early) -> None:
+    """Take one record in: an outcome or result line is merged into its write; any other record
+    is held in file order (a write until its outcome arrives)."""
+    if rec.kind in (OUTCOME, RESULT):
+        _pair(rec, waiting, early)
+        return
+    # (an outcome whose write is outside the range read shows nothing)
+    slot = _Slot(rec)
+    held.append(slot)
+    if slot.pending:
+        waiting[(rec.session, rec.seq)] = slot
+        for line in early.pop((rec.session, rec.seq), []):  # read before it (a clock set back)
+            _pair(line, waiting, early)
 
 
 _Early = dict[tuple[str, int], list[AuditRecord]]

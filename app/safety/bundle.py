@@ -171,55 +171,73 @@ def build_support_bundle(
     with zipfile.ZipFile(buf, "w", compression=zipfile.ZIP_DEFLATED) as zf:
         w = _Writer(zf, manifest)
         w.text("versions.json", json.dumps(versions(), indent=2) + "\n")
-        if settings is not None:
-            text = json.dumps(redact(settings), indent=2, ensure_ascii=False, default=str)
-            w.text("settings.json", text + "\n")
-        if project is not None:
-            w.file(f"project/{project.name}", project)
-        if profile is not None:
-            w.file("safety-profile.json", profile)
-        if register_profile is not None:
-            w.file("register-profile.json", register_profile)
-        first_day = now.date() - dt.timedelta(days=days - 1)
-        if audit_dir is not None:
-            found = audit_files(audit_dir, first_day, now.date())
-            for path in found:
-                w.file(f"audit/{path.name}", path)
-            if not found:
-                manifest.left_out.append(f"audit trail: no records in the last {days} days")
-        event_lines = None if events is None else list(events)
-        if event_lines:
-            w.text("events.txt", "".join(line.rstrip("\n") + "\n" for line in event_lines))
-        else:
-            manifest.left_out.append(
-                _NO_EVENTS if event_lines is None else f"event log: no events in the last {days} days"
-            )
-        if log_dir is not None:
-            cutoff = (now - dt.timedelta(days=days)).timestamp()
-            for path in sorted(p for p in log_dir.iterdir() if p.is_file()) if log_dir.is_dir() else []:
-                if path.stat().st_mtime >= cutoff:
-                    w.file(f"logs/{path.name}", path, redacted=True)
-        traffic_lines = None if traffic is None else list(traffic)
-        if traffic_lines:
-            w.text("traffic.txt", "".join(line.rstrip("\n") + "\n" for line in traffic_lines))
-        else:
-            manifest.left_out.append(_NO_TRAFFIC if traffic_lines is None else _TRAFFIC_EMPTY)
+        _add_settings(w, settings)
+        _add_inputs(w, project, profile, register_profile)
+        _add_audit(w, audit_dir, now.date(), days)
+        _add_lines(w, "events.txt", events, _NO_EVENTS, f"event log: no events in the last {days} days")
+        _add_logs(w, log_dir, (now - dt.timedelta(days=days)).timestamp())
+        _add_lines(w, "traffic.txt", traffic, _NO_TRAFFIC, _TRAFFIC_EMPTY)
         manifest.files.append("manifest.json")
-        zf.writestr(
-            "manifest.json",
-            json.dumps(
-                {
-                    "created": manifest.created,
-                    "days": days,
-                    "files": manifest.files,
-                    "left_out": manifest.left_out,
-                },
-                indent=2,
-                ensure_ascii=False,
-            )
-            + "\n",
-        )
+        zf.writestr("manifest.json", _manifest_json(manifest, days))
     return buf.getvalue(), manifest
+
+
+def _add_settings(w: _Writer, settings: Mapping[str, Any] | None) -> None:
+    """The settings, every secret removed."""
+    if settings is not None:
+        text = json.dumps(redact(settings), indent=2, ensure_ascii=False, default=str)
+        w.text("settings.json", text + "\n")
+
+
+def _add_inputs(
+    w: _Writer, project: Path | None, profile: Path | None, register_profile: Path | None
+) -> None:
+    """The files the operator works with: the project, the safety profile, the register profile."""
+    if project is not None:
+        w.file(f"project/{project.name}", project)
+    for name, path in (("safety-profile.json", profile), ("register-profile.json", register_profile)):
+        if path is not None:
+            w.file(name, path)
+
+
+def _add_audit(w: _Writer, audit_dir: Path | None, last_day: dt.date, days: int) -> None:
+    """The audit trail's day files of the last ``days`` days (said when there are none)."""
+    if audit_dir is None:
+        return
+    found = audit_files(audit_dir, last_day - dt.timedelta(days=days - 1), last_day)
+    for path in found:
+        w.file(f"audit/{path.name}", path)
+    if not found:
+        w.manifest.left_out.append(f"audit trail: no records in the last {days} days")
+
+
+def _add_lines(w: _Writer, name: str, lines: Iterable[str] | None, none_given: str, empty: str) -> None:
+    """A text of lines (the event log, the Modbus traffic); the manifest says why it is missing:
+    ``none_given`` when there was none to give, ``empty`` when it had no lines."""
+    given = None if lines is None else list(lines)
+    if given:
+        w.text(name, "".join(line.rstrip("\n") + "\n" for line in given))
+    else:
+        w.manifest.left_out.append(none_given if given is None else empty)
+
+
+def _add_logs(w: _Writer, log_dir: Path | None, cutoff: float) -> None:
+    """The log files changed since ``cutoff`` (a timestamp), secrets removed."""
+    if log_dir is None:
+        return
+    for path in sorted(p for p in log_dir.iterdir() if p.is_file()) if log_dir.is_dir() else []:
+        if path.stat().st_mtime >= cutoff:
+            w.file(f"logs/{path.name}", path, redacted=True)
+
+
+def _manifest_json(manifest: BundleManifest, days: int) -> str:
+    document = {
+        "created": manifest.created,
+        "days": days,
+        "files": manifest.files,
+        "left_out": manifest.left_out,
+    }
+    return json.dumps(document, indent=2, ensure_ascii=False) + "\n"
 
 
 def write_support_bundle(out: str | os.PathLike[str], **kwargs: Any) -> BundleManifest:

@@ -392,37 +392,65 @@ def plan_violations(
     or degenerate arcs are left to the plan's own checks.
     """
     loops = plan.loops if loops is None else loops
-    segs = plan.segments
-    n = len(segs)
     out: list[EnvelopeViolation] = []
-    for i, seg in enumerate(segs):
-        starts: list[PointLike] = []
-        if i == start_index and current_pose is not None:
-            starts.append(current_pose)
-        if i > 0 and (i > start_index or loops != 1):
-            prev = ledger.get(segs[i - 1].end_id)
-            if prev is not None:
-                starts.append(prev)
-        if i == 0 and loops != 1 and n > 1:
-            last = ledger.get(segs[-1].end_id)
-            if last is not None:
-                starts.append(last)
-        found: EnvelopeViolation | None = None
-        for start in starts:
-            try:
-                found = check_segment(envelope, start, seg, ledger)
-            except InvalidInput:
-                found = None
-            if found is not None:
-                break
-        if found is None and not starts:
-            end = ledger.get(seg.end_id)
-            via = ledger.get(seg.via_id) if seg.via_id is not None else None
-            found = (
-                check_speed(envelope, seg.speed)
-                or (check_point(envelope, xyz_of(end)) if end is not None else None)
-                or (check_point(envelope, xyz_of(via)) if via is not None else None)
-            )
+    for i, seg in enumerate(plan.segments):
+        starts = _segment_starts(plan.segments, i, ledger, current_pose, start_index, loops)
+        if starts:
+            found = _first_violation(envelope, starts, seg, ledger)
+        else:
+            found = _violation_without_start(envelope, seg, ledger)
         if found is not None:
             out.append(found.at_segment(i))
     return out
+
+
+def _segment_starts(
+    segs: list[Segment],
+    i: int,
+    ledger: PointLedger,
+    current_pose: PointLike | None,
+    start_index: int,
+    loops: int,
+) -> list[PointLike]:
+    """Where segment ``i`` may run from: the pose (the first segment run), the previous segment's
+    end (when that runs before it), the last segment's end (segment 0 of a further loop)."""
+    starts: list[PointLike] = []
+    if i == start_index and current_pose is not None:
+        starts.append(current_pose)
+    if i > 0 and (i > start_index or loops != 1):
+        prev = ledger.get(segs[i - 1].end_id)
+        if prev is not None:
+            starts.append(prev)
+    if i == 0 and loops != 1 and len(segs) > 1:
+        last = ledger.get(segs[-1].end_id)
+        if last is not None:
+            starts.append(last)
+    return starts
+
+
+def _first_violation(
+    envelope: Envelope, starts: list[PointLike], seg: Segment, ledger: PointLedger
+) -> EnvelopeViolation | None:
+    """The segment's first violation from the first start that has one (a segment its points
+    cannot make is left to the plan's checks)."""
+    for start in starts:
+        try:
+            found = check_segment(envelope, start, seg, ledger)
+        except InvalidInput:
+            found = None
+        if found is not None:
+            return found
+    return None
+
+
+def _violation_without_start(
+    envelope: Envelope, seg: Segment, ledger: PointLedger
+) -> EnvelopeViolation | None:
+    """A segment whose start is unknown: its speed, end point and middle point are checked."""
+    end = ledger.get(seg.end_id)
+    via = ledger.get(seg.via_id) if seg.via_id is not None else None
+    return (
+        check_speed(envelope, seg.speed)
+        or (check_point(envelope, xyz_of(end)) if end is not None else None)
+        or (check_point(envelope, xyz_of(via)) if via is not None else None)
+    )

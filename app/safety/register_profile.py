@@ -131,17 +131,33 @@ class RegisterProfile:
 
 
 def _check(p: RegisterProfile, where: str) -> None:
-    def bad(name: str, text: str) -> RegisterProfileError:
-        return RegisterProfileError(f"{where}: {name} {text}")
+    _check_kinds(p, where)
+    _check_whole_numbers(p, where)
+    _check_timeouts(p, where)
+    if isinstance(p.revision, bool) or not isinstance(p.revision, int) or p.revision < 0:
+        raise _bad(where, "revision", "must be a whole number >= 0")
 
+
+def _bad(where: str, name: str, text: str) -> RegisterProfileError:
+    return RegisterProfileError(f"{where}: {name} {text}")
+
+
+def _check_kinds(p: RegisterProfile, where: str) -> None:
+    """The name is text; the word order, clock layout and completion are ones TeachPad knows."""
     if not isinstance(p.name, str) or not p.name.strip() or len(p.name) > 80:
-        raise bad("name", "must be text of 1 to 80 characters")
+        raise _bad(where, "name", "must be text of 1 to 80 characters")
     if not isinstance(p.word_order, WordOrder):
-        raise bad("word_order", "must be low-first or high-first")
+        raise _bad(where, "word_order", "must be low-first or high-first")
     if not isinstance(p.datetime_layout, DateTimeLayout):
-        raise bad("datetime_layout", "must be split-words or packed32")
+        raise _bad(where, "datetime_layout", "must be split-words or packed32")
     if p.completion not in COMPLETION_MODES:
-        raise bad("completion", f"must be one of {', '.join(COMPLETION_MODES)}, got {_short(p.completion)}")
+        raise _bad(
+            where, "completion", f"must be one of {', '.join(COMPLETION_MODES)}, got {_short(p.completion)}"
+        )
+
+
+def _check_whole_numbers(p: RegisterProfile, where: str) -> None:
+    """The unit and the point id range: whole numbers in their ranges, the range not reversed."""
     for name, lo, hi in (
         ("unit", *UNIT_RANGE),
         ("point_id_min", *POINT_ID_RANGE),
@@ -149,9 +165,13 @@ def _check(p: RegisterProfile, where: str) -> None:
     ):
         value = getattr(p, name)
         if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
-            raise bad(name, f"must be a whole number {lo}..{hi}, got {_short(value)}")
+            raise _bad(where, name, f"must be a whole number {lo}..{hi}, got {_short(value)}")
     if p.point_id_min > p.point_id_max:
-        raise bad("point_id_min", f"({p.point_id_min}) is above point_id_max ({p.point_id_max})")
+        raise _bad(where, "point_id_min", f"({p.point_id_min}) is above point_id_max ({p.point_id_max})")
+
+
+def _check_timeouts(p: RegisterProfile, where: str) -> None:
+    """The timeouts: empty (automatic) or a number of seconds in their range."""
     for name, lo_f, hi_f in (
         ("poll_timeout", *POLL_TIMEOUT_RANGE),
         ("unconfirmed_after", *UNCONFIRMED_RANGE),
@@ -165,9 +185,7 @@ def _check(p: RegisterProfile, where: str) -> None:
             or not math.isfinite(value)
             or not lo_f <= value <= hi_f
         ):
-            raise bad(name, f"must be empty (automatic) or {lo_f:g}..{hi_f:g} s, got {_short(value)}")
-    if isinstance(p.revision, bool) or not isinstance(p.revision, int) or p.revision < 0:
-        raise bad("revision", "must be a whole number >= 0")
+            raise _bad(where, name, f"must be empty (automatic) or {lo_f:g}..{hi_f:g} s, got {_short(value)}")
 
 
 # --- JSON -------------------------------------------------------------------------------------

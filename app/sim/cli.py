@@ -8,7 +8,8 @@ import os
 import signal
 import sys
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import TextIO
 
 from pymodbus.constants import ExcCodes
@@ -141,55 +142,92 @@ def _watchdog(text: str) -> float | None:
     return seconds
 
 
+def _print_status(sim: SimController, _args: list[str], out: TextIO) -> None:
+    s = sim.state()
+    print(f"pose {' '.join(f'{v:.3f}' for v in s.pose)}", file=out)
+    print(f"joints {' '.join(f'{v:.3f}' for v in s.joints)}", file=out)
+    print(
+        f"mode {s.mode.name} program {s.program_state.name} alarms {int(s.alarms)} "
+        f"teach {'on' if s.teach_enabled else 'off'} ratio {s.teach_ratio:g} "
+        f"GV291 {s.command_status} points {len(s.points)}",
+        file=out,
+    )
+    bad = sim.bad_frame_counts()
+    print(
+        f"bad frames {sum(bad.values())}"
+        + "".join(f", {n} {reason}" for reason, n in sorted(bad.items()))
+        + f"; watchdog stops {len(sim.watchdog_events())}",
+        file=out,
+    )
+
+
+def _set_watchdog(sim: SimController, args: list[str], _out: TextIO) -> None:
+    try:
+        sim.set_watchdog(_watchdog(args[0]))
+    except argparse.ArgumentTypeError as exc:
+        raise ValueError(str(exc)) from None
+
+
+def _set_exception(sim: SimController, args: list[str], _out: TextIO) -> None:
+    """``exception CODE|off`` or ``exception CODE SECONDS``."""
+    if len(args) == 1:
+        sim.set_exception(None if args[0] == "off" else ExcCodes(int(args[0], 0)))
+    else:
+        sim.set_exception(ExcCodes(int(args[0], 0)), seconds=float(args[1]))
+
+
+@dataclass(frozen=True)
+class _Command:
+    """A stdin command: whether its words fit it, and what it does (ValueError: a bad value)."""
+
+    fits: Callable[[list[str]], bool]
+    run: Callable[[SimController, list[str], TextIO], object]
+
+
+def _no_words(args: list[str]) -> bool:
+    return not args
+
+
+def _one_word(args: list[str]) -> bool:
+    return len(args) == 1
+
+
+def _on_off(word: str) -> bool:
+    return word in ("on", "off")
+
+
+#: The stdin commands by name (``quit`` / ``exit`` end the loop, see :func:`execute`).
+_COMMANDS: dict[str, _Command] = {
+    "alarm": _Command(
+        lambda a: len(a) == 2 and a[0] in ALARM_NAMES and _on_off(a[1]),
+        lambda sim, a, _out: sim.set_alarm(ALARM_NAMES[a[0]], a[1] == "on"),
+    ),
+    "delay": _Command(_one_word, lambda sim, a, _out: sim.set_response_delay(float(a[0]))),
+    "status-delay": _Command(_one_word, lambda sim, a, _out: sim.set_status_delay(float(a[0]))),
+    "drop": _Command(_no_words, lambda sim, _a, _out: sim.drop_connections()),
+    "watchdog": _Command(_one_word, _set_watchdog),
+    "exception": _Command(lambda a: len(a) == 1 or (len(a) == 2 and a[0] != "off"), _set_exception),
+    "silent": _Command(
+        lambda a: len(a) == 1 and _on_off(a[0]), lambda sim, a, _out: sim.set_silent(a[0] == "on")
+    ),
+    "restart": _Command(_no_words, lambda sim, _a, _out: sim.restart_controller()),
+    "status": _Command(_no_words, _print_status),
+    "help": _Command(lambda _a: True, lambda _sim, _a, out: print(COMMANDS_HELP, file=out)),
+}
+
+
 def execute(sim: SimController, line: str, out: TextIO) -> bool:
     """Run one stdin command. Returns False when the simulator should quit."""
     words = line.split()
     if not words:
         return True
     cmd, args = words[0].lower(), [w.lower() for w in words[1:]]
+    if cmd in ("quit", "exit"):
+        return False
+    command = _COMMANDS.get(cmd)
     try:
-        if cmd == "alarm" and len(args) == 2 and args[0] in ALARM_NAMES and args[1] in ("on", "off"):
-            sim.set_alarm(ALARM_NAMES[args[0]], args[1] == "on")
-        elif cmd == "delay" and len(args) == 1:
-            sim.set_response_delay(float(args[0]))
-        elif cmd == "status-delay" and len(args) == 1:
-            sim.set_status_delay(float(args[0]))
-        elif cmd == "drop" and not args:
-            sim.drop_connections()
-        elif cmd == "watchdog" and len(args) == 1:
-            try:
-                sim.set_watchdog(_watchdog(args[0]))
-            except argparse.ArgumentTypeError as exc:
-                raise ValueError(str(exc)) from None
-        elif cmd == "exception" and len(args) == 1:
-            sim.set_exception(None if args[0] == "off" else ExcCodes(int(args[0], 0)))
-        elif cmd == "exception" and len(args) == 2 and args[0] != "off":
-            sim.set_exception(ExcCodes(int(args[0], 0)), seconds=float(args[1]))
-        elif cmd == "silent" and len(args) == 1 and args[0] in ("on", "off"):
-            sim.set_silent(args[0] == "on")
-        elif cmd == "restart" and not args:
-            sim.restart_controller()
-        elif cmd == "status" and not args:
-            s = sim.state()
-            print(f"pose {' '.join(f'{v:.3f}' for v in s.pose)}", file=out)
-            print(f"joints {' '.join(f'{v:.3f}' for v in s.joints)}", file=out)
-            print(
-                f"mode {s.mode.name} program {s.program_state.name} alarms {int(s.alarms)} "
-                f"teach {'on' if s.teach_enabled else 'off'} ratio {s.teach_ratio:g} "
-                f"GV291 {s.command_status} points {len(s.points)}",
-                file=out,
-            )
-            bad = sim.bad_frame_counts()
-            print(
-                f"bad frames {sum(bad.values())}"
-                + "".join(f", {n} {reason}" for reason, n in sorted(bad.items()))
-                + f"; watchdog stops {len(sim.watchdog_events())}",
-                file=out,
-            )
-        elif cmd == "help":
-            print(COMMANDS_HELP, file=out)
-        elif cmd in ("quit", "exit"):
-            return False
+        if command is not None and command.fits(args):
+            command.run(sim, args, out)
         else:
             print(f"unknown command: {line.strip()!r} (type help)", file=out)
     except ValueError as exc:
@@ -200,30 +238,8 @@ def execute(sim: SimController, line: str, out: TextIO) -> bool:
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    logging.basicConfig(
-        level=logging.DEBUG if args.verbose else logging.INFO,
-        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
-    )
-    if not args.verbose:
-        logging.getLogger("pymodbus").setLevel(logging.WARNING)
-    config = SimConfig(
-        host=args.host,
-        port=args.port,
-        unit=args.unit,
-        word_order=WordOrder.parse(args.word_order),
-        status_encoding=args.status_encoding,
-        status_delay=args.status_delay,
-        framer="rtu" if args.rtu_framing else "socket",
-        tick_hz=args.tick_hz,
-        watchdog=args.watchdog,
-        serial_port=args.serial,
-        baudrate=args.baud,
-        parity=args.parity,
-        stopbits=args.stopbits,
-        timing=args.timing,
-        gv291=args.gv291,
-        seed=args.seed,
-    )
+    _configure_logging(args.verbose)
+    config = _sim_config(args)
     sim = SimController(config)
     for point_id in args.refuse_point:
         sim.refuse_point(point_id)
@@ -242,18 +258,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         watch = threading.Thread(target=_wait_for_end_of_stdin, args=(done,), daemon=True)
         watch.start()
     if not args.no_stdin:
-
-        def read_stdin() -> None:
-            try:
-                for line in sys.stdin:
-                    if not execute(sim, line, sys.stdout):
-                        break
-            except BrokenPipeError:  # nobody reads our answers any more: stop, quietly
-                pass
-            done.set()
-
-        threading.Thread(target=read_stdin, name="sim-stdin", daemon=True).start()
-
+        threading.Thread(target=_read_commands, args=(sim, done), name="sim-stdin", daemon=True).start()
     try:
         while not done.wait(0.2):
             pass
@@ -265,6 +270,48 @@ def main(argv: Sequence[str] | None = None) -> int:
             signal.signal(sig, handler)  # type: ignore[arg-type]
     _say("teachpad-sim stopped")
     return 0
+
+
+def _configure_logging(verbose: bool) -> None:
+    logging.basicConfig(
+        level=logging.DEBUG if verbose else logging.INFO,
+        format="%(asctime)s %(levelname)s %(name)s: %(message)s",
+    )
+    if not verbose:
+        logging.getLogger("pymodbus").setLevel(logging.WARNING)
+
+
+def _sim_config(args: argparse.Namespace) -> SimConfig:
+    """The simulator's configuration from the command line's options."""
+    return SimConfig(
+        host=args.host,
+        port=args.port,
+        unit=args.unit,
+        word_order=WordOrder.parse(args.word_order),
+        status_encoding=args.status_encoding,
+        status_delay=args.status_delay,
+        framer="rtu" if args.rtu_framing else "socket",
+        tick_hz=args.tick_hz,
+        watchdog=args.watchdog,
+        serial_port=args.serial,
+        baudrate=args.baud,
+        parity=args.parity,
+        stopbits=args.stopbits,
+        timing=args.timing,
+        gv291=args.gv291,
+        seed=args.seed,
+    )
+
+
+def _read_commands(sim: SimController, done: threading.Event) -> None:
+    """The stdin commands, one a line, until ``quit`` or the end of stdin; then ``done``."""
+    try:
+        for line in sys.stdin:
+            if not execute(sim, line, sys.stdout):
+                break
+    except BrokenPipeError:  # nobody reads our answers any more: stop, quietly
+        pass
+    done.set()
 
 
 def _stop_on_signals(done: threading.Event) -> dict[signal.Signals, object]:

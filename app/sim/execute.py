@@ -9,6 +9,7 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable
+from dataclasses import dataclass
 
 from pymodbus.constants import ExcCodes
 
@@ -53,6 +54,38 @@ _STATUS_COMMANDS = frozenset(
     }
 )
 _GV291_REGS = range(gv_reg(GV_COMMAND_STATUS), gv_reg(GV_COMMAND_STATUS) + 2)
+_RATIO_REGS = range(gv_reg(GV_PARAM3), gv_reg(GV_PARAM3) + 2)
+# the commands whose 0 a host must have read before GV291 moves on (classic profile)
+_INSTANT_COMMANDS = frozenset({RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE})
+_MOVE_COMMANDS = frozenset({RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT})
+
+
+def _touches(covered: range, regs: range) -> bool:
+    """A write over ``covered`` reaches the first or the last register of ``regs`` (a float's two)."""
+    return regs.start in covered or regs.stop - 1 in covered
+
+
+@dataclass(frozen=True)
+class _Params:
+    """A run command's parameters, written beside it: GV200..GV205, the speed, the external axes'
+    offsets, the tool frame."""
+
+    p: list[float]
+    speed: float
+    ext: list[float]
+    tool: float
+
+
+#: The run commands the robot answers with a status from the parameters alone.
+_ROBOT_COMMANDS: dict[RunCommand, Callable[[SimRobot, _Params], int]] = {
+    RunCommand.STEP_JOINT: lambda robot, c: robot.step_joint(c.p + c.ext, c.speed),
+    RunCommand.STEP_BASE: lambda robot, c: robot.step_base(c.p, c.speed, c.ext),
+    RunCommand.MOVE_TO_POINT: lambda robot, c: robot.move_to_point(
+        c.p[0], c.p[1], c.p[2], c.p[3], c.speed, c.tool
+    ),
+    RunCommand.TEACH_ENABLE: lambda robot, c: robot.teach_enable(c.p[0], c.p[3]),
+    RunCommand.TEACH_DISABLE: lambda robot, c: robot.teach_disable(c.p[3]),
+}
 
 
 class CommandExecutor:
@@ -89,8 +122,7 @@ class CommandExecutor:
     def handle_write(self, regs: list[int], start: int, address: int, count: int) -> ExcCodes | None:
         """Act on the control registers a write covered (values already in ``regs``)."""
         covered = range(address, address + count)
-        robot = self.robot
-        if _GV291_REGS.start in covered or _GV291_REGS.stop - 1 in covered:
+        if _touches(covered, _GV291_REGS):
             refused = self._host_wrote_status(regs, start)
             if refused is not None:
                 return refused
@@ -98,10 +130,27 @@ class CommandExecutor:
         def value(reg: int) -> int:
             return regs[reg - start]
 
-        if REG_WORK_MODE in covered:
-            if not robot.set_work_mode(value(REG_WORK_MODE)):
-                return ExcCodes.ILLEGAL_VALUE
-            log.info("work mode -> %s", robot.work_mode.name)
+        if REG_WORK_MODE in covered and not self._set_work_mode(value(REG_WORK_MODE)):
+            return ExcCodes.ILLEGAL_VALUE
+        self._press_buttons(covered, value)
+        if self.robot.teach_enabled and _touches(covered, _RATIO_REGS):
+            gv = self.image.gv
+            self.robot.set_teach_ratio(
+                gv(regs, start, GV_PARAM3), gv(regs, start, GV_PARAM1), gv(regs, start, GV_PARAM2)
+            )
+        if REG_RUN_COMMAND in covered:
+            return self._run_command(regs, start, value(REG_RUN_COMMAND))
+        return None
+
+    def _set_work_mode(self, mode: int) -> bool:
+        if not self.robot.set_work_mode(mode):
+            return False
+        log.info("work mode -> %s", self.robot.work_mode.name)
+        return True
+
+    def _press_buttons(self, covered: range, value: Callable[[int], int]) -> None:
+        """The registers that act when written: stop, pause, resume (on a 1), go to zero (an axis)."""
+        robot = self.robot
         if REG_STOP in covered and value(REG_STOP) == 1:
             self._hold(latency=False, read_hold=False)
             robot.stop()
@@ -117,15 +166,6 @@ class CommandExecutor:
                 "all" if axis == 11 else f"J{axis + 1}",
                 "started" if robot.go_zero(axis) else "refused",
             )
-        ratio_regs = range(gv_reg(GV_PARAM3), gv_reg(GV_PARAM3) + 2)
-        if robot.teach_enabled and (ratio_regs.start in covered or ratio_regs.stop - 1 in covered):
-            gv = self.image.gv
-            robot.set_teach_ratio(
-                gv(regs, start, GV_PARAM3), gv(regs, start, GV_PARAM1), gv(regs, start, GV_PARAM2)
-            )
-        if REG_RUN_COMMAND in covered:
-            return self._run_command(regs, start, value(REG_RUN_COMMAND))
-        return None
 
     def _run_command(self, regs: list[int], start: int, code: int) -> ExcCodes | None:
         try:
@@ -133,60 +173,61 @@ class CommandExecutor:
         except ValueError:
             log.warning("unknown run command 0x%02X refused", code)
             return ExcCodes.ILLEGAL_VALUE
-        robot = self.robot
         if command in _STATUS_COMMANDS:
             # moves show 6 (moving) as their own evidence; only the instant commands wait
             # for a host to have seen the 0 (classic profile)
-            self._hold(
-                latency=True,
-                read_hold=command
-                in (RunCommand.CREATE_POINT, RunCommand.TEACH_ENABLE, RunCommand.TEACH_DISABLE),
-            )
-        p = self.image.gvs(regs, start, GV_PARAM0, 6)
-        speed = self.image.gv(regs, start, GV_EXPECTED_SPEED)
-        ext = self.image.gvs(regs, start, GV_EXT_OFFSET0, NUM_EXTERNAL_AXES)
-        tool = self.image.gv(regs, start, GV_TOOL_FRAME)
-        status: int | None = None
+            self._hold(latency=True, read_hold=command in _INSTANT_COMMANDS)
+        params = _Params(
+            p=self.image.gvs(regs, start, GV_PARAM0, 6),
+            speed=self.image.gv(regs, start, GV_EXPECTED_SPEED),
+            ext=self.image.gvs(regs, start, GV_EXT_OFFSET0, NUM_EXTERNAL_AXES),
+            tool=self.image.gv(regs, start, GV_TOOL_FRAME),
+        )
         if command is RunCommand.RUN_PROGRAM:
-            ok = robot.run_program(
-                regs[REG_PROGRAM_ID - start],
-                regs[REG_PROGRAM_MODE - start],
-                regs[REG_CYCLE_COUNT - start],
-                regs[REG_PROGRAM_SPEED - start],
-            )
-            log.info("run program %d: %s", regs[REG_PROGRAM_ID - start], "started" if ok else "refused")
+            self._run_program(regs, start)
             return None
-        if command is RunCommand.STEP_JOINT:
-            status = robot.step_joint(p + ext, speed)
-        elif command is RunCommand.STEP_BASE:
-            status = robot.step_base(p, speed, ext)
-        elif command is RunCommand.MOVE_TO_POINT:
-            status = robot.move_to_point(p[0], p[1], p[2], p[3], speed, tool)
-        elif command is RunCommand.CREATE_POINT:
-            source = p[1]
-            pose: list[float] | None = None
-            if source == 1:
-                first = robot.gv_source_ok(p[2])
-                if first is None:
-                    robot.last_kind = CommandKind.CREATE_POINT
-                    robot.command_status = 1
-                    log.info("create point %s refused: GV202 = %s is not a GV index 0..94", p[0], p[2])
-                    return None
-                pose = self.image.gvs(regs, start, first, 6)
-            elif source != 0:
-                robot.last_kind = CommandKind.CREATE_POINT
-                robot.command_status = 1
-                log.info("create point %s refused: GV201 = %s (0 current pose, 1 from GVs)", p[0], source)
+        if command is RunCommand.CREATE_POINT:
+            status = self._create_point(regs, start, params)
+            if status is None:
                 return None
-            status = robot.create_point(p[0], pose, tool)
-        elif command is RunCommand.TEACH_ENABLE:
-            status = robot.teach_enable(p[0], p[3])
-        elif command is RunCommand.TEACH_DISABLE:
-            status = robot.teach_disable(p[3])
-        if command in (RunCommand.STEP_JOINT, RunCommand.STEP_BASE, RunCommand.MOVE_TO_POINT):
+        else:
+            status = _ROBOT_COMMANDS[command](self.robot, params)
+        if command in _MOVE_COMMANDS:
             self._move_accepted()
         log.info("%s -> status %s", command.name, status)
         return None
+
+    def _run_program(self, regs: list[int], start: int) -> None:
+        ok = self.robot.run_program(
+            regs[REG_PROGRAM_ID - start],
+            regs[REG_PROGRAM_MODE - start],
+            regs[REG_CYCLE_COUNT - start],
+            regs[REG_PROGRAM_SPEED - start],
+        )
+        log.info("run program %d: %s", regs[REG_PROGRAM_ID - start], "started" if ok else "refused")
+
+    def _create_point(self, regs: list[int], start: int, c: _Params) -> int | None:
+        """Create point ``c.p[0]`` from the current pose (GV201 = 0) or from six GVs (GV201 = 1,
+        the first in GV202); its status, or None when the source was refused (status 1, said)."""
+        robot = self.robot
+        source = c.p[1]
+        pose: list[float] | None = None
+        if source == 1:
+            first = robot.gv_source_ok(c.p[2])
+            if first is None:
+                self._refuse_create_point()
+                log.info("create point %s refused: GV202 = %s is not a GV index 0..94", c.p[0], c.p[2])
+                return None
+            pose = self.image.gvs(regs, start, first, 6)
+        elif source != 0:
+            self._refuse_create_point()
+            log.info("create point %s refused: GV201 = %s (0 current pose, 1 from GVs)", c.p[0], source)
+            return None
+        return robot.create_point(c.p[0], pose, c.tool)
+
+    def _refuse_create_point(self) -> None:
+        self.robot.last_kind = CommandKind.CREATE_POINT
+        self.robot.command_status = 1
 
     def _host_wrote_status(self, regs: list[int], start: int) -> ExcCodes | None:
         """A host's write covered GV291: refuse it, keep it, or let the next refresh overwrite it."""

@@ -272,6 +272,25 @@ class SimController:
             self._registers = registers
         if self._silent:
             return ExcCodes.DEVICE_FAILURE  # not executed; the answer is dropped by _trace_packet
+        injected = await self._injected_fault(serial, connection, address, count)
+        if injected is not None:
+            return injected
+        values = None if set_values is None else [int(v) & 0xFFFF for v in set_values]
+        if values is not None:
+            refused = self.point_write_refusals.check(address, values, self.config.word_order)
+            if refused is not None:
+                log.info("write fc=0x%02X address=%d refused: exception %d", function_code, address, refused)
+                return refused
+        with self.lock:
+            return self._carry_out(
+                function_code, start_address, address, count, registers, values, connection
+            )
+
+    async def _injected_fault(
+        self, serial: int, connection: int | None, address: int, count: int
+    ) -> ExcCodes | None:
+        """The fault knobs, in order: the answer held (response delay, slow answers), then the
+        exception rule's code when it applies to this request."""
         slow, every = self._slow_answers
         held, delay_on, delay_range = self._delay_rule
         if not (delay_on in (None, connection) and touches(delay_range, address, count)):
@@ -289,53 +308,73 @@ class SimController:
             with self.lock:
                 self._exceptions_answered += 1
             return exc
-        if set_values is not None:
-            values = [int(v) & 0xFFFF for v in set_values]
-            refused = self.point_write_refusals.check(address, values, self.config.word_order)
-            if refused is not None:
-                log.info("write fc=0x%02X address=%d refused: exception %d", function_code, address, refused)
-                return refused
-        offset = address - start_address
+        return None
+
+    def _carry_out(
+        self,
+        function_code: int,
+        start_address: int,
+        address: int,
+        count: int,
+        registers: list[int],
+        values: list[int] | None,
+        connection: int | None,
+    ) -> ExcCodes | None:
+        """Carry the request out (under the lock): a write stored and acted on, the live registers
+        refreshed; the exception to answer, if any."""
+        if self._wipe_general:  # a restarted controller starts with cleared general-purpose GVs
+            self._wipe_general = False
+            first, last = max(0, -start_address), max(0, _GENERAL_REGISTERS - start_address)
+            registers[first:last] = [0] * (last - first)
         answer: ExcCodes | None = None
-        with self.lock:
-            if self._wipe_general:  # a restarted controller starts with cleared general-purpose GVs
-                self._wipe_general = False
-                first, last = max(0, -start_address), max(0, _GENERAL_REGISTERS - start_address)
-                registers[first:last] = [0] * (last - first)
-            if set_values is not None:
-                values = [int(v) & 0xFFFF for v in set_values]
-                self._log_write(WriteRecord(time.monotonic(), function_code, address, tuple(values)))
-                log.info(
-                    "write fc=0x%02X address=%d values=%s",
-                    function_code,
-                    address,
-                    " ".join(f"{v:04X}" for v in values),
-                )
-                before = registers[offset : offset + len(values)]
-                registers[offset : offset + len(values)] = values
-                result = self.executor.handle_write(registers, start_address, address, len(values))
-                if result is not None:  # refused: the write is not stored
-                    registers[offset : offset + len(values)] = before
-                    return result
-                ratio = gv_reg(GV_PARAM3)
-                if self.robot.jogging and address <= ratio + 1 and ratio < address + len(values):
-                    self.watchdog.jog_written(connection)
-                armer = self._exception_after
-                if armer is not None and address <= armer < address + len(values):
-                    self._exception_after = None  # the exception rule applies from the next request on
-                    self._arm_exception_window()
-                    log.info("exception rule armed by the write to %d", armer)
-                self._restart_if_due(address, len(values))
-                applied = self._applied_then
-                if applied is not None and address == applied[1]:
-                    self._applied_then = None  # once
-                    answer = applied[0]
-                    log.info("write to %d carried out, answered exception %d", address, int(answer))
-            self._refresh(registers, start_address)
-            status_reg = gv_reg(GV_COMMAND_STATUS)
-            if set_values is None and address <= status_reg < address + count:
-                self.status.seen(time.monotonic())  # a host has now seen the 0 (if it shows)
+        if values is not None:
+            refused = self._store_write(function_code, start_address, address, registers, values)
+            if refused is not None:  # refused: the write is not stored
+                return refused
+            answer = self._after_write(address, len(values), connection)
+        self._refresh(registers, start_address)
+        status_reg = gv_reg(GV_COMMAND_STATUS)
+        if values is None and address <= status_reg < address + count:
+            self.status.seen(time.monotonic())  # a host has now seen the 0 (if it shows)
         return answer
+
+    def _store_write(
+        self, function_code: int, start_address: int, address: int, registers: list[int], values: list[int]
+    ) -> ExcCodes | None:
+        """Log the write, store it and act on it; a write the controller refuses is put back."""
+        self._log_write(WriteRecord(time.monotonic(), function_code, address, tuple(values)))
+        log.info(
+            "write fc=0x%02X address=%d values=%s",
+            function_code,
+            address,
+            " ".join(f"{v:04X}" for v in values),
+        )
+        offset = address - start_address
+        before = registers[offset : offset + len(values)]
+        registers[offset : offset + len(values)] = values
+        result = self.executor.handle_write(registers, start_address, address, len(values))
+        if result is not None:
+            registers[offset : offset + len(values)] = before
+        return result
+
+    def _after_write(self, address: int, n: int, connection: int | None) -> ExcCodes | None:
+        """What a stored write sets off besides its command: the jog watchdog fed, the exception
+        rule armed, a restart that was due, a "carried out, answered exception" rule (its code)."""
+        ratio = gv_reg(GV_PARAM3)
+        if self.robot.jogging and address <= ratio + 1 and ratio < address + n:
+            self.watchdog.jog_written(connection)
+        armer = self._exception_after
+        if armer is not None and address <= armer < address + n:
+            self._exception_after = None  # the exception rule applies from the next request on
+            self._arm_exception_window()
+            log.info("exception rule armed by the write to %d", armer)
+        self._restart_if_due(address, n)
+        applied = self._applied_then
+        if applied is None or address != applied[1]:
+            return None
+        self._applied_then = None  # once
+        log.info("write to %d carried out, answered exception %d", address, int(applied[0]))
+        return applied[0]
 
     # --- registers ------------------------------------------------------------------------
     def published_status(self, now: float | None = None) -> int:

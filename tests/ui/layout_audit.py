@@ -122,42 +122,70 @@ def _button_needs(button: QAbstractButton) -> int:
 def clipped_texts(root: QWidget) -> list[str]:
     problems: list[str] = []
     for widget in visible_widgets(root):
-        if widget.property("elide"):
-            shown = widget.text() if isinstance(widget, QLabel | QAbstractButton) else ""
-            if shown and not widget.toolTip():
-                problems.append(f"{describe(widget)} elides on purpose but has no tooltip")
-            continue
-        if isinstance(widget, QLabel):
-            if not widget.text() or (widget.pixmap() is not None and not widget.pixmap().isNull()):
-                continue
-            if widget.wordWrap():
-                needed = widget.heightForWidth(widget.width())
-                if needed > widget.height() + SLACK_PX:
-                    problems.append(f"{describe(widget)} needs {needed} px of height, has {widget.height()}")
-                continue
-            needed, room = _label_width(widget), _label_room(widget)
-            if needed > room + SLACK_PX:
-                problems.append(f"{describe(widget)} needs {needed} px, has {room}")
-        elif isinstance(widget, QAbstractButton):
-            if not widget.text():
-                continue
-            needed = _button_needs(widget)
-            if needed > widget.width() + SLACK_PX:
-                problems.append(f"{describe(widget)} needs {needed} px, has {widget.width()}")
-        elif isinstance(widget, QGroupBox) and widget.title():
-            option = QStyleOptionGroupBox()
-            option.initFrom(widget)
-            option.text = widget.title()
-            option.subControls = QStyle.SubControl.SC_GroupBoxLabel
-            if widget.isCheckable():
-                option.subControls |= QStyle.SubControl.SC_GroupBoxCheckBox
-            metrics = QFontMetrics(widget.font())
-            needed = metrics.horizontalAdvance(_plain(widget.title())) + 2 * metrics.horizontalAdvance(" ")
-            if widget.isCheckable():
-                needed += widget.style().pixelMetric(QStyle.PixelMetric.PM_IndicatorWidth, option, widget) + 6
-            if needed > widget.width() + SLACK_PX:
-                problems.append(f"{describe(widget)} (title) needs {needed} px, has {widget.width()}")
+        problem = _clipped(widget)
+        if problem is not None:
+            problems.append(problem)
     return problems
+
+
+def _clipped(widget: QWidget) -> str | None:
+    """What of ``widget``'s text does not fit, by the kind of widget; None when it fits."""
+    if widget.property("elide"):
+        return _elided_without_tooltip(widget)
+    if isinstance(widget, QLabel):
+        return _clipped_label(widget)
+    if isinstance(widget, QAbstractButton):
+        return _clipped_button(widget)
+    if isinstance(widget, QGroupBox) and widget.title():
+        return _clipped_title(widget)
+    return None
+
+
+def _elided_without_tooltip(widget: QWidget) -> str | None:
+    """A widget that elides on purpose must say its whole text in a tooltip."""
+    shown = widget.text() if isinstance(widget, QLabel | QAbstractButton) else ""
+    if shown and not widget.toolTip():
+        return f"{describe(widget)} elides on purpose but has no tooltip"
+    return None
+
+
+def _clipped_label(widget: QLabel) -> str | None:
+    if not widget.text() or (widget.pixmap() is not None and not widget.pixmap().isNull()):
+        return None
+    if widget.wordWrap():
+        needed = widget.heightForWidth(widget.width())
+        if needed > widget.height() + SLACK_PX:
+            return f"{describe(widget)} needs {needed} px of height, has {widget.height()}"
+        return None
+    needed, room = _label_width(widget), _label_room(widget)
+    if needed > room + SLACK_PX:
+        return f"{describe(widget)} needs {needed} px, has {room}"
+    return None
+
+
+def _clipped_button(widget: QAbstractButton) -> str | None:
+    if not widget.text():
+        return None
+    needed = _button_needs(widget)
+    if needed > widget.width() + SLACK_PX:
+        return f"{describe(widget)} needs {needed} px, has {widget.width()}"
+    return None
+
+
+def _clipped_title(widget: QGroupBox) -> str | None:
+    option = QStyleOptionGroupBox()
+    option.initFrom(widget)
+    option.text = widget.title()
+    option.subControls = QStyle.SubControl.SC_GroupBoxLabel
+    if widget.isCheckable():
+        option.subControls |= QStyle.SubControl.SC_GroupBoxCheckBox
+    metrics = QFontMetrics(widget.font())
+    needed = metrics.horizontalAdvance(_plain(widget.title())) + 2 * metrics.horizontalAdvance(" ")
+    if widget.isCheckable():
+        needed += widget.style().pixelMetric(QStyle.PixelMetric.PM_IndicatorWidth, option, widget) + 6
+    if needed > widget.width() + SLACK_PX:
+        return f"{describe(widget)} (title) needs {needed} px, has {widget.width()}"
+    return None
 
 
 def paints_nothing(widget: QWidget) -> bool:
