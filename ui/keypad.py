@@ -133,24 +133,36 @@ class KeypadDialog(QDialog):
             return
         text = "" if self._fresh and key not in ("sign", "back") else self._text
         self._fresh = False
-        if key == "back":
-            text = text[:-1]
-        elif key == "clear":
-            text = ""
-        elif key == "sign":
-            if self._minimum < 0:
-                text = text[1:] if text.startswith("-") else "-" + text
-        elif key == ".":
-            if self._decimals > 0 and "." not in text:
-                text = (text or "0") + "."
-        elif key.isdigit():
-            if "." in text and len(text.split(".", 1)[1]) >= self._decimals:
-                return  # no more decimals than the field keeps
-            if text in ("0", "-0"):
-                text = text[:-1]  # no leading zeros
-            text += key
-        self._text = text
+        edited = self._edited(text, key)
+        if edited is None:
+            return
+        self._text = edited
         self._show()
+
+    def _edited(self, text: str, key: str) -> str | None:
+        """``text`` after the editing ``key`` (None: the key is refused, the text stays)."""
+        if key == "back":
+            return text[:-1]
+        if key == "clear":
+            return ""
+        if key == "sign":
+            if self._minimum < 0:
+                return text[1:] if text.startswith("-") else "-" + text
+            return text
+        if key == ".":
+            if self._decimals > 0 and "." not in text:
+                return (text or "0") + "."
+            return text
+        if key.isdigit():
+            return self._with_digit(text, key)
+        return text
+
+    def _with_digit(self, text: str, digit: str) -> str | None:
+        if "." in text and len(text.split(".", 1)[1]) >= self._decimals:
+            return None  # no more decimals than the field keeps
+        if text in ("0", "-0"):
+            text = text[:-1]  # no leading zeros
+        return text + digit
 
     def keyPressEvent(self, event: QKeyEvent) -> None:
         keys = {

@@ -414,62 +414,19 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
     if args.demo and not args.sim:
         parser.error("--demo needs --sim")
 
-    existing = QApplication.instance()
-    app = existing if isinstance(existing, QApplication) else QApplication([sys.argv[0], *qt_args])
-    app.setOrganizationName(ORGANIZATION)
-    app.setApplicationName(APPLICATION)
+    app = _application(qt_args)
     settings = AppSettings.from_file(args.settings) if args.settings else AppSettings()
-    translator = Translator()
-    language = args.lang or settings.language
-    if not translator.set_language(language):
-        print(f"teachpad: no translation for {language}, using English", file=sys.stderr)
-
-    connection: ConnectionSettings | None = None
-    if args.host and not args.sim:
-        remembered = settings.connection()  # with the register profile in force
-        connection = dataclasses.replace(
-            remembered,
-            host=args.host,
-            port=args.port,
-            unit=remembered.unit if args.unit is None else args.unit,
-            serial_port=None,
-            framer="socket",
-            monitor_only=args.monitor_only,
-        )
-        settings.save_connection(connection)
+    translator = _translator(args.lang or settings.language)
+    connection = _command_line_connection(args, settings)
 
     link = RobotLink(poll_hz=args.poll_hz or settings.poll_hz)
     window = MainWindow(link, settings, translator)
-    if args.size:
-        window.resize(*args.size)
-    if args.tab:
-        window.show_tab(args.tab)
+    _arrange(window, args)
     exit_loop = _LoopExit(app)
     starting_ms = round(SIM_START_TIMEOUT * 1000) if args.sim else 0
     shot = _Screenshot(window, link, args.screenshot, exit_loop, starting_ms) if args.screenshot else None
-    starter: _SimStarter | None = None
-    failure: list[str] = []
-    if args.sim:  # the simulator starts after the first paint (see _SimStarter)
-        starter = _SimStarter(window)
-
-        def sim_started(sim: SimProcess) -> None:
-            if exit_loop.ended:  # queued before the window closed: the starter stops that simulator
-                return
-            if shot is not None:
-                shot.rearm()
-            link.connect_to(
-                ConnectionSettings(host=sim.host, port=sim.port, unit=1, monitor_only=args.monitor_only)
-            )
-            if args.demo:
-                link.submit(RunProgram(DEMO_PROGRAM, ProgramMotionMode.CYCLE, 0, 100))
-
-        def sim_failed(reason: str) -> None:
-            print(f"teachpad: could not start the simulator: {reason}", file=sys.stderr)
-            failure.append(reason)
-            exit_loop(1)
-
-        starter.started.connect(sim_started)
-        starter.failed.connect(sim_failed)
+    # the simulator starts after the first paint (see _SimStarter)
+    starter = _sim_starter(window, link, args, exit_loop, shot) if args.sim else None
 
     collector = GuiThreadCollector(startup_gc, window)
 
@@ -487,23 +444,112 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
     try:
         code = exit_loop.exec()
     finally:
-        if shot is not None:
-            shot.cancel()
-        # saves the window state and shuts the link down (stops any jog); a screenshot run's
-        # close is not an operator's: no "Save changes?" may block it
-        if shot is not None:
-            window.close_unattended()
-        else:
-            window.close()
-        link.shutdown()
-        if starter is not None:
-            starter.close()
-        if not wait_for_detached_threads(THREADS_EXIT_WAIT):
-            print("teachpad: the link to the controller did not close in time", file=sys.stderr)
-        translator.uninstall()
-        collector.stop()  # automatic collection is back when main() ends
-        window.deleteLater()
+        _close_down(window, link, translator, collector, shot=shot, starter=starter)
     return int(code)
+
+
+def _application(qt_args: list[str]) -> QApplication:
+    """The running QApplication (a test's), or a new one with Qt's own arguments."""
+    existing = QApplication.instance()
+    app = existing if isinstance(existing, QApplication) else QApplication([sys.argv[0], *qt_args])
+    app.setOrganizationName(ORGANIZATION)
+    app.setApplicationName(APPLICATION)
+    return app
+
+
+def _translator(language: str) -> Translator:
+    """The GUI in ``language`` (English, said on stderr, when it has no translation)."""
+    translator = Translator()
+    if not translator.set_language(language):
+        print(f"teachpad: no translation for {language}, using English", file=sys.stderr)
+    return translator
+
+
+def _command_line_connection(args: argparse.Namespace, settings: AppSettings) -> ConnectionSettings | None:
+    """``--host`` (not with ``--sim``): the remembered connection to that host, remembered in
+    turn; None: no connection asked for on the command line."""
+    if not args.host or args.sim:
+        return None
+    remembered = settings.connection()  # with the register profile in force
+    connection = dataclasses.replace(
+        remembered,
+        host=args.host,
+        port=args.port,
+        unit=remembered.unit if args.unit is None else args.unit,
+        serial_port=None,
+        framer="socket",
+        monitor_only=args.monitor_only,
+    )
+    settings.save_connection(connection)
+    return connection
+
+
+def _arrange(window: MainWindow, args: argparse.Namespace) -> None:
+    """``--size`` and ``--tab``."""
+    if args.size:
+        window.resize(*args.size)
+    if args.tab:
+        window.show_tab(args.tab)
+
+
+def _sim_starter(
+    window: MainWindow,
+    link: RobotLink,
+    args: argparse.Namespace,
+    exit_loop: _LoopExit,
+    shot: _Screenshot | None,
+) -> _SimStarter:
+    """``--sim``: the simulator started after the first paint; the link connects to it (and
+    ``--demo`` runs the demo program), or the application ends when it cannot start."""
+    starter = _SimStarter(window)
+
+    def sim_started(sim: SimProcess) -> None:
+        if exit_loop.ended:  # queued before the window closed: the starter stops that simulator
+            return
+        if shot is not None:
+            shot.rearm()
+        link.connect_to(
+            ConnectionSettings(host=sim.host, port=sim.port, unit=1, monitor_only=args.monitor_only)
+        )
+        if args.demo:
+            link.submit(RunProgram(DEMO_PROGRAM, ProgramMotionMode.CYCLE, 0, 100))
+
+    def sim_failed(reason: str) -> None:
+        print(f"teachpad: could not start the simulator: {reason}", file=sys.stderr)
+        exit_loop(1)
+
+    starter.started.connect(sim_started)
+    starter.failed.connect(sim_failed)
+    return starter
+
+
+def _close_down(
+    window: MainWindow,
+    link: RobotLink,
+    translator: Translator,
+    collector: GuiThreadCollector,
+    *,
+    shot: _Screenshot | None,
+    starter: _SimStarter | None,
+) -> None:
+    """After the event loop: the window closed (its state saved), the link shut down (any jog
+    stopped), the simulator stopped, the worker threads awaited."""
+    if shot is not None:
+        shot.cancel()
+    # saves the window state and shuts the link down (stops any jog); a screenshot run's
+    # close is not an operator's: no "Save changes?" may block it
+    if shot is not None:
+        window.close_unattended()
+    else:
+        window.close()
+    link.shutdown()
+    if starter is not None:
+        starter.close()
+    if not wait_for_detached_threads(THREADS_EXIT_WAIT):
+        print("teachpad: the link to the controller did not close in time", file=sys.stderr)
+    translator.uninstall()
+    collector.stop()  # automatic collection is back when main() ends
+    window.deleteLater()
 
 
 if __name__ == "__main__":

@@ -30,6 +30,7 @@ Decisions on the open questions of PROTOCOL.md section 7 that live here:
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -85,6 +86,75 @@ _GENERAL_POSE_LAST_START = registers.GV_GENERAL_LAST - 5  # six GVs must fit in 
 
 
 ProgressCallback = Callable[[int, int], bool]
+
+
+class _PoseStaging:
+    """The staging of an upload's poses (:meth:`RobotClient.upload_points`): they alternate
+    between two blocks of GVs, and while the controller works on one point the next point's pose
+    goes into the other block (``spare`` None: one block, each pose written before its point)."""
+
+    def __init__(
+        self,
+        items: Sequence[tuple[int, Sequence[float]]],
+        gv_start: int,
+        spare: int | None,
+        write: Callable[[int, Sequence[float]], None],
+        halted: Callable[[], bool] | None,
+    ) -> None:
+        self._items = items
+        self._gv_start = gv_start
+        self.spare = spare
+        self._write = write
+        self._halted = halted
+        self.staged = -1  # the index of the item whose pose is already in its block
+
+    def block_of(self, index: int) -> int:
+        return self.spare if self.spare is not None and index % 2 else self._gv_start
+
+    def meanwhile(self, index: int) -> Callable[[], None] | None:
+        """What to do while point ``index`` is in flight: stage the next pose (None: nothing)."""
+        return (
+            functools.partial(self.stage, index + 1)
+            if self.spare is not None and index + 1 < len(self._items)
+            else None
+        )
+
+    def stage(self, nxt: int) -> None:
+        """Write item ``nxt``'s pose into its block, unless it is there already or a stop or
+        cancel is pending."""
+        if self.staged == nxt or (self._halted is not None and self._halted()):
+            return  # staged already (a busy retry); a stop or cancel is pending
+        try:
+            self._write(self.block_of(nxt), self._items[nxt][1])
+        except LINE_ERRORS:
+            return  # not known to be there: written again before its point is created
+        except ModbusExceptionError as exc:
+            # busy: staged after the result instead. Refused: the point in flight goes on,
+            # and the next poses go into the first block, each after the previous result
+            # (the unstaged way)
+            if not is_busy(exc):
+                self.spare = None
+        else:
+            self.staged = nxt
+
+
+def _failed_point(point_id: int, exc: TeachPadError) -> CommandResult:
+    """The result of a point whose writes or reads failed (it ends the batch)."""
+    return CommandResult(
+        RunCommand.CREATE_POINT,
+        CommandKind.CREATE_POINT,
+        None,
+        False,
+        str(exc),
+        {"point_id": float(point_id)},
+        reason=exc.as_reason(),
+    )
+
+
+def _point_result(point_id: int, result: CommandResult) -> CommandResult:
+    """A point's result, naming the point."""
+    details = dict(result.details, point_id=float(point_id))
+    return dataclasses.replace(result, message=f"point {point_id}: {result.message}", details=details)
 
 
 class RobotClient(CommandClient):
@@ -404,52 +474,27 @@ class RobotClient(CommandClient):
             results = []
         if not items or (halted is not None and halted()):
             return results
-        backoff = BusyBackoff(halted, between)  # busy before the first point: the status read, GV245
-        # a damaged frame there: prepared again (its status read tells whether a 444 <- auto took)
-        line = LineRetry(
-            self.settings, timing.LINE_POINT_RETRIES, halted, timeouts=timing.LINE_POINT_TIMEOUT_RETRIES
+        status = self._begin_upload(tool, halted, between)
+        staging = _PoseStaging(
+            items,
+            gv_start,
+            spare,
+            lambda gv, values: self._write_floats(gv, values, repeatable=True, halted=halted),
+            halted,
         )
-        status, _ = retry_busy(
-            lambda: retry_line(lambda: self._prepare(RunCommand.CREATE_POINT), line), backoff
-        )
-        retry_busy(lambda: self._write_tool(tool), backoff)
-        kind = CommandKind.CREATE_POINT
         total = len(items)
-        staged = -1  # the index of the item whose pose is already in its block
-
-        def block_of(index: int) -> int:
-            return spare if spare is not None and index % 2 else gv_start
-
         for index, (point_id, values) in enumerate(items):
             if halted is not None and halted():
                 break  # nothing of this point has gone out: it is not attempted
-            block = block_of(index)
-
-            def stage_next(nxt: int = index + 1) -> None:
-                nonlocal staged, spare
-                if staged == nxt or (halted is not None and halted()):
-                    return  # staged already (a busy retry); a stop or cancel is pending
-                try:
-                    self._write_floats(block_of(nxt), items[nxt][1], repeatable=True, halted=halted)
-                except LINE_ERRORS:
-                    return  # not known to be there: written again before its point is created
-                except ModbusExceptionError as exc:
-                    # busy: staged after the result instead. Refused: the point in flight goes on,
-                    # and the next poses go into the first block, each after the previous result
-                    # (the unstaged way)
-                    if not is_busy(exc):
-                        spare = None
-                else:
-                    staged = nxt
-
-            meanwhile = stage_next if spare is not None and index + 1 < total else None
+            block = staging.block_of(index)
+            meanwhile = staging.meanwhile(index)
             try:
                 result, status = self._create_one(
                     point_id,
                     values,
                     block,
                     status,
-                    write_pose=staged != index,
+                    write_pose=staging.staged != index,
                     meanwhile=meanwhile,
                     between=between,
                     backoff=BusyBackoff(halted, between),
@@ -467,25 +512,28 @@ class RobotClient(CommandClient):
                 ModbusExceptionError,
                 OutcomeUnknown,
             ) as exc:
-                results.append(
-                    CommandResult(
-                        RunCommand.CREATE_POINT,
-                        kind,
-                        None,
-                        False,
-                        str(exc),
-                        {"point_id": float(point_id)},
-                        reason=exc.as_reason(),
-                    )
-                )
+                results.append(_failed_point(point_id, exc))
                 break
-            details = dict(result.details, point_id=float(point_id))
-            results.append(
-                dataclasses.replace(result, message=f"point {point_id}: {result.message}", details=details)
-            )
+            results.append(_point_result(point_id, result))
             if progress is not None and progress(index + 1, total) is False:
                 break
         return results
+
+    def _begin_upload(
+        self, tool: int, halted: Callable[[], bool] | None, between: Callable[[], None] | None
+    ) -> ControllerStatus:
+        """Before an upload's first point: the status read (444 <- auto when manual) and GV245;
+        the status read."""
+        backoff = BusyBackoff(halted, between)  # busy before the first point: the status read, GV245
+        # a damaged frame there: prepared again (its status read tells whether a 444 <- auto took)
+        line = LineRetry(
+            self.settings, timing.LINE_POINT_RETRIES, halted, timeouts=timing.LINE_POINT_TIMEOUT_RETRIES
+        )
+        status, _ = retry_busy(
+            lambda: retry_line(lambda: self._prepare(RunCommand.CREATE_POINT), line), backoff
+        )
+        retry_busy(lambda: self._write_tool(tool), backoff)
+        return status
 
     def _create_one(
         self,

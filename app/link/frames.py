@@ -183,29 +183,46 @@ def frame_need(framing: Framing, request: Request, unit: int, tid: int, buf: byt
     When ``len(buf)`` reaches the returned length the answer is complete and fully checked.
     """
     if framing == "tcp":
-        if len(buf) < _MBAP + 1:
-            return _MBAP + 1
-        got_tid, protocol, length, got_unit = struct.unpack_from(">HHHB", buf)
-        if got_tid != tid:
-            raise _bad(
-                "transaction id",
-                tid,
-                got_tid,
-                f"transaction id {got_tid}, expected {tid} (an answer to another request)",
-            )
-        if protocol != 0:
-            raise _bad("protocol id", 0, protocol, f"MBAP protocol id {protocol}, expected 0")
-        if got_unit != unit:
-            raise _bad("unit id", unit, got_unit, f"unit id {got_unit}, expected {unit}")
-        size = _answer_pdu_size(request, buf, _MBAP)
-        if size is None:
-            return _MBAP + 2
-        if length != 1 + size:
-            raise _bad("length", 1 + size, length, f"MBAP length field {length}, expected {1 + size}")
-        total = _MBAP + size
-        if len(buf) >= total:
-            _check_pdu(request, buf[_MBAP:total])
-        return total
+        return _tcp_need(request, unit, tid, buf)
+    return _rtu_need(request, unit, buf)
+
+
+def _tcp_need(request: Request, unit: int, tid: int, buf: bytes) -> int:
+    """:func:`frame_need` of a Modbus TCP answer: the MBAP header, then the PDU."""
+    if len(buf) < _MBAP + 1:
+        return _MBAP + 1
+    length = _check_mbap(buf, unit, tid)
+    size = _answer_pdu_size(request, buf, _MBAP)
+    if size is None:
+        return _MBAP + 2
+    if length != 1 + size:
+        raise _bad("length", 1 + size, length, f"MBAP length field {length}, expected {1 + size}")
+    total = _MBAP + size
+    if len(buf) >= total:
+        _check_pdu(request, buf[_MBAP:total])
+    return total
+
+
+def _check_mbap(buf: bytes, unit: int, tid: int) -> int:
+    """The MBAP header names this request's answer (transaction id, protocol id, unit id); its
+    length field, checked by the caller once the PDU's size is known."""
+    got_tid, protocol, length, got_unit = struct.unpack_from(">HHHB", buf)
+    if got_tid != tid:
+        raise _bad(
+            "transaction id",
+            tid,
+            got_tid,
+            f"transaction id {got_tid}, expected {tid} (an answer to another request)",
+        )
+    if protocol != 0:
+        raise _bad("protocol id", 0, protocol, f"MBAP protocol id {protocol}, expected 0")
+    if got_unit != unit:
+        raise _bad("unit id", unit, got_unit, f"unit id {got_unit}, expected {unit}")
+    return int(length)
+
+
+def _rtu_need(request: Request, unit: int, buf: bytes) -> int:
+    """:func:`frame_need` of a Modbus RTU answer: unit id, PDU, CRC."""
     if len(buf) < 2:
         return 2
     if buf[0] != unit:

@@ -26,6 +26,7 @@ from app.link.foreign import audit_sighting
 from app.link.host import WorkerHost
 from app.link.types import Operation
 from app.models import ControllerStatus, Pose
+from app.safety.envelope import EnvelopeViolation
 
 __all__ = ["JOG_POLL_HZ_MIN", "Poller"]
 
@@ -35,6 +36,17 @@ __all__ = ["JOG_POLL_HZ_MIN", "Poller"]
 JOG_POLL_HZ_MIN = 10.0
 
 _log = logging.getLogger(__name__)
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class _Reading:
+    """What one poll read (see :meth:`Poller._read`)."""
+
+    status: ControllerStatus
+    pose: Pose
+    guard_stop: EnvelopeViolation | None  # the jog guard's stop (ratio 0 before a boundary)
+    canary: float | None  # the restart canary, read on the slow clock
+    read_time: float  # s: the two reads' time on the wire, for the RTT
 
 
 class Poller:
@@ -92,80 +104,102 @@ class Poller:
             self._host.publish_polled(new_pose, new_status, new_alarms, good_at)
 
     def poll_once(self) -> None:
-        host = self._host
-        client = host.client
+        client = self._host.client
         if client is None:
             return
         now = time.monotonic()
         self.last_poll = now
         with_clock = now >= self._next_clock
-        timeout = client.settings.effective_poll_timeout
-        canary: float | None = None
         try:
-            if host.supervisor.answering:
-                host.jog.settle_halt()  # a stop the controller has not confirmed: again, first
-            t0 = time.perf_counter()
-            status = client.read_status(with_clock=with_clock, timeout=timeout)
-            t1 = time.perf_counter()
-            host.run_urgent()  # a stop goes out between the two reads
-            if not host.link_up:
-                return
-            t2 = time.perf_counter()
-            pose = client.read_pose(timeout=timeout)
-            t3 = time.perf_counter()
-            guard_stop = host.jog.guard_pose(pose, t2, t3)  # ratio 0 before the TCP crosses a boundary
-            host.jog.halt_pose(pose)  # a jog's stop is over once answered and the pose is still
-            host.run_urgent()  # and before this poll's publishing: a stop waits one read at most
-            if not host.link_up:
-                return
-            gv = host.supervisor.canary_gv
-            if with_clock and host.supervisor.canary_token is not None and gv is not None:
-                canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock
-        except ResponseTimeout as exc:
-            self._report_error(exc)
-            self._command_unread(exc)
-            host.supervisor.poll_silent(exc, time.monotonic())
-            self._report_stats()
+            reading = self._read(client, with_clock)
+        except TeachPadError as exc:
+            self._poll_failed(exc)
             return
-        except (LinkError, MalformedResponse) as exc:
+        if reading is not None:
+            self._poll_answered(client, reading, now, with_clock)
+
+    def _read(self, client: RobotClient, with_clock: bool) -> _Reading | None:
+        """The poll's reads, status first, then pose, the urgent jobs run between them and after
+        them (None: the link went down meanwhile), and the canary on the slow clock."""
+        host = self._host
+        timeout = client.settings.effective_poll_timeout
+        if host.supervisor.answering:
+            host.jog.settle_halt()  # a stop the controller has not confirmed: again, first
+        t0 = time.perf_counter()
+        status = client.read_status(with_clock=with_clock, timeout=timeout)
+        t1 = time.perf_counter()
+        host.run_urgent()  # a stop goes out between the two reads
+        if not host.link_up:
+            return None
+        t2 = time.perf_counter()
+        pose = client.read_pose(timeout=timeout)
+        t3 = time.perf_counter()
+        guard_stop = host.jog.guard_pose(pose, t2, t3)  # ratio 0 before the TCP crosses a boundary
+        host.jog.halt_pose(pose)  # a jog's stop is over once answered and the pose is still
+        host.run_urgent()  # and before this poll's publishing: a stop waits one read at most
+        if not host.link_up:
+            return None
+        canary: float | None = None
+        gv = host.supervisor.canary_gv
+        if with_clock and host.supervisor.canary_token is not None and gv is not None:
+            canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock
+        return _Reading(status, pose, guard_stop, canary, (t1 - t0) + (t3 - t2))
+
+    def _poll_failed(self, exc: TeachPadError) -> None:
+        """A failed poll: reported once per distinct error, the command in flight told; silence
+        and a failed transaction go to the supervisor."""
+        host = self._host
+        self._report_error(exc)
+        self._command_unread(exc)
+        if isinstance(exc, ResponseTimeout):
+            host.supervisor.poll_silent(exc, time.monotonic())
+        elif isinstance(exc, (LinkError, MalformedResponse)):
             # A malformed answer is a failed poll: the transport counted it and resynchronised
             # (a TCP link is reopened by the next request); none of its values are published;
             # LINK_LOSS_POLLS of them in a row take the link down like any failed transaction.
-            self._report_error(exc)
-            self._command_unread(exc)
             host.supervisor.transport_failed(exc)
-            self._report_stats()
+        else:
             return
-        except TeachPadError as exc:
-            self._report_error(exc)
-            self._command_unread(exc)
-            return
+        self._report_stats()
+
+    def _poll_answered(self, client: RobotClient, reading: _Reading, now: float, with_clock: bool) -> None:
+        """A good poll: published, then the canary, another master's signs, the command in
+        flight, the jog, the RTT and the link statistics."""
+        host = self._host
         answered = time.monotonic()
         self._error = None
         self._unread_since = None
         host.supervisor.poll_answered()
         if not host.link_up:
             return
-        if guard_stop is not None:
-            host.publish_guard_stop(guard_stop)
+        if reading.guard_stop is not None:
+            host.publish_guard_stop(reading.guard_stop)
+        status, pose = self._clocked(client, reading.status, now, with_clock), reading.pose
+        self.publish(pose, status, good_at=answered)
+        if reading.canary is not None:
+            host.supervisor.canary_read(reading.canary)
+        self._report_foreign(client)
+        done = host.motion.update(status, pose, answered)
+        if done is not None:
+            host.emit_result(*done)
+        host.jog.after_status(status, answered, idle=host.motion.active is None)
+        rtt = self.rtt.note(reading.read_time, 2, answered)
+        if rtt is not None:
+            host.publish_rtt(rtt)
+        self._report_stats()
+
+    def _clocked(
+        self, client: RobotClient, status: ControllerStatus, now: float, with_clock: bool
+    ) -> ControllerStatus:
+        """The status with the controller's clock: read on the slow clock (and noted by the
+        audit), else the last one read."""
         if with_clock:
             self._next_clock = now + timing.CLOCK_POLL_PERIOD
             if client.audit is not None and status.clock is not None:
                 client.audit.note_controller_clock(status.clock.value, now)
         elif self.last_status is not None:
             status = dataclasses.replace(status, clock=self.last_status.clock)
-        self.publish(pose, status, good_at=answered)
-        if canary is not None:
-            host.supervisor.canary_read(canary)
-        self._report_foreign(client)
-        done = host.motion.update(status, pose, answered)
-        if done is not None:
-            host.emit_result(*done)
-        host.jog.after_status(status, answered, idle=host.motion.active is None)
-        rtt = self.rtt.note((t1 - t0) + (t3 - t2), 2, answered)
-        if rtt is not None:
-            host.publish_rtt(rtt)
-        self._report_stats()
+        return status
 
     def _command_unread(self, exc: TeachPadError) -> None:
         """A poll failed while a command is followed: its outcome is not told by it. The polls go

@@ -241,66 +241,104 @@ class CommandTracker:
         """Take one status read; return the result once the command has ended."""
         if self.result is not None:
             return self.result
-        self.reads += 1
-        self._sent.append(min(self._read_at, now))  # an unplanned read (a poll): its answer's time
-        self._read_at = math.inf
-        self.last_status = status
-        code = status.command_status_code
+        code = self._note_read(status, now)
         if status.alarms:
             if self.before.alarms and code == self.pre_code and now - self.started < self.ack_timeout:
                 return None  # sent during the alarm: the controller's own refusal code is on its way
             return self._alarm(status, code, now)
-        if code != self.pre_code:
-            if not self.code_left_pre:
-                self._ack_read = self.reads
-                self._ack_sent = self._sent[-1]
-            self.code_left_pre = True
+        self._note_code(code)
         progressed = self._note_motion(status, pose)
         if not self.acknowledged and (self.code_left_pre or self.motion_seen):
             self.acknowledged = True
             self.ack_time = now
         if self.acknowledged:
-            decoded = self.decode(code)
-            # A terminal code counts only once GV291 has left the stale pre-command value.
-            if self.code_left_pre and decoded.is_done:
-                return self._finish(
-                    True,
-                    decoded,
-                    f"{self.text}: {decoded.text}",
-                    now,
-                    reason=Reason("done", self._args(status=code)),
-                )
-            if self.code_left_pre and decoded.is_error:
-                err = CommandRefused(
-                    decoded, f"{self.text} refused: {decoded.text} (status {code})", params=self._args()
-                )
-                return self._fail(err, code, now)
-            stopped = self._check_stopped(status, code, now)
-            if stopped is not None:
-                return stopped
-            at_target = self._at_target(pose)
-            if self._moved_without_status(status, progressed, now, at_target=at_target):
-                if at_target:
-                    done = self.decode(STATUS_DONE)
-                    return self._finish(
-                        True,
-                        done,
-                        f"{self.text}: {done.text} (arrived at the point; the command status did not change)",
-                        now,
-                        reason=Reason("done", self._args(status=STATUS_DONE)),
-                    )
-                text = self.decode(self.pre_code).text
-                return self._fail(
-                    CommandTimeout(
-                        f"{self.text}: the arm moved and stopped, but the command status stayed "
-                        f"{self.pre_code} '{text}' from before the command; the result is unknown",
-                        code="result_unknown",
-                        params=self._args(status=self.pre_code),
-                    ),
-                    code,
-                    now,
-                )
-        elif self._teach_mode_changed(status):
+            result = self._judge_acknowledged(status, pose, code, progressed, now)
+        else:
+            result = self._judge_unacknowledged(status, code, now)
+        if result is not None:
+            return result
+        return self._check_deadline(code, progressed, now)
+
+    def _note_read(self, status: ControllerStatus, now: float) -> int:
+        """Count the read and keep its status; GV291's code in it."""
+        self.reads += 1
+        self._sent.append(min(self._read_at, now))  # an unplanned read (a poll): its answer's time
+        self._read_at = math.inf
+        self.last_status = status
+        return status.command_status_code
+
+    def _note_code(self, code: int) -> None:
+        """GV291 left the pre-command code (the first read that shows it is what the pacer learns from)."""
+        if code != self.pre_code:
+            if not self.code_left_pre:
+                self._ack_read = self.reads
+                self._ack_sent = self._sent[-1]
+            self.code_left_pre = True
+
+    def _judge_acknowledged(
+        self, status: ControllerStatus, pose: Pose | None, code: int, progressed: bool, now: float
+    ) -> CommandResult | None:
+        """The command was taken: what the status word says, then a stop, then what the pose says."""
+        said = self._judge_status_word(code, now)
+        if said is not None:
+            return said
+        stopped = self._check_stopped(status, code, now)
+        if stopped is not None:
+            return stopped
+        return self._judge_motion(status, pose, code, progressed, now)
+
+    def _judge_status_word(self, code: int, now: float) -> CommandResult | None:
+        """A terminal code (done or refused) ends the command, but only once GV291 has left the
+        stale pre-command value."""
+        decoded = self.decode(code)
+        if self.code_left_pre and decoded.is_done:
+            return self._finish(
+                True,
+                decoded,
+                f"{self.text}: {decoded.text}",
+                now,
+                reason=Reason("done", self._args(status=code)),
+            )
+        if self.code_left_pre and decoded.is_error:
+            err = CommandRefused(
+                decoded, f"{self.text} refused: {decoded.text} (status {code})", params=self._args()
+            )
+            return self._fail(err, code, now)
+        return None
+
+    def _judge_motion(
+        self, status: ControllerStatus, pose: Pose | None, code: int, progressed: bool, now: float
+    ) -> CommandResult | None:
+        """A move that moved and stopped while GV291 kept its stale code: done when the arm is at
+        the target, else the result is unknown (never a success)."""
+        at_target = self._at_target(pose)
+        if not self._moved_without_status(status, progressed, now, at_target=at_target):
+            return None
+        if at_target:
+            done = self.decode(STATUS_DONE)
+            return self._finish(
+                True,
+                done,
+                f"{self.text}: {done.text} (arrived at the point; the command status did not change)",
+                now,
+                reason=Reason("done", self._args(status=STATUS_DONE)),
+            )
+        text = self.decode(self.pre_code).text
+        return self._fail(
+            CommandTimeout(
+                f"{self.text}: the arm moved and stopped, but the command status stayed "
+                f"{self.pre_code} '{text}' from before the command; the result is unknown",
+                code="result_unknown",
+                params=self._args(status=self.pre_code),
+            ),
+            code,
+            now,
+        )
+
+    def _judge_unacknowledged(self, status: ControllerStatus, code: int, now: float) -> CommandResult | None:
+        """Not taken yet: proven by the controller mode (teach enable/disable), unconfirmed
+        (observe rule), or not acknowledged in time."""
+        if self._teach_mode_changed(status):
             decoded = self.decode(STATUS_DONE)
             return self._finish(
                 True,
@@ -310,13 +348,13 @@ class CommandTracker:
                 now,
                 reason=Reason("done_by_mode", self._args(mode=int(status.mode))),
             )
-        elif (
+        if (
             self.unconfirmed_after is not None
             and now - self.started >= self.unconfirmed_after
             and (self.decode(code).is_done or self.decode(code).is_error)
         ):
             return self._unconfirmed(code, now)
-        elif now - self.started >= self.ack_timeout:
+        if now - self.started >= self.ack_timeout:
             text = self.decode(self.pre_code).text
             return self._fail(
                 CommandTimeout(
@@ -328,6 +366,10 @@ class CommandTracker:
                 code,
                 now,
             )
+        return None
+
+    def _check_deadline(self, code: int, progressed: bool, now: float) -> CommandResult | None:
+        """The command's own time: a move making progress (no explicit timeout) moves it on."""
         if progressed and self.hard_timeout is None:
             self._deadline = now + self._budget
         if now >= self._deadline:

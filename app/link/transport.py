@@ -335,17 +335,24 @@ class Transport:
         return LinkError(message, params={"endpoint": self.settings.endpoint})
 
     def _exchange(self, what: str, request: Request, timeout: float) -> tuple[int, bytes]:
+        """One request and its checked answer: send it, wait for the answer (late answers to
+        earlier requests dropped on the way), judge it."""
+        tid = self._send(what, request)
+        buf = self._receive(what, request, tid, timeout)
+        return self._judge(what, buf)
+
+    def _send(self, what: str, request: Request) -> int:
+        """Send ``request`` on an open link with nothing stray waiting; its transaction id (RTU: 0)."""
         stream = self._stream
         if not stream.is_open:
             self.open()
         self._flush_stray()
-        unit = self.settings.unit
         framing = self.framing
         self._tid = tid = self._tid % 65000 + 1 if framing == "tcp" else 0
         if self._tid_sent:  # (TCP) the transaction ids of this connection's earlier requests
             self._earlier_tids.append(self._tid_sent)
         self._tid_sent = tid
-        frame = self._encode_request(framing, request, unit, tid)
+        frame = self._encode_request(framing, request, self.settings.unit, tid)
         self._counts["requests"] += 1
         try:
             stream.send(frame)
@@ -353,9 +360,15 @@ class Transport:
             raise self._lost(what) from None
         if self._observing:
             self._emit("tx", frame)
+        return tid
+
+    def _receive(self, what: str, request: Request, tid: int, timeout: float) -> bytes:
+        """The whole answer to the request sent with ``tid``, every field checked as it arrives
+        (:meth:`_need`, which drops late answers first); a malformed one is reported
+        (:meth:`_malformed`), silence raises :class:`ResponseTimeout`."""
         buf = b""
         need = 0  # nothing received yet: no field to check, receive first
-        own = tid.to_bytes(2, "big") if framing == "tcp" else b""
+        own = tid.to_bytes(2, "big") if self.framing == "tcp" else b""
         deadline = time.monotonic() + timeout
         try:
             while True:
@@ -363,31 +376,7 @@ class Transport:
                     buf, need = self._need(request, tid, own, buf)
                     if len(buf) >= need > 0:
                         break
-                remaining = deadline - time.monotonic()
-                if remaining <= 0:
-                    if not buf:
-                        self._count("timeouts", f"no answer to the {what}")
-                        self._resync("a timeout")
-                        raise ResponseTimeout(f"no answer to the {what}")
-                    raise MalformedResponse(
-                        f"answer cut short: {len(buf)} of {need} bytes within {_seconds(timeout)} s",
-                        field="length",
-                        expected=need,
-                        got=len(buf),
-                    )
-                try:
-                    buf += stream.recv(remaining)
-                except self._peer_closed:
-                    if not buf:
-                        raise self._lost(what) from None
-                    raise MalformedResponse(
-                        f"answer cut short: the controller closed the link after {len(buf)} of {need} bytes",
-                        field="length",
-                        expected=need,
-                        got=len(buf),
-                    ) from None
-                except OSError:
-                    raise self._lost(what) from None
+                buf += self._more(what, buf, need, deadline, timeout)
             if len(buf) > need:
                 raise MalformedResponse(
                     f"{len(buf) - need} bytes more than the {need}-byte answer",
@@ -396,17 +385,55 @@ class Transport:
                     got=len(buf),
                 )
         except MalformedResponse as exc:
-            if self._observing and buf:
-                self._emit("rx", buf)
-            message = f"malformed answer to the {what} from {self.settings.endpoint}: {str(exc)[:200]}"
-            self._count("malformed", message)
-            self._resync("a malformed answer")
-            error = MalformedResponse(message, field=exc.field, expected=exc.expected, got=exc.got)
-            error.params["endpoint"] = self.settings.endpoint
-            raise error from None
+            raise self._malformed(what, exc, buf) from None
+        return buf
+
+    def _more(self, what: str, buf: bytes, need: int, deadline: float, timeout: float) -> bytes:
+        """The next bytes of the answer (``buf`` so far, ``need`` its length so far known) before
+        ``deadline``: silence is a timeout, an answer begun and not finished is cut short."""
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            if not buf:
+                self._count("timeouts", f"no answer to the {what}")
+                self._resync("a timeout")
+                raise ResponseTimeout(f"no answer to the {what}")
+            raise MalformedResponse(
+                f"answer cut short: {len(buf)} of {need} bytes within {_seconds(timeout)} s",
+                field="length",
+                expected=need,
+                got=len(buf),
+            )
+        try:
+            return self._stream.recv(remaining)
+        except self._peer_closed:
+            if not buf:
+                raise self._lost(what) from None
+            raise MalformedResponse(
+                f"answer cut short: the controller closed the link after {len(buf)} of {need} bytes",
+                field="length",
+                expected=need,
+                got=len(buf),
+            ) from None
+        except OSError:
+            raise self._lost(what) from None
+
+    def _malformed(self, what: str, exc: MalformedResponse, buf: bytes) -> MalformedResponse:
+        """A malformed answer (``buf``: what arrived of it), counted, the link resynchronised:
+        the error to raise, naming the request and the endpoint."""
+        if self._observing and buf:
+            self._emit("rx", buf)
+        message = f"malformed answer to the {what} from {self.settings.endpoint}: {str(exc)[:200]}"
+        self._count("malformed", message)
+        self._resync("a malformed answer")
+        error = MalformedResponse(message, field=exc.field, expected=exc.expected, got=exc.got)
+        error.params["endpoint"] = self.settings.endpoint
+        return error
+
+    def _judge(self, what: str, buf: bytes) -> tuple[int, bytes]:
+        """A whole, checked answer: its (function code, data), or the controller's refusal raised."""
         if self._observing:
             self._emit("rx", buf)
-        function, data = self._decode_answer(framing, buf)
+        function, data = self._decode_answer(self.framing, buf)
         if function & 0x80:
             refused = self._exception(what, function & 0x7F, data[0])
             self._count("exceptions", str(refused))

@@ -28,6 +28,7 @@ words and counted as refused or failed; the next chunk goes on with the next poi
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -149,6 +150,30 @@ def check_upload_items(client: RobotClient, raw: Sequence[RawItem]) -> list[Uplo
     return items
 
 
+def _chunk_end(items: Sequence[UploadItem], first: int) -> int:
+    """Where the chunk that begins at ``first`` ends: at most :data:`app.timing.UPLOAD_CHUNK_POINTS`
+    points, all of one tool."""
+    tool = items[first][2]
+    last = first
+    while last < len(items) and last - first < timing.UPLOAD_CHUNK_POINTS and items[last][2] == tool:
+        last += 1
+    return last
+
+
+def _count_failure(upload: UploadRun, result: CommandResult) -> None:
+    """A point that failed on a sound link: the next chunk goes on with the next point in a
+    fresh call (its pose written anew, whatever was staged before). Refused only when the
+    controller said no (a refused status, a Modbus exception, which ended the batch there); a
+    point whose result never showed (no acknowledgement, a timeout, an alarm) failed, its words
+    say how."""
+    code = result.reason.code if result.reason is not None else ""
+    if code in REFUSAL_CODES:
+        upload.refused += 1
+    else:
+        upload.failed += 1
+    upload.first_failure = upload.first_failure or result.message
+
+
 class Uploader:
     """The running upload (one at a time)."""
 
@@ -210,42 +235,37 @@ class Uploader:
         host = self._host
         client = host.client_or_raise()
         start = time.monotonic()
-        items = upload.items
         first = upload.index
-        tool = items[first][2]
-        last = first
-        while last < len(items) and last - first < timing.UPLOAD_CHUNK_POINTS and items[last][2] == tool:
-            last += 1
+        last = _chunk_end(upload.items, first)
+        results, transport_error = self._send_chunk(client, upload, upload.items[first:last], start)
+        transport_error = self._tally(upload, first, results, transport_error)
+        if transport_error is not None:
+            upload.end = upload.end or transport_error
+            if host.link_up:  # a link already lost or closed (an urgent job meanwhile) counts no more
+                host.supervisor.transport_failed(transport_error)
+        self._note_progress(upload)
 
-        def progress(done: int, total: int) -> bool:
-            host.run_urgent()  # stop / pause / cancel / jog release between two points
-            if upload.end is not None or not host.link_up or host.closed:
-                return False
-            host.poll_if_due()
-            return host.link_up and time.monotonic() - start < timing.UPLOAD_CHUNK_SECONDS
-
-        def halted() -> bool:  # a stop or cancel on its way: no staging write, no next point
-            return self._halted(upload)
-
-        def between() -> None:  # between two reads of the point in flight (see the module docstring)
-            host.run_urgent()  # a stop's main-link 441 ends the point in flight as stopped
-            if not host.link_up or host.closed:  # lost or closed by an urgent job: no more reads
-                raise LinkError("the link went down while a point was in flight; its outcome is unknown")
-
+    def _send_chunk(
+        self, client: RobotClient, upload: UploadRun, items: Sequence[UploadItem], start: float
+    ) -> tuple[list[CommandResult], str | None]:
+        """One call of ``upload_points`` for ``items`` (one tool), under the upload's request id:
+        its results, and the link's failure before the first point (None: none)."""
+        host = self._host
+        tool = items[0][2]
         transport_error: str | None = None
         self._busy = True
         outer_id, host.request_id = host.request_id, upload.request_id
         try:
-            chunk = [(pid, pose) for pid, pose, _ in items[first:last]]
+            chunk = [(pid, pose) for pid, pose, _ in items]
             stage_gv = stage_gv_for(host.supervisor.canary_gv)
             results = client.upload_points(
                 chunk,
                 tool,
-                progress,
+                functools.partial(self._between_points, upload, start),
                 gv_start=UPLOAD_POSE_GV,
                 stage_gv=stage_gv,
-                halted=halted,
-                between=between,
+                halted=functools.partial(self._halted, upload),  # no staging write, no next point
+                between=self._between_reads,
             )
         except (LinkError, ResponseTimeout) as exc:  # before the first point (status read, mode)
             results, transport_error = [], str(exc)
@@ -257,32 +277,44 @@ class Uploader:
         finally:
             self._busy = False
             host.request_id = outer_id
-        for (point_id, _, _), result in zip(items[first:], results, strict=False):
+        return results, transport_error
+
+    def _between_points(self, upload: UploadRun, start: float, done: int, total: int) -> bool:
+        """``upload_points``'s progress: the urgent jobs and a due poll run between two points;
+        False ends the chunk (the upload ended, the link is down, or the chunk's time is up)."""
+        host = self._host
+        host.run_urgent()  # stop / pause / cancel / jog release between two points
+        if upload.end is not None or not host.link_up or host.closed:
+            return False
+        host.poll_if_due()
+        return host.link_up and time.monotonic() - start < timing.UPLOAD_CHUNK_SECONDS
+
+    def _between_reads(self) -> None:
+        """Between two reads of the point in flight (see the module docstring)."""
+        host = self._host
+        host.run_urgent()  # a stop's main-link 441 ends the point in flight as stopped
+        if not host.link_up or host.closed:  # lost or closed by an urgent job: no more reads
+            raise LinkError("the link went down while a point was in flight; its outcome is unknown")
+
+    def _tally(
+        self, upload: UploadRun, first: int, results: list[CommandResult], transport_error: str | None
+    ) -> str | None:
+        """Each point's result (the chunk began at ``first``) published and counted (good,
+        refused, failed); ``transport_error``, or the words of the last point whose link failed
+        (its outcome unknown)."""
+        host = self._host
+        for (point_id, _, _), result in zip(upload.items[first:], results, strict=False):
             upload.index += 1
             if result.ok:
                 upload.good += 1
                 host.publish_point_uploaded(point_id, True, "", result.unconfirmed)
-            else:
-                host.publish_point_uploaded(point_id, False, result.message or "failed")
-                if result.link_failed:  # its outcome is unknown, the link not to be trusted
-                    transport_error = result.message
-                elif not result.stopped_by_operator:
-                    # the link is fine: the next chunk goes on with the next point in a fresh call
-                    # (its pose written anew, whatever was staged before). Refused only when the
-                    # controller said no (a refused status, a Modbus exception, which ended the batch
-                    # there); a point whose result never showed (no acknowledgement, a timeout, an
-                    # alarm) failed, its words say how
-                    code = result.reason.code if result.reason is not None else ""
-                    if code in REFUSAL_CODES:
-                        upload.refused += 1
-                    else:
-                        upload.failed += 1
-                    upload.first_failure = upload.first_failure or result.message
-        if transport_error is not None:
-            upload.end = upload.end or transport_error
-            if host.link_up:  # a link already lost or closed (an urgent job meanwhile) counts no more
-                host.supervisor.transport_failed(transport_error)
-        self._note_progress(upload)
+                continue
+            host.publish_point_uploaded(point_id, False, result.message or "failed")
+            if result.link_failed:  # its outcome is unknown, the link not to be trusted
+                transport_error = result.message
+            elif not result.stopped_by_operator:
+                _count_failure(upload, result)
+        return transport_error
 
     def _halted(self, upload: UploadRun) -> bool:
         """Ending, or a stop or cancel asked for since it began (its job may not have run yet)."""

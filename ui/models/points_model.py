@@ -189,28 +189,11 @@ class PointsModel(UndoableListModel):
         column = index.column()
         if not 0 <= column < len(COLUMNS):
             return None
-        name = COLUMNS[column]
-        if role == Qt.ItemDataRole.DisplayRole:
-            return self._display(point, name)
-        if role == Qt.ItemDataRole.EditRole:
-            return self._edit_value(point, name)
-        if role == Qt.ItemDataRole.ToolTipRole:
-            return self._tooltip(point, name)
-        if role == Qt.ItemDataRole.TextAlignmentRole:
-            if column in NUMBER_COLUMNS:
-                return int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
-            return int(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
-        if role == Qt.ItemDataRole.ForegroundRole and column == COL_SYNC:
-            return self._sync_brushes(point.sync)[0]
-        if role == Qt.ItemDataRole.BackgroundRole and column == COL_SYNC:
-            return self._sync_brushes(point.sync)[1]
-        if role == POINT_ID_ROLE:
-            return point.id
-        if role == SYNC_ROLE:
-            return point.sync
-        return None
+        by_role = _DATA_BY_ROLE.get(role)
+        return None if by_role is None else by_role(self, point, column)
 
-    def _display(self, point: TempPoint, name: str) -> str:
+    def _display(self, point: TempPoint, column: int) -> str:
+        name = COLUMNS[column]
         if name in ("id",):
             return str(point.id)
         if name in ("name", "note"):
@@ -222,7 +205,8 @@ class PointsModel(UndoableListModel):
         value = point.get(name)
         return format_number(float(value), name) if isinstance(value, float | int) else str(value)
 
-    def _edit_value(self, point: TempPoint, name: str) -> str:
+    def _edit_value(self, point: TempPoint, column: int) -> str:
+        name = COLUMNS[column]
         if name == "sync":
             return point.sync.value
         value = point.get(name)
@@ -230,7 +214,8 @@ class PointsModel(UndoableListModel):
             return edit_text(value, name)
         return str(value)
 
-    def _tooltip(self, point: TempPoint, name: str) -> str | None:
+    def _tooltip(self, point: TempPoint, column: int) -> str | None:
+        name = COLUMNS[column]
         if name == "sync":
             if point.sync is SyncState.FAILED:
                 reason = point.sync_error or self.tr("no reason given")
@@ -254,6 +239,23 @@ class PointsModel(UndoableListModel):
         if name == "tool":
             return self.tr("Tool frame {value}").format(value=point.tool)
         return None
+
+    def _alignment(self, _point: TempPoint, column: int) -> int:
+        if column in NUMBER_COLUMNS:
+            return int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+        return int(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
+
+    def _sync_foreground(self, point: TempPoint, column: int) -> QBrush | None:
+        return self._sync_brushes(point.sync)[0] if column == COL_SYNC else None
+
+    def _sync_background(self, point: TempPoint, column: int) -> QBrush | None:
+        return self._sync_brushes(point.sync)[1] if column == COL_SYNC else None
+
+    def _point_id(self, point: TempPoint, _column: int) -> int:
+        return point.id
+
+    def _sync_state(self, point: TempPoint, _column: int) -> SyncState:
+        return point.sync
 
     def flags(self, index: ModelIndex) -> Qt.ItemFlag:
         if not index.isValid():
@@ -501,3 +503,16 @@ class PointsModel(UndoableListModel):
         self.ledger.replace_all([self.settle(p) for p in points])
         self.endResetModel()
         self._after_change(self.ledger)
+
+
+# what data() answers for each role: the cell's point and column in, the value out
+_DATA_BY_ROLE: dict[int, Callable[[PointsModel, TempPoint, int], Any]] = {
+    Qt.ItemDataRole.DisplayRole: PointsModel._display,
+    Qt.ItemDataRole.EditRole: PointsModel._edit_value,
+    Qt.ItemDataRole.ToolTipRole: PointsModel._tooltip,
+    Qt.ItemDataRole.TextAlignmentRole: PointsModel._alignment,
+    Qt.ItemDataRole.ForegroundRole: PointsModel._sync_foreground,
+    Qt.ItemDataRole.BackgroundRole: PointsModel._sync_background,
+    POINT_ID_ROLE: PointsModel._point_id,
+    SYNC_ROLE: PointsModel._sync_state,
+}

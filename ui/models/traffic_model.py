@@ -13,7 +13,7 @@ needed and the text is kept with the stored row, so 100 Hz traffic does not stal
 from __future__ import annotations
 
 from collections import OrderedDict
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
 from PySide6.QtCore import (
@@ -24,7 +24,7 @@ from PySide6.QtCore import (
     QSortFilterProxyModel,
     Qt,
 )
-from PySide6.QtGui import QBrush, QColor
+from PySide6.QtGui import QBrush, QColor, QFont
 
 from app.protocol import registers as regs
 from app.protocol.codec import WordOrder
@@ -64,7 +64,6 @@ _DISPLAY = Qt.ItemDataRole.DisplayRole.value
 _FOREGROUND = Qt.ItemDataRole.ForegroundRole.value
 _FONT = Qt.ItemDataRole.FontRole.value
 _TOOLTIP = Qt.ItemDataRole.ToolTipRole.value
-_USED_ROLES = frozenset({_DISPLAY, _FOREGROUND, _FONT, _TOOLTIP})
 
 
 class TrafficModel(QAbstractTableModel):
@@ -168,43 +167,54 @@ class TrafficModel(QAbstractTableModel):
         return records[len(records) - keep :] if keep < len(records) else records
 
     def _add(self, record: Any) -> None:
-        store = self._store
         frame = bytes(record.frame)
         rtu = record.transport == "rtu"
         offset = 1 if rtu else MBAP_SIZE  # where the PDU starts
         fc = frame[offset] if len(frame) > offset else None
         flags = RTU if rtu else 0
         if record.direction != "rx":
-            if fc == FunctionCode.READ_HOLDING_REGISTERS and len(frame) >= offset + 5:
-                address = int.from_bytes(frame[offset + 1 : offset + 3], "big")
-                count = int.from_bytes(frame[offset + 3 : offset + 5], "big")
-                if is_poll_read(address, count):
-                    flags |= POLL
-            elif fc == FunctionCode.WRITE_SINGLE_REGISTER and len(frame) >= offset + 5:
-                address = int.from_bytes(frame[offset + 1 : offset + 3], "big")
-                if address == regs.REG_RUN_COMMAND:
-                    self._note_command(int.from_bytes(frame[offset + 3 : offset + 5], "big"))
-            index = store.append(float(record.t), frame, flags, NO_ROW, self._command_value())
-            if not rtu and len(frame) >= 2:
-                tid = int.from_bytes(frame[:2], "big")
-                self._pending.pop(tid, None)
-                self._pending[tid] = index
-                while len(self._pending) > _MAX_PENDING:
-                    self._pending.popitem(last=False)
-            else:
-                self._last_request = index
-            return
-        # A response.
+            self._add_request(float(record.t), frame, rtu, offset, fc, flags)
+        else:
+            self._add_response(float(record.t), frame, rtu, offset, fc, flags)
+
+    def _add_request(
+        self, t: float, frame: bytes, rtu: bool, offset: int, fc: int | None, flags: int
+    ) -> None:
+        """A request: a poll marked, a run command noted, kept for pairing with its answer."""
+        flags |= self._peek_request(frame, offset, fc)
+        index = self._store.append(t, frame, flags, NO_ROW, self._command_value())
+        if not rtu and len(frame) >= 2:
+            tid = int.from_bytes(frame[:2], "big")
+            self._pending.pop(tid, None)
+            self._pending[tid] = index
+            while len(self._pending) > _MAX_PENDING:
+                self._pending.popitem(last=False)
+        else:
+            self._last_request = index
+
+    def _peek_request(self, frame: bytes, offset: int, fc: int | None) -> int:
+        """POLL for a poll's read (else 0); a write of the run command register is noted."""
+        if fc == FunctionCode.READ_HOLDING_REGISTERS and len(frame) >= offset + 5:
+            address = int.from_bytes(frame[offset + 1 : offset + 3], "big")
+            count = int.from_bytes(frame[offset + 3 : offset + 5], "big")
+            if is_poll_read(address, count):
+                return POLL
+        elif fc == FunctionCode.WRITE_SINGLE_REGISTER and len(frame) >= offset + 5:
+            address = int.from_bytes(frame[offset + 1 : offset + 3], "big")
+            if address == regs.REG_RUN_COMMAND:
+                self._note_command(int.from_bytes(frame[offset + 3 : offset + 5], "big"))
+        return 0
+
+    def _add_response(
+        self, t: float, frame: bytes, rtu: bool, offset: int, fc: int | None, flags: int
+    ) -> None:
+        """A response: paired with its request (same function), a poll's answer marked."""
+        store = self._store
         flags |= RX
         bad = fc is None or bool(fc & EXCEPTION_FLAG)
         if bad:
             flags |= BAD
-        request = NO_ROW
-        if not rtu:
-            if len(frame) >= 2:
-                request = self._pending.pop(int.from_bytes(frame[:2], "big"), NO_ROW)
-        else:
-            request, self._last_request = self._last_request, NO_ROW
+        request = self._request_answered(frame, rtu)
         paired = NO_ROW
         if request >= store.base and fc is not None:
             local = request - store.base
@@ -212,7 +222,17 @@ class TrafficModel(QAbstractTableModel):
                 paired = request
                 if store.flags(local) & POLL and not bad:
                     flags |= POLL
-        store.append(float(record.t), frame, flags, paired, self._command_value())
+        store.append(t, frame, flags, paired, self._command_value())
+
+    def _request_answered(self, frame: bytes, rtu: bool) -> int:
+        """The row of the request this response answers (NO_ROW: none known). TCP: by its
+        transaction id; RTU (half duplex): the last request."""
+        if rtu:
+            request, self._last_request = self._last_request, NO_ROW
+            return request
+        if len(frame) >= 2:
+            return self._pending.pop(int.from_bytes(frame[:2], "big"), NO_ROW)
+        return NO_ROW
 
     def _command_value(self) -> int:
         return NO_COMMAND if self._last_command is None else int(self._last_command)
@@ -329,30 +349,37 @@ class TrafficModel(QAbstractTableModel):
 
     def data(self, index: QModelIndex | QPersistentModelIndex, role: int = _DISPLAY) -> Any:
         # Called ~500 times per repaint: cheap role test first, plain int compares, cached texts.
-        if role not in _USED_ROLES or not index.isValid():
+        by_role = _DATA_BY_ROLE.get(role)
+        if by_role is None or not index.isValid():
             return None
         r, column = index.row(), index.column()
         store = self._store
         if not (0 <= r < len(store) and 0 <= column < _COLUMN_COUNT):
             return None
         row = self._views.get(store.base + r) or self._make_view(r)
-        if role == _DISPLAY:
-            if column == COL_MEANING:
-                return self._meaning_words(row._summary if row._summary is not None else self.summary(row))
-            if column == COL_BYTES:
-                return row.hex_display
-            if column == COL_TIME:
-                return row.time_display
-            return self._tx_text if row.direction == "tx" else self._rx_text
-        if role == _FOREGROUND:
-            if row.bad:  # exception response, or found malformed when decoded
-                return self._bad_brush
-            if column == COL_DIRECTION:
-                return self._tx_brush if row.direction == "tx" else self._rx_brush
-            return None
-        if role == _FONT:
-            return self._mono if column in (COL_TIME, COL_BYTES) else None
-        # Tooltip: rare, may decode again.
+        return by_role(self, row, column)
+
+    def _display(self, row: TrafficRow, column: int) -> str:
+        if column == COL_MEANING:
+            return self._meaning_words(row._summary if row._summary is not None else self.summary(row))
+        if column == COL_BYTES:
+            return row.hex_display
+        if column == COL_TIME:
+            return row.time_display
+        return self._tx_text if row.direction == "tx" else self._rx_text
+
+    def _foreground(self, row: TrafficRow, column: int) -> QBrush | None:
+        if row.bad:  # exception response, or found malformed when decoded
+            return self._bad_brush
+        if column == COL_DIRECTION:
+            return self._tx_brush if row.direction == "tx" else self._rx_brush
+        return None
+
+    def _font(self, _row: TrafficRow, column: int) -> QFont | None:
+        return self._mono if column in (COL_TIME, COL_BYTES) else None
+
+    def _tooltip(self, row: TrafficRow, column: int) -> str | None:
+        """Rare, may decode again."""
         if column == COL_BYTES:
             size = QCoreApplication.translate("TrafficModel", "{n} bytes").format(n=len(row.frame))
             return f"{size}\n{wrap_hex(row.hex)}"
@@ -372,6 +399,15 @@ class TrafficModel(QAbstractTableModel):
         if horizontal and role == Qt.ItemDataRole.DisplayRole and 0 <= section < _COLUMN_COUNT:
             return self._headers[section]
         return None
+
+
+# what data() answers for each role it answers (the others: None at once)
+_DATA_BY_ROLE: dict[int, Callable[[TrafficModel, TrafficRow, int], Any]] = {
+    _DISPLAY: TrafficModel._display,
+    _FOREGROUND: TrafficModel._foreground,
+    _FONT: TrafficModel._font,
+    _TOOLTIP: TrafficModel._tooltip,
+}
 
 
 class TrafficFilter(QSortFilterProxyModel):

@@ -29,7 +29,7 @@ from PySide6.QtCore import (
     Signal,
     Slot,
 )
-from PySide6.QtGui import QBrush, QColor
+from PySide6.QtGui import QBrush, QColor, QFont
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QComboBox,
@@ -197,26 +197,32 @@ class EventLogModel(QAbstractTableModel):
         r, column = index.row(), index.column()
         if not (0 <= r < len(self._events) and 0 <= column < _COLUMN_COUNT):
             return None
-        event = self._events[r]
-        if role == Qt.ItemDataRole.DisplayRole:
-            if column == COL_TIME:
-                return event.when.strftime("%H:%M:%S.") + f"{event.when.microsecond // 1000:03d}"
-            if column == COL_LEVEL:
-                return self.level_text(event.level)
-            if column == COL_SOURCE:
-                return event.source
+        by_role = _DATA_BY_ROLE.get(role)
+        return None if by_role is None else by_role(self, self._events[r], column)
+
+    def _display(self, event: LogEvent, column: int) -> str:
+        if column == COL_TIME:
+            return event.when.strftime("%H:%M:%S.") + f"{event.when.microsecond // 1000:03d}"
+        if column == COL_LEVEL:
+            return self.level_text(event.level)
+        if column == COL_SOURCE:
+            return event.source
+        return event.text
+
+    def _foreground(self, event: LogEvent, _column: int) -> QBrush | None:
+        return self._brushes()[0].get(event.level)
+
+    def _background(self, event: LogEvent, _column: int) -> QBrush | None:
+        return self._brushes()[1].get(event.level)
+
+    def _font(self, _event: LogEvent, column: int) -> QFont | None:
+        return self._mono if column == COL_TIME else None
+
+    def _tooltip(self, event: LogEvent, column: int) -> str | None:
+        if column == COL_TIME:
+            return event.when.isoformat(sep=" ", timespec="milliseconds")
+        if column == COL_MESSAGE:
             return event.text
-        if role == Qt.ItemDataRole.ForegroundRole:
-            return self._brushes()[0].get(event.level)
-        if role == Qt.ItemDataRole.BackgroundRole:
-            return self._brushes()[1].get(event.level)
-        if role == Qt.ItemDataRole.FontRole and column == COL_TIME:
-            return self._mono
-        if role == Qt.ItemDataRole.ToolTipRole:
-            if column == COL_TIME:
-                return event.when.isoformat(sep=" ", timespec="milliseconds")
-            if column == COL_MESSAGE:
-                return event.text
         return None
 
     def headerData(
@@ -226,6 +232,16 @@ class EventLogModel(QAbstractTableModel):
         if horizontal and role == Qt.ItemDataRole.DisplayRole and 0 <= section < _COLUMN_COUNT:
             return self._headers[section]
         return None
+
+
+# what data() answers for each role it answers: the row's event and the column in, the value out
+_DATA_BY_ROLE: dict[int, Callable[[EventLogModel, LogEvent, int], Any]] = {
+    Qt.ItemDataRole.DisplayRole: EventLogModel._display,
+    Qt.ItemDataRole.ForegroundRole: EventLogModel._foreground,
+    Qt.ItemDataRole.BackgroundRole: EventLogModel._background,
+    Qt.ItemDataRole.FontRole: EventLogModel._font,
+    Qt.ItemDataRole.ToolTipRole: EventLogModel._tooltip,
+}
 
 
 class _LevelFilter(QSortFilterProxyModel):
