@@ -31,7 +31,7 @@ if TYPE_CHECKING:
     import pyqtgraph as pg
 
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
-PLOT_MIN_HEIGHT = 80  # px: the planner's top row (segments, run box) needs the height at 1280×800
+PLOT_MIN_SIDE = 200  # px: each projection the planner shows is at least this wide and high
 MIN_LABEL_SPACING_PX = 44  # between two labelled ticks of the X axis: "-1200" and a gap
 
 FloatArray = NDArray[np.float64]
@@ -105,7 +105,7 @@ def style_plot(plot: pg.PlotWidget) -> None:
     plot.setMenuEnabled(False)
     plot.setAspectLocked(True)
     plot.getViewBox().setDefaultPadding(0.12)  # room for the point labels at the edges
-    plot.setMinimumSize(90, PLOT_MIN_HEIGHT)
+    plot.setMinimumSize(PLOT_MIN_SIDE, PLOT_MIN_SIDE)
 
 
 class Projection:
