@@ -48,8 +48,7 @@ from app.safety.envelope import Envelope
 from ui.joins import join_names
 from ui.palette import COLOR_INK_SOFT
 from ui.panels.plan_projection import MAX_LABELS as MAX_LABELS
-from ui.panels.plan_projection import PLOT_MIN_SIDE
-from ui.panels.plan_projection import FloatArray, Projection, style_plot
+from ui.panels.plan_projection import PLOT_MIN_SIDE, FloatArray, Projection, style_plot
 from ui.widgets.lines_label import LinesLabel
 
 LIVE_FPS = 30
@@ -103,7 +102,8 @@ class PlanPreview(QWidget):
         self._slot.setMinimumSize(PLOT_MIN_SIDE, PLOT_MIN_SIDE + QLabel().sizeHint().height())
         row.addWidget(self._slot, 1)
         self._compact = True
-        self._info = ("", "")  # (all the lines, the lines shown beside one projection)
+        # all the lines of the lengths / times, and the ones beside one projection (as many as fit)
+        self._info: tuple[str, list[str]] = ("", [])
         self.view_tabs = QTabBar(self)  # one projection at a time on a narrow preview
         self.view_tabs.setObjectName("PlanPreviewTabs")
         self.view_tabs.setDrawBase(False)
@@ -143,6 +143,7 @@ class PlanPreview(QWidget):
         layout.addLayout(row, 1)
         layout.addLayout(side)
         self._layout = layout
+        self._side = side
         self._fit_row = fit_row
         self._header = QHBoxLayout()  # the tabs and Fit on a narrow preview
         self._header.setContentsMargins(0, 0, 0, 0)
@@ -224,6 +225,8 @@ class PlanPreview(QWidget):
             self._compact = compact
             self._show_current()
         super().resizeEvent(event)
+        if compact:
+            self._show_info()  # as many lines as fit the new height
 
     @Slot()
     def _show_current(self, *_args: Any) -> None:
@@ -298,8 +301,9 @@ class PlanPreview(QWidget):
         """Points to mark (the plan's points), with labels (the first :data:`MAX_LABELS`)."""
         arr = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
         self._points = (arr, list(labels))
+        names = [*labels[: len(arr)], *[""] * (len(arr) - len(labels))]  # each point's hover tip
         for proj in self._projections.values():
-            proj.points.setData(arr[:, proj.h], arr[:, proj.v])
+            proj.points.setData(arr[:, proj.h], arr[:, proj.v], data=names)
             proj.set_labels(arr, list(labels))
 
     def set_start(self, xyz: Sequence[float] | FloatArray | None) -> None:
@@ -328,13 +332,32 @@ class PlanPreview(QWidget):
         self.reach_label.setVisible(bool(name))
 
     def set_info(self, text: str) -> None:
-        self._info = (text, text)
+        self._info = (text, [text] if text else [])
         self._show_info()
 
     def _show_info(self) -> None:
-        whole, short = self._info
-        self.info.setText(short if self._compact else whole)
-        self.info.setToolTip(whole if self._compact and short != whole else "")
+        """All the lines; beside one projection, the first lines that fit under it (whole lines:
+        nothing is cut mid-word), the rest in the tooltip."""
+        whole, lines = self._info
+        shown = whole
+        if self._compact:
+            room = self._info_room()
+            shown = ""
+            for n in range(len(lines), 0, -1):
+                candidate = "<br>".join(lines[:n])
+                self.info.setText(candidate)
+                if self.info.heightForWidth(max(self.info.width(), PLOT_MIN_SIDE)) <= room:
+                    shown = candidate
+                    break
+        self.info.setText(shown)
+        self.info.setToolTip(whole if shown != whole else "")
+        self.info.setVisible(bool(shown))  # an empty label would still take a line's height
+
+    def _info_room(self) -> int:
+        """Height left for the lengths / times under one projection of :data:`PLOT_MIN_SIDE` px."""
+        spacing = self._layout.spacing() + self._side.spacing() + 2
+        reach = self.reach_label.height() + self._side.spacing() if self.reach_label.isVisibleTo(self) else 0
+        return self.height() - self._header.sizeHint().height() - 2 - PLOT_MIN_SIDE - spacing - reach
 
     def show_plan(
         self, plan: Plan, ledger: PointLedger, start: Sequence[float] | None, selected: int | None
@@ -402,7 +425,7 @@ class PlanPreview(QWidget):
         )
         # beside one projection the plan's name (the segments' title) and the selected segment's
         # length and time (its row) are left to the tooltip: the totals and the start stay
-        self._info = ("<br>".join([name, *totals, *selected, start]), "<br>".join([*totals, start]))
+        self._info = ("<br>".join([name, *totals, *selected, start]), [*totals, start])
         self._show_info()
 
     def set_envelope(self, envelope: Envelope | None) -> None:

@@ -1,7 +1,8 @@
 """How the planner's boxes share its room, at 1280×800 as at 1920×1080.
 
 * The run strip (:class:`~ui.panels.planner_widgets.PlanRunBox`) spans the bottom at every size:
-  Run and Stop are always in the same place and never scroll.
+  Run and Stop are always in the same place and never scroll. Above it, as wide, the checks'
+  words (errors, points to upload) with Upload now and Check: read whole, before a run.
 * The plans list is a side pane on the left, shown when the panel is wide enough
   (:data:`PLANS_SHOWN_MIN_WIDTH`) and hidden on a narrow one; *Plans* (a toggle in the segments'
   row of buttons) shows or hides it, and from then on the operator's choice stays. The segments'
@@ -25,7 +26,7 @@ PREVIEW_COLUMN_WIDTH = 232  # px: the preview's share beside the segments in the
 
 
 class PlannerLayout(QWidget):
-    """The plans pane | (segments and preview) over the run strip (see the module docstring).
+    """The plans pane | (segments and preview) over the checks and the run strip (see the module docstring).
 
     Public: ``plans_action`` (checkable: the plans list shown), ``outer`` and ``work`` (the
     splitters), :meth:`wide` (the segments above the preview)."""
@@ -35,6 +36,7 @@ class PlannerLayout(QWidget):
         plans_box: QWidget,
         segments_box: QWidget,
         preview_box: QWidget,
+        checks_bar: QWidget,
         run_box: QWidget,
         plans_action: QAction,
         parent: QWidget | None = None,
@@ -58,6 +60,7 @@ class PlannerLayout(QWidget):
         column.setContentsMargins(0, 0, 0, 0)
         column.setSpacing(4)
         column.addWidget(self.work, 1)
+        column.addWidget(checks_bar)
         column.addWidget(run_box)
 
         self.outer = QSplitter(Qt.Orientation.Horizontal, self)

@@ -220,9 +220,7 @@ class PlannerPanel(QWidget):
             self.action_segment_up,
             self.action_segment_down,
         ]
-        self.segments_box = SegmentEditorBox(
-            self.segments, self._points, segment_actions, self.checks_bar, self
-        )
+        self.segments_box = SegmentEditorBox(self.segments, self._points, segment_actions, self)
         self.segment_view: QTableView = self.segments_box.segment_view
         self.point_pickers = install_point_pickers(self.segment_view, lambda: self._points.ledger)
 
@@ -234,10 +232,21 @@ class PlannerPanel(QWidget):
         preview_layout.addWidget(self.preview)
 
         self.arrangement = PlannerLayout(
-            self.plans_box, self.segments_box, self.preview_box, self.run_box, self.action_show_plans, self
+            self.plans_box,
+            self.segments_box,
+            self.preview_box,
+            self.checks_bar,
+            self.run_box,
+            self.action_show_plans,
+            self,
         )
         self.status = QLabel(self)
-        self.status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
+        self.status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
+        # as high for Chinese as for Latin text (a CJK fallback font is taller): the boxes above
+        # do not move when a message appears (the run strip moved 1 px after a stop in zh_CN)
+        probe = QLabel("Ag \u505c\u6b62")
+        probe.setFont(self.status.font())
+        self.status.setFixedHeight(probe.sizeHint().height())
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
         layout.setSpacing(4)

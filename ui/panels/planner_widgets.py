@@ -11,6 +11,7 @@ from PySide6.QtGui import QAction, QFontMetrics, QResizeEvent
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QComboBox,
+    QFrame,
     QGridLayout,
     QGroupBox,
     QHBoxLayout,
@@ -141,7 +142,7 @@ class PointRefDelegate(QStyledItemDelegate):
         model.setData(index, editor.itemData(found) if found >= 0 else text, Qt.ItemDataRole.EditRole)
 
 
-class PlanRunBox(QGroupBox):
+class PlanRunBox(QFrame):
     """Run, Run from here, Step, Pause, Resume and Stop in one row; under them Resume from k and
     how the run goes (progress, and the outcome in :data:`RUN_LABEL_LINES` lines).
 
@@ -162,6 +163,7 @@ class PlanRunBox(QGroupBox):
     ) -> None:
         super().__init__(parent)
         self.setObjectName("PlanRunBox")
+        self.setFrameShape(QFrame.Shape.StyledPanel)  # no title: the buttons say what it is
         stop_button = action_button(stop, bold=True)
         stop_button.setStyleSheet(f"QToolButton:enabled {{ color: {COLOR_ERROR}; }}")
         buttons = QGridLayout()
@@ -199,7 +201,7 @@ class PlanRunBox(QGroupBox):
         buttons.addWidget(self.resume_from_button, 1, 0, 1, 3, Qt.AlignmentFlag.AlignTop)
         buttons.addLayout(how, 1, 3, 1, 3)
         layout = QVBoxLayout(self)
-        layout.setContentsMargins(6, 6, 6, 6)
+        layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(buttons)
         self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Fixed)
 
@@ -241,8 +243,8 @@ class PlanRunBox(QGroupBox):
 
 
 class PlanChecksBar(QWidget):
-    """The checks under the segment table (wrapped to the room left), Upload now and Check on
-    their right: one row, the table keeps the height."""
+    """The checks across the planner under the segment table and the preview (wrapped at word
+    boundaries to the whole width), Upload now and Check on their right."""
 
     def __init__(
         self, upload: Callable[[], None], check: Callable[[], None], parent: QWidget | None = None
@@ -351,15 +353,14 @@ SEGMENT_COLUMN_WIDTHS: dict[int, int] = {
 
 
 class SegmentEditorBox(QGroupBox):
-    """The segment table (combo-box editors for kind, orientation and points), its buttons
-    above and the checks bar below."""
+    """The segment table (combo-box editors for kind, orientation and points) and its buttons
+    above it (the checks bar is under the table and the preview: :mod:`ui.panels.planner_layout`)."""
 
     def __init__(
         self,
         segments: SegmentTableModel,
         points: PointsModel,
         actions: Sequence[QAction],
-        checks_bar: PlanChecksBar,
         parent: QWidget | None = None,
     ) -> None:
         super().__init__(parent)
@@ -400,7 +401,6 @@ class SegmentEditorBox(QGroupBox):
         layout = QVBoxLayout(self)
         layout.addLayout(buttons)
         layout.addWidget(view, 1)
-        layout.addWidget(checks_bar)
 
         self._plan_name = ""
         self.setProperty("elide", True)  # the plan's name is elided in the title, whole in the tooltip
