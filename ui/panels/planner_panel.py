@@ -1,10 +1,12 @@
 """Trajectory planner panel: plans of the project, their segments, checks, preview and runs.
 
-Layout: on the left the plan list (name, loops, segments; add / duplicate / delete, rename
-and loops edited in place) and the run controls (Run, Run from here, Step, Pause, Resume,
-Stop, Resume from k; progress "segment k of n, loop i of m") below them; on the right the
-segment table (editable, undoable) with the checks on their rows and a summary line, and the
-preview (top / front / side) with lengths and times below it.
+Layout (:mod:`ui.panels.planner_layout`): the plan list (name, loops, segments; add / duplicate /
+delete, rename and loops edited in place) is a side pane, hidden on a narrow planner (*Plans*
+shows it; the segments' title names the plan); the segment table (editable, undoable) with the
+checks on its rows sits beside the preview (one projection at a time, its tabs) or, on a wide
+planner, above the three projections; under both, the checks' summary (Upload now, Check) and the
+run strip (Run, Run from here, Step, Pause, Resume, Stop, Resume from k; progress "segment k of n,
+loop i of m").
 
 Checks (:func:`app.plan.checks.check_plan`, with the robot model's reach once
 :meth:`PlannerPanel.set_reach` gave it), estimates and the preview are recomputed whenever the
@@ -18,9 +20,10 @@ injectable ``confirm(title, text) -> bool`` callable.
 
 What is shown is worked out without Qt by :mod:`app.plan.presenter`. The panel composes its
 parts: ``planner_actions`` (the QActions), ``planner_widgets`` (plan list, segment editor, run
-box, checks bar), ``planner_checks`` (the checks list, estimates, preview), ``planner_edit``
-(plan and segment edits), ``planner_run`` (the run flow), ``planner_follow`` (the plan on
-display kept in step with the list, the undo stack and the points).
+box, checks bar), ``planner_layout`` (how they share the room), ``planner_checks`` (the checks
+list, estimates, preview), ``planner_edit`` (plan and segment edits), ``planner_run`` (the run
+flow), ``planner_follow`` (the plan on display kept in step with the list, the undo stack and the
+points).
 """
 
 from __future__ import annotations
