@@ -1,8 +1,8 @@
-"""RobotLink: the GUI-thread facade of the worker (owns the thread, plain methods, shutdown).
+"""RobotLink: the GUI-thread facade of the worker (owns the thread, ``submit(op)``, shutdown).
 
 Besides the worker's signals (re-exposed for logs, benchmarks and tests) the link holds the
 GUI side's one picture of the robot, :class:`~app.link.state.RobotState` (``link.state``), and
-matches request ids in one place: ``link.track(link.move_to_point(...))`` gives a
+matches request ids in one place: ``link.track(link.submit(MoveToPoint(...)))`` gives a
 :class:`Pending` whose ``finished(CommandResult)`` / ``failed(WorkerError)`` fire only for that
 request. :class:`LinkPort` is the typed port that panels and controllers use (RobotLink fits;
 tests use a small fake that fits too).
