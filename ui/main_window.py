@@ -222,6 +222,7 @@ class MainWindow(QMainWindow):
             panel.bind(state)
         state.connectionChanged.connect(self._update_title)
         link.errorOccurred.connect(self._on_error)
+        link.errorOccurred.connect(self.control_column.refusal_line.on_error)  # a motion refused: said there
         link.controllerReconnected.connect(self._on_reconnected)
         link.controllerRestarted.connect(self._on_restarted)
         link.foreignMaster.connect(self._on_foreign_master)

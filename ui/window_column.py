@@ -22,6 +22,7 @@ from app.link.types import ConnectionState
 from ui.foreign_words import foreign_master_text
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
+from ui.panels.jog_refusal import MotionRefusalLine
 from ui.window_tabs import LazyTab
 
 if TYPE_CHECKING:  # built when their tab is first shown (LazyTab)
@@ -42,8 +43,9 @@ BANNER_STYLE = (
 
 class ControlColumn(QWidget):
     """``control_bar``, ``motion_banner``, ``tabs`` (``jog_panel``, ``step_panel``,
-    ``program_panel``; the last two built on first use). Changing the motion tab releases any
-    held jog."""
+    ``program_panel``; the last two built on first use), ``refusal_line`` under them (the latest
+    refusal of a motion, :mod:`ui.panels.jog_refusal`). Changing the motion tab releases any held
+    jog."""
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -79,6 +81,10 @@ class ControlColumn(QWidget):
         column.addWidget(self.motion_banner)
         column.addWidget(self.foreign_banner)
         column.addWidget(self.tabs, 1)
+        # the latest refusal of a motion, under the motion buttons (shown only while it holds)
+        self.refusal_line = MotionRefusalLine(self)
+        self.refusal_line.shownChanged.connect(self.jog_panel.make_room)  # the six rows keep fitting
+        column.addWidget(self.refusal_line)
         self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Expanding)
         self.retranslate()
 
@@ -94,6 +100,7 @@ class ControlColumn(QWidget):
         """Follow ``state``: the banner shows while the link is not writable, and says why."""
         self._state = state
         state.connectionChanged.connect(self._on_connection)
+        state.lastResultChanged.connect(self.refusal_line.on_result)
         self._show_banner()
 
     def retranslate(self) -> None:
@@ -108,6 +115,7 @@ class ControlColumn(QWidget):
     def _on_connection(self, connection: ConnectionState) -> None:
         if not connection.connected:
             self.hide_foreign_master()  # another controller may come next
+            self.refusal_line.clear_refusal()  # the motion banner says why nothing moves now
         self._show_banner()
 
     def show_foreign_master(self, what: str, value: float) -> bool:
