@@ -4,6 +4,8 @@ why. The JSON keys (``min_deg``, ``home_deg``) stay as written in the file."""
 
 from __future__ import annotations
 
+import errno as errnos
+import os
 from collections.abc import Mapping
 from typing import Any
 
@@ -44,6 +46,17 @@ _SENTENCES: dict[str, str] = {
     "profile_not_utf8": QT_TRANSLATE_NOOP("ProfileWords", "the robot profile is not UTF-8 text"),
     "profile_not_json": QT_TRANSLATE_NOOP("ProfileWords", "not valid JSON (line {line}, column {column})"),
 }
+# why the file could not be read, by its errno (the OS's own English, strerror, is not the operator's)
+_CAUSES: dict[int, str] = {
+    errnos.ENOENT: QT_TRANSLATE_NOOP("ProfileWords", "the file does not exist"),
+    errnos.EACCES: QT_TRANSLATE_NOOP("ProfileWords", "permission denied"),
+    errnos.EPERM: QT_TRANSLATE_NOOP("ProfileWords", "permission denied"),
+    errnos.EISDIR: QT_TRANSLATE_NOOP("ProfileWords", "it is a folder, not a file"),
+    errnos.ENOTDIR: QT_TRANSLATE_NOOP("ProfileWords", "a folder on its path is a file"),
+    errnos.ENAMETOOLONG: QT_TRANSLATE_NOOP("ProfileWords", "the file name is too long"),
+    errnos.EIO: QT_TRANSLATE_NOOP("ProfileWords", "the disk could not be read"),
+}
+_OTHER_CAUSE = QT_TRANSLATE_NOOP("ProfileWords", "system error {errno}")
 _JOINT = QT_TRANSLATE_NOOP("ProfileWords", "joint {n}")
 _JOINT_KEY = QT_TRANSLATE_NOOP("ProfileWords", "joint {n} {key}")
 
@@ -54,6 +67,20 @@ def _tr(text: str) -> str:
 
 def is_profile_code(code: str) -> bool:
     return code in _SENTENCES
+
+
+def _cause(args: Mapping[str, Any]) -> str:
+    """Why the file could not be read: its errno in words (an older record without one: the errno
+    whose OS text it is, on this machine); an errno with no words of its own by number."""
+    code = args.get("errno")
+    cause = str(args.get("cause", ""))
+    if not isinstance(code, int):
+        code = next((c for c in _CAUSES if os.strerror(c) == cause), None)
+    if code in _CAUSES:
+        return _tr(_CAUSES[code])
+    if isinstance(code, int):
+        return _tr(_OTHER_CAUSE).format(errno=code)
+    return cause
 
 
 def _place(args: Mapping[str, Any]) -> str:
@@ -71,6 +98,8 @@ def profile_text(code: str, args: Mapping[str, Any]) -> str | None:
     if sentence is None:
         return None
     fields = {k: str(v) for k, v in args.items()}
+    if code == "profile_unreadable":
+        fields["cause"] = _cause(args)
     try:
         text = _tr(sentence).format(**fields)
     except KeyError:

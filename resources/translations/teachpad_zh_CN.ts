@@ -390,187 +390,232 @@
     <context>
         <name>AuditWords</name>
         <message>
-            <location filename="../../ui/audit_words.py" line="34" />
+            <location filename="../../ui/audit_words.py" line="41" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="35" />
+            <location filename="../../ui/audit_words.py" line="42" />
             <source>step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="36" />
+            <location filename="../../ui/audit_words.py" line="43" />
             <source>teach</source>
             <translation>示教点</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="37" />
+            <location filename="../../ui/audit_words.py" line="44" />
             <source>run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="38" />
+            <location filename="../../ui/audit_words.py" line="45" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="39" />
+            <location filename="../../ui/audit_words.py" line="46" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="40" />
+            <location filename="../../ui/audit_words.py" line="47" />
             <source>reduced speed</source>
             <translation>降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="41" />
+            <location filename="../../ui/audit_words.py" line="48" />
             <source>edit points</source>
             <translation>编辑点位</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="42" />
+            <location filename="../../ui/audit_words.py" line="49" />
             <source>edit plans</source>
             <translation>编辑轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="43" />
+            <location filename="../../ui/audit_words.py" line="50" />
             <source>edit envelope</source>
             <translation>编辑安全范围</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="44" />
+            <location filename="../../ui/audit_words.py" line="51" />
             <source>change robot model</source>
             <translation>更换机器人模型</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="45" />
+            <location filename="../../ui/audit_words.py" line="52" />
             <source>leave reduced speed</source>
             <translation>退出降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="46" />
+            <location filename="../../ui/audit_words.py" line="53" />
             <source>reconnect to the same controller</source>
             <translation>重新连接同一控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="47" />
+            <location filename="../../ui/audit_words.py" line="54" />
             <source>change connection</source>
             <translation>更改连接</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="48" />
+            <location filename="../../ui/audit_words.py" line="55" />
             <source>change register profile</source>
             <translation>更改寄存器配置</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="49" />
+            <location filename="../../ui/audit_words.py" line="56" />
             <source>manage roles and passwords</source>
             <translation>管理角色与密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="50" />
+            <location filename="../../ui/audit_words.py" line="57" />
             <source>write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="51" />
+            <location filename="../../ui/audit_words.py" line="58" />
             <source>write controller registers directly</source>
             <translation>直接写控制器寄存器</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="52" />
+            <location filename="../../ui/audit_words.py" line="59" />
             <source>move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="53" />
+            <location filename="../../ui/audit_words.py" line="60" />
             <source>set the idle lock time</source>
             <translation>设置空闲锁定时间</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="54" />
+            <location filename="../../ui/audit_words.py" line="61" />
             <source>reduced speed on</source>
             <translation>开启降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="55" />
+            <location filename="../../ui/audit_words.py" line="62" />
             <source>reduced speed off</source>
             <translation>关闭降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="56" />
+            <location filename="../../ui/audit_words.py" line="63" />
             <source>clear the administrator password</source>
             <translation>清除管理员密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="61" />
+            <location filename="../../ui/audit_words.py" line="68" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="62" />
+            <location filename="../../ui/audit_words.py" line="69" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="63" />
+            <location filename="../../ui/audit_words.py" line="70" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="68" />
+            <location filename="../../ui/audit_words.py" line="75" />
             <source>log in as {role}</source>
             <translation>以{role}身份登录</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="69" />
+            <location filename="../../ui/audit_words.py" line="76" />
             <source>log out ({role})</source>
             <translation>注销（{role}）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="72" />
+            <location filename="../../ui/audit_words.py" line="79" />
             <source>set the {role} password</source>
             <translation>设置{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="76" />
+            <location filename="../../ui/audit_words.py" line="83" />
             <source>change the {role} password</source>
             <translation>更改{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="80" />
+            <location filename="../../ui/audit_words.py" line="87" />
             <source>clear the {role} password</source>
             <translation>清除{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="84" />
+            <location filename="../../ui/audit_words.py" line="91" />
             <source>locked back to operator after {seconds} s idle</source>
             <translation>空闲 {seconds} s 后锁回操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="89" />
+            <location filename="../../ui/audit_words.py" line="96" />
             <source>{action} ({register})</source>
             <translation>{action}（{register}）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="91" />
+            <location filename="../../ui/audit_words.py" line="98" />
             <source>write {what}</source>
             <translation>写入 {what}</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="94" />
+            <location filename="../../ui/audit_words.py" line="101" />
             <source>sent; TeachPad stopped before the answer was recorded</source>
             <translation>已发送；记录应答之前 TeachPad 已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="95" />
+            <location filename="../../ui/audit_words.py" line="102" />
             <source>sent and answered; the controller's outcome was not recorded (still under way when read, or TeachPad stopped first)</source>
             <translation>已发送并已应答；未记录控制器的结果（读取时仍在进行，或 TeachPad 先停止了）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="153" />
+            <location filename="../../ui/audit_words.py" line="232" />
+            <source>not sent: the controller is busy (program {state}); wait for it to end, or stop it</source>
+            <translation>未发送：控制器忙（程序{state}）；请等它结束，或将其停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="239" />
+            <source>wrong password for the {role} role</source>
+            <translation>{role}角色的密码错误</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="244" />
+            <source>no password is set for the {role} role; an administrator sets it</source>
+            <translation>{role}角色尚未设置密码；由管理员设置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="252" />
+            <source>the {role} role needs its password: run it in a terminal, or set {env}</source>
+            <translation>{role}角色需要密码：请在终端中运行，或设置 {env}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="260" />
+            <source>the administrator password is needed: run it in a terminal, or set {env}</source>
+            <translation>需要管理员密码：请在终端中运行，或设置 {env}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="267" />
+            <source>wrong administrator password</source>
+            <translation>管理员密码错误</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="272" />
+            <source>the administrator password can be changed, not removed (anyone could then set it)</source>
+            <translation>管理员密码只能修改，不能清除（否则任何人都可以重新设置它）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="285" />
+            <source>P{id} cannot be checked against the safety envelope: the host has no copy of it (give the project holding the point with {option})</source>
+            <translation>P{id} 无法对照安全范围检查：主机没有它的副本（请用 {option} 给出含有该点的工程）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="312" />
+            <source>another Modbus master wrote to the controller less than {hold} s ago</source>
+            <translation>另一个 Modbus 主站在不到 {hold} s 前写过控制器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="372" />
             <source>needs the {need} role ({role} was logged in)</source>
             <translation>需要{need}角色（当时登录的是{role}）</translation>
         </message>
@@ -4358,92 +4403,128 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProfileWords</name>
         <message>
-            <location filename="../../ui/messages_profile.py" line="24" />
+            <location filename="../../ui/messages_profile.py" line="26" />
             <source>the robot profile cannot be used</source>
             <translation>机器人模型配置文件无法使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="25" />
+            <location filename="../../ui/messages_profile.py" line="27" />
             <source>{value} is not a finite number</source>
             <translation>{value} 不是有限的数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="26" />
+            <location filename="../../ui/messages_profile.py" line="28" />
             <source>expected a list of six numbers X Y Z A B C, got {value}</source>
             <translation>应为六个数（X Y Z A B C）的列表，实际为 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="29" />
+            <location filename="../../ui/messages_profile.py" line="31" />
             <source>expected an object with {keys}</source>
             <translation>应为含有 {keys} 的对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="30" />
+            <location filename="../../ui/messages_profile.py" line="32" />
             <source>missing {keys}</source>
             <translation>缺少 {keys}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="31" />
+            <location filename="../../ui/messages_profile.py" line="33" />
             <source>the name {value} is not text</source>
             <translation>名称 {value} 不是文本</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="32" />
+            <location filename="../../ui/messages_profile.py" line="34" />
             <source>min_deg {low} is not below max_deg {high}</source>
             <translation>min_deg {low} 不小于 max_deg {high}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="33" />
+            <location filename="../../ui/messages_profile.py" line="35" />
             <source>a robot profile is a JSON object</source>
             <translation>机器人模型配置文件应为 JSON 对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="34" />
+            <location filename="../../ui/messages_profile.py" line="36" />
             <source>not a robot profile: its format is {value}, expected {expected}</source>
             <translation>不是机器人模型配置文件：format 为 {value}，应为 {expected}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="37" />
+            <location filename="../../ui/messages_profile.py" line="39" />
             <source>profile version {value} is not supported (this TeachPad reads version {expected})</source>
             <translation>不支持配置文件版本 {value}（本 TeachPad 读取版本 {expected}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="40" />
+            <location filename="../../ui/messages_profile.py" line="42" />
             <source>joints: expected a list of 1 to {most} joints</source>
             <translation>joints：应为含 1 到 {most} 个关节的列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="41" />
+            <location filename="../../ui/messages_profile.py" line="43" />
             <source>home_deg: expected {count} numbers, one per joint</source>
             <translation>home_deg：应为 {count} 个数，每个关节一个</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="42" />
+            <location filename="../../ui/messages_profile.py" line="44" />
             <source>too large for a robot profile (over {kb} kB)</source>
             <translation>文件过大，不是机器人模型配置文件（超过 {kb} kB）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="43" />
+            <location filename="../../ui/messages_profile.py" line="45" />
             <source>cannot read the robot profile ({cause})</source>
             <translation>无法读取机器人模型配置文件（{cause}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="44" />
+            <location filename="../../ui/messages_profile.py" line="46" />
             <source>the robot profile is not UTF-8 text</source>
             <translation>机器人模型配置文件不是 UTF-8 文本</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="45" />
+            <location filename="../../ui/messages_profile.py" line="47" />
             <source>not valid JSON (line {line}, column {column})</source>
             <translation>不是有效的 JSON（第 {line} 行，第 {column} 列）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="47" />
+            <location filename="../../ui/messages_profile.py" line="51" />
+            <source>the file does not exist</source>
+            <translation>文件不存在</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="52" />
+            <location filename="../../ui/messages_profile.py" line="53" />
+            <source>permission denied</source>
+            <translation>没有访问权限</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="54" />
+            <source>it is a folder, not a file</source>
+            <translation>这是文件夹，不是文件</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="55" />
+            <source>a folder on its path is a file</source>
+            <translation>其路径中的某个文件夹实际上是文件</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="56" />
+            <source>the file name is too long</source>
+            <translation>文件名太长</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="57" />
+            <source>the disk could not be read</source>
+            <translation>无法读取磁盘</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="59" />
+            <source>system error {errno}</source>
+            <translation>系统错误 {errno}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="60" />
             <source>joint {n}</source>
             <translation>关节 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="48" />
+            <location filename="../../ui/messages_profile.py" line="61" />
             <source>joint {n} {key}</source>
             <translation>关节 {n} 的 {key}</translation>
         </message>
