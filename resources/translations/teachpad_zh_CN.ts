@@ -4403,130 +4403,165 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProfileWords</name>
         <message>
-            <location filename="../../ui/messages_profile.py" line="26" />
+            <location filename="../../ui/messages_profile.py" line="31" />
             <source>the robot profile cannot be used</source>
             <translation>机器人模型配置文件无法使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="27" />
+            <location filename="../../ui/messages_profile.py" line="32" />
             <source>{value} is not a finite number</source>
             <translation>{value} 不是有限的数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="28" />
+            <location filename="../../ui/messages_profile.py" line="33" />
             <source>expected a list of six numbers X Y Z A B C, got {value}</source>
             <translation>应为六个数（X Y Z A B C）的列表，实际为 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="31" />
+            <location filename="../../ui/messages_profile.py" line="36" />
             <source>expected an object with {keys}</source>
             <translation>应为含有 {keys} 的对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="32" />
+            <location filename="../../ui/messages_profile.py" line="37" />
             <source>missing {keys}</source>
             <translation>缺少 {keys}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="33" />
+            <location filename="../../ui/messages_profile.py" line="38" />
             <source>the name {value} is not text</source>
             <translation>名称 {value} 不是文本</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="34" />
+            <location filename="../../ui/messages_profile.py" line="39" />
             <source>min_deg {low} is not below max_deg {high}</source>
             <translation>min_deg {low} 不小于 max_deg {high}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="35" />
+            <location filename="../../ui/messages_profile.py" line="40" />
             <source>a robot profile is a JSON object</source>
             <translation>机器人模型配置文件应为 JSON 对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="36" />
+            <location filename="../../ui/messages_profile.py" line="41" />
             <source>not a robot profile: its format is {value}, expected {expected}</source>
             <translation>不是机器人模型配置文件：format 为 {value}，应为 {expected}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="39" />
+            <location filename="../../ui/messages_profile.py" line="44" />
             <source>profile version {value} is not supported (this TeachPad reads version {expected})</source>
             <translation>不支持配置文件版本 {value}（本 TeachPad 读取版本 {expected}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="42" />
+            <location filename="../../ui/messages_profile.py" line="47" />
             <source>joints: expected a list of 1 to {most} joints</source>
             <translation>joints：应为含 1 到 {most} 个关节的列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="43" />
+            <location filename="../../ui/messages_profile.py" line="48" />
             <source>home_deg: expected {count} numbers, one per joint</source>
             <translation>home_deg：应为 {count} 个数，每个关节一个</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="44" />
+            <location filename="../../ui/messages_profile.py" line="49" />
             <source>too large for a robot profile (over {kb} kB)</source>
             <translation>文件过大，不是机器人模型配置文件（超过 {kb} kB）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="45" />
+            <location filename="../../ui/messages_profile.py" line="50" />
             <source>cannot read the robot profile ({cause})</source>
             <translation>无法读取机器人模型配置文件（{cause}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="46" />
+            <location filename="../../ui/messages_profile.py" line="51" />
             <source>the robot profile is not UTF-8 text</source>
             <translation>机器人模型配置文件不是 UTF-8 文本</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="47" />
+            <location filename="../../ui/messages_profile.py" line="52" />
             <source>not valid JSON (line {line}, column {column})</source>
             <translation>不是有效的 JSON（第 {line} 行，第 {column} 列）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="51" />
+            <location filename="../../ui/messages_profile.py" line="54" />
+            <source>cannot read the {what} ({cause})</source>
+            <translation>无法读取{what}（{cause}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="55" />
+            <source>the {what} is not UTF-8 text</source>
+            <translation>{what}不是 UTF-8 文本</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="56" />
+            <source>the {what} is not valid JSON (line {line}, column {column})</source>
+            <translation>{what}不是有效的 JSON（第 {line} 行，第 {column} 列）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="61" />
+            <source>register profile</source>
+            <translation>寄存器配置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="62" />
+            <source>safety profile</source>
+            <translation>安全配置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="70" />
+            <source>the file is too large ({size} bytes, at most {limit})</source>
+            <translation>文件太大（{size} 字节，最多 {limit}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="73" />
             <source>the file does not exist</source>
             <translation>文件不存在</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="52" />
-            <location filename="../../ui/messages_profile.py" line="53" />
+            <location filename="../../ui/messages_profile.py" line="74" />
+            <location filename="../../ui/messages_profile.py" line="75" />
             <source>permission denied</source>
             <translation>没有访问权限</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="54" />
+            <location filename="../../ui/messages_profile.py" line="76" />
             <source>it is a folder, not a file</source>
             <translation>这是文件夹，不是文件</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="55" />
+            <location filename="../../ui/messages_profile.py" line="77" />
             <source>a folder on its path is a file</source>
             <translation>其路径中的某个文件夹实际上是文件</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="56" />
+            <location filename="../../ui/messages_profile.py" line="78" />
             <source>the file name is too long</source>
             <translation>文件名太长</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="57" />
+            <location filename="../../ui/messages_profile.py" line="79" />
             <source>the disk could not be read</source>
             <translation>无法读取磁盘</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="59" />
+            <location filename="../../ui/messages_profile.py" line="81" />
             <source>system error {errno}</source>
             <translation>系统错误 {errno}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="60" />
+            <location filename="../../ui/messages_profile.py" line="82" />
             <source>joint {n}</source>
             <translation>关节 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="61" />
+            <location filename="../../ui/messages_profile.py" line="83" />
             <source>joint {n} {key}</source>
             <translation>关节 {n} 的 {key}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="151" />
+            <source>{why}; the remembered connection settings are used until an administrator saves a register profile</source>
+            <translation>{why}；在管理员保存寄存器配置之前，使用记住的连接设置</translation>
         </message>
     </context>
     <context>
@@ -5251,38 +5286,38 @@ Remove them all?</source>
             <translation>当前生效：记住的连接设置（尚未保存寄存器配置）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="266" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="268" />
             <source>Not loaded: {why}</source>
             <translation>未载入：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="269" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="271" />
             <source>Loaded “{name}” from {file}; press Save and apply to use it</source>
             <translation>已从 {file} 载入“{name}”；按“保存并应用”后生效</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="285" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="287" />
             <source>Cannot write {file}: {why}</source>
             <translation>无法写入 {file}：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="288" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="290" />
             <source>Saved to {file}</source>
             <translation>已保存到 {file}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="305" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="307" />
             <source>Load a register profile</source>
             <translation>载入寄存器配置</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="305" />
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="311" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="307" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="313" />
             <source>Register profiles (*.json)</source>
             <translation>寄存器配置 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="311" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="313" />
             <source>Save the register profile as</source>
             <translation>寄存器配置另存为</translation>
         </message>

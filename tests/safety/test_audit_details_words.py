@@ -24,7 +24,7 @@ from app.safety.envelope import EnvelopeViolation, ViolationCode
 from app.safety.roles import Role, RoleStore, WrongPassword
 from app.safety.session import SafetySession
 from app.view3d.profile import ProfileError, load_profile
-from tests.ui.pendant_support import translator_fixture  # noqa: F401 - fixture
+from tests.ui.pendant_support import app_settings_fixture, translator_fixture  # noqa: F401 - fixtures
 from tests.ui.test_messages import assert_chinese
 from ui.messages import error_text
 from ui.panels.audit_viewer import AuditModel
@@ -141,3 +141,43 @@ def test_a_refused_robot_profile_by_errno_in_both_languages(qapp: Any, translato
     assert "没有访问权限" in error_text(denied)
     assert_chinese(error_text(denied).replace("robot.json", ""))
     assert_chinese(error_text(odd).replace("r.json", ""))
+
+
+@pytest.mark.parametrize(
+    ("damage", "words"),
+    [
+        (lambda path: path.mkdir(), "这是文件夹，不是文件"),
+        (lambda path: path.write_text("{not json", encoding="utf-8"), "不是有效的 JSON"),
+        (lambda path: path.write_bytes(b"\xff\xfe\x00"), "不是 UTF-8 文本"),
+    ],
+)
+def test_the_register_profile_in_force_says_why_it_is_not_used_in_words(
+    qapp: Any, translator: Any, app_settings: Any, damage: Any, words: str
+) -> None:
+    path = app_settings.register_profile_path()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    damage(path)
+    assert "remembered connection settings are used" in app_settings.register_profile()[1]
+    assert translator.set_language("zh_CN")
+    problem = app_settings.register_profile()[1]
+    assert words in problem and "使用记住的连接设置" in problem, problem
+    assert_chinese(problem.replace(path.name, "").replace("JSON", "").replace("UTF-8", ""))
+
+
+def test_loading_a_missing_register_profile_says_so_in_words(
+    qapp: Any, translator: Any, tmp_path: Path
+) -> None:
+    from app.safety.register_profile import RegisterProfile
+    from ui.dialogs.register_profile_dialog import RegisterProfileDialog
+
+    def apply(_profile: RegisterProfile, _reconnect: bool = False) -> str | None:
+        return None
+
+    dialog = RegisterProfileDialog(RegisterProfile(), apply, None)
+    dialog.open_path = lambda: str(tmp_path / "gone.registers.json")
+    assert translator.set_language("zh_CN")
+    dialog.load()
+    text = dialog.error.text()
+    assert "文件不存在" in text, text
+    assert_chinese(text.replace("gone.registers.json", ""))
+    dialog.deleteLater()
