@@ -16,7 +16,7 @@ from app.link.client import StepFrame
 from app.protocol import registers
 from app.safety.envelope import Box, Envelope
 from tests.safety.test_gui_motion import _envelope
-from tests.safety.test_gui_roles import menu_fixture  # noqa: F401 - fixture
+from tests.safety.test_gui_roles import SAMPLE, menu_fixture  # noqa: F401 - fixture
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,
@@ -150,3 +150,22 @@ def test_a_refusal_goes_stale(
     assert line.isVisible()
     qtbot.waitUntil(lambda: not line.isVisible(), timeout=SIGNAL_TIMEOUT_MS)
     assert not line.shown
+
+
+def test_a_move_to_a_point_refused_reads_in_the_motion_area(
+    qtbot: Any, sim: Any, menu: SafetyMenu, window: Any, translator: Any
+) -> None:
+    assert window.project.open_file(SAMPLE)
+    _connected_at_rest(qtbot, window, sim)
+    ledger = window.project.points_model.ledger
+    target = max(ledger, key=lambda p: p.xyz[1])  # the point furthest along +Y
+    _face_ahead(menu, target.xyz[1] - 10.0)
+    window.set_language("zh_CN")
+    panel = window.points_panel
+    panel.select_rows([window.project.points_model.row_of(target.id)])
+    writes = len(sim.writes)
+    with qtbot.waitSignal(menu.safety.motionRefused, timeout=SIGNAL_TIMEOUT_MS):
+        panel.move_to_selected()
+    _under_the_buttons(window)
+    assert_chinese(window.control_column.refusal_line.text())
+    assert len(sim.writes) == writes  # at the simulator: nothing went out
