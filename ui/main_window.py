@@ -51,6 +51,7 @@ from app.link.robot_link import RobotLink
 from app.link.transport import ConnectionSettings
 from app.link.types import WorkerError
 from app.models import LINK_FAILURE_CODES
+from app.protocol.word_order_check import WordOrderVerdict
 from app.safety.location import Scope
 from app.safety.roles import Action
 from ui.controllers.link_guard import LinkGuard
@@ -60,6 +61,7 @@ from ui.controllers.plan_run_reasons import foreign_pause_text
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController, ProjectDialogs
 from ui.controllers.safety_menu import install_safety
+from ui.controllers.word_order_watch import WordOrderWatch
 from ui.dialogs.confirm import ConfirmFn
 from ui.i18n import Translator
 from ui.joins import labelled
@@ -223,6 +225,11 @@ class MainWindow(QMainWindow):
             panel.bind(state)
         state.connectionChanged.connect(self._update_title)
         link.errorOccurred.connect(self._on_error)
+        link.errorOccurred.connect(self.control_column.refusal_line.on_error)  # a motion refused: said there
+        # the register profile's float word order probably wrong: said once per connection
+        self.word_order_watch = WordOrderWatch(link, self)
+        self.word_order_watch.warned.connect(self.control_column.show_word_order)
+        self.word_order_watch.warned.connect(self._on_word_order)
         link.controllerReconnected.connect(self._on_reconnected)
         link.controllerRestarted.connect(self._on_restarted)
         link.foreignMaster.connect(self._on_foreign_master)
@@ -337,6 +344,19 @@ class MainWindow(QMainWindow):
         operation = self.event_log.operation_text(error.operation)
         silence = error.reason is not None and error.reason.code in LINK_FAILURE_CODES
         self.status_bar.show_message(labelled(operation, error_text(error)), until_answering=silence)
+
+    @Slot(object)
+    def _on_word_order(self, verdict: WordOrderVerdict | None) -> None:
+        if verdict is None:
+            return
+        from ui.messages_word_order import word_order_details, word_order_text
+
+        self.event_log.add_event(
+            "warning",
+            lambda: self.tr("link"),
+            lambda: f"{word_order_text(verdict)} {word_order_details(verdict)}",
+        )
+        self.status_bar.show_message(word_order_text(verdict))
 
     @Slot(str)
     def _show_message(self, text: str) -> None:

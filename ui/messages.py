@@ -421,6 +421,15 @@ def _named_fields(args: Mapping[str, Any], out: dict[str, str]) -> None:
 
 def reason_text(reason: Reason) -> str | None:
     """One translated sentence for ``reason``; None for a code this module does not know."""
+    text = _own_sentence(reason)
+    if text is not None:
+        return text
+    return _template_text(reason)
+
+
+def _own_sentence(reason: Reason) -> str | None:
+    """The codes worded by a sentence of their own (the envelope, the stops that name another
+    failure, a robot profile); None for the codes of the template tables."""
     args = reason.args
     if reason.code == "envelope_refused":
         return envelope_text(args)
@@ -433,6 +442,13 @@ def reason_text(reason: Reason) -> str | None:
         return _fresh_stop_text(reason)
     if is_profile_code(reason.code):
         return profile_text(reason.code, args)
+    return None
+
+
+def _template_text(reason: Reason) -> str | None:
+    """``reason`` in the sentence of the template tables (the bare one when an argument is
+    missing), wrapped in the (re)connect sentence when it says which controller."""
+    args = reason.args
     code = reason.code
     if code == "modbus_exception" and "unit" in args and args.get("exception") in GATEWAY_EXCEPTIONS:
         code = "modbus_gateway"  # a wrong unit id, most often: said as such

@@ -153,7 +153,12 @@ class AppSettings:
             fallback = regprofile.RegisterProfile.from_connection(self._remembered_connection())
         except regprofile.RegisterProfileError:  # a remembered value out of range
             fallback = regprofile.RegisterProfile()
-        return regprofile.active_profile(self.register_profile_path(), fallback)
+        profile, problem = regprofile.read_active_profile(self.register_profile_path(), fallback)
+        if problem is None:
+            return profile, ""
+        from ui.messages_profile import register_problem_text  # words: read when there is a problem
+
+        return profile, register_problem_text(problem)
 
     # --- project ----------------------------------------------------------------------
     @property

@@ -19,9 +19,11 @@ from PySide6.QtWidgets import QLabel, QSizePolicy, QTabWidget, QVBoxLayout, QWid
 
 from app.link.state import RobotState
 from app.link.types import ConnectionState
+from app.protocol.word_order_check import WordOrderVerdict
 from ui.foreign_words import foreign_master_text
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
+from ui.panels.jog_refusal import MotionRefusalLine
 from ui.window_tabs import LazyTab
 
 if TYPE_CHECKING:  # built when their tab is first shown (LazyTab)
@@ -42,8 +44,9 @@ BANNER_STYLE = (
 
 class ControlColumn(QWidget):
     """``control_bar``, ``motion_banner``, ``tabs`` (``jog_panel``, ``step_panel``,
-    ``program_panel``; the last two built on first use). Changing the motion tab releases any
-    held jog."""
+    ``program_panel``; the last two built on first use), ``refusal_line`` under them (the latest
+    refusal of a motion, :mod:`ui.panels.jog_refusal`). Changing the motion tab releases any held
+    jog."""
 
     def __init__(self, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -73,12 +76,24 @@ class ControlColumn(QWidget):
         self._foreign_timer = QTimer(self)
         self._foreign_timer.setSingleShot(True)
         self._foreign_timer.timeout.connect(self.hide_foreign_master)
+        # the register profile's float word order is probably wrong (ui/controllers/word_order_watch.py)
+        self.word_order_banner = QLabel(self)
+        self.word_order_banner.setObjectName("WordOrderBanner")
+        self.word_order_banner.setWordWrap(True)
+        self.word_order_banner.setStyleSheet(BANNER_STYLE)
+        self.word_order_banner.setVisible(False)
+        self._word_order: WordOrderVerdict | None = None
         column = QVBoxLayout(self)
         column.setContentsMargins(0, 0, 0, 0)
         column.addWidget(self.control_bar)
         column.addWidget(self.motion_banner)
         column.addWidget(self.foreign_banner)
+        column.addWidget(self.word_order_banner)
         column.addWidget(self.tabs, 1)
+        # the latest refusal of a motion, under the motion buttons (shown only while it holds)
+        self.refusal_line = MotionRefusalLine(self)
+        self.refusal_line.shownChanged.connect(self._make_room)  # the six rows keep fitting
+        column.addWidget(self.refusal_line)
         self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Expanding)
         self.retranslate()
 
@@ -94,6 +109,7 @@ class ControlColumn(QWidget):
         """Follow ``state``: the banner shows while the link is not writable, and says why."""
         self._state = state
         state.connectionChanged.connect(self._on_connection)
+        state.lastResultChanged.connect(self.refusal_line.on_result)
         self._show_banner()
 
     def retranslate(self) -> None:
@@ -103,11 +119,37 @@ class ControlColumn(QWidget):
         self._show_banner()
         if self._foreign_sign is not None:
             self.foreign_banner.setText(foreign_master_text(*self._foreign_sign))
+        self._show_word_order()
+
+    @Slot(object)
+    def show_word_order(self, verdict: WordOrderVerdict | None) -> None:
+        """The register profile's word order is probably wrong (``verdict``; None: no longer
+        said): what is wrong and what to set, the pose read both ways in its tooltip."""
+        self._word_order = verdict
+        self._show_word_order()
+        self._make_room()
+
+    def _show_word_order(self) -> None:
+        verdict = self._word_order
+        self.word_order_banner.setVisible(verdict is not None)
+        if verdict is None:
+            return
+        from ui.messages_word_order import word_order_details, word_order_text
+
+        self.word_order_banner.setText(word_order_text(verdict))
+        self.word_order_banner.setToolTip(word_order_details(verdict))
+
+    @Slot()
+    def _make_room(self) -> None:
+        """A line shown in the column under or over the tabs: the jog panel gives it its hints'
+        height (the six rows keep fitting a 1280×800 screen)."""
+        self.jog_panel.make_room(self.refusal_line.shown or self._word_order is not None)
 
     @Slot(ConnectionState)
     def _on_connection(self, connection: ConnectionState) -> None:
         if not connection.connected:
             self.hide_foreign_master()  # another controller may come next
+            self.refusal_line.clear_refusal()  # the motion banner says why nothing moves now
         self._show_banner()
 
     def show_foreign_master(self, what: str, value: float) -> bool:

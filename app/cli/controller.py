@@ -55,6 +55,7 @@ from app.protocol.enums import (
     controller_mode_text,
     program_state_text,
 )
+from app.protocol.word_order_check import judge_pose, warning_text
 from app.safety.jog_guard import GuardTiming, JogMotion
 
 __all__ = ["JOG_SECONDS_DEFAULT", "register"]
@@ -81,8 +82,16 @@ def cmd_status(ctx: CliContext) -> ExitCode:
     timeout = ctx.settings.effective_poll_timeout
     status = client.read_status(with_clock=True, timeout=timeout)
     pose = client.read_pose(timeout=timeout)
+    # the word order probably wrong (app/protocol/word_order_check.py): said on stderr, and in the
+    # JSON as "word_order_warning" (null when the pose reads right)
+    verdict = judge_pose(pose, ctx.settings.word_order)
+    warning = warning_text(verdict) if verdict.swapped else None
+    if warning is not None:
+        ctx.warn(warning)
     if ctx.args.json:
-        ctx.print(json.dumps({**status_to_dict(pose, status), "link": client.stats.as_dict()}))
+        said = None if warning is None else {"suggested": verdict.suggested.value, "message": warning}
+        data = {**status_to_dict(pose, status), "link": client.stats.as_dict(), "word_order_warning": said}
+        ctx.print(json.dumps(data))
     else:
         ctx.print(format_status(pose, status))
     return ExitCode.OK

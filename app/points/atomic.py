@@ -21,7 +21,7 @@ import time
 from pathlib import Path
 from typing import Any
 
-from app.errors import Reason
+from app.errors import Reason, TeachPadError
 from app.points.point import FileFormatError
 
 TEMP_PREFIX = ".teachpad-tmp."
@@ -160,7 +160,10 @@ def versioned_document(
     try:
         doc = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise error(f"{source} is not valid JSON (line {exc.lineno}: {exc.msg})") from None
+        where = {"what": what, "line": exc.lineno, "column": exc.colno}
+        raise _coded(
+            error, f"{source} is not valid JSON (line {exc.lineno}: {exc.msg})", "settings_not_json", where
+        ) from None
     if not isinstance(doc, dict) or doc.get("format") != fmt:
         raise error(f"{source} is not a TeachPad {what}")
     found = doc.get("version")
@@ -179,8 +182,19 @@ def read_settings_text(path: Path, limit: int, what: str, error: type[Exception]
     try:
         data = read_limited(path, limit)
     except FileFormatError as exc:
-        raise error(f"{what}: {exc}") from None
+        cause = exc.problem if exc.problem is not None else Reason("os_error")
+        params = {"what": what, "file": path.name, "cause": cause.code, **cause.args}
+        raise _coded(error, f"{what}: {exc}", "settings_unreadable", params) from None
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError:
-        raise error(f"{what} {path.name} is not UTF-8 text") from None
+        params = {"what": what, "file": path.name}
+        raise _coded(error, f"{what} {path.name} is not UTF-8 text", "settings_not_utf8", params) from None
+
+
+def _coded(error: type[Exception], message: str, code: str, params: dict[str, Any]) -> Exception:
+    """``error`` with ``message``, and with its code and arguments when it is a typed error (the
+    GUI words it: ui/messages_profile.py; the English stays the message)."""
+    if issubclass(error, TeachPadError):
+        return error(message, code=code, params=params)
+    return error(message)

@@ -52,7 +52,14 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
-from app.errors import LinkError, MalformedResponse, ModbusExceptionError, ResponseTimeout, WriteBlocked
+from app.errors import (
+    LinkError,
+    MalformedResponse,
+    ModbusExceptionError,
+    ResponseTimeout,
+    TeachPadError,
+    WriteBlocked,
+)
 from app.protocol import registers
 from app.protocol.codec import WordOrder
 from app.protocol.exceptions import not_carried_out
@@ -163,6 +170,15 @@ def _write_result(error: BaseException | None, judged: bool = False) -> tuple[st
     if judged and _went_out_unconfirmed(error):
         return Result.UNKNOWN, str(error)
     return Result.FAILED, str(error) or type(error).__name__
+
+
+def _error_reason(error: BaseException | None) -> dict[str, Any]:
+    """A write's error as its reason code and plain arguments beside the English detail (the
+    viewer words it in the operator's language; ui/audit_words.py); {} for an untyped error."""
+    if not isinstance(error, TeachPadError) or error.code == "error":
+        return {}
+    plain = {k: v for k, v in error.params.items() if v is None or isinstance(v, str | int | float | bool)}
+    return {"reason": error.code, "reason_args": plain}
 
 
 def _went_out_unconfirmed(error: BaseException) -> bool:
@@ -312,7 +328,13 @@ class AuditLog:
         except Exception:  # naming is a courtesy; never lose the record over it
             command = f"write {len(vals)} register(s) at {address}"
         result, detail = (Result.PENDING, "") if pending else _write_result(error)
-        args = {"fc": 6 if single else 16, "address": address, "values": vals[:MAX_VALUES_KEPT]}
+        args: dict[str, Any] = {
+            "fc": 6 if single else 16,
+            "address": address,
+            "values": vals[:MAX_VALUES_KEPT],
+        }
+        if not pending:
+            args.update(_error_reason(error))
         if len(vals) > MAX_VALUES_KEPT:
             args["count"] = len(vals)
         if judged:
@@ -348,9 +370,8 @@ class AuditLog:
 
     def _record_outcome(self, intent: AuditRecord, error: BaseException | None) -> None:
         result, detail = _write_result(error, intent.args.get("judged") is True)
-        self.record(
-            OUTCOME, intent.command, result=result, args={"ref": intent.seq}, detail=detail, role=intent.role
-        )
+        args = {"ref": intent.seq, **_error_reason(error)}
+        self.record(OUTCOME, intent.command, result=result, args=args, detail=detail, role=intent.role)
 
     def record_result(
         self, write: AuditRecord, result: str, detail: str, args: dict[str, Any] | None = None

@@ -262,12 +262,23 @@ def active_profile(path: Path, fallback: RegisterProfile) -> tuple[RegisterProfi
     """The profile in force at ``path`` and a problem ("" when none). No file: ``fallback`` (the
     remembered connection's decisions). A damaged file: ``fallback`` and the reason, so the
     window can say it instead of connecting with values nobody chose silently."""
+    profile, problem = read_active_profile(path, fallback)
+    if problem is None:
+        return profile, ""
+    return profile, f"{problem}; {FALLBACK_NOTE}"
+
+
+#: What a damaged profile in force means (said after the problem)
+FALLBACK_NOTE = "the remembered connection settings are used until an administrator saves a register profile"
+
+
+def read_active_profile(
+    path: Path, fallback: RegisterProfile
+) -> tuple[RegisterProfile, RegisterProfileError | None]:
+    """As :func:`active_profile`, the problem as the error itself (the GUI words it by its code)."""
     if not path.exists():
-        return fallback, ""
+        return fallback, None
     try:
-        return load_register_profile(path), ""
+        return load_register_profile(path), None
     except RegisterProfileError as exc:
-        return fallback, (
-            f"{exc}; the remembered connection settings are used until an administrator "
-            "saves a register profile"
-        )
+        return fallback, exc

@@ -218,7 +218,8 @@ def load_profile(path: str | os.PathLike[str]) -> RobotProfile:
         raise ProfileError(
             f"{label}: cannot read the robot profile ({exc.strerror or exc})",
             code="profile_unreadable",
-            params={"file": label, "cause": exc.strerror or str(exc)},
+            # errno beside the OS's English: the GUI words the common cases (ui/messages_profile.py)
+            params={"file": label, "cause": exc.strerror or str(exc), "errno": exc.errno},
         ) from exc
     except UnicodeDecodeError as exc:
         raise ProfileError(

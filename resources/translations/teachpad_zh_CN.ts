@@ -390,187 +390,232 @@
     <context>
         <name>AuditWords</name>
         <message>
-            <location filename="../../ui/audit_words.py" line="34" />
+            <location filename="../../ui/audit_words.py" line="41" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="35" />
+            <location filename="../../ui/audit_words.py" line="42" />
             <source>step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="36" />
+            <location filename="../../ui/audit_words.py" line="43" />
             <source>teach</source>
             <translation>示教点</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="37" />
+            <location filename="../../ui/audit_words.py" line="44" />
             <source>run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="38" />
+            <location filename="../../ui/audit_words.py" line="45" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="39" />
+            <location filename="../../ui/audit_words.py" line="46" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="40" />
+            <location filename="../../ui/audit_words.py" line="47" />
             <source>reduced speed</source>
             <translation>降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="41" />
+            <location filename="../../ui/audit_words.py" line="48" />
             <source>edit points</source>
             <translation>编辑点位</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="42" />
+            <location filename="../../ui/audit_words.py" line="49" />
             <source>edit plans</source>
             <translation>编辑轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="43" />
+            <location filename="../../ui/audit_words.py" line="50" />
             <source>edit envelope</source>
             <translation>编辑安全范围</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="44" />
+            <location filename="../../ui/audit_words.py" line="51" />
             <source>change robot model</source>
             <translation>更换机器人模型</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="45" />
+            <location filename="../../ui/audit_words.py" line="52" />
             <source>leave reduced speed</source>
             <translation>退出降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="46" />
+            <location filename="../../ui/audit_words.py" line="53" />
             <source>reconnect to the same controller</source>
             <translation>重新连接同一控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="47" />
+            <location filename="../../ui/audit_words.py" line="54" />
             <source>change connection</source>
             <translation>更改连接</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="48" />
+            <location filename="../../ui/audit_words.py" line="55" />
             <source>change register profile</source>
             <translation>更改寄存器配置</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="49" />
+            <location filename="../../ui/audit_words.py" line="56" />
             <source>manage roles and passwords</source>
             <translation>管理角色与密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="50" />
+            <location filename="../../ui/audit_words.py" line="57" />
             <source>write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="51" />
+            <location filename="../../ui/audit_words.py" line="58" />
             <source>write controller registers directly</source>
             <translation>直接写控制器寄存器</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="52" />
+            <location filename="../../ui/audit_words.py" line="59" />
             <source>move to point</source>
             <translation>运动到点</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="53" />
+            <location filename="../../ui/audit_words.py" line="60" />
             <source>set the idle lock time</source>
             <translation>设置空闲锁定时间</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="54" />
+            <location filename="../../ui/audit_words.py" line="61" />
             <source>reduced speed on</source>
             <translation>开启降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="55" />
+            <location filename="../../ui/audit_words.py" line="62" />
             <source>reduced speed off</source>
             <translation>关闭降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="56" />
+            <location filename="../../ui/audit_words.py" line="63" />
             <source>clear the administrator password</source>
             <translation>清除管理员密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="61" />
+            <location filename="../../ui/audit_words.py" line="68" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="62" />
+            <location filename="../../ui/audit_words.py" line="69" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="63" />
+            <location filename="../../ui/audit_words.py" line="70" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="68" />
+            <location filename="../../ui/audit_words.py" line="75" />
             <source>log in as {role}</source>
             <translation>以{role}身份登录</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="69" />
+            <location filename="../../ui/audit_words.py" line="76" />
             <source>log out ({role})</source>
             <translation>注销（{role}）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="72" />
+            <location filename="../../ui/audit_words.py" line="79" />
             <source>set the {role} password</source>
             <translation>设置{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="76" />
+            <location filename="../../ui/audit_words.py" line="83" />
             <source>change the {role} password</source>
             <translation>更改{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="80" />
+            <location filename="../../ui/audit_words.py" line="87" />
             <source>clear the {role} password</source>
             <translation>清除{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="84" />
+            <location filename="../../ui/audit_words.py" line="91" />
             <source>locked back to operator after {seconds} s idle</source>
             <translation>空闲 {seconds} s 后锁回操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="89" />
+            <location filename="../../ui/audit_words.py" line="96" />
             <source>{action} ({register})</source>
             <translation>{action}（{register}）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="91" />
+            <location filename="../../ui/audit_words.py" line="98" />
             <source>write {what}</source>
             <translation>写入 {what}</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="94" />
+            <location filename="../../ui/audit_words.py" line="101" />
             <source>sent; TeachPad stopped before the answer was recorded</source>
             <translation>已发送；记录应答之前 TeachPad 已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="95" />
+            <location filename="../../ui/audit_words.py" line="102" />
             <source>sent and answered; the controller's outcome was not recorded (still under way when read, or TeachPad stopped first)</source>
             <translation>已发送并已应答；未记录控制器的结果（读取时仍在进行，或 TeachPad 先停止了）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="153" />
+            <location filename="../../ui/audit_words.py" line="232" />
+            <source>not sent: the controller is busy (program {state}); wait for it to end, or stop it</source>
+            <translation>未发送：控制器忙（程序{state}）；请等它结束，或将其停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="239" />
+            <source>wrong password for the {role} role</source>
+            <translation>{role}角色的密码错误</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="244" />
+            <source>no password is set for the {role} role; an administrator sets it</source>
+            <translation>{role}角色尚未设置密码；由管理员设置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="252" />
+            <source>the {role} role needs its password: run it in a terminal, or set {env}</source>
+            <translation>{role}角色需要密码：请在终端中运行，或设置 {env}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="260" />
+            <source>the administrator password is needed: run it in a terminal, or set {env}</source>
+            <translation>需要管理员密码：请在终端中运行，或设置 {env}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="267" />
+            <source>wrong administrator password</source>
+            <translation>管理员密码错误</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="272" />
+            <source>the administrator password can be changed, not removed (anyone could then set it)</source>
+            <translation>管理员密码只能修改，不能清除（否则任何人都可以重新设置它）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="285" />
+            <source>P{id} cannot be checked against the safety envelope: the host has no copy of it (give the project holding the point with {option})</source>
+            <translation>P{id} 无法对照安全范围检查：主机没有它的副本（请用 {option} 给出含有该点的工程）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="312" />
+            <source>another Modbus master wrote to the controller less than {hold} s ago</source>
+            <translation>另一个 Modbus 主站在不到 {hold} s 前写过控制器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="372" />
             <source>needs the {need} role ({role} was logged in)</source>
             <translation>需要{need}角色（当时登录的是{role}）</translation>
         </message>
@@ -1145,137 +1190,137 @@
     <context>
         <name>JogPanel</name>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="264" />
+            <location filename="../../ui/panels/jog_panel.py" line="265" />
             <source>Base frame</source>
             <translation>基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="265" />
+            <location filename="../../ui/panels/jog_panel.py" line="266" />
             <source>User frame</source>
             <translation>用户坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="266" />
+            <location filename="../../ui/panels/jog_panel.py" line="267" />
             <source>Tool frame</source>
             <translation>工具坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="267" />
+            <location filename="../../ui/panels/jog_panel.py" line="268" />
             <source>Joint frame</source>
             <translation>关节坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="271" />
+            <location filename="../../ui/panels/jog_panel.py" line="272" />
             <source>User no.:</source>
             <translation>用户坐标号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="272" />
+            <location filename="../../ui/panels/jog_panel.py" line="273" />
             <source>Tool no.:</source>
             <translation>工具号：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="262" />
+            <location filename="../../ui/panels/jog_panel.py" line="263" />
             <source>Frame:</source>
             <translation>坐标系：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="273" />
+            <location filename="../../ui/panels/jog_panel.py" line="274" />
             <source>External axes</source>
             <translation>外部轴</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="357" />
+            <location filename="../../ui/panels/jog_panel.py" line="368" />
             <source>HOLD TO MOVE — release to stop</source>
             <translation>按住运动 — 松开即停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="277" />
+            <location filename="../../ui/panels/jog_panel.py" line="278" />
             <source>Speed:</source>
             <translation>速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="274" />
+            <location filename="../../ui/panels/jog_panel.py" line="275" />
             <source>J7–J11</source>
             <translation>J7–J11</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="275" />
+            <location filename="../../ui/panels/jog_panel.py" line="276" />
             <source>Touch mode: the rows show the external axes J7–J11</source>
             <translation>触屏模式：各行显示外部轴 J7–J11</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="282" />
+            <location filename="../../ui/panels/jog_panel.py" line="283" />
             <source>Keyboard: click this panel, then hold {plus} (+) or {minus} (−) for axes 1–6; releasing the key stops.</source>
             <translation>键盘：先单击本面板，再按住 {plus}（+）或 {minus}（−）点动第 1–6 轴；松开按键即停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="285" />
+            <location filename="../../ui/panels/jog_panel.py" line="286" />
             <source>Keys: hold {plus} (+) or {minus} (−)</source>
             <translation>按键：按住 {plus} (+) 或 {minus} (−)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="362" />
+            <location filename="../../ui/panels/jog_panel.py" line="373" />
             <source>Releasing — the controller has not confirmed</source>
             <translation>正在松开 — 控制器尚未确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="364" />
+            <location filename="../../ui/panels/jog_panel.py" line="375" />
             <source>Stopping — the controller has not confirmed</source>
             <translation>正在停止 — 控制器尚未确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="366" />
+            <location filename="../../ui/panels/jog_panel.py" line="377" />
             <source>The controller refused or did not answer the write that stops the arm. TeachPad sends it again at every poll until the controller answers and the arm is seen still.</source>
             <translation>控制器拒绝或未应答使机械臂停止的写入。TeachPad 每次轮询都会重新发送，直到控制器应答且确认机械臂已静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="370" />
+            <location filename="../../ui/panels/jog_panel.py" line="381" />
             <source>Stop was sent too.</source>
             <translation>也已发送停止命令。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="510" />
+            <location filename="../../ui/panels/jog_panel.py" line="521" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="510" />
+            <location filename="../../ui/panels/jog_panel.py" line="521" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="512" />
+            <location filename="../../ui/panels/jog_panel.py" line="523" />
             <source>Hold: {axis} − ({unit})</source>
             <translation>按住：{axis} −（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="515" />
+            <location filename="../../ui/panels/jog_panel.py" line="526" />
             <source>Hold: {axis} + ({unit})</source>
             <translation>按住：{axis} +（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="529" />
+            <location filename="../../ui/panels/jog_panel.py" line="540" />
             <source>{ratio} %</source>
             <translation>{ratio} %</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="534" />
+            <location filename="../../ui/panels/jog_panel.py" line="545" />
             <source>{ratio} % → {cap} % (reduced speed)</source>
             <translation>{ratio} % → {cap} %（降速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="536" />
+            <location filename="../../ui/panels/jog_panel.py" line="547" />
             <source>{ratio} % → {cap} %</source>
             <translation>{ratio} % → {cap} %</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="541" />
+            <location filename="../../ui/panels/jog_panel.py" line="552" />
             <source>Capped at {cap} % (reduced speed): the jog goes out at {cap} %, not {ratio} %</source>
             <translation>限制为 {cap} %（降速模式）：点动以 {cap} % 而不是 {ratio} % 发出</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="544" />
+            <location filename="../../ui/panels/jog_panel.py" line="555" />
             <source>Capped at {cap} % (the safety envelope's maximum): the jog goes out at {cap} %, not {ratio} %</source>
             <translation>限制为 {cap} %（安全范围的最大值）：点动以 {cap} % 而不是 {ratio} % 发出</translation>
         </message>
@@ -1401,18 +1446,18 @@
     <context>
         <name>MainWindow</name>
         <message>
-            <location filename="../../ui/window_column.py" line="100" />
+            <location filename="../../ui/window_column.py" line="116" />
             <source>Jog</source>
             <extracomment>How long the "another master" banner stays after the last sign of one (ms)</extracomment>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="101" />
+            <location filename="../../ui/window_column.py" line="117" />
             <source>Step</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="102" />
+            <location filename="../../ui/window_column.py" line="118" />
             <source>Program</source>
             <translation>程序</translation>
         </message>
@@ -1437,17 +1482,17 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="324" />
+            <location filename="../../ui/main_window.py" line="331" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="137" />
+            <location filename="../../ui/window_column.py" line="179" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="141" />
+            <location filename="../../ui/window_column.py" line="183" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
@@ -1468,7 +1513,7 @@
             <translation>往返 —</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="357" />
+            <location filename="../../ui/main_window.py" line="377" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
@@ -1493,29 +1538,30 @@
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="380" />
+            <location filename="../../ui/main_window.py" line="400" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="359" />
-            <location filename="../../ui/main_window.py" line="368" />
-            <location filename="../../ui/main_window.py" line="381" />
+            <location filename="../../ui/main_window.py" line="355" />
+            <location filename="../../ui/main_window.py" line="379" />
+            <location filename="../../ui/main_window.py" line="388" />
+            <location filename="../../ui/main_window.py" line="401" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="301" />
+            <location filename="../../ui/main_window.py" line="308" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="302" />
+            <location filename="../../ui/main_window.py" line="309" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="303" />
+            <location filename="../../ui/main_window.py" line="310" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1525,37 +1571,37 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="375" />
+            <location filename="../../ui/main_window.py" line="395" />
             <source>plan run</source>
             <translation>计划运行</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="455" />
+            <location filename="../../ui/main_window.py" line="475" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="457" />
+            <location filename="../../ui/main_window.py" line="477" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="470" />
+            <location filename="../../ui/main_window.py" line="490" />
             <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
             <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="472" />
+            <location filename="../../ui/main_window.py" line="492" />
             <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="491" />
+            <location filename="../../ui/main_window.py" line="511" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="491" />
+            <location filename="../../ui/main_window.py" line="511" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -2354,47 +2400,47 @@
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="516" />
+            <location filename="../../ui/messages.py" line="532" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="519" />
+            <location filename="../../ui/messages.py" line="535" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="565" />
+            <location filename="../../ui/messages.py" line="581" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="568" />
+            <location filename="../../ui/messages.py" line="584" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="572" />
+            <location filename="../../ui/messages.py" line="588" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="575" />
+            <location filename="../../ui/messages.py" line="591" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="578" />
+            <location filename="../../ui/messages.py" line="594" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="608" />
+            <location filename="../../ui/messages.py" line="624" />
             <source>{operation}: not sent, cancelled by Stop.</source>
             <translation>{operation}：未发送，已被停止取消。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="609" />
+            <location filename="../../ui/messages.py" line="625" />
             <source>{operation}: not sent, the upload was cancelled.</source>
             <translation>{operation}：未发送，上传已取消。</translation>
         </message>
@@ -2444,12 +2490,12 @@
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="525" />
+            <location filename="../../ui/messages.py" line="541" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="529" />
+            <location filename="../../ui/messages.py" line="545" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -4375,94 +4421,165 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProfileWords</name>
         <message>
-            <location filename="../../ui/messages_profile.py" line="24" />
+            <location filename="../../ui/messages_profile.py" line="31" />
             <source>the robot profile cannot be used</source>
             <translation>机器人模型配置文件无法使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="25" />
+            <location filename="../../ui/messages_profile.py" line="32" />
             <source>{value} is not a finite number</source>
             <translation>{value} 不是有限的数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="26" />
+            <location filename="../../ui/messages_profile.py" line="33" />
             <source>expected a list of six numbers X Y Z A B C, got {value}</source>
             <translation>应为六个数（X Y Z A B C）的列表，实际为 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="29" />
+            <location filename="../../ui/messages_profile.py" line="36" />
             <source>expected an object with {keys}</source>
             <translation>应为含有 {keys} 的对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="30" />
+            <location filename="../../ui/messages_profile.py" line="37" />
             <source>missing {keys}</source>
             <translation>缺少 {keys}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="31" />
+            <location filename="../../ui/messages_profile.py" line="38" />
             <source>the name {value} is not text</source>
             <translation>名称 {value} 不是文本</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="32" />
+            <location filename="../../ui/messages_profile.py" line="39" />
             <source>min_deg {low} is not below max_deg {high}</source>
             <translation>min_deg {low} 不小于 max_deg {high}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="33" />
+            <location filename="../../ui/messages_profile.py" line="40" />
             <source>a robot profile is a JSON object</source>
             <translation>机器人模型配置文件应为 JSON 对象</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="34" />
+            <location filename="../../ui/messages_profile.py" line="41" />
             <source>not a robot profile: its format is {value}, expected {expected}</source>
             <translation>不是机器人模型配置文件：format 为 {value}，应为 {expected}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="37" />
+            <location filename="../../ui/messages_profile.py" line="44" />
             <source>profile version {value} is not supported (this TeachPad reads version {expected})</source>
             <translation>不支持配置文件版本 {value}（本 TeachPad 读取版本 {expected}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="40" />
+            <location filename="../../ui/messages_profile.py" line="47" />
             <source>joints: expected a list of 1 to {most} joints</source>
             <translation>joints：应为含 1 到 {most} 个关节的列表</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="41" />
+            <location filename="../../ui/messages_profile.py" line="48" />
             <source>home_deg: expected {count} numbers, one per joint</source>
             <translation>home_deg：应为 {count} 个数，每个关节一个</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="42" />
+            <location filename="../../ui/messages_profile.py" line="49" />
             <source>too large for a robot profile (over {kb} kB)</source>
             <translation>文件过大，不是机器人模型配置文件（超过 {kb} kB）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="43" />
+            <location filename="../../ui/messages_profile.py" line="50" />
             <source>cannot read the robot profile ({cause})</source>
             <translation>无法读取机器人模型配置文件（{cause}）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="44" />
+            <location filename="../../ui/messages_profile.py" line="51" />
             <source>the robot profile is not UTF-8 text</source>
             <translation>机器人模型配置文件不是 UTF-8 文本</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="45" />
+            <location filename="../../ui/messages_profile.py" line="52" />
             <source>not valid JSON (line {line}, column {column})</source>
             <translation>不是有效的 JSON（第 {line} 行，第 {column} 列）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="47" />
+            <location filename="../../ui/messages_profile.py" line="54" />
+            <source>cannot read the {what} ({cause})</source>
+            <translation>无法读取{what}（{cause}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="55" />
+            <source>the {what} is not UTF-8 text</source>
+            <translation>{what}不是 UTF-8 文本</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="56" />
+            <source>the {what} is not valid JSON (line {line}, column {column})</source>
+            <translation>{what}不是有效的 JSON（第 {line} 行，第 {column} 列）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="61" />
+            <source>register profile</source>
+            <translation>寄存器配置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="62" />
+            <source>safety profile</source>
+            <translation>安全配置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="70" />
+            <source>the file is too large ({size} bytes, at most {limit})</source>
+            <translation>文件太大（{size} 字节，最多 {limit}）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="73" />
+            <source>the file does not exist</source>
+            <translation>文件不存在</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="74" />
+            <location filename="../../ui/messages_profile.py" line="75" />
+            <source>permission denied</source>
+            <translation>没有访问权限</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="76" />
+            <source>it is a folder, not a file</source>
+            <translation>这是文件夹，不是文件</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="77" />
+            <source>a folder on its path is a file</source>
+            <translation>其路径中的某个文件夹实际上是文件</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="78" />
+            <source>the file name is too long</source>
+            <translation>文件名太长</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="79" />
+            <source>the disk could not be read</source>
+            <translation>无法读取磁盘</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="81" />
+            <source>system error {errno}</source>
+            <translation>系统错误 {errno}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="82" />
             <source>joint {n}</source>
             <translation>关节 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_profile.py" line="48" />
+            <location filename="../../ui/messages_profile.py" line="83" />
             <source>joint {n} {key}</source>
             <translation>关节 {n} 的 {key}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_profile.py" line="151" />
+            <source>{why}; the remembered connection settings are used until an administrator saves a register profile</source>
+            <translation>{why}；在管理员保存寄存器配置之前，使用记住的连接设置</translation>
         </message>
     </context>
     <context>
@@ -5187,38 +5304,38 @@ Remove them all?</source>
             <translation>当前生效：记住的连接设置（尚未保存寄存器配置）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="266" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="268" />
             <source>Not loaded: {why}</source>
             <translation>未载入：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="269" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="271" />
             <source>Loaded “{name}” from {file}; press Save and apply to use it</source>
             <translation>已从 {file} 载入“{name}”；按“保存并应用”后生效</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="285" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="287" />
             <source>Cannot write {file}: {why}</source>
             <translation>无法写入 {file}：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="288" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="290" />
             <source>Saved to {file}</source>
             <translation>已保存到 {file}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="305" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="307" />
             <source>Load a register profile</source>
             <translation>载入寄存器配置</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="305" />
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="311" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="307" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="313" />
             <source>Register profiles (*.json)</source>
             <translation>寄存器配置 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/register_profile_dialog.py" line="311" />
+            <location filename="../../ui/dialogs/register_profile_dialog.py" line="313" />
             <source>Save the register profile as</source>
             <translation>寄存器配置另存为</translation>
         </message>
@@ -5331,77 +5448,77 @@ Remove them all?</source>
     <context>
         <name>SafetyController</name>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="206" />
+            <location filename="../../ui/controllers/safety.py" line="210" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="207" />
+            <location filename="../../ui/controllers/safety.py" line="211" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="208" />
+            <location filename="../../ui/controllers/safety.py" line="212" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="215" />
+            <location filename="../../ui/controllers/safety.py" line="219" />
             <source>Needs the {need} role (you are {role}); log in from the Safety menu</source>
             <translation>需要{need}角色（当前为{role}）；请从“安全”菜单登录</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="445" />
+            <location filename="../../ui/controllers/safety.py" line="464" />
             <source>{axis} = {value:.1f} is within stopping distance of the keep-out zone '{box}' (at {limit:.1f})</source>
             <translation>{axis} = {value:.1f}，已进入禁区“{box}”的停止距离内（边界 {limit:.1f}）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="449" />
+            <location filename="../../ui/controllers/safety.py" line="468" />
             <source>{axis} = {value:.1f} is within stopping distance of the limit at {limit:.1f}</source>
             <translation>{axis} = {value:.1f}，已进入限位 {limit:.1f} 的停止距离内</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="451" />
+            <location filename="../../ui/controllers/safety.py" line="470" />
             <source>{axis} = {value:.1f} mm is outside the allowed work space (limit {limit:.1f} mm)</source>
             <translation>{axis} = {value:.1f} mm 超出允许的工作空间（限值 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="454" />
+            <location filename="../../ui/controllers/safety.py" line="473" />
             <source>The path enters the keep-out zone '{box}' ({axis} = {value:.1f} mm, its face at {limit:.1f} mm)</source>
             <translation>路径进入禁区“{box}”（{axis} = {value:.1f} mm，边界在 {limit:.1f} mm）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="458" />
+            <location filename="../../ui/controllers/safety.py" line="477" />
             <source>{axis} = {value:.1f}° is beyond its limit {limit:.1f}°</source>
             <translation>{axis} = {value:.1f}° 超出限位 {limit:.1f}°</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="461" />
+            <location filename="../../ui/controllers/safety.py" line="480" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed in reduced-speed mode</source>
             <translation>速度 {value:g} mm/s 超过降速模式允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="463" />
+            <location filename="../../ui/controllers/safety.py" line="482" />
             <source>Speed {value:g} mm/s is above the {limit:g} mm/s allowed</source>
             <translation>速度 {value:g} mm/s 超过允许的 {limit:g} mm/s</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="467" />
+            <location filename="../../ui/controllers/safety.py" line="486" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed in reduced-speed mode</source>
             <translation>点动速度 {value:g} % 超过降速模式允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="469" />
+            <location filename="../../ui/controllers/safety.py" line="488" />
             <source>Jog speed {value:g} % is above the {limit:g} % allowed</source>
             <translation>点动速度 {value:g} % 超过允许的 {limit:g} %</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="474" />
+            <location filename="../../ui/controllers/safety.py" line="493" />
             <source>Segment {k}: {text}</source>
             <translation>第 {k} 段：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety.py" line="479" />
+            <location filename="../../ui/controllers/safety.py" line="503" />
             <source>Jog stopped before the limit: {why}</source>
             <translation>点动已在到达边界前停止：{why}</translation>
         </message>
@@ -6552,6 +6669,29 @@ Remove them all?</source>
             <location filename="../../ui/window_actions.py" line="213" />
             <source>Bigger motion buttons and an on-screen keypad for numbers</source>
             <translation>更大的运动按钮，数字输入使用屏幕小键盘</translation>
+        </message>
+    </context>
+    <context>
+        <name>WordOrderWords</name>
+        <message>
+            <location filename="../../ui/messages_word_order.py" line="27" />
+            <source>low word first (CDAB)</source>
+            <translation>低字在前（CDAB）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_word_order.py" line="28" />
+            <source>high word first (ABCD)</source>
+            <translation>高字在前（ABCD）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_word_order.py" line="30" />
+            <source>The controller's floats look word-swapped: set the register profile's word order to {order} (Safety → Register profile…), then connect again.</source>
+            <translation>控制器的浮点数看起来高低字颠倒了：请把寄存器配置的字序设为{order}（安全 → 寄存器配置…），然后重新连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_word_order.py" line="35" />
+            <source>Until then every position and speed read or sent is wrong. Read {current}, the pose is {read}; read {other}, it is {swapped}.</source>
+            <translation>在此之前，读到和发出的每个位置与速度都是错的。按{current}读取，位姿为 {read}；按{other}读取，则为 {swapped}。</translation>
         </message>
     </context>
 </TS>

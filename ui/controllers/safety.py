@@ -104,6 +104,10 @@ class SafetyController(QObject):
     capsChanged = Signal(object)  # MotionCaps | None: after every change of the envelope or the mode
     message = Signal(str)  # a refusal or a problem, already translated, for the event log / status
     # (emitted in the GUI thread only: its receivers touch widgets)
+    # A motion refused (a jog, a step, a move to a point) or a jog the guard stopped: a way to word
+    # it in the language in force (Callable[[], str]), for the motion area (ui/panels/jog_refusal.py)
+    motionRefused = Signal(object)
+    motionAccepted = Signal()  # a motion the guard rails let go (a jog, a step, a move to a point)
     _auditFailed = Signal(str)  # from the audit's own thread (the worker records writes)
 
     def __init__(
@@ -402,19 +406,22 @@ class SafetyController(QObject):
         try:
             self.session.check_step(pose, offsets, joint=joint, speed=speed)
         except (EnvelopeRefused, PermissionRefused) as exc:
-            return self.refusal(exc)
+            return self._motion_refused(exc)
+        self.motionAccepted.emit()
         return None
 
     def check_jog(self, pose: Pose | None, request: JogRequest) -> str | None:
         """Before a jog press (``request``'s ratio already capped): None, or why it would stop at
         once (audited). The worker's guard decides again on every poll."""
         if pose is None:
+            self.motionAccepted.emit()
             return None
         motion = JogMotion(request.frame, request.axis, request.direction, request.ratio)
         try:
             self.session.check_jog_start(pose, motion, self.poll_period)
         except (EnvelopeRefused, PermissionRefused) as exc:
-            return self.refusal(exc)
+            return self._motion_refused(exc)
+        self.motionAccepted.emit()
         return None
 
     def check_move(self, start: PointLike, segment: Segment, ledger: PointLedger) -> str | None:
@@ -433,9 +440,21 @@ class SafetyController(QObject):
         if start is None:
             return None  # an unknown point: the move refuses it itself
         try:
-            return self.check_move(start, Segment.line(point_id, speed), ledger)
+            self.session.check_move(start, Segment.line(point_id, speed), ledger)
+        except EnvelopeRefused as exc:
+            return self._motion_refused(exc)
         except TeachPadError as exc:
-            return str(exc)
+            text = str(exc)
+            self.motionRefused.emit(lambda: text)
+            return text
+        self.motionAccepted.emit()
+        return None
+
+    def _motion_refused(self, exc: EnvelopeRefused | PermissionRefused) -> str:
+        """A motion refused before it went out: told to the motion area (worded again on a language
+        change), its words in the language in force returned."""
+        self.motionRefused.emit(lambda: self.refusal(exc))
+        return self.refusal(exc)
 
     def violation_text(self, v: EnvelopeViolation) -> str:
         """:class:`EnvelopeViolation` in the operator's language."""
@@ -475,8 +494,13 @@ class SafetyController(QObject):
 
     @Slot(object)
     def _on_guard_stopped(self, violation: EnvelopeViolation) -> None:
+        self.motionRefused.emit(lambda: self.guard_stop_text(violation))
+        self.message.emit(self.guard_stop_text(violation))
+
+    def guard_stop_text(self, violation: EnvelopeViolation) -> str:
+        """The jog guard's stop before a boundary, in the operator's language."""
         why = self.violation_text(violation)
-        self.message.emit(self.tr("Jog stopped before the limit: {why}").format(why=why))
+        return self.tr("Jog stopped before the limit: {why}").format(why=why)
 
     @Slot(ConnectionState)
     def _on_connection(self, _state: ConnectionState) -> None:

@@ -336,6 +336,10 @@ def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> Safety
     window.view3d.robot.guard = safety
     window.view3d.on_built(lambda panel: attach_view3d(safety, panel))
     safety.message.connect(menu.show_message)  # a slot of the menu: a receiver in the GUI thread
+    # a refused motion is said in the motion area too, under its buttons, until the next accepted one
+    refusal_line = window.control_column.refusal_line
+    safety.motionRefused.connect(refusal_line.show_words)
+    safety.motionAccepted.connect(refusal_line.clear_refusal)
     if safety.problem:
         safety.message.emit(safety.problem)
     register_problem = window.settings.register_profile()[1]

@@ -263,7 +263,9 @@ class RegisterProfileDialog(QDialog):
         try:
             loaded = rp.load_register_profile(path)
         except TeachPadError as exc:
-            self.error.setText(self.tr("Not loaded: {why}").format(why=str(exc)[:200]))
+            from ui.messages import refusal_text  # its code in words (a file's cause), else the English
+
+            self.error.setText(self.tr("Not loaded: {why}").format(why=refusal_text(exc)[:200]))
             return
         self.set_profile(loaded)
         text = self.tr("Loaded \u201c{name}\u201d from {file}; press Save and apply to use it")

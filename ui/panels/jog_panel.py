@@ -146,6 +146,7 @@ class JogPanel(QWidget):
         self._halt: UnconfirmedHalt | None = None  # a stop the controller has not confirmed
         self._ratio_cap: float | None = None  # the envelope's cap in force (None: no envelope)
         self._reduced = False  # the cap is reduced-speed mode's
+        self._room = False  # the motion area's refusal line is shown under the panel (make_room)
 
         # compact rows: 6 rows of 40 px buttons fit a 1280×800 screen under the docks
         self.frame_box = QWidget(self)
@@ -350,8 +351,18 @@ class JogPanel(QWidget):
         self._halt = halt
         self._show_halt()
 
+    @Slot(bool)
+    def make_room(self, on: bool) -> None:
+        """The motion area's refusal line is shown under the panel (ui/panels/jog_refusal.py): the
+        keys hint and the standing "hold to move" instruction give it their height, so the six
+        rows still fit a 1280×800 screen without a scroll bar; an unconfirmed stop stays shown."""
+        self._room = on
+        self.keys_label.setVisible(not on)
+        self._show_halt()
+
     def _show_halt(self) -> None:
         halt = self._halt
+        self.hold_label.setVisible(halt is not None or not self._room)
         if halt is None:
             self.hold_label.setStyleSheet(_HOLD_STYLE)
             self.hold_label.setText(self.tr("HOLD TO MOVE — release to stop"))
