@@ -1099,82 +1099,82 @@
     <context>
         <name>EventLogPanel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="308" />
+            <location filename="../../ui/panels/event_log.py" line="324" />
             <source>Show:</source>
             <translation>显示：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="309" />
+            <location filename="../../ui/panels/event_log.py" line="325" />
             <source>All events</source>
             <translation>全部事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="310" />
+            <location filename="../../ui/panels/event_log.py" line="326" />
             <source>Warnings and errors</source>
             <translation>警告和错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="311" />
+            <location filename="../../ui/panels/event_log.py" line="327" />
             <source>Errors only</source>
             <translation>仅错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="312" />
+            <location filename="../../ui/panels/event_log.py" line="328" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="313" />
+            <location filename="../../ui/panels/event_log.py" line="329" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="356" />
+            <location filename="../../ui/panels/event_log.py" line="372" />
             <source>event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="357" />
+            <location filename="../../ui/panels/event_log.py" line="373" />
             <source>The event log is not saved for the next start: {why}</source>
             <translation>事件日志无法保存到下次启动：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="407" />
+            <location filename="../../ui/panels/event_log.py" line="423" />
             <source>alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="404" />
+            <location filename="../../ui/panels/event_log.py" line="420" />
             <source>Alarm raised: {name}</source>
             <translation>报警触发：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="404" />
+            <location filename="../../ui/panels/event_log.py" line="420" />
             <source>Alarm cleared: {name}</source>
             <translation>报警解除：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="413" />
+            <location filename="../../ui/panels/event_log.py" line="429" />
             <source>bit {n}</source>
             <translation>第 {n} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="417" />
+            <location filename="../../ui/panels/event_log.py" line="433" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="449" />
+            <location filename="../../ui/panels/event_log.py" line="465" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="474" />
+            <location filename="../../ui/panels/event_log.py" line="490" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="476" />
+            <location filename="../../ui/panels/event_log.py" line="492" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -1387,52 +1387,52 @@
     <context>
         <name>LinkGuard</name>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="135" />
+            <location filename="../../ui/controllers/link_guard.py" line="136" />
             <source>Disconnect</source>
             <translation>断开连接</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="139" />
+            <location filename="../../ui/controllers/link_guard.py" line="140" />
             <source>Disconnecting does not stop the robot, and TeachPad no longer shows what it does. Stop all motion first?</source>
             <translation>断开连接不会停止机器人，且 TeachPad 将不再显示它的动作。要先停止所有运动吗？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="143" />
+            <location filename="../../ui/controllers/link_guard.py" line="144" />
             <source>Stop, then disconnect</source>
             <translation>先停止，再断开</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="144" />
+            <location filename="../../ui/controllers/link_guard.py" line="145" />
             <source>Disconnect without stopping</source>
             <translation>不停止，直接断开</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="161" />
+            <location filename="../../ui/controllers/link_guard.py" line="162" />
             <source>Close TeachPad</source>
             <translation>关闭 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="162" />
+            <location filename="../../ui/controllers/link_guard.py" line="163" />
             <source>Closing TeachPad does not stop the robot. Stop all motion first?</source>
             <translation>关闭 TeachPad 不会停止机器人。要先停止所有运动吗？</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="163" />
+            <location filename="../../ui/controllers/link_guard.py" line="164" />
             <source>Stop, then close</source>
             <translation>先停止，再关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="164" />
+            <location filename="../../ui/controllers/link_guard.py" line="165" />
             <source>Close without stopping</source>
             <translation>不停止，直接关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="184" />
+            <location filename="../../ui/controllers/link_guard.py" line="185" />
             <source>the controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="186" />
+            <location filename="../../ui/controllers/link_guard.py" line="187" />
             <source>Under way on {endpoint}:
 {items}
 
@@ -1482,7 +1482,7 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="331" />
+            <location filename="../../ui/main_window.py" line="332" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1513,7 +1513,7 @@
             <translation>往返 —</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="377" />
+            <location filename="../../ui/main_window.py" line="378" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
@@ -1538,30 +1538,30 @@
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="400" />
+            <location filename="../../ui/main_window.py" line="401" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="355" />
-            <location filename="../../ui/main_window.py" line="379" />
-            <location filename="../../ui/main_window.py" line="388" />
-            <location filename="../../ui/main_window.py" line="401" />
+            <location filename="../../ui/main_window.py" line="356" />
+            <location filename="../../ui/main_window.py" line="380" />
+            <location filename="../../ui/main_window.py" line="389" />
+            <location filename="../../ui/main_window.py" line="402" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="308" />
+            <location filename="../../ui/main_window.py" line="309" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="309" />
+            <location filename="../../ui/main_window.py" line="310" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="310" />
+            <location filename="../../ui/main_window.py" line="311" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1571,37 +1571,37 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="395" />
+            <location filename="../../ui/main_window.py" line="396" />
             <source>plan run</source>
             <translation>计划运行</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="475" />
+            <location filename="../../ui/main_window.py" line="476" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="477" />
+            <location filename="../../ui/main_window.py" line="478" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="490" />
+            <location filename="../../ui/main_window.py" line="491" />
             <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
             <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="492" />
+            <location filename="../../ui/main_window.py" line="493" />
             <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="511" />
+            <location filename="../../ui/main_window.py" line="512" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="511" />
+            <location filename="../../ui/main_window.py" line="512" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -3752,12 +3752,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="349" />
+            <location filename="../../ui/panels/planner_panel.py" line="352" />
             <source>This cell cannot be edited: {why}</source>
             <translation>无法编辑此单元格：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="456" />
+            <location filename="../../ui/panels/planner_panel.py" line="459" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -3778,159 +3778,159 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="170" />
+            <location filename="../../ui/controllers/point_sync.py" line="171" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="181" />
+            <location filename="../../ui/controllers/point_sync.py" line="182" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="191" />
+            <location filename="../../ui/controllers/point_sync.py" line="192" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="193" />
+            <location filename="../../ui/controllers/point_sync.py" line="194" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="200" />
+            <location filename="../../ui/controllers/point_sync.py" line="201" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="226" />
+            <location filename="../../ui/controllers/point_sync.py" line="227" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="234" />
+            <location filename="../../ui/controllers/point_sync.py" line="235" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="237" />
+            <location filename="../../ui/controllers/point_sync.py" line="238" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="239" />
+            <location filename="../../ui/controllers/point_sync.py" line="240" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="248" />
+            <location filename="../../ui/controllers/point_sync.py" line="249" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="299" />
+            <location filename="../../ui/controllers/point_sync.py" line="304" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="322" />
+            <location filename="../../ui/controllers/point_sync.py" line="327" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="325" />
+            <location filename="../../ui/controllers/point_sync.py" line="330" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="356" />
+            <location filename="../../ui/controllers/point_sync.py" line="361" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="377" />
+            <location filename="../../ui/controllers/point_sync.py" line="382" />
             <source>Connected to another controller ({endpoint}): {n} points are not known to be on it. Restore all to create them there.</source>
             <translation>已连接到另一台控制器（{endpoint}）：不知道它是否保存着这 {n} 个点。点击“恢复全部”在其上创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="382" />
+            <location filename="../../ui/controllers/point_sync.py" line="387" />
             <source>The controller restarted, or it is not the one the points were uploaded to: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启，或不是上传这些点的那台控制器：其上可能已没有这 {n} 个点。点击“恢复全部”重新创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="410" />
+            <location filename="../../ui/controllers/point_sync.py" line="415" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="419" />
+            <location filename="../../ui/controllers/point_sync.py" line="424" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="430" />
+            <location filename="../../ui/controllers/point_sync.py" line="435" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="435" />
+            <location filename="../../ui/controllers/point_sync.py" line="440" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="445" />
+            <location filename="../../ui/controllers/point_sync.py" line="450" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="454" />
+            <location filename="../../ui/controllers/point_sync.py" line="459" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="459" />
+            <location filename="../../ui/controllers/point_sync.py" line="464" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="479" />
+            <location filename="../../ui/controllers/point_sync.py" line="484" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="266" />
-            <location filename="../../ui/controllers/point_sync.py" line="483" />
+            <location filename="../../ui/controllers/point_sync.py" line="269" />
+            <location filename="../../ui/controllers/point_sync.py" line="488" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="491" />
-            <location filename="../../ui/controllers/point_sync.py" line="500" />
+            <location filename="../../ui/controllers/point_sync.py" line="496" />
+            <location filename="../../ui/controllers/point_sync.py" line="505" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="546" />
+            <location filename="../../ui/controllers/point_sync.py" line="551" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="549" />
+            <location filename="../../ui/controllers/point_sync.py" line="554" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="561" />
+            <location filename="../../ui/controllers/point_sync.py" line="566" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="566" />
+            <location filename="../../ui/controllers/point_sync.py" line="571" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="573" />
+            <location filename="../../ui/controllers/point_sync.py" line="578" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -4035,92 +4035,92 @@
             <translation>外部轴（仅记录：控制器不保存）；CSV 列 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="236" />
+            <location filename="../../ui/models/points_model.py" line="221" />
             <source>no reason given</source>
             <translation>未给出原因</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="237" />
+            <location filename="../../ui/models/points_model.py" line="222" />
             <source>Upload failed: {reason}</source>
             <translation>上传失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="240" />
+            <location filename="../../ui/models/points_model.py" line="225" />
             <source>Not known whether the controller holds this point (it restarted, it is another controller, or the arm did not arrive there): a move to it creates it again first</source>
             <translation>不知道控制器是否保存着此点（控制器已重启、是另一台控制器，或机械臂未到达该点）：移动到此点时会先重新创建它</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="244" />
+            <location filename="../../ui/models/points_model.py" line="229" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="245" />
+            <location filename="../../ui/models/points_model.py" line="230" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="247" />
+            <location filename="../../ui/models/points_model.py" line="232" />
             <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
             <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="255" />
+            <location filename="../../ui/models/points_model.py" line="240" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="285" />
+            <location filename="../../ui/models/points_model.py" line="287" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="314" />
+            <location filename="../../ui/models/points_model.py" line="316" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="331" />
+            <location filename="../../ui/models/points_model.py" line="333" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="360" />
+            <location filename="../../ui/models/points_model.py" line="362" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="362" />
+            <location filename="../../ui/models/points_model.py" line="364" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="381" />
+            <location filename="../../ui/models/points_model.py" line="383" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="383" />
+            <location filename="../../ui/models/points_model.py" line="385" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="399" />
+            <location filename="../../ui/models/points_model.py" line="401" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="399" />
+            <location filename="../../ui/models/points_model.py" line="401" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="422" />
+            <location filename="../../ui/models/points_model.py" line="424" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="442" />
+            <location filename="../../ui/models/points_model.py" line="444" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -6098,37 +6098,37 @@ Remove them all?</source>
     <context>
         <name>TrafficModel</name>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="106" />
+            <location filename="../../ui/models/traffic_model.py" line="105" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="107" />
+            <location filename="../../ui/models/traffic_model.py" line="106" />
             <source>Dir</source>
             <translation>方向</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="108" />
+            <location filename="../../ui/models/traffic_model.py" line="107" />
             <source>Bytes</source>
             <translation>字节</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="109" />
+            <location filename="../../ui/models/traffic_model.py" line="108" />
             <source>Meaning</source>
             <translation>含义</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="111" />
+            <location filename="../../ui/models/traffic_model.py" line="110" />
             <source>→ Tx</source>
             <translation>→ 发送</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="112" />
+            <location filename="../../ui/models/traffic_model.py" line="111" />
             <source>← Rx</source>
             <translation>← 接收</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="357" />
+            <location filename="../../ui/models/traffic_model.py" line="384" />
             <source>{n} bytes</source>
             <translation>{n} 字节</translation>
         </message>
@@ -6319,38 +6319,38 @@ Remove them all?</source>
     <context>
         <name>UnderWay</name>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="88" />
+            <location filename="../../ui/controllers/link_guard.py" line="89" />
             <source>a program is running</source>
             <extracomment>mm or degrees: a smaller change between two polled poses is noise, not motion s: the arm counts as moving while the last good poll came within this of its last movement (a stale pose that was still changing when the link went counts as moving)</extracomment>
             <translation>程序正在运行</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="90" />
+            <location filename="../../ui/controllers/link_guard.py" line="91" />
             <source>a program is paused</source>
             <translation>程序已暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="92" />
+            <location filename="../../ui/controllers/link_guard.py" line="93" />
             <source>a jog is held</source>
             <translation>点动按住中</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="96" />
+            <location filename="../../ui/controllers/link_guard.py" line="97" />
             <source>{operation}: under way</source>
             <translation>{operation}：正在进行</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="98" />
+            <location filename="../../ui/controllers/link_guard.py" line="99" />
             <source>a plan run is under way</source>
             <translation>规划正在运行</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="101" />
+            <location filename="../../ui/controllers/link_guard.py" line="102" />
             <source>the arm is moving</source>
             <translation>机械臂正在运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/link_guard.py" line="103" />
+            <location filename="../../ui/controllers/link_guard.py" line="104" />
             <source>the arm was moving when last seen</source>
             <translation>最后一次看到时机械臂正在运动</translation>
         </message>
