@@ -11,6 +11,7 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
+from app.link.ops import GoZero
 from app.models import Pose
 from app.protocol.codec import WordOrder
 from app.protocol.word_order_check import judge_pose
@@ -81,7 +82,7 @@ def test_the_right_word_order_is_never_doubted(qtbot: Any, sim_factory: Any, win
     connect(qtbot, window.link, sim, poll_timeout=1.0)
     qtbot.waitUntil(lambda: window.link.state.pose is not None, timeout=SIGNAL_TIMEOUT_MS)
     with qtbot.waitSignal(window.link.state.lastResultChanged, timeout=30_000) as ended:
-        window.link.go_zero(None)  # every axis to zero, and the poses on the way
+        window.link.submit(GoZero(None))  # every axis to zero, and the poses on the way
     assert ended.args[0].ok, ended.args[0]
     assert all(abs(j) < 1e-3 for j in sim.state().joints[:6])  # at the zero pose
     panel = window.jog_panel

@@ -13,6 +13,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 from app.link.client import StepFrame
+from app.link.ops import GoZero
 from app.protocol import registers
 from app.safety.envelope import Box, Envelope
 from tests.safety.test_gui_motion import _envelope
@@ -131,7 +132,7 @@ def test_go_to_zero_refused_in_reduced_speed_reads_in_the_motion_area(
     writes = len(sim.writes)
     line = window.control_column.refusal_line
     with qtbot.waitSignal(window.link.errorOccurred, timeout=SIGNAL_TIMEOUT_MS):
-        window.link.go_zero(None)
+        window.link.submit(GoZero(None))
     qtbot.waitUntil(line.isVisible, timeout=SIGNAL_TIMEOUT_MS)
     assert_chinese(line.text())
     assert not [w for w in sim.writes[writes:] if w.address == registers.REG_GO_ZERO]  # never written
