@@ -31,7 +31,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     window_fixture,
 )
 from ui.main_window import MainWindow
-from ui.panels.view3d_canvas import TRIAD_PX, View3DCanvas
+from ui.panels.view3d_canvas import View3DCanvas
 from ui.panels.view3d_panel import View3DPanel
 
 DEMO = Path(__file__).resolve().parents[2] / "resources" / "samples" / "demo.teachpad.json"
@@ -242,6 +242,8 @@ def test_tcp_triad_keeps_its_screen_size_whatever_the_zoom(
         canvas.zoom_at(factor, x, y)
         canvas.repaint()
         lengths.append(_triad_px(canvas))
+    from ui.panels.view3d_canvas import TRIAD_PX
+
     assert lengths[0] == pytest.approx(TRIAD_PX, rel=0.15)  # the longest axis lies nearly across the view
     assert lengths[1] == pytest.approx(lengths[0], rel=0.03)
     assert lengths[2] == pytest.approx(lengths[0], rel=0.03)
