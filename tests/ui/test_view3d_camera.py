@@ -149,7 +149,10 @@ def test_the_wheel_zooms_about_the_cursor(qtbot: Any, window: MainWindow) -> Non
     xyz = np.array(model.point_at(model.row_of(2)).xyz)  # type: ignore[arg-type]
     x, y = _screen(canvas, xyz)[0]  # the cursor on point P2, away from the centre
     assert abs(x - canvas.width() / 2) > 40 or abs(y - canvas.height() / 2) > 40
-    plane = canvas.camera.point_at(x, y, canvas.width(), canvas.height())  # the world under the cursor
+    cam, w, h = canvas.camera, canvas.width(), canvas.height()
+    ppm = cam.pixels_per_mm(h)  # the world under the cursor, on the target's plane
+    plane = np.array(cam.target) + ((x - w / 2) * cam.basis[0] + (h / 2 - y) * cam.basis[1]) / ppm
+    assert np.allclose(_screen(canvas, plane)[0], (x, y))
     before = canvas.camera
     for notches in (3, -5, 1):
         _wheel(canvas, x, y, notches)
