@@ -286,3 +286,28 @@ def test_dry_run_plays_every_loop_and_names_it_in_both_languages(qtbot: Any, win
     assert bar.loop_label.text() == "第 2 轮（无限循环：之后每轮都相同）"
     window.set_language("en")
     assert bar.loop_label.text() == "loop 2 (endless: every later loop is the same)"
+
+
+@pytest.mark.parametrize("size", [(1280, 800), (1920, 1080)], ids=lambda s: f"{s[0]}x{s[1]}")
+@pytest.mark.parametrize("language", ["en", "zh_CN"])
+def test_the_3d_view_lays_out_whole_in_both_languages(
+    qtbot: Any, window: MainWindow, translator: Any, language: str, size: tuple[int, int]
+) -> None:
+    """Its buttons (Fit plan too), the model's line and the dry run bar with its loop: no text
+    clipped, no two widgets on top of each other, in its tab and beside the planner."""
+    from tests.ui.layout_audit import clipped_texts, overlapping_siblings
+    from tests.ui.test_layout import cjk_font_installed
+
+    assert window.project.open_file(DEMO)
+    window.set_language(language)
+    panel = _panel(window, qtbot, size)
+    window.planner_panel.select_plan(0)  # 2 loops: the loop shows in the dry run bar
+    qtbot.waitUntil(lambda: panel.dry_bar.loop_label.isVisible())
+    for where in ("tab", "beside the planner"):
+        panel.beside_button.setChecked(where != "tab")
+        qtbot.waitUntil(lambda: panel.isVisible())
+        _settle()
+        found = overlapping_siblings(panel)
+        if language == "en" or cjk_font_installed():
+            found += clipped_texts(panel)
+        assert not found, (where, found)
