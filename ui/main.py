@@ -42,7 +42,6 @@ if TYPE_CHECKING:  # subprocess and queue: imported when a simulator is started 
 
 SCREENSHOT_SETTLE_MS = 1500  # after the first pose: let the plots fill and the panels paint
 SCREENSHOT_TIMEOUT_MS = 20_000  # give up when no pose arrives
-VIEW3D_TAB = "3d"  # --tab: the 3D view's tab (built by ui/panels/view3d_host.py, not one of TAB_NAMES)
 DEMO_PROGRAM = 1  # the simulator's "square 100 mm in XY"
 SIM_START_TIMEOUT = 20.0  # s for the simulator process to say which port it listens on
 SIM_START_LATEST_MS = 5000  # start the simulator then, even when the window has not painted yet
@@ -279,9 +278,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--screenshot", metavar="PNG", help="save the window once connected with a pose, then exit"
     )
     parser.add_argument("--project", metavar="FILE", help="open this project (.teachpad.json) at start")
-    parser.add_argument(
-        "--tab", choices=(*TAB_NAMES, VIEW3D_TAB), help="work tab to show first (3d: the 3D view)"
-    )
+    parser.add_argument("--tab", choices=TAB_NAMES, help="work tab to show first")
     parser.add_argument(
         "--demo",
         action="store_true",
@@ -390,13 +387,6 @@ class _Screenshot:
         self.settle.stop()
 
 
-def _show_first_tab(window: MainWindow, tab: str) -> None:
-    if tab == VIEW3D_TAB:
-        window.work_tabs.setCurrentWidget(window.view3d.panel)
-    else:
-        window.show_tab(tab)
-
-
 def _start_session(window: MainWindow, project: str | None, *, shot_run: bool) -> None:
     """After the first paint: the event log of earlier sessions (kept from now on), the project.
     A screenshot run shows its own events only and never stops on a question."""
@@ -452,7 +442,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
     if args.size:
         window.resize(*args.size)
     if args.tab:
-        _show_first_tab(window, args.tab)
+        window.show_tab(args.tab)
     exit_loop = _LoopExit(app)
     starting_ms = round(SIM_START_TIMEOUT * 1000) if args.sim else 0
     shot = _Screenshot(window, link, args.screenshot, exit_loop, starting_ms) if args.screenshot else None

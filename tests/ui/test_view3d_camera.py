@@ -146,7 +146,9 @@ def test_the_wheel_zooms_about_the_cursor(qtbot: Any, window: MainWindow) -> Non
     canvas = panel.canvas
     canvas.set_camera(canvas.camera.preset(Preset.ISO))
     model = window.project.points_model
-    xyz = np.array(model.point_at(model.row_of(2)).xyz)  # type: ignore[arg-type]
+    row = model.row_of(2)
+    assert row is not None
+    xyz = np.array(model.point_at(row).xyz)
     x, y = _screen(canvas, xyz)[0]  # the cursor on point P2, away from the centre
     assert abs(x - canvas.width() / 2) > 40 or abs(y - canvas.height() / 2) > 40
     cam, w, h = canvas.camera, canvas.width(), canvas.height()
@@ -209,17 +211,19 @@ def test_point_labels_never_overlap_and_the_selected_one_shows(qtbot: Any, windo
     hidden = sorted(set(int(i) for i in canvas.point_ids) - {pid for pid, _r in canvas.label_rects})
     assert hidden
     row = window.project.points_model.row_of(hidden[0])
+    assert row is not None
     window.points_panel.select_rows([row])
     canvas.repaint()
     assert hidden[0] in {pid for pid, _r in canvas.label_rects}
     assert not _overlapping(canvas.label_rects)
     # ... and so does the hovered one
     others = sorted(set(int(i) for i in canvas.point_ids) - {pid for pid, _r in canvas.label_rects})
-    if others:
-        x, y = _screen(canvas, canvas.point_xyz[list(canvas.point_ids).index(others[0])])[0]
-        assert canvas.hover_at(x, y) is not None
-        canvas.repaint()
-        assert canvas.hovered_id in {pid for pid, _r in canvas.label_rects}
+    assert others
+    x, y = _screen(canvas, canvas.point_xyz[[int(i) for i in canvas.point_ids].index(others[0])])[0]
+    assert canvas.hover_at(x, y) is not None
+    canvas.repaint()
+    assert canvas.hovered_id in {pid for pid, _r in canvas.label_rects}
+    assert not _overlapping(canvas.label_rects)
 
 
 def _triad_px(canvas: View3DCanvas) -> float:

@@ -12,7 +12,8 @@ profile cannot reach (or only past a joint limit) are red. The dry run bar plays
 the drawn arm without sending anything, every loop of it ("loop 2 of 20"). *Fit all* frames
 the arm, the points and the plan, *Fit plan* the selected plan's path and its points; until the
 operator moves the camera it follows the scene (:mod:`ui.panels.view3d_canvas` says when). What
-the scene shows of the points and the plan (colours, sampling, red samples) is worked out without widgets in :mod:`ui.panels.view3d_scene`.
+the scene shows of the points and the plan (colours, sampling, red samples) is worked out
+without widgets in :mod:`ui.panels.view3d_scene`.
 
 The header names the robot model in use (its file and whether it agrees with the controller in
 the tooltip); a model whose forward kinematics disagree with the controller's pose is said in
