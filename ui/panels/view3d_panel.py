@@ -368,6 +368,7 @@ class View3DPanel(QWidget):
         from dataclasses import replace
 
         self.canvas.set_camera(replace(self.canvas.camera, ortho=ortho))
+        self.canvas.auto_fit()  # the same scene framed in the other projection (unless moved)
 
     # --- live robot ----------------------------------------------------------------------
     @Slot(object)
