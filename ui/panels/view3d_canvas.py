@@ -22,7 +22,7 @@ point names never overlap (:mod:`ui.panels.view3d_labels`).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Final
 
 import numpy as np
@@ -74,6 +74,7 @@ AA_MAX_PATH_ROWS: Final = 10_000  # longer paths are drawn without antialiasing
 MAX_LABELS: Final = 40  # point names drawn when few points are visible (the hovered and selected: always)
 LABEL_MIN_PX_PER_MM: Final = 0.6  # or when zoomed in this far
 LABEL_FONT_PT: Final = 8
+LABEL_BACKING: Final = QColor(255, 255, 255, 170)  # behind a name: readable over the arm and the path
 GRID_EXTENT_MM: Final = 1500.0
 GRID_STEP_MM: Final = 100.0
 AXIS_MM: Final = 150.0  # base frame axes
@@ -103,6 +104,8 @@ class View3DCanvas(QWidget):
         self.auto_camera = True  # the camera follows the scene until the operator moves it
         self._buf = Buffers()
         self._static: QPixmap | None = None
+        self._labels: QPixmap | None = None  # the names, drawn over the arm
+        self._point_depth = np.zeros(0)  # of the points drawn last (the names' priority)
         self._dragging = False
         self._press: QPointF | None = None
         self._last: QPointF | None = None
@@ -283,21 +286,30 @@ class View3DCanvas(QWidget):
     def render_scene(self, painter: QPainter) -> None:
         """Draw everything with ``painter`` (the widget's, or an image's in the benchmark)."""
         w, h = self.width(), self.height()
-        if self._dragging:
+        if self._dragging:  # no names while dragging
             painter.fillRect(0, 0, w, h, QColor(COLOR_BACKGROUND))
             self._draw_static(painter, lod=True)
-        else:
-            ratio = self.devicePixelRatioF()
-            if self._static is None or self._static.size() != self.size() * ratio:
-                pix = QPixmap(self.size() * ratio)
-                pix.setDevicePixelRatio(ratio)
-                pix.fill(QColor(COLOR_BACKGROUND))
-                p = QPainter(pix)
-                self._draw_static(p, lod=False)
-                p.end()
-                self._static = pix
-            painter.drawPixmap(0, 0, self._static)
+            self._draw_dynamic(painter)
+            return
+        ratio = self.devicePixelRatioF()
+        if self._static is None or self._labels is None or self._static.size() != self.size() * ratio:
+            self._static = self._layer(
+                ratio, QColor(COLOR_BACKGROUND), lambda p: self._draw_static(p, lod=False)
+            )
+            self._labels = self._layer(ratio, QColor(Qt.GlobalColor.transparent), self._draw_labels)
+        painter.drawPixmap(0, 0, self._static)
         self._draw_dynamic(painter)
+        painter.drawPixmap(0, 0, self._labels)  # the names over the arm: always readable
+
+    def _layer(self, ratio: float, background: QColor, draw: Callable[[QPainter], None]) -> QPixmap:
+        """A cached layer of the canvas's size, drawn once by ``draw``."""
+        pix = QPixmap(self.size() * ratio)
+        pix.setDevicePixelRatio(ratio)
+        pix.fill(background)
+        p = QPainter(pix)
+        draw(p)
+        p.end()
+        return pix
 
     def _draw_static(self, painter: QPainter, *, lod: bool) -> None:
         painter.setRenderHint(QPainter.RenderHint.Antialiasing, False)
@@ -380,8 +392,7 @@ class View3DCanvas(QWidget):
         if len(bad):
             self._buf.draw_sprites(painter, bad, COLOR_ERROR, MARKER_PX + 3)
         self.drawn["bad_points"] = bad
-        if not lod:
-            self._draw_labels(painter, pts, depth)
+        self._point_depth = depth
 
     def _draw_arrows(self, painter: QPainter, lod: bool) -> None:
         """One arrowhead per segment at its middle sample, pointing along the path."""
@@ -432,8 +443,14 @@ class View3DCanvas(QWidget):
         rest = [int(r) for r in ranked[: MAX_LABELS * 2 + len(must)] if int(r) not in taken]
         return must + rest, len(must)
 
-    def _draw_labels(self, painter: QPainter, pts: FloatArray, depth: FloatArray) -> None:
-        order, must = self._label_order(pts, depth)
+    def _draw_labels(self, painter: QPainter) -> None:
+        """The points' names (after a full static layer: drawn["points"] holds every point), each
+        on a light backing so that it reads over the arm and the path."""
+        pts = self.drawn.get("points", np.zeros((0, 2)))
+        if not len(pts) or len(pts) != len(self.point_ids):
+            self.label_rects = []
+            return
+        order, must = self._label_order(pts, self._point_depth)
         font = QFont(painter.font().family(), LABEL_FONT_PT)
         metrics = QFontMetricsF(font)
         sizes = np.zeros((len(pts), 2))
@@ -444,6 +461,7 @@ class View3DCanvas(QWidget):
         painter.setFont(font)
         for (_pid, rect), (row, _r) in zip(self.label_rects, placed, strict=True):
             must_show = row in order[:must]
+            painter.fillRect(rect, LABEL_BACKING)
             painter.setPen(QColor(COLOR_INK if must_show else COLOR_INK_SOFT))
             painter.drawText(rect, Qt.AlignmentFlag.AlignCenter, self.point_names[row])
 
