@@ -202,6 +202,8 @@ def test_point_labels_never_overlap_and_the_selected_one_shows(qtbot: Any, windo
             rects = canvas.label_rects
             assert rects and not _overlapping(rects), (preset, zoom, _overlapping(rects))
             assert all(canvas.rect().contains(r.toAlignedRect()) for _pid, r in rects)
+            badges = canvas._badge_rects()  # "no pose: home position shown" at least
+            assert badges and not [pid for pid, r in rects if any(r.intersects(b) for b in badges)]
             hidden_somewhere |= set(int(i) for i in canvas.point_ids) - {pid for pid, _r in rects}
     assert hidden_somewhere  # crowded views hide names (today they pile up)
     # a crowded view: the selected point's name shows whatever its rank, still without overlap

@@ -232,7 +232,7 @@ class View3DCanvas(QWidget):
     def set_badges(self, badges: list[tuple[str, str]]) -> None:
         if badges != self.badges:
             self.badges = badges
-            self.update()
+            self.invalidate()  # the point names keep clear of the badges
 
     def scene_bounds(self) -> FloatArray:
         parts = [self.point_xyz, self.path_xyz, np.zeros((1, 3))]
@@ -290,6 +290,7 @@ class View3DCanvas(QWidget):
             painter.fillRect(0, 0, w, h, QColor(COLOR_BACKGROUND))
             self._draw_static(painter, lod=True)
             self._draw_dynamic(painter)
+            self._draw_overlay(painter)
             return
         ratio = self.devicePixelRatioF()
         if self._static is None or self._labels is None or self._static.size() != self.size() * ratio:
@@ -300,6 +301,7 @@ class View3DCanvas(QWidget):
         painter.drawPixmap(0, 0, self._static)
         self._draw_dynamic(painter)
         painter.drawPixmap(0, 0, self._labels)  # the names over the arm: always readable
+        self._draw_overlay(painter)  # the badges and the scale over everything
 
     def _layer(self, ratio: float, background: QColor, draw: Callable[[QPainter], None]) -> QPixmap:
         """A cached layer of the canvas's size, drawn once by ``draw``."""
@@ -451,12 +453,13 @@ class View3DCanvas(QWidget):
             self.label_rects = []
             return
         order, must = self._label_order(pts, self._point_depth)
-        font = QFont(painter.font().family(), LABEL_FONT_PT)
+        font = QFont(self.font().family(), LABEL_FONT_PT)
         metrics = QFontMetricsF(font)
         sizes = np.zeros((len(pts), 2))
         for row in order:
             sizes[row] = (metrics.horizontalAdvance(self.point_names[row]) + 2.0, metrics.height())
-        placed = place_labels(pts, sizes, order, (self.width(), self.height()), must)
+        blocked = [(r.x(), r.y(), r.width(), r.height()) for r in [*self._badge_rects(), self._scale()[2]]]
+        placed = place_labels(pts, sizes, order, (self.width(), self.height()), must, blocked)
         self.label_rects = [(int(self.point_ids[row]), QRectF(*rect)) for row, rect in placed]
         painter.setFont(font)
         for (_pid, rect), (row, _r) in zip(self.label_rects, placed, strict=True):
@@ -487,7 +490,6 @@ class View3DCanvas(QWidget):
             self._buf.draw_polyline(painter, cam.project(self.trace, w, h)[0])
         self._draw_arm(painter, self.arm, self.flange, COLOR_ARM, "flange")
         self._draw_arm(painter, self.ghost_arm, self.ghost_flange, COLOR_GHOST_ARM, "ghost_flange")
-        self._draw_overlay(painter)
 
     def _draw_arm(
         self, painter: QPainter, links: FloatArray | None, flange: FloatArray | None, color: str, key: str
@@ -514,35 +516,50 @@ class View3DCanvas(QWidget):
         self.drawn[key] = tri[:1]
         self.drawn[f"{key}_triad"] = tri
 
+    def _badge_font(self) -> QFont:
+        font = QFont(self.font())
+        font.setBold(True)
+        return font
+
+    def _badge_rects(self) -> list[QRectF]:
+        """Where the badges go (top left, side by side)."""
+        metrics = QFontMetricsF(self._badge_font())
+        rects, x = [], 8.0
+        for text, _color in self.badges:
+            width = float(int(metrics.horizontalAdvance(text) + 12))
+            rects.append(QRectF(x, 8, width, metrics.height() + 6))
+            x += width + 6
+        return rects
+
+    def _scale(self) -> tuple[float, str, QRectF]:
+        """The scale bar: its length in pixels, its words and the rectangle both take (bottom
+        left): the grid step at the target's depth, rounded to a nice length."""
+        ppm = self.camera.pixels_per_mm(self.height())
+        length = nice_step(80.0 / max(ppm, 1e-9))
+        bar = length * ppm
+        text = f"{length:g} mm · {self.scale_text}"
+        width = 16 + bar + QFontMetricsF(QFont(self.font().family(), LABEL_FONT_PT)).horizontalAdvance(text)
+        return bar, text, QRectF(0, self.height() - 26, width + 4, 26)
+
     def _draw_overlay(self, painter: QPainter) -> None:
         """Badges (top left) and the grid's scale (bottom left)."""
         painter.setRenderHint(QPainter.RenderHint.Antialiasing, True)
-        font = QFont(painter.font())
-        font.setBold(True)
-        painter.setFont(font)
-        metrics = painter.fontMetrics()
-        x = 8
-        for text, color in self.badges:
-            width = metrics.horizontalAdvance(text) + 12
-            rect = QRectF(x, 8, width, metrics.height() + 6)
+        painter.setFont(self._badge_font())
+        for (text, color), rect in zip(self.badges, self._badge_rects(), strict=True):
             painter.setPen(pen(color, 1.5))
             painter.setBrush(QColor(COLOR_WHITE))
             painter.drawRoundedRect(rect, 4, 4)
             painter.setPen(QColor(color))
             painter.drawText(rect, Qt.AlignmentFlag.AlignCenter, text)
-            x += int(width) + 6
-        # scale bar: the grid step at the target's depth, rounded to a nice length
-        ppm = self.camera.pixels_per_mm(self.height())
-        length = nice_step(80.0 / max(ppm, 1e-9))
-        bar = length * ppm
+        bar, text, _rect = self._scale()
         y = self.height() - 14
         painter.setPen(pen(COLOR_AXIS, 2))
         painter.drawLine(QPointF(10, y), QPointF(10 + bar, y))
         painter.drawLine(QPointF(10, y - 4), QPointF(10, y + 4))
         painter.drawLine(QPointF(10 + bar, y - 4), QPointF(10 + bar, y + 4))
         painter.setPen(QColor(COLOR_INK))
-        painter.setFont(QFont(painter.font().family(), 8))
-        painter.drawText(QPointF(16 + bar, y + 4), f"{length:g} mm · {self.scale_text}")
+        painter.setFont(QFont(self.font().family(), LABEL_FONT_PT))
+        painter.drawText(QPointF(16 + bar, y + 4), text)
 
     # --- mouse -----------------------------------------------------------------------------
     def mousePressEvent(self, event: QMouseEvent) -> None:

@@ -57,11 +57,13 @@ def place_labels(
     order: Sequence[int],
     viewport: tuple[float, float],
     must: int = 0,
+    blocked: Sequence[Rect] = (),
 ) -> list[tuple[int, Rect]]:
     """(row, rectangle) of every label written, in ``order`` (rows of ``anchors``: the markers'
-    screen positions, ``sizes``: each label's width and height). See the module docstring."""
+    screen positions, ``sizes``: each label's width and height), clear of the ``blocked``
+    rectangles (the view's badges and scale) like of each other. See the module docstring."""
     width, height = viewport
-    placed: list[Rect] = []
+    placed: list[Rect] = list(blocked)
     out: list[tuple[int, Rect]] = []
     for i, row in enumerate(order):
         x, y = float(anchors[row, 0]), float(anchors[row, 1])
