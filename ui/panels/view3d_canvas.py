@@ -5,8 +5,9 @@ Everything is projected with one matrix product per layer (:class:`app.view3d.ca
 and drawn with one ``drawPoints``/``drawLines`` call per colour from numpy buffers (pyqtgraph's
 ``PrimitiveArray``, no Python object per point). The camera-dependent static layers (grid,
 points, path) are cached in a pixmap while the camera stands still, so a live pose only
-redraws the arm; while the mouse drags, large scenes are thinned (level of detail) and drawn
-in full again on release. The canvas keeps the screen positions it drew last in
+redraws the arm; the points' names are a second cached layer drawn over the arm (a hovered or
+selected point redraws only that layer); while the mouse drags, large scenes are thinned (level
+of detail) and drawn in full again on release. The canvas keeps the screen positions it drew last in
 :attr:`View3DCanvas.drawn` and the rectangles of the point names in
 :attr:`View3DCanvas.label_rects` (tests and the benchmark read them).
 
@@ -153,6 +154,11 @@ class View3DCanvas(QWidget):
         self._static = None
         self.update()
 
+    def invalidate_labels(self) -> None:
+        """Only the points' names must be placed and drawn again (not the whole static layer)."""
+        self._labels = None
+        self.update()
+
     def set_points(
         self,
         xyz: FloatArray,
@@ -181,18 +187,18 @@ class View3DCanvas(QWidget):
     def set_selected(self, ids: set[int]) -> None:
         if ids != self.selected_ids:
             self.selected_ids = set(ids)
-            self.invalidate()  # the selected points' names always show (static layer)
+            self.invalidate_labels()  # the selected points' names always show
 
     def set_hovered(self, point_id: int | None) -> None:
         if point_id != self.hovered_id:
             self.hovered_id = point_id
-            self.invalidate()
+            self.invalidate_labels()
 
     def set_plan_ids(self, ids: set[int]) -> None:
         """The points the plan uses (their names are written before the others')."""
         if ids != self.plan_ids:
             self.plan_ids = set(ids)
-            self.invalidate()
+            self.invalidate_labels()
 
     def set_path(
         self,
@@ -232,7 +238,7 @@ class View3DCanvas(QWidget):
     def set_badges(self, badges: list[tuple[str, str]]) -> None:
         if badges != self.badges:
             self.badges = badges
-            self.invalidate()  # the point names keep clear of the badges
+            self.invalidate_labels()  # the point names keep clear of the badges
 
     def scene_bounds(self) -> FloatArray:
         parts = [self.point_xyz, self.path_xyz, np.zeros((1, 3))]
@@ -293,10 +299,12 @@ class View3DCanvas(QWidget):
             self._draw_overlay(painter)
             return
         ratio = self.devicePixelRatioF()
-        if self._static is None or self._labels is None or self._static.size() != self.size() * ratio:
+        if self._static is None or self._static.size() != self.size() * ratio:
             self._static = self._layer(
                 ratio, QColor(COLOR_BACKGROUND), lambda p: self._draw_static(p, lod=False)
             )
+            self._labels = None
+        if self._labels is None:  # also alone: another point hovered or selected
             self._labels = self._layer(ratio, QColor(Qt.GlobalColor.transparent), self._draw_labels)
         painter.drawPixmap(0, 0, self._static)
         self._draw_dynamic(painter)
