@@ -25,7 +25,8 @@ NEAR_MM: Final = 10.0  # points closer to the eye than this are not drawn
 MIN_DISTANCE: Final = 50.0
 MAX_DISTANCE: Final = 100_000.0
 MAX_PITCH: Final = 90.0
-FIT_MARGIN: Final = 1.15
+FIT_MARGIN: Final = 1.1  # the fitted scene fills 1/1.1 of the viewport's tighter side
+FIT_MIN_HALF_MM: Final = 50.0  # a single point is framed 100 mm across
 PICK_RADIUS_PX: Final = 8.0
 
 
@@ -127,20 +128,70 @@ class Camera:
         yaw, pitch = PRESET_ANGLES[which]
         return replace(self, yaw=yaw, pitch=pitch)
 
-    def fitted(self, xyz: FloatArray, aspect: float = 1.0) -> Camera:
-        """Centred on the finite points, far enough for all of them to show."""
+    def pixels_per_mm_at(self, xyz: FloatArray, height: int) -> float:
+        """Scale at the depth of ``xyz`` (one point): what keeps a marker's screen size."""
+        if self.ortho:
+            return self.pixels_per_mm(height)
+        depth = float(self.to_camera(xyz)[0, 2])
+        return self.focal(height) / max(depth, NEAR_MM)
+
+    def point_at(self, sx: float, sy: float, width: int, height: int) -> FloatArray:
+        """The world point under the screen position (sx, sy) on the plane through the target
+        that faces the camera (inverse of :meth:`project` at the target's depth)."""
+        ppm = self.pixels_per_mm(height)
+        right, up = (sx - width / 2.0) / ppm, (height / 2.0 - sy) / ppm
+        point = np.asarray(self.target, dtype=np.float64) + right * self._basis[0] + up * self._basis[1]
+        return np.asarray(point, dtype=np.float64)
+
+    def zoomed_at(self, factor: float, sx: float, sy: float, width: int, height: int) -> Camera:
+        """Zoomed by ``factor`` about the screen position (sx, sy): the eye moves along the ray
+        through it, so every world point on that ray stays under (sx, sy) (perspective and
+        orthographic alike; the distance's limits shorten the step, never shift the point)."""
+        zoomed = self.zoomed(factor)
+        k = self.distance / zoomed.distance  # the factor left after the distance's limits
+        anchor = self.point_at(sx, sy, width, height)
+        target = np.asarray(self.target, dtype=np.float64)
+        moved = target + (anchor - target) * (1.0 - 1.0 / k)
+        return replace(zoomed, target=(float(moved[0]), float(moved[1]), float(moved[2])))
+
+    def fitted(self, xyz: FloatArray, aspect: float = 1.0, margin: float = FIT_MARGIN) -> Camera:
+        """Framing the finite points of ``xyz`` as tightly as the viewport (width / height
+        ``aspect``) allows with ``margin`` to spare, the direction of view kept.
+
+        In the camera's axes (right r, up u, depth f) a point is inside the horizontal field of
+        an eye at (e_r, e_f) when |r - e_r| <= (f - e_f) * tan: the two sides' supporting planes
+        (the extreme r + f*tan and r - f*tan over the points) give the eye's r and the farthest
+        depth it may stand at, the same for up; the eye takes the farther of the two depths.
+        Orthographic: the points' extents across the view. The target is where the view's axis
+        crosses the depth of the points' bounding box centre. A point, a line or a flat scene is
+        framed at least 100 mm across along its thin axes."""
         pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
         pts = pts[np.isfinite(pts).all(axis=1)]
         if not len(pts):
             return self
         lo, hi = pts.min(axis=0), pts.max(axis=0)
         centre = (lo + hi) / 2.0
-        radius = max(float(np.linalg.norm(hi - lo)) / 2.0, 50.0)
-        half = math.radians(self.fov) / 2.0
-        if aspect < 1.0:  # narrow window: the horizontal field is the smaller one
-            half = math.atan(math.tan(half) * aspect)
-        distance = radius * FIT_MARGIN / math.sin(half)
-        return replace(self, target=(float(centre[0]), float(centre[1]), float(centre[2])), distance=distance)
+        thin = np.flatnonzero((hi - lo) / 2.0 < FIT_MIN_HALF_MM)  # a point, a line, a flat scene
+        if len(thin):
+            pad = np.eye(3)[thin] * FIT_MIN_HALF_MM
+            pts = np.vstack([pts, centre + pad, centre - pad])
+        rel = (pts - centre) @ self._basis.T  # right, up, depth from the centre
+        tan_v = math.tan(math.radians(self.fov) / 2.0) / margin
+        tan_h = tan_v * max(aspect, 1e-3)
+        r, u, f = rel[:, 0], rel[:, 1], rel[:, 2]
+        depth = 0.0  # the target's, from the centre
+        if self.ortho:
+            eye_r, eye_u = (r.max() + r.min()) / 2.0, (u.max() + u.min()) / 2.0
+            distance = max((r.max() - r.min()) / 2.0 / tan_h, (u.max() - u.min()) / 2.0 / tan_v)
+        else:
+            a, b = (r + f * tan_h).min(), (r - f * tan_h).max()
+            c, d = (u + f * tan_v).min(), (u - f * tan_v).max()
+            eye_r, eye_u = (a + b) / 2.0, (c + d) / 2.0
+            eye_f = min((a - b) / (2.0 * tan_h), (c - d) / (2.0 * tan_v), f.min() - 2.0 * NEAR_MM)
+            distance = max(-eye_f, MIN_DISTANCE)  # the eye stays where it must be
+            depth = eye_f + distance
+        t = centre + eye_r * self._basis[0] + eye_u * self._basis[1] + depth * self._basis[2]
+        return replace(self, target=(float(t[0]), float(t[1]), float(t[2])), distance=float(distance))
 
 
 def pick(

@@ -909,44 +909,54 @@
     <context>
         <name>DryRunBar</name>
         <message>
-            <location filename="../../ui/panels/view3d_dryrun.py" line="66" />
+            <location filename="../../ui/panels/view3d_dryrun.py" line="70" />
             <source>Dry run:</source>
             <translation>空运行：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_dryrun.py" line="67" />
+            <location filename="../../ui/panels/view3d_dryrun.py" line="71" />
             <source>Pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_dryrun.py" line="67" />
+            <location filename="../../ui/panels/view3d_dryrun.py" line="71" />
             <source>Play</source>
             <translation>播放</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_dryrun.py" line="68" />
+            <location filename="../../ui/panels/view3d_dryrun.py" line="72" />
             <source>Play the plan on the drawn arm; nothing is sent to the robot</source>
             <translation>在绘制的机械臂上播放轨迹；不向机器人发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_dryrun.py" line="69" />
+            <location filename="../../ui/panels/view3d_dryrun.py" line="73" />
             <source>Live arm</source>
             <translation>实时机械臂</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_dryrun.py" line="70" />
+            <location filename="../../ui/panels/view3d_dryrun.py" line="74" />
             <source>Leave the dry run and show the robot's arm again</source>
             <translation>退出空运行，重新显示机器人的机械臂</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_dryrun.py" line="71" />
+            <location filename="../../ui/panels/view3d_dryrun.py" line="75" />
             <source>Speed of the dry run, times the planned speed</source>
             <translation>空运行速度（规划速度的倍数）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_dryrun.py" line="72" />
+            <location filename="../../ui/panels/view3d_dryrun.py" line="76" />
             <source>Drag to any moment of the plan</source>
             <translation>拖动到轨迹的任意时刻</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_dryrun.py" line="177" />
+            <source>loop %1 (endless: every later loop is the same)</source>
+            <translation>第 %1 轮（无限循环：之后每轮都相同）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_dryrun.py" line="178" />
+            <source>loop %1 of %2</source>
+            <translation>第 %1 轮（共 %2 轮）</translation>
         </message>
     </context>
     <context>
@@ -6358,7 +6368,7 @@ Remove them all?</source>
     <context>
         <name>View3DCanvas</name>
         <message>
-            <location filename="../../ui/panels/view3d_canvas.py" line="239" />
+            <location filename="../../ui/panels/view3d_canvas.py" line="329" />
             <source>grid %1 mm</source>
             <translation>网格 %1 mm</translation>
         </message>
@@ -6381,161 +6391,171 @@ Remove them all?</source>
     <context>
         <name>View3DPanel</name>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="224" />
+            <location filename="../../ui/panels/view3d_panel.py" line="234" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="225" />
+            <location filename="../../ui/panels/view3d_panel.py" line="235" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="226" />
+            <location filename="../../ui/panels/view3d_panel.py" line="236" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="227" />
+            <location filename="../../ui/panels/view3d_panel.py" line="237" />
             <source>Iso</source>
             <translation>轴测</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="231" />
+            <location filename="../../ui/panels/view3d_panel.py" line="241" />
             <source>Look at the scene from a preset direction</source>
             <translation>从预设方向观察场景</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="232" />
+            <location filename="../../ui/panels/view3d_panel.py" line="242" />
             <source>Fit all</source>
             <translation>全部显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="233" />
-            <source>Show the arm, the points and the plan</source>
-            <translation>显示机械臂、点位和轨迹</translation>
+            <location filename="../../ui/panels/view3d_panel.py" line="244" />
+            <source>Show the arm, the points and the plan (the view follows them again until you move it)</source>
+            <translation>显示机械臂、点位和轨迹（在您移动视图之前，视图会自动跟随它们）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="234" />
+            <location filename="../../ui/panels/view3d_panel.py" line="246" />
+            <source>Fit plan</source>
+            <translation>缩放至轨迹</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="247" />
+            <source>Show the selected plan's path and its points</source>
+            <translation>显示所选轨迹的路径及其点位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/view3d_panel.py" line="248" />
             <source>Orthographic</source>
             <translation>正交投影</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="235" />
+            <location filename="../../ui/panels/view3d_panel.py" line="249" />
             <source>Parallel projection (no perspective)</source>
             <translation>平行投影（无透视）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="236" />
+            <location filename="../../ui/panels/view3d_panel.py" line="250" />
             <source>Robot model…</source>
             <translation>机器人模型…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="237" />
+            <location filename="../../ui/panels/view3d_panel.py" line="251" />
             <source>Load another robot model profile (JSON; engineer)</source>
             <translation>加载其他机器人模型配置文件（JSON；需工程师）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="239" />
+            <location filename="../../ui/panels/view3d_panel.py" line="253" />
             <source>Beside the planner</source>
             <translation>在规划器旁显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="240" />
+            <location filename="../../ui/panels/view3d_panel.py" line="254" />
             <source>Show the 3D view next to the planner, not in its own tab</source>
             <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="242" />
+            <location filename="../../ui/panels/view3d_panel.py" line="256" />
             <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
             <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="276" />
-            <location filename="../../ui/panels/view3d_panel.py" line="325" />
+            <location filename="../../ui/panels/view3d_panel.py" line="290" />
+            <location filename="../../ui/panels/view3d_panel.py" line="339" />
             <source>Robot model not loaded: %1</source>
             <translation>未加载机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="285" />
-            <location filename="../../ui/panels/view3d_panel.py" line="287" />
+            <location filename="../../ui/panels/view3d_panel.py" line="299" />
+            <location filename="../../ui/panels/view3d_panel.py" line="301" />
             <source>Robot model: %1</source>
             <translation>机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="288" />
+            <location filename="../../ui/panels/view3d_panel.py" line="302" />
             <source>File: %1</source>
             <translation>文件：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="290" />
+            <location filename="../../ui/panels/view3d_panel.py" line="304" />
             <source>Shipped with TeachPad</source>
             <translation>TeachPad 自带</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="294" />
+            <location filename="../../ui/panels/view3d_panel.py" line="308" />
             <source>Not compared with the controller (no joint angles from it)</source>
             <translation>未与控制器比对（控制器未提供关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="297" />
+            <location filename="../../ui/panels/view3d_panel.py" line="311" />
             <source>Agrees with the controller's pose (within %1 mm, %2°)</source>
             <translation>与控制器的位姿一致（误差在 %1 mm、%2° 以内）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="331" />
+            <location filename="../../ui/panels/view3d_panel.py" line="345" />
             <source>Load a robot model profile</source>
             <translation>加载机器人模型配置文件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="331" />
+            <location filename="../../ui/panels/view3d_panel.py" line="345" />
             <source>Robot model profiles (*.json)</source>
             <translation>机器人模型配置文件 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="424" />
+            <location filename="../../ui/panels/view3d_panel.py" line="458" />
             <source>dry run: nothing is sent</source>
             <translation>空运行：不发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="426" />
+            <location filename="../../ui/panels/view3d_panel.py" line="460" />
             <source>no pose: home position shown</source>
             <translation>无位姿：显示原点姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="428" />
+            <location filename="../../ui/panels/view3d_panel.py" line="462" />
             <source>estimate (from the pose, no joint angles)</source>
             <translation>估算（由位姿求得，无关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="430" />
+            <location filename="../../ui/panels/view3d_panel.py" line="464" />
             <source>pose out of the model's reach</source>
             <translation>位姿超出模型可达范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="432" />
+            <location filename="../../ui/panels/view3d_panel.py" line="466" />
             <source>past a joint limit</source>
             <translation>超出关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="434" />
+            <location filename="../../ui/panels/view3d_panel.py" line="468" />
             <source>stale</source>
             <translation>数据过期</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="437" />
+            <location filename="../../ui/panels/view3d_panel.py" line="471" />
             <source>the robot model disagrees with the controller</source>
             <translation>机器人模型与控制器不一致</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="494" />
+            <location filename="../../ui/panels/view3d_panel.py" line="528" />
             <source>Out of the robot model's reach: %n point(s) (%1)</source>
             <translation>
                 <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="502" />
+            <location filename="../../ui/panels/view3d_panel.py" line="536" />
             <source>the path leaves the reach in %n segment(s) (%1)</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>

@@ -87,3 +87,42 @@ def test_dry_run_follows_the_estimates_and_the_true_arc() -> None:
     assert np.dot(xyz - geo.centre[0], geo.normal[0]) == pytest.approx(0.0, abs=1e-6)
     assert not np.allclose(xyz, centre)
     assert run.at(float(est.times[0]) + 0.01).segment == 1
+
+
+@pytest.mark.parametrize("loops", [3, 20])
+def test_dry_run_plays_every_loop_of_the_plan(loops: int) -> None:
+    """The timeline holds all N loops (the estimate's total time); every loop after the first
+    starts where the plan ends (A), as the runner runs it, not at the robot's pose."""
+    ledger = _ledger()
+    plan = Plan(
+        "p", [Segment.line(2, speed=100.0), Segment.line(3, speed=100.0), Segment.line(1, speed=80.0)]
+    )
+    plan.set_loops(loops)
+    pose = Pose(600, 0, 500, *DOWN)  # away from the plan: the first loop's first segment is longer
+    run = DryRun(plan, ledger, pose)
+    est = estimate_plan(plan, ledger, (600, 0, 500))
+    assert run.duration == pytest.approx(est.total_time)
+    assert run.at(0.0).loop == 1 and run.at(0.0).pose[:3] == pytest.approx((600, 0, 500))  # type: ignore[index]
+    second = est.loop_time + 1e-6
+    state = run.at(second)
+    assert (state.loop, state.loops, state.segment) == (2, loops, 0)
+    assert state.pose[:3] == pytest.approx((450, -100, 350))  # type: ignore[index]  # the plan's end, A
+    # half way through the last loop's first segment: half way from A to B
+    t = est.loop_time + (loops - 2) * est.next_loop_time + est.wrap_time / 2 + run.overhead / 2
+    state = run.at(t)
+    assert (state.loop, state.segment) == (loops, 0)
+    assert state.pose[:3] == pytest.approx((475, -50, 385))  # type: ignore[index]
+    assert run.at(run.duration).loop == loops
+    assert run.at(run.duration).pose[:3] == pytest.approx((450, -100, 350))  # type: ignore[index]
+
+
+def test_dry_run_of_an_endless_plan_plays_a_later_loop_too() -> None:
+    from app.view3d.path import ENDLESS_LOOPS_SHOWN
+
+    ledger = _ledger()
+    plan = Plan("p", [Segment.line(2), Segment.line(1)])
+    plan.set_loops(0)
+    run = DryRun(plan, ledger, Pose(600, 0, 500, *DOWN))
+    est = estimate_plan(plan, ledger, (600, 0, 500), loops=ENDLESS_LOOPS_SHOWN)
+    assert run.duration == pytest.approx(est.total_time)
+    assert (run.at(run.duration).loop, run.at(run.duration).loops) == (ENDLESS_LOOPS_SHOWN, 0)

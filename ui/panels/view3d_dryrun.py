@@ -3,7 +3,8 @@ multiple, with a scrubber. It only moves the drawing: nothing is sent to the con
 
 Time comes from :class:`app.view3d.path.DryRun` (the planner's geometry and time estimates);
 a timer advances it :data:`DRY_RUN_FPS` times a second by the elapsed wall time times the
-speed multiple.
+speed multiple. The timeline holds every loop of the plan; for a plan of more than one loop the
+bar says which one plays ("loop 2 of 20").
 """
 
 from __future__ import annotations
@@ -49,6 +50,8 @@ class DryRunBar(QWidget):
         self.slider.valueChanged.connect(self._on_slider)
         self.time_label = QLabel(self)
         self.time_label.setMinimumWidth(110)
+        self.loop_label = QLabel(self)
+        self.loop_label.setObjectName("DryRunLoopLabel")
         self.caption = QLabel(self)
         self.timer = QTimer(self)
         self.timer.setInterval(1000 // DRY_RUN_FPS)
@@ -58,6 +61,7 @@ class DryRunBar(QWidget):
         for w in (self.caption, self.play_button, self.stop_button, self.speed_box):
             layout.addWidget(w)
         layout.addWidget(self.slider, 1)
+        layout.addWidget(self.loop_label)
         layout.addWidget(self.time_label)
         self.retranslate()
         self.set_run(None)
@@ -161,3 +165,14 @@ class DryRunBar(QWidget):
     def _show_time(self) -> None:
         total = self.run.duration if self.run is not None else 0.0
         self.time_label.setText(f"{format_duration(self.time)} / {format_duration(total)}")
+        self.loop_label.setText(self.loop_text())
+        self.loop_label.setVisible(bool(self.loop_label.text()))
+
+    def loop_text(self) -> str:
+        """Which loop plays ("loop 2 of 20"); "" for a plan of one loop (or none)."""
+        if self.run is None or self.run.loops == 1:
+            return ""
+        loop, _local = self.run.loop_at(self.time)
+        if self.run.loops == 0:
+            return self.tr("loop %1 (endless: every later loop is the same)").replace("%1", str(loop))
+        return self.tr("loop %1 of %2").replace("%1", str(loop)).replace("%2", str(self.run.loops))

@@ -9,8 +9,11 @@ ways. The selected plan is a ghost path (lines and true arcs of :mod:`app.plan.g
 middle points as squares, the start as a green dot, one arrow per segment); during a run the
 segment being run is highlighted and the TCP leaves a trace. Points and path samples the
 profile cannot reach (or only past a joint limit) are red. The dry run bar plays the plan on
-the drawn arm without sending anything. What the scene shows of the points and the plan (colours,
-sampling, red samples) is worked out without widgets in :mod:`ui.panels.view3d_scene`.
+the drawn arm without sending anything, every loop of it ("loop 2 of 20"). *Fit all* frames
+the arm, the points and the plan, *Fit plan* the selected plan's path and its points; until the
+operator moves the camera it follows the scene (:mod:`ui.panels.view3d_canvas` says when). What
+the scene shows of the points and the plan (colours, sampling, red samples) is worked out
+without widgets in :mod:`ui.panels.view3d_scene`.
 
 The header names the robot model in use (its file and whether it agrees with the controller in
 the tooltip); a model whose forward kinematics disagree with the controller's pose is said in
@@ -99,7 +102,7 @@ class View3DPanel(QWidget):
         self._trace_n = 0
         self._running = False
         self._dry: DryRunState | None = None
-        self._fitted = False
+        self._refit_arm = False  # the first pose after connecting: frame the arm where it is
         self._dry_joints: np.ndarray | None = None
         self._scene_dirty = True
 
@@ -117,20 +120,21 @@ class View3DPanel(QWidget):
             bar.addWidget(button)
         self.fit_button = QToolButton(self)
         self.fit_button.clicked.connect(self.canvas.fit_all)
+        self.fit_plan_button = QToolButton(self)
+        self.fit_plan_button.setObjectName("View3DFitPlanButton")
+        self.fit_plan_button.clicked.connect(self.fit_plan)
         self.ortho_button = QToolButton(self)
         self.ortho_button.setCheckable(True)
         self.ortho_button.toggled.connect(self._on_ortho)
         self.beside_button = QToolButton(self)
         self.beside_button.setCheckable(True)
         self.beside_button.toggled.connect(self.besideToggled)
-        for w in (self.fit_button, self.ortho_button):
+        for w in (self.fit_button, self.fit_plan_button, self.ortho_button):
             bar.addWidget(w)
         bar.addStretch(1)
         self.profile_button = QToolButton(self)
         self.profile_button.setObjectName("RobotModelButton")
         self.profile_button.clicked.connect(self.choose_profile)
-        bar.addWidget(self.profile_button)
-        bar.addWidget(self.beside_button)
         self.message_label = QLabel(self)
         self.message_label.setWordWrap(True)
         self.message_label.setStyleSheet(f"color: {COLOR_ERROR};")
@@ -155,7 +159,12 @@ class View3DPanel(QWidget):
         layout = QVBoxLayout(self)
         layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(bar)
-        layout.addWidget(self.model_label)
+        model_row = QHBoxLayout()  # the model in use, its button, and where the view lives
+        model_row.setContentsMargins(0, 0, 0, 0)
+        model_row.addWidget(self.model_label, 1)
+        model_row.addWidget(self.profile_button)
+        model_row.addWidget(self.beside_button)
+        layout.addLayout(model_row)
         layout.addWidget(self.agreement_label)
         layout.addWidget(self.canvas, 1)
         layout.addWidget(self.message_label)
@@ -211,6 +220,7 @@ class View3DPanel(QWidget):
             seg.listEdited,
         ):
             signal.connect(self._schedule_scene)
+        planner.plan_view.model().dataChanged.connect(self._schedule_scene)  # a plan's loops (the dry run)
         self._schedule_scene()
 
     def attach_runner(self, runner: Any) -> None:
@@ -230,7 +240,11 @@ class View3DPanel(QWidget):
             button.setText(names[preset])
             button.setToolTip(self.tr("Look at the scene from a preset direction"))
         self.fit_button.setText(self.tr("Fit all"))
-        self.fit_button.setToolTip(self.tr("Show the arm, the points and the plan"))
+        self.fit_button.setToolTip(
+            self.tr("Show the arm, the points and the plan (the view follows them again until you move it)")
+        )
+        self.fit_plan_button.setText(self.tr("Fit plan"))
+        self.fit_plan_button.setToolTip(self.tr("Show the selected plan's path and its points"))
         self.ortho_button.setText(self.tr("Orthographic"))
         self.ortho_button.setToolTip(self.tr("Parallel projection (no perspective)"))
         self.profile_button.setText(self.tr("Robot model…"))
@@ -334,18 +348,33 @@ class View3DPanel(QWidget):
             self.load_profile_file(path)
 
     def set_preset(self, preset: Preset) -> None:
+        """Look from a preset direction at the whole scene (the view follows it again)."""
         self.canvas.set_camera(self.canvas.camera.preset(preset))
         self.canvas.fit_all()
+
+    @Slot()
+    def fit_plan(self) -> None:
+        """Frame the selected plan's path and the points it uses."""
+        self.canvas.fit_to(self.plan_bounds())
+
+    def plan_bounds(self) -> np.ndarray:
+        """The selected plan's path samples and its points, (n, 3)."""
+        ids = self.canvas.plan_ids
+        points = [p.xyz for p in self.ledger if p.id in ids]
+        return np.concatenate([self.canvas.path_xyz, np.array(points, dtype=np.float64).reshape(-1, 3)])
 
     @Slot(bool)
     def _on_ortho(self, ortho: bool) -> None:
         from dataclasses import replace
 
         self.canvas.set_camera(replace(self.canvas.camera, ortho=ortho))
+        self.canvas.auto_fit()  # the same scene framed in the other projection (unless moved)
 
     # --- live robot ----------------------------------------------------------------------
     @Slot(object)
     def on_pose(self, pose: Pose) -> None:
+        if self._pose is None:
+            self._refit_arm = True
         self._pose = pose
         if pose.joints is not None and len(pose.joints) >= self.model.dof:
             self._joints = tuple(pose.joints)
@@ -360,6 +389,8 @@ class View3DPanel(QWidget):
 
     @Slot(bool)
     def on_fresh(self, fresh: bool) -> None:
+        if fresh and not self._fresh:  # (re)connected, or answering again: frame the arm where it is
+            self._refit_arm = True
         self._fresh = fresh
         self._update_badges()
 
@@ -416,6 +447,9 @@ class View3DPanel(QWidget):
         else:
             q = self.tracker.joints
         self.canvas.set_arm(self.model.link_points(q), self.model.joint_points(q), self.model.forward(q))
+        if self._refit_arm:
+            self._refit_arm = False
+            self.canvas.auto_fit()
         self._update_badges()
 
     def _update_badges(self) -> None:
@@ -466,11 +500,11 @@ class View3DPanel(QWidget):
         self._show_plan(plan, ledger)
         self._show_reach()
         self._on_table_selection()
-        if not self._fitted and (len(points) or plan is not None):
-            self._fitted = True
-            self.canvas.fit_all()
+        self.canvas.auto_fit()  # a new project, new points, another plan: framed (unless moved)
 
     def _show_plan(self, plan: Plan | None, ledger: PointLedger) -> None:
+        self.canvas.set_plan_ids(plan.point_ids() if plan is not None else set())
+        self.fit_plan_button.setEnabled(plan is not None and len(plan) > 0)
         if plan is None or not len(plan):
             self.path_reach = None
             self.canvas.set_path(
