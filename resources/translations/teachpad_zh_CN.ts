@@ -6368,7 +6368,7 @@ Remove them all?</source>
     <context>
         <name>View3DCanvas</name>
         <message>
-            <location filename="../../ui/panels/view3d_canvas.py" line="329" />
+            <location filename="../../ui/panels/view3d_canvas.py" line="337" />
             <source>grid %1 mm</source>
             <translation>网格 %1 mm</translation>
         </message>
