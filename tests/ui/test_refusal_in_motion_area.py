@@ -16,8 +16,8 @@ from app.link.client import StepFrame
 from app.link.ops import GoZero
 from app.protocol import registers
 from app.safety.envelope import Box, Envelope
-from tests.safety.test_gui_motion import _envelope
-from tests.safety.test_gui_roles import SAMPLE, menu_fixture  # noqa: F401 - fixture
+from tests.ui.controllers.test_gui_motion import _envelope
+from tests.ui.controllers.test_gui_roles import SAMPLE, menu_fixture  # noqa: F401 - fixture
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,
