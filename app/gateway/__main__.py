@@ -1,0 +1,7 @@
+"""``python -m app.gateway``: the same as the ``teachpad-gateway`` console script."""
+
+import sys
+
+from app.gateway.cli import main
+
+sys.exit(main())

@@ -1,0 +1,277 @@
+"""The Sparkplug B 3.0 edge node: the TeachPad host is the node, each controller of the cell a device.
+
+Topics: ``spBv1.0/GROUP/{NBIRTH,NDEATH,NCMD}/NODE`` and ``spBv1.0/GROUP/{DBIRTH,DDATA,DDEATH}/NODE/DEVICE``.
+What the specification asks of an edge node, and how it is met here:
+
+* **NDEATH is the MQTT will** (QoS 1, not retained) carrying ``bdSeq``; a new MQTT session (a
+  reconnect after the broker went away) sets the will again with ``bdSeq + 1`` (0..255) before it
+  connects. A graceful stop publishes NDEATH itself (a clean disconnect does not fire the will).
+* On every connect: subscribe to NCMD, then **NBIRTH** (``seq`` 0, the same ``bdSeq``, the
+  ``Node Control/Rebirth`` metric), then a **DBIRTH** per answering controller (every metric, name and
+  alias), then **DDATA** by exception: only the metrics that moved past their deadband, by alias only.
+* ``seq`` counts every message of the node but NDEATH, 0..255 and round again; NBIRTH resets it to 0.
+* A controller that stops answering gets a **DDEATH** at its first failed poll; a **DBIRTH** when it
+  answers again. **NCMD** ``Node Control/Rebirth`` = true: NBIRTH and every DBIRTH again (same bdSeq).
+* Nothing from the plant is written to a controller: DCMD is not subscribed to (writes are off).
+
+Threads: paho's network thread (connect, NCMD) and one poller thread per controller call in here;
+one lock orders everything the node publishes, so ``seq`` goes out in order.
+"""
+
+from __future__ import annotations
+
+import logging
+import ssl
+import threading
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import paho.mqtt.client as mqtt
+from paho.mqtt.enums import CallbackAPIVersion
+
+from app.cell.cell_file import Cell
+from app.gateway import payload as pb
+from app.gateway.metrics import (
+    BDSEQ,
+    DEVICE_METRICS,
+    REBIRTH,
+    REBIRTH_ALIAS,
+    Reading,
+    changed,
+    clock_text,
+    device_alias,
+    device_values,
+)
+from app.gateway.poller import ControllerPoller, GatewayTiming
+
+__all__ = ["BrokerSettings", "EdgeNode", "NAMESPACE"]
+
+NAMESPACE = "spBv1.0"
+_log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class BrokerSettings:
+    """Where the MQTT broker is and how to log in."""
+
+    host: str
+    port: int = 1883
+    tls: bool = False
+    cafile: str | None = None  # None with tls: the system's trusted CAs
+    certfile: str | None = None  # a client certificate (with keyfile)
+    keyfile: str | None = None
+    username: str | None = None
+    password: str | None = None
+
+
+@dataclass
+class _Device:
+    """What the node knows of one controller (guarded by the node's lock)."""
+
+    name: str
+    index: int
+    alive: bool = False  # answering (a DBIRTH went out, or will on the next session)
+    values: dict[str, pb.Value] | None = None  # the last reading's values
+    sent: dict[str, pb.Value] | None = None  # what the subscribers were last told
+    clock: str | None = None
+
+
+def _now_ms() -> int:
+    return int(time.time() * 1000)
+
+
+class EdgeNode:
+    """Polls every controller of ``cell`` and publishes it as a Sparkplug B edge node."""
+
+    def __init__(
+        self,
+        cell: Cell,
+        broker: BrokerSettings,
+        *,
+        group: str,
+        node: str,
+        gateway: GatewayTiming | None = None,
+        deadbands: Mapping[str, float] | None = None,
+    ) -> None:
+        self.group = group
+        self.node = node
+        self.timing = gateway or GatewayTiming()
+        self._deadbands = dict(deadbands or {})
+        self._broker = broker
+        self._lock = threading.RLock()
+        self._devices = {c.name: _Device(c.name, i) for i, c in enumerate(cell.controllers)}
+        self._pollers = [ControllerPoller(c, self, self.timing) for c in cell.controllers]
+        self.bdseq = 0
+        self._seq = 0
+        self._online = False  # an MQTT session is up and NBIRTH went out
+        self.sessions = 0  # MQTT sessions so far (NBIRTHs after a connect)
+        self._running = False
+        self._client = self._make_client()
+
+    # -- topics ---------------------------------------------------------------------------
+    def topic(self, kind: str, device: str | None = None) -> str:
+        base = f"{NAMESPACE}/{self.group}/{kind}/{self.node}"
+        return base if device is None else f"{base}/{device}"
+
+    # -- lifecycle ------------------------------------------------------------------------
+    def _make_client(self) -> mqtt.Client:
+        client = mqtt.Client(
+            callback_api_version=CallbackAPIVersion.VERSION2,
+            client_id=f"teachpad-{self.group}-{self.node}",
+            clean_session=True,
+        )
+        b = self._broker
+        if b.username is not None:
+            client.username_pw_set(b.username, b.password)
+        if b.tls:
+            client.tls_set(ca_certs=b.cafile, certfile=b.certfile, keyfile=b.keyfile, cert_reqs=ssl.CERT_REQUIRED)
+        first, largest = self.timing.broker_retry
+        client.reconnect_delay_set(min_delay=max(1, round(first)), max_delay=max(1, round(largest)))
+        client.on_connect = self._on_connect
+        client.on_disconnect = self._on_disconnect
+        client.on_message = self._on_message
+        self._set_will(client)
+        return client
+
+    def _set_will(self, client: mqtt.Client) -> None:
+        client.will_set(self.topic("NDEATH"), self._ndeath(), qos=1, retain=False)
+
+    def _ndeath(self) -> bytes:
+        death = pb.Payload(timestamp=_now_ms())
+        metric = death.metrics.add(name=BDSEQ, timestamp=death.timestamp, datatype=pb.DataType.INT64)
+        pb.set_value(metric, pb.DataType.INT64, self.bdseq)
+        return pb.encode(death)
+
+    def start(self) -> None:
+        """Connect (in the background: a broker that is not up yet is tried again) and poll."""
+        self._running = True
+        self._client.connect_async(self._broker.host, self._broker.port, keepalive=self.timing.keepalive)
+        self._client.loop_start()
+        for poller in self._pollers:
+            poller.start()
+
+    def stop(self) -> None:
+        """Stop polling, publish NDEATH (a clean disconnect does not fire the will), disconnect."""
+        if not self._running:
+            return
+        self._running = False
+        for poller in self._pollers:
+            poller.stop()
+        with self._lock:
+            online, self._online = self._online, False
+            if online:
+                info = self._client.publish(self.topic("NDEATH"), self._ndeath(), qos=1)
+        if online:
+            try:
+                info.wait_for_publish(self.timing.stop_wait)
+            except (RuntimeError, ValueError) as exc:  # not sent: the broker fires the will anyway
+                _log.warning("NDEATH not sent on stop: %s", exc)
+        self._client.disconnect()
+        self._client.loop_stop()
+
+    # -- MQTT callbacks (paho's network thread) -------------------------------------------
+    def _on_connect(self, client: mqtt.Client, _userdata: Any, _flags: Any, reason: Any, _props: Any) -> None:
+        if reason.is_failure:
+            _log.warning("broker refused the connection: %s", reason)
+            return
+        client.subscribe(self.topic("NCMD"), qos=1)
+        with self._lock:
+            self.sessions += 1
+            self._birth()
+
+    def _on_disconnect(self, client: mqtt.Client, _userdata: Any, _flags: Any, reason: Any, _props: Any) -> None:
+        with self._lock:
+            if not self._online:
+                return
+            self._online = False
+            self.bdseq = (self.bdseq + 1) % 256  # the next session's will and NBIRTH
+            self._set_will(client)
+        _log.warning("broker connection lost (%s); a new session will have bdSeq %d", reason, self.bdseq)
+
+    def _on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        if message.topic != self.topic("NCMD"):
+            return
+        try:
+            command = pb.decode(message.payload)
+        except Exception as exc:  # a malformed NCMD is the sender's problem: said, ignored
+            _log.warning("NCMD not understood: %s", exc)
+            return
+        for metric in command.metrics:
+            is_rebirth = metric.name == REBIRTH or (not metric.name and metric.alias == REBIRTH_ALIAS)
+            if is_rebirth and pb.metric_value(metric) is True:
+                _log.info("rebirth asked for by NCMD")
+                with self._lock:
+                    if self._online:
+                        self._birth()
+
+    # -- publishing (under the lock) ------------------------------------------------------
+    def _publish(self, topic: str, message: Any) -> None:
+        message.seq = self._seq
+        self._seq = (self._seq + 1) % 256
+        self._client.publish(topic, pb.encode(message), qos=0, retain=False)
+
+    def _birth(self) -> None:
+        """NBIRTH (seq 0), then a DBIRTH for every answering controller."""
+        self._seq = 0
+        self._online = True
+        birth = pb.Payload(timestamp=_now_ms())
+        bdseq = birth.metrics.add(name=BDSEQ, timestamp=birth.timestamp, datatype=pb.DataType.INT64)
+        pb.set_value(bdseq, pb.DataType.INT64, self.bdseq)
+        rebirth = birth.metrics.add(
+            name=REBIRTH, alias=REBIRTH_ALIAS, timestamp=birth.timestamp, datatype=pb.DataType.BOOLEAN
+        )
+        pb.set_value(rebirth, pb.DataType.BOOLEAN, False)
+        self._publish(self.topic("NBIRTH"), birth)
+        for device in self._devices.values():
+            if device.alive and device.values is not None:
+                self._dbirth(device, birth.timestamp)
+
+    def _dbirth(self, device: _Device, stamp: int) -> None:
+        assert device.values is not None
+        message = pb.Payload(timestamp=stamp)
+        for i, spec in enumerate(DEVICE_METRICS):
+            metric = message.metrics.add(
+                name=spec.name, alias=device_alias(device.index, i), timestamp=stamp, datatype=spec.datatype
+            )
+            pb.set_value(metric, spec.datatype, device.values[spec.name])
+        device.sent = dict(device.values)
+        self._publish(self.topic("DBIRTH", device.name), message)
+
+    def _ddata(self, device: _Device, stamp: int) -> None:
+        assert device.values is not None and device.sent is not None
+        message = pb.Payload(timestamp=stamp)
+        for i, spec in enumerate(DEVICE_METRICS):
+            now = device.values[spec.name]
+            if changed(spec, device.sent[spec.name], now, self._deadbands):
+                metric = message.metrics.add(alias=device_alias(device.index, i), timestamp=stamp)
+                pb.set_value(metric, spec.datatype, now)
+                device.sent[spec.name] = now
+        if message.metrics:
+            self._publish(self.topic("DDATA", device.name), message)
+
+    # -- the pollers (their threads) ------------------------------------------------------
+    def answered(self, device: str, reading: Reading) -> None:
+        with self._lock:
+            state = self._devices[device]
+            if reading.clock is not None:
+                state.clock = clock_text(reading.clock)
+            freshness = int((time.monotonic() - reading.answered_at) * 1000)
+            state.values = device_values(reading, freshness, state.clock)
+            if not state.alive:
+                state.alive = True
+                if self._online:
+                    self._dbirth(state, reading.wall_ms)
+            elif self._online:
+                self._ddata(state, reading.wall_ms)
+
+    def silent(self, device: str, reason: str) -> None:
+        with self._lock:
+            state = self._devices[device]
+            if not state.alive:
+                return
+            state.alive = False
+            _log.warning("%s stopped answering: %s", device, reason)
+            if self._online:
+                self._publish(self.topic("DDEATH", device), pb.Payload(timestamp=_now_ms()))

@@ -1,0 +1,163 @@
+"""Sparkplug B 3.0 conformance of the edge node, one test per rule, against a real Mosquitto, read by
+an independent subscriber that decodes the payloads (tests/gateway/conftest.py)."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from app.gateway import payload as pb
+from app.gateway.metrics import DEVICE_METRICS, METRIC_INDEX, REBIRTH, REBIRTH_ALIAS, device_alias
+
+from .conftest import Received, Subscriber
+
+NODE_KINDS = {"NBIRTH", "DBIRTH", "DDATA", "DDEATH"}
+
+
+def _bdseq(message: Received) -> Any:
+    return pb.metric_value(message.metric("bdSeq"))
+
+
+def _aliases(message: Received) -> set[int]:
+    return {int(m.alias) for m in message.payload.metrics}
+
+
+def test_nbirth_seq0_bdseq_rebirth_then_a_dbirth_per_device(
+    sim_factory: Any, subscriber: Subscriber, gateway_factory: Any
+) -> None:
+    sims = {"R1": sim_factory(), "R2": sim_factory()}
+    gateway_factory(sims)
+    nbirth = subscriber.kind("NBIRTH")
+    assert nbirth.topic == "spBv1.0/plant/NBIRTH/pad1"
+    assert nbirth.seq == 0
+    assert _bdseq(nbirth) == 0
+    rebirth = nbirth.metric(REBIRTH)
+    assert rebirth.datatype == pb.DataType.BOOLEAN and pb.metric_value(rebirth) is False
+    assert (nbirth.qos, nbirth.retain) == (0, False)
+    start = subscriber.messages.index(nbirth)
+    births = {name: subscriber.kind("DBIRTH", name, start=start) for name in sims}
+    for index, (name, birth) in enumerate(births.items()):
+        assert birth.topic == f"spBv1.0/plant/DBIRTH/pad1/{name}"
+        assert [m.name for m in birth.payload.metrics] == [spec.name for spec in DEVICE_METRICS]
+        assert [m.alias for m in birth.payload.metrics] == [device_alias(index, i) for i in range(len(DEVICE_METRICS))]
+        assert all(m.datatype == spec.datatype for m, spec in zip(birth.payload.metrics, DEVICE_METRICS, strict=True))
+    # the values are the controller's: its pose as the simulator holds it
+    x = pb.metric_value(births["R1"].metric("Pose/X"))
+    assert x == sims["R1"].robot.pose[0] or abs(float(x) - float(sims["R1"].robot.pose[0])) < 1e-3  # type: ignore[arg-type]
+    # monitor-only: nothing was written to any controller
+    assert all(sim.writes == [] for sim in sims.values())
+
+
+def test_ddata_by_exception_with_deadband_and_aliases_only(
+    sim_factory: Any, subscriber: Subscriber, gateway_factory: Any
+) -> None:
+    sim = sim_factory()
+    gateway_factory({"R1": sim}, deadbands={"Link/RTT": 1e9, "Link/Freshness": 1e9})
+    birth = subscriber.kind("DBIRTH", "R1")
+    start = subscriber.count()
+    j1, j2 = device_alias(0, METRIC_INDEX["Joints/J1"]), device_alias(0, METRIC_INDEX["Joints/J2"])
+    joints = sim.robot.joints
+    sim.set_joint(1, float(joints[0]) + 0.005)  # within J1's deadband (0.01 deg): never sent
+    sim.set_joint(2, float(joints[1]) + 1.0)  # past J2's
+    data = subscriber.wait_for("DDATA with J2", lambda m: m.kind == "DDATA" and j2 in _aliases(m), start=start)
+    for message in subscriber.snapshot()[start:]:
+        if message.kind == "DDATA":
+            assert all(not m.name for m in message.payload.metrics), "a DDATA metric carries its name"
+            assert _aliases(message) <= _aliases(birth)
+            assert j1 not in _aliases(message), "J1 moved less than its deadband but was sent"
+    value = next(m for m in data.payload.metrics if m.alias == j2)
+    assert abs(pb.metric_value(value) - (float(joints[1]) + 1.0)) < 1e-3  # type: ignore[operator]
+    assert "Joints/J3" not in {spec.name for spec in DEVICE_METRICS if device_alias(0, METRIC_INDEX[spec.name]) in _aliases(data)}
+
+
+def test_seq_counts_every_node_message_and_wraps_at_255(
+    sim_factory: Any, subscriber: Subscriber, gateway_factory: Any
+) -> None:
+    sims = {"R1": sim_factory(), "R2": sim_factory()}
+    # RTT without a deadband: nearly every poll is a DDATA, so 256 messages come quickly
+    gateway_factory(sims, deadbands={"Link/RTT": 0.0}, poll_hz=100.0)
+    nbirth = subscriber.kind("NBIRTH")
+    start = subscriber.messages.index(nbirth)
+    subscriber.wait_for("300 node messages", lambda _m: subscriber_len(subscriber) - start > 300, timeout=30.0)
+    ours = [m for m in subscriber.snapshot()[start:] if m.kind in NODE_KINDS]
+    seqs = [m.seq for m in ours]
+    assert seqs[0] == 0
+    for before, after in zip(seqs, seqs[1:], strict=False):
+        assert after == ((before or 0) + 1) % 256, f"seq {before} was followed by {after}"
+    assert 255 in seqs and seqs[seqs.index(255) + 1] == 0
+
+
+def subscriber_len(subscriber: Subscriber) -> int:
+    return len(subscriber.messages)
+
+
+def test_ddeath_within_250_ms_of_silence_and_dbirth_when_it_answers_again(
+    sim_factory: Any, subscriber: Subscriber, gateway_factory: Any
+) -> None:
+    sims = {"R1": sim_factory(), "R2": sim_factory()}
+    gateway_factory(sims)
+    subscriber.kind("DBIRTH", "R2")
+    start = subscriber.count()
+    silent_at = time.monotonic()  # from here on no poll of R2 can be answered
+    sims["R2"].set_silent(True)
+    death = subscriber.kind("DDEATH", "R2", start=start)
+    took = death.at - silent_at
+    assert took <= 0.25, f"DDEATH {took * 1000:.0f} ms after the controller went silent"
+    assert death.seq is not None
+    sims["R2"].set_silent(False)
+    after = subscriber.messages.index(death)
+    again = subscriber.kind("DBIRTH", "R2", start=after)
+    assert [m.name for m in again.payload.metrics] == [spec.name for spec in DEVICE_METRICS]
+    # R1 kept answering: no DDEATH for it
+    assert not [m for m in subscriber.snapshot() if m.kind == "DDEATH" and m.device == "R1"]
+
+
+def test_rebirth_on_ncmd(sim_factory: Any, subscriber: Subscriber, gateway_factory: Any) -> None:
+    gateway_factory({"R1": sim_factory()})
+    first = subscriber.kind("NBIRTH")
+    subscriber.kind("DBIRTH", "R1")
+    start = subscriber.count()
+    command = pb.Payload(timestamp=int(time.time() * 1000))
+    metric = command.metrics.add(name=REBIRTH, datatype=pb.DataType.BOOLEAN)
+    pb.set_value(metric, pb.DataType.BOOLEAN, True)
+    subscriber.publish("spBv1.0/plant/NCMD/pad1", pb.encode(command))
+    again = subscriber.kind("NBIRTH", start=start)
+    assert again.seq == 0 and _bdseq(again) == _bdseq(first)
+    dbirth = subscriber.kind("DBIRTH", "R1", start=subscriber.messages.index(again))
+    assert dbirth.seq == 1
+    # by alias too (a host application that learned the alias from the NBIRTH)
+    start = subscriber.count()
+    command = pb.Payload(timestamp=int(time.time() * 1000))
+    pb.set_value(command.metrics.add(alias=REBIRTH_ALIAS), pb.DataType.BOOLEAN, True)
+    subscriber.publish("spBv1.0/plant/NCMD/pad1", pb.encode(command))
+    subscriber.kind("NBIRTH", start=start)
+
+
+def test_new_session_with_bdseq_plus_one_after_a_broker_restart(
+    sim_factory: Any, broker: Any, subscriber: Subscriber, gateway_factory: Any
+) -> None:
+    # the gateway tries the broker again 3 s after losing it: the new broker is up and the watcher
+    # (a fresh subscriber: the broker keeps no session over a restart) subscribed long before that
+    gateway_factory({"R1": sim_factory()}, broker_retry=(3.0, 3.0))
+    first = subscriber.kind("NBIRTH")
+    subscriber.kind("DBIRTH", "R1")
+    broker.restart()
+    watcher = type(subscriber)(broker.port)
+    try:
+        again = watcher.kind("NBIRTH", timeout=15.0)
+        assert _bdseq(again) == _bdseq(first) + 1
+        assert again.seq == 0
+        watcher.kind("DBIRTH", "R1", start=watcher.messages.index(again))
+    finally:
+        watcher.close()
+
+
+def test_stop_publishes_ndeath_with_the_sessions_bdseq(
+    sim_factory: Any, subscriber: Subscriber, gateway_factory: Any
+) -> None:
+    node = gateway_factory({"R1": sim_factory()})
+    first = subscriber.kind("NBIRTH")
+    node.stop()
+    death = subscriber.kind("NDEATH")
+    assert _bdseq(death) == _bdseq(first)
+    assert death.seq is None
