@@ -107,7 +107,7 @@ SIM_SLOW_PICKUP = (0.005, 0.025)
 SIM_SLOW_ZERO = (0.002, 0.015)
 
 # --- teachpad-gateway, the Sparkplug B edge node (app/gateway; issue 23) --------------------------
-GATEWAY_POLL_HZ = 20.0  # each controller's poll rate (a silent one: DDEATH within 1 / this + its poll timeout)
+GATEWAY_POLL_HZ = 20.0  # polls per controller per s (a silent one: DDEATH within 1 / this + poll timeout)
 GATEWAY_RECONNECT_BACKOFF = (0.2, 0.5, 1.0, 2.0)  # s between polls of a controller that does not answer
 GATEWAY_KEEPALIVE = 30  # s, the MQTT keepalive: the broker sends NDEATH at most 1.5 x this after a crash
 GATEWAY_BROKER_RETRY = (0.5, 5.0)  # s, paho's reconnect delay to the broker (first, largest)

@@ -129,8 +129,11 @@ def _where(raw: dict[str, Any]) -> dict[str, Any]:
     """``host``/``port`` or ``rtu``/``baud``, exactly one of the two."""
     host, rtu = _text(raw, "host"), _text(raw, "rtu")
     if (host is None) == (rtu is None):
-        raise ValueError("needs either host (Modbus TCP) or rtu (a serial device), not both" if host else
-                         "host is missing (or rtu, for a serial line)")
+        raise ValueError(
+            "needs either host (Modbus TCP) or rtu (a serial device), not both"
+            if host
+            else "host is missing (or rtu, for a serial line)"
+        )
     if host is not None:
         if "baud" in raw:
             raise ValueError("baud is for a serial line (rtu), not for host")
@@ -166,7 +169,9 @@ def _controller(raw: object, index: int, base: Path) -> CellController:
         if isinstance(name, str) and name.strip():
             label = f"controller {name!r}"
         if not isinstance(name, str) or not name.strip() or len(name) > MAX_NAME or "/" in name:
-            raise ValueError(f"name must be text of 1 to {MAX_NAME} characters without '/', got {_quote(name)}")
+            raise ValueError(
+                f"name must be text of 1 to {MAX_NAME} characters without '/', got {_quote(name)}"
+            )
         unknown = sorted(set(raw) - _FIELDS)
         if unknown:
             raise ValueError(f"unknown field {_quote(unknown[0])}")

@@ -42,11 +42,15 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action=VersionAction)
     parser.add_argument("cell", type=Path, metavar="CELL_FILE", help="the cell file (teachpad-cell JSON)")
-    parser.add_argument("--broker", required=True, help="mqtt://HOST[:PORT] (1883) or mqtts://HOST[:PORT] (8883)")
+    parser.add_argument(
+        "--broker", required=True, help="mqtt://HOST[:PORT] (1883) or mqtts://HOST[:PORT] (8883)"
+    )
     parser.add_argument("--group", default="teachpad", help="Sparkplug group id (default %(default)s)")
     parser.add_argument("--node", default=None, help="Sparkplug edge node id (default: this host's name)")
     parser.add_argument("--username", default=None, help=f"broker user name (its password: ${PASSWORD_ENV})")
-    parser.add_argument("--password-file", type=Path, default=None, help="read the broker password from this file")
+    parser.add_argument(
+        "--password-file", type=Path, default=None, help="read the broker password from this file"
+    )
     parser.add_argument("--tls", action="store_true", help="TLS to the broker (implied by mqtts://)")
     parser.add_argument("--cafile", default=None, help="CA certificates for TLS (default: the system's)")
     parser.add_argument("--certfile", default=None, help="client certificate for TLS")
@@ -57,7 +61,9 @@ def build_parser() -> argparse.ArgumentParser:
         default=timing.GATEWAY_KEEPALIVE,
         help="MQTT keepalive, s (default %(default)s): a crashed gateway's NDEATH comes within 1.5 x this",
     )
-    parser.add_argument("--poll-hz", type=float, default=timing.GATEWAY_POLL_HZ, help="polls per controller per s")
+    parser.add_argument(
+        "--poll-hz", type=float, default=timing.GATEWAY_POLL_HZ, help="polls per controller per s"
+    )
     parser.add_argument("-v", "--verbose", action="store_true", help="log every connection change")
     return parser
 

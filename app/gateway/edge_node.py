@@ -29,6 +29,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import paho.mqtt.client as mqtt
+from google.protobuf.message import DecodeError
 from paho.mqtt.enums import CallbackAPIVersion
 
 from app.cell.cell_file import Cell
@@ -46,7 +47,7 @@ from app.gateway.metrics import (
 )
 from app.gateway.poller import ControllerPoller, GatewayTiming
 
-__all__ = ["BrokerSettings", "EdgeNode", "NAMESPACE"]
+__all__ = ["NAMESPACE", "BrokerSettings", "EdgeNode"]
 
 NAMESPACE = "spBv1.0"
 _log = logging.getLogger(__name__)
@@ -126,7 +127,9 @@ class EdgeNode:
         if b.username is not None:
             client.username_pw_set(b.username, b.password)
         if b.tls:
-            client.tls_set(ca_certs=b.cafile, certfile=b.certfile, keyfile=b.keyfile, cert_reqs=ssl.CERT_REQUIRED)
+            client.tls_set(
+                ca_certs=b.cafile, certfile=b.certfile, keyfile=b.keyfile, cert_reqs=ssl.CERT_REQUIRED
+            )
         first, largest = self.timing.broker_retry
         client.reconnect_delay_set(min_delay=max(1, round(first)), max_delay=max(1, round(largest)))
         client.on_connect = self._on_connect
@@ -181,7 +184,9 @@ class EdgeNode:
             self.sessions += 1
             self._birth()
 
-    def _on_disconnect(self, client: mqtt.Client, _userdata: Any, _flags: Any, reason: Any, _props: Any) -> None:
+    def _on_disconnect(
+        self, client: mqtt.Client, _userdata: Any, _flags: Any, reason: Any, _props: Any
+    ) -> None:
         with self._lock:
             if not self._online:
                 return
@@ -195,7 +200,7 @@ class EdgeNode:
             return
         try:
             command = pb.decode(message.payload)
-        except Exception as exc:  # a malformed NCMD is the sender's problem: said, ignored
+        except DecodeError as exc:  # a malformed NCMD is the sender's problem: said, ignored
             _log.warning("NCMD not understood: %s", exc)
             return
         for metric in command.metrics:

@@ -21,7 +21,7 @@ from app.models import ControllerStatus, Pose
 from app.protocol.datetime_regs import ControllerClock
 from app.protocol.enums import ALARM_BITS, Alarm
 
-__all__ = ["DEVICE_METRICS", "MetricSpec", "REBIRTH", "device_alias", "device_values", "changed"]
+__all__ = ["DEVICE_METRICS", "REBIRTH", "MetricSpec", "changed", "device_alias", "device_values"]
 
 REBIRTH = "Node Control/Rebirth"
 REBIRTH_ALIAS = 1
@@ -48,7 +48,10 @@ class MetricSpec:
 
 
 def _specs() -> tuple[MetricSpec, ...]:
-    pose = [MetricSpec(f"Pose/{axis}", DataType.DOUBLE, 0.01, "mm" if axis in "XYZ" else "deg") for axis in "XYZABC"]
+    pose = [
+        MetricSpec(f"Pose/{axis}", DataType.DOUBLE, 0.01, "mm" if axis in "XYZ" else "deg")
+        for axis in "XYZABC"
+    ]
     joints = [MetricSpec(f"Joints/J{i}", DataType.DOUBLE, 0.01, "deg") for i in range(1, 7)]
     state = [
         MetricSpec("Status/Work mode", DataType.UINT16),

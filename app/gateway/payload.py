@@ -13,7 +13,7 @@ from typing import Any
 
 from app.gateway.proto_text import message_classes
 
-__all__ = ["DataType", "Metric", "Payload", "PROTO_FILE", "decode", "encode", "metric_value"]
+__all__ = ["PROTO_FILE", "DataType", "Metric", "Payload", "decode", "encode", "metric_value"]
 
 PROTO_FILE = Path(__file__).with_name("sparkplug_b.proto")
 _CLASSES = message_classes(PROTO_FILE.read_text(encoding="utf-8"), "sparkplug_b.proto")
@@ -83,7 +83,7 @@ def encode(payload: Any) -> bytes:
     return data
 
 
-def decode(data: bytes) -> Any:
+def decode(data: bytes | bytearray) -> Any:
     payload = Payload()
     payload.ParseFromString(data)
     return payload

@@ -85,7 +85,9 @@ def _tokenize(text: str) -> _Tokens:
             rest = text[pos:]
             if rest.strip():
                 at = pos + len(rest) - len(rest.lstrip())
-                raise ProtoSyntaxError(f"line {text.count(chr(10), 0, at) + 1}: cannot read {rest.strip()[:20]!r}")
+                raise ProtoSyntaxError(
+                    f"line {text.count(chr(10), 0, at) + 1}: cannot read {rest.strip()[:20]!r}"
+                )
             return _Tokens(out)
         group = match.lastindex or 0
         if group != 1:  # not a comment
@@ -151,7 +153,7 @@ def _field(
     out.number = tokens.number()
     tokens.take(";")
     if kind in _SCALARS:
-        out.type = _SCALARS[kind]  # type: ignore[assignment]
+        out.type = _SCALARS[kind]
     else:
         out.type_name, is_enum = scope.resolve(kind, where, line)
         out.type = _FDP.TYPE_ENUM if is_enum else _FDP.TYPE_MESSAGE

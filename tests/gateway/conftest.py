@@ -127,7 +127,9 @@ class Subscriber:
     def __init__(self, port: int) -> None:
         self.messages: list[Received] = []
         self._cond = threading.Condition()
-        self._client = mqtt.Client(callback_api_version=CallbackAPIVersion.VERSION2, client_id=f"test-sub-{os.getpid()}-{next(_ids)}")
+        self._client = mqtt.Client(
+            callback_api_version=CallbackAPIVersion.VERSION2, client_id=f"test-sub-{os.getpid()}-{next(_ids)}"
+        )
         self._client.on_message = self._on_message
         subscribed = threading.Event()
         self._client.on_subscribe = lambda *_: subscribed.set()
@@ -152,7 +154,9 @@ class Subscriber:
             self.messages.append(got)
             self._cond.notify_all()
 
-    def wait_for(self, what: str, match: Callable[[Received], bool], timeout: float = WAIT, start: int = 0) -> Received:
+    def wait_for(
+        self, what: str, match: Callable[[Received], bool], timeout: float = WAIT, start: int = 0
+    ) -> Received:
         """The first message from index ``start`` on that ``match``-es; fails saying ``what`` otherwise."""
         deadline = time.monotonic() + timeout
         with self._cond:
@@ -166,7 +170,9 @@ class Subscriber:
                     pytest.fail(f"no {what} within {timeout:g} s (last messages: {kinds})", pytrace=False)
                 self._cond.wait(left)
 
-    def kind(self, kind: str, device: str | None = None, *, start: int = 0, timeout: float = WAIT) -> Received:
+    def kind(
+        self, kind: str, device: str | None = None, *, start: int = 0, timeout: float = WAIT
+    ) -> Received:
         return self.wait_for(
             f"{kind} {device or ''}".strip(),
             lambda m: m.kind == kind and (device is None or m.device == device),

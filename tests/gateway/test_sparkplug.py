@@ -3,6 +3,7 @@ an independent subscriber that decodes the payloads (tests/gateway/conftest.py).
 
 from __future__ import annotations
 
+import itertools
 import time
 from typing import Any
 
@@ -39,8 +40,12 @@ def test_nbirth_seq0_bdseq_rebirth_then_a_dbirth_per_device(
     for index, (name, birth) in enumerate(births.items()):
         assert birth.topic == f"spBv1.0/plant/DBIRTH/pad1/{name}"
         assert [m.name for m in birth.payload.metrics] == [spec.name for spec in DEVICE_METRICS]
-        assert [m.alias for m in birth.payload.metrics] == [device_alias(index, i) for i in range(len(DEVICE_METRICS))]
-        assert all(m.datatype == spec.datatype for m, spec in zip(birth.payload.metrics, DEVICE_METRICS, strict=True))
+        assert [m.alias for m in birth.payload.metrics] == [
+            device_alias(index, i) for i in range(len(DEVICE_METRICS))
+        ]
+        assert all(
+            m.datatype == spec.datatype for m, spec in zip(birth.payload.metrics, DEVICE_METRICS, strict=True)
+        )
     # the values are the controller's: its pose as the simulator holds it
     x = pb.metric_value(births["R1"].metric("Pose/X"))
     assert x == sims["R1"].robot.pose[0] or abs(float(x) - float(sims["R1"].robot.pose[0])) < 1e-3  # type: ignore[arg-type]
@@ -59,7 +64,9 @@ def test_ddata_by_exception_with_deadband_and_aliases_only(
     joints = sim.robot.joints
     sim.set_joint(1, float(joints[0]) + 0.005)  # within J1's deadband (0.01 deg): never sent
     sim.set_joint(2, float(joints[1]) + 1.0)  # past J2's
-    data = subscriber.wait_for("DDATA with J2", lambda m: m.kind == "DDATA" and j2 in _aliases(m), start=start)
+    data = subscriber.wait_for(
+        "DDATA with J2", lambda m: m.kind == "DDATA" and j2 in _aliases(m), start=start
+    )
     for message in subscriber.snapshot()[start:]:
         if message.kind == "DDATA":
             assert all(not m.name for m in message.payload.metrics), "a DDATA metric carries its name"
@@ -67,7 +74,9 @@ def test_ddata_by_exception_with_deadband_and_aliases_only(
             assert j1 not in _aliases(message), "J1 moved less than its deadband but was sent"
     value = next(m for m in data.payload.metrics if m.alias == j2)
     assert abs(pb.metric_value(value) - (float(joints[1]) + 1.0)) < 1e-3  # type: ignore[operator]
-    assert "Joints/J3" not in {spec.name for spec in DEVICE_METRICS if device_alias(0, METRIC_INDEX[spec.name]) in _aliases(data)}
+    assert "Joints/J3" not in {
+        spec.name for spec in DEVICE_METRICS if device_alias(0, METRIC_INDEX[spec.name]) in _aliases(data)
+    }
 
 
 def test_seq_counts_every_node_message_and_wraps_at_255(
@@ -78,11 +87,13 @@ def test_seq_counts_every_node_message_and_wraps_at_255(
     gateway_factory(sims, deadbands={"Link/RTT": 0.0}, poll_hz=100.0)
     nbirth = subscriber.kind("NBIRTH")
     start = subscriber.messages.index(nbirth)
-    subscriber.wait_for("300 node messages", lambda _m: subscriber_len(subscriber) - start > 300, timeout=30.0)
+    subscriber.wait_for(
+        "300 node messages", lambda _m: subscriber_len(subscriber) - start > 300, timeout=30.0
+    )
     ours = [m for m in subscriber.snapshot()[start:] if m.kind in NODE_KINDS]
     seqs = [m.seq for m in ours]
     assert seqs[0] == 0
-    for before, after in zip(seqs, seqs[1:], strict=False):
+    for before, after in itertools.pairwise(seqs):
         assert after == ((before or 0) + 1) % 256, f"seq {before} was followed by {after}"
     assert 255 in seqs and seqs[seqs.index(255) + 1] == 0
 
