@@ -109,6 +109,7 @@ class EdgeNode:
         self._online = False  # an MQTT session is up and NBIRTH went out
         self.sessions = 0  # MQTT sessions so far (NBIRTHs after a connect)
         self._running = False
+        self.answers = 0  # answered polls of all controllers so far
         self._client = self._make_client()
 
     # -- topics ---------------------------------------------------------------------------
@@ -259,6 +260,7 @@ class EdgeNode:
     # -- the pollers (their threads) ------------------------------------------------------
     def answered(self, device: str, reading: Reading) -> None:
         with self._lock:
+            self.answers += 1
             state = self._devices[device]
             if reading.clock is not None:
                 state.clock = clock_text(reading.clock)

@@ -54,25 +54,39 @@ class Broker:
 
     def __init__(self, binary: str, folder: Path) -> None:
         self.binary = binary
-        self.port = free_port()
         self.config = folder / "mosquitto.conf"
+        self.log = folder / "mosquitto.log"
+        self.proc: subprocess.Popen[bytes] | None = None
+        self.port = 0
+
+    def _configure(self) -> None:
+        self.port = free_port()
         self.config.write_text(
             f"listener {self.port} 127.0.0.1\nallow_anonymous true\npersistence false\n"
             "log_dest stderr\nlog_type error\nlog_type warning\n"
         )
-        self.log = folder / "mosquitto.log"
-        self.proc: subprocess.Popen[bytes] | None = None
 
-    def start(self) -> None:
+    def start_fresh(self) -> None:
+        """On a free port; another one when another test took it between the choice and the bind."""
+        for _attempt in range(3):
+            self._configure()
+            if self.start(give_up=False):
+                return
+        pytest.fail(f"mosquitto could not listen on a free port: {self.log.read_text()[-500:]}")
+
+    def start(self, *, give_up: bool = True) -> bool:
+        """Start on :attr:`port` (a restart: the same); True once it accepts connections."""
         with self.log.open("ab") as log:
             self.proc = subprocess.Popen([self.binary, "-c", str(self.config)], stdout=log, stderr=log)
         deadline = time.monotonic() + BROKER_START_TIMEOUT
         while time.monotonic() < deadline:
             if self.proc.poll() is not None:
+                if not give_up and "in use" in self.log.read_text():
+                    return False
                 pytest.fail(f"mosquitto exited ({self.proc.returncode}): {self.log.read_text()[-500:]}")
             try:
                 socket.create_connection(("127.0.0.1", self.port), timeout=0.2).close()
-                return
+                return True
             except OSError:
                 time.sleep(0.02)  # polling a port that is not open yet: nothing to wait on
         pytest.fail(f"mosquitto did not listen on port {self.port} within {BROKER_START_TIMEOUT:g} s")
@@ -96,7 +110,7 @@ class Broker:
 @pytest.fixture
 def broker(tmp_path: Path) -> Iterator[Broker]:
     b = Broker(mosquitto_binary(), tmp_path)
-    b.start()
+    b.start_fresh()
     try:
         yield b
     finally:

@@ -128,10 +128,7 @@ def test_rebirth_on_ncmd(sim_factory: Any, subscriber: Subscriber, gateway_facto
     first = subscriber.kind("NBIRTH")
     subscriber.kind("DBIRTH", "R1")
     start = subscriber.count()
-    command = pb.Payload(timestamp=int(time.time() * 1000))
-    metric = command.metrics.add(name=REBIRTH, datatype=pb.DataType.BOOLEAN)
-    pb.set_value(metric, pb.DataType.BOOLEAN, True)
-    subscriber.publish("spBv1.0/plant/NCMD/pad1", pb.encode(command))
+    _ask_rebirth(subscriber)
     again = subscriber.kind("NBIRTH", start=start)
     assert again.seq == 0 and _bdseq(again) == _bdseq(first)
     dbirth = subscriber.kind("DBIRTH", "R1", start=subscriber.messages.index(again))
@@ -172,3 +169,32 @@ def test_stop_publishes_ndeath_with_the_sessions_bdseq(
     death = subscriber.kind("NDEATH")
     assert _bdseq(death) == _bdseq(first)
     assert death.seq is None
+
+
+def test_no_ddata_while_nothing_moves_past_its_deadband(
+    sim_factory: Any, subscriber: Subscriber, gateway_factory: Any
+) -> None:
+    node = gateway_factory({"R1": sim_factory()}, deadbands={"Link/RTT": 1e9, "Link/Freshness": 1e9})
+    subscriber.kind("DBIRTH", "R1")
+    start, answers = subscriber.count(), node.answers
+    wait_until(lambda: node.answers >= answers + 20, "20 more answered polls")
+    # a DDATA those polls caused comes before anything the node publishes after them (one
+    # connection, in order): ask for a rebirth and look at what came before its NBIRTH
+    _ask_rebirth(subscriber)
+    end = subscriber.messages.index(subscriber.kind("NBIRTH", start=start))
+    quiet = [m for m in subscriber.snapshot()[start:end] if m.kind == "DDATA"]
+    assert quiet == [], f"{len(quiet)} DDATA while the robot stood still"
+
+
+def wait_until(condition: Any, what: str, timeout: float = 10.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, f"no {what} within {timeout:g} s"
+        time.sleep(0.01)  # a counter in another thread: nothing to wait on
+
+
+def _ask_rebirth(subscriber: Subscriber) -> None:
+    command = pb.Payload(timestamp=int(time.time() * 1000))
+    metric = command.metrics.add(name=REBIRTH, datatype=pb.DataType.BOOLEAN)
+    pb.set_value(metric, pb.DataType.BOOLEAN, True)
+    subscriber.publish("spBv1.0/plant/NCMD/pad1", pb.encode(command))
