@@ -113,3 +113,5 @@ GATEWAY_KEEPALIVE = 30  # s, the MQTT keepalive: the broker sends NDEATH at most
 GATEWAY_BROKER_RETRY = (0.5, 5.0)  # s, paho's reconnect delay to the broker (first, largest)
 GATEWAY_CLOCK_PERIOD = 1.0  # s between reads of the controller's clock (with the status block)
 GATEWAY_STOP_WAIT = 2.0  # s a stopping gateway waits for its NDEATH to be sent
+# DDATA kept while the broker is away (sent flagged is_historical when it is back); older ones are dropped
+GATEWAY_HISTORY_LIMIT = 10_000

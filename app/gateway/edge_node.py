@@ -12,6 +12,10 @@ What the specification asks of an edge node, and how it is met here:
 * ``seq`` counts every message of the node but NDEATH, 0..255 and round again; NBIRTH resets it to 0.
 * A controller that stops answering gets a **DDEATH** at its first failed poll; a **DBIRTH** when it
   answers again. **NCMD** ``Node Control/Rebirth`` = true: NBIRTH and every DBIRTH again (same bdSeq).
+* **While the broker is away** the DDATA the controllers' changes would have been are kept, at most
+  ``history_limit`` (the oldest dropped first), and published after the next session's births with
+  every metric ``is_historical``; how many were dropped is the NBIRTH's ``Node Info/History dropped``
+  (since the start) and a warning.
 * Nothing from the plant is written to a controller: DCMD is not subscribed to (writes are off).
 
 Threads: paho's network thread (connect, NCMD) and one poller thread per controller call in here;
@@ -24,6 +28,7 @@ import logging
 import ssl
 import threading
 import time
+from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -32,11 +37,13 @@ import paho.mqtt.client as mqtt
 from google.protobuf.message import DecodeError
 from paho.mqtt.enums import CallbackAPIVersion
 
+from app import timing
 from app.cell.cell_file import Cell
 from app.gateway import payload as pb
 from app.gateway.metrics import (
     BDSEQ,
     DEVICE_METRICS,
+    HISTORY_DROPPED,
     REBIRTH,
     REBIRTH_ALIAS,
     Reading,
@@ -95,6 +102,7 @@ class EdgeNode:
         node: str,
         gateway: GatewayTiming | None = None,
         deadbands: Mapping[str, float] | None = None,
+        history_limit: int | None = None,
     ) -> None:
         self.group = group
         self.node = node
@@ -110,6 +118,9 @@ class EdgeNode:
         self.sessions = 0  # MQTT sessions so far (NBIRTHs after a connect)
         self._running = False
         self.answers = 0  # answered polls of all controllers so far
+        limit = timing.GATEWAY_HISTORY_LIMIT if history_limit is None else history_limit
+        self._history: deque[tuple[str, Any]] = deque(maxlen=max(1, limit))
+        self.history_dropped = 0  # DDATA the bound dropped while the broker was away, since the start
         self._client = self._make_client()
 
     # -- topics ---------------------------------------------------------------------------
@@ -133,6 +144,7 @@ class EdgeNode:
             )
         first, largest = self.timing.broker_retry
         client.reconnect_delay_set(min_delay=max(1, round(first)), max_delay=max(1, round(largest)))
+        client.enable_logger(logging.getLogger("app.gateway.mqtt"))
         client.on_connect = self._on_connect
         client.on_disconnect = self._on_disconnect
         client.on_message = self._on_message
@@ -218,8 +230,13 @@ class EdgeNode:
         self._seq = (self._seq + 1) % 256
         self._client.publish(topic, pb.encode(message), qos=0, retain=False)
 
+    @property
+    def online(self) -> bool:
+        """An MQTT session is up and its NBIRTH went out."""
+        return self._online
+
     def _birth(self) -> None:
-        """NBIRTH (seq 0), then a DBIRTH for every answering controller."""
+        """NBIRTH (seq 0), then a DBIRTH for every answering controller, then the history."""
         self._seq = 0
         self._online = True
         birth = pb.Payload(timestamp=_now_ms())
@@ -229,10 +246,28 @@ class EdgeNode:
             name=REBIRTH, alias=REBIRTH_ALIAS, timestamp=birth.timestamp, datatype=pb.DataType.BOOLEAN
         )
         pb.set_value(rebirth, pb.DataType.BOOLEAN, False)
+        dropped = birth.metrics.add(
+            name=HISTORY_DROPPED, timestamp=birth.timestamp, datatype=pb.DataType.UINT64
+        )
+        pb.set_value(dropped, pb.DataType.UINT64, self.history_dropped)
         self._publish(self.topic("NBIRTH"), birth)
         for device in self._devices.values():
             if device.alive and device.values is not None:
                 self._dbirth(device, birth.timestamp)
+        self._send_history()
+
+    def _send_history(self) -> None:
+        if self._history:
+            _log.warning(
+                "broker back: %d change(s) kept while it was away sent as historical (%d dropped so far)",
+                len(self._history),
+                self.history_dropped,
+            )
+        while self._history:
+            topic, message = self._history.popleft()
+            for metric in message.metrics:
+                metric.is_historical = True
+            self._publish(topic, message)
 
     def _dbirth(self, device: _Device, stamp: int) -> None:
         assert device.values is not None
@@ -246,6 +281,20 @@ class EdgeNode:
         self._publish(self.topic("DBIRTH", device.name), message)
 
     def _ddata(self, device: _Device, stamp: int) -> None:
+        """The metrics past their deadband: published, or kept while the broker is away."""
+        message = self._changes(device, stamp)
+        if message is None:
+            return
+        topic = self.topic("DDATA", device.name)
+        if self._online:
+            self._publish(topic, message)
+            return
+        if len(self._history) == self._history.maxlen:
+            self.history_dropped += 1
+        self._history.append((topic, message))
+
+    def _changes(self, device: _Device, stamp: int) -> Any:
+        """A DDATA payload of what moved past its deadband since the last one (None: nothing)."""
         assert device.values is not None and device.sent is not None
         message = pb.Payload(timestamp=stamp)
         for i, spec in enumerate(DEVICE_METRICS):
@@ -254,8 +303,7 @@ class EdgeNode:
                 metric = message.metrics.add(alias=device_alias(device.index, i), timestamp=stamp)
                 pb.set_value(metric, spec.datatype, now)
                 device.sent[spec.name] = now
-        if message.metrics:
-            self._publish(self.topic("DDATA", device.name), message)
+        return message if message.metrics else None
 
     # -- the pollers (their threads) ------------------------------------------------------
     def answered(self, device: str, reading: Reading) -> None:
@@ -270,7 +318,7 @@ class EdgeNode:
                 state.alive = True
                 if self._online:
                     self._dbirth(state, reading.wall_ms)
-            elif self._online:
+            elif state.sent is not None:  # births told the subscribers its values once
                 self._ddata(state, reading.wall_ms)
 
     def silent(self, device: str, reason: str) -> None:

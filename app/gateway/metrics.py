@@ -26,6 +26,7 @@ __all__ = ["DEVICE_METRICS", "REBIRTH", "MetricSpec", "changed", "device_alias",
 REBIRTH = "Node Control/Rebirth"
 REBIRTH_ALIAS = 1
 BDSEQ = "bdSeq"
+HISTORY_DROPPED = "Node Info/History dropped"
 ALIAS_BLOCK = 1000
 
 ALARM_METRIC_NAMES: dict[Alarm, str] = {

@@ -7,7 +7,9 @@ installs it), they are not skipped.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
+import logging
 import os
 import shutil
 import socket
@@ -136,17 +138,27 @@ class Received:
 
 
 class Subscriber:
-    """An independent Sparkplug consumer: subscribes to ``spBv1.0/#`` and decodes every payload."""
+    """An independent Sparkplug consumer: subscribes to ``spBv1.0/#`` and decodes every payload.
+
+    After a broker restart it subscribes again (:attr:`subscriptions` counts them)."""
 
     def __init__(self, port: int) -> None:
         self.messages: list[Received] = []
+        self.subscriptions = 0  # subscriptions made (one per connection)
         self._cond = threading.Condition()
         self._client = mqtt.Client(
             callback_api_version=CallbackAPIVersion.VERSION2, client_id=f"test-sub-{os.getpid()}-{next(_ids)}"
         )
+        self._client.reconnect_delay_set(1, 1)
+        self._client.enable_logger(logging.getLogger("tests.gateway.subscriber"))
         self._client.on_message = self._on_message
         subscribed = threading.Event()
-        self._client.on_subscribe = lambda *_: subscribed.set()
+
+        def on_subscribe(*_args: Any) -> None:
+            self.subscriptions += 1
+            subscribed.set()
+
+        self._client.on_subscribe = on_subscribe
         self._client.on_connect = lambda client, *_: client.subscribe("spBv1.0/#", qos=1)
         self._client.connect("127.0.0.1", port, keepalive=5)
         self._client.loop_start()
@@ -242,15 +254,22 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
 
     made: list[EdgeNode] = []
 
-    def make(sims: dict[str, Any], deadbands: dict[str, float] | None = None, **clocks: Any) -> EdgeNode:
+    def make(
+        sims: dict[str, Any],
+        deadbands: dict[str, float] | None = None,
+        history_limit: int | None = None,
+        port: int | None = None,
+        **clocks: Any,
+    ) -> EdgeNode:
         cell = load_cell(write_cell(tmp_path, sims))
         node = EdgeNode(
             cell,
-            BrokerSettings("127.0.0.1", broker.port),
+            BrokerSettings("127.0.0.1", port or broker.port),
             group="plant",
             node="pad1",
             gateway=GatewayTiming(**{**FAST, **clocks}),
             deadbands=deadbands,
+            history_limit=history_limit,
         )
         node.start()
         made.append(node)
@@ -261,3 +280,68 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
     finally:
         for node in made:
             node.stop()
+
+
+class BrokerLink:
+    """A TCP relay between the gateway and the broker that the test can cut and restore: the broker
+    out of the gateway's reach while the subscriber, connected directly, sees everything."""
+
+    def __init__(self, broker_port: int) -> None:
+        self.broker_port = broker_port
+        self._listener = socket.create_server(("127.0.0.1", 0))
+        self.port: int = self._listener.getsockname()[1]
+        self._cut = False
+        self._open: list[socket.socket] = []
+        self._lock = threading.Lock()
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self) -> None:
+        while True:
+            try:
+                near, _ = self._listener.accept()
+            except OSError:
+                return  # closed
+            with self._lock:
+                if self._cut:
+                    near.close()
+                    continue
+                far = socket.create_connection(("127.0.0.1", self.broker_port))
+                self._open += [near, far]
+            for a, b in ((near, far), (far, near)):
+                threading.Thread(target=self._pipe, args=(a, b), daemon=True).start()
+
+    @staticmethod
+    def _pipe(source: socket.socket, sink: socket.socket) -> None:
+        try:
+            while data := source.recv(65536):
+                sink.sendall(data)
+        except OSError:
+            pass  # the other side or cut() closed it
+        finally:
+            for s in (source, sink):
+                s.close()
+
+    def cut(self) -> None:
+        with self._lock:
+            self._cut = True
+            for s in self._open:
+                with contextlib.suppress(OSError):
+                    s.shutdown(socket.SHUT_RDWR)
+            self._open.clear()
+
+    def restore(self) -> None:
+        with self._lock:
+            self._cut = False
+
+    def close(self) -> None:
+        self.cut()
+        self._listener.close()
+
+
+@pytest.fixture
+def broker_link(broker: Broker) -> Iterator[BrokerLink]:
+    link = BrokerLink(broker.port)
+    try:
+        yield link
+    finally:
+        link.close()
