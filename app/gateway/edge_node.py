@@ -143,7 +143,7 @@ class EdgeNode:
                 ca_certs=b.cafile, certfile=b.certfile, keyfile=b.keyfile, cert_reqs=ssl.CERT_REQUIRED
             )
         first, largest = self.timing.broker_retry
-        client.reconnect_delay_set(min_delay=max(1, round(first)), max_delay=max(1, round(largest)))
+        client.reconnect_delay_set(min_delay=max(1, first), max_delay=max(1, first, largest))
         client.enable_logger(logging.getLogger("app.gateway.mqtt"))
         client.on_connect = self._on_connect
         client.on_disconnect = self._on_disconnect

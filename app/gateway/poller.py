@@ -42,7 +42,7 @@ class GatewayTiming:
     poll_timeout: float | None = None  # s; None: the connection's (0.15 s over TCP, by baud over RTU)
     backoff: tuple[float, ...] = field(default_factory=_backoff)
     keepalive: int = field(default_factory=lambda: timing.GATEWAY_KEEPALIVE)
-    broker_retry: tuple[float, float] = field(default_factory=lambda: timing.GATEWAY_BROKER_RETRY)
+    broker_retry: tuple[int, int] = field(default_factory=lambda: timing.GATEWAY_BROKER_RETRY)
     clock_period: float = field(default_factory=lambda: timing.GATEWAY_CLOCK_PERIOD)
     stop_wait: float = field(default_factory=lambda: timing.GATEWAY_STOP_WAIT)
 
