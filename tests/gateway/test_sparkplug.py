@@ -121,6 +121,8 @@ def test_ddeath_within_250_ms_of_silence_and_dbirth_when_it_answers_again(
     assert [m.name for m in again.payload.metrics] == [spec.name for spec in DEVICE_METRICS]
     # R1 kept answering: no DDEATH for it
     assert not [m for m in subscriber.snapshot() if m.kind == "DDEATH" and m.device == "R1"]
+    # reconnecting to a controller writes nothing either (monitor-only)
+    assert all(sim.writes == [] for sim in sims.values())
 
 
 def test_rebirth_on_ncmd(sim_factory: Any, subscriber: Subscriber, gateway_factory: Any) -> None:
