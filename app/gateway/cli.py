@@ -114,6 +114,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         level=logging.INFO if args.verbose else logging.WARNING,
         format=f"{PROG}: %(levelname)s %(message)s",
     )
+    if not args.verbose:  # paho's own lines ("Client is not connected ...") only with -v
+        logging.getLogger("app.gateway.mqtt").setLevel(logging.CRITICAL)
     try:
         _check(args)
         broker = broker_settings(args)

@@ -84,6 +84,7 @@ class _Device:
     values: dict[str, pb.Value] | None = None  # the last reading's values
     sent: dict[str, pb.Value] | None = None  # what the subscribers were last told
     clock: str | None = None
+    never_said: bool = True  # a controller that never answered is said once (then each loss)
 
 
 def _now_ms() -> int:
@@ -118,6 +119,7 @@ class EdgeNode:
         self.sessions = 0  # MQTT sessions so far (NBIRTHs after a connect)
         self._running = False
         self.answers = 0  # answered polls of all controllers so far
+        self._unreachable_said = False  # "cannot reach the broker" said once per outage
         limit = timing.GATEWAY_HISTORY_LIMIT if history_limit is None else history_limit
         self._history: deque[tuple[str, Any]] = deque(maxlen=max(1, limit))
         self.history_dropped = 0  # DDATA the bound dropped while the broker was away, since the start
@@ -146,6 +148,7 @@ class EdgeNode:
         client.reconnect_delay_set(min_delay=max(1, first), max_delay=max(1, first, largest))
         client.enable_logger(logging.getLogger("app.gateway.mqtt"))
         client.on_connect = self._on_connect
+        client.on_connect_fail = self._on_connect_fail
         client.on_disconnect = self._on_disconnect
         client.on_message = self._on_message
         self._set_will(client)
@@ -193,9 +196,25 @@ class EdgeNode:
             _log.warning("broker refused the connection: %s", reason)
             return
         client.subscribe(self.topic("NCMD"), qos=1)
+        if self._unreachable_said:
+            self._unreachable_said = False
+            _log.warning("connected to the MQTT broker at %s:%d", self._broker.host, self._broker.port)
         with self._lock:
             self.sessions += 1
             self._birth()
+
+    def _on_connect_fail(self, _client: mqtt.Client, _userdata: Any) -> None:
+        if not self._unreachable_said:
+            self._unreachable_said = True
+            b = self._broker
+            first, largest = self.timing.broker_retry
+            _log.warning(
+                "cannot reach the MQTT broker at %s:%d; trying again (every %d to %d s)",
+                b.host,
+                b.port,
+                first,
+                largest,
+            )
 
     def _on_disconnect(
         self, client: mqtt.Client, _userdata: Any, _flags: Any, reason: Any, _props: Any
@@ -325,6 +344,9 @@ class EdgeNode:
         with self._lock:
             state = self._devices[device]
             if not state.alive:
+                if state.never_said and state.values is None:
+                    _log.warning("%s does not answer (trying again): %s", device, reason)
+                state.never_said = False
                 return
             state.alive = False
             _log.warning("%s stopped answering: %s", device, reason)
