@@ -47,6 +47,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--group", default="teachpad", help="Sparkplug group id (default %(default)s)")
     parser.add_argument("--node", default=None, help="Sparkplug edge node id (default: this host's name)")
+    parser.add_argument(
+        "--primary-host",
+        default=None,
+        metavar="HOST_ID",
+        help="publish only while this Sparkplug host application's STATE says online",
+    )
     parser.add_argument("--username", default=None, help=f"broker user name (its password: ${PASSWORD_ENV})")
     parser.add_argument(
         "--password-file", type=Path, default=None, help="read the broker password from this file"
@@ -121,12 +127,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         broker = broker_settings(args)
         group = _name(args.group, "--group")
         node = _name(args.node if args.node is not None else socket.gethostname(), "--node")
+        primary = None if args.primary_host is None else _name(args.primary_host, "--primary-host")
         cell = load_cell(args.cell)
     except (UsageError, CellFileError) as exc:
         print(f"{PROG}: {exc}", file=sys.stderr)
         return EXIT_USAGE
     gateway = GatewayTiming(poll_hz=args.poll_hz, keepalive=args.keepalive)
-    edge = EdgeNode(cell, broker, group=group, node=node, gateway=gateway)
+    edge = EdgeNode(cell, broker, group=group, node=node, gateway=gateway, primary_host=primary)
     done = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: done.set())

@@ -16,6 +16,11 @@ What the specification asks of an edge node, and how it is met here:
   ``history_limit`` (the oldest dropped first), and published after the next session's births with
   every metric ``is_historical``; how many were dropped is the NBIRTH's ``Node Info/History dropped``
   (since the start) and a warning.
+* **A primary host application** (``primary_host``, optional): its retained ``spBv1.0/STATE/ID``
+  (JSON ``{"online": bool, "timestamp": ms}``, QoS 1) is subscribed to, and the node is born only
+  while it says online; an offline STATE (not older than the last one) ends the session: NDEATH,
+  disconnect, a new session (``bdSeq`` + 1) that waits for online again. Changes meanwhile are kept
+  as while the broker is away.
 * Nothing from the plant is written to a controller: DCMD is not subscribed to (writes are off).
 
 Threads: paho's network thread (connect, NCMD) and one poller thread per controller call in here;
@@ -24,6 +29,7 @@ one lock orders everything the node publishes, so ``seq`` goes out in order.
 
 from __future__ import annotations
 
+import json
 import logging
 import ssl
 import threading
@@ -104,6 +110,7 @@ class EdgeNode:
         gateway: GatewayTiming | None = None,
         deadbands: Mapping[str, float] | None = None,
         history_limit: int | None = None,
+        primary_host: str | None = None,
     ) -> None:
         self.group = group
         self.node = node
@@ -119,6 +126,11 @@ class EdgeNode:
         self.sessions = 0  # MQTT sessions so far (NBIRTHs after a connect)
         self._running = False
         self.answers = 0  # answered polls of all controllers so far
+        self.primary_host = primary_host
+        self._primary_online = False
+        self._primary_stamp = -1  # the newest STATE's timestamp (older ones are stale)
+        self._connected = False  # an MQTT session is up (born or waiting for the primary host)
+        self._disconnected = threading.Event()  # set by every on_disconnect
         self._unreachable_said = False  # "cannot reach the broker" said once per outage
         limit = timing.GATEWAY_HISTORY_LIMIT if history_limit is None else history_limit
         self._history: deque[tuple[str, Any]] = deque(maxlen=max(1, limit))
@@ -196,12 +208,17 @@ class EdgeNode:
             _log.warning("broker refused the connection: %s", reason)
             return
         client.subscribe(self.topic("NCMD"), qos=1)
+        if self.primary_host is not None:
+            client.subscribe(self._state_topic(), qos=1)
         if self._unreachable_said:
             self._unreachable_said = False
             _log.warning("connected to the MQTT broker at %s:%d", self._broker.host, self._broker.port)
         with self._lock:
             self.sessions += 1
-            self._birth()
+            self._connected = True
+            self._primary_online = False  # its retained STATE comes with the subscription
+            if self.primary_host is None:
+                self._birth()
 
     def _on_connect_fail(self, _client: mqtt.Client, _userdata: Any) -> None:
         if not self._unreachable_said:
@@ -219,7 +236,9 @@ class EdgeNode:
     def _on_disconnect(
         self, client: mqtt.Client, _userdata: Any, _flags: Any, reason: Any, _props: Any
     ) -> None:
+        self._disconnected.set()
         with self._lock:
+            self._connected = False
             if not self._online:
                 return
             self._online = False
@@ -227,7 +246,58 @@ class EdgeNode:
             self._set_will(client)
         _log.warning("broker connection lost (%s); a new session will have bdSeq %d", reason, self.bdseq)
 
+    def _state_topic(self) -> str:
+        return f"{NAMESPACE}/STATE/{self.primary_host}"
+
+    def _on_state(self, data: bytes) -> None:
+        """The primary host's STATE: born while it is online, the session ended when it goes offline."""
+        try:
+            state = json.loads(data.decode("utf-8"))
+            online, stamp = state["online"], state["timestamp"]
+            if not isinstance(online, bool) or not isinstance(stamp, int):
+                raise ValueError("online must be true or false, timestamp a whole number")
+        except (ValueError, KeyError, TypeError) as exc:
+            _log.warning("STATE of %s not understood: %s", self.primary_host, exc)
+            return
+        with self._lock:
+            if stamp < self._primary_stamp:
+                return  # stale
+            self._primary_stamp = stamp
+            self._primary_online = online
+            if online and self._connected and not self._online:
+                self._birth()
+            elif not online and self._online:
+                _log.warning(
+                    "primary host %s offline: session ended, a new one waits for it", self.primary_host
+                )
+                self._online = False
+                self._client.publish(self.topic("NDEATH"), self._ndeath(), qos=1)
+                threading.Thread(target=self._new_session, name="gateway-new-session", daemon=True).start()
+
+    def _new_session(self) -> None:
+        """Disconnect, then connect again with bdSeq + 1 (not from paho's own thread: it is stopped here)."""
+        self._disconnected.clear()
+        self._client.disconnect()
+        # paho closes the socket right after on_disconnect, in its thread: let it, then stop that thread
+        self._disconnected.wait(self.timing.stop_wait)
+        self._client.loop_stop()
+        # paho 2.2's loop_start makes a new wake-up socket pair without closing the last one's: close
+        # it here (its own method for that), or the next loop_start leaves two sockets to the GC
+        reset = getattr(self._client, "_reset_sockets", None)
+        if reset is not None:
+            reset(sockpair_only=True)
+        with self._lock:
+            if not self._running:
+                return
+            self.bdseq = (self.bdseq + 1) % 256
+            self._set_will(self._client)
+            self._client.connect_async(self._broker.host, self._broker.port, keepalive=self.timing.keepalive)
+            self._client.loop_start()
+
     def _on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        if self.primary_host is not None and message.topic == self._state_topic():
+            self._on_state(bytes(message.payload))
+            return
         if message.topic != self.topic("NCMD"):
             return
         try:

@@ -167,11 +167,12 @@ class Subscriber:
 
     def _on_message(self, _c: Any, _u: Any, message: mqtt.MQTTMessage) -> None:
         parts = message.topic.split("/")
+        state = parts[1] == "STATE"  # spBv1.0/STATE/HOST_ID: JSON, not a Sparkplug payload
         got = Received(
             message.topic,
-            parts[2],
+            "STATE" if state else parts[2],
             parts[4] if len(parts) > 4 else None,
-            pb.decode(message.payload) if parts[2] != "STATE" else None,
+            None if state else pb.decode(message.payload),
             time.monotonic(),
             message.qos,
             bool(message.retain),
@@ -214,8 +215,8 @@ class Subscriber:
         with self._cond:
             return list(self.messages)
 
-    def publish(self, topic: str, data: bytes) -> None:
-        self._client.publish(topic, data, qos=1).wait_for_publish(WAIT)
+    def publish(self, topic: str, data: bytes, *, retain: bool = False) -> None:
+        self._client.publish(topic, data, qos=1, retain=retain).wait_for_publish(WAIT)
 
     def close(self) -> None:
         self._client.disconnect()
@@ -259,6 +260,7 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
         deadbands: dict[str, float] | None = None,
         history_limit: int | None = None,
         port: int | None = None,
+        primary_host: str | None = None,
         **clocks: Any,
     ) -> EdgeNode:
         cell = load_cell(write_cell(tmp_path, sims))
@@ -270,6 +272,7 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
             gateway=GatewayTiming(**{**FAST, **clocks}),
             deadbands=deadbands,
             history_limit=history_limit,
+            primary_host=primary_host,
         )
         node.start()
         made.append(node)
