@@ -1,7 +1,8 @@
 """``teachpad-gateway CELL_FILE --broker mqtt://HOST:PORT [--group G] [--node N]``: headless, no widgets.
 
 Polls every controller of the cell (read-only) and publishes it as a Sparkplug B edge node
-(:mod:`app.gateway.edge_node`) until SIGINT or SIGTERM, then publishes NDEATH and exits 0. Exit 2
+(:mod:`app.gateway.edge_node`) until SIGINT or SIGTERM, then publishes NDEATH and exits 0. SIGHUP
+reads the cell file again (a controller that left gets its DDEATH, one that joined its DBIRTH). Exit 2
 (nothing started) for bad arguments or a cell file that cannot be used, with one line saying why.
 """
 
@@ -27,6 +28,7 @@ from app.version import VersionAction
 PROG = "teachpad-gateway"
 PASSWORD_ENV = "TEACHPAD_MQTT_PASSWORD"
 EXIT_USAGE = 2
+RELOAD_CHECK = 0.2  # s: how soon a SIGHUP (reload the cell file) is acted on
 _BAD_NAME_CHARS = set("/+#")
 
 
@@ -114,6 +116,16 @@ def _check(args: argparse.Namespace) -> None:
         raise UsageError(f"--poll-hz must be 0.1..200, got {args.poll_hz:g}")
 
 
+def _reload(edge: EdgeNode, path: Path) -> None:
+    """SIGHUP: the cell file again; a file that cannot be used is said and the running cell kept."""
+    try:
+        cell = load_cell(path)
+    except CellFileError as exc:
+        print(f"{PROG}: cell file not reloaded, the running cell stays: {exc}", file=sys.stderr, flush=True)
+        return
+    edge.set_cell(cell)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     logging.basicConfig(
@@ -135,8 +147,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     gateway = GatewayTiming(poll_hz=args.poll_hz, keepalive=args.keepalive)
     edge = EdgeNode(cell, broker, group=group, node=node, gateway=gateway, primary_host=primary)
     done = threading.Event()
+    reload = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: done.set())
+    signal.signal(signal.SIGHUP, lambda *_: reload.set())
     edge.start()
     print(
         f"{PROG}: {len(cell.controllers)} controller(s) of cell {cell.name!r} -> {broker.host}:{broker.port} "
@@ -144,7 +158,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         file=sys.stderr,
         flush=True,
     )
-    while not done.wait(1.0):
-        pass
+    while not done.wait(RELOAD_CHECK):
+        if reload.is_set():
+            reload.clear()
+            _reload(edge, args.cell)
     edge.stop()
     return 0

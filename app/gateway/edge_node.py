@@ -119,7 +119,9 @@ class EdgeNode:
         self._broker = broker
         self._lock = threading.RLock()
         self._devices = {c.name: _Device(c.name, i) for i, c in enumerate(cell.controllers)}
-        self._pollers = [ControllerPoller(c, self, self.timing) for c in cell.controllers]
+        self._controllers = {c.name: c for c in cell.controllers}
+        self._pollers = {c.name: ControllerPoller(c, self, self.timing) for c in cell.controllers}
+        self._next_index = len(cell.controllers)  # a controller that joins later: aliases never reused
         self.bdseq = 0
         self._seq = 0
         self._online = False  # an MQTT session is up and NBIRTH went out
@@ -180,7 +182,7 @@ class EdgeNode:
         self._running = True
         self._client.connect_async(self._broker.host, self._broker.port, keepalive=self.timing.keepalive)
         self._client.loop_start()
-        for poller in self._pollers:
+        for poller in self._pollers.values():
             poller.start()
 
     def stop(self) -> None:
@@ -188,7 +190,7 @@ class EdgeNode:
         if not self._running:
             return
         self._running = False
-        for poller in self._pollers:
+        for poller in list(self._pollers.values()):
             poller.stop()
         with self._lock:
             online, self._online = self._online, False
@@ -201,6 +203,36 @@ class EdgeNode:
                 _log.warning("NDEATH not sent on stop: %s", exc)
         self._client.disconnect()
         self._client.loop_stop()
+
+    def set_cell(self, cell: Cell) -> None:
+        """The cell file changed: a controller that left (or whose settings changed) gets its DDEATH
+        and its poller stops; one that joined gets a poller (and its DBIRTH at its first answer, with
+        aliases of its own: a device index is never used twice)."""
+        wanted = {c.name: c for c in cell.controllers}
+        with self._lock:
+            leaving = [n for n, c in self._controllers.items() if wanted.get(n) != c]
+            stopped = [self._pollers.pop(name) for name in leaving]
+            if leaving:  # their kept changes go with them (no DBIRTH will come before them)
+                topics = {self.topic("DDATA", name) for name in leaving}
+                kept = [(t, m) for t, m in self._history if t not in topics]
+                self._history = deque(kept, maxlen=self._history.maxlen)
+            for name in leaving:
+                state = self._devices.pop(name)
+                del self._controllers[name]
+                if state.alive and self._online:
+                    self._publish(self.topic("DDEATH", name), pb.Payload(timestamp=_now_ms()))
+            joining = [c for n, c in wanted.items() if n not in self._controllers]
+            for controller in joining:
+                self._devices[controller.name] = _Device(controller.name, self._next_index)
+                self._next_index += 1
+                self._controllers[controller.name] = controller
+                self._pollers[controller.name] = ControllerPoller(controller, self, self.timing)
+        for poller in stopped:  # outside the lock: its thread may be waiting for it
+            poller.stop()
+        if self._running:
+            for controller in joining:
+                self._pollers[controller.name].start()
+        _log.warning("cell changed: %d controller(s) left, %d joined", len(leaving), len(joining))
 
     # -- MQTT callbacks (paho's network thread) -------------------------------------------
     def _on_connect(self, client: mqtt.Client, _userdata: Any, _flags: Any, reason: Any, _props: Any) -> None:
@@ -398,7 +430,9 @@ class EdgeNode:
     def answered(self, device: str, reading: Reading) -> None:
         with self._lock:
             self.answers += 1
-            state = self._devices[device]
+            state = self._devices.get(device)
+            if state is None:  # it left the cell
+                return
             if reading.clock is not None:
                 state.clock = clock_text(reading.clock)
             freshness = int((time.monotonic() - reading.answered_at) * 1000)
@@ -412,7 +446,9 @@ class EdgeNode:
 
     def silent(self, device: str, reason: str) -> None:
         with self._lock:
-            state = self._devices[device]
+            state = self._devices.get(device)
+            if state is None:
+                return
             if not state.alive:
                 if state.never_said and state.values is None:
                     _log.warning("%s does not answer (trying again): %s", device, reason)

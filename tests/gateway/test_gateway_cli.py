@@ -15,7 +15,7 @@ import pytest
 
 from app.gateway import payload as pb
 from app.gateway.cli import main
-from tests.waits import kill_child, wait_child
+from tests.waits import kill_child, read_line, wait_child
 
 from .conftest import Subscriber, write_cell
 
@@ -116,3 +116,26 @@ def test_bad_arguments_are_one_line_and_exit_2(
 def test_the_console_script_is_declared() -> None:
     text = (Path(__file__).parents[2] / "pyproject.toml").read_text()
     assert 'teachpad-gateway = "app.gateway.cli:main"' in text
+
+
+def test_sighup_reads_the_cell_file_again(
+    sim_factory: Any, broker: Any, subscriber: Subscriber, tmp_path: Path
+) -> None:
+    sims = {"R1": sim_factory(), "R2": sim_factory()}
+    cell = write_cell(tmp_path, sims)
+    proc = _start(cell, broker.port)
+    try:
+        subscriber.kind("DBIRTH", "R2", timeout=30.0)
+        start = subscriber.count()
+        write_cell(tmp_path, {"R1": sims["R1"]})
+        proc.send_signal(signal.SIGHUP)
+        subscriber.kind("DDEATH", "R2", start=start)
+        cell.write_text("{")  # a broken file: said, the running cell stays
+        proc.send_signal(signal.SIGHUP)
+        assert proc.stderr is not None
+        while b"cell file not reloaded" not in (line := read_line(proc.stderr, "the reload's refusal")):
+            assert line, "teachpad-gateway ended without saying the cell file was not reloaded"
+        proc.send_signal(signal.SIGTERM)
+        assert wait_child(proc, "teachpad-gateway after SIGTERM") == 0
+    finally:
+        kill_child(proc)

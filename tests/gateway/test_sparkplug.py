@@ -264,3 +264,25 @@ def _historical(watcher: Subscriber, alias: int) -> list[tuple[float, int]]:
         for m in message.payload.metrics
         if m.alias == alias and m.is_historical
     ]
+
+
+def test_a_controller_that_leaves_the_cell_gets_its_ddeath_one_that_joins_its_dbirth(
+    sim_factory: Any, subscriber: Subscriber, gateway_factory: Any
+) -> None:
+    from app.cell.cell_file import Cell, CellController
+
+    sims = {"R1": sim_factory(), "R2": sim_factory(), "R3": sim_factory()}
+    node = gateway_factory({"R1": sims["R1"], "R2": sims["R2"]})
+    subscriber.kind("DBIRTH", "R2")
+    start = subscriber.count()
+    r1 = CellController("R1", host="127.0.0.1", port=sims["R1"].port)
+    node.set_cell(Cell("smaller", (r1,)))
+    subscriber.kind("DDEATH", "R2", start=start)
+    start = subscriber.count()
+    node.set_cell(Cell("other", (r1, CellController("R3", host="127.0.0.1", port=sims["R3"].port))))
+    joined = subscriber.kind("DBIRTH", "R3", start=start)
+    # device index 2: R2's aliases (index 1) are never given to another controller
+    assert joined.payload.metrics[0].alias == device_alias(2, 0)
+    assert not [
+        m for m in subscriber.snapshot()[start:] if m.device == "R1" and m.kind in ("DDEATH", "DBIRTH")
+    ]
