@@ -105,3 +105,16 @@ SIM_COMMAND_LATENCY = 0.001  # s from a create/teach command to its final GV291
 # SIM_SLOW_ZERO, then the result (each uniform in the range, seeded).
 SIM_SLOW_PICKUP = (0.005, 0.025)
 SIM_SLOW_ZERO = (0.002, 0.015)
+
+# --- teachpad-gateway, the Sparkplug B edge node (app/gateway; issue 23) --------------------------
+GATEWAY_POLL_HZ = 20.0  # polls per controller per s (a silent one: DDEATH within 1 / this + poll timeout)
+GATEWAY_RECONNECT_BACKOFF = (0.2, 0.5, 1.0, 2.0)  # s between polls of a controller that does not answer
+GATEWAY_KEEPALIVE = 30  # s, the MQTT keepalive: the broker sends NDEATH at most 1.5 x this after a crash
+GATEWAY_BROKER_RETRY = (
+    1,
+    30,
+)  # whole s: paho's reconnect delay to the broker (first, doubling to the largest)
+GATEWAY_CLOCK_PERIOD = 1.0  # s between reads of the controller's clock (with the status block)
+GATEWAY_STOP_WAIT = 2.0  # s a stopping gateway waits for its NDEATH to be sent
+# DDATA kept while the broker is away (sent flagged is_historical when it is back); older ones are dropped
+GATEWAY_HISTORY_LIMIT = 10_000

@@ -1,0 +1,166 @@
+"""``teachpad-gateway CELL_FILE --broker mqtt://HOST:PORT [--group G] [--node N]``: headless, no widgets.
+
+Polls every controller of the cell (read-only) and publishes it as a Sparkplug B edge node
+(:mod:`app.gateway.edge_node`) until SIGINT or SIGTERM, then publishes NDEATH and exits 0. SIGHUP
+reads the cell file again (a controller that left gets its DDEATH, one that joined its DBIRTH). Exit 2
+(nothing started) for bad arguments or a cell file that cannot be used, with one line saying why.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import signal
+import socket
+import sys
+import threading
+from collections.abc import Sequence
+from pathlib import Path
+from urllib.parse import urlsplit
+
+from app import timing
+from app.cell.cell_file import CellFileError, load_cell
+from app.gateway.edge_node import BrokerSettings, EdgeNode
+from app.gateway.poller import GatewayTiming
+from app.version import VersionAction
+
+PROG = "teachpad-gateway"
+PASSWORD_ENV = "TEACHPAD_MQTT_PASSWORD"
+EXIT_USAGE = 2
+RELOAD_CHECK = 0.2  # s: how soon a SIGHUP (reload the cell file) is acted on
+_BAD_NAME_CHARS = set("/+#")
+
+
+class UsageError(Exception):
+    """A bad argument: one line, exit 2."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog=PROG,
+        description="Publish every controller of a TeachPad cell file to an MQTT broker as a Sparkplug B "
+        "edge node (read-only: nothing is written to a controller).",
+    )
+    parser.add_argument("--version", action=VersionAction)
+    parser.add_argument("cell", type=Path, metavar="CELL_FILE", help="the cell file (teachpad-cell JSON)")
+    parser.add_argument(
+        "--broker", required=True, help="mqtt://HOST[:PORT] (1883) or mqtts://HOST[:PORT] (8883)"
+    )
+    parser.add_argument("--group", default="teachpad", help="Sparkplug group id (default %(default)s)")
+    parser.add_argument("--node", default=None, help="Sparkplug edge node id (default: this host's name)")
+    parser.add_argument(
+        "--primary-host",
+        default=None,
+        metavar="HOST_ID",
+        help="publish only while this Sparkplug host application's STATE says online",
+    )
+    parser.add_argument("--username", default=None, help=f"broker user name (its password: ${PASSWORD_ENV})")
+    parser.add_argument(
+        "--password-file", type=Path, default=None, help="read the broker password from this file"
+    )
+    parser.add_argument("--tls", action="store_true", help="TLS to the broker (implied by mqtts://)")
+    parser.add_argument("--cafile", default=None, help="CA certificates for TLS (default: the system's)")
+    parser.add_argument("--certfile", default=None, help="client certificate for TLS")
+    parser.add_argument("--keyfile", default=None, help="client certificate's private key")
+    parser.add_argument(
+        "--keepalive",
+        type=int,
+        default=timing.GATEWAY_KEEPALIVE,
+        help="MQTT keepalive, s (default %(default)s): a crashed gateway's NDEATH comes within 1.5 x this",
+    )
+    parser.add_argument(
+        "--poll-hz", type=float, default=timing.GATEWAY_POLL_HZ, help="polls per controller per s"
+    )
+    parser.add_argument("-v", "--verbose", action="store_true", help="log every connection change")
+    return parser
+
+
+def broker_settings(args: argparse.Namespace) -> BrokerSettings:
+    url = urlsplit(args.broker if "://" in args.broker else f"mqtt://{args.broker}")
+    if url.scheme not in ("mqtt", "mqtts") or not url.hostname:
+        raise UsageError(f"--broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT], got {args.broker!r}")
+    tls = args.tls or url.scheme == "mqtts" or args.cafile is not None
+    try:
+        port = url.port or (8883 if tls else 1883)
+    except ValueError:
+        raise UsageError(f"--broker: the port of {args.broker!r} is not a number 1..65535") from None
+    password = os.environ.get(PASSWORD_ENV)
+    if args.password_file is not None:
+        try:
+            password = args.password_file.read_text(encoding="utf-8").strip()
+        except OSError as exc:
+            raise UsageError(f"--password-file {args.password_file}: {exc.strerror}") from None
+    return BrokerSettings(
+        host=url.hostname,
+        port=port,
+        tls=tls,
+        cafile=args.cafile,
+        certfile=args.certfile,
+        keyfile=args.keyfile,
+        username=args.username or url.username,
+        password=password if password is not None else url.password,
+    )
+
+
+def _name(value: str, what: str) -> str:
+    if not value or _BAD_NAME_CHARS & set(value):
+        raise UsageError(f"{what} must be non-empty and without '/', '+' or '#', got {value!r}")
+    return value
+
+
+def _check(args: argparse.Namespace) -> None:
+    if not 1 <= args.keepalive <= 65535:
+        raise UsageError(f"--keepalive must be 1..65535 s, got {args.keepalive}")
+    if not 0.1 <= args.poll_hz <= 200:
+        raise UsageError(f"--poll-hz must be 0.1..200, got {args.poll_hz:g}")
+
+
+def _reload(edge: EdgeNode, path: Path) -> None:
+    """SIGHUP: the cell file again; a file that cannot be used is said and the running cell kept."""
+    try:
+        cell = load_cell(path)
+    except CellFileError as exc:
+        print(f"{PROG}: cell file not reloaded, the running cell stays: {exc}", file=sys.stderr, flush=True)
+        return
+    edge.set_cell(cell)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    logging.basicConfig(
+        level=logging.INFO if args.verbose else logging.WARNING,
+        format=f"{PROG}: %(levelname)s %(message)s",
+    )
+    if not args.verbose:  # paho's own lines ("Client is not connected ...") only with -v
+        logging.getLogger("app.gateway.mqtt").setLevel(logging.CRITICAL)
+    try:
+        _check(args)
+        broker = broker_settings(args)
+        group = _name(args.group, "--group")
+        node = _name(args.node if args.node is not None else socket.gethostname(), "--node")
+        primary = None if args.primary_host is None else _name(args.primary_host, "--primary-host")
+        cell = load_cell(args.cell)
+    except (UsageError, CellFileError) as exc:
+        print(f"{PROG}: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    gateway = GatewayTiming(poll_hz=args.poll_hz, keepalive=args.keepalive)
+    edge = EdgeNode(cell, broker, group=group, node=node, gateway=gateway, primary_host=primary)
+    done = threading.Event()
+    reload = threading.Event()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        signal.signal(sig, lambda *_: done.set())
+    signal.signal(signal.SIGHUP, lambda *_: reload.set())
+    edge.start()
+    print(
+        f"{PROG}: {len(cell.controllers)} controller(s) of cell {cell.name!r} -> {broker.host}:{broker.port} "
+        f"as spBv1.0/{group}/.../{node}",
+        file=sys.stderr,
+        flush=True,
+    )
+    while not done.wait(RELOAD_CHECK):
+        if reload.is_set():
+            reload.clear()
+            _reload(edge, args.cell)
+    edge.stop()
+    return 0

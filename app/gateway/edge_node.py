@@ -1,0 +1,460 @@
+"""The Sparkplug B 3.0 edge node: the TeachPad host is the node, each controller of the cell a device.
+
+Topics: ``spBv1.0/GROUP/{NBIRTH,NDEATH,NCMD}/NODE`` and ``spBv1.0/GROUP/{DBIRTH,DDATA,DDEATH}/NODE/DEVICE``.
+What the specification asks of an edge node, and how it is met here:
+
+* **NDEATH is the MQTT will** (QoS 1, not retained) carrying ``bdSeq``; a new MQTT session (a
+  reconnect after the broker went away) sets the will again with ``bdSeq + 1`` (0..255) before it
+  connects. A graceful stop publishes NDEATH itself (a clean disconnect does not fire the will).
+* On every connect: subscribe to NCMD, then **NBIRTH** (``seq`` 0, the same ``bdSeq``, the
+  ``Node Control/Rebirth`` metric), then a **DBIRTH** per answering controller (every metric, name and
+  alias), then **DDATA** by exception: only the metrics that moved past their deadband, by alias only.
+* ``seq`` counts every message of the node but NDEATH, 0..255 and round again; NBIRTH resets it to 0.
+* A controller that stops answering gets a **DDEATH** at its first failed poll; a **DBIRTH** when it
+  answers again. **NCMD** ``Node Control/Rebirth`` = true: NBIRTH and every DBIRTH again (same bdSeq).
+* **While the broker is away** the DDATA the controllers' changes would have been are kept, at most
+  ``history_limit`` (the oldest dropped first), and published after the next session's births with
+  every metric ``is_historical``; how many were dropped is the NBIRTH's ``Node Info/History dropped``
+  (since the start) and a warning.
+* **A primary host application** (``primary_host``, optional): its retained ``spBv1.0/STATE/ID``
+  (JSON ``{"online": bool, "timestamp": ms}``, QoS 1) is subscribed to, and the node is born only
+  while it says online; an offline STATE (not older than the last one) ends the session: NDEATH,
+  disconnect, a new session (``bdSeq`` + 1) that waits for online again. Changes meanwhile are kept
+  as while the broker is away.
+* Nothing from the plant is written to a controller: DCMD is not subscribed to (writes are off).
+
+Threads: paho's network thread (connect, NCMD) and one poller thread per controller call in here;
+one lock orders everything the node publishes, so ``seq`` goes out in order.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import ssl
+import threading
+import time
+from collections import deque
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import paho.mqtt.client as mqtt
+from google.protobuf.message import DecodeError
+from paho.mqtt.enums import CallbackAPIVersion
+
+from app import timing
+from app.cell.cell_file import Cell
+from app.gateway import payload as pb
+from app.gateway.metrics import (
+    BDSEQ,
+    DEVICE_METRICS,
+    HISTORY_DROPPED,
+    REBIRTH,
+    REBIRTH_ALIAS,
+    Reading,
+    changed,
+    clock_text,
+    device_alias,
+    device_values,
+)
+from app.gateway.poller import ControllerPoller, GatewayTiming
+
+__all__ = ["NAMESPACE", "BrokerSettings", "EdgeNode"]
+
+NAMESPACE = "spBv1.0"
+_log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class BrokerSettings:
+    """Where the MQTT broker is and how to log in."""
+
+    host: str
+    port: int = 1883
+    tls: bool = False
+    cafile: str | None = None  # None with tls: the system's trusted CAs
+    certfile: str | None = None  # a client certificate (with keyfile)
+    keyfile: str | None = None
+    username: str | None = None
+    password: str | None = None
+
+
+@dataclass
+class _Device:
+    """What the node knows of one controller (guarded by the node's lock)."""
+
+    name: str
+    index: int
+    alive: bool = False  # answering (a DBIRTH went out, or will on the next session)
+    values: dict[str, pb.Value] | None = None  # the last reading's values
+    sent: dict[str, pb.Value] | None = None  # what the subscribers were last told
+    clock: str | None = None
+    never_said: bool = True  # a controller that never answered is said once (then each loss)
+
+
+def _now_ms() -> int:
+    return int(time.time() * 1000)
+
+
+class EdgeNode:
+    """Polls every controller of ``cell`` and publishes it as a Sparkplug B edge node."""
+
+    def __init__(
+        self,
+        cell: Cell,
+        broker: BrokerSettings,
+        *,
+        group: str,
+        node: str,
+        gateway: GatewayTiming | None = None,
+        deadbands: Mapping[str, float] | None = None,
+        history_limit: int | None = None,
+        primary_host: str | None = None,
+    ) -> None:
+        self.group = group
+        self.node = node
+        self.timing = gateway or GatewayTiming()
+        self._deadbands = dict(deadbands or {})
+        self._broker = broker
+        self._lock = threading.RLock()
+        self._devices = {c.name: _Device(c.name, i) for i, c in enumerate(cell.controllers)}
+        self._controllers = {c.name: c for c in cell.controllers}
+        self._pollers = {c.name: ControllerPoller(c, self, self.timing) for c in cell.controllers}
+        self._next_index = len(cell.controllers)  # a controller that joins later: aliases never reused
+        self.bdseq = 0
+        self._seq = 0
+        self._online = False  # an MQTT session is up and NBIRTH went out
+        self.sessions = 0  # MQTT sessions so far (NBIRTHs after a connect)
+        self._running = False
+        self.answers = 0  # answered polls of all controllers so far
+        self.primary_host = primary_host
+        self._primary_online = False
+        self._primary_stamp = -1  # the newest STATE's timestamp (older ones are stale)
+        self._connected = False  # an MQTT session is up (born or waiting for the primary host)
+        self._disconnected = threading.Event()  # set by every on_disconnect
+        self._unreachable_said = False  # "cannot reach the broker" said once per outage
+        limit = timing.GATEWAY_HISTORY_LIMIT if history_limit is None else history_limit
+        self._history: deque[tuple[str, Any]] = deque(maxlen=max(1, limit))
+        self.history_dropped = 0  # DDATA the bound dropped while the broker was away, since the start
+        self._client = self._make_client()
+
+    # -- topics ---------------------------------------------------------------------------
+    def topic(self, kind: str, device: str | None = None) -> str:
+        base = f"{NAMESPACE}/{self.group}/{kind}/{self.node}"
+        return base if device is None else f"{base}/{device}"
+
+    # -- lifecycle ------------------------------------------------------------------------
+    def _make_client(self) -> mqtt.Client:
+        client = mqtt.Client(
+            callback_api_version=CallbackAPIVersion.VERSION2,
+            client_id=f"teachpad-{self.group}-{self.node}",
+            clean_session=True,
+        )
+        b = self._broker
+        if b.username is not None:
+            client.username_pw_set(b.username, b.password)
+        if b.tls:
+            client.tls_set(
+                ca_certs=b.cafile, certfile=b.certfile, keyfile=b.keyfile, cert_reqs=ssl.CERT_REQUIRED
+            )
+        first, largest = self.timing.broker_retry
+        client.reconnect_delay_set(min_delay=max(1, first), max_delay=max(1, first, largest))
+        client.enable_logger(logging.getLogger("app.gateway.mqtt"))
+        client.on_connect = self._on_connect
+        client.on_connect_fail = self._on_connect_fail
+        client.on_disconnect = self._on_disconnect
+        client.on_message = self._on_message
+        self._set_will(client)
+        return client
+
+    def _set_will(self, client: mqtt.Client) -> None:
+        client.will_set(self.topic("NDEATH"), self._ndeath(), qos=1, retain=False)
+
+    def _ndeath(self) -> bytes:
+        death = pb.Payload(timestamp=_now_ms())
+        metric = death.metrics.add(name=BDSEQ, timestamp=death.timestamp, datatype=pb.DataType.INT64)
+        pb.set_value(metric, pb.DataType.INT64, self.bdseq)
+        return pb.encode(death)
+
+    def start(self) -> None:
+        """Connect (in the background: a broker that is not up yet is tried again) and poll."""
+        self._running = True
+        self._client.connect_async(self._broker.host, self._broker.port, keepalive=self.timing.keepalive)
+        self._client.loop_start()
+        for poller in self._pollers.values():
+            poller.start()
+
+    def stop(self) -> None:
+        """Stop polling, publish NDEATH (a clean disconnect does not fire the will), disconnect."""
+        if not self._running:
+            return
+        self._running = False
+        for poller in list(self._pollers.values()):
+            poller.stop()
+        with self._lock:
+            online, self._online = self._online, False
+            if online:
+                info = self._client.publish(self.topic("NDEATH"), self._ndeath(), qos=1)
+        if online:
+            try:
+                info.wait_for_publish(self.timing.stop_wait)
+            except (RuntimeError, ValueError) as exc:  # not sent: the broker fires the will anyway
+                _log.warning("NDEATH not sent on stop: %s", exc)
+        self._client.disconnect()
+        self._client.loop_stop()
+
+    def set_cell(self, cell: Cell) -> None:
+        """The cell file changed: a controller that left (or whose settings changed) gets its DDEATH
+        and its poller stops; one that joined gets a poller (and its DBIRTH at its first answer, with
+        aliases of its own: a device index is never used twice)."""
+        wanted = {c.name: c for c in cell.controllers}
+        with self._lock:
+            leaving = [n for n, c in self._controllers.items() if wanted.get(n) != c]
+            stopped = [self._pollers.pop(name) for name in leaving]
+            if leaving:  # their kept changes go with them (no DBIRTH will come before them)
+                topics = {self.topic("DDATA", name) for name in leaving}
+                kept = [(t, m) for t, m in self._history if t not in topics]
+                self._history = deque(kept, maxlen=self._history.maxlen)
+            for name in leaving:
+                state = self._devices.pop(name)
+                del self._controllers[name]
+                if state.alive and self._online:
+                    self._publish(self.topic("DDEATH", name), pb.Payload(timestamp=_now_ms()))
+            joining = [c for n, c in wanted.items() if n not in self._controllers]
+            for controller in joining:
+                self._devices[controller.name] = _Device(controller.name, self._next_index)
+                self._next_index += 1
+                self._controllers[controller.name] = controller
+                self._pollers[controller.name] = ControllerPoller(controller, self, self.timing)
+        for poller in stopped:  # outside the lock: its thread may be waiting for it
+            poller.stop()
+        if self._running:
+            for controller in joining:
+                self._pollers[controller.name].start()
+        _log.warning("cell changed: %d controller(s) left, %d joined", len(leaving), len(joining))
+
+    # -- MQTT callbacks (paho's network thread) -------------------------------------------
+    def _on_connect(self, client: mqtt.Client, _userdata: Any, _flags: Any, reason: Any, _props: Any) -> None:
+        if reason.is_failure:
+            _log.warning("broker refused the connection: %s", reason)
+            return
+        client.subscribe(self.topic("NCMD"), qos=1)
+        if self.primary_host is not None:
+            client.subscribe(self._state_topic(), qos=1)
+        if self._unreachable_said:
+            self._unreachable_said = False
+            _log.warning("connected to the MQTT broker at %s:%d", self._broker.host, self._broker.port)
+        with self._lock:
+            self.sessions += 1
+            self._connected = True
+            self._primary_online = False  # its retained STATE comes with the subscription
+            if self.primary_host is None:
+                self._birth()
+
+    def _on_connect_fail(self, _client: mqtt.Client, _userdata: Any) -> None:
+        if not self._unreachable_said:
+            self._unreachable_said = True
+            b = self._broker
+            first, largest = self.timing.broker_retry
+            _log.warning(
+                "cannot reach the MQTT broker at %s:%d; trying again (every %d to %d s)",
+                b.host,
+                b.port,
+                first,
+                largest,
+            )
+
+    def _on_disconnect(
+        self, client: mqtt.Client, _userdata: Any, _flags: Any, reason: Any, _props: Any
+    ) -> None:
+        self._disconnected.set()
+        with self._lock:
+            self._connected = False
+            if not self._online:
+                return
+            self._online = False
+            self.bdseq = (self.bdseq + 1) % 256  # the next session's will and NBIRTH
+            self._set_will(client)
+        _log.warning("broker connection lost (%s); a new session will have bdSeq %d", reason, self.bdseq)
+
+    def _state_topic(self) -> str:
+        return f"{NAMESPACE}/STATE/{self.primary_host}"
+
+    def _on_state(self, data: bytes) -> None:
+        """The primary host's STATE: born while it is online, the session ended when it goes offline."""
+        try:
+            state = json.loads(data.decode("utf-8"))
+            online, stamp = state["online"], state["timestamp"]
+            if not isinstance(online, bool) or not isinstance(stamp, int):
+                raise ValueError("online must be true or false, timestamp a whole number")
+        except (ValueError, KeyError, TypeError) as exc:
+            _log.warning("STATE of %s not understood: %s", self.primary_host, exc)
+            return
+        with self._lock:
+            if stamp < self._primary_stamp:
+                return  # stale
+            self._primary_stamp = stamp
+            self._primary_online = online
+            if online and self._connected and not self._online:
+                self._birth()
+            elif not online and self._online:
+                _log.warning(
+                    "primary host %s offline: session ended, a new one waits for it", self.primary_host
+                )
+                self._online = False
+                self._client.publish(self.topic("NDEATH"), self._ndeath(), qos=1)
+                threading.Thread(target=self._new_session, name="gateway-new-session", daemon=True).start()
+
+    def _new_session(self) -> None:
+        """Disconnect, then connect again with bdSeq + 1 (not from paho's own thread: it is stopped here)."""
+        self._disconnected.clear()
+        self._client.disconnect()
+        # paho closes the socket right after on_disconnect, in its thread: let it, then stop that thread
+        self._disconnected.wait(self.timing.stop_wait)
+        self._client.loop_stop()
+        # paho 2.2's loop_start makes a new wake-up socket pair without closing the last one's: close
+        # it here (its own method for that), or the next loop_start leaves two sockets to the GC
+        reset = getattr(self._client, "_reset_sockets", None)
+        if reset is not None:
+            reset(sockpair_only=True)
+        with self._lock:
+            if not self._running:
+                return
+            self.bdseq = (self.bdseq + 1) % 256
+            self._set_will(self._client)
+            self._client.connect_async(self._broker.host, self._broker.port, keepalive=self.timing.keepalive)
+            self._client.loop_start()
+
+    def _on_message(self, _client: mqtt.Client, _userdata: Any, message: mqtt.MQTTMessage) -> None:
+        if self.primary_host is not None and message.topic == self._state_topic():
+            self._on_state(bytes(message.payload))
+            return
+        if message.topic != self.topic("NCMD"):
+            return
+        try:
+            command = pb.decode(message.payload)
+        except DecodeError as exc:  # a malformed NCMD is the sender's problem: said, ignored
+            _log.warning("NCMD not understood: %s", exc)
+            return
+        for metric in command.metrics:
+            is_rebirth = metric.name == REBIRTH or (not metric.name and metric.alias == REBIRTH_ALIAS)
+            if is_rebirth and pb.metric_value(metric) is True:
+                _log.info("rebirth asked for by NCMD")
+                with self._lock:
+                    if self._online:
+                        self._birth()
+
+    # -- publishing (under the lock) ------------------------------------------------------
+    def _publish(self, topic: str, message: Any) -> None:
+        message.seq = self._seq
+        self._seq = (self._seq + 1) % 256
+        self._client.publish(topic, pb.encode(message), qos=0, retain=False)
+
+    @property
+    def online(self) -> bool:
+        """An MQTT session is up and its NBIRTH went out."""
+        return self._online
+
+    def _birth(self) -> None:
+        """NBIRTH (seq 0), then a DBIRTH for every answering controller, then the history."""
+        self._seq = 0
+        self._online = True
+        birth = pb.Payload(timestamp=_now_ms())
+        bdseq = birth.metrics.add(name=BDSEQ, timestamp=birth.timestamp, datatype=pb.DataType.INT64)
+        pb.set_value(bdseq, pb.DataType.INT64, self.bdseq)
+        rebirth = birth.metrics.add(
+            name=REBIRTH, alias=REBIRTH_ALIAS, timestamp=birth.timestamp, datatype=pb.DataType.BOOLEAN
+        )
+        pb.set_value(rebirth, pb.DataType.BOOLEAN, False)
+        dropped = birth.metrics.add(
+            name=HISTORY_DROPPED, timestamp=birth.timestamp, datatype=pb.DataType.UINT64
+        )
+        pb.set_value(dropped, pb.DataType.UINT64, self.history_dropped)
+        self._publish(self.topic("NBIRTH"), birth)
+        for device in self._devices.values():
+            if device.alive and device.values is not None:
+                self._dbirth(device, birth.timestamp)
+        self._send_history()
+
+    def _send_history(self) -> None:
+        if self._history:
+            _log.warning(
+                "broker back: %d change(s) kept while it was away sent as historical (%d dropped so far)",
+                len(self._history),
+                self.history_dropped,
+            )
+        while self._history:
+            topic, message = self._history.popleft()
+            for metric in message.metrics:
+                metric.is_historical = True
+            self._publish(topic, message)
+
+    def _dbirth(self, device: _Device, stamp: int) -> None:
+        assert device.values is not None
+        message = pb.Payload(timestamp=stamp)
+        for i, spec in enumerate(DEVICE_METRICS):
+            metric = message.metrics.add(
+                name=spec.name, alias=device_alias(device.index, i), timestamp=stamp, datatype=spec.datatype
+            )
+            pb.set_value(metric, spec.datatype, device.values[spec.name])
+        device.sent = dict(device.values)
+        self._publish(self.topic("DBIRTH", device.name), message)
+
+    def _ddata(self, device: _Device, stamp: int) -> None:
+        """The metrics past their deadband: published, or kept while the broker is away."""
+        message = self._changes(device, stamp)
+        if message is None:
+            return
+        topic = self.topic("DDATA", device.name)
+        if self._online:
+            self._publish(topic, message)
+            return
+        if len(self._history) == self._history.maxlen:
+            self.history_dropped += 1
+        self._history.append((topic, message))
+
+    def _changes(self, device: _Device, stamp: int) -> Any:
+        """A DDATA payload of what moved past its deadband since the last one (None: nothing)."""
+        assert device.values is not None and device.sent is not None
+        message = pb.Payload(timestamp=stamp)
+        for i, spec in enumerate(DEVICE_METRICS):
+            now = device.values[spec.name]
+            if changed(spec, device.sent[spec.name], now, self._deadbands):
+                metric = message.metrics.add(alias=device_alias(device.index, i), timestamp=stamp)
+                pb.set_value(metric, spec.datatype, now)
+                device.sent[spec.name] = now
+        return message if message.metrics else None
+
+    # -- the pollers (their threads) ------------------------------------------------------
+    def answered(self, device: str, reading: Reading) -> None:
+        with self._lock:
+            self.answers += 1
+            state = self._devices.get(device)
+            if state is None:  # it left the cell
+                return
+            if reading.clock is not None:
+                state.clock = clock_text(reading.clock)
+            freshness = int((time.monotonic() - reading.answered_at) * 1000)
+            state.values = device_values(reading, freshness, state.clock)
+            if not state.alive:
+                state.alive = True
+                if self._online:
+                    self._dbirth(state, reading.wall_ms)
+            elif state.sent is not None:  # births told the subscribers its values once
+                self._ddata(state, reading.wall_ms)
+
+    def silent(self, device: str, reason: str) -> None:
+        with self._lock:
+            state = self._devices.get(device)
+            if state is None:
+                return
+            if not state.alive:
+                if state.never_said and state.values is None:
+                    _log.warning("%s does not answer (trying again): %s", device, reason)
+                state.never_said = False
+                return
+            state.alive = False
+            _log.warning("%s stopped answering: %s", device, reason)
+            if self._online:
+                self._publish(self.topic("DDEATH", device), pb.Payload(timestamp=_now_ms()))

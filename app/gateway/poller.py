@@ -1,0 +1,134 @@
+"""One controller's poller for the gateway: its own thread, client, timeouts and backoff.
+
+Monitor-only: the :class:`~app.link.client.RobotClient` is made with ``monitor_only=True`` (the one
+write guard refuses every write) and the poller only reads -- the status block (with the clock every
+:attr:`GatewayTiming.clock_period`), then the pose block, each with the poll timeout
+(``settings.effective_poll_timeout``: 0.15 s over TCP). A poll that fails (no answer in time, a
+refused or lost connection, a malformed answer) is reported at once (:meth:`DeviceListener.silent`),
+and the next tries come after :attr:`GatewayTiming.backoff`; a dead controller costs the others
+nothing (each has its own thread and link).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import threading
+import time
+from dataclasses import dataclass, field
+from typing import Protocol
+
+from app import timing
+from app.cell.cell_file import CellController
+from app.errors import TeachPadError
+from app.gateway.metrics import Reading
+from app.link.client import RobotClient
+from app.protocol.datetime_regs import ControllerClock
+
+__all__ = ["ControllerPoller", "DeviceListener", "GatewayTiming"]
+
+_log = logging.getLogger(__name__)
+
+
+def _backoff() -> tuple[float, ...]:
+    return timing.GATEWAY_RECONNECT_BACKOFF
+
+
+@dataclass(frozen=True)
+class GatewayTiming:
+    """The gateway's clocks (defaults: :mod:`app.timing`, read when made; tests pass shorter ones)."""
+
+    poll_hz: float = field(default_factory=lambda: timing.GATEWAY_POLL_HZ)
+    poll_timeout: float | None = None  # s; None: the connection's (0.15 s over TCP, by baud over RTU)
+    backoff: tuple[float, ...] = field(default_factory=_backoff)
+    keepalive: int = field(default_factory=lambda: timing.GATEWAY_KEEPALIVE)
+    broker_retry: tuple[int, int] = field(default_factory=lambda: timing.GATEWAY_BROKER_RETRY)
+    clock_period: float = field(default_factory=lambda: timing.GATEWAY_CLOCK_PERIOD)
+    stop_wait: float = field(default_factory=lambda: timing.GATEWAY_STOP_WAIT)
+
+
+class DeviceListener(Protocol):
+    """What the poller tells (from its own thread)."""
+
+    def answered(self, device: str, reading: Reading) -> None: ...
+
+    def silent(self, device: str, reason: str) -> None: ...
+
+
+class ControllerPoller:
+    """Polls one controller until :meth:`stop`; tells ``listener`` every answer and every failure."""
+
+    def __init__(self, controller: CellController, listener: DeviceListener, gateway: GatewayTiming) -> None:
+        self.name = controller.name
+        settings = controller.settings(monitor_only=True)
+        if gateway.poll_timeout is not None:
+            settings = dataclasses.replace(settings, poll_timeout=gateway.poll_timeout)
+        self._client = RobotClient(settings)
+        self._listener = listener
+        self._timing = gateway
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._run, name=f"gateway-poll-{self.name}", daemon=True)
+        self.errors = 0  # failed polls since the start
+        self._failures = 0  # failed polls in a row
+        self._next_clock = 0.0
+
+    def start(self) -> None:
+        self._thread.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread.is_alive():
+            self._thread.join()
+
+    def _run(self) -> None:
+        period = 1.0 / self._timing.poll_hz
+        next_poll = time.monotonic()
+        try:
+            while not self._stop.is_set():
+                if self.poll_once():
+                    next_poll += period
+                    now = time.monotonic()
+                    if next_poll < now - period:  # late by more than a period: no burst to catch up
+                        next_poll = now
+                else:
+                    steps = self._timing.backoff
+                    next_poll = time.monotonic() + steps[min(self._failures, len(steps)) - 1]
+                self._stop.wait(max(0.0, next_poll - time.monotonic()))
+        finally:
+            self._client.close()
+
+    def poll_once(self) -> bool:
+        """One poll; False when it failed (told to the listener as silence)."""
+        client = self._client
+        try:
+            if not client.connected:
+                client.connect()
+            clock = self._read(client)
+        except TeachPadError as exc:
+            self.errors += 1
+            self._failures += 1
+            _log.info("%s: poll failed: %s", self.name, exc)
+            self._listener.silent(self.name, str(exc))
+            return False
+        self._failures = 0
+        if clock is not None:
+            self._next_clock = time.monotonic() + self._timing.clock_period
+        return True
+
+    def _read(self, client: RobotClient) -> ControllerClock | None:
+        with_clock = time.monotonic() >= self._next_clock
+        t0 = time.perf_counter()
+        status = client.read_status(with_clock=with_clock, timeout=client.settings.effective_poll_timeout)
+        rtt_ms = (time.perf_counter() - t0) * 1000.0
+        pose = client.read_pose(timeout=client.settings.effective_poll_timeout)
+        reading = Reading(
+            pose=pose,
+            status=status,
+            clock=status.clock,
+            rtt_ms=rtt_ms,
+            errors=self.errors,
+            answered_at=time.monotonic(),
+            wall_ms=int(time.time() * 1000),
+        )
+        self._listener.answered(self.name, reading)
+        return status.clock

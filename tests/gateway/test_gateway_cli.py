@@ -1,0 +1,141 @@
+"""``teachpad-gateway`` as a process: the broker's NDEATH after ``kill -9``, a graceful stop, usage errors."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from app.gateway import payload as pb
+from app.gateway.cli import main
+from tests.waits import kill_child, read_line, wait_child
+
+from .conftest import Subscriber, write_cell
+
+KEEPALIVE = 2  # s: the broker's NDEATH must come within 1.5 x this after the gateway dies
+
+
+def _start(cell: Path, port: int, *extra: str) -> subprocess.Popen[bytes]:
+    return subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "app.gateway",
+            str(cell),
+            "--broker",
+            f"mqtt://127.0.0.1:{port}",
+            "--group",
+            "plant",
+            "--node",
+            "pad9",
+            "--keepalive",
+            str(KEEPALIVE),
+            *extra,
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+
+
+def test_broker_delivers_ndeath_after_kill_9_within_1_5_keepalive(
+    sim_factory: Any, broker: Any, subscriber: Subscriber, tmp_path: Path
+) -> None:
+    cell = write_cell(tmp_path, {"R1": sim_factory()})
+    proc = _start(cell, broker.port)
+    try:
+        birth = subscriber.kind("NBIRTH", timeout=30.0)  # a loaded machine starts Python slowly
+        subscriber.kind("DBIRTH", "R1", start=subscriber.messages.index(birth))
+        killed_at = time.monotonic()
+        os.kill(proc.pid, signal.SIGKILL)
+        death = subscriber.kind("NDEATH", timeout=1.5 * KEEPALIVE + 5.0)
+    finally:
+        kill_child(proc)
+    took = death.at - killed_at
+    assert took <= 1.5 * KEEPALIVE, f"NDEATH {took:.2f} s after kill -9 (keepalive {KEEPALIVE} s)"
+    assert death.topic == "spBv1.0/plant/NDEATH/pad9"
+    assert (death.qos, death.retain) == (1, False)  # the will: QoS 1, not retained
+    assert pb.metric_value(death.metric("bdSeq")) == pb.metric_value(birth.metric("bdSeq"))
+
+
+def test_sigterm_stops_with_ndeath_and_exit_0(
+    sim_factory: Any, broker: Any, subscriber: Subscriber, tmp_path: Path
+) -> None:
+    proc = _start(write_cell(tmp_path, {"R1": sim_factory()}), broker.port)
+    try:
+        subscriber.kind("NBIRTH", timeout=30.0)
+        proc.send_signal(signal.SIGTERM)
+        assert wait_child(proc, "teachpad-gateway after SIGTERM") == 0
+    finally:
+        kill_child(proc)
+    death = subscriber.kind("NDEATH")
+    assert death.qos == 1
+
+
+def _usage(capsys: pytest.CaptureFixture[str], *argv: str) -> str:
+    assert main(list(argv)) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Traceback" not in err
+    return err
+
+
+def test_a_bad_cell_file_is_one_line_and_exit_2(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    cell = tmp_path / "cell.json"
+    doc = {
+        "format": "teachpad-cell",
+        "version": 1,
+        "name": "c",
+        "controllers": [{"name": "R7", "host": "h", "port": 0}],
+    }
+    cell.write_text(json.dumps(doc))
+    err = _usage(capsys, str(cell), "--broker", "mqtt://127.0.0.1:1883")
+    assert "controller 'R7'" in err and "port" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["--broker", "http://x"], "--broker"),
+        (["--broker", "mqtt://h:99999"], "port"),
+        (["--broker", "mqtt://h", "--group", "a/b"], "--group"),
+        (["--broker", "mqtt://h", "--keepalive", "0"], "--keepalive"),
+    ],
+)
+def test_bad_arguments_are_one_line_and_exit_2(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], said: str
+) -> None:
+    assert said in _usage(capsys, str(tmp_path / "none.json"), *argv)
+
+
+def test_the_console_script_is_declared() -> None:
+    text = (Path(__file__).parents[2] / "pyproject.toml").read_text()
+    assert 'teachpad-gateway = "app.gateway.cli:main"' in text
+
+
+def test_sighup_reads_the_cell_file_again(
+    sim_factory: Any, broker: Any, subscriber: Subscriber, tmp_path: Path
+) -> None:
+    sims = {"R1": sim_factory(), "R2": sim_factory()}
+    cell = write_cell(tmp_path, sims)
+    proc = _start(cell, broker.port)
+    try:
+        subscriber.kind("DBIRTH", "R2", timeout=30.0)
+        start = subscriber.count()
+        write_cell(tmp_path, {"R1": sims["R1"]})
+        proc.send_signal(signal.SIGHUP)
+        subscriber.kind("DDEATH", "R2", start=start)
+        cell.write_text("{")  # a broken file: said, the running cell stays
+        proc.send_signal(signal.SIGHUP)
+        assert proc.stderr is not None
+        while b"cell file not reloaded" not in (line := read_line(proc.stderr, "the reload's refusal")):
+            assert line, "teachpad-gateway ended without saying the cell file was not reloaded"
+        proc.send_signal(signal.SIGTERM)
+        assert wait_child(proc, "teachpad-gateway after SIGTERM") == 0
+    finally:
+        kill_child(proc)
