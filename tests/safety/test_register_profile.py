@@ -36,7 +36,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     translator_fixture,
     window_fixture,
 )
-from ui.controllers.safety_menu import SafetyMenu, install_safety
+from ui.controllers.safety_menu import SafetyMenu
 from ui.dialogs.connection_dialog import ConnectionDialog
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
@@ -133,8 +133,7 @@ def test_only_the_administrator_changes_it_and_it_is_audited(tmp_path: Path) -> 
 
 @pytest.fixture(name="menu")
 def menu_fixture(window: Any) -> SafetyMenu:
-    existing = getattr(window, "safety_menu", None)
-    menu = existing if existing is not None else install_safety(window, scrypt_n=CHEAP_SCRYPT)
+    menu: SafetyMenu = window.safety_menu
     store = menu.safety.session.store
     store.scrypt_n = CHEAP_SCRYPT
     store.set_password(Role.ADMINISTRATOR, PASSWORD, by=Role.ADMINISTRATOR)
