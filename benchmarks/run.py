@@ -65,12 +65,12 @@ def main(argv: list[str] | None = None) -> int:
         out["core"] = guarded("core", lambda: core.run(args.quick))
     if "gui" in suites:
         try:
-            from benchmarks import gui
+            from benchmarks import gui, gui_memory
         except ImportError as exc:  # suite not written yet
             out["gui"] = {"skipped": str(exc)}
         else:
             out["gui"] = guarded("gui", lambda: gui.run(args.quick))
-            out["gui"]["memory"] = guarded("gui.memory", lambda: gui.run_memory(args.quick, args.long))
+            out["gui"]["memory"] = guarded("gui.memory", lambda: gui_memory.run_memory(args.quick, args.long))
     if "points" in suites:
         try:
             from benchmarks import points

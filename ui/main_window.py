@@ -46,8 +46,8 @@ from PySide6.QtWidgets import (
 )
 
 from app import __version__
+from app.connection import ConnectionSettings
 from app.link.robot_link import RobotLink
-from app.link.transport import ConnectionSettings
 from app.link.types import WorkerError
 from app.models import LINK_FAILURE_CODES
 from app.safety.location import Scope
@@ -57,7 +57,8 @@ from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.plan_run_reasons import foreign_pause_text
 from ui.controllers.point_sync import PointSyncController
-from ui.controllers.project_controller import ProjectController, ProjectDialogs
+from ui.controllers.project_controller import ProjectController
+from ui.controllers.project_dialogs import ProjectDialogs
 from ui.controllers.safety_menu import SafetyParts, install_safety
 from ui.dialogs.confirm import ConfirmFn
 from ui.i18n import Translator
@@ -70,7 +71,6 @@ from ui.touch import apply_touch_mode, mark_motion
 from ui.window_actions import WindowActions
 from ui.window_column import ControlColumn
 from ui.window_docks import WindowDocks
-from ui.window_geometry import DEFAULT_SIZE as DEFAULT_SIZE  # where the benchmarks import it from
 from ui.window_geometry import MIN_SIZE, default_size, restore_window
 from ui.window_rows import add_window_rows
 from ui.window_status import WindowStatusBar

@@ -20,10 +20,10 @@ from typing import Protocol
 
 from app import timing
 from app.errors import InvalidInput, MalformedResponse, ModbusExceptionError, Reason, ResponseTimeout
-from app.link.client import RobotClient, StepFrame
+from app.link.client import RobotClient
 from app.link.host import WorkerHost
 from app.link.tracker import CommandTracker
-from app.link.types import Operation
+from app.link.types import Operation, StepFrame
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import ProgramMotionMode
 

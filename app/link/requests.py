@@ -10,9 +10,8 @@ import threading
 from collections.abc import Callable, Iterable, Sequence
 from typing import TYPE_CHECKING, Protocol
 
-from app.link.client import StepFrame
 from app.link.jobs import JOG_PRESS, JOG_RATIO, Job, JobKind, JobQueue
-from app.link.types import JogRequest, Operation
+from app.link.types import JogRequest, Operation, StepFrame
 from app.link.upload import RawItem
 from app.protocol.enums import ProgramMotionMode, WorkMode
 

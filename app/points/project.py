@@ -60,50 +60,25 @@ from app.plan.segments import (
     validate_loops,
     validate_plan_name,
 )
-from app.points.atomic import MAX_FILE_BYTES, atomic_write_bytes, read_limited
+from app.points.atomic import atomic_write_bytes, read_limited
 from app.points.csv_io import decode_text, parse_points_csv, points_to_csv
+from app.points.fields import DEFAULT_LIMITS, FieldError, OversizedNumber, PointLimits, has_surrogates, shown
 from app.points.ledger import PointLedger
-from app.points.point import (
-    DEFAULT_LIMITS,
-    FieldError,
-    FileFormatError,
-    OversizedNumber,
-    PointLimits,
-    SyncState,
-    TempPoint,
-    fast_point_from_fields,
-    has_surrogates,
-    point_from_fields,
-    shown,
-)
+from app.points.point import FileFormatError, SyncState, TempPoint, fast_point_from_fields, point_from_fields
 from app.points.project_model import HISTORY_TEXT_MAX, Project, UploadRecord, now_iso
 from app.points.project_write import (
     FORMAT_NAME,
     FORMAT_VERSION,
-    ProjectTooLarge,
     project_bytes,
-    project_to_dict,
-    project_to_json,
 )
 
 PROJECT_SUFFIX = ".teachpad.json"
 
 __all__ = [
-    "FORMAT_NAME",
-    "FORMAT_VERSION",
-    "MAX_FILE_BYTES",
     "PROJECT_SUFFIX",
-    "FileFormatError",
-    "Project",
-    "ProjectTooLarge",
-    "UploadRecord",
-    "atomic_write_bytes",
     "load_project",
     "parse_project",
-    "project_bytes",
     "project_from_dict",
-    "project_to_dict",
-    "project_to_json",
     "read_points_csv",
     "save_project",
     "write_points_csv",

@@ -1,7 +1,7 @@
 """Writing the project file: the project as a JSON document and as the file's text.
 
-The format is described in :mod:`app.points.project` (which reads it and re-exports these
-names); whatever loading accepts, this writes back.
+The format is described in :mod:`app.points.project` (which reads it); whatever loading
+accepts, this writes back.
 
 Every writer works from a :class:`ProjectSnapshot`: an immutable copy taken in the thread that
 owns the project (the points, segments and upload records are frozen already, so the copy is a

@@ -22,7 +22,8 @@ from collections import Counter
 from typing import Any
 
 from app import timing
-from app.sim import SimConfig, SimController
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 from tests.hostile.commands import COMMANDS, MISBEHAVIOURS, SLOW, judge, run_case
 from tests.hostile.relay import HostileRelay
 from tests.hostile.server import Framing

@@ -9,8 +9,8 @@ from typing import Any
 
 import pytest
 
+from app.connection import ConnectionSettings
 from app.link import stop_line as stop_line_module
-from app.link.client import ConnectionSettings
 from app.link.jobs import JobKind
 from app.link.robot_link import RobotLink
 from app.link.stop_line import StopLine

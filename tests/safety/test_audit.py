@@ -17,17 +17,8 @@ import pytest
 
 from app.errors import LinkError, WriteBlocked
 from app.safety import audit, audit_read
-from app.safety.audit import (
-    AuditFilter,
-    AuditLog,
-    FsyncPolicy,
-    ReadStats,
-    Result,
-    audit_files,
-    export_csv,
-    query,
-    read_records,
-)
+from app.safety.audit import AuditLog, FsyncPolicy
+from app.safety.audit_read import AuditFilter, ReadStats, Result, audit_files, export_csv, query, read_records
 from tests.waits import wait_child
 
 ROOT = Path(__file__).resolve().parents[2]

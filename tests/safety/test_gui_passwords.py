@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 
 from app.errors import InvalidInput
-from app.safety.audit import Result, query
+from app.safety.audit_read import Result, query
 from app.safety.location import safety_location
 from app.safety.roles import Role
 from app.safety.session import PermissionRefused

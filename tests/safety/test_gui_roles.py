@@ -11,8 +11,9 @@ from typing import Any
 
 import pytest
 
-from app.safety.audit import query
-from app.safety.envelope import Box, Envelope
+from app.safety.audit_read import query
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 from app.safety.profile import load_profile
 from app.safety.roles import Action, Role, WrongPassword
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures

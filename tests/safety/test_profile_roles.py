@@ -7,9 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from app.errors import InvalidInput
-from app.safety.envelope import Box, Envelope
-from app.safety.profile import ProfileError, SafetyProfile, load_profile, save_profile
+from app.errors import InvalidInput, ProfileError
+from app.safety.box import Box
+from app.safety.envelope import Envelope
+from app.safety.profile import SafetyProfile, load_profile, save_profile
 from app.safety.roles import (
     Action,
     IdleLock,

@@ -11,10 +11,11 @@ from typing import Any
 
 import pytest
 
-from app.link.client import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
-from app.safety.audit import AuditLog, Result, query
+from app.safety.audit import AuditLog
+from app.safety.audit_read import Result, query
 from app.safety.register_profile import (
     RegisterProfile,
     RegisterProfileError,

@@ -14,10 +14,9 @@ from typing import Any
 
 from PySide6.QtCore import QObject, Signal
 
-from app.link.client import StepFrame
-from app.link.robot_link import LinkPort, Pending, RequestRouter
+from app.link.link_port import LinkPort, Pending, RequestRouter
 from app.link.state import RobotState
-from app.link.types import ConnectionState, ControllerIdentity, LinkState
+from app.link.types import ConnectionState, ControllerIdentity, LinkState, StepFrame
 from app.models import CommandResult
 from app.protocol.enums import CommandKind, CommandStatus, ProgramMotionMode, RunCommand, TeachFrame, WorkMode
 

@@ -13,6 +13,7 @@ from PySide6.QtCore import QCoreApplication, Qt, QTranslator
 from app.link.types import ConnectionState, LinkState
 from app.models import CommandResult
 from app.protocol.enums import Alarm, CommandKind, CommandStatus, RunCommand
+from ui.palette import COLOR_ERROR_BG, COLOR_WARN_BG
 from ui.panels.event_log import (
     COL_LEVEL,
     COL_MESSAGE,
@@ -22,7 +23,6 @@ from ui.panels.event_log import (
     EventLogPanel,
     LogEvent,
 )
-from ui.widgets_common import COLOR_ERROR_BG, COLOR_WARN_BG
 
 WHEN = dt.datetime(2025, 6, 1, 8, 30, 15, 250_000)
 

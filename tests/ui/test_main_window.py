@@ -8,7 +8,7 @@ import pytest
 from PySide6.QtCore import QSettings
 from PySide6.QtGui import QImage
 
-from app.link.client import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.link.types import LinkState
 from app.protocol.codec import WordOrder
 from app.protocol.enums import Alarm, TeachFrame, WorkMode

@@ -11,7 +11,7 @@ from PySide6.QtGui import QUndoStack
 from PySide6.QtWidgets import QWidget
 
 from app.link.types import ConnectionState, LinkState
-from app.points.project import Project
+from app.points.project_model import Project
 from app.protocol.enums import TeachFrame, WorkMode
 from tests.ui.fake_link import FakeLink
 from ui.controllers.motion import MotionController

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QObject, Signal, Slot
 
 from app.alarm_history import blocks_motion
-from app.link.robot_link import LinkPort
+from app.link.link_port import LinkPort
 from app.link.types import ConnectionState, JogRequest, StepFrame
 from app.models import ControllerStatus
 from app.protocol.enums import ProgramMotionMode, WorkMode

@@ -38,8 +38,6 @@ from app.points.ledger import PointLedger
 from app.safety.envelope import Envelope
 from ui.joins import join_names
 from ui.palette import COLOR_INK_SOFT
-from ui.panels.plan_projection import MAX_LABELS as MAX_LABELS
-from ui.panels.plan_projection import PLOT_MIN_HEIGHT as PLOT_MIN_HEIGHT
 from ui.panels.plan_projection import FloatArray, Projection, style_plot
 from ui.widgets.lines_label import LinesLabel
 
