@@ -212,3 +212,74 @@ def test_the_alone_check_sees_a_module_that_needs_another_first(tmp_path: Path) 
     (pkg / "second.py").write_text("from pkg.first import ONE\nTWO = ONE + 1\n", encoding="utf-8")
     failed = modules_that_fail_alone(tmp_path, ("pkg",), tmp_path / "cache")
     assert [line.split(":")[0] for line in failed] == ["pkg.first", "pkg.second"]
+
+
+# --- One of each (issue 22) -------------------------------------------------------------------------
+
+
+def _top_level(path: Path) -> list[ast.stmt]:
+    return ast.parse(path.read_text(encoding="utf-8"), filename=str(path)).body
+
+
+def test_no_two_classes_share_a_name() -> None:
+    """Two classes of one name (two ``UploadRun``, two ``ProfileError``) are two ideas under one
+    word: a reader, an import and an ``except`` can take the wrong one."""
+    homes: dict[str, list[str]] = {}
+    for name, path in _module_names(ROOT, PACKAGES).items():
+        for node in _top_level(path):
+            if isinstance(node, ast.ClassDef) and not node.name.startswith("_"):
+                homes.setdefault(node.name, []).append(name)
+    assert {name: where for name, where in homes.items() if len(where) > 1} == {}
+
+
+def test_the_gvs_teachpad_reserves_are_named_only_in_registers() -> None:
+    """A GV number given a name anywhere but app/protocol/registers.py (the simulator, the
+    controller's model, excepted) is a reserved register defined twice, or one to move there."""
+    named: list[str] = []
+    for name, path in _module_names(ROOT, PACKAGES).items():
+        if name == "app.protocol.registers" or name.startswith("app.sim"):
+            continue
+        for node in _top_level(path):
+            target: ast.expr | None = node.target if isinstance(node, ast.AnnAssign) else None
+            if isinstance(node, ast.Assign) and len(node.targets) == 1:
+                target = node.targets[0]
+            value = getattr(node, "value", None)
+            literal = isinstance(value, ast.Constant) and isinstance(value.value, int)
+            if isinstance(target, ast.Name) and "GV" in target.id.upper().split("_") and literal:
+                named.append(f"{name}.{target.id}")
+    assert named == []
+
+
+def test_no_module_re_exports_what_it_imports() -> None:
+    """A name is imported from the module that defines it: no ``__all__`` entry and no
+    ``import x as x`` hands on an imported name (strict mypy refuses every other way), so no
+    module stays an import's home "so older imports keep working" (that made circles)."""
+    assert re_exports(ROOT) == []
+
+
+def re_exports(root: Path) -> list[str]:
+    """``module.name`` for each imported name a module of app/ or ui/ hands on."""
+    handed_on: list[str] = []
+    for name, path in _module_names(root, PACKAGES).items():
+        body = _top_level(path)
+        imported: set[str] = set()
+        exported: set[str] = set()
+        for node in ast.walk(ast.Module(body=body, type_ignores=[])):
+            if isinstance(node, ast.Import | ast.ImportFrom):
+                for alias in node.names:
+                    local = alias.asname or alias.name.split(".")[0]
+                    imported.add(local)
+                    if alias.asname is not None and alias.asname == alias.name.rpartition(".")[2]:
+                        exported.add(local)
+            elif isinstance(node, ast.Assign) and any(
+                isinstance(target, ast.Name) and target.id == "__all__" for target in node.targets
+            ):
+                exported |= set(ast.literal_eval(node.value))
+        defined = {
+            target.id
+            for node in body
+            for target in ast.walk(node)
+            if isinstance(target, ast.Name) and isinstance(target.ctx, ast.Store)
+        } | {node.name for node in body if isinstance(node, ast.ClassDef | ast.FunctionDef)}
+        handed_on += [f"{name}.{n}" for n in sorted(exported & imported - defined)]
+    return handed_on

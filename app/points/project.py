@@ -65,7 +65,7 @@ from app.points.csv_io import decode_text, parse_points_csv, points_to_csv
 from app.points.fields import DEFAULT_LIMITS, FieldError, OversizedNumber, PointLimits, has_surrogates, shown
 from app.points.ledger import PointLedger
 from app.points.point import FileFormatError, SyncState, TempPoint, fast_point_from_fields, point_from_fields
-from app.points.project_model import HISTORY_TEXT_MAX, Project, UploadRecord, now_iso
+from app.points.project_model import HISTORY_TEXT_MAX, LastUpload, Project, now_iso
 from app.points.project_write import (
     FORMAT_NAME,
     FORMAT_VERSION,
@@ -212,7 +212,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
 
     raw_points = _expect(doc.get("points", []), list, top, "points", "points")
     points: list[TempPoint] = []
-    history: dict[int, UploadRecord] = {}
+    history: dict[int, LastUpload] = {}
     seen: dict[int, int] = {}
     unknown = SyncState.UNKNOWN
     for i, raw in enumerate(raw_points):
@@ -294,7 +294,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
     )
 
 
-def _history_from(raw: object, index: int, point_id: int) -> UploadRecord | None:
+def _history_from(raw: object, index: int, point_id: int) -> LastUpload | None:
     if raw is None:
         return None
     where = _point_place(index, point_id)
@@ -302,7 +302,7 @@ def _history_from(raw: object, index: int, point_id: int) -> UploadRecord | None
     inner: Place = (f"{where[0]} uploaded", Reason("place_point_upload", {"index": index, "id": point_id}))
     when = _text_field(obj, "time", inner)
     endpoint = _text_field(obj, "endpoint", inner)
-    return UploadRecord(when[:HISTORY_TEXT_MAX], endpoint[:HISTORY_TEXT_MAX])
+    return LastUpload(when[:HISTORY_TEXT_MAX], endpoint[:HISTORY_TEXT_MAX])
 
 
 def _segment_from_dict(obj: Mapping[str, Any], where: Place) -> Segment:

@@ -21,13 +21,13 @@ from app.errors import InvalidInput
 from app.plan.segments import Segment
 from app.points import atomic
 from app.points.point import EXT_FIELDS, POSE_FIELDS, TempPoint
-from app.points.project_model import Project, UploadRecord
+from app.points.project_model import LastUpload, Project
 
 FORMAT_NAME = "teachpad-project"
 FORMAT_VERSION = 1
 
 
-def _point_to_dict(p: TempPoint, history: UploadRecord | None = None) -> dict[str, Any]:
+def _point_to_dict(p: TempPoint, history: LastUpload | None = None) -> dict[str, Any]:
     d: dict[str, Any] = {"id": p.id, "name": p.name}
     d.update(zip(POSE_FIELDS, p.xyzabc, strict=True))
     d.update(zip(EXT_FIELDS, p.ext, strict=True))
@@ -69,7 +69,7 @@ class ProjectSnapshot:
     created: str
     modified: str
     points: tuple[TempPoint, ...]
-    upload_history: Mapping[int, UploadRecord]  # a read-only copy
+    upload_history: Mapping[int, LastUpload]  # a read-only copy
     plans: tuple[PlanSnapshot, ...]
     revision: int
 

@@ -21,7 +21,7 @@ from app.points.ledger import PointLedger
 from app.points.ledger_import import ImportMode
 from app.points.point import FileFormatError, SyncState, make_point
 from app.points.project import load_project, parse_project, read_points_csv, save_project, write_points_csv
-from app.points.project_model import Project, UploadRecord
+from app.points.project_model import LastUpload, Project
 from app.points.project_write import project_to_json
 
 SAMPLES = Path(__file__).resolve().parents[2] / "resources" / "samples"
@@ -321,7 +321,7 @@ def test_loaded_points_are_unknown_and_upload_history_round_trips(tmp_path: Path
     save_project(project, path)
     back = load_project(path)
     assert back.upload_history == project.upload_history
-    assert back.upload_history[5] == UploadRecord("2025-02-01T10:00:00Z", "tcp 10.0.0.5:502")
+    assert back.upload_history[5] == LastUpload("2025-02-01T10:00:00Z", "tcp 10.0.0.5:502")
     assert all(p.sync is SyncState.UNKNOWN for p in back.ledger)
 
 
