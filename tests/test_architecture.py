@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import ast
+import functools
 import os
 import subprocess
 import sys
@@ -70,6 +71,11 @@ KNOWN_CIRCLES: list[frozenset[str]] = [
 ]
 
 
+@functools.cache
+def _parsed(path: Path) -> ast.Module:  # each file once for all the checks below (read-only)
+    return ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+
+
 def _module_names(root: Path, packages: tuple[str, ...]) -> dict[str, Path]:
     names: dict[str, Path] = {}
     for package in packages:
@@ -98,7 +104,7 @@ def _import_targets(module: str, path: Path, known: dict[str, Path]) -> set[str]
 
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
     targets = with_packages(package)
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), filename=str(path))):
+    for node in ast.walk(_parsed(path)):
         if isinstance(node, ast.Import):
             for alias in node.names:
                 targets |= with_packages(alias.name)
@@ -218,7 +224,7 @@ def test_the_alone_check_sees_a_module_that_needs_another_first(tmp_path: Path) 
 
 
 def _top_level(path: Path) -> list[ast.stmt]:
-    return ast.parse(path.read_text(encoding="utf-8"), filename=str(path)).body
+    return _parsed(path).body
 
 
 def test_no_two_classes_share_a_name() -> None:
