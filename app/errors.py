@@ -206,6 +206,15 @@ class InvalidInput(TeachPadError, ValueError):
     code = "invalid_input"
 
 
+class ProfileError(InvalidInput):
+    """A profile file that cannot be used: a robot model (:mod:`app.view3d.profile`) or a safety
+    envelope (:mod:`app.safety.profile`); the message says which file, where and why. A robot
+    profile's code (``profile_*``) and params say the same for the GUI's words
+    (ui/messages_profile.py): ``where`` the field (``joint``, 1-based, and ``key``), ``file`` the
+    file when it came from one. (A register profile has its own error, a usage error of the CLI:
+    :class:`app.safety.register_profile.RegisterProfileError`.)"""
+
+
 def _short(value: object, limit: int = 24) -> object:
     """A bad value quoted in a reason: numbers as they are, anything else cut to a short prefix."""
     if value is None or isinstance(value, int | float):

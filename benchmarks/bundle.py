@@ -100,8 +100,8 @@ def run(quick: bool, bundle: Path = BUNDLE) -> dict[str, Any]:
     }
     runs = 3 if quick else 7
     out["runs"] = runs
-    from app.sim import SimController
     from app.sim.config import SimConfig
+    from app.sim.server import SimController
 
     with tempfile.TemporaryDirectory(prefix="teachpad-bench-bundle-") as tmp_name:
         home = Path(tmp_name)

@@ -13,9 +13,10 @@ from __future__ import annotations
 import time
 from typing import Any
 
-from app.link.client import ConnectionSettings, RobotClient
-from app.sim import SimConfig, SimController
-from app.sim.config import GV291_MODES, TIMING_PROFILES
+from app.connection import ConnectionSettings
+from app.link.client import RobotClient
+from app.sim.config import GV291_MODES, TIMING_PROFILES, SimConfig
+from app.sim.server import SimController
 
 
 def _poses(n: int) -> list[tuple[int, list[float]]]:

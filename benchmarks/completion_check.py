@@ -20,9 +20,12 @@ import time
 from pathlib import Path
 
 from app.plan.segments import Plan, Segment
-from app.points.ledger import PointLedger, SyncState, make_point
-from app.points.project import Project, load_project, save_project
-from app.sim import SimConfig, SimController
+from app.points.ledger import PointLedger
+from app.points.point import SyncState, make_point
+from app.points.project import load_project, save_project
+from app.points.project_model import Project
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 
 PLAN_SEGMENTS = 40
 

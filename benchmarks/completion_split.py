@@ -26,9 +26,11 @@ from typing import Any
 
 from pymodbus.client import ModbusTcpClient
 
-from app.link.client import ConnectionSettings, RobotClient
+from app.connection import ConnectionSettings
+from app.link.client import RobotClient
 from app.protocol import registers as R  # noqa: N812
-from app.sim import SimConfig, SimController
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 
 
 def _poses(n: int) -> list[tuple[int, list[float]]]:

@@ -19,12 +19,14 @@ from typing import Any
 
 from pymodbus.client import ModbusTcpClient
 
+from app.connection import ConnectionSettings
 from app.link import frames
-from app.link.client import ConnectionSettings, RobotClient
+from app.link.client import RobotClient
 from app.protocol import registers as R  # noqa: N812
 from app.protocol.codec import encode_floats
 from app.protocol.enums import RunCommand, decode_status_registers
-from app.sim import SimConfig, SimController
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 
 
 def _rate(fn: Callable[[], object], seconds: float) -> dict[str, float]:

@@ -57,7 +57,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEvent
 from PySide6.QtWidgets import QApplication
 
-from app.link.client import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.link.ops import RunProgram, Stop
 from app.link.robot_link import RobotLink
 from app.link.types import LinkState
@@ -80,31 +80,16 @@ from benchmarks.gui_common import (
     _wait_until,
     ratio,
 )
-from benchmarks.gui_memory import run_memory
-from benchmarks.gui_stalls import BusyNeighbour, _measure_streaming_busy, add_no_probe, measure_stalls
+from benchmarks.gui_stalls import _measure_streaming_busy, add_no_probe, measure_stalls
 from benchmarks.gui_startup import bench_startup
 from benchmarks.gui_stop import bench_stop_bare, bench_stop_gui
-from ui.main_window import DEFAULT_SIZE, MainWindow
+from ui.main_window import MainWindow
 from ui.settings import AppSettings
+from ui.window_geometry import DEFAULT_SIZE
 
-# Re-exported: benchmarks.streaming and the tests import these from here.
 __all__ = [
-    "POLL_HZ",
-    "STREAM_PROGRAM",
-    "BusyNeighbour",
-    "RemoteSim",
-    "_Counters",
-    "_PaintCounter",
-    "_motion_started",
-    "_qapp",
-    "_run_for",
-    "_wait_until",
-    "bench_startup",
     "bench_window",
-    "guarded",
-    "measure_stalls",
     "run",
-    "run_memory",
     "show_streaming_layout",
 ]
 

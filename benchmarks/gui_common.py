@@ -24,7 +24,8 @@ from app.link.types import ConnectionState
 from app.models import CommandResult, Pose
 from app.protocol import registers as R  # noqa: N812
 from app.protocol.enums import RunCommand
-from app.sim import SimConfig, SimController, WriteRecord
+from app.sim.config import SimConfig, WriteRecord
+from app.sim.server import SimController
 
 POLL_HZ = 100.0
 STALL_TIMER_MS = 1  # period of the probe timer that measures the GUI event loop's stalls

@@ -20,7 +20,7 @@ from benchmarks.gui_common import (
     STARTUP_TIMEOUT_S,
     STREAM_PROGRAM,
 )
-from ui.main_window import DEFAULT_SIZE
+from ui.window_geometry import DEFAULT_SIZE
 
 MEMORY_SETTLE_S = 3.0  # after the first pose, before the idle RSS is read
 SOAK_LONG_S, SOAK_LONG_EVERY_S = 600.0, 30.0  # --long: a 10-minute soak, RSS every 30 s

@@ -22,7 +22,7 @@ from benchmarks.gui_common import (
     not_measured,
     ratio,
 )
-from ui.main_window import DEFAULT_SIZE
+from ui.window_geometry import DEFAULT_SIZE
 
 # --------------------------------------------------------------------------------------------
 # 3. Start-up (in a fresh interpreter)

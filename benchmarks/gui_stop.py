@@ -19,7 +19,7 @@ from PySide6.QtGui import QMouseEvent
 from app.link.ops import RunProgram
 from app.protocol import registers as R  # noqa: N812
 from app.protocol.enums import ProgramMotionMode
-from app.sim import WriteRecord
+from app.sim.config import WriteRecord
 from benchmarks.gui_common import (
     INPUT_PHASE_SPREAD_S,
     POLL_HZ,

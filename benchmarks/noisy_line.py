@@ -21,9 +21,11 @@ import time
 from typing import Any
 
 from app.cli.points_upload import staged_upload
-from app.link.client import ConnectionSettings, RobotClient
+from app.connection import ConnectionSettings
+from app.link.client import RobotClient
 from app.points.point import TempPoint
-from app.sim import SimConfig, SimController
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 from tests.link.serial.relay import PtyRelay
 
 BAUD = 115200

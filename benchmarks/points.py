@@ -47,8 +47,10 @@ from app.plan.checks import check_plan
 from app.plan.estimates import estimate_plan
 from app.plan.geometry import plan_geometry, plan_path, segment_path
 from app.plan.segments import Plan, Segment
-from app.points.ledger import PointLedger, SyncState, TempPoint, make_point
-from app.points.project import Project, load_project, save_project
+from app.points.ledger import PointLedger
+from app.points.point import SyncState, TempPoint, make_point
+from app.points.project import load_project, save_project
+from app.points.project_model import Project
 from benchmarks import completion, restore
 from benchmarks.restore import QUICK_SAMPLE_S, ROUNDS, SAMPLE_S
 

@@ -32,11 +32,13 @@ from typing import Any
 from pymodbus.client import ModbusTcpClient
 
 from app.cli.points_upload import staged_upload
-from app.link.client import ConnectionSettings, RobotClient
-from app.points.ledger import TempPoint
+from app.connection import ConnectionSettings
+from app.link.client import RobotClient
+from app.points.point import TempPoint
 from app.protocol import registers as R  # noqa: N812
 from app.protocol.codec import encode_floats
-from app.sim import SimConfig, SimController
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 
 __all__ = ["BareSample", "RestoreRound", "bare_sample", "bench_restore", "summarize"]
 

@@ -38,11 +38,11 @@ def _core(args: argparse.Namespace) -> dict[str, Any]:
 
 def _gui(args: argparse.Namespace) -> dict[str, Any]:
     try:
-        from benchmarks import gui
+        from benchmarks import gui, gui_memory
     except ImportError as exc:  # suite not written yet
         return {"skipped": str(exc)}
     out = guarded("gui", lambda: gui.run(args.quick))
-    out["memory"] = guarded("gui.memory", lambda: gui.run_memory(args.quick, args.long))
+    out["memory"] = guarded("gui.memory", lambda: gui_memory.run_memory(args.quick, args.long))
     return out
 
 

@@ -20,7 +20,8 @@ from app.points.ledger import PointLedger
 from app.points.point import make_point
 from app.protocol.enums import TeachFrame
 from app.safety.audit import AuditLog, FsyncPolicy
-from app.safety.envelope import Box, Envelope, plan_violations
+from app.safety.box import Box
+from app.safety.envelope import Envelope, plan_violations
 from app.safety.jog_guard import JogGuard, JogMotion
 
 # eight small zones among the plan's paths (z 350..450 around the plan's z = 400)

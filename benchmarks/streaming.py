@@ -53,26 +53,24 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEvent, QEventLoop, QObject, Qt, QTimer
 from PySide6.QtWidgets import QApplication
 
-from app.link.client import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.link.ops import RunProgram, Stop
 from app.link.robot_link import RobotLink
 from app.link.types import ConnectionState, LinkState
 from app.models import ControllerStatus, Pose
 from app.protocol.enums import Alarm, ProgramMotionMode
-from benchmarks.gui import (
+from benchmarks.gui import show_streaming_layout
+from benchmarks.gui_common import (
     POLL_HZ,
     STREAM_PROGRAM,
-    BusyNeighbour,
     RemoteSim,
     _Counters,
     _motion_started,
     _qapp,
     _run_for,
     _wait_until,
-    measure_stalls,
-    show_streaming_layout,
 )
-from benchmarks.gui_stalls import add_no_probe
+from benchmarks.gui_stalls import BusyNeighbour, add_no_probe, measure_stalls
 from benchmarks.traffic import Feed
 from ui.main_window import MainWindow
 from ui.settings import AppSettings

@@ -19,7 +19,7 @@ os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 from PySide6.QtCore import QEventLoop, Qt, QTimer
 from PySide6.QtWidgets import QApplication
 
-from app.link.client import TrafficRecord
+from app.link.transport import TrafficRecord
 from app.protocol.codec import encode_floats
 from app.protocol.framing import encode_request, encode_response
 from app.protocol.registers import POSE_BLOCK_COUNT, POSE_BLOCK_START, STATUS_BLOCK_COUNT, STATUS_BLOCK_START

@@ -17,11 +17,12 @@ import time
 from PySide6.QtCore import QCoreApplication, QTimer
 
 from app import timing
-from app.link.client import ConnectionSettings, RobotClient
+from app.connection import ConnectionSettings
+from app.link.client import RobotClient
 from app.link.robot_link import RobotLink
-from app.sim import SimConfig, SimController
-
-CANARY_GV = 99
+from app.protocol.registers import CANARY_GV
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 
 
 def main() -> None:

@@ -36,14 +36,15 @@ from PySide6.QtWidgets import QApplication
 
 from app.plan.geometry import plan_path
 from app.plan.segments import Plan, Segment
-from app.points.ledger import PointLedger, SyncState, make_point
+from app.points.ledger import PointLedger
+from app.points.point import SyncState, make_point
 from app.view3d.camera import Preset
 from app.view3d.kinematics import ArmModel
 from app.view3d.profile import default_profile
 from app.view3d.reach import ReachChecker
 from ui.panels import view3d_canvas
 from ui.panels.view3d_canvas import View3DCanvas
-from ui.panels.view3d_panel import SYNC_COLORS
+from ui.panels.view3d_scene import SYNC_COLORS
 
 N_POINTS = 10_000
 N_SEGMENTS = 1_000

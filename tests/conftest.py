@@ -104,7 +104,8 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> 
 @pytest.fixture
 def sim() -> Iterator[Any]:
     """A running simulated controller on 127.0.0.1:<free port>, stopped after the test."""
-    from app.sim import SimConfig, SimController
+    from app.sim.config import SimConfig
+    from app.sim.server import SimController
 
     controller = SimController(SimConfig(host="127.0.0.1", port=0))
     controller.start()
@@ -117,7 +118,8 @@ def sim() -> Iterator[Any]:
 @pytest.fixture
 def sim_factory() -> Iterator[Any]:
     """Build simulators with custom settings; all are stopped after the test."""
-    from app.sim import SimConfig, SimController
+    from app.sim.config import SimConfig
+    from app.sim.server import SimController
 
     made: list[Any] = []
 
@@ -140,7 +142,8 @@ def sim_factory() -> Iterator[Any]:
 def make_client() -> Iterator[Any]:
     """RobotClients for a simulator (its port, framer and word order) or any ``port=``;
     connected unless ``connect=False``; every one is closed after the test."""
-    from app.link.client import ConnectionSettings, RobotClient
+    from app.connection import ConnectionSettings
+    from app.link.client import RobotClient
 
     made: list[Any] = []
 

@@ -27,9 +27,9 @@ from ui.gui_gc import GuiThreadCollector
 from ui.startup_gc import StartupGcPause, gc_paused
 
 with gc_paused():  # the window's modules: many objects made, almost none freed (ui/startup_gc.py)
+    from app.connection import ConnectionSettings
     from app.link.ops import RunProgram
     from app.link.robot_link import RobotLink, wait_for_detached_threads
-    from app.link.transport import ConnectionSettings
     from app.link.types import ConnectionState
     from app.models import Pose
     from app.protocol.enums import ProgramMotionMode

@@ -46,9 +46,9 @@ from PySide6.QtWidgets import (
 )
 
 from app import __version__
+from app.connection import ConnectionSettings
 from app.link.ops import Pause, Resume, Stop
 from app.link.robot_link import RobotLink
-from app.link.transport import ConnectionSettings
 from app.link.types import WorkerError
 from app.models import LINK_FAILURE_CODES
 from app.protocol.word_order_check import WordOrderVerdict
@@ -59,8 +59,9 @@ from ui.controllers.motion import MotionController
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.plan_run_reasons import foreign_pause_text
 from ui.controllers.point_sync import PointSyncController
-from ui.controllers.project_controller import ProjectController, ProjectDialogs
-from ui.controllers.safety_menu import install_safety
+from ui.controllers.project_controller import ProjectController
+from ui.controllers.project_dialogs import ProjectDialogs
+from ui.controllers.safety_menu import SafetyParts, install_safety
 from ui.controllers.word_order_watch import WordOrderWatch
 from ui.dialogs.confirm import ConfirmFn
 from ui.i18n import Translator
@@ -73,7 +74,6 @@ from ui.touch import apply_touch_mode, mark_motion
 from ui.window_actions import WindowActions
 from ui.window_column import ControlColumn
 from ui.window_docks import WindowDocks
-from ui.window_geometry import DEFAULT_SIZE as DEFAULT_SIZE  # where the benchmarks import it from
 from ui.window_geometry import MIN_SIZE, default_size, restore_window
 from ui.window_rows import add_window_rows
 from ui.window_status import WindowStatusBar
@@ -192,8 +192,9 @@ class MainWindow(QMainWindow):
         mark_motion(bar.stop_button, bar.pause_button, bar.resume_button)
         self.set_touch_mode(settings.touch_mode)
         self.view3d = install_view3d(self)  # the 3D tab (and its dock beside the planner)
-        self.safety_menu = install_safety(self)  # roles, envelope, audit trail (the Safety menu)
+        self.safety_menu = install_safety(self._safety_parts())  # roles, envelope, audit (Safety menu)
         self.motion.safety = self.safety_menu.safety
+        self.run_controller.audit = self.safety_menu.safety.session.audit  # a run's own pause (issue 19)
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])
@@ -246,6 +247,25 @@ class MainWindow(QMainWindow):
         project.titleChanged.connect(self._on_project_title)
         project.pathChanged.connect(self._on_project_path)
         project.statusMessage.connect(self._show_message)
+
+    def _safety_parts(self) -> SafetyParts:
+        """What the guard rails work with (:func:`~ui.controllers.safety_menu.install_safety`)."""
+        return SafetyParts(
+            host=self,
+            menu_before=self.menus.help_menu.menuAction(),
+            link=self.link,
+            settings=self.settings,
+            project=self.project,
+            event_log=self.event_log,
+            status_panel=self.status_panel,
+            traffic_panel=lambda: self.traffic_panel,
+            release_jogs=self.jog_panel.release_all,
+            connect_action=self.menus.connect_action,
+            points_tab=self.points_tab,
+            planner_tab=self.planner_tab,
+            view3d=self.view3d,
+            refusal_line=self.control_column.refusal_line,
+        )
 
     @property
     def traffic_panel(self) -> TrafficPanel:  # built when its dock is first seen (WindowDocks)

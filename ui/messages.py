@@ -8,7 +8,7 @@ reuse the "Protocol" translations. Something without a reason (an older producer
 its English message.
 
 The plan's checks and the safety envelope are worded in :mod:`ui.messages_plan`, refused values
-and files in :mod:`ui.messages_files`; both are re-exported here.
+and files in :mod:`ui.messages_files` (:func:`refusal_text` here words them).
 """
 
 from __future__ import annotations
@@ -19,7 +19,8 @@ from typing import Any
 from app.errors import Reason, TeachPadError
 from app.link.types import ConnectionState, WorkerError
 from app.models import CommandResult
-from app.points.point import FieldError, FileFormatError
+from app.points.fields import FieldError
+from app.points.point import FileFormatError
 from app.protocol.enums import (
     RUN_COMMAND_TEXT,
     UNKNOWN_STATUS_TEXT,
@@ -32,7 +33,7 @@ from app.protocol.enums import (
 from app.protocol.exceptions import GATEWAY_EXCEPTIONS
 from ui.joins import join_names
 from ui.messages_files import FILE_TEMPLATES, file_fields, file_text, os_problem
-from ui.messages_plan import _number, _tr, envelope_text, issue_line, issue_text
+from ui.messages_plan import _number, _tr, envelope_text
 from ui.messages_profile import is_profile_code, profile_text
 
 __all__ = [
@@ -41,8 +42,6 @@ __all__ = [
     "LEVEL_WARNING",
     "connection_text",
     "error_text",
-    "issue_line",
-    "issue_text",
     "operation_text",
     "os_error_text",
     "reason_text",

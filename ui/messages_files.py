@@ -1,7 +1,7 @@
 """The sentences of refused values and files: a point's fields, a points CSV file, a project
 file and a plan's segments (codes of app/points/fields.py, csv_io.py, project.py and
 app/plan/segments.py). Data and the file / place wording only: :mod:`ui.messages` adds
-:data:`FILE_TEMPLATES` to its sentences and re-exports :func:`ui.messages.refusal_text`.
+:data:`FILE_TEMPLATES` to its sentences (:func:`ui.messages.refusal_text`).
 """
 
 from __future__ import annotations

@@ -1,8 +1,7 @@
 """The plan's checks and the safety envelope in the operator's language.
 
 :func:`issue_text` words a :class:`~app.plan.checks.PlanIssue` (its code and arguments);
-:func:`envelope_text` a refusal of the safety envelope (app/safety/envelope.py). Re-exported by
-:mod:`ui.messages`, which importers keep using.
+:func:`envelope_text` a refusal of the safety envelope (app/safety/envelope.py).
 """
 
 from __future__ import annotations

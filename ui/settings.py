@@ -17,7 +17,7 @@ from typing import Any
 from PySide6.QtCore import QByteArray, QSettings
 
 from app import timing
-from app.link.transport import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.protocol.codec import WordOrder
 from app.safety import register_profile as regprofile
 from app.safety.location import safety_location

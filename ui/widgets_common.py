@@ -6,11 +6,7 @@ Translatable strings here use the context ``Panels``; protocol texts keep theirs
 
 from __future__ import annotations
 
-import contextlib
-import os
-import tempfile
 from collections.abc import Callable
-from pathlib import Path
 
 from PySide6.QtCore import QCoreApplication, QEvent, QSize, Qt
 from PySide6.QtGui import QFont, QFontDatabase, QFontMetrics, QPainter, QPaintEvent, QPalette, QResizeEvent
@@ -24,17 +20,14 @@ from app.protocol.enums import (
     TR_CONTEXT,
     UNKNOWN_STATUS_TEXT,
 )
-from ui.palette import (  # re-exported: panels import the state colours from here
+from ui.palette import (
     COLOR_BORDER,
     COLOR_ERROR,
-    COLOR_ERROR_BG,  # noqa: F401
     COLOR_INFO,
     COLOR_NEUTRAL,
     COLOR_NEUTRAL_BG,
     COLOR_OK,
-    COLOR_OK_BG,  # noqa: F401
     COLOR_WARN,
-    COLOR_WARN_BG,  # noqa: F401
     COLOR_WHITE,
 )
 from ui.widgets.number_text import fit_number, number_room, number_text
@@ -333,26 +326,6 @@ class NumericReadout(QFrame):
         text = self.PLACEHOLDER if value is None or nan else number_text(value, self._decimals)
         if text != self._number.text():
             self._number.setText(text)
-
-
-def atomic_write_text(path: str | os.PathLike[str], text: str, *, encoding: str = "utf-8") -> None:
-    """Write ``text`` to ``path`` atomically: a temp file in the same folder, then ``os.replace``.
-
-    Readers see the old file or the complete new one, never a partial one; the temp file is
-    removed if anything fails.
-    """
-    target = Path(path)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent or ".")
-    try:
-        with os.fdopen(fd, "w", encoding=encoding, newline="") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp_name, target)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp_name)
-        raise
 
 
 # --- connection state -------------------------------------------------------------------

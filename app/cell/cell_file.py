@@ -30,11 +30,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from app.errors import TeachPadError
-from app.link.transport import ConnectionSettings
+from app.connection import ConnectionSettings
+from app.errors import ProfileError, TeachPadError
 from app.points.atomic import atomic_write_bytes, read_settings_text, versioned_document
 from app.safety.register_profile import RegisterProfile, RegisterProfileError, load_register_profile
-from app.view3d.profile import ProfileError, RobotProfile, load_profile
+from app.view3d.profile import RobotProfile, load_profile
 
 __all__ = ["FORMAT", "VERSION", "Cell", "CellController", "CellFileError", "load_cell", "save_cell"]
 

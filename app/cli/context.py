@@ -20,8 +20,9 @@ from typing import TYPE_CHECKING, Any, TextIO, TypeVar
 
 from app import timing
 from app.cli.exit_codes import ExitCode
+from app.connection import ConnectionSettings
 from app.errors import ModbusExceptionError, TeachPadError
-from app.link.client import ConnectionSettings, RobotClient
+from app.link.client import RobotClient
 from app.link.foreign import ForeignSighting, audit_sighting
 from app.link.halt import RETRY_EXCEPTIONS
 from app.safety.audit import AuditLog

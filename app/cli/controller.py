@@ -33,10 +33,10 @@ from app.cli.format import (
 )
 from app.cli.watching import add_watch_parser
 from app.errors import AlarmRaised, InvalidInput, OutcomeUnknown, Reason, TeachPadError
-from app.link.client import RobotClient, StepFrame
+from app.link.client import RobotClient
 from app.link.halt import HaltWatch, HaltWrite, confirm_halt
 from app.link.outcome import UNKNOWN_ADVICE, outcome_note
-from app.link.types import HaltKind
+from app.link.types import HaltKind, StepFrame
 from app.link.watch import MotionWatch, StateCheck
 from app.models import CommandResult, ControllerStatus, Pose
 from app.plan.segments import Segment

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from app.errors import InvalidInput
-from app.link.client import StepFrame
+from app.link.types import StepFrame
 from app.models import ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.codec import WordOrder

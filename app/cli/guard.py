@@ -36,7 +36,8 @@ from app.errors import TeachPadError
 from app.models import Pose
 from app.plan.segments import Segment
 from app.points.ledger import PointLedger
-from app.safety.audit import AuditLog, Result
+from app.safety.audit import AuditLog
+from app.safety.audit_read import Result
 from app.safety.envelope import Envelope, EnvelopeRefused, EnvelopeViolation, check_speed
 from app.safety.jog_guard import JogMotion
 from app.safety.location import ENVELOPE_NAME

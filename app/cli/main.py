@@ -52,8 +52,8 @@ from app.cli.guard import (
     command_path,
 )
 from app.cli.help import add_examples
+from app.connection import ConnectionSettings
 from app.errors import InvalidInput, TeachPadError
-from app.link.client import ConnectionSettings
 from app.link.outcome import UNKNOWN_ADVICE
 from app.safety.caps import MotionCaps
 from app.safety.envelope import Envelope
@@ -73,10 +73,7 @@ __all__ = [
     "EXIT_OK",
     "EXIT_UNKNOWN",
     "EXIT_USAGE",
-    "PROG",
     "REGISTRARS",
-    "CliContext",
-    "ExitCode",
     "build_parser",
     "main",
 ]

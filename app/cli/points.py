@@ -39,23 +39,20 @@ from typing import Any, TextIO
 from app import timing
 from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode, exit_code_for
-from app.cli.points_upload import BootWatch, by_tool, open_boot, staged_upload
+from app.cli.points_upload import BootWatch, open_boot, staged_upload
 from app.errors import InvalidInput, ModbusExceptionError, TeachPadError
-from app.points.guard import CANARY_GV
-from app.points.ledger import EmptyImport, ImportMode, PointLedger
+from app.link.upload import group_by_tool
+from app.points.fields import PointLimits, tool_text
+from app.points.ledger import PointLedger
+from app.points.ledger_import import EmptyImport, ImportMode
 from app.points.lock import live_owner
-from app.points.point import FileFormatError, PointLimits, SyncState, TempPoint, tool_text
-from app.points.project import (
-    PROJECT_SUFFIX,
-    Project,
-    ProjectTooLarge,
-    load_project,
-    read_points_csv,
-    save_project,
-    write_points_csv,
-)
+from app.points.point import FileFormatError, SyncState, TempPoint
+from app.points.project import PROJECT_SUFFIX, load_project, read_points_csv, save_project, write_points_csv
+from app.points.project_model import Project
+from app.points.project_write import ProjectTooLarge
 from app.points.upload import BootLost, UploadReport, apply_upload, parse_id_list
 from app.points.upload_record import UploadRecord, load_record, record_path, save_record
+from app.protocol.registers import CANARY_GV
 
 # The table's members under the names callers imported before the table existed.
 EXIT_OK = ExitCode.OK
@@ -250,7 +247,7 @@ def _upload(
     proven: Callable[[list[TempPoint]], object] | None,
 ) -> UploadReport:
     line = _ProgressLine(ctx.out)
-    ordered = by_tool(points)
+    ordered = group_by_tool(points, lambda p: p.tool)
 
     def progress(done: int, total: int) -> None:
         if done < total:

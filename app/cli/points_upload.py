@@ -3,8 +3,8 @@
 :func:`staged_upload` drives :meth:`app.link.client.RobotClient.upload_points` (one batch per
 tool frame): per point its pose (the first of a batch only), GV200-202 and 440, while the
 controller creates it the next point's pose goes into the other pose block -- GV6..GV11, or
-GV12..GV17 when the restart canary (:data:`app.points.guard.CANARY_GV`) sits there
-(:func:`app.link.upload.stage_gv_for`) -- so the write fills the controller's latency. The
+GV12..GV17 when the restart canary (:data:`app.protocol.registers.CANARY_GV`) sits there
+(:func:`app.protocol.registers.stage_gv_for`) -- so the write fills the controller's latency. The
 outcome is an :class:`app.points.upload.UploadReport`, as the point-by-point upload gave.
 
 **Restarts** (issue 19): the upload watches the restart canary (:class:`BootWatch`, GV99) the way
@@ -26,17 +26,17 @@ from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
 from app.cli.exit_codes import LINK_ERRORS
+from app.connection import ConnectionSettings
 from app.errors import ModbusExceptionError, TeachPadError
-from app.link.transport import ConnectionSettings
 from app.link.types import ControllerIdentity
-from app.link.upload import UPLOAD_POSE_GV, refused_before_the_first, stage_gv_for
+from app.link.upload import group_by_tool, refused_before_the_first
 from app.models import CommandResult
-from app.points.guard import CANARY_GV
 from app.points.point import TempPoint
 from app.points.upload import BootLost, UploadOutcome, UploadReport
 from app.points.upload_record import UploadRecord
+from app.protocol.registers import CANARY_GV, UPLOAD_POSE_GV, stage_gv_for
 
-__all__ = ["CANARY_EVERY", "BootWatch", "by_tool", "open_boot", "staged_upload"]
+__all__ = ["CANARY_EVERY", "BootWatch", "open_boot", "staged_upload"]
 
 #: points created between two reads of the restart canary during an upload (and one after the last)
 CANARY_EVERY = 8
@@ -85,12 +85,8 @@ def open_boot(
     return BootWatch(gv, value), UploadRecord(replace(place, boot=value)), False
 
 
-def by_tool(points: Sequence[TempPoint]) -> list[TempPoint]:
-    """``points`` grouped by tool frame, stable: the tools in order of first appearance."""
-    groups: dict[int, list[TempPoint]] = {}
-    for p in points:
-        groups.setdefault(p.tool, []).append(p)
-    return [p for group in groups.values() for p in group]
+def _tool(point: TempPoint) -> int:
+    return point.tool
 
 
 def staged_upload(
@@ -101,9 +97,9 @@ def staged_upload(
     proven: Callable[[list[TempPoint]], object] | None = None,
 ) -> UploadReport:
     """Create ``points`` with ``RobotClient.upload_points``, as the GUI's upload does: in
-    :func:`by_tool` order (GV245 once per tool), the next point's pose staged in the spare pose
-    block (:func:`~app.link.upload.stage_gv_for` the restart canary's GV) while the controller
-    creates the current one.
+    :func:`~app.link.upload.group_by_tool` order (GV245 once per tool), the next point's pose
+    staged in the spare pose block (:func:`~app.protocol.registers.stage_gv_for` the restart
+    canary's GV) while the controller creates the current one.
 
     ``progress(done, total)`` (``done``: points tried, in that order) before each point and once
     at the end; False from it ends the upload there ("stopped on request"). A point the
@@ -115,7 +111,7 @@ def staged_upload(
     after each good read of the canary, every point confirmed so far (as sent), for a record kept
     while the upload runs.
     """
-    return _StagedUpload(client, by_tool(points), progress, watch, proven).run()
+    return _StagedUpload(client, group_by_tool(points, _tool), progress, watch, proven).run()
 
 
 class _StagedUpload:
@@ -275,7 +271,7 @@ def _repair(client: Any, watch: BootWatch, lost: BootLost, suspects: Sequence[Te
 
 
 def _tool_groups(points: Sequence[TempPoint]) -> list[list[TempPoint]]:
-    return [list(group) for _, group in itertools.groupby(by_tool(points), key=lambda p: p.tool)]
+    return [list(group) for _, group in itertools.groupby(group_by_tool(points, _tool), key=_tool)]
 
 
 def _record(report: UploadReport, batch: Sequence[TempPoint], results: Sequence[CommandResult]) -> str | None:

@@ -40,15 +40,16 @@ from app.cli.points import (
 from app.errors import CommandRefused, InvalidInput, TeachPadError
 from app.link.client import RobotClient
 from app.models import CommandResult, Pose
-from app.plan.checks import IssueCode, IssueKind, PlanIssue, PlanLimits, ReachCheck, check_plan
+from app.plan.checks import IssueCode, PlanIssue, PlanLimits, ReachCheck, check_plan
 from app.plan.estimates import estimate_plan, segment_timeouts
 from app.plan.geometry import PointLike
+from app.plan.issue_kind import IssueKind
 from app.plan.runner import PlanRunner, RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan
 from app.points.guard import PointGuard, PointMismatch, PointNotCreated
 from app.points.ledger import PointLedger
 from app.points.lock import live_owner
-from app.points.project import Project
+from app.points.project_model import Project
 from app.protocol.enums import MoveStatus
 from app.safety.envelope import Envelope
 from app.safety.profile import load_profile

@@ -31,19 +31,9 @@ from app.cli.format import parse_moment, parse_positive_int
 from app.errors import InvalidInput
 from app.event_store import EventStore, default_events_dir, export_line
 from app.points.atomic import atomic_write_bytes
-from app.safety.audit import (
-    AuditFilter,
-    AuditLog,
-    AuditRecord,
-    FsyncPolicy,
-    ReadStats,
-    Result,
-    default_audit_dir,
-    export_csv,
-    query,
-    result_label,
-)
+from app.safety.audit import AuditLog, FsyncPolicy, default_audit_dir
 from app.safety.audit_chain import verify_chain
+from app.safety.audit_read import AuditFilter, AuditRecord, ReadStats, Result, export_csv, query, result_label
 from app.safety.bundle import DEFAULT_DAYS, write_support_bundle
 from app.safety.roles import Role, RoleStore, WrongPassword, default_store_path
 

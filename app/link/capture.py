@@ -5,8 +5,9 @@ Qt-free; the worker feeds them from its polls and emits what they return.
 
 from __future__ import annotations
 
-from app.link.client import RobotClient, TrafficRecord
+from app.link.client import RobotClient
 from app.link.stats import LinkStats
+from app.link.transport import TrafficRecord
 
 __all__ = ["LinkStatsReporter", "RttMeter", "TrafficCapture"]
 

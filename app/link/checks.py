@@ -6,8 +6,8 @@ import enum
 from collections.abc import Sequence
 from typing import Any
 
+from app.connection import ConnectionSettings
 from app.errors import InvalidInput
-from app.link.transport import ConnectionSettings
 from app.protocol import registers
 from app.protocol.codec import WordOrder, check_float32
 

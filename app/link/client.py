@@ -36,6 +36,7 @@ import time
 from collections.abc import Callable, Iterable, Sequence
 
 from app import timing
+from app.connection import ConnectionSettings
 from app.errors import (
     ControllerBusy,
     InvalidInput,
@@ -52,11 +53,8 @@ from app.link.busy import BusyBackoff, is_busy, retry_busy
 from app.link.checks import check_enum, check_float, check_floats, check_int, check_tool
 from app.link.command_client import CommandClient
 from app.link.line_retry import LINE_ERRORS, LineRetry, retry_line
-from app.link.register_client import RegisterClient
-from app.link.stats import LinkStats
 from app.link.tracker import CommandTracker, command_text
-from app.link.transport import ConnectionSettings, TrafficRecord
-from app.link.types import StepFrame  # here for importers: the GUI imports it from types
+from app.link.types import StepFrame
 from app.link.watch import MotionWatch
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers
@@ -74,12 +72,7 @@ from app.protocol.enums import (
 from app.safety.caps import MotionCaps
 
 __all__ = [
-    "ConnectionSettings",
-    "LinkStats",
-    "RegisterClient",
     "RobotClient",
-    "StepFrame",
-    "TrafficRecord",
 ]
 
 _GENERAL_POSE_LAST_START = registers.GV_GENERAL_LAST - 5  # six GVs must fit in GV0..GV99

@@ -23,6 +23,7 @@ import time
 from collections.abc import Callable
 
 from app import timing
+from app.connection import ConnectionSettings
 from app.errors import (
     ForeignMasterRefused,
     LinkError,
@@ -32,9 +33,9 @@ from app.errors import (
     ResponseTimeout,
 )
 from app.link.outcome import outcome_note
+from app.link.pacer import ResultPacer
 from app.link.register_client import RegisterClient
-from app.link.tracker import CommandTracker, CompletionRule, ResultPacer, command_text
-from app.link.transport import ConnectionSettings
+from app.link.tracker import CommandTracker, CompletionRule, command_text
 from app.link.watch import MotionWatch, StateCheck
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol import registers

@@ -15,12 +15,13 @@ from app.models import CommandResult, ControllerStatus, Pose
 
 if TYPE_CHECKING:
     from app.link.capture import TrafficCapture
-    from app.link.client import RobotClient, TrafficRecord
+    from app.link.client import RobotClient
     from app.link.jog import JogMachine
     from app.link.motion import MotionTracker
     from app.link.poller import Poller
     from app.link.stats import LinkStats
     from app.link.supervisor import LinkSupervisor
+    from app.link.transport import TrafficRecord
     from app.link.upload import Uploader
     from app.safety.audit import AuditLog
     from app.safety.caps import MotionCaps

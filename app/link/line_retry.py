@@ -28,8 +28,8 @@ from collections.abc import Callable
 from typing import TypeVar
 
 from app import timing
+from app.connection import ConnectionSettings
 from app.errors import MalformedResponse, ResponseTimeout
-from app.link.transport import ConnectionSettings
 
 __all__ = ["LINE_ERRORS", "LineRetry", "on_noisy_line", "retry_line"]
 

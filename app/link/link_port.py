@@ -1,6 +1,6 @@
 """What panels and controllers hold of the link: :class:`LinkPort`, the typed port RobotLink
 fits (and the tests' small fake), :class:`Pending`, one request's outcome, and
-:class:`RequestRouter`, request id -> Pending. Re-exported by :mod:`app.link.robot_link`."""
+:class:`RequestRouter`, request id -> Pending."""
 
 from __future__ import annotations
 

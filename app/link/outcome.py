@@ -27,7 +27,8 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from app.models import LINK_FAILURE_CODES, CommandResult
-from app.safety.audit import AuditLog, AuditRecord
+from app.safety.audit import AuditLog
+from app.safety.audit_read import AuditRecord
 
 __all__ = ["UNKNOWN_ADVICE", "Outcome", "OutcomeHook", "outcome_args", "outcome_note", "outcome_of"]
 

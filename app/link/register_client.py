@@ -27,18 +27,20 @@ from collections.abc import Callable, Iterator, Sequence
 from typing import Self
 
 from app import timing
+from app.connection import ConnectionSettings
 from app.errors import InvalidInput, WriteBlocked
 from app.link.checks import check_float, check_int, check_settings, range_name
 from app.link.decode import decode_pose, decode_status
 from app.link.foreign import ForeignMasterWatch
 from app.link.line_retry import LINE_ERRORS, LineRetry, on_noisy_line
 from app.link.stats import LinkStats
-from app.link.transport import ConnectionSettings, TrafficObserver, Transport
+from app.link.transport import TrafficObserver, Transport
 from app.models import ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.codec import decode_floats, encode_floats
 from app.protocol.datetime_regs import ControllerClock, decode_clock
-from app.safety.audit import AuditLog, AuditRecord
+from app.safety.audit import AuditLog
+from app.safety.audit_read import AuditRecord
 
 __all__ = ["RegisterClient"]
 

@@ -26,12 +26,12 @@ from PySide6.QtCore import (
 )
 
 from app import timing
+from app.connection import ConnectionSettings
 from app.errors import Reason
-from app.link.link_port import LinkPort, Pending, RequestRouter
+from app.link.link_port import Pending, RequestRouter
 from app.link.ops import LinkOp, Stop
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, PollUpdate, RobotState
 from app.link.stats import LinkStats
-from app.link.transport import ConnectionSettings
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult, ControllerStatus, Pose
 
@@ -41,7 +41,7 @@ if TYPE_CHECKING:  # the worker (pymodbus, the envelope's numpy) is imported by 
     from app.safety.caps import MotionCaps
     from app.safety.jog_guard import JogGuard
 
-__all__ = ["LinkPort", "Pending", "RequestRouter", "RobotLink", "wait_for_detached_threads"]
+__all__ = ["RobotLink", "wait_for_detached_threads"]
 
 _log = logging.getLogger(__name__)
 

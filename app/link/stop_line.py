@@ -35,9 +35,11 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from app.connection import ConnectionSettings
 from app.errors import LinkError, MalformedResponse, ResponseTimeout
 from app.link import frames
-from app.link.client import ConnectionSettings, RobotClient, TrafficRecord
+from app.link.client import RobotClient
+from app.link.transport import TrafficRecord
 from app.protocol import registers
 
 if TYPE_CHECKING:

@@ -15,7 +15,7 @@ from app.errors import LinkError
 from app.link.hostname import host_problem_text
 
 if TYPE_CHECKING:
-    from app.link.transport import ConnectionSettings
+    from app.connection import ConnectionSettings
 
 __all__ = ["SIMULATOR_PORT", "PeerClosed", "SerialStream", "TcpStream"]
 

@@ -30,24 +30,22 @@ import random
 import time
 
 from app import timing
+from app.connection import ConnectionSettings
 from app.errors import LinkError, Reason, ResponseTimeout, TeachPadError
-from app.link.client import ConnectionSettings, RobotClient
+from app.link.client import RobotClient
 from app.link.foreign import ForeignSighting
 from app.link.host import WorkerHost
 from app.link.types import ConnectionState, ControllerIdentity, LinkState, Operation
-from app.link.upload import UPLOAD_POSE_GV
 from app.protocol import registers
+from app.protocol.registers import UPLOAD_POSE_GV
 
-__all__ = ["DEFAULT_CANARY_GV", "Cause", "LinkSupervisor", "check_canary_gv"]
+__all__ = ["Cause", "LinkSupervisor", "check_canary_gv"]
 
 #: Why the link changed: the typed error (its reason goes to the GUI), or only English text
 #: (the link-loss reason without a detail then).
 Cause = TeachPadError | str
 
 _log = logging.getLogger(__name__)
-
-#: The spare general-purpose GV holding the restart canary (registers 198-199); None disables it.
-DEFAULT_CANARY_GV: int | None = 99
 
 
 def check_canary_gv(canary_gv: int | None) -> None:

@@ -61,7 +61,7 @@ from app.errors import (
     Reason,
     TeachPadError,
 )
-from app.link.arrival import POSE_EPSILON, arrived, pose_moved
+from app.link.arrival import arrived, pose_moved
 from app.link.foreign import ForeignMasterWatch, overlapped_text
 from app.link.outcome import UNKNOWN_ADVICE, OutcomeHook
 from app.link.pacer import ResultPacer
@@ -81,13 +81,10 @@ from app.protocol.enums import (
 
 __all__ = [
     "BACKOFF_DOUBLINGS_MAX",
-    "POSE_EPSILON",
     "CommandTracker",
     "CompletionRule",
-    "ResultPacer",
     "backoff",
     "command_text",
-    "pose_moved",
 ]
 
 CompletionRule = Literal["sentinel", "observe"]

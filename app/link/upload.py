@@ -33,6 +33,7 @@ import math
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
+from typing import TypeVar
 
 from app import timing
 from app.errors import (
@@ -49,30 +50,27 @@ from app.link.types import Operation
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import CommandKind, RunCommand
+from app.protocol.registers import UPLOAD_POSE_GV, stage_gv_for
 
 __all__ = [
-    "UPLOAD_POSE_GV",
-    "UPLOAD_STAGE_GV",
     "UploadItem",
-    "UploadRun",
     "Uploader",
+    "WorkerUpload",
     "check_upload_items",
     "group_by_tool",
     "refused_before_the_first",
-    "stage_gv_for",
 ]
 
-UPLOAD_POSE_GV = 0  # an upload passes each pose in GV0..GV5 (case 2.2) ...
-UPLOAD_STAGE_GV = 6  # ... and every other one in GV6..GV11, written while the previous one is created
 _FLOAT32_MAX = 3.4028234663852886e38
 
 UploadItem = tuple[int, tuple[float, ...], int]  # (point id, pose X Y Z A B C, tool frame)
 RawItem = tuple[object, tuple[object, ...], object]
+T = TypeVar("T")
 
 
 @dataclass
-class UploadRun:
-    """An upload under way."""
+class WorkerUpload:
+    """An upload the worker is sending: its items and how far it got."""
 
     request_id: int | None
     items: list[UploadItem]  # grouped by tool frame: GV245 is written once per group
@@ -87,18 +85,13 @@ class UploadRun:
     first_failure: str = ""  # the first refused or failed point's words, for the final result
 
 
-def stage_gv_for(canary_gv: int | None) -> int:
-    """The upload's second pose block: GV6..GV11, or GV12..GV17 when the restart canary is there."""
-    if canary_gv is not None and UPLOAD_STAGE_GV <= canary_gv < UPLOAD_STAGE_GV + 6:
-        return UPLOAD_STAGE_GV + 6
-    return UPLOAD_STAGE_GV
-
-
-def group_by_tool(items: Iterable[UploadItem]) -> list[UploadItem]:
-    """Stable grouping: the tools in order of first appearance, each tool's points in input order."""
-    groups: dict[int, list[UploadItem]] = {}
+def group_by_tool(items: Iterable[T], tool: Callable[[T], int]) -> list[T]:
+    """The order points are uploaded in (GV245 is written once per tool frame), the GUI's and the
+    CLI's: grouped by ``tool(item)``, stable -- the tools in order of first appearance, each tool's
+    points in input order."""
+    groups: dict[int, list[T]] = {}
     for item in items:
-        groups.setdefault(item[2], []).append(item)
+        groups.setdefault(tool(item), []).append(item)
     return [item for group in groups.values() for item in group]
 
 
@@ -160,7 +153,7 @@ def _chunk_end(items: Sequence[UploadItem], first: int) -> int:
     return last
 
 
-def _count_failure(upload: UploadRun, result: CommandResult) -> None:
+def _count_failure(upload: WorkerUpload, result: CommandResult) -> None:
     """A point that failed on a sound link: the next chunk goes on with the next point in a
     fresh call (its pose written anew, whatever was staged before). Refused only when the
     controller said no (a refused status, a Modbus exception, which ended the batch there); a
@@ -182,7 +175,7 @@ class Uploader:
         since the upload began, a stop or cancel is on its way and nothing more is written."""
         self._host = host
         self._halt_count = halt_count
-        self.run: UploadRun | None = None
+        self.run: WorkerUpload | None = None
         self._busy = False  # inside a chunk (client.upload_points is running)
 
     def start(self, raw: list[RawItem]) -> bool:
@@ -191,7 +184,7 @@ class Uploader:
         client = host.client_or_raise()
         if client.settings.monitor_only:
             raise WriteBlocked(f"monitor-only mode: {Operation.UPLOAD_POINTS} was not sent")
-        items = group_by_tool(check_upload_items(client, raw))
+        items = group_by_tool(check_upload_items(client, raw), lambda item: item[2])
         if not items:
             host.emit_result(
                 CommandResult(
@@ -205,7 +198,7 @@ class Uploader:
             )
             return False
         host.jog.leave_teach(host.poller.last_status)
-        self.run = UploadRun(host.request_id, items, halts_at_start=self._halt_count())
+        self.run = WorkerUpload(host.request_id, items, halts_at_start=self._halt_count())
         self._note_progress(self.run, force=True)
         return True
 
@@ -231,7 +224,7 @@ class Uploader:
             return False
         return True
 
-    def _chunk(self, upload: UploadRun) -> None:
+    def _chunk(self, upload: WorkerUpload) -> None:
         host = self._host
         client = host.client_or_raise()
         start = time.monotonic()
@@ -246,7 +239,7 @@ class Uploader:
         self._note_progress(upload)
 
     def _send_chunk(
-        self, client: RobotClient, upload: UploadRun, items: Sequence[UploadItem], start: float
+        self, client: RobotClient, upload: WorkerUpload, items: Sequence[UploadItem], start: float
     ) -> tuple[list[CommandResult], str | None]:
         """One call of ``upload_points`` for ``items`` (one tool), under the upload's request id:
         its results, and the link's failure before the first point (None: none)."""
@@ -279,7 +272,7 @@ class Uploader:
             host.request_id = outer_id
         return results, transport_error
 
-    def _between_points(self, upload: UploadRun, start: float, done: int, total: int) -> bool:
+    def _between_points(self, upload: WorkerUpload, start: float, done: int, total: int) -> bool:
         """``upload_points``'s progress: the urgent jobs and a due poll run between two points;
         False ends the chunk (the upload ended, the link is down, or the chunk's time is up)."""
         host = self._host
@@ -297,7 +290,7 @@ class Uploader:
             raise LinkError("the link went down while a point was in flight; its outcome is unknown")
 
     def _tally(
-        self, upload: UploadRun, first: int, results: list[CommandResult], transport_error: str | None
+        self, upload: WorkerUpload, first: int, results: list[CommandResult], transport_error: str | None
     ) -> str | None:
         """Each point's result (the chunk began at ``first``) published and counted (good,
         refused, failed); ``transport_error``, or the words of the last point whose link failed
@@ -316,11 +309,11 @@ class Uploader:
                 _count_failure(upload, result)
         return transport_error
 
-    def _halted(self, upload: UploadRun) -> bool:
+    def _halted(self, upload: WorkerUpload) -> bool:
         """Ending, or a stop or cancel asked for since it began (its job may not have run yet)."""
         return upload.end is not None or self._halt_count() != upload.halts_at_start
 
-    def _note_progress(self, upload: UploadRun, *, force: bool = False) -> None:
+    def _note_progress(self, upload: WorkerUpload, *, force: bool = False) -> None:
         now = time.monotonic()
         due = force or now - upload.progress_at >= timing.UPLOAD_PROGRESS_PERIOD
         if upload.index != upload.progress_done and due:

@@ -60,6 +60,7 @@ import numpy  # noqa: F401 - the jog guard's arithmetic (app/lazy_numpy.py): imp
 from PySide6.QtCore import QCoreApplication, QObject, Qt, QTimer, Signal, Slot  # not by a check mid-jog
 
 from app import timing
+from app.connection import ConnectionSettings
 from app.errors import (
     CommandRefused,
     LinkError,
@@ -71,7 +72,7 @@ from app.errors import (
     WriteBlocked,
 )
 from app.link.capture import TrafficCapture
-from app.link.client import ConnectionSettings, RobotClient, TrafficRecord
+from app.link.client import RobotClient
 from app.link.commands import WorkerCommands
 from app.link.jobs import Job, JobQueue
 from app.link.jog import JogMachine, PreemptedError
@@ -81,16 +82,18 @@ from app.link.poller import Poller
 from app.link.state import PollUpdate
 from app.link.stats import LinkStats
 from app.link.stop_line import StopLine
-from app.link.supervisor import DEFAULT_CANARY_GV, LinkSupervisor
+from app.link.supervisor import LinkSupervisor
+from app.link.transport import TrafficRecord
 from app.link.types import ConnectionState, LinkState, Operation, UnconfirmedHalt, WorkerError
 from app.link.upload import Uploader
 from app.models import CommandResult, ControllerStatus, Pose
+from app.protocol.registers import CANARY_GV
 from app.safety.audit import AuditLog
 from app.safety.caps import MotionCaps
 from app.safety.envelope import EnvelopeViolation
 from app.safety.jog_guard import JogGuard
 
-__all__ = ["DEFAULT_CANARY_GV", "SHUTDOWN_TIMEOUT_MS", "STOP_HANDOFF_WAIT", "RobotWorker"]
+__all__ = ["SHUTDOWN_TIMEOUT_MS", "RobotWorker"]
 
 _log = logging.getLogger(__name__)
 
@@ -130,9 +133,7 @@ class RobotWorker(QObject):
     # The next chunk of an upload, one event-loop turn later (polls and queued calls in between).
     _uploadStep = Signal()  # noqa: N815
 
-    def __init__(
-        self, poll_hz: float = timing.POLL_HZ_DEFAULT, *, canary_gv: int | None = DEFAULT_CANARY_GV
-    ) -> None:
+    def __init__(self, poll_hz: float = timing.POLL_HZ_DEFAULT, *, canary_gv: int | None = CANARY_GV) -> None:
         super().__init__()
         self._poll_hz = float(poll_hz)
         self._jobs = JobQueue(halting=(Stop.operation, CancelUpload.operation))

@@ -16,14 +16,13 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from app.errors import InvalidInput
+from app.lazy_numpy import FloatArray
 from app.plan.geometry import PointLike, arc_geometry, xyz_of
-from app.plan.issue_kind import IssueKind as IssueKind  # re-exported: its home before issue_kind.py
-from app.plan.segments import FloatArray, Plan, Segment
-from app.points.ledger import (
-    PointLedger,
-    SyncState,
-    tool_text,
-)
+from app.plan.issue_kind import IssueKind
+from app.plan.segments import Plan, Segment
+from app.points.fields import tool_text
+from app.points.ledger import PointLedger
+from app.points.point import SyncState
 from app.safety.envelope import Envelope, EnvelopeRefused, plan_violations
 
 if TYPE_CHECKING:

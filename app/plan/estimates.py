@@ -10,8 +10,9 @@ from typing import TYPE_CHECKING
 
 from app import timing
 from app.errors import InvalidInput
+from app.lazy_numpy import FloatArray
 from app.plan.geometry import PointLike, plan_geometry
-from app.plan.segments import FloatArray, Plan
+from app.plan.segments import Plan
 from app.points.ledger import (
     PointLedger,
 )

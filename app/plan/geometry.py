@@ -13,12 +13,11 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from app.errors import InvalidInput
+from app.lazy_numpy import FloatArray
 from app.models import Pose
-from app.plan.segments import FloatArray, Plan, Segment
-from app.points.ledger import (
-    PointLedger,
-    TempPoint,
-)
+from app.plan.segments import Plan, Segment
+from app.points.ledger import PointLedger
+from app.points.point import TempPoint
 
 if TYPE_CHECKING:
     import numpy as np

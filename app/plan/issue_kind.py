@@ -1,7 +1,7 @@
 """How bad a plan's issue is (:class:`IssueKind`), apart from the checks themselves.
 
-:mod:`app.plan.checks` re-exports it; the tables and messages that colour or word an issue's
-kind import it from here, so the window's first paint does not import the checks (and the
+The checks, the tables and the messages that colour or word an issue's kind import it from
+here, so the window's first paint does not import the checks (and the
 geometry they use) before a plan is checked.
 """
 

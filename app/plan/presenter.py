@@ -16,8 +16,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from app.models import Pose
-from app.plan.checks import IssueKind, PlanIssue, ids_needing_upload
+from app.plan.checks import PlanIssue, ids_needing_upload
 from app.plan.estimates import PlanEstimate
+from app.plan.issue_kind import IssueKind
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger
 

@@ -29,7 +29,6 @@ import enum
 from dataclasses import dataclass, field, replace
 
 from app.errors import InvalidInput
-from app.lazy_numpy import FloatArray as FloatArray  # for the plan's importers
 from app.points.fields import FieldError, parse_float, parse_int, parse_tool, shown
 from app.protocol.enums import QT_TRANSLATE_NOOP
 from app.protocol.registers import TOOL_NONE

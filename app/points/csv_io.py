@@ -14,18 +14,9 @@ import io
 from collections.abc import Iterable
 
 from app.errors import Reason
+from app.points.fields import DEFAULT_LIMITS, FieldError, PointLimits, shown
 from app.points.number_text import value_text
-from app.points.point import (
-    CSV_COLUMNS,
-    CSV_REQUIRED,
-    DEFAULT_LIMITS,
-    FieldError,
-    FileFormatError,
-    PointLimits,
-    TempPoint,
-    point_from_fields,
-    shown,
-)
+from app.points.point import CSV_COLUMNS, CSV_REQUIRED, FileFormatError, TempPoint, point_from_fields
 
 _POSE_FIELDS = ("x", "y", "z", "a", "b", "c")
 

@@ -37,9 +37,8 @@ from typing import Protocol
 from app.errors import TeachPadError
 from app.models import CommandResult, Pose
 from app.points.point import TempPoint
+from app.protocol.registers import CANARY_GV
 
-#: Spare GV holding the restart canary (the GUI link's default too: ``app.link.worker``).
-CANARY_GV = 99
 #: Largest distance (mm) between the pose after a segment and the host's end point.
 ARRIVAL_TOLERANCE_MM = 1.0
 #: How many of the create-points sent a guard remembers (PointGuard.created): a run with endless

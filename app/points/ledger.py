@@ -10,8 +10,7 @@ The ledger is not thread-safe: one thread (the GUI's) owns it; workers get
 restart, a reconnect or a loaded file.
 
 The point itself lives in :mod:`app.points.point`, CSV in :mod:`app.points.csv_io`, uploads in
-:mod:`app.points.upload`, importing a file's list in :mod:`app.points.ledger_import`; their names
-are re-exported here for older imports.
+:mod:`app.points.upload`, importing a file's list in :mod:`app.points.ledger_import`.
 """
 
 from __future__ import annotations
@@ -20,39 +19,16 @@ from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
 
 from app.errors import InvalidInput
-from app.points.ledger_import import EmptyImport, ImportMode, ImportReport, merge_import
+from app.points.fields import DEFAULT_LIMITS, FieldError, PointLimits
+from app.points.ledger_import import ImportMode, ImportReport, merge_import
 from app.points.point import (
-    CONTROLLER_FIELDS,
-    CSV_COLUMNS,
-    CSV_REQUIRED,
-    DEFAULT_LIMITS,
-    EXT_FIELDS,
-    NAME_MAX_CHARS,
-    NOTE_MAX_CHARS,
     POINT_FIELDS,
-    POSE_FIELDS,
-    SYNC_STATE_TEXT,
-    TOOL_MAX,
-    TR_CONTEXT,
     ZERO_EXT,
-    Ext5,
-    FieldError,
-    FileFormatError,
-    PointLimits,
-    Pose6,
     SyncState,
     TempPoint,
     _mark_changed,
     is_valid_point,
     make_point,
-    parse_float,
-    parse_int,
-    parse_point_id,
-    parse_text,
-    parse_tool,
-    point_from_fields,
-    point_from_pose,
-    tool_text,
     with_field,
 )
 from app.protocol.registers import TOOL_NONE
@@ -376,62 +352,7 @@ class PointLedger:
             )
 
 
-# Older imports (``from app.points.ledger import parse_points_csv``) keep working: the CSV and
-# upload names are re-exported. Imported last: app.points.upload refers back to this module.
-from app.points.csv_io import decode_text, parse_points_csv, points_to_csv  # noqa: E402
-from app.points.upload import (  # noqa: E402
-    PointUploader,
-    UploadOutcome,
-    UploadReport,
-    apply_upload,
-    parse_id_list,
-    upload_points,
-)
-
 __all__ = [
-    "CONTROLLER_FIELDS",
-    "CSV_COLUMNS",
-    "CSV_REQUIRED",
-    "DEFAULT_LIMITS",
-    "EXT_FIELDS",
-    "NAME_MAX_CHARS",
-    "NOTE_MAX_CHARS",
-    "POINT_FIELDS",
-    "POSE_FIELDS",
-    "SYNC_STATE_TEXT",
-    "TOOL_MAX",
-    "TOOL_NONE",
-    "TR_CONTEXT",
-    "ZERO_EXT",
-    "EmptyImport",
-    "Ext5",
-    "FieldError",
-    "FileFormatError",
-    "ImportMode",
-    "ImportReport",
     "PointEdit",
     "PointLedger",
-    "PointLimits",
-    "PointUploader",
-    "Pose6",
-    "SyncState",
-    "TempPoint",
-    "UploadOutcome",
-    "UploadReport",
-    "apply_upload",
-    "decode_text",
-    "make_point",
-    "parse_float",
-    "parse_id_list",
-    "parse_int",
-    "parse_point_id",
-    "parse_points_csv",
-    "parse_text",
-    "parse_tool",
-    "point_from_fields",
-    "point_from_pose",
-    "points_to_csv",
-    "tool_text",
-    "upload_points",
-    "with_field",
 ]

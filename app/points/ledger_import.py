@@ -1,7 +1,7 @@
 """Importing a parsed point list into the ledger: modes, the report, the merge rule.
 
 :meth:`app.points.ledger.PointLedger.import_points` uses :func:`merge_import` and then swaps
-its list; the names here are re-exported by :mod:`app.points.ledger` for older imports.
+its list.
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ nothing else) and leave the state alone. A loaded file never says ``ON_CONTROLLE
 cannot know what a controller holds.
 
 Values from files and editors go through the ``parse_*`` functions of
-:mod:`app.points.fields` (re-exported here), which refuse with a :class:`FieldError` naming the
+:mod:`app.points.fields`, which refuse with a :class:`FieldError` naming the
 field and quote at most :data:`QUOTE_CHARS` characters of a bad value (:func:`shown`).
 """
 
@@ -29,62 +29,39 @@ from app.errors import InvalidInput, Reason
 from app.models import Pose
 from app.points.fields import (
     DEFAULT_LIMITS,
-    INT_DIGITS_MAX,
     NAME_MAX_CHARS,
     NOTE_MAX_CHARS,
-    QUOTE_CHARS,
     TOOL_MAX,
     FieldError,
-    OversizedNumber,
     PointLimits,
     has_surrogates,
     parse_float,
-    parse_int,
     parse_point_id,
     parse_text,
     parse_tool,
-    shown,
-    tool_text,
 )
 from app.protocol.enums import QT_TRANSLATE_NOOP
 from app.protocol.registers import TOOL_NONE
 
 _POSE32 = struct.Struct("<6f")
 
-__all__ = [  # the field parsing lives in app.points.fields; re-exported for older imports
+__all__ = [
     "CONTROLLER_FIELDS",
     "CSV_COLUMNS",
     "CSV_REQUIRED",
-    "DEFAULT_LIMITS",
     "EXT_FIELDS",
-    "INT_DIGITS_MAX",
-    "NAME_MAX_CHARS",
-    "NOTE_MAX_CHARS",
     "POINT_FIELDS",
     "POSE_FIELDS",
-    "QUOTE_CHARS",
     "SYNC_STATE_TEXT",
-    "TOOL_MAX",
     "ZERO_EXT",
-    "FieldError",
     "FileFormatError",
-    "OversizedNumber",
-    "PointLimits",
     "SyncState",
     "TempPoint",
     "fast_point_from_fields",
-    "has_surrogates",
     "is_valid_point",
     "make_point",
-    "parse_float",
-    "parse_int",
-    "parse_point_id",
-    "parse_text",
-    "parse_tool",
     "point_from_fields",
     "point_from_pose",
-    "shown",
-    "tool_text",
     "with_field",
 ]
 

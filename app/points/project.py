@@ -60,50 +60,25 @@ from app.plan.segments import (
     validate_loops,
     validate_plan_name,
 )
-from app.points.atomic import MAX_FILE_BYTES, atomic_write_bytes, read_limited
+from app.points.atomic import atomic_write_bytes, read_limited
 from app.points.csv_io import decode_text, parse_points_csv, points_to_csv
+from app.points.fields import DEFAULT_LIMITS, FieldError, OversizedNumber, PointLimits, has_surrogates, shown
 from app.points.ledger import PointLedger
-from app.points.point import (
-    DEFAULT_LIMITS,
-    FieldError,
-    FileFormatError,
-    OversizedNumber,
-    PointLimits,
-    SyncState,
-    TempPoint,
-    fast_point_from_fields,
-    has_surrogates,
-    point_from_fields,
-    shown,
-)
-from app.points.project_model import HISTORY_TEXT_MAX, Project, UploadRecord, now_iso
+from app.points.point import FileFormatError, SyncState, TempPoint, fast_point_from_fields, point_from_fields
+from app.points.project_model import HISTORY_TEXT_MAX, LastUpload, Project, now_iso
 from app.points.project_write import (
     FORMAT_NAME,
     FORMAT_VERSION,
-    ProjectTooLarge,
     project_bytes,
-    project_to_dict,
-    project_to_json,
 )
 
 PROJECT_SUFFIX = ".teachpad.json"
 
 __all__ = [
-    "FORMAT_NAME",
-    "FORMAT_VERSION",
-    "MAX_FILE_BYTES",
     "PROJECT_SUFFIX",
-    "FileFormatError",
-    "Project",
-    "ProjectTooLarge",
-    "UploadRecord",
-    "atomic_write_bytes",
     "load_project",
     "parse_project",
-    "project_bytes",
     "project_from_dict",
-    "project_to_dict",
-    "project_to_json",
     "read_points_csv",
     "save_project",
     "write_points_csv",
@@ -254,13 +229,11 @@ def _checked_document(data: object, *, scan_text: bool) -> dict[str, Any]:
     return doc
 
 
-def _points_from(
-    raw_points: list[Any], limits: PointLimits
-) -> tuple[list[TempPoint], dict[int, UploadRecord]]:
+def _points_from(raw_points: list[Any], limits: PointLimits) -> tuple[list[TempPoint], dict[int, LastUpload]]:
     """The file's points and their upload history. The fast path takes a well-formed point
     whole; anything else goes the careful way, whose refusal says where and what."""
     points: list[TempPoint] = []
-    history: dict[int, UploadRecord] = {}
+    history: dict[int, LastUpload] = {}
     seen: dict[int, int] = {}
     unknown = SyncState.UNKNOWN
     for i, raw in enumerate(raw_points):
@@ -343,7 +316,7 @@ def _plan_from(raw: object, index: int, taken: set[str]) -> Plan:
     return Plan(plan_name, segments, loops)
 
 
-def _history_from(raw: object, index: int, point_id: int) -> UploadRecord | None:
+def _history_from(raw: object, index: int, point_id: int) -> LastUpload | None:
     if raw is None:
         return None
     where = _point_place(index, point_id)
@@ -351,7 +324,7 @@ def _history_from(raw: object, index: int, point_id: int) -> UploadRecord | None
     inner: Place = (f"{where[0]} uploaded", Reason("place_point_upload", {"index": index, "id": point_id}))
     when = _text_field(obj, "time", inner)
     endpoint = _text_field(obj, "endpoint", inner)
-    return UploadRecord(when[:HISTORY_TEXT_MAX], endpoint[:HISTORY_TEXT_MAX])
+    return LastUpload(when[:HISTORY_TEXT_MAX], endpoint[:HISTORY_TEXT_MAX])
 
 
 def _segment_from_dict(obj: Mapping[str, Any], where: Place) -> Segment:

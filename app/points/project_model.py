@@ -20,7 +20,7 @@ def now_iso() -> str:
 
 
 @dataclass(frozen=True)
-class UploadRecord:
+class LastUpload:
     """History: when this host last uploaded a point, and to which controller. Never proof that
     the controller still holds it (it may have restarted, another tool may have overwritten it)."""
 
@@ -38,8 +38,8 @@ class Project:
     description: str = ""
     created: str = field(default_factory=now_iso)
     modified: str = ""
-    #: point id -> the last upload of that point (history only; see :class:`UploadRecord`)
-    upload_history: dict[int, UploadRecord] = field(default_factory=dict)
+    #: point id -> the last upload of that point (history only; see :class:`LastUpload`)
+    upload_history: dict[int, LastUpload] = field(default_factory=dict)
     _revision: int = field(default=0, init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -63,7 +63,7 @@ class Project:
         stamp = when or now_iso()
         ids = list(point_ids)
         for point_id in ids:
-            self.upload_history[point_id] = UploadRecord(stamp, endpoint[:HISTORY_TEXT_MAX])
+            self.upload_history[point_id] = LastUpload(stamp, endpoint[:HISTORY_TEXT_MAX])
         if ids:
             self._revision += 1
 

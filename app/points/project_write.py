@@ -1,7 +1,7 @@
 """Writing the project file: the project as a JSON document and as the file's text.
 
-The format is described in :mod:`app.points.project` (which reads it and re-exports these
-names); whatever loading accepts, this writes back.
+The format is described in :mod:`app.points.project` (which reads it); whatever loading
+accepts, this writes back.
 
 Every writer works from a :class:`ProjectSnapshot`: an immutable copy taken in the thread that
 owns the project (the points, segments and upload records are frozen already, so the copy is a
@@ -21,13 +21,13 @@ from app.errors import InvalidInput
 from app.plan.segments import Segment
 from app.points import atomic
 from app.points.point import EXT_FIELDS, POSE_FIELDS, TempPoint
-from app.points.project_model import Project, UploadRecord
+from app.points.project_model import LastUpload, Project
 
 FORMAT_NAME = "teachpad-project"
 FORMAT_VERSION = 1
 
 
-def _point_to_dict(p: TempPoint, history: UploadRecord | None = None) -> dict[str, Any]:
+def _point_to_dict(p: TempPoint, history: LastUpload | None = None) -> dict[str, Any]:
     d: dict[str, Any] = {"id": p.id, "name": p.name}
     d.update(zip(POSE_FIELDS, p.xyzabc, strict=True))
     d.update(zip(EXT_FIELDS, p.ext, strict=True))
@@ -69,7 +69,7 @@ class ProjectSnapshot:
     created: str
     modified: str
     points: tuple[TempPoint, ...]
-    upload_history: Mapping[int, UploadRecord]  # a read-only copy
+    upload_history: Mapping[int, LastUpload]  # a read-only copy
     plans: tuple[PlanSnapshot, ...]
     revision: int
 

@@ -439,7 +439,6 @@ __all__ = [
     "ItemKind",
     "RegisterItem",
     "describe_registers",
-    "format_float32",
     "gv_register_name",
     "run_command_of",
 ]

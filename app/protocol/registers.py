@@ -78,6 +78,22 @@ GV_COMMAND_STATUS: Final = 291  # regs 582-583
 GV_GENERAL_FIRST: Final = 0
 GV_GENERAL_LAST: Final = 99
 
+# --- The general-purpose GVs TeachPad takes for itself (a controller restart clears them) ---------
+# Every one is named here and nowhere else.
+POSE_GVS: Final = 6  # a pose passed in GVs: X Y Z A B C
+UPLOAD_POSE_GV: Final = 0  # GV0..GV5: the pose of the point being created (case 2.2)
+UPLOAD_STAGE_GV: Final = 6  # GV6..GV11: the next point's pose, written while the previous one is created
+UPLOAD_STAGE_GV_MOVED: Final = 12  # GV12..GV17: the staging block when the restart canary is in GV6..GV11
+CANARY_GV: Final = 99  # the restart canary (registers 198-199): a random token; a restart clears it
+
+
+def stage_gv_for(canary_gv: int | None) -> int:
+    """The upload's second pose block: GV6..GV11, or GV12..GV17 when the restart canary is there."""
+    if canary_gv is not None and UPLOAD_STAGE_GV <= canary_gv < UPLOAD_STAGE_GV + POSE_GVS:
+        return UPLOAD_STAGE_GV_MOVED
+    return UPLOAD_STAGE_GV
+
+
 # --- Read blocks used by the monitor -----------------------------------------------------
 # One FC03 can read at most 125 registers.
 MAX_READ_REGISTERS: Final = 125

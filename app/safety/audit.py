@@ -35,8 +35,7 @@ in ``args.status`` when there is one), ``stopped`` or ``unknown`` (see
 but without its result line reads ``unknown``.
 
 The record format and the reader (:func:`read_records`, :func:`query`, :func:`export_csv`,
-:class:`AuditFilter`, :class:`ReadStats`) live in :mod:`app.safety.audit_read`; they are
-re-exported here.
+:class:`AuditFilter`, :class:`ReadStats`) live in :mod:`app.safety.audit_read`.
 """
 
 from __future__ import annotations
@@ -65,56 +64,28 @@ from app.protocol.codec import WordOrder
 from app.protocol.exceptions import not_carried_out
 from app.safety.audit_chain import last_line_hash, line_hash
 from app.safety.audit_read import (
-    CSV_COLUMNS,
-    FILE_RE,
-    MAX_OUTCOME_LAG,
     OUTCOME,
     RESULT,
-    UNKNOWN_DETAIL,
-    UNKNOWN_OUTCOME_DETAIL,
-    AuditFilter,
     AuditRecord,
-    ReadStats,
     Result,
     audit_file_name,
     audit_file_parts,
-    audit_files,
-    export_csv,
-    query,
-    read_records,
-    result_label,
 )
 from app.safety.location import safety_location, user_data_dir
 
 __all__ = [  # the reader's names stay importable from here (app.safety.audit_read)
-    "CSV_COLUMNS",
-    "FILE_RE",
     "FSYNC_INTERVAL",
     "KEEP_DAYS",
     "MAX_DETAIL_CHARS",
     "MAX_FILE_BYTES",
-    "MAX_OUTCOME_LAG",
     "MAX_TOTAL_BYTES",
     "MAX_VALUES_KEPT",
-    "OUTCOME",
-    "RESULT",
-    "UNKNOWN_DETAIL",
-    "UNKNOWN_OUTCOME_DETAIL",
-    "AuditFilter",
     "AuditLog",
-    "AuditRecord",
     "AuditUnavailable",
     "FsyncPolicy",
-    "ReadStats",
-    "Result",
-    "audit_files",
     "brings_to_rest",
     "default_audit_dir",
     "default_data_dir",
-    "export_csv",
-    "query",
-    "read_records",
-    "result_label",
 ]
 
 MAX_FILE_BYTES = 8 * 1024 * 1024

@@ -11,9 +11,6 @@ as ``unknown``, and so does a judged write answered but without its result line.
 not parse (a line cut short by a power cut, damage) are skipped and counted in
 :class:`ReadStats`. :func:`query` filters (:class:`AuditFilter`), :func:`export_csv` writes what
 the viewer shows.
-
-Everything here is re-exported by :mod:`app.safety.audit`, so ``from app.safety.audit import
-query`` keeps working.
 """
 
 from __future__ import annotations

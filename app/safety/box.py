@@ -3,7 +3,7 @@ and keep-out zones, with the geometry its checks need.
 
 Containment of a point or of many, the nearest face, the clearance, and chords against the box
 by the slab test (exact, so a thin box between two path samples is not missed). Used by
-:mod:`app.safety.envelope` (which re-exports it; its checks and clearance serve the jog guard)
+:mod:`app.safety.envelope` (its checks and clearance serve the jog guard)
 and the 3-D views (``edges``).
 """
 
@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from app.errors import InvalidInput
-from app.plan.segments import FloatArray
+from app.lazy_numpy import FloatArray
 
 if TYPE_CHECKING:
     import numpy as np

@@ -34,7 +34,7 @@ from typing import Any
 import app
 from app.errors import InvalidInput
 from app.points.atomic import atomic_write_bytes
-from app.safety.audit import audit_files
+from app.safety.audit_read import audit_files
 from app.safety.roles import STORE_FORMAT
 
 DEFAULT_DAYS = 7

@@ -29,9 +29,10 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from app.errors import InvalidInput, TeachPadError
+from app.lazy_numpy import FloatArray
 from app.models import Pose
 from app.plan.geometry import PointLike, segment_length, segment_path, xyz_of
-from app.plan.segments import FloatArray, Plan, Segment
+from app.plan.segments import Plan, Segment
 from app.points.ledger import PointLedger
 from app.safety.box import Box
 from app.safety.caps import MotionCaps
@@ -46,7 +47,6 @@ __all__ = [
     "AXIS_NAMES",
     "MAX_SAMPLES_PER_SEGMENT",
     "REDUCED_SPEED_DEFAULT",
-    "Box",
     "Envelope",
     "EnvelopeRefused",
     "EnvelopeViolation",

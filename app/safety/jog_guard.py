@@ -29,8 +29,8 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Protocol
 
 from app.geometry import abc_to_matrix
+from app.lazy_numpy import FloatArray
 from app.models import Pose
-from app.plan.segments import FloatArray
 from app.protocol.enums import TeachFrame
 from app.safety.envelope import (
     AXIS_NAMES,

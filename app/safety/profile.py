@@ -32,9 +32,10 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from app.errors import InvalidInput, TeachPadError
+from app.errors import InvalidInput, ProfileError
 from app.points.atomic import atomic_write_bytes, read_settings_text, versioned_document
-from app.safety.envelope import Box, Envelope
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 
 if TYPE_CHECKING:  # the robot model is read only for a fresh install
     from app.view3d.profile import RobotProfile
@@ -43,10 +44,6 @@ FORMAT = "teachpad-safety"
 VERSION = 1
 PROFILE_SUFFIX = ".safety.json"
 _MAX_BYTES = 1024 * 1024
-
-
-class ProfileError(TeachPadError):
-    """A safety profile file that cannot be used; the message names the file and the field."""
 
 
 @dataclass(frozen=True)

@@ -39,8 +39,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Literal
 
+from app.connection import ConnectionSettings
 from app.errors import TeachPadError
-from app.link.transport import ConnectionSettings
 from app.points.atomic import atomic_write_bytes, read_settings_text, versioned_document
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout

@@ -28,7 +28,8 @@ from app.models import Pose
 from app.plan.geometry import PointLike
 from app.plan.segments import Segment
 from app.points.ledger import PointLedger
-from app.safety.audit import AuditLog, Result
+from app.safety.audit import AuditLog
+from app.safety.audit_read import Result
 from app.safety.envelope import (
     Envelope,
     EnvelopeRefused,

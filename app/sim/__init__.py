@@ -7,21 +7,3 @@ input and the communication watchdog in :mod:`app.sim.guard` and :mod:`app.sim.t
 :mod:`app.sim.commands`, its motion segments in :mod:`app.sim.motion`);
 :mod:`app.sim.kinematics` holds the DH model; ``teachpad-sim`` is :func:`app.sim.cli.main`.
 """
-
-from app.sim.commands import StoredPoint
-from app.sim.config import SimConfig, SimEvent, SimSnapshot, WriteRecord
-from app.sim.motion import TraceSample
-from app.sim.robot import PROGRAMS, SimRobot
-from app.sim.server import SimController
-
-__all__ = [
-    "PROGRAMS",
-    "SimConfig",
-    "SimController",
-    "SimEvent",
-    "SimRobot",
-    "SimSnapshot",
-    "StoredPoint",
-    "TraceSample",
-    "WriteRecord",
-]

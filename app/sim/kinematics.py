@@ -23,6 +23,11 @@ Joint limits are in :data:`JOINT_LIMITS`; the home pose :data:`HOME_JOINTS` is a
 singularity, with the tool pointing down in front of the robot.
 
 Orientation A B C follows :mod:`app.geometry` (fixed X-Y-Z, ``R = Rz(C) Ry(B) Rx(A)``).
+
+Separate from TeachPad's own kinematics (:mod:`app.view3d.kinematics`) on purpose, though both
+solve a DH arm: this is the controller's model, the other TeachPad's; kept apart, the simulator
+is an independent check of ours (the 3D view's agreement with the controller, the reach checks),
+and a mistake in one is not copied into the other. Do not merge them.
 Inverse kinematics is numerical (damped least squares from a seed, usually the current
 joints); it fails (returns ``None``) when it does not converge or leaves the joint limits.
 """

@@ -24,7 +24,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Final
 
 from app.geometry import pose_to_transform
-from app.plan.checks import IssueCode, IssueKind, PlanIssue
+from app.plan.checks import IssueCode, PlanIssue
+from app.plan.issue_kind import IssueKind
 
 if TYPE_CHECKING:
     import numpy as np

@@ -3,6 +3,10 @@ arm's polyline for drawing) and numerical inverse kinematics seeded from the las
 
 IK is damped least squares (as the simulator's). Its result says how it ended: a solution
 within the limits, one that passes a joint limit, or none (the target is out of reach).
+
+Separate from the simulator's kinematics (:mod:`app.sim.kinematics`) on purpose: that one is the
+controller's model, this one TeachPad's; the simulator checks ours independently (the model's
+agreement with the controller's joints and pose, the reach checks), so neither imports the other.
 """
 
 from __future__ import annotations

@@ -18,7 +18,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Final
 
-from app.errors import InvalidInput
+from app.errors import InvalidInput, ProfileError
 from app.geometry import pose_to_transform
 
 if TYPE_CHECKING:
@@ -34,14 +34,6 @@ DEFAULT_PROFILE_FILE: Final = "sim_arm.json"
 MAX_JOINTS: Final = 12
 MAX_FILE_BYTES: Final = 1_000_000
 _QUOTE_CHARS: Final = 40  # a bad value is quoted up to this many characters
-
-
-class ProfileError(InvalidInput):
-    """A robot profile file that cannot be used; the message says where and why. Its code
-    (``profile_*``) and params say the same for the GUI's words (ui/messages_files.py): ``where``
-    the field (``joint``, 1-based, and ``key``), ``file`` the file when it came from one."""
-
-    code = "profile_invalid"
 
 
 @dataclass(frozen=True)

@@ -24,10 +24,12 @@ from typing import TYPE_CHECKING, Final
 
 from app.geometry import pose_to_transform
 from app.models import Pose
-from app.plan.checks import IssueCode, IssueKind, PlanIssue
+from app.plan.checks import IssueCode, PlanIssue
 from app.plan.geometry import PointLike, plan_path
+from app.plan.issue_kind import IssueKind
 from app.plan.segments import Plan
-from app.points.ledger import PointLedger, TempPoint
+from app.points.ledger import PointLedger
+from app.points.point import TempPoint
 from app.view3d.kinematics import ArmModel, Reach
 from app.view3d.path import sample_poses, segment_rotations, start_of
 

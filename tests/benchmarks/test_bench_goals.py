@@ -45,7 +45,7 @@ def test_goals_judge_present_figures_and_list_missing_ones() -> None:
 
 
 def test_busy_neighbour_ends_its_processes() -> None:
-    from benchmarks.gui import BusyNeighbour
+    from benchmarks.gui_stalls import BusyNeighbour
 
     with BusyNeighbour(1) as busy:
         children = list(busy._children)

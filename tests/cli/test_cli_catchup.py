@@ -15,7 +15,8 @@ from app.cli.exit_codes import ExitCode
 from app.cli.main import build_parser, main, settings_from_args
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
-from app.safety.audit import AuditLog, Result
+from app.safety.audit import AuditLog
+from app.safety.audit_read import Result
 from app.safety.register_profile import RegisterProfile, profile_to_json
 from app.view3d.profile import default_profile, profile_to_dict
 

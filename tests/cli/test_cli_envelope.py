@@ -12,8 +12,10 @@ import pytest
 
 from app.cli.exit_codes import ExitCode
 from app.cli.main import main
-from app.safety.audit import Result, default_audit_dir, query
-from app.safety.envelope import Box, Envelope
+from app.safety.audit import default_audit_dir
+from app.safety.audit_read import Result, query
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 from tests.cli.conftest import save_envelope
 from tests.cli.test_cli_points import SAMPLES
 

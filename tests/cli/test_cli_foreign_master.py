@@ -11,7 +11,8 @@ import pytest
 
 from app.cli.exit_codes import ExitCode
 from app.cli.main import main
-from app.link.client import ConnectionSettings, RobotClient
+from app.connection import ConnectionSettings
+from app.link.client import RobotClient
 from app.safety.audit import default_audit_dir
 from tests.waits import join
 

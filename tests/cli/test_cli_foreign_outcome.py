@@ -17,7 +17,7 @@ from app import timing
 from app.cli.exit_codes import ExitCode
 from app.cli.main import main
 from app.protocol import registers
-from app.safety.audit import Result, query
+from app.safety.audit_read import Result, query
 from tests.waits import join
 
 UNKNOWN_WORDS = "sent; the outcome is unknown \u2014 check the robot before sending it again"

@@ -19,7 +19,7 @@ from pymodbus.constants import ExcCodes
 from app import timing
 from app.cli.exit_codes import ExitCode
 from app.cli.main import main
-from app.link.client import StepFrame
+from app.link.types import StepFrame
 from app.protocol import registers
 from app.sim.config import WriteRecord
 from tests.ui.pendant_support import jogging, ratio_writes

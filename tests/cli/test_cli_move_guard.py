@@ -13,7 +13,8 @@ import pytest
 
 from app.cli.exit_codes import ExitCode
 from app.points.point import make_point
-from app.points.project import Project, save_project
+from app.points.project import save_project
+from app.points.project_model import Project
 from app.protocol.enums import RunCommand
 from app.protocol.registers import REG_RUN_COMMAND
 from tests.cli.test_cli import one_line_error, run

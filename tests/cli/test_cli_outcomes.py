@@ -17,7 +17,7 @@ from app.cli.exit_codes import ExitCode
 from app.cli.main import main
 from app.protocol import registers
 from app.protocol.enums import Alarm, ProgramState
-from app.safety.audit import AuditRecord, Result, query, result_label
+from app.safety.audit_read import AuditRecord, Result, query, result_label
 
 SCAN = 0.02
 UNKNOWN_WORDS = "sent; the outcome is unknown \u2014 check the robot before sending it again"

@@ -12,9 +12,9 @@ import pytest
 from app.cli import points as cli_points
 from app.cli import run_plan
 from app.cli.context import CliContext
+from app.connection import ConnectionSettings
 from app.errors import CommandRefused, LinkError
-from app.link.client import ConnectionSettings
-from app.points.ledger import SyncState
+from app.points.point import SyncState
 from app.points.project import load_project
 from app.protocol.enums import CommandKind, CommandStatus
 from tests.fakes import FakeClient
@@ -311,6 +311,7 @@ def test_through_the_main_cli(
 ) -> None:
     """app/cli/main.py registers this module and calls handler(ctx)."""
     from app.cli import main as main_cli
+    from app.cli.context import CliContext
 
     assert main_cli.main(["points", "list", str(demo)]) == 0
     assert "8 point(s), 2 plan(s)" in capsys.readouterr().out
@@ -318,7 +319,7 @@ def test_through_the_main_cli(
     assert "check only" in capsys.readouterr().out
 
     fake = FakeClient()
-    monkeypatch.setattr(main_cli.CliContext, "client", property(lambda self: fake))
+    monkeypatch.setattr(CliContext, "client", property(lambda self: fake))
     assert main_cli.main(["run", str(demo), "--plan", "circle", "--upload"]) == 0
     assert len(fake.moves) == 4 and len(fake.creates) == 5 + 6
     assert not fake.closed  # the context owns the client (it closes its own, real one)

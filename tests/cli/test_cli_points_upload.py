@@ -12,10 +12,9 @@ import pytest
 from pymodbus.constants import ExcCodes
 
 from app.cli.exit_codes import ExitCode
-from app.link.upload import UPLOAD_POSE_GV, stage_gv_for
-from app.points.guard import CANARY_GV
 from app.points.project import load_project
 from app.protocol import registers
+from app.protocol.registers import CANARY_GV, UPLOAD_POSE_GV, stage_gv_for
 from tests.cli.ctrl_c import interrupt_cli
 from tests.cli.test_cli import SCAN, run
 

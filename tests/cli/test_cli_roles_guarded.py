@@ -11,7 +11,7 @@ import pytest
 
 from app.cli.exit_codes import ExitCode
 from app.cli.main import main
-from app.safety.audit import Result, query
+from app.safety.audit_read import Result, query
 from app.safety.roles import Role, RoleStore
 
 ADMIN = "admin-Pa55"

@@ -12,7 +12,8 @@ import pytest
 from app.cli.exit_codes import ExitCode
 from app.cli.main import main
 from app.protocol import registers
-from app.safety.audit import Result, default_audit_dir, query
+from app.safety.audit import default_audit_dir
+from app.safety.audit_read import Result, query
 from app.safety.roles import Role, RoleStore, default_store_path
 
 ADMIN = "admin-Pa55"

@@ -15,7 +15,8 @@ from app.cli.exit_codes import ExitCode
 from app.cli.main import main
 from app.points.project import PROJECT_SUFFIX
 from app.protocol import registers
-from app.safety.audit import AuditLog, FsyncPolicy, Result
+from app.safety.audit import AuditLog, FsyncPolicy
+from app.safety.audit_read import Result
 
 SCAN = 0.02
 

@@ -17,14 +17,13 @@ import pytest
 from pymodbus.constants import ExcCodes
 
 from app.cli.exit_codes import ExitCode
-from app.link.upload import stage_gv_for
 from app.points import atomic
 from app.points import project as project_module
-from app.points.guard import CANARY_GV
 from app.points.project import load_project
 from app.points.upload_record import load_record, record_path
 from app.protocol import registers
 from app.protocol.codec import registers_to_float
+from app.protocol.registers import CANARY_GV, stage_gv_for
 from tests.cli.ctrl_c import ROOT, ctrl_c_child, interrupt_cli, untraced_env
 from tests.cli.test_cli import run
 from tests.waits import CHILD_TIMEOUT, kill_child

@@ -25,7 +25,10 @@ from app.cli import controller, run_plan
 from app.cli.context import CliContext, sigint_deferred, wait_motion
 from app.cli.exit_codes import ExitCode
 from app.cli.main import build_parser
-from app.link.client import ConnectionSettings, RobotClient, StepFrame, TrafficRecord
+from app.connection import ConnectionSettings
+from app.link.client import RobotClient
+from app.link.transport import TrafficRecord
+from app.link.types import StepFrame
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import ProgramState

@@ -122,6 +122,7 @@ def _error_classes() -> list[type[errors.TeachPadError]]:
 def test_every_typed_error_maps_to_one_code() -> None:
     expected = {
         errors.InvalidInput: ExitCode.USAGE,
+        errors.ProfileError: ExitCode.USAGE,  # a robot or safety profile that cannot be used
         errors.LinkError: ExitCode.LINK,
         errors.ResponseTimeout: ExitCode.LINK,
         errors.MalformedResponse: ExitCode.LINK,

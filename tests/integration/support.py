@@ -15,7 +15,9 @@ from typing import Any
 import numpy as np
 
 from app.link.client import RobotClient
-from app.points.ledger import PointLedger, apply_upload, make_point, upload_points
+from app.points.ledger import PointLedger
+from app.points.point import make_point
+from app.points.upload import apply_upload, upload_points
 from app.protocol import registers
 from app.protocol.enums import RunCommand
 

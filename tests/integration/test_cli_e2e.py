@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 
 from app.cli import main as cli
-from app.points.ledger import SyncState
+from app.points.point import SyncState
 from app.points.project import load_project
 from tests.integration.support import assert_pose_at, move_commands
 

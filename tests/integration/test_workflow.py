@@ -14,12 +14,14 @@ from typing import Any
 import numpy as np
 
 from app.errors import CommandRefused, CommandStopped, CommandTimeout
-from app.link.client import RobotClient, StepFrame
+from app.link.client import RobotClient
+from app.link.types import StepFrame
 from app.plan.checks import check_plan, has_errors, ids_needing_upload
 from app.plan.geometry import arc_geometry, plan_path
 from app.plan.runner import PlanRunner, RunEvent, RunProgress, RunState
 from app.plan.segments import Plan, Segment
-from app.points.ledger import PointLedger, SyncState, point_from_pose
+from app.points.ledger import PointLedger
+from app.points.point import SyncState, point_from_pose
 from app.protocol import registers
 from app.protocol.enums import ProgramState
 from tests.integration.support import (

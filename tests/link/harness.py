@@ -6,14 +6,16 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
+from app.connection import ConnectionSettings
 from app.errors import LinkError, Reason
 from app.link.capture import TrafficCapture
-from app.link.client import ConnectionSettings, RobotClient, TrafficRecord
+from app.link.client import RobotClient
 from app.link.jog import JogMachine
 from app.link.motion import MotionTracker
 from app.link.poller import Poller
 from app.link.stats import LinkStats
 from app.link.supervisor import LinkSupervisor
+from app.link.transport import TrafficRecord
 from app.link.types import ConnectionState, LinkState, UnconfirmedHalt, WorkerError
 from app.link.upload import Uploader
 from app.models import CommandResult, ControllerStatus, Pose

@@ -16,7 +16,8 @@ from app.link.ops import CreatePoint, Stop
 from app.link.robot_link import RobotLink
 from app.link.types import WorkerError
 from app.protocol import registers
-from app.safety.audit import AuditLog, AuditRecord
+from app.safety.audit import AuditLog
+from app.safety.audit_read import AuditRecord
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,

@@ -5,8 +5,8 @@ from __future__ import annotations
 from typing import Any
 
 from app.link.capture import LinkStatsReporter, RttMeter, TrafficCapture
-from app.link.client import TrafficRecord
 from app.link.stats import LinkStats
+from app.link.transport import TrafficRecord
 
 
 def test_rtt_is_the_mean_per_period_and_reported_on_change() -> None:

@@ -7,10 +7,10 @@ from typing import Any
 
 import pytest
 
+from app.connection import ConnectionSettings
 from app.errors import InvalidInput, WriteBlocked
 from app.link.client import RobotClient
 from app.link.register_client import RegisterClient
-from app.link.transport import ConnectionSettings
 from app.protocol import registers
 from app.protocol.enums import ControllerMode
 

@@ -10,11 +10,13 @@ from typing import Any
 import pytest
 
 from app.errors import ManualModeRefused, ReducedSpeedRefused
-from app.link.client import RobotClient, StepFrame
+from app.link.client import RobotClient
+from app.link.types import StepFrame
 from app.protocol import registers
 from app.protocol.codec import WordOrder, registers_to_float
 from app.protocol.enums import TeachFrame, WorkMode
-from app.safety.audit import AuditLog, query
+from app.safety.audit import AuditLog
+from app.safety.audit_read import query
 from app.safety.caps import MotionCaps
 
 MakeClient = Any

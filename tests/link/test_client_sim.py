@@ -24,7 +24,9 @@ from app.errors import (
     ResponseTimeout,
     WriteBlocked,
 )
-from app.link.client import RobotClient, StepFrame, TrafficRecord
+from app.link.client import RobotClient
+from app.link.transport import TrafficRecord
+from app.link.types import StepFrame
 from app.protocol.codec import WordOrder, decode_floats
 from app.protocol.enums import (
     Alarm,
@@ -678,7 +680,7 @@ def test_client_in_a_thread_while_another_reads(scan_sim: Any, make_client: Make
 
 
 def test_clients_are_context_managers(sim: Any) -> None:
-    from app.link.client import ConnectionSettings
+    from app.connection import ConnectionSettings
 
     with RobotClient(ConnectionSettings(port=sim.port)) as c:
         assert c.connected
@@ -699,7 +701,7 @@ def test_late_answer_is_not_taken_for_the_next_request(sim: Any, make_client: Ma
 
 
 def test_settings_are_checked() -> None:
-    from app.link.client import ConnectionSettings
+    from app.connection import ConnectionSettings
 
     for bad in (
         {"port": 0},

@@ -15,9 +15,11 @@ import pytest
 
 from app.cli import main as cli
 from app.errors import ModbusExceptionError, WriteBlocked
-from app.link.client import StepFrame
-from app.points.ledger import PointLedger, SyncState, make_point
-from app.points.project import Project, save_project
+from app.link.types import StepFrame
+from app.points.ledger import PointLedger
+from app.points.point import SyncState, make_point
+from app.points.project import save_project
+from app.points.project_model import Project
 from app.protocol.enums import STATUS_SENTINEL, CreatePointStatus, TeachFrame
 
 GV291_REG = 582

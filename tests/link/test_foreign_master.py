@@ -14,14 +14,15 @@ from typing import Any
 import pytest
 
 from app import timing
+from app.connection import ConnectionSettings
 from app.errors import ForeignMasterRefused, OutcomeUnknown
-from app.link.client import ConnectionSettings, RobotClient, StepFrame
-from app.link.types import ControllerIdentity
+from app.link.client import RobotClient
+from app.link.types import ControllerIdentity, StepFrame
+from app.protocol.registers import CANARY_GV
 from app.safety.audit import AuditLog
 from tests.link.harness import PartsHost
 from tests.waits import join
 
-CANARY_GV = 99
 CANARY_REG = 2 * CANARY_GV
 
 

@@ -8,8 +8,8 @@ from typing import Any
 import pytest
 from PySide6.QtWidgets import QDialogButtonBox
 
+from app.connection import ConnectionSettings
 from app.link.robot_link import RobotLink
-from app.link.transport import ConnectionSettings
 from app.link.types import LinkState
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,

@@ -12,6 +12,7 @@ import pytest
 from pymodbus.framer import FramerSocket
 from pymodbus.pdu import DecodePDU
 
+from app.connection import ConnectionSettings
 from app.link.frames import (
     FC_WRITE_MULTIPLE,
     answer_registers,
@@ -21,7 +22,6 @@ from app.link.frames import (
     write_single_request,
 )
 from app.link.streams import TcpStream
-from app.link.transport import ConnectionSettings
 from app.protocol.codec import (
     WordOrder,
     check_float32,

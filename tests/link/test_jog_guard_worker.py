@@ -15,7 +15,8 @@ from app.link.robot_link import RobotLink
 from app.link.types import JogRequest, WorkerError
 from app.protocol.enums import TeachFrame
 from app.safety.audit import AuditLog, FsyncPolicy
-from app.safety.envelope import Box, Envelope, ViolationCode
+from app.safety.box import Box
+from app.safety.envelope import Envelope, ViolationCode
 from app.safety.jog_guard import JogGuard
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,

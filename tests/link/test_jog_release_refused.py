@@ -16,14 +16,14 @@ import pytest
 from pymodbus.constants import ExcCodes
 
 from app import timing
-from app.link.client import StepFrame
 from app.link.ops import JogPress, JogRelease, Step, Stop
 from app.link.robot_link import RobotLink
-from app.link.types import HaltKind, JogRequest, UnconfirmedHalt
+from app.link.types import HaltKind, JogRequest, StepFrame, UnconfirmedHalt
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import TeachFrame
-from app.safety.envelope import Box, Envelope
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 from app.safety.jog_guard import JogGuard
 from app.sim.config import WriteRecord
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures

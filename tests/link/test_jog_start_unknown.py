@@ -19,7 +19,8 @@ from app.link.robot_link import RobotLink
 from app.link.types import JogRequest, WorkerError
 from app.protocol import registers
 from app.protocol.enums import TeachFrame
-from app.safety.envelope import Box, Envelope
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 from app.safety.jog_guard import JogGuard
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,

@@ -9,7 +9,8 @@ from typing import Any
 from app.link.ops import Stop
 from app.link.robot_link import RobotLink
 from app.protocol import registers
-from app.safety.audit import AuditLog, query
+from app.safety.audit import AuditLog
+from app.safety.audit_read import query
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,

@@ -15,10 +15,10 @@ import pytest
 from pymodbus.constants import ExcCodes
 
 from app import timing
-from app.link.client import StepFrame
 from app.link.ops import GoZero, RunProgram, Step
 from app.link.outcome import Outcome, outcome_of
 from app.link.robot_link import RobotLink
+from app.link.types import StepFrame
 from app.models import CommandResult
 from app.protocol import registers
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures

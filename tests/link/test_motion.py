@@ -126,9 +126,9 @@ def test_take_forgets_the_active_motion() -> None:
 
 def test_motion_commands_start_without_waiting_and_refuse_a_second_motion(sim: object) -> None:
     from app.errors import InvalidInput as Refused
-    from app.link.client import StepFrame
     from app.link.motion import MotionCommands
     from app.link.ops import CreatePoint, GoZero, Step
+    from app.link.types import StepFrame
     from tests.link.harness import PartsHost
 
     host = PartsHost()

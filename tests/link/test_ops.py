@@ -11,6 +11,7 @@ import pytest
 
 from app.link import ops
 from app.link.jobs import Job, JobQueue
+from app.link.link_port import LinkPort
 from app.link.ops import (
     JOG_PRESS,
     JOG_RATIO,
@@ -31,7 +32,7 @@ from app.link.ops import (
     Stop,
     UploadPoints,
 )
-from app.link.robot_link import LinkPort, RobotLink
+from app.link.robot_link import RobotLink
 from app.link.types import JogRequest, StepFrame
 from app.models import CommandResult
 from app.protocol.enums import TeachFrame, WorkMode

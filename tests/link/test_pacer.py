@@ -10,7 +10,8 @@ import itertools
 import pytest
 
 from app import timing
-from app.link.tracker import CommandTracker, ResultPacer
+from app.link.pacer import ResultPacer
+from app.link.tracker import CommandTracker
 from app.protocol.enums import RunCommand
 from tests.link.test_tracker import DONE, HOME, st
 

@@ -7,9 +7,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from app.link.client import StepFrame
 from app.link.ops import Step
 from app.link.robot_link import RobotLink
+from app.link.types import StepFrame
 from app.models import CommandResult
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,

@@ -7,8 +7,8 @@ from typing import Any
 import pytest
 
 from app import timing
-from app.link.client import RobotClient, StepFrame
-from app.link.types import LinkState, Operation
+from app.link.client import RobotClient
+from app.link.types import LinkState, Operation, StepFrame
 from app.models import Pose
 from tests.link.harness import PartsHost
 

@@ -11,12 +11,12 @@ from typing import Any
 
 import pytest
 
-from app.link.client import StepFrame
+from app.link.link_port import Pending, RequestRouter
 from app.link.ops import CreatePoint, MoveToPoint, Pause, Step
-from app.link.robot_link import Pending, RequestRouter, RobotLink
+from app.link.robot_link import RobotLink
 from app.link.state import RobotState
 from app.link.stats import LinkStats
-from app.link.types import ConnectionState, LinkState, WorkerError
+from app.link.types import ConnectionState, LinkState, StepFrame, WorkerError
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import Alarm, ControllerMode, ProgramState
 from tests.ui.fake_link import FakeLink

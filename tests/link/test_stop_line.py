@@ -10,8 +10,8 @@ from typing import Any, ClassVar
 
 import pytest
 
+from app.connection import ConnectionSettings
 from app.link import stop_line as stop_line_module
-from app.link.client import ConnectionSettings
 from app.link.ops import LinkOp, Stop
 from app.link.robot_link import RobotLink
 from app.link.stop_line import StopLine

@@ -25,7 +25,7 @@ def test_unreachable_backs_off(sim_factory: Any, monkeypatch: pytest.MonkeyPatch
     port = sim.port
     sim.stop()
     parts = PartsHost()
-    from app.link.client import ConnectionSettings
+    from app.connection import ConnectionSettings
 
     parts.supervisor.connect_to(ConnectionSettings(host="127.0.0.1", port=port, timeout=0.2))
     for _ in range(2):

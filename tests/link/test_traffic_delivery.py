@@ -15,9 +15,9 @@ import pytest
 from PySide6.QtCore import QCoreApplication, Qt
 
 from app import timing
-from app.link.client import TrafficRecord
 from app.link.ops import CreatePoint, JogPress
 from app.link.robot_link import RobotLink
+from app.link.transport import TrafficRecord
 from app.link.types import JogRequest, LinkState
 from app.models import CommandResult
 from app.protocol import registers

@@ -27,17 +27,11 @@ from app.errors import (
 from app.link.jobs import Job, JobQueue
 from app.link.ops import CancelUpload, JogRelease, Stop, UploadPoints
 from app.link.types import LinkState
-from app.link.upload import (
-    UPLOAD_STAGE_GV,
-    RawItem,
-    Uploader,
-    check_upload_items,
-    group_by_tool,
-    stage_gv_for,
-)
+from app.link.upload import RawItem, Uploader, check_upload_items, group_by_tool
 from app.models import LINK_FAILURE_CODES, CommandResult
 from app.protocol import registers
 from app.protocol.enums import CommandKind, CommandStatus, RunCommand
+from app.protocol.registers import UPLOAD_STAGE_GV, stage_gv_for
 from tests.link.harness import PartsHost
 
 POSE = (100.0, 0.0, 300.0, 180.0, 0.0, 0.0)
@@ -45,7 +39,7 @@ POSE = (100.0, 0.0, 300.0, 180.0, 0.0, 0.0)
 
 def test_grouping_keeps_tools_in_first_seen_order() -> None:
     items = [(1, POSE, 5), (2, POSE, 3), (3, POSE, 5)]
-    assert [pid for pid, _, _ in group_by_tool(items)] == [1, 3, 2]
+    assert [pid for pid, _, _ in group_by_tool(items, lambda item: item[2])] == [1, 3, 2]
 
 
 def test_every_item_is_checked_and_bad_values_are_quoted_short(sim: Any, make_client: Any) -> None:

@@ -11,8 +11,6 @@ from pymodbus.constants import ExcCodes
 
 from app import timing
 from app.errors import Reason
-from app.link import worker as worker_module
-from app.link.client import StepFrame
 from app.link.ops import (
     CancelUpload,
     CreatePoint,
@@ -30,11 +28,12 @@ from app.link.ops import (
     UploadPoints,
 )
 from app.link.robot_link import RobotLink
-from app.link.types import JogRequest, LinkState, Operation, WorkerError
+from app.link.types import JogRequest, LinkState, Operation, StepFrame, WorkerError
 from app.link.worker import RobotWorker
 from app.models import CommandResult, Pose
 from app.protocol import registers
 from app.protocol.enums import Alarm, ControllerMode, ProgramState, TeachFrame, WorkMode
+from app.protocol.registers import CANARY_GV
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     canary_link_fixture,
@@ -577,7 +576,7 @@ def test_restart_canary_detects_a_restart_under_a_live_link(
     reconnected: list[bool] = []
     link.controllerReconnected.connect(lambda: reconnected.append(True))
     connect(qtbot, link, sim)
-    assert worker_module.DEFAULT_CANARY_GV == 99
+    assert CANARY_GV == 99  # the default
     assert len(gv_writes(sim, 99)) == 1
     token = gv_writes(sim, 99)[0][1]
     assert token != 0.0 and [w.address for w in sim.writes] == [198]

@@ -12,12 +12,11 @@ from PySide6.QtCore import QObject, QThread, Signal
 
 from app import timing
 from app.link import robot_link as robot_link_module
-from app.link.client import StepFrame
 from app.link.ops import JogPress, Step
 from app.link.robot_link import RobotLink
 from app.link.state import PollUpdate
 from app.link.stats import LinkStats
-from app.link.types import ConnectionState, JogRequest, LinkState
+from app.link.types import ConnectionState, JogRequest, LinkState, StepFrame
 from app.link.worker import RobotWorker
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.enums import TeachFrame

@@ -181,7 +181,7 @@ def test_a_monitor_only_stop_after_a_disconnect_sends_nothing(qtbot: Any, sim: A
 
 
 def test_motions_in_flight_until_their_outcome(qtbot: Any, sim: Any, link: RobotLink) -> None:
-    from app.link.client import StepFrame
+    from app.link.types import StepFrame
 
     connect(qtbot, link, sim)
     assert not link.motions_in_flight

@@ -10,7 +10,8 @@ import pytest
 from app.link.ops import UploadPoints
 from app.link.robot_link import RobotLink
 from app.models import CommandResult
-from app.points.ledger import PointLedger, SyncState, make_point
+from app.points.ledger import PointLedger
+from app.points.point import SyncState, make_point
 from app.points.upload import UploadOutcome, UploadReport, apply_upload
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
@@ -61,7 +62,7 @@ def test_upload_carries_unconfirmed(
 
 def test_every_sync_state_has_a_colour_text_and_tooltip(qapp: Any) -> None:
     from ui.models.point_columns import SYNC_COLOURS, sync_text
-    from ui.panels.view3d_panel import SYNC_COLORS
+    from ui.panels.view3d_scene import SYNC_COLORS
 
     assert set(SYNC_COLOURS) == set(SyncState) == set(SYNC_COLORS)
     assert sync_text(SyncState.UNCONFIRMED) == "on controller, unconfirmed"

@@ -10,14 +10,7 @@ import pytest
 
 from app.errors import InvalidInput
 from app.models import Pose
-from app.plan.checks import (
-    IssueCode,
-    IssueKind,
-    PlanLimits,
-    check_plan,
-    has_errors,
-    ids_needing_upload,
-)
+from app.plan.checks import IssueCode, PlanLimits, check_plan, has_errors, ids_needing_upload
 from app.plan.estimates import (
     SEGMENT_OVERHEAD_S,
     estimate_plan,
@@ -26,8 +19,11 @@ from app.plan.estimates import (
     segment_timeouts,
 )
 from app.plan.geometry import arc_geometry, plan_path, segment_length, segment_path
+from app.plan.issue_kind import IssueKind
 from app.plan.segments import Plan, Segment, SegmentKind
-from app.points.ledger import FieldError, PointLedger, SyncState, make_point
+from app.points.fields import FieldError
+from app.points.ledger import PointLedger
+from app.points.point import SyncState, make_point
 
 ON = SyncState.ON_CONTROLLER
 HOME = (400.0, 0.0, 450.0)

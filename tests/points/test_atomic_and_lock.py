@@ -18,7 +18,9 @@ import pytest
 from app.points import atomic
 from app.points.lock import LockOwner, ProjectLock, ProjectLocked, live_owner, lock_path
 from app.points.point import make_point
-from app.points.project import Project, load_project, project_to_json, save_project
+from app.points.project import load_project, save_project
+from app.points.project_model import Project
+from app.points.project_write import project_to_json
 from tests.waits import kill_child, read_line, wait_child
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -179,7 +181,7 @@ def test_the_cli_does_not_write_a_project_open_in_a_teachpad(
 
     from app.cli import points as cli_points
     from app.cli.context import CliContext
-    from app.link.client import ConnectionSettings
+    from app.connection import ConnectionSettings
 
     _child, project = other_teachpad
     csv_path = tmp_path / "in.csv"

@@ -15,11 +15,13 @@ import pytest
 
 from app.cli import points as cli_points
 from app.cli.context import CliContext
-from app.link.client import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.points.csv_io import parse_points_csv, points_to_csv
+from app.points.fields import QUOTE_CHARS
 from app.points.number_text import shown_value
-from app.points.point import QUOTE_CHARS, FileFormatError, TempPoint
-from app.points.project import load_project, parse_project, project_to_json, read_points_csv, save_project
+from app.points.point import FileFormatError, TempPoint
+from app.points.project import load_project, parse_project, read_points_csv, save_project
+from app.points.project_write import project_to_json
 
 MESSAGE_MAX = 400  # a refusal is a sentence or two, never the bad value itself
 BIG_LINE = 10 * 1024 * 1024

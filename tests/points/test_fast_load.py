@@ -8,17 +8,17 @@ from collections.abc import Sequence
 
 import pytest
 
+from app.points.fields import FieldError, PointLimits
 from app.points.ledger import PointLedger
 from app.points.point import (
-    FieldError,
-    PointLimits,
+    FileFormatError,
     SyncState,
     fast_point_from_fields,
     is_valid_point,
     make_point,
     point_from_fields,
 )
-from app.points.project import FileFormatError, _parse_project_exact, parse_project
+from app.points.project import _parse_project_exact, parse_project
 
 GOOD = {
     "id": 7,

@@ -13,28 +13,16 @@ import pytest
 from app.errors import InvalidInput
 from app.plan.checks import check_plan, has_errors
 from app.plan.segments import Plan, Segment
+from app.points.atomic import atomic_write_bytes
 from app.points.autosave import autosave_path, discard_autosave, find_autosave, save_autosave
-from app.points.ledger import (
-    FileFormatError,
-    ImportMode,
-    PointLedger,
-    PointLimits,
-    SyncState,
-    make_point,
-    parse_points_csv,
-    points_to_csv,
-)
-from app.points.project import (
-    Project,
-    UploadRecord,
-    atomic_write_bytes,
-    load_project,
-    parse_project,
-    project_to_json,
-    read_points_csv,
-    save_project,
-    write_points_csv,
-)
+from app.points.csv_io import parse_points_csv, points_to_csv
+from app.points.fields import PointLimits
+from app.points.ledger import PointLedger
+from app.points.ledger_import import ImportMode
+from app.points.point import FileFormatError, SyncState, make_point
+from app.points.project import load_project, parse_project, read_points_csv, save_project, write_points_csv
+from app.points.project_model import LastUpload, Project
+from app.points.project_write import project_to_json
 
 SAMPLES = Path(__file__).resolve().parents[2] / "resources" / "samples"
 HEADER = "id,name,x,y,z,a,b,c,e1,e2,e3,e4,e5,tool,note"
@@ -333,7 +321,7 @@ def test_loaded_points_are_unknown_and_upload_history_round_trips(tmp_path: Path
     save_project(project, path)
     back = load_project(path)
     assert back.upload_history == project.upload_history
-    assert back.upload_history[5] == UploadRecord("2025-02-01T10:00:00Z", "tcp 10.0.0.5:502")
+    assert back.upload_history[5] == LastUpload("2025-02-01T10:00:00Z", "tcp 10.0.0.5:502")
     assert all(p.sync is SyncState.UNKNOWN for p in back.ledger)
 
 

@@ -11,7 +11,9 @@ from app.errors import InvalidInput
 from app.plan.segments import Plan, validate_plan_name
 from app.points import project as project_module
 from app.points.point import FileFormatError
-from app.points.project import Project, parse_project, project_to_json
+from app.points.project import parse_project
+from app.points.project_model import Project
+from app.points.project_write import project_to_json
 
 MANY = 20_000
 

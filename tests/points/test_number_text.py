@@ -4,8 +4,11 @@ a CSV written so reads back as the same point on the controller."""
 
 from __future__ import annotations
 
-from app.points.ledger import ImportMode, PointLedger, SyncState, make_point, parse_points_csv, points_to_csv
+from app.points.csv_io import parse_points_csv, points_to_csv
+from app.points.ledger import PointLedger
+from app.points.ledger_import import ImportMode
 from app.points.number_text import display_text, shown_value, value_text
+from app.points.point import SyncState, make_point
 from app.protocol.codec import decode_floats, encode_floats
 
 

@@ -11,10 +11,11 @@ from typing import Any
 
 from app.plan.runner import PlanRunner, RunState
 from app.plan.segments import Plan, Segment
-from app.points.guard import CANARY_GV, PointGuard, PointMismatch
+from app.points.guard import PointGuard, PointMismatch
 from app.points.ledger import PointLedger
 from app.points.point import make_point
 from app.protocol import registers
+from app.protocol.registers import CANARY_GV
 
 MakeClient = Callable[..., Any]
 SPEED = 120.0  # mm/s: 30 mm moves of 0.25 s (a much shorter move can end between two status polls)

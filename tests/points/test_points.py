@@ -8,18 +8,11 @@ import pytest
 
 from app.errors import CommandRefused, InvalidInput, LinkError
 from app.models import Pose
-from app.points.ledger import (
-    FieldError,
-    ImportMode,
-    PointLedger,
-    PointLimits,
-    SyncState,
-    apply_upload,
-    make_point,
-    parse_id_list,
-    point_from_pose,
-    upload_points,
-)
+from app.points.fields import FieldError, PointLimits
+from app.points.ledger import PointLedger
+from app.points.ledger_import import ImportMode
+from app.points.point import SyncState, make_point, point_from_pose
+from app.points.upload import apply_upload, parse_id_list, upload_points
 from app.protocol.enums import CommandKind, CommandStatus
 from app.protocol.registers import TOOL_NONE
 from tests.fakes import FakeClient

@@ -12,6 +12,7 @@ from app.protocol.codec import WordOrder, encode_floats, float_to_registers
 from app.protocol.datetime_regs import DateTimeLayout, encode_clock
 from app.protocol.enums import Alarm, RunCommand
 from app.protocol.exceptions import MODBUS_EXCEPTION_TEXT, exception_text
+from app.protocol.float_text import format_float32
 from app.protocol.frames import FrameDecoder, decode_frame
 from app.protocol.framing import (
     FunctionCode,
@@ -20,7 +21,7 @@ from app.protocol.framing import (
     encode_response,
     encode_write_gv,
 )
-from app.protocol.naming import ItemKind, describe_registers, format_float32
+from app.protocol.naming import ItemKind, describe_registers
 from app.protocol.registers import (
     GV_EXPECTED_SPEED,
     GV_PARAM0,

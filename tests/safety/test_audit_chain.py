@@ -12,8 +12,9 @@ import pytest
 
 from app.cli.exit_codes import ExitCode
 from app.cli.main import main
-from app.safety.audit import AuditLog, FsyncPolicy, audit_files
+from app.safety.audit import AuditLog, FsyncPolicy
 from app.safety.audit_chain import verify_chain
+from app.safety.audit_read import audit_files
 
 
 def _trail(directory: Path) -> list[Path]:

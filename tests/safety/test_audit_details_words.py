@@ -14,7 +14,7 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
-from app.errors import ModbusExceptionError, ReducedSpeedRefused
+from app.errors import ModbusExceptionError, ProfileError, ReducedSpeedRefused
 from app.link.foreign import ForeignSighting, audit_sighting
 from app.protocol import registers
 from app.safety.audit import AuditLog
@@ -23,7 +23,7 @@ from app.safety.caps import MotionCaps
 from app.safety.envelope import EnvelopeViolation, ViolationCode
 from app.safety.roles import Role, RoleStore, WrongPassword
 from app.safety.session import SafetySession
-from app.view3d.profile import ProfileError, load_profile
+from app.view3d.profile import load_profile
 from tests.ui.pendant_support import app_settings_fixture, translator_fixture  # noqa: F401 - fixtures
 from tests.ui.test_messages import assert_chinese
 from ui.messages import error_text

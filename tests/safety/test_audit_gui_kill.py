@@ -23,7 +23,7 @@ from typing import Any
 
 import pytest
 
-from app.safety.audit import ReadStats, Result, audit_files, read_records
+from app.safety.audit_read import ReadStats, Result, audit_files, read_records
 from app.safety.register_profile import PROFILE_NAME, RegisterProfile, save_register_profile
 from tests.waits import wait_child
 from ui.panels.audit_viewer import AuditViewer

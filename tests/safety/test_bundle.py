@@ -11,8 +11,9 @@ import pytest
 
 from app.cli.main import main
 from app.safety.audit import AuditLog
+from app.safety.box import Box
 from app.safety.bundle import REMOVED, redact, write_support_bundle
-from app.safety.envelope import Box, Envelope
+from app.safety.envelope import Envelope
 from app.safety.profile import SafetyProfile, save_profile
 from app.safety.roles import Role, RoleStore
 

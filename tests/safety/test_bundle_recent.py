@@ -25,7 +25,6 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     translator_fixture,
     window_fixture,
 )
-from ui.controllers.safety_menu import install_safety
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
@@ -38,7 +37,7 @@ def bundle(out: Path) -> tuple[list[str], dict[str, Any], zipfile.ZipFile]:
 def test_the_bundle_has_the_traffic_the_dock_never_showed(
     qtbot: Any, sim: Any, window: Any, tmp_path: Path
 ) -> None:
-    menu = getattr(window, "safety_menu", None) or install_safety(window, scrypt_n=2**4)
+    menu = window.safety_menu
     assert not window.traffic_dock.isVisible() or window.event_dock.isVisible()  # tabbed behind
     connect(qtbot, window.link, sim, poll_timeout=1.0)
     with qtbot.waitSignal(window.link.trafficObserved, timeout=10_000):  # a poll's frames (or more)

@@ -7,12 +7,13 @@ import pytest
 
 from app.errors import InvalidInput
 from app.models import Pose
-from app.plan.checks import IssueCode, IssueKind, check_plan, has_errors
+from app.plan.checks import IssueCode, check_plan, has_errors
+from app.plan.issue_kind import IssueKind
 from app.plan.segments import Plan, Segment, SegmentKind
 from app.points.ledger import PointLedger
 from app.points.point import SyncState, make_point
+from app.safety.box import Box
 from app.safety.envelope import (
-    Box,
     Envelope,
     EnvelopeRefused,
     ViolationCode,

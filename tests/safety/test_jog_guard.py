@@ -10,7 +10,8 @@ import pytest
 from app.models import Pose
 from app.protocol import registers
 from app.protocol.enums import TeachFrame
-from app.safety.envelope import Box, Envelope, ViolationCode
+from app.safety.box import Box
+from app.safety.envelope import Envelope, ViolationCode
 from app.safety.jog_guard import (
     JOG_GUARD_EXTRA_MM,
     JOG_GUARD_WINDOW,

@@ -7,9 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from app.errors import InvalidInput
-from app.safety.envelope import Box, Envelope
-from app.safety.profile import ProfileError, SafetyProfile, load_profile, save_profile
+from app.errors import InvalidInput, ProfileError
+from app.safety.box import Box
+from app.safety.envelope import Envelope
+from app.safety.profile import SafetyProfile, load_profile, save_profile
 from app.safety.roles import (
     Action,
     IdleLock,
@@ -20,6 +21,7 @@ from app.safety.roles import (
     allowed,
     permission_reason,
 )
+from app.view3d.profile import load_profile as load_robot_profile
 
 FAST_N = 2**8  # scrypt cost for tests
 
@@ -67,6 +69,19 @@ def test_bad_profiles_are_refused_with_the_field(tmp_path: Path, mutate: object,
     path.write_text(json.dumps(doc))
     with pytest.raises(ProfileError, match=message):
         load_profile(path)
+
+
+def test_one_profile_error_for_a_safety_and_a_robot_profile(tmp_path: Path) -> None:
+    """One class (issue 22): whoever catches a profile that cannot be used catches both kinds."""
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    with pytest.raises(ProfileError) as safety:
+        load_profile(bad)
+    with pytest.raises(ProfileError) as robot:
+        load_robot_profile(bad)
+    assert type(safety.value) is type(robot.value) is ProfileError
+    assert isinstance(safety.value, InvalidInput) and safety.value.code == "invalid_input"  # said in words
+    assert robot.value.code == "profile_not_json"  # worded by the GUI from its code
 
 
 def test_bad_profile_files(tmp_path: Path) -> None:

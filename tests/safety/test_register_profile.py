@@ -11,10 +11,11 @@ from typing import Any
 
 import pytest
 
-from app.link.client import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
-from app.safety.audit import AuditLog, Result, query
+from app.safety.audit import AuditLog
+from app.safety.audit_read import Result, query
 from app.safety.register_profile import (
     RegisterProfile,
     RegisterProfileError,
@@ -36,7 +37,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     translator_fixture,
     window_fixture,
 )
-from ui.controllers.safety_menu import SafetyMenu, install_safety
+from ui.controllers.safety_menu import SafetyMenu
 from ui.dialogs.connection_dialog import ConnectionDialog
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
@@ -133,8 +134,7 @@ def test_only_the_administrator_changes_it_and_it_is_audited(tmp_path: Path) -> 
 
 @pytest.fixture(name="menu")
 def menu_fixture(window: Any) -> SafetyMenu:
-    existing = getattr(window, "safety_menu", None)
-    menu = existing if existing is not None else install_safety(window, scrypt_n=CHEAP_SCRYPT)
+    menu: SafetyMenu = window.safety_menu
     store = menu.safety.session.store
     store.scrypt_n = CHEAP_SCRYPT
     store.set_password(Role.ADMINISTRATOR, PASSWORD, by=Role.ADMINISTRATOR)

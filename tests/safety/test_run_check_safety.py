@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 
 from app.cli import points as cli_points
-from app.safety.envelope import Box, Envelope
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 from app.safety.profile import SafetyProfile, save_profile
 from tests.cli.test_cli_points import SAMPLES, Cli
 

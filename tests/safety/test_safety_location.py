@@ -14,7 +14,7 @@ import pytest
 
 from app.cli.main import main as cli_main
 from app.safety import location
-from app.safety.audit import Result, query, read_records
+from app.safety.audit_read import Result, query, read_records
 from app.safety.box import Box
 from app.safety.envelope import Envelope
 from app.safety.location import Scope, safety_location

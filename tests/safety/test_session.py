@@ -7,10 +7,12 @@ from typing import Any
 
 import pytest
 
-from app.link.client import StepFrame
+from app.link.types import StepFrame
 from app.protocol.enums import TeachFrame
-from app.safety.audit import AuditLog, Result, read_records
-from app.safety.envelope import Box, Envelope, EnvelopeRefused, ViolationCode
+from app.safety.audit import AuditLog
+from app.safety.audit_read import Result, read_records
+from app.safety.box import Box
+from app.safety.envelope import Envelope, EnvelopeRefused, ViolationCode
 from app.safety.jog_guard import JogMotion
 from app.safety.roles import Action, IdleLock, Role, RoleStore, WrongPassword
 from app.safety.session import PermissionRefused, SafetySession

@@ -15,8 +15,8 @@ from pathlib import Path
 import pytest
 
 from app.protocol.enums import Alarm
-from app.sim import SimController
 from app.sim.cli import build_parser, execute, main
+from app.sim.server import SimController
 from tests.sim.conftest import Bus, poll
 from tests.waits import CHILD_TIMEOUT, read_line
 

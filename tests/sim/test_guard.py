@@ -12,8 +12,8 @@ from typing import Any
 import pytest
 
 from app.protocol.registers import GV_PARAM0, GV_PARAM3, REG_RUN_COMMAND
-from app.sim import SimController
 from app.sim.guard import BadFrames, screen_request
+from app.sim.server import SimController
 from tests.sim.conftest import Bus
 
 MBAP_HEADER = struct.Struct(">HHHB")

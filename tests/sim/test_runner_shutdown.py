@@ -8,7 +8,8 @@ from typing import Any
 
 import pytest
 
-from app.sim import SimConfig, SimController
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 from app.sim.transport import ServerRunner
 
 

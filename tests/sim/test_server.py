@@ -28,7 +28,9 @@ from app.protocol.registers import (
     REG_STOP,
     REG_WORK_MODE,
 )
-from app.sim import SimConfig, SimController, kinematics
+from app.sim import kinematics
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 from tests.sim.conftest import Bus, poll
 
 RUN = REG_RUN_COMMAND

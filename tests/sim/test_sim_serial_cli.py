@@ -11,7 +11,8 @@ from typing import Any
 
 import pytest
 
-from app.link.client import ConnectionSettings, RobotClient
+from app.connection import ConnectionSettings
+from app.link.client import RobotClient
 from app.sim.cli import build_parser, execute
 from app.sim.guard import WATCHDOG_TIMEOUT
 from tests.link.serial.relay import PtyRelay

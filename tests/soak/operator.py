@@ -20,7 +20,7 @@ from PySide6.QtGui import QAction
 from PySide6.QtTest import QTest
 from PySide6.QtWidgets import QAbstractButton, QApplication, QMenu
 
-from app.link.transport import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.safety.roles import Role
 from ui.main_window import MainWindow
 

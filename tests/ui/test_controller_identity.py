@@ -15,13 +15,12 @@ from typing import Any
 import pytest
 
 from app import timing
-from app.link.client import ConnectionSettings, StepFrame
+from app.connection import ConnectionSettings
 from app.link.robot_link import RobotLink
-from app.link.types import LinkState
-from app.points.guard import CANARY_GV
-from app.points.ledger import SyncState
+from app.link.types import LinkState, StepFrame
+from app.points.point import SyncState
 from app.protocol.enums import RunCommand
-from app.protocol.registers import REG_RUN_COMMAND
+from app.protocol.registers import CANARY_GV, REG_RUN_COMMAND
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,

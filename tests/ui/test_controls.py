@@ -7,9 +7,8 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
-from app.link.client import StepFrame
 from app.link.ops import RunProgram, Step, Stop
-from app.link.types import WorkerError
+from app.link.types import StepFrame, WorkerError
 from app.models import CommandResult
 from app.protocol.enums import ControllerMode, ProgramMotionMode, ProgramState, WorkMode
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures

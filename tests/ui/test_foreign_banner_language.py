@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 
 from app.link.robot_link import RobotLink
-from app.points.guard import CANARY_GV
+from app.protocol.registers import CANARY_GV
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,

@@ -13,9 +13,9 @@ import pytest
 
 from app.errors import ForeignMasterRefused
 from app.link.robot_link import RobotLink
-from app.points.guard import CANARY_GV
-from app.points.ledger import SyncState
+from app.points.point import SyncState
 from app.protocol.enums import RunCommand
+from app.protocol.registers import CANARY_GV
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,

@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
-from app.link.client import StepFrame
+from app.link.types import StepFrame
 from app.models import CommandResult
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,

@@ -8,7 +8,7 @@ import pytest
 from PySide6.QtCore import QSettings
 from PySide6.QtGui import QImage
 
-from app.link.client import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.link.ops import JogPress, JogRelease, SetMode
 from app.link.types import JogRequest, LinkState
 from app.protocol.codec import WordOrder

@@ -33,7 +33,8 @@ from app.errors import (
 from app.link.tracker import CommandTracker
 from app.link.types import Operation, WorkerError
 from app.models import CommandResult, ControllerStatus
-from app.plan.checks import IssueCode, IssueKind
+from app.plan.checks import IssueCode
+from app.plan.issue_kind import IssueKind
 from app.points.point import FileFormatError
 from app.protocol.enums import (
     _STATUS_TEXT,
@@ -331,7 +332,8 @@ def _plan_issues() -> list[Any]:
     """At least one issue of every code, from the real checks (and the reach check's wording)."""
     from app.plan.checks import PlanIssue, check_plan
     from app.plan.segments import Plan, Segment, SegmentKind
-    from app.points.ledger import PointLedger, SyncState, make_point
+    from app.points.ledger import PointLedger
+    from app.points.point import SyncState, make_point
     from app.safety.envelope import Envelope, EnvelopeRefused
     from app.view3d.agreement import ModelAgreement, model_issue
     from app.view3d.kinematics import Reach
@@ -401,7 +403,7 @@ def _plan_issues() -> list[Any]:
 
 
 def test_every_plan_check_reads_in_chinese(zh: None) -> None:
-    from ui.messages import issue_line, issue_text
+    from ui.messages_plan import issue_line, issue_text
 
     issues = _plan_issues()
     assert {i.code for i in issues} == set(IssueCode), "an issue code is not covered"
@@ -434,8 +436,10 @@ def test_the_plan_checks_stay_english_for_the_cli() -> None:
 
 
 def test_the_ledgers_refusals_read_in_chinese(zh: None) -> None:
-    from app.points.ledger import EmptyImport, ImportMode, PointLedger, make_point
-    from app.points.point import PointLimits
+    from app.points.fields import PointLimits
+    from app.points.ledger import PointLedger
+    from app.points.ledger_import import EmptyImport, ImportMode
+    from app.points.point import make_point
     from ui.messages import refusal_text
 
     ledger = PointLedger([make_point(1, "一", (0, 0, 0, 0, 0, 0)), make_point(2, "二", (1, 0, 0, 0, 0, 0))])
@@ -483,7 +487,8 @@ def _without_quoted(text: str) -> str:
 
 def test_a_points_fields_and_files_refusals_read_in_chinese(zh: None) -> None:
     from app.points.csv_io import decode_text, parse_points_csv
-    from app.points.point import FieldError, FileFormatError, make_point
+    from app.points.fields import FieldError
+    from app.points.point import FileFormatError, make_point
     from ui.messages import refusal_text
 
     fields: list[Callable[[], object]] = [
@@ -715,7 +720,7 @@ def test_segment_jog_and_unreadable_file_codes_read_in_chinese(zh: None, tmp_pat
 
 def test_a_robot_model_that_disagrees_reads_in_words(zh: None) -> None:
     from app.view3d.agreement import ModelAgreement, model_issue
-    from ui.messages import issue_text
+    from ui.messages_plan import issue_text
 
     assert issue_text(model_issue(ModelAgreement("arm B", 312.4, 0.1))) == (
         "机器人模型\u201carm B\u201d与控制器的位姿相差 312 mm：可达性检查可能有误。"

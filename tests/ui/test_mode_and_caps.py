@@ -15,7 +15,7 @@ from app.link.types import WorkerError
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import WorkMode
-from app.safety.audit import query
+from app.safety.audit_read import query
 from app.safety.envelope import REDUCED_SPEED_DEFAULT
 from app.safety.profile import load_profile
 from app.view3d.profile import default_profile

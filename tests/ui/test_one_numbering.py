@@ -13,8 +13,10 @@ from PySide6.QtGui import QUndoStack
 
 from app.cli.main import main
 from app.models import Pose
-from app.points.ledger import make_point, points_to_csv, tool_text
-from app.points.project import Project
+from app.points.csv_io import points_to_csv
+from app.points.fields import tool_text
+from app.points.point import make_point
+from app.points.project_model import Project
 from app.protocol.codec import float_to_registers
 from app.protocol.enums import JOINT_AXIS_NAMES
 from app.protocol.naming import describe_registers

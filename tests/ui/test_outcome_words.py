@@ -14,15 +14,15 @@ from PySide6.QtCore import QCoreApplication, QTranslator
 
 from app import timing
 from app.errors import Reason
-from app.link.client import StepFrame
 from app.link.ops import GoZero, RunProgram, Step
 from app.link.outcome import Outcome, outcome_of
 from app.link.robot_link import RobotLink
-from app.link.types import LinkState, Operation
+from app.link.types import LinkState, Operation, StepFrame
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import Alarm, RunCommand
-from app.safety.audit import AuditLog, AuditRecord, Result, query, result_label
+from app.safety.audit import AuditLog
+from app.safety.audit_read import AuditRecord, Result, query, result_label
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,

@@ -21,7 +21,7 @@ from PySide6.QtCore import QPoint, QRect, QRectF
 from PySide6.QtGui import QTextLayout, QTextOption
 from PySide6.QtWidgets import QAbstractButton, QAbstractScrollArea, QLabel, QWidget
 
-from app.link.client import StepFrame
+from app.link.types import StepFrame
 from app.plan.segments import Plan, Segment
 from tests.ui.layout_audit import clipped_texts, overlapping_siblings
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures

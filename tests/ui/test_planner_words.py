@@ -9,7 +9,7 @@ from typing import Any
 
 import pytest
 
-from app.link.client import StepFrame
+from app.link.types import StepFrame
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import Alarm
 from app.protocol.registers import REG_RUN_COMMAND

@@ -12,10 +12,11 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
-from app.link.client import StepFrame
 from app.link.ops import GoZero
+from app.link.types import StepFrame
 from app.protocol import registers
-from app.safety.envelope import Box, Envelope
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 from tests.ui.controllers.test_gui_motion import _envelope
 from tests.ui.controllers.test_gui_roles import SAMPLE, menu_fixture  # noqa: F401 - fixture
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures

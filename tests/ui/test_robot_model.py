@@ -12,7 +12,7 @@ from typing import Any
 import pytest
 
 from app.plan.checks import IssueCode
-from app.safety.audit import query
+from app.safety.audit_read import query
 from app.safety.roles import Role
 from app.view3d.agreement import MODEL_TOLERANCE_DEG, MODEL_TOLERANCE_MM
 from app.view3d.profile import default_profile, profile_to_dict

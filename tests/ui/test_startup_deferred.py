@@ -14,7 +14,8 @@ from typing import Any
 
 import pytest
 
-from app.link.transport import ConnectionSettings, Transport
+from app.connection import ConnectionSettings
+from app.link.transport import Transport
 from app.safety.location import ENVELOPE_NAME
 from app.safety.profile import SafetyProfile, save_profile
 from app.view3d.profile import default_profile

@@ -20,8 +20,8 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
-from app.link.client import StepFrame
 from app.link.robot_link import RobotLink
+from app.link.types import StepFrame
 from app.models import CommandResult
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import RunCommand

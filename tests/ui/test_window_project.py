@@ -10,7 +10,7 @@ from typing import Any
 import pytest
 
 from app.plan.runner import RunState
-from app.points.ledger import SyncState
+from app.points.point import SyncState
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,

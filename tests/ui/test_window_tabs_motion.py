@@ -13,7 +13,7 @@ from PySide6.QtGui import QUndoStack
 from PySide6.QtWidgets import QWidget
 
 from app.link.types import StepFrame
-from app.points.project import Project
+from app.points.project_model import Project
 from app.protocol import registers
 from app.protocol.enums import Alarm, ProgramMotionMode
 from tests.ui.fake_link import FakeLink

@@ -8,9 +8,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from app.errors import ProfileError
 from app.sim import kinematics as sim_kin
 from app.view3d.kinematics import ArmModel, ArmTracker, Reach
-from app.view3d.profile import ProfileError, default_profile, load_profile, profile_to_dict
+from app.view3d.profile import default_profile, load_profile, profile_to_dict
 
 
 @pytest.fixture(name="model")

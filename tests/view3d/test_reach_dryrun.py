@@ -6,10 +6,12 @@ import numpy as np
 import pytest
 
 from app.models import Pose
-from app.plan.checks import IssueCode, IssueKind, check_plan
+from app.plan.checks import IssueCode, check_plan
 from app.plan.estimates import estimate_plan
+from app.plan.issue_kind import IssueKind
 from app.plan.segments import Plan, Segment
-from app.points.ledger import PointLedger, make_point
+from app.points.ledger import PointLedger
+from app.points.point import make_point
 from app.view3d.kinematics import ArmModel, Reach
 from app.view3d.path import DryRun
 from app.view3d.profile import default_profile

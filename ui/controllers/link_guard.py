@@ -22,9 +22,9 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QObject, Slot
 from PySide6.QtWidgets import QWidget
 
+from app.connection import ConnectionSettings
 from app.link.ops import Stop
 from app.link.robot_link import RobotLink
-from app.link.transport import ConnectionSettings
 from app.link.types import LinkState, Operation
 from app.models import Pose
 from app.protocol.enums import ProgramState

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QObject, Signal, Slot
 
 from app.alarm_history import blocks_motion
+from app.link.link_port import LinkPort
 from app.link.ops import (
     GoZero,
     JogPress,
@@ -43,7 +44,6 @@ from app.link.ops import (
     Step,
     Stop,
 )
-from app.link.robot_link import LinkPort
 from app.link.types import ConnectionState, JogRequest, StepFrame
 from app.models import ControllerStatus
 from app.protocol.enums import ProgramMotionMode, WorkMode

@@ -54,8 +54,8 @@ from PySide6.QtCore import QObject, Signal, Slot
 
 from app import timing
 from app.errors import LinkError, TeachPadError
+from app.link.link_port import LinkPort, Pending
 from app.link.ops import MoveToPoint, Pause, Resume, Stop, UploadPoints
-from app.link.robot_link import LinkPort, Pending
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult, Pose
 from app.plan.segments import Plan, Segment

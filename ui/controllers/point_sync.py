@@ -43,15 +43,16 @@ from collections.abc import Iterable
 from PySide6.QtCore import QObject, Signal, Slot
 
 from app.errors import InvalidInput
+from app.link.link_port import LinkPort, Pending
 from app.link.ops import CancelUpload, CreatePoint, MoveToPoint, Stop, UploadPoints
-from app.link.robot_link import LinkPort, Pending
 from app.link.types import ConnectionState, ControllerIdentity, WorkerError
 from app.models import CommandResult, Pose
-from app.points.ledger import SyncState, UploadReport
+from app.points.point import SyncState
+from app.points.upload import UploadReport
 from app.protocol.enums import MoveStatus
 from app.protocol.registers import TOOL_NONE
 from ui.controllers.new_point import NewPointPose, new_point_pose
-from ui.controllers.point_sync_state import UploadRun, batch_reason, pose_from_details, result_reason
+from ui.controllers.point_sync_state import UploadTally, batch_reason, pose_from_details, result_reason
 from ui.controllers.run_points import RunPoints, SegmentPoints
 from ui.messages import connection_text, error_text, refusal_text, result_text
 from ui.models.points_model import PointsModel
@@ -103,7 +104,7 @@ class PointSyncController(QObject):
         self._controller: ControllerIdentity | None = None
         self._live = False  # the link is up with self._controller (a new connection re-identifies)
         self._pending: Pending | None = None  # the outcome of the running teach / move / upload
-        self._upload: UploadRun | None = None
+        self._upload: UploadTally | None = None
         self._restore_offered = False
         self.teach_tool = TOOL_NONE
         if link is not None:
@@ -194,7 +195,7 @@ class PointSyncController(QObject):
         link = self._ready(self.tr("Upload"))
         if link is None:
             return False
-        upload = UploadRun({p.id: p for p in points}, restore)
+        upload = UploadTally({p.id: p for p in points}, restore)
         self._upload = upload
         self._set_operation("upload")
         self.uploadProgress.emit(0, len(points))

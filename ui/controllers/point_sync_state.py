@@ -2,7 +2,7 @@
 mean for it (why a result ended, the taught pose in a create-point result, why a batch ended
 early).
 
-:class:`~ui.controllers.point_sync.PointSyncController` owns one :class:`UploadRun` per upload
+:class:`~ui.controllers.point_sync.PointSyncController` owns one :class:`UploadTally` per upload
 request; nothing here talks to the link or the model, or holds a Qt object.
 """
 
@@ -11,7 +11,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from app.models import CommandResult, Pose
-from app.points.ledger import TempPoint, UploadOutcome, UploadReport
+from app.points.point import TempPoint
+from app.points.upload import UploadOutcome, UploadReport
 from ui.messages import result_text
 
 POSE_DETAIL_KEYS: tuple[str, ...] = ("x", "y", "z", "a", "b", "c")
@@ -37,8 +38,8 @@ def batch_reason(message: str) -> str:
 
 
 @dataclass
-class UploadRun:
-    """One upload request in flight: what was sent, what the link reported so far."""
+class UploadTally:
+    """One upload request as the GUI follows it: what was sent, what the link reported so far."""
 
     points: dict[int, TempPoint]  # id -> the point as sent (ledger order)
     restore: bool

@@ -42,19 +42,12 @@ from PySide6.QtGui import QAction, QKeySequence, QUndoStack
 
 from app.errors import InvalidInput
 from app.points.autosave import AutosaveDone, AutosaveWriter, autosave_path, discard_autosave, find_autosave
-from app.points.ledger import EmptyImport, ImportMode, PointLedger
+from app.points.ledger import PointLedger
+from app.points.ledger_import import EmptyImport, ImportMode
 from app.points.point import FileFormatError
-from app.points.project import (
-    PROJECT_SUFFIX,
-    Project,
-    ProjectTooLarge,
-    load_project,
-    project_bytes,
-    read_points_csv,
-    save_project,
-    write_points_csv,
-)
-from app.points.project_write import take_snapshot
+from app.points.project import PROJECT_SUFFIX, load_project, read_points_csv, save_project, write_points_csv
+from app.points.project_model import Project
+from app.points.project_write import ProjectTooLarge, project_bytes, take_snapshot
 from ui.controllers.project_dialogs import ProjectDialogs
 from ui.messages import os_error_text, refusal_text
 from ui.models.plan_model import PlanListModel
@@ -69,7 +62,7 @@ AUTOSAVE_INTERVAL_S = 60.0  # seconds between autosaves while there are unsaved 
 AUTOSAVE_FLUSH_S = 10.0
 SAVE_CHOICES = ("save", "discard", "cancel")
 
-__all__ = ["AUTOSAVE_FLUSH_S", "AUTOSAVE_INTERVAL_S", "SAVE_CHOICES", "ProjectController", "ProjectDialogs"]
+__all__ = ["AUTOSAVE_FLUSH_S", "AUTOSAVE_INTERVAL_S", "SAVE_CHOICES", "ProjectController"]
 
 
 class ProjectController(QObject):

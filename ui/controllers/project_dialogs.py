@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from app.points.ledger import ImportMode
+from app.points.ledger_import import ImportMode
 
 if TYPE_CHECKING:
     from PySide6.QtWidgets import QWidget

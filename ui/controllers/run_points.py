@@ -34,7 +34,8 @@ from dataclasses import dataclass, field
 from app.errors import TeachPadError
 from app.models import Pose
 from app.points.guard import PointGuard, PointNotCreated
-from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport
+from app.points.point import SyncState, TempPoint
+from app.points.upload import UploadOutcome, UploadReport
 from ui.models.points_model import PointsModel
 
 __all__ = ["ArrivalUnknown", "RunPoints", "SegmentPoints"]

@@ -1,6 +1,7 @@
-"""The Safety menu and the window's role gating, composed onto the main window in one call.
+"""The Safety menu and the window's role gating, composed onto the window's parts in one call.
 
-:func:`install_safety` creates the :class:`SafetyController`, gates the window's controls by
+:func:`install_safety` takes the parts it works with by name (:class:`SafetyParts`; it does not
+know the window, which composes it), creates the :class:`SafetyController`, gates the controls by
 role (connection, register profile, passwords: administrator; point and plan edits, the envelope,
 the robot model: engineer), feeds the envelope to the planner, the 3D view and the worker, and
 adds the menu: log in / out, reduced speed, envelope, register profile, passwords and lock, audit
@@ -17,12 +18,13 @@ from __future__ import annotations
 
 import tempfile
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QEvent, QObject, QTimer, Slot
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QLabel, QMenu
+from PySide6.QtWidgets import QLabel, QMainWindow, QMenu
 
 from app.errors import TeachPadError
 from app.link.types import LinkState
@@ -31,21 +33,51 @@ from app.safety.roles import Action, Role
 from app.safety.session import PermissionRefused
 from ui.controllers.safety import SafetyController
 
-if TYPE_CHECKING:  # the window composes this menu; only its type is needed here (the dialogs
-    # are imported when opened: the window's first paint does not wait for them)
+if TYPE_CHECKING:  # types only (the dialogs and the lazily built panels are imported when opened
+    # or built: the window's first paint does not wait for them)
+    from app.link.robot_link import RobotLink
+    from ui.controllers.project_controller import ProjectController
     from ui.dialogs.register_profile_dialog import RegisterProfileDialog
-    from ui.main_window import MainWindow
+    from ui.panels.event_log import EventLogPanel
+    from ui.panels.jog_refusal import MotionRefusalLine
     from ui.panels.planner_panel import PlannerPanel
     from ui.panels.points_panel import PointsPanel
+    from ui.panels.status_panel import StatusPanel
+    from ui.panels.traffic_panel import TrafficPanel
+    from ui.panels.view3d_host import View3DHost
     from ui.panels.view3d_panel import View3DPanel
+    from ui.settings import AppSettings
+    from ui.window_tabs import LazyTab
+
+
+@dataclass(frozen=True)
+class SafetyParts:
+    """What the guard rails are composed onto, each part by name."""
+
+    host: QMainWindow  # its menu bar and status bar; the dialogs' parent; its show, hide, language
+    menu_before: QAction  # the Safety menu goes before this one in the menu bar (Help's)
+    link: RobotLink
+    settings: AppSettings  # the register profile in force, the poll rate, the bundle's settings
+    project: ProjectController  # its file (the bundle), its points (the move-to check)
+    event_log: EventLogPanel  # refusals are logged; the bundle carries it
+    status_panel: StatusPanel  # refusals show as its last command
+    traffic_panel: Callable[[], TrafficPanel]  # the bundle carries it (built when first asked for)
+    release_jogs: Callable[[], None]  # before a reconnect with a new register profile
+    connect_action: QAction  # gated: changing the connection is the administrator's
+    points_tab: LazyTab[PointsPanel]
+    planner_tab: LazyTab[PlannerPanel]
+    view3d: View3DHost
+    refusal_line: MotionRefusalLine  # a refused motion is said under the motion buttons too
 
 
 class SafetyMenu(QObject):
     """See the module docstring. ``save_path(title, suggested)`` is replaceable (tests)."""
 
-    def __init__(self, window: MainWindow, safety: SafetyController) -> None:
+    def __init__(self, parts: SafetyParts, safety: SafetyController) -> None:
+        window = parts.host
         super().__init__(window)
         self.window = window
+        self.parts = parts
         self.safety = safety
         self.save_path: Callable[[str, str], str | None] = self._ask_save_path
         self.login_action = QAction(self)
@@ -87,7 +119,7 @@ class SafetyMenu(QObject):
                 self.menu.addSeparator()
             else:
                 self.menu.addAction(action)
-        window.menuBar().insertMenu(window.menus.help_menu.menuAction(), self.menu)
+        window.menuBar().insertMenu(parts.menu_before, self.menu)
         self.role_label = QLabel(window)
         self.role_label.setObjectName("RoleLabel")
         window.statusBar().addPermanentWidget(self.role_label)
@@ -152,8 +184,8 @@ class SafetyMenu(QObject):
     def show_message(self, text: str) -> None:
         """A refusal or a problem of the guard rails: where the operator looks for what became of
         the command (the status dock's *Last command*), the event log and the status bar."""
-        self.window.event_log.add_event("warning", self.source_name(), text)
-        self.window.status_panel.show_refusal(text)
+        self.parts.event_log.add_event("warning", self.source_name(), text)
+        self.parts.status_panel.show_refusal(text)
         self.window.statusBar().showMessage(text, 8000)
 
     def source_name(self) -> str:
@@ -188,12 +220,12 @@ class SafetyMenu(QObject):
 
     def register_profile(self) -> RegisterProfile:
         """The register profile in force."""
-        return self.window.settings.register_profile()[0]
+        return self.parts.settings.register_profile()[0]
 
     def register_profile_dialog(self) -> RegisterProfileDialog:
         from ui.dialogs.register_profile_dialog import RegisterProfileDialog
 
-        link = self.window.link
+        link = self.parts.link
         connected = link.settings is not None and link.connection.state is not LinkState.DISCONNECTED
         return RegisterProfileDialog(
             self.register_profile(),
@@ -211,10 +243,10 @@ class SafetyMenu(QObject):
     def apply_register_profile(self, profile: RegisterProfile, reconnect: bool = False) -> str | None:
         """Save ``profile`` as the one in force (administrator only: refused and audited otherwise)
         and, with ``reconnect``, connect the link again with it. None when done, else why not."""
-        window = self.window
+        parts = self.parts
         try:
             saved = self.safety.session.set_register_profile(
-                window.settings.register_profile_path(), profile, self.register_profile()
+                parts.settings.register_profile_path(), profile, self.register_profile()
             )
         except PermissionRefused:
             why = self.safety.reason(Action.REGISTER_PROFILE) or ""
@@ -222,12 +254,12 @@ class SafetyMenu(QObject):
             return why
         except (OSError, TeachPadError) as exc:
             return self.tr("The register profile could not be saved: {why}").format(why=str(exc)[:200])
-        link = window.link
+        link = parts.link
         if reconnect and link.settings is not None:
-            window.jog_panel.release_all()
+            parts.release_jogs()
             link.connect_to(saved.apply(link.settings))
         text = self.tr("Register profile \u201c{name}\u201d saved (revision {rev})")
-        window.statusBar().showMessage(text.format(name=saved.name, rev=saved.revision), 8000)
+        self.window.statusBar().showMessage(text.format(name=saved.name, rev=saved.revision), 8000)
         return None
 
     @Slot()
@@ -250,22 +282,22 @@ class SafetyMenu(QObject):
         path = self.save_path(self.tr("Write a support bundle"), "teachpad-support.zip")
         if not path:
             return None
-        window = self.window
-        store = window.settings.store
+        window, parts = self.window, self.parts
+        store = parts.settings.store
         settings = {key: store.value(key) for key in store.allKeys()}
         settings["safety_state"] = self.safety.location.describe()  # where roles, envelope, audit live
-        project = window.project.path
+        project = parts.project.path
         profile = self.safety.profile_path if self.safety.profile_path.exists() else None
-        register_profile: Path | None = window.settings.register_profile_path()
+        register_profile: Path | None = parts.settings.register_profile_path()
         if register_profile is not None and not register_profile.exists():
             register_profile = None
         from app.safety.bundle import write_support_bundle  # importlib.metadata: not at start-up
 
         try:
             with tempfile.TemporaryDirectory() as tmp:
-                window.event_log.export_to(Path(tmp) / "events.txt")
+                parts.event_log.export_to(Path(tmp) / "events.txt")
                 events = (Path(tmp) / "events.txt").read_text(encoding="utf-8-sig").splitlines()
-                window.traffic_panel.export_to(Path(tmp) / "traffic.txt", visible_only=False)
+                parts.traffic_panel().export_to(Path(tmp) / "traffic.txt", visible_only=False)
                 traffic = (Path(tmp) / "traffic.txt").read_text(encoding="utf-8-sig").splitlines()
                 manifest = write_support_bundle(
                     path,
@@ -295,11 +327,12 @@ class SafetyMenu(QObject):
         return Path(path)
 
 
-def gate_points(safety: SafetyController, window: MainWindow, panel: PointsPanel) -> None:
+def gate_points(safety: SafetyController, parts: SafetyParts, panel: PointsPanel) -> None:
     """The points table's edits by role; its move-to checked against the envelope."""
     safety.gate_panel(panel, Action.EDIT_POINTS)
+    link, project = parts.link, parts.project
     panel.move_check = lambda point_id, speed: safety.check_move_to(
-        window.link.state.pose, point_id, speed, window.project.points_model.ledger
+        link.state.pose, point_id, speed, project.points_model.ledger
     )
     panel.set_caps(safety.caps)
     safety.capsChanged.connect(panel.set_caps)
@@ -317,32 +350,31 @@ def attach_view3d(safety: SafetyController, panel: View3DPanel) -> None:
     safety.gate(panel.profile_button, Action.ROBOT_MODEL)
 
 
-def install_safety(window: MainWindow, *, scrypt_n: int | None = None) -> SafetyMenu:
-    """Compose the guard rails onto ``window`` (its 3D view already installed)."""
-    safety = SafetyController(window.link, parent=window, scrypt_n=scrypt_n)
-    safety.set_poll_rate(window.settings.poll_hz)  # the jog guard's margin follows the poll period
-    window.run_controller.audit = safety.session.audit  # a run's own pause is audited (issue 19)
-    menu = SafetyMenu(window, safety)
-    safety.gate(window.menus.connect_action, Action.CONNECTION)
+def install_safety(parts: SafetyParts, *, scrypt_n: int | None = None) -> SafetyMenu:
+    """Compose the guard rails onto ``parts`` (the 3D view already installed)."""
+    safety = SafetyController(parts.link, parent=parts.host, scrypt_n=scrypt_n)
+    safety.set_poll_rate(parts.settings.poll_hz)  # the jog guard's margin follows the poll period
+    menu = SafetyMenu(parts, safety)
+    safety.gate(parts.connect_action, Action.CONNECTION)
     safety.gate(menu.envelope_action, Action.EDIT_ENVELOPE)
     safety.gate(menu.register_profile_action, Action.REGISTER_PROFILE)
     safety.gate(menu.passwords_action, Action.MANAGE_ROLES)
     # Points and Planner are built on first show (ui/window_tabs.py): each is gated the moment
     # it exists, before it is in its tab, with the role in force then and at every change after.
-    window.points_tab.on_built(lambda panel: gate_points(safety, window, panel))
-    window.planner_tab.on_built(lambda panel: gate_planner(safety, panel))
+    parts.points_tab.on_built(lambda panel: gate_points(safety, parts, panel))
+    parts.planner_tab.on_built(lambda panel: gate_planner(safety, panel))
     # the robot model is an engineer's: its loads pass the guard (refused and audited otherwise);
     # the 3D view is built on first show: its canvas and its Robot model… button are attached then
-    window.view3d.robot.guard = safety
-    window.view3d.on_built(lambda panel: attach_view3d(safety, panel))
+    parts.view3d.robot.guard = safety
+    parts.view3d.on_built(lambda panel: attach_view3d(safety, panel))
     safety.message.connect(menu.show_message)  # a slot of the menu: a receiver in the GUI thread
     # a refused motion is said in the motion area too, under its buttons, until the next accepted one
-    refusal_line = window.control_column.refusal_line
+    refusal_line = parts.refusal_line
     safety.motionRefused.connect(refusal_line.show_words)
     safety.motionAccepted.connect(refusal_line.clear_refusal)
     if safety.problem:
         safety.message.emit(safety.problem)
-    register_problem = window.settings.register_profile()[1]
+    register_problem = parts.settings.register_profile()[1]
     if register_problem:
         safety.message.emit(register_problem)
     return menu

@@ -32,8 +32,8 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.connection import ConnectionSettings
 from app.link.hostname import host_problem
-from app.link.transport import ConnectionSettings
 from app.link.types import ConnectionState, LinkState
 from app.protocol.codec import WordOrder
 from app.safety.register_profile import RegisterProfile

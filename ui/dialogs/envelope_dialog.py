@@ -27,7 +27,8 @@ from PySide6.QtWidgets import (
 )
 
 from app.errors import TeachPadError
-from app.safety.envelope import Box, Envelope
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 from ui.controllers.safety import SafetyController
 
 JOINTS = 6

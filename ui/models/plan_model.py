@@ -24,8 +24,8 @@ from app.plan.segments import (
     validate_loops,
     validate_plan_name,
 )
-from app.points.ledger import FieldError
-from app.points.project import Project
+from app.points.fields import FieldError
+from app.points.project_model import Project
 from ui.messages import refusal_text
 from ui.models.plan_columns import (
     PLAN_COL_LOOPS,

@@ -7,13 +7,9 @@ from PySide6.QtCore import (
     Qt,
 )
 
-from app.points.ledger import (
-    EXT_FIELDS,
-    POSE_FIELDS,
-    SyncState,
-)
-from app.points.ledger import TR_CONTEXT as POINTS_CORE_CONTEXT
 from app.points.number_text import display_text, value_text
+from app.points.point import EXT_FIELDS, POSE_FIELDS, SyncState
+from app.points.point import TR_CONTEXT as POINTS_CORE_CONTEXT
 from app.protocol.registers import TOOL_NONE
 from ui.palette import (
     COLOR_ERROR,

@@ -11,7 +11,7 @@ from collections.abc import Callable, Iterable, Sequence
 from PySide6.QtGui import QUndoCommand
 
 from app.plan.segments import Plan, Segment
-from app.points.ledger import TempPoint
+from app.points.point import TempPoint
 
 
 class ReplaceAllCommand(QUndoCommand):

@@ -34,20 +34,12 @@ from PySide6.QtCore import (
 from PySide6.QtGui import QBrush, QColor, QUndoStack
 
 from app.errors import InvalidInput
-from app.points.ledger import (
-    FieldError,
-    ImportMode,
-    ImportReport,
-    PointLedger,
-    SyncState,
-    TempPoint,
-    UploadReport,
-    apply_upload,
-    make_point,
-    point_from_pose,
-    with_field,
-)
-from app.points.project import Project
+from app.points.fields import FieldError
+from app.points.ledger import PointLedger
+from app.points.ledger_import import ImportMode, ImportReport
+from app.points.point import SyncState, TempPoint, make_point, point_from_pose, with_field
+from app.points.project_model import Project
+from app.points.upload import UploadReport, apply_upload
 from app.protocol.registers import TOOL_NONE
 from ui.messages import refusal_text
 from ui.models.point_columns import (

@@ -13,7 +13,8 @@ from PySide6.QtCore import Qt
 
 from app.errors import InvalidInput
 from app.plan.segments import DEFAULT_SPEED, Plan, Segment, SegmentKind
-from app.points.ledger import FieldError, PointLedger, parse_point_id
+from app.points.fields import FieldError, parse_point_id
+from app.points.ledger import PointLedger
 from app.protocol.registers import TOOL_NONE
 from ui.models.point_columns import TOOL_NONE_WORDS
 

@@ -28,14 +28,16 @@ from PySide6.QtCore import (
 from PySide6.QtGui import QBrush, QColor, QIcon, QUndoStack
 
 from app.errors import InvalidInput
-from app.plan.checks import IssueKind, PlanIssue
+from app.plan.checks import PlanIssue
+from app.plan.issue_kind import IssueKind
 from app.plan.segments import (
     Plan,
     Segment,
     SegmentKind,
 )
 from app.points.ledger import PointLedger
-from ui.messages import issue_line, refusal_text
+from ui.messages import refusal_text
+from ui.messages_plan import issue_line
 from ui.models.plan_columns import (
     COL_END,
     COL_IGNORE,

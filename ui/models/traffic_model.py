@@ -46,8 +46,6 @@ __all__ = [
     "VIEW_CACHE_SIZE",
     "TrafficFilter",
     "TrafficModel",
-    "TrafficRow",
-    "is_poll_read",
 ]
 
 # 20,000 rows: the last minute or so of 100 Hz polling (2 reads a poll, each a request and an

@@ -28,10 +28,10 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.safety.audit import AuditFilter, AuditRecord, ReadStats, Result, export_csv, query, result_label
+from app.points.atomic import atomic_write_bytes
 from app.safety.audit_chain import verify_chain
+from app.safety.audit_read import AuditFilter, AuditRecord, ReadStats, Result, export_csv, query, result_label
 from ui.audit_words import command_words, detail_words
-from ui.widgets_common import atomic_write_text
 
 DEFAULT_DAYS = 7  # the range shown when the viewer opens
 MAX_ROWS = 20000  # newest rows kept in the table (the CSV export takes the same rows)
@@ -241,7 +241,7 @@ class AuditViewer(QDialog):
         buffer = io.StringIO(newline="")
         n = export_csv(self.model.records, buffer)
         try:  # atomically, UTF-8 with a BOM: Excel on a Chinese Windows reads it as UTF-8
-            atomic_write_text(path, buffer.getvalue(), encoding="utf-8-sig")
+            atomic_write_bytes(path, buffer.getvalue().encode("utf-8-sig"))
         except OSError as exc:
             self.status.setText(
                 self.tr("Cannot write {file}: {why}").format(file=Path(path).name, why=exc.strerror or exc)

@@ -46,15 +46,13 @@ from app.event_store import EventStore, StoredEvent, export_line
 from app.link.state import RobotState
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult
+from app.points.atomic import atomic_write_bytes
 from app.protocol.enums import ALARM_BITS, ALARM_TEXT, TR_CONTEXT
 from ui.messages import connection_text, error_text, operation_text, result_level, result_text
+from ui.palette import COLOR_ERROR, COLOR_ERROR_BG, COLOR_WARN_BG
 from ui.widgets_common import (
-    COLOR_ERROR,
-    COLOR_ERROR_BG,
-    COLOR_WARN_BG,
     LEVEL_ERROR,
     LEVEL_WARN,
-    atomic_write_text,
     connection_display,
     export_with_dialog,
     monospace_font,
@@ -480,7 +478,7 @@ class EventLogPanel(QWidget):
                 for row in range(self.proxy.rowCount())
             )
         lines = [export_line(_stored(e)) for e in events]  # one line per event
-        atomic_write_text(path, "".join(line + "\n" for line in lines), encoding="utf-8-sig")
+        atomic_write_bytes(path, "".join(line + "\n" for line in lines).encode("utf-8-sig"))
         return len(lines)
 
     @Slot()

@@ -1,8 +1,8 @@
 """The monitor's figures that the panel needs before its plots exist.
 
-:mod:`ui.panels.monitor_plots` (the pyqtgraph plots, built after the window's first paint)
-re-exports them; the panel and its readouts import them from here, so the window's first paint
-does not import the plots' module.
+The panel, its readouts and :mod:`ui.panels.monitor_plots` (the pyqtgraph plots, built after
+the window's first paint) import them from here, so the window's first paint does not import the
+plots' module.
 """
 
 from __future__ import annotations

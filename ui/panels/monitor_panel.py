@@ -40,17 +40,14 @@ from app.link.state import RobotState
 from app.models import Pose
 from ui.display_clock import DISPLAY_INTERVAL_MS, DisplayClock
 from ui.models.ring_buffer import RingBuffer
+from ui.palette import COLOR_NEUTRAL
 from ui.panels.monitor_figures import CARTESIAN as _CARTESIAN
-from ui.panels.monitor_figures import MAX_PLOT_POINTS, PAINT_MARGIN, PLOT_INTERVAL_MS, TRACE_MIN_SPAN_MM
+from ui.panels.monitor_figures import PLOT_INTERVAL_MS
 from ui.panels.monitor_readouts import BIG_POINTS_MAX, MIN_WIDTH, PANEL_MARGIN, ReadoutBoxes, readout_scale
-from ui.widgets_common import COLOR_NEUTRAL, NumericReadout
+from ui.widgets_common import NumericReadout
 
 __all__ = [
-    "MAX_PLOT_POINTS",
     "PAINT_INTERVAL_MS",
-    "PAINT_MARGIN",
-    "PLOT_INTERVAL_MS",
-    "TRACE_MIN_SPAN_MM",
     "MonitorPanel",
 ]
 

@@ -39,7 +39,6 @@ from ui.panels.monitor_figures import (
     CARTESIAN,
     MAX_PLOT_POINTS,
     PAINT_MARGIN,
-    PLOT_INTERVAL_MS,
     TRACE_MIN_SPAN_MM,
 )
 
@@ -55,13 +54,9 @@ if TYPE_CHECKING:  # imported when the first plot is built (the window's first p
 
 __all__ = [
     "AXIS_TICK_POINTS",
-    "CARTESIAN",
     "GRID_COLOR",
     "LEFT_AXIS_WIDTH",
-    "MAX_PLOT_POINTS",
     "MIN_PLOT_POINTS",
-    "PAINT_MARGIN",
-    "PLOT_INTERVAL_MS",
     "MonitorPlots",
     "add_legend",
     "cache_legend",

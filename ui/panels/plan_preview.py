@@ -5,7 +5,7 @@ path of :func:`app.plan.geometry.plan_path` (NaN rows separate unknown segments;
 so a plan of 1,000 segments is three ``setData`` calls, not 3,000 items. Arcs are the true
 circles through start, middle and end (the core samples them with the middle point among the
 samples). On top: the selected segment (thick), the referenced points (one scatter item,
-labels for the first :data:`MAX_LABELS`), where the plan starts, and while a plan runs the
+labels for the first `MAX_LABELS` of plan_projection), where the plan starts, and while a plan runs the
 live TCP (position and a short trail), repainted at most :data:`LIVE_FPS` times a second from
 the latest pose (poses arrive at the poll rate). Outside a run, poses are only remembered.
 The items of one projection are a :class:`ui.panels.plan_projection.Projection`.
@@ -47,7 +47,6 @@ from app.points.ledger import PointLedger
 from app.safety.envelope import Envelope
 from ui.joins import join_names
 from ui.palette import COLOR_INK_SOFT
-from ui.panels.plan_projection import MAX_LABELS as MAX_LABELS
 from ui.panels.plan_projection import PLOT_MIN_SIDE, FloatArray, Projection, style_plot
 from ui.widgets.lines_label import LinesLabel
 
@@ -298,7 +297,7 @@ class PlanPreview(QWidget):
             self._auto_range()
 
     def set_points(self, xyz: FloatArray | Sequence[Sequence[float]], labels: Sequence[str] = ()) -> None:
-        """Points to mark (the plan's points), with labels (the first :data:`MAX_LABELS`)."""
+        """Points to mark (the plan's points), with labels (plan_projection.MAX_LABELS at most)."""
         arr = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
         self._points = (arr, list(labels))
         names = [*labels[: len(arr)], *[""] * (len(arr) - len(labels))]  # each point's hover tip

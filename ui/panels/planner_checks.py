@@ -19,7 +19,7 @@ from app.plan.presenter import plan_info, plan_start, summarize_checks
 from app.plan.segments import Plan
 from app.points.ledger import PointLedger
 from app.safety.envelope import Envelope
-from ui.messages import issue_line, issue_text
+from ui.messages_plan import issue_line, issue_text
 from ui.models.segment_model import SegmentTableModel
 from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_widgets import PlanChecksBar

@@ -40,14 +40,14 @@ from app.plan.checks import PlanIssue, PlanLimits, ReachCheck
 from app.plan.presenter import Level, PanelState, action_states
 from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, SegmentKind
-from app.points.ledger import UploadReport
+from app.points.upload import UploadReport
 from app.safety.envelope import Envelope
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.plan_run_reasons import foreign_pause_text
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.safety import lock_editing
 from ui.dialogs.confirm import ConfirmFn, ask_confirmation
-from ui.messages import issue_text
+from ui.messages_plan import issue_text
 from ui.models.plan_columns import PLAN_COL_NAME
 from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel

@@ -14,15 +14,17 @@ from typing import Protocol
 from PySide6.QtCore import QObject
 
 from app.errors import InvalidInput, TeachPadError
-from app.plan.checks import IssueKind, PlanIssue, ids_needing_upload
+from app.plan.checks import PlanIssue, ids_needing_upload
+from app.plan.issue_kind import IssueKind
 from app.plan.presenter import RunBlock, RunKind, run_gate, run_kind
 from app.plan.runner import RunOutcome, RunState
 from app.plan.segments import Plan
-from app.points.ledger import UploadReport
+from app.points.upload import UploadReport
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController
 from ui.joins import join_names
-from ui.messages import error_text, issue_text, refusal_text
+from ui.messages import error_text, refusal_text
+from ui.messages_plan import issue_text
 from ui.models.points_model import PointsModel
 from ui.panels.planner_checks import PlannerChecks
 

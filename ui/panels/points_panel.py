@@ -17,7 +17,7 @@ from PySide6.QtGui import QAction, QKeySequence
 from PySide6.QtWidgets import QLabel, QSizePolicy, QVBoxLayout, QWidget
 
 from app.errors import InvalidInput
-from app.points.ledger import UploadReport
+from app.points.upload import UploadReport
 from app.safety.caps import MotionCaps
 from ui.controllers.point_sync import LEVEL_ERROR, LEVEL_INFO, LEVEL_WARN, PointSyncController
 from ui.controllers.safety import lock_editing
@@ -25,8 +25,8 @@ from ui.dialogs.confirm import ConfirmFn, ask_confirmation
 from ui.messages import refusal_text
 from ui.models.point_filter import PointFilterProxy
 from ui.models.points_model import PointsModel
+from ui.palette import COLOR_ERROR, COLOR_OK
 from ui.panels.points_parts import PointsActionBar, PointsTable, RestoreBanner, UploadProgressRow
-from ui.widgets_common import COLOR_ERROR, COLOR_OK
 
 
 class PointsPanel(QWidget):

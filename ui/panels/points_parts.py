@@ -37,8 +37,8 @@ from PySide6.QtWidgets import (
 
 from ui.controllers.point_sync import DEFAULT_MOVE_SPEED, MAX_MOVE_SPEED
 from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COLUMNS, EXT_COLUMNS
+from ui.palette import COLOR_WARN, COLOR_WARN_BG
 from ui.touch import MOTION_MIN_HEIGHT, mark_motion
-from ui.widgets_common import COLOR_WARN, COLOR_WARN_BG
 
 __all__ = ["PointsActionBar", "PointsTable", "RestoreBanner", "UploadProgressRow"]
 

@@ -49,12 +49,9 @@ from app.protocol.registers import GV_DATE
 from ui import messages
 from ui.joins import join_names
 from ui.messages import connection_text, result_level, result_text
+from ui.palette import COLOR_ERROR, COLOR_NEUTRAL, COLOR_OK, COLOR_WARN
 from ui.widgets.live_label import LiveLabel
 from ui.widgets_common import (
-    COLOR_ERROR,
-    COLOR_NEUTRAL,
-    COLOR_OK,
-    COLOR_WARN,
     LEVEL_ERROR,
     LEVEL_INFO,
     LEVEL_OFF,

@@ -38,6 +38,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from app.points.atomic import atomic_write_bytes
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 from ui.display_clock import DisplayClock
@@ -52,7 +53,6 @@ from ui.models.traffic_model import (
 from ui.palette import COLOR_NEUTRAL
 from ui.widgets.live_label import LiveLabel
 from ui.widgets_common import (
-    atomic_write_text,
     export_with_dialog,
     monospace_font,
 )
@@ -288,7 +288,7 @@ class TrafficPanel(QWidget):
             text = buffer.getvalue()
         else:
             text = "".join("\t".join(f) + "\n" for f in fields)
-        atomic_write_text(path, text, encoding="utf-8-sig")  # with a BOM: Excel reads it as UTF-8
+        atomic_write_bytes(path, text.encode("utf-8-sig"))  # with a BOM: Excel reads it as UTF-8
         return len(rows)
 
     @Slot()

@@ -154,7 +154,7 @@ class View3DHost(QObject):
         disagreeing = agreement is not None and not agreement.agrees
         if disagreeing and not self._disagreeing and agreement is not None:
             from app.view3d.agreement import model_issue
-            from ui.messages import issue_text
+            from ui.messages_plan import issue_text
 
             self.window.event_log.add_event("warning", self.tr("3D view"), issue_text(model_issue(agreement)))
         if (disagreeing or self._disagreeing) and self._planner is not None:

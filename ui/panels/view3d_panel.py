@@ -57,17 +57,13 @@ from app.view3d.path import DryRun, DryRunState, start_of
 from app.view3d.profile import RobotProfile
 from app.view3d.reach import PathReach, ReachChecker
 from ui.joins import join_names, join_sentences
-from ui.messages import issue_text
+from ui.messages_plan import issue_text
 from ui.models.points_model import PointsModel
 from ui.palette import COLOR_CURVE_PURPLE, COLOR_ERROR, COLOR_INFO, COLOR_NEUTRAL, COLOR_WARN
 from ui.panels.view3d_canvas import View3DCanvas
 from ui.panels.view3d_dryrun import DryRunBar
 from ui.panels.view3d_robot import RobotModelSource
-from ui.panels.view3d_scene import MAX_PATH_ROWS as MAX_PATH_ROWS
-from ui.panels.view3d_scene import PATH_SAMPLES as PATH_SAMPLES
-from ui.panels.view3d_scene import REACH_MAX_POINTS as REACH_MAX_POINTS
-from ui.panels.view3d_scene import SYNC_COLORS as SYNC_COLORS
-from ui.panels.view3d_scene import arc_middles, bad_path_samples, path_samples, reach_checked
+from ui.panels.view3d_scene import SYNC_COLORS, arc_middles, bad_path_samples, path_samples, reach_checked
 from ui.widgets.lines_label import LinesLabel
 
 LIVE_FPS: Final = 30

@@ -158,7 +158,8 @@ class RobotModelSource(QObject):
         return error
 
     def _load(self, path: str) -> str | None:
-        from app.view3d.profile import ProfileError, load_profile
+        from app.errors import ProfileError
+        from app.view3d.profile import load_profile
 
         try:
             profile = load_profile(path)

@@ -12,8 +12,8 @@ from typing import Final
 import numpy as np
 
 from app.plan.segments import Plan
-from app.points.ledger import PointLedger, SyncState
-from app.points.point import TempPoint
+from app.points.ledger import PointLedger
+from app.points.point import SyncState, TempPoint
 from app.view3d.reach import PathReach
 from ui.palette import COLOR_CURVE_PURPLE, COLOR_NEUTRAL, COLOR_OK, COLOR_WARN
 

@@ -22,7 +22,8 @@ from collections import Counter
 from typing import Any
 
 from app import timing
-from app.sim import SimConfig, SimController
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 from tests.link.hostile.commands import COMMANDS, MISBEHAVIOURS, SLOW, judge, run_case
 from tests.link.hostile.relay import HostileRelay
 from tests.link.hostile.server import Framing

@@ -32,15 +32,16 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Literal
 
+from app.connection import ConnectionSettings
 from app.errors import OutcomeUnknown, TeachPadError
-from app.link.client import ConnectionSettings, RobotClient
+from app.link.client import RobotClient
 from app.link.outcome import Outcome, outcome_of
 from app.link.types import StepFrame
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
-from tests.link.hostile.relay import Exchange, HostileRelay, Later, Misbehaviour, Reply
-from tests.link.hostile.server import Answer
+from tests.link.hostile.relay import Exchange, HostileRelay, Later, Misbehaviour
+from tests.link.hostile.server import Answer, Reply
 
 # -- misbehaviours -----------------------------------------------------------------------------
 

@@ -20,8 +20,9 @@ import time
 from dataclasses import dataclass
 from typing import Any
 
+from app.connection import ConnectionSettings
 from app.errors import MalformedResponse, TeachPadError
-from app.link.client import ConnectionSettings, RobotClient
+from app.link.client import RobotClient
 from tests.link.hostile.server import Answer, Framing, HostileServer, Reply
 
 _CONTROL = range(440, 446)

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 from tests.link.hostile.server import Answer, Framing, Reply, crc16
 
-__all__ = ["Exchange", "HostileRelay", "Later", "Misbehaviour", "Reply"]
+__all__ = ["Exchange", "HostileRelay", "Later", "Misbehaviour"]
 
 #: What the client gets for one request: from the correct answer and the answer sent before it
 #: on this relay (b"" before the first).

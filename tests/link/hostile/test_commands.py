@@ -18,6 +18,7 @@ import pytest
 
 from app import timing
 from app.cli.exit_codes import ExitCode, exit_code_for
+from app.connection import ConnectionSettings
 from app.errors import (
     LinkError,
     MalformedResponse,
@@ -26,12 +27,13 @@ from app.errors import (
     ResponseTimeout,
     TeachPadError,
 )
-from app.link.client import ConnectionSettings, RobotClient
+from app.link.client import RobotClient
 from app.link.outcome import Outcome, outcome_of
 from app.link.types import StepFrame
 from app.models import CommandResult
 from app.protocol import registers
-from app.safety.audit import AuditLog, Result, read_records
+from app.safety.audit import AuditLog
+from app.safety.audit_read import Result, read_records
 from tests.link.hostile.commands import (
     COMMANDS,
     MISBEHAVIOURS,

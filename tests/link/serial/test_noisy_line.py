@@ -17,14 +17,16 @@ import pytest
 from app import timing
 from app.cli.exit_codes import ExitCode
 from app.cli.main import main
+from app.connection import ConnectionSettings
 from app.errors import ResponseTimeout, TeachPadError
-from app.link.client import ConnectionSettings, RobotClient, StepFrame
+from app.link.client import RobotClient
 from app.link.ops import UploadPoints
 from app.link.robot_link import RobotLink
-from app.link.types import LinkState
+from app.link.types import LinkState, StepFrame
 from app.models import CommandResult
 from app.protocol import registers
-from app.sim import SimConfig, SimController
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 from benchmarks.noisy_line import project_points, wrong_points
 from tests.link.serial.relay import PtyRelay
 from tests.ui.pendant_support import SIGNAL_TIMEOUT_MS, is_state

@@ -8,11 +8,13 @@ from typing import Any
 
 import pytest
 
+from app.connection import ConnectionSettings
 from app.errors import TeachPadError
-from app.link.client import ConnectionSettings, RobotClient
+from app.link.client import RobotClient
 from app.protocol.enums import TeachFrame, WorkMode
 from app.protocol.registers import REG_WORK_MODE
-from app.sim import SimConfig, SimController
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 from tests.link.serial.relay import PtyRelay
 
 pytestmark = pytest.mark.skipif(not hasattr(__import__("os"), "openpty"), reason="needs POSIX ptys")

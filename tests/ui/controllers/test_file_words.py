@@ -12,7 +12,7 @@ import pytest
 from PySide6.QtCore import QCoreApplication, QTranslator
 from PySide6.QtGui import QUndoStack
 
-from app.points.ledger import ImportMode
+from app.points.ledger_import import ImportMode
 from app.points.project import load_project
 from tests.ui.controllers.test_project_controller import SAMPLES, FakeDialogs
 from tests.ui.test_messages import QM, assert_chinese

@@ -9,7 +9,8 @@ from typing import Any
 
 import pytest
 
-from app.safety.envelope import Box, Envelope
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 from app.safety.roles import Role
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,

@@ -9,9 +9,10 @@ import pytest
 from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import QApplication
 
-from app.link.client import StepFrame
-from app.safety.audit import query
-from app.safety.envelope import Box, Envelope
+from app.link.types import StepFrame
+from app.safety.audit_read import query
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 from app.safety.roles import Role
 from tests.ui.controllers.test_gui_roles import PASSWORD, menu_fixture  # noqa: F401 - fixture
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures

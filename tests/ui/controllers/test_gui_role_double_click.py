@@ -21,7 +21,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     translator_fixture,
     window_fixture,
 )
-from ui.controllers.safety_menu import SafetyMenu, install_safety
+from ui.controllers.safety_menu import SafetyMenu
 from ui.models.point_columns import COL_NAME
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
@@ -32,8 +32,7 @@ PASSWORD = "cell-42"
 
 @pytest.fixture(name="menu")
 def menu_fixture(window: Any) -> SafetyMenu:
-    existing = getattr(window, "safety_menu", None)
-    menu = existing if existing is not None else install_safety(window, scrypt_n=2**4)
+    menu: SafetyMenu = window.safety_menu
     store = menu.safety.session.store
     store.scrypt_n = 2**4
     for role in (Role.ADMINISTRATOR, Role.ENGINEER):

@@ -11,8 +11,9 @@ from typing import Any
 
 import pytest
 
-from app.safety.audit import query
-from app.safety.envelope import Box, Envelope
+from app.safety.audit_read import query
+from app.safety.box import Box
+from app.safety.envelope import Envelope
 from app.safety.profile import load_profile
 from app.safety.roles import Action, Role, WrongPassword
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -24,7 +25,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     translator_fixture,
     window_fixture,
 )
-from ui.controllers.safety_menu import SafetyMenu, install_safety
+from ui.controllers.safety_menu import SafetyMenu
 from ui.panels.audit_viewer import AuditViewer
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
@@ -36,8 +37,7 @@ CHEAP_SCRYPT = 2**4  # tests only: the real cost is 2**14
 
 @pytest.fixture(name="menu")
 def menu_fixture(window: Any) -> SafetyMenu:
-    existing = getattr(window, "safety_menu", None)
-    menu = existing if existing is not None else install_safety(window, scrypt_n=CHEAP_SCRYPT)
+    menu: SafetyMenu = window.safety_menu
     store = menu.safety.session.store
     store.scrypt_n = CHEAP_SCRYPT
     for role in (Role.ADMINISTRATOR, Role.ENGINEER):

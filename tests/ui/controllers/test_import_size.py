@@ -10,8 +10,9 @@ from typing import Any
 import pytest
 
 from app.points import atomic
-from app.points.ledger import ImportMode
-from app.points.project import Project, load_project
+from app.points.ledger_import import ImportMode
+from app.points.project import load_project
+from app.points.project_model import Project
 from tests.ui.controllers.test_project_controller import FakeDialogs
 from ui.controllers.project_controller import ProjectController
 

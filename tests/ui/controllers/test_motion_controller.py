@@ -12,7 +12,7 @@ from PySide6.QtWidgets import QWidget
 
 from app.link.ops import GoZero, JogPress, JogRelease, Pause, Resume, SetMode, Stop
 from app.link.types import ConnectionState, LinkState
-from app.points.project import Project
+from app.points.project_model import Project
 from app.protocol.enums import TeachFrame, WorkMode
 from tests.ui.fake_link import FakeLink
 from ui.controllers.motion import MotionController

@@ -24,10 +24,11 @@ from app.link.robot_link import RobotLink
 from app.plan.runner import RunState
 from app.plan.segments import Plan, Segment
 from app.points.point import make_point
-from app.points.project import Project
+from app.points.project_model import Project
 from app.protocol.enums import ProgramState, RunCommand
 from app.protocol.registers import REG_RUN_COMMAND
-from app.safety.audit import AuditLog, query
+from app.safety.audit import AuditLog
+from app.safety.audit_read import query
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,

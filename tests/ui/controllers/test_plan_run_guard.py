@@ -20,9 +20,8 @@ from app.link.types import LinkState
 from app.models import Pose
 from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, Segment
-from app.points.ledger import SyncState
-from app.points.point import make_point
-from app.points.project import Project
+from app.points.point import SyncState, make_point
+from app.points.project_model import Project
 from app.protocol.enums import RunCommand
 from app.protocol.registers import REG_RUN_COMMAND
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures

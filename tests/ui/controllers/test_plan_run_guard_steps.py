@@ -13,9 +13,8 @@ from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import Pose
 from app.plan.runner import RunState
 from app.plan.segments import Plan, Segment
-from app.points.ledger import SyncState
-from app.points.point import make_point
-from app.points.project import Project
+from app.points.point import SyncState, make_point
+from app.points.project_model import Project
 from tests.ui.fake_link import FakeLink
 from tests.ui.pendant_support import translator_fixture  # noqa: F401 - fixture
 from ui.controllers.plan_run_controller import PlanRunController

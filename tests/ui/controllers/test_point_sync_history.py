@@ -12,9 +12,10 @@ import pytest
 
 from app.link.robot_link import RobotLink
 from app.link.types import ConnectionState, LinkState
-from app.points.ledger import UploadReport
 from app.points.point import make_point
-from app.points.project import Project, load_project
+from app.points.project import load_project
+from app.points.project_model import Project
+from app.points.upload import UploadReport
 from tests.ui.controllers.test_project_controller import FakeDialogs
 from tests.ui.fake_link import FakeLink
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures

@@ -14,8 +14,9 @@ from typing import Any
 import pytest
 
 from app.points.autosave import save_autosave
-from app.points.ledger import ImportMode, SyncState
+from app.points.ledger_import import ImportMode
 from app.points.lock import live_owner, lock_path
+from app.points.point import SyncState
 from app.points.project import load_project
 from tests.waits import kill_child, read_line, wait_child
 from ui.controllers.project_controller import ProjectController

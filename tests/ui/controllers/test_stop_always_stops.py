@@ -10,13 +10,12 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
-from app.link.client import StepFrame
 from app.link.ops import RunProgram, Step, Stop
-from app.link.types import LinkState
+from app.link.types import LinkState, StepFrame
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, ProgramState
-from app.safety.audit import query
+from app.safety.audit_read import query
 from app.safety.roles import REQUIRED_ROLE, Action, Role
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,

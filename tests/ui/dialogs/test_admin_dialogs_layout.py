@@ -12,7 +12,7 @@ from PySide6.QtCore import QCoreApplication
 from PySide6.QtGui import QFontDatabase
 from PySide6.QtWidgets import QApplication, QDialog
 
-from app.link.client import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.safety.register_profile import RegisterProfile
 from app.safety.roles import Action, Role
 from tests.ui.layout_audit import clipped_texts, overlapping_siblings

@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 from PySide6.QtCore import Qt
 
-from app.link.client import ConnectionSettings
+from app.connection import ConnectionSettings
 from app.link.robot_link import RobotLink
 from app.link.types import ConnectionState, LinkState
 from app.protocol.codec import WordOrder

@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 
 from app.errors import InvalidInput
-from app.safety.audit import Result, query
+from app.safety.audit_read import Result, query
 from app.safety.location import safety_location
 from app.safety.roles import Role
 from app.safety.session import PermissionRefused
@@ -23,7 +23,6 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     window_fixture,
 )
 from ui.controllers.safety import SafetyController
-from ui.controllers.safety_menu import install_safety
 from ui.dialogs.password_dialog import PasswordDialog
 
 pytestmark = [pytest.mark.timeout(60), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
@@ -107,11 +106,7 @@ def test_the_operator_cannot_use_it(qtbot: Any, safety: Any) -> None:
 
 
 def test_the_menu_entry_is_the_administrators(window: Any) -> None:
-    menu = (
-        install_safety(window, scrypt_n=2**4)
-        if getattr(window, "safety_menu", None) is None
-        else window.safety_menu
-    )
+    menu = window.safety_menu
     menu.safety.session.store.scrypt_n = 2**4
     menu.safety.session.set_password(Role.ADMINISTRATOR, ADMIN_PW)
     action = menu.passwords_action

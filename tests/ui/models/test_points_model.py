@@ -11,8 +11,10 @@ from PySide6.QtGui import QUndoStack
 
 from app.models import Pose
 from app.plan.segments import Plan, Segment
-from app.points.ledger import SyncState, TempPoint, UploadOutcome, UploadReport, make_point
-from app.points.project import Project, load_project
+from app.points.point import SyncState, TempPoint, make_point
+from app.points.project import load_project
+from app.points.project_model import Project
+from app.points.upload import UploadOutcome, UploadReport
 from ui.models.point_columns import COL_ID, COL_NAME, COL_SYNC, COL_TOOL, COL_X, COLUMNS
 from ui.models.point_filter import PointFilterProxy
 from ui.models.points_model import PointsModel

@@ -8,8 +8,8 @@ from typing import Any
 from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 
-from app.points.ledger import make_point
-from app.points.project import Project
+from app.points.point import make_point
+from app.points.project_model import Project
 from app.protocol.codec import decode_floats, encode_floats
 from ui.models.point_columns import COLUMNS
 from ui.models.points_model import PointsModel

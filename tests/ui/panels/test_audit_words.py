@@ -70,7 +70,8 @@ def test_the_refusals_details_read_in_chinese(qapp: Any, translator: Any, tmp_pa
     import pytest
 
     from app.models import Pose
-    from app.safety.envelope import Box, Envelope, EnvelopeRefused
+    from app.safety.box import Box
+    from app.safety.envelope import Envelope, EnvelopeRefused
     from app.safety.roles import Action, RoleStore
     from app.safety.session import PermissionRefused, SafetySession
 

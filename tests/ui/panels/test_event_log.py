@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import datetime as dt
+import os
+import stat
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -12,7 +14,9 @@ from PySide6.QtCore import QCoreApplication, Qt, QTranslator
 
 from app.link.types import ConnectionState, LinkState
 from app.models import CommandResult
+from app.points import atomic
 from app.protocol.enums import Alarm, CommandKind, CommandStatus, RunCommand
+from ui.palette import COLOR_ERROR_BG, COLOR_WARN_BG
 from ui.panels.event_log import (
     COL_LEVEL,
     COL_MESSAGE,
@@ -22,7 +26,6 @@ from ui.panels.event_log import (
     EventLogPanel,
     LogEvent,
 )
-from ui.widgets_common import COLOR_ERROR_BG, COLOR_WARN_BG
 
 WHEN = dt.datetime(2025, 6, 1, 8, 30, 15, 250_000)
 
@@ -165,6 +168,21 @@ def test_export_is_atomic(tmp_path: Path, panel: EventLogPanel) -> None:
     with pytest.raises(OSError):
         panel.export_to(tmp_path / "nope" / "events.txt")
     assert [p.name for p in tmp_path.iterdir()] == ["events.txt"]
+
+
+def test_export_is_the_one_atomic_writers(tmp_path: Path, panel: EventLogPanel) -> None:
+    """The GUI's exports save as every file of TeachPad does (app/points/atomic.py, issue 22): a
+    killed export's leftover temp file is removed by the next one, and the file keeps its mode."""
+    panel.add_event("info", "link", "connected", WHEN)
+    target = tmp_path / "events.txt"
+    target.write_text("previous")
+    target.chmod(0o644)
+    leftover = tmp_path / f"{atomic.TEMP_PREFIX}events.txt.0123456789ab{atomic.TEMP_SUFFIX}"
+    leftover.write_bytes(b"half an export")
+    os.utime(leftover, (1_000_000_000.0, 1_000_000_000.0))  # long before: a killed export's
+    assert panel.export_to(target) == 1
+    assert [p.name for p in tmp_path.iterdir()] == ["events.txt"]
+    assert stat.S_IMODE(target.stat().st_mode) == 0o644
 
 
 def test_model_passes_the_model_tester(qtmodeltester: Any) -> None:

@@ -20,8 +20,9 @@ from app.protocol.enums import Alarm, ControllerMode, ProgramState
 from benchmarks.traffic import Feed
 from tests.ui.fake_link import FakeLink
 from ui.display_clock import DISPLAY_INTERVAL_MS
+from ui.panels.monitor_figures import PLOT_INTERVAL_MS
 from ui.panels.monitor_panel import MonitorPanel
-from ui.panels.monitor_plots import PLOT_INTERVAL_MS, RANGE_MIN_SPAN, fit_range
+from ui.panels.monitor_plots import RANGE_MIN_SPAN, fit_range
 from ui.panels.status_panel import StatusPanel
 from ui.panels.traffic_panel import TrafficPanel
 from ui.widgets.live_label import LiveLabel

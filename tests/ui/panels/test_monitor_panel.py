@@ -11,7 +11,8 @@ from PySide6.QtCore import QCoreApplication, QTranslator
 
 from app.models import Pose
 from ui.panels import monitor_panel
-from ui.panels.monitor_panel import MAX_PLOT_POINTS, PAINT_INTERVAL_MS, PAINT_MARGIN, MonitorPanel
+from ui.panels.monitor_figures import MAX_PLOT_POINTS, PAINT_MARGIN
+from ui.panels.monitor_panel import PAINT_INTERVAL_MS, MonitorPanel
 
 # The offscreen platform warns on every top-level show; it says nothing about the panel.
 pytestmark = pytest.mark.qt_log_ignore("This plugin does not support propagateSizeHints")

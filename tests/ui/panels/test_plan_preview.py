@@ -13,7 +13,8 @@ import pytest
 from app.models import Pose
 from app.plan.geometry import plan_path
 from app.plan.segments import Plan, Segment
-from app.points.ledger import PointLedger, make_point
+from app.points.ledger import PointLedger
+from app.points.point import make_point
 from ui.panels.plan_preview import PROJECTIONS, PlanPreview
 
 

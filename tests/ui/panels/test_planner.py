@@ -17,11 +17,13 @@ from PySide6.QtGui import QUndoStack
 from app.link.ops import MoveToPoint, Pause, Resume, Stop, UploadPoints
 from app.link.types import WorkerError
 from app.models import Pose
-from app.plan.checks import IssueKind
+from app.plan.issue_kind import IssueKind
 from app.plan.runner import RunState
 from app.plan.segments import Segment, SegmentKind
-from app.points.ledger import SyncState, UploadOutcome, UploadReport
-from app.points.project import Project, load_project
+from app.points.point import SyncState
+from app.points.project import load_project
+from app.points.project_model import Project
+from app.points.upload import UploadOutcome, UploadReport
 from tests.ui.fake_link import FakeLink
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController

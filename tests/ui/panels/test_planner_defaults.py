@@ -13,8 +13,10 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QUndoStack
 
 from app.plan.segments import Plan, Segment
-from app.points.ledger import PointLedger, SyncState
-from app.points.project import Project, load_project
+from app.points.ledger import PointLedger
+from app.points.point import SyncState
+from app.points.project import load_project
+from app.points.project_model import Project
 from tests.ui.fake_link import FakeLink
 from ui.controllers.plan_run_controller import PlanRunController
 from ui.controllers.point_sync import PointSyncController

@@ -14,7 +14,7 @@ from PySide6.QtGui import QUndoStack
 from app.link.ops import CancelUpload, CreatePoint, MoveToPoint, Stop, UploadPoints
 from app.link.types import ConnectionState, ControllerIdentity, LinkState, WorkerError
 from app.models import CommandResult, Pose
-from app.points.ledger import SyncState, make_point
+from app.points.point import SyncState, make_point
 from app.points.project import load_project
 from app.protocol.enums import CommandKind, RunCommand
 from tests.ui.fake_link import FAKE_CONTROLLER, FakeLink
@@ -310,7 +310,7 @@ def test_a_silence_on_the_same_connection_keeps_the_points(panel: PointsPanel, l
 
 
 def _report_ok(model: PointsModel, ids: list[int]) -> Any:
-    from app.points.ledger import UploadOutcome, UploadReport
+    from app.points.upload import UploadOutcome, UploadReport
 
     return UploadReport([UploadOutcome(pid, True, sent=model.ledger.point(pid)) for pid in ids])
 
@@ -446,7 +446,7 @@ def test_external_axes_columns_hideable(panel: PointsPanel) -> None:
 
 
 def test_points_with_other_ids_work(qtbot: Any) -> None:
-    from app.points.project import Project
+    from app.points.project_model import Project
 
     project = Project()
     project.ledger.replace_all([make_point(10000, "last")])
@@ -492,7 +492,7 @@ def test_add_without_a_live_pose_copies_a_point_and_says_so(
 
 
 def test_add_to_an_empty_list_without_a_link_is_zeros_and_says_so(qtbot: Any) -> None:
-    from app.points.project import Project
+    from app.points.project_model import Project
 
     model = PointsModel(Project(), QUndoStack())
     panel = PointsPanel(model, PointSyncController(model), confirm=lambda title, text: False)

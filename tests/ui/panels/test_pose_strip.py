@@ -16,7 +16,7 @@ from PySide6.QtWidgets import QApplication, QMainWindow, QWidget
 
 from app.link.ops import GoZero, JogPress, Stop
 from app.models import ControllerStatus, Pose
-from app.points.project import Project
+from app.points.project_model import Project
 from app.protocol.enums import Alarm, ControllerMode, ProgramState, TeachFrame
 from tests.ui.fake_link import FakeLink
 from tests.ui.pendant_support import translator_fixture  # noqa: F401 - fixture

@@ -20,8 +20,9 @@ from app.protocol.enums import (
     ProgramState,
     RunCommand,
 )
+from ui.palette import COLOR_ERROR, COLOR_OK, COLOR_WARN
 from ui.panels.status_panel import StatusPanel
-from ui.widgets_common import COLOR_ERROR, COLOR_OK, COLOR_WARN, LEVEL_ERROR, LEVEL_OFF, LEVEL_OK, LEVEL_WARN
+from ui.widgets_common import LEVEL_ERROR, LEVEL_OFF, LEVEL_OK, LEVEL_WARN
 
 
 def status(

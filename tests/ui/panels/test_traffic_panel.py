@@ -16,14 +16,8 @@ from PySide6.QtCore import QCoreApplication, QModelIndex, Qt, QTranslator
 from app.protocol.codec import WordOrder, encode_floats
 from app.protocol.framing import encode_request, encode_response, encode_write_gv
 from app.protocol.registers import POSE_BLOCK_COUNT, POSE_BLOCK_START, STATUS_BLOCK_COUNT, STATUS_BLOCK_START
-from ui.models.traffic_model import (
-    COL_BYTES,
-    COL_DIRECTION,
-    COL_MEANING,
-    COL_TIME,
-    TrafficModel,
-    is_poll_read,
-)
+from ui.models.traffic_model import COL_BYTES, COL_DIRECTION, COL_MEANING, COL_TIME, TrafficModel
+from ui.models.traffic_row import is_poll_read
 from ui.panels.traffic_panel import TrafficPanel
 
 pytestmark = pytest.mark.qt_log_ignore("This plugin does not support propagateSizeHints")

@@ -10,8 +10,8 @@ import pytest
 from PySide6.QtGui import QUndoStack
 
 from app.link.robot_link import RobotLink
-from app.points.ledger import SyncState, make_point
-from app.points.project import Project
+from app.points.point import SyncState, make_point
+from app.points.project_model import Project
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     canary_link_fixture,

@@ -9,7 +9,8 @@ from typing import Any
 
 import pytest
 
-from app.plan.checks import IssueCode, IssueKind
+from app.plan.checks import IssueCode
+from app.plan.issue_kind import IssueKind
 from app.safety.roles import Role
 from app.view3d.profile import default_profile, profile_to_dict
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
