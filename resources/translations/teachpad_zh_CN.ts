@@ -3114,48 +3114,48 @@
     <context>
         <name>PlanChecksBar</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="250" />
+            <location filename="../../ui/panels/planner_widgets.py" line="269" />
             <source>Upload now</source>
             <translation>立即上传</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="251" />
+            <location filename="../../ui/panels/planner_widgets.py" line="270" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="260" />
+            <location filename="../../ui/panels/planner_widgets.py" line="279" />
             <source>Checks passed; the plan cannot run until the emergency stop or servo alarm is cleared</source>
             <translation>检查通过；急停或伺服报警解除之前，计划不能运行</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="276" />
+            <location filename="../../ui/panels/planner_widgets.py" line="295" />
             <source>Checks passed: ready to run</source>
             <translation>检查通过：可以运行</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="279" />
+            <location filename="../../ui/panels/planner_widgets.py" line="298" />
             <source>%n error(s)</source>
             <translation>
                 <numerusform>%n 个错误</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="281" />
+            <location filename="../../ui/panels/planner_widgets.py" line="300" />
             <source>%n point(s) need upload</source>
             <translation>
                 <numerusform>%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_widgets.py" line="283" />
+            <location filename="../../ui/panels/planner_widgets.py" line="302" />
             <source>%n warning(s)</source>
             <translation>
                 <numerusform>%n 个警告</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="286" />
+            <location filename="../../ui/panels/planner_widgets.py" line="305" />
             <source>Upload now?</source>
             <translation>立即上传？</translation>
         </message>
@@ -3171,7 +3171,7 @@
     <context>
         <name>PlanListBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="320" />
+            <location filename="../../ui/panels/planner_widgets.py" line="339" />
             <source>Plans</source>
             <translation>轨迹规划</translation>
         </message>
@@ -3242,73 +3242,88 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="186" />
+            <location filename="../../ui/panels/plan_preview.py" line="254" />
             <source>Top (XY)</source>
-            <extracomment>(key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
+            <extracomment>px: a narrower preview shows one projection at a time (its tabs), the lengths / times below it (key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="187" />
+            <location filename="../../ui/panels/plan_preview.py" line="255" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="188" />
+            <location filename="../../ui/panels/plan_preview.py" line="256" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="192" />
+            <location filename="../../ui/panels/plan_preview.py" line="261" />
+            <source>Top</source>
+            <translation>俯视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/plan_preview.py" line="262" />
+            <source>Front</source>
+            <translation>正视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/plan_preview.py" line="263" />
+            <source>Side</source>
+            <translation>侧视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/plan_preview.py" line="268" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="195" />
+            <location filename="../../ui/panels/plan_preview.py" line="271" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="253" />
+            <location filename="../../ui/panels/plan_preview.py" line="330" />
             <source>Reach: robot model “%1”</source>
             <translation>可达性：机器人模型“%1”</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="299" />
+            <location filename="../../ui/panels/plan_preview.py" line="401" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="301" />
+            <location filename="../../ui/panels/plan_preview.py" line="402" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="304" />
+            <location filename="../../ui/panels/plan_preview.py" line="406" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="305" />
+            <location filename="../../ui/panels/plan_preview.py" line="407" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="309" />
+            <location filename="../../ui/panels/plan_preview.py" line="411" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="316" />
+            <location filename="../../ui/panels/plan_preview.py" line="419" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="319" />
+            <location filename="../../ui/panels/plan_preview.py" line="422" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="321" />
+            <location filename="../../ui/panels/plan_preview.py" line="424" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -3316,23 +3331,18 @@
     <context>
         <name>PlanRunBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="190" />
-            <source>Run</source>
-            <extracomment>Colour of a summary line by level (the status line uses the darker warning text).</extracomment>
-            <translation>运行</translation>
-        </message>
-        <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="193" />
+            <location filename="../../ui/panels/planner_widgets.py" line="212" />
             <source>endless</source>
+            <extracomment>Colour of a summary line by level (the status line uses the darker warning text).</extracomment>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="195" />
+            <location filename="../../ui/panels/planner_widgets.py" line="214" />
             <source>Segment {k} of {n}, loop {i} of {m}</source>
             <translation>第 {k}/{n} 段，第 {i}/{m} 次循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="216" />
+            <location filename="../../ui/panels/planner_widgets.py" line="235" />
             <source>Finished: {n} segments run</source>
             <translation>已完成：运行了 {n} 段</translation>
         </message>
@@ -3681,19 +3691,27 @@
         </message>
     </context>
     <context>
-        <name>PlannerPanel</name>
+        <name>PlannerLayout</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="247" />
-            <source>Preview</source>
-            <translation>预览</translation>
+            <location filename="../../ui/panels/planner_layout.py" line="82" />
+            <source>Plans</source>
+            <translation>轨迹列表</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="335" />
+            <location filename="../../ui/panels/planner_layout.py" line="83" />
+            <source>Show or hide the list of plans</source>
+            <translation>显示或隐藏轨迹列表</translation>
+        </message>
+    </context>
+    <context>
+        <name>PlannerPanel</name>
+        <message>
+            <location filename="../../ui/panels/planner_panel.py" line="349" />
             <source>This cell cannot be edited: {why}</source>
             <translation>无法编辑此单元格：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="440" />
+            <location filename="../../ui/panels/planner_panel.py" line="456" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -5504,35 +5522,40 @@ Remove them all?</source>
     <context>
         <name>SegmentEditorBox</name>
         <message>
-            <location filename="../../ui/panels/planner_widgets.py" line="389" />
+            <location filename="../../ui/panels/planner_widgets.py" line="422" />
             <source>Segments</source>
             <translation>轨迹段</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_widgets.py" line="422" />
+            <source>Segments of “{plan}”</source>
+            <translation>轨迹“{plan}”的轨迹段</translation>
         </message>
     </context>
     <context>
         <name>SegmentTableModel</name>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="106" />
+            <location filename="../../ui/models/segment_model.py" line="119" />
             <source>Type</source>
             <translation>类型</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="107" />
+            <location filename="../../ui/models/segment_model.py" line="120" />
             <source>Middle point</source>
             <translation>中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="108" />
+            <location filename="../../ui/models/segment_model.py" line="121" />
             <source>End point</source>
             <translation>终点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="110" />
+            <location filename="../../ui/models/segment_model.py" line="123" />
             <source>Orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="112" />
+            <location filename="../../ui/models/segment_model.py" line="125" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
@@ -5562,122 +5585,122 @@ Remove them all?</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="105" />
+            <location filename="../../ui/models/segment_model.py" line="118" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="109" />
+            <location filename="../../ui/models/segment_model.py" line="122" />
             <source>Speed</source>
             <translation>速度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="111" />
+            <location filename="../../ui/models/segment_model.py" line="124" />
             <source>Ignore mid.</source>
             <translation>忽略中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="113" />
+            <location filename="../../ui/models/segment_model.py" line="126" />
             <source>Length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="114" />
+            <location filename="../../ui/models/segment_model.py" line="127" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="205" />
+            <location filename="../../ui/models/segment_model.py" line="218" />
             <source>Checks before running: hover the icon for details</source>
             <translation>运行前检查：鼠标悬停在图标上查看详情</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="206" />
+            <location filename="../../ui/models/segment_model.py" line="219" />
             <source>Speed in mm/s (GV225)</source>
             <translation>速度，单位 mm/s（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="207" />
+            <location filename="../../ui/models/segment_model.py" line="220" />
             <source>Middle point of an arc (GV200)</source>
             <translation>圆弧的中间点（GV200）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="208" />
+            <location filename="../../ui/models/segment_model.py" line="221" />
             <source>End point (GV201)</source>
             <translation>终点（GV201）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="209" />
+            <location filename="../../ui/models/segment_model.py" line="222" />
             <source>Orientation kept constant or changing along the move (GV202)</source>
             <translation>运动中姿态保持不变或变化（GV202）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="210" />
+            <location filename="../../ui/models/segment_model.py" line="223" />
             <source>Ignore the arc's middle point orientation (GV203)</source>
             <translation>忽略圆弧中间点的姿态（GV203）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="211" />
+            <location filename="../../ui/models/segment_model.py" line="224" />
             <source>Tool frame of the move (GV245)</source>
             <translation>运动使用的工具坐标系（GV245）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="212" />
+            <location filename="../../ui/models/segment_model.py" line="225" />
             <source>Estimated path length</source>
             <translation>估计路径长度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="213" />
+            <location filename="../../ui/models/segment_model.py" line="226" />
             <source>Estimated time: length / speed plus a fixed overhead per segment</source>
             <translation>估计时间：长度 / 速度，加上每段固定开销</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="313" />
+            <location filename="../../ui/models/segment_model.py" line="329" />
             <source>Segment {n}: no problems found</source>
             <translation>第 {n} 段：未发现问题</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="318" />
+            <location filename="../../ui/models/segment_model.py" line="334" />
             <source>Point P{id} does not exist</source>
             <translation>点 P{id} 不存在</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="353" />
+            <location filename="../../ui/models/segment_model.py" line="369" />
             <source>Segment {n}, {column}: refused, {reason}</source>
             <translation>第 {n} 段，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="367" />
+            <location filename="../../ui/models/segment_model.py" line="383" />
             <source>Edit segment {n} {column}</source>
             <translation>编辑第 {n} 段 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="379" />
+            <location filename="../../ui/models/segment_model.py" line="395" />
             <source>Add {kind} segment</source>
             <translation>添加{kind}段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="396" />
+            <location filename="../../ui/models/segment_model.py" line="412" />
             <source>Add {n} segments</source>
             <translation>添加 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="405" />
+            <location filename="../../ui/models/segment_model.py" line="421" />
             <source>Delete segment {n}</source>
             <translation>删除第 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="407" />
+            <location filename="../../ui/models/segment_model.py" line="423" />
             <source>Delete {n} segments</source>
             <translation>删除 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="428" />
+            <location filename="../../ui/models/segment_model.py" line="444" />
             <source>Move segment up</source>
             <translation>上移段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="428" />
+            <location filename="../../ui/models/segment_model.py" line="444" />
             <source>Move segment down</source>
             <translation>下移段</translation>
         </message>

@@ -15,7 +15,7 @@ new row starts with are :mod:`ui.models.segment_edits`.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
 import numpy as np
@@ -95,6 +95,19 @@ class SegmentTableModel(UndoableListModel):
         self._missing = QBrush(QColor(COLOR_ERROR))
         self._active_bg = QBrush(QColor(COLOR_ACTIVE_BG))
         self._failed_bg = QBrush(QColor(COLOR_ERROR_BG))
+        role = Qt.ItemDataRole
+        self._role_data: dict[int, Callable[[int, Segment, int], Any]] = {
+            role.DisplayRole: self._display,
+            role.EditRole: lambda _row, seg, column: self._edit_value(seg, column),
+            role.CheckStateRole: self._check_state,
+            role.DecorationRole: self._decoration,
+            role.ToolTipRole: self._tooltip,
+            role.ForegroundRole: self._foreground,
+            role.BackgroundRole: self._background,
+            role.TextAlignmentRole: self._alignment,
+            ISSUE_ROLE: lambda row, _seg, _column: self.issues_of(row),
+            ISSUE_LEVEL_ROLE: lambda row, _seg, _column: self._worst(row),
+        }
         self.retranslate()
 
     def tr(self, text: str, disambiguation: str | None = None, n: int = -1) -> str:
@@ -221,38 +234,41 @@ class SegmentTableModel(UndoableListModel):
         row, column = index.row(), index.column()
         if not 0 <= column < len(SEG_COLUMNS):
             return None
-        seg = plan[row]
-        if role == Qt.ItemDataRole.DisplayRole:
-            return self._display(row, seg, column)
-        if role == Qt.ItemDataRole.EditRole:
-            return self._edit_value(seg, column)
-        if role == Qt.ItemDataRole.CheckStateRole and column == COL_IGNORE:
-            return Qt.CheckState.Checked if seg.ignore_middle else Qt.CheckState.Unchecked
-        if role == Qt.ItemDataRole.DecorationRole and column == COL_INDEX:
-            worst = self._worst(row)
-            if worst is None:
-                return None
-            if worst not in self._icons:
-                self._icons[worst] = issue_icon(worst)
-            return self._icons[worst]
-        if role == Qt.ItemDataRole.ToolTipRole:
-            return self._tooltip(row, seg, column)
-        if role == Qt.ItemDataRole.ForegroundRole and column in (COL_VIA, COL_END):
-            pid = seg.via_id if column == COL_VIA else seg.end_id
-            if pid is not None and self._ledger.get(pid) is None:
-                return self._missing
-        if role == Qt.ItemDataRole.BackgroundRole:
-            if row == self._failed:
-                return self._failed_bg
-            if row == self._active:
-                return self._active_bg
-        if role == Qt.ItemDataRole.TextAlignmentRole and column in RIGHT_ALIGNED:
-            return int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
-        if role == ISSUE_ROLE:
-            return self.issues_of(row)
-        if role == ISSUE_LEVEL_ROLE:
-            return self._worst(row)
-        return None
+        role_data = self._role_data.get(role)
+        return None if role_data is None else role_data(row, plan[row], column)
+
+    # --- what each role shows (row, segment, column) -> value; None: nothing
+    def _check_state(self, _row: int, seg: Segment, column: int) -> Qt.CheckState | None:
+        if column != COL_IGNORE:
+            return None
+        return Qt.CheckState.Checked if seg.ignore_middle else Qt.CheckState.Unchecked
+
+    def _decoration(self, row: int, _seg: Segment, column: int) -> QIcon | None:
+        worst = self._worst(row) if column == COL_INDEX else None
+        if worst is None:
+            return None
+        if worst not in self._icons:
+            self._icons[worst] = issue_icon(worst)
+        return self._icons[worst]
+
+    def _foreground(self, _row: int, seg: Segment, column: int) -> QBrush | None:
+        if column not in (COL_VIA, COL_END):
+            return None
+        pid = seg.via_id if column == COL_VIA else seg.end_id
+        return self._missing if pid is not None and self._ledger.get(pid) is None else None
+
+    def _background(self, row: int, _seg: Segment, _column: int) -> QBrush | None:
+        if row == self._failed:
+            return self._failed_bg
+        return self._active_bg if row == self._active else None
+
+    @staticmethod
+    def _alignment(_row: int, _seg: Segment, column: int) -> int | None:
+        return (
+            int(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
+            if column in RIGHT_ALIGNED
+            else None
+        )
 
     def _worst(self, row: int) -> IssueKind | None:
         issues = self._issues.get(row)

@@ -28,7 +28,16 @@ from typing import Any
 import numpy as np
 from PySide6.QtCore import QCoreApplication, QEvent, Qt, QTimer, Slot
 from PySide6.QtGui import QResizeEvent
-from PySide6.QtWidgets import QBoxLayout, QHBoxLayout, QLabel, QSizePolicy, QToolButton, QVBoxLayout, QWidget
+from PySide6.QtWidgets import (
+    QBoxLayout,
+    QHBoxLayout,
+    QLabel,
+    QSizePolicy,
+    QTabBar,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
 
 from app.models import Pose
 from app.plan.geometry import PlanPath, plan_path
@@ -39,8 +48,7 @@ from app.safety.envelope import Envelope
 from ui.joins import join_names
 from ui.palette import COLOR_INK_SOFT
 from ui.panels.plan_projection import MAX_LABELS as MAX_LABELS
-from ui.panels.plan_projection import PLOT_MIN_HEIGHT as PLOT_MIN_HEIGHT
-from ui.panels.plan_projection import FloatArray, Projection, style_plot
+from ui.panels.plan_projection import PLOT_MIN_SIDE, FloatArray, Projection, style_plot
 from ui.widgets.lines_label import LinesLabel
 
 LIVE_FPS = 30
@@ -48,6 +56,8 @@ TRAIL_LENGTH = 600  # live TCP positions kept for the trail
 INFO_WIDTH = 210  # px, the lengths / times column (at most)
 INFO_MIN_WIDTH = 140  # px, on a narrow window
 INFO_BELOW_WIDTH = 620  # px: a narrower preview shows the lengths / times below the plots
+#: px: a narrower preview shows one projection at a time (its tabs), the lengths / times below it
+COMPACT_BELOW_WIDTH = 3 * PLOT_MIN_SIDE + 2 * 6 + INFO_MIN_WIDTH + 6
 
 #: (key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.
 PROJECTIONS: tuple[tuple[str, int, int], ...] = (("top", 0, 1), ("front", 0, 2), ("side", 1, 2))
@@ -89,8 +99,19 @@ class PlanPreview(QWidget):
         # Until the plots exist, a placeholder asks for the room they will (layouts stay the same).
         self._boxes: tuple[FloatArray, FloatArray] = (np.empty((0, 3)), np.empty((0, 3)))  # envelope
         self._slot: QWidget | None = QWidget(self)
-        self._slot.setMinimumSize(len(PROJECTIONS) * 90 + 12, 110 + QLabel().sizeHint().height())
+        self._slot.setMinimumSize(PLOT_MIN_SIDE, PLOT_MIN_SIDE + QLabel().sizeHint().height())
         row.addWidget(self._slot, 1)
+        self._compact = True
+        # all the lines of the lengths / times, and the ones beside one projection (as many as fit)
+        self._info: tuple[str, list[str]] = ("", [])
+        self.view_tabs = QTabBar(self)  # one projection at a time on a narrow preview
+        self.view_tabs.setObjectName("PlanPreviewTabs")
+        self.view_tabs.setDrawBase(False)
+        self.view_tabs.setUsesScrollButtons(False)
+        self.view_tabs.setElideMode(Qt.TextElideMode.ElideNone)
+        for _key, _h, _v in PROJECTIONS:
+            self.view_tabs.addTab("")
+        self.view_tabs.currentChanged.connect(self._show_current)
         self.info = QLabel(self)
         self.info.setWordWrap(True)
         self.info.setStyleSheet(f"color: {COLOR_INK_SOFT};")
@@ -117,11 +138,22 @@ class PlanPreview(QWidget):
         side.addWidget(self.info, 1)
         side.addLayout(fit_row)
         # The lengths / times sit right of the plots, or below them on a narrow panel.
-        layout = QBoxLayout(QBoxLayout.Direction.LeftToRight, self)
+        layout = QBoxLayout(QBoxLayout.Direction.TopToBottom)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.addLayout(row, 1)
         layout.addLayout(side)
         self._layout = layout
+        self._side = side
+        self._fit_row = fit_row
+        self._header = QHBoxLayout()  # the tabs and Fit on a narrow preview
+        self._header.setContentsMargins(0, 0, 0, 0)
+        self._header.addWidget(self.view_tabs, 1, Qt.AlignmentFlag.AlignBottom)
+        outer = QVBoxLayout(self)
+        outer.setContentsMargins(0, 0, 0, 0)
+        outer.setSpacing(2)
+        outer.addLayout(self._header)
+        outer.addLayout(layout, 1)
+        self._show_current()
         self.retranslate()
 
     @property
@@ -159,9 +191,8 @@ class PlanPreview(QWidget):
             cell.addWidget(title)
             cell.addWidget(plot, 1)
             self._row.addLayout(cell, 1)
-            title.show()  # children made after their parent was shown are hidden until shown
-            plot.show()
         self.retranslate()
+        self._show_current()
         # draw what the setters remembered
         for proj in self._projections.values():
             proj.set_boxes(*self._boxes)
@@ -173,13 +204,50 @@ class PlanPreview(QWidget):
         self._auto_range()
         self._operator_view = operator_view
 
+    @property
+    def compact(self) -> bool:
+        """One projection at a time (the tabs choose it), the lengths / times below it."""
+        return self._compact
+
+    def shown_projections(self) -> list[Projection]:
+        """The projections on screen: all three, or the current tab's on a narrow preview."""
+        return [p for p in self._projections.values() if p.plot.isVisibleTo(self)]
+
     def resizeEvent(self, event: QResizeEvent) -> None:
-        below = event.size().width() < INFO_BELOW_WIDTH
+        width = event.size().width()
+        compact = width < COMPACT_BELOW_WIDTH
+        below = compact or width < INFO_BELOW_WIDTH
         direction = QBoxLayout.Direction.TopToBottom if below else QBoxLayout.Direction.LeftToRight
         if self._layout.direction() != direction:
             self._layout.setDirection(direction)
             self.info.setMaximumWidth(16777215 if below else INFO_WIDTH)
+        if compact != self._compact:
+            self._compact = compact
+            self._show_current()
         super().resizeEvent(event)
+        if compact:
+            self._show_info()  # as many lines as fit the new height
+
+    @Slot()
+    def _show_current(self, *_args: Any) -> None:
+        """All three projections with their titles, or the current tab's alone."""
+        compact = self._compact
+        self.view_tabs.setVisible(compact)
+        # Fit beside the tabs on a narrow preview, else under the lengths / times
+        self._fit_row.removeWidget(self.fit_button)
+        self._header.removeWidget(self.fit_button)
+        if compact:
+            self._header.addWidget(self.fit_button, 0, Qt.AlignmentFlag.AlignBottom)
+        else:
+            self._fit_row.insertWidget(0, self.fit_button)
+        self._show_info()
+        current = self.view_tabs.currentIndex()
+        for i, (key, _h, _v) in enumerate(PROJECTIONS):
+            proj, title = self._projections.get(key), self._titles.get(key)
+            if proj is None or title is None:
+                continue
+            proj.plot.setVisible(not compact or i == current)
+            title.setVisible(not compact)
 
     def retranslate(self) -> None:
         names = {
@@ -189,6 +257,14 @@ class PlanPreview(QWidget):
         }
         for key, title in self._titles.items():
             title.setText(names[key])
+        tabs = {
+            "top": QCoreApplication.translate("PlanPreview", "Top"),
+            "front": QCoreApplication.translate("PlanPreview", "Front"),
+            "side": QCoreApplication.translate("PlanPreview", "Side"),
+        }
+        for i, (key, _h, _v) in enumerate(PROJECTIONS):
+            self.view_tabs.setTabText(i, tabs[key])
+            self.view_tabs.setTabToolTip(i, names[key])
         self.fit_button.setText(QCoreApplication.translate("PlanPreview", "Fit"))
         self.set_reach_model(self._reach_model)
         self.fit_button.setToolTip(
@@ -225,8 +301,9 @@ class PlanPreview(QWidget):
         """Points to mark (the plan's points), with labels (the first :data:`MAX_LABELS`)."""
         arr = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
         self._points = (arr, list(labels))
+        names = [*labels[: len(arr)], *[""] * (len(arr) - len(labels))]  # each point's hover tip
         for proj in self._projections.values():
-            proj.points.setData(arr[:, proj.h], arr[:, proj.v])
+            proj.points.setData(arr[:, proj.h], arr[:, proj.v], data=names)
             proj.set_labels(arr, list(labels))
 
     def set_start(self, xyz: Sequence[float] | FloatArray | None) -> None:
@@ -255,7 +332,32 @@ class PlanPreview(QWidget):
         self.reach_label.setVisible(bool(name))
 
     def set_info(self, text: str) -> None:
-        self.info.setText(text)
+        self._info = (text, [text] if text else [])
+        self._show_info()
+
+    def _show_info(self) -> None:
+        """All the lines; beside one projection, the first lines that fit under it (whole lines:
+        nothing is cut mid-word), the rest in the tooltip."""
+        whole, lines = self._info
+        shown = whole
+        if self._compact:
+            room = self._info_room()
+            shown = ""
+            for n in range(len(lines), 0, -1):
+                candidate = "<br>".join(lines[:n])
+                self.info.setText(candidate)
+                if self.info.heightForWidth(max(self.info.width(), PLOT_MIN_SIDE)) <= room:
+                    shown = candidate
+                    break
+        self.info.setText(shown)
+        self.info.setToolTip(whole if shown != whole else "")
+        self.info.setVisible(bool(shown))  # an empty label would still take a line's height
+
+    def _info_room(self) -> int:
+        """Height left for the lengths / times under one projection of :data:`PLOT_MIN_SIDE` px."""
+        spacing = self._layout.spacing() + self._side.spacing() + 2
+        reach = self.reach_label.height() + self._side.spacing() if self.reach_label.isVisibleTo(self) else 0
+        return self.height() - self._header.sizeHint().height() - 2 - PLOT_MIN_SIDE - spacing - reach
 
     def show_plan(
         self, plan: Plan, ledger: PointLedger, start: Sequence[float] | None, selected: int | None
@@ -297,30 +399,34 @@ class PlanPreview(QWidget):
     def show_info(self, info: PlanInfo) -> None:
         """The plan's lengths and times (worked out by :func:`app.plan.presenter.plan_info`)."""
         loops = self.tr("endless") if info.loops == 0 else str(info.loops)
-        lines = [
-            self.tr("<b>{name}</b>: {n} segments, loops: {loops}").format(
-                name=info.name, n=info.segments, loops=loops
-            ),
+        name = self.tr("<b>{name}</b>: {n} segments, loops: {loops}").format(
+            name=info.name, n=info.segments, loops=loops
+        )
+        totals = [
             self.tr("One loop: {length}, {time}").format(length=info.loop_length, time=info.loop_time),
             self.tr("Total: {length}, {time}").format(length=info.total_length, time=info.total_time),
         ]
         if info.unknown:
-            lines.append(
+            totals.append(
                 self.tr("Not counted (unknown length): segments {list}").format(
                     list=join_names(str(k) for k in info.unknown)
                 )
             )
+        selected: list[str] = []
         if info.selected is not None:
             k = info.selected
-            lines.append(
+            selected.append(
                 self.tr("Segment {k}: {length}, {time}").format(k=k.number, length=k.length, time=k.time)
             )
-        lines.append(
+        start = (
             self.tr("Start: end of the last segment (robot pose unknown)")
             if info.assumed_start
             else self.tr("Start: the robot's current pose")
         )
-        self.set_info("<br>".join(lines))
+        # beside one projection the plan's name (the segments' title) and the selected segment's
+        # length and time (its row) are left to the tooltip: the totals and the start stay
+        self._info = ("<br>".join([name, *totals, *selected, start]), [*totals, start])
+        self._show_info()
 
     def set_envelope(self, envelope: Envelope | None) -> None:
         """Outline the keep-in box and the keep-out boxes in every projection (None: none)."""

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QPointF, QRectF, Qt
 
 from ui.palette import (
     COLOR_AXIS,
@@ -31,10 +31,19 @@ if TYPE_CHECKING:
     import pyqtgraph as pg
 
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
-PLOT_MIN_HEIGHT = 80  # px: the planner's top row (segments, run box) needs the height at 1280×800
+PLOT_MIN_SIDE = 200  # px: each projection the planner shows is at least this wide and high
 MIN_LABEL_SPACING_PX = 44  # between two labelled ticks of the X axis: "-1200" and a gap
 
+#: Where a point's label goes (pyqtgraph anchors: the label's corner at the point), first free
+#: one first: above right, above left, below right, below left.
+LABEL_ANCHORS: tuple[tuple[float, float], ...] = ((0.0, 1.0), (1.0, 1.0), (0.0, 0.0), (1.0, 0.0))
+
 FloatArray = NDArray[np.float64]
+
+
+def point_tip(x: float, y: float, data: object) -> str:
+    """The tooltip of a point under the mouse: its label (hidden where labels would pile up)."""
+    return f"{data}  ({x:.1f}, {y:.1f} mm)" if data else f"({x:.1f}, {y:.1f} mm)"
 
 
 def wider_interval(interval: float) -> float:
@@ -105,7 +114,7 @@ def style_plot(plot: pg.PlotWidget) -> None:
     plot.setMenuEnabled(False)
     plot.setAspectLocked(True)
     plot.getViewBox().setDefaultPadding(0.12)  # room for the point labels at the edges
-    plot.setMinimumSize(90, PLOT_MIN_HEIGHT)
+    plot.setMinimumSize(PLOT_MIN_SIDE, PLOT_MIN_SIDE)
 
 
 class Projection:
@@ -121,7 +130,9 @@ class Projection:
         self.selected = pg.PlotCurveItem(
             pen=pg.mkPen(COLOR_HIGHLIGHT, width=5), connect="finite", antialias=True
         )
-        self.points = pg.ScatterPlotItem(size=7, brush=pg.mkBrush(COLOR_AXIS), pen=pg.mkPen("w"))
+        self.points = pg.ScatterPlotItem(
+            size=7, brush=pg.mkBrush(COLOR_AXIS), pen=pg.mkPen("w"), hoverable=True, tip=point_tip
+        )
         self.start = pg.ScatterPlotItem(
             size=11, symbol="t1", brush=pg.mkBrush(COLOR_START), pen=pg.mkPen("w")
         )
@@ -133,6 +144,8 @@ class Projection:
         self.keep_in: pg.PlotCurveItem | None = None
         self.keep_out: pg.PlotCurveItem | None = None
         self.labels: list[pg.TextItem] = []
+        self._label_at: list[tuple[float, float]] = []  # each label's point (view coordinates)
+        plot.getViewBox().sigTransformChanged.connect(self.place_labels)
         for z, item in enumerate((self.path, self.selected, self.points, self.start, self.trail, self.tcp)):
             item.setZValue(z)
             plot.addItem(item)
@@ -161,9 +174,38 @@ class Projection:
         for label in self.labels:
             self.plot.removeItem(label)
         self.labels = []
+        self._label_at = []
         for row, text in zip(xyz[:MAX_LABELS], texts[:MAX_LABELS], strict=False):
-            label = pg.TextItem(text, color=COLOR_INK_SOFT, anchor=(0.0, 1.0))
-            label.setPos(float(row[self.h]), float(row[self.v]))
+            label = pg.TextItem(text, color=COLOR_INK_SOFT, anchor=LABEL_ANCHORS[0])
+            at = (float(row[self.h]), float(row[self.v]))
+            label.setPos(*at)
             label.setZValue(10)
             self.plot.addItem(label)
             self.labels.append(label)
+            self._label_at.append(at)
+        self.place_labels()
+
+    def place_labels(self) -> None:
+        """Give each label the first corner of its point where it covers no label placed before
+        it, on screen; a label with no free corner is hidden (its point names it on hover).
+
+        Labels keep their screen size whatever the zoom, so this is done again whenever the view
+        changes (a zoom, a pan, a resize): points that lie close ("P2P3P4") are named one by one
+        as the operator zooms in."""
+        view = self.plot.getViewBox()
+        taken: list[QRectF] = []
+        for label, (x, y) in zip(self.labels, self._label_at, strict=True):
+            size = label.textItem.boundingRect().size()
+            at = view.mapViewToScene(QPointF(x, y))
+            free = None
+            for ax, ay in LABEL_ANCHORS:
+                box = QRectF(
+                    at.x() - size.width() * ax, at.y() - size.height() * ay, size.width(), size.height()
+                )
+                if not any(box.intersects(other) for other in taken):
+                    free = (ax, ay)
+                    taken.append(box)
+                    break
+            if free is not None and tuple(label.anchor) != free:
+                label.setAnchor(free)
+            label.setVisible(free is not None)

@@ -1,10 +1,12 @@
 """Trajectory planner panel: plans of the project, their segments, checks, preview and runs.
 
-Layout: on the left the plan list (name, loops, segments; add / duplicate / delete, rename
-and loops edited in place) and the run controls (Run, Run from here, Step, Pause, Resume,
-Stop, Resume from k; progress "segment k of n, loop i of m") below them; on the right the
-segment table (editable, undoable) with the checks on their rows and a summary line, and the
-preview (top / front / side) with lengths and times below it.
+Layout (:mod:`ui.panels.planner_layout`): the plan list (name, loops, segments; add / duplicate /
+delete, rename and loops edited in place) is a side pane, hidden on a narrow planner (*Plans*
+shows it; the segments' title names the plan); the segment table (editable, undoable) with the
+checks on its rows sits beside the preview (one projection at a time, its tabs) or, on a wide
+planner, above the three projections; under both, the checks' summary (Upload now, Check) and the
+run strip (Run, Run from here, Step, Pause, Resume, Stop, Resume from k; progress "segment k of n,
+loop i of m").
 
 Checks (:func:`app.plan.checks.check_plan`, with the robot model's reach once
 :meth:`PlannerPanel.set_reach` gave it), estimates and the preview are recomputed whenever the
@@ -18,9 +20,10 @@ injectable ``confirm(title, text) -> bool`` callable.
 
 What is shown is worked out without Qt by :mod:`app.plan.presenter`. The panel composes its
 parts: ``planner_actions`` (the QActions), ``planner_widgets`` (plan list, segment editor, run
-box, checks bar), ``planner_checks`` (the checks list, estimates, preview), ``planner_edit``
-(plan and segment edits), ``planner_run`` (the run flow), ``planner_follow`` (the plan on
-display kept in step with the list, the undo stack and the points).
+box, checks bar), ``planner_layout`` (how they share the room), ``planner_checks`` (the checks
+list, estimates, preview), ``planner_edit`` (plan and segment edits), ``planner_run`` (the run
+flow), ``planner_follow`` (the plan on display kept in step with the list, the undo stack and the
+points).
 """
 
 from __future__ import annotations
@@ -29,6 +32,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, Signal, Slot
+from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QGroupBox, QLabel, QSizePolicy, QTableView, QVBoxLayout, QWidget
 
 from app.models import Pose
@@ -53,6 +57,7 @@ from ui.panels.planner_actions import PlannerActions
 from ui.panels.planner_checks import PlannerChecks
 from ui.panels.planner_edit import PlanEdits, install_point_pickers
 from ui.panels.planner_follow import PlanFollower
+from ui.panels.planner_layout import PlannerLayout
 from ui.panels.planner_run import PlanRunFlow
 from ui.panels.planner_widgets import (
     STATUS_COLOURS,
@@ -60,7 +65,6 @@ from ui.panels.planner_widgets import (
     PlanListBox,
     PlanRunBox,
     SegmentEditorBox,
-    planner_splitters,
 )
 
 ModelIndex = QModelIndex | QPersistentModelIndex
@@ -179,7 +183,7 @@ class PlannerPanel(QWidget):
         self.action_resume_from = a["resume_from"]
 
     def _build(self) -> None:
-        # left: plans + run controls
+        """The boxes; how they share the room is :class:`~ui.panels.planner_layout.PlannerLayout`."""
         self.plans_box = PlanListBox(
             self._plans,
             [
@@ -205,38 +209,51 @@ class PlannerPanel(QWidget):
         self.run_label = self.run_box.run_label
         self.run_progress = self.run_box.run_progress
 
-        # middle: segments
         self.checks_bar: PlanChecksBar = PlanChecksBar(self.upload_needed, self.recheck, self)
         self.summary = self.checks_bar.summary
         self.upload_button = self.checks_bar.upload_button
         self.check_button = self.checks_bar.check_button
+        self.action_show_plans = QAction(self)  # the plans list shown (PlannerLayout toggles it)
+        self.action_show_plans.setCheckable(True)
         segment_actions = [
+            self.action_show_plans,
             self.action_add_line,
             self.action_add_arc,
             self.action_delete_segment,
             self.action_segment_up,
             self.action_segment_down,
         ]
-        self.segments_box = SegmentEditorBox(
-            self.segments, self._points, segment_actions, self.checks_bar, self
-        )
+        self.segments_box = SegmentEditorBox(self.segments, self._points, segment_actions, self)
         self.segment_view: QTableView = self.segments_box.segment_view
         self.point_pickers = install_point_pickers(self.segment_view, lambda: self._points.ledger)
 
-        # right: preview
         self.preview: PlanPreview = PlanPreview(self)
         self.preview_box = QGroupBox(self)
+        self.preview_box.setObjectName("PlanPreviewBox")
         preview_layout = QVBoxLayout(self.preview_box)
+        preview_layout.setContentsMargins(6, 4, 6, 6)
         preview_layout.addWidget(self.preview)
 
-        self.splitter, self.outer_splitter = planner_splitters(
-            self, self.plans_box, self.run_box, self.segments_box, self.preview_box
+        self.arrangement = PlannerLayout(
+            self.plans_box,
+            self.segments_box,
+            self.preview_box,
+            self.checks_bar,
+            self.run_box,
+            self.action_show_plans,
+            self,
         )
         self.status = QLabel(self)
-        self.status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
+        self.status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Fixed)
+        # as high for Chinese as for Latin text (a CJK fallback font is taller): the boxes above
+        # do not move when a message appears (the run strip moved 1 px after a stop in zh_CN)
+        probe = QLabel("Ag \u505c\u6b62")
+        probe.setFont(self.status.font())
+        self.status.setFixedHeight(probe.sizeHint().height())
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 6)
-        layout.addWidget(self.outer_splitter, 1)
+        layout.setSpacing(4)
+        layout.addWidget(self.arrangement, 1)
         layout.addWidget(self.status)
 
     def retranslate(self) -> None:
@@ -244,7 +261,7 @@ class PlannerPanel(QWidget):
         self.plans_box.retranslate()
         self.run_box.retranslate()
         self.segments_box.retranslate()
-        self.preview_box.setTitle(self.tr("Preview"))
+        self.arrangement.retranslate()
         self.checks_bar.retranslate()
         self._plans.retranslate()
         self.segments.retranslate()
@@ -353,7 +370,9 @@ class PlannerPanel(QWidget):
 
     def recheck(self) -> None:
         """Checks, estimates and preview of the plan on display."""
-        self.checks.recheck(self.current_plan(), self._selected_index())
+        plan = self.current_plan()
+        self.segments_box.set_plan_name(plan.name if plan is not None else "")
+        self.checks.recheck(plan, self._selected_index())
         self._update_actions()
 
     def _selected_index(self) -> int | None:

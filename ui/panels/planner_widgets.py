@@ -7,10 +7,11 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 from PySide6.QtCore import QAbstractItemModel, QModelIndex, QPersistentModelIndex, Qt
-from PySide6.QtGui import QAction
+from PySide6.QtGui import QAction, QFontMetrics, QResizeEvent
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QComboBox,
+    QFrame,
     QGridLayout,
     QGroupBox,
     QHBoxLayout,
@@ -19,7 +20,6 @@ from PySide6.QtWidgets import (
     QProgressBar,
     QPushButton,
     QSizePolicy,
-    QSplitter,
     QStyledItemDelegate,
     QStyleOptionViewItem,
     QTableView,
@@ -50,7 +50,7 @@ from ui.models.plan_model import PlanListModel
 from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
 from ui.palette import COLOR_ERROR, COLOR_INFO, COLOR_OK, COLOR_WARN, COLOR_WARN_TEXT
-from ui.touch import RowsScrollArea, mark_motion
+from ui.touch import mark_motion
 from ui.widgets.lines_label import LinesLabel
 
 ModelIndex = QModelIndex | QPersistentModelIndex
@@ -66,7 +66,8 @@ STATUS_COLOURS: dict[Level, str] = {**SUMMARY_COLOURS, Level.WARN: COLOR_WARN_TE
 
 
 RUN_LABEL_LINES = 2
-SEGMENT_BUTTONS_PER_ROW = 5
+RESUME_FROM_MIN_WIDTH = 120  # px: "Resume from segment 12, loop 3" has half the run strip
+SEGMENT_BUTTONS_PER_ROW = 6  # Plans (show / hide the list) and the five segment edits
 SUMMARY_MIN_WIDTH = 120  # px, the checks' summary beside Upload now / Check (it wraps)
 PLAN_LIST_MIN_ROWS = 2  # the plan list scrolls below this; the run box keeps its room
 
@@ -141,10 +142,13 @@ class PointRefDelegate(QStyledItemDelegate):
         model.setData(index, editor.itemData(found) if found >= 0 else text, Qt.ItemDataRole.EditRole)
 
 
-class PlanRunBox(QGroupBox):
-    """Run, Run from here / Step, Stop / Pause, Resume / Resume from k, and the run's progress.
+class PlanRunBox(QFrame):
+    """Run, Run from here, Step, Pause, Resume and Stop in one row; under them Resume from k and
+    how the run goes (progress, and the outcome in :data:`RUN_LABEL_LINES` lines).
 
-    Two buttons a row: the box stays narrow enough to sit beside the plans and the segments."""
+    A strip across the planner's width: it never scrolls, and nothing in it moves when a stop
+    shows Resume from k (its place is kept while it is hidden) or a long reason (the label's
+    height is fixed; the whole text is in its tooltip and the planner's status line)."""
 
     def __init__(
         self,
@@ -158,36 +162,51 @@ class PlanRunBox(QGroupBox):
         parent: QWidget | None = None,
     ) -> None:
         super().__init__(parent)
+        self.setObjectName("PlanRunBox")
+        self.setFrameShape(QFrame.Shape.StyledPanel)  # no title: the buttons say what it is
         stop_button = action_button(stop, bold=True)
         stop_button.setStyleSheet(f"QToolButton:enabled {{ color: {COLOR_ERROR}; }}")
         buttons = QGridLayout()
         buttons.setSpacing(3)
-        rows = (
-            (action_button(run, bold=True), action_button(run_from)),
-            (action_button(step), stop_button),
-            (action_button(pause), action_button(resume)),
+        row = (
+            action_button(run, bold=True),
+            action_button(run_from),
+            action_button(step),
+            action_button(pause),
+            action_button(resume),
+            stop_button,
         )
-        for row, pair in enumerate(rows):
-            for column, button in enumerate(pair):
-                mark_motion(button)
-                buttons.addWidget(button, row, column)
+        for column, button in enumerate(row):
+            mark_motion(button)
+            buttons.addWidget(button, 0, column)
+            buttons.setColumnStretch(column, 1)
         self.resume_from_button = action_button(resume_from)
         mark_motion(self.resume_from_button)
+        policy = self.resume_from_button.sizePolicy()
+        policy.setRetainSizeWhenHidden(True)  # a stop shows it: nothing beside it moves
+        policy.setHorizontalPolicy(QSizePolicy.Policy.Ignored)  # its width: the grid's, not its text's
+        self.resume_from_button.setSizePolicy(policy)
+        self.resume_from_button.setMinimumWidth(RESUME_FROM_MIN_WIDTH)
+        self.resume_from_button.hide()  # until a stopped run can be resumed
         # the outcome of a run (a stop's reason can be long) gets room for RUN_LABEL_LINES
         # lines from the start, so the box does not grow over its neighbours after a stop
         self.run_label = LinesLabel(RUN_LABEL_LINES, self)
         self.run_progress = QProgressBar(self)
         self.run_progress.setTextVisible(False)
         self.run_progress.setMaximumHeight(10)
+        how = QVBoxLayout()
+        how.setSpacing(2)
+        how.addWidget(self.run_progress)
+        how.addWidget(self.run_label)
+        buttons.addWidget(self.resume_from_button, 1, 0, 1, 3, Qt.AlignmentFlag.AlignTop)
+        buttons.addLayout(how, 1, 3, 1, 3)
         layout = QVBoxLayout(self)
+        layout.setContentsMargins(4, 4, 4, 4)
         layout.addLayout(buttons)
-        layout.addWidget(self.resume_from_button)
-        layout.addWidget(self.run_progress)
-        layout.addWidget(self.run_label)
-        layout.addStretch(1)  # a tall box keeps its buttons at the top
+        self.setSizePolicy(QSizePolicy.Policy.Preferred, QSizePolicy.Policy.Fixed)
 
     def retranslate(self) -> None:
-        self.setTitle(self.tr("Run"))
+        pass  # the buttons' words are their actions'; the strip has no title (its height is the table's)
 
     def show_progress(self, progress: RunProgress) -> None:
         loops = self.tr("endless") if progress.loops == 0 else str(progress.loops)
@@ -224,8 +243,8 @@ class PlanRunBox(QGroupBox):
 
 
 class PlanChecksBar(QWidget):
-    """The checks under the segment table (wrapped to the room left), Upload now and Check on
-    their right: one row, the table keeps the height."""
+    """The checks across the planner under the segment table and the preview (wrapped at word
+    boundaries to the whole width), Upload now and Check on their right."""
 
     def __init__(
         self, upload: Callable[[], None], check: Callable[[], None], parent: QWidget | None = None
@@ -334,15 +353,14 @@ SEGMENT_COLUMN_WIDTHS: dict[int, int] = {
 
 
 class SegmentEditorBox(QGroupBox):
-    """The segment table (combo-box editors for kind, orientation and points), its buttons
-    above and the checks bar below."""
+    """The segment table (combo-box editors for kind, orientation and points) and its buttons
+    above it (the checks bar is under the table and the preview: :mod:`ui.panels.planner_layout`)."""
 
     def __init__(
         self,
         segments: SegmentTableModel,
         points: PointsModel,
         actions: Sequence[QAction],
-        checks_bar: PlanChecksBar,
         parent: QWidget | None = None,
     ) -> None:
         super().__init__(parent)
@@ -383,44 +401,27 @@ class SegmentEditorBox(QGroupBox):
         layout = QVBoxLayout(self)
         layout.addLayout(buttons)
         layout.addWidget(view, 1)
-        layout.addWidget(checks_bar)
+
+        self._plan_name = ""
+        self.setProperty("elide", True)  # the plan's name is elided in the title, whole in the tooltip
 
     def retranslate(self) -> None:
-        self.setTitle(self.tr("Segments"))
+        self._show_title()
 
+    def set_plan_name(self, name: str) -> None:
+        """The plan on display, named in the title (the plans list can be hidden)."""
+        self._plan_name = name
+        self._show_title()
 
-def planner_splitters(
-    parent: QWidget, plans_box: QWidget, run_box: QWidget, segments_box: QWidget, preview_box: QWidget
-) -> tuple[QSplitter, QSplitter]:
-    """A narrow left column with the plans above the run box (the order of the work), and the
-    work column: the segment table above the preview. At 1280×800 the work tab is only ~600 px
-    wide: three boxes side by side left the segment table 180 px wide with one row showing; this
-    way it gets all but the left column's width and half the height. Returns (work column, outer)."""
-    left = QSplitter(Qt.Orientation.Vertical, parent)
-    left.setObjectName("PlannerLeftColumn")
-    left.addWidget(plans_box)
-    run_scroll = RowsScrollArea(run_box, parent)  # scrolls only with touch-size buttons on 800 px
-    run_scroll.setObjectName("PlanRunScroll")
-    left.addWidget(run_scroll)
-    left.setStretchFactor(0, 1)
-    left.setStretchFactor(1, 0)
-    left.setChildrenCollapsible(False)
-    left.setHandleWidth(4)
-    work = QSplitter(Qt.Orientation.Vertical, parent)
-    work.setObjectName("PlannerWorkColumn")
-    work.addWidget(segments_box)
-    work.addWidget(preview_box)
-    work.setStretchFactor(0, 1)
-    work.setStretchFactor(1, 1)
-    work.setSizes([320, 280])  # a few segment rows first, then the projections
-    work.setChildrenCollapsible(False)
-    work.setHandleWidth(4)
-    outer = QSplitter(Qt.Orientation.Horizontal, parent)
-    outer.addWidget(left)
-    outer.addWidget(work)
-    outer.setStretchFactor(0, 0)
-    outer.setStretchFactor(1, 1)
-    outer.setSizes([220, 1000])
-    outer.setChildrenCollapsible(False)
-    outer.setHandleWidth(4)  # every pixel counts on a 1280 px screen
-    return work, outer
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        super().resizeEvent(event)
+        self._show_title()
+
+    def _show_title(self) -> None:
+        name = self._plan_name
+        title = self.tr("Segments of \u201c{plan}\u201d").format(plan=name) if name else self.tr("Segments")
+        metrics = QFontMetrics(self.font())
+        room = self.width() - 4 * metrics.horizontalAdvance(" ") - 16
+        shown = metrics.elidedText(title, Qt.TextElideMode.ElideRight, max(room, 40))
+        self.setTitle(shown)
+        self.setToolTip(title if shown != title else "")
