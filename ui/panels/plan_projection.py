@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtCore import QMarginsF, QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QTransform
 from PySide6.QtWidgets import QGraphicsItem, QGraphicsSimpleTextItem
 
@@ -43,6 +43,7 @@ if TYPE_CHECKING:
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
 PLOT_MIN_SIDE = 200  # px: each projection the planner shows is at least this wide and high
 MIN_LABEL_SPACING_PX = 44  # between two labelled ticks of the X axis: "-1200" and a gap
+LABEL_MARGIN_PX = 4  # round a label's text: off its point's dot, apart from its neighbours
 
 #: Where a point's label goes (the label's corner at the point, as fractions of its width and
 #: height from its top left), first free one first: above right, above left, below right, below left.
@@ -222,7 +223,8 @@ class Projection:
         taken: list[QRectF] = []
         for i, (x, y) in enumerate(self._label_at):
             label = self._slots[i]
-            size = label.boundingRect().size()
+            text = label.boundingRect().size()
+            size = text.grownBy(QMarginsF(*(LABEL_MARGIN_PX,) * 4))
             at = view.mapViewToScene(QPointF(x, y))
             free = None
             for ax, ay in LABEL_ANCHORS:
@@ -235,7 +237,9 @@ class Projection:
                     break
             if free is not None:
                 # in the label's own (pixel) coordinates: its corner ``free`` at its position
-                shift = QTransform.fromTranslate(-size.width() * free[0], -size.height() * free[1])
+                shift = QTransform.fromTranslate(
+                    LABEL_MARGIN_PX - size.width() * free[0], LABEL_MARGIN_PX - size.height() * free[1]
+                )
                 if label.transform() != shift:
                     label.setTransform(shift)
             label.setVisible(free is not None)
