@@ -81,10 +81,10 @@ def each_view(panel: PlannerPanel) -> list[Projection]:
 def label_boxes(projection: Projection) -> list[tuple[str, QRectF]]:
     """The shown point labels of ``projection`` and where they are on screen (scene pixels)."""
     boxes = []
+    to_screen = projection.plot.viewportTransform()
     for label in projection.labels:
-        if label.isVisible():
-            label.updateTransform(force=True)  # as painted (pyqtgraph does it just before a paint)
-            boxes.append((label.textItem.toPlainText(), label.mapRectToScene(label.boundingRect())))
+        if label.isVisible():  # where Qt paints it (its size in pixels, whatever the zoom)
+            boxes.append((label.text(), label.deviceTransform(to_screen).mapRect(label.boundingRect())))
     return boxes
 
 

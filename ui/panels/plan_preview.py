@@ -471,6 +471,8 @@ class PlanPreview(QWidget):
         """Draw the TCP from :meth:`on_pose` (throttled) until :meth:`stop_live`."""
         self._trail[:] = np.nan
         self._trail_count = 0
+        for proj in self._projections.values():
+            proj.trail.setData([], [])  # a new trail (the last run's is gone)
         self._live_wanted = True
         self._paint_live()
         if self.isVisible() and not self._live_timer.isActive():
@@ -519,7 +521,10 @@ class PlanPreview(QWidget):
         end = k + 1 + TRAIL_LENGTH if self._trail_count > TRAIL_LENGTH else k + 1
         view = self._trail[end - n : end]
         for proj in self._projections.values():
-            proj.trail.setData(view[:, proj.h], view[:, proj.v])
+            # copies: pyqtgraph keeps the arrays it is given, and the ring buffer is written
+            # again (and refilled with NaN by a new run): a curve whose data turned all NaN
+            # under it raised in its paint (pyqtgraph 0.14 arrayToLineSegments)
+            proj.trail.setData(view[:, proj.h].copy(), view[:, proj.v].copy())
         if self._last_tcp is not None:
             self._paint_tcp(self._last_tcp)
 

@@ -2,6 +2,14 @@
 preview (fixed axes, locked aspect) and the items drawn on it: the path, the selected segment,
 the points and their labels, the start, the live TCP and its trail, the safety envelope's boxes.
 pyqtgraph is imported when a projection is built (the planner is a hidden tab at start).
+
+The point labels are plain Qt items (``QGraphicsSimpleTextItem``, no Python ``paint``), made once
+per projection and label slot and reused (new text, position, shown / hidden), never pyqtgraph
+``TextItem``s removed and re-created at each plan change: with PySide6 6.11.2/6.11.3 a Python
+exception pending while Qt paints a *new* item with a Python ``paint`` (an exception from another
+item's ``paint``) makes shiboken release a reference it does not own to the class's ``paint``
+function — re-created labels drained ``TextItem.paint`` until it was freed (a segfault). See
+``tests/ui/panels/test_plan_labels_crash.py``.
 """
 
 from __future__ import annotations
@@ -12,7 +20,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtCore import QMarginsF, QPointF, QRectF, Qt
+from PySide6.QtGui import QBrush, QColor, QTransform
+from PySide6.QtWidgets import QGraphicsItem, QGraphicsSimpleTextItem
 
 from ui.palette import (
     COLOR_AXIS,
@@ -33,9 +43,10 @@ if TYPE_CHECKING:
 MAX_LABELS = 40  # point labels drawn (more would clutter and cost)
 PLOT_MIN_SIDE = 200  # px: each projection the planner shows is at least this wide and high
 MIN_LABEL_SPACING_PX = 44  # between two labelled ticks of the X axis: "-1200" and a gap
+LABEL_MARGIN_PX = 4  # round a label's text: off its point's dot, apart from its neighbours
 
-#: Where a point's label goes (pyqtgraph anchors: the label's corner at the point), first free
-#: one first: above right, above left, below right, below left.
+#: Where a point's label goes (the label's corner at the point, as fractions of its width and
+#: height from its top left), first free one first: above right, above left, below right, below left.
 LABEL_ANCHORS: tuple[tuple[float, float], ...] = ((0.0, 1.0), (1.0, 1.0), (0.0, 0.0), (1.0, 0.0))
 
 FloatArray = NDArray[np.float64]
@@ -143,8 +154,9 @@ class Projection:
         # the safety envelope (added at the first envelope): each box's 12 edges projected, dashed
         self.keep_in: pg.PlotCurveItem | None = None
         self.keep_out: pg.PlotCurveItem | None = None
-        self.labels: list[pg.TextItem] = []
-        self._label_at: list[tuple[float, float]] = []  # each label's point (view coordinates)
+        # label slots, made as needed (at most MAX_LABELS) and kept: the first len(_label_at) are used
+        self._slots: list[QGraphicsSimpleTextItem] = []
+        self._label_at: list[tuple[float, float]] = []  # each used label's point (view coordinates)
         plot.getViewBox().sigTransformChanged.connect(self.place_labels)
         for z, item in enumerate((self.path, self.selected, self.points, self.start, self.trail, self.tcp)):
             item.setZValue(z)
@@ -169,21 +181,36 @@ class Projection:
         self.keep_out.setData(keep_out[:, self.h], keep_out[:, self.v])
 
     def set_labels(self, xyz: FloatArray, texts: Sequence[str]) -> None:
-        import pyqtgraph as pg
-
-        for label in self.labels:
-            self.plot.removeItem(label)
-        self.labels = []
+        """Label the first :data:`MAX_LABELS` points; the label items are reused (see the module
+        docstring), the ones not needed are hidden."""
         self._label_at = []
-        for row, text in zip(xyz[:MAX_LABELS], texts[:MAX_LABELS], strict=False):
-            label = pg.TextItem(text, color=COLOR_INK_SOFT, anchor=LABEL_ANCHORS[0])
+        for i, (row, text) in enumerate(zip(xyz[:MAX_LABELS], texts[:MAX_LABELS], strict=False)):
+            label = self._label(i)
             at = (float(row[self.h]), float(row[self.v]))
+            label.setText(text)
             label.setPos(*at)
-            label.setZValue(10)
-            self.plot.addItem(label)
-            self.labels.append(label)
             self._label_at.append(at)
+        for label in self._slots[len(self._label_at) :]:
+            label.setVisible(False)
         self.place_labels()
+
+    def _label(self, i: int) -> QGraphicsSimpleTextItem:
+        """Label slot ``i``, made (once) on first use."""
+        while len(self._slots) <= i:
+            label = QGraphicsSimpleTextItem()
+            label.setBrush(QBrush(QColor(COLOR_INK_SOFT)))
+            # its size in pixels whatever the zoom, its position a point of the plot
+            label.setFlag(QGraphicsItem.GraphicsItemFlag.ItemIgnoresTransformations)
+            label.setZValue(10)
+            label.setVisible(False)
+            self.plot.getViewBox().addItem(label, ignoreBounds=True)
+            self._slots.append(label)
+        return self._slots[i]
+
+    @property
+    def labels(self) -> list[QGraphicsSimpleTextItem]:
+        """The labels of the points (shown, or hidden where they would cover another)."""
+        return self._slots[: len(self._label_at)]
 
     def place_labels(self) -> None:
         """Give each label the first corner of its point where it covers no label placed before
@@ -194,8 +221,10 @@ class Projection:
         as the operator zooms in."""
         view = self.plot.getViewBox()
         taken: list[QRectF] = []
-        for label, (x, y) in zip(self.labels, self._label_at, strict=True):
-            size = label.textItem.boundingRect().size()
+        for i, (x, y) in enumerate(self._label_at):
+            label = self._slots[i]
+            text = label.boundingRect().size()
+            size = text.grownBy(QMarginsF(*(LABEL_MARGIN_PX,) * 4))
             at = view.mapViewToScene(QPointF(x, y))
             free = None
             for ax, ay in LABEL_ANCHORS:
@@ -206,6 +235,11 @@ class Projection:
                     free = (ax, ay)
                     taken.append(box)
                     break
-            if free is not None and tuple(label.anchor) != free:
-                label.setAnchor(free)
+            if free is not None:
+                # in the label's own (pixel) coordinates: its corner ``free`` at its position
+                shift = QTransform.fromTranslate(
+                    LABEL_MARGIN_PX - size.width() * free[0], LABEL_MARGIN_PX - size.height() * free[1]
+                )
+                if label.transform() != shift:
+                    label.setTransform(shift)
             label.setVisible(free is not None)
